@@ -1,0 +1,44 @@
+# pinarms — the two commands a user needs: `make demo` and `make test`.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.pinarms-installed
+
+.PHONY: install demo demo-quick test browser urdf bench clean
+
+# Create .venv if missing and install the project with its test and benchmark extras.
+# Idempotent: re-runs pip only when pyproject.toml changed.
+install: $(STAMP)
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test,bench]"
+	touch $(STAMP)
+
+# Debian's chromium for the browser tests (never a downloaded browser build).
+browser:
+	@if [ -x /usr/bin/chromium ]; then :; \
+	elif [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null; then \
+		echo "installing Debian's chromium for the browser tests"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; \
+	else echo "note: /usr/bin/chromium missing and cannot apt-get install it: browser tests will be skipped"; fi
+
+demo: install
+	$(VENV)/bin/pinarms demo --out demo-output
+
+demo-quick: install
+	$(VENV)/bin/pinarms demo --quick --out demo-output
+
+test: install browser
+	$(PY) -m pytest -q tests
+
+# Regenerate urdf/*.urdf from robots/xacro/*.xacro.
+urdf: install
+	$(VENV)/bin/pinarms urdf build
+
+bench: install
+	for f in benchmarks/*.py; do echo "== $$f"; $(PY) $$f || exit 1; done
+
+clean:
+	rm -rf $(VENV) demo-output .pytest_cache build *.egg-info

@@ -1,0 +1,42 @@
+"""Exceptions of pinarms.
+
+Every error pinarms raises on purpose derives from :class:`PinarmsError`, so a caller
+can catch the whole family with one ``except``. The base lives here, in the bottom
+package of the one-way flow (robots → planning → optim → viz), and the packages above
+derive their own errors from it.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "PinarmsError",
+    "InvalidInput",
+    "RobotNotFound",
+    "ModelError",
+    "UnreachableTarget",
+    "LimitViolation",
+]
+
+
+class PinarmsError(Exception):
+    """Base of every error pinarms raises on purpose."""
+
+
+class InvalidInput(PinarmsError, ValueError):
+    """An argument has the wrong shape, type or value (NaN, inf, negative count, ...)."""
+
+
+class RobotNotFound(PinarmsError, LookupError):
+    """A robot name is not known to :func:`robots.load`."""
+
+
+class ModelError(PinarmsError):
+    """A robot description (xacro or URDF) is malformed or cannot be modelled."""
+
+
+class UnreachableTarget(PinarmsError):
+    """No configuration within the joint limits reaches the requested target."""
+
+
+class LimitViolation(PinarmsError):
+    """A configuration or trajectory violates the robot's limits."""
