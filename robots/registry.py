@@ -1,0 +1,251 @@
+"""Robots by name: the built-in arms of the four papers and example-robot-data's arms.
+
+``load(name)`` is the one entry point, like ``robot_descriptions``; ``names()`` lists
+what it accepts; ``from_urdf(path)`` loads any other URDF.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import importlib.resources
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import pinocchio as pin
+
+from .errors import InvalidInput, ModelError, RobotNotFound
+from .robot import Robot
+
+__all__ = ["load", "names", "from_urdf", "from_urdf_text", "builtin_names", "RobotInfo", "info"]
+
+
+@dataclass(frozen=True)
+class RobotInfo:
+    """What the registry knows about a robot name."""
+
+    name: str
+    source: str  # "pinarms" (built-in, generated from robots/xacro) or "example-robot-data"
+    description: str
+    urdf_relpath: str  # inside urdf/ (built-in) or example-robot-data's robots/ folder
+    tcp: str = "tcp"
+    frozen_joints: tuple[str, ...] = ()  # joints fixed at zero (grippers of example robots)
+
+
+_BUILTIN = {
+    info.name: info
+    for info in (
+        RobotInfo("scara_mushroom", "pinarms", "4-axis SCARA of an enoki-mushroom packing line (seed 000)", "scara_mushroom.urdf"),
+        RobotInfo("aubo_i3", "pinarms", "AUBO-i3 6-axis collaborative arm handling food (seed 001)", "aubo_i3.urdf"),
+        RobotInfo("gantry_flower", "pinarms", "3-axis Cartesian gantry packing flowers (seed 002)", "gantry_flower.urdf"),
+        RobotInfo("koji_turner", "pinarms", "suspended koji-block turning arm with a parallelogram (seed 004)", "koji_turner.urdf"),
+        RobotInfo("koji_turner_rail", "pinarms", "koji turning arm on its two overhead-rail slides (seed 004)", "koji_turner_rail.urdf"),
+    )
+}
+
+_EXAMPLE = {
+    info.name: info
+    for info in (
+        RobotInfo("ur3", "example-robot-data", "Universal Robots UR3", "ur_description/urdf/ur3_robot.urdf", tcp="tool0"),
+        RobotInfo("ur5", "example-robot-data", "Universal Robots UR5", "ur_description/urdf/ur5_robot.urdf", tcp="tool0"),
+        RobotInfo("ur10", "example-robot-data", "Universal Robots UR10", "ur_description/urdf/ur10_robot.urdf", tcp="tool0"),
+        RobotInfo(
+            "panda",
+            "example-robot-data",
+            "Franka Emika Panda, 7 DoF (fingers fixed)",
+            "panda_description/urdf/panda.urdf",
+            tcp="panda_hand_tcp",
+            frozen_joints=("panda_finger_joint1", "panda_finger_joint2"),
+        ),
+    )
+}
+
+
+def builtin_names() -> list[str]:
+    """Names of the arms defined by pinarms itself."""
+    return list(_BUILTIN)
+
+
+def names() -> list[str]:
+    """Every name :func:`load` accepts."""
+    return list(_BUILTIN) + list(_EXAMPLE)
+
+
+def info(name: str) -> RobotInfo:
+    """Registry entry of ``name``; raises :class:`RobotNotFound` listing the known names."""
+    if name in _BUILTIN:
+        return _BUILTIN[name]
+    if name in _EXAMPLE:
+        return _EXAMPLE[name]
+    raise RobotNotFound(f"unknown robot {name!r}; known robots: {', '.join(names())} (or use robots.from_urdf(path))")
+
+
+@lru_cache(maxsize=1)
+def _example_robot_data_share() -> Path:
+    """The installed ``share/example-robot-data`` folder (example-robot-data ships no Python loader)."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError as exc:  # pragma: no cover - a dependency
+        raise RobotNotFound("example-robot-data is not installed: pip install example-robot-data") from exc
+    for f in dist.files or ():
+        parts = Path(str(f)).parts
+        if "example-robot-data" in parts and "robots" in parts:
+            full = Path(dist.locate_file(f))
+            idx = full.parts.index("example-robot-data")
+            return Path(*full.parts[: idx + 1])
+    raise RobotNotFound("example-robot-data is installed but ships no robots/ folder")
+
+
+def builtin_urdf_path(name: str) -> Path:
+    """Path of the committed URDF of built-in arm ``name``."""
+    entry = info(name)
+    if entry.source != "pinarms":
+        raise RobotNotFound(f"{name!r} is not a built-in pinarms arm; built-ins: {', '.join(_BUILTIN)}")
+    return Path(str(importlib.resources.files("urdf") / entry.urdf_relpath))
+
+
+def load(name: str) -> Robot:
+    """Load a robot by name (see :func:`names`).
+
+    Raises:
+        RobotNotFound: the name is unknown (the message lists the known names).
+    """
+    if not isinstance(name, str):
+        raise InvalidInput(f"robot name must be a string, got {name!r}")
+    entry = info(name)
+    if entry.source == "pinarms":
+        path = builtin_urdf_path(name)
+        if not path.exists():
+            raise ModelError(f"the URDF of {name!r} is missing ({path.name}); regenerate it with `pinarms urdf build`")
+        robot = from_urdf(path, tcp=entry.tcp, name=name, description=entry.description)
+    else:
+        share = _example_robot_data_share()
+        path = share / "robots" / entry.urdf_relpath
+        robot = from_urdf(
+            path,
+            tcp=entry.tcp,
+            name=name,
+            package_dirs=(str(share.parent),),
+            freeze=entry.frozen_joints,
+            description=entry.description,
+        )
+    from .ik import attach_analytic_ik  # late import: ik solvers need the Robot class
+
+    attach_analytic_ik(robot)
+    return robot
+
+
+def _freeze_joints(root: ET.Element, freeze: tuple[str, ...], source: str) -> None:
+    """Turn the named joints into fixed joints at their zero position (mimics of them too)."""
+    joints = {j.get("name"): j for j in root.iter("joint")}
+    for jname in freeze:
+        if jname not in joints:
+            raise ModelError(f"{source}: cannot freeze joint {jname!r}: no such joint")
+    for j in root.iter("joint"):
+        mimic = j.find("mimic")
+        if j.get("name") in freeze or (mimic is not None and mimic.get("joint") in freeze):
+            if mimic is not None and float(mimic.get("offset", 0.0)) != 0.0:
+                raise ModelError(f"{source}: cannot freeze mimic joint {j.get('name')!r} with a non-zero offset")
+            j.set("type", "fixed")
+            for child in list(j):
+                if child.tag in ("mimic", "limit", "axis", "dynamics", "safety_controller"):
+                    j.remove(child)
+
+
+def from_urdf_text(
+    urdf_text: str,
+    *,
+    tcp: str | None = None,
+    name: str | None = None,
+    source: str = "<string>",
+    urdf_path: Path | None = None,
+    package_dirs: tuple[str, ...] = (),
+    freeze: tuple[str, ...] = (),
+    description: str = "",
+) -> Robot:
+    """Build a :class:`Robot` from URDF text (see :func:`from_urdf`)."""
+    try:
+        root = ET.fromstring(urdf_text)
+    except ET.ParseError as exc:
+        raise ModelError(f"{source} is not well-formed XML: {exc}") from exc
+    if root.tag != "robot":
+        raise ModelError(f"{source} is not a URDF: its root element is <{root.tag}>, expected <robot>")
+    if not root.findall("link"):
+        raise ModelError(f"{source} defines no <link>")
+    if freeze:
+        _freeze_joints(root, tuple(freeze), source)
+        urdf_text = ET.tostring(root, encoding="unicode")
+    try:
+        model = pin.buildModelFromXML(urdf_text, mimic=True)
+    except Exception as exc:  # pinocchio raises RuntimeError/ValueError with its own message
+        raise ModelError(f"Pinocchio cannot build a model from {source}: {exc}") from exc
+    if model.nv == 0:
+        raise ModelError(f"{source} has no movable joint")
+    if tcp is None:
+        tcp = "tcp" if model.existFrame("tcp") else _last_body_frame(model)
+    return Robot(
+        model,
+        name=name or root.get("name", "robot"),
+        urdf_text=urdf_text,
+        urdf_path=urdf_path,
+        package_dirs=package_dirs,
+        tcp_frame=tcp,
+        description=description,
+    )
+
+
+def from_urdf(
+    path: str | Path,
+    tcp: str | None = None,
+    *,
+    name: str | None = None,
+    package_dirs: tuple[str, ...] = (),
+    freeze: tuple[str, ...] = (),
+    description: str = "",
+) -> Robot:
+    """Load any URDF file.
+
+    Args:
+        path: the URDF file.
+        tcp: frame used as ``"tcp"``; default: a frame named ``tcp`` if there is one, else
+            the last link of the kinematic tree.
+        name: robot name (default: the URDF's ``<robot name>``).
+        package_dirs: folders that resolve ``package://`` mesh paths (for the viewer).
+        freeze: joints to fix at zero (e.g. gripper fingers).
+
+    Raises:
+        ModelError: the file is missing, not XML, not a URDF, or Pinocchio rejects it.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ModelError(f"cannot read URDF file {str(path)!r}: {exc.strerror or exc}") from exc
+    if not package_dirs:
+        package_dirs = (str(path.parent),)
+    return from_urdf_text(
+        text,
+        tcp=tcp,
+        name=name,
+        source=str(path),
+        urdf_path=path,
+        package_dirs=tuple(package_dirs),
+        freeze=tuple(freeze),
+        description=description,
+    )
+
+
+def _last_body_frame(model: pin.Model) -> str:
+    """The body frame deepest in the tree (most ancestors), last defined on ties."""
+    best, best_depth = None, -1
+    for f in model.frames:
+        if f.type != pin.FrameType.BODY:
+            continue
+        depth, j = 0, f.parentJoint
+        while j > 0:
+            depth += 1
+            j = model.parents[j]
+        if depth >= best_depth:
+            best, best_depth = f.name, depth
+    return best
