@@ -1,0 +1,35 @@
+"""Optimisation: a genetic algorithm written here, and segment timing of trajectories.
+
+The GA engine (:func:`run_ga`, :class:`GASettings`, operators in ``selection``,
+``crossover``, ``mutation``, ``adaptive``, ``constraints``) minimises vectorised
+objectives over a box and knows nothing about trajectories. The timing layer
+(:class:`TimingProblem`, :func:`minimize_time`, :func:`minimize_time_jerk`) turns segment
+durations of a planning trajectory into objective and constraint arrays, and checks every
+GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
+limit along the same path (:mod:`optim.reference`).
+"""
+
+from optim.engine import GAHistory, GAProgress, GAResult, run_ga
+from optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
+from optim.exact import ExactSolution, solve_exact
+from optim.problem import KINDS, TimingProblem
+from optim.settings import GASettings
+from optim.timing import TimingResult, minimize_time
+
+__all__ = [
+    "run_ga",
+    "GASettings",
+    "GAResult",
+    "GAHistory",
+    "GAProgress",
+    "TimingProblem",
+    "KINDS",
+    "TimingResult",
+    "minimize_time",
+    "ExactSolution",
+    "solve_exact",
+    "OptimError",
+    "InfeasibleProblem",
+    "InvalidLimits",
+    "InvalidSettings",
+]

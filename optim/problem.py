@@ -1,0 +1,255 @@
+"""The segment-timing problem: turns segment durations into peaks, constraints, totals.
+
+A :class:`TimingProblem` holds via points (m+1, n_joints), a trajectory family and
+per-joint limits. For durations ``h`` (m,) it builds the trajectory with knot times
+``[0, cumsum(h)]`` through :mod:`planning` and reads its exact peaks. It is the bridge
+between trajectories and the optimisers: the GA sees only arrays.
+
+Scaling laws used by the exact optimiser and by the final rescaling: with durations
+``s * r`` (ratios ``r``, total ``s``), peak velocity scales as 1/s, acceleration as
+1/s**2 and jerk as 1/s**3 (time scaling of the same curve), so the smallest feasible
+total for given ratios is::
+
+    s*(r) = max_j max( v_j(r) / V_j, sqrt(a_j(r) / A_j), cbrt(k_j(r) / J_j) )
+
+where ``v, a, k`` are the peaks at total 1.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Protocol
+
+import numpy as np
+
+from robots.errors import InvalidInput
+from optim.errors import InvalidLimits, InvalidSettings
+
+__all__ = ["TimingProblem", "KINDS", "Builder", "check_limit"]
+
+#: Trajectory families known to :func:`optim.minimize_time`.
+KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
+
+#: Relative margin under the limits kept by rescaled answers (round-off safety).
+SAFETY = 1e-9
+
+
+class _PeaksLike(Protocol):
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    jerk: np.ndarray
+
+
+class _TrajectoryLike(Protocol):
+    def peaks(self) -> _PeaksLike: ...
+
+
+#: Maps (knot times (m+1,), positions (m+1, n)) to a trajectory with ``peaks()``.
+Builder = Callable[[np.ndarray, np.ndarray], Any]
+
+
+def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndarray | None:
+    """A per-joint limit (scalar or (n_joints,)) as a (n_joints,) positive finite array.
+
+    Raises :class:`InvalidLimits` for <= 0, NaN/inf, or a wrong shape; returns None for
+    an optional limit left out.
+    """
+    if value is None:
+        if required:
+            raise InvalidLimits(f"{name} is required: give a positive limit per joint (SI units)")
+        return None
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidLimits(f"{name}={value!r} is not numeric: give a positive number per "
+                            "joint") from exc
+    if arr.ndim > 1 or (arr.ndim == 1 and arr.size not in (1, n_joints)):
+        raise InvalidLimits(f"{name} has shape {arr.shape}: give a scalar or {n_joints} values "
+                            "(one per joint)")
+    arr = np.broadcast_to(arr.reshape(-1) if arr.ndim else arr, (n_joints,)).astype(float)
+    if not np.all(np.isfinite(arr)):
+        raise InvalidLimits(f"{name}={arr.tolist()} holds NaN or inf: give finite limits")
+    if np.any(arr <= 0.0):
+        raise InvalidLimits(f"{name}={arr.tolist()} must be > 0 for every joint")
+    return arr
+
+
+def _planning_builder(kind: str, options: dict[str, Any]) -> Builder:
+    import planning  # optim sits above planning in the one-way flow
+
+    if kind == "3-5-3":
+        opts = {"degrees": (3, 5, 3), **options}
+        return lambda t, q: planning.piecewise_polynomial(t, q, **opts)
+    if kind == "multi-quintic":
+        return lambda t, q: planning.multi_quintic(t, q, **options)
+    if kind == "quintic-bspline":
+        return lambda t, q: planning.quintic_bspline(t, q, **options)
+    raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of {KINDS}")
+
+
+class TimingProblem:
+    """Minimum-time (and time-jerk) timing of a trajectory through fixed via points.
+
+    Args:
+        positions: (m+1, n_joints) or (m+1,) via points, SI (rad or m).
+        kind: ``"3-5-3"``, ``"multi-quintic"`` or ``"quintic-bspline"``.
+        vmax: Velocity limit per joint (scalar or (n_joints,)), rad/s or m/s. Required.
+        amax: Acceleration limit per joint, rad/s^2 or m/s^2, or None.
+        jmax: Jerk limit per joint, rad/s^3 or m/s^3, or None.
+        bounds: Segment-duration bounds (s): (m, 2) rows, or one (lower, upper) pair for
+            all segments, or None for defaults (see :attr:`bounds`).
+        trajectory_options: Extra keyword arguments for the planning constructor (e.g.
+            ``velocities=0`` for multi-quintic rest at every via point).
+        builder: Replace the planning constructor (advanced; tests and custom families).
+    """
+
+    def __init__(self, positions: Any, kind: str, vmax: Any, amax: Any = None,
+                 jmax: Any = None, bounds: Any = None,
+                 trajectory_options: dict[str, Any] | None = None,
+                 builder: Builder | None = None) -> None:
+        q = np.asarray(positions, dtype=float)
+        if q.ndim == 1:
+            q = q[:, None]
+        if q.ndim != 2 or q.shape[0] < 2:
+            raise InvalidInput(f"positions of shape {np.shape(positions)}: give (m+1,) or "
+                               "(m+1, n_joints) via points, at least 2")
+        if not np.all(np.isfinite(q)):
+            raise InvalidInput("positions hold NaN or inf: give finite via points (rad or m)")
+        if kind not in KINDS:
+            raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of "
+                               f"{KINDS}")
+        self.positions = q
+        self.kind = kind
+        self.n_segments = q.shape[0] - 1
+        self.n_joints = q.shape[1]
+        self.vmax = check_limit(vmax, self.n_joints, "vmax", required=True)
+        self.amax = check_limit(amax, self.n_joints, "amax", required=False)
+        self.jmax = check_limit(jmax, self.n_joints, "jmax", required=False)
+        if np.all(np.ptp(q, axis=0) == 0.0):
+            raise InvalidInput("positions do not move (all via points equal): nothing to time")
+        self.trajectory_options = dict(trajectory_options or {})
+        self._build = builder or _planning_builder(kind, self.trajectory_options)
+        self.evaluations = 0
+        self.bounds = self._check_bounds(bounds)
+
+    # -- trajectories and peaks -------------------------------------------------------
+    def knot_times(self, durations: np.ndarray) -> np.ndarray:
+        """Knot times (m+1,) (s) from segment durations (m,)."""
+        return np.concatenate([[0.0], np.cumsum(np.asarray(durations, dtype=float))])
+
+    def trajectory(self, durations: np.ndarray) -> Any:
+        """The planning trajectory for segment durations (m,) (s)."""
+        return self._build(self.knot_times(durations), self.positions)
+
+    def peaks(self, durations: np.ndarray) -> np.ndarray:
+        """Exact peaks as (3, n_joints): |velocity|, |acceleration|, |jerk| maxima."""
+        self.evaluations += 1
+        p = self.trajectory(durations).peaks()
+        return np.stack([np.asarray(p.velocity, dtype=float).reshape(-1),
+                         np.asarray(p.acceleration, dtype=float).reshape(-1),
+                         np.asarray(p.jerk, dtype=float).reshape(-1)])
+
+    def minimal_scale(self, ratios: np.ndarray) -> float:
+        """s*(r): the smallest total (s) meeting every limit with durations ``s * r``."""
+        r = np.asarray(ratios, dtype=float)
+        r = r / r.sum()
+        pk = self.peaks(r)
+        s = np.max(pk[0] / self.vmax)
+        if self.amax is not None:
+            s = max(s, float(np.max(np.sqrt(pk[1] / self.amax))))
+        if self.jmax is not None:
+            s = max(s, float(np.max(np.cbrt(pk[2] / self.jmax))))
+        return float(s)
+
+    # -- arrays for the GA --------------------------------------------------------------
+    def limit_ratios(self, durations: np.ndarray) -> np.ndarray:
+        """Peak / limit per active limit and joint, flattened (n_con,)."""
+        pk = self.peaks(durations)
+        parts = [pk[0] / self.vmax]
+        if self.amax is not None:
+            parts.append(pk[1] / self.amax)
+        if self.jmax is not None:
+            parts.append(pk[2] / self.jmax)
+        return np.concatenate(parts)
+
+    def peaks_batch(self, population: np.ndarray) -> np.ndarray:
+        """Exact peaks for a population of durations (pop, m) -> (pop, 3, n_joints).
+
+        Each individual's trajectory is built by the planning constructor (they take one
+        timing at a time); the peak search then runs once for the whole population: every
+        polynomial piece is rewritten in normalised time ``u = tau / h_i`` in [0, 1] and all
+        pieces of all joints and individuals become the columns of one single-piece
+        planning trajectory, whose exact peaks are divided by ``h_i``, ``h_i**2``,
+        ``h_i**3`` (the r-th derivative in real time is the r-th in ``u`` over ``h_i**r``).
+        """
+        h = np.atleast_2d(np.asarray(population, dtype=float))
+        pop, m = h.shape
+        trajs = [self.trajectory(row) for row in h]
+        self.evaluations += pop
+        if not all(hasattr(t, "coefficients") for t in trajs):
+            out = []
+            for t in trajs:
+                p = t.peaks()
+                out.append([p.velocity, p.acceleration, p.jerk])
+            return np.asarray(out, dtype=float).reshape(pop, 3, self.n_joints)
+        from planning.trajectory import Trajectory
+
+        coefs = np.stack([np.asarray(t.coefficients, dtype=float) for t in trajs])  # (P,m,K+1,n)
+        width = coefs.shape[2]
+        seg = np.stack([np.diff(np.asarray(t.knot_times, dtype=float)) for t in trajs])  # (P,m')
+        if coefs.shape[1] != seg.shape[1]:
+            raise InvalidInput("trajectory pieces and knot times disagree")
+        powers = seg[:, :, None] ** np.arange(width)  # (P, m', K+1)
+        normalised = coefs * powers[..., None]
+        columns = np.moveaxis(normalised, 2, -1).reshape(-1, width)  # (P*m'*n, K+1)
+        pk = Trajectory(np.array([0.0, 1.0]), columns.T[None, :, :]).peaks()
+        per = np.stack([pk.velocity, pk.acceleration, pk.jerk])  # (3, P*m'*n)
+        per = per.reshape(3, pop, seg.shape[1], self.n_joints)
+        per = per / seg[None, :, :, None] ** np.arange(1, 4)[:, None, None, None]
+        return np.moveaxis(per.max(axis=2), 0, 1)  # (P, 3, n)
+
+    def limit_ratios_batch(self, population: np.ndarray) -> np.ndarray:
+        """Peak / limit for a population (pop, m) -> (pop, n_con)."""
+        pk = self.peaks_batch(population)
+        parts = [pk[:, 0] / self.vmax]
+        if self.amax is not None:
+            parts.append(pk[:, 1] / self.amax)
+        if self.jmax is not None:
+            parts.append(pk[:, 2] / self.jmax)
+        return np.concatenate(parts, axis=1)
+
+    def constraints(self, population: np.ndarray) -> np.ndarray:
+        """``peak / limit - 1`` for a population of durations (pop, m) -> (pop, n_con).
+
+        Rows repeated in the population (elites, uncrossed copies) are computed once.
+        """
+        h = np.atleast_2d(np.asarray(population, dtype=float))
+        unique, inverse = np.unique(h, axis=0, return_inverse=True)
+        return self.limit_ratios_batch(unique)[inverse.reshape(-1)] - 1.0
+
+    def is_feasible(self, durations: np.ndarray, rtol: float = 0.0) -> bool:
+        """Whether every peak is within its limit (times 1 + rtol) and h within bounds."""
+        h = np.asarray(durations, dtype=float)
+        lo, hi = self.bounds[:, 0], self.bounds[:, 1]
+        if np.any(h < lo * (1 - 1e-12)) or np.any(h > hi * (1 + 1e-12)):
+            return False
+        return bool(np.all(self.limit_ratios(h) <= 1.0 + rtol))
+
+    # -- bounds --------------------------------------------------------------------------
+    def reference_total(self) -> float:
+        """s* for equal segment durations: a feasible total every default bound contains."""
+        return self.minimal_scale(np.full(self.n_segments, 1.0 / self.n_segments))
+
+    def _check_bounds(self, bounds: Any) -> np.ndarray:
+        m = self.n_segments
+        if bounds is None:
+            s0 = self.reference_total()
+            return np.tile([s0 / (100.0 * m), s0], (m, 1))
+        b = np.asarray(bounds, dtype=float)
+        if b.shape == (2,):
+            b = np.tile(b, (m, 1))
+        if b.shape != (m, 2):
+            raise InvalidSettings(f"bounds of shape {b.shape}: give (lower, upper) in s, or "
+                                  f"({m}, 2) rows, one per segment")
+        if not np.all(np.isfinite(b)) or np.any(b[:, 0] <= 0.0) or np.any(b[:, 0] > b[:, 1]):
+            raise InvalidSettings(f"bounds {b.tolist()}: need 0 < lower <= upper (s), finite")
+        return b.copy()

@@ -1,0 +1,169 @@
+"""Minimum-time segment timing of a trajectory through via points: GA or exact.
+
+``minimize_time`` is the user-facing entry: it builds a :class:`~optim.problem.TimingProblem`,
+solves it with the GA of this package (``method="ga"``) or with the deterministic
+scaling-law optimiser (``method="exact"``), verifies the answer with planning's exact
+peaks, and never returns an infeasible timing (it raises :class:`InfeasibleProblem`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from optim.engine import GAHistory, GAProgress, run_ga
+from optim.errors import InfeasibleProblem, InvalidSettings
+from optim.exact import solve_exact
+from optim.problem import SAFETY, TimingProblem
+from optim.settings import GASettings
+
+__all__ = ["TimingResult", "minimize_time", "finish_timing", "rescale_to_limits"]
+
+METHODS = ("ga", "exact")
+
+
+@dataclass(frozen=True)
+class TimingResult:
+    """A verified timing.
+
+    Attributes:
+        durations: (m,) segment durations (s), shared by all joints.
+        total: Their sum (s).
+        trajectory: The planning trajectory with these durations.
+        peaks: Its exact peaks (planning ``Peaks``: velocity, acceleration, jerk per joint).
+        history: GA history per generation (None for ``method="exact"``).
+        method: ``"ga"`` or ``"exact"`` (or a two-stage label for time-jerk results).
+        evaluations: Trajectories built and peaked by the optimiser.
+        wall_time: Seconds spent.
+        raw_total: GA: total of the GA's best individual before rescaling to the limits;
+            exact: equal to ``total``.
+        kind: Trajectory family.
+        stop_reason: GA stop reason ("" for exact).
+    """
+
+    durations: np.ndarray
+    total: float
+    trajectory: Any
+    peaks: Any
+    history: GAHistory | None
+    method: str
+    evaluations: int
+    wall_time: float
+    raw_total: float
+    kind: str
+    stop_reason: str = ""
+
+    @property
+    def knot_times(self) -> np.ndarray:
+        """Knot times (m+1,) (s)."""
+        return np.concatenate([[0.0], np.cumsum(self.durations)])
+
+
+def rescale_to_limits(problem: TimingProblem, durations: np.ndarray) -> np.ndarray:
+    """Scale feasible durations down (same ratios) until the first limit is reached.
+
+    Keeps the lower bounds; never scales up past the given durations.
+    """
+    h = np.asarray(durations, dtype=float)
+    s = h.sum()
+    r = h / s
+    s_new = problem.minimal_scale(r) * (1.0 + SAFETY)
+    s_new = max(s_new, float(np.max(problem.bounds[:, 0] / r)))
+    return r * min(s, s_new)
+
+
+def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
+                  history: GAHistory | None, evaluations: int, t0: float,
+                  raw_total: float, stop_reason: str = "") -> TimingResult:
+    """Build the final trajectory, verify it with its exact peaks, wrap the result."""
+    h = np.asarray(durations, dtype=float)
+    if not problem.is_feasible(h):
+        ratios = problem.limit_ratios(h)
+        raise InfeasibleProblem(
+            f"the {method} timing {np.round(h, 6).tolist()} s exceeds a limit (peak/limit up "
+            f"to {ratios.max():.6g}): no feasible timing was found; widen the bounds")
+    traj = problem.trajectory(h)
+    return TimingResult(durations=h, total=float(h.sum()), trajectory=traj, peaks=traj.peaks(),
+                        history=history, method=method, evaluations=evaluations,
+                        wall_time=time.perf_counter() - t0, raw_total=raw_total,
+                        kind=problem.kind, stop_reason=stop_reason)
+
+
+def _infeasible(problem: TimingProblem, method: str) -> InfeasibleProblem:
+    b = problem.bounds
+    return InfeasibleProblem(
+        f"no timing within the duration bounds meets the limits ({method}): segment bounds "
+        f"{np.round(b, 6).tolist()} s allow at most {b[:, 1].sum():.6g} s in all; raise the "
+        "upper bounds or relax vmax/amax/jmax")
+
+
+def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: Any = None,
+                  method: str = "ga", seed: int = 0, settings: GASettings | None = None,
+                  bounds: Any = None, *, max_generations: int | None = None,
+                  stall_generations: int | None = None, time_limit: float | None = None,
+                  rescale: bool = True, initial: Any = None,
+                  callback: Callable[[GAProgress], bool | None] | None = None,
+                  trajectory_options: dict[str, Any] | None = None,
+                  problem: TimingProblem | None = None) -> TimingResult:
+    """Shortest segment durations through via points under per-joint limits.
+
+    Minimises ``T = h_1 + ... + h_m`` subject to max|velocity| <= vmax, and optionally
+    max|acceleration| <= amax and max|jerk| <= jmax, for every joint over the whole
+    trajectory (exact peaks), with the same durations for all joints.
+
+    Args:
+        positions: (m+1, n_joints) or (m+1,) via points (rad or m).
+        kind: ``"3-5-3"``, ``"multi-quintic"`` or ``"quintic-bspline"``.
+        vmax, amax, jmax: Limits per joint (scalar or (n_joints,)), SI (rad/s, rad/s^2,
+            rad/s^3 or m/...). ``vmax`` is required; None leaves a limit out.
+        method: ``"ga"`` (the GA of this package) or ``"exact"`` (scaling-law optimiser).
+        seed: Seed of the GA (or of the exact optimiser's random starts).
+        settings: GA settings (default :meth:`GASettings.seed002`).
+        bounds: Segment-duration bounds (s): one (lower, upper) pair or (m, 2) rows.
+            Default: ``[s0 / (100 m), s0]`` per segment, s0 the minimal total with equal
+            durations (a feasible total, so the optimum lies inside).
+        max_generations, stall_generations, time_limit: GA stopping rules.
+        rescale: GA only: scale the GA's best (same ratios) down until the first limit is
+            reached; the unscaled total is kept in ``raw_total``.
+        initial: GA only: (k, m) durations put into the initial population (e.g. the
+            paper's initial times).
+        callback: GA progress callback (see :func:`optim.run_ga`).
+        trajectory_options: Extra keyword arguments of the planning constructor.
+        problem: A prebuilt :class:`TimingProblem` (then positions/kind/limits/bounds
+            are ignored).
+
+    Returns:
+        :class:`TimingResult`, verified against the limits.
+
+    Raises:
+        InvalidLimits: A limit is <= 0, NaN/inf or has the wrong shape.
+        InfeasibleProblem: No timing within the bounds meets the limits.
+    """
+    t0 = time.perf_counter()
+    if method not in METHODS:
+        raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
+    if problem is None:
+        problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
+                                trajectory_options=trajectory_options)
+    before = problem.evaluations
+    if method == "exact":
+        sol = solve_exact(problem, seed=seed)
+        if not sol.feasible:
+            raise _infeasible(problem, "exact")
+        return finish_timing(problem, sol.durations, method="exact", history=None,
+                             evaluations=problem.evaluations - before, t0=t0,
+                             raw_total=sol.total)
+    settings = GASettings.seed002() if settings is None else settings
+    result = run_ga(lambda h: h.sum(axis=1), problem.bounds, settings,
+                    constraints=problem.constraints, seed=seed,
+                    max_generations=max_generations, stall_generations=stall_generations,
+                    time_limit=time_limit, callback=callback, initial=initial)
+    if not result.feasible:
+        raise _infeasible(problem, "ga")
+    h = rescale_to_limits(problem, result.x) if rescale else result.x
+    return finish_timing(problem, h, method="ga", history=result.history,
+                         evaluations=problem.evaluations - before, t0=t0,
+                         raw_total=float(result.f), stop_reason=result.stop_reason)
