@@ -1,0 +1,705 @@
+"""The ``pinarms`` command line.
+
+Every command prints a short human-readable report, or with ``--json`` one JSON document
+on stdout. Units are SI (m, rad, s) unless ``--deg`` / ``--mm`` ask for degrees and
+millimetres at the edge (:mod:`pinarms.units` converts). A user mistake (unknown robot,
+malformed numbers, unreachable target, infeasible limits, missing file) ends with one line
+``Error: ...`` on stderr and a non-zero exit status, never a Python traceback.
+
+Exit status: 0 success, 1 a pinarms error (bad value, unreachable, infeasible, ...),
+2 a command-line usage error (unknown option, missing argument).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import click
+import numpy as np
+
+import robots
+from robots.errors import InvalidInput, PinarmsError
+from robots.robot import Robot
+
+from .units import angle_scale, joints_from_si, joints_to_si, length_scale, prismatic_mask
+
+__all__ = ["cli", "main"]
+
+# numbers may be negative: "-0.5" must reach the command as a value, not as an option
+_NUMBERS = {"ignore_unknown_options": True}
+TRAJECTORY_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline", "polynomial", "piecewise")
+OPTIMIZE_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
+
+
+# --------------------------------------------------------------------------- plumbing
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+class _Group(click.Group):
+    """A click group that turns pinarms errors into one-line messages (exit status 1)."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except PinarmsError as exc:
+            raise click.ClickException(_one_line(exc)) from None
+        except FileNotFoundError as exc:
+            raise click.ClickException(f"file not found: {exc.filename or _one_line(exc)}") from None
+        except OSError as exc:
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise click.ClickException(f"{where}{exc.strerror or _one_line(exc)}") from None
+
+
+def jsonable(obj: Any) -> Any:
+    """Plain JSON types for numpy arrays/scalars, dataclasses, paths and dict-like results."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    for method in ("as_dict", "to_dict"):
+        if callable(getattr(obj, method, None)):
+            return jsonable(getattr(obj, method)())
+    if hasattr(obj, "_asdict"):
+        return jsonable(obj._asdict())
+    return obj if isinstance(obj, (str, int, type(None))) else str(obj)
+
+
+def _emit(as_json: bool, data: dict, lines: Iterable[str]) -> None:
+    if as_json:
+        click.echo(json.dumps(jsonable(data), indent=2))
+    else:
+        for line in lines:
+            click.echo(line)
+
+
+def _fmt(values: Any, digits: int = 6) -> str:
+    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    return "  ".join(f"{v:.{digits}g}" for v in arr)
+
+
+def _show_progress(as_json: bool) -> bool:
+    """Progress bars only for a person at a terminal, never in machine-readable output."""
+    return (not as_json) and sys.stderr.isatty()
+
+
+def _load_robot(name: str) -> Robot:
+    """A registry name, or the path of any ``.urdf`` file."""
+    if name.lower().endswith(".urdf"):
+        return robots.from_urdf(name)
+    return robots.load(name)
+
+
+def _floats(text: str, what: str) -> np.ndarray:
+    """``"1, 2,3"`` → array; a clear usage error otherwise."""
+    parts = [p for p in text.replace(";", ",").split(",") if p.strip()]
+    try:
+        values = np.array([float(p) for p in parts], dtype=float)
+    except ValueError:
+        raise click.BadParameter(f"{what} must be comma-separated numbers, got {text!r}") from None
+    if values.size == 0:
+        raise click.BadParameter(f"{what} is empty")
+    if not np.all(np.isfinite(values)):
+        raise click.BadParameter(f"{what} holds a non-finite value: {text!r}")
+    return values
+
+
+def _limit(text: str | None, what: str, scale: float) -> np.ndarray | float | None:
+    if text is None:
+        return None
+    values = _floats(text, what) * scale
+    return float(values[0]) if values.size == 1 else values
+
+
+def _vectors_from_args(values: tuple[float, ...]) -> np.ndarray:
+    return np.asarray(values, dtype=float)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="pinarms", prog_name="pinarms")
+def cli() -> None:
+    """pinarms: model, plan and time-optimise food/agricultural handling arms (on Pinocchio).
+
+    Units are SI (m, rad, s); --deg and --mm convert at the command line.
+    Every command takes --json for machine-readable output.
+    """
+
+
+def main() -> None:
+    """Console-script entry point (``pinarms``)."""
+    cli(prog_name="pinarms")
+
+
+json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON document instead of text.")
+
+
+# --------------------------------------------------------------------------- robots
+@cli.command("robots")
+@json_option
+def robots_cmd(as_json: bool) -> None:
+    """List the robots `pinarms` knows (built-in arms and example-robot-data arms) with their DoF."""
+    from robots.registry import info
+
+    rows = []
+    for name in robots.names():
+        entry = info(name)
+        robot = robots.load(name)
+        rows.append(
+            {
+                "name": name,
+                "dof": robot.nq,
+                "source": entry.source,
+                "description": entry.description,
+                "joints": list(robot.joint_names),
+            }
+        )
+    width = max(len(r["name"]) for r in rows)
+    lines = [f"{'name':<{width}}  dof  source              description"]
+    lines += [f"{r['name']:<{width}}  {r['dof']:>3}  {r['source']:<18}  {r['description']}" for r in rows]
+    _emit(as_json, {"robots": rows}, lines)
+
+
+# --------------------------------------------------------------------------- fk
+@cli.command("fk", context_settings=_NUMBERS)
+@click.argument("robot")
+@click.argument("q", nargs=-1, type=float, required=True)
+@click.option("--deg", is_flag=True, help="Revolute joint values in degrees (output angles too).")
+@click.option("--mm", is_flag=True, help="Prismatic joint values and the output position in millimetres.")
+@click.option("--frame", default="tcp", show_default=True, help="Frame whose pose is printed.")
+@json_option
+def fk_cmd(robot: str, q: tuple[float, ...], deg: bool, mm: bool, frame: str, as_json: bool) -> None:
+    """Forward kinematics: pose of FRAME for joint values Q... (one per independent joint)."""
+    import pinocchio as pin
+
+    arm = _load_robot(robot)
+    values = _vectors_from_args(q)
+    if values.size != arm.nq:
+        raise InvalidInput(
+            f"{arm.name} has {arm.nq} joints ({', '.join(arm.joint_names)}); got {values.size} value(s) for Q"
+        )
+    q_si = joints_to_si(arm, values, deg=deg, mm=mm)
+    T = arm.fk(q_si, frame=frame)
+    rpy = pin.rpy.matrixToRpy(T[:3, :3])
+    pos = T[:3, 3] / length_scale(mm)
+    ang = rpy / angle_scale(deg)
+    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
+    limits_ok = bool(arm.within_limits(q_si))
+    data = {
+        "robot": arm.name,
+        "frame": frame,
+        "q": values,
+        "q_si": q_si,
+        "position": pos,
+        "rpy": ang,
+        "units": {"position": lu, "angles": au},
+        "T": T,
+        "within_limits": limits_ok,
+    }
+    lines = [
+        f"{arm.name}  frame {frame}",
+        f"position [{lu}]: {_fmt(pos)}",
+        f"roll pitch yaw [{au}]: {_fmt(ang)}",
+        "T (frame → base, SI):",
+        *("  " + "  ".join(f"{v: .6f}" for v in row) for row in T),
+    ]
+    if not limits_ok:
+        lines.append("warning: q is outside the joint limits: " + "; ".join(arm.limit_violations(q_si)))
+    _emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- ik
+def _target_pose(pose: np.ndarray, deg: bool, mm: bool) -> np.ndarray:
+    import pinocchio as pin
+
+    if pose.size not in (3, 6):
+        raise InvalidInput(f"give X Y Z or X Y Z ROLL PITCH YAW (3 or 6 numbers), got {pose.size}")
+    T = np.eye(4)
+    T[:3, 3] = pose[:3] * length_scale(mm)
+    if pose.size == 6:
+        T[:3, :3] = pin.rpy.rpyToMatrix(*(pose[3:] * angle_scale(deg)))
+    return T
+
+
+@cli.command("ik", context_settings=_NUMBERS)
+@click.argument("robot")
+@click.argument("pose", nargs=-1, type=float, required=True)
+@click.option("--all", "all_solutions", is_flag=True, help="Every analytic solution within the limits.")
+@click.option("--deg", is_flag=True, help="ROLL PITCH YAW and revolute joint output in degrees.")
+@click.option("--mm", is_flag=True, help="X Y Z and prismatic joint output in millimetres.")
+@click.option("--seed-q", default=None, help="Comma-separated start configuration for the numerical solver.")
+@json_option
+def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, mm: bool,
+           seed_q: str | None, as_json: bool) -> None:
+    """Inverse kinematics for the tcp at X Y Z [ROLL PITCH YAW] (base frame).
+
+    With three numbers only the position is asked (orientation free for the numerical
+    solver; with --all the orientation is taken as the base's). With --all every
+    closed-form solution within the joint limits is listed.
+    """
+    arm = _load_robot(robot)
+    values = _vectors_from_args(pose)
+    T = _target_pose(values, deg, mm)
+    position_only = values.size == 3
+    if all_solutions:
+        if not arm.has_analytic_ik:
+            raise InvalidInput(f"{arm.name} has no closed-form IK; drop --all to use the numerical solver")
+        sols = np.atleast_2d(arm.ik_all(T))
+        if sols.size == 0:
+            sols = np.zeros((0, arm.nq))
+    else:
+        q0 = None
+        if seed_q is not None:
+            q0 = joints_to_si(arm, _floats(seed_q, "--seed-q"), deg=deg, mm=mm)
+        sols = np.atleast_2d(arm.ik(T, q0, position_only=position_only))
+    rows = []
+    for q in sols:
+        T_q = arm.fk(q)
+        rows.append(
+            {
+                "q": joints_from_si(arm, q, deg=deg, mm=mm),
+                "position_error_m": float(np.linalg.norm(T_q[:3, 3] - T[:3, 3])),
+            }
+        )
+    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
+    kinds = ["mm" if (p and mm) else "m" if p else au for p in prismatic_mask(arm)]
+    data = {
+        "robot": arm.name,
+        "target": {"position": values[:3], "rpy": values[3:] if values.size == 6 else None},
+        "units": {"position": lu, "angles": au, "joints": kinds},
+        "joint_names": list(arm.joint_names),
+        "solutions": rows,
+    }
+    header = "  ".join(f"{n}[{u}]" for n, u in zip(arm.joint_names, kinds))
+    lines = [f"{arm.name}: {len(rows)} solution(s)  ({header})"]
+    lines += [f"  {_fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m" for r in rows]
+    if not rows:
+        lines.append("  none within the joint limits")
+    _emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- workspace
+@cli.command("workspace")
+@click.argument("robot")
+@click.option("-n", "n", default=20000, show_default=True, type=click.IntRange(min=1), help="Samples.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed.")
+@click.option("--frame", default="tcp", show_default=True)
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Also save the cloud into a session file.")
+@json_option
+def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, as_json: bool) -> None:
+    """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region."""
+    arm = _load_robot(robot)
+    ws = robots.sample_workspace(arm, n=n, seed=seed, frame=frame)
+    summary = jsonable(ws.summary())
+    lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
+    data = {
+        "robot": arm.name,
+        "n": n,
+        "seed": seed,
+        "frame": frame,
+        "bounding_box_m": {"min": lo, "max": hi},
+        "manipulability": {"mean": float(np.mean(ws.manipulability)), "max": float(np.max(ws.manipulability))},
+        "summary": summary,
+    }
+    lines = [
+        f"{arm.name}: {n} samples of frame {frame} (seed {seed})",
+        f"bounding box [m]: min {_fmt(lo, 4)}  max {_fmt(hi, 4)}",
+        f"manipulability: mean {np.mean(ws.manipulability):.4g}, max {np.max(ws.manipulability):.4g}",
+    ]
+    if isinstance(summary, dict):
+        lines += [f"{k}: {v}" for k, v in summary.items()]
+    else:
+        lines.append(str(summary))
+    if session_path:
+        session = _new_session(arm, f"workspace of {arm.name}")
+        session.add_workspace("workspace", ws)
+        session.save(session_path)
+        data["session"] = session_path
+        lines.append(f"session written: {session_path}")
+    _emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- via points
+def read_via_file(path: str) -> dict[str, Any]:
+    """Via points from a JSON or CSV file.
+
+    JSON: ``{"times": [...], "positions": [[...], ...], "kind": ..., "degree": ...}``
+    (``times``/``kind`` optional). CSV: a header row; a column named ``t`` or ``time``
+    holds knot times, every other column is one joint; one row per via point.
+    """
+    file = Path(path)
+    text = file.read_text(encoding="utf-8")
+    if file.suffix.lower() == ".json":
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InvalidInput(f"{path}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
+        if not isinstance(doc, dict) or "positions" not in doc:
+            raise InvalidInput(f"{path}: expected an object with 'positions' (and optional 'times', 'kind')")
+        return doc
+    rows = list(csv.reader(io.StringIO(text)))
+    rows = [r for r in rows if any(c.strip() for c in r)]
+    if len(rows) < 3:
+        raise InvalidInput(f"{path}: a CSV needs a header row and at least two via points")
+    header = [h.strip().lower() for h in rows[0]]
+    try:
+        table = np.array([[float(c) for c in r] for r in rows[1:]], dtype=float)
+    except ValueError:
+        raise InvalidInput(f"{path}: every CSV cell after the header must be a number") from None
+    if table.ndim != 2 or table.shape[1] != len(header):
+        raise InvalidInput(f"{path}: every CSV row must have {len(header)} cells like the header")
+    doc: dict[str, Any] = {}
+    time_cols = [i for i, h in enumerate(header) if h in ("t", "time", "time_s", "t_s")]
+    if time_cols:
+        doc["times"] = table[:, time_cols[0]]
+    joints = [i for i in range(len(header)) if i not in time_cols]
+    doc["positions"] = table[:, joints]
+    doc["joint_names"] = [rows[0][i].strip() for i in joints]
+    return doc
+
+
+def _via_input(via: tuple[str, ...], times: str | None, file: str | None) -> tuple[np.ndarray | None, np.ndarray, dict]:
+    """(times or None, positions (m+1, n_joints), extra file options)."""
+    if file and via:
+        raise click.UsageError("give via points either with --via or with --file, not both")
+    extra: dict = {}
+    if file:
+        doc = read_via_file(file)
+        positions = np.asarray(doc["positions"], dtype=float)
+        t = None if doc.get("times") is None else np.asarray(doc["times"], dtype=float)
+        extra = {k: v for k, v in doc.items() if k not in ("positions", "times")}
+    elif via:
+        points = [_floats(v, "--via") for v in via]
+        if len({p.size for p in points}) != 1:
+            raise InvalidInput(f"every --via must have the same number of joint values, got sizes {[p.size for p in points]}")
+        positions = np.vstack(points)
+        t = None
+    else:
+        raise click.UsageError("give via points with --via (repeat it, one point each) or --file")
+    if times is not None:
+        t = _floats(times, "--times")
+    if positions.ndim == 1:
+        positions = positions[:, None]
+    if positions.shape[0] < 2:
+        raise InvalidInput(f"need at least two via points, got {positions.shape[0]}")
+    return t, positions, extra
+
+
+def _new_session(robot: Robot | str | None, title: str):
+    """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
+    import viz
+
+    return viz.Session(robot=robot, title=title)
+
+
+def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degree: int | None, degrees: str | None):
+    import planning
+
+    if kind == "3-5-3":
+        return planning.piecewise_polynomial(times, positions, degrees=(3, 5, 3))
+    if kind == "piecewise":
+        if degrees is None:
+            raise click.UsageError("--kind piecewise needs --degrees, e.g. --degrees 4,3,4")
+        degs = tuple(int(d) for d in _floats(degrees, "--degrees"))
+        return planning.piecewise_polynomial(times, positions, degrees=degs)
+    if kind == "multi-quintic":
+        return planning.multi_quintic(times, positions)
+    if kind == "quintic-bspline":
+        return planning.quintic_bspline(times, positions)
+    if kind == "polynomial":
+        if degree is None:
+            raise click.UsageError("--kind polynomial needs --degree (3, 5 or 7)")
+        return planning.polynomial(times, positions, degree)
+    raise click.UsageError(f"unknown kind {kind!r}; use one of {', '.join(TRAJECTORY_KINDS)}")
+
+
+def _peaks_lines(peaks: Any, scale: float, unit: str) -> list[str]:
+    return [
+        f"peak |velocity|     [{unit}/s]:   {_fmt(np.asarray(peaks.velocity) / scale)}",
+        f"peak |acceleration| [{unit}/s²]:  {_fmt(np.asarray(peaks.acceleration) / scale)}",
+        f"peak |jerk|         [{unit}/s³]:  {_fmt(np.asarray(peaks.jerk) / scale)}",
+    ]
+
+
+def _peaks_dict(peaks: Any, scale: float) -> dict:
+    return {
+        "velocity": np.asarray(peaks.velocity) / scale,
+        "acceleration": np.asarray(peaks.acceleration) / scale,
+        "jerk": np.asarray(peaks.jerk) / scale,
+    }
+
+
+def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float, n_joints: int):
+    """Velocity/acceleration/jerk limits (SI) from options, else the robot's velocity limits."""
+    v = _limit(vmax, "--vmax", scale)
+    a = _limit(amax, "--amax", scale)
+    j = _limit(jmax, "--jmax", scale)
+    if v is None and robot is not None:
+        if robot.nq != n_joints:
+            raise InvalidInput(f"{robot.name} has {robot.nq} joints but the via points have {n_joints}")
+        v = robot.velocity_limit
+        if not np.all(v > 0):
+            raise InvalidInput(f"{robot.name}'s URDF gives no velocity limit for every joint; pass --vmax")
+    return v, a, j
+
+
+# --------------------------------------------------------------------------- plan
+@cli.command("plan", context_settings=_NUMBERS)
+@click.option("--kind", type=click.Choice(TRAJECTORY_KINDS), default="3-5-3", show_default=True)
+@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
+@click.option("--times", default=None, help="Comma-separated knot times [s], one per via point.")
+@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
+              help="Via points (and times) from a .json or .csv file.")
+@click.option("--degree", type=int, default=None, help="Degree for --kind polynomial.")
+@click.option("--degrees", default=None, help="Per-segment degrees for --kind piecewise, e.g. 4,3,4.")
+@click.option("--deg", is_flag=True, help="Joint values and limits in degrees.")
+@click.option("--robot", default=None, help="Take velocity limits from this robot (and store it in the session).")
+@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint, comma-separated.")
+@click.option("--amax", default=None, help="Acceleration limit(s).")
+@click.option("--jmax", default=None, help="Jerk limit(s).")
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Save the trajectory into a session file.")
+@json_option
+def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jmax, session_path, as_json) -> None:
+    """Plan a joint trajectory through via points; print its exact peaks and the limit check.
+
+    Example (seed 000, joint 1): pinarms plan --kind 3-5-3 --deg --times 0,2,4,6
+    --via 55.5 --via 69.7 --via 106.5 --via 124.5 --vmax 55
+    """
+    import planning
+
+    t, positions, extra = _via_input(via, times, file)
+    if t is None:
+        raise click.UsageError("give knot times with --times (or a 't' column / 'times' key in the file)")
+    if extra.get("kind") and kind == "3-5-3" and extra["kind"] in TRAJECTORY_KINDS:
+        kind = extra["kind"]
+    degree = degree if degree is not None else extra.get("degree")
+    scale = angle_scale(deg)
+    arm = _load_robot(robot) if robot else None
+    traj = _build_trajectory(kind, t, positions * scale, degree, degrees)
+    peaks = traj.peaks()
+    unit = "deg" if deg else "rad|m"
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale, traj.n_joints)
+    report = None
+    if v is not None:
+        report = traj.check(planning.JointLimits(v, a, j))
+    data = {
+        "kind": kind,
+        "n_joints": traj.n_joints,
+        "duration_s": traj.duration,
+        "knot_times_s": traj.knot_times,
+        "units": unit,
+        "peaks": _peaks_dict(peaks, scale),
+        "limits_ok": None if report is None else bool(report.ok),
+        "violations": [] if report is None else [
+            {"joint": int(vi[0]), "time_s": float(vi[1]), "kind": str(vi[2]),
+             "value": float(vi[3]) / scale, "limit": float(vi[4]) / scale}
+            for vi in report.violations
+        ],
+    }
+    lines = [
+        f"{kind} trajectory: {traj.n_joints} joint(s), {positions.shape[0]} via points, duration {traj.duration:.6g} s",
+        f"knot times [s]: {_fmt(traj.knot_times)}",
+        *_peaks_lines(peaks, scale, "deg" if deg else "rad|m"),
+    ]
+    if report is not None:
+        lines.append("limits: ok" if report.ok else f"limits: {len(report.violations)} violation(s)")
+        lines += [
+            f"  joint {d['joint']} {d['kind']} {d['value']:.6g} > {d['limit']:.6g} at t = {d['time_s']:.4g} s"
+            for d in data["violations"][:10]
+        ]
+    if session_path:
+        session = _new_session(arm, f"{kind} trajectory")
+        session.add_trajectory(kind, traj)
+        session.save(session_path)
+        data["session"] = session_path
+        lines.append(f"session written: {session_path}")
+    _emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- optimize
+@cli.command("optimize", context_settings=_NUMBERS)
+@click.option("--kind", type=click.Choice(OPTIMIZE_KINDS), default="3-5-3", show_default=True)
+@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
+@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
+              help="Via points from a .json or .csv file.")
+@click.option("--deg", is_flag=True, help="Joint values and limits in degrees.")
+@click.option("--robot", default=None, help="Take velocity limits from this robot.")
+@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint.")
+@click.option("--amax", default=None, help="Acceleration limit(s).")
+@click.option("--jmax", default=None, help="Jerk limit(s).")
+@click.option("--method", type=click.Choice(["ga", "exact"]), default="ga", show_default=True)
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the GA.")
+@click.option("--generations", default=None, type=click.IntRange(min=1), help="Maximum GA generations.")
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Save the optimised trajectory (and GA history) into a session file.")
+@json_option
+def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, session_path, as_json) -> None:
+    """Shortest segment times through via points under velocity/acceleration/jerk limits.
+
+    Example (seed 000): pinarms optimize --kind 3-5-3 --deg --via 55.5 --via 69.7
+    --via 106.5 --via 124.5 --vmax 55
+    """
+    import optim
+
+    _, positions, _ = _via_input(via, None, file)
+    scale = angle_scale(deg)
+    arm = _load_robot(robot) if robot else None
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale, positions.shape[1])
+    if v is None:
+        raise click.UsageError("give a velocity limit with --vmax (or --robot)")
+    kwargs: dict[str, Any] = {}
+    if generations is not None and method == "ga":
+        kwargs["max_generations"] = generations
+    progress = _show_progress(as_json) and method == "ga"
+    if progress:
+        bar = click.progressbar(length=generations or 200, label="GA generations", file=sys.stderr)
+        bar.__enter__()
+
+        def tick(_state: Any) -> None:
+            bar.update(1)
+
+        kwargs["callback"] = tick
+    try:
+        result = optim.minimize_time(positions * scale, kind, v, a, j, method=method, seed=seed, **kwargs)
+    finally:
+        if progress:
+            bar.__exit__(None, None, None)
+    data = {
+        "kind": kind,
+        "method": result.method,
+        "durations_s": result.durations,
+        "total_s": result.total,
+        "peaks": _peaks_dict(result.peaks, scale),
+        "units": "deg" if deg else "rad|m",
+        "generations": None if result.history is None else len(getattr(result.history, "best", [])),
+        "wall_time_s": result.wall_time,
+    }
+    lines = [
+        f"{kind}, method {result.method}: total {result.total:.6g} s",
+        f"segment durations [s]: {_fmt(result.durations)}",
+        *_peaks_lines(result.peaks, scale, "deg" if deg else "rad|m"),
+    ]
+    if session_path:
+        session = _new_session(arm, f"time-optimal {kind}")
+        session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
+        if result.history is not None and hasattr(session, "add_history"):
+            session.add_history(f"{kind} GA", result.history)
+        session.save(session_path)
+        data["session"] = session_path
+        lines.append(f"session written: {session_path}")
+    _emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- sessions
+@cli.command("view")
+@click.argument("session", type=click.Path(exists=True))
+@click.option("--no-wait", is_flag=True, help="Open the viewer, print its address and return.")
+@json_option
+def view_cmd(session: str, no_wait: bool, as_json: bool) -> None:
+    """Open a saved SESSION in the MeshCat viewer (browser; local server on 127.0.0.1)."""
+    import viz
+
+    loaded = viz.load_session(session)
+    viewer = viz.show(loaded) if not no_wait else viz.show(loaded, wait=False)
+    url = getattr(viewer, "url", None) or getattr(viewer, "web_url", None)
+    _emit(as_json, {"session": session, "url": url}, [f"viewer: {url}" if url else "viewer closed"])
+
+
+@cli.command("export-html")
+@click.argument("session", type=click.Path(exists=True))
+@click.argument("out", type=click.Path(dir_okay=False))
+@json_option
+def export_html_cmd(session: str, out: str, as_json: bool) -> None:
+    """Write SESSION as one self-contained HTML page OUT (opens offline in any browser)."""
+    import viz
+
+    loaded = viz.load_session(session)
+    path = viz.export_html(loaded, out)
+    path = Path(path) if path else Path(out)
+    size = path.stat().st_size
+    _emit(as_json, {"session": session, "html": str(path), "bytes": size}, [f"wrote {path} ({size / 1e6:.2f} MB)"])
+
+
+# --------------------------------------------------------------------------- urdf
+@cli.group("urdf", cls=_Group)
+def urdf_group() -> None:
+    """Build the built-in URDFs from their xacro sources, or export a URDF for other tools."""
+
+
+@urdf_group.command("build")
+@click.option("--check", is_flag=True, help="Only check: exit 1 and list the URDFs that differ from their xacro.")
+@click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False),
+              help="Write into this folder instead of the urdf/ package.")
+@json_option
+def urdf_build_cmd(check: bool, out_dir: str | None, as_json: bool) -> None:
+    """Regenerate urdf/*.urdf from robots/xacro/*.urdf.xacro."""
+    from robots import urdf_build
+
+    if check:
+        stale = urdf_build.stale(out_dir)
+        _emit(as_json, {"stale": stale}, [f"stale: {name}" for name in stale] or ["all URDFs are up to date"])
+        if stale:
+            raise SystemExit(1)
+        return
+    written = urdf_build.build_all(out_dir)
+    _emit(as_json, {"written": [str(p) for p in written]}, [f"wrote {p}" for p in written])
+
+
+@urdf_group.command("export")
+@click.argument("robot")
+@click.argument("out_dir", type=click.Path(file_okay=True))
+@click.option("--overwrite", is_flag=True, help="Replace a non-empty folder.")
+@json_option
+def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, as_json: bool) -> None:
+    """Write ROBOT as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR."""
+    from .export import export_urdf
+
+    result = export_urdf(_load_robot(robot), out_dir, overwrite=overwrite)
+    _emit(
+        as_json,
+        {"folder": result.folder, "urdf": result.urdf, "meshes": list(result.meshes)},
+        [f"wrote {result.urdf} and {len(result.meshes)} mesh file(s)"],
+    )
+
+
+# --------------------------------------------------------------------------- demo
+@cli.command("demo")
+@click.option("--quick", is_flag=True, help="Smaller samples and GA runs: under a minute.")
+@click.option("--out", "out_dir", default="demo-output", show_default=True, type=click.Path(file_okay=False))
+@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004"]), help="Run only these studies.")
+@json_option
+def demo_cmd(quick: bool, out_dir: str, only: tuple[str, ...], as_json: bool) -> None:
+    """Redo the four papers' studies, print the paper-vs-pinarms table and write sessions, HTML and plots."""
+    from .demo import run_demo
+
+    progress: Callable[[str], None] | None = None
+    if _show_progress(as_json):
+        progress = lambda label: click.echo(f"· {label}", err=True)  # noqa: E731
+    result = run_demo(out_dir, quick=quick, only=only or None, progress=progress)
+    _emit(as_json, result.as_dict(), [result.table_text(), "", *(f"wrote {p}" for p in result.files)])
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

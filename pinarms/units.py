@@ -1,0 +1,50 @@
+"""Unit conversion at the command-line edge: degrees and millimetres in, SI inside.
+
+pinarms works in SI (m, rad, s) everywhere. The CLI accepts ``--deg`` (revolute joint
+values and roll/pitch/yaw in degrees) and ``--mm`` (prismatic joint values and Cartesian
+positions in millimetres); this module is the one place that converts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robots.robot import Robot
+
+__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale"]
+
+
+def prismatic_mask(robot: Robot) -> np.ndarray:
+    """``(nq,)`` bool: True where the independent joint is prismatic (metres), else revolute (rad)."""
+    mask = np.zeros(robot.nq, dtype=bool)
+    model = robot.model
+    for i in range(1, model.njoints):
+        joint = model.joints[i]
+        short = joint.shortname()
+        if "Mimic" in short or joint.nv == 0:
+            continue
+        if short.startswith("JointModelP") and not short.startswith("JointModelPlanar"):
+            mask[joint.idx_v] = True
+    return mask
+
+
+def length_scale(mm: bool) -> float:
+    """Metres per user length unit."""
+    return 1e-3 if mm else 1.0
+
+
+def angle_scale(deg: bool) -> float:
+    """Radians per user angle unit."""
+    return np.pi / 180.0 if deg else 1.0
+
+
+def joints_to_si(robot: Robot, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+    """User joint values (deg/rad for revolute, mm/m for prismatic) → SI, shape kept."""
+    scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
+    return np.asarray(values, dtype=float) * scale
+
+
+def joints_from_si(robot: Robot, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+    """SI joint values → user units (inverse of :func:`joints_to_si`)."""
+    scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
+    return np.asarray(values, dtype=float) / scale
