@@ -1,0 +1,90 @@
+"""Kinematic limits of a set of joints, as a specification object.
+
+A :class:`JointLimits` only *describes* limits; :meth:`planning.Trajectory.check` and the
+optimisers of :mod:`optim` apply them. Units are SI and per joint: rad, rad/s, rad/s²,
+rad/s³ for revolute joints (m, m/s, ... for prismatic ones).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from planning._inputs import finite_array
+from planning.errors import TrajectoryError
+
+__all__ = ["JointLimits"]
+
+_POSITIVE = ("velocity", "acceleration", "jerk")
+_FIELDS = ("velocity", "acceleration", "jerk", "lower", "upper")
+
+
+@dataclass(frozen=True, eq=False)
+class JointLimits:
+    """Per-joint limits; scalars apply to every joint, ``None`` means "not limited".
+
+    Attributes:
+        velocity: max |qd| (rad/s or m/s), scalar or (n_joints,), > 0.
+        acceleration: max |qdd| (rad/s² or m/s²), optional, > 0.
+        jerk: max |qddd| (rad/s³ or m/s³), optional, > 0.
+        lower, upper: position bounds (rad or m), optional; ``lower < upper``.
+    """
+
+    velocity: Any
+    acceleration: Any = None
+    jerk: Any = None
+    lower: Any = None
+    upper: Any = None
+
+    def __post_init__(self) -> None:
+        for name in _FIELDS:
+            value = getattr(self, name)
+            if value is None:
+                if name == "velocity":
+                    raise TrajectoryError("velocity limit is required (rad/s or m/s per joint)")
+                continue
+            arr = finite_array(value, f"{name} limit")
+            if arr.ndim > 1:
+                raise TrajectoryError(f"{name} limit must be a scalar or a 1-D per-joint array, got shape {arr.shape}")
+            if name in _POSITIVE and np.any(arr <= 0.0):
+                bad = arr.reshape(-1)[np.argmax(arr.reshape(-1) <= 0.0)]
+                raise TrajectoryError(f"{name} limit must be positive, got {bad!r}")
+            arr = arr.copy()
+            arr.flags.writeable = False
+            object.__setattr__(self, name, arr)
+        if self.lower is not None and self.upper is not None:
+            lo, hi = np.broadcast_arrays(self.lower, self.upper)
+            if np.any(lo >= hi):
+                i = int(np.argmax(np.atleast_1d(lo >= hi)))
+                raise TrajectoryError(
+                    f"lower position limit must be below upper; joint {i}: "
+                    f"{np.atleast_1d(lo)[i]!r} >= {np.atleast_1d(hi)[i]!r}"
+                )
+
+    def for_joints(self, name: str, n_joints: int) -> np.ndarray:
+        """Limit ``name`` broadcast to (n_joints,); raises if it has a different joint count."""
+        if name not in _FIELDS:
+            raise TrajectoryError(f"unknown limit {name!r}; expected one of {_FIELDS}")
+        arr = getattr(self, name)
+        if arr is None:
+            raise TrajectoryError(f"no {name} limit is set")
+        if arr.ndim == 1 and arr.size not in (1, n_joints):
+            raise TrajectoryError(f"{name} limit has {arr.size} entries but the trajectory has {n_joints} joints")
+        return np.broadcast_to(arr.reshape(-1) if arr.ndim else arr, (n_joints,)).astype(float)
+
+    @classmethod
+    def from_robot(cls, robot: Any, acceleration: Any = None, jerk: Any = None) -> "JointLimits":
+        """Velocity and position limits of a robot (``velocity_limit``, ``lower``, ``upper``), plus optional ones."""
+        return cls(
+            velocity=np.asarray(robot.velocity_limit, dtype=float),
+            acceleration=acceleration,
+            jerk=jerk,
+            lower=np.asarray(robot.lower, dtype=float),
+            upper=np.asarray(robot.upper, dtype=float),
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-able form (``None`` for unset limits)."""
+        return {k: (None if getattr(self, k) is None else getattr(self, k).tolist()) for k in _FIELDS}

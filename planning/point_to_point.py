@@ -1,0 +1,198 @@
+"""Rest-to-rest point-to-point profiles: trapezoidal velocity and jerk-limited double-S.
+
+Both follow Biagiotti & Melchiorri, *Trajectory Planning for Automatic Machines and
+Robots* (Springer 2008): sec. 3.2.2 (trapezoidal, with the triangular case when the
+cruise velocity cannot be reached) and sec. 3.4 (double-S, with the cases where the
+maximum velocity and/or the maximum acceleration are not reached; for a rest-to-rest
+motion these have closed forms).
+
+Multi-joint motions are *synchronised*: every joint gets its own minimum-time profile,
+the slowest joint sets the duration ``T``, and every other joint's profile is uniformly
+time-scaled to last ``T`` (velocity / λ, acceleration / λ², jerk / λ³ with λ >= 1, so no
+limit is exceeded). With ``synchronized=False`` each joint moves in its own minimum time
+and then holds its target.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning import _inputs
+from planning.errors import TrajectoryError
+from planning.trajectory import Trajectory, stack_joints
+
+__all__ = ["trapezoidal", "double_s", "double_s_phases", "trapezoidal_phases"]
+
+
+def trapezoidal_phases(distance: float, vmax: float, amax: float) -> tuple[float, float]:
+    """Acceleration time ``Ta`` and total time ``T`` (s) of a rest-to-rest trapezoidal move.
+
+    ``distance`` >= 0 (rad or m). When ``distance < vmax²/amax`` the cruise velocity is not
+    reached (triangular profile: ``Ta = sqrt(distance/amax)``, ``T = 2 Ta``).
+    """
+    if distance <= 0.0:
+        return 0.0, 0.0
+    if distance * amax >= vmax * vmax:
+        Ta = vmax / amax
+        return Ta, distance / vmax + Ta
+    Ta = math.sqrt(distance / amax)
+    return Ta, 2.0 * Ta
+
+
+def double_s_phases(distance: float, vmax: float, amax: float, jmax: float) -> tuple[float, float, float]:
+    """Jerk time ``Tj``, acceleration time ``Ta`` and cruise time ``Tv`` (s) of a rest-to-rest double-S.
+
+    The deceleration mirrors the acceleration (``Td = Ta``), total time ``T = 2 Ta + Tv``.
+    Cases (B&M sec. 3.4): amax reached or not while reaching vmax; if vmax is not reached
+    (``Tv`` would be negative), ``Ta = (amax²/jmax + sqrt(amax⁴/jmax² + 4 amax distance)) / (2 amax)``;
+    if then ``Ta < 2 Tj`` neither vmax nor amax is reached: ``Tj = (distance / (2 jmax))^(1/3)``, ``Ta = 2 Tj``.
+    """
+    if distance <= 0.0:
+        return 0.0, 0.0, 0.0
+    if vmax * jmax < amax * amax:
+        Tj = math.sqrt(vmax / jmax)
+        Ta = 2.0 * Tj
+    else:
+        Tj = amax / jmax
+        Ta = Tj + vmax / amax
+    Tv = distance / vmax - Ta
+    if Tv >= 0.0:
+        return Tj, Ta, Tv
+    Tj = amax / jmax
+    Ta = (amax * amax / jmax + math.sqrt(amax**4 / jmax**2 + 4.0 * amax * distance)) / (2.0 * amax)
+    if Ta < 2.0 * Tj:
+        Tj = (distance / (2.0 * jmax)) ** (1.0 / 3.0)
+        Ta = 2.0 * Tj
+    return Tj, Ta, 0.0
+
+
+def _integrate_jerk_phases(q0: float, durations: list[float], jerks: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Breaks (from 0) and cubic coefficients (k, 4) of constant-jerk phases starting at rest at q0."""
+    total = sum(durations)
+    keep = [(d, j) for d, j in zip(durations, jerks) if d > 1e-14 * max(total, 1e-300)]
+    breaks = [0.0]
+    coefs = []
+    q, v, a = q0, 0.0, 0.0
+    for d, j in keep:
+        coefs.append([q, v, 0.5 * a, j / 6.0])
+        q, v, a = q + v * d + 0.5 * a * d * d + j * d**3 / 6.0, v + a * d + 0.5 * j * d * d, a + j * d
+        breaks.append(breaks[-1] + d)
+    return np.array(breaks), np.array(coefs)
+
+
+def _one_joint(breaks: np.ndarray, coefs: np.ndarray, q1: float, T_own: float, T: float, synchronized: bool) -> Trajectory:
+    """Single-joint trajectory over [0, T]: scaled to T, or held at q1 after its own T_own."""
+    if coefs.size == 0:  # no motion
+        return Trajectory([0.0, T], np.array([[[q1]]]))
+    if synchronized:
+        lam = T / T_own
+        b = breaks * lam
+        b[-1] = T
+        c = coefs / (lam ** np.arange(coefs.shape[1]))[None, :]
+        return Trajectory(b, c[:, :, None])
+    b = breaks.copy()
+    c = coefs
+    if T - T_own > 1e-12 * T:
+        b = np.append(b, T)
+        hold = np.zeros((1, coefs.shape[1]))
+        hold[0, 0] = q1
+        c = np.vstack([coefs, hold])
+    else:
+        b[-1] = T
+    return Trajectory(b, c[:, :, None])
+
+
+def _endpoints(q0: Any, q1: Any) -> tuple[np.ndarray, np.ndarray]:
+    a = _inputs.finite_array(q0, "q0")
+    b = _inputs.finite_array(q1, "q1")
+    a, b = np.atleast_1d(a), np.atleast_1d(b)
+    if a.ndim != 1 or a.shape != b.shape:
+        raise TrajectoryError(f"q0 and q1 must be (n_joints,) arrays of the same shape, got {a.shape} and {b.shape}")
+    if np.all(a == b):
+        raise TrajectoryError(f"q0 equals q1 ({a.tolist()}): there is no motion to plan")
+    return a, b
+
+
+def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = True) -> Trajectory:
+    """Rest-to-rest trapezoidal-velocity move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
+
+    ``vmax`` (rad/s) and ``amax`` (rad/s²) are scalars or per joint. Pieces are quadratics.
+    """
+    a, b = _endpoints(q0, q1)
+    n = a.size
+    v = _inputs.per_joint(vmax, n, "vmax", positive=True)
+    acc = _inputs.per_joint(amax, n, "amax", positive=True)
+    profiles = []
+    for j in range(n):
+        d = abs(b[j] - a[j])
+        Ta, T = trapezoidal_phases(d, v[j], acc[j])
+        sign = math.copysign(1.0, b[j] - a[j])
+        profiles.append((Ta, T, sign))
+    T = max(p[1] for p in profiles)
+    parts = []
+    for j, (Ta, Tj_total, sign) in enumerate(profiles):
+        if Tj_total == 0.0:
+            parts.append(_one_joint(np.array([0.0]), np.zeros((0, 3)), b[j], 0.0, T, synchronized))
+            continue
+        Tc = Tj_total - 2.0 * Ta
+        pieces_d = [Ta, Tc, Ta]
+        pieces_a = [sign * acc[j], 0.0, -sign * acc[j]]
+        total = Tj_total
+        keep = [(d, ac) for d, ac in zip(pieces_d, pieces_a) if d > 1e-14 * total]
+        breaks = [0.0]
+        coefs = []
+        q, vel = a[j], 0.0
+        for d, ac in keep:
+            coefs.append([q, vel, 0.5 * ac])
+            q, vel = q + vel * d + 0.5 * ac * d * d, vel + ac * d
+            breaks.append(breaks[-1] + d)
+        parts.append(_one_joint(np.array(breaks), np.array(coefs), b[j], Tj_total, T, synchronized))
+    definition = {
+        "kind": "trapezoidal",
+        "q0": a.tolist(),
+        "q1": b.tolist(),
+        "vmax": v.tolist(),
+        "amax": acc.tolist(),
+        "synchronized": bool(synchronized),
+    }
+    return stack_joints(parts, definition)
+
+
+def double_s(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any, *, synchronized: bool = True) -> Trajectory:
+    """Rest-to-rest jerk-limited (double-S) move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
+
+    ``vmax`` (rad/s), ``amax`` (rad/s²), ``jmax`` (rad/s³): scalars or per joint. Pieces are
+    cubics (constant jerk per phase, up to seven phases).
+    """
+    a, b = _endpoints(q0, q1)
+    n = a.size
+    v = _inputs.per_joint(vmax, n, "vmax", positive=True)
+    acc = _inputs.per_joint(amax, n, "amax", positive=True)
+    jer = _inputs.per_joint(jmax, n, "jmax", positive=True)
+    own = []
+    for j in range(n):
+        d = abs(b[j] - a[j])
+        if d == 0.0:
+            own.append((np.array([0.0]), np.zeros((0, 4)), 0.0))
+            continue
+        Tj, Ta, Tv = double_s_phases(d, v[j], acc[j], jer[j])
+        s = math.copysign(1.0, b[j] - a[j]) * jer[j]
+        durations = [Tj, Ta - 2.0 * Tj, Tj, Tv, Tj, Ta - 2.0 * Tj, Tj]
+        jerks = [s, 0.0, -s, 0.0, -s, 0.0, s]
+        breaks, coefs = _integrate_jerk_phases(a[j], durations, jerks)
+        own.append((breaks, coefs, 2.0 * Ta + Tv))
+    T = max(o[2] for o in own)
+    parts = [_one_joint(br, co, b[j], Tt, T, synchronized) for j, (br, co, Tt) in enumerate(own)]
+    definition = {
+        "kind": "double_s",
+        "q0": a.tolist(),
+        "q1": b.tolist(),
+        "vmax": v.tolist(),
+        "amax": acc.tolist(),
+        "jmax": jer.tolist(),
+        "synchronized": bool(synchronized),
+    }
+    return stack_joints(parts, definition)

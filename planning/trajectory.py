@@ -1,0 +1,601 @@
+"""The joint-space trajectory: a piecewise polynomial in time, one column per joint.
+
+Every trajectory family of :mod:`planning` (single polynomials, 3-5-3, multi-segment
+quintics, quintic B-splines, trapezoidal and double-S profiles) is converted to one common
+representation, so that sampling, exact peak search, limit checks, time scaling and
+concatenation are written once and vectorised over instants and joints:
+
+* ``breaks`` — knot times ``t_0 < t_1 < ... < t_m`` (s), shape ``(m+1,)``;
+* ``coefficients`` — shape ``(m, K+1, n_joints)``: on piece ``i`` and for
+  ``tau = t - t_i`` in ``[0, t_{i+1} - t_i]`` (s), joint ``j`` is at
+  ``q_j(t) = sum_k coefficients[i, k, j] * tau**k`` (ascending powers, the joint's unit:
+  rad for revolute, m for prismatic joints).
+
+A trajectory knows nothing about limits or optimisers (the split follows toppra: path,
+constraints and algorithm are separate objects). :meth:`Trajectory.check` takes a
+:class:`planning.JointLimits` spec and returns a :class:`LimitReport`.
+
+Peaks are *exact*: on each piece the extrema of ``|d^r q / dt^r|`` are at the piece ends
+or at real roots of the next derivative, which are found for all pieces, joints and
+derivative orders at once (closed form up to degree 2, batched companion-matrix
+eigenvalues above).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from planning._inputs import finite_array
+from planning.errors import OutOfTimeRange, TrajectoryError
+
+__all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
+
+#: Relative size below which a leading polynomial coefficient counts as zero in the root
+#: search (in normalised piece time s in [0, 1], where all coefficients are comparable).
+_ROOT_RTOL = 1e-12
+
+#: Names of the derivative orders, as used in :class:`Violation` and the peak report.
+_KIND_BY_ORDER = {1: "velocity", 2: "acceleration", 3: "jerk"}
+
+
+@dataclass(frozen=True, eq=False)
+class Peaks:
+    """Per-joint maxima of ``|qd|``, ``|qdd|`` and ``|qddd|`` over a whole trajectory.
+
+    Each field has shape ``(n_joints,)`` in the joint's unit per s, s², s³
+    (rad/s, rad/s², rad/s³ for revolute joints). Computed exactly, not by sampling.
+    """
+
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    jerk: np.ndarray
+
+    def as_dict(self) -> dict[str, list[float]]:
+        """JSON-able form ``{"velocity": [...], "acceleration": [...], "jerk": [...]}``."""
+        return {k: getattr(self, k).tolist() for k in ("velocity", "acceleration", "jerk")}
+
+
+class Violation(NamedTuple):
+    """One limit violation: joint index, time (s) of the worst value, kind, value, limit.
+
+    ``kind`` is one of ``"position_lower"``, ``"position_upper"``, ``"velocity"``,
+    ``"acceleration"``, ``"jerk"``. For velocity/acceleration/jerk ``value`` is the peak
+    magnitude on the offending piece; for positions it is the extreme position.
+    """
+
+    joint: int
+    time: float
+    kind: str
+    value: float
+    limit: float
+
+
+@dataclass(frozen=True, eq=False)
+class LimitReport:
+    """Result of :meth:`Trajectory.check`: every violation, at most one per joint, kind and piece."""
+
+    violations: tuple[Violation, ...] = field(default_factory=tuple)
+
+    @property
+    def ok(self) -> bool:
+        """True when no limit is violated."""
+        return not self.violations
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+    def __str__(self) -> str:
+        if self.ok:
+            return "all limits respected"
+        lines = [f"{len(self.violations)} limit violation(s):"]
+        for v in self.violations:
+            lines.append(
+                f"  joint {v.joint} at t = {v.time:.6g} s: {v.kind} {v.value:.6g} exceeds limit {v.limit:.6g}"
+            )
+        return "\n".join(lines)
+
+
+def _derivative_coefficients(coefs: np.ndarray, order: int, axis: int) -> np.ndarray:
+    """Coefficients (ascending powers along ``axis``) of the ``order``-th derivative; same length, zero padded."""
+    c = np.moveaxis(np.asarray(coefs, dtype=float), axis, -1)
+    width = c.shape[-1]
+    out = np.zeros_like(c)
+    if order < width:
+        k = np.arange(order, width)
+        falling = np.ones(width - order)
+        for r in range(order):
+            falling *= k - r
+        out[..., : width - order] = c[..., order:] * falling
+    return np.moveaxis(out, -1, axis)
+
+
+@functools.lru_cache(maxsize=64)
+def _derivative_matrices(width: int, orders: tuple[int, ...]) -> np.ndarray:
+    """Right-multiplication matrices (o, W, 2W-1) from ascending coefficients (.., W) to derivatives.
+
+    ``c @ M[i]`` holds, side by side, the coefficients of the ``orders[i]``-th derivative
+    (first W columns) and of the next derivative (last W-1 columns; its always-zero top
+    coefficient dropped). For W = 1 the second block is one zero column.
+    """
+    eye = np.eye(width)
+    blocks = []
+    for r in orders:
+        nxt = _derivative_coefficients(eye, r + 1, axis=1)[:, : max(width - 1, 1)]
+        if width == 1:
+            nxt = np.zeros((1, 1))
+        blocks.append(np.concatenate([_derivative_coefficients(eye, r, axis=1), nxt], axis=1))
+    M = np.stack(blocks)
+    M.flags.writeable = False
+    return M
+
+
+def _horner(coefs: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Evaluate rows of ascending coefficients (B, D+1) at points (B, C) -> (B, C)."""
+    out = np.zeros(s.shape)
+    for k in range(coefs.shape[1] - 1, -1, -1):
+        out = out * s + coefs[:, k : k + 1]
+    return out
+
+
+_THIRDS = (2.0 * np.pi / 3.0) * np.arange(3)
+
+
+def _cubic_roots(R: np.ndarray) -> np.ndarray:
+    """Real parts of the three roots of cubics with ascending coefficients R (k, 4), R[:, 3] != 0.
+
+    Closed form (Cardano for one real root, trigonometric for three); a complex pair
+    contributes its real part. Root errors only matter to second order for the extremum
+    values evaluated there. Both branches are computed for all rows (fewer numpy calls).
+    """
+    inv = 1.0 / R[:, 3]
+    B3 = R[:, 2] * inv / 3.0
+    C = R[:, 1] * inv
+    p = C - 3.0 * B3 * B3
+    q = B3 * (2.0 * B3 * B3 - C) + R[:, 0] * inv
+    disc = 0.25 * q * q + p * p * p / 27.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.cbrt(-0.5 * q - np.copysign(np.sqrt(np.maximum(disc, 0.0)), q))
+        y1 = np.where(u != 0.0, u - p / (3.0 * u), 0.0)
+        mag = 2.0 * np.sqrt(np.maximum(-p, 0.0) / 3.0)
+        arg = np.where(mag > 0.0, -4.0 * q / (mag * mag * mag), 1.0)
+    theta = np.arccos(np.minimum(np.maximum(arg, -1.0), 1.0)) / 3.0
+    three = mag[:, None] * np.cos(theta[:, None] - _THIRDS)
+    one = np.stack([y1, -0.5 * y1, -0.5 * y1], axis=1)
+    return np.where((disc > 0.0)[:, None], one, three) - B3[:, None]
+
+
+def _candidate_points(R: np.ndarray) -> np.ndarray:
+    """Points of [0, 1] where the polynomials with ascending coefficients ``R`` (B, D+1) may vanish.
+
+    Returns (B, max(D, 1)): the real parts of all roots, clipped to [0, 1], zero padded.
+    Extra candidates are harmless (the caller evaluates the function there and takes the
+    extreme), so complex roots keep their real part and no root is ever missed. Leading
+    coefficients below ``_ROOT_RTOL`` times the row's largest one are dropped (their roots
+    lie far outside [0, 1]). Closed forms up to degree 3, companion-matrix eigenvalues above.
+    """
+    B, width = R.shape
+    D = width - 1
+    out = np.zeros((B, max(D, 1)))
+    if D == 0 or B == 0:
+        return out
+    mag = np.abs(R)
+    threshold = _ROOT_RTOL * mag.max(axis=1)
+    significant = mag > threshold[:, None]
+    degree = D - np.argmax(significant[:, ::-1], axis=1)
+    degree[threshold == 0.0] = 0
+    for d in range(1, D + 1):
+        rows = np.flatnonzero(degree == d)
+        if rows.size == 0:
+            continue
+        Rr = R[rows, : d + 1]
+        if d == 1:
+            out[rows, 0] = -Rr[:, 0] / Rr[:, 1]
+        elif d == 2:
+            a, b, c = Rr[:, 2], Rr[:, 1], Rr[:, 0]
+            sq = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
+            q = -0.5 * (b + np.copysign(sq, b))
+            out[rows, 0] = q / a
+            safe_q = np.where(q != 0.0, q, 1.0)
+            out[rows, 1] = np.where(q != 0.0, c / safe_q, 0.0)
+        elif d == 3:
+            out[rows, :3] = _cubic_roots(Rr)
+        else:
+            monic = Rr[:, :d] / Rr[:, d : d + 1]
+            companion = np.zeros((rows.size, d, d))
+            companion[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+            companion[:, :, d - 1] = -monic
+            out[rows, :d] = np.linalg.eigvals(companion).real
+    return np.minimum(np.maximum(out, 0.0), 1.0)
+
+
+class Trajectory:
+    """A joint trajectory: piecewise polynomial in time, per joint (see the module docstring).
+
+    Build one with the constructors of :mod:`planning` (``polynomial``,
+    ``piecewise_polynomial``, ``multi_quintic``, ``quintic_bspline``, ``trapezoidal``,
+    ``double_s``) or directly from ``breaks`` (s, strictly increasing, (m+1,)) and
+    ``coefficients`` ((m, K+1, n_joints), ascending powers of the time since each piece's
+    start). ``definition`` is the JSON-able recipe :func:`planning.from_definition` rebuilds
+    it from; when omitted the raw breaks and coefficients are used.
+    """
+
+    def __init__(self, breaks: Any, coefficients: Any, definition: dict | None = None) -> None:
+        b = finite_array(breaks, "breaks")
+        c = finite_array(coefficients, "coefficients")
+        if b.ndim != 1 or b.size < 2:
+            raise TrajectoryError(f"breaks must be a 1-D array of at least 2 instants (s), got shape {b.shape}")
+        if np.any(np.diff(b) <= 0.0):
+            i = int(np.argmax(np.diff(b) <= 0.0))
+            raise TrajectoryError(f"breaks must be strictly increasing; breaks[{i + 1}] = {b[i + 1]!r} <= {b[i]!r}")
+        if c.ndim == 2:
+            c = c[:, :, None]
+        if c.ndim != 3 or c.shape[0] != b.size - 1 or c.shape[1] < 1 or c.shape[2] < 1:
+            raise TrajectoryError(
+                f"coefficients must have shape ({b.size - 1}, degree+1, n_joints) for {b.size} breaks, got {c.shape}"
+            )
+        self._breaks = b.copy()
+        self._coefs = c.copy()
+        self._breaks.flags.writeable = False
+        self._coefs.flags.writeable = False
+        self._definition = definition
+        self._stack: np.ndarray | None = None
+        self._norm: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ basic data
+    @property
+    def n_joints(self) -> int:
+        """Number of joints (columns)."""
+        return self._coefs.shape[2]
+
+    @property
+    def n_segments(self) -> int:
+        """Number of polynomial pieces."""
+        return self._coefs.shape[0]
+
+    @property
+    def degree(self) -> int:
+        """Highest polynomial degree stored (K); lower-degree pieces are zero padded."""
+        return self._coefs.shape[1] - 1
+
+    @property
+    def start_time(self) -> float:
+        """First knot time (s)."""
+        return float(self._breaks[0])
+
+    @property
+    def end_time(self) -> float:
+        """Last knot time (s)."""
+        return float(self._breaks[-1])
+
+    @property
+    def duration(self) -> float:
+        """Total duration (s)."""
+        return float(self._breaks[-1] - self._breaks[0])
+
+    @property
+    def knot_times(self) -> np.ndarray:
+        """Piece boundaries (s), shape (m+1,) (a copy)."""
+        return self._breaks.copy()
+
+    @property
+    def segment_durations(self) -> np.ndarray:
+        """Piece durations (s), shape (m,)."""
+        return np.diff(self._breaks)
+
+    @property
+    def coefficients(self) -> np.ndarray:
+        """Coefficients (m, K+1, n_joints), ascending powers of the time since the piece start (a copy)."""
+        return self._coefs.copy()
+
+    @property
+    def definition(self) -> dict:
+        """JSON-able recipe (kind, knot times, via points, options) for :func:`planning.from_definition`."""
+        if self._definition is not None:
+            return _json_copy(self._definition)
+        return {
+            "kind": "ppoly",
+            "breaks": self._breaks.tolist(),
+            "coefficients": self._coefs.tolist(),
+        }
+
+    def __repr__(self) -> str:
+        kind = (self._definition or {}).get("kind", "ppoly")
+        return (
+            f"Trajectory(kind={kind!r}, n_joints={self.n_joints}, n_segments={self.n_segments}, "
+            f"degree={self.degree}, t=[{self.start_time:g}, {self.end_time:g}] s)"
+        )
+
+    # -------------------------------------------------------------------- sampling
+    def _derivative_stack(self) -> np.ndarray:
+        """(m, K+1, 4*n): coefficients of q, qd, qdd, qddd side by side (cached)."""
+        if self._stack is None:
+            c = self._coefs
+            parts = [_derivative_coefficients(c, r, axis=1) for r in range(4)]
+            self._stack = np.concatenate(parts, axis=2)
+        return self._stack
+
+    def _check_times(self, t: Any) -> tuple[np.ndarray, bool]:
+        arr = finite_array(t, "t")
+        scalar = arr.ndim == 0
+        arr = np.atleast_1d(arr)
+        if arr.ndim != 1:
+            raise TrajectoryError(f"t must be a scalar or a 1-D array of instants (s), got shape {arr.shape}")
+        t0, t1 = self._breaks[0], self._breaks[-1]
+        tol = 1e-12 * max(1.0, abs(t0), abs(t1))
+        if arr.size and (arr.min() < t0 - tol or arr.max() > t1 + tol):
+            bad = arr[(arr < t0 - tol) | (arr > t1 + tol)][0]
+            raise OutOfTimeRange(
+                f"t = {bad!r} s is outside the trajectory's time range [{t0!r}, {t1!r}] s; "
+                "sample within it (a trajectory does not extrapolate)"
+            )
+        return np.clip(arr, t0, t1), scalar
+
+    def sample(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration and jerk at the instants ``t`` (s).
+
+        Returns ``(q, qd, qdd, qddd)``, each ``(len(t), n_joints)`` (or ``(n_joints,)`` for a
+        scalar ``t``). At an interior knot the piece that starts there is used. Raises
+        :class:`planning.errors.OutOfTimeRange` for instants outside
+        ``[start_time, end_time]`` (beyond a 1e-12 relative tolerance, which is clipped).
+        """
+        tt, scalar = self._check_times(t)
+        n = self.n_joints
+        D = self._derivative_stack()
+        m = self.n_segments
+        seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
+        tau = tt - self._breaks[seg]
+        powers = tau[:, None] ** np.arange(self.degree + 1)
+        out = np.empty((tt.size, 4 * n))
+        if m == 1:
+            np.matmul(powers, D[0], out=out)
+        else:
+            sorted_input = tt.size < 2 or bool(np.all(seg[1:] >= seg[:-1]))
+            order = None if sorted_input else np.argsort(seg, kind="stable")
+            seg_sorted = seg if order is None else seg[order]
+            edges = np.searchsorted(seg_sorted, np.arange(m + 1))
+            for s in np.flatnonzero(np.diff(edges)):
+                lo, hi = edges[s], edges[s + 1]
+                if order is None:
+                    out[lo:hi] = powers[lo:hi] @ D[s]
+                else:
+                    idx = order[lo:hi]
+                    out[idx] = powers[idx] @ D[s]
+        q, qd, qdd, qddd = (out[:, r * n : (r + 1) * n] for r in range(4))
+        if scalar:
+            return q[0].copy(), qd[0].copy(), qdd[0].copy(), qddd[0].copy()
+        return q, qd, qdd, qddd
+
+    def __call__(self, t: Any) -> np.ndarray:
+        """Positions only: ``sample(t)[0]``."""
+        return self.sample(t)[0]
+
+    def at_rate(self, hz: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Sample at ``hz`` (1/s): instants ``start + k/hz`` plus the end instant.
+
+        Returns ``(t, q, qd, qdd, qddd)``; ``t`` is (N,), the others (N, n_joints).
+        """
+        rate = float(finite_array(hz, "hz"))
+        if rate <= 0.0:
+            raise TrajectoryError(f"hz must be positive, got {hz!r}")
+        count = int(math.floor(self.duration * rate * (1.0 + 1e-12))) + 1
+        t = self.start_time + np.arange(count) / rate
+        t = t[t < self.end_time - 1e-9 / rate]
+        t = np.append(t, self.end_time)
+        return (t, *self.sample(t))
+
+    # ---------------------------------------------------------------- exact extrema
+    def _normalised(self) -> np.ndarray:
+        """Coefficients (m, n, K+1) of each piece in normalised time s = tau / h in [0, 1] (cached)."""
+        if self._norm is None:
+            h = np.diff(self._breaks)
+            width = self.degree + 1
+            cn = self._coefs * (h[:, None] ** np.arange(width))[:, :, None]
+            self._norm = np.ascontiguousarray(np.moveaxis(cn, 1, 2))
+        return self._norm
+
+    def _extrema(self, orders: tuple[int, ...], with_times: bool = True) -> tuple[np.ndarray, Any]:
+        """Values and times of the candidate extrema of derivatives ``orders`` per piece.
+
+        Returns ``(values, times)``, each (len(orders), m, n, C): the derivative of order r
+        (in the joint's unit / s^r) at the piece ends and at every root of the next
+        derivative within the piece. Max/min over the last axis are the exact extrema.
+        """
+        cn = self._normalised()  # (m, n, W)
+        m, n, width = cn.shape
+        h = np.diff(self._breaks)
+        M = _derivative_matrices(width, orders)  # (o, W, 2W-1): [derivative r | derivative r+1]
+        o = len(orders)
+        PR = np.matmul(cn.reshape(m * n, width), M)  # (o, m*n, 2W-1), coefficients in s
+        scale = np.repeat(h[None, :] ** -np.asarray(orders, dtype=float)[:, None], n, axis=1)  # (o, m*n)
+        P = PR[:, :, :width] * scale[:, :, None]  # d^r q / dt^r = h^-r d^r q / ds^r
+        roots = _candidate_points(PR[:, :, width:].reshape(o * m * n, -1))
+        B = roots.shape[0]
+        s = np.empty((B, roots.shape[1] + 2))
+        s[:, 0] = 0.0
+        s[:, 1] = 1.0
+        s[:, 2:] = roots
+        values = _horner(P.reshape(B, width), s).reshape(o, m, n, -1)
+        if not with_times:
+            return values, None
+        times = self._breaks[:-1][None, :, None, None] + s.reshape(o, m, n, -1) * h[None, :, None, None]
+        return values, times
+
+    def peaks(self) -> Peaks:
+        """Exact per-joint maxima of |velocity|, |acceleration| and |jerk| over the whole duration."""
+        values, _ = self._extrema((1, 2, 3), with_times=False)
+        top = np.abs(values).max(axis=(1, 3))  # (3, n)
+        return Peaks(velocity=top[0], acceleration=top[1], jerk=top[2])
+
+    def position_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """Exact per-joint minimum and maximum position over the whole duration, each (n_joints,)."""
+        values, _ = self._extrema((0,), with_times=False)
+        return values[0].min(axis=(0, 2)), values[0].max(axis=(0, 2))
+
+    def check(self, limits: Any, rtol: float = 1e-9) -> LimitReport:
+        """Check against a :class:`planning.JointLimits`; report every violation.
+
+        A value counts as a violation when it exceeds the limit by more than ``rtol``
+        relative (so an optimised trajectory that touches a limit passes). One
+        :class:`Violation` is reported per joint, kind and piece, at the time of the worst
+        value on that piece; the list is sorted by time.
+        """
+        from planning.limits import JointLimits
+
+        if not isinstance(limits, JointLimits):
+            raise TrajectoryError(f"limits must be a planning.JointLimits, got {type(limits).__name__}")
+        n = self.n_joints
+        found: list[Violation] = []
+        orders = tuple(r for r, name in _KIND_BY_ORDER.items() if getattr(limits, name) is not None)
+        if orders:
+            values, times = self._extrema(orders)
+            mag = np.abs(values)
+            best = np.argmax(mag, axis=3)[..., None]
+            peak = np.take_along_axis(mag, best, axis=3)[..., 0]  # (o, m, n)
+            when = np.take_along_axis(times, best, axis=3)[..., 0]
+            for o, r in enumerate(orders):
+                name = _KIND_BY_ORDER[r]
+                lim = limits.for_joints(name, n)
+                bad = peak[o] > lim[None, :] * (1.0 + rtol)
+                for seg, j in zip(*np.nonzero(bad)):
+                    found.append(Violation(int(j), float(when[o, seg, j]), name, float(peak[o, seg, j]), float(lim[j])))
+        if limits.lower is not None or limits.upper is not None:
+            values, times = self._extrema((0,))
+            v, tm = values[0], times[0]  # (m, n, C)
+            span = np.maximum(np.abs(v).max(), 1.0)
+            if limits.lower is not None:
+                lo = limits.for_joints("lower", n)
+                idx = np.argmin(v, axis=2)[..., None]
+                vmin = np.take_along_axis(v, idx, axis=2)[..., 0]
+                tmin = np.take_along_axis(tm, idx, axis=2)[..., 0]
+                for seg, j in zip(*np.nonzero(vmin < lo[None, :] - rtol * span)):
+                    found.append(Violation(int(j), float(tmin[seg, j]), "position_lower", float(vmin[seg, j]), float(lo[j])))
+            if limits.upper is not None:
+                hi = limits.for_joints("upper", n)
+                idx = np.argmax(v, axis=2)[..., None]
+                vmax = np.take_along_axis(v, idx, axis=2)[..., 0]
+                tmax = np.take_along_axis(tm, idx, axis=2)[..., 0]
+                for seg, j in zip(*np.nonzero(vmax > hi[None, :] + rtol * span)):
+                    found.append(Violation(int(j), float(tmax[seg, j]), "position_upper", float(vmax[seg, j]), float(hi[j])))
+        found.sort(key=lambda v: (v.time, v.joint, v.kind))
+        return LimitReport(tuple(found))
+
+    # ------------------------------------------------------------ transformations
+    def scaled(self, factor: float) -> "Trajectory":
+        """Time-scaled copy: duration multiplied by ``factor`` (> 0), same start time.
+
+        Velocities scale by 1/factor, accelerations by 1/factor², jerks by 1/factor³.
+        """
+        f = float(finite_array(factor, "factor"))
+        if f <= 0.0:
+            raise TrajectoryError(f"factor must be positive, got {factor!r}")
+        breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
+        coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        return Trajectory(breaks, coefs, {"kind": "scaled", "factor": f, "base": self.definition})
+
+    def shifted(self, start_time: float) -> "Trajectory":
+        """Copy that starts at ``start_time`` (s) instead of :attr:`start_time`."""
+        t0 = float(finite_array(start_time, "start_time"))
+        breaks = self._breaks - self._breaks[0] + t0
+        return Trajectory(breaks, self._coefs, {"kind": "shifted", "start_time": t0, "base": self.definition})
+
+    def concatenated(self, other: "Trajectory", atol: float = 1e-9) -> "Trajectory":
+        """This trajectory followed by ``other`` (shifted in time to start where this one ends).
+
+        The end position of ``self`` must equal the start position of ``other`` within
+        ``atol`` per joint; velocities and accelerations are not required to match (a
+        rest-to-rest pair joins smoothly, others may have a step in velocity: check it).
+        """
+        if not isinstance(other, Trajectory):
+            raise TrajectoryError(f"can only concatenate a Trajectory, got {type(other).__name__}")
+        if other.n_joints != self.n_joints:
+            raise TrajectoryError(
+                f"cannot concatenate a {other.n_joints}-joint trajectory to a {self.n_joints}-joint one"
+            )
+        q_end = self.sample(self.end_time)[0]
+        q_start = other.sample(other.start_time)[0]
+        gap = np.abs(q_end - q_start)
+        if np.any(gap > atol):
+            j = int(np.argmax(gap))
+            raise TrajectoryError(
+                f"position jump at the junction: joint {j} ends at {q_end[j]!r} but the next trajectory "
+                f"starts at {q_start[j]!r} (|gap| {gap[j]:.3g} > atol {atol:g}); start it where this one ends"
+            )
+        width = max(self.degree, other.degree) + 1
+        a = _pad_degree(self._coefs, width)
+        b = _pad_degree(other._coefs, width)
+        breaks = np.concatenate([self._breaks, other._breaks[1:] - other._breaks[0] + self._breaks[-1]])
+        parts = []
+        for d in (self.definition, other.definition):
+            parts.extend(d["parts"] if d.get("kind") == "concatenated" else [d])
+        return Trajectory(breaks, np.concatenate([a, b], axis=0), {"kind": "concatenated", "parts": parts})
+
+
+# ---------------------------------------------------------------------- helpers
+def _json_copy(obj: Any) -> Any:
+    """Deep copy of a JSON-able structure (dicts, lists, numbers, strings)."""
+    if isinstance(obj, dict):
+        return {k: _json_copy(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_copy(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _pad_degree(coefs: np.ndarray, width: int) -> np.ndarray:
+    """Zero-pad coefficients (m, K+1, n) to (m, width, n)."""
+    if coefs.shape[1] == width:
+        return coefs
+    out = np.zeros((coefs.shape[0], width, coefs.shape[2]))
+    out[:, : coefs.shape[1]] = coefs
+    return out
+
+
+def taylor_shift(coefs: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Re-expand pieces about a later origin: coefficients of ``q(offset + u)`` in ``u``.
+
+    ``coefs`` (m, K+1, n) ascending powers; ``offset`` (m,) in s. Returns (m, K+1, n).
+    """
+    width = coefs.shape[1]
+    i = np.arange(width)
+    binom = np.array([[math.comb(int(b), int(a)) if b >= a else 0 for b in i] for a in i], dtype=float)
+    expo = np.clip(i[None, :] - i[:, None], 0, None)
+    M = binom[None] * np.asarray(offset, dtype=float)[:, None, None] ** expo[None]
+    M = np.where((i[None, :] >= i[:, None])[None], M, 0.0)
+    return np.einsum("ski,sij->skj", M, coefs)
+
+
+def stack_joints(parts: list[Trajectory], definition: dict | None = None) -> Trajectory:
+    """Combine single-joint trajectories with the same time range into one multi-joint trajectory.
+
+    The breaks are the union of all parts' breaks (instants closer than 1e-12 of the
+    duration are merged); each part is re-expanded about the union breaks.
+    """
+    t0, t1 = parts[0].start_time, parts[0].end_time
+    tol = 1e-12 * max(1.0, abs(t0), abs(t1))
+    for p in parts[1:]:
+        if abs(p.start_time - t0) > tol or abs(p.end_time - t1) > tol:
+            raise TrajectoryError(
+                f"cannot stack trajectories over different times: [{t0}, {t1}] vs [{p.start_time}, {p.end_time}] s"
+            )
+    allb = np.sort(np.concatenate([p._breaks for p in parts]))
+    keep = np.concatenate([[True], np.diff(allb) > tol])
+    breaks = allb[keep]
+    breaks[0], breaks[-1] = t0, t1
+    if breaks.size >= 2 and breaks[-1] - breaks[-2] <= tol:
+        breaks = np.delete(breaks, -2)
+    mid = 0.5 * (breaks[:-1] + breaks[1:])
+    width = max(p.degree for p in parts) + 1
+    cols = []
+    for p in parts:
+        seg = np.clip(np.searchsorted(p._breaks, mid, side="right") - 1, 0, p.n_segments - 1)
+        c = _pad_degree(p._coefs, width)[seg]
+        cols.append(taylor_shift(c, breaks[:-1] - p._breaks[seg]))
+    return Trajectory(breaks, np.concatenate(cols, axis=2), definition)
