@@ -1,0 +1,48 @@
+"""Visualisation and saved sessions: MeshCat scenes in the browser, standalone HTML, plots.
+
+>>> import robots, viz
+>>> s = viz.Session(robots.load("ur5"), title="demo")
+>>> s.save("demo.pinarms")
+>>> with viz.show(viz.load_session("demo.pinarms")) as viewer:
+...     print(viewer.url)
+>>> viz.export_html(s, "demo.html")
+"""
+
+from .errors import SessionFormatError, ViewerError, VizError
+from .html import export_html
+from .scene import SceneInfo, build_scene
+from .session import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    BoxObject,
+    HistoryRecord,
+    PointSet,
+    RobotEntry,
+    Session,
+    TrajectoryRecord,
+    WorkspaceRecord,
+    load_session,
+)
+from .viewer import MeshcatServer, Viewer, show
+
+__all__ = [
+    "Session",
+    "load_session",
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "RobotEntry",
+    "BoxObject",
+    "TrajectoryRecord",
+    "WorkspaceRecord",
+    "PointSet",
+    "HistoryRecord",
+    "show",
+    "Viewer",
+    "MeshcatServer",
+    "export_html",
+    "build_scene",
+    "SceneInfo",
+    "VizError",
+    "SessionFormatError",
+    "ViewerError",
+]
