@@ -24,7 +24,7 @@ def finite_array(value: Any, what: str) -> np.ndarray:
         bad = np.argwhere(~np.isfinite(arr))[0]
         index = tuple(int(i) for i in bad)
         raise TrajectoryError(
-            f"{what} must be finite; entry {index if arr.ndim else ()} is {arr[tuple(bad)]!r}"
+            f"{what} must be finite; entry {index if arr.ndim else ()} is {float(arr[tuple(bad)])!r}"
         )
     return arr
 
@@ -40,8 +40,8 @@ def knot_times(times: Any, what: str = "times", minimum: int = 2) -> np.ndarray:
     if np.any(steps <= 0.0):
         i = int(np.argmax(steps <= 0.0))
         raise TrajectoryError(
-            f"{what} must be strictly increasing; {what}[{i + 1}] = {t[i + 1]!r} does not come "
-            f"after {what}[{i}] = {t[i]!r}"
+            f"{what} must be strictly increasing; {what}[{i + 1}] = {float(t[i + 1])!r} does not come "
+            f"after {what}[{i}] = {float(t[i])!r}"
         )
     return t
 
@@ -53,7 +53,7 @@ def durations(values: Any, what: str = "durations") -> np.ndarray:
         raise TrajectoryError(f"{what} must be a non-empty 1-D sequence (s), got shape {h.shape}")
     if np.any(h <= 0.0):
         i = int(np.argmax(h <= 0.0))
-        raise TrajectoryError(f"{what} must be positive; {what}[{i}] = {h[i]!r}")
+        raise TrajectoryError(f"{what} must be positive; {what}[{i}] = {float(h[i])!r}")
     return h
 
 
@@ -83,7 +83,7 @@ def per_joint(value: Any, n_joints: int, what: str, *, positive: bool = False) -
     v = np.broadcast_to(v.reshape(-1) if v.ndim else v, (n_joints,)).astype(float)
     if positive and np.any(v <= 0.0):
         i = int(np.argmax(v <= 0.0))
-        raise TrajectoryError(f"{what} must be positive; entry {i} is {v[i]!r}")
+        raise TrajectoryError(f"{what} must be positive; entry {i} is {float(v[i])!r}")
     return v
 
 

@@ -50,7 +50,7 @@ class JointLimits:
                 raise TrajectoryError(f"{name} limit must be a scalar or a 1-D per-joint array, got shape {arr.shape}")
             if name in _POSITIVE and np.any(arr <= 0.0):
                 bad = arr.reshape(-1)[np.argmax(arr.reshape(-1) <= 0.0)]
-                raise TrajectoryError(f"{name} limit must be positive, got {bad!r}")
+                raise TrajectoryError(f"{name} limit must be positive, got {float(bad)!r}")
             arr = arr.copy()
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
@@ -60,7 +60,7 @@ class JointLimits:
                 i = int(np.argmax(np.atleast_1d(lo >= hi)))
                 raise TrajectoryError(
                     f"lower position limit must be below upper; joint {i}: "
-                    f"{np.atleast_1d(lo)[i]!r} >= {np.atleast_1d(hi)[i]!r}"
+                    f"{float(np.atleast_1d(lo)[i])!r} >= {float(np.atleast_1d(hi)[i])!r}"
                 )
 
     def for_joints(self, name: str, n_joints: int) -> np.ndarray:

@@ -231,7 +231,7 @@ class Trajectory:
             raise TrajectoryError(f"breaks must be a 1-D array of at least 2 instants (s), got shape {b.shape}")
         if np.any(np.diff(b) <= 0.0):
             i = int(np.argmax(np.diff(b) <= 0.0))
-            raise TrajectoryError(f"breaks must be strictly increasing; breaks[{i + 1}] = {b[i + 1]!r} <= {b[i]!r}")
+            raise TrajectoryError(f"breaks must be strictly increasing; breaks[{i + 1}] = {float(b[i + 1])!r} <= {float(b[i])!r}")
         if c.ndim == 2:
             c = c[:, :, None]
         if c.ndim != 3 or c.shape[0] != b.size - 1 or c.shape[1] < 1 or c.shape[2] < 1:
@@ -330,7 +330,7 @@ class Trajectory:
         if arr.size and (arr.min() < t0 - tol or arr.max() > t1 + tol):
             bad = arr[(arr < t0 - tol) | (arr > t1 + tol)][0]
             raise OutOfTimeRange(
-                f"t = {bad!r} s is outside the trajectory's time range [{t0!r}, {t1!r}] s; "
+                f"t = {float(bad)!r} s is outside the trajectory's time range [{float(t0)!r}, {float(t1)!r}] s; "
                 "sample within it (a trajectory does not extrapolate)"
             )
         return np.clip(arr, t0, t1), scalar
@@ -522,8 +522,8 @@ class Trajectory:
         if np.any(gap > atol):
             j = int(np.argmax(gap))
             raise TrajectoryError(
-                f"position jump at the junction: joint {j} ends at {q_end[j]!r} but the next trajectory "
-                f"starts at {q_start[j]!r} (|gap| {gap[j]:.3g} > atol {atol:g}); start it where this one ends"
+                f"position jump at the junction: joint {j} ends at {float(q_end[j])!r} but the next trajectory "
+                f"starts at {float(q_start[j])!r} (|gap| {gap[j]:.3g} > atol {atol:g}); start it where this one ends"
             )
         width = max(self.degree, other.degree) + 1
         a = _pad_degree(self._coefs, width)
