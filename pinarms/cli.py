@@ -310,8 +310,11 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
 def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, as_json: bool) -> None:
     """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region."""
     arm = _load_robot(robot)
-    ws = robots.sample_workspace(arm, n=n, seed=seed, frame=frame)
-    summary = jsonable(ws.summary())
+    from robots.workspace import sample_workspace
+
+    ws = sample_workspace(arm, n=n, seed=seed, frame=frame)
+    summary_obj = ws.summary()
+    summary = jsonable(summary_obj)
     lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
     data = {
         "robot": arm.name,
@@ -327,10 +330,10 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
         f"bounding box [m]: min {_fmt(lo, 4)}  max {_fmt(hi, 4)}",
         f"manipulability: mean {np.mean(ws.manipulability):.4g}, max {np.max(ws.manipulability):.4g}",
     ]
-    if isinstance(summary, dict):
+    if callable(getattr(summary_obj, "text", None)):
+        lines.append(summary_obj.text())
+    elif isinstance(summary, dict):
         lines += [f"{k}: {v}" for k, v in summary.items()]
-    else:
-        lines.append(str(summary))
     if session_path:
         session = _new_session(arm, f"workspace of {arm.name}")
         session.add_workspace("workspace", ws)
