@@ -6,10 +6,12 @@
 >>> with viz.show(viz.load_session("demo.pinarms")) as viewer:
 ...     print(viewer.url)
 >>> viz.export_html(s, "demo.html")
+>>> viz.plot_trajectory("joints.png", traj, limits=limits)
 """
 
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
+from .plots import plot_ga_convergence, plot_joint_curves, plot_trajectory, plot_workspace
 from .scene import SceneInfo, build_scene
 from .session import (
     FORMAT_NAME,
@@ -41,6 +43,10 @@ __all__ = [
     "MeshcatServer",
     "export_html",
     "build_scene",
+    "plot_joint_curves",
+    "plot_trajectory",
+    "plot_ga_convergence",
+    "plot_workspace",
     "SceneInfo",
     "VizError",
     "SessionFormatError",

@@ -23,15 +23,13 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import matplotlib
-import meshcat
-import meshcat.animation
-import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 from pinocchio.visualize import MeshcatVisualizer
 
 from robots.errors import InvalidInput
 
+from ._meshcat import meshcat, mg
 from .errors import ViewerError
 
 __all__ = ["SceneInfo", "build_scene", "ROOT", "colors_by_value"]

@@ -58,7 +58,8 @@ FORMAT_NAME = "pinarms-session"
 FORMAT_VERSION = 1
 JSON_MEMBER = "session.json"
 
-_NAME_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}$")
+#: names of robots, trajectories, ...: 1-100 printable characters, no "/" (scene path separator)
+_NAME_RE = re.compile(r"^(?=.*\S)[^/\x00-\x1f\x7f]{1,100}$")
 _POINT_KINDS = ("via", "target")
 _F8 = np.dtype("<f8")
 
@@ -174,7 +175,7 @@ class HistoryRecord:
 def _check_name(name: Any, what: str) -> str:
     if not isinstance(name, str) or not _NAME_RE.match(name):
         raise InvalidInput(
-            f"{what} name {name!r} is not allowed: use 1-64 letters, digits, '_', '-' or '.', not starting with '-' or '.'"
+            f"{what} name {name!r} is not allowed: use 1-100 printable characters without '/'"
         )
     return name
 
@@ -484,42 +485,43 @@ class Session:
 
         doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "metadata": self.metadata}
         doc["robots"] = []
-        for e in self.robots.values():
+        for i, e in enumerate(self.robots.values()):
             urdf_member = None
             if e.urdf_text is not None:
-                urdf_member = f"robots/{e.key}.urdf"
+                urdf_member = f"robots/{i}.urdf"
                 texts[urdf_member] = e.urdf_text
             doc["robots"].append({
                 "key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
                 "joint_names": list(e.joint_names), "urdf_member": urdf_member, "package_dirs": list(e.package_dirs),
-                "base_to_world": ref(f"arrays/robots/{e.key}/base_to_world.npy", e.base_to_world),
+                "base_to_world": ref(f"arrays/robots/{i}/base_to_world.npy", e.base_to_world),
             })
         doc["objects"] = [
             {"name": b.name, "shape": "box", "color": list(b.color),
-             "size": ref(f"arrays/objects/{b.name}/size.npy", b.size),
-             "pose": ref(f"arrays/objects/{b.name}/pose.npy", b.pose)}
-            for b in self.objects.values()
+             "size": ref(f"arrays/objects/{i}/size.npy", b.size),
+             "pose": ref(f"arrays/objects/{i}/pose.npy", b.pose)}
+            for i, b in enumerate(self.objects.values())
         ]
         doc["trajectories"] = [
             {"name": r.name, "robot": r.robot, "definition": r.definition,
-             "t": ref(f"arrays/trajectories/{r.name}/t.npy", r.t),
-             "q": ref(f"arrays/trajectories/{r.name}/q.npy", r.q),
-             "knot_times": ref(f"arrays/trajectories/{r.name}/knot_times.npy", r.knot_times)}
-            for r in self.trajectories.values()
+             "t": ref(f"arrays/trajectories/{i}/t.npy", r.t),
+             "q": ref(f"arrays/trajectories/{i}/q.npy", r.q),
+             "knot_times": ref(f"arrays/trajectories/{i}/knot_times.npy", r.knot_times)}
+            for i, r in enumerate(self.trajectories.values())
         ]
         doc["workspaces"] = [
             {"name": r.name, "robot": r.robot,
-             "points": ref(f"arrays/workspaces/{r.name}/points.npy", r.points),
-             "manipulability": ref(f"arrays/workspaces/{r.name}/manipulability.npy", r.manipulability)}
-            for r in self.workspaces.values()
+             "points": ref(f"arrays/workspaces/{i}/points.npy", r.points),
+             "manipulability": ref(f"arrays/workspaces/{i}/manipulability.npy", r.manipulability)}
+            for i, r in enumerate(self.workspaces.values())
         ]
         doc["points"] = [
-            {"name": p.name, "kind": p.kind, "robot": p.robot, "points": ref(f"arrays/points/{p.name}/points.npy", p.points)}
-            for p in self.point_sets.values()
+            {"name": p.name, "kind": p.kind, "robot": p.robot, "points": ref(f"arrays/points/{i}/points.npy", p.points)}
+            for i, p in enumerate(self.point_sets.values())
         ]
         doc["histories"] = [
-            {"name": h.name, "columns": {k: ref(f"arrays/histories/{h.name}/{k}.npy", v) for k, v in h.columns.items()}}
-            for h in self.histories.values()
+            {"name": h.name,
+             "columns": {k: ref(f"arrays/histories/{i}/{c}.npy", v) for c, (k, v) in enumerate(h.columns.items())}}
+            for i, h in enumerate(self.histories.values())
         ]
         return doc, arrays, texts
 

@@ -12,15 +12,14 @@ import io
 import subprocess
 import sys
 import threading
+import time
 import weakref
 from pathlib import Path
 from typing import Any
 
-import meshcat
-from meshcat.visualizer import ViewerWindow
-
 from robots.errors import InvalidInput
 
+from ._meshcat import ViewerWindow, meshcat
 from .errors import ViewerError
 
 __all__ = ["MeshcatServer", "Viewer", "show"]
@@ -128,14 +127,26 @@ class Viewer(MeshcatServer):
 
     scene: Any
 
+    def wait(self, poll_s: float = 0.5) -> None:
+        """Block until Ctrl+C (or until the server process dies), then stop the server."""
+        try:
+            while self.running:
+                time.sleep(poll_s)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            self.close()
 
-def show(session: Any, port: int | None = None, open_browser: bool = False, **scene_options: Any) -> Viewer:
+
+def show(session: Any, port: int | None = None, open_browser: bool = False, wait: bool = False,
+         **scene_options: Any) -> Viewer:
     """Start MeshCat on 127.0.0.1 and show ``session``; return the running :class:`Viewer`.
 
     Args:
         session: a :class:`viz.Session`.
         port: HTTP port (default: a free one).
         open_browser: open the page in the default web browser.
+        wait: block until Ctrl+C, then stop the server (same as ``show(...).wait()``).
         scene_options: passed to :func:`viz.scene.build_scene` (``animate``, ``fps``, ...).
 
     Stop it with ``viewer.close()`` or use it as a context manager; the server process is
@@ -153,4 +164,6 @@ def show(session: Any, port: int | None = None, open_browser: bool = False, **sc
         import webbrowser
 
         webbrowser.open(viewer.url, new=2)
+    if wait:
+        viewer.wait()
     return viewer

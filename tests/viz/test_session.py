@@ -1,0 +1,300 @@
+"""Saved sessions: exact round trip, validation of damaged files, future versions, atomic writes."""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import zipfile
+
+import numpy as np
+import pytest
+
+import planning
+import robots
+import viz
+import viz.session as vs
+from robots.errors import InvalidInput, PinarmsError
+from viz import SessionFormatError
+
+LEVER_URDF = """<robot name="lever">
+  <link name="base_link"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+  <link name="arm"><visual><origin xyz="0.2 0 0"/><geometry><box size="0.4 0.04 0.04"/></geometry></visual></link>
+  <link name="tcp"/>
+  <joint name="j1" type="revolute"><parent link="base_link"/><child link="arm"/><axis xyz="0 0 1"/>
+    <origin xyz="0 0 0.1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <joint name="tool" type="fixed"><parent link="arm"/><child link="tcp"/><origin xyz="0.4 0 0"/></joint>
+</robot>"""
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return robots.load("ur5")
+
+
+@pytest.fixture()
+def session(ur5):
+    s = viz.Session(ur5, title="pick & place", metadata={"line": "enoki", "speeds": (1.5, 2)})
+    times = np.array([0.0, 1.0, 3.0, 4.0])
+    via = ur5.random_q(4, seed=1)
+    s.add_trajectory("P1-P4 quintic", planning.multi_quintic(times, via), hz=50)
+    s.add_trajectory("raw", (np.linspace(0, 1, 7), ur5.random_q(7, seed=2)))
+    q = ur5.random_q(300, seed=3)
+    s.add_workspace("cloud", points=ur5.position(q), manipulability=ur5.manipulability(q))
+    s.add_points("targets", [[0.4, 0.1, 0.2], [0.3, -0.2, 0.25]], kind="target")
+    s.add_points("vias", [[0.1, 0.2, 0.3]], robot="ur5")
+    s.add_history("ga", {"best": [5.0, 4.0, 3.6], "mean": [7.0, 5.5, 4.0], "feasible_share": [0.2, 0.6, 1.0]})
+    lever = robots.from_urdf_text(LEVER_URDF)
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 0.5, 0.0]
+    s.add_robot(lever, base_to_world=T)
+    s.add_box("conveyor", [1.2, 0.3, 0.05], pose=T, color=(0.2, 0.3, 0.8, 0.5))
+    return s
+
+
+def test_round_trip_is_exact(session, tmp_path):
+    path = session.save(tmp_path / "study.pinarms")
+    back = viz.load_session(path)
+    assert back == session
+    # bit-equal arrays, equal JSON, same order
+    for name, rec in session.trajectories.items():
+        got = back.trajectories[name]
+        assert got.q.dtype == np.float64 and got.q.tobytes() == rec.q.tobytes()
+        assert got.t.tobytes() == rec.t.tobytes() and got.definition == rec.definition
+    assert list(back.trajectories) == ["P1-P4 quintic", "raw"]
+    assert back.metadata == session.metadata
+    assert back.metadata["user"] == {"line": "enoki", "speeds": [1.5, 2]}
+    assert back.robots["ur5"].source == "registry" and back.robots["lever"].source == "urdf"
+    assert back.robots["lever"].urdf_text == LEVER_URDF
+    np.testing.assert_array_equal(back.robots["lever"].base_to_world[:3, 3], [1.0, 0.5, 0.0])
+    # saving what was loaded gives the same document again
+    again = viz.load_session(back.save(tmp_path / "again.pinarms"))
+    assert again == session
+
+
+def test_loaded_trajectory_rebuilds_and_robots_reload(session, tmp_path):
+    back = viz.load_session(session.save(tmp_path / "s.pinarms"))
+    rec = back.trajectories["P1-P4 quintic"]
+    traj = rec.rebuild()
+    np.testing.assert_allclose(traj.sample(rec.t)[0], rec.q, atol=1e-12)
+    np.testing.assert_array_equal(rec.knot_times, [0.0, 1.0, 3.0, 4.0])
+    assert set(rec.knot_times) <= set(rec.t)  # knots are sampled exactly
+    with pytest.raises(InvalidInput, match="samples only"):
+        back.trajectories["raw"].rebuild()
+    lever = back.robot("lever")  # rebuilt from the embedded URDF
+    np.testing.assert_allclose(lever.position(np.array([0.0])), [0.4, 0.0, 0.1])
+    assert back.robot("ur5").nq == 6
+
+
+def test_members_are_json_and_npy_never_pickle(session, tmp_path):
+    path = session.save(tmp_path / "s.pinarms")
+    with zipfile.ZipFile(path) as zf:
+        names = zf.namelist()
+        doc = json.loads(zf.read("session.json"))
+        assert doc["format"] == "pinarms-session" and doc["version"] == viz.FORMAT_VERSION
+        npys = [n for n in names if n.endswith(".npy")]
+        assert len(npys) == 2 + 3 * 2 + 2 + 2 + 3 + 2  # bases, trajectories, cloud, points, history, box
+        for n in npys:
+            arr = np.load(io.BytesIO(zf.read(n)), allow_pickle=False)
+            assert arr.dtype == np.float64
+        assert "robots/1.urdf" in names
+
+
+def _rewrite(src, dst, *, drop=(), replace=None):
+    """Copy the session zip ``src`` to ``dst`` without the ``drop`` members and with ``replace`` {member: bytes}."""
+    replace = replace or {}
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for item in zin.infolist():
+            if item.filename in drop:
+                continue
+            zout.writestr(item.filename, replace.get(item.filename, zin.read(item.filename)))
+    return dst
+
+
+def _doc(path):
+    with zipfile.ZipFile(path) as zf:
+        return json.loads(zf.read("session.json"))
+
+
+def _npy(arr):
+    buf = io.BytesIO()
+    np.save(buf, arr)
+    return buf.getvalue()
+
+
+@pytest.fixture()
+def saved(session, tmp_path):
+    return session.save(tmp_path / "good.pinarms")
+
+
+def test_truncated_file(saved, tmp_path):
+    data = saved.read_bytes()
+    for cut in (len(data) // 2, len(data) - 10, 30):
+        bad = tmp_path / f"cut{cut}.pinarms"
+        bad.write_bytes(data[:cut])
+        with pytest.raises(SessionFormatError, match="not a zip archive, or truncated"):
+            viz.load_session(bad)
+
+
+def test_garbage_and_empty_files(tmp_path):
+    bad = tmp_path / "garbage.pinarms"
+    bad.write_bytes(np.random.default_rng(0).bytes(5000))
+    with pytest.raises(SessionFormatError, match="not a zip"):
+        viz.load_session(bad)
+    empty = tmp_path / "empty.pinarms"
+    empty.write_bytes(b"")
+    with pytest.raises(SessionFormatError):
+        viz.load_session(empty)
+    with pytest.raises(InvalidInput, match="does not exist"):
+        viz.load_session(tmp_path / "missing.pinarms")
+
+
+def test_corrupt_member_bytes(saved, tmp_path):
+    data = bytearray(saved.read_bytes())
+    with zipfile.ZipFile(saved) as zf:
+        info = zf.getinfo("session.json")
+    start = info.header_offset + 30 + len(info.filename) + len(info.extra)
+    data[start + 5 : start + 25] = bytes(20)  # damage the compressed session.json in place
+    bad = tmp_path / "crc.pinarms"
+    bad.write_bytes(bytes(data))
+    with pytest.raises(SessionFormatError, match="session.json"):
+        viz.load_session(bad)
+
+
+def test_missing_members(saved, tmp_path):
+    with pytest.raises(SessionFormatError, match="'session.json' is missing"):
+        viz.load_session(_rewrite(saved, tmp_path / "a.pinarms", drop={"session.json"}))
+    member = _doc(saved)["trajectories"][0]["q"]["member"]
+    with pytest.raises(SessionFormatError, match=f"{member}' is missing"):
+        viz.load_session(_rewrite(saved, tmp_path / "b.pinarms", drop={member}))
+    with pytest.raises(SessionFormatError, match="robots/1.urdf' is missing"):
+        viz.load_session(_rewrite(saved, tmp_path / "c.pinarms", drop={"robots/1.urdf"}))
+
+
+def test_bad_json(saved, tmp_path):
+    cases = {
+        b"{not json": "not valid UTF-8 JSON",
+        b"[1, 2]": "must hold a JSON object",
+        json.dumps({"format": "other", "version": 1}).encode(): "format 'other'",
+        json.dumps({"format": "pinarms-session", "version": "1"}).encode(): "not a positive integer",
+    }
+    for i, (payload, message) in enumerate(cases.items()):
+        bad = _rewrite(saved, tmp_path / f"j{i}.pinarms", replace={"session.json": payload})
+        with pytest.raises(SessionFormatError, match=message):
+            viz.load_session(bad)
+    doc = _doc(saved)
+    del doc["workspaces"][0]["manipulability"]
+    bad = _rewrite(saved, tmp_path / "field.pinarms", replace={"session.json": json.dumps(doc).encode()})
+    with pytest.raises(SessionFormatError, match=r"workspaces\[0\] lacks the field 'manipulability'"):
+        viz.load_session(bad)
+    doc = _doc(saved)
+    doc["trajectories"][1]["robot"] = "nobody"
+    bad = _rewrite(saved, tmp_path / "robot.pinarms", replace={"session.json": json.dumps(doc).encode()})
+    with pytest.raises(SessionFormatError, match="'nobody' is not one of the session's robots"):
+        viz.load_session(bad)
+
+
+def test_wrong_array_shape_and_dtype(saved, tmp_path):
+    doc = _doc(saved)
+    q_ref = doc["trajectories"][0]["q"]
+    n, nq = q_ref["shape"]
+    # a q of 5 columns for a 6-joint robot, consistently declared in the index
+    doc["trajectories"][0]["q"]["shape"] = [n, nq - 1]
+    bad = _rewrite(saved, tmp_path / "shape.pinarms", replace={
+        "session.json": json.dumps(doc).encode(), q_ref["member"]: _npy(np.zeros((n, nq - 1)))})
+    with pytest.raises(SessionFormatError, match=rf"shape \({n}, {nq - 1}\), expected \({n}, {nq}\)"):
+        viz.load_session(bad)
+    # array disagrees with the index
+    bad = _rewrite(saved, tmp_path / "index.pinarms", replace={q_ref["member"]: _npy(np.zeros((n + 1, nq)))})
+    with pytest.raises(SessionFormatError, match="but session.json says"):
+        viz.load_session(bad)
+    # integer array
+    bad = _rewrite(saved, tmp_path / "dtype.pinarms", replace={q_ref["member"]: _npy(np.zeros((n, nq), dtype=np.int64))})
+    with pytest.raises(SessionFormatError, match="dtype int64, expected float64"):
+        viz.load_session(bad)
+    # a pickled object array is refused, never unpickled
+    obj = np.empty(2, dtype=object)
+    obj[:] = [{"a": 1}, None]
+    buf = io.BytesIO()
+    np.save(buf, obj, allow_pickle=True)
+    bad = _rewrite(saved, tmp_path / "pickle.pinarms", replace={q_ref["member"]: buf.getvalue()})
+    with pytest.raises(SessionFormatError, match="not a readable .npy array"):
+        viz.load_session(bad)
+    # NaN
+    nan = np.zeros((n, nq))
+    nan[1, 2] = np.nan
+    bad = _rewrite(saved, tmp_path / "nan.pinarms", replace={q_ref["member"]: _npy(nan)})
+    with pytest.raises(SessionFormatError, match="NaN"):
+        viz.load_session(bad)
+
+
+def test_future_format_version(saved, tmp_path):
+    doc = _doc(saved)
+    doc["version"] = viz.FORMAT_VERSION + 1
+    doc["something_new"] = {"x": 1}
+    bad = _rewrite(saved, tmp_path / "future.pinarms", replace={"session.json": json.dumps(doc).encode()})
+    with pytest.raises(SessionFormatError, match=rf"version {viz.FORMAT_VERSION + 1}, newer .* upgrade pinarms"):
+        viz.load_session(bad)
+
+
+def test_session_format_error_is_a_pinarms_error():
+    assert issubclass(SessionFormatError, PinarmsError)
+
+
+def test_atomic_write_failure_leaves_nothing(session, tmp_path, monkeypatch):
+    calls = {"n": 0}
+    real_save = np.save
+
+    def failing_save(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise OSError("disk full (simulated)")
+        return real_save(*args, **kwargs)
+
+    monkeypatch.setattr(vs.np, "save", failing_save)
+    target = tmp_path / "new.pinarms"
+    with pytest.raises(OSError, match="simulated"):
+        session.save(target)
+    assert calls["n"] == 4
+    assert os.listdir(tmp_path) == []  # no target, no temporary file
+
+
+def test_atomic_write_failure_keeps_previous_file(session, tmp_path, monkeypatch):
+    target = session.save(tmp_path / "s.pinarms")
+    before = target.read_bytes()
+    session.add_points("more", [[0.0, 0.0, 1.0]])
+
+    def failing_save(*args, **kwargs):
+        raise KeyboardInterrupt  # even an interrupt mid-write leaves the old file intact
+
+    monkeypatch.setattr(vs.np, "save", failing_save)
+    with pytest.raises(KeyboardInterrupt):
+        session.save(target)
+    assert target.read_bytes() == before
+    assert os.listdir(tmp_path) == ["s.pinarms"]
+    assert "more" not in viz.load_session(target).point_sets
+
+
+def test_bad_inputs_name_the_problem(ur5, tmp_path):
+    s = viz.Session(ur5)
+    with pytest.raises(InvalidInput, match="6 joints"):
+        s.add_trajectory("x", (np.linspace(0, 1, 5), np.zeros((5, 4))))
+    with pytest.raises(InvalidInput, match="strictly increasing"):
+        s.add_trajectory("x", (np.array([0.0, 1.0, 1.0]), np.zeros((3, 6))))
+    with pytest.raises(InvalidInput, match="not allowed"):
+        s.add_points("a/b", [[0, 0, 0]])
+    s.add_points("p", [[0, 0, 0]])
+    with pytest.raises(InvalidInput, match="already exists"):
+        s.add_points("p", [[0, 0, 0]])
+    with pytest.raises(InvalidInput, match="kind"):
+        s.add_points("q", [[0, 0, 0]], kind="waypoint")
+    with pytest.raises(InvalidInput, match="rigid transform"):
+        s.add_robot("panda", base_to_world=np.diag([2.0, 1, 1, 1]))
+    with pytest.raises(InvalidInput, match="JSON-able"):
+        viz.Session(ur5, metadata={"x": float("nan")})
+    with pytest.raises(InvalidInput, match="folder"):
+        s.save(tmp_path / "no" / "such" / "dir.pinarms")
+    two = viz.Session(ur5)
+    two.add_robot("ur5", key="ur5_b")
+    with pytest.raises(InvalidInput, match="2 robots"):
+        two.add_trajectory("t", (np.array([0.0, 1.0]), np.zeros((2, 6))))
