@@ -1,0 +1,83 @@
+"""Trajectory layer timings, side by side with plain scipy B-splines.
+
+Run: python benchmarks/trajectory.py
+Prints, for the same data, planning's time and scipy's, and their ratio:
+  * sampling q, qd, qdd, qddd of 6 joints at 10 000 instants (target <= 5 ms);
+  * building a 10-segment quintic B-spline for 6 joints (target <= 1 ms);
+  * building + exact peaks of a 10-segment 3-joint quintic B-spline (the optimiser's inner
+    call; scipy reference: build + peaks by dense sampling at 2 000 instants, not exact).
+"""
+
+from __future__ import annotations
+
+import timeit
+
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+import planning
+
+H = np.array([0.21, 0.15, 0.24, 0.27, 0.19, 0.16, 0.13, 0.23, 0.15, 0.16])  # seed 002, s
+TIMES = np.concatenate([[0.0], np.cumsum(H)])
+
+
+def best(fn, number: int) -> float:
+    """Best of 5 repeats, seconds per call."""
+    return min(timeit.repeat(fn, number=number, repeat=5)) / number
+
+
+def scipy_spline(q: np.ndarray):
+    zero = np.zeros(q.shape[1])
+    return make_interp_spline(TIMES, q, k=5, bc_type=([(1, zero), (2, zero)], [(1, zero), (2, zero)]))
+
+
+def row(label: str, ours: float, ref: float, target: float | None) -> None:
+    tgt = "" if target is None else f"  target <= {target * 1e3:.1f} ms: {'ok' if ours <= target else 'MISSED'}"
+    print(f"{label:<44} {ours * 1e6:9.1f} us {ref * 1e6:9.1f} us {ours / ref:7.2f}x{tgt}")
+
+
+def main() -> None:
+    rng = np.random.default_rng(0)
+    q6 = rng.normal(size=(TIMES.size, 6))
+    q3 = q6[:, :3].copy()
+    t = np.linspace(0.0, TIMES[-1], 10_000)
+    traj6 = planning.quintic_bspline(TIMES, q6)
+    ref6 = scipy_spline(q6)
+    err = max(np.abs(traj6.sample(t)[nu] - ref6(t, nu)).max() / np.abs(ref6(t, nu)).max() for nu in range(4))
+    print(f"max relative difference planning vs scipy over q..qddd: {err:.1e}")
+    print(f"{'':<44} {'planning':>12} {'scipy':>12} {'ratio':>8}")
+    row(
+        "sample 6 joints x 10 000 instants (q..qddd)",
+        best(lambda: traj6.sample(t), 50),
+        best(lambda: [ref6(t, nu) for nu in range(4)], 50),
+        5e-3,
+    )
+    row(
+        "build 10-segment quintic B-spline, 6 joints",
+        best(lambda: planning.quintic_bspline(TIMES, q6), 500),
+        best(lambda: scipy_spline(q6), 500),
+        1e-3,
+    )
+    dense = np.linspace(0.0, TIMES[-1], 2000)
+
+    def scipy_peaks():
+        s = scipy_spline(q3)
+        return [np.abs(s(dense, nu)).max(axis=0) for nu in (1, 2, 3)]
+
+    row(
+        "build + peaks, 3 joints (exact vs 2000 samples)",
+        best(lambda: planning.quintic_bspline(TIMES, q3).peaks(), 500),
+        best(scipy_peaks, 500),
+        None,
+    )
+    traj3 = planning.quintic_bspline(TIMES, q3)
+
+    def peaks_only():
+        traj3._norm = None  # drop the cache: measure the full peak search
+        return traj3.peaks()
+
+    print(f"{'exact peaks alone, 3 joints x 10 segments':<44} {best(peaks_only, 500) * 1e6:9.1f} us")
+
+
+if __name__ == "__main__":
+    main()
