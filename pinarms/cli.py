@@ -492,6 +492,8 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     """
     import planning
 
+    if session_path and not robot:
+        raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
     t, positions, extra = _via_input(via, times, file)
     if t is None:
         raise click.UsageError("give knot times with --times (or a 't' column / 'times' key in the file)")
@@ -566,6 +568,8 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     """
     import optim
 
+    if session_path and not robot:
+        raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
     _, positions, _ = _via_input(via, None, file)
     scale = angle_scale(deg)
     arm = _load_robot(robot) if robot else None
@@ -617,17 +621,25 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
 
 # --------------------------------------------------------------------------- sessions
 @cli.command("view")
-@click.argument("session", type=click.Path(exists=True))
-@click.option("--no-wait", is_flag=True, help="Open the viewer, print its address and return.")
+@click.argument("session", type=click.Path(exists=True, dir_okay=False))
+@click.option("--port", default=None, type=click.IntRange(1, 65535), help="HTTP port (default: a free one).")
+@click.option("--open", "open_browser", is_flag=True, help="Open the page in the default web browser.")
+@click.option("--no-wait", is_flag=True, help="Show, print the address and stop at once (for scripts/tests).")
 @json_option
-def view_cmd(session: str, no_wait: bool, as_json: bool) -> None:
-    """Open a saved SESSION in the MeshCat viewer (browser; local server on 127.0.0.1)."""
+def view_cmd(session: str, port: int | None, open_browser: bool, no_wait: bool, as_json: bool) -> None:
+    """Open a saved SESSION in the MeshCat viewer (local server on 127.0.0.1; Ctrl+C stops it)."""
     import viz
 
     loaded = viz.load_session(session)
-    viewer = viz.show(loaded) if not no_wait else viz.show(loaded, wait=False)
-    url = getattr(viewer, "url", None) or getattr(viewer, "web_url", None)
-    _emit(as_json, {"session": session, "url": url}, [f"viewer: {url}" if url else "viewer closed"])
+    viewer = viz.show(loaded, port=port, open_browser=open_browser, wait=False)
+    try:
+        _emit(as_json, {"session": session, "url": viewer.url, "title": loaded.title},
+              [f"{loaded.title or session}: viewer at {viewer.url}"] + ([] if no_wait else ["press Ctrl+C to stop"]))
+        if not no_wait:
+            sys.stdout.flush()
+            viewer.wait()
+    finally:
+        viewer.close()
 
 
 @cli.command("export-html")

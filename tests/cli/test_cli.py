@@ -1,0 +1,217 @@
+"""The `pinarms` command line through click's CliRunner: output, --json, units, errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import robots
+from pinarms.cli import cli, read_via_file
+
+SEED000 = ["--via", "55.5", "--via", "69.7", "--via", "106.5", "--via", "124.5"]
+
+
+@pytest.fixture
+def run():
+    runner = CliRunner()
+
+    def invoke(*args: str, ok: bool = True):
+        result = runner.invoke(cli, list(args))
+        if ok:
+            assert result.exit_code == 0, (result.output, result.stderr, result.exception)
+        return result
+
+    return invoke
+
+
+def as_json(result) -> dict:
+    return json.loads(result.stdout)
+
+
+def assert_user_error(result, code: int, *fragments: str) -> None:
+    """Non-zero exit, one 'Error:' line on stderr, no traceback."""
+    assert result.exit_code == code, (result.output, result.exception)
+    assert "Traceback" not in result.output
+    assert not isinstance(result.exception, Exception) or isinstance(result.exception, SystemExit)
+    err = result.stderr
+    assert "Error:" in err
+    for fragment in fragments:
+        assert fragment in err, err
+
+
+def test_robots_lists_every_name_with_dof(run):
+    data = as_json(run("robots", "--json"))
+    by_name = {r["name"]: r for r in data["robots"]}
+    assert list(by_name) == robots.names()
+    assert by_name["aubo_i3"]["dof"] == 6 and by_name["koji_turner"]["dof"] == 4
+    assert by_name["panda"]["dof"] == 7 and by_name["panda"]["source"] == "example-robot-data"
+    text = run("robots").stdout
+    assert "scara_mushroom" in text and "ur5" in text
+
+
+def test_fk_koji_paper_example_in_degrees_and_mm(run):
+    # seed 004: (-90, 25, -30, 90) deg -> (1197.3, 250.0, -929.2) mm
+    data = as_json(run("fk", "koji_turner", "-90", "25", "-30", "90", "--deg", "--mm", "--json"))
+    np.testing.assert_allclose(data["position"], [1197.3, 250.0, -929.2], atol=0.05)
+    assert data["units"] == {"position": "mm", "angles": "deg"}
+    np.testing.assert_allclose(data["q_si"], np.radians([-90, 25, -30, 90]))
+    assert data["within_limits"] is True
+    text = run("fk", "koji_turner", "-90", "25", "-30", "90", "--deg", "--mm").stdout
+    assert "1197.33" in text
+
+
+def test_fk_si_matches_api_and_prismatic_mm(run):
+    arm = robots.load("gantry_flower")
+    q = np.array([0.3, 0.2, -0.1])
+    data = as_json(run("fk", "gantry_flower", "300", "200", "-100", "--mm", "--json"))
+    np.testing.assert_allclose(data["q_si"], q)
+    np.testing.assert_allclose(np.array(data["T"]), arm.fk(q), atol=1e-12)
+    np.testing.assert_allclose(data["position"], arm.position(q) * 1000, atol=1e-9)
+
+
+def test_fk_frame_option_and_limit_warning(run):
+    arm = robots.load("scara_mushroom")
+    data = as_json(run("fk", "scara_mushroom", "0", "0", "0", "0", "--frame", "flange", "--json"))
+    np.testing.assert_allclose(data["position"], arm.position(np.zeros(4), frame="flange"))
+    text = run("fk", "scara_mushroom", "3", "0", "0", "0").stdout
+    assert "outside the joint limits" in text and "j1" in text
+
+
+def test_fk_errors_are_one_line(run):
+    assert_user_error(run("fk", "no_such_arm", "1", ok=False), 1, "unknown robot 'no_such_arm'", "aubo_i3")
+    assert_user_error(run("fk", "ur5", "1", "2", ok=False), 1, "has 6 joints", "got 2")
+    assert_user_error(run("fk", "ur5", "1", "x", "0", "0", "0", "0", ok=False), 2, "not a valid float")
+    assert_user_error(run("fk", "ur5", "0", "0", "0", "0", "0", "0", "--frame", "nope", ok=False), 1, "no frame 'nope'")
+    assert_user_error(run("fk", "ok", ok=False), 2, "Missing argument")
+
+
+def test_ik_round_trip_or_clear_error(run):
+    arm = robots.load("koji_turner")
+    if not hasattr(arm, "ik"):
+        pytest.skip("numerical IK (Robot.ik) is not part of this build yet")
+    result = run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg", "--json")
+    data = as_json(result)
+    assert data["solutions"]
+    for sol in data["solutions"]:
+        assert sol["position_error_m"] < 1e-6
+        p = arm.position(np.radians(sol["q"]))
+        np.testing.assert_allclose(p * 1000, [1197.3, 250.0, -929.2], atol=1e-3)
+    assert_user_error(run("ik", "koji_turner", "10", "10", "10", ok=False), 1)
+
+
+def test_ik_all_needs_a_closed_form_and_pose_size(run):
+    arm = robots.load("ur5")
+    assert_user_error(run("ik", "ur5", "0.1", "0.2", ok=False), 1, "3 or 6 numbers")
+    if not arm.has_analytic_ik:
+        assert_user_error(run("ik", "ur5", "0.3", "0.1", "0.4", "--all", ok=False), 1, "no closed-form IK")
+
+
+def test_workspace_json_and_session(run, tmp_path):
+    out = tmp_path / "ws.pinarms"
+    data = as_json(run("workspace", "gantry_flower", "-n", "2000", "--seed", "3", "--json", "--session", str(out)))
+    arm = robots.load("gantry_flower")
+    lo, hi = np.array(data["bounding_box_m"]["min"]), np.array(data["bounding_box_m"]["max"])
+    # the gantry's workspace is its stroke box (tcp offset aside): extent equals the strokes
+    np.testing.assert_allclose(hi - lo, arm.upper - arm.lower, atol=0.02)
+    assert data["n"] == 2000 and out.is_file()
+    import viz
+
+    assert viz.load_session(out).workspaces
+    assert_user_error(run("workspace", "gantry_flower", "-n", "0", ok=False), 2, "-n")
+
+
+def test_plan_seed000_peaks_and_limit_check(run, tmp_path):
+    args = ["plan", "--kind", "3-5-3", "--deg", "--times", "0,2,4,6", *SEED000, "--vmax", "55"]
+    data = as_json(run(*args, "--json"))
+    import planning
+
+    traj = planning.piecewise_polynomial([0, 2, 4, 6], np.radians([55.5, 69.7, 106.5, 124.5]), degrees=(3, 5, 3))
+    assert data["duration_s"] == pytest.approx(6.0)
+    assert data["peaks"]["velocity"][0] == pytest.approx(np.degrees(traj.peaks().velocity[0]), rel=1e-9)
+    assert data["limits_ok"] is True
+    tight = as_json(run(*args[:-1], "20", "--json"))
+    assert tight["limits_ok"] is False
+    assert tight["violations"][0]["kind"].startswith("vel") and tight["violations"][0]["limit"] == pytest.approx(20)
+    assert_user_error(run(*args, "--session", str(tmp_path / "p.pinarms"), ok=False), 2, "--robot")
+    text = run("plan", "--kind", "quintic-bspline", "--times", "0,1,2,3", "--via", "0,0", "--via", "-0.5,0.2",
+               "--via", "0.3,0.4", "--via", "1,1").stdout
+    assert "quintic-bspline trajectory: 2 joint(s)" in text
+
+
+def test_plan_from_csv_and_json_files(run, tmp_path):
+    csv_file = tmp_path / "via.csv"
+    csv_file.write_text("t,j1,j2\n0,0,0\n1,0.5,-0.2\n3,1.0,0.1\n4,1.2,0.0\n")
+    doc = read_via_file(str(csv_file))
+    np.testing.assert_allclose(doc["times"], [0, 1, 3, 4])
+    assert doc["positions"].shape == (4, 2) and doc["joint_names"] == ["j1", "j2"]
+    a = as_json(run("plan", "--kind", "multi-quintic", "--file", str(csv_file), "--json"))
+    json_file = tmp_path / "via.json"
+    json_file.write_text(json.dumps({"kind": "multi-quintic", "times": [0, 1, 3, 4],
+                                     "positions": doc["positions"].tolist()}))
+    b = as_json(run("plan", "--file", str(json_file), "--json"))
+    assert b["kind"] == "multi-quintic"
+    np.testing.assert_allclose(a["peaks"]["velocity"], b["peaks"]["velocity"])
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    assert_user_error(run("plan", "--file", str(bad), ok=False), 1, "not valid JSON")
+
+
+def test_plan_bad_input(run):
+    assert_user_error(run("plan", "--times", "0,1", ok=False), 2, "--via")
+    assert_user_error(run("plan", "--via", "1", "--via", "2", ok=False), 2, "--times")
+    assert_user_error(run("plan", "--times", "0,1,x", "--via", "1", "--via", "2", ok=False), 2, "comma-separated")
+    assert_user_error(run("plan", "--kind", "3-5-3", "--times", "0,1,1,2", *SEED000, ok=False), 1)
+    assert_user_error(run("plan", "--kind", "spline9", ok=False), 2, "spline9")
+
+
+def test_optimize_seed000_exact_and_ga(run, tmp_path):
+    exact = as_json(run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--method", "exact", "--json"))
+    assert exact["peaks"]["velocity"][0] == pytest.approx(55.0, rel=1e-3)
+    assert sum(exact["durations_s"]) == pytest.approx(exact["total_s"])
+    ga = as_json(run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--generations", "30",
+                     "--seed", "1", "--json"))
+    assert ga["method"] == "ga"
+    assert ga["total_s"] >= exact["total_s"] * (1 - 1e-6)
+    assert ga["total_s"] <= 6.0 and ga["peaks"]["velocity"][0] <= 55.0 * (1 + 1e-6)
+    session = tmp_path / "opt.pinarms"
+    assert_user_error(run("optimize", *SEED000, "--vmax", "55", "--session", str(session), ok=False), 2, "--robot")
+    via4 = ["--via", "1,0.5,0.02,0", "--via", "1.2,0.8,0.05,0.3", "--via", "1.5,1.0,0.02,0.6"]
+    data = as_json(run("optimize", "--kind", "multi-quintic", *via4, "--robot", "scara_mushroom", "--method", "exact",
+                       "--session", str(session), "--json"))
+    arm = robots.load("scara_mushroom")
+    assert np.all(np.array(data["peaks"]["velocity"]) <= arm.velocity_limit * (1 + 1e-6))
+    assert session.is_file()
+    assert_user_error(run("optimize", *SEED000, ok=False), 2, "--vmax")
+    assert_user_error(run("optimize", *SEED000, "--vmax", "-1", ok=False), 1)
+
+
+def test_export_html_and_view(run, tmp_path):
+    session = tmp_path / "s.pinarms"
+    run("plan", "--kind", "multi-quintic", "--times", "0,1,2", "--via", "0,0,0,0", "--via", "0.5,0.1,0.02,0",
+        "--via", "1,0.2,0.05,0.5", "--robot", "scara_mushroom", "--session", str(session))
+    out = tmp_path / "s.html"
+    data = as_json(run("export-html", str(session), str(out), "--json"))
+    assert out.is_file() and data["bytes"] == out.stat().st_size > 100_000
+    assert "<html" in out.read_text(encoding="utf-8", errors="replace")[:2000].lower()
+    view = as_json(run("view", str(session), "--no-wait", "--json"))
+    assert view["url"].startswith("http://127.0.0.1:")
+    assert_user_error(run("export-html", str(tmp_path / "missing.pinarms"), str(out), ok=False), 2, "does not exist")
+    corrupt = tmp_path / "corrupt.pinarms"
+    corrupt.write_bytes(b"not a session")
+    assert_user_error(run("view", str(corrupt), "--no-wait", ok=False), 1)
+
+
+def test_urdf_build_check_and_export(run, tmp_path):
+    data = as_json(run("urdf", "build", "--out", str(tmp_path / "built"), "--json"))
+    assert len(data["written"]) == len(robots.builtin_names())
+    assert as_json(run("urdf", "build", "--check", "--json"))["stale"] == []
+    out = tmp_path / "koji"
+    data = as_json(run("urdf", "export", "koji_turner", str(out), "--json"))
+    text = (out / "koji_turner.urdf").read_text()
+    assert "<mimic" in text and data["urdf"].endswith("koji_turner.urdf")
+    assert_user_error(run("urdf", "export", "koji_turner", str(out), ok=False), 1, "not empty")
+    run("urdf", "export", "koji_turner", str(out), "--overwrite")
+    assert_user_error(run("urdf", "export", "nope", str(tmp_path / "n"), ok=False), 1, "unknown robot")
