@@ -31,3 +31,9 @@ __all__ = [
     "UnreachableTarget",
     "LimitViolation",
 ]
+
+# workspace analysis and station layout
+from .layout import LayoutReport, check_layout  # noqa: E402
+from .workspace import Workspace, sample_workspace  # noqa: E402
+
+__all__ += ["Workspace", "sample_workspace", "LayoutReport", "check_layout"]
