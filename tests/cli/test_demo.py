@@ -1,0 +1,54 @@
+"""`pinarms demo --quick`: the table rows, the files, and the paper numbers that must agree."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from pinarms.cli import cli
+
+
+@pytest.mark.slow
+def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
+    out = tmp_path / "demo"
+    result = CliRunner().invoke(cli, ["demo", "--quick", "--out", str(out), "--json"])
+    assert result.exit_code == 0, (result.output, result.exception)
+    data = json.loads(result.stdout)
+    rows = data["rows"]
+    assert {r["study"] for r in rows} == {"000", "001", "002", "004"}
+    for r in rows:
+        assert r["status"] in ("agrees", "differs", "n/a")
+        if r["status"] == "differs":
+            assert r["note"], f"row {r['quantity']!r} differs without a reason"
+    by = {(r["study"], r["quantity"]): r for r in rows}
+    # numbers the papers and pinarms must share
+    table3 = [r for r in rows if r["quantity"].startswith("Table 3 J1-J3")]
+    assert len(table3) == 21 and all(r["status"] == "agrees" for r in table3)
+    assert by[("004", "FK example 1 x")]["status"] == "agrees"
+    assert by[("004", "FK example 1 z")]["status"] == "agrees"
+    assert by[("000", "initial total time")]["status"] == "agrees"
+    assert by[("002", "jerk jump at interior knots / jerk limit")]["status"] == "agrees"
+    assert by[("000", "GA peak |v| joint 1")]["pinarms"] <= 55.0 * (1 + 1e-6)
+    # files
+    for key in ("000", "001", "002", "004"):
+        assert (out / "sessions" / f"seed{key}.pinarms").is_file()
+        assert (out / "html" / f"seed{key}.html").stat().st_size > 100_000
+        assert (out / "plots" / f"seed{key}_joints.png").is_file()
+    assert (out / "plots" / "seed001_workspace.png").is_file()
+    md = (out / "table.md").read_text()
+    assert md.count("\n| ") == len(rows) + 1
+    assert json.loads((out / "table.json").read_text()) == rows
+    import viz
+
+    session = viz.load_session(out / "sessions" / "seed001.pinarms")
+    assert session.trajectories and session.workspaces
+
+
+def test_demo_text_table_only_one_study(tmp_path):
+    result = CliRunner().invoke(cli, ["demo", "--quick", "--only", "004", "--out", str(tmp_path)])
+    assert result.exit_code == 0, (result.output, result.exception)
+    assert "paper vs pinarms" in result.stdout
+    assert "FK example 2 z" in result.stdout and "differs" in result.stdout
+    assert (tmp_path / "table.md").is_file()
