@@ -11,5 +11,6 @@ with warnings.catch_warnings():
     import meshcat.geometry as mg
     import meshcat.transformations
     from meshcat.visualizer import ViewerWindow
+    from pinocchio.visualize import MeshcatVisualizer
 
-__all__ = ["meshcat", "mg", "ViewerWindow"]
+__all__ = ["meshcat", "mg", "ViewerWindow", "MeshcatVisualizer"]

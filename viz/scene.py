@@ -25,11 +25,10 @@ from typing import Any, Sequence
 import matplotlib
 import numpy as np
 import pinocchio as pin
-from pinocchio.visualize import MeshcatVisualizer
 
 from robots.errors import InvalidInput
 
-from ._meshcat import meshcat, mg
+from ._meshcat import MeshcatVisualizer, meshcat, mg
 from .errors import ViewerError
 
 __all__ = ["SceneInfo", "build_scene", "ROOT", "colors_by_value"]

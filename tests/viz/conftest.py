@@ -1,0 +1,36 @@
+"""Shared fixtures of the viz tests: a small packing-line session (SCARA, conveyor, crate)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import planning
+import robots
+import viz
+
+DEG = np.pi / 180.0
+
+
+def _pose(x: float, y: float, z: float) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = [x, y, z]
+    return T
+
+
+@pytest.fixture(scope="session")
+def line_session() -> viz.Session:
+    """SCARA on a 3-5-3 pick-and-place through seed 000's joint-1 path points, plus a UR5 cell."""
+    arm = robots.load("scara_mushroom")
+    s = viz.Session(arm, title="enoki packing line", key="scara")
+    j1 = np.array([55.5, 69.7, 106.5, 124.5]) * DEG
+    via = np.column_stack([j1, np.array([-60.0, -40.0, 30.0, 60.0]) * DEG, [0.02, 0.10, 0.10, 0.02],
+                           np.array([0.0, 30.0, 60.0, 90.0]) * DEG])
+    traj = planning.piecewise_polynomial([0.0, 1.086, 2.329, 3.607], via, degrees=(3, 5, 3))
+    s.add_trajectory("pick-place 3-5-3", traj, hz=60)
+    q = arm.random_q(1500, seed=7)
+    s.add_workspace("scara cloud", points=arm.position(q), manipulability=arm.manipulability(q, part="position"))
+    s.add_points("crate targets", [[0.3, -0.3, 0.05], [0.35, -0.3, 0.05]], kind="target")
+    s.add_box("conveyor", [1.2, 0.25, 0.06], pose=_pose(0.35, 0.3, 0.03), color=(0.3, 0.3, 0.35, 1.0))
+    s.add_box("crate", [0.3, 0.2, 0.1], pose=_pose(0.32, -0.3, 0.05), color=(0.8, 0.6, 0.3, 1.0))
+    return s

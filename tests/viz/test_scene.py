@@ -1,0 +1,118 @@
+"""Scene building and HTML export against a real MeshCat server (no browser needed)."""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+import pytest
+
+import robots
+import viz
+from robots.errors import InvalidInput
+from viz.scene import build_scene, colors_by_value
+from viz.viewer import MeshcatServer
+
+
+def _listening_addresses(port: int) -> set[str]:
+    """Local addresses (hex, /proc/net/tcp form) with a listening socket on ``port``."""
+    out = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        if not os.path.exists(table):
+            continue
+        with open(table) as f:
+            for line in f.readlines()[1:]:
+                local, state = line.split()[1], line.split()[3]
+                addr, p = local.split(":")
+                if state == "0A" and int(p, 16) == port:
+                    out.add(addr)
+    return out
+
+
+def test_scene_contents_and_animation(line_session):
+    with MeshcatServer() as server:
+        info = build_scene(server.visualizer, line_session, fps=25)
+        assert server.running
+    arm = line_session.robot("scara")
+    rec = line_session.trajectories["pick-place 3-5-3"]
+    assert info.robots["scara"] == [f"pinarms/robots/scara/visuals/{g}" for g in (
+        "base_link_0", "upper_arm_link_0", "upper_arm_link_1", "forearm_link_0", "forearm_link_1",
+        "quill_link_0", "hand_link_0", "hand_link_1")]
+    assert info.paths == {"pick-place 3-5-3": "pinarms/paths/pick-place 3-5-3"}
+    assert info.clouds == {"scara cloud": "pinarms/workspace/scara cloud"}
+    assert len(info.points["crate targets"]) == 2 and len(info.points["vias:pick-place 3-5-3"]) == 4
+    assert info.animated == ("pick-place 3-5-3",)
+    assert info.duration == pytest.approx(3.607)
+    assert info.n_frames == int(np.floor(3.607 * 25)) + 2  # 25 fps plus the exact end pose
+    # the bounds hold the TCP path and the boxes
+    tcp = arm.position(rec.q)
+    assert np.all(info.bounds[0] <= tcp.min(axis=0)) and np.all(info.bounds[1] >= tcp.max(axis=0))
+    assert info.bounds[1][0] >= 0.35 + 0.6 - 1e-12  # conveyor's far end
+    assert not server.running
+
+
+def test_animate_choice_is_checked(line_session):
+    with MeshcatServer() as server:
+        with pytest.raises(InvalidInput, match="cannot animate"):
+            build_scene(server.visualizer, line_session, animate=["nope"])
+        info = build_scene(server.visualizer, line_session, animate=())
+        assert info.animated == () and info.n_frames == 0
+
+
+def test_server_binds_loopback_only_and_stops():
+    server = MeshcatServer()
+    port = int(re.search(r":(\d+)/", server.url).group(1))
+    assert server.url == f"http://127.0.0.1:{port}/static/"
+    assert server.zmq_url.startswith("tcp://127.0.0.1:")
+    if os.path.exists("/proc/net/tcp"):
+        assert _listening_addresses(port) == {"0100007F"}  # 127.0.0.1, nothing on 0.0.0.0
+        zport = int(server.zmq_url.rsplit(":", 1)[1])
+        assert _listening_addresses(zport) == {"0100007F"}
+    pid = server.pid
+    assert os.path.exists(f"/proc/{pid}")
+    server.close()
+    server.close()  # idempotent
+    assert not server.running
+    assert not os.path.exists(f"/proc/{pid}")
+    assert _listening_addresses(port) == set()
+
+
+def test_bad_port():
+    with pytest.raises(InvalidInput, match="port"):
+        MeshcatServer(port=70000)
+
+
+def test_export_html_is_self_contained(line_session, tmp_path):
+    out = viz.export_html(line_session, tmp_path / "line.html")
+    html = out.read_text(encoding="utf-8")
+    assert html.lstrip().lower().startswith("<!doctype html") or "<html" in html[:500].lower()
+    assert "src=\"http" not in html and "href=\"http" not in html  # nothing fetched from a server
+    assert html.count("fetch(\"data:application/octet-binary;base64,") > 20  # the replayed scene
+    assert os.listdir(tmp_path) == ["line.html"]
+
+
+def test_colors_by_value_scale():
+    c = colors_by_value(np.array([0.0, 0.5, 1.0]))
+    assert c.shape == (3, 3)
+    np.testing.assert_allclose(c[0], [0.267004, 0.004874, 0.329415], atol=1e-6)  # viridis(0)
+    np.testing.assert_allclose(c[2], [0.993248, 0.906157, 0.143936], atol=1e-6)  # viridis(1)
+    assert np.all(colors_by_value(np.zeros(4)) == colors_by_value(np.zeros(4))[0])
+
+
+def test_two_robots_with_base_placement(tmp_path):
+    s = viz.Session("ur5")
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 0.0, 0.0]
+    s.add_robot("panda", base_to_world=T)
+    panda = s.robot("panda")
+    q = panda.random_q(20, seed=1)
+    s.add_trajectory("panda move", (np.linspace(0.0, 1.0, 20), q), robot="panda")
+    with MeshcatServer() as server:
+        info = build_scene(server.visualizer, s, fps=10)
+    assert set(info.robots) == {"ur5", "panda"}
+    assert info.animated == ("panda move",)
+    # the path is drawn in the world frame: panda's TCP shifted by its base placement
+    tcp_world = panda.position(q) + [1.0, 0.0, 0.0]
+    assert np.all(info.bounds[1] >= tcp_world.max(axis=0) - 1e-12)
+    assert info.bounds[1][0] >= 1.0
