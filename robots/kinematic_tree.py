@@ -230,37 +230,49 @@ class KinematicTree:
         _run_chunks(block, N)
         return out
 
-    def frame_jacobian(self, q: np.ndarray, frame_id: int) -> np.ndarray:
-        """Frame Jacobians ``(N, 6, nq)``: world-aligned axes at the frame origin, linear rows first.
+    def origin_and_columns(self, qc: np.ndarray, frame_id: int) -> tuple[list, list]:
+        """Frame origin and Jacobian columns of one chunk ``qc (n, nq)``, structure of arrays.
+
+        Returns ``p`` (3 arrays ``(n,)``, world frame [m]) and ``cols``: for each
+        independent joint, 6 entries (linear then angular, world axes at the frame origin),
+        each an ``(n,)`` array or the float 0.0 when the joint does not move the frame.
 
         Column of a revolute joint with world axis ``ω`` through ``o``: ``[ω × (p − o); ω]``;
         of a prismatic joint: ``[axis; 0]``; a mimic joint adds ``scale ×`` its column to
         its master's column.
         """
+        joint, _, fp = self.frame_of(frame_id)
+        Rs, ps = self._joint_poses(qc, joint)
+        p = _add(ps[joint], _vec_const(Rs[joint], fp))
+        cols: list = [[0.0] * 6 for _ in range(self.nq)]
+        for i in self.ancestors[joint]:
+            w = [Rs[i][k][2] for k in range(3)]
+            if self.kind[i] == _REVOLUTE:
+                d = [p[a] - ps[i][a] for a in range(3)]
+                six = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]] + w
+            else:
+                six = w + [0.0, 0.0, 0.0]
+            k, col = self.scale[i], cols[self.q_index[i]]
+            for a in range(6):
+                col[a] = col[a] + (six[a] if k == 1.0 else k * six[a])
+        return p, cols
+
+    def frame_jacobian(self, q: np.ndarray, frame_id: int) -> np.ndarray:
+        """Frame Jacobians ``(N, 6, nq)``: world-aligned axes at the frame origin, linear rows first."""
         N = q.shape[0]
         J = np.zeros((N, 6, self.nq))
-        joint, _, fp = self.frame_of(frame_id)
 
         def block(start: int) -> None:
             qc = q[start : start + _CHUNK]
             Jc = J[start : start + qc.shape[0]]
-            Rs, ps = self._joint_poses(qc, joint)
-            p_frame = _add(ps[joint], _vec_const(Rs[joint], fp))
-            for i in self.ancestors[joint]:
-                w = [Rs[i][k][2] for k in range(3)]
-                col, k = self.q_index[i], self.scale[i]
-                if self.kind[i] == _REVOLUTE:
-                    d = [p_frame[a] - ps[i][a] for a in range(3)]
-                    lin = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]]
-                    for a in range(3):
-                        Jc[:, a, col] += k * lin[a]
-                        Jc[:, 3 + a, col] += k * w[a]
-                else:
-                    for a in range(3):
-                        Jc[:, a, col] += k * w[a]
+            _, cols = self.origin_and_columns(qc, frame_id)
+            for c, col in enumerate(cols):
+                for a in range(6):
+                    Jc[:, a, c] = col[a]
 
         _run_chunks(block, N)
         return J
+
 
 def _run_chunks(block, N: int) -> None:
     """Call ``block(start)`` for every chunk of ``N`` samples, on all cores when it pays.

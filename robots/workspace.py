@@ -124,7 +124,7 @@ def _positions_and_dexterity(
     w = np.empty(N)
     c = np.empty(N)
     tree = getattr(robot, "_tree", None)
-    fast = tree is not None and robot.nq >= 3 and hasattr(tree, "_joint_poses")
+    fast = tree is not None and robot.nq >= 3 and hasattr(tree, "origin_and_columns")
 
     def block(start: int) -> None:
         qc = q[start : start + chunk]
@@ -153,25 +153,10 @@ def _positions_and_dexterity(
 
 def _tree_position_and_columns(tree: Any, qc: np.ndarray, frame_id: int, nq: int) -> tuple[list, list]:
     """Frame origin (3 arrays) and linear Jacobian columns (nq × 3 arrays) of one chunk."""
-    joint, _, fp = tree.frame_of(frame_id)
-    Rs, ps = tree._joint_poses(qc, joint)
-    R = Rs[joint]
-    p = [ps[joint][a] + R[a][0] * fp[0] + R[a][1] * fp[1] + R[a][2] * fp[2] for a in range(3)]
+    p, cols = tree.origin_and_columns(qc, frame_id)
     n = qc.shape[0]
-    p = [np.broadcast_to(v, (n,)) if np.ndim(v) == 0 else v for v in p]
-    zero = np.zeros(n)
-    cols: list = [[zero, zero, zero] for _ in range(nq)]
-    for i in tree.ancestors[joint]:
-        ax = [Rs[i][k][2] for k in range(3)]
-        col, k = int(tree.q_index[i]), float(tree.scale[i])
-        if tree.kind[i] == 1:  # revolute: ω × (p − o)
-            d = [p[a] - ps[i][a] for a in range(3)]
-            lin = [ax[1] * d[2] - ax[2] * d[1], ax[2] * d[0] - ax[0] * d[2], ax[0] * d[1] - ax[1] * d[0]]
-        else:  # prismatic: the axis
-            lin = ax
-        cols[col] = [cols[col][a] + (lin[a] if k == 1.0 else k * lin[a]) for a in range(3)]
-    cols = [[np.broadcast_to(v, (n,)) if np.ndim(v) == 0 else v for v in col] for col in cols]
-    return p, cols
+    full = lambda v: np.broadcast_to(v, (n,)) if np.ndim(v) == 0 else v  # noqa: E731
+    return [full(v) for v in p], [[full(v) for v in col[:3]] for col in cols]
 
 
 # ----------------------------------------------------------------- sphere fits
