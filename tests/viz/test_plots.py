@@ -1,0 +1,71 @@
+"""Plots: PNG and SVG files with the expected content, atomic writes, checked inputs."""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import planning
+import viz
+from robots.errors import InvalidInput
+
+
+@pytest.fixture(scope="module")
+def traj():
+    via = np.deg2rad([[55.5, 69.7, 106.5, 124.5]]).T
+    return planning.piecewise_polynomial([0.0, 2.0, 4.0, 6.0], via, degrees=(3, 5, 3))
+
+
+def test_joint_curves_png(traj, tmp_path):
+    limits = planning.JointLimits(velocity=np.deg2rad(55.0), acceleration=1.0, jerk=5.0)
+    out = viz.plot_trajectory(tmp_path / "j1.png", traj, limits=limits, degrees=True, joint_names=["J1"])
+    assert out == tmp_path / "j1.png"
+    img = Image.open(out)
+    assert img.format == "PNG"
+    w, h = img.size
+    assert w > 600 and h > 4 * 200  # four panels: position, velocity, acceleration, jerk
+    assert os.listdir(tmp_path) == ["j1.png"]
+
+
+def test_joint_curves_svg_labels(traj, tmp_path):
+    t = np.linspace(0.0, 6.0, 50)
+    q, qd, _, _ = traj.sample(t)
+    out = viz.plot_joint_curves(tmp_path / "c.svg", t, q, qd, knot_times=traj.knot_times, limits={"velocity": 0.9})
+    text = out.read_text()
+    assert "position" in text and "velocity" in text and "acceleration" not in text
+    # ±limit lines: two horizontal dashed lines at ±0.9 in the velocity panel
+    assert text.count("stroke-dasharray") >= 2
+    ET.parse(out)  # well-formed XML
+
+
+def test_ga_convergence(tmp_path):
+    hist = {"best": [6.0, 4.1, 3.7, 3.61], "mean": [9.0, 6.0, 4.5, 3.9], "feasible_share": [0.1, 0.5, 0.9, 1.0]}
+    out = viz.plot_ga_convergence(tmp_path / "ga.svg", hist)
+    text = out.read_text()
+    assert "generation" in text and "feasible share" in text and "population mean" in text
+    s = viz.Session()
+    rec = s.add_history("ga", hist)
+    assert Image.open(viz.plot_ga_convergence(tmp_path / "ga.png", rec)).format == "PNG"
+    with pytest.raises(InvalidInput, match="best"):
+        viz.plot_ga_convergence(tmp_path / "x.png", {"mean": [1.0]})
+
+
+def test_workspace_views(tmp_path):
+    rng = np.random.default_rng(0)
+    pts = rng.normal(size=(500, 3)) * 0.3
+    w = np.linalg.norm(pts, axis=1)
+    out = viz.plot_workspace(tmp_path / "ws.svg", pts, w, mm=True)
+    text = out.read_text()
+    assert "top view" in text and "side view" in text and "manipulability" in text and "[mm]" in text
+    with pytest.raises(InvalidInput, match=r"\(500,\)"):
+        viz.plot_workspace(tmp_path / "bad.png", pts, w[:10])
+
+
+def test_bad_suffix_writes_nothing(traj, tmp_path):
+    with pytest.raises(InvalidInput, match=".png or .svg"):
+        viz.plot_trajectory(tmp_path / "j.pdf", traj)
+    assert os.listdir(tmp_path) == []
