@@ -14,6 +14,9 @@ from optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, Opti
 from optim.exact import ExactSolution, solve_exact
 from optim.problem import KINDS, TimingProblem
 from optim.settings import GASettings
+from optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
+                              ruckig_limit, toppra_limit)
+from optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
 from optim.timing import TimingResult, minimize_time
 
 __all__ = [
@@ -26,6 +29,14 @@ __all__ = [
     "KINDS",
     "TimingResult",
     "minimize_time",
+    "minimize_time_jerk",
+    "TimeJerkResult",
+    "jerk_integral",
+    "path_velocity_limit",
+    "toppra_limit",
+    "ruckig_limit",
+    "double_s_limit",
+    "MissingReference",
     "ExactSolution",
     "solve_exact",
     "OptimError",

@@ -77,8 +77,12 @@ def _planning_builder(kind: str, options: dict[str, Any]) -> Builder:
     import planning  # optim sits above planning in the one-way flow
 
     if kind == "3-5-3":
-        opts = {"degrees": (3, 5, 3), **options}
-        return lambda t, q: planning.piecewise_polynomial(t, q, **opts)
+        # Cubic first and last segments, quintics between (3-5-3 for three segments).
+        def build_353(t: np.ndarray, q: np.ndarray) -> Any:
+            m = t.shape[0] - 1
+            degrees = (3,) + (5,) * (m - 2) + (3,) if m >= 2 else (5,)
+            return planning.piecewise_polynomial(t, q, **{"degrees": degrees, **options})
+        return build_353
     if kind == "multi-quintic":
         return lambda t, q: planning.multi_quintic(t, q, **options)
     if kind == "quintic-bspline":
@@ -171,8 +175,8 @@ class TimingProblem:
             parts.append(pk[2] / self.jmax)
         return np.concatenate(parts)
 
-    def peaks_batch(self, population: np.ndarray) -> np.ndarray:
-        """Exact peaks for a population of durations (pop, m) -> (pop, 3, n_joints).
+    def piece_peaks_batch(self, population: np.ndarray) -> np.ndarray:
+        """Exact peaks per polynomial piece, (pop, 3, pieces, n_joints), for durations (pop, m).
 
         Each individual's trajectory is built by the planning constructor (they take one
         timing at a time); the peak search then runs once for the whole population: every
@@ -181,23 +185,15 @@ class TimingProblem:
         planning trajectory, whose exact peaks are divided by ``h_i``, ``h_i**2``,
         ``h_i**3`` (the r-th derivative in real time is the r-th in ``u`` over ``h_i**r``).
         """
-        h = np.atleast_2d(np.asarray(population, dtype=float))
-        pop, m = h.shape
-        trajs = [self.trajectory(row) for row in h]
-        self.evaluations += pop
-        if not all(hasattr(t, "coefficients") for t in trajs):
-            out = []
-            for t in trajs:
-                p = t.peaks()
-                out.append([p.velocity, p.acceleration, p.jerk])
-            return np.asarray(out, dtype=float).reshape(pop, 3, self.n_joints)
         from planning.trajectory import Trajectory
 
+        h = np.atleast_2d(np.asarray(population, dtype=float))
+        pop = h.shape[0]
+        trajs = [self.trajectory(row) for row in h]
+        self.evaluations += pop
         coefs = np.stack([np.asarray(t.coefficients, dtype=float) for t in trajs])  # (P,m,K+1,n)
         width = coefs.shape[2]
         seg = np.stack([np.diff(np.asarray(t.knot_times, dtype=float)) for t in trajs])  # (P,m')
-        if coefs.shape[1] != seg.shape[1]:
-            raise InvalidInput("trajectory pieces and knot times disagree")
         powers = seg[:, :, None] ** np.arange(width)  # (P, m', K+1)
         normalised = coefs * powers[..., None]
         columns = np.moveaxis(normalised, 2, -1).reshape(-1, width)  # (P*m'*n, K+1)
@@ -205,7 +201,24 @@ class TimingProblem:
         per = np.stack([pk.velocity, pk.acceleration, pk.jerk])  # (3, P*m'*n)
         per = per.reshape(3, pop, seg.shape[1], self.n_joints)
         per = per / seg[None, :, :, None] ** np.arange(1, 4)[:, None, None, None]
-        return np.moveaxis(per.max(axis=2), 0, 1)  # (P, 3, n)
+        return np.moveaxis(per, 0, 1)  # (P, 3, m', n)
+
+    def peaks_batch(self, population: np.ndarray) -> np.ndarray:
+        """Exact peaks for a population of durations (pop, m) -> (pop, 3, n_joints)."""
+        return self.piece_peaks_batch(population).max(axis=2)
+
+    def _limits_stack(self) -> tuple[np.ndarray, np.ndarray]:
+        """(kinds,) indices of the active limits and their values (kinds, n_joints)."""
+        kinds = [0] + ([1] if self.amax is not None else []) + ([2] if self.jmax is not None else [])
+        values = [self.vmax, self.amax, self.jmax]
+        return np.array(kinds), np.stack([values[k] for k in kinds])
+
+    def piece_limit_ratios_batch(self, population: np.ndarray) -> np.ndarray:
+        """Peak / limit per active limit, piece and joint: (pop, n_con * pieces)."""
+        pk = self.piece_peaks_batch(population)
+        kinds, lim = self._limits_stack()
+        ratios = pk[:, kinds] / lim[None, :, None, :]
+        return ratios.reshape(ratios.shape[0], -1)
 
     def limit_ratios_batch(self, population: np.ndarray) -> np.ndarray:
         """Peak / limit for a population (pop, m) -> (pop, n_con)."""
@@ -218,13 +231,15 @@ class TimingProblem:
         return np.concatenate(parts, axis=1)
 
     def constraints(self, population: np.ndarray) -> np.ndarray:
-        """``peak / limit - 1`` for a population of durations (pop, m) -> (pop, n_con).
+        """``peak / limit * (1 + SAFETY) - 1`` for durations (pop, m) -> (pop, n_con).
 
-        Rows repeated in the population (elites, uncrossed copies) are computed once.
+        Feasible (<= 0) keeps a relative margin of ``SAFETY`` under every limit, so that
+        answers stay feasible through round-off. Rows repeated in the population
+        (elites, uncrossed copies) are computed once.
         """
         h = np.atleast_2d(np.asarray(population, dtype=float))
         unique, inverse = np.unique(h, axis=0, return_inverse=True)
-        return self.limit_ratios_batch(unique)[inverse.reshape(-1)] - 1.0
+        return self.limit_ratios_batch(unique)[inverse.reshape(-1)] * (1.0 + SAFETY) - 1.0
 
     def is_feasible(self, durations: np.ndarray, rtol: float = 0.0) -> bool:
         """Whether every peak is within its limit (times 1 + rtol) and h within bounds."""
