@@ -258,7 +258,7 @@ class TimingProblem:
         m = self.n_segments
         if bounds is None:
             s0 = self.reference_total()
-            return np.tile([s0 / (100.0 * m), s0], (m, 1))
+            return np.tile([s0 / (20.0 * m), s0 * min(1.0, 4.0 / m)], (m, 1))
         b = np.asarray(bounds, dtype=float)
         if b.shape == (2,):
             b = np.tile(b, (m, 1))

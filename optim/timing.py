@@ -16,7 +16,7 @@ import numpy as np
 
 from optim.engine import GAHistory, GAProgress, run_ga
 from optim.errors import InfeasibleProblem, InvalidSettings
-from optim.exact import solve_exact
+from optim.exact import scaled_to_limits, solve_exact, start_ratios
 from optim.problem import SAFETY, TimingProblem
 from optim.settings import GASettings
 
@@ -123,8 +123,9 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
         seed: Seed of the GA (or of the exact optimiser's random starts).
         settings: GA settings (default :meth:`GASettings.seed002`).
         bounds: Segment-duration bounds (s): one (lower, upper) pair or (m, 2) rows.
-            Default: ``[s0 / (100 m), s0]`` per segment, s0 the minimal total with equal
-            durations (a feasible total, so the optimum lies inside).
+            Default: ``[s0 / (20 m), min(s0, 4 s0 / m)]`` per segment, s0 the minimal
+            total with equal durations (so equal durations s0/m are inside and feasible).
+            Pass wider bounds if one segment may need more than 4x the average.
         max_generations, stall_generations, time_limit: GA stopping rules.
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
@@ -157,6 +158,12 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
                              evaluations=problem.evaluations - before, t0=t0,
                              raw_total=sol.total)
     settings = GASettings.seed002() if settings is None else settings
+    if initial is None:
+        # Feasible, informed individuals (seed 002 starts from feasible timings): the
+        # scaling-law starts (equal ratios, ratios from the segment lengths) at s*(r).
+        starts = [scaled_to_limits(problem, r) for r in start_ratios(problem, 0, seed)[:3]]
+        rows = [h for h, ok in starts if ok and np.all(h >= problem.bounds[:, 0])]
+        initial = np.array(rows) if rows else None
     result = run_ga(lambda h: h.sum(axis=1), problem.bounds, settings,
                     constraints=problem.constraints, seed=seed,
                     max_generations=max_generations, stall_generations=stall_generations,
