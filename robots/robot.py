@@ -225,3 +225,201 @@ class Robot:
     def has_analytic_ik(self) -> bool:
         """Whether :meth:`ik_all` has a closed form for this arm."""
         return self._analytic_ik is not None
+
+    def check_target(self, target: Any, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
+        """Validate IK target(s): a pose ``(4, 4)`` / ``(N, 4, 4)`` frame → base [m], proper rotation.
+
+        With ``position_only`` a position ``(3,)`` / ``(N, 3)`` [m] is accepted too.
+        Returns the ``(N, 4, 4)`` array and whether a single target was given.
+
+        Raises:
+            InvalidInput: wrong shape, non-finite entries, or a rotation block that is not a
+                proper rotation (orthonormal within 1e-6, determinant +1).
+        """
+        try:
+            arr = np.asarray(target, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInput(f"IK target must be numbers, got {target!r}") from exc
+        if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
+            single = arr.ndim == 1
+            pts = arr.reshape(-1, 3)
+            arr = np.tile(np.eye(4), (pts.shape[0], 1, 1))
+            arr[:, :3, 3] = pts
+        else:
+            single = arr.ndim == 2
+            if single:
+                arr = arr[None]
+            if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+                extra = " or a position (3,)" if position_only else ""
+                raise InvalidInput(
+                    f"IK target must be a pose of shape (4, 4) or (N, 4, 4){extra}, got shape {np.shape(target)}"
+                )
+        if not np.all(np.isfinite(arr)):
+            raise InvalidInput("IK target holds a non-finite value (NaN or inf)")
+        if not position_only or not single or np.shape(target) == (4, 4):
+            R = arr[:, :3, :3]
+            ortho = np.abs(R @ np.swapaxes(R, 1, 2) - np.eye(3)).max(axis=(1, 2))
+            det = np.linalg.det(R)
+            bad = np.flatnonzero((ortho > 1e-6) | (det < 0.0))
+            if bad.size:
+                k = int(bad[0])
+                raise InvalidInput(
+                    f"IK target {k}: its rotation block is not a proper rotation "
+                    f"(|R Rᵀ − I| = {ortho[k]:.3g}, det = {det[k]:.6g}); pass a homogeneous transform"
+                )
+            if np.abs(arr[:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max() > 1e-9:
+                raise InvalidInput("IK target: the last row of a homogeneous transform must be (0, 0, 0, 1)")
+        return arr, single
+
+    def ik_all(self, target: Any, q_ref: Any = None) -> np.ndarray | list[np.ndarray]:
+        """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
+
+        Args:
+            target: tcp pose ``(4, 4)`` (frame → base, m), or a batch ``(N, 4, 4)``.
+            q_ref: ``(nq,)`` or ``(N, nq)``: solutions are sorted by distance to it
+                (default :attr:`neutral`); it also fixes the free joint at singular poses.
+
+        Returns:
+            ``(k, nq)`` for one target (``k = 0`` allowed: see :meth:`ik_failure_reason`), a
+            list of ``N`` such arrays for a batch. Every row's FK meets the target within
+            1e-9 m and 1e-9 rad.
+
+        Raises:
+            ModelError: the arm has no closed form (use :meth:`ik`).
+        """
+        if self._analytic_ik is None:
+            raise ModelError(
+                f"robot '{self.name}' has no analytic IK (closed forms: SCARA, gantry, koji arm, UR-type); "
+                "use Robot.ik for a numerical solution"
+            )
+        T, single = self.check_target(target)
+        ref = None
+        if q_ref is not None:
+            ref, _ = self.check_q(q_ref)
+            if ref.shape[0] not in (1, T.shape[0]):
+                raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
+        sols = self._analytic_ik.solve(T, ref)
+        return sols[0] if single else sols
+
+    def _numerical_ik(self):
+        solver = getattr(self, "_numerical_ik_solver", None)
+        if solver is None:
+            from .ik.numerical import NumericalIK  # late import: the solvers need the Robot class
+
+            solver = self._numerical_ik_solver = NumericalIK(self)
+        return solver
+
+    def _limit_diagnosis(self, q: np.ndarray) -> list[str]:
+        """Joints of ``q`` outside their limits, each revolute angle taken at its 2π equivalent nearest the range."""
+        q = np.array(q, dtype=float)
+        tree = self._tree
+        for j in range(self.nq):
+            rev = tree.kind[[i for i in range(1, self.model.njoints) if tree.q_index[i] == j and tree.scale[i] == 1.0][0]] == 1
+            if rev:
+                mid = 0.5 * (self.lower[j] + self.upper[j])
+                q[j] = mid + (q[j] - mid + np.pi) % (2.0 * np.pi) - np.pi
+        return self.limit_violations(q)
+
+    def ik_failure_reason(self, target: Any, *, position_only: bool = False) -> str | None:
+        """Why ``target`` (one pose ``(4, 4)``) has no IK solution within the limits, or ``None`` if it has one.
+
+        The answer says whether the pose is out of reach (or has an orientation the arm cannot
+        take) or needs a joint outside its limits, naming the joints.
+        """
+        T, single = self.check_target(target, position_only=position_only)
+        if not single:
+            raise InvalidInput("ik_failure_reason takes one target")
+        what = "position" if position_only else "pose"
+        if self._analytic_ik is not None and not position_only:
+            if self._analytic_ik.solve(T)[0].shape[0]:
+                return None
+            idx, free = self._analytic_ik.candidates(T, respect_limits=False)
+            if free.shape[0] == 0:
+                return self._unreachable_text(T[0], position_only)
+            worst = min(free, key=lambda q: len(self._limit_diagnosis(q)))
+            return (
+                f"the {what} is within reach but every solution needs a joint outside its limits; "
+                f"nearest: {'; '.join(self._limit_diagnosis(worst))}"
+            )
+        solver = self._numerical_ik()
+        res = solver.solve(T[0], position_only=position_only, tol=1e-9, max_restarts=20)
+        if res.success:
+            return None
+        free = solver.solve(T[0], position_only=position_only, tol=1e-9, max_restarts=20, limits=False)
+        if free.success:
+            return (
+                f"the {what} is within reach but needs a joint outside its limits: "
+                f"{'; '.join(self._limit_diagnosis(free.q)) or 'a limit'}"
+            )
+        return self._unreachable_text(T[0], position_only, res)
+
+    def _unreachable_text(self, T: np.ndarray, position_only: bool, res=None) -> str:
+        if res is None:
+            res = self._numerical_ik().solve(T, position_only=position_only, tol=1e-9, max_restarts=10, limits=False)
+        if res.position_error > 1e-6 or position_only:
+            return (
+                f"the target is out of reach: the closest tcp position found is {res.position_error:.4g} m away "
+                f"(rotation error {res.rotation_error:.3g} rad)"
+            )
+        return (
+            f"the target's orientation cannot be taken by '{self.name}' at that position "
+            f"(rotation error {res.rotation_error:.3g} rad remains)"
+        )
+
+    def ik(
+        self,
+        target: Any,
+        q_seed: Any = None,
+        *,
+        position_only: bool = False,
+        tol: float = 1e-10,
+        max_restarts: int = 40,
+        seed: int | np.random.Generator | None = 0,
+    ) -> np.ndarray:
+        """One configuration ``(nq,)`` within the limits whose tcp meets ``target`` within ``tol``.
+
+        Arms with a closed form start from the analytic solution nearest ``q_seed`` (refined by
+        the numerical solver to ``tol``); other arms, and ``position_only`` targets, use
+        damped least squares from ``q_seed`` then seeded random restarts.
+
+        Args:
+            target: tcp pose ``(4, 4)`` frame → base [m]; with ``position_only`` a position
+                ``(3,)`` [m] (or a pose whose rotation is ignored).
+            q_seed: start ``(nq,)`` (default: the middle of the joint ranges).
+            tol: required position error [m] and rotation error [rad].
+            max_restarts: random restarts after the first attempt.
+            seed: seed or generator of the restarts (results are reproducible).
+
+        Raises:
+            UnreachableTarget: no configuration within the limits found; the message gives the
+                remaining error and says whether the target is out of reach or needs a joint
+                outside its limits. A configuration that misses the target is never returned.
+        """
+        from .errors import UnreachableTarget
+
+        T, single = self.check_target(target, position_only=position_only)
+        if not single:
+            raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
+        if not (isinstance(tol, (int, float)) and tol > 0.0):
+            raise InvalidInput(f"tol must be a positive number [m, rad], got {tol!r}")
+        seed_q = None
+        if q_seed is not None:
+            seed_q, _ = self.check_q(q_seed)
+            seed_q = seed_q[0]
+        solver = self._numerical_ik()
+        if self._analytic_ik is not None and not position_only:
+            sols = self._analytic_ik.solve(T, None if seed_q is None else seed_q[None])[0]
+            for q in sols[:4]:
+                q2, pe, re, _ = solver.attempt(q, T[0], False, tol)
+                if pe <= tol and re <= tol and self.within_limits(q2):
+                    return q2
+        res = solver.solve(T[0], seed_q, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        if res.success and self.within_limits(res.q):
+            return res.q
+        reason = self.ik_failure_reason(T[0, :3, 3] if position_only else T[0], position_only=position_only)
+        raise UnreachableTarget(
+            f"robot '{self.name}': no configuration within the joint limits reaches the "
+            f"{'position' if position_only else 'pose'} within tol = {tol:g} "
+            f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
+            f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
+        )

@@ -1,0 +1,173 @@
+"""What every closed-form solver shares: candidates → 2π equivalents → limits → FK check.
+
+A family solver (:mod:`.ur_type`, :mod:`.scara`, :mod:`.gantry`, :mod:`.koji`) only
+implements :meth:`AnalyticIK.raw`: the branch candidates ``(N, B, nq)`` of a batch of
+targets, NaN where a branch does not exist. :meth:`AnalyticIK.solve` then
+
+1. wraps revolute angles to ``(-π, π]`` and adds every ``θ ± 2kπ`` that lies within the
+   joint's limits (a joint with a range wider than 2π has several equivalents),
+2. drops candidates outside the limits (tolerance :data:`LIMIT_TOL`),
+3. recomputes the forward kinematics of every candidate and keeps those that meet the
+   target within :data:`FK_TOL` (a branch through a singular configuration or a target
+   the family cannot reach, e.g. a tilted target for a SCARA, fails here),
+4. removes duplicates and sorts each target's solutions by distance to ``q_ref``.
+
+All steps are vectorised over the batch (the number of solutions per target varies, so
+rows are expanded with ``np.repeat`` and split once at the end).
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL"]
+
+#: Joint-limit tolerance of the returned solutions [rad or m].
+LIMIT_TOL = 1e-9
+#: A returned solution's FK meets the target within this [m] in position and [rad] in rotation.
+FK_TOL = 1e-9
+
+_TWO_PI = 2.0 * np.pi
+_CHUNK = 8192  # targets per block
+_MAX_ROWS = 1 << 20  # candidate rows per block (bounds memory for wide joint ranges)
+_WORKERS = max(1, min(4, os.cpu_count() or 1))
+
+
+class AnalyticIK:
+    """Base of the closed-form solvers. Subclasses set :attr:`family` and implement :meth:`raw`.
+
+    Args:
+        robot: the :class:`robots.Robot` to solve for; the solver reads its geometry from
+            ``robot.model`` when built and checks the structure it assumes.
+        frame: the target frame (default the robot's tcp).
+    """
+
+    family = "analytic"
+
+    def __init__(self, robot, frame: str = "tcp") -> None:
+        self.robot = robot
+        self.frame = frame
+        nq = robot.nq
+        self._revolute = np.zeros(nq, dtype=bool)
+
+    # ------------------------------------------------------------ to implement
+    def raw(self, targets: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+        """Branch candidates ``(N, B, nq)`` for targets ``(N, 4, 4)``; NaN where a branch does not exist.
+
+        ``q_ref (N, nq)`` picks the free joint at singular configurations.
+        """
+        raise NotImplementedError
+
+    # ----------------------------------------------------------------- helpers
+    def _mark_revolute(self, axes) -> None:
+        for a in axes:
+            if a.kind == "revolute" and not a.is_mimic:
+                self._revolute[a.q_index] = True
+
+    def _self_check(self, n: int = 24) -> None:
+        """Raise ModelError unless FK → raw IK recovers random in-limit configurations."""
+        robot = self.robot
+        q = robot.random_q(n, seed=12345)
+        T = robot.fk(q, self.frame)
+        cand = self.raw(T, q)
+        diff = cand - q[:, None, :]
+        rev = self._revolute
+        diff[..., rev] = (diff[..., rev] + np.pi) % _TWO_PI - np.pi
+        err = np.nanmax(np.abs(np.nan_to_num(diff, nan=np.inf)), axis=-1).min(axis=1)
+        bad = np.flatnonzero(err > 1e-6)
+        if bad.size:
+            raise ModelError(
+                f"the {self.family} closed form does not reproduce robot '{robot.name}': "
+                f"FK of q = {np.round(q[bad[0]], 6).tolist()} is not solved back (joint error "
+                f"{err[bad[0]]:.3g}); its geometry differs from what the solver assumes"
+            )
+
+    # ------------------------------------------------------------------ public
+    def _shifts(self) -> list[tuple[int, np.ndarray]]:
+        """Revolute joints whose range admits more than one 2π equivalent, with their ``k`` values."""
+        lo, hi = self.robot.lower, self.robot.upper
+        out = []
+        for j in np.flatnonzero(self._revolute):
+            k = np.arange(np.ceil((lo[j] - np.pi) / _TWO_PI), np.floor((hi[j] + np.pi) / _TWO_PI) + 1)
+            if not (k.size == 1 and k[0] == 0.0):
+                out.append((int(j), k))
+        return out
+
+    def _dense(
+        self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Solutions of one chunk as ``q (n, K, nq)`` sorted by distance to ``q_ref`` and ``valid (n, K)``."""
+        robot = self.robot
+        nq = robot.nq
+        q = self.raw(targets, q_ref)
+        n, B = q.shape[:2]
+        rev = self._revolute
+        q[..., rev] = np.pi - (np.pi - q[..., rev]) % _TWO_PI  # wrap to (-π, π]
+        valid = np.all(np.isfinite(q), axis=-1)
+        for b in range(1, B):  # branches that coincide (singular or boundary poses)
+            same = np.all(np.abs(q[:, :b] - q[:, b : b + 1]) <= 1e-8, axis=-1) & valid[:, :b]
+            valid[:, b] &= ~np.any(same, axis=1)
+        lo, hi = robot.lower, robot.upper
+        if respect_limits:
+            for j, k in self._shifts():
+                q = np.repeat(q, k.size, axis=1)
+                q[..., j] += _TWO_PI * np.tile(k, q.shape[1] // k.size)
+                valid = np.repeat(valid, k.size, axis=1)
+            valid &= np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=-1)
+        rows = q[valid]
+        if rows.shape[0]:
+            T = robot.fk(rows, self.frame)
+            ref = np.broadcast_to(targets[:, None], (n, q.shape[1], 4, 4))[valid]
+            pos_err = np.linalg.norm(T[:, :3, 3] - ref[:, :3, 3], axis=1)
+            rot_err = np.linalg.norm((T[:, :3, :3] - ref[:, :3, :3]).reshape(-1, 9), axis=1) / np.sqrt(2.0)
+            valid[valid] = (pos_err <= FK_TOL) & (rot_err <= FK_TOL)
+        dist = np.where(valid, np.linalg.norm(q - q_ref[:, None, :], axis=-1), np.inf)
+        order = np.argsort(dist, axis=1, kind="stable")
+        q = np.take_along_axis(q, order[..., None], axis=1)
+        valid = np.take_along_axis(valid, order, axis=1)
+        return q, valid
+
+    def candidates(
+        self, targets: np.ndarray, q_ref: np.ndarray | None = None, *, respect_limits: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Verified solutions of a batch: ``(index (M,), q (M, nq))``, index = target row, sorted by target then distance.
+
+        With ``respect_limits=False`` the joint limits are ignored (each revolute angle is
+        given once, wrapped to ``(-π, π]``): used to tell *out of reach* from *limits*.
+        """
+        robot = self.robot
+        N = targets.shape[0]
+        nq = robot.nq
+        q_ref = robot.neutral[None, :] if q_ref is None else np.asarray(q_ref, dtype=float)
+        q_ref = np.ascontiguousarray(np.broadcast_to(q_ref, (N, nq)))
+        width = 8 * int(np.prod([k.size for _, k in self._shifts()])) if respect_limits else 8
+        chunk = max(1, min(_CHUNK, _MAX_ROWS // width))
+        starts = list(range(0, N, chunk))
+        parts: list = [None] * len(starts)
+
+        def run(i: int) -> None:
+            s = starts[i]
+            q, valid = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits)
+            counts = valid.sum(axis=1)
+            parts[i] = (np.repeat(np.arange(s, s + q.shape[0]), counts), q[valid])
+
+        if len(starts) > 1 and _WORKERS > 1:
+            with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
+                list(pool.map(run, range(len(starts))))
+        else:
+            for i in range(len(starts)):
+                run(i)
+        if not parts:
+            return np.zeros(0, dtype=int), np.zeros((0, nq))
+        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+    def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None) -> list[np.ndarray]:
+        """Every solution within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first."""
+        idx, q = self.candidates(targets, q_ref)
+        counts = np.bincount(idx, minlength=targets.shape[0])
+        return np.split(q, np.cumsum(counts)[:-1])

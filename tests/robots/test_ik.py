@@ -1,0 +1,270 @@
+"""Closed-form IK: every solution within limits, batched, for the four arms and the UR family."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import robots
+from robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
+from robots.errors import InvalidInput, ModelError
+from robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
+
+ANALYTIC = ["scara_mushroom", "gantry_flower", "koji_turner", "aubo_i3", "ur3", "ur5", "ur10"]
+MAX_SOLUTIONS = {"scara_mushroom": 2 * 2, "gantry_flower": 1, "koji_turner": 4, "aubo_i3": 8, "ur3": 8 * 64, "ur5": 8 * 64, "ur10": 8 * 64}
+
+# Seed 001, table 2 joint columns (rad), read as the paper's modified D-H angles.
+TABLE2_THETA = np.array(
+    [
+        [-2.6180, -0.8727, 0.9599, 1.4835, -1.5708, 0.0000],
+        [-2.6180, -0.8727, 0.7854, 1.6581, -1.5708, 0.0000],
+        [0.7854, 2.2689, 2.1817, 1.6581, -1.5708, -0.7854],
+        [0.7854, 2.2689, 2.3562, 1.4835, -1.5708, -0.7854],
+    ]
+)
+
+
+@pytest.fixture(scope="module", params=ANALYTIC)
+def arm(request):
+    return robots.load(request.param)
+
+
+def _pose_errors(robot, q, T):
+    F = robot.fk(q)
+    pos = np.linalg.norm(F[..., :3, 3] - T[..., :3, 3], axis=-1)
+    rot = np.linalg.norm(F[..., :3, :3] - T[..., :3, :3], axis=(-2, -1)) / np.sqrt(2.0)
+    return pos, rot
+
+
+def test_each_arm_gets_its_family(arm):
+    expected = {"scara_mushroom": ScaraIK, "gantry_flower": GantryIK, "koji_turner": KojiIK}.get(arm.name, URTypeIK)
+    assert isinstance(arm._analytic_ik, expected)
+    assert arm.has_analytic_ik
+
+
+def test_round_trip_batch_all_solutions_valid(arm):
+    q = arm.random_q(300, seed=11)
+    T = arm.fk(q)
+    sols = arm.ik_all(T, q_ref=q)
+    assert isinstance(sols, list) and len(sols) == 300
+    for k, s in enumerate(sols):
+        assert 1 <= s.shape[0] <= MAX_SOLUTIONS[arm.name]
+        # sorted by distance to q_ref, and the nearest is the configuration itself
+        d = np.linalg.norm(s - q[k], axis=1)
+        assert np.all(np.diff(d) >= -1e-12)
+        assert d[0] < 1e-8
+    allq = np.concatenate(sols)
+    idx = np.repeat(np.arange(300), [s.shape[0] for s in sols])
+    pos, rot = _pose_errors(arm, allq, T[idx])
+    assert pos.max() <= FK_TOL and rot.max() <= FK_TOL
+    assert np.all(arm.within_limits(allq, tol=LIMIT_TOL))
+    # no duplicates within one target
+    for s in sols:
+        if s.shape[0] > 1:
+            gaps = np.abs(s[:, None, :] - s[None, :, :]).max(axis=-1) + np.eye(s.shape[0])
+            assert gaps.min() > 1e-8
+
+
+def test_single_target_returns_array(arm):
+    q = arm.random_q(1, seed=3)[0]
+    s = arm.ik_all(arm.fk(q))
+    assert s.ndim == 2 and s.shape[1] == arm.nq and s.shape[0] >= 1
+
+
+@settings(max_examples=40, deadline=None)
+@given(u=st.lists(st.floats(0.0, 1.0), min_size=6, max_size=6))
+def test_property_aubo_round_trip(u):
+    arm = _AUBO
+    q = arm.lower + np.array(u) * (arm.upper - arm.lower)
+    sols = arm.ik_all(arm.fk(q), q_ref=q)
+    assert sols.shape[0] >= 1
+    assert np.abs(sols[0] - q).max() < 1e-7
+    pos, rot = _pose_errors(arm, sols, np.broadcast_to(arm.fk(q), (sols.shape[0], 4, 4)))
+    assert pos.max() <= FK_TOL and rot.max() <= FK_TOL
+
+
+_AUBO = robots.load("aubo_i3")
+
+
+def test_aubo_solution_counts_match_a_numerical_search():
+    """8 branches where all exist; where only 4 reach, an exhaustive numerical search finds 4 too."""
+    q8 = np.array([1.94, -0.54, 0.29, -2.8, 1.5, 0.23])
+    _, free = _AUBO._analytic_ik.candidates(_AUBO.fk(q8)[None], respect_limits=False)
+    assert free.shape[0] == 8
+    q4 = np.array([0.3, -0.4, 1.1, 0.5, 0.8, -0.6])
+    T = _AUBO.fk(q4)
+    _, free = _AUBO._analytic_ik.candidates(T[None], respect_limits=False)
+    assert free.shape[0] == 4
+    solver = _AUBO._numerical_ik()
+    rng = np.random.default_rng(0)
+    found = []
+    for _ in range(120):
+        q, pe, re, _ = solver.attempt(rng.uniform(-np.pi, np.pi, 6), T, False, 1e-10, limits=False)
+        if pe < 1e-9 and re < 1e-9:
+            w = (q + np.pi) % (2 * np.pi) - np.pi
+            if not any(np.abs(w - x).max() < 1e-6 for x in found):
+                found.append(w)
+    assert len(found) == 4
+    for w in found:
+        assert np.abs(free - w).max(axis=1).min() < 1e-6
+
+
+def test_ur5_wide_limits_give_every_two_pi_equivalent():
+    ur5 = robots.load("ur5")
+    q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])  # generic, all |q| < π
+    sols = ur5.ik_all(ur5.fk(q))
+    # 8 branches; joints with range [-2π, 2π] (all but the elbow) each admit 2 equivalents
+    assert sols.shape[0] == 8 * 2**5
+    wrapped = (sols[:, [0, 1, 3, 4, 5]] + np.pi) % (2 * np.pi) - np.pi
+    assert len(np.unique(np.round(np.column_stack([wrapped, sols[:, 2]]), 8), axis=0)) == 8
+
+
+def test_table2_joint_columns_come_back_from_ik_of_their_fk():
+    """Seed 001 table 2 (paper's angles) → manufacturer joint values → FK → IK → same values."""
+    q = aubo_mdh_to_joint(TABLE2_THETA)
+    assert np.all(_AUBO.within_limits(q))
+    sols = _AUBO.ik_all(_AUBO.fk(q), q_ref=q)
+    for k in range(4):
+        np.testing.assert_allclose(sols[k][0], q[k], atol=1e-9)
+        np.testing.assert_allclose(aubo_joint_to_mdh(sols[k][0]), TABLE2_THETA[k], atol=1e-9)
+        assert sols[k].shape[0] >= 2  # other branches exist too (shoulder/elbow/wrist)
+
+
+def test_scara_two_elbow_branches_and_yaw():
+    scara = robots.load("scara_mushroom")
+    q = np.array([0.6, 0.9, 0.05, 0.4])
+    s = scara.ik_all(scara.fk(q), q_ref=q)
+    np.testing.assert_allclose(s[0], q, atol=1e-10)
+    elbows = np.unique(np.sign(np.round(s[:, 1], 9)))
+    assert set(elbows) == {-1.0, 1.0}  # elbow left and right
+    np.testing.assert_allclose(s[:, 2], 0.05, atol=1e-12)  # same stroke for every branch
+
+
+def test_scara_tilted_target_has_no_solution_and_says_why():
+    scara = robots.load("scara_mushroom")
+    T = scara.fk(np.array([0.6, 0.9, 0.05, 0.4]))
+    c, s = np.cos(0.2), np.sin(0.2)
+    T[:3, :3] = T[:3, :3] @ np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    assert scara.ik_all(T).shape == (0, 4)
+    assert "orientation" in scara.ik_failure_reason(T)
+
+
+def test_gantry_unique_solution_and_stroke_limits():
+    gantry = robots.load("gantry_flower")
+    q = np.array([0.4, 0.3, -0.1])
+    s = gantry.ik_all(gantry.fk(q))
+    assert s.shape == (1, 3)
+    np.testing.assert_allclose(s[0], q, atol=1e-12)
+    T = gantry.fk(np.array([1.0, 0.3, -0.1]))
+    T[0, 3] += 0.5  # x stroke is 1.2 m: 1.5 m needs x beyond it
+    assert gantry.ik_all(T).shape == (0, 3)
+    reason = gantry.ik_failure_reason(T)
+    assert "limits" in reason and "x = 1.5" in reason
+
+
+KOJI_PAPER_MATRIX = np.array(  # seed 004 eq. after (6): T for (−90, 25, −30, 90)°, mm → m
+    [[1.0, 0.0, 0.0, 1.1973], [0.0, 1.0, 0.0, 0.250], [0.0, 0.0, 1.0, -0.9292], [0.0, 0.0, 0.0, 1.0]]
+)
+
+
+def _koji_paper_branch(koji, T):
+    """The candidate with the waist at −90° and the upper arm raised (limits not applied)."""
+    _, free = koji._analytic_ik.candidates(T[None], respect_limits=False)
+    deg = np.degrees(free)
+    pick = deg[(np.abs(deg[:, 0] + 90.0) < 1e-6) & (deg[:, 1] > 0.0)]
+    assert pick.shape[0] == 1
+    return pick[0]
+
+
+def test_koji_paper_example_from_the_printed_position():
+    koji = robots.load("koji_turner")
+    deg = _koji_paper_branch(koji, KOJI_PAPER_MATRIX)
+    assert deg[0] == pytest.approx(-90.0, abs=1e-9)
+    assert deg[3] == pytest.approx(90.0, abs=1e-9)
+    # the printed position is the FK rounded to 0.1 mm: angles within 0.005° of (25, −30)
+    assert deg[1] == pytest.approx(25.0011, abs=1e-4)
+    assert deg[2] == pytest.approx(-30.0046, abs=1e-4)
+    # the paper's 25.0271° up / 30.0339° down, to the stated 0.03°
+    assert deg[1] == pytest.approx(25.0271, abs=0.03)
+    assert -deg[2] == pytest.approx(30.0339, abs=0.03)
+
+
+def test_koji_printed_position_needs_the_shoulder_just_past_25_degrees():
+    """25.0011° > the 25° range end: strictly, no solution within limits, and the reason says which joint."""
+    koji = robots.load("koji_turner")
+    assert koji.ik_all(KOJI_PAPER_MATRIX).shape == (0, 4)
+    reason = koji.ik_failure_reason(KOJI_PAPER_MATRIX)
+    assert "limits" in reason and "shoulder" in reason
+    # the exact FK of the paper's configuration is solved within limits
+    q = np.radians([-90.0, 25.0, -30.0, 90.0])
+    np.testing.assert_allclose(koji.ik_all(koji.fk(q))[0], q, atol=1e-12)
+
+
+def test_koji_paper_angles_come_from_x_rounded_to_whole_mm():
+    """(1197.0, ·, −929.2) mm gives the paper's 25.0271°, 30.0339° (docs/ik.md)."""
+    koji = robots.load("koji_turner")
+    T = KOJI_PAPER_MATRIX.copy()
+    T[0, 3] = 1.1970
+    deg = _koji_paper_branch(koji, T)
+    assert deg[1] == pytest.approx(25.0271, abs=2e-4)
+    assert -deg[2] == pytest.approx(30.0339, abs=2e-4)
+
+
+def test_koji_four_candidates_before_the_range_check():
+    koji = robots.load("koji_turner")
+    arm = koji._analytic_ik.arm_angles(np.array([[1.1973, 0.0, -0.9292]]))
+    assert np.all(np.isfinite(arm))
+    assert arm.shape == (1, 4, 3)
+    np.testing.assert_allclose(np.sort(np.degrees(arm[0, :, 0])), [-90.0, -90.0, 90.0, 90.0], atol=1e-9)
+
+
+def test_koji_exact_fk_round_trip_of_the_paper_configuration():
+    koji = robots.load("koji_turner")
+    q = np.radians([-90.0, 25.0, -30.0, 90.0])
+    s = koji.ik_all(koji.fk(q))
+    np.testing.assert_allclose(s[0], q, atol=1e-12)
+
+
+def test_ik_all_without_closed_form_raises():
+    with pytest.raises(ModelError, match="no analytic IK"):
+        robots.load("panda").ik_all(np.eye(4))
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [np.zeros((3, 3)), np.full((4, 4), np.nan), np.diag([1.0, 1.0, -1.0, 1.0]), np.diag([2.0, 1.0, 1.0, 1.0])],
+)
+def test_invalid_targets(bad):
+    with pytest.raises(InvalidInput):
+        _AUBO.ik_all(bad)
+
+
+def test_structure_checks_raise_model_error():
+    with pytest.raises(ModelError):
+        analytic_solver(robots.load("panda"), "ur_type")
+    with pytest.raises(ModelError):
+        analytic_solver(_AUBO, "koji")
+    with pytest.raises(ModelError):
+        analytic_solver(robots.load("koji_turner"), "scara")
+    with pytest.raises(InvalidInput):
+        analytic_solver(_AUBO, "delta")
+
+
+def test_ur_type_checks_intersecting_wrist_axes():
+    """A UR5 whose last two axes do not meet is rejected (structure verified, not assumed)."""
+    ur5 = robots.load("ur5")
+    text = ur5.urdf_text.replace('name="wrist_3_joint" type="revolute">', 'name="wrist_3_joint" type="revolute">', 1)
+    import re
+
+    text = re.sub(
+        r'(<joint name="wrist_3_joint".*?<origin rpy="[^"]*" xyz=")([^"]*)(")',
+        lambda m: m.group(1) + "0.01 0.0823 0.0" + m.group(3),
+        text,
+        count=1,
+        flags=re.S,
+    )
+    bent = robots.from_urdf_text(text, tcp="tool0", name="ur5_bent")
+    with pytest.raises(ModelError, match="do not intersect"):
+        URTypeIK(bent)
