@@ -334,13 +334,14 @@ class Robot:
             if self._analytic_ik.solve(T)[0].shape[0]:
                 return None
             idx, free = self._analytic_ik.candidates(T, respect_limits=False)
-            if free.shape[0] == 0:
-                return self._unreachable_text(T[0], position_only)
-            worst = min(free, key=lambda q: len(self._limit_diagnosis(q)))
-            return (
-                f"the {what} is within reach but every solution needs a joint outside its limits; "
-                f"nearest: {'; '.join(self._limit_diagnosis(worst))}"
-            )
+            if free.shape[0]:
+                worst = min(free, key=lambda q: len(self._limit_diagnosis(q)))
+                return (
+                    f"the {what} is within reach but every solution needs a joint outside its limits; "
+                    f"nearest: {'; '.join(self._limit_diagnosis(worst))}"
+                )
+            # none from the closed form (also at singular poses, where θ free joints were fixed):
+            # the numerical diagnosis below decides
         solver = self._numerical_ik()
         res = solver.solve(T[0], position_only=position_only, tol=1e-9, max_restarts=20)
         if res.success:

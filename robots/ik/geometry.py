@@ -143,7 +143,7 @@ def rotate_const(direction: np.ndarray, angle: np.ndarray, v: np.ndarray) -> np.
     return par + c * (v - par) + s * np.cross(w, v)
 
 
-def solve_cos_sin(a: np.ndarray, b: np.ndarray, c: np.ndarray, slack: float = 1e-12) -> np.ndarray:
+def solve_cos_sin(a: np.ndarray, b: np.ndarray, c: np.ndarray, slack: float = 1e-10) -> np.ndarray:
     """Both roots ``x`` of ``a·cos x + b·sin x = c``, stacked on a new last axis ``(..., 2)``.
 
     Roots are NaN where ``|c| > sqrt(a² + b²)`` beyond a relative ``slack`` (no real

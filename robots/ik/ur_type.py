@@ -38,6 +38,8 @@ from .solver import AnalyticIK
 
 __all__ = ["URTypeIK"]
 
+_SINGULAR = 1e-6  # |component of R_gᵀR1w2 normal to w6| below which θ6 is also taken from q_ref
+
 
 class URTypeIK(AnalyticIK):
     """All IK solutions of a UR-type 6R arm (three parallel middle axes, intersecting last two)."""
@@ -111,10 +113,20 @@ class URTypeIK(AnalyticIK):
         y = (R1w2 @ Rg)[:, :, None, :]  # rows: (R_gᵀ R1 w2)ᵀ, (N,2,1,3)
         z = rotate_const(w5, -q5, w2)  # (N,2,2,3)
         y6 = y @ w6
-        singular = np.sum(y * y, axis=-1) - y6 * y6 < 1e-20
-        q6 = angle_about(w6, y, z)
-        q6 = np.where(singular, q_ref[:, 5, None, None], q6)
+        y_perp = np.sqrt(np.maximum(np.sum(y * y, axis=-1) - y6 * y6, 0.0))  # = |sin θ5|-like
+        q6 = np.where(y_perp > 1e-12, angle_about(w6, y, z), np.nan)
+        out = self._finish(Rg, tg, q1, q5, q6)
+        near = y_perp < _SINGULAR
+        if near.any():  # wrist singularity: θ6 is free, take q_ref's (the arm keeps its planar freedom)
+            alt = self._finish(Rg, tg, q1, q5, np.where(near, q_ref[:, 5, None, None], np.nan) + 0.0 * q5)
+            out = np.concatenate([out, alt], axis=1)
+        return out
 
+    def _finish(self, Rg, tg, q1, q5, q6) -> np.ndarray:
+        """φ, the planar arm and θ4 for given θ1 (N,2), θ5 and θ6 (N,2,2): candidates (N, 8, 6)."""
+        w1, w2, w3, w4, w5, w6 = self.w
+        p1, p2, p3, p4, p5, p6 = self.p
+        N = Rg.shape[0]
         # φ = angle of R1ᵀ R_g R6ᵀ R5ᵀ about w2
         a = self.basis[0]
         t = rotate_const(w5, -q5, a)
