@@ -345,19 +345,22 @@ def study_004(quick: bool = False) -> Study:
                             if abs(p[k] - xyz[k]) > tol[k] else ""))
     target = np.eye(4)
     target[:3, 3] = np.array([1197.3, 250.0, -929.2]) * MM
+    ik_note = "paper's 0.03° come from the rounded target position"
+    sols = np.zeros((0, arm.nq))
     if arm.has_analytic_ik and hasattr(arm, "ik_all"):
-        sols = np.atleast_2d(arm.ik_all(target))
-    elif hasattr(arm, "ik"):
-        sols = np.atleast_2d(arm.ik(target, position_only=True))
-    else:  # inverse kinematics not installed in this build
-        sols = np.zeros((0, arm.nq))
+        sols = np.atleast_2d(arm.ik_all(target)).reshape(-1, arm.nq)
+    if sols.size == 0 and hasattr(arm, "ik"):
+        try:
+            sols = np.atleast_2d(arm.ik(target, position_only=True))
+            ik_note = "the paper's answer needs θ2 = 25.03° > the 25° limit: pinarms returns another in-limit branch"
+        except robots.UnreachableTarget as exc:
+            ik_note = f"unreachable within the limits: {exc}"[:140]
     if sols.size:
         best = sols[np.argmin(np.abs(sols[:, 0] + 90 * DEG))] / DEG
     for k, (label, paper) in enumerate((("θ1", -90.0), ("θ2 upper arm", 25.03), ("θ3 forearm", -30.03))):
         rows.append(Row("004", f"IK of (1197.3, 250, -929.2) mm: {label}", paper,
                         float(best[k]) if sols.size else None, "deg", 0.01,
-                        "paper's 0.03° come from the rounded target position" if sols.size
-                        else "inverse kinematics not available in this build"))
+                        ik_note if sols.size or hasattr(arm, "ik") else "inverse kinematics not available in this build"))
 
     rates = np.array([-9.0, 2.5, 3.0, 9.0]) * DEG
     q0 = np.array([45.0, 0.0, -30.0, -45.0]) * DEG
