@@ -21,7 +21,7 @@ def test_jerk_integral_is_exact():
     assert jerk_integral(traj) == pytest.approx(total, rel=1e-6)
 
 
-@pytest.mark.parametrize("method", ["exact", "ga"])
+@pytest.mark.parametrize("method", ["exact", pytest.param("ga", marks=pytest.mark.slow)])
 def test_two_stage_holds_time_cap_and_lowers_jerk(method):
     r = minimize_time_jerk(S0.positions, S0.kind, S0.vmax, mode="two-stage", method=method,
                            time_factor=1.1, max_generations=40)
