@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg.lapack import dposv as _posv
 
 __all__ = ["NumericalIK", "IKResult"]
 
@@ -74,10 +75,12 @@ class NumericalIK:
         robot,
         frame: str = "tcp",
         *,
-        max_iter: int = 60,
+        max_iter: int = 30,
         damping: float = 1e-3,
         min_damping: float = 1e-12,
         max_step: float = 0.5,
+        stall_ratio: float = 0.9,
+        stall_steps: int = 4,
     ) -> None:
         self.robot = robot
         self.model = robot.model
@@ -95,6 +98,8 @@ class NumericalIK:
         self.damping = float(damping)
         self.min_damping = float(min_damping)
         self.max_step = float(max_step)
+        self.stall_ratio = float(stall_ratio)
+        self.stall_steps = int(stall_steps)
 
     # ------------------------------------------------------------------ pieces
     def _pin_q(self, q: np.ndarray) -> np.ndarray:
@@ -125,11 +130,12 @@ class NumericalIK:
         M = self.data.oMf[self.frame_id]
         if position_only:
             e = p_des - M.translation
-            n = float(np.linalg.norm(e))
-            return e, None, n, 0.0
+            return e, None, float(np.sqrt(e @ e)), 0.0
         D = M.actInv(T_des)
         e = pin.log6(D).vector
-        return e, D, float(np.linalg.norm(M.translation - p_des)), float(np.linalg.norm(e[3:]))
+        dp = M.translation - p_des
+        w = e[3:]
+        return e, D, float(np.sqrt(dp @ dp)), float(np.sqrt(w @ w))
 
     def attempt(
         self, q0: np.ndarray, target: np.ndarray, position_only: bool, tol: float, limits: bool = True
@@ -171,27 +177,35 @@ class NumericalIK:
                 e_t, D_t, pe_t, re_t = self._residual(q_try, T_des, p_des, position_only)
                 E_t = float(e_t @ e_t)
                 if E_t < E:
-                    stall = stall + 1 if E_t > 0.99 * E else 0
+                    stall = stall + 1 if E_t > self.stall_ratio * E else 0
                     q, e, D, pos_err, rot_err, E = q_try, e_t, D_t, pe_t, re_t, E_t
                     mu = max(mu / 3.0, 1e-9)
                     accepted = True
                     break
                 mu *= 5.0
-            if not accepted or stall >= 8:
+            if not accepted or stall >= self.stall_steps:
                 break
         if not position_only:  # exact rotation angle for the report
             pos_err, rot_err = self.errors(q, target, position_only)
         return q, pos_err, rot_err, it
 
     def _step(self, A: np.ndarray, e: np.ndarray, lam: float) -> np.ndarray:
+        """Damped least-squares step, capped at :attr:`max_step` per joint (LAPACK ``posv`` on the SPD system)."""
         rows, cols = A.shape
         if rows <= cols:
-            dq = A.T @ np.linalg.solve(A @ A.T + lam * np.eye(rows), e)
+            G = A @ A.T
+            G.flat[:: rows + 1] += lam
+            _, x, info = _posv(G, e)
+            dq = A.T @ x if info == 0 else A.T @ np.linalg.lstsq(G, e, rcond=None)[0]
         else:
-            dq = np.linalg.solve(A.T @ A + lam * np.eye(cols), A.T @ e)
-        step = float(np.max(np.abs(dq)))
+            G = A.T @ A
+            G.flat[:: cols + 1] += lam
+            _, dq, info = _posv(G, A.T @ e)
+            if info != 0:
+                dq = np.linalg.lstsq(G, A.T @ e, rcond=None)[0]
+        step = float(np.abs(dq).max())
         if step > self.max_step:
-            dq *= self.max_step / step
+            dq = dq * (self.max_step / step)
         return dq
 
     def _ranked_starts(self, rng: np.random.Generator, target: np.ndarray, position_only: bool) -> np.ndarray:
