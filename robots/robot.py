@@ -271,13 +271,18 @@ class Robot:
                 raise InvalidInput("IK target: the last row of a homogeneous transform must be (0, 0, 0, 1)")
         return arr, single
 
-    def ik_all(self, target: Any, q_ref: Any = None) -> np.ndarray | list[np.ndarray]:
+    def ik_all(
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True
+    ) -> np.ndarray | list[np.ndarray]:
         """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
 
         Args:
             target: tcp pose ``(4, 4)`` (frame → base, m), or a batch ``(N, 4, 4)``.
             q_ref: ``(nq,)`` or ``(N, nq)``: solutions are sorted by distance to it
                 (default :attr:`neutral`); it also fixes the free joint at singular poses.
+            respect_limits: ``False`` returns the geometric solutions whatever the joint
+                limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
+                printed pose lies outside a range. Check them with :meth:`within_limits`.
 
         Returns:
             ``(k, nq)`` for one target (``k = 0`` allowed: see :meth:`ik_failure_reason`), a
@@ -298,7 +303,11 @@ class Robot:
             ref, _ = self.check_q(q_ref)
             if ref.shape[0] not in (1, T.shape[0]):
                 raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
-        sols = self._analytic_ik.solve(T, ref)
+        if respect_limits:
+            sols = self._analytic_ik.solve(T, ref)
+        else:
+            idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
+            sols = np.split(q, np.cumsum(np.bincount(idx, minlength=T.shape[0]))[:-1])
         return sols[0] if single else sols
 
     def _numerical_ik(self):
@@ -311,6 +320,14 @@ class Robot:
 
     def _limit_diagnosis(self, q: np.ndarray) -> list[str]:
         """Joints of ``q`` outside their limits, each revolute angle taken at its 2π equivalent nearest the range."""
+        return self.limit_violations(self._wrapped_to_range(q))
+
+    def _limit_excess(self, q: np.ndarray) -> float:
+        """Total distance of ``q`` outside its limits [rad or m], revolute angles wrapped as above."""
+        q = self._wrapped_to_range(q)
+        return float(np.sum(np.maximum(self.lower - q, 0.0) + np.maximum(q - self.upper, 0.0)))
+
+    def _wrapped_to_range(self, q: np.ndarray) -> np.ndarray:
         q = np.array(q, dtype=float)
         tree = self._tree
         for j in range(self.nq):
@@ -318,7 +335,7 @@ class Robot:
             if rev:
                 mid = 0.5 * (self.lower[j] + self.upper[j])
                 q[j] = mid + (q[j] - mid + np.pi) % (2.0 * np.pi) - np.pi
-        return self.limit_violations(q)
+        return q
 
     def ik_failure_reason(self, target: Any, *, position_only: bool = False) -> str | None:
         """Why ``target`` (one pose ``(4, 4)``) has no IK solution within the limits, or ``None`` if it has one.
@@ -335,7 +352,7 @@ class Robot:
                 return None
             idx, free = self._analytic_ik.candidates(T, respect_limits=False)
             if free.shape[0]:
-                worst = min(free, key=lambda q: len(self._limit_diagnosis(q)))
+                worst = min(free, key=self._limit_excess)
                 return (
                     f"the {what} is within reach but every solution needs a joint outside its limits; "
                     f"nearest: {'; '.join(self._limit_diagnosis(worst))}"

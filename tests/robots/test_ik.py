@@ -171,7 +171,8 @@ KOJI_PAPER_MATRIX = np.array(  # seed 004 eq. after (6): T for (−90, 25, −30
 
 def _koji_paper_branch(koji, T):
     """The candidate with the waist at −90° and the upper arm raised (limits not applied)."""
-    _, free = koji._analytic_ik.candidates(T[None], respect_limits=False)
+    free = koji.ik_all(T, respect_limits=False)
+    assert not koji.within_limits(free).any()
     deg = np.degrees(free)
     pick = deg[(np.abs(deg[:, 0] + 90.0) < 1e-6) & (deg[:, 1] > 0.0)]
     assert pick.shape[0] == 1
