@@ -16,8 +16,9 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 import planning
+from robots.papers import SEED002
 
-H = np.array([0.21, 0.15, 0.24, 0.27, 0.19, 0.16, 0.13, 0.23, 0.15, 0.16])  # seed 002, s
+H = SEED002.initial_durations_s  # seed 002, s
 TIMES = np.concatenate([[0.0], np.cumsum(H)])
 
 

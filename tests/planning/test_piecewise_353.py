@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 
 import planning
+from robots.papers import SEED000
 from planning.errors import ConditionCountError, TrajectoryError
 
 # Seed 000, joint 1 path points (degrees) and segment times (s).
-JOINT1_DEG = np.array([55.5, 69.7, 106.5, 124.5])
-INITIAL_TIMES = (2.0, 2.0, 2.0)
-OPTIMISED_TIMES = (1.086, 1.243, 1.278)
-PAPER_PEAK_DEG_S = 54.2
+JOINT1_DEG = np.array(SEED000.path_deg)
+INITIAL_TIMES = SEED000.initial_times_s
+OPTIMISED_TIMES = SEED000.paper_times_s
+PAPER_PEAK_DEG_S = SEED000.peak_velocity_deg_s
 
 
 def knots(durations):

@@ -7,9 +7,10 @@ import pytest
 from scipy.interpolate import make_interp_spline
 
 import planning
+from robots.papers import SEED002
 
 # Seed 002's initial segment times (s) and a representative lift-feed-lower path (m).
-SEED002_H = np.array([0.21, 0.15, 0.24, 0.27, 0.19, 0.16, 0.13, 0.23, 0.15, 0.16])
+SEED002_H = SEED002.initial_durations_s
 TIMES = np.concatenate([[0.0], np.cumsum(SEED002_H)])
 PATH = np.column_stack(
     [

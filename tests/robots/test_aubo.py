@@ -13,18 +13,12 @@ from robots.conventions import (
     deg_to_rad,
     m_to_mm,
 )
+from robots.papers import SEED001
 
 from _descriptions import pin_frame, pin_model, random_q
 
 # Seed 001, table 2: joint columns (rad) and the Cartesian points as printed (mm).
-TABLE2_JOINTS = np.array(
-    [
-        [-2.6180, -0.8727, 0.9599, 1.4835, -1.5708, 0.0000],
-        [-2.6180, -0.8727, 0.7854, 1.6581, -1.5708, 0.0000],
-        [0.7854, 2.2689, 2.1817, 1.6581, -1.5708, -0.7854],
-        [0.7854, 2.2689, 2.3562, 1.4835, -1.5708, -0.7854],
-    ]
-)
+TABLE2_JOINTS = SEED001.table2_joints
 
 
 def craig_link(alpha, a, d, theta):

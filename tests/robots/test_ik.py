@@ -10,20 +10,14 @@ from hypothesis import strategies as st
 import robots
 from robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
 from robots.errors import InvalidInput, ModelError
+from robots.papers import SEED001
 from robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
 
 ANALYTIC = ["scara_mushroom", "gantry_flower", "koji_turner", "aubo_i3", "ur3", "ur5", "ur10"]
 MAX_SOLUTIONS = {"scara_mushroom": 2 * 2, "gantry_flower": 1, "koji_turner": 4, "aubo_i3": 8, "ur3": 8 * 64, "ur5": 8 * 64, "ur10": 8 * 64}
 
 # Seed 001, table 2 joint columns (rad), read as the paper's modified D-H angles.
-TABLE2_THETA = np.array(
-    [
-        [-2.6180, -0.8727, 0.9599, 1.4835, -1.5708, 0.0000],
-        [-2.6180, -0.8727, 0.7854, 1.6581, -1.5708, 0.0000],
-        [0.7854, 2.2689, 2.1817, 1.6581, -1.5708, -0.7854],
-        [0.7854, 2.2689, 2.3562, 1.4835, -1.5708, -0.7854],
-    ]
-)
+TABLE2_THETA = SEED001.table2_joints
 
 
 @pytest.fixture(scope="module", params=ANALYTIC)

@@ -8,6 +8,7 @@ import pytest
 import planning
 import robots
 import viz
+from robots.papers import SEED000
 
 DEG = np.pi / 180.0
 
@@ -23,10 +24,10 @@ def line_session() -> viz.Session:
     """SCARA on a 3-5-3 pick-and-place through seed 000's joint-1 path points, plus a UR5 cell."""
     arm = robots.load("scara_mushroom")
     s = viz.Session(arm, title="enoki packing line", key="scara")
-    j1 = np.array([55.5, 69.7, 106.5, 124.5]) * DEG
+    j1 = SEED000.path_rad
     via = np.column_stack([j1, np.array([-60.0, -40.0, 30.0, 60.0]) * DEG, [0.02, 0.10, 0.10, 0.02],
                            np.array([0.0, 30.0, 60.0, 90.0]) * DEG])
-    traj = planning.piecewise_polynomial([0.0, 1.086, 2.329, 3.607], via, degrees=(3, 5, 3))
+    traj = planning.piecewise_polynomial(SEED000.paper_knot_times_s, via, degrees=(3, 5, 3))
     s.add_trajectory("pick-place 3-5-3", traj, hz=60)
     q = arm.random_q(1500, seed=7)
     s.add_workspace("scara cloud", points=arm.position(q), manipulability=arm.manipulability(q, part="position"))

@@ -12,12 +12,13 @@ from PIL import Image
 import planning
 import viz
 from robots.errors import InvalidInput
+from robots.papers import SEED000
 
 
 @pytest.fixture(scope="module")
 def traj():
-    via = np.deg2rad([[55.5, 69.7, 106.5, 124.5]]).T
-    return planning.piecewise_polynomial([0.0, 2.0, 4.0, 6.0], via, degrees=(3, 5, 3))
+    via = SEED000.path_rad[:, None]
+    return planning.piecewise_polynomial(SEED000.initial_knot_times_s, via, degrees=(3, 5, 3))
 
 
 def test_joint_curves_png(traj, tmp_path):
