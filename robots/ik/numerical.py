@@ -1,25 +1,45 @@
-"""Numerical IK for any URDF: damped least squares (Levenberg–Marquardt) on the SE(3) log error.
+"""Numerical IK for any URDF: Levenberg–Marquardt on the SE(3) log error, joint limits by projection.
 
 Error of a configuration ``q`` for a target pose ``T_target`` (frame → base)::
 
-    e(q) = log6( T(q)⁻¹ · T_target )        (6,) twist in the frame's own axes [m, rad]
+    D(q) = T(q)⁻¹ · T_target,    e(q) = log6(D(q))    (6,) twist in the frame's own axes [m, rad]
 
-Newton's step solves ``Jlog6(D⁻¹) · J_local(q) · Δq = e`` with ``D = T(q)⁻¹ T_target``;
-pinarms damps it, ``Δq = Aᵀ (A Aᵀ + λ I)⁻¹ e`` (or ``(AᵀA + λI)⁻¹ Aᵀ e`` when the arm has
-fewer joints than task rows) with ``λ = λ₀ ‖e‖² + λ_min`` (large steps far away, Newton's
-quadratic convergence near the solution), caps each joint's step, and *projects* the new
-configuration into the joint limits (bounded joints clipped, continuous joints wrapped):
-the iterate never leaves the limits. ``position_only`` uses the 3 linear rows of the
-world-aligned Jacobian and the position error instead.
+Moving the joints by ``Δq`` moves the frame by ``J_local Δq`` (a twist in its own axes, on
+the left of ``D``), and ``log6(exp(−ξ) D) ≈ log6(D) − Jlog6(D⁻¹) ξ`` (``Jlog6(D⁻¹)`` is the
+inverse of the left Jacobian of ``SE(3)`` at ``log6(D)``): the Gauss–Newton system is
+``A Δq = e`` with ``A = Jlog6(D⁻¹) · J_local``. pinarms damps it (Levenberg–Marquardt)::
 
-An attempt stops when the error is within ``tol`` (success), after ``max_iter`` steps, or
-when the error has stagnated. The first attempt starts from ``q_seed``; the next ones from
-configurations drawn uniformly within the limits by a seeded generator, taken in
-order of their pose distance to the target (one batched FK over 32 draws).
+    Δq = Aᵀ (A Aᵀ + λ I)⁻¹ e           (nq ≥ 6; (AᵀA + λI)⁻¹ Aᵀ e when nq < 6)
+    λ  = μ ‖e‖² + λ_min                 (Sugihara's damping, μ adapted)
 
-The inner loop calls Pinocchio directly (``framesForwardKinematics`` and
-``computeFrameJacobian``): one configuration at a time is what IK needs, and the batched
-numpy path of :class:`robots.kinematic_tree.KinematicTree` would only add overhead.
+A step is kept only if it lowers ``‖e‖²`` (then ``μ`` shrinks ×3); otherwise ``μ`` grows
+×5 and the step is recomputed. Each joint's step is capped (``max_step``). Far from the
+target ``λ`` is large (short, gradient-like steps); near it ``λ → λ_min`` and the steps
+are Newton's (quadratic convergence, 1e-10 reached in one or two steps from 1e-5).
+
+Joint limits, by projection with an active set: each new iterate is projected into the
+limits (continuous joints wrapped to ``(-π, π]``; a revolute joint whose range spans a
+full turn or more, e.g. the UR's ±2π, is shifted by ∓2π when it leaves its range, which
+changes no pose; other joints clipped), and joints held at a limit and pushed outwards
+are removed from the step (their Jacobian columns zeroed) so the free joints move. The
+iterate never leaves the limits: ``limits=False`` is only for diagnostics.
+
+``position_only`` uses the position error ``p_target − p(q)`` and the 3 linear rows of the
+world-aligned frame Jacobian instead.
+
+An attempt stops when the position error [m] and the rotation error [rad] are both within
+``tol`` (success), after ``max_iter`` steps, when no step lowers the error, or when the
+error has stagnated (``‖e‖²`` falls by less than ``1 − stall_ratio`` ``stall_steps``
+times in a row). The first attempt starts from ``q_seed``; the next ones from
+configurations drawn uniformly within the limits by a seeded generator, taken in order
+of their pose distance to the target.
+
+Speed: one configuration at a time is what IK needs, so the loop calls Pinocchio
+directly: per trial step one ``computeJointJacobians`` (forward kinematics and every
+joint Jacobian at once), ``updateFramePlacement`` and ``log6``; the frame Jacobian of an
+accepted step is then read with ``getFrameJacobian`` without recomputing anything. The
+damped system is 6×6 (or nq×nq) and solved by LAPACK's Cholesky (``posv``). The exact
+errors are computed only once ``‖e‖²`` is small enough for them to possibly meet ``tol``.
 Pinocchio's model is built with ``mimic=True``, so mimic joints (the koji arm's
 parallelogram) are followed and the Jacobian is w.r.t. the independent joints.
 """
@@ -32,10 +52,15 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg.lapack import dposv as _posv
 
+from ..kinematic_tree import _REVOLUTE
+
 __all__ = ["NumericalIK", "IKResult"]
 
 _POOL = 32  # random starts drawn at once and ranked by their distance to the target
 _ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
+_TWO_PI = 2.0 * np.pi
+_MU_MAX = 1e8  # an attempt gives up when no step with μ below this lowers the error
+_FREE, _WINDOW, _CLIP = 0, 1, 2  # projection modes of an iterate (see NumericalIK._project)
 
 
 @dataclass(frozen=True)
@@ -60,14 +85,17 @@ class IKResult:
 
 
 class NumericalIK:
-    """Damped-least-squares IK of one robot frame, joint limits respected, seeded random restarts.
+    """Levenberg–Marquardt IK of one robot frame, joint limits respected, seeded random restarts.
 
     Args:
         robot: a :class:`robots.Robot`.
         frame: target frame (default the tcp).
         max_iter: iterations per attempt.
-        damping: ``λ₀`` of ``λ = λ₀‖e‖² + λ_min``.
+        damping: initial ``μ`` of ``λ = μ‖e‖² + λ_min``.
+        min_damping: ``λ_min`` [1 / (m or rad)²].
         max_step: largest change of one joint per iteration [rad or m].
+        stall_ratio, stall_steps: an attempt stops when ``‖e‖²`` falls by less than
+            ``1 − stall_ratio`` for ``stall_steps`` accepted steps in a row.
     """
 
     def __init__(
@@ -76,9 +104,9 @@ class NumericalIK:
         frame: str = "tcp",
         *,
         max_iter: int = 30,
-        damping: float = 1e-3,
+        damping: float = 1e-2,
         min_damping: float = 1e-12,
-        max_step: float = 0.5,
+        max_step: float = 1.5,
         stall_ratio: float = 0.9,
         stall_steps: int = 4,
     ) -> None:
@@ -88,134 +116,244 @@ class NumericalIK:
         self.frame_id = robot.frame_id(frame)
         self._frame = frame
         self.nq = robot.nq
-        coords = robot._tree.coordinates
+        tree = robot._tree
+        coords = tree.coordinates
         self.unbounded = np.array(coords.is_unbounded, dtype=bool)
-        self._identity_coords = (not self.unbounded.any()) and self.model.nq == self.nq
+        self._any_unbounded = bool(self.unbounded.any())
+        self._identity_coords = (not self._any_unbounded) and self.model.nq == self.nq
         self._coords = coords
         self.lower = np.where(self.unbounded, -np.pi, robot.lower)
         self.upper = np.where(self.unbounded, np.pi, robot.upper)
+        revolute = np.zeros(self.nq, dtype=bool)
+        for i in range(1, self.model.njoints):
+            joint = self.model.joints[i]
+            if "Mimic" not in joint.shortname() and tree.kind[i] == _REVOLUTE:
+                revolute[joint.idx_v] = True
+        #: bounded revolute joints whose range spans a full turn: leaving the range is undone by ∓2π
+        self.full_turn = revolute & ~self.unbounded & (self.upper - self.lower >= _TWO_PI)
+        self._any_full_turn = bool(self.full_turn.any())
+        self._window = revolute & ~self.unbounded  # wrapped to their range's 2π window in free descents
+        self._any_revolute = bool(self._window.any())
+        self._mid = 0.5 * (self.lower + self.upper)
         self.max_iter = int(max_iter)
         self.damping = float(damping)
         self.min_damping = float(min_damping)
         self.max_step = float(max_step)
         self.stall_ratio = float(stall_ratio)
         self.stall_steps = int(stall_steps)
+        self._wide = self.nq >= 6  # solve the 6×6 system AAᵀ (else the nq×nq system AᵀA)
 
     # ------------------------------------------------------------------ pieces
     def _pin_q(self, q: np.ndarray) -> np.ndarray:
         return q if self._identity_coords else self._coords.to_pin(q)
 
     def errors(self, q: np.ndarray, target: np.ndarray, position_only: bool) -> tuple[float, float]:
-        """``(position error [m], rotation error [rad])`` of ``q`` for ``target`` (4,4) or (3,)."""
-        pin.framesForwardKinematics(self.model, self.data, self._pin_q(q))
-        M = self.data.oMf[self.frame_id]
-        if position_only:
-            return float(np.linalg.norm(M.translation - target[:3, 3])), 0.0
+        """``(position error [m], rotation error [rad])`` of ``q`` for ``target`` (4,4)."""
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        M = pin.updateFramePlacement(self.model, self.data, self.frame_id)
         dp = float(np.linalg.norm(M.translation - target[:3, 3]))
-        dR = M.rotation.T @ target[:3, :3]
-        return dp, float(np.linalg.norm(pin.log3(dR)))
-
-    def _project(self, q: np.ndarray, limits: bool) -> np.ndarray:
-        if self.unbounded.any():
-            u = self.unbounded
-            q[u] = np.pi - (np.pi - q[u]) % (2.0 * np.pi)
-        if limits:
-            np.clip(q, self.lower, self.upper, out=q)
-        return q
-
-    def _residual(self, q: np.ndarray, T_des, p_des: np.ndarray, position_only: bool):
-        """``(e, D, pos_err, rot_err)`` at ``q`` (FK evaluated into ``self.data``)."""
-        qp = self._pin_q(q)
-        pin.framesForwardKinematics(self.model, self.data, qp)
-        M = self.data.oMf[self.frame_id]
         if position_only:
-            e = p_des - M.translation
-            return e, None, float(np.sqrt(e @ e)), 0.0
-        D = M.actInv(T_des)
-        e = pin.log6(D).vector
-        dp = M.translation - p_des
-        w = e[3:]
-        return e, D, float(np.sqrt(dp @ dp)), float(np.sqrt(w @ w))
+            return dp, 0.0
+        return dp, float(np.linalg.norm(pin.log3(M.rotation.T @ target[:3, :3])))
+
+    def in_limits(self, q: np.ndarray) -> bool:
+        """``lower ≤ q ≤ upper`` exactly (no tolerance)."""
+        return not ((q < self.lower).any() or (q > self.upper).any())
+
+    def _project(self, q: np.ndarray, mode: int) -> bool:
+        """Bring ``q`` into the limits in place (see the module doc); ``True`` if a joint was clipped to a limit.
+
+        ``mode``: :data:`_CLIP` projection into the limits, :data:`_WINDOW` revolute angles
+        wrapped to ``[mid − π, mid + π)`` of their range (no clipping), :data:`_FREE`
+        continuous joints wrapped only.
+        """
+        if self._any_unbounded:
+            u = self.unbounded
+            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
+        if mode == _FREE:
+            return False
+        if mode == _WINDOW:
+            if self._any_revolute:
+                r, mid = self._window, self._mid
+                q[r] = mid[r] + (q[r] - mid[r] + np.pi) % _TWO_PI - np.pi
+            return False
+        lo, hi = self.lower, self.upper
+        if not ((q < lo).any() or (q > hi).any()):
+            return False
+        if self._any_full_turn:
+            w = self.full_turn
+            q[w & (q > hi)] -= _TWO_PI
+            q[w & (q < lo)] += _TWO_PI
+        np.minimum(np.maximum(q, lo, out=q), hi, out=q)
+        return bool(((q <= lo) | (q >= hi)).any())
+
+    def _target(self, target: np.ndarray, position_only: bool):
+        target = np.asarray(target, dtype=float)
+        p_des = np.array(target[:3, 3])
+        T_des = None if position_only else pin.SE3(np.array(target[:3, :3]), p_des)
+        return T_des, p_des
 
     def attempt(
         self, q0: np.ndarray, target: np.ndarray, position_only: bool, tol: float, limits: bool = True
     ) -> tuple[np.ndarray, float, float, int]:
-        """One Levenberg–Marquardt descent from ``q0``: ``(q, pos_err, rot_err, iterations)``.
+        """One Levenberg–Marquardt descent from ``q0`` to ``target`` (4, 4): ``(q, pos_err, rot_err, iterations)``.
 
-        A step is accepted only if it lowers ``‖e‖²``; otherwise the damping grows and the
-        step is recomputed. Joints held at a limit by the projection and pushed beyond it
-        are taken out of the step (their Jacobian columns removed) so the free joints move.
+        With ``limits`` every iterate is projected into the joint limits; without, joints
+        move freely (continuous joints wrapped), for diagnostics.
+        """
+        T_des, p_des = self._target(target, position_only)
+        mode = _CLIP if limits else _FREE
+        return self._descend(np.array(q0, dtype=float), T_des, p_des, position_only, float(tol), mode)
+
+    def _attempt_within_limits(self, q0, T_des, p_des, position_only: bool, tol: float):
+        """Free descent (angles wrapped to their range's window), then, if it met the target
+        outside the limits, a projected descent from there: ``(q, pos_err, rot_err, its, ok)``.
+
+        A returned ``q`` is always within the limits (projected if the descent ended outside).
+        """
+        q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, _WINDOW)
+        met = pe <= tol and re <= tol
+        if met and self.in_limits(q):
+            return q, pe, re, it, True
+        if not met:  # no pose reached from this start: report its projection, restart elsewhere
+            self._project(q, _CLIP)
+            pe, re = self._errors_to(q, T_des, p_des, position_only)
+            return q, pe, re, it, False
+        self._project(q, _CLIP)  # a solution outside the limits: slide back along the limits
+        q, pe, re, it2 = self._descend(q, T_des, p_des, position_only, tol, _CLIP)
+        return q, pe, re, it + it2, pe <= tol and re <= tol
+
+    def _errors_to(self, q, T_des, p_des, position_only: bool) -> tuple[float, float]:
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        M = pin.updateFramePlacement(self.model, self.data, self.frame_id)
+        d = M.translation - p_des
+        pe = float(np.sqrt(d.dot(d)))
+        if position_only:
+            return pe, 0.0
+        w = pin.log3(M.rotation.T.dot(T_des.rotation))
+        return pe, float(np.sqrt(w.dot(w)))
+
+    def _descend(self, q, T_des, p_des, position_only: bool, tol: float, mode: int, patience: int = 1):
+        """Levenberg–Marquardt from ``q`` (modified in place), projecting each iterate by ``mode``.
+
+        ``patience`` multiplies ``max_iter`` and ``stall_steps`` (a final polish of a failed solve).
         """
         model, data, fid = self.model, self.data, self.frame_id
-        q = self._project(np.array(q0, dtype=float), limits)
-        T_des = None if position_only else pin.SE3(target[:3, :3], target[:3, 3])
-        p_des = np.array(target[:3, 3])
+        jacobians, placement, frame_jacobian = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian
+        log6, jlog6 = pin.log6, pin.Jlog6
+        pin_q, project = self._pin_q, self._project
         lower, upper = self.lower, self.upper
-        e, D, pos_err, rot_err = self._residual(q, T_des, p_des, position_only)
-        E = float(e @ e)
-        mu = self.damping
+        wide = self._wide
+        min_damping, max_step = self.min_damping, self.max_step
+        stall_ratio, stall_steps = self.stall_ratio, self.stall_steps * patience
+        max_iter = self.max_iter * patience
+        ref = pin.LOCAL_WORLD_ALIGNED if position_only else pin.LOCAL
+        tol2 = tol * tol
+        gate = 4.0 * tol2  # ‖e‖² above this cannot meet tol (|e_lin| ≤ (1 + O(angle)) · position error)
+
+        def evaluate(x):
+            jacobians(model, data, pin_q(x))
+            M = placement(model, data, fid)
+            if position_only:
+                d = p_des - M.translation
+                return d, None, float(d.dot(d))
+            D = M.actInv(T_des)
+            d = log6(D).vector
+            return d, D, float(d.dot(d))
+
+        def converged(d, D, E):
+            if E > gate:
+                return False
+            if position_only:
+                return True  # E is the squared position error
+            t, w = D.translation, d[3:]  # |D.translation| = ‖p − p_target‖, d[3:] = log3(Rᵀ R_target)
+            return t.dot(t) <= tol2 and w.dot(w) <= tol2
+
+        at_limit = project(q, mode) or (mode == _CLIP and bool(((q <= lower) | (q >= upper)).any()))
+        e, D, E = evaluate(q)
+        mu, nu = self.damping, 2.0
         it = 0
         stall = 0
-        while it < self.max_iter and not (pos_err <= tol and rot_err <= tol):
+        done = converged(e, D, E)
+        while not done and it < max_iter:
             it += 1
-            qp = self._pin_q(q)
-            if position_only:
-                A = pin.computeFrameJacobian(model, data, qp, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
-            else:
-                A = pin.Jlog6(D.inverse()) @ pin.computeFrameJacobian(model, data, qp, fid, pin.LOCAL)
+            J = frame_jacobian(model, data, fid, ref)  # data holds the joint Jacobians of q
+            A = J[:3] if position_only else jlog6(D.inverse()).dot(J)
             accepted = False
-            while mu < 1e8:
-                dq = self._step(A, e, mu * E + self.min_damping)
-                if limits:  # joints at a limit pushed outwards: freeze them and re-solve
+            while mu < _MU_MAX:
+                lam = mu * E + min_damping
+                dq = self._step(A, e, lam, wide)
+                if at_limit:  # joints at a limit pushed outwards: take them out and re-solve
                     blocked = ((q <= lower) & (dq < 0.0)) | ((q >= upper) & (dq > 0.0))
                     if blocked.any():
                         A_free = A.copy()
                         A_free[:, blocked] = 0.0
-                        dq = self._step(A_free, e, mu * E + self.min_damping)
+                        dq = self._step(A_free, e, lam, wide)
                         dq[blocked] = 0.0
-                q_try = self._project(q + dq, limits)
-                e_t, D_t, pe_t, re_t = self._residual(q_try, T_des, p_des, position_only)
-                E_t = float(e_t @ e_t)
-                if E_t < E:
-                    stall = stall + 1 if E_t > self.stall_ratio * E else 0
-                    q, e, D, pos_err, rot_err, E = q_try, e_t, D_t, pe_t, re_t, E_t
-                    mu = max(mu / 3.0, 1e-9)
+                step = max(dq.max(), -dq.min())
+                if step > max_step:
+                    dq *= max_step / step
+                q_try = q + dq
+                clipped = project(q_try, mode)
+                e_t, D_t, E_t = evaluate(q_try)
+                if E_t < E:  # accept; Nielsen's update of μ from the gain ratio ρ
+                    r = e - A.dot(dq)
+                    predicted = E - r.dot(r)
+                    rho = (E - E_t) / predicted if predicted > 0.0 else 1.0
+                    mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
+                    nu = 2.0
+                    stall = stall + 1 if E_t > stall_ratio * E else 0
+                    q, e, D, E, at_limit = q_try, e_t, D_t, E_t, clipped
                     accepted = True
                     break
-                mu *= 5.0
-            if not accepted or stall >= self.stall_steps:
+                mu *= nu
+                nu *= 2.0
+            if not accepted:
                 break
-        if not position_only:  # exact rotation angle for the report
-            pos_err, rot_err = self.errors(q, target, position_only)
-        return q, pos_err, rot_err, it
+            done = converged(e, D, E)
+            if stall >= stall_steps:
+                break
+        if position_only:
+            return q, float(np.sqrt(E)), 0.0, it
+        t, w = D.translation, e[3:]
+        return q, float(np.sqrt(t.dot(t))), float(np.sqrt(w.dot(w))), it
 
-    def _step(self, A: np.ndarray, e: np.ndarray, lam: float) -> np.ndarray:
-        """Damped least-squares step, capped at :attr:`max_step` per joint (LAPACK ``posv`` on the SPD system)."""
-        rows, cols = A.shape
-        if rows <= cols:
-            G = A @ A.T
-            G.flat[:: rows + 1] += lam
-            _, x, info = _posv(G, e)
-            dq = A.T @ x if info == 0 else A.T @ np.linalg.lstsq(G, e, rcond=None)[0]
-        else:
-            G = A.T @ A
-            G.flat[:: cols + 1] += lam
-            _, dq, info = _posv(G, A.T @ e)
+    @staticmethod
+    def _step(A: np.ndarray, e: np.ndarray, lam: float, wide: bool) -> np.ndarray:
+        """Damped least-squares step (LAPACK ``posv`` on the symmetric positive definite system)."""
+        if wide:
+            G = A.dot(A.T)
+            G.flat[:: G.shape[0] + 1] += lam
+            _, x, info = _posv(G, e, overwrite_a=1)
             if info != 0:
-                dq = np.linalg.lstsq(G, A.T @ e, rcond=None)[0]
-        step = float(np.abs(dq).max())
-        if step > self.max_step:
-            dq = dq * (self.max_step / step)
+                x = np.linalg.lstsq(A.dot(A.T) + lam * np.eye(A.shape[0]), e, rcond=None)[0]
+            return A.T.dot(x)
+        G = A.T.dot(A)
+        G.flat[:: G.shape[0] + 1] += lam
+        b = A.T.dot(e)
+        _, dq, info = _posv(G, b, overwrite_a=1)
+        if info != 0:
+            dq = np.linalg.lstsq(A.T.dot(A) + lam * np.eye(A.shape[1]), b, rcond=None)[0]
         return dq
 
     def _ranked_starts(self, rng: np.random.Generator, target: np.ndarray, position_only: bool) -> np.ndarray:
-        """:data:`_POOL` uniform draws within the limits, closest to the target first (one batched FK)."""
+        """:data:`_POOL` uniform draws within the limits, closest to the target first.
+
+        Distance: ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first term).
+        """
         q = rng.uniform(self.lower, self.upper, size=(_POOL, self.nq))
-        T = self.robot.fk(q, self._frame)
-        cost = np.linalg.norm(T[:, :3, 3] - target[:3, 3], axis=1)
+        model, data, fid = self.model, self.data, self.frame_id
+        p = np.empty((_POOL, 3))
+        R = np.empty((_POOL, 3, 3))
+        for k in range(_POOL):  # one Pinocchio FK each: faster than the batched numpy FK for 32 rows
+            pin.forwardKinematics(model, data, self._pin_q(q[k]))
+            M = pin.updateFramePlacement(model, data, fid)
+            p[k] = M.translation
+            R[k] = M.rotation
+        cost = np.linalg.norm(p - target[:3, 3], axis=1)
         if not position_only:
-            cost = cost + _ROT_WEIGHT * np.linalg.norm((T[:, :3, :3] - target[:3, :3]).reshape(-1, 9), axis=1)
-        return q[np.argsort(cost)]
+            cost = cost + _ROT_WEIGHT * np.linalg.norm((R - target[:3, :3]).reshape(-1, 9), axis=1)
+        return q[np.argsort(cost, kind="stable")]
 
     # ------------------------------------------------------------------ public
     def solve(
@@ -238,22 +376,37 @@ class NumericalIK:
             seed: seed or ``numpy.random.Generator`` of the restarts.
             limits: keep the iterates within the joint limits (``False`` only for diagnostics).
         """
-        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        q0 = 0.5 * (self.lower + self.upper) if q_seed is None else np.asarray(q_seed, dtype=float)
+        target = np.asarray(target, dtype=float)
+        T_des, p_des = self._target(target, position_only)
+        tol = float(tol)
+        q0 = 0.5 * (self.lower + self.upper) if q_seed is None else np.array(q_seed, dtype=float)
+        rng = None
         best = None
         iterations = 0
         pool = np.empty((0, self.nq))
         for attempt in range(int(max_restarts) + 1):
             if attempt > 0:
                 if pool.shape[0] == 0:
+                    if rng is None:
+                        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
                     pool = self._ranked_starts(rng, target, position_only)
-                q0, pool = pool[0], pool[1:]
-            q, pe, re, it = self.attempt(q0, target, position_only, tol, limits)
+                q0, pool = pool[0].copy(), pool[1:]
+            if limits:
+                q, pe, re, it, ok = self._attempt_within_limits(q0, T_des, p_des, position_only, tol)
+            else:
+                q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, _FREE)
+                ok = pe <= tol and re <= tol
             iterations += it
-            score = pe + re
-            if best is None or score < best[1] + best[2]:
-                best = (q, pe, re)
-            if pe <= tol and re <= tol:
+            if ok:
                 return IKResult(q, True, pe, re, attempt + 1, iterations)
+            if best is None or pe + re < best[1] + best[2]:
+                best = (q, pe, re)
         q, pe, re = best
+        if limits:  # the closest configuration within the limits: a projected descent from the best end
+            q, pe, re, it = self._descend(q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
+            iterations += it
+            if pe + re > best[1] + best[2]:
+                q, pe, re = best
+            elif pe <= tol and re <= tol:
+                return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)
