@@ -46,6 +46,26 @@ def knot_times(times: Any, what: str = "times", minimum: int = 2) -> np.ndarray:
     return t
 
 
+def knot_times_batch(times: Any, what: str = "times", minimum: int = 2) -> np.ndarray:
+    """Knot times of P trajectories as a (P, m+1) array, every row strictly increasing (s)."""
+    t = finite_array(times, what)
+    if t.ndim != 2:
+        raise TrajectoryError(
+            f"{what} must be a 2-D array (P individuals, m+1 instants) (s), got shape {t.shape}; "
+            "for a single trajectory use the constructor without _batch"
+        )
+    if t.shape[1] < minimum:
+        raise TrajectoryError(f"{what} needs at least {minimum} instants per row, got shape {t.shape}")
+    steps = np.diff(t, axis=1)
+    if np.any(steps <= 0.0):
+        p, i = (int(k) for k in np.argwhere(steps <= 0.0)[0])
+        raise TrajectoryError(
+            f"{what} rows must be strictly increasing; {what}[{p}, {i + 1}] = {float(t[p, i + 1])!r} does not "
+            f"come after {what}[{p}, {i}] = {float(t[p, i])!r}"
+        )
+    return t
+
+
 def durations(values: Any, what: str = "durations") -> np.ndarray:
     """Positive segment durations (s) as a (m,) array."""
     h = finite_array(values, what)

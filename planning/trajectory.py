@@ -17,13 +17,12 @@ constraints and algorithm are separate objects). :meth:`Trajectory.check` takes 
 
 Peaks are *exact*: on each piece the extrema of ``|d^r q / dt^r|`` are at the piece ends
 or at real roots of the next derivative, which are found for all pieces, joints and
-derivative orders at once (closed form up to degree 2, batched companion-matrix
-eigenvalues above).
+derivative orders at once (closed form up to degree 3, batched companion-matrix
+eigenvalues above; :mod:`planning.extrema`, which also peaks whole populations).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -32,12 +31,9 @@ import numpy as np
 
 from planning._inputs import finite_array
 from planning.errors import OutOfTimeRange, TrajectoryError
+from planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
 
 __all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
-
-#: Relative size below which a leading polynomial coefficient counts as zero in the root
-#: search (in normalised piece time s in [0, 1], where all coefficients are comparable).
-_ROOT_RTOL = 1e-12
 
 #: Names of the derivative orders, as used in :class:`Violation` and the peak report.
 _KIND_BY_ORDER = {1: "velocity", 2: "acceleration", 3: "jerk"}
@@ -98,119 +94,6 @@ class LimitReport:
                 f"  joint {v.joint} at t = {v.time:.6g} s: {v.kind} {v.value:.6g} exceeds limit {v.limit:.6g}"
             )
         return "\n".join(lines)
-
-
-def _derivative_coefficients(coefs: np.ndarray, order: int, axis: int) -> np.ndarray:
-    """Coefficients (ascending powers along ``axis``) of the ``order``-th derivative; same length, zero padded."""
-    c = np.moveaxis(np.asarray(coefs, dtype=float), axis, -1)
-    width = c.shape[-1]
-    out = np.zeros_like(c)
-    if order < width:
-        k = np.arange(order, width)
-        falling = np.ones(width - order)
-        for r in range(order):
-            falling *= k - r
-        out[..., : width - order] = c[..., order:] * falling
-    return np.moveaxis(out, -1, axis)
-
-
-@functools.lru_cache(maxsize=64)
-def _derivative_matrices(width: int, orders: tuple[int, ...]) -> np.ndarray:
-    """Right-multiplication matrices (o, W, 2W-1) from ascending coefficients (.., W) to derivatives.
-
-    ``c @ M[i]`` holds, side by side, the coefficients of the ``orders[i]``-th derivative
-    (first W columns) and of the next derivative (last W-1 columns; its always-zero top
-    coefficient dropped). For W = 1 the second block is one zero column.
-    """
-    eye = np.eye(width)
-    blocks = []
-    for r in orders:
-        nxt = _derivative_coefficients(eye, r + 1, axis=1)[:, : max(width - 1, 1)]
-        if width == 1:
-            nxt = np.zeros((1, 1))
-        blocks.append(np.concatenate([_derivative_coefficients(eye, r, axis=1), nxt], axis=1))
-    M = np.stack(blocks)
-    M.flags.writeable = False
-    return M
-
-
-def _horner(coefs: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Evaluate rows of ascending coefficients (B, D+1) at points (B, C) -> (B, C)."""
-    out = np.zeros(s.shape)
-    for k in range(coefs.shape[1] - 1, -1, -1):
-        out = out * s + coefs[:, k : k + 1]
-    return out
-
-
-_THIRDS = (2.0 * np.pi / 3.0) * np.arange(3)
-
-
-def _cubic_roots(R: np.ndarray) -> np.ndarray:
-    """Real parts of the three roots of cubics with ascending coefficients R (k, 4), R[:, 3] != 0.
-
-    Closed form (Cardano for one real root, trigonometric for three); a complex pair
-    contributes its real part. Root errors only matter to second order for the extremum
-    values evaluated there. Both branches are computed for all rows (fewer numpy calls).
-    """
-    inv = 1.0 / R[:, 3]
-    B3 = R[:, 2] * inv / 3.0
-    C = R[:, 1] * inv
-    p = C - 3.0 * B3 * B3
-    q = B3 * (2.0 * B3 * B3 - C) + R[:, 0] * inv
-    disc = 0.25 * q * q + p * p * p / 27.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.cbrt(-0.5 * q - np.copysign(np.sqrt(np.maximum(disc, 0.0)), q))
-        y1 = np.where(u != 0.0, u - p / (3.0 * u), 0.0)
-        mag = 2.0 * np.sqrt(np.maximum(-p, 0.0) / 3.0)
-        arg = np.where(mag > 0.0, -4.0 * q / (mag * mag * mag), 1.0)
-    theta = np.arccos(np.minimum(np.maximum(arg, -1.0), 1.0)) / 3.0
-    three = mag[:, None] * np.cos(theta[:, None] - _THIRDS)
-    one = np.stack([y1, -0.5 * y1, -0.5 * y1], axis=1)
-    return np.where((disc > 0.0)[:, None], one, three) - B3[:, None]
-
-
-def _candidate_points(R: np.ndarray) -> np.ndarray:
-    """Points of [0, 1] where the polynomials with ascending coefficients ``R`` (B, D+1) may vanish.
-
-    Returns (B, max(D, 1)): the real parts of all roots, clipped to [0, 1], zero padded.
-    Extra candidates are harmless (the caller evaluates the function there and takes the
-    extreme), so complex roots keep their real part and no root is ever missed. Leading
-    coefficients below ``_ROOT_RTOL`` times the row's largest one are dropped (their roots
-    lie far outside [0, 1]). Closed forms up to degree 3, companion-matrix eigenvalues above.
-    """
-    B, width = R.shape
-    D = width - 1
-    out = np.zeros((B, max(D, 1)))
-    if D == 0 or B == 0:
-        return out
-    mag = np.abs(R)
-    threshold = _ROOT_RTOL * mag.max(axis=1)
-    significant = mag > threshold[:, None]
-    degree = D - np.argmax(significant[:, ::-1], axis=1)
-    degree[threshold == 0.0] = 0
-    for d in range(1, D + 1):
-        rows = np.flatnonzero(degree == d)
-        if rows.size == 0:
-            continue
-        Rr = R[rows, : d + 1]
-        if d == 1:
-            out[rows, 0] = -Rr[:, 0] / Rr[:, 1]
-        elif d == 2:
-            a, b, c = Rr[:, 2], Rr[:, 1], Rr[:, 0]
-            sq = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
-            q = -0.5 * (b + np.copysign(sq, b))
-            out[rows, 0] = q / a
-            safe_q = np.where(q != 0.0, q, 1.0)
-            out[rows, 1] = np.where(q != 0.0, c / safe_q, 0.0)
-        elif d == 3:
-            out[rows, :3] = _cubic_roots(Rr)
-        else:
-            monic = Rr[:, :d] / Rr[:, d : d + 1]
-            companion = np.zeros((rows.size, d, d))
-            companion[:, np.arange(1, d), np.arange(d - 1)] = 1.0
-            companion[:, :, d - 1] = -monic
-            out[rows, :d] = np.linalg.eigvals(companion).real
-    return np.minimum(np.maximum(out, 0.0), 1.0)
 
 
 class Trajectory:
@@ -315,7 +198,7 @@ class Trajectory:
         """(m, K+1, 4*n): coefficients of q, qd, qdd, qddd side by side (cached)."""
         if self._stack is None:
             c = self._coefs
-            parts = [_derivative_coefficients(c, r, axis=1) for r in range(4)]
+            parts = [derivative_coefficients(c, r, axis=1) for r in range(4)]
             self._stack = np.concatenate(parts, axis=2)
         return self._stack
 
@@ -392,10 +275,7 @@ class Trajectory:
     def _normalised(self) -> np.ndarray:
         """Coefficients (m, n, K+1) of each piece in normalised time s = tau / h in [0, 1] (cached)."""
         if self._norm is None:
-            h = np.diff(self._breaks)
-            width = self.degree + 1
-            cn = self._coefs * (h[:, None] ** np.arange(width))[:, :, None]
-            self._norm = np.ascontiguousarray(np.moveaxis(cn, 1, 2))
+            self._norm = normalised_pieces(self._coefs, np.diff(self._breaks))
         return self._norm
 
     def _extrema(self, orders: tuple[int, ...], with_times: bool = True) -> tuple[np.ndarray, Any]:
@@ -403,25 +283,14 @@ class Trajectory:
 
         Returns ``(values, times)``, each (len(orders), m, n, C): the derivative of order r
         (in the joint's unit / s^r) at the piece ends and at every root of the next
-        derivative within the piece. Max/min over the last axis are the exact extrema.
+        derivative within the piece (:func:`planning.extrema.piece_extrema`). Max/min over
+        the last axis are the exact extrema.
         """
-        cn = self._normalised()  # (m, n, W)
-        m, n, width = cn.shape
         h = np.diff(self._breaks)
-        M = _derivative_matrices(width, orders)  # (o, W, 2W-1): [derivative r | derivative r+1]
-        o = len(orders)
-        PR = np.matmul(cn.reshape(m * n, width), M)  # (o, m*n, 2W-1), coefficients in s
-        scale = np.repeat(h[None, :] ** -np.asarray(orders, dtype=float)[:, None], n, axis=1)  # (o, m*n)
-        P = PR[:, :, :width] * scale[:, :, None]  # d^r q / dt^r = h^-r d^r q / ds^r
-        roots = _candidate_points(PR[:, :, width:].reshape(o * m * n, -1))
-        B = roots.shape[0]
-        s = np.empty((B, roots.shape[1] + 2))
-        s[:, 0] = 0.0
-        s[:, 1] = 1.0
-        s[:, 2:] = roots
-        values = _horner(P.reshape(B, width), s).reshape(o, m, n, -1)
+        values, s = piece_extrema(self._normalised(), h, orders)
         if not with_times:
             return values, None
+        o, m, n = values.shape[:3]
         times = self._breaks[:-1][None, :, None, None] + s.reshape(o, m, n, -1) * h[None, :, None, None]
         return values, times
 
