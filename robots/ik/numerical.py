@@ -60,7 +60,7 @@ _POOL = 32  # random starts drawn at once and ranked by their distance to the ta
 _ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 _TWO_PI = 2.0 * np.pi
 _MU_MAX = 1e8  # an attempt gives up when no step with μ below this lowers the error
-_FREE, _WINDOW, _CLIP = 0, 1, 2  # projection modes of an iterate (see NumericalIK._project)
+_FREE, _WINDOW, _CLIP = 0, 1, 2  # free descent; free then wrapped to the ranges' windows; projected descent
 
 
 @dataclass(frozen=True)
@@ -132,9 +132,10 @@ class NumericalIK:
         #: bounded revolute joints whose range spans a full turn: leaving the range is undone by ∓2π
         self.full_turn = revolute & ~self.unbounded & (self.upper - self.lower >= _TWO_PI)
         self._any_full_turn = bool(self.full_turn.any())
-        self._window = revolute & ~self.unbounded  # wrapped to their range's 2π window in free descents
-        self._any_revolute = bool(self._window.any())
-        self._mid = 0.5 * (self.lower + self.upper)
+        window = revolute & ~self.unbounded  # wrapped to the 2π window centred on their range
+        self._any_revolute = bool(window.any())
+        self._window_low = np.where(window, 0.5 * (self.lower + self.upper) - np.pi, 0.0)
+        self._window_turns = np.where(window, 1.0 / _TWO_PI, 0.0)  # 0: the joint is never shifted
         self.max_iter = int(max_iter)
         self.damping = float(damping)
         self.min_damping = float(min_damping)
@@ -160,23 +161,24 @@ class NumericalIK:
         """``lower ≤ q ≤ upper`` exactly (no tolerance)."""
         return not ((q < self.lower).any() or (q > self.upper).any())
 
-    def _project(self, q: np.ndarray, mode: int) -> bool:
-        """Bring ``q`` into the limits in place (see the module doc); ``True`` if a joint was clipped to a limit.
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
+        """Revolute angles of ``q`` (in place) to the ``2π`` window centred on their range, continuous ones to ``(-π, π]``."""
+        if self._any_unbounded:
+            u = self.unbounded
+            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
+        if self._any_revolute:
+            q -= _TWO_PI * np.floor((q - self._window_low) * self._window_turns)
+        return q
 
-        ``mode``: :data:`_CLIP` projection into the limits, :data:`_WINDOW` revolute angles
-        wrapped to ``[mid − π, mid + π)`` of their range (no clipping), :data:`_FREE`
-        continuous joints wrapped only.
+    def _clip(self, q: np.ndarray) -> bool:
+        """Project ``q`` into the limits in place; ``True`` if a joint was clipped to a limit.
+
+        Continuous joints are wrapped to ``(-π, π]``; a revolute joint whose range spans a
+        full turn is shifted by ∓2π when it leaves its range; the others are clipped.
         """
         if self._any_unbounded:
             u = self.unbounded
             q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
-        if mode == _FREE:
-            return False
-        if mode == _WINDOW:
-            if self._any_revolute:
-                r, mid = self._window, self._mid
-                q[r] = mid[r] + (q[r] - mid[r] + np.pi) % _TWO_PI - np.pi
-            return False
         lo, hi = self.lower, self.upper
         if not ((q < lo).any() or (q > hi).any()):
             return False
@@ -216,10 +218,10 @@ class NumericalIK:
         if met and self.in_limits(q):
             return q, pe, re, it, True
         if not met:  # no pose reached from this start: report its projection, restart elsewhere
-            self._project(q, _CLIP)
+            self._clip(q)
             pe, re = self._errors_to(q, T_des, p_des, position_only)
             return q, pe, re, it, False
-        self._project(q, _CLIP)  # a solution outside the limits: slide back along the limits
+        self._clip(q)  # a solution outside the limits: slide back along the limits
         q, pe, re, it2 = self._descend(q, T_des, p_des, position_only, tol, _CLIP)
         return q, pe, re, it + it2, pe <= tol and re <= tol
 
@@ -241,10 +243,13 @@ class NumericalIK:
         model, data, fid = self.model, self.data, self.frame_id
         jacobians, placement, frame_jacobian = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian
         log6, jlog6 = pin.log6, pin.Jlog6
-        pin_q, project = self._pin_q, self._project
+        pin_q = self._pin_q
         lower, upper = self.lower, self.upper
+        clip = mode == _CLIP
         wide = self._wide
+        G_diag = slice(None, None, (6 if wide else self.nq) + 1)
         min_damping, max_step = self.min_damping, self.max_step
+        max_step2 = max_step * max_step
         stall_ratio, stall_steps = self.stall_ratio, self.stall_steps * patience
         max_iter = self.max_iter * patience
         ref = pin.LOCAL_WORLD_ALIGNED if position_only else pin.LOCAL
@@ -269,7 +274,7 @@ class NumericalIK:
             t, w = D.translation, d[3:]  # |D.translation| = ‖p − p_target‖, d[3:] = log3(Rᵀ R_target)
             return t.dot(t) <= tol2 and w.dot(w) <= tol2
 
-        at_limit = project(q, mode) or (mode == _CLIP and bool(((q <= lower) | (q >= upper)).any()))
+        at_limit = clip and (self._clip(q) or bool(((q <= lower) | (q >= upper)).any()))
         e, D, E = evaluate(q)
         mu, nu = self.damping, 2.0
         it = 0
@@ -279,10 +284,17 @@ class NumericalIK:
             it += 1
             J = frame_jacobian(model, data, fid, ref)  # data holds the joint Jacobians of q
             A = J[:3] if position_only else jlog6(D.inverse()).dot(J)
+            gram = A.dot(A.T) if wide else A.T.dot(A)
+            rhs = e if wide else A.T.dot(e)
             accepted = False
             while mu < _MU_MAX:
                 lam = mu * E + min_damping
-                dq = self._step(A, e, lam, wide)
+                G = gram.copy()
+                G.flat[G_diag] += lam
+                _, x, info = _posv(G, rhs, overwrite_a=1)
+                if info != 0:  # not positive definite in floating point: least squares instead
+                    x = np.linalg.lstsq(gram + lam * np.eye(gram.shape[0]), rhs, rcond=None)[0]
+                dq = A.T.dot(x) if wide else x
                 if at_limit:  # joints at a limit pushed outwards: take them out and re-solve
                     blocked = ((q <= lower) & (dq < 0.0)) | ((q >= upper) & (dq > 0.0))
                     if blocked.any():
@@ -290,11 +302,12 @@ class NumericalIK:
                         A_free[:, blocked] = 0.0
                         dq = self._step(A_free, e, lam, wide)
                         dq[blocked] = 0.0
-                step = max(dq.max(), -dq.min())
-                if step > max_step:
-                    dq *= max_step / step
+                if dq.dot(dq) > max_step2:  # cheap test first: the 2-norm bounds every joint's step
+                    step = max(dq.max(), -dq.min())
+                    if step > max_step:
+                        dq *= max_step / step
                 q_try = q + dq
-                clipped = project(q_try, mode)
+                clipped = clip and self._clip(q_try)
                 e_t, D_t, E_t = evaluate(q_try)
                 if E_t < E:  # accept; Nielsen's update of μ from the gain ratio ρ
                     r = e - A.dot(dq)
@@ -313,6 +326,11 @@ class NumericalIK:
             done = converged(e, D, E)
             if stall >= stall_steps:
                 break
+        if mode == _WINDOW:
+            self._wrap(q)
+        elif self._any_unbounded:
+            u = self.unbounded
+            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
         if position_only:
             return q, float(np.sqrt(E)), 0.0, it
         t, w = D.translation, e[3:]
