@@ -26,8 +26,8 @@ def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
     # numbers the papers and pinarms must share
     table3 = [r for r in rows if r["quantity"].startswith("Table 3 J1-J3")]
     assert len(table3) == 21 and all(r["status"] == "agrees" for r in table3)
-    assert by[("004", "FK example 1 x")]["status"] == "agrees"
-    assert by[("004", "FK example 1 z")]["status"] == "agrees"
+    assert by[("004", "FK example 3 x")]["status"] == "agrees"  # the paper's third: (-90, 25, -30, 90) deg
+    assert by[("004", "FK example 3 z")]["status"] == "agrees"
     assert by[("000", "initial total time")]["status"] == "agrees"
     assert by[("002", "jerk jump at interior knots / jerk limit")]["status"] == "agrees"
     assert by[("000", "GA peak |v| joint 1")]["pinarms"] <= 55.0 * (1 + 1e-6)
@@ -50,5 +50,5 @@ def test_demo_text_table_only_one_study(tmp_path):
     result = CliRunner().invoke(cli, ["demo", "--quick", "--only", "004", "--out", str(tmp_path)])
     assert result.exit_code == 0, (result.output, result.exception)
     assert "paper vs pinarms" in result.stdout
-    assert "FK example 2 z" in result.stdout and "differs" in result.stdout
+    assert "FK example 1 z" in result.stdout and "differs" in result.stdout
     assert (tmp_path / "table.md").is_file()
