@@ -12,27 +12,40 @@ inverse of the left Jacobian of ``SE(3)`` at ``log6(D)``): the Gauss–Newton sy
     Δq = Aᵀ (A Aᵀ + λ I)⁻¹ e           (nq ≥ 6; (AᵀA + λI)⁻¹ Aᵀ e when nq < 6)
     λ  = μ ‖e‖² + λ_min                 (Sugihara's damping, μ adapted)
 
-A step is kept only if it lowers ``‖e‖²`` (then ``μ`` shrinks ×3); otherwise ``μ`` grows
-×5 and the step is recomputed. Each joint's step is capped (``max_step``). Far from the
-target ``λ`` is large (short, gradient-like steps); near it ``λ → λ_min`` and the steps
-are Newton's (quadratic convergence, 1e-10 reached in one or two steps from 1e-5).
+A step is kept only if it lowers ``‖e‖²``; ``μ`` then follows Nielsen's update from the
+gain ratio ρ = (actual decrease of ‖e‖²) / (decrease predicted by the linear model):
+``μ ← μ · max(1/3, 1 − (2ρ − 1)³)``; a rejected step multiplies ``μ`` by ν = 2, 4, 8, …
+and is recomputed. Each joint's step is capped (``max_step``). Far from the target ``λ``
+is large (short, gradient-like steps); near it ``λ → λ_min`` and the steps are Newton's
+(quadratic convergence: 1e-10 is reached in one or two steps from 1e-5).
 
-Joint limits, by projection with an active set: each new iterate is projected into the
-limits (continuous joints wrapped to ``(-π, π]``; a revolute joint whose range spans a
-full turn or more, e.g. the UR's ±2π, is shifted by ∓2π when it leaves its range, which
-changes no pose; other joints clipped), and joints held at a limit and pushed outwards
-are removed from the step (their Jacobian columns zeroed) so the free joints move. The
-iterate never leaves the limits: ``limits=False`` is only for diagnostics.
+Joint limits. Clipping every iterate into the limits traps many descents at a limit
+(the branch they head for lies beyond it), so an attempt runs in two phases:
+
+1. a *free* descent (joints unconstrained). Its result is wrapped: each revolute angle
+   to the ``2π`` window centred on its range (the pose is unchanged). If it meets the
+   target and lies within the limits, that is the answer.
+2. if it met the target *outside* the limits, a *projected* descent from its projection
+   into the limits: every iterate is projected (continuous joints wrapped to ``(-π, π]``;
+   a revolute joint whose range spans a full turn or more, e.g. the UR's ±2π, shifted by
+   ∓2π when it leaves its range; other joints clipped), and joints held at a limit and
+   pushed outwards are taken out of the step (their Jacobian columns zeroed) so the free
+   joints move (an active set). Redundant arms often slide back into the limits this way.
+
+A descent that did not meet the target ends the attempt (the next start is tried).
+``attempt(limits=True)`` is the projected descent alone (used to refine closed-form
+solutions); ``limits=False`` the free one, for diagnostics.
 
 ``position_only`` uses the position error ``p_target − p(q)`` and the 3 linear rows of the
 world-aligned frame Jacobian instead.
 
-An attempt stops when the position error [m] and the rotation error [rad] are both within
+A descent stops when the position error [m] and the rotation error [rad] are both within
 ``tol`` (success), after ``max_iter`` steps, when no step lowers the error, or when the
 error has stagnated (``‖e‖²`` falls by less than ``1 − stall_ratio`` ``stall_steps``
 times in a row). The first attempt starts from ``q_seed``; the next ones from
 configurations drawn uniformly within the limits by a seeded generator, taken in order
-of their pose distance to the target.
+of their pose distance to the target. A success is confirmed on the returned ``q`` by a
+fresh forward kinematics and a limit check.
 
 Speed: one configuration at a time is what IK needs, so the loop calls Pinocchio
 directly: per trial step one ``computeJointJacobians`` (forward kinematics and every
@@ -392,7 +405,13 @@ class NumericalIK:
             q_seed: first start ``(nq,)`` (default: the middle of the joint ranges).
             tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
             seed: seed or ``numpy.random.Generator`` of the restarts.
-            limits: keep the iterates within the joint limits (``False`` only for diagnostics).
+            limits: return a configuration within the joint limits (``False``: joints move
+                freely, only for diagnostics such as telling *out of reach* from *limits*).
+
+        Each attempt: a free descent from the start (revolute angles then wrapped to the 2π
+        window centred on their range); if it meets the target outside the limits, a
+        projected descent from its projection. Success is confirmed on the returned ``q``
+        with a fresh forward kinematics.
         """
         target = np.asarray(target, dtype=float)
         T_des, p_des = self._target(target, position_only)
@@ -415,6 +434,9 @@ class NumericalIK:
                 q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, _FREE)
                 ok = pe <= tol and re <= tol
             iterations += it
+            if ok:  # confirm on the returned q itself (after wrapping) with a fresh FK
+                pe, re = self._errors_to(q, T_des, p_des, position_only)
+                ok = pe <= tol and re <= tol and (not limits or self.in_limits(q))
             if ok:
                 return IKResult(q, True, pe, re, attempt + 1, iterations)
             if best is None or pe + re < best[1] + best[2]:
@@ -426,5 +448,7 @@ class NumericalIK:
             if pe + re > best[1] + best[2]:
                 q, pe, re = best
             elif pe <= tol and re <= tol:
-                return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
+                pe, re = self._errors_to(q, T_des, p_des, position_only)
+                if pe <= tol and re <= tol:
+                    return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)
