@@ -37,3 +37,8 @@ from .layout import LayoutReport, check_layout  # noqa: E402
 from .workspace import Workspace, sample_workspace  # noqa: E402
 
 __all__ += ["Workspace", "sample_workspace", "LayoutReport", "check_layout"]
+
+# the four papers' published numbers, as printed (data only)
+from . import papers  # noqa: E402
+
+__all__ += ["papers"]
