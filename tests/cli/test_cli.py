@@ -10,8 +10,9 @@ from click.testing import CliRunner
 
 import robots
 from pinarms.cli import cli, read_via_file
+from robots.papers import SEED000 as PAPER000
 
-SEED000 = ["--via", "55.5", "--via", "69.7", "--via", "106.5", "--via", "124.5"]
+SEED000 = [arg for deg in PAPER000.path_deg for arg in ("--via", f"{deg:g}")]  # --via 55.5 --via 69.7 ...
 
 
 @pytest.fixture
@@ -128,7 +129,7 @@ def test_plan_seed000_peaks_and_limit_check(run, tmp_path):
     data = as_json(run(*args, "--json"))
     import planning
 
-    traj = planning.piecewise_polynomial([0, 2, 4, 6], np.radians([55.5, 69.7, 106.5, 124.5]), degrees=(3, 5, 3))
+    traj = planning.piecewise_polynomial(PAPER000.initial_knot_times_s, PAPER000.path_rad, degrees=(3, 5, 3))
     assert data["duration_s"] == pytest.approx(6.0)
     assert data["peaks"]["velocity"][0] == pytest.approx(np.degrees(traj.peaks().velocity[0]), rel=1e-9)
     assert data["limits_ok"] is True
