@@ -119,7 +119,7 @@ class NumericalIK:
         max_iter: int = 30,
         damping: float = 1e-2,
         min_damping: float = 1e-12,
-        max_step: float = 1.5,
+        max_step: float = 1.0,
         stall_ratio: float = 0.9,
         stall_steps: int = 4,
     ) -> None:

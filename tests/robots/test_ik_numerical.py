@@ -183,7 +183,7 @@ def test_random_reachable_poses_all_solved_from_random_starts(name):
         assert robot.within_limits(res.q, tol=0.0)
         assert abs(pe - res.position_error) <= 1e-12 and abs(re - res.rotation_error) <= 1e-12
         attempts.append(res.attempts)
-    assert np.mean(attempts) <= 2.5  # measured 1.3 (ur5) to 1.9 (panda) per pose
+    assert np.mean(attempts) <= 2.5  # measured 1.25 (ur5) to 1.76 (panda) per pose
 
 
 def test_full_turn_joints_are_shifted_by_two_pi_not_clipped():
@@ -198,7 +198,7 @@ def test_full_turn_joints_are_shifted_by_two_pi_not_clipped():
         q, pe, re, _ = solver.attempt(ur5.upper.copy(), Tk, False, 1e-10)
         assert ur5.within_limits(q, tol=0.0)
         solved += pe <= 1e-10 and re <= 1e-10
-    assert solved >= 30  # 34 of 40 (2 of 40 when the joints are clipped instead)
+    assert solved >= 28  # 32 of 40 (2 of 40 when the joints are clipped instead)
 
 
 def test_a_free_descent_ending_outside_the_limits_is_never_returned():
