@@ -24,7 +24,7 @@ from scipy.optimize import minimize
 
 from optim.problem import SAFETY, TimingProblem
 
-__all__ = ["ExactSolution", "solve_exact", "start_ratios", "scaled_to_limits"]
+__all__ = ["ExactSolution", "solve_exact", "start_ratios", "scaled_to_limits", "polish_durations"]
 
 
 @dataclass(frozen=True)
@@ -82,6 +82,24 @@ def _slsqp(problem: TimingProblem, h0: np.ndarray, maxiter: int) -> np.ndarray:
                                  "jac": lambda h: values_and_jacobian(h)[1]}],
                    options={"maxiter": maxiter, "ftol": 1e-10})
     return np.clip(np.asarray(res.x, dtype=float), lo, hi)
+
+
+def polish_durations(problem: TimingProblem, durations: np.ndarray,
+                     maxiter: int = 60) -> tuple[np.ndarray, bool]:
+    """Local refinement of a timing: SLSQP started from ``durations``, rescaled onto the limits.
+
+    The answer is the local minimum of the total nearest (for SLSQP) to the given timing,
+    not a global search: :func:`optim.minimize_time` uses it as the optional final polish
+    of a GA answer (``polish=True``). Returns the better of the refined and the given
+    timing (both rescaled onto the limits by :func:`scaled_to_limits`) and whether it
+    meets the upper bounds.
+    """
+    h0 = np.clip(np.asarray(durations, dtype=float), problem.bounds[:, 0], problem.bounds[:, 1])
+    given, ok_given = scaled_to_limits(problem, h0)
+    refined, ok = scaled_to_limits(problem, _slsqp(problem, h0, maxiter))
+    if (ok and not ok_given) or (ok == ok_given and refined.sum() < given.sum()):
+        return refined, ok
+    return given, ok_given
 
 
 def _polish(problem: TimingProblem, h: np.ndarray, maxfev: int) -> np.ndarray:

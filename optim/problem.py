@@ -5,6 +5,12 @@ per-joint limits. For durations ``h`` (m,) it builds the trajectory with knot ti
 ``[0, cumsum(h)]`` through :mod:`planning` and reads its exact peaks. It is the bridge
 between trajectories and the optimisers: the GA sees only arrays.
 
+A population of durations (P, m) is evaluated in a few numpy calls: planning's batched
+constructor (``piecewise_polynomial_batch``, ``multi_quintic_batch``,
+``quintic_bspline_batch``) gives the coefficients of all P trajectories from one batched
+solve, and :func:`planning.piece_peaks_batch` peaks every piece of every individual in
+one pass. Single timings go through the same code with P = 1.
+
 Scaling laws used by the exact optimiser and by the final rescaling: with durations
 ``s * r`` (ratios ``r``, total ``s``), peak velocity scales as 1/s, acceleration as
 1/s**2 and jerk as 1/s**3 (time scaling of the same curve), so the smallest feasible
@@ -24,7 +30,7 @@ import numpy as np
 from robots.errors import InvalidInput
 from optim.errors import InvalidLimits, InvalidSettings
 
-__all__ = ["TimingProblem", "KINDS", "Builder", "check_limit"]
+__all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
 #: Trajectory families known to :func:`optim.minimize_time`.
 KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
@@ -43,8 +49,12 @@ class _TrajectoryLike(Protocol):
     def peaks(self) -> _PeaksLike: ...
 
 
-#: Maps (knot times (m+1,), positions (m+1, n)) to a trajectory with ``peaks()``.
+#: Maps (knot times (m+1,), positions (m+1, n)) to a trajectory with ``peaks()``,
+#: ``coefficients`` and ``knot_times``.
 Builder = Callable[[np.ndarray, np.ndarray], Any]
+
+#: Maps (knot times (P, m+1), positions (m+1, n)) to coefficients (P, m, K+1, n).
+BatchBuilder = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndarray | None:
@@ -73,20 +83,24 @@ def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndar
     return arr
 
 
-def _planning_builder(kind: str, options: dict[str, Any]) -> Builder:
+def _planning_builders(kind: str, options: dict[str, Any]) -> tuple[Builder, BatchBuilder]:
+    """The planning constructor of ``kind`` for one timing and for a population."""
     import planning  # optim sits above planning in the one-way flow
 
     if kind == "3-5-3":
         # Cubic first and last segments, quintics between (3-5-3 for three segments).
-        def build_353(t: np.ndarray, q: np.ndarray) -> Any:
-            m = t.shape[0] - 1
-            degrees = (3,) + (5,) * (m - 2) + (3,) if m >= 2 else (5,)
-            return planning.piecewise_polynomial(t, q, **{"degrees": degrees, **options})
-        return build_353
+        def with_degrees(t: np.ndarray) -> dict[str, Any]:
+            m = t.shape[-1] - 1
+            return {"degrees": (3,) + (5,) * (m - 2) + (3,) if m >= 2 else (5,), **options}
+
+        return (lambda t, q: planning.piecewise_polynomial(t, q, **with_degrees(t)),
+                lambda t, q: planning.piecewise_polynomial_batch(t, q, **with_degrees(t)))
     if kind == "multi-quintic":
-        return lambda t, q: planning.multi_quintic(t, q, **options)
+        return (lambda t, q: planning.multi_quintic(t, q, **options),
+                lambda t, q: planning.multi_quintic_batch(t, q, **options))
     if kind == "quintic-bspline":
-        return lambda t, q: planning.quintic_bspline(t, q, **options)
+        return (lambda t, q: planning.quintic_bspline(t, q, **options),
+                lambda t, q: planning.quintic_bspline_batch(t, q, **options))
     raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of {KINDS}")
 
 
@@ -104,6 +118,7 @@ class TimingProblem:
         trajectory_options: Extra keyword arguments for the planning constructor (e.g.
             ``velocities=0`` for multi-quintic rest at every via point).
         builder: Replace the planning constructor (advanced; tests and custom families).
+            A custom builder is called once per individual (no batched form).
     """
 
     def __init__(self, positions: Any, kind: str, vmax: Any, amax: Any = None,
@@ -131,7 +146,10 @@ class TimingProblem:
         if np.all(np.ptp(q, axis=0) == 0.0):
             raise InvalidInput("positions do not move (all via points equal): nothing to time")
         self.trajectory_options = dict(trajectory_options or {})
-        self._build = builder or _planning_builder(kind, self.trajectory_options)
+        if builder is None:
+            self._build, self._build_batch = _planning_builders(kind, self.trajectory_options)
+        else:
+            self._build, self._build_batch = builder, None
         self.evaluations = 0
         self.bounds = self._check_bounds(bounds)
 
@@ -146,23 +164,23 @@ class TimingProblem:
 
     def peaks(self, durations: np.ndarray) -> np.ndarray:
         """Exact peaks as (3, n_joints): |velocity|, |acceleration|, |jerk| maxima."""
-        self.evaluations += 1
-        p = self.trajectory(durations).peaks()
-        return np.stack([np.asarray(p.velocity, dtype=float).reshape(-1),
-                         np.asarray(p.acceleration, dtype=float).reshape(-1),
-                         np.asarray(p.jerk, dtype=float).reshape(-1)])
+        return self.peaks_batch(np.asarray(durations, dtype=float)[None])[0]
 
     def minimal_scale(self, ratios: np.ndarray) -> float:
         """s*(r): the smallest total (s) meeting every limit with durations ``s * r``."""
-        r = np.asarray(ratios, dtype=float)
-        r = r / r.sum()
-        pk = self.peaks(r)
-        s = np.max(pk[0] / self.vmax)
+        return float(self.minimal_scale_batch(np.asarray(ratios, dtype=float)[None])[0])
+
+    def minimal_scale_batch(self, ratios: np.ndarray) -> np.ndarray:
+        """s*(r) for a population of ratios (pop, m) -> (pop,) (s); rows need not sum to 1."""
+        r = np.atleast_2d(np.asarray(ratios, dtype=float))
+        r = r / r.sum(axis=1, keepdims=True)
+        pk = self.peaks_batch(r)  # (pop, 3, n) at total 1
+        s = np.max(pk[:, 0] / self.vmax, axis=1)
         if self.amax is not None:
-            s = max(s, float(np.max(np.sqrt(pk[1] / self.amax))))
+            s = np.maximum(s, np.max(np.sqrt(pk[:, 1] / self.amax), axis=1))
         if self.jmax is not None:
-            s = max(s, float(np.max(np.cbrt(pk[2] / self.jmax))))
-        return float(s)
+            s = np.maximum(s, np.max(np.cbrt(pk[:, 2] / self.jmax), axis=1))
+        return s
 
     # -- arrays for the GA --------------------------------------------------------------
     def limit_ratios(self, durations: np.ndarray) -> np.ndarray:
@@ -175,33 +193,33 @@ class TimingProblem:
             parts.append(pk[2] / self.jmax)
         return np.concatenate(parts)
 
+    def coefficients_batch(self, population: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Knot times (pop, m'+1) (s) and piece coefficients (pop, m', K+1, n) for durations (pop, m).
+
+        With a planning family, one call of its batched constructor (m' = m); with a
+        custom ``builder``, one call per individual (its pieces, m' of them, may differ
+        from the segments). Counts ``pop`` evaluations.
+        """
+        h = np.atleast_2d(np.asarray(population, dtype=float))
+        self.evaluations += h.shape[0]
+        times = np.concatenate([np.zeros((h.shape[0], 1)), np.cumsum(h, axis=1)], axis=1)
+        if self._build_batch is not None:
+            return times, self._build_batch(times, self.positions)
+        trajs = [self._build(row, self.positions) for row in times]
+        coefs = np.stack([np.asarray(t.coefficients, dtype=float) for t in trajs])
+        return np.stack([np.asarray(t.knot_times, dtype=float) for t in trajs]), coefs
+
     def piece_peaks_batch(self, population: np.ndarray) -> np.ndarray:
         """Exact peaks per polynomial piece, (pop, 3, pieces, n_joints), for durations (pop, m).
 
-        Each individual's trajectory is built by the planning constructor (they take one
-        timing at a time); the peak search then runs once for the whole population: every
-        polynomial piece is rewritten in normalised time ``u = tau / h_i`` in [0, 1] and all
-        pieces of all joints and individuals become the columns of one single-piece
-        planning trajectory, whose exact peaks are divided by ``h_i``, ``h_i**2``,
-        ``h_i**3`` (the r-th derivative in real time is the r-th in ``u`` over ``h_i**r``).
+        The coefficients of all individuals come from :meth:`coefficients_batch`; the exact
+        peak search (:func:`planning.piece_peaks_batch`) then runs once for the whole
+        population.
         """
-        from planning.trajectory import Trajectory
+        import planning
 
-        h = np.atleast_2d(np.asarray(population, dtype=float))
-        pop = h.shape[0]
-        trajs = [self.trajectory(row) for row in h]
-        self.evaluations += pop
-        coefs = np.stack([np.asarray(t.coefficients, dtype=float) for t in trajs])  # (P,m,K+1,n)
-        width = coefs.shape[2]
-        seg = np.stack([np.diff(np.asarray(t.knot_times, dtype=float)) for t in trajs])  # (P,m')
-        powers = seg[:, :, None] ** np.arange(width)  # (P, m', K+1)
-        normalised = coefs * powers[..., None]
-        columns = np.moveaxis(normalised, 2, -1).reshape(-1, width)  # (P*m'*n, K+1)
-        pk = Trajectory(np.array([0.0, 1.0]), columns.T[None, :, :]).peaks()
-        per = np.stack([pk.velocity, pk.acceleration, pk.jerk])  # (3, P*m'*n)
-        per = per.reshape(3, pop, seg.shape[1], self.n_joints)
-        per = per / seg[None, :, :, None] ** np.arange(1, 4)[:, None, None, None]
-        return np.moveaxis(per, 0, 1)  # (P, 3, m', n)
+        times, coefs = self.coefficients_batch(population)
+        return planning.piece_peaks_batch(times, coefs)
 
     def peaks_batch(self, population: np.ndarray) -> np.ndarray:
         """Exact peaks for a population of durations (pop, m) -> (pop, 3, n_joints)."""

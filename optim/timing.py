@@ -16,7 +16,7 @@ import numpy as np
 
 from optim.engine import GAHistory, GAProgress, run_ga
 from optim.errors import InfeasibleProblem, InvalidSettings
-from optim.exact import scaled_to_limits, solve_exact, start_ratios
+from optim.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
 from optim.problem import SAFETY, TimingProblem
 from optim.settings import GASettings
 
@@ -35,13 +35,16 @@ class TimingResult:
         trajectory: The planning trajectory with these durations.
         peaks: Its exact peaks (planning ``Peaks``: velocity, acceleration, jerk per joint).
         history: GA history per generation (None for ``method="exact"``).
-        method: ``"ga"`` or ``"exact"`` (or a two-stage label for time-jerk results).
+        method: ``"ga"``, ``"ga+polish"`` (GA answer refined by the local polish),
+            ``"exact"`` (or a two-stage label for time-jerk results).
         evaluations: Trajectories built and peaked by the optimiser.
         wall_time: Seconds spent.
         raw_total: GA: total of the GA's best individual before rescaling to the limits;
             exact: equal to ``total``.
         kind: Trajectory family.
         stop_reason: GA stop reason ("" for exact).
+        unpolished_total: ``"ga+polish"``: total (s) of the GA's answer (rescaled onto the
+            limits) before the local polish; None otherwise.
     """
 
     durations: np.ndarray
@@ -55,6 +58,7 @@ class TimingResult:
     raw_total: float
     kind: str
     stop_reason: str = ""
+    unpolished_total: float | None = None
 
     @property
     def knot_times(self) -> np.ndarray:
@@ -77,7 +81,8 @@ def rescale_to_limits(problem: TimingProblem, durations: np.ndarray) -> np.ndarr
 
 def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
                   history: GAHistory | None, evaluations: int, t0: float,
-                  raw_total: float, stop_reason: str = "") -> TimingResult:
+                  raw_total: float, stop_reason: str = "",
+                  unpolished_total: float | None = None) -> TimingResult:
     """Build the final trajectory, verify it with its exact peaks, wrap the result."""
     h = np.asarray(durations, dtype=float)
     if not problem.is_feasible(h):
@@ -89,7 +94,8 @@ def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
     return TimingResult(durations=h, total=float(h.sum()), trajectory=traj, peaks=traj.peaks(),
                         history=history, method=method, evaluations=evaluations,
                         wall_time=time.perf_counter() - t0, raw_total=raw_total,
-                        kind=problem.kind, stop_reason=stop_reason)
+                        kind=problem.kind, stop_reason=stop_reason,
+                        unpolished_total=unpolished_total)
 
 
 def _infeasible(problem: TimingProblem, method: str) -> InfeasibleProblem:
@@ -104,7 +110,7 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
                   method: str = "ga", seed: int = 0, settings: GASettings | None = None,
                   bounds: Any = None, *, max_generations: int | None = None,
                   stall_generations: int | None = None, time_limit: float | None = None,
-                  rescale: bool = True, initial: Any = None,
+                  rescale: bool = True, polish: bool = False, initial: Any = None,
                   callback: Callable[[GAProgress], bool | None] | None = None,
                   trajectory_options: dict[str, Any] | None = None,
                   problem: TimingProblem | None = None) -> TimingResult:
@@ -129,6 +135,10 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
         max_generations, stall_generations, time_limit: GA stopping rules.
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
+        polish: GA only: refine the GA's (rescaled) answer by a local gradient method
+            (SLSQP from it, :func:`optim.exact.polish_durations`) and keep the better of
+            the two; the result's method is then ``"ga+polish"`` and the GA's own total is
+            kept in ``unpolished_total``. Off by default: the default answer is the GA's.
         initial: GA only: (k, m) durations put into the initial population (e.g. the
             paper's initial times).
         callback: GA progress callback (see :func:`optim.run_ga`).
@@ -171,6 +181,13 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
     if not result.feasible:
         raise _infeasible(problem, "ga")
     h = rescale_to_limits(problem, result.x) if rescale else result.x
-    return finish_timing(problem, h, method="ga", history=result.history,
+    label, unpolished = "ga", None
+    if polish:
+        refined, ok = polish_durations(problem, h)
+        label, unpolished = "ga+polish", float(h.sum())
+        if ok and refined.sum() < h.sum():
+            h = refined
+    return finish_timing(problem, h, method=label, history=result.history,
                          evaluations=problem.evaluations - before, t0=t0,
-                         raw_total=float(result.f), stop_reason=result.stop_reason)
+                         raw_total=float(result.f), stop_reason=result.stop_reason,
+                         unpolished_total=unpolished)
