@@ -155,7 +155,6 @@ class NumericalIK:
         self.max_step = float(max_step)
         self.stall_ratio = float(stall_ratio)
         self.stall_steps = int(stall_steps)
-        self._wide = self.nq >= 6  # solve the 6×6 system AAᵀ (else the nq×nq system AᵀA)
 
     # ------------------------------------------------------------------ pieces
     def _pin_q(self, q: np.ndarray) -> np.ndarray:
@@ -259,8 +258,9 @@ class NumericalIK:
         pin_q = self._pin_q
         lower, upper = self.lower, self.upper
         clip = mode == _CLIP
-        wide = self._wide
-        G_diag = slice(None, None, (6 if wide else self.nq) + 1)
+        rows = 3 if position_only else 6  # task rows
+        wide = self.nq >= rows  # solve the rows×rows system AAᵀ (else the nq×nq system AᵀA)
+        G_diag = slice(None, None, (rows if wide else self.nq) + 1)  # the diagonal of the flattened system
         min_damping, max_step = self.min_damping, self.max_step
         max_step2 = max_step * max_step
         stall_ratio, stall_steps = self.stall_ratio, self.stall_steps * patience

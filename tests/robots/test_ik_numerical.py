@@ -278,3 +278,15 @@ def test_continuous_joint_is_wrapped_to_one_turn():
         res = solver.solve(np.block([[np.eye(3), p[:, None]], [np.zeros((1, 3)), 1.0]]), s, position_only=True)
         assert res.success and np.linalg.norm(arm3.position(res.q) - p) <= 1e-10
         assert -np.pi <= res.q[0] <= np.pi and arm3.within_limits(res.q, tol=0.0)
+
+
+def test_position_only_newton_steps_converge_quadratically(arm):
+    """Position-only (3 task rows, damped 3×3 system): 1e-12 within 3 steps from 1e-4 off."""
+    solver = NumericalIK(arm)
+    rng = np.random.default_rng(4)
+    for q in arm.random_q(5, seed=14):
+        T = arm.fk(q)
+        q_off = q + 1e-4 * rng.standard_normal(arm.nq)
+        q2, pe, _, its = solver.attempt(q_off, T, True, 1e-12, limits=False)
+        assert pe <= 1e-12 and its <= 3
+        assert np.linalg.norm(arm.position(q2) - T[:3, 3]) <= 1e-12
