@@ -153,12 +153,18 @@ class GASettings:
     @classmethod
     def seed002(cls) -> "GASettings":
         """Seed 002's improved GA: elitism + tournament, non-uniform mutation (c = 2),
-        adaptive pc/pm (pc1 0.9, pc2 0.6, pm1 0.1, pm2 0.001, the usual values of this
-        rule; the paper prints none) and an adaptive penalty, fitness = 1 / (f + p).
-        Crossover: arithmetic (the paper names none)."""
+        adaptive pc/pm and an adaptive penalty, fitness = 1 / (f + p).
+
+        The paper prints none of pc1, pc2, pm1, pm2 nor the crossover operator (arithmetic
+        here) or the generation budget. pc1 0.9 and pc2 0.6 are the usual values of this
+        rule; pm1 0.2, pm2 0.01 and 600 generations were chosen over the usual pm1 0.1,
+        pm2 0.001 and 300 generations by a 20-seed comparison on the seed 002 gantry
+        timing (median gap to the exact optimum 0.41 % instead of 1.06 %, worst 1.05 %
+        instead of 2.25 %; docs/optim.md). Nothing in the GA depends on the problem.
+        """
         return cls(population=50, selection="tournament", tournament_size=2,
                    crossover="arithmetic", crossover_probability=0.9,
                    mutation="non-uniform", mutation_probability=0.1, nonuniform_shape=2.0,
-                   elitism=2, adaptive=True, pc1=0.9, pc2=0.6, pm1=0.1, pm2=0.001,
-                   constraint_handling="adaptive-penalty", max_generations=300,
+                   elitism=2, adaptive=True, pc1=0.9, pc2=0.6, pm1=0.2, pm2=0.01,
+                   constraint_handling="adaptive-penalty", max_generations=600,
                    stall_generations=None)
