@@ -143,6 +143,12 @@ def rotate_const(direction: np.ndarray, angle: np.ndarray, v: np.ndarray) -> np.
     return par + c * (v - par) + s * np.cross(w, v)
 
 
+#: ``1 − |c| / sqrt(a² + b²)`` below which :func:`solve_cos_sin` treats the roots as one.
+#: A genuine pair of roots that close (≤ 1.4e-7 rad apart) is recovered by the
+#: solver's Gauss–Newton polish.
+_DOUBLE_ROOT = 1e-14
+
+
 def solve_cos_sin(a: np.ndarray, b: np.ndarray, c: np.ndarray, slack: float = 1e-10) -> np.ndarray:
     """Both roots ``x`` of ``a·cos x + b·sin x = c``, stacked on a new last axis ``(..., 2)``.
 
@@ -153,6 +159,9 @@ def solve_cos_sin(a: np.ndarray, b: np.ndarray, c: np.ndarray, slack: float = 1e
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = c / r
     ratio = np.where(np.abs(ratio) <= 1.0 + slack, np.clip(ratio, -1.0, 1.0), np.nan)
+    # |ratio| within rounding of 1 is a double root: arccos would turn a 1e-16 rounding
+    # error into a 1e-8 angle error (a square root), so snap it to the tangent point.
+    ratio = np.where(np.abs(ratio) >= 1.0 - _DOUBLE_ROOT, np.sign(ratio), ratio)
     base = np.arctan2(b, a)
     delta = np.arccos(ratio)
     return np.stack([base + delta, base - delta], axis=-1)

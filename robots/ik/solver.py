@@ -31,6 +31,8 @@ __all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL"]
 LIMIT_TOL = 1e-9
 #: A returned solution's FK meets the target within this [m] in position and [rad] in rotation.
 FK_TOL = 1e-9
+#: Candidates whose FK misses the target by less than this [m, rad] are polished, not dropped.
+POLISH_RANGE = 1e-5
 
 _TWO_PI = 2.0 * np.pi
 _CHUNK = 8192  # targets per block
@@ -121,16 +123,57 @@ class AnalyticIK:
             valid &= np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=-1)
         rows = q[valid]
         if rows.shape[0]:
-            T = robot.fk(rows, self.frame)
             ref = np.broadcast_to(targets[:, None], (n, q.shape[1], 4, 4))[valid]
-            pos_err = np.linalg.norm(T[:, :3, 3] - ref[:, :3, 3], axis=1)
-            rot_err = np.linalg.norm((T[:, :3, :3] - ref[:, :3, :3]).reshape(-1, 9), axis=1) / np.sqrt(2.0)
-            valid[valid] = (pos_err <= FK_TOL) & (rot_err <= FK_TOL)
+            pos_err, rot_err = self._pose_errors(rows, ref)
+            ok = (pos_err <= FK_TOL) & (rot_err <= FK_TOL)
+            # Near a double root (a wrist or shoulder singularity) the closed form loses
+            # half the digits (an error ~1e-8 from a square root of a rounding error):
+            # polish those candidates with Gauss–Newton steps, then check them again.
+            near = ~ok & (pos_err < POLISH_RANGE) & (rot_err < POLISH_RANGE)
+            if near.any():
+                polished = self._polish(rows[near], ref[near])
+                pe, re = self._pose_errors(polished, ref[near])
+                fixed = (pe <= FK_TOL) & (re <= FK_TOL)
+                if respect_limits:
+                    fixed &= np.all((polished >= lo - LIMIT_TOL) & (polished <= hi + LIMIT_TOL), axis=-1)
+                rows[near] = polished
+                ok[near] = fixed
+                q[valid] = rows
+            valid[valid] = ok
         dist = np.where(valid, np.linalg.norm(q - q_ref[:, None, :], axis=-1), np.inf)
         order = np.argsort(dist, axis=1, kind="stable")
         q = np.take_along_axis(q, order[..., None], axis=1)
         valid = np.take_along_axis(valid, order, axis=1)
         return q, valid
+
+    def _pose_errors(self, q: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position error [m] and rotation error (Frobenius / √2, ≈ angle) [rad] of ``q (M, nq)``."""
+        T = self.robot.fk(q, self.frame)
+        pos_err = np.linalg.norm(T[:, :3, 3] - ref[:, :3, 3], axis=1)
+        rot_err = np.linalg.norm((T[:, :3, :3] - ref[:, :3, :3]).reshape(-1, 9), axis=1) / np.sqrt(2.0)
+        return pos_err, rot_err
+
+    def _polish(self, q: np.ndarray, ref: np.ndarray, steps: int = 3) -> np.ndarray:
+        """Gauss–Newton steps ``Δq = J⁺ e`` towards the targets ``ref (M, 4, 4)``, batched.
+
+        ``e`` stacks the position error and the small-angle rotation error
+        ``vee(R_ref Rᵀ − R R_refᵀ) / 2`` in base axes (the Jacobian's frame); the
+        pseudo-inverse keeps the step minimal where the Jacobian is singular.
+        """
+        q = q.copy()
+        for _ in range(steps):
+            T = self.robot.fk(q, self.frame)
+            J = self.robot.jacobian(q, self.frame)
+            M = ref[:, :3, :3] @ np.swapaxes(T[:, :3, :3], 1, 2)
+            e = np.concatenate(
+                [
+                    ref[:, :3, 3] - T[:, :3, 3],
+                    0.5 * np.stack([M[:, 2, 1] - M[:, 1, 2], M[:, 0, 2] - M[:, 2, 0], M[:, 1, 0] - M[:, 0, 1]], axis=1),
+                ],
+                axis=1,
+            )
+            q += (np.linalg.pinv(J, rcond=1e-10) @ e[:, :, None])[:, :, 0]
+        return q
 
     def candidates(
         self, targets: np.ndarray, q_ref: np.ndarray | None = None, *, respect_limits: bool = True

@@ -263,3 +263,21 @@ def test_ur_type_checks_intersecting_wrist_axes():
     bent = robots.from_urdf_text(text, tcp="tool0", name="ur5_bent")
     with pytest.raises(ModelError, match="do not intersect"):
         URTypeIK(bent)
+
+
+def test_aubo_double_root_at_the_joint_limits_is_exact():
+    """θ5 = 0 is a double root of the wrist-flip equation; with five joints at their limits
+    a 1e-8 rounding error would push the solution out of range: it must come back exactly."""
+    q = np.radians([-170.0, -170.0, -170.0, -170.0, 0.0, -170.0])
+    sols = _AUBO.ik_all(_AUBO.fk(q), q_ref=q)
+    assert np.abs(sols[0] - q).max() < 1e-12
+
+
+@pytest.mark.parametrize("theta5", [1e-7, -3e-8, 2e-6])
+def test_aubo_nearly_double_roots_are_polished_not_dropped(theta5):
+    q = np.array([0.4, -0.3, 1.1, 0.2, theta5, -0.7])
+    sols = _AUBO.ik_all(_AUBO.fk(q), q_ref=q)
+    # near the wrist singularity θ4 − θ6 is ill-conditioned: the FK tolerance allows ~1e-9 / |θ5|
+    assert np.abs(sols[0] - q).max() < 1e-5
+    pos, rot = _pose_errors(_AUBO, sols, np.broadcast_to(_AUBO.fk(q), (sols.shape[0], 4, 4)))
+    assert pos.max() <= FK_TOL and rot.max() <= FK_TOL
