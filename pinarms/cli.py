@@ -294,7 +294,10 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
     lines = [f"{arm.name}: {len(rows)} solution(s)  ({header})"]
     lines += [f"  {_fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m" for r in rows]
     if not rows:
-        lines.append("  none within the joint limits")
+        reason = arm.ik_failure_reason(values[:3] if position_only and not all_solutions else T,
+                                       position_only=position_only and not all_solutions)
+        data["reason"] = reason
+        lines.append(f"  none within the joint limits: {reason}")
     _emit(as_json, data, lines)
 
 
@@ -611,7 +614,7 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     if session_path:
         session = _new_session(arm, f"time-optimal {kind}")
         session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
-        if result.history is not None and hasattr(session, "add_history"):
+        if result.history is not None:
             session.add_history(f"{kind} GA", result.history)
         session.save(session_path)
         data["session"] = session_path

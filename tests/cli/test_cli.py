@@ -91,8 +91,6 @@ def test_fk_errors_are_one_line(run):
 
 def test_ik_round_trip_or_clear_error(run):
     arm = robots.load("koji_turner")
-    if not hasattr(arm, "ik"):
-        pytest.skip("numerical IK (Robot.ik) is not part of this build yet")
     result = run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg", "--json")
     data = as_json(result)
     assert data["solutions"]
@@ -100,14 +98,22 @@ def test_ik_round_trip_or_clear_error(run):
         assert sol["position_error_m"] < 1e-6
         p = arm.position(np.radians(sol["q"]))
         np.testing.assert_allclose(p * 1000, [1197.3, 250.0, -929.2], atol=1e-3)
-    assert_user_error(run("ik", "koji_turner", "10", "10", "10", ok=False), 1)
+    assert_user_error(run("ik", "koji_turner", "10", "10", "10", ok=False), 1, "out of reach")
+
+
+def test_ik_all_without_solution_says_why(run):
+    # seed 004's printed pose needs the shoulder 0.0011° past its 25° range end
+    data = as_json(run("ik", "koji_turner", "1197.3", "250", "-929.2", "0", "0", "0", "--mm", "--deg", "--all", "--json"))
+    assert data["solutions"] == []
+    assert "outside its limits" in data["reason"] and "shoulder" in data["reason"]
 
 
 def test_ik_all_needs_a_closed_form_and_pose_size(run):
-    arm = robots.load("ur5")
     assert_user_error(run("ik", "ur5", "0.1", "0.2", ok=False), 1, "3 or 6 numbers")
-    if not arm.has_analytic_ik:
-        assert_user_error(run("ik", "ur5", "0.3", "0.1", "0.4", "--all", ok=False), 1, "no closed-form IK")
+    assert not robots.load("panda").has_analytic_ik
+    assert_user_error(run("ik", "panda", "0.3", "0.1", "0.4", "--all", ok=False), 1, "no closed-form IK")
+    data = as_json(run("ik", "ur5", "0.3", "0.1", "0.4", "180", "0", "0", "--deg", "--all", "--json"))
+    assert len(data["solutions"]) >= 2
 
 
 def test_workspace_json_and_session(run, tmp_path):

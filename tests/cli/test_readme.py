@@ -23,10 +23,6 @@ def test_readme_has_the_two_commands_and_a_quickstart():
 
 @pytest.mark.slow
 def test_readme_quickstart_runs(tmp_path, monkeypatch):
-    from robots.robot import Robot
-
-    if not hasattr(Robot, "ik"):
-        pytest.skip("the quickstart uses Robot.ik (numerical IK), not part of this build yet")
     monkeypatch.chdir(tmp_path)
     code = _python_blocks()[0]
     exec(compile(code, str(README), "exec"), {"__name__": "readme"})

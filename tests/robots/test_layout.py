@@ -10,10 +10,6 @@ from robots.errors import InvalidInput
 from robots.layout import check_layout, default_orientation
 from robots.workspace import sample_workspace
 
-needs_ik = pytest.mark.skipif(
-    not (hasattr(robots.Robot, "ik_all") and hasattr(robots.Robot, "ik")),
-    reason="Robot.ik_all / Robot.ik have not landed yet",
-)
 
 
 def test_default_orientation_points_the_tool_down_for_six_axis_arms():
@@ -43,7 +39,6 @@ def test_bad_orientation_raises_invalid_input():
         check_layout(robots.load("aubo_i3"), [[0.3, 0.3, 0.2]], orientation=np.ones((3, 3)))
 
 
-@needs_ik
 @pytest.mark.parametrize("name", ["aubo_i3", "scara_mushroom", "gantry_flower", "koji_turner"])
 def test_sampled_points_are_reachable_and_far_points_are_not(name):
     robot = robots.load(name)
