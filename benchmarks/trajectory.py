@@ -6,6 +6,9 @@ Prints, for the same data, planning's time and scipy's, and their ratio:
   * building a 10-segment quintic B-spline for 6 joints (target <= 1 ms);
   * building + exact peaks of a 10-segment 3-joint quintic B-spline (the optimiser's inner
     call; scipy reference: build + peaks by dense sampling at 2 000 instants, not exact).
+Then, for a population of P = 100 timings of the same via points (what the GA evaluates
+per generation), the batched constructors and batched peaks against a Python loop of the
+single-trajectory calls, with their ratio.
 """
 
 from __future__ import annotations
@@ -78,6 +81,38 @@ def main() -> None:
         return traj3.peaks()
 
     print(f"{'exact peaks alone, 3 joints x 10 segments':<44} {best(peaks_only, 500) * 1e6:9.1f} us")
+    population(rng, q3)
+
+
+def population(rng: np.random.Generator, q3: np.ndarray, P: int = 100) -> None:
+    """Batched constructors and peaks for P timings vs a loop of single calls."""
+    times = np.concatenate([np.zeros((P, 1)), np.cumsum(H * rng.uniform(0.5, 1.5, (P, H.size)), axis=1)], axis=1)
+    t353 = np.concatenate([np.zeros((P, 1)), np.cumsum(rng.uniform(0.5, 2.0, (P, 3)), axis=1)], axis=1)
+    q353 = np.radians([55.5, 69.7, 106.5, 124.5])
+    print(f"\npopulation of P = {P} timings{'':<23} {'batched':>12} {'loop':>12} {'ratio':>8}")
+    cases = [
+        ("quintic B-spline, 10 segments, 3 joints", lambda: planning.quintic_bspline_batch(times, q3),
+         lambda: [planning.quintic_bspline(t, q3) for t in times]),
+        ("multi-quintic, 10 segments, 3 joints", lambda: planning.multi_quintic_batch(times, q3),
+         lambda: [planning.multi_quintic(t, q3) for t in times]),
+        ("3-5-3, 1 joint (seed 000)", lambda: planning.piecewise_polynomial_batch(t353, q353),
+         lambda: [planning.piecewise_polynomial(t, q353) for t in t353]),
+    ]
+    for label, batched, loop in cases:
+        row(f"build {label}", best(batched, 20), best(loop, 2), None)
+    coefs = planning.quintic_bspline_batch(times, q3)
+    trajs = [planning.Trajectory(t, c) for t, c in zip(times, coefs)]
+
+    def loop_peaks():
+        for tr in trajs:
+            tr._norm = None  # drop the cache: measure the full peak search
+            tr.peaks()
+
+    row("exact peaks, B-spline population", best(lambda: planning.peaks_batch(times, coefs), 20),
+        best(loop_peaks, 2), None)
+    row("build + peaks, B-spline population",
+        best(lambda: planning.peaks_batch(times, planning.quintic_bspline_batch(times, q3)), 20),
+        best(lambda: [planning.quintic_bspline(t, q3).peaks() for t in times], 2), None)
 
 
 if __name__ == "__main__":
