@@ -46,12 +46,17 @@ class _PeaksLike(Protocol):
 
 
 class _TrajectoryLike(Protocol):
+    """What a custom builder must return (a :class:`planning.Trajectory` does)."""
+
+    knot_times: np.ndarray
+    coefficients: np.ndarray
+
     def peaks(self) -> _PeaksLike: ...
 
 
 #: Maps (knot times (m+1,), positions (m+1, n)) to a trajectory with ``peaks()``,
-#: ``coefficients`` and ``knot_times``.
-Builder = Callable[[np.ndarray, np.ndarray], Any]
+#: ``coefficients`` and ``knot_times`` (see ``_TrajectoryLike``).
+Builder = Callable[[np.ndarray, np.ndarray], "_TrajectoryLike"]
 
 #: Maps (knot times (P, m+1), positions (m+1, n)) to coefficients (P, m, K+1, n).
 BatchBuilder = Callable[[np.ndarray, np.ndarray], np.ndarray]
