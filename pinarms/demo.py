@@ -136,8 +136,23 @@ def study_000(quick: bool = False) -> Study:
     session.add_trajectory("353_initial_2-2-2s",
                            planning.piecewise_polynomial(paper.initial_knot_times_s, q_via, degrees=(3, 5, 3)))
     session.add_history("ga_time", ga.history)
+    _add_line_objects(session, arm.position(q_via[0]), arm.position(q_via[-1]))
     plots = _plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised")
     return Study("000", "SCARA enoki-mushroom packer: 3-5-3 + GA timing", rows, session, plots)
+
+
+def _add_line_objects(session: Any, pick_m: np.ndarray, place_m: np.ndarray) -> None:
+    """The packing line around the SCARA: the mushroom conveyor under the pick point and
+    the box under the place point (both tops 20 mm below the tool point), for the viewer."""
+    belt = np.array([0.12, 0.70, 0.03])  # m: width (radial), length (tangential), thickness
+    crate = np.array([0.15, 0.20, 0.10])  # m
+    for name, size, at, rgba in (("mushroom_conveyor", belt, pick_m, (0.25, 0.25, 0.25, 1.0)),
+                                 ("packing_box", crate, place_m, (0.80, 0.65, 0.40, 1.0))):
+        yaw = np.arctan2(at[1], at[0])  # local x radial from the base axis, local y tangential
+        pose = np.eye(4)
+        pose[:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]
+        pose[:3, 3] = [at[0], at[1], at[2] - 0.02 - size[2] / 2]
+        session.add_box(name, size, pose, color=rgba)
 
 
 # --------------------------------------------------------------------- seed 001

@@ -277,7 +277,7 @@ def _place_camera(vis: meshcat.Visualizer, lo: np.ndarray, hi: np.ndarray) -> No
     (three.js), so the world point (x, y, z) is written (x, z, -y).
     """
     reach = float(np.max(np.abs(np.vstack([lo, hi])))) if np.any(hi > lo) else 1.0
-    d = 1.7 * max(reach, 0.3)
+    d = 2.6 * max(reach, 0.3)
     x, y, z = 0.75 * d, -0.55 * d, 0.45 * d
     vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
 
