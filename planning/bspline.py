@@ -6,21 +6,26 @@ and snap are continuous, which is why seed 002 takes k = 5 (k >= 4 is needed for
 continuous jerk). The four extra conditions of an odd-degree interpolating spline are the
 end velocities and accelerations (zero unless given).
 
-The spline is computed in its piecewise-polynomial form: m quintic pieces (6m unknowns)
-fixed by the positions at both ends of every piece (2m), continuity of derivatives 1..4 at
-the m-1 interior knots (4(m-1)) and the end velocities and accelerations (4). This is the
-system of :mod:`planning.piecewise` with degrees 5-5-...-5, ``continuity=4`` and
-``end_order=2``, solved by the same code (batched over timings); a C⁴ quintic spline
-through the points with these end conditions is unique, so it *is* the B-spline of
-:func:`scipy.interpolate.make_interp_spline` (``k=5``, first and second derivatives given
-at both ends), which the tests check to 1e-9.
+:func:`quintic_bspline` builds it with scipy's B-spline machinery
+(:func:`scipy.interpolate.make_interp_spline`, ``k=5``, first and second derivatives given
+at both ends) and converts it to the common piecewise-polynomial form by evaluating the
+derivatives at the start of every piece.
+
+:func:`quintic_bspline_batch` serves the optimiser, which needs the spline for a whole
+population of timings at once: a C⁴ quintic spline through the points with these end
+conditions is unique, so it solves the equivalent piecewise system (m quintic pieces, 6m
+unknowns: positions at both ends of every piece, continuity of derivatives 1..4 at the
+m-1 interior knots, the 4 end conditions) with :mod:`planning.piecewise`'s batched solver.
+The tests check that both give the same coefficients.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import make_interp_spline
 
 from planning import _inputs
 from planning.piecewise import solve_coefficients
@@ -58,7 +63,8 @@ def quintic_bspline_batch(
 
     Returns:
         (P, m, 6, n_joints) coefficients in ascending powers of the time since each piece's
-        start; row p is ``quintic_bspline(times[p], ...).coefficients`` (same code).
+        start; row p equals ``quintic_bspline(times[p], ...).coefficients`` (the same spline,
+        solved as a piecewise system instead of by scipy).
     """
     t = _inputs.knot_times_batch(times)
     q = _inputs.via_positions(positions, t.shape[1])
@@ -94,7 +100,10 @@ def quintic_bspline(
                                                 "end_velocity": end_velocity,
                                                 "start_acceleration": start_acceleration,
                                                 "end_acceleration": end_acceleration})
-    coefs = solve_coefficients(t[None], q, (5,) * (t.size - 1), 4, 2, start, end)[0]
+    spline = make_interp_spline(
+        t, q, k=5, bc_type=([(1, start[0]), (2, start[1])], [(1, end[0]), (2, end[1])])
+    )
+    coefs = np.stack([spline(t[:-1], nu=k) / math.factorial(k) for k in range(6)], axis=1)
     definition = {"kind": "quintic_bspline", "times": t.tolist(), "positions": q.tolist()}
     definition.update({k: v.tolist() for k, v in vals.items()})
     return Trajectory(t, coefs, definition)
