@@ -196,7 +196,6 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
     """
     settings = GASettings() if settings is None else settings
     lower, upper = _check_bounds(bounds)
-    dim = lower.shape[0]
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     G = settings.max_generations if max_generations is None else int(max_generations)
     stall = settings.stall_generations if stall_generations is None else int(stall_generations)

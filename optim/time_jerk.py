@@ -28,7 +28,7 @@ from scipy.optimize import minimize
 
 from optim.engine import GAHistory, run_ga
 from optim.errors import InfeasibleProblem, InvalidSettings
-from optim.exact import scaled_to_limits, solve_exact
+from optim.exact import solve_exact
 from optim.problem import SAFETY, TimingProblem
 from optim.settings import GASettings
 from optim.timing import minimize_time
@@ -101,12 +101,8 @@ def _jerk_integrals(coefs: np.ndarray, seg: np.ndarray) -> np.ndarray:
 
 def jerk_integral_batch(problem: TimingProblem, population: np.ndarray) -> np.ndarray:
     """J(h) for a population of durations (pop, m) -> (pop,)."""
-    h = np.atleast_2d(np.asarray(population, dtype=float))
-    trajs = [problem.trajectory(row) for row in h]
-    problem.evaluations += h.shape[0]
-    coefs = np.stack([np.asarray(t.coefficients, dtype=float) for t in trajs])
-    seg = np.stack([np.diff(np.asarray(t.knot_times, dtype=float)) for t in trajs])
-    return _jerk_integrals(coefs, seg)
+    times, coefs = problem.coefficients_batch(population)
+    return _jerk_integrals(coefs, np.diff(times, axis=1))
 
 
 def _ratio_search(problem: TimingProblem, cost, starts: list[np.ndarray], maxfev: int) -> np.ndarray:

@@ -324,7 +324,7 @@ class WorkspaceSummary:
             ),
             f"  near-singular (σmin/σmax of J_v < {self.singular_threshold:g}): {self.singular_share:.1%}",
             f"  position manipulability: mean {self.manipulability_mean:.4g}, max {self.manipulability_max:.4g}",
-            f"  radial profile around the sphere centre (shell [mm]: samples, share near-singular):",
+            "  radial profile around the sphere centre (shell [mm]: samples, share near-singular):",
         ]
         p = self.profile
         for lo, hi, n, sing in zip(p.edges[:-1], p.edges[1:], p.counts, p.singular_share):

@@ -98,7 +98,7 @@ class KojiIK(AnalyticIK):
         W = np.asarray(wrist_points, dtype=float)
         N = W.shape[0]
         w1, w2 = self.waist.direction, self.shoulder.direction
-        p1, p2, p4 = self.waist.point, self.shoulder.point, self.wrist.point
+        p1, p4 = self.waist.point, self.wrist.point
         v1 = W - p1
         k12 = w1 @ w2
         vw1 = v1 @ w1

@@ -105,7 +105,6 @@ class AnalyticIK:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Solutions of one chunk as ``q (n, K, nq)`` sorted by distance to ``q_ref`` and ``valid (n, K)``."""
         robot = self.robot
-        nq = robot.nq
         q = self.raw(targets, q_ref)
         n, B = q.shape[:2]
         rev = self._revolute

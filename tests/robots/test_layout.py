@@ -50,7 +50,7 @@ def test_sampled_points_are_reachable_and_far_points_are_not(name):
     report = check_layout(robot, np.concatenate([poses, far[None]]), workspace=ws)
     assert report.reachable.tolist() == [True, True, True, False]
     assert not report.all_reachable
-    for check, qi in zip(report.points[:3], q):
+    for check in report.points[:3]:
         # every branch meets the target and respects the limits
         np.testing.assert_allclose(robot.fk(check.solutions)[:, :3, 3], check.target[None, :3, 3].repeat(check.n_branches, 0), atol=1e-6)
         assert np.all(robot.within_limits(check.solutions))

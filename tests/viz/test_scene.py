@@ -8,7 +8,6 @@ import re
 import numpy as np
 import pytest
 
-import robots
 import viz
 from robots.errors import InvalidInput
 from viz.scene import build_scene, colors_by_value
