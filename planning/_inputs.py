@@ -66,6 +66,14 @@ def knot_times_batch(times: Any, what: str = "times", minimum: int = 2) -> np.nd
     return t
 
 
+def scalar(value: Any, what: str) -> float:
+    """A finite real number given as a Python/numpy scalar or a 0-d array."""
+    arr = finite_array(value, what)
+    if arr.ndim != 0:
+        raise TrajectoryError(f"{what} must be a single number, got shape {arr.shape}: {value!r}")
+    return float(arr)
+
+
 def durations(values: Any, what: str = "durations") -> np.ndarray:
     """Positive segment durations (s) as a (m,) array."""
     h = finite_array(values, what)

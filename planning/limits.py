@@ -55,7 +55,13 @@ class JointLimits:
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
         if self.lower is not None and self.upper is not None:
-            lo, hi = np.broadcast_arrays(self.lower, self.upper)
+            try:
+                lo, hi = np.broadcast_arrays(self.lower, self.upper)
+            except ValueError:
+                raise TrajectoryError(
+                    f"lower and upper position limits must have the same number of joints, got "
+                    f"{self.lower.size} and {self.upper.size} entries"
+                ) from None
             if np.any(lo >= hi):
                 i = int(np.argmax(np.atleast_1d(lo >= hi)))
                 raise TrajectoryError(

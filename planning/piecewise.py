@@ -50,7 +50,13 @@ def _degrees(degrees: str | Sequence[int]) -> tuple[int, ...]:
             raise TrajectoryError(
                 f"degrees {degrees!r} is not a preset ({sorted(PRESETS)}) nor a pattern like '3-5-3'"
             ) from None
-    out = tuple(degrees)
+    try:
+        out = tuple(degrees)
+    except TypeError:
+        raise TrajectoryError(
+            f"degrees must be a sequence of positive integers (one per segment) or a preset "
+            f"{sorted(PRESETS)}, got {degrees!r}"
+        ) from None
     if not out or any(isinstance(d, bool) or not isinstance(d, (int, np.integer)) or d < 1 for d in out):
         raise TrajectoryError(f"degrees must be positive integers, one per segment, got {degrees!r}")
     return tuple(int(d) for d in out)

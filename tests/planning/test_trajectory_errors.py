@@ -91,3 +91,28 @@ def test_joint_limits_from_a_robot_like_object():
     traj = planning.multi_quintic([0, 1], [[0.0, 0.0], [0.5, 2.5]])
     kinds = {(v.joint, v.kind) for v in traj.check(lim).violations}
     assert kinds == {(1, "position_upper"), (1, "velocity"), (1, "acceleration")}  # 2.5 rad in 1 s
+
+
+@pytest.mark.parametrize("degrees", [None, 5, 3.0])
+def test_degrees_that_are_not_a_sequence_are_named(degrees):
+    with pytest.raises(TrajectoryError, match=f"degrees must be a sequence.*got {degrees!r}"):
+        planning.piecewise_polynomial([0, 1, 2, 3], [0.0, 1.0, 0.5, 2.0], degrees)
+
+
+def test_scalar_arguments_refuse_arrays_and_huge_sample_counts():
+    traj = planning.quintic_bspline([0.0, 1.0, 3.0], [0.0, 1.0, 2.0])
+    with pytest.raises(TrajectoryError, match=r"hz must be a single number, got shape \(2,\)"):
+        traj.at_rate([1, 2])
+    with pytest.raises(TrajectoryError, match=r"factor must be a single number"):
+        traj.scaled([1.0, 2.0])
+    with pytest.raises(TrajectoryError, match=r"start_time must be a single number"):
+        traj.shifted(np.zeros(3))
+    # 1e12 Hz over 3 s would be 3e12 instants: refused, named, before any allocation.
+    with pytest.raises(TrajectoryError, match=r"hz = 1e\+12 over 3 s gives 3000000000004 instants"):
+        traj.at_rate(1e12)
+    assert traj.at_rate(np.float64(10.0))[0].shape == (31,)
+
+
+def test_joint_limits_with_position_bounds_of_different_lengths():
+    with pytest.raises(TrajectoryError, match="same number of joints, got 2 and 3"):
+        JointLimits(velocity=1.0, lower=[0.0, 1.0], upper=[1.0, 2.0, 3.0])
