@@ -51,6 +51,35 @@ def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
     return arr, single
 
 
+def check_seed(seed: Any, what: str = "seed") -> Any:
+    """``seed`` unchanged if it is ``None``, a non-negative int or a ``numpy.random.Generator``.
+
+    Raises:
+        InvalidInput: anything else (a negative or fractional number, a string, ...).
+    """
+    if seed is None or isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInput(f"{what} must be None, a non-negative integer or a numpy.random.Generator, got {seed!r}")
+    return seed
+
+
+def as_generator(seed: Any, what: str = "seed") -> np.random.Generator:
+    """``seed`` (see :func:`check_seed`) as a ``numpy.random.Generator`` (a Generator is returned as is)."""
+    seed = check_seed(seed, what)
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+
+
+def check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
+    """``tol`` as a finite float ``>= 0`` (``> 0`` when ``positive``); :class:`InvalidInput` otherwise."""
+    ok = isinstance(tol, (int, float, np.integer, np.floating)) and not isinstance(tol, bool)
+    value = float(tol) if ok else float("nan")
+    if not (np.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
+        sign = "positive" if positive else "non-negative"
+        raise InvalidInput(f"{what} must be a finite {sign} number, got {tol!r}")
+    return value
+
+
 class Robot:
     """A robot arm: Pinocchio model plus batched kinematics.
 
@@ -151,6 +180,7 @@ class Robot:
     def within_limits(self, q: Any, tol: float = 1e-9) -> bool | np.ndarray:
         """Whether ``q`` lies within the position limits (``tol`` in rad or m); never clamps."""
         arr, single = self.check_q(q)
+        tol = check_tolerance(tol, "limit tolerance tol [rad or m]")
         ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=1)
         return bool(ok[0]) if single else ok
 
@@ -159,6 +189,7 @@ class Robot:
         arr, single = self.check_q(q)
         if not single:
             raise InvalidInput("limit_violations takes one configuration of shape (nq,)")
+        tol = check_tolerance(tol, "limit tolerance tol [rad or m]")
         out = []
         for name, v, lo, hi in zip(self.joint_names, arr[0], self.lower, self.upper):
             if v < lo - tol or v > hi + tol:
@@ -167,9 +198,9 @@ class Robot:
 
     def random_q(self, n: int, seed: int | np.random.Generator | None = 0) -> np.ndarray:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
-        if not isinstance(n, (int, np.integer)) or n <= 0:
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
-        rng = np.random.default_rng(seed)
+        rng = as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
     # ------------------------------------------------------------- kinematics
@@ -254,6 +285,8 @@ class Robot:
                 raise InvalidInput(
                     f"IK target must be a pose of shape (4, 4) or (N, 4, 4){extra}, got shape {np.shape(target)}"
                 )
+        if arr.shape[0] == 0:
+            return arr, single
         if not np.all(np.isfinite(arr)):
             raise InvalidInput("IK target holds a non-finite value (NaN or inf)")
         if not position_only or not single or np.shape(target) == (4, 4):
@@ -298,6 +331,8 @@ class Robot:
                 "use Robot.ik for a numerical solution"
             )
         T, single = self.check_target(target)
+        if T.shape[0] == 0:
+            return []
         ref = None
         if q_ref is not None:
             ref, _ = self.check_q(q_ref)
@@ -418,8 +453,10 @@ class Robot:
         T, single = self.check_target(target, position_only=position_only)
         if not single:
             raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
-        if not (isinstance(tol, (int, float)) and tol > 0.0):
-            raise InvalidInput(f"tol must be a positive number [m, rad], got {tol!r}")
+        tol = check_tolerance(tol, "tol [m, rad]", positive=True)
+        if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
+            raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+        check_seed(seed)
         seed_q = None
         if q_seed is not None:
             seed_q, _ = self.check_q(q_seed)

@@ -281,3 +281,8 @@ def test_aubo_nearly_double_roots_are_polished_not_dropped(theta5):
     assert np.abs(sols[0] - q).max() < 1e-5
     pos, rot = _pose_errors(_AUBO, sols, np.broadcast_to(_AUBO.fk(q), (sols.shape[0], 4, 4)))
     assert pos.max() <= FK_TOL and rot.max() <= FK_TOL
+
+
+def test_empty_batch_of_targets_gives_an_empty_list():
+    assert _AUBO.ik_all(np.zeros((0, 4, 4))) == []
+    assert _AUBO.fk(np.zeros((0, 6))).shape == (0, 4, 4)

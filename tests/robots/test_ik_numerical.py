@@ -290,3 +290,29 @@ def test_position_only_newton_steps_converge_quadratically(arm):
         q2, pe, _, its = solver.attempt(q_off, T, True, 1e-12, limits=False)
         assert pe <= 1e-12 and its <= 3
         assert np.linalg.norm(arm.position(q2) - T[:3, 3]) <= 1e-12
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"tol": np.inf}, "tol"),
+        ({"tol": np.nan}, "tol"),
+        ({"tol": -1e-6}, "tol"),
+        ({"max_restarts": -1}, "max_restarts"),
+        ({"max_restarts": 2.5}, "max_restarts"),
+        ({"seed": -3}, "seed must be"),
+        ({"seed": "abc"}, "seed must be"),
+    ],
+)
+def test_invalid_solver_settings_are_named(kwargs, message):
+    """An infinite tol would accept any configuration; bad counts and seeds are named, not ignored."""
+    panda = robots.load("panda")
+    with pytest.raises(InvalidInput, match=message):
+        panda.ik(panda.fk(panda.neutral), **kwargs)
+
+
+def test_numpy_float_tolerance_is_accepted():
+    ur5 = robots.load("ur5")
+    q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])
+    sol = ur5.ik(ur5.fk(q), q_seed=q, tol=np.float32(1e-6))
+    assert np.linalg.norm(ur5.position(sol) - ur5.position(q)) <= 1e-6

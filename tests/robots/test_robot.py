@@ -216,3 +216,23 @@ def test_unknown_tcp_frame_raises_model_error(tmp_path):
     with pytest.raises(ModelError, match="no frame 'gripper' to use as tcp"):
         robots.from_urdf(path, tcp="gripper")
     assert robots.from_urdf(path).tcp_frame == "tcp"
+
+
+@pytest.mark.parametrize("tol", [-1e-3, np.nan, np.inf, "0.1", True])
+def test_limit_tolerance_must_be_finite_and_non_negative(tol):
+    robot = robots.load("ur5")
+    with pytest.raises(InvalidInput, match="limit tolerance tol"):
+        robot.within_limits(robot.neutral, tol=tol)
+    with pytest.raises(InvalidInput, match="limit tolerance tol"):
+        robot.limit_violations(robot.neutral, tol=tol)
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, "abc", True])
+def test_random_q_rejects_bad_seeds_and_counts(seed):
+    robot = robots.load("ur5")
+    with pytest.raises(InvalidInput, match="seed must be"):
+        robot.random_q(3, seed=seed)
+    with pytest.raises(InvalidInput, match="positive integer"):
+        robot.random_q(True)
+    gen = np.random.default_rng(7)
+    assert np.array_equal(robot.random_q(4, seed=gen), robot.random_q(4, seed=np.random.default_rng(7)))
