@@ -25,7 +25,7 @@ from optim.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feas
 from optim.errors import InvalidSettings
 from optim.settings import GASettings
 
-__all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress"]
+__all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress", "random_generator"]
 
 Objective = Callable[[np.ndarray], np.ndarray]
 
@@ -91,6 +91,23 @@ class GAResult:
     wall_time: float
 
 
+def random_generator(seed: int | np.random.Generator) -> np.random.Generator:
+    """The random generator of a run: a given Generator, or one seeded by a non-negative int."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidSettings(f"seed={seed!r}: give a non-negative integer or a "
+                              "numpy.random.Generator")
+    return np.random.default_rng(int(seed))
+
+
+def _count(value: object, name: str, minimum: int) -> int:
+    """An integer option >= minimum (generations)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise InvalidSettings(f"{name}={value!r}: use an integer >= {minimum}")
+    return int(value)
+
+
 def _check_bounds(bounds: np.ndarray | tuple) -> tuple[np.ndarray, np.ndarray]:
     b = np.asarray(bounds, dtype=float)
     if b.ndim == 2 and b.shape[0] == 2 and b.shape[1] != 2:
@@ -143,9 +160,15 @@ def _initial_population(evaluate: _Evaluator, lower: np.ndarray, upper: np.ndarr
     dim = lower.shape[0]
     rows: list[np.ndarray] = []
     if initial is not None:
-        init = np.atleast_2d(np.asarray(initial, dtype=float))
-        if init.shape[1] != dim:
+        try:
+            init = np.atleast_2d(np.asarray(initial, dtype=float))
+        except (TypeError, ValueError):
+            raise InvalidSettings(f"initial={initial!r} is not numeric: give (k, {dim}) "
+                                  "individuals") from None
+        if init.ndim != 2 or init.shape[1] != dim:
             raise InvalidSettings(f"initial of shape {init.shape}: rows must have {dim} genes")
+        if not np.all(np.isfinite(init)):
+            raise InvalidSettings("initial individuals hold NaN or inf: give finite genes")
         if np.any(init < lower - 1e-12) or np.any(init > upper + 1e-12):
             raise InvalidSettings("initial individuals must lie within the bounds")
         rows.append(np.clip(init[:pop], lower, upper))
@@ -195,12 +218,17 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
         :class:`GAResult`. ``feasible`` is False if no feasible individual was ever seen.
     """
     settings = GASettings() if settings is None else settings
+    if not isinstance(settings, GASettings):
+        raise InvalidSettings(f"settings must be an optim.GASettings, got {type(settings).__name__}")
     lower, upper = _check_bounds(bounds)
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    G = settings.max_generations if max_generations is None else int(max_generations)
-    stall = settings.stall_generations if stall_generations is None else int(stall_generations)
-    if G < 0:
-        raise InvalidSettings(f"max_generations={G}: use >= 0")
+    rng = random_generator(seed)
+    G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
+    stall = (settings.stall_generations if stall_generations is None
+             else _count(stall_generations, "stall_generations", 1))
+    if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))
+                                       and np.isfinite(time_limit) and time_limit >= 0):
+        raise InvalidSettings(f"time_limit={time_limit!r}: give a finite number of seconds >= 0 "
+                              "or None")
     pop = settings.population
     t0 = time.perf_counter()
     evaluate = _Evaluator(objective, constraints)

@@ -91,6 +91,17 @@ class GASettings:
     stall_tolerance: float = 1e-9
 
     def __post_init__(self) -> None:
+        try:
+            self._validate()
+        except TypeError:  # e.g. None or a string where a number belongs
+            fields = {k: v for k, v in self.__dict__.items()
+                      if k not in ("selection", "crossover", "mutation", "constraint_handling",
+                                   "adaptive")
+                      and not (v is None and k == "stall_generations")
+                      and (isinstance(v, bool) or not isinstance(v, (int, float)))}
+            raise InvalidSettings(f"GASettings: {fields} must be numbers") from None
+
+    def _validate(self) -> None:
         def bad(name: str, value: object, what: str) -> InvalidSettings:
             return InvalidSettings(f"GASettings.{name}={value!r}: {what}")
 

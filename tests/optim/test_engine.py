@@ -136,3 +136,27 @@ def test_presets_match_papers():
     assert s2.adaptive and s2.selection == "tournament" and s2.elitism >= 1
     assert s2.mutation == "non-uniform" and s2.nonuniform_shape == 2.0
     assert s2.constraint_handling == "adaptive-penalty"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"seed": -1}, "seed=-1"),
+    ({"seed": 1.5}, "seed=1.5"),
+    ({"seed": "a"}, "seed='a'"),
+    ({"time_limit": float("nan")}, "time_limit=nan"),
+    ({"time_limit": -1.0}, "time_limit=-1.0"),
+    ({"stall_generations": 0}, "stall_generations=0"),
+    ({"max_generations": 2.5}, "max_generations=2.5"),
+    ({"initial": [[0.1, float("nan")]]}, "NaN or inf"),
+    ({"initial": "x"}, "initial='x' is not numeric"),
+    ({"settings": "fast"}, "settings must be an optim.GASettings"),
+])
+def test_bad_run_options_raise_named_errors(kwargs, message):
+    # A NaN time limit used to be ignored silently (elapsed >= nan is never true).
+    with pytest.raises(InvalidSettings, match=message.replace("(", r"\(").replace(".", r"\.")):
+        run_ga(sphere, [(-1, 1), (-1, 1)], **{"settings": GASettings(), **kwargs})
+
+
+@pytest.mark.parametrize("field", ["population", "crossover_probability", "elitism"])
+def test_settings_with_non_numbers_raise_named_errors(field):
+    with pytest.raises(InvalidSettings, match=f"'{field}': None"):
+        GASettings(**{field: None})
