@@ -23,6 +23,7 @@ where ``v, a, k`` are the peaks at total 1.
 
 from __future__ import annotations
 
+import inspect
 from typing import Any, Callable, Protocol
 
 import numpy as np
@@ -37,6 +38,9 @@ KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
 
 #: Relative margin under the limits kept by rescaled answers (round-off safety).
 SAFETY = 1e-9
+
+#: Factor on the default upper duration bound ``s0 * min(1, 4 / m)`` (see ``TimingProblem``).
+DEFAULT_UPPER_MARGIN = 1.001
 
 
 class _PeaksLike(Protocol):
@@ -93,20 +97,20 @@ def _planning_builders(kind: str, options: dict[str, Any]) -> tuple[Builder, Bat
     import planning  # optim sits above planning in the one-way flow
 
     if kind == "3-5-3":
-        # Cubic first and last segments, quintics between (3-5-3 for three segments).
-        def with_degrees(t: np.ndarray) -> dict[str, Any]:
-            m = t.shape[-1] - 1
-            return {"degrees": (3,) + (5,) * (m - 2) + (3,) if m >= 2 else (5,), **options}
-
-        return (lambda t, q: planning.piecewise_polynomial(t, q, **with_degrees(t)),
-                lambda t, q: planning.piecewise_polynomial_batch(t, q, **with_degrees(t)))
-    if kind == "multi-quintic":
-        return (lambda t, q: planning.multi_quintic(t, q, **options),
-                lambda t, q: planning.multi_quintic_batch(t, q, **options))
-    if kind == "quintic-bspline":
-        return (lambda t, q: planning.quintic_bspline(t, q, **options),
-                lambda t, q: planning.quintic_bspline_batch(t, q, **options))
-    raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of {KINDS}")
+        single, batch = planning.piecewise_polynomial, planning.piecewise_polynomial_batch
+        options = {"degrees": (3, 5, 3), **options}
+    elif kind == "multi-quintic":
+        single, batch = planning.multi_quintic, planning.multi_quintic_batch
+    elif kind == "quintic-bspline":
+        single, batch = planning.quintic_bspline, planning.quintic_bspline_batch
+    else:
+        raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of {KINDS}")
+    known = [p for p in inspect.signature(batch).parameters if p not in ("times", "positions")]
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise InvalidSettings(f"trajectory_options {unknown} are not options of the {kind!r} "
+                              f"constructor; it takes {known}")
+    return (lambda t, q: single(t, q, **options), lambda t, q: batch(t, q, **options))
 
 
 class TimingProblem:
@@ -114,7 +118,7 @@ class TimingProblem:
 
     Args:
         positions: (m+1, n_joints) or (m+1,) via points, SI (rad or m).
-        kind: ``"3-5-3"``, ``"multi-quintic"`` or ``"quintic-bspline"``.
+        kind: ``"3-5-3"`` (exactly 4 via points), ``"multi-quintic"`` or ``"quintic-bspline"``.
         vmax: Velocity limit per joint (scalar or (n_joints,)), rad/s or m/s. Required.
         amax: Acceleration limit per joint, rad/s^2 or m/s^2, or None.
         jmax: Jerk limit per joint, rad/s^3 or m/s^3, or None.
@@ -130,7 +134,11 @@ class TimingProblem:
                  jmax: Any = None, bounds: Any = None,
                  trajectory_options: dict[str, Any] | None = None,
                  builder: Builder | None = None) -> None:
-        q = np.asarray(positions, dtype=float)
+        try:
+            q = np.asarray(positions, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidInput(f"positions={positions!r} are not numeric: give (m+1,) or "
+                               "(m+1, n_joints) via points (rad or m)") from None
         if q.ndim == 1:
             q = q[:, None]
         if q.ndim != 2 or q.shape[0] < 2:
@@ -141,6 +149,10 @@ class TimingProblem:
         if kind not in KINDS:
             raise InvalidInput(f"kind={kind!r} is not a known trajectory family: use one of "
                                f"{KINDS}")
+        if kind == "3-5-3" and q.shape[0] != 4:
+            raise InvalidInput(f"kind='3-5-3' has 3 segments and needs 4 via points, got "
+                               f"{q.shape[0]}; for another count use 'multi-quintic' or "
+                               "'quintic-bspline'")
         self.positions = q
         self.kind = kind
         self.n_segments = q.shape[0] - 1
@@ -280,9 +292,16 @@ class TimingProblem:
     def _check_bounds(self, bounds: Any) -> np.ndarray:
         m = self.n_segments
         if bounds is None:
+            # The upper bound keeps a 0.1 % margin over s0 * min(1, 4/m): with one segment
+            # the only feasible durations are s0 (1 + SAFETY) and above.
             s0 = self.reference_total()
-            return np.tile([s0 / (20.0 * m), s0 * min(1.0, 4.0 / m)], (m, 1))
-        b = np.asarray(bounds, dtype=float)
+            return np.tile([s0 / (20.0 * m), s0 * min(1.0, 4.0 / m) * DEFAULT_UPPER_MARGIN],
+                           (m, 1))
+        try:
+            b = np.asarray(bounds, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidSettings(f"bounds={bounds!r} are not numeric: give (lower, upper) in s, "
+                                  f"or ({m}, 2) rows") from None
         if b.shape == (2,):
             b = np.tile(b, (m, 1))
         if b.shape != (m, 2):

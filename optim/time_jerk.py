@@ -11,10 +11,12 @@ Two formulations:
 - ``mode="two-stage"`` (seed 002): first the minimum time T* (:func:`minimize_time`),
   then minimum J(h) under the limits with ``T <= time_factor * T*``.
 
-``method="exact"`` uses the scaling laws: for ratios r and total s, J = J1(r) s^-5 with
-J1 the cost at total 1, so the best s for given ratios is known in closed form (weighted:
-``s = (5 k_J J1 / k_T)^(1/6)`` clipped to the feasible interval; two-stage: the largest
-allowed s); Nelder-Mead then optimises the ratios. ``method="ga"`` runs the GA on h.
+``method="exact"`` runs SLSQP on the durations h (smooth objective, the peak of every
+piece as its own constraint, the time cap as a linear constraint, forward-difference
+gradients of all perturbed timings in one batched evaluation), started from the exact
+time-optimal answer (weighted: the time-optimal timing; two-stage: T* scaled up to the
+cap). For ratios r and total s, J = J1(r) s^-5 (J1 the cost at total 1), so the
+two-stage optimum uses the whole allowed time (unless the upper bounds stop it). ``method="ga"`` runs the GA on h.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from optim.engine import GAHistory, run_ga
+from optim.engine import GAHistory, random_generator, run_ga
 from optim.errors import InfeasibleProblem, InvalidSettings
 from optim.exact import solve_exact
 from optim.problem import SAFETY, TimingProblem
@@ -105,26 +107,6 @@ def jerk_integral_batch(problem: TimingProblem, population: np.ndarray) -> np.nd
     return _jerk_integrals(coefs, np.diff(times, axis=1))
 
 
-def _ratio_search(problem: TimingProblem, cost, starts: list[np.ndarray], maxfev: int) -> np.ndarray:
-    """Nelder-Mead over softmax coordinates of the ratios; returns the best durations."""
-    best_h, best_val = None, np.inf
-    for r0 in starts:
-        z = np.log(np.asarray(r0, dtype=float) / np.sum(r0))
-        val, h = cost(z)
-        for _ in range(3 if problem.n_segments > 1 else 0):  # restarts: NM stalls in 10-D
-            res = minimize(lambda x: cost(x)[0], z, method="Nelder-Mead",
-                           options={"xatol": 1e-9, "fatol": 1e-14, "maxfev": maxfev,
-                                    "adaptive": problem.n_segments > 3})
-            if not res.fun < val * (1.0 - 1e-9):
-                break
-            z = res.x
-            val, h = cost(z)
-        if val < best_val:
-            best_h, best_val = h, val
-    assert best_h is not None
-    return best_h
-
-
 def _interval(problem: TimingProblem, r: np.ndarray) -> tuple[float, float]:
     """Feasible totals [s_min, s_max] for ratios r (limits and bounds)."""
     s_min = problem.minimal_scale(r) * (1.0 + SAFETY)
@@ -193,7 +175,7 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
             :func:`optim.minimize_time`.
         mode: ``"two-stage"`` (seed 002: time-optimal first, then minimum jerk with
             ``T <= time_factor * T*``) or ``"weighted"`` (min ``k_time T + k_jerk J``).
-        method: ``"ga"`` or ``"exact"`` (scaling laws + Nelder-Mead on the ratios).
+        method: ``"ga"`` or ``"exact"`` (SLSQP from the exact time-optimal timing).
         k_time: Weight of the total time (1/s units of the objective).
         k_jerk: Weight of the jerk integral (objective units per unit^2/s^5).
         time_factor: Two-stage: allowed total over the time-optimal total (>= 1).
@@ -209,9 +191,15 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
         raise InvalidSettings(f"mode={mode!r}: use one of {MODES}")
     if method not in ("ga", "exact"):
         raise InvalidSettings(f"method={method!r}: use 'ga' or 'exact'")
-    if mode == "two-stage" and not (np.isfinite(time_factor) and time_factor >= 1.0):
+    random_generator(seed)  # refuse a bad seed before any work
+    def number(value: Any) -> bool:
+        return isinstance(value, (int, float, np.number)) and not isinstance(value, bool) \
+            and bool(np.isfinite(value))
+
+    if mode == "two-stage" and not (number(time_factor) and time_factor >= 1.0):
         raise InvalidSettings(f"time_factor={time_factor!r}: use a finite value >= 1")
-    if mode == "weighted" and not (k_time >= 0.0 and k_jerk >= 0.0 and k_time + k_jerk > 0.0):
+    if mode == "weighted" and not (number(k_time) and number(k_jerk) and k_time >= 0.0
+                                   and k_jerk >= 0.0 and k_time + k_jerk > 0.0):
         raise InvalidSettings(f"k_time={k_time!r}, k_jerk={k_jerk!r}: use weights >= 0, "
                               "not both zero")
     if problem is None:

@@ -14,7 +14,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from optim.engine import GAHistory, GAProgress, run_ga
+from optim.engine import GAHistory, GAProgress, random_generator, run_ga
 from optim.errors import InfeasibleProblem, InvalidSettings
 from optim.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
 from optim.problem import SAFETY, TimingProblem
@@ -122,14 +122,14 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
 
     Args:
         positions: (m+1, n_joints) or (m+1,) via points (rad or m).
-        kind: ``"3-5-3"``, ``"multi-quintic"`` or ``"quintic-bspline"``.
+        kind: ``"3-5-3"`` (exactly 4 via points), ``"multi-quintic"`` or ``"quintic-bspline"``.
         vmax, amax, jmax: Limits per joint (scalar or (n_joints,)), SI (rad/s, rad/s^2,
             rad/s^3 or m/...). ``vmax`` is required; None leaves a limit out.
         method: ``"ga"`` (the GA of this package) or ``"exact"`` (scaling-law optimiser).
         seed: Seed of the GA (or of the exact optimiser's random starts).
         settings: GA settings (default :meth:`GASettings.seed002`).
         bounds: Segment-duration bounds (s): one (lower, upper) pair or (m, 2) rows.
-            Default: ``[s0 / (20 m), min(s0, 4 s0 / m)]`` per segment, s0 the minimal
+            Default: ``[s0 / (20 m), 1.001 min(s0, 4 s0 / m)]`` per segment, s0 the minimal
             total with equal durations (so equal durations s0/m are inside and feasible).
             Pass wider bounds if one segment may need more than 4x the average.
         max_generations, stall_generations, time_limit: GA stopping rules.
@@ -156,6 +156,7 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
     t0 = time.perf_counter()
     if method not in METHODS:
         raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
+    random_generator(seed)  # refuse a bad seed before any work, for both methods
     if problem is None:
         problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
                                 trajectory_options=trajectory_options)

@@ -121,3 +121,51 @@ def test_seed002_gantry_exact_and_ga_feasible():
     ga = minimize_time(None, None, None, method="ga", problem=p, seed=0, max_generations=80)
     _assert_feasible(ga, s.vmax, s.amax, s.jmax)
     assert ex.total <= ga.total * (1 + 1e-6) and ga.total < 1.89
+
+
+@pytest.mark.parametrize("kind", ["multi-quintic", "quintic-bspline"])
+@pytest.mark.parametrize("method", ["ga", "exact"])
+def test_single_segment_point_to_point_is_solved(kind, method):
+    # One rest-to-rest quintic peaks at 15/8 d/T: with d = 0.8 rad, vmax 2 rad/s the
+    # minimum time is 0.75 s. The default bounds used to stop just below it (infeasible).
+    r = minimize_time([0.2, 1.0], kind, 2.0, method=method, seed=0, max_generations=20)
+    assert r.total == pytest.approx(15 / 8 * 0.8 / 2.0, rel=1e-8)
+    _assert_feasible(r, 2.0)
+
+
+def test_353_needs_exactly_four_via_points():
+    from robots.errors import InvalidInput
+
+    for q in ([0.0, 1.0], [0.0, 1.0, 2.0], [0.0, 1.0, 2.0, 3.0, 4.0]):
+        with pytest.raises(InvalidInput, match=f"needs 4 via points, got {len(q)}"):
+            minimize_time(q, "3-5-3", 1.0, method="exact")
+
+
+def test_non_numeric_positions_bounds_and_unknown_options_are_named():
+    from optim import InvalidSettings
+    from robots.errors import InvalidInput
+
+    with pytest.raises(InvalidInput, match="positions=.*not numeric"):
+        minimize_time(["a", "b"], "multi-quintic", 1.0)
+    with pytest.raises(InvalidSettings, match="bounds='short' are not numeric"):
+        minimize_time(S0.positions, S0.kind, S0.vmax, bounds="short")
+    with pytest.raises(InvalidSettings, match=r"\['speed'\] are not options of the 'multi-quintic'"):
+        minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, trajectory_options={"speed": 1})
+    # Known options still pass through (heuristic via velocities change the optimum).
+    rest = minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact")
+    moving = minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact",
+                           trajectory_options={"velocities": "heuristic"})
+    assert moving.total < rest.total * 0.9
+
+
+@pytest.mark.parametrize("method", ["ga", "exact"])
+def test_bad_seed_is_refused_before_any_work(method):
+    from optim import InvalidSettings, minimize_time_jerk
+
+    with pytest.raises(InvalidSettings, match="seed=-1"):
+        minimize_time(S0.positions, S0.kind, S0.vmax, method=method, seed=-1)
+    with pytest.raises(InvalidSettings, match="time_factor='a'"):
+        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, method=method, time_factor="a")
+    with pytest.raises(InvalidSettings, match="k_time='a'"):
+        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, method=method, mode="weighted",
+                           k_time="a")
