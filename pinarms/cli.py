@@ -125,15 +125,26 @@ def _floats(text: str, what: str) -> np.ndarray:
     return values
 
 
-def _limit(text: str | None, what: str, scale: float) -> np.ndarray | float | None:
+def _limit(text: str | None, what: str, scale: float | np.ndarray) -> np.ndarray | float | None:
+    """A limit option in user units → SI: one value for every joint, or one per joint."""
     if text is None:
         return None
-    values = _floats(text, what) * scale
+    values = _floats(text, what)
+    per_joint = np.asarray(scale, dtype=float)
+    if per_joint.ndim and values.size not in (1, per_joint.size):
+        raise InvalidInput(f"{what} takes one value or one per joint ({per_joint.size}), got {values.size}")
+    values = values * per_joint
     return float(values[0]) if values.size == 1 else values
 
 
 def _vectors_from_args(values: tuple[float, ...]) -> np.ndarray:
     return np.asarray(values, dtype=float)
+
+
+def _at(scale: float | np.ndarray, joint: int) -> float:
+    """The scale of one joint (a scalar scale applies to every joint)."""
+    arr = np.asarray(scale, dtype=float)
+    return float(arr[joint]) if arr.ndim else float(arr)
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -270,7 +281,12 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
     else:
         q0 = None
         if seed_q is not None:
-            q0 = joints_to_si(arm, _floats(seed_q, "--seed-q"), deg=deg, mm=mm)
+            start = _floats(seed_q, "--seed-q")
+            if start.size != arm.nq:
+                raise InvalidInput(
+                    f"--seed-q needs {arm.nq} values for {arm.name} ({', '.join(arm.joint_names)}), got {start.size}"
+                )
+            q0 = joints_to_si(arm, start, deg=deg, mm=mm)
         sols = np.atleast_2d(arm.ik(T, q0, position_only=position_only))
     rows = []
     for q in sols:
@@ -293,9 +309,8 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
     header = "  ".join(f"{n}[{u}]" for n, u in zip(arm.joint_names, kinds))
     lines = [f"{arm.name}: {len(rows)} solution(s)  ({header})"]
     lines += [f"  {_fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m" for r in rows]
-    if not rows:
-        reason = arm.ik_failure_reason(values[:3] if position_only and not all_solutions else T,
-                                       position_only=position_only and not all_solutions)
+    if not rows:  # only with --all: the numerical solver raises UnreachableTarget instead
+        reason = arm.ik_failure_reason(T)
         data["reason"] = reason
         lines.append(f"  none within the joint limits: {reason}")
     _emit(as_json, data, lines)
@@ -311,8 +326,13 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
               help="Also save the cloud into a session file.")
 @json_option
 def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, as_json: bool) -> None:
-    """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region."""
+    """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region.
+
+    The region is robots.placement.recommend_region's radial band on the working side of
+    the base plane (distances in the JSON in metres).
+    """
     arm = _load_robot(robot)
+    from robots.placement import recommend_region
     from robots.workspace import sample_workspace
 
     ws = sample_workspace(arm, n=n, seed=seed, frame=frame)
@@ -337,6 +357,12 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
         lines.append(summary_obj.text())
     elif isinstance(summary, dict):
         lines += [f"{k}: {v}" for k, v in summary.items()]
+    region = recommend_region(ws)
+    data["region"] = {
+        "about": region.about, "origin_m": region.origin, "r_inner_m": region.r_inner, "r_outer_m": region.r_outer,
+        "side": region.side, "z_limit_m": region.z_limit, "criteria": region.criteria,
+    }
+    lines += region.text().splitlines()[:2]
     if session_path:
         session = _new_session(arm, f"workspace of {arm.name}")
         session.add_workspace("workspace", ws)
@@ -440,7 +466,31 @@ def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degre
     raise click.UsageError(f"unknown kind {kind!r}; use one of {', '.join(TRAJECTORY_KINDS)}")
 
 
-def _peaks_lines(peaks: Any, scale: float, unit: str) -> list[str]:
+def _joint_scale(robot: Robot | None, deg: bool, n_joints: int) -> float | np.ndarray:
+    """SI per user unit of each via-point column (and of its limits).
+
+    Without a robot every joint is taken as revolute: radians per degree with ``--deg``,
+    else 1. With a robot its prismatic joints stay in metres (scale 1) whatever ``--deg``
+    says, and the number of columns must be its number of joints.
+    """
+    if robot is None:
+        return angle_scale(deg)
+    if robot.nq != n_joints:
+        raise InvalidInput(
+            f"{robot.name} has {robot.nq} joints ({', '.join(robot.joint_names)}) but the via points have "
+            f"{n_joints} value(s) each"
+        )
+    return np.where(prismatic_mask(robot), 1.0, angle_scale(deg))
+
+
+def _unit_label(robot: Robot | None, deg: bool) -> str:
+    """Unit of the via-point values: ``deg``, ``deg|m`` (robot with prismatic joints) or ``rad|m``."""
+    if not deg:
+        return "rad|m"
+    return "deg|m" if robot is not None and bool(np.any(prismatic_mask(robot))) else "deg"
+
+
+def _peaks_lines(peaks: Any, scale: float | np.ndarray, unit: str) -> list[str]:
     return [
         f"peak |velocity|     [{unit}/s]:   {_fmt(np.asarray(peaks.velocity) / scale)}",
         f"peak |acceleration| [{unit}/s²]:  {_fmt(np.asarray(peaks.acceleration) / scale)}",
@@ -448,7 +498,7 @@ def _peaks_lines(peaks: Any, scale: float, unit: str) -> list[str]:
     ]
 
 
-def _peaks_dict(peaks: Any, scale: float) -> dict:
+def _peaks_dict(peaks: Any, scale: float | np.ndarray) -> dict:
     return {
         "velocity": np.asarray(peaks.velocity) / scale,
         "acceleration": np.asarray(peaks.acceleration) / scale,
@@ -456,17 +506,20 @@ def _peaks_dict(peaks: Any, scale: float) -> dict:
     }
 
 
-def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float, n_joints: int):
-    """Velocity/acceleration/jerk limits (SI) from options, else the robot's velocity limits."""
+def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float | np.ndarray):
+    """Velocity/acceleration/jerk limits (SI) from options, else the robot's velocity limits.
+
+    ``--amax``/``--jmax`` without a velocity limit are a usage error, not silently ignored.
+    """
     v = _limit(vmax, "--vmax", scale)
     a = _limit(amax, "--amax", scale)
     j = _limit(jmax, "--jmax", scale)
     if v is None and robot is not None:
-        if robot.nq != n_joints:
-            raise InvalidInput(f"{robot.name} has {robot.nq} joints but the via points have {n_joints}")
         v = robot.velocity_limit
         if not np.all(v > 0):
             raise InvalidInput(f"{robot.name}'s URDF gives no velocity limit for every joint; pass --vmax")
+    if v is None and (a is not None or j is not None):
+        raise click.UsageError("--amax/--jmax need a velocity limit too: give --vmax (or --robot)")
     return v, a, j
 
 
@@ -479,7 +532,8 @@ def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float, n_
               help="Via points (and times) from a .json or .csv file.")
 @click.option("--degree", type=int, default=None, help="Degree for --kind polynomial.")
 @click.option("--degrees", default=None, help="Per-segment degrees for --kind piecewise, e.g. 4,3,4.")
-@click.option("--deg", is_flag=True, help="Joint values and limits in degrees.")
+@click.option("--deg", is_flag=True,
+              help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
 @click.option("--robot", default=None, help="Take velocity limits from this robot (and store it in the session).")
 @click.option("--vmax", default=None, help="Velocity limit(s), one or per joint, comma-separated.")
 @click.option("--amax", default=None, help="Acceleration limit(s).")
@@ -503,12 +557,12 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     if extra.get("kind") and kind == "3-5-3" and extra["kind"] in TRAJECTORY_KINDS:
         kind = extra["kind"]
     degree = degree if degree is not None else extra.get("degree")
-    scale = angle_scale(deg)
     arm = _load_robot(robot) if robot else None
+    scale = _joint_scale(arm, deg, positions.shape[1])
     traj = _build_trajectory(kind, t, positions * scale, degree, degrees)
     peaks = traj.peaks()
-    unit = "deg" if deg else "rad|m"
-    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale, traj.n_joints)
+    unit = _unit_label(arm, deg)
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
     report = None
     if v is not None:
         report = traj.check(planning.JointLimits(v, a, j))
@@ -522,14 +576,14 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
         "limits_ok": None if report is None else bool(report.ok),
         "violations": [] if report is None else [
             {"joint": int(vi[0]), "time_s": float(vi[1]), "kind": str(vi[2]),
-             "value": float(vi[3]) / scale, "limit": float(vi[4]) / scale}
+             "value": float(vi[3]) / _at(scale, int(vi[0])), "limit": float(vi[4]) / _at(scale, int(vi[0]))}
             for vi in report.violations
         ],
     }
     lines = [
         f"{kind} trajectory: {traj.n_joints} joint(s), {positions.shape[0]} via points, duration {traj.duration:.6g} s",
         f"knot times [s]: {_fmt(traj.knot_times)}",
-        *_peaks_lines(peaks, scale, "deg" if deg else "rad|m"),
+        *_peaks_lines(peaks, scale, unit),
     ]
     if report is not None:
         lines.append("limits: ok" if report.ok else f"limits: {len(report.violations)} violation(s)")
@@ -552,7 +606,8 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
 @click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
 @click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
               help="Via points from a .json or .csv file.")
-@click.option("--deg", is_flag=True, help="Joint values and limits in degrees.")
+@click.option("--deg", is_flag=True,
+              help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
 @click.option("--robot", default=None, help="Take velocity limits from this robot.")
 @click.option("--vmax", default=None, help="Velocity limit(s), one or per joint.")
 @click.option("--amax", default=None, help="Acceleration limit(s).")
@@ -574,9 +629,10 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     if session_path and not robot:
         raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
     _, positions, _ = _via_input(via, None, file)
-    scale = angle_scale(deg)
     arm = _load_robot(robot) if robot else None
-    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale, positions.shape[1])
+    scale = _joint_scale(arm, deg, positions.shape[1])
+    unit = _unit_label(arm, deg)
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
     if v is None:
         raise click.UsageError("give a velocity limit with --vmax (or --robot)")
     kwargs: dict[str, Any] = {}
@@ -584,7 +640,8 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
         kwargs["max_generations"] = generations
     progress = _show_progress(as_json) and method == "ga"
     if progress:
-        bar = click.progressbar(length=generations or 200, label="GA generations", file=sys.stderr)
+        budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
+        bar = click.progressbar(length=budget, label="GA generations", file=sys.stderr)
         bar.__enter__()
 
         def tick(_state: Any) -> None:
@@ -602,14 +659,14 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
         "durations_s": result.durations,
         "total_s": result.total,
         "peaks": _peaks_dict(result.peaks, scale),
-        "units": "deg" if deg else "rad|m",
+        "units": unit,
         "generations": None if result.history is None else len(getattr(result.history, "best", [])),
         "wall_time_s": result.wall_time,
     }
     lines = [
         f"{kind}, method {result.method}: total {result.total:.6g} s",
         f"segment durations [s]: {_fmt(result.durations)}",
-        *_peaks_lines(result.peaks, scale, "deg" if deg else "rad|m"),
+        *_peaks_lines(result.peaks, scale, unit),
     ]
     if session_path:
         session = _new_session(arm, f"time-optimal {kind}")

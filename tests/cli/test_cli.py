@@ -222,3 +222,85 @@ def test_urdf_build_check_and_export(run, tmp_path):
     assert_user_error(run("urdf", "export", "koji_turner", str(out), ok=False), 1, "not empty")
     run("urdf", "export", "koji_turner", str(out), "--overwrite")
     assert_user_error(run("urdf", "export", "nope", str(tmp_path / "n"), ok=False), 1, "unknown robot")
+
+
+def test_deg_with_a_robot_keeps_prismatic_joints_in_metres(run):
+    # scara_mushroom's j3 is a prismatic stroke: 0.05 -> 0.10 m must stay metres under --deg
+    via_deg = ["--via", "10,20,0.05,0", "--via", "20,30,0.1,0", "--via", "30,30,0.15,0"]
+    via_si = [a if a == "--via" else ",".join(f"{v:.17g}" for v in np.array(a.split(","), float)
+                                               * [np.pi / 180, np.pi / 180, 1, np.pi / 180]) for a in via_deg]
+    common = ["--kind", "multi-quintic", "--robot", "scara_mushroom", "--json"]
+    plan = as_json(run("plan", *common, "--deg", "--times", "0,1,2", *via_deg))
+    assert plan["units"] == "deg|m"
+    # quintic rest-to-rest over 1 s: peak |v| = 1.875 · stroke
+    assert plan["peaks"]["velocity"][2] == pytest.approx(1.875 * 0.05, rel=1e-9)
+    assert plan["peaks"]["velocity"][0] == pytest.approx(1.875 * 10, rel=1e-9)
+    deg = as_json(run("optimize", *common, "--deg", "--method", "exact", *via_deg))
+    si = as_json(run("optimize", *common, "--method", "exact", *via_si))
+    assert deg["total_s"] == pytest.approx(si["total_s"], rel=1e-6)
+    np.testing.assert_allclose(deg["peaks"]["velocity"][2:3], si["peaks"]["velocity"][2:3], rtol=1e-6)
+    # the prismatic stroke is what limits the timing here: 0.5 m/s on j3
+    assert si["peaks"]["velocity"][2] == pytest.approx(robots.load("scara_mushroom").velocity_limit[2], rel=1e-3)
+
+
+def test_limit_options_are_never_silently_ignored(run):
+    one = ["plan", "--kind", "multi-quintic", "--times", "0,1", "--via", "1", "--via", "2"]
+    assert_user_error(run(*one, "--amax", "1", ok=False), 2, "--vmax")
+    assert_user_error(run(*one, "--jmax", "1", ok=False), 2, "--vmax")
+    data = as_json(run(*one, "--vmax", "10", "--amax", "1", "--json"))
+    assert data["limits_ok"] is False and data["violations"][0]["kind"].startswith("acc")
+    four = ["plan", "--kind", "multi-quintic", "--times", "0,1", "--via", "1,0,0,0", "--via", "2,0,0,0",
+            "--robot", "scara_mushroom"]
+    assert_user_error(run(*four, "--vmax", "1,2", ok=False), 1, "--vmax takes one value or one per joint (4)")
+    assert_user_error(run("plan", *one[1:], "--robot", "scara_mushroom", ok=False), 1, "has 4 joints", "1 value")
+
+
+def test_ik_seed_q_of_the_wrong_size_is_a_one_line_error(run):
+    assert_user_error(run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg", "--seed-q", "1,2",
+                          ok=False), 1, "--seed-q needs 4 values", "got 2")
+    data = as_json(run("ik", "koji_turner", "1.1973", "0.25", "-0.9292", "--seed-q", "-1.5,0.4,-0.5,1.5", "--json"))
+    assert data["solutions"][0]["position_error_m"] < 1e-9
+
+
+def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypatch):
+    import click
+
+    import optim
+    import pinarms.cli as cli_module
+
+    seen = {}
+
+    class Bar:
+        def __init__(self, length, **_):
+            seen["length"], seen["updates"] = length, 0
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def update(self, n):
+            seen["updates"] += n
+
+    monkeypatch.setattr(cli_module, "_show_progress", lambda as_json: True)
+    monkeypatch.setattr(click, "progressbar", Bar)
+    run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55")
+    assert seen["length"] == optim.GASettings.seed002().max_generations
+    assert 0 < seen["updates"] <= seen["length"]
+    run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--generations", "7")
+    assert seen["length"] == 7 and seen["updates"] <= 7
+
+
+def test_workspace_prints_the_recommended_table_region(run):
+    from robots.placement import recommend_region
+    from robots.workspace import sample_workspace
+
+    data = as_json(run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange", "--json"))
+    region = recommend_region(sample_workspace(robots.load("aubo_i3"), n=3000, seed=0, frame="flange"))
+    assert data["region"]["side"] == "above" == region.side
+    assert data["region"]["r_inner_m"] == pytest.approx(region.r_inner)
+    assert data["region"]["r_outer_m"] == pytest.approx(region.r_outer)
+    assert 0.1 < data["region"]["r_inner_m"] < data["region"]["r_outer_m"] < 0.8
+    text = run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange").stdout
+    assert "recommended table region" in text and f"{region.r_outer * 1000:.0f} mm" in text
