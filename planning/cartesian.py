@@ -101,7 +101,7 @@ def joint_path_from_waypoints(
         q_start: optional configuration (nq,) selecting the branch of the first waypoint.
         **options: passed on to the trajectory constructor.
     """
-    key = kind.replace("_", "-")
+    key = kind.replace("_", "-") if isinstance(kind, str) else kind
     if key not in PATH_KINDS:
         raise TrajectoryError(f"unknown trajectory kind {kind!r}; choose one of {sorted(PATH_KINDS)}")
     P = _poses(poses)

@@ -120,6 +120,8 @@ def test_bad_cartesian_input():
         planning.joint_waypoints(arm, np.zeros((3, 3)))
     with pytest.raises(TrajectoryError, match="unknown trajectory kind"):
         planning.joint_path_from_waypoints(arm, poses, np.arange(5.0), kind="spline9")
+    with pytest.raises(TrajectoryError, match="unknown trajectory kind None"):
+        planning.joint_path_from_waypoints(arm, poses, np.arange(5.0), kind=None)
     traj3 = planning.multi_quintic([0, 1], np.zeros((2, 3)) + [[0, 0, 0], [1, 1, 1]])
     with pytest.raises(TrajectoryError, match="robot has nq = 2"):
         planning.tcp_path(arm, traj3, 10.0)
