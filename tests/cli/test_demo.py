@@ -52,3 +52,17 @@ def test_demo_text_table_only_one_study(tmp_path):
     assert "paper vs pinarms" in result.stdout
     assert "FK example 1 z" in result.stdout and "differs" in result.stdout
     assert (tmp_path / "table.md").is_file()
+
+
+def test_demo_ik_rows_use_the_error_the_paper_states():
+    # seed 004 section 3: "the one-decimal position causes 0.1° of error in θ" (not a tolerance fitted to ours)
+    from pinarms.demo import study_004
+    from robots.papers import SEED004
+
+    rows = [r for r in study_004(quick=True).rows if r.quantity.startswith("IK of")]
+    assert len(rows) == 3
+    for row, paper in zip(rows, (SEED004.ik_theta1_deg, SEED004.ik_theta2_deg, -SEED004.ik_theta3_down_deg)):
+        assert row.paper == paper and row.tolerance == SEED004.ik_stated_error_deg == 0.1
+        assert row.status == "agrees"
+    # ours solve the printed target: θ2 within 0.002° of 25°, i.e. 0.026° from the paper's 25.0271°
+    assert rows[1].pinarms == pytest.approx(25.0011, abs=1e-4)
