@@ -431,8 +431,9 @@ class Robot:
     ) -> np.ndarray:
         """One configuration ``(nq,)`` within the limits whose tcp meets ``target`` within ``tol``.
 
-        Arms with a closed form start from the analytic solution nearest ``q_seed`` (refined by
-        the numerical solver to ``tol``); other arms, and ``position_only`` targets, use
+        Arms with a closed form start from the analytic branches nearest ``q_seed`` (each revolute
+        angle at its 2π equivalent within the limits nearest ``q_seed``), refined and checked by
+        the numerical solver to ``tol``; other arms, and ``position_only`` targets, use
         damped least squares from ``q_seed`` then seeded random restarts.
 
         Args:
@@ -463,8 +464,8 @@ class Robot:
             seed_q = seed_q[0]
         solver = self._numerical_ik()
         if self._analytic_ik is not None and not position_only:
-            sols = self._analytic_ik.solve(T, None if seed_q is None else seed_q[None])[0]
-            for q in sols[:4]:
+            starts = self._analytic_ik.starts(T[0], self.neutral if seed_q is None else seed_q)
+            for q in starts[:4]:
                 q2, pe, re, _ = solver.attempt(q, T[0], False, tol)
                 if pe <= tol and re <= tol and self.within_limits(q2):
                     return q2

@@ -208,6 +208,32 @@ class AnalyticIK:
             return np.zeros(0, dtype=int), np.zeros((0, nq))
         return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
+    def starts(self, target: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+        """Branch candidates of one target ``(4, 4)`` as starts of a local refinement: ``(k, nq)``.
+
+        Each revolute angle is moved to its 2π equivalent within the limits nearest ``q_ref
+        (nq,)``; branches that do not exist, or that no equivalent brings within the limits,
+        are dropped, the rest sorted by distance to ``q_ref``. Unlike :meth:`solve` the
+        candidates are *not* checked by forward kinematics (nor every 2π equivalent listed):
+        :meth:`robots.Robot.ik` refines and checks them with Pinocchio, which costs less for
+        one target than the batched machinery.
+        """
+        lo, hi = self.robot.lower, self.robot.upper
+        q_ref = np.asarray(q_ref, dtype=float)
+        q = self.raw(target[None], q_ref[None])[0]
+        q = q[np.all(np.isfinite(q), axis=1)]
+        rev = self._revolute
+        if rev.any():
+            lo_r, hi_r = lo[rev], hi[rev]
+            centre = np.clip(q_ref[rev], lo_r, hi_r)
+            nearest = q[:, rev] + _TWO_PI * np.round((centre - q[:, rev]) / _TWO_PI)
+            options = nearest[None] + _TWO_PI * np.array([0.0, -1.0, 1.0])[:, None, None]  # (3, k, r)
+            inside = (options >= lo_r - LIMIT_TOL) & (options <= hi_r + LIMIT_TOL)
+            pick = np.argmin(np.where(inside, np.abs(options - q_ref[rev]), np.inf), axis=0)
+            q[:, rev] = np.take_along_axis(options, pick[None], axis=0)[0]
+        q = q[np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=1)]
+        return q[np.argsort(np.linalg.norm(q - q_ref, axis=1), kind="stable")]
+
     def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None) -> list[np.ndarray]:
         """Every solution within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first."""
         idx, q = self.candidates(targets, q_ref)

@@ -286,3 +286,36 @@ def test_aubo_nearly_double_roots_are_polished_not_dropped(theta5):
 def test_empty_batch_of_targets_gives_an_empty_list():
     assert _AUBO.ik_all(np.zeros((0, 4, 4))) == []
     assert _AUBO.fk(np.zeros((0, 6))).shape == (0, 4, 4)
+
+
+def test_starts_of_one_target_are_the_in_limit_equivalents_nearest_the_reference():
+    """Robot.ik's cheap path: raw branches, each joint at its 2π equivalent nearest q_ref within limits."""
+    ur5 = robots.load("ur5")
+    q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])
+    T = ur5.fk(q)
+    ref = q + np.array([-2 * np.pi + 0.1, 0.0, 0.0, 2 * np.pi - 0.2, 0.0, 0.0])
+    starts = ur5._analytic_ik.starts(T, ref)
+    assert 1 <= starts.shape[0] <= 8  # one row per branch, not every 2π equivalent (256)
+    assert np.all(ur5.within_limits(starts, tol=LIMIT_TOL))
+    d = np.linalg.norm(starts - ref, axis=1)
+    assert np.all(np.diff(d) >= 0.0)
+    expected = q + np.array([-2 * np.pi, 0.0, 0.0, 2 * np.pi, 0.0, 0.0])
+    np.testing.assert_allclose(starts[0], expected, atol=1e-9)
+    # the same row is the nearest of ik_all's full list
+    np.testing.assert_allclose(ur5.ik_all(T, q_ref=ref)[0], starts[0], atol=1e-9)
+    # and Robot.ik returns it (refined), within limits
+    np.testing.assert_allclose(ur5.ik(T, ref), expected, atol=1e-9)
+
+
+def test_starts_drop_branches_no_equivalent_brings_within_limits():
+    """AUBO-i3 (±170°): a branch needing a joint in (170°, 190°) has no equivalent inside."""
+    aubo = _AUBO
+    q = np.array([0.3, -0.4, 1.1, 0.5, 0.8, -0.6])
+    T = aubo.fk(q)
+    _, free = aubo._analytic_ik.candidates(T[None], respect_limits=False)
+    starts = aubo._analytic_ik.starts(T, q)
+    inside = free[aubo.within_limits(free)]
+    assert starts.shape[0] == inside.shape[0]
+    np.testing.assert_allclose(np.sort(starts, axis=0), np.sort(inside, axis=0), atol=1e-7)
+    koji = robots.load("koji_turner")
+    assert koji._analytic_ik.starts(KOJI_PAPER_MATRIX, koji.neutral).shape[0] == 0  # shoulder 25.0011° > 25°
