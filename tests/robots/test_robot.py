@@ -54,13 +54,27 @@ def _interior_q(robot, n, seed):
     return rng.uniform(robot.lower + 1e-3, robot.upper - 1e-3, size=(n, robot.nq))
 
 
-@pytest.mark.parametrize("name", EXAMPLE)
+@pytest.mark.parametrize("name", BUILTIN + EXAMPLE)
 def test_batched_fk_equals_pinocchio(name):
     robot = robots.load(name)
     q = robot.random_q(300, seed=7)
-    assert np.abs(robot.fk(q) - robot.fk_pinocchio(q)).max() < 1e-12
+    for frame in ("tcp", robot.model.frames[robot.frame_id("tcp")].name, robot.model.names[robot.model.njoints - 1]):
+        assert np.abs(robot.fk(q, frame) - robot.fk_pinocchio(q, frame)).max() < 1e-12
     # a single configuration returns one (4, 4) pose
     assert robot.fk(q[0]).shape == (4, 4)
+
+
+@pytest.mark.parametrize("name", BUILTIN + EXAMPLE)
+def test_batched_jacobian_equals_pinocchio(name):
+    """World-aligned axes at the frame origin, w.r.t. the independent joints (mimics folded in)."""
+    robot = robots.load(name)
+    data = robot.model.createData()
+    fid = robot.frame_id("tcp")
+    q = robot.random_q(20, seed=8)
+    J = robot.jacobian(q)
+    for k in range(len(q)):
+        J_pin = pin.computeFrameJacobian(robot.model, data, robot.q_to_pinocchio(q[k]), fid, pin.LOCAL_WORLD_ALIGNED)
+        assert np.abs(J[k] - J_pin).max() < 1e-12
 
 
 def test_mimic_robot_counts_independent_joints_only(mimic_robot):
