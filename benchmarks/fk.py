@@ -11,6 +11,7 @@ the other, so machine load affects them alike.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -54,7 +55,9 @@ def main() -> None:
 
     err = np.abs(T[: len(sub)] - T_loop).max()
     pos_err = np.linalg.norm(T[: len(sub), :3, 3] - T_loop[:, :3, 3], axis=1).max()
-    print(f"robot {robot.name}: {args.n:,} configurations, best of {args.repeat}")
+    load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
+    print(f"robot {robot.name}: {args.n:,} configurations, best of {args.repeat}; "
+          f"{os.cpu_count()} cores, load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
     print(f"  pinarms batched FK     : {best_vec:8.3f} s  ({best_vec / args.n * 1e9:7.1f} ns/config)")
     print(f"  Pinocchio Python loop  : {best_loop:8.3f} s  ({best_loop / args.n * 1e9:7.1f} ns/config, "
           f"timed on {len(sub):,} and extrapolated)")

@@ -15,7 +15,7 @@ Conventions
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -23,13 +23,10 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError
 from .kinematic_tree import KinematicTree
 
-if TYPE_CHECKING:  # pragma: no cover
-    pass
-
 __all__ = ["Robot"]
 
 
-def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
+def _as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
     """Validate ``values`` as ``(width,)`` or ``(N, width)`` finite floats.
 
     Returns the ``(N, width)`` array and whether the input was a single vector.
@@ -51,7 +48,7 @@ def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
     return arr, single
 
 
-def check_seed(seed: Any, what: str = "seed") -> Any:
+def _check_seed(seed: Any, what: str = "seed") -> Any:
     """``seed`` unchanged if it is ``None``, a non-negative int or a ``numpy.random.Generator``.
 
     Raises:
@@ -64,13 +61,13 @@ def check_seed(seed: Any, what: str = "seed") -> Any:
     return seed
 
 
-def as_generator(seed: Any, what: str = "seed") -> np.random.Generator:
-    """``seed`` (see :func:`check_seed`) as a ``numpy.random.Generator`` (a Generator is returned as is)."""
-    seed = check_seed(seed, what)
+def _as_generator(seed: Any, what: str = "seed") -> np.random.Generator:
+    """``seed`` (see :func:`_check_seed`) as a ``numpy.random.Generator`` (a Generator is returned as is)."""
+    seed = _check_seed(seed, what)
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
-def check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
+def _check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
     """``tol`` as a finite float ``>= 0`` (``> 0`` when ``positive``); :class:`InvalidInput` otherwise."""
     ok = isinstance(tol, (int, float, np.integer, np.floating)) and not isinstance(tol, bool)
     value = float(tol) if ok else float("nan")
@@ -163,7 +160,7 @@ class Robot:
 
     def check_q(self, q: Any) -> tuple[np.ndarray, bool]:
         """``q`` as a ``(N, nq)`` array plus a flag telling it was one ``(nq,)`` vector."""
-        return as_batch(q, self.nq, f"joint vector q of '{self.name}' (joints {list(self.joint_names)})")
+        return _as_batch(q, self.nq, f"joint vector q of '{self.name}' (joints {list(self.joint_names)})")
 
     def q_to_pinocchio(self, q: Any) -> np.ndarray:
         """Pinocchio's configuration vector(s) for ``q`` (continuous joints as cos/sin)."""
@@ -180,7 +177,7 @@ class Robot:
     def within_limits(self, q: Any, tol: float = 1e-9) -> bool | np.ndarray:
         """Whether ``q`` lies within the position limits (``tol`` in rad or m); never clamps."""
         arr, single = self.check_q(q)
-        tol = check_tolerance(tol, "limit tolerance tol [rad or m]")
+        tol = _check_tolerance(tol, "limit tolerance tol [rad or m]")
         ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=1)
         return bool(ok[0]) if single else ok
 
@@ -189,7 +186,7 @@ class Robot:
         arr, single = self.check_q(q)
         if not single:
             raise InvalidInput("limit_violations takes one configuration of shape (nq,)")
-        tol = check_tolerance(tol, "limit tolerance tol [rad or m]")
+        tol = _check_tolerance(tol, "limit tolerance tol [rad or m]")
         out = []
         for name, v, lo, hi in zip(self.joint_names, arr[0], self.lower, self.upper):
             if v < lo - tol or v > hi + tol:
@@ -200,7 +197,7 @@ class Robot:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
-        rng = as_generator(seed)
+        rng = _as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
     # ------------------------------------------------------------- kinematics
@@ -454,10 +451,10 @@ class Robot:
         T, single = self.check_target(target, position_only=position_only)
         if not single:
             raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
-        tol = check_tolerance(tol, "tol [m, rad]", positive=True)
+        tol = _check_tolerance(tol, "tol [m, rad]", positive=True)
         if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
             raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
-        check_seed(seed)
+        _check_seed(seed)
         seed_q = None
         if q_seed is not None:
             seed_q, _ = self.check_q(q_seed)
