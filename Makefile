@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.pinarms-installed
 
-.PHONY: install demo demo-quick test browser urdf bench clean
+.PHONY: install demo demo-quick readme-table test browser urdf bench clean
 
 # Create .venv if missing and install the project with its test and benchmark extras.
 # Idempotent: re-runs pip only when pyproject.toml changed.
@@ -29,6 +29,10 @@ demo: install
 
 demo-quick: install
 	$(VENV)/bin/pinarms demo --quick --out demo-output
+
+# The full demo, and its paper-vs-pinarms table written into README.md (between its markers).
+readme-table: install
+	$(VENV)/bin/pinarms demo --out demo-output --readme README.md
 
 test: install browser
 	$(PY) -m pytest -q tests

@@ -28,3 +28,64 @@ def test_readme_quickstart_runs(tmp_path, monkeypatch):
     exec(compile(code, str(README), "exec"), {"__name__": "readme"})
     assert (tmp_path / "study.pinarms").is_file()
     assert (tmp_path / "study.html").stat().st_size > 100_000
+
+
+def _cells(line: str) -> list[str]:
+    return [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+
+
+def test_readme_table_is_the_code_s_table():
+    """Every README row that does not depend on the run's budget (GA generations, samples) is
+    exactly what the demo's studies print now; the summary line counts the README's rows."""
+    from pinarms.demo import study_000, study_001, study_004
+    from pinarms.report import TABLE_BEGIN, TABLE_END, markdown_table
+
+    text = README.read_text(encoding="utf-8")
+    block = text[text.index(TABLE_BEGIN) : text.index(TABLE_END)]
+    lines = [line for line in block.splitlines() if line.startswith("| 00")]
+    budget = ("GA", "reduced by", "workspace sphere", "recommended")
+    checked = 0
+    for study in (study_000(quick=True), study_001(quick=True), study_004(quick=True)):
+        for row in study.rows:
+            if any(word in row.quantity for word in budget):
+                continue
+            expected = markdown_table([row]).splitlines()[2]
+            assert expected in lines, f"README row out of date; run `make readme-table`:\n{expected}"
+            checked += 1
+    assert checked >= 40
+    statuses = [_cells(line)[6] for line in lines]
+    summary = (f"{len(lines)} rows: {statuses.count('agrees')} agree, {statuses.count('differs')} differ "
+               f"(reason given), {statuses.count('n/a')} not comparable.")
+    assert summary in block
+    assert {_cells(line)[0] for line in lines} == {"000", "001", "002", "004"}
+
+
+def test_splice_table_replaces_only_the_marked_block():
+    from pinarms.report import TABLE_BEGIN, TABLE_END, Row, splice_table
+    from robots.errors import InvalidInput
+
+    doc = f"intro\n{TABLE_BEGIN}\nold table\n{TABLE_END}\noutro\n"
+    rows = [Row("004", "x", 1.0, 1.0, "mm", 0.1), Row("004", "y", 1.0, 2.0, "mm", 0.1, "typo")]
+    new = splice_table(doc, rows)
+    assert "old table" not in new and new.startswith("intro\n") and new.endswith(f"{TABLE_END}\noutro\n")
+    assert "| 004 | y | 1 | 2 | mm | 0.1 | differs | typo |" in new
+    assert "2 rows: 1 agree, 1 differ (reason given), 0 not comparable." in new
+    assert splice_table(new, rows) == new
+    with pytest.raises(InvalidInput, match="markers|once each"):
+        splice_table("no markers here", rows)
+    with pytest.raises(InvalidInput):
+        splice_table(f"{TABLE_END}\n{TABLE_BEGIN}\n", rows)
+
+
+def test_demo_readme_option_checks_before_the_long_run(tmp_path):
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    plain = tmp_path / "plain.md"
+    plain.write_text("no markers\n")
+    result = CliRunner().invoke(cli, ["demo", "--out", str(tmp_path / "out"), "--readme", str(plain)])
+    assert result.exit_code == 1 and "once each" in result.stderr
+    assert not (tmp_path / "out").exists()  # refused before any study ran
+    result = CliRunner().invoke(cli, ["demo", "--quick", "--readme", str(plain)])
+    assert result.exit_code == 2 and "--readme" in result.stderr
