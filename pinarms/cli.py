@@ -389,7 +389,7 @@ def read_via_file(path: str) -> dict[str, Any]:
             raise InvalidInput(f"{path}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
         if not isinstance(doc, dict) or "positions" not in doc:
             raise InvalidInput(f"{path}: expected an object with 'positions' (and optional 'times', 'kind')")
-        return doc
+        return _checked_via_doc(doc, path)
     rows = list(csv.reader(io.StringIO(text)))
     rows = [r for r in rows if any(c.strip() for c in r)]
     if len(rows) < 3:
@@ -409,6 +409,31 @@ def read_via_file(path: str) -> dict[str, Any]:
     doc["positions"] = table[:, joints]
     doc["joint_names"] = [rows[0][i].strip() for i in joints]
     return doc
+
+
+def _checked_via_doc(doc: dict[str, Any], path: str) -> dict[str, Any]:
+    """A JSON via-point document with numeric arrays and a known kind, or InvalidInput."""
+    out = dict(doc)
+    for key, ndim in (("positions", 2), ("times", 1)):
+        if out.get(key) is None:
+            continue
+        try:
+            arr = np.asarray(out[key], dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidInput(f"{path}: '{key}' must be {'rows of ' if ndim == 2 else 'a list of '}numbers "
+                               f"(one {'row' if ndim == 2 else 'value'} per via point)") from None
+        if key == "positions" and arr.ndim == 1:
+            arr = arr[:, None]
+        if arr.ndim != ndim:
+            raise InvalidInput(f"{path}: '{key}' must be a {ndim}-D list of numbers, got shape {arr.shape}")
+        out[key] = arr
+    kind = out.get("kind")
+    if kind is not None and kind not in TRAJECTORY_KINDS:
+        raise InvalidInput(f"{path}: unknown 'kind' {kind!r}; use one of {', '.join(TRAJECTORY_KINDS)}")
+    degree = out.get("degree")
+    if degree is not None and (isinstance(degree, bool) or not isinstance(degree, int)):
+        raise InvalidInput(f"{path}: 'degree' must be a whole number (3, 5 or 7), got {degree!r}")
+    return out
 
 
 def _via_input(via: tuple[str, ...], times: str | None, file: str | None) -> tuple[np.ndarray | None, np.ndarray, dict]:
@@ -453,7 +478,10 @@ def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degre
     if kind == "piecewise":
         if degrees is None:
             raise click.UsageError("--kind piecewise needs --degrees, e.g. --degrees 4,3,4")
-        degs = tuple(int(d) for d in _floats(degrees, "--degrees"))
+        values = _floats(degrees, "--degrees")
+        if np.any(values != np.round(values)) or np.any(values < 1):
+            raise click.BadParameter(f"--degrees takes whole polynomial degrees >= 1, got {degrees!r}")
+        degs = tuple(int(d) for d in values)
         return planning.piecewise_polynomial(times, positions, degrees=degs)
     if kind == "multi-quintic":
         return planning.multi_quintic(times, positions)

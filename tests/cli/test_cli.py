@@ -304,3 +304,34 @@ def test_workspace_prints_the_recommended_table_region(run):
     assert 0.1 < data["region"]["r_inner_m"] < data["region"]["r_outer_m"] < 0.8
     text = run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange").stdout
     assert "recommended table region" in text and f"{region.r_outer * 1000:.0f} mm" in text
+
+
+def test_piecewise_degrees_must_be_whole_numbers(run):
+    base = ["plan", "--kind", "piecewise", "--times", "0,1,2,3", "--via", "0", "--via", "1", "--via", "2", "--via", "3"]
+    assert_user_error(run(*base, "--degrees", "3.5,5,3", ok=False), 2, "whole polynomial degrees")
+    assert_user_error(run(*base, "--degrees", "0,5,3", ok=False), 2, "whole polynomial degrees")
+    data = as_json(run(*base, "--degrees", "3,5,3", "--json"))
+    assert data["duration_s"] == pytest.approx(3.0)
+
+
+@pytest.mark.parametrize("doc, fragment", [
+    ({"positions": [["a"], ["b"]], "times": [0, 1]}, "'positions' must be rows of numbers"),
+    ({"positions": [[1, 2], [3]], "times": [0, 1]}, "'positions' must be rows of numbers"),
+    ({"positions": [[[1]], [[2]]], "times": [0, 1]}, "2-D list"),
+    ({"positions": [1, 2], "times": "x"}, "'times' must be a list of numbers"),
+    ({"positions": [0, 1], "times": [0, 1], "kind": "spline9"}, "unknown 'kind' 'spline9'"),
+    ({"positions": [0, 1], "times": [0, 1], "kind": "polynomial", "degree": "x"}, "'degree' must be a whole number"),
+])
+def test_corrupt_via_files_are_one_line_errors(run, tmp_path, doc, fragment):
+    path = tmp_path / "via.json"
+    path.write_text(json.dumps(doc))
+    assert_user_error(run("plan", "--file", str(path), ok=False), 1, fragment)
+    assert_user_error(run("optimize", "--file", str(path), "--vmax", "1", ok=False), 1, fragment)
+
+
+def test_one_column_json_via_file_plans(run, tmp_path):
+    path = tmp_path / "via.json"
+    path.write_text(json.dumps({"positions": [0, 1], "times": [0, 2], "kind": "polynomial", "degree": 5}))
+    data = as_json(run("plan", "--file", str(path), "--json"))
+    assert data["kind"] == "polynomial" and data["n_joints"] == 1
+    assert data["peaks"]["velocity"][0] == pytest.approx(1.875 / 2)
