@@ -392,10 +392,10 @@ class Robot:
             # none from the closed form (also at singular poses, where θ free joints were fixed):
             # the numerical diagnosis below decides
         solver = self._numerical_ik()
-        res = solver.solve(T[0], position_only=position_only, tol=1e-9, max_restarts=20)
+        res = solver._solve(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=True)
         if res.success:
             return None
-        free = solver.solve(T[0], position_only=position_only, tol=1e-9, max_restarts=20, limits=False)
+        free = solver._solve(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=False)
         if free.success:
             return (
                 f"the {what} is within reach but needs a joint outside its limits: "
@@ -405,7 +405,9 @@ class Robot:
 
     def _unreachable_text(self, T: np.ndarray, position_only: bool, res=None) -> str:
         if res is None:
-            res = self._numerical_ik().solve(T, position_only=position_only, tol=1e-9, max_restarts=10, limits=False)
+            res = self._numerical_ik()._solve(
+                T, None, position_only=position_only, tol=1e-9, max_restarts=10, seed=0, limits=False
+            )
         if res.position_error > 1e-6 or position_only:
             return (
                 f"the target is out of reach: the closest tcp position found is {res.position_error:.4g} m away "
@@ -466,7 +468,9 @@ class Robot:
                 q2, pe, re, _ = solver.attempt(q, T[0], False, tol)
                 if pe <= tol and re <= tol and self.within_limits(q2):
                     return q2
-        res = solver.solve(T[0], seed_q, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        res = solver._solve(
+            T[0], seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True
+        )
         if res.success and self.within_limits(res.q):
             return res.q
         reason = self.ik_failure_reason(T[0, :3, 3] if position_only else T[0], position_only=position_only)

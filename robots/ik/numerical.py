@@ -65,7 +65,9 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg.lapack import dposv as _posv
 
+from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
+from ..robot import _check_seed, _check_tolerance
 
 __all__ = ["NumericalIK", "IKResult"]
 
@@ -412,7 +414,28 @@ class NumericalIK:
         window centred on their range); if it meets the target outside the limits, a
         projected descent from its projection. Success is confirmed on the returned ``q``
         with a fresh forward kinematics.
+
+        Raises:
+            InvalidInput: a target that is not one finite pose ``(4, 4)`` with a proper
+                rotation (with ``position_only`` a position ``(3,)`` is accepted), a seed of
+                the wrong shape or non-finite, ``tol`` not finite and positive,
+                ``max_restarts`` not a non-negative integer, or a bad ``seed``.
         """
+        robot = self.robot
+        T, single = robot.check_target(target, position_only=position_only)
+        if not single:
+            raise InvalidInput("NumericalIK.solve takes one target: a pose (4, 4) (or a position (3,) with position_only)")
+        if q_seed is not None:
+            q_seed = robot.check_q(q_seed)[0][0]
+        if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
+            raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+        return self._solve(
+            T[0], q_seed, position_only=position_only, tol=_check_tolerance(tol, "tol [m, rad]", positive=True),
+            max_restarts=int(max_restarts), seed=_check_seed(seed), limits=bool(limits),
+        )
+
+    def _solve(self, target, q_seed, *, position_only, tol, max_restarts, seed, limits) -> IKResult:
+        """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once)."""
         target = np.asarray(target, dtype=float)
         T_des, p_des = self._target(target, position_only)
         tol = float(tol)

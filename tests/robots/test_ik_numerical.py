@@ -316,3 +316,29 @@ def test_numpy_float_tolerance_is_accepted():
     q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])
     sol = ur5.ik(ur5.fk(q), q_seed=q, tol=np.float32(1e-6))
     assert np.linalg.norm(ur5.position(sol) - ur5.position(q)) <= 1e-6
+
+
+@pytest.mark.parametrize(
+    "args, kwargs, message",
+    [
+        ((np.eye(3),), {}, "pose of shape"),
+        ((np.full((4, 4), np.nan),), {}, "non-finite"),
+        ((np.eye(4), np.zeros(3)), {}, r"shape \(6,\)"),
+        ((np.eye(4), np.full(6, np.inf)), {}, "non-finite"),
+        ((np.eye(4),), {"tol": -1.0}, "tol"),
+        ((np.eye(4),), {"max_restarts": -2}, "max_restarts"),
+        ((np.eye(4),), {"seed": 0.5}, "seed must be"),
+        ((np.stack([np.eye(4)] * 2),), {}, "one target"),
+    ],
+)
+def test_numerical_solver_names_bad_input(args, kwargs, message):
+    """The public solver class checks its input like Robot.ik (no NaN result, no Pinocchio traceback)."""
+    with pytest.raises(InvalidInput, match=message):
+        NumericalIK(robots.load("ur5")).solve(*args, **kwargs)
+
+
+def test_numerical_solver_accepts_a_position_when_position_only():
+    ur5 = robots.load("ur5")
+    p = ur5.position(np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6]))
+    res = NumericalIK(ur5).solve(p, position_only=True)
+    assert res.success and np.linalg.norm(ur5.position(res.q) - p) <= 1e-10
