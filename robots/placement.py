@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InvalidInput
-from .workspace import SINGULAR_INVERSE_CONDITION, radial_distance
+from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
 
 if TYPE_CHECKING:  # pragma: no cover
     from .workspace import Workspace
@@ -103,7 +103,7 @@ class RecommendedRegion:
             return f"{head}: no shell meets the criteria {self.criteria}"
         lines = [
             head,
-            f"  z {'>' if self.side == 'above' else '<'} {self.z_limit * mm:.0f} mm and "
+            f"  z {'>' if self.side == 'above' else '<'} {self.z_limit * mm + 0.0:.0f} mm and "
             f"{self.r_inner * mm:.0f} mm < r < {self.r_outer * mm:.0f} mm (r = {where})",
             "  criteria: " + ", ".join(f"{k} = {v:g}" for k, v in self.criteria.items()),
             "  shell [mm]   samples  near-singular  core collision  accepted",
@@ -160,10 +160,18 @@ def recommend_region(
         ("max_singular_share", max_singular_share, 0.0, 1.0),
         ("max_collision_share", max_collision_share, 0.0, 1.0),
     ):
-        if not (np.isfinite(v) and lo < v <= hi) if name == "width" else not (lo <= v <= hi):
-            raise InvalidInput(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
-    if not (np.isfinite(z_clearance) and z_clearance >= 0):
+        if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool):
+            raise InvalidInput(f"{name} must be a number, got {v!r}")
+        if name == "width" and not (np.isfinite(v) and v > 0):
+            raise InvalidInput(f"width must be a positive shell width in m, got {v!r}")
+        if name != "width" and not (lo <= v <= hi):
+            raise InvalidInput(f"{name} must be a share in [{lo:g}, {hi:g}], got {v!r}")
+    real = (int, float, np.integer, np.floating)
+    if isinstance(z_clearance, bool) or not isinstance(z_clearance, real) or not (np.isfinite(z_clearance) and z_clearance >= 0):
         raise InvalidInput(f"z_clearance must be a length ≥ 0 in m, got {z_clearance!r}")
+    singular_threshold = _check_threshold(singular_threshold)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
     if isinstance(n_collision, bool) or not isinstance(n_collision, (int, np.integer)) or n_collision < 0:
         raise InvalidInput(f"n_collision must be an integer ≥ 0, got {n_collision!r}")
 
@@ -172,7 +180,7 @@ def recommend_region(
         origin = workspace.fit_sphere().centre.copy()
         if about == "axis":
             origin[2] = 0.0
-    origin = np.asarray(origin, dtype=float).reshape(3)
+    origin = _as_point(origin, "origin")
     if side == "auto":
         side = "above" if np.count_nonzero(P[:, 2] > 0) >= P.shape[0] / 2 else "below"
     z_limit = z_clearance if side == "above" else -z_clearance

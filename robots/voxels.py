@@ -9,6 +9,7 @@ an estimate of the distance to the workspace boundary [m], resolution ``voxel_si
 
 Sampling leaves holes where samples are sparse: use several samples per voxel on average
 (e.g. 10⁶ samples for 1 cm voxels in a 1.4 m cube has about 0.4 per voxel: prefer 2 cm).
+:func:`suggest_voxel_size` picks the edge that gives about 10 samples per reachable voxel.
 """
 
 from __future__ import annotations
@@ -21,7 +22,34 @@ from scipy import ndimage
 
 from .errors import InvalidInput
 
-__all__ = ["VoxelMap", "VoxelQuery"]
+__all__ = ["VoxelMap", "VoxelQuery", "suggest_voxel_size", "SAMPLES_PER_VOXEL"]
+
+SAMPLES_PER_VOXEL = 10
+"""Mean samples per reachable voxel aimed at by :func:`suggest_voxel_size`."""
+
+
+def suggest_voxel_size(points: Any, samples_per_voxel: float = SAMPLES_PER_VOXEL) -> float:
+    """Voxel edge [m] at which the reachable voxels hold about ``samples_per_voxel`` samples each.
+
+    With fewer samples per voxel many reachable voxels stay empty by chance and the map
+    reports holes and near-zero margins inside the workspace (10⁵ UR5 samples in 2 cm
+    voxels: 1.3 samples per occupied voxel, 35 % of reachable points found). The reachable
+    volume ``V`` is measured on a coarse map (40 voxels along the longest side), then
+    ``edge = (samples_per_voxel · V / N)^(1/3)``, rounded up to the millimetre.
+    """
+    P = np.asarray(points, dtype=float)
+    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0 or not np.all(np.isfinite(P)):
+        raise InvalidInput(f"points must be a non-empty finite (N, 3) array [m], got shape {P.shape}")
+    if not (np.isfinite(samples_per_voxel) and samples_per_voxel > 0):
+        raise InvalidInput(f"samples_per_voxel must be a positive number, got {samples_per_voxel!r}")
+    extent = np.ptp(P, axis=0)
+    coarse = max(float(extent.max()) / 40.0, 1e-3)
+    ijk = ((P - P.min(axis=0)) / coarse).astype(np.int64)
+    shape = ijk.max(axis=0) + 1
+    occupied = np.unique(np.ravel_multi_index(ijk.T, shape)).size
+    volume = occupied * coarse**3
+    edge = (samples_per_voxel * volume / P.shape[0]) ** (1.0 / 3.0)
+    return float(np.ceil(max(edge, 1e-3) * 1000.0) / 1000.0)
 
 
 @dataclass(frozen=True)
@@ -125,7 +153,10 @@ class VoxelMap:
 
     def query(self, points: Any) -> VoxelQuery:
         """Is each of ``points (N, 3)`` or ``(3,)`` [m] reachable, with what margin and dexterity?"""
-        P = np.asarray(points, dtype=float)
+        try:
+            P = np.asarray(points, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInput(f"query points must be numbers with shape (N, 3) [m], got {points!r}") from exc
         if P.ndim == 1:
             P = P[None, :]
         if P.ndim != 2 or P.shape[1] != 3 or not np.all(np.isfinite(P)):

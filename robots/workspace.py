@@ -242,8 +242,12 @@ def fit_sphere_to_hull(points: Any, n_bins: int | None = None, iterations: int =
     inside the true boundary (the outer shell is sparse), so the radius is biased low.
     """
     P = _as_points(points, "points")
+    if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or iterations < 1:
+        raise InvalidInput(f"iterations must be an integer >= 1, got {iterations!r}")
+    if n_bins is not None and (isinstance(n_bins, bool) or not isinstance(n_bins, (int, np.integer)) or n_bins < 8):
+        raise InvalidInput(f"n_bins must be None (automatic) or an integer >= 8 direction cells, got {n_bins!r}")
     fit = fit_sphere(P)
-    for _ in range(max(1, int(iterations))):
+    for _ in range(int(iterations)):
         idx = hull_points(P, fit.centre, n_bins)
         if idx.size < 4:
             break
@@ -369,8 +373,8 @@ class Workspace:
         return self.points.shape[0]
 
     def near_singular(self, threshold: float = SINGULAR_INVERSE_CONDITION) -> np.ndarray:
-        """``(n,)`` bool: samples whose ``σ_min/σ_max`` of ``J_v`` is below ``threshold``."""
-        return self.inverse_condition < threshold
+        """``(n,)`` bool: samples whose ``σ_min/σ_max`` of ``J_v`` is below ``threshold`` (in (0, 1])."""
+        return self.inverse_condition < _check_threshold(threshold)
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """``(min (3,), max (3,))`` of the sampled points [m]."""
@@ -396,8 +400,9 @@ class Workspace:
                 around the vertical axis through ``origin``.
             mask: ``(n,)`` bool, only these samples are counted (e.g. ``points[:, 2] > 0``).
         """
-        if not (np.isfinite(width) and width > 0):
+        if not (isinstance(width, (int, float, np.integer, np.floating)) and np.isfinite(width) and width > 0):
             raise InvalidInput(f"shell width must be a positive length in m, got {width!r}")
+        singular_threshold = _check_threshold(singular_threshold)
         origin = self.fit_sphere().centre if origin is None else _as_point(origin, "origin")
         P, w, c = self.points, self.manipulability, self.inverse_condition
         if mask is not None:
@@ -424,6 +429,7 @@ class Workspace:
 
     def summary(self, *, width: float = 0.05, singular_threshold: float = SINGULAR_INVERSE_CONDITION) -> WorkspaceSummary:
         """Bounding box, outer-hull sphere, radial profile (shells of ``width`` m) and singular share."""
+        singular_threshold = _check_threshold(singular_threshold)
         lo, hi = self.bounding_box()
         sphere = self.fit_sphere()
         profile = self.radial_profile(sphere.centre, width=width, singular_threshold=singular_threshold)
@@ -441,10 +447,16 @@ class Workspace:
             manipulability_max=float(np.max(self.manipulability)),
         )
 
-    def voxel_map(self, voxel_size: float = 0.02, *, min_count: int = 1) -> "VoxelMap":
-        """Voxel reachability map of the samples (see :class:`robots.voxels.VoxelMap`)."""
-        from .voxels import VoxelMap
+    def voxel_map(self, voxel_size: float | None = None, *, min_count: int = 1) -> "VoxelMap":
+        """Voxel reachability map of the samples (see :class:`robots.voxels.VoxelMap`).
 
+        ``voxel_size`` [m]; default: :func:`robots.voxels.suggest_voxel_size` (about 10
+        samples per reachable voxel, so that chance holes do not fake a boundary).
+        """
+        from .voxels import VoxelMap, suggest_voxel_size
+
+        if voxel_size is None:
+            voxel_size = suggest_voxel_size(self.points)
         return VoxelMap.from_samples(self.points, self.manipulability, voxel_size, min_count=min_count)
 
     def recommend_region(self, **options: Any) -> "RecommendedRegion":
@@ -510,7 +522,19 @@ def _as_points(points: Any, what: str) -> np.ndarray:
     return P
 
 
+def _check_threshold(threshold: Any) -> float:
+    """``singular_threshold``: a ``σ_min/σ_max`` bound in (0, 1]."""
+    ok = isinstance(threshold, (int, float, np.integer, np.floating)) and not isinstance(threshold, bool)
+    if not (ok and 0.0 < float(threshold) <= 1.0):
+        raise InvalidInput(
+            f"singular_threshold must be an inverse condition number σ_min/σ_max in (0, 1], got {threshold!r}"
+        )
+    return float(threshold)
+
+
 def _as_point(point: Any, what: str) -> np.ndarray:
+    if np.shape(point) not in ((3,), (1, 3)):
+        raise InvalidInput(f"{what} must be one point (3,) [m], got shape {np.shape(point)}")
     P = _as_points(point, what)
     if P.shape[0] != 1:
         raise InvalidInput(f"{what} must be one point (3,) [m], got shape {np.shape(point)}")

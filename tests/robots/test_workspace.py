@@ -205,3 +205,46 @@ def test_workspace_arrays_are_read_only(aubo):
     ws = sample_workspace(aubo, n=10, seed=0)
     with pytest.raises(ValueError):
         ws.points[0, 0] = 1.0
+
+
+def test_default_voxel_size_keeps_the_interior_free_of_chance_holes(aubo):
+    """2 cm voxels with 10⁵ samples leave half of the reachable points in empty voxels; the default does not."""
+    from robots.voxels import suggest_voxel_size
+
+    ws = sample_workspace(aubo, n=100_000, seed=0)
+    vm = ws.voxel_map()
+    assert vm.voxel_size == suggest_voxel_size(ws.points)
+    assert 8 <= ws.n / np.count_nonzero(vm.reachable) <= 13  # about 10 samples per reachable voxel
+    inside = aubo.position(aubo.random_q(2000, seed=9))  # reachable by construction
+    assert np.mean(vm.query(inside).reachable) > 0.97
+    with pytest.raises(InvalidInput, match="samples_per_voxel"):
+        suggest_voxel_size(ws.points, 0)
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda ws: ws.summary(singular_threshold=float("nan")), "singular_threshold"),
+        (lambda ws: ws.summary(singular_threshold=-1.0), "singular_threshold"),
+        (lambda ws: ws.near_singular(2.0), "singular_threshold"),
+        (lambda ws: ws.radial_profile(singular_threshold=0.0), "singular_threshold"),
+        (lambda ws: ws.recommend_region(singular_threshold=float("nan"), n_collision=0), "singular_threshold"),
+        (lambda ws: ws.recommend_region(origin=[0.0, 0.0], n_collision=0), "origin must be one point"),
+        (lambda ws: ws.recommend_region(origin=[np.nan, 0.0, 0.0], n_collision=0), "origin holds NaN"),
+        (lambda ws: ws.recommend_region(z_clearance="1", n_collision=0), "z_clearance"),
+        (lambda ws: ws.recommend_region(seed="a"), "seed"),
+        (lambda ws: ws.recommend_region(max_singular_share=float("nan"), n_collision=0), "max_singular_share"),
+        (lambda ws: fit_sphere_to_hull(ws.points, iterations=0), "iterations"),
+        (lambda ws: fit_sphere_to_hull(ws.points, n_bins=-5), "n_bins"),
+        (lambda ws: ws.voxel_map(0.1).query("conveyor"), "query points"),
+    ],
+)
+def test_bad_analysis_options_raise_invalid_input(aubo, call, match):
+    ws = sample_workspace(aubo, n=500, seed=0)
+    with pytest.raises(InvalidInput, match=match):
+        call(ws)
+
+
+def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
+    ws = sample_workspace(aubo, n=2000, seed=0)
+    assert "z < 0 mm" in ws.recommend_region(side="below", n_collision=0).text()
