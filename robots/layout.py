@@ -21,7 +21,13 @@ Positions without an orientation get one: for arms with 6 or more joints the too
 straight down (tool z along the base's −z, tool x along the base's +x), the usual
 pick-and-place pose; for arms with fewer joints (SCARA, gantry, koji arm) the orientation
 the tool has at the neutral configuration, which these arms keep up to a rotation about the
-vertical that their last joint provides.
+vertical (yaw). The yaw of such a position-only target is free: when the neutral yaw has no
+solution within the limits, the yaws ±5°, ±10°, … ±180° are tried in that order and the
+first one with a solution is used (``PointCheck.target`` holds it); if none has one (near
+the limits the usable yaws can form a narrow interval), a position-only numerical IK from
+``n_seeds`` starts looks for a configuration and the closed form is solved at its yaw. This matters for arms
+whose last joint moves the tool point, e.g. the koji arm, whose wrist carries the tool
+``H = 0.25 m`` off its axis: its reachable positions need a matching yaw.
 """
 
 from __future__ import annotations
@@ -49,7 +55,8 @@ class PointCheck:
     Attributes:
         name: label of the point.
         target: ``(4, 4)`` pose asked, tcp → base [m].
-        solutions: ``(k, nq)`` IK solutions within the joint limits (k = 0: unreachable).
+        solutions: ``(k, nq)`` IK solutions within the joint limits (k = 0: unreachable),
+            every 2π-shifted copy included (see :attr:`n_branches`).
         manipulability: ``(k,)`` position manipulability of each solution.
         inverse_condition: ``(k,)`` ``σ_min/σ_max`` of the position Jacobian of each.
         best: index of the most dexterous solution (-1 if unreachable).
@@ -72,9 +79,26 @@ class PointCheck:
         return self.solutions.shape[0] > 0
 
     @property
-    def n_branches(self) -> int:
-        """Number of distinct IK solutions found."""
+    def n_solutions(self) -> int:
+        """Number of IK solutions within the limits (2π-shifted copies of a revolute angle counted apart)."""
         return int(self.solutions.shape[0])
+
+    @property
+    def n_branches(self) -> int:
+        """Number of distinct arm configurations among :attr:`solutions`.
+
+        Solutions whose joint values differ only by multiples of 2π (a revolute joint with
+        a range wider than one turn, e.g. the UR arms' ±360°) are the same configuration of
+        the arm and count once: a UR5 pose has at most 8 branches but up to 8·2⁶ solutions.
+        (A prismatic joint's values would have to differ by exactly 2π m to be merged.)
+        """
+        q = self.solutions
+        if q.shape[0] < 2:
+            return int(q.shape[0])
+        d = q[:, None, :] - q[None, :, :]
+        same = np.all(np.abs((d + np.pi) % (2.0 * np.pi) - np.pi) < 1e-6, axis=2)
+        first = np.argmax(same, axis=1)  # lowest index of each solution's class
+        return int(np.count_nonzero(first == np.arange(q.shape[0])))
 
 
 @dataclass(frozen=True)
@@ -102,13 +126,14 @@ class LayoutReport:
         lines = [
             f"layout check of {self.robot} ({self.frame}, {self.method} IK; dexterity = w / median w "
             f"of the workspace = {self.median_manipulability:.4g})",
-            "  point                 x [mm]   y [mm]   z [mm]  branches  dexterity  σmin/σmax  margin [mm]",
+            "  point                 x [mm]   y [mm]   z [mm]  branches (solutions)  dexterity  σmin/σmax  margin [mm]",
         ]
         for p in self.points:
             x, y, z = p.target[:3, 3] * 1000.0
             if p.reachable:
                 lines.append(
-                    f"  {p.name:<20s} {x:8.1f} {y:8.1f} {z:8.1f}  {p.n_branches:8d}  {p.dexterity_ratio:9.2f}"
+                    f"  {p.name:<20s} {x:8.1f} {y:8.1f} {z:8.1f}  {p.n_branches:8d} {f'({p.n_solutions})':>11s}"
+                    f"  {p.dexterity_ratio:9.2f}"
                     f"  {p.inverse_condition[p.best]:9.3f}  {p.boundary_margin * 1000.0:11.0f}"
                 )
             else:
@@ -124,8 +149,27 @@ def default_orientation(robot: "Robot") -> np.ndarray:
     return robot.fk(robot.neutral)[:3, :3]
 
 
+_YAW_STEP_DEG = 5
+
+
+def _yaw_candidates() -> np.ndarray:
+    """Yaws [rad] tried for position-only targets of arms with < 6 joints: 0, +5°, −5°, … 180°."""
+    steps = [0]
+    for k in range(1, 180 // _YAW_STEP_DEG):
+        steps += [k * _YAW_STEP_DEG, -k * _YAW_STEP_DEG]
+    return np.radians(steps + [180])
+
+
+def _rot_z(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
 def _targets(robot: "Robot", points: Any, orientation: Any) -> np.ndarray:
-    arr = np.asarray(points, dtype=float)
+    try:
+        arr = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"points must be positions (N, 3) [m] or poses (N, 4, 4) of numbers, got {points!r}") from exc
     if arr.ndim == 1 and arr.shape == (3,):
         arr = arr[None]
     if arr.ndim == 2 and arr.shape == (4, 4) and orientation is None and np.allclose(arr[3], [0, 0, 0, 1]):
@@ -172,7 +216,7 @@ def check_layout(
     names: Any = None,
     orientation: Any = None,
     workspace: Workspace | None = None,
-    voxel_size: float = 0.02,
+    voxel_size: float | None = None,
     n_seeds: int = 8,
     seed: int = 0,
 ) -> LayoutReport:
@@ -185,14 +229,22 @@ def check_layout(
         names: labels of the points (default ``P1, P2, ...``).
         workspace: a sampled workspace of the robot's tcp used for the dexterity median
             and the boundary margin (default: 100 000 samples with ``seed``).
-        voxel_size: voxel edge of the boundary-margin map [m].
-        n_seeds: starts of the numerical IK (arms without a closed form).
+        voxel_size: voxel edge of the boundary-margin map [m]; default: about 10 samples
+            per reachable voxel (:func:`robots.voxels.suggest_voxel_size`).
+        n_seeds: starts of the numerical IK (arms without a closed form), ≥ 1.
+        seed: seed of the default workspace and of the numerical IK starts.
+
+    Position-only targets of arms with fewer than 6 joints have a free yaw (module doc).
 
     Raises:
-        InvalidInput: malformed points, names or orientation.
+        InvalidInput: malformed points, names, orientation or n_seeds, or a workspace of
+            another robot or frame.
     """
     T = _targets(robot, points, orientation)
+    yaw_free = orientation is None and robot.nq < 6 and np.ndim(points) in (1, 2) and np.shape(points)[-1] == 3
     N = T.shape[0]
+    if isinstance(n_seeds, bool) or not isinstance(n_seeds, (int, np.integer)) or n_seeds < 1:
+        raise InvalidInput(f"n_seeds must be an integer >= 1 (starts of the numerical IK), got {n_seeds!r}")
     if names is None:
         names = [f"P{i + 1}" for i in range(N)]
     names = [str(n) for n in names]
@@ -200,14 +252,44 @@ def check_layout(
         raise InvalidInput(f"got {len(names)} names for {N} points")
     if workspace is None:
         workspace = sample_workspace(robot, 100_000, seed=seed, frame="tcp")
+    elif not isinstance(workspace, Workspace) or workspace.robot.name != robot.name or (
+        workspace.robot.frame_id(workspace.frame) != robot.frame_id("tcp")
+    ):
+        raise InvalidInput(
+            "workspace must be a Workspace sampled for this robot's tcp "
+            f"(sample_workspace({robot.name!r}, frame='tcp')), got "
+            + (f"one of {workspace.robot.name!r} ({workspace.frame})" if isinstance(workspace, Workspace) else type(workspace).__name__)
+        )
     median_w = float(np.median(workspace.manipulability))
     vmap = workspace.voxel_map(voxel_size)
     margins = vmap.query(T[:, :3, 3]).margin
 
     if robot.has_analytic_ik:
         method = "analytic"
-        sols = robot.ik_all(T)
-        sols = [np.asarray(s, dtype=float).reshape(-1, robot.nq) for s in sols]
+        sols = [np.asarray(s, dtype=float).reshape(-1, robot.nq) for s in robot.ik_all(T)]
+        if yaw_free:
+            # position-only target of an arm that keeps the tool vertical: its yaw is free
+            R0 = T[:, :3, :3].copy()
+            for yaw in _yaw_candidates()[1:]:
+                todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
+                if not todo:
+                    break
+                Ty = T[todo].copy()
+                Ty[:, :3, :3] = _rot_z(yaw) @ R0[todo]
+                for i, Ti, q in zip(todo, Ty, robot.ik_all(Ty)):
+                    q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
+                    if q.shape[0]:
+                        sols[i], T[i] = q, Ti
+            # near the limits the usable yaws can be a narrow interval between grid values:
+            # a position-only numerical solve finds one, the closed form then gives its branches
+            todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
+            if todo:
+                for i, q in zip(todo, _numerical_solutions(robot, T[todo], n_seeds, seed, position_only=True)):
+                    if q.shape[0]:
+                        Ti = T[i].copy()
+                        Ti[:3, :3] = robot.fk(q[0])[:3, :3]
+                        exact = np.asarray(robot.ik_all(Ti), dtype=float).reshape(-1, robot.nq)
+                        sols[i], T[i] = (exact, Ti) if exact.shape[0] else (q[:1], Ti)
     else:
         method = "numerical"
         sols = _numerical_solutions(robot, T, n_seeds, seed, position_only=robot.nq < 6)
