@@ -335,11 +335,13 @@ class Robot:
             ref, _ = self.check_q(q_ref)
             if ref.shape[0] not in (1, T.shape[0]):
                 raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
+        from .ik.solver import split_by_target  # late import: the solvers need the Robot class
+
         if respect_limits:
             sols = self._analytic_ik.solve(T, ref)
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
-            sols = np.split(q, np.cumsum(np.bincount(idx, minlength=T.shape[0]))[:-1])
+            sols = split_by_target(idx, q, T.shape[0])
         return sols[0] if single else sols
 
     def _numerical_ik(self):

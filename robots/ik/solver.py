@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL"]
+__all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL", "split_by_target"]
 
 #: Joint-limit tolerance of the returned solutions [rad or m].
 LIMIT_TOL = 1e-9
@@ -38,6 +38,15 @@ _TWO_PI = 2.0 * np.pi
 _CHUNK = 8192  # targets per block
 _MAX_ROWS = 1 << 20  # candidate rows per block (bounds memory for wide joint ranges)
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
+
+
+def split_by_target(idx: np.ndarray, q: np.ndarray, n_targets: int) -> list[np.ndarray]:
+    """Rows ``q (M, nq)`` sorted by target index ``idx (M,)`` as a list of ``n_targets`` arrays ``(k_i, nq)``.
+
+    Plain slices (views): ``np.split`` costs ≈ 10× more per piece, which matters for 10⁵ targets.
+    """
+    ends = np.cumsum(np.bincount(idx, minlength=n_targets)).tolist()
+    return [q[a:b] for a, b in zip([0] + ends[:-1], ends)]
 
 
 class AnalyticIK:
@@ -237,5 +246,4 @@ class AnalyticIK:
     def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None) -> list[np.ndarray]:
         """Every solution within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first."""
         idx, q = self.candidates(targets, q_ref)
-        counts = np.bincount(idx, minlength=targets.shape[0])
-        return np.split(q, np.cumsum(counts)[:-1])
+        return split_by_target(idx, q, targets.shape[0])

@@ -319,3 +319,13 @@ def test_starts_drop_branches_no_equivalent_brings_within_limits():
     np.testing.assert_allclose(np.sort(starts, axis=0), np.sort(inside, axis=0), atol=1e-7)
     koji = robots.load("koji_turner")
     assert koji._analytic_ik.starts(KOJI_PAPER_MATRIX, koji.neutral).shape[0] == 0  # shoulder 25.0011° > 25°
+
+
+def test_split_by_target_keeps_empty_targets_and_order():
+    from robots.ik.solver import split_by_target
+
+    q = np.arange(12.0).reshape(4, 3)
+    parts = split_by_target(np.array([1, 1, 3, 3]), q, 5)
+    assert [p.shape for p in parts] == [(0, 3), (2, 3), (0, 3), (2, 3), (0, 3)]
+    np.testing.assert_array_equal(np.concatenate(parts), q)
+    assert split_by_target(np.zeros(0, dtype=int), np.zeros((0, 3)), 0) == []
