@@ -52,6 +52,7 @@ __all__ = [
     "PointSet",
     "HistoryRecord",
     "load_session",
+    "MAX_TRAJECTORY_SAMPLES",
 ]
 
 FORMAT_NAME = "pinarms-session"
@@ -62,6 +63,8 @@ JSON_MEMBER = "session.json"
 _NAME_RE = re.compile(r"^(?=.*\S)[^/\x00-\x1f\x7f]{1,100}$")
 _POINT_KINDS = ("via", "target")
 _F8 = np.dtype("<f8")
+MAX_TRAJECTORY_SAMPLES = 2_000_000
+"""Most samples :meth:`Session.add_trajectory` takes from a Trajectory (duration × hz)."""
 
 
 # ---------------------------------------------------------------------------- records
@@ -155,7 +158,10 @@ class PointSet:
 
 @dataclass(frozen=True, eq=False)
 class HistoryRecord:
-    """An optimisation history: equal-length 1-D float columns (``best`` and usually ``mean``), one row per generation."""
+    """An optimisation history: equal-length 1-D float columns (``best`` and usually ``mean``), one row per generation.
+
+    ``inf`` marks a generation without any finite objective (NaN is never stored).
+    """
 
     name: str
     columns: dict[str, np.ndarray]
@@ -188,8 +194,8 @@ def _json_normalised(obj: Any, what: str) -> Any:
         raise InvalidInput(f"{what} must be JSON-able (dicts, lists, str, finite numbers, bool, None): {exc}") from exc
 
 
-def _float_array(values: Any, what: str, ndim: int, width: int | None = None) -> np.ndarray:
-    """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``)."""
+def _float_array(values: Any, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
+    """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``); ±inf allowed on request."""
     try:
         arr = np.array(values, dtype=_F8)
     except (TypeError, ValueError) as exc:
@@ -197,8 +203,8 @@ def _float_array(values: Any, what: str, ndim: int, width: int | None = None) ->
     if arr.ndim != ndim or (width is not None and arr.shape[-1] != width):
         shape = "(N,)" if ndim == 1 else f"(N, {width})"
         raise InvalidInput(f"{what} must have shape {shape}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise InvalidInput(f"{what} holds NaN or infinite values")
+    if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
+        raise InvalidInput(f"{what} holds NaN{'' if allow_inf else ' or infinite'} values")
     arr.flags.writeable = False
     return arr
 
@@ -363,7 +369,10 @@ class Session:
         size_arr = _float_array(size, f"size of box {name!r}", 1, 3)
         if np.any(size_arr <= 0):
             raise InvalidInput(f"size of box {name!r} must be positive edge lengths in m, got {size_arr.tolist()}")
-        rgba = tuple(float(c) for c in np.asarray(color, dtype=float).ravel())
+        try:
+            rgba = tuple(float(c) for c in np.asarray(color, dtype=float).ravel())
+        except (TypeError, ValueError):
+            rgba = ()
         if len(rgba) != 4 or not all(0.0 <= c <= 1.0 for c in rgba):
             raise InvalidInput(f"color of box {name!r} must be 4 RGBA values in [0, 1], got {color!r}")
         box = BoxObject(name, size_arr, _pose(pose, f"pose of box {name!r}"), rgba)
@@ -388,7 +397,13 @@ class Session:
             if not (isinstance(hz, (int, float)) and math.isfinite(hz) and hz > 0):
                 raise InvalidInput(f"hz must be a positive sampling rate in 1/s, got {hz!r}")
             knots = np.asarray(trajectory.knot_times, dtype=float)
-            n = max(2, int(math.ceil((knots[-1] - knots[0]) * hz)) + 1)
+            n_wanted = (knots[-1] - knots[0]) * hz
+            if not n_wanted < MAX_TRAJECTORY_SAMPLES:
+                raise InvalidInput(
+                    f"trajectory {name!r}: {knots[-1] - knots[0]:g} s at hz={hz:g} gives {n_wanted:.3g} samples, more "
+                    f"than {MAX_TRAJECTORY_SAMPLES:,}; lower hz"
+                )
+            n = max(2, int(math.ceil(n_wanted)) + 1)
             t = np.union1d(np.linspace(knots[0], knots[-1], n), knots)
             q = trajectory.sample(t)[0]
             definition = _json_normalised(trajectory.definition, f"definition of trajectory {name!r}")
@@ -420,11 +435,17 @@ class Session:
         name = self._free(self.workspaces, name, "workspace")
         entry = self._entry(robot)
         if workspace is not None:
+            if not (hasattr(workspace, "points") and hasattr(workspace, "manipulability")):
+                raise InvalidInput(
+                    f"workspace {name!r} must be a robots.Workspace (points, manipulability), got {type(workspace).__name__}"
+                )
             points, manipulability = workspace.points, workspace.manipulability
         if points is None or manipulability is None:
             raise InvalidInput(f"workspace {name!r}: give a Workspace, or both points= and manipulability=")
         pts = _float_array(points, f"points of workspace {name!r}", 2, 3)
         w = _float_array(manipulability, f"manipulability of workspace {name!r}", 1)
+        if pts.shape[0] == 0:
+            raise InvalidInput(f"workspace {name!r} has no points; sample at least one")
         if w.shape[0] != pts.shape[0] or np.any(w < 0):
             raise InvalidInput(
                 f"workspace {name!r} needs one manipulability value >= 0 per point; got {w.shape[0]} for {pts.shape[0]} points"
@@ -442,7 +463,13 @@ class Session:
         if kind not in _POINT_KINDS:
             raise InvalidInput(f"kind of point set {name!r} must be one of {_POINT_KINDS}, got {kind!r}")
         key = None if robot is None else self._entry(robot).key
-        pts = _float_array(np.atleast_2d(np.asarray(points, dtype=float)), f"points of point set {name!r}", 2, 3)
+        try:
+            arr = np.atleast_2d(np.asarray(points, dtype=float))
+        except (TypeError, ValueError) as exc:
+            raise InvalidInput(f"points of point set {name!r} must be numbers (n, 3) in m, got {points!r}") from exc
+        pts = _float_array(arr, f"points of point set {name!r}", 2, 3)
+        if pts.shape[0] == 0:
+            raise InvalidInput(f"point set {name!r} has no points; give at least one (n, 3) row in m")
         ps = PointSet(name, kind, key, pts)
         self.point_sets[name] = ps
         return ps
@@ -465,8 +492,11 @@ class Session:
         out: dict[str, np.ndarray] = {}
         for k, v in cols.items():
             _check_name(k, f"column of history {name!r}")
-            out[k] = _float_array(v, f"column {k!r} of history {name!r}", 1)
+            # a generation without any finite objective records inf (optim's GA does so)
+            out[k] = _float_array(v, f"column {k!r} of history {name!r}", 1, allow_inf=True)
         lengths = {v.shape[0] for v in out.values()}
+        if 0 in lengths:
+            raise InvalidInput(f"history {name!r} has no generations; record at least one row")
         if len(lengths) != 1:
             raise InvalidInput(f"columns of history {name!r} must have equal lengths, got {sorted(lengths)}")
         rec = HistoryRecord(name, out)
@@ -592,7 +622,7 @@ class _Reader:
             raise self.fail(f"{where}.name {name!r} is not a valid name")
         return name
 
-    def array(self, obj: Any, key: str, where: str, shape: tuple[int | None, ...]) -> np.ndarray:
+    def array(self, obj: Any, key: str, where: str, shape: tuple[int | None, ...], allow_inf: bool = False) -> np.ndarray:
         ref = self.field(obj, key, dict, where)
         member = self.field(ref, "member", str, f"{where}.{key}")
         dtype = self.field(ref, "dtype", str, f"{where}.{key}")
@@ -611,8 +641,8 @@ class _Reader:
         if len(shape) != arr.ndim or any(s is not None and s != a for s, a in zip(shape, arr.shape)):
             want = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
             raise self.fail(f"member {member!r} has shape {arr.shape}, expected {want}")
-        if not np.all(np.isfinite(arr)):
-            raise self.fail(f"member {member!r} holds NaN or infinite values")
+        if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
+            raise self.fail(f"member {member!r} holds NaN{'' if allow_inf else ' or infinite'} values")
         arr.flags.writeable = False
         return arr
 
@@ -771,7 +801,7 @@ def _read(r: _Reader, package_dirs: Any) -> Session:
         cols_doc = r.field(o, "columns", dict, where)
         if "best" not in cols_doc:
             raise r.fail(f"{where}.columns lacks 'best'")
-        cols = {k: r.array(cols_doc, k, f"{where}.columns", (None,)) for k in cols_doc}
+        cols = {k: r.array(cols_doc, k, f"{where}.columns", (None,), allow_inf=True) for k in cols_doc}
         if len({c.shape[0] for c in cols.values()}) != 1:
             raise r.fail(f"{where}.columns have different lengths")
         s.histories[name] = HistoryRecord(name, cols)
