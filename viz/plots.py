@@ -41,6 +41,17 @@ def _save(fig: Figure, path: str | Path) -> Path:
     return atomic_write(p, lambda f: f.write(data))
 
 
+def _numbers(values: Any, what: str, allow_inf: bool = False) -> np.ndarray:
+    """``values`` as a finite float array (±inf kept if ``allow_inf``), or InvalidInput naming ``what``."""
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"{what} must be numbers, got {type(values).__name__}") from exc
+    if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
+        raise InvalidInput(f"{what} holds NaN{'' if allow_inf else ' or infinite'} values")
+    return arr
+
+
 def _limit_array(limits: Any, kind: str, n: int) -> np.ndarray | None:
     """Per-joint limit of ``kind`` from a JointLimits-like object or a mapping, or None."""
     if limits is None:
@@ -48,7 +59,12 @@ def _limit_array(limits: Any, kind: str, n: int) -> np.ndarray | None:
     value = limits.get(kind) if isinstance(limits, Mapping) else getattr(limits, kind, None)
     if value is None:
         return None
-    arr = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    try:
+        arr = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"{kind} limit must be one number or one per joint ({n}), got {value!r}") from exc
+    if np.any(np.isnan(arr)) or np.any(arr <= 0):
+        raise InvalidInput(f"{kind} limit must be positive (inf: no limit), got {arr.tolist()}")
     return arr
 
 
@@ -78,14 +94,16 @@ def plot_joint_curves(
         joint_names: legend labels (default ``joint 1..n``).
         degrees: show values ×180/π (revolute joints).
     """
-    tt = np.asarray(t, dtype=float)
+    tt = _numbers(t, "t")
     if tt.ndim != 1 or tt.size < 2:
         raise InvalidInput(f"t must be (N,) instants in s with N >= 2, got shape {tt.shape}")
+    if np.any(np.diff(tt) <= 0):
+        raise InvalidInput("t must be strictly increasing instants in s")
     series = []
     for order, values in enumerate((q, qd, qdd, qddd)):
         if values is None:
             continue
-        arr = np.asarray(values, dtype=float)
+        arr = _numbers(values, _ORDERS[order])
         arr = arr[:, None] if arr.ndim == 1 else arr
         if arr.ndim != 2 or arr.shape[0] != tt.size:
             raise InvalidInput(f"{_ORDERS[order]} must have shape ({tt.size}, n_joints), got {np.shape(values)}")
@@ -100,7 +118,7 @@ def plot_joint_curves(
         raise InvalidInput(f"joint_names has {len(names)} names for {n} joints")
     scale = 180.0 / math.pi if degrees else 1.0
     unit = "°" if degrees else "rad or m"
-    knots = None if knot_times is None else np.asarray(knot_times, dtype=float)
+    knots = None if knot_times is None else _numbers(knot_times, "knot_times").ravel()
 
     fig = Figure(figsize=(7.5, 2.3 * len(series) + 0.4))
     axes = fig.subplots(len(series), 1, sharex=True, squeeze=False)
@@ -133,8 +151,10 @@ def plot_joint_curves(
 
 def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
     """:func:`plot_joint_curves` of a ``planning.Trajectory`` (sampled at ``samples`` instants plus its knots)."""
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise InvalidInput(f"samples must be an integer >= 2 (instants drawn), got {samples!r}")
     knots = np.asarray(trajectory.knot_times, dtype=float)
-    t = np.union1d(np.linspace(knots[0], knots[-1], max(int(samples), 2)), knots)
+    t = np.union1d(np.linspace(knots[0], knots[-1], int(samples)), knots)
     q, qd, qdd, qddd = trajectory.sample(t)
     return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=knots, limits=limits, **options)
 
@@ -143,7 +163,8 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     """Best and mean objective per generation (and the feasible share when recorded).
 
     ``history``: a GA history (``best``, ``mean``, optional ``feasible_share``), a result
-    with ``.history``, a :class:`viz.HistoryRecord` or a mapping of columns.
+    with ``.history``, a :class:`viz.HistoryRecord` or a mapping of columns. Generations
+    recorded as ``inf`` (no finite objective) are left as gaps in the curves.
     """
     if hasattr(history, "columns"):
         history = history.columns
@@ -153,18 +174,30 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     best = get("best")
     if best is None:
         raise InvalidInput("history needs a 'best' column (objective of the best individual per generation)")
-    best = np.asarray(best, dtype=float)
+    best = _numbers(best, "best", allow_inf=True)
+    if best.ndim != 1 or best.size == 0:
+        raise InvalidInput(f"best must hold one objective per generation (G,) with G >= 1, got shape {best.shape}")
     gens = np.arange(best.size)
+
+    def column(key: str) -> np.ndarray | None:
+        values = get(key)
+        if values is None:
+            return None
+        arr = _numbers(values, key, allow_inf=True)
+        if arr.shape != best.shape:
+            raise InvalidInput(f"{key} must have one value per generation {best.shape}, got shape {arr.shape}")
+        return arr
+
     fig = Figure(figsize=(7, 3.6))
     ax = fig.subplots()
     ax.plot(gens, best, lw=1.8, label="best")
-    mean = get("mean")
+    mean = column("mean")
     if mean is not None:
-        ax.plot(gens, np.asarray(mean, dtype=float), lw=1.2, ls="--", label="population mean")
-    feasible = get("feasible_share")
+        ax.plot(gens, mean, lw=1.2, ls="--", label="population mean")
+    feasible = column("feasible_share")
     if feasible is not None:
         ax2 = ax.twinx()
-        ax2.plot(gens, np.asarray(feasible, dtype=float), color="0.55", lw=0.9, label="feasible share")
+        ax2.plot(gens, feasible, color="0.55", lw=0.9, label="feasible share")
         ax2.set_ylim(0, 1.05)
         ax2.set_ylabel("feasible share")
         ax2.legend(loc="center right", fontsize=8)
@@ -185,10 +218,12 @@ def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *,
     """
     if hasattr(points, "points"):
         points, manipulability = points.points, points.manipulability
-    pts = np.asarray(points, dtype=float)
+    pts = _numbers(points, "points")
     if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
         raise InvalidInput(f"points must have shape (n, 3) with n >= 1, got {pts.shape}")
-    w = None if manipulability is None else np.asarray(manipulability, dtype=float)
+    if colormap not in matplotlib.colormaps:
+        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
+    w = None if manipulability is None else _numbers(manipulability, "manipulability")
     if w is not None and w.shape != (pts.shape[0],):
         raise InvalidInput(f"manipulability must have shape ({pts.shape[0]},), got {w.shape}")
     k = 1000.0 if mm else 1.0

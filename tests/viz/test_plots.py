@@ -70,3 +70,30 @@ def test_bad_suffix_writes_nothing(traj, tmp_path):
     with pytest.raises(InvalidInput, match=".png or .svg"):
         viz.plot_trajectory(tmp_path / "j.pdf", traj)
     assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 0.5], [1.0, 2.0, 3.0]), "strictly increasing"),
+        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1.0, np.nan, 3.0]), "NaN"),
+        (lambda p: viz.plot_joint_curves(p, "abc", [1.0, 2.0, 3.0]), "t must be numbers"),
+        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": -1.0}), "positive"),
+        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": [1.0, 2.0]}), "one per joint"),
+        (lambda p: viz.plot_ga_convergence(p, {"best": []}), "G >= 1"),
+        (lambda p: viz.plot_ga_convergence(p, {"best": [[1.0, 2.0], [3.0, 4.0]]}), "one objective per generation"),
+        (lambda p: viz.plot_ga_convergence(p, {"best": [1.0, 2.0], "mean": [1.0, 2.0, 3.0]}), "mean must have one value"),
+        (lambda p: viz.plot_ga_convergence(p, {"best": [1.0, float("nan")]}), "NaN"),
+        (lambda p: viz.plot_workspace(p, np.full((3, 3), np.nan)), "NaN"),
+        (lambda p: viz.plot_workspace(p, np.zeros((3, 3)), colormap="nope"), "colormap"),
+    ],
+)
+def test_bad_plot_data_raises_invalid_input_and_writes_nothing(call, match, tmp_path):
+    with pytest.raises(InvalidInput, match=match):
+        call(tmp_path / "bad.png")
+    assert os.listdir(tmp_path) == []
+
+
+def test_trajectory_sample_count_is_checked_not_clamped(traj, tmp_path):
+    with pytest.raises(InvalidInput, match="samples must be an integer >= 2"):
+        viz.plot_trajectory(tmp_path / "j.png", traj, samples=0)
