@@ -184,15 +184,14 @@ def recommend_region(
     if side == "auto":
         side = "above" if np.count_nonzero(P[:, 2] > 0) >= P.shape[0] / 2 else "below"
     z_limit = z_clearance if side == "above" else -z_clearance
-    keep = np.flatnonzero(P[:, 2] > z_limit if side == "above" else P[:, 2] < z_limit)
-    r = radial_distance(P[keep], origin, about)
-    k = max(1, int(np.ceil((r.max() if r.size else width) / width)))
-    edges = np.arange(k + 1) * width
-    shell = np.minimum((r / width).astype(int), k - 1)
-    counts = np.bincount(shell, minlength=k)
-    sing = np.bincount(shell, weights=workspace.inverse_condition[keep] < singular_threshold, minlength=k)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        singular_share = np.where(counts > 0, sing / counts, np.nan)
+    side_mask = P[:, 2] > z_limit if side == "above" else P[:, 2] < z_limit
+    keep = np.flatnonzero(side_mask)
+    profile = workspace.radial_profile(
+        origin, about=about, width=width, mask=side_mask, singular_threshold=singular_threshold
+    )
+    edges, counts, singular_share = profile.edges, profile.counts, profile.singular_share
+    k = counts.size
+    shell = np.minimum((radial_distance(P[keep], origin, about) / width).astype(int), k - 1)
 
     checked = np.zeros(k, dtype=int)
     collided = np.zeros(k)
