@@ -279,8 +279,13 @@ class Robot:
                 arr = arr[None]
             if arr.ndim != 3 or arr.shape[1:] != (4, 4):
                 extra = " or a position (3,)" if position_only else ""
+                hint = (
+                    "; for a position without orientation use Robot.ik(position, position_only=True)"
+                    if not position_only and np.shape(target)[-1:] == (3,)
+                    else ""
+                )
                 raise InvalidInput(
-                    f"IK target must be a pose of shape (4, 4) or (N, 4, 4){extra}, got shape {np.shape(target)}"
+                    f"IK target must be a pose of shape (4, 4) or (N, 4, 4){extra}, got shape {np.shape(target)}{hint}"
                 )
         if arr.shape[0] == 0:
             return arr, single

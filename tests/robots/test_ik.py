@@ -329,3 +329,11 @@ def test_split_by_target_keeps_empty_targets_and_order():
     assert [p.shape for p in parts] == [(0, 3), (2, 3), (0, 3), (2, 3), (0, 3)]
     np.testing.assert_array_equal(np.concatenate(parts), q)
     assert split_by_target(np.zeros(0, dtype=int), np.zeros((0, 3)), 0) == []
+
+
+def test_a_position_given_to_ik_all_says_how_to_solve_it():
+    koji = robots.load("koji_turner")
+    with pytest.raises(InvalidInput, match=r"got shape \(3,\).*position_only=True"):
+        koji.ik_all(np.array([1.1973, 0.25, -0.9292]))
+    q = koji.ik(np.array([1.1973, 0.25, -0.9292]), position_only=True)
+    np.testing.assert_allclose(koji.position(q), [1.1973, 0.25, -0.9292], atol=1e-10)
