@@ -337,3 +337,26 @@ def test_a_position_given_to_ik_all_says_how_to_solve_it():
         koji.ik_all(np.array([1.1973, 0.25, -0.9292]))
     q = koji.ik(np.array([1.1973, 0.25, -0.9292]), position_only=True)
     np.testing.assert_allclose(koji.position(q), [1.1973, 0.25, -0.9292], atol=1e-10)
+
+
+def test_koji_paper_candidate_lists_are_our_branches_at_x_rounded_to_whole_mm():
+    """Seed 004 eq. (8) prints four θ2 and four θ3 (down) candidates; at (1197.0, 250, −929.2) mm
+    every one is an angle of our four geometric branches, either as is or shifted by 90°."""
+    from robots.papers import SEED004
+
+    koji = robots.load("koji_turner")
+    T = KOJI_PAPER_MATRIX.copy()
+    T[0, 3] = 1.1970
+    deg = np.degrees(koji.ik_all(T, respect_limits=False))
+    assert deg.shape == (4, 4)
+    back = deg[np.abs(deg[:, 0] + 90.0) < 1e-9]  # θ1 = −90°: upper arm raised / lowered
+    front = deg[np.abs(deg[:, 0] - 90.0) < 1e-9]  # θ1 = +90°: the arm folded back
+    up, down = back[np.argmax(back[:, 1])], back[np.argmin(back[:, 1])]
+    ours = {
+        # θ2 list: both elbows of the θ1 = −90° branch (magnitudes), then 90° + their forearm angles
+        "theta2": [abs(down[1]), up[1], 90.0 - up[2], 90.0 + down[2]],
+        # θ3 (down) list: 90° below the folded branch's θ2, 90° + |θ2| of the lowered elbow, both forearms
+        "theta3": [front[:, 1].max() - 90.0, 90.0 - down[1], -up[2], -down[2]],
+    }
+    np.testing.assert_allclose(ours["theta2"], SEED004.ik_theta2_candidates_deg, atol=2e-4)
+    np.testing.assert_allclose(ours["theta3"], SEED004.ik_theta3_candidates_deg, atol=2e-4)
