@@ -444,13 +444,17 @@ class Robot:
 
         Args:
             target: tcp pose ``(4, 4)`` frame → base [m]; with ``position_only`` a position
-                ``(3,)`` [m] (or a pose whose rotation is ignored).
-            q_seed: start ``(nq,)`` (default: the middle of the joint ranges).
+                ``(3,)`` [m] (or a pose, whose rotation must still be a proper rotation, ignored).
+            q_seed: start ``(nq,)`` (default: the middle of the joint ranges for the numerical
+                solver; :attr:`neutral` for choosing among closed-form branches).
             tol: required position error [m] and rotation error [rad].
             max_restarts: random restarts after the first attempt.
             seed: seed or generator of the restarts (results are reproducible).
 
         Raises:
+            InvalidInput: a malformed target or ``q_seed`` (shape, NaN/inf, not a proper
+                rotation), ``tol`` not finite and positive, ``max_restarts`` not a non-negative
+                integer, or a bad ``seed``.
             UnreachableTarget: no configuration within the limits found; the message gives the
                 remaining error and says whether the target is out of reach or needs a joint
                 outside its limits. A configuration that misses the target is never returned.
