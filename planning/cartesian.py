@@ -3,9 +3,13 @@
 These are the only functions of :mod:`planning` that talk to a robot. They use only the
 robot's public methods (duck typing, so any object with the same methods works):
 
-* ``has_analytic_ik`` (bool) and ``ik_all(pose, q_ref=...) -> (k, nq)`` — every analytic
-  solution within the joint limits; the one nearest (Euclidean, rad/m) to the previous
-  waypoint's solution is kept, so consecutive waypoints stay on one branch;
+* ``has_analytic_ik`` (bool) and ``ik_branches(pose, q_ref=...) -> (q (k, nq), branch (k,))``
+  — every analytic solution within the joint limits with its branch label (shoulder, elbow,
+  wrist flip): the solution on the previous waypoint's branch is kept (the nearest such
+  one, in rad/m), so consecutive waypoints stay in one arm configuration even when another
+  branch happens to be closer in joint space; only when that branch has no solution within
+  the limits does the path switch to the nearest solution of another branch. (An object
+  with ``ik_all(pose, q_ref=...)`` but no ``ik_branches`` gets the nearest solution.)
 * otherwise ``ik(pose, q_seed=previous) -> (nq,)`` — numerical IK seeded with the
   previous solution (which usually keeps the branch, but cannot guarantee it);
 * ``fk(q (N, nq), frame=...) -> (N, 4, 4)`` — batched forward kinematics.
@@ -48,11 +52,12 @@ def _poses(poses: Any) -> np.ndarray:
 
 
 def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
-    """Joint configurations (N, nq) for TCP poses (N, 4, 4), each nearest the previous one.
+    """Joint configurations (N, nq) for TCP poses (N, 4, 4) on one IK branch, each nearest the previous one.
 
     The first pose's solution is the one nearest ``q_start`` when given; otherwise, with
     analytic IK, the first solution the robot returns, and with numerical IK the robot's
-    default seed.
+    default seed. With analytic IK the following poses keep the first pose's branch (see
+    the module docstring).
 
     Raises:
         robots.errors.UnreachableTarget: naming the waypoint index that has no solution.
@@ -61,15 +66,24 @@ def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
     nq = int(robot.nq)
     prev = None if q_start is None else _inputs.per_joint(q_start, nq, "q_start")
     analytic = bool(getattr(robot, "has_analytic_ik", False))
+    labelled = analytic and hasattr(robot, "ik_branches")
     out = np.empty((P.shape[0], nq))
+    branch = None
     for i, pose in enumerate(P):  # one IK per waypoint (a handful), not per sample
         try:
             if analytic:
-                sols = np.asarray(robot.ik_all(pose, q_ref=prev), dtype=float).reshape(-1, nq)
+                if labelled:
+                    sols, labels = robot.ik_branches(pose, q_ref=prev)
+                    sols = np.asarray(sols, dtype=float).reshape(-1, nq)
+                else:
+                    sols = np.asarray(robot.ik_all(pose, q_ref=prev), dtype=float).reshape(-1, nq)
+                    labels = np.full(sols.shape[0], -1)
                 if sols.shape[0] == 0:
                     raise UnreachableTarget("no analytic solution within the joint limits")
-                pick = 0 if prev is None else int(np.argmin(np.linalg.norm(sols - prev, axis=1)))
-                q = sols[pick]
+                same = np.flatnonzero(labels == branch) if branch is not None else np.arange(0)
+                pool = same if same.size else np.arange(sols.shape[0])
+                pick = pool[0] if prev is None else pool[int(np.argmin(np.linalg.norm(sols[pool] - prev, axis=1)))]
+                q, branch = sols[pick], labels[pick]
             else:
                 q = np.asarray(robot.ik(pose, q_seed=prev), dtype=float).reshape(nq)
         except UnreachableTarget as exc:

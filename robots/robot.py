@@ -327,19 +327,9 @@ class Robot:
         Raises:
             ModelError: the arm has no closed form (use :meth:`ik`).
         """
-        if self._analytic_ik is None:
-            raise ModelError(
-                f"robot '{self.name}' has no analytic IK (closed forms: SCARA, gantry, koji arm, UR-type); "
-                "use Robot.ik for a numerical solution"
-            )
-        T, single = self.check_target(target)
+        T, single, ref = self._analytic_targets(target, q_ref)
         if T.shape[0] == 0:
             return []
-        ref = None
-        if q_ref is not None:
-            ref, _ = self.check_q(q_ref)
-            if ref.shape[0] not in (1, T.shape[0]):
-                raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
         from .ik.solver import split_by_target  # late import: the solvers need the Robot class
 
         if respect_limits:
@@ -348,6 +338,38 @@ class Robot:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
         return sols[0] if single else sols
+
+    def ik_branches(self, target: Any, q_ref: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`ik_all` of one pose ``(4, 4)`` with the branch label of every solution.
+
+        Returns:
+            ``q (k, nq)`` as :meth:`ik_all` and ``branch (k,)`` integers: the closed form's
+            branch (UR-type: shoulder × wrist flip × elbow, 0-7; SCARA: elbow; koji arm:
+            arm-plane candidates). Along a continuous path a solution keeps its label until
+            the path crosses a singularity, so equal labels mean "the same arm
+            configuration" for consecutive waypoints (see
+            :func:`planning.joint_waypoints`).
+        """
+        T, single, ref = self._analytic_targets(target, q_ref)
+        if not single:
+            raise InvalidInput("ik_branches takes one pose of shape (4, 4)")
+        _, q, branch = self._analytic_ik.candidates(T, ref, with_branches=True)
+        return q, branch
+
+    def _analytic_targets(self, target: Any, q_ref: Any) -> tuple[np.ndarray, bool, np.ndarray | None]:
+        """Checked targets ``(N, 4, 4)``, single flag and ``q_ref`` rows for the closed forms."""
+        if self._analytic_ik is None:
+            raise ModelError(
+                f"robot '{self.name}' has no analytic IK (closed forms: SCARA, gantry, koji arm, UR-type); "
+                "use Robot.ik for a numerical solution"
+            )
+        T, single = self.check_target(target)
+        ref = None
+        if q_ref is not None:
+            ref, _ = self.check_q(q_ref)
+            if ref.shape[0] not in (1, T.shape[0]):
+                raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
+        return T, single, ref
 
     def _numerical_ik(self):
         solver = getattr(self, "_numerical_ik_solver", None)

@@ -59,6 +59,9 @@ class AnalyticIK:
     """
 
     family = "analytic"
+    #: Number of geometric branches of :meth:`raw` (its candidate slots modulo this are the
+    #: branch labels; extra slots, e.g. at a singular wrist, repeat branches). None: every slot.
+    n_branches: int | None = None
 
     def __init__(self, robot, frame: str = "tcp") -> None:
         self.robot = robot
@@ -111,11 +114,12 @@ class AnalyticIK:
 
     def _dense(
         self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Solutions of one chunk as ``q (n, K, nq)`` sorted by distance to ``q_ref`` and ``valid (n, K)``."""
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Solutions of one chunk sorted by distance to ``q_ref``: ``q (n, K, nq)``, ``valid (n, K)``, ``branch (n, K)``."""
         robot = self.robot
         q = self.raw(targets, q_ref)
         n, B = q.shape[:2]
+        branch = np.broadcast_to(np.arange(B) % (self.n_branches or B), (n, B))
         rev = self._revolute
         q[..., rev] = np.pi - (np.pi - q[..., rev]) % _TWO_PI  # wrap to (-π, π]
         valid = np.all(np.isfinite(q), axis=-1)
@@ -128,6 +132,7 @@ class AnalyticIK:
                 q = np.repeat(q, k.size, axis=1)
                 q[..., j] += _TWO_PI * np.tile(k, q.shape[1] // k.size)
                 valid = np.repeat(valid, k.size, axis=1)
+                branch = np.repeat(branch, k.size, axis=1)
             valid &= np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=-1)
         rows = q[valid]
         if rows.shape[0]:
@@ -152,7 +157,8 @@ class AnalyticIK:
         order = np.argsort(dist, axis=1, kind="stable")
         q = np.take_along_axis(q, order[..., None], axis=1)
         valid = np.take_along_axis(valid, order, axis=1)
-        return q, valid
+        branch = np.take_along_axis(branch, order, axis=1)
+        return q, valid, branch
 
     def _pose_errors(self, q: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Position error [m] and rotation error (Frobenius / √2, ≈ angle) [rad] of ``q (M, nq)``."""
@@ -184,12 +190,19 @@ class AnalyticIK:
         return q
 
     def candidates(
-        self, targets: np.ndarray, q_ref: np.ndarray | None = None, *, respect_limits: bool = True
-    ) -> tuple[np.ndarray, np.ndarray]:
+        self,
+        targets: np.ndarray,
+        q_ref: np.ndarray | None = None,
+        *,
+        respect_limits: bool = True,
+        with_branches: bool = False,
+    ) -> tuple[np.ndarray, ...]:
         """Verified solutions of a batch: ``(index (M,), q (M, nq))``, index = target row, sorted by target then distance.
 
         With ``respect_limits=False`` the joint limits are ignored (each revolute angle is
         given once, wrapped to ``(-π, π]``): used to tell *out of reach* from *limits*.
+        With ``with_branches`` a third array ``branch (M,)`` gives each solution's branch
+        label (see :meth:`robots.Robot.ik_branches`).
         """
         robot = self.robot
         N = targets.shape[0]
@@ -203,9 +216,9 @@ class AnalyticIK:
 
         def run(i: int) -> None:
             s = starts[i]
-            q, valid = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits)
+            q, valid, branch = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits)
             counts = valid.sum(axis=1)
-            parts[i] = (np.repeat(np.arange(s, s + q.shape[0]), counts), q[valid])
+            parts[i] = (np.repeat(np.arange(s, s + q.shape[0]), counts), q[valid], branch[valid])
 
         if len(starts) > 1 and _WORKERS > 1:
             with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
@@ -214,8 +227,9 @@ class AnalyticIK:
             for i in range(len(starts)):
                 run(i)
         if not parts:
-            return np.zeros(0, dtype=int), np.zeros((0, nq))
-        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+            parts = [(np.zeros(0, dtype=int), np.zeros((0, nq)), np.zeros(0, dtype=int))]
+        out = tuple(np.concatenate([p[k] for p in parts]) for k in range(3))
+        return out if with_branches else out[:2]
 
     def starts(self, target: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
         """Branch candidates of one target ``(4, 4)`` as starts of a local refinement: ``(k, nq)``.

@@ -139,3 +139,41 @@ def test_tcp_path_on_a_built_in_robot():
     assert p.shape == (51, 3)
     np.testing.assert_allclose(p[[0, -1]], robot.fk(q)[:, :3, 3], atol=1e-12)
     np.testing.assert_allclose(p[25], robot.fk(traj.sample(t[25])[0])[:3, 3], atol=1e-12)
+
+
+class LabelledPlanarArm(PlanarArm):
+    """The planar arm with branch labels (0: elbow up, 1: elbow down), like robots.Robot.ik_branches."""
+
+    def ik_branches(self, pose, q_ref=None):
+        sols = self.ik_all(pose, q_ref)
+        return sols, np.where(sols[:, 1] >= 0.0, 0, 1)
+
+
+def test_labelled_branch_is_kept_even_when_another_branch_is_nearer():
+    # near the stretched-out pose the other elbow can be nearer in joint space: at waypoint 2
+    # the true (elbow-up) solution is 0.054 rad away from waypoint 1, the elbow-down one 0.046
+    q_true = np.array([[0.2, 0.30], [0.2, 0.01], [0.15, 0.03], [0.15, 0.30]])
+    poses = PlanarArm().fk(q_true)
+    q = planning.joint_waypoints(LabelledPlanarArm(), poses, q_start=q_true[0])
+    np.testing.assert_allclose(q, q_true, atol=1e-9)
+    q_nearest = planning.joint_waypoints(PlanarArm(), poses, q_start=q_true[0])
+    assert q_nearest[2, 1] < 0.0  # without labels the path flips the elbow
+
+
+def test_aubo_table2_waypoints_keep_the_branch_until_the_limits_force_a_switch():
+    import robots
+    from robots import conventions as conv
+    from robots import papers
+
+    arm = robots.load("aubo_i3")
+    q_paper = np.array([conv.aubo_mdh_to_joint(t) for t in papers.SEED001.table2_joints])
+    labels = [int(arm.ik_branches(arm.fk(q), q_ref=q)[1][0]) for q in q_paper]
+    # P1, P2 in one branch; P3, P4 in another, because P3's solution on the first branch needs
+    # the shoulder at 175° (range ±170°)
+    assert labels[0] == labels[1] and labels[2] == labels[3] and labels[1] != labels[2]
+    _, geometric = arm._analytic_ik.candidates(arm.fk(q_paper[2])[None], respect_limits=False, with_branches=True)[1:]
+    assert labels[0] in geometric  # the first branch exists geometrically at P3 ...
+    sols, lab = arm.ik_branches(arm.fk(q_paper[2]))
+    assert labels[0] not in lab  # ... but not within the joint limits
+    q = planning.joint_waypoints(arm, arm.fk(q_paper), q_start=q_paper[0])
+    np.testing.assert_allclose(q, q_paper, atol=1e-9)

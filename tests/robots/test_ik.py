@@ -360,3 +360,46 @@ def test_koji_paper_candidate_lists_are_our_branches_at_x_rounded_to_whole_mm():
     }
     np.testing.assert_allclose(ours["theta2"], SEED004.ik_theta2_candidates_deg, atol=2e-4)
     np.testing.assert_allclose(ours["theta3"], SEED004.ik_theta3_candidates_deg, atol=2e-4)
+
+
+# paths that stay clear of every singularity (elbow straight, wrist axes aligned, wrist
+# centre on the base axis, SCARA arm straight): a label may change only at one of those
+SMOOTH_PATHS = {
+    "aubo_i3": ([0.3, -0.4, 1.2, 0.5, 1.0, 0.2], [0.6, -0.1, 1.5, 0.8, 1.3, 0.5]),
+    "ur5": ([0.3, -1.4, 1.2, -0.5, 1.0, 0.2], [0.6, -1.1, 1.5, -0.2, 1.3, 0.5]),
+    "scara_mushroom": ([0.3, 0.8, 0.05, 0.2], [0.6, 1.1, 0.08, 0.5]),
+    "koji_turner": ([0.3, 0.1, -0.2, 0.5], [0.6, 0.3, 0.1, 0.8]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SMOOTH_PATHS))
+def test_branch_label_is_constant_along_a_smooth_path(name):
+    """A configuration keeps its branch label while it moves without crossing a singularity."""
+    arm = robots.load(name)
+    q0, q1 = (np.array(v) for v in SMOOTH_PATHS[name])
+    labels = []
+    for s in np.linspace(0.0, 1.0, 25):
+        q = (1 - s) * q0 + s * q1
+        sols, lab = arm.ik_branches(arm.fk(q), q_ref=q)
+        assert np.abs(sols[0] - q).max() < 1e-7  # the path's own configuration is found ...
+        labels.append(int(lab[0]))  # ... and its label read
+    assert len(set(labels)) == 1
+
+
+def test_branch_label_changes_across_the_elbow_singularity():
+    arm = robots.load("aubo_i3")
+    q_a = np.array([0.3, -0.4, 0.2, 0.5, 1.0, 0.2])
+    q_b = q_a.copy()
+    q_b[2] = -0.2  # the elbow passes through straight (θ3 = 0)
+    la = arm.ik_branches(arm.fk(q_a), q_ref=q_a)[1][0]
+    lb = arm.ik_branches(arm.fk(q_b), q_ref=q_b)[1][0]
+    assert la != lb
+
+
+def test_ik_branches_takes_one_pose():
+    arm = robots.load("aubo_i3")
+    T = arm.fk(arm.random_q(2, seed=1))
+    with pytest.raises(InvalidInput, match="one pose"):
+        arm.ik_branches(T)
+    with pytest.raises(ModelError, match="no analytic IK"):
+        robots.load("panda").ik_branches(np.eye(4))
