@@ -34,9 +34,25 @@ __all__ = [
 
 # workspace analysis and station layout
 from .layout import LayoutReport, check_layout  # noqa: E402
-from .workspace import Workspace, sample_workspace  # noqa: E402
+from .placement import RecommendedRegion, recommend_region  # noqa: E402
+from .self_collision import SelfCollision  # noqa: E402
+from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
+from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
 
-__all__ += ["Workspace", "sample_workspace", "LayoutReport", "check_layout"]
+__all__ += [
+    "Workspace",
+    "WorkspaceSummary",
+    "SphereFit",
+    "sample_workspace",
+    "fit_sphere",
+    "VoxelMap",
+    "suggest_voxel_size",
+    "RecommendedRegion",
+    "recommend_region",
+    "SelfCollision",
+    "LayoutReport",
+    "check_layout",
+]
 
 # the four papers' published numbers, as printed (data only)
 from . import papers  # noqa: E402
