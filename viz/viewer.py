@@ -77,9 +77,13 @@ class MeshcatServer:
                 err = proc.stderr.read().decode("utf-8", "replace").strip().splitlines()[-1:]  # type: ignore[assignment]
             _stop_process(proc)
             hint = f" ({err[0]})" if err else ""
-            raise ViewerError(
-                f"the MeshCat server did not start{hint}; if port {port} was given, it may be in use: try port=None"
+            advice = (
+                f"; port {port} may be in use: pick another one, or let pinarms choose a free port "
+                "(port=None in Python, no --port on the command line)"
+                if port is not None
+                else ""
             )
+            raise ViewerError(f"the MeshCat server did not start{hint}{advice}")
         self._proc = proc
         self.pid: int = proc.pid
         self.url: str = urls["web_url"]

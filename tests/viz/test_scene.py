@@ -82,6 +82,15 @@ def test_bad_port():
         MeshcatServer(port=70000)
 
 
+def test_port_in_use_says_what_to_do():
+    from viz import ViewerError
+
+    with MeshcatServer() as first:
+        port = int(re.search(r":(\d+)/", first.url).group(1))
+        with pytest.raises(ViewerError, match=f"port {port} may be in use.*no --port"):
+            MeshcatServer(port=port)
+
+
 def test_export_html_is_self_contained(line_session, tmp_path):
     out = viz.export_html(line_session, tmp_path / "line.html")
     html = out.read_text(encoding="utf-8")
