@@ -38,6 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",
+    "SPHERE_COVERAGE_MIN",
     "Workspace",
     "WorkspaceSummary",
     "SphereFit",
@@ -49,6 +50,8 @@ __all__ = [
 ]
 
 SINGULAR_INVERSE_CONDITION = 0.1
+#: :attr:`SphereFit.coverage` below which a sphere fit is flagged as not describing the cloud.
+SPHERE_COVERAGE_MIN = 0.5
 """Samples whose ``σ_min/σ_max`` of the position Jacobian is below this are near-singular."""
 
 _CHUNK = 16384
@@ -171,6 +174,11 @@ class SphereFit:
         max_residual: largest ``| |p − centre| − radius |`` over the fitted points [m].
         n_points: number of points the fit used (hull points for :func:`fit_sphere_to_hull`).
         method: ``"algebraic"`` or ``"outer-hull"``.
+        coverage: share of the equal-area direction cells around ``centre`` that hold
+            samples (see :func:`hull_points`): near 1 when the cloud surrounds the centre;
+            below :data:`SPHERE_COVERAGE_MIN` the samples cover only a patch of the sphere
+            (a slab or a box seen from far away) and the fit says little about the
+            workspace, however small its residual.
     """
 
     centre: np.ndarray
@@ -179,6 +187,12 @@ class SphereFit:
     max_residual: float
     n_points: int
     method: str
+    coverage: float = float("nan")
+
+    @property
+    def meaningful(self) -> bool:
+        """Whether the samples surround the centre well enough for the sphere to describe them."""
+        return bool(self.coverage >= SPHERE_COVERAGE_MIN)
 
     @property
     def relative_rms(self) -> float:
@@ -201,15 +215,16 @@ def fit_sphere(points: Any) -> SphereFit:
     centre = sol[:3]
     radius = float(np.sqrt(max(sol[3] + centre @ centre, 0.0)))
     res = np.linalg.norm(P - centre, axis=1) - radius
-    return SphereFit(centre, radius, float(np.sqrt(np.mean(res**2))), float(np.max(np.abs(res))), P.shape[0], "algebraic")
+    return SphereFit(centre, radius, float(np.sqrt(np.mean(res**2))), float(np.max(np.abs(res))), P.shape[0], "algebraic",
+                     direction_coverage(P, centre))
 
 
-def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = None) -> np.ndarray:
-    """The farthest point from ``centre`` in each direction cell (indices into ``points``).
+def _direction_cells(points: np.ndarray, centre: np.ndarray, n_bins: int | None) -> tuple[np.ndarray, np.ndarray, int]:
+    """Equal-area direction cell of every point seen from ``centre``, its distance, and the cell count.
 
-    Directions are cut into equal-area cells: ``n_z`` bands of ``cos(polar angle)`` times
-    ``2 n_z`` azimuth sectors. By default ``n_bins ≈ N / 30`` (between 32 and 2048 cells),
-    so that each cell holds about 30 samples.
+    Directions are cut into ``n_z`` bands of ``cos(polar angle)`` times ``2 n_z`` azimuth
+    sectors. By default ``n_bins ≈ N / 30`` (between 32 and 2048 cells), so that each cell
+    holds about 30 samples.
     """
     N = points.shape[0]
     if n_bins is None:
@@ -222,14 +237,29 @@ def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = Non
         cz = np.where(r > 0, d[:, 2] / r, 0.0)
     iz = np.minimum(((cz + 1.0) * 0.5 * n_z).astype(int), n_z - 1)
     iaz = np.minimum(((np.arctan2(d[:, 1], d[:, 0]) + np.pi) / (2 * np.pi) * n_az).astype(int), n_az - 1)
-    cell = iz * n_az + iaz
-    rmax = np.full(n_z * n_az, -1.0)
+    return iz * n_az + iaz, r, n_z * n_az
+
+
+def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = None) -> np.ndarray:
+    """The farthest point from ``centre`` in each direction cell (indices into ``points``).
+
+    Cells as in :func:`_direction_cells`: equal-area, about 30 samples each by default.
+    """
+    cell, r, n_cells = _direction_cells(points, centre, n_bins)
+    rmax = np.full(n_cells, -1.0)
     np.maximum.at(rmax, cell, r)
     is_max = r == rmax[cell]
     idx = np.flatnonzero(is_max)
     # one point per cell (ties are rare; keep the first)
     _, first = np.unique(cell[idx], return_index=True)
     return idx[first]
+
+
+def direction_coverage(points: Any, centre: Any, n_bins: int | None = None) -> float:
+    """Share of the direction cells around ``centre`` [m] that hold at least one of ``points``."""
+    P = _as_points(points, "points")
+    cell, _, n_cells = _direction_cells(P, np.asarray(centre, dtype=float), n_bins)
+    return float(np.unique(cell).size / n_cells)
 
 
 def fit_sphere_to_hull(points: Any, n_bins: int | None = None, iterations: int = 3) -> SphereFit:
@@ -252,7 +282,8 @@ def fit_sphere_to_hull(points: Any, n_bins: int | None = None, iterations: int =
         if idx.size < 4:
             break
         fit = fit_sphere(P[idx])
-    return SphereFit(fit.centre, fit.radius, fit.rms_residual, fit.max_residual, fit.n_points, "outer-hull")
+    return SphereFit(fit.centre, fit.radius, fit.rms_residual, fit.max_residual, fit.n_points, "outer-hull",
+                     direction_coverage(P, fit.centre, n_bins))
 
 
 # ------------------------------------------------------------- radial profile
@@ -323,8 +354,9 @@ class WorkspaceSummary:
                 *(v * mm for pair in zip(self.bbox_min, self.bbox_max) for v in pair)
             ),
             "  outer-hull sphere: centre ({:.0f}, {:.0f}, {:.0f}) mm, radius {:.0f} mm, "
-            "rms residual {:.1f} mm ({:.1%} of r) over {} hull points".format(
-                *(s.centre * mm), s.radius * mm, s.rms_residual * mm, s.relative_rms, s.n_points
+            "rms residual {:.1f} mm ({:.1%} of r) over {} hull points, direction coverage {:.0%}{}".format(
+                *(s.centre * mm), s.radius * mm, s.rms_residual * mm, s.relative_rms, s.n_points, s.coverage,
+                "" if s.meaningful else " (the samples cover only a patch of this sphere: it does not describe them)",
             ),
             f"  near-singular (σmin/σmax of J_v < {self.singular_threshold:g}): {self.singular_share:.1%}",
             f"  position manipulability: mean {self.manipulability_mean:.4g}, max {self.manipulability_max:.4g}",

@@ -248,3 +248,23 @@ def test_bad_analysis_options_raise_invalid_input(aubo, call, match):
 def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
     ws = sample_workspace(aubo, n=2000, seed=0)
     assert "z < 0 mm" in ws.recommend_region(side="below", n_collision=0).text()
+
+
+def test_direction_coverage_tells_a_ball_from_a_patch():
+    from robots.workspace import direction_coverage
+
+    rng = np.random.default_rng(0)
+    d = rng.normal(size=(20000, 3))
+    ball = d / np.linalg.norm(d, axis=1, keepdims=True)
+    assert direction_coverage(ball, np.zeros(3)) > 0.99
+    upper = ball[ball[:, 2] > 0]
+    assert 0.45 < direction_coverage(upper, np.zeros(3)) < 0.55
+
+
+def test_sphere_fit_of_a_slab_is_flagged_not_trusted():
+    aubo = robots.sample_workspace(robots.load("aubo_i3"), n=20000, seed=0).fit_sphere()
+    assert aubo.meaningful and aubo.coverage > 0.95
+    rail = robots.sample_workspace(robots.load("koji_turner_rail"), n=20000, seed=0)
+    fit = rail.fit_sphere()
+    assert not fit.meaningful and fit.coverage < 0.2  # a 28 m "sphere" through a slab of rail positions
+    assert "does not describe them" in rail.summary().text()
