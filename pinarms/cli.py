@@ -372,6 +372,87 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     _emit(as_json, data, lines)
 
 
+# --------------------------------------------------------------------------- layout
+@cli.command("layout", context_settings=_NUMBERS)
+@click.argument("robot")
+@click.argument("xyz", nargs=-1, type=float, required=True)
+@click.option("--mm", is_flag=True, help="Positions in and boundary margins out in millimetres.")
+@click.option("--names", default=None, help="Comma-separated labels of the points (default P1, P2, ...).")
+@click.option("-n", "n", default=100_000, show_default=True, type=click.IntRange(min=1),
+              help="Workspace samples for the dexterity median and the boundary margin.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the workspace and IK starts.")
+@json_option
+def layout_cmd(robot: str, xyz: tuple[float, ...], mm: bool, names: str | None, n: int, seed: int,
+               as_json: bool) -> None:
+    """Check a line layout: can ROBOT's tcp reach each pick/place point X Y Z [X Y Z ...] (base frame)?
+
+    Per point: reachable or not, the number of IK branches within the joint limits, the
+    best branch's position manipulability and dexterity ratio (its manipulability over the
+    sampled workspace's median) and the distance to the workspace boundary
+    (robots.check_layout; the tool points down for 6+ joint arms, its yaw is free for
+    fewer). An unreachable point is reported, not an error (exit status 0).
+    """
+    arm = _load_robot(robot)
+    from robots.workspace import sample_workspace
+
+    values = _vectors_from_args(xyz)
+    if values.size % 3:
+        raise InvalidInput(f"give the points as X Y Z triples (a multiple of 3 numbers), got {values.size}")
+    points = values.reshape(-1, 3)
+    labels = None
+    if names is not None:
+        labels = [s.strip() for s in names.split(",")]
+        if len(labels) != len(points) or not all(labels):
+            raise InvalidInput(f"--names needs {len(points)} non-empty comma-separated label(s), got {names!r}")
+    scale = length_scale(mm)
+    ws = sample_workspace(arm, n=n, seed=seed, frame="tcp")
+    report = robots.check_layout(arm, points * scale, names=labels, workspace=ws, seed=seed)
+    lu = "mm" if mm else "m"
+    rows = []
+    for p, given in zip(report.points, points):
+        best_w = float(p.manipulability[p.best]) if p.reachable else 0.0
+        rows.append(
+            {
+                "name": p.name,
+                "position": given,
+                "reachable": p.reachable,
+                "branches": p.n_branches,
+                "solutions": p.n_solutions,
+                "manipulability": best_w,
+                "dexterity_ratio": p.dexterity_ratio,
+                "inverse_condition": float(p.inverse_condition[p.best]) if p.reachable else 0.0,
+                "boundary_margin": p.boundary_margin / scale,
+                "q_best_si": p.solutions[p.best] if p.reachable else None,
+            }
+        )
+    data = {
+        "robot": arm.name,
+        "method": report.method,
+        "n": n,
+        "seed": seed,
+        "units": {"position": lu, "boundary_margin": lu, "manipulability": "SI", "q_best_si": "rad or m"},
+        "median_manipulability": report.median_manipulability,
+        "all_reachable": report.all_reachable,
+        "points": rows,
+    }
+    width = max(8, *(len(r["name"]) for r in rows))
+    lines = [
+        f"{arm.name}: {len(rows)} point(s), {report.method} IK, workspace median manipulability "
+        f"{report.median_manipulability:.4g} ({n} samples, seed {seed})",
+        f"  {'point':<{width}}  {f'position [{lu}]':<29}  reachable  branches  manipulability  dexterity  margin [{lu}]",
+    ]
+    for r in rows:
+        where = " ".join(f"{v:9.6g}" for v in r["position"])
+        if r["reachable"]:
+            lines.append(f"  {r['name']:<{width}}  {where}  {'yes':>9}  {r['branches']:8d}  {r['manipulability']:14.4g}"
+                         f"  {r['dexterity_ratio']:9.2f}  {r['boundary_margin']:.4g}")
+        else:
+            lines.append(f"  {r['name']:<{width}}  {where}  {'NO':>9}  (no IK solution within the joint limits)")
+    lines.append("all points reachable" if report.all_reachable else
+                 f"{int(np.count_nonzero(~report.reachable))} point(s) NOT reachable: move them or the robot")
+    _emit(as_json, data, lines)
+
+
 # --------------------------------------------------------------------------- via points
 def read_via_file(path: str) -> dict[str, Any]:
     """Via points from a JSON or CSV file.

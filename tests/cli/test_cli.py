@@ -335,3 +335,49 @@ def test_one_column_json_via_file_plans(run, tmp_path):
     data = as_json(run("plan", "--file", str(path), "--json"))
     assert data["kind"] == "polynomial" and data["n_joints"] == 1
     assert data["peaks"]["velocity"][0] == pytest.approx(1.875 / 2)
+
+
+def test_layout_reports_reachable_and_unreachable_points(run):
+    from robots.workspace import sample_workspace
+
+    arm = robots.load("aubo_i3")
+    result = run("layout", "aubo_i3", "0.3", "0.2", "0.2", "10", "0", "0", "-n", "5000", "--seed", "2", "--json")
+    assert result.exit_code == 0  # an unreachable point is a report, not an error
+    data = as_json(result)
+    expected = robots.check_layout(arm, [[0.3, 0.2, 0.2], [10, 0, 0]], workspace=sample_workspace(arm, 5000, seed=2),
+                                   seed=2)
+    assert data["robot"] == "aubo_i3" and data["method"] == "analytic" and data["all_reachable"] is False
+    assert data["n"] == 5000 and data["seed"] == 2 and data["units"]["position"] == "m"
+    near, far = data["points"]
+    assert [near["name"], far["name"]] == ["P1", "P2"]
+    assert near["reachable"] is True and far["reachable"] is False
+    p = expected.points[0]
+    assert near["branches"] == p.n_branches >= 1 and near["solutions"] == p.n_solutions
+    assert near["manipulability"] == pytest.approx(p.manipulability[p.best], rel=1e-12)
+    assert near["dexterity_ratio"] == pytest.approx(p.dexterity_ratio, rel=1e-12) and near["dexterity_ratio"] > 0
+    assert near["boundary_margin"] == pytest.approx(p.boundary_margin) and near["boundary_margin"] > 0
+    np.testing.assert_allclose(arm.position(np.array(near["q_best_si"])), [0.3, 0.2, 0.2], atol=1e-9)
+    assert far["branches"] == 0 and far["manipulability"] == 0 and far["q_best_si"] is None
+    text = run("layout", "aubo_i3", "0.3", "0.2", "0.2", "10", "0", "0", "-n", "5000").stdout
+    assert "NO" in text and "1 point(s) NOT reachable" in text
+    assert "all points reachable" in run("layout", "aubo_i3", "0.3", "0.2", "0.2", "-n", "5000").stdout
+
+
+def test_layout_mm_and_names(run):
+    si = as_json(run("layout", "aubo_i3", "0.3", "-0.2", "0.25", "-n", "5000", "--json"))
+    mm = as_json(run("layout", "aubo_i3", "300", "-200", "250", "--mm", "--names", "tray", "-n", "5000", "--json"))
+    assert mm["units"]["position"] == mm["units"]["boundary_margin"] == "mm"
+    assert mm["points"][0]["name"] == "tray" and mm["points"][0]["position"] == [300, -200, 250]
+    assert mm["points"][0]["boundary_margin"] == pytest.approx(si["points"][0]["boundary_margin"] * 1000, rel=1e-9)
+    assert mm["points"][0]["branches"] == si["points"][0]["branches"]
+    assert mm["points"][0]["manipulability"] == pytest.approx(si["points"][0]["manipulability"], rel=1e-12)
+    assert "margin [mm]" in run("layout", "aubo_i3", "300", "-200", "250", "--mm", "-n", "5000").stdout
+
+
+def test_layout_bad_input_is_one_line(run):
+    assert_user_error(run("layout", "aubo_i3", "0.3", "0.2", ok=False), 1, "X Y Z triples", "got 2")
+    assert_user_error(run("layout", "aubo_i3", "0.3", "x", "0.2", ok=False), 2, "not a valid float")
+    assert_user_error(run("layout", "aubo_i3", "0.3", "0.2", "0.1", "--names", "a,b", ok=False), 1, "--names needs 1")
+    assert_user_error(run("layout", "no_such_arm", "0", "0", "0", ok=False), 1, "unknown robot")
+    assert_user_error(run("layout", "aubo_i3", ok=False), 2, "Missing argument")
+    assert_user_error(run("layout", "aubo_i3", "0", "0", "0", "-n", "0", ok=False), 2, "-n")
