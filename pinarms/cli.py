@@ -348,15 +348,10 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
         "manipulability": {"mean": float(np.mean(ws.manipulability)), "max": float(np.max(ws.manipulability))},
         "summary": summary,
     }
-    lines = [
-        f"{arm.name}: {n} samples of frame {frame} (seed {seed})",
-        f"bounding box [m]: min {_fmt(lo, 4)}  max {_fmt(hi, 4)}",
-        f"manipulability: mean {np.mean(ws.manipulability):.4g}, max {np.max(ws.manipulability):.4g}",
-    ]
-    if callable(getattr(summary_obj, "text", None)):
-        lines.append(summary_obj.text())
-    elif isinstance(summary, dict):
-        lines += [f"{k}: {v}" for k, v in summary.items()]
+    # the summary's text names robot, frame and samples and gives the bounding box [mm] and
+    # the manipulability: printed once, with the seed added to its first line
+    lines = summary_obj.text().splitlines()
+    lines[0] += f" (seed {seed})"
     region = recommend_region(ws)
     data["region"] = {
         "about": region.about, "origin_m": region.origin, "r_inner_m": region.r_inner, "r_outer_m": region.r_outer,

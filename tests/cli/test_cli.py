@@ -381,3 +381,12 @@ def test_layout_bad_input_is_one_line(run):
     assert_user_error(run("layout", "no_such_arm", "0", "0", "0", ok=False), 1, "unknown robot")
     assert_user_error(run("layout", "aubo_i3", ok=False), 2, "Missing argument")
     assert_user_error(run("layout", "aubo_i3", "0", "0", "0", "-n", "0", ok=False), 2, "-n")
+
+
+def test_workspace_text_gives_extent_and_manipulability_once(run):
+    text = run("workspace", "aubo_i3", "-n", "2000", "--seed", "4").stdout
+    assert text.count("bounding box") == 1 and "bounding box [mm]" in text
+    assert text.count("manipulability: mean") == 1
+    assert text.splitlines()[0] == "workspace of aubo_i3 (tcp), 2000 samples (seed 4)"
+    data = as_json(run("workspace", "aubo_i3", "-n", "2000", "--seed", "4", "--json"))
+    assert set(data) >= {"bounding_box_m", "manipulability", "summary", "region"}
