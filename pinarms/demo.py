@@ -137,7 +137,9 @@ def study_000(quick: bool = False) -> Study:
                            planning.piecewise_polynomial(paper.initial_knot_times_s, q_via, degrees=(3, 5, 3)))
     session.add_history("ga_time", ga.history)
     _add_line_objects(session, arm.position(q_via[0]), arm.position(q_via[-1]))
-    plots = _plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised")
+    # the paper draws its joint curves in degrees: so do ours (joint 1 is revolute)
+    plots = _plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised",
+                   degrees=True)
     return Study("000", "SCARA enoki-mushroom packer: 3-5-3 + GA timing", rows, session, plots)
 
 

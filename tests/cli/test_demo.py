@@ -66,3 +66,22 @@ def test_demo_ik_rows_use_the_error_the_paper_states():
         assert row.status == "agrees"
     # ours solve the printed target: θ2 within 0.002° of 25°, i.e. 0.026° from the paper's 25.0271°
     assert rows[1].pinarms == pytest.approx(25.0011, abs=1e-4)
+
+
+def test_demo_joint_plots_in_degrees_for_seed000_only(tmp_path, monkeypatch):
+    # seed 000's paper draws joint 1 in degrees; the other studies keep SI (rad, m)
+    from pinarms.demo import study_000, study_004
+    from viz import plots as vplots
+
+    seen = {}
+    real = vplots.plot_trajectory
+
+    def spy(path, trajectory, **options):
+        seen[path.name] = options.get("degrees", False)
+        return real(path, trajectory, **options)
+
+    monkeypatch.setattr(vplots, "plot_trajectory", spy)
+    for key, study in (("000", study_000(quick=True)), ("004", study_004(quick=True))):
+        study.plots["joints"](tmp_path / f"seed{key}_joints.png")
+    assert seen == {"seed000_joints.png": True, "seed004_joints.png": False}
+    assert (tmp_path / "seed000_joints.png").stat().st_size > 10_000
