@@ -431,10 +431,11 @@ def layout_cmd(robot: str, xyz: tuple[float, ...], mm: bool, names: str | None, 
         "points": rows,
     }
     width = max(8, *(len(r["name"]) for r in rows))
+    position_head = f"position [{lu}]"
     lines = [
-        f"{arm.name}: {len(rows)} point(s), {report.method} IK, workspace median manipulability "
-        f"{report.median_manipulability:.4g} ({n} samples, seed {seed})",
-        f"  {'point':<{width}}  {f'position [{lu}]':<29}  reachable  branches  manipulability  dexterity  margin [{lu}]",
+        (f"{arm.name}: {len(rows)} point(s), {report.method} IK, workspace median manipulability "
+         f"{report.median_manipulability:.4g} ({n} samples, seed {seed})"),
+        f"  {'point':<{width}}  {position_head:<29}  reachable  branches  manipulability  dexterity  margin [{lu}]",
     ]
     for r in rows:
         where = " ".join(f"{v:9.6g}" for v in r["position"])
