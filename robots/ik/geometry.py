@@ -144,9 +144,11 @@ def rotate_const(direction: np.ndarray, angle: np.ndarray, v: np.ndarray) -> np.
 
 
 #: ``1 − |c| / sqrt(a² + b²)`` below which :func:`solve_cos_sin` treats the roots as one.
-#: A genuine pair of roots that close (≤ 1.4e-7 rad apart) is recovered by the
-#: solver's Gauss–Newton polish.
-_DOUBLE_ROOT = 1e-14
+#: Rounding in ``c`` reaches ~1e-13 relative after a chain of transforms (an arccos would
+#: then be off by ~5e-7 rad). A genuine pair of roots that close (≤ 2.8e-6 rad apart)
+#: merges into one whose pose error is second order (within the FK tolerance) or is
+#: restored by the solver's Gauss–Newton polish.
+_DOUBLE_ROOT = 1e-12
 
 
 def solve_cos_sin(a: np.ndarray, b: np.ndarray, c: np.ndarray, slack: float = 1e-10) -> np.ndarray:

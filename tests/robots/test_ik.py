@@ -403,3 +403,18 @@ def test_ik_branches_takes_one_pose():
         arm.ik_branches(T)
     with pytest.raises(ModelError, match="no analytic IK"):
         robots.load("panda").ik_branches(np.eye(4))
+
+
+@pytest.mark.parametrize(
+    "q_deg",
+    [
+        [-85.0, -49.563, 0.0, -114.402, 1.508, -116.562],  # elbow straight (θ3 = 0)
+        [141.4, -170.0, 0.0, 75.157, -160.52, 64.194],  # elbow straight, shoulder at its limit
+    ],
+)
+def test_aubo_straight_elbow_comes_back_to_rounding(q_deg):
+    """θ3 = 0 is a double root of the planar two-link step: without snapping, rounding in
+    the chain (~1e-13) would leave the elbow ~5e-7 rad off."""
+    q = np.radians(q_deg)
+    sols = _AUBO.ik_all(_AUBO.fk(q), q_ref=q)
+    assert np.abs(sols[0] - q).max() < 1e-9
