@@ -128,11 +128,9 @@ def test_bad_cartesian_input():
 
 
 def test_tcp_path_on_a_built_in_robot():
-    robots = pytest.importorskip("robots")
-    try:
-        robot = robots.load("scara_mushroom")
-    except Exception as exc:  # the robot package is developed alongside; report why
-        pytest.skip(f"robots.load('scara_mushroom') unavailable: {exc}")
+    import robots
+
+    robot = robots.load("scara_mushroom")
     q = robot.random_q(2, seed=3)
     traj = planning.multi_quintic([0.0, 1.0], q)
     t, p = planning.tcp_path(robot, traj, hz=50.0)
