@@ -6,14 +6,13 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
+import pybullet  # a test dependency (the project's [test] extra): an independent engine
 import pytest
+import yourdfpy
 
 import robots
 from pinarms.export import export_urdf, mesh_references
 from robots.errors import InvalidInput, PinarmsError, RobotNotFound
-
-pybullet = pytest.importorskip("pybullet")
-yourdfpy = pytest.importorskip("yourdfpy")
 
 ALL = robots.names()
 N_CONFIGS = 8
