@@ -6,9 +6,11 @@ objectives over a box and knows nothing about trajectories. The timing layer
 (:class:`TimingProblem`, :func:`minimize_time`, :func:`minimize_time_jerk`) turns segment
 durations of a planning trajectory into objective and constraint arrays, and checks every
 GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
-limit along the same path (:mod:`optim.reference`).
+limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a whole
+pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
 """
 
+from optim.cycle import CycleResult, PickPlace, plan_cycle
 from optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from optim.exact import ExactSolution, solve_exact
@@ -30,6 +32,9 @@ __all__ = [
     "TimingResult",
     "minimize_time",
     "minimize_time_jerk",
+    "PickPlace",
+    "CycleResult",
+    "plan_cycle",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",
