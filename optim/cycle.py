@@ -44,7 +44,7 @@ from planning import Trajectory, joint_waypoints
 from planning.trajectory import Peaks
 from robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["PickPlace", "CycleResult", "plan_cycle", "CYCLE_KINDS", "LINE_NAMES"]
+__all__ = ["CYCLE_KINDS", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")

@@ -58,7 +58,7 @@ def test_all_waypoints_on_one_ik_branch(planned):
 
 
 def test_timing_respects_the_limits_by_dense_sampling(planned):
-    arm, spec, limits, res = planned
+    _, spec, limits, res = planned
     traj = res.trajectory
     t = np.linspace(traj.start_time, traj.end_time, 40_001)
     _, qd, qdd, qddd = traj.sample(t)
