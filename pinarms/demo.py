@@ -82,7 +82,7 @@ def _session(robot: Any, title: str):
 
 # --------------------------------------------------------------------- seed 000
 def study_000(quick: bool = False) -> Study:
-    """SCARA mushroom packer: 3-5-3 trajectory of joint 1 and its GA time optimisation."""
+    """SCARA mushroom packer: 3-5-3 trajectory of joint 1, its GA time optimisation, the pick-and-place cycle."""
     import optim
     import planning
 
@@ -131,6 +131,18 @@ def study_000(quick: bool = False) -> Study:
     hold = np.clip(np.array([0.0, 60.0 * DEG, 0.05, 0.0]), arm.lower, arm.upper)
     q_via = np.tile(hold, (4, 1))
     q_via[:, 0] = path
+
+    # the whole pick-and-place cycle between the same pick (conveyor) and place (box) poses
+    spec = optim.PickPlace(arm.fk(q_via[0]), arm.fk(q_via[-1]), lift=0.05, dwell=0.2)
+    cycle = optim.plan_cycle(arm, spec, q_start=q_via[0])
+    what = ("pick-and-place cycle of the SCARA (pick on the conveyor, place in the box, lift 50 mm, dwell 0.2 s, "
+            "joint limits of the model)")
+    why = (f"the paper gives none for the SCARA; moves {cycle.move_times[0]:.3f} + {cycle.move_times[1]:.3f} s "
+           "(optim.plan_cycle, exact)")
+    rows.append(Row("000", f"{what}: cycle time", None, cycle.cycle_time, "s", None, why))
+    rows.append(Row("000", f"{what}: picks per minute", None, cycle.picks_per_minute, "1/min", None,
+                    "the paper gives none for the SCARA"))
+    session.add_trajectory("pick_place_cycle", cycle.trajectory)
     anim = planning.piecewise_polynomial(ga.knot_times, q_via, degrees=(3, 5, 3))
     session.add_trajectory("353_optimised", anim)
     session.add_trajectory("353_initial_2-2-2s",
@@ -247,7 +259,7 @@ BOUNDS_002_S = (SEED002.precision_s, 0.5)
 
 
 def study_002(quick: bool = False) -> Study:
-    """Flower gantry: quintic B-spline through 10 segments, improved-GA time (and time–jerk) optimisation."""
+    """Flower gantry: quintic B-spline through 10 segments, improved-GA time (and time–jerk) optimisation, cycle."""
     import optim
     import planning
 
@@ -295,7 +307,19 @@ def study_002(quick: bool = False) -> Study:
     rows.append(Row("002", "time–jerk two-stage: total", None, float(tj.total), "s", None,
                     "minimum jerk with the total at most 1.05 × its own stage-one optimum"))
 
+    # the whole cycle of that move: clamp, lift-feed-lower, release, and back (dwell 0.2 s, pinarms's choice)
     transmission = conv.GANTRY_TRANSMISSION_M_PER_RAD
+    tcp = arm.position(np.array(GANTRY_PATH_AXIS_M))
+    spec = optim.PickPlace(tcp[0], tcp[-1], lift=float(tcp[1, 2] - tcp[0, 2]), dwell=0.2, via=list(tcp[2:-2]))
+    cycle = optim.plan_cycle(arm, spec, kind="quintic-bspline", vmax=arm.velocity_limit,
+                             amax=a * transmission, jmax=j * transmission)
+    what = ("pick-and-place cycle of the gantry (the lift-feed-lower move and back, dwell 0.2 s, axis limits "
+            f"{arm.velocity_limit[0]:g} m/s of the model, {a * transmission:g} m/s², {j * transmission:g} m/s³)")
+    rows.append(Row("002", f"{what}: cycle time", None, cycle.cycle_time, "s", None,
+                    f"moves {cycle.move_times[0]:.3f} + {cycle.move_times[1]:.3f} s (optim.plan_cycle, exact)"))
+    rows.append(Row("002", f"{what}: picks per minute", paper.grasps_per_minute, cycle.picks_per_minute, "1/min",
+                    None, "different path (the paper's is not printed), limits of the model, not the machine's"))
+
     session = _session(arm, "seed 002: flower gantry, quintic B-spline, improved GA")
     axis_traj = planning.quintic_bspline(together.knot_times, path * transmission)
     session.add_trajectory("lift-feed-lower_time_optimal", axis_traj)
