@@ -361,9 +361,7 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     if session_path:
         session = _new_session(arm, f"workspace of {arm.name}")
         session.add_workspace("workspace", ws)
-        session.save(session_path)
-        data["session"] = session_path
-        lines.append(f"session written: {session_path}")
+        _save_session(session, session_path, data, lines)
     _emit(as_json, data, lines)
 
 
@@ -547,6 +545,13 @@ def _new_session(robot: Robot | str | None, title: str):
     return viz.Session(robot=robot, title=title)
 
 
+def _save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
+    """Write ``session`` to ``path`` and report it in the command's JSON ``data`` and text ``lines``."""
+    session.save(path)
+    data["session"] = path
+    lines.append(f"session written: {path}")
+
+
 def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degree: int | None, degrees: str | None):
     import planning
 
@@ -699,9 +704,7 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     if session_path:
         session = _new_session(arm, f"{kind} trajectory")
         session.add_trajectory(kind, traj)
-        session.save(session_path)
-        data["session"] = session_path
-        lines.append(f"session written: {session_path}")
+        _save_session(session, session_path, data, lines)
     _emit(as_json, data, lines)
 
 
@@ -778,9 +781,7 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
         session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
         if result.history is not None:
             session.add_history(f"{kind} GA", result.history)
-        session.save(session_path)
-        data["session"] = session_path
-        lines.append(f"session written: {session_path}")
+        _save_session(session, session_path, data, lines)
     _emit(as_json, data, lines)
 
 
@@ -845,9 +846,7 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
         session.add_points("cycle_via_points", res.waypoints[:, :3, 3], kind="via")
         place_m = res.waypoints[res.names.index("place"), :3, 3]
         session.add_points("pick_place", np.stack([res.waypoints[0, :3, 3], place_m]), kind="target")
-        session.save(session_path)
-        data["session"] = session_path
-        lines.append(f"session written: {session_path}")
+        _save_session(session, session_path, data, lines)
     _emit(as_json, data, lines)
 
 
