@@ -17,7 +17,7 @@ import time
 import numpy as np
 import pinocchio as pin
 
-import robots
+from pinarms import robots
 
 
 def pinocchio_loop(robot: robots.Robot, q: np.ndarray, frame: str = "tcp") -> np.ndarray:

@@ -27,8 +27,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pinocchio as pin
 
-import robots
-from robots.ik import NumericalIK
+from pinarms import robots
+from pinarms.robots.ik import NumericalIK
 
 
 def analytic(n: int, seed: int, repeat: int = 3) -> dict:
@@ -90,7 +90,7 @@ def numerical(robot: robots.Robot, T: np.ndarray, starts: np.ndarray, tol: float
 
 def robot_ik(robot: robots.Robot, T: np.ndarray, starts: np.ndarray, tol: float = 1e-10, runs: int = 3) -> dict:
     """``Robot.ik`` (closed-form solution nearest the start, refined; numerical fallback)."""
-    from robots.errors import UnreachableTarget
+    from pinarms.robots.errors import UnreachableTarget
 
     best = None
     for _ in range(runs):

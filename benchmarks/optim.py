@@ -20,9 +20,10 @@ import timeit
 _HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _HERE]
 
-from optim import GASettings, TimingProblem, minimize_time, scenarios
-from optim.reference import path_velocity_limit, ruckig_limit, toppra_limit
-from robots.papers import SEED000
+from pinarms import scenarios
+from pinarms.optim import GASettings, TimingProblem, minimize_time
+from pinarms.optim.reference import path_velocity_limit, ruckig_limit, toppra_limit
+from pinarms.papers import SEED000
 
 
 def pymoo_ga(problem: TimingProblem, seed: int, generations: int) -> tuple[float, float]:
@@ -51,7 +52,7 @@ def population_evaluation(s2) -> None:
     """Constraints of one GA population (50 timings): batched planning vs one trajectory at a time."""
     import numpy as np
 
-    import planning
+    from pinarms import planning
 
     batched = TimingProblem(s2.positions, s2.kind, s2.vmax, s2.amax, s2.jmax)
     one_by_one = TimingProblem(s2.positions, s2.kind, s2.vmax, s2.amax, s2.jmax, builder=planning.quintic_bspline)

@@ -18,8 +18,8 @@ import timeit
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-import planning
-from robots.papers import SEED002
+from pinarms import planning
+from pinarms.papers import SEED002
 
 H = SEED002.initial_durations_s  # seed 002, s
 TIMES = np.concatenate([[0.0], np.cumsum(H)])

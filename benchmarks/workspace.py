@@ -22,8 +22,8 @@ import time
 import numpy as np
 import pinocchio as pin
 
-import robots
-from robots.workspace import sample_workspace
+from pinarms import robots
+from pinarms.robots.workspace import sample_workspace
 
 LOOP_SUBSET = 20_000
 TARGET_S = 3.0

@@ -10,16 +10,16 @@ limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a w
 pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
 """
 
-from optim.cycle import CycleResult, PickPlace, plan_cycle
-from optim.engine import GAHistory, GAProgress, GAResult, run_ga
-from optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
-from optim.exact import ExactSolution, solve_exact
-from optim.problem import KINDS, TimingProblem
-from optim.settings import GASettings
-from optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
+from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
+from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
+from pinarms.optim.exact import ExactSolution, solve_exact
+from pinarms.optim.problem import KINDS, TimingProblem
+from pinarms.optim.settings import GASettings
+from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
                               ruckig_limit, toppra_limit)
-from optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
-from optim.timing import TimingResult, minimize_time
+from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
+from pinarms.optim.timing import TimingResult, minimize_time
 
 __all__ = [
     "run_ga",

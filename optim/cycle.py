@@ -37,12 +37,13 @@ from typing import Any
 
 import numpy as np
 
-from optim.errors import InvalidLimits, InvalidSettings
-from optim.problem import check_limit
-from optim.timing import TimingResult, minimize_time
-from planning import Trajectory, joint_waypoints
-from planning.trajectory import Peaks
-from robots.errors import InvalidInput, UnreachableTarget
+from pinarms.optim.errors import InvalidLimits, InvalidSettings
+from pinarms.optim.problem import check_limit
+from pinarms.optim.timing import TimingResult, minimize_time
+from pinarms.planning import Trajectory, joint_waypoints
+from pinarms.planning.trajectory import Peaks
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.robots.ties import argmin_tied
 
 __all__ = ["CYCLE_KINDS", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
 
@@ -147,7 +148,7 @@ class PickPlace:
         """Waypoints (4 + len(via), 4, 4) of the move to place, tcp → base [m], in :attr:`names` order."""
         R = self.orientation
         if R is None and any(p.shape == (3,) for p in (self.pick, self.place, *self.via)):
-            from robots.layout import default_orientation
+            from pinarms.robots.layout import default_orientation
 
             R = default_orientation(robot)
 
@@ -395,7 +396,7 @@ def _branch_labels(robot: Any, poses: np.ndarray, q: np.ndarray) -> np.ndarray:
         sols, labels = robot.ik_branches(pose, q_ref=qi)
         sols = np.asarray(sols, dtype=float).reshape(-1, q.shape[1])
         if sols.shape[0]:
-            k = int(np.argmin(np.linalg.norm(sols - qi, axis=1)))
+            k = argmin_tied(np.linalg.norm(sols - qi, axis=1))
             if np.linalg.norm(sols[k] - qi) < 1e-6:
                 out[i] = int(labels[k])
     return out

@@ -19,11 +19,11 @@ from typing import Callable
 
 import numpy as np
 
-from optim import adaptive, crossover, mutation, selection
-from optim.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feasibility_rules,
+from pinarms.optim import adaptive, crossover, mutation, selection
+from pinarms.optim.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feasibility_rules,
                                rank_penalty, violation)
-from optim.errors import InvalidSettings
-from optim.settings import GASettings
+from pinarms.optim.errors import InvalidSettings
+from pinarms.optim.settings import GASettings
 
 __all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress", "random_generator"]
 

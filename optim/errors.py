@@ -6,7 +6,7 @@ catches everything pinarms raises on purpose.
 
 from __future__ import annotations
 
-from robots.errors import PinarmsError
+from pinarms.robots.errors import PinarmsError
 
 __all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings"]
 

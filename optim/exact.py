@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from optim.problem import SAFETY, TimingProblem
+from pinarms.optim.problem import SAFETY, TimingProblem
 
 __all__ = ["ExactSolution", "solve_exact", "start_ratios", "scaled_to_limits", "polish_durations"]
 

@@ -28,8 +28,8 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from robots.errors import InvalidInput
-from optim.errors import InvalidLimits, InvalidSettings
+from pinarms.robots.errors import InvalidInput
+from pinarms.optim.errors import InvalidLimits, InvalidSettings
 
 __all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
@@ -94,7 +94,7 @@ def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndar
 
 def _planning_builders(kind: str, options: dict[str, Any]) -> tuple[Builder, BatchBuilder]:
     """The planning constructor of ``kind`` for one timing and for a population."""
-    import planning  # optim sits above planning in the one-way flow
+    from pinarms import planning  # optim sits above planning in the one-way flow
 
     if kind == "3-5-3":
         single, batch = planning.piecewise_polynomial, planning.piecewise_polynomial_batch
@@ -233,7 +233,7 @@ class TimingProblem:
         peak search (:func:`planning.piece_peaks_batch`) then runs once for the whole
         population.
         """
-        import planning
+        from pinarms import planning
 
         times, coefs = self.coefficients_batch(population)
         return planning.piece_peaks_batch(times, coefs)

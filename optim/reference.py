@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from optim.errors import OptimError
-from optim.problem import check_limit
+from pinarms.optim.errors import OptimError
+from pinarms.optim.problem import check_limit
 
 __all__ = ["path_velocity_limit", "toppra_limit", "ruckig_limit", "double_s_limit",
            "MissingReference"]
@@ -98,6 +98,6 @@ def ruckig_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:
 
 def double_s_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:
     """Rest-to-rest double-S duration (s) from q0 to q1 (planning's profile, synchronised)."""
-    import planning
+    from pinarms import planning
 
     return float(planning.double_s(q0, q1, vmax, amax, jmax).duration)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from optim.errors import InvalidSettings
+from pinarms.optim.errors import InvalidSettings
 
 __all__ = ["GASettings", "SELECTIONS", "CROSSOVERS", "MUTATIONS", "CONSTRAINT_HANDLINGS"]
 

@@ -28,12 +28,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from optim.engine import GAHistory, random_generator, run_ga
-from optim.errors import InfeasibleProblem, InvalidSettings
-from optim.exact import solve_exact
-from optim.problem import SAFETY, TimingProblem
-from optim.settings import GASettings
-from optim.timing import minimize_time
+from pinarms.optim.engine import GAHistory, random_generator, run_ga
+from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
+from pinarms.optim.exact import solve_exact
+from pinarms.optim.problem import SAFETY, TimingProblem
+from pinarms.optim.settings import GASettings
+from pinarms.optim.timing import minimize_time
 
 __all__ = ["TimeJerkResult", "minimize_time_jerk", "jerk_integral", "jerk_integral_batch"]
 

@@ -24,9 +24,9 @@ from typing import Any, Callable, Iterable
 import click
 import numpy as np
 
-import robots
-from robots.errors import InvalidInput, PinarmsError
-from robots.robot import Robot
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.robots.robot import Robot
 
 from .units import angle_scale, joints_from_si, joints_to_si, length_scale, prismatic_mask
 
@@ -170,7 +170,7 @@ json_option = click.option("--json", "as_json", is_flag=True, help="Print one JS
 @json_option
 def robots_cmd(as_json: bool) -> None:
     """List the robots `pinarms` knows (built-in arms and example-robot-data arms) with their DoF."""
-    from robots.registry import info
+    from pinarms.robots.registry import info
 
     rows = []
     for name in robots.names():
@@ -332,8 +332,8 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     the base plane (distances in the JSON in metres).
     """
     arm = _load_robot(robot)
-    from robots.placement import recommend_region
-    from robots.workspace import sample_workspace
+    from pinarms.robots.placement import recommend_region
+    from pinarms.robots.workspace import sample_workspace
 
     ws = sample_workspace(arm, n=n, seed=seed, frame=frame)
     summary_obj = ws.summary()
@@ -386,7 +386,7 @@ def layout_cmd(robot: str, xyz: tuple[float, ...], mm: bool, names: str | None, 
     fewer). An unreachable point is reported, not an error (exit status 0).
     """
     arm = _load_robot(robot)
-    from robots.workspace import sample_workspace
+    from pinarms.robots.workspace import sample_workspace
 
     values = _vectors_from_args(xyz)
     if values.size % 3:
@@ -540,7 +540,7 @@ def _via_input(via: tuple[str, ...], times: str | None, file: str | None) -> tup
 
 def _new_session(robot: Robot | str | None, title: str):
     """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
-    import viz
+    from pinarms import viz
 
     return viz.Session(robot=robot, title=title)
 
@@ -553,7 +553,7 @@ def _save_session(session: Any, path: str, data: dict, lines: list[str]) -> None
 
 
 def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degree: int | None, degrees: str | None):
-    import planning
+    from pinarms import planning
 
     if kind == "3-5-3":
         return planning.piecewise_polynomial(times, positions, degrees=(3, 5, 3))
@@ -657,7 +657,7 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     Example (seed 000, joint 1): pinarms plan --kind 3-5-3 --deg --times 0,2,4,6
     --via 55.5 --via 69.7 --via 106.5 --via 124.5 --vmax 55
     """
-    import planning
+    from pinarms import planning
 
     if session_path and not robot:
         raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
@@ -732,7 +732,7 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     Example (seed 000): pinarms optimize --kind 3-5-3 --deg --via 55.5 --via 69.7
     --via 106.5 --via 124.5 --vmax 55
     """
-    import optim
+    from pinarms import optim
 
     if session_path and not robot:
         raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
@@ -814,7 +814,7 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
 
     Example: pinarms cycle aubo_i3 --pick 350 200 150 --place -100 400 100 --mm
     """
-    import optim
+    from pinarms import optim
 
     arm = _load_robot(robot)
     scale = length_scale(mm)
@@ -859,7 +859,7 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
 @json_option
 def view_cmd(session: str, port: int | None, open_browser: bool, no_wait: bool, as_json: bool) -> None:
     """Open a saved SESSION in the MeshCat viewer (local server on 127.0.0.1; Ctrl+C stops it)."""
-    import viz
+    from pinarms import viz
 
     loaded = viz.load_session(session)
     viewer = viz.show(loaded, port=port, open_browser=open_browser, wait=False)
@@ -879,7 +879,7 @@ def view_cmd(session: str, port: int | None, open_browser: bool, no_wait: bool, 
 @json_option
 def export_html_cmd(session: str, out: str, as_json: bool) -> None:
     """Write SESSION as one self-contained HTML page OUT (opens offline in any browser)."""
-    import viz
+    from pinarms import viz
 
     loaded = viz.load_session(session)
     path = viz.export_html(loaded, out)
@@ -901,7 +901,7 @@ def urdf_group() -> None:
 @json_option
 def urdf_build_cmd(check: bool, out_dir: str | None, as_json: bool) -> None:
     """Regenerate urdf/*.urdf from robots/xacro/*.urdf.xacro."""
-    from robots import urdf_build
+    from pinarms.robots import urdf_build
 
     if check:
         stale = urdf_build.stale(out_dir)

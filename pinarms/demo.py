@@ -11,9 +11,9 @@ plots. The runner writes, into ``out_dir``::
     plots/seed<k>_*.png        joint curves, GA convergence, workspace views
 
 ``quick`` uses fewer samples and GA generations (under a minute on two cores); the
-published numbers compared are the same. They all come from :mod:`robots.papers`; seed
+published numbers compared are the same. They all come from :mod:`pinarms.papers`; seed
 002's via points (the paper prints none) are pinarms's representative path
-:data:`optim.scenarios.GANTRY_PATH_AXIS_M`.
+:data:`pinarms.scenarios.GANTRY_PATH_AXIS_M`.
 """
 
 from __future__ import annotations
@@ -26,9 +26,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-import robots
-from robots import conventions as conv
-from robots.papers import SEED000, SEED001, SEED002, SEED004
+from pinarms import robots
+from pinarms.robots import conventions as conv
+from pinarms.papers import SEED000, SEED001, SEED002, SEED004
 
 from .report import Row, format_table, markdown_table
 
@@ -75,7 +75,7 @@ class DemoResult:
 
 
 def _session(robot: Any, title: str):
-    import viz
+    from pinarms import viz
 
     return viz.Session(robot, title=title)
 
@@ -83,8 +83,8 @@ def _session(robot: Any, title: str):
 # --------------------------------------------------------------------- seed 000
 def study_000(quick: bool = False) -> Study:
     """SCARA mushroom packer: 3-5-3 trajectory of joint 1, its GA time optimisation, the pick-and-place cycle."""
-    import optim
-    import planning
+    from pinarms import optim
+    from pinarms import planning
 
     arm = robots.load("scara_mushroom")
     paper = SEED000
@@ -172,8 +172,8 @@ def _add_line_objects(session: Any, pick_m: np.ndarray, place_m: np.ndarray) -> 
 # --------------------------------------------------------------------- seed 001
 def study_001(quick: bool = False) -> Study:
     """AUBO-i3: workspace and table region, 3-segment quintic vs Table 3, quintic/septic comparison."""
-    import planning
-    from robots.workspace import sample_workspace
+    from pinarms import planning
+    from pinarms.robots.workspace import sample_workspace
 
     arm = robots.load("aubo_i3")
     paper = SEED001
@@ -187,7 +187,7 @@ def study_001(quick: bool = False) -> Study:
                     sphere.centre[2] / MM, "mm", 20.0, "outer-hull sphere fit; the paper reads its centre off a plot"))
     rows.append(Row("001", "workspace sphere radius", paper.sphere_radius_mm, sphere.radius / MM, "mm", 60.0,
                     "paper: 'about 600 mm' read off its figure; ours is a least-squares fit to the outer hull"))
-    from robots.placement import recommend_region
+    from pinarms.robots.placement import recommend_region
 
     region = recommend_region(ws)
     why = "from sample density, dexterity and self-collision share per shell; thresholds not tuned to the paper"
@@ -210,14 +210,17 @@ def study_001(quick: bool = False) -> Study:
                     "most rows agree to 1e-4; the rest are the robot's tracking error"))
 
     # how much of the paper's 4 s the arm's own speed limits leave (issue: optimise P1→P4)
-    import optim
+    from pinarms import optim
 
     fastest = optim.minimize_time(table2, "multi-quintic", arm.velocity_limit, method="exact")
-    limiting = arm.joint_names[int(np.argmax(fastest.peaks.velocity / arm.velocity_limit))]
+    from pinarms.robots.ties import near_max
+
+    at_limit = [arm.joint_names[k] for k in near_max(fastest.peaks.velocity / arm.velocity_limit)]
+    limiting = " and ".join(at_limit) + (" at their limits" if len(at_limit) > 1 else " at its limit")
     rows.append(Row("001", "time-optimal P1→P4 (3 quintics, at rest at P2/P3, joint speed limits)",
                     float(times[-1]), fastest.total, "s", None,
                     f"the paper's 1/2/1 s use a fraction of the {np.degrees(arm.velocity_limit[0]):.0f} °/s limit; "
-                    f"ours {'/'.join(f'{h:.3f}' for h in fastest.durations)} s, {limiting} at its limit"))
+                    f"ours {'/'.join(f'{h:.3f}' for h in fastest.durations)} s, {limiting}"))
 
     single = planning.polynomial(times[[0, 3]], table2[[0, 3]], 5)
     miss = np.abs(single.sample(times[1:3])[0] - table2[1:3]).max()
@@ -260,10 +263,10 @@ BOUNDS_002_S = (SEED002.precision_s, 0.5)
 
 def study_002(quick: bool = False) -> Study:
     """Flower gantry: quintic B-spline through 10 segments, improved-GA time (and time–jerk) optimisation, cycle."""
-    import optim
-    import planning
+    from pinarms import optim
+    from pinarms import planning
 
-    from optim.scenarios import GANTRY_PATH_AXIS_M, gantry_path_motor_rad
+    from pinarms.scenarios import GANTRY_PATH_AXIS_M, gantry_path_motor_rad
 
     arm = robots.load("gantry_flower")
     paper = SEED002
@@ -341,7 +344,7 @@ def _print_step(value: float) -> float:
 
 def study_004(quick: bool = False) -> Study:
     """Koji turner: the paper's forward-kinematics examples, its IK example, the joint-rate simulation."""
-    import planning
+    from pinarms import planning
 
     arm = robots.load("koji_turner")
     paper = SEED004
@@ -372,7 +375,9 @@ def study_004(quick: bool = False) -> Study:
     target[:3, 3] = paper.ik_target_m
     answer_deg = paper.ik_answer_deg
     sols = arm.ik_all(target, respect_limits=False)
-    best = sols[np.argmin(np.abs(sols[:, :3] / DEG - answer_deg).max(axis=1))] / DEG
+    from pinarms.robots.ties import argmin_tied
+
+    best = sols[argmin_tied(np.abs(sols[:, :3] / DEG - answer_deg).max(axis=1))] / DEG
     # tolerance: the error the paper itself states for its one-decimal target (section 3)
     ik_note = ("ours solve the printed target (the FK rounded to 0.1 mm); the paper's digits follow from x rounded "
                "to 1197.0 mm (docs/ik.md)")
@@ -411,7 +416,7 @@ def study_004(quick: bool = False) -> Study:
 # --------------------------------------------------------------------- plots
 def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = False) -> dict[str, Callable[[Path], Any]]:
     """Plot writers (path → file) of a trajectory's joint curves and a GA history."""
-    from viz import plots as vplots
+    from pinarms.viz import plots as vplots
 
     out: dict[str, Callable[[Path], Any]] = {
         "joints": lambda path: vplots.plot_trajectory(path, traj, limits=limits, title=title, degrees=degrees),
@@ -422,7 +427,7 @@ def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = Fal
 
 
 def _workspace_plots(ws: Any, title: str) -> dict[str, Callable[[Path], Any]]:
-    from viz import plots as vplots
+    from pinarms.viz import plots as vplots
 
     return {"workspace": lambda path: vplots.plot_workspace(path, ws, title=title, mm=True)}
 
@@ -438,7 +443,7 @@ STUDIES: dict[str, Callable[[bool], Study]] = {
 def run_demo(out_dir: str | Path = "demo-output", *, quick: bool = False, only: Any = None,
              progress: Callable[[str], None] | None = None) -> DemoResult:
     """Run the studies, write the table, sessions, HTML pages and plots into ``out_dir``."""
-    import viz
+    from pinarms import viz
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

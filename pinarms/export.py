@@ -26,9 +26,9 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-import robots
-from robots.errors import InvalidInput, ModelError
-from robots.robot import Robot
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.robots.robot import Robot
 
 __all__ = ["ExportedURDF", "export_urdf", "mesh_references"]
 

@@ -144,7 +144,7 @@ def splice_table(document: str, rows: Sequence[Row]) -> str:
     Raises:
         InvalidInput: the document lacks the two markers (in that order, once each).
     """
-    from robots.errors import InvalidInput
+    from pinarms.robots.errors import InvalidInput
 
     begin, end = document.find(TABLE_BEGIN), document.find(TABLE_END)
     if document.count(TABLE_BEGIN) != 1 or document.count(TABLE_END) != 1 or end < begin:

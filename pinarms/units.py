@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robots.robot import Robot
+from pinarms.robots.robot import Robot
 
 __all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale"]
 

@@ -8,17 +8,17 @@ at once, and :func:`peaks_batch` peaks them in one pass (for optimisers).
 Units: s, and rad or m per joint.
 """
 
-from planning.bspline import quintic_bspline, quintic_bspline_batch
-from planning.cartesian import joint_path_from_waypoints, joint_waypoints, tcp_path
-from planning.definition import from_definition
-from planning.errors import ConditionCountError, OutOfTimeRange, TrajectoryError
-from planning.extrema import peaks_batch, piece_peaks_batch
-from planning.limits import JointLimits
-from planning.multi_quintic import heuristic_velocities, multi_quintic, multi_quintic_batch
-from planning.piecewise import PRESETS, piecewise_polynomial, piecewise_polynomial_batch
-from planning.point_to_point import double_s, trapezoidal
-from planning.polynomial import polynomial
-from planning.trajectory import LimitReport, Peaks, Trajectory, Violation
+from pinarms.planning.bspline import quintic_bspline, quintic_bspline_batch
+from pinarms.planning.cartesian import joint_path_from_waypoints, joint_waypoints, tcp_path
+from pinarms.planning.definition import from_definition
+from pinarms.planning.errors import ConditionCountError, OutOfTimeRange, TrajectoryError
+from pinarms.planning.extrema import peaks_batch, piece_peaks_batch
+from pinarms.planning.limits import JointLimits
+from pinarms.planning.multi_quintic import heuristic_velocities, multi_quintic, multi_quintic_batch
+from pinarms.planning.piecewise import PRESETS, piecewise_polynomial, piecewise_polynomial_batch
+from pinarms.planning.point_to_point import double_s, trapezoidal
+from pinarms.planning.polynomial import polynomial
+from pinarms.planning.trajectory import LimitReport, Peaks, Trajectory, Violation
 
 __all__ = [
     "Trajectory",

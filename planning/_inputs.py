@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from planning.errors import TrajectoryError
+from pinarms.planning.errors import TrajectoryError
 
 
 def finite_array(value: Any, what: str) -> np.ndarray:

@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from planning import _inputs
-from planning.piecewise import solve_coefficients
-from planning.trajectory import Trajectory
+from pinarms.planning import _inputs
+from pinarms.planning.piecewise import solve_coefficients
+from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["quintic_bspline", "quintic_bspline_batch"]
 

@@ -23,14 +23,15 @@ from typing import Any, Callable
 
 import numpy as np
 
-from planning import _inputs
-from planning.bspline import quintic_bspline
-from planning.errors import TrajectoryError
-from planning.multi_quintic import multi_quintic
-from planning.piecewise import piecewise_polynomial
-from planning.polynomial import polynomial
-from planning.trajectory import Trajectory
-from robots.errors import UnreachableTarget
+from pinarms.planning import _inputs
+from pinarms.planning.bspline import quintic_bspline
+from pinarms.planning.errors import TrajectoryError
+from pinarms.planning.multi_quintic import multi_quintic
+from pinarms.planning.piecewise import piecewise_polynomial
+from pinarms.planning.polynomial import polynomial
+from pinarms.planning.trajectory import Trajectory
+from pinarms.robots.errors import UnreachableTarget
+from pinarms.robots.ties import argmin_tied
 
 __all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "PATH_KINDS"]
 
@@ -82,7 +83,7 @@ def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
                     raise UnreachableTarget("no analytic solution within the joint limits")
                 same = np.flatnonzero(labels == branch) if branch is not None else np.arange(0)
                 pool = same if same.size else np.arange(sols.shape[0])
-                pick = pool[0] if prev is None else pool[int(np.argmin(np.linalg.norm(sols[pool] - prev, axis=1)))]
+                pick = pool[0] if prev is None else pool[argmin_tied(np.linalg.norm(sols[pool] - prev, axis=1))]
                 q, branch = sols[pick], labels[pick]
             else:
                 q = np.asarray(robot.ik(pose, q_seed=prev), dtype=float).reshape(nq)

@@ -12,13 +12,13 @@ from __future__ import annotations
 from functools import reduce
 from typing import Any, Callable
 
-from planning.bspline import quintic_bspline
-from planning.errors import TrajectoryError
-from planning.multi_quintic import multi_quintic
-from planning.piecewise import piecewise_polynomial
-from planning.point_to_point import double_s, trapezoidal
-from planning.polynomial import polynomial
-from planning.trajectory import Trajectory
+from pinarms.planning.bspline import quintic_bspline
+from pinarms.planning.errors import TrajectoryError
+from pinarms.planning.multi_quintic import multi_quintic
+from pinarms.planning.piecewise import piecewise_polynomial
+from pinarms.planning.point_to_point import double_s, trapezoidal
+from pinarms.planning.polynomial import polynomial
+from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["from_definition", "KINDS"]
 

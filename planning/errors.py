@@ -7,7 +7,7 @@ the whole pinarms family with one ``except``; :class:`TrajectoryError` is also a
 
 from __future__ import annotations
 
-from robots.errors import PinarmsError
+from pinarms.robots.errors import PinarmsError
 
 __all__ = ["TrajectoryError", "ConditionCountError", "OutOfTimeRange"]
 

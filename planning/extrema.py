@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from planning import _inputs
-from planning.errors import TrajectoryError
+from pinarms.planning import _inputs
+from pinarms.planning.errors import TrajectoryError
 
 __all__ = ["piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
 

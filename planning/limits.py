@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from planning._inputs import finite_array
-from planning.errors import TrajectoryError
+from pinarms.planning._inputs import finite_array
+from pinarms.planning.errors import TrajectoryError
 
 __all__ = ["JointLimits"]
 

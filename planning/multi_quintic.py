@@ -31,9 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from planning import _inputs
-from planning.errors import TrajectoryError
-from planning.trajectory import Trajectory
+from pinarms.planning import _inputs
+from pinarms.planning.errors import TrajectoryError
+from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["multi_quintic", "multi_quintic_batch", "quintic_hermite_coefficients", "heuristic_velocities"]
 

@@ -29,10 +29,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from planning import _inputs
-from planning.errors import ConditionCountError, TrajectoryError
-from planning.polynomial import derivative_row
-from planning.trajectory import Trajectory
+from pinarms.planning import _inputs
+from pinarms.planning.errors import ConditionCountError, TrajectoryError
+from pinarms.planning.polynomial import derivative_row
+from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["piecewise_polynomial", "piecewise_polynomial_batch", "solve_coefficients", "PRESETS"]
 

@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from planning import _inputs
-from planning.errors import TrajectoryError
-from planning.trajectory import Trajectory, stack_joints
+from pinarms.planning import _inputs
+from pinarms.planning.errors import TrajectoryError
+from pinarms.planning.trajectory import Trajectory, stack_joints
 
 __all__ = ["trapezoidal", "double_s", "double_s_phases", "trapezoidal_phases"]
 

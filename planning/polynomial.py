@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from planning import _inputs
-from planning.errors import ConditionCountError, TrajectoryError
-from planning.trajectory import Trajectory
+from pinarms.planning import _inputs
+from pinarms.planning.errors import ConditionCountError, TrajectoryError
+from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["polynomial", "derivative_row"]
 

@@ -29,9 +29,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from planning._inputs import finite_array, scalar
-from planning.errors import OutOfTimeRange, TrajectoryError
-from planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
+from pinarms.planning._inputs import finite_array, scalar
+from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
+from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
 
 __all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
 
@@ -321,7 +321,7 @@ class Trajectory:
         :class:`Violation` is reported per joint, kind and piece, at the time of the worst
         value on that piece; the list is sorted by time.
         """
-        from planning.limits import JointLimits
+        from pinarms.planning.limits import JointLimits
 
         if not isinstance(limits, JointLimits):
             raise TrajectoryError(f"limits must be a planning.JointLimits, got {type(limits).__name__}")

@@ -1,6 +1,6 @@
 """Robots as data: URDF models in Pinocchio with batched kinematics (SI units).
 
->>> import robots
+>>> from pinarms import robots
 >>> arm = robots.load("aubo_i3")
 >>> T = arm.fk(arm.neutral)          # (4, 4) tcp → base
 """
@@ -53,8 +53,3 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
-
-# the four papers' published numbers, as printed (data only)
-from . import papers  # noqa: E402
-
-__all__ += ["papers"]

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 __all__ = [
     "deg_to_rad",

@@ -102,7 +102,7 @@ def builtin_urdf_path(name: str) -> Path:
     entry = info(name)
     if entry.source != "pinarms":
         raise RobotNotFound(f"{name!r} is not a built-in pinarms arm; built-ins: {', '.join(_BUILTIN)}")
-    return Path(str(importlib.resources.files("urdf") / entry.urdf_relpath))
+    return Path(str(importlib.resources.files("pinarms.urdf") / entry.urdf_relpath))
 
 
 def load(name: str) -> Robot:

@@ -21,7 +21,7 @@ import tempfile
 import xml.dom.minidom
 from pathlib import Path
 
-from robots.errors import ModelError, RobotNotFound
+from pinarms.robots.errors import ModelError, RobotNotFound
 
 __all__ = [
     "XACRO_DIR",

@@ -10,9 +10,9 @@ import pybullet  # a test dependency (the project's [test] extra): an independen
 import pytest
 import yourdfpy
 
-import robots
+from pinarms import robots
 from pinarms.export import export_urdf, mesh_references
-from robots.errors import InvalidInput, PinarmsError, RobotNotFound
+from pinarms.robots.errors import InvalidInput, PinarmsError, RobotNotFound
 
 ALL = robots.names()
 N_CONFIGS = 8

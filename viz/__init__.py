@@ -1,6 +1,6 @@
 """Visualisation and saved sessions: MeshCat scenes in the browser, standalone HTML, plots.
 
->>> import robots, viz
+>>> from pinarms import robots, viz
 >>> s = viz.Session(robots.load("ur5"), title="demo")
 >>> s.save("demo.pinarms")
 >>> with viz.show(viz.load_session("demo.pinarms")) as viewer:

@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 from typing import BinaryIO, Callable
 
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 __all__ = ["atomic_write"]
 

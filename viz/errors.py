@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from robots.errors import PinarmsError
+from pinarms.robots.errors import PinarmsError
 
 __all__ = ["VizError", "SessionFormatError", "ViewerError"]
 

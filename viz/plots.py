@@ -18,7 +18,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 from ._atomic import atomic_write
 

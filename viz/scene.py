@@ -26,7 +26,7 @@ import matplotlib
 import numpy as np
 import pinocchio as pin
 
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 from ._meshcat import MeshcatVisualizer, meshcat, mg
 from .errors import ViewerError

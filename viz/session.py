@@ -34,9 +34,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-import robots
-from robots.errors import InvalidInput, PinarmsError
-from robots.robot import Robot
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.robots.robot import Robot
 
 from ._atomic import atomic_write
 from .errors import SessionFormatError
@@ -131,7 +131,7 @@ class TrajectoryRecord:
         """The :class:`planning.Trajectory` rebuilt from :attr:`definition`."""
         if self.definition is None:
             raise InvalidInput(f"trajectory {self.name!r} was saved from samples only; it has no definition to rebuild")
-        import planning  # late import: only this method needs it
+        from pinarms import planning  # late import: only this method needs it
 
         return planning.from_definition(self.definition)
 

@@ -17,7 +17,7 @@ import weakref
 from pathlib import Path
 from typing import Any
 
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 from ._meshcat import ViewerWindow, meshcat
 from .errors import ViewerError

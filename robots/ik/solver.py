@@ -24,6 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..errors import ModelError
+from ..ties import argsort_tied
 
 __all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL", "split_by_target"]
 
@@ -255,7 +256,7 @@ class AnalyticIK:
             pick = np.argmin(np.where(inside, np.abs(options - q_ref[rev]), np.inf), axis=0)
             q[:, rev] = np.take_along_axis(options, pick[None], axis=0)[0]
         q = q[np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=1)]
-        return q[np.argsort(np.linalg.norm(q - q_ref, axis=1), kind="stable")]
+        return q[argsort_tied(np.linalg.norm(q - q_ref, axis=1))]
 
     def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None) -> list[np.ndarray]:
         """Every solution within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first."""

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-import robots
+from pinarms import robots
 from pinarms.cli import cli, read_via_file
-from robots.papers import SEED000 as PAPER000
+from pinarms.papers import SEED000 as PAPER000
 
 SEED000 = [arg for deg in PAPER000.path_deg for arg in ("--via", f"{deg:g}")]  # --via 55.5 --via 69.7 ...
 
@@ -124,7 +124,7 @@ def test_workspace_json_and_session(run, tmp_path):
     # the gantry's workspace is its stroke box (tcp offset aside): extent equals the strokes
     np.testing.assert_allclose(hi - lo, arm.upper - arm.lower, atol=0.02)
     assert data["n"] == 2000 and out.is_file()
-    import viz
+    from pinarms import viz
 
     assert viz.load_session(out).workspaces
     assert_user_error(run("workspace", "gantry_flower", "-n", "0", ok=False), 2, "-n")
@@ -133,7 +133,7 @@ def test_workspace_json_and_session(run, tmp_path):
 def test_plan_seed000_peaks_and_limit_check(run, tmp_path):
     args = ["plan", "--kind", "3-5-3", "--deg", "--times", "0,2,4,6", *SEED000, "--vmax", "55"]
     data = as_json(run(*args, "--json"))
-    import planning
+    from pinarms import planning
 
     traj = planning.piecewise_polynomial(PAPER000.initial_knot_times_s, PAPER000.path_rad, degrees=(3, 5, 3))
     assert data["duration_s"] == pytest.approx(6.0)
@@ -265,7 +265,7 @@ def test_ik_seed_q_of_the_wrong_size_is_a_one_line_error(run):
 def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypatch):
     import click
 
-    import optim
+    from pinarms import optim
     import pinarms.cli as cli_module
 
     seen = {}
@@ -293,8 +293,8 @@ def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypa
 
 
 def test_workspace_prints_the_recommended_table_region(run):
-    from robots.placement import recommend_region
-    from robots.workspace import sample_workspace
+    from pinarms.robots.placement import recommend_region
+    from pinarms.robots.workspace import sample_workspace
 
     data = as_json(run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange", "--json"))
     region = recommend_region(sample_workspace(robots.load("aubo_i3"), n=3000, seed=0, frame="flange"))
@@ -338,7 +338,7 @@ def test_one_column_json_via_file_plans(run, tmp_path):
 
 
 def test_layout_reports_reachable_and_unreachable_points(run):
-    from robots.workspace import sample_workspace
+    from pinarms.robots.workspace import sample_workspace
 
     arm = robots.load("aubo_i3")
     result = run("layout", "aubo_i3", "0.3", "0.2", "0.2", "10", "0", "0", "-n", "5000", "--seed", "2", "--json")

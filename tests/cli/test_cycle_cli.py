@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-import robots
-from optim.cycle import PickPlace, plan_cycle
+from pinarms import robots
+from pinarms.optim.cycle import PickPlace, plan_cycle
 from pinarms.cli import cli
 
 AUBO = ["aubo_i3", "--pick", "350", "200", "150", "--place", "-100", "400", "100", "--mm"]
@@ -45,7 +45,7 @@ def test_cycle_json_in_si_with_limits_and_session(tmp_path):
     assert data["waypoints"][1]["position_m"] == pytest.approx([0.3, 0.25, 0.14], abs=1e-12)
     assert max(max(v) for v in data["limit_ratios"].values()) <= 1.0 + 1e-9
     assert data["one_branch"] is True
-    import viz
+    from pinarms import viz
 
     session = viz.load_session(out)
     assert list(session.trajectories) == ["cycle"]

@@ -40,7 +40,7 @@ def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
     md = (out / "table.md").read_text()
     assert md.count("\n| ") == len(rows) + 1
     assert json.loads((out / "table.json").read_text()) == rows
-    import viz
+    from pinarms import viz
 
     session = viz.load_session(out / "sessions" / "seed001.pinarms")
     assert session.trajectories and session.workspaces
@@ -57,7 +57,7 @@ def test_demo_text_table_only_one_study(tmp_path):
 def test_demo_ik_rows_use_the_error_the_paper_states():
     # seed 004 section 3: "the one-decimal position causes 0.1° of error in θ" (not a tolerance fitted to ours)
     from pinarms.demo import study_004
-    from robots.papers import SEED004
+    from pinarms.papers import SEED004
 
     rows = [r for r in study_004(quick=True).rows if r.quantity.startswith("IK of")]
     assert len(rows) == 3
@@ -71,7 +71,7 @@ def test_demo_ik_rows_use_the_error_the_paper_states():
 def test_demo_joint_plots_in_degrees_for_seed000_only(tmp_path, monkeypatch):
     # seed 000's paper draws joint 1 in degrees; the other studies keep SI (rad, m)
     from pinarms.demo import study_000, study_004
-    from viz import plots as vplots
+    from pinarms.viz import plots as vplots
 
     seen = {}
     real = vplots.plot_trajectory

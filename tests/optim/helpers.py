@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planning.trajectory import Trajectory
+from pinarms.planning.trajectory import Trajectory
 
 
 def build_353(times: np.ndarray, positions: np.ndarray) -> Trajectory:

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from optim import GASettings, TimingProblem, minimize_time, scenarios
-from optim.exact import polish_durations
+from pinarms import scenarios
+from pinarms.optim import GASettings, TimingProblem, minimize_time
+from pinarms.optim.exact import polish_durations
 from tests.optim.helpers import dense_peaks
 
 S0 = scenarios.seed000()

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from optim.cycle import LINE_NAMES, PickPlace, plan_cycle
-from optim.errors import InvalidLimits
-from robots.errors import InvalidInput, UnreachableTarget
+from pinarms import robots
+from pinarms.optim.cycle import LINE_NAMES, PickPlace, plan_cycle
+from pinarms.optim.errors import InvalidLimits
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
 # pick / place points inside each arm's working region (base frame, m)
 POINTS = {
@@ -109,7 +109,7 @@ def test_doubling_vmax_halves_a_velocity_limited_cycle(name):
 
 
 def test_transfer_vias_and_the_gantry_path():
-    from optim.scenarios import GANTRY_PATH_AXIS_M
+    from pinarms.scenarios import GANTRY_PATH_AXIS_M
 
     arm = robots.load("gantry_flower")
     P = arm.position(GANTRY_PATH_AXIS_M)

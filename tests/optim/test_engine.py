@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from optim import GASettings, InvalidSettings, run_ga
+from pinarms.optim import GASettings, InvalidSettings, run_ga
 
 PRESETS = {
     "default": GASettings(),

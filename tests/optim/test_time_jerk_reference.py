@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from optim import (InvalidSettings, jerk_integral, minimize_time, minimize_time_jerk,
-                   path_velocity_limit, ruckig_limit, double_s_limit, toppra_limit, scenarios)
+from pinarms.optim import (InvalidSettings, jerk_integral, minimize_time, minimize_time_jerk,
+                   path_velocity_limit, ruckig_limit, double_s_limit, toppra_limit)
+from pinarms import scenarios
 from tests.optim.helpers import dense_peaks
 
 S1 = scenarios.seed001()

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from optim import (GASettings, InfeasibleProblem, InvalidLimits, TimingProblem, minimize_time,
-                   scenarios)
+from pinarms.optim import (GASettings, InfeasibleProblem, InvalidLimits, TimingProblem, minimize_time)
+from pinarms import scenarios
 from tests.optim.helpers import build_353, dense_peaks
 
 S0 = scenarios.seed000()
@@ -134,7 +134,7 @@ def test_single_segment_point_to_point_is_solved(kind, method):
 
 
 def test_353_needs_exactly_four_via_points():
-    from robots.errors import InvalidInput
+    from pinarms.robots.errors import InvalidInput
 
     for q in ([0.0, 1.0], [0.0, 1.0, 2.0], [0.0, 1.0, 2.0, 3.0, 4.0]):
         with pytest.raises(InvalidInput, match=f"needs 4 via points, got {len(q)}"):
@@ -142,8 +142,8 @@ def test_353_needs_exactly_four_via_points():
 
 
 def test_non_numeric_positions_bounds_and_unknown_options_are_named():
-    from optim import InvalidSettings
-    from robots.errors import InvalidInput
+    from pinarms.optim import InvalidSettings
+    from pinarms.robots.errors import InvalidInput
 
     with pytest.raises(InvalidInput, match="positions=.*not numeric"):
         minimize_time(["a", "b"], "multi-quintic", 1.0)
@@ -160,7 +160,7 @@ def test_non_numeric_positions_bounds_and_unknown_options_are_named():
 
 @pytest.mark.parametrize("method", ["ga", "exact"])
 def test_bad_seed_is_refused_before_any_work(method):
-    from optim import InvalidSettings, minimize_time_jerk
+    from pinarms.optim import InvalidSettings, minimize_time_jerk
 
     with pytest.raises(InvalidSettings, match="seed=-1"):
         minimize_time(S0.positions, S0.kind, S0.vmax, method=method, seed=-1)

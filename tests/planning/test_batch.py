@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.interpolate import make_interp_spline
 
-import planning
-from planning.errors import ConditionCountError, TrajectoryError
+from pinarms import planning
+from pinarms.planning.errors import ConditionCountError, TrajectoryError
 
 RNG = np.random.default_rng(20240605)
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-from planning.errors import TrajectoryError
-from robots.errors import UnreachableTarget
+from pinarms import planning
+from pinarms.planning.errors import TrajectoryError
+from pinarms.robots.errors import UnreachableTarget
 
 
 class PlanarArm:
@@ -128,7 +128,7 @@ def test_bad_cartesian_input():
 
 
 def test_tcp_path_on_a_built_in_robot():
-    import robots
+    from pinarms import robots
 
     robot = robots.load("scara_mushroom")
     q = robot.random_q(2, seed=3)
@@ -159,9 +159,9 @@ def test_labelled_branch_is_kept_even_when_another_branch_is_nearer():
 
 
 def test_aubo_table2_waypoints_keep_the_branch_until_the_limits_force_a_switch():
-    import robots
-    from robots import conventions as conv
-    from robots import papers
+    from pinarms import robots
+    from pinarms.robots import conventions as conv
+    from pinarms import papers
 
     arm = robots.load("aubo_i3")
     q_paper = np.array([conv.aubo_mdh_to_joint(t) for t in papers.SEED001.table2_joints])

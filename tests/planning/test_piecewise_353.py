@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-from robots.papers import SEED000
-from planning.errors import ConditionCountError, TrajectoryError
+from pinarms import planning
+from pinarms.papers import SEED000
+from pinarms.planning.errors import ConditionCountError, TrajectoryError
 
 # Seed 000, joint 1 path points (degrees) and segment times (s).
 JOINT1_DEG = np.array(SEED000.path_deg)

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-from planning import JointLimits
-from planning.point_to_point import double_s_phases, trapezoidal_phases
+from pinarms import planning
+from pinarms.planning import JointLimits
+from pinarms.planning.point_to_point import double_s_phases, trapezoidal_phases
 
 
 @pytest.mark.parametrize(

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-from robots.papers import SEED001
+from pinarms import planning
+from pinarms.papers import SEED001
 
 TIMES = list(SEED001.via_times_s)
 # Table 2, joints J1..J6 (rad), points P1..P4.

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.interpolate import make_interp_spline
 
-import planning
-from robots.papers import SEED002
+from pinarms import planning
+from pinarms.papers import SEED002
 
 # Seed 002's initial segment times (s) and a representative lift-feed-lower path (m).
 SEED002_H = SEED002.initial_durations_s

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-from planning import JointLimits
-from planning.errors import ConditionCountError, TrajectoryError
-from robots.errors import PinarmsError
+from pinarms import planning
+from pinarms.planning import JointLimits
+from pinarms.planning.errors import ConditionCountError, TrajectoryError
+from pinarms.robots.errors import PinarmsError
 
 
 @pytest.mark.parametrize(

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import planning
-from planning import JointLimits, Trajectory
-from planning.errors import OutOfTimeRange, TrajectoryError
+from pinarms import planning
+from pinarms.planning import JointLimits, Trajectory
+from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
 
 
 def random_bspline(seed: int, n_seg: int = 6, n_joints: int = 3) -> Trajectory:

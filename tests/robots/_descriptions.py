@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import yourdfpy
 
-from robots.urdf_build import URDF_DIR
+from pinarms.robots.urdf_build import URDF_DIR
 
 
 def urdf_file(name: str) -> Path:

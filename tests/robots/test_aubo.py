@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robots.conventions import (
+from pinarms.robots.conventions import (
     aubo_flange_from_mdh,
     aubo_fk_mdh,
     aubo_joint_to_mdh,
@@ -13,7 +13,7 @@ from robots.conventions import (
     deg_to_rad,
     m_to_mm,
 )
-from robots.papers import SEED001
+from pinarms.papers import SEED001
 
 from _descriptions import pin_frame, pin_model, random_q
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robots.conventions import (
+from pinarms.robots.conventions import (
     GANTRY_TRANSMISSION_M_PER_RAD,
     aubo_joint_to_mdh,
     aubo_mdh_to_joint,
@@ -17,7 +17,7 @@ from robots.conventions import (
     rad_to_deg,
     wrap_angle,
 )
-from robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput
 
 
 def test_angle_and_length_conversions_on_arrays():
@@ -82,7 +82,7 @@ def test_gantry_motor_side_limits_to_axis_side():
 def test_gantry_urdf_velocity_is_the_paper_motor_limit_through_the_transmission():
     import pinocchio as pin
 
-    from robots.urdf_build import URDF_DIR
+    from pinarms.robots.urdf_build import URDF_DIR
 
     model = pin.buildModelFromUrdf(str(URDF_DIR / "gantry_flower.urdf"))
     np.testing.assert_allclose(model.velocityLimit, gantry_motor_to_axis(np.full(3, 100.0)))

@@ -9,9 +9,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-import robots
-from robots.errors import ModelError, RobotNotFound
-from robots.urdf_build import XACRO_DIR, build, build_all, build_file, source_names, stale, urdf_path
+from pinarms import robots
+from pinarms.robots.errors import ModelError, RobotNotFound
+from pinarms.robots.urdf_build import XACRO_DIR, build, build_all, build_file, source_names, stale, urdf_path
 
 from _descriptions import independent_joint_names, pin_frame, pin_model, random_q, urdf_file, yourdf_model
 
@@ -182,7 +182,7 @@ def test_malformed_urdf_raises_model_error(tmp_path):
 
 def test_command_line_check_reports_up_to_date():
     result = subprocess.run(
-        [sys.executable, "-m", "robots.urdf_build", "--check"], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "pinarms.robots.urdf_build", "--check"], capture_output=True, text=True, timeout=120
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "up to date" in result.stdout

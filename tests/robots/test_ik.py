@@ -7,11 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import robots
-from robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
-from robots.errors import InvalidInput, ModelError
-from robots.papers import SEED001
-from robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
+from pinarms import robots
+from pinarms.robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
+from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.papers import SEED001
+from pinarms.robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
 
 ANALYTIC = ["scara_mushroom", "gantry_flower", "koji_turner", "aubo_i3", "ur3", "ur5", "ur10"]
 MAX_SOLUTIONS = {"scara_mushroom": 2 * 2, "gantry_flower": 1, "koji_turner": 4, "aubo_i3": 8, "ur3": 8 * 64, "ur5": 8 * 64, "ur10": 8 * 64}
@@ -322,7 +322,7 @@ def test_starts_drop_branches_no_equivalent_brings_within_limits():
 
 
 def test_split_by_target_keeps_empty_targets_and_order():
-    from robots.ik.solver import split_by_target
+    from pinarms.robots.ik.solver import split_by_target
 
     q = np.arange(12.0).reshape(4, 3)
     parts = split_by_target(np.array([1, 1, 3, 3]), q, 5)
@@ -342,7 +342,7 @@ def test_a_position_given_to_ik_all_says_how_to_solve_it():
 def test_koji_paper_candidate_lists_are_our_branches_at_x_rounded_to_whole_mm():
     """Seed 004 eq. (8) prints four θ2 and four θ3 (down) candidates; at (1197.0, 250, −929.2) mm
     every one is an angle of our four geometric branches, either as is or shifted by 90°."""
-    from robots.papers import SEED004
+    from pinarms.papers import SEED004
 
     koji = robots.load("koji_turner")
     T = KOJI_PAPER_MATRIX.copy()

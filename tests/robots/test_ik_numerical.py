@@ -6,9 +6,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from robots.errors import InvalidInput, UnreachableTarget
-from robots.ik import NumericalIK
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.robots.ik import NumericalIK
 
 ALL_ARMS = ["scara_mushroom", "gantry_flower", "koji_turner", "koji_turner_rail", "aubo_i3", "ur5", "panda"]
 

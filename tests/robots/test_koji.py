@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robots.conventions import deg_to_rad, koji_fk_paper, m_to_mm
+from pinarms.robots.conventions import deg_to_rad, koji_fk_paper, m_to_mm
 
 from _descriptions import pin_frame, pin_model, random_q
 

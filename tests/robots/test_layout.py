@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from robots.errors import InvalidInput
-from robots.layout import check_layout, default_orientation
-from robots.workspace import sample_workspace
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput
+from pinarms.robots.layout import check_layout, default_orientation
+from pinarms.robots.workspace import sample_workspace
 
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from robots import InvalidInput, ModelError, RobotNotFound
+from pinarms import robots
+from pinarms.robots import InvalidInput, ModelError, RobotNotFound
 
 BUILTIN = robots.builtin_names()
 EXAMPLE = ["ur5", "panda"]

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from robots.errors import InvalidInput
-from robots.workspace import (
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput
+from pinarms.robots.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,
     fit_sphere_to_hull,
@@ -209,7 +209,7 @@ def test_workspace_arrays_are_read_only(aubo):
 
 def test_default_voxel_size_keeps_the_interior_free_of_chance_holes(aubo):
     """2 cm voxels with 10⁵ samples leave half of the reachable points in empty voxels; the default does not."""
-    from robots.voxels import suggest_voxel_size
+    from pinarms.robots.voxels import suggest_voxel_size
 
     ws = sample_workspace(aubo, n=100_000, seed=0)
     vm = ws.voxel_map()
@@ -251,7 +251,7 @@ def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
 
 
 def test_direction_coverage_tells_a_ball_from_a_patch():
-    from robots.workspace import direction_coverage
+    from pinarms.robots.workspace import direction_coverage
 
     rng = np.random.default_rng(0)
     d = rng.normal(size=(20000, 3))

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import planning
-import robots
-import viz
-from robots.papers import SEED000
+from pinarms import planning
+from pinarms import robots
+from pinarms import viz
+from pinarms.papers import SEED000
 
 DEG = np.pi / 180.0
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import viz
+from pinarms import viz
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

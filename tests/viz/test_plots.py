@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-import planning
-import viz
-from robots.errors import InvalidInput
-from robots.papers import SEED000
+from pinarms import planning
+from pinarms import viz
+from pinarms.robots.errors import InvalidInput
+from pinarms.papers import SEED000
 
 
 @pytest.fixture(scope="module")

@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-import viz
-from robots.errors import InvalidInput
-from viz.scene import build_scene, colors_by_value
-from viz.viewer import MeshcatServer
+from pinarms import viz
+from pinarms.robots.errors import InvalidInput
+from pinarms.viz.scene import build_scene, colors_by_value
+from pinarms.viz.viewer import MeshcatServer
 
 
 def _listening_addresses(port: int) -> set[str]:
@@ -83,7 +83,7 @@ def test_bad_port():
 
 
 def test_port_in_use_says_what_to_do():
-    from viz import ViewerError
+    from pinarms.viz import ViewerError
 
     with MeshcatServer() as first:
         port = int(re.search(r":(\d+)/", first.url).group(1))

@@ -10,12 +10,12 @@ import zipfile
 import numpy as np
 import pytest
 
-import planning
-import robots
-import viz
-import viz.session as vs
-from robots.errors import InvalidInput, PinarmsError
-from viz import SessionFormatError
+from pinarms import planning
+from pinarms import robots
+from pinarms import viz
+import pinarms.viz.session as vs
+from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.viz import SessionFormatError
 
 LEVER_URDF = """<robot name="lever">
   <link name="base_link"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>

@@ -1,7 +1,7 @@
 """The papers' timing problems as data (via points, limits, the papers' numbers).
 
 Angles in the papers are degrees; everything here is SI (rad, m, s) unless the name
-says otherwise. The published numbers come from :mod:`robots.papers`; the one thing
+says otherwise. The published numbers come from :mod:`pinarms.papers`; the one thing
 this module adds is seed 002's representative lift-feed-lower path
 (:data:`GANTRY_PATH_AXIS_M`), because the paper prints none. Used by the demo, the tests,
 ``benchmarks/optim.py`` and ``docs/optim.md``.
@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robots.conventions import GANTRY_TRANSMISSION_M_PER_RAD
-from robots.papers import SEED000, SEED001, SEED002
+from pinarms.robots.conventions import GANTRY_TRANSMISSION_M_PER_RAD
+from pinarms.papers import SEED000, SEED001, SEED002
 
 __all__ = ["PaperScenario", "seed000", "seed001", "seed002", "GANTRY_PATH_AXIS_M", "gantry_path_motor_rad",
            "GANTRY_MOTOR_RAD_PER_M"]

@@ -1,14 +1,14 @@
-"""optim.scenarios: the paper numbers come from robots.papers; seed 002's one representative path."""
+"""pinarms.scenarios: the paper numbers come from pinarms.papers; seed 002's one representative path."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-import robots
-from optim import scenarios
-from robots.conventions import GANTRY_TRANSMISSION_M_PER_RAD
-from robots.papers import SEED000, SEED001, SEED002
+from pinarms import robots
+from pinarms import scenarios
+from pinarms.robots.conventions import GANTRY_TRANSMISSION_M_PER_RAD
+from pinarms.papers import SEED000, SEED001, SEED002
 
 
 def test_seed000_and_seed001_read_the_papers_module():

@@ -14,7 +14,7 @@ by the demo's paper-vs-pinarms table and in docs/. Numbers that pinarms chooses 
 the models (``robots/xacro``, ``robots/conventions.py``) or the scenarios
 (``optim/scenarios.py``), never here.
 
->>> from robots.papers import SEED000
+>>> from pinarms.papers import SEED000
 >>> SEED000.paper_total_s
 3.607
 """

@@ -1,4 +1,4 @@
-"""robots.papers: the published numbers pinned to the printed values (the literals are the point)."""
+"""pinarms.papers: the published numbers pinned to the printed values (the literals are the point)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from robots import papers
-from robots.papers import SEED000, SEED001, SEED002, SEED004
+from pinarms import papers
+from pinarms.papers import SEED000, SEED001, SEED002, SEED004
 
 
 def test_seed000_as_printed():
@@ -103,7 +103,7 @@ def test_seed004_si_conversions():
 
 
 def test_models_use_the_printed_lengths():
-    from robots import conventions as conv
+    from pinarms.robots import conventions as conv
 
     assert (conv.KOJI_A2, conv.KOJI_A3, conv.KOJI_D1, conv.KOJI_H) == pytest.approx(SEED004.lengths_m, abs=1e-15)
 
