@@ -141,6 +141,25 @@ class Robot:
         self._analytic_ik = None  # set by the registry for arms with a closed form
 
     # ----------------------------------------------------------------- basics
+    def __reduce__(self):
+        """Pickle as its description (URDF text, tcp frame, IK family), rebuilt on unpickling.
+
+        A sweep ships the robot to worker processes (:mod:`pinarms.execution`); each
+        process (and thread) rebuilds it once from the URDF text and reuses it. State set
+        after loading other than the closed-form IK is not carried over.
+        """
+        ik = self._analytic_ik
+        family = None
+        if ik is not None:
+            from .ik import FAMILIES
+
+            family = next((k for k, cls in FAMILIES.items() if type(ik) is cls), None)
+        frame = getattr(ik, "frame", "tcp")
+        return (
+            _rebuild_robot,
+            (self.name, self.urdf_text, self.tcp_frame, self.description, self.package_dirs, family, frame),
+        )
+
     def __repr__(self) -> str:
         return f"Robot({self.name!r}, nq={self.nq}, joints={list(self.joint_names)})"
 
@@ -513,3 +532,31 @@ class Robot:
             f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
             f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
         )
+
+
+_REBUILT = __import__("threading").local()
+
+
+def _rebuild_robot(name, urdf_text, tcp_frame, description, package_dirs, family, ik_frame) -> "Robot":
+    """A pickled :class:`Robot` rebuilt from its URDF text (cached per thread: built once per worker)."""
+    import hashlib
+
+    key = (name, hashlib.sha256(urdf_text.encode()).hexdigest(), tcp_frame, family, ik_frame)
+    cache = getattr(_REBUILT, "robots", None)
+    if cache is None:
+        cache = _REBUILT.robots = {}
+    robot = cache.get(key)
+    if robot is None:
+        from .registry import from_urdf_text
+
+        robot = from_urdf_text(
+            urdf_text, tcp=tcp_frame, name=name, package_dirs=tuple(package_dirs), description=description
+        )
+        if family is not None:
+            from .ik import analytic_solver
+
+            robot._analytic_ik = analytic_solver(robot, family, ik_frame)
+        if len(cache) >= 8:
+            cache.pop(next(iter(cache)))
+        cache[key] = robot
+    return robot
