@@ -217,8 +217,12 @@ def test_wrong_array_shape_and_dtype(saved, tmp_path):
     obj[:] = [{"a": 1}, None]
     buf = io.BytesIO()
     np.save(buf, obj, allow_pickle=True)
-    bad = _rewrite(saved, tmp_path / "pickle.pinarms", replace={q_ref["member"]: buf.getvalue()})
-    with pytest.raises(SessionFormatError, match="not a readable .npy array"):
+    padded = buf.getvalue() + bytes(n * nq * 8)  # the zip entry's size is then what the index's shape needs
+    bad = _rewrite(saved, tmp_path / "pickle.pinarms", replace={q_ref["member"]: padded})
+    with pytest.raises(SessionFormatError, match="object array: pickled data is never loaded"):
+        viz.load_session(bad)
+    bad = _rewrite(saved, tmp_path / "pickle2.pinarms", replace={q_ref["member"]: buf.getvalue()})
+    with pytest.raises(SessionFormatError, match=r"holds \d+ bytes in the zip directory, but session.json's shape"):
         viz.load_session(bad)
     # NaN
     nan = np.zeros((n, nq))
