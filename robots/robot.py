@@ -609,3 +609,34 @@ class Robot:
             f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
             f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
         )
+
+    # --------------------------------------------------------------- dynamics
+    #: The :class:`robots.dynamics.Payload` this robot carries (``None``: the bare arm).
+    payload = None
+
+    def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
+        """A copy of this robot carrying a payload (this robot is unchanged).
+
+        ``mass`` [kg] (or a :class:`robots.dynamics.Payload`), ``com`` (3,) [m] in ``frame``
+        (default the tcp), ``inertia`` (3, 3) [kg·m²] about the centre of mass (default a point
+        mass). See :func:`robots.dynamics.with_payload`.
+        """
+        from .dynamics import with_payload
+
+        return with_payload(self, mass, com=com, inertia=inertia, frame=frame)
+
+    def inverse_dynamics(self, q: Any, qd: Any, qdd: Any) -> np.ndarray:
+        """Joint torques [N·m or N] for ``q, qd, qdd`` (each (nq,) or (N, nq)), by Pinocchio's RNEA.
+
+        See :func:`robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
+        mapped onto the independent joints).
+        """
+        from .dynamics import inverse_dynamics
+
+        return inverse_dynamics(self, q, qd, qdd)
+
+    def gravity(self, q: Any) -> np.ndarray:
+        """Joint torques [N·m or N] holding ``q`` ((nq,) or (N, nq)) still against gravity."""
+        from .dynamics import gravity_torques
+
+        return gravity_torques(self, q)
