@@ -58,3 +58,8 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
+from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
+
+__all__ += ["Payload", "InvalidPayload", "MissingInertials"]
