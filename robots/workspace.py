@@ -18,6 +18,8 @@ A sample is *near-singular* when its inverse condition is below
 
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
+Where the tables should stand is :func:`robots.placement.recommend_region` (the module above
+this one: placement imports workspace, never the other way).
 """
 
 from __future__ import annotations
@@ -31,10 +33,10 @@ import numpy as np
 
 from .errors import InvalidInput
 
+from .voxels import VoxelMap, suggest_voxel_size
+
 if TYPE_CHECKING:  # pragma: no cover
-    from .placement import RecommendedRegion
     from .robot import Robot
-    from .voxels import VoxelMap
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",
@@ -489,17 +491,9 @@ class Workspace:
         ``voxel_size`` [m]; default: :func:`robots.voxels.suggest_voxel_size` (about 10
         samples per reachable voxel, so that chance holes do not fake a boundary).
         """
-        from .voxels import VoxelMap, suggest_voxel_size
-
         if voxel_size is None:
             voxel_size = suggest_voxel_size(self.points)
         return VoxelMap.from_samples(self.points, self.manipulability, voxel_size, min_count=min_count)
-
-    def recommend_region(self, **options: Any) -> "RecommendedRegion":
-        """Where pick/place tables should stand (see :func:`robots.placement.recommend_region`)."""
-        from .placement import recommend_region
-
-        return recommend_region(self, **options)
 
 
 def sample_workspace(
