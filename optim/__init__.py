@@ -7,13 +7,17 @@ objectives over a box and knows nothing about trajectories. The timing layer
 durations of a planning trajectory into objective and constraint arrays, and checks every
 GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
 limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a whole
-pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
+pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back);
+:func:`search_layout` ranks base placements of an arm by the picks per minute of that cycle
+(many cycles, run through :mod:`pinarms.execution`: serial or on Dask).
 """
 
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
+from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
+                                         search_layout)
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -35,6 +39,11 @@ __all__ = [
     "PickPlace",
     "CycleResult",
     "plan_cycle",
+    "search_layout",
+    "LayoutSearch",
+    "Refinement",
+    "grid_candidates",
+    "random_candidates",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",
