@@ -11,7 +11,8 @@
 
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
-from .plots import plot_ga_convergence, plot_joint_curves, plot_trajectory, plot_workspace
+from .layout_session import layout_search_session
+from .plots import plot_ga_convergence, plot_joint_curves, plot_layout_search, plot_trajectory, plot_workspace
 from .scene import SceneInfo, build_scene
 from .session import (
     FORMAT_NAME,
@@ -47,6 +48,8 @@ __all__ = [
     "plot_trajectory",
     "plot_ga_convergence",
     "plot_workspace",
+    "plot_layout_search",
+    "layout_search_session",
     "SceneInfo",
     "VizError",
     "SessionFormatError",
