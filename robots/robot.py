@@ -418,14 +418,21 @@ class Robot:
         return arr, single
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False
     ) -> np.ndarray | list[np.ndarray]:
-        """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
+        """Every closed-form IK branch within the joint limits (tolerance 1e-9 rad or m), each once.
+
+        A branch (UR-type: shoulder × wrist flip × elbow) is listed once, each revolute angle
+        at its 2π equivalent within the limits nearest ``q_ref``; a branch none of whose
+        equivalents lies within the limits is left out.
 
         Args:
             target: tcp pose ``(4, 4)`` (frame → base, m), or a batch ``(N, 4, 4)``.
             q_ref: ``(nq,)`` or ``(N, nq)``: solutions are sorted by distance to it
-                (default :attr:`neutral`); it also fixes the free joint at singular poses.
+                (default :attr:`neutral`); it also fixes the free joint at singular poses
+                and picks each angle's 2π equivalent.
+            equivalents: also list every other 2π equivalent within the limits (a UR's ±2π
+                joints give up to 2⁶ = 64 rows per branch, about 228 per pose).
             respect_limits: ``False`` returns the geometric solutions whatever the joint
                 limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
@@ -442,7 +449,7 @@ class Robot:
         if T.shape[0] == 0:
             return []
         if respect_limits:
-            sols = self._analytic_ik.solve(T, ref)
+            sols = self._analytic_ik.solve(T, ref, equivalents=bool(equivalents))
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
