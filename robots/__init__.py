@@ -8,12 +8,17 @@
 from .errors import (
     InvalidInput,
     LimitViolation,
+    MissingMesh,
     ModelError,
     PinarmsError,
     RobotNotFound,
     UnreachableTarget,
+    XacroArgError,
+    XacroError,
+    XacroForbidden,
+    XacroLimitExceeded,
 )
-from .registry import builtin_names, from_urdf, from_urdf_text, info, load, names
+from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
 from .robot import Robot
 
 __all__ = [
@@ -24,12 +29,18 @@ __all__ = [
     "info",
     "from_urdf",
     "from_urdf_text",
+    "from_xacro",
     "PinarmsError",
     "InvalidInput",
     "RobotNotFound",
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 # workspace analysis and station layout
@@ -53,3 +64,8 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# users' xacro files, expanded behind a wall
+from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
+
+__all__ += ["XacroLimits", "expand_xacro"]

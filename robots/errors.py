@@ -15,6 +15,11 @@ __all__ = [
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 
@@ -40,3 +45,23 @@ class UnreachableTarget(PinarmsError):
 
 class LimitViolation(PinarmsError):
     """A configuration or trajectory violates the robot's limits."""
+
+
+class XacroError(ModelError):
+    """xacro cannot expand a file: unknown macro, undefined property, malformed XML, missing file."""
+
+
+class XacroForbidden(XacroError):
+    """A xacro file reads outside its allowed folders or uses a construct pinarms refuses."""
+
+
+class XacroLimitExceeded(XacroError):
+    """Expanding a xacro file took too long, needed too much memory or produced too much text."""
+
+
+class XacroArgError(XacroError, InvalidInput):
+    """A xacro argument is not declared by the file, or is not a number where a number is due."""
+
+
+class MissingMesh(ModelError):
+    """A mesh file named by a description does not exist."""
