@@ -21,7 +21,7 @@ from pinarms.optim.path_timing import PathTiming, time_optimal
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
-                              ruckig_limit, toppra_limit)
+                                     ruckig_limit, toppra_limit, toppra_path_duration)
 from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
 from pinarms.optim.timing import TimingResult, minimize_time
 
@@ -45,6 +45,7 @@ __all__ = [
     "jerk_integral",
     "path_velocity_limit",
     "toppra_limit",
+    "toppra_path_duration",
     "ruckig_limit",
     "double_s_limit",
     "MissingReference",

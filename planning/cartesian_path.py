@@ -16,7 +16,7 @@ both ends: C² in s, error O(h⁶).
    continuously and never jumps to another IK branch. A step is refused — and halved —
    when Newton does not converge, when the correction or the joint step is large (a jump),
    when a joint leaves its limits, or when the Jacobian's smallest singular value falls
-   below ``singular_tolerance``. When the step has shrunk below ``locate`` (1 µm of arc
+   below ``singular_tolerance``. When the step has shrunk below ``locate`` (10 µm of arc
    length by default) the path stops there with a named error:
    :class:`planning.errors.SingularityOnPath`, :class:`~planning.errors.JointLimitOnPath`
    or :class:`~planning.errors.UnreachableOnPath` (s, pose, reason).
@@ -54,10 +54,10 @@ __all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE"
 #: Default largest tcp deviation from the tool path [m] (0.1 mm).
 DEFAULT_TOLERANCE = 1e-4
 #: Default smallest singular value of the weighted Jacobian [m/rad] below which the arm counts as singular.
-DEFAULT_SINGULAR_TOLERANCE = 1e-3
+DEFAULT_SINGULAR_TOLERANCE = 1e-4
 #: Newton's method stops when the position error [m] and the weighted rotation error [m] are below this.
 _NEWTON_TOL = 1e-11
-_NEWTON_ITERATIONS = 12
+_NEWTON_ITERATIONS = 8
 #: A continuation step is refused when Newton corrects the prediction by more than this [rad or m] ...
 _MAX_CORRECTION = 0.05
 #: ... or when a joint moves more than this in one step [rad or m].
@@ -221,6 +221,14 @@ def _solve_knots(sv: _Solver, s: np.ndarray, q: np.ndarray) -> list[_Knot]:
     return [_Knot(float(s[i]), q[i], (dq_r[i], ddq_r[i]), (dq_l[i], ddq_l[i]), float(sig[i])) for i in range(s.size)]
 
 
+class _Stop(Exception):
+    """Internal: the continuation of one start cannot pass arc length ``s`` (diagnosed once, by :func:`_failure`)."""
+
+    def __init__(self, s: float, q_last: np.ndarray, kind: str, detail: str) -> None:
+        super().__init__(detail)
+        self.s, self.q_last, self.kind, self.detail = s, q_last, kind, detail
+
+
 def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) -> PathError:
     """The named error for a continuation that cannot get past arc length s."""
     robot, tool = sv.robot, sv.tool
@@ -240,8 +248,8 @@ def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) 
             reason = f"the path leaves the workspace: {why}"
             return UnreachableOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}",
                                      s=s, pose=pose, reason=reason, q=q_last)
-    reason = (f"the arm reaches a singular configuration ({detail}); it cannot follow the path through it "
-              "without changing IK branch")
+    reason = (f"the arm comes too close to a singular configuration ({detail}); it cannot follow the path "
+              "through it without changing IK branch")
     return SingularityOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}; move the path away "
                              "from the singularity or split it there", s=s, pose=pose, reason=reason, q=q_last)
 
@@ -273,15 +281,15 @@ def _continue(sv: _Solver, start: _Knot, s_end: float, locate: float) -> list[_K
         if not kind:
             knot = _solve_knots(sv, np.array([s_new]), q[None])[0]
             if knot.sigma < sv.singular:
-                kind, detail = "singular", (f"smallest singular value of the weighted Jacobian {knot.sigma:.3g} m/rad "
-                                            f"< {sv.singular:g}")
+                kind, detail = "singular", (f"smallest singular value of the weighted Jacobian {knot.sigma:.4g} m/rad "
+                                            f"< singular_tolerance {sv.singular:g}")
             else:
                 out.append(knot)
                 cur = knot
                 h = 2.0 * hh
                 continue
         if hh <= locate:
-            raise _failure(sv, s_new, cur.q, kind, detail)
+            raise _Stop(s_new, cur.q, kind, detail)
         h = 0.5 * hh
     return out
 
@@ -319,7 +327,7 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
     L = tool.length
     first = _solve_knots(sv, np.array([0.0]), q0[None])[0]
     if first.sigma < sv.singular:
-        raise _failure(sv, 0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.3g} "
+        raise _Stop(0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.4g} "
                                                 f"m/rad < {sv.singular:g} at the start")
     # planned knots: the tool path's breaks, each piece cut into steps of at most _INITIAL_STEP
     planned = [0.0]
@@ -352,8 +360,8 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
         if np.any(sig_c < sv.singular):
             i, c = np.unravel_index(int(np.argmin(sig_c)), sig_c.shape)
             if h[i] <= locate:
-                raise _failure(sv, float(sc[i, c]), knots[i].q, "singular",
-                               f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.3g} m/rad < {sv.singular:g}")
+                raise _Stop(float(sc[i, c]), knots[i].q, "singular",
+                               f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad < singular_tolerance {sv.singular:g}")
             bad[i] = True
         if not bad.any():
             break
@@ -363,9 +371,9 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
             i = int(tiny[0])
             if sv.outside(qc[i]).max() > 1e-9:
                 j = int(np.argmax(np.maximum(sv.lower - qc[i], qc[i] - sv.upper).max(axis=0)))
-                raise _failure(sv, float(sc[i, 1]), knots[i].q, "limit",
+                raise _Stop(float(sc[i, 1]), knots[i].q, "limit",
                                f"joint {sv.robot.joint_names[j]} would pass its limit between knots")
-            raise _failure(sv, float(sc[i, 1]), knots[i].q, "singular",
+            raise _Stop(float(sc[i, 1]), knots[i].q, "singular",
                            f"the tolerance cannot be met: the joint path bends too fast (σ_min {sig_all[i].min():.3g} m/rad)")
         mids = s[idx] + 0.5 * h[idx]
         pred = _eval(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
@@ -394,7 +402,7 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
     if branch is not None:
         end = _labels(sv.robot, tool.pose(L), q[-1])
         if end is not None and end != branch:
-            raise _failure(sv, L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
+            raise _Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
     return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance,
                          q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
                          max_deviation=(float(pos.max()), float(rot.max())))
@@ -409,7 +417,7 @@ def _coefficients(knots: list[_Knot]) -> np.ndarray:
 
 def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
                 frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE,
-                locate: float = 1e-6) -> CartesianPath:
+                locate: float = 1e-5) -> CartesianPath:
     """The joint path that makes the tcp follow ``path`` within ``tolerance`` (module docstring).
 
     Args:
@@ -420,13 +428,15 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
             ``tolerance / path.weight`` rad.
         q_start: configuration (nq,) selecting the branch: the path starts at the IK solution
             nearest to it (itself if its tcp is at the start pose). Default: each closed-form
-            solution at the start in the robot's order until one follows the whole path (the
-            first one's error is raised if none does); numerical IK for other arms.
+            solution at the start in the robot's order until one follows the whole path (if
+            none does, the error of the one that got farthest is raised, ties to the first);
+            numerical IK for other arms.
         frame: the robot frame that follows the path (default the tcp).
         singular_tolerance: smallest singular value [m/rad] of the weighted Jacobian
-            ``[J_v; w J_ω]`` allowed on the way (1e-3: a joint turning 1 rad moves the tool
-            less than 1 mm in its weakest direction).
-        locate: arc length [m] to which a failure is located.
+            ``[J_v; w J_ω]`` allowed on the way (default 1e-4: closer to a singularity a joint
+            turning 1 rad moves the tool less than 0.1 mm in its weakest direction; on an
+            AUBO-i3 passing through a wrist singularity this stops the path about 5 mm before it).
+        locate: arc length [m] to which a failure is located (10 µm).
 
     Raises:
         SingularityOnPath, JointLimitOnPath, UnreachableOnPath: the arm cannot follow the path on
@@ -452,14 +462,15 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
         reason = robot.ik_failure_reason(pose0) or "no IK solution"
         raise UnreachableOnPath(f"robot '{robot.name}' cannot reach the start of the path (s = 0): {reason}",
                                 s=0.0, pose=pose0, reason=reason)
-    first_error: PathError | None = None
+    farthest: _Stop | None = None
     for q in starts:
         try:
             return _build(sv, np.asarray(q, dtype=float), tol, loc)
-        except PathError as exc:
-            first_error = first_error or exc
-    assert first_error is not None
-    raise first_error
+        except _Stop as stop:
+            if farthest is None or stop.s > farthest.s + loc:
+                farthest = stop
+    assert farthest is not None
+    raise _failure(sv, farthest.s, farthest.q_last, farthest.kind, farthest.detail)
 
 
 def cartesian_path(robot: Any, poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT,
