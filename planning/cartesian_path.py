@@ -242,7 +242,7 @@ def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) 
                                 s=s, pose=pose, reason=reason, q=q_last)
     # out of reach, or an orientation the arm cannot take, a little farther on?
     ahead = tool.pose(min(s + max(1e-3, 1e-3 * tool.length), tool.length))
-    for target in (pose, ahead):
+    for target in (ahead, pose):
         why = robot.ik_failure_reason(target) if hasattr(robot, "ik_failure_reason") else None
         if why is not None and "outside its limits" not in why and "outside their limits" not in why:
             reason = f"the path leaves the workspace: {why}"
