@@ -6,6 +6,7 @@
 """
 
 from .errors import (
+    ExecutionError,
     InvalidInput,
     LimitViolation,
     ModelError,
@@ -30,6 +31,7 @@ __all__ = [
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "ExecutionError",
 ]
 
 # workspace analysis and station layout
