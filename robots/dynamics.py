@@ -244,7 +244,6 @@ def with_payload(robot: "Robot", mass: Any, com: Any = None, inertia: Any = None
         load = None
     new = copy.copy(robot)
     new.model = model
-    new._data = model.createData()
     new._model_without_payload = base_model
     new.payload = load
     new.__dict__.pop("_numerical_ik_solver", None)
