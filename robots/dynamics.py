@@ -46,6 +46,7 @@ __all__ = [
     "kinetic_energy",
     "potential_energy",
     "total_mass",
+    "holding_torques",
 ]
 
 #: Gravity [m/s²] in the base frame (Pinocchio's default model gravity).
@@ -381,3 +382,33 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
             for i in range(1, model.njoints)
         )
     return float(out[0]) if single else out
+
+
+def holding_torques(robot: "Robot", n: int = 20000, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Largest torque each joint needs to hold the arm (and its payload) still anywhere in its ranges.
+
+    ``max over q within the joint limits of |g_j(q)|`` [N·m or N]: the static load a joint must
+    carry before any acceleration (e.g. a rated payload at full reach). Found by ``n`` seeded
+    uniform samples, the best three per joint refined by a bounded quasi-Newton search.
+
+    Returns:
+        ``(torque (nq,), q (nq, nq))``: the maxima and, row j, the configuration of joint j's.
+    """
+    from scipy.optimize import minimize
+
+    q = robot.random_q(n, seed=seed)
+    g = np.abs(gravity_torques(robot, q))
+    best = g.max(axis=0)
+    where = q[np.argmax(g, axis=0)]
+    bounds = list(zip(robot.lower, robot.upper))
+    for j in range(robot.nq):
+        if not best[j] > 0.0:
+            continue
+        for k in np.argsort(g[:, j])[-3:]:
+            res = minimize(lambda x: -abs(float(gravity_torques(robot, x)[j])), q[k], method="L-BFGS-B",
+                           bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-10, "maxiter": 500})
+            x = np.clip(res.x, robot.lower, robot.upper)
+            value = abs(float(gravity_torques(robot, x)[j]))
+            if value > best[j]:
+                best[j], where[j] = value, x
+    return best, where
