@@ -281,3 +281,18 @@ def test_aubo_efforts_follow_the_stated_rule():
     large = ur5.effort_limit[1] / ur5_hold[1] * max(hold[1], hold[2])
     small = large * ur5.effort_limit[3] / ur5.effort_limit[1]
     np.testing.assert_allclose(aubo.effort_limit, [large] * 3 + [small] * 3, atol=0.05)
+
+
+#: Rated payloads the built-in arms are sized for (docs/robots/*.md): a mushroom bundle with
+#: margin, a flower bunch with margin, one fresh koji block.
+RATED_KG = {"scara_mushroom": 1.0, "gantry_flower": 2.0, "koji_turner": 4.0, "koji_turner_rail": 4.0}
+
+
+@pytest.mark.parametrize("name", sorted(RATED_KG))
+def test_estimated_arms_efforts_follow_the_sizing_rule(name):
+    """Effort = hold the rated payload anywhere and reach top speed from rest in 0.25 s, rounded up."""
+    from pinarms.robots.dynamics import holding_torques
+
+    robot = robots.load(name)
+    demand, _ = holding_torques(robot.with_payload(RATED_KG[name]), n=4000, accel_time=0.25)
+    np.testing.assert_array_equal(robot.effort_limit, np.maximum(np.ceil(demand), 1.0))
