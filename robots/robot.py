@@ -23,7 +23,10 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError
 from .kinematic_tree import KinematicTree
 
-__all__ = ["Robot"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+
+MAX_RANDOM_SAMPLES = 50_000_000
+"""Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
 
 
 def _as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
@@ -32,9 +35,11 @@ def _as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
     Returns the ``(N, width)`` array and whether the input was a single vector.
     """
     try:
+        if np.iscomplexobj(values):
+            raise TypeError("complex numbers")
         arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers, got {values!r}") from exc
+        raise InvalidInput(f"{what} must be numbers (real), got {values!r}") from exc
     single = arr.ndim == 1
     if single:
         arr = arr[None, :]
@@ -197,6 +202,9 @@ class Robot:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+        if n > MAX_RANDOM_SAMPLES:
+            raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (about "
+                               f"{n * 100 / 1e9:.3g} GB of work); draw several seeded batches instead")
         rng = _as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
@@ -265,9 +273,11 @@ class Robot:
                 proper rotation (orthonormal within 1e-6, determinant +1).
         """
         try:
+            if np.iscomplexobj(target):
+                raise TypeError("complex numbers")
             arr = np.asarray(target, dtype=float)
         except (TypeError, ValueError) as exc:
-            raise InvalidInput(f"IK target must be numbers, got {target!r}") from exc
+            raise InvalidInput(f"IK target must be numbers (real), got {target!r}") from exc
         if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
             single = arr.ndim == 1
             pts = arr.reshape(-1, 3)
@@ -492,7 +502,9 @@ class Robot:
         _check_seed(seed)
         seed_q = None
         if q_seed is not None:
-            seed_q, _ = self.check_q(q_seed)
+            seed_q, one = self.check_q(q_seed)
+            if not one:
+                raise InvalidInput(f"q_seed must be one configuration of shape ({self.nq},), got {np.shape(q_seed)}")
             seed_q = seed_q[0]
         solver = self._numerical_ik()
         if self._analytic_ik is not None and not position_only:
