@@ -32,7 +32,10 @@ from .ik.numerical import NumericalIK
 from .ik.solver import split_by_target
 from .kinematic_tree import KinematicTree
 
-__all__ = ["Robot"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+
+MAX_RANDOM_SAMPLES = 50_000_000
+"""Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
 
 #: Batches of at most this many configurations are evaluated by one Pinocchio call per
 #: configuration (about 1-2 µs each); larger ones by the batched numpy evaluation, whose
@@ -229,6 +232,9 @@ class Robot:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+        if n > MAX_RANDOM_SAMPLES:
+            raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (about "
+                               f"{n * 100 / 1e9:.3g} GB of work); draw several seeded batches instead")
         rng = _as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
@@ -376,9 +382,11 @@ class Robot:
                 if ortho <= 1e-6 and det > 0.0:
                     return target[None], True
         try:
+            if np.iscomplexobj(target):
+                raise TypeError("complex numbers")
             arr = np.asarray(target, dtype=float)
         except (TypeError, ValueError) as exc:
-            raise InvalidInput(f"IK target must be numbers, got {target!r}") from exc
+            raise InvalidInput(f"IK target must be numbers (real), got {target!r}") from exc
         if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
             single = arr.ndim == 1
             pts = arr.reshape(-1, 3)

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InvalidInput
+from .robot import MAX_RANDOM_SAMPLES
 
 if TYPE_CHECKING:  # pragma: no cover
     from .placement import RecommendedRegion
@@ -509,18 +510,21 @@ def sample_workspace(
 
     Args:
         robot: any :class:`~robots.robot.Robot`.
-        n: number of samples (> 0). 10⁶ samples take about 100 MB.
+        n: number of samples (> 0, at most ``MAX_RANDOM_SAMPLES`` = 5·10⁷). 10⁶ samples take about 100 MB.
         seed: seed or ``numpy.random.Generator``; the same seed gives the same samples
             (``q`` equals ``robot.random_q(n, seed)``).
         frame: frame whose origin is sampled (``"tcp"`` = the robot's tool frame).
         chunk: samples evaluated per block (bounds the working memory).
 
     Raises:
-        InvalidInput: ``n`` is not a positive integer, ``chunk`` is not positive, or
+        InvalidInput: ``n`` is not a positive integer or is above 5·10⁷, ``chunk`` is not positive, or
             ``frame`` is not a frame of the robot.
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
         raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+    if n > MAX_RANDOM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (10⁶ samples take "
+                           f"about 100 MB); sample several seeded workspaces and merge them")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk <= 0:
         raise InvalidInput(f"chunk must be a positive integer, got {chunk!r}")
     robot.frame_id(frame)  # raises InvalidInput naming the frames
