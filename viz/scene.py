@@ -129,22 +129,28 @@ class _RobotDrawing:
         """Show configuration ``q (nq,)``."""
         self.pv.display(self.robot.q_to_pinocchio(q))
 
-    def extent(self) -> np.ndarray:
-        """Corners of the visual geometries' boxes at the displayed pose, ``(8k, 3)`` in the base frame [m].
+    def extent(self, qs: np.ndarray) -> np.ndarray:
+        """Corners of the visual geometries' boxes at each row of ``qs (F, nq)``, ``(8kF, 3)`` in the base frame [m].
 
-        A geometry whose box is unknown contributes its origin.
+        A geometry whose box is unknown contributes its origin. The displayed pose is untouched.
         """
-        corners = []
+        model, gmodel = self.pv.model, self.pv.visual_model
+        data, gdata = model.createData(), gmodel.createData()
         signs = np.array(np.meshgrid([0, 1], [0, 1], [0, 1])).reshape(3, -1).T
-        for g, M in zip(self.pv.visual_model.geometryObjects, self.pv.visual_data.oMg):
+        local = []
+        for g in gmodel.geometryObjects:
             try:
                 g.geometry.computeLocalAABB()
                 lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
-                local = (lo + signs * (hi - lo)) * np.asarray(g.meshScale)
+                local.append((lo + signs * (hi - lo)) * np.asarray(g.meshScale))
             except Exception:  # noqa: BLE001 - a geometry coal cannot bound: its origin only
-                local = np.zeros((1, 3))
-            corners.append(local @ M.rotation.T + M.translation)
-        return np.vstack(corners) if corners else np.zeros((1, 3))
+                local.append(np.zeros((1, 3)))
+        corners = [np.zeros((1, 3))]
+        for qp in np.atleast_2d(self.robot.q_to_pinocchio(qs)):
+            pin.forwardKinematics(model, data, qp)
+            pin.updateGeometryPlacements(model, data, gmodel, gdata)
+            corners += [box @ M.rotation.T + M.translation for box, M in zip(local, gdata.oMg)]
+        return np.vstack(corners)
 
     def record(self, anim: meshcat.animation.Animation, vis: meshcat.Visualizer, qs: np.ndarray) -> None:
         """Add one key frame per row of ``qs (F, nq)`` to ``anim`` (rigid poses: tracks hold position + rotation)."""
@@ -304,7 +310,9 @@ def build_scene(
         recs = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
         recs = recs or [r for r in session.trajectories.values() if r.robot == key]
         drawing.display(recs[0].q[0] if recs else drawing.robot.neutral)
-        framed.append(_transform_points(session.robots[key].base_to_world, drawing.extent()))
+        # framed over the whole motion: the pose at 9 instants of its (first) trajectory
+        poses = recs[0].q[np.linspace(0, recs[0].q.shape[0] - 1, 9).round().astype(int)] if recs else drawing.robot.neutral
+        framed.append(_transform_points(session.robots[key].base_to_world, drawing.extent(poses)))
 
     parts = bounds + [_point_set_world(session, n) for n in session.point_sets]
     everything = np.vstack(parts) if parts else np.zeros((1, 3))
@@ -350,9 +358,10 @@ def build_scene(
     _place_camera(vis, camera)
     vis["/Background"].set_property("top_color", _BACKGROUND[0])
     vis["/Background"].set_property("bottom_color", _BACKGROUND[1])
-    # the floor: at z = 0, or under the lowest point of a suspended arm and its path
+    # the floor: at z = 0, or under the lowest point of a suspended arm (most of it below its base) and its path
     content = np.vstack(framed) if framed else np.vstack([lo, hi])
-    floor_z = 0.0 if content[:, 2].min() >= -0.05 else float(np.floor(content[:, 2].min() / 0.1) * 0.1)
+    suspended = np.median(content[:, 2]) < 0.0 and content[:, 2].min() < -0.05
+    floor_z = float(np.floor(content[:, 2].min() / 0.1) * 0.1) if suspended else 0.0
     grid, grid_step = floor_grid(content.min(axis=0), content.max(axis=0), floor_z)
     vis["/Grid"].set_property("visible", False)  # MeshCat's 20 m grid: replaced by one sized to the content
     vis[f"{ROOT}/floor"].set_object(mg.LineSegments(mg.PointsGeometry(grid.T.astype(np.float32)),
