@@ -19,6 +19,7 @@ from pinarms.planning.piecewise import PRESETS, piecewise_polynomial, piecewise_
 from pinarms.planning.point_to_point import double_s, trapezoidal
 from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import LimitReport, Peaks, Trajectory, Violation
+from pinarms.planning.torque import TorquePeaks, torque_peaks, torques
 
 __all__ = [
     "Trajectory",
@@ -46,4 +47,7 @@ __all__ = [
     "TrajectoryError",
     "ConditionCountError",
     "OutOfTimeRange",
+    "TorquePeaks",
+    "torques",
+    "torque_peaks",
 ]

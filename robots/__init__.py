@@ -6,6 +6,7 @@
 """
 
 from .errors import (
+    ExecutionError,
     InvalidInput,
     LimitViolation,
     ModelError,
@@ -30,6 +31,7 @@ __all__ = [
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "ExecutionError",
 ]
 
 # workspace analysis and station layout
@@ -53,3 +55,8 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
+from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
+
+__all__ += ["Payload", "InvalidPayload", "MissingInertials"]

@@ -59,6 +59,7 @@ parallelogram) are followed and the Jacobian is w.r.t. the independent joints.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,7 +68,8 @@ from scipy.linalg.lapack import dposv as _posv
 
 from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
-from ..robot import _check_seed, _check_tolerance
+from .._checks import check_seed as _check_seed
+from .._checks import check_tolerance as _check_tolerance
 
 __all__ = ["NumericalIK", "IKResult"]
 
@@ -127,7 +129,7 @@ class NumericalIK:
     ) -> None:
         self.robot = robot
         self.model = robot.model
-        self.data = robot.model.createData()
+        self._local = threading.local()  # per-thread Pinocchio data: one solver serves many threads
         self.frame_id = robot.frame_id(frame)
         self._frame = frame
         self.nq = robot.nq
@@ -157,6 +159,14 @@ class NumericalIK:
         self.max_step = float(max_step)
         self.stall_ratio = float(stall_ratio)
         self.stall_steps = int(stall_steps)
+
+    @property
+    def data(self) -> pin.Data:
+        """This thread's Pinocchio data (each thread gets its own on first use)."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
 
     # ------------------------------------------------------------------ pieces
     def _pin_q(self, q: np.ndarray) -> np.ndarray:
