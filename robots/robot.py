@@ -204,6 +204,15 @@ class Robot:
         return out[0] if single else out
 
     @property
+    def joint_units(self) -> tuple[str, ...]:
+        """Unit of each independent joint's position, in ``q`` order: ``"rad"`` (revolute) or ``"m"`` (prismatic)."""
+        units = [""] * self.nq
+        for j in self.model.joints[1:]:
+            if "Mimic" not in j.shortname():
+                units[j.idx_v] = "m" if j.shortname().startswith("JointModelP") else "rad"
+        return tuple(units)
+
+    @property
     def neutral(self) -> np.ndarray:
         """The zero configuration, moved inside the limits where zero is outside them."""
         return np.clip(np.zeros(self.nq), self.lower, self.upper)

@@ -33,7 +33,6 @@ from .errors import InvalidInput
 from .robot import MAX_RANDOM_SAMPLES
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .placement import RecommendedRegion
     from .robot import Robot
     from .voxels import VoxelMap
 
@@ -491,12 +490,6 @@ class Workspace:
         if voxel_size is None:
             voxel_size = suggest_voxel_size(self.points)
         return VoxelMap.from_samples(self.points, self.manipulability, voxel_size, min_count=min_count)
-
-    def recommend_region(self, **options: Any) -> "RecommendedRegion":
-        """Where pick/place tables should stand (see :func:`robots.placement.recommend_region`)."""
-        from .placement import recommend_region
-
-        return recommend_region(self, **options)
 
 
 def sample_workspace(
