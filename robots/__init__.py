@@ -51,6 +51,7 @@ from .placement import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
 from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
 from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
+from .workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
 
 __all__ += [
     "Workspace",
@@ -58,6 +59,8 @@ __all__ += [
     "SphereFit",
     "sample_workspace",
     "fit_sphere",
+    "StreamedWorkspace",
+    "stream_workspace",
     "VoxelMap",
     "suggest_voxel_size",
     "RecommendedRegion",
