@@ -10,6 +10,9 @@ limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a w
 pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back);
 :func:`search_layout` ranks base placements of an arm by the picks per minute of that cycle
 (many cycles, run through :mod:`pinarms.execution`: serial or on Dask).
+:func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
+Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
+:mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
 """
 
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
@@ -18,10 +21,11 @@ from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettin
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
+from pinarms.optim.path_timing import PathTiming, time_optimal
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
-                              ruckig_limit, toppra_limit)
+                                     ruckig_limit, toppra_limit, toppra_path_duration)
 from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
 from pinarms.optim.timing import TimingResult, minimize_time
 
@@ -44,10 +48,13 @@ __all__ = [
     "Refinement",
     "grid_candidates",
     "random_candidates",
+    "time_optimal",
+    "PathTiming",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",
     "toppra_limit",
+    "toppra_path_duration",
     "ruckig_limit",
     "double_s_limit",
     "MissingReference",

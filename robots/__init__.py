@@ -9,12 +9,17 @@ from .errors import (
     ExecutionError,
     InvalidInput,
     LimitViolation,
+    MissingMesh,
     ModelError,
     PinarmsError,
     RobotNotFound,
     UnreachableTarget,
+    XacroArgError,
+    XacroError,
+    XacroForbidden,
+    XacroLimitExceeded,
 )
-from .registry import builtin_names, from_urdf, from_urdf_text, info, load, names
+from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
 from .robot import Robot
 
 __all__ = [
@@ -25,6 +30,7 @@ __all__ = [
     "info",
     "from_urdf",
     "from_urdf_text",
+    "from_xacro",
     "PinarmsError",
     "InvalidInput",
     "RobotNotFound",
@@ -32,6 +38,11 @@ __all__ = [
     "UnreachableTarget",
     "LimitViolation",
     "ExecutionError",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 # workspace analysis and station layout
@@ -63,3 +74,8 @@ __all__ += [
 from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
 
 __all__ += ["Payload", "InvalidPayload", "MissingInertials"]
+
+# users' xacro files, expanded behind a wall
+from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
+
+__all__ += ["XacroLimits", "expand_xacro"]

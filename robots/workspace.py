@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InvalidInput
-
+from .robot import MAX_RANDOM_SAMPLES
 from .voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -511,7 +511,8 @@ def sample_workspace(
 
     Args:
         robot: any :class:`~robots.robot.Robot`.
-        n: number of samples (> 0). 10⁶ samples take about 100 MB; for 10⁸ and more use
+        n: number of samples (> 0, at most ``MAX_RANDOM_SAMPLES`` = 5·10⁷ in one call). 10⁶ samples
+            take about 100 MB; for 10⁸ and more use
             :func:`robots.workspace_stream.stream_workspace` (reductions only, flat memory).
         seed: seed or ``numpy.random.Generator``; the same seed gives the same samples
             (``q`` equals ``robot.random_q(n, seed)``).
@@ -524,12 +525,15 @@ def sample_workspace(
             identical to the one-piece run bit for bit, whoever runs the tasks.
 
     Raises:
-        InvalidInput: ``n`` is not a positive integer, ``chunk`` is not positive, or
+        InvalidInput: ``n`` is not a positive integer or is above 5·10⁷, ``chunk`` is not positive, or
             ``frame`` is not a frame of the robot; a ``scheduler`` with a Generator seed.
         ExecutionError: a task failed (its chunk index is named).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
         raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+    if n > MAX_RANDOM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (10⁶ samples take "
+                           f"about 100 MB); sample several seeded workspaces and merge them")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk <= 0:
         raise InvalidInput(f"chunk must be a positive integer, got {chunk!r}")
     if isinstance(task_samples, bool) or not isinstance(task_samples, (int, np.integer)) or task_samples <= 0:
