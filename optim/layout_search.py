@@ -50,6 +50,7 @@ __all__ = [
     "grid_candidates",
     "random_candidates",
     "base_to_world",
+    "points_in_base_frame",
     "search_layout",
 ]
 
@@ -135,8 +136,11 @@ def base_to_world(placement: Any) -> np.ndarray:
     return T[0] if single else T
 
 
-def _to_base(points: np.ndarray, placements: np.ndarray) -> np.ndarray:
-    """Points ``(K, 3)`` of the line frame in the base frames of ``(M, 4)`` placements: ``(M, K, 3)``."""
+def points_in_base_frame(points: np.ndarray, placements: np.ndarray) -> np.ndarray:
+    """Points ``(K, 3)`` of the line frame in the base frames of ``(M, 4)`` placements: ``(M, K, 3)``.
+
+    ``p_base = R_z(-yaw) (p - (x, y, z))``, the inverse of :func:`base_to_world`.
+    """
     d = points[None, :, :] - placements[:, None, :3]
     c, s = np.cos(placements[:, 3])[:, None], np.sin(placements[:, 3])[:, None]
     out = np.empty_like(d)
@@ -198,8 +202,8 @@ def _classify(exc: PinarmsError) -> str:
 
 def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool = False):
     """Plan every (pick, place) pair's cycle from this placement; ``_Outcome`` (and the first cycle)."""
-    picks_b = _to_base(st.picks, placement[None, :])[0]
-    places_b = _to_base(st.places, placement[None, :])[0]
+    picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
+    places_b = points_in_base_frame(st.places, placement[None, :])[0]
     R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
@@ -221,20 +225,36 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
     return outcome, (first if keep_cycle else None)
 
 
+#: Robots already used in this process, by search token: a worker unpickles the robot with
+#: every task, but keeps using the first copy, whose IK caches are warm (~10 % of a cycle plan).
+_WARM: dict[str, Any] = {}
+
+
+def _warm(robot: Any, token: str) -> Any:
+    if token not in _WARM:
+        if len(_WARM) >= 4:
+            _WARM.pop(next(iter(_WARM)))
+        _WARM[token] = robot
+    return _WARM[token]
+
+
 @dataclass(frozen=True)
 class _ChunkTask:
     robot: Any
+    token: str  # one per search (and robot)
     placements: np.ndarray  # (m, 4)
     settings: _Settings
 
 
 def _evaluate_chunk(task: _ChunkTask) -> list[_Outcome]:
-    return [_evaluate(task.robot, p, task.settings)[0] for p in task.placements]
+    robot = _warm(task.robot, task.token)
+    return [_evaluate(robot, p, task.settings)[0] for p in task.placements]
 
 
 @dataclass(frozen=True)
 class _RefineTask:
     robot: Any
+    token: str
     start: np.ndarray  # (4,)
     free: np.ndarray  # (k,) indices of the free coordinates
     bounds: np.ndarray  # (4, 2)
@@ -247,6 +267,7 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
     """Bounded Nelder-Mead from ``start`` over the free coordinates: (placement, picks/min, evaluations)."""
     from scipy.optimize import minimize
 
+    robot = _warm(task.robot, task.token)
     free, lo, hi = task.free, task.bounds[task.free, 0], task.bounds[task.free, 1]
     seen: dict[bytes, float] = {}
     best = {"placement": task.start.copy(), "ppm": None}
@@ -260,7 +281,7 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
         p = placement(z)
         key = p.tobytes()
         if key not in seen:
-            ppm = _evaluate(task.robot, p, task.settings)[0].picks_per_minute
+            ppm = _evaluate(robot, p, task.settings)[0].picks_per_minute
             seen[key] = -ppm
             # strictly better by more than the tie tolerance: the earliest evaluation wins ties
             if best["ppm"] is None or ppm > best["ppm"] * (1.0 + _PPM_RTOL) + 1e-12:
@@ -468,7 +489,7 @@ def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], lis
     names = names + [f"above {n}" for n in names]  # the user's points first, then the lift points
     world = np.vstack([pts, up])
     K = world.shape[0]
-    P = _to_base(world, cand)  # (M, K, 3)
+    P = points_in_base_frame(world, cand)  # (M, K, 3)
     T = np.zeros((M, K, 4, 4))
     if st.orientation is None:
         T[:, :, :3, :3] = default_orientation(robot)
@@ -585,7 +606,10 @@ def search_layout(
 
     failure, reason = _screen(robot, cand, st)
     todo = [m for m in range(M) if not failure[m]]
-    tasks = [_ChunkTask(robot, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
+    import uuid
+
+    token = uuid.uuid4().hex
+    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
     n_refine = int(refine)
     total = len(tasks) + n_refine
 
@@ -607,7 +631,7 @@ def search_layout(
 
     ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
     vmap = ws.voxel_map()
-    pts = _to_base(np.vstack([picks_w, places_w]), cand)
+    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
     margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1).min(axis=1)
     order = _ranking(ppm, margin)
 
@@ -619,7 +643,7 @@ def search_layout(
     if starts and free.size:
         bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
         step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
-        rtasks = [_RefineTask(robot, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
+        rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
         found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=phase(len(tasks)))
         refinement = Refinement(
             starts=np.array(starts),
