@@ -533,7 +533,8 @@ def sample_workspace(
         raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
     if n > MAX_RANDOM_SAMPLES:
         raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (10⁶ samples take "
-                           f"about 100 MB); sample several seeded workspaces and merge them")
+                           f"about 100 MB); for more, robots.stream_workspace keeps only the reductions (voxel map, "
+                           "profile, hull sphere) in flat memory")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk <= 0:
         raise InvalidInput(f"chunk must be a positive integer, got {chunk!r}")
     if isinstance(task_samples, bool) or not isinstance(task_samples, (int, np.integer)) or task_samples <= 0:

@@ -61,6 +61,7 @@ __all__ = [
     "TASK_SAMPLES",
     "PILOT_SAMPLES",
     "MIN_DEFAULT_VOXEL",
+    "MAX_STREAM_SAMPLES",
 ]
 
 #: Samples per task (a task evaluates them in blocks and returns reductions only).
@@ -69,6 +70,8 @@ TASK_SAMPLES = 2_000_000
 PILOT_SAMPLES = 200_000
 #: Smallest default voxel edge [m] (a finer grid must be asked for with ``voxel_size``).
 MIN_DEFAULT_VOXEL = 0.01
+#: Largest ``n`` accepted (10¹²).
+MAX_STREAM_SAMPLES = 10**12
 _BLOCK = 262_144
 _OFFSET = np.int64(1 << 20)  # voxel indices in [-2^20, 2^20) per axis: ±10 km at 1 cm
 
@@ -334,6 +337,8 @@ def stream_workspace(
     ):
         raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
     n, seed = int(n), int(seed)
+    if n > MAX_STREAM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_STREAM_SAMPLES:,} (about a week on 100 cores)")
     pilot = sample_workspace(robot, min(n, PILOT_SAMPLES), seed=seed, frame=frame)
     centre = pilot.fit_sphere().centre
     if voxel_size is None:
