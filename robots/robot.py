@@ -15,6 +15,7 @@ Conventions
 from __future__ import annotations
 
 import math
+from math import isfinite as _isfinite
 import threading
 from pathlib import Path
 from typing import Any
@@ -189,7 +190,7 @@ class Robot:
         """
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64:
             s = q.dot(q)
-            if s - s == 0.0:  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
+            if _isfinite(s):  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
                 return q if self._same_q else self._tree.coordinates.to_pin(q)
         return None
 
@@ -261,7 +262,7 @@ class Robot:
             fid = self.frame_id(frame)  # raises the named error
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined (a call costs as much as the check)
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 pin.forwardKinematics(self.model, data, q)
@@ -317,7 +318,7 @@ class Robot:
             fid = self.frame_id(frame)
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
