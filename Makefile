@@ -37,7 +37,7 @@ readme-table: install
 test: install browser
 	$(PY) -m pytest -q tests
 
-# Regenerate urdf/*.urdf from robots/xacro/*.xacro.
+# Regenerate urdf/*.urdf and urdf/cells/*.urdf from robots/xacro/ (arms and cells).
 urdf: install
 	$(VENV)/bin/pinarms urdf build
 

@@ -7,6 +7,10 @@
 
 from .errors import (
     InvalidInput,
+    CellError,
+    CellNotFound,
+    CollisionError,
+    CollisionGeometryError,
     LimitViolation,
     MissingMesh,
     ModelError,
@@ -41,6 +45,10 @@ __all__ = [
     "XacroLimitExceeded",
     "XacroArgError",
     "MissingMesh",
+    "CellError",
+    "CellNotFound",
+    "CollisionGeometryError",
+    "CollisionError",
 ]
 
 # workspace analysis and station layout
@@ -69,3 +77,19 @@ __all__ += [
 from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
 
 __all__ += ["XacroLimits", "expand_xacro"]
+
+# cells: several arms, fixtures, collision checks
+from .cell import (  # noqa: E402
+    ArmMotion,
+    Cell,
+    CellArm,
+    Clearance,
+    Collisions,
+    CollisionPair,
+    MotionCheck,
+    cell_names,
+    load_cell,
+)
+
+__all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
+            "load_cell"]
