@@ -24,6 +24,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from ..collision_requests import cold_start
 from ..errors import CellError, CollisionGeometryError, InvalidInput, ModelError
 from ..robot import Robot
 from ..xacro_expand import mesh_path
@@ -281,7 +282,7 @@ class Cell:
 
     def _fixtures(self) -> tuple[Fixture, ...]:
         data = self.model.createData()
-        gd = pin.GeometryData(self.collision_model)
+        gd = cold_start(pin.GeometryData(self.collision_model))
         pin.updateGeometryPlacements(self.model, data, self.collision_model, gd, pin.neutral(self.model))
         by_link: dict[str, list[Shape]] = {name: [] for name in self.spec.fixtures}
         for k, g in enumerate(self.collision_model.geometryObjects):
@@ -327,10 +328,8 @@ class Cell:
                 )
 
     def _new_geometry_data(self) -> pin.GeometryData:
-        gd = pin.GeometryData(self.collision_model)
-        for req in gd.distanceRequests:
-            req.gjk_tolerance = 1e-10  # exact distances (coal's default 1e-6 m is coarser than the checks)
-        return gd
+        # exact distances (coal's default 1e-6 m is coarser than the checks), no warm start
+        return cold_start(pin.GeometryData(self.collision_model), distance_tolerance=1e-10)
 
     # --------------------------------------------------------------- joint vector
     @property

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from ..collision_requests import cold_start
 from ..errors import CollisionGeometryError, InvalidInput
 from .pairs import CollisionPair
 
@@ -117,7 +118,7 @@ class _Checkers:
     def __init__(self, cell: "Cell") -> None:
         self.cell = cell
         self.margin: float | None = None
-        self.gd = pin.GeometryData(cell.collision_model)
+        self.gd = cold_start(pin.GeometryData(cell.collision_model))
         self.manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(cell.model, cell.collision_model, self.gd)
         self.data = cell.model.createData()
         self.pools: dict[int, Any] = {}
@@ -135,6 +136,8 @@ class _Checkers:
             pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(
                 self.cell.model, self.cell.collision_model, threads
             )
+            for gd in pool.getGeometryDatas():
+                cold_start(gd)
             self.pools[threads] = pool
         if self.pool_margin.get(threads) != margin:
             for gd in pool.getGeometryDatas():
@@ -181,7 +184,7 @@ def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
     touching: list[tuple[int, ...]] = [()] * arr.shape[0]
     if hit.any():
         qp = cell.robot.q_to_pinocchio(arr)
-        gd = pin.GeometryData(cell.collision_model)
+        gd = cold_start(pin.GeometryData(cell.collision_model))
         _set_margin(gd, margin)
         for i in np.flatnonzero(hit):
             pin.updateGeometryPlacements(cell.model, cell._data, cell.collision_model, gd, qp[i])
