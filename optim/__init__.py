@@ -10,7 +10,9 @@ limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a w
 pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
 """
 
+from pinarms.optim.cell_cycle import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
@@ -35,6 +37,9 @@ __all__ = [
     "PickPlace",
     "CycleResult",
     "plan_cycle",
+    "CellCycleReport",
+    "LineSchedule",
+    "schedule_line",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",

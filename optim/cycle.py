@@ -186,6 +186,8 @@ class CycleResult:
             while travelling it, per :data:`LINE_NAMES`.
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
+        cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
+            (:class:`optim.cell_cycle.CellCycleReport`); else None.
     """
 
     robot: str
@@ -201,6 +203,7 @@ class CycleResult:
     jmax: np.ndarray | None = field(repr=False)
     line_deviation: np.ndarray = field(repr=False)
     branches: np.ndarray = field(repr=False)
+    cell_report: Any = field(default=None, repr=False)
 
     @property
     def one_branch(self) -> bool:
@@ -257,6 +260,7 @@ class CycleResult:
             "max_line_deviation_m": self.max_line_deviation,
             "branches": self.branches.tolist(),
             "one_branch": self.one_branch,
+            **({"cell": self.cell_report.as_dict()} if self.cell_report is not None else {}),
         }
 
 
@@ -300,7 +304,9 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
-               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None) -> CycleResult:
+               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None, cell: Any = None,
+               clearance: float = 0.02, arm: str | None = None, hold: Any = None, margin: float = 0.005,
+               lift_step: float = 0.02) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -317,6 +323,12 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         seed: seed of the optimiser.
         q_start: configuration (nq,) whose nearest IK solution is taken at the pick (it
             selects the branch of the whole cycle).
+        cell: a :class:`robots.cell.Cell` holding ``robot`` (``cell.arm(name).robot``): the
+            cycle must then keep ``clearance`` [m] from the fixtures and the other arms
+            (held at ``hold``, a cell configuration, default neutral), checked continuously
+            at resolution ``margin`` [m]; it is re-planned (higher lift by ``lift_step``,
+            then via points) until it does (:mod:`optim.cell_cycle`). Points stay in the
+            arm's base frame. ``arm`` names the arm when ``robot`` is not the cell's object.
 
     Raises:
         InvalidInput: ``spec`` is not a :class:`PickPlace`, or a bad ``q_start``/``kind``.
@@ -327,7 +339,15 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
         InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
+            re-planned cycle keeps the clearance; the message names the blocking bodies.
     """
+    if cell is not None:
+        from pinarms.optim.cell_cycle import plan_cycle_in_cell
+
+        return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
+                                  lift_step=lift_step, plan=plan_cycle, kind=kind, vmax=vmax, amax=amax, jmax=jmax,
+                                  method=method, seed=seed, q_start=q_start)
     if not isinstance(spec, PickPlace):
         raise InvalidInput(f"spec must be a PickPlace, got {type(spec).__name__}")
     if kind not in CYCLE_KINDS:
