@@ -13,7 +13,9 @@ Cartesian line's joint image) under constraint objects by reachability analysis 
 :mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
 """
 
+from pinarms.optim.cell_cycle import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
@@ -41,6 +43,9 @@ __all__ = [
     "plan_cycle",
     "time_optimal",
     "PathTiming",
+    "CellCycleReport",
+    "LineSchedule",
+    "schedule_line",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",

@@ -188,6 +188,8 @@ class CycleResult:
             (``robot.ik_branches``; -1 for arms solved numerically).
         payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
+        cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
+            (:class:`optim.cell_cycle.CellCycleReport`); else None.
     """
 
     robot: str
@@ -212,6 +214,7 @@ class CycleResult:
         if self.torque_limit is None:
             return None
         return np.maximum(*(m.torque_ratios for m in self.moves))
+    cell_report: Any = field(default=None, repr=False)
 
     @property
     def one_branch(self) -> bool:
@@ -271,6 +274,7 @@ class CycleResult:
             "payload": None if self.payload is None else self.payload.as_dict(),
             "torque_limit": None if self.torque_limit is None else self.torque_limit.tolist(),
             "torque_ratios": None if self.torque_limit is None else self.torque_ratios.tolist(),
+            **({"cell": self.cell_report.as_dict()} if self.cell_report is not None else {}),
         }
 
 
@@ -315,7 +319,9 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
                jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None,
-               payload: Any = None, torque_limits: Any = False) -> CycleResult:
+               payload: Any = None, torque_limits: Any = False, cell: Any = None,
+               clearance: float = 0.02, arm: str | None = None, hold: Any = None, margin: float = 0.005,
+               lift_step: float = 0.02) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -338,6 +344,12 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         torque_limits: ``True`` (the URDF's ``effort`` limits) or limits per joint [N·m or
             N]: both moves are also timed under joint-torque limits (see
             :func:`optim.minimize_time`); ``False``: kinematic limits only.
+        cell: a :class:`robots.cell.Cell` holding ``robot`` (``cell.arm(name).robot``): the
+            cycle must then keep ``clearance`` [m] from the fixtures and the other arms
+            (held at ``hold``, a cell configuration, default neutral), checked continuously
+            at resolution ``margin`` [m]; it is re-planned (higher lift by ``lift_step``,
+            then via points) until it does (:mod:`optim.cell_cycle`). Points stay in the
+            arm's base frame. ``arm`` names the arm when ``robot`` is not the cell's object.
 
     Raises:
         InvalidInput: ``spec`` is not a :class:`PickPlace`, or a bad ``q_start``/``kind``.
@@ -348,7 +360,16 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
         InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
+            re-planned cycle keeps the clearance; the message names the blocking bodies.
     """
+    if cell is not None:
+        from pinarms.optim.cell_cycle import plan_cycle_in_cell
+
+        return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
+                                  lift_step=lift_step, plan=plan_cycle, kind=kind, vmax=vmax, amax=amax, jmax=jmax,
+                                  method=method, seed=seed, q_start=q_start, payload=payload,
+                                  torque_limits=torque_limits)
     if not isinstance(spec, PickPlace):
         raise InvalidInput(f"spec must be a PickPlace, got {type(spec).__name__}")
     if kind not in CYCLE_KINDS:
