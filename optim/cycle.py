@@ -45,10 +45,14 @@ from pinarms.planning.trajectory import Peaks
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
-__all__ = ["CYCLE_KINDS", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
+__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
+
+#: How the tcp approaches and leaves pick and place: through the lift points in joint space, or on
+#: straight vertical lines (:mod:`optim.straight_approach`).
+CYCLE_APPROACHES = ("joint", "straight")
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.
 LINE_NAMES = ("lift from pick", "lower to place", "lift from place", "lower to pick")
@@ -186,6 +190,10 @@ class CycleResult:
             while travelling it, per :data:`LINE_NAMES`.
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
+        approach: ``"joint"`` or ``"straight"`` (straight vertical lines at pick and place;
+            ``moves`` are then :class:`optim.straight_approach.StraightMove`).
+        joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
+            the same limits (None otherwise).
     """
 
     robot: str
@@ -201,6 +209,19 @@ class CycleResult:
     jmax: np.ndarray | None = field(repr=False)
     line_deviation: np.ndarray = field(repr=False)
     branches: np.ndarray = field(repr=False)
+    approach: str = "joint"
+    joint_cycle_time: float | None = None
+
+    @property
+    def straight_cost(self) -> float | None:
+        """Time [s] the straight approach adds to the joint-space cycle (None for a joint-space cycle)."""
+        return None if self.joint_cycle_time is None else self.cycle_time - self.joint_cycle_time
+
+    @property
+    def line_cost(self) -> float | None:
+        """Time [s] the four straight lines take beyond joint-space lines between the same configurations
+        (same limits, same time scaling; None for a joint-space cycle)."""
+        return None if self.approach != "straight" else float(sum(m.line_cost for m in self.moves))
 
     @property
     def one_branch(self) -> bool:
@@ -257,6 +278,10 @@ class CycleResult:
             "max_line_deviation_m": self.max_line_deviation,
             "branches": self.branches.tolist(),
             "one_branch": self.one_branch,
+            "approach": self.approach,
+            "joint_cycle_time_s": self.joint_cycle_time,
+            "straight_cost_s": self.straight_cost,
+            "line_cost_s": self.line_cost,
         }
 
 
@@ -300,7 +325,8 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
-               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None) -> CycleResult:
+               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None,
+               approach: str = "joint", tool_speed: float | None = None) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -317,6 +343,11 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         seed: seed of the optimiser.
         q_start: configuration (nq,) whose nearest IK solution is taken at the pick (it
             selects the branch of the whole cycle).
+        approach: ``"joint"`` (through the lift points in joint space) or ``"straight"``
+            (straight vertical lines at pick and place, time-optimal along them, needs
+            ``amax``; the joint-space cycle is planned too and its time kept in
+            ``joint_cycle_time``: :mod:`optim.straight_approach`).
+        tool_speed: with ``approach="straight"``, a tcp speed limit on the lines [m/s].
 
     Raises:
         InvalidInput: ``spec`` is not a :class:`PickPlace`, or a bad ``q_start``/``kind``.
@@ -337,6 +368,14 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
                            "point(s) more: use 'multi-quintic' or 'quintic-bspline'")
     if method not in ("exact", "ga"):
         raise InvalidSettings(f"method={method!r}: use 'exact' or 'ga'")
+    if approach not in CYCLE_APPROACHES:
+        raise InvalidInput(f"approach={approach!r}: use one of {CYCLE_APPROACHES}")
+    if approach == "straight":
+        from pinarms.optim.straight_approach import straight_cycle
+
+        joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
+                           q_start=q_start)
+        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed)
     v, a, j = _limits(robot, vmax, amax, jmax)
     poses = spec.poses(robot)
     names = spec.names
