@@ -48,10 +48,14 @@ from pinarms.planning import Trajectory
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples, _limit
 from pinarms.planning.trajectory import taylor_shift
 
-__all__ = ["PathTiming", "time_optimal", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
+__all__ = ["PathTiming", "time_optimal", "time_scaled", "SHAPES", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
 
 #: Where each grid interval is re-checked, as fractions of its length.
 CHECK_FRACTIONS = np.array([0.25, 0.5, 0.75, 1.0])
+#: Rest-to-rest shapes σ(τ) of :func:`time_scaled`, ascending coefficients in τ ∈ [0, 1]
+#: (cubic: zero end velocity; quintic: zero end velocity and acceleration).
+SHAPES = {"cubic": (0.0, 0.0, 3.0, -2.0), "quintic": (0.0, 0.0, 0.0, 10.0, -15.0, 6.0)}
+
 #: Multiples of the first smoothing window tried under a jerk limit.
 SMOOTHING_FACTORS = (1.0, 1.6, 2.5)
 
@@ -478,3 +482,56 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
     grid_all = np.concatenate([r[0] for r in results])
     return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing),
                       int(sum(r[4] for r in results)), ratios)
+
+
+def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
+                samples: int = 2001) -> PathTiming:
+    """The path timed by a fixed rest-to-rest shape ``s(t) = a + L σ(t / T)``, T as short as the limits allow.
+
+    The classic alternative to the time-optimal profile: a smooth law (``"quintic"``:
+    ``σ = 10τ³ − 15τ⁴ + 6τ⁵``, zero velocity and acceleration at both ends; ``"cubic"``),
+    the same shape on every section between stops. With ``u = L σ''/T²`` and
+    ``x = L² σ'²/T²`` every row ``a u + b x`` scales as ``1/T²``, so the shortest T follows
+    from the rows at ``samples`` instants of τ; the exact joint peaks of the composed
+    trajectory then fix the last digits (:attr:`PathTiming.dilation`).
+
+    Raises:
+        InfeasibleProblem: a row's bounds exclude 0 (no T satisfies it).
+        InvalidSettings: an unknown shape, bad arguments.
+    """
+    cons = tuple(constraints)
+    if not cons or not all(isinstance(c, PathConstraint) for c in cons):
+        raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
+    if shape not in SHAPES:
+        raise InvalidSettings(f"shape must be one of {sorted(SHAPES)}, got {shape!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 3:
+        raise InvalidSettings(f"samples must be an integer >= 3, got {samples!r}")
+    sig = np.array(SHAPES[shape])
+    tau = np.linspace(0.0, 1.0, int(samples))
+    d1 = np.polynomial.polynomial.polyval(tau, sig[1:] * np.arange(1, sig.size))
+    d2 = np.polynomial.polynomial.polyval(tau, sig[2:] * np.arange(2, sig.size) * np.arange(1, sig.size - 1))
+    laws, grids = [], []
+    for a, b in path.sections():
+        L = b - a
+        s = a + L * np.polynomial.polynomial.polyval(tau, sig)
+        rows = PathRows.concatenate_points([_rows(path, cons, s[:1], "right"), _rows(path, cons, s[1:], "left")])
+        val = rows.values(L * d2, (L * d1) ** 2)  # a u + b x at T = 1; at T it is val / T²
+        with np.errstate(divide="ignore", invalid="ignore"):
+            up = np.where(val > 0.0, np.where(rows.hi > 0.0, val / rows.hi, np.where(np.isinf(rows.hi), 0.0, np.inf)), 0.0)
+            dn = np.where(val < 0.0, np.where(rows.lo < 0.0, val / rows.lo, np.where(np.isinf(rows.lo), 0.0, np.inf)), 0.0)
+        need = np.maximum(up, dn)
+        if np.any(~np.isfinite(need)):
+            raise InfeasibleProblem(f"a limit cannot be met at any speed on the section [{a:.6g}, {b:.6g}]")
+        T = float(np.sqrt(need.max()))
+        coef = L * sig / T ** np.arange(sig.size)
+        coef[0] += a
+        laws.append((np.array([0.0, T]), coef[None]))
+        grids.append(s)
+    tb, C, traj = _assemble(path, laws)
+    f = max(c.exact_dilation(_Peaked(traj)) for c in cons)
+    if f > 1.0 + 1e-12:
+        tb, C = _scaled_law(tb, C, f)
+        traj = Trajectory(tb, _compose_law(path, tb, C))
+    names = [c.name for c in cons for _ in range(c.rows(PathSamples.of(path, [0.0])).a.shape[1])]
+    rows, u, x = _law_rows(path, cons, tb, C)
+    return PathTiming(path, cons, traj, tb, C, np.concatenate(grids), float(f), 0.0, 0, _ratios(rows, u, x, names))
