@@ -194,6 +194,8 @@ class CycleResult:
             ``moves`` are then :class:`optim.straight_approach.StraightMove`).
         joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
             the same limits (None otherwise).
+        payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
+        torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
     """
 
     robot: str
@@ -209,6 +211,8 @@ class CycleResult:
     jmax: np.ndarray | None = field(repr=False)
     line_deviation: np.ndarray = field(repr=False)
     branches: np.ndarray = field(repr=False)
+    payload: Any = None
+    torque_limit: np.ndarray | None = field(default=None, repr=False)
     approach: str = "joint"
     joint_cycle_time: float | None = None
 
@@ -222,6 +226,13 @@ class CycleResult:
         """Time [s] the four straight lines take beyond joint-space lines between the same configurations
         (same limits, same time scaling; None for a joint-space cycle)."""
         return None if self.approach != "straight" else float(sum(m.line_cost for m in self.moves))
+
+    @property
+    def torque_ratios(self) -> np.ndarray | None:
+        """Refined torque peak / limit per joint (nq,) over both moves (loaded and empty), or None."""
+        if self.torque_limit is None:
+            return None
+        return np.maximum(*(m.torque_ratios for m in self.moves))
 
     @property
     def one_branch(self) -> bool:
@@ -278,6 +289,9 @@ class CycleResult:
             "max_line_deviation_m": self.max_line_deviation,
             "branches": self.branches.tolist(),
             "one_branch": self.one_branch,
+            "payload": None if self.payload is None else self.payload.as_dict(),
+            "torque_limit": None if self.torque_limit is None else self.torque_limit.tolist(),
+            "torque_ratios": None if self.torque_limit is None else self.torque_ratios.tolist(),
             "approach": self.approach,
             "joint_cycle_time_s": self.joint_cycle_time,
             "straight_cost_s": self.straight_cost,
@@ -326,7 +340,8 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
                jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None,
-               approach: str = "joint", tool_speed: float | None = None) -> CycleResult:
+               payload: Any = None, torque_limits: Any = False, approach: str = "joint",
+               tool_speed: float | None = None) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -343,6 +358,12 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         seed: seed of the optimiser.
         q_start: configuration (nq,) whose nearest IK solution is taken at the pick (it
             selects the branch of the whole cycle).
+        payload: what the gripper carries from pick to place: a mass [kg], a
+            :class:`robots.Payload` or its dict form. The move to place is timed with the arm
+            carrying it, the move back to the pick with the empty gripper.
+        torque_limits: ``True`` (the URDF's ``effort`` limits) or limits per joint [N·m or
+            N]: both moves are also timed under joint-torque limits (see
+            :func:`optim.minimize_time`); ``False``: kinematic limits only.
         approach: ``"joint"`` (through the lift points in joint space) or ``"straight"``
             (straight vertical lines at pick and place, time-optimal along them, needs
             ``amax``; the joint-space cycle is planned too and its time kept in
@@ -373,10 +394,17 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     if approach == "straight":
         from pinarms.optim.straight_approach import straight_cycle
 
+        if not (torque_limits is None or torque_limits is False):
+            raise InvalidSettings("approach='straight' times the lines under joint velocity/acceleration (and tool "
+                                  "speed) limits only: a torque limit along a Cartesian path needs a torque path "
+                                  "constraint (planning.path_constraints); use approach='joint' with torque_limits")
         joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
                            q_start=q_start)
         return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed)
     v, a, j = _limits(robot, vmax, amax, jmax)
+    from pinarms.optim.torque import torque_constraint
+
+    loaded = torque_constraint(robot, torque_limits, payload)  # the keywords checked before any IK
     poses = spec.poses(robot)
     names = spec.names
     try:
@@ -397,10 +425,19 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
                 ) from exc
         raise
     options = {"velocities": "heuristic"} if kind == "multi-quintic" else None
-    moves = (
-        minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options),
-        minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options),
-    )
+    if loaded is None:
+        moves = (
+            minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options),
+            minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options),
+        )
+    else:
+        empty = torque_constraint(robot, loaded.limit)  # the same limits, nothing in the gripper
+        moves = (
+            minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options,
+                          robot=loaded.robot, torque_limits=loaded.limit),
+            minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options,
+                          robot=empty.robot, torque_limits=empty.limit),
+        )
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
         parts = [_hold(q_out[0], spec.dwell), parts[0], _hold(q_out[-1], spec.dwell), parts[1]]
@@ -423,6 +460,8 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         jmax=j,
         line_deviation=_line_deviation(robot, moves, ends),
         branches=np.concatenate([branches, branches[-2::-1]]),
+        payload=None if loaded is None else loaded.robot.payload,
+        torque_limit=None if loaded is None else loaded.limit.copy(),
     )
 
 

@@ -29,6 +29,7 @@ from pinarms.planning.piecewise import PRESETS, piecewise_polynomial, piecewise_
 from pinarms.planning.point_to_point import double_s, trapezoidal
 from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import LimitReport, Peaks, Trajectory, Violation
+from pinarms.planning.torque import TorquePeaks, torque_peaks, torques
 
 __all__ = [
     "Trajectory",
@@ -71,6 +72,9 @@ __all__ = [
     "TrajectoryError",
     "ConditionCountError",
     "OutOfTimeRange",
+    "TorquePeaks",
+    "torques",
+    "torque_peaks",
     "BlendTooLarge",
     "PathError",
     "SingularityOnPath",
