@@ -75,7 +75,8 @@ class PathTiming:
         dilation: the uniform time dilation f >= 1 applied after the checks.
         smoothing: the averaging window τ [s] (0 without a jerk limit).
         rounds: grid refinements made.
-        ratios: per constraint name, the largest value / bound of the dense check (<= 1).
+        ratios: per constraint name, the largest value / bound of the dense check (<= 1; for
+            speed limits the ratio of speeds, not of their squares).
     """
 
     path: Any = field(repr=False)
@@ -176,9 +177,13 @@ def _dilation_needed(rows: PathRows, u: np.ndarray, x: np.ndarray) -> np.ndarray
 
 
 def _ratios(rows: PathRows, u: np.ndarray, x: np.ndarray, names: list[str]) -> dict[str, float]:
+    """Largest value / bound per constraint name; for rows without u (speed limits on ṡ²) the
+    square root, so that the ratio is one of speeds."""
     val = rows.values(u, x)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.maximum(np.where(rows.hi > 0.0, val / rows.hi, 0.0), np.where(rows.lo < 0.0, val / rows.lo, 0.0))
+    first_order = np.all(rows.a == 0.0, axis=0)
+    r = np.where(first_order[None, :], np.sqrt(np.maximum(r, 0.0)), r)
     out: dict[str, float] = {}
     for j, name in enumerate(names):
         out[name] = max(out.get(name, 0.0), float(np.max(r[:, j])) if r.shape[0] else 0.0)
