@@ -46,6 +46,7 @@ from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
 from pinarms.optim.reachability import reachability_profile
 from pinarms.planning import Trajectory
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples, _limit
+from pinarms.planning.extrema import normalised_pieces, piece_extrema
 from pinarms.planning.trajectory import taylor_shift
 
 __all__ = ["PathTiming", "time_optimal", "time_scaled", "SHAPES", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
@@ -125,17 +126,42 @@ class PathTiming:
 
 
 class _Peaked:
-    """A trajectory's joint count and exact peaks, computed once for every constraint's exact check."""
+    """A trajectory's exact per-joint peaks, each derivative order computed once, on first use.
 
-    def __init__(self, trajectory: Trajectory, peaks: Any = None) -> None:
+    Stands for the trajectory in :meth:`PathConstraint.exact_dilation` (``n_joints`` and
+    ``peaks()`` with ``velocity``, ``acceleration``, ``jerk``): every constraint shares one,
+    and orders nobody asks for (jerk, mostly) are never computed.
+    """
+
+    def __init__(self, trajectory: Trajectory) -> None:
         self.n_joints = trajectory.n_joints
-        self._trajectory = trajectory
-        self._peaks = peaks
+        self._coefs = trajectory.coefficients
+        self._h = trajectory.segment_durations
+        self._normalised = None
+        self._cache: dict[int, np.ndarray] = {}
 
-    def peaks(self):
-        if self._peaks is None:
-            self._peaks = self._trajectory.peaks()
-        return self._peaks
+    def _order(self, r: int) -> np.ndarray:
+        if r not in self._cache:
+            if self._normalised is None:
+                self._normalised = normalised_pieces(self._coefs, self._h)
+            values, _ = piece_extrema(self._normalised, self._h, (r,))
+            self._cache[r] = np.abs(values[0]).max(axis=(0, 2))
+        return self._cache[r]
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return self._order(1)
+
+    @property
+    def acceleration(self) -> np.ndarray:
+        return self._order(2)
+
+    @property
+    def jerk(self) -> np.ndarray:
+        return self._order(3)
+
+    def peaks(self) -> "_Peaked":
+        return self
 
 
 def _grid(path: Any, a: float, b: float, total: float, n: int, kappa: float) -> np.ndarray:
@@ -465,18 +491,19 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
             cand = [_smoothed(t, c, tau) for t, c in laws]
             ctb, cC, ctraj = _assemble(path, cand)
             g2 = _law_check(path, cons, ctb, cC)
-            peaks = ctraj.peaks()
-            fj = max(1.0, float(np.max(peaks.jerk / jmax)) ** (1.0 / 3.0), np.sqrt(g2),
-                     max(c.exact_dilation(_Peaked(ctraj, peaks)) for c in cons))
+            peaked = _Peaked(ctraj)
+            fj = max(1.0, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0), np.sqrt(g2),
+                     max(c.exact_dilation(peaked) for c in cons))
             if best is None or ctraj.duration * fj < best[0]:
                 best = (ctraj.duration * fj, tau, fj, ctb, cC)
         _, smoothing, fj, tb, C = best
         tb, C = _scaled_law(tb, C, fj)
         traj = Trajectory(tb, _compose_law(path, tb, C))
         f *= fj
-    f_exact = max(c.exact_dilation(_Peaked(traj)) for c in cons)
+    peaked = _Peaked(traj)
+    f_exact = max(c.exact_dilation(peaked) for c in cons)
     if jmax is not None:
-        f_exact = max(f_exact, float(np.max(_Peaked(traj).peaks().jerk / jmax)) ** (1.0 / 3.0))
+        f_exact = max(f_exact, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0))
     if f_exact > 1.0 + 1e-12:  # between the check points (or past a rounding): slow once more, exactly
         tb, C = _scaled_law(tb, C, f_exact)
         traj = Trajectory(tb, _compose_law(path, tb, C))
@@ -533,7 +560,8 @@ def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str 
         laws.append((np.array([0.0, T]), coef[None]))
         grids.append(s)
     tb, C, traj = _assemble(path, laws)
-    f = max(c.exact_dilation(_Peaked(traj)) for c in cons)
+    peaked = _Peaked(traj)
+    f = max(c.exact_dilation(peaked) for c in cons)
     if f > 1.0 + 1e-12:
         tb, C = _scaled_law(tb, C, f)
         traj = Trajectory(tb, _compose_law(path, tb, C))
