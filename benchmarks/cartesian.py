@@ -8,6 +8,9 @@ Prints, side by side in one run:
   * toppra on the same sampled path: a cubic spline through the joint path's knots (toppra's
     SplineInterpolator, what a toppra user feeds it), parameterised on a grid of the same size;
   * toppra on our path itself (the adapter optim.toppra_path_duration), on our grid;
+  * the reachability analysis alone (optim.reachability on the rows at the grid points) beside
+    toppra's parameterisation on the same grid: algorithm against algorithm (ours then also
+    checks between grid points, verifies the exact joint peaks and composes q(t) exactly);
 and the durations, their ratio, and how far the tcp strays from the line on each path
 (FK at 10 points per knot interval).
 """
@@ -74,6 +77,11 @@ def main() -> None:
     t_scale = best(lambda: optim.time_optimal(path, cons), 3)
     t_toppra = best(toppra_on_samples, 3)
     t_adapter = best(lambda: optim.toppra_path_duration(path, v, a, grid), 3)
+    from pinarms.optim.reachability import reachability_profile
+
+    rows = planning.PathRows.concatenate([c.rows(planning.PathSamples.of(path, grid)) for c in cons])
+    t_core = best(lambda: reachability_profile(rows.a, rows.b, rows.lo, rows.hi, grid), 5)
+    t_rows = best(lambda: planning.PathRows.concatenate([c.rows(planning.PathSamples.of(path, grid)) for c in cons]), 5)
     d_adapter = optim.toppra_path_duration(path, v, a, grid)
     d_dense = optim.toppra_path_duration(path, v, a, np.linspace(0.0, path.length, 3001))
 
@@ -88,6 +96,8 @@ def main() -> None:
     print(f"{'time-scale it (v, a) / toppra on the sampled path':<52} {t_scale * 1e3:9.1f} ms "
           f"{t_toppra * 1e3:9.1f} ms {t_scale / t_toppra:7.2f}x")
     print(f"{'  toppra reading our path (adapter), our grid':<52} {'':>12} {t_adapter * 1e3:9.1f} ms")
+    print(f"{'  rows + reachability alone / toppra adapter':<52} {(t_rows + t_core) * 1e3:9.1f} ms "
+          f"{t_adapter * 1e3:9.1f} ms {(t_rows + t_core) / t_adapter:7.2f}x")
     print(f"{'build + time-scale / toppra spline + parameterise':<52} {(t_build + t_scale) * 1e3:9.1f} ms "
           f"{t_toppra * 1e3:9.1f} ms {(t_build + t_scale) / t_toppra:7.2f}x")
     print(f"{'duration [s]: ours / toppra on the sampled path':<52} {timing.duration:12.6f} "
