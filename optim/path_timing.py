@@ -289,7 +289,10 @@ def _polyint(C: np.ndarray) -> np.ndarray:
 
 
 def _smoothed(tb: np.ndarray, C: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
-    """The law averaged over a trailing window τ: s_τ(t) = (1/τ) ∫_{t−τ}^{t} s, on [t0, t_end + τ] (module docstring)."""
+    """The law averaged over a trailing window τ: ``s_τ(t) = (1/τ) ∫_{t−τ}^{t} s`` on [t0, t_end + τ].
+
+    (Module docstring, jerk.) The law is extended at rest before its start and after its end.
+    """
     a, b = C[0, 0], _law_eval(tb, C, tb[-1:])[0][0]
     # the law at rest before its start and after its end, one piece each (length τ)
     eb = np.concatenate([[tb[0] - tau], tb, [tb[-1] + tau]])
