@@ -19,7 +19,7 @@ from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
-from pinarms.optim.path_timing import PathTiming, time_optimal
+from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -42,6 +42,7 @@ __all__ = [
     "CycleResult",
     "plan_cycle",
     "time_optimal",
+    "time_scaled",
     "PathTiming",
     "CellCycleReport",
     "LineSchedule",

@@ -1,4 +1,4 @@
-"""Plots (matplotlib, Agg backend): joint curves, GA convergence, workspace projections,
+"""Plots (matplotlib, Agg backend): joint curves, tcp speed, GA convergence, workspace projections,
 clearance over time and multi-arm schedules.
 
 Figures are drawn on matplotlib's Agg canvas directly (no pyplot state, the user's
@@ -24,8 +24,12 @@ from pinarms.robots.errors import InvalidInput
 
 from ._atomic import atomic_write
 
-__all__ = ["plot_joint_curves", "plot_trajectory", "plot_ga_convergence", "plot_workspace", "plot_clearance",
-           "plot_schedule"]
+__all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
+           "plot_clearance", "plot_schedule"]
+
+#: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
+#: interval) is drawn without knot markers and lines.
+MAX_DRAWN_KNOTS = 40
 
 _FORMATS = {".png": "png", ".svg": "svg"}
 _ORDERS = ("position", "velocity", "acceleration", "jerk")
@@ -216,7 +220,40 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
     knots = np.asarray(trajectory.knot_times, dtype=float)
     t = np.union1d(np.linspace(knots[0], knots[-1], int(samples)), knots)
     q, qd, qdd, qddd = trajectory.sample(t)
-    return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=knots, limits=limits, **options)
+    drawn = knots if knots.size <= MAX_DRAWN_KNOTS else None
+    return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=drawn, limits=limits, **options)
+
+
+def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
+                    title: str = "tcp speed") -> Path:
+    """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
+
+    Args:
+        t: instants (N,) [s]; speed: linear speed (N,) [m/s]; angular: optional (N,) [rad/s]
+            (second axis); limit: a tool-speed limit [m/s], drawn dashed.
+    """
+    tt = _numbers(t, "t")
+    v = _numbers(speed, "speed")
+    if tt.ndim != 1 or tt.size < 2 or v.shape != tt.shape:
+        raise InvalidInput(f"t and speed must be (N,) arrays of the same length, N >= 2; got {tt.shape} and {v.shape}")
+    fig = Figure(figsize=(7.5, 3.0))
+    ax = fig.subplots()
+    ax.plot(tt, v, lw=1.5, label="linear [m/s]")
+    if limit is not None:
+        ax.axhline(float(limit), color="k", ls="--", lw=0.9, label=f"limit {float(limit):g} m/s")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("tcp speed [m/s]")
+    ax.grid(True, alpha=0.3)
+    if angular is not None:
+        w = _numbers(angular, "angular")
+        if w.shape != tt.shape:
+            raise InvalidInput(f"angular must have the shape of t {tt.shape}, got {w.shape}")
+        ax2 = ax.twinx()
+        ax2.plot(tt, w, lw=1.0, color="tab:orange", label="angular [rad/s]")
+        ax2.set_ylabel("angular [rad/s]")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(title)
+    return _save(fig, path)
 
 
 def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
