@@ -78,14 +78,14 @@ def _plain_shot(page, t: float) -> np.ndarray:
 def _check_page(page, line_session) -> None:
     page.wait_for_function(READY, timeout=20000)
     got = page.evaluate(CONTENTS)
-    assert set(got["links"]) == {"base_link_0", "upper_arm_link_0", "upper_arm_link_1", "forearm_link_0",
-                                 "forearm_link_1", "quill_link_0", "hand_link_0", "hand_link_1"}
+    assert set(got["links"]) == {"base_link_0", "upper_arm_link_0", "upper_arm_link_1", "j2_drive_0",
+                                 "forearm_link_0", "j34_drives_0", "quill_link_0", "hand_link_0", "gripper_0"}
     assert all(kind == "Mesh" for kind in got["links"].values())
     assert got["path"] == "Line"
     assert got["cloud"] == "Points"
     assert got["cloudCount"] == line_session.workspaces[CLOUD].points.shape[0]
     assert sorted(got["boxes"]) == ["conveyor", "crate"]
-    assert got["actions"] == 8  # one track group per visual geometry
+    assert got["actions"] == 9  # one track group per visual geometry
     assert got["duration"] == pytest.approx(3.607, abs=1.0 / 30 + 1e-6)
 
     start, middle = _plain_shot(page, 0.0), _plain_shot(page, 1.8)

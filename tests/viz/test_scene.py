@@ -36,8 +36,8 @@ def test_scene_contents_and_animation(line_session):
     arm = line_session.robot("scara")
     rec = line_session.trajectories["pick-place 3-5-3"]
     assert info.robots["scara"] == [f"pinarms/robots/scara/visuals/{g}" for g in (
-        "base_link_0", "upper_arm_link_0", "upper_arm_link_1", "forearm_link_0", "forearm_link_1",
-        "quill_link_0", "hand_link_0", "hand_link_1")]
+        "base_link_0", "upper_arm_link_0", "upper_arm_link_1", "forearm_link_0", "quill_link_0", "hand_link_0",
+        "gripper_0", "j34_drives_0", "j2_drive_0")]
     assert info.paths == {"pick-place 3-5-3": "pinarms/paths/pick-place 3-5-3"}
     assert info.clouds == {"scara cloud": "pinarms/workspace/scara cloud"}
     assert len(info.points["crate targets"]) == 2 and len(info.points["vias:pick-place 3-5-3"]) == 4
