@@ -7,6 +7,10 @@
   by TOPP-RA (Pham and Pham 2018; the ``toppra`` package, optional: ``pip install
   pinarms[reference]``). The path is a cubic spline through samples of the trajectory spaced
   evenly in joint-space arc length, cut where the trajectory rests.
+- :func:`toppra_path_duration`: TOPP-RA (toppra) on a :class:`planning.JointPath` itself,
+  read through an adapter (the same q(s), q'(s), q''(s) that :func:`optim.time_optimal`
+  uses), on a grid of the caller's choice: the independent check of the time scaling
+  written here.
 - :func:`ruckig_limit` / :func:`double_s_limit`: jerk-limited, rest-to-rest point to
   point from the first to the last via point (ruckig, optional; or planning's double-S),
   a lower bound for any rest-to-rest motion through the via points.
@@ -24,7 +28,7 @@ import numpy as np
 from pinarms.optim.errors import OptimError
 from pinarms.optim.problem import check_limit
 
-__all__ = ["path_velocity_limit", "toppra_limit", "ruckig_limit", "double_s_limit",
+__all__ = ["path_velocity_limit", "toppra_limit", "toppra_path_duration", "ruckig_limit", "double_s_limit",
            "MissingReference"]
 
 
@@ -135,6 +139,67 @@ def toppra_limit(trajectory: Any, vmax: Any, amax: Any = None, n: int = 400, *, 
                              "under these limits")
         duration += float(algo.compute_trajectory(0.0, 0.0).duration)
     return duration
+
+
+def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, tool_speed: float | None = None,
+                         discretization: str = "interpolation") -> float:
+    """Duration (s) of toppra's time-optimal parameterisation of ``path`` (a :class:`planning.JointPath`).
+
+    Args:
+        path: the joint path; toppra evaluates ``path.sample(s)`` (q, q', q'') directly.
+        vmax, amax: joint limits (scalar or per joint).
+        gridpoints: toppra's grid in s (increasing, from 0 to ``path.length``).
+        tool_speed: optional tcp speed limit [m/s], as toppra's second-order constraint
+            ``|J_v q'|² ṡ² <= v²`` (needs ``path.robot``).
+        discretization: toppra's scheme for the acceleration (and tool) rows,
+            ``"interpolation"`` (its default) or ``"collocation"``.
+    """
+    try:
+        import toppra
+        import toppra.algorithm
+        import toppra.constraint
+        from toppra.interpolator import AbstractGeometricPath
+    except ImportError as exc:  # pragma: no cover - toppra is in the test extra
+        raise MissingReference("toppra is not installed: pip install 'pinarms[reference]'") from exc
+
+    class _Adapter(AbstractGeometricPath):
+        def __call__(self, s, order=0):
+            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
+            return out[0] if np.ndim(s) == 0 else out
+
+        @property
+        def dof(self):
+            return path.n_joints
+
+        @property
+        def path_interval(self):
+            return np.array([0.0, path.length])
+
+    dof = path.n_joints
+    v = check_limit(vmax, dof, "vmax", required=True)
+    a = check_limit(amax, dof, "amax", required=True)
+    scheme = {"interpolation": toppra.constraint.DiscretizationType.Interpolation,
+              "collocation": toppra.constraint.DiscretizationType.Collocation}[discretization]
+    constraints = [toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
+                   toppra.constraint.JointAccelerationConstraint(np.column_stack([-a, a]), discretization_scheme=scheme)]
+    if tool_speed is not None:
+        robot, frame = path.robot, path.frame
+
+        def speed_squared(q, qd, qdd):  # |J_v(q) qd|^2: a = f(q, 0, q') = 0, b = f(q, q', q'') = |J_v q'|^2
+            J = np.asarray(robot.jacobian(np.asarray(q, dtype=float), frame=frame))[:3]
+            return np.array([float(np.sum((J @ np.asarray(qd, dtype=float)) ** 2))])
+
+        F, g = np.array([[1.0]]), np.array([float(tool_speed) ** 2])
+        constraints.append(toppra.constraint.SecondOrderConstraint(
+            speed_squared, lambda q: F, lambda q: g, dof, discretization_scheme=scheme))
+    grid = np.asarray(gridpoints, dtype=float)
+    algo = toppra.algorithm.TOPPRA(constraints, _Adapter(), gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    out = algo.compute_parameterization(0.0, 0.0)
+    sd = out[1] if isinstance(out, tuple) else None
+    if sd is None or np.any(~np.isfinite(sd)):
+        raise OptimError("TOPP-RA found no parameterisation of the path under these limits")
+    sd = np.asarray(sd, dtype=float)
+    return float(np.sum(2.0 * np.diff(grid) / (sd[:-1] + sd[1:])))
 
 
 def ruckig_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:

@@ -417,8 +417,12 @@ class Trajectory:
         f = scalar(factor, "factor")
         if f <= 0.0:
             raise TrajectoryError(f"factor must be positive, got {factor!r}")
-        breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
-        coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
+            coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        if not (np.all(np.isfinite(breaks)) and np.all(np.isfinite(coefs)) and np.all(np.diff(breaks) > 0.0)):
+            raise TrajectoryError(f"factor {f!r} takes the scaled trajectory beyond float64 (its times or "
+                                  f"coefficients overflow or collapse); use a factor nearer 1")
         return Trajectory(breaks, coefs, {"kind": "scaled", "factor": f, "base": self.definition})
 
     def shifted(self, start_time: float) -> "Trajectory":
