@@ -105,6 +105,7 @@ class _Peaked:
 
     def __init__(self, trajectory: Trajectory) -> None:
         self.n_joints = trajectory.n_joints
+        self.trajectory = trajectory  # for constraints that need more than the peaks (joint torque)
         self._trajectory = trajectory
         self._peaks = None
 

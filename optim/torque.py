@@ -105,31 +105,12 @@ class TorqueConstraint:
     def refined_scale(self, trajectory: Any) -> float:
         """Factor (>= 1) on every duration that brings the *refined* torque peaks under the limits.
 
-        The grid misses the exact peak by a hair; the refined peaks (planning's bracketing
-        search) and the scaling law at those instants give the factor, iterated until the
-        refined ratio is within 1e-12.
+        The grid misses the exact peak by a hair; the refined peaks and the scaling law at
+        those instants give the factor (:func:`planning.torque.torque_dilation`).
         """
-        from pinarms.planning.torque import piece_torque_peaks
+        from pinarms.planning.torque import torque_dilation
 
-        factor = 1.0
-        traj = trajectory
-        for _ in range(8):
-            peak, when, _ = piece_torque_peaks(traj, self.robot, self.samples_per_piece)
-            if np.all(peak <= self.limit * (1.0 + 1e-12)):
-                return factor
-            q, qd, qdd, _ = traj.sample(np.clip(when.reshape(-1), traj.start_time, traj.end_time))
-            g = self.robot.gravity(q)
-            b = self.robot.inverse_dynamics(q, qd, qdd) - g
-            L = self.limit
-            with np.errstate(divide="ignore", invalid="ignore"):
-                bound = np.where(b > 0.0, (L - g) / b, np.where(b < 0.0, (L + g) / -b, np.inf))
-            u = float(np.min(bound))
-            if not u > 0.0:
-                return np.inf
-            step = max(1.0 / np.sqrt(u), 1.0) * (1.0 + 1e-12)
-            factor *= step
-            traj = traj.scaled(step)
-        return factor
+        return torque_dilation(trajectory, self.robot, self.limit, self.samples_per_piece)
 
 
 def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,
