@@ -11,7 +11,7 @@
 
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
-from .plots import plot_ga_convergence, plot_joint_curves, plot_trajectory, plot_workspace
+from .plots import plot_ga_convergence, plot_joint_curves, plot_torques, plot_trajectory, plot_workspace
 from .scene import SceneInfo, build_scene
 from .session import (
     FORMAT_NAME,
@@ -48,6 +48,7 @@ __all__ = [
     "plot_trajectory",
     "plot_ga_convergence",
     "plot_workspace",
+    "plot_torques",
     "SceneInfo",
     "VizError",
     "SessionFormatError",
