@@ -244,7 +244,10 @@ class Trajectory:
         m = self.n_segments
         seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
         tau = tt - self._breaks[seg]
-        powers = tau[:, None] ** np.arange(self.degree + 1)
+        powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
+        powers[:, 0] = 1.0
+        for k in range(1, self.degree + 1):
+            np.multiply(powers[:, k - 1], tau, out=powers[:, k])
         out = np.empty((tt.size, 4 * n))
         if m == 1:
             np.matmul(powers, D[0], out=out)

@@ -15,6 +15,7 @@ Conventions
 from __future__ import annotations
 
 import math
+from math import isfinite as _isfinite
 import threading
 from pathlib import Path
 from typing import Any
@@ -189,7 +190,7 @@ class Robot:
         """
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64:
             s = q.dot(q)
-            if s - s == 0.0:  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
+            if _isfinite(s):  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
                 return q if self._same_q else self._tree.coordinates.to_pin(q)
         return None
 
@@ -261,7 +262,7 @@ class Robot:
             fid = self.frame_id(frame)  # raises the named error
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined (a call costs as much as the check)
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 pin.forwardKinematics(self.model, data, q)
@@ -317,7 +318,7 @@ class Robot:
             fid = self.frame_id(frame)
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
@@ -675,9 +676,40 @@ class Robot:
             seeds, _ = self.check_q(q_seed)
             if seeds.shape[0] not in (1, N):
                 raise InvalidInput(f"q_seed must be one configuration or one per target ({N}), got {seeds.shape[0]}")
-        res = self._numerical_ik().solve_batch(
-            T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed
-        )
+        solver = self._numerical_ik()
+        if self._analytic_ik is not None and not position_only:
+            # closed form first: it pays in batch (all branches of 10⁵ poses/s); each target takes
+            # its branch nearest the seed, projected into the limits (ik_all allows 1e-9), and
+            # keeps it when its FK meets tol; the others go to the batched numerical solver
+            # from that branch (one or two steps) or, without one, from the stored table
+            idx, qs = self._analytic_ik.candidates(T, seeds if seeds is not None else self.neutral[None])
+            q = np.full((N, self.nq), np.nan)
+            if idx.size:
+                first = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
+                q[idx[first]] = np.clip(qs[first], self.lower, self.upper)
+            has = np.flatnonzero(np.isfinite(q[:, 0]))
+            good = np.zeros(N, dtype=bool)
+            if has.size:
+                pe, re = solver.batch_errors(q[has], T[has], False)
+                good[has[(pe <= tol) & (re <= tol)]] = True
+            rest = np.flatnonzero(~good)
+            if rest.size:
+                start = q[rest]
+                if seeds is not None:
+                    miss = ~np.isfinite(start[:, 0])
+                    start[miss] = np.broadcast_to(seeds, (N, self.nq))[rest][miss]
+                res = solver.solve_batch(T[rest], start, position_only=False, tol=tol, max_restarts=max_restarts, seed=seed)
+                q[rest] = res.q
+            ok = self.within_limits(q, tol=0.0)
+            pe, re = solver.batch_errors(q, T, False)
+            ok &= (pe <= tol) & (re <= tol)
+            if ok.all():
+                return q
+            from .ik.numerical import BatchIKResult
+
+            res = BatchIKResult(q, ok, pe, re, 0)
+        else:
+            res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
         ok = res.success & self.within_limits(res.q, tol=0.0)
         if ok.all():
             return res.q

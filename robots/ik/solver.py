@@ -135,18 +135,15 @@ class AnalyticIK:
                 valid = np.repeat(valid, k.size, axis=1)
                 branch = np.repeat(branch, k.size, axis=1)
         elif respect_limits:  # each branch once: every angle at its equivalent within the limits nearest q_ref
-            for j, _ in self._shifts():
-                qj, ref = q[..., j], q_ref[:, j, None]
-                base = qj + _TWO_PI * np.round((np.clip(ref, lo[j], hi[j]) - qj) / _TWO_PI)
-                best = base.copy()
-                best_d = np.where((base >= lo[j] - LIMIT_TOL) & (base <= hi[j] + LIMIT_TOL), np.abs(base - ref), np.inf)
-                for shift in (-_TWO_PI, _TWO_PI):
-                    cand = base + shift
-                    d = np.where((cand >= lo[j] - LIMIT_TOL) & (cand <= hi[j] + LIMIT_TOL), np.abs(cand - ref), np.inf)
-                    better = d < best_d
-                    best = np.where(better, cand, best)
-                    best_d = np.where(better, d, best_d)
-                q[..., j] = best
+            js = [j for j, _ in self._shifts()]
+            if js:
+                lo_j, hi_j = lo[js], hi[js]
+                qj, ref = q[..., js], q_ref[:, None, js]
+                base = qj + _TWO_PI * np.round((np.clip(ref, lo_j, hi_j) - qj) / _TWO_PI)
+                cand = base[None] + _TWO_PI * np.array([0.0, -1.0, 1.0])[:, None, None, None]  # (3, n, B, m)
+                inside = (cand >= lo_j - LIMIT_TOL) & (cand <= hi_j + LIMIT_TOL)
+                pick = np.argmin(np.where(inside, np.abs(cand - ref), np.inf), axis=0)
+                q[..., js] = np.take_along_axis(cand, pick[None], axis=0)[0]
         if respect_limits:
             valid &= np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=-1)
         rows = q[valid]
