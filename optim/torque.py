@@ -55,20 +55,39 @@ class TorqueConstraint:
     def n_joints(self) -> int:
         return int(self.robot.nq)
 
-    def _torques(self, times: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Torques and gravity torques (P, m, k, n) on the grid, and the positions (P, m, k, n)."""
+    def _torques(self, times: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Torques and positions (P, m, k, n) on the grid."""
         from pinarms.planning.torque import piece_states
 
         q, qd, qdd = piece_states(times, coefs, self.s)
-        shape = q.shape
-        flat = q.reshape(-1, shape[-1])
-        tau = self.robot.inverse_dynamics(flat, qd.reshape(flat.shape), qdd.reshape(flat.shape)).reshape(shape)
-        return tau, q, shape
+        flat = q.reshape(-1, q.shape[-1])
+        tau = self.robot.inverse_dynamics(flat, qd.reshape(flat.shape), qdd.reshape(flat.shape)).reshape(q.shape)
+        return tau, q
 
     def piece_ratios(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
         """``max |tau| / L`` per piece and joint on the grid: (P, m, n)."""
-        tau, _, _ = self._torques(times, coefs)
+        tau, _ = self._torques(times, coefs)
         return np.abs(tau).max(axis=2) / self.limit
+
+    def path_static_check(self, times: np.ndarray, coefs: np.ndarray) -> None:
+        """Refuse a path (one timing's pieces) through a pose the arm cannot hold still, naming it.
+
+        Where ``|g(q)| > L`` no timing of that path exists (slower only tends to ``g``).
+        """
+        from pinarms.planning.torque import piece_states
+
+        q, _, _ = piece_states(np.atleast_2d(times)[:1], np.asarray(coefs)[:1], self.s)
+        q = q[0]  # (m, k, n)
+        g = np.abs(self.robot.gravity(q.reshape(-1, q.shape[-1]))).reshape(q.shape)
+        over = g > self.limit
+        if np.any(over):
+            seg, k, j = (int(i) for i in np.argwhere(over)[0])
+            raise InfeasibleProblem(
+                f"robot '{self.robot.name}' cannot hold the path still between via points {seg} and {seg + 1} "
+                f"(at {self.s[k]:.0%} of that segment, q = {np.round(q[seg, k], 4).tolist()}): joint "
+                f"{self.robot.joint_names[j]} needs {g[seg, k, j]:.4g} N·m against gravity (payload included), "
+                f"its limit is {self.limit[j]:.4g}; no timing helps: lighten the payload or change the path"
+            )
 
     def minimal_scale(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
         """Smallest time scale s (P,) meeting the torque limits on the grid (module docstring).
@@ -76,7 +95,8 @@ class TorqueConstraint:
         ``times``/``coefs`` describe timings at any total; the answer multiplies those
         durations. ``inf`` where a sample cannot be held still (``|g| > L``).
         """
-        tau, q, shape = self._torques(times, coefs)
+        tau, q = self._torques(times, coefs)
+        shape = q.shape
         g = self.robot.gravity(q.reshape(-1, shape[-1])).reshape(shape)
         P = shape[0]
         b = (tau - g).reshape(P, -1, shape[-1])

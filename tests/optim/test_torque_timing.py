@@ -196,3 +196,17 @@ def test_torque_path_constraint_refuses_a_load_it_cannot_hold(aubo):
     weak = planning.JointTorqueConstraint(aubo.with_payload(3.0), limit=[100.0, 5.0, 100.0, 100.0, 100.0, 100.0])
     with pytest.raises(InfeasibleProblem, match="no admissible speed at s = "):
         optim.time_optimal(path, [weak])
+
+
+def test_a_path_through_a_pose_the_arm_cannot_hold_is_named(aubo):
+    """Both via points can be held, the level arm between them cannot: no timing exists."""
+    q0, q1 = np.array([0.0, -1.2, 0.0, 0.0, 0.0, 0.0]), np.array([0.0, -1.9, 0.0, 0.0, 0.0, 0.0])
+    loaded = aubo.with_payload(3.0)
+    g = np.abs(loaded.gravity(np.array([q0, [0.0, -np.pi / 2, 0.0, 0.0, 0.0, 0.0], q1])))[:, 1]
+    limits = aubo.effort_limit.copy()
+    limits[1] = 0.5 * (max(g[0], g[2]) + g[1])  # above both ends, below the level pose
+    for method in ("exact", "ga"):
+        with pytest.raises(InfeasibleProblem, match=r"cannot hold the path still between via points 0 and 1 .* "
+                                                    r"joint upperArm_joint needs"):
+            optim.minimize_time(np.array([q0, q1]), "multi-quintic", aubo.velocity_limit, method=method,
+                                max_generations=5, robot=aubo, payload=3.0, torque_limits=limits)
