@@ -135,6 +135,7 @@ class _Peaked:
 
     def __init__(self, trajectory: Trajectory) -> None:
         self.n_joints = trajectory.n_joints
+        self.trajectory = trajectory  # for constraints that need more than the peaks (joint torque)
         self._coefs = trajectory.coefficients
         self._h = trajectory.segment_durations
         self._normalised = None

@@ -222,6 +222,9 @@ def study_001(quick: bool = False) -> Study:
                     f"the paper's 1/2/1 s use a fraction of the {np.degrees(arm.velocity_limit[0]):.0f} °/s limit; "
                     f"ours {'/'.join(f'{h:.3f}' for h in fastest.durations)} s, {limiting}"))
 
+    dyn_rows, dyn_plots = _dynamics_001(arm, table2, quick)
+    rows.extend(dyn_rows)
+
     single = planning.polynomial(times[[0, 3]], table2[[0, 3]], 5)
     miss = np.abs(single.sample(times[1:3])[0] - table2[1:3]).max()
     rows.append(Row("001", "single quintic P1→P4 misses P2/P3 by", "misses", float(miss), "rad", None,
@@ -253,6 +256,7 @@ def study_001(quick: bool = False) -> Study:
     lift = lines["P1-P2_straight"]
     plots["lift_tool_speed"] = lambda path: _tool_speed_plot(path, lift, "seed 001: straight P1→P2 lift, quintic law at 210 °/s")
     plots.update(_workspace_plots(ws, "seed 001: AUBO-i3 workspace (flange)"))
+    plots.update(dyn_plots)
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
 
 
@@ -311,6 +315,76 @@ def _tool_speed_plot(path: Path, timing: Any, title: str) -> Any:
     t = np.linspace(0.0, timing.duration, 400)
     lin, ang = timing.tool_speed(t)
     return vplots.plot_tool_speed(path, t, lin, angular=ang, title=title)
+
+
+#: Payloads of the AUBO-i3 rows [kg]: empty gripper, half and full rated payload (3 kg, AUBO's datasheet).
+AUBO_PAYLOADS_KG = (0.0, 1.5, 3.0)
+
+#: The AUBO-i3 pick-and-place of the dynamics rows: conveyor pick and tray place 115° apart at
+#: about 0.46 m radius, inside the paper's recommended band (200 mm < r < 500 mm, z > 0).
+AUBO_PICK_M, AUBO_PLACE_M = (0.45, -0.10, 0.02), (-0.10, 0.45, 0.02)
+
+
+def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row], dict[str, Callable[[Path], Any]]]:
+    """Seed 001 under joint torque limits: P1→P4 and a pick-and-place with 0, 1.5 and 3 kg.
+
+    The paper's joints are converted to the manufacturer's convention (robots.conventions;
+    the arm's real configurations, within ±170°): torques depend on the actual pose.
+    """
+    from pinarms import optim
+    from pinarms.robots.ties import near_max
+
+    rows: list[Row] = []
+    q = conv.aubo_mdh_to_joint(table2)
+    v = arm.velocity_limit
+    speed = optim.minimize_time(q, "multi-quintic", v, method="exact")
+    for kg in AUBO_PAYLOADS_KG:
+        ex = optim.minimize_time(q, "multi-quintic", v, method="exact", robot=arm, payload=kg, torque_limits=True)
+        ratios = ex.torque_ratios
+        tight = [arm.joint_names[k] for k in near_max(ratios)]
+        ref = optim.toppra_limit(ex.trajectory, v, robot=arm, payload=kg, torque_limits=True)
+        rows.append(Row(
+            "001", f"P1→P4 with {kg:g} kg: time-optimal under joint speed + torque (exact)", None, ex.total, "s", None,
+            f"speed only {speed.total:.3f} s ({100.0 * (ex.total / speed.total - 1.0):+.1f} %); peak torque/limit "
+            f"{ratios.max():.3f} ({', '.join(tight)}); TOPP-RA along the same path {ref:.3f} s "
+            f"(bang-bang, the path's optimum: ×{ex.total / ref:.2f})"))
+        if kg == AUBO_PAYLOADS_KG[-1]:
+            gens = 30 if quick else 120
+            ga = optim.minimize_time(q, "multi-quintic", v, method="ga", seed=0, max_generations=gens,
+                                     robot=arm, payload=kg, torque_limits=True)
+            rows.append(Row(
+                "001", f"P1→P4 with {kg:g} kg: GA under joint speed + torque", None, ga.total, "s", None,
+                f"{gens} generations, seed 0; ×{ga.total / ex.total:.3f} the exact optimum above; peak torque/limit "
+                f"{ga.torque_ratios.max():.3f}"))
+    spec = optim.PickPlace(AUBO_PICK_M, AUBO_PLACE_M, lift=0.08, dwell=0.3)
+    free = optim.plan_cycle(arm, spec)
+    what = "AUBO-i3 pick-and-place (r ≈ 0.46 m, 115° apart, lift 80 mm, dwell 0.3 s)"
+    rows.append(Row("001", f"{what}: cycle time, joint speed only", None, free.cycle_time, "s", None,
+                    f"{free.picks_per_minute:.1f} picks/min; the paper gives none"))
+    for kg in AUBO_PAYLOADS_KG:
+        cyc = optim.plan_cycle(arm, spec, payload=kg, torque_limits=True)
+        tight = [arm.joint_names[k] for k in near_max(cyc.torque_ratios)]
+        rows.append(Row(
+            "001", f"{what}: cycle time with {kg:g} kg, speed + torque", None, cyc.cycle_time, "s", None,
+            f"{cyc.picks_per_minute:.1f} picks/min ({100.0 * (cyc.cycle_time / free.cycle_time - 1.0):+.1f} %); "
+            f"loaded move {cyc.move_times[0]:.3f} s, empty return {cyc.move_times[1]:.3f} s; peak torque/limit "
+            f"{cyc.torque_ratios.max():.3f} ({', '.join(tight)})"))
+
+    heavy = arm.with_payload(AUBO_PAYLOADS_KG[-1])
+    limited = optim.minimize_time(q, "multi-quintic", v, method="exact", robot=arm, payload=AUBO_PAYLOADS_KG[-1],
+                                  torque_limits=True).trajectory
+
+    def write(path: Path) -> Any:
+        from pinarms.viz import plots as vplots
+
+        t = np.linspace(0.0, limited.duration, 600)
+        ts = np.linspace(0.0, speed.trajectory.duration, 600)
+        return vplots.plot_torques(
+            path, t, limited.torques(heavy, t), arm.effort_limit, joint_names=arm.joint_names,
+            series={"speed-only timing (torque not checked)": (ts, speed.trajectory.torques(heavy, ts))},
+            title=f"seed 001: P1→P4 with {AUBO_PAYLOADS_KG[-1]:g} kg, joint torques against the limits")
+
+    return rows, {"torques": write}
 
 
 def _unwrap_rows(q: np.ndarray) -> np.ndarray:
@@ -469,6 +543,7 @@ def study_004(quick: bool = False) -> Study:
 
     lift_rows, lift = _koji_lift_004(arm, angles_deg[0] * DEG)
     rows.extend(lift_rows)
+    rows.extend(_koji_block_rows(arm))
 
     session = _session(arm, "seed 004: koji turner, joints at constant rates")
     session.add_trajectory("block_lifted_straight_up", lift.trajectory, hz=200.0)
@@ -513,6 +588,43 @@ def _koji_lift_004(arm: Any, q0: np.ndarray) -> tuple[list[Row], Any]:
             f"joint-space line at the same limits {joint.duration:.4f} s (straight costs "
             f"{100 * (straight.duration / joint.duration - 1):.1f} %)"),
     ], straight
+
+
+#: Mass [kg] of one koji block as pinarms assumes it (the paper gives none): a pressed block of moist
+#: wheat koji about 0.32 × 0.19 × 0.055 m (3.3 dm³) at about 1.2 kg/dm³ (docs/robots/koji_turner.md).
+KOJI_BLOCK_KG = 4.0
+
+
+def _koji_block_rows(arm: Any) -> list[Row]:
+    """The koji arm turning one block: lift it, swing 90°, turn it 90° on the wrist, set it down (and back)."""
+    from pinarms import optim
+    from pinarms.optim import InfeasibleProblem
+    from pinarms.robots.ties import near_max
+
+    q_pick = np.array([0.0, 0.15, -0.35, 0.0])
+    q_place = np.array([np.pi / 2, 0.15, -0.35, np.pi / 2])
+    spec = optim.PickPlace(arm.fk(q_pick), arm.fk(q_place), lift=0.10, dwell=0.5)
+    free = optim.plan_cycle(arm, spec)
+    what = "koji block turn (swing 90°, turn the block 90°, lift 0.1 m, dwell 0.5 s)"
+    rows = [Row("004", f"{what}: cycle time, joint speed only", None, free.cycle_time, "s", None,
+                "the paper times no cycle; joint speeds of the model (0.3–1 rad/s)")]
+    loaded = optim.plan_cycle(arm, spec, payload=KOJI_BLOCK_KG, torque_limits=True)
+    tight = [arm.joint_names[k] for k in near_max(loaded.torque_ratios)]
+    rows.append(Row("004", f"{what}: cycle time with one {KOJI_BLOCK_KG:g} kg block, speed + torque", None,
+                    loaded.cycle_time, "s", None,
+                    f"block mass assumed (0.32 × 0.19 × 0.055 m of pressed moist koji, ≈1.2 kg/dm³); "
+                    f"{100.0 * (loaded.cycle_time / free.cycle_time - 1.0):+.1f} %; peak torque/limit "
+                    f"{loaded.torque_ratios.max():.3f} ({', '.join(tight)})"))
+    try:
+        optim.plan_cycle(arm, spec, payload=2 * KOJI_BLOCK_KG, torque_limits=True)
+        two = "feasible"
+    except InfeasibleProblem as exc:
+        two = str(exc).split(":")[1].split(";")[0].strip()
+    rows.append(Row("004", f"{what}: two blocks ({2 * KOJI_BLOCK_KG:g} kg) at once", None,
+                    "infeasible" if two != "feasible" else "feasible", "", None,
+                    f"{two}; efforts sized for one block, no balancing cylinder or counterweight modelled "
+                    "(the paper's fig. 1 has both)"))
+    return rows
 
 
 # --------------------------------------------------------------------- plots

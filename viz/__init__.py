@@ -11,7 +11,14 @@
 
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
-from .plots import plot_ga_convergence, plot_joint_curves, plot_tool_speed, plot_trajectory, plot_workspace
+from .plots import (
+    plot_ga_convergence,
+    plot_joint_curves,
+    plot_tool_speed,
+    plot_torques,
+    plot_trajectory,
+    plot_workspace,
+)
 from .scene import SceneInfo, build_scene
 from .session import (
     FORMAT_NAME,
@@ -49,6 +56,7 @@ __all__ = [
     "plot_tool_speed",
     "plot_ga_convergence",
     "plot_workspace",
+    "plot_torques",
     "SceneInfo",
     "VizError",
     "SessionFormatError",

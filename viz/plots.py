@@ -25,7 +25,7 @@ from pinarms.robots.errors import InvalidInput
 from ._atomic import atomic_write
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
-           "plot_clearance", "plot_schedule"]
+           "plot_clearance", "plot_schedule", "plot_torques"]
 
 #: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
 #: interval) is drawn without knot markers and lines.
@@ -414,4 +414,77 @@ def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: s
     ax.set_xlabel("time [s]  (bars: tcp in the shared zone; ticks: cycle starts)")
     ax.set_title(title or f"{schedule.cell}: {schedule.picks_per_minute:.1f} picks/min, period {period:.2f} s")
     ax.grid(True, axis="x", alpha=0.3)
+
+
+def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
+                 units: Sequence[str] | None = None, series: Mapping[str, Any] | None = None, title: str = "joint torques") -> Path:
+    """Joint torques against their limits: one panel per joint, ±limit dashed, peaks marked.
+
+    Args:
+        path: output file (.png or .svg).
+        t: instants (N,) [s].
+        torques: (N, n) [N·m, or N for prismatic joints]: the main curve (e.g. with the payload).
+        limits: (n,) torque limits (dashed ±lines, with the peak's share of the limit in the
+            panel title), or None.
+        joint_names: panel titles (default ``joint 1..n``); units: per joint (default N·m).
+        series: more curves to compare ``{label: (t (M,), torques (M, n))}`` (e.g. without the
+            payload, or a slower timing), drawn thinner.
+    """
+    tt = _numbers(t, "t")
+    tau = _numbers(torques, "torques")
+    if tt.ndim != 1 or tt.size < 2 or np.any(np.diff(tt) <= 0):
+        raise InvalidInput("t must be (N,) strictly increasing instants in s with N >= 2")
+    tau = tau[:, None] if tau.ndim == 1 else tau
+    if tau.ndim != 2 or tau.shape[0] != tt.size:
+        raise InvalidInput(f"torques must have shape ({tt.size}, n_joints), got {np.shape(torques)}")
+    n = tau.shape[1]
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    if len(names) != n:
+        raise InvalidInput(f"joint_names has {len(names)} names for {n} joints")
+    unit = list(units) if units is not None else ["N·m"] * n
+    if len(unit) != n:
+        raise InvalidInput(f"units has {len(unit)} entries for {n} joints")
+    lim = None
+    if limits is not None:
+        lim = np.broadcast_to(_numbers(limits, "limits", allow_inf=True), (n,))
+        if np.any(lim <= 0):
+            raise InvalidInput(f"limits must be positive, got {lim.tolist()}")
+    extra = []
+    for label, (te, ve) in (series or {}).items():
+        te, ve = _numbers(te, f"t of {label!r}"), _numbers(ve, f"torques of {label!r}")
+        ve = ve[:, None] if ve.ndim == 1 else ve
+        if ve.shape != (te.size, n):
+            raise InvalidInput(f"series {label!r} must be (t (M,), torques (M, {n})), got {te.shape} and {ve.shape}")
+        extra.append((str(label), te, ve))
+    cols = 2 if n > 3 else 1
+    rows = int(math.ceil(n / cols))
+    fig = Figure(figsize=(8.8 if cols == 2 else 7.0, 2.1 * rows + 0.6), layout="constrained")
+    axes = fig.subplots(rows, cols, sharex=True, squeeze=False).reshape(-1)
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j in range(n):
+        ax = axes[j]
+        for k, (label, te, ve) in enumerate(extra):
+            ax.plot(te, ve[:, j], color=colors[(k + 1) % len(colors)], lw=0.9, alpha=0.8, label=label)
+        ax.plot(tt, tau[:, j], color=colors[0], lw=1.5, label="torque")
+        k = int(np.argmax(np.abs(tau[:, j])))
+        ax.plot(tt[k], tau[k, j], "o", color=colors[0], ms=4)
+        head = names[j]
+        if lim is not None and np.isfinite(lim[j]):
+            for sign in (1, -1):
+                ax.axhline(sign * lim[j], color="k", ls="--", lw=0.9, alpha=0.8)
+            head += f"  (peak {abs(tau[k, j]) / lim[j]:.0%} of ±{np.format_float_positional(lim[j], 4, fractional=False, trim='-')})"
+        ax.set_title(head, fontsize=9)
+        ax.set_ylabel(f"[{unit[j]}]")
+        ax.grid(True, alpha=0.3)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for ax in axes[max(0, n - cols):n]:
+        ax.set_xlabel("time [s]")
+    handles, texts = axes[0].get_legend_handles_labels()
+    if lim is not None:
+        handles.append(Line2D([], [], color="k", ls="--", lw=0.9))
+        texts.append("±limit")
+    fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
+    if title:
+        fig.suptitle(title)
     return _save(fig, path)

@@ -123,7 +123,7 @@ def _registry_name(robot: Robot) -> str | None:
     except PinarmsError:
         return None
     if ref.urdf_text == robot.urdf_text and ref.tcp_frame == robot.tcp_frame:
-        return robot.name
+        return robot.name  # a payload is stored beside the name (RobotEntry.payload)
     return None
 
 
@@ -189,7 +189,8 @@ class Session:
         """Add a robot placed at ``base_to_world`` (4, 4) in the world; return its key.
 
         A robot that ``robots.load`` rebuilds exactly is stored by name; any other has its
-        URDF text embedded so that the session reopens anywhere.
+        URDF text embedded so that the session reopens anywhere. A robot carrying a payload
+        (``robot.with_payload``) keeps it: the session stores the payload and reapplies it.
         """
         if isinstance(robot, str):
             robot = robots.load(robot)
@@ -208,6 +209,7 @@ class Session:
             base_to_world=_pose(base_to_world, f"base_to_world of robot {key!r}"),
             urdf_text=None if reg else robot.urdf_text,
             package_dirs=() if reg else tuple(str(p) for p in robot.package_dirs),
+            payload=None if robot.payload is None else robot.payload.as_dict(),
         )
         self._loaded[key] = robot
         return key
@@ -226,6 +228,8 @@ class Session:
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
                 )
+            if entry.payload is not None:
+                rob = rob.with_payload(entry.payload)
             if tuple(rob.joint_names) != entry.joint_names:
                 raise SessionFormatError(
                     f"robot {entry.key!r} ({entry.name}) was saved with joints {list(entry.joint_names)} but now loads "

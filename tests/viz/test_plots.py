@@ -193,3 +193,22 @@ def test_tool_speed_plot_of_a_straight_lift_and_its_joint_curves(tmp_path):
     assert Image.open(out).size[1] > 900  # four panels; the dense timing's knots are not drawn
     with pytest.raises(InvalidInput, match="same length"):
         viz.plot_tool_speed(tmp_path / "bad.png", t, lin[:-1])
+
+
+def test_torque_curves_against_limits(tmp_path):
+    from pinarms import robots
+    from pinarms.viz.plots import plot_torques
+
+    arm = robots.load("aubo_i3").with_payload(3.0)
+    move = planning.multi_quintic([0.0, 0.6], np.array([[0.3, -0.4, 1.2, 0.2, 1.57, 0.0], [-0.9, 0.4, 1.8, 0.5, 1.2, 0.5]]))
+    t = np.linspace(0.0, 0.6, 200)
+    tau = move.torques(arm, t)
+    out = plot_torques(tmp_path / "tau.svg", t, tau, arm.effort_limit, joint_names=arm.joint_names,
+                       series={"slower": (t * 1.2, move.scaled(1.2).torques(arm, t * 1.2))}, title="torques")
+    text = out.read_text()
+    peak = np.abs(tau[:, 1]).max() / arm.effort_limit[1]
+    assert "upperArm_joint" in text and f"peak {peak:.0%}" in text and "slower" in text and "±limit" in text
+    with pytest.raises(InvalidInput, match="torques must have shape"):
+        plot_torques(tmp_path / "bad.png", t, tau[:10])
+    with pytest.raises(InvalidInput, match="limits must be positive"):
+        plot_torques(tmp_path / "bad.png", t, tau, np.zeros(6))
