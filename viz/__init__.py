@@ -21,6 +21,7 @@ from .session import (
     PointSet,
     RobotEntry,
     Session,
+    SessionLimits,
     TrajectoryRecord,
     WorkspaceRecord,
     load_session,
@@ -30,6 +31,7 @@ from .viewer import MeshcatServer, Viewer, show
 __all__ = [
     "Session",
     "load_session",
+    "SessionLimits",
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "RobotEntry",
