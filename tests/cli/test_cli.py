@@ -266,7 +266,7 @@ def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypa
     import click
 
     from pinarms import optim
-    import pinarms.cli as cli_module
+    import pinarms.cli._common as cli_common
 
     seen = {}
 
@@ -283,7 +283,7 @@ def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypa
         def update(self, n):
             seen["updates"] += n
 
-    monkeypatch.setattr(cli_module, "_show_progress", lambda as_json: True)
+    monkeypatch.setattr(cli_common, "show_progress", lambda as_json: True)
     monkeypatch.setattr(click, "progressbar", Bar)
     run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55")
     assert seen["length"] == optim.GASettings.seed002().max_generations

@@ -66,7 +66,7 @@ CORPUS = [
     ("robot-within-limits-complex", lambda: ur5().within_limits(_C), InvalidInput, "real"),
     ("robot-ik-complex-target", lambda: ur5().ik_all(np.eye(4, dtype=complex)), InvalidInput, "real"),
     ("robot-ik-empty-seed-batch", lambda: ur5().ik(ur5().fk(ur5().neutral), np.zeros((0, 6))), InvalidInput,
-     "one configuration"),
+     "q_seed"),
     ("random-q-1e15", lambda: ur5().random_q(10**15), InvalidInput, "more than 50,000,000"),
     ("workspace-1e15", lambda: robots.sample_workspace(ur5(), 10**15), InvalidInput, "more than 50,000,000"),
     ("minimize-time-complex-limit", lambda: optim.minimize_time([[0.0] * 6, [1.0] * 6], "multi-quintic", _C),

@@ -1,0 +1,169 @@
+"""Shared plumbing of the ``pinarms`` command line: the command group, error handling,
+JSON output, number parsing, unit scales and session saving (one place for every command group).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any, Iterable
+
+import click
+import numpy as np
+
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.robots.robot import Robot
+
+__all__ = ["cli", "main", "json_option", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
+           "show_progress", "load_robot", "floats", "si_limit", "vectors_from_args", "joint_scale_at",
+           "new_session", "save_session"]
+
+# numbers may be negative: "-0.5" must reach the command as a value, not as an option
+NUMBERS = {"ignore_unknown_options": True}
+
+
+def one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+class PinarmsGroup(click.Group):
+    """A click group that turns pinarms errors into one-line messages (exit status 1)."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except PinarmsError as exc:
+            raise click.ClickException(one_line(exc)) from None
+        except FileNotFoundError as exc:
+            raise click.ClickException(f"file not found: {exc.filename or one_line(exc)}") from None
+        except OSError as exc:
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise click.ClickException(f"{where}{exc.strerror or one_line(exc)}") from None
+
+
+def jsonable(obj: Any) -> Any:
+    """Plain JSON types for numpy arrays/scalars, dataclasses, paths and dict-like results."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    for method in ("as_dict", "to_dict"):
+        if callable(getattr(obj, method, None)):
+            return jsonable(getattr(obj, method)())
+    if hasattr(obj, "_asdict"):
+        return jsonable(obj._asdict())
+    return obj if isinstance(obj, (str, int, type(None))) else str(obj)
+
+
+def emit(as_json: bool, data: dict, lines: Iterable[str]) -> None:
+    if as_json:
+        click.echo(json.dumps(jsonable(data), indent=2))
+    else:
+        for line in lines:
+            click.echo(line)
+
+
+def fmt(values: Any, digits: int = 6) -> str:
+    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    return "  ".join(f"{v:.{digits}g}" for v in arr)
+
+
+def show_progress(as_json: bool) -> bool:
+    """Progress bars only for a person at a terminal, never in machine-readable output."""
+    return (not as_json) and sys.stderr.isatty()
+
+
+def load_robot(name: str) -> Robot:
+    """A registry name, or the path of any ``.urdf`` file."""
+    if name.lower().endswith(".urdf"):
+        return robots.from_urdf(name)
+    return robots.load(name)
+
+
+def floats(text: str, what: str) -> np.ndarray:
+    """``"1, 2,3"`` → array; a clear usage error otherwise."""
+    parts = [p for p in text.replace(";", ",").split(",") if p.strip()]
+    try:
+        values = np.array([float(p) for p in parts], dtype=float)
+    except ValueError:
+        raise click.BadParameter(f"{what} must be comma-separated numbers, got {text!r}") from None
+    if values.size == 0:
+        raise click.BadParameter(f"{what} is empty")
+    if not np.all(np.isfinite(values)):
+        raise click.BadParameter(f"{what} holds a non-finite value: {text!r}")
+    return values
+
+
+def si_limit(text: str | None, what: str, scale: float | np.ndarray) -> np.ndarray | float | None:
+    """A limit option in user units → SI: one value for every joint, or one per joint."""
+    if text is None:
+        return None
+    values = floats(text, what)
+    per_joint = np.asarray(scale, dtype=float)
+    if per_joint.ndim and values.size not in (1, per_joint.size):
+        raise InvalidInput(f"{what} takes one value or one per joint ({per_joint.size}), got {values.size}")
+    values = values * per_joint
+    return float(values[0]) if values.size == 1 else values
+
+
+def vectors_from_args(values: tuple[float, ...]) -> np.ndarray:
+    return np.asarray(values, dtype=float)
+
+
+def joint_scale_at(scale: float | np.ndarray, joint: int) -> float:
+    """The scale of one joint (a scalar scale applies to every joint)."""
+    arr = np.asarray(scale, dtype=float)
+    return float(arr[joint]) if arr.ndim else float(arr)
+
+
+@click.group(cls=PinarmsGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="pinarms", prog_name="pinarms")
+def cli() -> None:
+    """pinarms: model, plan and time-optimise food/agricultural handling arms (on Pinocchio).
+
+    Units are SI (m, rad, s); --deg and --mm convert at the command line.
+    Every command takes --json for machine-readable output.
+    """
+
+
+def main() -> None:
+    """Console-script entry point (``pinarms``)."""
+    cli(prog_name="pinarms")
+
+
+json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON document instead of text.")
+
+
+
+def new_session(robot: Robot | str | None, title: str):
+    """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
+    from pinarms import viz
+
+    return viz.Session(robot=robot, title=title)
+
+
+def save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
+    """Write ``session`` to ``path`` and report it in the command's JSON ``data`` and text ``lines``."""
+    session.save(path)
+    data["session"] = path
+    lines.append(f"session written: {path}")
+
+

@@ -1,0 +1,314 @@
+"""Commands about one robot: ``robots``, ``fk``, ``ik``, ``workspace``, ``layout``."""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from pinarms import robots
+from pinarms.robots.errors import InvalidInput
+from pinarms.units import (
+    angle_scale,
+    joints_from_si,
+    joints_to_si,
+    length_scale,
+    prismatic_mask,
+)
+
+from ._common import (
+    NUMBERS,
+    cli,
+    emit,
+    floats,
+    fmt,
+    json_option,
+    jsonable,
+    load_robot,
+    new_session,
+    save_session,
+    vectors_from_args,
+)
+
+
+# --------------------------------------------------------------------------- robots
+@cli.command("robots")
+@json_option
+def robots_cmd(as_json: bool) -> None:
+    """List the robots `pinarms` knows (built-in arms and example-robot-data arms) with their DoF."""
+    from pinarms.robots.registry import info
+
+    rows = []
+    for name in robots.names():
+        entry = info(name)
+        robot = robots.load(name)
+        rows.append(
+            {
+                "name": name,
+                "dof": robot.nq,
+                "source": entry.source,
+                "description": entry.description,
+                "joints": list(robot.joint_names),
+            }
+        )
+    width = max(len(r["name"]) for r in rows)
+    lines = [f"{'name':<{width}}  dof  source              description"]
+    lines += [f"{r['name']:<{width}}  {r['dof']:>3}  {r['source']:<18}  {r['description']}" for r in rows]
+    emit(as_json, {"robots": rows}, lines)
+
+
+# --------------------------------------------------------------------------- fk
+@cli.command("fk", context_settings=NUMBERS)
+@click.argument("robot")
+@click.argument("q", nargs=-1, type=float, required=True)
+@click.option("--deg", is_flag=True, help="Revolute joint values in degrees (output angles too).")
+@click.option("--mm", is_flag=True, help="Prismatic joint values and the output position in millimetres.")
+@click.option("--frame", default="tcp", show_default=True, help="Frame whose pose is printed.")
+@json_option
+def fk_cmd(robot: str, q: tuple[float, ...], deg: bool, mm: bool, frame: str, as_json: bool) -> None:
+    """Forward kinematics: pose of FRAME for joint values Q... (one per independent joint)."""
+    import pinocchio as pin
+
+    arm = load_robot(robot)
+    values = vectors_from_args(q)
+    if values.size != arm.nq:
+        raise InvalidInput(
+            f"{arm.name} has {arm.nq} joints ({', '.join(arm.joint_names)}); got {values.size} value(s) for Q"
+        )
+    q_si = joints_to_si(arm, values, deg=deg, mm=mm)
+    T = arm.fk(q_si, frame=frame)
+    rpy = pin.rpy.matrixToRpy(T[:3, :3])
+    pos = T[:3, 3] / length_scale(mm)
+    ang = rpy / angle_scale(deg)
+    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
+    limits_ok = bool(arm.within_limits(q_si))
+    data = {
+        "robot": arm.name,
+        "frame": frame,
+        "q": values,
+        "q_si": q_si,
+        "position": pos,
+        "rpy": ang,
+        "units": {"position": lu, "angles": au},
+        "T": T,
+        "within_limits": limits_ok,
+    }
+    lines = [
+        f"{arm.name}  frame {frame}",
+        f"position [{lu}]: {fmt(pos)}",
+        f"roll pitch yaw [{au}]: {fmt(ang)}",
+        "T (frame → base, SI):",
+        *("  " + "  ".join(f"{v: .6f}" for v in row) for row in T),
+    ]
+    if not limits_ok:
+        lines.append("warning: q is outside the joint limits: " + "; ".join(arm.limit_violations(q_si)))
+    emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- ik
+def _target_pose(pose: np.ndarray, deg: bool, mm: bool) -> np.ndarray:
+    import pinocchio as pin
+
+    if pose.size not in (3, 6):
+        raise InvalidInput(f"give X Y Z or X Y Z ROLL PITCH YAW (3 or 6 numbers), got {pose.size}")
+    T = np.eye(4)
+    T[:3, 3] = pose[:3] * length_scale(mm)
+    if pose.size == 6:
+        T[:3, :3] = pin.rpy.rpyToMatrix(*(pose[3:] * angle_scale(deg)))
+    return T
+
+
+@cli.command("ik", context_settings=NUMBERS)
+@click.argument("robot")
+@click.argument("pose", nargs=-1, type=float, required=True)
+@click.option("--all", "all_solutions", is_flag=True, help="Every analytic solution within the limits.")
+@click.option("--deg", is_flag=True, help="ROLL PITCH YAW and revolute joint output in degrees.")
+@click.option("--mm", is_flag=True, help="X Y Z and prismatic joint output in millimetres.")
+@click.option("--seed-q", default=None, help="Comma-separated start configuration for the numerical solver.")
+@json_option
+def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, mm: bool,
+           seed_q: str | None, as_json: bool) -> None:
+    """Inverse kinematics for the tcp at X Y Z [ROLL PITCH YAW] (base frame).
+
+    With three numbers only the position is asked (orientation free for the numerical
+    solver; with --all the orientation is taken as the base's). With --all every
+    closed-form solution within the joint limits is listed.
+    """
+    arm = load_robot(robot)
+    values = vectors_from_args(pose)
+    T = _target_pose(values, deg, mm)
+    position_only = values.size == 3
+    if all_solutions:
+        if not arm.has_analytic_ik:
+            raise InvalidInput(f"{arm.name} has no closed-form IK; drop --all to use the numerical solver")
+        sols = np.atleast_2d(arm.ik_all(T))
+        if sols.size == 0:
+            sols = np.zeros((0, arm.nq))
+    else:
+        q0 = None
+        if seed_q is not None:
+            start = floats(seed_q, "--seed-q")
+            if start.size != arm.nq:
+                raise InvalidInput(
+                    f"--seed-q needs {arm.nq} values for {arm.name} ({', '.join(arm.joint_names)}), got {start.size}"
+                )
+            q0 = joints_to_si(arm, start, deg=deg, mm=mm)
+        sols = np.atleast_2d(arm.ik(T, q0, position_only=position_only))
+    rows = []
+    for q in sols:
+        T_q = arm.fk(q)
+        rows.append(
+            {
+                "q": joints_from_si(arm, q, deg=deg, mm=mm),
+                "position_error_m": float(np.linalg.norm(T_q[:3, 3] - T[:3, 3])),
+            }
+        )
+    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
+    kinds = ["mm" if (p and mm) else "m" if p else au for p in prismatic_mask(arm)]
+    data = {
+        "robot": arm.name,
+        "target": {"position": values[:3], "rpy": values[3:] if values.size == 6 else None},
+        "units": {"position": lu, "angles": au, "joints": kinds},
+        "joint_names": list(arm.joint_names),
+        "solutions": rows,
+    }
+    header = "  ".join(f"{n}[{u}]" for n, u in zip(arm.joint_names, kinds))
+    lines = [f"{arm.name}: {len(rows)} solution(s)  ({header})"]
+    lines += [f"  {fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m" for r in rows]
+    if not rows:  # only with --all: the numerical solver raises UnreachableTarget instead
+        reason = arm.ik_failure_reason(T)
+        data["reason"] = reason
+        lines.append(f"  none within the joint limits: {reason}")
+    emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- workspace
+@cli.command("workspace")
+@click.argument("robot")
+@click.option("-n", "n", default=20000, show_default=True, type=click.IntRange(min=1), help="Samples.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed.")
+@click.option("--frame", default="tcp", show_default=True)
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Also save the cloud into a session file.")
+@json_option
+def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, as_json: bool) -> None:
+    """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region.
+
+    The region is robots.placement.recommend_region's radial band on the working side of
+    the base plane (distances in the JSON in metres).
+    """
+    arm = load_robot(robot)
+    from pinarms.robots.placement import recommend_region
+    from pinarms.robots.workspace import sample_workspace
+
+    ws = sample_workspace(arm, n=n, seed=seed, frame=frame)
+    summary_obj = ws.summary()
+    summary = jsonable(summary_obj)
+    lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
+    data = {
+        "robot": arm.name,
+        "n": n,
+        "seed": seed,
+        "frame": frame,
+        "bounding_box_m": {"min": lo, "max": hi},
+        "manipulability": {"mean": float(np.mean(ws.manipulability)), "max": float(np.max(ws.manipulability))},
+        "summary": summary,
+    }
+    # the summary's text names robot, frame and samples and gives the bounding box [mm] and
+    # the manipulability: printed once, with the seed added to its first line
+    lines = summary_obj.text().splitlines()
+    lines[0] += f" (seed {seed})"
+    region = recommend_region(ws)
+    data["region"] = {
+        "about": region.about, "origin_m": region.origin, "r_inner_m": region.r_inner, "r_outer_m": region.r_outer,
+        "side": region.side, "z_limit_m": region.z_limit, "criteria": region.criteria,
+    }
+    lines += region.text().splitlines()[:2]
+    if session_path:
+        session = new_session(arm, f"workspace of {arm.name}")
+        session.add_workspace("workspace", ws)
+        save_session(session, session_path, data, lines)
+    emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- layout
+@cli.command("layout", context_settings=NUMBERS)
+@click.argument("robot")
+@click.argument("xyz", nargs=-1, type=float, required=True)
+@click.option("--mm", is_flag=True, help="Positions in and boundary margins out in millimetres.")
+@click.option("--names", default=None, help="Comma-separated labels of the points (default P1, P2, ...).")
+@click.option("-n", "n", default=100_000, show_default=True, type=click.IntRange(min=1),
+              help="Workspace samples for the dexterity median and the boundary margin.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the workspace and IK starts.")
+@json_option
+def layout_cmd(robot: str, xyz: tuple[float, ...], mm: bool, names: str | None, n: int, seed: int,
+               as_json: bool) -> None:
+    """Check a line layout: can ROBOT's tcp reach each pick/place point X Y Z [X Y Z ...] (base frame)?
+
+    Per point: reachable or not, the number of IK branches within the joint limits, the
+    best branch's position manipulability and dexterity ratio (its manipulability over the
+    sampled workspace's median) and the distance to the workspace boundary
+    (robots.check_layout; the tool points down for 6+ joint arms, its yaw is free for
+    fewer). An unreachable point is reported, not an error (exit status 0).
+    """
+    arm = load_robot(robot)
+    from pinarms.robots.workspace import sample_workspace
+
+    values = vectors_from_args(xyz)
+    if values.size % 3:
+        raise InvalidInput(f"give the points as X Y Z triples (a multiple of 3 numbers), got {values.size}")
+    points = values.reshape(-1, 3)
+    labels = None
+    if names is not None:
+        labels = [s.strip() for s in names.split(",")]
+        if len(labels) != len(points) or not all(labels):
+            raise InvalidInput(f"--names needs {len(points)} non-empty comma-separated label(s), got {names!r}")
+    scale = length_scale(mm)
+    ws = sample_workspace(arm, n=n, seed=seed, frame="tcp")
+    report = robots.check_layout(arm, points * scale, names=labels, workspace=ws, seed=seed)
+    lu = "mm" if mm else "m"
+    rows = []
+    for p, given in zip(report.points, points):
+        best_w = float(p.manipulability[p.best]) if p.reachable else 0.0
+        rows.append(
+            {
+                "name": p.name,
+                "position": given,
+                "reachable": p.reachable,
+                "branches": p.n_branches,
+                "solutions": p.n_solutions,
+                "manipulability": best_w,
+                "dexterity_ratio": p.dexterity_ratio,
+                "inverse_condition": float(p.inverse_condition[p.best]) if p.reachable else 0.0,
+                "boundary_margin": p.boundary_margin / scale,
+                "q_best_si": p.solutions[p.best] if p.reachable else None,
+            }
+        )
+    data = {
+        "robot": arm.name,
+        "method": report.method,
+        "n": n,
+        "seed": seed,
+        "units": {"position": lu, "boundary_margin": lu, "manipulability": "SI", "q_best_si": "rad or m"},
+        "median_manipulability": report.median_manipulability,
+        "all_reachable": report.all_reachable,
+        "points": rows,
+    }
+    width = max(8, *(len(r["name"]) for r in rows))
+    position_head = f"position [{lu}]"
+    lines = [
+        (f"{arm.name}: {len(rows)} point(s), {report.method} IK, workspace median manipulability "
+         f"{report.median_manipulability:.4g} ({n} samples, seed {seed})"),
+        f"  {'point':<{width}}  {position_head:<29}  reachable  branches  manipulability  dexterity  margin [{lu}]",
+    ]
+    for r in rows:
+        where = " ".join(f"{v:9.6g}" for v in r["position"])
+        if r["reachable"]:
+            lines.append(f"  {r['name']:<{width}}  {where}  {'yes':>9}  {r['branches']:8d}  {r['manipulability']:14.4g}"
+                         f"  {r['dexterity_ratio']:9.2f}  {r['boundary_margin']:.4g}")
+        else:
+            lines.append(f"  {r['name']:<{width}}  {where}  {'NO':>9}  (no IK solution within the joint limits)")
+    lines.append("all points reachable" if report.all_reachable else
+                 f"{int(np.count_nonzero(~report.reachable))} point(s) NOT reachable: move them or the robot")
+    emit(as_json, data, lines)
+
+

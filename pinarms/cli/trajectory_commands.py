@@ -1,0 +1,364 @@
+"""Joint trajectories through via points: ``plan`` and ``optimize`` (via points from options, CSV or JSON)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from pinarms.robots.errors import InvalidInput
+from pinarms.robots.robot import Robot
+from pinarms.units import (
+    angle_scale,
+    prismatic_mask,
+)
+
+from . import _common as common
+from ._common import (
+    NUMBERS,
+    cli,
+    emit,
+    floats,
+    fmt,
+    joint_scale_at,
+    json_option,
+    load_robot,
+    new_session,
+    save_session,
+    si_limit,
+)
+
+TRAJECTORY_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline", "polynomial", "piecewise")
+OPTIMIZE_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
+
+
+# --------------------------------------------------------------------------- via points
+def read_via_file(path: str) -> dict[str, Any]:
+    """Via points from a JSON or CSV file.
+
+    JSON: ``{"times": [...], "positions": [[...], ...], "kind": ..., "degree": ...}``
+    (``times``/``kind`` optional). CSV: a header row; a column named ``t`` or ``time``
+    holds knot times, every other column is one joint; one row per via point.
+    """
+    file = Path(path)
+    text = file.read_text(encoding="utf-8")
+    if file.suffix.lower() == ".json":
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InvalidInput(f"{path}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
+        if not isinstance(doc, dict) or "positions" not in doc:
+            raise InvalidInput(f"{path}: expected an object with 'positions' (and optional 'times', 'kind')")
+        return _checked_via_doc(doc, path)
+    rows = list(csv.reader(io.StringIO(text)))
+    rows = [r for r in rows if any(c.strip() for c in r)]
+    if len(rows) < 3:
+        raise InvalidInput(f"{path}: a CSV needs a header row and at least two via points")
+    header = [h.strip().lower() for h in rows[0]]
+    try:
+        table = np.array([[float(c) for c in r] for r in rows[1:]], dtype=float)
+    except ValueError:
+        raise InvalidInput(f"{path}: every CSV cell after the header must be a number") from None
+    if table.ndim != 2 or table.shape[1] != len(header):
+        raise InvalidInput(f"{path}: every CSV row must have {len(header)} cells like the header")
+    doc: dict[str, Any] = {}
+    time_cols = [i for i, h in enumerate(header) if h in ("t", "time", "time_s", "t_s")]
+    if time_cols:
+        doc["times"] = table[:, time_cols[0]]
+    joints = [i for i in range(len(header)) if i not in time_cols]
+    doc["positions"] = table[:, joints]
+    doc["joint_names"] = [rows[0][i].strip() for i in joints]
+    return doc
+
+
+def _checked_via_doc(doc: dict[str, Any], path: str) -> dict[str, Any]:
+    """A JSON via-point document with numeric arrays and a known kind, or InvalidInput."""
+    out = dict(doc)
+    for key, ndim in (("positions", 2), ("times", 1)):
+        if out.get(key) is None:
+            continue
+        try:
+            arr = np.asarray(out[key], dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidInput(f"{path}: '{key}' must be {'rows of ' if ndim == 2 else 'a list of '}numbers "
+                               f"(one {'row' if ndim == 2 else 'value'} per via point)") from None
+        if key == "positions" and arr.ndim == 1:
+            arr = arr[:, None]
+        if arr.ndim != ndim:
+            raise InvalidInput(f"{path}: '{key}' must be a {ndim}-D list of numbers, got shape {arr.shape}")
+        out[key] = arr
+    kind = out.get("kind")
+    if kind is not None and kind not in TRAJECTORY_KINDS:
+        raise InvalidInput(f"{path}: unknown 'kind' {kind!r}; use one of {', '.join(TRAJECTORY_KINDS)}")
+    degree = out.get("degree")
+    if degree is not None and (isinstance(degree, bool) or not isinstance(degree, int)):
+        raise InvalidInput(f"{path}: 'degree' must be a whole number (3, 5 or 7), got {degree!r}")
+    return out
+
+
+def _via_input(via: tuple[str, ...], times: str | None, file: str | None) -> tuple[np.ndarray | None, np.ndarray, dict]:
+    """(times or None, positions (m+1, n_joints), extra file options)."""
+    if file and via:
+        raise click.UsageError("give via points either with --via or with --file, not both")
+    extra: dict = {}
+    if file:
+        doc = read_via_file(file)
+        positions = np.asarray(doc["positions"], dtype=float)
+        t = None if doc.get("times") is None else np.asarray(doc["times"], dtype=float)
+        extra = {k: v for k, v in doc.items() if k not in ("positions", "times")}
+    elif via:
+        points = [floats(v, "--via") for v in via]
+        if len({p.size for p in points}) != 1:
+            raise InvalidInput(f"every --via must have the same number of joint values, got sizes {[p.size for p in points]}")
+        positions = np.vstack(points)
+        t = None
+    else:
+        raise click.UsageError("give via points with --via (repeat it, one point each) or --file")
+    if times is not None:
+        t = floats(times, "--times")
+    if positions.ndim == 1:
+        positions = positions[:, None]
+    if positions.shape[0] < 2:
+        raise InvalidInput(f"need at least two via points, got {positions.shape[0]}")
+    return t, positions, extra
+
+
+def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degree: int | None, degrees: str | None):
+    from pinarms import planning
+
+    if kind == "3-5-3":
+        return planning.piecewise_polynomial(times, positions, degrees=(3, 5, 3))
+    if kind == "piecewise":
+        if degrees is None:
+            raise click.UsageError("--kind piecewise needs --degrees, e.g. --degrees 4,3,4")
+        values = floats(degrees, "--degrees")
+        if np.any(values != np.round(values)) or np.any(values < 1):
+            raise click.BadParameter(f"--degrees takes whole polynomial degrees >= 1, got {degrees!r}")
+        degs = tuple(int(d) for d in values)
+        return planning.piecewise_polynomial(times, positions, degrees=degs)
+    if kind == "multi-quintic":
+        return planning.multi_quintic(times, positions)
+    if kind == "quintic-bspline":
+        return planning.quintic_bspline(times, positions)
+    if kind == "polynomial":
+        if degree is None:
+            raise click.UsageError("--kind polynomial needs --degree (3, 5 or 7)")
+        return planning.polynomial(times, positions, degree)
+    raise click.UsageError(f"unknown kind {kind!r}; use one of {', '.join(TRAJECTORY_KINDS)}")
+
+
+def _joint_scale(robot: Robot | None, deg: bool, n_joints: int) -> float | np.ndarray:
+    """SI per user unit of each via-point column (and of its limits).
+
+    Without a robot every joint is taken as revolute: radians per degree with ``--deg``,
+    else 1. With a robot its prismatic joints stay in metres (scale 1) whatever ``--deg``
+    says, and the number of columns must be its number of joints.
+    """
+    if robot is None:
+        return angle_scale(deg)
+    if robot.nq != n_joints:
+        raise InvalidInput(
+            f"{robot.name} has {robot.nq} joints ({', '.join(robot.joint_names)}) but the via points have "
+            f"{n_joints} value(s) each"
+        )
+    return np.where(prismatic_mask(robot), 1.0, angle_scale(deg))
+
+
+def _unit_label(robot: Robot | None, deg: bool) -> str:
+    """Unit of the via-point values: ``deg``, ``deg|m`` (robot with prismatic joints) or ``rad|m``."""
+    if not deg:
+        return "rad|m"
+    return "deg|m" if robot is not None and bool(np.any(prismatic_mask(robot))) else "deg"
+
+
+def _peaks_lines(peaks: Any, scale: float | np.ndarray, unit: str) -> list[str]:
+    return [
+        f"peak |velocity|     [{unit}/s]:   {fmt(np.asarray(peaks.velocity) / scale)}",
+        f"peak |acceleration| [{unit}/s²]:  {fmt(np.asarray(peaks.acceleration) / scale)}",
+        f"peak |jerk|         [{unit}/s³]:  {fmt(np.asarray(peaks.jerk) / scale)}",
+    ]
+
+
+def _peaks_dict(peaks: Any, scale: float | np.ndarray) -> dict:
+    return {
+        "velocity": np.asarray(peaks.velocity) / scale,
+        "acceleration": np.asarray(peaks.acceleration) / scale,
+        "jerk": np.asarray(peaks.jerk) / scale,
+    }
+
+
+def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float | np.ndarray):
+    """Velocity/acceleration/jerk limits (SI) from options, else the robot's velocity limits.
+
+    ``--amax``/``--jmax`` without a velocity limit are a usage error, not silently ignored.
+    """
+    v = si_limit(vmax, "--vmax", scale)
+    a = si_limit(amax, "--amax", scale)
+    j = si_limit(jmax, "--jmax", scale)
+    if v is None and robot is not None:
+        v = robot.velocity_limit
+        if not np.all(v > 0):
+            raise InvalidInput(f"{robot.name}'s URDF gives no velocity limit for every joint; pass --vmax")
+    if v is None and (a is not None or j is not None):
+        raise click.UsageError("--amax/--jmax need a velocity limit too: give --vmax (or --robot)")
+    return v, a, j
+
+
+# --------------------------------------------------------------------------- plan
+@cli.command("plan", context_settings=NUMBERS)
+@click.option("--kind", type=click.Choice(TRAJECTORY_KINDS), default="3-5-3", show_default=True)
+@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
+@click.option("--times", default=None, help="Comma-separated knot times [s], one per via point.")
+@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
+              help="Via points (and times) from a .json or .csv file.")
+@click.option("--degree", type=int, default=None, help="Degree for --kind polynomial.")
+@click.option("--degrees", default=None, help="Per-segment degrees for --kind piecewise, e.g. 4,3,4.")
+@click.option("--deg", is_flag=True,
+              help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
+@click.option("--robot", default=None, help="Take velocity limits from this robot (and store it in the session).")
+@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint, comma-separated.")
+@click.option("--amax", default=None, help="Acceleration limit(s).")
+@click.option("--jmax", default=None, help="Jerk limit(s).")
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Save the trajectory into a session file.")
+@json_option
+def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jmax, session_path, as_json) -> None:
+    """Plan a joint trajectory through via points; print its exact peaks and the limit check.
+
+    Example (seed 000, joint 1): pinarms plan --kind 3-5-3 --deg --times 0,2,4,6
+    --via 55.5 --via 69.7 --via 106.5 --via 124.5 --vmax 55
+    """
+    from pinarms import planning
+
+    if session_path and not robot:
+        raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
+    t, positions, extra = _via_input(via, times, file)
+    if t is None:
+        raise click.UsageError("give knot times with --times (or a 't' column / 'times' key in the file)")
+    if extra.get("kind") and kind == "3-5-3" and extra["kind"] in TRAJECTORY_KINDS:
+        kind = extra["kind"]
+    degree = degree if degree is not None else extra.get("degree")
+    arm = load_robot(robot) if robot else None
+    scale = _joint_scale(arm, deg, positions.shape[1])
+    traj = _build_trajectory(kind, t, positions * scale, degree, degrees)
+    peaks = traj.peaks()
+    unit = _unit_label(arm, deg)
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
+    report = None
+    if v is not None:
+        report = traj.check(planning.JointLimits(v, a, j))
+    data = {
+        "kind": kind,
+        "n_joints": traj.n_joints,
+        "duration_s": traj.duration,
+        "knot_times_s": traj.knot_times,
+        "units": unit,
+        "peaks": _peaks_dict(peaks, scale),
+        "limits_ok": None if report is None else bool(report.ok),
+        "violations": [] if report is None else [
+            {"joint": int(vi[0]), "time_s": float(vi[1]), "kind": str(vi[2]),
+             "value": float(vi[3]) / joint_scale_at(scale, int(vi[0])), "limit": float(vi[4]) / joint_scale_at(scale, int(vi[0]))}
+            for vi in report.violations
+        ],
+    }
+    lines = [
+        f"{kind} trajectory: {traj.n_joints} joint(s), {positions.shape[0]} via points, duration {traj.duration:.6g} s",
+        f"knot times [s]: {fmt(traj.knot_times)}",
+        *_peaks_lines(peaks, scale, unit),
+    ]
+    if report is not None:
+        lines.append("limits: ok" if report.ok else f"limits: {len(report.violations)} violation(s)")
+        lines += [
+            f"  joint {d['joint']} {d['kind']} {d['value']:.6g} > {d['limit']:.6g} at t = {d['time_s']:.4g} s"
+            for d in data["violations"][:10]
+        ]
+    if session_path:
+        session = new_session(arm, f"{kind} trajectory")
+        session.add_trajectory(kind, traj)
+        save_session(session, session_path, data, lines)
+    emit(as_json, data, lines)
+
+
+# --------------------------------------------------------------------------- optimize
+@cli.command("optimize", context_settings=NUMBERS)
+@click.option("--kind", type=click.Choice(OPTIMIZE_KINDS), default="3-5-3", show_default=True)
+@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
+@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
+              help="Via points from a .json or .csv file.")
+@click.option("--deg", is_flag=True,
+              help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
+@click.option("--robot", default=None, help="Take velocity limits from this robot.")
+@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint.")
+@click.option("--amax", default=None, help="Acceleration limit(s).")
+@click.option("--jmax", default=None, help="Jerk limit(s).")
+@click.option("--method", type=click.Choice(["ga", "exact"]), default="ga", show_default=True)
+@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the GA.")
+@click.option("--generations", default=None, type=click.IntRange(min=1), help="Maximum GA generations.")
+@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+              help="Save the optimised trajectory (and GA history) into a session file.")
+@json_option
+def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, session_path, as_json) -> None:
+    """Shortest segment times through via points under velocity/acceleration/jerk limits.
+
+    Example (seed 000): pinarms optimize --kind 3-5-3 --deg --via 55.5 --via 69.7
+    --via 106.5 --via 124.5 --vmax 55
+    """
+    from pinarms import optim
+
+    if session_path and not robot:
+        raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
+    _, positions, _ = _via_input(via, None, file)
+    arm = load_robot(robot) if robot else None
+    scale = _joint_scale(arm, deg, positions.shape[1])
+    unit = _unit_label(arm, deg)
+    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
+    if v is None:
+        raise click.UsageError("give a velocity limit with --vmax (or --robot)")
+    kwargs: dict[str, Any] = {}
+    if generations is not None and method == "ga":
+        kwargs["max_generations"] = generations
+    progress = common.show_progress(as_json) and method == "ga"
+    if progress:
+        budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
+        bar = click.progressbar(length=budget, label="GA generations", file=sys.stderr)
+        bar.__enter__()
+
+        def tick(_state: Any) -> None:
+            bar.update(1)
+
+        kwargs["callback"] = tick
+    try:
+        result = optim.minimize_time(positions * scale, kind, v, a, j, method=method, seed=seed, **kwargs)
+    finally:
+        if progress:
+            bar.__exit__(None, None, None)
+    data = {
+        "kind": kind,
+        "method": result.method,
+        "durations_s": result.durations,
+        "total_s": result.total,
+        "peaks": _peaks_dict(result.peaks, scale),
+        "units": unit,
+        "generations": None if result.history is None else len(getattr(result.history, "best", [])),
+        "wall_time_s": result.wall_time,
+    }
+    lines = [
+        f"{kind}, method {result.method}: total {result.total:.6g} s",
+        f"segment durations [s]: {fmt(result.durations)}",
+        *_peaks_lines(result.peaks, scale, unit),
+    ]
+    if session_path:
+        session = new_session(arm, f"time-optimal {kind}")
+        session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
+        if result.history is not None:
+            session.add_history(f"{kind} GA", result.history)
+        save_session(session, session_path, data, lines)
+    emit(as_json, data, lines)
+
+
