@@ -28,6 +28,7 @@ from .session import (
     PointSet,
     RobotEntry,
     Session,
+    SessionLimits,
     TrajectoryRecord,
     WorkspaceRecord,
     load_session,
@@ -38,6 +39,7 @@ from .viewer import Viewer, show
 __all__ = [
     "Session",
     "load_session",
+    "SessionLimits",
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "RobotEntry",
