@@ -29,7 +29,7 @@ from ._checks import check_seed as _check_seed
 from ._checks import check_tolerance as _check_tolerance
 from .errors import InvalidInput, ModelError
 from .ik.numerical import NumericalIK
-from .ik.solver import split_by_target
+from .ik.solver import LIMIT_TOL, split_by_target
 from .kinematic_tree import KinematicTree
 
 __all__ = ["Robot"]
@@ -51,6 +51,11 @@ class _PerThread(threading.local):
 
 
 _PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
+
+
+def _limit_tolerance(value: Any) -> float:
+    """``limit_tolerance`` checked (a finite distance ≥ 0, rad or m), at least the solvers' own 1e-9."""
+    return max(_check_tolerance(value, "limit_tolerance [rad or m]"), LIMIT_TOL)
 
 
 class Robot:
@@ -416,7 +421,7 @@ class Robot:
         return arr, single
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, limit_tolerance: float = 0.0
     ) -> np.ndarray | list[np.ndarray]:
         """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
 
@@ -427,6 +432,9 @@ class Robot:
             respect_limits: ``False`` returns the geometric solutions whatever the joint
                 limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
+            limit_tolerance: accept solutions up to this far outside a joint's range [rad or
+                m] (returned as they are, never clamped), e.g. a printed pose that needs a
+                joint a rounding error past its limit (see :mod:`robots.ik.near_limits`).
 
         Returns:
             ``(k, nq)`` for one target (``k = 0`` allowed: see :meth:`ik_failure_reason`), a
@@ -437,10 +445,11 @@ class Robot:
             ModelError: the arm has no closed form (use :meth:`ik`).
         """
         T, single, ref = self._analytic_targets(target, q_ref)
+        limit_tol = _limit_tolerance(limit_tolerance)
         if T.shape[0] == 0:
             return []
         if respect_limits:
-            sols = self._analytic_ik.solve(T, ref)
+            sols = self._analytic_ik.solve(T, ref, limit_tol)
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
@@ -561,6 +570,7 @@ class Robot:
         tol: float = 1e-10,
         max_restarts: int = 40,
         seed: int | np.random.Generator | None = 0,
+        limit_tolerance: float = 0.0,
     ) -> np.ndarray:
         """One configuration ``(nq,)`` within the limits whose tcp meets ``target`` within ``tol``.
 
@@ -577,6 +587,9 @@ class Robot:
             tol: required position error [m] and rotation error [rad].
             max_restarts: random restarts after the first attempt.
             seed: seed or generator of the restarts (results are reproducible).
+            limit_tolerance: when no configuration within the limits meets the target,
+                accept one up to this far outside a joint's range [rad or m] (not clamped;
+                a configuration within the limits is always preferred).
 
         Raises:
             InvalidInput: a malformed target or ``q_seed`` (shape, NaN/inf, not a proper
@@ -592,6 +605,7 @@ class Robot:
         if not single:
             raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
         tol = _check_tolerance(tol, "tol [m, rad]", positive=True)
+        limit_tol = _limit_tolerance(limit_tolerance)
         if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
             raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
         _check_seed(seed)
@@ -611,6 +625,10 @@ class Robot:
         )
         if res.success and self.within_limits(res.q):
             return res.q
+        if limit_tol > LIMIT_TOL:
+            q = self._ik_within_tolerance(T[0], seed_q, res.q, position_only, tol, limit_tol)
+            if q is not None:
+                return q
         reason = self.ik_failure_reason(T[0, :3, 3] if position_only else T[0], position_only=position_only)
         raise UnreachableTarget(
             f"robot '{self.name}': no configuration within the joint limits reaches the "
@@ -618,6 +636,25 @@ class Robot:
             f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
             f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
         )
+
+    def _ik_within_tolerance(self, T: np.ndarray, seed_q: np.ndarray | None, best: np.ndarray,
+                             position_only: bool, tol: float, limit_tol: float) -> np.ndarray | None:
+        """A configuration meeting ``T`` within ``tol`` and the limits widened by ``limit_tol``, or None.
+
+        Starts: the closed-form branches within the widened limits, then ``best`` (the
+        strict search's closest configuration); each refined with the joints free.
+        """
+        solver = self._numerical_ik()
+        starts = [best]
+        if self._analytic_ik is not None and not position_only:
+            ref = self.neutral if seed_q is None else seed_q
+            starts = list(self._analytic_ik.starts(T, ref, limit_tol)[:4]) + starts
+        for q in starts:
+            q2, pe, re, _ = solver.attempt(np.array(q, dtype=float), T, position_only, tol, limits=False)
+            q2 = self._wrapped_to_range(q2)
+            if pe <= tol and re <= tol and self.within_limits(q2, tol=limit_tol):
+                return q2
+        return None
 
     # --------------------------------------------------------------- dynamics
     #: The :class:`robots.dynamics.Payload` this robot carries (``None``: the bare arm).

@@ -23,6 +23,8 @@ A sample is *near-singular* when its inverse condition is below
 from __future__ import annotations
 
 import os
+import threading
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -113,7 +115,8 @@ def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]
 
 
 def _positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK
+    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK,
+    progress: Callable[[int, int], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
 
@@ -142,7 +145,12 @@ def _positions_and_dexterity(
             points[start : start + n, a] = p[a]
         w[start : start + n] = wc
         c[start : start + n] = cc
+        if progress is not None:
+            with lock:
+                done[0] += n
+                progress(done[0], N)
 
+    lock, done = threading.Lock(), [0]
     starts = range(0, N, chunk)
     if len(starts) < 2 or _WORKERS == 1:
         for s in starts:
@@ -497,6 +505,7 @@ def sample_workspace(
     seed: int | np.random.Generator | None = 0,
     frame: str = "tcp",
     chunk: int = _CHUNK,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Workspace:
     """Monte Carlo workspace: ``n`` joint vectors uniform within the limits, and their frame origins.
 
@@ -507,6 +516,8 @@ def sample_workspace(
             (``q`` equals ``robot.random_q(n, seed)``).
         frame: frame whose origin is sampled (``"tcp"`` = the robot's tool frame).
         chunk: samples evaluated per block (bounds the working memory).
+        progress: called as ``progress(done, n)`` after each block (from worker threads,
+            one call at a time), e.g. a :class:`pinarms.progress.ProgressBar`.
 
     Raises:
         InvalidInput: ``n`` is not a positive integer, ``chunk`` is not positive, or
@@ -520,7 +531,7 @@ def sample_workspace(
     if not (np.all(np.isfinite(robot.lower)) and np.all(np.isfinite(robot.upper))):
         raise InvalidInput(f"robot '{robot.name}' has unbounded joint limits; sampling needs finite limits")
     q = robot.random_q(int(n), seed=seed)
-    points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk))
+    points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk), progress)
     return Workspace(
         robot=robot,
         frame=frame,
