@@ -77,6 +77,8 @@ def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndar
             raise InvalidLimits(f"{name} is required: give a positive limit per joint (SI units)")
         return None
     try:
+        if np.iscomplexobj(value):
+            raise TypeError("complex numbers")
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InvalidLimits(f"{name}={value!r} is not numeric: give a positive number per "
@@ -138,6 +140,8 @@ class TimingProblem:
                  trajectory_options: dict[str, Any] | None = None,
                  builder: Builder | None = None, torque: Any = None) -> None:
         try:
+            if np.iscomplexobj(positions):
+                raise TypeError("complex numbers")
             q = np.asarray(positions, dtype=float)
         except (TypeError, ValueError):
             raise InvalidInput(f"positions={positions!r} are not numeric: give (m+1,) or "
@@ -321,6 +325,8 @@ class TimingProblem:
             return np.tile([s0 / (20.0 * m), s0 * min(1.0, 4.0 / m) * DEFAULT_UPPER_MARGIN],
                            (m, 1))
         try:
+            if np.iscomplexobj(bounds):
+                raise TypeError("complex numbers")
             b = np.asarray(bounds, dtype=float)
         except (TypeError, ValueError):
             raise InvalidSettings(f"bounds={bounds!r} are not numeric: give (lower, upper) in s, "

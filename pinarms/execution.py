@@ -37,7 +37,14 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["chunk_seeds", "split_count", "map_chunks", "describe_scheduler", "ExecutionError"]
+__all__ = [
+    "chunk_seeds",
+    "split_count",
+    "map_chunks",
+    "reduce_chunks",
+    "describe_scheduler",
+    "ExecutionError",
+]
 
 #: Bits of each chunk seed drawn from the chunk's SeedSequence (two 64-bit words).
 SEED_BITS = 128
@@ -183,35 +190,79 @@ def map_chunks(
     in ``tasks``) and its seed (a task's ``seed`` attribute or ``"seed"`` key) when a task
     raises or its worker dies; the remaining tasks are cancelled and nothing is returned.
     """
+    tasks = list(tasks)
+    results: list = [None] * len(tasks)
+
+    def keep(i, result):
+        results[i] = result
+
+    _run(fn, tasks, keep, scheduler, progress)
+    return results
+
+
+def reduce_chunks(
+    fn: Callable[[Any], Any],
+    tasks: Sequence,
+    combine: Callable[[Any, Any], Any],
+    initial: Any,
+    *,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Any:
+    """``combine(... combine(combine(initial, fn(t0)), fn(t1)) ..., fn(tn))``, folded in task order.
+
+    Like :func:`map_chunks`, but each result is folded into the accumulator as soon as the
+    results of all earlier tasks are folded (a result that arrives early waits, and is
+    dropped once folded), so the memory holds the accumulator and a few results rather than
+    every result. The fold order is the task order whatever the scheduler: floating-point
+    sums come out identical bit for bit. ``combine(acc, result)`` returns the new accumulator
+    (it may update ``acc`` in place and return it) and runs in this process.
+    """
+    if not callable(combine):
+        raise _invalid(f"combine must be callable, got {type(combine).__name__}")
+    tasks = list(tasks)
+    state = {"acc": initial, "next": 0}
+    waiting: dict[int, Any] = {}
+
+    def fold(i, result):
+        waiting[i] = result
+        while state["next"] in waiting:
+            state["acc"] = combine(state["acc"], waiting.pop(state["next"]))
+            state["next"] += 1
+
+    _run(fn, tasks, fold, scheduler, progress)
+    return state["acc"]
+
+
+def _run(fn, tasks, on_result, scheduler, progress) -> None:
     if not callable(fn):
         raise _invalid(f"fn must be callable, got {type(fn).__name__}")
-    tasks = list(tasks)
     kind, arg = _parse_scheduler(scheduler)
     total = len(tasks)
     if progress is not None:
         progress(0, total)
     if kind == "serial" or total == 0:
-        return _map_serial(fn, tasks, progress)
-    if kind == "client":
-        return _map_client(arg, fn, tasks, progress)
-    if kind == "processes":
-        return _map_local_cluster(arg, fn, tasks, progress)
-    return _map_address(arg, fn, tasks, progress)
+        _map_serial(fn, tasks, on_result, progress)
+    elif kind == "client":
+        _map_client(arg, fn, tasks, on_result, progress)
+    elif kind == "processes":
+        _map_local_cluster(arg, fn, tasks, on_result, progress)
+    else:
+        _map_address(arg, fn, tasks, on_result, progress)
 
 
-def _map_serial(fn, tasks, progress):
-    results = []
+def _map_serial(fn, tasks, on_result, progress):
     for index, task in enumerate(tasks):
         try:
-            results.append(fn(task))
+            result = fn(task)
         except Exception as exc:
             raise _failure(index, task, "raised", _one_line(exc)) from exc
+        on_result(index, result)
         if progress is not None:
             progress(index + 1, len(tasks))
-    return results
 
 
-def _map_local_cluster(n_workers, fn, tasks, progress):
+def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
     import warnings
 
     from distributed import Client, LocalCluster
@@ -228,10 +279,10 @@ def _map_local_cluster(n_workers, fn, tasks, progress):
             dashboard_address=None,
         )
     with cluster, Client(cluster) as client:
-        return _map_client(client, fn, tasks, progress)
+        _map_client(client, fn, tasks, on_result, progress)
 
 
-def _map_address(address, fn, tasks, progress):
+def _map_address(address, fn, tasks, on_result, progress):
     import dask
     from distributed import Client
 
@@ -247,10 +298,10 @@ def _map_address(address, fn, tasks, progress):
             cause=_one_line(exc),
         ) from exc
     with client:
-        return _map_client(client, fn, tasks, progress)
+        _map_client(client, fn, tasks, on_result, progress)
 
 
-def _map_client(client, fn, tasks, progress):
+def _map_client(client, fn, tasks, on_result, progress):
     import uuid
 
     from distributed import as_completed
@@ -267,7 +318,6 @@ def _map_client(client, fn, tasks, progress):
     keys = [f"pinarms-{name}-{token}-{i}" for i in range(total)]
     futures = client.map(fn, tasks, key=keys, pure=False)
     index_of = {f.key: i for i, f in enumerate(futures)}
-    results: list = [None] * total
     done = 0
     try:
         for future in as_completed(futures):
@@ -282,12 +332,12 @@ def _map_client(client, fn, tasks, progress):
                 except Exception as exc:
                     raise _failure(i, tasks[i], "raised", _one_line(exc)) from exc
                 raise _failure(i, tasks[i], "failed", future.status)  # pragma: no cover
-            results[i] = future.result()
+            result = future.result()
             future.release()
+            on_result(i, result)
             done += 1
             if progress is not None:
                 progress(done, total)
     finally:
         if done < total:
             client.cancel([f for f in futures if not f.done()])
-    return results

@@ -244,7 +244,10 @@ class Trajectory:
         m = self.n_segments
         seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
         tau = tt - self._breaks[seg]
-        powers = tau[:, None] ** np.arange(self.degree + 1)
+        powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
+        powers[:, 0] = 1.0
+        for k in range(1, self.degree + 1):
+            np.multiply(powers[:, k - 1], tau, out=powers[:, k])
         out = np.empty((tt.size, 4 * n))
         if m == 1:
             np.matmul(powers, D[0], out=out)
@@ -417,8 +420,12 @@ class Trajectory:
         f = scalar(factor, "factor")
         if f <= 0.0:
             raise TrajectoryError(f"factor must be positive, got {factor!r}")
-        breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
-        coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
+            coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        if not (np.all(np.isfinite(breaks)) and np.all(np.isfinite(coefs)) and np.all(np.diff(breaks) > 0.0)):
+            raise TrajectoryError(f"factor {f!r} takes the scaled trajectory beyond float64 (its times or "
+                                  f"coefficients overflow or collapse); use a factor nearer 1")
         return Trajectory(breaks, coefs, {"kind": "scaled", "factor": f, "base": self.definition})
 
     def shifted(self, start_time: float) -> "Trajectory":

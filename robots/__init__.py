@@ -9,12 +9,17 @@ from .errors import (
     ExecutionError,
     InvalidInput,
     LimitViolation,
+    MissingMesh,
     ModelError,
     PinarmsError,
     RobotNotFound,
     UnreachableTarget,
+    XacroArgError,
+    XacroError,
+    XacroForbidden,
+    XacroLimitExceeded,
 )
-from .registry import builtin_names, from_urdf, from_urdf_text, info, load, names
+from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
 from .robot import Robot
 
 __all__ = [
@@ -25,6 +30,7 @@ __all__ = [
     "info",
     "from_urdf",
     "from_urdf_text",
+    "from_xacro",
     "PinarmsError",
     "InvalidInput",
     "RobotNotFound",
@@ -32,6 +38,11 @@ __all__ = [
     "UnreachableTarget",
     "LimitViolation",
     "ExecutionError",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 # workspace analysis and station layout
@@ -40,6 +51,7 @@ from .placement import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
 from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
 from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
+from .workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
 
 __all__ += [
     "Workspace",
@@ -47,6 +59,8 @@ __all__ += [
     "SphereFit",
     "sample_workspace",
     "fit_sphere",
+    "StreamedWorkspace",
+    "stream_workspace",
     "VoxelMap",
     "suggest_voxel_size",
     "RecommendedRegion",
@@ -60,3 +74,8 @@ __all__ += [
 from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
 
 __all__ += ["Payload", "InvalidPayload", "MissingInertials"]
+
+# users' xacro files, expanded behind a wall
+from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
+
+__all__ += ["XacroLimits", "expand_xacro"]

@@ -21,9 +21,11 @@ def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
     Returns the ``(N, width)`` array and whether the input was a single vector.
     """
     try:
+        if np.iscomplexobj(values):
+            raise TypeError("complex numbers")
         arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers, got {values!r}") from exc
+        raise InvalidInput(f"{what} must be numbers (real), got {values!r}") from exc
     single = arr.ndim == 1
     if single:
         arr = arr[None, :]

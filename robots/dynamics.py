@@ -46,6 +46,7 @@ __all__ = [
     "kinetic_energy",
     "potential_energy",
     "total_mass",
+    "holding_torques",
 ]
 
 #: Gravity [m/s²] in the base frame (Pinocchio's default model gravity).
@@ -381,3 +382,53 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
             for i in range(1, model.njoints)
         )
     return float(out[0]) if single else out
+
+
+def holding_torques(
+    robot: "Robot", n: int = 20000, seed: int = 0, accel_time: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Largest torque each joint needs to hold the arm (and its payload) anywhere in its ranges.
+
+    ``max over q within the joint limits of |g_j(q)|`` [N·m or N]: the static load a joint must
+    carry before any acceleration (e.g. a rated payload at full reach). With ``accel_time``
+    [s], the joint must also start from rest to its speed limit in that time at the worst
+    place: ``max_q |g_j(q)| + M_jj(q) v_j / accel_time`` (the usual servo sizing: load torque
+    plus acceleration torque; the other joints at rest). Found by ``n`` seeded uniform samples,
+    the best three per joint refined by a bounded quasi-Newton search.
+
+    Returns:
+        ``(torque (nq,), q (nq, nq))``: the maxima and, row j, the configuration of joint j's.
+    """
+    from scipy.optimize import minimize
+
+    if accel_time is not None and not (isinstance(accel_time, (int, float)) and accel_time > 0.0):
+        raise InvalidInput(f"accel_time must be a positive number of seconds, got {accel_time!r}")
+    alpha = np.zeros(robot.nq) if accel_time is None else np.asarray(robot.velocity_limit, dtype=float) / accel_time
+
+    def demand(q: np.ndarray, j: int) -> np.ndarray:
+        """|g_j| + M_jj alpha_j for rows of q (N, nq)."""
+        g = gravity_torques(robot, q)[:, j]
+        if not alpha[j] > 0.0:
+            return np.abs(g)
+        qdd = np.zeros_like(q)
+        qdd[:, j] = alpha[j]
+        return np.abs(g) + (inverse_dynamics(robot, q, np.zeros_like(q), qdd)[:, j] - g)
+
+    q = robot.random_q(n, seed=seed)
+    best = np.zeros(robot.nq)
+    where = np.tile(robot.neutral, (robot.nq, 1))
+    bounds = list(zip(robot.lower, robot.upper))
+    for j in range(robot.nq):
+        values = demand(q, j)
+        k_best = int(np.argmax(values))
+        best[j], where[j] = values[k_best], q[k_best]
+        if not best[j] > 0.0:
+            continue
+        for k in np.argsort(values)[-3:]:
+            res = minimize(lambda x: -float(demand(x[None], j)[0]), q[k], method="L-BFGS-B",
+                           bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-10, "maxiter": 500})
+            x = np.clip(res.x, robot.lower, robot.upper)
+            value = float(demand(x[None], j)[0])
+            if value > best[j]:
+                best[j], where[j] = value, x
+    return best, where

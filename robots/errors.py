@@ -16,6 +16,11 @@ __all__ = [
     "UnreachableTarget",
     "LimitViolation",
     "ExecutionError",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 
@@ -66,3 +71,23 @@ class ExecutionError(PinarmsError):
 
 def _rebuild_execution_error(message, chunk, seed, cause):
     return ExecutionError(message, chunk=chunk, seed=seed, cause=cause)
+
+
+class XacroError(ModelError):
+    """xacro cannot expand a file: unknown macro, undefined property, malformed XML, missing file."""
+
+
+class XacroForbidden(XacroError):
+    """A xacro file reads outside its allowed folders or uses a construct pinarms refuses."""
+
+
+class XacroLimitExceeded(XacroError):
+    """Expanding a xacro file took too long, needed too much memory or produced too much text."""
+
+
+class XacroArgError(XacroError, InvalidInput):
+    """A xacro argument is not declared by the file, or is not a number where a number is due."""
+
+
+class MissingMesh(ModelError):
+    """A mesh file named by a description does not exist."""

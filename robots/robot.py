@@ -15,6 +15,7 @@ Conventions
 from __future__ import annotations
 
 import math
+from math import isfinite as _isfinite
 import threading
 from pathlib import Path
 from typing import Any
@@ -27,12 +28,15 @@ from ._checks import as_batch as _as_batch
 from ._checks import as_generator as _as_generator
 from ._checks import check_seed as _check_seed
 from ._checks import check_tolerance as _check_tolerance
-from .errors import InvalidInput, ModelError
+from .errors import InvalidInput, ModelError, UnreachableTarget
 from .ik.numerical import NumericalIK
 from .ik.solver import LIMIT_TOL, split_by_target
 from .kinematic_tree import KinematicTree
 
-__all__ = ["Robot"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+
+MAX_RANDOM_SAMPLES = 50_000_000
+"""Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
 
 #: Batches of at most this many configurations are evaluated by one Pinocchio call per
 #: configuration (about 1-2 µs each); larger ones by the batched numpy evaluation, whose
@@ -191,7 +195,7 @@ class Robot:
         """
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64:
             s = q.dot(q)
-            if s - s == 0.0:  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
+            if _isfinite(s):  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
                 return q if self._same_q else self._tree.coordinates.to_pin(q)
         return None
 
@@ -243,6 +247,9 @@ class Robot:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+        if n > MAX_RANDOM_SAMPLES:
+            raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (about "
+                               f"{n * 100 / 1e9:.3g} GB of work); draw several seeded batches instead")
         rng = _as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
@@ -260,7 +267,7 @@ class Robot:
             fid = self.frame_id(frame)  # raises the named error
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined (a call costs as much as the check)
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 pin.forwardKinematics(self.model, data, q)
@@ -316,7 +323,7 @@ class Robot:
             fid = self.frame_id(frame)
         if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
             s = q.dot(q)  # the fast path of _one, inlined
-            if s - s == 0.0:
+            if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
                 return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
@@ -378,10 +385,23 @@ class Robot:
             InvalidInput: wrong shape, non-finite entries, or a rotation block that is not a
                 proper rotation (orthonormal within 1e-6, determinant +1).
         """
+        if target.__class__ is np.ndarray and target.shape == (4, 4) and target.dtype is _F64:
+            m = target.tolist()  # one pose: the checks below in plain floats (numpy calls cost µs each)
+            (a, b, c, x), (d, e, f, y), (g, h, i, z), last = m
+            if all(map(math.isfinite, (a, b, c, d, e, f, g, h, i, x, y, z))) and last == [0.0, 0.0, 0.0, 1.0]:
+                ortho = max(
+                    abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0), abs(g * g + h * h + i * i - 1.0),
+                    abs(a * d + b * e + c * f), abs(a * g + b * h + c * i), abs(d * g + e * h + f * i),
+                )
+                det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+                if ortho <= 1e-6 and det > 0.0:
+                    return target[None], True
         try:
+            if np.iscomplexobj(target):
+                raise TypeError("complex numbers")
             arr = np.asarray(target, dtype=float)
         except (TypeError, ValueError) as exc:
-            raise InvalidInput(f"IK target must be numbers, got {target!r}") from exc
+            raise InvalidInput(f"IK target must be numbers (real), got {target!r}") from exc
         if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
             single = arr.ndim == 1
             pts = arr.reshape(-1, 3)
@@ -421,14 +441,22 @@ class Robot:
         return arr, single
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, limit_tolerance: float = 0.0
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False,
+        limit_tolerance: float = 0.0,
     ) -> np.ndarray | list[np.ndarray]:
-        """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
+        """Every closed-form IK branch within the joint limits (tolerance 1e-9 rad or m), each once.
+
+        A branch (UR-type: shoulder × wrist flip × elbow) is listed once, each revolute angle
+        at its 2π equivalent within the limits nearest ``q_ref``; a branch none of whose
+        equivalents lies within the limits is left out.
 
         Args:
             target: tcp pose ``(4, 4)`` (frame → base, m), or a batch ``(N, 4, 4)``.
             q_ref: ``(nq,)`` or ``(N, nq)``: solutions are sorted by distance to it
-                (default :attr:`neutral`); it also fixes the free joint at singular poses.
+                (default :attr:`neutral`); it also fixes the free joint at singular poses
+                and picks each angle's 2π equivalent.
+            equivalents: also list every other 2π equivalent within the limits (a UR's ±2π
+                joints give up to 2⁶ = 64 rows per branch, about 228 per pose).
             respect_limits: ``False`` returns the geometric solutions whatever the joint
                 limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
@@ -449,7 +477,7 @@ class Robot:
         if T.shape[0] == 0:
             return []
         if respect_limits:
-            sols = self._analytic_ik.solve(T, ref, limit_tol)
+            sols = self._analytic_ik.solve(T, ref, equivalents=bool(equivalents), limit_tol=limit_tol)
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
@@ -572,24 +600,31 @@ class Robot:
         seed: int | np.random.Generator | None = 0,
         limit_tolerance: float = 0.0,
     ) -> np.ndarray:
-        """One configuration ``(nq,)`` within the limits whose tcp meets ``target`` within ``tol``.
+        """A configuration within the limits whose tcp meets ``target`` within ``tol``: ``(nq,)``, or ``(N, nq)`` for a batch.
 
-        Arms with a closed form start from the analytic branches nearest ``q_seed`` (each revolute
-        angle at its 2π equivalent within the limits nearest ``q_seed``), refined and checked by
-        the numerical solver to ``tol``; other arms, and ``position_only`` targets, use
-        damped least squares from ``q_seed`` then seeded random restarts.
+        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`) from
+        ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
+        the target); if that descent fails, arms with a closed form try their analytic
+        branches nearest ``q_seed`` (default :attr:`neutral`; each revolute angle at its 2π
+        equivalent within the limits nearest it), refined by the solver; then seeded random
+        restarts. The answer is the solution the descent reaches, normally the one nearest
+        the start; use :meth:`ik_all` (``q_ref``) for the closed-form branch nearest a
+        configuration. A batch of targets ``(N, 4, 4)`` (or positions ``(N, 3)`` with
+        ``position_only``) is solved at once by batched Levenberg–Marquardt on batched
+        FK and Jacobians (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is
+        then ``(nq,)`` or ``(N, nq)``.
 
         Args:
-            target: tcp pose ``(4, 4)`` frame → base [m]; with ``position_only`` a position
-                ``(3,)`` [m] (or a pose, whose rotation must still be a proper rotation, ignored).
-            q_seed: start ``(nq,)`` (default: the middle of the joint ranges for the numerical
-                solver; :attr:`neutral` for choosing among closed-form branches).
+            target: tcp pose ``(4, 4)`` frame → base [m], or ``(N, 4, 4)``; with
+                ``position_only`` a position ``(3,)`` / ``(N, 3)`` [m] (or a pose, whose
+                rotation must still be a proper rotation, ignored).
+            q_seed: start ``(nq,)`` (or ``(N, nq)`` for a batch).
             tol: required position error [m] and rotation error [rad].
-            max_restarts: random restarts after the first attempt.
+            max_restarts: random restarts after the first attempt (per target).
             seed: seed or generator of the restarts (results are reproducible).
-            limit_tolerance: when no configuration within the limits meets the target,
-                accept one up to this far outside a joint's range [rad or m] (not clamped;
-                a configuration within the limits is always preferred).
+            limit_tolerance: one target: when no configuration within the limits meets it,
+                accept one up to this far outside a joint's range [rad or m] (not clamped; a
+                configuration within the limits is always preferred). Not for batches.
 
         Raises:
             InvalidInput: a malformed target or ``q_seed`` (shape, NaN/inf, not a proper
@@ -598,44 +633,50 @@ class Robot:
             UnreachableTarget: no configuration within the limits found; the message gives the
                 remaining error and says whether the target is out of reach or needs a joint
                 outside its limits. A configuration that misses the target is never returned.
+                For a batch the message names the targets that failed; the exception carries
+                ``solved`` (``(N,)`` bool) and ``q`` (``(N, nq)``, the solved rows valid).
         """
-        from .errors import UnreachableTarget
-
         T, single = self.check_target(target, position_only=position_only)
-        if not single:
-            raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
         tol = _check_tolerance(tol, "tol [m, rad]", positive=True)
-        limit_tol = _limit_tolerance(limit_tolerance)
         if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
             raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
         _check_seed(seed)
+        limit_tol = _limit_tolerance(limit_tolerance)
+        if not single:
+            if limit_tol > LIMIT_TOL:
+                raise InvalidInput("limit_tolerance is for one target; solve a batch within the limits, or one by one")
+            return self._ik_batch(T, q_seed, position_only, tol, int(max_restarts), seed)
         seed_q = None
         if q_seed is not None:
-            seed_q, _ = self.check_q(q_seed)
+            seed_q, one = self.check_q(q_seed)
+            if not one:
+                raise InvalidInput(f"q_seed of one target must have shape ({self.nq},), got {np.shape(q_seed)}")
             seed_q = seed_q[0]
         solver = self._numerical_ik()
-        if self._analytic_ik is not None and not position_only:
-            starts = self._analytic_ik.starts(T[0], self.neutral if seed_q is None else seed_q)
+        T0 = T[0]
+        res = solver._solve(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
+                            polish=False)
+        if res.success:
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        if self._analytic_ik is not None and not position_only:  # closed-form starts: where the first descent failed
+            starts = self._analytic_ik.starts(T0, self.neutral if seed_q is None else seed_q)
             for q in starts[:4]:
-                q2, pe, re, _ = solver.attempt(q, T[0], False, tol)
-                if pe <= tol and re <= tol and self.within_limits(q2):
-                    return q2
+                q2, pe, re, _ = solver.attempt(q, T0, False, tol)
+                if pe <= tol and re <= tol and solver.in_limits(q2):
+                    pe, re = solver.errors(q2, T0, False)
+                    if pe <= tol and re <= tol:
+                        return q2
         res = solver._solve(
-            T[0], seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True
+            T0, seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True,
+            first=False,
         )
         if res.success and self.within_limits(res.q):
-            return res.q
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         if limit_tol > LIMIT_TOL:
-            q = self._ik_within_tolerance(T[0], seed_q, res.q, position_only, tol, limit_tol)
+            q = self._ik_within_tolerance(T0, seed_q, res.q, position_only, tol, limit_tol)
             if q is not None:
                 return q
-        reason = self.ik_failure_reason(T[0, :3, 3] if position_only else T[0], position_only=position_only)
-        raise UnreachableTarget(
-            f"robot '{self.name}': no configuration within the joint limits reaches the "
-            f"{'position' if position_only else 'pose'} within tol = {tol:g} "
-            f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
-            f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
-        )
+        raise UnreachableTarget(self._ik_failure_text(T0, position_only, tol, res))
 
     def _ik_within_tolerance(self, T: np.ndarray, seed_q: np.ndarray | None, best: np.ndarray,
                              position_only: bool, tol: float, limit_tol: float) -> np.ndarray | None:
@@ -655,6 +696,75 @@ class Robot:
             if pe <= tol and re <= tol and self.within_limits(q2, tol=limit_tol):
                 return q2
         return None
+
+    def _ik_failure_text(self, T0: np.ndarray, position_only: bool, tol: float, res) -> str:
+        reason = self.ik_failure_reason(T0[:3, 3] if position_only else T0, position_only=position_only)
+        return (
+            f"robot '{self.name}': no configuration within the joint limits reaches the "
+            f"{'position' if position_only else 'pose'} within tol = {tol:g} "
+            f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
+            f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
+        )
+
+    def _ik_batch(self, T: np.ndarray, q_seed: Any, position_only: bool, tol: float, max_restarts: int, seed) -> np.ndarray:
+        """:meth:`ik` of a checked batch ``T (N, 4, 4)``."""
+        N = T.shape[0]
+        if N == 0:
+            return np.zeros((0, self.nq))
+        seeds = None
+        if q_seed is not None:
+            seeds, _ = self.check_q(q_seed)
+            if seeds.shape[0] not in (1, N):
+                raise InvalidInput(f"q_seed must be one configuration or one per target ({N}), got {seeds.shape[0]}")
+        solver = self._numerical_ik()
+        if self._analytic_ik is not None and not position_only:
+            # closed form first: it pays in batch (all branches of 10⁵ poses/s); each target takes
+            # its branch nearest the seed, projected into the limits (ik_all allows 1e-9), and
+            # keeps it when its FK meets tol; the others go to the batched numerical solver
+            # from that branch (one or two steps) or, without one, from the stored table
+            idx, qs = self._analytic_ik.candidates(T, seeds if seeds is not None else self.neutral[None])
+            q = np.full((N, self.nq), np.nan)
+            if idx.size:
+                first = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
+                q[idx[first]] = np.clip(qs[first], self.lower, self.upper)
+            has = np.flatnonzero(np.isfinite(q[:, 0]))
+            good = np.zeros(N, dtype=bool)
+            if has.size:
+                pe, re = solver.batch_errors(q[has], T[has], False)
+                good[has[(pe <= tol) & (re <= tol)]] = True
+            rest = np.flatnonzero(~good)
+            if rest.size:
+                start = q[rest]
+                if seeds is not None:
+                    miss = ~np.isfinite(start[:, 0])
+                    start[miss] = np.broadcast_to(seeds, (N, self.nq))[rest][miss]
+                res = solver.solve_batch(T[rest], start, position_only=False, tol=tol, max_restarts=max_restarts, seed=seed)
+                q[rest] = res.q
+            ok = self.within_limits(q, tol=0.0)
+            pe, re = solver.batch_errors(q, T, False)
+            ok &= (pe <= tol) & (re <= tol)
+            if ok.all():
+                return q
+            from .ik.numerical import BatchIKResult
+
+            res = BatchIKResult(q, ok, pe, re, 0)
+        else:
+            res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        ok = res.success & self.within_limits(res.q, tol=0.0)
+        if ok.all():
+            return res.q
+        bad = np.flatnonzero(~ok)
+        k = int(bad[0])
+        from .ik.numerical import IKResult
+
+        first = IKResult(res.q[k], False, float(res.position_error[k]), float(res.rotation_error[k]), 1 + max_restarts, 0)
+        exc = UnreachableTarget(
+            f"{bad.size} of {N} targets not solved (indices {bad[:10].tolist()}{' ...' if bad.size > 10 else ''}); "
+            f"target {k}: {self._ik_failure_text(T[k], position_only, tol, first)}"
+        )
+        exc.solved = ok
+        exc.q = res.q
+        raise exc
 
     # --------------------------------------------------------------- dynamics
     #: The :class:`robots.dynamics.Payload` this robot carries (``None``: the bare arm).

@@ -118,3 +118,27 @@ def test_tests_and_benchmarks_import_the_namespace_only():
         if any(n.startswith("top-level") for n in _imported_packages(f))
     )
     assert not offenders, f"import pinarms.robots etc., not top-level robots: {offenders}"
+
+
+def _relative_imports(path: Path) -> set[str]:
+    """Sibling modules a module of ``robots/`` imports (``from .x import``, at any level)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return {
+        node.module.split(".")[0]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
+    }
+
+
+def test_workspace_analysis_modules_import_one_way():
+    """voxels → workspace → workspace_stream, placement, layout: nothing imports back down-up."""
+    above = {
+        "voxels": {"workspace", "workspace_stream", "placement", "layout"},
+        "workspace": {"workspace_stream", "placement", "layout"},
+        "workspace_stream": {"placement", "layout"},
+        "placement": {"layout", "workspace_stream"},
+    }
+    wrong = {
+        m: sorted(_relative_imports(ROOT / "robots" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+    }
+    assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"

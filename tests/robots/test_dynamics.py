@@ -257,3 +257,42 @@ def test_state_shapes_must_agree(aubo):
         aubo.inverse_dynamics(q, np.zeros((2, 6)), np.zeros((3, 6)))
     with pytest.raises(InvalidInput, match="qdd"):
         aubo.inverse_dynamics(q, np.zeros((3, 6)), np.full((3, 6), np.nan))
+
+
+# ------------------------------------------------------------------ the AUBO-i3 model's numbers
+def test_aubo_weighs_the_datasheet_16_kg_with_the_manufacturers_mass_split(aubo):
+    masses = np.array([aubo.model.inertias[i].mass for i in range(aubo.model.njoints)])
+    assert total_mass(aubo) == pytest.approx(16.0, abs=1e-9)
+    manufacturer = np.array([0.97332, 1.173, 2.7791, 1.5214, 0.63348, 0.63348, 0.13713])
+    np.testing.assert_allclose(masses / masses.sum(), manufacturer / manufacturer.sum(), rtol=1e-12)
+
+
+def test_aubo_efforts_follow_the_stated_rule():
+    """Large module = UR5's headroom × the 3 kg holding torque at full reach; small = × 28/150 (docs/robots/aubo_i3.md)."""
+    from pinarms.robots.dynamics import holding_torques
+
+    ur5 = robots.load("ur5")
+    ur5_hold, _ = holding_torques(ur5.with_payload(5.0, frame="tool0"), n=4000)
+    assert ur5_hold[1] == pytest.approx(105.54, abs=0.01)  # 5 kg at the UR5's full reach
+    aubo = robots.load("aubo_i3")
+    hold, q = holding_torques(aubo.with_payload(3.0, frame="flange"), n=4000)
+    assert hold[1] == pytest.approx(54.73, abs=0.01)
+    assert abs(q[1, 1]) == pytest.approx(np.pi / 2, abs=1e-3) and abs(q[1, 2]) < 1e-3  # stretched level
+    large = ur5.effort_limit[1] / ur5_hold[1] * max(hold[1], hold[2])
+    small = large * ur5.effort_limit[3] / ur5.effort_limit[1]
+    np.testing.assert_allclose(aubo.effort_limit, [large] * 3 + [small] * 3, atol=0.05)
+
+
+#: Rated payloads the built-in arms are sized for (docs/robots/*.md): a mushroom bundle with
+#: margin, a flower bunch with margin, one fresh koji block.
+RATED_KG = {"scara_mushroom": 1.0, "gantry_flower": 2.0, "koji_turner": 4.0, "koji_turner_rail": 4.0}
+
+
+@pytest.mark.parametrize("name", sorted(RATED_KG))
+def test_estimated_arms_efforts_follow_the_sizing_rule(name):
+    """Effort = hold the rated payload anywhere and reach top speed from rest in 0.25 s, rounded up."""
+    from pinarms.robots.dynamics import holding_torques
+
+    robot = robots.load(name)
+    demand, _ = holding_torques(robot.with_payload(RATED_KG[name]), n=4000, accel_time=0.25)
+    np.testing.assert_array_equal(robot.effort_limit, np.maximum(np.ceil(demand), 1.0))
