@@ -62,8 +62,9 @@ class DemoResult:
     def rows(self) -> list[Row]:
         return [r for s in self.studies for r in s.rows]
 
-    def table_text(self) -> str:
-        return format_table(self.rows)
+    def table_text(self, width: int | None = None) -> str:
+        """The table for a terminal (``width``: wrap to that many columns; None: one line per row)."""
+        return format_table(self.rows, width=width)
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -660,7 +661,11 @@ STUDIES: dict[str, Callable[[bool], Study]] = {
 
 def run_demo(out_dir: str | Path = "demo-output", *, quick: bool = False, only: Any = None,
              progress: Callable[[str], None] | None = None) -> DemoResult:
-    """Run the studies, write the table, sessions, HTML pages and plots into ``out_dir``."""
+    """Run the studies, write the table, sessions, HTML pages and plots into ``out_dir``.
+
+    ``progress(label)`` is called as each study starts (``"seed 001: running the study"``)
+    and ends (``"seed 001: done"``).
+    """
     from pinarms import viz
 
     out = Path(out_dir)
@@ -690,6 +695,8 @@ def run_demo(out_dir: str | Path = "demo-output", *, quick: bool = False, only: 
                 png = out / "plots" / f"seed{key}_{name}.png"
                 write(png)
                 files.append(png)
+        if progress:
+            progress(f"seed {key}: done")
     result = DemoResult(studies, files, out)
     (out / "table.md").write_text("# paper vs pinarms\n\n" + markdown_table(result.rows) + "\n", encoding="utf-8")
     (out / "table.json").write_text(json.dumps(result.as_dict()["rows"], indent=2), encoding="utf-8")
