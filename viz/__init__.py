@@ -11,9 +11,11 @@
 
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
+from .layout_session import layout_search_session
 from .plots import (
     plot_ga_convergence,
     plot_joint_curves,
+    plot_layout_search,
     plot_tool_speed,
     plot_torques,
     plot_trajectory,
@@ -59,6 +61,8 @@ __all__ = [
     "plot_ga_convergence",
     "plot_workspace",
     "plot_torques",
+    "plot_layout_search",
+    "layout_search_session",
     "SceneInfo",
     "VizError",
     "SessionFormatError",

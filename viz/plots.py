@@ -25,7 +25,8 @@ from pinarms.robots.errors import InvalidInput
 from ._atomic import atomic_write
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
-           "plot_clearance", "plot_schedule", "plot_torques"]
+           "plot_clearance", "plot_schedule", "plot_torques",
+           "plot_layout_search"]
 
 #: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
 #: interval) is drawn without knot markers and lines.
@@ -487,4 +488,56 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
     fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
     if title:
         fig.suptitle(title)
+
+
+def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
+                       mm: bool = True) -> Path:
+    """Picks per minute over the (x, y) placements of a layout search (:class:`optim.LayoutSearch`).
+
+    One square per (x, y) of the candidates, coloured by the best picks/min over their z and
+    yaw; placements where no candidate could run the cycle are grey crosses. The picks
+    (triangles), places (squares), the best grid placement (star) and the refined one
+    (diamond, when the refinement gained) are marked. Line frame; ``mm`` labels millimetres.
+    """
+    if not all(hasattr(result, a) for a in ("candidates", "picks_per_minute", "picks", "places")):
+        raise InvalidInput(f"result must be an optim.LayoutSearch, got {type(result).__name__}")
+    if colormap not in matplotlib.colormaps:
+        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
+    cand = _numbers(result.candidates, "candidates")
+    ppm = _numbers(result.picks_per_minute, "picks per minute")
+    k = 1000.0 if mm else 1.0
+    unit = "mm" if mm else "m"
+    xy, inverse = np.unique(np.round(cand[:, :2], 9), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    best = np.zeros(xy.shape[0])
+    np.maximum.at(best, inverse, ppm)
+    ok = best > 0
+    fig = Figure(figsize=(7.5, 6.0))
+    ax = fig.subplots()
+    size = 36.0 if xy.shape[0] > 400 else 90.0
+    sc = ax.scatter(xy[ok, 0] * k, xy[ok, 1] * k, c=best[ok], cmap=colormap, marker="s", s=size, linewidths=0)
+    if (~ok).any():
+        ax.scatter(xy[~ok, 0] * k, xy[~ok, 1] * k, marker="x", s=size * 0.4, color="0.6", linewidths=1.0,
+                   label="cycle not possible")
+    picks, places = _numbers(result.picks, "picks"), _numbers(result.places, "places")
+    ax.scatter(picks[:, 0] * k, picks[:, 1] * k, marker="^", s=80, color="tab:red", edgecolors="k", label="pick")
+    ax.scatter(places[:, 0] * k, places[:, 1] * k, marker="s", s=80, color="tab:orange", edgecolors="k",
+               label="place")
+    index = getattr(result, "best_index", -1)
+    if index >= 0:
+        ax.scatter([cand[index, 0] * k], [cand[index, 1] * k], marker="*", s=260, color="white", edgecolors="k",
+                   label=f"best grid placement ({ppm[index]:.1f}/min)")
+    refined = getattr(result, "refinement", None)
+    if refined is not None and refined.gain > 0:
+        j = int(np.argmax(refined.picks_per_minute))
+        ax.scatter([refined.placements[j, 0] * k], [refined.placements[j, 1] * k], marker="D", s=90,
+                   color="magenta", edgecolors="k", label=f"refined ({refined.picks_per_minute[j]:.1f}/min)")
+    if ok.any():
+        fig.colorbar(sc, ax=ax, label="picks per minute (best over z, yaw)", shrink=0.85)
+    ax.set_xlabel(f"base x [{unit}]")
+    ax.set_ylabel(f"base y [{unit}]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(title or f"layout search of {getattr(result, 'robot', 'the arm')}: picks per minute by base position")
     return _save(fig, path)
