@@ -26,7 +26,6 @@ Frames and units: positions in metres, angles in radians, times in seconds.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
