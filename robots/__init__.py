@@ -53,3 +53,26 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# reachability maps: tool poses per voxel, orientation sets, HDF5 files
+from .orientations import (  # noqa: E402
+    OrientationSet,
+    so3_orientations,
+    tool_axis_orientations,
+    tool_down_orientations,
+)
+from .reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
+from .reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
+
+__all__ += [
+    "ReachabilityMap",
+    "reachability_map",
+    "reach_bound",
+    "OrientationSet",
+    "so3_orientations",
+    "tool_axis_orientations",
+    "tool_down_orientations",
+    "ReachabilityFileError",
+    "save_reachability",
+    "load_reachability",
+]
