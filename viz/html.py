@@ -18,6 +18,10 @@ def export_html(session: Any, path: str | Path, **scene_options: Any) -> Path:
     animation (play/pause/scrub in the page's Animations panel). ``scene_options`` go to
     :func:`viz.scene.build_scene`. The file is written atomically.
     """
-    html, _ = scene_html(session, **scene_options)
+    html, info = scene_html(session, **scene_options)
+    if info.reachability:  # reachability maps: colour bar and slice slider (viz.reach_overlay)
+        from .reach_overlay import inject_overlay
+
+        html = inject_overlay(html, session, info.reachability)
     data = html.encode("utf-8")
     return atomic_write(path, lambda f: f.write(data))

@@ -9,6 +9,8 @@ Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
 - ``pinarms/paths/<name>`` — the TCP path of a trajectory (``Line``), world frame;
 - ``pinarms/vias/<name>/<i>`` — the TCP at the trajectory's knots (small spheres);
 - ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres).
+- ``pinarms/reachability/<name>/...`` — reachability maps: voxel layers and a colour bar
+  (:mod:`viz.reach_scene`).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
 robot) play together from time 0, sampled at ``fps`` frames per second.
@@ -19,7 +21,7 @@ from __future__ import annotations
 import contextlib
 import io
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import matplotlib
@@ -54,6 +56,7 @@ class SceneInfo:
         n_frames: animation frames.
         fps: animation frame rate (1/s).
         bounds: world bounding box of the content, ((3,), (3,)) m.
+        reachability: reachability map name → scene paths of its voxel layers and colour bar.
     """
 
     robots: dict[str, list[str]]
@@ -66,6 +69,7 @@ class SceneInfo:
     n_frames: int
     fps: float
     bounds: tuple[np.ndarray, np.ndarray]
+    reachability: dict[str, list[str]] = field(default_factory=dict)
 
 
 def colors_by_value(values: np.ndarray, colormap: str = "viridis") -> np.ndarray:
@@ -197,6 +201,10 @@ def build_scene(
         clouds[name] = path
         bounds.append(world)
 
+    from .reach_scene import draw_reachability  # coloured voxel layers and a colour bar per map
+
+    reach_paths = draw_reachability(vis, session, ROOT, bounds)
+
     paths, knots_drawn = {}, {}
     for i, (name, rec) in enumerate(session.trajectories.items()):
         robot = drawings[rec.robot].robot
@@ -266,7 +274,7 @@ def build_scene(
         robots={k: d.geometry_paths for k, d in drawings.items()},
         objects={n: f"{ROOT}/objects/{n}" for n in session.objects},
         clouds=clouds, paths=paths, points=all_points, animated=animated, duration=duration,
-        n_frames=n_frames, fps=float(fps), bounds=(lo, hi),
+        n_frames=n_frames, fps=float(fps), bounds=(lo, hi), reachability=reach_paths,
     )
 
 

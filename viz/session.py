@@ -281,6 +281,7 @@ class Session:
         self.workspaces: dict[str, WorkspaceRecord] = {}
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
+        self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
@@ -503,6 +504,18 @@ class Session:
         self.histories[name] = rec
         return rec
 
+    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        """
+        from .reach_record import make_record
+
+        name = self._free(self.reachability, name, "reachability")
+        rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
+        self.reachability[name] = rec
+        return rec
+
     # ---------------------------------------------------------------- (de)serialisation
     def to_document(self) -> tuple[dict, dict[str, np.ndarray], dict[str, str]]:
         """The ``session.json`` document, the arrays by member name, and the text members."""
@@ -553,6 +566,10 @@ class Session:
              "columns": {k: ref(f"arrays/histories/{i}/{c}.npy", v) for c, (k, v) in enumerate(h.columns.items())}}
             for i, h in enumerate(self.histories.values())
         ]
+        if self.reachability:  # optional: sessions without maps keep their documents unchanged
+            from .reach_record import record_document
+
+            doc["reachability"] = record_document(self.reachability, ref)
         return doc, arrays, texts
 
     def __eq__(self, other: object) -> bool:
@@ -805,4 +822,8 @@ def _read(r: _Reader, package_dirs: Any) -> Session:
         if len({c.shape[0] for c in cols.values()}) != 1:
             raise r.fail(f"{where}.columns have different lengths")
         s.histories[name] = HistoryRecord(name, cols)
+
+    from .reach_record import read_records
+
+    s.reachability = read_records(r, doc, robot_key)
     return s
