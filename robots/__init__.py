@@ -63,6 +63,7 @@ from .orientations import (  # noqa: E402
 )
 from .reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
 from .reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
+from .base_placement import BasePlacements, base_placements, tool_down_poses  # noqa: E402
 
 __all__ += [
     "ReachabilityMap",
@@ -75,4 +76,7 @@ __all__ += [
     "ReachabilityFileError",
     "save_reachability",
     "load_reachability",
+    "BasePlacements",
+    "base_placements",
+    "tool_down_poses",
 ]

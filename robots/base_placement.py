@@ -7,8 +7,8 @@ The arm's base stands on a plane at height ``z`` [m] (world frame), at ``(x, y)`
 :func:`base_placements` answers with the inverse of a :class:`~robots.reachability.ReachabilityMap`
 restricted to bases on the plane:
 
-1. **Candidates.** A grid of ``(x, y)`` (step ``xy_step``, default the map's resolution) over the
-   tasks' bounding box grown by the map's horizontal reach, times yaws every ``yaw_step``.
+1. **Candidates.** A grid of ``(x, y) = (i, j)·xy_step`` (default step: the map's resolution)
+   over the tasks' bounding box grown by the map's horizontal reach, times yaws ``k·yaw_step``.
    A base farther (horizontally) from a task than the farthest reachable voxel of the map is
    dropped at once.
 2. **Map lookups.** For each candidate and task: the voxel of ``T_b``'s position and the set's
@@ -241,8 +241,9 @@ def base_placements(
     reach = _horizontal_reach(reach_map)
     P = T_tasks[:, :3, 3]
     lo, hi = P[:, :2].min(axis=0) - reach, P[:, :2].max(axis=0) + reach
-    xs = lo[0] + step * np.arange(int(np.floor((hi[0] - lo[0]) / step)) + 1)
-    ys = lo[1] + step * np.arange(int(np.floor((hi[1] - lo[1]) / step)) + 1)
+    # grid aligned on multiples of the step (x = i·step, y = j·step)
+    xs = step * np.arange(int(np.ceil(lo[0] / step)), int(np.floor(hi[0] / step)) + 1)
+    ys = step * np.arange(int(np.ceil(lo[1] / step)), int(np.floor(hi[1] / step)) + 1)
     yaws = yaw_step * np.arange(int(np.ceil(2 * np.pi / yaw_step - 1e-9)))
     n_grid = xs.size * ys.size * yaws.size
     if n_grid > MAX_CANDIDATES:
