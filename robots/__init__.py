@@ -6,14 +6,20 @@
 """
 
 from .errors import (
+    ExecutionError,
     InvalidInput,
     LimitViolation,
+    MissingMesh,
     ModelError,
     PinarmsError,
     RobotNotFound,
     UnreachableTarget,
+    XacroArgError,
+    XacroError,
+    XacroForbidden,
+    XacroLimitExceeded,
 )
-from .registry import builtin_names, from_urdf, from_urdf_text, info, load, names
+from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
 from .robot import Robot
 
 __all__ = [
@@ -24,12 +30,19 @@ __all__ = [
     "info",
     "from_urdf",
     "from_urdf_text",
+    "from_xacro",
     "PinarmsError",
     "InvalidInput",
     "RobotNotFound",
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "ExecutionError",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
 ]
 
 # workspace analysis and station layout
@@ -38,6 +51,7 @@ from .placement import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
 from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
 from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
+from .workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
 
 __all__ += [
     "Workspace",
@@ -45,6 +59,8 @@ __all__ += [
     "SphereFit",
     "sample_workspace",
     "fit_sphere",
+    "StreamedWorkspace",
+    "stream_workspace",
     "VoxelMap",
     "suggest_voxel_size",
     "RecommendedRegion",
@@ -53,6 +69,16 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
+from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
+
+__all__ += ["Payload", "InvalidPayload", "MissingInertials"]
+
+# users' xacro files, expanded behind a wall
+from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
+
+__all__ += ["XacroLimits", "expand_xacro"]
 
 # reachability maps: tool poses per voxel, orientation sets, HDF5 files
 from .orientations import (  # noqa: E402

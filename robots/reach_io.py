@@ -47,6 +47,7 @@ from .reachability import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
 
 __all__ = [
     "ReachabilityFileError",
+    "StreamWriter",
     "save_reachability",
     "load_reachability",
     "FORMAT_NAME",
@@ -124,6 +125,85 @@ def _write(h5: Any, m: ReachabilityMap) -> None:
         _write_dataset(g, "manipulability", np.asarray(s.manipulability, dtype="<f8"))
 
 
+def _temporary(path: str | os.PathLike) -> tuple[Path, str]:
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")
+    if target.is_dir():
+        raise InvalidInput(f"cannot write {str(target)!r}: it is a folder; give a file name")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
+    os.close(fd)
+    return target, tmp
+
+
+def _publish(tmp: str, target: Path) -> None:
+    with open(tmp, "rb+") as f:
+        os.fsync(f.fileno())
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, target)
+
+
+class StreamWriter:
+    """Writes a map whose stored solutions arrive chunk by chunk (``reachability_map(out=...)``).
+
+    :meth:`append` adds solutions to extendable, chunked, gzip datasets under ``/poses`` of a
+    temporary file; :meth:`finish` writes the rest of the map and renames the file to its
+    target; :meth:`abort` removes the temporary file. Memory: one chunk's solutions.
+    """
+
+    def __init__(self, path: str | os.PathLike, nq: int) -> None:
+        import h5py
+
+        self.target, self.tmp = _temporary(path)
+        self.nq = int(nq)
+        self.count = 0
+        self.h5 = h5py.File(self.tmp, "w")
+        g = self.h5.create_group("poses")
+        rows = 1 << 16
+        g.create_dataset("voxel", shape=(0,), maxshape=(None,), dtype="<i8", chunks=(rows,), **_GZIP)
+        g.create_dataset("orientation", shape=(0,), maxshape=(None,), dtype="<i4", chunks=(rows,), **_GZIP)
+        g.create_dataset("q", shape=(0, self.nq), maxshape=(None, self.nq), dtype="<f8", chunks=(rows // 8, self.nq),
+                         **_GZIP)
+        g.create_dataset("manipulability", shape=(0,), maxshape=(None,), dtype="<f8", chunks=(rows,), **_GZIP)
+
+    def append(self, voxel: np.ndarray, orientation: np.ndarray, q: np.ndarray, w: np.ndarray) -> None:
+        """Add ``K`` solutions: grid flat indices, orientation indices, ``q (K, nq)``, manipulabilities."""
+        k = int(np.asarray(voxel).size)
+        if k == 0:
+            return
+        g = self.h5["poses"]
+        end = self.count + k
+        for name, data in (("voxel", np.asarray(voxel, "<i8")), ("orientation", np.asarray(orientation, "<i4")),
+                           ("q", np.asarray(q, "<f8").reshape(k, self.nq)), ("manipulability", np.asarray(w, "<f8"))):
+            g[name].resize(end, axis=0)
+            g[name][self.count : end] = data
+        self.count = end
+
+    def finish(self, reach_map: ReachabilityMap) -> Path:
+        """Write the map's other members, close and rename the file; return the target path."""
+        if reach_map.solutions is not None:
+            raise InvalidInput("a streamed map keeps its solutions in the file, not in memory")
+        if self.count != reach_map.n_reached:
+            raise InvalidInput(f"{self.count} solutions were streamed for {reach_map.n_reached} reached poses")
+        _write(self.h5, reach_map)
+        self.h5.close()
+        _publish(self.tmp, self.target)
+        return self.target
+
+    def abort(self) -> None:
+        """Close and remove the temporary file (the target is left as it was)."""
+        try:
+            self.h5.close()
+        finally:
+            try:
+                os.unlink(self.tmp)
+            except FileNotFoundError:
+                pass
+
+
 def save_reachability(reach_map: ReachabilityMap, path: str | os.PathLike) -> Path:
     """Write ``reach_map`` to ``path`` (HDF5, written to a temporary file then renamed); return the path.
 
@@ -135,23 +215,11 @@ def save_reachability(reach_map: ReachabilityMap, path: str | os.PathLike) -> Pa
 
     if not isinstance(reach_map, ReachabilityMap):
         raise InvalidInput(f"save_reachability needs a ReachabilityMap, got {type(reach_map).__name__}")
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")
-    if target.is_dir():
-        raise InvalidInput(f"cannot write {str(target)!r}: it is a folder; give a file name")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
-    os.close(fd)
+    target, tmp = _temporary(path)
     try:
         with h5py.File(tmp, "w") as h5:
             _write(h5, reach_map)
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
+        _publish(tmp, target)
     except BaseException:
         try:
             os.unlink(tmp)

@@ -348,7 +348,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
 def solve_chunk(task: ChunkTask) -> dict:
     """Reachability of one chunk of voxels (the task function of :func:`reachability_map`).
 
-    Returns a dict of arrays: ``reached (n, M)`` bool, ``index (n,)``, ``best (n,)`` (NaN where
+    Returns a dict of arrays: ``voxels (n,)`` (the task's), ``reached (n, M)`` bool, ``index (n,)``, ``best (n,)`` (NaN where
     nothing is reached), ``n_solutions`` (every in-limit solution found, before collisions), and
     with ``keep_solutions`` the reached poses' ``pose_voxel (K,)`` (grid flat index),
     ``pose_orientation (K,)``, ``q (K, nq)`` and ``w (K,)``.
@@ -374,35 +374,40 @@ def solve_chunk(task: ChunkTask) -> dict:
         rows = pose // M
         starts = np.flatnonzero(np.concatenate(([True], rows[1:] != rows[:-1])))
         best[rows[starts]] = np.maximum.reduceat(w, starts)
-    out = {"reached": reached, "index": index, "best": best, "n_solutions": n_all}
+    out = {"voxels": task.voxels, "reached": reached, "index": index, "best": best, "n_solutions": n_all}
     if task.keep_solutions:
         out.update(pose_voxel=task.voxels[pose // M], pose_orientation=(pose % M).astype(np.int32), q=q, w=w)
     return out
 
 
 # ----------------------------------------------------------------------------- execution
-def _map_chunks(fn: Callable, tasks: list, scheduler: Any, progress: Callable[[int, int], None] | None) -> list:
-    """The execution layer's ``map_chunks`` (serial by default, Dask by ``scheduler``)."""
-    if scheduler is None:
-        out = []
-        for i, task in enumerate(tasks):
-            out.append(fn(task))
-            if progress is not None:
-                progress(i + 1, len(tasks))
-        return out
-    try:
-        from distributed import Client
-    except ImportError as exc:  # pragma: no cover - a dependency
-        raise InvalidInput("scheduler needs dask.distributed: pip install 'dask[distributed]'") from exc
-    if not isinstance(scheduler, Client):
-        raise InvalidInput(f"scheduler must be None (serial) or a distributed.Client, got {type(scheduler).__name__}")
-    futures = scheduler.map(fn, tasks, pure=False)
-    out = []
-    for i, f in enumerate(futures):
-        out.append(f.result())
-        if progress is not None:
-            progress(i + 1, len(tasks))
-    return out
+class _Accumulator:
+    """Folds chunk results in task order (:func:`pinarms.execution.reduce_chunks`): per-voxel arrays
+    in memory, the stored solutions in memory or streamed to a file writer, then dropped."""
+
+    def __init__(self, keep_solutions: bool, writer: Any) -> None:
+        self.keep = keep_solutions and writer is None
+        self.writer = writer
+        self.parts: list[dict] = []
+        self.solutions: list[tuple] = []
+        self.round_reachable: list[np.ndarray] = []
+
+    def __call__(self, acc: "_Accumulator", result: dict) -> "_Accumulator":
+        if "q" in result:
+            sol = (result.pop("pose_voxel"), result.pop("pose_orientation"), result.pop("q"), result.pop("w"))
+            if self.writer is not None:
+                self.writer.append(*sol)
+            elif self.keep:
+                self.solutions.append(sol)
+        self.parts.append(result)
+        self.round_reachable.append(result["voxels"][result["index"] > 0])
+        return self
+
+
+def _fold_round(tasks: list, acc: _Accumulator, scheduler: Any, progress: Callable | None) -> None:
+    from pinarms.execution import reduce_chunks
+
+    reduce_chunks(solve_chunk, tasks, acc, acc, scheduler=scheduler, progress=progress)
 
 
 # ----------------------------------------------------------------------------- the map
@@ -761,6 +766,7 @@ def reachability_map(
     self_collision: bool = False,
     collision: Any = None,
     keep_solutions: bool = True,
+    out: Any = None,
     chunk_voxels: int | None = None,
     samples: int | None = None,
     seed: int = 0,
@@ -787,12 +793,18 @@ def reachability_map(
         collision: an object with ``in_collision(q (N, nq)) -> (N,) bool`` (e.g. a cell's
             fixtures); picklable when a cluster runs the map.
         keep_solutions: keep the stored solution of every reached pose (``K·(nq+2)`` numbers).
+        out: an HDF5 file to write the map to, the stored solutions streamed into it chunk by
+            chunk (then the returned map holds no solutions: memory stays flat in the number of
+            voxels but for the per-voxel arrays; read them back with
+            :func:`robots.reach_io.load_reachability`). Written to a temporary file and renamed
+            when complete.
         chunk_voxels: voxels per task (default: about 10⁵ poses for closed forms, 1.5·10³ for
             the numerical solver). The map depends on it only through the numerical warm starts.
         samples: joint samples marking the first voxels (default: 2 per voxel of the bound
             sphere, between 2·10⁵ and 5·10⁶).
         seed: seed of the samples and of the numerical restarts.
-        scheduler: ``None`` (serial, here) or a Dask scheduler (see :mod:`pinarms.execution`).
+        scheduler: ``None`` (serial, here), ``"processes[:N]"``, ``"tcp://HOST:8786"``, ``"env"`` or a
+            ``distributed.Client`` (see :mod:`pinarms.execution`).
         progress: ``progress(voxels_done, voxels_to_do)`` after each chunk (the second number
             grows when a closure round adds voxels).
 
@@ -849,60 +861,75 @@ def reachability_map(
     base = dict(robot=spec, origin=origin, resolution=resolution, shape=shape, rotations=oset.rotations,
                 group=oset.group, n_groups=oset.n_groups, roll_free=oset.roll_free, solver=solver,
                 manipulability=manipulability, restarts=restarts, tol=tol, self_collision=bool(self_collision),
-                collision=collision, keep_solutions=bool(keep_solutions), seed=seed)
+                collision=collision, keep_solutions=bool(keep_solutions) or out is not None, seed=seed)
 
-    todo = _dilate(_seed_voxels(arm, origin, resolution, shape, samples, seed), shape, all_centres_inside)
-    computed = np.zeros(n_grid, dtype=bool)
-    results: list[tuple[np.ndarray, dict]] = []
-    done_voxels, total_voxels, rounds = 0, int(todo.size), 0
-    while todo.size:
-        rounds += 1
-        computed[todo] = True
-        chunks = [todo[s : s + chunk_voxels] for s in range(0, todo.size, chunk_voxels)]
-        tasks = [ChunkTask(voxels=c, **base) for c in chunks]
-        offset = done_voxels
+    writer = None
+    if out is not None:
+        from .reach_io import StreamWriter
 
-        def report(done: int, total: int, _offset=offset, _chunks=chunks) -> None:
-            if progress is not None:
-                progress(_offset + sum(c.size for c in _chunks[:done]), total_voxels)
+        writer = StreamWriter(out, arm.nq)
+    acc = _Accumulator(bool(keep_solutions) or writer is not None, writer)
+    try:
+        todo = _dilate(_seed_voxels(arm, origin, resolution, shape, samples, seed), shape, all_centres_inside)
+        computed = np.zeros(n_grid, dtype=bool)
+        done_voxels, total_voxels, rounds = 0, int(todo.size), 0
+        while todo.size:
+            rounds += 1
+            computed[todo] = True
+            chunks = [todo[s : s + chunk_voxels] for s in range(0, todo.size, chunk_voxels)]
+            tasks = [ChunkTask(voxels=c, **base) for c in chunks]
+            ends = np.cumsum([c.size for c in chunks])
 
-        outs = _map_chunks(solve_chunk, tasks, scheduler, report if progress is not None else None)
-        done_voxels += int(todo.size)
-        results.extend(zip(chunks, outs))
-        reachable = np.concatenate([c[o["index"] > 0] for c, o in zip(chunks, outs)])
-        frontier = _dilate(reachable, shape, all_centres_inside) if reachable.size else np.zeros(0, np.int64)
-        todo = frontier[~computed[frontier]]
-        total_voxels += int(todo.size)
+            def report(done: int, total: int, _offset=done_voxels, _ends=ends) -> None:
+                progress(_offset + (int(_ends[done - 1]) if done else 0), total_voxels)
 
-    return _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, results, dict(
-        seed=seed, chunk_voxels=chunk_voxels, restarts=restarts, tol=tol, self_collision=bool(self_collision),
-        collision=None if collision is None else type(collision).__name__, samples=samples, rounds=rounds,
-        bound_centre=centre.tolist(), bound_radius=radius, keep_solutions=bool(keep_solutions),
-    ), time.perf_counter() - t0, scheduler)
+            acc.round_reachable = []
+            _fold_round(tasks, acc, scheduler, report if progress is not None else None)
+            done_voxels += int(todo.size)
+            reachable = np.concatenate(acc.round_reachable) if acc.round_reachable else np.zeros(0, np.int64)
+            frontier = _dilate(reachable, shape, all_centres_inside) if reachable.size else np.zeros(0, np.int64)
+            todo = frontier[~computed[frontier]]
+            total_voxels += int(todo.size)
+
+        params = dict(
+            seed=seed, chunk_voxels=chunk_voxels, restarts=restarts, tol=tol, self_collision=bool(self_collision),
+            collision=None if collision is None else type(collision).__name__, samples=samples, rounds=rounds,
+            bound_centre=centre.tolist(), bound_radius=radius, keep_solutions=bool(keep_solutions) or writer is not None,
+        )
+        m = _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, acc, params,
+                      time.perf_counter() - t0, scheduler)
+        if writer is not None:
+            writer.finish(m)
+            writer = None
+        return m
+    finally:
+        if writer is not None:
+            writer.abort()
 
 
-def _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, results, params, seconds, scheduler):
+def _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, acc, params, seconds, scheduler):
     M = oset.size
-    if results:
-        voxels = np.concatenate([c for c, _ in results]).astype(np.int64)
-        reached = np.concatenate([o["reached"] for _, o in results]).reshape(-1, M)
-        index = np.concatenate([o["index"] for _, o in results])
-        best = np.concatenate([o["best"] for _, o in results])
-        n_solutions = int(sum(o["n_solutions"] for _, o in results))
+    parts = acc.parts
+    if parts:
+        voxels = np.concatenate([o["voxels"] for o in parts]).astype(np.int64)
+        reached = np.concatenate([o["reached"] for o in parts]).reshape(-1, M)
+        index = np.concatenate([o["index"] for o in parts])
+        best = np.concatenate([o["best"] for o in parts])
+        n_solutions = int(sum(o["n_solutions"] for o in parts))
     else:
         voxels, reached = np.zeros(0, np.int64), np.zeros((0, M), bool)
         index, best, n_solutions = np.zeros(0), np.zeros(0), 0
     order = np.argsort(voxels, kind="stable")
     solutions = None
-    if params["keep_solutions"]:
-        parts = [o for _, o in results]
-        cat = lambda key, dt, shp: (np.concatenate([p[key] for p in parts]).astype(dt) if parts  # noqa: E731
-                                    else np.zeros(shp, dt))
-        solutions = PoseSolutions(cat("pose_voxel", np.int64, (0,)), cat("pose_orientation", np.int32, (0,)),
-                                  cat("q", float, (0, arm.nq)).reshape(-1, arm.nq), cat("w", float, (0,)))
+    if acc.keep:
+        sols = acc.solutions
+        cat = lambda k, dt, shp: (np.concatenate([x[k] for x in sols]).astype(dt) if sols  # noqa: E731
+                                  else np.zeros(shp, dt))
+        solutions = PoseSolutions(cat(0, np.int64, (0,)), cat(1, np.int32, (0,)),
+                                  cat(2, float, (0, arm.nq)).reshape(-1, arm.nq), cat(3, float, (0,)))
     params = dict(params, n_solutions=n_solutions, seconds=seconds,
                   poses_per_second=voxels.size * M / seconds if seconds > 0 else 0.0,
-                  scheduler="serial" if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)))
+                  scheduler=_describe(scheduler))
     return ReachabilityMap(
         robot=arm.name, urdf_sha256=spec.sha256, tcp_frame=arm.tcp_frame, joint_names=tuple(arm.joint_names),
         joint_lower=np.array(arm.lower, dtype=float), joint_upper=np.array(arm.upper, dtype=float), solver=solver,
@@ -911,3 +938,9 @@ def _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape
         reached=np.ascontiguousarray(reached[order]), index=index[order], best_manipulability=best[order],
         solutions=solutions, parameters=params,
     )
+
+
+def _describe(scheduler: Any) -> str:
+    from pinarms.execution import describe_scheduler
+
+    return describe_scheduler(scheduler)

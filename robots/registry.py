@@ -18,7 +18,7 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 
-__all__ = ["load", "names", "from_urdf", "from_urdf_text", "builtin_names", "RobotInfo", "info"]
+__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info"]
 
 
 @dataclass(frozen=True)
@@ -233,6 +233,53 @@ def from_urdf(
         package_dirs=tuple(package_dirs),
         freeze=tuple(freeze),
         description=description,
+    )
+
+
+def from_xacro(
+    path: str | Path,
+    tcp: str | None = None,
+    *,
+    name: str | None = None,
+    packages: dict[str, str | Path] | None = None,
+    limits=None,
+    xacro_args: dict | None = None,
+    **args,
+) -> Robot:
+    """Load a user's xacro file as a :class:`Robot`, expanded behind a wall.
+
+    The file is expanded by :func:`~pinarms.robots.xacro_expand.expand_xacro`: in a child
+    process bounded in time and memory, reading only its own folder and the ``packages``
+    it is given (``$(find pinarms)`` is the built-in arms' macros). Mesh files must lie
+    in those folders too.
+
+    Args:
+        path: the ``.xacro`` file (its ``<robot>`` must describe one arm).
+        tcp: frame used as ``"tcp"`` (default: ``tcp`` if present, else the deepest link).
+        name: robot name (default: the URDF's ``<robot name>``).
+        packages: ``{name: folder}`` for ``$(find name)`` and ``package://name/...``.
+        limits: a :class:`~pinarms.robots.xacro_expand.XacroLimits`.
+        xacro_args: the file's ``xacro:arg`` values, for names that clash with the
+            keywords above; otherwise pass them as keywords (``height=0.8``).
+
+    Raises:
+        XacroForbidden, XacroLimitExceeded, XacroArgError, XacroError: see
+            :func:`~pinarms.robots.xacro_expand.expand_xacro`.
+        MissingMesh: a mesh file named by the URDF does not exist.
+        ModelError: Pinocchio cannot build a model of the result.
+    """
+    from .xacro_expand import check_mesh_files, expand_xacro
+
+    path = Path(path)
+    all_args = {**(xacro_args or {}), **args}
+    result = expand_xacro(path, all_args, packages=packages, limits=limits)
+    pkgs = check_mesh_files(result.urdf_text, path, packages)
+    return from_urdf_text(
+        result.urdf_text,
+        tcp=tcp,
+        name=name,
+        source=str(path),
+        package_dirs=tuple(dict.fromkeys([str(path.resolve().parent), *pkgs])),
     )
 
 

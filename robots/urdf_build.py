@@ -33,6 +33,7 @@ __all__ = [
     "build_file",
     "build_all",
     "stale",
+    "write_atomic",
 ]
 
 #: Folder of the xacro sources (inside the ``robots`` package).
@@ -131,7 +132,8 @@ def build(name: str) -> str:
     return build_file(path, source_label=f"robots/xacro/{path.name}")
 
 
-def _write_atomic(path: Path, text: str) -> None:
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -157,7 +159,7 @@ def build_all(out_dir: str | os.PathLike | None = None) -> list[Path]:
     written = []
     for name, text in texts.items():
         target = urdf_path(name, out_dir)
-        _write_atomic(target, text)
+        write_atomic(target, text)
         written.append(target)
     return written
 

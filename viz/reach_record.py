@@ -2,10 +2,10 @@
 
 A :class:`ReachabilityRecord` keeps what the viewer shows (not the whole map: the HDF5 file
 keeps that): the centres of the voxels whose reachability index exceeds ``min_index``, in
-the robot's base frame [m], their index in [0, 1], their best manipulability, the voxel edge
-[m] and a one-line description of the orientation set. In ``session.json`` it is an entry of
-the optional list ``"reachability"`` (absent when a session holds no map, so older sessions
-are unchanged); its arrays are float64 ``.npy`` members like every other array.
+the robot's base frame [m], their index in (0, 1], their best manipulability, the voxel edge
+[m] and a one-line description of the orientation set. In ``session.json`` it is an item of
+the optional section ``"reachability"`` (a row of :data:`viz.session_format.KINDS`; absent
+when a session holds no map, so older files and readers are unaffected).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["ReachabilityRecord", "make_record", "record_document", "read_records", "MAX_DESCRIPTION"]
+__all__ = ["ReachabilityRecord", "make_record", "encode_reachability", "decode_reachability", "MAX_DESCRIPTION"]
 
 MAX_DESCRIPTION = 2000
 
@@ -48,7 +48,7 @@ def make_record(name: str, robot_key: str, reach_map: Any, min_index: float, flo
     for attr in ("reachable_centres", "best_manipulability", "orientations", "resolution"):
         if not hasattr(reach_map, attr):
             raise InvalidInput(f"reachability {name!r} must be a robots.ReachabilityMap, got {type(reach_map).__name__}")
-    if not (isinstance(min_index, (int, float)) and 0.0 <= float(min_index) < 1.0):
+    if isinstance(min_index, bool) or not (isinstance(min_index, (int, float)) and 0.0 <= float(min_index) < 1.0):
         raise InvalidInput(f"min_index must be a number in [0, 1), got {min_index!r}")
     centres, index = reach_map.reachable_centres(float(min_index))
     if centres.shape[0] == 0:
@@ -64,39 +64,21 @@ def make_record(name: str, robot_key: str, reach_map: Any, min_index: float, flo
     )
 
 
-def record_document(records: dict, ref: Callable) -> list[dict]:
-    """The ``"reachability"`` entries of ``session.json`` (arrays through the session's ``ref``)."""
-    return [
-        {"name": r.name, "robot": r.robot, "resolution": r.resolution, "description": r.description,
-         "centres": ref(f"arrays/reachability/{i}/centres.npy", r.centres),
-         "index": ref(f"arrays/reachability/{i}/index.npy", r.index),
-         "manipulability": ref(f"arrays/reachability/{i}/manipulability.npy", r.manipulability)}
-        for i, r in enumerate(records.values())
-    ]
+def encode_reachability(r: ReachabilityRecord) -> tuple[dict, dict, dict]:
+    """JSON fields, arrays and texts of one record (see :class:`viz.session_format.Kind`)."""
+    return ({"name": r.name, "robot": r.robot, "resolution": r.resolution, "description": r.description},
+            {"centres": r.centres, "index": r.index, "manipulability": r.manipulability}, {})
 
 
-def read_records(reader: Any, doc: dict, robot_key: Callable) -> dict[str, ReachabilityRecord]:
-    """Check and read the optional ``"reachability"`` list of a session document."""
-    entries = doc.get("reachability", [])
-    if not isinstance(entries, list):
-        raise reader.fail("session.reachability must be a list")
-    out: dict[str, ReachabilityRecord] = {}
-    for i, o in enumerate(entries):
-        where = f"reachability[{i}]"
-        name = reader.name(o, where)
-        if name in out:
-            raise reader.fail(f"reachability name {name!r} appears twice")
-        key = robot_key(o, where)
-        res = reader.field(o, "resolution", (int, float), where)
-        if not (math.isfinite(res) and res > 0):
-            raise reader.fail(f"{where}.resolution must be a positive length in m")
-        desc = reader.field(o, "description", str, where)
-        if len(desc) > MAX_DESCRIPTION:
-            raise reader.fail(f"{where}.description is longer than {MAX_DESCRIPTION} characters")
-        centres = reader.array(o, "centres", where, (None, 3))
-        index = reader.array(o, "index", where, (centres.shape[0],))
-        w = reader.array(o, "manipulability", where, (centres.shape[0],))
-        if np.any(index <= 0) or np.any(index > 1) or np.any(w < 0):
-            raise reader.fail(f"{where}: index must lie in (0, 1] and manipulability be >= 0")
-        out[name] = ReachabilityRecord(name, key, centres, index, w, float(res), desc)
-    return out
+def decode_reachability(it: Any) -> ReachabilityRecord:
+    """The record of a validated session item (JSON fields checked here, arrays already read)."""
+    res = it.field("resolution", (int, float))
+    if isinstance(res, bool) or not (math.isfinite(res) and res > 0):
+        raise it.fail(f"{it.where}.resolution must be a positive length in m")
+    desc = it.field("description", str)
+    if len(desc) > MAX_DESCRIPTION:
+        raise it.fail(f"{it.where}.description is longer than {MAX_DESCRIPTION} characters")
+    index, w = it.arrays["index"], it.arrays["manipulability"]
+    if np.any(index <= 0) or np.any(index > 1) or np.any(w < 0):
+        raise it.fail(f"{it.where}: index must lie in (0, 1] and manipulability be >= 0")
+    return ReachabilityRecord(it.key, it.robot, it.arrays["centres"], index, w, float(res), desc)

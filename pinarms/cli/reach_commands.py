@@ -37,7 +37,8 @@ def _progress_printer():
 @click.option("--self-collision", is_flag=True, help="Drop IK solutions where the arm hits itself.")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the samples and IK restarts.")
 @click.option("--scheduler", default=None,
-              help="Where to run the chunks: omit (here, serially), or a Dask scheduler (see `pinarms.execution`).")
+              help="Where to run the chunks: omit (here, serially), processes[:N] (local Dask workers), "
+                   "tcp://HOST:8786 (a Dask cluster) or env (DASK_SCHEDULER_ADDRESS).")
 @click.option("--out", "out_path", default=None, type=click.Path(dir_okay=False),
               help="Save the whole map (every pose and stored solution) to this HDF5 file.")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
@@ -59,7 +60,7 @@ def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: 
     n = orientations if orientations is not None else (50 if cone is None else 16)
     sched = _scheduler(scheduler)
     m = reachability_map(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik, self_collision=self_collision,
-                         seed=seed, keep_solutions=out_path is not None, scheduler=sched,
+                         seed=seed, keep_solutions=False, out=out_path, scheduler=sched,
                          progress=_progress_printer() if show_progress(as_json) else None)
     reach = m.index > 0
     data = {
@@ -82,15 +83,14 @@ def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: 
         "grid_shape": list(m.shape),
     }
     lines = [m.text()]
+    if out_path:
+        data["file"] = out_path
+        lines.append(f"map written: {out_path} (every pose, its stored IK solution streamed chunk by chunk)")
     if m.n_reached == 0 and cone is None and arm.nq < 6:
         note = (f"{arm.name} has {arm.nq} joints: it cannot take arbitrary orientations, so no rotation of an SO(3) set "
                 "is reached; use --tool-down (its tool axis stays vertical)")
         data["note"] = note
         lines.append("note: " + note)
-    if out_path:
-        m.save(out_path)
-        data["file"] = out_path
-        lines.append(f"map written: {out_path}")
     if session_path:
         session = new_session(arm, f"reachability map of {arm.name}")
         session.add_reachability("tool down" if cone is not None else "reachability", m)
@@ -99,13 +99,5 @@ def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: 
 
 
 def _scheduler(text: str | None):
-    """The ``--scheduler`` value as the execution layer takes it (``None``: serial)."""
-    if text is None:
-        return None
-    try:
-        from pinarms.execution import map_chunks  # noqa: F401  (present once the execution layer is installed)
-    except ImportError:
-        from pinarms.robots.errors import InvalidInput
-
-        raise InvalidInput("--scheduler needs pinarms' execution layer (pinarms.execution), which this install lacks") from None
+    """The ``--scheduler`` value as the execution layer takes it (``None``: serial, here)."""
     return text

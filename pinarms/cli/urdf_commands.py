@@ -20,14 +20,33 @@ def urdf_group() -> None:
 
 
 @urdf_group.command("build")
+@click.argument("source", required=False, type=click.Path(dir_okay=False))
+@click.option("--arg", "xacro_args", multiple=True, metavar="NAME=VALUE",
+              help="A xacro:arg value of SOURCE (repeatable).")
+@click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+              help="A folder for $(find NAME) and package://NAME/ in SOURCE (repeatable).")
+@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False),
+              help="Write SOURCE's URDF to this file (default: print it).")
 @click.option("--check", is_flag=True, help="Only check: exit 1 and list the URDFs that differ from their xacro.")
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False),
               help="Write into this folder instead of the urdf/ package.")
 @json_option
-def urdf_build_cmd(check: bool, out_dir: str | None, as_json: bool) -> None:
-    """Regenerate urdf/*.urdf from robots/xacro/*.urdf.xacro."""
+def urdf_build_cmd(source: str | None, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
+                   check: bool, out_dir: str | None, as_json: bool) -> None:
+    """Regenerate urdf/*.urdf from robots/xacro/*.urdf.xacro, or expand a user's SOURCE.xacro.
+
+    SOURCE is expanded behind a wall (docs/cells.md): it may read only its own folder and
+    the --package folders, within a time and memory bound.
+    """
     from pinarms.robots import urdf_build
 
+    if source is not None:
+        if check or out_dir:
+            raise click.UsageError("--check and --out apply to the built-in arms; with SOURCE use -o OUT.urdf")
+        _build_user_xacro(source, xacro_args, packages, output, as_json)
+        return
+    if xacro_args or packages or output:
+        raise click.UsageError("--arg, --package and -o need a SOURCE.xacro file")
     if check:
         stale = urdf_build.stale(out_dir)
         emit(as_json, {"stale": stale}, [f"stale: {name}" for name in stale] or ["all URDFs are up to date"])
@@ -36,6 +55,36 @@ def urdf_build_cmd(check: bool, out_dir: str | None, as_json: bool) -> None:
         return
     written = urdf_build.build_all(out_dir)
     emit(as_json, {"written": [str(p) for p in written]}, [f"wrote {p}" for p in written])
+
+
+def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
+                      as_json: bool) -> None:
+    from pathlib import Path
+
+    from pinarms.robots.urdf_build import write_atomic
+    from pinarms.robots.xacro_expand import check_mesh_files, expand_xacro, parse_xacro_args
+
+    args = parse_xacro_args(xacro_args)
+    pkgs = {}
+    for item in packages:
+        name, sep, folder = item.partition("=")
+        if not sep or not name.strip() or not folder.strip():
+            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
+        pkgs[name.strip()] = folder.strip()
+    header = (f" Generated from {Path(source).name} by `pinarms urdf build` (pinarms). ",)
+    result = expand_xacro(source, args, packages=pkgs, header=header)
+    check_mesh_files(result.urdf_text, source, pkgs)
+    if output is None and not as_json:
+        click.echo(result.urdf_text, nl=False)
+        return
+    if output is not None:
+        write_atomic(Path(output), result.urdf_text)
+    emit(
+        as_json,
+        {"written": output, "args": dict(result.args), "files": list(result.files),
+         **({} if output is not None else {"urdf": result.urdf_text})},
+        [f"wrote {output} (args: {', '.join(f'{k}={v}' for k, v in result.args.items()) or 'none'})"],
+    )
 
 
 @urdf_group.command("export")

@@ -123,9 +123,11 @@ def test_rail_variant_is_the_koji_arm_shifted_by_the_rails():
 
 def test_rail_variant_shares_the_koji_arm_source():
     for variant in ("koji_turner", "koji_turner_rail"):
-        text = (XACRO_DIR / f"{variant}.urdf.xacro").read_text()
+        top = (XACRO_DIR / f"{variant}.urdf.xacro").read_text()
+        assert f'<xacro:include filename="{variant}.xacro"/>' in top  # the arm's own macro
+        text = (XACRO_DIR / f"{variant}.xacro").read_text()
         assert '<xacro:include filename="koji_arm.xacro"/>' in text
-        assert 'name="shoulder"' not in text  # the arm's joints are defined once, in the macro
+        assert 'name="${prefix}shoulder"' not in text  # the arm's joints are defined once, in koji_arm
 
 
 def test_build_all_writes_every_file_atomically(tmp_path):

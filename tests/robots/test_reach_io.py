@@ -201,3 +201,22 @@ def test_an_unknown_filter_is_refused(saved, tmp_path):
 
     with pytest.raises(ReachabilityFileError, match="filter"):
         load_reachability(_edit(saved, tmp_path, scaleoffset))
+
+
+def test_a_streamed_map_file_equals_the_map_built_in_memory(small_map, tmp_path):
+    streamed = reachability_map(robots.load("aubo_i3"), 0.2, 8, out=tmp_path / "streamed.h5")
+    assert streamed.solutions is None
+    assert load_reachability(tmp_path / "streamed.h5").identical(small_map)
+
+
+class _Raises:
+    def in_collision(self, q):
+        raise RuntimeError("collision checker broke")
+
+
+def test_a_failing_chunk_leaves_no_file(tmp_path):
+    from pinarms.robots.errors import ExecutionError
+
+    with pytest.raises(ExecutionError, match="chunk 0.*collision checker broke"):
+        reachability_map(robots.load("aubo_i3"), 0.2, 8, collision=_Raises(), out=tmp_path / "broken.h5")
+    assert list(tmp_path.iterdir()) == []

@@ -61,16 +61,18 @@ def test_bad_reachability_inputs_and_files(reach_session, tmp_path):
         viz.load_session(bad)
 
 
-def test_scene_draws_one_layer_per_height_and_a_colour_bar(reach_session):
-    from pinarms.viz.scene import scene_html
+def test_scene_draws_one_layer_per_height_and_the_page_lists_them(reach_session):
+    from pinarms.viz.html import scene_html
 
     s, m = reach_session
     _, info = scene_html(s)
-    paths = info.reachability["tool down <15°>"]
-    layers = [p for p in paths if "/layers/" in p]
+    layers = info.reachability["tool down <15°>"]
     z = np.unique(np.round(s.reachability["tool down <15°>"].centres[:, 2], 6))
     assert len(layers) == z.size
-    assert paths[-1].endswith("/colorbar")
+    entry = info.page["reachability"][0]
+    assert entry["name"] == "tool down <15°>" and len(entry["colors"]) >= 2
+    assert [layer["path"] for layer in entry["layers"]] == layers
+    assert [layer["z_mm"] for layer in entry["layers"]] == sorted(int(round(v * 1000)) for v in z)
 
 
 @pytest.mark.browser
@@ -98,7 +100,7 @@ def test_standalone_page_has_a_colour_bar_and_a_working_slice_slider(reach_sessi
               return r && r.children[{name!r}] && Object.keys(r.children[{name!r}].children.layers.children).length === {n_layers};
             }}""", timeout=20000)
             title = page.text_content("#pinarms-reach-0")
-            assert name in title and "reachability index" in title
+            assert name in title and "reachability index" in title and "15° cone" in title
             gradient = page.eval_on_selector("#pinarms-reach-0 .pinarms-colorbar", "e => getComputedStyle(e).backgroundImage")
             assert "linear-gradient" in gradient
             kind = page.evaluate(f"""() => viewer.scene_tree.children.meshcat.children.pinarms.children.reachability
