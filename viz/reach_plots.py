@@ -70,8 +70,7 @@ def plot_reachability_section(
     mm = 1000.0
     fig = Figure(figsize=(7.5, 6.0))
     ax = fig.add_subplot(1, 1, 1)
-    cmap = matplotlib.colormaps[INDEX_COLORMAP].copy()
-    cmap.set_bad("white")
+    cmap = matplotlib.colormaps[INDEX_COLORMAP].with_extremes(bad="white")
     mesh = ax.pcolormesh(rho_e * mm, z_e * mm, np.ma.masked_invalid(mean).T, cmap=cmap, vmin=0.0, vmax=1.0,
                          shading="flat")
     cb = fig.colorbar(mesh, ax=ax)
