@@ -22,8 +22,8 @@ Method
    (``Robot.has_analytic_ik``) get *every* branch within the joint limits at once (batched,
    each solution checked by forward kinematics within 1e-9 m / 1e-9 rad); any other URDF gets
    the numerical solver (damped least squares, joint limits, ``restarts`` seeded random
-   restarts after a warm start from the same orientation's solution in the previous voxel of
-   the chunk, or the previous roll of the same direction). Optional collision checks
+   restarts after a warm start from the same orientation's solution in a face-neighbour voxel
+   already solved in the chunk, or the previous roll of the same direction). Optional collision checks
    (``self_collision=True`` and/or ``collision=`` any object with ``in_collision(q (N, nq)) ->
    (N,) bool``, e.g. a cell's fixtures) drop solutions.
 4. **Scores.** Per pose: reached or not, the stored solution (the one with the largest
@@ -78,7 +78,7 @@ MAX_GRID_VOXELS = 200_000_000
 #: Relative tolerance under which two solutions' manipulabilities count as tied.
 TIE_RTOL = 1e-9
 _TIE_ATOL = 1e-15
-_POSES_PER_CHUNK = {"analytic": 100_000, "numerical": 1_500}
+_POSES_PER_CHUNK = {"analytic": 100_000, "numerical": 10_000}
 
 
 # ----------------------------------------------------------------------------- robot specs
@@ -319,18 +319,30 @@ def _solve_analytic(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nda
 
 
 def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """As :func:`_solve_analytic`, one seeded numerical solve per pose (one solution per pose)."""
+    """As :func:`_solve_analytic`, one seeded numerical solve per pose (one solution per pose).
+
+    Warm start of pose ``k`` of a voxel: the solution of pose ``k`` in a face neighbour already
+    solved in this chunk (the voxel below, then behind in y, then in x: voxels come in grid
+    order), else the previous roll of the same direction in this voxel; then ``restarts``
+    random starts drawn by the generator seeded with ``(seed, voxel flat index)``.
+    """
     solver = robot._numerical_ik()
     T = _poses(task)
     n, M = task.voxels.size, task.rotations.shape[0]
     nq = robot.nq
-    warm = np.full((M, nq), np.nan)
+    ny, nz = task.shape[1], task.shape[2]
+    solved: dict[int, np.ndarray] = {}
     poses, qs = [], []
     for r in range(n):
-        rng = np.random.default_rng([task.seed, int(task.voxels[r])])
+        v = int(task.voxels[r])
+        rng = np.random.default_rng([task.seed, v])
+        k_idx = v % nz
+        j_idx = (v // nz) % ny
+        neighbours = [solved.get(u) for u, ok in ((v - 1, k_idx > 0), (v - nz, j_idx > 0), (v - ny * nz, True)) if ok]
+        neighbours = [a for a in neighbours if a is not None]
         here = np.full((M, nq), np.nan)
         for k in range(M):
-            start = warm[k] if np.isfinite(warm[k, 0]) else None
+            start = next((a[k] for a in neighbours if np.isfinite(a[k, 0])), None)
             if start is None and k > 0 and task.group[k] == task.group[k - 1] and np.isfinite(here[k - 1, 0]):
                 start = here[k - 1]  # previous roll of the same direction
             res = solver._solve(T[r * M + k], start, position_only=False, tol=task.tol,
@@ -339,7 +351,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
                 here[k] = res.q
                 poses.append(r * M + k)
                 qs.append(res.q)
-        warm = np.where(np.isfinite(here), here, warm)
+        solved[v] = here
     pose = np.asarray(poses, dtype=np.int64)
     q = np.asarray(qs, dtype=float).reshape(-1, nq)
     return pose, q, _manipulability(robot, q, task.manipulability), int(pose.size)
@@ -798,7 +810,7 @@ def reachability_map(
             voxels but for the per-voxel arrays; read them back with
             :func:`robots.reach_io.load_reachability`). Written to a temporary file and renamed
             when complete.
-        chunk_voxels: voxels per task (default: about 10⁵ poses for closed forms, 1.5·10³ for
+        chunk_voxels: voxels per task (default: about 10⁵ poses for closed forms, 10⁴ for
             the numerical solver). The map depends on it only through the numerical warm starts.
         samples: joint samples marking the first voxels (default: 2 per voxel of the bound
             sphere, between 2·10⁵ and 5·10⁶).
