@@ -15,13 +15,15 @@ Cartesian line's joint image) under constraint objects by reachability analysis 
 :mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
 """
 
+from pinarms.optim.cell_cycle import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
-from pinarms.optim.path_timing import PathTiming, time_optimal
+from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -49,7 +51,11 @@ __all__ = [
     "grid_candidates",
     "random_candidates",
     "time_optimal",
+    "time_scaled",
     "PathTiming",
+    "CellCycleReport",
+    "LineSchedule",
+    "schedule_line",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",

@@ -12,7 +12,15 @@
 from .errors import SessionFormatError, ViewerError, VizError
 from .html import export_html
 from .layout_session import layout_search_session
-from .plots import plot_ga_convergence, plot_joint_curves, plot_layout_search, plot_trajectory, plot_workspace
+from .plots import (
+    plot_ga_convergence,
+    plot_joint_curves,
+    plot_layout_search,
+    plot_tool_speed,
+    plot_torques,
+    plot_trajectory,
+    plot_workspace,
+)
 from .scene import SceneInfo, build_scene
 from .session import (
     FORMAT_NAME,
@@ -22,6 +30,7 @@ from .session import (
     PointSet,
     RobotEntry,
     Session,
+    SessionLimits,
     TrajectoryRecord,
     WorkspaceRecord,
     load_session,
@@ -32,6 +41,7 @@ from .viewer import Viewer, show
 __all__ = [
     "Session",
     "load_session",
+    "SessionLimits",
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "RobotEntry",
@@ -47,8 +57,10 @@ __all__ = [
     "build_scene",
     "plot_joint_curves",
     "plot_trajectory",
+    "plot_tool_speed",
     "plot_ga_convergence",
     "plot_workspace",
+    "plot_torques",
     "plot_layout_search",
     "layout_search_session",
     "SceneInfo",

@@ -19,6 +19,8 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     cycle_commands,
     demo_command,
     layout_commands,
+    line_commands,
+    reach_commands,
     robot_commands,
     session_commands,
     trajectory_commands,

@@ -19,8 +19,8 @@ from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
 __all__ = ["cli", "main", "json_option", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
-           "show_progress", "load_robot", "floats", "si_limit", "vectors_from_args", "joint_scale_at",
-           "new_session", "save_session", "scheduler_option", "progress_bar"]
+           "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
+           "joint_scale_at", "new_session", "save_session", "scheduler_option"]
 
 # numbers may be negative: "-0.5" must reach the command as a value, not as an option
 NUMBERS = {"ignore_unknown_options": True}
@@ -88,7 +88,26 @@ def fmt(values: Any, digits: int = 6) -> str:
 
 def show_progress(as_json: bool) -> bool:
     """Progress bars only for a person at a terminal, never in machine-readable output."""
-    return (not as_json) and sys.stderr.isatty()
+    from pinarms.progress import wanted
+
+    return wanted(as_json, sys.stderr)
+
+
+def progress_bar(label: str, total: int | None, as_json: bool):
+    """A :class:`pinarms.progress.ProgressBar` on stderr, drawn only when :func:`show_progress` says so."""
+    from pinarms.progress import ProgressBar
+
+    return ProgressBar(label, total, enabled=show_progress(as_json), stream=sys.stderr)
+
+
+def terminal_width() -> int | None:
+    """Columns of the terminal stdout writes to (``COLUMNS`` if set); ``None`` for a pipe or a file."""
+    import os
+    import shutil
+
+    if not (sys.stdout.isatty() or os.environ.get("COLUMNS")):
+        return None
+    return max(40, shutil.get_terminal_size().columns)
 
 
 def load_robot(name: str) -> Robot:
@@ -159,7 +178,6 @@ scheduler_option = click.option(
          "(local worker processes). Default: serially here, or DASK_SCHEDULER_ADDRESS when it is set.")
 
 
-
 def new_session(robot: Robot | str | None, title: str):
     """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
     from pinarms import viz
@@ -174,37 +192,3 @@ def save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
     lines.append(f"session written: {path}")
 
 
-
-
-class progress_bar:  # noqa: N801  (used like a function in a with-statement)
-    """A click progress bar on stderr fed by ``callback(done, total)`` (pinarms.execution's progress).
-
-    Shown only for a person at a terminal (:func:`show_progress`); ``callback`` is None otherwise.
-    """
-
-    def __init__(self, as_json: bool, label: str) -> None:
-        self.enabled = show_progress(as_json)
-        self.label = label
-        self._bar = None
-        self._done = 0
-
-    def __enter__(self) -> "progress_bar":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        if self._bar is not None:
-            self._bar.__exit__(*exc)
-
-    @property
-    def callback(self):
-        if not self.enabled:
-            return None
-
-        def update(done: int, total: int) -> None:
-            if self._bar is None:
-                self._bar = click.progressbar(length=max(total, 1), label=self.label, file=sys.stderr)
-                self._bar.__enter__()
-            self._bar.update(done - self._done)
-            self._done = done
-
-        return update
