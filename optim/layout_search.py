@@ -170,6 +170,38 @@ class _Settings:
     amax: Any
     jmax: Any
     seed: int
+    cell: "_CellRecipe | None" = None
+
+
+@dataclass(frozen=True)
+class _CellRecipe:
+    """How a worker rebuilds the cell (a Cell holds coal objects that do not pickle)."""
+
+    token: str
+    urdf_text: str
+    source: str
+    base_dir: str
+    packages: tuple[tuple[str, str], ...]
+    args: tuple[tuple[str, str], ...]
+    seed: int
+    arm: str
+    carry: tuple[str, ...]
+    clearance: float
+
+
+#: Cells by search token in this process (the caller's own cell, or one rebuilt from its recipe).
+_CELLS: dict[str, Any] = {}
+
+
+def _cell_of(recipe: _CellRecipe) -> Any:
+    if recipe.token not in _CELLS:
+        from pinarms.robots.cell import Cell
+
+        if len(_CELLS) >= 2:
+            _CELLS.pop(next(iter(_CELLS)))
+        _CELLS[recipe.token] = Cell(recipe.urdf_text, source=recipe.source, base_dir=recipe.base_dir,
+                                    packages=dict(recipe.packages), args=dict(recipe.args), seed=recipe.seed)
+    return _CELLS[recipe.token]
 
 
 @dataclass(frozen=True)
@@ -205,13 +237,22 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
     picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
     places_b = points_in_base_frame(st.places, placement[None, :])[0]
     R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
+    in_cell: dict[str, Any] = {}
+    if st.cell is not None:
+        try:
+            moved = _cell_of(st.cell).with_arm_base(st.cell.arm, base_to_world(placement), carry=st.cell.carry)
+        except PinarmsError as exc:
+            return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
+                            f"the cell cannot hold the arm there: {exc}"), None
+        robot = moved.arm(st.cell.arm).robot
+        in_cell = {"cell": moved, "arm": st.cell.arm, "clearance": st.cell.clearance}
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
         for j, place in enumerate(places_b):
             spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
             try:
                 cycle = plan_cycle(robot, spec, kind=st.kind, vmax=st.vmax, amax=st.amax, jmax=st.jmax,
-                                   method="exact", seed=st.seed)
+                                   method="exact", seed=st.seed, **in_cell)
             except PinarmsError as exc:
                 where = f"pick {i + 1} → place {j + 1}"
                 return _Outcome(_classify(exc), f"{where}: {exc}"), None
@@ -553,11 +594,20 @@ def search_layout(
     chunk_size: int = 4,
     scheduler: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    arm: str | None = None,
+    clearance: float = 0.02,
+    carry: tuple[str, ...] = (),
 ) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
-        robot: a :class:`robots.Robot` (the arm to place).
+        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
+            then the arm ``arm`` of the cell (its only arm by default) is moved among the
+            cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
+            the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
+            must keep ``clearance`` [m] from the fixtures and the other arms
+            (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
+            points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
         picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
             paired with every place.
         candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
@@ -580,8 +630,32 @@ def search_layout(
         InvalidSettings: unknown ``kind``.
         ExecutionError: a task failed on the scheduler (chunk index named).
     """
+    import uuid
+
     from pinarms.execution import map_chunks
     from pinarms.robots.workspace import sample_workspace
+
+    token = uuid.uuid4().hex
+    recipe = None
+    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
+        cell = robot
+        if arm is None:
+            if len(cell.arms) != 1:
+                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
+            arm = cell.arms[0].name
+        robot = cell.arm(arm).robot
+        if not (isinstance(clearance, (int, float, np.integer, np.floating)) and np.isfinite(clearance)
+                and clearance >= 0):
+            raise InvalidInput(f"clearance must be a distance >= 0 in m, got {clearance!r}")
+        for name in carry:
+            cell.fixture(name)
+        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
+                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
+                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
+                             tuple(carry), float(clearance))
+        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+    elif arm is not None or carry:
+        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
 
     picks_w, places_w = _points(picks, "picks"), _points(places, "places")
     cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
@@ -601,14 +675,11 @@ def search_layout(
                 or np.linalg.det(R) < 0:
             raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
     PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
-    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed))
+    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
     M = cand.shape[0]
 
     failure, reason = _screen(robot, cand, st)
     todo = [m for m in range(M) if not failure[m]]
-    import uuid
-
-    token = uuid.uuid4().hex
     tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
     n_refine = int(refine)
     total = len(tasks) + n_refine

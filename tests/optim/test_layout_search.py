@@ -120,3 +120,23 @@ def test_bad_input(scara, points):
         search_layout(scara, [1, 2], place, np.zeros((1, 4)))
     with pytest.raises(InvalidInput, match="lift"):
         search_layout(scara, pick, place, np.zeros((1, 4)), lift=0.0)
+
+
+@pytest.mark.slow
+def test_in_a_cell_a_candidate_that_collides_fails_as_collision():
+    from pinarms.robots.cell import load_cell
+
+    station = load_cell("aubo_food_station")
+    pick, place = np.array([0.36, 0.0, 0.75]), np.array([0.0, -0.42, 0.77])
+    # the cell's own placement; 250 mm towards the crate (the shoulder in the crate wall); out of reach
+    cand = np.array([[0.0, 0.0, 0.7, 0.0], [0.0, -0.25, 0.7, 0.0], [0.9, 0.0, 0.7, 0.0]])
+    res = search_layout(station, pick, place, cand, refine=0, carry=("stand",), workspace_samples=20_000)
+    assert res.failure == ("", "collision", "unreachable")
+    assert "crate_wall" in res.reason[1] and "clearance 20.0 mm" in res.reason[1]
+    arm = station.arm("aubo")
+    direct = optim.plan_cycle(arm.robot, optim.PickPlace(arm.to_base(pick), arm.to_base(place)), cell=station,
+                              clearance=0.02)
+    assert res.cycle_time[0] == pytest.approx(direct.cycle_time, rel=1e-12) and direct.cell_report.extra_time > 0
+    assert res.best_cycle.cell_report.lift == direct.cell_report.lift
+    with pytest.raises(InvalidInput, match="carry"):
+        search_layout(robots.load("aubo_i3"), pick, place, cand, carry=("stand",))
