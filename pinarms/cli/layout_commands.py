@@ -140,5 +140,5 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
 
         if res.best_placement is None:
             raise InvalidInput("no placement runs the cycle: there is no best placement to save in a session")
-        save_session(viz.layout_search_session(res, arm), session_path, data, lines)
+        save_session(viz.layout_search_session(res, arm, cell=cell, carry=tuple(carry)), session_path, data, lines)
     emit(as_json, data, lines)
