@@ -50,6 +50,7 @@ __all__ = [
     "map_chunks",
     "reduce_chunks",
     "describe_scheduler",
+    "task_threads",
     "ExecutionError",
 ]
 
@@ -64,6 +65,21 @@ def __getattr__(name: str):
 
         return ExecutionError
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def task_threads() -> int | None:
+    """Threads a task may start itself: 1 inside a Dask worker (a worker per core already
+    uses the cores), ``None`` (the caller's default) in this process. Never changes results."""
+    import sys
+
+    distributed = sys.modules.get("distributed")  # a worker has it imported; never import it here
+    if distributed is None:
+        return None
+    try:
+        distributed.get_worker()
+    except ValueError:
+        return None
+    return 1
 
 
 def _invalid(message: str) -> Exception:

@@ -243,12 +243,15 @@ def _run_task(task: WorkspaceTask) -> _Reduction:
     """Evaluate one task's samples block by block; return its reduction (voxels shipped sparse)."""
     acc = _Reduction()
     robot, spec = task.robot, task.spec
+    from pinarms.execution import task_threads
+
+    threads = task_threads()
     rng = _generator_at(robot, task.seed, task.start)
     done = 0
     while done < task.count:
         m = min(spec.block, task.count - done)
         q = rng.uniform(robot.lower, robot.upper, size=(m, robot.nq))
-        P, w, c = _positions_and_dexterity(robot, q, spec.frame)
+        P, w, c = _positions_and_dexterity(robot, q, spec.frame, threads=threads)
         _add_block(acc, P, w, c, spec)
         done += m
     acc.vox_sparse = _sparse_voxels(acc)
