@@ -75,7 +75,7 @@ def child_workspace(scheduler: str | None, n: int) -> dict:
 
     arm = robots.load("aubo_i3")
     t0 = time.perf_counter()
-    s = stream_workspace(arm, n, seed=0, scheduler=scheduler)
+    s = stream_workspace(arm, n, seed=0, voxel_size=0.01, scheduler=scheduler)  # one grid for every n
     wall = time.perf_counter() - t0
     v = s.voxels
     return {"wall_s": wall, "n": n, "voxel_mm": v.voxel_size * 1000, "voxels": list(v.shape),
