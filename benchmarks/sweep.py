@@ -120,6 +120,17 @@ def child_station(quick: bool) -> dict:
         r = np.linalg.norm(b - centre, axis=1)
         inside += int(np.all((b[:, 2] > 0) & (r > 0.2) & (r < 0.5)))
     out["planned_inside_band"] = inside
+    # the best placement whose points keep 100 mm from the workspace edge (min_margin=0.1 would
+    # rule the others out before planning: the same answer)
+    kept = [i for i in res.order if res.ok[i] and res.margin[i] >= 0.1]
+    if kept:
+        i = kept[0]
+        b = points_in_base_frame(np.vstack([p1, place]), cand[i][None])[0]
+        out["best_margin_100"] = {"placement": cand[i].tolist(), "ppm": float(res.picks_per_minute[i]),
+                                  "margin_mm": float(res.margin[i] * 1000),
+                                  "z_mm": (b[:, 2] * 1000).tolist(),
+                                  "r_centre_mm": (np.linalg.norm(b - centre, axis=1) * 1000).tolist()}
+    out["best_margin_mm"] = float(res.margin[res.best_index] * 1000)
     top = res.order[:20]
     out["top20_inside_band"] = int(sum(
         np.all([(bb[2] > 0) and 0.2 < np.linalg.norm(bb - centre) < 0.5
@@ -180,7 +191,14 @@ def bench_station(quick: bool) -> None:
               f"(horizontal {p['r_axis_mm']:.0f} mm): {'inside' if inside else 'outside'} the paper's band "
               "(z > 0, 200 < r < 500 mm)")
     print(f"  planned placements with both points in the band: {r['planned_inside_band']} of {r['planned']}; "
-          f"among the 20 best: {r['top20_inside_band']}")
+          f"among the 20 best: {r['top20_inside_band']}; the best's points are {r['best_margin_mm']:.0f} mm from "
+          "the workspace edge")
+    m = r.get("best_margin_100")
+    if m:
+        x, y, z, _ = m["placement"]
+        print(f"  best with both points >= 100 mm from the workspace edge: base at ({x * 1000:.0f}, {y * 1000:.0f}, "
+              f"{z * 1000:.0f}) mm, {m['ppm']:.2f} picks/min; P1, P4 at z {m['z_mm'][0]:.0f}, {m['z_mm'][1]:.0f} mm, "
+              f"r {m['r_centre_mm'][0]:.0f}, {m['r_centre_mm'][1]:.0f} mm from (0, 0, 160) mm")
 
 
 def main(argv: list[str]) -> None:

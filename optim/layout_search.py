@@ -55,7 +55,7 @@ __all__ = [
 ]
 
 #: Why a candidate fails, in the order they are checked.
-FAILURES = ("unreachable", "joint limit", "collision", "timing")
+FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing")
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
 _PPM_RTOL = 1e-9
@@ -353,6 +353,8 @@ class Refinement:
         picks_per_minute: ``(k,)`` picks/min there.
         evaluations: ``(k,)`` cycles planned by each search.
         free: names of the coordinates searched (those the candidates vary).
+        margin: ``(k,)`` boundary margin [m] of each refined placement; one below the
+            search's ``min_margin`` is reported but never taken as the best placement.
     """
 
     starts: np.ndarray
@@ -361,6 +363,7 @@ class Refinement:
     picks_per_minute: np.ndarray
     evaluations: np.ndarray
     free: tuple[str, ...]
+    margin: np.ndarray | None = None
 
     @property
     def gain(self) -> float:
@@ -498,6 +501,7 @@ class LayoutSearch:
                 "placements": r.placements.tolist(),
                 "picks_per_minute": r.picks_per_minute.tolist(),
                 "evaluations": r.evaluations.tolist(),
+                "boundary_margin_m": None if r.margin is None else r.margin.tolist(),
                 "gain_picks_per_minute": r.gain,
             }
         return out
@@ -597,6 +601,7 @@ def search_layout(
     arm: str | None = None,
     clearance: float = 0.02,
     carry: tuple[str, ...] = (),
+    min_margin: float = 0.0,
 ) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
@@ -616,6 +621,9 @@ def search_layout(
             :func:`optim.plan_cycle`).
         orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
             the robot's (tool down for six-axis arms), in its base frame.
+        min_margin: smallest boundary margin [m] a pick or place may have; candidates below
+            fail as ``"boundary"`` before any cycle is planned (0: no such rule). The fastest
+            cycles are often near the edge of the workspace, where the arm is stretched.
         refine: how many of the best candidates start a continuous search (0: none).
         refine_evaluations: cycles each continuous search may plan.
         workspace_samples: samples of the workspace whose voxel map gives the boundary margins.
@@ -675,10 +683,25 @@ def search_layout(
                 or np.linalg.det(R) < 0:
             raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
     PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
+    if not (isinstance(min_margin, (int, float, np.integer, np.floating)) and np.isfinite(min_margin)
+            and min_margin >= 0):
+        raise InvalidInput(f"min_margin must be a distance >= 0 in m, got {min_margin!r}")
     st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
     M = cand.shape[0]
 
     failure, reason = _screen(robot, cand, st)
+    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
+    vmap = ws.voxel_map()
+    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
+    point_margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1)
+    margin = point_margin.min(axis=1)
+    if min_margin > 0:
+        names = [f"pick {i + 1}" for i in range(len(picks_w))] + [f"place {j + 1}" for j in range(len(places_w))]
+        for m in np.flatnonzero((margin < min_margin) & np.array([not f for f in failure])):
+            k = int(np.argmin(point_margin[m]))
+            failure[m] = "boundary"
+            reason[m] = (f"{names[k]} is {point_margin[m, k] * 1e3:.0f} mm from the edge of the workspace, "
+                         f"less than min_margin {min_margin * 1e3:.0f} mm")
     todo = [m for m in range(M) if not failure[m]]
     tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
     n_refine = int(refine)
@@ -700,10 +723,6 @@ def search_layout(
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
 
-    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
-    vmap = ws.voxel_map()
-    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
-    margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1).min(axis=1)
     order = _ranking(ppm, margin)
 
     refinement = None
@@ -723,9 +742,13 @@ def search_layout(
             picks_per_minute=np.array([f[1] for f in found]),
             evaluations=np.array([f[2] for f in found]),
             free=tuple(AXES[k] for k in free),
+            margin=vmap.query(points_in_base_frame(np.vstack([picks_w, places_w]),
+                                                   np.array([f[0] for f in found])).reshape(-1, 3))
+            .margin.reshape(len(found), -1).min(axis=1),
         )
-        k = int(np.argmax(refinement.picks_per_minute))
-        if refinement.picks_per_minute[k] > best_ppm * (1.0 + _PPM_RTOL):
+        eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
+        k = int(np.argmax(eligible))
+        if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
             best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
     best_cycle = None
     if best_placement is not None:

@@ -66,6 +66,9 @@ def _range(text: str, what: str, scale: float, random: bool):
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of random placements, workspace and optimiser.")
 @click.option("--chunk-size", default=4, show_default=True, type=int, help="Placements per task.")
 @click.option("--top", default=10, show_default=True, type=int, help="Rows of the ranked table.")
+@click.option("--min-margin", default=0.0, show_default=True, type=float,
+              help="Rule out placements whose picks or places are closer than this to the workspace edge "
+                   "[m, or mm with --mm].")
 @click.option("--cell", "cell_name", default=None,
               help="Search inside a cell (built-in name or .xacro/.urdf file): ROBOT is then the arm's name in it, "
                    "the line frame is the cell's world and every cycle keeps --clearance from its fixtures.")
@@ -79,7 +82,7 @@ def _range(text: str, what: str, scale: float, random: bool):
 @scheduler_option
 @json_option
 def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, n_random, mm, deg, lift, dwell, kind,
-                      vmax, amax, jmax, refine, refine_evaluations, seed, chunk_size, top, cell_name, clearance, carry,
+                      vmax, amax, jmax, refine, refine_evaluations, seed, chunk_size, top, min_margin, cell_name, clearance, carry,
                       plot_path, session_path, scheduler, as_json) -> None:
     """Where to put ROBOT for the most picks per minute: rank base placements by their cycle.
 
@@ -121,7 +124,8 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
             lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
             vmax=si_limit(vmax, "--vmax", ones), amax=si_limit(amax, "--amax", ones),
             jmax=si_limit(jmax, "--jmax", ones), refine=refine, refine_evaluations=refine_evaluations, seed=seed,
-            chunk_size=chunk_size, scheduler=scheduler, progress=bar if bar.enabled else None, **in_cell,
+            chunk_size=chunk_size, scheduler=scheduler, progress=bar if bar.enabled else None,
+            min_margin=min_margin * k, **in_cell,
         )
     data = res.as_dict()
     from pinarms.execution import describe_scheduler

@@ -140,3 +140,17 @@ def test_in_a_cell_a_candidate_that_collides_fails_as_collision():
     assert res.best_cycle.cell_report.lift == direct.cell_report.lift
     with pytest.raises(InvalidInput, match="carry"):
         search_layout(robots.load("aubo_i3"), pick, place, cand, carry=("stand",))
+
+
+def test_min_margin_rules_out_points_near_the_workspace_edge(scara, points):
+    pick, place = points
+    cand = np.array([[0.0, 0.0, 0.0, 0.0], [0.1, 0.0, 0.0, 0.0]])
+    free = search_layout(scara, pick, place, cand, lift=0.02, refine=0, workspace_samples=20_000)
+    limit = float(np.mean(free.margin))  # between the two candidates' margins
+    assert free.margin.min() < limit < free.margin.max()
+    res = search_layout(scara, pick, place, cand, lift=0.02, refine=0, workspace_samples=20_000, min_margin=limit)
+    near = int(np.argmin(free.margin))
+    assert res.failure[near] == "boundary" and "from the edge of the workspace" in res.reason[near]
+    assert res.failure[1 - near] == "" and res.best_index == 1 - near
+    with pytest.raises(InvalidInput, match="min_margin"):
+        search_layout(scara, pick, place, cand, min_margin=-1.0)
