@@ -321,17 +321,19 @@ class Robot:
             if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
-                return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
+                J = pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
+                return J if J.ndim == 2 else J.reshape(6, 1)  # Pinocchio gives (6,) for a 1-DoF model
         x = self._one(q)
         if x is not None:
-            return pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)
+            J = pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)
+            return J if J.ndim == 2 else J.reshape(6, 1)
         arr, single = self.check_q(q)
         if arr.shape[0] <= SMALL_BATCH:
             model, data = self.model, self._pin_data()
             qp = arr if self._same_q else self._tree.coordinates.to_pin(arr)
             J = np.empty((arr.shape[0], 6, self.nq))
             for k in range(arr.shape[0]):
-                J[k] = pin.computeFrameJacobian(model, data, qp[k], fid, _LWA)
+                J[k] = pin.computeFrameJacobian(model, data, qp[k], fid, _LWA).reshape(6, -1)
         else:
             J = self._tree.frame_jacobian(arr, fid)
         return J[0] if single else J

@@ -78,6 +78,12 @@ CORPUS = [
     ("urdf-internal-entity", lambda: robots.from_urdf_text(
         '<!DOCTYPE robot [<!ENTITY n "b">]>' + _TWO.format(lo=-1, hi=1, v=1).replace('child link="b"', 'child link="&n;"')),
      ModelError, "entit"),
+    ("jacobian-1-dof-batch", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1)).jacobian(np.zeros((3, 1))),
+     None, None),
+    ("urdf-joint-to-undefined-link", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1).replace(
+        'child link="b"', 'child link="zzz"')), ModelError, "not defined"),
+    ("urdf-duplicate-link", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1).replace(
+        '<link name="b"/>', '<link name="b"/><link name="b"/>')), ModelError, "defined twice"),
     ("session-metadata-not-a-mapping", lambda: viz.Session(metadata=True), InvalidInput, "mapping"),
     ("session-metadata-lone-surrogate", lambda: viz.Session(metadata={"k": "\ud800"}), InvalidInput, "JSON-able"),
     ("session-points-complex", lambda: viz.Session().add_points("p", np.zeros((1, 3), complex)), InvalidInput,
@@ -91,7 +97,7 @@ CORPUS = [
 def test_corpus(call, error, fragment):
     result, err = outcome(call)
     if error is None:
-        assert err is None
+        assert err is None, err
         return
     assert isinstance(err, error), err
     assert fragment in str(err), str(err)

@@ -366,18 +366,35 @@ def test_builder_arguments(tmp_path_factory, data, method):
     elif method == "save-nul":
         call = (s.save, (folder / "a\x00b.pinarms",), {})
     elif method == "init":
-        call = (viz.Session, (data.draw(st.one_of(_anything, st.just("ur5"))),),
-                {"title": data.draw(_anything), "metadata": data.draw(st.one_of(st.none(), _anything))})
+        call = (viz.Session, (data.draw(st.one_of(st.just(GANTRY), st.just("ur5"), _anything)),),
+                {"title": data.draw(st.one_of(st.text(max_size=12), _anything)),
+                 "metadata": data.draw(st.one_of(st.none(), st.dictionaries(st.text(max_size=5), st.integers()),
+                                                 _anything))})
     elif method == "save":
         name = data.draw(st.one_of(st.text(max_size=12), st.sampled_from(["", ".", "..", "sub/x", "/", "x\x00"])))
         call = (s.save, (folder / name if name and "\x00" not in name else name,), {})
     else:
-        n_required = {"add_points": 2, "add_box": 2, "add_workspace": 1, "add_history": 2, "add_trajectory": 2,
-                      "add_robot": 1}[method]
-        args = [data.draw(st.one_of(st.text(max_size=12), _anything))]
-        n_optional = {"add_box": 2, "add_workspace": 1}.get(method, 0)
-        args += [data.draw(_anything) for _ in range(n_required - 1 + data.draw(st.integers(0, n_optional)))]
-        call = (getattr(s, method), tuple(args), {})
+        odd = data.draw(st.sampled_from(["none", "none", "name", "value", "all"]))
+        name = data.draw(_anything if odd in ("name", "all") else st.text(
+            st.characters(blacklist_categories=("Cc", "Cs"), blacklist_characters="/"), min_size=1, max_size=12
+        ).filter(str.strip))
+        n = data.draw(st.integers(1, 4))
+        pts = st.lists(st.lists(st.floats(-2, 2), min_size=3, max_size=3), min_size=n, max_size=n).map(np.array)
+        valid = {
+            "add_points": st.tuples(pts),
+            "add_box": st.tuples(st.lists(st.floats(0.01, 2), min_size=3, max_size=3)),
+            "add_workspace": st.tuples(st.just(robots.sample_workspace(GANTRY, 5, seed=1))),
+            "add_history": st.tuples(st.fixed_dictionaries({"best": st.lists(st.floats(0, 9), min_size=n, max_size=n)})),
+            "add_trajectory": st.tuples(st.just((np.linspace(0.0, 1.0, n + 1), GANTRY.random_q(n + 1, seed=n)))),
+            "add_robot": st.tuples(st.sampled_from(["ur5", "scara_mushroom"])),
+        }[method]
+        n_odd = {"add_box": 3, "add_workspace": 1}.get(method, 1)
+        values = data.draw(st.tuples(*[_anything] * data.draw(st.integers(1, n_odd))) if odd in ("value", "all")
+                           else valid)
+        if method == "add_robot":
+            call = (s.add_robot, values, {"key": name})
+        else:
+            call = (getattr(s, method), (name, *values), {})
     before = listing(folder)
     fn, args, kwargs = call
     result, err = outcome(fn, *args, **kwargs)
