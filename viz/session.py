@@ -22,6 +22,7 @@ import importlib.metadata
 import json
 import math
 import os
+import threading
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping
@@ -178,6 +179,7 @@ class Session:
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
         self._loaded: dict[str, Robot] = {}
+        self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
             self.add_robot(robot, key=key, base_to_world=base_to_world)
@@ -224,6 +226,13 @@ class Session:
     def robot(self, key: str | None = None) -> Robot:
         """The :class:`robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
         entry = self._entry(key)
+        rob = self._loaded.get(entry.key)
+        if rob is not None:
+            return rob
+        with self._loading:
+            return self._load_robot(entry)
+
+    def _load_robot(self, entry: RobotEntry) -> Robot:
         if entry.key not in self._loaded:
             if entry.source == "registry":
                 rob = robots.load(entry.name)
