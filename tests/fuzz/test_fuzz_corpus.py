@@ -71,6 +71,15 @@ CORPUS = [
     ("workspace-1e15", lambda: robots.sample_workspace(ur5(), 10**15), InvalidInput, "more than 50,000,000"),
     ("minimize-time-complex-limit", lambda: optim.minimize_time([[0.0] * 6, [1.0] * 6], "multi-quintic", _C),
      InvalidLimits, "not numeric"),
+    ("minimize-time-vmax-5e-324", lambda: optim.minimize_time([[0.0], [1.0]], "multi-quintic", 5e-324),
+     InvalidLimits, "outside [1e-09, 1e+12]"),
+    ("urdf-mimic-multiplier-0", lambda: robots.from_urdf_text(
+        '<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+        '<joint name="j0" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+        '<limit lower="0" upper="1" effort="1" velocity="1"/></joint>'
+        '<joint name="j1" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>'
+        '<limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="j0" multiplier="0"/></joint></robot>'),
+     ModelError, "non-zero multiplier"),
     ("urdf-not-a-string", lambda: robots.from_urdf_text(None), InvalidInput, "string"),
     ("urdf-lower-above-upper", lambda: robots.from_urdf_text(_TWO.format(lo=1, hi=-1, v=1)), ModelError, "swap"),
     ("urdf-negative-velocity", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=-2)), ModelError,
