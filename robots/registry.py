@@ -6,6 +6,7 @@ what it accepts; ``from_urdf(path)`` loads any other URDF.
 
 from __future__ import annotations
 
+import difflib
 import importlib.metadata
 import importlib.resources
 import xml.etree.ElementTree as ET
@@ -20,7 +21,7 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 
-__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info"]
+__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest"]
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,31 @@ def info(name: str) -> RobotInfo:
         return _BUILTIN[name]
     if name in _EXAMPLE:
         return _EXAMPLE[name]
-    raise RobotNotFound(f"unknown robot {name!r}; known robots: {', '.join(names())} (or use robots.from_urdf(path))")
+    close = suggest(name)
+    hint = f"did you mean {' or '.join(close)}? " if close else ""
+    raise RobotNotFound(f"unknown robot {name!r}; {hint}known robots: {', '.join(names())} "
+                        "(or use robots.from_urdf(path))")
+
+
+def suggest(name: str, limit: int = 3) -> list[str]:
+    """Known robot names close to ``name`` (a typo, another case, ``-`` for ``_``), closest first.
+
+    Names are compared lowered, with ``-`` and spaces read as ``_``: an exact match after
+    that comes alone; then the names that contain ``name`` (3 characters or more, e.g.
+    ``koji``), in registry order; then :func:`difflib.get_close_matches` (similarity ratio
+    ≥ 0.6), at most ``limit`` in all.
+    """
+    def norm(text: str) -> str:
+        return text.lower().replace("-", "_").replace(" ", "_")
+
+    known = names()
+    by_norm = {norm(k): k for k in known}
+    key = norm(name)
+    if key in by_norm:
+        return [by_norm[key]]
+    found = [k for k in by_norm if len(key) >= 3 and key in k]
+    found += [k for k in difflib.get_close_matches(key, list(by_norm), n=limit, cutoff=0.6) if k not in found]
+    return [by_norm[k] for k in found[:limit]]
 
 
 @lru_cache(maxsize=1)

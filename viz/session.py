@@ -131,7 +131,7 @@ def _registry_name(robot: Robot) -> str | None:
     except PinarmsError:
         return None
     if ref.urdf_text == robot.urdf_text and ref.tcp_frame == robot.tcp_frame:
-        return robot.name
+        return robot.name  # a payload is stored beside the name (RobotEntry.payload)
     return None
 
 
@@ -178,6 +178,7 @@ class Session:
         self.workspaces: dict[str, WorkspaceRecord] = {}
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
+        self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
         self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
         self.package_dirs_override: tuple[str, ...] | None = None
@@ -200,7 +201,8 @@ class Session:
         """Add a robot placed at ``base_to_world`` (4, 4) in the world; return its key.
 
         A robot that ``robots.load`` rebuilds exactly is stored by name; any other has its
-        URDF text embedded so that the session reopens anywhere.
+        URDF text embedded so that the session reopens anywhere. A robot carrying a payload
+        (``robot.with_payload``) keeps it: the session stores the payload and reapplies it.
         """
         if isinstance(robot, str):
             robot = robots.load(robot)
@@ -219,6 +221,7 @@ class Session:
             base_to_world=_pose(base_to_world, f"base_to_world of robot {key!r}"),
             urdf_text=None if reg else robot.urdf_text,
             package_dirs=() if reg else tuple(str(p) for p in robot.package_dirs),
+            payload=None if robot.payload is None else robot.payload.as_dict(),
         )
         self._loaded[key] = robot
         return key
@@ -244,6 +247,8 @@ class Session:
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
                 )
+            if entry.payload is not None:
+                rob = rob.with_payload(entry.payload)
             if tuple(rob.joint_names) != entry.joint_names:
                 raise SessionFormatError(
                     f"robot {entry.key!r} ({entry.name}) was saved with joints {list(entry.joint_names)} but now loads "
@@ -405,6 +410,18 @@ class Session:
             raise InvalidInput(f"columns of history {name!r} must have equal lengths, got {sorted(lengths)}")
         rec = HistoryRecord(name, out)
         self.histories[name] = rec
+        return rec
+
+    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        """
+        from .reach_record import make_record
+
+        name = self._free(self.reachability, name, "reachability")
+        rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
+        self.reachability[name] = rec
         return rec
 
     # ---------------------------------------------------------------- (de)serialisation

@@ -550,6 +550,29 @@ def test_zip_bombs_are_refused_fast_with_little_memory(bombs):
         assert r["peak_mb"] < 200 and r["rss_growth_mb"] < 200, (name, r)
 
 
+def test_payload_is_kept_and_checked(tmp_path):
+    from pinarms import robots as _robots
+    from pinarms.viz import Session, load_session
+
+    arm = _robots.load("aubo_i3").with_payload(3.0, com=[0.0, 0.0, 0.04], inertia=[0.01, 0.01, 0.006])
+    path = Session(arm, title="3 kg food pack").save(tmp_path / "pack.pinarms")
+    doc = _doc(path)
+    assert doc["robots"][0]["source"] == "registry" and doc["robots"][0]["payload"]["mass_kg"] == 3.0
+    again = load_session(path).robot()
+    assert again.payload.mass == 3.0
+    np.testing.assert_array_equal(again.payload.com, [0.0, 0.0, 0.04])
+    q = arm.random_q(5, seed=2)
+    np.testing.assert_allclose(again.gravity(q), arm.gravity(q), rtol=1e-14, atol=1e-14)
+    # a bare arm writes no payload field (sessions without one read as before)
+    bare = Session(_robots.load("aubo_i3")).save(tmp_path / "bare.pinarms")
+    assert "payload" not in _doc(bare)["robots"][0] and load_session(bare).robot().payload is None
+    # a hostile payload is refused with the reason
+    doc["robots"][0]["payload"]["mass_kg"] = -3.0
+    bad = _rewrite(path, tmp_path / "bad.pinarms", replace={"session.json": json.dumps(doc).encode()})
+    with pytest.raises(SessionFormatError, match=r"robots\[0\]\.payload: payload mass must be >= 0"):
+        load_session(bad)
+
+
 # ---------------------------------------------------------------------------- limits, meshes, leftovers
 def test_limits_refuse_big_sessions_and_say_how_to_raise_them(saved):
     doc = _doc(saved)
