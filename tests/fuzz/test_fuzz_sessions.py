@@ -35,7 +35,8 @@ LEVER_URDF = """<robot name="lever">
 
 
 def _build_base() -> bytes:
-    """A small session touching every kind: registry + embedded robots, box, trajectories, cloud, points, history."""
+    """A small session touching every kind: registry + embedded robots (one with a payload), box, trajectories,
+    cloud, points, history, reachability map."""
     gantry = robots.load("gantry_flower")
     s = viz.Session(gantry, title="fuzz base", metadata={"line": "roses", "n": 3})
     s.add_trajectory("move", planning.multi_quintic(np.array([0.0, 0.5, 1.0]), gantry.random_q(3, seed=1)), hz=10)
@@ -44,9 +45,12 @@ def _build_base() -> bytes:
     s.add_workspace("cloud", points=gantry.position(q), manipulability=np.linspace(0.0, 1.0, 5))
     s.add_points("targets", [[0.1, 0.2, 0.3]], kind="target")
     s.add_history("ga", {"best": [3.0, 2.0], "mean": [np.inf, 2.5]})
-    s.add_robot(robots.from_urdf_text(LEVER_URDF), base_to_world=np.eye(4))
+    s.add_robot(robots.from_urdf_text(LEVER_URDF).with_payload(0.5, com=[0.0, 0.0, 0.02]), base_to_world=np.eye(4))
     s.add_box("crate", [0.3, 0.2, 0.1])
-    buf = io.BytesIO()
+    # the kinds added by others later are fuzzed the same way: a payload and a small reachability map
+    from pinarms.robots.reachability import reachability_map
+
+    s.add_reachability("reach", reachability_map(gantry, 0.25, 2, tool_down=0.1, roll_steps=2), robot="gantry_flower")
     import tempfile
 
     with tempfile.TemporaryDirectory() as d:
@@ -175,6 +179,11 @@ def _set(doc, path, value, op):
 @example(edits=[(BASE_PATHS.index(("robots", 1, "urdf_member")), "robots/0.urdf", "set")])
 @example(edits=[(BASE_PATHS.index(("trajectories", 0)), None, "duplicate")])
 @example(edits=[(BASE_PATHS.index(("trajectories", 0, "definition", "kind")), "3-5-3", "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "mass_kg")), -1.0, "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "inertia_kg_m2")), [[1, 2], [3]], "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "frame")), "no_such_frame", "set")])
+@example(edits=[(BASE_PATHS.index(("reachability", 0, "centres")), [2**40, 3], "shape")])
+@example(edits=[(BASE_PATHS.index(("reachability", 0, "robot")), "nobody", "set")])
 def test_session_json_edits(tmp_path_factory, edits):
     doc = json.loads(json.dumps(BASE_DOC))
     for idx, value, op in edits:
