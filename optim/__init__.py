@@ -18,6 +18,7 @@ from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.path_timing import PathTiming, time_optimal
+from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -40,6 +41,7 @@ __all__ = [
     "CycleResult",
     "plan_cycle",
     "time_optimal",
+    "TorqueConstraint",
     "PathTiming",
     "TimeJerkResult",
     "jerk_integral",
