@@ -488,6 +488,7 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
     fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
     if title:
         fig.suptitle(title)
+    return _save(fig, path)
 
 
 def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
