@@ -10,10 +10,12 @@ import difflib
 import importlib.metadata
 import importlib.resources
 import xml.etree.ElementTree as ET
+import xml.parsers.expat
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
 from .errors import InvalidInput, ModelError, RobotNotFound
@@ -189,7 +191,17 @@ def from_urdf_text(
     freeze: tuple[str, ...] = (),
     description: str = "",
 ) -> Robot:
-    """Build a :class:`Robot` from URDF text (see :func:`from_urdf`)."""
+    """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
+
+    Raises:
+        InvalidInput: ``urdf_text`` is not a string.
+        ModelError: not well-formed XML, not a URDF, a DOCTYPE or entity declaration
+            (URDF has none; Pinocchio's parser would not expand them), joint limits with
+            lower > upper or negative speed/effort, or Pinocchio rejects the model.
+    """
+    if not isinstance(urdf_text, str):
+        raise InvalidInput(f"urdf_text must be the URDF as a string, got {type(urdf_text).__name__}")
+    _refuse_dtd(urdf_text, source)
     try:
         root = ET.fromstring(urdf_text)
     except ET.ParseError as exc:
@@ -207,6 +219,7 @@ def from_urdf_text(
         raise ModelError(f"Pinocchio cannot build a model from {source}: {exc}") from exc
     if model.nv == 0:
         raise ModelError(f"{source} has no movable joint")
+    _check_limits(model, source)
     if tcp is None:
         tcp = "tcp" if model.existFrame("tcp") else _last_body_frame(model)
     return Robot(
@@ -218,6 +231,52 @@ def from_urdf_text(
         tcp_frame=tcp,
         description=description,
     )
+
+
+def _refuse_dtd(text: str, source: str) -> None:
+    """ModelError when the XML declares a DOCTYPE or entities (expat reads the prolog only)."""
+
+    def refuse(*_: object) -> None:
+        raise ModelError(
+            f"{source} declares a DOCTYPE or XML entities; URDF uses neither and Pinocchio's parser does not expand "
+            f"them (entity expansion is refused): expand them first, e.g. with xacro"
+        )
+
+    parser = xml.parsers.expat.ParserCreate()
+    parser.StartDoctypeDeclHandler = refuse
+    parser.EntityDeclHandler = refuse
+    parser.StartElementHandler = _stop_at_root
+    try:
+        parser.Parse(text, True)
+    except (xml.parsers.expat.ExpatError, _RootReached):
+        pass  # malformed XML is reported by the parse that follows; the root element ends the prolog
+
+
+class _RootReached(Exception):
+    """Raised by the prolog scan at the first element."""
+
+
+def _stop_at_root(*_: object) -> None:
+    raise _RootReached
+
+
+def _check_limits(model: pin.Model, source: str) -> None:
+    """ModelError for position limits with lower > upper, or negative speed or effort limits."""
+    for i in range(1, model.njoints):
+        j = model.joints[i]
+        if j.nq == 0 or "Mimic" in j.shortname():
+            continue
+        name = model.names[i]
+        lo = model.lowerPositionLimit[j.idx_q: j.idx_q + j.nq]
+        hi = model.upperPositionLimit[j.idx_q: j.idx_q + j.nq]
+        if np.any(lo > hi):
+            raise ModelError(f"{source}: joint {name!r} has lower limit {lo.tolist()} above its upper limit "
+                             f"{hi.tolist()}; swap them")
+        v = model.velocityLimit[j.idx_v: j.idx_v + j.nv]
+        e = model.effortLimit[j.idx_v: j.idx_v + j.nv]
+        if np.any(v < 0) or np.any(e < 0):
+            raise ModelError(f"{source}: joint {name!r} has a negative velocity or effort limit "
+                             f"({v.tolist()}, {e.tolist()}); limits are magnitudes")
 
 
 def from_urdf(

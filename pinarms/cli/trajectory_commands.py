@@ -319,11 +319,20 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
 @click.option("--method", type=click.Choice(["ga", "exact"]), default="ga", show_default=True)
 @click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the GA.")
 @click.option("--generations", default=None, type=click.IntRange(min=1), help="Maximum GA generations.")
+@click.option("--payload", default=None,
+              help="Mass at the tcp, e.g. 3kg or 800g (needs --robot): also limits joint torques "
+                   "(--torque-max, default the URDF's efforts).")
+@click.option("--torque", "torque", is_flag=True, help="Also limit joint torques to the URDF's efforts (needs --robot).")
+@click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints] (needs --robot).")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
               help="Save the optimised trajectory (and GA history) into a session file.")
 @json_option
-def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, session_path, as_json) -> None:
+def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, payload, torque, torque_max,
+                 session_path, as_json) -> None:
     """Shortest segment times through via points under velocity/acceleration/jerk limits.
+
+    With --payload, --torque or --torque-max the joint torques of --robot (Pinocchio's RNEA,
+    payload included) are limited too.
 
     Example (seed 000): pinarms optimize --kind 3-5-3 --deg --via 55.5 --via 69.7
     --via 106.5 --via 124.5 --vmax 55
@@ -342,6 +351,14 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     kwargs: dict[str, Any] = {}
     if generations is not None and method == "ga":
         kwargs["max_generations"] = generations
+    if payload is not None or torque or torque_max is not None:
+        if arm is None:
+            raise click.UsageError("--payload, --torque and --torque-max need --robot (its inverse dynamics give the torques)")
+        from pinarms.units import mass_kg
+
+        limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
+        kwargs.update(robot=arm, payload=None if payload is None else mass_kg(payload),
+                      torque_limits=True if limits is None else limits)
     budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
     bar = common.progress_bar("GA generations", budget, as_json or method != "ga")
     if bar.enabled:
@@ -365,8 +382,16 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
         f"segment durations [s]: {fmt(result.durations)}",
         *_peaks_lines(result.peaks, scale, unit),
     ]
+    carrying = arm
+    if result.torque_peaks is not None:
+        carrying = arm if kwargs.get("payload") is None else arm.with_payload(kwargs["payload"])
+        data["torque_peaks"] = result.torque_peaks.as_dict()
+        data["torque_limit"] = result.torque_limit
+        data["payload_kg"] = kwargs.get("payload")
+        lines.append("torque / limit: " + ", ".join(
+            f"{n} {r:.3f}" for n, r in zip(arm.joint_names, result.torque_ratios)))
     if session_path:
-        session = new_session(arm, f"time-optimal {kind}")
+        session = new_session(carrying, f"time-optimal {kind}")
         session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
         if result.history is not None:
             session.add_history(f"{kind} GA", result.history)
