@@ -24,6 +24,7 @@ from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
 from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
+from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -52,6 +53,7 @@ __all__ = [
     "random_candidates",
     "time_optimal",
     "time_scaled",
+    "TorqueConstraint",
     "PathTiming",
     "CellCycleReport",
     "LineSchedule",
