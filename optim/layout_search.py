@@ -273,7 +273,7 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
         z = z0.copy()
         z[k] = z[k] + task.step[free][k] if z[k] + task.step[free][k] <= hi[k] else z[k] - task.step[free][k]
         simplex.append(z)
-    res = minimize(cost, z0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
+    minimize(cost, z0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
                    options={"initial_simplex": np.array(simplex), "maxfev": task.evaluations,
                             "xatol": 1e-4, "fatol": 1e-6})
     return best["placement"], float(best["ppm"]), len(seen)

@@ -244,6 +244,9 @@ def study_001(quick: bool = False) -> Study:
         rows.append(Row("001", f"Table 2 {name} Cartesian from its joints (paper MDH)", p, tuple(np.round(xyz, 1)),
                         "mm", 1.0, "paper's D-H frame: x, y negated (180° base yaw) and ~21 mm off; z agrees"))
 
+    reach_rows, reach_map, reach_plot = _tool_down_band(arm, quick)
+    rows.extend(reach_rows)
+
     session = _session(arm, "seed 001: AUBO-i3 workspace and 3-segment quintic")
     q_robot = conv.aubo_mdh_to_joint(table2)
     robot_traj = planning.multi_quintic(times, _unwrap_rows(q_robot))
@@ -258,6 +261,8 @@ def study_001(quick: bool = False) -> Study:
     plots["lift_tool_speed"] = lambda path: _tool_speed_plot(path, lift, "seed 001: straight P1→P2 lift, quintic law at 210 °/s")
     plots.update(_workspace_plots(ws, "seed 001: AUBO-i3 workspace (flange)"))
     plots.update(dyn_plots)
+    session.add_reachability("tool down 15 deg", reach_map)
+    plots["reach_tool_down"] = reach_plot
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
 
 
@@ -386,6 +391,59 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
             title=f"seed 001: P1→P4 with {AUBO_PAYLOADS_KG[-1]:g} kg, joint torques against the limits")
 
     return rows, {"torques": write}
+
+
+def _tool_down_band(arm: Any, quick: bool) -> tuple[list[Row], Any, Callable[[Path], Any]]:
+    """The paper's table band (z > 0, 200 mm < r < 500 mm around its sphere centre) over the
+    tool-down reachability map of the tcp (15° cone, roll free; coarse voxels to stay fast).
+
+    ``quick`` is accepted for symmetry with the other helpers; the map is the same either way."""
+    from pinarms.robots.reachability import reachability_map
+
+    paper = SEED001
+    res = 0.06  # the same map in quick and full runs (about 4 s on one core): the rows are reproducible
+    m = reachability_map(arm, res, 6, tool_down=15.0 * DEG, roll_steps=6)
+    centre = paper.sphere_centre_m
+    c = m.centres()
+    r = np.linalg.norm(c - centre, axis=1)
+    up = c[:, 2] > paper.table_z_min_mm * MM
+    band = up & (r > paper.table_r_min_mm * MM) & (r < paper.table_r_max_mm * MM)
+    outside = up & (r >= paper.table_r_max_mm * MM) & (r < paper.table_r_max_mm * MM + 0.1)
+    # outer edge: the first shell (a third of a voxel wide) beyond r_min whose mean index is below 0.5
+    width = res / 3.0
+    edge = float("nan")
+    for k in range(int(np.ceil((r.max() - paper.table_r_min_mm * MM) / width))):
+        lo = paper.table_r_min_mm * MM + k * width
+        sel = up & (r >= lo) & (r < lo + width)
+        if sel.any() and m.index[sel].mean() < 0.5:
+            edge = lo
+            break
+    unreached = band & (m.index == 0)
+    top = float(c[unreached, 2].min()) if unreached.any() else float("nan")
+    what = f"tool-down map ({res * 1000:.0f} mm voxels, tcp z within 15° of down, any roll)"
+    rows = [
+        Row("001", f"{what}: mean index in the paper's table band", "recommended band",
+            round(float(m.index[band].mean()), 3), "", None,
+            "z > 0, 200 < r < 500 mm around the paper's sphere centre; kinematics only (no collisions)"),
+        Row("001", "tool-down map: band voxels reached pointing down (index > 0)", None,
+            round(float(np.mean(m.index[band] > 0)), 3), "share", None,
+            f"the unreached band voxels all lie at z >= {top / MM:.0f} mm (the band's top, above the shoulder)"),
+        Row("001", "tool-down map: mean index just outside the band (500-600 mm, z > 0)", "sparse, near-singular",
+            round(float(m.index[outside].mean()), 3), "", None, "the paper's 'sparse between 500 and 600 mm'"),
+        Row("001", "tool-down map: outer edge of the band (first shell with mean index < 0.5)", paper.table_r_max_mm,
+            round(edge / MM, 1), "mm", res / MM,
+            f"shells {width * 1000:.0f} mm wide from r = 200 mm, z > 0; tolerance one voxel"),
+    ]
+    band_spec = {"centre": centre, "r_inner": paper.table_r_min_mm * MM, "r_outer": paper.table_r_max_mm * MM,
+                 "z_min": paper.table_z_min_mm * MM, "label": "paper's table band (z > 0, 200 < r < 500 mm)"}
+
+    def plot(path: Path) -> Any:
+        from pinarms.viz.reach_plots import plot_reachability_section
+
+        return plot_reachability_section(path, m, band=band_spec,
+                                         title=f"seed 001: AUBO-i3 {what}, paper's table band in red")
+
+    return rows, m, plot
 
 
 def _unwrap_rows(q: np.ndarray) -> np.ndarray:

@@ -11,7 +11,8 @@ import numpy as np
 
 from pinarms.robots.robot import Robot
 
-__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale", "mass_kg"]
+__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale", "mass_kg",
+           "parse_length", "parse_angle"]
 
 
 def prismatic_mask(robot: Robot) -> np.ndarray:
@@ -74,3 +75,28 @@ def mass_kg(text: str) -> float:
     if not np.isfinite(value) or value < 0.0:
         raise InvalidInput(f"a mass must be finite and >= 0 kg, got {text!r}")
     return value
+
+
+_LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+_ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "°": np.pi / 180.0}
+
+
+def _quantity(text: str, units: dict, default_unit: str, what: str) -> float:
+    import re
+
+    from pinarms.robots.errors import InvalidInput
+
+    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-z°]*)\s*", str(text))
+    if not match or (match.group(2) and match.group(2) not in units):
+        raise InvalidInput(f"{what} must be a number with an optional unit ({', '.join(units)}), got {text!r}")
+    return float(match.group(1)) * units[match.group(2) or default_unit]
+
+
+def parse_length(text: str, what: str = "length") -> float:
+    """``"0.025"``, ``"25mm"``, ``"2.5cm"`` → metres (a bare number is in metres)."""
+    return _quantity(text, _LENGTH_UNITS, "m", what)
+
+
+def parse_angle(text: str, what: str = "angle") -> float:
+    """``"15deg"``, ``"15°"``, ``"0.26rad"`` → radians (a bare number is in degrees)."""
+    return _quantity(text, _ANGLE_UNITS, "deg", what)

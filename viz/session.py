@@ -177,6 +177,7 @@ class Session:
         self.workspaces: dict[str, WorkspaceRecord] = {}
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
+        self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
@@ -400,6 +401,18 @@ class Session:
             raise InvalidInput(f"columns of history {name!r} must have equal lengths, got {sorted(lengths)}")
         rec = HistoryRecord(name, out)
         self.histories[name] = rec
+        return rec
+
+    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        """
+        from .reach_record import make_record
+
+        name = self._free(self.reachability, name, "reachability")
+        rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
+        self.reachability[name] = rec
         return rec
 
     # ---------------------------------------------------------------- (de)serialisation

@@ -26,7 +26,6 @@ Frames and units: positions in metres, angles in radians, times in seconds.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
@@ -243,6 +242,9 @@ def check_name(name: Any, what: str) -> str:
 
 
 # ---------------------------------------------------------------------------- the table of kinds
+from .reach_record import decode_reachability, encode_reachability  # noqa: E402  (a kind defined in its own module)
+
+
 @dataclass(frozen=True)
 class ArraySpec:
     """An array field of an item: ``shape`` entries are ints (fixed), or names of dimensions.
@@ -289,6 +291,7 @@ class Kind:
     decode: Callable[["_Item"], Any]
     texts: tuple[TextSpec, ...] = ()
     robot_ref: str | None = None  # "required" / "optional": the item's "robot" field names a session robot
+    optional: bool = False  # the section may be absent (written only when it has items): older files lack it
 
 
 def _encode_robot(e: RobotEntry) -> tuple[dict, dict, dict]:
@@ -394,6 +397,9 @@ KINDS: tuple[Kind, ...] = (
     Kind("histories", "histories", "history", "name",
          (ArraySpec("columns", ("G",), allow_inf=True, columns=True, required=("best",)),),
          _encode_history, _decode_history),
+    Kind("reachability", "reachability", "reachability map", "name",
+         (ArraySpec("centres", ("N", 3), min_rows=1), ArraySpec("index", ("N",)), ArraySpec("manipulability", ("N",))),
+         encode_reachability, decode_reachability, robot_ref="required", optional=True),
 )
 
 
@@ -434,7 +440,8 @@ def to_document(metadata: dict, tables: Mapping[str, Mapping[str, Any]]) -> tupl
                 else:
                     fields[spec.field] = ref(f"{base}/{spec.field}.npy", value)
             items.append(fields)
-        doc[kind.section] = items
+        if items or not kind.optional:
+            doc[kind.section] = items
     return doc, arrays, texts
 
 
@@ -831,7 +838,8 @@ def _read(r: _Reader) -> SessionContents:
     for kind in KINDS:
         items: list[_Item] = []
         seen: set[str] = set()
-        for i, obj in enumerate(r.field(doc, kind.section, list, "session")):
+        listed = r.field(doc, kind.section, list, "session") if (kind.section in doc or not kind.optional) else []
+        for i, obj in enumerate(listed):
             it = _Item(r, kind, obj, i)
             if it.key in seen:
                 raise r.fail(f"{kind.what} name {it.key!r} appears twice")

@@ -178,7 +178,6 @@ scheduler_option = click.option(
          "(local worker processes). Default: serially here, or DASK_SCHEDULER_ADDRESS when it is set.")
 
 
-
 def new_session(robot: Robot | str | None, title: str):
     """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
     from pinarms import viz
@@ -193,37 +192,3 @@ def save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
     lines.append(f"session written: {path}")
 
 
-
-
-class progress_bar:  # noqa: N801  (used like a function in a with-statement)
-    """A click progress bar on stderr fed by ``callback(done, total)`` (pinarms.execution's progress).
-
-    Shown only for a person at a terminal (:func:`show_progress`); ``callback`` is None otherwise.
-    """
-
-    def __init__(self, as_json: bool, label: str) -> None:
-        self.enabled = show_progress(as_json)
-        self.label = label
-        self._bar = None
-        self._done = 0
-
-    def __enter__(self) -> "progress_bar":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        if self._bar is not None:
-            self._bar.__exit__(*exc)
-
-    @property
-    def callback(self):
-        if not self.enabled:
-            return None
-
-        def update(done: int, total: int) -> None:
-            if self._bar is None:
-                self._bar = click.progressbar(length=max(total, 1), label=self.label, file=sys.stderr)
-                self._bar.__enter__()
-            self._bar.update(done - self._done)
-            self._done = done
-
-        return update

@@ -99,12 +99,12 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
         candidates = optim.grid_candidates(**axes)
     picks, places = np.array(pick) * k, np.array(place) * k
     ones = np.ones(arm.nq)
-    with progress_bar(as_json, f"{arm.name}: {len(candidates)} placements") as bar:
+    with progress_bar(f"{arm.name}: placements", len(candidates), as_json) as bar:
         res = optim.search_layout(
             arm, picks, places, candidates, lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
             vmax=si_limit(vmax, "--vmax", ones), amax=si_limit(amax, "--amax", ones),
             jmax=si_limit(jmax, "--jmax", ones), refine=refine, refine_evaluations=refine_evaluations, seed=seed,
-            chunk_size=chunk_size, scheduler=scheduler, progress=bar.callback,
+            chunk_size=chunk_size, scheduler=scheduler, progress=bar if bar.enabled else None,
         )
     data = res.as_dict()
     from pinarms.execution import describe_scheduler
