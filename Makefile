@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.pinarms-installed
 
-.PHONY: install demo demo-quick readme-table test browser urdf bench clean
+.PHONY: install demo demo-quick readme-table test browser urdf bench clean docs-pictures
 
 # Create .venv if missing and install the project with its test and benchmark extras.
 # Idempotent: re-runs pip only when pyproject.toml changed.
@@ -36,6 +36,10 @@ readme-table: install
 
 test: install browser
 	$(PY) -m pytest -q tests
+
+# The pictures of README.md and docs/ (viewer pages in headless Chromium, plots), from the tests that check them.
+docs-pictures: install browser
+	PINARMS_DOCS_PICTURES=1 $(PY) -m pytest -q tests/viz/test_browser.py tests/viz/test_plots.py
 
 # Regenerate urdf/*.urdf and urdf/cells/*.urdf from robots/xacro/ (arms and cells).
 urdf: install

@@ -8,6 +8,9 @@ durations of a planning trajectory into objective and constraint arrays, and che
 GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
 limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a whole
 pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
+:func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
+Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
+:mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
 """
 
 from pinarms.optim.cell_cycle import CellCycleReport
@@ -16,10 +19,11 @@ from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
 from pinarms.optim.exact import ExactSolution, solve_exact
+from pinarms.optim.path_timing import PathTiming, time_optimal
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
-                              ruckig_limit, toppra_limit)
+                                     ruckig_limit, toppra_limit, toppra_path_duration)
 from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
 from pinarms.optim.timing import TimingResult, minimize_time
 
@@ -40,10 +44,13 @@ __all__ = [
     "CellCycleReport",
     "LineSchedule",
     "schedule_line",
+    "time_optimal",
+    "PathTiming",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",
     "toppra_limit",
+    "toppra_path_duration",
     "ruckig_limit",
     "double_s_limit",
     "MissingReference",

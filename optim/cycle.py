@@ -186,6 +186,8 @@ class CycleResult:
             while travelling it, per :data:`LINE_NAMES`.
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
+        payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
+        torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
         cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
             (:class:`optim.cell_cycle.CellCycleReport`); else None.
     """
@@ -203,7 +205,16 @@ class CycleResult:
     jmax: np.ndarray | None = field(repr=False)
     line_deviation: np.ndarray = field(repr=False)
     branches: np.ndarray = field(repr=False)
+    payload: Any = None
+    torque_limit: np.ndarray | None = field(default=None, repr=False)
     cell_report: Any = field(default=None, repr=False)
+
+    @property
+    def torque_ratios(self) -> np.ndarray | None:
+        """Refined torque peak / limit per joint (nq,) over both moves (loaded and empty), or None."""
+        if self.torque_limit is None:
+            return None
+        return np.maximum(*(m.torque_ratios for m in self.moves))
 
     @property
     def one_branch(self) -> bool:
@@ -260,6 +271,9 @@ class CycleResult:
             "max_line_deviation_m": self.max_line_deviation,
             "branches": self.branches.tolist(),
             "one_branch": self.one_branch,
+            "payload": None if self.payload is None else self.payload.as_dict(),
+            "torque_limit": None if self.torque_limit is None else self.torque_limit.tolist(),
+            "torque_ratios": None if self.torque_limit is None else self.torque_ratios.tolist(),
             **({"cell": self.cell_report.as_dict()} if self.cell_report is not None else {}),
         }
 
@@ -304,9 +318,9 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
-               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None, cell: Any = None,
-               clearance: float = 0.02, arm: str | None = None, hold: Any = None, margin: float = 0.005,
-               lift_step: float = 0.02) -> CycleResult:
+               jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None,
+               payload: Any = None, torque_limits: Any = False, cell: Any = None, clearance: float = 0.02,
+               arm: str | None = None, hold: Any = None, margin: float = 0.005, lift_step: float = 0.02) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -323,6 +337,12 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         seed: seed of the optimiser.
         q_start: configuration (nq,) whose nearest IK solution is taken at the pick (it
             selects the branch of the whole cycle).
+        payload: what the gripper carries from pick to place: a mass [kg], a
+            :class:`robots.Payload` or its dict form. The move to place is timed with the arm
+            carrying it, the move back to the pick with the empty gripper.
+        torque_limits: ``True`` (the URDF's ``effort`` limits) or limits per joint [N·m or
+            N]: both moves are also timed under joint-torque limits (see
+            :func:`optim.minimize_time`); ``False``: kinematic limits only.
         cell: a :class:`robots.cell.Cell` holding ``robot`` (``cell.arm(name).robot``): the
             cycle must then keep ``clearance`` [m] from the fixtures and the other arms
             (held at ``hold``, a cell configuration, default neutral), checked continuously
@@ -347,7 +367,8 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
 
         return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
                                   lift_step=lift_step, plan=plan_cycle, kind=kind, vmax=vmax, amax=amax, jmax=jmax,
-                                  method=method, seed=seed, q_start=q_start)
+                                  method=method, seed=seed, q_start=q_start, payload=payload,
+                                  torque_limits=torque_limits)
     if not isinstance(spec, PickPlace):
         raise InvalidInput(f"spec must be a PickPlace, got {type(spec).__name__}")
     if kind not in CYCLE_KINDS:
@@ -358,6 +379,9 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     if method not in ("exact", "ga"):
         raise InvalidSettings(f"method={method!r}: use 'exact' or 'ga'")
     v, a, j = _limits(robot, vmax, amax, jmax)
+    from pinarms.optim.torque import torque_constraint
+
+    loaded = torque_constraint(robot, torque_limits, payload)  # the keywords checked before any IK
     poses = spec.poses(robot)
     names = spec.names
     try:
@@ -378,10 +402,19 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
                 ) from exc
         raise
     options = {"velocities": "heuristic"} if kind == "multi-quintic" else None
-    moves = (
-        minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options),
-        minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options),
-    )
+    if loaded is None:
+        moves = (
+            minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options),
+            minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options),
+        )
+    else:
+        empty = torque_constraint(robot, loaded.limit)  # the same limits, nothing in the gripper
+        moves = (
+            minimize_time(q_out, kind, v, a, j, method=method, seed=seed, trajectory_options=options,
+                          robot=loaded.robot, torque_limits=loaded.limit),
+            minimize_time(q_out[::-1], kind, v, a, j, method=method, seed=seed, trajectory_options=options,
+                          robot=empty.robot, torque_limits=empty.limit),
+        )
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
         parts = [_hold(q_out[0], spec.dwell), parts[0], _hold(q_out[-1], spec.dwell), parts[1]]
@@ -404,6 +437,8 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         jmax=j,
         line_deviation=_line_deviation(robot, moves, ends),
         branches=np.concatenate([branches, branches[-2::-1]]),
+        payload=None if loaded is None else loaded.robot.payload,
+        torque_limit=None if loaded is None else loaded.limit.copy(),
     )
 
 

@@ -36,20 +36,27 @@ class GAHistory:
 
     Attributes:
         best: (G+1,) objective of the best-so-far individual (feasibility rules order).
-        mean: (G+1,) mean objective of the population (finite values only).
+        mean: (G+1,) mean objective of the whole population (finite values only),
+            infeasible individuals included: their objective is the raw one (no penalty), so
+            when few individuals are feasible this mean can lie *below* ``best`` (they
+            are faster than the limits allow).
         feasible_share: (G+1,) share of feasible individuals in the population.
         best_violation: (G+1,) total constraint violation of the best-so-far.
+        feasible_mean: (G+1,) mean objective of the feasible individuals of the
+            generation (``inf`` when none is feasible); never below ``best`` once a
+            feasible individual has been found (the best-so-far is the least of them all).
     """
 
     best: np.ndarray
     mean: np.ndarray
     feasible_share: np.ndarray
     best_violation: np.ndarray
+    feasible_mean: np.ndarray
 
     def as_dict(self) -> dict[str, list[float]]:
         """JSON-able copy."""
         return {k: getattr(self, k).tolist()
-                for k in ("best", "mean", "feasible_share", "best_violation")}
+                for k in ("best", "mean", "feasible_share", "best_violation", "feasible_mean")}
 
 
 @dataclass(frozen=True)
@@ -243,6 +250,7 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
     hist_mean: list[float] = []
     hist_feas: list[float] = []
     hist_viol: list[float] = []
+    hist_feas_mean: list[float] = []
     best_x, best_f, best_v = x[0].copy(), np.inf, np.inf
     stall_count = 0
     stop_reason = "max_generations"
@@ -270,7 +278,9 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
         finite = np.isfinite(f)
         hist_best.append(best_f)
         hist_mean.append(float(np.mean(f[finite])) if np.any(finite) else np.inf)
+        feasible_now = (v <= FEASIBILITY_TOLERANCE) & finite
         hist_feas.append(float(np.mean(v <= FEASIBILITY_TOLERANCE)))
+        hist_feas_mean.append(float(np.mean(f[feasible_now])) if np.any(feasible_now) else np.inf)
         hist_viol.append(best_v if best_v > FEASIBILITY_TOLERANCE else 0.0)
 
         elapsed = time.perf_counter() - t0
@@ -334,7 +344,7 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
         v = np.concatenate([v[elites], vc])
 
     history = GAHistory(np.asarray(hist_best), np.asarray(hist_mean),
-                        np.asarray(hist_feas), np.asarray(hist_viol))
+                        np.asarray(hist_feas), np.asarray(hist_viol), np.asarray(hist_feas_mean))
     feasible = bool(best_v <= FEASIBILITY_TOLERANCE)
     return GAResult(x=best_x, f=best_f, feasible=feasible,
                     violation=0.0 if feasible else best_v, history=history,

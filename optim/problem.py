@@ -77,6 +77,8 @@ def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndar
             raise InvalidLimits(f"{name} is required: give a positive limit per joint (SI units)")
         return None
     try:
+        if np.iscomplexobj(value):
+            raise TypeError("complex numbers")
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InvalidLimits(f"{name}={value!r} is not numeric: give a positive number per "
@@ -128,13 +130,18 @@ class TimingProblem:
             ``velocities=0`` for multi-quintic rest at every via point).
         builder: Replace the planning constructor (advanced; tests and custom families).
             A custom builder is called once per individual (no batched form).
+        torque: Joint-torque limits of a robot (:class:`optim.torque.TorqueConstraint`),
+            checked on a grid per piece beside the exact v/a/jerk peaks, with their own
+            scaling law in :meth:`minimal_scale`; None: kinematic limits only.
     """
 
     def __init__(self, positions: Any, kind: str, vmax: Any, amax: Any = None,
                  jmax: Any = None, bounds: Any = None,
                  trajectory_options: dict[str, Any] | None = None,
-                 builder: Builder | None = None) -> None:
+                 builder: Builder | None = None, torque: Any = None) -> None:
         try:
+            if np.iscomplexobj(positions):
+                raise TypeError("complex numbers")
             q = np.asarray(positions, dtype=float)
         except (TypeError, ValueError):
             raise InvalidInput(f"positions={positions!r} are not numeric: give (m+1,) or "
@@ -168,6 +175,12 @@ class TimingProblem:
         else:
             self._build, self._build_batch = builder, None
         self.evaluations = 0
+        self.torque = torque
+        if torque is not None:
+            if torque.n_joints != self.n_joints:
+                raise InvalidSettings(f"the torque limits are for {torque.n_joints} joints but the via points have "
+                                      f"{self.n_joints}: give every joint of the arm")
+            torque.static_check(q)
         self.bounds = self._check_bounds(bounds)
 
     # -- trajectories and peaks -------------------------------------------------------
@@ -189,10 +202,15 @@ class TimingProblem:
 
     def minimal_scale_batch(self, ratios: np.ndarray) -> np.ndarray:
         """s*(r) for a population of ratios (pop, m) -> (pop,) (s); rows need not sum to 1."""
+        from pinarms import planning
+
         r = np.atleast_2d(np.asarray(ratios, dtype=float))
         r = r / r.sum(axis=1, keepdims=True)
-        pk = self.peaks_batch(r)  # (pop, 3, n) at total 1
+        times, coefs = self.coefficients_batch(r)
+        pk = planning.piece_peaks_batch(times, coefs).max(axis=2)  # (pop, 3, n) at total 1
         s = np.max(pk[:, 0] / self.vmax, axis=1)
+        if self.torque is not None:
+            s = np.maximum(s, self.torque.minimal_scale(times, coefs))
         if self.amax is not None:
             s = np.maximum(s, np.max(np.sqrt(pk[:, 1] / self.amax), axis=1))
         if self.jmax is not None:
@@ -201,14 +219,8 @@ class TimingProblem:
 
     # -- arrays for the GA --------------------------------------------------------------
     def limit_ratios(self, durations: np.ndarray) -> np.ndarray:
-        """Peak / limit per active limit and joint, flattened (n_con,)."""
-        pk = self.peaks(durations)
-        parts = [pk[0] / self.vmax]
-        if self.amax is not None:
-            parts.append(pk[1] / self.amax)
-        if self.jmax is not None:
-            parts.append(pk[2] / self.jmax)
-        return np.concatenate(parts)
+        """Peak / limit per active limit and joint, flattened (n_con,) (torque last, when set)."""
+        return self.limit_ratios_batch(np.asarray(durations, dtype=float)[None])[0]
 
     def coefficients_batch(self, population: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Knot times (pop, m'+1) (s) and piece coefficients (pop, m', K+1, n) for durations (pop, m).
@@ -238,6 +250,15 @@ class TimingProblem:
         times, coefs = self.coefficients_batch(population)
         return planning.piece_peaks_batch(times, coefs)
 
+    def _piece_ratios_and_torque(self, population: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """Peaks per piece (pop, 3, pieces, n) and torque ratios per piece (pop, pieces, n) or None."""
+        from pinarms import planning
+
+        times, coefs = self.coefficients_batch(population)
+        pk = planning.piece_peaks_batch(times, coefs)
+        tq = None if self.torque is None else self.torque.piece_ratios(times, coefs)
+        return pk, tq
+
     def peaks_batch(self, population: np.ndarray) -> np.ndarray:
         """Exact peaks for a population of durations (pop, m) -> (pop, 3, n_joints)."""
         return self.piece_peaks_batch(population).max(axis=2)
@@ -250,19 +271,25 @@ class TimingProblem:
 
     def piece_limit_ratios_batch(self, population: np.ndarray) -> np.ndarray:
         """Peak / limit per active limit, piece and joint: (pop, n_con * pieces)."""
-        pk = self.piece_peaks_batch(population)
+        pk, tq = self._piece_ratios_and_torque(population)
         kinds, lim = self._limits_stack()
         ratios = pk[:, kinds] / lim[None, :, None, :]
-        return ratios.reshape(ratios.shape[0], -1)
+        ratios = ratios.reshape(ratios.shape[0], -1)
+        if tq is not None:
+            ratios = np.concatenate([ratios, tq.reshape(tq.shape[0], -1)], axis=1)
+        return ratios
 
     def limit_ratios_batch(self, population: np.ndarray) -> np.ndarray:
-        """Peak / limit for a population (pop, m) -> (pop, n_con)."""
-        pk = self.peaks_batch(population)
+        """Peak / limit for a population (pop, m) -> (pop, n_con) (torque last, when set)."""
+        pk, tq = self._piece_ratios_and_torque(population)
+        pk = pk.max(axis=2)
         parts = [pk[:, 0] / self.vmax]
         if self.amax is not None:
             parts.append(pk[:, 1] / self.amax)
         if self.jmax is not None:
             parts.append(pk[:, 2] / self.jmax)
+        if tq is not None:
+            parts.append(tq.max(axis=1))
         return np.concatenate(parts, axis=1)
 
     def constraints(self, population: np.ndarray) -> np.ndarray:
@@ -298,6 +325,8 @@ class TimingProblem:
             return np.tile([s0 / (20.0 * m), s0 * min(1.0, 4.0 / m) * DEFAULT_UPPER_MARGIN],
                            (m, 1))
         try:
+            if np.iscomplexobj(bounds):
+                raise TypeError("complex numbers")
             b = np.asarray(bounds, dtype=float)
         except (TypeError, ValueError):
             raise InvalidSettings(f"bounds={bounds!r} are not numeric: give (lower, upper) in s, "

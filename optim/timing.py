@@ -45,6 +45,9 @@ class TimingResult:
         stop_reason: GA stop reason ("" for exact).
         unpolished_total: ``"ga+polish"``: total (s) of the GA's answer (rescaled onto the
             limits) before the local polish; None otherwise.
+        torque_peaks: with torque limits, the refined per-joint torque peaks of
+            ``trajectory`` (:class:`planning.TorquePeaks`, N·m or N); None otherwise.
+        torque_limit: the torque limits (n,) used [N·m or N], or None.
     """
 
     durations: np.ndarray
@@ -59,6 +62,15 @@ class TimingResult:
     kind: str
     stop_reason: str = ""
     unpolished_total: float | None = None
+    torque_peaks: Any = None
+    torque_limit: np.ndarray | None = None
+
+    @property
+    def torque_ratios(self) -> np.ndarray | None:
+        """Refined torque peak / limit per joint (n,), or None without torque limits."""
+        if self.torque_peaks is None:
+            return None
+        return self.torque_peaks.torque / self.torque_limit
 
     @property
     def knot_times(self) -> np.ndarray:
@@ -85,17 +97,26 @@ def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
                   unpolished_total: float | None = None) -> TimingResult:
     """Build the final trajectory, verify it with its exact peaks, wrap the result."""
     h = np.asarray(durations, dtype=float)
+    torque = getattr(problem, "torque", None)
+    if torque is not None:
+        # the grid's torque peaks miss the true ones by a hair: stretch onto the refined peaks
+        factor = torque.refined_scale(problem.trajectory(h))
+        if not np.isfinite(factor):
+            raise InfeasibleProblem(f"the {method} timing cannot meet the torque limits at any speed")
+        h = h * factor
     if not problem.is_feasible(h):
         ratios = problem.limit_ratios(h)
         raise InfeasibleProblem(
             f"the {method} timing {np.round(h, 6).tolist()} s exceeds a limit (peak/limit up "
             f"to {ratios.max():.6g}): no feasible timing was found; widen the bounds")
     traj = problem.trajectory(h)
+    tq_peaks = None if torque is None else traj.torque_peaks(torque.robot, torque.samples_per_piece)
     return TimingResult(durations=h, total=float(h.sum()), trajectory=traj, peaks=traj.peaks(),
                         history=history, method=method, evaluations=evaluations,
                         wall_time=time.perf_counter() - t0, raw_total=raw_total,
                         kind=problem.kind, stop_reason=stop_reason,
-                        unpolished_total=unpolished_total)
+                        unpolished_total=unpolished_total, torque_peaks=tq_peaks,
+                        torque_limit=None if torque is None else torque.limit.copy())
 
 
 def _infeasible(problem: TimingProblem, method: str) -> InfeasibleProblem:
@@ -113,7 +134,8 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
                   rescale: bool = True, polish: bool = False, initial: Any = None,
                   callback: Callable[[GAProgress], bool | None] | None = None,
                   trajectory_options: dict[str, Any] | None = None,
-                  problem: TimingProblem | None = None) -> TimingResult:
+                  problem: TimingProblem | None = None, robot: Any = None, payload: Any = None,
+                  torque_limits: Any = False, torque_samples: int | None = None) -> TimingResult:
     """Shortest segment durations through via points under per-joint limits.
 
     Minimises ``T = h_1 + ... + h_m`` subject to max|velocity| <= vmax, and optionally
@@ -145,21 +167,41 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
         trajectory_options: Extra keyword arguments of the planning constructor.
         problem: A prebuilt :class:`TimingProblem` (then positions/kind/limits/bounds
             are ignored).
+        robot: The arm (a :class:`robots.Robot`) whose joints the via points are; needed
+            for torque limits.
+        payload: What the tcp carries: a mass [kg], a :class:`robots.Payload` or its dict
+            form (``robot.with_payload``); only with ``torque_limits``.
+        torque_limits: ``True``: also limit every joint's torque to the URDF's ``effort``
+            (``robot.effort_limit``, N·m or N); or limits per joint; ``False``: kinematic
+            limits only. The torques (inverse dynamics of the robot with its payload) are
+            checked on ``torque_samples`` instants per piece (default 48) with their own
+            scaling law (:mod:`optim.torque`), and the answer is finally stretched onto the
+            refined torque peaks, so it is feasible when re-checked densely. A torque-limited
+            timing is never shorter than the kinematic one.
+        torque_samples: Grid instants per polynomial piece for the torque constraint.
 
     Returns:
         :class:`TimingResult`, verified against the limits.
 
     Raises:
         InvalidLimits: A limit is <= 0, NaN/inf or has the wrong shape.
-        InfeasibleProblem: No timing within the bounds meets the limits.
+        InvalidSettings: torque limits without a robot, a payload without torque limits.
+        InfeasibleProblem: No timing within the bounds meets the limits (also: the arm
+            cannot hold a via point still with its payload).
     """
     t0 = time.perf_counter()
     if method not in METHODS:
         raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
     random_generator(seed)  # refuse a bad seed before any work, for both methods
+    from pinarms.optim.torque import torque_constraint
+
+    torque = torque_constraint(robot, torque_limits, payload, torque_samples)
     if problem is None:
         problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
-                                trajectory_options=trajectory_options)
+                                trajectory_options=trajectory_options, torque=torque)
+    elif torque is not None:
+        raise InvalidSettings("give torque limits either in the prebuilt problem (TimingProblem(torque=...)) "
+                              "or as keywords, not both")
     before = problem.evaluations
     if method == "exact":
         sol = solve_exact(problem, seed=seed)

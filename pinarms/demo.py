@@ -151,7 +151,7 @@ def study_000(quick: bool = False) -> Study:
     _add_line_objects(session, arm.position(q_via[0]), arm.position(q_via[-1]))
     # the paper draws its joint curves in degrees: so do ours (joint 1 is revolute)
     plots = _plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised",
-                   degrees=True)
+                   degrees=True, joint_names=[arm.joint_names[0]], joint_units=[arm.joint_units[0]])
     return Study("000", "SCARA enoki-mushroom packer: 3-5-3 + GA timing", rows, session, plots)
 
 
@@ -245,7 +245,7 @@ def study_001(quick: bool = False) -> Study:
     session.add_workspace("workspace_flange", ws)
     session.add_points("P1-P4_via", arm.position(_unwrap_rows(q_robot)), kind="via")
     limits = planning.JointLimits(arm.velocity_limit)
-    plots = _plots(traj, limits, None, "seed 001: 3-segment quintic (paper angles)")
+    plots = _plots(traj, limits, None, "seed 001: 3-segment quintic (paper angles)", robot=arm)
     plots.update(_workspace_plots(ws, "seed 001: AUBO-i3 workspace (flange)"))
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
 
@@ -329,7 +329,8 @@ def study_002(quick: bool = False) -> Study:
     session.add_points("via_points", arm.position(np.array(GANTRY_PATH_AXIS_M)), kind="via")
     session.add_history("improved_ga_3axes", together.history)
     limits = planning.JointLimits(v, a, j)
-    plots = _plots(together.trajectory, limits, together.history, "seed 002: motor side, time-optimal B-spline")
+    plots = _plots(together.trajectory, limits, together.history, "seed 002: motor side, time-optimal B-spline",
+                   joint_names=[f"{name} motor" for name in arm.joint_names], joint_units=["rad"] * 3)
     return Study("002", "flower gantry: quintic B-spline + improved GA", rows, session, plots)
 
 
@@ -409,17 +410,21 @@ def study_004(quick: bool = False) -> Study:
                                   velocities=np.tile(rates, (6, 1)), accelerations=np.zeros((6, 4)))
     session.add_trajectory("constant_rates_10s", traj)
     session.add_points("fk_examples", arm.position(angles_deg * DEG), kind="target")
-    plots = _plots(traj, planning.JointLimits(arm.velocity_limit), None, "seed 004: joint rates")
+    plots = _plots(traj, planning.JointLimits(arm.velocity_limit), None, "seed 004: joint rates", robot=arm)
     return Study("004", "koji-block turner: FK examples, IK, simulation", rows, session, plots)
 
 
 # --------------------------------------------------------------------- plots
-def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = False) -> dict[str, Callable[[Path], Any]]:
-    """Plot writers (path → file) of a trajectory's joint curves and a GA history."""
+def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = False,
+           **joints: Any) -> dict[str, Callable[[Path], Any]]:
+    """Plot writers (path → file) of a trajectory's joint curves and a GA history.
+
+    ``joints``: ``robot=`` or ``joint_names=`` and ``joint_units=`` of the joints drawn.
+    """
     from pinarms.viz import plots as vplots
 
     out: dict[str, Callable[[Path], Any]] = {
-        "joints": lambda path: vplots.plot_trajectory(path, traj, limits=limits, title=title, degrees=degrees),
+        "joints": lambda path: vplots.plot_trajectory(path, traj, limits=limits, title=title, degrees=degrees, **joints),
     }
     if history is not None:
         out["ga"] = lambda path: vplots.plot_ga_convergence(path, history, title=f"{title}: GA", ylabel="total time [s]")

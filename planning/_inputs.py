@@ -17,9 +17,11 @@ from pinarms.planning.errors import TrajectoryError
 def finite_array(value: Any, what: str) -> np.ndarray:
     """``value`` as a float64 array; raises if it is not numeric or holds NaN/inf."""
     try:
+        if np.iscomplexobj(value):
+            raise TypeError("complex values")
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise TrajectoryError(f"{what} must be numeric, got {value!r}") from exc
+        raise TrajectoryError(f"{what} must be numeric (real), got {value!r}") from exc
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))[0]
         index = tuple(int(i) for i in bad)

@@ -33,7 +33,7 @@ from pinarms.planning.trajectory import Trajectory
 from pinarms.robots.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
-__all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "PATH_KINDS"]
+__all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "tcp_speed", "PATH_KINDS"]
 
 PATH_KINDS: dict[str, Callable[..., Trajectory]] = {
     "multi-quintic": multi_quintic,
@@ -136,3 +136,19 @@ def tcp_path(robot: Any, trajectory: Trajectory, hz: float, frame: str = "tcp") 
     t, q = trajectory.at_rate(hz)[:2]
     T = np.asarray(robot.fk(q, frame=frame))
     return t, T[:, :3, 3].copy()
+
+
+def tcp_speed(robot: Any, trajectory: Trajectory, hz: float, frame: str = "tcp") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """tcp speed along a trajectory sampled at ``hz``: ``(t (N,), linear (N,) [m/s], angular (N,) [rad/s])``.
+
+    ``|J(q) q̇|`` per sample (batched Jacobian, base axes at the tcp): the Cartesian speed
+    to plot beside the joint curves, or to check against a tool-speed limit.
+    """
+    if trajectory.n_joints != int(robot.nq):
+        raise TrajectoryError(
+            f"the trajectory has {trajectory.n_joints} joints but the robot has nq = {robot.nq}"
+        )
+    t, q, qd = trajectory.at_rate(hz)[:3]
+    J = np.asarray(robot.jacobian(q, frame=frame))
+    twist = np.einsum("nij,nj->ni", J, qd)
+    return t, np.linalg.norm(twist[:, :3], axis=1), np.linalg.norm(twist[:, 3:], axis=1)

@@ -60,25 +60,43 @@ _BUILDERS: dict[str, Callable[[dict], Trajectory]] = {
         _get(d, "jmax"),
         synchronized=d.get("synchronized", True),
     ),
-    "scaled": lambda d: from_definition(_get(d, "base")).scaled(_get(d, "factor")),
-    "shifted": lambda d: from_definition(_get(d, "base")).shifted(_get(d, "start_time")),
-    "concatenated": lambda d: reduce(
-        lambda a, b: a.concatenated(b), [from_definition(p) for p in _get(d, "parts")]
-    ),
+    "scaled": lambda d: _nested(_get(d, "base"), d).scaled(_get(d, "factor")),
+    "shifted": lambda d: _nested(_get(d, "base"), d).shifted(_get(d, "start_time")),
+    "concatenated": lambda d: reduce(lambda a, b: a.concatenated(b), [_nested(p, d) for p in _parts(d)]),
     "ppoly": lambda d: Trajectory(_get(d, "breaks"), _get(d, "coefficients")),
 }
+
+#: Deepest nesting of derived definitions (scaled of shifted of concatenated of ...) rebuilt.
+MAX_DEPTH = 32
+
+
+def _nested(part: Any, parent: dict) -> Trajectory:
+    return from_definition(part, _depth=parent["_depth"] + 1)
+
+
+def _parts(d: dict) -> list:
+    parts = _get(d, "parts")
+    if not isinstance(parts, list) or not parts:
+        raise TrajectoryError("a 'concatenated' definition needs a non-empty 'parts' list of definitions")
+    return parts
+
 
 #: Kinds :func:`from_definition` understands.
 KINDS: tuple[str, ...] = tuple(sorted(_BUILDERS))
 
 
-def from_definition(definition: dict) -> Trajectory:
-    """Rebuild the trajectory described by ``definition`` (a dict as given by ``Trajectory.definition``)."""
+def from_definition(definition: dict, *, _depth: int = 0) -> Trajectory:
+    """Rebuild the trajectory described by ``definition`` (a dict as given by ``Trajectory.definition``).
+
+    Raises:
+        TrajectoryError: not a dict, an unknown kind, a missing field, derived definitions
+            nested deeper than :data:`MAX_DEPTH`; the constructors' own errors otherwise.
+    """
     if not isinstance(definition, dict):
         raise TrajectoryError(f"a trajectory definition must be a dict, got {type(definition).__name__}")
+    if _depth > MAX_DEPTH:
+        raise TrajectoryError(f"trajectory definitions nest deeper than {MAX_DEPTH} levels")
     kind = definition.get("kind")
-    if kind not in _BUILDERS:
-        raise TrajectoryError(f"unknown trajectory kind {kind!r}; known kinds: {', '.join(KINDS)}")
-    if kind == "concatenated" and not definition.get("parts"):
-        raise TrajectoryError("a 'concatenated' definition needs a non-empty 'parts' list")
-    return _BUILDERS[kind](definition)
+    if not isinstance(kind, str) or kind not in _BUILDERS:
+        raise TrajectoryError(f"unknown trajectory kind {str(kind)[:100]!r}; known kinds: {', '.join(KINDS)}")
+    return _BUILDERS[kind]({**definition, "_depth": _depth})

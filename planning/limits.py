@@ -17,8 +17,8 @@ from pinarms.planning.errors import TrajectoryError
 
 __all__ = ["JointLimits"]
 
-_POSITIVE = ("velocity", "acceleration", "jerk")
-_FIELDS = ("velocity", "acceleration", "jerk", "lower", "upper")
+_POSITIVE = ("velocity", "acceleration", "jerk", "torque")
+_FIELDS = ("velocity", "acceleration", "jerk", "lower", "upper", "torque")
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,6 +30,9 @@ class JointLimits:
         acceleration: max |qdd| (rad/s² or m/s²), optional, > 0.
         jerk: max |qddd| (rad/s³ or m/s³), optional, > 0.
         lower, upper: position bounds (rad or m), optional; ``lower < upper``.
+        torque: max |joint torque| (N·m, or N for prismatic joints), optional, > 0; checking it
+            needs the robot whose inverse dynamics give the torques
+            (:meth:`planning.Trajectory.check` with ``robot=``).
     """
 
     velocity: Any
@@ -37,6 +40,7 @@ class JointLimits:
     jerk: Any = None
     lower: Any = None
     upper: Any = None
+    torque: Any = None
 
     def __post_init__(self) -> None:
         for name in _FIELDS:
@@ -81,14 +85,30 @@ class JointLimits:
         return np.broadcast_to(arr.reshape(-1) if arr.ndim else arr, (n_joints,)).astype(float)
 
     @classmethod
-    def from_robot(cls, robot: Any, acceleration: Any = None, jerk: Any = None) -> "JointLimits":
-        """Velocity and position limits of a robot (``velocity_limit``, ``lower``, ``upper``), plus optional ones."""
+    def from_robot(cls, robot: Any, acceleration: Any = None, jerk: Any = None, torque: Any = None) -> "JointLimits":
+        """Velocity and position limits of a robot (``velocity_limit``, ``lower``, ``upper``), plus optional ones.
+
+        ``torque=True`` takes the URDF's joint ``effort`` limits (``robot.effort_limit``);
+        a number or array gives them explicitly (N·m or N).
+        """
+        if torque is True:
+            effort = np.asarray(robot.effort_limit, dtype=float)
+            missing = [name for name, e in zip(robot.joint_names, effort) if not e > 0.0]
+            if missing:
+                raise TrajectoryError(
+                    f"robot '{robot.name}' has no effort limit for joint(s) {missing} in its URDF: "
+                    "pass torque=[...] (N·m or N per joint)"
+                )
+            torque = effort
+        elif torque is False:
+            torque = None
         return cls(
             velocity=np.asarray(robot.velocity_limit, dtype=float),
             acceleration=acceleration,
             jerk=jerk,
             lower=np.asarray(robot.lower, dtype=float),
             upper=np.asarray(robot.upper, dtype=float),
+            torque=torque,
         )
 
     def as_dict(self) -> dict[str, Any]:

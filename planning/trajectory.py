@@ -63,8 +63,9 @@ class Violation(NamedTuple):
     """One limit violation: joint index, time (s) of the worst value, kind, value, limit.
 
     ``kind`` is one of ``"position_lower"``, ``"position_upper"``, ``"velocity"``,
-    ``"acceleration"``, ``"jerk"``. For velocity/acceleration/jerk ``value`` is the peak
-    magnitude on the offending piece; for positions it is the extreme position.
+    ``"acceleration"``, ``"jerk"``, ``"torque"``. For velocity/acceleration/jerk/torque
+    ``value`` is the peak magnitude on the offending piece; for positions it is the extreme
+    position.
     """
 
     joint: int
@@ -73,12 +74,18 @@ class Violation(NamedTuple):
     value: float
     limit: float
 
+    @property
+    def ratio(self) -> float:
+        """``value / limit`` (how far past the limit; positions: the signed ratio)."""
+        return self.value / self.limit if self.limit != 0.0 else float("inf")
+
 
 @dataclass(frozen=True, eq=False)
 class LimitReport:
     """Result of :meth:`Trajectory.check`: every violation, at most one per joint, kind and piece."""
 
     violations: tuple[Violation, ...] = field(default_factory=tuple)
+    joint_names: tuple[str, ...] | None = None
 
     @property
     def ok(self) -> bool:
@@ -93,8 +100,10 @@ class LimitReport:
             return "all limits respected"
         lines = [f"{len(self.violations)} limit violation(s):"]
         for v in self.violations:
+            name = f" ({self.joint_names[v.joint]})" if self.joint_names and v.joint < len(self.joint_names) else ""
+            ratio = f" (ratio {v.ratio:.4g})" if v.kind in ("velocity", "acceleration", "jerk", "torque") else ""
             lines.append(
-                f"  joint {v.joint} at t = {v.time:.6g} s: {v.kind} {v.value:.6g} exceeds limit {v.limit:.6g}"
+                f"  joint {v.joint}{name} at t = {v.time:.6g} s: {v.kind} {v.value:.6g} exceeds limit {v.limit:.6g}{ratio}"
             )
         return "\n".join(lines)
 
@@ -235,7 +244,10 @@ class Trajectory:
         m = self.n_segments
         seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
         tau = tt - self._breaks[seg]
-        powers = tau[:, None] ** np.arange(self.degree + 1)
+        powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
+        powers[:, 0] = 1.0
+        for k in range(1, self.degree + 1):
+            np.multiply(powers[:, k - 1], tau, out=powers[:, k])
         out = np.empty((tt.size, 4 * n))
         if m == 1:
             np.matmul(powers, D[0], out=out)
@@ -313,13 +325,18 @@ class Trajectory:
         values, _ = self._extrema((0,), with_times=False)
         return values[0].min(axis=(0, 2)), values[0].max(axis=(0, 2))
 
-    def check(self, limits: Any, rtol: float = 1e-9) -> LimitReport:
+    def check(self, limits: Any, rtol: float = 1e-9, *, robot: Any = None) -> LimitReport:
         """Check against a :class:`planning.JointLimits`; report every violation.
 
         A value counts as a violation when it exceeds the limit by more than ``rtol``
         relative (so an optimised trajectory that touches a limit passes). One
         :class:`Violation` is reported per joint, kind and piece, at the time of the worst
         value on that piece; the list is sorted by time.
+
+        Torque limits (``limits.torque``) need ``robot`` (a :class:`robots.Robot`, with its
+        payload if it carries one): its inverse dynamics give the torques, peaked per piece
+        on a dense grid refined around each maximum (:mod:`planning.torque`). With a robot
+        the report names the joints.
         """
         from pinarms.planning.limits import JointLimits
 
@@ -327,6 +344,17 @@ class Trajectory:
             raise TrajectoryError(f"limits must be a planning.JointLimits, got {type(limits).__name__}")
         n = self.n_joints
         found: list[Violation] = []
+        if limits.torque is not None:
+            if robot is None:
+                raise TrajectoryError(
+                    "torque limits need the robot whose inverse dynamics give the torques: check(limits, robot=arm)"
+                )
+            from pinarms.planning.torque import piece_torque_peaks
+
+            lim = limits.for_joints("torque", n)
+            peak, when, _ = piece_torque_peaks(self, robot)
+            for seg, j in zip(*np.nonzero(peak > lim[None, :] * (1.0 + rtol))):
+                found.append(Violation(int(j), float(when[seg, j]), "torque", float(peak[seg, j]), float(lim[j])))
         orders = tuple(r for r, name in _KIND_BY_ORDER.items() if getattr(limits, name) is not None)
         if orders:
             values, times = self._extrema(orders)
@@ -359,7 +387,29 @@ class Trajectory:
                 for seg, j in zip(*np.nonzero(vmax > hi[None, :] + rtol * span)):
                     found.append(Violation(int(j), float(tmax[seg, j]), "position_upper", float(vmax[seg, j]), float(hi[j])))
         found.sort(key=lambda v: (v.time, v.joint, v.kind))
-        return LimitReport(tuple(found))
+        names = tuple(robot.joint_names) if robot is not None and getattr(robot, "nq", None) == n else None
+        return LimitReport(tuple(found), names)
+
+    # --------------------------------------------------------------------- torques
+    def torques(self, robot: Any, t: Any) -> np.ndarray:
+        """Joint torques [N·m or N] of ``robot`` following this trajectory at instants ``t`` [s].
+
+        ``(len(t), nq)`` (or ``(nq,)`` for a scalar ``t``), by the robot's inverse dynamics
+        (:func:`planning.torque.torques`); a payload is the robot's own (``robot.with_payload``).
+        """
+        from pinarms.planning.torque import torques
+
+        return torques(self, robot, t)
+
+    def torque_peaks(self, robot: Any, samples_per_piece: int | None = None) -> Any:
+        """Per-joint peaks of ``|torque|`` with their instants (:class:`planning.torque.TorquePeaks`).
+
+        Dense grid per piece (default :data:`planning.torque.SAMPLES_PER_PIECE`) refined
+        around each maximum; see :mod:`planning.torque`.
+        """
+        from pinarms.planning.torque import SAMPLES_PER_PIECE, torque_peaks
+
+        return torque_peaks(self, robot, SAMPLES_PER_PIECE if samples_per_piece is None else samples_per_piece)
 
     # ------------------------------------------------------------ transformations
     def scaled(self, factor: float) -> "Trajectory":
@@ -370,8 +420,12 @@ class Trajectory:
         f = scalar(factor, "factor")
         if f <= 0.0:
             raise TrajectoryError(f"factor must be positive, got {factor!r}")
-        breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
-        coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            breaks = self._breaks[0] + (self._breaks - self._breaks[0]) * f
+            coefs = self._coefs / (f ** np.arange(self.degree + 1))[None, :, None]
+        if not (np.all(np.isfinite(breaks)) and np.all(np.isfinite(coefs)) and np.all(np.diff(breaks) > 0.0)):
+            raise TrajectoryError(f"factor {f!r} takes the scaled trajectory beyond float64 (its times or "
+                                  f"coefficients overflow or collapse); use a factor nearer 1")
         return Trajectory(breaks, coefs, {"kind": "scaled", "factor": f, "base": self.definition})
 
     def shifted(self, start_time: float) -> "Trajectory":

@@ -6,6 +6,7 @@
 """
 
 from .errors import (
+    ExecutionError,
     InvalidInput,
     CellError,
     CellNotFound,
@@ -40,6 +41,7 @@ __all__ = [
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "ExecutionError",
     "XacroError",
     "XacroForbidden",
     "XacroLimitExceeded",
@@ -57,6 +59,7 @@ from .placement import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
 from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
 from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
+from .workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
 
 __all__ += [
     "Workspace",
@@ -64,6 +67,8 @@ __all__ += [
     "SphereFit",
     "sample_workspace",
     "fit_sphere",
+    "StreamedWorkspace",
+    "stream_workspace",
     "VoxelMap",
     "suggest_voxel_size",
     "RecommendedRegion",
@@ -72,6 +77,11 @@ __all__ += [
     "LayoutReport",
     "check_layout",
 ]
+
+# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
+from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
+
+__all__ += ["Payload", "InvalidPayload", "MissingInertials"]
 
 # users' xacro files, expanded behind a wall
 from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402

@@ -15,6 +15,7 @@ __all__ = [
     "ModelError",
     "UnreachableTarget",
     "LimitViolation",
+    "ExecutionError",
     "XacroError",
     "XacroForbidden",
     "XacroLimitExceeded",
@@ -49,6 +50,31 @@ class UnreachableTarget(PinarmsError):
 
 class LimitViolation(PinarmsError):
     """A configuration or trajectory violates the robot's limits."""
+
+
+class ExecutionError(PinarmsError):
+    """A chunk of a sweep failed: its task raised, or the worker running it died.
+
+    Raised by :func:`pinarms.execution.map_chunks` (serial loop or Dask cluster alike) instead
+    of returning a partial result. ``chunk`` is the failing task's index in the task list
+    (``None`` when the cluster itself could not be reached), ``seed`` the task's seed when it
+    carries one, ``cause`` a one-line description of the original error. Re-run the chunk on
+    its own with that seed to reproduce it.
+    """
+
+    def __init__(self, message: str, *, chunk: int | None = None, seed: int | None = None,
+                 cause: str = "") -> None:
+        super().__init__(message)
+        self.chunk = chunk
+        self.seed = seed
+        self.cause = cause
+
+    def __reduce__(self):  # keep the fields when the error crosses a process boundary
+        return (_rebuild_execution_error, (str(self), self.chunk, self.seed, self.cause))
+
+
+def _rebuild_execution_error(message, chunk, seed, cause):
+    return ExecutionError(message, chunk=chunk, seed=seed, cause=cause)
 
 
 class XacroError(ModelError):

@@ -59,24 +59,24 @@ class JointCoordinates:
         """Pinocchio configuration vector(s) for ``q (nq,)`` or ``(N, nq)``."""
         q = np.asarray(q, dtype=float)
         out = np.zeros(q.shape[:-1] + (self.nq_pin,))
-        for j, (iq, unb) in enumerate(zip(self.idx_q_pin, self.is_unbounded)):
-            if unb:
-                out[..., iq] = np.cos(q[..., j])
-                out[..., iq + 1] = np.sin(q[..., j])
-            else:
-                out[..., iq] = q[..., j]
+        unb = self.is_unbounded
+        if not unb.any():
+            out[..., self.idx_q_pin] = q
+            return out
+        iq = self.idx_q_pin
+        out[..., iq[~unb]] = q[..., ~unb]
+        out[..., iq[unb]] = np.cos(q[..., unb])
+        out[..., iq[unb] + 1] = np.sin(q[..., unb])
         return out
 
     def from_pin(self, q_pin: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`to_pin`."""
         q_pin = np.asarray(q_pin, dtype=float)
-        cols = []
-        for iq, unb in zip(self.idx_q_pin, self.is_unbounded):
-            if unb:
-                cols.append(np.arctan2(q_pin[..., iq + 1], q_pin[..., iq]))
-            else:
-                cols.append(q_pin[..., iq])
-        return np.stack(cols, axis=-1)
+        iq, unb = self.idx_q_pin, self.is_unbounded
+        out = q_pin[..., iq]
+        if unb.any():
+            out[..., unb] = np.arctan2(q_pin[..., iq[unb] + 1], q_pin[..., iq[unb]])
+        return out
 
 
 class KinematicTree:
@@ -166,13 +166,35 @@ class KinematicTree:
                 chain.append(j)
                 j = self.parent[j]
             self.ancestors.append(chain[::-1])
+        # Constants of the evaluation, computed once: for every joint the nonzero terms of
+        # its placement (entries within 1e-14 of 0 or ±1 snapped), its coordinate's
+        # index, scale and offset as plain Python numbers; the same for every frame.
+        self._steps = [None] + [
+            (
+                i,
+                int(self.parent[i]),
+                _matrix_terms(self.local_R[i]),
+                _vector_terms(self.local_p[i]),
+                int(self.q_index[i]),
+                float(self.scale[i]),
+                float(self.offset[i]),
+                int(self.kind[i]) == _REVOLUTE,
+            )
+            for i in range(1, n)
+        ]
+        self._path = [tuple(self._steps[i] for i in chain) for chain in self.ancestors]
+        self._frames = []
+        for f in model.frames:
+            A = axis_rot[f.parentJoint]
+            fR = A.T @ f.placement.rotation
+            fp = A.T @ f.placement.translation
+            self._frames.append((int(f.parentJoint), fR, fp, _matrix_terms(fR), _vector_terms(fp)))
 
     # ------------------------------------------------------------------ frames
     def frame_of(self, frame_id: int) -> tuple[int, np.ndarray, np.ndarray]:
         """``(joint, R, p)``: the frame's parent joint and its placement in the batched joint frame."""
-        f = self.model.frames[frame_id]
-        A = self.axis_rot[f.parentJoint]
-        return f.parentJoint, A.T @ f.placement.rotation, A.T @ f.placement.translation
+        joint, fR, fp, _, _ = self._frames[frame_id]
+        return joint, fR.copy(), fp.copy()
 
     # ------------------------------------------------------------- evaluation
     # Rotations are held as 3×3 nested lists of (N,) arrays (structure of arrays), so
@@ -186,17 +208,16 @@ class KinematicTree:
         """
         Rs = {0: _IDENTITY}
         ps = {0: [0.0, 0.0, 0.0]}
-        for i in self.ancestors[upto]:
-            par = self.parent[i]
+        for i, par, R_terms, p_terms, iq, scale, offset, revolute in self._path[upto]:
             Rp, pp = Rs[par], ps[par]
-            R = _mat_const(Rp, self.local_R[i])
-            p = _add(pp, _vec_const(Rp, self.local_p[i]))
-            value = q[:, self.q_index[i]]
-            if self.scale[i] != 1.0:
-                value = self.scale[i] * value
-            if self.offset[i] != 0.0:
-                value = value + self.offset[i]
-            if self.kind[i] == _REVOLUTE:
+            R = _mat_const(Rp, R_terms)
+            p = _add(pp, _vec_const(Rp, p_terms))
+            value = q[:, iq]
+            if scale != 1.0:
+                value = scale * value
+            if offset != 0.0:
+                value = value + offset
+            if revolute:
                 c, s = np.cos(value), np.sin(value)
                 for row in R:
                     x, y = row[0], row[1]
@@ -210,7 +231,7 @@ class KinematicTree:
         """Homogeneous transforms ``(N, 4, 4)`` frame → world for a batch ``q (N, nq)``."""
         N = q.shape[0]
         out = np.empty((N, 4, 4))
-        joint, fR, fp = self.frame_of(frame_id)
+        joint, _, _, fR, fp = self._frames[frame_id]
 
         def block(start: int) -> None:
             qc = q[start : start + _CHUNK]
@@ -241,7 +262,7 @@ class KinematicTree:
         of a prismatic joint: ``[axis; 0]``; a mimic joint adds ``scale ×`` its column to
         its master's column.
         """
-        joint, _, fp = self.frame_of(frame_id)
+        joint, _, _, _, fp = self._frames[frame_id]
         Rs, ps = self._joint_poses(qc, joint)
         p = _add(ps[joint], _vec_const(Rs[joint], fp))
         cols: list = [[0.0] * 6 for _ in range(self.nq)]
@@ -256,6 +277,38 @@ class KinematicTree:
             for a in range(6):
                 col[a] = col[a] + (six[a] if k == 1.0 else k * six[a])
         return p, cols
+
+    def pose_and_jacobian(self, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Frame rotation ``(N, 3, 3)``, origin ``(N, 3)`` [m] and Jacobian ``(N, 6, nq)`` of a batch, in one pass.
+
+        The Jacobian is :meth:`frame_jacobian`'s (base axes at the frame origin, linear rows
+        first). One evaluation of the joint poses serves all three (batched IK needs them at
+        every iterate); no threads: the caller chunks.
+        """
+        N = q.shape[0]
+        joint, _, _, fR, fp = self._frames[frame_id]
+        Rs, ps = self._joint_poses(q, joint)
+        Rj = Rs[joint]
+        Rf = _mat_const(Rj, fR)
+        p = _add(ps[joint], _vec_const(Rj, fp))
+        R = np.empty((N, 3, 3))
+        P = np.empty((N, 3))
+        for a in range(3):
+            P[:, a] = p[a]
+            for b in range(3):
+                R[:, a, b] = Rf[a][b]
+        J = np.zeros((N, 6, self.nq))
+        for i in self.ancestors[joint]:
+            w = [Rs[i][k][2] for k in range(3)]
+            if self.kind[i] == _REVOLUTE:
+                d = [p[a] - ps[i][a] for a in range(3)]
+                six = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]] + w
+            else:
+                six = w + [0.0, 0.0, 0.0]
+            k, c = self.scale[i], self.q_index[i]
+            for a in range(6):
+                J[:, a, c] += six[a] if k == 1.0 else k * six[a]
+        return R, P, J
 
     def frame_jacobian(self, q: np.ndarray, frame_id: int) -> np.ndarray:
         """Frame Jacobians ``(N, 6, nq)``: world-aligned axes at the frame origin, linear rows first."""
@@ -300,26 +353,36 @@ def _snap(x: float) -> float:
     return float(x)
 
 
-def _lin(terms: list) -> Any:
-    """Σ coefficient·value over (value, coefficient) pairs, skipping zeros and unit factors."""
+def _vector_terms(v: np.ndarray) -> tuple:
+    """``((k, v_k), ...)`` for the entries of a constant vector that are not (snapped) zero."""
+    return tuple((k, c) for k in range(3) if (c := _snap(v[k])) != 0.0)
+
+
+def _matrix_terms(C: np.ndarray) -> tuple:
+    """:func:`_vector_terms` of each column of a constant 3×3 matrix."""
+    return tuple(_vector_terms(C[:, b]) for b in range(3))
+
+
+def _dot(row: list, terms: tuple) -> Any:
+    """``Σ row[k]·c`` over the precomputed nonzero terms ``(k, c)``, skipping exact zeros and unit factors."""
     acc = 0.0
-    for value, coef in terms:
-        coef = _snap(coef)
-        if coef == 0.0 or (isinstance(value, float) and value == 0.0):
+    for k, c in terms:
+        value = row[k]
+        if value.__class__ is float and value == 0.0:
             continue
-        term = value if coef == 1.0 else (-value if coef == -1.0 else coef * value)
-        acc = term if (isinstance(acc, float) and acc == 0.0) else acc + term
+        term = value if c == 1.0 else (-value if c == -1.0 else c * value)
+        acc = term if (acc.__class__ is float and acc == 0.0) else acc + term
     return acc
 
 
-def _mat_const(R: list, C: np.ndarray) -> list:
-    """``R · C`` for a batched rotation ``R`` (nested lists) and a constant 3×3 ``C``."""
-    return [[_lin([(R[a][k], C[k, b]) for k in range(3)]) for b in range(3)] for a in range(3)]
+def _mat_const(R: list, C_terms: tuple) -> list:
+    """``R · C`` for a batched rotation ``R`` (nested lists) and a constant 3×3 ``C`` (as :func:`_matrix_terms`)."""
+    return [[_dot(row, col) for col in C_terms] for row in R]
 
 
-def _vec_const(R: list, v: np.ndarray) -> list:
-    """``R · v`` for a batched rotation ``R`` and a constant vector ``v``."""
-    return [_lin([(R[a][k], v[k]) for k in range(3)]) for a in range(3)]
+def _vec_const(R: list, v_terms: tuple) -> list:
+    """``R · v`` for a batched rotation ``R`` and a constant vector ``v`` (as :func:`_vector_terms`)."""
+    return [_dot(row, v_terms) for row in R]
 
 
 def _add(p: list, d: list) -> list:

@@ -266,7 +266,7 @@ def check_layout(
 
     if robot.has_analytic_ik:
         method = "analytic"
-        sols = [np.asarray(s, dtype=float).reshape(-1, robot.nq) for s in robot.ik_all(T)]
+        sols = [np.asarray(s, dtype=float).reshape(-1, robot.nq) for s in robot.ik_all(T, equivalents=True)]
         if yaw_free:
             # position-only target of an arm that keeps the tool vertical: its yaw is free
             R0 = T[:, :3, :3].copy()
@@ -276,7 +276,7 @@ def check_layout(
                     break
                 Ty = T[todo].copy()
                 Ty[:, :3, :3] = _rot_z(yaw) @ R0[todo]
-                for i, Ti, q in zip(todo, Ty, robot.ik_all(Ty)):
+                for i, Ti, q in zip(todo, Ty, robot.ik_all(Ty, equivalents=True)):
                     q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
                     if q.shape[0]:
                         sols[i], T[i] = q, Ti
@@ -288,7 +288,7 @@ def check_layout(
                     if q.shape[0]:
                         Ti = T[i].copy()
                         Ti[:3, :3] = robot.fk(q[0])[:3, :3]
-                        exact = np.asarray(robot.ik_all(Ti), dtype=float).reshape(-1, robot.nq)
+                        exact = np.asarray(robot.ik_all(Ti, equivalents=True), dtype=float).reshape(-1, robot.nq)
                         sols[i], T[i] = (exact, Ti) if exact.shape[0] else (q[:1], Ti)
     else:
         method = "numerical"

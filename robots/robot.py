@@ -14,67 +14,47 @@ Conventions
 
 from __future__ import annotations
 
+import math
+from math import isfinite as _isfinite
+import threading
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg.lapack import dpotrf as _potrf
 
-from .errors import InvalidInput, ModelError
+from ._checks import as_batch as _as_batch
+from ._checks import as_generator as _as_generator
+from ._checks import check_seed as _check_seed
+from ._checks import check_tolerance as _check_tolerance
+from .errors import InvalidInput, ModelError, UnreachableTarget
+from .ik.numerical import NumericalIK
+from .ik.solver import split_by_target
 from .kinematic_tree import KinematicTree
 
-__all__ = ["Robot"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+
+MAX_RANDOM_SAMPLES = 50_000_000
+"""Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
+
+#: Batches of at most this many configurations are evaluated by one Pinocchio call per
+#: configuration (about 1-2 µs each); larger ones by the batched numpy evaluation, whose
+#: fixed cost (about 100 µs) pays from a few dozen configurations on.
+SMALL_BATCH = 24
+
+_F64 = np.dtype(np.float64)
+_LWA = pin.LOCAL_WORLD_ALIGNED
 
 
-def _as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
-    """Validate ``values`` as ``(width,)`` or ``(N, width)`` finite floats.
+class _PerThread(threading.local):
+    """Per-thread slot of a Robot's Pinocchio data (``model`` is the model it was made for)."""
 
-    Returns the ``(N, width)`` array and whether the input was a single vector.
-    """
-    try:
-        arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers, got {values!r}") from exc
-    single = arr.ndim == 1
-    if single:
-        arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != width:
-        raise InvalidInput(
-            f"{what} must have shape ({width},) or (N, {width}), got {np.shape(values)}"
-        )
-    if not np.all(np.isfinite(arr)):
-        bad = np.argwhere(~np.isfinite(arr))[0]
-        raise InvalidInput(f"{what} holds a non-finite value at index {tuple(bad.tolist())}")
-    return arr, single
+    model = None
+    data = None
 
 
-def _check_seed(seed: Any, what: str = "seed") -> Any:
-    """``seed`` unchanged if it is ``None``, a non-negative int or a ``numpy.random.Generator``.
-
-    Raises:
-        InvalidInput: anything else (a negative or fractional number, a string, ...).
-    """
-    if seed is None or isinstance(seed, np.random.Generator):
-        return seed
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInput(f"{what} must be None, a non-negative integer or a numpy.random.Generator, got {seed!r}")
-    return seed
-
-
-def _as_generator(seed: Any, what: str = "seed") -> np.random.Generator:
-    """``seed`` (see :func:`_check_seed`) as a ``numpy.random.Generator`` (a Generator is returned as is)."""
-    seed = _check_seed(seed, what)
-    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-
-
-def _check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
-    """``tol`` as a finite float ``>= 0`` (``> 0`` when ``positive``); :class:`InvalidInput` otherwise."""
-    ok = isinstance(tol, (int, float, np.integer, np.floating)) and not isinstance(tol, bool)
-    value = float(tol) if ok else float("nan")
-    if not (np.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
-        sign = "positive" if positive else "non-negative"
-        raise InvalidInput(f"{what} must be a finite {sign} number, got {tol!r}")
-    return value
+_PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
 
 
 class Robot:
@@ -113,9 +93,16 @@ class Robot:
         self.urdf_path = urdf_path
         self.package_dirs = tuple(package_dirs)
         self.description = description
-        self._data = model.createData()
+        self._local = _PerThread()  # per-thread Pinocchio data (see _pin_data)
         self._tree = KinematicTree(model)
         self.nq: int = self._tree.nq
+        coords = self._tree.coordinates
+        #: Pinocchio's configuration vector is pinarms' q itself (no continuous joint)
+        self._same_q = (not coords.is_unbounded.any()) and model.nq == self.nq
+        self._shape1 = (self.nq,)
+        self._frame_ids: dict[str, int] = {}
+        for i, f in enumerate(model.frames):
+            self._frame_ids.setdefault(f.name, i)  # the first frame of a name, as Pinocchio's getFrameId
         names = [""] * self.nq
         for i in range(1, model.njoints):
             j = model.joints[i]
@@ -132,13 +119,36 @@ class Robot:
         self.upper = hi
         self.velocity_limit = np.array(model.velocityLimit, dtype=float)
         self.effort_limit = np.array(model.effortLimit, dtype=float)
-        if tcp_frame not in self.frame_names:
-            raise ModelError(
-                f"robot '{name}' has no frame '{tcp_frame}' to use as tcp; "
-                f"frames are: {', '.join(self.frame_names)}"
-            )
         self.tcp_frame = tcp_frame
         self._analytic_ik = None  # set by the registry for arms with a closed form
+
+    # ------------------------------------------------------------- threads
+    # Thread-safety rule: a Robot may be shared by any number of threads. Pinocchio's Data
+    # (the scratch memory of its algorithms) is the only state written during kinematics
+    # and IK, and every thread gets its own, created on first use; everything else a call
+    # reads (model, limits, compiled constants) is never written after construction.
+    def _pin_data(self) -> pin.Data:
+        """This thread's Pinocchio data of :attr:`model` (created on first use, again if the model was replaced)."""
+        local = self._local
+        if local.model is not self.model:
+            local.data = self.model.createData()
+            local.model = self.model
+        return local.data
+
+    @property
+    def _data(self) -> pin.Data:
+        """This thread's Pinocchio data (kept for code written before the per-thread data)."""
+        return self._pin_data()
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state.pop("_local", None)  # per-thread scratch data: never copied
+        state.pop("_numerical_ik_solver", None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._local = _PerThread()
 
     # ----------------------------------------------------------------- basics
     def __repr__(self) -> str:
@@ -149,14 +159,40 @@ class Robot:
         """Names of every Pinocchio frame (links, joints, fixed frames)."""
         return tuple(f.name for f in self.model.frames)
 
+    @property
+    def tcp_frame(self) -> str:
+        """The frame used when ``frame="tcp"`` is asked."""
+        return self._tcp_frame
+
+    @tcp_frame.setter
+    def tcp_frame(self, name: str) -> None:
+        if not isinstance(name, str) or name not in self._frame_ids:
+            raise ModelError(
+                f"robot '{self.name}' has no frame {name!r} to use as tcp; frames are: {', '.join(self.frame_names)}"
+            )
+        self._tcp_frame = name
+        self._frame_lookup = {**self._frame_ids, "tcp": self._frame_ids[name]}
+
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame`` (``"tcp"`` means :attr:`tcp_frame`)."""
-        name = self.tcp_frame if frame == "tcp" else frame
-        if not isinstance(name, str) or not self.model.existFrame(name):
+        try:
+            return self._frame_lookup[frame]
+        except (KeyError, TypeError):
             raise InvalidInput(
                 f"robot '{self.name}' has no frame {frame!r}; frames are: {', '.join(self.frame_names)}"
-            )
-        return self.model.getFrameId(name)
+            ) from None
+
+    def _one(self, q: Any) -> np.ndarray | None:
+        """Pinocchio's vector for ``q`` when it is one valid float64 configuration ``(nq,)``, else ``None``.
+
+        The fast path of the one-configuration calls; anything else (lists, batches, wrong
+        shapes, NaN) goes through :meth:`check_q`, which names what is wrong.
+        """
+        if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64:
+            s = q.dot(q)
+            if _isfinite(s):  # finite (a NaN or inf entry makes it NaN; an overflow goes the slow way)
+                return q if self._same_q else self._tree.coordinates.to_pin(q)
+        return None
 
     def check_q(self, q: Any) -> tuple[np.ndarray, bool]:
         """``q`` as a ``(N, nq)`` array plus a flag telling it was one ``(nq,)`` vector."""
@@ -167,6 +203,15 @@ class Robot:
         arr, single = self.check_q(q)
         out = self._tree.coordinates.to_pin(arr)
         return out[0] if single else out
+
+    @property
+    def joint_units(self) -> tuple[str, ...]:
+        """Unit of each independent joint's position, in ``q`` order: ``"rad"`` (revolute) or ``"m"`` (prismatic)."""
+        units = [""] * self.nq
+        for j in self.model.joints[1:]:
+            if "Mimic" not in j.shortname():
+                units[j.idx_v] = "m" if j.shortname().startswith("JointModelP") else "rad"
+        return tuple(units)
 
     @property
     def neutral(self) -> np.ndarray:
@@ -197,15 +242,53 @@ class Robot:
         """``n`` configurations ``(n, nq)`` drawn uniformly within the position limits."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
             raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+        if n > MAX_RANDOM_SAMPLES:
+            raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (about "
+                               f"{n * 100 / 1e9:.3g} GB of work); draw several seeded batches instead")
         rng = _as_generator(seed)
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
     # ------------------------------------------------------------- kinematics
     def fk(self, q: Any, frame: str = "tcp") -> np.ndarray:
-        """Pose ``T_frame_to_base``: ``(4, 4)`` for ``q (nq,)``, ``(N, 4, 4)`` for ``q (N, nq)``."""
+        """Pose ``T_frame_to_base``: ``(4, 4)`` for ``q (nq,)``, ``(N, 4, 4)`` for ``q (N, nq)``.
+
+        One configuration (and batches of up to :data:`SMALL_BATCH`) are evaluated by
+        Pinocchio directly; larger batches by the batched evaluator (:mod:`.kinematic_tree`).
+        Both agree to rounding (about 1e-15).
+        """
+        try:
+            fid = self._frame_lookup[frame]
+        except (KeyError, TypeError):
+            fid = self.frame_id(frame)  # raises the named error
+        if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
+            s = q.dot(q)  # the fast path of _one, inlined (a call costs as much as the check)
+            if _isfinite(s):
+                local = self._local
+                data = local.data if local.model is self.model else self._pin_data()
+                pin.forwardKinematics(self.model, data, q)
+                return pin.updateFramePlacement(self.model, data, fid).homogeneous
+        x = self._one(q)
+        if x is not None:
+            data = self._pin_data()
+            pin.forwardKinematics(self.model, data, x)
+            return pin.updateFramePlacement(self.model, data, fid).homogeneous
         arr, single = self.check_q(q)
-        T = self._tree.frame_pose(arr, self.frame_id(frame))
+        if arr.shape[0] <= SMALL_BATCH:
+            T = self._pin_poses(arr, fid)
+        else:
+            T = self._tree.frame_pose(arr, fid)
         return T[0] if single else T
+
+    def _pin_poses(self, arr: np.ndarray, fid: int) -> np.ndarray:
+        """Poses ``(N, 4, 4)`` of a checked batch by one Pinocchio call per configuration."""
+        model, data = self.model, self._pin_data()
+        qp = arr if self._same_q else self._tree.coordinates.to_pin(arr)
+        out = np.empty((arr.shape[0], 4, 4))
+        fk, place = pin.forwardKinematics, pin.updateFramePlacement
+        for k in range(arr.shape[0]):
+            fk(model, data, qp[k])
+            out[k] = place(model, data, fid).homogeneous
+        return out
 
     def position(self, q: Any, frame: str = "tcp") -> np.ndarray:
         """Origin of ``frame`` in the base frame [m]: ``(3,)`` or ``(N, 3)``."""
@@ -218,15 +301,39 @@ class Robot:
         fid = self.frame_id(frame)
         qp = self._tree.coordinates.to_pin(arr)
         out = np.empty((arr.shape[0], 4, 4))
+        data = self._pin_data()
         for k in range(arr.shape[0]):
-            pin.framesForwardKinematics(self.model, self._data, qp[k])
-            out[k] = self._data.oMf[fid].homogeneous
+            pin.framesForwardKinematics(self.model, data, qp[k])
+            out[k] = data.oMf[fid].homogeneous
         return out[0] if single else out
 
     def jacobian(self, q: Any, frame: str = "tcp") -> np.ndarray:
-        """Frame Jacobian ``(6, nq)`` or ``(N, 6, nq)``: base axes at the frame origin, linear rows first."""
+        """Frame Jacobian ``(6, nq)`` or ``(N, 6, nq)``: base axes at the frame origin, linear rows first.
+
+        Small batches by Pinocchio directly, large ones batched, as :meth:`fk`.
+        """
+        try:
+            fid = self._frame_lookup[frame]
+        except (KeyError, TypeError):
+            fid = self.frame_id(frame)
+        if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
+            s = q.dot(q)  # the fast path of _one, inlined
+            if _isfinite(s):
+                local = self._local
+                data = local.data if local.model is self.model else self._pin_data()
+                return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
+        x = self._one(q)
+        if x is not None:
+            return pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)
         arr, single = self.check_q(q)
-        J = self._tree.frame_jacobian(arr, self.frame_id(frame))
+        if arr.shape[0] <= SMALL_BATCH:
+            model, data = self.model, self._pin_data()
+            qp = arr if self._same_q else self._tree.coordinates.to_pin(arr)
+            J = np.empty((arr.shape[0], 6, self.nq))
+            for k in range(arr.shape[0]):
+                J[k] = pin.computeFrameJacobian(model, data, qp[k], fid, _LWA)
+        else:
+            J = self._tree.frame_jacobian(arr, fid)
         return J[0] if single else J
 
     def manipulability(self, q: Any, frame: str = "tcp", part: str = "full") -> float | np.ndarray:
@@ -237,16 +344,25 @@ class Robot:
                 When the Jacobian has fewer columns than rows (an arm with fewer joints
                 than task dimensions), ``w = sqrt(det(Jᵀ J))``: the volume of the velocity
                 ellipsoid within the arm's own motion space.
+
+        Returns:
+            a float for one ``q (nq,)``, an array ``(N,)`` for a batch.
         """
         J = self.jacobian(q, frame)
-        rows = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
-        if part not in rows:
-            raise InvalidInput(f"part must be one of {sorted(rows)}, got {part!r}")
-        J = J[..., rows[part], :]
+        rows = _PARTS.get(part) if isinstance(part, str) else None
+        if rows is None:
+            raise InvalidInput(f"part must be one of {sorted(_PARTS)}, got {part!r}")
+        J = J[..., rows, :]
         m, n = J.shape[-2:]
+        if J.ndim == 2:  # one configuration: sqrt(det G) is the product of G's Cholesky diagonal
+            G = J.dot(J.T) if m <= n else J.T.dot(J)
+            L, info = _potrf(G, overwrite_a=1)
+            if info == 0:
+                return math.prod(L.diagonal().tolist())
+            G = J.dot(J.T) if m <= n else J.T.dot(J)  # singular in floating point: as the batch does
+            return float(np.sqrt(max(np.linalg.det(G), 0.0)))
         G = J @ np.swapaxes(J, -1, -2) if m <= n else np.swapaxes(J, -1, -2) @ J
-        w = np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
-        return float(w) if np.ndim(w) == 0 else w
+        return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
 
     # -------------------------------------------------------- inverse kinematics
     @property
@@ -264,10 +380,23 @@ class Robot:
             InvalidInput: wrong shape, non-finite entries, or a rotation block that is not a
                 proper rotation (orthonormal within 1e-6, determinant +1).
         """
+        if target.__class__ is np.ndarray and target.shape == (4, 4) and target.dtype is _F64:
+            m = target.tolist()  # one pose: the checks below in plain floats (numpy calls cost µs each)
+            (a, b, c, x), (d, e, f, y), (g, h, i, z), last = m
+            if all(map(math.isfinite, (a, b, c, d, e, f, g, h, i, x, y, z))) and last == [0.0, 0.0, 0.0, 1.0]:
+                ortho = max(
+                    abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0), abs(g * g + h * h + i * i - 1.0),
+                    abs(a * d + b * e + c * f), abs(a * g + b * h + c * i), abs(d * g + e * h + f * i),
+                )
+                det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+                if ortho <= 1e-6 and det > 0.0:
+                    return target[None], True
         try:
+            if np.iscomplexobj(target):
+                raise TypeError("complex numbers")
             arr = np.asarray(target, dtype=float)
         except (TypeError, ValueError) as exc:
-            raise InvalidInput(f"IK target must be numbers, got {target!r}") from exc
+            raise InvalidInput(f"IK target must be numbers (real), got {target!r}") from exc
         if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
             single = arr.ndim == 1
             pts = arr.reshape(-1, 3)
@@ -307,14 +436,21 @@ class Robot:
         return arr, single
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False
     ) -> np.ndarray | list[np.ndarray]:
-        """Every closed-form IK solution within the joint limits (tolerance 1e-9 rad or m).
+        """Every closed-form IK branch within the joint limits (tolerance 1e-9 rad or m), each once.
+
+        A branch (UR-type: shoulder × wrist flip × elbow) is listed once, each revolute angle
+        at its 2π equivalent within the limits nearest ``q_ref``; a branch none of whose
+        equivalents lies within the limits is left out.
 
         Args:
             target: tcp pose ``(4, 4)`` (frame → base, m), or a batch ``(N, 4, 4)``.
             q_ref: ``(nq,)`` or ``(N, nq)``: solutions are sorted by distance to it
-                (default :attr:`neutral`); it also fixes the free joint at singular poses.
+                (default :attr:`neutral`); it also fixes the free joint at singular poses
+                and picks each angle's 2π equivalent.
+            equivalents: also list every other 2π equivalent within the limits (a UR's ±2π
+                joints give up to 2⁶ = 64 rows per branch, about 228 per pose).
             respect_limits: ``False`` returns the geometric solutions whatever the joint
                 limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
@@ -330,10 +466,8 @@ class Robot:
         T, single, ref = self._analytic_targets(target, q_ref)
         if T.shape[0] == 0:
             return []
-        from .ik.solver import split_by_target  # late import: the solvers need the Robot class
-
         if respect_limits:
-            sols = self._analytic_ik.solve(T, ref)
+            sols = self._analytic_ik.solve(T, ref, equivalents=bool(equivalents))
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
@@ -371,11 +505,9 @@ class Robot:
                 raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
         return T, single, ref
 
-    def _numerical_ik(self):
+    def _numerical_ik(self) -> NumericalIK:
         solver = getattr(self, "_numerical_ik_solver", None)
-        if solver is None:
-            from .ik.numerical import NumericalIK  # late import: the solvers need the Robot class
-
+        if solver is None:  # two threads may both build one: either is fine (no shared scratch state)
             solver = self._numerical_ik_solver = NumericalIK(self)
         return solver
 
@@ -457,20 +589,27 @@ class Robot:
         max_restarts: int = 40,
         seed: int | np.random.Generator | None = 0,
     ) -> np.ndarray:
-        """One configuration ``(nq,)`` within the limits whose tcp meets ``target`` within ``tol``.
+        """A configuration within the limits whose tcp meets ``target`` within ``tol``: ``(nq,)``, or ``(N, nq)`` for a batch.
 
-        Arms with a closed form start from the analytic branches nearest ``q_seed`` (each revolute
-        angle at its 2π equivalent within the limits nearest ``q_seed``), refined and checked by
-        the numerical solver to ``tol``; other arms, and ``position_only`` targets, use
-        damped least squares from ``q_seed`` then seeded random restarts.
+        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`) from
+        ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
+        the target); if that descent fails, arms with a closed form try their analytic
+        branches nearest ``q_seed`` (default :attr:`neutral`; each revolute angle at its 2π
+        equivalent within the limits nearest it), refined by the solver; then seeded random
+        restarts. The answer is the solution the descent reaches, normally the one nearest
+        the start; use :meth:`ik_all` (``q_ref``) for the closed-form branch nearest a
+        configuration. A batch of targets ``(N, 4, 4)`` (or positions ``(N, 3)`` with
+        ``position_only``) is solved at once by batched Levenberg–Marquardt on batched
+        FK and Jacobians (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is
+        then ``(nq,)`` or ``(N, nq)``.
 
         Args:
-            target: tcp pose ``(4, 4)`` frame → base [m]; with ``position_only`` a position
-                ``(3,)`` [m] (or a pose, whose rotation must still be a proper rotation, ignored).
-            q_seed: start ``(nq,)`` (default: the middle of the joint ranges for the numerical
-                solver; :attr:`neutral` for choosing among closed-form branches).
+            target: tcp pose ``(4, 4)`` frame → base [m], or ``(N, 4, 4)``; with
+                ``position_only`` a position ``(3,)`` / ``(N, 3)`` [m] (or a pose, whose
+                rotation must still be a proper rotation, ignored).
+            q_seed: start ``(nq,)`` (or ``(N, nq)`` for a batch).
             tol: required position error [m] and rotation error [rad].
-            max_restarts: random restarts after the first attempt.
+            max_restarts: random restarts after the first attempt (per target).
             seed: seed or generator of the restarts (results are reproducible).
 
         Raises:
@@ -480,36 +619,140 @@ class Robot:
             UnreachableTarget: no configuration within the limits found; the message gives the
                 remaining error and says whether the target is out of reach or needs a joint
                 outside its limits. A configuration that misses the target is never returned.
+                For a batch the message names the targets that failed; the exception carries
+                ``solved`` (``(N,)`` bool) and ``q`` (``(N, nq)``, the solved rows valid).
         """
-        from .errors import UnreachableTarget
-
         T, single = self.check_target(target, position_only=position_only)
-        if not single:
-            raise InvalidInput("Robot.ik takes one target of shape (4, 4); use ik_all for batches")
         tol = _check_tolerance(tol, "tol [m, rad]", positive=True)
         if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
             raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
         _check_seed(seed)
+        if not single:
+            return self._ik_batch(T, q_seed, position_only, tol, int(max_restarts), seed)
         seed_q = None
         if q_seed is not None:
-            seed_q, _ = self.check_q(q_seed)
+            seed_q, one = self.check_q(q_seed)
+            if not one:
+                raise InvalidInput(f"q_seed of one target must have shape ({self.nq},), got {np.shape(q_seed)}")
             seed_q = seed_q[0]
         solver = self._numerical_ik()
-        if self._analytic_ik is not None and not position_only:
-            starts = self._analytic_ik.starts(T[0], self.neutral if seed_q is None else seed_q)
+        T0 = T[0]
+        res = solver._solve(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
+                            polish=False)
+        if res.success:
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        if self._analytic_ik is not None and not position_only:  # closed-form starts: where the first descent failed
+            starts = self._analytic_ik.starts(T0, self.neutral if seed_q is None else seed_q)
             for q in starts[:4]:
-                q2, pe, re, _ = solver.attempt(q, T[0], False, tol)
-                if pe <= tol and re <= tol and self.within_limits(q2):
-                    return q2
+                q2, pe, re, _ = solver.attempt(q, T0, False, tol)
+                if pe <= tol and re <= tol and solver.in_limits(q2):
+                    pe, re = solver.errors(q2, T0, False)
+                    if pe <= tol and re <= tol:
+                        return q2
         res = solver._solve(
-            T[0], seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True
+            T0, seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True,
+            first=False,
         )
         if res.success and self.within_limits(res.q):
-            return res.q
-        reason = self.ik_failure_reason(T[0, :3, 3] if position_only else T[0], position_only=position_only)
-        raise UnreachableTarget(
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        raise UnreachableTarget(self._ik_failure_text(T0, position_only, tol, res))
+
+    def _ik_failure_text(self, T0: np.ndarray, position_only: bool, tol: float, res) -> str:
+        reason = self.ik_failure_reason(T0[:3, 3] if position_only else T0, position_only=position_only)
+        return (
             f"robot '{self.name}': no configuration within the joint limits reaches the "
             f"{'position' if position_only else 'pose'} within tol = {tol:g} "
             f"(best: position error {res.position_error:.3g} m, rotation error {res.rotation_error:.3g} rad "
             f"after {res.attempts} starts); {reason or 'the solver did not converge: try more max_restarts or another q_seed'}"
         )
+
+    def _ik_batch(self, T: np.ndarray, q_seed: Any, position_only: bool, tol: float, max_restarts: int, seed) -> np.ndarray:
+        """:meth:`ik` of a checked batch ``T (N, 4, 4)``."""
+        N = T.shape[0]
+        if N == 0:
+            return np.zeros((0, self.nq))
+        seeds = None
+        if q_seed is not None:
+            seeds, _ = self.check_q(q_seed)
+            if seeds.shape[0] not in (1, N):
+                raise InvalidInput(f"q_seed must be one configuration or one per target ({N}), got {seeds.shape[0]}")
+        solver = self._numerical_ik()
+        if self._analytic_ik is not None and not position_only:
+            # closed form first: it pays in batch (all branches of 10⁵ poses/s); each target takes
+            # its branch nearest the seed, projected into the limits (ik_all allows 1e-9), and
+            # keeps it when its FK meets tol; the others go to the batched numerical solver
+            # from that branch (one or two steps) or, without one, from the stored table
+            idx, qs = self._analytic_ik.candidates(T, seeds if seeds is not None else self.neutral[None])
+            q = np.full((N, self.nq), np.nan)
+            if idx.size:
+                first = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
+                q[idx[first]] = np.clip(qs[first], self.lower, self.upper)
+            has = np.flatnonzero(np.isfinite(q[:, 0]))
+            good = np.zeros(N, dtype=bool)
+            if has.size:
+                pe, re = solver.batch_errors(q[has], T[has], False)
+                good[has[(pe <= tol) & (re <= tol)]] = True
+            rest = np.flatnonzero(~good)
+            if rest.size:
+                start = q[rest]
+                if seeds is not None:
+                    miss = ~np.isfinite(start[:, 0])
+                    start[miss] = np.broadcast_to(seeds, (N, self.nq))[rest][miss]
+                res = solver.solve_batch(T[rest], start, position_only=False, tol=tol, max_restarts=max_restarts, seed=seed)
+                q[rest] = res.q
+            ok = self.within_limits(q, tol=0.0)
+            pe, re = solver.batch_errors(q, T, False)
+            ok &= (pe <= tol) & (re <= tol)
+            if ok.all():
+                return q
+            from .ik.numerical import BatchIKResult
+
+            res = BatchIKResult(q, ok, pe, re, 0)
+        else:
+            res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        ok = res.success & self.within_limits(res.q, tol=0.0)
+        if ok.all():
+            return res.q
+        bad = np.flatnonzero(~ok)
+        k = int(bad[0])
+        from .ik.numerical import IKResult
+
+        first = IKResult(res.q[k], False, float(res.position_error[k]), float(res.rotation_error[k]), 1 + max_restarts, 0)
+        exc = UnreachableTarget(
+            f"{bad.size} of {N} targets not solved (indices {bad[:10].tolist()}{' ...' if bad.size > 10 else ''}); "
+            f"target {k}: {self._ik_failure_text(T[k], position_only, tol, first)}"
+        )
+        exc.solved = ok
+        exc.q = res.q
+        raise exc
+
+    # --------------------------------------------------------------- dynamics
+    #: The :class:`robots.dynamics.Payload` this robot carries (``None``: the bare arm).
+    payload = None
+
+    def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
+        """A copy of this robot carrying a payload (this robot is unchanged).
+
+        ``mass`` [kg] (or a :class:`robots.dynamics.Payload`), ``com`` (3,) [m] in ``frame``
+        (default the tcp), ``inertia`` (3, 3) [kg·m²] about the centre of mass (default a point
+        mass). See :func:`robots.dynamics.with_payload`.
+        """
+        from .dynamics import with_payload
+
+        return with_payload(self, mass, com=com, inertia=inertia, frame=frame)
+
+    def inverse_dynamics(self, q: Any, qd: Any, qdd: Any) -> np.ndarray:
+        """Joint torques [N·m or N] for ``q, qd, qdd`` (each (nq,) or (N, nq)), by Pinocchio's RNEA.
+
+        See :func:`robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
+        mapped onto the independent joints).
+        """
+        from .dynamics import inverse_dynamics
+
+        return inverse_dynamics(self, q, qd, qdd)
+
+    def gravity(self, q: Any) -> np.ndarray:
+        """Joint torques [N·m or N] holding ``q`` ((nq,) or (N, nq)) still against gravity."""
+        from .dynamics import gravity_torques
+
+        return gravity_torques(self, q)

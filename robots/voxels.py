@@ -118,16 +118,45 @@ class VoxelMap:
         with np.errstate(invalid="ignore", divide="ignore"):
             mean = np.where(count > 0, total / count, np.nan)
         wmin[count == 0] = np.nan
-        occupied = (count >= min_count).reshape(shape)
+        shape = tuple(int(v) for v in shape)
+        return cls.from_counts(
+            origin, voxel_size, count.reshape(shape), mean.reshape(shape), wmin.reshape(shape), min_count=min_count
+        )
+
+    @classmethod
+    def from_counts(
+        cls,
+        origin: Any,
+        voxel_size: float,
+        count: np.ndarray,
+        mean_manipulability: np.ndarray,
+        min_manipulability: np.ndarray,
+        *,
+        min_count: int = 1,
+    ) -> "VoxelMap":
+        """Build the map from per-voxel reductions (``(nx, ny, nz)`` arrays), computing the margins.
+
+        Used for maps reduced elsewhere (streamed workspaces): ``count`` samples per voxel,
+        their mean and minimum manipulability (NaN where empty); ``origin (3,)`` [m] is the
+        minimum corner of voxel ``[0, 0, 0]``.
+        """
+        if not (isinstance(voxel_size, (int, float, np.floating)) and np.isfinite(voxel_size) and voxel_size > 0):
+            raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
+        if isinstance(min_count, bool) or not isinstance(min_count, (int, np.integer)) or min_count < 1:
+            raise InvalidInput(f"min_count must be an integer >= 1, got {min_count!r}")
+        count = np.asarray(count)
+        if count.ndim != 3 or np.shape(mean_manipulability) != count.shape or np.shape(min_manipulability) != count.shape:
+            raise InvalidInput("count, mean and min manipulability must be (nx, ny, nz) arrays of one shape")
+        occupied = count >= min_count
         padded = np.pad(occupied, 1, constant_values=False)
         dist = ndimage.distance_transform_edt(padded)[1:-1, 1:-1, 1:-1]
         margin = np.where(occupied, (dist - 0.5) * voxel_size, 0.0)
         return cls(
-            origin=origin,
+            origin=np.asarray(origin, dtype=float),
             voxel_size=float(voxel_size),
-            count=count.reshape(shape),
-            mean_manipulability=mean.reshape(shape),
-            min_manipulability=wmin.reshape(shape),
+            count=count,
+            mean_manipulability=np.asarray(mean_manipulability, dtype=float),
+            min_manipulability=np.asarray(min_manipulability, dtype=float),
             margin=margin,
             min_count=int(min_count),
         )

@@ -18,6 +18,8 @@ A sample is *near-singular* when its inverse condition is below
 
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
+Where the tables should stand is :func:`robots.placement.recommend_region` (the module above
+this one: placement imports workspace, never the other way).
 """
 
 from __future__ import annotations
@@ -30,11 +32,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InvalidInput
+from .robot import MAX_RANDOM_SAMPLES
+from .voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .placement import RecommendedRegion
     from .robot import Robot
-    from .voxels import VoxelMap
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",
@@ -44,6 +46,8 @@ __all__ = [
     "SphereFit",
     "RadialProfile",
     "sample_workspace",
+    "random_q_slice",
+    "TASK_SAMPLES",
     "fit_sphere",
     "fit_sphere_to_hull",
     "position_dexterity",
@@ -55,6 +59,8 @@ SPHERE_COVERAGE_MIN = 0.5
 """Samples whose ``σ_min/σ_max`` of the position Jacobian is below this are near-singular."""
 
 _CHUNK = 16384
+#: Samples per task when a sweep is cut into tasks (:mod:`pinarms.execution`); about 2 s each.
+TASK_SAMPLES = 2_000_000
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
 
@@ -485,17 +491,9 @@ class Workspace:
         ``voxel_size`` [m]; default: :func:`robots.voxels.suggest_voxel_size` (about 10
         samples per reachable voxel, so that chance holes do not fake a boundary).
         """
-        from .voxels import VoxelMap, suggest_voxel_size
-
         if voxel_size is None:
             voxel_size = suggest_voxel_size(self.points)
         return VoxelMap.from_samples(self.points, self.manipulability, voxel_size, min_count=min_count)
-
-    def recommend_region(self, **options: Any) -> "RecommendedRegion":
-        """Where pick/place tables should stand (see :func:`robots.placement.recommend_region`)."""
-        from .placement import recommend_region
-
-        return recommend_region(self, **options)
 
 
 def sample_workspace(
@@ -504,30 +502,53 @@ def sample_workspace(
     seed: int | np.random.Generator | None = 0,
     frame: str = "tcp",
     chunk: int = _CHUNK,
+    *,
+    scheduler: Any = None,
+    progress: Any = None,
+    task_samples: int = TASK_SAMPLES,
 ) -> Workspace:
     """Monte Carlo workspace: ``n`` joint vectors uniform within the limits, and their frame origins.
 
     Args:
         robot: any :class:`~robots.robot.Robot`.
-        n: number of samples (> 0). 10⁶ samples take about 100 MB.
+        n: number of samples (> 0, at most ``MAX_RANDOM_SAMPLES`` = 5·10⁷ in one call). 10⁶ samples
+            take about 100 MB; for 10⁸ and more use
+            :func:`robots.workspace_stream.stream_workspace` (reductions only, flat memory).
         seed: seed or ``numpy.random.Generator``; the same seed gives the same samples
             (``q`` equals ``robot.random_q(n, seed)``).
         frame: frame whose origin is sampled (``"tcp"`` = the robot's tool frame).
         chunk: samples evaluated per block (bounds the working memory).
+        scheduler, progress: with an integer ``seed``, more than ``task_samples`` samples
+            (or any ``scheduler``) are cut into tasks of ``task_samples`` run by
+            :func:`pinarms.execution.map_chunks` (serial by default, or on Dask). Task ``k``
+            draws its slice of the same stream (:func:`random_q_slice`), so the result is
+            identical to the one-piece run bit for bit, whoever runs the tasks.
 
     Raises:
-        InvalidInput: ``n`` is not a positive integer, ``chunk`` is not positive, or
-            ``frame`` is not a frame of the robot.
+        InvalidInput: ``n`` is not a positive integer or is above 5·10⁷, ``chunk`` is not positive, or
+            ``frame`` is not a frame of the robot; a ``scheduler`` with a Generator seed.
+        ExecutionError: a task failed (its chunk index is named).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
         raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
+    if n > MAX_RANDOM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (10⁶ samples take "
+                           f"about 100 MB); sample several seeded workspaces and merge them")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk <= 0:
         raise InvalidInput(f"chunk must be a positive integer, got {chunk!r}")
+    if isinstance(task_samples, bool) or not isinstance(task_samples, (int, np.integer)) or task_samples <= 0:
+        raise InvalidInput(f"task_samples must be a positive integer, got {task_samples!r}")
     robot.frame_id(frame)  # raises InvalidInput naming the frames
     if not (np.all(np.isfinite(robot.lower)) and np.all(np.isfinite(robot.upper))):
         raise InvalidInput(f"robot '{robot.name}' has unbounded joint limits; sampling needs finite limits")
-    q = robot.random_q(int(n), seed=seed)
-    points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk))
+    integer_seed = isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)
+    if scheduler is not None and not integer_seed:
+        raise InvalidInput(f"sampling on a scheduler needs an integer seed >= 0 (each task re-creates its stream), got {seed!r}")
+    if integer_seed and (n > task_samples or scheduler is not None):
+        q, points, w, c = _sample_in_tasks(robot, int(n), int(seed), frame, int(chunk), int(task_samples), scheduler, progress)
+    else:
+        q = robot.random_q(int(n), seed=seed)
+        points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk))
     return Workspace(
         robot=robot,
         frame=frame,
@@ -537,6 +558,63 @@ def sample_workspace(
         manipulability=w,
         inverse_condition=c,
     )
+
+
+def _generator_at(robot: "Robot", seed: int, start: int) -> np.random.Generator:
+    """``default_rng(seed)`` advanced past the draws of samples ``0 … start-1`` of ``random_q``."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
+    bit = np.random.PCG64(int(seed))
+    bit.advance(int(start) * robot.nq)
+    return np.random.Generator(bit)
+
+
+def random_q_slice(robot: "Robot", seed: int, start: int, count: int) -> np.ndarray:
+    """Samples ``start … start+count-1`` of ``robot.random_q(n, seed)``, without drawing the others.
+
+    ``random_q`` draws ``(n, nq)`` uniforms row by row from ``numpy.random.default_rng(seed)``
+    (PCG64, one 64-bit draw per number), so sample ``i`` starts at draw ``i·nq``: the
+    generator jumps there (``PCG64.advance``) in a few microseconds.
+    """
+    for name, v in (("start", start), ("count", count)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise InvalidInput(f"{name} must be an integer >= 0, got {v!r}")
+    return _generator_at(robot, seed, start).uniform(robot.lower, robot.upper, size=(int(count), robot.nq))
+
+
+@dataclass(frozen=True)
+class _SampleTask:
+    robot: Any
+    seed: int
+    start: int
+    count: int
+    frame: str
+    chunk: int
+
+
+def _sample_task(task: _SampleTask) -> tuple:
+    q = random_q_slice(task.robot, task.seed, task.start, task.count)
+    return (q, *_positions_and_dexterity(task.robot, q, task.frame, task.chunk))
+
+
+def _sample_in_tasks(robot, n, seed, frame, chunk, task_samples, scheduler, progress) -> tuple:
+    from pinarms.execution import reduce_chunks
+
+    tasks, start = [], 0
+    while start < n:
+        count = min(task_samples, n - start)
+        tasks.append(_SampleTask(robot, seed, start, count, frame, chunk))
+        start += count
+    out = (np.empty((n, robot.nq)), np.empty((n, 3)), np.empty(n), np.empty(n))
+    starts = iter(t.start for t in tasks)
+
+    def place(acc, part):
+        s = next(starts)
+        for dst, src in zip(acc, part):
+            dst[s : s + src.shape[0]] = src
+        return acc
+
+    return reduce_chunks(_sample_task, tasks, place, out, scheduler=scheduler, progress=progress)
 
 
 # ------------------------------------------------------------------ helpers

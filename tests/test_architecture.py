@@ -1,5 +1,9 @@
 """The one-way flow of the packages: robots → planning → optim → viz → pinarms (CLI, studies).
 
+Below them all sits the execution layer ``pinarms.execution`` (serial loop or Dask): every
+package may import it, and it imports only numpy, Dask and the error classes
+(``pinarms.robots.errors``, a module that imports nothing of ours).
+
 The folders ``robots/``, ``planning/``, ``optim/``, ``viz/`` sit at the repository's top level
 and install as ``pinarms.robots``, ``pinarms.planning``, ... Every module's imports (module
 level and inside functions) are read with ``ast``; a package may import only the packages
@@ -16,7 +20,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ["robots", "planning", "optim", "viz", "pinarms"]
-ALLOWED = {pkg: set(ORDER[: i + 1]) for i, pkg in enumerate(ORDER)}
+#: The bottom layer, a module of the ``pinarms`` folder that every package may import.
+BOTTOM = {"pinarms.execution": "execution"}
+ALLOWED = {pkg: set(ORDER[: i + 1]) | set(BOTTOM.values()) for i, pkg in enumerate(ORDER)}
 SUBPACKAGES = set(ORDER[:-1]) | {"urdf"}
 
 
@@ -28,8 +34,12 @@ def _layer(module: str, names: list[str]) -> set[str]:
     if parts[0] != "pinarms":
         return set()
     if len(parts) > 1:
+        if ".".join(parts[:2]) in BOTTOM:
+            return {BOTTOM[".".join(parts[:2])]}
         return {parts[1]} if parts[1] in SUBPACKAGES else {"pinarms"}
-    return {n if n in SUBPACKAGES else "pinarms" for n in names}
+    return {
+        BOTTOM.get(f"pinarms.{n}") or (n if n in SUBPACKAGES else "pinarms") for n in names
+    }
 
 
 def _imported_packages(path: Path) -> set[str]:
@@ -56,6 +66,41 @@ def test_imports_go_one_way(package):
     assert not wrong, f"{package} imports packages above it (or as top-level names): {wrong}"
 
 
+def _imported_modules(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            out.add(node.module)
+    return out
+
+
+def test_the_execution_layer_imports_only_numpy_dask_and_the_errors():
+    import sys
+
+    modules = _imported_modules(ROOT / "pinarms" / "execution.py")
+    ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
+    assert ours == {"pinarms.robots.errors"}, ours
+    third_party = {
+        m.split(".")[0] for m in modules - ours if m.split(".")[0] not in sys.stdlib_module_names
+    }
+    assert third_party <= {"numpy", "dask", "distributed"}, third_party
+    # and the errors module it reaches imports nothing of ours
+    errors = _imported_modules(ROOT / "robots" / "errors.py")
+    assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
+
+
+def test_every_package_may_import_the_execution_layer(tmp_path):
+    module = tmp_path / "m.py"
+    module.write_text("from pinarms import execution\nfrom pinarms.execution import map_chunks\n")
+    assert _imported_packages(module) == {"execution"}
+    assert all("execution" in ALLOWED[pkg] for pkg in ORDER)
+    module.write_text("from pinarms import execution, demo\n")
+    assert _imported_packages(module) == {"execution", "pinarms"}
+
+
 def test_the_checker_sees_function_level_and_top_level_imports(tmp_path):
     module = tmp_path / "m.py"
     module.write_text(
@@ -73,3 +118,27 @@ def test_tests_and_benchmarks_import_the_namespace_only():
         if any(n.startswith("top-level") for n in _imported_packages(f))
     )
     assert not offenders, f"import pinarms.robots etc., not top-level robots: {offenders}"
+
+
+def _relative_imports(path: Path) -> set[str]:
+    """Sibling modules a module of ``robots/`` imports (``from .x import``, at any level)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return {
+        node.module.split(".")[0]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
+    }
+
+
+def test_workspace_analysis_modules_import_one_way():
+    """voxels → workspace → workspace_stream, placement, layout: nothing imports back down-up."""
+    above = {
+        "voxels": {"workspace", "workspace_stream", "placement", "layout"},
+        "workspace": {"workspace_stream", "placement", "layout"},
+        "workspace_stream": {"placement", "layout"},
+        "placement": {"layout", "workspace_stream"},
+    }
+    wrong = {
+        m: sorted(_relative_imports(ROOT / "robots" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+    }
+    assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"

@@ -25,7 +25,8 @@ from .session import (
     WorkspaceRecord,
     load_session,
 )
-from .viewer import MeshcatServer, Viewer, show
+from .server import MeshcatServer
+from .viewer import Viewer, show
 
 __all__ = [
     "Session",

@@ -2,20 +2,37 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 from typing import Any
 
 from ._atomic import atomic_write
-from .scene import scene_html
+from .page import with_page
+from .scene import SceneInfo, build_scene
+from .server import MeshcatServer
 
-__all__ = ["export_html"]
+__all__ = ["export_html", "scene_html"]
+
+
+def scene_html(session: Any, **scene_options: Any) -> tuple[str, SceneInfo]:
+    """The session's scene as one self-contained HTML page, and what was drawn.
+
+    A MeshCat server runs for a moment (MeshCat replays its scene tree into the page);
+    the page carries pinarms' title, colour bar and controls (:mod:`viz.page`).
+    """
+    with MeshcatServer() as server, contextlib.redirect_stdout(io.StringIO()):
+        info = build_scene(server.visualizer, session, **scene_options)
+        html = server.static_html()
+    return with_page(html, info.page["title"]), info
 
 
 def export_html(session: Any, path: str | Path, **scene_options: Any) -> Path:
     """Write the session's scene as one self-contained HTML file (opens offline); return the path.
 
     The page holds MeshCat's JavaScript, the geometry, the clouds, the paths and the
-    animation (play/pause/scrub in the page's Animations panel). ``scene_options`` go to
+    animation, framed on the robots, with the study's title, the clouds' colour bar, and
+    play/pause, a time slider and a cloud switch at the bottom. ``scene_options`` go to
     :func:`viz.scene.build_scene`. The file is written atomically.
     """
     html, _ = scene_html(session, **scene_options)

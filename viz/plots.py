@@ -18,6 +18,7 @@ import matplotlib
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from pinarms.robots.errors import InvalidInput
 
@@ -70,6 +71,26 @@ def _limit_array(limits: Any, kind: str, n: int) -> np.ndarray | None:
     return arr
 
 
+def _joint_labels(n: int, robot: Any, joint_names: Sequence[str] | None,
+                  joint_units: Sequence[str] | None) -> tuple[list[str], list[str] | None]:
+    """Legend names and units (``"rad"``/``"m"`` per joint, or None when unknown) of ``n`` joints."""
+    if robot is not None:
+        if robot.nq != n:
+            raise InvalidInput(f"the curves have {n} joints but robot '{robot.name}' has {robot.nq}: "
+                               "pass joint_names= and joint_units= for the joints drawn")
+        joint_names = robot.joint_names if joint_names is None else joint_names
+        joint_units = robot.joint_units if joint_units is None else joint_units
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    if len(names) != n:
+        raise InvalidInput(f"joint_names has {len(names)} names for {n} joints")
+    if joint_units is None:
+        return names, None
+    units = list(joint_units)
+    if len(units) != n or any(u not in ("rad", "m") for u in units):
+        raise InvalidInput(f"joint_units must give 'rad' or 'm' for each of the {n} joints, got {units!r}")
+    return names, units
+
+
 def plot_joint_curves(
     path: str | Path,
     t: Any,
@@ -80,7 +101,9 @@ def plot_joint_curves(
     *,
     knot_times: Any = None,
     limits: Any = None,
+    robot: Any = None,
     joint_names: Sequence[str] | None = None,
+    joint_units: Sequence[str] | None = None,
     degrees: bool = False,
     title: str = "",
 ) -> Path:
@@ -92,10 +115,24 @@ def plot_joint_curves(
             derivatives left ``None`` are not drawn.
         knot_times: knot (via point) instants (s): vertical dotted lines, markers on the curves.
         limits: ``planning.JointLimits`` or a mapping with ``velocity``, ``acceleration``,
-            ``jerk`` (per joint or scalar, SI): drawn as dashed ±limit lines.
-        joint_names: legend labels (default ``joint 1..n``).
-        degrees: show values ×180/π (revolute joints).
+            ``jerk`` (per joint or scalar, SI): drawn as dashed ±limit lines, labelled.
+        robot: a ``robots.Robot`` whose joints are drawn: the default names and units.
+        joint_names: legend labels (default: the robot's joint names, else ``joint 1..n``).
+        joint_units: ``"rad"`` or ``"m"`` per joint (default: the robot's); the axes say the
+            unit of the joints drawn (``rad or m`` only when it is not known).
+        degrees: show revolute joints (unit ``"rad"``) ×180/π, in degrees.
+
+    The legend stands to the right of the panels, outside the curves.
     """
+    fig = _joint_curves_figure(t, q, qd, qdd, qddd, knot_times=knot_times, limits=limits, robot=robot,
+                               joint_names=joint_names, joint_units=joint_units, degrees=degrees, title=title)
+    return _save(fig, path)
+
+
+def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_times: Any, limits: Any, robot: Any,
+                         joint_names: Sequence[str] | None, joint_units: Sequence[str] | None, degrees: bool,
+                         title: str) -> Figure:
+    """The figure of :func:`plot_joint_curves` (checked inputs)."""
     tt = _numbers(t, "t")
     if tt.ndim != 1 or tt.size < 2:
         raise InvalidInput(f"t must be (N,) instants in s with N >= 2, got shape {tt.shape}")
@@ -115,40 +152,61 @@ def plot_joint_curves(
     n = series[0][1].shape[1]
     if any(a.shape[1] != n for _, a in series):
         raise InvalidInput("q, qd, qdd and qddd must have the same number of joints")
-    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
-    if len(names) != n:
-        raise InvalidInput(f"joint_names has {len(names)} names for {n} joints")
-    scale = 180.0 / math.pi if degrees else 1.0
-    unit = "°" if degrees else "rad or m"
+    names, units = _joint_labels(n, robot, joint_names, joint_units)
+    if units is None:  # unknown kinds: SI values as given
+        scale = np.full(n, 180.0 / math.pi if degrees else 1.0)
+        shown = ["°" if degrees else "rad or m"] * n
+    else:
+        scale = np.array([180.0 / math.pi if (degrees and u == "rad") else 1.0 for u in units])
+        shown = ["°" if (degrees and u == "rad") else u for u in units]
+    kinds = sorted(set(shown), key=shown.index)
+    mixed = len(kinds) > 1
+    labels = [f"{name} [{u}]" if mixed else name for name, u in zip(names, shown)]
     knots = None if knot_times is None else _numbers(knot_times, "knot_times").ravel()
 
-    fig = Figure(figsize=(7.5, 2.3 * len(series) + 0.4))
+    fig = Figure(figsize=(8.8, 2.3 * len(series) + 0.5), layout="constrained")
     axes = fig.subplots(len(series), 1, sharex=True, squeeze=False)
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, (order, arr) in zip(axes[:, 0], series):
         for j in range(n):
             c = colors[j % len(colors)]
-            ax.plot(tt, arr[:, j] * scale, color=c, lw=1.4, label=names[j])
+            ax.plot(tt, arr[:, j] * scale[j], color=c, lw=1.4, label=labels[j])
             if knots is not None:
-                ax.plot(knots, np.interp(knots, tt, arr[:, j]) * scale, "o", color=c, ms=4)
+                ax.plot(knots, np.interp(knots, tt, arr[:, j]) * scale[j], "o", color=c, ms=4)
         lim = _limit_array(limits, _ORDERS[order], n) if order > 0 else None
         if lim is not None:
-            shared = bool(np.all(lim == lim[0]))  # one limit for every joint: one black pair of lines
-            for j in range(1 if shared else n):
-                if np.isfinite(lim[j]):
-                    c = "k" if shared else colors[j % len(colors)]
-                    for sign in (1, -1):
-                        ax.axhline(sign * lim[j] * scale, color=c, ls="--", lw=0.9, alpha=0.8)
+            _draw_limits(ax, lim * scale, names, [f"{u}{_UNITS[order]}" for u in shown], colors)
         if knots is not None:
             for tk in knots:
                 ax.axvline(tk, color="0.6", ls=":", lw=0.8)
-        ax.set_ylabel(f"{_ORDERS[order]}\n[{unit}{_UNITS[order]}]")
+        unit_text = " | ".join(f"{u}{_UNITS[order]}" for u in kinds)
+        ax.set_ylabel(f"{_ORDERS[order]}\n[{unit_text}]")
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
-    axes[0, 0].legend(loc="best", fontsize=8, ncol=min(n, 4))
+    handles, texts = axes[0, 0].get_legend_handles_labels()
+    if knots is not None:
+        handles.append(Line2D([], [], color="0.6", ls=":", marker="o", ms=4, lw=0.8))
+        texts.append("via points")
+    fig.legend(handles, texts, loc="outside right upper", fontsize=8, title="joints", title_fontsize=8)
     if title:
-        axes[0, 0].set_title(title)
-    return _save(fig, path)
+        fig.suptitle(title)
+    return fig
+
+
+def _draw_limits(ax: Any, lim: np.ndarray, names: list[str], units: list[str], colors: list[str]) -> None:
+    """Dashed ±limit lines, each labelled with its value (one black pair when every joint shares it)."""
+    same_unit = len(set(units)) == 1
+    shared = bool(np.all(lim == lim[0])) and same_unit
+    for j in range(1 if shared else lim.size):
+        if not np.isfinite(lim[j]):
+            continue
+        c = "k" if shared else colors[j % len(colors)]
+        for sign in (1, -1):
+            ax.axhline(sign * lim[j], color=c, ls="--", lw=0.9, alpha=0.8)
+        who = "limit" if shared else f"{names[j]} limit"
+        value = np.format_float_positional(lim[j], precision=4, fractional=False, trim="-")
+        ax.annotate(f"{who} ±{value} {units[j]}", xy=(1.0, lim[j]), xycoords=("axes fraction", "data"),
+                    xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=c)
 
 
 def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
@@ -162,11 +220,18 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
 
 
 def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
-    """Best and mean objective per generation (and the feasible share when recorded).
+    """Best-so-far and mean objective per generation, and the feasible share when recorded.
 
-    ``history``: a GA history (``best``, ``mean``, optional ``feasible_share``), a result
-    with ``.history``, a :class:`viz.HistoryRecord` or a mapping of columns. Generations
-    recorded as ``inf`` (no finite objective) are left as gaps in the curves.
+    ``history``: a GA history (``best``, ``feasible_mean`` or ``mean``, optional
+    ``feasible_share``), a result with ``.history``, a :class:`viz.HistoryRecord` or a
+    mapping of columns. Generations recorded as ``inf`` (no finite objective) are left as
+    gaps in the curves.
+
+    The mean drawn is that of the *feasible* individuals (``feasible_mean``) when the
+    history has it: never below the best-so-far. The whole population's ``mean`` counts
+    infeasible individuals with their raw objective (faster than the limits allow), so it
+    can dip below the best when few are feasible; drawn only for histories without
+    ``feasible_mean``, and then labelled so.
     """
     if hasattr(history, "columns"):
         history = history.columns
@@ -190,24 +255,25 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
             raise InvalidInput(f"{key} must have one value per generation {best.shape}, got shape {arr.shape}")
         return arr
 
-    fig = Figure(figsize=(7, 3.6))
+    fig = Figure(figsize=(8.8, 3.8), layout="constrained")
     ax = fig.subplots()
-    ax.plot(gens, best, lw=1.8, label="best")
-    mean = column("mean")
-    if mean is not None:
-        ax.plot(gens, mean, lw=1.2, ls="--", label="population mean")
+    lines = ax.plot(gens, best, lw=1.8, label="best so far")
+    feasible_mean, mean = column("feasible_mean"), column("mean")
+    if feasible_mean is not None:
+        lines += ax.plot(gens, feasible_mean, lw=1.2, ls="--", label="mean of the feasible individuals")
+    elif mean is not None:
+        lines += ax.plot(gens, mean, lw=1.2, ls="--", label="population mean (infeasible ones too:\ncan lie below the best)")
     feasible = column("feasible_share")
     if feasible is not None:
         ax2 = ax.twinx()
-        ax2.plot(gens, feasible, color="0.55", lw=0.9, label="feasible share")
+        lines += ax2.plot(gens, feasible, color="0.55", lw=0.9, label="feasible share (right axis)")
         ax2.set_ylim(0, 1.05)
         ax2.set_ylabel("feasible share")
-        ax2.legend(loc="center right", fontsize=8)
     ax.set_xlabel("generation")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    fig.legend(lines, [ln.get_label() for ln in lines], loc="outside right upper", fontsize=8)
     return _save(fig, path)
 
 

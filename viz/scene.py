@@ -5,19 +5,24 @@ Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
 - ``pinarms/robots/<key>`` — a robot, placed at its ``base_to_world``; its visual geometry
   (Pinocchio's visual model of the URDF) in ``pinarms/robots/<key>/visuals/<geometry>``;
 - ``pinarms/objects/<name>`` — static boxes (conveyor, crate);
-- ``pinarms/workspace/<name>`` — a workspace cloud (``Points``) coloured by manipulability;
-- ``pinarms/paths/<name>`` — the TCP path of a trajectory (``Line``), world frame;
+- ``pinarms/workspace/<name>`` — a workspace cloud (``Points``, translucent) coloured by
+  manipulability;
+- ``pinarms/paths/<name>`` — the TCP path of a trajectory, world frame: a thin tube
+  (``Mesh``), since browsers draw WebGL lines one pixel wide whatever their width;
 - ``pinarms/vias/<name>/<i>`` — the TCP at the trajectory's knots (small spheres);
 - ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
-robot) play together from time 0, sampled at ``fps`` frames per second.
+robot) play together from time 0, sampled at ``fps`` frames per second, looping.
+
+What the page around the scene shows (title, colour bar, framing, controls: see
+:mod:`viz.page`) is stored on the scene root as the property ``pinarms_page`` (JSON), so
+that the standalone page and the live viewer read it the same way.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
+import json
 import warnings
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -30,10 +35,13 @@ from pinarms.robots.errors import InvalidInput
 
 from ._meshcat import MeshcatVisualizer, meshcat, mg
 from .errors import ViewerError
+from .page import PAGE_PROPERTY, colorbar_stops, manipulability_unit
+from .shapes import downsample_polyline, floor_grid, frame_view, tube_mesh
 
 __all__ = ["SceneInfo", "build_scene", "ROOT", "colors_by_value"]
 
 ROOT = "pinarms"
+_BACKGROUND = ([0.96, 0.97, 0.99], [0.74, 0.78, 0.85])  # top, bottom (RGB in [0, 1])
 
 _PATH_COLORS = (0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B)
 _POINT_COLORS = {"via": 0xFF7F0E, "target": 0xD62728}
@@ -54,6 +62,10 @@ class SceneInfo:
         n_frames: animation frames.
         fps: animation frame rate (1/s).
         bounds: world bounding box of the content, ((3,), (3,)) m.
+        target: the point the view is centred on and orbits around (world, m): the middle
+            of the robots and their tcp paths (not of the clouds or boxes).
+        camera: where the camera opens (world, m).
+        page: what the page around the scene shows (see :mod:`viz.page`).
     """
 
     robots: dict[str, list[str]]
@@ -66,6 +78,9 @@ class SceneInfo:
     n_frames: int
     fps: float
     bounds: tuple[np.ndarray, np.ndarray]
+    target: np.ndarray
+    camera: np.ndarray
+    page: dict[str, Any]
 
 
 def colors_by_value(values: np.ndarray, colormap: str = "viridis") -> np.ndarray:
@@ -114,6 +129,29 @@ class _RobotDrawing:
         """Show configuration ``q (nq,)``."""
         self.pv.display(self.robot.q_to_pinocchio(q))
 
+    def extent(self, qs: np.ndarray) -> np.ndarray:
+        """Corners of the visual geometries' boxes at each row of ``qs (F, nq)``, ``(8kF, 3)`` in the base frame [m].
+
+        A geometry whose box is unknown contributes its origin. The displayed pose is untouched.
+        """
+        model, gmodel = self.pv.model, self.pv.visual_model
+        data, gdata = model.createData(), gmodel.createData()
+        signs = np.array(np.meshgrid([0, 1], [0, 1], [0, 1])).reshape(3, -1).T
+        local = []
+        for g in gmodel.geometryObjects:
+            try:
+                g.geometry.computeLocalAABB()
+                lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
+                local.append((lo + signs * (hi - lo)) * np.asarray(g.meshScale))
+            except Exception:  # noqa: BLE001 - a geometry coal cannot bound: its origin only
+                local.append(np.zeros((1, 3)))
+        corners = [np.zeros((1, 3))]
+        for qp in np.atleast_2d(self.robot.q_to_pinocchio(qs)):
+            pin.forwardKinematics(model, data, qp)
+            pin.updateGeometryPlacements(model, data, gmodel, gdata)
+            corners += [box @ M.rotation.T + M.translation for box, M in zip(local, gdata.oMg)]
+        return np.vstack(corners)
+
     def record(self, anim: meshcat.animation.Animation, vis: meshcat.Visualizer, qs: np.ndarray) -> None:
         """Add one key frame per row of ``qs (F, nq)`` to ``anim`` (rigid poses: tracks hold position + rotation)."""
         model, data = self.pv.model, self.pv.data
@@ -138,6 +176,20 @@ def _sphere_set(vis: meshcat.Visualizer, base: str, points: np.ndarray, radius: 
     return paths
 
 
+class _CloudMaterial(mg.PointsMaterial):
+    """MeshCat's point material, translucent and of a fixed size on screen [px]: the cloud never
+    hides what stands inside it, and points near the camera do not grow into squares."""
+
+    def __init__(self, pixels: float, opacity: float) -> None:
+        super().__init__(size=pixels)
+        self.opacity = opacity
+
+    def lower(self, object_data: Any) -> dict:
+        data = super().lower(object_data)
+        data.update(transparent=True, opacity=self.opacity, depthWrite=False, sizeAttenuation=False)
+        return data
+
+
 def build_scene(
     vis: meshcat.Visualizer,
     session: Any,
@@ -145,21 +197,33 @@ def build_scene(
     animate: Sequence[str] | None = None,
     fps: float = 30.0,
     play: bool = True,
-    point_size: float = 0.012,
-    sphere_radius: float = 0.012,
+    point_pixels: float = 3.0,
+    cloud_opacity: float = 0.3,
+    show_clouds: bool = True,
+    max_cloud_points: int = 20_000,
+    sphere_radius: float | None = None,
     colormap: str = "viridis",
     hide_background: bool = False,
 ) -> SceneInfo:
     """Draw ``session`` into the MeshCat visualizer ``vis``; return what was drawn.
 
+    The view opens framed on the robots and their tcp paths (clouds and boxes may extend
+    beyond it), clouds translucent, the animation looping.
+
     Args:
-        vis: a ``meshcat.Visualizer`` (e.g. ``viz.viewer.MeshcatServer().visualizer``).
+        vis: a ``meshcat.Visualizer`` (e.g. ``viz.MeshcatServer().visualizer``).
         session: a :class:`viz.Session`.
         animate: trajectory names to animate (at most one per robot); default: the first
             trajectory of each robot; ``()`` for no animation.
         fps: animation frame rate (1/s).
-        play: start playing when a browser opens the page.
-        point_size: workspace point size (m); sphere_radius: via-point sphere radius (m).
+        play: start playing (looping) when a browser opens the page.
+        point_pixels: size of the workspace points on screen [px]; cloud_opacity: their
+            opacity in (0, 1];
+            show_clouds: whether the clouds are shown when the page opens (the page has a
+            switch either way); max_cloud_points: a larger cloud is drawn as a seeded
+            uniform subsample of that many points (the page says so; the session keeps all).
+        sphere_radius: via-point sphere radius (m); default 1.5 % of the framed radius, at
+            least 12 mm; the tcp path tube's radius is 40 % of it.
         colormap: matplotlib colormap for manipulability (low → high).
         hide_background: hide MeshCat's background, grid and axes (plain white page).
     """
@@ -167,10 +231,20 @@ def build_scene(
         raise InvalidInput(f"fps must be a positive frame rate in 1/s, got {fps!r}")
     if colormap not in matplotlib.colormaps:
         raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
+    if not (isinstance(cloud_opacity, (int, float)) and 0.0 < cloud_opacity <= 1.0):
+        raise InvalidInput(f"cloud_opacity must be in (0, 1], got {cloud_opacity!r}")
+    for name, value, unit in (("point_pixels", point_pixels, "px"), ("sphere_radius", sphere_radius, "m")):
+        if value is None and name == "sphere_radius":
+            continue
+        if isinstance(value, bool) or not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+            raise InvalidInput(f"{name} must be a positive size in {unit}, got {value!r}")
+    if isinstance(max_cloud_points, bool) or not isinstance(max_cloud_points, (int, np.integer)) or max_cloud_points < 1:
+        raise InvalidInput(f"max_cloud_points must be a positive integer, got {max_cloud_points!r}")
     vis[ROOT].delete()
     bounds: list[np.ndarray] = []
+    framed: list[np.ndarray] = []  # what the view is centred on: robots and tcp paths
 
-    # robots and their TCP paths
+    # robots
     drawings: dict[str, _RobotDrawing] = {}
     for key, entry in session.robots.items():
         robot = session.robot(key)
@@ -187,37 +261,34 @@ def build_scene(
         corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T * box.size / 2
         bounds.append(_transform_points(box.pose, corners))
 
-    clouds = {}
+    clouds, cloud_robots, cloud_shown, w_max = {}, [], {}, 0.0
     for name, ws in session.workspaces.items():
         world = _transform_points(session.robots[ws.robot].base_to_world, ws.points)
+        colors = colors_by_value(ws.manipulability, colormap)  # scaled by the whole cloud's maximum
+        shown = np.arange(world.shape[0])
+        if world.shape[0] > max_cloud_points:
+            shown = np.sort(np.random.default_rng(0).choice(world.shape[0], size=int(max_cloud_points), replace=False))
+        cloud_shown[name] = (shown.size, world.shape[0])
         path = f"{ROOT}/workspace/{name}"
-        vis[path].set_object(mg.PointCloud(world.T.astype(np.float32),
-                                           colors_by_value(ws.manipulability, colormap).T.astype(np.float32),
-                                           size=point_size))
+        vis[path].set_object(mg.Points(
+            mg.PointsGeometry(world[shown].T.astype(np.float32), colors[shown].T.astype(np.float32)),
+            _CloudMaterial(point_pixels, cloud_opacity)))
+        if not show_clouds:
+            vis[path].set_property("visible", False)
         clouds[name] = path
+        cloud_robots.append(ws.robot)
+        w_max = max(w_max, float(np.max(ws.manipulability)))
         bounds.append(world)
 
-    paths, knots_drawn = {}, {}
+    paths, knots_drawn, tcp_paths = {}, {}, {}
     for i, (name, rec) in enumerate(session.trajectories.items()):
         robot = drawings[rec.robot].robot
         T_base = session.robots[rec.robot].base_to_world
-        tcp = _transform_points(T_base, robot.position(rec.q))
-        path = f"{ROOT}/paths/{name}"
-        color = _PATH_COLORS[i % len(_PATH_COLORS)]
-        vis[path].set_object(mg.Line(mg.PointsGeometry(tcp.T.astype(np.float32)),
-                                     mg.LineBasicMaterial(color=color, linewidth=2)))
-        paths[name] = path
+        tcp_paths[name] = _transform_points(T_base, robot.position(rec.q))
         q_knots = _interp_rows(rec.knot_times, rec.t, rec.q)
-        knots = _transform_points(T_base, robot.position(q_knots))
-        knots_drawn[name] = _sphere_set(vis, f"{ROOT}/vias/{name}", knots, sphere_radius, color)
-        bounds.append(tcp)
-
-    points = {}
-    for name, ps in session.point_sets.items():
-        T = np.eye(4) if ps.robot is None else session.robots[ps.robot].base_to_world
-        world = _transform_points(T, ps.points)
-        points[name] = _sphere_set(vis, f"{ROOT}/points/{name}", world, sphere_radius, _POINT_COLORS[ps.kind])
-        bounds.append(world)
+        knots_drawn[name] = _transform_points(T_base, robot.position(q_knots))
+        bounds.append(tcp_paths[name])
+        framed.append(tcp_paths[name])
 
     # which trajectories play
     if animate is None:
@@ -239,6 +310,35 @@ def build_scene(
         recs = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
         recs = recs or [r for r in session.trajectories.values() if r.robot == key]
         drawing.display(recs[0].q[0] if recs else drawing.robot.neutral)
+        # framed over the whole motion: the pose at 9 instants of its (first) trajectory
+        poses = recs[0].q[np.linspace(0, recs[0].q.shape[0] - 1, 9).round().astype(int)] if recs else drawing.robot.neutral
+        framed.append(_transform_points(session.robots[key].base_to_world, drawing.extent(poses)))
+
+    parts = bounds + [_point_set_world(session, n) for n in session.point_sets]
+    everything = np.vstack(parts) if parts else np.zeros((1, 3))
+    lo, hi = everything.min(axis=0), everything.max(axis=0)
+    bases = np.array([e.base_to_world[:3, 3] for e in session.robots.values()]).reshape(-1, 3)
+    toward = np.vstack(list(tcp_paths.values())).mean(axis=0) - bases.mean(axis=0) if tcp_paths and bases.size else None
+    target, camera, radius = frame_view(np.vstack(framed) if framed else everything, toward)
+
+    if sphere_radius is None:
+        sphere_radius = max(0.012, 0.015 * radius)
+    tube = sphere_radius / 2.5
+    points = {}
+    for name, ps in session.point_sets.items():
+        points[name] = _sphere_set(vis, f"{ROOT}/points/{name}", _point_set_world(session, name), sphere_radius,
+                                   _POINT_COLORS[ps.kind])
+    for i, (name, tcp) in enumerate(tcp_paths.items()):
+        path = f"{ROOT}/paths/{name}"
+        color = _PATH_COLORS[i % len(_PATH_COLORS)]
+        mesh = tube_mesh(downsample_polyline(tcp), tube)
+        if mesh is None:  # the tcp stands still: a dot
+            vis[path].set_object(mg.Sphere(2.0 * tube), mg.MeshLambertMaterial(color=color))
+            vis[path].set_transform(meshcat.transformations.translation_matrix(tcp[0]))
+        else:
+            vis[path].set_object(mg.TriangularMeshGeometry(*mesh), mg.MeshLambertMaterial(color=color))
+        paths[name] = path
+        knots_drawn[name] = _sphere_set(vis, f"{ROOT}/vias/{name}", knots_drawn[name], sphere_radius, color)
 
     duration, n_frames = 0.0, 0
     if animated:
@@ -253,40 +353,81 @@ def build_scene(
             rec = session.trajectories[name]
             qs = _interp_rows(rec.t[0] + times, rec.t, rec.q)
             drawings[rec.robot].record(anim, vis, qs)
-        vis.set_animation(anim, play=play, repetitions=1)
+        vis.set_animation(anim, play=play, repetitions=float("inf"))
 
-    lo = np.min(np.vstack(bounds), axis=0) if bounds else np.zeros(3)
-    hi = np.max(np.vstack(bounds), axis=0) if bounds else np.zeros(3)
-    _place_camera(vis, lo, hi)
+    _place_camera(vis, camera)
+    vis["/Background"].set_property("top_color", _BACKGROUND[0])
+    vis["/Background"].set_property("bottom_color", _BACKGROUND[1])
+    # the floor: at z = 0, or under the lowest point of a suspended arm (most of it below its base) and its path
+    content = np.vstack(framed) if framed else np.vstack([lo, hi])
+    suspended = np.median(content[:, 2]) < 0.0 and content[:, 2].min() < -0.05
+    floor_z = float(np.floor(content[:, 2].min() / 0.1) * 0.1) if suspended else 0.0
+    grid, grid_step = floor_grid(content.min(axis=0), content.max(axis=0), floor_z)
+    vis["/Grid"].set_property("visible", False)  # MeshCat's 20 m grid: replaced by one sized to the content
+    vis[f"{ROOT}/floor"].set_object(mg.LineSegments(mg.PointsGeometry(grid.T.astype(np.float32)),
+                                                    mg.LineBasicMaterial(color=0xA0A8B4)))
     if hide_background:
-        for node in ("/Background", "/Grid", "/Axes"):
+        for node in ("/Background", "/Axes", f"{ROOT}/floor"):
             vis[node].set_property("visible", False)
+
+    page = {
+        "title": session.title or "pinarms session",
+        "lines": _summary_lines(session, animated, cloud_shown) + [f"floor grid: {grid_step * 100:.0f} cm squares at z = {floor_z:+.1f} m"],
+        "target": target.tolist(),
+        "camera": camera.tolist(),
+        "clouds": list(clouds.values()),
+        "clouds_visible": bool(show_clouds),
+        "animation": {"duration": duration, "playing": bool(play and animated)},
+        "colorbar": None,
+    }
+    if clouds:
+        units = {manipulability_unit(session.robot(k).joint_units) for k in cloud_robots}
+        page["colorbar"] = {
+            "label": "position manipulability √det(J_v J_vᵀ)",
+            "unit": units.pop() if len(units) == 1 else "",
+            "min": 0.0,
+            "max": w_max,
+            "colors": colorbar_stops(colormap),
+        }
+    vis[ROOT].set_property(PAGE_PROPERTY, json.dumps(page, ensure_ascii=False))
+
     all_points = {**{f"vias:{k}": v for k, v in knots_drawn.items()}, **points}
     return SceneInfo(
         robots={k: d.geometry_paths for k, d in drawings.items()},
         objects={n: f"{ROOT}/objects/{n}" for n in session.objects},
         clouds=clouds, paths=paths, points=all_points, animated=animated, duration=duration,
-        n_frames=n_frames, fps=float(fps), bounds=(lo, hi),
+        n_frames=n_frames, fps=float(fps), bounds=(lo, hi), target=target, camera=camera, page=page,
     )
 
 
-def _place_camera(vis: meshcat.Visualizer, lo: np.ndarray, hi: np.ndarray) -> None:
-    """Look at the world origin from the front-right, far enough to see the content's bounding box.
+def _point_set_world(session: Any, name: str) -> np.ndarray:
+    """Points of the session's point set ``name`` in the world frame, ``(n, 3)`` [m]."""
+    ps = session.point_sets[name]
+    T = np.eye(4) if ps.robot is None else session.robots[ps.robot].base_to_world
+    return _transform_points(T, ps.points)
 
-    MeshCat 0.3.2 orbits around the world origin; the camera object sits in a y-up frame
-    (three.js), so the world point (x, y, z) is written (x, z, -y).
+
+def _summary_lines(session: Any, animated: tuple[str, ...], cloud_shown: dict[str, tuple[int, int]]) -> list[str]:
+    """One line per robot (its name and DoF), trajectory (duration; ▶ when animated) and cloud."""
+    lines = []
+    for key, entry in session.robots.items():
+        robot = session.robot(key)
+        label = entry.name if key == entry.name else f"{key} ({entry.name})"
+        lines.append(f"robot {label}: {robot.nq} joints")
+    for name, rec in session.trajectories.items():
+        mark = "▶ " if name in animated else ""
+        lines.append(f"{mark}{name}: {float(rec.t[-1] - rec.t[0]):.3g} s")
+    for name, (shown, total) in cloud_shown.items():
+        lines.append(f"cloud {name}: {total} samples" if shown == total else f"cloud {name}: {shown} of {total} samples shown")
+    return lines
+
+
+def _place_camera(vis: meshcat.Visualizer, camera: np.ndarray) -> None:
+    """Put MeshCat's camera at ``camera`` (world, m).
+
+    The camera object sits in a y-up frame (three.js), so the world point (x, y, z) is
+    written (x, z, -y). MeshCat orbits around the world origin; the page script
+    (:mod:`viz.page`) moves the orbit's centre to the framed target.
     """
-    reach = float(np.max(np.abs(np.vstack([lo, hi])))) if np.any(hi > lo) else 1.0
-    d = 2.6 * max(reach, 0.3)
-    x, y, z = 0.75 * d, -0.55 * d, 0.45 * d
+    x, y, z = (float(v) for v in camera)
     vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
-
-
-def scene_html(session: Any, **options: Any) -> tuple[str, SceneInfo]:
-    """The session's scene as MeshCat's self-contained static HTML (a server runs for a moment)."""
-    from .viewer import MeshcatServer
-
-    with MeshcatServer() as server, contextlib.redirect_stdout(io.StringIO()):
-        info = build_scene(server.visualizer, session, **options)
-        html = server.static_html()
-    return html, info

@@ -1,16 +1,14 @@
-"""Saved sessions: what a user keeps from a study, in one open, versioned file.
+"""Saved sessions: the :class:`Session` builder, what a user keeps from a study.
 
 A session holds robots (a registry name, or the URDF text embedded) with their base
 placements, static boxes (a conveyor, a crate), named trajectories (their definition plus
 sampled joint positions), workspace clouds with manipulability, via points and targets,
 optimisation histories, and free metadata.
 
-File format (``FORMAT_NAME`` version ``FORMAT_VERSION``; full spec in docs/viz.md): a zip
-archive holding ``session.json`` (format, version, metadata, index of everything) and one
-``.npy`` file per array (``numpy.save``; loaded with ``allow_pickle=False``), plus
-``robots/<key>.urdf`` for embedded URDFs. Never pickle. Written atomically; validated on
-load (:class:`SessionFormatError` says what is wrong). A save/load round trip is exact:
-arrays are bit-equal and the JSON is equal.
+This module builds sessions from the user's objects (checking every argument) and saves
+and loads them; the file format itself (records, the table of member kinds, bounded and
+validated reading, writing) is :mod:`pinarms.viz.session_format`. Never pickle; written
+atomically; a save/load round trip is exact (arrays bit-equal, JSON equal).
 
 Frames and units: positions in metres, angles in radians, times in seconds. Every robot
 has a pose ``base_to_world`` (4×4). Workspace points, point sets with a ``robot`` and
@@ -21,13 +19,9 @@ robot are in the world frame.
 from __future__ import annotations
 
 import importlib.metadata
-import io
 import json
 import math
-import re
-import zipfile
-import zlib
-from dataclasses import dataclass
+import os
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping
@@ -38,13 +32,32 @@ from pinarms import robots
 from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
-from ._atomic import atomic_write
 from .errors import SessionFormatError
+from .session_format import (
+    F8 as _F8,
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    KINDS,
+    POINT_KINDS as _POINT_KINDS,
+    BoxObject,
+    HistoryRecord,
+    PointSet,
+    RobotEntry,
+    SessionLimits,
+    TrajectoryRecord,
+    WorkspaceRecord,
+    check_mesh_paths,
+    check_name as _check_name,
+    read_session,
+    to_document,
+    write_session,
+)
 
 __all__ = [
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "Session",
+    "SessionLimits",
     "RobotEntry",
     "BoxObject",
     "TrajectoryRecord",
@@ -55,137 +68,11 @@ __all__ = [
     "MAX_TRAJECTORY_SAMPLES",
 ]
 
-FORMAT_NAME = "pinarms-session"
-FORMAT_VERSION = 1
-JSON_MEMBER = "session.json"
-
-#: names of robots, trajectories, ...: 1-100 printable characters, no "/" (scene path separator)
-_NAME_RE = re.compile(r"^(?=.*\S)[^/\x00-\x1f\x7f]{1,100}$")
-_POINT_KINDS = ("via", "target")
-_F8 = np.dtype("<f8")
 MAX_TRAJECTORY_SAMPLES = 2_000_000
 """Most samples :meth:`Session.add_trajectory` takes from a Trajectory (duration × hz)."""
 
 
-# ---------------------------------------------------------------------------- records
-@dataclass(frozen=True, eq=False)
-class RobotEntry:
-    """A robot of the session.
-
-    Attributes:
-        key: name of the robot in this session (scene path ``pinarms/<key>``).
-        source: ``"registry"`` (reloaded with ``robots.load(name)``) or ``"urdf"``
-            (rebuilt from the embedded ``urdf_text``).
-        name: the robot's name (registry name for ``"registry"``).
-        tcp_frame: frame used as the tool centre point.
-        joint_names: independent joints, in ``q`` order.
-        base_to_world: pose of the robot's base in the world frame, (4, 4), m.
-        urdf_text: embedded URDF (``None`` for registry robots).
-        package_dirs: folders that resolved ``package://`` meshes when saved (a hint only).
-    """
-
-    key: str
-    source: str
-    name: str
-    tcp_frame: str
-    joint_names: tuple[str, ...]
-    base_to_world: np.ndarray
-    urdf_text: str | None = None
-    package_dirs: tuple[str, ...] = ()
-
-    @property
-    def nq(self) -> int:
-        """Number of independent joints."""
-        return len(self.joint_names)
-
-
-@dataclass(frozen=True, eq=False)
-class BoxObject:
-    """A static box in the scene (conveyor, crate): ``size`` (3,) m, ``pose`` box→world (4, 4), ``color`` RGBA in [0, 1]."""
-
-    name: str
-    size: np.ndarray
-    pose: np.ndarray
-    color: tuple[float, float, float, float]
-
-
-@dataclass(frozen=True, eq=False)
-class TrajectoryRecord:
-    """A trajectory of one robot: definition (JSON recipe or ``None``) plus samples.
-
-    Attributes:
-        t: sample instants (N,), s, strictly increasing.
-        q: joint positions (N, nq) at ``t`` (rad or m, the robot's ``q`` order).
-        knot_times: knot (via point) instants (m+1,), s.
-        definition: ``Trajectory.definition`` (rebuild with :meth:`rebuild`), or ``None``.
-    """
-
-    name: str
-    robot: str
-    t: np.ndarray
-    q: np.ndarray
-    knot_times: np.ndarray
-    definition: dict | None
-
-    def rebuild(self) -> Any:
-        """The :class:`planning.Trajectory` rebuilt from :attr:`definition`."""
-        if self.definition is None:
-            raise InvalidInput(f"trajectory {self.name!r} was saved from samples only; it has no definition to rebuild")
-        from pinarms import planning  # late import: only this method needs it
-
-        return planning.from_definition(self.definition)
-
-
-@dataclass(frozen=True, eq=False)
-class WorkspaceRecord:
-    """A workspace cloud: ``points`` (n, 3) m in the robot's base frame, ``manipulability`` (n,)."""
-
-    name: str
-    robot: str
-    points: np.ndarray
-    manipulability: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
-class PointSet:
-    """Via points or targets: ``points`` (n, 3) m, in ``robot``'s base frame or the world frame (``robot`` None)."""
-
-    name: str
-    kind: str
-    robot: str | None
-    points: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
-class HistoryRecord:
-    """An optimisation history: equal-length 1-D float columns (``best`` and usually ``mean``), one row per generation.
-
-    ``inf`` marks a generation without any finite objective (NaN is never stored).
-    """
-
-    name: str
-    columns: dict[str, np.ndarray]
-
-    @property
-    def best(self) -> np.ndarray:
-        """Best objective per generation."""
-        return self.columns["best"]
-
-    @property
-    def mean(self) -> np.ndarray | None:
-        """Mean objective per generation, when recorded."""
-        return self.columns.get("mean")
-
-
 # ---------------------------------------------------------------------------- helpers
-def _check_name(name: Any, what: str) -> str:
-    if not isinstance(name, str) or not _NAME_RE.match(name):
-        raise InvalidInput(
-            f"{what} name {name!r} is not allowed: use 1-100 printable characters without '/'"
-        )
-    return name
-
-
 def _json_normalised(obj: Any, what: str) -> Any:
     """``obj`` as it will come back from JSON (tuples → lists); rejects NaN and non-JSON values."""
     try:
@@ -333,6 +220,8 @@ class Session:
                 rob = robots.load(entry.name)
             else:
                 dirs = self.package_dirs_override if self.package_dirs_override is not None else entry.package_dirs
+                # an embedded URDF comes from a file: its meshes must stay inside the package dirs
+                check_mesh_paths(entry.urdf_text, tuple(dirs), f"session robot {entry.key!r}")
                 rob = robots.from_urdf_text(
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
@@ -504,56 +393,12 @@ class Session:
         return rec
 
     # ---------------------------------------------------------------- (de)serialisation
+    def _tables(self) -> dict[str, dict[str, Any]]:
+        return {kind.attr: getattr(self, kind.attr) for kind in KINDS}
+
     def to_document(self) -> tuple[dict, dict[str, np.ndarray], dict[str, str]]:
         """The ``session.json`` document, the arrays by member name, and the text members."""
-        arrays: dict[str, np.ndarray] = {}
-        texts: dict[str, str] = {}
-
-        def ref(member: str, arr: np.ndarray) -> dict:
-            arrays[member] = arr
-            return {"member": member, "dtype": arr.dtype.str, "shape": list(arr.shape)}
-
-        doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "metadata": self.metadata}
-        doc["robots"] = []
-        for i, e in enumerate(self.robots.values()):
-            urdf_member = None
-            if e.urdf_text is not None:
-                urdf_member = f"robots/{i}.urdf"
-                texts[urdf_member] = e.urdf_text
-            doc["robots"].append({
-                "key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
-                "joint_names": list(e.joint_names), "urdf_member": urdf_member, "package_dirs": list(e.package_dirs),
-                "base_to_world": ref(f"arrays/robots/{i}/base_to_world.npy", e.base_to_world),
-            })
-        doc["objects"] = [
-            {"name": b.name, "shape": "box", "color": list(b.color),
-             "size": ref(f"arrays/objects/{i}/size.npy", b.size),
-             "pose": ref(f"arrays/objects/{i}/pose.npy", b.pose)}
-            for i, b in enumerate(self.objects.values())
-        ]
-        doc["trajectories"] = [
-            {"name": r.name, "robot": r.robot, "definition": r.definition,
-             "t": ref(f"arrays/trajectories/{i}/t.npy", r.t),
-             "q": ref(f"arrays/trajectories/{i}/q.npy", r.q),
-             "knot_times": ref(f"arrays/trajectories/{i}/knot_times.npy", r.knot_times)}
-            for i, r in enumerate(self.trajectories.values())
-        ]
-        doc["workspaces"] = [
-            {"name": r.name, "robot": r.robot,
-             "points": ref(f"arrays/workspaces/{i}/points.npy", r.points),
-             "manipulability": ref(f"arrays/workspaces/{i}/manipulability.npy", r.manipulability)}
-            for i, r in enumerate(self.workspaces.values())
-        ]
-        doc["points"] = [
-            {"name": p.name, "kind": p.kind, "robot": p.robot, "points": ref(f"arrays/points/{i}/points.npy", p.points)}
-            for i, p in enumerate(self.point_sets.values())
-        ]
-        doc["histories"] = [
-            {"name": h.name,
-             "columns": {k: ref(f"arrays/histories/{i}/{c}.npy", v) for c, (k, v) in enumerate(h.columns.items())}}
-            for i, h in enumerate(self.histories.values())
-        ]
-        return doc, arrays, texts
+        return to_document(self.metadata, self._tables())
 
     def __eq__(self, other: object) -> bool:
         """Same JSON document and bit-equal arrays (dtype, shape and bytes)."""
@@ -568,241 +413,41 @@ class Session:
 
     __hash__ = None  # type: ignore[assignment]
 
-    def save(self, path: str | Path) -> Path:
+    def save(self, path: str | os.PathLike) -> Path:
         """Write the session to ``path`` (one zip file, atomically); return the path."""
-        doc, arrays, texts = self.to_document()
-        payload = json.dumps(doc, indent=1, allow_nan=False, ensure_ascii=False)
-
-        def write(f: Any) -> None:
-            with zipfile.ZipFile(f, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-                zf.writestr(JSON_MEMBER, payload.encode("utf-8"))
-                for member, text in texts.items():
-                    zf.writestr(member, text.encode("utf-8"))
-                for member, arr in arrays.items():
-                    buf = io.BytesIO()
-                    np.save(buf, np.ascontiguousarray(arr), allow_pickle=False)
-                    zf.writestr(member, buf.getvalue())
-
-        return atomic_write(path, write)
+        return write_session(path, self.metadata, self._tables())
 
 
-# ---------------------------------------------------------------------------- loading
-class _Reader:
-    """Validating reader of one session archive; every problem becomes a SessionFormatError."""
-
-    def __init__(self, path: Path, zf: zipfile.ZipFile) -> None:
-        self.path = path
-        self.zf = zf
-
-    def fail(self, what: str) -> SessionFormatError:
-        return SessionFormatError(f"{str(self.path)!r} is not a valid pinarms session: {what}")
-
-    def read(self, member: str) -> bytes:
-        try:
-            return self.zf.read(member)
-        except KeyError:
-            raise self.fail(f"member {member!r} is missing (the file is incomplete)") from None
-        except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as exc:
-            raise self.fail(f"member {member!r} is corrupt ({exc})") from None
-
-    def field(self, obj: Any, key: str, types: type | tuple, where: str) -> Any:
-        if not isinstance(obj, dict):
-            raise self.fail(f"{where} must be a JSON object")
-        if key not in obj:
-            raise self.fail(f"{where} lacks the field {key!r}")
-        value = obj[key]
-        allowed = types if isinstance(types, tuple) else (types,)
-        if not isinstance(value, allowed) or (isinstance(value, bool) and bool not in allowed):
-            raise self.fail(f"{where}.{key} has the wrong type ({type(value).__name__})")
-        return value
-
-    def name(self, obj: Any, where: str) -> str:
-        name = self.field(obj, "name", str, where)
-        if not _NAME_RE.match(name):
-            raise self.fail(f"{where}.name {name!r} is not a valid name")
-        return name
-
-    def array(self, obj: Any, key: str, where: str, shape: tuple[int | None, ...], allow_inf: bool = False) -> np.ndarray:
-        ref = self.field(obj, key, dict, where)
-        member = self.field(ref, "member", str, f"{where}.{key}")
-        dtype = self.field(ref, "dtype", str, f"{where}.{key}")
-        idx_shape = self.field(ref, "shape", list, f"{where}.{key}")
-        if dtype != _F8.str:
-            raise self.fail(f"{where}.{key} declares dtype {dtype!r}; this version stores float64 ({_F8.str!r}) only")
-        data = self.read(member)
-        try:
-            arr = np.load(io.BytesIO(data), allow_pickle=False)
-        except Exception as exc:  # numpy raises ValueError/EOFError/... on a damaged .npy
-            raise self.fail(f"member {member!r} is not a readable .npy array ({exc})") from None
-        if not isinstance(arr, np.ndarray) or arr.dtype != _F8:
-            raise self.fail(f"member {member!r} has dtype {getattr(arr, 'dtype', '?')}, expected float64")
-        if list(arr.shape) != idx_shape:
-            raise self.fail(f"member {member!r} has shape {arr.shape}, but session.json says {tuple(idx_shape)}")
-        if len(shape) != arr.ndim or any(s is not None and s != a for s, a in zip(shape, arr.shape)):
-            want = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
-            raise self.fail(f"member {member!r} has shape {arr.shape}, expected {want}")
-        if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
-            raise self.fail(f"member {member!r} holds NaN{'' if allow_inf else ' or infinite'} values")
-        arr.flags.writeable = False
-        return arr
-
-    def unique(self, seen: set, name: str, where: str) -> None:
-        if name in seen:
-            raise self.fail(f"{where} name {name!r} appears twice")
-        seen.add(name)
-
-
-def load_session(path: str | Path, *, package_dirs: tuple[str, ...] | list[str] | None = None) -> Session:
+def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | list[str] | None = None,
+                 limits: SessionLimits | None = None) -> Session:
     """Read and validate a session file written by :meth:`Session.save`.
+
+    Files users exchange are hostile until checked: the reader compares every member's
+    declared size with ``session.json``'s index and with ``limits`` before reading it, reads
+    arrays streaming, and refuses what does not fit (see :class:`SessionLimits` and
+    docs/viz.md).
 
     Args:
         path: the session file.
         package_dirs: folders resolving ``package://`` meshes of embedded URDFs (default:
             the folders recorded when the session was saved).
+        limits: the most the reader accepts (default ``SessionLimits()``: 1 GiB in all,
+            512 MiB per array, 16 MiB per URDF, 64 MiB of JSON).
 
     Raises:
         SessionFormatError: the file is not a zip, is truncated or corrupt, lacks a member,
-            has a malformed ``session.json``, arrays of the wrong dtype or shape, or was
-            written by a newer format version.
+            has a malformed ``session.json``, arrays of the wrong dtype or shape, members
+            larger than their index or the limits, or was written by a newer format version.
         InvalidInput: ``path`` does not exist or is a folder.
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InvalidInput(f"session file {str(p)!r} does not exist (or is not a file)")
-    try:
-        zf = zipfile.ZipFile(p, "r")
-    except zipfile.BadZipFile:
-        raise SessionFormatError(
-            f"{str(p)!r} is not a valid pinarms session: not a zip archive, or truncated (its directory is missing)"
-        ) from None
-    except OSError as exc:
-        raise SessionFormatError(f"cannot read session {str(p)!r}: {exc}") from None
-    with zf:
-        return _read(_Reader(p, zf), package_dirs)
-
-
-def _read(r: _Reader, package_dirs: Any) -> Session:
-    raw = r.read(JSON_MEMBER)
-    try:
-        doc = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise r.fail(f"{JSON_MEMBER} is not valid UTF-8 JSON ({exc})") from None
-    if not isinstance(doc, dict):
-        raise r.fail(f"{JSON_MEMBER} must hold a JSON object")
-    if doc.get("format") != FORMAT_NAME:
-        raise r.fail(f"{JSON_MEMBER} has format {doc.get('format')!r}, expected {FORMAT_NAME!r}")
-    version = doc.get("version")
-    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise r.fail(f"format version {version!r} is not a positive integer")
-    if version > FORMAT_VERSION:
-        raise SessionFormatError(
-            f"{str(r.path)!r} was written in session format version {version}, newer than this pinarms reads "
-            f"(up to {FORMAT_VERSION}); upgrade pinarms to open it"
-        )
-
+    if package_dirs is not None and (isinstance(package_dirs, (str, bytes)) or
+                                     not all(isinstance(d, (str, os.PathLike)) for d in package_dirs)):
+        raise InvalidInput(f"package_dirs must be a list of folders, got {package_dirs!r}")
+    contents = read_session(path, limits)
     s = Session()
-    meta = r.field(doc, "metadata", dict, "session")
-    for k, typ in (("title", str), ("created", str), ("pinarms_version", str), ("user", dict)):
-        r.field(meta, k, typ, "metadata")
-    s.metadata = meta
+    s.metadata = contents.metadata
+    for kind in KINDS:
+        setattr(s, kind.attr, contents.tables[kind.attr])
     if package_dirs is not None:
         s.package_dirs_override = tuple(str(d) for d in package_dirs)
-
-    seen: set = set()
-    for i, e in enumerate(r.field(doc, "robots", list, "session")):
-        where = f"robots[{i}]"
-        key = r.field(e, "key", str, where)
-        if not _NAME_RE.match(key):
-            raise r.fail(f"{where}.key {key!r} is not a valid name")
-        r.unique(seen, key, "robot")
-        source = r.field(e, "source", str, where)
-        if source not in ("registry", "urdf"):
-            raise r.fail(f"{where}.source must be 'registry' or 'urdf', got {source!r}")
-        joints = r.field(e, "joint_names", list, where)
-        if not joints or not all(isinstance(j, str) for j in joints):
-            raise r.fail(f"{where}.joint_names must be a non-empty list of strings")
-        urdf_member = e.get("urdf_member")
-        urdf_text = None
-        if source == "urdf":
-            if not isinstance(urdf_member, str):
-                raise r.fail(f"{where} embeds its URDF but has no urdf_member")
-            try:
-                urdf_text = r.read(urdf_member).decode("utf-8")
-            except UnicodeDecodeError:
-                raise r.fail(f"member {urdf_member!r} is not UTF-8 text") from None
-        dirs = r.field(e, "package_dirs", list, where)
-        s.robots[key] = RobotEntry(
-            key=key, source=source, name=r.field(e, "name", str, where), tcp_frame=r.field(e, "tcp_frame", str, where),
-            joint_names=tuple(joints), base_to_world=r.array(e, "base_to_world", where, (4, 4)), urdf_text=urdf_text,
-            package_dirs=tuple(str(d) for d in dirs),
-        )
-
-    def robot_key(obj: dict, where: str, optional: bool = False) -> str | None:
-        key = obj.get("robot") if optional else r.field(obj, "robot", str, where)
-        if key is None and optional:
-            return None
-        if key not in s.robots:
-            raise r.fail(f"{where}.robot {key!r} is not one of the session's robots ({', '.join(s.robots) or 'none'})")
-        return key
-
-    seen = set()
-    for i, o in enumerate(r.field(doc, "objects", list, "session")):
-        where = f"objects[{i}]"
-        name = r.name(o, where)
-        r.unique(seen, name, "object")
-        if r.field(o, "shape", str, where) != "box":
-            raise r.fail(f"{where}.shape {o['shape']!r} is not known (this version knows 'box')")
-        color = r.field(o, "color", list, where)
-        if len(color) != 4 or not all(isinstance(c, (int, float)) and 0 <= c <= 1 for c in color):
-            raise r.fail(f"{where}.color must be 4 RGBA numbers in [0, 1]")
-        s.objects[name] = BoxObject(name, r.array(o, "size", where, (3,)), r.array(o, "pose", where, (4, 4)),
-                                    tuple(float(c) for c in color))
-
-    seen = set()
-    for i, o in enumerate(r.field(doc, "trajectories", list, "session")):
-        where = f"trajectories[{i}]"
-        name = r.name(o, where)
-        r.unique(seen, name, "trajectory")
-        key = robot_key(o, where)
-        if "definition" not in o or not (o["definition"] is None or isinstance(o["definition"], dict)):
-            raise r.fail(f"{where}.definition must be a JSON object or null")
-        t = r.array(o, "t", where, (None,))
-        q = r.array(o, "q", where, (t.shape[0], s.robots[key].nq))
-        if t.shape[0] < 2 or np.any(np.diff(t) <= 0):
-            raise r.fail(f"{where}.t must hold at least 2 strictly increasing instants")
-        knots = r.array(o, "knot_times", where, (None,))
-        s.trajectories[name] = TrajectoryRecord(name, key, t, q, knots, o["definition"])
-
-    seen = set()
-    for i, o in enumerate(r.field(doc, "workspaces", list, "session")):
-        where = f"workspaces[{i}]"
-        name = r.name(o, where)
-        r.unique(seen, name, "workspace")
-        key = robot_key(o, where)
-        pts = r.array(o, "points", where, (None, 3))
-        w = r.array(o, "manipulability", where, (pts.shape[0],))
-        s.workspaces[name] = WorkspaceRecord(name, key, pts, w)
-
-    seen = set()
-    for i, o in enumerate(r.field(doc, "points", list, "session")):
-        where = f"points[{i}]"
-        name = r.name(o, where)
-        r.unique(seen, name, "point set")
-        kind = r.field(o, "kind", str, where)
-        if kind not in _POINT_KINDS:
-            raise r.fail(f"{where}.kind must be one of {_POINT_KINDS}, got {kind!r}")
-        s.point_sets[name] = PointSet(name, kind, robot_key(o, where, optional=True), r.array(o, "points", where, (None, 3)))
-
-    seen = set()
-    for i, o in enumerate(r.field(doc, "histories", list, "session")):
-        where = f"histories[{i}]"
-        name = r.name(o, where)
-        r.unique(seen, name, "history")
-        cols_doc = r.field(o, "columns", dict, where)
-        if "best" not in cols_doc:
-            raise r.fail(f"{where}.columns lacks 'best'")
-        cols = {k: r.array(cols_doc, k, f"{where}.columns", (None,), allow_inf=True) for k in cols_doc}
-        if len({c.shape[0] for c in cols.values()}) != 1:
-            raise r.fail(f"{where}.columns have different lengths")
-        s.histories[name] = HistoryRecord(name, cols)
     return s

@@ -42,7 +42,8 @@ world-aligned frame Jacobian instead.
 A descent stops when the position error [m] and the rotation error [rad] are both within
 ``tol`` (success), after ``max_iter`` steps, when no step lowers the error, or when the
 error has stagnated (``‖e‖²`` falls by less than ``1 − stall_ratio`` ``stall_steps``
-times in a row). The first attempt starts from ``q_seed``; the next ones from
+times in a row). The first attempt starts from ``q_seed`` (default: of 256 configurations
+drawn once within the limits, the one whose pose is nearest the target); the next ones from
 configurations drawn uniformly within the limits by a seeded generator, taken in order
 of their pose distance to the target. A success is confirmed on the returned ``q`` by a
 fresh forward kinematics and a limit check.
@@ -59,6 +60,7 @@ parallelogram) are followed and the Jacobian is w.r.t. the independent joints.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,10 +69,16 @@ from scipy.linalg.lapack import dposv as _posv
 
 from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
-from ..robot import _check_seed, _check_tolerance
+from .._checks import check_seed as _check_seed
+from .._checks import check_tolerance as _check_tolerance
 
-__all__ = ["NumericalIK", "IKResult"]
+__all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
+_TABLE = 256  # configurations stored with their poses for the first start (table_start)
+_BATCH_CHUNK = 4096  # targets per batched solve (bounds the working set)
+_BATCH_ITER = 15  # iterations of one batched attempt before its target restarts
+_BATCH_TRIES = 6  # batched attempts per target before the per-target solver takes it
+_BATCH_HANDOFF = 4  # the batched loop stops when this many targets (or 1 %) remain
 _POOL = 32  # random starts drawn at once and ranked by their distance to the target
 _ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 _TWO_PI = 2.0 * np.pi
@@ -127,7 +135,8 @@ class NumericalIK:
     ) -> None:
         self.robot = robot
         self.model = robot.model
-        self.data = robot.model.createData()
+        self._local = threading.local()  # per-thread Pinocchio data: one solver serves many threads
+        self._table = None  # start table (see table_start), made on first use
         self.frame_id = robot.frame_id(frame)
         self._frame = frame
         self.nq = robot.nq
@@ -157,6 +166,14 @@ class NumericalIK:
         self.max_step = float(max_step)
         self.stall_ratio = float(stall_ratio)
         self.stall_steps = int(stall_steps)
+
+    @property
+    def data(self) -> pin.Data:
+        """This thread's Pinocchio data (each thread gets its own on first use)."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
 
     # ------------------------------------------------------------------ pieces
     def _pin_q(self, q: np.ndarray) -> np.ndarray:
@@ -262,7 +279,7 @@ class NumericalIK:
         clip = mode == _CLIP
         rows = 3 if position_only else 6  # task rows
         wide = self.nq >= rows  # solve the rows×rows system AAᵀ (else the nq×nq system AᵀA)
-        G_diag = slice(None, None, (rows if wide else self.nq) + 1)  # the diagonal of the flattened system
+        eye = np.eye(rows if wide else self.nq)  # G + λI by one add (a strided in-place add costs 4x more)
         min_damping, max_step = self.min_damping, self.max_step
         max_step2 = max_step * max_step
         stall_ratio, stall_steps = self.stall_ratio, self.stall_steps * patience
@@ -271,8 +288,10 @@ class NumericalIK:
         tol2 = tol * tol
         gate = 4.0 * tol2  # ‖e‖² above this cannot meet tol (|e_lin| ≤ (1 + O(angle)) · position error)
 
+        same_q = self._identity_coords
+
         def evaluate(x):
-            jacobians(model, data, pin_q(x))
+            jacobians(model, data, x if same_q else pin_q(x))
             M = placement(model, data, fid)
             if position_only:
                 d = p_des - M.translation
@@ -304,9 +323,7 @@ class NumericalIK:
             accepted = False
             while mu < _MU_MAX:
                 lam = mu * E + min_damping
-                G = gram.copy()
-                G.flat[G_diag] += lam
-                _, x, info = _posv(G, rhs, overwrite_a=1)
+                _, x, info = _posv(gram + lam * eye, rhs, overwrite_a=1)
                 if info != 0:  # not positive definite in floating point: least squares instead
                     x = np.linalg.lstsq(gram + lam * np.eye(gram.shape[0]), rhs, rcond=None)[0]
                 dq = A.T.dot(x) if wide else x
@@ -369,6 +386,47 @@ class NumericalIK:
             dq = np.linalg.lstsq(A.T.dot(A) + lam * np.eye(A.shape[1]), b, rcond=None)[0]
         return dq
 
+    def nearest_equivalent(self, q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+        """``q`` with each bounded revolute angle at its 2π equivalent within the limits nearest ``q_ref`` (same pose)."""
+        if not self._any_revolute:
+            return q
+        turns = self._window_turns > 0.0
+        k = np.arange(-2.0, 3.0)[:, None]
+        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + _TWO_PI * k  # (5, nq)
+        inside = (options >= self.lower) & (options <= self.upper)
+        cost = np.where(inside, np.abs(options - q_ref), np.inf)
+        best = np.argmin(cost, axis=0)
+        pick = options[best, np.arange(self.nq)]
+        ok = turns & np.isfinite(cost[best, np.arange(self.nq)])
+        return np.where(ok, pick, q)
+
+    def _start_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:data:`_TABLE` configurations drawn within the limits (seed 0) with their frame poses, made once."""
+        table = self._table
+        if table is None:
+            q = np.random.default_rng(0).uniform(self.lower, self.upper, size=(_TABLE, self.nq))
+            T = self.robot.fk(q, self._frame)
+            p = np.ascontiguousarray(T[:, :3, 3])
+            R = np.ascontiguousarray(T[:, :3, :3].reshape(-1, 9))
+            table = self._table = (q, p, np.einsum("ij,ij->i", p, p), R)  # one assignment: safe across threads
+        return table
+
+    def table_start(self, target: np.ndarray, position_only: bool = False) -> np.ndarray:
+        """The stored configuration whose frame pose is nearest ``target (4, 4)``: a copy ``(nq,)``.
+
+        Distance ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first
+        term) over :data:`_TABLE` configurations drawn once within the limits; starting there
+        saves 2-4 iterations over the middle of the ranges.
+        """
+        q, p, pp, R = self._start_table()
+        pt = target[:3, 3]
+        d2 = pp - 2.0 * p.dot(pt) + pt.dot(pt)
+        cost = np.sqrt(np.maximum(d2, 0.0))
+        if not position_only:
+            rt = target[:3, :3].reshape(9)
+            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * R.dot(rt), 0.0))
+        return q[int(np.argmin(cost))].copy()
+
     def _ranked_starts(self, rng: np.random.Generator, target: np.ndarray, position_only: bool) -> np.ndarray:
         """:data:`_POOL` uniform draws within the limits, closest to the target first.
 
@@ -404,7 +462,7 @@ class NumericalIK:
 
         Args:
             target: pose ``(4, 4)`` frame → base (only its translation is used when ``position_only``).
-            q_seed: first start ``(nq,)`` (default: the middle of the joint ranges).
+            q_seed: first start ``(nq,)`` (default: :meth:`table_start`, the stored configuration nearest the target).
             tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
             seed: seed or ``numpy.random.Generator`` of the restarts.
             limits: return a configuration within the joint limits (``False``: joints move
@@ -434,17 +492,28 @@ class NumericalIK:
             max_restarts=int(max_restarts), seed=_check_seed(seed), limits=bool(limits),
         )
 
-    def _solve(self, target, q_seed, *, position_only, tol, max_restarts, seed, limits) -> IKResult:
-        """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once)."""
+    def _solve(
+        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True
+    ) -> IKResult:
+        """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once).
+
+        ``first=False`` skips the attempt from the first start (already tried by the caller);
+        ``polish=False`` skips the final projected descent of a failed solve.
+        """
         target = np.asarray(target, dtype=float)
         T_des, p_des = self._target(target, position_only)
         tol = float(tol)
-        q0 = 0.5 * (self.lower + self.upper) if q_seed is None else np.array(q_seed, dtype=float)
+        if not first:
+            q0 = None
+        elif q_seed is None:
+            q0 = self.table_start(target, position_only)
+        else:
+            q0 = np.array(q_seed, dtype=float)
         rng = None
         best = None
         iterations = 0
         pool = np.empty((0, self.nq))
-        for attempt in range(int(max_restarts) + 1):
+        for attempt in range(0 if first else 1, int(max_restarts) + 1):
             if attempt > 0:
                 if pool.shape[0] == 0:
                     if rng is None:
@@ -464,8 +533,11 @@ class NumericalIK:
                 return IKResult(q, True, pe, re, attempt + 1, iterations)
             if best is None or pe + re < best[1] + best[2]:
                 best = (q, pe, re)
+        if best is None:
+            return IKResult(np.clip(self.table_start(target, position_only), self.lower, self.upper), False,
+                            np.inf, np.inf, 0, 0)
         q, pe, re = best
-        if limits:  # the closest configuration within the limits: a projected descent from the best end
+        if limits and polish:  # the closest configuration within the limits: a projected descent from the best end
             q, pe, re, it = self._descend(q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
             iterations += it
             if pe + re > best[1] + best[2]:
@@ -475,3 +547,263 @@ class NumericalIK:
                 if pe <= tol and re <= tol:
                     return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)
+
+
+# ------------------------------------------------------------------ batched solver
+@dataclass(frozen=True)
+class BatchIKResult:
+    """Outcome of :meth:`NumericalIK.solve_batch`.
+
+    Attributes:
+        q: ``(N, nq)`` configurations within the limits [rad or m]; a row meets its target
+            only where ``success``.
+        success: ``(N,)`` position and rotation errors within the tolerance, within the limits.
+        position_error: ``(N,)`` [m]; rotation_error: ``(N,)`` [rad] (0 in position-only mode).
+        iterations: batched iterations run (each one step for every unsolved target).
+    """
+
+    q: np.ndarray
+    success: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    iterations: int
+
+
+def _log3(R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation vectors ``(n, 3)`` [rad] of rotation matrices ``(n, 3, 3)`` and their angles ``(n,)``.
+
+    The angle is ``atan2(|w|, (tr R − 1)/2)`` with ``w = vee(R − Rᵀ)/2`` (accurate near 0, where
+    an arccos loses half the digits); within 0.45 rad of π the axis comes from the symmetric part.
+    """
+    w = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=1)
+    c = 0.5 * (R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2] - 1.0)
+    s = np.sqrt(np.einsum("ij,ij->i", w, w))
+    theta = np.arctan2(s, c)
+    k = np.ones_like(theta)
+    np.divide(theta, s, out=k, where=s > 1e-300)
+    out = w * k[:, None]
+    near = c < -0.9  # θ > 2.69 rad: |w| = sin θ is small, take the axis from (R + Rᵀ)/2 − c I = (1 − c) a aᵀ
+    if near.any():
+        Rn, cn, wn, tn = R[near], c[near], w[near], theta[near]
+        B = 0.5 * (Rn + np.swapaxes(Rn, 1, 2)) - cn[:, None, None] * np.eye(3)
+        i = np.argmax(np.diagonal(B, axis1=1, axis2=2), axis=1)
+        col = B[np.arange(i.size), :, i]
+        axis = col / np.sqrt(np.maximum(np.einsum("ij,ij->i", col, col), 1e-300))[:, None]
+        sign = np.where(np.einsum("ij,ij->i", axis, wn) < 0.0, -1.0, 1.0)
+        out[near] = axis * (sign * tn)[:, None]
+    return out, theta
+
+
+def _solve_batch(self, targets: np.ndarray, starts: np.ndarray, position_only: bool, tol: float, rng) -> tuple:
+    """Levenberg–Marquardt on every target at once; a target whose descent fails restarts in place.
+
+    Each target's step is the one of :meth:`NumericalIK._descend` (Sugihara damping, Nielsen's
+    μ update, per-joint step cap), with the frame Jacobian in base axes and the rotation
+    error ``log3(R_target R(q)ᵀ)`` in base axes; batched FK and Jacobians give every step
+    in a few numpy calls. An attempt is free (revolute angles wrapped to their range's
+    window when it meets the target); one that meets the target outside the limits goes
+    on as a projected descent from its projection (iterates projected into the limits,
+    joints held at a limit and pushed outwards taken out of the step); one that stalls,
+    stops lowering the error or runs out of iterations restarts from a uniform draw within
+    the limits. The loop ends when the unsolved targets are few (the per-target solver
+    finishes them faster than more batched iterations). Returns ``(q, solved (N,), iterations)``.
+    """
+    tree, fid = self.robot._tree, self.frame_id
+    N, nq = starts.shape
+    lo, hi = self.lower, self.upper
+    rows = 3 if position_only else 6
+    wide = nq >= rows
+    eye = np.eye(rows if wide else nq)
+    pt, Rt = targets[:, :3, 3], targets[:, :3, :3]
+    tol2 = tol * tol
+    max_iter = _BATCH_ITER
+    handoff = max(_BATCH_HANDOFF, N // 100)
+
+    def evaluate(x, k):
+        R, p, J = tree.pose_and_jacobian(x, fid)
+        e = np.empty((x.shape[0], rows))
+        e[:, :3] = pt[k] - p
+        if position_only:
+            return e, J[:, :3], np.zeros(x.shape[0])
+        e[:, 3:], theta = _log3(Rt[k] @ np.swapaxes(R, 1, 2))
+        return e, J, theta
+
+    q_out = np.clip(starts, lo, hi)
+    solved = np.zeros(N, dtype=bool)
+    # state of the active targets (rows aligned with idx)
+    idx = np.arange(N)
+    q = starts.copy()
+    e, J, theta = evaluate(q, idx)
+    E = np.einsum("ij,ij->i", e, e)
+    mu = np.full(N, self.damping)
+    nu = np.full(N, 2.0)
+    stall = np.zeros(N, dtype=int)
+    its = np.zeros(N, dtype=int)
+    tries = np.ones(N, dtype=int)
+    clip = np.zeros(N, dtype=bool)
+    total = 0
+    while idx.size > handoff:
+        total += 1
+        # --- one damped step for every active target
+        lam = mu * E + self.min_damping
+        dq = _damped_steps(J, e, lam, wide, eye)
+        if clip.any():
+            blocked = clip[:, None] & (((q <= lo) & (dq < 0.0)) | ((q >= hi) & (dq > 0.0)))
+            rb = blocked.any(axis=1)
+            if rb.any():  # active set: the blocked joints' columns out, the step solved again
+                dq_f = _damped_steps(J[rb] * (~blocked[rb])[:, None, :], e[rb], lam[rb], wide, eye)
+                dq_f[blocked[rb]] = 0.0
+                dq[rb] = dq_f
+        step = np.abs(dq).max(axis=1)
+        big = step > self.max_step
+        if big.any():
+            dq[big] *= (self.max_step / step[big])[:, None]
+        q_try = q + dq
+        if clip.any():
+            qc = q_try[clip]
+            if self._any_full_turn:
+                w = self.full_turn
+                qc -= _TWO_PI * (w & (qc > hi))
+                qc += _TWO_PI * (w & (qc < lo))
+            q_try[clip] = np.minimum(np.maximum(qc, lo), hi)
+        e_t, J_t, theta_t = evaluate(q_try, idx)
+        E_t = np.einsum("ij,ij->i", e_t, e_t)
+        acc = E_t < E
+        r = e - (J @ dq[:, :, None])[:, :, 0]
+        predicted = E - np.einsum("ij,ij->i", r, r)
+        rho = (E - E_t) / np.where(predicted > 0.0, predicted, np.inf)
+        rho[predicted <= 0.0] = 1.0
+        mu = np.where(acc, np.maximum(mu * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12), mu * nu)
+        nu = np.where(acc, 2.0, 2.0 * nu)
+        stall = np.where(acc, np.where(E_t > self.stall_ratio * E, stall + 1, 0), stall)
+        its += 1
+        q[acc], e[acc], J[acc], theta[acc], E[acc] = q_try[acc], e_t[acc], J_t[acc], theta_t[acc], E_t[acc]
+        # --- outcomes
+        met = (np.einsum("ij,ij->i", e[:, :3], e[:, :3]) <= tol2) & (theta <= tol)
+        if met.any():
+            qm = q[met]
+            if self._any_unbounded:
+                u = self.unbounded
+                qm[:, u] = np.pi - (np.pi - qm[:, u]) % _TWO_PI
+            if self._any_revolute:
+                qm -= _TWO_PI * np.floor((qm - self._window_low) * self._window_turns)
+            inside = np.all((qm >= lo) & (qm <= hi), axis=1)
+            k_met = np.flatnonzero(met)
+            done = k_met[inside]
+            q_out[idx[done]] = qm[inside]
+            solved[idx[done]] = True
+            slide = k_met[~inside & ~clip[k_met]]  # met outside the limits: projected descent from the projection
+            fail_clip = k_met[~inside & clip[k_met]]
+            q[slide] = np.clip(qm[~inside & ~clip[k_met]], lo, hi)
+            clip[slide] = True
+        else:
+            done = slide = fail_clip = np.zeros(0, dtype=int)
+        give_up = (mu >= _MU_MAX) | (stall >= self.stall_steps) | (its >= max_iter)
+        give_up[done] = False
+        give_up[slide] = False
+        give_up[fail_clip] = True
+        restart = np.flatnonzero(give_up)
+        fresh = np.concatenate([slide, restart])
+        if restart.size:
+            q[restart] = rng.uniform(lo, hi, size=(restart.size, nq))
+            clip[restart] = False
+            tries[restart] += 1
+        if fresh.size:
+            mu[fresh], nu[fresh], stall[fresh], its[fresh] = self.damping, 2.0, 0, 0
+            e_f, J_f, th_f = evaluate(q[fresh], idx[fresh])
+            e[fresh], J[fresh], theta[fresh] = e_f, J_f, th_f
+            E[fresh] = np.einsum("ij,ij->i", e_f, e_f)
+        keep = np.ones(idx.size, dtype=bool)
+        keep[done] = False
+        keep &= tries <= _BATCH_TRIES
+        if not keep.all():
+            idx, q, e, J, theta, E = idx[keep], q[keep], e[keep], J[keep], theta[keep], E[keep]
+            mu, nu, stall, its, tries, clip = mu[keep], nu[keep], stall[keep], its[keep], tries[keep], clip[keep]
+    return q_out, solved, total
+
+
+def _damped_steps(J: np.ndarray, e: np.ndarray, lam: np.ndarray, wide: bool, eye: np.ndarray) -> np.ndarray:
+    """Damped least-squares steps ``(n, nq)`` of a batch: ``Jᵀ(JJᵀ + λI)⁻¹e`` (or ``(JᵀJ + λI)⁻¹Jᵀe``)."""
+    Jt = np.swapaxes(J, 1, 2)
+    if wide:
+        G = J @ Jt + lam[:, None, None] * eye
+        return (Jt @ np.linalg.solve(G, e[:, :, None]))[:, :, 0]
+    G = Jt @ J + lam[:, None, None] * eye
+    return np.linalg.solve(G, Jt @ e[:, :, None])[:, :, 0]
+
+
+def _batch_errors(self, q: np.ndarray, targets: np.ndarray, position_only: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Position [m] and rotation [rad] errors of ``q (N, nq)`` for ``targets (N, 4, 4)`` by a fresh batched FK."""
+    T = self.robot.fk(q, self._frame)
+    pe = np.linalg.norm(T[:, :3, 3] - targets[:, :3, 3], axis=1)
+    if position_only:
+        return pe, np.zeros(q.shape[0])
+    _, theta = _log3(targets[:, :3, :3] @ np.swapaxes(T[:, :3, :3], 1, 2))
+    return pe, theta
+
+
+def solve_batch(
+    self,
+    targets: np.ndarray,
+    q_seed: np.ndarray | None = None,
+    *,
+    position_only: bool = False,
+    tol: float = 1e-10,
+    max_restarts: int = 40,
+    seed: int | np.random.Generator | None = 0,
+) -> BatchIKResult:
+    """Many targets at once: batched Levenberg–Marquardt, then :meth:`solve` for the few left.
+
+    Args:
+        targets: checked poses ``(N, 4, 4)`` frame → base [m].
+        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
+            :meth:`table_start` of each target).
+        tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
+        max_restarts, seed: restarts of the per-target solver that finishes the targets the
+            batch left (a few per thousand), and the seed of all random starts.
+
+    Every success is confirmed by a fresh batched forward kinematics and an exact limit check.
+    """
+    targets = np.asarray(targets, dtype=float)
+    N = targets.shape[0]
+    nq = self.nq
+    tol = float(tol)
+    starts = None
+    if q_seed is not None:
+        starts = np.array(np.broadcast_to(np.asarray(q_seed, dtype=float), (N, nq)))
+    missing = np.arange(N) if starts is None else np.flatnonzero(~np.all(np.isfinite(starts), axis=1))
+    if missing.size:  # no seed (or a NaN row): of the stored table, the configuration whose pose is nearest
+        q_table, p_tab, pp_tab, R_tab = self._start_table()
+        pt = targets[missing, :3, 3]
+        d2 = pp_tab[None, :] - 2.0 * pt @ p_tab.T + np.einsum("ij,ij->i", pt, pt)[:, None]
+        cost = np.sqrt(np.maximum(d2, 0.0))
+        if not position_only:
+            rt = targets[missing, :3, :3].reshape(missing.size, 9)
+            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * rt @ R_tab.T, 0.0))
+        if starts is None:
+            starts = np.empty((N, nq))
+        starts[missing] = q_table[np.argmin(cost, axis=1)]
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    q = np.empty((N, nq))
+    success = np.zeros(N, dtype=bool)
+    iterations = 0
+    for s in range(0, N, _BATCH_CHUNK):
+        q[s : s + _BATCH_CHUNK], success[s : s + _BATCH_CHUNK], its = _solve_batch(
+            self, targets[s : s + _BATCH_CHUNK], starts[s : s + _BATCH_CHUNK], position_only, tol, rng
+        )
+        iterations += its
+    if success.any():  # confirm by a fresh FK (the solve's own errors are those of the last iterate)
+        k = np.flatnonzero(success)
+        pe, re = _batch_errors(self, q[k], targets[k], position_only)
+        success[k[(pe > tol) | (re > tol)]] = False
+    for k in np.flatnonzero(~success):  # the few the batch left: per-target solver with restarts
+        res = self._solve(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
+                          seed=rng, limits=True)
+        q[k] = res.q
+        success[k] = res.success
+    pos_err, rot_err = _batch_errors(self, q, targets, position_only)
+    return BatchIKResult(q, success, pos_err, rot_err, iterations)
+
+
+NumericalIK.solve_batch = solve_batch
+NumericalIK.batch_errors = _batch_errors

@@ -114,7 +114,7 @@ class AnalyticIK:
         return out
 
     def _dense(
-        self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool
+        self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool, equivalents: bool = False
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Solutions of one chunk sorted by distance to ``q_ref``: ``q (n, K, nq)``, ``valid (n, K)``, ``branch (n, K)``."""
         robot = self.robot
@@ -128,12 +128,23 @@ class AnalyticIK:
             same = np.all(np.abs(q[:, :b] - q[:, b : b + 1]) <= 1e-8, axis=-1) & valid[:, :b]
             valid[:, b] &= ~np.any(same, axis=1)
         lo, hi = robot.lower, robot.upper
-        if respect_limits:
+        if respect_limits and equivalents:  # every 2π equivalent within the limits
             for j, k in self._shifts():
                 q = np.repeat(q, k.size, axis=1)
                 q[..., j] += _TWO_PI * np.tile(k, q.shape[1] // k.size)
                 valid = np.repeat(valid, k.size, axis=1)
                 branch = np.repeat(branch, k.size, axis=1)
+        elif respect_limits:  # each branch once: every angle at its equivalent within the limits nearest q_ref
+            js = [j for j, _ in self._shifts()]
+            if js:
+                lo_j, hi_j = lo[js], hi[js]
+                qj, ref = q[..., js], q_ref[:, None, js]
+                base = qj + _TWO_PI * np.round((np.clip(ref, lo_j, hi_j) - qj) / _TWO_PI)
+                cand = base[None] + _TWO_PI * np.array([0.0, -1.0, 1.0])[:, None, None, None]  # (3, n, B, m)
+                inside = (cand >= lo_j - LIMIT_TOL) & (cand <= hi_j + LIMIT_TOL)
+                pick = np.argmin(np.where(inside, np.abs(cand - ref), np.inf), axis=0)
+                q[..., js] = np.take_along_axis(cand, pick[None], axis=0)[0]
+        if respect_limits:
             valid &= np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=-1)
         rows = q[valid]
         if rows.shape[0]:
@@ -197,6 +208,7 @@ class AnalyticIK:
         *,
         respect_limits: bool = True,
         with_branches: bool = False,
+        equivalents: bool = False,
     ) -> tuple[np.ndarray, ...]:
         """Verified solutions of a batch: ``(index (M,), q (M, nq))``, index = target row, sorted by target then distance.
 
@@ -210,14 +222,14 @@ class AnalyticIK:
         nq = robot.nq
         q_ref = robot.neutral[None, :] if q_ref is None else np.asarray(q_ref, dtype=float)
         q_ref = np.ascontiguousarray(np.broadcast_to(q_ref, (N, nq)))
-        width = 8 * int(np.prod([k.size for _, k in self._shifts()])) if respect_limits else 8
+        width = 8 * int(np.prod([k.size for _, k in self._shifts()])) if respect_limits and equivalents else 8
         chunk = max(1, min(_CHUNK, _MAX_ROWS // width))
         starts = list(range(0, N, chunk))
         parts: list = [None] * len(starts)
 
         def run(i: int) -> None:
             s = starts[i]
-            q, valid, branch = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits)
+            q, valid, branch = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits, equivalents)
             counts = valid.sum(axis=1)
             parts[i] = (np.repeat(np.arange(s, s + q.shape[0]), counts), q[valid], branch[valid])
 
@@ -258,7 +270,11 @@ class AnalyticIK:
         q = q[np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=1)]
         return q[argsort_tied(np.linalg.norm(q - q_ref, axis=1))]
 
-    def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None) -> list[np.ndarray]:
-        """Every solution within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first."""
-        idx, q = self.candidates(targets, q_ref)
+    def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None, equivalents: bool = False) -> list[np.ndarray]:
+        """The solutions within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first.
+
+        Each branch once (its angles at the 2π equivalents within the limits nearest
+        ``q_ref``); with ``equivalents`` every 2π equivalent within the limits as well.
+        """
+        idx, q = self.candidates(targets, q_ref, equivalents=equivalents)
         return split_by_target(idx, q, targets.shape[0])

@@ -105,10 +105,13 @@ def test_aubo_solution_counts_match_a_numerical_search():
         assert np.abs(free - w).max(axis=1).min() < 1e-6
 
 
-def test_ur5_wide_limits_give_every_two_pi_equivalent():
+def test_ur5_wide_limits_give_each_branch_once_and_equivalents_on_request():
     ur5 = robots.load("ur5")
     q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])  # generic, all |q| < π
-    sols = ur5.ik_all(ur5.fk(q))
+    branches = ur5.ik_all(ur5.fk(q))
+    assert branches.shape[0] == 8
+    assert np.abs(branches - q).max(axis=1).min() < 1e-9  # q itself (within the limits, nearest neutral of its equivalents)
+    sols = ur5.ik_all(ur5.fk(q), equivalents=True)
     # 8 branches; joints with range [-2π, 2π] (all but the elbow) each admit 2 equivalents
     assert sols.shape[0] == 8 * 2**5
     wrapped = (sols[:, [0, 1, 3, 4, 5]] + np.pi) % (2 * np.pi) - np.pi
@@ -418,3 +421,39 @@ def test_aubo_straight_elbow_comes_back_to_rounding(q_deg):
     q = np.radians(q_deg)
     sols = _AUBO.ik_all(_AUBO.fk(q), q_ref=q)
     assert np.abs(sols[0] - q).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", ["ur3", "ur5", "ur10", "aubo_i3"])
+def test_ik_all_lists_each_branch_once_every_row_checked_by_fk(name):
+    """Distinct branches: no two rows are 2π equivalents, every row meets its pose by FK, within limits."""
+    arm = robots.load(name)
+    q = arm.random_q(300, seed=21)
+    T = arm.fk(q)
+    sols = arm.ik_all(T)
+    counts = np.array([s.shape[0] for s in sols])
+    assert counts.min() >= 1 and counts.max() <= 8
+    rows = np.concatenate(sols)
+    idx = np.repeat(np.arange(len(sols)), counts)
+    F = arm.fk(rows)
+    assert np.linalg.norm(F[:, :3, 3] - T[idx, :3, 3], axis=1).max() <= 1e-9
+    assert np.linalg.norm(F[:, :3, :3] - T[idx, :3, :3], axis=(1, 2)).max() <= 2e-9
+    assert np.all(arm.within_limits(rows))
+    for s in sols:  # no repeats, also modulo 2π
+        wrapped = np.round((s + np.pi) % (2 * np.pi) - np.pi, 7)
+        wrapped[np.isclose(np.abs(wrapped), np.pi)] = np.pi
+        assert len(np.unique(wrapped, axis=0)) == s.shape[0]
+    # the generating configuration is among the branches (up to 2π)
+    for k in range(0, 300, 10):
+        d = (sols[k] - q[k] + np.pi) % (2 * np.pi) - np.pi
+        assert np.abs(d).max(axis=1).min() < 1e-6
+
+
+def test_ik_all_branch_equivalent_is_the_one_nearest_q_ref():
+    ur5 = robots.load("ur5")
+    q = np.array([0.3, -1.2, 1.1, -0.5, 0.8, -0.6])
+    ref = q + np.array([-2 * np.pi + 0.1, 0.0, 0.0, 2 * np.pi - 0.2, 0.0, 0.0])
+    sols = ur5.ik_all(ur5.fk(q), q_ref=ref)
+    assert sols.shape[0] == 8
+    np.testing.assert_allclose(sols[0], q + np.array([-2 * np.pi, 0.0, 0.0, 2 * np.pi, 0.0, 0.0]), atol=1e-9)
+    every = ur5.ik_all(ur5.fk(q), q_ref=ref, equivalents=True)
+    assert every.shape[0] == 256 and np.allclose(every[0], sols[0], atol=1e-12)

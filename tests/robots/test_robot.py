@@ -112,7 +112,7 @@ def test_batched_jacobian_equals_single(mimic_robot):
     q = mimic_robot.random_q(40, seed=9)
     J = mimic_robot.jacobian(q)
     assert J.shape == (40, 6, 2)
-    assert np.allclose(J[17], mimic_robot.jacobian(q[17]), atol=0, rtol=0)
+    assert np.abs(J[17] - mimic_robot.jacobian(q[17])).max() <= 1e-12  # single: Pinocchio; batch: numpy
 
 
 def test_manipulability_ur5():

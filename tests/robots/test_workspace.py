@@ -7,6 +7,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
+from pinarms.robots.placement import recommend_region
 from pinarms.robots.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,
@@ -158,7 +159,7 @@ def test_voxel_map_answers_reachability_margin_and_dexterity(aubo):
 def test_aubo_recommended_region(aubo):
     """Criteria fixed in docs/workspace.md; the band is reported, not tuned (paper: 200-500 mm)."""
     ws = sample_workspace(aubo, n=100_000, seed=0, frame="flange")
-    reg = ws.recommend_region()
+    reg = recommend_region(ws)
     assert reg.side == "above" and reg.z_limit == 0.0
     # measured: 225-625 mm. Inner bound: the arm folds onto its base below ~0.2 m;
     # outer bound: the stretched shell beyond ~0.62 m is mostly near-singular.
@@ -173,7 +174,7 @@ def test_aubo_recommended_region(aubo):
 def test_suspended_arm_region_is_below_the_base():
     koji = robots.load("koji_turner")
     ws = sample_workspace(koji, n=20000, seed=0)
-    reg = ws.recommend_region(n_collision=1000)
+    reg = recommend_region(ws, n_collision=1000)
     assert reg.side == "below"
     assert not reg.empty and reg.r_outer > reg.r_inner
 
@@ -194,11 +195,11 @@ def test_bad_options_raise_invalid_input(aubo):
     with pytest.raises(InvalidInput, match="chunk"):
         sample_workspace(aubo, n=10, chunk=0)
     with pytest.raises(InvalidInput, match="about"):
-        ws.recommend_region(about="sphere")
+        recommend_region(ws, about="sphere")
     with pytest.raises(InvalidInput, match="width"):
         ws.radial_profile(width=-1.0)
     with pytest.raises(InvalidInput, match="max_collision_share"):
-        ws.recommend_region(max_collision_share=1.5)
+        recommend_region(ws, max_collision_share=1.5)
 
 
 def test_workspace_arrays_are_read_only(aubo):
@@ -228,12 +229,12 @@ def test_default_voxel_size_keeps_the_interior_free_of_chance_holes(aubo):
         (lambda ws: ws.summary(singular_threshold=-1.0), "singular_threshold"),
         (lambda ws: ws.near_singular(2.0), "singular_threshold"),
         (lambda ws: ws.radial_profile(singular_threshold=0.0), "singular_threshold"),
-        (lambda ws: ws.recommend_region(singular_threshold=float("nan"), n_collision=0), "singular_threshold"),
-        (lambda ws: ws.recommend_region(origin=[0.0, 0.0], n_collision=0), "origin must be one point"),
-        (lambda ws: ws.recommend_region(origin=[np.nan, 0.0, 0.0], n_collision=0), "origin holds NaN"),
-        (lambda ws: ws.recommend_region(z_clearance="1", n_collision=0), "z_clearance"),
-        (lambda ws: ws.recommend_region(seed="a"), "seed"),
-        (lambda ws: ws.recommend_region(max_singular_share=float("nan"), n_collision=0), "max_singular_share"),
+        (lambda ws: recommend_region(ws, singular_threshold=float("nan"), n_collision=0), "singular_threshold"),
+        (lambda ws: recommend_region(ws, origin=[0.0, 0.0], n_collision=0), "origin must be one point"),
+        (lambda ws: recommend_region(ws, origin=[np.nan, 0.0, 0.0], n_collision=0), "origin holds NaN"),
+        (lambda ws: recommend_region(ws, z_clearance="1", n_collision=0), "z_clearance"),
+        (lambda ws: recommend_region(ws, seed="a"), "seed"),
+        (lambda ws: recommend_region(ws, max_singular_share=float("nan"), n_collision=0), "max_singular_share"),
         (lambda ws: fit_sphere_to_hull(ws.points, iterations=0), "iterations"),
         (lambda ws: fit_sphere_to_hull(ws.points, n_bins=-5), "n_bins"),
         (lambda ws: ws.voxel_map(0.1).query("conveyor"), "query points"),
@@ -247,7 +248,7 @@ def test_bad_analysis_options_raise_invalid_input(aubo, call, match):
 
 def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
     ws = sample_workspace(aubo, n=2000, seed=0)
-    assert "z < 0 mm" in ws.recommend_region(side="below", n_collision=0).text()
+    assert "z < 0 mm" in recommend_region(ws, side="below", n_collision=0).text()
 
 
 def test_direction_coverage_tells_a_ball_from_a_patch():

@@ -48,6 +48,10 @@ def test_ga_convergence(tmp_path):
     out = viz.plot_ga_convergence(tmp_path / "ga.svg", hist)
     text = out.read_text()
     assert "generation" in text and "feasible share" in text and "population mean" in text
+    assert "can lie below the best" in text  # a mean of all individuals says what it counts
+    hist["feasible_mean"] = [7.0, 5.0, 4.0, 3.7]
+    text = viz.plot_ga_convergence(tmp_path / "ga2.svg", hist).read_text()
+    assert "mean of the feasible individuals" in text and "population mean" not in text
     s = viz.Session()
     rec = s.add_history("ga", hist)
     assert Image.open(viz.plot_ga_convergence(tmp_path / "ga.png", rec)).format == "PNG"
@@ -97,3 +101,65 @@ def test_bad_plot_data_raises_invalid_input_and_writes_nothing(call, match, tmp_
 def test_trajectory_sample_count_is_checked_not_clamped(traj, tmp_path):
     with pytest.raises(InvalidInput, match="samples must be an integer >= 2"):
         viz.plot_trajectory(tmp_path / "j.png", traj, samples=0)
+
+
+def _panel_labels(fig) -> list[str]:
+    return [ax.get_ylabel() for ax in fig.axes]
+
+
+def test_joint_axes_say_the_unit_of_the_joints_drawn():
+    from pinarms import robots
+    from pinarms.viz.plots import _joint_curves_figure
+
+    def figure(robot, q, **kw):
+        t = np.linspace(0.0, 1.0, 20)
+        qd = np.gradient(q, t, axis=0)
+        return _joint_curves_figure(t, q, qd, None, None, knot_times=[0.0, 1.0], limits={"velocity": 2.0}, robot=robot,
+                                    joint_names=None, joint_units=None, title="", **kw)
+
+    aubo, scara, gantry = robots.load("aubo_i3"), robots.load("scara_mushroom"), robots.load("gantry_flower")
+    q6 = np.linspace(0.0, 1.0, 20)[:, None] * np.ones(6)
+    assert _panel_labels(figure(aubo, q6, degrees=False)) == ["position\n[rad]", "velocity\n[rad/s]"]
+    assert _panel_labels(figure(aubo, q6, degrees=True)) == ["position\n[°]", "velocity\n[°/s]"]
+    assert _panel_labels(figure(gantry, q6[:, :3], degrees=True)) == ["position\n[m]", "velocity\n[m/s]"]
+    fig = figure(scara, q6[:, :4], degrees=True)
+    assert _panel_labels(fig) == ["position\n[° | m]", "velocity\n[°/s | m/s]"]
+    legend = fig.legends[0]
+    assert [t.get_text() for t in legend.get_texts()] == ["j1 [°]", "j2 [°]", "j3 [m]", "j4 [°]", "via points"]
+    # prismatic values are not converted to degrees; revolute ones are
+    lines = fig.axes[0].get_lines()
+    assert lines[4].get_ydata().max() == pytest.approx(1.0) and lines[0].get_ydata().max() == pytest.approx(180 / np.pi)
+    # the legend stands outside every panel; the limit lines are labelled with their values
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    box = legend.get_window_extent(renderer)
+    assert all(not box.overlaps(ax.get_window_extent(renderer)) for ax in fig.axes)
+    notes = [t.get_text() for t in fig.axes[1].texts]
+    assert notes == ["j1 limit ±114.6 °/s", "j2 limit ±114.6 °/s", "j3 limit ±2 m/s", "j4 limit ±114.6 °/s"]
+    notes = [t.get_text() for t in figure(aubo, q6, degrees=False).axes[1].texts]
+    assert notes == ["limit ±2 rad/s"]  # one limit for all: one black pair of lines, one label
+    with pytest.raises(InvalidInput, match="robot 'aubo_i3' has 6"):
+        figure(aubo, q6[:, :4], degrees=False)
+    with pytest.raises(InvalidInput, match="joint_units"):
+        _joint_curves_figure(np.linspace(0, 1, 5), np.zeros((5, 2)), None, None, None, knot_times=None, limits=None,
+                             robot=None, joint_names=None, joint_units=["rad", "deg"], degrees=False, title="")
+
+
+def test_docs_joint_curves_picture(tmp_path):
+    """docs/viz_joint_curves.png: seed 000's joint 1 at the paper's optimised times (``make docs-pictures``)."""
+    from pathlib import Path
+
+    from pinarms import robots
+
+    scara = robots.load("scara_mushroom")
+    traj = planning.piecewise_polynomial(SEED000.paper_knot_times_s, SEED000.path_rad[:, None], degrees=(3, 5, 3))
+    target = tmp_path / "viz_joint_curves.png"
+    if os.environ.get("PINARMS_DOCS_PICTURES") == "1":
+        target = Path(__file__).resolve().parents[2] / "docs" / "viz_joint_curves.png"
+    out = viz.plot_trajectory(target, traj, limits=planning.JointLimits(velocity=np.deg2rad(55.0)), degrees=True,
+                              joint_names=[f"{scara.joint_names[0]} (seed 000 joint 1)"], joint_units=["rad"],
+                              title="seed 000: 3-5-3 at the paper's optimised times 1.086, 1.243, 1.278 s")
+    w, h = Image.open(out).size
+    assert w > 800 and h > 900

@@ -1,0 +1,250 @@
+"""Time-optimal path parameterisation by reachability analysis (TOPP-RA), on arrays.
+
+The algorithm of Pham and Pham, "A new approach to time-optimal path parameterization
+based on reachability analysis", IEEE T-RO 34(3), 2018, written here from the paper.
+
+On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
+control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
+each grid point the limits are rows ``lo <= a u + b x <= hi``
+(:class:`planning.PathRows`, collocation: the point's rows with that interval's u).
+
+1. **Controllable sets, backwards.** ``K_N = {x_end}``; ``K_i`` is the set of x at s_i from
+   which some admissible u reaches ``K_{i+1}``. It is an interval: u must satisfy every
+   lower row ``a u >= lo − b x`` and upper row ``a u <= hi − b x`` of the point plus the two
+   rows ``λ <= x + 2Δ u <= μ`` of ``K_{i+1} = [λ, μ]``; such u exists iff every lower row
+   stays below every upper row. For rows ``(a, b, lo)`` and ``(a', b', hi')`` with
+   ``a, a' >= 0`` that is ``(a b' − a' b) x <= a hi' − a' lo`` — one linear inequality in x
+   per pair (Fourier–Motzkin elimination of u, no division, exact). Pairs between the
+   point's own rows are the same for every step and are evaluated for all points at once
+   (:func:`feasible_states`); only the pairs with the two ``K_{i+1}`` rows are computed in
+   the backward loop.
+2. **Greedy forward pass.** From ``x_0``, take the largest admissible u that keeps
+   ``x_{i+1}`` in ``K_{i+1}``. Every state stays controllable, so the pass never fails, and
+   the result is time-optimal on the grid (the paper's theorem).
+
+The profile's duration is ``sum 2 Δ_i / (√x_i + √x_{i+1})`` (exact for constant s̈ on each
+interval). Limits are enforced at the grid points only; :func:`optim.time_optimal` checks
+between them and refines the grid where needed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pinarms.optim.errors import InfeasibleProblem
+
+__all__ = ["Profile", "feasible_states", "controllable_sets", "greedy_profile", "interpolated_rows",
+           "reachability_profile", "X_CAP"]
+
+#: Largest ṡ² considered (the sets are capped here where nothing limits the speed).
+X_CAP = 1e12
+
+
+@dataclass(frozen=True, eq=False)
+class Profile:
+    """A time-optimal profile on a grid.
+
+    Attributes:
+        s: grid (N+1,) [path unit].
+        x: ṡ² at the grid points (N+1,).
+        u: s̈ on each interval (N,).
+        controllable: (N+1, 2) the controllable sets ``[lo, hi]`` of x.
+    """
+
+    s: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    controllable: np.ndarray
+
+    @property
+    def sd(self) -> np.ndarray:
+        """ṡ at the grid points (N+1,)."""
+        return np.sqrt(np.maximum(self.x, 0.0))
+
+    @property
+    def times(self) -> np.ndarray:
+        """Instants (N+1,) [s] at the grid points, from 0."""
+        sd = self.sd
+        dt = 2.0 * np.diff(self.s) / (sd[:-1] + sd[1:])
+        return np.concatenate([[0.0], np.cumsum(dt)])
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+
+def _normalise(a, b, lo, hi):
+    """Rows with a >= 0 (a row with a < 0 is multiplied by −1, swapping its bounds)."""
+    neg = a < 0.0
+    a2 = np.where(neg, -a, a)
+    b2 = np.where(neg, -b, b)
+    lo2 = np.where(neg, -hi, lo)
+    hi2 = np.where(neg, -lo, hi)
+    return a2, b2, lo2, hi2
+
+
+def feasible_states(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The x-interval (N, 2) where each grid point's own rows admit some u (before reachability)."""
+    a, b, lo, hi = _normalise(a, b, lo, hi)
+    N = a.shape[0]
+    xlo = np.zeros(N)
+    xhi = np.full(N, X_CAP)
+    # rows without u: b x within [lo, hi]
+    free = a == 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for bound, sign in ((hi, 1.0), (lo, -1.0)):
+            ok = free & np.isfinite(bound)
+            bb, cc = sign * b, sign * bound  # bb x <= cc
+            up = ok & (bb > 0.0)
+            xhi = np.minimum(xhi, np.min(np.where(up, cc / np.where(up, bb, 1.0), np.inf), axis=1))
+            dn = ok & (bb < 0.0)
+            xlo = np.maximum(xlo, np.max(np.where(dn, cc / np.where(dn, bb, 1.0), -np.inf), axis=1))
+            bad = ok & (bb == 0.0) & (cc < 0.0)
+            if bad.any():
+                xlo[np.any(bad, axis=1)] = np.inf
+    # pairs of a lower row (a, b, lo) and an upper row (a2, b2, hi2), both with a > 0
+    L = (~free) & np.isfinite(lo)
+    U = (~free) & np.isfinite(hi)
+    if L.any() and U.any():
+        pair = L[:, :, None] & U[:, None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = a[:, :, None] * b[:, None, :] - a[:, None, :] * b[:, :, None]  # (N, lower, upper)
+            d = a[:, :, None] * np.where(U, hi, 0.0)[:, None, :] - a[:, None, :] * np.where(L, lo, 0.0)[:, :, None]
+            pos = pair & (c > 0.0)
+            xhi = np.minimum(xhi, np.min(np.where(pos, d / np.where(pos, c, 1.0), np.inf), axis=(1, 2)))
+            neg = pair & (c < 0.0)
+            xlo = np.maximum(xlo, np.max(np.where(neg, d / np.where(neg, c, 1.0), -np.inf), axis=(1, 2)))
+        bad = pair & (c == 0.0) & (d < 0.0)
+        if bad.any():
+            xlo[np.any(bad, axis=(1, 2))] = np.inf
+    return np.stack([xlo, xhi], axis=1)
+
+
+def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray,
+                      x_end: float = 0.0, feasible: np.ndarray | None = None) -> np.ndarray:
+    """Controllable sets (N+1, 2) of x, backwards from ``x_end`` (module docstring, step 1).
+
+    Raises:
+        InfeasibleProblem: a set is empty (the path cannot be followed to its end under the rows);
+            the message names the grid point.
+    """
+    a, b, lo, hi = _normalise(a, b, lo, hi)
+    X = feasible_states(a, b, lo, hi) if feasible is None else feasible
+    N = s.size - 1
+    delta = np.diff(s)
+    K = np.empty((N + 1, 2))
+    tol = 1e-9
+    end_lo, end_hi = max(X[N, 0], x_end), min(X[N, 1], x_end)
+    if end_lo > end_hi + tol * max(1.0, x_end):
+        raise InfeasibleProblem(f"the path cannot end with ṡ² = {x_end:g} at s = {s[N]:.6g}: the limits there allow "
+                                f"[{X[N, 0]:.6g}, {X[N, 1]:.6g}]")
+    K[N] = (x_end, x_end)
+    Lmask = np.isfinite(lo)
+    Umask = np.isfinite(hi)
+    for i in range(N - 1, -1, -1):
+        lam, mu = K[i + 1]
+        two = 2.0 * delta[i]
+        xlo, xhi = X[i]
+        ai, bi = a[i], b[i]
+        # lower row of the point with the upper row x + 2Δu <= mu: (a·1 − 2Δ b) x <= a mu − 2Δ lo
+        m = Lmask[i]
+        c = ai[m] - two * bi[m]
+        d = ai[m] * mu - two * lo[i][m]
+        # the lower row x + 2Δu >= lam with an upper row of the point: (2Δ b' − a') x <= 2Δ hi' − a' lam
+        m2 = Umask[i]
+        c = np.concatenate([c, two * bi[m2] - ai[m2], [0.0]])
+        d = np.concatenate([d, two * hi[i][m2] - ai[m2] * lam, [two * (mu - lam)]])
+        pos, neg = c > 0.0, c < 0.0
+        if pos.any():
+            xhi = min(xhi, float(np.min(d[pos] / c[pos])))
+        if neg.any():
+            xlo = max(xlo, float(np.max(d[neg] / c[neg])))
+        zero = ~(pos | neg)
+        if np.any(d[zero] < -tol * np.maximum(1.0, np.abs(d[zero]))):
+            xlo = np.inf
+        xlo = max(xlo, 0.0)
+        if xlo > xhi + tol * max(1.0, abs(xhi)):
+            raise InfeasibleProblem(
+                f"no admissible speed at s = {s[i]:.6g} (grid point {i} of {N}): the limits cannot bring the "
+                f"motion to the path's end from there; relax the limits or change the path")
+        K[i] = (xlo, max(xlo, xhi))
+    return K
+
+
+def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray, K: np.ndarray,
+                   x_start: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The greedy forward pass (module docstring, step 2): ``x`` (N+1,), ``u`` (N,).
+
+    Raises:
+        InfeasibleProblem: ``x_start`` is outside the first controllable set.
+    """
+    a, b, lo, hi = _normalise(a, b, lo, hi)
+    N = s.size - 1
+    if not K[0, 0] - 1e-9 * max(1.0, K[0, 0]) <= x_start <= K[0, 1] + 1e-9 * max(1.0, K[0, 1]):
+        raise InfeasibleProblem(f"the start speed ṡ² = {x_start:g} is not controllable: from there the limits allow "
+                                f"[{K[0, 0]:.6g}, {K[0, 1]:.6g}]")
+    delta = np.diff(s)
+    x = np.empty(N + 1)
+    u = np.empty(N)
+    x[0] = min(max(x_start, K[0, 0]), K[0, 1])
+    scale = np.abs(b).max(axis=1) * np.maximum(K[:, 1], 1.0) + np.where(np.isfinite(hi), np.abs(hi), 0.0).max(axis=1)
+    for i in range(N):
+        xi = x[i]
+        two = 2.0 * delta[i]
+        ai = a[i]
+        act = ai > 1e-9 * max(scale[i], 1e-300)
+        upper = (K[i + 1, 1] - xi) / two
+        lower = (K[i + 1, 0] - xi) / two
+        if act.any():
+            aa, bb = ai[act], b[i][act]
+            h_, l_ = hi[i][act], lo[i][act]
+            fin = np.isfinite(h_)
+            if fin.any():
+                upper = min(upper, float(np.min((h_[fin] - bb[fin] * xi) / aa[fin])))
+            fin = np.isfinite(l_)
+            if fin.any():
+                lower = max(lower, float(np.max((l_[fin] - bb[fin] * xi) / aa[fin])))
+        ui = max(upper, lower) if upper < lower else upper  # rounding only: stay controllable
+        xn = xi + two * ui
+        xn = min(max(xn, K[i + 1, 0]), K[i + 1, 1], X_CAP)
+        u[i] = (xn - xi) / two
+        x[i + 1] = xn
+    return x, u
+
+
+def interpolated_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                      s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rows (N+1, 2m) of the *interpolation* discretisation (the paper's first-order scheme).
+
+    Grid point i gets its own rows and those of point i+1 written in (u_i, x_i): there
+    ``x_{i+1} = x_i + 2 Δ_i u_i``, so ``a' = a_{i+1} + 2 Δ_i b_{i+1}``, ``b' = b_{i+1}``. The interval's
+    constant s̈ then satisfies the limits at both its ends (the error left inside is O(Δ²));
+    the last point keeps its own rows twice.
+    """
+    delta = np.diff(s)
+    a2, b2, lo2, hi2 = a.copy(), b.copy(), lo.copy(), hi.copy()
+    a2[:-1] = a[1:] + 2.0 * delta[:, None] * b[1:]
+    b2[:-1], lo2[:-1], hi2[:-1] = b[1:], lo[1:], hi[1:]
+    return (np.concatenate([a, a2], axis=1), np.concatenate([b, b2], axis=1),
+            np.concatenate([lo, lo2], axis=1), np.concatenate([hi, hi2], axis=1))
+
+
+def reachability_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray,
+                         x_start: float = 0.0, x_end: float = 0.0, scheme: str = "interpolation") -> Profile:
+    """Time-optimal profile on the grid ``s`` (N+1,) under rows (N+1, m) (module docstring).
+
+    ``scheme="interpolation"`` (default) also imposes each interval's end rows
+    (:func:`interpolated_rows`); ``"collocation"`` only the rows at the interval's start.
+    """
+    s = np.asarray(s, dtype=float)
+    if s.ndim != 1 or s.size < 2 or np.any(np.diff(s) <= 0.0):
+        raise InfeasibleProblem("the grid must be strictly increasing with at least 2 points")
+    if scheme == "interpolation":
+        a, b, lo, hi = interpolated_rows(a, b, lo, hi, s)
+    elif scheme != "collocation":
+        raise InfeasibleProblem(f"scheme must be 'interpolation' or 'collocation', got {scheme!r}")
+    K = controllable_sets(a, b, lo, hi, s, x_end)
+    x, u = greedy_profile(a, b, lo, hi, s, K, x_start)
+    return Profile(s, x, u, K)

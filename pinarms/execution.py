@@ -1,0 +1,343 @@
+"""Execution layer: one function applied to many tasks, here or on a Dask cluster.
+
+Every sweep of pinarms (large workspaces, layout searches, multi-seed GA studies) is cut
+into *tasks*, applied with :func:`map_chunks`. The same call runs
+
+- ``scheduler=None`` (default): a serial loop in this process, no set-up;
+- ``scheduler="processes"`` (or ``"processes:N"``): a local Dask cluster of ``N`` worker
+  processes (one thread each, on 127.0.0.1, no dashboard), started and closed by the call;
+- ``scheduler="tcp://HOST:8786"``: an existing Dask cluster (``dask scheduler`` +
+  ``dask worker``), connected and disconnected by the call;
+- ``scheduler=client``: a ``distributed.Client`` the caller owns (kept open);
+- ``scheduler="env"``: the address in the standard ``DASK_SCHEDULER_ADDRESS`` variable
+  (an error when it is unset). The variable is read **only** when asked for (here, or by the
+  CLI's ``--scheduler`` option), so a library call never leaves the machine by surprise.
+
+Results are identical whatever runs them: randomness enters a task only through its own
+seed (:func:`chunk_seeds`), tasks are pure functions of their arguments, and results come
+back in task order. A task that raises, or a worker that dies, gives
+:class:`~pinarms.robots.errors.ExecutionError` with the chunk index and its seed, and no
+partial result (callers write files only after a complete result).
+
+This module sits at the bottom of the one-way flow: it imports numpy at module level, Dask
+lazily, and the error class (``pinarms.robots.errors``) lazily when it raises; every package
+(robots, planning, optim, viz, the CLI) may import it.
+
+Cost model: the function and each task are pickled and shipped to a worker, the result
+pickled back. Keep tasks small (seeds, counts, a few arrays) and results reduced (voxel
+counts, tables), and make a task last about a second or more: a Dask task costs roughly
+1 ms of scheduling overhead.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "chunk_seeds",
+    "split_count",
+    "map_chunks",
+    "reduce_chunks",
+    "describe_scheduler",
+    "ExecutionError",
+]
+
+#: Bits of each chunk seed drawn from the chunk's SeedSequence (two 64-bit words).
+SEED_BITS = 128
+
+
+def __getattr__(name: str):
+    # ``pinarms.execution.ExecutionError`` without importing the robots package at import time.
+    if name == "ExecutionError":
+        from pinarms.robots.errors import ExecutionError
+
+        return ExecutionError
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _invalid(message: str) -> Exception:
+    from pinarms.robots.errors import InvalidInput
+
+    return InvalidInput(message)
+
+
+def chunk_seeds(seed: int, n_chunks: int) -> list[int]:
+    """Independent seeds of ``n_chunks`` chunks of one seeded sweep.
+
+    Rule: chunk ``k``'s seed is the 128-bit integer made of the first two 64-bit words of
+    ``numpy.random.SeedSequence(seed).spawn(n_chunks)[k].generate_state(2, numpy.uint64)``
+    (word 0 the low word). A spawned child depends only on ``seed`` and ``k``, so chunk ``k``
+    has the same seed whatever the number of chunks; a task makes its generator with
+    ``numpy.random.default_rng(chunk_seed)``.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise _invalid(f"seed must be a non-negative integer, got {seed!r}")
+    if isinstance(n_chunks, bool) or not isinstance(n_chunks, (int, np.integer)) or n_chunks < 0:
+        raise _invalid(f"n_chunks must be a non-negative integer, got {n_chunks!r}")
+    children = np.random.SeedSequence(int(seed)).spawn(int(n_chunks))
+    out = []
+    for child in children:
+        low, high = child.generate_state(2, dtype=np.uint64)
+        out.append(int(low) | (int(high) << 64))
+    return out
+
+
+def split_count(n: int, chunk_size: int) -> list[int]:
+    """Sizes of the chunks of ``n`` items, ``chunk_size`` each and the remainder last.
+
+    ``split_count(10, 4) == [4, 4, 2]``; ``split_count(0, 4) == []``.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+        raise _invalid(f"n must be a non-negative integer, got {n!r}")
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
+        raise _invalid(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    n, chunk_size = int(n), int(chunk_size)
+    full, rest = divmod(n, chunk_size)
+    return [chunk_size] * full + ([rest] if rest else [])
+
+
+def _task_seed(task: Any) -> int | None:
+    """The seed a task carries: its ``seed`` attribute or ``"seed"`` key, else ``None``."""
+    seed = task.get("seed") if isinstance(task, Mapping) else getattr(task, "seed", None)
+    return int(seed) if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) else None
+
+
+def _failure(index: int, task: Any, what: str, cause: str):
+    from pinarms.robots.errors import ExecutionError
+
+    seed = _task_seed(task)
+    seed_text = f" (seed {seed})" if seed is not None else ""
+    return ExecutionError(
+        f"chunk {index}{seed_text} {what}: {cause}. Nothing was returned; re-run that chunk "
+        "alone (same task, same seed) to reproduce it.",
+        chunk=index,
+        seed=seed,
+        cause=cause,
+    )
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
+
+
+def describe_scheduler(scheduler: Any = None) -> str:
+    """A short text naming where :func:`map_chunks` would run with this ``scheduler``."""
+    kind, arg = _parse_scheduler(scheduler)
+    if kind == "serial":
+        return "serial (this process)"
+    if kind == "processes":
+        return f"local Dask cluster, {arg} worker process{'es' if arg != 1 else ''}"
+    if kind == "address":
+        return f"Dask cluster at {arg}"
+    return f"Dask client {getattr(arg, 'scheduler', None) and arg.scheduler.address}"
+
+
+def _parse_scheduler(scheduler: Any) -> tuple[str, Any]:
+    if scheduler is None or scheduler == "serial":
+        return "serial", None
+    if isinstance(scheduler, str):
+        text = scheduler.strip()
+        if text == "env":
+            address = os.environ.get("DASK_SCHEDULER_ADDRESS", "").strip()
+            if not address:
+                raise _invalid(
+                    'scheduler="env" reads DASK_SCHEDULER_ADDRESS, which is not set: export '
+                    "DASK_SCHEDULER_ADDRESS=tcp://HOST:8786 or pass the address itself"
+                )
+            return _parse_scheduler(address)
+        if text == "processes" or text.startswith("processes:"):
+            count = text.partition(":")[2]
+            if not count:
+                return "processes", max(1, os.cpu_count() or 1)
+            if not count.isdigit() or int(count) < 1:
+                raise _invalid(f"scheduler {scheduler!r}: the worker count after 'processes:' must be a positive integer")
+            return "processes", int(count)
+        if "://" in text:
+            return "address", text
+        raise _invalid(
+            f"unknown scheduler {scheduler!r}: use None (serial), 'processes', 'processes:N', "
+            "'tcp://HOST:8786', 'env' (DASK_SCHEDULER_ADDRESS) or a distributed.Client"
+        )
+    try:
+        from distributed import Client
+    except ImportError:  # pragma: no cover - dask[distributed] is a dependency
+        Client = ()  # noqa: N806
+    if Client and isinstance(scheduler, Client):
+        return "client", scheduler
+    raise _invalid(f"scheduler must be None, a string or a distributed.Client, got {type(scheduler).__name__}")
+
+
+def map_chunks(
+    fn: Callable[[Any], Any],
+    tasks: Sequence,
+    *,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list:
+    """``[fn(task) for task in tasks]``, run serially or on Dask, results in task order.
+
+    ``fn`` must be a picklable top-level function (a module-level ``def``, not a lambda or a
+    closure) when a cluster runs it; it must not rely on global state. ``scheduler``: see the
+    module docstring. ``progress(done, total)`` is called in this process each time a result
+    arrives (and once with ``(0, total)`` before the first).
+
+    Raises :class:`~pinarms.robots.errors.ExecutionError` naming the failing chunk (its index
+    in ``tasks``) and its seed (a task's ``seed`` attribute or ``"seed"`` key) when a task
+    raises or its worker dies; the remaining tasks are cancelled and nothing is returned.
+    """
+    tasks = list(tasks)
+    results: list = [None] * len(tasks)
+
+    def keep(i, result):
+        results[i] = result
+
+    _run(fn, tasks, keep, scheduler, progress)
+    return results
+
+
+def reduce_chunks(
+    fn: Callable[[Any], Any],
+    tasks: Sequence,
+    combine: Callable[[Any, Any], Any],
+    initial: Any,
+    *,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Any:
+    """``combine(... combine(combine(initial, fn(t0)), fn(t1)) ..., fn(tn))``, folded in task order.
+
+    Like :func:`map_chunks`, but each result is folded into the accumulator as soon as the
+    results of all earlier tasks are folded (a result that arrives early waits, and is
+    dropped once folded), so the memory holds the accumulator and a few results rather than
+    every result. The fold order is the task order whatever the scheduler: floating-point
+    sums come out identical bit for bit. ``combine(acc, result)`` returns the new accumulator
+    (it may update ``acc`` in place and return it) and runs in this process.
+    """
+    if not callable(combine):
+        raise _invalid(f"combine must be callable, got {type(combine).__name__}")
+    tasks = list(tasks)
+    state = {"acc": initial, "next": 0}
+    waiting: dict[int, Any] = {}
+
+    def fold(i, result):
+        waiting[i] = result
+        while state["next"] in waiting:
+            state["acc"] = combine(state["acc"], waiting.pop(state["next"]))
+            state["next"] += 1
+
+    _run(fn, tasks, fold, scheduler, progress)
+    return state["acc"]
+
+
+def _run(fn, tasks, on_result, scheduler, progress) -> None:
+    if not callable(fn):
+        raise _invalid(f"fn must be callable, got {type(fn).__name__}")
+    kind, arg = _parse_scheduler(scheduler)
+    total = len(tasks)
+    if progress is not None:
+        progress(0, total)
+    if kind == "serial" or total == 0:
+        _map_serial(fn, tasks, on_result, progress)
+    elif kind == "client":
+        _map_client(arg, fn, tasks, on_result, progress)
+    elif kind == "processes":
+        _map_local_cluster(arg, fn, tasks, on_result, progress)
+    else:
+        _map_address(arg, fn, tasks, on_result, progress)
+
+
+def _map_serial(fn, tasks, on_result, progress):
+    for index, task in enumerate(tasks):
+        try:
+            result = fn(task)
+        except Exception as exc:
+            raise _failure(index, task, "raised", _one_line(exc)) from exc
+        on_result(index, result)
+        if progress is not None:
+            progress(index + 1, len(tasks))
+
+
+def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
+    import warnings
+
+    from distributed import Client, LocalCluster
+
+    n_workers = min(n_workers, len(tasks))
+    with warnings.catch_warnings():
+        # the scheduler's HTTP endpoint moves to a free port when 8787 is taken: not our concern
+        warnings.filterwarnings("ignore", message="Port .* is already in use")
+        cluster = LocalCluster(
+            n_workers=n_workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+        )
+    with cluster, Client(cluster) as client:
+        _map_client(client, fn, tasks, on_result, progress)
+
+
+def _map_address(address, fn, tasks, on_result, progress):
+    import dask
+    from distributed import Client
+
+    try:  # Dask's standard connect timeout (distributed.comm.timeouts.connect, 30 s by default)
+        client = Client(address, timeout=dask.config.get("distributed.comm.timeouts.connect"))
+    except (OSError, TimeoutError) as exc:
+        from pinarms.robots.errors import ExecutionError
+
+        raise ExecutionError(
+            f"cannot reach the Dask scheduler at {address}: {_one_line(exc)}. Start one with "
+            "`dask scheduler` and workers with `dask worker ADDRESS` (docs/sweeps.md), or run "
+            "without a scheduler",
+            cause=_one_line(exc),
+        ) from exc
+    with client:
+        _map_client(client, fn, tasks, on_result, progress)
+
+
+def _map_client(client, fn, tasks, on_result, progress):
+    import uuid
+
+    from distributed import as_completed
+    from distributed.client import FutureCancelledError
+
+    try:
+        from distributed import KilledWorker
+    except ImportError:  # pragma: no cover - older distributed
+        from distributed.scheduler import KilledWorker
+
+    total = len(tasks)
+    token = uuid.uuid4().hex[:12]
+    name = getattr(fn, "__name__", "task")
+    keys = [f"pinarms-{name}-{token}-{i}" for i in range(total)]
+    futures = client.map(fn, tasks, key=keys, pure=False)
+    index_of = {f.key: i for i, f in enumerate(futures)}
+    done = 0
+    try:
+        for future in as_completed(futures):
+            i = index_of[future.key]
+            if future.status == "error" or future.status == "cancelled":
+                try:
+                    future.result()
+                except KilledWorker as exc:
+                    raise _failure(i, tasks[i], "lost its worker (the worker process died)", _one_line(exc)) from exc
+                except FutureCancelledError as exc:
+                    raise _failure(i, tasks[i], "was cancelled by the cluster", _one_line(exc)) from exc
+                except Exception as exc:
+                    raise _failure(i, tasks[i], "raised", _one_line(exc)) from exc
+                raise _failure(i, tasks[i], "failed", future.status)  # pragma: no cover
+            result = future.result()
+            future.release()
+            on_result(i, result)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    finally:
+        if done < total:
+            client.cancel([f for f in futures if not f.done()])

@@ -1,0 +1,499 @@
+"""The joint-space image of a tool path: IK along the path, on one branch, within a tolerance.
+
+:func:`cartesian_path` (tcp poses → :class:`planning.ToolPath` → joints) and
+:func:`joint_image` (a ToolPath you built) return a :class:`CartesianPath`: a
+:class:`planning.JointPath` ``q(s)`` whose tcp stays within ``tolerance`` of the tool path
+at the same arc length s.
+
+**How.** Knots ``s_k`` carry the exact IK solution ``q_k`` and its path derivatives
+``q' = J⁺ X'`` and ``q'' = J⁺ (X'' − J̇ q')`` (X: the tool path, J the tcp Jacobian in base
+axes with the angular rows weighted by the path's ``w``; J̇ q' by a central difference
+along q'). Between knots q(s) is the **quintic Hermite** interpolant of (q, q', q'') at
+both ends: C² in s, error O(h⁶).
+
+1. *Continuation, one branch.* From the start configuration each knot is reached by a
+   predictor (Taylor step) and Newton's method on the pose error, so the solution moves
+   continuously and never jumps to another IK branch. A step is refused — and halved —
+   when Newton does not converge, when the correction or the joint step is large (a jump),
+   when a joint leaves its limits, or when the Jacobian's smallest singular value falls
+   below ``singular_tolerance``. When the step has shrunk below ``locate`` (10 µm of arc
+   length by default) the path stops there with a named error:
+   :class:`planning.errors.SingularityOnPath`, :class:`~planning.errors.JointLimitOnPath`
+   or :class:`~planning.errors.UnreachableOnPath` (s, pose, reason).
+2. *Tolerance rule.* Every interval is checked by FK at 1/4, 1/2 and 3/4 of its length:
+   it is split in two when the tcp there is farther than ``tolerance / 2`` from the tool
+   path's position (or its orientation more than ``tolerance / (2 w)`` rad away), or when
+   the Jacobian's smallest singular value changes by more than a factor 2 across it
+   (ill-conditioned stretches get dense knots). New knots are solved in one batch. The
+   factor 1/2 is the margin that the tolerance holds everywhere between the checks (tests
+   verify it by FK at ten times the knot density).
+
+With a closed-form IK (``robot.ik_branches``) the start's branch label is recorded, and the
+end's label is checked to be the same.
+
+Units: m, rad; s in m (the tool path's weighted arc length).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+import numpy as np
+
+from pinarms.planning import _so3
+from pinarms.planning._inputs import finite_array, per_joint
+from pinarms.planning.errors import (JointLimitOnPath, PathError, SingularityOnPath, TrajectoryError,
+                                     UnreachableOnPath)
+from pinarms.planning.joint_path import JointPath, jacobian_rate
+from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
+from pinarms.robots.errors import UnreachableTarget
+from pinarms.robots.ties import argmin_tied
+
+__all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
+
+#: Default largest tcp deviation from the tool path [m] (0.1 mm).
+DEFAULT_TOLERANCE = 1e-4
+#: Default smallest singular value of the weighted Jacobian [m/rad] below which the arm counts as singular.
+DEFAULT_SINGULAR_TOLERANCE = 1e-4
+#: Newton's method stops when the position error [m] and the weighted rotation error [m] are below this.
+_NEWTON_TOL = 1e-11
+_NEWTON_ITERATIONS = 8
+#: A continuation step is refused when Newton corrects the prediction by more than this [rad or m] ...
+_MAX_CORRECTION = 0.05
+#: ... or when a joint moves more than this in one step [rad or m].
+_MAX_JOINT_STEP = 0.3
+#: Longest initial knot spacing [m of arc length].
+_INITIAL_STEP = 0.1
+#: Check points of the tolerance rule, as fractions of an interval.
+_CHECKS = np.array([0.25, 0.5, 0.75])
+
+
+class CartesianPath(JointPath):
+    """A :class:`planning.JointPath` that follows a :class:`planning.ToolPath` (module docstring).
+
+    Extra attributes:
+        tool_path: the followed :class:`ToolPath` (s is its arc length, m).
+        tolerance: the tcp position tolerance [m] it was built to (orientation: ``tolerance / w`` rad).
+        q_knots: (K+1, nq) exact IK solutions at the knots ``breaks``.
+        sigma_min: (K+1,) smallest singular value of the weighted Jacobian at the knots [m/rad].
+        branch: closed-form IK branch label of the whole path, or None (numerical IK).
+        max_deviation: (position [m], rotation [rad]) largest tcp deviation found at the check points.
+    """
+
+    def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Any, frame: str,
+                 tolerance: float, q_knots: np.ndarray, sigma_min: np.ndarray, branch: int | None,
+                 max_deviation: tuple[float, float]) -> None:
+        super().__init__(breaks, coefficients, stops=tool.stops, robot=robot, frame=frame)
+        self.tool_path = tool
+        self.tolerance = float(tolerance)
+        self.q_knots = q_knots
+        self.sigma_min = sigma_min
+        self.branch = branch
+        self.max_deviation = max_deviation
+        for arr in (self.q_knots, self.sigma_min):
+            arr.flags.writeable = False
+
+    def deviation(self, s: Any) -> tuple[np.ndarray, np.ndarray]:
+        """tcp deviation at arc lengths ``s``: position [m] and rotation [rad] from the tool path at the same s."""
+        arr, _ = self._check_s(s)
+        T = np.asarray(self.robot.fk(self(arr), frame=self.frame))
+        ref = self.tool_path.pose(arr)
+        pos = np.linalg.norm(T[:, :3, 3] - ref[:, :3, 3], axis=1)
+        rot = _so3.angle(np.swapaxes(ref[:, :3, :3], 1, 2) @ T[:, :3, :3])
+        return pos, rot
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-able summary (SI units)."""
+        return {"tool_path": self.tool_path.as_dict(), "tolerance_m": self.tolerance, "knots_m": self.breaks.tolist(),
+                "q_knots": self.q_knots.tolist(), "sigma_min_m_per_rad": self.sigma_min.tolist(),
+                "branch": self.branch, "max_deviation_m": self.max_deviation[0],
+                "max_rotation_deviation_rad": self.max_deviation[1]}
+
+
+# ---------------------------------------------------------------------------- helpers
+def _hermite(s0: np.ndarray, s1: np.ndarray, a: tuple, b: tuple) -> np.ndarray:
+    """Quintic Hermite coefficients (K, 6, n) on [s0, s1] from (q, q', q'') at both ends (each (K, n))."""
+    h = (s1 - s0)[:, None]
+    q0, v0, a0 = a
+    q1, v1, a1 = b
+    c = np.empty((h.shape[0], 6, q0.shape[1]))
+    c[:, 0], c[:, 1], c[:, 2] = q0, v0, 0.5 * a0
+    c[:, 3] = (20.0 * (q1 - q0) - (8.0 * v1 + 12.0 * v0) * h - (3.0 * a0 - a1) * h * h) / (2.0 * h**3)
+    c[:, 4] = (30.0 * (q0 - q1) + (14.0 * v1 + 16.0 * v0) * h + (3.0 * a0 - 2.0 * a1) * h * h) / (2.0 * h**4)
+    c[:, 5] = (12.0 * (q1 - q0) - 6.0 * (v1 + v0) * h - (a0 - a1) * h * h) / (2.0 * h**5)
+    return c
+
+
+def _eval(c: np.ndarray, sig: np.ndarray) -> np.ndarray:
+    """Value of quintic pieces c (K, 6, n) at local offsets sig (K, M) -> (K, M, n)."""
+    powers = sig[..., None] ** np.arange(6)
+    return np.einsum("kmd,kdn->kmn", powers, c)
+
+
+class _Solver:
+    """IK along one tool path for one robot: Newton, derivatives, conditioning (batched)."""
+
+    def __init__(self, robot: Any, tool: ToolPath, frame: str, singular_tolerance: float) -> None:
+        self.robot, self.tool, self.frame = robot, tool, frame
+        self.w = tool.weight
+        self.scale = np.array([1.0, 1.0, 1.0, self.w, self.w, self.w])
+        self.singular = singular_tolerance
+        self.lower = np.asarray(robot.lower, dtype=float)
+        self.upper = np.asarray(robot.upper, dtype=float)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        return np.asarray(self.robot.jacobian(q, frame=self.frame)) * self.scale[:, None]
+
+    def errors(self, q: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """Weighted pose errors (N, 6) [m]: position, w × rotation vector of T R(q)ᵀ (base axes)."""
+        F = np.asarray(self.robot.fk(q, frame=self.frame))
+        e = np.empty((q.shape[0], 6))
+        e[:, :3] = T[:, :3, 3] - F[:, :3, 3]
+        e[:, 3:] = self.w * _so3.log(T[:, :3, :3] @ np.swapaxes(F[:, :3, :3], 1, 2))
+        return e
+
+    def newton(self, q0: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Solutions near q0 (N, nq) for targets T (N, 4, 4) and a converged flag (N,).
+
+        Chord Newton: the Jacobian's pseudo-inverse is evaluated at the start and refreshed every
+        4 iterations (the predictions start close, so each iteration costs one batched FK).
+        """
+        q = q0.copy()
+        active = np.ones(q.shape[0], dtype=bool)
+        ok = np.zeros(q.shape[0], dtype=bool)
+        pinv = np.zeros((q.shape[0], q.shape[1], 6))
+        for it in range(_NEWTON_ITERATIONS):
+            idx = np.flatnonzero(active)
+            if idx.size == 0:
+                break
+            e = self.errors(q[idx], T[idx])
+            done = np.abs(e).max(axis=1) <= _NEWTON_TOL
+            ok[idx[done]] = True
+            active[idx[done]] = False
+            idx, e = idx[~done], e[~done]
+            if idx.size == 0:
+                break
+            if it % 4 == 0:
+                pinv[idx] = np.linalg.pinv(self.jacobian(q[idx]), rcond=1e-12)
+            q[idx] += (pinv[idx] @ e[:, :, None])[:, :, 0]
+        if active.any():
+            idx = np.flatnonzero(active)
+            ok[idx] = np.abs(self.errors(q[idx], T[idx])).max(axis=1) <= _NEWTON_TOL * 10.0
+        return q, ok
+
+    def derivatives(self, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """q' (N, nq), q'' (N, nq) from the tool path's d1, d2 (N, 6), and σ_min (N,) of the weighted Jacobian."""
+        J = self.jacobian(q)
+        U, S, Vt = np.linalg.svd(J, full_matrices=False)
+        inv = np.where(S > 1e-14 * S[:, :1], 1.0 / np.where(S > 0.0, S, 1.0), 0.0)
+        pinv = np.einsum("nji,nj,nkj->nik", Vt, inv, U)
+        x1 = d1 * self.scale
+        x2 = d2 * self.scale
+        dq = np.einsum("nij,nj->ni", pinv, x1)
+        rate = jacobian_rate(self.robot, q, dq, self.frame) * self.scale
+        ddq = np.einsum("nij,nj->ni", pinv, x2 - rate)
+        return dq, ddq, S[:, -1]
+
+    def outside(self, q: np.ndarray) -> np.ndarray:
+        """Largest excess of each row beyond the joint limits (N,) [rad or m]."""
+        return np.maximum(self.lower - q, q - self.upper).max(axis=1)
+
+
+class _Knot:
+    __slots__ = ("s", "q", "dq", "ddq", "dq_l", "ddq_l", "sigma")
+
+    def __init__(self, s: float, q: np.ndarray, right: tuple, left: tuple, sigma: float) -> None:
+        self.s, self.q, self.sigma = s, q, sigma
+        self.dq, self.ddq = right
+        self.dq_l, self.ddq_l = left
+
+
+def _solve_knots(sv: _Solver, s: np.ndarray, q: np.ndarray) -> list[_Knot]:
+    """Knots at s (N,) for configurations q (N, nq) already on the path (derivatives on both sides)."""
+    tool = sv.tool
+    T, r1, r2 = tool.evaluate(s, "right")
+    _, l1, l2 = tool.evaluate(s, "left")
+    dq_r, ddq_r, sig = sv.derivatives(q, r1, r2)
+    differ = np.abs(l1 - r1).max(axis=1) + np.abs(l2 - r2).max(axis=1) > 0.0
+    dq_l, ddq_l = dq_r.copy(), ddq_r.copy()
+    if differ.any():
+        dq_l[differ], ddq_l[differ], _ = sv.derivatives(q[differ], l1[differ], l2[differ])
+    return [_Knot(float(s[i]), q[i], (dq_r[i], ddq_r[i]), (dq_l[i], ddq_l[i]), float(sig[i])) for i in range(s.size)]
+
+
+class _Stop(Exception):
+    """Internal: the continuation of one start cannot pass arc length ``s`` (diagnosed once, by :func:`_failure`)."""
+
+    def __init__(self, s: float, q_last: np.ndarray, kind: str, detail: str) -> None:
+        super().__init__(detail)
+        self.s, self.q_last, self.kind, self.detail = s, q_last, kind, detail
+
+
+def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) -> PathError:
+    """The named error for a continuation that cannot get past arc length s."""
+    robot, tool = sv.robot, sv.tool
+    pose = tool.pose(min(s, tool.length))
+    where = (f"at s = {s:.6g} m of the {tool.length:.6g} m tool path, tcp at "
+             f"{np.array2string(pose[:3, 3], precision=6, separator=', ')} m")
+    if kind == "limit":
+        reason = f"{detail} on this IK branch"
+        return JointLimitOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}; move the path, "
+                                "start from another branch (q_start) or split the path there",
+                                s=s, pose=pose, reason=reason, q=q_last)
+    # out of reach, or an orientation the arm cannot take, a little farther on?
+    ahead = tool.pose(min(s + max(1e-3, 1e-3 * tool.length), tool.length))
+    for target in (ahead, pose):
+        why = robot.ik_failure_reason(target) if hasattr(robot, "ik_failure_reason") else None
+        if why is not None and "outside its limits" not in why and "outside their limits" not in why:
+            reason = f"the path leaves the workspace: {why}"
+            return UnreachableOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}",
+                                     s=s, pose=pose, reason=reason, q=q_last)
+    reason = (f"the arm comes too close to a singular configuration ({detail}); it cannot follow the path "
+              "through it without changing IK branch")
+    return SingularityOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}; move the path away "
+                             "from the singularity or split it there", s=s, pose=pose, reason=reason, q=q_last)
+
+
+def _continue(sv: _Solver, start: _Knot, s_end: float, locate: float) -> list[_Knot]:
+    """Knots from ``start`` to ``s_end`` by predictor–corrector continuation (adaptive step), start excluded."""
+    out: list[_Knot] = []
+    cur = start
+    h = s_end - cur.s
+    while s_end - cur.s > 1e-15 * max(1.0, s_end):
+        h = min(h, s_end - cur.s)
+        s_new = cur.s + h if s_end - (cur.s + h) > 1e-12 * max(1.0, s_end) else s_end
+        hh = s_new - cur.s
+        pred = cur.q + cur.dq * hh + 0.5 * cur.ddq * hh * hh
+        T = sv.tool.pose(s_new)[None]
+        q, ok = sv.newton(pred[None], T)
+        q = q[0]
+        kind, detail = "", ""
+        if not ok[0]:
+            kind, detail = "newton", "Newton's method does not converge on the pose"
+        elif np.abs(q - pred).max() > _MAX_CORRECTION or np.abs(q - cur.q).max() > _MAX_JOINT_STEP:
+            kind, detail = "jump", "the IK solution jumps"
+        elif sv.outside(q[None])[0] > 1e-9:
+            j = int(np.argmax(np.maximum(sv.lower - q, q - sv.upper)))
+            side = "upper" if q[j] > sv.upper[j] else "lower"
+            kind = "limit"
+            detail = (f"joint {sv.robot.joint_names[j]} would pass its {side} limit "
+                      f"{(sv.upper if side == 'upper' else sv.lower)[j]:.6g}")
+        if not kind:
+            knot = _solve_knots(sv, np.array([s_new]), q[None])[0]
+            if knot.sigma < sv.singular:
+                kind, detail = "singular", (f"smallest singular value of the weighted Jacobian {knot.sigma:.4g} m/rad "
+                                            f"< singular_tolerance {sv.singular:g}")
+            else:
+                out.append(knot)
+                cur = knot
+                h = 2.0 * hh
+                continue
+        if hh <= locate:
+            raise _Stop(s_new, cur.q, kind, detail)
+        h = 0.5 * hh
+    return out
+
+
+def _labels(robot: Any, pose: np.ndarray, q: np.ndarray) -> int | None:
+    if not (getattr(robot, "has_analytic_ik", False) and hasattr(robot, "ik_branches")):
+        return None
+    sols, labels = robot.ik_branches(pose, q_ref=q)
+    sols = np.asarray(sols, dtype=float).reshape(-1, q.size)
+    if sols.shape[0] == 0:
+        return None
+    k = argmin_tied(np.linalg.norm(sols - q, axis=1))
+    return int(labels[k]) if np.linalg.norm(sols[k] - q) < 1e-6 else None
+
+
+def _starts(robot: Any, pose: np.ndarray, q_start: np.ndarray | None) -> list[np.ndarray]:
+    """Start configurations to try, in order: near q_start, or every closed-form branch, or numerical IK."""
+    nq = int(robot.nq)
+    if q_start is not None:
+        T = np.asarray(robot.fk(q_start))
+        if np.linalg.norm(T[:3, 3] - pose[:3, 3]) < 1e-6 and _so3.angle(T[:3, :3].T @ pose[:3, :3]) < 1e-6:
+            return [q_start]
+    if getattr(robot, "has_analytic_ik", False) and hasattr(robot, "ik_branches"):
+        sols, _ = robot.ik_branches(pose, q_ref=q_start)
+        sols = np.asarray(sols, dtype=float).reshape(-1, nq)
+        if q_start is not None and sols.shape[0]:
+            return [sols[argmin_tied(np.linalg.norm(sols - q_start, axis=1))]]
+        if sols.shape[0]:
+            return list(sols)
+    return [np.asarray(robot.ik(pose, q_seed=q_start), dtype=float).reshape(nq)]
+
+
+def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> CartesianPath:
+    tool = sv.tool
+    L = tool.length
+    first = _solve_knots(sv, np.array([0.0]), q0[None])[0]
+    if first.sigma < sv.singular:
+        raise _Stop(0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.4g} "
+                                                f"m/rad < {sv.singular:g} at the start")
+    # planned knots: the tool path's breaks, each piece cut into steps of at most _INITIAL_STEP
+    planned = [0.0]
+    for a, b in zip(tool.breaks[:-1], tool.breaks[1:]):
+        n = max(1, int(np.ceil((b - a) / _INITIAL_STEP)))
+        planned.extend((a + (b - a) * np.arange(1, n + 1) / n).tolist())
+    planned[-1] = L
+    knots = [first]
+    for target in planned[1:]:
+        knots.extend(_continue(sv, knots[-1], target, locate))
+    # tolerance rule: refine until every interval passes its check points
+    rot_tol = 0.5 * tolerance / sv.w
+    for _ in range(60):
+        s = np.array([k.s for k in knots])
+        coefs = _coefficients(knots)
+        h = np.diff(s)
+        sc = s[:-1, None] + h[:, None] * _CHECKS
+        qc = _eval(coefs, h[:, None] * _CHECKS)  # (K, 3, n)
+        K, C, n = qc.shape
+        flat = qc.reshape(-1, n)
+        ref = tool.pose(sc.reshape(-1))
+        F = np.asarray(sv.robot.fk(flat, frame=sv.frame))
+        pos = np.linalg.norm(F[:, :3, 3] - ref[:, :3, 3], axis=1).reshape(K, C)
+        rot = _so3.angle(np.swapaxes(ref[:, :3, :3], 1, 2) @ F[:, :3, :3]).reshape(K, C)
+        sig_c = np.linalg.svd(sv.jacobian(flat), compute_uv=False)[:, -1].reshape(K, C)
+        sig_k = np.array([k.sigma for k in knots])
+        sig_all = np.concatenate([sig_k[:-1, None], sig_c, sig_k[1:, None]], axis=1)
+        bad = (pos.max(axis=1) > 0.5 * tolerance) | (rot.max(axis=1) > rot_tol) | \
+              (sig_all.max(axis=1) > 2.0 * sig_all.min(axis=1)) | (sv.outside(flat).reshape(K, C).max(axis=1) > 1e-9)
+        if np.any(sig_c < sv.singular):
+            i, c = np.unravel_index(int(np.argmin(sig_c)), sig_c.shape)
+            if h[i] <= locate:
+                raise _Stop(float(sc[i, c]), knots[i].q, "singular",
+                               f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad < singular_tolerance {sv.singular:g}")
+            bad[i] = True
+        if not bad.any():
+            break
+        idx = np.flatnonzero(bad)
+        tiny = idx[h[idx] <= locate]
+        if tiny.size:
+            i = int(tiny[0])
+            if sv.outside(qc[i]).max() > 1e-9:
+                j = int(np.argmax(np.maximum(sv.lower - qc[i], qc[i] - sv.upper).max(axis=0)))
+                raise _Stop(float(sc[i, 1]), knots[i].q, "limit",
+                               f"joint {sv.robot.joint_names[j]} would pass its limit between knots")
+            raise _Stop(float(sc[i, 1]), knots[i].q, "singular",
+                           f"the tolerance cannot be met: the joint path bends too fast (σ_min {sig_all[i].min():.3g} m/rad)")
+        mids = s[idx] + 0.5 * h[idx]
+        pred = _eval(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
+        q_new, ok = sv.newton(pred, tool.pose(mids))
+        ok &= np.abs(q_new - pred).max(axis=1) <= _MAX_CORRECTION
+        ok &= sv.outside(q_new) <= 1e-9
+        new = _solve_knots(sv, mids[ok], q_new[ok]) if ok.any() else []
+        new = [k for k in new if k.sigma >= sv.singular]
+        inserted = {round(k.s, 15): k for k in new}
+        result = []
+        for i, k in enumerate(knots):
+            result.append(k)
+            if i < len(knots) - 1 and bad[i]:
+                mid = inserted.get(round(s[i] + 0.5 * h[i], 15))
+                if mid is not None:
+                    result.append(mid)
+                else:  # the batch could not solve it: walk the interval step by step (raises where it fails)
+                    result.extend(_continue(sv, k, float(s[i] + 0.5 * h[i]), locate))
+        knots = result
+    else:  # pragma: no cover - 60 halvings of every interval is far below `locate`
+        raise TrajectoryError("the tolerance rule did not converge in 60 refinement rounds")
+    s = np.array([k.s for k in knots])
+    s[-1] = L
+    q = np.array([k.q for k in knots])
+    branch = _labels(sv.robot, tool.pose(0.0), q[0])
+    if branch is not None:
+        end = _labels(sv.robot, tool.pose(L), q[-1])
+        if end is not None and end != branch:
+            raise _Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
+    return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance,
+                         q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
+                         max_deviation=(float(pos.max()), float(rot.max())))
+
+
+def _coefficients(knots: list[_Knot]) -> np.ndarray:
+    s = np.array([k.s for k in knots])
+    a = (np.array([k.q for k in knots[:-1]]), np.array([k.dq for k in knots[:-1]]), np.array([k.ddq for k in knots[:-1]]))
+    b = (np.array([k.q for k in knots[1:]]), np.array([k.dq_l for k in knots[1:]]), np.array([k.ddq_l for k in knots[1:]]))
+    return _hermite(s[:-1], s[1:], a, b)
+
+
+def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+                frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE,
+                locate: float = 1e-5) -> CartesianPath:
+    """The joint path that makes the tcp follow ``path`` within ``tolerance`` (module docstring).
+
+    Args:
+        robot: a :class:`robots.Robot` (``fk``, ``jacobian``, ``lower``/``upper``, ``ik`` or
+            ``ik_branches``, ``ik_failure_reason``).
+        path: the :class:`planning.ToolPath` (tcp → base poses, m).
+        tolerance: largest tcp position deviation [m] (default 0.1 mm); the orientation's is
+            ``tolerance / path.weight`` rad.
+        q_start: configuration (nq,) selecting the branch: the path starts at the IK solution
+            nearest to it (itself if its tcp is at the start pose). Default: each closed-form
+            solution at the start in the robot's order until one follows the whole path (if
+            none does, the error of the one that got farthest is raised, ties to the first);
+            numerical IK for other arms.
+        frame: the robot frame that follows the path (default the tcp).
+        singular_tolerance: smallest singular value [m/rad] of the weighted Jacobian
+            ``[J_v; w J_ω]`` allowed on the way (default 1e-4: closer to a singularity a joint
+            turning 1 rad moves the tool less than 0.1 mm in its weakest direction; on an
+            AUBO-i3 passing through a wrist singularity this stops the path about 5 mm before it).
+        locate: arc length [m] to which a failure is located (10 µm).
+
+    Raises:
+        SingularityOnPath, JointLimitOnPath, UnreachableOnPath: the arm cannot follow the path on
+            one branch; ``s``, ``pose`` and ``reason`` say where and why.
+        TrajectoryError: bad arguments.
+    """
+    if not isinstance(path, ToolPath):
+        raise TrajectoryError(f"path must be a planning.ToolPath, got {type(path).__name__}")
+    tol = _positive(tolerance, "tolerance [m]")
+    sing = _positive(singular_tolerance, "singular_tolerance [m/rad]")
+    loc = _positive(locate, "locate [m]")
+    nq = int(robot.nq)
+    q0 = None if q_start is None else per_joint(q_start, nq, "q_start")
+    sv = _Solver(robot, path, frame, sing)
+    pose0 = path.pose(0.0)
+    try:
+        starts = _starts(robot, pose0, q0)
+    except UnreachableTarget as exc:
+        reason = robot.ik_failure_reason(pose0) if hasattr(robot, "ik_failure_reason") else str(exc)
+        raise UnreachableOnPath(f"robot '{robot.name}' cannot reach the start of the path (s = 0): {reason}",
+                                s=0.0, pose=pose0, reason=str(reason)) from exc
+    if not starts:
+        reason = robot.ik_failure_reason(pose0) or "no IK solution"
+        raise UnreachableOnPath(f"robot '{robot.name}' cannot reach the start of the path (s = 0): {reason}",
+                                s=0.0, pose=pose0, reason=reason)
+    farthest: _Stop | None = None
+    for q in starts:
+        try:
+            return _build(sv, np.asarray(q, dtype=float), tol, loc)
+        except _Stop as stop:
+            if farthest is None or stop.s > farthest.s + loc:
+                farthest = stop
+    assert farthest is not None
+    raise _failure(sv, farthest.s, farthest.q_last, farthest.kind, farthest.detail)
+
+
+def cartesian_path(robot: Any, poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT,
+                   stops: Iterable[int] = (), tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+                   frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE) -> CartesianPath:
+    """Straight tcp lines through ``poses`` (blends of radius ``blend`` at the corners), as joints.
+
+    :func:`planning.tool_path` builds the geometry (position linear, orientation by SLERP,
+    arc length with ``weight`` m/rad), :func:`joint_image` its joint-space image on one IK
+    branch within ``tolerance`` (default 0.1 mm). Time it with :func:`optim.time_optimal`.
+
+    Args:
+        robot: a :class:`robots.Robot`.
+        poses: (N, 4, 4) tcp → base poses [m].
+        blend, weight, stops: see :func:`planning.tool_path`.
+        tolerance, q_start, frame, singular_tolerance: see :func:`joint_image`.
+    """
+    return joint_image(robot, tool_path(poses, blend=blend, weight=weight, stops=stops), tolerance=tolerance,
+                       q_start=q_start, frame=frame, singular_tolerance=singular_tolerance)
+
+
+def _positive(value: Any, what: str) -> float:
+    arr = finite_array(value, what)
+    if arr.ndim != 0 or float(arr) <= 0.0:
+        raise TrajectoryError(f"{what} must be a positive number, got {value!r}")
+    return float(arr)

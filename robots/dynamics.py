@@ -1,0 +1,434 @@
+"""Rigid-body dynamics of a :class:`robots.Robot`: payloads, joint torques, energies.
+
+Conventions
+-----------
+- Gravity is ``g = (0, 0, -9.81) m/s²`` in the robot's base frame (Pinocchio's default):
+  the base's +z points up.
+- Joint torques ``tau`` are per *independent* joint, in ``q`` order, N·m for revolute and
+  N for prismatic joints, the generalised forces that produce the motion
+  ``tau = M(q) qdd + C(q, qd) qd + g(q)`` (no friction, no motor inertia). For an arm with
+  ``<mimic>`` joints (the koji arm's parallelogram) the coupled joints are no coordinates:
+  with ``q_full = G q + offset`` the torque on the independent joints is
+  ``tau = Gᵀ tau_full`` (virtual work of the ideal coupling), which Pinocchio's RNEA on a
+  model built with ``mimic=True`` computes directly.
+- Batches: ``q, qd, qdd`` of shape ``(N, nq)`` give ``(N, nq)``; a single ``(nq,)`` gives
+  ``(nq,)``. A batch goes to Pinocchio's RNEA in one call (``pinocchio.rneaInParallel``),
+  without a Python loop over samples.
+- A :class:`Payload` is a rigid body fixed to a frame of the arm (default the tcp): mass
+  [kg], centre of mass [m] in that frame, inertia tensor [kg·m²] about the centre of mass in
+  that frame's axes.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import InvalidInput, ModelError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .robot import Robot
+
+__all__ = [
+    "GRAVITY",
+    "Payload",
+    "MissingInertials",
+    "InvalidPayload",
+    "as_payload",
+    "with_payload",
+    "check_inertials",
+    "inverse_dynamics",
+    "gravity_torques",
+    "kinetic_energy",
+    "potential_energy",
+    "total_mass",
+    "holding_torques",
+]
+
+#: Gravity [m/s²] in the base frame (Pinocchio's default model gravity).
+GRAVITY = np.array([0.0, 0.0, -9.81])
+
+#: Relative tolerance of the inertia checks (symmetry, positive semi-definiteness, triangle inequalities).
+_INERTIA_RTOL = 1e-9
+
+
+class MissingInertials(ModelError):
+    """The robot's URDF gives no mass to the links a joint moves: its torques would be meaningless."""
+
+
+class InvalidPayload(InvalidInput):
+    """A payload has a negative mass, a non-finite entry or an inertia tensor no rigid body has."""
+
+
+@dataclass(frozen=True, eq=False)
+class Payload:
+    """A rigid payload fixed to a frame of the arm (a gripped food pack, a tray, a koji block).
+
+    Attributes:
+        mass: mass [kg], ``>= 0``.
+        com: centre of mass (3,) [m] in ``frame`` (default: at the frame's origin).
+        inertia: inertia tensor (3, 3) [kg·m²] about the centre of mass, in ``frame``'s axes;
+            symmetric, positive semi-definite and obeying the triangle inequalities
+            (``Ixx + Iyy >= Izz`` and permutations) like every rigid body's. Default zero:
+            a point mass.
+        frame: the arm's frame the payload is fixed to (``"tcp"``: the robot's tcp frame).
+
+    Raises:
+        InvalidPayload: negative or non-finite mass, a ``com`` that is not 3 finite numbers,
+            an inertia that is not (3, 3) / (3,) principal moments, not symmetric, not positive
+            semi-definite or violating a triangle inequality, or an inertia without a mass.
+    """
+
+    mass: float
+    com: Any = (0.0, 0.0, 0.0)
+    inertia: Any = None
+    frame: str = "tcp"
+
+    def __post_init__(self) -> None:
+        ok = isinstance(self.mass, (int, float, np.integer, np.floating)) and not isinstance(self.mass, bool)
+        mass = float(self.mass) if ok else float("nan")
+        if not np.isfinite(mass):
+            raise InvalidPayload(f"payload mass must be a finite number of kg, got {self.mass!r}")
+        if mass < 0.0:
+            raise InvalidPayload(f"payload mass must be >= 0 kg, got {mass!r} kg: a negative mass is no payload")
+        try:
+            com = np.array(self.com, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InvalidPayload(f"payload com must be 3 numbers (m), got {self.com!r}") from exc
+        if com.shape != (3,) or not np.all(np.isfinite(com)):
+            raise InvalidPayload(f"payload com must be 3 finite numbers (m) in frame {self.frame!r}, got {self.com!r}")
+        inertia = _check_inertia(self.inertia, mass)
+        if not isinstance(self.frame, str) or not self.frame:
+            raise InvalidPayload(f"payload frame must be a frame name, got {self.frame!r}")
+        com.setflags(write=False)
+        inertia.setflags(write=False)
+        object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "com", com)
+        object.__setattr__(self, "inertia", inertia)
+
+    def spatial_inertia(self) -> pin.Inertia:
+        """The payload as a Pinocchio spatial inertia in ``frame``."""
+        return pin.Inertia(self.mass, self.com.copy(), self.inertia.copy())
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-able form: ``mass_kg``, ``com_m``, ``inertia_kg_m2`` (3×3 rows), ``frame``."""
+        return {
+            "mass_kg": self.mass,
+            "com_m": self.com.tolist(),
+            "inertia_kg_m2": self.inertia.tolist(),
+            "frame": self.frame,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Any) -> "Payload":
+        """Inverse of :meth:`as_dict` (checked like the constructor).
+
+        Raises:
+            InvalidPayload: not a mapping with ``mass_kg`` (and optionally ``com_m``,
+                ``inertia_kg_m2``, ``frame``), or bad values.
+        """
+        if not isinstance(data, dict) or "mass_kg" not in data:
+            raise InvalidPayload(f"a payload must be a mapping with mass_kg, com_m, inertia_kg_m2, frame; got {data!r}")
+        unknown = sorted(set(data) - {"mass_kg", "com_m", "inertia_kg_m2", "frame"})
+        if unknown:
+            raise InvalidPayload(f"unknown payload field(s) {unknown}; expected mass_kg, com_m, inertia_kg_m2, frame")
+        return cls(
+            data["mass_kg"],
+            com=data.get("com_m", (0.0, 0.0, 0.0)),
+            inertia=data.get("inertia_kg_m2"),
+            frame=data.get("frame", "tcp"),
+        )
+
+    def __repr__(self) -> str:
+        return f"Payload(mass={self.mass:g} kg, com={self.com.tolist()} m, frame={self.frame!r})"
+
+
+def _check_inertia(value: Any, mass: float) -> np.ndarray:
+    """A physically consistent inertia tensor (3, 3) [kg·m²] about the centre of mass."""
+    if value is None:
+        return np.zeros((3, 3))
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidPayload(f"payload inertia must be a (3, 3) tensor or (3,) principal moments in kg·m², got {value!r}") from exc
+    if arr.shape == (3,):
+        arr = np.diag(arr)
+    if arr.shape != (3, 3):
+        raise InvalidPayload(f"payload inertia must be a (3, 3) tensor or (3,) principal moments in kg·m², got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InvalidPayload("payload inertia holds NaN or inf")
+    scale = max(float(np.abs(arr).max()), 1e-300)
+    asym = float(np.abs(arr - arr.T).max())
+    if asym > _INERTIA_RTOL * scale:
+        i, j = np.unravel_index(int(np.argmax(np.abs(arr - arr.T))), arr.shape)
+        raise InvalidPayload(
+            f"payload inertia is not symmetric: I[{i},{j}] = {arr[i, j]:.6g} but I[{j},{i}] = {arr[j, i]:.6g} kg·m²; "
+            "an inertia tensor is symmetric (give the products of inertia once, on both sides)"
+        )
+    arr = 0.5 * (arr + arr.T)
+    if not np.any(arr):
+        return arr
+    if mass == 0.0:
+        raise InvalidPayload("payload inertia is non-zero but its mass is 0 kg: give the mass too")
+    moments = np.linalg.eigvalsh(arr)
+    if moments[0] < -_INERTIA_RTOL * scale:
+        raise InvalidPayload(
+            f"payload inertia is not positive semi-definite (principal moments {np.round(moments, 12).tolist()} kg·m²): "
+            "no rigid body has a negative moment of inertia"
+        )
+    a, b, c = np.sort(moments)
+    if a + b < c * (1.0 - _INERTIA_RTOL) - _INERTIA_RTOL * scale:
+        raise InvalidPayload(
+            f"payload inertia violates the triangle inequality: principal moments {a:.6g} + {b:.6g} < {c:.6g} kg·m² "
+            "(for any rigid body each moment is at most the sum of the other two)"
+        )
+    return arr
+
+
+def as_payload(payload: Any, *, com: Any = None, inertia: Any = None, frame: str | None = None) -> Payload | None:
+    """A :class:`Payload` from a mass [kg], a Payload, its dict form, or ``None`` (no payload).
+
+    ``com``, ``inertia`` and ``frame`` apply when ``payload`` is a mass.
+    """
+    if payload is None:
+        return None
+    if isinstance(payload, Payload):
+        if com is not None or inertia is not None or frame is not None:
+            raise InvalidPayload("give com, inertia and frame in the Payload itself, not beside it")
+        return payload
+    if isinstance(payload, dict):
+        return Payload.from_dict(payload)
+    return Payload(
+        payload,
+        com=(0.0, 0.0, 0.0) if com is None else com,
+        inertia=inertia,
+        frame="tcp" if frame is None else frame,
+    )
+
+
+# --------------------------------------------------------------------------- robots
+def with_payload(robot: "Robot", mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
+    """A copy of ``robot`` carrying a payload; ``robot`` itself is unchanged.
+
+    A payload replaces the one ``robot`` already carries (payloads do not stack); ``mass=0``
+    with no inertia gives the bare arm back. The kinematics (frames, limits, IK) are the
+    robot's own; only the inertia of the body holding ``frame`` changes.
+
+    Args:
+        mass: payload mass [kg] (or a :class:`Payload` / its dict form).
+        com: centre of mass (3,) [m] in ``frame`` (default its origin).
+        inertia: (3, 3) tensor or (3,) principal moments [kg·m²] about the centre of mass
+            (default a point mass).
+        frame: frame the payload is fixed to (default ``"tcp"``).
+
+    Raises:
+        InvalidPayload: see :class:`Payload`.
+        InvalidInput: ``robot`` has no frame ``frame``.
+    """
+    load = as_payload(mass, com=com, inertia=inertia, frame=frame)
+    base_model = getattr(robot, "_model_without_payload", None) or robot.model
+    model = pin.Model(base_model)
+    if load is not None and (load.mass > 0.0):
+        fid = robot.frame_id(load.frame)
+        f = base_model.frames[fid]
+        jid = f.parentJoint
+        if jid == 0:
+            raise InvalidPayload(
+                f"frame {load.frame!r} of robot '{robot.name}' is fixed to the base: a payload there moves no joint"
+            )
+        model.inertias[jid] = model.inertias[jid] + f.placement.act(load.spatial_inertia())
+    else:
+        load = None
+    new = copy.copy(robot)
+    new.model = model
+    new._model_without_payload = base_model
+    new.payload = load
+    new.__dict__.pop("_numerical_ik_solver", None)
+    new.__dict__.pop("_inertials_checked", None)
+    return new
+
+
+def check_inertials(robot: "Robot") -> None:
+    """Raise :class:`MissingInertials` if a joint of ``robot`` moves no mass at all.
+
+    Every independent joint must carry some mass beyond it (its links, or a payload): a URDF
+    without ``<inertial>`` elements loads for kinematics, but its torques would all be zero.
+    """
+    if getattr(robot, "_inertials_checked", False):
+        return
+    model = robot.model
+    subtree = np.array([model.inertias[i].mass for i in range(model.njoints)], dtype=float)
+    for i in range(model.njoints - 1, 0, -1):
+        subtree[model.parents[i]] += subtree[i]
+    massless = []
+    for i in range(1, model.njoints):
+        if "Mimic" in model.joints[i].shortname():
+            continue
+        if not subtree[i] > 0.0:
+            massless.append(model.names[i])
+    if massless:
+        raise MissingInertials(
+            f"robot '{robot.name}' has no mass beyond joint(s) {massless}: its URDF gives those links no "
+            "<inertial> (mass, centre of mass, inertia); add them, or use robots.load(...) for a built-in arm "
+            "whose URDF carries inertials"
+        )
+    robot._inertials_checked = True
+
+
+def total_mass(robot: "Robot") -> float:
+    """Mass [kg] of every body of ``robot`` (base link and payload included)."""
+    return float(sum(robot.model.inertias[i].mass for i in range(robot.model.njoints)))
+
+
+def _state(robot: "Robot", values: Any, what: str, n: int | None) -> tuple[np.ndarray, bool]:
+    arr, single = robot.check_q(values) if what == "q" else _as_rows(robot, values, what)
+    if n is not None and arr.shape[0] != n:
+        raise InvalidInput(f"{what} has {arr.shape[0]} rows but q has {n}: give one row per configuration")
+    return arr, single
+
+
+def _as_rows(robot: "Robot", values: Any, what: str) -> tuple[np.ndarray, bool]:
+    from .robot import _as_batch
+
+    unit = {"qd": "rad/s or m/s", "qdd": "rad/s² or m/s²"}[what]
+    return _as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
+
+
+def _rnea_batch(robot: "Robot", q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    """Pinocchio's RNEA on N states at once: (N, nq) each → (N, nq)."""
+    n = q.shape[0]
+    if n == 0:
+        return np.zeros((0, robot.nq))
+    qp = robot.q_to_pinocchio(q).reshape(n, -1)
+    # one model/data pair per call: calls from several threads never share a Data
+    pool = pin.ModelPool(robot.model, 1)
+    tau = pin.rneaInParallel(1, pool, np.asfortranarray(qp.T), np.asfortranarray(qd.T), np.asfortranarray(qdd.T))
+    # a batch of one comes back as a vector (nv,) rather than (nv, 1)
+    return np.ascontiguousarray(np.asarray(tau).reshape(robot.nq, n).T)
+
+
+def inverse_dynamics(robot: "Robot", q: Any, qd: Any, qdd: Any) -> np.ndarray:
+    """Joint torques ``tau = M(q) qdd + C(q, qd) qd + g(q)`` (module conventions).
+
+    Args:
+        q: (nq,) or (N, nq) [rad or m]; qd: same shape [rad/s or m/s]; qdd: same shape
+            [rad/s² or m/s²].
+
+    Returns:
+        (nq,) or (N, nq) torques [N·m or N] on the independent joints.
+
+    Raises:
+        InvalidInput: shapes that disagree, NaN/inf.
+        MissingInertials: the robot's URDF carries no inertials (see :func:`check_inertials`).
+    """
+    check_inertials(robot)
+    qa, single = robot.check_q(q)
+    va, _ = _state(robot, qd, "qd", qa.shape[0])
+    aa, _ = _state(robot, qdd, "qdd", qa.shape[0])
+    tau = _rnea_batch(robot, qa, va, aa)
+    return tau[0] if single else tau
+
+
+def gravity_torques(robot: "Robot", q: Any) -> np.ndarray:
+    """Torques [N·m or N] that hold ``q`` (nq,) or (N, nq) still against gravity: ``g(q)``."""
+    check_inertials(robot)
+    qa, single = robot.check_q(q)
+    zero = np.zeros_like(qa)
+    tau = _rnea_batch(robot, qa, zero, zero)
+    return tau[0] if single else tau
+
+
+def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
+    """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body from forward kinematics.
+
+    ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (Pinocchio's
+    ``forwardKinematics``, mimic joints followed) and ``Y_i`` its spatial inertia: computed
+    apart from RNEA, so the energy balance checks it. One configuration at a time (a
+    reference for checks, not a batch kernel).
+    """
+    check_inertials(robot)
+    qa, single = robot.check_q(q)
+    va, _ = _state(robot, qd, "qd", qa.shape[0])
+    qp = robot.q_to_pinocchio(qa).reshape(qa.shape[0], -1)
+    model = robot.model
+    data = model.createData()
+    out = np.empty(qa.shape[0])
+    for k in range(qa.shape[0]):
+        pin.forwardKinematics(model, data, qp[k], va[k])
+        out[k] = 0.5 * sum(model.inertias[i].vtiv(data.v[i]) for i in range(1, model.njoints))
+    return float(out[0]) if single else out
+
+
+def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
+    """Gravitational potential energy ``-Σ m_i g·c_i`` [J] of the moving bodies (zero at the base origin's height).
+
+    From forward kinematics (centres of mass ``c_i`` in the base frame), one configuration at
+    a time (a reference for checks).
+    """
+    check_inertials(robot)
+    qa, single = robot.check_q(q)
+    qp = robot.q_to_pinocchio(qa).reshape(qa.shape[0], -1)
+    model = robot.model
+    data = model.createData()
+    out = np.empty(qa.shape[0])
+    for k in range(qa.shape[0]):
+        pin.forwardKinematics(model, data, qp[k])
+        out[k] = -sum(
+            model.inertias[i].mass * float(model.gravity.linear @ data.oMi[i].act(model.inertias[i].lever))
+            for i in range(1, model.njoints)
+        )
+    return float(out[0]) if single else out
+
+
+def holding_torques(
+    robot: "Robot", n: int = 20000, seed: int = 0, accel_time: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Largest torque each joint needs to hold the arm (and its payload) anywhere in its ranges.
+
+    ``max over q within the joint limits of |g_j(q)|`` [N·m or N]: the static load a joint must
+    carry before any acceleration (e.g. a rated payload at full reach). With ``accel_time``
+    [s], the joint must also start from rest to its speed limit in that time at the worst
+    place: ``max_q |g_j(q)| + M_jj(q) v_j / accel_time`` (the usual servo sizing: load torque
+    plus acceleration torque; the other joints at rest). Found by ``n`` seeded uniform samples,
+    the best three per joint refined by a bounded quasi-Newton search.
+
+    Returns:
+        ``(torque (nq,), q (nq, nq))``: the maxima and, row j, the configuration of joint j's.
+    """
+    from scipy.optimize import minimize
+
+    if accel_time is not None and not (isinstance(accel_time, (int, float)) and accel_time > 0.0):
+        raise InvalidInput(f"accel_time must be a positive number of seconds, got {accel_time!r}")
+    alpha = np.zeros(robot.nq) if accel_time is None else np.asarray(robot.velocity_limit, dtype=float) / accel_time
+
+    def demand(q: np.ndarray, j: int) -> np.ndarray:
+        """|g_j| + M_jj alpha_j for rows of q (N, nq)."""
+        g = gravity_torques(robot, q)[:, j]
+        if not alpha[j] > 0.0:
+            return np.abs(g)
+        qdd = np.zeros_like(q)
+        qdd[:, j] = alpha[j]
+        return np.abs(g) + (inverse_dynamics(robot, q, np.zeros_like(q), qdd)[:, j] - g)
+
+    q = robot.random_q(n, seed=seed)
+    best = np.zeros(robot.nq)
+    where = np.tile(robot.neutral, (robot.nq, 1))
+    bounds = list(zip(robot.lower, robot.upper))
+    for j in range(robot.nq):
+        values = demand(q, j)
+        k_best = int(np.argmax(values))
+        best[j], where[j] = values[k_best], q[k_best]
+        if not best[j] > 0.0:
+            continue
+        for k in np.argsort(values)[-3:]:
+            res = minimize(lambda x: -float(demand(x[None], j)[0]), q[k], method="L-BFGS-B",
+                           bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-10, "maxiter": 500})
+            x = np.clip(res.x, robot.lower, robot.upper)
+            value = float(demand(x[None], j)[0])
+            if value > best[j]:
+                best[j], where[j] = value, x
+    return best, where
