@@ -44,7 +44,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInput
-from .collision import _margin, exact_min_distance, pair_lower_bounds
+from .collision import _margin, exact_min_distance
 from .pairs import CollisionPair
 
 if TYPE_CHECKING:  # pragma: no cover
