@@ -415,6 +415,7 @@ def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: s
     ax.set_xlabel("time [s]  (bars: tcp in the shared zone; ticks: cycle starts)")
     ax.set_title(title or f"{schedule.cell}: {schedule.picks_per_minute:.1f} picks/min, period {period:.2f} s")
     ax.grid(True, axis="x", alpha=0.3)
+    return _save(fig, path)
 
 
 def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
@@ -488,6 +489,7 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
     fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
     if title:
         fig.suptitle(title)
+    return _save(fig, path)
 
 
 def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
