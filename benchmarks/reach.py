@@ -48,7 +48,16 @@ def child(name: str, args: dict) -> dict:
     from pinarms.robots.reachability import reachability_map
 
     if args.get("one_core"):
+        # one core: no thread pools either (pinarms sizes them by os.cpu_count(), not by the affinity)
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+        import pinarms.robots.ik.solver as ik_solver
+        import pinarms.robots.kinematic_tree as tree
+
+        ik_solver._WORKERS = tree._WORKERS = 1
+    if args.get("trace"):
+        import tracemalloc
+
+        tracemalloc.start()
     arm = robots.load(args["robot"])
     opts = dict(args.get("opts", {}))
     if "out" in opts:
@@ -57,7 +66,13 @@ def child(name: str, args: dict) -> dict:
     t0, c0 = time.perf_counter(), time.process_time()
     m = reachability_map(arm, args["resolution"], args["orientations"], **opts)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    traced = None
+    if args.get("trace"):
+        import tracemalloc
+
+        traced = tracemalloc.get_traced_memory()[1] / 1e6
     out = {
+        "traced_peak_mb": traced,
         "name": name, "wall_s": wall, "cpu_s": cpu, "voxels": m.n_voxels, "poses": m.n_poses,
         "reached": m.n_reached, "reachable_voxels": int(np.count_nonzero(m.index > 0)),
         "mean_index": float(m.index[m.index > 0].mean()) if m.n_reached else 0.0,
@@ -191,15 +206,17 @@ def memory() -> None:
         for label, opts in (("per-voxel arrays only", {"keep_solutions": False}),
                             ("solutions streamed (out=)", {"out": True}),
                             ("solutions in memory", {"keep_solutions": True})):
-            r = run_child(f"mem-{res}-{label}", robot="aubo_i3", resolution=res, orientations=50, opts=opts)
+            r = run_child(f"mem-{res}-{label}", robot="aubo_i3", resolution=res, orientations=50, opts=opts, trace=True)
             rows.append((res, label, r))
             extra = f", file {r['file_mb']:.0f} MB" if "file_mb" in r else ""
-            print(f"  {res * 1000:4.0f} mm  {label:<27} {r['voxels']:>9,} voxels  peak {r['rss_mb']:7.0f} MB "
-                  f"(after imports {r['rss_before_mb']:.0f} MB){extra}")
+            print(f"  {res * 1000:4.0f} mm  {label:<27} {r['voxels']:>9,} voxels  peak RSS {r['rss_mb']:7.0f} MB "
+                  f"(after imports {r['rss_before_mb']:.0f} MB), peak of numpy/Python allocations "
+                  f"{r['traced_peak_mb']:7.1f} MB{extra}")
     for label in ("per-voxel arrays only", "solutions streamed (out=)", "solutions in memory"):
         (_, _, a), (_, _, b) = [x for x in rows if x[1] == label]
-        slope = (b["rss_mb"] - a["rss_mb"]) / ((b["voxels"] - a["voxels"]) / 1e6)
-        print(f"  {label:<27}: {slope:7.0f} MB per million voxels (difference of the two peaks)")
+        dv = (b["voxels"] - a["voxels"]) / 1e6
+        print(f"  {label:<27}: {(b['traced_peak_mb'] - a['traced_peak_mb']) / dv:7.0f} MB per million voxels "
+              f"(numpy/Python allocations), {(b['rss_mb'] - a['rss_mb']) / dv:7.0f} MB (peak RSS)")
     print()
 
 
