@@ -1,20 +1,20 @@
-"""Inverse kinematics: batched closed form, numerical solver and ikpy, side by side in one run.
+"""Inverse kinematics beside the Robotics Toolbox for Python's C++ ``ik_LM`` (when installed) and ikpy, in one run.
 
-Targets are the FK of random in-limit configurations (reachable by construction); the
-numerical solvers start from other random in-limit configurations. Targets of the
-analytic part: AUBO-i3 poses per second (batched ``ik_all``), share solved, largest FK
-error. Numerical part: ``NumericalIK`` alone (no closed form anywhere: the figure the
-issue asks for) on aubo_i3, ur5 and panda: success rate at tol = 1e-10 (m and rad),
-checked independently with the batched FK, median and p90 time per solve, starts and
-iterations per pose; each arm's poses are solved ``--runs`` times and the run with the
-lowest median is reported (the machine is shared: the load average is printed). Then
-``Robot.ik`` (closed form first, refined by the numerical solver) for the arms that have
-one, and ikpy (the same poses, the same starts, its default optimiser with full
-orientation) with its success rate at 1e-6 m / 1e-6 rad and its median time.
+Targets are the FK of random in-limit configurations (reachable by construction).
 
-    python benchmarks/ik.py [--n-analytic 100000] [--n 1000] [--runs 3] [--ikpy-n 200] [--seed 0]
+1. Closed form, batched ``ik_all``: UR5 and AUBO-i3 poses per second, branches per pose
+   (each once), largest FK error.
+2. One target at a time: ``Robot.ik`` (numerical first; closed-form branches only when the
+   first descent fails) beside ``ik_LM`` (C++, its own random starts, ``tol = 5e-13``),
+   both judged by the same strict check (1e-6 m, 1e-6 rad, joint limits); median and p95.
+3. Batched: ``Robot.ik(T (N, 4, 4))`` per target, beside ``ik_LM`` per target.
+4. ``NumericalIK`` alone on random starts (no closed form anywhere), and ikpy on the first
+   ``--ikpy-n`` poses when installed (ikpy takes tens of ms per solve).
 
-ikpy is slow (tens of ms per solve); it runs on the first ``--ikpy-n`` poses of each arm.
+Goals (issue 21): one target at least as fast as ``ik_LM`` at the strict check, 100 % within
+limits; batched at least 5x faster per target than ``ik_LM``; ``ik_all`` >= 100 000 poses/s.
+
+    python benchmarks/ik.py [--n 300] [--n-batch 2000] [--n-analytic 100000] [--ikpy-n 0]
 """
 
 from __future__ import annotations
@@ -24,15 +24,22 @@ import os
 import time
 import xml.etree.ElementTree as ET
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 
-from pinarms import robots
-from pinarms.robots.ik import NumericalIK
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _peers import FAIRNESS, absent_line, rtb_ets, rtb_version  # noqa: E402
+
+from pinarms import robots  # noqa: E402
+from pinarms.robots.errors import UnreachableTarget  # noqa: E402
+from pinarms.robots.ik import NumericalIK  # noqa: E402
 
 
-def analytic(n: int, seed: int, repeat: int = 3) -> dict:
-    robot = robots.load("aubo_i3")
+def analytic(n: int, seed: int, repeat: int = 3, name: str = "aubo_i3") -> dict:
+    robot = robots.load(name)
     q = robot.random_q(n, seed=seed)
     T = robot.fk(q)
     best = np.inf
@@ -167,55 +174,109 @@ def _load() -> str:
         return "load average unavailable"
 
 
+def strict_ok(robot, q, T, tol: float = 1e-6) -> bool:
+    """FK of ``q`` within ``tol`` m and ``tol`` rad of ``T`` and ``q`` within the joint limits (no tolerance)."""
+    if q is None or not np.all(np.isfinite(q)) or not robot.within_limits(q, tol=0.0):
+        return False
+    F = robot.fk(q)
+    return bool(np.linalg.norm(F[:3, 3] - T[:3, 3]) <= tol and np.linalg.norm(pin.log3(F[:3, :3].T @ T[:3, :3])) <= tol)
+
+
+def one_at_a_time(robot, ets, T) -> dict:
+    out = {}
+    times, ok = [], 0
+    for k in range(len(T)):
+        t0 = time.perf_counter()
+        try:
+            q = robot.ik(T[k], seed=k)
+        except UnreachableTarget:
+            q = None
+        times.append(time.perf_counter() - t0)
+        ok += strict_ok(robot, q, T[k])
+    out["pinarms"] = (np.median(times), np.quantile(times, 0.95), ok / len(T))
+    if ets is not None:
+        times, ok = [], 0
+        for k in range(len(T)):
+            t0 = time.perf_counter()
+            sol = ets.ik_LM(T[k], tol=5e-13, joint_limits=True)
+            times.append(time.perf_counter() - t0)
+            ok += strict_ok(robot, np.asarray(sol[0], dtype=float), T[k])
+        out["rtb"] = (np.median(times), np.quantile(times, 0.95), ok / len(T))
+    return out
+
+
+def batch(robot, T, repeat: int = 2) -> tuple[float, float]:
+    best, q = np.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        q = robot.ik(T)
+        best = min(best, time.perf_counter() - t0)
+    ok = np.mean([strict_ok(robot, q[k], T[k]) for k in range(len(T))])
+    return best / len(T), ok
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=300, help="targets per arm, one at a time")
+    parser.add_argument("--n-batch", type=int, default=2000, help="targets per arm, batched")
     parser.add_argument("--n-analytic", type=int, default=100_000)
-    parser.add_argument("--n", type=int, default=1000, help="poses per arm for the numerical solver")
-    parser.add_argument("--runs", type=int, default=3, help="runs per arm; the one with the lowest median is shown")
-    parser.add_argument("--ikpy-n", type=int, default=200, help="poses per arm given to ikpy (first ones)")
+    parser.add_argument("--arms", nargs="+", default=["panda", "ur5", "aubo_i3"])
+    parser.add_argument("--runs", type=int, default=1, help="runs of the NumericalIK-alone table")
+    parser.add_argument("--ikpy-n", type=int, default=0, help="poses per arm given to ikpy (first ones; 0: skip)")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
 
-    print(f"{os.cpu_count()} cores, {_load()}")
-    a = analytic(args.n_analytic, args.seed)
-    print(f"analytic ik_all, AUBO-i3, {args.n_analytic} random reachable poses (batched, best of 3)")
-    print(f"  poses/s           {a['poses_per_s']:>12,.0f}   (target >= 100,000)")
-    print(f"  solved            {100 * a['solved']:>11.3f} %  (target 100 %), mean {a['mean_solutions']:.2f} solutions/pose")
-    print(f"  max FK error      {a['max_pos_err']:>12.2e} m, {a['max_rot_err']:.2e} rad (target <= 1e-9 m); all within limits: {a['in_limits']}")
+    version = rtb_version()
+    print(f"{os.cpu_count()} cores, {_load()}; " + (f"Robotics Toolbox for Python {version}" if version else absent_line()))
+    print(FAIRNESS)
     print()
-    print(
-        f"numerical IK (NumericalIK alone, no closed-form seed): {args.n} random reachable poses per arm, "
-        f"random starts, best of {args.runs} runs; ikpy on the first {args.ikpy_n}"
-    )
-    header = (
-        f"{'arm':<10} {'pinarms ok':>11} {'median ms':>10} {'p90 ms':>8} {'starts':>7} {'iters':>6} {'us/iter':>8} | "
-        f"{'ikpy ok':>8} {'median ms':>10} | {'speed-up':>8}"
-    )
-    print(header)
-    print("-" * len(header))
+    print(f"1. closed form, batched ik_all, {args.n_analytic:,} random reachable poses (best of 3)")
+    for name in ("ur5", "aubo_i3"):
+        a = analytic(args.n_analytic, args.seed, name=name)
+        print(f"  {name:<8} {a['poses_per_s']:>10,.0f} poses/s (goal >= 100,000)  solved {100 * a['solved']:.2f} %  "
+              f"{a['mean_solutions']:.2f} branches/pose  max FK error {a['max_pos_err']:.1e} m {a['max_rot_err']:.1e} rad  "
+              f"within limits: {a['in_limits']}")
+    print()
+    print(f"2. one target at a time, {args.n} random reachable poses per arm, strict check (1e-6 m, 1e-6 rad, limits)")
+    print(f"  {'arm':<9} {'pinarms median':>15} {'p95':>8} {'ok':>7} | {'ik_LM median':>13} {'p95':>8} {'ok':>7} | "
+          f"{'ik_LM/pinarms':>13}")
     samples = {}
-    for name in ("aubo_i3", "ur5", "panda"):
+    for name in args.arms:
         robot = robots.load(name)
-        q = robot.random_q(args.n, seed=args.seed + 1)
-        starts = robot.random_q(args.n, seed=args.seed + 2)
-        T = robot.fk(q)
-        samples[name] = (robot, T, starts)
-        ours = numerical(robot, T, starts, runs=args.runs)
-        m = min(args.ikpy_n, args.n)
-        peer = ikpy_run(robot, T[:m], starts[:m]) if m > 0 else {"success": float("nan"), "median_ms": float("nan")}
-        print(
-            f"{name:<10} {100 * ours['success']:>10.1f}% {ours['median_ms']:>10.3f} {ours['p90_ms']:>8.2f} "
-            f"{ours['mean_starts']:>7.2f} {ours['mean_iterations']:>6.1f} {ours['us_per_iteration']:>8.1f} | "
-            f"{100 * peer['success']:>7.1f}% {peer['median_ms']:>10.2f} | "
-            f"{peer['median_ms'] / ours['median_ms']:>7.1f}x"
-        )
-    print("targets: pinarms >= 99.5 % at tol 1e-10 (m, rad), median <= 1 ms; ikpy success judged at 1e-6 m / 1e-6 rad")
+        T = robot.fk(robot.random_q(max(args.n, args.n_batch), seed=args.seed + 1))
+        ets = rtb_ets(robot)
+        samples[name] = (robot, T, ets)
+        r = one_at_a_time(robot, ets, T[: args.n])
+        med, p95, ok = r["pinarms"]
+        line = f"  {name:<9} {med * 1e3:13.3f}ms {p95 * 1e3:7.2f}ms {100 * ok:6.1f}%"
+        if "rtb" in r:
+            rm, rp, rok = r["rtb"]
+            line += f" | {rm * 1e3:11.3f}ms {rp * 1e3:7.2f}ms {100 * rok:6.1f}% | {rm / med:12.2f}x"
+        print(line + "   (goal: ratio >= 1)")
     print()
-    print("Robot.ik with the closed-form seed (solution nearest the start, refined to 1e-10), same poses and starts")
-    for name in ("aubo_i3", "ur5"):
-        robot, T, starts = samples[name]
-        r = robot_ik(robot, T, starts, runs=args.runs)
-        print(f"{name:<10} {100 * r['success']:>10.1f}% {r['median_ms']:>10.3f} {r['p90_ms']:>8.2f}")
+    print(f"3. batched Robot.ik(T (N, 4, 4)), N = {args.n_batch}, time per target (best of 2) beside ik_LM's median above")
+    for name in args.arms:
+        robot, T, ets = samples[name]
+        per, ok = batch(robot, T[: args.n_batch])
+        line = f"  {name:<9} {per * 1e6:10.1f} us/target  ok {100 * ok:6.2f}%"
+        if ets is not None:
+            r = one_at_a_time(robot, ets, T[: min(args.n, 100)])
+            line += f" | ik_LM median {r['rtb'][0] * 1e6:8.1f} us  ratio {r['rtb'][0] / per:6.2f}x (goal >= 5x)"
+        print(line)
+    print()
+    print(f"4. NumericalIK alone from random starts (tol 1e-10), {args.n} poses per arm"
+          + (f"; ikpy on the first {args.ikpy_n}" if args.ikpy_n else ""))
+    for name in args.arms:
+        robot, T, _ = samples[name]
+        starts = robot.random_q(args.n, seed=args.seed + 2)
+        ours = numerical(robot, T[: args.n], starts, runs=args.runs)
+        line = (f"  {name:<9} {100 * ours['success']:6.1f}%  median {ours['median_ms']:.3f} ms  p90 {ours['p90_ms']:.2f} ms  "
+                f"{ours['mean_starts']:.2f} starts  {ours['mean_iterations']:.1f} iterations  "
+                f"{ours['us_per_iteration']:.1f} us/iteration")
+        if args.ikpy_n:
+            peer = ikpy_run(robot, T[: args.ikpy_n], starts[: args.ikpy_n])
+            line += f" | ikpy {100 * peer['success']:.1f}% median {peer['median_ms']:.2f} ms"
+        print(line)
     print(_load())
 
 

@@ -82,6 +82,30 @@ def main() -> None:
 
     print(f"{'exact peaks alone, 3 joints x 10 segments':<44} {best(peaks_only, 500) * 1e6:9.1f} us")
     population(rng, q3)
+    quintic_vs_jtraj()
+
+
+def quintic_vs_jtraj() -> None:
+    """Quintic rest-to-rest, 6 joints x 10 000 instants, beside the Robotics Toolbox's jtraj (goal: within 1.2x)."""
+    q0, q1 = np.zeros(6), np.linspace(0.5, 1.5, 6)
+    t = np.linspace(0.0, 2.0, 10_000)
+    ends = np.stack([q0, q1])
+
+    def ours():
+        return planning.polynomial([0.0, 2.0], ends, 5).sample(t)
+
+    built = planning.polynomial([0.0, 2.0], ends, 5)
+    print("\nquintic rest-to-rest, 6 joints x 10 000 instants (pinarms: q..qddd; jtraj: q..qdd)")
+    print(f"  build + sample {best(ours, 20) * 1e6:9.1f} us   build {best(lambda: planning.polynomial([0.0, 2.0], ends, 5), 200) * 1e6:7.1f} us"
+          f"   sample a built one {best(lambda: built.sample(t), 20) * 1e6:9.1f} us")
+    try:
+        import roboticstoolbox as rtb
+    except Exception:  # noqa: BLE001 - optional peer
+        print("  Robotics Toolbox for Python: not installed here (pip install roboticstoolbox-python); jtraj left out")
+        return
+    a, b = best(ours, 20), best(lambda: rtb.jtraj(q0, q1, t), 20)
+    diff = np.abs(ours()[0] - rtb.jtraj(q0, q1, t).q).max()
+    print(f"  jtraj {b * 1e6:9.1f} us   ratio pinarms / jtraj {a / b:5.2f}x (goal <= 1.2x); max |q difference| {diff:.1e} rad")
 
 
 def population(rng: np.random.Generator, q3: np.ndarray, P: int = 100) -> None:

@@ -26,7 +26,6 @@ Frames and units: positions in metres, angles in radians, times in seconds.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
@@ -134,6 +133,9 @@ class RobotEntry:
         base_to_world: pose of the robot's base in the world frame, (4, 4), m.
         urdf_text: embedded URDF (``None`` for registry robots).
         package_dirs: folders that resolved ``package://`` meshes when saved (a hint only).
+        payload: the payload the robot carries (:meth:`robots.dynamics.Payload.as_dict`:
+            ``mass_kg``, ``com_m``, ``inertia_kg_m2``, ``frame``), or ``None``; reapplied
+            with ``robot.with_payload`` when the session reopens.
     """
 
     key: str
@@ -144,6 +146,7 @@ class RobotEntry:
     base_to_world: np.ndarray
     urdf_text: str | None = None
     package_dirs: tuple[str, ...] = ()
+    payload: dict | None = None
 
     @property
     def nq(self) -> int:
@@ -292,9 +295,11 @@ class Kind:
 
 
 def _encode_robot(e: RobotEntry) -> tuple[dict, dict, dict]:
-    return ({"key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
-             "joint_names": list(e.joint_names), "package_dirs": list(e.package_dirs)},
-            {"base_to_world": e.base_to_world}, {"urdf_member": e.urdf_text})
+    fields = {"key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
+              "joint_names": list(e.joint_names), "package_dirs": list(e.package_dirs)}
+    if e.payload is not None:  # written only when there is one: sessions without stay as they were
+        fields["payload"] = e.payload
+    return fields, {"base_to_world": e.base_to_world}, {"urdf_member": e.urdf_text}
 
 
 def _decode_robot(it: _Item) -> RobotEntry:
@@ -306,9 +311,17 @@ def _decode_robot(it: _Item) -> RobotEntry:
     dirs = it.field("package_dirs", list)
     if not all(isinstance(d, str) for d in dirs):
         raise it.fail(f"{it.where}.package_dirs must be a list of strings")
+    payload = None
+    if "payload" in it.obj:
+        from pinarms.robots.dynamics import InvalidPayload, Payload
+
+        try:
+            payload = Payload.from_dict(it.field("payload", dict)).as_dict()
+        except InvalidPayload as exc:
+            raise it.fail(f"{it.where}.payload: {exc}") from None
     return RobotEntry(key=it.key, source=source, name=it.field("name", str), tcp_frame=it.field("tcp_frame", str),
                       joint_names=it.joint_names, base_to_world=it.arrays["base_to_world"],
-                      urdf_text=it.texts.get("urdf_member"), package_dirs=tuple(dirs))
+                      urdf_text=it.texts.get("urdf_member"), package_dirs=tuple(dirs), payload=payload)
 
 
 def _encode_box(b: BoxObject) -> tuple[dict, dict, dict]:

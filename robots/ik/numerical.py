@@ -756,7 +756,8 @@ def solve_batch(
 
     Args:
         targets: checked poses ``(N, 4, 4)`` frame → base [m].
-        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default: :meth:`table_start` of each target).
+        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
+            :meth:`table_start` of each target).
         tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
         max_restarts, seed: restarts of the per-target solver that finishes the targets the
             batch left (a few per thousand), and the seed of all random starts.
@@ -767,16 +768,21 @@ def solve_batch(
     N = targets.shape[0]
     nq = self.nq
     tol = float(tol)
-    if q_seed is None:
+    starts = None
+    if q_seed is not None:
+        starts = np.array(np.broadcast_to(np.asarray(q_seed, dtype=float), (N, nq)))
+    missing = np.arange(N) if starts is None else np.flatnonzero(~np.all(np.isfinite(starts), axis=1))
+    if missing.size:  # no seed (or a NaN row): of the stored table, the configuration whose pose is nearest
         q_table, p_tab, pp_tab, R_tab = self._start_table()
-        pt = targets[:, :3, 3]
+        pt = targets[missing, :3, 3]
         d2 = pp_tab[None, :] - 2.0 * pt @ p_tab.T + np.einsum("ij,ij->i", pt, pt)[:, None]
         cost = np.sqrt(np.maximum(d2, 0.0))
         if not position_only:
-            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * targets[:, :3, :3].reshape(N, 9) @ R_tab.T, 0.0))
-        starts = q_table[np.argmin(cost, axis=1)]
-    else:
-        starts = np.array(np.broadcast_to(np.asarray(q_seed, dtype=float), (N, nq)))
+            rt = targets[missing, :3, :3].reshape(missing.size, 9)
+            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * rt @ R_tab.T, 0.0))
+        if starts is None:
+            starts = np.empty((N, nq))
+        starts[missing] = q_table[np.argmin(cost, axis=1)]
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     q = np.empty((N, nq))
     success = np.zeros(N, dtype=bool)
@@ -800,3 +806,4 @@ def solve_batch(
 
 
 NumericalIK.solve_batch = solve_batch
+NumericalIK.batch_errors = _batch_errors
