@@ -654,6 +654,11 @@ class Robot:
             seed_q = seed_q[0]
         solver = self._numerical_ik()
         T0 = T[0]
+        # compiled Levenberg–Marquardt: the first start, then the seeded restarts, in one native call
+        res = solver._solve_compiled(T0, seed_q, bool(position_only), tol, int(max_restarts), seed)
+        if res.success:
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        # not found: the interpreted solver's path (closed-form branches, restarts, a final polish) for the diagnosis
         res = solver._solve(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
                             polish=False)
         if res.success:
