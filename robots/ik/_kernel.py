@@ -43,11 +43,12 @@ _P_MU0, _P_LAMMIN, _P_STEP, _P_STALLR, _P_STALLN, _P_ITER = 0, 1, 2, 3, 4, 5
 
 
 @njit(cache=True, nogil=True)
-def _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
-    """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` (m, 3)."""
-    Rc = np.eye(3)
-    pc = np.zeros(3)
-    Rn = np.empty((3, 3))
+def _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S):
+    """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` (m, 3); ``S`` (3, 7) scratch."""
+    Rc, Rn, pc = S[:, 0:3], S[:, 3:6], S[:, 6]
+    Rc[:, :] = 0.0
+    Rc[0, 0] = Rc[1, 1] = Rc[2, 2] = 1.0
+    pc[:] = 0.0
     for k in range(qi.shape[0]):
         for a in range(3):
             pa = pc[a]
@@ -111,9 +112,8 @@ def _jacobian(qi, sc, rev, Z, O, p, J):
 
 
 @njit(cache=True, nogil=True)
-def _log3_of(Rt, R, w):
+def _log3_of(Rt, R, w, M):
     """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
-    M = np.empty((3, 3))
     for a in range(3):
         for b in range(3):
             M[a, b] = Rt[a, 0] * R[b, 0] + Rt[a, 1] * R[b, 1] + Rt[a, 2] * R[b, 2]
@@ -144,10 +144,10 @@ def _log3_of(Rt, R, w):
 
 
 @njit(cache=True, nogil=True)
-def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J):
-    """Error ``e``, Jacobian ``J`` of ``q``; returns ``(‖e‖², position error², rotation angle)``."""
+def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S):
+    """Error ``e``, Jacobian ``J`` of ``q``; returns ``(‖e‖², position error², rotation angle)``; ``S`` (3, 10) scratch."""
     qi, sc, of, rev, LR, Lp, fR, fp = C
-    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O)
+    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S[:, :7])
     _jacobian(qi, sc, rev, Z, O, p, J)
     pe2 = 0.0
     for a in range(3):
@@ -155,7 +155,7 @@ def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J):
         pe2 += e[a] * e[a]
     if posonly:
         return pe2, pe2, 0.0
-    theta = _log3_of(Rt, R, e[3:])
+    theta = _log3_of(Rt, R, e[3:], S[:, 7:10])
     return pe2 + e[3] * e[3] + e[4] * e[4] + e[5] * e[5], pe2, theta
 
 
@@ -190,11 +190,14 @@ def _cholesky_solve(G, b, x):
 
 
 @njit(cache=True, nogil=True)
-def _damped_step(J, rows, e, lam, free, dq):
-    """``dq = Aᵀ(AAᵀ + λI)⁻¹e`` (``(AᵀA + λI)⁻¹Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed."""
+def _damped_step(J, rows, e, lam, free, dq, Gs, x):
+    """``dq = Aᵀ(AAᵀ + λI)⁻¹e`` (``(AᵀA + λI)⁻¹Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed.
+
+    ``Gs`` (≥ n, ≥ n) and ``x`` (≥ n) are scratch.
+    """
     nq = J.shape[1]
     if nq >= rows:
-        G = np.empty((rows, rows))
+        G = Gs[:rows, :rows]
         for a in range(rows):
             for b in range(a + 1):
                 s = 0.0
@@ -204,7 +207,6 @@ def _damped_step(J, rows, e, lam, free, dq):
                 G[a, b] = s
                 G[b, a] = s
             G[a, a] += lam
-        x = np.empty(rows)
         if not _cholesky_solve(G, e[:rows], x):
             return False
         for j in range(nq):
@@ -214,8 +216,8 @@ def _damped_step(J, rows, e, lam, free, dq):
                     s += J[a, j] * x[a]
             dq[j] = s
         return True
-    G = np.empty((nq, nq))
-    bvec = np.empty(nq)
+    G = Gs[:nq, :nq]
+    bvec = x
     for i in range(nq):
         s = 0.0
         for a in range(rows):
@@ -300,6 +302,9 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
     dq = np.empty(nq)
     free = np.ones(nq, dtype=np.bool_)
     all_free = np.ones(nq, dtype=np.bool_)
+    S = np.empty((3, 10))
+    nb_ = max(rows, nq)
+    Gs, xs = np.empty((nb_, nb_)), np.empty(nb_)
     at_limit = False
     if clip:
         at_limit = _clip(q, L)
@@ -307,7 +312,7 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
             for j in range(nq):
                 if q[j] <= lo[j] or q[j] >= hi[j]:
                     at_limit = True
-    E, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J)
+    E, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S)
     mu, nu = mu0, 2.0
     it = 0
     stall = 0
@@ -317,7 +322,7 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
         accepted = False
         while mu < _MU_MAX:
             lam = mu * E + lam_min
-            if not _damped_step(J, rows, e, lam, all_free, dq):
+            if not _damped_step(J, rows, e, lam, all_free, dq, Gs, xs):
                 mu *= nu
                 nu *= 2.0
                 continue
@@ -328,7 +333,7 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
                     free[j] = not blocked
                     nb += blocked
                 if nb:
-                    if not _damped_step(J, rows, e, lam, free, dq):
+                    if not _damped_step(J, rows, e, lam, free, dq, Gs, xs):
                         mu *= nu
                         nu *= 2.0
                         continue
@@ -343,7 +348,7 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
                 dq[j] *= scale
                 q_t[j] = q[j] + dq[j]
             clipped = _clip(q_t, L) if clip else False
-            E_t, pe2_t, th_t = _evaluate(q_t, C, Rt, pt, posonly, R, p, Z, O, e_t, J_t)
+            E_t, pe2_t, th_t = _evaluate(q_t, C, Rt, pt, posonly, R, p, Z, O, e_t, J_t, S)
             if E_t < E:  # accept; Nielsen's update of μ from the gain ratio
                 predicted = E
                 for a in range(rows):
@@ -385,7 +390,7 @@ def errors(q, C, Rt, pt, posonly):
     m = C[0].shape[0]
     R, p, Z, O = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3))
     e, J = np.empty(6), np.empty((6, q.shape[0]))
-    _, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J)
+    _, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, np.empty((3, 10)))
     return math.sqrt(pe2), th
 
 
@@ -405,9 +410,9 @@ def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol):
 
 
 @njit(cache=True, nogil=True)
-def _cost(C, q, Rt, pt, posonly, R, p, Z, O):
+def _cost(C, q, Rt, pt, posonly, R, p, Z, O, S):
     qi, sc, of, rev, LR, Lp, fR, fp = C
-    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O)
+    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S)
     d = math.sqrt((p[0] - pt[0]) ** 2 + (p[1] - pt[1]) ** 2 + (p[2] - pt[2]) ** 2)
     if posonly:
         return d
@@ -456,6 +461,7 @@ def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
     np.random.seed(seed)
     m = C[0].shape[0]
     R, p, Z, O = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3))
+    S = np.empty((3, 7))
     pool = np.empty((_POOL, nq))
     cost = np.empty(_POOL)
     order = np.empty(0, dtype=np.int64)
@@ -466,7 +472,7 @@ def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
             for i in range(_POOL):
                 for j in range(nq):
                     pool[i, j] = lo[j] + (hi[j] - lo[j]) * np.random.random()
-                cost[i] = _cost(C, pool[i], Rt, pt, posonly, R, p, Z, O)
+                cost[i] = _cost(C, pool[i], Rt, pt, posonly, R, p, Z, O, S)
             order = np.argsort(cost, kind="mergesort")
             k = 0
         q[:] = pool[order[k]]

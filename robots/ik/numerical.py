@@ -388,17 +388,18 @@ class NumericalIK:
         return dq
 
     def nearest_equivalent(self, q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-        """``q`` with each bounded revolute angle at its 2π equivalent within the limits nearest ``q_ref`` (same pose)."""
+        """``q`` ``(nq,)`` or ``(N, nq)`` with each bounded revolute angle at its 2π equivalent within the
+        limits nearest ``q_ref`` (same shape, or ``(nq,)``): the same pose."""
         if not self._any_revolute:
             return q
         turns = self._window_turns > 0.0
-        k = np.arange(-2.0, 3.0)[:, None]
-        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + _TWO_PI * k  # (5, nq)
+        k = _TWO_PI * np.arange(-2.0, 3.0).reshape((5,) + (1,) * q.ndim)
+        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + k  # (5, ..., nq)
         inside = (options >= self.lower) & (options <= self.upper)
         cost = np.where(inside, np.abs(options - q_ref), np.inf)
-        best = np.argmin(cost, axis=0)
-        pick = options[best, np.arange(self.nq)]
-        ok = turns & np.isfinite(cost[best, np.arange(self.nq)])
+        best = np.argmin(cost, axis=0)[None]
+        pick = np.take_along_axis(options, best, 0)[0]
+        ok = turns & np.isfinite(np.take_along_axis(cost, best, 0)[0])
         return np.where(ok, pick, q)
 
     def _start_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -551,16 +552,30 @@ class NumericalIK:
         )
 
     def _solve(
-        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True
+        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True,
+        compiled: bool = True,
     ) -> IKResult:
         """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once).
 
         ``first=False`` skips the attempt from the first start (already tried by the caller);
-        ``polish=False`` skips the final projected descent of a failed solve.
+        ``polish=False`` skips the final projected descent of a failed solve; ``compiled=False``
+        runs the attempts interpreted (step by step through Pinocchio) instead of :mod:`._kernel`.
         """
         target = np.asarray(target, dtype=float)
         T_des, p_des = self._target(target, position_only)
         tol = float(tol)
+        if compiled and limits and first:
+            res = self._solve_compiled(target, q_seed, bool(position_only), tol, int(max_restarts), seed)
+            if res.success or not polish:
+                return res
+            # the closest configuration within the limits: a patient projected descent from the best end
+            q, pe, re, it = self._descend(res.q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
+            if pe + re > res.position_error + res.rotation_error:
+                return res
+            if pe <= tol and re <= tol:
+                pe, re = self._errors_to(q, T_des, p_des, position_only)
+            ok = pe <= tol and re <= tol and self.in_limits(q)
+            return IKResult(q, bool(ok), pe, re, res.attempts, res.iterations + it)
         if not first:
             q0 = None
         elif q_seed is None:
@@ -686,7 +701,8 @@ def solve_batch(
     Each target gets the attempts of :meth:`solve` (free descent, projected descent when it
     meets the target outside the limits) from its start, then up to ``max_restarts`` uniform
     starts within the limits nearest pose first, the whole loop compiled; target ``k``'s
-    restarts are seeded from ``seed`` and ``k`` (results do not depend on the thread blocks).
+    restarts are seeded by ``seed + k`` (for an integer ``seed``: row ``k`` is ``Robot.ik(targets[k],
+    seed=seed + k)``, bit for bit; the thread blocks change nothing).
 
     Args:
         targets: checked poses ``(N, 4, 4)`` frame → base [m].
@@ -716,7 +732,6 @@ def solve_batch(
         if starts is None:
             starts = np.empty((N, nq))
         starts[missing] = q_table[np.argmin(cost, axis=1)]
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     kernel, C, L, P, _ = self._compiled()
     Rts = np.ascontiguousarray(targets[:, :3, :3])
     pts = np.ascontiguousarray(targets[:, :3, 3])
@@ -724,7 +739,8 @@ def solve_batch(
     q = np.empty((N, nq))
     success = np.zeros(N, dtype=bool)
     pe, re = np.empty(N), np.empty(N)
-    base = _seed_int(rng)  # target k's restarts are seeded by base + k: the same whatever the blocks
+    base = _seed_int(seed)  # target k's restarts: seed + k, as solve(targets[k], seed=seed + k); any blocks
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(base)
     iterations = [0]
 
     def block(s: int, e: int) -> None:  # compiled and nogil: the blocks run in parallel
