@@ -415,13 +415,10 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     if approach == "straight":
         from pinarms.optim.straight_approach import straight_cycle
 
-        if not (torque_limits is None or torque_limits is False):
-            raise InvalidSettings("approach='straight' times the lines under joint velocity/acceleration (and tool "
-                                  "speed) limits only: a torque limit along a Cartesian path needs a torque path "
-                                  "constraint (planning.path_constraints); use approach='joint' with torque_limits")
         joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
-                           q_start=q_start)
-        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed)
+                           q_start=q_start, payload=payload, torque_limits=torque_limits)
+        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed,
+                              payload=payload, torque_limits=torque_limits)
     v, a, j = _limits(robot, vmax, amax, jmax)
     from pinarms.optim.torque import torque_constraint
 

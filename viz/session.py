@@ -265,6 +265,67 @@ class Session:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
         return name
 
+    def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
+                 name: str = "cell motion", hz: float = 100.0) -> str:
+        """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
+
+        Args:
+            cell: the cell; its joint vector is the robot's, poses are in the world frame
+                (``base_to_world`` is the identity).
+            key: its key (default: the cell's name).
+            motions: the arms' motions (:class:`robots.cell.ArmMotion` objects or
+                ``{arm: trajectory}``), stored as one trajectory ``name`` of the whole cell,
+                sampled at ``hz`` over their window: the viewer animates all arms together.
+            check: a :class:`robots.cell.MotionCheck` of those motions: its samples in
+                contact become the point set ``"<name> contacts"`` (kind ``"contact"``, drawn
+                red), at the middle of the contact pair's nearest points.
+
+        The arms' tcp frames are recorded in ``metadata["cells"][key]`` so that the viewer
+        draws each arm's tcp path.
+        """
+        from pinarms.robots.cell import Cell
+        from pinarms.robots.cell.motion import sample_motions
+
+        if not isinstance(cell, Cell):
+            raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")
+        key = self.add_robot(cell.robot, key=cell.name if key is None else key)
+        self.metadata.setdefault("cells", {})[key] = {
+            "name": cell.name,
+            "args": dict(cell.args),
+            "arms": {a.name: {"tcp_frame": a.prefix + a.robot.tcp_frame, "q_start": a.q_slice.start,
+                              "q_stop": a.q_slice.stop} for a in cell.arms},
+            "fixtures": [f.name for f in cell.fixtures],
+        }
+        if motions is not None:
+            t, q = sample_motions(cell, motions, hz=hz, window=None if check is None else check.window)
+            self.add_trajectory(name, (t, q), robot=key)
+        if check is not None:
+            if motions is None:
+                raise InvalidInput("a check needs the motions it was made of (motions=...)")
+            inside = np.flatnonzero(np.asarray(check.clearance) <= 0.0)
+            if inside.size:  # at most 400 contact samples, evenly spread
+                inside = inside[np.linspace(0, inside.size - 1, min(inside.size, 400)).round().astype(int)]
+                from pinarms.robots.cell.motion import _motions, configurations
+
+                qs = configurations(cell, _motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
+                cl = cell.clearance(qs)
+                self.add_points(f"{name} contacts", 0.5 * (cl.point_a + cl.point_b), kind="contact")
+        return key
+
+    def cell_tcp_frames(self, key: str) -> dict[str, str]:
+        """``{arm: tcp frame}`` of the cell stored under ``key`` (``{}`` for a plain robot)."""
+        entry = self.metadata.get("cells", {})
+        info = entry.get(key) if isinstance(entry, dict) else None
+        arms = info.get("arms") if isinstance(info, dict) else None
+        if not isinstance(arms, dict):
+            return {}
+        out = {}
+        for arm, data in arms.items():
+            frame = data.get("tcp_frame") if isinstance(data, dict) else None
+            if isinstance(arm, str) and isinstance(frame, str):
+                out[arm] = frame
+        return out
+
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""

@@ -65,6 +65,7 @@ def test_a_place_too_close_to_a_wall_is_a_collision_error(station):
         optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
 
 
+@pytest.mark.slow
 def test_a_transfer_no_lift_can_clear_names_what_blocks(tmp_path):
     path = tmp_path / "walled.urdf.xacro"
     path.write_text("""<?xml version="1.0"?>
@@ -101,6 +102,7 @@ def line_schedule(line):
     return cycles, optim.schedule_line(line, cycles, margin=0.01)
 
 
+@pytest.mark.slow
 def test_two_arm_schedule_never_collides_checked_densely(line, line_schedule):
     cycles, schedule = line_schedule
     assert schedule.offsets["left"] == 0.0
