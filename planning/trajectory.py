@@ -236,6 +236,11 @@ class Trajectory:
         return self._stack
 
     def _check_times(self, t: Any) -> tuple[np.ndarray, bool]:
+        if t.__class__ is np.ndarray and t.dtype == np.float64 and t.ndim == 1 and t.size:
+            # fast path: min and max are NaN/±inf when any entry is, so two reductions check it all
+            lo, hi = float(t.min()), float(t.max())
+            if self._breaks[0] <= lo and hi <= self._breaks[-1]:  # False for NaN
+                return t, False
         arr = finite_array(t, "t")
         scalar = arr.ndim == 0
         arr = np.atleast_1d(arr)
@@ -269,11 +274,14 @@ class Trajectory:
         else:
             seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
             tau = tt - self._breaks[seg]
-        powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
-        powers[:, 0] = 1.0
+        # τ^k by running products (a float power per entry costs 10x), each power a contiguous row;
+        # the product below reads the transposed view without copying
+        rows = np.empty((self.degree + 1, tt.size))
+        rows[0] = 1.0
         with np.errstate(over="ignore", invalid="ignore"):
             for k in range(1, self.degree + 1):
-                np.multiply(powers[:, k - 1], tau, out=powers[:, k])
+                np.multiply(rows[k - 1], tau, out=rows[k])
+        powers = rows.T
         out = np.empty((tt.size, 4 * n))
         with np.errstate(over="ignore", invalid="ignore"):
             self._evaluate(powers, D, seg, out)
