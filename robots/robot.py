@@ -602,17 +602,18 @@ class Robot:
     ) -> np.ndarray:
         """A configuration within the limits whose tcp meets ``target`` within ``tol``: ``(nq,)``, or ``(N, nq)`` for a batch.
 
-        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`) from
-        ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
-        the target); if that descent fails, arms with a closed form try their analytic
-        branches nearest ``q_seed`` (default :attr:`neutral`; each revolute angle at its 2π
-        equivalent within the limits nearest it), refined by the solver; then seeded random
-        restarts. The answer is the solution the descent reaches, normally the one nearest
+        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`, compiled)
+        from ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
+        the target), then seeded random restarts; if none meets the target, arms with a closed
+        form try their analytic branches nearest ``q_seed`` (default :attr:`neutral`; each
+        revolute angle at its 2π equivalent within the limits nearest it), refined by the
+        interpreted solver, then its restarts. The answer is the solution the descent reaches, normally the one nearest
         the start; use :meth:`ik_all` (``q_ref``) for the closed-form branch nearest a
         configuration. A batch of targets ``(N, 4, 4)`` (or positions ``(N, 3)`` with
-        ``position_only``) is solved at once by batched Levenberg–Marquardt on batched
-        FK and Jacobians (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is
-        then ``(nq,)`` or ``(N, nq)``.
+        ``position_only``) is solved by the compiled solver in thread blocks
+        (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is then ``(nq,)`` or
+        ``(N, nq)``; for an integer ``seed``, row ``k`` equals ``ik(target[k], q_seed[k],
+        seed=seed + k)``.
 
         Args:
             target: tcp pose ``(4, 4)`` frame → base [m], or ``(N, 4, 4)``; with

@@ -38,11 +38,22 @@ _POOL = 32
 _ROT_WEIGHT = 0.1
 _TWO_PI = 2.0 * math.pi
 
+
+
+def _jit(function):
+    """``numba.njit`` with ``nogil``, cached on disk (beside the source, or numba's user cache
+    directory when that is read-only); without any writable cache location, compiled per process."""
+    try:
+        return njit(cache=True, nogil=True)(function)
+    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
+        return njit(nogil=True)(function)
+
+
 # P (float64 array) holds the settings: μ0, λ_min, max_step, stall_ratio, stall_steps, max_iter
 _P_MU0, _P_LAMMIN, _P_STEP, _P_STALLR, _P_STALLN, _P_ITER = 0, 1, 2, 3, 4, 5
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S):
     """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` (m, 3); ``S`` (3, 7) scratch."""
     Rc, Rn, pc = S[:, 0:3], S[:, 3:6], S[:, 6]
@@ -89,7 +100,7 @@ def _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S):
         p[a] = pa
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _jacobian(qi, sc, rev, Z, O, p, J):
     """Frame Jacobian ``J (6, nq)`` in base axes at the frame origin ``p``, linear rows first."""
     J[:, :] = 0.0
@@ -111,7 +122,7 @@ def _jacobian(qi, sc, rev, Z, O, p, J):
             J[2, j] += s * z2
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _log3_of(Rt, R, w, M):
     """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
     for a in range(3):
@@ -143,7 +154,7 @@ def _log3_of(Rt, R, w, M):
     return theta
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S):
     """Error ``e``, Jacobian ``J`` of ``q``; returns ``(‖e‖², position error², rotation angle)``; ``S`` (3, 10) scratch."""
     qi, sc, of, rev, LR, Lp, fR, fp = C
@@ -159,7 +170,7 @@ def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S):
     return pe2 + e[3] * e[3] + e[4] * e[4] + e[5] * e[5], pe2, theta
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _cholesky_solve(G, b, x):
     """Solve ``G x = b`` (G symmetric positive definite, overwritten by its factor); False if not SPD."""
     n = G.shape[0]
@@ -189,7 +200,7 @@ def _cholesky_solve(G, b, x):
     return True
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _damped_step(J, rows, e, lam, free, dq, Gs, x):
     """``dq = Aᵀ(AAᵀ + λI)⁻¹e`` (``(AᵀA + λI)⁻¹Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed.
 
@@ -234,7 +245,7 @@ def _damped_step(J, rows, e, lam, free, dq, Gs, x):
     return _cholesky_solve(G, bvec, dq)
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _wrap(q, L):
     lo, hi, full_turn, unbounded, wlow, wturns = L
     for j in range(q.shape[0]):
@@ -244,7 +255,7 @@ def _wrap(q, L):
             q[j] -= _TWO_PI * math.floor((q[j] - wlow[j]) * wturns[j])
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _clip(q, L):
     """Project ``q`` into the limits in place (see ``NumericalIK._clip``); True if a joint was clipped."""
     lo, hi, full_turn, unbounded, wlow, wturns = L
@@ -273,7 +284,7 @@ def _clip(q, L):
     return at
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _in_limits(q, L):
     lo, hi = L[0], L[1]
     for j in range(q.shape[0]):
@@ -282,7 +293,7 @@ def _in_limits(q, L):
     return True
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
     """Levenberg–Marquardt from ``q`` (modified in place): ``(position error [m], rotation error [rad], iterations)``."""
     lo, hi = L[0], L[1]
@@ -384,7 +395,7 @@ def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
     return math.sqrt(pe2), th, it
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def errors(q, C, Rt, pt, posonly):
     """``(position error [m], rotation error [rad])`` of ``q``."""
     m = C[0].shape[0]
@@ -394,7 +405,7 @@ def errors(q, C, Rt, pt, posonly):
     return math.sqrt(pe2), th
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol):
     """Free descent (wrapped), then, met outside the limits, a projected one: ``(pe, re, iterations, ok)``; q in place, within the limits."""
     pe, re, it = descend(q, C, L, P, Rt, pt, posonly, tol, WINDOW, 1)
@@ -409,7 +420,7 @@ def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol):
     return pe, re, it + it2, pe <= tol and re <= tol
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def _cost(C, q, Rt, pt, posonly, R, p, Z, O, S):
     qi, sc, of, rev, LR, Lp, fR, fp = C
     _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S)
@@ -423,7 +434,7 @@ def _cost(C, q, Rt, pt, posonly, R, p, Z, O, S):
     return d + _ROT_WEIGHT * math.sqrt(f)
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
     """Row of the start table whose pose is nearest ``(Rt, pt)`` (``‖Δp‖ + 0.1 m/rad · ‖ΔR‖_F``)."""
     best, k_best = np.inf, 0
@@ -442,7 +453,7 @@ def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
     return k_best
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
     """Attempt from ``q0``, then up to ``restarts`` starts drawn within the limits (``seed`` < 2³²), nearest pose first.
 
@@ -490,7 +501,7 @@ def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
     return False, best_pe, best_re, attempts, its
 
 
-@njit(cache=True, nogil=True)
+@_jit
 def solve_many(Rts, pts, starts, C, L, P, posonly, tol, restarts, seed, q_out, ok, pe, re):
     """:func:`solve` for every target ``k`` (restarts seeded by ``seed + k``); returns the total iterations."""
     total = 0
