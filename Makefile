@@ -41,7 +41,7 @@ test: install browser
 docs-pictures: install browser
 	PINARMS_DOCS_PICTURES=1 $(PY) -m pytest -q tests/viz/test_browser.py tests/viz/test_plots.py
 
-# Regenerate urdf/*.urdf from robots/xacro/*.xacro.
+# Regenerate urdf/*.urdf and urdf/cells/*.urdf from robots/xacro/ (arms and cells).
 urdf: install
 	$(VENV)/bin/pinarms urdf build
 

@@ -8,6 +8,10 @@
 from .errors import (
     ExecutionError,
     InvalidInput,
+    CellError,
+    CellNotFound,
+    CollisionError,
+    CollisionGeometryError,
     LimitViolation,
     MissingMesh,
     ModelError,
@@ -43,6 +47,10 @@ __all__ = [
     "XacroLimitExceeded",
     "XacroArgError",
     "MissingMesh",
+    "CellError",
+    "CellNotFound",
+    "CollisionGeometryError",
+    "CollisionError",
 ]
 
 # workspace analysis and station layout
@@ -79,3 +87,19 @@ __all__ += ["Payload", "InvalidPayload", "MissingInertials"]
 from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
 
 __all__ += ["XacroLimits", "expand_xacro"]
+
+# cells: several arms, fixtures, collision checks
+from .cell import (  # noqa: E402
+    ArmMotion,
+    Cell,
+    CellArm,
+    Clearance,
+    Collisions,
+    CollisionPair,
+    MotionCheck,
+    cell_names,
+    load_cell,
+)
+
+__all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
+            "load_cell"]

@@ -21,6 +21,10 @@ __all__ = [
     "XacroLimitExceeded",
     "XacroArgError",
     "MissingMesh",
+    "CellError",
+    "CellNotFound",
+    "CollisionGeometryError",
+    "CollisionError",
 ]
 
 
@@ -91,3 +95,19 @@ class XacroArgError(XacroError, InvalidInput):
 
 class MissingMesh(ModelError):
     """A mesh file named by a description does not exist."""
+
+
+class CellError(ModelError):
+    """A cell description is malformed: duplicate names, no arm, an arm that cannot be modelled."""
+
+
+class CollisionGeometryError(ModelError):
+    """A collision geometry cannot be loaded or a pair of geometries cannot be checked."""
+
+
+class CollisionError(PinarmsError):
+    """A motion cannot be made collision-free; the message says which bodies block it."""
+
+
+class CellNotFound(RobotNotFound):
+    """A cell name is not a built-in cell, or a cell file does not exist."""

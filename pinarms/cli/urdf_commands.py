@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
 from ._common import (
@@ -33,7 +35,7 @@ def urdf_group() -> None:
 @json_option
 def urdf_build_cmd(source: str | None, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
                    check: bool, out_dir: str | None, as_json: bool) -> None:
-    """Regenerate urdf/*.urdf from robots/xacro/*.urdf.xacro, or expand a user's SOURCE.xacro.
+    """Regenerate urdf/*.urdf and urdf/cells/*.urdf from robots/xacro/, or expand a user's SOURCE.xacro.
 
     SOURCE is expanded behind a wall (docs/cells.md): it may read only its own folder and
     the --package folders, within a time and memory bound.
@@ -47,20 +49,21 @@ def urdf_build_cmd(source: str | None, xacro_args: tuple[str, ...], packages: tu
         return
     if xacro_args or packages or output:
         raise click.UsageError("--arg, --package and -o need a SOURCE.xacro file")
+    from pinarms.robots.cell import library
+
+    cells_dir = None if out_dir is None else str(Path(out_dir) / "cells")
     if check:
-        stale = urdf_build.stale(out_dir)
+        stale = urdf_build.stale(out_dir) + [f"cells/{name}" for name in library.stale_cells(cells_dir)]
         emit(as_json, {"stale": stale}, [f"stale: {name}" for name in stale] or ["all URDFs are up to date"])
         if stale:
             raise SystemExit(1)
         return
-    written = urdf_build.build_all(out_dir)
+    written = urdf_build.build_all(out_dir) + library.build_cells(cells_dir)
     emit(as_json, {"written": [str(p) for p in written]}, [f"wrote {p}" for p in written])
 
 
 def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
                       as_json: bool) -> None:
-    from pathlib import Path
-
     from pinarms.robots.urdf_build import write_atomic
     from pinarms.robots.xacro_expand import check_mesh_files, expand_xacro, parse_xacro_args
 

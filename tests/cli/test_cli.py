@@ -213,7 +213,9 @@ def test_export_html_and_view(run, tmp_path):
 
 def test_urdf_build_check_and_export(run, tmp_path):
     data = as_json(run("urdf", "build", "--out", str(tmp_path / "built"), "--json"))
-    assert len(data["written"]) == len(robots.builtin_names())
+    from pinarms.robots.cell import cell_names
+
+    assert len(data["written"]) == len(robots.builtin_names()) + len(cell_names())  # arms and cells
     assert as_json(run("urdf", "build", "--check", "--json"))["stale"] == []
     out = tmp_path / "koji"
     data = as_json(run("urdf", "export", "koji_turner", str(out), "--json"))

@@ -1,0 +1,37 @@
+"""Cells: several arms at their bases, fixtures, one Pinocchio model and collision checks.
+
+>>> from pinarms import robots
+>>> cell = robots.load_cell("mushroom_line")
+>>> cell.arms[0].name, cell.nq
+('left', 8)
+>>> bool(cell.in_collision(cell.neutral))
+False
+"""
+
+from .cell import Cell, CellArm, Fixture, Shape
+from .collision import Clearance, Collisions
+from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
+from .motion import ArmMotion, Contact, MotionCheck, check_motion
+from .pairs import AllowedPair, CollisionPair
+
+__all__ = [
+    "load_cell",
+    "cell_names",
+    "cell_source_path",
+    "cell_urdf_path",
+    "build_cell",
+    "build_cells",
+    "stale_cells",
+    "Cell",
+    "CellArm",
+    "Fixture",
+    "Shape",
+    "CollisionPair",
+    "AllowedPair",
+    "Collisions",
+    "Clearance",
+    "ArmMotion",
+    "Contact",
+    "MotionCheck",
+    "check_motion",
+]

@@ -1,0 +1,478 @@
+"""A cell: several arms at their bases, fixed fixtures, one Pinocchio model and its collision model.
+
+:class:`Cell` is what :func:`~pinarms.robots.cell.load_cell` returns. Frames: every pose
+is *world* (the cell URDF's root link, z up) unless a name says otherwise
+(``base_to_world``: an arm's base frame → world). The **cell joint vector** ``q`` holds
+one coordinate per independent joint of every arm (rad or m), arm after arm in the order
+of :attr:`Cell.arms`; :attr:`CellArm.q_slice` is each arm's block.
+
+Collision checks live in :mod:`.collision` (:meth:`Cell.in_collision`,
+:meth:`Cell.collisions`, :meth:`Cell.clearance`) and :mod:`.motion`
+(:meth:`Cell.check_motion`); the pairs they check and the pairs they skip, with the
+reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Mapping
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from ..errors import CellError, CollisionGeometryError, InvalidInput, ModelError
+from ..robot import Robot
+from ..xacro_expand import mesh_path
+from .description import ArmSpec, CellSpec, arm_urdf, describe
+from .placements import BatchedPlacements
+
+__all__ = ["Cell", "CellArm", "Fixture", "Shape"]
+
+
+@dataclass(frozen=True, eq=False)
+class CellArm:
+    """One arm of a cell.
+
+    Attributes:
+        name: the arm's name in the cell (``"left"``).
+        robot: the arm alone (link and joint names without the prefix, its base link as
+            root): IK, limits and trajectories work on it as on any :class:`Robot`.
+        base_to_world: ``(4, 4)`` pose of the arm's base frame in the world [m].
+        q_slice: the arm's coordinates in the cell joint vector.
+        prefix: what the arm's names carry in the cell (``"left_"``).
+        model: the built-in arm it is (``"scara_mushroom"``), or ``None``.
+    """
+
+    name: str
+    robot: Robot
+    base_to_world: np.ndarray
+    q_slice: slice
+    prefix: str
+    model: str | None
+
+    @property
+    def nq(self) -> int:
+        """Number of the arm's joint coordinates."""
+        return self.robot.nq
+
+    def to_world(self, pose: Any) -> np.ndarray:
+        """A pose ``(4, 4)`` / ``(N, 4, 4)`` or a point ``(3,)`` / ``(N, 3)`` from the arm's base frame to the world."""
+        arr = np.asarray(pose, dtype=float)
+        if arr.shape[-2:] == (4, 4):
+            return self.base_to_world @ arr
+        if arr.shape[-1:] == (3,):
+            return arr @ self.base_to_world[:3, :3].T + self.base_to_world[:3, 3]
+        raise InvalidInput(f"to_world takes poses (4, 4) or points (3,), got shape {arr.shape}")
+
+    def to_base(self, pose: Any) -> np.ndarray:
+        """Inverse of :meth:`to_world`: world pose(s) or point(s) in the arm's base frame."""
+        inv = np.linalg.inv(self.base_to_world)
+        arr = np.asarray(pose, dtype=float)
+        if arr.shape[-2:] == (4, 4):
+            return inv @ arr
+        if arr.shape[-1:] == (3,):
+            return arr @ inv[:3, :3].T + inv[:3, 3]
+        raise InvalidInput(f"to_base takes poses (4, 4) or points (3,), got shape {arr.shape}")
+
+    def tcp_to_world(self, q_arm: Any) -> np.ndarray:
+        """Pose(s) of the arm's tcp in the world for the arm's own ``q (nq,)`` / ``(N, nq)``."""
+        return self.base_to_world @ self.robot.fk(q_arm)
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """One collision primitive of a fixture.
+
+    Attributes:
+        kind: ``"box"``, ``"cylinder"``, ``"sphere"``, ``"capsule"`` or ``"mesh"``.
+        size: box ``(sx, sy, sz)``, cylinder and capsule ``(radius, length)`` along local
+            z, sphere ``(radius,)``, mesh its scale ``(x, y, z)`` [m or 1].
+        shape_to_world: ``(4, 4)`` pose of the primitive's centre (mesh: its origin).
+        mesh: the mesh file as the URDF names it (``None`` for primitives).
+        geometry: its name in :attr:`Cell.collision_model`.
+    """
+
+    kind: str
+    size: tuple[float, ...]
+    shape_to_world: np.ndarray
+    mesh: str | None
+    geometry: str
+
+
+@dataclass(frozen=True, eq=False)
+class Fixture:
+    """A fixed body of the cell (a link without joints to the arms): name and shapes."""
+
+    name: str
+    shapes: tuple[Shape, ...]
+
+
+def _shape_of(geometry: Any) -> tuple[str, tuple[float, ...]]:
+    if isinstance(geometry, coal.Box):
+        return "box", tuple(float(v) for v in 2.0 * np.asarray(geometry.halfSide))
+    if isinstance(geometry, coal.Cylinder):
+        return "cylinder", (float(geometry.radius), float(2.0 * geometry.halfLength))
+    if isinstance(geometry, coal.Capsule):
+        return "capsule", (float(geometry.radius), float(2.0 * geometry.halfLength))
+    if isinstance(geometry, coal.Sphere):
+        return "sphere", (float(geometry.radius),)
+    if isinstance(geometry, (coal.BVHModelBase, coal.ConvexBase)):
+        return "mesh", ()
+    return type(geometry).__name__, ()
+
+
+@lru_cache(maxsize=1)
+def _builtin_joint_names() -> dict[tuple[str, ...], str]:
+    from ..registry import builtin_names, load
+
+    return {load(name).joint_names: name for name in builtin_names()}
+
+
+class Cell:
+    """Several arms, their fixtures and their collision geometry in one Pinocchio model.
+
+    Build one with :func:`~pinarms.robots.cell.load_cell`.
+
+    Attributes:
+        name: the cell's name (the URDF's ``<robot name>``).
+        source: where it came from (a file path or ``"builtin:<name>"``).
+        urdf_text: the cell's URDF (mesh paths as the file gives them).
+        args: the xacro arguments used (empty for a URDF).
+        robot: the whole cell as one :class:`Robot` (joint vector = the cell's ``q``,
+            poses in the world): batched FK of any frame, limits, random configurations.
+        model: its Pinocchio model; ``collision_model``: the coal geometry
+            (``pin.GeometryModel``) with the checked pairs as its collision pairs.
+        arms: the arms (:class:`CellArm`), in joint-vector order.
+        fixtures: the fixtures (:class:`Fixture`), in document order.
+        pairs: the checked pairs (:class:`~.pairs.CollisionPair`).
+        allowed: the pairs never checked, each with its reason (:class:`~.pairs.AllowedPair`).
+    """
+
+    def __init__(
+        self,
+        urdf_text: str,
+        *,
+        source: str,
+        base_dir: str | Path,
+        packages: Mapping[str, str | Path] | None = None,
+        args: Mapping[str, str] | None = None,
+        seed: int = 0,
+    ) -> None:
+        from .pairs import classify_pairs
+
+        self.source = source
+        self.urdf_text = urdf_text
+        self.args = dict(args or {})
+        self._packages = dict(packages or {})
+        self._base_dir = Path(base_dir)
+        try:
+            root = ET.fromstring(urdf_text)
+        except ET.ParseError as exc:
+            raise CellError(f"{source} is not well-formed XML: {exc}") from exc
+        spec: CellSpec = describe(root, source)
+        self.spec = spec
+        self.name = spec.name
+        try:
+            model = pin.buildModelFromXML(urdf_text, mimic=True)
+        except Exception as exc:  # Pinocchio's own message
+            raise CellError(f"Pinocchio cannot build a model of {source}: {exc}") from exc
+        tcp = next((a.prefix + "tcp" for a in spec.arms if model.existFrame(a.prefix + "tcp")), None)
+        tcp = tcp or model.frames[len(model.frames) - 1].name
+        self.robot = Robot(model, name=self.name, urdf_text=urdf_text, tcp_frame=tcp, description=f"cell {self.name}")
+        self.model = model
+        self.arms = tuple(self._build_arm(root, arm) for arm in spec.arms)
+        self.arms = tuple(sorted(self.arms, key=lambda a: a.q_slice.start))
+        self._arm_index = {a.name: k for k, a in enumerate(self.arms)}
+        self.collision_model = self._build_geometry(root)
+        self._placements = BatchedPlacements(model)
+        self._pin_index = self._plain_pin_index()
+        self._data = model.createData()
+        self.fixtures = self._fixtures()
+        self.pairs, self.allowed = classify_pairs(self, seed=seed)
+        self._finish_geometry()
+
+    # ------------------------------------------------------------------ building
+    def _build_arm(self, root: ET.Element, spec: ArmSpec) -> CellArm:
+        from ..ik import _FAMILY_OF, attach_analytic_ik
+        from ..registry import from_urdf_text
+
+        text = arm_urdf(root, spec)
+        robot = from_urdf_text(text, tcp=None, name=spec.name, source=f"arm {spec.name!r} of {self.source}",
+                               package_dirs=tuple(self._package_dirs()))
+        model_name = _builtin_joint_names().get(robot.joint_names)
+        robot.description = f"{model_name or 'arm'} {spec.name!r} of cell {self.name}"
+        if model_name in _FAMILY_OF:
+            try:
+                attach_analytic_ik(robot, _FAMILY_OF[model_name])
+            except ModelError:
+                robot._analytic_ik = None  # the arm was changed: numerical IK only
+        cell_names = self.robot.joint_names
+        idx = [cell_names.index(spec.prefix + j) if spec.prefix + j in cell_names else -1 for j in robot.joint_names]
+        if -1 in idx or idx != list(range(idx[0], idx[0] + len(idx))):
+            raise CellError(
+                f"{self.source}: the joints of arm {spec.name!r} are not one block of the cell's joint vector "
+                f"(cell joints {list(cell_names)}); an arm must be one subtree below its base"
+            )
+        base_id = self.model.getFrameId(spec.base_link)
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
+        base_to_world = data.oMf[base_id].homogeneous.copy()
+        return CellArm(
+            name=spec.name,
+            robot=robot,
+            base_to_world=base_to_world,
+            q_slice=slice(idx[0], idx[0] + len(idx)),
+            prefix=spec.prefix,
+            model=model_name,
+        )
+
+    def _plain_pin_index(self) -> np.ndarray | None:
+        """Where each cell coordinate sits in Pinocchio's q, when every joint stores one value (else ``None``)."""
+        index = np.full(self.nq, -1, dtype=int)
+        for i in range(1, self.model.njoints):
+            joint = self.model.joints[i]
+            if "Mimic" in joint.shortname():
+                continue
+            if joint.nq != 1:
+                return None  # a continuous joint (cos, sin): use Robot.q_to_pinocchio
+            index[joint.idx_v] = joint.idx_q
+        return None if (index < 0).any() else index
+
+    def _package_dirs(self) -> list[str]:
+        from ..xacro_expand import BUILTIN_PACKAGE
+
+        return [str(BUILTIN_PACKAGE[1]), *(str(Path(v)) for v in self._packages.values())]
+
+    def _resolved_urdf(self, root: ET.Element) -> str:
+        """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""
+        resolved = ET.fromstring(ET.tostring(root))
+        for mesh in resolved.iter("mesh"):
+            mesh.set("filename", str(mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)))
+        return ET.tostring(resolved, encoding="unicode")
+
+    def _build_geometry(self, root: ET.Element) -> pin.GeometryModel:
+        text = self._resolved_urdf(root)
+        try:
+            gm = pin.buildGeomFromUrdfString(self.model, text, pin.COLLISION, package_dirs=self._package_dirs())
+        except Exception as exc:
+            raise CollisionGeometryError(f"cannot load the collision geometry of {self.source}: {exc}") from exc
+        expected: dict[str, int] = {}
+        for link in root.findall("link"):
+            n = len(link.findall("collision"))
+            if n:
+                expected[link.get("name")] = n
+        got: dict[str, int] = {}
+        for g in gm.geometryObjects:
+            link = self.model.frames[g.parentFrame].name
+            got[link] = got.get(link, 0) + 1
+        missing = sorted(link for link, n in expected.items() if got.get(link, 0) < n)
+        if missing:
+            raise CollisionGeometryError(
+                f"{self.source}: the collision geometry of link(s) {', '.join(missing)} did not load "
+                "(an unsupported or empty <geometry>?); every <collision> must give a box, cylinder, sphere, "
+                "capsule or mesh"
+            )
+        self._visual_text = text
+        return gm
+
+    def _fixtures(self) -> tuple[Fixture, ...]:
+        data = self.model.createData()
+        gd = pin.GeometryData(self.collision_model)
+        pin.updateGeometryPlacements(self.model, data, self.collision_model, gd, pin.neutral(self.model))
+        by_link: dict[str, list[Shape]] = {name: [] for name in self.spec.fixtures}
+        for k, g in enumerate(self.collision_model.geometryObjects):
+            link = self.model.frames[g.parentFrame].name
+            if link not in by_link:
+                continue
+            kind, size = _shape_of(g.geometry)
+            mesh = None
+            if kind == "mesh":
+                size = tuple(float(v) for v in np.asarray(g.meshScale))
+                mesh = self._mesh_name(link)
+            by_link[link].append(Shape(kind, size, gd.oMg[k].homogeneous.copy(), mesh, g.name))
+        return tuple(Fixture(name, tuple(shapes)) for name, shapes in by_link.items())
+
+    def _mesh_name(self, link: str) -> str | None:
+        root = ET.fromstring(self.urdf_text)
+        for el in root.findall("link"):
+            if el.get("name") == link:
+                mesh = el.find("collision/geometry/mesh")
+                return None if mesh is None else mesh.get("filename")
+        return None
+
+    def _finish_geometry(self) -> None:
+        """Keep only the checked pairs in the collision model, tight coal tolerances, and test every pair once."""
+        gm = self.collision_model
+        gm.removeAllCollisionPairs()
+        for p in self.pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+        self._gd = self._new_geometry_data()
+        q0 = pin.neutral(self.model)
+        pin.updateGeometryPlacements(self.model, self._data, gm, self._gd, q0)
+        for k, p in enumerate(self.pairs):
+            try:
+                d = pin.computeDistance(gm, self._gd, k).min_distance
+                pin.computeCollision(gm, self._gd, k)
+            except Exception as exc:
+                raise CollisionGeometryError(
+                    f"{self.source}: the pair ({p.body_a}, {p.body_b}) cannot be checked by coal: {exc}"
+                ) from exc
+            if not np.isfinite(d):
+                raise CollisionGeometryError(
+                    f"{self.source}: the distance between {p.body_a} and {p.body_b} is {d}: check their geometry"
+                )
+
+    def _new_geometry_data(self) -> pin.GeometryData:
+        gd = pin.GeometryData(self.collision_model)
+        for req in gd.distanceRequests:
+            req.gjk_tolerance = 1e-10  # exact distances (coal's default 1e-6 m is coarser than the checks)
+        return gd
+
+    # --------------------------------------------------------------- joint vector
+    @property
+    def nq(self) -> int:
+        """Length of the cell joint vector."""
+        return self.robot.nq
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the cell's joints (with the arms' prefixes), in ``q`` order."""
+        return self.robot.joint_names
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower joint limits ``(nq,)`` [rad or m]."""
+        return self.robot.lower
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper joint limits ``(nq,)`` [rad or m]."""
+        return self.robot.upper
+
+    @property
+    def neutral(self) -> np.ndarray:
+        """Every arm at its neutral configuration."""
+        return self.robot.neutral
+
+    def random_q(self, n: int, seed: int | np.random.Generator | None = 0) -> np.ndarray:
+        """``n`` cell configurations ``(n, nq)`` drawn uniformly within the joint limits."""
+        return self.robot.random_q(n, seed=seed)
+
+    def arm(self, name: str) -> CellArm:
+        """The arm called ``name``; :class:`InvalidInput` lists the arms otherwise."""
+        if name not in self._arm_index:
+            raise InvalidInput(f"cell {self.name!r} has no arm {name!r}; arms: {', '.join(self._arm_index)}")
+        return self.arms[self._arm_index[name]]
+
+    def fixture(self, name: str) -> Fixture:
+        """The fixture called ``name``; :class:`InvalidInput` lists the fixtures otherwise."""
+        for f in self.fixtures:
+            if f.name == name:
+                return f
+        raise InvalidInput(f"cell {self.name!r} has no fixture {name!r}; fixtures: {', '.join(f.name for f in self.fixtures)}")
+
+    def q_from_arms(self, arm_q: Mapping[str, Any], base: Any = None) -> np.ndarray:
+        """A cell joint vector from ``{arm name: q_arm (nq_arm,) or (N, nq_arm)}``.
+
+        Arms not named keep ``base`` (default :attr:`neutral`). Batches of the named arms
+        must have the same ``N``; the result is ``(nq,)`` or ``(N, nq)``.
+        """
+        rows = None
+        parts = {}
+        for name, value in arm_q.items():
+            arm = self.arm(name)
+            arr, single = arm.robot.check_q(value)
+            parts[name] = (arm, arr)
+            if not single:
+                if rows not in (None, arr.shape[0]):
+                    raise InvalidInput(f"arm batches differ in length: {rows} and {arr.shape[0]}")
+                rows = arr.shape[0]
+        q0 = self.neutral if base is None else self.robot.check_q(base)[0][0]
+        out = np.tile(q0, (rows or 1, 1))
+        for arm, arr in parts.values():
+            out[:, arm.q_slice] = arr
+        return out[0] if rows is None else out
+
+    def arm_q(self, q: Any, name: str) -> np.ndarray:
+        """The block of arm ``name`` in the cell vector(s) ``q``."""
+        arr, single = self.robot.check_q(q)
+        out = arr[:, self.arm(name).q_slice]
+        return out[0] if single else out
+
+    def world_pose(self, q: Any, frame: str) -> np.ndarray:
+        """Pose(s) ``(4, 4)`` / ``(N, 4, 4)`` of any cell frame (``"left_tcp"``) in the world."""
+        return self.robot.fk(q, frame)
+
+    def _q_pin_single(self, q: Any) -> np.ndarray | None:
+        """Pinocchio's vector for one finite float ``q (nq,)`` without the general checks, else ``None``."""
+        if type(q) is not np.ndarray or q.shape != (self.nq,) or q.dtype != np.float64:
+            return None
+        if not np.isfinite(q).all():
+            return None
+        if self._pin_index is None:
+            return None
+        out = np.zeros(self.model.nq)
+        out[self._pin_index] = q
+        return out
+
+    # ----------------------------------------------------------- geometry access
+    @property
+    def geometry_names(self) -> tuple[str, ...]:
+        """Names of the collision geometries, in :attr:`collision_model` order."""
+        return tuple(g.name for g in self.collision_model.geometryObjects)
+
+    def geometry_placements(self, q: Any) -> tuple[np.ndarray, np.ndarray]:
+        """World rotations ``(N, G, 3, 3)`` and centres ``(N, G, 3)`` of every geometry frame, batched."""
+        arr, _ = self.robot.check_q(q)
+        R, p = self._placements.joints(arr)
+        gm = self.collision_model
+        parents = np.array([g.parentJoint for g in gm.geometryObjects], dtype=int)
+        local_R = np.array([g.placement.rotation for g in gm.geometryObjects])
+        local_p = np.array([g.placement.translation for g in gm.geometryObjects])
+        Rg = R[:, parents] @ local_R
+        pg = p[:, parents] + np.einsum("ngij,gj->ngi", R[:, parents], local_p)
+        return Rg, pg
+
+    def __repr__(self) -> str:
+        return (
+            f"Cell({self.name!r}, arms={[a.name for a in self.arms]}, fixtures={len(self.fixtures)}, "
+            f"nq={self.nq}, pairs checked={len(self.pairs)}, allowed={len(self.allowed)})"
+        )
+
+    # ------------------------------------------------------------------ checks
+    def in_collision(self, q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+        """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) touches.
+
+        A pair touches when its distance is at most ``margin`` [m] (0: contact or
+        penetration). Pinocchio's broad phase (dynamic AABB tree) culls pairs whose boxes are
+        apart and coal decides the rest, stopping at the first contact; a batch runs in
+        Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
+        """
+        from .collision import in_collision
+
+        return in_collision(self, q, margin=margin, threads=threads)
+
+    def collisions(self, q: Any, *, margin: float = 0.0):
+        """Which checked pairs touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
+        from .collision import collisions
+
+        return collisions(self, q, margin=margin)
+
+    def clearance(self, q: Any, *, margin: float = 0.0):
+        """Smallest signed distance [m] over the checked pairs, and the pair: a :class:`~.collision.Clearance`."""
+        from .collision import clearance
+
+        return clearance(self, q, margin=margin)
+
+    def check_motion(self, motions: Any, *, margin: float = 0.01, **kwargs):
+        """Check the arms' trajectories together, continuously in time: a :class:`~.motion.MotionCheck`.
+
+        See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
+        """
+        from .motion import check_motion
+
+        return check_motion(self, motions, margin=margin, **kwargs)

@@ -1,0 +1,315 @@
+"""Collisions and clearance of cell configurations, one or a batch (Pinocchio + coal).
+
+- :func:`in_collision`: does a configuration touch? Pinocchio's broad phase (coal's dynamic
+  AABB tree) culls the checked pairs whose boxes are apart, then coal decides the others,
+  stopping at the first contact. One configuration: one call; a batch: Pinocchio's C++
+  batch (``computeCollisionsInParallel`` on a broad-phase pool), no Python per configuration.
+- :func:`collisions`: *which* pairs touch (the batch above first, then every pair of the
+  touching configurations only).
+- :func:`clearance`: the smallest signed distance (coal, negative = penetration depth)
+  and the pair that has it. A numpy broad phase bounds every pair's distance from below
+  for the whole batch at once (bounding spheres of the moving geometries against bounding
+  spheres or boxes); per configuration, coal's exact distance is computed for the pairs in
+  increasing order of their bound until the next bound exceeds the best exact distance.
+  The result is the exact minimum over all checked pairs.
+
+Distances are in m, in the world frame; the pairs are :attr:`Cell.pairs`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import CollisionGeometryError, InvalidInput
+from .pairs import CollisionPair
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .cell import Cell
+
+__all__ = ["Collisions", "Clearance", "in_collision", "collisions", "clearance", "pair_lower_bounds"]
+
+
+@dataclass(frozen=True, eq=False)
+class Collisions:
+    """Which checked pairs touch, per configuration.
+
+    Attributes:
+        pairs: the checked pairs (:attr:`Cell.pairs`).
+        colliding: ``(N,)`` bool: the configuration has at least one touching pair.
+        touching: per configuration, the indices (into ``pairs``) of the touching pairs.
+        margin: pairs closer than this [m] count as touching.
+        single: one configuration was given.
+    """
+
+    pairs: tuple[CollisionPair, ...]
+    colliding: np.ndarray
+    touching: tuple[tuple[int, ...], ...]
+    margin: float
+    single: bool
+
+    def __bool__(self) -> bool:
+        return bool(self.colliding.any())
+
+    def __len__(self) -> int:
+        return len(self.touching)
+
+    def pairs_at(self, i: int = 0) -> list[CollisionPair]:
+        """The touching pairs of configuration ``i``."""
+        return [self.pairs[k] for k in self.touching[i]]
+
+    def bodies_at(self, i: int = 0) -> list[tuple[str, str]]:
+        """``(body_a, body_b)`` of the touching pairs of configuration ``i``."""
+        return [self.pairs[k].bodies for k in self.touching[i]]
+
+
+@dataclass(frozen=True, eq=False)
+class Clearance:
+    """The smallest signed distance over the checked pairs, per configuration.
+
+    Attributes:
+        distance: [m] ``float`` (one configuration) or ``(N,)``; negative: the bodies
+            overlap by that depth.
+        pair: index into ``pairs`` of the pair that has it (``int`` or ``(N,)``).
+        point_a, point_b: nearest points on ``body_a`` and ``body_b`` in the world [m]
+            (``(3,)`` or ``(N, 3)``).
+        margin: the requested safety distance [m].
+        pairs: the checked pairs.
+    """
+
+    distance: Any
+    pair: Any
+    point_a: np.ndarray
+    point_b: np.ndarray
+    margin: float
+    pairs: tuple[CollisionPair, ...]
+
+    @property
+    def ok(self) -> Any:
+        """Whether the clearance is at least ``margin`` (``bool`` or ``(N,)``)."""
+        return self.distance >= self.margin
+
+    def pair_of(self, i: int | None = None) -> CollisionPair:
+        """The closest pair (of configuration ``i`` for a batch)."""
+        k = self.pair if i is None else self.pair[i]
+        return self.pairs[int(k)]
+
+
+def _margin(margin: Any) -> float:
+    ok = isinstance(margin, (int, float, np.integer, np.floating)) and not isinstance(margin, bool)
+    value = float(margin) if ok else float("nan")
+    if not np.isfinite(value) or value < 0.0:
+        raise InvalidInput(f"margin must be a finite number >= 0 [m], got {margin!r}")
+    return value
+
+
+def _set_margin(gd: pin.GeometryData, margin: float) -> None:
+    for req in gd.collisionRequests:
+        req.security_margin = margin
+
+
+class _Checkers:
+    """Pinocchio broad-phase checkers of one cell (dynamic AABB tree), per safety margin."""
+
+    def __init__(self, cell: "Cell") -> None:
+        self.cell = cell
+        self.margin: float | None = None
+        self.gd = pin.GeometryData(cell.collision_model)
+        self.manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(cell.model, cell.collision_model, self.gd)
+        self.data = cell.model.createData()
+        self.pools: dict[int, Any] = {}
+        self.pool_margin: dict[int, float] = {}
+
+    def single(self, q_pin: np.ndarray, margin: float) -> bool:
+        if self.margin != margin:
+            _set_margin(self.gd, margin)
+            self.margin = margin
+        return bool(pin.computeCollisions(self.cell.model, self.data, self.manager, q_pin, True))
+
+    def batch(self, q_pin: np.ndarray, margin: float, threads: int) -> np.ndarray:
+        pool = self.pools.get(threads)
+        if pool is None:
+            pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(
+                self.cell.model, self.cell.collision_model, threads
+            )
+            self.pools[threads] = pool
+        if self.pool_margin.get(threads) != margin:
+            for gd in pool.getGeometryDatas():
+                _set_margin(gd, margin)
+            self.pool_margin[threads] = margin
+        out = pin.computeCollisionsInParallel(threads, pool, np.asfortranarray(q_pin.T), True, False)
+        return np.asarray(out, dtype=bool).reshape(-1)
+
+
+def _checkers(cell: "Cell") -> _Checkers:
+    checkers = getattr(cell, "_checkers", None)
+    if checkers is None:
+        checkers = cell._checkers = _Checkers(cell)
+    return checkers
+
+
+def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+    """See :meth:`Cell.in_collision`."""
+    if margin != 0.0:
+        margin = _margin(margin)
+    checkers = _checkers(cell)
+    fast = cell._q_pin_single(q)  # one finite (nq,) vector: skip the batch machinery
+    if fast is not None and cell.pairs:
+        return checkers.single(fast, float(margin))
+    margin = _margin(margin)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise InvalidInput(f"threads must be a positive integer, got {threads!r}")
+    arr, single = cell.robot.check_q(q)
+    if not cell.pairs:
+        return False if single else np.zeros(arr.shape[0], dtype=bool)
+    qp = cell.robot.q_to_pinocchio(arr)
+    if single:
+        return checkers.single(qp[0], margin)
+    return checkers.batch(qp, margin, int(threads))
+
+
+def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
+    """See :meth:`Cell.collisions`."""
+    margin = _margin(margin)
+    arr, single = cell.robot.check_q(q)
+    hit = np.atleast_1d(in_collision(cell, arr if not single else arr[0], margin=margin))
+    if single:
+        hit = np.array([hit[0]])
+    touching: list[tuple[int, ...]] = [()] * arr.shape[0]
+    if hit.any():
+        qp = cell.robot.q_to_pinocchio(arr)
+        gd = pin.GeometryData(cell.collision_model)
+        _set_margin(gd, margin)
+        for i in np.flatnonzero(hit):
+            pin.updateGeometryPlacements(cell.model, cell._data, cell.collision_model, gd, qp[i])
+            pin.computeCollisions(cell.collision_model, gd, False)
+            touching[i] = tuple(k for k, r in enumerate(gd.collisionResults) if r.isCollision())
+    return Collisions(cell.pairs, hit.copy(), tuple(touching), margin, single)
+
+
+# ------------------------------------------------------------------ broad phase
+def _bounds_data(cell: "Cell") -> dict:
+    """Constant data of the broad phase: bounding spheres, static boxes, pair index lists."""
+    cached = getattr(cell, "_bounds", None)
+    if cached is not None:
+        return cached
+    objs = list(cell.collision_model.geometryObjects)
+    G = len(objs)
+    radius = np.zeros(G)
+    half = np.zeros((G, 3))
+    offset = np.zeros((G, 3))  # bounding-box centre in the parent joint's frame
+    for k, g in enumerate(objs):
+        g.geometry.computeLocalAABB()
+        lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
+        half[k] = (hi - lo) / 2.0
+        radius[k] = float(np.linalg.norm(half[k]))
+        offset[k] = g.placement.act((lo + hi) / 2.0)
+    joint = np.array([g.parentJoint for g in objs], dtype=int)
+    by_joint = {int(j): np.flatnonzero(joint == j) for j in np.unique(joint) if j > 0}
+    static = joint == 0
+    data = cell.model.createData()
+    pin.forwardKinematics(cell.model, data, pin.neutral(cell.model))
+    box_R = np.array([g.placement.rotation for g in objs])  # static: parent joint is the world
+    box_c = offset.copy()
+    ia = np.array([p.index_a for p in cell.pairs], dtype=int)
+    ib = np.array([p.index_b for p in cell.pairs], dtype=int)
+    # pairs of a moving geometry with a static one, grouped by the static geometry
+    static_groups = []
+    for s_idx in np.flatnonzero(static):
+        cols = np.flatnonzero((ib == s_idx) & ~static[ia])
+        cols_b = np.flatnonzero((ia == s_idx) & ~static[ib])
+        cols = np.concatenate([cols, cols_b])
+        if cols.size:
+            moving = np.where(ia[cols] == s_idx, ib[cols], ia[cols])
+            static_groups.append((int(s_idx), cols, moving))
+    cached = {
+        "radius": radius, "half": half, "offset": offset, "by_joint": by_joint, "static": static,
+        "box_R": box_R, "box_c": box_c, "ia": ia, "ib": ib, "static_groups": static_groups,
+    }
+    cell._bounds = cached
+    return cached
+
+
+def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
+    """``(N, P)`` lower bounds of every checked pair's distance [m] for a batch ``q (N, nq)``.
+
+    Bounding sphere against bounding sphere (for overlapping bodies too: the penetration
+    depth of two bodies is at most that of their bounding spheres); against a static
+    geometry, also the moving geometry's sphere against the static one's oriented bounding
+    box when that proves them apart (tighter for long fixtures such as a conveyor). A bound
+    may be negative; it never exceeds the signed distance.
+    """
+    b = _bounds_data(cell)
+    arr = np.asarray(q, dtype=float)
+    N, G = arr.shape[0], len(b["radius"])
+    R, p = cell._placements.joints(arr)
+    c = np.empty((N, G, 3))
+    c[:, b["static"]] = b["box_c"][b["static"]]
+    for j, idx in b["by_joint"].items():
+        c[:, idx] = p[:, j, None, :] + np.matmul(R[:, j], b["offset"][idx].T).transpose(0, 2, 1)
+    ia, ib = b["ia"], b["ib"]
+    lb = np.linalg.norm(c[:, ia] - c[:, ib], axis=-1) - b["radius"][ia] - b["radius"][ib]
+    for s_idx, cols, moving in b["static_groups"]:
+        local = (c[:, moving] - b["box_c"][s_idx]) @ b["box_R"][s_idx]
+        outside = np.maximum(np.abs(local) - b["half"][s_idx], 0.0)
+        box_lb = np.linalg.norm(outside, axis=-1) - b["radius"][moving]
+        # a positive bound proves the pair apart by at least that much; a negative one says
+        # nothing about the penetration depth (the sphere's centre may lie inside the box)
+        lb[:, cols] = np.where(box_lb > 0.0, np.maximum(lb[:, cols], box_lb), lb[:, cols])
+    return lb
+
+
+def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
+    """See :meth:`Cell.clearance`."""
+    margin = _margin(margin)
+    arr, single = cell.robot.check_q(q)
+    N = arr.shape[0]
+    if not cell.pairs:
+        inf = np.full(N, np.inf)
+        nan3 = np.full((N, 3), np.nan)
+        pick = (lambda x: x[0]) if single else (lambda x: x)
+        return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, cell.pairs)
+    dist, pair, pa, pb = exact_min_distance(cell, arr)
+    if single:
+        return Clearance(float(dist[0]), int(pair[0]), pa[0], pb[0], margin, cell.pairs)
+    return Clearance(dist, pair, pa, pb, margin, cell.pairs)
+
+
+def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None):
+    """Exact smallest distance over the checked pairs for each row of ``arr (N, nq)``.
+
+    Returns ``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``.
+    """
+    N = arr.shape[0]
+    if lb is None:
+        lb = pair_lower_bounds(cell, arr)
+    order = np.argsort(lb, axis=1, kind="stable")
+    sorted_lb = np.take_along_axis(lb, order, axis=1)
+    qp = cell.robot.q_to_pinocchio(arr)
+    gm, gd, model, data = cell.collision_model, cell._gd, cell.model, cell._data
+    dist = np.empty(N)
+    best_pair = np.empty(N, dtype=int)
+    pa = np.empty((N, 3))
+    pb = np.empty((N, 3))
+    P = lb.shape[1]
+    for i in range(N):
+        pin.updateGeometryPlacements(model, data, gm, gd, qp[i])
+        best, arg, res_best = np.inf, -1, None
+        row, row_lb = order[i], sorted_lb[i]
+        for r in range(P):
+            if row_lb[r] >= best:
+                break
+            k = int(row[r])
+            res = pin.computeDistance(gm, gd, k)
+            d = res.min_distance
+            if not np.isfinite(d):
+                p = cell.pairs[k]
+                raise CollisionGeometryError(f"coal returned distance {d} for {p.body_a} – {p.body_b}")
+            if d < best:
+                best, arg, res_best = d, k, (np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2()))
+        dist[i], best_pair[i] = best, arg
+        pa[i], pb[i] = res_best
+    return dist, best_pair, pa, pb

@@ -1,0 +1,259 @@
+"""Which pairs of collision geometries a cell checks, and which it never checks (and why).
+
+Like an SRDF's ``disable_collisions`` list, computed once when the cell is loaded. A pair
+of geometries is **not checked** (an :class:`AllowedPair`) for one of these reasons:
+
+``same link``
+    both belong to one link (its primitives overlap by construction);
+``rigid``
+    no joint lies between them (two fixtures, a fixture and an arm's base, the parts of one
+    link group): their distance never changes, so a contact between them is part of the
+    design, not of a motion;
+``adjacent``
+    their links are joined by one joint (``<mimic>`` joints count as part of the joint they
+    follow, so a parallelogram's links are adjacent to their neighbours), or one is the
+    arm's own base and the other is carried by the arm's first joint;
+``out of reach``
+    proven never to touch: every point of a moving geometry stays within a ball around the
+    origin of its arm's first joint (radius: the joint offsets along the chain, the
+    prismatic strokes and the geometry's own bounding sphere, by the triangle inequality),
+    and that ball does not reach the other geometry's bounding box (a fixture) or ball
+    (another arm);
+``always``
+    in contact in at least 95 % of 200 seeded random configurations of the cell (parts of
+    one assembly that overlap whatever the joints do);
+``constant``
+    apart by the same distance (within 1e-9 m) in all those configurations: primitives
+    coaxial with every joint between them (a base and the shoulder housing turning about
+    it), whose gap is a design constant, not something a motion can close.
+
+Unlike the sampled "never in collision" of setup assistants, a pair is only dropped as
+"never" when it is proven (``out of reach``): a sample can miss a rare contact, a bound cannot.
+Every other pair is a :class:`CollisionPair` and is checked.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .cell import Cell
+
+__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES"]
+
+#: Share of random configurations in contact above which a pair is "always" touching.
+ALWAYS_SHARE = 0.95
+#: Random configurations sampled for the "always" rule.
+ALWAYS_SAMPLES = 200
+
+
+@dataclass(frozen=True)
+class CollisionPair:
+    """A checked pair of collision geometries.
+
+    Attributes:
+        index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
+        geometry_a, geometry_b: geometry names (``"<link>_<k>"``).
+        body_a, body_b: link names (an arm's body first).
+        owner_a, owner_b: arm or fixture names.
+        kind: ``"self"`` (one arm), ``"arm-arm"`` or ``"arm-fixture"``.
+    """
+
+    index_a: int
+    index_b: int
+    geometry_a: str
+    geometry_b: str
+    body_a: str
+    body_b: str
+    owner_a: str
+    owner_b: str
+    kind: str
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """``(body_a, body_b)``."""
+        return (self.body_a, self.body_b)
+
+    def __str__(self) -> str:
+        return f"{self.body_a} – {self.body_b}"
+
+
+@dataclass(frozen=True)
+class AllowedPair:
+    """A pair of geometries the cell never checks, and why (see the module doc)."""
+
+    geometry_a: str
+    geometry_b: str
+    body_a: str
+    body_b: str
+    reason: str
+
+
+def _effective(model: pin.Model, j: int) -> int:
+    while j > 0 and "Mimic" in model.joints[j].shortname():
+        j = model.parents[j]
+    return j
+
+
+def _root_joint(model: pin.Model, j: int) -> int:
+    while j > 0 and model.parents[j] > 0:
+        j = model.parents[j]
+    return j
+
+
+def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
+    """Centre and radius of the bounding sphere, and half extents of the local AABB."""
+    geometry.computeLocalAABB()
+    lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
+    center, half = (lo + hi) / 2.0, (hi - lo) / 2.0
+    return center, float(np.linalg.norm(half)), half
+
+
+def _point_box_distance(point: np.ndarray, R: np.ndarray, center: np.ndarray, half: np.ndarray) -> float:
+    local = R.T @ (point - center)
+    return float(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0)))
+
+
+def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
+    """Split every pair of the cell's collision geometries into checked and allowed pairs."""
+    model, gm = cell.model, cell.collision_model
+    objs = list(gm.geometryObjects)
+    G = len(objs)
+    link = [model.frames[g.parentFrame].name for g in objs]
+    owner_of_link: dict[str, str] = {}
+    for arm in cell.spec.arms:
+        for name in arm.links:
+            owner_of_link[name] = arm.name
+    for name in cell.spec.fixtures:
+        owner_of_link[name] = name
+    owner = [owner_of_link.get(name, name) for name in link]
+    is_arm = [name in {a.name for a in cell.spec.arms} for name in owner]
+    joint = [int(g.parentJoint) for g in objs]
+    eff = [_effective(model, j) for j in joint]
+
+    # reach balls of moving geometries, boxes of static ones (world frame, neutral configuration)
+    data = model.createData()
+    gd = pin.GeometryData(gm)
+    q0 = pin.neutral(model)
+    pin.updateGeometryPlacements(model, data, gm, gd, q0)
+    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
+    spheres = [_local_sphere(g.geometry) for g in objs]
+    ball_center = np.zeros((G, 3))
+    ball_radius = np.zeros(G)
+    box_R = np.zeros((G, 3, 3))
+    box_c = np.zeros((G, 3))
+    box_half = np.zeros((G, 3))
+    for k, g in enumerate(objs):
+        center, radius, half = spheres[k]
+        M = gd.oMg[k]
+        box_R[k], box_c[k], box_half[k] = M.rotation, M.rotation @ center + M.translation, half
+        if joint[k] == 0:
+            continue
+        r = _root_joint(model, joint[k])
+        ball_center[k] = data.oMi[r].translation
+        total, j = float(np.linalg.norm(g.placement.act(center))) + radius, joint[k]
+        while j > 0:
+            jm = model.joints[j]
+            if j != r:
+                total += float(np.linalg.norm(model.jointPlacements[j].translation))
+            if _is_prismatic(model, data, j):
+                iq = jm.idx_q
+                scale = abs(jm.extract().scaling) if "Mimic" in jm.shortname() else 1.0
+                stroke = max(abs(lower[iq]), abs(upper[iq])) if np.isfinite(lower[iq]) else np.inf
+                total += scale * stroke
+            j = model.parents[j]
+        ball_radius[k] = total
+
+    checked: list[tuple[int, int]] = []
+    allowed: list[AllowedPair] = []
+
+    def allow(a: int, b: int, reason: str) -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason))
+
+    for a in range(G):
+        for b in range(a + 1, G):
+            if link[a] == link[b]:
+                allow(a, b, "same link")
+                continue
+            ea, eb = eff[a], eff[b]
+            if ea == eb:
+                allow(a, b, "rigid")
+                continue
+            adjacent = (ea > 0 and eb > 0 and (_effective(model, model.parents[ea]) == eb or _effective(model, model.parents[eb]) == ea))
+            if (ea == 0 or eb == 0) and owner[a] == owner[b]:
+                moving = b if ea == 0 else a
+                adjacent = _effective(model, model.parents[eff[moving]]) == 0
+            if adjacent:
+                allow(a, b, "adjacent")
+                continue
+            if _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner):
+                allow(a, b, "out of reach")
+                continue
+            checked.append((a, b))
+
+    # "always": pairs in contact in at least ALWAYS_SHARE of random configurations
+    if checked:
+        probe = pin.GeometryModel()
+        for g in objs:
+            probe.addGeometryObject(g)
+        for a, b in checked:
+            probe.addCollisionPair(pin.CollisionPair(a, b))
+        pd = pin.GeometryData(probe)
+        for req in pd.distanceRequests:
+            req.gjk_tolerance = 1e-12
+        qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
+        hits = np.zeros(len(checked))
+        dmin = np.full(len(checked), np.inf)
+        dmax = np.full(len(checked), -np.inf)
+        for q in np.atleast_2d(qs):
+            pin.updateGeometryPlacements(model, data, probe, pd, q)
+            pin.computeCollisions(probe, pd, False)
+            pin.computeDistances(probe, pd)
+            hits += [r.isCollision() for r in pd.collisionResults]
+            d = np.array([r.min_distance for r in pd.distanceResults])
+            dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
+        keep = []
+        for k, ((a, b), h) in enumerate(zip(checked, hits)):
+            if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
+                allow(a, b, "always")
+            elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
+                allow(a, b, "constant")
+            else:
+                keep.append((a, b))
+        checked = keep
+
+    pairs = []
+    for a, b in checked:
+        if not is_arm[a] and is_arm[b]:
+            a, b = b, a
+        if is_arm[a] and is_arm[b]:
+            kind = "self" if owner[a] == owner[b] else "arm-arm"
+        else:
+            kind = "arm-fixture"
+        pairs.append(CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind))
+    order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
+    pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
+    return tuple(pairs), tuple(allowed)
+
+
+def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
+    motion = np.array(data.joints[j].S).reshape(6, -1)[:, 0]
+    return bool(np.linalg.norm(motion[3:]) < 1e-12)
+
+
+def _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner) -> bool:
+    moving_a, moving_b = joint[a] > 0, joint[b] > 0
+    if moving_a and moving_b:
+        if owner[a] == owner[b]:
+            return False
+        gap = np.linalg.norm(ball_center[a] - ball_center[b]) - ball_radius[a] - ball_radius[b]
+        return bool(gap > 0.0)
+    m, s = (a, b) if moving_a else (b, a)
+    if not (moving_a or moving_b):
+        return False
+    gap = _point_box_distance(ball_center[m], box_R[s], box_c[s], box_half[s]) - ball_radius[m]
+    return bool(gap > 0.0)
