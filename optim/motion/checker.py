@@ -186,6 +186,7 @@ class MotionChecker:
         self.levers = levers[self.cols]
         self.moving_speed = float(sum(np.abs(m.trajectory.peaks().velocity) @ levers[c]
                                       for m, c in zip(self.moving, self._moving_cols)))
+        self._travel_t, self._travel_i = self._moving_travel(levers)
         # the pairs that involve a planned arm, each with its margin
         planned = set(self.arms)
         self.pair_index = np.array([k for k, p in enumerate(cell.pairs) if p.owner_a in planned or p.owner_b in planned],
@@ -209,6 +210,41 @@ class MotionChecker:
         self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0}
 
     # ------------------------------------------------------------------ plumbing
+    def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
+        """Cumulative bound ``I(t)`` [m] of the moving arms' point travel, on a time grid.
+
+        On each bin of width h the point speed is at most ``max(v_a, v_b) + A h / 2`` (``v``
+        from the exact joint speeds at the bin ends times the levers, ``A`` from the exact
+        acceleration peaks), and never more than the exact velocity peaks allow: the rule of
+        :func:`robots.cell.check_motion`. Outside its trajectory an arm holds still.
+        """
+        if not self.moving:
+            return np.array([0.0, 1.0]), np.zeros(2)
+        edges = []
+        for m in self.moving:
+            tr = m.trajectory
+            edges.append(m.offset + np.linspace(0.0, tr.end_time - tr.start_time, bins + 1))
+        grid = np.unique(np.concatenate(edges))
+        speed = np.zeros(grid.size - 1)
+        for m, c in zip(self.moving, self._moving_cols):
+            tr = m.trajectory
+            lev = levers[c]
+            peaks = tr.peaks()
+            cap = float(np.abs(peaks.velocity) @ lev)
+            acc = float(np.abs(peaks.acceleration) @ lev)
+            tau = np.clip(grid - m.offset + tr.start_time, tr.start_time, tr.end_time)
+            v = np.abs(np.asarray(tr.sample(tau)[1], dtype=float).reshape(grid.size, -1)) @ lev
+            h = np.diff(grid)
+            inside = (grid[1:] > m.offset) & (grid[:-1] < m.offset + tr.end_time - tr.start_time)
+            speed += np.where(inside, np.minimum(np.maximum(v[:-1], v[1:]) + acc * h / 2.0, cap), 0.0)
+        cumulative = np.concatenate([[0.0], np.cumsum(speed * np.diff(grid))])
+        return grid, cumulative
+
+    def moving_travel(self, ta: Any, tb: Any) -> np.ndarray:
+        """Bound [m] of how far any point of the moving arms travels between cell times ``ta`` and ``tb``."""
+        I = np.interp(np.asarray(tb, dtype=float), self._travel_t, self._travel_i)
+        return np.abs(I - np.interp(np.asarray(ta, dtype=float), self._travel_t, self._travel_i))
+
     def _pin_is_identity(self) -> bool:
         if self.model.nq != self.cell.nq:
             return False
@@ -309,11 +345,8 @@ class MotionChecker:
 
     # ------------------------------------------------------------------ proofs
     def travel(self, xa: np.ndarray, xb: np.ndarray) -> float:
-        """Bound [m] of how far any point of the geometry moves along the straight edge ``xa → xb``."""
-        T = float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
-        if self.timed:
-            T += self.moving_speed * abs(float(xb[self.n] - xa[self.n]))
-        return T
+        """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
+        return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
     def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False) -> Verdict:
         """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
@@ -403,25 +436,22 @@ class MotionChecker:
             todo = nxt
 
     def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
-        """The samples ``(n+1, dim)`` of the straight edge ``xa → xb`` and their budgets ``(n,)``."""
+        """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
         xa = np.asarray(xa, dtype=float)
         xb = np.asarray(xb, dtype=float)
         T = self.travel(xa, xb)
         n = max(1, int(math.ceil(T / self.step * (1.0 + 1e-12))))
         f = np.arange(n + 1) / n
-        X = xa + f[:, None] * (xb - xa)
-        return X, np.full(n, T / n)
+        return xa + f[:, None] * (xb - xa), np.full(n, T / n)
 
     def edge_valid(self, xa: Any, xb: Any) -> Verdict:
-        """Whether the straight edge ``xa → xb`` keeps every margin everywhere (module docstring).
-
-        With a moving arm, the time coordinate must increase along the edge.
-        """
+        """Whether the straight joint-space edge ``xa → xb`` keeps every margin everywhere (module docstring)."""
+        if self.timed:
+            raise InvalidInput("straight edges are checked with the other arms held; a moving arm is checked "
+                               "along a timed trajectory (trajectory_valid)")
         xa = np.asarray(xa, dtype=float)
         xb = np.asarray(xb, dtype=float)
         self.counts["edges"] += 1
-        if self.timed and not xb[self.n] > xa[self.n]:
-            return Verdict(False, 0, 0.0)
         X, budgets = self.edge_samples(xa, xb)
         n = budgets.size
 
@@ -433,6 +463,60 @@ class MotionChecker:
         if v.ok:
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
+
+    def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
+        """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,
+        against the moving arms at the same instants (and the fixtures, the held arms).
+
+        ``until``: the cell time up to which the proof runs (default: the end of the moving
+        arms' motions, if later than the trajectory's): the planned arms hold their last
+        configuration meanwhile.
+
+        Samples uniform in time so that the planned arms' travel (exact velocity peaks times
+        the levers) plus the moving arms' (:meth:`moving_travel`) is at most ``step`` between
+        two; a halved interval gets each half's own budget."""
+        from pinarms.planning import Trajectory
+
+        tr = trajectory
+        vb = float(np.abs(np.asarray(tr.peaks().velocity, dtype=float)) @ self.levers)
+        if until is None and self.timed:
+            until = max(m.offset + m.trajectory.end_time - m.trajectory.start_time for m in self.moving)
+        end = t0 + tr.end_time - tr.start_time
+        if until is not None and until > end + 1e-12:
+            C = tr.coefficients
+            rest = np.zeros((1, C.shape[1], C.shape[2]))
+            rest[0, 0] = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
+            tr = Trajectory(np.append(tr.knot_times, tr.end_time + (until - end)), np.concatenate([C, rest]))
+        duration = tr.end_time - tr.start_time
+        total = vb * duration + (float(self.moving_travel(t0, t0 + duration)) if self.timed else 0.0)
+        n = max(1, int(math.ceil(total / self.step * (1.0 + 1e-12))))
+        tau = tr.start_time + duration * np.arange(n + 1) / n
+
+        def budget(ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
+            out = vb * (tb - ta)
+            if self.timed:
+                out = out + self.moving_travel(t0 + ta - tr.start_time, t0 + tb - tr.start_time)
+            return out
+
+        def states(taus: np.ndarray) -> np.ndarray:
+            q = np.asarray(tr.sample(taus)[0], dtype=float).reshape(taus.size, -1)
+            return np.column_stack([q, t0 + taus - tr.start_time]) if self.timed else q
+
+        def midpoint(i: int, a: float, b: float, B: float):
+            ta = tau[i] + a * (tau[i + 1] - tau[i])
+            tb = tau[i] + b * (tau[i + 1] - tau[i])
+            tm = 0.5 * (ta + tb)
+            halves = budget(np.array([ta, tm]), np.array([tm, tb]))
+            return states(np.array([tm]))[0], halves[0], halves[1]
+
+        budgets = budget(tau[:-1], tau[1:])
+        if np.any(budgets > self.step * (1.0 + 1e-9)):  # the moving arms' share is uneven: split where needed
+            extra = np.maximum(1, np.ceil(budgets / self.step)).astype(int)
+            first = np.repeat(np.cumsum(extra) - extra, extra)
+            k = np.arange(int(extra.sum())) - first
+            tau = np.append(np.repeat(tau[:-1], extra) + k * np.repeat(np.diff(tau) / extra, extra), tau[-1])
+            budgets = budget(tau[:-1], tau[1:])
+        return self.prove(states(tau), budgets, midpoint)
 
     def path_valid(self, X: np.ndarray) -> Verdict:
         """A polyline through states ``X (M, dim)``: every edge :meth:`edge_valid`."""

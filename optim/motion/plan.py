@@ -44,8 +44,8 @@ from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.planning import JointPath, Trajectory
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["MotionPlan", "ClearanceProfile", "plan_motion", "SIMPLIFIER", "time_path", "clearance_profile",
-           "cell_trajectory"]
+__all__ = ["MotionPlan", "ClearanceProfile", "plan_motion", "plan_geometry", "SIMPLIFIER", "time_path",
+           "clearance_profile", "cell_trajectory"]
 
 #: What shortcuts the path (said in every result).
 SIMPLIFIER = "OMPL PathSimplifier (reduceVertices, partialShortcutPath, ropeShortcutPath), edges proven by pinarms"
@@ -443,26 +443,10 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     constraints, limits = _limits(cell, arms, vmax, amax, torque)
     x0 = _joints(cell, arms, start, "start")
     _check_start(checker, x0, "start")
-    goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
-    G = np.array([g.q for g in goals if g.valid])
-    seconds: dict[str, float] = {}
-    say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
-    result = search(checker, x0, G, planner=key, time_limit=float(time_limit), seed=int(seed))
-    seconds["search"] = result.seconds
-    if result.path is None:
-        raise NoPathFound(
-            f"{result.planner} found no collision-free path in {float(time_limit):g} s ({result.states} states "
-            f"explored, {len(G)} goal configuration(s), margin {checker.margin * 1e3:.1f} mm): raise time_limit, try "
-            "another planner or seed, or lower the margin", planner=result.planner, time_limit=float(time_limit),
-            seconds=result.seconds, states=result.states, goals=len(G))
-    t = time.perf_counter()
-    say(f"path found by {result.planner} in {result.seconds:.3f} s ({result.states} states); shortcutting")
-    simplified = shortcut(checker, result.path, seed=int(seed))
-    seconds["shortcut"] = time.perf_counter() - t
-    t = time.perf_counter()
-    robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
-    path, method, _ = smooth_path(checker, simplified, robot)
-    seconds["smooth"] = time.perf_counter() - t
+    geo = plan_geometry(checker, arms, x0, goal, planner=key, time_limit=float(time_limit), seed=int(seed), frame=frame,
+                        say=say)
+    seconds = dict(geo["seconds"])
+    path, method = geo["path"], geo["smoothing"]
     t = time.perf_counter()
     say(f"smoothed ({method}); timing")
     timing = time_path(path, constraints, grid)
@@ -486,12 +470,44 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     profile = clearance_profile(checker, traj)
     seconds["check"] = time.perf_counter() - t
     seconds["total"] = time.perf_counter() - t_all
-    gi = int(np.argmin(np.linalg.norm(G - result.path[-1], axis=1)))
-    return MotionPlan(cell=cell, arms=arms, start=x0, goal=G[gi], goals=tuple(goals), raw_path=result.path,
-                      simplified=simplified, path=path, smoothing=method, timing=timing, trajectory=traj, check=check,
-                      clearance=profile, hold=checker.hold.copy(), planner=result.planner, seed=int(seed),
-                      time_limit=float(time_limit), margin=checker.margin, self_margin=checker.self_margin,
-                      states=result.states, seconds=seconds, limits=limits)
+    return MotionPlan(cell=cell, arms=arms, start=x0, goal=geo["simplified"][-1], goals=tuple(geo["goals"]),
+                      raw_path=geo["raw"], simplified=geo["simplified"], path=path, smoothing=method, timing=timing,
+                      trajectory=traj, check=check, clearance=profile, hold=checker.hold.copy(), planner=geo["planner"],
+                      seed=int(seed), time_limit=float(time_limit), margin=checker.margin,
+                      self_margin=checker.self_margin, states=geo["states"], seconds=seconds, limits=limits)
+
+
+def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
+                  time_limit: float, seed: int, frame: str | None = None,
+                  say: Callable[[str], None] = lambda _m: None) -> dict:
+    """Steps 1-4 of the module docstring for a checked start: goals, search, shortcut, smoothing.
+
+    Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
+    ``states``, ``seconds``.
+    """
+    cell = checker.cell
+    goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    G = np.array([g.q for g in goals if g.valid])
+    seconds: dict[str, float] = {}
+    say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
+    result = search(checker, x0, G, planner=planner, time_limit=float(time_limit), seed=int(seed))
+    seconds["search"] = result.seconds
+    if result.path is None:
+        raise NoPathFound(
+            f"{result.planner} found no collision-free path in {float(time_limit):g} s ({result.states} states "
+            f"explored, {len(G)} goal configuration(s), margin {checker.margin * 1e3:.1f} mm): raise time_limit, try "
+            "another planner or seed, or lower the margin", planner=result.planner, time_limit=float(time_limit),
+            seconds=result.seconds, states=result.states, goals=len(G))
+    t = time.perf_counter()
+    say(f"path found by {result.planner} in {result.seconds:.3f} s ({result.states} states); shortcutting")
+    simplified = shortcut(checker, result.path, seed=int(seed))
+    seconds["shortcut"] = time.perf_counter() - t
+    t = time.perf_counter()
+    robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
+    path, method, _ = smooth_path(checker, simplified, robot)
+    seconds["smooth"] = time.perf_counter() - t
+    return {"goals": goals, "raw": result.path, "simplified": simplified, "path": path, "smoothing": method,
+            "planner": result.planner, "states": result.states, "seconds": seconds}
 
 
 def _columns(traj: Trajectory, start: int, n: int) -> Trajectory:

@@ -38,7 +38,7 @@ import numpy as np
 from pinarms.robots.errors import CellNotFound, InvalidInput, UnreachableTarget
 
 __all__ = ["Region", "Scene", "Query", "SCENES", "SCENE_DIR", "scene_names", "scene_path", "load_scene",
-           "scene_queries", "region_pose"]
+           "scene_queries", "region_pose", "valid_ik"]
 
 #: Folder of the scene cell files.
 SCENE_DIR = Path(__file__).resolve().parent / "scene_files"
@@ -166,15 +166,18 @@ class Query:
     goal_pose: np.ndarray
 
 
-def _valid_ik(cell: Any, arm: Any, T_world: np.ndarray, hold: np.ndarray, margin: float,
-              rng: np.random.Generator) -> np.ndarray | None:
-    """A configuration of ``arm`` reaching ``T_world`` with clearance >= margin, or None."""
+def valid_ik(checker: Any, T_world: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+    """A configuration of the checker's (one) arm reaching ``T_world`` that is a valid state, or None.
+
+    Closed-form arms: the first valid branch; others: up to 6 seeded numerical solutions."""
     from pinarms.optim.motion.goals import closed_form
 
+    cell = checker.cell
+    arm = cell.arm(checker.arms[0])
     robot = closed_form(arm.robot)
     T = arm.to_base(T_world)
     if robot.has_analytic_ik:
-        cands = np.asarray(robot.ik_all(T)).reshape(-1, arm.nq)
+        cands = np.asarray(robot.ik_all(T), dtype=float).reshape(-1, arm.nq)
     else:
         cands = []
         for _ in range(6):
@@ -183,15 +186,11 @@ def _valid_ik(cell: Any, arm: Any, T_world: np.ndarray, hold: np.ndarray, margin
                                       max_restarts=4))
             except UnreachableTarget:
                 continue
-        cands = np.asarray(cands).reshape(-1, arm.nq)
-    if cands.shape[0] == 0:
-        return None
-    full = np.tile(hold, (cands.shape[0], 1))
-    full[:, arm.q_slice] = cands
-    ok = ~np.asarray(cell.in_collision(full, margin=margin))
-    if not ok.any():
-        return None
-    return cands[int(np.argmax(ok))]
+        cands = np.asarray(cands, dtype=float).reshape(-1, arm.nq)
+    for q in cands:
+        if np.all(np.isfinite(q)) and checker.state_valid(q):
+            return q
+    return None
 
 
 def scene_queries(name: str, n: int = 50, *, seed: int = 0, margin: float = 0.01,
@@ -204,20 +203,22 @@ def scene_queries(name: str, n: int = 50, *, seed: int = 0, margin: float = 0.01
     scene = SCENES[name] if name in SCENES else None
     if scene is None:
         raise CellNotFound(f"unknown planning scene {name!r}; scenes: {', '.join(SCENES)}")
+    from pinarms.optim.motion.checker import MotionChecker
+
     cell = cell if cell is not None else load_scene(name)
     rng = np.random.default_rng(seed)
-    arm = cell.arm(scene.arm)
     hold = cell.neutral.copy()
     for other, region in scene.hold.items():
-        held = cell.arm(other)
+        held = MotionChecker(cell, [other], margin=margin, hold=hold)
         for _ in range(200):
             p = rng.uniform(region.lo, region.hi)
-            q = _valid_ik(cell, held, region_pose(region, p, rng.uniform(-0.5, 0.5)), hold, margin, rng)
+            q = valid_ik(held, region_pose(region, p, rng.uniform(-0.5, 0.5)), rng)
             if q is not None:
-                hold[held.q_slice] = q
+                hold[cell.arm(other).q_slice] = q
                 break
         else:
             raise UnreachableTarget(f"scene {name!r}: no clear configuration of arm {other!r} in region {region.name!r}")
+    checker = MotionChecker(cell, [scene.arm], margin=margin, hold=hold)
     queries: list[Query] = []
     k = len(scene.regions)
     attempts = 0
@@ -229,7 +230,7 @@ def scene_queries(name: str, n: int = 50, *, seed: int = 0, margin: float = 0.01
         ends = []
         for r in (scene.regions[i], scene.regions[j]):
             T = region_pose(r, rng.uniform(r.lo, r.hi), rng.uniform(-np.pi / 6, np.pi / 6))
-            q = _valid_ik(cell, arm, T, hold, margin, rng)
+            q = valid_ik(checker, T, rng)
             if q is None:
                 break
             ends.append((q, T))

@@ -76,16 +76,8 @@ class BulletScene:
                     if pts:
                         best = min(best, min(p[8] for p in pts))
             return best
-        other = self.arms[b][0]
-        m = self.pb.getNumJoints(other, physicsClientId=self.client)
-        for la in range(-1, n):
-            for lb in range(-1, m):
-                if la == -1 and lb == -1:
-                    continue
-                pts = self.pb.getClosestPoints(body, other, 1.0, linkIndexA=la, linkIndexB=lb, physicsClientId=self.client)
-                if pts:
-                    best = min(best, min(p[8] for p in pts))
-        return best
+        pts = self.pb.getClosestPoints(body, self.arms[b][0], 0.25, physicsClientId=self.client)
+        return min((p[8] for p in pts), default=np.inf)
 
     def close(self):
         self.pb.disconnect(self.client)
