@@ -7,7 +7,9 @@ objectives over a box and knows nothing about trajectories. The timing layer
 durations of a planning trajectory into objective and constraint arrays, and checks every
 GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
 limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a whole
-pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back).
+pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back);
+:func:`search_layout` ranks base placements of an arm by the picks per minute of that cycle
+(many cycles, run through :mod:`pinarms.execution`: serial or on Dask).
 :func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
 Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
 :mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
@@ -15,13 +17,17 @@ Cartesian line's joint image) under constraint objects by reachability analysis 
 continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """
 
+from pinarms.optim.cell_cycle import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.exact import ExactSolution, solve_exact
-from pinarms.optim.path_timing import PathTiming, time_optimal
+from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
+                                         search_layout)
+from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -43,8 +49,17 @@ __all__ = [
     "PickPlace",
     "CycleResult",
     "plan_cycle",
+    "search_layout",
+    "LayoutSearch",
+    "Refinement",
+    "grid_candidates",
+    "random_candidates",
     "time_optimal",
+    "time_scaled",
     "PathTiming",
+    "CellCycleReport",
+    "LineSchedule",
+    "schedule_line",
     "TimeJerkResult",
     "jerk_integral",
     "path_velocity_limit",

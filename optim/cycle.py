@@ -45,10 +45,14 @@ from pinarms.planning.trajectory import Peaks
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
-__all__ = ["CYCLE_KINDS", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
+__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "LINE_NAMES", "CycleResult", "PickPlace", "plan_cycle"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
+
+#: How the tcp approaches and leaves pick and place: through the lift points in joint space, or on
+#: straight vertical lines (:mod:`optim.straight_approach`).
+CYCLE_APPROACHES = ("joint", "straight")
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.
 LINE_NAMES = ("lift from pick", "lower to place", "lift from place", "lower to pick")
@@ -186,8 +190,14 @@ class CycleResult:
             while travelling it, per :data:`LINE_NAMES`.
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
+        approach: ``"joint"`` or ``"straight"`` (straight vertical lines at pick and place;
+            ``moves`` are then :class:`optim.straight_approach.StraightMove`).
+        joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
+            the same limits (None otherwise).
         payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
+        cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
+            (:class:`optim.cell_cycle.CellCycleReport`); else None.
     """
 
     robot: str
@@ -205,6 +215,19 @@ class CycleResult:
     branches: np.ndarray = field(repr=False)
     payload: Any = None
     torque_limit: np.ndarray | None = field(default=None, repr=False)
+    approach: str = "joint"
+    joint_cycle_time: float | None = None
+
+    @property
+    def straight_cost(self) -> float | None:
+        """Time [s] the straight approach adds to the joint-space cycle (None for a joint-space cycle)."""
+        return None if self.joint_cycle_time is None else self.cycle_time - self.joint_cycle_time
+
+    @property
+    def line_cost(self) -> float | None:
+        """Time [s] the four straight lines take beyond joint-space lines between the same configurations
+        (same limits, same time scaling; None for a joint-space cycle)."""
+        return None if self.approach != "straight" else float(sum(m.line_cost for m in self.moves))
 
     @property
     def torque_ratios(self) -> np.ndarray | None:
@@ -212,6 +235,7 @@ class CycleResult:
         if self.torque_limit is None:
             return None
         return np.maximum(*(m.torque_ratios for m in self.moves))
+    cell_report: Any = field(default=None, repr=False)
 
     @property
     def one_branch(self) -> bool:
@@ -271,6 +295,11 @@ class CycleResult:
             "payload": None if self.payload is None else self.payload.as_dict(),
             "torque_limit": None if self.torque_limit is None else self.torque_limit.tolist(),
             "torque_ratios": None if self.torque_limit is None else self.torque_ratios.tolist(),
+            **({"cell": self.cell_report.as_dict()} if self.cell_report is not None else {}),
+            "approach": self.approach,
+            "joint_cycle_time_s": self.joint_cycle_time,
+            "straight_cost_s": self.straight_cost,
+            "line_cost_s": self.line_cost,
         }
 
 
@@ -315,7 +344,10 @@ def _limits(robot: Any, vmax: Any, amax: Any, jmax: Any) -> tuple[np.ndarray, An
 
 def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
                jmax: Any = None, method: str = "exact", seed: int = 0, q_start: Any = None,
-               payload: Any = None, torque_limits: Any = False) -> CycleResult:
+               payload: Any = None, torque_limits: Any = False, approach: str = "joint",
+               tool_speed: float | None = None, cell: Any = None, clearance: float = 0.02,
+               arm: str | None = None, hold: Any = None, margin: float = 0.005,
+               lift_step: float = 0.02) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -338,6 +370,17 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         torque_limits: ``True`` (the URDF's ``effort`` limits) or limits per joint [N·m or
             N]: both moves are also timed under joint-torque limits (see
             :func:`optim.minimize_time`); ``False``: kinematic limits only.
+        cell: a :class:`robots.cell.Cell` holding ``robot`` (``cell.arm(name).robot``): the
+            cycle must then keep ``clearance`` [m] from the fixtures and the other arms
+            (held at ``hold``, a cell configuration, default neutral), checked continuously
+            at resolution ``margin`` [m]; it is re-planned (higher lift by ``lift_step``,
+            then via points) until it does (:mod:`optim.cell_cycle`). Points stay in the
+            arm's base frame. ``arm`` names the arm when ``robot`` is not the cell's object.
+        approach: ``"joint"`` (through the lift points in joint space) or ``"straight"``
+            (straight vertical lines at pick and place, time-optimal along them, needs
+            ``amax``; the joint-space cycle is planned too and its time kept in
+            ``joint_cycle_time``: :mod:`optim.straight_approach`).
+        tool_speed: with ``approach="straight"``, a tcp speed limit on the lines [m/s].
 
     Raises:
         InvalidInput: ``spec`` is not a :class:`PickPlace`, or a bad ``q_start``/``kind``.
@@ -348,7 +391,16 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
         InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
+            re-planned cycle keeps the clearance; the message names the blocking bodies.
     """
+    if cell is not None:
+        from pinarms.optim.cell_cycle import plan_cycle_in_cell
+
+        return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
+                                  lift_step=lift_step, plan=plan_cycle, kind=kind, vmax=vmax, amax=amax, jmax=jmax,
+                                  method=method, seed=seed, q_start=q_start, payload=payload,
+                                  torque_limits=torque_limits, approach=approach, tool_speed=tool_speed)
     if not isinstance(spec, PickPlace):
         raise InvalidInput(f"spec must be a PickPlace, got {type(spec).__name__}")
     if kind not in CYCLE_KINDS:
@@ -358,6 +410,18 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
                            "point(s) more: use 'multi-quintic' or 'quintic-bspline'")
     if method not in ("exact", "ga"):
         raise InvalidSettings(f"method={method!r}: use 'exact' or 'ga'")
+    if approach not in CYCLE_APPROACHES:
+        raise InvalidInput(f"approach={approach!r}: use one of {CYCLE_APPROACHES}")
+    if approach == "straight":
+        from pinarms.optim.straight_approach import straight_cycle
+
+        if not (torque_limits is None or torque_limits is False):
+            raise InvalidSettings("approach='straight' times the lines under joint velocity/acceleration (and tool "
+                                  "speed) limits only: a torque limit along a Cartesian path needs a torque path "
+                                  "constraint (planning.path_constraints); use approach='joint' with torque_limits")
+        joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
+                           q_start=q_start)
+        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed)
     v, a, j = _limits(robot, vmax, amax, jmax)
     from pinarms.optim.torque import torque_constraint
 

@@ -56,6 +56,8 @@ def scaled_to_limits(problem: TimingProblem, ratios: np.ndarray) -> tuple[np.nda
     r = np.asarray(ratios, dtype=float)
     r = r / r.sum()
     s = problem.minimal_scale(r) * (1.0 + SAFETY)
+    if not np.isfinite(s):  # no speed meets a limit with these ratios (e.g. gravity beyond a torque limit)
+        return problem.bounds[:, 1].copy(), False
     s = max(s, float(np.max(problem.bounds[:, 0] / r)))
     h = s * r
     return h, bool(np.all(h <= problem.bounds[:, 1] * (1.0 + 1e-12)))

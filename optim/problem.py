@@ -181,6 +181,9 @@ class TimingProblem:
                 raise InvalidSettings(f"the torque limits are for {torque.n_joints} joints but the via points have "
                                       f"{self.n_joints}: give every joint of the arm")
             torque.static_check(q)
+            equal = np.full((1, self.n_segments), 1.0 / self.n_segments)
+            torque.path_static_check(*self.coefficients_batch(equal))
+            self.evaluations = 0
         self.bounds = self._check_bounds(bounds)
 
     # -- trajectories and peaks -------------------------------------------------------

@@ -122,9 +122,36 @@ def feasible_states(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray
     return np.stack([xlo, xhi], axis=1)
 
 
+def _bounds(c: np.ndarray, slope: np.ndarray, offset: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Rows ``c x <= slope y + offset`` as ``x <= Su y + Ou`` (c > 0) and ``x >= Sl y + Ol`` (c < 0).
+
+    Rows that do not apply get the neutral offset (+inf for upper, -inf for lower bounds), so
+    that a step of the loops is a min and a max over whole rows. ``c == 0`` rows are returned
+    as ``0 <= slope y + offset`` conditions (``Zs``, ``Zo``; neutral +inf where they do not apply).
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(c != 0.0, 1.0 / np.where(c != 0.0, c, 1.0), 0.0)
+        up = c > 0.0
+        dn = c < 0.0
+        zero = (c == 0.0) & np.isfinite(offset)
+        Su = np.where(up, slope * inv, 0.0)
+        Ou = np.where(up, offset * inv, np.inf)
+        Sl = np.where(dn, slope * inv, 0.0)
+        Ol = np.where(dn, offset * inv, -np.inf)
+        Zs = np.where(zero, slope, 0.0)
+        Zo = np.where(zero, offset, np.inf)
+    Ou[np.isnan(Ou)] = np.inf
+    Ol[np.isnan(Ol)] = -np.inf
+    return Su, Ou, Sl, Ol, Zs, Zo
+
+
 def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray,
                       x_end: float = 0.0, feasible: np.ndarray | None = None) -> np.ndarray:
     """Controllable sets (N+1, 2) of x, backwards from ``x_end`` (module docstring, step 1).
+
+    The pair inequalities with the two rows of ``K_{i+1} = [λ, μ]`` are linear in μ or λ; their
+    slopes and offsets are computed for every grid point before the loop, so that each step
+    is a few whole-row minima and maxima.
 
     Raises:
         InfeasibleProblem: a set is empty (the path cannot be followed to its end under the rows);
@@ -133,7 +160,7 @@ def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
     a, b, lo, hi = _normalise(a, b, lo, hi)
     X = feasible_states(a, b, lo, hi) if feasible is None else feasible
     N = s.size - 1
-    delta = np.diff(s)
+    two = np.concatenate([2.0 * np.diff(s), [1.0]])[:, None]
     K = np.empty((N + 1, 2))
     tol = 1e-9
     end_lo, end_hi = max(X[N, 0], x_end), min(X[N, 1], x_end)
@@ -141,30 +168,22 @@ def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
         raise InfeasibleProblem(f"the path cannot end with ṡ² = {x_end:g} at s = {s[N]:.6g}: the limits there allow "
                                 f"[{X[N, 0]:.6g}, {X[N, 1]:.6g}]")
     K[N] = (x_end, x_end)
-    Lmask = np.isfinite(lo)
-    Umask = np.isfinite(hi)
+    with np.errstate(invalid="ignore"):
+        # a lower row of the point with x + 2Δu <= μ:  (a − 2Δ b) x <= a μ − 2Δ lo
+        mu_rows = _bounds(np.where(np.isfinite(lo), a - two * b, 0.0), np.where(np.isfinite(lo), a, 0.0),
+                          np.where(np.isfinite(lo), -two * lo, np.inf))
+        # x + 2Δu >= λ with an upper row of the point:  (2Δ b − a) x <= 2Δ hi − a λ
+        lam_rows = _bounds(np.where(np.isfinite(hi), two * b - a, 0.0), np.where(np.isfinite(hi), -a, 0.0),
+                           np.where(np.isfinite(hi), two * hi, np.inf))
+    Su, Ou, Sl, Ol, Zs, Zo = mu_rows
+    Tu, Vu, Tl, Vl, Ys, Yo = lam_rows
     for i in range(N - 1, -1, -1):
         lam, mu = K[i + 1]
-        two = 2.0 * delta[i]
-        xlo, xhi = X[i]
-        ai, bi = a[i], b[i]
-        # lower row of the point with the upper row x + 2Δu <= mu: (a·1 − 2Δ b) x <= a mu − 2Δ lo
-        m = Lmask[i]
-        c = ai[m] - two * bi[m]
-        d = ai[m] * mu - two * lo[i][m]
-        # the lower row x + 2Δu >= lam with an upper row of the point: (2Δ b' − a') x <= 2Δ hi' − a' lam
-        m2 = Umask[i]
-        c = np.concatenate([c, two * bi[m2] - ai[m2], [0.0]])
-        d = np.concatenate([d, two * hi[i][m2] - ai[m2] * lam, [two * (mu - lam)]])
-        pos, neg = c > 0.0, c < 0.0
-        if pos.any():
-            xhi = min(xhi, float(np.min(d[pos] / c[pos])))
-        if neg.any():
-            xlo = max(xlo, float(np.max(d[neg] / c[neg])))
-        zero = ~(pos | neg)
-        if np.any(d[zero] < -tol * np.maximum(1.0, np.abs(d[zero]))):
+        xhi = min(X[i, 1], float(np.min(Su[i] * mu + Ou[i])), float(np.min(Tu[i] * lam + Vu[i])))
+        xlo = max(X[i, 0], float(np.max(Sl[i] * mu + Ol[i])), float(np.max(Tl[i] * lam + Vl[i])), 0.0)
+        zero = min(float(np.min(Zs[i] * mu + Zo[i])), float(np.min(Ys[i] * lam + Yo[i])))
+        if zero < -tol * max(1.0, abs(mu)) or mu < lam - tol * max(1.0, mu):
             xlo = np.inf
-        xlo = max(xlo, 0.0)
         if xlo > xhi + tol * max(1.0, abs(xhi)):
             raise InfeasibleProblem(
                 f"no admissible speed at s = {s[i]:.6g} (grid point {i} of {N}): the limits cannot bring the "
@@ -176,6 +195,9 @@ def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
 def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray, K: np.ndarray,
                    x_start: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The greedy forward pass (module docstring, step 2): ``x`` (N+1,), ``u`` (N,).
+
+    Rows whose ``a`` is below 1e-9 of the row's scale bound x, not u (they were met by the
+    controllable sets); the others bound u by ``(hi − b x) / a`` and ``(lo − b x) / a``.
 
     Raises:
         InfeasibleProblem: ``x_start`` is outside the first controllable set.
@@ -190,25 +212,20 @@ def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     u = np.empty(N)
     x[0] = min(max(x_start, K[0, 0]), K[0, 1])
     scale = np.abs(b).max(axis=1) * np.maximum(K[:, 1], 1.0) + np.where(np.isfinite(hi), np.abs(hi), 0.0).max(axis=1)
+    act = a > 1e-9 * np.maximum(scale, 1e-300)[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(act, 1.0 / np.where(act, a, 1.0), 0.0)
+        up_s = np.where(act & np.isfinite(hi), -b * inv, 0.0)  # u <= up_s x + up_o
+        up_o = np.where(act & np.isfinite(hi), hi * inv, np.inf)
+        dn_s = np.where(act & np.isfinite(lo), -b * inv, 0.0)  # u >= dn_s x + dn_o
+        dn_o = np.where(act & np.isfinite(lo), lo * inv, -np.inf)
     for i in range(N):
         xi = x[i]
         two = 2.0 * delta[i]
-        ai = a[i]
-        act = ai > 1e-9 * max(scale[i], 1e-300)
-        upper = (K[i + 1, 1] - xi) / two
-        lower = (K[i + 1, 0] - xi) / two
-        if act.any():
-            aa, bb = ai[act], b[i][act]
-            h_, l_ = hi[i][act], lo[i][act]
-            fin = np.isfinite(h_)
-            if fin.any():
-                upper = min(upper, float(np.min((h_[fin] - bb[fin] * xi) / aa[fin])))
-            fin = np.isfinite(l_)
-            if fin.any():
-                lower = max(lower, float(np.max((l_[fin] - bb[fin] * xi) / aa[fin])))
-        ui = max(upper, lower) if upper < lower else upper  # rounding only: stay controllable
-        xn = xi + two * ui
-        xn = min(max(xn, K[i + 1, 0]), K[i + 1, 1], X_CAP)
+        upper = min((K[i + 1, 1] - xi) / two, float(np.min(up_s[i] * xi + up_o[i])))
+        lower = max((K[i + 1, 0] - xi) / two, float(np.max(dn_s[i] * xi + dn_o[i])))
+        ui = lower if upper < lower else upper  # rounding only: stay controllable
+        xn = min(max(xi + two * ui, K[i + 1, 0]), K[i + 1, 1], X_CAP)
         u[i] = (xn - xi) / two
         x[i + 1] = xn
     return x, u

@@ -55,20 +55,39 @@ class TorqueConstraint:
     def n_joints(self) -> int:
         return int(self.robot.nq)
 
-    def _torques(self, times: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Torques and gravity torques (P, m, k, n) on the grid, and the positions (P, m, k, n)."""
+    def _torques(self, times: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Torques and positions (P, m, k, n) on the grid."""
         from pinarms.planning.torque import piece_states
 
         q, qd, qdd = piece_states(times, coefs, self.s)
-        shape = q.shape
-        flat = q.reshape(-1, shape[-1])
-        tau = self.robot.inverse_dynamics(flat, qd.reshape(flat.shape), qdd.reshape(flat.shape)).reshape(shape)
-        return tau, q, shape
+        flat = q.reshape(-1, q.shape[-1])
+        tau = self.robot.inverse_dynamics(flat, qd.reshape(flat.shape), qdd.reshape(flat.shape)).reshape(q.shape)
+        return tau, q
 
     def piece_ratios(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
         """``max |tau| / L`` per piece and joint on the grid: (P, m, n)."""
-        tau, _, _ = self._torques(times, coefs)
+        tau, _ = self._torques(times, coefs)
         return np.abs(tau).max(axis=2) / self.limit
+
+    def path_static_check(self, times: np.ndarray, coefs: np.ndarray) -> None:
+        """Refuse a path (one timing's pieces) through a pose the arm cannot hold still, naming it.
+
+        Where ``|g(q)| > L`` no timing of that path exists (slower only tends to ``g``).
+        """
+        from pinarms.planning.torque import piece_states
+
+        q, _, _ = piece_states(np.atleast_2d(times)[:1], np.asarray(coefs)[:1], self.s)
+        q = q[0]  # (m, k, n)
+        g = np.abs(self.robot.gravity(q.reshape(-1, q.shape[-1]))).reshape(q.shape)
+        over = g > self.limit
+        if np.any(over):
+            seg, k, j = (int(i) for i in np.argwhere(over)[0])
+            raise InfeasibleProblem(
+                f"robot '{self.robot.name}' cannot hold the path still between via points {seg} and {seg + 1} "
+                f"(at {self.s[k]:.0%} of that segment, q = {np.round(q[seg, k], 4).tolist()}): joint "
+                f"{self.robot.joint_names[j]} needs {g[seg, k, j]:.4g} N·m against gravity (payload included), "
+                f"its limit is {self.limit[j]:.4g}; no timing helps: lighten the payload or change the path"
+            )
 
     def minimal_scale(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
         """Smallest time scale s (P,) meeting the torque limits on the grid (module docstring).
@@ -76,7 +95,8 @@ class TorqueConstraint:
         ``times``/``coefs`` describe timings at any total; the answer multiplies those
         durations. ``inf`` where a sample cannot be held still (``|g| > L``).
         """
-        tau, q, shape = self._torques(times, coefs)
+        tau, q = self._torques(times, coefs)
+        shape = q.shape
         g = self.robot.gravity(q.reshape(-1, shape[-1])).reshape(shape)
         P = shape[0]
         b = (tau - g).reshape(P, -1, shape[-1])
@@ -105,31 +125,12 @@ class TorqueConstraint:
     def refined_scale(self, trajectory: Any) -> float:
         """Factor (>= 1) on every duration that brings the *refined* torque peaks under the limits.
 
-        The grid misses the exact peak by a hair; the refined peaks (planning's bracketing
-        search) and the scaling law at those instants give the factor, iterated until the
-        refined ratio is within 1e-12.
+        The grid misses the exact peak by a hair; the refined peaks and the scaling law at
+        those instants give the factor (:func:`planning.torque.torque_dilation`).
         """
-        from pinarms.planning.torque import piece_torque_peaks
+        from pinarms.planning.torque import torque_dilation
 
-        factor = 1.0
-        traj = trajectory
-        for _ in range(8):
-            peak, when, _ = piece_torque_peaks(traj, self.robot, self.samples_per_piece)
-            if np.all(peak <= self.limit * (1.0 + 1e-12)):
-                return factor
-            q, qd, qdd, _ = traj.sample(np.clip(when.reshape(-1), traj.start_time, traj.end_time))
-            g = self.robot.gravity(q)
-            b = self.robot.inverse_dynamics(q, qd, qdd) - g
-            L = self.limit
-            with np.errstate(divide="ignore", invalid="ignore"):
-                bound = np.where(b > 0.0, (L - g) / b, np.where(b < 0.0, (L + g) / -b, np.inf))
-            u = float(np.min(bound))
-            if not u > 0.0:
-                return np.inf
-            step = max(1.0 / np.sqrt(u), 1.0) * (1.0 + 1e-12)
-            factor *= step
-            traj = traj.scaled(step)
-        return factor
+        return torque_dilation(trajectory, self.robot, self.limit, self.samples_per_piece)
 
 
 def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,

@@ -25,12 +25,13 @@ import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+from typing import Callable
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
-__all__ = ["ExportedURDF", "export_urdf", "mesh_references"]
+__all__ = ["ExportedURDF", "ExportedMJCF", "export_urdf", "export_mjcf", "mesh_references"]
 
 
 @dataclass(frozen=True)
@@ -119,6 +120,46 @@ def _rewrite_filenames(urdf_text: str, mapping: dict[str, str]) -> str:
     return pattern.sub(repl, urdf_text)
 
 
+def _check_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InvalidInput(f"export folder {str(out)!r} is a file; give a folder path")
+    if out.is_dir() and any(out.iterdir()) and not overwrite:
+        raise InvalidInput(f"export folder {str(out)!r} is not empty; choose another folder or pass overwrite=True")
+    return out
+
+
+def _publish(out: Path, fill: Callable[[Path], None]) -> None:
+    """Fill a temporary sibling folder with ``fill(tmp)``, then rename it to ``out``.
+
+    A failure leaves no half-written folder; an existing ``out`` is removed only after the
+    new one is in place (and put back if the rename fails).
+    """
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
+    try:
+        fill(tmp)
+        old = None
+        if out.exists():
+            if any(out.iterdir()):
+                old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+                old.rmdir()
+                os.rename(out, old)
+            else:
+                out.rmdir()
+        try:
+            os.rename(tmp, out)
+        except OSError:
+            if old is not None:
+                os.rename(old, out)  # put the previous export back
+            raise
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
 def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overwrite: bool = False) -> ExportedURDF:
     """Write a self-contained URDF folder for ``robot_or_name`` into ``out_dir``.
 
@@ -140,12 +181,7 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
     robot = robots.load(robot_or_name) if isinstance(robot_or_name, str) else robot_or_name
     if not isinstance(robot, Robot):
         raise InvalidInput(f"export_urdf takes a robots.Robot or a robot name, got {robot_or_name!r}")
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InvalidInput(f"export folder {str(out)!r} is a file; give a folder path")
-    if out.is_dir() and any(out.iterdir()) and not overwrite:
-        raise InvalidInput(f"export folder {str(out)!r} is not empty; choose another folder or pass overwrite=True")
-
+    out = _check_folder(out_dir, overwrite)
     mapping: dict[str, str] = {}
     copies: dict[PurePosixPath, Path] = {}
     for ref in mesh_references(robot.urdf_text):
@@ -158,32 +194,143 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
                 copies[dest.parent / PurePosixPath(image)] = image_source
     text = _rewrite_filenames(robot.urdf_text, mapping)
 
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
-    try:
-        urdf_name = f"{robot.name}.urdf"
+    urdf_name = f"{robot.name}.urdf"
+
+    def fill(tmp: Path) -> None:
         (tmp / urdf_name).write_text(text, encoding="utf-8")
         for dest, source in copies.items():
             target = tmp / Path(*dest.parts)
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(source, target)
-        old = None
-        if out.exists():
-            if any(out.iterdir()):
-                old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-                old.rmdir()
-                os.rename(out, old)
-            else:
-                out.rmdir()
-        try:
-            os.rename(tmp, out)
-        except OSError:
-            if old is not None:
-                os.rename(old, out)  # put the previous export back
-            raise
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+
+    _publish(out, fill)
     return ExportedURDF(folder=out, urdf=out / urdf_name, meshes=tuple(sorted(str(d) for d in copies)))
+
+
+# --------------------------------------------------------------------------- MuJoCo
+@dataclass(frozen=True)
+class ExportedMJCF:
+    """What :func:`export_mjcf` wrote.
+
+    Attributes:
+        folder: the export folder.
+        mjcf: the MJCF file inside it (``<name>.xml``).
+        sites: the frames that carry a MuJoCo ``site`` of the same name (flange, tcp, ...).
+        meshes: the copied mesh files, relative to ``folder`` (POSIX paths), sorted.
+    """
+
+    folder: Path
+    mjcf: Path
+    sites: tuple[str, ...]
+    meshes: tuple[str, ...]
+
+
+#: Radius of the exported sites [m] (they are markers: no mass, no collision).
+SITE_SIZE_M = 0.01
+
+
+def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites: tuple[str, ...] | None = None,
+                overwrite: bool = False) -> ExportedMJCF:
+    """Write ``robot_or_name`` as a MuJoCo model (MJCF) that keeps the tool point, into ``out_dir``.
+
+    MuJoCo reads URDF itself, and turns ``<mimic>`` into joint equality constraints, but by
+    default it fuses every link attached by a fixed joint into its parent: the massless
+    ``flange`` and ``tcp`` links, and with them the tool point, are lost. This export
+    compiles the URDF with MuJoCo's documented URDF extension
+    ``<mujoco><compiler fusestatic="false"/></mujoco>`` (every link stays a body), saves
+    the compiled model as MJCF, and puts a ``site`` named like the frame at the origin of
+    the bodies in ``sites`` (default: ``flange`` and the robot's tcp frame, where they
+    exist), so ``data.site("tcp").xpos`` is the tcp position in MuJoCo. The mimic equality
+    constraints are made as stiff as MuJoCo allows (``solref`` time constant twice the time
+    step, ``solimp`` 0.99–0.999): a parallelogram is a rigid linkage, and MuJoCo's default
+    soft constraint lets the koji arm's linkage sag by 0.8° under its own weight.
+
+    COLLADA (``.dae``) meshes, which MuJoCo cannot read, are left out of the visual geometry
+    (``discardvisual``); the collision meshes stay. Needs the ``mujoco`` package
+    (``pip install mujoco``, or pinarms' ``mujoco`` extra).
+
+    Raises:
+        InvalidInput: ``out_dir`` is a file, or not empty (without ``overwrite``); a frame
+            of ``sites`` is not a link of the robot.
+        ModelError: ``mujoco`` is not installed, or MuJoCo refuses the model.
+    """
+    try:
+        import mujoco
+    except ImportError as exc:
+        raise ModelError("export_mjcf needs MuJoCo's Python package: pip install mujoco "
+                         "(or pip install 'pinarms[mujoco]')") from exc
+    robot = robots.load(robot_or_name) if isinstance(robot_or_name, str) else robot_or_name
+    if not isinstance(robot, Robot):
+        raise InvalidInput(f"export_mjcf takes a robots.Robot or a robot name, got {robot_or_name!r}")
+    out = _check_folder(out_dir, overwrite)
+    links = {link.get("name") for link in ET.fromstring(robot.urdf_text).iter("link")}
+    if sites is None:
+        sites = tuple(dict.fromkeys(f for f in ("flange", robot.tcp_frame) if f in links))
+    for frame in sites:
+        if frame not in links:
+            raise InvalidInput(f"site {frame!r} is not a link of robot '{robot.name}'; links: {', '.join(sorted(links))}")
+    name = f"{robot.name}.xml"
+    written: dict[str, tuple[str, ...]] = {}
+
+    def fill(tmp: Path) -> None:
+        staged = export_urdf(robot, tmp / "urdf")
+        dae = any(m.lower().endswith(".dae") for m in staged.meshes)
+        extension = (f'<mujoco><compiler fusestatic="false" discardvisual="{"true" if dae else "false"}" '
+                     'strippath="false"/></mujoco>')
+        text = staged.urdf.read_text(encoding="utf-8")
+        head, end, tail = text.rpartition("</robot>")
+        compiled = staged.folder / f"{robot.name}.mujoco.urdf"
+        compiled.write_text(f"{head}{extension}\n{end}{tail}", encoding="utf-8")
+        try:
+            model = mujoco.MjModel.from_xml_path(str(compiled))
+            mujoco.mj_saveLastXML(str(tmp / name), model)
+        except Exception as exc:  # MuJoCo raises ValueError with its own message
+            raise ModelError(f"MuJoCo refuses robot '{robot.name}': {' '.join(str(exc).split())}") from exc
+        tree = ET.parse(tmp / name)
+        for frame in sites:
+            body = tree.getroot().find(f".//body[@name='{frame}']")
+            if body is None:  # pragma: no cover - fusestatic="false" keeps every link
+                raise ModelError(f"MuJoCo dropped the body {frame!r} of robot '{robot.name}'")
+            ET.SubElement(body, "site", {"name": frame, "size": f"{SITE_SIZE_M:g}", "rgba": "0.85 0.15 0.15 1"})
+        _mesh_paths_relative_to(tree, staged.folder, tmp)
+        step = float(model.opt.timestep)
+        for eq in tree.getroot().iter("equality"):
+            for joint in eq.iter("joint"):  # a linkage is rigid: the stiffest constraint the time step allows
+                joint.set("solref", f"{2.0 * step:g} 1")
+                joint.set("solimp", "0.99 0.999 0.001")
+        ET.indent(tree)
+        tree.write(tmp / name, encoding="unicode")
+        kept = [m for m in staged.meshes if not (dae and m.lower().endswith(".dae"))]
+        for mesh in kept:
+            target = tmp / Path(*PurePosixPath(mesh).parts)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(staged.folder / Path(*PurePosixPath(mesh).parts), target)
+        shutil.rmtree(staged.folder)
+        written["meshes"] = tuple(sorted(kept))
+
+    _publish(out, fill)
+    return ExportedMJCF(folder=out, mjcf=out / name, sites=tuple(sites), meshes=written["meshes"])
+
+
+def _mesh_paths_relative_to(tree: ET.ElementTree, source: Path, target: Path) -> None:
+    """Mesh ``file`` attributes of a saved MJCF, relative to ``source``, made relative to ``target``'s layout.
+
+    The staged URDF folder and the final folder hold the meshes at the same relative paths
+    (``meshes/...``), so a path is kept relative and stripped of any absolute prefix.
+    """
+    root = tree.getroot()
+    compiler = root.find("compiler")
+    if compiler is not None:
+        for key in ("meshdir", "assetdir", "texturedir"):
+            compiler.attrib.pop(key, None)
+    for mesh in root.iter("mesh"):
+        file = mesh.get("file")
+        if not file:
+            continue
+        path = Path(file)
+        if path.is_absolute():
+            try:
+                path = path.relative_to(source)
+            except ValueError:
+                continue
+        mesh.set("file", PurePosixPath(*path.parts).as_posix())

@@ -10,6 +10,7 @@ inputs are not printed).
 from __future__ import annotations
 
 import math
+import textwrap
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -106,17 +107,61 @@ def _cells(row: Row) -> list[str]:
 HEADER = ["seed", "quantity", "paper", "pinarms", "unit", "tol", "status", "note"]
 
 
-def format_table(rows: Sequence[Row], title: str = "paper vs pinarms") -> str:
-    """A plain-text table for the terminal."""
+#: When a table must fit a width: the paper's and pinarms' values (tuples) wrap beyond
+#: _VALUE_WIDTH characters, quantity and note share the room left (in these shares), and no
+#: wrapped column gets fewer than _MIN_WRAPPED characters.
+_VALUES = (2, 3)
+_TEXTS = {1: 0.45, 7: 0.55}
+_VALUE_WIDTH = 18
+_MIN_WRAPPED = 10
+
+
+def format_table(rows: Sequence[Row], title: str = "paper vs pinarms", width: int | None = None) -> str:
+    """A plain-text table for the terminal.
+
+    ``width``: wrap the ``quantity`` and ``note`` columns (at word boundaries) so that every
+    line fits in that many characters; ``None`` keeps each row on one line. Only the
+    layout changes: every word of every cell is printed (``table.md`` and ``table.json``
+    hold the same rows unwrapped).
+    """
     cells = [HEADER] + [_cells(r) for r in rows]
-    widths = [max(len(c[i]) for c in cells) for i in range(len(HEADER) - 1)]
+    n = len(HEADER)
+    widths = [max(len(c[i]) for c in cells) for i in range(n)]
+    wrap: set[int] = set()
+    if width is not None:
+        if isinstance(width, bool) or not isinstance(width, int) or width < 40:
+            from pinarms.robots.errors import InvalidInput
+
+            raise InvalidInput(f"table width must be an integer of at least 40 characters, got {width!r}")
+        if sum(widths) + 2 * (n - 1) > width:
+            wrap = set(_VALUES) | set(_TEXTS)
+            for i in _VALUES:
+                widths[i] = min(widths[i], _VALUE_WIDTH)
+            room = width - 2 * (n - 1) - sum(w for i, w in enumerate(widths) if i not in _TEXTS)
+            natural = {i: widths[i] for i in _TEXTS}
+            for i, share in _TEXTS.items():
+                widths[i] = min(natural[i], max(_MIN_WRAPPED, int(room * share)))
+            spare = room - sum(widths[i] for i in _TEXTS)
+            for i in _TEXTS:  # room one text column does not need goes to the other
+                extra = max(0, min(spare, natural[i] - widths[i]))
+                widths[i] += extra
+                spare -= extra
+            excess = sum(widths) + 2 * (n - 1) - width
+            for i in _VALUES:  # still too wide: narrower value columns
+                cut = max(0, min(excess, widths[i] - _MIN_WRAPPED))
+                widths[i] -= cut
+                excess -= cut
     lines = [title, "=" * len(title)]
     for k, c in enumerate(cells):
-        lines.append("  ".join(v.ljust(w) for v, w in zip(c[:-1], widths)) + ("  " + c[-1] if c[-1] else ""))
+        wrapped = [textwrap.wrap(v, widths[i]) or [""] if i in wrap else [v]
+                   for i, v in enumerate(c)]
+        for part in range(max(len(w) for w in wrapped)):
+            parts = [w[part] if part < len(w) else "" for w in wrapped]
+            lines.append("  ".join(v.ljust(w) for v, w in zip(parts[:-1], widths)) + ("  " + parts[-1] if parts[-1] else ""))
         if k == 0:
-            lines.append("  ".join("-" * w for w in widths) + "  ----")
+            lines.append("  ".join("-" * w for w in widths[:-1]) + "  ----")
     lines.append(summary_line(rows))
-    return "\n".join(lines)
+    return "\n".join(line.rstrip() for line in lines)
 
 
 def summary_line(rows: Sequence[Row]) -> str:

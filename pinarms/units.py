@@ -11,7 +11,8 @@ import numpy as np
 
 from pinarms.robots.robot import Robot
 
-__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale"]
+__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale", "mass_kg",
+           "parse_length", "parse_angle"]
 
 
 def prismatic_mask(robot: Robot) -> np.ndarray:
@@ -48,3 +49,54 @@ def joints_from_si(robot: Robot, values: np.ndarray, *, deg: bool, mm: bool) -> 
     """SI joint values → user units (inverse of :func:`joints_to_si`)."""
     scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
     return np.asarray(values, dtype=float) / scale
+
+
+_MASS_UNITS = {"kg": 1.0, "g": 1e-3}
+
+
+def mass_kg(text: str) -> float:
+    """A mass given at the command line (``"3kg"``, ``"1.5 kg"``, ``"800g"``, or a bare number of kg) → kg.
+
+    Raises:
+        robots.errors.InvalidInput: not a finite number with an optional ``kg``/``g`` unit, or negative.
+    """
+    from pinarms.robots.errors import InvalidInput
+
+    raw = str(text).strip().lower()
+    factor = 1.0
+    for unit in ("kg", "g"):
+        if raw.endswith(unit):
+            raw, factor = raw[: -len(unit)].strip(), _MASS_UNITS[unit]
+            break
+    try:
+        value = float(raw) * factor
+    except ValueError:
+        raise InvalidInput(f"a mass must be a number of kg with an optional unit (3kg, 1.5 kg, 800g), got {text!r}") from None
+    if not np.isfinite(value) or value < 0.0:
+        raise InvalidInput(f"a mass must be finite and >= 0 kg, got {text!r}")
+    return value
+
+
+_LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+_ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "°": np.pi / 180.0}
+
+
+def _quantity(text: str, units: dict, default_unit: str, what: str) -> float:
+    import re
+
+    from pinarms.robots.errors import InvalidInput
+
+    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-z°]*)\s*", str(text))
+    if not match or (match.group(2) and match.group(2) not in units):
+        raise InvalidInput(f"{what} must be a number with an optional unit ({', '.join(units)}), got {text!r}")
+    return float(match.group(1)) * units[match.group(2) or default_unit]
+
+
+def parse_length(text: str, what: str = "length") -> float:
+    """``"0.025"``, ``"25mm"``, ``"2.5cm"`` → metres (a bare number is in metres)."""
+    return _quantity(text, _LENGTH_UNITS, "m", what)
+
+
+def parse_angle(text: str, what: str = "angle") -> float:
+    """``"15deg"``, ``"15°"``, ``"0.26rad"`` → radians (a bare number is in degrees)."""
+    return _quantity(text, _ANGLE_UNITS, "deg", what)

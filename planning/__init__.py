@@ -29,7 +29,7 @@ from pinarms.planning.piecewise import PRESETS, piecewise_polynomial, piecewise_
 from pinarms.planning.point_to_point import double_s, trapezoidal
 from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import LimitReport, Peaks, Trajectory, Violation
-from pinarms.planning.torque import TorquePeaks, torque_peaks, torques
+from pinarms.planning.torque import JointTorqueConstraint, TorquePeaks, torque_peaks, torques
 
 __all__ = [
     "Trajectory",
@@ -73,6 +73,7 @@ __all__ = [
     "ConditionCountError",
     "OutOfTimeRange",
     "TorquePeaks",
+    "JointTorqueConstraint",
     "torques",
     "torque_peaks",
     "BlendTooLarge",

@@ -328,7 +328,7 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
     first = _solve_knots(sv, np.array([0.0]), q0[None])[0]
     if first.sigma < sv.singular:
         raise _Stop(0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.4g} "
-                                                f"m/rad < {sv.singular:g} at the start")
+                                         f"m/rad < singular_tolerance {sv.singular:g} at the start")
     # planned knots: the tool path's breaks, each piece cut into steps of at most _INITIAL_STEP
     planned = [0.0]
     for a, b in zip(tool.breaks[:-1], tool.breaks[1:]):
@@ -361,7 +361,8 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
             i, c = np.unravel_index(int(np.argmin(sig_c)), sig_c.shape)
             if h[i] <= locate:
                 raise _Stop(float(sc[i, c]), knots[i].q, "singular",
-                               f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad < singular_tolerance {sv.singular:g}")
+                            f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad "
+                            f"< singular_tolerance {sv.singular:g}")
             bad[i] = True
         if not bad.any():
             break

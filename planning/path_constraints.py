@@ -90,6 +90,12 @@ class PathRows:
         return PathRows(*(np.concatenate([getattr(p, k) for p in parts], axis=1) for k in ("a", "b", "lo", "hi")),
                         tuple(label for p in parts for label in p.labels))
 
+    @staticmethod
+    def concatenate_points(parts: list["PathRows"]) -> "PathRows":
+        """The same rows at the points of several samplings, one after the other."""
+        return PathRows(*(np.concatenate([getattr(p, k) for p in parts], axis=0) for k in ("a", "b", "lo", "hi")),
+                        parts[0].labels)
+
     def values(self, u: np.ndarray, x: np.ndarray) -> np.ndarray:
         """``a u + b x`` (N, m) for per-point ``u``, ``x`` (N,)."""
         return self.a * u[:, None] + self.b * x[:, None]

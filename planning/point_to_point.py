@@ -15,6 +15,7 @@ and then holds its target.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -22,7 +23,7 @@ import numpy as np
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
-from pinarms.planning.trajectory import Trajectory, stack_joints
+from pinarms.planning.trajectory import MAX_DURATION, Trajectory, stack_joints
 
 __all__ = ["trapezoidal", "double_s", "double_s_phases", "trapezoidal_phases"]
 
@@ -89,10 +90,11 @@ def _one_joint(breaks: np.ndarray, coefs: np.ndarray, q1: float, T_own: float, T
         return Trajectory([0.0, T], np.array([[[q1]]]))
     if synchronized:
         lam = T / T_own
-        b = breaks * lam
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            b = breaks * lam
+            c = coefs / (lam ** np.arange(coefs.shape[1]))[None, :]
         b[-1] = T
-        c = coefs / (lam ** np.arange(coefs.shape[1]))[None, :]
-        return Trajectory(b, c[:, :, None])
+        return Trajectory(b, c[:, :, None])  # refuses non-finite coefficients by name
     b = breaks.copy()
     c = coefs
     if T - T_own > 1e-12 * T:
@@ -103,6 +105,13 @@ def _one_joint(breaks: np.ndarray, coefs: np.ndarray, q1: float, T_own: float, T
     else:
         b[-1] = T
     return Trajectory(b, c[:, :, None])
+
+
+def _total(T: float) -> float:
+    if not (math.isfinite(T) and T <= MAX_DURATION):
+        raise TrajectoryError(f"the move would last {T:.3g} s with these limits, more than {MAX_DURATION:.0e} s: "
+                              f"give limits of a physical motion")
+    return T
 
 
 def _endpoints(q0: Any, q1: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -116,6 +125,19 @@ def _endpoints(q0: Any, q1: Any) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+def _quiet_floats(fn: Any) -> Any:
+    """Run ``fn`` without float warnings: absurd limits (1e-300, 1e300) overflow the phase times,
+    and the Trajectory built at the end refuses non-finite or over-long results by name."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with np.errstate(all="ignore"):
+            return fn(*args, **kwargs)
+
+    return wrapper
+
+
+@_quiet_floats
 def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = True) -> Trajectory:
     """Rest-to-rest trapezoidal-velocity move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
 
@@ -131,7 +153,7 @@ def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = 
         Ta, T = trapezoidal_phases(d, v[j], acc[j])
         sign = math.copysign(1.0, b[j] - a[j])
         profiles.append((Ta, T, sign))
-    T = max(p[1] for p in profiles)
+    T = _total(max(p[1] for p in profiles))
     parts = []
     for j, (Ta, Tj_total, sign) in enumerate(profiles):
         if Tj_total == 0.0:
@@ -161,6 +183,7 @@ def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = 
     return stack_joints(parts, definition)
 
 
+@_quiet_floats
 def double_s(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any, *, synchronized: bool = True) -> Trajectory:
     """Rest-to-rest jerk-limited (double-S) move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
 
@@ -184,7 +207,7 @@ def double_s(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any, *, synchronized:
         jerks = [s, 0.0, -s, 0.0, -s, 0.0, s]
         breaks, coefs = _integrate_jerk_phases(a[j], durations, jerks)
         own.append((breaks, coefs, 2.0 * Ta + Tv))
-    T = max(o[2] for o in own)
+    T = _total(max(o[2] for o in own))
     parts = [_one_joint(br, co, b[j], Tt, T, synchronized) for j, (br, co, Tt) in enumerate(own)]
     definition = {
         "kind": "double_s",

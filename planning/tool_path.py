@@ -362,10 +362,10 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
             other = b[k + 1] if corner == k else b[k]
             alpha = float(np.arccos(np.clip(e[corner - 1] @ e[corner], -1.0, 1.0)))
             fits = max(d[k] - other, 0.0) / (np.tan(0.5 * alpha) if arc[corner] else 1.0)
+            shared = f", {other:.6g} m already used by the other blend" if other else ""
             raise BlendTooLarge(
                 f"the blend of radius {used[corner]:g} m at pose {corner} needs {b[corner]:.6g} m of line {k} "
-                f"(poses {k}–{k + 1}, {d[k]:.6g} m long{f', {other:.6g} m already used by the next blend' if other else ''}); "
-                f"use a radius <= {fits:.6g} m there"
+                f"(poses {k}–{k + 1}, {d[k]:.6g} m long{shared}); use a radius <= {fits:.6g} m there"
             )
 
     pieces: list = []

@@ -12,6 +12,10 @@ the largest ``|tau_j|`` of every piece and joint is then refined by a bracketing
 about 1e-7 of the grid spacing). A peak narrower than the grid spacing can be missed; raise
 ``samples_per_piece`` for very fast, long pieces.
 
+Along a geometric path (:func:`optim.time_optimal`) the torque is linear in (s̈, ṡ²):
+:class:`JointTorqueConstraint` gives those rows to the time-optimal path scaling like the
+other :mod:`planning.path_constraints`.
+
 The batched helpers (:func:`piece_states`, :func:`piece_torques`) work on the coefficient
 arrays of a whole population of timings (``(P, m, K+1, n)``, as the ``*_batch``
 constructors return them), so that an optimiser gets every individual's torques from one
@@ -28,9 +32,12 @@ import numpy as np
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
 from pinarms.planning.extrema import derivative_coefficients
+from pinarms.planning.path_constraints import PathConstraint, PathRows
 
 __all__ = [
     "SAMPLES_PER_PIECE",
+    "JointTorqueConstraint",
+    "torque_dilation",
     "TorquePeaks",
     "torques",
     "torque_peaks",
@@ -210,3 +217,80 @@ def check_torque_limit(limit: Any, n_joints: int) -> np.ndarray:
     if np.any(arr <= 0.0):
         raise TrajectoryError(f"torque limit must be positive for every joint, got {arr.tolist()}")
     return arr
+
+
+def torque_dilation(trajectory: Any, robot: Any, limit: Any, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
+    """Smallest uniform time dilation f >= 1 after which the refined torque peaks are within ``limit``.
+
+    Scaling every duration by f leaves the path and the normalised instants unchanged and
+    gives ``tau(f) = (tau - g) / f² + g`` (``g`` the gravity torque there): at the refined peak
+    instants the f each needs follows in closed form; repeated (at most 8 times) until the
+    refined peaks are within the limits to 1e-12. ``inf`` when a peak is (nearly) all gravity
+    beyond the limit: no speed helps.
+    """
+    L = check_torque_limit(limit, trajectory.n_joints)
+    factor = 1.0
+    traj = trajectory
+    for _ in range(8):
+        peak, when, _ = piece_torque_peaks(traj, robot, samples_per_piece)
+        if np.all(peak <= L * (1.0 + 1e-12)):
+            return factor
+        q, qd, qdd, _ = traj.sample(np.clip(when.reshape(-1), traj.start_time, traj.end_time))
+        g = robot.gravity(q)
+        b = robot.inverse_dynamics(q, qd, qdd) - g
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.where(b > 0.0, (L - g) / b, np.where(b < 0.0, (L + g) / -b, np.inf))
+        u = float(np.min(bound))
+        if not u > 0.0:
+            return float("inf")
+        step = max(1.0 / np.sqrt(u), 1.0) * (1.0 + 1e-12)
+        factor *= step
+        traj = traj.scaled(step)
+    return factor
+
+
+class JointTorqueConstraint(PathConstraint):
+    """``|tau_j| <= limit_j`` [N·m or N] along a geometric path, for :func:`optim.time_optimal`.
+
+    With ``u = s̈`` and ``x = ṡ²`` the inverse dynamics along ``q(s)`` is
+    ``tau = M(q) q' u + (M(q) q'' + C(q, q') q') x + g(q)``, so the rows are ``a = M q'``,
+    ``b = M q'' + C(q, q') q'`` and ``-limit - g <= a u + b x <= limit - g``, all from the
+    robot's RNEA (three batched calls per grid). Gravity beyond a limit at some s leaves no
+    feasible speed there (the timing says where).
+
+    Args:
+        robot: the arm, with its payload (``robot.with_payload``); default the path's robot.
+        limit: torque limits, scalar or per joint [N·m or N]; ``None``: the robot's URDF efforts.
+    """
+
+    name = "joint torque"
+
+    def __init__(self, robot: Any = None, limit: Any = None) -> None:
+        self.robot = robot
+        self.limit = limit
+
+    def _arm_and_limit(self, robot: Any, n: int) -> tuple[Any, np.ndarray]:
+        arm = self.robot if self.robot is not None else robot
+        if arm is None:
+            raise TrajectoryError("JointTorqueConstraint needs a robot: JointTorqueConstraint(robot=arm) or a path with one")
+        _robot_joints(arm, n)
+        limit = arm.effort_limit if self.limit is None else self.limit
+        if self.limit is None and not np.all(np.asarray(limit, dtype=float) > 0.0):
+            raise TrajectoryError(f"robot '{arm.name}' has no effort limit for some joint in its URDF: give limit=[...]")
+        return arm, check_torque_limit(limit, n)
+
+    def rows(self, samples: Any) -> PathRows:
+        """Linear bounds on (s̈, ṡ²) at the samples (see the class docstring)."""
+        n = samples.dq.shape[1]
+        arm, L = self._arm_and_limit(getattr(samples.path, "robot", None), n)
+        zero = np.zeros_like(samples.q)
+        g = arm.gravity(samples.q)
+        a = arm.inverse_dynamics(samples.q, zero, samples.dq) - g
+        b = arm.inverse_dynamics(samples.q, samples.dq, samples.ddq) - g
+        return PathRows(a, b, -L - g, L - g, tuple(f"torque of joint {j + 1}" for j in range(n)))
+
+    def exact_dilation(self, trajectory: Any) -> float:
+        """Uniform dilation making the timed trajectory's refined torque peaks meet the limits (:func:`torque_dilation`)."""
+        traj = getattr(trajectory, "trajectory", trajectory)
+        arm, L = self._arm_and_limit(None, traj.n_joints)
+        return torque_dilation(traj, arm, L)

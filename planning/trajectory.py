@@ -38,6 +38,10 @@ __all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
 #: Most instants :meth:`Trajectory.at_rate` produces (10 million: 1.3 GB for 4 arrays of 4 joints).
 MAX_SAMPLES = 10_000_000
 
+#: Longest trajectory accepted (s): 10⁹ s is about 32 years; anything longer comes from limits or
+#: times beyond any physical motion, and its powers of time would overflow float64 when sampled.
+MAX_DURATION = 1e9
+
 #: Names of the derivative orders, as used in :class:`Violation` and the peak report.
 _KIND_BY_ORDER = {1: "velocity", 2: "acceleration", 3: "jerk"}
 
@@ -127,6 +131,11 @@ class Trajectory:
         if np.any(np.diff(b) <= 0.0):
             i = int(np.argmax(np.diff(b) <= 0.0))
             raise TrajectoryError(f"breaks must be strictly increasing; breaks[{i + 1}] = {float(b[i + 1])!r} <= {float(b[i])!r}")
+        if b[-1] - b[0] > MAX_DURATION:
+            raise TrajectoryError(
+                f"the trajectory would last {float(b[-1] - b[0]):.3g} s, more than {MAX_DURATION:.0e} s (about 32 years): "
+                f"its limits or times are beyond any physical motion"
+            )
         if c.ndim == 2:
             c = c[:, :, None]
         if c.ndim != 3 or c.shape[0] != b.size - 1 or c.shape[1] < 1 or c.shape[2] < 1:
@@ -246,13 +255,30 @@ class Trajectory:
         tau = tt - self._breaks[seg]
         powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
         powers[:, 0] = 1.0
-        for k in range(1, self.degree + 1):
-            np.multiply(powers[:, k - 1], tau, out=powers[:, k])
+        with np.errstate(over="ignore", invalid="ignore"):
+            for k in range(1, self.degree + 1):
+                np.multiply(powers[:, k - 1], tau, out=powers[:, k])
         out = np.empty((tt.size, 4 * n))
+        with np.errstate(over="ignore", invalid="ignore"):
+            self._evaluate(powers, D, seg, out)
+        if not np.all(np.isfinite(out)):
+            i = int(np.argmax(~np.all(np.isfinite(out), axis=1)))
+            raise TrajectoryError(
+                f"the trajectory's values overflow float64 at t = {float(tt[i])!r} s (its times or coefficients are "
+                f"beyond any physical motion: check the limits and times it was built from)"
+            )
+        q, qd, qdd, qddd = (out[:, r * n : (r + 1) * n] for r in range(4))
+        if scalar:
+            return q[0].copy(), qd[0].copy(), qdd[0].copy(), qddd[0].copy()
+        return q, qd, qdd, qddd
+
+    def _evaluate(self, powers: np.ndarray, D: np.ndarray, seg: np.ndarray, out: np.ndarray) -> None:
+        """``out[i] = powers[i] @ D[seg[i]]``, grouped by segment."""
+        m = self.n_segments
         if m == 1:
             np.matmul(powers, D[0], out=out)
         else:
-            sorted_input = tt.size < 2 or bool(np.all(seg[1:] >= seg[:-1]))
+            sorted_input = seg.size < 2 or bool(np.all(seg[1:] >= seg[:-1]))
             order = None if sorted_input else np.argsort(seg, kind="stable")
             seg_sorted = seg if order is None else seg[order]
             edges = np.searchsorted(seg_sorted, np.arange(m + 1))
@@ -263,10 +289,6 @@ class Trajectory:
                 else:
                     idx = order[lo:hi]
                     out[idx] = powers[idx] @ D[s]
-        q, qd, qdd, qddd = (out[:, r * n : (r + 1) * n] for r in range(4))
-        if scalar:
-            return q[0].copy(), qd[0].copy(), qdd[0].copy(), qddd[0].copy()
-        return q, qd, qdd, qddd
 
     def __call__(self, t: Any) -> np.ndarray:
         """Positions only: ``sample(t)[0]``."""

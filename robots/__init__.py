@@ -103,3 +103,30 @@ from .cell import (  # noqa: E402
 
 __all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
             "load_cell"]
+
+# reachability maps: tool poses per voxel, orientation sets, HDF5 files
+from .orientations import (  # noqa: E402
+    OrientationSet,
+    so3_orientations,
+    tool_axis_orientations,
+    tool_down_orientations,
+)
+from .reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
+from .reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
+from .base_placement import BasePlacements, base_placements, tool_down_poses  # noqa: E402
+
+__all__ += [
+    "ReachabilityMap",
+    "reachability_map",
+    "reach_bound",
+    "OrientationSet",
+    "so3_orientations",
+    "tool_axis_orientations",
+    "tool_down_orientations",
+    "ReachabilityFileError",
+    "save_reachability",
+    "load_reachability",
+    "BasePlacements",
+    "base_placements",
+    "tool_down_poses",
+]

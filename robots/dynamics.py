@@ -230,7 +230,9 @@ def with_payload(robot: "Robot", mass: Any, com: Any = None, inertia: Any = None
         InvalidInput: ``robot`` has no frame ``frame``.
     """
     load = as_payload(mass, com=com, inertia=inertia, frame=frame)
-    base_model = getattr(robot, "_model_without_payload", None) or robot.model
+    base_model = getattr(robot, "_model_without_payload", None)
+    if base_model is None:
+        base_model = robot.model
     model = pin.Model(base_model)
     if load is not None and (load.mass > 0.0):
         fid = robot.frame_id(load.frame)

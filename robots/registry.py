@@ -6,19 +6,22 @@ what it accepts; ``from_urdf(path)`` loads any other URDF.
 
 from __future__ import annotations
 
+import difflib
 import importlib.metadata
 import importlib.resources
 import xml.etree.ElementTree as ET
+import xml.parsers.expat
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 
-__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info"]
+__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest"]
 
 
 @dataclass(frozen=True)
@@ -78,7 +81,31 @@ def info(name: str) -> RobotInfo:
         return _BUILTIN[name]
     if name in _EXAMPLE:
         return _EXAMPLE[name]
-    raise RobotNotFound(f"unknown robot {name!r}; known robots: {', '.join(names())} (or use robots.from_urdf(path))")
+    close = suggest(name)
+    hint = f"did you mean {' or '.join(close)}? " if close else ""
+    raise RobotNotFound(f"unknown robot {name!r}; {hint}known robots: {', '.join(names())} "
+                        "(or use robots.from_urdf(path))")
+
+
+def suggest(name: str, limit: int = 3) -> list[str]:
+    """Known robot names close to ``name`` (a typo, another case, ``-`` for ``_``), closest first.
+
+    Names are compared lowered, with ``-`` and spaces read as ``_``: an exact match after
+    that comes alone; then the names that contain ``name`` (3 characters or more, e.g.
+    ``koji``), in registry order; then :func:`difflib.get_close_matches` (similarity ratio
+    ≥ 0.6), at most ``limit`` in all.
+    """
+    def norm(text: str) -> str:
+        return text.lower().replace("-", "_").replace(" ", "_")
+
+    known = names()
+    by_norm = {norm(k): k for k in known}
+    key = norm(name)
+    if key in by_norm:
+        return [by_norm[key]]
+    found = [k for k in by_norm if len(key) >= 3 and key in k]
+    found += [k for k in difflib.get_close_matches(key, list(by_norm), n=limit, cutoff=0.6) if k not in found]
+    return [by_norm[k] for k in found[:limit]]
 
 
 @lru_cache(maxsize=1)
@@ -164,7 +191,17 @@ def from_urdf_text(
     freeze: tuple[str, ...] = (),
     description: str = "",
 ) -> Robot:
-    """Build a :class:`Robot` from URDF text (see :func:`from_urdf`)."""
+    """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
+
+    Raises:
+        InvalidInput: ``urdf_text`` is not a string.
+        ModelError: not well-formed XML, not a URDF, a DOCTYPE or entity declaration
+            (URDF has none; Pinocchio's parser would not expand them), joint limits with
+            lower > upper or negative speed/effort, or Pinocchio rejects the model.
+    """
+    if not isinstance(urdf_text, str):
+        raise InvalidInput(f"urdf_text must be the URDF as a string, got {type(urdf_text).__name__}")
+    _refuse_dtd(urdf_text, source)
     try:
         root = ET.fromstring(urdf_text)
     except ET.ParseError as exc:
@@ -182,6 +219,7 @@ def from_urdf_text(
         raise ModelError(f"Pinocchio cannot build a model from {source}: {exc}") from exc
     if model.nv == 0:
         raise ModelError(f"{source} has no movable joint")
+    _check_limits(model, source)
     if tcp is None:
         tcp = "tcp" if model.existFrame("tcp") else _last_body_frame(model)
     return Robot(
@@ -193,6 +231,52 @@ def from_urdf_text(
         tcp_frame=tcp,
         description=description,
     )
+
+
+def _refuse_dtd(text: str, source: str) -> None:
+    """ModelError when the XML declares a DOCTYPE or entities (expat reads the prolog only)."""
+
+    def refuse(*_: object) -> None:
+        raise ModelError(
+            f"{source} declares a DOCTYPE or XML entities; URDF uses neither and Pinocchio's parser does not expand "
+            f"them (entity expansion is refused): expand them first, e.g. with xacro"
+        )
+
+    parser = xml.parsers.expat.ParserCreate()
+    parser.StartDoctypeDeclHandler = refuse
+    parser.EntityDeclHandler = refuse
+    parser.StartElementHandler = _stop_at_root
+    try:
+        parser.Parse(text, True)
+    except (xml.parsers.expat.ExpatError, _RootReached):
+        pass  # malformed XML is reported by the parse that follows; the root element ends the prolog
+
+
+class _RootReached(Exception):
+    """Raised by the prolog scan at the first element."""
+
+
+def _stop_at_root(*_: object) -> None:
+    raise _RootReached
+
+
+def _check_limits(model: pin.Model, source: str) -> None:
+    """ModelError for position limits with lower > upper, or negative speed or effort limits."""
+    for i in range(1, model.njoints):
+        j = model.joints[i]
+        if j.nq == 0 or "Mimic" in j.shortname():
+            continue
+        name = model.names[i]
+        lo = model.lowerPositionLimit[j.idx_q: j.idx_q + j.nq]
+        hi = model.upperPositionLimit[j.idx_q: j.idx_q + j.nq]
+        if np.any(lo > hi):
+            raise ModelError(f"{source}: joint {name!r} has lower limit {lo.tolist()} above its upper limit "
+                             f"{hi.tolist()}; swap them")
+        v = model.velocityLimit[j.idx_v: j.idx_v + j.nv]
+        e = model.effortLimit[j.idx_v: j.idx_v + j.nv]
+        if np.any(v < 0) or np.any(e < 0):
+            raise ModelError(f"{source}: joint {name!r} has a negative velocity or effort limit "
+                             f"({v.tolist()}, {e.tolist()}); limits are magnitudes")
 
 
 def from_urdf(

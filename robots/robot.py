@@ -30,7 +30,7 @@ from ._checks import check_seed as _check_seed
 from ._checks import check_tolerance as _check_tolerance
 from .errors import InvalidInput, ModelError, UnreachableTarget
 from .ik.numerical import NumericalIK
-from .ik.solver import split_by_target
+from .ik.solver import LIMIT_TOL, split_by_target
 from .kinematic_tree import KinematicTree
 
 __all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
@@ -55,6 +55,11 @@ class _PerThread(threading.local):
 
 
 _PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
+
+
+def _limit_tolerance(value: Any) -> float:
+    """``limit_tolerance`` checked (a finite distance ≥ 0, rad or m), at least the solvers' own 1e-9."""
+    return max(_check_tolerance(value, "limit_tolerance [rad or m]"), LIMIT_TOL)
 
 
 class Robot:
@@ -436,7 +441,8 @@ class Robot:
         return arr, single
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False
+        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False,
+        limit_tolerance: float = 0.0,
     ) -> np.ndarray | list[np.ndarray]:
         """Every closed-form IK branch within the joint limits (tolerance 1e-9 rad or m), each once.
 
@@ -454,6 +460,9 @@ class Robot:
             respect_limits: ``False`` returns the geometric solutions whatever the joint
                 limits (each revolute angle once, in ``(-π, π]``), e.g. to see how far a
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
+            limit_tolerance: accept solutions up to this far outside a joint's range [rad or
+                m] (returned as they are, never clamped), e.g. a printed pose that needs a
+                joint a rounding error past its limit (see :mod:`robots.ik.near_limits`).
 
         Returns:
             ``(k, nq)`` for one target (``k = 0`` allowed: see :meth:`ik_failure_reason`), a
@@ -464,10 +473,11 @@ class Robot:
             ModelError: the arm has no closed form (use :meth:`ik`).
         """
         T, single, ref = self._analytic_targets(target, q_ref)
+        limit_tol = _limit_tolerance(limit_tolerance)
         if T.shape[0] == 0:
             return []
         if respect_limits:
-            sols = self._analytic_ik.solve(T, ref, equivalents=bool(equivalents))
+            sols = self._analytic_ik.solve(T, ref, equivalents=bool(equivalents), limit_tol=limit_tol)
         else:
             idx, q = self._analytic_ik.candidates(T, ref, respect_limits=False)
             sols = split_by_target(idx, q, T.shape[0])
@@ -588,6 +598,7 @@ class Robot:
         tol: float = 1e-10,
         max_restarts: int = 40,
         seed: int | np.random.Generator | None = 0,
+        limit_tolerance: float = 0.0,
     ) -> np.ndarray:
         """A configuration within the limits whose tcp meets ``target`` within ``tol``: ``(nq,)``, or ``(N, nq)`` for a batch.
 
@@ -611,6 +622,9 @@ class Robot:
             tol: required position error [m] and rotation error [rad].
             max_restarts: random restarts after the first attempt (per target).
             seed: seed or generator of the restarts (results are reproducible).
+            limit_tolerance: one target: when no configuration within the limits meets it,
+                accept one up to this far outside a joint's range [rad or m] (not clamped; a
+                configuration within the limits is always preferred). Not for batches.
 
         Raises:
             InvalidInput: a malformed target or ``q_seed`` (shape, NaN/inf, not a proper
@@ -627,7 +641,10 @@ class Robot:
         if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
             raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
         _check_seed(seed)
+        limit_tol = _limit_tolerance(limit_tolerance)
         if not single:
+            if limit_tol > LIMIT_TOL:
+                raise InvalidInput("limit_tolerance is for one target; solve a batch within the limits, or one by one")
             return self._ik_batch(T, q_seed, position_only, tol, int(max_restarts), seed)
         seed_q = None
         if q_seed is not None:
@@ -655,7 +672,30 @@ class Robot:
         )
         if res.success and self.within_limits(res.q):
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        if limit_tol > LIMIT_TOL:
+            q = self._ik_within_tolerance(T0, seed_q, res.q, position_only, tol, limit_tol)
+            if q is not None:
+                return q
         raise UnreachableTarget(self._ik_failure_text(T0, position_only, tol, res))
+
+    def _ik_within_tolerance(self, T: np.ndarray, seed_q: np.ndarray | None, best: np.ndarray,
+                             position_only: bool, tol: float, limit_tol: float) -> np.ndarray | None:
+        """A configuration meeting ``T`` within ``tol`` and the limits widened by ``limit_tol``, or None.
+
+        Starts: the closed-form branches within the widened limits, then ``best`` (the
+        strict search's closest configuration); each refined with the joints free.
+        """
+        solver = self._numerical_ik()
+        starts = [best]
+        if self._analytic_ik is not None and not position_only:
+            ref = self.neutral if seed_q is None else seed_q
+            starts = list(self._analytic_ik.starts(T, ref, limit_tol)[:4]) + starts
+        for q in starts:
+            q2, pe, re, _ = solver.attempt(np.array(q, dtype=float), T, position_only, tol, limits=False)
+            q2 = self._wrapped_to_range(q2)
+            if pe <= tol and re <= tol and self.within_limits(q2, tol=limit_tol):
+                return q2
+        return None
 
     def _ik_failure_text(self, T0: np.ndarray, position_only: bool, tol: float, res) -> str:
         reason = self.ik_failure_reason(T0[:3, 3] if position_only else T0, position_only=position_only)

@@ -12,8 +12,11 @@ motion-planning setup tools (e.g. MoveIt's setup assistant), with pinarms' rules
 3. *always* collisions: pairs in contact in at least 95 % of 200 random configurations
    (seeded), i.e. overlapping primitives of one rigid assembly.
 
-Checking is one Pinocchio/coal call per configuration (not batched): use it on
-sub-samples of a few thousand configurations.
+:meth:`SelfCollision.in_collision` runs coal's broad phase (a dynamic AABB tree culls the
+pairs whose boxes are apart) through Pinocchio: one call for one configuration, and
+Pinocchio's C++ batch (``computeCollisionsInParallel``) for a batch, so no Python runs per
+configuration. Per-pair answers (:meth:`colliding_pairs`, a ``pairs`` mask) loop in
+Python over the configurations: use them on sub-samples of a few thousand.
 
 *Core* bodies are those fixed to the base or carried only by the first ``core_joints``
 joints of the chain to the tool (for a floor-standing arm: the base and the turret turning
@@ -29,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from .collision_requests import cold_start
 from .errors import InvalidInput, ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -70,7 +74,7 @@ class SelfCollision:
                 if not adjacent:
                     gm.addCollisionPair(pin.CollisionPair(a, b))
         self._gm = gm
-        self._gd = pin.GeometryData(gm)
+        self._gd = cold_start(pin.GeometryData(gm))
         self._data = model.createData()
         # default and always-colliding pairs
         q_probe = np.vstack([robot.neutral[None, :], robot.random_q(_ALWAYS_SAMPLES, seed=seed)])
@@ -78,12 +82,25 @@ class SelfCollision:
         drop = hits[0] | (hits[1:].mean(axis=0) >= _ALWAYS_SHARE) if hits.size else np.zeros(0, bool)
         for k in sorted(np.flatnonzero(drop), reverse=True):
             gm.removeCollisionPair(gm.collisionPairs[int(k)])
-        self._gd = pin.GeometryData(gm)
+        self._gd = cold_start(pin.GeometryData(gm))
         names = [g.name for g in gm.geometryObjects]
         self.pairs = np.array([(names[p.first], names[p.second]) for p in gm.collisionPairs], dtype=object).reshape(-1, 2)
         self._pair_joints = np.array(
             [(eff[p.first], eff[p.second]) for p in gm.collisionPairs], dtype=int
         ).reshape(-1, 2)
+        self._bp_gd = cold_start(pin.GeometryData(gm))
+        self._bp_data = model.createData()
+        self._manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(model, gm, self._bp_gd)
+        self._pool = None
+        index = np.full(robot.nq, -1, dtype=int)  # cell of each coordinate in Pinocchio's q
+        plain = True
+        for i in range(1, model.njoints):
+            joint = model.joints[i]
+            if "Mimic" in joint.shortname():
+                continue
+            plain &= joint.nq == 1
+            index[joint.idx_v] = joint.idx_q
+        self._pin_index = index if plain and (index >= 0).all() else None
 
     def core_pair_mask(self, core_joints: int = 1) -> np.ndarray:
         """``(n_pairs,)`` bool: pairs with at least one *core* body (see the module doc).
@@ -133,6 +150,13 @@ class SelfCollision:
             pairs: optional ``(n_pairs,)`` bool mask (e.g. :meth:`core_pair_mask`): only
                 these pairs count.
         """
+        if pairs is None and self._pin_index is not None and type(q) is np.ndarray and q.shape == (self.robot.nq,) \
+                and q.dtype == np.float64 and np.isfinite(q).all():
+            if not self.n_pairs:
+                return False
+            qp = np.zeros(self.robot.model.nq)
+            qp[self._pin_index] = q
+            return bool(pin.computeCollisions(self.robot.model, self._bp_data, self._manager, qp, True))
         arr, single = self.robot.check_q(q)
         if pairs is not None:
             pairs = np.asarray(pairs, dtype=bool)
@@ -140,13 +164,17 @@ class SelfCollision:
                 raise InvalidInput(f"pairs must be a bool mask of shape ({self.n_pairs},), got {pairs.shape}")
             out = self._pair_hits(arr)[:, pairs].any(axis=1) if self.n_pairs else np.zeros(arr.shape[0], bool)
             return bool(out[0]) if single else out
-        qp = self.robot.q_to_pinocchio(arr)
-        out = np.zeros(arr.shape[0], dtype=bool)
-        if self.n_pairs:
-            for i in range(arr.shape[0]):
-                pin.updateGeometryPlacements(self.robot.model, self._data, self._gm, self._gd, qp[i])
-                out[i] = pin.computeCollisions(self._gm, self._gd, True)
-        return bool(out[0]) if single else out
+        qp = np.atleast_2d(self.robot.q_to_pinocchio(arr))
+        if not self.n_pairs:
+            return False if single else np.zeros(arr.shape[0], dtype=bool)
+        if single:
+            return bool(pin.computeCollisions(self.robot.model, self._bp_data, self._manager, qp[0], True))
+        if self._pool is None:
+            self._pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.robot.model, self._gm, 1)
+            for gd in self._pool.getGeometryDatas():
+                cold_start(gd)
+        out = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(qp.T), True, False)
+        return np.asarray(out, dtype=bool).reshape(-1)
 
     def colliding_pairs(self, q: Any) -> list[tuple[str, str]]:
         """Names of the body pairs in contact at one configuration ``q (nq,)``."""

@@ -25,6 +25,7 @@ this one: placement imports workspace, never the other way).
 from __future__ import annotations
 
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -120,12 +121,13 @@ def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]
 
 
 def _positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK
+    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK, progress: Any = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
 
     Uses the robot's compiled kinematic tree for one pass over the joints per chunk
-    (positions and the linear Jacobian columns together), on all cores.
+    (positions and the linear Jacobian columns together), on all cores. ``progress(done, N)``
+    is called after each chunk (from the worker threads, one call at a time).
     """
     fid = robot.frame_id(frame)
     N = q.shape[0]
@@ -149,7 +151,12 @@ def _positions_and_dexterity(
             points[start : start + n, a] = p[a]
         w[start : start + n] = wc
         c[start : start + n] = cc
+        if progress is not None:
+            with lock:
+                done[0] += n
+                progress(done[0], N)
 
+    lock, done = threading.Lock(), [0]
     starts = range(0, N, chunk)
     if len(starts) < 2 or _WORKERS == 1:
         for s in starts:
@@ -523,6 +530,8 @@ def sample_workspace(
             :func:`pinarms.execution.map_chunks` (serial by default, or on Dask). Task ``k``
             draws its slice of the same stream (:func:`random_q_slice`), so the result is
             identical to the one-piece run bit for bit, whoever runs the tasks.
+            ``progress(done, total)`` counts tasks then, samples (per chunk) for a one-piece
+            run; e.g. a :class:`pinarms.progress.ProgressBar`.
 
     Raises:
         InvalidInput: ``n`` is not a positive integer or is above 5·10⁷, ``chunk`` is not positive, or
@@ -548,7 +557,7 @@ def sample_workspace(
         q, points, w, c = _sample_in_tasks(robot, int(n), int(seed), frame, int(chunk), int(task_samples), scheduler, progress)
     else:
         q = robot.random_q(int(n), seed=seed)
-        points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk))
+        points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk), progress)
     return Workspace(
         robot=robot,
         frame=frame,

@@ -97,7 +97,11 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> 
     Raises:
         InvalidInput: the target's folder does not exist or the target is a folder.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InvalidInput(f"a file path must be a str or a path, got {type(path).__name__}")
     target = Path(path)
+    if "\x00" in str(target) or not target.name or target.name in (".", ".."):
+        raise InvalidInput(f"cannot write {str(target)!r}: not a file name")
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")

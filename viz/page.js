@@ -137,3 +137,80 @@
 
   setInterval(tick, 100);
 })();
+
+// Reachability maps (page key "reachability", see viz/page.py): one panel per map with the
+// index colour bar and a slice control over its voxel layers (all / up to / only this layer).
+(function () {
+  "use strict";
+  var PROPERTY = "pinarms_page";
+  var shown = null;
+  var pane = null;
+
+  function el(tag, attrs, parent) {
+    var e = document.createElement(tag);
+    Object.keys(attrs || {}).forEach(function (k) {
+      if (k === "text") e.textContent = attrs[k]; else e.setAttribute(k, attrs[k]);
+    });
+    if (parent) parent.appendChild(e);
+    return e;
+  }
+
+  function panel(m, i, bottom) {
+    var box = el("div", {id: "pinarms-reach-" + i, "class": "pinarms-reach"}, pane);
+    box.style.cssText = "position:absolute;right:12px;pointer-events:auto;background:rgba(255,255,255,.86);" +
+      "border-radius:6px;box-shadow:0 1px 4px rgba(0,0,0,.25);padding:8px 12px;width:300px;bottom:" + bottom + "px";
+    el("div", {"class": "label", text: m.label + ": " + m.name}, box).style.fontWeight = "600";
+    el("div", {"class": "description", text: m.description}, box).style.cssText = "font-size:11px;color:#4a5466";
+    var bar = el("div", {"class": "pinarms-colorbar"}, box);
+    bar.style.cssText = "height:14px;border-radius:2px;margin:4px 0 2px 0;background:linear-gradient(to right," +
+      m.colors.join(",") + ")";
+    var ticks = el("div", {}, box);
+    ticks.style.cssText = "display:flex;justify-content:space-between;font-size:11px;color:#4a5466";
+    ["0", "0.5", "1"].forEach(function (t) { el("span", {text: t}, ticks); });
+    var row = el("div", {}, box);
+    row.style.cssText = "display:flex;gap:6px;align-items:center;margin-top:4px";
+    var mode = el("select", {"class": "pinarms-slice-mode"}, row);
+    [["all", "all layers"], ["below", "layers up to"], ["only", "this layer only"]].forEach(function (o) {
+      el("option", {value: o[0], text: o[1]}, mode);
+    });
+    var n = m.layers.length;
+    var slider = el("input", {"class": "pinarms-slice", type: "range", min: "0", max: String(n - 1), step: "1",
+                              value: String(n - 1)}, row);
+    slider.style.width = "120px";
+    var label = el("span", {"class": "pinarms-slice-label"}, box);
+    label.style.cssText = "font-size:11px;font-variant-numeric:tabular-nums";
+    function apply() {
+      var k = parseInt(slider.value, 10);
+      label.textContent = "z = " + m.layers[k].z_mm + " mm (base frame)";
+      m.layers.forEach(function (layer, j) {
+        var visible = mode.value === "all" || (mode.value === "below" ? j <= k : j === k);
+        window.viewer.set_property(["meshcat"].concat(layer.path.split("/")), "visible", visible);
+      });
+      window.viewer.set_dirty();
+    }
+    slider.addEventListener("input", apply);
+    mode.addEventListener("change", apply);
+    label.textContent = "z = " + m.layers[n - 1].z_mm + " mm (base frame)";
+    return box;
+  }
+
+  function tick() {
+    var m = window.viewer && window.viewer.scene_tree && window.viewer.scene_tree.children.meshcat;
+    var r = m && m.children.pinarms;
+    var text = r && r.object && r.object[PROPERTY];
+    if (!text || text === shown) return;
+    shown = text;
+    var info = JSON.parse(text);
+    if (pane) pane.remove();
+    pane = null;
+    var maps = info.reachability || [];
+    if (!maps.length) return;
+    pane = el("div", {id: "pinarms-reach"}, document.body);
+    pane.style.cssText = "position:absolute;left:0;top:0;width:100%;height:100%;pointer-events:none;" +
+      "font:13px/1.35 system-ui,-apple-system,'Segoe UI',Roboto,sans-serif;color:#1d2533";
+    var bottom = (info.animation && info.animation.duration > 0) || (info.clouds && info.clouds.length) ? 64 : 12;
+    maps.forEach(function (map, i) { bottom += panel(map, i, bottom).offsetHeight + 8; });
+  }
+
+  setInterval(tick, 100);
+})();

@@ -13,6 +13,10 @@ the standalone HTML export and in the live viewer alike, a small script
   ``max``, ``colors`` from low to high),
 - offers play/pause, a time slider and a switch for the clouds (``clouds``,
   ``clouds_visible``, ``animation.duration`` in s).
+- for reachability maps (``reachability``, present only when the scene has one: a list of
+  ``name``, ``description``, ``label``, ``colors`` from index 0 to 1, and ``layers``, each a
+  scene ``path`` and its height ``z_mm``, lowest first), a panel per map with its colour bar
+  and a slice control: all layers, the layers up to a height, or that layer only.
 
 The JSON keys above are the whole contract between the two sides.
 """

@@ -1,4 +1,5 @@
-"""Plots (matplotlib, Agg backend): joint curves, GA convergence, workspace projections.
+"""Plots (matplotlib, Agg backend): joint curves, tcp speed, GA convergence, workspace projections,
+clearance over time and multi-arm schedules.
 
 Figures are drawn on matplotlib's Agg canvas directly (no pyplot state, the user's
 backend is left alone). Every function takes data and an output path ending in ``.png`` or ``.svg``, writes the
@@ -23,7 +24,13 @@ from pinarms.robots.errors import InvalidInput
 
 from ._atomic import atomic_write
 
-__all__ = ["plot_joint_curves", "plot_trajectory", "plot_ga_convergence", "plot_workspace"]
+__all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
+           "plot_clearance", "plot_schedule", "plot_torques",
+           "plot_layout_search"]
+
+#: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
+#: interval) is drawn without knot markers and lines.
+MAX_DRAWN_KNOTS = 40
 
 _FORMATS = {".png": "png", ".svg": "svg"}
 _ORDERS = ("position", "velocity", "acceleration", "jerk")
@@ -214,7 +221,40 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
     knots = np.asarray(trajectory.knot_times, dtype=float)
     t = np.union1d(np.linspace(knots[0], knots[-1], int(samples)), knots)
     q, qd, qdd, qddd = trajectory.sample(t)
-    return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=knots, limits=limits, **options)
+    drawn = knots if knots.size <= MAX_DRAWN_KNOTS else None
+    return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=drawn, limits=limits, **options)
+
+
+def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
+                    title: str = "tcp speed") -> Path:
+    """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
+
+    Args:
+        t: instants (N,) [s]; speed: linear speed (N,) [m/s]; angular: optional (N,) [rad/s]
+            (second axis); limit: a tool-speed limit [m/s], drawn dashed.
+    """
+    tt = _numbers(t, "t")
+    v = _numbers(speed, "speed")
+    if tt.ndim != 1 or tt.size < 2 or v.shape != tt.shape:
+        raise InvalidInput(f"t and speed must be (N,) arrays of the same length, N >= 2; got {tt.shape} and {v.shape}")
+    fig = Figure(figsize=(7.5, 3.0))
+    ax = fig.subplots()
+    ax.plot(tt, v, lw=1.5, label="linear [m/s]")
+    if limit is not None:
+        ax.axhline(float(limit), color="k", ls="--", lw=0.9, label=f"limit {float(limit):g} m/s")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("tcp speed [m/s]")
+    ax.grid(True, alpha=0.3)
+    if angular is not None:
+        w = _numbers(angular, "angular")
+        if w.shape != tt.shape:
+            raise InvalidInput(f"angular must have the shape of t {tt.shape}, got {w.shape}")
+        ax2 = ax.twinx()
+        ax2.plot(tt, w, lw=1.0, color="tab:orange", label="angular [rad/s]")
+        ax2.set_ylabel("angular [rad/s]")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(title)
+    return _save(fig, path)
 
 
 def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
@@ -308,4 +348,198 @@ def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *,
         ax.grid(True, alpha=0.3)
     if w is not None and sc is not None:
         fig.colorbar(sc, ax=axes, label="manipulability", shrink=0.85)
+    return _save(fig, path)
+
+
+def plot_clearance(path: str | Path, check: Any, *, title: str = "clearance over time", mm: bool = True) -> Path:
+    """Smallest distance over the checked pairs against time, from a cell's motion check.
+
+    ``check`` is a :class:`robots.cell.MotionCheck` (best with ``curve=True``: exact at
+    every sample). Samples in contact are marked red, the required clearance is a dashed
+    line, the closest sample is annotated with its pair.
+    """
+    t = _numbers(getattr(check, "times", None), "check.times")
+    d = _numbers(getattr(check, "clearance", None), "check.clearance")
+    if t.ndim != 1 or t.shape != d.shape or t.size == 0:
+        raise InvalidInput(f"check.times and check.clearance must be equal 1-D arrays, got {t.shape} and {d.shape}")
+    k = 1000.0 if mm else 1.0
+    unit = "mm" if mm else "m"
+    fig = Figure(figsize=(9, 3.6))
+    ax = fig.subplots()
+    exact = np.asarray(getattr(check, "exact", np.ones(t.size, bool)), dtype=bool)
+    ax.plot(t[exact], d[exact] * k, lw=1.0, color="#2a6fb5", label="smallest distance")
+    if (~exact).any():
+        ax.plot(t[~exact], d[~exact] * k, ".", ms=2, color="#9aa7b5", label="screened (at least)")
+    touch = d <= 0.0
+    if touch.any():
+        ax.plot(t[touch], d[touch] * k, ".", ms=4, color="#d62728", label="contact")
+    required = float(getattr(check, "required", 0.0))
+    if required > 0.0:
+        ax.axhline(required * k, ls="--", color="#555555", lw=0.8, label=f"required {required * k:g} {unit}")
+    ax.axhline(0.0, color="black", lw=0.6)
+    i = int(np.argmin(np.where(exact, d, np.inf))) if exact.any() else int(np.argmin(d))
+    pair = getattr(check, "min_clearance_pair", None)
+    if pair is not None:
+        ax.annotate(f"{d[i] * k:.1f} {unit}: {pair}", (t[i], d[i] * k), textcoords="offset points", xytext=(6, 10),
+                    fontsize=8)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"distance [{unit}]")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    return _save(fig, path)
+
+
+def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: str | None = None) -> Path:
+    """Each arm's busy intervals in the shared zone over ``periods`` line periods (a Gantt chart).
+
+    ``schedule`` is an :class:`optim.LineSchedule`; each arm's cycle start is marked.
+    """
+    arms = list(getattr(schedule, "arms", ()))
+    period = float(getattr(schedule, "period", float("nan")))
+    if not arms or not math.isfinite(period) or period <= 0.0:
+        raise InvalidInput("schedule must be an optim.LineSchedule with arms and a positive period")
+    if isinstance(periods, bool) or not isinstance(periods, int) or periods < 1:
+        raise InvalidInput(f"periods must be a positive integer, got {periods!r}")
+    colors = ["#2a6fb5", "#e07b19", "#2ca02c", "#9467bd"]
+    fig = Figure(figsize=(9, 1.2 + 0.6 * len(arms)))
+    ax = fig.subplots()
+    for row, name in enumerate(arms):
+        bars = [(a + p * period, b - a) for p in range(periods) for a, b in schedule.busy.get(name, [])]
+        ax.broken_barh(bars, (row - 0.35, 0.7), color=colors[row % len(colors)], alpha=0.85)
+        for p in range(periods):
+            start = schedule.offsets[name] + p * period
+            ax.plot([start, start], [row - 0.45, row + 0.45], color="black", lw=1.2)
+    ax.set_yticks(range(len(arms)), [f"{a} ({schedule.cycle_times[a]:.2f} s)" for a in arms])
+    ax.set_xlim(0.0, periods * period)
+    ax.set_xlabel("time [s]  (bars: tcp in the shared zone; ticks: cycle starts)")
+    ax.set_title(title or f"{schedule.cell}: {schedule.picks_per_minute:.1f} picks/min, period {period:.2f} s")
+    ax.grid(True, axis="x", alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
+                 units: Sequence[str] | None = None, series: Mapping[str, Any] | None = None, title: str = "joint torques") -> Path:
+    """Joint torques against their limits: one panel per joint, ±limit dashed, peaks marked.
+
+    Args:
+        path: output file (.png or .svg).
+        t: instants (N,) [s].
+        torques: (N, n) [N·m, or N for prismatic joints]: the main curve (e.g. with the payload).
+        limits: (n,) torque limits (dashed ±lines, with the peak's share of the limit in the
+            panel title), or None.
+        joint_names: panel titles (default ``joint 1..n``); units: per joint (default N·m).
+        series: more curves to compare ``{label: (t (M,), torques (M, n))}`` (e.g. without the
+            payload, or a slower timing), drawn thinner.
+    """
+    tt = _numbers(t, "t")
+    tau = _numbers(torques, "torques")
+    if tt.ndim != 1 or tt.size < 2 or np.any(np.diff(tt) <= 0):
+        raise InvalidInput("t must be (N,) strictly increasing instants in s with N >= 2")
+    tau = tau[:, None] if tau.ndim == 1 else tau
+    if tau.ndim != 2 or tau.shape[0] != tt.size:
+        raise InvalidInput(f"torques must have shape ({tt.size}, n_joints), got {np.shape(torques)}")
+    n = tau.shape[1]
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    if len(names) != n:
+        raise InvalidInput(f"joint_names has {len(names)} names for {n} joints")
+    unit = list(units) if units is not None else ["N·m"] * n
+    if len(unit) != n:
+        raise InvalidInput(f"units has {len(unit)} entries for {n} joints")
+    lim = None
+    if limits is not None:
+        lim = np.broadcast_to(_numbers(limits, "limits", allow_inf=True), (n,))
+        if np.any(lim <= 0):
+            raise InvalidInput(f"limits must be positive, got {lim.tolist()}")
+    extra = []
+    for label, (te, ve) in (series or {}).items():
+        te, ve = _numbers(te, f"t of {label!r}"), _numbers(ve, f"torques of {label!r}")
+        ve = ve[:, None] if ve.ndim == 1 else ve
+        if ve.shape != (te.size, n):
+            raise InvalidInput(f"series {label!r} must be (t (M,), torques (M, {n})), got {te.shape} and {ve.shape}")
+        extra.append((str(label), te, ve))
+    cols = 2 if n > 3 else 1
+    rows = int(math.ceil(n / cols))
+    fig = Figure(figsize=(8.8 if cols == 2 else 7.0, 2.1 * rows + 0.6), layout="constrained")
+    axes = fig.subplots(rows, cols, sharex=True, squeeze=False).reshape(-1)
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j in range(n):
+        ax = axes[j]
+        for k, (label, te, ve) in enumerate(extra):
+            ax.plot(te, ve[:, j], color=colors[(k + 1) % len(colors)], lw=0.9, alpha=0.8, label=label)
+        ax.plot(tt, tau[:, j], color=colors[0], lw=1.5, label="torque")
+        k = int(np.argmax(np.abs(tau[:, j])))
+        ax.plot(tt[k], tau[k, j], "o", color=colors[0], ms=4)
+        head = names[j]
+        if lim is not None and np.isfinite(lim[j]):
+            for sign in (1, -1):
+                ax.axhline(sign * lim[j], color="k", ls="--", lw=0.9, alpha=0.8)
+            head += f"  (peak {abs(tau[k, j]) / lim[j]:.0%} of ±{np.format_float_positional(lim[j], 4, fractional=False, trim='-')})"
+        ax.set_title(head, fontsize=9)
+        ax.set_ylabel(f"[{unit[j]}]")
+        ax.grid(True, alpha=0.3)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for ax in axes[max(0, n - cols):n]:
+        ax.set_xlabel("time [s]")
+    handles, texts = axes[0].get_legend_handles_labels()
+    if lim is not None:
+        handles.append(Line2D([], [], color="k", ls="--", lw=0.9))
+        texts.append("±limit")
+    fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
+    if title:
+        fig.suptitle(title)
+    return _save(fig, path)
+
+
+def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
+                       mm: bool = True) -> Path:
+    """Picks per minute over the (x, y) placements of a layout search (:class:`optim.LayoutSearch`).
+
+    One square per (x, y) of the candidates, coloured by the best picks/min over their z and
+    yaw; placements where no candidate could run the cycle are grey crosses. The picks
+    (triangles), places (squares), the best grid placement (star) and the refined one
+    (diamond, when the refinement gained) are marked. Line frame; ``mm`` labels millimetres.
+    """
+    if not all(hasattr(result, a) for a in ("candidates", "picks_per_minute", "picks", "places")):
+        raise InvalidInput(f"result must be an optim.LayoutSearch, got {type(result).__name__}")
+    if colormap not in matplotlib.colormaps:
+        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
+    cand = _numbers(result.candidates, "candidates")
+    ppm = _numbers(result.picks_per_minute, "picks per minute")
+    k = 1000.0 if mm else 1.0
+    unit = "mm" if mm else "m"
+    xy, inverse = np.unique(np.round(cand[:, :2], 9), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    best = np.zeros(xy.shape[0])
+    np.maximum.at(best, inverse, ppm)
+    ok = best > 0
+    fig = Figure(figsize=(7.5, 6.0))
+    ax = fig.subplots()
+    size = 36.0 if xy.shape[0] > 400 else 90.0
+    sc = ax.scatter(xy[ok, 0] * k, xy[ok, 1] * k, c=best[ok], cmap=colormap, marker="s", s=size, linewidths=0)
+    if (~ok).any():
+        ax.scatter(xy[~ok, 0] * k, xy[~ok, 1] * k, marker="x", s=size * 0.4, color="0.6", linewidths=1.0,
+                   label="cycle not possible")
+    picks, places = _numbers(result.picks, "picks"), _numbers(result.places, "places")
+    ax.scatter(picks[:, 0] * k, picks[:, 1] * k, marker="^", s=80, color="tab:red", edgecolors="k", label="pick")
+    ax.scatter(places[:, 0] * k, places[:, 1] * k, marker="s", s=80, color="tab:orange", edgecolors="k",
+               label="place")
+    index = getattr(result, "best_index", -1)
+    if index >= 0:
+        ax.scatter([cand[index, 0] * k], [cand[index, 1] * k], marker="*", s=260, color="white", edgecolors="k",
+                   label=f"best grid placement ({ppm[index]:.1f}/min)")
+    refined = getattr(result, "refinement", None)
+    if refined is not None and refined.gain > 0:
+        j = int(np.argmax(refined.picks_per_minute))
+        ax.scatter([refined.placements[j, 0] * k], [refined.placements[j, 1] * k], marker="D", s=90,
+                   color="magenta", edgecolors="k", label=f"refined ({refined.picks_per_minute[j]:.1f}/min)")
+    if ok.any():
+        fig.colorbar(sc, ax=ax, label="picks per minute (best over z, yaw)", shrink=0.85)
+    ax.set_xlabel(f"base x [{unit}]")
+    ax.set_ylabel(f"base y [{unit}]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(title or f"layout search of {getattr(result, 'robot', 'the arm')}: picks per minute by base position")
     return _save(fig, path)

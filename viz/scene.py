@@ -10,7 +10,9 @@ Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
 - ``pinarms/paths/<name>`` — the TCP path of a trajectory, world frame: a thin tube
   (``Mesh``), since browsers draw WebGL lines one pixel wide whatever their width;
 - ``pinarms/vias/<name>/<i>`` — the TCP at the trajectory's knots (small spheres);
-- ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres).
+- ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres);
+- ``pinarms/reachability/<name>/layers/z<mm>mm`` — reachability maps: the voxels of one
+  horizontal layer each (:mod:`viz.reach_scene`; the page's slice control shows/hides them).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
 robot) play together from time 0, sampled at ``fps`` frames per second, looping.
@@ -24,7 +26,7 @@ from __future__ import annotations
 
 import json
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import matplotlib
@@ -66,6 +68,7 @@ class SceneInfo:
             of the robots and their tcp paths (not of the clouds or boxes).
         camera: where the camera opens (world, m).
         page: what the page around the scene shows (see :mod:`viz.page`).
+        reachability: reachability map name → scene paths of its voxel layers (lowest first).
     """
 
     robots: dict[str, list[str]]
@@ -81,6 +84,7 @@ class SceneInfo:
     target: np.ndarray
     camera: np.ndarray
     page: dict[str, Any]
+    reachability: dict[str, list[str]] = field(default_factory=dict)
 
 
 def colors_by_value(values: np.ndarray, colormap: str = "viridis") -> np.ndarray:
@@ -280,6 +284,10 @@ def build_scene(
         w_max = max(w_max, float(np.max(ws.manipulability)))
         bounds.append(world)
 
+    from .reach_scene import draw_reachability  # voxel layers coloured by reachability index
+
+    reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
+
     paths, knots_drawn, tcp_paths = {}, {}, {}
     for i, (name, rec) in enumerate(session.trajectories.items()):
         robot = drawings[rec.robot].robot
@@ -389,6 +397,8 @@ def build_scene(
             "max": w_max,
             "colors": colorbar_stops(colormap),
         }
+    if reach_page:
+        page["reachability"] = reach_page
     vis[ROOT].set_property(PAGE_PROPERTY, json.dumps(page, ensure_ascii=False))
 
     all_points = {**{f"vias:{k}": v for k, v in knots_drawn.items()}, **points}
@@ -397,6 +407,7 @@ def build_scene(
         objects={n: f"{ROOT}/objects/{n}" for n in session.objects},
         clouds=clouds, paths=paths, points=all_points, animated=animated, duration=duration,
         n_frames=n_frames, fps=float(fps), bounds=(lo, hi), target=target, camera=camera, page=page,
+        reachability=reach_paths,
     )
 
 

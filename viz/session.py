@@ -76,17 +76,24 @@ MAX_TRAJECTORY_SAMPLES = 2_000_000
 def _json_normalised(obj: Any, what: str) -> Any:
     """``obj`` as it will come back from JSON (tuples → lists); rejects NaN and non-JSON values."""
     try:
-        return json.loads(json.dumps(obj, allow_nan=False))
-    except (TypeError, ValueError) as exc:
+        return json.loads(json.dumps(obj, allow_nan=False, ensure_ascii=False).encode("utf-8"))
+    except (TypeError, ValueError, RecursionError) as exc:  # UnicodeEncodeError (lone surrogates) is a ValueError
         raise InvalidInput(f"{what} must be JSON-able (dicts, lists, str, finite numbers, bool, None): {exc}") from exc
+
+
+def _real(values: Any, what: str) -> np.ndarray:
+    """``values`` as a fresh float64 array; complex numbers and non-numbers raise InvalidInput."""
+    try:
+        if np.iscomplexobj(values):
+            raise TypeError("complex numbers")
+        return np.array(values, dtype=_F8)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidInput(f"{what} must be numbers (real), got {type(values).__name__}") from exc
 
 
 def _float_array(values: Any, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
     """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``); ±inf allowed on request."""
-    try:
-        arr = np.array(values, dtype=_F8)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers, got {type(values).__name__}") from exc
+    arr = _real(values, what)
     if arr.ndim != ndim or (width is not None and arr.shape[-1] != width):
         shape = "(N,)" if ndim == 1 else f"(N, {width})"
         raise InvalidInput(f"{what} must have shape {shape}, got {arr.shape}")
@@ -97,7 +104,7 @@ def _float_array(values: Any, what: str, ndim: int, width: int | None = None, *,
 
 
 def _pose(values: Any, what: str) -> np.ndarray:
-    T = np.array(np.eye(4) if values is None else values, dtype=_F8)
+    T = _real(np.eye(4) if values is None else values, what)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise InvalidInput(f"{what} must be a finite (4, 4) homogeneous transform, got shape {T.shape}")
     R = T[:3, :3]
@@ -123,7 +130,7 @@ def _registry_name(robot: Robot) -> str | None:
     except PinarmsError:
         return None
     if ref.urdf_text == robot.urdf_text and ref.tcp_frame == robot.tcp_frame:
-        return robot.name
+        return robot.name  # a payload is stored beside the name (RobotEntry.payload)
     return None
 
 
@@ -155,6 +162,8 @@ class Session:
     ) -> None:
         if not isinstance(title, str):
             raise InvalidInput(f"title must be a string, got {title!r}")
+        if metadata is not None and not isinstance(metadata, Mapping):
+            raise InvalidInput(f"metadata must be a mapping (dict) of JSON-able values, got {type(metadata).__name__}")
         user = _json_normalised(dict(metadata or {}), "metadata")
         self.metadata: dict[str, Any] = {
             "title": title,
@@ -168,6 +177,7 @@ class Session:
         self.workspaces: dict[str, WorkspaceRecord] = {}
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
+        self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
@@ -189,7 +199,8 @@ class Session:
         """Add a robot placed at ``base_to_world`` (4, 4) in the world; return its key.
 
         A robot that ``robots.load`` rebuilds exactly is stored by name; any other has its
-        URDF text embedded so that the session reopens anywhere.
+        URDF text embedded so that the session reopens anywhere. A robot carrying a payload
+        (``robot.with_payload``) keeps it: the session stores the payload and reapplies it.
         """
         if isinstance(robot, str):
             robot = robots.load(robot)
@@ -208,6 +219,7 @@ class Session:
             base_to_world=_pose(base_to_world, f"base_to_world of robot {key!r}"),
             urdf_text=None if reg else robot.urdf_text,
             package_dirs=() if reg else tuple(str(p) for p in robot.package_dirs),
+            payload=None if robot.payload is None else robot.payload.as_dict(),
         )
         self._loaded[key] = robot
         return key
@@ -226,6 +238,8 @@ class Session:
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
                 )
+            if entry.payload is not None:
+                rob = rob.with_payload(entry.payload)
             if tuple(rob.joint_names) != entry.joint_names:
                 raise SessionFormatError(
                     f"robot {entry.key!r} ({entry.name}) was saved with joints {list(entry.joint_names)} but now loads "
@@ -259,8 +273,8 @@ class Session:
         if np.any(size_arr <= 0):
             raise InvalidInput(f"size of box {name!r} must be positive edge lengths in m, got {size_arr.tolist()}")
         try:
-            rgba = tuple(float(c) for c in np.asarray(color, dtype=float).ravel())
-        except (TypeError, ValueError):
+            rgba = tuple(float(c) for c in _real(color, "color").ravel())
+        except InvalidInput:
             rgba = ()
         if len(rgba) != 4 or not all(0.0 <= c <= 1.0 for c in rgba):
             raise InvalidInput(f"color of box {name!r} must be 4 RGBA values in [0, 1], got {color!r}")
@@ -301,7 +315,7 @@ class Session:
                 f"trajectory {name!r} must be a planning.Trajectory or a (t, q) pair of arrays, got {type(trajectory).__name__}"
             )
         t = _float_array(t, f"t of trajectory {name!r}", 1)
-        q_arr = np.asarray(q, dtype=float)
+        q_arr = _real(q, f"q of trajectory {name!r}")
         if q_arr.ndim == 1 and entry.nq == 1:
             q_arr = q_arr[:, None]
         q = _float_array(q_arr, f"q of trajectory {name!r} (robot {entry.key!r} has {entry.nq} joints)", 2, entry.nq)
@@ -352,10 +366,7 @@ class Session:
         if kind not in _POINT_KINDS:
             raise InvalidInput(f"kind of point set {name!r} must be one of {_POINT_KINDS}, got {kind!r}")
         key = None if robot is None else self._entry(robot).key
-        try:
-            arr = np.atleast_2d(np.asarray(points, dtype=float))
-        except (TypeError, ValueError) as exc:
-            raise InvalidInput(f"points of point set {name!r} must be numbers (n, 3) in m, got {points!r}") from exc
+        arr = np.atleast_2d(_real(points, f"points of point set {name!r} (n, 3) in m"))
         pts = _float_array(arr, f"points of point set {name!r}", 2, 3)
         if pts.shape[0] == 0:
             raise InvalidInput(f"point set {name!r} has no points; give at least one (n, 3) row in m")
@@ -390,6 +401,18 @@ class Session:
             raise InvalidInput(f"columns of history {name!r} must have equal lengths, got {sorted(lengths)}")
         rec = HistoryRecord(name, out)
         self.histories[name] = rec
+        return rec
+
+    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        """
+        from .reach_record import make_record
+
+        name = self._free(self.reachability, name, "reachability")
+        rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
+        self.reachability[name] = rec
         return rec
 
     # ---------------------------------------------------------------- (de)serialisation

@@ -26,7 +26,6 @@ Frames and units: positions in metres, angles in radians, times in seconds.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
@@ -134,6 +133,9 @@ class RobotEntry:
         base_to_world: pose of the robot's base in the world frame, (4, 4), m.
         urdf_text: embedded URDF (``None`` for registry robots).
         package_dirs: folders that resolved ``package://`` meshes when saved (a hint only).
+        payload: the payload the robot carries (:meth:`robots.dynamics.Payload.as_dict`:
+            ``mass_kg``, ``com_m``, ``inertia_kg_m2``, ``frame``), or ``None``; reapplied
+            with ``robot.with_payload`` when the session reopens.
     """
 
     key: str
@@ -144,6 +146,7 @@ class RobotEntry:
     base_to_world: np.ndarray
     urdf_text: str | None = None
     package_dirs: tuple[str, ...] = ()
+    payload: dict | None = None
 
     @property
     def nq(self) -> int:
@@ -239,6 +242,9 @@ def check_name(name: Any, what: str) -> str:
 
 
 # ---------------------------------------------------------------------------- the table of kinds
+from .reach_record import decode_reachability, encode_reachability  # noqa: E402  (a kind defined in its own module)
+
+
 @dataclass(frozen=True)
 class ArraySpec:
     """An array field of an item: ``shape`` entries are ints (fixed), or names of dimensions.
@@ -285,12 +291,15 @@ class Kind:
     decode: Callable[["_Item"], Any]
     texts: tuple[TextSpec, ...] = ()
     robot_ref: str | None = None  # "required" / "optional": the item's "robot" field names a session robot
+    optional: bool = False  # the section may be absent (written only when it has items): older files lack it
 
 
 def _encode_robot(e: RobotEntry) -> tuple[dict, dict, dict]:
-    return ({"key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
-             "joint_names": list(e.joint_names), "package_dirs": list(e.package_dirs)},
-            {"base_to_world": e.base_to_world}, {"urdf_member": e.urdf_text})
+    fields = {"key": e.key, "source": e.source, "name": e.name, "tcp_frame": e.tcp_frame,
+              "joint_names": list(e.joint_names), "package_dirs": list(e.package_dirs)}
+    if e.payload is not None:  # written only when there is one: sessions without stay as they were
+        fields["payload"] = e.payload
+    return fields, {"base_to_world": e.base_to_world}, {"urdf_member": e.urdf_text}
 
 
 def _decode_robot(it: _Item) -> RobotEntry:
@@ -302,9 +311,17 @@ def _decode_robot(it: _Item) -> RobotEntry:
     dirs = it.field("package_dirs", list)
     if not all(isinstance(d, str) for d in dirs):
         raise it.fail(f"{it.where}.package_dirs must be a list of strings")
+    payload = None
+    if "payload" in it.obj:
+        from pinarms.robots.dynamics import InvalidPayload, Payload
+
+        try:
+            payload = Payload.from_dict(it.field("payload", dict)).as_dict()
+        except InvalidPayload as exc:
+            raise it.fail(f"{it.where}.payload: {exc}") from None
     return RobotEntry(key=it.key, source=source, name=it.field("name", str), tcp_frame=it.field("tcp_frame", str),
                       joint_names=it.joint_names, base_to_world=it.arrays["base_to_world"],
-                      urdf_text=it.texts.get("urdf_member"), package_dirs=tuple(dirs))
+                      urdf_text=it.texts.get("urdf_member"), package_dirs=tuple(dirs), payload=payload)
 
 
 def _encode_box(b: BoxObject) -> tuple[dict, dict, dict]:
@@ -380,6 +397,9 @@ KINDS: tuple[Kind, ...] = (
     Kind("histories", "histories", "history", "name",
          (ArraySpec("columns", ("G",), allow_inf=True, columns=True, required=("best",)),),
          _encode_history, _decode_history),
+    Kind("reachability", "reachability", "reachability map", "name",
+         (ArraySpec("centres", ("N", 3), min_rows=1), ArraySpec("index", ("N",)), ArraySpec("manipulability", ("N",))),
+         encode_reachability, decode_reachability, robot_ref="required", optional=True),
 )
 
 
@@ -420,7 +440,8 @@ def to_document(metadata: dict, tables: Mapping[str, Mapping[str, Any]]) -> tupl
                 else:
                     fields[spec.field] = ref(f"{base}/{spec.field}.npy", value)
             items.append(fields)
-        doc[kind.section] = items
+        if items or not kind.optional:
+            doc[kind.section] = items
     return doc, arrays, texts
 
 
@@ -817,7 +838,8 @@ def _read(r: _Reader) -> SessionContents:
     for kind in KINDS:
         items: list[_Item] = []
         seen: set[str] = set()
-        for i, obj in enumerate(r.field(doc, kind.section, list, "session")):
+        listed = r.field(doc, kind.section, list, "session") if (kind.section in doc or not kind.optional) else []
+        for i, obj in enumerate(listed):
             it = _Item(r, kind, obj, i)
             if it.key in seen:
                 raise r.fail(f"{kind.what} name {it.key!r} appears twice")

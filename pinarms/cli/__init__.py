@@ -18,6 +18,9 @@ from __future__ import annotations
 from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     cycle_commands,
     demo_command,
+    layout_commands,
+    line_commands,
+    reach_commands,
     robot_commands,
     session_commands,
     trajectory_commands,

@@ -19,8 +19,8 @@ from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
 __all__ = ["cli", "main", "json_option", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
-           "show_progress", "load_robot", "floats", "si_limit", "vectors_from_args", "joint_scale_at",
-           "new_session", "save_session"]
+           "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
+           "joint_scale_at", "new_session", "save_session", "scheduler_option"]
 
 # numbers may be negative: "-0.5" must reach the command as a value, not as an option
 NUMBERS = {"ignore_unknown_options": True}
@@ -88,7 +88,26 @@ def fmt(values: Any, digits: int = 6) -> str:
 
 def show_progress(as_json: bool) -> bool:
     """Progress bars only for a person at a terminal, never in machine-readable output."""
-    return (not as_json) and sys.stderr.isatty()
+    from pinarms.progress import wanted
+
+    return wanted(as_json, sys.stderr)
+
+
+def progress_bar(label: str, total: int | None, as_json: bool):
+    """A :class:`pinarms.progress.ProgressBar` on stderr, drawn only when :func:`show_progress` says so."""
+    from pinarms.progress import ProgressBar
+
+    return ProgressBar(label, total, enabled=show_progress(as_json), stream=sys.stderr)
+
+
+def terminal_width() -> int | None:
+    """Columns of the terminal stdout writes to (``COLUMNS`` if set); ``None`` for a pipe or a file."""
+    import os
+    import shutil
+
+    if not (sys.stdout.isatty() or os.environ.get("COLUMNS")):
+        return None
+    return max(40, shutil.get_terminal_size().columns)
 
 
 def load_robot(name: str) -> Robot:
@@ -151,6 +170,12 @@ def main() -> None:
 
 json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON document instead of text.")
 
+#: Where a sweep runs (pinarms.execution): none = here, serially; the standard
+#: DASK_SCHEDULER_ADDRESS variable is read when the option is not given.
+scheduler_option = click.option(
+    "--scheduler", default=None, envvar="DASK_SCHEDULER_ADDRESS", show_envvar=True, metavar="ADDRESS",
+    help="Run the work on Dask: tcp://HOST:8786 (a running `dask scheduler`), or 'processes' / 'processes:N' "
+         "(local worker processes). Default: serially here, or DASK_SCHEDULER_ADDRESS when it is set.")
 
 
 def new_session(robot: Robot | str | None, title: str):

@@ -7,6 +7,7 @@ import numpy as np
 
 from pinarms.units import (
     length_scale,
+    mass_kg,
 )
 
 from ._common import (
@@ -38,18 +39,27 @@ from ._common import (
 @click.option("--jmax", default=None, help="Jerk limit(s) [rad/s³ or m/s³].")
 @click.option("--method", type=click.Choice(["exact", "ga"]), default="exact", show_default=True)
 @click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the optimiser.")
+@click.option("--payload", default=None,
+              help="What the gripper carries from pick to place, e.g. 3kg or 800g (its centre of mass at the tcp); "
+                   "times both moves also under joint torque limits (--torque-max, default the URDF's efforts).")
+@click.option("--torque", "torque", is_flag=True, help="Also limit joint torques (the URDF's efforts), without a payload.")
+@click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints], one or per joint.")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
               help="Save the cycle (trajectory, via points, pick and place) into a session file.")
 @json_option
-def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, method, seed, session_path,
-              as_json) -> None:
+def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, method, seed, payload, torque,
+              torque_max, session_path, as_json) -> None:
     """Time-optimal pick-and-place cycle of ROBOT: pick, lift, transfer, lower, place, and back.
 
     Prints the time of each move, the cycle time, picks per minute and how far the tcp
     leaves the straight vertical approach/retreat lines (optim.plan_cycle; the tool points
     down on 6+ joint arms). Limits are SI per joint; --mm converts only lengths.
 
-    Example: pinarms cycle aubo_i3 --pick 350 200 150 --place -100 400 100 --mm
+    With --payload (or --torque) both moves are also timed under joint torque limits, the
+    move to place carrying the payload and the move back empty (robots' inverse dynamics,
+    Pinocchio's RNEA).
+
+    Example: pinarms cycle aubo_i3 --pick 350 200 150 --place -100 400 100 --mm --payload 3kg
     """
     from pinarms import optim
 
@@ -59,9 +69,12 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     lift_m = 0.05 if lift is None else lift * scale
     spec = optim.PickPlace(np.array(pick) * scale, np.array(place) * scale, lift=lift_m, dwell=dwell,
                            via=[np.array(v) * scale for v in via])
+    kg = None if payload is None else mass_kg(payload)
+    limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
+    torque_limits = limits if limits is not None else (True if (kg is not None or torque) else False)
     res = optim.plan_cycle(arm, spec, kind=kind, vmax=si_limit(vmax, "--vmax", np.ones(arm.nq)),
                            amax=si_limit(amax, "--amax", np.ones(arm.nq)), jmax=si_limit(jmax, "--jmax", np.ones(arm.nq)),
-                           method=method, seed=seed)
+                           method=method, seed=seed, payload=kg, torque_limits=torque_limits)
     data = res.as_dict()
     data["units"] = {"lengths": "m", "times": "s", "limits": "rad or m per s^k", "given_points": lu}
     dev = res.line_deviation / scale
@@ -77,8 +90,13 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
         "IK: one branch for every waypoint" if res.one_branch else
         f"IK: branches {res.branches.tolist()} (the joint limits force a switch, or the arm is solved numerically)",
     ]
+    if res.torque_limit is not None:
+        carried = "nothing" if res.payload is None else f"{res.payload.mass:g} kg"
+        lines.insert(4, f"torque / limit (carrying {carried} to the place, empty back): "
+                        + ", ".join(f"{n} {r:.3f}" for n, r in zip(arm.joint_names, res.torque_ratios)))
     if session_path:
-        session = new_session(arm, f"pick-and-place cycle of {arm.name}")
+        session = new_session(arm if res.payload is None else arm.with_payload(res.payload),
+                              f"pick-and-place cycle of {arm.name}")
         session.add_trajectory("cycle", res.trajectory)
         session.add_points("cycle_via_points", res.waypoints[:, :3, 3], kind="via")
         place_m = res.waypoints[res.names.index("place"), :3, 3]

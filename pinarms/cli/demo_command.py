@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable
-
 import click
 
 from . import _common as common
@@ -32,11 +30,16 @@ def demo_cmd(quick: bool, out_dir: str, only: tuple[str, ...], readme: str | Non
         raise click.UsageError("--readme takes the table of the full run: drop --quick and --only")
     if readme:
         splice_table(Path(readme).read_text(encoding="utf-8"), [])  # markers checked before the long run
-    progress: Callable[[str], None] | None = None
-    if common.show_progress(as_json):
-        progress = lambda label: click.echo(f"· {label}", err=True)  # noqa: E731
-    result = run_demo(out_dir, quick=quick, only=only or None, progress=progress)
-    lines = [result.table_text(), "", *(f"wrote {p}" for p in result.files)]
+    n_studies = len(only) if only else 4
+    with common.progress_bar("demo studies", n_studies, as_json) as bar:
+        def progress(label: str) -> None:
+            bar.step(label)
+            if label.endswith("done"):
+                bar.advance()
+
+        result = run_demo(out_dir, quick=quick, only=only or None, progress=progress)
+    # the terminal gets the table wrapped to its width; table.md / table.json keep every row whole
+    lines = [result.table_text(width=common.terminal_width()), "", *(f"wrote {p}" for p in result.files)]
     data = result.as_dict()
     if readme:
         doc = Path(readme)

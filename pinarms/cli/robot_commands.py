@@ -15,6 +15,7 @@ from pinarms.units import (
     prismatic_mask,
 )
 
+from . import _common as common
 from ._common import (
     NUMBERS,
     cli,
@@ -121,26 +122,43 @@ def _target_pose(pose: np.ndarray, deg: bool, mm: bool) -> np.ndarray:
 @click.argument("robot")
 @click.argument("pose", nargs=-1, type=float, required=True)
 @click.option("--all", "all_solutions", is_flag=True, help="Every analytic solution within the limits.")
-@click.option("--deg", is_flag=True, help="ROLL PITCH YAW and revolute joint output in degrees.")
-@click.option("--mm", is_flag=True, help="X Y Z and prismatic joint output in millimetres.")
+@click.option("--deg", is_flag=True, help="ROLL PITCH YAW, revolute joints (and --limit-tol) in degrees.")
+@click.option("--mm", is_flag=True, help="X Y Z, prismatic joints (and --limit-tol) in millimetres.")
 @click.option("--seed-q", default=None, help="Comma-separated start configuration for the numerical solver.")
+@click.option("--limit-tol", "limit_tol", default=None, type=click.FloatRange(min=0.0),
+              help="Accept solutions up to this far outside a joint's range (deg with --deg, else rad; "
+                   "mm with --mm, else m, for prismatic joints); never clamped.")
 @json_option
 def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, mm: bool,
-           seed_q: str | None, as_json: bool) -> None:
+           seed_q: str | None, limit_tol: float | None, as_json: bool) -> None:
     """Inverse kinematics for the tcp at X Y Z [ROLL PITCH YAW] (base frame).
 
     With three numbers only the position is asked (orientation free for the numerical
-    solver; with --all the orientation is taken as the base's). With --all every
-    closed-form solution within the joint limits is listed.
+    solver; with --all, or for the note below, the orientation is taken as the base's).
+    With --all every closed-form solution within the joint limits is listed. Closed-form
+    solutions that miss a joint range by less than 1° (1 mm) are named with how far they
+    miss; --limit-tol accepts them (a solution within the limits is always preferred).
     """
+    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.robots.ik import near_limit_solutions
+
     arm = load_robot(robot)
     values = vectors_from_args(pose)
     T = _target_pose(values, deg, mm)
     position_only = values.size == 3
+    prismatic = prismatic_mask(arm)
+    user = np.where(prismatic, length_scale(mm), angle_scale(deg))  # SI per user unit, per joint
+    kinds = ["mm" if (p and mm) else "m" if p else ("deg" if deg else "rad") for p in prismatic]
+    # --limit-tol in user units, per joint kind: one SI tolerance (the smaller of the two readings)
+    tol_si = 0.0 if limit_tol is None else float(np.min(limit_tol * user))
+    near = []
+    if arm.has_analytic_ik:
+        near = near_limit_solutions(arm, T, within=max(float(np.min(np.where(prismatic, 1e-3, np.radians(1.0)))),
+                                                      2.0 * tol_si))
     if all_solutions:
         if not arm.has_analytic_ik:
             raise InvalidInput(f"{arm.name} has no closed-form IK; drop --all to use the numerical solver")
-        sols = np.atleast_2d(arm.ik_all(T))
+        sols = np.atleast_2d(arm.ik_all(T, limit_tolerance=tol_si))
         if sols.size == 0:
             sols = np.zeros((0, arm.nq))
     else:
@@ -152,33 +170,97 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
                     f"--seed-q needs {arm.nq} values for {arm.name} ({', '.join(arm.joint_names)}), got {start.size}"
                 )
             q0 = joints_to_si(arm, start, deg=deg, mm=mm)
-        sols = np.atleast_2d(arm.ik(T, q0, position_only=position_only))
+        accepted = [s.q for s in near if s.worst <= tol_si]
+        try:
+            sols = np.atleast_2d(arm.ik(T, q0, position_only=position_only, limit_tolerance=tol_si))
+        except UnreachableTarget:
+            if not accepted:
+                raise InvalidInput(_unreachable(arm, T, values, position_only, near, user, kinds, mm)) from None
+            sols = np.atleast_2d(accepted[0])
+        if position_only and accepted:  # asked for: the closed form (orientation as the base's) within --limit-tol
+            sols = np.atleast_2d(accepted[0])
     rows = []
     for q in sols:
         T_q = arm.fk(q)
+        outside = _outside(arm, q, user)
         rows.append(
             {
                 "q": joints_from_si(arm, q, deg=deg, mm=mm),
                 "position_error_m": float(np.linalg.norm(T_q[:3, 3] - T[:3, 3])),
+                "outside_limits": outside,
             }
         )
     lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
-    kinds = ["mm" if (p and mm) else "m" if p else au for p in prismatic_mask(arm)]
     data = {
         "robot": arm.name,
         "target": {"position": values[:3], "rpy": values[3:] if values.size == 6 else None},
         "units": {"position": lu, "angles": au, "joints": kinds},
         "joint_names": list(arm.joint_names),
+        "limit_tolerance": limit_tol,
         "solutions": rows,
+        "near_limit_solutions": [
+            {"q": joints_from_si(arm, s.q, deg=deg, mm=mm), "outside_limits": _outside(arm, s.q, user)} for s in near
+        ],
     }
     header = "  ".join(f"{n}[{u}]" for n, u in zip(arm.joint_names, kinds))
     lines = [f"{arm.name}: {len(rows)} solution(s)  ({header})"]
-    lines += [f"  {fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m" for r in rows]
+    for r in rows:
+        beyond = "".join(f"; {j} {abs(e):.4g} {kinds[arm.joint_names.index(j)]} outside its range"
+                         for j, e in r["outside_limits"].items())
+        lines.append(f"  {fmt(r['q'])}   |Δp| = {r['position_error_m']:.1e} m{beyond}")
     if not rows:  # only with --all: the numerical solver raises UnreachableTarget instead
         reason = arm.ik_failure_reason(T)
         data["reason"] = reason
         lines.append(f"  none within the joint limits: {reason}")
+    taken = [r["q"] for r in rows]
+    for s, d in zip(near, data["near_limit_solutions"]):
+        if any(np.allclose(d["q"], q, atol=1e-9) for q in taken):
+            continue
+        misses = ", ".join(f"{j} by {abs(e):.4g} {kinds[arm.joint_names.index(j)]} "
+                           f"({'above' if e > 0 else 'below'} {_limit_text(arm, j, e, user)})"
+                           for j, e in d["outside_limits"].items())
+        need = max(abs(e) for e in d["outside_limits"].values())
+        lines.append(f"  note: the closed-form solution ({fmt(d['q'])}) lies outside the joint ranges: {misses}; "
+                     f"--limit-tol {float(np.format_float_positional(need * 1.01, precision=2, fractional=False))} "
+                     "accepts it")
     emit(as_json, data, lines)
+
+
+def _outside(arm, q: np.ndarray, user: np.ndarray) -> dict[str, float]:
+    """Joints of ``q`` outside their range → signed excess in user units (revolute angles wrapped to the range)."""
+    from pinarms.robots.ik import limit_excess
+
+    _, excess = limit_excess(arm, q)
+    return {n: float(e / u) for n, e, u in zip(arm.joint_names, excess, user) if abs(e) > 1e-9}
+
+
+def _limit_text(arm, joint: str, excess: float, user: np.ndarray) -> str:
+    j = arm.joint_names.index(joint)
+    limit = arm.upper[j] if excess > 0 else arm.lower[j]
+    return f"{limit / user[j]:.6g}"
+
+
+def _unreachable(arm, T: np.ndarray, values: np.ndarray, position_only: bool, near: list, user: np.ndarray,
+                 kinds: list[str], mm: bool) -> str:
+    """Why no configuration reaches the target, in the units the user typed."""
+    from pinarms.robots.ik import NumericalIK
+
+    unit = "mm" if mm else "m"
+    where = f"({', '.join(f'{v:g}' for v in values[:3])}) {unit}"
+    head = f"robot '{arm.name}': no configuration within the joint limits reaches {where}"
+    free = NumericalIK(arm).solve(T, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=False)
+    if free.success or near:
+        q = near[0].q if near else free.q
+        misses = "; ".join(f"{j} {abs(e):.4g} {kinds[arm.joint_names.index(j)]} "
+                           f"{'above' if e > 0 else 'below'} its range end {_limit_text(arm, j, e, user)}"
+                           for j, e in _outside(arm, q, user).items())
+        small = all(abs(e) * u <= (1e-3 if k in ("mm", "m") else np.radians(1.0))
+                    for e, u, k in ((e, user[arm.joint_names.index(j)], kinds[arm.joint_names.index(j)])
+                                    for j, e in _outside(arm, q, user).items()))
+        return f"{head}: it is within reach but needs {misses}" + (" (--limit-tol accepts that much)" if small else "")
+    scale = 1e3 if mm else 1.0
+    return (f"{head}: it is out of reach; the closest tcp position found is "
+            f"{free.position_error * scale:.4g} {unit} away")
 
 
 # --------------------------------------------------------------------------- workspace
@@ -200,7 +282,9 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     from pinarms.robots.placement import recommend_region
     from pinarms.robots.workspace import sample_workspace
 
-    ws = sample_workspace(arm, n=n, seed=seed, frame=frame)
+    # a million samples take about a second: a bar from there on
+    with common.progress_bar("workspace samples", n, as_json or n < 1_000_000) as bar:
+        ws = sample_workspace(arm, n=n, seed=seed, frame=frame, progress=bar if bar.enabled else None)
     summary_obj = ws.summary()
     summary = jsonable(summary_obj)
     lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -56,17 +55,13 @@ def read_via_file(path: str) -> dict[str, Any]:
         if not isinstance(doc, dict) or "positions" not in doc:
             raise InvalidInput(f"{path}: expected an object with 'positions' (and optional 'times', 'kind')")
         return _checked_via_doc(doc, path)
-    rows = list(csv.reader(io.StringIO(text)))
-    rows = [r for r in rows if any(c.strip() for c in r)]
+    reader = csv.reader(io.StringIO(text))
+    numbered = [(reader.line_num, r) for r in reader if any(c.strip() for c in r)]  # line numbers of the file
+    lines, rows = [n for n, _ in numbered], [r for _, r in numbered]
     if len(rows) < 3:
         raise InvalidInput(f"{path}: a CSV needs a header row and at least two via points")
     header = [h.strip().lower() for h in rows[0]]
-    try:
-        table = np.array([[float(c) for c in r] for r in rows[1:]], dtype=float)
-    except ValueError:
-        raise InvalidInput(f"{path}: every CSV cell after the header must be a number") from None
-    if table.ndim != 2 or table.shape[1] != len(header):
-        raise InvalidInput(f"{path}: every CSV row must have {len(header)} cells like the header")
+    table = _csv_numbers(rows, lines, path)
     doc: dict[str, Any] = {}
     time_cols = [i for i, h in enumerate(header) if h in ("t", "time", "time_s", "t_s")]
     if time_cols:
@@ -75,6 +70,30 @@ def read_via_file(path: str) -> dict[str, Any]:
     doc["positions"] = table[:, joints]
     doc["joint_names"] = [rows[0][i].strip() for i in joints]
     return doc
+
+
+def _csv_numbers(rows: list[list[str]], lines: list[int], path: str) -> np.ndarray:
+    """The cells after the header row as a float table, or InvalidInput naming the row and column.
+
+    A row is named by its line in the file (``lines``: the header is usually row 1), a
+    column by its number (from 1) and its header.
+    """
+    header = rows[0]
+    table = np.empty((len(rows) - 1, len(header)))
+    for k, (r, row) in enumerate(zip(lines[1:], rows[1:])):
+        if len(row) != len(header):
+            raise InvalidInput(f"{path}: CSV row {r} has {len(row)} cells, the header has {len(header)} "
+                               f"({', '.join(h.strip() for h in header)})")
+        for c, cell in enumerate(row):
+            try:
+                value = float(cell)
+            except ValueError:
+                value = float("nan")
+            if not np.isfinite(value):
+                raise InvalidInput(f"{path}: CSV row {r}, column {c + 1} ({header[c].strip()!r}): "
+                                   f"{cell.strip()!r} is not a finite number")
+            table[k, c] = value
+    return table
 
 
 def _checked_via_doc(doc: dict[str, Any], path: str) -> dict[str, Any]:
@@ -300,11 +319,20 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
 @click.option("--method", type=click.Choice(["ga", "exact"]), default="ga", show_default=True)
 @click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the GA.")
 @click.option("--generations", default=None, type=click.IntRange(min=1), help="Maximum GA generations.")
+@click.option("--payload", default=None,
+              help="Mass at the tcp, e.g. 3kg or 800g (needs --robot): also limits joint torques "
+                   "(--torque-max, default the URDF's efforts).")
+@click.option("--torque", "torque", is_flag=True, help="Also limit joint torques to the URDF's efforts (needs --robot).")
+@click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints] (needs --robot).")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
               help="Save the optimised trajectory (and GA history) into a session file.")
 @json_option
-def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, session_path, as_json) -> None:
+def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, payload, torque, torque_max,
+                 session_path, as_json) -> None:
     """Shortest segment times through via points under velocity/acceleration/jerk limits.
+
+    With --payload, --torque or --torque-max the joint torques of --robot (Pinocchio's RNEA,
+    payload included) are limited too.
 
     Example (seed 000): pinarms optimize --kind 3-5-3 --deg --via 55.5 --via 69.7
     --via 106.5 --via 124.5 --vmax 55
@@ -323,21 +351,22 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     kwargs: dict[str, Any] = {}
     if generations is not None and method == "ga":
         kwargs["max_generations"] = generations
-    progress = common.show_progress(as_json) and method == "ga"
-    if progress:
-        budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
-        bar = click.progressbar(length=budget, label="GA generations", file=sys.stderr)
-        bar.__enter__()
+    if payload is not None or torque or torque_max is not None:
+        if arm is None:
+            raise click.UsageError("--payload, --torque and --torque-max need --robot (its inverse dynamics give the torques)")
+        from pinarms.units import mass_kg
 
-        def tick(_state: Any) -> None:
-            bar.update(1)
-
-        kwargs["callback"] = tick
+        limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
+        kwargs.update(robot=arm, payload=None if payload is None else mass_kg(payload),
+                      torque_limits=True if limits is None else limits)
+    budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
+    bar = common.progress_bar("GA generations", budget, as_json or method != "ga")
+    if bar.enabled:
+        kwargs["callback"] = lambda _state: bar.advance()
     try:
         result = optim.minimize_time(positions * scale, kind, v, a, j, method=method, seed=seed, **kwargs)
     finally:
-        if progress:
-            bar.__exit__(None, None, None)
+        bar.close()
     data = {
         "kind": kind,
         "method": result.method,
@@ -353,8 +382,16 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
         f"segment durations [s]: {fmt(result.durations)}",
         *_peaks_lines(result.peaks, scale, unit),
     ]
+    carrying = arm
+    if result.torque_peaks is not None:
+        carrying = arm if kwargs.get("payload") is None else arm.with_payload(kwargs["payload"])
+        data["torque_peaks"] = result.torque_peaks.as_dict()
+        data["torque_limit"] = result.torque_limit
+        data["payload_kg"] = kwargs.get("payload")
+        lines.append("torque / limit: " + ", ".join(
+            f"{n} {r:.3f}" for n, r in zip(arm.joint_names, result.torque_ratios)))
     if session_path:
-        session = new_session(arm, f"time-optimal {kind}")
+        session = new_session(carrying, f"time-optimal {kind}")
         session.add_trajectory(f"{kind} ({result.method})", result.trajectory)
         if result.history is not None:
             session.add_history(f"{kind} GA", result.history)

@@ -94,16 +94,28 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
 @click.argument("robot")
 @click.argument("out_dir", type=click.Path(file_okay=True))
 @click.option("--overwrite", is_flag=True, help="Replace a non-empty folder.")
+@click.option("--mjcf", is_flag=True,
+              help="Write a MuJoCo model (MJCF) instead, with sites at the flange and tcp (needs: pip install mujoco).")
 @json_option
-def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, as_json: bool) -> None:
-    """Write ROBOT as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR."""
-    from pinarms.export import export_urdf
+def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, as_json: bool) -> None:
+    """Write ROBOT as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
+    With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
+    at the flange and at the tcp, mimic joints as equality constraints.
+    """
+    from pinarms.export import export_mjcf, export_urdf
+
+    if mjcf:
+        result = export_mjcf(load_robot(robot), out_dir, overwrite=overwrite)
+        emit(
+            as_json,
+            {"folder": result.folder, "mjcf": result.mjcf, "sites": list(result.sites), "meshes": list(result.meshes)},
+            [f"wrote {result.mjcf} (sites: {', '.join(result.sites)}) and {len(result.meshes)} mesh file(s)"],
+        )
+        return
     result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite)
     emit(
         as_json,
         {"folder": result.folder, "urdf": result.urdf, "meshes": list(result.meshes)},
         [f"wrote {result.urdf} and {len(result.meshes)} mesh file(s)"],
     )
-
-

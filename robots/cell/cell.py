@@ -24,6 +24,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from ..collision_requests import cold_start
 from ..errors import CellError, CollisionGeometryError, InvalidInput, ModelError
 from ..robot import Robot
 from ..xacro_expand import mesh_path
@@ -193,6 +194,7 @@ class Cell:
         self._data = model.createData()
         self.fixtures = self._fixtures()
         self.pairs, self.allowed = classify_pairs(self, seed=seed)
+        self.kinds: tuple[str, ...] = ("self", "arm-arm", "arm-fixture")
         self._finish_geometry()
 
     # ------------------------------------------------------------------ building
@@ -281,7 +283,7 @@ class Cell:
 
     def _fixtures(self) -> tuple[Fixture, ...]:
         data = self.model.createData()
-        gd = pin.GeometryData(self.collision_model)
+        gd = cold_start(pin.GeometryData(self.collision_model))
         pin.updateGeometryPlacements(self.model, data, self.collision_model, gd, pin.neutral(self.model))
         by_link: dict[str, list[Shape]] = {name: [] for name in self.spec.fixtures}
         for k, g in enumerate(self.collision_model.geometryObjects):
@@ -327,10 +329,8 @@ class Cell:
                 )
 
     def _new_geometry_data(self) -> pin.GeometryData:
-        gd = pin.GeometryData(self.collision_model)
-        for req in gd.distanceRequests:
-            req.gjk_tolerance = 1e-10  # exact distances (coal's default 1e-6 m is coarser than the checks)
-        return gd
+        # exact distances (coal's default 1e-6 m is coarser than the checks), no warm start
+        return cold_start(pin.GeometryData(self.collision_model), distance_tolerance=1e-10)
 
     # --------------------------------------------------------------- joint vector
     @property
@@ -436,6 +436,39 @@ class Cell:
         Rg = R[:, parents] @ local_R
         pg = p[:, parents] + np.einsum("ngij,gj->ngi", R[:, parents], local_p)
         return Rg, pg
+
+    def with_pairs(self, kinds: str | tuple[str, ...] | list[str]) -> "Cell":
+        """The same cell checking only the pairs of the given kinds.
+
+        Args:
+            kinds: one or several of ``"self"``, ``"arm-arm"``, ``"arm-fixture"``; or
+                ``"external"`` for ``("arm-arm", "arm-fixture")`` (what a safety distance to
+                obstacles and other arms is about: an arm's own links are designed close).
+
+        The result shares the model and the arms; its :attr:`pairs` (and so every check) are
+        the subset. The pairs left out are not added to :attr:`allowed`.
+        """
+        import copy
+
+        if isinstance(kinds, str):
+            kinds = ("arm-arm", "arm-fixture") if kinds == "external" else (kinds,)
+        kinds = tuple(kinds)
+        unknown = [k for k in kinds if k not in ("self", "arm-arm", "arm-fixture")]
+        if unknown or not kinds:
+            raise InvalidInput(f"kinds must be among 'self', 'arm-arm', 'arm-fixture' (or 'external'), got {kinds!r}")
+        view = copy.copy(self)
+        view.pairs = tuple(p for p in self.pairs if p.kind in kinds)
+        gm = self.collision_model.copy()
+        gm.removeAllCollisionPairs()
+        for p in view.pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+        view.collision_model = gm
+        view._data = self.model.createData()
+        view._gd = view._new_geometry_data()
+        for cache in ("_bounds", "_checkers"):
+            view.__dict__.pop(cache, None)
+        view.kinds = kinds
+        return view
 
     def __repr__(self) -> str:
         return (

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from ..collision_requests import cold_start
 from ..errors import CollisionGeometryError, InvalidInput
 from .pairs import CollisionPair
 
@@ -117,7 +118,7 @@ class _Checkers:
     def __init__(self, cell: "Cell") -> None:
         self.cell = cell
         self.margin: float | None = None
-        self.gd = pin.GeometryData(cell.collision_model)
+        self.gd = cold_start(pin.GeometryData(cell.collision_model))
         self.manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(cell.model, cell.collision_model, self.gd)
         self.data = cell.model.createData()
         self.pools: dict[int, Any] = {}
@@ -135,6 +136,8 @@ class _Checkers:
             pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(
                 self.cell.model, self.cell.collision_model, threads
             )
+            for gd in pool.getGeometryDatas():
+                cold_start(gd)
             self.pools[threads] = pool
         if self.pool_margin.get(threads) != margin:
             for gd in pool.getGeometryDatas():
@@ -181,7 +184,7 @@ def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
     touching: list[tuple[int, ...]] = [()] * arr.shape[0]
     if hit.any():
         qp = cell.robot.q_to_pinocchio(arr)
-        gd = pin.GeometryData(cell.collision_model)
+        gd = cold_start(pin.GeometryData(cell.collision_model))
         _set_margin(gd, margin)
         for i in np.flatnonzero(hit):
             pin.updateGeometryPlacements(cell.model, cell._data, cell.collision_model, gd, qp[i])
@@ -284,6 +287,8 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
     Returns ``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``.
     """
     N = arr.shape[0]
+    if lb is None and N <= 4:  # a few configurations: every pair in Pinocchio's loop beats the broad phase
+        return _all_pairs_min_distance(cell, arr)
     if lb is None:
         lb = pair_lower_bounds(cell, arr)
     order = np.argsort(lb, axis=1, kind="stable")
@@ -313,3 +318,23 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
         dist[i], best_pair[i] = best, arg
         pa[i], pb[i] = res_best
     return dist, best_pair, pa, pb
+
+
+def _all_pairs_min_distance(cell: "Cell", arr: np.ndarray):
+    qp = cell.robot.q_to_pinocchio(arr)
+    gm, gd = cell.collision_model, cell._gd
+    N = arr.shape[0]
+    dist, pair = np.empty(N), np.empty(N, dtype=int)
+    pa, pb = np.empty((N, 3)), np.empty((N, 3))
+    for i in range(N):
+        pin.updateGeometryPlacements(cell.model, cell._data, gm, gd, qp[i])
+        pin.computeDistances(gm, gd)
+        d = np.array([r.min_distance for r in gd.distanceResults])
+        if not np.all(np.isfinite(d)):
+            p = cell.pairs[int(np.flatnonzero(~np.isfinite(d))[0])]
+            raise CollisionGeometryError(f"coal returned a non-finite distance for {p.body_a} – {p.body_b}")
+        k = int(np.argmin(d))
+        r = gd.distanceResults[k]
+        dist[i], pair[i] = d[k], k
+        pa[i], pb[i] = np.array(r.getNearestPoint1()), np.array(r.getNearestPoint2())
+    return dist, pair, pa, pb

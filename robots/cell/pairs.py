@@ -40,6 +40,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
+from ..collision_requests import cold_start
+
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
@@ -202,9 +204,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             probe.addGeometryObject(g)
         for a, b in checked:
             probe.addCollisionPair(pin.CollisionPair(a, b))
-        pd = pin.GeometryData(probe)
-        for req in pd.distanceRequests:
-            req.gjk_tolerance = 1e-12
+        pd = cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
         qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
         hits = np.zeros(len(checked))
         dmin = np.full(len(checked), np.inf)

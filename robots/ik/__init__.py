@@ -4,6 +4,8 @@
   :class:`KojiIK`: every solution within the joint limits, batched over targets.
 - :class:`NumericalIK`: damped least squares on Pinocchio's SE(3) log error with joint
   limits and seeded random restarts, for any arm (mimic joints and 7-DoF included).
+- :func:`near_limit_solutions`: closed-form solutions a little outside the joint ranges,
+  and by how much (to tell users; ``limit_tolerance=`` accepts them).
 
 Users normally call :meth:`robots.Robot.ik_all` and :meth:`robots.Robot.ik`.
 """
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 from .gantry import GantryIK
 from .koji import KojiIK
+from .near_limits import OutsideLimits, limit_excess, near_limit_solutions
 from .numerical import IKResult, NumericalIK
 from .scara import ScaraIK
 from .solver import FK_TOL, LIMIT_TOL, AnalyticIK
@@ -28,6 +31,9 @@ __all__ = [
     "KojiIK",
     "NumericalIK",
     "IKResult",
+    "OutsideLimits",
+    "limit_excess",
+    "near_limit_solutions",
     "FK_TOL",
     "LIMIT_TOL",
 ]

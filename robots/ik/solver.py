@@ -103,9 +103,10 @@ class AnalyticIK:
             )
 
     # ------------------------------------------------------------------ public
-    def _shifts(self) -> list[tuple[int, np.ndarray]]:
-        """Revolute joints whose range admits more than one 2π equivalent, with their ``k`` values."""
-        lo, hi = self.robot.lower, self.robot.upper
+    def _shifts(self, limit_tol: float = LIMIT_TOL) -> list[tuple[int, np.ndarray]]:
+        """Revolute joints whose range (widened to ``limit_tol``) admits more than one 2π equivalent, with their ``k``."""
+        widen = limit_tol - LIMIT_TOL
+        lo, hi = self.robot.lower - widen, self.robot.upper + widen
         out = []
         for j in np.flatnonzero(self._revolute):
             k = np.arange(np.ceil((lo[j] - np.pi) / _TWO_PI), np.floor((hi[j] + np.pi) / _TWO_PI) + 1)
@@ -114,7 +115,8 @@ class AnalyticIK:
         return out
 
     def _dense(
-        self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool, equivalents: bool = False
+        self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool, equivalents: bool = False,
+        limit_tol: float = LIMIT_TOL,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Solutions of one chunk sorted by distance to ``q_ref``: ``q (n, K, nq)``, ``valid (n, K)``, ``branch (n, K)``."""
         robot = self.robot
@@ -127,15 +129,16 @@ class AnalyticIK:
         for b in range(1, B):  # branches that coincide (singular or boundary poses)
             same = np.all(np.abs(q[:, :b] - q[:, b : b + 1]) <= 1e-8, axis=-1) & valid[:, :b]
             valid[:, b] &= ~np.any(same, axis=1)
-        lo, hi = robot.lower, robot.upper
+        widen = limit_tol - LIMIT_TOL  # a caller's tolerance beyond the solver's own
+        lo, hi = robot.lower - widen, robot.upper + widen
         if respect_limits and equivalents:  # every 2π equivalent within the limits
-            for j, k in self._shifts():
+            for j, k in self._shifts(limit_tol):
                 q = np.repeat(q, k.size, axis=1)
                 q[..., j] += _TWO_PI * np.tile(k, q.shape[1] // k.size)
                 valid = np.repeat(valid, k.size, axis=1)
                 branch = np.repeat(branch, k.size, axis=1)
         elif respect_limits:  # each branch once: every angle at its equivalent within the limits nearest q_ref
-            js = [j for j, _ in self._shifts()]
+            js = [j for j, _ in self._shifts(limit_tol)]
             if js:
                 lo_j, hi_j = lo[js], hi[js]
                 qj, ref = q[..., js], q_ref[:, None, js]
@@ -209,27 +212,30 @@ class AnalyticIK:
         respect_limits: bool = True,
         with_branches: bool = False,
         equivalents: bool = False,
+        limit_tol: float = LIMIT_TOL,
     ) -> tuple[np.ndarray, ...]:
         """Verified solutions of a batch: ``(index (M,), q (M, nq))``, index = target row, sorted by target then distance.
 
         With ``respect_limits=False`` the joint limits are ignored (each revolute angle is
         given once, wrapped to ``(-π, π]``): used to tell *out of reach* from *limits*.
         With ``with_branches`` a third array ``branch (M,)`` gives each solution's branch
-        label (see :meth:`robots.Robot.ik_branches`).
+        label (see :meth:`robots.Robot.ik_branches`). ``limit_tol`` [rad or m]: how far
+        outside its range a joint may lie (default the solver's own :data:`LIMIT_TOL`).
         """
         robot = self.robot
         N = targets.shape[0]
         nq = robot.nq
         q_ref = robot.neutral[None, :] if q_ref is None else np.asarray(q_ref, dtype=float)
         q_ref = np.ascontiguousarray(np.broadcast_to(q_ref, (N, nq)))
-        width = 8 * int(np.prod([k.size for _, k in self._shifts()])) if respect_limits and equivalents else 8
+        width = 8 * int(np.prod([k.size for _, k in self._shifts(limit_tol)])) if respect_limits and equivalents else 8
         chunk = max(1, min(_CHUNK, _MAX_ROWS // width))
         starts = list(range(0, N, chunk))
         parts: list = [None] * len(starts)
 
         def run(i: int) -> None:
             s = starts[i]
-            q, valid, branch = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits, equivalents)
+            q, valid, branch = self._dense(targets[s : s + chunk], q_ref[s : s + chunk], respect_limits, equivalents,
+                                           limit_tol)
             counts = valid.sum(axis=1)
             parts[i] = (np.repeat(np.arange(s, s + q.shape[0]), counts), q[valid], branch[valid])
 
@@ -244,7 +250,7 @@ class AnalyticIK:
         out = tuple(np.concatenate([p[k] for p in parts]) for k in range(3))
         return out if with_branches else out[:2]
 
-    def starts(self, target: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    def starts(self, target: np.ndarray, q_ref: np.ndarray, limit_tol: float = LIMIT_TOL) -> np.ndarray:
         """Branch candidates of one target ``(4, 4)`` as starts of a local refinement: ``(k, nq)``.
 
         Each revolute angle is moved to its 2π equivalent within the limits nearest ``q_ref
@@ -252,9 +258,10 @@ class AnalyticIK:
         are dropped, the rest sorted by distance to ``q_ref``. Unlike :meth:`solve` the
         candidates are *not* checked by forward kinematics (nor every 2π equivalent listed):
         :meth:`robots.Robot.ik` refines and checks them with Pinocchio, which costs less for
-        one target than the batched machinery.
+        one target than the batched machinery. ``limit_tol`` [rad or m] widens the limits.
         """
-        lo, hi = self.robot.lower, self.robot.upper
+        widen = limit_tol - LIMIT_TOL
+        lo, hi = self.robot.lower - widen, self.robot.upper + widen
         q_ref = np.asarray(q_ref, dtype=float)
         q = self.raw(target[None], q_ref[None])[0]
         q = q[np.all(np.isfinite(q), axis=1)]
@@ -270,11 +277,13 @@ class AnalyticIK:
         q = q[np.all((q >= lo - LIMIT_TOL) & (q <= hi + LIMIT_TOL), axis=1)]
         return q[argsort_tied(np.linalg.norm(q - q_ref, axis=1))]
 
-    def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None, equivalents: bool = False) -> list[np.ndarray]:
+    def solve(self, targets: np.ndarray, q_ref: np.ndarray | None = None, equivalents: bool = False,
+              limit_tol: float = LIMIT_TOL) -> list[np.ndarray]:
         """The solutions within limits per target: a list of ``N`` arrays ``(k_i, nq)``, nearest to ``q_ref`` first.
 
         Each branch once (its angles at the 2π equivalents within the limits nearest
         ``q_ref``); with ``equivalents`` every 2π equivalent within the limits as well.
+        ``limit_tol`` [rad or m]: how far outside its range a joint may lie.
         """
-        idx, q = self.candidates(targets, q_ref, equivalents=equivalents)
+        idx, q = self.candidates(targets, q_ref, equivalents=equivalents, limit_tol=limit_tol)
         return split_by_target(idx, q, targets.shape[0])

@@ -265,33 +265,79 @@ def test_ik_seed_q_of_the_wrong_size_is_a_one_line_error(run):
 
 
 def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypatch):
-    import click
+    import re
 
     from pinarms import optim
     import pinarms.cli._common as cli_common
 
-    seen = {}
+    monkeypatch.setattr(cli_common, "show_progress", lambda as_json: not as_json)  # as on a terminal
+    budget = optim.GASettings.seed002().max_generations
 
-    class Bar:
-        def __init__(self, length, **_):
-            seen["length"], seen["updates"] = length, 0
+    def last_state(result) -> tuple[int, int]:
+        line = result.stderr.split("\r\x1b[2K")[-1]
+        assert line.startswith("GA generations  [") and line.endswith("s\n"), line
+        done, total = re.search(r"(\d+)/(\d+)", line).groups()
+        return int(done), int(total)
 
-        def __enter__(self):
-            return self
+    done, total = last_state(run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55"))
+    assert total == budget and 0 < done <= total
+    done, total = last_state(run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--generations", "7"))
+    assert total == 7 and done <= 7
+    quiet = run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--generations", "7", "--json")
+    assert quiet.stderr == ""  # never with --json
+    assert run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--method", "exact").stderr == ""
 
-        def __exit__(self, *exc):
-            return False
 
-        def update(self, n):
-            seen["updates"] += n
+def test_workspace_progress_from_a_million_samples(run, monkeypatch):
+    import pinarms.cli._common as cli_common
 
-    monkeypatch.setattr(cli_common, "show_progress", lambda as_json: True)
-    monkeypatch.setattr(click, "progressbar", Bar)
-    run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55")
-    assert seen["length"] == optim.GASettings.seed002().max_generations
-    assert 0 < seen["updates"] <= seen["length"]
-    run("optimize", "--kind", "3-5-3", "--deg", *SEED000, "--vmax", "55", "--generations", "7")
-    assert seen["length"] == 7 and seen["updates"] <= 7
+    monkeypatch.setattr(cli_common, "show_progress", lambda as_json: not as_json)
+    assert run("workspace", "gantry_flower", "-n", "20000").stderr == ""
+    big = run("workspace", "gantry_flower", "-n", "1000000")
+    assert big.stderr.split("\r\x1b[2K")[-1].startswith("workspace samples  [########################]  100%  1000000/1000000")
+
+
+def test_ik_names_closed_form_solutions_just_outside_the_ranges(run):
+    """seed 004: (1197.3, 250, -929.2) mm needs the shoulder 0.0011° above 25° and the forearm 0.0046° below -30°."""
+    out = run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg").output
+    assert "note: the closed-form solution (-90  25.0011  -30.0046  90) lies outside the joint ranges: " \
+           "shoulder by 0.001128 deg (above 25), forearm by 0.004608 deg (below -30); --limit-tol 0.0047 accepts it" in out
+    data = as_json(run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg", "--limit-tol", "0.0047", "--json"))
+    (sol,) = data["solutions"]
+    np.testing.assert_allclose(sol["q"], [-90.0, 25.0011, -30.0046, 90.0], atol=1e-4)
+    assert sol["position_error_m"] < 1e-9
+    assert sol["outside_limits"] == pytest.approx({"shoulder": 0.0011279, "forearm": -0.0046080}, abs=1e-6)
+    # too small a tolerance: the numerical solution within the ranges, and the note again
+    data = as_json(run("ik", "koji_turner", "1197.3", "250", "-929.2", "--mm", "--deg", "--limit-tol", "0.004", "--json"))
+    assert data["solutions"][0]["outside_limits"] == {} and len(data["near_limit_solutions"]) == 1
+    pose = ("1197.3", "250", "-929.2", "0", "0", "0", "--mm", "--deg")
+    assert_user_error(run("ik", "koji_turner", *pose, ok=False), 1, "needs shoulder 0.001128 deg above its range end 25",
+                      "--limit-tol accepts")
+    data = as_json(run("ik", "koji_turner", *pose, "--limit-tol", "0.005", "--json"))
+    np.testing.assert_allclose(data["solutions"][0]["q"], [-90.0, 25.0011, -30.0046, 90.0], atol=1e-4)
+
+
+def test_unreachable_target_in_the_units_typed(run):
+    err = run("ik", "koji_turner", "3000", "10", "10", "--mm", ok=False)
+    assert_user_error(err, 1, "reaches (3000, 10, 10) mm", "out of reach", "1547 mm away")
+    err = run("ik", "koji_turner", "3", "0.01", "0.01", ok=False)
+    assert_user_error(err, 1, "reaches (3, 0.01, 0.01) m", "1.547 m away")
+
+
+def test_robot_name_typo_suggests_close_names(run):
+    assert_user_error(run("fk", "aubo_i5", "0", "0", "0", "0", "0", "0", ok=False), 1, "did you mean aubo_i3?")
+
+
+def test_bad_csv_names_row_and_column(run, tmp_path):
+    bad = tmp_path / "via.csv"
+    bad.write_text("t,j1,j2\n\n0,0.1,0.2\n1,0.3,abc\n2,0.5,0.6\n", encoding="utf-8")
+    assert_user_error(run("plan", "--kind", "multi-quintic", "--file", str(bad), ok=False), 1,
+                      "CSV row 4, column 3 ('j2'): 'abc' is not a finite number")
+    bad.write_text("t,j1,j2\n0,0.1,0.2\n1,0.3\n", encoding="utf-8")
+    assert_user_error(run("plan", "--kind", "multi-quintic", "--file", str(bad), ok=False), 1,
+                      "CSV row 3 has 2 cells, the header has 3 (t, j1, j2)")
+    bad.write_text("t,j1\n0,0\n1,nan\n", encoding="utf-8")
+    assert_user_error(run("plan", "--kind", "multi-quintic", "--file", str(bad), ok=False), 1, "row 3, column 2 ('j1')")
 
 
 def test_workspace_prints_the_recommended_table_region(run):

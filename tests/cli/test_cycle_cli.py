@@ -69,3 +69,38 @@ def test_cycle_errors_are_one_line(args, fragment):
     assert result.exit_code == 1, (result.output, result.exception)
     assert "Traceback" not in result.output and "Error:" in result.stderr
     assert fragment in result.stderr, result.stderr
+
+
+def test_cycle_with_a_payload_times_torques_too():
+    base = ["cycle", "aubo_i3", "--pick", "450", "-100", "20", "--place", "-100", "450", "20", "--mm",
+            "--lift", "80", "--dwell", "0.3", "--json"]
+    free = CliRunner().invoke(cli, base)
+    loaded = CliRunner().invoke(cli, base + ["--payload", "3kg"])
+    assert free.exit_code == 0 and loaded.exit_code == 0, (free.output, loaded.output)
+    a, b = json.loads(free.stdout), json.loads(loaded.stdout)
+    assert a["payload"] is None and b["payload"]["mass_kg"] == 3.0
+    assert max(b["torque_ratios"]) <= 1.0 + 1e-9 and max(b["torque_ratios"]) > 0.999  # the shoulder binds
+    assert b["cycle_time_s"] > a["cycle_time_s"] * 1.01  # 5.647 s against 5.536 s
+    assert b["move_times_s"][0] > b["move_times_s"][1]  # loaded there, empty back
+    text = CliRunner().invoke(cli, base[:-1] + ["--payload", "1500g"]).stdout
+    assert "torque / limit (carrying 1.5 kg to the place, empty back): shoulder_joint" in text
+
+
+def test_payload_options_are_checked():
+    bad = CliRunner().invoke(cli, ["cycle", "aubo_i3", "--pick", "0.45", "-0.1", "0.02", "--place", "-0.1", "0.45",
+                                   "0.02", "--payload", "3lb"])
+    assert bad.exit_code != 0 and "a mass must be a number of kg" in bad.output
+    no_robot = CliRunner().invoke(cli, ["optimize", "--kind", "multi-quintic", "--via", "0,0", "--via", "1,1",
+                                        "--vmax", "1", "--payload", "3kg"])
+    assert no_robot.exit_code == 2 and "need --robot" in no_robot.output
+
+
+def test_mass_units_at_the_edge():
+    from pinarms.robots.errors import InvalidInput
+    from pinarms.units import mass_kg
+
+    assert mass_kg("3kg") == 3.0 and mass_kg(" 1.5 KG ") == 1.5 and mass_kg("800g") == pytest.approx(0.8)
+    assert mass_kg("2") == 2.0
+    for text in ("-1kg", "nan", "3 lb", ""):
+        with pytest.raises(InvalidInput):
+            mass_kg(text)

@@ -52,6 +52,16 @@ def test_demo_text_table_only_one_study(tmp_path):
     assert "paper vs pinarms" in result.stdout
     assert "FK example 1 z" in result.stdout and "differs" in result.stdout
     assert (tmp_path / "table.md").is_file()
+    # a pipe or a file gets one line per row; a terminal of 100 columns gets the table wrapped to it,
+    # with a bar per study on stderr; table.md keeps every row on one line
+    long_note = max(result.stdout.splitlines(), key=len)
+    assert len(long_note) > 100
+    narrow = CliRunner().invoke(cli, ["demo", "--quick", "--only", "004", "--out", str(tmp_path)], env={"COLUMNS": "100"})
+    table = narrow.stdout.split("\n\nwrote ")[0]
+    assert max(len(line) for line in table.splitlines()) <= 100
+    assert sorted(table.replace(" ", "").replace("-", "").replace("\n", "")) == sorted(
+        result.stdout.split("\n\nwrote ")[0].replace(" ", "").replace("-", "").replace("\n", ""))
+    assert any(len(line) > 100 for line in (tmp_path / "table.md").read_text(encoding="utf-8").splitlines())
 
 
 def test_demo_ik_rows_use_the_error_the_paper_states():

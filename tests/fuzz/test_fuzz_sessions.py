@@ -343,3 +343,50 @@ def test_too_many_members(tmp_path):
     members = list(BASE_MEMBERS.items()) + [(f"junk/{i}", b"") for i in range(20_001)]
     with pytest.raises(SessionFormatError, match="max_members"):
         viz.load_session(_write(tmp_path, _zip(members, zipfile.ZIP_STORED)))
+
+
+# ---------------------------------------------------------------------------- the builder
+GANTRY = robots.load("gantry_flower")
+_anything = st.one_of(st.none(), st.booleans(), st.integers(-3, 3), st.floats(), st.text(max_size=12),
+                      st.sampled_from(["\ud800", "a/b", "", " ", "x" * 101, "../../x", "\x00"]),
+                      st.lists(st.floats(), max_size=7), st.dictionaries(st.text(max_size=5), st.floats(), max_size=3),
+                      st.just(np.zeros((2, 3), dtype=complex)), st.just(object()))
+
+
+@settings(max_examples=120 * EXPLORE)
+@given(data=st.data(), method=st.sampled_from(["add_points", "add_box", "add_workspace", "add_history",
+                                               "add_trajectory", "add_robot", "init", "save"]))
+@example(data=None, method="metadata-surrogate")
+@example(data=None, method="save-nul")
+def test_builder_arguments(tmp_path_factory, data, method):
+    folder = tmp_path_factory.mktemp("b")
+    s = viz.Session(GANTRY)
+    if method == "metadata-surrogate":
+        call = (viz.Session, (GANTRY,), {"metadata": {"k": "\ud800"}})
+    elif method == "save-nul":
+        call = (s.save, (folder / "a\x00b.pinarms",), {})
+    elif method == "init":
+        call = (viz.Session, (data.draw(st.one_of(_anything, st.just("ur5"))),),
+                {"title": data.draw(_anything), "metadata": data.draw(st.one_of(st.none(), _anything))})
+    elif method == "save":
+        name = data.draw(st.one_of(st.text(max_size=12), st.sampled_from(["", ".", "..", "sub/x", "/", "x\x00"])))
+        call = (s.save, (folder / name if name and "\x00" not in name else name,), {})
+    else:
+        n_required = {"add_points": 2, "add_box": 2, "add_workspace": 1, "add_history": 2, "add_trajectory": 2,
+                      "add_robot": 1}[method]
+        args = [data.draw(st.one_of(st.text(max_size=12), _anything))]
+        n_optional = {"add_box": 2, "add_workspace": 1}.get(method, 0)
+        args += [data.draw(_anything) for _ in range(n_required - 1 + data.draw(st.integers(0, n_optional)))]
+        call = (getattr(s, method), tuple(args), {})
+    before = listing(folder)
+    fn, args, kwargs = call
+    result, err = outcome(fn, *args, **kwargs)
+    after = listing(folder)
+    if method in ("save", "save-nul") and err is None:
+        assert after[str(folder)] - before[str(folder)] <= {str(Path(result).relative_to(folder))}
+    else:
+        assert after == before, "a refused or non-saving call wrote a file"
+    if err is None and method not in ("save", "save-nul", "init"):
+        saved, err2 = outcome(s.save, folder / "ok.pinarms")
+        assert err2 is None, err2
+        assert viz.load_session(saved) == s

@@ -8,6 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.optim.cycle import LINE_NAMES, PickPlace, plan_cycle
 from pinarms.optim.errors import InvalidLimits
+from pinarms.planning import JointLimits
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
 # pick / place points inside each arm's working region (base frame, m)
@@ -167,3 +168,45 @@ def test_bad_arguments():
         plan_cycle(arm, spec, kind="cubic")
     with pytest.raises(InvalidInput, match="PickPlace"):
         plan_cycle(arm, {"pick": [0.3, 0.25, 0.1]})
+
+
+# ------------------------------------------------------------------ straight approach and retreat
+@pytest.fixture(scope="module")
+def straight_aubo():
+    arm = robots.load("aubo_i3")
+    pick, place = POINTS["aubo_i3"]
+    spec = PickPlace(pick, place, lift=0.05, dwell=0.2)
+    return arm, plan_cycle(arm, spec, amax=2.0 * arm.velocity_limit, approach="straight", tool_speed=0.5)
+
+
+def test_straight_approach_keeps_the_tcp_on_the_vertical_lines(straight_aubo):
+    arm, res = straight_aubo
+    assert res.approach == "straight"
+    assert res.max_line_deviation < 1e-4  # within the Cartesian path's 0.1 mm tolerance
+    joint = plan_cycle(arm, res.spec, amax=res.amax)
+    assert joint.max_line_deviation > 1e-3  # the joint-space lift bows by more than 1 mm on this arm
+    assert res.joint_cycle_time == pytest.approx(joint.cycle_time, rel=1e-12)
+    assert res.straight_cost == pytest.approx(res.cycle_time - joint.cycle_time)
+    assert 0.0 <= res.line_cost < 0.01  # a 5 cm lift costs almost nothing over a joint-space line
+
+
+def test_straight_cycle_is_one_feasible_closed_trajectory(straight_aubo):
+    arm, res = straight_aubo
+    assert res.trajectory.check(JointLimits(res.vmax, res.amax)).ok
+    assert res.trajectory.duration == pytest.approx(res.cycle_time, rel=1e-12)
+    q_end = res.trajectory(res.trajectory.end_time)
+    assert np.abs(q_end - res.q_via[0]).max() < 1e-8  # back at the pick configuration
+    for move in res.moves:
+        assert move.total == pytest.approx(move.trajectory.duration, rel=1e-12)
+        for line in move.lines:
+            t = np.linspace(0.0, line.duration, 401)
+            assert line.tool_speed(t)[0].max() <= 0.5 * (1 + 1e-6)  # carrying food
+    assert res.as_dict()["approach"] == "straight"
+
+
+def test_straight_approach_needs_an_acceleration_limit():
+    arm = robots.load("scara_mushroom")
+    with pytest.raises(InvalidLimits, match="amax"):
+        plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="straight")
+    with pytest.raises(InvalidInput, match="approach"):
+        plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="diagonal")

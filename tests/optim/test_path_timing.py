@@ -64,7 +64,7 @@ def test_the_result_is_a_trajectory_feasible_when_rechecked_densely(timed, limit
 
 def test_within_one_percent_of_toppra_on_the_same_path(timed, limits, lift):
     v, a = limits
-    same_grid = toppra_path_duration(lift, v, a, np.unique(timed.s))
+    same_grid = toppra_path_duration(lift, v, a, np.unique(timed.grid))
     assert timed.duration == pytest.approx(same_grid, rel=1e-3)
     dense = toppra_path_duration(lift, v, a, np.linspace(0.0, lift.length, 2001))
     assert timed.duration == pytest.approx(dense, rel=1e-2)
@@ -97,7 +97,8 @@ def test_tool_speed_limit_while_carrying_food(aubo, lift, limits):
     assert lin.max() <= 0.5 * (1.0 + 1e-3)
     assert lin.max() > 0.49  # the limit is reached on a 0.3 m lift
     assert res.ratios["tool speed"] <= 1.0 + 1e-9
-    assert res.duration == pytest.approx(toppra_path_duration(lift, v, a, np.unique(res.s), tool_speed=0.5), rel=1e-3)
+    assert res.duration == pytest.approx(toppra_path_duration(lift, v, a, np.unique(res.grid), tool_speed=0.5),
+                                         rel=1e-3)
     assert np.abs(res.tool_speed(t[::50])[0] - lin[::50]).max() < 1e-6  # the result's own speed profile agrees
 
 
@@ -125,10 +126,28 @@ def test_a_stop_brings_the_arm_to_rest(aubo):
     assert path.stops.size == 1
     res = time_optimal(path, [JointVelocityConstraint(aubo.velocity_limit),
                               JointAccelerationConstraint(2 * aubo.velocity_limit)])
-    k = int(np.flatnonzero(np.isclose(res.s, path.stops[0]))[0])
-    t_stop = res.t[k]
-    assert res.sd[k] == 0.0
-    assert np.abs(res.trajectory.sample(t_stop)[1]).max() < 1e-12
+    t_stop = res.time_at(path.stops[0])[0]
+    knots = res.trajectory.knot_times
+    k = int(np.argmin(np.abs(knots - t_stop)))
+    assert abs(knots[k] - t_stop) < 1e-6  # the sections join at the stop (ṡ = 0: s(t) is flat there)
+    assert res.state(knots[k])[1][0] == 0.0
+    assert np.abs(res.trajectory.sample(knots[k])[1]).max() < 1e-12
+
+
+def test_jerk_limit_gives_a_smoothed_feasible_result(lift, limits, timed):
+    v, a = limits
+    cons = [JointVelocityConstraint(v), JointAccelerationConstraint(a)]
+    res = time_optimal(lift, cons, jerk=60.0)
+    assert res.smoothing > 0.0
+    assert res.trajectory.check(JointLimits(v, a, 60.0)).ok  # exact peaks, jerk included
+    assert res.trajectory.peaks().jerk.max() > 0.999 * 60.0 or res.trajectory.peaks().acceleration.max() > 0.999 * a[0]
+    assert timed.duration < res.duration < 2.0 * timed.duration
+    t = np.linspace(0.0, res.duration, 5001)
+    s, sd, sdd = res.state(t)
+    assert np.all(np.diff(s) >= 0.0) and sd[0] == 0.0 and abs(sd[-1]) < 1e-12
+    assert np.abs(res.trajectory(t) - lift(s)).max() < 1e-12  # still the same path, exactly
+    _, qd, qdd, _ = res.trajectory.sample(np.array([0.0, res.duration]))
+    assert np.abs(qdd).max() < 1e-9  # smoothed: no acceleration step at the start and the end
 
 
 def test_the_trajectory_goes_into_a_session_and_comes_back(timed, aubo, tmp_path):

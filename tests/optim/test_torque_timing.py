@@ -132,3 +132,81 @@ def test_cycle_carries_the_payload_to_the_place_only(aubo):
     empty_dense = _dense_ratio(aubo, cycle.moves[1].trajectory, limits, 20_001)
     assert np.all(loaded_dense <= 1.0 + 1e-9) and np.all(empty_dense <= 1.0 + 1e-9)
     assert cycle.as_dict()["payload"]["mass_kg"] == 3.0
+
+
+# ------------------------------------------------------------------ time-optimal along the path
+def _toppra_torque(path, robot, vmax, grid):
+    """toppra's own TOPP-RA with its JointTorqueConstraint (inverse dynamics = our RNEA) on ``path``."""
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+    from toppra.interpolator import AbstractGeometricPath
+
+    class Adapter(AbstractGeometricPath):
+        def __call__(self, s, order=0):
+            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
+            return out[0] if np.ndim(s) == 0 else out
+
+        @property
+        def dof(self):
+            return path.n_joints
+
+        @property
+        def path_interval(self):
+            return np.array([0.0, path.length])
+
+    L, v = robot.effort_limit, np.asarray(vmax, dtype=float)
+    constraints = [toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
+                   toppra.constraint.JointTorqueConstraint(
+                       lambda q, qd, qdd: robot.inverse_dynamics(q, qd, qdd), np.column_stack([-L, L]),
+                       np.zeros(path.n_joints),
+                       discretization_scheme=toppra.constraint.DiscretizationType.Interpolation)]
+    algo = toppra.algorithm.TOPPRA(constraints, Adapter(), gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    sd = np.asarray(algo.compute_parameterization(0.0, 0.0)[1], dtype=float)
+    return float(np.sum(2.0 * np.diff(grid) / (sd[:-1] + sd[1:])))
+
+
+@pytest.mark.parametrize("payload", [0.0, 3.0])
+def test_toppra_agrees_with_the_exact_time_optimal_scaling_on_one_segment(aubo, payload):
+    """One straight joint-space segment under joint speed + torque limits: TOPP-RA (toppra) and pinarms's
+    time-optimal path scaling with its JointTorqueConstraint agree within 2 % (seen: 1e-8 on the same grid);
+    the polynomial segment timing (minimize_time, exact) is slower, never faster."""
+    from pinarms import planning
+
+    loaded = aubo.with_payload(payload)
+    path = planning.joint_spline(VIA[[0, 2]], robot=aubo)
+    ours = optim.time_optimal(path, [planning.path_constraints.JointVelocityConstraint(aubo.velocity_limit),
+                                     planning.JointTorqueConstraint(loaded)], grid=200)
+    reference = _toppra_torque(path, loaded, aubo.velocity_limit, np.linspace(0.0, path.length, 201))
+    assert ours.duration == pytest.approx(reference, rel=0.02)
+    dense = _dense_ratio(loaded, ours.trajectory, aubo.effort_limit, 50_001)
+    assert np.all(dense <= 1.0 + 1e-9) and dense.max() > 0.999  # feasible and tight
+    poly = optim.minimize_time(VIA[[0, 2]], "multi-quintic", aubo.velocity_limit, method="exact",
+                               robot=aubo, payload=payload, torque_limits=True)
+    assert poly.total >= ours.duration
+    # the reference on the polynomial's own path (spline of its samples, cut at rests) says the same
+    assert optim.toppra_limit(poly.trajectory, aubo.velocity_limit, robot=aubo, payload=payload,
+                              torque_limits=True) == pytest.approx(reference, rel=0.02)
+
+
+def test_torque_path_constraint_refuses_a_load_it_cannot_hold(aubo):
+    from pinarms import planning
+
+    path = planning.joint_spline(VIA[[0, 2]], robot=aubo)
+    weak = planning.JointTorqueConstraint(aubo.with_payload(3.0), limit=[100.0, 5.0, 100.0, 100.0, 100.0, 100.0])
+    with pytest.raises(InfeasibleProblem, match="no admissible speed at s = "):
+        optim.time_optimal(path, [weak])
+
+
+def test_a_path_through_a_pose_the_arm_cannot_hold_is_named(aubo):
+    """Both via points can be held, the level arm between them cannot: no timing exists."""
+    q0, q1 = np.array([0.0, -1.2, 0.0, 0.0, 0.0, 0.0]), np.array([0.0, -1.9, 0.0, 0.0, 0.0, 0.0])
+    loaded = aubo.with_payload(3.0)
+    g = np.abs(loaded.gravity(np.array([q0, [0.0, -np.pi / 2, 0.0, 0.0, 0.0, 0.0], q1])))[:, 1]
+    limits = aubo.effort_limit.copy()
+    limits[1] = 0.5 * (max(g[0], g[2]) + g[1])  # above both ends, below the level pose
+    for method in ("exact", "ga"):
+        with pytest.raises(InfeasibleProblem, match=r"cannot hold the path still between via points 0 and 1 .* "
+                                                    r"joint upperArm_joint needs"):
+            optim.minimize_time(np.array([q0, q1]), "multi-quintic", aubo.velocity_limit, method=method,
+                                max_generations=5, robot=aubo, payload=3.0, torque_limits=limits)

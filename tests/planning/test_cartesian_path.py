@@ -8,7 +8,6 @@ import pytest
 from pinarms import robots
 from pinarms.planning import (CartesianPath, JointLimitOnPath, PathError, SingularityOnPath, UnreachableOnPath,
                               cartesian_path, joint_spline)
-from pinarms.planning import _so3
 from pinarms.robots.layout import default_orientation
 
 
@@ -22,8 +21,8 @@ def pose(R, p):
 def dense(path: CartesianPath, per_interval: int = 10) -> np.ndarray:
     """Arc lengths 10x denser than the knots the path was built from (every knot included)."""
     b = path.breaks
-    return np.concatenate([b[:-1, None] + np.diff(b)[:, None] * np.arange(per_interval) / per_interval,
-                           ]).reshape(-1).tolist() + [b[-1]]
+    inner = b[:-1, None] + np.diff(b)[:, None] * np.arange(per_interval) / per_interval
+    return np.append(inner.reshape(-1), b[-1])
 
 
 def distance_to_segment(p, a, b):
@@ -47,7 +46,7 @@ def lift(aubo):
 def test_straight_lift_stays_within_tolerance_of_the_line(aubo, lift):
     P, path = lift
     assert path.tolerance == 1e-4
-    s = np.array(dense(path))
+    s = dense(path)
     assert s.size == 10 * (path.breaks.size - 1) + 1
     T = aubo.fk(path(s))  # FK at 10x the knot density
     off_line = distance_to_segment(T[:, :3, 3], P[0, :3, 3], P[1, :3, 3])
@@ -66,7 +65,7 @@ def test_a_tighter_tolerance_adds_knots_where_needed(aubo, lift):
     P, loose = lift
     tight = cartesian_path(aubo, P, tolerance=1e-7, q_start=loose.q_knots[0])
     assert tight.breaks.size > loose.breaks.size
-    s = np.array(dense(tight))
+    s = dense(tight)
     assert tight.deviation(s)[0].max() < 1e-7
     assert np.abs(tight(s) - loose(s)).max() < 1e-3  # same branch, same joint path
 
@@ -77,7 +76,7 @@ def test_blended_corners_stay_within_tolerance_and_joint_tangent_is_continuous()
     P = np.stack([pose(R, p) for p in ([0.4, 0.2, 0.1], [0.4, 0.2, 0.3], [0.2, 0.45, 0.3], [0.2, 0.45, 0.1])])
     path = cartesian_path(ur5, P, blend=0.05)
     assert path.stops.size == 0
-    s = np.array(dense(path))
+    s = dense(path)
     assert path.deviation(s)[0].max() < 1e-4
     inner = path.breaks[1:-1]
     _, dq_l, _ = path.sample(inner, "left")
@@ -98,7 +97,7 @@ def test_other_arm_families(name, points):
     R = default_orientation(arm)
     P = np.stack([pose(R, p) for p in points])
     path = cartesian_path(arm, P, blend=0.03)
-    s = np.array(dense(path))
+    s = dense(path)
     pos, rot = path.deviation(s)
     assert pos.max() < 1e-4
     assert arm.within_limits(path(s)).all()

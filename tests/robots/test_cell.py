@@ -8,6 +8,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.cell import cell_names, load_cell, stale_cells
+from pinarms.robots.collision_requests import cold_start
+from pinarms.robots.self_collision import SelfCollision
 from pinarms.robots.errors import (
     CellError,
     CellNotFound,
@@ -175,7 +177,7 @@ def test_batched_single_and_plain_pinocchio_loops_agree(line):
     q = line.random_q(400, seed=5)
     gm = line.collision_model
     for margin in (0.0, 0.02):
-        gd = pin.GeometryData(gm)
+        gd = cold_start(pin.GeometryData(gm))
         for req in gd.collisionRequests:
             req.security_margin = margin
         data = line.model.createData()
@@ -188,7 +190,7 @@ def test_batched_single_and_plain_pinocchio_loops_agree(line):
         np.testing.assert_array_equal(line.in_collision(q, margin=margin), plain)
         np.testing.assert_array_equal([line.in_collision(x, margin=margin) for x in q], plain)
     hits = line.collisions(q[:60])
-    gd = pin.GeometryData(gm)
+    gd = cold_start(pin.GeometryData(gm))
     data = line.model.createData()
     for i, qp in enumerate(line.robot.q_to_pinocchio(q[:60])):
         pin.updateGeometryPlacements(line.model, data, gm, gd, qp)
@@ -196,14 +198,38 @@ def test_batched_single_and_plain_pinocchio_loops_agree(line):
         assert hits.touching[i] == tuple(k for k, r in enumerate(gd.collisionResults) if r.isCollision())
 
 
+def test_checks_match_a_fresh_geometry_data_per_configuration(station):
+    """The ground truth: coal from scratch for every configuration (no warm-started GJK)."""
+    q = station.random_q(600, seed=9)
+    gm = station.collision_model
+    data = station.model.createData()
+    truth = []
+    for qp in station.robot.q_to_pinocchio(q):
+        gd = pin.GeometryData(gm)
+        pin.updateGeometryPlacements(station.model, data, gm, gd, qp)
+        truth.append(pin.computeCollisions(gm, gd, True))
+    truth = np.array(truth)
+    assert 0.1 < truth.mean() < 0.9
+    np.testing.assert_array_equal(station.in_collision(q), truth)
+    np.testing.assert_array_equal([station.in_collision(x) for x in q], truth)
+    arm = robots.load("aubo_i3")
+    sc = SelfCollision(arm)
+    qa = arm.random_q(600, seed=9)
+    truth = []
+    for qp in arm.q_to_pinocchio(qa):
+        gd = pin.GeometryData(sc._gm)
+        pin.updateGeometryPlacements(arm.model, arm.model.createData(), sc._gm, gd, qp)
+        truth.append(pin.computeCollisions(sc._gm, gd, True))
+    np.testing.assert_array_equal(sc.in_collision(qa), truth)
+    np.testing.assert_array_equal([sc.in_collision(x) for x in qa], truth)
+
+
 def test_clearance_is_the_exact_minimum_over_the_checked_pairs(line, station):
     for cell in (line, station):
         q = cell.random_q(80, seed=2)
         cl = cell.clearance(q)
         gm = cell.collision_model
-        gd = pin.GeometryData(gm)
-        for req in gd.distanceRequests:
-            req.gjk_tolerance = 1e-10
+        gd = cold_start(pin.GeometryData(gm), distance_tolerance=1e-10)
         data = cell.model.createData()
         for i, qp in enumerate(cell.robot.q_to_pinocchio(q)):
             pin.updateGeometryPlacements(cell.model, data, gm, gd, qp)

@@ -163,3 +163,52 @@ def test_docs_joint_curves_picture(tmp_path):
                               title="seed 000: 3-5-3 at the paper's optimised times 1.086, 1.243, 1.278 s")
     w, h = Image.open(out).size
     assert w > 800 and h > 900
+
+
+def test_tool_speed_plot_of_a_straight_lift_and_its_joint_curves(tmp_path):
+    from pathlib import Path
+
+    from pinarms import optim, robots
+    from pinarms.robots.layout import default_orientation
+
+    arm = robots.load("aubo_i3")
+    poses = np.stack([np.eye(4), np.eye(4)])
+    poses[:, :3, :3] = default_orientation(arm)
+    poses[0, :3, 3], poses[1, :3, 3] = [0.35, 0.20, 0.0], [0.35, 0.20, 0.30]
+    path = planning.cartesian_path(arm, poses)
+    v, a = arm.velocity_limit, 2.0 * arm.velocity_limit
+    timing = optim.time_optimal(path, [planning.JointVelocityConstraint(v), planning.JointAccelerationConstraint(a),
+                                       planning.ToolSpeedConstraint(0.5)])
+    speed_png, joints_png = tmp_path / "cartesian_lift_tool_speed.png", tmp_path / "cartesian_lift_joints.png"
+    if os.environ.get("PINARMS_DOCS_PICTURES") == "1":
+        docs = Path(__file__).resolve().parents[2] / "docs"
+        speed_png, joints_png = docs / speed_png.name, docs / joints_png.name
+    t, lin, ang = planning.tcp_speed(arm, timing.trajectory, 1000.0)
+    assert ang.max() < 1e-9  # a pure translation
+    out = viz.plot_tool_speed(speed_png, t, lin, limit=0.5,
+                              title="AUBO-i3: straight 0.3 m lift, time-optimal, tcp speed <= 0.5 m/s")
+    assert Image.open(out).size[0] > 700
+    out = viz.plot_trajectory(joints_png, timing.trajectory, limits=planning.JointLimits(v, a), robot=arm,
+                              title=f"AUBO-i3: straight 0.3 m lift in {timing.duration:.3f} s (TOPP-RA, 2 v/s)")
+    assert Image.open(out).size[1] > 900  # four panels; the dense timing's knots are not drawn
+    with pytest.raises(InvalidInput, match="same length"):
+        viz.plot_tool_speed(tmp_path / "bad.png", t, lin[:-1])
+
+
+def test_torque_curves_against_limits(tmp_path):
+    from pinarms import robots
+    from pinarms.viz.plots import plot_torques
+
+    arm = robots.load("aubo_i3").with_payload(3.0)
+    move = planning.multi_quintic([0.0, 0.6], np.array([[0.3, -0.4, 1.2, 0.2, 1.57, 0.0], [-0.9, 0.4, 1.8, 0.5, 1.2, 0.5]]))
+    t = np.linspace(0.0, 0.6, 200)
+    tau = move.torques(arm, t)
+    out = plot_torques(tmp_path / "tau.svg", t, tau, arm.effort_limit, joint_names=arm.joint_names,
+                       series={"slower": (t * 1.2, move.scaled(1.2).torques(arm, t * 1.2))}, title="torques")
+    text = out.read_text()
+    peak = np.abs(tau[:, 1]).max() / arm.effort_limit[1]
+    assert "upperArm_joint" in text and f"peak {peak:.0%}" in text and "slower" in text and "±limit" in text
+    with pytest.raises(InvalidInput, match="torques must have shape"):
+        plot_torques(tmp_path / "bad.png", t, tau[:10])
+    with pytest.raises(InvalidInput, match="limits must be positive"):
+        plot_torques(tmp_path / "bad.png", t, tau, np.zeros(6))

@@ -35,9 +35,13 @@ def test_scene_contents_and_animation(line_session):
         assert server.running
     arm = line_session.robot("scara")
     rec = line_session.trajectories["pick-place 3-5-3"]
-    assert info.robots["scara"] == [f"pinarms/robots/scara/visuals/{g}" for g in (
-        "base_link_0", "upper_arm_link_0", "upper_arm_link_1", "forearm_link_0", "forearm_link_1",
-        "quill_link_0", "hand_link_0", "hand_link_1")]
+    import pinocchio as pin
+
+    from pinarms.robots.registry import builtin_urdf_path
+
+    _, _, visual = pin.buildModelsFromUrdf(str(builtin_urdf_path("scara_mushroom")))
+    assert info.robots["scara"] == [f"pinarms/robots/scara/visuals/{g.name}" for g in visual.geometryObjects]
+    assert len(info.robots["scara"]) >= 6
     assert info.paths == {"pick-place 3-5-3": "pinarms/paths/pick-place 3-5-3"}
     assert info.clouds == {"scara cloud": "pinarms/workspace/scara cloud"}
     assert len(info.points["crate targets"]) == 2 and len(info.points["vias:pick-place 3-5-3"]) == 4

@@ -547,3 +547,138 @@ def test_zip_bombs_are_refused_fast_with_little_memory(bombs):
         assert _re.search(expected[name], r["error"][1]), (name, r["error"][1])
         assert r["s"] < 1.0, (name, r)
         assert r["peak_mb"] < 200 and r["rss_growth_mb"] < 200, (name, r)
+
+
+def test_payload_is_kept_and_checked(tmp_path):
+    from pinarms import robots as _robots
+    from pinarms.viz import Session, load_session
+
+    arm = _robots.load("aubo_i3").with_payload(3.0, com=[0.0, 0.0, 0.04], inertia=[0.01, 0.01, 0.006])
+    path = Session(arm, title="3 kg food pack").save(tmp_path / "pack.pinarms")
+    doc = _doc(path)
+    assert doc["robots"][0]["source"] == "registry" and doc["robots"][0]["payload"]["mass_kg"] == 3.0
+    again = load_session(path).robot()
+    assert again.payload.mass == 3.0
+    np.testing.assert_array_equal(again.payload.com, [0.0, 0.0, 0.04])
+    q = arm.random_q(5, seed=2)
+    np.testing.assert_allclose(again.gravity(q), arm.gravity(q), rtol=1e-14, atol=1e-14)
+    # a bare arm writes no payload field (sessions without one read as before)
+    bare = Session(_robots.load("aubo_i3")).save(tmp_path / "bare.pinarms")
+    assert "payload" not in _doc(bare)["robots"][0] and load_session(bare).robot().payload is None
+    # a hostile payload is refused with the reason
+    doc["robots"][0]["payload"]["mass_kg"] = -3.0
+    bad = _rewrite(path, tmp_path / "bad.pinarms", replace={"session.json": json.dumps(doc).encode()})
+    with pytest.raises(SessionFormatError, match=r"robots\[0\]\.payload: payload mass must be >= 0"):
+        load_session(bad)
+
+
+# ---------------------------------------------------------------------------- limits, meshes, leftovers
+def test_limits_refuse_big_sessions_and_say_how_to_raise_them(saved):
+    doc = _doc(saved)
+    q = doc["trajectories"][0]["q"]
+    with pytest.raises(SessionFormatError, match=r"more than the 4,000 allowed for one array \(limit max_array_bytes\)"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_array_bytes=4000))
+    with pytest.raises(SessionFormatError, match=r"add up to more than 10,000 bytes .*raise it with load_session"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_total_bytes=10_000))
+    with pytest.raises(SessionFormatError, match="max_text_bytes"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_text_bytes=100))
+    with pytest.raises(SessionFormatError, match="session.json.*more than the 1,000 allowed"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_json_bytes=1000))
+    with pytest.raises(SessionFormatError, match="nests deeper than 3 levels"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_json_depth=3))
+    with pytest.raises(SessionFormatError, match="max_members"):
+        viz.load_session(saved, limits=viz.SessionLimits(max_members=5))
+    assert q["shape"][0] * q["shape"][1] * 8 > 4000  # the first refusal is about this array, not a smaller one
+    ok = viz.load_session(saved, limits=viz.SessionLimits(max_total_bytes=200_000, max_array_bytes=50_000))
+    assert ok.trajectories.keys() == {"P1-P4 quintic", "raw"}
+    with pytest.raises(InvalidInput, match="positive integer"):
+        viz.SessionLimits(max_total_bytes=0)
+    with pytest.raises(InvalidInput, match="SessionLimits"):
+        viz.load_session(saved, limits={"max_total_bytes": 1})
+
+
+MESH_URDF = LEVER_URDF.replace('<box size="0.1 0.1 0.1"/>', '<mesh filename="{}"/>')
+
+
+@pytest.mark.parametrize("filename, ok", [
+    ("package://lever/meshes/base.stl", True),
+    ("meshes/base.stl", True),                               # relative: resolved against the package dirs
+    ("{pkg}/lever/meshes/base.stl", True),                   # absolute, inside a package dir
+    ("file://{pkg}/lever/meshes/base.stl", True),
+    ("package://lever/meshes/missing.stl", True),            # missing: left to the viewer
+    ("package://lever/../../../etc/passwd.stl", False),      # '..'
+    ("/etc/hosts.stl", False),                               # absolute, outside
+    ("file:///etc/hosts.stl", False),
+    ("http://example.com/base.stl", False),                  # other schemes
+    ("package://lever/escape.stl", False),                   # a symbolic link out of the package dir
+    ("package://lever/meshes/base.txt", False),              # not a mesh file
+    ("package://lever/fifo.stl", False),                     # not a regular file
+])
+def test_embedded_urdf_meshes_stay_inside_the_package_dirs(tmp_path, filename, ok):
+    pkg = tmp_path / "pkg"
+    (pkg / "lever" / "meshes").mkdir(parents=True)
+    (pkg / "lever" / "meshes" / "base.stl").write_bytes(b"solid x\nendsolid x\n")
+    (pkg / "lever" / "meshes" / "base.txt").write_text("x")
+    outside = tmp_path / "secret.stl"
+    outside.write_text("secret")
+    os.symlink(outside, pkg / "lever" / "escape.stl")
+    os.mkfifo(pkg / "lever" / "fifo.stl")
+    urdf = MESH_URDF.format(filename.format(pkg=pkg))
+    robot = robots.from_urdf_text(urdf, package_dirs=(str(pkg),))
+    s = viz.Session(robot, key="lever")
+    back = viz.load_session(s.save(tmp_path / "m.pinarms"))
+    assert back.robots["lever"].source == "urdf"
+    if ok:
+        assert back.robot("lever").nq == 1
+    else:
+        with pytest.raises(SessionFormatError, match="mesh"):
+            back.robot("lever")
+    # the package dirs recorded in the file are only a default: an explicit one is checked the same way
+    other = viz.load_session(tmp_path / "m.pinarms", package_dirs=[str(tmp_path / "empty")])
+    if filename.startswith(("/", "file://", "http")) or ".." in filename or filename.endswith(".txt"):
+        with pytest.raises(SessionFormatError, match="mesh"):
+            other.robot("lever")
+
+
+_CRASH = textwrap.dedent("""
+    import os, signal, sys
+    import numpy as np
+    from pinarms import viz
+    s = viz.Session("ur5")
+    s.add_points("p", [[0.0, 0.0, 0.0]])
+    real = np.save
+    def dying_save(*a, **k):
+        real(*a, **k)
+        os.kill(os.getpid(), signal.SIGKILL)  # as a power cut or the OOM killer would
+    np.save = dying_save
+    s.save(sys.argv[1])
+""")
+
+
+def test_part_files_of_a_killed_save_are_removed_by_the_next_save(session, tmp_path):
+    from pinarms.viz import _atomic
+
+    target = tmp_path / "s.pinarms"
+    proc = subprocess.run([sys.executable, "-c", _CRASH, str(target)], capture_output=True, timeout=120)
+    assert proc.returncode == -9
+    leftovers = [p for p in os.listdir(tmp_path) if p.endswith(".part")]
+    assert len(leftovers) == 1 and leftovers[0].startswith(".s.pinarms.") and not target.exists()
+    # a leftover becomes stale once unlocked and STALE_AFTER_S old
+    old = os.path.getmtime(tmp_path / leftovers[0]) - 10 * _atomic.STALE_AFTER_S
+    os.utime(tmp_path / leftovers[0], (old, old))
+    # ... unlike a save of the same file in progress (locked), a fresh one, or another file's
+    live = tmp_path / ".s.pinarms.live0001.part"
+    live.write_bytes(b"x")
+    os.utime(live, (old, old))
+    fresh = tmp_path / ".s.pinarms.fresh001.part"
+    fresh.write_bytes(b"x")
+    other = tmp_path / ".other.pinarms.abcd1234.part"
+    other.write_bytes(b"x")
+    os.utime(other, (old, old))
+    import fcntl
+
+    with open(live, "rb") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        session.save(target)
+    assert sorted(os.listdir(tmp_path)) == sorted(["s.pinarms", live.name, fresh.name, other.name])
+    assert viz.load_session(target) == session

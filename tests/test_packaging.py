@@ -1,0 +1,87 @@
+"""Packaging: one import namespace. The wheel installs next to PyPI's own ``robots``, ``optim``,
+``planning`` and ``viz`` in a fresh virtualenv, and the README's quickstart runs there from
+outside the repository; the editable install maps the repository's folders to ``pinarms.*``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+NAMESAKES = ("robots", "optim", "planning", "viz")  # PyPI projects unrelated to pinarms
+PINARMS_PACKAGES = ("robots", "planning", "optim", "viz", "urdf")
+
+PROBE = f"""
+import importlib, importlib.resources, importlib.util, json, sys
+out = {{}}
+for name in {NAMESAKES!r}:
+    spec = importlib.util.find_spec(name)
+    out[name] = None if spec is None else spec.origin
+import pinarms
+for name in {PINARMS_PACKAGES!r}:
+    out["pinarms." + name] = importlib.import_module("pinarms." + name).__file__
+out["page.js"] = importlib.resources.files("pinarms.viz").joinpath("page.js").is_file()
+out["koji urdf"] = importlib.resources.files("pinarms.urdf").joinpath("koji_turner.urdf").is_file()
+from pinarms import optim
+out["minimize_time"] = callable(optim.minimize_time)
+print(json.dumps(out))
+"""
+
+
+def _quickstart() -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    return re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)[0]
+
+
+def _run(cmd: list, cwd: Path, timeout: float = 900) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    result = subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    assert result.returncode == 0, f"{cmd}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    return result
+
+
+@pytest.mark.slow
+def test_wheel_beside_pypi_namesakes_runs_the_quickstart(tmp_path):
+    """About 3 minutes with a warm pip cache: the fresh virtualenv gets Pinocchio and all."""
+    dist = tmp_path / "dist"
+    _run([sys.executable, "-m", "pip", "wheel", ROOT, "--no-deps", "-w", dist, "-q"], tmp_path)
+    (wheel,) = dist.glob("pinarms-*.whl")
+    env_dir = tmp_path / "venv"
+    venv.create(env_dir, with_pip=True)
+    py = env_dir / "bin" / "python"
+    # pinarms first, then the namesakes: pip would silently overwrite a top-level package of the same name
+    _run([py, "-m", "pip", "install", "-q", "--no-compile", wheel], tmp_path)
+    _run([py, "-m", "pip", "install", "-q", "--no-compile", *NAMESAKES], tmp_path)
+    work = tmp_path / "outside"
+    work.mkdir()
+    found = json.loads(_run([py, "-c", PROBE], work).stdout)
+    site = str(env_dir)
+    for name in NAMESAKES:  # PyPI's packages, untouched
+        assert found[name] and found[name].startswith(site) and "pinarms" not in found[name]
+    for name in PINARMS_PACKAGES:  # pinarms' packages, from the wheel (not from the repository)
+        origin = found[f"pinarms.{name}"]
+        assert origin.startswith(site) and f"pinarms{os.sep}{name}{os.sep}__init__.py" in origin
+    assert found["page.js"] and found["koji urdf"] and found["minimize_time"]
+    (work / "quickstart.py").write_text(_quickstart(), encoding="utf-8")
+    out = _run([py, "quickstart.py"], work).stdout
+    assert "[1197.3  250.  -929.2]" in out
+    assert (work / "study.pinarms").is_file() and (work / "study.html").stat().st_size > 100_000
+
+
+def test_editable_install_maps_the_folders(tmp_path):
+    """The development install (``make install``): ``pinarms.robots`` is the repository's robots/ folder,
+    and no top-level ``robots``/``optim``/... is installed by pinarms."""
+    found = json.loads(_run([sys.executable, "-c", PROBE], tmp_path).stdout)
+    for name in PINARMS_PACKAGES:
+        assert Path(found[f"pinarms.{name}"]) == ROOT / name / "__init__.py"
+    for name in NAMESAKES:
+        assert found[name] is None or not found[name].startswith(str(ROOT))
+    assert found["page.js"] and found["koji urdf"]

@@ -1,0 +1,58 @@
+"""Progress bars: drawn on a terminal's stderr only, never with --json or into a pipe."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from pinarms import robots
+from pinarms.progress import ProgressBar, wanted
+
+
+class _Tty(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_wanted_only_for_a_terminal_without_json():
+    assert wanted(False, _Tty()) is True
+    assert wanted(True, _Tty()) is False
+    assert wanted(False, io.StringIO()) is False  # a pipe or a file
+
+
+def test_bar_counts_and_ends_its_line():
+    out = _Tty()
+    with ProgressBar("GA generations", 300, stream=out, min_interval=0.0) as bar:
+        for g in range(1, 301):
+            bar(g)
+    text = out.getvalue()
+    last = text.split("\r\x1b[2K")[-1]
+    assert last.startswith("GA generations  [########################]  100%  300/300") and last.endswith("s\n")
+    assert text.count("\n") == 1
+
+
+def test_disabled_bar_writes_nothing():
+    out = _Tty()
+    with ProgressBar("demo", 4, enabled=False, stream=out) as bar:
+        bar.advance(note="seed 001")
+        bar(4)
+    assert out.getvalue() == ""
+
+
+def test_redraws_are_throttled():
+    out = _Tty()
+    bar = ProgressBar("samples", 10**6, stream=out, min_interval=3600.0)
+    for k in range(1, 1001):
+        bar(k * 1000)
+    bar.close()
+    assert out.getvalue().count("\r") <= 3  # the first draw, the finished state (and nothing between)
+
+
+def test_workspace_sampling_reports_every_sample():
+    calls: list[tuple[int, int]] = []
+    ws = robots.sample_workspace(robots.load("aubo_i3"), n=70_000, seed=0, chunk=16384, progress=lambda d, t: calls.append((d, t)))
+    assert [t for _, t in calls] == [70_000] * 5
+    assert sorted(d for d, _ in calls) == [d for d, _ in calls] and calls[-1][0] == 70_000
+    quiet = robots.sample_workspace(robots.load("aubo_i3"), n=70_000, seed=0, chunk=16384)
+    np.testing.assert_array_equal(ws.points, quiet.points)

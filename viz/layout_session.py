@@ -1,0 +1,45 @@
+"""A layout search as a session: the arm at its best placement, its cycle, the candidates.
+
+:func:`layout_search_session` builds a :class:`viz.Session` from an
+:class:`optim.LayoutSearch`: the robot stands at the best placement (``base_to_world``), its
+best cycle is the animated trajectory, the candidate base positions are a point cloud
+coloured by picks per minute (stored as a workspace cloud whose value is picks/min, in the
+robot's base frame as clouds are), and the picks and places are target points (line frame).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pinarms.robots.errors import InvalidInput
+
+from .session import Session
+
+__all__ = ["layout_search_session"]
+
+
+def layout_search_session(result: Any, robot: Any, *, title: str | None = None) -> Session:
+    """Session of a layout search of ``robot`` (see the module docstring).
+
+    Raises:
+        InvalidInput: no candidate could run the cycle (nothing to place), or a result of another robot.
+    """
+    from pinarms.optim.layout_search import base_to_world
+
+    if getattr(result, "best_placement", None) is None:
+        raise InvalidInput("the layout search found no placement that runs the cycle: nothing to show")
+    if getattr(result, "robot", None) != robot.name:
+        raise InvalidInput(f"the layout search is of {result.robot!r}, not of {robot.name!r}")
+    T = base_to_world(result.best_placement)
+    session = Session(robot, title=title or f"layout search of {robot.name}", base_to_world=T)
+    if result.best_cycle is not None:
+        session.add_trajectory("best_cycle", result.best_cycle.trajectory)
+    world = np.column_stack([result.candidates[:, :3], np.ones(len(result.candidates))])
+    in_base = (np.linalg.inv(T) @ world.T).T[:, :3]
+    session.add_workspace("candidates_picks_per_minute", points=in_base,
+                          manipulability=np.asarray(result.picks_per_minute, dtype=float))
+    session.add_points("picks", result.picks, kind="target")
+    session.add_points("places", result.places, kind="target")
+    return session
