@@ -35,12 +35,10 @@ Distances in m, the world frame; joint coordinates in rad or m; time in s.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Sequence
 
-import coal
 import numpy as np
 import pinocchio as pin
 
@@ -49,8 +47,10 @@ from pinarms.robots.errors import InvalidInput
 
 __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS"]
 
-#: Largest number of halvings of one interval before it is declared unproven (invalid).
+#: Finest level of the proof: intervals of ``step / 2^MAX_SPLITS`` travel; still unproven there: invalid.
 MAX_SPLITS = 10
+#: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
+COARSE_LEVELS = 3
 
 
 @dataclass(frozen=True)
@@ -85,16 +85,11 @@ class Verdict:
 
 
 def _cold(gd: pin.GeometryData) -> pin.GeometryData:
-    """Start every GJK from coal's default guess: a cached guess from another configuration
-    can miss a contact between configurations far apart (a planner's samples)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        for req in list(gd.collisionRequests) + list(gd.distanceRequests):
-            req.enable_cached_gjk_guess = False
-            req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
-    for req in gd.distanceRequests:
-        req.gjk_tolerance = 1e-10
-    return gd
+    """Cold-started GJK (a cached guess from another configuration misses contacts between a
+    planner's far-apart samples: :mod:`robots.collision_requests`), exact distances."""
+    from pinarms.robots.collision_requests import cold_start
+
+    return cold_start(gd, distance_tolerance=1e-10)
 
 
 def _set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
@@ -255,7 +250,7 @@ class MotionChecker:
         pool = self._pools.get(which)
         if pool is None:
             pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.model, self.geometry, self.threads)
-            extra = 0.0 if which == "margin" else self.step / 2.0 ** (int(which) + 1)
+            extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
             margins = self.pair_margin + extra
             for gd in pool.getGeometryDatas():
                 _cold(gd)
@@ -348,21 +343,22 @@ class MotionChecker:
         """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
-    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False) -> Verdict:
+    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
         """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
 
         ``budgets (N-1,)``: travel bound [m] between consecutive samples (each ≤ ``step``);
         ``midpoint(i, a, b, B) -> (x, B_left, B_right)``: the state between fractions ``a`` and
         ``b`` of interval ``i`` (whose budget is ``B``) and the budgets of the two halves.
         ``convex``: the samples lie on a straight edge between two states within the joint
-        limits (then every sample is within them: the limits box is convex).
+        limits (then every sample is within them: the limits box is convex). ``top``: the
+        level of the given samples (0: budgets ≤ ``step``; −k: budgets ≤ ``step · 2^k``).
 
         The proof is a ladder of batched screens (module docstring): at level ``L`` an
         interval's budget is at most ``step / 2^L`` and its two ends are screened with the
         margins raised by ``s_L = step / 2^(L+1)``; both passing proves the interval (the
         excess stays ``≥ (s_L + s_L − B)/2 ≥ 0``). An interval not proven is halved; a sample
         closer than the margins themselves ends the proof (invalid), and so does an interval
-        still unproven after :data:`MAX_SPLITS` halvings.
+        still unproven at level :data:`MAX_SPLITS`.
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         N = X.shape[0]
@@ -372,7 +368,8 @@ class MotionChecker:
                 return Verdict(False, int(np.argmin(inside)), 0.0)
         Q = self.full(X)
         order = coarse_first(N - 1)
-        flags = self.batch_collides(Q[order], 0, stop=True)
+        level = int(top)
+        flags = self.batch_collides(Q[order], level, stop=True)
         if not flags.any():
             return Verdict(True)
         first = int(order[int(np.argmax(flags))])
@@ -384,15 +381,12 @@ class MotionChecker:
         # every sample keeps the margins: prove the intervals between them, level by level
         states = [x for x in X]
         qs = [q for q in Q]
-        lb = np.full(N, -1.0)  # proven lower bound of each sample's excess (-1: nothing known)
-        lb[:] = 0.0
-        screened = self.batch_collides(Q, 0)
-        lb[~screened] = self.step / 2.0
+        lb = np.zeros(N)  # proven lower bound of each sample's excess (all keep the margins)
+        screened = self.batch_collides(Q, level)
+        lb[~screened] = self.step / 2.0 ** (level + 1)
         # intervals: (left sample, right sample, budget, source interval, fraction a, fraction b)
         todo = [(i, i + 1, float(budgets[i]), i, 0.0, 1.0) for i in range(N - 1)]
-        level = 0
         while True:
-            s_level = self.step / 2.0 ** (level + 1)
             todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
             if not todo:
                 return Verdict(True, exact=level)
@@ -437,12 +431,18 @@ class MotionChecker:
 
     def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
         """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
+        X, budgets, _ = self._edge_samples(xa, xb, 0)
+        return X, budgets
+
+    def _edge_samples(self, xa: Any, xb: Any, coarse: int = COARSE_LEVELS) -> tuple[np.ndarray, np.ndarray, int]:
+        """Samples of the straight edge at the coarsest level ``−k`` (``k ≤ coarse``): budgets ≤ ``step · 2^k``."""
         xa = np.asarray(xa, dtype=float)
         xb = np.asarray(xb, dtype=float)
         T = self.travel(xa, xb)
-        n = max(1, int(math.ceil(T / self.step * (1.0 + 1e-12))))
+        k = int(np.clip(math.floor(math.log2(max(T / self.step, 1.0))), 0, coarse))
+        n = max(1, int(math.ceil(T / (self.step * 2.0 ** k) * (1.0 + 1e-12))))
         f = np.arange(n + 1) / n
-        return xa + f[:, None] * (xb - xa), np.full(n, T / n)
+        return xa + f[:, None] * (xb - xa), np.full(n, T / n), -k
 
     def edge_valid(self, xa: Any, xb: Any) -> Verdict:
         """Whether the straight joint-space edge ``xa → xb`` keeps every margin everywhere (module docstring)."""
@@ -452,14 +452,14 @@ class MotionChecker:
         xa = np.asarray(xa, dtype=float)
         xb = np.asarray(xb, dtype=float)
         self.counts["edges"] += 1
-        X, budgets = self.edge_samples(xa, xb)
+        X, budgets, top = self._edge_samples(xa, xb)
         n = budgets.size
 
         def midpoint(i: int, a: float, b: float, B: float):
             f = (i + 0.5 * (a + b)) / n
             return xa + f * (xb - xa), 0.5 * B, 0.5 * B
 
-        v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()))
+        v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
         if v.ok:
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
