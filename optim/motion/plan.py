@@ -60,7 +60,9 @@ class ClearanceProfile:
             arm and a fixture or another arm; ``environment_pair``: its pair index into
             ``pairs`` (−1 when there is none); ``own``: ``(M,)`` smallest distance between
             two links of one planned arm [m].
-        pairs: the pairs checked (those involving a planned arm).
+        pairs: the pairs checked (those involving a planned arm); ``required``: the margin [m].
+
+    ``viz.plot_clearance(path, profile)`` draws it over time.
     """
 
     times: np.ndarray
@@ -68,6 +70,24 @@ class ClearanceProfile:
     environment_pair: np.ndarray
     own: np.ndarray
     pairs: tuple
+    required: float = 0.0
+
+    # what viz.plot_clearance reads: viz.plot_clearance("clearance.png", plan.clearance)
+    @property
+    def clearance(self) -> np.ndarray:
+        """``environment`` (the name the clearance plot reads)."""
+        return self.environment
+
+    @property
+    def exact(self) -> np.ndarray:
+        """Every sample is an exact distance (coal)."""
+        return np.ones(self.times.size, dtype=bool)
+
+    @property
+    def min_clearance_pair(self) -> str | None:
+        """``"body_a – body_b"`` of the closest pair to the environment."""
+        pair = self.min_pair
+        return None if pair is None else f"{pair[0]} – {pair[1]}"
 
     @property
     def min_environment(self) -> float:
@@ -386,7 +406,7 @@ def clearance_profile(checker: MotionChecker, trajectory: Trajectory, *, samples
     own = np.array([p.kind == "self" for p in checker.pairs])
     env_e, env_k, env_d = checker.excess(Q, mask=~own)
     own_e, own_k, own_d = checker.excess(Q, mask=own) if own.any() else (None, None, np.full(t.size, np.inf))
-    return ClearanceProfile(t, env_d, env_k, own_d, checker.pairs)
+    return ClearanceProfile(t, env_d, env_k, own_d, checker.pairs, checker.margin)
 
 
 # ------------------------------------------------------------------ the planner

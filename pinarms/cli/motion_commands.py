@@ -56,11 +56,13 @@ def load_any_cell(name: str) -> Any:
 @click.option("--deg", is_flag=True, help="ROLL PITCH YAW and --from-q in degrees.")
 @click.option("--mm", is_flag=True, help="Positions and --margin in millimetres.")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the whole cell and the planned motion (tool path, clearance) into a session file.")
+              help="Save the whole cell and the planned motion (tool path, goal) into a session file.")
+@click.option("--plot", "plot_path", default=None, type=click.Path(dir_okay=False),
+              help="Write the clearance-over-time plot (PNG).")
 @json_option
 def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, start_q: str | None, margin: float,
                planner: str, time_limit: float, seed: int, amax: str | None, no_torque: bool, deg: bool, mm: bool,
-               session_path: str | None, as_json: bool) -> None:
+               session_path: str | None, plot_path: str | None, as_json: bool) -> None:
     """Plan a collision-free move of an arm in CELL to a tool pose, prove it clear, time it optimally.
 
     CELL is a planning scene (aubo_crate_guard, panda_shelf, ...), a built-in cell
@@ -136,6 +138,13 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
         f"{plan.seconds['shortcut']:.3f}, smooth {plan.seconds['smooth']:.3f}, time {plan.seconds['time']:.3f}, "
         f"check {plan.seconds['check']:.3f})",
     ]
+    if plot_path:
+        from pinarms.viz.plots import plot_clearance
+
+        plot_clearance(plot_path, cl, title=f"{c.name}: arm {arm.name}, clearance to fixtures and other arms",
+                           mm=True)
+        data["plot"] = plot_path
+        lines.append(f"clearance plot written: {plot_path}")
     if session_path:
         from pinarms import viz
 

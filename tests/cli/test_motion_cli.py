@@ -16,7 +16,7 @@ def test_motion_over_the_wall_json_and_session(tmp_path):
     out = tmp_path / "move.pinarms"
     result = CliRunner().invoke(cli, ["motion", WALL, "--from", "450", "200", "800", "--to", "450", "-200",
                                       "800", "--margin", "10", "--mm", "--time-limit", "30", "--json",
-                                      "--session", str(out)])
+                                      "--session", str(out), "--plot", str(tmp_path / "clearance.png")])
     assert result.exit_code == 0, (result.output, result.exception)
     data = json.loads(result.stdout)
     assert data["arm"] == "aubo" and data["planner"] == "RRTConnect" and data["collision_free"]
@@ -25,6 +25,7 @@ def test_motion_over_the_wall_json_and_session(tmp_path):
     assert abs(data["tool_path_world_m"][-1][1] + 0.2) < 1e-6  # ends at the goal
     from pinarms import viz
 
+    assert (tmp_path / "clearance.png").stat().st_size > 10_000
     session = viz.load_session(out)
     assert session.robot().nq == 6 and "motion" in session.trajectories
 
