@@ -1,35 +1,39 @@
-"""Validity of the planned arms of a cell: states, straight edges and paths, proven continuously.
+"""Validity of the planned arms of a cell: states, straight edges and timed motions, proven continuously.
 
 :class:`MotionChecker` answers what a sampling planner asks, for the arms being planned
 (one arm, or two arms in their joint space) while the other arms of the cell hold still
-or follow their own timed trajectories:
+or follow their own timed trajectories (:class:`TimedArm`):
 
-- **State** ``x`` (the planned arms' joint coordinates, plus the time for a plan around a
-  moving arm): inside the joint limits and every checked pair that involves a planned arm
-  at least its margin apart — ``margin`` for arm–fixture and arm–arm pairs,
-  ``self_margin`` for two links of one arm (adjacent links are close by design).
-  One Pinocchio call: its broad phase (dynamic AABB tree) and coal with each pair's
-  security margin, stopping at the first pair too close.
+- **State** ``x`` (the planned arms' joint coordinates; with moving arms, the time last):
+  inside the joint limits and every checked pair that involves a planned arm at least its
+  margin apart — ``margin`` for arm–fixture and arm–arm pairs, ``self_margin`` for two
+  links of one arm (an arm's own links are close by design). One Pinocchio call (coal with
+  each pair's security margin, GJK started cold), stopping at the first pair too close.
 - **Edge** ``x_a → x_b`` (a straight line in joint space): the continuous rule of
   :func:`robots.cell.check_motion`, in joint space instead of time. Every point of the
   planned arms' geometry moves at most ``T = Σ_j |Δq_j| ℓ_j`` along the edge (the levers
-  ``ℓ_j`` of :func:`robots.cell.motion.joint_levers`; an arm following its trajectory adds
-  ``Σ_j max|q̇_j| ℓ_j Δt``). The edge is cut into ``n = ceil(T / step)`` equal pieces
-  (``step`` defaults to the margin: nothing thinner than the margin fits between two
-  samples), and **all n + 1 samples are checked as one batch** by Pinocchio's C++ loop
-  (``computeCollisionsInParallel``) with each pair's margin raised by ``step / 2``. A
-  sample that passes keeps every pair at least ``margin + step/2`` apart; the smallest
-  excess ``E = min_k (d_k − margin_k)`` is 1-Lipschitz in the travel, so between two such
-  samples (travel ≤ step) ``E ≥ (E_a + E_b − step)/2 ≥ 0``: the edge keeps every margin
-  everywhere, not only at the samples. Samples that fail that screen but not the margin
-  itself get coal's exact distances, and the interval bound is proven or the interval
-  halved (at most :data:`MAX_SPLITS` times) — the same proof as the cells' time check.
-  The samples are checked coarse-first (ends, middle, quarters, ...) with Pinocchio's
+  ``ℓ_j`` of :func:`robots.cell.motion.joint_levers`). The smallest excess
+  ``E = min_k (d_k − margin_k)`` is 1-Lipschitz in that travel, so between two samples with
+  travel ``B`` between them ``E ≥ (E_a + E_b − B)/2``. Samples whose pairs all pass with
+  their margins raised by ``s`` have ``E ≥ s``; two such neighbours with ``B ≤ 2s`` prove
+  the interval. The proof is a **ladder of batched screens**: the edge is first cut into
+  pieces of at most ``step · 2^k`` travel (``k ≤`` :data:`COARSE_LEVELS`; ``step`` defaults
+  to the margin: nothing thinner than the margin fits between two samples of the finest
+  regular level), **all samples checked as one batch** by Pinocchio's C++ loop
+  (``computeCollisionsInParallel``) with the margins raised by half the piece's budget; an
+  interval not proven is halved and its ends screened with half the raise, down to
+  ``step / 2^MAX_SPLITS``. A sample closer than the margins themselves ends the proof (the
+  edge is invalid), and so does an interval unproven at the finest level. The samples of a
+  level are checked coarse-first (ends, middle, quarters, ...) with Pinocchio's
   stop-at-first-collision, so an edge through an obstacle is rejected after a few samples.
-- **Path**: any sequence of samples with travel budgets between them (a spline, a timed
-  trajectory) goes through the same proof (:meth:`MotionChecker.prove`).
+- **Timed motion** (:meth:`MotionChecker.trajectory_valid`): samples uniform in time so
+  that the planned arms' travel (exact velocity peaks times the levers) plus the moving
+  arms' (:meth:`MotionChecker.moving_travel`, per time bin from their exact speeds and
+  acceleration peaks) stays within a step between two, through the same proof.
 
-Distances in m, the world frame; joint coordinates in rad or m; time in s.
+Exact distances (:meth:`MotionChecker.excess`, coal) serve the reports: which pair is
+closest, the clearance along a motion. Distances in m, the world frame; joint coordinates
+in rad or m; time in s.
 """
 
 from __future__ import annotations
