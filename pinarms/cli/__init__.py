@@ -21,6 +21,7 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     demo_command,
     layout_commands,
     line_commands,
+    motion_commands,
     reach_commands,
     robot_commands,
     session_commands,
