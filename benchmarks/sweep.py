@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -40,6 +41,18 @@ def _peaks() -> dict:
     own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
     return {"peak_mb": round(own, 1), "largest_worker_peak_mb": round(children, 1)}
+
+
+def _noop(task):
+    return task
+
+
+def child_startup() -> dict:
+    from pinarms.execution import map_chunks
+
+    t0 = time.perf_counter()
+    map_chunks(_noop, [0, 1], scheduler="processes:2")
+    return {"wall_s": time.perf_counter() - t0}
 
 
 def child_layout(scheduler: str | None, quick: bool) -> dict:
@@ -62,7 +75,7 @@ def child_workspace(scheduler: str | None, n: int) -> dict:
 
     arm = robots.load("aubo_i3")
     t0 = time.perf_counter()
-    s = stream_workspace(arm, n, seed=0, scheduler=scheduler)
+    s = stream_workspace(arm, n, seed=0, voxel_size=0.01, scheduler=scheduler)  # one grid for every n
     wall = time.perf_counter() - t0
     v = s.voxels
     return {"wall_s": wall, "n": n, "voxel_mm": v.voxel_size * 1000, "voxels": list(v.shape),
@@ -92,10 +105,10 @@ def child_station(quick: bool) -> dict:
            "best_placement": best.tolist(), "best_ppm": res.best_picks_per_minute,
            "grid_best_ppm": float(res.picks_per_minute[res.best_index]),
            "refine_gain": None if res.refinement is None else res.refinement.gain, "points": {}}
-    from pinarms.optim.layout_search import _to_base
+    from pinarms.optim.layout_search import points_in_base_frame
 
     for name, p in (("pick P1", p1), ("place P4", place)):
-        b = _to_base(p[None], best[None])[0, 0]
+        b = points_in_base_frame(p[None], best[None])[0, 0]
         out["points"][name] = {"base_frame_mm": (b * 1000).tolist(), "z_mm": b[2] * 1000,
                                "r_centre_mm": float(np.linalg.norm(b - centre) * 1000),
                                "r_axis_mm": float(np.hypot(b[0], b[1]) * 1000)}
@@ -103,14 +116,25 @@ def child_station(quick: bool) -> dict:
     ok = np.flatnonzero(res.ok)
     inside = 0
     for i in ok:
-        b = _to_base(np.vstack([p1, place]), cand[i][None])[0]
+        b = points_in_base_frame(np.vstack([p1, place]), cand[i][None])[0]
         r = np.linalg.norm(b - centre, axis=1)
         inside += int(np.all((b[:, 2] > 0) & (r > 0.2) & (r < 0.5)))
     out["planned_inside_band"] = inside
+    # the best placement whose points keep 100 mm from the workspace edge (min_margin=0.1 would
+    # rule the others out before planning: the same answer)
+    kept = [i for i in res.order if res.ok[i] and res.margin[i] >= 0.1]
+    if kept:
+        i = kept[0]
+        b = points_in_base_frame(np.vstack([p1, place]), cand[i][None])[0]
+        out["best_margin_100"] = {"placement": cand[i].tolist(), "ppm": float(res.picks_per_minute[i]),
+                                  "margin_mm": float(res.margin[i] * 1000),
+                                  "z_mm": (b[:, 2] * 1000).tolist(),
+                                  "r_centre_mm": (np.linalg.norm(b - centre, axis=1) * 1000).tolist()}
+    out["best_margin_mm"] = float(res.margin[res.best_index] * 1000)
     top = res.order[:20]
     out["top20_inside_band"] = int(sum(
         np.all([(bb[2] > 0) and 0.2 < np.linalg.norm(bb - centre) < 0.5
-                for bb in _to_base(np.vstack([p1, place]), cand[i][None])[0]]) for i in top))
+                for bb in points_in_base_frame(np.vstack([p1, place]), cand[i][None])[0]]) for i in top))
     return out
 
 
@@ -167,7 +191,14 @@ def bench_station(quick: bool) -> None:
               f"(horizontal {p['r_axis_mm']:.0f} mm): {'inside' if inside else 'outside'} the paper's band "
               "(z > 0, 200 < r < 500 mm)")
     print(f"  planned placements with both points in the band: {r['planned_inside_band']} of {r['planned']}; "
-          f"among the 20 best: {r['top20_inside_band']}")
+          f"among the 20 best: {r['top20_inside_band']}; the best's points are {r['best_margin_mm']:.0f} mm from "
+          "the workspace edge")
+    m = r.get("best_margin_100")
+    if m:
+        x, y, z, _ = m["placement"]
+        print(f"  best with both points >= 100 mm from the workspace edge: base at ({x * 1000:.0f}, {y * 1000:.0f}, "
+              f"{z * 1000:.0f}) mm, {m['ppm']:.2f} picks/min; P1, P4 at z {m['z_mm'][0]:.0f}, {m['z_mm'][1]:.0f} mm, "
+              f"r {m['r_centre_mm'][0]:.0f}, {m['r_centre_mm'][1]:.0f} mm from (0, 0, 160) mm")
 
 
 def main(argv: list[str]) -> None:
@@ -177,6 +208,8 @@ def main(argv: list[str]) -> None:
         rest = [a for a in rest if a != "--quick"]
         if part == "layout":
             out = child_layout(None if rest[0] == "serial" else rest[0], quick)
+        elif part == "startup":
+            out = child_startup()
         elif part == "workspace":
             out = child_workspace(None if rest[0] == "serial" else rest[0], int(rest[1]))
         else:
@@ -185,10 +218,15 @@ def main(argv: list[str]) -> None:
         return
     quick = "--quick" in argv
     parts = [a for a in argv if not a.startswith("--")] or ["all"]
+    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start (other work "
+          "running on the machine slows both columns and lowers the ratio)")
+    print(f"a local cluster of 2 worker processes starts and stops in {_run('startup')['wall_s']:.1f} s "
+          "(included in every '2 workers' time below)")
     if parts == ["all"]:
         parts = ["layout", "workspace", "station"]
     for part in parts:
         {"layout": bench_layout, "workspace": bench_workspace, "station": bench_station}[part](quick)
+    print(f"load average at the end: {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":  # worker processes are spawned: the guard is required

@@ -50,11 +50,12 @@ __all__ = [
     "grid_candidates",
     "random_candidates",
     "base_to_world",
+    "points_in_base_frame",
     "search_layout",
 ]
 
 #: Why a candidate fails, in the order they are checked.
-FAILURES = ("unreachable", "joint limit", "collision", "timing")
+FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing")
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
 _PPM_RTOL = 1e-9
@@ -135,8 +136,11 @@ def base_to_world(placement: Any) -> np.ndarray:
     return T[0] if single else T
 
 
-def _to_base(points: np.ndarray, placements: np.ndarray) -> np.ndarray:
-    """Points ``(K, 3)`` of the line frame in the base frames of ``(M, 4)`` placements: ``(M, K, 3)``."""
+def points_in_base_frame(points: np.ndarray, placements: np.ndarray) -> np.ndarray:
+    """Points ``(K, 3)`` of the line frame in the base frames of ``(M, 4)`` placements: ``(M, K, 3)``.
+
+    ``p_base = R_z(-yaw) (p - (x, y, z))``, the inverse of :func:`base_to_world`.
+    """
     d = points[None, :, :] - placements[:, None, :3]
     c, s = np.cos(placements[:, 3])[:, None], np.sin(placements[:, 3])[:, None]
     out = np.empty_like(d)
@@ -166,6 +170,38 @@ class _Settings:
     amax: Any
     jmax: Any
     seed: int
+    cell: "_CellRecipe | None" = None
+
+
+@dataclass(frozen=True)
+class _CellRecipe:
+    """How a worker rebuilds the cell (a Cell holds coal objects that do not pickle)."""
+
+    token: str
+    urdf_text: str
+    source: str
+    base_dir: str
+    packages: tuple[tuple[str, str], ...]
+    args: tuple[tuple[str, str], ...]
+    seed: int
+    arm: str
+    carry: tuple[str, ...]
+    clearance: float
+
+
+#: Cells by search token in this process (the caller's own cell, or one rebuilt from its recipe).
+_CELLS: dict[str, Any] = {}
+
+
+def _cell_of(recipe: _CellRecipe) -> Any:
+    if recipe.token not in _CELLS:
+        from pinarms.robots.cell import Cell
+
+        if len(_CELLS) >= 2:
+            _CELLS.pop(next(iter(_CELLS)))
+        _CELLS[recipe.token] = Cell(recipe.urdf_text, source=recipe.source, base_dir=recipe.base_dir,
+                                    packages=dict(recipe.packages), args=dict(recipe.args), seed=recipe.seed)
+    return _CELLS[recipe.token]
 
 
 @dataclass(frozen=True)
@@ -198,16 +234,25 @@ def _classify(exc: PinarmsError) -> str:
 
 def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool = False):
     """Plan every (pick, place) pair's cycle from this placement; ``_Outcome`` (and the first cycle)."""
-    picks_b = _to_base(st.picks, placement[None, :])[0]
-    places_b = _to_base(st.places, placement[None, :])[0]
+    picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
+    places_b = points_in_base_frame(st.places, placement[None, :])[0]
     R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
+    in_cell: dict[str, Any] = {}
+    if st.cell is not None:
+        try:
+            moved = _cell_of(st.cell).with_arm_base(st.cell.arm, base_to_world(placement), carry=st.cell.carry)
+        except PinarmsError as exc:
+            return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
+                            f"the cell cannot hold the arm there: {exc}"), None
+        robot = moved.arm(st.cell.arm).robot
+        in_cell = {"cell": moved, "arm": st.cell.arm, "clearance": st.cell.clearance}
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
         for j, place in enumerate(places_b):
             spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
             try:
                 cycle = plan_cycle(robot, spec, kind=st.kind, vmax=st.vmax, amax=st.amax, jmax=st.jmax,
-                                   method="exact", seed=st.seed)
+                                   method="exact", seed=st.seed, **in_cell)
             except PinarmsError as exc:
                 where = f"pick {i + 1} → place {j + 1}"
                 return _Outcome(_classify(exc), f"{where}: {exc}"), None
@@ -221,20 +266,36 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
     return outcome, (first if keep_cycle else None)
 
 
+#: Robots already used in this process, by search token: a worker unpickles the robot with
+#: every task, but keeps using the first copy, whose IK caches are warm (~10 % of a cycle plan).
+_WARM: dict[str, Any] = {}
+
+
+def _warm(robot: Any, token: str) -> Any:
+    if token not in _WARM:
+        if len(_WARM) >= 4:
+            _WARM.pop(next(iter(_WARM)))
+        _WARM[token] = robot
+    return _WARM[token]
+
+
 @dataclass(frozen=True)
 class _ChunkTask:
     robot: Any
+    token: str  # one per search (and robot)
     placements: np.ndarray  # (m, 4)
     settings: _Settings
 
 
 def _evaluate_chunk(task: _ChunkTask) -> list[_Outcome]:
-    return [_evaluate(task.robot, p, task.settings)[0] for p in task.placements]
+    robot = _warm(task.robot, task.token)
+    return [_evaluate(robot, p, task.settings)[0] for p in task.placements]
 
 
 @dataclass(frozen=True)
 class _RefineTask:
     robot: Any
+    token: str
     start: np.ndarray  # (4,)
     free: np.ndarray  # (k,) indices of the free coordinates
     bounds: np.ndarray  # (4, 2)
@@ -247,6 +308,7 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
     """Bounded Nelder-Mead from ``start`` over the free coordinates: (placement, picks/min, evaluations)."""
     from scipy.optimize import minimize
 
+    robot = _warm(task.robot, task.token)
     free, lo, hi = task.free, task.bounds[task.free, 0], task.bounds[task.free, 1]
     seen: dict[bytes, float] = {}
     best = {"placement": task.start.copy(), "ppm": None}
@@ -260,7 +322,7 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
         p = placement(z)
         key = p.tobytes()
         if key not in seen:
-            ppm = _evaluate(task.robot, p, task.settings)[0].picks_per_minute
+            ppm = _evaluate(robot, p, task.settings)[0].picks_per_minute
             seen[key] = -ppm
             # strictly better by more than the tie tolerance: the earliest evaluation wins ties
             if best["ppm"] is None or ppm > best["ppm"] * (1.0 + _PPM_RTOL) + 1e-12:
@@ -291,6 +353,8 @@ class Refinement:
         picks_per_minute: ``(k,)`` picks/min there.
         evaluations: ``(k,)`` cycles planned by each search.
         free: names of the coordinates searched (those the candidates vary).
+        margin: ``(k,)`` boundary margin [m] of each refined placement; one below the
+            search's ``min_margin`` is reported but never taken as the best placement.
     """
 
     starts: np.ndarray
@@ -299,6 +363,7 @@ class Refinement:
     picks_per_minute: np.ndarray
     evaluations: np.ndarray
     free: tuple[str, ...]
+    margin: np.ndarray | None = None
 
     @property
     def gain(self) -> float:
@@ -436,6 +501,7 @@ class LayoutSearch:
                 "placements": r.placements.tolist(),
                 "picks_per_minute": r.picks_per_minute.tolist(),
                 "evaluations": r.evaluations.tolist(),
+                "boundary_margin_m": None if r.margin is None else r.margin.tolist(),
                 "gain_picks_per_minute": r.gain,
             }
         return out
@@ -468,7 +534,7 @@ def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], lis
     names = names + [f"above {n}" for n in names]  # the user's points first, then the lift points
     world = np.vstack([pts, up])
     K = world.shape[0]
-    P = _to_base(world, cand)  # (M, K, 3)
+    P = points_in_base_frame(world, cand)  # (M, K, 3)
     T = np.zeros((M, K, 4, 4))
     if st.orientation is None:
         T[:, :, :3, :3] = default_orientation(robot)
@@ -532,11 +598,21 @@ def search_layout(
     chunk_size: int = 4,
     scheduler: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    arm: str | None = None,
+    clearance: float = 0.02,
+    carry: tuple[str, ...] = (),
+    min_margin: float = 0.0,
 ) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
-        robot: a :class:`robots.Robot` (the arm to place).
+        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
+            then the arm ``arm`` of the cell (its only arm by default) is moved among the
+            cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
+            the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
+            must keep ``clearance`` [m] from the fixtures and the other arms
+            (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
+            points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
         picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
             paired with every place.
         candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
@@ -545,6 +621,9 @@ def search_layout(
             :func:`optim.plan_cycle`).
         orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
             the robot's (tool down for six-axis arms), in its base frame.
+        min_margin: smallest boundary margin [m] a pick or place may have; candidates below
+            fail as ``"boundary"`` before any cycle is planned (0: no such rule). The fastest
+            cycles are often near the edge of the workspace, where the arm is stretched.
         refine: how many of the best candidates start a continuous search (0: none).
         refine_evaluations: cycles each continuous search may plan.
         workspace_samples: samples of the workspace whose voxel map gives the boundary margins.
@@ -559,8 +638,32 @@ def search_layout(
         InvalidSettings: unknown ``kind``.
         ExecutionError: a task failed on the scheduler (chunk index named).
     """
+    import uuid
+
     from pinarms.execution import map_chunks
     from pinarms.robots.workspace import sample_workspace
+
+    token = uuid.uuid4().hex
+    recipe = None
+    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
+        cell = robot
+        if arm is None:
+            if len(cell.arms) != 1:
+                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
+            arm = cell.arms[0].name
+        robot = cell.arm(arm).robot
+        if not (isinstance(clearance, (int, float, np.integer, np.floating)) and np.isfinite(clearance)
+                and clearance >= 0):
+            raise InvalidInput(f"clearance must be a distance >= 0 in m, got {clearance!r}")
+        for name in carry:
+            cell.fixture(name)
+        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
+                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
+                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
+                             tuple(carry), float(clearance))
+        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+    elif arm is not None or carry:
+        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
 
     picks_w, places_w = _points(picks, "picks"), _points(places, "places")
     cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
@@ -580,12 +683,27 @@ def search_layout(
                 or np.linalg.det(R) < 0:
             raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
     PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
-    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed))
+    if not (isinstance(min_margin, (int, float, np.integer, np.floating)) and np.isfinite(min_margin)
+            and min_margin >= 0):
+        raise InvalidInput(f"min_margin must be a distance >= 0 in m, got {min_margin!r}")
+    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
     M = cand.shape[0]
 
     failure, reason = _screen(robot, cand, st)
+    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
+    vmap = ws.voxel_map()
+    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
+    point_margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1)
+    margin = point_margin.min(axis=1)
+    if min_margin > 0:
+        names = [f"pick {i + 1}" for i in range(len(picks_w))] + [f"place {j + 1}" for j in range(len(places_w))]
+        for m in np.flatnonzero((margin < min_margin) & np.array([not f for f in failure])):
+            k = int(np.argmin(point_margin[m]))
+            failure[m] = "boundary"
+            reason[m] = (f"{names[k]} is {point_margin[m, k] * 1e3:.0f} mm from the edge of the workspace, "
+                         f"less than min_margin {min_margin * 1e3:.0f} mm")
     todo = [m for m in range(M) if not failure[m]]
-    tasks = [_ChunkTask(robot, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
+    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
     n_refine = int(refine)
     total = len(tasks) + n_refine
 
@@ -605,10 +723,6 @@ def search_layout(
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
 
-    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
-    vmap = ws.voxel_map()
-    pts = _to_base(np.vstack([picks_w, places_w]), cand)
-    margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1).min(axis=1)
     order = _ranking(ppm, margin)
 
     refinement = None
@@ -619,7 +733,7 @@ def search_layout(
     if starts and free.size:
         bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
         step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
-        rtasks = [_RefineTask(robot, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
+        rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
         found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=phase(len(tasks)))
         refinement = Refinement(
             starts=np.array(starts),
@@ -628,9 +742,13 @@ def search_layout(
             picks_per_minute=np.array([f[1] for f in found]),
             evaluations=np.array([f[2] for f in found]),
             free=tuple(AXES[k] for k in free),
+            margin=vmap.query(points_in_base_frame(np.vstack([picks_w, places_w]),
+                                                   np.array([f[0] for f in found])).reshape(-1, 3))
+            .margin.reshape(len(found), -1).min(axis=1),
         )
-        k = int(np.argmax(refinement.picks_per_minute))
-        if refinement.picks_per_minute[k] > best_ppm * (1.0 + _PPM_RTOL):
+        eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
+        k = int(np.argmax(eligible))
+        if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
             best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
     best_cycle = None
     if best_placement is not None:

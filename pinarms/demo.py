@@ -202,6 +202,8 @@ def study_001(quick: bool = False) -> Study:
                     "our rule keeps shells up to 25 % near-singular; the paper's 500 mm is a visual, more cautious pick"))
     rows.append(Row("001", f"recommended region: z {'>' if region.side == 'above' else '<'}", paper.table_z_min_mm,
                     region.z_limit / MM, "mm", 1.0, why))
+    layout_rows, layout = _layout_search_001(arm)
+    rows.extend(layout_rows)
 
     times = np.array(paper.via_times_s)
     traj = planning.multi_quintic(times, table2)
@@ -272,6 +274,10 @@ def study_001(quick: bool = False) -> Study:
     session.add_trajectory("planned_table_to_crate", planned["trajectory"], hz=200.0)
     for name, size, pose in planned["boxes"]:
         session.add_box(name, size, pose, color=(0.93, 0.52, 0.12, 0.6))
+    from pinarms.viz import plots as vplots
+
+    plots["layout_search"] = lambda path: vplots.plot_layout_search(
+        path, layout, title="seed 001: picks/min by base position (P1 → P4, paper's frame)")
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
 
 
@@ -321,6 +327,52 @@ def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
             if shape.kind == "box":
                 boxes.append((shape.geometry, shape.size, arm.to_base(shape.shape_to_world)))
     return rows, {"trajectory": plan.trajectory, "boxes": boxes, "plan": plan}
+
+
+def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
+    """Where to bolt the AUBO-i3 for the station's pick P1 → place P4 (optim.search_layout, small grid).
+
+    Line frame = the paper's frame, whose x and y are ours negated: the paper's own base is
+    the placement (0, 0, 0, yaw 180°). Base positions on a 100 mm grid around it (3 × 3, the
+    same with ``quick``: a few seconds), no refinement (the CLI and benchmarks/sweep.py refine).
+    Returns the table rows and the search (for its plot).
+    """
+    from pinarms import optim
+
+    paper = SEED001
+    pick = np.array(paper.table2_p1_p2_mm[0]) * MM
+    lift = (paper.table2_p1_p2_mm[1][2] - paper.table2_p1_p2_mm[0][2]) * MM
+    place = np.array([42.0, 222.0, 244.0]) * MM  # Table 2's P4, printed "(42222244)"
+    cand = optim.grid_candidates(x=(-0.1, 0.1, 0.1), y=(-0.1, 0.1, 0.1), z=0.0, yaw=np.pi)
+    res = optim.search_layout(arm, pick, place, cand, lift=lift, refine=0, workspace_samples=50_000)
+    what = f"layout search ({len(cand)} base positions on a 100 mm grid around the paper's; pick P1 → place P4)"
+    rows = []
+    at_paper = int(np.flatnonzero(np.all(np.isclose(cand[:, :2], 0.0), axis=1))[0])
+    cycle_note = (f"time-optimal cycle under the joint speed limits, tool pointing down, lift {lift / MM:.0f} mm, "
+                  "dwell 0.2 s (optim.plan_cycle)")
+    if res.failure[at_paper]:
+        rows.append(Row("001", f"{what}: cycle at the paper's placement", None, res.failure[at_paper], "", None,
+                        res.reason[at_paper].split(" (no IK")[0] + " (our tcp, tool pointing down)"))
+    else:
+        rows.append(Row("001", f"{what}: picks/min at the paper's placement", None,
+                        float(res.picks_per_minute[at_paper]), "1/min", None, cycle_note))
+    if res.best_placement is None:
+        rows.append(Row("001", f"{what}: best placement", None, "none", "", None,
+                        "; ".join(sorted(set(f for f in res.failure if f)))))
+        return rows, res
+    x, y = res.best_placement[:2]
+    rows.append(Row("001", f"{what}: best picks/min", None, res.best_picks_per_minute, "1/min", None,
+                    f"base moved by ({x / MM:.0f}, {y / MM:.0f}) mm; {int(res.ok.sum())} of {len(cand)} run the cycle; "
+                    + cycle_note))
+    from pinarms.optim.layout_search import points_in_base_frame
+
+    b = points_in_base_frame(np.vstack([pick, place]), res.best_placement[None])[0]
+    r = np.linalg.norm(b - np.array([0.0, 0.0, 0.16]), axis=1) / MM
+    inside = bool(np.all((b[:, 2] > 0) & (r > paper.table_r_min_mm) & (r < paper.table_r_max_mm)))
+    rows.append(Row("001", f"{what}: P1, P4 distance from (0, 0, 160) mm at the best placement",
+                    f"{paper.table_r_min_mm:.0f} < r < {paper.table_r_max_mm:.0f}", tuple(float(v) for v in np.round(r, 0)), "mm", None,
+                    f"{'inside' if inside else 'outside'} the paper's band (z {b[0, 2] / MM:.0f} mm > 0)"))
+    return rows, res
 
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -23,6 +23,13 @@ This module sits at the bottom of the one-way flow: it imports numpy at module l
 lazily, and the error class (``pinarms.robots.errors``) lazily when it raises; every package
 (robots, planning, optim, viz, the CLI) may import it.
 
+Threads: every task runs with the BLAS and OpenMP thread pools limited to one thread
+(``threadpoolctl``), in the serial loop as on a worker. OpenBLAS's results depend on its
+thread count in the last bits (a pick-and-place cycle time moved by 4e-16 s between one and
+two BLAS threads), and Dask's workers start with one BLAS thread: one thread everywhere
+makes a serial run and any cluster agree bit for bit (and two single-thread workers on two
+cores do not fight over them).
+
 Cost model: the function and each task are pickled and shipped to a worker, the result
 pickled back. Keep tasks small (seeds, counts, a few arrays) and results reduced (voxel
 counts, tables), and make a task last about a second or more: a Dask task costs roughly
@@ -43,6 +50,7 @@ __all__ = [
     "map_chunks",
     "reduce_chunks",
     "describe_scheduler",
+    "task_threads",
     "ExecutionError",
 ]
 
@@ -57,6 +65,21 @@ def __getattr__(name: str):
 
         return ExecutionError
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def task_threads() -> int | None:
+    """Threads a task may start itself: 1 inside a Dask worker (a worker per core already
+    uses the cores), ``None`` (the caller's default) in this process. Never changes results."""
+    import sys
+
+    distributed = sys.modules.get("distributed")  # a worker has it imported; never import it here
+    if distributed is None:
+        return None
+    try:
+        distributed.get_worker()
+    except ValueError:
+        return None
+    return 1
 
 
 def _invalid(message: str) -> Exception:
@@ -251,10 +274,18 @@ def _run(fn, tasks, on_result, scheduler, progress) -> None:
         _map_address(arg, fn, tasks, on_result, progress)
 
 
+def _one_thread(task, fn):
+    """``fn(task)`` with the BLAS/OpenMP pools at one thread (see the module docstring)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        return fn(task)
+
+
 def _map_serial(fn, tasks, on_result, progress):
     for index, task in enumerate(tasks):
         try:
-            result = fn(task)
+            result = _one_thread(task, fn)
         except Exception as exc:
             raise _failure(index, task, "raised", _one_line(exc)) from exc
         on_result(index, result)
@@ -316,7 +347,7 @@ def _map_client(client, fn, tasks, on_result, progress):
     token = uuid.uuid4().hex[:12]
     name = getattr(fn, "__name__", "task")
     keys = [f"pinarms-{name}-{token}-{i}" for i in range(total)]
-    futures = client.map(fn, tasks, key=keys, pure=False)
+    futures = client.map(_one_thread, tasks, fn=fn, key=keys, pure=False)
     index_of = {f.key: i for i, f in enumerate(futures)}
     done = 0
     try:

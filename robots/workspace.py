@@ -121,7 +121,7 @@ def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]
 
 
 def _positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK, progress: Any = None
+    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK, progress: Any = None, threads: int | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
 
@@ -158,11 +158,12 @@ def _positions_and_dexterity(
 
     lock, done = threading.Lock(), [0]
     starts = range(0, N, chunk)
-    if len(starts) < 2 or _WORKERS == 1:
+    threads = _WORKERS if threads is None else max(1, int(threads))
+    if len(starts) < 2 or threads == 1:
         for s in starts:
             block(s)
     else:
-        with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
+        with ThreadPoolExecutor(max_workers=threads) as pool:
             list(pool.map(block, starts))
     return points, w, c
 
@@ -542,7 +543,8 @@ def sample_workspace(
         raise InvalidInput(f"number of samples n must be a positive integer, got {n!r}")
     if n > MAX_RANDOM_SAMPLES:
         raise InvalidInput(f"n = {n:,} samples is more than {MAX_RANDOM_SAMPLES:,} at once (10⁶ samples take "
-                           f"about 100 MB); sample several seeded workspaces and merge them")
+                           f"about 100 MB); for more, robots.stream_workspace keeps only the reductions (voxel map, "
+                           "profile, hull sphere) in flat memory")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk <= 0:
         raise InvalidInput(f"chunk must be a positive integer, got {chunk!r}")
     if isinstance(task_samples, bool) or not isinstance(task_samples, (int, np.integer)) or task_samples <= 0:
@@ -602,8 +604,10 @@ class _SampleTask:
 
 
 def _sample_task(task: _SampleTask) -> tuple:
+    from pinarms.execution import task_threads
+
     q = random_q_slice(task.robot, task.seed, task.start, task.count)
-    return (q, *_positions_and_dexterity(task.robot, q, task.frame, task.chunk))
+    return (q, *_positions_and_dexterity(task.robot, q, task.frame, task.chunk, threads=task_threads()))
 
 
 def _sample_in_tasks(robot, n, seed, frame, chunk, task_samples, scheduler, progress) -> tuple:

@@ -2,7 +2,7 @@
 
 :func:`stream_workspace` draws the same joint samples as :func:`~robots.workspace.sample_workspace`
 (``robot.random_q(n, seed)``) but never holds them: the samples are cut into tasks of
-``task_samples`` (2·10⁶ by default, about 2 s each), each task evaluates its samples in
+``task_samples`` (10⁷ by default, about 10 s each), each task evaluates its samples in
 blocks and returns only reductions, and the reductions are folded **in task order** into
 
 - the bounding box, the mean and maximum position manipulability, the near-singular share;
@@ -61,16 +61,20 @@ __all__ = [
     "TASK_SAMPLES",
     "PILOT_SAMPLES",
     "MIN_DEFAULT_VOXEL",
+    "MAX_STREAM_SAMPLES",
 ]
 
-#: Samples per task (a task evaluates them in blocks and returns reductions only).
-TASK_SAMPLES = 2_000_000
+#: Samples per task (a task evaluates them in blocks and returns reductions only). A task's
+#: result holds its occupied voxels (24 bytes each, up to the whole grid): with 10⁷ samples a
+#: task lasts about 10 s and ships at most a few tens of MB, small beside its work.
+TASK_SAMPLES = 10_000_000
 #: Samples of the in-memory pilot that fixes the shell centre and the default voxel edge.
 PILOT_SAMPLES = 200_000
 #: Smallest default voxel edge [m] (a finer grid must be asked for with ``voxel_size``).
 MIN_DEFAULT_VOXEL = 0.01
+#: Largest ``n`` accepted (10¹²).
+MAX_STREAM_SAMPLES = 10**12
 _BLOCK = 262_144
-_OFFSET = np.int64(1 << 20)  # voxel indices in [-2^20, 2^20) per axis: ±10 km at 1 cm
 
 
 # ------------------------------------------------------------------ reductions
@@ -178,10 +182,17 @@ def _pad_shells(acc: _Reduction, k: int) -> None:
 
 
 def _sparse_voxels(acc: _Reduction) -> tuple:
-    """The occupied voxels of ``acc``: global indices ``(k, 3)``, count, sum and min of manipulability."""
+    """The occupied voxels of ``acc``, compact for shipping (24 bytes per voxel).
+
+    ``(lo (3,), shape (3,), flat index in that block (int32), count (int32), sum and min of
+    manipulability (float64))``.
+    """
     flat = np.flatnonzero(acc.vox_count.reshape(-1))
-    ijk = np.column_stack(np.unravel_index(flat, acc.vox_count.shape)) + acc.vox_lo
-    return ijk, acc.vox_count.reshape(-1)[flat], acc.vox_sum.reshape(-1)[flat], acc.vox_min.reshape(-1)[flat]
+    index = flat.astype(np.int32) if acc.vox_count.size < 2**31 else flat
+    count = acc.vox_count.reshape(-1)[flat]
+    count = count.astype(np.int32) if count.size and count.max() < 2**31 else count
+    return (acc.vox_lo.copy(), np.array(acc.vox_count.shape), index, count,
+            acc.vox_sum.reshape(-1)[flat], acc.vox_min.reshape(-1)[flat])
 
 
 def _merge(acc: _Reduction, part: _Reduction) -> None:
@@ -192,8 +203,9 @@ def _merge(acc: _Reduction, part: _Reduction) -> None:
     acc.sum_w += part.sum_w
     acc.max_w = max(acc.max_w, part.max_w)
     acc.n_singular += part.n_singular
-    ijk, count, total, wmin = part.vox_sparse
-    if ijk.shape[0]:
+    lo, shape, index, count, total, wmin = part.vox_sparse
+    if index.shape[0]:
+        ijk = np.column_stack(np.unravel_index(index.astype(np.int64), tuple(int(v) for v in shape))) + lo
         _grow(acc, ijk.min(axis=0), ijk.max(axis=0))
         flat = np.ravel_multi_index((ijk - acc.vox_lo).T, acc.vox_count.shape)
         acc.vox_count.reshape(-1)[flat] += count
@@ -240,12 +252,15 @@ def _run_task(task: WorkspaceTask) -> _Reduction:
     """Evaluate one task's samples block by block; return its reduction (voxels shipped sparse)."""
     acc = _Reduction()
     robot, spec = task.robot, task.spec
+    from pinarms.execution import task_threads
+
+    threads = task_threads()
     rng = _generator_at(robot, task.seed, task.start)
     done = 0
     while done < task.count:
         m = min(spec.block, task.count - done)
         q = rng.uniform(robot.lower, robot.upper, size=(m, robot.nq))
-        P, w, c = _positions_and_dexterity(robot, q, spec.frame)
+        P, w, c = _positions_and_dexterity(robot, q, spec.frame, threads=threads)
         _add_block(acc, P, w, c, spec)
         done += m
     acc.vox_sparse = _sparse_voxels(acc)
@@ -334,6 +349,8 @@ def stream_workspace(
     ):
         raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
     n, seed = int(n), int(seed)
+    if n > MAX_STREAM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_STREAM_SAMPLES:,} (about a week on 100 cores)")
     pilot = sample_workspace(robot, min(n, PILOT_SAMPLES), seed=seed, frame=frame)
     centre = pilot.fit_sphere().centre
     if voxel_size is None:

@@ -1,7 +1,7 @@
 """The one-way flow of the packages: robots → planning → optim → viz → pinarms (CLI, studies).
 
 Below them all sits the execution layer ``pinarms.execution`` (serial loop or Dask): every
-package may import it, and it imports only numpy, Dask and the error classes
+package may import it, and it imports only numpy, Dask, threadpoolctl and the error classes
 (``pinarms.robots.errors``, a module that imports nothing of ours).
 
 The folders ``robots/``, ``planning/``, ``optim/``, ``viz/`` sit at the repository's top level
@@ -77,7 +77,7 @@ def _imported_modules(path: Path) -> set[str]:
     return out
 
 
-def test_the_execution_layer_imports_only_numpy_dask_and_the_errors():
+def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_errors():
     import sys
 
     modules = _imported_modules(ROOT / "pinarms" / "execution.py")
@@ -86,7 +86,7 @@ def test_the_execution_layer_imports_only_numpy_dask_and_the_errors():
     third_party = {
         m.split(".")[0] for m in modules - ours if m.split(".")[0] not in sys.stdlib_module_names
     }
-    assert third_party <= {"numpy", "dask", "distributed"}, third_party
+    assert third_party <= {"numpy", "dask", "distributed", "threadpoolctl"}, third_party
     # and the errors module it reaches imports nothing of ours
     errors = _imported_modules(ROOT / "robots" / "errors.py")
     assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors

@@ -180,3 +180,12 @@ def test_importing_the_layer_loads_neither_dask_nor_the_robots():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_reduce_chunks_folds_in_task_order(client):
+    tasks = [{"n": k, "fail": False} for k in range(7)]
+    fold = lambda acc, r: acc + [r]  # noqa: E731
+    assert execution.reduce_chunks(fail_on_chunk, tasks, fold, []) == [0, 2, 4, 6, 8, 10, 12]
+    assert execution.reduce_chunks(fail_on_chunk, tasks, fold, [], scheduler=client) == [0, 2, 4, 6, 8, 10, 12]
+    with pytest.raises(InvalidInput, match="combine"):
+        execution.reduce_chunks(fail_on_chunk, tasks, None, [])

@@ -20,8 +20,13 @@ from .session import Session
 __all__ = ["layout_search_session"]
 
 
-def layout_search_session(result: Any, robot: Any, *, title: str | None = None) -> Session:
+def layout_search_session(result: Any, robot: Any, *, title: str | None = None, cell: Any = None,
+                          carry: tuple[str, ...] = ()) -> Session:
     """Session of a layout search of ``robot`` (see the module docstring).
+
+    With the ``cell`` the search ran in, its box-shaped fixtures are added as boxes (other
+    shapes by their bounding box: cylinders as square prisms; meshes are left out); the
+    fixtures in ``carry`` are drawn where they stand with the arm at its best placement.
 
     Raises:
         InvalidInput: no candidate could run the cycle (nothing to place), or a result of another robot.
@@ -40,6 +45,19 @@ def layout_search_session(result: Any, robot: Any, *, title: str | None = None) 
     in_base = (np.linalg.inv(T) @ world.T).T[:, :3]
     session.add_workspace("candidates_picks_per_minute", points=in_base,
                           manipulability=np.asarray(result.picks_per_minute, dtype=float))
+    if cell is not None:
+        if carry:
+            cell = cell.with_arm_base(result.robot, T, carry=tuple(carry))
+        for fixture in cell.fixtures:
+            for k, shape in enumerate(fixture.shapes):
+                if shape.kind == "box":
+                    size = shape.size
+                elif shape.kind in ("cylinder", "capsule"):
+                    size = (2 * shape.size[0], 2 * shape.size[0], shape.size[1])
+                else:
+                    continue
+                name = fixture.name if len(fixture.shapes) == 1 else f"{fixture.name}_{k}"
+                session.add_box(name, size, shape.shape_to_world, color=(0.7, 0.7, 0.7, 1.0))
     session.add_points("picks", result.picks, kind="target")
     session.add_points("places", result.places, kind="target")
     return session

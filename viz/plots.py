@@ -504,7 +504,7 @@ def plot_layout_search(path: str | Path, result: Any, *, title: str | None = Non
 
     One square per (x, y) of the candidates, coloured by the best picks/min over their z and
     yaw; placements where no candidate could run the cycle are grey crosses. The picks
-    (triangles), places (squares), the best grid placement (star) and the refined one
+    (triangles), places (squares), the best grid placement (black frame) and the refined one
     (diamond, when the refinement gained) are marked. Line frame; ``mm`` labels millimetres.
     """
     if not all(hasattr(result, a) for a in ("candidates", "picks_per_minute", "picks", "places")):
@@ -533,8 +533,8 @@ def plot_layout_search(path: str | Path, result: Any, *, title: str | None = Non
                label="place")
     index = getattr(result, "best_index", -1)
     if index >= 0:
-        ax.scatter([cand[index, 0] * k], [cand[index, 1] * k], marker="*", s=260, color="white", edgecolors="k",
-                   label=f"best grid placement ({ppm[index]:.1f}/min)")
+        ax.scatter([cand[index, 0] * k], [cand[index, 1] * k], marker="s", s=size * 2.2, facecolors="none",
+                   edgecolors="k", linewidths=2.0, label=f"best grid placement ({ppm[index]:.1f}/min)")
     refined = getattr(result, "refinement", None)
     if refined is not None and refined.gain > 0:
         j = int(np.argmax(refined.picks_per_minute))

@@ -66,6 +66,15 @@ def _range(text: str, what: str, scale: float, random: bool):
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of random placements, workspace and optimiser.")
 @click.option("--chunk-size", default=4, show_default=True, type=int, help="Placements per task.")
 @click.option("--top", default=10, show_default=True, type=int, help="Rows of the ranked table.")
+@click.option("--min-margin", default=0.0, show_default=True, type=float,
+              help="Rule out placements whose picks or places are closer than this to the workspace edge "
+                   "[m, or mm with --mm].")
+@click.option("--cell", "cell_name", default=None,
+              help="Search inside a cell (built-in name or .xacro/.urdf file): ROBOT is then the arm's name in it, "
+                   "the line frame is the cell's world and every cycle keeps --clearance from its fixtures.")
+@click.option("--clearance", default=0.02, show_default=True, type=float,
+              help="With --cell: distance the cycle keeps from fixtures and other arms [m, or mm with --mm].")
+@click.option("--carry", multiple=True, help="With --cell: a fixture that moves with the arm (its stand); repeat.")
 @click.option("--plot", "plot_path", default=None, type=click.Path(dir_okay=False),
               help="Write the picks/min map over the (x, y) placements (.png or .svg).")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
@@ -73,8 +82,8 @@ def _range(text: str, what: str, scale: float, random: bool):
 @scheduler_option
 @json_option
 def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, n_random, mm, deg, lift, dwell, kind,
-                      vmax, amax, jmax, refine, refine_evaluations, seed, chunk_size, top, plot_path, session_path,
-                      scheduler, as_json) -> None:
+                      vmax, amax, jmax, refine, refine_evaluations, seed, chunk_size, top, min_margin, cell_name, clearance, carry,
+                      plot_path, session_path, scheduler, as_json) -> None:
     """Where to put ROBOT for the most picks per minute: rank base placements by their cycle.
 
     Every placement (x, y, z, yaw of the base in the line frame) is screened by IK (which
@@ -87,8 +96,18 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
     """
     from pinarms import optim
 
-    arm = load_robot(robot)
     k = 1e-3 if mm else 1.0
+    in_cell = {}
+    if cell_name:
+        from pinarms.robots.cell import load_cell
+
+        cell = load_cell(cell_name)
+        arm = cell.arm(robot).robot
+        in_cell = {"arm": robot, "clearance": clearance * k, "carry": tuple(carry)}
+    else:
+        if carry:
+            raise InvalidInput("--carry names fixtures of a cell: give --cell too")
+        cell, arm = None, load_robot(robot)
     ky = np.pi / 180.0 if deg else 1.0
     random = n_random is not None
     axes = {name: _range(text, f"--{name}", scale, random)
@@ -101,10 +120,12 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
     ones = np.ones(arm.nq)
     with progress_bar(f"{arm.name}: placements", len(candidates), as_json) as bar:
         res = optim.search_layout(
-            arm, picks, places, candidates, lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
+            cell if cell is not None else arm, picks, places, candidates,
+            lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
             vmax=si_limit(vmax, "--vmax", ones), amax=si_limit(amax, "--amax", ones),
             jmax=si_limit(jmax, "--jmax", ones), refine=refine, refine_evaluations=refine_evaluations, seed=seed,
             chunk_size=chunk_size, scheduler=scheduler, progress=bar if bar.enabled else None,
+            min_margin=min_margin * k, **in_cell,
         )
     data = res.as_dict()
     from pinarms.execution import describe_scheduler
@@ -123,5 +144,5 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
 
         if res.best_placement is None:
             raise InvalidInput("no placement runs the cycle: there is no best placement to save in a session")
-        save_session(viz.layout_search_session(res, arm), session_path, data, lines)
+        save_session(viz.layout_search_session(res, arm, cell=cell, carry=tuple(carry)), session_path, data, lines)
     emit(as_json, data, lines)

@@ -27,6 +27,7 @@ from ._common import (
     load_robot,
     new_session,
     save_session,
+    scheduler_option,
     vectors_from_args,
 )
 
@@ -270,15 +271,25 @@ def _unreachable(arm, T: np.ndarray, values: np.ndarray, position_only: bool, ne
 @click.option("--seed", default=0, show_default=True, type=int, help="Random seed.")
 @click.option("--frame", default="tcp", show_default=True)
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Also save the cloud into a session file.")
+              help="Also save the cloud into a session file (with --stream: the reachable voxel centres).")
+@click.option("--stream", is_flag=True,
+              help="Keep only reductions (bounding box, voxel map, profile, hull sphere) in flat memory: "
+                   "for 10^8 samples and more; no table region.")
+@click.option("--voxel", "voxel_mm", default=None, type=float, help="With --stream: voxel edge [mm] (default >= 10 mm).")
+@scheduler_option
 @json_option
-def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, as_json: bool) -> None:
+def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str | None, stream: bool,
+                  voxel_mm: float | None, scheduler: str | None, as_json: bool) -> None:
     """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region.
 
     The region is robots.placement.recommend_region's radial band on the working side of
-    the base plane (distances in the JSON in metres).
+    the base plane (distances in the JSON in metres). With --stream the samples are
+    reduced in tasks of 2e6 (serially, or on Dask with --scheduler) and never held.
     """
     arm = load_robot(robot)
+    if stream:
+        _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json)
+        return
     from pinarms.robots.placement import recommend_region
     from pinarms.robots.workspace import sample_workspace
 
@@ -310,6 +321,33 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     if session_path:
         session = new_session(arm, f"workspace of {arm.name}")
         session.add_workspace("workspace", ws)
+        save_session(session, session_path, data, lines)
+    emit(as_json, data, lines)
+
+
+def _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json) -> None:
+    from pinarms.execution import describe_scheduler
+    from pinarms.robots.workspace_stream import stream_workspace
+
+    with common.progress_bar("workspace tasks", None, as_json) as bar:
+        res = stream_workspace(arm, n, seed=seed, frame=frame,
+                               voxel_size=None if voxel_mm is None else voxel_mm * 1e-3,
+                               scheduler=scheduler, progress=bar if bar.enabled else None)
+    v = res.voxels
+    data = {
+        "robot": arm.name, "n": n, "seed": seed, "frame": frame, "streamed": True,
+        "ran_on": describe_scheduler(scheduler), "tasks": res.n_tasks,
+        "summary": jsonable(res.summary),
+        "voxels": {"voxel_size_m": v.voxel_size, "shape": list(v.shape), "origin_m": v.origin,
+                   "reachable": int(np.count_nonzero(v.reachable)), "reachable_volume_m3": v.reachable_volume},
+    }
+    lines = res.text().splitlines()
+    lines[0] += f" (seed {seed}, streamed in {res.n_tasks} tasks, {describe_scheduler(scheduler)})"
+    if session_path:
+        session = new_session(arm, f"workspace of {arm.name} ({n:.0e} samples, voxel centres)")
+        reach = v.reachable
+        session.add_workspace("workspace_voxels", points=v.voxel_centres(),
+                              manipulability=v.mean_manipulability[reach])
         save_session(session, session_path, data, lines)
     emit(as_json, data, lines)
 

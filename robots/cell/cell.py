@@ -168,6 +168,7 @@ class Cell:
         self.source = source
         self.urdf_text = urdf_text
         self.args = dict(args or {})
+        self._seed = seed
         self._packages = dict(packages or {})
         self._base_dir = Path(base_dir)
         try:
@@ -437,6 +438,53 @@ class Cell:
         Rg = R[:, parents] @ local_R
         pg = p[:, parents] + np.einsum("ngij,gj->ngi", R[:, parents], local_p)
         return Rg, pg
+
+    def with_arm_base(self, name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> "Cell":
+        """A new cell: this one with arm ``name``'s base at ``base_to_world`` ``(4, 4)`` [m] in the world.
+
+        The fixed joint that holds the arm's base link to its parent gets the origin that puts
+        the base there; its parent stays where it is. Fixtures named in ``carry`` (a stand, a
+        pedestal) keep their pose relative to the arm's base instead of the world. The cell
+        is rebuilt from the edited URDF (collision pairs classified again); this cell is
+        unchanged. Used by layout searches that move an arm among fixed fixtures.
+
+        Raises:
+            InvalidInput: unknown arm or fixture, or not a rigid transform.
+            CellError: the arm's base (or a carried fixture) is not held by a fixed joint.
+        """
+        arm = self.arm(name)
+        T = np.asarray(base_to_world, dtype=float)
+        if T.shape != (4, 4) or not np.all(np.isfinite(T)) or np.abs(T[:3, :3] @ T[:3, :3].T - np.eye(3)).max() > 1e-9 \
+                or np.linalg.det(T[:3, :3]) < 0 or np.abs(T[3] - [0, 0, 0, 1]).max() > 1e-12:
+            raise InvalidInput(f"base_to_world of arm {name!r} must be a rigid transform (4, 4), got {base_to_world!r}")
+        spec = next(a for a in self.spec.arms if a.name == arm.name)
+        for fixture in carry:
+            self.fixture(fixture)  # InvalidInput for an unknown name
+        root = ET.fromstring(self.urdf_text)
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
+
+        def world(link: str) -> np.ndarray:
+            return data.oMf[self.model.getFrameId(link)].homogeneous
+
+        def place(link: str, link_to_world: np.ndarray) -> None:
+            holder = next((j for j in root.iter("joint")
+                           if j.find("child") is not None and j.find("child").get("link") == link), None)
+            if holder is None or holder.get("type") != "fixed":
+                raise CellError(f"link {link!r} of cell {self.name!r} is not held by a fixed joint: cannot move it")
+            origin = np.linalg.inv(world(holder.find("parent").get("link"))) @ link_to_world
+            element = holder.find("origin")
+            if element is None:
+                element = ET.SubElement(holder, "origin")
+            element.set("xyz", " ".join(repr(float(v)) for v in origin[:3, 3]))
+            element.set("rpy", " ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(origin[:3, :3])))
+
+        moved = T @ np.linalg.inv(arm.base_to_world)
+        for fixture in carry:
+            place(fixture, moved @ world(fixture))
+        place(spec.base_link, T)
+        return Cell(ET.tostring(root, encoding="unicode"), source=f"{self.source} (arm {name!r} moved)",
+                    base_dir=self._base_dir, packages=self._packages, args=self.args, seed=self._seed)
 
     def with_pairs(self, kinds: str | tuple[str, ...] | list[str]) -> "Cell":
         """The same cell checking only the pairs of the given kinds.

@@ -63,3 +63,19 @@ def test_scheduler_from_the_standard_variable(monkeypatch):
 def test_bad_ranges_are_usage_errors():
     result = CliRunner().invoke(cli, [*SCARA[:-4], "--x", "0:1", "--y", "0"])
     assert result.exit_code == 2 and "LO:HI:STEP" in result.output
+
+
+def test_workspace_stream_option(tmp_path):
+    from pinarms.robots.workspace_stream import stream_workspace
+
+    out = tmp_path / "voxels.pinarms"
+    result = CliRunner().invoke(cli, ["workspace", "aubo_i3", "-n", "60000", "--stream", "--voxel", "50",
+                                      "--json", "--session", str(out)])
+    assert result.exit_code == 0, (result.output, result.exception)
+    data = json.loads(result.stdout)
+    api = stream_workspace(robots.load("aubo_i3"), 60_000, seed=0, voxel_size=0.05)
+    assert data["streamed"] and data["tasks"] == 1 and data["ran_on"] == "serial (this process)"
+    assert data["summary"]["bbox_max"] == api.summary.bbox_max.tolist()
+    assert data["voxels"]["reachable"] == int(api.voxels.reachable.sum())
+    cloud = viz.load_session(out).workspaces["workspace_voxels"]
+    assert cloud.points.shape == (int(api.voxels.reachable.sum()), 3)

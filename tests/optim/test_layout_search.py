@@ -120,3 +120,37 @@ def test_bad_input(scara, points):
         search_layout(scara, [1, 2], place, np.zeros((1, 4)))
     with pytest.raises(InvalidInput, match="lift"):
         search_layout(scara, pick, place, np.zeros((1, 4)), lift=0.0)
+
+
+@pytest.mark.slow
+def test_in_a_cell_a_candidate_that_collides_fails_as_collision():
+    from pinarms.robots.cell import load_cell
+
+    station = load_cell("aubo_food_station")
+    pick, place = np.array([0.36, 0.0, 0.75]), np.array([0.0, -0.42, 0.77])
+    # the cell's own placement; 250 mm towards the crate (the shoulder in the crate wall); out of reach
+    cand = np.array([[0.0, 0.0, 0.7, 0.0], [0.0, -0.25, 0.7, 0.0], [0.9, 0.0, 0.7, 0.0]])
+    res = search_layout(station, pick, place, cand, refine=0, carry=("stand",), workspace_samples=20_000)
+    assert res.failure == ("", "collision", "unreachable")
+    assert "crate_wall" in res.reason[1] and "clearance 20.0 mm" in res.reason[1]
+    arm = station.arm("aubo")
+    direct = optim.plan_cycle(arm.robot, optim.PickPlace(arm.to_base(pick), arm.to_base(place)), cell=station,
+                              clearance=0.02)
+    assert res.cycle_time[0] == pytest.approx(direct.cycle_time, rel=1e-12) and direct.cell_report.extra_time > 0
+    assert res.best_cycle.cell_report.lift == direct.cell_report.lift
+    with pytest.raises(InvalidInput, match="carry"):
+        search_layout(robots.load("aubo_i3"), pick, place, cand, carry=("stand",))
+
+
+def test_min_margin_rules_out_points_near_the_workspace_edge(scara, points):
+    pick, place = points
+    cand = np.array([[0.0, 0.0, 0.0, 0.0], [0.1, 0.0, 0.0, 0.0]])
+    free = search_layout(scara, pick, place, cand, lift=0.02, refine=0, workspace_samples=20_000)
+    limit = float(np.mean(free.margin))  # between the two candidates' margins
+    assert free.margin.min() < limit < free.margin.max()
+    res = search_layout(scara, pick, place, cand, lift=0.02, refine=0, workspace_samples=20_000, min_margin=limit)
+    near = int(np.argmin(free.margin))
+    assert res.failure[near] == "boundary" and "from the edge of the workspace" in res.reason[near]
+    assert res.failure[1 - near] == "" and res.best_index == 1 - near
+    with pytest.raises(InvalidInput, match="min_margin"):
+        search_layout(scara, pick, place, cand, min_margin=-1.0)
