@@ -31,7 +31,7 @@ import numpy as np
 
 from pinarms.planning._inputs import finite_array, scalar
 from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
-from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
+from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
 __all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
 

@@ -39,7 +39,7 @@ from pinarms.optim.errors import (GoalInCollision, InfeasibleProblem, InvalidLim
                                   StartInCollision)
 from pinarms.optim.motion.checker import MotionChecker
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
-from pinarms.optim.motion.search import FIRST_SOLUTION, PLANNERS, search, shortcut
+from pinarms.optim.motion.search import PLANNERS, search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.planning import JointPath, Trajectory
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
