@@ -15,6 +15,12 @@ Sections (each measurement runs in a fresh child process, so its peak memory is 
   the sample's configuration does reach at the cell's exact pose (voxel centre, set rotation):
   poses the map's IK missed. The AUBO-i3's closed form runs through the same check as a
   control.
+- ``station``: seed 001's station (the paper's Table 2 pick P1 and place P4, 45 mm lift):
+  ``optim.search_layout`` over a blind grid of base placements (x, y every 0.05 m, z 0 /
+  0.1 / 0.2 m, yaw 0) beside the same search started from the candidates of
+  ``robots.base_placements`` on the tool-down map (the 20 best per base height): the best
+  placement of each, the distance between them (in voxels of the map), and the cycles each
+  planned.
 - ``memory``: peak resident memory of maps of growing size (per-voxel arrays only; solutions
   streamed to a file with ``out=``; solutions kept in memory), stated per million voxels.
 
@@ -48,7 +54,16 @@ def child(name: str, args: dict) -> dict:
     from pinarms.robots.reachability import reachability_map
 
     if args.get("one_core"):
+        # one core: no thread pools either (pinarms sizes them by os.cpu_count(), not by the affinity)
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+        import pinarms.robots.ik.solver as ik_solver
+        import pinarms.robots.kinematic_tree as tree
+
+        ik_solver._WORKERS = tree._WORKERS = 1
+    if args.get("trace"):
+        import tracemalloc
+
+        tracemalloc.start()
     arm = robots.load(args["robot"])
     opts = dict(args.get("opts", {}))
     if "out" in opts:
@@ -57,7 +72,13 @@ def child(name: str, args: dict) -> dict:
     t0, c0 = time.perf_counter(), time.process_time()
     m = reachability_map(arm, args["resolution"], args["orientations"], **opts)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    traced = None
+    if args.get("trace"):
+        import tracemalloc
+
+        traced = tracemalloc.get_traced_memory()[1] / 1e6
     out = {
+        "traced_peak_mb": traced,
         "name": name, "wall_s": wall, "cpu_s": cpu, "voxels": m.n_voxels, "poses": m.n_poses,
         "reached": m.n_reached, "reachable_voxels": int(np.count_nonzero(m.index > 0)),
         "mean_index": float(m.index[m.index > 0].mean()) if m.n_reached else 0.0,
@@ -121,8 +142,6 @@ def dask() -> None:
 
 def _binned_misses(arm, m, n_samples: int, seed: int, max_checks: int) -> dict:
     """Cells (voxel, nearest set rotation) entered by a joint-space sample that the map does not reach."""
-    from pinarms.robots.errors import UnreachableTarget
-
     rng = np.random.default_rng(seed)
     o = m.orientations
     hit_rows, hit_k, seeds = [], [], []
@@ -191,19 +210,78 @@ def memory() -> None:
         for label, opts in (("per-voxel arrays only", {"keep_solutions": False}),
                             ("solutions streamed (out=)", {"out": True}),
                             ("solutions in memory", {"keep_solutions": True})):
-            r = run_child(f"mem-{res}-{label}", robot="aubo_i3", resolution=res, orientations=50, opts=opts)
+            r = run_child(f"mem-{res}-{label}", robot="aubo_i3", resolution=res, orientations=50, opts=opts, trace=True)
             rows.append((res, label, r))
             extra = f", file {r['file_mb']:.0f} MB" if "file_mb" in r else ""
-            print(f"  {res * 1000:4.0f} mm  {label:<27} {r['voxels']:>9,} voxels  peak {r['rss_mb']:7.0f} MB "
-                  f"(after imports {r['rss_before_mb']:.0f} MB){extra}")
+            print(f"  {res * 1000:4.0f} mm  {label:<27} {r['voxels']:>9,} voxels  peak RSS {r['rss_mb']:7.0f} MB "
+                  f"(after imports {r['rss_before_mb']:.0f} MB), peak of numpy/Python allocations "
+                  f"{r['traced_peak_mb']:7.1f} MB{extra}")
     for label in ("per-voxel arrays only", "solutions streamed (out=)", "solutions in memory"):
         (_, _, a), (_, _, b) = [x for x in rows if x[1] == label]
-        slope = (b["rss_mb"] - a["rss_mb"]) / ((b["voxels"] - a["voxels"]) / 1e6)
-        print(f"  {label:<27}: {slope:7.0f} MB per million voxels (difference of the two peaks)")
+        dv = (b["voxels"] - a["voxels"]) / 1e6
+        print(f"  {label:<27}: {(b['traced_peak_mb'] - a['traced_peak_mb']) / dv:7.0f} MB per million voxels "
+              f"(numpy/Python allocations), {(b['rss_mb'] - a['rss_mb']) / dv:7.0f} MB (peak RSS)")
     print()
 
 
-SECTIONS = {"aubo": aubo, "dask": dask, "panda": panda, "memory": memory}
+def station() -> None:
+    from pinarms import optim, robots
+    from pinarms.papers import SEED001
+    from pinarms.robots.base_placement import base_placements, tool_down_poses
+    from pinarms.robots.reachability import reachability_map
+
+    arm = robots.load("aubo_i3")
+    p1, p2 = (np.array(p) * 1e-3 for p in SEED001.table2_p1_p2_mm)
+    place = np.array([42.0, 222.0, 244.0]) * 1e-3  # Table 2's P4 (printed "(42222244)")
+    lift = float(p2[2] - p1[2])
+    heights = (0.0, 0.1, 0.2)
+    grid = optim.grid_candidates(x=(-0.2, 0.7, 0.05), y=(-0.3, 0.7, 0.05), z=(0.0, 0.2, 0.1))
+    t0 = time.perf_counter()
+    blind = optim.search_layout(arm, p1, place, grid, lift=lift, refine=0)
+    t_blind = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    m = reachability_map(arm, 0.05, 8, tool_down=np.radians(15), keep_solutions=False)
+    t_map = time.perf_counter() - t0
+    points = np.vstack([p1, p1 + [0, 0, lift], place, place + [0, 0, lift]])
+    tasks = tool_down_poses(points, m.orientations.tool_axis)
+    t0 = time.perf_counter()
+    chosen = []
+    for z in heights:
+        bp = base_placements(m, tasks, robot=arm, z=z, yaw_step=2 * np.pi, verify=20)
+        chosen.append(bp.candidates[bp.verified][:20])
+    cand = np.vstack(chosen)
+    t_place = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    seeded = optim.search_layout(arm, p1, place, cand, lift=lift, refine=0)
+    t_seeded = time.perf_counter() - t0
+
+    def best(res):
+        return res.best_placement, res.best_picks_per_minute
+
+    def evaluated(res):  # candidates whose cycles were planned (past the batched IK screen)
+        return int(sum(f not in ("unreachable", "joint limit") for f in res.failure))
+
+    (b1, ppm1), (b2, ppm2) = best(blind), best(seeded)
+    gap = float(np.linalg.norm((b1 - b2)[:3])) if b1 is not None and b2 is not None else float("nan")
+    rank_in_blind = None
+    if b2 is not None:
+        same = np.flatnonzero(np.all(np.abs(grid - b2) < 1e-9, axis=1))
+        if same.size:
+            rank_in_blind = int(np.flatnonzero(blind.order == same[0])[0]) + 1
+    print("seed 001 station: pick P1, place P4 (Table 2), 45 mm lift, AUBO-i3; picks/min of the time-optimal cycle")
+    print(f"  blind grid: {len(grid)} placements, {evaluated(blind)} past the IK screen (cycles planned), "
+          f"{int(blind.ok.sum())} feasible, best {b1.tolist() if b1 is not None else None} at {ppm1:.2f} picks/min, {t_blind:.0f} s")
+    print(f"  from the map: tool-down map {t_map:.0f} s, base_placements {t_place:.1f} s, {len(cand)} candidates "
+          f"(20 best verified per height), {evaluated(seeded)} cycles planned, {int(seeded.ok.sum())} feasible, best "
+          f"{b2.tolist() if b2 is not None else None} at {ppm2:.2f} picks/min, {t_seeded:.0f} s")
+    print(f"  best placements {gap * 1000:.0f} mm apart ({gap / m.resolution:.1f} voxels of the map); the map's best "
+          f"ranks {rank_in_blind} of {int(blind.ok.sum())} in the blind search; cycles planned: "
+          f"{evaluated(seeded)} instead of {evaluated(blind)} ({evaluated(blind) / max(evaluated(seeded), 1):.1f}x fewer)")
+    print()
+
+
+SECTIONS = {"aubo": aubo, "dask": dask, "panda": panda, "station": station, "memory": memory}
 
 
 if __name__ == "__main__":

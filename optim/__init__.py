@@ -13,17 +13,22 @@ pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, an
 :func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
 Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
 :mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
+:func:`plan_motion` plans a collision-free move of an arm in a cell with OMPL, proves it
+continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """
 
 from pinarms.optim.cell_cycle import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
-from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings, OptimError
+from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
+                                  InvalidSettings, NoPathFound, OptimError, PlanningError, StartInCollision)
+from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
 from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
+from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.problem import KINDS, TimingProblem
 from pinarms.optim.settings import GASettings
 from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
@@ -52,6 +57,7 @@ __all__ = [
     "random_candidates",
     "time_optimal",
     "time_scaled",
+    "TorqueConstraint",
     "PathTiming",
     "CellCycleReport",
     "LineSchedule",
@@ -70,4 +76,11 @@ __all__ = [
     "InfeasibleProblem",
     "InvalidLimits",
     "InvalidSettings",
+    "plan_motion",
+    "MotionPlan",
+    "PlanningError",
+    "EndpointInCollision",
+    "StartInCollision",
+    "GoalInCollision",
+    "NoPathFound",
 ]

@@ -11,7 +11,11 @@ fails, the cycle is re-planned, in this order, until it passes:
    (the transfer then starts and ends higher), up to the highest lift the arm reaches;
 2. **add a via point** above the middle of the transfer (between "above pick" and
    "above place", at the highest lifted height plus ``lift_step`` per attempt, three
-   heights), then two via points at one and two thirds.
+   heights), then two via points at one and two thirds;
+3. **plan the transfer** round what blocks (a crate under a guard, a shelf, the other
+   arm's column): :func:`optim.motion.cycle.planned_cycle` keeps the lift and lowering at
+   the spec's height and plans the transfer between them with OMPL, every edge proven
+   continuously (:mod:`optim.motion`).
 
 Each re-planned cycle is re-timed (time-optimal under the same limits) and re-checked.
 The result carries a :class:`CellCycleReport`: what was tried, the lift and via points
@@ -50,6 +54,8 @@ class CellCycleReport:
         cycle_time_without_cell: the cycle planned ignoring the cell [s];
             ``extra_time``: the kept cycle's time minus it [s].
         attempts: each attempt in order: ``(description, clear, min clearance [m], pair)``.
+        planned_transfer: the transfer was planned around the cell (:mod:`optim.motion.cycle`)
+            after raising the lift and via points could not clear.
     """
 
     cell: str
@@ -64,6 +70,7 @@ class CellCycleReport:
     cycle_time_without_cell: float
     extra_time: float
     attempts: tuple[tuple[str, bool, float, str], ...] = field(default=())
+    planned_transfer: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -79,6 +86,7 @@ class CellCycleReport:
             "cycle_time_without_cell_s": self.cycle_time_without_cell,
             "extra_time_s": self.extra_time,
             "attempts": [{"what": a, "clear": c, "min_clearance_m": d, "pair": p} for a, c, d, p in self.attempts],
+            "planned_transfer": self.planned_transfer,
         }
 
 
@@ -116,7 +124,7 @@ def _describe(check) -> tuple[float, str, float]:
 
 
 def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, arm: str | None, hold: Any,
-                       margin: float, lift_step: float, plan: Any, **plan_kwargs: Any):
+                       margin: float, lift_step: float, plan: Any, plan_transfer: bool = True, **plan_kwargs: Any):
     """Plan ``spec`` for ``robot`` (an arm of ``cell``) keeping ``clearance`` (module doc).
 
     ``plan`` is :func:`optim.cycle.plan_cycle` (called without a cell for each attempt).
@@ -193,6 +201,25 @@ def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, ar
                     break
             if ok:
                 break
+    planned_transfer = False
+    if not ok and plan_transfer:
+        # raising the transfer cannot clear: plan it round what blocks (OMPL, optim.motion)
+        from pinarms.optim.errors import PlanningError
+        from pinarms.optim.motion.cycle import planned_cycle
+
+        try:
+            result = planned_cycle(robot, spec, base, cell=cell, arm=cell_arm, clearance=clearance, hold=hold_q,
+                                   margin=margin, seed=int(plan_kwargs.get("seed", 0)))
+            ok, ext, slf = _verdict(external, own, ArmMotion(cell_arm.name, result.trajectory), clearance, margin,
+                                    hold_q)
+            d, pair, t = _describe(ext if ok else (ext if not ext.clear or slf is None else slf))
+            move = result.moves[0]
+            description = f"lift {spec.lift:.3f} m, transfer planned by {move.planner} ({move.states} states)"
+            attempts.append((description, bool(ok), float(d), pair))
+            last = (description, d, pair, t, ok, result, ext)
+            lift, vias, planned_transfer = spec.lift, (), bool(ok)
+        except (PlanningError, CollisionError) as exc:
+            attempts.append((f"transfer planned around the cell: {exc}", False, float("nan"), ""))
     if not ok:
         description, d, pair, t, _, _, _ = last
         raise CollisionError(
@@ -218,5 +245,6 @@ def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, ar
         cycle_time_without_cell=float(base.cycle_time),
         extra_time=float(result.cycle_time - base.cycle_time),
         attempts=tuple(attempts),
+        planned_transfer=planned_transfer,
     )
     return dataclasses.replace(result, cell_report=report)

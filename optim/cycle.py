@@ -347,7 +347,7 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
                payload: Any = None, torque_limits: Any = False, approach: str = "joint",
                tool_speed: float | None = None, cell: Any = None, clearance: float = 0.02,
                arm: str | None = None, hold: Any = None, margin: float = 0.005,
-               lift_step: float = 0.02) -> CycleResult:
+               lift_step: float = 0.02, plan_transfer: bool = True) -> CycleResult:
     """Plan and time one full pick-and-place cycle of ``robot`` (see the module docstring).
 
     Args:
@@ -374,8 +374,10 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
             cycle must then keep ``clearance`` [m] from the fixtures and the other arms
             (held at ``hold``, a cell configuration, default neutral), checked continuously
             at resolution ``margin`` [m]; it is re-planned (higher lift by ``lift_step``,
-            then via points) until it does (:mod:`optim.cell_cycle`). Points stay in the
-            arm's base frame. ``arm`` names the arm when ``robot`` is not the cell's object.
+            then via points, then — ``plan_transfer`` — a transfer planned round what
+            blocks by :mod:`optim.motion`) until it does (:mod:`optim.cell_cycle`). Points
+            stay in the arm's base frame. ``arm`` names the arm when ``robot`` is not the
+            cell's object.
         approach: ``"joint"`` (through the lift points in joint space) or ``"straight"``
             (straight vertical lines at pick and place, time-optimal along them, needs
             ``amax``; the joint-space cycle is planned too and its time kept in
@@ -398,7 +400,8 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         from pinarms.optim.cell_cycle import plan_cycle_in_cell
 
         return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
-                                  lift_step=lift_step, plan=plan_cycle, kind=kind, vmax=vmax, amax=amax, jmax=jmax,
+                                  lift_step=lift_step, plan=plan_cycle, plan_transfer=plan_transfer, kind=kind,
+                                  vmax=vmax, amax=amax, jmax=jmax,
                                   method=method, seed=seed, q_start=q_start, payload=payload,
                                   torque_limits=torque_limits, approach=approach, tool_speed=tool_speed)
     if not isinstance(spec, PickPlace):
@@ -415,13 +418,10 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     if approach == "straight":
         from pinarms.optim.straight_approach import straight_cycle
 
-        if not (torque_limits is None or torque_limits is False):
-            raise InvalidSettings("approach='straight' times the lines under joint velocity/acceleration (and tool "
-                                  "speed) limits only: a torque limit along a Cartesian path needs a torque path "
-                                  "constraint (planning.path_constraints); use approach='joint' with torque_limits")
         joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
-                           q_start=q_start)
-        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed)
+                           q_start=q_start, payload=payload, torque_limits=torque_limits)
+        return straight_cycle(robot, joint, kind=kind, method=method, seed=seed, tool_speed=tool_speed,
+                              payload=payload, torque_limits=torque_limits)
     v, a, j = _limits(robot, vmax, amax, jmax)
     from pinarms.optim.torque import torque_constraint
 

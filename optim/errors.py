@@ -6,9 +6,10 @@ catches everything pinarms raises on purpose.
 
 from __future__ import annotations
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.robots.errors import CollisionError, PinarmsError
 
-__all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings"]
+__all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "PlanningError",
+           "EndpointInCollision", "StartInCollision", "GoalInCollision", "NoPathFound"]
 
 
 class OptimError(PinarmsError):
@@ -29,3 +30,50 @@ class InvalidLimits(OptimError, ValueError):
 
 class InvalidSettings(OptimError, ValueError):
     """A GA setting, a bound or an argument of an optimiser is out of range."""
+
+
+class PlanningError(OptimError):
+    """A collision-free motion could not be planned (:func:`optim.plan_motion`)."""
+
+
+class EndpointInCollision(PlanningError, CollisionError):
+    """The start or the goal of a motion is itself too close to something.
+
+    Attributes:
+        which: ``"start"`` or ``"goal"``.
+        pairs: ``(body_a, body_b)`` of the pair nearest its margin, one per configuration
+            tried (one for a joint goal, one per IK branch for a pose goal).
+        distances: their distances [m] (negative: penetration depth).
+    """
+
+    def __init__(self, message: str, *, which: str = "", pairs: tuple = (), distances: tuple = ()) -> None:
+        super().__init__(message)
+        self.which = which
+        self.pairs = tuple(pairs)
+        self.distances = tuple(distances)
+
+
+class StartInCollision(EndpointInCollision):
+    """The start configuration is closer than the margin to a fixture, another arm or itself."""
+
+
+class GoalInCollision(EndpointInCollision):
+    """Every goal configuration (each IK branch of a pose goal) is closer than the margin to something."""
+
+
+class NoPathFound(PlanningError):
+    """The planner found no collision-free path within its time limit (never a silent straight line).
+
+    Attributes:
+        planner: the OMPL planner used; ``time_limit`` and ``seconds`` [s]; ``states``: the
+        states it explored; ``goals``: the goal configurations it aimed at.
+    """
+
+    def __init__(self, message: str, *, planner: str = "", time_limit: float = 0.0, seconds: float = 0.0,
+                 states: int = 0, goals: int = 0) -> None:
+        super().__init__(message)
+        self.planner = planner
+        self.time_limit = time_limit
+        self.seconds = seconds
+        self.states = states
+        self.goals = goals

@@ -69,7 +69,8 @@ BatchBuilder = Callable[[np.ndarray, np.ndarray], np.ndarray]
 def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndarray | None:
     """A per-joint limit (scalar or (n_joints,)) as a (n_joints,) positive finite array.
 
-    Raises :class:`InvalidLimits` for <= 0, NaN/inf, or a wrong shape; returns None for
+    Raises :class:`InvalidLimits` for <= 0, NaN/inf, values outside :data:`LIMIT_RANGE`, or a
+    wrong shape; returns None for
     an optional limit left out.
     """
     if value is None:
@@ -91,7 +92,14 @@ def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndar
         raise InvalidLimits(f"{name}={arr.tolist()} holds NaN or inf: give finite limits")
     if np.any(arr <= 0.0):
         raise InvalidLimits(f"{name}={arr.tolist()} must be > 0 for every joint")
+    if np.any(arr < LIMIT_RANGE[0]) or np.any(arr > LIMIT_RANGE[1]):
+        raise InvalidLimits(f"{name}={arr.tolist()} lies outside [{LIMIT_RANGE[0]:g}, {LIMIT_RANGE[1]:g}] (SI): no "
+                            "physical joint has such a limit, and the timing would overflow float64")
     return arr
+
+
+#: Range of every kinematic limit accepted (SI units: rad/s or m/s, rad/s², rad/s³, ...).
+LIMIT_RANGE = (1e-9, 1e12)
 
 
 def _planning_builders(kind: str, options: dict[str, Any]) -> tuple[Builder, BatchBuilder]:

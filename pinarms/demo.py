@@ -6,10 +6,13 @@ paper-vs-pinarms table (:class:`pinarms.report.Row`), a :class:`viz.Session` and
 plots. The runner writes, into ``out_dir``::
 
     table.md, table.json       the paper-vs-pinarms table
-    sessions/seed<k>.pinarms   one session per study (``pinarms view`` reopens it)
+    sessions/seed<k>.pinarms   one session per study (``pinarms view`` reopens it; cell.pinarms)
     html/seed<k>.html          the same scene as one standalone HTML page
-    plots/seed<k>_*.png        joint curves, GA convergence, workspace views
+    plots/seed<k>_*.png        joint curves, GA convergence, workspace views; cell_schedule.png,
+                               cell_clearance.png
 
+The ``cell`` study (docs/cells.md) plans the two SCARAs of ``mushroom_line`` on one belt and
+the AUBO-i3's crate cycle in ``aubo_food_station``, its rows filed under seeds 000 and 001.
 ``quick`` uses fewer samples and GA generations (under a minute on two cores); the
 published numbers compared are the same. They all come from :mod:`pinarms.papers`; seed
 002's via points (the paper prints none) are pinarms's representative path
@@ -32,7 +35,8 @@ from pinarms.papers import SEED000, SEED001, SEED002, SEED004
 
 from .report import Row, format_table, markdown_table
 
-__all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004"]
+__all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004",
+           "study_cell"]
 
 DEG = np.pi / 180.0
 MM = 1e-3
@@ -248,6 +252,8 @@ def study_001(quick: bool = False) -> Study:
 
     reach_rows, reach_map, reach_plot = _tool_down_band(arm, quick)
     rows.extend(reach_rows)
+    planned_rows, planned = _planned_move_001()
+    rows.extend(planned_rows)
 
     session = _session(arm, "seed 001: AUBO-i3 workspace and 3-segment quintic")
     q_robot = conv.aubo_mdh_to_joint(table2)
@@ -265,11 +271,62 @@ def study_001(quick: bool = False) -> Study:
     plots.update(dyn_plots)
     session.add_reachability("tool down 15 deg", reach_map)
     plots["reach_tool_down"] = reach_plot
+    session.add_trajectory("planned_table_to_crate", planned["trajectory"], hz=200.0)
+    for name, size, pose in planned["boxes"]:
+        session.add_box(name, size, pose, color=(0.93, 0.52, 0.12, 0.6))
     from pinarms.viz import plots as vplots
 
     plots["layout_search"] = lambda path: vplots.plot_layout_search(
         path, layout, title="seed 001: picks/min by base position (P1 → P4, paper's frame)")
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
+
+
+def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
+    """One planned move in the AUBO-i3 food station with a crate under a guard (optim.plan_motion).
+
+    From the food table to the crate's far half, under the guard plate: OMPL's RRT-Connect
+    (seed 0), every edge proven to keep 10 mm, shortcut, spline proven again, time-optimal
+    under the URDF's joint speed and torque limits. Beside it the unobstructed move: the
+    straight joint-space move between the same configurations, timed the same way (it runs
+    through the cell: the row names the pair it hits).
+    """
+    from pinarms.optim.motion import MotionChecker, SCENES, load_scene, plan_motion
+    from pinarms.optim.motion.plan import _limits, time_path
+    from pinarms.optim.motion.scenes import region_pose
+    from pinarms.optim.motion.smoothing import polyline_path
+
+    cell = load_scene("aubo_crate_guard")
+    arm = cell.arm("aubo")
+    table, crate = SCENES["aubo_crate_guard"].regions
+    checker = MotionChecker(cell, ["aubo"], margin=0.01)
+    start_pose = region_pose(table, 0.5 * (np.array(table.lo) + np.array(table.hi)))
+    goal_pose = region_pose(crate, 0.5 * (np.array(crate.lo) + np.array(crate.hi)))
+    from pinarms.optim.motion.goals import ik_candidates
+
+    q0 = next(q for q in ik_candidates(arm.robot, arm.to_base(start_pose), cell.neutral)[0] if checker.state_valid(q))
+    plan = plan_motion(cell, "aubo", q0, goal_pose, margin=0.01, time_limit=60.0, seed=0)
+    constraints, _ = _limits(cell, ("aubo",), None, None, True)
+    straight = time_path(polyline_path(np.stack([q0, plan.goal])), constraints)
+    s = np.linspace(0.0, 1.0, 401)[:, None]
+    line = cell.q_from_arms({"aubo": q0 + s * (plan.goal - q0)})
+    hit = cell.clearance(line)
+    k = int(np.argmin(hit.distance))
+    pair = hit.pair_of(k)
+    rows = [
+        Row("001", "planned move food table → crate under the guard (OMPL RRT-Connect, 10 mm, time-optimal)",
+            None, round(plan.duration, 3), "s", None,
+            f"{plan.smoothing}, proven clear (min {plan.clearance.min_environment * 1e3:.1f} mm, "
+            f"{plan.clearance.min_pair[0]} – {plan.clearance.min_pair[1]}); search {plan.states} states"),
+        Row("001", "the unobstructed move (straight in joint space, same limits)", None, round(straight.duration, 3),
+            "s", None, f"goes {-hit.distance[k] * 1e3:.0f} mm into {pair.body_b} ({pair.body_a}): the detour costs "
+            f"{plan.duration - straight.duration:+.3f} s"),
+    ]
+    boxes = []
+    for fixture in cell.fixtures:
+        for shape in fixture.shapes:
+            if shape.kind == "box":
+                boxes.append((shape.geometry, shape.size, arm.to_base(shape.shape_to_world)))
+    return rows, {"trajectory": plan.trajectory, "boxes": boxes, "plan": plan}
 
 
 def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
@@ -667,6 +724,63 @@ def study_004(quick: bool = False) -> Study:
     return Study("004", "koji-block turner: FK examples, IK, simulation", rows, session, plots)
 
 
+# --------------------------------------------------------------------- cells
+#: The mushroom line's tasks: each SCARA picks in the middle of the belt and places in its
+#: own packing box (world frame, m).
+LINE_TASKS = {"left": ((-0.05, -0.03, 0.84), (0.22, 0.68, 0.84)), "right": ((0.05, 0.03, 0.84), (0.22, -0.68, 0.84))}
+
+
+def study_cell(quick: bool = False) -> Study:
+    """Cells: the two-SCARA mushroom line scheduled on one belt, and the AUBO-i3 food station's crate cycle."""
+    from pinarms import optim, viz
+    from pinarms.robots.cell import ArmMotion, load_cell
+    from pinarms.viz import plots as vplots
+
+    rows: list[Row] = []
+    line = load_cell("mushroom_line")
+    cycles = {}
+    for name, (pick, place) in LINE_TASKS.items():
+        arm = line.arm(name)
+        spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.03, dwell=0.15)
+        cycles[name] = optim.plan_cycle(arm.robot, spec, cell=line, clearance=0.02)
+    for name, res in cycles.items():
+        rep = res.cell_report
+        rows.append(Row("000", f"mushroom_line, {name} SCARA: cycle keeping 20 mm from belt, box and the other arm",
+                        None, res.cycle_time, "s", None,
+                        f"lift raised 30 → {rep.lift / MM:.0f} mm after {len(rep.attempts)} attempts: "
+                        f"+{rep.extra_time:.3f} s against the cycle through the box wall"))
+    schedule = optim.schedule_line(line, cycles, margin=0.01, n_offsets=24)
+    rows.append(Row("000", "mushroom_line, two SCARAs on one belt: line rate (every time offset checked continuously)",
+                    None, schedule.picks_per_minute, "1/min", None,
+                    f"period {schedule.period:.3f} s, right arm {schedule.offsets['right']:.3f} s behind; "
+                    f"{int(schedule.clear.sum())} of {schedule.clear.size} offsets collision-free"))
+    rows.append(Row("000", "mushroom_line: one SCARA alone (its own cycle)", None,
+                    schedule.single_arm_picks_per_minute["left"], "1/min", None, "the paper's line has one arm"))
+    rows.append(Row("000", "mushroom_line: closest approach of the two arms over a period", None,
+                    schedule.arm_check.min_clearance / MM, "mm", None,
+                    "exact distance at every sample of the continuous check"))
+
+    station = load_cell("aubo_food_station")
+    arm = station.arm("aubo")
+    spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
+                           lift=0.05, dwell=0.2)
+    crate = optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
+    rep = crate.cell_report
+    rows.append(Row("001", "aubo_food_station: table → crate cycle keeping 20 mm (table and crate in the band)",
+                    None, crate.cycle_time, "s", None,
+                    f"lift 50 → {rep.lift / MM:.0f} mm: +{rep.extra_time:.3f} s against the cycle through the crate wall"))
+
+    motions = [ArmMotion(n, cycles[n].trajectory, schedule.offsets[n], schedule.period) for n in schedule.arms]
+    session = viz.Session(title="cells: mushroom_line, two SCARAs on one belt")
+    session.add_cell(line, motions=motions, name="two-arm schedule", hz=50.0)
+    plots = {
+        "schedule": lambda path: vplots.plot_schedule(path, schedule),
+        "clearance": lambda path: vplots.plot_clearance(path, schedule.arm_check,
+                                                       title="mushroom_line: distance between the two arms"),
+    }
+    return Study("cell", "cells: two SCARAs on one belt, AUBO-i3 food station", rows, session, plots)
+
+
 #: Height [m] the koji block is lifted straight up in seed 004's study (pinarms's choice: a block's
 #: clearance above the stack; 0.15 m is where that lift leaves the arm's workspace).
 KOJI_LIFT_M = 0.1
@@ -766,6 +880,7 @@ STUDIES: dict[str, Callable[[bool], Study]] = {
     "001": study_001,
     "002": study_002,
     "004": study_004,
+    "cell": study_cell,
 }
 
 
@@ -792,17 +907,18 @@ def run_demo(out_dir: str | Path = "demo-output", *, quick: bool = False, only: 
         studies.append(study)
         if study.session is not None:
             (out / "sessions").mkdir(exist_ok=True)
-            path = out / "sessions" / f"seed{key}.pinarms"
+            stem = f"seed{key}" if key.isdigit() else key
+            path = out / "sessions" / f"{stem}.pinarms"
             study.session.save(path)
             files.append(path)
             (out / "html").mkdir(exist_ok=True)
-            html = out / "html" / f"seed{key}.html"
+            html = out / "html" / f"{stem}.html"
             viz.export_html(study.session, html)
             files.append(html)
         if study.plots:
             (out / "plots").mkdir(exist_ok=True)
             for name, write in study.plots.items():
-                png = out / "plots" / f"seed{key}_{name}.png"
+                png = out / "plots" / f"{'seed' + key if key.isdigit() else key}_{name}.png"
                 write(png)
                 files.append(png)
         if progress:

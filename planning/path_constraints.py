@@ -113,9 +113,10 @@ class PathConstraint:
     def exact_dilation(self, trajectory: Any) -> float:
         """Smallest time dilation factor f >= 1 that makes a timed ``trajectory`` satisfy the limit exactly.
 
-        ``trajectory`` is a :class:`planning.Trajectory` (or any object with ``n_joints`` and
-        ``peaks()``). Default 1 (not known exactly: the timing checks the rows densely
-        instead); joint limits use the trajectory's exact peaks.
+        ``trajectory`` is a :class:`planning.Trajectory`, or the timing's stand-in with
+        ``n_joints``, ``peaks()`` (computed once for every constraint) and ``trajectory`` (the
+        Trajectory itself). Default 1 (not known exactly: the timing checks the rows densely
+        instead); joint limits use the exact peaks, joint torque its refined torque peaks.
         """
         return 1.0
 

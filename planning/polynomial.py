@@ -16,6 +16,7 @@ the common piecewise representation of :class:`planning.Trajectory` (one piece).
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -67,14 +68,9 @@ def polynomial(times: Any, positions: Any, degree: int) -> Trajectory:
             f"a degree-{K} polynomial through {n_points} points leaves {extra} end condition(s), "
             f"which cannot be split between the two ends; use degree {K - 1} or {K + 1}"
         )
-    rest_orders = extra // 2
     T = t[-1] - t[0]
     s = (t - t[0]) / T
-    rows = [derivative_row(K, 0, si) for si in s]
-    for r in range(1, rest_orders + 1):
-        rows.append(derivative_row(K, r, 0.0))
-        rows.append(derivative_row(K, r, 1.0))
-    A = np.array(rows)
+    A = _conditions(K, tuple(s.tolist()))
     b = np.zeros((K + 1, q.shape[1]))
     b[:n_points] = q
     try:
@@ -84,3 +80,19 @@ def polynomial(times: Any, positions: Any, degree: int) -> Trajectory:
     coefs = a / (T ** np.arange(K + 1))[:, None]
     definition = {"kind": "polynomial", "times": t.tolist(), "positions": q.tolist(), "degree": K}
     return Trajectory(t[[0, -1]], coefs[None], definition)
+
+
+@functools.lru_cache(maxsize=256)
+def _conditions(degree: int, s: tuple[float, ...]) -> np.ndarray:
+    """The condition matrix (K+1, K+1) of :func:`polynomial` (cached: a rest-to-rest move always has s = (0, 1)).
+
+    Rows: the positions at the normalised instants ``s``, then derivatives 1, 2, ... equal to
+    zero at s = 0 and s = 1, alternately.
+    """
+    rows = [derivative_row(degree, 0, si) for si in s]
+    for r in range(1, (degree + 1 - len(s)) // 2 + 1):
+        rows.append(derivative_row(degree, r, 0.0))
+        rows.append(derivative_row(degree, r, 1.0))
+    A = np.array(rows)
+    A.flags.writeable = False
+    return A

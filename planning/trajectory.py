@@ -31,7 +31,7 @@ import numpy as np
 
 from pinarms.planning._inputs import finite_array, scalar
 from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
-from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
+from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
 __all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
 
@@ -44,6 +44,10 @@ MAX_DURATION = 1e9
 
 #: Names of the derivative orders, as used in :class:`Violation` and the peak report.
 _KIND_BY_ORDER = {1: "velocity", 2: "acceleration", 3: "jerk"}
+# OpenBLAS runs a matrix product on several threads above M·N·K = 4 · 65536: on a busy machine
+# those threads wait for cores and a 10 000 × 6 by 6 × 24 product takes 1-30 ms instead of
+# 0.1 ms. Sampling multiplies in row blocks below that size (one thread each).
+_GEMM_ONE_THREAD = 4 * 65536
 
 
 @dataclass(frozen=True, eq=False)
@@ -219,11 +223,24 @@ class Trajectory:
         """(m, K+1, 4*n): coefficients of q, qd, qdd, qddd side by side (cached)."""
         if self._stack is None:
             c = self._coefs
-            parts = [derivative_coefficients(c, r, axis=1) for r in range(4)]
-            self._stack = np.concatenate(parts, axis=2)
+            m, width, n = c.shape
+            stack = np.zeros((m, width, 4 * n))
+            k = np.arange(width, dtype=float)
+            falling = np.ones(width)
+            for r in range(4):  # d^r/dτ^r of Σ c_k τ^k: coefficient j is c_(j+r) · (j+r)!/j!
+                if r:
+                    falling = falling[1:] * k[1 : width - r + 1]  # (j+r)!/j! = ((j+1)+(r−1))!/(j+1)! · (j+1)
+                if r < width:
+                    np.multiply(c[:, r:, :], falling[None, :, None], out=stack[:, : width - r, r * n : (r + 1) * n])
+            self._stack = stack
         return self._stack
 
     def _check_times(self, t: Any) -> tuple[np.ndarray, bool]:
+        if t.__class__ is np.ndarray and t.dtype == np.float64 and t.ndim == 1 and t.size:
+            # fast path: min and max are NaN/±inf when any entry is, so two reductions check it all
+            lo, hi = float(t.min()), float(t.max())
+            if self._breaks[0] <= lo and hi <= self._breaks[-1]:  # False for NaN
+                return t, False
         arr = finite_array(t, "t")
         scalar = arr.ndim == 0
         arr = np.atleast_1d(arr)
@@ -251,17 +268,25 @@ class Trajectory:
         n = self.n_joints
         D = self._derivative_stack()
         m = self.n_segments
-        seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
-        tau = tt - self._breaks[seg]
-        powers = np.empty((tt.size, self.degree + 1))  # τ^k by running products (a float power per entry costs 10x)
-        powers[:, 0] = 1.0
+        if m == 1:
+            seg = None
+            tau = tt - self._breaks[0]
+        else:
+            seg = np.clip(np.searchsorted(self._breaks, tt, side="right") - 1, 0, m - 1)
+            tau = tt - self._breaks[seg]
+        # τ^k by running products (a float power per entry costs 10x), each power a contiguous row;
+        # the product below reads the transposed view without copying
+        rows = np.empty((self.degree + 1, tt.size))
+        rows[0] = 1.0
         with np.errstate(over="ignore", invalid="ignore"):
             for k in range(1, self.degree + 1):
-                np.multiply(powers[:, k - 1], tau, out=powers[:, k])
+                np.multiply(rows[k - 1], tau, out=rows[k])
+        powers = rows.T
         out = np.empty((tt.size, 4 * n))
         with np.errstate(over="ignore", invalid="ignore"):
             self._evaluate(powers, D, seg, out)
-        if not np.all(np.isfinite(out)):
+            total = np.add.reduce(out, axis=None)  # NaN/inf if any entry is (or if the sum overflows: full check)
+        if not math.isfinite(total) and not np.all(np.isfinite(out)):
             i = int(np.argmax(~np.all(np.isfinite(out), axis=1)))
             raise TrajectoryError(
                 f"the trajectory's values overflow float64 at t = {float(tt[i])!r} s (its times or coefficients are "
@@ -276,7 +301,7 @@ class Trajectory:
         """``out[i] = powers[i] @ D[seg[i]]``, grouped by segment."""
         m = self.n_segments
         if m == 1:
-            np.matmul(powers, D[0], out=out)
+            _matmul_rows(powers, D[0], out)
         else:
             sorted_input = seg.size < 2 or bool(np.all(seg[1:] >= seg[:-1]))
             order = None if sorted_input else np.argsort(seg, kind="stable")
@@ -285,7 +310,7 @@ class Trajectory:
             for s in np.flatnonzero(np.diff(edges)):
                 lo, hi = edges[s], edges[s + 1]
                 if order is None:
-                    out[lo:hi] = powers[lo:hi] @ D[s]
+                    _matmul_rows(powers[lo:hi], D[s], out[lo:hi])
                 else:
                     idx = order[lo:hi]
                     out[idx] = powers[idx] @ D[s]
@@ -552,3 +577,13 @@ def stack_joints(parts: list[Trajectory], definition: dict | None = None) -> Tra
         c = _pad_degree(p._coefs, width)[seg]
         cols.append(taylor_shift(c, breaks[:-1] - p._breaks[seg]))
     return Trajectory(breaks, np.concatenate(cols, axis=2), definition)
+
+
+def _matmul_rows(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    """``out = a @ b`` in row blocks small enough for OpenBLAS to use one thread (see ``_GEMM_ONE_THREAD``)."""
+    rows = max(1, _GEMM_ONE_THREAD // max(1, a.shape[1] * b.shape[1]))
+    if a.shape[0] <= rows:
+        np.matmul(a, b, out=out)
+        return
+    for s in range(0, a.shape[0], rows):
+        np.matmul(a[s : s + rows], b, out=out[s : s + rows])

@@ -387,7 +387,7 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
 
 
 def holding_torques(
-    robot: "Robot", n: int = 20000, seed: int = 0, accel_time: float | None = None
+    robot: "Robot", n: int = 20000, seed: int = 0, accel_time: float | None = None, starts: int = 3
 ) -> tuple[np.ndarray, np.ndarray]:
     """Largest torque each joint needs to hold the arm (and its payload) anywhere in its ranges.
 
@@ -396,7 +396,7 @@ def holding_torques(
     [s], the joint must also start from rest to its speed limit in that time at the worst
     place: ``max_q |g_j(q)| + M_jj(q) v_j / accel_time`` (the usual servo sizing: load torque
     plus acceleration torque; the other joints at rest). Found by ``n`` seeded uniform samples,
-    the best three per joint refined by a bounded quasi-Newton search.
+    the best ``starts`` per joint refined by a bounded quasi-Newton search.
 
     Returns:
         ``(torque (nq,), q (nq, nq))``: the maxima and, row j, the configuration of joint j's.
@@ -426,7 +426,7 @@ def holding_torques(
         best[j], where[j] = values[k_best], q[k_best]
         if not best[j] > 0.0:
             continue
-        for k in np.argsort(values)[-3:]:
+        for k in np.argsort(values)[-max(int(starts), 1):]:
             res = minimize(lambda x: -float(demand(x[None], j)[0]), q[k], method="L-BFGS-B",
                            bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-10, "maxiter": 500})
             x = np.clip(res.x, robot.lower, robot.upper)

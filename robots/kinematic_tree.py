@@ -114,6 +114,12 @@ class KinematicTree:
             if is_mimic:
                 mimic = joint.extract()
                 self.scale[i], self.offset[i] = mimic.scaling, mimic.offset
+                if not (np.isfinite(mimic.scaling) and mimic.scaling != 0.0 and np.isfinite(mimic.offset)):
+                    raise ModelError(
+                        f"mimic joint '{model.names[i]}' has multiplier {mimic.scaling!r} and offset "
+                        f"{mimic.offset!r}; a mimic needs a finite, non-zero multiplier (a joint that never "
+                        "moves is a fixed joint)"
+                    )
             elif joint.nv != 1:
                 raise ModelError(
                     f"joint '{model.names[i]}' is a {short} with {joint.nv} degrees of freedom; "

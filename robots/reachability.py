@@ -13,9 +13,10 @@ Method
    the tool frame's offset) plus the strokes of prismatic joints (:func:`reach_bound`). The grid
    is the sphere's bounding box, aligned so that voxel centres lie at ``(i + ½)·resolution``.
 2. **Voxels computed.** Seeded joint-space samples mark the voxels the tool can enter; those
-   and their 26 neighbours inside the sphere are computed first. Then every voxel next to a
-   voxel with a non-zero index that was not computed yet is computed, round after round, until
-   none is left (a closure: the map cannot stop at a sampling hole). Voxels never computed
+   and their 6 face neighbours inside the sphere are computed first. Then every face neighbour
+   of a voxel with a non-zero index that was not computed yet is computed, round after round,
+   until none is left (a closure: the map cannot stop at a sampling hole; a reachable region
+   joined to the rest only by voxel edges or corners, never by a face, would be missed). Voxels never computed
    have index 0; ``ReachabilityMap.open_faces`` counts computed reachable voxels on the grid
    boundary (0 by construction of the bound).
 3. **Poses.** For each voxel of a chunk, the ``M`` poses ``(R_k, p)``: closed-form arms
@@ -727,10 +728,10 @@ def _seed_voxels(robot: "Robot", origin: np.ndarray, resolution: float, shape: t
 
 
 def _dilate(flat: np.ndarray, shape: tuple, allowed: np.ndarray) -> np.ndarray:
-    """``flat`` and its 26 neighbours, restricted to the bool grid ``allowed``."""
+    """``flat`` and its 6 face neighbours, restricted to the bool grid ``allowed``."""
     grid = np.zeros(int(np.prod(shape)), dtype=bool)
     grid[flat] = True
-    grown = ndimage.binary_dilation(grid.reshape(shape), structure=np.ones((3, 3, 3), dtype=bool))
+    grown = ndimage.binary_dilation(grid.reshape(shape), structure=ndimage.generate_binary_structure(3, 1))
     return np.flatnonzero(grown.reshape(-1) & allowed)
 
 

@@ -210,6 +210,7 @@ def from_urdf_text(
         raise ModelError(f"{source} is not a URDF: its root element is <{root.tag}>, expected <robot>")
     if not root.findall("link"):
         raise ModelError(f"{source} defines no <link>")
+    _check_tree(root, source)
     if freeze:
         _freeze_joints(root, tuple(freeze), source)
         urdf_text = ET.tostring(root, encoding="unicode")
@@ -231,6 +232,61 @@ def from_urdf_text(
         tcp_frame=tcp,
         description=description,
     )
+
+
+def _check_tree(root: ET.Element, source: str) -> None:
+    """ModelError unless the links and joints form one tree (Pinocchio 4.1 crashes the process on a loop).
+
+    Names unique, every joint between two defined links, every link the child of at most
+    one joint, one root, every link reachable from it.
+    """
+    links = [ln.get("name") for ln in root.findall("link")]
+    seen: set = set()
+    for name in links:
+        if not name:
+            raise ModelError(f"{source}: a <link> has no name")
+        if name in seen:
+            raise ModelError(f"{source}: link {name!r} is defined twice")
+        seen.add(name)
+    parent_of: dict[str, str] = {}
+    children: dict[str, list[str]] = {name: [] for name in links}
+    joint_names: set = set()
+    for j in root.findall("joint"):
+        jname = j.get("name")
+        if not jname:
+            raise ModelError(f"{source}: a <joint> has no name")
+        if jname in joint_names:
+            raise ModelError(f"{source}: joint {jname!r} is defined twice")
+        joint_names.add(jname)
+        ends = []
+        for tag in ("parent", "child"):
+            el = j.find(tag)
+            link = None if el is None else el.get("link")
+            if link is None:
+                raise ModelError(f"{source}: joint {jname!r} has no <{tag} link=...>")
+            if link not in children:
+                raise ModelError(f"{source}: joint {jname!r} names {tag} link {link!r}, which is not defined")
+            ends.append(link)
+        parent, child = ends
+        if child in parent_of:
+            raise ModelError(f"{source}: link {child!r} is the child of two joints ({parent_of[child]!r} and "
+                             f"{jname!r}); a URDF is a tree (close loops with constraints, not joints)")
+        parent_of[child] = jname
+        children[parent].append(child)
+    roots = [name for name in links if name not in parent_of]
+    if len(roots) != 1:
+        what = "no root link (the joints form a loop)" if not roots else f"several root links {roots}"
+        raise ModelError(f"{source}: {what}; a URDF is one tree")
+    reached, stack = set(), [roots[0]]
+    while stack:
+        link = stack.pop()
+        if link in reached:
+            continue
+        reached.add(link)
+        stack.extend(children[link])
+    if len(reached) != len(links):
+        lost = [name for name in links if name not in reached]
+        raise ModelError(f"{source}: links {lost} are not connected to the root {roots[0]!r} (a loop); a URDF is one tree")
 
 
 def _refuse_dtd(text: str, source: str) -> None:

@@ -326,17 +326,19 @@ class Robot:
             if _isfinite(s):
                 local = self._local
                 data = local.data if local.model is self.model else self._pin_data()
-                return pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
+                J = pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
+                return J if J.ndim == 2 else J.reshape(6, 1)  # Pinocchio gives (6,) for a 1-DoF model
         x = self._one(q)
         if x is not None:
-            return pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)
+            J = pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)
+            return J if J.ndim == 2 else J.reshape(6, 1)
         arr, single = self.check_q(q)
         if arr.shape[0] <= SMALL_BATCH:
             model, data = self.model, self._pin_data()
             qp = arr if self._same_q else self._tree.coordinates.to_pin(arr)
             J = np.empty((arr.shape[0], 6, self.nq))
             for k in range(arr.shape[0]):
-                J[k] = pin.computeFrameJacobian(model, data, qp[k], fid, _LWA)
+                J[k] = pin.computeFrameJacobian(model, data, qp[k], fid, _LWA).reshape(6, -1)
         else:
             J = self._tree.frame_jacobian(arr, fid)
         return J[0] if single else J
@@ -602,17 +604,18 @@ class Robot:
     ) -> np.ndarray:
         """A configuration within the limits whose tcp meets ``target`` within ``tol``: ``(nq,)``, or ``(N, nq)`` for a batch.
 
-        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`) from
-        ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
-        the target); if that descent fails, arms with a closed form try their analytic
-        branches nearest ``q_seed`` (default :attr:`neutral`; each revolute angle at its 2π
-        equivalent within the limits nearest it), refined by the solver; then seeded random
-        restarts. The answer is the solution the descent reaches, normally the one nearest
+        One target: Levenberg–Marquardt (:class:`~pinarms.robots.ik.NumericalIK`, compiled)
+        from ``q_seed`` (default: of 256 configurations stored with their poses, the one nearest
+        the target), then seeded random restarts; if none meets the target, arms with a closed
+        form try their analytic branches nearest ``q_seed`` (default :attr:`neutral`; each
+        revolute angle at its 2π equivalent within the limits nearest it), refined by the
+        interpreted solver, then its restarts. The answer is the solution the descent reaches, normally the one nearest
         the start; use :meth:`ik_all` (``q_ref``) for the closed-form branch nearest a
         configuration. A batch of targets ``(N, 4, 4)`` (or positions ``(N, 3)`` with
-        ``position_only``) is solved at once by batched Levenberg–Marquardt on batched
-        FK and Jacobians (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is
-        then ``(nq,)`` or ``(N, nq)``.
+        ``position_only``) is solved by the compiled solver in thread blocks
+        (:meth:`~pinarms.robots.ik.NumericalIK.solve_batch`); ``q_seed`` is then ``(nq,)`` or
+        ``(N, nq)``; for an integer ``seed``, row ``k`` equals ``ik(target[k], q_seed[k],
+        seed=seed + k)``.
 
         Args:
             target: tcp pose ``(4, 4)`` frame → base [m], or ``(N, 4, 4)``; with
@@ -654,8 +657,13 @@ class Robot:
             seed_q = seed_q[0]
         solver = self._numerical_ik()
         T0 = T[0]
+        # compiled Levenberg–Marquardt: the first start, then the seeded restarts, in one native call
+        res = solver._solve_compiled(T0, seed_q, bool(position_only), tol, int(max_restarts), seed)
+        if res.success:
+            return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
+        # not found: the interpreted solver's path (closed-form branches, restarts, a final polish) for the diagnosis
         res = solver._solve(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
-                            polish=False)
+                            polish=False, compiled=False)
         if res.success:
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         if self._analytic_ik is not None and not position_only:  # closed-form starts: where the first descent failed
@@ -717,39 +725,12 @@ class Robot:
             if seeds.shape[0] not in (1, N):
                 raise InvalidInput(f"q_seed must be one configuration or one per target ({N}), got {seeds.shape[0]}")
         solver = self._numerical_ik()
-        if self._analytic_ik is not None and not position_only:
-            # closed form first: it pays in batch (all branches of 10⁵ poses/s); each target takes
-            # its branch nearest the seed, projected into the limits (ik_all allows 1e-9), and
-            # keeps it when its FK meets tol; the others go to the batched numerical solver
-            # from that branch (one or two steps) or, without one, from the stored table
-            idx, qs = self._analytic_ik.candidates(T, seeds if seeds is not None else self.neutral[None])
-            q = np.full((N, self.nq), np.nan)
-            if idx.size:
-                first = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
-                q[idx[first]] = np.clip(qs[first], self.lower, self.upper)
-            has = np.flatnonzero(np.isfinite(q[:, 0]))
-            good = np.zeros(N, dtype=bool)
-            if has.size:
-                pe, re = solver.batch_errors(q[has], T[has], False)
-                good[has[(pe <= tol) & (re <= tol)]] = True
-            rest = np.flatnonzero(~good)
-            if rest.size:
-                start = q[rest]
-                if seeds is not None:
-                    miss = ~np.isfinite(start[:, 0])
-                    start[miss] = np.broadcast_to(seeds, (N, self.nq))[rest][miss]
-                res = solver.solve_batch(T[rest], start, position_only=False, tol=tol, max_restarts=max_restarts, seed=seed)
-                q[rest] = res.q
-            ok = self.within_limits(q, tol=0.0)
-            pe, re = solver.batch_errors(q, T, False)
-            ok &= (pe <= tol) & (re <= tol)
-            if ok.all():
-                return q
-            from .ik.numerical import BatchIKResult
-
-            res = BatchIKResult(q, ok, pe, re, 0)
-        else:
-            res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        # the compiled solver for every target (≈ 10-30 µs each): cheaper than the closed form's
+        # batched evaluation, FK check and sorting, which cost ≈ 10-80 µs per pose here
+        res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
+        if seeds is not None:  # as for one target: the 2π equivalents within the limits nearest the seeds
+            q = solver.nearest_equivalent(res.q, seeds if seeds.shape[0] == N else seeds[0])
+            res = type(res)(q, res.success, res.position_error, res.rotation_error, res.iterations)
         ok = res.success & self.within_limits(res.q, tol=0.0)
         if ok.all():
             return res.q

@@ -13,9 +13,9 @@ motion-planning setup tools (e.g. MoveIt's setup assistant), with pinarms' rules
    (seeded), i.e. overlapping primitives of one rigid assembly.
 
 :meth:`SelfCollision.in_collision` runs coal's broad phase (a dynamic AABB tree culls the
-pairs whose boxes are apart) through Pinocchio: one call for one configuration, and
-Pinocchio's C++ batch (``computeCollisionsInParallel``) for a batch, so no Python runs per
-configuration. Per-pair answers (:meth:`colliding_pairs`, a ``pairs`` mask) loop in
+pairs whose boxes are apart) through Pinocchio: one call for one configuration (Pinocchio's
+plain loop below 64 pairs, where the tree costs more than it culls), and Pinocchio's C++
+batch (``computeCollisionsInParallel``) for a batch, so no Python runs per configuration. Per-pair answers (:meth:`colliding_pairs`, a ``pairs`` mask) loop in
 Python over the configurations: use them on sub-samples of a few thousand.
 
 *Core* bodies are those fixed to the base or carried only by the first ``core_joints``
@@ -27,6 +27,7 @@ where the tool is, and a planner avoids them by choosing another orientation.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -41,6 +42,9 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["SelfCollision"]
 
 _ALWAYS_SHARE = 0.95
+#: From this many checked pairs on, one configuration is checked through the broad phase
+#: (below it, the AABB tree costs more than it culls: AUBO-i3, 50 pairs).
+BROAD_PHASE_PAIRS = 64
 _ALWAYS_SAMPLES = 200
 
 
@@ -101,6 +105,18 @@ class SelfCollision:
             plain &= joint.nq == 1
             index[joint.idx_v] = joint.idx_q
         self._pin_index = index if plain and (index >= 0).all() else None
+        self._pin_identity = self._pin_index is not None and model.nq == robot.nq and \
+            bool(np.array_equal(self._pin_index, np.arange(robot.nq)))
+        self._q_shape = (robot.nq,)
+        self._n_pairs = len(gm.collisionPairs)
+        self._model = model
+
+    def _single(self, q_pin: np.ndarray) -> bool:
+        """One configuration: the broad phase when it pays (many pairs), else Pinocchio's plain loop."""
+        if self._n_pairs >= BROAD_PHASE_PAIRS:
+            return bool(pin.computeCollisions(self._model, self._bp_data, self._manager, q_pin, True))
+        pin.updateGeometryPlacements(self._model, self._bp_data, self._gm, self._bp_gd, q_pin)
+        return bool(pin.computeCollisions(self._gm, self._bp_gd, True))
 
     def core_pair_mask(self, core_joints: int = 1) -> np.ndarray:
         """``(n_pairs,)`` bool: pairs with at least one *core* body (see the module doc).
@@ -150,13 +166,18 @@ class SelfCollision:
             pairs: optional ``(n_pairs,)`` bool mask (e.g. :meth:`core_pair_mask`): only
                 these pairs count.
         """
-        if pairs is None and self._pin_index is not None and type(q) is np.ndarray and q.shape == (self.robot.nq,) \
-                and q.dtype == np.float64 and np.isfinite(q).all():
-            if not self.n_pairs:
+        if pairs is None and self._pin_index is not None and type(q) is np.ndarray and q.shape == self._q_shape \
+                and q.dtype == np.float64 and math.isfinite(q.sum()):  # one plain vector: the short path
+            if not self._n_pairs:
                 return False
-            qp = np.zeros(self.robot.model.nq)
-            qp[self._pin_index] = q
-            return bool(pin.computeCollisions(self.robot.model, self._bp_data, self._manager, qp, True))
+            if not self._pin_identity:
+                qp = np.zeros(self._model.nq)
+                qp[self._pin_index] = q
+                q = qp
+            if self._n_pairs >= BROAD_PHASE_PAIRS:
+                return bool(pin.computeCollisions(self._model, self._bp_data, self._manager, q, True))
+            pin.updateGeometryPlacements(self._model, self._bp_data, self._gm, self._bp_gd, q)
+            return bool(pin.computeCollisions(self._gm, self._bp_gd, True))
         arr, single = self.robot.check_q(q)
         if pairs is not None:
             pairs = np.asarray(pairs, dtype=bool)
@@ -168,7 +189,7 @@ class SelfCollision:
         if not self.n_pairs:
             return False if single else np.zeros(arr.shape[0], dtype=bool)
         if single:
-            return bool(pin.computeCollisions(self.robot.model, self._bp_data, self._manager, qp[0], True))
+            return self._single(qp[0])
         if self._pool is None:
             self._pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.robot.model, self._gm, 1)
             for gd in self._pool.getGeometryDatas():

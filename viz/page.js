@@ -139,7 +139,8 @@
 })();
 
 // Reachability maps (page key "reachability", see viz/page.py): one panel per map with the
-// index colour bar and a slice control over its voxel layers (all / up to / only this layer).
+// index colour bar and a slice control over its voxel layers (hidden at first, so that the voxels
+// never hide the robot; then all / up to / only this layer; moving the slider shows that layer).
 (function () {
   "use strict";
   var PROPERTY = "pinarms_page";
@@ -170,7 +171,7 @@
     var row = el("div", {}, box);
     row.style.cssText = "display:flex;gap:6px;align-items:center;margin-top:4px";
     var mode = el("select", {"class": "pinarms-slice-mode"}, row);
-    [["all", "all layers"], ["below", "layers up to"], ["only", "this layer only"]].forEach(function (o) {
+    [["none", "hidden"], ["all", "all layers"], ["below", "layers up to"], ["only", "this layer only"]].forEach(function (o) {
       el("option", {value: o[0], text: o[1]}, mode);
     });
     var n = m.layers.length;
@@ -183,12 +184,12 @@
       var k = parseInt(slider.value, 10);
       label.textContent = "z = " + m.layers[k].z_mm + " mm (base frame)";
       m.layers.forEach(function (layer, j) {
-        var visible = mode.value === "all" || (mode.value === "below" ? j <= k : j === k);
+        var visible = mode.value !== "none" && (mode.value === "all" || (mode.value === "below" ? j <= k : j === k));
         window.viewer.set_property(["meshcat"].concat(layer.path.split("/")), "visible", visible);
       });
       window.viewer.set_dirty();
     }
-    slider.addEventListener("input", apply);
+    slider.addEventListener("input", function () { if (mode.value === "none") { mode.value = "only"; } apply(); });
     mode.addEventListener("change", apply);
     label.textContent = "z = " + m.layers[n - 1].z_mm + " mm (base frame)";
     return box;

@@ -199,18 +199,23 @@ def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_t
 
 
 def _draw_limits(ax: Any, lim: np.ndarray, names: list[str], units: list[str], colors: list[str]) -> None:
-    """Dashed ±limit lines, each labelled with its value (one black pair when every joint shares it)."""
-    same_unit = len(set(units)) == 1
-    shared = bool(np.all(lim == lim[0])) and same_unit
-    for j in range(1 if shared else lim.size):
-        if not np.isfinite(lim[j]):
-            continue
-        c = "k" if shared else colors[j % len(colors)]
+    """Dashed ±limit lines, each pair labelled with its value and the joints it holds for.
+
+    Joints sharing a limit (same value and unit) share one pair of lines: black and
+    labelled ``limit`` when every joint does, else black and naming them; a limit of one
+    joint only is drawn in that joint's colour.
+    """
+    groups: dict[tuple[float, str], list[int]] = {}
+    for j in range(lim.size):
+        if np.isfinite(lim[j]):
+            groups.setdefault((float(lim[j]), units[j]), []).append(j)
+    for (value, unit), joints in groups.items():
+        c = colors[joints[0] % len(colors)] if len(joints) == 1 else "k"
         for sign in (1, -1):
-            ax.axhline(sign * lim[j], color=c, ls="--", lw=0.9, alpha=0.8)
-        who = "limit" if shared else f"{names[j]} limit"
-        value = np.format_float_positional(lim[j], precision=4, fractional=False, trim="-")
-        ax.annotate(f"{who} ±{value} {units[j]}", xy=(1.0, lim[j]), xycoords=("axes fraction", "data"),
+            ax.axhline(sign * value, color=c, ls="--", lw=0.9, alpha=0.8)
+        who = "limit" if len(joints) == lim.size else f"{', '.join(names[j] for j in joints)} limit"
+        text = np.format_float_positional(value, precision=4, fractional=False, trim="-")
+        ax.annotate(f"{who} ±{text} {unit}", xy=(1.0, value), xycoords=("axes fraction", "data"),
                     xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=c)
 
 
@@ -298,7 +303,8 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     lines = ax.plot(gens, best, lw=1.8, label="best so far")
     feasible_mean, mean = column("feasible_mean"), column("mean")
     if feasible_mean is not None:
-        lines += ax.plot(gens, feasible_mean, lw=1.2, ls="--", label="mean of the feasible individuals")
+        gap = "\n(gaps: no feasible individual)" if np.any(~np.isfinite(feasible_mean)) else ""
+        lines += ax.plot(gens, feasible_mean, lw=1.2, ls="--", label=f"mean of the feasible individuals{gap}")
     elif mean is not None:
         lines += ax.plot(gens, mean, lw=1.2, ls="--", label="population mean (infeasible ones too:\ncan lie below the best)")
     feasible = column("feasible_share")
@@ -415,6 +421,7 @@ def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: s
     ax.set_xlabel("time [s]  (bars: tcp in the shared zone; ticks: cycle starts)")
     ax.set_title(title or f"{schedule.cell}: {schedule.picks_per_minute:.1f} picks/min, period {period:.2f} s")
     ax.grid(True, axis="x", alpha=0.3)
+    return _save(fig, path)
 
 
 def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
@@ -488,6 +495,7 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
     fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
     if title:
         fig.suptitle(title)
+    return _save(fig, path)
 
 
 def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",

@@ -90,7 +90,7 @@ def plot_reachability_section(
         zz = np.array([z_min, z_min])
         reach = np.sqrt(np.maximum(np.array([r_in, r_out]) ** 2 - (z_min - centre[2]) ** 2, 0.0))
         ax.plot((rho_c + reach) * mm, zz * mm, color="red", lw=2, label=band.get("label", "table band"))
-        ax.legend(loc="upper right")
+        ax.legend(loc="lower right", fontsize=8)
     ax.set_xlabel("horizontal distance from the base axis ρ [mm]")
     ax.set_ylabel("height z [mm] (base frame)")
     ax.set_aspect("equal")

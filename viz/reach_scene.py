@@ -57,6 +57,7 @@ def draw_reachability(vis: Any, session: Any, root: str, bounds: list) -> tuple[
             path = f"{root}/reachability/{name}/layers/{layer_name(z)}"
             vis[path].set_object(mg.PointCloud(world.T.astype(np.float32), colors.T.astype(np.float32),
                                                size=0.9 * rec.resolution))
+            vis[path].set_property("visible", False)  # opaque voxels would hide the robot: the page's slice control shows them
             paths.append(path)
             layers.append({"path": path, "z_mm": int(round(z * 1000.0))})
         bounds.append(_transform(T, rec.centres))

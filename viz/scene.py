@@ -46,7 +46,7 @@ ROOT = "pinarms"
 _BACKGROUND = ([0.96, 0.97, 0.99], [0.74, 0.78, 0.85])  # top, bottom (RGB in [0, 1])
 
 _PATH_COLORS = (0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B)
-_POINT_COLORS = {"via": 0xFF7F0E, "target": 0xD62728}
+_POINT_COLORS = {"via": 0xFF7F0E, "target": 0xD62728, "contact": 0xFF0000}
 
 
 @dataclass(frozen=True)
@@ -292,11 +292,15 @@ def build_scene(
     for i, (name, rec) in enumerate(session.trajectories.items()):
         robot = drawings[rec.robot].robot
         T_base = session.robots[rec.robot].base_to_world
-        tcp_paths[name] = _transform_points(T_base, robot.position(rec.q))
         q_knots = _interp_rows(rec.knot_times, rec.t, rec.q)
-        knots_drawn[name] = _transform_points(T_base, robot.position(q_knots))
-        bounds.append(tcp_paths[name])
-        framed.append(tcp_paths[name])
+        # a cell: one tcp path per arm; a robot: its tcp
+        frames = {arm: f for arm, f in session.cell_tcp_frames(rec.robot).items() if f in robot.frame_names}
+        for arm, frame in (frames.items() if frames else [(None, "tcp")]):
+            label = name if arm is None else f"{name}: {arm}"
+            tcp_paths[label] = _transform_points(T_base, robot.position(rec.q, frame))
+            knots_drawn[label] = _transform_points(T_base, robot.position(q_knots, frame))
+            bounds.append(tcp_paths[label])
+            framed.append(tcp_paths[label])
 
     # which trajectories play
     if animate is None:

@@ -22,6 +22,7 @@ import importlib.metadata
 import json
 import math
 import os
+import threading
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping
@@ -179,6 +180,7 @@ class Session:
         self.histories: dict[str, HistoryRecord] = {}
         self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
+        self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
             self.add_robot(robot, key=key, base_to_world=base_to_world)
@@ -227,6 +229,13 @@ class Session:
     def robot(self, key: str | None = None) -> Robot:
         """The :class:`robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
         entry = self._entry(key)
+        rob = self._loaded.get(entry.key)
+        if rob is not None:
+            return rob
+        with self._loading:
+            return self._load_robot(entry)
+
+    def _load_robot(self, entry: RobotEntry) -> Robot:
         if entry.key not in self._loaded:
             if entry.source == "registry":
                 rob = robots.load(entry.name)
@@ -264,6 +273,67 @@ class Session:
         if name in table:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
         return name
+
+    def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
+                 name: str = "cell motion", hz: float = 100.0) -> str:
+        """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
+
+        Args:
+            cell: the cell; its joint vector is the robot's, poses are in the world frame
+                (``base_to_world`` is the identity).
+            key: its key (default: the cell's name).
+            motions: the arms' motions (:class:`robots.cell.ArmMotion` objects or
+                ``{arm: trajectory}``), stored as one trajectory ``name`` of the whole cell,
+                sampled at ``hz`` over their window: the viewer animates all arms together.
+            check: a :class:`robots.cell.MotionCheck` of those motions: its samples in
+                contact become the point set ``"<name> contacts"`` (kind ``"contact"``, drawn
+                red), at the middle of the contact pair's nearest points.
+
+        The arms' tcp frames are recorded in ``metadata["cells"][key]`` so that the viewer
+        draws each arm's tcp path.
+        """
+        from pinarms.robots.cell import Cell
+        from pinarms.robots.cell.motion import sample_motions
+
+        if not isinstance(cell, Cell):
+            raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")
+        key = self.add_robot(cell.robot, key=cell.name if key is None else key)
+        self.metadata.setdefault("cells", {})[key] = {
+            "name": cell.name,
+            "args": dict(cell.args),
+            "arms": {a.name: {"tcp_frame": a.prefix + a.robot.tcp_frame, "q_start": a.q_slice.start,
+                              "q_stop": a.q_slice.stop} for a in cell.arms},
+            "fixtures": [f.name for f in cell.fixtures],
+        }
+        if motions is not None:
+            t, q = sample_motions(cell, motions, hz=hz, window=None if check is None else check.window)
+            self.add_trajectory(name, (t, q), robot=key)
+        if check is not None:
+            if motions is None:
+                raise InvalidInput("a check needs the motions it was made of (motions=...)")
+            inside = np.flatnonzero(np.asarray(check.clearance) <= 0.0)
+            if inside.size:  # at most 400 contact samples, evenly spread
+                inside = inside[np.linspace(0, inside.size - 1, min(inside.size, 400)).round().astype(int)]
+                from pinarms.robots.cell.motion import _motions, configurations
+
+                qs = configurations(cell, _motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
+                cl = cell.clearance(qs)
+                self.add_points(f"{name} contacts", 0.5 * (cl.point_a + cl.point_b), kind="contact")
+        return key
+
+    def cell_tcp_frames(self, key: str) -> dict[str, str]:
+        """``{arm: tcp frame}`` of the cell stored under ``key`` (``{}`` for a plain robot)."""
+        entry = self.metadata.get("cells", {})
+        info = entry.get(key) if isinstance(entry, dict) else None
+        arms = info.get("arms") if isinstance(info, dict) else None
+        if not isinstance(arms, dict):
+            return {}
+        out = {}
+        for arm, data in arms.items():
+            frame = data.get("tcp_frame") if isinstance(data, dict) else None
+            if isinstance(arm, str) and isinstance(frame, str):
+                out[arm] = frame
+        return out
 
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:

@@ -75,7 +75,7 @@ JSON_MEMBER = "session.json"
 #: names of robots, trajectories, ...: 1-100 printable characters, no "/" (scene path separator),
 #: no lone surrogates (they cannot be written as UTF-8)
 NAME_RE = re.compile(r"^(?=.*\S)[^/\x00-\x1f\x7f\ud800-\udfff]{1,100}$")
-POINT_KINDS = ("via", "target")
+POINT_KINDS = ("via", "target", "contact")
 F8 = np.dtype("<f8")
 
 MiB = 1 << 20

@@ -16,10 +16,12 @@ A new command group is a new module here that decorates its commands with
 from __future__ import annotations
 
 from . import (  # noqa: F401  (each module registers its commands on ``cli``)
+    cell_commands,
     cycle_commands,
     demo_command,
     layout_commands,
     line_commands,
+    motion_commands,
     reach_commands,
     robot_commands,
     session_commands,

@@ -44,11 +44,15 @@ from ._common import (
                    "times both moves also under joint torque limits (--torque-max, default the URDF's efforts).")
 @click.option("--torque", "torque", is_flag=True, help="Also limit joint torques (the URDF's efforts), without a payload.")
 @click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints], one or per joint.")
+@click.option("--straight", is_flag=True,
+              help="Straight vertical lines at pick and place, time-optimal along them (needs --amax); "
+                   "the joint-space cycle's time is reported beside it.")
+@click.option("--vtool", default=None, type=float, help="With --straight: tcp speed limit on the lines [m/s, or mm/s with --mm].")
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
               help="Save the cycle (trajectory, via points, pick and place) into a session file.")
 @json_option
 def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, method, seed, payload, torque,
-              torque_max, session_path, as_json) -> None:
+              torque_max, straight, vtool, session_path, as_json) -> None:
     """Time-optimal pick-and-place cycle of ROBOT: pick, lift, transfer, lower, place, and back.
 
     Prints the time of each move, the cycle time, picks per minute and how far the tcp
@@ -58,6 +62,9 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     With --payload (or --torque) both moves are also timed under joint torque limits, the
     move to place carrying the payload and the move back empty (robots' inverse dynamics,
     Pinocchio's RNEA).
+
+    With --straight the tcp rises and lowers on straight vertical lines (within 0.1 mm),
+    timed time-optimally along them; the arm stops at the lift points.
 
     Example: pinarms cycle aubo_i3 --pick 350 200 150 --place -100 400 100 --mm --payload 3kg
     """
@@ -74,7 +81,9 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     torque_limits = limits if limits is not None else (True if (kg is not None or torque) else False)
     res = optim.plan_cycle(arm, spec, kind=kind, vmax=si_limit(vmax, "--vmax", np.ones(arm.nq)),
                            amax=si_limit(amax, "--amax", np.ones(arm.nq)), jmax=si_limit(jmax, "--jmax", np.ones(arm.nq)),
-                           method=method, seed=seed, payload=kg, torque_limits=torque_limits)
+                           method=method, seed=seed, payload=kg, torque_limits=torque_limits,
+                           approach="straight" if straight else "joint",
+                           tool_speed=None if vtool is None else vtool * scale)
     data = res.as_dict()
     data["units"] = {"lengths": "m", "times": "s", "limits": "rad or m per s^k", "given_points": lu}
     dev = res.line_deviation / scale
@@ -90,6 +99,10 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
         "IK: one branch for every waypoint" if res.one_branch else
         f"IK: branches {res.branches.tolist()} (the joint limits force a switch, or the arm is solved numerically)",
     ]
+    if res.approach == "straight":
+        lines.insert(4, f"straight lines: joint-space cycle {res.joint_cycle_time:.4f} s "
+                        f"(straight {res.straight_cost:+.4f} s); the four lines take {res.line_cost:+.4f} s "
+                        "beside joint-space lines between the same configurations")
     if res.torque_limit is not None:
         carried = "nothing" if res.payload is None else f"{res.payload.mass:g} kg"
         lines.insert(4, f"torque / limit (carrying {carried} to the place, empty back): "

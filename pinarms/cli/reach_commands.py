@@ -2,25 +2,12 @@
 
 from __future__ import annotations
 
-import sys
-
 import click
 import numpy as np
 
 from pinarms.units import parse_angle, parse_length
 
-from ._common import cli, emit, json_option, load_robot, new_session, save_session, show_progress
-
-
-def _progress_printer():
-    """``progress(done, total)`` writing one updating line to stderr."""
-    def report(done: int, total: int) -> None:
-        pct = 100.0 * done / total if total else 100.0
-        sys.stderr.write(f"\rreach: {done}/{total} voxels ({pct:5.1f} %)")
-        if done >= total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-    return report
+from ._common import cli, emit, json_option, load_robot, new_session, progress_bar, save_session
 
 
 @cli.command("reach")
@@ -59,9 +46,9 @@ def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: 
     cone = None if tool_down is None else parse_angle(tool_down, "--tool-down")
     n = orientations if orientations is not None else (50 if cone is None else 16)
     sched = _scheduler(scheduler)
-    m = reachability_map(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik, self_collision=self_collision,
-                         seed=seed, keep_solutions=False, out=out_path, scheduler=sched,
-                         progress=_progress_printer() if show_progress(as_json) else None)
+    with progress_bar("reachability voxels", None, as_json) as bar:
+        m = reachability_map(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik, self_collision=self_collision,
+                             seed=seed, keep_solutions=False, out=out_path, scheduler=sched, progress=bar)
     reach = m.index > 0
     data = {
         "robot": m.robot,

@@ -184,7 +184,8 @@ class Cell:
             raise CellError(f"Pinocchio cannot build a model of {source}: {exc}") from exc
         tcp = next((a.prefix + "tcp" for a in spec.arms if model.existFrame(a.prefix + "tcp")), None)
         tcp = tcp or model.frames[len(model.frames) - 1].name
-        self.robot = Robot(model, name=self.name, urdf_text=urdf_text, tcp_frame=tcp, description=f"cell {self.name}")
+        self.robot = Robot(model, name=self.name, urdf_text=urdf_text, tcp_frame=tcp, description=f"cell {self.name}",
+                           package_dirs=tuple(self._package_dirs()))
         self.model = model
         self.arms = tuple(self._build_arm(root, arm) for arm in spec.arms)
         self.arms = tuple(sorted(self.arms, key=lambda a: a.q_slice.start))
@@ -248,7 +249,7 @@ class Cell:
     def _package_dirs(self) -> list[str]:
         from ..xacro_expand import BUILTIN_PACKAGE
 
-        return [str(BUILTIN_PACKAGE[1]), *(str(Path(v)) for v in self._packages.values())]
+        return [str(self._base_dir.resolve()), str(BUILTIN_PACKAGE[1]), *(str(Path(v)) for v in self._packages.values())]
 
     def _resolved_urdf(self, root: ET.Element) -> str:
         """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""

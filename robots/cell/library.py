@@ -4,6 +4,8 @@ Built-in cells are xacro files in ``robots/xacro/cells/<name>.urdf.xacro``; thei
 generated and committed in ``urdf/cells/<name>.urdf`` like the arms' (``pinarms urdf
 build``; :func:`stale_cells` lists those that differ from a fresh build). Every cell file,
 built-in or not, is expanded behind the wall of :mod:`pinarms.robots.xacro_expand`.
+Relative mesh paths of a built-in cell resolve against ``urdf/cells/`` (where its URDF is
+committed: ``urdf/cells/meshes/``), so the committed URDF loads in other tools as it is.
 """
 
 from __future__ import annotations
@@ -124,13 +126,13 @@ def load_cell(
         source = cell_source_path(text_or_path)
         if all_args:
             result = expand_xacro(source, all_args, packages=packages, limits=limits, header=_header(text_or_path))
-            return Cell(result.urdf_text, source=f"builtin:{text_or_path}", base_dir=source.parent, packages=packages,
+            return Cell(result.urdf_text, source=f"builtin:{text_or_path}", base_dir=CELL_URDF_DIR, packages=packages,
                         args=result.args, seed=seed)
         urdf = cell_urdf_path(text_or_path)
         if not urdf.is_file():
             raise ModelError(f"the URDF of cell {text_or_path!r} is missing ({urdf.name}); regenerate it with `pinarms urdf build`")
         declared = {}
-        return Cell(urdf.read_text(encoding="utf-8"), source=f"builtin:{text_or_path}", base_dir=source.parent,
+        return Cell(urdf.read_text(encoding="utf-8"), source=f"builtin:{text_or_path}", base_dir=CELL_URDF_DIR,
                     packages=packages, args=declared, seed=seed)
     path = Path(path_or_name)
     if not path.is_file():

@@ -50,7 +50,7 @@ from .pairs import CollisionPair
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers"]
+__all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers", "motion_window", "sample_motions"]
 
 #: Largest number of halvings of one interval (its approach budget then 1/64 of the margin);
 #: an interval still unproven is reported as not clear (never as clear).
@@ -283,6 +283,32 @@ def configurations(cell: "Cell", motions: list[ArmMotion], times: np.ndarray, ho
     return Q
 
 
+def motion_window(motions: list[ArmMotion]) -> tuple[float, float]:
+    """Default time window [s]: earliest start to latest end, or ``(0, longest period)`` if a motion repeats."""
+    if any(m.period is not None for m in motions):
+        return (0.0, max(float(m.period or (m.trajectory.end_time - m.trajectory.start_time)) for m in motions))
+    return (
+        min(float(m.offset) for m in motions),
+        max(float(m.offset) + m.trajectory.end_time - m.trajectory.start_time for m in motions),
+    )
+
+
+def sample_motions(cell: "Cell", motions: Any, *, hz: float = 100.0, window: tuple[float, float] | None = None,
+                   hold: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """The arms' motions sampled together: times ``(M,)`` [s] and cell configurations ``(M, nq)``.
+
+    ``hz`` samples per second over ``window`` (default :func:`motion_window`), its end included.
+    """
+    motions = _motions(cell, motions)
+    if not (isinstance(hz, (int, float)) and math.isfinite(hz) and hz > 0):
+        raise InvalidInput(f"hz must be a positive sampling rate in 1/s, got {hz!r}")
+    t0, t1 = motion_window(motions) if window is None else (float(window[0]), float(window[1]))
+    n = max(2, int(math.ceil((t1 - t0) * hz)) + 1)
+    times = np.linspace(t0, t1, n)
+    hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+    return times, configurations(cell, motions, times, hold_q)
+
+
 # ------------------------------------------------------------------ the check
 def _speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> tuple[np.ndarray, float]:
     """Bound of the approach speed ``V`` [m/s] on each cell of ``grid`` (module doc), and the global bound."""
@@ -351,13 +377,7 @@ def check_motion(
     motions = _motions(cell, motions)
     hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
     if window is None:
-        if any(m.period is not None for m in motions):
-            window = (0.0, max(float(m.period or (m.trajectory.end_time - m.trajectory.start_time)) for m in motions))
-        else:
-            window = (
-                min(float(m.offset) for m in motions),
-                max(float(m.offset) + m.trajectory.end_time - m.trajectory.start_time for m in motions),
-            )
+        window = motion_window(motions)
     t0, t1 = float(window[0]), float(window[1])
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
         raise InvalidInput(f"window must be (t_start, t_end) with t_end >= t_start, got {window!r}")

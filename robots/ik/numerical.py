@@ -56,11 +56,18 @@ damped system is 6×6 (or nq×nq) and solved by LAPACK's Cholesky (``posv``). Th
 errors are computed only once ``‖e‖²`` is small enough for them to possibly meet ``tol``.
 Pinocchio's model is built with ``mimic=True``, so mimic joints (the koji arm's
 parallelogram) are followed and the Jacobian is w.r.t. the independent joints.
+
+:meth:`NumericalIK.solve`, ``Robot.ik`` and :meth:`NumericalIK.solve_batch` run the same
+attempts compiled (:mod:`._kernel`, the whole solve in one native call, ≈ 5× cheaper per
+step); the interpreted descent above remains for failure diagnosis, the closed-form
+refinement and :meth:`attempt`.
 """
 
 from __future__ import annotations
 
+import os
 import threading
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,10 +82,8 @@ from .._checks import check_tolerance as _check_tolerance
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
 _TABLE = 256  # configurations stored with their poses for the first start (table_start)
-_BATCH_CHUNK = 4096  # targets per batched solve (bounds the working set)
-_BATCH_ITER = 15  # iterations of one batched attempt before its target restarts
-_BATCH_TRIES = 6  # batched attempts per target before the per-target solver takes it
-_BATCH_HANDOFF = 4  # the batched loop stops when this many targets (or 1 %) remain
+_WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
+_PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
 _POOL = 32  # random starts drawn at once and ranked by their distance to the target
 _ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 _TWO_PI = 2.0 * np.pi
@@ -137,6 +142,7 @@ class NumericalIK:
         self.model = robot.model
         self._local = threading.local()  # per-thread Pinocchio data: one solver serves many threads
         self._table = None  # start table (see table_start), made on first use
+        self._kernel_args = None  # the compiled solver's constant arrays (see _compiled), made on first use
         self.frame_id = robot.frame_id(frame)
         self._frame = frame
         self.nq = robot.nq
@@ -387,17 +393,18 @@ class NumericalIK:
         return dq
 
     def nearest_equivalent(self, q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-        """``q`` with each bounded revolute angle at its 2π equivalent within the limits nearest ``q_ref`` (same pose)."""
+        """``q`` ``(nq,)`` or ``(N, nq)`` with each bounded revolute angle at its 2π equivalent within the
+        limits nearest ``q_ref`` (same shape, or ``(nq,)``): the same pose."""
         if not self._any_revolute:
             return q
         turns = self._window_turns > 0.0
-        k = np.arange(-2.0, 3.0)[:, None]
-        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + _TWO_PI * k  # (5, nq)
+        k = _TWO_PI * np.arange(-2.0, 3.0).reshape((5,) + (1,) * q.ndim)
+        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + k  # (5, ..., nq)
         inside = (options >= self.lower) & (options <= self.upper)
         cost = np.where(inside, np.abs(options - q_ref), np.inf)
-        best = np.argmin(cost, axis=0)
-        pick = options[best, np.arange(self.nq)]
-        ok = turns & np.isfinite(cost[best, np.arange(self.nq)])
+        best = np.argmin(cost, axis=0)[None]
+        pick = np.take_along_axis(options, best, 0)[0]
+        ok = turns & np.isfinite(np.take_along_axis(cost, best, 0)[0])
         return np.where(ok, pick, q)
 
     def _start_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -446,6 +453,63 @@ class NumericalIK:
             cost = cost + _ROT_WEIGHT * np.linalg.norm((R - target[:3, :3]).reshape(-1, 9), axis=1)
         return q[np.argsort(cost, kind="stable")]
 
+    # ------------------------------------------------------------------ compiled path
+    def _compiled(self) -> tuple:
+        """``(kernel module, C, L, P, table)``: the chain, limits and settings as arrays for :mod:`._kernel`, made once."""
+        args = self._kernel_args
+        if args is None:
+            from . import _kernel  # numba: imported (and its functions loaded from the cache) on first use
+
+            tree = self.robot._tree
+            joint, fR, fp = tree.frame_of(self.frame_id)
+            chain = np.array(tree.ancestors[joint], dtype=np.int64)
+            C = (
+                np.ascontiguousarray(tree.q_index[chain], dtype=np.int64),
+                np.ascontiguousarray(tree.scale[chain], dtype=float),
+                np.ascontiguousarray(tree.offset[chain], dtype=float),
+                np.ascontiguousarray(tree.kind[chain] == _REVOLUTE),
+                np.ascontiguousarray(tree.local_R[chain], dtype=float).reshape(-1, 3, 3),
+                np.ascontiguousarray(tree.local_p[chain], dtype=float).reshape(-1, 3),
+                np.ascontiguousarray(fR, dtype=float),
+                np.ascontiguousarray(fp, dtype=float),
+            )
+            L = (
+                np.ascontiguousarray(self.lower, dtype=float),
+                np.ascontiguousarray(self.upper, dtype=float),
+                np.ascontiguousarray(self.full_turn),
+                np.ascontiguousarray(self.unbounded),
+                np.ascontiguousarray(self._window_low, dtype=float),
+                np.ascontiguousarray(self._window_turns, dtype=float),
+            )
+            P = np.array([self.damping, self.min_damping, self.max_step, self.stall_ratio, self.stall_steps,
+                          self.max_iter], dtype=float)
+            q_tab, p_tab, pp_tab, R_tab = self._start_table()
+            args = self._kernel_args = (_kernel, C, L, P, (q_tab, p_tab, pp_tab, R_tab))  # one assignment: thread-safe
+        return args
+
+    def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
+                        seed) -> IKResult:
+        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the table's
+        nearest pose), then up to ``max_restarts`` seeded uniform starts nearest pose first.
+
+        A success is confirmed by Pinocchio's forward kinematics of the returned ``q`` and an exact
+        limit check (independent of the compiled chain evaluation).
+        """
+        kernel, C, L, P, (tq, tp, tpp, tR) = self._compiled()
+        Rt = np.ascontiguousarray(target[:3, :3], dtype=float)
+        pt = np.ascontiguousarray(target[:3, 3], dtype=float)
+        if q_seed is None:
+            q0 = tq[kernel.table_index(tq, tp, tpp, tR, Rt, pt, position_only)]
+        else:
+            q0 = np.ascontiguousarray(q_seed, dtype=float)
+        q = np.empty(self.nq)
+        ok, pe, re, attempts, its = kernel.solve(q0, C, L, P, Rt, pt, position_only, tol, max_restarts,
+                                                 _seed_int(seed), q)
+        if ok:
+            pe, re = self.errors(q, target, position_only)
+            ok = pe <= tol and re <= tol and self.in_limits(q)
+        return IKResult(q, bool(ok), float(pe), float(re), int(attempts), int(its))
+
     # ------------------------------------------------------------------ public
     def solve(
         self,
@@ -493,16 +557,30 @@ class NumericalIK:
         )
 
     def _solve(
-        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True
+        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True,
+        compiled: bool = True,
     ) -> IKResult:
         """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once).
 
         ``first=False`` skips the attempt from the first start (already tried by the caller);
-        ``polish=False`` skips the final projected descent of a failed solve.
+        ``polish=False`` skips the final projected descent of a failed solve; ``compiled=False``
+        runs the attempts interpreted (step by step through Pinocchio) instead of :mod:`._kernel`.
         """
         target = np.asarray(target, dtype=float)
         T_des, p_des = self._target(target, position_only)
         tol = float(tol)
+        if compiled and limits and first:
+            res = self._solve_compiled(target, q_seed, bool(position_only), tol, int(max_restarts), seed)
+            if res.success or not polish:
+                return res
+            # the closest configuration within the limits: a patient projected descent from the best end
+            q, pe, re, it = self._descend(res.q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
+            if pe + re > res.position_error + res.rotation_error:
+                return res
+            if pe <= tol and re <= tol:
+                pe, re = self._errors_to(q, T_des, p_des, position_only)
+            ok = pe <= tol and re <= tol and self.in_limits(q)
+            return IKResult(q, bool(ok), pe, re, res.attempts, res.iterations + it)
         if not first:
             q0 = None
         elif q_seed is None:
@@ -549,6 +627,15 @@ class NumericalIK:
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)
 
 
+def _seed_int(seed) -> int:
+    """A 32-bit seed for the compiled solver's generator from ``seed`` (int, ``Generator`` or None)."""
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**32))
+    if seed is None:
+        return int(np.random.default_rng().integers(2**32))
+    return int(seed) & 0xFFFFFFFF
+
+
 # ------------------------------------------------------------------ batched solver
 @dataclass(frozen=True)
 class BatchIKResult:
@@ -559,7 +646,7 @@ class BatchIKResult:
             only where ``success``.
         success: ``(N,)`` position and rotation errors within the tolerance, within the limits.
         position_error: ``(N,)`` [m]; rotation_error: ``(N,)`` [rad] (0 in position-only mode).
-        iterations: batched iterations run (each one step for every unsolved target).
+        iterations: Levenberg–Marquardt iterations over all targets.
     """
 
     q: np.ndarray
@@ -594,144 +681,6 @@ def _log3(R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return out, theta
 
 
-def _solve_batch(self, targets: np.ndarray, starts: np.ndarray, position_only: bool, tol: float, rng) -> tuple:
-    """Levenberg–Marquardt on every target at once; a target whose descent fails restarts in place.
-
-    Each target's step is the one of :meth:`NumericalIK._descend` (Sugihara damping, Nielsen's
-    μ update, per-joint step cap), with the frame Jacobian in base axes and the rotation
-    error ``log3(R_target R(q)ᵀ)`` in base axes; batched FK and Jacobians give every step
-    in a few numpy calls. An attempt is free (revolute angles wrapped to their range's
-    window when it meets the target); one that meets the target outside the limits goes
-    on as a projected descent from its projection (iterates projected into the limits,
-    joints held at a limit and pushed outwards taken out of the step); one that stalls,
-    stops lowering the error or runs out of iterations restarts from a uniform draw within
-    the limits. The loop ends when the unsolved targets are few (the per-target solver
-    finishes them faster than more batched iterations). Returns ``(q, solved (N,), iterations)``.
-    """
-    tree, fid = self.robot._tree, self.frame_id
-    N, nq = starts.shape
-    lo, hi = self.lower, self.upper
-    rows = 3 if position_only else 6
-    wide = nq >= rows
-    eye = np.eye(rows if wide else nq)
-    pt, Rt = targets[:, :3, 3], targets[:, :3, :3]
-    tol2 = tol * tol
-    max_iter = _BATCH_ITER
-    handoff = max(_BATCH_HANDOFF, N // 100)
-
-    def evaluate(x, k):
-        R, p, J = tree.pose_and_jacobian(x, fid)
-        e = np.empty((x.shape[0], rows))
-        e[:, :3] = pt[k] - p
-        if position_only:
-            return e, J[:, :3], np.zeros(x.shape[0])
-        e[:, 3:], theta = _log3(Rt[k] @ np.swapaxes(R, 1, 2))
-        return e, J, theta
-
-    q_out = np.clip(starts, lo, hi)
-    solved = np.zeros(N, dtype=bool)
-    # state of the active targets (rows aligned with idx)
-    idx = np.arange(N)
-    q = starts.copy()
-    e, J, theta = evaluate(q, idx)
-    E = np.einsum("ij,ij->i", e, e)
-    mu = np.full(N, self.damping)
-    nu = np.full(N, 2.0)
-    stall = np.zeros(N, dtype=int)
-    its = np.zeros(N, dtype=int)
-    tries = np.ones(N, dtype=int)
-    clip = np.zeros(N, dtype=bool)
-    total = 0
-    while idx.size > handoff:
-        total += 1
-        # --- one damped step for every active target
-        lam = mu * E + self.min_damping
-        dq = _damped_steps(J, e, lam, wide, eye)
-        if clip.any():
-            blocked = clip[:, None] & (((q <= lo) & (dq < 0.0)) | ((q >= hi) & (dq > 0.0)))
-            rb = blocked.any(axis=1)
-            if rb.any():  # active set: the blocked joints' columns out, the step solved again
-                dq_f = _damped_steps(J[rb] * (~blocked[rb])[:, None, :], e[rb], lam[rb], wide, eye)
-                dq_f[blocked[rb]] = 0.0
-                dq[rb] = dq_f
-        step = np.abs(dq).max(axis=1)
-        big = step > self.max_step
-        if big.any():
-            dq[big] *= (self.max_step / step[big])[:, None]
-        q_try = q + dq
-        if clip.any():
-            qc = q_try[clip]
-            if self._any_full_turn:
-                w = self.full_turn
-                qc -= _TWO_PI * (w & (qc > hi))
-                qc += _TWO_PI * (w & (qc < lo))
-            q_try[clip] = np.minimum(np.maximum(qc, lo), hi)
-        e_t, J_t, theta_t = evaluate(q_try, idx)
-        E_t = np.einsum("ij,ij->i", e_t, e_t)
-        acc = E_t < E
-        r = e - (J @ dq[:, :, None])[:, :, 0]
-        predicted = E - np.einsum("ij,ij->i", r, r)
-        rho = (E - E_t) / np.where(predicted > 0.0, predicted, np.inf)
-        rho[predicted <= 0.0] = 1.0
-        mu = np.where(acc, np.maximum(mu * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12), mu * nu)
-        nu = np.where(acc, 2.0, 2.0 * nu)
-        stall = np.where(acc, np.where(E_t > self.stall_ratio * E, stall + 1, 0), stall)
-        its += 1
-        q[acc], e[acc], J[acc], theta[acc], E[acc] = q_try[acc], e_t[acc], J_t[acc], theta_t[acc], E_t[acc]
-        # --- outcomes
-        met = (np.einsum("ij,ij->i", e[:, :3], e[:, :3]) <= tol2) & (theta <= tol)
-        if met.any():
-            qm = q[met]
-            if self._any_unbounded:
-                u = self.unbounded
-                qm[:, u] = np.pi - (np.pi - qm[:, u]) % _TWO_PI
-            if self._any_revolute:
-                qm -= _TWO_PI * np.floor((qm - self._window_low) * self._window_turns)
-            inside = np.all((qm >= lo) & (qm <= hi), axis=1)
-            k_met = np.flatnonzero(met)
-            done = k_met[inside]
-            q_out[idx[done]] = qm[inside]
-            solved[idx[done]] = True
-            slide = k_met[~inside & ~clip[k_met]]  # met outside the limits: projected descent from the projection
-            fail_clip = k_met[~inside & clip[k_met]]
-            q[slide] = np.clip(qm[~inside & ~clip[k_met]], lo, hi)
-            clip[slide] = True
-        else:
-            done = slide = fail_clip = np.zeros(0, dtype=int)
-        give_up = (mu >= _MU_MAX) | (stall >= self.stall_steps) | (its >= max_iter)
-        give_up[done] = False
-        give_up[slide] = False
-        give_up[fail_clip] = True
-        restart = np.flatnonzero(give_up)
-        fresh = np.concatenate([slide, restart])
-        if restart.size:
-            q[restart] = rng.uniform(lo, hi, size=(restart.size, nq))
-            clip[restart] = False
-            tries[restart] += 1
-        if fresh.size:
-            mu[fresh], nu[fresh], stall[fresh], its[fresh] = self.damping, 2.0, 0, 0
-            e_f, J_f, th_f = evaluate(q[fresh], idx[fresh])
-            e[fresh], J[fresh], theta[fresh] = e_f, J_f, th_f
-            E[fresh] = np.einsum("ij,ij->i", e_f, e_f)
-        keep = np.ones(idx.size, dtype=bool)
-        keep[done] = False
-        keep &= tries <= _BATCH_TRIES
-        if not keep.all():
-            idx, q, e, J, theta, E = idx[keep], q[keep], e[keep], J[keep], theta[keep], E[keep]
-            mu, nu, stall, its, tries, clip = mu[keep], nu[keep], stall[keep], its[keep], tries[keep], clip[keep]
-    return q_out, solved, total
-
-
-def _damped_steps(J: np.ndarray, e: np.ndarray, lam: np.ndarray, wide: bool, eye: np.ndarray) -> np.ndarray:
-    """Damped least-squares steps ``(n, nq)`` of a batch: ``Jᵀ(JJᵀ + λI)⁻¹e`` (or ``(JᵀJ + λI)⁻¹Jᵀe``)."""
-    Jt = np.swapaxes(J, 1, 2)
-    if wide:
-        G = J @ Jt + lam[:, None, None] * eye
-        return (Jt @ np.linalg.solve(G, e[:, :, None]))[:, :, 0]
-    G = Jt @ J + lam[:, None, None] * eye
-    return np.linalg.solve(G, Jt @ e[:, :, None])[:, :, 0]
-
-
 def _batch_errors(self, q: np.ndarray, targets: np.ndarray, position_only: bool) -> tuple[np.ndarray, np.ndarray]:
     """Position [m] and rotation [rad] errors of ``q (N, nq)`` for ``targets (N, 4, 4)`` by a fresh batched FK."""
     T = self.robot.fk(q, self._frame)
@@ -752,15 +701,20 @@ def solve_batch(
     max_restarts: int = 40,
     seed: int | np.random.Generator | None = 0,
 ) -> BatchIKResult:
-    """Many targets at once: batched Levenberg–Marquardt, then :meth:`solve` for the few left.
+    """Many targets at once: the compiled solver over the batch (in threads), then :meth:`solve` for any left.
+
+    Each target gets the attempts of :meth:`solve` (free descent, projected descent when it
+    meets the target outside the limits) from its start, then up to ``max_restarts`` uniform
+    starts within the limits nearest pose first, the whole loop compiled; target ``k``'s
+    restarts are seeded by ``seed + k`` (for an integer ``seed``: row ``k`` is ``Robot.ik(targets[k],
+    seed=seed + k)``, bit for bit; the thread blocks change nothing).
 
     Args:
         targets: checked poses ``(N, 4, 4)`` frame → base [m].
         q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
             :meth:`table_start` of each target).
         tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
-        max_restarts, seed: restarts of the per-target solver that finishes the targets the
-            batch left (a few per thousand), and the seed of all random starts.
+        max_restarts, seed: restarts per target, and the seed of all random starts.
 
     Every success is confirmed by a fresh batched forward kinematics and an exact limit check.
     """
@@ -783,19 +737,33 @@ def solve_batch(
         if starts is None:
             starts = np.empty((N, nq))
         starts[missing] = q_table[np.argmin(cost, axis=1)]
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    kernel, C, L, P, _ = self._compiled()
+    Rts = np.ascontiguousarray(targets[:, :3, :3])
+    pts = np.ascontiguousarray(targets[:, :3, 3])
+    starts = np.ascontiguousarray(starts)
     q = np.empty((N, nq))
     success = np.zeros(N, dtype=bool)
-    iterations = 0
-    for s in range(0, N, _BATCH_CHUNK):
-        q[s : s + _BATCH_CHUNK], success[s : s + _BATCH_CHUNK], its = _solve_batch(
-            self, targets[s : s + _BATCH_CHUNK], starts[s : s + _BATCH_CHUNK], position_only, tol, rng
-        )
-        iterations += its
-    if success.any():  # confirm by a fresh FK (the solve's own errors are those of the last iterate)
+    pe, re = np.empty(N), np.empty(N)
+    base = _seed_int(seed)  # target k's restarts: seed + k, as solve(targets[k], seed=seed + k); any blocks
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(base)
+    iterations = [0]
+
+    def block(s: int, e: int) -> None:  # compiled and nogil: the blocks run in parallel
+        iterations.append(kernel.solve_many(Rts[s:e], pts[s:e], starts[s:e], C, L, P, bool(position_only), tol,
+                                            int(max_restarts), base + s, q[s:e], success[s:e], pe[s:e], re[s:e]))
+
+    bounds = np.linspace(0, N, min(_WORKERS, max(1, N // _PARALLEL_MIN)) + 1).astype(int)
+    if bounds.size == 2:
+        block(0, N)
+    else:
+        with ThreadPoolExecutor(bounds.size - 1) as pool:
+            list(pool.map(block, bounds[:-1], bounds[1:]))
+    iterations = int(sum(iterations))
+    if success.any():  # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
         k = np.flatnonzero(success)
-        pe, re = _batch_errors(self, q[k], targets[k], position_only)
-        success[k[(pe > tol) | (re > tol)]] = False
+        pe_k, re_k = _batch_errors(self, q[k], targets[k], position_only)
+        inside = np.all((q[k] >= self.lower) & (q[k] <= self.upper), axis=1)
+        success[k[(pe_k > tol) | (re_k > tol) | ~inside]] = False
     for k in np.flatnonzero(~success):  # the few the batch left: per-target solver with restarts
         res = self._solve(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
                           seed=rng, limits=True)

@@ -104,3 +104,15 @@ def test_mass_units_at_the_edge():
     for text in ("-1kg", "nan", "3 lb", ""):
         with pytest.raises(InvalidInput):
             mass_kg(text)
+
+
+def test_cycle_straight_reports_the_joint_space_cycle_beside_it():
+    result = invoke("scara_mushroom", "--pick", "0.3", "0.25", "0.1", "--place", "-0.2", "0.35", "0.08",
+                    "--amax", "10", "--straight", "--vtool", "0.3", "--json")
+    assert result.exit_code == 0, (result.output, result.exception)
+    data = json.loads(result.stdout)
+    assert data["approach"] == "straight"
+    assert data["joint_cycle_time_s"] > 0.0 and data["line_cost_s"] == pytest.approx(0.0, abs=1e-6)
+    assert max(data["line_deviation_m"].values()) < 1e-6  # the SCARA's z axis: straight anyway
+    bad = invoke("scara_mushroom", "--pick", "0.3", "0.25", "0.1", "--place", "-0.2", "0.35", "0.08", "--straight")
+    assert bad.exit_code == 1 and "amax" in bad.output

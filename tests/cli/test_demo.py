@@ -37,6 +37,12 @@ def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
         assert (out / "html" / f"seed{key}.html").stat().st_size > 100_000
         assert (out / "plots" / f"seed{key}_joints.png").is_file()
     assert (out / "plots" / "seed001_workspace.png").is_file()
+    # the cell study: two SCARAs on one belt (rows filed under seed 000), the AUBO station (001)
+    assert (out / "sessions" / "cell.pinarms").is_file() and (out / "plots" / "cell_schedule.png").is_file()
+    line = by[("000", "mushroom_line, two SCARAs on one belt: line rate (every time offset checked continuously)")]
+    alone = by[("000", "mushroom_line: one SCARA alone (its own cycle)")]
+    assert line["pinarms"] > 1.8 * alone["pinarms"]
+    assert by[("000", "mushroom_line: closest approach of the two arms over a period")]["pinarms"] > 0.0
     md = (out / "table.md").read_text()
     assert md.count("\n| ") == len(rows) + 1
     assert json.loads((out / "table.json").read_text()) == rows

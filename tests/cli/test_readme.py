@@ -89,3 +89,17 @@ def test_demo_readme_option_checks_before_the_long_run(tmp_path):
     assert not (tmp_path / "out").exists()  # refused before any study ran
     result = CliRunner().invoke(cli, ["demo", "--quick", "--readme", str(plain)])
     assert result.exit_code == 2 and "--readme" in result.stderr
+
+
+def test_readme_cell_example_loads(tmp_path):
+    """'Your own cell': the xacro as written loads as a cell with one arm and its fixtures, collision-free."""
+    from pinarms import robots
+
+    text = README.read_text(encoding="utf-8")
+    block = text[text.index('<robot name="my_line"') : text.index("</robot>", text.index('<robot name="my_line"')) + 8]
+    path = tmp_path / "my_line.urdf.xacro"
+    path.write_text(block, encoding="utf-8")
+    cell = robots.load_cell(path)
+    assert [a.name for a in cell.arms] == ["left"] and cell.arm("left").robot.nq == 4
+    assert {"belt", "box", "box_wall_xpos"} <= {f.name for f in cell.fixtures}
+    assert not cell.in_collision(cell.neutral)

@@ -12,6 +12,8 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 import numpy as np
+from hypothesis import event
+from hypothesis.errors import InvalidArgument
 
 from pinarms.robots.errors import PinarmsError
 
@@ -72,9 +74,19 @@ def outcome(fn: Callable[..., Any], *args: Any, seconds: float = 10.0, **kwargs:
     except PinarmsError as exc:
         assert type(exc) is not PinarmsError, f"a bare PinarmsError instead of a named subclass: {exc}"
         assert str(exc).strip(), f"{type(exc).__name__} without a message"
+        _event(f"{getattr(fn, '__name__', 'call')}: {type(exc).__name__}")
         return None, exc
     assert_finite(result)
+    _event(f"{getattr(fn, '__name__', 'call')}: returned")
     return result, None
+
+
+def _event(label: str) -> None:
+    """Count outcomes in Hypothesis' statistics (pytest --hypothesis-show-statistics)."""
+    try:
+        event(label)
+    except InvalidArgument:  # outside a Hypothesis test (the corpus)
+        pass
 
 
 def listing(*folders: Path) -> dict[str, set[str]]:

@@ -71,6 +71,15 @@ CORPUS = [
     ("workspace-1e15", lambda: robots.sample_workspace(ur5(), 10**15), InvalidInput, "more than 50,000,000"),
     ("minimize-time-complex-limit", lambda: optim.minimize_time([[0.0] * 6, [1.0] * 6], "multi-quintic", _C),
      InvalidLimits, "not numeric"),
+    ("minimize-time-vmax-5e-324", lambda: optim.minimize_time([[0.0], [1.0]], "multi-quintic", 5e-324),
+     InvalidLimits, "outside [1e-09, 1e+12]"),
+    ("urdf-mimic-multiplier-0", lambda: robots.from_urdf_text(
+        '<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+        '<joint name="j0" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+        '<limit lower="0" upper="1" effort="1" velocity="1"/></joint>'
+        '<joint name="j1" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>'
+        '<limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="j0" multiplier="0"/></joint></robot>'),
+     ModelError, "non-zero multiplier"),
     ("urdf-not-a-string", lambda: robots.from_urdf_text(None), InvalidInput, "string"),
     ("urdf-lower-above-upper", lambda: robots.from_urdf_text(_TWO.format(lo=1, hi=-1, v=1)), ModelError, "swap"),
     ("urdf-negative-velocity", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=-2)), ModelError,
@@ -78,6 +87,12 @@ CORPUS = [
     ("urdf-internal-entity", lambda: robots.from_urdf_text(
         '<!DOCTYPE robot [<!ENTITY n "b">]>' + _TWO.format(lo=-1, hi=1, v=1).replace('child link="b"', 'child link="&n;"')),
      ModelError, "entit"),
+    ("jacobian-1-dof-batch", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1)).jacobian(np.zeros((3, 1))),
+     None, None),
+    ("urdf-joint-to-undefined-link", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1).replace(
+        'child link="b"', 'child link="zzz"')), ModelError, "not defined"),
+    ("urdf-duplicate-link", lambda: robots.from_urdf_text(_TWO.format(lo=-1, hi=1, v=1).replace(
+        '<link name="b"/>', '<link name="b"/><link name="b"/>')), ModelError, "defined twice"),
     ("session-metadata-not-a-mapping", lambda: viz.Session(metadata=True), InvalidInput, "mapping"),
     ("session-metadata-lone-surrogate", lambda: viz.Session(metadata={"k": "\ud800"}), InvalidInput, "JSON-able"),
     ("session-points-complex", lambda: viz.Session().add_points("p", np.zeros((1, 3), complex)), InvalidInput,
@@ -91,7 +106,7 @@ CORPUS = [
 def test_corpus(call, error, fragment):
     result, err = outcome(call)
     if error is None:
-        assert err is None
+        assert err is None, err
         return
     assert isinstance(err, error), err
     assert fragment in str(err), str(err)

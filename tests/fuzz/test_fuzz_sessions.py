@@ -35,7 +35,8 @@ LEVER_URDF = """<robot name="lever">
 
 
 def _build_base() -> bytes:
-    """A small session touching every kind: registry + embedded robots, box, trajectories, cloud, points, history."""
+    """A small session touching every kind: registry + embedded robots (one with a payload), box, trajectories,
+    cloud, points, history, reachability map."""
     gantry = robots.load("gantry_flower")
     s = viz.Session(gantry, title="fuzz base", metadata={"line": "roses", "n": 3})
     s.add_trajectory("move", planning.multi_quintic(np.array([0.0, 0.5, 1.0]), gantry.random_q(3, seed=1)), hz=10)
@@ -44,9 +45,12 @@ def _build_base() -> bytes:
     s.add_workspace("cloud", points=gantry.position(q), manipulability=np.linspace(0.0, 1.0, 5))
     s.add_points("targets", [[0.1, 0.2, 0.3]], kind="target")
     s.add_history("ga", {"best": [3.0, 2.0], "mean": [np.inf, 2.5]})
-    s.add_robot(robots.from_urdf_text(LEVER_URDF), base_to_world=np.eye(4))
+    s.add_robot(robots.from_urdf_text(LEVER_URDF).with_payload(0.5, com=[0.0, 0.0, 0.02]), base_to_world=np.eye(4))
     s.add_box("crate", [0.3, 0.2, 0.1])
-    buf = io.BytesIO()
+    # the kinds added by others later are fuzzed the same way: a payload and a small reachability map
+    from pinarms.robots.reachability import reachability_map
+
+    s.add_reachability("reach", reachability_map(gantry, 0.25, 2, tool_down=0.1, roll_steps=2), robot="gantry_flower")
     import tempfile
 
     with tempfile.TemporaryDirectory() as d:
@@ -175,6 +179,11 @@ def _set(doc, path, value, op):
 @example(edits=[(BASE_PATHS.index(("robots", 1, "urdf_member")), "robots/0.urdf", "set")])
 @example(edits=[(BASE_PATHS.index(("trajectories", 0)), None, "duplicate")])
 @example(edits=[(BASE_PATHS.index(("trajectories", 0, "definition", "kind")), "3-5-3", "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "mass_kg")), -1.0, "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "inertia_kg_m2")), [[1, 2], [3]], "set")])
+@example(edits=[(BASE_PATHS.index(("robots", 1, "payload", "frame")), "no_such_frame", "set")])
+@example(edits=[(BASE_PATHS.index(("reachability", 0, "centres")), [2**40, 3], "shape")])
+@example(edits=[(BASE_PATHS.index(("reachability", 0, "robot")), "nobody", "set")])
 def test_session_json_edits(tmp_path_factory, edits):
     doc = json.loads(json.dumps(BASE_DOC))
     for idx, value, op in edits:
@@ -366,18 +375,35 @@ def test_builder_arguments(tmp_path_factory, data, method):
     elif method == "save-nul":
         call = (s.save, (folder / "a\x00b.pinarms",), {})
     elif method == "init":
-        call = (viz.Session, (data.draw(st.one_of(_anything, st.just("ur5"))),),
-                {"title": data.draw(_anything), "metadata": data.draw(st.one_of(st.none(), _anything))})
+        call = (viz.Session, (data.draw(st.one_of(st.just(GANTRY), st.just("ur5"), _anything)),),
+                {"title": data.draw(st.one_of(st.text(max_size=12), _anything)),
+                 "metadata": data.draw(st.one_of(st.none(), st.dictionaries(st.text(max_size=5), st.integers()),
+                                                 _anything))})
     elif method == "save":
         name = data.draw(st.one_of(st.text(max_size=12), st.sampled_from(["", ".", "..", "sub/x", "/", "x\x00"])))
         call = (s.save, (folder / name if name and "\x00" not in name else name,), {})
     else:
-        n_required = {"add_points": 2, "add_box": 2, "add_workspace": 1, "add_history": 2, "add_trajectory": 2,
-                      "add_robot": 1}[method]
-        args = [data.draw(st.one_of(st.text(max_size=12), _anything))]
-        n_optional = {"add_box": 2, "add_workspace": 1}.get(method, 0)
-        args += [data.draw(_anything) for _ in range(n_required - 1 + data.draw(st.integers(0, n_optional)))]
-        call = (getattr(s, method), tuple(args), {})
+        odd = data.draw(st.sampled_from(["none", "none", "name", "value", "all"]))
+        name = data.draw(_anything if odd in ("name", "all") else st.text(
+            st.characters(blacklist_categories=("Cc", "Cs"), blacklist_characters="/"), min_size=1, max_size=12
+        ).filter(str.strip))
+        n = data.draw(st.integers(1, 4))
+        pts = st.lists(st.lists(st.floats(-2, 2), min_size=3, max_size=3), min_size=n, max_size=n).map(np.array)
+        valid = {
+            "add_points": st.tuples(pts),
+            "add_box": st.tuples(st.lists(st.floats(0.01, 2), min_size=3, max_size=3)),
+            "add_workspace": st.tuples(st.just(robots.sample_workspace(GANTRY, 5, seed=1))),
+            "add_history": st.tuples(st.fixed_dictionaries({"best": st.lists(st.floats(0, 9), min_size=n, max_size=n)})),
+            "add_trajectory": st.tuples(st.just((np.linspace(0.0, 1.0, n + 1), GANTRY.random_q(n + 1, seed=n)))),
+            "add_robot": st.tuples(st.sampled_from(["ur5", "scara_mushroom"])),
+        }[method]
+        n_odd = {"add_box": 3, "add_workspace": 1}.get(method, 1)
+        values = data.draw(st.tuples(*[_anything] * data.draw(st.integers(1, n_odd))) if odd in ("value", "all")
+                           else valid)
+        if method == "add_robot":
+            call = (s.add_robot, values, {"key": name})
+        else:
+            call = (getattr(s, method), (name, *values), {})
     before = listing(folder)
     fn, args, kwargs = call
     result, err = outcome(fn, *args, **kwargs)

@@ -210,3 +210,23 @@ def test_straight_approach_needs_an_acceleration_limit():
         plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="straight")
     with pytest.raises(InvalidInput, match="approach"):
         plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="diagonal")
+
+
+@pytest.mark.slow
+def test_straight_approach_with_a_payload_under_torque_limits():
+    from pinarms import optim, planning
+
+    arm = robots.load("scara_mushroom")
+    spec = PickPlace(*POINTS["scara_mushroom"], lift=0.04, dwell=0.1)
+    amax = 20.0 * arm.velocity_limit
+    res = plan_cycle(arm, spec, amax=amax, approach="straight", payload=0.5, torque_limits=True)
+    assert res.payload is not None and res.torque_limit is not None
+    ratios = res.torque_ratios
+    assert ratios.max() <= 1.0 + 1e-6  # refined torque peaks of both moves, lines included
+    assert ratios.max() > 0.99  # the torques limit this cycle
+    lift_loaded, lift_empty = res.moves[0].lines[0], res.moves[1].lines[1]
+    assert lift_loaded.ratios["joint torque"] <= 1.0 + 1e-6
+    kinematic = optim.time_optimal(lift_loaded.path, [planning.JointVelocityConstraint(res.vmax),
+                                                      planning.JointAccelerationConstraint(res.amax)])
+    assert lift_loaded.duration > kinematic.duration * 1.01  # the loaded lift is torque-limited
+    assert lift_empty.duration < lift_loaded.duration  # the empty gripper lowers to the pick faster

@@ -73,3 +73,15 @@ def test_a_map_of_another_robot_is_refused(down_map):
         base_placements(down_map, _station([0, 0, 1]))
     with pytest.raises(InvalidInput, match="proper rotation"):
         base_placements(down_map, np.ones((1, 4, 4)), verify=0)
+
+
+def test_candidates_feed_search_layout_directly(aubo, down_map):
+    from pinarms import optim
+
+    pick, place = np.array([0.45, 0.0, 0.1]), np.array([0.0, 0.45, 0.1])
+    tasks = tool_down_poses(np.vstack([pick, pick + [0, 0, 0.05], place, place + [0, 0, 0.05]]),
+                            down_map.orientations.tool_axis)
+    bp = base_placements(down_map, tasks, robot=aubo, z=0.0, yaw_step=2 * np.pi, verify=3)
+    assert bp.verified[:3].all() and np.all(bp.candidates[:, 3] == 0.0)
+    res = optim.search_layout(aubo, pick, place, bp.candidates[:3], lift=0.05, refine=0)
+    assert res.ok.all() and res.best_picks_per_minute > 0

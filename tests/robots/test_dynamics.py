@@ -272,10 +272,10 @@ def test_aubo_efforts_follow_the_stated_rule():
     from pinarms.robots.dynamics import holding_torques
 
     ur5 = robots.load("ur5")
-    ur5_hold, _ = holding_torques(ur5.with_payload(5.0, frame="tool0"), n=4000)
+    ur5_hold, _ = holding_torques(ur5.with_payload(5.0, frame="tool0"), n=4000, starts=1)
     assert ur5_hold[1] == pytest.approx(105.54, abs=0.01)  # 5 kg at the UR5's full reach
     aubo = robots.load("aubo_i3")
-    hold, q = holding_torques(aubo.with_payload(3.0, frame="flange"), n=4000)
+    hold, q = holding_torques(aubo.with_payload(3.0, frame="flange"), n=4000, starts=1)
     assert hold[1] == pytest.approx(54.73, abs=0.01)
     assert abs(q[1, 1]) == pytest.approx(np.pi / 2, abs=1e-3) and abs(q[1, 2]) < 1e-3  # stretched level
     large = ur5.effort_limit[1] / ur5_hold[1] * max(hold[1], hold[2])

@@ -210,7 +210,7 @@ def test_unknown_frame_lists_frames():
         (
             "<robot name='x'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
             "<parent link='a'/><child link='zzz'/><limit lower='0' upper='1' effort='1' velocity='1'/></joint></robot>",
-            "Pinocchio cannot build",
+            "child link 'zzz', which is not defined",
         ),
     ],
 )

@@ -11,7 +11,7 @@ import pytest
 from pinarms import viz
 from pinarms.robots.errors import InvalidInput
 from pinarms.viz.scene import build_scene, colors_by_value
-from pinarms.viz.viewer import MeshcatServer
+from pinarms.viz.server import MeshcatServer
 
 
 def _listening_addresses(port: int) -> set[str]:
@@ -128,3 +128,32 @@ def test_two_robots_with_base_placement(tmp_path):
     tcp_world = panda.position(q) + [1.0, 0.0, 0.0]
     assert np.all(info.bounds[1] >= tcp_world.max(axis=0) - 1e-12)
     assert info.bounds[1][0] >= 1.0
+
+
+def test_page_info_frames_the_robot_and_names_the_colours(line_session):
+    from pinarms.viz.page import manipulability_unit
+
+    with MeshcatServer() as server:
+        info = build_scene(server.visualizer, line_session, max_cloud_points=1000)
+        with pytest.raises(InvalidInput, match="cloud_opacity"):
+            build_scene(server.visualizer, line_session, cloud_opacity=0.0)
+        with pytest.raises(InvalidInput, match="max_cloud_points"):
+            build_scene(server.visualizer, line_session, max_cloud_points=0)
+        with pytest.raises(InvalidInput, match="point_pixels"):
+            build_scene(server.visualizer, line_session, point_pixels=-1.0)
+    page = info.page
+    assert page["title"] == "enoki packing line"
+    assert "cloud scara cloud: 1000 of 1500 samples shown" in page["lines"]
+    assert "▶ pick-place 3-5-3: 3.61 s" in page["lines"]
+    bar = page["colorbar"]
+    w = line_session.workspaces["scara cloud"].manipulability
+    assert bar["min"] == 0.0 and bar["max"] == pytest.approx(float(w.max()))  # the whole cloud's maximum
+    assert bar["unit"] == "" and len(bar["colors"]) == 11 and bar["colors"][0] == "#440154"  # viridis(0)
+    assert manipulability_unit(("rad",) * 6) == "m³" and manipulability_unit(("m",) * 3) == "1"
+    # the view is centred on the robot and its path, not on the conveyor's middle nor the origin
+    tcp = line_session.robot("scara").position(line_session.trajectories["pick-place 3-5-3"].q)
+    assert np.linalg.norm(info.target[:2] - tcp.mean(axis=0)[:2]) < 0.3
+    assert info.page["target"] == info.target.tolist() and info.page["camera"] == info.camera.tolist()
+    distance = np.linalg.norm(info.camera - info.target)
+    assert 0.5 < distance < 3.0
+    assert info.camera[2] > info.target[2]  # from above

@@ -533,6 +533,7 @@ def test_zip_bombs_are_refused_fast_with_little_memory(bombs):
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     results = {r["path"].rsplit("/", 1)[1].split(".")[0]: r for r in json.loads(proc.stdout)}
+    print(json.dumps({k: {m: round(v, 4) for m, v in r.items() if m in ("s", "peak_mb", "rss_growth_mb")} for k, r in results.items()}))
     expected = {
         "honest": r"points.npy' declares shape \(89478480, 3\) \(2,147,483,520 bytes\), more than the 536,870,912 allowed",
         "index_small": r"points.npy' holds 2,147,483,648 bytes in the zip directory, but session.json's shape \(100, 3\) needs 2,400",
@@ -682,3 +683,28 @@ def test_part_files_of_a_killed_save_are_removed_by_the_next_save(session, tmp_p
         session.save(target)
     assert sorted(os.listdir(tmp_path)) == sorted(["s.pinarms", live.name, fresh.name, other.name])
     assert viz.load_session(target) == session
+
+
+# ---------------------------------------------------------------------------- threads
+def test_sessions_from_several_threads(session, tmp_path):
+    """Loading, reading, asking for robots and saving from 8 threads: one Robot per key, whole files only.
+
+    The interpreter switches threads every microsecond to make interleavings likely.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    path = session.save(tmp_path / "shared.pinarms")
+    back = viz.load_session(path)
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        with ThreadPoolExecutor(8) as pool:
+            loaded = list(pool.map(lambda _: viz.load_session(path), range(8)))
+            got = list(pool.map(lambda _: back.robot("lever"), range(8)))
+            saved = list(pool.map(lambda i: back.save(tmp_path / "out.pinarms"), range(8)))
+    finally:
+        sys.setswitchinterval(old)
+    assert all(s == session for s in loaded)
+    assert all(r is got[0] for r in got)  # the same Robot for every thread
+    assert saved[0] == tmp_path / "out.pinarms" and viz.load_session(saved[0]) == session
+    assert sorted(os.listdir(tmp_path)) == ["out.pinarms", "shared.pinarms"]  # no .part left behind

@@ -1,0 +1,199 @@
+"""Motion planning in cells: pinarms (OMPL + continuous proof) on seven scenes, pyroboplan beside it.
+
+For every planning scene (optim/motion/scene_files: shelf, table with a box, crate under a
+guard, two arms over one belt; Panda, UR5, AUBO-i3) the same seeded queries
+(:func:`optim.motion.scene_queries`: start and goal tool poses in two different task
+regions, clear IK solutions) are planned with :func:`optim.plan_motion` (RRT-Connect,
+margin 10 mm, search time limit ``--time-limit``), and the table gives, per scene:
+
+* success within the time limit (the search), median and p95 search time;
+* median and p95 of the whole plan (search, shortcut, smoothing proven again, time-optimal
+  timing, the cell's own re-check and the clearance profile);
+* path length in joint space after shortcutting (rad), and the trajectory duration (s,
+  time-optimal under the URDF's velocity and torque limits);
+* the smallest clearance to fixtures / the other arm over all plans (must be >= margin).
+
+pyroboplan's RRT-Connect runs on the Panda scenes, same queries, same collision geometry
+(the same cell URDF), in its own virtual environment (pyroboplan pins pin 4.0.0)::
+
+    python3 -m venv /tmp/pyroboplan-venv && /tmp/pyroboplan-venv/bin/pip install pyroboplan
+
+(``--pyroboplan PYTHON`` points elsewhere; the table says when it is absent.) It checks
+states every 0.05 rad along each edge with a padding of the margin (its
+``collision_distance_padding``), on the arm–environment pairs (it pads every pair alike, and
+the Panda's own links sit closer than 10 mm by design), then shortcuts with its own
+``shortcut_path``. pinarms proves every edge continuously (nothing thinner than the margin
+is skipped), so its checks are more numerous per edge.
+
+Last, the validity checker's speed on the configurations of the planned edges: pinarms'
+batched edge check (one Pinocchio C++ call per edge, broad phase) against a plain loop of
+Pinocchio's ``computeCollisions`` (stop at first collision; default and cold-started GJK)
+on the same pairs, margins and configurations.
+
+    python benchmarks/planning.py [--queries 50] [--time-limit 1.0] [--scenes a,b] [--pyroboplan PY]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from pinarms.optim.errors import PlanningError
+from pinarms.optim.motion import MotionChecker, SCENES, load_scene, plan_motion, scene_queries
+from pinarms.robots.collision_requests import cold_start
+
+MARGIN = 0.01
+WORKER = Path(__file__).resolve().parent / "_pyroboplan_worker.py"
+DEFAULT_PYROBOPLAN = "/tmp/pyroboplan-venv/bin/python"
+
+
+def pct(values, q):
+    return float(np.percentile(values, q)) if len(values) else float("nan")
+
+
+def run_pinarms(name: str, n: int, time_limit: float) -> dict:
+    cell = load_scene(name)
+    scene = SCENES[name]
+    queries, hold = scene_queries(name, n, seed=0, margin=MARGIN)
+    rec = {"search": [], "total": [], "length": [], "duration": [], "clearance": [], "ok": 0, "fail": 0,
+           "smoothing": {}, "states": []}
+    for k, q in enumerate(queries):
+        try:
+            plan = plan_motion(cell, scene.arm, q.start, q.goal, margin=MARGIN, time_limit=time_limit, seed=k,
+                               hold=hold)
+        except PlanningError:
+            rec["fail"] += 1
+            continue
+        rec["ok"] += 1
+        rec["search"].append(plan.seconds["search"])
+        rec["total"].append(plan.seconds["total"])
+        rec["length"].append(plan.path_length)
+        rec["duration"].append(plan.duration)
+        rec["clearance"].append(plan.clearance.min_environment)
+        rec["states"].append(plan.states)
+        rec["smoothing"][plan.smoothing] = rec["smoothing"].get(plan.smoothing, 0) + 1
+    rec["queries"] = queries
+    rec["hold"] = hold
+    return rec
+
+
+def run_pyroboplan(python: str, name: str, queries, hold, time_limit: float) -> dict | None:
+    if not (python and os.path.exists(python)):
+        return None
+    cell = load_scene(name)
+    scene = SCENES[name]
+    checker = MotionChecker(cell, [scene.arm], margin=MARGIN, hold=hold)
+    pairs = [[p.geometry_a, p.geometry_b] for p in checker.pairs if p.kind != "self"]
+    job = {"urdf": cell.urdf_text, "pairs": pairs, "padding": MARGIN, "step": 0.05, "time_limit": time_limit,
+           "seed": 0, "shortcut": True, "columns": checker.cols.tolist(), "hold": hold.tolist(),
+           "queries": [{"start": q.start.tolist(), "goal": q.goal.tolist()} for q in queries]}
+    run = subprocess.run([python, str(WORKER)], input=json.dumps(job), capture_output=True, text=True, timeout=3600)
+    if run.returncode != 0:
+        print(f"  pyroboplan failed on {name}: {run.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
+        return None
+    return json.loads(run.stdout)
+
+
+def best_of(repeat: int, fn):
+    best, out = np.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def checker_speed(name: str, queries, hold, repeat: int = 3) -> dict:
+    """Configurations/s on the samples of the straight start→goal edges (each edge one batch), best of ``repeat``."""
+    cell = load_scene(name)
+    checker = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, hold=hold)
+    edges = [checker.full(checker.edge_samples(q.start, q.goal)[0]) for q in queries]
+    n = sum(len(e) for e in edges)
+    t_batch, batched = best_of(repeat, lambda: np.concatenate([checker.batch_collides(Q, "margin") for Q in edges]))
+    model, gm = checker.model, checker.geometry
+    out = {"configurations": n, "pinarms_batched": n / t_batch, "loop": checker.batch_loop}
+    for label, cold in (("plain_loop", False), ("plain_loop_cold", True)):
+        data = model.createData()
+        gd = pin.GeometryData(gm)
+        if cold:
+            cold_start(gd)
+        for req, m in zip(gd.collisionRequests, checker.pair_margin):
+            req.security_margin = float(m)
+        t, plain = best_of(repeat, lambda: np.array([pin.computeCollisions(model, data, gm, gd, q, True)
+                                                     for Q in edges for q in Q]))
+        out[label] = n / t
+        out[label + "_disagreements"] = int(np.sum(plain != batched))
+    some = np.concatenate(edges[:10])[:, checker.cols]
+    t, _ = best_of(repeat, lambda: [checker.state_valid(x) for x in some])
+    out["pinarms_single"] = len(some) / t
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--queries", type=int, default=50)
+    ap.add_argument("--time-limit", type=float, default=1.0)
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--pyroboplan", default=DEFAULT_PYROBOPLAN, help="Python of pyroboplan's virtual environment")
+    args = ap.parse_args()
+    names = [s for s in args.scenes.split(",") if s]
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"motion planning, {args.queries} seeded queries per scene, margin {MARGIN * 1e3:.0f} mm, search limit "
+          f"{args.time_limit:g} s, load average {load:.1f} on {os.cpu_count()} cores")
+    have_pyroboplan = os.path.exists(args.pyroboplan)
+    if not have_pyroboplan:
+        print(f"pyroboplan: absent ({args.pyroboplan} not found); create its environment as the docstring says")
+    header = (f"{'scene':<18} {'ok':>6} {'search med/p95 [s]':>19} {'plan med/p95 [s]':>17} {'length [rad]':>13} "
+              f"{'duration [s]':>13} {'min clr [mm]':>12}")
+    print(header)
+    rows = []
+    for name in names:
+        t0 = time.perf_counter()
+        rec = run_pinarms(name, args.queries, args.time_limit)
+        n = rec["ok"] + rec["fail"]
+        print(f"{name:<18} {rec['ok']:>3}/{n:<2} {pct(rec['search'], 50):>9.3f}/{pct(rec['search'], 95):<9.3f}"
+              f"{pct(rec['total'], 50):>8.2f}/{pct(rec['total'], 95):<8.2f} {np.median(rec['length']) if rec['length'] else np.nan:>13.2f} "
+              f"{np.median(rec['duration']) if rec['duration'] else np.nan:>13.3f} "
+              f"{1e3 * min(rec['clearance']) if rec['clearance'] else np.nan:>12.2f}   ({time.perf_counter() - t0:.0f} s; "
+              f"{', '.join(f'{k} {v}' for k, v in rec['smoothing'].items())})")
+        rows.append((name, rec))
+    panda = [(name, rec) for name, rec in rows if SCENES[name].arm == "panda"]
+    if panda:
+        print("\nPanda scenes, RRT-Connect side by side (same queries, same cell URDF):")
+        print(f"{'scene':<18} {'tool':<10} {'ok':>6} {'search med/p95 [s]':>19} {'length raw→shortcut [rad]':>26}")
+        for name, rec in panda:
+            print(f"{name:<18} {'pinarms':<10} {rec['ok']:>3}/{rec['ok'] + rec['fail']:<2} "
+                  f"{pct(rec['search'], 50):>9.3f}/{pct(rec['search'], 95):<9.3f} {'':>10}{np.median(rec['length']):>8.2f}")
+            res = run_pyroboplan(args.pyroboplan, name, rec["queries"], rec["hold"], args.time_limit) \
+                if have_pyroboplan else None
+            if res is None:
+                print(f"{name:<18} {'pyroboplan':<10} absent")
+                continue
+            r = res["results"]
+            ok = [x for x in r if x["ok"]]
+            t = [x["seconds"] for x in ok]
+            print(f"{name:<18} {'pyroboplan':<10} {len(ok):>3}/{len(r):<2} {pct(t, 50):>9.3f}/{pct(t, 95):<9.3f} "
+                  f"{np.median([x['length'] for x in ok]) if ok else np.nan:>9.2f}→"
+                  f"{np.median([x.get('shortcut_length', np.nan) for x in ok]) if ok else np.nan:<8.2f} (pin {res['pin']})")
+    print("\nvalidity checker, configurations/s (best of 3) on the straight start→goal edges' samples "
+          "(same pairs and margins; 'plain misses': configurations the plain loop's warm-started GJK calls clear "
+          "that the batch finds closer than the margin):")
+    print(f"{'scene':<18} {'configs':>8} {'pinarms batch':>14} {'plain loop':>11} {'cold loop':>10} {'pinarms 1-by-1':>15}"
+          f" {'batch/plain':>12} {'plain misses':>13}  loop")
+    for name, rec in rows:
+        s = checker_speed(name, rec["queries"], rec["hold"])
+        print(f"{name:<18} {s['configurations']:>8} {s['pinarms_batched']:>14.0f} {s['plain_loop']:>11.0f} "
+              f"{s['plain_loop_cold']:>10.0f} {s['pinarms_single']:>15.0f} {s['pinarms_batched'] / s['plain_loop']:>11.2f}x "
+              f"{s['plain_loop_disagreements']:>13}  {s['loop']}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,24 @@
+"""Collision-free motion in a cell (OMPL), proven continuously, timed optimally (docs/motion.md).
+
+- :func:`plan_motion`: one arm (or two together) from a start to a goal joint vector or
+  tool pose, every IK branch a goal; :class:`MotionPlan` (raw, shortcut and smooth paths,
+  time-optimal :class:`planning.Trajectory`, the cell's re-check, the clearance profile).
+- :class:`MotionChecker`: state, edge and timed-motion validity (:mod:`.checker`).
+- :func:`plan_around` / :func:`plan_two_arms`: one arm around the other's timed
+  trajectory, or both together (:mod:`.two_arms`).
+- :func:`planned_cycle`: the transfer ``plan_cycle(..., cell=)`` falls back to (:mod:`.cycle`).
+- The planning scenes and their seeded queries (:mod:`.scenes`), example-robot-data arms
+  as xacro macros (:mod:`.arm_macros`).
+"""
+
+from pinarms.optim.motion.checker import MotionChecker, TimedArm, Verdict
+from pinarms.optim.motion.goals import GoalCandidate
+from pinarms.optim.motion.plan import ClearanceProfile, MotionPlan, plan_motion
+from pinarms.optim.motion.scenes import SCENES, Query, Region, Scene, load_scene, scene_names, scene_path, scene_queries
+from pinarms.optim.motion.search import PLANNERS
+from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, plan_two_arms
+from pinarms.optim.motion.cycle import PlannedMove, planned_cycle
+
+__all__ = ["plan_motion", "MotionPlan", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
+           "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names", "scene_path", "load_scene", "scene_queries",
+           "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan", "planned_cycle", "PlannedMove"]

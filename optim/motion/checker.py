@@ -1,0 +1,574 @@
+"""Validity of the planned arms of a cell: states, straight edges and timed motions, proven continuously.
+
+:class:`MotionChecker` answers what a sampling planner asks, for the arms being planned
+(one arm, or two arms in their joint space) while the other arms of the cell hold still
+or follow their own timed trajectories (:class:`TimedArm`):
+
+- **State** ``x`` (the planned arms' joint coordinates; with moving arms, the time last):
+  inside the joint limits and every checked pair that involves a planned arm at least its
+  margin apart — ``margin`` for arm–fixture and arm–arm pairs, ``self_margin`` for two
+  links of one arm (an arm's own links are close by design). One Pinocchio call (coal with
+  each pair's security margin, GJK started cold), stopping at the first pair too close.
+- **Edge** ``x_a → x_b`` (a straight line in joint space): the continuous rule of
+  :func:`robots.cell.check_motion`, in joint space instead of time. Every point of the
+  planned arms' geometry moves at most ``T = Σ_j |Δq_j| ℓ_j`` along the edge (the levers
+  ``ℓ_j`` of :func:`robots.cell.motion.joint_levers`). The smallest excess
+  ``E = min_k (d_k − margin_k)`` is 1-Lipschitz in that travel, so between two samples with
+  travel ``B`` between them ``E ≥ (E_a + E_b − B)/2``. Samples whose pairs all pass with
+  their margins raised by ``s`` have ``E ≥ s``; two such neighbours with ``B ≤ 2s`` prove
+  the interval. The proof is a **ladder of batched screens**: the edge is first cut into
+  pieces of at most ``step · 2^k`` travel (``k ≤`` :data:`COARSE_LEVELS`; ``step`` defaults
+  to the margin: nothing thinner than the margin fits between two samples of the finest
+  regular level), **all samples checked as one batch** by Pinocchio's C++ loop
+  (``computeCollisionsInParallel``) with the margins raised by half the piece's budget; an
+  interval not proven is halved and its ends screened with half the raise, down to
+  ``step / 2^MAX_SPLITS``. A sample closer than the margins themselves ends the proof (the
+  edge is invalid), and so does an interval unproven at the finest level. The samples of a
+  level are checked coarse-first (ends, middle, quarters, ...) with Pinocchio's
+  stop-at-first-collision, so an edge through an obstacle is rejected after a few samples.
+- **Timed motion** (:meth:`MotionChecker.trajectory_valid`): samples uniform in time so
+  that the planned arms' travel (exact velocity peaks times the levers) plus the moving
+  arms' (:meth:`MotionChecker.moving_travel`, per time bin from their exact speeds and
+  acceleration peaks) stays within a step between two, through the same proof.
+
+Exact distances (:meth:`MotionChecker.excess`, coal) serve the reports: which pair is
+closest, the clearance along a motion. Distances in m, the world frame; joint coordinates
+in rad or m; time in s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from pinarms.optim.errors import InvalidSettings
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS"]
+
+#: Finest level of the proof: intervals of ``step / 2^MAX_SPLITS`` travel; still unproven there: invalid.
+MAX_SPLITS = 10
+#: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
+COARSE_LEVELS = 3
+
+
+@dataclass(frozen=True)
+class TimedArm:
+    """An arm that follows its own trajectory while others are planned around it.
+
+    Attributes:
+        arm: the arm's name in the cell.
+        trajectory: its :class:`planning.Trajectory` (the arm's own joint order).
+        offset: cell time [s] at which the trajectory's ``start_time`` is played; before
+            and after, the arm holds the trajectory's first and last configuration.
+    """
+
+    arm: str
+    trajectory: Any
+    offset: float = 0.0
+
+    def q_at(self, t: np.ndarray) -> np.ndarray:
+        tr = self.trajectory
+        tau = np.clip(np.asarray(t, dtype=float) - self.offset + tr.start_time, tr.start_time, tr.end_time)
+        return np.asarray(tr.sample(tau)[0], dtype=float).reshape(np.size(t), -1)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What a proof over samples found: ``ok`` and, when not, the first failing sample (index, fraction)."""
+
+    ok: bool
+    first_bad: int = -1
+    fraction: float = 1.0
+    exact: int = 0
+
+
+def _cold(gd: pin.GeometryData) -> pin.GeometryData:
+    """Cold-started GJK (a cached guess from another configuration misses contacts between a
+    planner's far-apart samples: :mod:`robots.collision_requests`), exact distances."""
+    from pinarms.robots.collision_requests import cold_start
+
+    return cold_start(gd, distance_tolerance=1e-10)
+
+
+def _set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
+    for req, m in zip(gd.collisionRequests, margins):
+        req.security_margin = float(m)
+
+
+@lru_cache(maxsize=4096)
+def _coarse_first(n: int) -> np.ndarray:
+    order = _coarse_order(n)
+    order.flags.writeable = False
+    return order
+
+
+def coarse_first(n: int) -> np.ndarray:
+    """Indices 0..n ordered ends first, then midpoints of ever finer halvings (bit-reversed order)."""
+    return _coarse_first(int(n))
+
+
+def _coarse_order(n: int) -> np.ndarray:
+    """Indices 0..n ordered ends first, then midpoints of ever finer halvings (bit-reversed order)."""
+    if n <= 0:
+        return np.zeros(1, dtype=int)
+    bits = max(1, int(math.ceil(math.log2(n))))
+    k = np.arange(1 << bits)
+    rev = np.zeros_like(k)
+    for b in range(bits):
+        rev |= ((k >> b) & 1) << (bits - 1 - b)
+    inner = (rev * n) >> bits  # bit-reversed fractions of the interval, floored to samples
+    order = np.concatenate([[0, n], inner])
+    _, first = np.unique(order, return_index=True)
+    return order[np.sort(first)]
+
+
+class MotionChecker:
+    """State, edge and path validity of the planned arms of ``cell`` (module docstring).
+
+    Args:
+        cell: a :class:`robots.Cell`.
+        arms: the planned arms' names (their coordinates, in this order, make ``x``).
+        margin: clearance every pair with a fixture or another arm keeps [m] (> 0).
+        self_margin: clearance between two links of one planned arm [m] (≥ 0).
+        hold: cell configuration ``(nq,)`` of the arms not planned (default the cell's
+            neutral); the planned arms' entries are ignored.
+        moving: :class:`TimedArm` s that follow trajectories meanwhile: then ``x`` ends
+            with the time [s] and their configuration at that time is used.
+        step: largest travel [m] of any point between two samples of an edge (default
+            ``margin``).
+        threads: threads of Pinocchio's batch checks.
+
+    Raises:
+        InvalidInput: an unknown arm, a bad hold configuration or margins.
+    """
+
+    def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
+                 hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
+                 threads: int = 1) -> None:
+        from pinarms.robots.cell.motion import joint_levers
+
+        self.cell = cell
+        names = [arms] if isinstance(arms, str) else list(arms)
+        if not names or len(set(names)) != len(names):
+            raise InvalidInput(f"arms must name distinct arms of the cell, got {arms!r}")
+        self.arms = tuple(cell.arm(a).name for a in names)
+        for name, value in (("margin", margin), ("self_margin", self_margin)):
+            ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+            if not ok or not math.isfinite(float(value)) or float(value) < 0.0:
+                raise InvalidInput(f"{name} must be a finite number >= 0 [m], got {value!r}")
+        if float(margin) <= 0.0:
+            raise InvalidInput("margin must be > 0 m: it also sets the step of the continuous edge check")
+        self.margin = float(margin)
+        self.self_margin = float(self_margin)
+        self.step = self.margin if step is None else float(step)
+        if not (math.isfinite(self.step) and self.step > 0.0):
+            raise InvalidInput(f"step must be a positive length [m], got {step!r}")
+        self.cols = np.concatenate([np.arange(cell.nq)[cell.arm(a).q_slice] for a in self.arms])
+        self.n = int(self.cols.size)
+        self.lower = np.asarray(cell.lower, dtype=float)[self.cols]
+        self.upper = np.asarray(cell.upper, dtype=float)[self.cols]
+        base = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+        self.hold = np.array(base, dtype=float)
+        self.moving = tuple(moving)
+        for m in self.moving:
+            if m.arm in self.arms:
+                raise InvalidInput(f"arm {m.arm!r} is both planned and moving on its own trajectory")
+        self._moving_cols = [np.arange(cell.nq)[cell.arm(m.arm).q_slice] for m in self.moving]
+        self.timed = bool(self.moving)
+        levers = np.asarray(joint_levers(cell), dtype=float)
+        self.levers = levers[self.cols]
+        self.moving_speed = float(sum(np.abs(m.trajectory.peaks().velocity) @ levers[c]
+                                      for m, c in zip(self.moving, self._moving_cols)))
+        self._travel_t, self._travel_i = self._moving_travel(levers)
+        # the pairs that involve a planned arm, each with its margin
+        planned = set(self.arms)
+        self.pair_index = np.array([k for k, p in enumerate(cell.pairs) if p.owner_a in planned or p.owner_b in planned],
+                                   dtype=int)
+        self.pairs = tuple(cell.pairs[k] for k in self.pair_index)
+        self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
+        gm = cell.collision_model.copy()
+        gm.removeAllCollisionPairs()
+        for p in self.pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+        self.geometry = gm
+        self.model = cell.model
+        self.threads = int(threads)
+        self._data = self.model.createData()
+        self._gd = _cold(pin.GeometryData(gm))
+        _set_margins(self._gd, self.pair_margin)
+        self._manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(self.model, gm, self._gd)
+        self._gd_dist = _cold(pin.GeometryData(gm))
+        self._pools: dict[Any, Any] = {}
+        #: Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see :meth:`_calibrate`).
+        self.batch_loop: str | None = None
+        self._identity = self._pin_is_identity()
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0}
+
+    # ------------------------------------------------------------------ plumbing
+    def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
+        """Cumulative bound ``I(t)`` [m] of the moving arms' point travel, on a time grid.
+
+        On each bin of width h the point speed is at most ``max(v_a, v_b) + A h / 2`` (``v``
+        from the exact joint speeds at the bin ends times the levers, ``A`` from the exact
+        acceleration peaks), and never more than the exact velocity peaks allow: the rule of
+        :func:`robots.cell.check_motion`. Outside its trajectory an arm holds still.
+        """
+        if not self.moving:
+            return np.array([0.0, 1.0]), np.zeros(2)
+        edges = []
+        for m in self.moving:
+            tr = m.trajectory
+            edges.append(m.offset + np.linspace(0.0, tr.end_time - tr.start_time, bins + 1))
+        grid = np.unique(np.concatenate(edges))
+        speed = np.zeros(grid.size - 1)
+        for m, c in zip(self.moving, self._moving_cols):
+            tr = m.trajectory
+            lev = levers[c]
+            peaks = tr.peaks()
+            cap = float(np.abs(peaks.velocity) @ lev)
+            acc = float(np.abs(peaks.acceleration) @ lev)
+            tau = np.clip(grid - m.offset + tr.start_time, tr.start_time, tr.end_time)
+            v = np.abs(np.asarray(tr.sample(tau)[1], dtype=float).reshape(grid.size, -1)) @ lev
+            h = np.diff(grid)
+            inside = (grid[1:] > m.offset) & (grid[:-1] < m.offset + tr.end_time - tr.start_time)
+            speed += np.where(inside, np.minimum(np.maximum(v[:-1], v[1:]) + acc * h / 2.0, cap), 0.0)
+        cumulative = np.concatenate([[0.0], np.cumsum(speed * np.diff(grid))])
+        return grid, cumulative
+
+    def moving_travel(self, ta: Any, tb: Any) -> np.ndarray:
+        """Bound [m] of how far any point of the moving arms travels between cell times ``ta`` and ``tb``."""
+        I = np.interp(np.asarray(tb, dtype=float), self._travel_t, self._travel_i)
+        return np.abs(I - np.interp(np.asarray(ta, dtype=float), self._travel_t, self._travel_i))
+
+    def _pin_is_identity(self) -> bool:
+        if self.model.nq != self.cell.nq:
+            return False
+        q = self.cell.random_q(3, seed=0)
+        return bool(np.array_equal(self.cell.robot.q_to_pinocchio(q), q))
+
+    def _calibrate(self) -> str:
+        """The faster of Pinocchio's two batch loops for this geometry, timed once on a straight edge
+        between two random configurations (the verdicts are the same; only the speed differs):
+        ``"broad phase"`` (dynamic AABB tree: many geometries far apart) or ``"pairs"`` (every
+        checked pair in turn, stopping at the first contact: few pairs, or many overlapping
+        bounding boxes)."""
+        import time as _time
+
+        x = self.cell.random_q(2, seed=0)[:, self.cols]
+        if self.timed:
+            x = np.column_stack([x, np.zeros(2)])
+        Q = self.full(x[0] + np.linspace(0.0, 1.0, 96)[:, None] * (x[1] - x[0]))
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        best, choice = np.inf, "broad phase"
+        for name in ("broad phase", "pairs"):
+            pool = self._make_pool(name, self.pair_margin)
+            pin.computeCollisionsInParallel(self.threads, pool, qp[:, :8], True, False)  # warm up
+            t0 = _time.perf_counter()
+            pin.computeCollisionsInParallel(self.threads, pool, qp, True, False)
+            dt = _time.perf_counter() - t0
+            if dt < best:
+                best, choice = dt, name
+        return choice
+
+    def _make_pool(self, kind: str, margins: np.ndarray):
+        if kind == "pairs":
+            pool = pin.GeometryPool(self.model, self.geometry, self.threads)
+        else:
+            pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.model, self.geometry, self.threads)
+        for gd in pool.getGeometryDatas():
+            _cold(gd)
+            _set_margins(gd, margins)
+        return pool
+
+    def _pool(self, which: Any):
+        pool = self._pools.get(which)
+        if pool is None:
+            if self.batch_loop is None:
+                self.batch_loop = self._calibrate()
+            extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
+            pool = self._make_pool(self.batch_loop, self.pair_margin + extra)
+            self._pools[which] = pool
+        return pool
+
+    def _to_pin(self, Q: np.ndarray) -> np.ndarray:
+        return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
+
+    def full(self, X: Any) -> np.ndarray:
+        """Cell configurations ``(N, nq)`` for planned states ``X (N, n[+1])`` (time last when timed)."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        Q = np.tile(self.hold, (X.shape[0], 1))
+        Q[:, self.cols] = X[:, : self.n]
+        if self.timed:
+            t = X[:, self.n]
+            for m, c in zip(self.moving, self._moving_cols):
+                Q[:, c] = m.q_at(t)
+        return Q
+
+    def within_limits(self, X: np.ndarray) -> np.ndarray:
+        X = np.atleast_2d(X)
+        return np.all((X[:, : self.n] >= self.lower - 1e-12) & (X[:, : self.n] <= self.upper + 1e-12), axis=1)
+
+    # ------------------------------------------------------------------ states
+    def state_valid(self, x: Any) -> bool:
+        """One planned state: within the limits and every pair at least its margin apart."""
+        x = np.asarray(x, dtype=float)
+        self.counts["states"] += 1
+        if not self.within_limits(x[None])[0]:
+            return False
+        q = self.full(x[None])[0]
+        return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
+
+    def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
+        margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
+        stop at the first such row (the rows after it are then reported False)."""
+        Q = np.atleast_2d(Q)
+        self.counts["configurations"] += Q.shape[0]
+        if Q.shape[0] == 0:
+            return np.zeros(0, dtype=bool)
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        out = pin.computeCollisionsInParallel(self.threads, self._pool(which), qp, True, bool(stop))
+        return np.asarray(out, dtype=bool).reshape(-1)
+
+    def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
+        the index (into :attr:`pairs`) of that pair and its distance ``d_k`` [m].
+
+        ``mask (P,)`` bool: only those pairs (e.g. the arm–environment ones). coal's distances
+        of the pairs in increasing order of a numpy lower bound
+        (:func:`robots.cell.collision.pair_lower_bounds`), stopping when the next bound
+        exceeds the best found: exact, not sampled."""
+        from pinarms.robots.cell.collision import pair_lower_bounds
+
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        N = Q.shape[0]
+        self.counts["exact"] += N
+        lb = pair_lower_bounds(self.cell, Q)[:, self.pair_index] - self.pair_margin
+        if mask is not None:
+            lb[:, ~np.asarray(mask, dtype=bool)] = np.inf
+        order = np.argsort(lb, axis=1, kind="stable")
+        qp = self._to_pin(Q)
+        gm, gd = self.geometry, self._gd_dist
+        out = np.full(N, np.inf)
+        arg = np.full(N, -1, dtype=int)
+        dist = np.full(N, np.inf)
+        for i in range(N):
+            pin.updateGeometryPlacements(self.model, self._data, gm, gd, qp[i])
+            best, k_best, d_best = np.inf, -1, np.inf
+            for k in order[i]:
+                if lb[i, k] >= best or not np.isfinite(lb[i, k]):
+                    break
+                d = pin.computeDistance(gm, gd, int(k)).min_distance
+                e = d - self.pair_margin[k]
+                if e < best:
+                    best, k_best, d_best = e, int(k), d
+            out[i], arg[i], dist[i] = best, k_best, d_best
+        return out, arg, dist
+
+    def closest(self, x: Any) -> tuple[float, Any, float]:
+        """``(excess [m], pair, distance [m])`` of the pair nearest its margin at state ``x``."""
+        e, k, d = self.excess(self.full(np.asarray(x, dtype=float)[None]))
+        return float(e[0]), (self.pairs[int(k[0])] if k[0] >= 0 else None), float(d[0])
+
+    # ------------------------------------------------------------------ proofs
+    def travel(self, xa: np.ndarray, xb: np.ndarray) -> float:
+        """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
+        return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
+
+    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
+        """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
+
+        ``budgets (N-1,)``: travel bound [m] between consecutive samples (each ≤ ``step``);
+        ``midpoint(i, a, b, B) -> (x, B_left, B_right)``: the state between fractions ``a`` and
+        ``b`` of interval ``i`` (whose budget is ``B``) and the budgets of the two halves.
+        ``convex``: the samples lie on a straight edge between two states within the joint
+        limits (then every sample is within them: the limits box is convex). ``top``: the
+        level of the given samples (0: budgets ≤ ``step``; −k: budgets ≤ ``step · 2^k``).
+
+        The proof is a ladder of batched screens (module docstring): at level ``L`` an
+        interval's budget is at most ``step / 2^L`` and its two ends are screened with the
+        margins raised by ``s_L = step / 2^(L+1)``; both passing proves the interval (the
+        excess stays ``≥ (s_L + s_L − B)/2 ≥ 0``). An interval not proven is halved; a sample
+        closer than the margins themselves ends the proof (invalid), and so does an interval
+        still unproven at level :data:`MAX_SPLITS`.
+        """
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        N = X.shape[0]
+        if not convex:
+            inside = self.within_limits(X)
+            if not inside.all():
+                return Verdict(False, int(np.argmin(inside)), 0.0)
+        Q = self.full(X)
+        order = coarse_first(N - 1)
+        level = int(top)
+        flags = self.batch_collides(Q[order], level, stop=True)
+        if not flags.any():
+            return Verdict(True)
+        first = int(order[int(np.argmax(flags))])
+        if self.batch_collides(Q[first][None], "margin")[0]:
+            return Verdict(False, first)
+        hits = self.batch_collides(Q[order], "margin", stop=True)
+        if hits.any():
+            return Verdict(False, int(order[int(np.argmax(hits))]))
+        # every sample keeps the margins: prove the intervals between them, level by level
+        states = [x for x in X]
+        qs = [q for q in Q]
+        lb = np.zeros(N)  # proven lower bound of each sample's excess (all keep the margins)
+        screened = self.batch_collides(Q, level)
+        lb[~screened] = self.step / 2.0 ** (level + 1)
+        # intervals: (left sample, right sample, budget, source interval, fraction a, fraction b)
+        todo = [(i, i + 1, float(budgets[i]), i, 0.0, 1.0) for i in range(N - 1)]
+        while True:
+            todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
+            if not todo:
+                return Verdict(True, exact=level)
+            if level >= MAX_SPLITS:
+                i = todo[0][3]
+                return Verdict(False, i, todo[0][4], level)
+            level += 1
+            s_level = self.step / 2.0 ** (level + 1)
+            nxt = []
+            new_states = []
+            for a, b, B, src, fa, fb in todo:
+                xm, bl, br = midpoint(src, fa, fb, B)
+                m = len(states) + len(new_states)
+                new_states.append(np.asarray(xm, dtype=float))
+                fm = 0.5 * (fa + fb)
+                nxt.append((a, m, float(bl), src, fa, fm))
+                nxt.append((m, b, float(br), src, fm, fb))
+            Xm = np.array(new_states)
+            inside = self.within_limits(Xm)
+            if not inside.all():
+                k = int(np.argmin(inside))
+                return Verdict(False, todo[k][3], 0.5 * (todo[k][4] + todo[k][5]), level)
+            Qm = self.full(Xm)
+            states.extend(Xm)
+            qs.extend(Qm)
+            lb = np.concatenate([lb, np.full(len(new_states), -1.0)])
+            ends = sorted({k for iv in nxt for k in iv[:2] if lb[k] < s_level})
+            Qe = np.array([qs[k] for k in ends])
+            passed = ~self.batch_collides(Qe, level)
+            for k, ok in zip(ends, passed):
+                if ok:
+                    lb[k] = s_level
+            unknown = [k for k, ok in zip(ends, passed) if not ok and lb[k] < 0.0]
+            if unknown:
+                bad = self.batch_collides(np.array([qs[k] for k in unknown]), "margin")
+                if bad.any():
+                    k = unknown[int(np.argmax(bad))]
+                    iv = next(iv for iv in nxt if k in iv[:2])
+                    return Verdict(False, iv[3], iv[4], level)
+                lb[unknown] = 0.0
+            todo = nxt
+
+    def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
+        X, budgets, _ = self._edge_samples(xa, xb, 0)
+        return X, budgets
+
+    def _edge_samples(self, xa: Any, xb: Any, coarse: int = COARSE_LEVELS) -> tuple[np.ndarray, np.ndarray, int]:
+        """Samples of the straight edge at the coarsest level ``−k`` (``k ≤ coarse``): budgets ≤ ``step · 2^k``."""
+        xa = np.asarray(xa, dtype=float)
+        xb = np.asarray(xb, dtype=float)
+        T = self.travel(xa, xb)
+        k = int(np.clip(math.floor(math.log2(max(T / self.step, 1.0))), 0, coarse))
+        n = max(1, int(math.ceil(T / (self.step * 2.0 ** k) * (1.0 + 1e-12))))
+        f = np.arange(n + 1) / n
+        return xa + f[:, None] * (xb - xa), np.full(n, T / n), -k
+
+    def edge_valid(self, xa: Any, xb: Any) -> Verdict:
+        """Whether the straight joint-space edge ``xa → xb`` keeps every margin everywhere (module docstring)."""
+        if self.timed:
+            raise InvalidInput("straight edges are checked with the other arms held; a moving arm is checked "
+                               "along a timed trajectory (trajectory_valid)")
+        xa = np.asarray(xa, dtype=float)
+        xb = np.asarray(xb, dtype=float)
+        self.counts["edges"] += 1
+        X, budgets, top = self._edge_samples(xa, xb)
+        n = budgets.size
+
+        def midpoint(i: int, a: float, b: float, B: float):
+            f = (i + 0.5 * (a + b)) / n
+            return xa + f * (xb - xa), 0.5 * B, 0.5 * B
+
+        v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
+        if v.ok:
+            return v
+        return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
+
+    def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
+        """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,
+        against the moving arms at the same instants (and the fixtures, the held arms).
+
+        ``until``: the cell time up to which the proof runs (default: the end of the moving
+        arms' motions, if later than the trajectory's): the planned arms hold their last
+        configuration meanwhile.
+
+        Samples uniform in time so that the planned arms' travel (exact velocity peaks times
+        the levers) plus the moving arms' (:meth:`moving_travel`) is at most ``step`` between
+        two; a halved interval gets each half's own budget."""
+        from pinarms.planning import Trajectory
+
+        tr = trajectory
+        vb = float(np.abs(np.asarray(tr.peaks().velocity, dtype=float)) @ self.levers)
+        if until is None and self.timed:
+            until = max(m.offset + m.trajectory.end_time - m.trajectory.start_time for m in self.moving)
+        end = t0 + tr.end_time - tr.start_time
+        if until is not None and until > end + 1e-12:
+            C = tr.coefficients
+            rest = np.zeros((1, C.shape[1], C.shape[2]))
+            rest[0, 0] = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
+            tr = Trajectory(np.append(tr.knot_times, tr.end_time + (until - end)), np.concatenate([C, rest]))
+        duration = tr.end_time - tr.start_time
+        total = vb * duration + (float(self.moving_travel(t0, t0 + duration)) if self.timed else 0.0)
+        n = max(1, int(math.ceil(total / self.step * (1.0 + 1e-12))))
+        tau = tr.start_time + duration * np.arange(n + 1) / n
+
+        def budget(ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
+            out = vb * (tb - ta)
+            if self.timed:
+                out = out + self.moving_travel(t0 + ta - tr.start_time, t0 + tb - tr.start_time)
+            return out
+
+        def states(taus: np.ndarray) -> np.ndarray:
+            q = np.asarray(tr.sample(taus)[0], dtype=float).reshape(taus.size, -1)
+            return np.column_stack([q, t0 + taus - tr.start_time]) if self.timed else q
+
+        def midpoint(i: int, a: float, b: float, B: float):
+            ta = tau[i] + a * (tau[i + 1] - tau[i])
+            tb = tau[i] + b * (tau[i + 1] - tau[i])
+            tm = 0.5 * (ta + tb)
+            halves = budget(np.array([ta, tm]), np.array([tm, tb]))
+            return states(np.array([tm]))[0], halves[0], halves[1]
+
+        budgets = budget(tau[:-1], tau[1:])
+        if np.any(budgets > self.step * (1.0 + 1e-9)):  # the moving arms' share is uneven: split where needed
+            extra = np.maximum(1, np.ceil(budgets / self.step)).astype(int)
+            first = np.repeat(np.cumsum(extra) - extra, extra)
+            k = np.arange(int(extra.sum())) - first
+            tau = np.append(np.repeat(tau[:-1], extra) + k * np.repeat(np.diff(tau) / extra, extra), tau[-1])
+            budgets = budget(tau[:-1], tau[1:])
+        return self.prove(states(tau), budgets, midpoint)
+
+    def path_valid(self, X: np.ndarray) -> Verdict:
+        """A polyline through states ``X (M, dim)``: every edge :meth:`edge_valid`."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        for i in range(X.shape[0] - 1):
+            v = self.edge_valid(X[i], X[i + 1])
+            if not v.ok:
+                return Verdict(False, i, v.fraction, v.exact)
+        return Verdict(True)
+
+
+def check_settings(value: Any, name: str) -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    x = float(value) if ok else float("nan")
+    if not math.isfinite(x) or x <= 0.0:
+        raise InvalidSettings(f"{name} must be a positive number, got {value!r}")
+    return x

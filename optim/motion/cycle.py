@@ -1,0 +1,147 @@
+"""The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
+
+:func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
+adding via points (:mod:`optim.cell_cycle`). A crate under a guard, a shelf or the other
+arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
+then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
+lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
+plans the transfer between "above pick" and "above place" with :func:`plan_motion`'s
+search, shortcut and smoothing (OMPL, every edge proven continuously); the move back runs
+the same path in reverse. Each part is timed optimally from rest to rest under the cycle's
+limits (joint velocity and acceleration; the URDF's torque limits when no acceleration
+limit is given) and the parts are joined at rest. The cycle (dwells, move to place, move
+back) is returned as a :class:`optim.CycleResult` whose moves are :class:`PlannedMove` s.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.motion.checker import MotionChecker
+from pinarms.optim.motion.plan import _limits, plan_geometry, time_path
+from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
+from pinarms.planning import Trajectory
+from pinarms.robots.errors import CollisionError
+
+__all__ = ["PlannedMove", "planned_cycle"]
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedMove:
+    """One move of a cycle with a planned transfer: the lift, the transfer, the lowering (at rest between).
+
+    Attributes:
+        parts: the three timings (:class:`optim.PathTiming`).
+        trajectory: the three concatenated.
+        planner: the OMPL planner that found the transfer; ``states``: the states it explored.
+    """
+
+    parts: tuple = field(repr=False)
+    trajectory: Trajectory = field(repr=False)
+    planner: str = ""
+    states: int = 0
+    robot: Any = field(default=None, repr=False)
+    torque_limit: Any = field(default=None, repr=False)
+
+    @property
+    def durations(self) -> np.ndarray:
+        """(3,) [s]: lift, transfer, lowering."""
+        return np.array([p.duration for p in self.parts])
+
+    @property
+    def total(self) -> float:
+        """Duration of the move [s]."""
+        return float(self.durations.sum())
+
+    @property
+    def knot_times(self) -> np.ndarray:
+        """Boundaries of the three parts [s] (the first and the last part are the vertical moves)."""
+        return np.concatenate([[0.0], np.cumsum(self.durations)])
+
+    @property
+    def line_cost(self) -> float:
+        """0: the lines are the cycle's own (their cost is reported by the cycle they come from)."""
+        return 0.0
+
+    @property
+    def torque_ratios(self) -> np.ndarray | None:
+        """Peak torque / limit per joint along the move (None without a torque limit)."""
+        if self.torque_limit is None or self.robot is None:
+            return None
+        return self.trajectory.torque_peaks(self.robot).ratios(self.torque_limit)
+
+
+def _lines(base: Any, k: int) -> tuple[list, list]:
+    """(lift, lowering) paths of the move to place and of the move back, and their kind."""
+    q = base.q_via
+    if base.approach == "straight":
+        there = [base.moves[0].lines[0].path, base.moves[0].lines[1].path]
+        back = [base.moves[1].lines[0].path, base.moves[1].lines[1].path]
+        return there, back
+    pick, up_pick, up_place, place = q[0], q[1], q[k - 2], q[k - 1]
+    return ([polyline_path(np.stack([pick, up_pick])), polyline_path(np.stack([up_place, place]))],
+            [polyline_path(np.stack([place, up_place])), polyline_path(np.stack([up_pick, pick]))])
+
+
+def _hold(q: np.ndarray, seconds: float) -> Trajectory:
+    return Trajectory([0.0, seconds], np.asarray(q, dtype=float)[None, None, :])
+
+
+def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
+                  margin: float, planner: str = "rrtconnect", time_limit: float = 5.0, seed: int = 0) -> Any:
+    """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
+
+    Args:
+        base: the :class:`optim.CycleResult` of ``spec`` without the cell (its via points fix
+            the IK branch; its limits are used).
+        arm: the :class:`robots.cell.CellArm`; ``clearance``: distance kept from fixtures and
+            other arms [m] (the arm's own links: no contact); ``hold``: the cell configuration
+            of the other arms; ``margin``: the check's resolution when ``clearance`` is 0.
+
+    Raises:
+        CollisionError: a vertical move itself is too close to something (no transfer can
+            help), or :class:`optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
+    """
+    k = len(spec.names)
+    q = base.q_via
+    checker = MotionChecker(cell, [arm.name], margin=clearance if clearance > 0.0 else margin, hold=hold)
+    there, back = _lines(base, k)
+    for label, path in (("lift at the pick", there[0]), ("lowering at the place", there[1])):
+        verdict, _ = prove_path(checker, path)
+        if not verdict.ok:
+            raise CollisionError(f"the {label} of arm {arm.name!r} itself comes closer than "
+                                 f"{checker.margin * 1e3:.1f} mm to something: no transfer can clear it; move the "
+                                 "pick/place or lower the lift")
+    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], planner=planner, time_limit=time_limit, seed=seed)
+    transfer = geo["path"]
+    reverse, _, _ = smooth_path(checker, geo["simplified"][::-1], arm.robot)
+    amax = base.amax
+    torque = True if amax is None and base.torque_limit is None else (base.torque_limit
+                                                                       if base.torque_limit is not None else False)
+    constraints, _ = _limits(cell, (arm.name,), base.vmax, amax, torque)
+
+    def move(paths: list) -> PlannedMove:
+        parts = tuple(time_path(p, constraints) for p in paths)
+        traj = parts[0].trajectory
+        for p in parts[1:]:
+            traj = traj.concatenated(p.trajectory, atol=1e-7)
+        return PlannedMove(parts, traj, geo["planner"], geo["states"], arm.robot, base.torque_limit)
+
+    m1 = move([there[0], transfer, there[1]])
+    m2 = move([back[0], reverse, back[1]])
+    pieces = [m1.trajectory, m2.trajectory]
+    if spec.dwell > 0.0:
+        pieces = [_hold(q[0], spec.dwell), pieces[0], _hold(q[k - 1], spec.dwell), pieces[1]]
+    trajectory = pieces[0]
+    for p in pieces[1:]:
+        trajectory = trajectory.concatenated(p, atol=1e-7)
+    from pinarms.optim.cycle import _line_deviation
+
+    P = spec.poses(robot)[:, :3, 3]
+    ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
+    return dataclasses.replace(base, moves=(m1, m2), trajectory=trajectory, peaks=trajectory.peaks(),
+                               line_deviation=_line_deviation(robot, (m1, m2), ends))

@@ -1,0 +1,252 @@
+"""Two arms: plan one arm around the other's timed trajectory, or both together.
+
+:func:`plan_around` plans arm B while arm A follows its own trajectory:
+
+1. **Path.** B's path is planned (:func:`plan_motion`'s search, shortcut and smoothing)
+   with A parked at the **end** of its trajectory, where it stays once its move is done:
+   B's path can never be blocked by A for good.
+2. **Time.** B's path is timed optimally (:func:`optim.time_optimal`), and B leaves its start
+   at the earliest instant ``t0 + d`` (``d`` in steps of ``delay_step``) for which the
+   continuous proof with A **at the same instants** accepts the whole motion: B waiting at
+   its start, then moving, against A moving (:meth:`MotionChecker.trajectory_valid`: samples
+   every ``margin`` of the two arms' combined travel, A's travel bounded from its exact
+   speeds and accelerations). A start inside A's sweep has no such instant.
+
+:func:`plan_two_arms` tries :func:`plan_around` and, when it finds nothing (no path, or no
+start instant up to A's end), plans both arms in their joint space (:func:`plan_motion`
+with two arms: A from its trajectory's start to its end, B from its start to its goal).
+Every result is re-checked by the cell's own continuous time check with both arms moving
+(:func:`robots.cell.check_motion`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError, StartInCollision
+from pinarms.optim.motion.checker import MotionChecker, TimedArm
+from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_motion
+from pinarms.planning import Trajectory
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms"]
+
+
+@dataclass(frozen=True, eq=False)
+class AroundPlan:
+    """Arm B planned around timed arms (see the module docstring).
+
+    Attributes:
+        arm: B's name; ``moving``: the :class:`TimedArm` s it avoids; ``t0``: when B may
+            leave [s, cell time]; ``delay``: how long it waits there for them [s].
+        plan: B's geometric path and its time-optimal timing (a :class:`MotionPlan` made
+            with the moving arms parked at their ends).
+        trajectory: B's joint trajectory in cell time (``start_time = t0``: the wait, then
+            the move).
+        check: the cell's continuous check with B and the moving arms together.
+        delays_tried: the start delays proven not to clear, before the one used.
+    """
+
+    cell: Any = field(repr=False)
+    arm: str
+    moving: tuple
+    t0: float
+    delay: float
+    plan: MotionPlan = field(repr=False)
+    trajectory: Trajectory = field(repr=False)
+    check: Any = field(repr=False)
+    delays_tried: int
+    seconds: dict = field(repr=False)
+
+    @property
+    def end_time(self) -> float:
+        """When B arrives [s, cell time]."""
+        return float(self.trajectory.end_time)
+
+    @property
+    def duration(self) -> float:
+        """B's motion time without the wait [s]."""
+        return float(self.plan.duration)
+
+
+@dataclass(frozen=True, eq=False)
+class TwoArmPlan:
+    """The outcome of :func:`plan_two_arms`: which method worked and each arm's trajectory.
+
+    Attributes:
+        method: ``"around"`` (B planned around A's trajectory, A unchanged) or ``"joint"``
+            (both planned together; A's path changed, its ends kept).
+        trajectories: ``{arm: Trajectory}``; ``offsets``: ``{arm: offset}`` [s] to play them
+            with (:class:`robots.cell.ArmMotion`: the cell time at which each trajectory's
+            ``start_time`` is played).
+        around: the :class:`AroundPlan` (``None`` when it failed); ``joint``: the two-arm
+            :class:`MotionPlan` (``None`` when not needed).
+        attempts: ``(method, outcome)`` in order.
+        check: the cell's continuous check of both arms together.
+    """
+
+    method: str
+    trajectories: dict
+    offsets: dict
+    around: AroundPlan | None = field(repr=False)
+    joint: MotionPlan | None = field(repr=False)
+    attempts: tuple
+    check: Any = field(repr=False)
+
+    @property
+    def end_time(self) -> float:
+        """When the last arm arrives [s, cell time]."""
+        return max(self.offsets[a] + t.duration for a, t in self.trajectories.items())
+
+
+def _timed_arms(cell: Any, moving: Any) -> tuple[TimedArm, ...]:
+    if isinstance(moving, TimedArm):
+        return (moving,)
+    if isinstance(moving, Mapping):
+        out = []
+        for name, value in moving.items():
+            traj, offset = (value if isinstance(value, tuple) else (value, 0.0))
+            out.append(TimedArm(cell.arm(name).name, traj, float(offset)))
+        return tuple(out)
+    return tuple(moving)
+
+
+def _waiting(trajectory: Trajectory, q0: np.ndarray, t0: float, delay: float) -> Trajectory:
+    """``trajectory`` played from ``t0 + delay``, the arm at rest at ``q0`` from ``t0`` (cell time)."""
+    knots = trajectory.knot_times - trajectory.start_time
+    C = trajectory.coefficients
+    if delay <= 0.0:
+        return Trajectory(knots + t0, C)
+    wait = np.zeros((1, C.shape[1], C.shape[2]))
+    wait[0, 0] = q0
+    return Trajectory(np.concatenate([[t0], knots + t0 + delay]), np.concatenate([wait, C]))
+
+
+def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: float = 0.0, margin: float = 0.01,
+                self_margin: float = 0.0, planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0,
+                hold: Any = None, vmax: Any = None, amax: Any = None, torque: Any = True, delay_step: float = 0.05,
+                grid: int = 200, progress: Callable[[str], None] | None = None) -> AroundPlan:
+    """Plan ``arm`` from ``start`` (ready at cell time ``t0``) to ``goal`` around the ``moving`` arms.
+
+    Args:
+        moving: ``{arm: trajectory}``, ``{arm: (trajectory, offset)}`` or :class:`TimedArm` s:
+            the arms that follow their own trajectories meanwhile (cell time = offset +
+            trajectory time − its start; they hold their ends outside).
+        t0: when B may leave its start [s, cell time].
+        delay_step: resolution of the start delay [s].
+        Others as :func:`plan_motion` (``hold``: the cell configuration of the other arms).
+
+    Raises:
+        StartInCollision: B's start touches a moving arm at ``t0``.
+        NoPathFound: no path around the moving arms' end configuration, or no start delay up
+            to their end that clears their motion (the message says which).
+        GoalInCollision, InvalidInput, ...: as :func:`plan_motion`.
+    """
+    t_all = time.perf_counter()
+    say = progress or (lambda _m: None)
+    arms = (cell.arm(arm).name,)
+    timed = _timed_arms(cell, moving)
+    if not timed:
+        raise InvalidInput("plan_around needs at least one moving arm (use plan_motion otherwise)")
+    ok = isinstance(delay_step, (int, float)) and not isinstance(delay_step, bool) and np.isfinite(delay_step)
+    if not ok or delay_step <= 0.0:
+        raise InvalidSettings(f"delay_step must be a positive number of seconds, got {delay_step!r}")
+    base = cell.neutral.copy() if hold is None else np.array(cell.robot.check_q(hold)[0][0], dtype=float)
+    parked = base.copy()
+    for m in timed:
+        parked[cell.arm(m.arm).q_slice] = m.trajectory.sample(m.trajectory.end_time)[0]
+    together = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=base, moving=timed)
+    x0 = _joints(cell, arms, start, "start")
+    _check_start(together, np.append(x0, t0), "start")
+    say("planning the path around the other arm(s) parked at the end of their motion")
+    try:
+        plan = plan_motion(cell, arms[0], x0, goal, margin=margin, self_margin=self_margin, planner=planner,
+                           time_limit=time_limit, seed=seed, hold=parked, vmax=vmax, amax=amax, torque=torque,
+                           grid=grid)
+    except StartInCollision as exc:
+        raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({exc}): it "
+                          "cannot wait there; plan both arms together", planner="", time_limit=float(time_limit)) \
+            from exc
+    t = time.perf_counter()
+    t_end = max(m.offset + m.trajectory.duration for m in timed)
+    delays = np.arange(0.0, max(t_end - t0, 0.0) + delay_step, delay_step)
+    chosen = None
+    for k, d in enumerate(delays):
+        candidate = _waiting(plan.trajectory, x0, float(t0), float(d))
+        if together.trajectory_valid(candidate, float(t0)).ok:
+            chosen = (k, float(d), candidate)
+            break
+    seconds = dict(plan.seconds)
+    seconds["delay"] = time.perf_counter() - t
+    if chosen is None:
+        raise NoPathFound(
+            f"arm {arms[0]!r}: its path around {[m.arm for m in timed]} parked at their ends is clear, but no start "
+            f"delay from 0 to {delays[-1]:.2f} s (step {delay_step:g} s) keeps the margin while they move: its start "
+            "lies in their sweep", planner=plan.planner, time_limit=float(time_limit), seconds=plan.seconds["search"],
+            states=plan.states, goals=1)
+    k, d, trajectory = chosen
+    say(f"leaves {d:.2f} s after {t0:.2f} s; checking both arms together")
+    t = time.perf_counter()
+    check = _check_together(cell, {arms[0]: (trajectory, trajectory.start_time)}, timed, together)
+    seconds["check_together"] = time.perf_counter() - t
+    seconds["total"] = time.perf_counter() - t_all
+    return AroundPlan(cell=cell, arm=arms[0], moving=timed, t0=float(t0), delay=d, plan=plan, trajectory=trajectory,
+                      check=check, delays_tried=k, seconds=seconds)
+
+
+def _check_together(cell: Any, planned: Mapping[str, tuple], timed: tuple, checker: MotionChecker) -> Any:
+    from pinarms.robots.cell.motion import ArmMotion
+
+    motions = [ArmMotion(name, traj, offset) for name, (traj, offset) in planned.items()]
+    motions += [ArmMotion(m.arm, m.trajectory, m.offset) for m in timed]
+    check = cell.check_motion(motions, margin=checker.margin, clearance=0.0, hold=checker.hold)
+    if not check.collision_free:
+        raise PlanningError(f"the two-arm motion failed the cell's continuous check: {check.summary()}")
+    return check
+
+
+def plan_two_arms(cell: Any, arm: str, start: Any, goal: Any, other: str, other_trajectory: Trajectory, *,
+                  other_offset: float = 0.0, t0: float = 0.0, margin: float = 0.01, self_margin: float = 0.0,
+                  planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0, hold: Any = None,
+                  vmax: Any = None, amax: Any = None, torque: Any = True,
+                  progress: Callable[[str], None] | None = None) -> TwoArmPlan:
+    """Plan ``arm`` (B) while ``other`` (A) follows ``other_trajectory``; both together if that fails.
+
+    First :func:`plan_around` (A keeps its trajectory). If it finds nothing, both arms are
+    planned in their joint space with :func:`plan_motion`, both leaving at ``t0``: A from
+    where its trajectory has it at ``t0`` to the trajectory's last configuration, B from
+    ``start`` to ``goal`` (a joint goal). A's own path and timing are then replaced.
+    """
+    attempts = []
+    try:
+        around = plan_around(cell, arm, start, goal, {other: (other_trajectory, other_offset)}, t0=t0, margin=margin,
+                             self_margin=self_margin, planner=planner, time_limit=time_limit, seed=seed, hold=hold,
+                             vmax=vmax, amax=amax, torque=torque, progress=progress)
+        attempts.append(("around", f"leaves after {around.delay:.2f} s, arrives at {around.end_time:.3f} s"))
+        return TwoArmPlan("around", {arm: around.trajectory, other: other_trajectory},
+                          {arm: around.trajectory.start_time, other: other_offset}, around, None, tuple(attempts),
+                          around.check)
+    except NoPathFound as exc:
+        attempts.append(("around", str(exc)))
+    if progress:
+        progress("planning both arms together")
+    tr = other_trajectory
+    now = float(np.clip(t0 - other_offset + tr.start_time, tr.start_time, tr.end_time))
+    a_start = np.asarray(tr.sample(now)[0], dtype=float)  # where A is when both leave
+    a_end = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
+    b_start = _joints(cell, (cell.arm(arm).name,), start, "start")
+    b_goal = goal[arm] if isinstance(goal, Mapping) else goal
+    joint = plan_motion(cell, (other, arm), {other: a_start, arm: b_start},
+                        {other: a_end, arm: np.asarray(b_goal, dtype=float)}, margin=margin, self_margin=self_margin,
+                        planner=planner, time_limit=time_limit, seed=seed, hold=hold, vmax=vmax, amax=amax,
+                        torque=torque, progress=progress)
+    attempts.append(("joint", f"both arms together, {joint.duration:.3f} s"))
+    na = cell.arm(other).nq
+    traj = joint.trajectory
+    ta = Trajectory(traj.knot_times + t0, traj.coefficients[:, :, :na])
+    tb = Trajectory(traj.knot_times + t0, traj.coefficients[:, :, na:])
+    return TwoArmPlan("joint", {other: ta, arm: tb}, {other: t0, arm: t0}, None, joint, tuple(attempts), joint.check)

@@ -1,0 +1,42 @@
+"""`pinarms motion CELL ...`: a planned, proven, timed move from the command line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from click.testing import CliRunner
+
+from pinarms.cli import cli
+
+WALL = str(Path(__file__).resolve().parents[1] / "optim" / "data" / "aubo_wall.urdf.xacro")
+
+
+def test_motion_over_the_wall_json_and_session(tmp_path):
+    out = tmp_path / "move.pinarms"
+    result = CliRunner().invoke(cli, ["motion", WALL, "--from", "450", "200", "800", "--to", "450", "-200",
+                                      "800", "--margin", "10", "--mm", "--time-limit", "30", "--json",
+                                      "--session", str(out), "--plot", str(tmp_path / "clearance.png")])
+    assert result.exit_code == 0, (result.output, result.exception)
+    data = json.loads(result.stdout)
+    assert data["arm"] == "aubo" and data["planner"] == "RRTConnect" and data["collision_free"]
+    assert data["margin_m"] == 0.01 and data["min_clearance_environment_m"] >= 0.01
+    assert data["duration_s"] > 0.0 and len(data["tool_path_world_m"]) == 50
+    assert abs(data["tool_path_world_m"][-1][1] + 0.2) < 1e-6  # ends at the goal
+    from pinarms import viz
+
+    assert (tmp_path / "clearance.png").stat().st_size > 10_000
+    session = viz.load_session(out)
+    assert session.robot().nq == 6 and "motion" in session.trajectories
+
+
+def test_motion_goal_inside_the_wall_is_one_error_line():
+    result = CliRunner().invoke(cli, ["motion", WALL, "--from", "0.45", "0.2", "0.80", "--to", "0.45", "0.0", "0.80"])
+    assert result.exit_code == 1
+    assert "Traceback" not in result.output
+    assert result.stderr.startswith("Error:") and "inside fixture 'wall'" in result.stderr
+
+
+def test_motion_needs_an_arm_in_a_two_arm_cell():
+    result = CliRunner().invoke(cli, ["motion", "mushroom_line", "--to", "0", "0", "0.9"])
+    assert result.exit_code == 1 and "give --arm" in result.stderr
