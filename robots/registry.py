@@ -21,7 +21,8 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 
-__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest"]
+__all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest",
+           "match_builtin"]
 
 
 @dataclass(frozen=True)
@@ -157,10 +158,47 @@ def load(name: str) -> Robot:
             freeze=entry.frozen_joints,
             description=entry.description,
         )
-    from .ik import attach_analytic_ik  # late import: ik solvers need the Robot class
+    return robot  # its closed-form IK (if any) was recognised by from_urdf_text
 
-    attach_analytic_ik(robot)
-    return robot
+
+def _kinematics(robot: Robot) -> tuple[tuple[int, ...], np.ndarray]:
+    """What makes an arm the arm it is, without its names: the tree, joint kinds, axes,
+    placements, mimic couplings, position limits and the tcp's placement.
+
+    Returns ``(integers, floats)``: parents, kinds and coordinate indices; then every
+    joint's placement and axis, mimic multiplier and offset, the limits and the tcp.
+    """
+    tree, model = robot._tree, robot.model
+    n = model.njoints
+    ints = (n, *tree.parent.tolist(), *tree.kind.tolist(), *tree.q_index.tolist())
+    place = [np.asarray(model.jointPlacements[i].homogeneous[:3]).ravel() for i in range(1, n)]
+    tcp = model.frames[robot.frame_id("tcp")]
+    floats = np.concatenate([
+        *place, np.asarray(tree.axis_rot)[1:, :, 2].ravel(), tree.scale, tree.offset, robot.lower, robot.upper,
+        np.asarray(tcp.placement.homogeneous[:3]).ravel(),
+    ])
+    return (*ints, int(tcp.parentJoint)), floats
+
+
+@lru_cache(maxsize=1)
+def _builtin_kinematics() -> tuple[tuple[str, tuple[int, ...], np.ndarray], ...]:
+    return tuple((name, *_kinematics(load(name))) for name in builtin_names())
+
+
+def match_builtin(robot: Robot, tol: float = 1e-9) -> str | None:
+    """The built-in arm that ``robot`` is, told from its kinematics, or ``None``.
+
+    Names play no part: two arms are the same when their trees, joint kinds, joint
+    placements and axes, mimic couplings, position limits and tcp placement agree within
+    ``tol`` [m, rad, 1]. A cell arm placed by a built-in macro (``<xacro:scara_mushroom
+    prefix="left_" .../>``) is that built-in; a user's arm with other lengths or limits
+    (whatever its joints are called) is not.
+    """
+    ints, floats = _kinematics(robot)
+    for name, ref_ints, ref_floats in _builtin_kinematics():
+        if ref_ints == ints and ref_floats.shape == floats.shape and np.allclose(ref_floats, floats, rtol=0.0, atol=tol):
+            return name
+    return None
 
 
 def _freeze_joints(root: ET.Element, freeze: tuple[str, ...], source: str) -> None:
@@ -193,6 +231,9 @@ def from_urdf_text(
 ) -> Robot:
     """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
 
+    Its closed-form IK, when its kinematic structure matches a family, is attached
+    (:func:`robots.ik.recognise`; ``robot.ik_family``).
+
     Raises:
         InvalidInput: ``urdf_text`` is not a string.
         ModelError: not well-formed XML, not a URDF, a DOCTYPE or entity declaration
@@ -223,7 +264,7 @@ def from_urdf_text(
     _check_limits(model, source)
     if tcp is None:
         tcp = "tcp" if model.existFrame("tcp") else _last_body_frame(model)
-    return Robot(
+    robot = Robot(
         model,
         name=name or root.get("name", "robot"),
         urdf_text=urdf_text,
@@ -232,6 +273,10 @@ def from_urdf_text(
         tcp_frame=tcp,
         description=description,
     )
+    from .ik import attach_analytic_ik  # late import: ik solvers need the Robot class
+
+    attach_analytic_ik(robot)  # by geometry, proven by FK round trips (robot.ik_family)
+    return robot
 
 
 def _check_tree(root: ET.Element, source: str) -> None:
@@ -344,7 +389,7 @@ def from_urdf(
     freeze: tuple[str, ...] = (),
     description: str = "",
 ) -> Robot:
-    """Load any URDF file.
+    """Load any URDF file (closed-form IK attached when its geometry matches a family: ``robot.ik_family``).
 
     Args:
         path: the URDF file.

@@ -126,6 +126,7 @@ class Robot:
         self.effort_limit = np.array(model.effortLimit, dtype=float)
         self.tcp_frame = tcp_frame
         self._analytic_ik = None  # set by the registry for arms with a closed form
+        self._ik_rejected: dict[str, str] = {}  # why each closed-form family was refused (recognition)
 
     # ------------------------------------------------------------- threads
     # Thread-safety rule: a Robot may be shared by any number of threads. Pinocchio's Data
@@ -175,8 +176,13 @@ class Robot:
             raise ModelError(
                 f"robot '{self.name}' has no frame {name!r} to use as tcp; frames are: {', '.join(self.frame_names)}"
             )
+        changed = name != getattr(self, "_tcp_frame", name)
         self._tcp_frame = name
         self._frame_lookup = {**self._frame_ids, "tcp": self._frame_ids[name]}
+        if changed and self.__dict__.get("_analytic_ik") is not None:
+            from .ik import attach_analytic_ik  # the closed form was proven for the old tcp: recognise again
+
+            attach_analytic_ik(self)
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame`` (``"tcp"`` means :attr:`tcp_frame`)."""
@@ -377,6 +383,17 @@ class Robot:
         """Whether :meth:`ik_all` has a closed form for this arm."""
         return self._analytic_ik is not None
 
+    @property
+    def ik_family(self) -> str | None:
+        """The closed-form family recognised from the arm's geometry, or ``None`` (numerical IK only).
+
+        ``"ur_type"``, ``"scara"``, ``"gantry"`` or ``"koji"``: the kinematic structure
+        (joint types, axes, offsets, lengths read from the model) matched that family and
+        its closed form solved back random configurations at load (``robots.ik.recognise``).
+        """
+        solver = self._analytic_ik
+        return None if solver is None else solver.key
+
     def check_target(self, target: Any, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
         """Validate IK target(s): a pose ``(4, 4)`` / ``(N, 4, 4)`` frame → base [m], proper rotation.
 
@@ -505,8 +522,10 @@ class Robot:
     def _analytic_targets(self, target: Any, q_ref: Any) -> tuple[np.ndarray, bool, np.ndarray | None]:
         """Checked targets ``(N, 4, 4)``, single flag and ``q_ref`` rows for the closed forms."""
         if self._analytic_ik is None:
+            why = "; ".join(f"{k}: {v}" for k, v in getattr(self, "_ik_rejected", {}).items())
             raise ModelError(
-                f"robot '{self.name}' has no analytic IK (closed forms: SCARA, gantry, koji arm, UR-type); "
+                f"robot '{self.name}' has no analytic IK (closed forms: SCARA, gantry, koji arm, UR-type; "
+                f"{'refused: ' + why if why else 'its joints are not those of any of them'}); "
                 "use Robot.ik for a numerical solution"
             )
         T, single = self.check_target(target)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -25,7 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
-from ..errors import CellError, CollisionGeometryError, InvalidInput, ModelError
+from ..errors import CellError, CollisionGeometryError, InvalidInput
 from ..robot import Robot
 from ..xacro_expand import mesh_path
 from .description import ArmSpec, CellSpec, arm_urdf, describe
@@ -45,7 +44,8 @@ class CellArm:
         base_to_world: ``(4, 4)`` pose of the arm's base frame in the world [m].
         q_slice: the arm's coordinates in the cell joint vector.
         prefix: what the arm's names carry in the cell (``"left_"``).
-        model: the built-in arm it is (``"scara_mushroom"``), or ``None``.
+        model: the built-in arm it is (``"scara_mushroom"``), told from its kinematics, never
+            from names (:func:`~pinarms.robots.registry.match_builtin`), or ``None``.
     """
 
     name: str
@@ -59,6 +59,11 @@ class CellArm:
     def nq(self) -> int:
         """Number of the arm's joint coordinates."""
         return self.robot.nq
+
+    @property
+    def ik_family(self) -> str | None:
+        """The closed-form IK family recognised from the arm's geometry (``robot.ik_family``), or ``None``."""
+        return self.robot.ik_family
 
     def to_world(self, pose: Any) -> np.ndarray:
         """A pose ``(4, 4)`` / ``(N, 4, 4)`` or a point ``(3,)`` / ``(N, 3)`` from the arm's base frame to the world."""
@@ -124,13 +129,6 @@ def _shape_of(geometry: Any) -> tuple[str, tuple[float, ...]]:
     if isinstance(geometry, (coal.BVHModelBase, coal.ConvexBase)):
         return "mesh", ()
     return type(geometry).__name__, ()
-
-
-@lru_cache(maxsize=1)
-def _builtin_joint_names() -> dict[tuple[str, ...], str]:
-    from ..registry import builtin_names, load
-
-    return {load(name).joint_names: name for name in builtin_names()}
 
 
 class Cell:
@@ -201,19 +199,14 @@ class Cell:
 
     # ------------------------------------------------------------------ building
     def _build_arm(self, root: ET.Element, spec: ArmSpec) -> CellArm:
-        from ..ik import _FAMILY_OF, attach_analytic_ik
-        from ..registry import from_urdf_text
+        from ..registry import from_urdf_text, match_builtin
 
         text = arm_urdf(root, spec)
+        # closed-form IK by geometry (robot.ik_family); the built-in it is by kinematics, not names
         robot = from_urdf_text(text, tcp=None, name=spec.name, source=f"arm {spec.name!r} of {self.source}",
                                package_dirs=tuple(self._package_dirs()))
-        model_name = _builtin_joint_names().get(robot.joint_names)
+        model_name = match_builtin(robot)
         robot.description = f"{model_name or 'arm'} {spec.name!r} of cell {self.name}"
-        if model_name in _FAMILY_OF:
-            try:
-                attach_analytic_ik(robot, _FAMILY_OF[model_name])
-            except ModelError:
-                robot._analytic_ik = None  # the arm was changed: numerical IK only
         cell_names = self.robot.joint_names
         idx = [cell_names.index(spec.prefix + j) if spec.prefix + j in cell_names else -1 for j in robot.joint_names]
         if -1 in idx or idx != list(range(idx[0], idx[0] + len(idx))):

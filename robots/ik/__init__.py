@@ -7,7 +7,11 @@
 - :func:`near_limit_solutions`: closed-form solutions a little outside the joint ranges,
   and by how much (to tell users; ``limit_tolerance=`` accepts them).
 
-Users normally call :meth:`robots.Robot.ik_all` and :meth:`robots.Robot.ik`.
+Every robot loaded by :mod:`robots.registry` (``load``, ``from_urdf``, ``from_urdf_text``,
+``from_xacro``) and every arm of a cell gets the closed form of its family when its
+kinematic structure matches one (:func:`recognise`, by geometry, proven by FK round trips
+at load); ``robot.ik_family`` says which. Users normally call :meth:`robots.Robot.ik_all`
+and :meth:`robots.Robot.ik`.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from .gantry import GantryIK
 from .koji import KojiIK
 from .near_limits import OutsideLimits, limit_excess, near_limit_solutions
 from .numerical import IKResult, NumericalIK
+from .recognise import Recognition, recognise
 from .scara import ScaraIK
 from .solver import FK_TOL, LIMIT_TOL, AnalyticIK
 from .ur_type import URTypeIK
@@ -23,6 +28,8 @@ from .ur_type import URTypeIK
 __all__ = [
     "attach_analytic_ik",
     "analytic_solver",
+    "recognise",
+    "Recognition",
     "FAMILIES",
     "AnalyticIK",
     "URTypeIK",
@@ -46,7 +53,9 @@ FAMILIES: dict[str, type[AnalyticIK]] = {
     "koji": KojiIK,
 }
 
-#: Family of each registry robot that has a closed form (koji_turner_rail is redundant: numerical only).
+#: Family of each registry robot that has a closed form (koji_turner_rail is redundant: numerical
+#: only). Kept for reference and for callers that look a family up by name; robots get their
+#: family by :func:`recognise`, never from this table.
 _FAMILY_OF = {
     "scara_mushroom": "scara",
     "aubo_i3": "ur_type",
@@ -72,13 +81,23 @@ def analytic_solver(robot, family: str, frame: str = "tcp") -> AnalyticIK:
     return FAMILIES[family](robot, frame)
 
 
-def attach_analytic_ik(robot, family: str | None = None) -> None:
-    """Give ``robot`` the closed-form solver of its arm family (by registry name unless ``family`` is given).
+def attach_analytic_ik(robot, family: str | None = None) -> str | None:
+    """Give ``robot`` the closed-form solver of its family; return the family's key (or ``None``).
 
-    Robots without a known family keep ``robot._analytic_ik = None`` (numerical IK only).
+    Without ``family`` the family is recognised from the robot's kinematic structure and
+    proven by FK round trips (:func:`recognise`); a robot that matches none keeps
+    ``robot._analytic_ik = None`` (numerical IK only). With ``family`` that solver is built
+    (and proven) or an error is raised.
 
     Raises:
-        ModelError: the robot's model lacks the structure of its family.
+        InvalidInput: unknown ``family``.
+        ModelError: ``family`` is given and the robot's model lacks its structure.
     """
-    family = family or _FAMILY_OF.get(robot.name)
-    robot._analytic_ik = None if family is None else analytic_solver(robot, family)
+    if family is None:
+        found = recognise(robot)
+        robot._analytic_ik = found.solver
+        robot._ik_rejected = found.rejected
+        return found.family
+    robot._analytic_ik = analytic_solver(robot, family)
+    robot._ik_rejected = {}
+    return family

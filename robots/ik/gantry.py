@@ -21,6 +21,7 @@ class GantryIK(AnalyticIK):
     """The one IK solution of a three-prismatic-axis gantry."""
 
     family = "Cartesian gantry"
+    key = "gantry"
 
     def __init__(self, robot, frame: str = "tcp") -> None:
         super().__init__(robot, frame)

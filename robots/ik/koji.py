@@ -36,6 +36,7 @@ class KojiIK(AnalyticIK):
     """All IK solutions (up to 4) of the koji arm: waist, upper arm, absolute forearm, wrist."""
 
     family = "parallelogram arm (koji turner)"
+    key = "koji"
 
     def __init__(self, robot, frame: str = "tcp") -> None:
         super().__init__(robot, frame)

@@ -31,6 +31,7 @@ class ScaraIK(AnalyticIK):
     """All IK solutions (two elbow branches) of a 4-axis SCARA, for position + yaw targets."""
 
     family = "SCARA"
+    key = "scara"
 
     def __init__(self, robot, frame: str = "tcp") -> None:
         super().__init__(robot, frame)

@@ -35,6 +35,9 @@ FK_TOL = 1e-9
 #: Candidates whose FK misses the target by less than this [m, rad] are polished, not dropped.
 POLISH_RANGE = 1e-5
 
+#: Seeded random configurations each closed form must solve back when it is built (the load-time proof).
+PROOF_SAMPLES = 32
+
 _TWO_PI = 2.0 * np.pi
 _CHUNK = 8192  # targets per block
 _MAX_ROWS = 1 << 20  # candidate rows per block (bounds memory for wide joint ranges)
@@ -60,6 +63,8 @@ class AnalyticIK:
     """
 
     family = "analytic"
+    #: Short name of the family (a key of :data:`robots.ik.FAMILIES`), reported as ``Robot.ik_family``.
+    key = "analytic"
     #: Number of geometric branches of :meth:`raw` (its candidate slots modulo this are the
     #: branch labels; extra slots, e.g. at a singular wrist, repeat branches). None: every slot.
     n_branches: int | None = None
@@ -84,8 +89,14 @@ class AnalyticIK:
             if a.kind == "revolute" and not a.is_mimic:
                 self._revolute[a.q_index] = True
 
-    def _self_check(self, n: int = 24) -> None:
-        """Raise ModelError unless FK → raw IK recovers random in-limit configurations."""
+    def _self_check(self, n: int = PROOF_SAMPLES) -> None:
+        """Prove the closed form on this robot: raise ModelError unless FK → IK recovers ``n`` random configurations.
+
+        The configurations are seeded and within the limits. For each one, (1) a raw branch
+        candidate equals it (joint error ≤ 1e-6, revolute angles modulo 2π), and (2) the
+        verified solutions (within the limits, each reproducing the pose within
+        :data:`FK_TOL`) contain it: the one nearest it lies within 1e-6 of it.
+        """
         robot = self.robot
         q = robot.random_q(n, seed=12345)
         T = robot.fk(q, self.frame)
@@ -94,11 +105,19 @@ class AnalyticIK:
         rev = self._revolute
         diff[..., rev] = (diff[..., rev] + np.pi) % _TWO_PI - np.pi
         err = np.nanmax(np.abs(np.nan_to_num(diff, nan=np.inf)), axis=-1).min(axis=1)
+        what = "is not solved back"
+        if not np.any(err > 1e-6):
+            idx, sols = self.candidates(T, q)  # sorted by target, nearest q first
+            first = np.full(n, -1)
+            found, at = np.unique(idx, return_index=True)
+            first[found] = at
+            err = np.where(first >= 0, np.abs(sols[np.maximum(first, 0)] - q).max(axis=1), np.inf)
+            what = "has no verified solution (FK within 1e-9) equal to it"
         bad = np.flatnonzero(err > 1e-6)
         if bad.size:
             raise ModelError(
                 f"the {self.family} closed form does not reproduce robot '{robot.name}': "
-                f"FK of q = {np.round(q[bad[0]], 6).tolist()} is not solved back (joint error "
+                f"FK of q = {np.round(q[bad[0]], 6).tolist()} {what} (joint error "
                 f"{err[bad[0]]:.3g}); its geometry differs from what the solver assumes"
             )
 

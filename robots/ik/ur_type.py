@@ -45,6 +45,7 @@ class URTypeIK(AnalyticIK):
     """All IK solutions of a UR-type 6R arm (three parallel middle axes, intersecting last two)."""
 
     family = "UR-type (three parallel axes)"
+    key = "ur_type"
     n_branches = 8  # shoulder × wrist flip × elbow; slots 8-15 repeat them at a singular wrist
 
     def __init__(self, robot, frame: str = "tcp") -> None:
