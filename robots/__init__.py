@@ -100,9 +100,10 @@ from .cell import (  # noqa: E402
     cell_names,
     load_cell,
 )
+from .cell.compose import ArmPlacement, FixturePrimitive, compose_cell  # noqa: E402
 
 __all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
-            "load_cell"]
+            "load_cell", "ArmPlacement", "FixturePrimitive", "compose_cell"]
 
 # reachability maps: tool poses per voxel, orientation sets, HDF5 files
 from .orientations import (  # noqa: E402

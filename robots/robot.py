@@ -179,7 +179,7 @@ class Robot:
         changed = name != getattr(self, "_tcp_frame", name)
         self._tcp_frame = name
         self._frame_lookup = {**self._frame_ids, "tcp": self._frame_ids[name]}
-        if changed and self.__dict__.get("_analytic_ik") is not None:
+        if changed and (self.__dict__.get("_analytic_ik") is not None or self.__dict__.get("_ik_auto", False)):
             from .ik import attach_analytic_ik  # the closed form was proven for the old tcp: recognise again
 
             attach_analytic_ik(self)

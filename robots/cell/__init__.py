@@ -10,6 +10,15 @@ False
 
 from .cell import Cell, CellArm, Fixture, Shape
 from .collision import Clearance, Collisions
+from .compose import (
+    ArmPlacement,
+    CellDescription,
+    FixturePrimitive,
+    compose_cell,
+    compose_cell_urdf,
+    load_cell_description,
+    read_cell_description,
+)
 from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
 from .motion import ArmMotion, Contact, MotionCheck, check_motion
 from .pairs import AllowedPair, CollisionPair
@@ -34,4 +43,11 @@ __all__ = [
     "Contact",
     "MotionCheck",
     "check_motion",
+    "ArmPlacement",
+    "FixturePrimitive",
+    "CellDescription",
+    "compose_cell",
+    "compose_cell_urdf",
+    "load_cell_description",
+    "read_cell_description",
 ]

@@ -101,7 +101,8 @@ def load_cell(
     xacro_args: Mapping[str, Any] | None = None,
     **args: Any,
 ) -> Cell:
-    """Load a cell: a built-in name, a ``.xacro`` file (expanded behind the wall) or a ``.urdf`` file.
+    """Load a cell: a built-in name, a ``.xacro`` file (expanded behind the wall), a ``.urdf`` file
+    or a ``.toml`` cell description (any URDF arms under prefixes: :mod:`.compose`).
 
     Args:
         path_or_name: ``"mushroom_line"``, ``"aubo_food_station"`` (see :func:`cell_names`),
@@ -121,7 +122,7 @@ def load_cell(
     """
     all_args = {**(xacro_args or {}), **args}
     text_or_path = str(path_or_name)
-    is_file = text_or_path.endswith((".xacro", ".urdf")) or os.sep in text_or_path or "/" in text_or_path
+    is_file = text_or_path.endswith((".xacro", ".urdf", ".toml")) or os.sep in text_or_path or "/" in text_or_path
     if not is_file:
         source = cell_source_path(text_or_path)
         if all_args:
@@ -137,6 +138,12 @@ def load_cell(
     path = Path(path_or_name)
     if not path.is_file():
         raise CellNotFound(f"cell file {str(path)!r} does not exist; built-in cells: {', '.join(cell_names())}")
+    if path.name.endswith(".toml"):  # a cell description: arms by URDF file under prefixes (compose.py)
+        if all_args:
+            raise InvalidInput(f"{str(path)!r} is a cell description: it takes no xacro arguments")
+        from .compose import load_cell_description
+
+        return load_cell_description(path, packages=packages, seed=seed)
     if path.name.endswith(".xacro"):
         result = expand_xacro(path, all_args, packages=packages, limits=limits,
                               header=(f" Generated from {path.name} by pinarms. ",))

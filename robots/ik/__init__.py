@@ -97,6 +97,7 @@ def attach_analytic_ik(robot, family: str | None = None) -> str | None:
         found = recognise(robot)
         robot._analytic_ik = found.solver
         robot._ik_rejected = found.rejected
+        robot._ik_auto = True  # recognised again if the tcp frame changes
         return found.family
     robot._analytic_ik = analytic_solver(robot, family)
     robot._ik_rejected = {}
