@@ -92,33 +92,24 @@ class AnalyticIK:
     def _self_check(self, n: int = PROOF_SAMPLES) -> None:
         """Prove the closed form on this robot: raise ModelError unless FK → IK recovers ``n`` random configurations.
 
-        The configurations are seeded and within the limits. For each one, (1) a raw branch
-        candidate equals it (joint error ≤ 1e-6, revolute angles modulo 2π), and (2) the
-        verified solutions (within the limits, each reproducing the pose within
-        :data:`FK_TOL`) contain it: the one nearest it lies within 1e-6 of it.
+        The configurations are seeded and within the limits. The verified solutions of each
+        one's pose (within the limits, each reproducing the pose within :data:`FK_TOL`) must
+        contain it: the solution nearest it lies within 1e-6 of it (2π equivalents of a
+        revolute angle are taken nearest it, so they count as the same).
         """
         robot = self.robot
         q = robot.random_q(n, seed=12345)
-        T = robot.fk(q, self.frame)
-        cand = self.raw(T, q)
-        diff = cand - q[:, None, :]
-        rev = self._revolute
-        diff[..., rev] = (diff[..., rev] + np.pi) % _TWO_PI - np.pi
-        err = np.nanmax(np.abs(np.nan_to_num(diff, nan=np.inf)), axis=-1).min(axis=1)
-        what = "is not solved back"
-        if not np.any(err > 1e-6):
-            idx, sols = self.candidates(T, q)  # sorted by target, nearest q first
-            first = np.full(n, -1)
-            found, at = np.unique(idx, return_index=True)
-            first[found] = at
-            err = np.where(first >= 0, np.abs(sols[np.maximum(first, 0)] - q).max(axis=1), np.inf)
-            what = "has no verified solution (FK within 1e-9) equal to it"
+        idx, sols = self.candidates(robot.fk(q, self.frame), q)  # sorted by target, nearest q first
+        first = np.full(n, -1)
+        found, at = np.unique(idx, return_index=True)
+        first[found] = at
+        err = np.where(first >= 0, np.abs(sols[np.maximum(first, 0)] - q).max(axis=1), np.inf)
         bad = np.flatnonzero(err > 1e-6)
         if bad.size:
             raise ModelError(
-                f"the {self.family} closed form does not reproduce robot '{robot.name}': "
-                f"FK of q = {np.round(q[bad[0]], 6).tolist()} {what} (joint error "
-                f"{err[bad[0]]:.3g}); its geometry differs from what the solver assumes"
+                f"the {self.family} closed form does not reproduce robot '{robot.name}': the pose of "
+                f"q = {np.round(q[bad[0]], 6).tolist()} has no solution (reproducing it within {FK_TOL:g}) equal to "
+                f"it (joint error {err[bad[0]]:.3g}); its geometry differs from what the solver assumes"
             )
 
     # ------------------------------------------------------------------ public
