@@ -103,7 +103,9 @@ class AnalyticIK:
         first = np.full(n, -1)
         found, at = np.unique(idx, return_index=True)
         first[found] = at
-        err = np.where(first >= 0, np.abs(sols[np.maximum(first, 0)] - q).max(axis=1), np.inf)
+        err = np.full(n, np.inf)
+        if sols.shape[0]:
+            err = np.where(first >= 0, np.abs(sols[np.maximum(first, 0)] - q).max(axis=1), np.inf)
         bad = np.flatnonzero(err > 1e-6)
         if bad.size:
             raise ModelError(
