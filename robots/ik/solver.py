@@ -35,6 +35,8 @@ FK_TOL = 1e-9
 #: Candidates whose FK misses the target by less than this [m, rad] are polished, not dropped.
 POLISH_RANGE = 1e-5
 
+#: Most combinations of 2π equivalents per branch that ``equivalents=True`` lists.
+MAX_EQUIVALENTS = 4096
 #: Seeded random configurations each closed form must solve back when it is built (the load-time proof).
 PROOF_SAMPLES = 32
 
@@ -115,16 +117,36 @@ class AnalyticIK:
             )
 
     # ------------------------------------------------------------------ public
-    def _shifts(self, limit_tol: float = LIMIT_TOL) -> list[tuple[int, np.ndarray]]:
-        """Revolute joints whose range (widened to ``limit_tol``) admits more than one 2π equivalent, with their ``k``."""
+    def _shift_ranges(self, limit_tol: float = LIMIT_TOL) -> list[tuple[int, float, float]]:
+        """Revolute joints whose range (widened to ``limit_tol``) admits more than one 2π equivalent: ``(j, k_min, k_max)``.
+
+        Counts only (no arrays): a joint with a huge range (±1e9 rad) costs nothing here.
+        """
         widen = limit_tol - LIMIT_TOL
         lo, hi = self.robot.lower - widen, self.robot.upper + widen
         out = []
         for j in np.flatnonzero(self._revolute):
-            k = np.arange(np.ceil((lo[j] - np.pi) / _TWO_PI), np.floor((hi[j] + np.pi) / _TWO_PI) + 1)
-            if not (k.size == 1 and k[0] == 0.0):
-                out.append((int(j), k))
+            k0, k1 = float(np.ceil((lo[j] - np.pi) / _TWO_PI)), float(np.floor((hi[j] + np.pi) / _TWO_PI))
+            if not (k0 == 0.0 and k1 == 0.0):
+                out.append((int(j), k0, k1))
         return out
+
+    def _shifts(self, limit_tol: float = LIMIT_TOL) -> list[tuple[int, np.ndarray]]:
+        """The 2π multiples ``k`` of each joint of :meth:`_shift_ranges` (``equivalents=True`` lists them all).
+
+        Raises:
+            InvalidInput: more than :data:`MAX_EQUIVALENTS` combinations per branch.
+        """
+        ranges = self._shift_ranges(limit_tol)
+        total = float(np.prod([k1 - k0 + 1.0 for _, k0, k1 in ranges]))
+        if total > MAX_EQUIVALENTS:
+            from ..errors import InvalidInput
+
+            raise InvalidInput(
+                f"robot '{self.robot.name}': its joint ranges hold {total:.3g} combinations of 2π equivalents per "
+                f"branch; equivalents=True lists at most {MAX_EQUIVALENTS} (ask without equivalents)"
+            )
+        return [(j, np.arange(k0, k1 + 1.0)) for j, k0, k1 in ranges]
 
     def _dense(
         self, targets: np.ndarray, q_ref: np.ndarray, respect_limits: bool, equivalents: bool = False,
@@ -150,7 +172,7 @@ class AnalyticIK:
                 valid = np.repeat(valid, k.size, axis=1)
                 branch = np.repeat(branch, k.size, axis=1)
         elif respect_limits:  # each branch once: every angle at its equivalent within the limits nearest q_ref
-            js = [j for j, _ in self._shifts(limit_tol)]
+            js = [j for j, _, _ in self._shift_ranges(limit_tol)]
             if js:
                 lo_j, hi_j = lo[js], hi[js]
                 qj, ref = q[..., js], q_ref[:, None, js]

@@ -168,3 +168,17 @@ def test_an_explicit_family_that_does_not_fit_raises():
     arm = robots.from_urdf(DATA / "user_scara.urdf")
     with pytest.raises(ModelError):
         attach_analytic_ik(arm, "ur_type")
+
+
+def test_huge_joint_ranges_cost_nothing_at_load_and_equivalents_are_bounded():
+    from pinarms.robots.errors import InvalidInput
+
+    text = (DATA / "user_scara.urdf").read_text(encoding="utf-8").replace('lower="-2.6" upper="2.6"',
+                                                                          'lower="-1e9" upper="1e9"')
+    arm = robots.from_urdf_text(text)  # 3e8 equivalents of j1: never enumerated
+    assert arm.ik_family == "scara"
+    q = np.array([1.0e3, 2.0, 0.1, -1.0])
+    sols = arm.ik_all(arm.fk(q), q_ref=q)
+    assert np.abs(sols[0] - q).max() < 1e-6
+    with pytest.raises(InvalidInput, match="equivalents"):
+        arm.ik_all(arm.fk(q), equivalents=True)
