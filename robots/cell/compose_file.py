@@ -88,6 +88,8 @@ class CellDescription:
 
 # ----------------------------------------------------------------- reading files
 def _read_bounded(path: Path, limit: int, what: str) -> str:
+    if path.exists() and not path.is_file():
+        raise CellError(f"{what} {str(path)!r} is not a regular file")
     try:
         with open(path, "rb") as fh:
             data = fh.read(limit + 1)
@@ -167,8 +169,11 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CellError(f"cell description {str(path)!r} is not valid TOML: {exc}") from exc
+    except RecursionError:
+        raise CellError(f"cell description {str(path)!r} nests arrays or tables too deeply") from None
     _keys(doc, {"name", "arm", "fixture"}, {"arm"}, f"cell description {str(path)!r}")
-    name = _name(doc.get("name", re.sub(r"\W", "_", path.name.split(".")[0]) or "cell"), str(path))
+    default = re.sub(r"\W", "_", path.name.split(".")[0])
+    name = _name(doc.get("name", default if _NAME.match(default) else "cell"), str(path))
     arm_tables, fixture_tables = doc["arm"], doc.get("fixture", [])
     if not isinstance(arm_tables, list) or not isinstance(fixture_tables, list):
         raise CellError(f"{path}: write arms as [[arm]] tables and fixtures as [[fixture]] tables")

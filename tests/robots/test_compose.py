@@ -201,3 +201,12 @@ def test_an_arm_file_with_two_movable_subtrees_is_refused(folder):
     (folder / "user_scara.urdf").write_text(text, encoding="utf-8")
     with pytest.raises(CellError, match="one base"):
         compose_cell_urdf([ArmPlacement("a", "user_scara.urdf")], base_dir=folder)
+
+
+def test_deep_nesting_and_special_files_are_refused(folder):
+    (folder / "deep.toml").write_text("a = " + "[" * 50000 + "]" * 50000 + "\n", encoding="utf-8")
+    with pytest.raises(CellError, match="too deeply"):
+        read_cell_description(folder / "deep.toml")
+    os.mkfifo(folder / "pipe.urdf")
+    with pytest.raises(CellError, match="not a regular file"):
+        compose_cell_urdf([ArmPlacement("a", "pipe.urdf")], base_dir=folder)
