@@ -65,6 +65,7 @@ __all__ = [
     "load_cell_description",
 ]
 
+
 def _inside(real: Path, roots: Sequence[Path]) -> bool:
     return any(real == r or r in real.parents for r in roots)
 
@@ -83,7 +84,8 @@ def _arm_file(ref: str | os.PathLike, base_dir: Path, packages: Mapping[str, Pat
         root, rel_path = packages[pkg], rel
     else:
         root, rel_path = base_dir, text
-    if strict and (os.path.isabs(rel_path) or rel_path.startswith(("/", "\\", "file:")) or ".." in re.split(r"[/\\]", rel_path)):
+    parts = re.split(r"[/\\]", rel_path)
+    if strict and (os.path.isabs(rel_path) or rel_path.startswith(("/", "\\", "file:")) or ".." in parts):
         raise XacroForbidden(f"{where}: urdf {text!r} must be a relative path without '..' (inside the "
                              "description's folder) or package://PKG/path")
     target = Path(rel_path) if os.path.isabs(rel_path) else root / rel_path
@@ -135,25 +137,31 @@ def _parse_arm(path: Path, source: str) -> ET.Element:
 
 def _base_of(root: ET.Element, source: str) -> tuple[str, str]:
     """The arm's root link and its base (the one static link its movable joints hang from)."""
-    joints = root.findall("joint")
-    child_links = {j.find("child").get("link") for j in joints}
+    below: dict[str, list[tuple[str, str]]] = {}  # parent link -> [(joint type, child link)]
+    child_links = set()
+    for j in root.findall("joint"):
+        child = j.find("child").get("link")
+        child_links.add(child)
+        below.setdefault(j.find("parent").get("link"), []).append((j.get("type"), child))
     root_link = next(ln.get("name") for ln in root.findall("link") if ln.get("name") not in child_links)
     static, stack = [], [root_link]
-    while stack:
+    while stack:  # links reached from the root through fixed joints only
         link = stack.pop()
         static.append(link)
-        stack.extend(j.find("child").get("link") for j in joints
-                     if j.find("parent").get("link") == link and j.get("type") == "fixed")
-    bases = [ln for ln in static if any(j.find("parent").get("link") == ln and j.get("type") in _MOVABLE for j in joints)]
+        stack.extend(child for kind, child in below.get(link, ()) if kind == "fixed")
+    bases = [ln for ln in static if any(kind in _MOVABLE for kind, _ in below.get(ln, ()))]
     if len(bases) != 1:
         raise CellError(f"{source}: an arm has one base (a link reached through fixed joints from the root, with "
-                        f"movable joints below it); found {len(bases)}: {bases}")
+                        f"movable joints below it); found {len(bases)}: {bases[:5]}")
     return root_link, bases[0]
 
 
 def _arm_elements(arm: ArmPlacement, path: Path, base_dir: Path, packages: Mapping[str, Path]) -> list[ET.Element]:
     """The arm's materials, links and joints, prefixed, and the fixed joint that mounts it in the world."""
     source = f"URDF {str(path)!r} of arm {arm.name!r}"
+    if path.name.endswith(".xacro"):
+        raise CellError(f"{source} is a xacro file: expand it first (`pinarms urdf build {path.name} -o arm.urdf`) "
+                        "or place it from a xacro cell")
     root = _parse_arm(path, source)
     root_link, base = _base_of(root, source)
     link_names = {ln.get("name") for ln in root.findall("link")}
