@@ -41,7 +41,7 @@ from .srdf import contact_pairs
 __all__ = ["EngineComparison", "compare_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
 
 #: Agreement asked of the two engines on a pair of primitives [m] (both iterate to ~1e-6 m or better).
-TOLERANCE_M = 1e-5
+TOLERANCE_M = 1e-6
 #: Largest distance MuJoCo is asked to measure [m]; pairs farther apart in pinarms are not compared.
 DISTMAX = 0.5
 
@@ -96,8 +96,9 @@ class EngineComparison:
             f"  min distance  pinarms (coal) {self.min_pinarms * 1e3:9.4f} mm  ({self.min_pinarms_pair})",
             f"  min distance  MuJoCo         {self.min_mujoco * 1e3:9.4f} mm  ({self.min_mujoco_pair})",
             f"  max |difference| primitives  {self.max_abs_difference:.3e} m (tolerance {self.tolerance:g} m)",
-            f"  meshes (MuJoCo: convex hull) MuJoCo above coal by at most {self.max_mesh_excess:.3e} m, "
-            f"below by at most {self.max_mesh_gap:.3e} m",
+            (f"  meshes (MuJoCo: convex hull) MuJoCo above coal by at most {self.max_mesh_excess:.3e} m, "
+             f"below by at most {self.max_mesh_gap:.3e} m") if math.isfinite(self.max_mesh_excess)
+            else "  meshes: no pair with a mesh",
             f"  contacts: pinarms {self.contacts_pinarms}, MuJoCo {self.contacts_mujoco}, "
             f"MuJoCo only {self.mujoco_only}  -> {'agree' if self.agrees else 'DISAGREE'}",
         ]
