@@ -2,7 +2,7 @@
 
 :func:`controller_trajectory` samples a planned motion at a user-chosen rate (125 Hz,
 500 Hz, ...): instants ``k / rate`` from the start, plus the end instant (so the last point
-is the motion's end; it follows the one before by less than one period). Instants are
+is the motion's end, to the nanosecond below; it follows the one before by less than one period). Instants are
 whole nanoseconds (``time_from_start`` is ``{sec, nanosec}``), and every point is the
 trajectory evaluated at exactly its written instant: positions, velocities and
 accelerations reproduce it to float precision, far below 1e-9. Every position is checked
@@ -171,7 +171,7 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
     """
     hz = _rate(rate)
     names, lower, upper, start, end, sample = _source(source, robot, arm, cycles)
-    duration_ns = int(round((end - start) * 1e9))
+    duration_ns = int(math.floor((end - start) * 1e9))  # the last instant never after the end
     step_ns = 1e9 / hz
     count = int(math.floor(duration_ns / step_ns * (1.0 + 1e-12))) + 1
     if count > MAX_POINTS:
