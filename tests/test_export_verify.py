@@ -45,7 +45,7 @@ def test_mujoco_sees_the_contacts_pinarms_sees(line, free_cycles):
     """A cycle through a box wall: both engines report contact, at the same instants and pairs."""
     result = compare_in_mujoco(line, free_cycles["left"], arm="left", samples=150)
     assert result.contacts_pinarms > 0
-    assert result.contacts_mujoco > 0
+    assert result.contacts_mujoco == result.contacts_pinarms
     assert result.min_mujoco < 0 and result.min_pinarms < 0
     assert result.mujoco_only == 0
     assert result.max_abs_difference <= TOLERANCE_M
@@ -87,7 +87,7 @@ def test_shipped_motions_agree_in_mujoco(tmp_path):
 
     from pinarms.cli import cli
 
-    run = CliRunner().invoke(cli, ["verify", "shipped", "--samples", "200", "--controller-dir", str(tmp_path),
+    run = CliRunner().invoke(cli, ["verify", "shipped", "--samples", "100", "--controller-dir", str(tmp_path),
                                    "--rate", "125", "--json"])
     assert run.exit_code == 0, run.output
     doc = json.loads(run.output)
@@ -98,7 +98,7 @@ def test_shipped_motions_agree_in_mujoco(tmp_path):
         assert r["max_abs_difference"] <= TOLERANCE_M
         assert abs(r["min_mujoco"] - r["min_pinarms"]) <= TOLERANCE_M
         assert r["min_pinarms"] > 0.0
-    assert len(doc["written"]) == 2 * 7
+    assert len(doc["written"]) == 2 * 6  # YAML and CSV: four motions, and the schedule per arm
 
 
 def test_cli_bad_rate_fails_before_planning():

@@ -59,7 +59,8 @@ class EngineComparison:
             ``max_mesh_excess``: largest ``d_mujoco − d_pinarms`` over pairs with a mesh (≤ tolerance
             when MuJoCo's hull is conservative), ``max_mesh_gap`` the largest ``d_pinarms − d_mujoco`` there.
         contacts_pinarms: (instant, pair) in contact for pinarms (distance ≤ 0);
-            ``contacts_mujoco``: contacts of MuJoCo's collision pass between checked pairs;
+            ``contacts_mujoco``: (instant, pair) with a contact from MuJoCo's collision pass
+            (a box on a box gives several contact points: counted once);
             ``mujoco_only``: (instant, pair) where MuJoCo touches and pinarms says clear.
         tolerance: :data:`TOLERANCE_M`.
     """
@@ -99,7 +100,7 @@ class EngineComparison:
             (f"  meshes (MuJoCo: convex hull) MuJoCo above coal by at most {self.max_mesh_excess:.3e} m, "
              f"below by at most {self.max_mesh_gap:.3e} m") if math.isfinite(self.max_mesh_excess)
             else "  meshes: no pair with a mesh",
-            f"  contacts: pinarms {self.contacts_pinarms}, MuJoCo {self.contacts_mujoco}, "
+            f"  contacts (instant, pair): pinarms {self.contacts_pinarms}, MuJoCo {self.contacts_mujoco}, "
             f"MuJoCo only {self.mujoco_only}  -> {'agree' if self.agrees else 'DISAGREE'}",
         ]
 
@@ -188,7 +189,6 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
     d_mj = np.empty_like(d_pin)
     set_q = _mujoco_setter(model, cell)
     fromto = np.zeros(6)
-    contacts_mj = 0
     mj_touch = np.zeros_like(d_pin, dtype=bool)
     for i, q in enumerate(qs):
         set_q(data, q)
@@ -197,7 +197,6 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
         for c in range(data.ncon):
             k = checked.get(frozenset((int(data.contact[c].geom1), int(data.contact[c].geom2))))
             if k is not None and data.contact[c].dist <= 0.0:
-                contacts_mj += 1
                 mj_touch[i, k] = True
         for k, (a, b) in enumerate(ids):
             d_mj[i, k] = mujoco.mj_geomDistance(model, data, int(a), int(b), DISTMAX, fromto)
@@ -213,7 +212,7 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
         max_abs_difference=float(np.abs(diff[prim]).max()) if prim.any() else 0.0,
         max_mesh_excess=float(diff[mesh].max()) if mesh.any() else -math.inf,
         max_mesh_gap=float((-diff[mesh]).max()) if mesh.any() else 0.0,
-        contacts_pinarms=int((d_pin <= 0.0).sum()), contacts_mujoco=contacts_mj,
+        contacts_pinarms=int((d_pin <= 0.0).sum()), contacts_mujoco=int(mj_touch.sum()),
         mujoco_only=int(((mj_touch | (d_mj < 0.0)) & (d_pin > 0.0)).sum()),
     )
 
