@@ -147,3 +147,40 @@ def test_export_cell_refuses_non_empty_folder(tmp_path):
     with pytest.raises(InvalidInput, match="not empty"):
         export_cell("mushroom_line", tmp_path / "x", mjcf=False)
     assert (tmp_path / "x" / "keep.txt").read_text() == "mine"
+
+
+def test_cell_states_reach_pinocchio(tmp_path):
+    cell = load_cell("mushroom_line")
+    q_left, q_right = np.array([0.3, -0.4, 0.05, 0.2]), np.array([-0.3, 0.4, 0.1, -0.2])
+    out = export_cell(cell, tmp_path / "s", mjcf=False, states={"pick": {"left": q_left},
+                                                                 "both": {"left": q_left, "right": q_right}})
+    model, _ = _pinocchio_pairs(out.urdf, out.srdf, out.folder)
+    pick = model.referenceConfigurations["pick"]
+    np.testing.assert_allclose(pick, cell.robot.q_to_pinocchio(cell.q_from_arms({"left": q_left})), atol=0)
+    both = model.referenceConfigurations["both"]
+    np.testing.assert_allclose(both, cell.robot.q_to_pinocchio(cell.q_from_arms({"left": q_left, "right": q_right})),
+                               atol=0)
+    root = ET.parse(out.srdf).getroot()
+    assert root.find("group_state[@name='both']").get("group") == "cell"
+    assert root.find("group_state[@name='left_home']").get("group") == "left"
+    with pytest.raises(InvalidInput, match="no arm"):
+        export_cell(cell, tmp_path / "t", mjcf=False, states={"pick": {"middle": q_left}})
+
+
+def test_cli_exports_a_cell(tmp_path):
+    import json
+
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    run = CliRunner().invoke(cli, ["urdf", "export", "aubo_food_station", str(tmp_path / "c"), "--srdf", "--mjcf",
+                                   "--json"])
+    assert run.exit_code == 0, run.output
+    doc = json.loads(run.output)
+    assert doc["meshes"] == ["meshes/hopper.stl"] and doc["sites"] == ["aubo_flange", "aubo_tcp"]
+    assert mujoco.MjModel.from_xml_path(doc["mjcf"]).nsite == 2
+    model, pairs = _pinocchio_pairs(doc["urdf"], doc["srdf"], doc["folder"])
+    assert len(pairs) == len(contact_pairs(load_cell("aubo_food_station")))
+    run = CliRunner().invoke(cli, ["urdf", "export", "scara_mushroom", str(tmp_path / "a"), "--srdf"])
+    assert run.exit_code == 0 and (tmp_path / "a" / "scara_mushroom.srdf").is_file()

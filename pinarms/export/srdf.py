@@ -86,8 +86,8 @@ def _state_joints(cell: Any, arm: Any, q: Any, state: str) -> list[tuple[str, fl
     bad = np.flatnonzero((arr < lo - 1e-12) | (arr > hi + 1e-12))
     if bad.size:
         j = int(bad[0])
-        raise InvalidInput(f"state {state!r} of arm {arm.name!r}: joint {arm.robot.joint_names[j]} = {arr[j]!r} "
-                           f"is outside its limits [{lo[j]!r}, {hi[j]!r}]")
+        raise InvalidInput(f"state {state!r} of arm {arm.name!r}: joint {arm.robot.joint_names[j]} = {float(arr[j])!r} "
+                           f"is outside its limits [{float(lo[j])!r}, {float(hi[j])!r}]")
     return [(arm.prefix + name, float(v)) for name, v in zip(arm.robot.joint_names, arr)]
 
 

@@ -184,8 +184,8 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
     bad = (q < np.asarray(lower) - 1e-12) | (q > np.asarray(upper) + 1e-12)
     if bad.any():
         i, j = (int(v[0]) for v in np.nonzero(bad))
-        raise LimitViolation(f"joint {names[j]} = {q[i, j]!r} at t = {t[i] - start:.9f} s is outside its limits "
-                             f"[{lower[j]!r}, {upper[j]!r}]: the trajectory cannot be sent as it is")
+        raise LimitViolation(f"joint {names[j]} = {float(q[i, j])!r} at t = {t[i] - start:.9f} s is outside its limits "
+                             f"[{float(lower[j])!r}, {float(upper[j])!r}]: the trajectory cannot be sent as it is")
     return ControllerTrajectory(names, ticks, q, qd, qdd)
 
 
