@@ -34,7 +34,7 @@ def scara():
 def move(scara):
     q0 = np.zeros(scara.nq)
     q1 = 0.5 * (scara.lower + scara.upper) + 0.3 * (scara.upper - scara.lower)
-    return multi_quintic([0.0, 0.4, 0.777], np.stack([q0, 0.5 * (q0 + q1) + 0.05, q1]), velocities="heuristic")
+    return multi_quintic([0.0, 1.1, 2.077], np.stack([q0, 0.5 * (q0 + q1) + 0.05, q1]), velocities="heuristic")
 
 
 @pytest.mark.parametrize("rate", [125, 500, 333.3])
@@ -115,3 +115,11 @@ def test_unwritable_target_leaves_nothing(scara, move, tmp_path):
     write_trajectory_csv(tmp_path / "m.csv", sampled)
     assert (tmp_path / "m.csv").read_text().startswith("time_s,pos:")
     assert [p.name for p in tmp_path.iterdir()] == ["m.csv"]
+
+
+def test_too_fast_is_refused(scara, move):
+    fast = move.scaled(0.05)
+    peak = float((fast.peaks().velocity / scara.velocity_limit).max())
+    assert peak > 1.0
+    with pytest.raises(LimitViolation, match="velocity limit"):
+        controller_trajectory(fast, 125, robot=scara)

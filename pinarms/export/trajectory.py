@@ -6,7 +6,8 @@ is the motion's end, to the nanosecond below; it follows the one before by less 
 whole nanoseconds (``time_from_start`` is ``{sec, nanosec}``), and every point is the
 trajectory evaluated at exactly its written instant: positions, velocities and
 accelerations reproduce it to float precision, far below 1e-9. Every position is checked
-against the joint limits (a violation is an error, never clamped).
+against the joint limits and every velocity against the URDF's velocity limits (a
+violation is an error, never clamped).
 
 Sources: a :class:`pinarms.planning.Trajectory` with its robot, a planned cycle
 (:class:`pinarms.optim.CycleResult`, with its robot or cell arm), a planned move
@@ -98,22 +99,23 @@ def line_arm_sampler(schedule: Any, cycles: Mapping[str, Any], arm: str) -> tupl
 
 
 def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] | None):
-    """``(joint names, lower, upper, start, end, sample)`` of what is to be written."""
+    """``(joint names, (lower, upper, velocity limit), start, end, sample)`` of what is to be written."""
     from pinarms.optim import CycleResult, LineSchedule
     from pinarms.optim.motion import MotionPlan
     from pinarms.planning import Trajectory
 
     if isinstance(source, MotionPlan):
         cell = source.cell
-        names, lo, hi = [], [], []
+        names, lo, hi, vmax = [], [], [], []
         for name in source.arms:
             a = cell.arm(name)
             names += [a.prefix + j for j in a.robot.joint_names]
             lo.append(a.robot.lower)
             hi.append(a.robot.upper)
+            vmax.append(a.robot.velocity_limit)
         traj = source.trajectory
-        return tuple(names), np.concatenate(lo), np.concatenate(hi), traj.start_time, traj.end_time, \
-            lambda t: traj.sample(t)[:3]
+        limits = (np.concatenate(lo), np.concatenate(hi), np.concatenate(vmax))
+        return tuple(names), limits, traj.start_time, traj.end_time, lambda t: traj.sample(t)[:3]
     if isinstance(source, LineSchedule):
         if cycles is None or arm is None:
             raise InvalidInput("a line schedule is written one arm at a time: give arm= and the cycles= it scheduled")
@@ -122,8 +124,7 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
             raise InvalidInput("a line schedule needs its cell as robot=")
         _check_width(cycles[arm].trajectory.n_joints if arm in cycles else -1, cell_arm.robot, f"arm {arm!r}")
         start, end, sample = line_arm_sampler(source, cycles, arm)
-        return tuple(cell_arm.prefix + j for j in cell_arm.robot.joint_names), cell_arm.robot.lower, \
-            cell_arm.robot.upper, start, end, sample
+        return tuple(cell_arm.prefix + j for j in cell_arm.robot.joint_names), _limits(cell_arm.robot), start, end, sample
     prefix = ""
     if robot is not None and hasattr(robot, "arm"):  # a cell: the arm's prefixed names
         if arm is None:
@@ -143,8 +144,12 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
         raise InvalidInput(f"cannot write {type(source).__name__} for a controller: give a Trajectory, a CycleResult, "
                            "a MotionPlan or a LineSchedule")
     _check_width(traj.n_joints, robot, "the trajectory")
-    return tuple(prefix + j for j in robot.joint_names), robot.lower, robot.upper, traj.start_time, traj.end_time, \
+    return tuple(prefix + j for j in robot.joint_names), _limits(robot), traj.start_time, traj.end_time, \
         lambda t: traj.sample(t)[:3]
+
+
+def _limits(robot: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return robot.lower, robot.upper, np.asarray(robot.velocity_limit, dtype=float)
 
 
 def _check_width(n: int, robot: Any, what: str) -> None:
@@ -170,7 +175,7 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
         LimitViolation: a sample outside the joint limits. InvalidInput: anything else missing.
     """
     hz = _rate(rate)
-    names, lower, upper, start, end, sample = _source(source, robot, arm, cycles)
+    names, (lower, upper, vmax), start, end, sample = _source(source, robot, arm, cycles)
     duration_ns = int(math.floor((end - start) * 1e9))  # the last instant never after the end
     step_ns = 1e9 / hz
     count = int(math.floor(duration_ns / step_ns * (1.0 + 1e-12))) + 1
@@ -186,6 +191,12 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
         i, j = (int(v[0]) for v in np.nonzero(bad))
         raise LimitViolation(f"joint {names[j]} = {float(q[i, j])!r} at t = {t[i] - start:.9f} s is outside its limits "
                              f"[{float(lower[j])!r}, {float(upper[j])!r}]: the trajectory cannot be sent as it is")
+    limit = np.where(vmax > 0, vmax, np.inf)  # a URDF velocity of 0 means "not given"
+    fast = np.abs(qd) > limit * (1.0 + 1e-9) + 1e-12
+    if fast.any():
+        i, j = (int(v[0]) for v in np.nonzero(fast))
+        raise LimitViolation(f"joint {names[j]} moves at {float(qd[i, j])!r} at t = {t[i] - start:.9f} s, beyond its "
+                             f"velocity limit {float(limit[j])!r}: re-time the trajectory under the robot's limits")
     return ControllerTrajectory(names, ticks, q, qd, qdd)
 
 
@@ -242,7 +253,7 @@ def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) ->
     import yaml
 
     with open(path, encoding="utf-8") as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml when present
     try:
         names = tuple(str(n) for n in doc["joint_names"])
         points = doc["points"]
