@@ -31,18 +31,22 @@ def verify_shipped_cmd(samples: int, no_line: bool, controller_dir: str | None, 
     """
     from pinarms.export import compare_in_mujoco
     from pinarms.export.shipped import shipped_motions
-
     from pinarms.export.trajectory import _rate
+    from pinarms.progress import ProgressBar, wanted
 
     if controller_dir is not None:
         _rate(rate)  # a bad rate fails before the planning
+    with ProgressBar("planning the shipped motions", enabled=wanted(as_json)) as bar:
+        motions = shipped_motions(line=not no_line, progress=bar)
     results, written = [], []
-    for motion in shipped_motions(line=not no_line):
-        result = compare_in_mujoco(motion.cell, motion.source, arm=motion.arm, cycles=motion.cycles or None,
-                                   samples=samples)
-        results.append((motion.name, result))
-        if controller_dir is not None:
-            written += _write_controller_files(Path(controller_dir), motion, rate)
+    with ProgressBar("replaying in MuJoCo", total=len(motions), enabled=wanted(as_json)) as bar:
+        for k, motion in enumerate(motions):
+            result = compare_in_mujoco(motion.cell, motion.source, arm=motion.arm, cycles=motion.cycles or None,
+                                       samples=samples)
+            results.append((motion.name, result))
+            if controller_dir is not None:
+                written += _write_controller_files(Path(controller_dir), motion, rate)
+            bar(k + 1)
     lines = [line for _, r in results for line in r.lines()]
     lines += [f"wrote {p}" for p in written]
     emit(as_json, {"motions": {name: r.as_dict() for name, r in results}, "written": [str(p) for p in written]}, lines)

@@ -26,8 +26,17 @@ class ShippedMotion:
     cycles: dict = field(default_factory=dict)
 
 
-def shipped_motions(*, line: bool = True, n_offsets: int = 24) -> list[ShippedMotion]:
-    """Plan the shipped motions (about 10 s; ``line=False`` skips the mushroom line, 15 s more)."""
+def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Any = None) -> list[ShippedMotion]:
+    """Plan the shipped motions (about 10 s; ``line=False`` skips the mushroom line, 15 s more).
+
+    ``progress(done, total)`` is called after each motion is planned.
+    """
+    total = 5 if line else 2
+
+    def step(done: int) -> None:
+        if progress is not None:
+            progress(done, total)
+
     from pinarms import optim
     from pinarms.demo import LINE_TASKS, _planned_move_001
     from pinarms.robots.cell import load_cell
@@ -39,8 +48,10 @@ def shipped_motions(*, line: bool = True, n_offsets: int = 24) -> list[ShippedMo
                            lift=0.05, dwell=0.2)
     out.append(ShippedMotion("station_cycle", station, optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02),
                              arm="aubo"))
+    step(1)
     plan = _planned_move_001()[1]["plan"]
     out.append(ShippedMotion("crate_guard_move", plan.cell, plan))
+    step(2)
     if line:
         cell = load_cell("mushroom_line")
         cycles = {}
@@ -49,6 +60,8 @@ def shipped_motions(*, line: bool = True, n_offsets: int = 24) -> list[ShippedMo
             spec = optim.PickPlace(a.to_base(np.array(pick)), a.to_base(np.array(place)), lift=0.03, dwell=0.15)
             cycles[name] = optim.plan_cycle(a.robot, spec, cell=cell, clearance=0.02)
             out.append(ShippedMotion(f"line_{name}_cycle", cell, cycles[name], arm=name))
+            step(len(out))
         schedule = optim.schedule_line(cell, cycles, margin=0.01, n_offsets=n_offsets)
         out.append(ShippedMotion("line_schedule", cell, schedule, cycles=cycles))
+        step(len(out))
     return out
