@@ -175,12 +175,16 @@ def test_cli_exports_a_cell(tmp_path):
     from pinarms.cli import cli
 
     run = CliRunner().invoke(cli, ["urdf", "export", "aubo_food_station", str(tmp_path / "c"), "--srdf", "--mjcf",
-                                   "--json"])
+                                   "--study-poses", "--json"])
     assert run.exit_code == 0, run.output
     doc = json.loads(run.output)
     assert doc["meshes"] == ["meshes/hopper.stl"] and doc["sites"] == ["aubo_flange", "aubo_tcp"]
     assert mujoco.MjModel.from_xml_path(doc["mjcf"]).nsite == 2
     model, pairs = _pinocchio_pairs(doc["urdf"], doc["srdf"], doc["folder"])
     assert len(pairs) == len(contact_pairs(load_cell("aubo_food_station")))
+    pick, place = model.referenceConfigurations["pick"], model.referenceConfigurations["place"]
+    assert np.abs(pick - place).max() > 0.5  # the demo's pick and place poses, not home
+    run = CliRunner().invoke(cli, ["urdf", "export", "aubo_i3", str(tmp_path / "p"), "--study-poses", "--srdf"])
+    assert run.exit_code == 2 and "built-in cells" in run.output
     run = CliRunner().invoke(cli, ["urdf", "export", "scara_mushroom", str(tmp_path / "a"), "--srdf"])
     assert run.exit_code == 0 and (tmp_path / "a" / "scara_mushroom.srdf").is_file()

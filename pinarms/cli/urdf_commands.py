@@ -101,9 +101,11 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
               help="Also write the SRDF (MoveIt: groups, end effector, home, disable_collisions from pinarms' pairs).")
 @click.option("--cell", "is_cell", is_flag=True,
               help="ROBOT is a cell file (a built-in cell name is recognised without it).")
+@click.option("--study-poses", is_flag=True,
+              help="With --srdf, a built-in cell: also the demo's pick/place poses as named states (plans its cycles).")
 @json_option
 def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf: bool, is_cell: bool,
-                    as_json: bool) -> None:
+                    study_poses: bool, as_json: bool) -> None:
     """Write ROBOT (an arm or a whole cell) as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
     With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
@@ -112,10 +114,18 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
     (a built-in cell name, or --cell FILE) is written as URDF, plus SRDF and MJCF when asked.
     """
     from pinarms.export import export_cell, export_mjcf, export_urdf
-    from pinarms.robots.cell import cell_names
+    from pinarms.robots.cell import cell_names, load_cell
 
+    if study_poses and not srdf:
+        raise click.UsageError("--study-poses are SRDF states: add --srdf")
     if is_cell or robot in cell_names():
-        result = export_cell(robot, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite)
+        cell = load_cell(robot)
+        states = None
+        if study_poses:
+            from pinarms.export.shipped import study_states
+
+            states = study_states(cell)
+        result = export_cell(cell, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite, states=states)
         files = [p for p in (result.urdf, result.srdf, result.mjcf) if p is not None]
         emit(
             as_json,
@@ -124,6 +134,8 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
             [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)"],
         )
         return
+    if study_poses:
+        raise click.UsageError("--study-poses apply to the built-in cells")
     if mjcf:
         if srdf:
             raise click.UsageError("--srdf goes with the URDF export (run it once without --mjcf)")
