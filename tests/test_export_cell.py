@@ -188,3 +188,24 @@ def test_cli_exports_a_cell(tmp_path):
     assert run.exit_code == 2 and "built-in cells" in run.output
     run = CliRunner().invoke(cli, ["urdf", "export", "scara_mushroom", str(tmp_path / "a"), "--srdf"])
     assert run.exit_code == 0 and (tmp_path / "a" / "scara_mushroom.srdf").is_file()
+
+
+def test_cell_with_a_linkage_keeps_mimic_as_equalities(tmp_path):
+    """The koji turner's parallelogram (two <mimic> joints) as a one-arm cell: MuJoCo equalities, tcp site at FK."""
+    from pinarms import robots
+    from pinarms.export.cell import cell_of_urdf_folder
+
+    robot = robots.load("koji_turner")
+    cell = cell_of_urdf_folder(robot, export_urdf(robot, tmp_path / "u").folder)
+    out = export_cell(cell, tmp_path / "c")
+    model = mujoco.MjModel.from_xml_path(str(out.mjcf))
+    assert model.neq == 2
+    data = mujoco.MjData(model)
+    q = np.array([0.3, 0.4, -0.5, 0.2])
+    for name, value in zip(cell.joint_names, q):
+        data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
+    for k in range(model.neq):
+        dep, lead = model.jnt_qposadr[model.eq_obj1id[k]], model.jnt_qposadr[model.eq_obj2id[k]]
+        data.qpos[dep] = np.polyval(model.eq_data[k, :5][::-1], data.qpos[lead])
+    mujoco.mj_kinematics(model, data)
+    np.testing.assert_allclose(data.site("tcp").xpos, cell.world_pose(q, "tcp")[:3, 3], atol=1e-9)
