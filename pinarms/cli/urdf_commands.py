@@ -95,17 +95,50 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
 @click.argument("out_dir", type=click.Path(file_okay=True))
 @click.option("--overwrite", is_flag=True, help="Replace a non-empty folder.")
 @click.option("--mjcf", is_flag=True,
-              help="Write a MuJoCo model (MJCF) instead, with sites at the flange and tcp (needs: pip install mujoco).")
+              help="Write a MuJoCo model (MJCF) instead (a cell: beside its URDF), with sites at the flange and tcp "
+                   "(needs: pip install mujoco).")
+@click.option("--srdf", is_flag=True,
+              help="Also write the SRDF (MoveIt: groups, end effector, home, disable_collisions from pinarms' pairs).")
+@click.option("--cell", "is_cell", is_flag=True,
+              help="ROBOT is a cell file (a built-in cell name is recognised without it).")
+@click.option("--study-poses", is_flag=True,
+              help="With --srdf, a built-in cell: also the demo's pick/place poses as named states (plans its cycles).")
 @json_option
-def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, as_json: bool) -> None:
-    """Write ROBOT as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
+def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf: bool, is_cell: bool,
+                    study_poses: bool, as_json: bool) -> None:
+    """Write ROBOT (an arm or a whole cell) as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
     With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
-    at the flange and at the tcp, mimic joints as equality constraints.
+    at the flange and at the tcp, mimic joints as equality constraints. With --srdf it also
+    holds ROBOT.srdf; the URDF then gives each collision element its own link. A cell
+    (a built-in cell name, or --cell FILE) is written as URDF, plus SRDF and MJCF when asked.
     """
-    from pinarms.export import export_mjcf, export_urdf
+    from pinarms.export import export_cell, export_mjcf, export_urdf
+    from pinarms.robots.cell import cell_names, load_cell
 
+    if study_poses and not srdf:
+        raise click.UsageError("--study-poses are SRDF states: add --srdf")
+    if is_cell or robot in cell_names():
+        cell = load_cell(robot)
+        states = None
+        if study_poses:
+            from pinarms.export.shipped import study_states
+
+            states = study_states(cell)
+        result = export_cell(cell, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite, states=states)
+        files = [p for p in (result.urdf, result.srdf, result.mjcf) if p is not None]
+        emit(
+            as_json,
+            {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "mjcf": result.mjcf,
+             "sites": list(result.sites), "meshes": list(result.meshes)},
+            [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)"],
+        )
+        return
+    if study_poses:
+        raise click.UsageError("--study-poses apply to the built-in cells")
     if mjcf:
+        if srdf:
+            raise click.UsageError("--srdf goes with the URDF export (run it once without --mjcf)")
         result = export_mjcf(load_robot(robot), out_dir, overwrite=overwrite)
         emit(
             as_json,
@@ -113,9 +146,10 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, as_js
             [f"wrote {result.mjcf} (sites: {', '.join(result.sites)}) and {len(result.meshes)} mesh file(s)"],
         )
         return
-    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite)
+    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf)
     emit(
         as_json,
-        {"folder": result.folder, "urdf": result.urdf, "meshes": list(result.meshes)},
-        [f"wrote {result.urdf} and {len(result.meshes)} mesh file(s)"],
+        {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes)},
+        [f"wrote {result.urdf}{'' if result.srdf is None else f' and {result.srdf}'} and "
+         f"{len(result.meshes)} mesh file(s)"],
     )

@@ -47,6 +47,7 @@ class ExportedURDF:
     folder: Path
     urdf: Path
     meshes: tuple[str, ...]
+    srdf: Path | None = None
 
 
 def mesh_references(urdf_text: str) -> list[str]:
@@ -160,7 +161,8 @@ def _publish(out: Path, fill: Callable[[Path], None]) -> None:
         raise
 
 
-def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overwrite: bool = False) -> ExportedURDF:
+def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overwrite: bool = False,
+                srdf: bool = False, states: dict | None = None) -> ExportedURDF:
     """Write a self-contained URDF folder for ``robot_or_name`` into ``out_dir``.
 
     Args:
@@ -168,6 +170,12 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
         out_dir: the folder to create. It must not exist or be empty, unless ``overwrite``.
         overwrite: replace an existing non-empty folder (the old one is removed only
             after the new one is complete).
+        srdf: also write ``<name>.srdf`` (:mod:`pinarms.export.srdf`: the arm's group,
+            end effector, ``home`` and ``states``, disable_collisions from pinarms' pair
+            classification). The URDF then gives every collision element its own link
+            (:func:`pinarms.export.cell.one_collision_per_link`) instead of being kept byte
+            for byte, so that the SRDF can name every pair.
+        states: with ``srdf``, extra named states ``{name: q (nq,)}`` [rad or m].
 
     Returns:
         :class:`ExportedURDF` with the folder, the URDF path and the copied mesh files.
@@ -181,6 +189,11 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
     robot = robots.load(robot_or_name) if isinstance(robot_or_name, str) else robot_or_name
     if not isinstance(robot, Robot):
         raise InvalidInput(f"export_urdf takes a robots.Robot or a robot name, got {robot_or_name!r}")
+    if srdf:
+        from .cell import export_robot_with_srdf
+
+        done = export_robot_with_srdf(robot, out_dir, overwrite=overwrite, states=states)
+        return ExportedURDF(folder=done.folder, urdf=done.urdf, meshes=done.meshes, srdf=done.srdf)
     out = _check_folder(out_dir, overwrite)
     mapping: dict[str, str] = {}
     copies: dict[PurePosixPath, Path] = {}
@@ -274,43 +287,69 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
 
     def fill(tmp: Path) -> None:
         staged = export_urdf(robot, tmp / "urdf")
-        dae = any(m.lower().endswith(".dae") for m in staged.meshes)
-        extension = (f'<mujoco><compiler fusestatic="false" discardvisual="{"true" if dae else "false"}" '
-                     'strippath="false"/></mujoco>')
-        text = staged.urdf.read_text(encoding="utf-8")
-        head, end, tail = text.rpartition("</robot>")
-        compiled = staged.folder / f"{robot.name}.mujoco.urdf"
-        compiled.write_text(f"{head}{extension}\n{end}{tail}", encoding="utf-8")
-        try:
-            model = mujoco.MjModel.from_xml_path(str(compiled))
-            mujoco.mj_saveLastXML(str(tmp / name), model)
-        except Exception as exc:  # MuJoCo raises ValueError with its own message
-            raise ModelError(f"MuJoCo refuses robot '{robot.name}': {' '.join(str(exc).split())}") from exc
-        tree = ET.parse(tmp / name)
-        for frame in sites:
-            body = tree.getroot().find(f".//body[@name='{frame}']")
-            if body is None:  # pragma: no cover - fusestatic="false" keeps every link
-                raise ModelError(f"MuJoCo dropped the body {frame!r} of robot '{robot.name}'")
-            ET.SubElement(body, "site", {"name": frame, "size": f"{SITE_SIZE_M:g}", "rgba": "0.85 0.15 0.15 1"})
-        _mesh_paths_relative_to(tree, staged.folder, tmp)
-        step = float(model.opt.timestep)
-        for eq in tree.getroot().iter("equality"):
-            for joint in eq.iter("joint"):  # a linkage is rigid: the stiffest constraint the time step allows
-                joint.set("solref", f"{2.0 * step:g} 1")
-                joint.set("solimp", "0.99 0.999 0.001")
-        ET.indent(tree)
-        tree.write(tmp / name, encoding="unicode")
-        kept = [m for m in staged.meshes if not (dae and m.lower().endswith(".dae"))]
-        for mesh in kept:
-            target = tmp / Path(*PurePosixPath(mesh).parts)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(staged.folder / Path(*PurePosixPath(mesh).parts), target)
+        written["meshes"] = compile_mjcf(mujoco, staged.urdf, staged.meshes, tmp / name, sites, f"robot '{robot.name}'")
         shutil.rmtree(staged.folder)
-        written["meshes"] = tuple(sorted(kept))
 
     _publish(out, fill)
     return ExportedMJCF(folder=out, mjcf=out / name, sites=tuple(sites), meshes=written["meshes"])
 
+
+
+def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, sites: tuple[str, ...] | list[str],
+                 label: str, geom_names: dict[str, str] | None = None) -> tuple[str, ...]:
+    """Compile the self-contained URDF ``urdf`` (meshes at ``meshes`` beside it) into the MJCF file ``target``.
+
+    Every link stays a body (``fusestatic="false"``), a site named like each frame of
+    ``sites`` sits at the origin of its body, joint equalities (``<mimic>``) are made as
+    stiff as the time step allows, mesh paths are made relative, and the meshes MuJoCo
+    reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
+    body (``{body: name}``). Returns the meshes copied (POSIX paths relative to the folder).
+    """
+    folder = urdf.parent
+    dae = any(m.lower().endswith(".dae") for m in meshes)
+    extension = (f'<mujoco><compiler fusestatic="false" discardvisual="{"true" if dae else "false"}" '
+                 'strippath="false"/></mujoco>')
+    text = urdf.read_text(encoding="utf-8")
+    head, end, tail = text.rpartition("</robot>")
+    compiled = folder / (urdf.stem + ".mujoco.urdf")
+    compiled.write_text(f"{head}{extension}\n{end}{tail}", encoding="utf-8")
+    try:
+        model = mujoco.MjModel.from_xml_path(str(compiled))
+        mujoco.mj_saveLastXML(str(target), model)
+    except Exception as exc:  # MuJoCo raises ValueError with its own message
+        raise ModelError(f"MuJoCo refuses {label}: {' '.join(str(exc).split())}") from exc
+    finally:
+        compiled.unlink(missing_ok=True)
+    tree = ET.parse(target)
+    for frame in sites:
+        body = tree.getroot().find(f".//body[@name='{frame}']")
+        if body is None:  # pragma: no cover - fusestatic="false" keeps every link
+            raise ModelError(f"MuJoCo dropped the body {frame!r} of {label}")
+        ET.SubElement(body, "site", {"name": frame, "size": f"{SITE_SIZE_M:g}", "rgba": "0.85 0.15 0.15 1"})
+    for body_name, geom_name in (geom_names or {}).items():
+        body = tree.getroot().find(f".//body[@name='{body_name}']")
+        colliding = [] if body is None else [g for g in body.findall("geom")
+                                             if g.get("contype", "1") != "0" or g.get("conaffinity", "1") != "0"]
+        if len(colliding) != 1:
+            raise ModelError(f"MuJoCo made {len(colliding)} colliding geoms of body {body_name!r} of {label}, "
+                             "expected one")
+        colliding[0].set("name", geom_name)
+    _mesh_paths_relative_to(tree, folder, target.parent)
+    step = float(model.opt.timestep)
+    for eq in tree.getroot().iter("equality"):
+        for joint in eq.iter("joint"):  # a linkage is rigid: the stiffest constraint the time step allows
+            joint.set("solref", f"{2.0 * step:g} 1")
+            joint.set("solimp", "0.99 0.999 0.001")
+    ET.indent(tree)
+    tree.write(target, encoding="unicode")
+    kept = [m for m in meshes if not (dae and m.lower().endswith(".dae"))]
+    for mesh in kept:
+        dest = target.parent / Path(*PurePosixPath(mesh).parts)
+        if dest.resolve() == (folder / Path(*PurePosixPath(mesh).parts)).resolve():
+            continue
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(folder / Path(*PurePosixPath(mesh).parts), dest)
+    return tuple(sorted(kept))
 
 def _mesh_paths_relative_to(tree: ET.ElementTree, source: Path, target: Path) -> None:
     """Mesh ``file`` attributes of a saved MJCF, relative to ``source``, made relative to ``target``'s layout.

@@ -1,0 +1,273 @@
+"""Whole cells out: one folder with the cell's URDF, SRDF and MJCF and the meshes they use.
+
+``export_cell(cell_or_name, out_dir)`` writes
+
+    out_dir/
+        <cell>.urdf     arms and fixtures; mesh paths relative to this file; one collision
+                        element per link (see below); loads in Pinocchio, MoveIt, yourdfpy
+        <cell>.srdf     planning groups, end effectors, named states, disable_collisions
+                        (:mod:`pinarms.export.srdf`)
+        <cell>.xml      MuJoCo: every link a body, fixtures as geoms of static bodies, a site
+                        at every arm's flange and tcp, ``<mimic>`` as joint equalities, each
+                        collision geom named like pinarms' geometry (``left_forearm_link_0``)
+        meshes/...      every mesh file referenced
+
+**One collision element per link.** SRDF disables collisions between links; pinarms
+classifies geometries. A link ``L`` with several ``<collision>`` elements keeps the first,
+and the k-th moves (same origin, same geometry) to a new link ``L_collision_k`` held to ``L``
+by a fixed joint ``L_collision_k_joint`` at the identity: the bodies and their geometry do
+not change, and the SRDF can name every geometry pair.
+
+Everything is written into a temporary sibling folder and renamed into place.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import struct
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+from typing import Any, Mapping
+
+from pinarms.robots.errors import InvalidInput
+
+from .errors import MeshNotFound
+from .robot import _check_folder, _publish, compile_mjcf, export_urdf
+from .srdf import geometry_links, srdf_text
+
+__all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
+
+
+@dataclass(frozen=True)
+class ExportedCell:
+    """What :func:`export_cell` wrote.
+
+    Attributes:
+        folder: the export folder; ``urdf``, ``srdf``, ``mjcf``: the files in it (``mjcf``
+            ``None`` when not asked).
+        meshes: the copied mesh files, relative to ``folder`` (POSIX paths), sorted.
+        sites: the MuJoCo sites (each arm's flange and tcp).
+        geometry_links: ``{pinarms geometry name: exported link name}``.
+    """
+
+    folder: Path
+    urdf: Path
+    srdf: Path | None
+    mjcf: Path | None
+    meshes: tuple[str, ...]
+    sites: tuple[str, ...]
+    geometry_links: dict[str, str]
+
+
+def _parse(text: str) -> ET.Element:
+    return ET.fromstring(text, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
+
+
+def one_collision_per_link(root: ET.Element) -> dict[str, str]:
+    """Move every ``<collision>`` after a link's first to its own link on a fixed joint (module doc), in place.
+
+    Returns ``{new link: its parent link}``.
+    """
+    added: dict[str, str] = {}
+    children = list(root)
+    taken = {el.get("name") for el in root if el.tag in ("link", "joint")}
+    for link in [el for el in children if el.tag == "link"]:
+        collisions = link.findall("collision")
+        position = list(root).index(link)
+        for k, collision in enumerate(collisions[1:], start=1):
+            name = f"{link.get('name')}_collision_{k}"
+            if name in taken or f"{name}_joint" in taken:
+                raise InvalidInput(f"cannot split the collisions of link {link.get('name')!r}: the name {name!r} is taken")
+            link.remove(collision)
+            new_link = ET.Element("link", {"name": name})
+            new_link.append(collision)
+            joint = ET.Element("joint", {"name": f"{name}_joint", "type": "fixed"})
+            ET.SubElement(joint, "parent", {"link": link.get("name")})
+            ET.SubElement(joint, "child", {"link": name})
+            ET.SubElement(joint, "origin", {"xyz": "0 0 0", "rpy": "0 0 0"})
+            root.insert(position + 2 * k - 1, new_link)
+            root.insert(position + 2 * k, joint)
+            added[name] = link.get("name")
+    return added
+
+
+def _mesh_source(reference: str, cell: Any) -> Path:
+    """The file a mesh reference of ``cell`` names (relative paths: the cell's folder; ``package://``: its packages)."""
+    dirs = [Path(d) for d in cell.robot.package_dirs]
+    if reference.startswith("package://"):
+        rel = reference[len("package://"):].partition("/")[2]
+        candidates = [d / rel for d in dirs]
+    elif reference.startswith("file://"):
+        candidates = [Path(reference[len("file://"):])]
+    else:
+        candidates = [Path(reference)] if os.path.isabs(reference) else [dirs[0] / reference] if dirs else []
+    for path in candidates:
+        if path.is_file():
+            return path
+    raise MeshNotFound(
+        f"cell {cell.name!r}: mesh {reference!r} cannot be found (looked at {', '.join(str(c) for c in candidates) or 'nothing'}); "
+        "put the mesh file back or load the cell with the packages that hold it (load_cell(path, packages=...))"
+    )
+
+
+def _binary_stl(source: Path) -> bytes | None:
+    """An ASCII STL file as binary STL (MuJoCo reads binary STL only), or ``None`` if already binary."""
+    data = source.read_bytes()
+    head = data[:512].lstrip().lower()
+    if not head.startswith(b"solid") or b"facet" not in data[:4096].lower():
+        return None
+    words = data.decode("ascii", errors="replace").split()
+    facets = []
+    try:
+        for i, w in enumerate(words):
+            if w == "normal":
+                normal = [float(v) for v in words[i + 1 : i + 4]]
+            elif w == "vertex":
+                facets.append((normal, [float(v) for v in words[i + 1 : i + 4]]))
+    except (ValueError, UnboundLocalError) as exc:
+        raise MeshNotFound(f"mesh {source} is not a readable ASCII STL file ({exc})") from exc
+    if not facets or len(facets) % 3:
+        raise MeshNotFound(f"mesh {source} is not a readable ASCII STL file (vertices not in triangles)")
+    out = bytearray(b"binary STL written by pinarms".ljust(80, b" "))
+    out += struct.pack("<I", len(facets) // 3)
+    for k in range(0, len(facets), 3):
+        out += struct.pack("<3f", *facets[k][0])
+        for _, vertex in facets[k : k + 3]:
+            out += struct.pack("<3f", *vertex)
+        out += b"\x00\x00"
+    return bytes(out)
+
+
+def _copy_meshes(root: ET.Element, cell: Any, folder: Path) -> tuple[str, ...]:
+    """Copy every mesh ``root`` references into ``folder/meshes`` and point the URDF at the copies."""
+    dest_of: dict[Path, str] = {}
+    used: set[str] = set()
+    for mesh in root.iter("mesh"):
+        source = _mesh_source(mesh.get("filename", ""), cell).resolve()
+        if source not in dest_of:
+            stem, suffix, k = source.stem, source.suffix, 0
+            name = f"meshes/{stem}{suffix}"
+            while name in used:
+                k += 1
+                name = f"meshes/{stem}_{k}{suffix}"
+            used.add(name)
+            dest_of[source] = name
+            target = folder / Path(*PurePosixPath(name).parts)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            binary = _binary_stl(source) if suffix.lower() == ".stl" else None
+            if binary is None:
+                shutil.copyfile(source, target)
+            else:
+                target.write_bytes(binary)
+        mesh.set("filename", dest_of[source])
+    return tuple(sorted(dest_of.values()))
+
+
+def _sites(cell: Any, root: ET.Element) -> tuple[str, ...]:
+    links = {el.get("name") for el in root.iter("link")}
+    return tuple(f for arm in cell.arms for f in dict.fromkeys((arm.prefix + "flange", arm.prefix + arm.robot.tcp_frame))
+                 if f in links)
+
+
+def _write_cell(cell: Any, folder: Path, *, srdf: bool, mjcf: bool,
+                states: Mapping[str, Mapping[str, Any]] | None) -> ExportedCell:
+    """Write the cell's files into the (new, empty) ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    root = _parse(cell.urdf_text)
+    meshes = _copy_meshes(root, cell, folder)
+    one_collision_per_link(root)
+    links = geometry_links(cell)
+    ET.indent(root)
+    urdf = folder / f"{cell.name}.urdf"
+    urdf.write_text('<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n", encoding="utf-8")
+    srdf_path = None
+    if srdf:
+        srdf_path = folder / f"{cell.name}.srdf"
+        srdf_path.write_text(srdf_text(cell, states=states), encoding="utf-8")
+    sites = _sites(cell, root)
+    mjcf_path = None
+    if mjcf:
+        mujoco = _mujoco()
+        mjcf_path = folder / f"{cell.name}.xml"
+        compile_mjcf(mujoco, urdf, meshes, mjcf_path, sites, f"cell {cell.name!r}",
+                     geom_names={link: geometry for geometry, link in links.items()})
+    return ExportedCell(folder, urdf, srdf_path, mjcf_path, meshes, sites if mjcf else (), links)
+
+
+def _mujoco():
+    try:
+        import mujoco
+    except ImportError as exc:
+        from pinarms.robots.errors import ModelError
+
+        raise ModelError("the MJCF export needs MuJoCo's Python package: pip install mujoco "
+                         "(or pip install 'pinarms[mujoco]')") from exc
+    return mujoco
+
+
+def _load(cell_or_name: Any):
+    from pinarms.robots.cell import Cell, load_cell
+
+    cell = load_cell(cell_or_name) if isinstance(cell_or_name, (str, os.PathLike)) else cell_or_name
+    if not isinstance(cell, Cell):
+        raise InvalidInput(f"export_cell takes a robots.cell.Cell, a built-in cell name or a cell file, got {cell_or_name!r}")
+    return cell
+
+
+def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
+                states: Mapping[str, Mapping[str, Any]] | None = None, overwrite: bool = False) -> ExportedCell:
+    """Write a whole cell (URDF + SRDF + MJCF + meshes) into ``out_dir`` (module doc).
+
+    Args:
+        cell_or_name: a :class:`pinarms.robots.cell.Cell`, a built-in cell name or a cell file.
+        srdf, mjcf: write the SRDF, the MJCF (the latter needs ``mujoco``).
+        states: extra named SRDF states ``{name: {arm: q_arm}}`` (:func:`srdf.cycle_states`).
+        overwrite: replace a non-empty ``out_dir`` (only once the new one is complete).
+
+    Raises:
+        CellNotFound: unknown cell name. InvalidInput: ``out_dir`` is a file or not empty
+        (without ``overwrite``); a bad state. MeshNotFound: a mesh cannot be found.
+        ModelError: MuJoCo is missing or refuses the model.
+    """
+    cell = _load(cell_or_name)
+    out = _check_folder(out_dir, overwrite)
+    result: dict[str, ExportedCell] = {}
+
+    def fill(tmp: Path) -> None:
+        result["cell"] = _write_cell(cell, tmp, srdf=srdf, mjcf=mjcf, states=states)
+
+    _publish(out, fill)
+    r = result["cell"]
+    move = lambda p: None if p is None else out / p.name  # noqa: E731
+    return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links)
+
+
+def cell_of_urdf_folder(robot: Any, folder: Path):
+    """A one-arm :class:`Cell` of ``robot`` built from its exported (self-contained) URDF folder."""
+    from pinarms.robots.cell import Cell
+
+    text = (folder / f"{robot.name}.urdf").read_text(encoding="utf-8")
+    return Cell(text, source=f"robot {robot.name!r}", base_dir=folder)
+
+
+def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite: bool = False,
+                           states: Mapping[str, Any] | None = None) -> ExportedCell:
+    """One arm as a folder with its URDF (one collision per link) and SRDF (one-arm cell rules)."""
+    out = _check_folder(out_dir, overwrite)
+    result: dict[str, ExportedCell] = {}
+
+    def fill(tmp: Path) -> None:
+        staged = export_urdf(robot, tmp / ".staged")
+        cell = cell_of_urdf_folder(robot, staged.folder)
+        arm_states = None if states is None else {k: {cell.arms[0].name: v} for k, v in states.items()}
+        result["cell"] = _write_cell(cell, tmp / "out", srdf=True, mjcf=False, states=arm_states)
+        for entry in (tmp / "out").iterdir():
+            os.rename(entry, tmp / entry.name)
+        (tmp / "out").rmdir()
+        shutil.rmtree(staged.folder)
+
+    _publish(out, fill)
+    r = result["cell"]
+    return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links)

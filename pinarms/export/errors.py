@@ -1,0 +1,23 @@
+"""Errors of the export package (each is also the project's matching general class)."""
+
+from __future__ import annotations
+
+from pinarms.robots.errors import InvalidInput, MissingMesh, PinarmsError
+
+__all__ = ["ExportError", "MeshNotFound", "InvalidRate", "JointMismatch"]
+
+
+class ExportError(PinarmsError):
+    """Something pinarms was asked to export cannot be written as asked."""
+
+
+class MeshNotFound(ExportError, MissingMesh):
+    """A mesh the exported description references cannot be found (the folder would not load elsewhere)."""
+
+
+class InvalidRate(ExportError, InvalidInput):
+    """A controller sample rate that is not a finite number > 0 [Hz]."""
+
+
+class JointMismatch(ExportError, InvalidInput):
+    """A trajectory whose joints are not those of the robot or arm it is written for."""

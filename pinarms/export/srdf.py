@@ -1,0 +1,158 @@
+"""SRDF (MoveIt's semantic robot description) of an arm or a cell, from pinarms' pair classification.
+
+One planning group per arm (a chain from its base link to its tool link), a one-link group
+for the tool and an ``end_effector`` on it, named states (``home``: every joint at 0, and
+any poses given), and the ``disable_collisions`` list. MoveIt's setup assistant samples
+random configurations (10 000 by default) to call a pair "never in collision"; here every
+pair comes from :mod:`pinarms.robots.cell.pairs`, where "never" is a proof:
+
+=================  ==========  ==========================================================
+pinarms reason     SRDF        why the pair is never checked
+=================  ==========  ==========================================================
+``out of reach``   Never       proven: the reach ball of one misses the other
+``same link``      Adjacent    one link (exported as a link and its collision sub-links)
+``adjacent``       Adjacent    links joined by one joint
+``rigid``          Default     no joint between them: their distance never changes
+``always``         Default     in contact in ≥ 95 % of random configurations (by design)
+``constant``       Default     a constant gap (coaxial with every joint between them)
+=================  ==========  ==========================================================
+
+The pinarms reason is kept in an XML comment before each element.
+
+SRDF disables collisions between *links*, pinarms classifies *geometries*: a link with
+several ``<collision>`` elements can have one geometry checked against a body and another
+proven out of reach. The exported URDF therefore gives every collision element its own
+link (:func:`pinarms.export.cell.one_collision_per_link`), and the SRDF is written against
+those links: after ``pin.removeCollisionPairs(model, geom_model, srdf)`` Pinocchio checks
+exactly the pairs pinarms checks at contact (:func:`contact_pairs`).
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from typing import Any, Mapping
+
+import numpy as np
+
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "cycle_states"]
+
+#: SRDF ``reason`` of each pinarms reason for not checking a pair.
+SRDF_REASON = {
+    "out of reach": "Never",
+    "same link": "Adjacent",
+    "adjacent": "Adjacent",
+    "rigid": "Default",
+    "always": "Default",
+    "constant": "Default",
+}
+
+_STATE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
+
+
+def contact_pairs(cell: Any) -> tuple:
+    """The pairs a contact check of ``cell`` looks at (``cell.pairs_for(0.0)``, or ``cell.pairs``)."""
+    pairs_for = getattr(cell, "pairs_for", None)
+    return tuple(pairs_for(0.0)) if callable(pairs_for) else tuple(cell.pairs)
+
+
+def geometry_links(cell: Any) -> dict[str, str]:
+    """``{geometry name: exported link}``: the k-th collision of link ``L`` is link ``L_collision_k`` (k ≥ 1)."""
+    out: dict[str, str] = {}
+    count: dict[str, int] = {}
+    for g in cell.collision_model.geometryObjects:
+        link = cell.model.frames[g.parentFrame].name
+        k = count.get(link, 0)
+        count[link] = k + 1
+        out[g.name] = link if k == 0 else f"{link}_collision_{k}"
+    return out
+
+
+def cycle_states(cycle: Any) -> dict[str, np.ndarray]:
+    """Named poses of a planned cycle (:class:`pinarms.optim.CycleResult`): its waypoints' joints, by label."""
+    out: dict[str, np.ndarray] = {}
+    for label, q in zip(cycle.names, np.asarray(cycle.q_via)):
+        out.setdefault(re.sub(r"[^A-Za-z0-9_]+", "_", str(label)).strip("_"), np.asarray(q, dtype=float))
+    return out
+
+
+def _state_joints(cell: Any, arm: Any, q: Any, state: str) -> list[tuple[str, float]]:
+    arr = np.asarray(q, dtype=float)
+    if arr.shape != (arm.nq,) or not np.all(np.isfinite(arr)):
+        raise InvalidInput(f"state {state!r} of arm {arm.name!r}: expected {arm.nq} finite joint values, got {q!r}")
+    lo, hi = arm.robot.lower, arm.robot.upper
+    bad = np.flatnonzero((arr < lo - 1e-12) | (arr > hi + 1e-12))
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInput(f"state {state!r} of arm {arm.name!r}: joint {arm.robot.joint_names[j]} = {float(arr[j])!r} "
+                           f"is outside its limits [{float(lo[j])!r}, {float(hi[j])!r}]")
+    return [(arm.prefix + name, float(v)) for name, v in zip(arm.robot.joint_names, arr)]
+
+
+def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> list[tuple[str, str, list]]:
+    """``(state name, group, [(joint, value)])``: ``home`` for every arm, then the given states."""
+    several = len(cell.arms) > 1
+    out = []
+    if several:
+        out.append(("home", "cell", [j for arm in cell.arms for j in _state_joints(cell, arm, np.zeros(arm.nq), "home")]))
+    for arm in cell.arms:
+        out.append((f"{arm.name}_home" if several else "home", arm.name,
+                    _state_joints(cell, arm, np.zeros(arm.nq), "home")))
+    for name, per_arm in (states or {}).items():
+        if not isinstance(name, str) or not _STATE_NAME.match(name) or any(name == s[0] for s in out):
+            raise InvalidInput(f"state name {name!r} must be a new identifier (letters, digits, _ . -)")
+        if not isinstance(per_arm, Mapping) or not per_arm:
+            raise InvalidInput(f"state {name!r} must map arm names to joint values, got {per_arm!r}")
+        joints = [j for arm_name, q in per_arm.items() for j in _state_joints(cell, cell.arm(arm_name), q, name)]
+        group = next(iter(per_arm)) if len(per_arm) == 1 else "cell"
+        if group == "cell" and not several:
+            group = cell.arms[0].name
+        out.append((name, group, joints))
+    return out
+
+
+def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
+    """The SRDF of ``cell`` (a :class:`pinarms.robots.cell.Cell`) against its exported URDF's links.
+
+    Args:
+        states: extra named states ``{name: {arm name: q_arm (nq_arm,)}}`` [rad or m]
+            (a study's pick and place poses, :func:`cycle_states`).
+
+    Raises:
+        InvalidInput: a state with an unknown arm, a wrong length, a value outside the
+            joint limits, or a name already used.
+    """
+    links = geometry_links(cell)
+    root = ET.Element("robot", {"name": cell.name})
+    root.append(ET.Comment(f" Semantic description of {cell.name} for MoveIt and Pinocchio, written by pinarms "
+                           "(pinarms.export). Link names are those of the URDF exported beside it. "))
+    for arm in cell.arms:
+        spec = next(a for a in cell.spec.arms if a.name == arm.name)
+        group = ET.SubElement(root, "group", {"name": arm.name})
+        ET.SubElement(group, "chain", {"base_link": spec.base_link, "tip_link": arm.prefix + arm.robot.tcp_frame})
+        tool = ET.SubElement(root, "group", {"name": f"{arm.name}_tool"})
+        ET.SubElement(tool, "link", {"name": arm.prefix + arm.robot.tcp_frame})
+    if len(cell.arms) > 1:
+        everything = ET.SubElement(root, "group", {"name": "cell"})
+        for arm in cell.arms:
+            ET.SubElement(everything, "group", {"name": arm.name})
+    for name, group, joints in _states(cell, states):
+        element = ET.SubElement(root, "group_state", {"name": name, "group": group})
+        for joint, value in joints:
+            ET.SubElement(element, "joint", {"name": joint, "value": repr(value)})
+    for arm in cell.arms:
+        ET.SubElement(root, "end_effector", {"name": f"{arm.name}_tool", "parent_link": arm.prefix + arm.robot.tcp_frame,
+                                             "group": f"{arm.name}_tool", "parent_group": arm.name})
+    checked = {frozenset((p.geometry_a, p.geometry_b)) for p in contact_pairs(cell)}
+    for pair in cell.allowed:
+        if frozenset((pair.geometry_a, pair.geometry_b)) in checked:
+            continue  # a pair pinarms allows but checks at contact (its proven bound is not above 0)
+        if pair.reason not in SRDF_REASON:
+            raise InvalidInput(f"cell {cell.name!r}: pair reason {pair.reason!r} has no SRDF reason")
+        root.append(ET.Comment(f" pinarms: {pair.reason} ({pair.geometry_a} - {pair.geometry_b}) "))
+        ET.SubElement(root, "disable_collisions", {"link1": links[pair.geometry_a], "link2": links[pair.geometry_b],
+                                                   "reason": SRDF_REASON[pair.reason]})
+    ET.indent(root)
+    return '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n"
