@@ -126,6 +126,24 @@ def _refuse(expr: str, construct: str, what: str) -> ExpressionRefused:
     )
 
 
+def _refusal(text: str, node: ast.AST) -> ExpressionRefused | None:
+    kind = type(node)
+    if kind in _NAMED:
+        return _refuse(text, kind.__name__, f"{_NAMED[kind]} ({kind.__name__})")
+    if kind not in _PLAIN:
+        return _refuse(text, kind.__name__, f"the construct {kind.__name__}")
+    if kind is ast.Constant and not isinstance(node.value, _SCALARS):
+        return _refuse(text, "Constant", f"the literal {node.value!r} ({type(node.value).__name__})")
+    name = node.id if kind is ast.Name else node.attr if kind is ast.Attribute else None
+    if name is not None and name.startswith("__"):
+        return _refuse(text, "dunder", f"the name '{name}' (names starting with '__')")
+    if kind is ast.Dict and any(key is None for key in node.keys):
+        return _refuse(text, "DictUnpack", "dict unpacking '**'")
+    if kind is ast.keyword and node.arg is None:
+        return _refuse(text, "KeywordUnpack", "keyword unpacking '**'")
+    return None
+
+
 @lru_cache(maxsize=4096)
 def check_expression(expr: str) -> ast.Expression:
     """Parse ``expr`` and check every node against the whitelist; the checked tree.
@@ -140,26 +158,19 @@ def check_expression(expr: str) -> ast.Expression:
         raise ExpressionTooLarge(text[:60] + "...", "length",
                                  f"{len(text)} characters, more than the {MAX_EXPRESSION_CHARS} allowed")
     tree = ast.parse(text, mode="eval")
+    refusals: list[tuple[tuple[bool, int, int, int], ExpressionRefused]] = []
     stack: list[tuple[ast.AST, int]] = [(tree, 0)]
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
             raise ExpressionTooLarge(text, "depth", f"nested deeper than {MAX_DEPTH} levels")
-        kind = type(node)
-        if kind in _NAMED:
-            raise _refuse(text, kind.__name__, f"{_NAMED[kind]} ({kind.__name__})")
-        if kind not in _PLAIN:
-            raise _refuse(text, kind.__name__, f"the construct {kind.__name__}")
-        if kind is ast.Constant and not isinstance(node.value, _SCALARS):
-            raise _refuse(text, "Constant", f"the literal {node.value!r} ({type(node.value).__name__})")
-        name = node.id if kind is ast.Name else node.attr if kind is ast.Attribute else None
-        if name is not None and name.startswith("__"):
-            raise _refuse(text, "dunder", f"the name '{name}' (names starting with '__')")
-        if kind is ast.Dict and any(key is None for key in node.keys):
-            raise _refuse(text, "DictUnpack", "dict unpacking '**'")
-        if kind is ast.keyword and node.arg is None:
-            raise _refuse(text, "KeywordUnpack", "keyword unpacking '**'")
+        refusal = _refusal(text, node)
+        if refusal is not None:  # reported in reading order: the first refused construct of the text
+            end = getattr(node, "end_col_offset", None)  # parts without a place (a lambda's arguments) come last
+            refusals.append(((end is None, getattr(node, "end_lineno", 0), end or 0, depth), refusal))
         stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    if refusals:
+        raise min(refusals, key=lambda item: item[0])[1]
     return tree
 
 
