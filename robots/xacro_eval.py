@@ -157,7 +157,10 @@ def check_expression(expr: str) -> ast.Expression:
     if len(text) > MAX_EXPRESSION_CHARS:
         raise ExpressionTooLarge(text[:60] + "...", "length",
                                  f"{len(text)} characters, more than the {MAX_EXPRESSION_CHARS} allowed")
-    tree = ast.parse(text, mode="eval")
+    try:
+        tree = ast.parse(text, mode="eval")
+    except (MemoryError, RecursionError):  # CPython's parser gives up on ~1000 nested unary operators
+        raise ExpressionTooLarge(text[:60] + "...", "depth", f"nested deeper than {MAX_DEPTH} levels") from None
     refusals: list[tuple[tuple[bool, int, int, int], ExpressionRefused]] = []
     stack: list[tuple[ast.AST, int]] = [(tree, 0)]
     while stack:

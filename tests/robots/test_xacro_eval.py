@@ -132,6 +132,8 @@ def test_everything_else_is_refused_by_name(expr, needle):
         ("s * 2**19 + s * 2**19", "items"),
         ("1" + "+1" * 200, f"deeper than {MAX_DEPTH}"),
         ("1" * (MAX_EXPRESSION_CHARS + 1), "characters"),
+        ("-" * 9000 + "1", f"deeper than {MAX_DEPTH}"),
+        ("[1]" + "[0]" * 3000, f"deeper than {MAX_DEPTH}"),
     ],
 )
 def test_sizes_are_bounded_before_they_are_computed(expr, needle):
