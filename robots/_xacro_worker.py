@@ -192,7 +192,8 @@ def _failure(exc: BaseException, xacro, declared: dict) -> dict:
         return {"ok": False, "kind": "xacro", "message": "macros or properties recurse without end", "declared": declared}
     if isinstance(exc, xml.parsers.expat.ExpatError):
         name = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else "the file"
-        message = f"'{name}' is not well-formed XML: {exc} (line {exc.lineno}, column {exc.offset + 1} of '{name}')"
+        message = (f"'{name}' is not well-formed XML at line {exc.lineno}, column {exc.offset + 1}: "
+                   f"{xml.parsers.expat.ErrorString(exc.code)}")
         return {"ok": False, "kind": "xacro", "message": message, "declared": declared}
     message = " ".join(str(exc).split()) or type(exc).__name__
     if where:
