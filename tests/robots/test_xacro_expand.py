@@ -377,6 +377,37 @@ def test_code_inside_the_sandbox_writes_nothing_and_reads_only_the_allowed_folde
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["cell", "other", "part.txt", "secret.txt"]
 
 
+FALLBACK = r"""
+import importlib.util, json, os, sys
+spec = importlib.util.spec_from_file_location("sandbox", sys.argv[1])
+sandbox = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(sandbox)
+def no_landlock(roots):
+    raise OSError("Landlock is not available")
+sandbox._landlock = no_landlock
+out = {"wall": sandbox.enter_wall([sys.argv[2]]), "uid": os.getuid(), "gid": os.getgid()}
+try:
+    os.mkdir(os.path.join(sys.argv[2], "new_dir"))
+    out["create_dir"] = "done"
+except OSError as exc:
+    out["create_dir"] = type(exc).__name__
+sys.stdout.write(json.dumps(out))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="the fallback drops root's privileges")
+def test_without_landlock_a_root_child_drops_to_nobody(tmp_path):
+    folder = tmp_path / "cell"
+    folder.mkdir(mode=0o755)
+    sandbox = Path(robots.__file__).resolve().parent / "_xacro_sandbox.py"
+    done = subprocess.run([sys.executable, "-I", "-B", "-c", FALLBACK, str(sandbox), str(folder)],
+                          capture_output=True, text=True, timeout=60, env={})
+    assert done.returncode == 0, done.stderr
+    assert __import__("json").loads(done.stdout) == {"wall": "user nobody (no Landlock)", "uid": 65534, "gid": 65534,
+                                                     "create_dir": "PermissionError"}
+    assert list(folder.iterdir()) == []
+
+
 def test_expansions_report_the_wall_they_ran_behind(tmp_path):
     result = expand_xacro(write(tmp_path, "pedestal.xacro", SCARA_ON_PEDESTAL))
     assert result.wall.startswith(("landlock", "user nobody", "resource limits only"))
