@@ -20,6 +20,7 @@ from .errors import (
     UnreachableTarget,
     XacroArgError,
     XacroError,
+    XacroFileNotFound,
     XacroForbidden,
     XacroLimitExceeded,
 )
@@ -44,6 +45,7 @@ __all__ = [
     "ExecutionError",
     "XacroError",
     "XacroForbidden",
+    "XacroFileNotFound",
     "XacroLimitExceeded",
     "XacroArgError",
     "MissingMesh",

@@ -1,9 +1,11 @@
 """Expand one xacro file inside a walled subprocess (run by :mod:`pinarms.robots.xacro_expand`).
 
-This file runs as a script (``python -I _xacro_worker.py``) in a child process started
+This file runs as a script (``python -I -B _xacro_worker.py``) in a child process started
 with resource limits (address space, CPU time, no file writes, no new processes), an
 empty environment and a wall-clock timeout set by the parent. It imports only the
-standard library and ``xacro``, never pinarms (nor Pinocchio).
+standard library, ``xacro`` and ``yaml``, and loads two sibling files by path:
+``xacro_eval.py`` (the expression whitelist) and ``_xacro_sandbox.py`` (the Landlock wall),
+never pinarms itself (nor Pinocchio).
 
 Protocol: one JSON request on stdin::
 
@@ -11,66 +13,45 @@ Protocol: one JSON request on stdin::
      "packages": {"pkg": "/abs/dir"}, "header": ["comment text", ...]}
 
 and one JSON answer on stdout: ``{"ok": true, "urdf": "...", "files": [...],
-"declared": {"arg": "default"}}`` or ``{"ok": false, "kind": "forbidden" | "xacro" |
-"args", "message": "..."}``.
+"declared": {"arg": "default"}, "wall": "..."}`` or ``{"ok": false, "kind": "forbidden" |
+"limit" | "not_found" | "xacro" | "args" | "memory", "message": "...", ...}``.
 
-The wall, on top of xacro's own refusal of names starting with ``__``:
+The walls, in order:
 
-- every file xacro opens (the input, ``<xacro:include>`` files, ``load_yaml``) must lie,
-  after resolving symbolic links, inside one of the allowed ``roots``;
-- ``$(find PKG)`` resolves only the packages named in the request;
-- ``$(env ...)``, ``$(optenv ...)``, ``$(eval ...)`` and ``$(cwd)`` are refused;
-- each ``${...}`` expression is parsed and may hold only literals, names, arithmetic,
-  comparisons, boolean and conditional expressions, calls, subscripts and attribute
-  access to names that do not start with ``_``: no lambda, comprehension, generator,
-  assignment expression, and no string literal holding ``__``.
+1. every ``${...}`` goes through :func:`xacro_eval.evaluate` (xacro's ``safe_eval`` is
+   replaced; the name ``eval`` inside xacro's modules refuses), never Python's ``eval``;
+2. every file xacro opens (the input, ``<xacro:include>`` files, ``load_yaml``) must lie,
+   after resolving symbolic links, inside one of the allowed ``roots``; ``$(find PKG)``
+   resolves only the packages named; ``$(env)``, ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse;
+3. before any file of the request is read, the process walls itself in
+   (:func:`_xacro_sandbox.enter_wall`): it can then write nothing and read only the roots
+   and Python's own folders, whatever code might run.
 """
 
 from __future__ import annotations
 
-import ast
+import errno
+import importlib.util
 import json
 import os
 import sys
+from pathlib import Path
 
 
 class Forbidden(Exception):
     """The file asks for something outside the wall."""
 
 
-class ArgProblem(Exception):
-    """A xacro argument given by the caller is not declared by the file."""
+class TooLarge(Exception):
+    """An expression would build a value beyond the size bounds."""
 
 
-_ALLOWED_NODES = (
-    ast.Expression, ast.Constant, ast.Name, ast.Load, ast.BinOp, ast.UnaryOp, ast.BoolOp,
-    ast.Compare, ast.IfExp, ast.Call, ast.keyword, ast.Attribute, ast.Subscript, ast.Slice,
-    ast.Tuple, ast.List, ast.Dict, ast.Set, ast.JoinedStr, ast.FormattedValue,
-    ast.operator, ast.unaryop, ast.boolop, ast.cmpop,
-)
-# attributes that lead from an object to frames, code or globals (defence in depth: no
-# construct allowed above creates a generator or a function, but refuse them by name too)
-_DENIED_ATTRIBUTES = {"format", "format_map", "mro", "gi_frame", "gi_code", "cr_frame", "ag_frame",
-                      "f_back", "f_globals", "f_locals", "f_builtins", "f_code", "tb_frame", "tb_next"}
-
-
-def check_expression(expr: str) -> None:
-    """Refuse a ``${...}`` expression outside the allowed subset (see the module doc)."""
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError:
-        return  # xacro reports the syntax error itself
-    for node in ast.walk(tree):
-        if not isinstance(node, _ALLOWED_NODES):
-            raise Forbidden(f"expression '{expr.strip()}' uses {type(node).__name__}, which pinarms does not allow in xacro")
-        if isinstance(node, ast.Attribute) and (node.attr.startswith("_") or node.attr in _DENIED_ATTRIBUTES):
-            raise Forbidden(f"expression '{expr.strip()}' accesses attribute '{node.attr}', which pinarms does not allow")
-        if isinstance(node, ast.Name) and node.id.startswith("_"):
-            raise Forbidden(f"expression '{expr.strip()}' uses name '{node.id}', which pinarms does not allow")
-        if isinstance(node, ast.Constant) and isinstance(node.value, (str, bytes)) and (
-            "__" in (node.value if isinstance(node.value, str) else node.value.decode("latin-1"))
-        ):
-            raise Forbidden(f"expression '{expr.strip()}' holds a string with '__', which pinarms does not allow")
+def _load_sibling(name: str):
+    spec = importlib.util.spec_from_file_location(f"pinarms_xacro_child_{name}", Path(__file__).with_name(f"{name}.py"))
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 class RecordingArgs(dict):
@@ -91,96 +72,161 @@ class RecordingArgs(dict):
             dict.__setitem__(self, name, value)
 
 
+def _location(xacro) -> str:
+    """Where xacro is: the innermost file being read and the macro being expanded."""
+    parts = []
+    if xacro.macrostack:
+        macro = xacro.macrostack[-1]
+        defined = macro.history[-1][-1] if macro.history and macro.history[-1] else None
+        parts.append(f"in macro '{macro.body.getAttribute('name')}'" + (f" (defined in '{defined}')" if defined else ""))
+    if xacro.filestack and xacro.filestack[-1]:
+        parts.append(f"in file '{xacro.filestack[-1]}'")
+    return ", ".join(parts)
+
+
+class _Hooks:
+    """xacro's file, expression and substitution entry points, walled."""
+
+    def __init__(self, xacro, subst, whitelist, roots: list[str], packages: dict[str, str]) -> None:
+        self.xacro, self.subst, self.whitelist = xacro, subst, whitelist
+        self.roots, self.packages = roots, packages
+        self.original_parse, self.original_load_yaml = xacro.parse, xacro.load_yaml
+        self.functions = {
+            **whitelist.FUNCTIONS,
+            "xacro.arg": self.arg, "xacro.tokenize": self.tokenize,
+            "load_yaml": self.load_yaml, "xacro.load_yaml": self.load_yaml,
+        }
+
+    def inside(self, path: str) -> bool:
+        real = os.path.realpath(path)
+        return any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in self.roots)
+
+    def check_path(self, path: str, what: str) -> str:
+        if not self.inside(path):
+            raise Forbidden(
+                f"{what} '{path}' is outside the folders this file may read "
+                f"(its own folder and the packages given: {', '.join(sorted(self.packages)) or 'none'})"
+            )
+        return path
+
+    def parse(self, inp, filename=None):
+        if inp is None and filename is not None:
+            self.check_path(os.path.join(self.xacro.root_dir, filename), "file")
+        return self.original_parse(inp, filename)
+
+    def load_yaml(self, filename):
+        if not isinstance(filename, str):
+            raise TypeError(f"load_yaml() takes a file name, got {type(filename).__name__}")
+        self.check_path(self.xacro.abs_filename_spec(filename), "yaml file")
+        return self.original_load_yaml(filename)
+
+    def arg(self, name):
+        return self.xacro.substitution_args_context["arg"][name]
+
+    def tokenize(self, s, sep=",; ", skip_empty=True):
+        if not isinstance(s, str) or not isinstance(sep, str) or set(sep) & set("[]\\^-"):
+            raise ValueError("xacro.tokenize() takes a string and separator characters other than [ ] \\ ^ -")
+        return self.xacro.tokenize(s, sep, bool(skip_empty))
+
+    def safe_eval(self, expr, globals, locals=None):
+        try:
+            return self.whitelist.evaluate(expr, globals, functions=self.functions,
+                                           namespaces=(self.xacro.NameSpace,), attr_dicts=(self.xacro.YamlDictWrapper,))
+        except self.whitelist.ExpressionTooLarge as exc:
+            raise TooLarge(f"{_location(self.xacro)}: {exc}") from None
+        except self.whitelist.ExpressionRefused as exc:
+            raise Forbidden(f"{_location(self.xacro)}: {exc}") from None
+
+    def find(self, pkg):
+        if pkg not in self.packages:
+            raise Forbidden(
+                f"$(find {pkg}): package '{pkg}' is not among the packages given "
+                f"({', '.join(sorted(self.packages)) or 'none'}); pass it in packages={{'{pkg}': folder}}"
+            )
+        return self.packages[pkg]
+
+    def eval_extension(self, s):
+        if s.strip() == "$(cwd)":
+            raise Forbidden("$(cwd) is not allowed in pinarms' xacro (files must not depend on the machine)")
+        return self.original_eval_extension(s)
+
+    def install(self) -> None:
+        xacro, subst = self.xacro, self.subst
+
+        def refuse(what):
+            def fn(*args, **kwargs):
+                raise Forbidden(f"{what} is not allowed in pinarms' xacro (files must not depend on the machine)")
+
+            return fn
+
+        self.original_eval_extension = xacro.eval_extension
+        xacro.parse, xacro.load_yaml, xacro.safe_eval = self.parse, self.load_yaml, self.safe_eval
+        xacro.eval_extension = self.eval_extension
+        xacro._global_symbols = xacro.create_global_symbols()  # picks up the checked load_yaml
+        xacro.eval = subst.eval = refuse("Python's eval")  # any path left to eval() inside xacro refuses
+        subst._eval_env, subst._eval_optenv, subst._eval = refuse("$(env ...)"), refuse("$(optenv ...)"), refuse("$(eval ...)")
+        subst._eval_find = self.find
+        subst._eval_dict.update(env=subst._eval_env, optenv=subst._eval_optenv, find=self.find)
+
+
+def _failure(exc: BaseException, xacro, declared: dict) -> dict:
+    """The answer for an exception out of xacro: its kind and a message naming where it happened."""
+    import xml.parsers.expat
+
+    chain, inner = [exc], exc
+    while getattr(inner, "exc", None) is not None and len(chain) < 20:  # XacroException wraps the cause
+        inner = inner.exc
+        chain.append(inner)
+    where = _location(xacro)
+    for item in chain:
+        if isinstance(item, Forbidden):
+            return {"ok": False, "kind": "forbidden", "message": str(item), "declared": declared}
+        if isinstance(item, TooLarge):
+            return {"ok": False, "kind": "limit", "message": str(item), "declared": declared}
+        if isinstance(item, MemoryError):
+            return {"ok": False, "kind": "memory", "message": "out of memory", "declared": declared}
+        if isinstance(item, OSError) and item.errno == errno.ENOENT:
+            message = f"file '{item.filename}' does not exist" + (f" (included {where})" if where else "")
+            return {"ok": False, "kind": "not_found", "message": message, "declared": declared}
+    if isinstance(exc, RecursionError):
+        return {"ok": False, "kind": "xacro", "message": "macros or properties recurse without end", "declared": declared}
+    if isinstance(exc, xml.parsers.expat.ExpatError):
+        name = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else "the file"
+        message = (f"'{name}' is not well-formed XML at line {exc.lineno}, column {exc.offset + 1}: "
+                   f"{xml.parsers.expat.ErrorString(exc.code)}")
+        return {"ok": False, "kind": "xacro", "message": message, "declared": declared}
+    message = " ".join(str(exc).split()) or type(exc).__name__
+    if where:
+        message += f" ({where})"
+    return {"ok": False, "kind": "xacro", "message": message, "declared": declared}
+
+
 def main() -> int:
     request = json.loads(sys.stdin.read())
     roots = [os.path.realpath(r) for r in request["roots"]]
     packages = {k: os.path.realpath(v) for k, v in request.get("packages", {}).items()}
 
+    import xml.dom.minidom
+    import xml.parsers.expat  # noqa: F401 - imported before the wall, with everything xacro needs
+
     import xacro
     import xacro.substitution_args as subst
+    import yaml  # noqa: F401
 
-    def inside(path: str) -> bool:
-        real = os.path.realpath(path)
-        return any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in roots)
-
-    def check_path(path: str, what: str) -> str:
-        if not inside(path):
-            raise Forbidden(
-                f"{what} '{path}' is outside the folders this file may read "
-                f"(its own folder and the packages given: {', '.join(sorted(packages)) or 'none'})"
-            )
-        return path
-
-    original_parse = xacro.parse
-
-    def parse(inp, filename=None):
-        if inp is None and filename is not None:
-            check_path(os.path.join(xacro.root_dir, filename), "file")
-        return original_parse(inp, filename)
-
-    original_load_yaml = xacro.load_yaml
-
-    def load_yaml(filename):
-        check_path(xacro.abs_filename_spec(filename), "yaml file")
-        return original_load_yaml(filename)
-
-    original_safe_eval = xacro.safe_eval
-
-    def safe_eval(expr, globals, locals=None):
-        check_expression(expr)
-        return original_safe_eval(expr, globals, locals)
-
-    def refuse(what):
-        def fn(*args, **kwargs):
-            raise Forbidden(f"$({what} ...) is not allowed in pinarms' xacro (files must not depend on the machine)")
-
-        return fn
-
-    def find(pkg):
-        if pkg not in packages:
-            raise Forbidden(
-                f"$(find {pkg}): package '{pkg}' is not among the packages given "
-                f"({', '.join(sorted(packages)) or 'none'}); pass it in packages={{'{pkg}': folder}}"
-            )
-        return packages[pkg]
-
-    original_eval_extension = xacro.eval_extension
-
-    def eval_extension(s):
-        if s.strip() == "$(cwd)":
-            raise Forbidden("$(cwd) is not allowed in pinarms' xacro (files must not depend on the machine)")
-        return original_eval_extension(s)
-
-    xacro.parse = parse
-    xacro.load_yaml = load_yaml
-    xacro.safe_eval = safe_eval
-    xacro.eval_extension = eval_extension
-    xacro._global_symbols = xacro.create_global_symbols()  # picks up the checked load_yaml
-    subst._eval_env = refuse("env")
-    subst._eval_optenv = refuse("optenv")
-    subst._eval_find = find
-    subst._eval = refuse("eval")
-    subst._eval_dict.update(env=refuse("env"), optenv=refuse("optenv"), find=find)
+    whitelist = _load_sibling("xacro_eval")
+    hooks = _Hooks(xacro, subst, whitelist, roots, packages)
+    hooks.install()
+    wall = _load_sibling("_xacro_sandbox").enter_wall(roots)
 
     args = RecordingArgs({str(k): str(v) for k, v in request.get("args", {}).items()})
     path = request["path"]
     try:
-        check_path(path, "file")
+        hooks.check_path(path, "file")
         doc = xacro.process_file(path, mappings=args)
     except Forbidden as exc:
         return _answer({"ok": False, "kind": "forbidden", "message": str(exc), "declared": args.declared})
-    except MemoryError:
-        return _answer({"ok": False, "kind": "memory", "message": "out of memory", "declared": args.declared})
-    except RecursionError:
-        return _answer({"ok": False, "kind": "xacro", "message": "macros or properties recurse without end", "declared": args.declared})
-    except Exception as exc:  # XacroException, ExpatError, NameError, ...
-        inner = getattr(exc, "exc", None)
-        if isinstance(inner, Forbidden):
-            return _answer({"ok": False, "kind": "forbidden", "message": str(inner), "declared": args.declared})
-        if isinstance(inner, MemoryError):
-            return _answer({"ok": False, "kind": "memory", "message": "out of memory", "declared": args.declared})
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        return _answer({"ok": False, "kind": "xacro", "message": message, "declared": args.declared})
+    except Exception as exc:  # XacroException, ExpatError, NameError, MemoryError, RecursionError ...
+        return _answer(_failure(exc, xacro, args.declared))
     unknown = sorted(set(dict.keys(args)) - set(args.declared))
     if unknown:
         declared = ", ".join(sorted(args.declared)) or "none"
@@ -194,13 +240,12 @@ def main() -> int:
             "autogenerated by xacro" in node.data or "EDITING THIS FILE BY HAND" in node.data or set(node.data.strip()) == {"="}
         ):
             doc.removeChild(node)
-    import xml.dom.minidom
-
     first = doc.firstChild
     for text in request.get("header", []):
         doc.insertBefore(xml.dom.minidom.Comment(text), first)
     files = sorted({os.path.realpath(f) for f in xacro.all_includes} | {os.path.realpath(path)})
-    return _answer({"ok": True, "urdf": doc.toprettyxml(indent="  "), "files": files, "declared": args.declared})
+    return _answer({"ok": True, "urdf": doc.toprettyxml(indent="  "), "files": files, "declared": args.declared,
+                    "wall": wall})
 
 
 def _answer(obj: dict) -> int:

@@ -23,6 +23,7 @@ __all__ = [
     "MissingMesh",
     "CellError",
     "CellNotFound",
+    "XacroFileNotFound",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -111,3 +112,11 @@ class CollisionError(PinarmsError):
 
 class CellNotFound(RobotNotFound):
     """A cell name is not a built-in cell, or a cell file does not exist."""
+
+
+class XacroFileNotFound(XacroError, CellNotFound):
+    """A xacro file, a file it includes or a yaml file it loads does not exist (the message names it).
+
+    Both a :class:`XacroError` and the not-found error of cells (:class:`CellNotFound`, a
+    ``LookupError``), so a cell whose included arm file is missing is caught either way.
+    """

@@ -8,27 +8,37 @@ machine's files or hang it, so :func:`expand_xacro` runs xacro in a child proces
 - **time**: a wall-clock timeout and a CPU-time limit (:attr:`XacroLimits.timeout_s`);
 - **memory**: an address-space limit (:attr:`XacroLimits.memory_bytes`) and a cap on the
   size of the URDF text (:attr:`XacroLimits.output_bytes`);
-- **no writes, no processes**: the child may not create files or start processes, and
-  gets an empty environment;
+- **a sandbox**: before reading any file of the request the child walls itself in with
+  Linux Landlock (:mod:`pinarms.robots._xacro_sandbox`): it can write, create or remove
+  nothing, execute no program, and read only the allowed folders below plus the
+  interpreter's standard library and site-packages; it also gets an empty environment and
+  may not start processes (resource limit). Without Landlock a root child drops to the
+  user ``nobody``; :attr:`XacroResult.wall` says which wall was up;
 - **files**: the input, its includes and ``load_yaml`` files must lie (symbolic links
   resolved) inside the file's own folder or a package folder the caller names;
   ``$(find PKG)`` resolves only those packages (``pinarms`` is always given: the folder
   of the built-in arms' macros, so a cell can ``<xacro:include
   filename="$(find pinarms)/scara_mushroom.xacro"/>``);
-- **expressions**: ``${...}`` may use literals, names, arithmetic, comparisons, ``and`` /
-  ``or`` / ``not``, ``a if c else b``, calls, subscripts and attributes whose name does
-  not start with ``_`` (xacro's own functions: ``radians``, ``pi``, ``sin``, ...,
-  ``xacro.arg``, ``load_yaml``); lambdas, comprehensions, generators and ``:=`` are
-  refused, and so are ``$(env)``, ``$(optenv)``, ``$(eval)`` and ``$(cwd)``.
+- **expressions**: ``${...}`` is evaluated by the whitelist of
+  :mod:`pinarms.robots.xacro_eval`, never by Python's ``eval``: literals, property names,
+  arithmetic, comparisons, ``and`` / ``or`` / ``not``, ``a if c else b``, subscripts of
+  lists and dicts, and calls of a fixed set of math functions (``radians``, ``sin``, ...,
+  ``xacro.arg``, ``xacro.tokenize``, ``load_yaml``); anything else is
+  :class:`~pinarms.robots.errors.XacroForbidden` naming the construct, and numbers or
+  strings beyond the size bounds are :class:`~pinarms.robots.errors.XacroLimitExceeded`
+  at once. ``$(env)``, ``$(optenv)``, ``$(eval)`` and ``$(cwd)`` are refused.
 
 Everything else of xacro works as documented by ROS: properties, macros with default and
 block parameters, ``xacro:if``/``unless``, ``xacro:arg`` with defaults, includes with
 namespaces. Errors are named: :class:`~pinarms.robots.errors.XacroForbidden` (the wall),
 :class:`~pinarms.robots.errors.XacroLimitExceeded` (time, memory, size),
+:class:`~pinarms.robots.errors.XacroFileNotFound` (the file, an included file or a yaml
+file does not exist; also a :class:`~pinarms.robots.errors.CellNotFound`),
 :class:`~pinarms.robots.errors.XacroArgError` (an argument the file does not declare, or
 a non-number for an argument whose default is a number) and
 :class:`~pinarms.robots.errors.XacroError` (xacro itself fails: unknown macro, undefined
-property, malformed XML).
+property, malformed XML: the message names the file, included or not, and the line).
+See docs/files.md.
 """
 
 from __future__ import annotations
@@ -43,7 +53,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-from .errors import InvalidInput, MissingMesh, XacroArgError, XacroError, XacroForbidden, XacroLimitExceeded
+from .errors import (
+    InvalidInput,
+    MissingMesh,
+    XacroArgError,
+    XacroError,
+    XacroFileNotFound,
+    XacroForbidden,
+    XacroLimitExceeded,
+)
 
 __all__ = ["XacroLimits", "XacroResult", "expand_xacro", "BUILTIN_PACKAGE", "parse_xacro_args", "mesh_path", "check_mesh_files"]
 
@@ -83,12 +101,15 @@ class XacroResult:
         files: every file read (the input, includes, yaml), resolved paths, sorted.
         args: the ``xacro:arg`` values used (declared defaults, overridden by the caller's).
         declared: the file's ``xacro:arg`` declarations and their defaults.
+        wall: the sandbox the expansion ran in: ``"landlock (ABI n)"``, ``"user nobody
+            (no Landlock)"`` or ``"resource limits only"``.
     """
 
     urdf_text: str
     files: tuple[str, ...]
     args: Mapping[str, str] = field(default_factory=dict)
     declared: Mapping[str, str] = field(default_factory=dict)
+    wall: str = ""
 
 
 def _as_number(text: str) -> float | None:
@@ -166,15 +187,17 @@ def expand_xacro(
         XacroLimitExceeded: time, memory or output size exceeded.
         XacroArgError: an argument the file does not declare, or a non-number for a
             numeric one.
-        XacroError: the file is missing or xacro fails (unknown macro, undefined property,
-            malformed XML, root element not ``<robot>``).
+        XacroFileNotFound: the file, a file it includes or a yaml file it loads is missing.
+        XacroError: xacro fails (unknown macro, undefined property, malformed XML of the
+            file or of an included file: the message names that file and the line; root
+            element not ``<robot>``).
     """
     limits = limits if limits is not None else XacroLimits()
     if not isinstance(limits, XacroLimits):
         raise InvalidInput(f"limits must be a XacroLimits, got {type(limits).__name__}")
     path = Path(path)
     if not path.is_file():
-        raise XacroError(f"xacro file {str(path)!r} does not exist")
+        raise XacroFileNotFound(f"xacro file {str(path)!r} does not exist")
     given = {str(k): _arg_text(str(k), v) for k, v in (args or {}).items()}
     pkgs = {BUILTIN_PACKAGE[0]: str(BUILTIN_PACKAGE[1])}
     for name, folder in (packages or {}).items():
@@ -186,7 +209,7 @@ def expand_xacro(
     request = {"path": str(path.resolve()), "args": given, "roots": roots, "packages": pkgs, "header": list(header)}
     try:
         proc = subprocess.run(
-            [sys.executable, "-I", str(_WORKER)],
+            [sys.executable, "-I", "-B", str(_WORKER)],
             input=json.dumps(request),
             capture_output=True,
             text=True,
@@ -225,10 +248,11 @@ def expand_xacro(
             raise XacroLimitExceeded(
                 f"xacro on {str(path)!r} needed more than {limits.memory_bytes / 2**20:g} MiB of memory; pinarms stopped it"
             )
-        cls = {"forbidden": XacroForbidden, "args": XacroArgError}.get(kind, XacroError)
+        cls = {"forbidden": XacroForbidden, "args": XacroArgError, "limit": XacroLimitExceeded,
+               "not_found": XacroFileNotFound}.get(kind, XacroError)
         raise cls(f"xacro on {str(path)!r}: {message}")
     used = {k: given.get(k, v) for k, v in declared.items()}
-    return XacroResult(answer["urdf"], tuple(answer["files"]), used, declared)
+    return XacroResult(answer["urdf"], tuple(answer["files"]), used, declared, answer.get("wall", ""))
 
 
 def _check_numeric_args(path: Path, given: dict[str, str], declared: dict[str, str | None]) -> None:

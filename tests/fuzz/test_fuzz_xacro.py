@@ -121,3 +121,57 @@ def test_malformed_xacro(tmp_path_factory, text, args):
     assert "secret" not in robot.urdf_text
     out, err = outcome(robot.fk, robot.neutral)
     assert err is None and np.all(np.isfinite(out))
+
+
+# ---- the expression whitelist on its own, against xacro's real symbol table (in-process, fast) ---------
+
+_atoms = st.sampled_from([
+    "python", "xacro", "math", "pi", "L", "s", "lst", "cfg", "vars", "type", "getattr", "eval", "open", "sin",
+    "xacro.abs_filename", "python.vars", "python.type", "python.getattr", "math.pi", "xacro.arg", "radians",
+    "'_'", "'__'", "'_globals_'", "'os'", "0", "1", "9", "10**9", "2.5", "()", "[]", "{}", "None", "True",
+])
+_suffixes = st.sampled_from([
+    "", ".__class__", ".__globals__", ".format", ".vars", ".type", ".abs_filename", ".pi", ".sin", ".real",
+    "()", "(1)", "('x')", "(s)", "[0]", "['_'+'_globals_'+'_']", "[1:]", " ** 9 ** 9", " * 10**9", " + '_'",
+    " % 1", " if 1 else 0", ".__subclasses__()",
+])
+
+
+@st.composite
+def hostile_expressions(draw):
+    parts = [draw(_atoms) + "".join(draw(st.lists(_suffixes, max_size=4)))]
+    for _ in range(draw(st.integers(0, 2))):
+        op = draw(st.sampled_from([" + ", " * ", " and ", " or ", ", ", "(", "["]))
+        inner = draw(_atoms) + draw(_suffixes)
+        parts.append(f"{op}{inner}" + (")" if op == "(" else "]" if op == "[" else ""))
+    text = "".join(parts)
+    wrap = draw(st.sampled_from(["{}", "[{} for c in 'ab']", "(lambda: {})()", "f'{{{}}}'", "({} := 1)", "max(*{})",
+                                 "{}"]))
+    return wrap.format(text)
+
+
+@settings(max_examples=300 * EXPLORE)
+@given(expr=hostile_expressions())
+@example(expr="python.vars(python.type(python.vars(python.type(xacro.abs_filename))['_'+'_globals_'+'_']))"
+              "['_'+'_get_'+'_']('os')")
+def test_hostile_expressions_give_data_or_a_named_error(expr):
+    import time
+
+    import xacro
+
+    from pinarms.robots.xacro_eval import MAX_LENGTH, ExpressionError, evaluate
+
+    symbols = xacro.Table(xacro.create_global_symbols())
+    for name, value in {"L": 0.3, "s": "arm", "lst": [1, 2], "cfg": {"a": 1}}.items():
+        symbols[name] = value
+    start = time.perf_counter()
+    try:
+        value = evaluate(expr, symbols, namespaces=(xacro.NameSpace,), attr_dicts=(xacro.YamlDictWrapper,))
+    except (ExpressionError, SyntaxError, NameError, TypeError, ValueError, ZeroDivisionError, OverflowError,
+            KeyError, IndexError, AttributeError):
+        value = None
+    assert time.perf_counter() - start < 1.0, expr
+    assert isinstance(value, (bool, int, float, complex, str, list, tuple, dict, type(None))), (expr, value)
+    assert not isinstance(value, xacro.NameSpace), expr
+    if isinstance(value, (str, list, tuple, dict)):
+        assert len(value) <= MAX_LENGTH
