@@ -170,7 +170,7 @@ def _pose_of_unreached(h5, _):
         (_unsorted, "strictly increasing"),
         (_nan_origin, "NaN"),
         (_scale_rotation, "not a proper rotation"),
-        (_flip_bit, "does not follow from /voxels/reached"),
+        (_flip_bit, "does not follow from /voxels/reached|solutions for the 837 reached poses"),
         (_q_outside, "outside the joint limits"),
         (_pose_of_unreached, "marked unreached|exactly one solution"),
     ],
