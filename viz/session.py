@@ -246,8 +246,8 @@ class Session:
             else:
                 # an embedded URDF comes from a file: its meshes must stay inside the folders the caller
                 # allowed; the folders the file names (entry.package_dirs) only appear in the message
-                dirs = self.mesh_dirs
-                check_mesh_paths(entry.urdf_text, dirs, f"session robot {entry.key!r}", recorded=entry.package_dirs)
+                dirs = check_mesh_paths(entry.urdf_text, self.mesh_dirs, f"session robot {entry.key!r}",
+                                        recorded=entry.package_dirs)
                 rob = robots.from_urdf_text(
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
@@ -527,10 +527,11 @@ def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | lis
 
     Args:
         path: the session file.
-        package_dirs: folders besides the session file's own folder that meshes of embedded
-            URDFs may come from (``package://`` paths are resolved against each). Folders
-            named inside the file are never used by themselves: a mesh outside the session's
-            folder and these is refused with :class:`SessionFormatError` naming it.
+        package_dirs: folders besides the session file's own folder (and pinarms' own model
+            folders) that meshes of embedded URDFs may come from (``package://`` paths are
+            resolved against each). Folders named inside the file are never used by
+            themselves: a mesh outside these is refused with :class:`SessionFormatError`
+            naming it and saying what to pass.
         limits: the most the reader accepts (default ``SessionLimits()``: 1 GiB in all,
             512 MiB per array, 16 MiB per URDF, 64 MiB of JSON).
 
@@ -549,5 +550,12 @@ def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | lis
     for kind in KINDS:
         setattr(s, kind.attr, contents.tables[kind.attr])
     own = str(Path(path).resolve().parent)
-    s.mesh_dirs = tuple(dict.fromkeys([own, *(os.fspath(d) for d in (package_dirs or ()))]))
+    s.mesh_dirs = tuple(dict.fromkeys([own, *(os.fspath(d) for d in (package_dirs or ())), *_shipped_model_dirs()]))
     return s
+
+
+def _shipped_model_dirs() -> tuple[str, ...]:
+    """pinarms' own model folders (built-in URDFs and cells with their meshes, the xacro macros): always allowed."""
+    import pinarms.urdf
+
+    return (str(Path(pinarms.urdf.__file__).resolve().parent), str(Path(robots.__file__).resolve().parent / "xacro"))

@@ -902,7 +902,7 @@ _MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".glb", ".gltf", ".3ds", ".fbx
 
 
 def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str, *,
-                     recorded: tuple[str, ...] = ()) -> None:
+                     recorded: tuple[str, ...] = ()) -> tuple[str, ...]:
     """Refuse an embedded URDF whose meshes may lie outside the allowed folders ``package_dirs``.
 
     ``package_dirs`` are the folders the *caller* allows (:func:`viz.load_session` passes the
@@ -915,6 +915,11 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
     and non-regular files (devices, FIFOs) are refused. A package-relative mesh found in no
     allowed folder is refused when the file names folders of its own that were not passed
     (the message says which to pass); otherwise it is left to the viewer (which reports it).
+    Recorded folders that lie inside an allowed folder (links followed) are searched too.
+
+    Returns:
+        The folders to resolve meshes against: the recorded ones inside the allowed folders,
+        then the allowed folders.
 
     Raises:
         SessionFormatError: naming the robot and the mesh path, and what to pass instead.
@@ -929,8 +934,14 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
         raise SessionFormatError(f"{source}: the embedded URDF is not well-formed XML ({exc})") from None
     roots = [Path(d).resolve() for d in package_dirs if isinstance(d, str) and d]
     where = f"the allowed folders {[str(b) for b in roots]}" if roots else "the allowed folders (none)"
-    allowed_text = {os.path.normpath(str(b)) for b in roots}
-    unlisted = [d for d in recorded if isinstance(d, str) and d and os.path.normpath(d) not in allowed_text]
+    inside, unlisted = [], []
+    for d in recorded:
+        real = Path(d).resolve() if isinstance(d, str) and os.path.isabs(d) else None
+        if real is not None and any(real.is_relative_to(b) for b in roots):
+            inside.append(real)
+        elif isinstance(d, str) and d:
+            unlisted.append(d)
+    bases = list(dict.fromkeys(inside + roots))
     how = ("if you trust that folder, pass it: viz.load_session(path, package_dirs=[...]) or "
            "--package-dir FOLDER on the command line")
     for mesh in root.iter("mesh"):
@@ -957,7 +968,7 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
                 raise SessionFormatError(f"{source}: mesh {shown} leaves its package folder ('..')")
             # Pinocchio tries <dir>/<path>; some versions also <dir>/<path without its package name>
             tails = [rel.parts] + ([rel.parts[1:]] if scheme and len(rel.parts) > 1 else [])
-            candidates = [base.joinpath(*tail) for base in roots for tail in tails]
+            candidates = [base.joinpath(*tail) for base in bases for tail in tails]
         found = False
         for cand in candidates:
             if not os.path.lexists(cand):
@@ -973,3 +984,4 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
             raise SessionFormatError(
                 f"{source}: mesh {shown} is in none of {where}; the session file names the folder(s) "
                 f"{[d[:200] for d in unlisted[:5]]}, which a session cannot allow by itself: {how}")
+    return tuple(str(b) for b in bases)
