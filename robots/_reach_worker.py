@@ -105,6 +105,10 @@ def _typed(value, key: str, kind: str, where: str):
                 raise Refused(f"attribute {key!r} of {where} is not UTF-8 text") from None
         if not isinstance(value, str) or len(value) > MAX_TEXT:
             raise Refused(f"attribute {key!r} of {where} must be text of at most {MAX_TEXT} characters")
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:  # lone surrogates from undecodable bytes
+            raise Refused(f"attribute {key!r} of {where} is not UTF-8 text") from None
         return value
     if kind == "bool":
         if isinstance(value, (bool, np.bool_)):
