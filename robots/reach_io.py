@@ -3,7 +3,8 @@
 Layout (format ``pinarms-reachability``, version :data:`FORMAT_VERSION`), SI units::
 
     /                      attrs: format, version, pinarms_version, robot, urdf_sha256, tcp_frame,
-                                  solver, manipulability, resolution [m], shape (3,), parameters (JSON)
+                                  solver, manipulability, resolution [m], shape (3,), parameters (JSON),
+                                  n_reached (count of reached poses; optional when reading)
     /robot/joint_lower     (nq,) f8 [rad or m]     attrs: joint_names (JSON list)
     /robot/joint_upper     (nq,) f8
     /grid/origin           (3,) f8  corner of voxel [0, 0, 0] [m]; voxel (i, j, k) has flat index (i·ny + j)·nz + k
@@ -26,8 +27,17 @@ outside the file (external storage, virtual datasets), an unknown compression fi
 array larger than ``max_bytes`` in memory, a shape that disagrees with the others, NaN where
 numbers are needed, indices out of range, a rotation that is not a rotation, an index that
 does not follow from the reached bits, or a stored solution outside the joint limits all
-raise :class:`ReachabilityFileError` naming the member and the problem. Nothing is read
-before its declared size has been checked.
+raise :class:`ReachabilityFileError` naming the member and the problem.
+
+The HDF5 library runs in a child process (:mod:`robots._reach_worker`, started by
+:mod:`robots._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
+wall-clock time (``timeout`` for opening the file and checking its layout, then 1 s per
+20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before any
+data is read, the declared dtypes and shapes are checked against each other (joints,
+orientations, voxels, stored solutions ≤ V·M and = ``n_reached``) and against
+``max_bytes``, and the storage against what a writer produces (fill value 0, every chunk
+written, chunks ≤ 16 MiB and ≤ 2²⁰ of them). The arrays come back as raw bytes into arrays
+sized here; nothing is unpickled.
 """
 
 from __future__ import annotations
