@@ -10,6 +10,7 @@ the child sends is unpickled or evaluated.
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import resource
@@ -57,6 +58,10 @@ class ReaderChild:
             self.close()
             raise
         self.fd = self.proc.stdout.fileno()
+        try:  # fewer, larger reads for big maps (Linux caps unprivileged pipes at 1 MiB)
+            fcntl.fcntl(self.fd, fcntl.F_SETPIPE_SZ, 1 << 20)
+        except OSError:
+            pass
         os.set_blocking(self.fd, False)
         self.poll = select.poll()
         self.poll.register(self.fd, select.POLLIN | select.POLLHUP | select.POLLERR)
