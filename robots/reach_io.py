@@ -383,7 +383,7 @@ def _manifest(p: Path, raw: bytes, request: dict) -> dict:
         attrs, listed = doc["attrs"], doc["arrays"]
     except (ValueError, KeyError, TypeError, UnicodeDecodeError, RecursionError):
         raise bad("is malformed") from None
-    table = list(DATASETS) + (list(POSES) if len(listed) > len(DATASETS) else [])
+    table = list(DATASETS) + (list(POSES) if request["solutions"] and len(listed) > len(DATASETS) else [])
     if not isinstance(attrs, dict) or not isinstance(listed, list) or len(listed) != len(table):
         raise bad("lists other members than a map has")
     dims: dict[str, int] = {}
