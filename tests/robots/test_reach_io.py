@@ -370,3 +370,38 @@ def test_timeout_is_checked(saved):
     with pytest.raises(InvalidInput, match="timeout"):
         load_reachability(saved, timeout=0)
     assert load_reachability(saved, timeout=30.0).n_reached == 838
+
+
+def test_the_reader_process_runs_under_its_limits():
+    from pinarms.robots import reach_io
+    from pinarms.robots._reach_child import ReaderChild
+
+    with ReaderChild(reach_io.READER_MEMORY, 7) as child:
+        assert child.frame(time.monotonic() + 60) == (b"R", 0)  # up, waiting for its request
+        limits = {ln[:26].strip(): ln[26:].split() for ln in open(f"/proc/{child.proc.pid}/limits")}
+        status = open(f"/proc/{child.proc.pid}/status").read()
+    assert limits["Max address space"][:2] == [str(reach_io.READER_MEMORY)] * 2
+    assert limits["Max cpu time"][:2] == ["7", "7"] and limits["Max file size"][:2] == ["0", "0"]
+    assert child.proc.returncode is not None  # killed and reaped on leaving the block
+    assert int(status.split("VmHWM:")[1].split()[0]) * 1024 < reach_io.READER_MEMORY
+
+
+@pytest.mark.parametrize("edit, match", [
+    (lambda d: d["arrays"][10].update(shape=[428, 9]), "disagrees with the other members"),
+    (lambda d: d["arrays"][0].update(dtype="|O"), "describes /robot/joint_lower wrongly"),
+    (lambda d: d["arrays"].pop(), "lists other members"),
+    (lambda d: d["arrays"][7].update(shape=[2**39]), "max_bytes"),
+])
+def test_the_parent_checks_the_readers_answer_again(saved, edit, match):
+    """A reader that libhdf5 let an attacker control could send anything: the manifest is checked again."""
+    from pinarms.robots import reach_io
+    from pinarms.robots._reach_worker import DATASETS
+
+    arrays = [{"name": n, "dtype": np.dtype(t).str, "shape": [{"nq": 6, "M": 8, "G": 8, "V": 428}.get(s, s) for s in shape]}
+              for n, t, shape in DATASETS]
+    doc = {"attrs": {}, "arrays": arrays}
+    request = {"max_bytes": 2**30, "solutions": False}
+    assert set(reach_io._manifest(saved, json.dumps(doc).encode(), request)["arrays"]) == {n for n, _, _ in DATASETS}
+    edit(doc)
+    with pytest.raises(ReachabilityFileError, match=match):
+        reach_io._manifest(saved, json.dumps(doc).encode(), request)
