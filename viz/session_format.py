@@ -936,7 +936,10 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
     where = f"the allowed folders {[str(b) for b in roots]}" if roots else "the allowed folders (none)"
     inside, unlisted = [], []
     for d in recorded:
-        real = Path(d).resolve() if isinstance(d, str) and os.path.isabs(d) else None
+        try:
+            real = Path(d).resolve() if isinstance(d, str) and os.path.isabs(d) else None
+        except (ValueError, OSError):  # a NUL byte, a path too long: never a folder to search
+            real = None
         if real is not None and any(real.is_relative_to(b) for b in roots):
             inside.append(real)
         elif isinstance(d, str) and d:
