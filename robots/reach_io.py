@@ -322,12 +322,11 @@ def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, di
             _expect(p, child, child.frame(deadline), b"K", deadline)
             child.finish(time.monotonic() + 5.0)
     except ChildTimeout:
-        limit = timeout if stage.startswith("opening") else None
+        bound = {"starting the reader": f"{_STARTUP_TIMEOUT:g} s", "opening it and checking its layout": f"{timeout:g} s"}
         raise ReachabilityFileError(
             f"{shown!r} is not a valid pinarms reachability map: {stage} did not finish in time "
-            f"({'%g s' % limit if limit else 'the bound of timeout + 1 s per 20 MB'}; a damaged HDF5 file can make "
-            "the library loop forever), so the reader was stopped; if it is a large valid map on a busy machine, "
-            "pass a larger timeout"
+            f"({bound.get(stage, f'{timeout:g} s + 1 s per 20 MB')}; a damaged HDF5 file can make the library loop "
+            "forever), so the reader was stopped; if it is a large valid map on a busy machine, pass a larger timeout"
         ) from None
     except ChildGone as exc:
         raise ReachabilityFileError(f"{shown!r} is not a valid pinarms reachability map: {_gone(exc.args[0])} while "
