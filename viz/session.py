@@ -181,6 +181,10 @@ class Session:
         self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self._loaded: dict[str, Robot] = {}
         self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
+        #: folders meshes of robots stored in a file may be read from (set by :func:`load_session`:
+        #: the session file's own folder and the caller's ``package_dirs``; never folders named in the file)
+        self.mesh_dirs: tuple[str, ...] = ()
+        #: kept for callers that read it; :func:`load_session` leaves it ``None`` (each robot carries its folders)
         self.package_dirs_override: tuple[str, ...] | None = None
         if robot is not None:
             self.add_robot(robot, key=key, base_to_world=base_to_world)
@@ -240,9 +244,10 @@ class Session:
             if entry.source == "registry":
                 rob = robots.load(entry.name)
             else:
-                dirs = self.package_dirs_override if self.package_dirs_override is not None else entry.package_dirs
-                # an embedded URDF comes from a file: its meshes must stay inside the package dirs
-                check_mesh_paths(entry.urdf_text, tuple(dirs), f"session robot {entry.key!r}")
+                # an embedded URDF comes from a file: its meshes must stay inside the folders the caller
+                # allowed; the folders the file names (entry.package_dirs) only appear in the message
+                dirs = check_mesh_paths(entry.urdf_text, self.mesh_dirs, f"session robot {entry.key!r}",
+                                        recorded=entry.package_dirs)
                 rob = robots.from_urdf_text(
                     entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
                     package_dirs=tuple(dirs),
@@ -522,8 +527,11 @@ def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | lis
 
     Args:
         path: the session file.
-        package_dirs: folders resolving ``package://`` meshes of embedded URDFs (default:
-            the folders recorded when the session was saved).
+        package_dirs: folders besides the session file's own folder (and pinarms' own model
+            folders) that meshes of embedded URDFs may come from (``package://`` paths are
+            resolved against each). Folders named inside the file are never used by
+            themselves: a mesh outside these is refused with :class:`SessionFormatError`
+            naming it and saying what to pass.
         limits: the most the reader accepts (default ``SessionLimits()``: 1 GiB in all,
             512 MiB per array, 16 MiB per URDF, 64 MiB of JSON).
 
@@ -541,6 +549,13 @@ def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | lis
     s.metadata = contents.metadata
     for kind in KINDS:
         setattr(s, kind.attr, contents.tables[kind.attr])
-    if package_dirs is not None:
-        s.package_dirs_override = tuple(str(d) for d in package_dirs)
+    own = str(Path(path).resolve().parent)
+    s.mesh_dirs = tuple(dict.fromkeys([own, *(os.fspath(d) for d in (package_dirs or ())), *_shipped_model_dirs()]))
     return s
+
+
+def _shipped_model_dirs() -> tuple[str, ...]:
+    """pinarms' own model folders (built-in URDFs and cells with their meshes, the xacro macros): always allowed."""
+    import pinarms.urdf
+
+    return (str(Path(pinarms.urdf.__file__).resolve().parent), str(Path(robots.__file__).resolve().parent / "xacro"))

@@ -132,7 +132,9 @@ class RobotEntry:
         joint_names: independent joints, in ``q`` order.
         base_to_world: pose of the robot's base in the world frame, (4, 4), m.
         urdf_text: embedded URDF (``None`` for registry robots).
-        package_dirs: folders that resolved ``package://`` meshes when saved (a hint only).
+        package_dirs: folders that resolved ``package://`` meshes when saved: a hint shown in
+            error messages only; loading never reads meshes from them unless the caller
+            passes them (``load_session(..., package_dirs=...)``).
         payload: the payload the robot carries (:meth:`robots.dynamics.Payload.as_dict`:
             ``mass_kg``, ``com_m``, ``inertia_kg_m2``, ``frame``), or ``None``; reapplied
             with ``robot.with_payload`` when the session reopens.
@@ -899,18 +901,28 @@ def _read(r: _Reader) -> SessionContents:
 _MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".glb", ".gltf", ".3ds", ".fbx")
 
 
-def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str) -> None:
-    """Refuse an embedded URDF whose meshes may lie outside ``package_dirs``.
+def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str, *,
+                     recorded: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """Refuse an embedded URDF whose meshes may lie outside the allowed folders ``package_dirs``.
 
+    ``package_dirs`` are the folders the *caller* allows (:func:`viz.load_session` passes the
+    session file's own folder and its ``package_dirs`` argument); folders named inside the
+    file (``recorded``, the ``package_dirs`` of ``session.json``) never widen them.
     Pinocchio resolves ``package://p`` (and ``model://p``) and relative paths ``p`` against
-    each package dir, and uses absolute paths and ``file://`` URLs as they are. Each must
+    each allowed folder, and uses absolute paths and ``file://`` URLs as they are. Each must
     name a mesh file (``.stl``, ``.dae``, ...) that lies, symbolic links followed, inside
-    one of the package dirs: ``..`` escapes, absolute paths elsewhere, other URL schemes and
-    non-regular files (devices, FIFOs) are refused. A mesh that exists nowhere is left to
-    the viewer (which reports it); the kinematics never read meshes.
+    one of the allowed folders: ``..`` escapes, absolute paths elsewhere, other URL schemes
+    and non-regular files (devices, FIFOs) are refused. A package-relative mesh found in no
+    allowed folder is refused when the file names folders of its own that were not passed
+    (the message says which to pass); otherwise it is left to the viewer (which reports it).
+    Recorded folders that lie inside an allowed folder (links followed) are searched too.
+
+    Returns:
+        The folders to resolve meshes against: the recorded ones inside the allowed folders,
+        then the allowed folders.
 
     Raises:
-        SessionFormatError: naming the robot and the mesh path.
+        SessionFormatError: naming the robot and the mesh path, and what to pass instead.
     """
     import xml.etree.ElementTree as ET
 
@@ -921,7 +933,20 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str)
     except ET.ParseError as exc:
         raise SessionFormatError(f"{source}: the embedded URDF is not well-formed XML ({exc})") from None
     roots = [Path(d).resolve() for d in package_dirs if isinstance(d, str) and d]
-    where = f"the package dirs {[str(b) for b in roots]}" if roots else "the session's package dirs (none recorded)"
+    where = f"the allowed folders {[str(b) for b in roots]}" if roots else "the allowed folders (none)"
+    inside, unlisted = [], []
+    for d in recorded:
+        try:
+            real = Path(d).resolve() if isinstance(d, str) and os.path.isabs(d) else None
+        except (ValueError, OSError):  # a NUL byte, a path too long: never a folder to search
+            real = None
+        if real is not None and any(real.is_relative_to(b) for b in roots):
+            inside.append(real)
+        elif isinstance(d, str) and d:
+            unlisted.append(d)
+    bases = list(dict.fromkeys(inside + roots))
+    how = ("if you trust that folder, pass it: viz.load_session(path, package_dirs=[...]) or "
+           "--package-dir FOLDER on the command line")
     for mesh in root.iter("mesh"):
         name = mesh.get("filename", "")
         shown = repr(name[:200])
@@ -934,24 +959,32 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str)
         rel = PurePosixPath(rest)
         if rel.suffix.lower() not in _MESH_SUFFIXES:
             raise SessionFormatError(f"{source}: mesh {shown} is not a mesh file ({', '.join(_MESH_SUFFIXES)})")
-        if scheme == "file" or rel.is_absolute():
+        absolute = scheme == "file" or rel.is_absolute()
+        if absolute:
             if not rel.is_absolute():
                 raise SessionFormatError(f"{source}: mesh {shown} is a file:// URL without an absolute path")
+            if not any(Path(rest).resolve().is_relative_to(b) for b in roots):
+                raise SessionFormatError(f"{source}: mesh {shown} lies outside {where}; {how}")
             candidates = [Path(rest)]
         else:
             if ".." in rel.parts or not rel.parts:
                 raise SessionFormatError(f"{source}: mesh {shown} leaves its package folder ('..')")
             # Pinocchio tries <dir>/<path>; some versions also <dir>/<path without its package name>
             tails = [rel.parts] + ([rel.parts[1:]] if scheme and len(rel.parts) > 1 else [])
-            candidates = [base.joinpath(*tail) for base in roots for tail in tails]
+            candidates = [base.joinpath(*tail) for base in bases for tail in tails]
+        found = False
         for cand in candidates:
             if not os.path.lexists(cand):
                 continue
+            found = True
             real = cand.resolve()
             if not any(real.is_relative_to(base) for base in roots):
-                raise SessionFormatError(f"{source}: mesh {shown} resolves to {str(real)!r}, outside {where}")
+                raise SessionFormatError(f"{source}: mesh {shown} resolves to {str(real)!r}, outside {where}; {how}")
             if not real.is_file():
                 raise SessionFormatError(f"{source}: mesh {shown} resolves to {str(real)!r}, which is not a "
                                          f"regular file")
-        if (scheme == "file" or rel.is_absolute()) and not any(Path(rest).resolve().is_relative_to(b) for b in roots):
-            raise SessionFormatError(f"{source}: mesh {shown} lies outside {where}")
+        if not found and not absolute and unlisted:
+            raise SessionFormatError(
+                f"{source}: mesh {shown} is in none of {where}; the session file names the folder(s) "
+                f"{[d[:200] for d in unlisted[:5]]}, which a session cannot allow by itself: {how}")
+    return tuple(str(b) for b in bases)

@@ -284,7 +284,8 @@ def test_hostile_array_members(tmp_path, case):
 
 @pytest.mark.parametrize("case", ["duplicate_member", "duplicate_json", "dotdot", "absolute", "backslash",
                                   "bzip2", "lzma", "stored", "urdf_doctype", "urdf_entities", "urdf_not_utf8",
-                                  "urdf_big", "urdf_mesh_escape", "urdf_mesh_absolute", "urdf_mesh_device"])
+                                  "urdf_big", "urdf_mesh_escape", "urdf_mesh_absolute", "urdf_mesh_device",
+                                  "urdf_mesh_own_root"])
 def test_hostile_archives(tmp_path, case):
     members = list(BASE_MEMBERS.items())
     method = zipfile.ZIP_DEFLATED
@@ -324,8 +325,10 @@ def test_hostile_archives(tmp_path, case):
         members.append((urdf, BASE_MEMBERS[urdf] + b" " * (17 << 20)))
         match = "max_text_bytes"
     elif case.startswith("urdf_mesh"):
+        other = tmp_path.parent / f"{tmp_path.name}_other"  # a folder beside the session's, holding a part
         fname = {"urdf_mesh_escape": "package://lever/../../../etc/shadow.stl",
-                 "urdf_mesh_absolute": "/etc/hosts.stl", "urdf_mesh_device": "package://zero.stl"}[case]
+                 "urdf_mesh_absolute": "/etc/hosts.stl", "urdf_mesh_device": "package://zero.stl",
+                 "urdf_mesh_own_root": f"package://{other}/secret_part.stl"}[case]
         text = BASE_MEMBERS[urdf].decode().replace('<box size="0.1 0.1 0.1"/>', f'<mesh filename="{fname}"/>')
         members.append((urdf, text.encode()))
         pkg = tmp_path / "pkg"
@@ -333,6 +336,10 @@ def test_hostile_archives(tmp_path, case):
         if case == "urdf_mesh_device":
             os.symlink("/dev/zero", pkg / "zero.stl")
         doc["robots"][1]["package_dirs"] = [str(pkg)]
+        if case == "urdf_mesh_own_root":  # the file names "/" as its package folder: it allows nothing by itself
+            other.mkdir()
+            (other / "secret_part.stl").write_bytes(b"solid s\nendsolid s\n")
+            doc["robots"][1]["package_dirs"] = ["/"]
         expect_ok = True  # the file loads; the robot is refused when it is built
     members = [(n, d) for n, d in members if not (n == urdf and case.startswith("urdf") and d == BASE_MEMBERS[urdf])]
     members = [(n, json.dumps(doc).encode() if n == "session.json" and d == BASE_MEMBERS["session.json"] else d)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import zipfile
 
 import numpy as np
@@ -615,8 +616,9 @@ MESH_URDF = LEVER_URDF.replace('<box size="0.1 0.1 0.1"/>', '<mesh filename="{}"
     ("package://lever/meshes/base.txt", False),              # not a mesh file
     ("package://lever/fifo.stl", False),                     # not a regular file
 ])
-def test_embedded_urdf_meshes_stay_inside_the_package_dirs(tmp_path, filename, ok):
-    pkg = tmp_path / "pkg"
+def test_embedded_urdf_meshes_stay_inside_the_allowed_folders(tmp_path, filename, ok):
+    study = tmp_path / "study"
+    pkg = study / "pkg"
     (pkg / "lever" / "meshes").mkdir(parents=True)
     (pkg / "lever" / "meshes" / "base.stl").write_bytes(b"solid x\nendsolid x\n")
     (pkg / "lever" / "meshes" / "base.txt").write_text("x")
@@ -627,18 +629,59 @@ def test_embedded_urdf_meshes_stay_inside_the_package_dirs(tmp_path, filename, o
     urdf = MESH_URDF.format(filename.format(pkg=pkg))
     robot = robots.from_urdf_text(urdf, package_dirs=(str(pkg),))
     s = viz.Session(robot, key="lever")
-    back = viz.load_session(s.save(tmp_path / "m.pinarms"))
-    assert back.robots["lever"].source == "urdf"
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    # beside its package folder (inside the session's own folder), or elsewhere with the folder passed
+    for back in (viz.load_session(s.save(study / "m.pinarms")),
+                 viz.load_session(s.save(elsewhere / "m.pinarms"), package_dirs=[str(pkg)])):
+        assert back.robots["lever"].source == "urdf"
+        if ok:
+            rob = back.robot("lever")
+            assert rob.nq == 1 and str(pkg) in rob.package_dirs
+        else:
+            with pytest.raises(SessionFormatError, match="mesh"):
+                back.robot("lever")
+    # elsewhere without it: the folder the file names is never used by itself, and the message says what to pass
+    far = viz.load_session(elsewhere / "m.pinarms")
+    with pytest.raises(SessionFormatError, match="mesh") as info:
+        far.robot("lever")
     if ok:
-        assert back.robot("lever").nq == 1
-    else:
-        with pytest.raises(SessionFormatError, match="mesh"):
-            back.robot("lever")
-    # the package dirs recorded in the file are only a default: an explicit one is checked the same way
-    other = viz.load_session(tmp_path / "m.pinarms", package_dirs=[str(tmp_path / "empty")])
-    if filename.startswith(("/", "file://", "http")) or ".." in filename or filename.endswith(".txt"):
-        with pytest.raises(SessionFormatError, match="mesh"):
-            other.robot("lever")
+        assert "--package-dir" in str(info.value) and "package_dirs=" in str(info.value)
+
+
+SECRET_STL = b"solid secret_part\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n" \
+             b"endfacet\nendsolid secret_part\n"
+
+
+@pytest.mark.parametrize("form", ["absolute", "package_named"])
+def test_a_session_cannot_allow_folders_by_itself(tmp_path, form):
+    """Issue 29 item 2: package_dirs ["/"] in session.json and a mesh in another folder: refused, no page written."""
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    other = tmp_path / "other"
+    other.mkdir()
+    secret = other / "secret_part.stl"
+    secret.write_bytes(SECRET_STL)
+    study = tmp_path / "study"
+    study.mkdir()
+    mesh = f"package://{other}/secret_part.stl" if form == "absolute" else f"package:/{other}/secret_part.stl"
+    robot = robots.from_urdf_text(MESH_URDF.format(mesh), package_dirs=("/",))
+    path = viz.Session(robot, key="lever").save(study / "s.pinarms")
+    assert _doc(path)["robots"][0]["package_dirs"] == ["/"]
+    page = study / "page.html"
+    with pytest.raises(SessionFormatError, match=re.escape(repr(mesh))) as info:
+        viz.export_html(viz.load_session(path), page)
+    assert "package_dirs=" in str(info.value) and "--package-dir" in str(info.value)
+    assert not page.exists() and not list(study.glob("*.part"))
+    result = CliRunner().invoke(cli, ["export-html", str(path), str(page)])
+    assert result.exit_code != 0 and "Traceback" not in result.output
+    lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error:") and "secret_part.stl" in lines[0], result.stderr
+    assert not page.exists()
+    if form == "absolute":  # the caller may allow the folder: then the mesh is read from it (and only then)
+        assert viz.load_session(path, package_dirs=[str(other)]).robot("lever").nq == 1
 
 
 _CRASH = textwrap.dedent("""
