@@ -193,7 +193,6 @@ class Cell:
         self.collision_model = self._build_geometry(root)
         self._placements = BatchedPlacements(model)
         self._pin_index = self._plain_pin_index()
-        self._data = model.createData()
         self.fixtures = self._fixtures()
         self.pairs, self.allowed = classify_pairs(self, seed=seed)
         self.kinds: tuple[str, ...] = ("self", "arm-arm", "arm-fixture")
@@ -309,18 +308,18 @@ class Cell:
         return None
 
     def _finish_geometry(self) -> None:
-        """Keep only the checked pairs in the collision model, tight coal tolerances, and test every pair once."""
-        gm = self.collision_model
-        gm.removeAllCollisionPairs()
-        for p in self.pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-        self._gd = self._new_geometry_data()
-        q0 = pin.neutral(self.model)
-        pin.updateGeometryPlacements(self.model, self._data, gm, self._gd, q0)
-        for k, p in enumerate(self.pairs):
+        """Keep only the checked pairs in the collision model, the candidate pairs, and test every candidate once."""
+        from .pairs import reach_pairs
+
+        reach, bounds = reach_pairs(self, self.allowed)
+        self._set_candidates(self.pairs, reach, bounds)
+        n = len(self._candidates)
+        gm, gd = self._views.geometry(n), self._views.distance_data(n)
+        pin.updateGeometryPlacements(self.model, self._views.data(), gm, gd, pin.neutral(self.model))
+        for k, p in enumerate(self._candidates):
             try:
-                d = pin.computeDistance(gm, self._gd, k).min_distance
-                pin.computeCollision(gm, self._gd, k)
+                d = pin.computeDistance(gm, gd, k).min_distance
+                pin.computeCollision(gm, gd, k)
             except Exception as exc:
                 raise CollisionGeometryError(
                     f"{self.source}: the pair ({p.body_a}, {p.body_b}) cannot be checked by coal: {exc}"
@@ -330,9 +329,46 @@ class Cell:
                     f"{self.source}: the distance between {p.body_a} and {p.body_b} is {d}: check their geometry"
                 )
 
-    def _new_geometry_data(self) -> pin.GeometryData:
-        # exact distances (coal's default 1e-6 m is coarser than the checks), no warm start
-        return cold_start(pin.GeometryData(self.collision_model), distance_tolerance=1e-10)
+    def _set_candidates(self, pairs: tuple, reach: tuple, bounds: np.ndarray) -> None:
+        """Checked pairs, then out-of-reach pairs by increasing bound; the collision model keeps the checked ones."""
+        from .views import PairViews
+
+        self.pairs = tuple(pairs)
+        self._reach = tuple(reach)
+        self._reach_bounds = np.asarray(bounds, dtype=float)
+        self._candidates = self.pairs + self._reach
+        gm = self.collision_model
+        gm.removeAllCollisionPairs()
+        for p in self.pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+        self._views = PairViews(self.model, gm, self._candidates)
+        for cache in ("_bounds",):
+            self.__dict__.pop(cache, None)
+
+    # ------------------------------------------------------------------ pairs
+    def _n_for(self, clearance: float, *, strict: bool = False) -> int:
+        """How many candidate pairs a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it)."""
+        side = "left" if strict else "right"
+        return len(self.pairs) + int(np.searchsorted(self._reach_bounds, clearance, side=side))
+
+    def pairs_for(self, clearance: float) -> tuple:
+        """The pairs a check at ``clearance`` (or margin) [m] must look at.
+
+        The checked pairs (:attr:`pairs`) followed by every ``"out of reach"`` pair whose
+        proven distance bound (:attr:`AllowedPair.distance_bound`) is at most ``clearance``,
+        in increasing order of that bound: the pairs left out are proven farther than
+        ``clearance`` in every configuration. ``pairs_for(0.0)`` is :attr:`pairs`; the
+        result is always a prefix of ``pairs_for(inf)``, so a pair index means the same pair
+        at every clearance.
+
+        Raises:
+            InvalidInput: ``clearance`` not a number ≥ 0 (``inf`` allowed).
+        """
+        ok = isinstance(clearance, (int, float, np.integer, np.floating)) and not isinstance(clearance, bool)
+        value = float(clearance) if ok else float("nan")
+        if not value >= 0.0:
+            raise InvalidInput(f"clearance must be a number >= 0 [m] (inf allowed), got {clearance!r}")
+        return self._candidates[: self._n_for(value)]
 
     # --------------------------------------------------------------- joint vector
     @property
@@ -494,8 +530,9 @@ class Cell:
                 ``"external"`` for ``("arm-arm", "arm-fixture")`` (what a safety distance to
                 obstacles and other arms is about: an arm's own links are designed close).
 
-        The result shares the model and the arms; its :attr:`pairs` (and so every check) are
-        the subset. The pairs left out are not added to :attr:`allowed`.
+        The result shares the model and the arms; its :attr:`pairs` and its out-of-reach
+        pairs (:meth:`pairs_for`), and so every check, are the subset. The pairs left out are
+        not added to :attr:`allowed`.
         """
         import copy
 
@@ -506,16 +543,10 @@ class Cell:
         if unknown or not kinds:
             raise InvalidInput(f"kinds must be among 'self', 'arm-arm', 'arm-fixture' (or 'external'), got {kinds!r}")
         view = copy.copy(self)
-        view.pairs = tuple(p for p in self.pairs if p.kind in kinds)
-        gm = self.collision_model.copy()
-        gm.removeAllCollisionPairs()
-        for p in view.pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-        view.collision_model = gm
-        view._data = self.model.createData()
-        view._gd = view._new_geometry_data()
-        for cache in ("_bounds", "_checkers"):
-            view.__dict__.pop(cache, None)
+        view.collision_model = self.collision_model.copy()
+        keep = np.array([p.kind in kinds for p in self._reach], dtype=bool)
+        view._set_candidates(tuple(p for p in self.pairs if p.kind in kinds),
+                             tuple(p for p, k in zip(self._reach, keep) if k), self._reach_bounds[keep])
         view.kinds = kinds
         return view
 
@@ -530,7 +561,7 @@ class Cell:
         """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) touches.
 
         A pair touches when its distance is at most ``margin`` [m] (0: contact or
-        penetration). Pinocchio's broad phase (dynamic AABB tree) culls pairs whose boxes are
+        penetration); the pairs looked at are :meth:`pairs_for` ``(margin)``. Pinocchio's broad phase (dynamic AABB tree) culls pairs whose boxes are
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
@@ -539,13 +570,17 @@ class Cell:
         return in_collision(self, q, margin=margin, threads=threads)
 
     def collisions(self, q: Any, *, margin: float = 0.0):
-        """Which checked pairs touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
+        """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
         from .collision import collisions
 
         return collisions(self, q, margin=margin)
 
     def clearance(self, q: Any, *, margin: float = 0.0):
-        """Smallest signed distance [m] over the checked pairs, and the pair: a :class:`~.collision.Clearance`."""
+        """Smallest signed distance [m] over every pair not allowed by design, and the pair: a :class:`~.collision.Clearance`.
+
+        The checked pairs and every out-of-reach pair whose bound is below the smallest
+        distance found: the true minimum over all pairs but those allowed by design.
+        """
         from .collision import clearance
 
         return clearance(self, q, margin=margin)

@@ -18,7 +18,12 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     origin of its arm's first joint (radius: the joint offsets along the chain, the
     prismatic strokes and the geometry's own bounding sphere, by the triangle inequality),
     and that ball does not reach the other geometry's bounding box (a fixture) or ball
-    (another arm);
+    (another arm). The gap is kept as :attr:`AllowedPair.distance_bound`, a proven lower
+    bound of the pair's distance in every configuration (for a fixture, the larger of the
+    ball-to-box gap and coal's exact distance from the ball to the fixture's own shape).
+    Such a pair is dropped only from checks whose clearance or margin is below that bound:
+    :meth:`Cell.pairs_for` brings it back for any larger one, and :meth:`Cell.clearance`
+    computes it whenever its bound is below the smallest distance found;
 ``always``
     in contact in at least 95 % of 200 seeded random configurations of the cell (parts of
     one assembly that overlap whatever the joints do);
@@ -29,7 +34,9 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
 
 Unlike the sampled "never in collision" of setup assistants, a pair is only dropped as
 "never" when it is proven (``out of reach``): a sample can miss a rare contact, a bound cannot.
-Every other pair is a :class:`CollisionPair` and is checked.
+Every other pair is a :class:`CollisionPair` and is checked. Pairs allowed by design
+(``same link``, ``rigid``, ``adjacent``, ``always``, ``constant``) are never checked at any
+clearance: their distance does not depend on a motion, or they touch by construction.
 """
 
 from __future__ import annotations
@@ -37,6 +44,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -45,7 +53,11 @@ from ..collision_requests import cold_start
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES"]
+__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "reach_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES",
+           "BY_DESIGN"]
+
+#: Reasons of the pairs allowed by design: never checked, at any clearance.
+BY_DESIGN = ("same link", "rigid", "adjacent", "always", "constant")
 
 #: Share of random configurations in contact above which a pair is "always" touching.
 ALWAYS_SHARE = 0.95
@@ -86,13 +98,24 @@ class CollisionPair:
 
 @dataclass(frozen=True)
 class AllowedPair:
-    """A pair of geometries the cell never checks, and why (see the module doc)."""
+    """A pair of geometries the cell does not check at clearance 0, and why (see the module doc).
+
+    Attributes:
+        distance_bound: for ``"out of reach"``: a proven lower bound (> 0) of the pair's
+            distance in every configuration [m]; checks at a clearance or margin at least
+            this large include the pair (:meth:`Cell.pairs_for`). For ``"constant"``: the
+            constant gap. ``-inf`` for the other reasons (allowed by design, never checked).
+        index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
+    """
 
     geometry_a: str
     geometry_b: str
     body_a: str
     body_b: str
     reason: str
+    distance_bound: float = float("-inf")
+    index_a: int = -1
+    index_b: int = -1
 
 
 def _effective(model: pin.Model, j: int) -> int:
@@ -125,15 +148,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     model, gm = cell.model, cell.collision_model
     objs = list(gm.geometryObjects)
     G = len(objs)
-    link = [model.frames[g.parentFrame].name for g in objs]
-    owner_of_link: dict[str, str] = {}
-    for arm in cell.spec.arms:
-        for name in arm.links:
-            owner_of_link[name] = arm.name
-    for name in cell.spec.fixtures:
-        owner_of_link[name] = name
-    owner = [owner_of_link.get(name, name) for name in link]
-    is_arm = [name in {a.name for a in cell.spec.arms} for name in owner]
+    link, owner, is_arm = _owners(cell)
     joint = [int(g.parentJoint) for g in objs]
     eff = [_effective(model, j) for j in joint]
 
@@ -173,8 +188,8 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
-    def allow(a: int, b: int, reason: str) -> None:
-        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason))
+    def allow(a: int, b: int, reason: str, bound: float = float("-inf")) -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
 
     for a in range(G):
         for b in range(a + 1, G):
@@ -192,8 +207,9 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             if adjacent:
                 allow(a, b, "adjacent")
                 continue
-            if _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner):
-                allow(a, b, "out of reach")
+            gap = _reach_gap(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner)
+            if gap > 0.0:
+                allow(a, b, "out of reach", _tighter(gap, a, b, objs, joint, ball_center, ball_radius, gd))
                 continue
             checked.append((a, b))
 
@@ -221,23 +237,48 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
                 allow(a, b, "always")
             elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
-                allow(a, b, "constant")
+                allow(a, b, "constant", dmin[k])
             else:
                 keep.append((a, b))
         checked = keep
 
-    pairs = []
-    for a, b in checked:
-        if not is_arm[a] and is_arm[b]:
-            a, b = b, a
-        if is_arm[a] and is_arm[b]:
-            kind = "self" if owner[a] == owner[b] else "arm-arm"
-        else:
-            kind = "arm-fixture"
-        pairs.append(CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind))
+    pairs = [_pair(a, b, objs, link, owner, is_arm) for a, b in checked]
     order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
     pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
     return tuple(pairs), tuple(allowed)
+
+
+def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
+    model, objs = cell.model, list(cell.collision_model.geometryObjects)
+    link = [model.frames[g.parentFrame].name for g in objs]
+    owner_of_link: dict[str, str] = {}
+    for arm in cell.spec.arms:
+        for name in arm.links:
+            owner_of_link[name] = arm.name
+    for name in cell.spec.fixtures:
+        owner_of_link[name] = name
+    owner = [owner_of_link.get(name, name) for name in link]
+    arms = {a.name for a in cell.spec.arms}
+    return link, owner, [name in arms for name in owner]
+
+
+def _pair(a: int, b: int, objs: list, link: list[str], owner: list[str], is_arm: list[bool]) -> CollisionPair:
+    if not is_arm[a] and is_arm[b]:
+        a, b = b, a
+    if is_arm[a] and is_arm[b]:
+        kind = "self" if owner[a] == owner[b] else "arm-arm"
+    else:
+        kind = "arm-fixture"
+    return CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind)
+
+
+def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
+    """The ``"out of reach"`` pairs as :class:`CollisionPair` s, in increasing order of their bound, and the bounds [m]."""
+    objs = list(cell.collision_model.geometryObjects)
+    link, owner, is_arm = _owners(cell)
+    reach = sorted((p for p in allowed if p.reason == "out of reach"), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
+    pairs = tuple(_pair(p.index_a, p.index_b, objs, link, owner, is_arm) for p in reach)
+    return pairs, np.array([p.distance_bound for p in reach], dtype=float)
 
 
 def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
@@ -245,15 +286,30 @@ def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
     return bool(np.linalg.norm(motion[3:]) < 1e-12)
 
 
-def _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner) -> bool:
+def _reach_gap(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner) -> float:
+    """A proven lower bound of the pair's distance over every configuration (≤ 0: no proof)."""
     moving_a, moving_b = joint[a] > 0, joint[b] > 0
     if moving_a and moving_b:
         if owner[a] == owner[b]:
-            return False
-        gap = np.linalg.norm(ball_center[a] - ball_center[b]) - ball_radius[a] - ball_radius[b]
-        return bool(gap > 0.0)
+            return float("-inf")
+        return float(np.linalg.norm(ball_center[a] - ball_center[b]) - ball_radius[a] - ball_radius[b])
     m, s = (a, b) if moving_a else (b, a)
     if not (moving_a or moving_b):
-        return False
-    gap = _point_box_distance(ball_center[m], box_R[s], box_c[s], box_half[s]) - ball_radius[m]
-    return bool(gap > 0.0)
+        return float("-inf")
+    return _point_box_distance(ball_center[m], box_R[s], box_c[s], box_half[s]) - float(ball_radius[m])
+
+
+def _tighter(gap: float, a: int, b: int, objs: list, joint: list[int], ball_center, ball_radius, gd) -> float:
+    """``gap``, or coal's distance from the reach ball to a fixture's own shape when larger (less 1e-9 m)."""
+    if joint[a] > 0 and joint[b] > 0:
+        return gap
+    m, s = (a, b) if joint[a] > 0 else (b, a)
+    try:
+        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        request.gjk_tolerance = 1e-10
+        ball = coal.Transform3s(np.eye(3), np.asarray(ball_center[m], dtype=float))
+        d = coal.distance(coal.Sphere(float(ball_radius[m])), ball, objs[s].geometry,
+                         coal.Transform3s(gd.oMg[s].rotation, gd.oMg[s].translation), request, result)
+    except Exception:  # a shape coal cannot measure against a sphere: keep the box bound
+        return gap
+    return max(gap, float(d) - 1e-9) if np.isfinite(d) else gap
