@@ -23,6 +23,7 @@ __all__ = [
     "MissingMesh",
     "CellError",
     "CellNotFound",
+    "CellTooLarge",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -99,6 +100,10 @@ class MissingMesh(ModelError):
 
 class CellError(ModelError):
     """A cell description is malformed: duplicate names, no arm, an arm that cannot be modelled."""
+
+
+class CellTooLarge(CellError):
+    """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
 
 
 class CollisionGeometryError(ModelError):

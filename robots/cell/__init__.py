@@ -13,6 +13,7 @@ from .collision import Clearance, Collisions
 from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
 from .motion import ArmMotion, Contact, MotionCheck, check_motion
 from .pairs import AllowedPair, CollisionPair
+from ..errors import CellTooLarge
 
 __all__ = [
     "load_cell",
@@ -34,4 +35,5 @@ __all__ = [
     "Contact",
     "MotionCheck",
     "check_motion",
+    "CellTooLarge",
 ]

@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
-from ..errors import CellError, CollisionGeometryError, InvalidInput, ModelError
+from ..errors import CellError, CellTooLarge, CollisionGeometryError, InvalidInput, ModelError
 from ..robot import Robot
 from ..xacro_expand import mesh_path
 from .description import ArmSpec, CellSpec, arm_urdf, describe
@@ -175,7 +175,14 @@ class Cell:
             root = ET.fromstring(urdf_text)
         except ET.ParseError as exc:
             raise CellError(f"{source} is not well-formed XML: {exc}") from exc
+        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_geometry
+
+        if len(urdf_text) > MAX_CELL_FILE_BYTES:
+            raise CellTooLarge(f"{source}: the cell's URDF is {len(urdf_text)} characters; the limit is {MAX_CELL_FILE_BYTES}")
+        check_counts(root, 0, 0, source)  # geometries and pairs first: cheap, before anything else
         spec: CellSpec = describe(root, source)
+        check_counts(root, len(spec.arms), len(spec.fixtures), source)
+        check_geometry(root, spec.fixtures, source)
         self.spec = spec
         self.name = spec.name
         try:
@@ -253,8 +260,12 @@ class Cell:
     def _resolved_urdf(self, root: ET.Element) -> str:
         """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""
         resolved = ET.fromstring(ET.tostring(root))
+        from .limits import check_mesh_size
+
         for mesh in resolved.iter("mesh"):
-            mesh.set("filename", str(mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)))
+            path = mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)
+            check_mesh_size(path)  # by stat: a huge mesh is refused unread
+            mesh.set("filename", str(path))
         return ET.tostring(resolved, encoding="unicode")
 
     def _build_geometry(self, root: ET.Element) -> pin.GeometryModel:
