@@ -9,7 +9,8 @@ of :attr:`Cell.arms`; :attr:`CellArm.q_slice` is each arm's block.
 Collision checks live in :mod:`.collision` (:meth:`Cell.in_collision`,
 :meth:`Cell.collisions`, :meth:`Cell.clearance`) and :mod:`.motion`
 (:meth:`Cell.check_motion`); the pairs they check and the pairs they skip, with the
-reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`).
+reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`); the pairs a check at a
+clearance looks at in :meth:`Cell.pairs_for`.
 """
 
 from __future__ import annotations
@@ -150,7 +151,12 @@ class Cell:
         arms: the arms (:class:`CellArm`), in joint-vector order.
         fixtures: the fixtures (:class:`Fixture`), in document order.
         pairs: the checked pairs (:class:`~.pairs.CollisionPair`).
-        allowed: the pairs never checked, each with its reason (:class:`~.pairs.AllowedPair`).
+        allowed: the pairs not checked at clearance 0, each with its reason
+            (:class:`~.pairs.AllowedPair`); the ``"out of reach"`` ones carry a proven
+            ``distance_bound`` and come back in checks at a larger clearance
+            (:meth:`pairs_for`).
+
+    Thread-safe: each thread uses its own Pinocchio and coal data (:mod:`.views`).
     """
 
     def __init__(
