@@ -213,8 +213,11 @@ def _bounds_data(cell: "Cell") -> dict:
     return cached
 
 
-def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
-    """``(N, P)`` lower bounds of every checked pair's distance [m] for a batch ``q (N, nq)``.
+def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.ndarray:
+    """``(N, P)`` lower bounds of the candidate pairs' distances [m] for a batch ``q (N, nq)``.
+
+    Columns: the first ``n`` candidate pairs (default all: :meth:`Cell.pairs_for` ``(inf)``;
+    the checked pairs are the first ``len(cell.pairs)``).
 
     Bounding sphere against bounding sphere (for overlapping bodies too: the penetration
     depth of two bodies is at most that of their bounding spheres); against a static
@@ -230,9 +233,15 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
     c[:, b["static"]] = b["box_c"][b["static"]]
     for j, idx in b["by_joint"].items():
         c[:, idx] = p[:, j, None, :] + np.matmul(R[:, j], b["offset"][idx].T).transpose(0, 2, 1)
-    ia, ib = b["ia"], b["ib"]
+    n = len(b["ia"]) if n is None else int(n)
+    ia, ib = b["ia"][:n], b["ib"][:n]
     lb = np.linalg.norm(c[:, ia] - c[:, ib], axis=-1) - b["radius"][ia] - b["radius"][ib]
     for s_idx, cols, moving in b["static_groups"]:
+        if n < len(b["ia"]):
+            keep = cols < n
+            cols, moving = cols[keep], moving[keep]
+            if not cols.size:
+                continue
         local = (c[:, moving] - b["box_c"][s_idx]) @ b["box_R"][s_idx]
         outside = np.maximum(np.abs(local) - b["half"][s_idx], 0.0)
         box_lb = np.linalg.norm(outside, axis=-1) - b["radius"][moving]
@@ -253,8 +262,14 @@ def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
         nan3 = np.full((N, 3), np.nan)
         pick = (lambda x: x[0]) if single else (lambda x: x)
         return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, pairs)
-    dist, pair, pa, pb = exact_min_distance(cell, arr)
-    _reach_pass(cell, arr, dist, pair, pa, pb)
+    if N <= 4:  # a few configurations: the checked pairs in Pinocchio's loop, then the out-of-reach ones needed
+        dist, pair, pa, pb = exact_min_distance(cell, arr)
+        _reach_pass(cell, arr, dist, pair, pa, pb)
+    else:  # one pass over every candidate, each out-of-reach pair's bound raised to its proven one
+        lb = pair_lower_bounds(cell, arr)
+        n0 = len(cell.pairs)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        dist, pair, pa, pb = exact_min_distance(cell, arr, lb=lb, n=len(pairs))
     if single:
         return Clearance(float(dist[0]), int(pair[0]), pa[0], pb[0], margin, pairs)
     return Clearance(dist, pair, pa, pb, margin, pairs)
@@ -270,7 +285,7 @@ def _reach_pass(cell: "Cell", arr: np.ndarray, dist: np.ndarray, pair: np.ndarra
     n_max = max(cell._n_for(float(dist[i]), strict=True) for i in need)
     views = cell._views
     gm, gd, data = views.geometry(n_max), views.distance_data(n_max), views.data()
-    lb = pair_lower_bounds(cell, arr[need])[:, n0:n_max]
+    lb = pair_lower_bounds(cell, arr[need], n_max)[:, n0:]
     bounds = cell._reach_bounds
     qp = cell.robot.q_to_pinocchio(arr[need])
     for row, i in enumerate(need):
@@ -307,7 +322,7 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
     if lb is None and N <= 4:  # a few configurations: every pair in Pinocchio's loop beats the broad phase
         return _all_pairs_min_distance(cell, arr, n)
     if lb is None:
-        lb = pair_lower_bounds(cell, arr)[:, :n]
+        lb = pair_lower_bounds(cell, arr, n)
     order = np.argsort(lb, axis=1, kind="stable")
     sorted_lb = np.take_along_axis(lb, order, axis=1)
     qp = cell.robot.q_to_pinocchio(arr)
