@@ -325,15 +325,16 @@ class Cell:
         return None
 
     def _finish_geometry(self) -> None:
-        """Keep only the checked pairs in the collision model, the candidate pairs, and test every candidate once."""
+        """Keep only the checked pairs in the collision model, the candidate pairs, and test every checked pair once."""
         from .pairs import reach_pairs
 
         reach, bounds = reach_pairs(self, self.allowed)
         self._set_candidates(self.pairs, reach, bounds)
-        n = len(self._candidates)
+        # the checked pairs once each (an out-of-reach pair coal cannot measure is a named error when used)
+        n = len(self.pairs)
         gm, gd = self._views.geometry(n), self._views.distance_data(n)
         pin.updateGeometryPlacements(self.model, self._views.data(), gm, gd, pin.neutral(self.model))
-        for k, p in enumerate(self._candidates):
+        for k, p in enumerate(self.pairs):
             try:
                 d = pin.computeDistance(gm, gd, k).min_distance
                 pin.computeCollision(gm, gd, k)

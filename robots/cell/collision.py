@@ -251,6 +251,10 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.n
     return lb
 
 
+#: Up to this many out-of-reach pairs, a batch's clearance sorts them with the checked pairs in one pass.
+ONE_PASS_REACH = 2000
+
+
 def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
     """See :meth:`Cell.clearance`."""
     margin = _margin(margin)
@@ -262,7 +266,9 @@ def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
         nan3 = np.full((N, 3), np.nan)
         pick = (lambda x: x[0]) if single else (lambda x: x)
         return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, pairs)
-    if N <= 4:  # a few configurations: the checked pairs in Pinocchio's loop, then the out-of-reach ones needed
+    if N <= 4 or len(cell._reach) > ONE_PASS_REACH:
+        # a few configurations (the checked pairs in Pinocchio's loop), or a huge cell: the checked
+        # pairs first, then only the out-of-reach pairs whose bound is below each row's distance
         dist, pair, pa, pb = exact_min_distance(cell, arr)
         _reach_pass(cell, arr, dist, pair, pa, pb)
     else:  # one pass over every candidate, each out-of-reach pair's bound raised to its proven one

@@ -138,11 +138,6 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
     return center, float(np.linalg.norm(half)), half
 
 
-def _point_box_distance(point: np.ndarray, R: np.ndarray, center: np.ndarray, half: np.ndarray) -> float:
-    local = R.T @ (point - center)
-    return float(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0)))
-
-
 def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
     """Split every pair of the cell's collision geometries into checked and allowed pairs."""
     model, gm = cell.model, cell.collision_model
@@ -185,6 +180,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             j = model.parents[j]
         ball_radius[k] = total
 
+    gaps = _reach_gaps(np.array(joint), ball_center, ball_radius, box_R, box_c, box_half, owner)
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
@@ -207,12 +203,15 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             if adjacent:
                 allow(a, b, "adjacent")
                 continue
-            gap = _reach_gap(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner)
+            gap = gaps[a, b]
             if gap > 0.0:
                 allow(a, b, "out of reach", _tighter(gap, a, b, objs, joint, ball_center, ball_radius, gd))
                 continue
             checked.append((a, b))
 
+    from .limits import check_pairs
+
+    check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
     # "always": pairs in contact in at least ALWAYS_SHARE of random configurations
     if checked:
         probe = pin.GeometryModel()
@@ -286,17 +285,29 @@ def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
     return bool(np.linalg.norm(motion[3:]) < 1e-12)
 
 
-def _reach_gap(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner) -> float:
-    """A proven lower bound of the pair's distance over every configuration (≤ 0: no proof)."""
-    moving_a, moving_b = joint[a] > 0, joint[b] > 0
-    if moving_a and moving_b:
-        if owner[a] == owner[b]:
-            return float("-inf")
-        return float(np.linalg.norm(ball_center[a] - ball_center[b]) - ball_radius[a] - ball_radius[b])
-    m, s = (a, b) if moving_a else (b, a)
-    if not (moving_a or moving_b):
-        return float("-inf")
-    return _point_box_distance(ball_center[m], box_R[s], box_c[s], box_half[s]) - float(ball_radius[m])
+def _reach_gaps(joint: np.ndarray, ball_center, ball_radius, box_R, box_c, box_half, owner: list[str]) -> np.ndarray:
+    """``(G, G)`` proven lower bounds of every pair's distance over every configuration (≤ 0 or -inf: no proof).
+
+    Two moving geometries of different owners: the gap between their reach balls; a moving
+    geometry and a static one: the gap from the reach ball to the static one's oriented box.
+    """
+    G = joint.size
+    gaps = np.full((G, G), -np.inf)
+    moving = np.flatnonzero(joint > 0)
+    static = np.flatnonzero(joint == 0)
+    if moving.size:
+        owners = np.unique(np.array(owner, dtype=object)[moving], return_inverse=True)[1]
+        c, r = ball_center[moving], ball_radius[moving]
+        mm = np.linalg.norm(c[:, None] - c[None], axis=-1) - r[:, None] - r[None]
+        mm[owners[:, None] == owners[None]] = -np.inf  # one arm's own links: never "out of reach"
+        gaps[np.ix_(moving, moving)] = mm
+    if moving.size and static.size:
+        local = np.einsum("sji,msj->msi", box_R[static], ball_center[moving][:, None] - box_c[static][None])
+        outside = np.linalg.norm(np.maximum(np.abs(local) - box_half[static][None], 0.0), axis=-1)
+        ms = outside - ball_radius[moving][:, None]
+        gaps[np.ix_(moving, static)] = ms
+        gaps[np.ix_(static, moving)] = ms.T
+    return gaps
 
 
 def _tighter(gap: float, a: int, b: int, objs: list, joint: list[int], ball_center, ball_radius, gd) -> float:
@@ -304,6 +315,8 @@ def _tighter(gap: float, a: int, b: int, objs: list, joint: list[int], ball_cent
     if joint[a] > 0 and joint[b] > 0:
         return gap
     m, s = (a, b) if joint[a] > 0 else (b, a)
+    if isinstance(objs[s].geometry, coal.Box):
+        return gap  # the ball-to-box gap is already exact for a box
     try:
         request, result = coal.DistanceRequest(), coal.DistanceResult()
         request.gjk_tolerance = 1e-10
