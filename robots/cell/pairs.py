@@ -103,8 +103,10 @@ class AllowedPair:
     Attributes:
         distance_bound: for ``"out of reach"``: a proven lower bound (> 0) of the pair's
             distance in every configuration [m]; checks at a clearance or margin at least
-            this large include the pair (:meth:`Cell.pairs_for`). For ``"constant"``: the
-            constant gap. ``-inf`` for the other reasons (allowed by design, never checked).
+            this large include the pair (:meth:`Cell.pairs_for`). ``inf`` for the pairs
+            allowed by design (:data:`BY_DESIGN`): never checked, at any clearance — so
+            ``[p for p in cell.allowed if p.distance_bound <= c]`` is exactly the allowed
+            pairs a check at ``c`` must bring back.
         index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
     """
 
@@ -113,7 +115,7 @@ class AllowedPair:
     body_a: str
     body_b: str
     reason: str
-    distance_bound: float = float("-inf")
+    distance_bound: float = float("inf")
     index_a: int = -1
     index_b: int = -1
 
@@ -184,7 +186,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
-    def allow(a: int, b: int, reason: str, bound: float = float("-inf")) -> None:
+    def allow(a: int, b: int, reason: str, bound: float = float("inf")) -> None:
         allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
 
     for a in range(G):
@@ -236,7 +238,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
                 allow(a, b, "always")
             elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
-                allow(a, b, "constant", dmin[k])
+                allow(a, b, "constant")
             else:
                 keep.append((a, b))
         checked = keep

@@ -39,7 +39,9 @@ def test_the_post_is_out_of_reach_with_a_proven_bound_below_its_distance(post):
     assert len(back) == len(post.pairs) + 1 and back[-1].bodies == ("arm_upper_arm", "post")
     assert post.pairs_for(float("inf"))[: len(post.pairs)] == post.pairs
     for design in (p for p in post.allowed if p.reason != "out of reach"):
-        assert design.distance_bound == -np.inf or design.reason == "constant"
+        assert design.distance_bound == np.inf  # by design: never brought back
+    back_by_bound = [p for p in post.allowed if p.distance_bound <= 0.02]
+    assert [(p.index_a, p.index_b) for p in back_by_bound] == [(pair.index_a, pair.index_b)]
 
 
 @pytest.mark.parametrize("bad", [-0.001, float("nan"), "0.02", None, True])
