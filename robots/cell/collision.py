@@ -129,6 +129,10 @@ def _margin(margin: Any) -> float:
     return value
 
 
+#: Most threads of one batched contact check (each holds its own copy of the collision data).
+MAX_THREADS = 64
+
+
 def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
     """See :meth:`Cell.in_collision`."""
     if margin != 0.0:
@@ -138,8 +142,8 @@ def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1)
     if fast is not None and n:
         return cell._views.checker(n).single(fast, float(margin))
     margin = _margin(margin)
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise InvalidInput(f"threads must be a positive integer, got {threads!r}")
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= MAX_THREADS:
+        raise InvalidInput(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
     arr, single = cell.robot.check_q(q)
     if not n:
         return False if single else np.zeros(arr.shape[0], dtype=bool)

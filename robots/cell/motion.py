@@ -326,6 +326,9 @@ def configurations(cell: "Cell", motions: list[ArmMotion], times: np.ndarray, ho
     for m in motions:
         arm = cell.arm(m.arm)
         Q[:, arm.q_slice] = np.asarray(m.trajectory.sample(m.local_time(times))[0], dtype=float).reshape(times.size, -1)
+        if not np.isfinite(Q[:, arm.q_slice]).all():
+            bad = times[np.flatnonzero(~np.isfinite(Q[:, arm.q_slice]).all(axis=1))[0]]
+            raise InvalidInput(f"the trajectory of arm {m.arm!r} gives non-finite joint values at t = {bad!r} s")
     return Q
 
 

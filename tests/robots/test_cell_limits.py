@@ -171,3 +171,23 @@ def test_a_late_offset_within_the_limit_still_finds_the_contact_time():
     result = facing.check_motion([ArmMotion("one", swing, offset=late)], margin=0.01, hold=np.zeros(facing.nq))
     assert early.first_contact is not None and result.first_contact is not None
     assert abs(result.first_contact.time - late - early.first_contact.time) < 1e-5
+
+
+@pytest.mark.parametrize("threads", [0, -1, 10**6, 2.0, True])
+def test_batch_threads_are_bounded(post, threads):
+    with pytest.raises(InvalidInput, match="threads must be an integer from 1 to 64"):
+        post.in_collision(post.random_q(3), threads=threads)
+
+
+def test_a_trajectory_that_turns_nan_is_a_named_error(post):
+    class Broken:
+        start_time, end_time = 0.0, 1.0
+
+        def sample(self, t):
+            t = np.atleast_1d(np.asarray(t, dtype=float))
+            q = np.zeros((t.size, 4))
+            q[t > 0.5] = np.nan
+            return q if t.size > 1 else q[0], np.zeros_like(q if t.size > 1 else q[0])
+
+    with pytest.raises(InvalidInput, match="non-finite joint values"):
+        post.check_motion([ArmMotion("arm", Broken())], margin=0.01)
