@@ -18,9 +18,11 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     origin of its arm's first joint (radius: the joint offsets along the chain, the
     prismatic strokes and the geometry's own bounding sphere, by the triangle inequality),
     and that ball does not reach the other geometry's bounding box (a fixture) or ball
-    (another arm). The gap is kept as :attr:`AllowedPair.distance_bound`, a proven lower
-    bound of the pair's distance in every configuration (for a fixture, the larger of the
-    ball-to-box gap and coal's exact distance from the ball to the fixture's own shape).
+    (another arm). The pair keeps :attr:`AllowedPair.distance_bound`, a proven lower bound
+    of its distance in every configuration: the largest of that gap, coal's exact distance
+    from the ball to a fixture's own shape, and coal's distance between the solid cylinder
+    an arm's revolute first joint sweeps the geometry through and the fixture (or the other
+    arm's cylinder), see :mod:`.reach`.
     Such a pair is dropped only from checks whose clearance or margin is below that bound:
     :meth:`Cell.pairs_for` brings it back for any larger one, and :meth:`Cell.clearance`
     computes it whenever its bound is below the smallest distance found;
@@ -49,6 +51,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
+from .reach import root_cylinders, tighter_bound
 
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
@@ -183,6 +186,10 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
         ball_radius[k] = total
 
     gaps = _reach_gaps(np.array(joint), ball_center, ball_radius, box_R, box_c, box_half, owner)
+    cylinders = root_cylinders(model, data, objs, joint, ball_radius)
+
+    def placement(k: int) -> coal.Transform3s:
+        return coal.Transform3s(gd.oMg[k].rotation, gd.oMg[k].translation)
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
@@ -207,7 +214,8 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
                 continue
             gap = gaps[a, b]
             if gap > 0.0:
-                allow(a, b, "out of reach", _tighter(gap, a, b, objs, joint, ball_center, ball_radius, gd))
+                allow(a, b, "out of reach", tighter_bound(gap, a, b, objs, joint, ball_center, ball_radius, placement,
+                                                          cylinders))
                 continue
             checked.append((a, b))
 
@@ -310,21 +318,3 @@ def _reach_gaps(joint: np.ndarray, ball_center, ball_radius, box_R, box_c, box_h
         gaps[np.ix_(moving, static)] = ms
         gaps[np.ix_(static, moving)] = ms.T
     return gaps
-
-
-def _tighter(gap: float, a: int, b: int, objs: list, joint: list[int], ball_center, ball_radius, gd) -> float:
-    """``gap``, or coal's distance from the reach ball to a fixture's own shape when larger (less 1e-9 m)."""
-    if joint[a] > 0 and joint[b] > 0:
-        return gap
-    m, s = (a, b) if joint[a] > 0 else (b, a)
-    if isinstance(objs[s].geometry, coal.Box):
-        return gap  # the ball-to-box gap is already exact for a box
-    try:
-        request, result = coal.DistanceRequest(), coal.DistanceResult()
-        request.gjk_tolerance = 1e-10
-        ball = coal.Transform3s(np.eye(3), np.asarray(ball_center[m], dtype=float))
-        d = coal.distance(coal.Sphere(float(ball_radius[m])), ball, objs[s].geometry,
-                         coal.Transform3s(gd.oMg[s].rotation, gd.oMg[s].translation), request, result)
-    except Exception:  # a shape coal cannot measure against a sphere: keep the box bound
-        return gap
-    return max(gap, float(d) - 1e-9) if np.isfinite(d) else gap

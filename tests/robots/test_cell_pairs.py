@@ -126,3 +126,27 @@ def test_arm_motion_offsets_keep_the_pair_order(post):
     result = post.check_motion([ArmMotion("arm", SWEEP, offset=2.0)], margin=0.01, clearance=0.02)
     assert result.window == (2.0, 3.0)
     assert result.pairs == post.pairs_for(0.03 + 1e-6)
+
+
+@pytest.mark.parametrize("name", ["mushroom_line", "aubo_food_station", "post", "facing"])
+def test_every_out_of_reach_bound_holds_on_random_configurations(name, post, facing):
+    import pinocchio as pin
+
+    from pinarms.robots.collision_requests import cold_start
+
+    cell = {"post": post, "facing": facing}.get(name) or load_cell(name)
+    reach = [p for p in cell.allowed if p.reason == "out of reach"]
+    gm = cell.collision_model.copy()
+    gm.removeAllCollisionPairs()
+    for p in reach:
+        gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+    gd = cold_start(pin.GeometryData(gm), distance_tolerance=1e-10)
+    data = cell.model.createData()
+    bounds = np.array([p.distance_bound for p in reach])
+    smallest = np.full(len(reach), np.inf)
+    for q in cell.robot.q_to_pinocchio(cell.random_q(400, seed=21)):
+        pin.updateGeometryPlacements(cell.model, data, gm, gd, q)
+        pin.computeDistances(gm, gd)
+        smallest = np.minimum(smallest, [r.min_distance for r in gd.distanceResults])
+    assert np.all(bounds > 0.0)
+    assert np.all(smallest >= bounds - 1e-9), [(reach[k].body_a, reach[k].body_b) for k in np.flatnonzero(smallest < bounds)]
