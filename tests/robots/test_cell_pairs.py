@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import planning
+from pinarms.optim.motion.scenes import load_scene, scene_names
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.collision import exact_min_distance
 from pinarms.robots.errors import InvalidInput
@@ -130,11 +131,20 @@ def test_arm_motion_offsets_keep_the_pair_order(post):
 
 @pytest.mark.parametrize("name", ["mushroom_line", "aubo_food_station", "post", "facing"])
 def test_every_out_of_reach_bound_holds_on_random_configurations(name, post, facing):
+    _bounds_hold(({"post": post, "facing": facing}.get(name) or load_cell(name)))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", scene_names())
+def test_every_out_of_reach_bound_of_the_scenes_holds_on_random_configurations(name):
+    _bounds_hold(load_scene(name))
+
+
+def _bounds_hold(cell):
     import pinocchio as pin
 
     from pinarms.robots.collision_requests import cold_start
 
-    cell = {"post": post, "facing": facing}.get(name) or load_cell(name)
     reach = [p for p in cell.allowed if p.reason == "out of reach"]
     gm = cell.collision_model.copy()
     gm.removeAllCollisionPairs()
