@@ -11,12 +11,18 @@ fresh ``GeometryData`` reports. :func:`cold_start` turns the warm start off; eve
 
 from __future__ import annotations
 
+import threading
 import warnings
 
 import coal
 import pinocchio as pin
 
 __all__ = ["cold_start"]
+
+# ``warnings.catch_warnings`` swaps the process-wide filter list: two threads inside it at once
+# restore each other's filters mid-block (a thread then meets coal's DeprecationWarning under
+# the caller's filters, e.g. as an error). One thread at a time sets the deprecated flag.
+_WARNINGS_LOCK = threading.Lock()
 
 
 def cold_start(gd: pin.GeometryData, *, distance_tolerance: float | None = None) -> pin.GeometryData:
@@ -28,7 +34,7 @@ def cold_start(gd: pin.GeometryData, *, distance_tolerance: float | None = None)
     Returns:
         ``gd`` itself.
     """
-    with warnings.catch_warnings():
+    with _WARNINGS_LOCK, warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)  # coal renamed the flag, still honours it
         for req in list(gd.collisionRequests) + list(gd.distanceRequests):
             req.enable_cached_gjk_guess = False

@@ -24,6 +24,7 @@ __all__ = [
     "CellError",
     "CellNotFound",
     "XacroFileNotFound",
+    "CellTooLarge",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -100,6 +101,10 @@ class MissingMesh(ModelError):
 
 class CellError(ModelError):
     """A cell description is malformed: duplicate names, no arm, an arm that cannot be modelled."""
+
+
+class CellTooLarge(CellError):
+    """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
 
 
 class CollisionGeometryError(ModelError):

@@ -96,6 +96,12 @@ def _cold(gd: pin.GeometryData) -> pin.GeometryData:
     return cold_start(gd, distance_tolerance=1e-10)
 
 
+def _pairs_for(cell: Any, clearance: float) -> tuple:
+    """The cell's pairs a check at ``clearance`` [m] must look at (checked + out-of-reach pairs not proven farther)."""
+    pairs_for = getattr(cell, "pairs_for", None)
+    return pairs_for(clearance) if callable(pairs_for) else cell.pairs
+
+
 def _set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
     for req, m in zip(gd.collisionRequests, margins):
         req.security_margin = float(m)
@@ -186,11 +192,13 @@ class MotionChecker:
         self.moving_speed = float(sum(np.abs(m.trajectory.peaks().velocity) @ levers[c]
                                       for m, c in zip(self.moving, self._moving_cols)))
         self._travel_t, self._travel_i = self._moving_travel(levers)
-        # the pairs that involve a planned arm, each with its margin
+        # the pairs that involve a planned arm, each with its margin: every pair not proven
+        # farther than the larger margin (Cell.pairs_for), indices into that prefix of the candidates
         planned = set(self.arms)
-        self.pair_index = np.array([k for k, p in enumerate(cell.pairs) if p.owner_a in planned or p.owner_b in planned],
+        relevant = _pairs_for(cell, max(self.margin, self.self_margin))
+        self.pair_index = np.array([k for k, p in enumerate(relevant) if p.owner_a in planned or p.owner_b in planned],
                                    dtype=int)
-        self.pairs = tuple(cell.pairs[k] for k in self.pair_index)
+        self.pairs = tuple(relevant[k] for k in self.pair_index)
         self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
         gm = cell.collision_model.copy()
         gm.removeAllCollisionPairs()

@@ -22,6 +22,7 @@ from .compose import (
 from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
 from .motion import ArmMotion, Contact, MotionCheck, check_motion
 from .pairs import AllowedPair, CollisionPair
+from ..errors import CellTooLarge
 
 __all__ = [
     "load_cell",
@@ -50,4 +51,5 @@ __all__ = [
     "compose_cell_urdf",
     "load_cell_description",
     "read_cell_description",
+    "CellTooLarge",
 ]

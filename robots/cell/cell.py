@@ -9,7 +9,8 @@ of :attr:`Cell.arms`; :attr:`CellArm.q_slice` is each arm's block.
 Collision checks live in :mod:`.collision` (:meth:`Cell.in_collision`,
 :meth:`Cell.collisions`, :meth:`Cell.clearance`) and :mod:`.motion`
 (:meth:`Cell.check_motion`); the pairs they check and the pairs they skip, with the
-reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`).
+reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`); the pairs a check at a
+clearance looks at in :meth:`Cell.pairs_for`.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
-from ..errors import CellError, CollisionGeometryError, InvalidInput
+from ..errors import CellError, CellTooLarge, CollisionGeometryError, InvalidInput
 from ..robot import Robot
 from ..xacro_expand import mesh_path
 from .description import ArmSpec, CellSpec, arm_urdf, describe
@@ -148,7 +149,12 @@ class Cell:
         arms: the arms (:class:`CellArm`), in joint-vector order.
         fixtures: the fixtures (:class:`Fixture`), in document order.
         pairs: the checked pairs (:class:`~.pairs.CollisionPair`).
-        allowed: the pairs never checked, each with its reason (:class:`~.pairs.AllowedPair`).
+        allowed: the pairs not checked at clearance 0, each with its reason
+            (:class:`~.pairs.AllowedPair`); the ``"out of reach"`` ones carry a proven
+            ``distance_bound`` and come back in checks at a larger clearance
+            (:meth:`pairs_for`).
+
+    Thread-safe: each thread uses its own Pinocchio and coal data (:mod:`.views`).
     """
 
     def __init__(
@@ -173,7 +179,14 @@ class Cell:
             root = ET.fromstring(urdf_text)
         except ET.ParseError as exc:
             raise CellError(f"{source} is not well-formed XML: {exc}") from exc
+        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_geometry
+
+        if len(urdf_text) > MAX_CELL_FILE_BYTES:
+            raise CellTooLarge(f"{source}: the cell's URDF is {len(urdf_text)} characters; the limit is {MAX_CELL_FILE_BYTES}")
+        check_counts(root, 0, 0, source)  # geometries and pairs first: cheap, before anything else
         spec: CellSpec = describe(root, source)
+        check_counts(root, len(spec.arms), len(spec.fixtures), source)
+        check_geometry(root, spec.fixtures, source)
         self.spec = spec
         self.name = spec.name
         try:
@@ -191,7 +204,6 @@ class Cell:
         self.collision_model = self._build_geometry(root)
         self._placements = BatchedPlacements(model)
         self._pin_index = self._plain_pin_index()
-        self._data = model.createData()
         self.fixtures = self._fixtures()
         self.pairs, self.allowed = classify_pairs(self, seed=seed)
         self.kinds: tuple[str, ...] = ("self", "arm-arm", "arm-fixture")
@@ -247,8 +259,12 @@ class Cell:
     def _resolved_urdf(self, root: ET.Element) -> str:
         """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""
         resolved = ET.fromstring(ET.tostring(root))
+        from .limits import check_mesh_size
+
         for mesh in resolved.iter("mesh"):
-            mesh.set("filename", str(mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)))
+            path = mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)
+            check_mesh_size(path)  # by stat: a huge mesh is refused unread
+            mesh.set("filename", str(path))
         return ET.tostring(resolved, encoding="unicode")
 
     def _build_geometry(self, root: ET.Element) -> pin.GeometryModel:
@@ -302,18 +318,19 @@ class Cell:
         return None
 
     def _finish_geometry(self) -> None:
-        """Keep only the checked pairs in the collision model, tight coal tolerances, and test every pair once."""
-        gm = self.collision_model
-        gm.removeAllCollisionPairs()
-        for p in self.pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-        self._gd = self._new_geometry_data()
-        q0 = pin.neutral(self.model)
-        pin.updateGeometryPlacements(self.model, self._data, gm, self._gd, q0)
+        """Keep only the checked pairs in the collision model, the candidate pairs, and test every checked pair once."""
+        from .pairs import reach_pairs
+
+        reach, bounds = reach_pairs(self, self.allowed)
+        self._set_candidates(self.pairs, reach, bounds)
+        # the checked pairs once each (an out-of-reach pair coal cannot measure is a named error when used)
+        n = len(self.pairs)
+        gm, gd = self._views.geometry(n), self._views.distance_data(n)
+        pin.updateGeometryPlacements(self.model, self._views.data(), gm, gd, pin.neutral(self.model))
         for k, p in enumerate(self.pairs):
             try:
-                d = pin.computeDistance(gm, self._gd, k).min_distance
-                pin.computeCollision(gm, self._gd, k)
+                d = pin.computeDistance(gm, gd, k).min_distance
+                pin.computeCollision(gm, gd, k)
             except Exception as exc:
                 raise CollisionGeometryError(
                     f"{self.source}: the pair ({p.body_a}, {p.body_b}) cannot be checked by coal: {exc}"
@@ -323,9 +340,46 @@ class Cell:
                     f"{self.source}: the distance between {p.body_a} and {p.body_b} is {d}: check their geometry"
                 )
 
-    def _new_geometry_data(self) -> pin.GeometryData:
-        # exact distances (coal's default 1e-6 m is coarser than the checks), no warm start
-        return cold_start(pin.GeometryData(self.collision_model), distance_tolerance=1e-10)
+    def _set_candidates(self, pairs: tuple, reach: tuple, bounds: np.ndarray) -> None:
+        """Checked pairs, then out-of-reach pairs by increasing bound; the collision model keeps the checked ones."""
+        from .views import PairViews
+
+        self.pairs = tuple(pairs)
+        self._reach = tuple(reach)
+        self._reach_bounds = np.asarray(bounds, dtype=float)
+        self._candidates = self.pairs + self._reach
+        gm = self.collision_model
+        gm.removeAllCollisionPairs()
+        for p in self.pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+        self._views = PairViews(self.model, gm, self._candidates)
+        for cache in ("_bounds",):
+            self.__dict__.pop(cache, None)
+
+    # ------------------------------------------------------------------ pairs
+    def _n_for(self, clearance: float, *, strict: bool = False) -> int:
+        """How many candidate pairs a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it)."""
+        side = "left" if strict else "right"
+        return len(self.pairs) + int(np.searchsorted(self._reach_bounds, clearance, side=side))
+
+    def pairs_for(self, clearance: float) -> tuple:
+        """The pairs a check at ``clearance`` (or margin) [m] must look at.
+
+        The checked pairs (:attr:`pairs`) followed by every ``"out of reach"`` pair whose
+        proven distance bound (:attr:`AllowedPair.distance_bound`) is at most ``clearance``,
+        in increasing order of that bound: the pairs left out are proven farther than
+        ``clearance`` in every configuration. ``pairs_for(0.0)`` is :attr:`pairs`; the
+        result is always a prefix of ``pairs_for(inf)``, so a pair index means the same pair
+        at every clearance.
+
+        Raises:
+            InvalidInput: ``clearance`` not a number ≥ 0 (``inf`` allowed).
+        """
+        ok = isinstance(clearance, (int, float, np.integer, np.floating)) and not isinstance(clearance, bool)
+        value = float(clearance) if ok else float("nan")
+        if not value >= 0.0:
+            raise InvalidInput(f"clearance must be a number >= 0 [m] (inf allowed), got {clearance!r}")
+        return self._candidates[: self._n_for(value)]
 
     # --------------------------------------------------------------- joint vector
     @property
@@ -487,8 +541,9 @@ class Cell:
                 ``"external"`` for ``("arm-arm", "arm-fixture")`` (what a safety distance to
                 obstacles and other arms is about: an arm's own links are designed close).
 
-        The result shares the model and the arms; its :attr:`pairs` (and so every check) are
-        the subset. The pairs left out are not added to :attr:`allowed`.
+        The result shares the model and the arms; its :attr:`pairs` and its out-of-reach
+        pairs (:meth:`pairs_for`), and so every check, are the subset. The pairs left out are
+        not added to :attr:`allowed`.
         """
         import copy
 
@@ -499,16 +554,10 @@ class Cell:
         if unknown or not kinds:
             raise InvalidInput(f"kinds must be among 'self', 'arm-arm', 'arm-fixture' (or 'external'), got {kinds!r}")
         view = copy.copy(self)
-        view.pairs = tuple(p for p in self.pairs if p.kind in kinds)
-        gm = self.collision_model.copy()
-        gm.removeAllCollisionPairs()
-        for p in view.pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-        view.collision_model = gm
-        view._data = self.model.createData()
-        view._gd = view._new_geometry_data()
-        for cache in ("_bounds", "_checkers"):
-            view.__dict__.pop(cache, None)
+        view.collision_model = self.collision_model.copy()
+        keep = np.array([p.kind in kinds for p in self._reach], dtype=bool)
+        view._set_candidates(tuple(p for p in self.pairs if p.kind in kinds),
+                             tuple(p for p, k in zip(self._reach, keep) if k), self._reach_bounds[keep])
         view.kinds = kinds
         return view
 
@@ -523,7 +572,7 @@ class Cell:
         """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) touches.
 
         A pair touches when its distance is at most ``margin`` [m] (0: contact or
-        penetration). Pinocchio's broad phase (dynamic AABB tree) culls pairs whose boxes are
+        penetration); the pairs looked at are :meth:`pairs_for` ``(margin)``. Pinocchio's broad phase (dynamic AABB tree) culls pairs whose boxes are
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
@@ -532,13 +581,17 @@ class Cell:
         return in_collision(self, q, margin=margin, threads=threads)
 
     def collisions(self, q: Any, *, margin: float = 0.0):
-        """Which checked pairs touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
+        """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
         from .collision import collisions
 
         return collisions(self, q, margin=margin)
 
     def clearance(self, q: Any, *, margin: float = 0.0):
-        """Smallest signed distance [m] over the checked pairs, and the pair: a :class:`~.collision.Clearance`."""
+        """Smallest signed distance [m] over every pair not allowed by design, and the pair: a :class:`~.collision.Clearance`.
+
+        The checked pairs and every out-of-reach pair whose bound is below the smallest
+        distance found: the true minimum over all pairs but those allowed by design.
+        """
         from .collision import clearance
 
         return clearance(self, q, margin=margin)

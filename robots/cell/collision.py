@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
 from ..errors import CollisionGeometryError, InvalidInput
 from .pairs import CollisionPair
 
@@ -66,19 +65,29 @@ class Collisions:
         """``(body_a, body_b)`` of the touching pairs of configuration ``i``."""
         return [self.pairs[k].bodies for k in self.touching[i]]
 
+    def __repr__(self) -> str:
+        n = int(self.colliding.sum())
+        where = f"{n} of {self.colliding.size} configurations touch" if not self.single else (
+            f"{len(self.touching[0])} pair(s) touch" + (f", e.g. {self.pairs[self.touching[0][0]]}" if self.touching[0] else ""))
+        return f"Collisions({where} at margin {self.margin * 1e3:.1f} mm; {len(self.pairs)} pairs looked at)"
+
 
 @dataclass(frozen=True, eq=False)
 class Clearance:
-    """The smallest signed distance over the checked pairs, per configuration.
+    """The smallest signed distance over every pair not allowed by design, per configuration.
 
     Attributes:
         distance: [m] ``float`` (one configuration) or ``(N,)``; negative: the bodies
-            overlap by that depth.
+            overlap by that depth. Exact (coal) over the checked pairs and every
+            out-of-reach pair whose proven bound is below it.
         pair: index into ``pairs`` of the pair that has it (``int`` or ``(N,)``).
         point_a, point_b: nearest points on ``body_a`` and ``body_b`` in the world [m]
             (``(3,)`` or ``(N, 3)``).
         margin: the requested safety distance [m].
-        pairs: the checked pairs.
+        pairs: the candidate pairs (:meth:`Cell.pairs_for` ``(inf)``: the checked pairs
+            first, then the out-of-reach ones).
+
+    ``repr`` is a one-line summary (smallest distance, its pair, how many configurations).
     """
 
     distance: Any
@@ -98,6 +107,18 @@ class Clearance:
         k = self.pair if i is None else self.pair[i]
         return self.pairs[int(k)]
 
+    def __repr__(self) -> str:
+        d = np.atleast_1d(np.asarray(self.distance, dtype=float))
+        k = np.atleast_1d(np.asarray(self.pair))
+        if d.size == 0:
+            return "Clearance(no configurations)"
+        i = int(np.argmin(d))
+        pair = str(self.pairs[int(k[i])]) if k[i] >= 0 else "no pair"
+        where = "" if np.ndim(self.distance) == 0 else f" (configuration {i} of {d.size})"
+        ok = int(np.count_nonzero(d >= self.margin))
+        return (f"Clearance({d[i] * 1e3:.3f} mm{where}, {pair}; {ok} of {d.size} at least the margin "
+                f"{self.margin * 1e3:.1f} mm; {len(self.pairs)} pairs)")
+
 
 def _margin(margin: Any) -> float:
     ok = isinstance(margin, (int, float, np.integer, np.floating)) and not isinstance(margin, bool)
@@ -107,71 +128,29 @@ def _margin(margin: Any) -> float:
     return value
 
 
-def _set_margin(gd: pin.GeometryData, margin: float) -> None:
-    for req in gd.collisionRequests:
-        req.security_margin = margin
-
-
-class _Checkers:
-    """Pinocchio broad-phase checkers of one cell (dynamic AABB tree), per safety margin."""
-
-    def __init__(self, cell: "Cell") -> None:
-        self.cell = cell
-        self.margin: float | None = None
-        self.gd = cold_start(pin.GeometryData(cell.collision_model))
-        self.manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(cell.model, cell.collision_model, self.gd)
-        self.data = cell.model.createData()
-        self.pools: dict[int, Any] = {}
-        self.pool_margin: dict[int, float] = {}
-
-    def single(self, q_pin: np.ndarray, margin: float) -> bool:
-        if self.margin != margin:
-            _set_margin(self.gd, margin)
-            self.margin = margin
-        return bool(pin.computeCollisions(self.cell.model, self.data, self.manager, q_pin, True))
-
-    def batch(self, q_pin: np.ndarray, margin: float, threads: int) -> np.ndarray:
-        pool = self.pools.get(threads)
-        if pool is None:
-            pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(
-                self.cell.model, self.cell.collision_model, threads
-            )
-            for gd in pool.getGeometryDatas():
-                cold_start(gd)
-            self.pools[threads] = pool
-        if self.pool_margin.get(threads) != margin:
-            for gd in pool.getGeometryDatas():
-                _set_margin(gd, margin)
-            self.pool_margin[threads] = margin
-        out = pin.computeCollisionsInParallel(threads, pool, np.asfortranarray(q_pin.T), True, False)
-        return np.asarray(out, dtype=bool).reshape(-1)
-
-
-def _checkers(cell: "Cell") -> _Checkers:
-    checkers = getattr(cell, "_checkers", None)
-    if checkers is None:
-        checkers = cell._checkers = _Checkers(cell)
-    return checkers
+#: Most threads of one batched contact check (each holds its own copy of the collision data).
+MAX_THREADS = 64
 
 
 def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
     """See :meth:`Cell.in_collision`."""
     if margin != 0.0:
         margin = _margin(margin)
-    checkers = _checkers(cell)
+    n = cell._n_for(float(margin)) if margin == margin else 0
     fast = cell._q_pin_single(q)  # one finite (nq,) vector: skip the batch machinery
-    if fast is not None and cell.pairs:
-        return checkers.single(fast, float(margin))
+    if fast is not None and n:
+        return cell._views.checker(n).single(fast, float(margin))
     margin = _margin(margin)
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise InvalidInput(f"threads must be a positive integer, got {threads!r}")
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= MAX_THREADS:
+        raise InvalidInput(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
     arr, single = cell.robot.check_q(q)
-    if not cell.pairs:
+    if not n:
         return False if single else np.zeros(arr.shape[0], dtype=bool)
     qp = cell.robot.q_to_pinocchio(arr)
+    checker = cell._views.checker(n)
     if single:
-        return checkers.single(qp[0], margin)
-    return checkers.batch(qp, margin, int(threads))
+        return checker.single(qp[0], margin)
+    return checker.batch(qp, margin, int(threads))
 
 
 def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
@@ -182,15 +161,16 @@ def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
     if single:
         hit = np.array([hit[0]])
     touching: list[tuple[int, ...]] = [()] * arr.shape[0]
+    n = cell._n_for(margin)
     if hit.any():
         qp = cell.robot.q_to_pinocchio(arr)
-        gd = cold_start(pin.GeometryData(cell.collision_model))
-        _set_margin(gd, margin)
+        views = cell._views
+        gm, gd, data = views.geometry(n), views.collision_data(n, margin), views.data()
         for i in np.flatnonzero(hit):
-            pin.updateGeometryPlacements(cell.model, cell._data, cell.collision_model, gd, qp[i])
-            pin.computeCollisions(cell.collision_model, gd, False)
+            pin.updateGeometryPlacements(cell.model, data, gm, gd, qp[i])
+            pin.computeCollisions(gm, gd, False)
             touching[i] = tuple(k for k, r in enumerate(gd.collisionResults) if r.isCollision())
-    return Collisions(cell.pairs, hit.copy(), tuple(touching), margin, single)
+    return Collisions(cell.pairs_for(margin), hit.copy(), tuple(touching), margin, single)
 
 
 # ------------------------------------------------------------------ broad phase
@@ -217,8 +197,8 @@ def _bounds_data(cell: "Cell") -> dict:
     pin.forwardKinematics(cell.model, data, pin.neutral(cell.model))
     box_R = np.array([g.placement.rotation for g in objs])  # static: parent joint is the world
     box_c = offset.copy()
-    ia = np.array([p.index_a for p in cell.pairs], dtype=int)
-    ib = np.array([p.index_b for p in cell.pairs], dtype=int)
+    ia = np.array([p.index_a for p in cell._candidates], dtype=int)
+    ib = np.array([p.index_b for p in cell._candidates], dtype=int)
     # pairs of a moving geometry with a static one, grouped by the static geometry
     static_groups = []
     for s_idx in np.flatnonzero(static):
@@ -236,8 +216,11 @@ def _bounds_data(cell: "Cell") -> dict:
     return cached
 
 
-def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
-    """``(N, P)`` lower bounds of every checked pair's distance [m] for a batch ``q (N, nq)``.
+def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.ndarray:
+    """``(N, P)`` lower bounds of the candidate pairs' distances [m] for a batch ``q (N, nq)``.
+
+    Columns: the first ``n`` candidate pairs (default all: :meth:`Cell.pairs_for` ``(inf)``;
+    the checked pairs are the first ``len(cell.pairs)``).
 
     Bounding sphere against bounding sphere (for overlapping bodies too: the penetration
     depth of two bodies is at most that of their bounding spheres); against a static
@@ -253,9 +236,15 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
     c[:, b["static"]] = b["box_c"][b["static"]]
     for j, idx in b["by_joint"].items():
         c[:, idx] = p[:, j, None, :] + np.matmul(R[:, j], b["offset"][idx].T).transpose(0, 2, 1)
-    ia, ib = b["ia"], b["ib"]
+    n = len(b["ia"]) if n is None else int(n)
+    ia, ib = b["ia"][:n], b["ib"][:n]
     lb = np.linalg.norm(c[:, ia] - c[:, ib], axis=-1) - b["radius"][ia] - b["radius"][ib]
     for s_idx, cols, moving in b["static_groups"]:
+        if n < len(b["ia"]):
+            keep = cols < n
+            cols, moving = cols[keep], moving[keep]
+            if not cols.size:
+                continue
         local = (c[:, moving] - b["box_c"][s_idx]) @ b["box_R"][s_idx]
         outside = np.maximum(np.abs(local) - b["half"][s_idx], 0.0)
         box_lb = np.linalg.norm(outside, axis=-1) - b["radius"][moving]
@@ -265,36 +254,89 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray) -> np.ndarray:
     return lb
 
 
+#: Up to this many out-of-reach pairs, a batch's clearance sorts them with the checked pairs in one pass.
+ONE_PASS_REACH = 2000
+
+
 def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
     """See :meth:`Cell.clearance`."""
     margin = _margin(margin)
     arr, single = cell.robot.check_q(q)
     N = arr.shape[0]
-    if not cell.pairs:
+    pairs = cell._candidates
+    if not pairs:
         inf = np.full(N, np.inf)
         nan3 = np.full((N, 3), np.nan)
         pick = (lambda x: x[0]) if single else (lambda x: x)
-        return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, cell.pairs)
-    dist, pair, pa, pb = exact_min_distance(cell, arr)
+        return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, pairs)
+    if N <= 4 or len(cell._reach) > ONE_PASS_REACH:
+        # a few configurations (the checked pairs in Pinocchio's loop), or a huge cell: the checked
+        # pairs first, then only the out-of-reach pairs whose bound is below each row's distance
+        dist, pair, pa, pb = exact_min_distance(cell, arr)
+        _reach_pass(cell, arr, dist, pair, pa, pb)
+    else:  # one pass over every candidate, each out-of-reach pair's bound raised to its proven one
+        lb = pair_lower_bounds(cell, arr)
+        n0 = len(cell.pairs)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        dist, pair, pa, pb = exact_min_distance(cell, arr, lb=lb, n=len(pairs))
     if single:
-        return Clearance(float(dist[0]), int(pair[0]), pa[0], pb[0], margin, cell.pairs)
-    return Clearance(dist, pair, pa, pb, margin, cell.pairs)
+        return Clearance(float(dist[0]), int(pair[0]), pa[0], pb[0], margin, pairs)
+    return Clearance(dist, pair, pa, pb, margin, pairs)
 
 
-def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None):
-    """Exact smallest distance over the checked pairs for each row of ``arr (N, nq)``.
+def _reach_pass(cell: "Cell", arr: np.ndarray, dist: np.ndarray, pair: np.ndarray, pa: np.ndarray,
+                pb: np.ndarray) -> None:
+    """Bring in the out-of-reach pairs whose bound is below each row's smallest distance (in place)."""
+    n0 = len(cell.pairs)
+    need = [i for i in range(arr.shape[0]) if cell._n_for(float(dist[i]), strict=True) > n0]
+    if not need:
+        return
+    n_max = max(cell._n_for(float(dist[i]), strict=True) for i in need)
+    views = cell._views
+    gm, gd, data = views.geometry(n_max), views.distance_data(n_max), views.data()
+    lb = pair_lower_bounds(cell, arr[need], n_max)[:, n0:]
+    bounds = cell._reach_bounds
+    qp = cell.robot.q_to_pinocchio(arr[need])
+    for row, i in enumerate(need):
+        pin.updateGeometryPlacements(cell.model, data, gm, gd, qp[row])
+        for k in range(n0, n_max):
+            if bounds[k - n0] >= dist[i]:
+                break
+            if lb[row, k - n0] >= dist[i]:
+                continue
+            res = pin.computeDistance(gm, gd, k)
+            d = _finite(cell, res.min_distance, k)
+            if d < dist[i]:
+                dist[i], pair[i] = d, k
+                pa[i], pb[i] = np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2())
 
-    Returns ``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``.
+
+def _finite(cell: "Cell", d: float, k: int) -> float:
+    if not np.isfinite(d):
+        p = cell._candidates[k]
+        raise CollisionGeometryError(f"coal returned distance {d} for {p.body_a} – {p.body_b}")
+    return float(d)
+
+
+def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None, n: int | None = None):
+    """Exact smallest distance over the first ``n`` candidate pairs (default: the checked pairs) per row of ``arr (N, nq)``.
+
+    Returns ``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``; ``pair`` indexes
+    :meth:`Cell.pairs_for` (a prefix of the candidates). ``inf`` and pair −1 when ``n`` is 0.
     """
     N = arr.shape[0]
+    n = len(cell.pairs) if n is None else int(n)
+    if n == 0:
+        return np.full(N, np.inf), np.full(N, -1, dtype=int), np.full((N, 3), np.nan), np.full((N, 3), np.nan)
     if lb is None and N <= 4:  # a few configurations: every pair in Pinocchio's loop beats the broad phase
-        return _all_pairs_min_distance(cell, arr)
+        return _all_pairs_min_distance(cell, arr, n)
     if lb is None:
-        lb = pair_lower_bounds(cell, arr)
+        lb = pair_lower_bounds(cell, arr, n)
     order = np.argsort(lb, axis=1, kind="stable")
     sorted_lb = np.take_along_axis(lb, order, axis=1)
     qp = cell.robot.q_to_pinocchio(arr)
-    gm, gd, model, data = cell.collision_model, cell._gd, cell.model, cell._data
+    views = cell._views
+    gm, gd, model, data = views.geometry(n), views.distance_data(n), cell.model, views.data()
     dist = np.empty(N)
     best_pair = np.empty(N, dtype=int)
     pa = np.empty((N, 3))
@@ -309,10 +351,7 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
                 break
             k = int(row[r])
             res = pin.computeDistance(gm, gd, k)
-            d = res.min_distance
-            if not np.isfinite(d):
-                p = cell.pairs[k]
-                raise CollisionGeometryError(f"coal returned distance {d} for {p.body_a} – {p.body_b}")
+            d = _finite(cell, res.min_distance, k)
             if d < best:
                 best, arg, res_best = d, k, (np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2()))
         dist[i], best_pair[i] = best, arg
@@ -320,19 +359,19 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
     return dist, best_pair, pa, pb
 
 
-def _all_pairs_min_distance(cell: "Cell", arr: np.ndarray):
+def _all_pairs_min_distance(cell: "Cell", arr: np.ndarray, n: int):
     qp = cell.robot.q_to_pinocchio(arr)
-    gm, gd = cell.collision_model, cell._gd
+    views = cell._views
+    gm, gd, data = views.geometry(n), views.distance_data(n), views.data()
     N = arr.shape[0]
     dist, pair = np.empty(N), np.empty(N, dtype=int)
     pa, pb = np.empty((N, 3)), np.empty((N, 3))
     for i in range(N):
-        pin.updateGeometryPlacements(cell.model, cell._data, gm, gd, qp[i])
+        pin.updateGeometryPlacements(cell.model, data, gm, gd, qp[i])
         pin.computeDistances(gm, gd)
         d = np.array([r.min_distance for r in gd.distanceResults])
         if not np.all(np.isfinite(d)):
-            p = cell.pairs[int(np.flatnonzero(~np.isfinite(d))[0])]
-            raise CollisionGeometryError(f"coal returned a non-finite distance for {p.body_a} – {p.body_b}")
+            _finite(cell, float(d[np.flatnonzero(~np.isfinite(d))[0]]), int(np.flatnonzero(~np.isfinite(d))[0]))
         k = int(np.argmin(d))
         r = gd.distanceResults[k]
         dist[i], pair[i] = d[k], k

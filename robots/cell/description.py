@@ -160,12 +160,14 @@ def describe(root: ET.Element, source: str) -> CellSpec:
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise CellError(f"{source}: several arms are named {dup[0]!r}; give each arm its own prefix")
+    static_set = set(static)
     fixtures = tuple(
         link for link in links
-        if link not in taken and link in set(static) and links[link].find("collision") is not None
+        if link not in taken and link in static_set and links[link].find("collision") is not None
     )
-    frames = tuple(link for link in links if link not in taken and link not in fixtures)
-    moving_outside = [link for link in links if link not in taken and link not in set(static)]
+    fixture_set = set(fixtures)
+    frames = tuple(link for link in links if link not in taken and link not in fixture_set)
+    moving_outside = [link for link in links if link not in taken and link not in static_set]
     if moving_outside:  # pragma: no cover - every movable subtree hangs from a static base
         raise CellError(f"{source}: links {moving_outside} move but belong to no arm")
     return CellSpec(name=root.get("name", "cell"), root_link=root_link, arms=tuple(arms), fixtures=fixtures, frames=frames)

@@ -18,6 +18,7 @@ from ..errors import CellNotFound, InvalidInput, ModelError
 from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
 from ..xacro_expand import XacroLimits, expand_xacro
 from .cell import Cell
+from .limits import MAX_CELL_FILE_BYTES, check_file_size, read_cell_file
 
 __all__ = [
     "CELL_XACRO_DIR",
@@ -145,14 +146,12 @@ def load_cell(
 
         return load_cell_description(path, packages=packages, seed=seed)
     if path.name.endswith(".xacro"):
+        check_file_size(path, MAX_CELL_FILE_BYTES, "cell file")  # by stat, before the expansion reads it
         result = expand_xacro(path, all_args, packages=packages, limits=limits,
                               header=(f" Generated from {path.name} by pinarms. ",))
         return Cell(result.urdf_text, source=str(path), base_dir=path.resolve().parent, packages=packages,
                     args=result.args, seed=seed)
     if all_args:
         raise InvalidInput(f"{str(path)!r} is a URDF: it takes no xacro arguments (got {', '.join(all_args)})")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ModelError(f"cannot read cell file {str(path)!r}: {exc.strerror or exc}") from exc
+    text = read_cell_file(path)  # sized by stat, read up to the cap only
     return Cell(text, source=str(path), base_dir=path.resolve().parent, packages=packages, seed=seed)

@@ -57,6 +57,21 @@ __all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers"
 MAX_SPLITS = 6
 #: Largest number of samples of one check.
 MAX_SAMPLES = 2_000_000
+#: Largest magnitude of a time (offset, period, window end, trajectory time) [s]: about 11.6
+#: days; beyond it a double cannot resolve the bisection's 1e-6 s.
+MAX_TIME = 1e6
+#: Largest margin or clearance a check takes [m].
+MAX_DISTANCE = 1e3
+#: Largest number of bisection steps locating the first contact (1e-6 s over MAX_TIME needs 41).
+MAX_BISECTIONS = 64
+
+
+def _time(value: Any, what: str) -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    t = float(value) if ok else float("nan")
+    if not (math.isfinite(t) and abs(t) <= MAX_TIME):
+        raise InvalidInput(f"{what} must be a finite time within ±{MAX_TIME:.0e} s, got {value!r}")
+    return t
 
 
 @dataclass(frozen=True)
@@ -123,13 +138,19 @@ class MotionCheck:
             ``(M,)`` is true, else the screen's bound ``required + margin`` (the sample is at
             least that far from every contact); ``pair_index``: ``(M,)`` index into
             ``pairs`` of the closest pair (−1 where not exact).
-        min_clearance: among the exact samples; when no sample came within
-            ``required + margin`` of a contact (and ``curve`` was off) it is that bound and
-            ``min_clearance_pair`` is ``None``.
+        min_clearance: the smallest value of ``clearance``: an exact distance when
+            :attr:`min_clearance_is_exact` (then ``min_clearance_pair`` is its pair), else
+            — no sample came within ``required + margin`` of a contact and ``curve`` was
+            off — the screening *bound* ``required + margin`` and ``min_clearance_pair`` is
+            ``None``. Quote :attr:`min_sample_distance` for a distance and
+            :attr:`lower_bound` for a proven bound.
         dt: the finest time step [s] (at the global speed bound); ``speed_bound``: that
             bound ``V`` [m/s];
             ``margin`` and ``required`` [m]; ``window``: ``(t_start, t_end)`` [s].
-        pairs: the checked pairs of the cell.
+        pairs: the pairs looked at (:meth:`Cell.pairs_for` at ``required + margin``); the
+            pairs left out are proven farther than that in every configuration.
+
+    ``repr`` is :meth:`summary`.
     """
 
     collision_free: bool
@@ -157,6 +178,25 @@ class MotionCheck:
         return int(self.times.size)
 
     @property
+    def min_clearance_is_exact(self) -> bool:
+        """Whether :attr:`min_clearance` is an exact distance (else the screening bound)."""
+        return self.min_clearance_pair is not None
+
+    @property
+    def min_sample_distance(self) -> float:
+        """The smallest exact distance at a sample [m] (coal); ``nan`` when every sample was screened clear."""
+        d = self.clearance[self.exact]
+        return float(d.min()) if d.size else float("nan")
+
+    @property
+    def screening_bound(self) -> float:
+        """The screen's distance ``required + margin`` [m]: a sample not computed exactly is at least this far."""
+        return self.required + self.margin
+
+    def __repr__(self) -> str:
+        return f"MotionCheck({self.summary()})"
+
+    @property
     def in_contact(self) -> np.ndarray:
         """``(M,)`` bool: the samples in contact (distance ≤ 0)."""
         return self.clearance <= 0.0
@@ -167,11 +207,13 @@ class MotionCheck:
             c = self.first_contact
             head = f"contact at t = {c.time:.4f} s: {c.pair} (depth {c.depth * 1e3:.1f} mm)"
         elif self.min_clearance_pair is None:
-            head = f"{'clear' if self.clear else 'NOT proven clear'}: every distance stays above {self.min_clearance * 1e3:.1f} mm"
+            head = (f"{'clear' if self.clear else 'NOT proven clear'}: every sample at least {self.min_clearance * 1e3:.1f} mm"
+                    f" (screening bound), proven lower bound {self.lower_bound * 1e3:.1f} mm")
         else:
             head = (
-                f"{'clear' if self.clear else 'NOT proven clear'}: minimum clearance {self.min_clearance * 1e3:.1f} mm"
-                f" at t = {self.min_clearance_time:.4f} s ({self.min_clearance_pair})"
+                f"{'clear' if self.clear else 'NOT proven clear'}: smallest sampled distance {self.min_clearance * 1e3:.1f} mm"
+                f" at t = {self.min_clearance_time:.4f} s ({self.min_clearance_pair}), proven lower bound "
+                f"{self.lower_bound * 1e3:.1f} mm"
             )
         return f"{head}; {self.n_samples} samples, dt = {self.dt * 1e3:.3f} ms, speed bound {self.speed_bound:.2f} m/s"
 
@@ -263,9 +305,13 @@ def _motions(cell: "Cell", motions: Any) -> list[ArmMotion]:
         n = np.asarray(traj.sample(traj.start_time)[0]).shape
         if n != (arm.nq,):
             raise InvalidInput(f"the trajectory of arm {m.arm!r} has {n[0] if n else 0} joints, the arm {arm.nq}")
-        if not math.isfinite(float(m.offset)):
-            raise InvalidInput(f"offset of arm {m.arm!r} must be finite, got {m.offset!r}")
+        _time(m.offset, f"offset of arm {m.arm!r}")
+        start = _time(traj.start_time, f"start_time of the trajectory of arm {m.arm!r}")
+        end = _time(traj.end_time, f"end_time of the trajectory of arm {m.arm!r}")
+        if end < start:
+            raise InvalidInput(f"the trajectory of arm {m.arm!r} ends ({end!r} s) before it starts ({start!r} s)")
         if m.period is not None:
+            _time(m.period, f"period of arm {m.arm!r}")
             duration = traj.end_time - traj.start_time
             if not (math.isfinite(float(m.period)) and float(m.period) >= duration - 1e-12 and m.period > 0):
                 raise InvalidInput(
@@ -280,6 +326,9 @@ def configurations(cell: "Cell", motions: list[ArmMotion], times: np.ndarray, ho
     for m in motions:
         arm = cell.arm(m.arm)
         Q[:, arm.q_slice] = np.asarray(m.trajectory.sample(m.local_time(times))[0], dtype=float).reshape(times.size, -1)
+        if not np.isfinite(Q[:, arm.q_slice]).all():
+            bad = times[np.flatnonzero(~np.isfinite(Q[:, arm.q_slice]).all(axis=1))[0]]
+            raise InvalidInput(f"the trajectory of arm {m.arm!r} gives non-finite joint values at t = {bad!r} s")
     return Q
 
 
@@ -302,8 +351,13 @@ def sample_motions(cell: "Cell", motions: Any, *, hz: float = 100.0, window: tup
     motions = _motions(cell, motions)
     if not (isinstance(hz, (int, float)) and math.isfinite(hz) and hz > 0):
         raise InvalidInput(f"hz must be a positive sampling rate in 1/s, got {hz!r}")
-    t0, t1 = motion_window(motions) if window is None else (float(window[0]), float(window[1]))
+    w0, w1 = motion_window(motions) if window is None else (window[0], window[1])
+    t0, t1 = _time(w0, "window start"), _time(w1, "window end")
+    if t1 < t0:
+        raise InvalidInput(f"window must be (t_start, t_end) with t_end >= t_start, got {window!r}")
     n = max(2, int(math.ceil((t1 - t0) * hz)) + 1)
+    if n > MAX_SAMPLES:
+        raise InvalidInput(f"{n} samples at {hz!r} Hz over {t1 - t0:.3g} s: at most {MAX_SAMPLES}; lower hz or the window")
     times = np.linspace(t0, t1, n)
     hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
     return times, configurations(cell, motions, times, hold_q)
@@ -371,15 +425,21 @@ def check_motion(
             window that would need more than 2 000 000 samples.
     """
     margin = _margin(margin)
-    if margin <= 0.0:
-        raise InvalidInput("margin must be > 0 m: it sets the time step")
+    if margin <= 0.0 or margin > MAX_DISTANCE:
+        raise InvalidInput(f"margin must be > 0 m and at most {MAX_DISTANCE:g} m: it sets the time step, got {margin!r}")
     required = _margin(clearance)
+    if required > MAX_DISTANCE:
+        raise InvalidInput(f"clearance must be at most {MAX_DISTANCE:g} m, got {clearance!r}")
     motions = _motions(cell, motions)
     hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
     if window is None:
         window = motion_window(motions)
-    t0, t1 = float(window[0]), float(window[1])
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
+    try:
+        w0, w1 = window
+    except (TypeError, ValueError):
+        raise InvalidInput(f"window must be (t_start, t_end) [s], got {window!r}") from None
+    t0, t1 = _time(w0, "window start"), _time(w1, "window end")
+    if t1 < t0:
         raise InvalidInput(f"window must be (t_start, t_end) with t_end >= t_start, got {window!r}")
 
     # fine grid at the global bound's step, then samples every `margin` of approach budget
@@ -413,18 +473,23 @@ def check_motion(
 
     Q = configurations(cell, motions, times, hold_q)
     screen = required + margin
+    # every pair not proven farther than the screen distance (Cell.pairs_for): the pairs left
+    # out keep a distance above `screen` >= `required` in every configuration
+    n_pairs = cell._n_for(screen + 1e-6)
+    pairs = cell._candidates[:n_pairs]
+    left_out = cell._reach_bounds[n_pairs - len(cell.pairs):]
     exact = np.ones(times.size, dtype=bool) if curve else cell.in_collision(Q, margin=screen + 1e-6)
     d = np.full(times.size, screen)
     k = np.full(times.size, -1, dtype=int)
     if exact.any():
-        de, ke, _, _ = exact_min_distance(cell, Q[exact])
+        de, ke, _, _ = exact_min_distance(cell, Q[exact], n=n_pairs)
         d[exact], k[exact] = de, ke
 
     samples_t, samples_d, samples_k, samples_x = list(times), list(d), list(k), list(exact)
 
     def evaluate(ts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Qs = configurations(cell, motions, ts, hold_q)
-        ds, ks, _, _ = exact_min_distance(cell, Qs)
+        ds, ks, _, _ = exact_min_distance(cell, Qs, n=n_pairs)
         samples_t.extend(ts)
         samples_d.extend(ds)
         samples_k.extend(ks)
@@ -477,8 +542,10 @@ def check_motion(
         t_hit, d_hit, k_hit = all_t[i], all_d[i], all_k[i]
         if i > 0:  # bisect between the last clear sample and the first in contact
             ta, tb = all_t[i - 1], all_t[i]
-            while tb - ta > 1e-6:
+            for _ in range(MAX_BISECTIONS):
                 tm = 0.5 * (ta + tb)
+                if tb - ta <= 1e-6 or not ta < tm < tb:
+                    break
                 dm, km = evaluate(np.array([tm]))
                 if dm[0] <= 0.0:
                     tb, d_hit, k_hit = tm, dm[0], km[0]
@@ -487,12 +554,14 @@ def check_motion(
             t_hit = tb
         first = Contact(
             time=float(t_hit),
-            pair=cell.pairs[int(k_hit)],
+            pair=pairs[int(k_hit)],
             depth=float(max(-d_hit, 0.0)),
             q=configurations(cell, motions, np.array([t_hit]), hold_q)[0],
         )
         all_t, all_d, all_k, all_x = collected()
     lower = min(lower, float(all_d.min()))
+    if left_out.size:  # the pairs left out are proven at least this far apart
+        lower = min(lower, float(left_out[0]))
     exact_d = np.where(all_x, all_d, np.inf)
     i_min = int(np.argmin(exact_d)) if np.isfinite(exact_d).any() else int(np.argmin(all_d))
     collision_free = first is None and lower > 0.0
@@ -504,7 +573,7 @@ def check_motion(
         max_depth=float(max(0.0, -all_d.min())),
         min_clearance=float(all_d[i_min]),
         min_clearance_time=float(all_t[i_min]),
-        min_clearance_pair=cell.pairs[int(all_k[i_min])] if all_k[i_min] >= 0 else None,
+        min_clearance_pair=pairs[int(all_k[i_min])] if all_k[i_min] >= 0 else None,
         lower_bound=float(lower),
         times=all_t,
         clearance=all_d,
@@ -515,5 +584,5 @@ def check_motion(
         margin=margin,
         required=required,
         window=(t0, t1),
-        pairs=cell.pairs,
+        pairs=pairs,
     )

@@ -18,7 +18,14 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     origin of its arm's first joint (radius: the joint offsets along the chain, the
     prismatic strokes and the geometry's own bounding sphere, by the triangle inequality),
     and that ball does not reach the other geometry's bounding box (a fixture) or ball
-    (another arm);
+    (another arm). The pair keeps :attr:`AllowedPair.distance_bound`, a proven lower bound
+    of its distance in every configuration: the largest of that gap, coal's exact distance
+    from the ball to a fixture's own shape, and coal's distance between the solid cylinder
+    an arm's revolute first joint sweeps the geometry through and the fixture (or the other
+    arm's cylinder), see :mod:`.reach`.
+    Such a pair is dropped only from checks whose clearance or margin is below that bound:
+    :meth:`Cell.pairs_for` brings it back for any larger one, and :meth:`Cell.clearance`
+    computes it whenever its bound is below the smallest distance found;
 ``always``
     in contact in at least 95 % of 200 seeded random configurations of the cell (parts of
     one assembly that overlap whatever the joints do);
@@ -29,7 +36,9 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
 
 Unlike the sampled "never in collision" of setup assistants, a pair is only dropped as
 "never" when it is proven (``out of reach``): a sample can miss a rare contact, a bound cannot.
-Every other pair is a :class:`CollisionPair` and is checked.
+Every other pair is a :class:`CollisionPair` and is checked. Pairs allowed by design
+(``same link``, ``rigid``, ``adjacent``, ``always``, ``constant``) are never checked at any
+clearance: their distance does not depend on a motion, or they touch by construction.
 """
 
 from __future__ import annotations
@@ -37,15 +46,21 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import coal
 import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
+from .reach import root_cylinders, tighter_bound
 
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES"]
+__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "reach_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES",
+           "BY_DESIGN"]
+
+#: Reasons of the pairs allowed by design: never checked, at any clearance.
+BY_DESIGN = ("same link", "rigid", "adjacent", "always", "constant")
 
 #: Share of random configurations in contact above which a pair is "always" touching.
 ALWAYS_SHARE = 0.95
@@ -86,13 +101,26 @@ class CollisionPair:
 
 @dataclass(frozen=True)
 class AllowedPair:
-    """A pair of geometries the cell never checks, and why (see the module doc)."""
+    """A pair of geometries the cell does not check at clearance 0, and why (see the module doc).
+
+    Attributes:
+        distance_bound: for ``"out of reach"``: a proven lower bound (> 0) of the pair's
+            distance in every configuration [m]; checks at a clearance or margin at least
+            this large include the pair (:meth:`Cell.pairs_for`). ``inf`` for the pairs
+            allowed by design (:data:`BY_DESIGN`): never checked, at any clearance — so
+            ``[p for p in cell.allowed if p.distance_bound <= c]`` is exactly the allowed
+            pairs a check at ``c`` must bring back.
+        index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
+    """
 
     geometry_a: str
     geometry_b: str
     body_a: str
     body_b: str
     reason: str
+    distance_bound: float = float("inf")
+    index_a: int = -1
+    index_b: int = -1
 
 
 def _effective(model: pin.Model, j: int) -> int:
@@ -115,25 +143,12 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
     return center, float(np.linalg.norm(half)), half
 
 
-def _point_box_distance(point: np.ndarray, R: np.ndarray, center: np.ndarray, half: np.ndarray) -> float:
-    local = R.T @ (point - center)
-    return float(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0)))
-
-
 def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
     """Split every pair of the cell's collision geometries into checked and allowed pairs."""
     model, gm = cell.model, cell.collision_model
     objs = list(gm.geometryObjects)
     G = len(objs)
-    link = [model.frames[g.parentFrame].name for g in objs]
-    owner_of_link: dict[str, str] = {}
-    for arm in cell.spec.arms:
-        for name in arm.links:
-            owner_of_link[name] = arm.name
-    for name in cell.spec.fixtures:
-        owner_of_link[name] = name
-    owner = [owner_of_link.get(name, name) for name in link]
-    is_arm = [name in {a.name for a in cell.spec.arms} for name in owner]
+    link, owner, is_arm = _owners(cell)
     joint = [int(g.parentJoint) for g in objs]
     eff = [_effective(model, j) for j in joint]
 
@@ -170,11 +185,16 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             j = model.parents[j]
         ball_radius[k] = total
 
+    gaps = _reach_gaps(np.array(joint), ball_center, ball_radius, box_R, box_c, box_half, owner)
+    cylinders = root_cylinders(model, data, objs, joint, ball_radius)
+
+    def placement(k: int) -> coal.Transform3s:
+        return coal.Transform3s(gd.oMg[k].rotation, gd.oMg[k].translation)
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
-    def allow(a: int, b: int, reason: str) -> None:
-        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason))
+    def allow(a: int, b: int, reason: str, bound: float = float("inf")) -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
 
     for a in range(G):
         for b in range(a + 1, G):
@@ -192,11 +212,16 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
             if adjacent:
                 allow(a, b, "adjacent")
                 continue
-            if _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner):
-                allow(a, b, "out of reach")
+            gap = gaps[a, b]
+            if gap > 0.0:
+                allow(a, b, "out of reach", tighter_bound(gap, a, b, objs, joint, ball_center, ball_radius, placement,
+                                                          cylinders))
                 continue
             checked.append((a, b))
 
+    from .limits import check_pairs
+
+    check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
     # "always": pairs in contact in at least ALWAYS_SHARE of random configurations
     if checked:
         probe = pin.GeometryModel()
@@ -226,18 +251,43 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
                 keep.append((a, b))
         checked = keep
 
-    pairs = []
-    for a, b in checked:
-        if not is_arm[a] and is_arm[b]:
-            a, b = b, a
-        if is_arm[a] and is_arm[b]:
-            kind = "self" if owner[a] == owner[b] else "arm-arm"
-        else:
-            kind = "arm-fixture"
-        pairs.append(CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind))
+    pairs = [_pair(a, b, objs, link, owner, is_arm) for a, b in checked]
     order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
     pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
     return tuple(pairs), tuple(allowed)
+
+
+def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
+    model, objs = cell.model, list(cell.collision_model.geometryObjects)
+    link = [model.frames[g.parentFrame].name for g in objs]
+    owner_of_link: dict[str, str] = {}
+    for arm in cell.spec.arms:
+        for name in arm.links:
+            owner_of_link[name] = arm.name
+    for name in cell.spec.fixtures:
+        owner_of_link[name] = name
+    owner = [owner_of_link.get(name, name) for name in link]
+    arms = {a.name for a in cell.spec.arms}
+    return link, owner, [name in arms for name in owner]
+
+
+def _pair(a: int, b: int, objs: list, link: list[str], owner: list[str], is_arm: list[bool]) -> CollisionPair:
+    if not is_arm[a] and is_arm[b]:
+        a, b = b, a
+    if is_arm[a] and is_arm[b]:
+        kind = "self" if owner[a] == owner[b] else "arm-arm"
+    else:
+        kind = "arm-fixture"
+    return CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind)
+
+
+def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
+    """The ``"out of reach"`` pairs as :class:`CollisionPair` s, in increasing order of their bound, and the bounds [m]."""
+    objs = list(cell.collision_model.geometryObjects)
+    link, owner, is_arm = _owners(cell)
+    reach = sorted((p for p in allowed if p.reason == "out of reach"), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
+    pairs = tuple(_pair(p.index_a, p.index_b, objs, link, owner, is_arm) for p in reach)
+    return pairs, np.array([p.distance_bound for p in reach], dtype=float)
 
 
 def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
@@ -245,15 +295,26 @@ def _is_prismatic(model: pin.Model, data: pin.Data, j: int) -> bool:
     return bool(np.linalg.norm(motion[3:]) < 1e-12)
 
 
-def _out_of_reach(a, b, joint, ball_center, ball_radius, box_R, box_c, box_half, owner) -> bool:
-    moving_a, moving_b = joint[a] > 0, joint[b] > 0
-    if moving_a and moving_b:
-        if owner[a] == owner[b]:
-            return False
-        gap = np.linalg.norm(ball_center[a] - ball_center[b]) - ball_radius[a] - ball_radius[b]
-        return bool(gap > 0.0)
-    m, s = (a, b) if moving_a else (b, a)
-    if not (moving_a or moving_b):
-        return False
-    gap = _point_box_distance(ball_center[m], box_R[s], box_c[s], box_half[s]) - ball_radius[m]
-    return bool(gap > 0.0)
+def _reach_gaps(joint: np.ndarray, ball_center, ball_radius, box_R, box_c, box_half, owner: list[str]) -> np.ndarray:
+    """``(G, G)`` proven lower bounds of every pair's distance over every configuration (≤ 0 or -inf: no proof).
+
+    Two moving geometries of different owners: the gap between their reach balls; a moving
+    geometry and a static one: the gap from the reach ball to the static one's oriented box.
+    """
+    G = joint.size
+    gaps = np.full((G, G), -np.inf)
+    moving = np.flatnonzero(joint > 0)
+    static = np.flatnonzero(joint == 0)
+    if moving.size:
+        owners = np.unique(np.array(owner, dtype=object)[moving], return_inverse=True)[1]
+        c, r = ball_center[moving], ball_radius[moving]
+        mm = np.linalg.norm(c[:, None] - c[None], axis=-1) - r[:, None] - r[None]
+        mm[owners[:, None] == owners[None]] = -np.inf  # one arm's own links: never "out of reach"
+        gaps[np.ix_(moving, moving)] = mm
+    if moving.size and static.size:
+        local = np.einsum("sji,msj->msi", box_R[static], ball_center[moving][:, None] - box_c[static][None])
+        outside = np.linalg.norm(np.maximum(np.abs(local) - box_half[static][None], 0.0), axis=-1)
+        ms = outside - ball_radius[moving][:, None]
+        gaps[np.ix_(moving, static)] = ms
+        gaps[np.ix_(static, moving)] = ms.T
+    return gaps
