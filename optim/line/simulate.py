@@ -56,7 +56,7 @@ class SimResult:
     Attributes:
         picked_by: arm index or -1 (missed); ``meet``: rendezvous time [s] (NaN if missed);
         ``u_meet``: pre-grasp point along the belt [m]; ``start``, ``finish``: the pick's
-        start and end [s]; ``arms``: names; ``duration``: observed time [s] (the stream's);
+        start and end [s]; ``t0``: arrival times [s]; ``arms``: names; ``duration``: observed time [s] (the stream's);
         ``busy``: per arm, time spent moving [s]; ``overlaps``: pairs of picks (item a, item b)
         by neighbouring arms with overlapping windows at overlapping times.
     """
@@ -70,6 +70,7 @@ class SimResult:
     duration: float
     busy: np.ndarray
     decisions: int
+    t0: np.ndarray = field(default_factory=lambda: np.zeros(0))
     overlaps: list = field(default_factory=list)
 
     @property
@@ -234,7 +235,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     done = picked_by >= 0
     np.add.at(busy, picked_by[done], np.clip(finish[done], 0.0, span) - np.clip(start[done], 0.0, span))
     return SimResult(names, picked_by, meet, u_meet,
-                     start, finish, max(span, 1e-9), busy, decisions)
+                     start, finish, max(span, 1e-9), busy, decisions, t0)
 
 
 def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: _ArmState, speed: float, rule: Rule,

@@ -129,11 +129,12 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
 
 def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
                    item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
-                   scheduler: Any = None, progress: Any = None) -> TaskMap:
+                   du_range: tuple[float, float] | None = None, scheduler: Any = None,
+                   progress: Any = None) -> TaskMap:
     """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
 
-    ``du`` spans the arm's horizontal reach either side of its base; ``w`` the belt's width
-    less ``margin`` [m] at each edge (half an item's width).
+    ``du`` spans the arm's horizontal reach either side of its base (or ``du_range`` [m]);
+    ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
@@ -147,7 +148,10 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     rest_configuration(station)
     start = time.perf_counter()
     R = horizontal_reach(station)
-    du = np.linspace(-R, R, nu)
+    lo, hi = (-R, R) if du_range is None else (float(du_range[0]), float(du_range[1]))
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise InvalidInput(f"du_range must be two finite numbers, low < high [m], got {du_range!r}")
+    du = np.linspace(lo, hi, nu)
     half = belt.width / 2.0 - margin
     if half <= 0.0:
         raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
