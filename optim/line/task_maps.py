@@ -33,7 +33,7 @@ from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick, rest_configuration
-from pinarms.optim.line.windows import check_reach, horizontal_reach
+from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["TaskMap", "build_task_map", "map_error", "MapError"]
@@ -133,7 +133,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
                    progress: Any = None) -> TaskMap:
     """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
 
-    ``du`` spans the arm's horizontal reach either side of its base (or ``du_range`` [m]);
+    ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
     ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
 
     Raises:
@@ -147,8 +147,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     check_reach(station, belt, item_height)
     rest_configuration(station)
     start = time.perf_counter()
-    R = horizontal_reach(station)
-    lo, hi = (-R, R) if du_range is None else (float(du_range[0]), float(du_range[1]))
+    lo, hi = belt_span(station, belt) if du_range is None else (float(du_range[0]), float(du_range[1]))
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
         raise InvalidInput(f"du_range must be two finite numbers, low < high [m], got {du_range!r}")
     du = np.linspace(lo, hi, nu)

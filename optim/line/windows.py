@@ -18,7 +18,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.errors import BeltOutOfReach
 from pinarms.optim.line.station import Station
 
-__all__ = ["PickWindow", "check_reach", "horizontal_reach", "windows_overlap", "REACH_SAMPLES"]
+__all__ = ["PickWindow", "check_reach", "belt_span", "horizontal_reach", "windows_overlap", "REACH_SAMPLES"]
 
 #: Seeded random configurations that sample an arm's workspace.
 REACH_SAMPLES = 4000
@@ -51,6 +51,17 @@ def horizontal_reach(station: Station) -> float:
     q = station.robot.random_q(REACH_SAMPLES, seed=0)
     p = station.robot.position(q)
     return float(np.max(np.hypot(p[:, 0], p[:, 1])))
+
+
+def belt_span(station: Station, belt: Belt, margin: float = 0.05) -> tuple[float, float]:
+    """Range of ``du`` [m] (along the belt, from the base's projection) of sampled tcp points over
+    the belt (across within its half width + ``margin``): where the map's grid is laid."""
+    p = belt.to_belt(_workspace_world(station))
+    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    over = np.abs(p[:, 1]) <= belt.width / 2.0 + margin
+    if not over.any():
+        return (-horizontal_reach(station), horizontal_reach(station))
+    return float(p[over, 0].min() - u_base), float(p[over, 0].max() - u_base)
 
 
 def check_reach(station: Station, belt: Belt, grasp_height: float, tolerance: float = 0.02) -> None:
