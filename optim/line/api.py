@@ -66,7 +66,10 @@ class Stream:
 @dataclass(frozen=True, eq=False)
 class LineSpec:
     """A line (module doc). ``target_miss_rate``: the miss rate asked for (fraction);
-    ``map_grid``: (nu, nw) of the task maps."""
+    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`robots.cell.Cell` whose arms
+    are the stations (same names and bases) — then neighbours whose windows overlap start a pick
+    only when the cell's continuous check proves it keeps ``clearance`` [m] from the neighbour's
+    (:mod:`~.neighbours`; the seeds then run in this process)."""
 
     belt: Belt
     stations: tuple[Station, ...]
@@ -76,6 +79,8 @@ class LineSpec:
     seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
     target_miss_rate: float = 0.01
     map_grid: tuple[int, int] = (24, 7)
+    cell: Any = None
+    clearance: float = 0.01
 
     def __post_init__(self) -> None:
         if not isinstance(self.belt, Belt):
@@ -113,6 +118,7 @@ class LineResult:
 
     def as_dict(self) -> dict[str, Any]:
         return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
+                "neighbour_checks": [list(r.checks) for r in self.runs],
                 "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
 
 
@@ -154,8 +160,14 @@ def sim_arms(spec: LineSpec, maps: dict[str, tuple[TaskMap, ...]]) -> list[SimAr
 def _run_seed(task: dict) -> SimResult:
     spec = task["spec"]
     items = spec.stream.items(spec.belt, task["seed"])
+    guard = None
+    if spec.cell is not None:
+        from pinarms.optim.line.neighbours import NeighbourGuard
+
+        guard = NeighbourGuard(spec.cell, spec.stations, spec.belt, spec.tracking, spec.stream.types,
+                               clearance=spec.clearance)
     return simulate(task["arms"], items, spec.belt.speed, spec.rule, duration=spec.stream.duration,
-                    width=spec.belt.width)
+                    width=spec.belt.width, guard=guard)
 
 
 def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None) -> LineResult:
@@ -164,7 +176,8 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None)
 
     maps = build_maps(spec, scheduler=scheduler) if maps is None else maps
     arms = sim_arms(spec, maps)
-    runs = map_chunks(_run_seed, [{"spec": spec, "arms": arms, "seed": s} for s in spec.seeds], scheduler=scheduler)
+    runs = map_chunks(_run_seed, [{"spec": spec, "arms": arms, "seed": s} for s in spec.seeds],
+                      scheduler=scheduler if spec.cell is None else None)
     figures = summarise(runs)
     windows = tuple(window_of(st, spec.belt, maps[st.name][0]) for st in spec.stations)
     ordered = sorted(windows, key=lambda w: w.u_base)

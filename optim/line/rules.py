@@ -26,7 +26,7 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["RULES", "Rule", "Candidates", "choose_simple", "best_sequence"]
+__all__ = ["RULES", "Rule", "Candidates", "choose_simple", "rank_simple", "best_sequence"]
 
 RULES = ("first", "nearest", "shortest", "bands", "split", "lookahead")
 
@@ -62,15 +62,20 @@ class Candidates:
     distance: np.ndarray
 
 
-def choose_simple(rule: str, c: Candidates) -> int:
-    """Position in ``c`` of the item a simple rule starts now (``c`` holds startable items only)."""
+def rank_simple(rule: str, c: Candidates) -> np.ndarray:
+    """Positions in ``c`` in a simple rule's order of preference (``c`` holds startable items only)."""
     if rule in ("first", "bands", "split"):
-        return int(np.lexsort((c.index, c.t0))[0])
+        return np.lexsort((c.index, c.t0))
     if rule == "nearest":
-        return int(np.lexsort((c.t0, c.distance))[0])
+        return np.lexsort((c.index, c.t0, c.distance))
     if rule == "shortest":
-        return int(np.lexsort((c.t0, c.finish))[0])
+        return np.lexsort((c.index, c.t0, c.finish))
     raise InvalidInput(f"rule {rule!r} is not a simple rule")
+
+
+def choose_simple(rule: str, c: Candidates) -> int:
+    """Position in ``c`` of the item a simple rule starts now (its first preference)."""
+    return int(rank_simple(rule, c)[0])
 
 
 def best_sequence(ready: float, items: list[int], intercept: Callable[[float, int], Any],

@@ -14,8 +14,11 @@ downstream), the first ``u`` where ``t + t_A(u) ≤ t0 + u / v`` (the arm, leavi
 starts exist, the arm sleeps until the earliest. An item that no arm takes is **missed** (it
 leaves the last window).
 
-Neighbouring arms whose windows overlap: the picks they make at overlapping times are listed
-(:attr:`SimResult.overlaps`) for the cell's continuous check (:func:`optim.line.api.check_overlaps`).
+Neighbouring arms whose windows overlap: with a ``guard`` (:class:`optim.line.neighbours.NeighbourGuard`:
+exact picks through the cell's continuous check at the clearance), an arm starts a pick only when
+it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
+choice, or waits until that neighbour's pick ends. Each guarded pair is counted in
+:attr:`SimResult.checks` (checks, blocked).
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from pinarms.optim.line.items import Items
-from pinarms.optim.line.rules import Candidates, Rule, best_sequence, choose_simple
+from pinarms.optim.line.rules import Candidates, Rule, best_sequence, rank_simple
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.robots.errors import InvalidInput
 
@@ -71,7 +74,7 @@ class SimResult:
     busy: np.ndarray
     decisions: int
     t0: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    overlaps: list = field(default_factory=list)
+    checks: tuple[int, int] = (0, 0)
 
     @property
     def n_items(self) -> int:
@@ -157,7 +160,7 @@ def _eligible(rule: Rule, arm_index: int, n_arms: int, idx: np.ndarray, w: np.nd
 
 
 def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | str = "first", *,
-             duration: float | None = None, width: float | None = None) -> SimResult:
+             duration: float | None = None, width: float | None = None, guard: Any = None) -> SimResult:
     """Run the line (module doc). ``arms`` in any order (sorted upstream first here);
     ``speed`` [m/s] must be the maps' belt speed; ``duration`` [s]: the observed time for
     the rates (default the last arrival); ``width`` [m]: belt width (the "bands" rule).
@@ -189,6 +192,10 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     meet, u_meet, start, finish = (np.full(n, np.nan) for _ in range(4))
     taken = np.zeros(n, dtype=bool)
     busy = np.zeros(len(arms))
+    neighbours = {k: [j for j in range(len(arms)) if j != k and states[j].u_min < states[k].u_max
+                      and states[k].u_min < states[j].u_max] for k in range(len(arms))} if guard else {}
+    ongoing: list = [None] * len(arms)
+    counts = [0, 0]
     heap = [(0.0, k) for k in range(len(arms))]
     heapq.heapify(heap)
     decisions = 0
@@ -214,28 +221,57 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
             continue
         idx, s, m, f, u = idx[ok], s[ok], m[ok], f[ok], u[ok]
         if rule.name == "lookahead":
-            choice = _lookahead(st, t, idx, s, t0, rule.horizon)
+            prefs = [_lookahead(st, t, idx, s, t0, rule.horizon)]
         else:
-            now = s <= t + EPS
-            choice = None
-            if now.any():
-                sel = np.flatnonzero(now)
-                dist = np.hypot(speed * (t - t0[idx[sel]]) - st.rest[0], items.w[idx[sel]] - st.rest[1])
-                c = Candidates(idx[sel], s[sel], m[sel], f[sel], t0[idx[sel]], items.w[idx[sel]], dist)
-                choice = int(sel[choose_simple(rule.name, c)])
-        if choice is None or s[choice] > t + EPS:
-            heapq.heappush(heap, (float(s.min()) if choice is None else float(s[choice]), k))
+            sel = np.flatnonzero(s <= t + EPS)
+            dist = np.hypot(speed * (t - t0[idx[sel]]) - st.rest[0], items.w[idx[sel]] - st.rest[1])
+            c = Candidates(idx[sel], s[sel], m[sel], f[sel], t0[idx[sel]], items.w[idx[sel]], dist)
+            prefs = [int(sel[j]) for j in rank_simple(rule.name, c)] if sel.size else []
+        if not prefs or s[prefs[0]] > t + EPS:
+            heapq.heappush(heap, (float(s.min()) if not prefs else float(s[prefs[0]]), k))
+            continue
+        choice, blocked_until = None, np.inf
+        for j in prefs:
+            pick = (arms[k].name, int(idx[j]), t, float(m[j]), float(u[j]), float(items.w[idx[j]]),
+                    int(items.kind[idx[j]]))
+            until = _blocked(guard, pick, float(f[j]), k, neighbours, ongoing, t, counts)
+            if until is None:
+                choice = j
+                break
+            blocked_until = min(blocked_until, until)
+        if choice is None:
+            heapq.heappush(heap, (max(t + 1e-6, blocked_until), k))
             continue
         i = int(idx[choice])
         taken[i] = True
         picked_by[i], meet[i], u_meet[i], start[i], finish[i] = order[k], m[choice], u[choice], t, f[choice]
+        ongoing[k] = (arms[k].name, i, t, float(m[choice]), float(u[choice]), float(items.w[i]), int(items.kind[i]),
+                      float(f[choice]))
         heapq.heappush(heap, (float(f[choice]), k))
     span = float(duration) if duration is not None else (float(t0[-1]) if n else 0.0)
     busy = np.zeros(len(names))  # time moving within the observed span [0, span]
     done = picked_by >= 0
     np.add.at(busy, picked_by[done], np.clip(finish[done], 0.0, span) - np.clip(start[done], 0.0, span))
     return SimResult(names, picked_by, meet, u_meet,
-                     start, finish, max(span, 1e-9), busy, decisions, t0)
+                     start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]))
+
+
+def _blocked(guard: Any, pick: tuple, finish: float, k: int, neighbours: dict, ongoing: list, t: float,
+             counts: list) -> float | None:
+    """None when ``pick`` is clear of every ongoing pick of an overlapping neighbour, else when
+    the earliest blocking pick ends."""
+    if guard is None:
+        return None
+    until = None
+    for j in neighbours.get(k, ()):
+        other = ongoing[j]
+        if other is None or other[7] <= t:
+            continue
+        counts[0] += 1
+        if not guard(pick, other[:7]):
+            counts[1] += 1
+            until = other[7] if until is None else min(until, other[7])
+    return until
 
 
 def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: _ArmState, speed: float, rule: Rule,
