@@ -27,7 +27,7 @@ from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES"]
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
 #: ``"ok"``: the miss rate's mean is within the target; ``"misses above target"``: it is not.
@@ -184,3 +184,33 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None)
     overlapping = tuple((a.station, b.station) for a, b in zip(ordered, ordered[1:]) if windows_overlap(a, b))
     status = STATUSES[0] if figures.miss_rate <= spec.target_miss_rate else STATUSES[1]
     return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed)
+
+
+@dataclass(frozen=True)
+class LineCurve:
+    """Throughput and miss rate against one parameter: ``parameter`` (``"rate"``, ``"speed"`` or
+    ``"arms"``), ``values`` (K,), ``picks_per_minute`` (K,), ``miss_rate`` (K,) and its interval
+    ``miss_low``/``miss_high`` (K,), ``arrivals_per_minute`` (K,)."""
+
+    parameter: str
+    values: np.ndarray
+    picks_per_minute: np.ndarray
+    miss_rate: np.ndarray
+    miss_low: np.ndarray
+    miss_high: np.ndarray
+    arrivals_per_minute: np.ndarray
+
+
+def line_curve(make_spec: Any, parameter: str, values: Sequence[float], maps: Any, *,
+               scheduler: Any = None) -> LineCurve:
+    """Run ``make_spec(value)`` (a :class:`LineSpec`) for each value; ``maps(spec)`` gives its
+    task maps (e.g. :func:`pinarms.studies.line.maps_for`, or :func:`build_maps`)."""
+    if parameter not in ("rate", "speed", "arms"):
+        raise InvalidInput(f"parameter must be 'rate', 'speed' or 'arms', got {parameter!r}")
+    rows = []
+    for v in values:
+        spec = make_spec(v)
+        f = run_line(spec, maps=maps(spec), scheduler=scheduler).figures
+        rows.append((f.picks_per_minute, f.miss_rate, *f.miss_rate_ci, f.arrivals_per_minute))
+    a = np.array(rows, dtype=float).reshape(-1, 5)
+    return LineCurve(parameter, np.asarray(values, dtype=float), *a.T)

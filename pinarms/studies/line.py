@@ -103,13 +103,27 @@ def arms_needed(rate: float, *, paper_limit: bool, max_arms: int = 20, start: in
                 **kw: Any) -> tuple[int | None, Any]:
     """Fewest SCARAs (from ``start`` up) whose mean miss rate is ≤ 1 % at ``rate`` bunches/min
     (and that line's result)."""
-    last = None
+    n, last, _ = _arms_history(rate, paper_limit=paper_limit, max_arms=max_arms, start=start, **kw)
+    return n, last
+
+
+def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: int = 1,
+                  **kw: Any) -> tuple[int | None, Any, Any]:
+    """:func:`arms_needed` and the curve (:class:`optim.line.LineCurve`) of the lines tried."""
+    from pinarms.optim.line import LineCurve
+
+    last, tried = None, []
+    found = None
     for n in range(max(1, start), max_arms + 1):
         spec = scara_line(n, rate, paper_limit=paper_limit, **kw)
         last = run_line(spec, maps=maps_for(spec))
+        f = last.figures
+        tried.append((n, f.picks_per_minute, f.miss_rate, *f.miss_rate_ci, f.arrivals_per_minute))
         if last.status == "ok":
-            return n, last
-    return None, last
+            found = n
+            break
+    a = np.array(tried, dtype=float)
+    return found, last, LineCurve("arms", a[:, 0], *a[:, 1:].T)
 
 
 def max_flow(make_spec: Any, lo: float, hi: float, *, target: float = 0.01, steps: int = 8) -> float:
@@ -126,6 +140,7 @@ def study(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), durat
           check_points: int = 2) -> dict[str, Any]:
     """The study's figures (module doc), with each map's error against exact planning."""
     out: dict[str, Any] = {"rate_per_min": rate}
+    objects: dict[str, Any] = {}
     for label, paper in (("model limits", False), ("paper 55 deg/s joint 1", True)):
         one = scara_line(1, rate, paper_limit=paper, seeds=seeds, duration=duration)
         m = maps_for(one)["scara 1"][0]
@@ -133,8 +148,9 @@ def study(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), durat
         single = run_line(replace(one, stream=Stream("regular", 120.0, 120.0, types=(ENOKI,)), seeds=(0,)),
                           maps={"scara 1": (m,)})
         # no fewer arms than the flow over one saturated arm's rate
-        start = int(np.ceil(rate / single.figures.picks_per_minute))
-        n, res = arms_needed(rate, paper_limit=paper, seeds=seeds, duration=duration, start=start)
+        start = max(1, int(np.ceil(rate / single.figures.picks_per_minute)) - 1)
+        n, res, curve = _arms_history(rate, paper_limit=paper, seeds=seeds, duration=duration, start=start)
+        objects[label] = (res, curve)
         f = res.figures
         out[label] = {"arms": n, "picks_per_min": f.picks_per_minute, "miss_rate": f.miss_rate,
                       "miss_rate_ci": f.miss_rate_ci, "utilisation": f.utilisation, "belt_speed_m_s": res.belt_speed,
@@ -152,6 +168,7 @@ def study(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), durat
                      "max_flow_1pct_regular": max_flow(lambda r: gantry_line(r, kind="regular", seeds=(0,),
                                                                            duration=duration), 5.0, 60.0),
                      "belt_speed_m_s": g_spec.belt.speed, "map_error_max": err.max}
+    out["_objects"] = objects  # the runs and curves behind the figures (for plots; not JSON)
     return out
 
 
@@ -168,6 +185,7 @@ def demo_study(quick: bool = False) -> Any:
 
     seeds = (0, 1, 2) if quick else (0, 1, 2, 3, 4)
     out = study(60.0, seeds=seeds, duration=600.0)
+    objects = out.pop("_objects")
     rows = []
     for label in ("model limits", "paper 55 deg/s joint 1"):
         d = out[label]
@@ -186,4 +204,15 @@ def demo_study(quick: bool = False) -> Any:
     rows.append(Row("002", "gantry: largest regular flow at <= 1 % miss", 60.0, round(g["max_flow_1pct_regular"], 1),
                     "items/min", None, f"at 60/min Poisson: {g['poisson_60']['picks_per_minute']:.1f} picks/min, "
                                        f"miss {100 * g['poisson_60']['miss_rate']:.1f} %"))
-    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows)
+    from pinarms.viz.line_plots import plot_line_curve, plot_line_schedule
+
+    res, curve = objects["model limits"]
+    res_p, curve_p = objects["paper 55 deg/s joint 1"]
+    plots = {
+        "schedule": lambda p: plot_line_schedule(p, res.runs[0], title=f"{len(res.windows)} SCARAs, 60 enoki bunches/min "
+                                                                       "(seed 0, first 120 s)"),
+        "arms": lambda p: plot_line_curve(p, curve, title="SCARAs (model limits) at 60 bunches/min"),
+        "arms_paper_limit": lambda p: plot_line_curve(p, curve_p, title="SCARAs (55 deg/s on joint 1) at 60 bunches/min"),
+    }
+    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows,
+                 plots=plots)
