@@ -59,7 +59,8 @@ class SimResult:
     Attributes:
         picked_by: arm index or -1 (missed); ``meet``: rendezvous time [s] (NaN if missed);
         ``u_meet``: pre-grasp point along the belt [m]; ``start``, ``finish``: the pick's
-        start and end [s]; ``t0``: arrival times [s]; ``arms``: names; ``duration``: observed time [s] (the stream's);
+        start and end [s]; ``t0``, ``w``, ``kind``: the items' arrival times [s],
+        positions across [m] and types; ``arms``: names; ``duration``: observed time [s] (the stream's);
         ``busy``: per arm, time spent moving [s]; ``overlaps``: pairs of picks (item a, item b)
         by neighbouring arms with overlapping windows at overlapping times.
     """
@@ -75,6 +76,8 @@ class SimResult:
     decisions: int
     t0: np.ndarray = field(default_factory=lambda: np.zeros(0))
     checks: tuple[int, int] = (0, 0)
+    w: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     @property
     def n_items(self) -> int:
@@ -253,7 +256,8 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     done = picked_by >= 0
     np.add.at(busy, picked_by[done], np.clip(finish[done], 0.0, span) - np.clip(start[done], 0.0, span))
     return SimResult(names, picked_by, meet, u_meet,
-                     start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]))
+                     start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]),
+                     items.w, items.kind)
 
 
 def _blocked(guard: Any, pick: tuple, finish: float, k: int, neighbours: dict, ongoing: list, t: float,

@@ -214,5 +214,9 @@ def demo_study(quick: bool = False) -> Any:
         "arms": lambda p: plot_line_curve(p, curve, title="SCARAs (model limits) at 60 bunches/min"),
         "arms_paper_limit": lambda p: plot_line_curve(p, curve_p, title="SCARAs (55 deg/s on joint 1) at 60 bunches/min"),
     }
+    from pinarms.viz.line_session import line_session
+
+    session = line_session(scara_line(len(res.windows), 60.0), res.runs[0], t_max=20.0 if quick else 40.0,
+                           title=f"{len(res.windows)} SCARAs picking enoki bunches from a belt (first seconds of seed 0)")
     return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows,
-                 plots=plots)
+                 session=session, plots=plots)
