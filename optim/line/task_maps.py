@@ -86,6 +86,9 @@ class TaskMap:
         """Write the map as ``.npz`` atomically (a temporary file renamed into place)."""
         path = Path(path)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # the permissions of a plainly created file, not mkstemp's 0600
         try:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
