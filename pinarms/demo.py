@@ -36,7 +36,7 @@ from pinarms.papers import SEED000, SEED001, SEED002, SEED004
 from .report import Row, format_table, markdown_table
 
 __all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004",
-           "study_cell"]
+           "study_cell", "study_line"]
 
 DEG = np.pi / 180.0
 MM = 1e-3
@@ -875,12 +875,20 @@ def _workspace_plots(ws: Any, title: str) -> dict[str, Callable[[Path], Any]]:
     return {"workspace": lambda path: vplots.plot_workspace(path, ws, title=title, mm=True)}
 
 
+def study_line(quick: bool = False) -> Study:
+    """The line study (:mod:`pinarms.studies.line`): arms, picks/min and miss rate on a belt."""
+    from pinarms.studies.line import demo_study
+
+    return demo_study(quick)
+
+
 STUDIES: dict[str, Callable[[bool], Study]] = {
     "000": study_000,
     "001": study_001,
     "002": study_002,
     "004": study_004,
     "cell": study_cell,
+    "line": study_line,
 }
 
 

@@ -16,6 +16,7 @@ A new command group is a new module here that decorates its commands with
 from __future__ import annotations
 
 from . import (  # noqa: F401  (each module registers its commands on ``cli``)
+    belt_commands,
     cell_commands,
     cycle_commands,
     demo_command,

@@ -17,7 +17,7 @@ from ._common import (
 @cli.command("demo")
 @click.option("--quick", is_flag=True, help="Smaller samples and GA runs: under a minute.")
 @click.option("--out", "out_dir", default="demo-output", show_default=True, type=click.Path(file_okay=False))
-@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell"]), help="Run only these studies.")
+@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell", "line"]), help="Run only these studies.")
 @click.option("--readme", "readme", default=None, type=click.Path(exists=True, dir_okay=False),
               help="Also write the table into this markdown file, between its table markers (full run only).")
 @json_option

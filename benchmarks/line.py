@@ -1,0 +1,149 @@
+"""The line: simulation speed, map building, look-ahead vs simple rules, sizing serial vs Dask.
+
+Parts (figures printed, not timed tests; docs/line.md quotes a full run):
+
+1. ``simulate``: one hour of a four-arm SCARA line at 120 items/min (about 7 200 items),
+   maps loaded (seed 000's SCARA, model limits), each rule, one core.
+2. ``maps``: one arm's task-time maps built (24 × 7 exact picks, serial) and their error
+   against exact planning at 30 random picks.
+3. ``rules``: look-ahead (horizon 4) against first / nearest / shortest on the same streams:
+   one arm below, at and above its capacity; four arms at 60 and 120 items/min.
+4. ``sizing``: a sizing sweep (``optim.line.sizing.evaluate_layouts``: 24 layouts × 4 seeds)
+   serial vs a LocalCluster of two single-thread workers (127.0.0.1, no dashboard); the
+   results must be identical.
+
+Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|all]
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+
+def _scara(n: int, rate: float, duration: float = 3600.0, seeds=(0,), rule: str = "first"):
+    from pinarms.studies.line import maps_for, scara_line
+
+    spec = scara_line(n, rate, seeds=seeds, duration=duration, rule=rule)
+    return spec, maps_for(spec)
+
+
+def part_simulate() -> None:
+    from pinarms.optim.line import simulate
+    from pinarms.optim.line.api import sim_arms
+    from threadpoolctl import threadpool_limits
+
+    spec, maps = _scara(4, 120.0)
+    items = spec.stream.items(spec.belt, 0)
+    arms = sim_arms(spec, maps)
+    print(f"[simulate] 4 SCARAs, 120 items/min Poisson, 1 h: {len(items)} items")
+    with threadpool_limits(1):
+        for rule in ("first", "nearest", "shortest", "split", "bands"):
+            t = time.perf_counter()
+            r = simulate(arms, items, spec.belt.speed, rule, duration=3600.0, width=spec.belt.width)
+            dt = time.perf_counter() - t
+            print(f"  {rule:9s} {dt:6.2f} s   picks/min {r.picks_per_minute:6.1f}   miss {100 * r.miss_rate:5.1f} %"
+                  f"   decisions {r.decisions}")
+
+
+def part_maps() -> None:
+    from pinarms.optim.line import build_task_map, map_error
+    from pinarms.studies.line import ENOKI, scara_line
+
+    spec = scara_line(1, 60.0)
+    st = spec.stations[0]
+    t = time.perf_counter()
+    m = build_task_map(st, spec.belt, spec.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=24, nw=7)
+    print(f"[maps] one SCARA, 24 x 7 exact picks: built in {time.perf_counter() - t:.1f} s, "
+          f"{np.isfinite(m.approach).sum()} feasible")
+    e = map_error(m, st, spec.belt, spec.tracking, n=30, item_height=ENOKI.size[2], seed=7)
+    print(f"  error vs exact planning at {e.relative.size} random picks: mean {100 * e.mean:.3f} %, "
+          f"max {100 * e.max:.3f} %, 95th {100 * np.percentile(e.relative, 95):.3f} % "
+          f"({e.planning_seconds / e.relative.size:.2f} s per exact pick)")
+
+
+def part_rules() -> None:
+    from pinarms.optim.line import Rule, simulate
+    from pinarms.optim.line.api import sim_arms
+
+    print("[rules] picks on the same streams (3 seeds x 600 s); gain of look-ahead (horizon 4) over the best simple rule")
+    for n, rate in ((1, 10.0), (1, 20.0), (1, 40.0), (4, 60.0), (4, 120.0)):
+        spec, maps = _scara(n, rate, duration=600.0)
+        arms = sim_arms(spec, maps)
+        picks = {}
+        t_la = 0.0
+        for rule in ("first", "nearest", "shortest", "lookahead"):
+            total = 0
+            for seed in range(3):
+                items = spec.stream.items(spec.belt, seed)
+                t = time.perf_counter()
+                r = simulate(arms, items, spec.belt.speed, Rule(rule, 4), duration=600.0)
+                if rule == "lookahead":
+                    t_la += time.perf_counter() - t
+                total += r.picks
+            picks[rule] = total
+        best = max(picks[k] for k in ("first", "nearest", "shortest"))
+        print(f"  {n} arm(s) {rate:5.0f}/min  " + "  ".join(f"{k} {v}" for k, v in picks.items()) +
+              f"   gain {100 * (picks['lookahead'] / best - 1):+.1f} %   look-ahead {t_la:.1f} s")
+
+
+def part_rules_synthetic() -> None:
+    """Where look-ahead gains: task times that differ strongly between items (a synthetic map
+    whose leave time grows from 0.3 s to 2.5 s across the belt), one arm near its capacity."""
+    from pinarms.optim.line import Belt, Rule, TaskMap, poisson_items, simulate
+    from pinarms.optim.line.simulate import SimArm
+
+    belt = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
+    du, w = np.linspace(-0.3, 0.3, 13), np.array([-0.15, 0.15])
+    m = TaskMap("synthetic", du, w, np.full((13, 2), 0.4), np.tile([0.3, 2.5], (13, 1)), 0.5, 0.1, 0.2, 0.1)
+    for rate in (20.0, 36.0, 60.0):
+        picks = {}
+        for rule in ("first", "shortest", "lookahead"):
+            picks[rule] = sum(simulate([SimArm("a", 1.0, (m,))], poisson_items(belt, rate / 60.0, 600.0, seed=s),
+                                       0.2, Rule(rule, 5), duration=600.0).picks for s in range(3))
+        best = max(picks["first"], picks["shortest"])
+        print(f"  synthetic 1 arm {rate:4.0f}/min  " + "  ".join(f"{k} {v}" for k, v in picks.items()) +
+              f"   gain {100 * (picks['lookahead'] / best - 1):+.1f} %")
+
+
+def _layouts(k: int, rng: np.random.Generator):
+    return [(0.6 + np.concatenate([[0.0], np.cumsum(rng.uniform(0.9, 1.4, 3))]), 0.2) for _ in range(k)]
+
+
+def _warm() -> None:
+    import pinarms.optim.line.sizing  # noqa: F401
+
+
+def part_sizing() -> None:
+    from dask.distributed import Client, LocalCluster
+
+    from pinarms.optim.line.sizing import SizingProblem, evaluate_layouts
+    from pinarms.studies.line import ENOKI, maps_for, scara_line
+
+    spec = scara_line(1, 60.0)
+    problem = SizingProblem({0.2: maps_for(spec)["scara 1"][0]}, 60.0, item=ENOKI, seeds=(0, 1, 2, 3), duration=600.0)
+    layouts = _layouts(24, np.random.default_rng(0))
+    t = time.perf_counter()
+    serial = evaluate_layouts(problem, layouts)
+    t_serial = time.perf_counter() - t
+    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+                      processes=True) as cluster, Client(cluster) as client:
+        client.run(_warm)  # workers up, pinarms imported, before the clock starts
+        t = time.perf_counter()
+        dask = evaluate_layouts(problem, layouts, scheduler=client)
+        t_dask = time.perf_counter() - t
+    same = np.array_equal(serial, dask)
+    print(f"[sizing] {len(layouts)} layouts x {len(problem.seeds)} seeds (4 SCARAs, 60/min, 600 s): serial {t_serial:.1f} s, "
+          f"2 workers {t_dask:.1f} s, ratio {t_serial / t_dask:.2f}, identical: {same}")
+
+
+PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,
+         "sizing": part_sizing}
+
+if __name__ == "__main__":
+    which = sys.argv[1] if len(sys.argv) > 1 else "all"
+    for name, fn in PARTS.items():
+        if which in (name, "all"):
+            fn()

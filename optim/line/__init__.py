@@ -1,0 +1,35 @@
+"""The line: items on a moving belt, several arms picking on the fly, assignment, simulation, sizing.
+
+- :mod:`~.belt` (:class:`Belt`, :class:`PlaceBox`), :mod:`~.items` (streams: Poisson, regular
+  pitch, arrivals file), :mod:`~.station` (an arm beside the belt with its box and limits);
+- :mod:`~.tracking` (:func:`plan_pick`: the rendezvous with a moving item, time-optimal),
+  :mod:`~.windows` (each arm's pick window), :mod:`~.task_maps` (task times built once,
+  interpolated, with their error against exact planning);
+- :mod:`~.rules` (assignment rules), :mod:`~.simulate` (event-based simulation of N arms),
+  :mod:`~.report` (picks/min, miss rate with its interval, utilisation, waits);
+- :mod:`~.api` (:func:`run_line`: one :class:`LineSpec` in, one :class:`LineResult` out),
+  :mod:`~.sizing` (fewest arms, positions and belt speed for a flow);
+- :mod:`~.schedule` keeps the time offsets of several arms cycling together (:func:`schedule_line`).
+"""
+
+from pinarms.optim.line.api import LineCurve, LineResult, LineSpec, Stream, build_maps, line_curve, run_line
+from pinarms.optim.line.belt import Belt, PlaceBox
+from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
+from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
+from pinarms.optim.line.report import LineFigures, summarise
+from pinarms.optim.line.rules import RULES, Rule
+from pinarms.optim.line.schedule import LineSchedule, schedule_line
+from pinarms.optim.line.simulate import SimArm, SimResult, simulate
+from pinarms.optim.line.station import Station, base_pose
+from pinarms.optim.line.task_maps import MapError, TaskMap, build_task_map, map_error
+from pinarms.optim.line.tracking import PickPlan, TrackingSpec, plan_pick
+from pinarms.optim.line.windows import PickWindow, check_reach
+
+__all__ = [
+    "LineSchedule", "schedule_line",
+    "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
+    "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
+    "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "SimArm", "SimResult", "simulate",
+    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "run_line", "build_maps", "LineCurve", "line_curve",
+    "BeltOutOfReach", "ArrivalsFileError",
+]

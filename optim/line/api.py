@@ -1,0 +1,216 @@
+"""One line description in, one result out: :func:`run_line`.
+
+A :class:`LineSpec` holds the belt, the stations (arms with their boxes), the item stream,
+how arms pick (:class:`TrackingSpec`), the assignment rule, the seeds and the miss rate
+asked for. :func:`run_line` builds each station's task-time maps (once per distinct station
+shape: stations that differ only by their place along the belt share them), simulates every
+seed on the execution layer (serial by default, a Dask cluster by address; same results
+either way) and returns a :class:`LineResult` with a status and the figures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
+from pinarms.optim.line.report import LineFigures, summarise
+from pinarms.optim.line.rules import Rule
+from pinarms.optim.line.simulate import SimArm, SimResult, simulate
+from pinarms.optim.line.station import Station
+from pinarms.optim.line.task_maps import TaskMap, build_task_map
+from pinarms.optim.line.tracking import TrackingSpec
+from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve"]
+
+STREAM_KINDS = ("poisson", "regular", "file")
+#: ``"ok"``: the miss rate's mean is within the target; ``"misses above target"``: it is not.
+STATUSES = ("ok", "misses above target")
+
+
+@dataclass(frozen=True)
+class Stream:
+    """The items: ``kind`` ``"poisson"`` (``rate`` items/min at random), ``"regular"`` (one every
+    60/``rate`` s) or ``"file"`` (``path`` of an arrivals file); ``duration`` [s] simulated;
+    ``types`` of items (one :class:`ItemType` by default)."""
+
+    kind: str = "poisson"
+    rate: float = 60.0
+    duration: float = 600.0
+    path: str | None = None
+    types: tuple[ItemType, ...] = (ItemType("item"),)
+
+    def __post_init__(self) -> None:
+        if self.kind not in STREAM_KINDS:
+            raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
+        if self.kind == "file" and not self.path:
+            raise InvalidInput("a 'file' stream needs the path of its arrivals file")
+        _number(self.rate, "stream rate [items/min]", positive=True)
+        _number(self.duration, "stream duration [s]", positive=True)
+        object.__setattr__(self, "types", tuple(self.types))
+
+    def items(self, belt: Belt, seed: int) -> Items:
+        if self.kind == "poisson":
+            return poisson_items(belt, self.rate / 60.0, self.duration, types=self.types, seed=seed)
+        if self.kind == "regular":
+            return regular_items(belt, 60.0 / self.rate, self.duration, types=self.types, seed=seed)
+        return read_arrivals(Path(self.path), belt, self.types)
+
+
+@dataclass(frozen=True, eq=False)
+class LineSpec:
+    """A line (module doc). ``target_miss_rate``: the miss rate asked for (fraction);
+    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`robots.cell.Cell` whose arms
+    are the stations (same names and bases) — then neighbours whose windows overlap start a pick
+    only when the cell's continuous check proves it keeps ``clearance`` [m] from the neighbour's
+    (:mod:`~.neighbours`; the seeds then run in this process)."""
+
+    belt: Belt
+    stations: tuple[Station, ...]
+    stream: Stream = Stream()
+    tracking: TrackingSpec = TrackingSpec()
+    rule: Rule = Rule()
+    seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
+    target_miss_rate: float = 0.01
+    map_grid: tuple[int, int] = (24, 7)
+    cell: Any = None
+    clearance: float = 0.01
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.belt, Belt):
+            raise InvalidInput("belt must be a Belt")
+        st = tuple(self.stations)
+        if not st or not all(isinstance(s, Station) for s in st):
+            raise InvalidInput("stations must be a non-empty sequence of Station")
+        names = [s.name for s in st]
+        if len(set(names)) != len(names):
+            raise InvalidInput(f"station names must be unique, got {names}")
+        object.__setattr__(self, "stations", st)
+        if not self.seeds:
+            raise InvalidInput("seeds must hold at least one seed")
+        object.__setattr__(self, "seeds", tuple(int(s) for s in self.seeds))
+        rate = _number(self.target_miss_rate, "target miss rate")
+        if not 0.0 <= rate < 1.0:
+            raise InvalidInput(f"target miss rate must be in [0, 1), got {self.target_miss_rate!r}")
+        if isinstance(self.rule, str):
+            object.__setattr__(self, "rule", Rule(self.rule))
+
+
+@dataclass(frozen=True, eq=False)
+class LineResult:
+    """The line's answer: ``status`` (:data:`STATUSES`), ``figures`` (:class:`LineFigures`),
+    ``windows`` (each arm's :class:`PickWindow`), ``overlapping`` (neighbour pairs whose
+    windows overlap), ``runs`` (one :class:`SimResult` per seed), ``maps`` (per station)."""
+
+    status: str
+    figures: LineFigures
+    windows: tuple[PickWindow, ...]
+    overlapping: tuple[tuple[str, str], ...]
+    runs: tuple[SimResult, ...] = field(repr=False)
+    maps: dict = field(repr=False, default_factory=dict)
+    belt_speed: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
+                "neighbour_checks": [list(r.checks) for r in self.runs],
+                "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
+
+
+def _shape_key(st: Station, belt: Belt) -> tuple:
+    b = belt.to_belt(st.base_to_world[:3, 3])
+    rel = st.world_to_base(st.place.position)
+    lim = st.limits
+    return (st.robot.name, round(float(b[1]), 9), round(float(b[2]), 9),
+            tuple(np.round(st.base_to_world[:3, :3], 9).ravel()), tuple(np.round(rel, 9)),
+            tuple(lim["vmax"]), tuple(lim["amax"]), lim["torque"])
+
+
+def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
+    """Task maps of every station, one per item type, built once per distinct station shape."""
+    cache: dict = {} if known is None else known
+    out = {}
+    for st in spec.stations:
+        maps = []
+        for t in spec.stream.types:
+            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid)
+            if key not in cache:
+                cache[key] = build_task_map(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],
+                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler)
+            maps.append(cache[key])
+        out[st.name] = tuple(maps)
+    return out
+
+
+def sim_arms(spec: LineSpec, maps: dict[str, tuple[TaskMap, ...]]) -> list[SimArm]:
+    """The stations as the simulator sees them."""
+    arms = []
+    for st in spec.stations:
+        u_base = float(spec.belt.to_belt(st.base_to_world[:3, 3])[0])
+        rest = spec.belt.to_belt(st.place.position)
+        arms.append(SimArm(st.name, u_base, maps[st.name], (float(rest[0]), float(rest[1]))))
+    return arms
+
+
+def _run_seed(task: dict) -> SimResult:
+    spec = task["spec"]
+    items = spec.stream.items(spec.belt, task["seed"])
+    guard = None
+    if spec.cell is not None:
+        from pinarms.optim.line.neighbours import NeighbourGuard
+
+        guard = NeighbourGuard(spec.cell, spec.stations, spec.belt, spec.tracking, spec.stream.types,
+                               clearance=spec.clearance)
+    return simulate(task["arms"], items, spec.belt.speed, spec.rule, duration=spec.stream.duration,
+                    width=spec.belt.width, guard=guard)
+
+
+def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None) -> LineResult:
+    """Simulate the line on every seed and summarise (module doc)."""
+    from pinarms.execution import map_chunks
+
+    maps = build_maps(spec, scheduler=scheduler) if maps is None else maps
+    arms = sim_arms(spec, maps)
+    runs = map_chunks(_run_seed, [{"spec": spec, "arms": arms, "seed": s} for s in spec.seeds],
+                      scheduler=scheduler if spec.cell is None else None)
+    figures = summarise(runs)
+    windows = tuple(window_of(st, spec.belt, maps[st.name][0]) for st in spec.stations)
+    ordered = sorted(windows, key=lambda w: w.u_base)
+    overlapping = tuple((a.station, b.station) for a, b in zip(ordered, ordered[1:]) if windows_overlap(a, b))
+    status = STATUSES[0] if figures.miss_rate <= spec.target_miss_rate else STATUSES[1]
+    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed)
+
+
+@dataclass(frozen=True)
+class LineCurve:
+    """Throughput and miss rate against one parameter: ``parameter`` (``"rate"``, ``"speed"`` or
+    ``"arms"``), ``values`` (K,), ``picks_per_minute`` (K,), ``miss_rate`` (K,) and its interval
+    ``miss_low``/``miss_high`` (K,), ``arrivals_per_minute`` (K,)."""
+
+    parameter: str
+    values: np.ndarray
+    picks_per_minute: np.ndarray
+    miss_rate: np.ndarray
+    miss_low: np.ndarray
+    miss_high: np.ndarray
+    arrivals_per_minute: np.ndarray
+
+
+def line_curve(make_spec: Any, parameter: str, values: Sequence[float], maps: Any, *,
+               scheduler: Any = None) -> LineCurve:
+    """Run ``make_spec(value)`` (a :class:`LineSpec`) for each value; ``maps(spec)`` gives its
+    task maps (e.g. :func:`pinarms.studies.line.maps_for`, or :func:`build_maps`)."""
+    if parameter not in ("rate", "speed", "arms"):
+        raise InvalidInput(f"parameter must be 'rate', 'speed' or 'arms', got {parameter!r}")
+    rows = []
+    for v in values:
+        spec = make_spec(v)
+        f = run_line(spec, maps=maps(spec), scheduler=scheduler).figures
+        rows.append((f.picks_per_minute, f.miss_rate, *f.miss_rate_ci, f.arrivals_per_minute))
+    a = np.array(rows, dtype=float).reshape(-1, 5)
+    return LineCurve(parameter, np.asarray(values, dtype=float), *a.T)

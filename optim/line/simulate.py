@@ -1,0 +1,303 @@
+"""Event-based simulation of N arms picking items from a moving belt.
+
+Each arm is a state machine: **idle** at rest at its box → (decision) → **moving** through its
+pick (approach, tracking, leave, release; times from its :class:`TaskMap`) → idle. Events are
+the instants an arm becomes idle or wakes up to look again; they are processed in time order
+(ties: upstream arm first), so an item taken by one arm is gone for the others.
+
+At a decision at time ``t`` an arm computes, for every item not yet taken near its window, the
+**earliest reachable intercept**: along its map's grid of pre-grasp points ``u`` (ascending
+downstream), the first ``u`` where ``t + t_A(u) ≤ t0 + u / v`` (the arm, leaving now, is at
+``u`` no later than the item), refined linearly between grid points; the arm leaves at
+``start = t0 + u/v − t_A(u) ≥ t`` so that it meets the item exactly. Items whose start is
+``t`` can be started now; the rule (:mod:`optim.line.rules`) picks one, or, when only later
+starts exist, the arm sleeps until the earliest. An item that no arm takes is **missed** (it
+leaves the last window).
+
+Neighbouring arms whose windows overlap: with a ``guard`` (:class:`optim.line.neighbours.NeighbourGuard`:
+exact picks through the cell's continuous check at the clearance), an arm starts a pick only when
+it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
+choice, or waits until that neighbour's pick ends. Each guarded pair is counted in
+:attr:`SimResult.checks` (checks, blocked).
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from pinarms.optim.line.items import Items
+from pinarms.optim.line.rules import Candidates, Rule, best_sequence, rank_simple
+from pinarms.optim.line.task_maps import TaskMap
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["SimArm", "SimResult", "simulate", "EPS"]
+
+#: Time tolerance of "start now" [s].
+EPS = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class SimArm:
+    """One arm as the simulator sees it: ``name``, ``u_base`` (its base projected on the belt,
+    m), ``maps`` (one :class:`TaskMap` per item type, in the stream's type order) and
+    ``rest`` (the tool at rest at its box, belt coordinates u, w [m], for the "nearest" rule)."""
+
+    name: str
+    u_base: float
+    maps: tuple[TaskMap, ...]
+    rest: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class SimResult:
+    """What happened (arrays (N,) over items, in stream order).
+
+    Attributes:
+        picked_by: arm index or -1 (missed); ``meet``: rendezvous time [s] (NaN if missed);
+        ``u_meet``: pre-grasp point along the belt [m]; ``start``, ``finish``: the pick's
+        start and end [s]; ``t0``, ``w``, ``kind``: the items' arrival times [s],
+        positions across [m] and types; ``arms``: names; ``duration``: observed time [s] (the stream's);
+        ``busy``: per arm, time spent moving [s]; ``overlaps``: pairs of picks (item a, item b)
+        by neighbouring arms with overlapping windows at overlapping times.
+    """
+
+    arms: tuple[str, ...]
+    picked_by: np.ndarray
+    meet: np.ndarray
+    u_meet: np.ndarray
+    start: np.ndarray
+    finish: np.ndarray
+    duration: float
+    busy: np.ndarray
+    decisions: int
+    t0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    checks: tuple[int, int] = (0, 0)
+    w: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @property
+    def n_items(self) -> int:
+        return int(self.picked_by.size)
+
+    @property
+    def picks(self) -> int:
+        return int(np.count_nonzero(self.picked_by >= 0))
+
+    @property
+    def misses(self) -> int:
+        return self.n_items - self.picks
+
+    @property
+    def miss_rate(self) -> float:
+        return self.misses / self.n_items if self.n_items else 0.0
+
+    @property
+    def picks_per_minute(self) -> float:
+        return 60.0 * self.picks / self.duration
+
+    @property
+    def utilisation(self) -> np.ndarray:
+        return self.busy / self.duration
+
+
+class _ArmState:
+    """Per arm: the grid of pre-grasp points (absolute u) and every item's times on it."""
+
+    def __init__(self, arm: SimArm, items: Items, speed: float) -> None:
+        m0 = arm.maps[0]
+        self.u = arm.u_base + m0.du
+        n = len(items)
+        self.tA = np.empty((n, self.u.size))
+        self.tC = np.empty((n, self.u.size))
+        self.extra = np.empty(n)
+        for k, m in enumerate(arm.maps):
+            if m.du.shape != m0.du.shape or np.any(m.du != m0.du):
+                raise InvalidInput(f"arm {arm.name!r}: the maps of all item types must share one du grid")
+            sel = items.kind == k
+            self.tA[sel], self.tC[sel] = m.rows(items.w[sel])
+            self.extra[sel] = m.track + m.release
+        ok = np.isfinite(self.tA) & np.isfinite(self.tC)
+        self.tA[~ok] = np.nan
+        cols = np.flatnonzero(ok.any(axis=0))
+        if cols.size == 0:
+            raise InvalidInput(f"arm {arm.name!r}: its maps hold no feasible pick")
+        self.u_min, self.u_max = float(self.u[cols[0]]), float(self.u[cols[-1]])
+        self.max_tA = float(np.nanmax(self.tA)) if np.isfinite(self.tA).any() else 0.0
+        self.speed = speed
+        self.rest = np.array(arm.rest)
+
+    def intercept(self, t: float, idx: np.ndarray, t0: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(ok, start, meet, finish, u) of items ``idx`` for the arm ready at ``t``."""
+        tA, tC = self.tA[idx], self.tC[idx]
+        t_item = t0[idx, None] + self.u[None, :] / self.speed
+        g = t + tA - t_item
+        good = np.isfinite(tA) & (g <= 0.0)
+        ok = good.any(axis=1)
+        k = np.argmax(good, axis=1)
+        rows = np.arange(idx.size)
+        km = np.maximum(k - 1, 0)
+        prev_ok = (k > 0) & np.isfinite(tA[rows, km]) & (g[rows, km] > 0.0)
+        gp, gk = np.where(prev_ok, g[rows, km], 0.0), g[rows, k]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = np.where(prev_ok, gp / (gp - gk), 1.0)
+        u = np.where(prev_ok, self.u[km] + f * (self.u[k] - self.u[km]), self.u[k])
+        a = np.where(prev_ok, tA[rows, km] + f * (tA[rows, k] - tA[rows, km]), tA[rows, k])
+        c = np.where(prev_ok, tC[rows, km] + f * (tC[rows, k] - tC[rows, km]), tC[rows, k])
+        meet = t0[idx] + u / self.speed
+        start = np.maximum(meet - a, t)
+        finish = meet + self.extra[idx] + c
+        return ok, start, meet, finish, u
+
+
+def _eligible(rule: Rule, arm_index: int, n_arms: int, idx: np.ndarray, w: np.ndarray, width: float) -> np.ndarray:
+    if rule.name == "bands":
+        band = np.clip(((w[idx] + width / 2.0) / width * n_arms).astype(int), 0, n_arms - 1)
+        return idx[band == arm_index]
+    if rule.name == "split":
+        return idx[idx % n_arms == arm_index]
+    return idx
+
+
+def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | str = "first", *,
+             duration: float | None = None, width: float | None = None, guard: Any = None) -> SimResult:
+    """Run the line (module doc). ``arms`` in any order (sorted upstream first here);
+    ``speed`` [m/s] must be the maps' belt speed; ``duration`` [s]: the observed time for
+    the rates (default the last arrival); ``width`` [m]: belt width (the "bands" rule).
+
+    Raises:
+        InvalidInput: no arms, a speed ≤ 0 or NaN or differing from the maps', bad rule.
+    """
+    rule = rule if isinstance(rule, Rule) else Rule(str(rule))
+    if not arms:
+        raise InvalidInput("simulate needs at least one arm")
+    if not (isinstance(speed, (int, float)) and np.isfinite(speed) and speed > 0.0):
+        raise InvalidInput(f"belt speed must be a finite number > 0 [m/s], got {speed!r}")
+    for a in arms:
+        for m in a.maps:
+            if abs(m.speed - speed) > 1e-9 * max(1.0, speed):
+                raise InvalidInput(f"arm {a.name!r}: its task map was built for {m.speed} m/s, the belt runs at "
+                                   f"{speed} m/s: build the map at this speed")
+        if len(a.maps) != len(items.types):
+            raise InvalidInput(f"arm {a.name!r} has {len(a.maps)} maps for {len(items.types)} item types")
+    if rule.name == "bands" and width is None:
+        raise InvalidInput("the 'bands' rule needs the belt width")
+    names = tuple(a.name for a in arms)
+    order = sorted(range(len(arms)), key=lambda k: arms[k].u_base)
+    arms = [arms[k] for k in order]
+    n = len(items)
+    t0 = items.t0
+    states = [_ArmState(a, items, speed) for a in arms]
+    picked_by = np.full(n, -1)
+    meet, u_meet, start, finish = (np.full(n, np.nan) for _ in range(4))
+    taken = np.zeros(n, dtype=bool)
+    busy = np.zeros(len(arms))
+    neighbours = {k: [j for j in range(len(arms)) if j != k and states[j].u_min < states[k].u_max
+                      and states[k].u_min < states[j].u_max] for k in range(len(arms))} if guard else {}
+    ongoing: list = [None] * len(arms)
+    counts = [0, 0]
+    heap = [(0.0, k) for k in range(len(arms))]
+    heapq.heapify(heap)
+    decisions = 0
+    while heap:
+        t, k = heapq.heappop(heap)
+        st = states[k]
+        decisions += 1
+        lo = int(np.searchsorted(t0, t - st.u_max / speed))
+        hi = int(np.searchsorted(t0, t - st.u_min / speed + st.max_tA, side="right"))
+        if rule.name == "lookahead":
+            hi = max(hi, min(n, lo + rule.horizon))
+        idx = np.arange(lo, hi)
+        idx = _eligible(rule, k, len(arms), idx[~taken[lo:hi]], items.w, width or 0.0)
+        nxt = _next_wake(t, hi, taken, t0, st, speed, rule, k, len(arms), items, width)
+        if idx.size == 0:
+            if nxt is not None:
+                heapq.heappush(heap, (nxt, k))
+            continue
+        ok, s, m, f, u = st.intercept(t, idx, t0)
+        if not ok.any():
+            if nxt is not None:
+                heapq.heappush(heap, (nxt, k))
+            continue
+        idx, s, m, f, u = idx[ok], s[ok], m[ok], f[ok], u[ok]
+        if rule.name == "lookahead":
+            prefs = [_lookahead(st, t, idx, s, t0, rule.horizon)]
+        else:
+            sel = np.flatnonzero(s <= t + EPS)
+            dist = np.hypot(speed * (t - t0[idx[sel]]) - st.rest[0], items.w[idx[sel]] - st.rest[1])
+            c = Candidates(idx[sel], s[sel], m[sel], f[sel], t0[idx[sel]], items.w[idx[sel]], dist)
+            prefs = [int(sel[j]) for j in rank_simple(rule.name, c)] if sel.size else []
+        if not prefs or s[prefs[0]] > t + EPS:
+            heapq.heappush(heap, (float(s.min()) if not prefs else float(s[prefs[0]]), k))
+            continue
+        choice, blocked_until = None, np.inf
+        for j in prefs:
+            pick = (arms[k].name, int(idx[j]), t, float(m[j]), float(u[j]), float(items.w[idx[j]]),
+                    int(items.kind[idx[j]]))
+            until = _blocked(guard, pick, float(f[j]), k, neighbours, ongoing, t, counts)
+            if until is None:
+                choice = j
+                break
+            blocked_until = min(blocked_until, until)
+        if choice is None:
+            heapq.heappush(heap, (max(t + 1e-6, blocked_until), k))
+            continue
+        i = int(idx[choice])
+        taken[i] = True
+        picked_by[i], meet[i], u_meet[i], start[i], finish[i] = order[k], m[choice], u[choice], t, f[choice]
+        ongoing[k] = (arms[k].name, i, t, float(m[choice]), float(u[choice]), float(items.w[i]), int(items.kind[i]),
+                      float(f[choice]))
+        heapq.heappush(heap, (float(f[choice]), k))
+    span = float(duration) if duration is not None else (float(t0[-1]) if n else 0.0)
+    busy = np.zeros(len(names))  # time moving within the observed span [0, span]
+    done = picked_by >= 0
+    np.add.at(busy, picked_by[done], np.clip(finish[done], 0.0, span) - np.clip(start[done], 0.0, span))
+    return SimResult(names, picked_by, meet, u_meet,
+                     start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]),
+                     items.w, items.kind)
+
+
+def _blocked(guard: Any, pick: tuple, finish: float, k: int, neighbours: dict, ongoing: list, t: float,
+             counts: list) -> float | None:
+    """None when ``pick`` is clear of every ongoing pick of an overlapping neighbour, else when
+    the earliest blocking pick ends."""
+    if guard is None:
+        return None
+    until = None
+    for j in neighbours.get(k, ()):
+        other = ongoing[j]
+        if other is None or other[7] <= t:
+            continue
+        counts[0] += 1
+        if not guard(pick, other[:7]):
+            counts[1] += 1
+            until = other[7] if until is None else min(until, other[7])
+    return until
+
+
+def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: _ArmState, speed: float, rule: Rule,
+               k: int, n_arms: int, items: Items, width: float | None) -> float | None:
+    """When the arm should look again if nothing can start now: the next item beyond the range."""
+    rest = np.arange(hi, min(hi + 64, t0.size))
+    rest = _eligible(rule, k, n_arms, rest[~taken[rest]], items.w, width or 0.0) if rest.size else rest
+    j = hi if rest.size == 0 else int(rest[0])
+    if j >= t0.size:
+        return None
+    return max(t + 1e-6, float(t0[j] + st.u_min / speed - st.max_tA))
+
+
+def _lookahead(st: _ArmState, t: float, idx: np.ndarray, s: np.ndarray, t0: np.ndarray, horizon: int) -> int:
+    order = np.argsort(s, kind="stable")[:horizon]
+    pool = [int(idx[j]) for j in order]
+
+    def intercept(ready: float, i: int):
+        ok, s1, m1, f1, _ = st.intercept(ready, np.array([i]), t0)
+        return (float(s1[0]), float(f1[0])) if ok[0] else None
+
+    _, _, seq = best_sequence(t, pool, intercept, horizon)
+    if not seq:
+        return int(order[0])
+    return int(np.flatnonzero(idx == seq[0])[0])

@@ -1,0 +1,157 @@
+"""Sizing a line: the fewest arms, their places along the belt and the belt speed for a flow.
+
+For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`optim.run_ga`) searches the
+gaps between neighbouring arms (each in ``[min_gap, max_gap]`` m) and the belt speed (one of
+the given speeds, a gene rounded to the nearest) for the lowest mean miss rate over the
+seeds (Monte Carlo: every individual of a generation × every seed is one simulation task
+on the execution layer — serial by default, a Dask cluster by address; tasks are pure
+functions of their seeds, so the result is the same either way). The first ``n`` whose best
+line misses no more than asked is the answer, with its positions and speed.
+
+``n_min`` defaults to the flow over one saturated arm's rate. The maps (one per belt speed)
+are built once: moving an arm along the belt keeps its map valid (:mod:`~.task_maps`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from pinarms.optim.line.items import ItemType, poisson_items
+from pinarms.optim.line.rules import Rule
+from pinarms.optim.line.simulate import SimArm, simulate
+from pinarms.optim.line.task_maps import TaskMap
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["SizingProblem", "SizingResult", "size_line", "evaluate_layouts"]
+
+
+@dataclass(frozen=True, eq=False)
+class SizingProblem:
+    """What to size. ``maps``: ``{belt speed [m/s]: TaskMap}`` of one arm model (arms shifted
+    along the belt reuse it); ``rest``: the arm's box relative to its base on the belt
+    (du, w) [m]; ``rate``: flow [items/min] (Poisson); ``max_miss``: miss rate asked for;
+    ``min_gap``/``max_gap``: distance between neighbouring arms [m]; ``first_u``: the first
+    arm's place along the belt [m]; ``seeds``, ``duration`` [s] of each simulation."""
+
+    maps: dict
+    rate: float
+    max_miss: float = 0.01
+    min_gap: float = 0.9
+    max_gap: float = 1.5
+    first_u: float = 0.6
+    rest: tuple[float, float] = (-0.2, 0.45)
+    item: ItemType = ItemType("item")
+    width: float = 0.3
+    rule: Rule = Rule()
+    seeds: tuple[int, ...] = (0, 1, 2, 3)
+    duration: float = 300.0
+
+    def __post_init__(self) -> None:
+        if not self.maps or not all(isinstance(m, TaskMap) for m in self.maps.values()):
+            raise InvalidInput("maps must be {belt speed: TaskMap}, at least one")
+        for v, m in self.maps.items():
+            if abs(m.speed - float(v)) > 1e-9:
+                raise InvalidInput(f"the map given for {v} m/s was built for {m.speed} m/s")
+        if not (0.0 < self.min_gap <= self.max_gap):
+            raise InvalidInput(f"need 0 < min_gap <= max_gap [m], got {self.min_gap}, {self.max_gap}")
+
+    @property
+    def speeds(self) -> np.ndarray:
+        return np.array(sorted(float(v) for v in self.maps))
+
+
+@dataclass(frozen=True)
+class SizingResult:
+    """``status``: ``"ok"`` or ``"not found"`` (no ``n <= max_arms`` meets the miss rate);
+    ``arms``: how many; ``positions``: along the belt [m]; ``speed`` [m/s]; ``miss_rate``:
+    mean over the seeds; ``picks_per_minute``; ``tried``: ``{n: best miss rate}``;
+    ``evaluations``: simulations run."""
+
+    status: str
+    arms: int | None
+    positions: tuple[float, ...]
+    speed: float
+    miss_rate: float
+    picks_per_minute: float
+    tried: dict = field(default_factory=dict)
+    evaluations: int = 0
+
+
+def _layout(problem: SizingProblem, genes: np.ndarray) -> tuple[np.ndarray, float]:
+    speeds = problem.speeds
+    k = int(np.clip(np.rint(genes[-1]), 0, speeds.size - 1))
+    gaps = genes[:-1]
+    return problem.first_u + np.concatenate([[0.0], np.cumsum(gaps)]), float(speeds[k])
+
+
+def _sim_task(task: dict) -> tuple[float, float]:
+    """(miss rate, picks/min) of one layout on one seed: a task of the execution layer."""
+    p: SizingProblem = task["problem"]
+    m = p.maps[task["speed"]]
+    arms = [SimArm(f"arm {k + 1}", float(u), (m,), (float(u) + p.rest[0], p.rest[1]))
+            for k, u in enumerate(task["positions"])]
+    from pinarms.optim.line.belt import Belt
+
+    belt = Belt((0.0, 0.0, 0.0), speed=task["speed"], width=p.width, length=1.0)
+    items = poisson_items(belt, p.rate / 60.0, p.duration, types=(p.item,), seed=task["seed"])
+    r = simulate(arms, items, task["speed"], p.rule, duration=p.duration, width=p.width)
+    return r.miss_rate, r.picks_per_minute
+
+
+def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple[np.ndarray, float]], *,
+                     scheduler: Any = None) -> np.ndarray:
+    """Mean (miss rate, picks/min) over the seeds of each ``(positions, speed)``: (len, 2)."""
+    from pinarms.execution import map_chunks
+
+    tasks = [{"problem": problem, "positions": [float(x) for x in pos], "speed": speed, "seed": s}
+             for pos, speed in layouts for s in problem.seeds]
+    out = np.array(map_chunks(_sim_task, tasks, scheduler=scheduler), dtype=float).reshape(len(layouts),
+                                                                                          len(problem.seeds), 2)
+    return out.mean(axis=1)
+
+
+def size_line(problem: SizingProblem, *, n_min: int | None = None, max_arms: int = 12, population: int = 12,
+              generations: int = 8, seed: int = 0, scheduler: Any = None,
+              progress: Callable[[str], None] | None = None) -> SizingResult:
+    """The fewest arms, their places and the belt speed for ``problem`` (module doc)."""
+    from pinarms.optim.engine import run_ga
+    from pinarms.optim.settings import GASettings
+
+    if n_min is None:
+        m = problem.maps[problem.speeds[-1]]
+        cycle = float(np.nanmin(m.approach + m.leave)) + m.track + m.release
+        n_min = max(1, int(np.floor(problem.rate * cycle / 60.0)))
+    tried: dict = {}
+    evals = 0
+    best = None
+    for n in range(n_min, max_arms + 1):
+        bounds = np.array([[problem.min_gap, problem.max_gap]] * (n - 1) + [[-0.49, problem.speeds.size - 0.51]])
+        cache: dict = {}
+
+        def objective(pop: np.ndarray) -> np.ndarray:
+            nonlocal evals
+            layouts = [_layout(problem, g) for g in pop]
+            res = evaluate_layouts(problem, layouts, scheduler=scheduler)
+            evals += len(layouts) * len(problem.seeds)
+            for g, r in zip(pop, res):
+                cache[tuple(np.round(g, 12))] = r
+            # lowest miss rate first; among equal ones the shorter line and slower belt
+            span = np.array([lay[0][-1] - lay[0][0] for lay in layouts])
+            return res[:, 0] + 1e-4 * span + 1e-5 * np.array([lay[1] for lay in layouts])
+
+        settings = GASettings(population=population, elitism=2)
+        ga = run_ga(objective, bounds, settings, seed=seed + n, max_generations=generations,
+                    stall_generations=generations)
+        pos, speed = _layout(problem, ga.x)
+        miss, ppm = evaluate_layouts(problem, [(pos, speed)], scheduler=scheduler)[0]
+        tried[n] = float(miss)
+        if progress:
+            progress(f"{n} arms: best miss rate {100 * miss:.2f} % at {speed} m/s")
+        best = (n, pos, speed, miss, ppm)
+        if miss <= problem.max_miss:
+            return SizingResult("ok", n, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals)
+    n, pos, speed, miss, ppm = best
+    return SizingResult("not found", None, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals)

@@ -1,0 +1,212 @@
+"""Per-arm task-time maps: pick times over the belt, built once from exact planning, interpolated.
+
+Planning a pick exactly (:func:`optim.line.tracking.plan_pick`: IK of the tracking segment and
+two time-optimal moves) takes about 0.2 s; a simulation asks for millions. A :class:`TaskMap`
+stores, on a grid of pre-grasp points relative to the arm (``du`` along the belt from the
+arm's base, ``w`` across), the approach time ``t_A`` (from rest at the box to the pre-grasp
+point, moving with the belt) and the leave time ``t_C`` (from the end of the tracking
+segment to rest at the box, carrying the item); NaN where the pick is infeasible. Between
+grid points the times are interpolated bilinearly; a point is feasible when its four
+surrounding grid points are. :func:`map_error` compares the interpolation with exact
+planning at seeded random points.
+
+A map holds for one arm model, limits, lateral offset and height of the base, box position
+relative to the base, belt speed, tracking spec and item mass: moving the arm (and its box)
+along the belt keeps it valid, which is what the sizing search uses.
+
+Built on the execution layer (:func:`pinarms.execution.map_chunks`: serial by default, or a
+Dask cluster), one task per ``du`` column, same result either way. Saved as ``.npz`` (no pickle).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.errors import InfeasibleProblem, OptimError
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.station import Station
+from pinarms.optim.line.tracking import TrackingSpec, plan_pick, rest_configuration
+from pinarms.optim.line.windows import belt_span, check_reach
+from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
+
+__all__ = ["TaskMap", "build_task_map", "map_error", "MapError"]
+
+
+@dataclass(frozen=True, eq=False)
+class TaskMap:
+    """Task times over the belt (module doc). ``du`` (nu,), ``w`` (nw,) [m]; ``approach``,
+    ``leave`` (nu, nw) [s] (NaN: infeasible); ``track``, ``release`` [s]; ``speed`` [m/s] and
+    ``mass`` [kg] it was built for; ``build_seconds``."""
+
+    station: str
+    du: np.ndarray
+    w: np.ndarray
+    approach: np.ndarray
+    leave: np.ndarray
+    track: float
+    release: float
+    speed: float
+    mass: float
+    build_seconds: float = 0.0
+
+    def _weights(self, grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2)
+        f = (x - grid[i]) / (grid[i + 1] - grid[i])
+        f = np.where((x < grid[0]) | (x > grid[-1]), np.nan, f)
+        return i, f
+
+    def times(self, du: Any, w: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Interpolated ``(t_A, t_C)`` [s] at points ``du``, ``w`` (broadcast); NaN where infeasible."""
+        du, w = np.broadcast_arrays(np.asarray(du, float), np.asarray(w, float))
+        i, fu = self._weights(self.du, du)
+        j, fw = self._weights(self.w, w)
+        out = []
+        for table in (self.approach, self.leave):
+            a, b = table[i, j], table[i + 1, j]
+            c, d = table[i, j + 1], table[i + 1, j + 1]
+            out.append((a * (1 - fu) + b * fu) * (1 - fw) + (c * (1 - fu) + d * fu) * fw)
+        return out[0], out[1]
+
+    def rows(self, w: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``(t_A, t_C)`` of shape (len(w), nu) at the grid's ``du`` for items at ``w`` [m] across."""
+        j, fw = self._weights(self.w, np.asarray(w, float))
+        out = []
+        for table in (self.approach, self.leave):
+            out.append((table[:, j] * (1 - fw) + table[:, j + 1] * fw).T)
+        return out[0], out[1]
+
+    def save(self, path: str | Path) -> Path:
+        """Write the map as ``.npz`` atomically (a temporary file renamed into place)."""
+        path = Path(path)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # the permissions of a plainly created file, not mkstemp's 0600
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
+                         scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
+                         station=np.array(self.station))
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "TaskMap":
+        """Read a map written by :meth:`save` (no pickle); InvalidInput when malformed."""
+        try:
+            with np.load(Path(path), allow_pickle=False) as z:
+                du, w, a, c, s, name = (z[k] for k in ("du", "w", "approach", "leave", "scalars", "station"))
+        except (OSError, KeyError, ValueError) as exc:
+            raise InvalidInput(f"{path}: not a task map file ({exc})") from None
+        if a.shape != (du.size, w.size) or c.shape != a.shape or s.shape != (5,):
+            raise InvalidInput(f"{path}: task map arrays of inconsistent shapes")
+        return cls(str(name), du, w, a, c, *map(float, s))
+
+
+def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Exact times of one ``du`` column (a task of the execution layer)."""
+    st, belt, spec = task["station"], task["belt"], task["spec"]
+    u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(st)
+    tA = np.full(len(task["w"]), np.nan)
+    tC = np.full(len(task["w"]), np.nan)
+    for j, w in enumerate(task["w"]):
+        try:
+            plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
+                             q_rest=q_rest)
+        except (UnreachableTarget, InfeasibleProblem, OptimError):
+            continue
+        tA[j], tC[j] = plan.times[0], plan.times[2]
+    return tA, tC
+
+
+def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
+                   item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
+                   du_range: tuple[float, float] | None = None, scheduler: Any = None,
+                   progress: Any = None) -> TaskMap:
+    """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
+
+    ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
+    ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
+
+    Raises:
+        BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
+        UnreachableTarget: the arm cannot reach its box.
+    """
+    from pinarms.execution import map_chunks
+
+    if not (isinstance(nu, int) and isinstance(nw, int) and nu >= 2 and nw >= 2):
+        raise InvalidInput(f"nu and nw must be integers >= 2, got {nu!r}, {nw!r}")
+    check_reach(station, belt, item_height)
+    rest_configuration(station)
+    start = time.perf_counter()
+    lo, hi = belt_span(station, belt) if du_range is None else (float(du_range[0]), float(du_range[1]))
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise InvalidInput(f"du_range must be two finite numbers, low < high [m], got {du_range!r}")
+    du = np.linspace(lo, hi, nu)
+    half = belt.width / 2.0 - margin
+    if half <= 0.0:
+        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
+    w = np.linspace(-half, half, nw)
+    tasks = [{"station": station, "belt": belt, "spec": spec, "du": float(d), "w": w.tolist(), "mass": mass,
+              "height": item_height, "seed": 0} for d in du]
+    cols = map_chunks(_column, tasks, scheduler=scheduler, progress=progress)
+    tA = np.stack([c[0] for c in cols])
+    tC = np.stack([c[1] for c in cols])
+    return TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(mass),
+                   time.perf_counter() - start)
+
+
+@dataclass(frozen=True)
+class MapError:
+    """Interpolated vs exact task time at random feasible points: ``relative`` (n,) errors of
+    the task time (approach + tracking + leave + release), ``max``, ``mean``, ``points`` (n, 2)."""
+
+    relative: np.ndarray
+    points: np.ndarray
+    planning_seconds: float
+
+    @property
+    def max(self) -> float:
+        return float(np.max(self.relative)) if self.relative.size else float("nan")
+
+    @property
+    def mean(self) -> float:
+        return float(np.mean(self.relative)) if self.relative.size else float("nan")
+
+
+def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
+              n: int = 30, item_height: float = 0.04, seed: int = 0) -> MapError:
+    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc)."""
+    rng = np.random.default_rng(seed)
+    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(station)
+    rel, pts = [], []
+    tries = 0
+    start = time.perf_counter()
+    while len(rel) < n and tries < 50 * n:
+        tries += 1
+        du = rng.uniform(task_map.du[0], task_map.du[-1])
+        w = rng.uniform(task_map.w[0], task_map.w[-1])
+        tA, tC = task_map.times(du, w)
+        if not (np.isfinite(tA) and np.isfinite(tC)):
+            continue
+        try:
+            plan = plan_pick(station, belt, spec, u_base + du, w, item_height=item_height, mass=task_map.mass,
+                             q_rest=q_rest)
+        except PinarmsError:
+            continue
+        approx = float(tA + tC) + task_map.track + task_map.release
+        rel.append(abs(approx - plan.duration) / plan.duration)
+        pts.append((du, w))
+    return MapError(np.array(rel), np.array(pts).reshape(-1, 2), time.perf_counter() - start)

@@ -1,0 +1,249 @@
+"""Conveyor tracking: one pick of a moving item and its place, time-optimal, from FK-checkable joints.
+
+A pick is a **rendezvous**. From rest at its box, the arm moves to the *pre-grasp* point
+(``lift`` m above the item's grasp point) and arrives there moving with the belt; then, still
+moving with the belt, it descends (``descend`` s), closes the gripper (``grasp`` s), lifts
+(``descend`` s): the *tracking segment*, whose tool path is the item's path plus a vertical
+quintic (zero vertical speed and acceleration at its ends); then it moves to its box, arriving
+at rest, and releases the item (``release`` s)::
+
+    approach (time-optimal)  │ tracking (belt velocity + vertical) │ leave (time-optimal) │ release
+    rest at box ─▶ pre-grasp │ descend · grasp · lift               │ ─▶ rest at box        │ hold
+
+Approach and leave are joint-space cubic Hermite paths whose end tangents are the tracking
+segment's joint velocities (``q̇ = J⁺ ṗ`` from the Jacobian), timed by the project's
+time-optimal TOPP-RA (:func:`optim.time_optimal`) with the path speed at that end fixed so
+the joint velocities match exactly; limits: joint velocity, acceleration and — where the arm
+has inertials — torque, with the item as payload on the leave move. The tracking segment's
+joints are the arm's IK at dense instants (one branch, continuous), a clamped cubic spline in
+time whose end velocities are the exact ``J⁺ ṗ``; it is checked against the same limits.
+
+Tool orientation: the arm's default tool orientation (:func:`robots.layout.default_orientation`,
+pointing down on a SCARA), yaw aligned with the belt through the whole pick.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from pinarms.optim.errors import InfeasibleProblem
+from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.station import Station
+from pinarms.planning import Trajectory
+from pinarms.planning.joint_path import JointPath
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
+
+__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "TRACK_SAMPLES"]
+
+#: IK instants per tracking segment (spline knots).
+TRACK_SAMPLES = 41
+
+
+@dataclass(frozen=True)
+class TrackingSpec:
+    """How the arm picks (module doc): ``lift`` [m] above the grasp point, ``descend`` [s] each
+    way, ``grasp`` [s] gripper closing while tracking, ``release`` [s] at the box,
+    ``grid`` TOPP-RA grid intervals per move."""
+
+    lift: float = 0.03
+    descend: float = 0.2
+    grasp: float = 0.1
+    release: float = 0.1
+    grid: int = 40
+
+    def __post_init__(self) -> None:
+        for name in ("lift", "descend"):
+            _number(getattr(self, name), f"{name} of the tracking spec", positive=True)
+        for name in ("grasp", "release"):
+            if _number(getattr(self, name), f"{name} [s] of the tracking spec") < 0.0:
+                raise InvalidInput(f"{name} [s] of the tracking spec must be >= 0")
+
+    @property
+    def track_time(self) -> float:
+        """Duration of the tracking segment [s]."""
+        return 2.0 * self.descend + self.grasp
+
+
+@dataclass(eq=False)
+class PickPlan:
+    """One planned pick (module doc). Times in s from the start of the approach.
+
+    Attributes:
+        station: the arm's name; ``u_pre``, ``w``: belt coordinates of the pre-grasp point [m];
+        approach, leave: the :class:`optim.PathTiming` of the two moves; ``tracking``: the
+        tracking segment's :class:`planning.Trajectory`; ``q_rest``: the arm at its box;
+        :attr:`trajectory`: the whole pick (approach, tracking, leave, release), one
+        :class:`planning.Trajectory`; ``grasp_window``: (start, end) of the gripper closing [s]; ``times``: approach,
+        tracking, leave, release [s].
+    """
+
+    station: str
+    u_pre: float
+    w: float
+    approach: Any
+    tracking: Trajectory
+    leave: Any
+    q_rest: np.ndarray
+    grasp_window: tuple[float, float]
+    times: tuple[float, float, float, float]
+
+    @functools.cached_property
+    def trajectory(self) -> Trajectory:
+        hold = Trajectory([0.0, max(self.times[3], 1e-6)], self.q_rest[None, None, :])
+        return self.approach.trajectory.concatenated(self.tracking, atol=1e-7) \
+            .concatenated(self.leave.trajectory, atol=1e-7).concatenated(hold, atol=1e-7)
+
+    @property
+    def duration(self) -> float:
+        return float(sum(self.times))
+
+
+def _sigma(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x**3 * (10.0 - 15.0 * x + 6.0 * x * x)
+
+
+def tracking_points(belt: Belt, spec: TrackingSpec, u_pre: float, w: float, z_grasp: float,
+                    tau: np.ndarray) -> np.ndarray:
+    """World tool points (N, 3) [m] of the tracking segment at its times ``tau`` [s]."""
+    d, g = spec.descend, spec.grasp
+    h = np.where(tau < d, 1.0 - _sigma(tau / d), np.where(tau <= d + g, 0.0, _sigma((tau - d - g) / d)))
+    return belt.to_world(u_pre + belt.speed * tau, w, z_grasp + spec.lift * h)
+
+
+def _poses(station: Station, p_world: np.ndarray) -> np.ndarray:
+    from pinarms.robots.layout import default_orientation
+
+    R = default_orientation(station.robot)
+    T = np.tile(np.eye(4), (p_world.shape[0], 1, 1))
+    T[:, :3, :3] = R
+    T[:, :3, 3] = station.world_to_base(p_world)
+    return T
+
+
+def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget."""
+    robot = station.robot
+    if robot.has_analytic_ik:
+        sols = robot.ik_all(poses, q_ref=q_ref)
+        out = np.empty((poses.shape[0], robot.nq))
+        prev = q_ref
+        q0, labels = robot.ik_branches(poses[0], q_ref)
+        want = _branch_label(robot, q_ref)
+        same = q0[labels == want]
+        if same.shape[0]:  # stay on the rest configuration's branch (maps continuous over the belt)
+            prev = same[np.argmin(np.abs(same - q_ref).sum(axis=1))]
+        for k, s in enumerate(sols):
+            if s.shape[0] == 0:
+                raise UnreachableTarget(f"arm {station.name!r} cannot reach tool point "
+                                        f"{np.round(poses[k, :3, 3], 4).tolist()} (base frame)")
+            out[k] = s[np.argmin(np.abs(s - prev).sum(axis=1))]
+            prev = out[k]
+        return out
+    out = np.empty((poses.shape[0], robot.nq))
+    prev = q_ref
+    for k in range(poses.shape[0]):
+        out[k] = prev = robot.ik(poses[k], prev)
+    return out
+
+
+def _branch_label(robot: Any, q: np.ndarray) -> int:
+    """The closed-form branch label of configuration ``q`` (-1 when none matches)."""
+    sols, labels = robot.ik_branches(robot.fk(q), q)
+    if sols.shape[0] == 0:
+        return -1
+    k = int(np.argmin(np.abs(sols - q).sum(axis=1)))
+    return int(labels[k]) if np.abs(sols[k] - q).max() < 1e-6 else -1
+
+
+def _joint_rates(station: Station, q: np.ndarray, v_world: np.ndarray) -> np.ndarray:
+    """Joint velocities (nq,) that move the tcp at ``v_world`` [m/s] with no rotation."""
+    J = station.robot.jacobian(q)  # (6, nq) in the base frame (linear; angular)
+    twist = np.concatenate([station.base_to_world[:3, :3].T @ v_world, np.zeros(3)])
+    qd, *_ = np.linalg.lstsq(J, twist, rcond=None)
+    return qd
+
+
+def _hermite(q0: np.ndarray, m0: np.ndarray, q1: np.ndarray, m1: np.ndarray, robot: Any) -> JointPath:
+    c = np.stack([q0, m0, 3.0 * (q1 - q0) - 2.0 * m0 - m1, 2.0 * (q0 - q1) + m0 + m1])
+    return JointPath([0.0, 1.0], c[None], robot=robot)
+
+
+def _constraints(station: Station, mass: float) -> list:
+    from pinarms.planning.path_constraints import JointAccelerationConstraint, JointVelocityConstraint
+    from pinarms.planning.path_torque import JointTorqueConstraint
+
+    lim = station.limits
+    cons = [JointVelocityConstraint(lim["vmax"]), JointAccelerationConstraint(lim["amax"])]
+    if lim["torque"]:
+        robot = station.robot.with_payload(mass) if mass > 0.0 else station.robot
+        cons.append(JointTorqueConstraint(robot, np.asarray(station.robot.effort_limit, float)))
+    return cons
+
+
+def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> Any:
+    """Time-optimal move q0 → q1 starting with joint velocity qd0 and ending with qd1 (one of them 0)."""
+    from pinarms.optim.path_timing import time_optimal
+
+    chord = q1 - q0
+    L = float(np.linalg.norm(chord))
+    moving = qd1 if np.any(qd1) else qd0
+    speed = float(np.linalg.norm(moving))
+    k = L / speed if speed > 1e-12 and L > 1e-9 else 1.0
+    m0, m1 = (chord, k * qd1) if np.any(qd1) else (k * qd0, chord)
+    path = _hermite(q0, m0, q1, m1, station.robot)
+    ends = {"end_speed": 1.0 / k} if np.any(qd1) else {"start_speed": 1.0 / k}
+    return time_optimal(path, _constraints(station, mass), grid=grid, **ends)
+
+
+def _check_limits(station: Station, traj: Trajectory, what: str) -> None:
+    peaks = traj.peaks()
+    lim = station.limits
+    over = np.flatnonzero((peaks.velocity > lim["vmax"] * (1 + 1e-9)) | (peaks.acceleration > lim["amax"] * (1 + 1e-9)))
+    if over.size:
+        raise InfeasibleProblem(f"arm {station.name!r}: the {what} needs joint {int(over[0]) + 1} beyond its "
+                                "velocity or acceleration limit (belt too fast here)")
+
+
+def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, *,
+              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None) -> PickPlan:
+    """Plan one pick whose pre-grasp point is at belt coordinates (``u_pre``, ``w``) (module doc).
+
+    ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
+
+    Raises:
+        UnreachableTarget: a point of the tracking segment or the box out of reach.
+        InfeasibleProblem: the belt is too fast for the arm there, or a move cannot meet its limits.
+    """
+    robot = station.robot
+    q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
+    n = TRACK_SAMPLES
+    tau = np.linspace(0.0, spec.track_time, n)
+    p = tracking_points(belt, spec, u_pre, w, item_height, tau)
+    q = _ik_path(station, _poses(station, p), q_rest)
+    qd_in = _joint_rates(station, q[0], belt.velocity)
+    qd_out = _joint_rates(station, q[-1], belt.velocity)
+    spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
+    tracking = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
+    _check_limits(station, tracking, "tracking segment")
+    approach = _timed_move(station, q_rest, np.zeros(robot.nq), q[0], qd_in, 0.0, spec.grid)
+    leave = _timed_move(station, q[-1], qd_out, q_rest, np.zeros(robot.nq), mass, spec.grid)
+    tA = float(approach.duration)
+    times = (tA, spec.track_time, float(leave.duration), spec.release)
+    return PickPlan(station.name, float(u_pre), float(w), approach, tracking, leave, q_rest,
+                    (tA + spec.descend, tA + spec.descend + spec.grasp), times)
+
+
+def rest_configuration(station: Station) -> np.ndarray:
+    """The arm's configuration at rest at its box (IK of the place point, nearest neutral)."""
+    pose = _poses(station, station.place.position[None])
+    try:
+        return _ik_path(station, pose, station.robot.neutral)[0]
+    except UnreachableTarget:
+        raise UnreachableTarget(f"arm {station.name!r} cannot reach its place box {station.place.name!r} at "
+                                f"{station.place.position.tolist()} m (world): move the box into its reach") from None

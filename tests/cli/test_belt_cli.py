@@ -1,0 +1,32 @@
+"""`pinarms belt ...`: a line simulated from the command line; bad input is one error line."""
+
+import json
+
+from click.testing import CliRunner
+
+from pinarms.cli import cli
+
+
+def test_belt_run_json_figures():
+    r = CliRunner().invoke(cli, ["belt", "run", "--arms", "2", "--rate", "20", "--seeds", "2", "--duration", "120",
+                                 "--json"])
+    assert r.exit_code == 0, (r.output, r.exception)
+    data = json.loads(r.stdout)
+    f = data["figures"]
+    assert data["status"] in ("ok", "misses above target") and data["belt_speed_m_s"] == 0.2
+    assert len(f["arms"]) == 2 and 0.0 <= f["miss_rate"] <= 1.0
+    assert 0.0 < f["picks_per_minute"] <= f["arrivals_per_minute"]
+    assert f["miss_rate_ci"][0] <= f["miss_rate"] <= f["miss_rate_ci"][1]
+
+
+def test_belt_run_arrivals_file_and_errors(tmp_path):
+    p = tmp_path / "arrivals.csv"
+    p.write_text("time,across,type\n0.5,0.0,enoki bunch\n1.0,x,enoki bunch\n")
+    r = CliRunner().invoke(cli, ["belt", "run", "--arms", "1", "--arrivals", str(p)])
+    assert r.exit_code == 1 and "row 2" in r.output and "'across'" in r.output and "Traceback" not in r.output
+    p.write_text("time,across,type\n0.5,0.0,enoki bunch\n4.0,0.05,enoki bunch\n")
+    r = CliRunner().invoke(cli, ["belt", "run", "--arms", "1", "--arrivals", str(p), "--duration", "30", "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["figures"]["picks_per_minute"] == 4.0  # both picked in 30 s
+    r = CliRunner().invoke(cli, ["belt", "run", "--speed", "0"])
+    assert r.exit_code == 1 and "belt speed" in r.output

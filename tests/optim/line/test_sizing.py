@@ -1,0 +1,42 @@
+"""Sizing: the fewest arms for a flow, by the GA, Monte Carlo over seeds."""
+
+import numpy as np
+import pytest
+
+from pinarms.optim.line import ItemType, TaskMap
+from pinarms.optim.line.sizing import SizingProblem, evaluate_layouts, size_line
+from pinarms.robots.errors import InvalidInput
+
+
+def _map(speed=0.2, cycle_part=1.0):
+    du, w = np.linspace(-0.3, 0.3, 13), np.array([-0.15, 0.15])
+    return TaskMap("a", du, w, np.full((13, 2), cycle_part), np.full((13, 2), cycle_part), 0.5, 0.1, speed, 0.1)
+
+
+def test_fewest_arms_meet_the_miss_rate_and_one_fewer_does_not():
+    # a 2.6 s cycle: one arm takes about 23 items/min; 50/min needs at least three
+    p = SizingProblem({0.2: _map()}, rate=50.0, max_miss=0.02, item=ItemType("x"), seeds=(0, 1), duration=240.0,
+                      min_gap=0.7, max_gap=1.2)
+    r = size_line(p, population=6, generations=2)
+    assert r.status == "ok" and r.arms >= 3
+    assert r.miss_rate <= 0.02
+    assert r.arms - 1 in r.tried and r.tried[r.arms - 1] > 0.02  # one arm fewer was tried and misses more
+    gaps = np.diff(r.positions)
+    assert np.all(gaps >= 0.7 - 1e-12) and np.all(gaps <= 1.2 + 1e-12)
+    # the reported miss rate is the mean over the seeds of that layout
+    again = evaluate_layouts(p, [(np.array(r.positions), r.speed)])[0]
+    assert again[0] == pytest.approx(r.miss_rate, abs=1e-15)
+
+
+def test_sizing_problem_checks_its_maps():
+    with pytest.raises(InvalidInput, match="built for 0.2 m/s"):
+        SizingProblem({0.3: _map(0.2)}, rate=10.0)
+
+
+@pytest.mark.slow
+def test_serial_and_dask_give_identical_results():
+    p = SizingProblem({0.2: _map()}, rate=40.0, item=ItemType("x"), seeds=(0, 1, 2), duration=120.0)
+    layouts = [(np.array([0.6, 1.5]), 0.2), (np.array([0.6, 1.8, 2.9]), 0.2)]
+    serial = evaluate_layouts(p, layouts)
+    dask = evaluate_layouts(p, layouts, scheduler="processes:2")
+    assert np.array_equal(serial, dask)
