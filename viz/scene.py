@@ -287,6 +287,9 @@ def build_scene(
     from .reach_scene import draw_reachability  # voxel layers coloured by reachability index
 
     reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
+    from .line_scene import animate_lines, draw_lines, line_duration  # belt lines: belt, items
+
+    line_lines = draw_lines(vis, session, ROOT, bounds)
 
     paths, knots_drawn, tcp_paths = {}, {}, {}
     for i, (name, rec) in enumerate(session.trajectories.items()):
@@ -353,8 +356,9 @@ def build_scene(
         knots_drawn[name] = _sphere_set(vis, f"{ROOT}/vias/{name}", knots_drawn[name], sphere_radius, color)
 
     duration, n_frames = 0.0, 0
-    if animated:
-        duration = max(float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated)
+    if animated or line_lines:
+        duration = max([float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated]
+                       + [line_duration(session)])
         n_frames = int(np.floor(duration * fps + 1e-9)) + 1
         times = np.minimum(np.arange(n_frames) / fps, duration)
         if times[-1] < duration:  # end exactly on the last pose
@@ -365,6 +369,7 @@ def build_scene(
             rec = session.trajectories[name]
             qs = _interp_rows(rec.t[0] + times, rec.t, rec.q)
             drawings[rec.robot].record(anim, vis, qs)
+        animate_lines(vis, anim, session, ROOT, times, animated, drawings)
         vis.set_animation(anim, play=play, repetitions=float("inf"))
 
     _place_camera(vis, camera)
@@ -384,12 +389,12 @@ def build_scene(
 
     page = {
         "title": session.title or "pinarms session",
-        "lines": _summary_lines(session, animated, cloud_shown) + [f"floor grid: {grid_step * 100:.0f} cm squares at z = {floor_z:+.1f} m"],
+        "lines": _summary_lines(session, animated, cloud_shown) + line_lines + [f"floor grid: {grid_step * 100:.0f} cm squares at z = {floor_z:+.1f} m"],
         "target": target.tolist(),
         "camera": camera.tolist(),
         "clouds": list(clouds.values()),
         "clouds_visible": bool(show_clouds),
-        "animation": {"duration": duration, "playing": bool(play and animated)},
+        "animation": {"duration": duration, "playing": bool(play and (animated or line_lines))},
         "colorbar": None,
     }
     if clouds:
