@@ -120,6 +120,8 @@ def animate_lines(vis: Any, anim: Any, session: Any, root: str, times: np.ndarra
             traj = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
             if traj:
                 tr = traj[0]
+                for node in ("paths", "vias"):  # the items show the picks; tcp tubes would hide the belt
+                    vis[f"{root}/{node}/{tr.name}"].set_property("visible", False)
                 q = np.stack([np.interp(tr.t[0] + times, tr.t, tr.q[:, j]) for j in range(tr.q.shape[1])], axis=1)
                 T = session.robots[key].base_to_world
                 tcp[k] = drawings[key].robot.position(q) @ T[:3, :3].T + T[:3, 3]
