@@ -186,4 +186,8 @@ def demo_study(quick: bool = False) -> Any:
     rows.append(Row("002", "gantry: largest regular flow at <= 1 % miss", 60.0, round(g["max_flow_1pct_regular"], 1),
                     "items/min", None, f"at 60/min Poisson: {g['poisson_60']['picks_per_minute']:.1f} picks/min, "
                                        f"miss {100 * g['poisson_60']['miss_rate']:.1f} %"))
-    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows)
+    from pinarms.studies.line_views import line_views  # session, page, schedule and sizing plots
+
+    session, plots = line_views(out["model limits"]["arms"] or 1, 60.0, seeds=seeds[:3], duration=300.0)
+    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows, session,
+                 plots)
