@@ -155,3 +155,26 @@ def test_huge_and_misshapen_item_tables_refused(saved, tmp_path):
         viz.load_session(_rewrite(saved, tmp_path / "huge.pinarms", items=huge))
     with pytest.raises(SessionFormatError, match=r"items.npy. has shape \(3, 5\), expected \(3, 9\)"):
         viz.load_session(_rewrite(saved, tmp_path / "cols.pinarms", items=np.zeros((3, 5))))
+
+
+def test_arms_naming_no_robot_refused_when_drawn(saved, tmp_path):
+    from pinarms.viz.errors import ViewerError
+
+    bad = viz.load_session(_rewrite(saved, tmp_path / "ghost.pinarms", line={"arms": ["ghost 1", "ghost 2"]}))
+    with pytest.raises(ViewerError, match="arm 'ghost 1', which is not a robot of this session"):
+        viz.export_html(bad, tmp_path / "ghost.html")
+    assert not (tmp_path / "ghost.html").exists()
+
+
+def test_save_line_views_writes_session_page_and_schedule(belt_line, tmp_path):
+    from pinarms.viz.line_session import save_line_views
+
+    spec, result = belt_line
+    paths = save_line_views(spec, result, session=tmp_path / "l.pinarms", html=tmp_path / "l.html",
+                            schedule=tmp_path / "l.svg", duration=3.0)
+    assert [p.name for p in paths] == ["l.pinarms", "l.html", "l.svg"]
+    back = viz.load_session(tmp_path / "l.pinarms")
+    rec = next(iter(back.lines.values()))
+    assert rec.duration == 3.0 and rec.arms == tuple(st.name for st in spec.stations)
+    assert "<title>belt line: 2 arm(s), 90 items/min, belt 0.2 m/s</title>" in (tmp_path / "l.html").read_text()
+    assert "missed" in (tmp_path / "l.svg").read_text()
