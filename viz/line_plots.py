@@ -108,7 +108,8 @@ def _band(result: Any) -> tuple[float, float, float, float, float, float]:
     runs = getattr(result, "runs", None)
     fig = getattr(result, "figures", result)
     if not hasattr(fig, "miss_rate_ci") or not hasattr(fig, "picks_per_minute"):
-        raise InvalidInput(f"each curve point must be an optim.line LineResult or LineFigures, got {type(result).__name__}")
+        raise InvalidInput(f"each curve point must be an optim.line LineResult or LineFigures, "
+                           f"got {type(result).__name__}")
     if runs:
         tp = confidence_interval([x.picks_per_minute for x in runs])
     else:

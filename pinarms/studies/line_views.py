@@ -26,8 +26,8 @@ def line_views(n_arms: int, rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 
     spec = scara_line(n, rate, seeds=seeds, duration=duration)
     result = run_line(spec, maps=maps_for(spec))
     f = result.figures
-    session = viz.Session(title=f"seed 000 line: {n} SCARA(s), {rate:g} enoki bunches/min, belt {spec.belt.speed:g} m/s "
-                                f"({f.picks_per_minute:.1f} picks/min, miss {100 * f.miss_rate:.1f} %)")
+    session = viz.Session(title=f"seed 000 line: {n} SCARA(s), {rate:g} enoki bunches/min, "
+                                f"belt {spec.belt.speed:g} m/s ({f.picks_per_minute:.1f} picks/min, miss {100 * f.miss_rate:.1f} %)")
     session.add_line(spec, result, duration=window)
 
     def sizing(path: Any) -> Any:
