@@ -25,7 +25,7 @@ import numpy as np
 
 from ._meshcat import mg
 from .errors import ViewerError
-from .line_record import MISSED
+from .line_record import MISSED, NOT_DRAWN
 from .line_session import BOX_DEPTH
 
 __all__ = ["draw_lines", "animate_lines", "item_positions", "ITEM_COLOR", "MISSED_COLOR"]
@@ -57,8 +57,10 @@ def draw_lines(vis: Any, session: Any, root: str, bounds: list) -> list[str]:
         vis[f"{base}/miss"].set_transform(strip)
         corners = np.array(np.meshgrid([0, rec.length], [-rec.width / 2, rec.width / 2], [-rec.thickness, 0.0]))
         bounds.append(_to_world(T, *corners.reshape(3, -1)))
+        lost = int(np.count_nonzero(rec.items[:, 6] == NOT_DRAWN))
         lines.append(f"{name}: belt {rec.length:.2f} m at {rec.speed:g} m/s, {rec.items.shape[0]} items in "
-                     f"{rec.duration:g} s: {rec.n_picked} picked, {rec.n_missed} missed (red)")
+                     f"{rec.duration:g} s: {rec.n_picked} picked, {rec.n_missed} missed (red)"
+                     + (f", {lost} picked but not replanned (left on the belt)" if lost else ""))
     return lines
 
 

@@ -114,6 +114,10 @@ def test_page_shows_belt_arms_and_moving_items(browser, belt_session, belt_line,
     page.evaluate(HIDE, ROBOTS)
     assert _diff(_shot(page, 1.0), _shot(page, 4.0)).sum() > 500, "the items did not move on the page"
     page.evaluate(SHOW, ROBOTS)
+    # missed items: a red twin each (MeshCat animates no colours), red from the miss strip on
+    red = page.evaluate("""() => Object.values(viewer.scene_tree.children.meshcat.children.pinarms.children.lines
+        .children.belt.children.missed.children).map(n => n.children['<object>'].object.material.color.getHex())""")
+    assert red == [0xD62728] * rec.n_missed
     title = page.inner_text("#pinarms-title")
     assert f"{rec.n_picked} picked, {rec.n_missed} missed (red)" in title
     picture = _shot(page, 4.0)
