@@ -152,3 +152,29 @@ def line_duration(session: Any) -> float:
 
 
 __all__.append("line_duration")
+
+
+#: A line of more arms than this opens framed on its first arms (where items arrive) and the belt under them.
+FRAMED_ARMS = 3
+
+
+def line_focus(session: Any, points: np.ndarray) -> np.ndarray:
+    """What the view of a scene opens framed on: ``points`` (k, 3), or, for a line of more than
+    :data:`FRAMED_ARMS` arms, those of them up to 0.6 m past the third arm's base along the belt
+    and the belt from its start to there (the page's orbit and zoom reach the rest)."""
+    lines = list(getattr(session, "lines", {}).values())
+    if not lines or len(lines[0].arms) <= FRAMED_ARMS:
+        return points
+    rec = lines[0]
+    T = rec.belt_to_world
+    bases = [session.robots[k].base_to_world[:3, 3] for k in rec.arms if k in session.robots]
+    if len(bases) <= FRAMED_ARMS:
+        return points
+    u_bases = np.sort([(b - T[:3, 3]) @ T[:3, 0] for b in bases])
+    u_hi = float(min(rec.length, u_bases[FRAMED_ARMS - 1] + 0.6))
+    u = (points - T[:3, 3]) @ T[:3, 0]
+    corners = np.array(np.meshgrid([0.0, u_hi], [-rec.width / 2, rec.width / 2], [-rec.thickness, 0.0]))
+    return np.vstack([points[u <= u_hi], _to_world(T, *corners.reshape(3, -1))])
+
+
+__all__.append("line_focus")

@@ -178,3 +178,17 @@ def test_save_line_views_writes_session_page_and_schedule(belt_line, tmp_path):
     assert rec.duration == 3.0 and rec.arms == tuple(st.name for st in spec.stations)
     assert "<title>belt line: 2 arm(s), 90 items/min, belt 0.2 m/s</title>" in (tmp_path / "l.html").read_text()
     assert "missed" in (tmp_path / "l.svg").read_text()
+
+
+def test_long_line_opens_on_its_first_arms(belt_session, monkeypatch):
+    from pinarms.viz import line_scene
+
+    rec = belt_session.lines["belt"]
+    T = rec.belt_to_world
+    pts = T[:3, 3] + np.outer(np.linspace(0.0, rec.length, 11), T[:3, 0])  # along the whole belt
+    assert line_scene.line_focus(belt_session, pts) is pts  # two arms: everything framed
+    monkeypatch.setattr(line_scene, "FRAMED_ARMS", 1)
+    u_first = (belt_session.robots["scara 1"].base_to_world[:3, 3] - T[:3, 3]) @ T[:3, 0]
+    u = (line_scene.line_focus(belt_session, pts) - T[:3, 3]) @ T[:3, 0]
+    assert u.max() == pytest.approx(u_first + 0.6) and u.min() == pytest.approx(0.0)
+    assert np.count_nonzero(u <= u_first + 0.6 + 1e-9) == u.size
