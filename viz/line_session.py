@@ -1,11 +1,20 @@
-"""A session of the line: the belt, the boxes, every arm replaying its picks, picks and misses marked.
+"""A simulated belt line into a session: its arms, their picks as joint trajectories, the belt, the items.
 
-Each arm's picks in the shown time are planned exactly again (:func:`optim.line.plan_pick` at
-the simulated rendezvous point) and played on one clock: the arm holds at its box until a pick
-starts, so that its rendezvous is at the simulated time (or right after its previous pick ends
-when the exact plan runs a little longer than the map said). Grasp points are marked as
-``target`` points of the arm that picked, missed items as ``contact`` points at the end of the
-belt. Items themselves are not animated (the session format has no moving objects yet).
+:func:`add_line` takes a line (:class:`optim.line.LineSpec`) and its result
+(:class:`optim.line.LineResult`, one :class:`SimResult` per seed) and adds to a
+:class:`viz.Session`, for a window of one run (default the first 20 s of the first seed):
+
+- each station's arm as a robot (key: the station's name) at its base pose, and its box as
+  a translucent static box under the release point;
+- each arm's joint trajectory through its picks of the window, ``"<station> picks"``: the
+  simulator keeps only pick times, so every pick of the window is planned again exactly
+  (:func:`optim.line.tracking.plan_pick` at the simulated rendezvous point, rest at the box
+  between picks). The exact plan's times differ from the task map's by its error (≤ 1 %); a
+  pick that would start before the previous one ends waits for it (the item is then met a
+  little downstream of the simulated point: the picture, not the figures);
+- a :class:`viz.line_record.LineRecord` with the belt and every item on it during the window.
+
+Units: m, s, rad.
 """
 
 from __future__ import annotations
@@ -14,65 +23,147 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.robots.errors import InvalidInput, PinarmsError
 
-from .session import Session
+from .line_record import ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
 
-__all__ = ["line_session"]
+__all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
-
-def _arm_samples(plans: list[tuple[float, Any]], q_rest: np.ndarray, t_end: float, hz: float) -> tuple[np.ndarray, np.ndarray]:
-    t_all, q_all = [np.array([0.0])], [q_rest[None]]
-    clock = 0.0
-    for start, plan in plans:
-        start = max(start, clock + 1.0 / hz)
-        tt = np.arange(0.0, plan.duration, 1.0 / hz)
-        t_all.append(start + tt)
-        q_all.append(plan.trajectory.sample(tt)[0])
-        clock = start + tt[-1]
-    if clock < t_end:
-        t_all.append(np.array([t_end]))
-        q_all.append(q_rest[None])
-    return np.concatenate(t_all), np.concatenate(q_all)
+#: Depth of the drawn place boxes [m] and the gap between an item's bottom and the box's rim at release [m].
+BOX_DEPTH = 0.08
+BOX_GAP = 0.01
+DEFAULT_WINDOW_S = 20.0
 
 
-def line_session(spec: Any, run: Any, *, t_max: float = 30.0, hz: float = 50.0, title: str = "") -> Session:
-    """The line ``spec`` (:class:`optim.line.LineSpec`) replaying ``run`` (a :class:`SimResult`) over
-    its first ``t_max`` s (module doc)."""
+def _window(start: Any, duration: Any) -> tuple[float, float]:
+    ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in (start, duration))
+    if not ok or start < 0.0 or not 0.0 < duration <= 3600.0:
+        raise InvalidInput(f"the window shown must be start >= 0 s and 0 < duration <= 3600 s, got {start!r}, "
+                           f"{duration!r}")
+    return float(start), float(duration)
+
+
+def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float) -> tuple[list, dict]:
+    """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}."""
     from pinarms.optim.line.tracking import plan_pick, rest_configuration
 
-    belt = spec.belt
-    session = Session(title=title or f"line: {len(spec.stations)} arm(s), belt {belt.speed} m/s")
-    T = belt.belt_to_world.copy()
-    T[:3, 3] = belt.to_world(belt.length / 2.0, 0.0, -0.01)
-    session.add_box("belt", (belt.length, belt.width, 0.02), T, (0.2, 0.2, 0.22, 1.0))
-    kinds = spec.stream.types
+    st = spec.stations[k]
+    q_rest = rest_configuration(st)
+    tr = spec.tracking
+    out, times = [], {}
+    free_at = -np.inf
+    for i in picks:
+        if run.start[i] >= t_end:
+            break
+        kind = items.types[int(items.kind[i])]
+        try:
+            plan = plan_pick(st, spec.belt, tr, float(run.u_meet[i]), float(items.w[i]), item_height=kind.size[2],
+                             mass=kind.mass, q_rest=q_rest)
+        except PinarmsError:
+            continue  # drawn on the belt, not marked (NOT_DRAWN)
+        s = max(float(run.meet[i]) - plan.times[0], free_at)
+        out.append((s, plan))
+        times[int(i)] = (s + plan.times[0] + tr.descend + tr.grasp, s + plan.times[0] + plan.times[1] + plan.times[2])
+        free_at = s + plan.duration
+    return out, times
+
+
+def _arm_samples(q_rest: np.ndarray, plans: list, t: np.ndarray) -> np.ndarray:
+    q = np.tile(q_rest, (t.size, 1))
+    for s, plan in plans:
+        sel = (t >= s) & (t <= s + plan.duration)
+        if sel.any():
+            q[sel] = plan.trajectory.sample(np.clip(t[sel] - s, 0.0, plan.trajectory.duration))[0]
+    return q
+
+
+def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float = 0.0,
+             duration: float = DEFAULT_WINDOW_S, name: str = "line", hz: float = 30.0) -> LineRecord:
+    """Add the window [``start``, ``start + duration``] s of run ``run`` of ``result`` (module doc).
+
+    Args:
+        session: a :class:`viz.Session` (its robot keys must not clash with the stations' names).
+        spec: the :class:`optim.line.LineSpec` simulated; ``result``: its :class:`optim.line.LineResult`.
+        run: index of the seed's run in ``result.runs``.
+        hz: sampling rate of the arms' trajectories [1/s].
+
+    Raises:
+        InvalidInput: a bad window, run index or rate; a station name already used as a robot key.
+    """
+    from pinarms.optim.line.tracking import rest_configuration
+
+    t_a, dur = _window(start, duration)
+    runs = getattr(result, "runs", None)
+    if not runs or not (isinstance(run, int) and 0 <= run < len(runs)):
+        raise InvalidInput(f"run must index result.runs (0..{len(runs or ()) - 1}), got {run!r}")
+    if not (isinstance(hz, (int, float)) and np.isfinite(hz) and 1.0 <= hz <= 1000.0):
+        raise InvalidInput(f"hz must be a sampling rate in [1, 1000] 1/s, got {hz!r}")
+    r = runs[run]
+    items = spec.stream.items(spec.belt, spec.seeds[run])
+    if len(items) != r.picked_by.size or not np.array_equal(items.t0, r.t0):
+        raise InvalidInput("result does not belong to spec: its run's items differ from the stream's")
+    belt, t_b = spec.belt, t_a + dur
+    h_max = max(t.size[2] for t in items.types)
+    t = np.append(np.arange(0.0, dur, 1.0 / hz), dur)
+    grasp: dict[int, tuple[float, float]] = {}
+    arms = []
     for k, st in enumerate(spec.stations):
-        key = session.add_robot(st.robot, key=st.name.replace(" ", "_"), base_to_world=st.base_to_world)
-        B = np.eye(4)
-        B[:3, 3] = st.place.position - [0.0, 0.0, 0.06]
-        session.add_box(f"{key} box", (0.2, 0.15, 0.06), B, (0.85, 0.6, 0.3, 1.0))
-        sel = np.flatnonzero((run.picked_by == k) & (run.start < t_max))
-        plans, grasps = [], []
-        for i in sel[np.argsort(run.start[sel])]:
-            kind = kinds[int(run.kind[i])]
-            try:
-                plan = plan_pick(st, belt, spec.tracking, float(run.u_meet[i]), float(run.w[i]),
-                                 item_height=kind.size[2], mass=kind.mass)
-            except PinarmsError:
-                continue
-            plans.append((float(run.meet[i]) - plan.times[0], plan))
-            grasps.append(belt.to_world(run.u_meet[i] + belt.speed * spec.tracking.descend, run.w[i],
-                                        kind.size[2]))
-        q_rest = rest_configuration(st)
-        t, q = _arm_samples(plans, q_rest, t_max, hz)
-        session.add_trajectory(f"{key} picks", (t, q), robot=key)
-        if grasps:
-            session.add_points(f"{key} grasps", st.world_to_base(np.array(grasps)), kind="target", robot=key)
-    missed = np.flatnonzero((run.picked_by < 0) & (run.t0 < t_max))
-    if missed.size:
-        last = spec.stations[-1]
-        p = belt.to_world(np.full(missed.size, belt.length), run.w[missed], 0.02)
-        session.add_points("missed items", last.world_to_base(p), kind="contact",
-                           robot=last.name.replace(" ", "_"))
-    return session
+        key = session.add_robot(st.robot, key=st.name, base_to_world=st.base_to_world)
+        arms.append(key)
+        picks = np.flatnonzero(r.picked_by == k)
+        picks = picks[np.argsort(r.start[picks], kind="stable")]
+        plans, times = _plan_arm(spec, k, picks, r, items, t_b)
+        grasp.update(times)
+        session.add_trajectory(f"{st.name} picks", (t, _arm_samples(rest_configuration(st), plans, t_a + t)), robot=key)
+        box = np.eye(4)
+        box[:3, 3] = st.place.position - [0.0, 0.0, h_max + BOX_GAP + BOX_DEPTH / 2.0]
+        session.add_box(f"{st.name}: {st.place.name}", [0.2, 0.16, BOX_DEPTH], pose=box, color=(0.75, 0.55, 0.3, 0.45))
+    on_belt = np.flatnonzero((items.t0 <= t_b) & (items.t0 + belt.length / belt.speed >= t_a))
+    rows = np.zeros((on_belt.size, len(ITEM_COLUMNS)))
+    for row, i in enumerate(on_belt):
+        size = items.types[int(items.kind[i])].size
+        k = int(r.picked_by[i])
+        if k < 0:
+            arm, tg, tr = MISSED, 0.0, 0.0
+        elif int(i) in grasp:
+            arm, (tg, tr) = k, grasp[int(i)]
+            tg, tr = tg - t_a, tr - t_a
+        elif r.start[i] >= t_b:  # picked after the window: on the belt all along
+            arm, tg = k, max(float(r.meet[i]) - t_a, float(items.t0[i]) - t_a)
+            tr = tg
+        else:
+            arm, tg, tr = NOT_DRAWN, 0.0, 0.0
+        rows[row] = (items.t0[i] - t_a, items.w[i], items.yaw[i], *size, arm, tg, tr)
+    ends = [w.u_max for w in getattr(result, "windows", ())] or [belt.length]
+    u_miss = float(min(belt.length, max(ends) + belt.speed * spec.tracking.track_time))
+    thickness = max(0.05, 1.25 * max(max(tp.size) for tp in items.types))
+    rec = make_line(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world, length=belt.length,
+                    width=belt.width, thickness=thickness, speed=belt.speed, u_miss=u_miss, duration=dur, items=rows)
+    session.lines[rec.name] = rec
+    return rec
+
+
+def save_line_views(spec: Any, result: Any, *, session: Any = None, html: Any = None, schedule: Any = None,
+                    title: str | None = None, run: int = 0, duration: float = DEFAULT_WINDOW_S) -> list:
+    """Write what a line engineer looks at: the session (``.pinarms``), its standalone page
+    (``.html``) and the schedule plot (``.png``/``.svg``) of run ``run``, window [0, ``duration``] s
+    for the animation and [0, 3 × ``duration``] s for the schedule; each path optional. Returns the paths written."""
+    from .html import export_html
+    from .line_plots import plot_line_schedule
+    from .session import Session
+
+    written = []
+    if session is not None or html is not None:
+        s = Session(title=title or f"belt line: {len(spec.stations)} arm(s), {spec.stream.rate:g} items/min, "
+                                   f"belt {spec.belt.speed:g} m/s")
+        add_line(s, spec, result, run=run, duration=duration)
+        if session is not None:
+            written.append(s.save(session))
+        if html is not None:
+            written.append(export_html(s, html))
+    if schedule is not None:
+        written.append(plot_line_schedule(schedule, result, run=run, window=(0.0, 3.0 * duration)))
+    return written
+
+
+__all__.append("save_line_views")

@@ -287,6 +287,10 @@ def build_scene(
     from .reach_scene import draw_reachability  # voxel layers coloured by reachability index
 
     reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
+    from .line_scene import animate_lines, draw_lines, line_duration  # belt lines: belt, items
+
+    line_lines = draw_lines(vis, session, ROOT, bounds)
+    line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
 
     paths, knots_drawn, tcp_paths = {}, {}, {}
     for i, (name, rec) in enumerate(session.trajectories.items()):
@@ -331,7 +335,9 @@ def build_scene(
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     bases = np.array([e.base_to_world[:3, 3] for e in session.robots.values()]).reshape(-1, 3)
     toward = np.vstack(list(tcp_paths.values())).mean(axis=0) - bases.mean(axis=0) if tcp_paths and bases.size else None
-    target, camera, radius = frame_view(np.vstack(framed) if framed else everything, toward)
+    from .line_scene import line_focus  # a long belt line: its first arms
+
+    target, camera, radius = frame_view(line_focus(session, np.vstack(framed) if framed else everything), toward)
 
     if sphere_radius is None:
         sphere_radius = max(0.012, 0.015 * radius)
@@ -353,8 +359,9 @@ def build_scene(
         knots_drawn[name] = _sphere_set(vis, f"{ROOT}/vias/{name}", knots_drawn[name], sphere_radius, color)
 
     duration, n_frames = 0.0, 0
-    if animated:
-        duration = max(float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated)
+    if animated or line_lines:
+        duration = max([float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated]
+                       + [line_duration(session)])
         n_frames = int(np.floor(duration * fps + 1e-9)) + 1
         times = np.minimum(np.arange(n_frames) / fps, duration)
         if times[-1] < duration:  # end exactly on the last pose
@@ -365,6 +372,7 @@ def build_scene(
             rec = session.trajectories[name]
             qs = _interp_rows(rec.t[0] + times, rec.t, rec.q)
             drawings[rec.robot].record(anim, vis, qs)
+        animate_lines(vis, anim, session, ROOT, times, animated, drawings)
         vis.set_animation(anim, play=play, repetitions=float("inf"))
 
     _place_camera(vis, camera)
@@ -384,12 +392,12 @@ def build_scene(
 
     page = {
         "title": session.title or "pinarms session",
-        "lines": _summary_lines(session, animated, cloud_shown) + [f"floor grid: {grid_step * 100:.0f} cm squares at z = {floor_z:+.1f} m"],
+        "lines": _summary_lines(session, animated, cloud_shown, line_arms) + line_lines + [f"floor grid: {grid_step * 100:.0f} cm squares at z = {floor_z:+.1f} m"],
         "target": target.tolist(),
         "camera": camera.tolist(),
         "clouds": list(clouds.values()),
         "clouds_visible": bool(show_clouds),
-        "animation": {"duration": duration, "playing": bool(play and animated)},
+        "animation": {"duration": duration, "playing": bool(play and (animated or line_lines))},
         "colorbar": None,
     }
     if clouds:
@@ -422,14 +430,23 @@ def _point_set_world(session: Any, name: str) -> np.ndarray:
     return _transform_points(T, ps.points)
 
 
-def _summary_lines(session: Any, animated: tuple[str, ...], cloud_shown: dict[str, tuple[int, int]]) -> list[str]:
-    """One line per robot (its name and DoF), trajectory (duration; ▶ when animated) and cloud."""
+def _summary_lines(session: Any, animated: tuple[str, ...], cloud_shown: dict[str, tuple[int, int]],
+                   line_arms: set[str] = frozenset()) -> list[str]:
+    """One line per robot (its name and DoF), trajectory (duration; ▶ when animated) and cloud;
+    the arms of a belt line (``line_arms``) and their trajectories in one line."""
     lines = []
+    if line_arms:
+        names = sorted({session.robots[k].name for k in line_arms if k in session.robots})
+        lines.append(f"{len(line_arms)} arms along the belt ({', '.join(names)}), each through its picks")
     for key, entry in session.robots.items():
+        if key in line_arms:
+            continue
         robot = session.robot(key)
         label = entry.name if key == entry.name else f"{key} ({entry.name})"
         lines.append(f"robot {label}: {robot.nq} joints")
     for name, rec in session.trajectories.items():
+        if rec.robot in line_arms:
+            continue
         mark = "▶ " if name in animated else ""
         lines.append(f"{mark}{name}: {float(rec.t[-1] - rec.t[0]):.3g} s")
     for name, (shown, total) in cloud_shown.items():

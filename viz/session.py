@@ -179,6 +179,7 @@ class Session:
         self.point_sets: dict[str, PointSet] = {}
         self.histories: dict[str, HistoryRecord] = {}
         self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
+        self.lines: dict[str, Any] = {}  # name → viz.line_record.LineRecord (belt, items; viz.line_session)
         self._loaded: dict[str, Robot] = {}
         self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
         #: folders meshes of robots stored in a file may be read from (set by :func:`load_session`:
@@ -489,6 +490,12 @@ class Session:
         rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
         self.reachability[name] = rec
         return rec
+
+    def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
+        """Add an animated window of a simulated belt line (:func:`viz.line_session.add_line`)."""
+        from .line_session import add_line
+
+        return add_line(self, spec, result, **options)
 
     # ---------------------------------------------------------------- (de)serialisation
     def _tables(self) -> dict[str, dict[str, Any]]:

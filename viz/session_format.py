@@ -245,6 +245,7 @@ def check_name(name: Any, what: str) -> str:
 
 # ---------------------------------------------------------------------------- the table of kinds
 from .reach_record import decode_reachability, encode_reachability  # noqa: E402  (a kind defined in its own module)
+from .line_record import decode_line, encode_line  # noqa: E402  (a belt line: its own module)
 
 
 @dataclass(frozen=True)
@@ -402,6 +403,8 @@ KINDS: tuple[Kind, ...] = (
     Kind("reachability", "reachability", "reachability map", "name",
          (ArraySpec("centres", ("N", 3), min_rows=1), ArraySpec("index", ("N",)), ArraySpec("manipulability", ("N",))),
          encode_reachability, decode_reachability, robot_ref="required", optional=True),
+    Kind("lines", "lines", "line", "name", (ArraySpec("belt_to_world", (4, 4)), ArraySpec("items", ("N", 9))),
+         encode_line, decode_line, optional=True),
 )
 
 

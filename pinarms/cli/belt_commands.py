@@ -83,15 +83,27 @@ def belt() -> None:
 @click.option("--arms", type=int, default=3, show_default=True, help="Arms along the belt.")
 @click.option("--arrivals", type=click.Path(exists=True, dir_okay=False), default=None,
               help="CSV arrivals file (time,across,type[,yaw]) instead of the Poisson stream.")
+@click.option("--session", "session_path", type=click.Path(dir_okay=False), default=None,
+              help="Also save the first seed's first --window seconds as a session (.pinarms; pinarms view).")
+@click.option("--html", "html_path", type=click.Path(dir_okay=False), default=None,
+              help="Also write that window as a standalone page (.html).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None,
+              help="Also plot who picked what when (.png or .svg; 3 x --window seconds).")
+@click.option("--window", type=float, default=20.0, show_default=True, help="Seconds animated in --session/--html.")
 @scheduler_option
 @json_option
-def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arrivals, scheduler, as_json) -> None:
+def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arrivals, session_path, html_path,
+             plot_path, window, scheduler, as_json) -> None:
     """Simulate a line and print picks/min, miss rate, utilisation."""
     from pinarms.optim.line import run_line
     from pinarms.studies.line import maps_for
 
     spec = _spec(preset, arms, rate, speed, paper_limit, rule, seeds, duration, arrivals)
     res = run_line(spec, maps=maps_for(spec), scheduler=scheduler)
+    if session_path or html_path or plot_path:
+        from pinarms.viz.line_session import save_line_views
+
+        save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=window)
     emit(as_json, res.as_dict(), _figures_lines(res, f"belt run: {preset}, {arms} arm(s), rule {rule}"))
 
 

@@ -185,7 +185,7 @@ def demo_study(quick: bool = False) -> Any:
 
     seeds = (0, 1, 2) if quick else (0, 1, 2, 3, 4)
     out = study(60.0, seeds=seeds, duration=600.0)
-    objects = out.pop("_objects")
+    out.pop("_objects")  # the runs and curves behind the figures (not JSON); the views re-run what they show
     rows = []
     for label in ("model limits", "paper 55 deg/s joint 1"):
         d = out[label]
@@ -204,19 +204,8 @@ def demo_study(quick: bool = False) -> Any:
     rows.append(Row("002", "gantry: largest regular flow at <= 1 % miss", 60.0, round(g["max_flow_1pct_regular"], 1),
                     "items/min", None, f"at 60/min Poisson: {g['poisson_60']['picks_per_minute']:.1f} picks/min, "
                                        f"miss {100 * g['poisson_60']['miss_rate']:.1f} %"))
-    from pinarms.viz.line_plots import plot_line_curve, plot_line_schedule
+    from pinarms.studies.line_views import line_views  # session, page, schedule and sizing plots
 
-    res, curve = objects["model limits"]
-    res_p, curve_p = objects["paper 55 deg/s joint 1"]
-    plots = {
-        "schedule": lambda p: plot_line_schedule(p, res.runs[0], title=f"{len(res.windows)} SCARAs, 60 enoki bunches/min "
-                                                                       "(seed 0, first 120 s)"),
-        "arms": lambda p: plot_line_curve(p, curve, title="SCARAs (model limits) at 60 bunches/min"),
-        "arms_paper_limit": lambda p: plot_line_curve(p, curve_p, title="SCARAs (55 deg/s on joint 1) at 60 bunches/min"),
-    }
-    from pinarms.viz.line_session import line_session
-
-    session = line_session(scara_line(len(res.windows), 60.0), res.runs[0], t_max=20.0 if quick else 40.0,
-                           title=f"{len(res.windows)} SCARAs picking enoki bunches from a belt (first seconds of seed 0)")
-    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows,
-                 session=session, plots=plots)
+    session, plots = line_views(out["model limits"]["arms"] or 1, 60.0, seeds=seeds[:3], duration=300.0)
+    return Study("line", "the line: enoki bunches on seed 000's belt, seed 002's gantry fed by a belt", rows, session,
+                 plots)

@@ -35,3 +35,22 @@ def line_session() -> viz.Session:
     s.add_box("conveyor", [1.2, 0.25, 0.06], pose=_pose(0.35, 0.3, 0.03), color=(0.3, 0.3, 0.35, 1.0))
     s.add_box("crate", [0.3, 0.2, 0.1], pose=_pose(0.32, -0.3, 0.05), color=(0.8, 0.6, 0.3, 1.0))
     return s
+
+
+@pytest.fixture(scope="session")
+def belt_line():
+    """Seed 000's line of two SCARAs at 90 bunches/min (one seed, 20 s) and its result (package task maps)."""
+    from pinarms.optim.line import run_line
+    from pinarms.studies.line import maps_for, scara_line
+
+    spec = scara_line(2, 90.0, seeds=(0,), duration=20.0)
+    return spec, run_line(spec, maps=maps_for(spec, build=False))
+
+
+@pytest.fixture(scope="session")
+def belt_session(belt_line) -> viz.Session:
+    """The first 8 s of :func:`belt_line` in a session (arms replanned pick by pick)."""
+    spec, result = belt_line
+    s = viz.Session(title="enoki belt line")
+    s.add_line(spec, result, duration=8.0, name="belt")
+    return s
