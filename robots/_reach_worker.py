@@ -330,7 +330,8 @@ def _stream(h5, arrays: list, slice_bytes: int) -> None:
 
 def _load_sandbox():
     """The sibling ``_sandbox.py``, loaded by path (this script imports no pinarms module)."""
-    spec = importlib.util.spec_from_file_location("pinarms_reach_child_sandbox", Path(__file__).with_name("_sandbox.py"))
+    path = Path(__file__).with_name("_sandbox.py")
+    spec = importlib.util.spec_from_file_location("pinarms_reach_child_sandbox", path)
     sandbox = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(sandbox)
     return sandbox
@@ -372,7 +373,8 @@ def main() -> None:
             raise Refused(f"not an HDF5 file, or truncated ({' '.join(str(exc).split())})") from None
         with h5:
             attrs, arrays = _inspect(h5, req)
-            _send(b"M", json.dumps({"attrs": attrs, "arrays": arrays, "wall": wall}, ensure_ascii=False).encode("utf-8"))
+            manifest = {"attrs": attrs, "arrays": arrays, "wall": wall}
+            _send(b"M", json.dumps(manifest, ensure_ascii=False).encode("utf-8"))
             _stream(h5, arrays, req["limits"]["slice_bytes"])
         _send(b"K")
     except Refused as exc:
