@@ -2,15 +2,19 @@
 
 This file runs as a script (``python -I _reach_worker.py``) in a child process whose address
 space, CPU time and file writes the parent limits and whose wall-clock time it bounds. It
-imports only the standard library, NumPy and h5py, never pinarms (nor Pinocchio); the
-parent imports it only for the tables below.
+imports only the standard library, NumPy and h5py, and loads the sibling ``_sandbox.py`` by
+path, never pinarms (nor Pinocchio); the parent imports it only for the tables below.
+
+Before the map is opened by h5py the process walls itself in (:func:`enter_wall`, with
+Landlock): it can then read only the map file and Python's own folders, and write, create,
+remove or execute nothing, whatever a damaged file makes libhdf5 do.
 
 Protocol: one JSON request on stdin ``{"path", "solutions", "max_bytes", "limits": {...}}``;
 on stdout a sequence of frames ``tag (1 byte) + length (4 bytes, little-endian) + payload``:
 
 - ``R`` (empty): the interpreter is up with h5py imported; the file is opened only after this frame.
-- ``M`` (JSON): the attributes and the arrays to come (name, dtype, shape), sent once every
-  declared layout is checked, before any data is read.
+- ``M`` (JSON): the attributes, the arrays to come (name, dtype, shape) and the wall the
+  reader is behind, sent once every declared layout is checked, before any data is read.
 - ``D`` (raw bytes): the next bytes of the current array, arrays in the manifest's order,
   C order, the dtype of the manifest (little-endian). No Python object is ever pickled.
 - ``E`` (JSON ``{"message": ...}``): the file is refused; ``K`` (empty): every array was sent.
@@ -27,11 +31,14 @@ chunks or contiguous data never written are refused (a map writer writes every b
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import os
+import stat
 import struct
 import sys
+from pathlib import Path
 
 FORMAT_NAME = "pinarms-reachability"
 FORMAT_VERSION = 1
@@ -321,19 +328,53 @@ def _stream(h5, arrays: list, slice_bytes: int) -> None:
             reached = count
 
 
+def _load_sandbox():
+    """The sibling ``_sandbox.py``, loaded by path (this script imports no pinarms module)."""
+    path = Path(__file__).with_name("_sandbox.py")
+    spec = importlib.util.spec_from_file_location("pinarms_reach_child_sandbox", path)
+    sandbox = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sandbox)
+    return sandbox
+
+
+def enter_wall(path: str) -> tuple[str, object]:
+    """Wall this process in before the map is parsed; which wall is up and what h5py is to open.
+
+    The map is opened first (without blocking; anything but a regular file is refused). Under
+    Landlock the process may then read only that file and Python's folders, and h5py opens
+    it by name. Without Landlock a root process drops to the user ``nobody``, which may not
+    reach the map's folder: h5py then reads the file object opened before.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as exc:
+        raise Refused(f"it cannot be opened ({exc.strerror})") from None
+    handle = os.fdopen(fd, "rb", buffering=0)
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        handle.close()
+        raise Refused("it is not a regular file")
+    wall = _load_sandbox().enter_wall([path])
+    if wall.startswith("user nobody"):
+        return wall, handle
+    handle.close()
+    return wall, path
+
+
 def main() -> None:
     import h5py  # imported before the ready frame: the parent's bound on the file's inspection starts there
 
     _send(b"R")
     req = json.loads(sys.stdin.buffer.read(1 << 20))
     try:
+        wall, source = enter_wall(req["path"])
         try:
-            h5 = h5py.File(req["path"], "r", rdcc_nbytes=req["limits"]["max_chunk_bytes"] * 2, rdcc_w0=1.0)
+            h5 = h5py.File(source, "r", rdcc_nbytes=req["limits"]["max_chunk_bytes"] * 2, rdcc_w0=1.0)
         except Exception as exc:  # OSError for a truncated or non-HDF5 file
             raise Refused(f"not an HDF5 file, or truncated ({' '.join(str(exc).split())})") from None
         with h5:
             attrs, arrays = _inspect(h5, req)
-            _send(b"M", json.dumps({"attrs": attrs, "arrays": arrays}, ensure_ascii=False).encode("utf-8"))
+            manifest = {"attrs": attrs, "arrays": arrays, "wall": wall}
+            _send(b"M", json.dumps(manifest, ensure_ascii=False).encode("utf-8"))
             _stream(h5, arrays, req["limits"]["slice_bytes"])
         _send(b"K")
     except Refused as exc:

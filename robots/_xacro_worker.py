@@ -4,8 +4,8 @@ This file runs as a script (``python -I -B _xacro_worker.py``) in a child proces
 with resource limits (address space, CPU time, no file writes, no new processes), an
 empty environment and a wall-clock timeout set by the parent. It imports only the
 standard library, ``xacro`` and ``yaml``, and loads two sibling files by path:
-``xacro_eval.py`` (the expression whitelist) and ``_xacro_sandbox.py`` (the Landlock wall),
-never pinarms itself (nor Pinocchio).
+``xacro_eval.py`` (the expression whitelist) and ``_sandbox.py`` (the Landlock wall, shared
+with the map reader), never pinarms itself (nor Pinocchio).
 
 Protocol: one JSON request on stdin::
 
@@ -24,7 +24,7 @@ The walls, in order:
    after resolving symbolic links, inside one of the allowed ``roots``; ``$(find PKG)``
    resolves only the packages named; ``$(env)``, ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse;
 3. before any file of the request is read, the process walls itself in
-   (:func:`_xacro_sandbox.enter_wall`): it can then write nothing and read only the roots
+   (:func:`_sandbox.enter_wall`): it can then write nothing and read only the roots
    and Python's own folders, whatever code might run.
 """
 
@@ -216,7 +216,7 @@ def main() -> int:
     whitelist = _load_sibling("xacro_eval")
     hooks = _Hooks(xacro, subst, whitelist, roots, packages)
     hooks.install()
-    wall = _load_sibling("_xacro_sandbox").enter_wall(roots)
+    wall = _load_sibling("_sandbox").enter_wall(roots)
 
     args = RecordingArgs({str(k): str(v) for k, v in request.get("args", {}).items()})
     path = request["path"]

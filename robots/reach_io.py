@@ -32,7 +32,10 @@ raise :class:`ReachabilityFileError` naming the member and the problem.
 The HDF5 library runs in a child process (:mod:`robots._reach_worker`, started by
 :mod:`robots._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
 wall-clock time (``timeout`` for opening the file and checking its layout, then 1 s per
-20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before any
+20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before it
+opens the map the child walls itself in (Landlock, :mod:`robots._sandbox`): it may read
+only the map file and Python's folders and write or execute nothing;
+:attr:`ReachabilityMap.reader_wall` says which wall was up. Before any
 data is read, the declared dtypes and shapes are checked against each other (joints,
 orientations, voxels, stored solutions ≤ V·M and = ``n_reached``) and against
 ``max_bytes``, and the storage against what a writer produces (fill value 0, every chunk
@@ -286,12 +289,12 @@ def load_reachability(path: str | os.PathLike, *, solutions: bool = True, max_by
     request = {"path": str(p.resolve()), "solutions": bool(solutions), "max_bytes": int(max_bytes),
                "limits": _CHILD_LIMITS}
     cpu = int(_STARTUP_TIMEOUT + timeout + max_bytes / _MIN_RATE) + 1
-    attrs, arrays = _receive(p, request, float(timeout), cpu)
-    return _check(_Checker(p, attrs, arrays), bool(solutions))
+    attrs, arrays, wall = _receive(p, request, float(timeout), cpu)
+    return _check(_Checker(p, attrs, arrays, wall), bool(solutions))
 
 
-def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, dict[str, np.ndarray]]:
-    """Run the reader child; its checked attributes and arrays."""
+def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, dict[str, np.ndarray], str]:
+    """Run the reader child; its checked attributes and arrays, and the wall it was behind."""
     from ._reach_child import ChildGone, ChildTimeout, ReaderChild
 
     shown = str(p)
@@ -331,7 +334,7 @@ def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, di
     except ChildGone as exc:
         raise ReachabilityFileError(f"{shown!r} is not a valid pinarms reachability map: {_gone(exc.args[0])} while "
                                     f"{stage}") from None
-    return manifest["attrs"], manifest["arrays"]
+    return manifest["attrs"], manifest["arrays"], manifest["wall"]
 
 
 def _gone(status: Any) -> str:
@@ -379,12 +382,14 @@ def _manifest(p: Path, raw: bytes, request: dict) -> dict:
 
     try:
         doc = json.loads(raw.decode("utf-8"))
-        attrs, listed = doc["attrs"], doc["arrays"]
+        attrs, listed, wall = doc["attrs"], doc["arrays"], doc.get("wall", "")
     except (ValueError, KeyError, TypeError, UnicodeDecodeError, RecursionError):
         raise bad("is malformed") from None
     table = list(DATASETS) + (list(POSES) if request["solutions"] and len(listed) > len(DATASETS) else [])
     if not isinstance(attrs, dict) or not isinstance(listed, list) or len(listed) != len(table):
         raise bad("lists other members than a map has")
+    if not isinstance(wall, str) or len(wall) > 100:
+        raise bad("names its wall wrongly")
     dims: dict[str, int] = {}
     arrays: dict[str, np.ndarray] = {}
     total = 0
@@ -401,14 +406,14 @@ def _manifest(p: Path, raw: bytes, request: dict) -> dict:
         if total > request["max_bytes"]:
             raise bad(f"declares more than max_bytes = {request['max_bytes']}")
         arrays[name] = np.empty(tuple(got), dtype=dtype)
-    return {"attrs": attrs, "arrays": arrays}
+    return {"attrs": attrs, "arrays": arrays, "wall": wall}
 
 
 class _Checker:
     """The attributes and arrays the reader sent; each problem becomes a :class:`ReachabilityFileError`."""
 
-    def __init__(self, path: Path, attrs: dict, arrays: dict[str, np.ndarray]) -> None:
-        self.path, self.attrs, self.arrays = path, attrs, arrays
+    def __init__(self, path: Path, attrs: dict, arrays: dict[str, np.ndarray], wall: str = "") -> None:
+        self.path, self.attrs, self.arrays, self.wall = path, attrs, arrays, wall
 
     def fail(self, what: str) -> ReachabilityFileError:
         return ReachabilityFileError(f"{str(self.path)!r} is not a valid pinarms reachability map: {what}")
@@ -480,6 +485,7 @@ def _check(r: _Checker, want_solutions: bool) -> ReachabilityMap:
         manipulability_kind=manip, origin=r.finite("grid/origin"), resolution=resolution,
         shape=(int(shape[0]), int(shape[1]), int(shape[2])), orientations=oset, voxels=flat, reached=reached,
         index=index, best_manipulability=best, solutions=sols, parameters=r.json("/", "parameters", dict),
+        reader_wall=r.wall,
     )
 
 

@@ -469,6 +469,9 @@ class ReachabilityMap:
         solutions: the stored solution per reached pose, or ``None`` (not kept).
         parameters: how the map was made (JSON-able): seed, chunking, IK options, collisions,
             bound, statistics.
+        reader_wall: for a map loaded from a file, the wall its reader process was behind
+            (``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or ``"resource limits
+            only"``); ``""`` for a map built here. Not saved, not compared.
     """
 
     robot: str
@@ -489,6 +492,7 @@ class ReachabilityMap:
     best_manipulability: np.ndarray = field(default=None, repr=False)
     solutions: PoseSolutions | None = field(default=None, repr=False)
     parameters: dict = field(default_factory=dict)
+    reader_wall: str = field(default="", repr=False)
 
     def __post_init__(self) -> None:
         for name in ("joint_lower", "joint_upper", "origin", "voxels", "reached", "index", "best_manipulability"):

@@ -9,7 +9,7 @@ machine's files or hang it, so :func:`expand_xacro` runs xacro in a child proces
 - **memory**: an address-space limit (:attr:`XacroLimits.memory_bytes`) and a cap on the
   size of the URDF text (:attr:`XacroLimits.output_bytes`);
 - **a sandbox**: before reading any file of the request the child walls itself in with
-  Linux Landlock (:mod:`pinarms.robots._xacro_sandbox`): it can write, create or remove
+  Linux Landlock (:mod:`pinarms.robots._sandbox`): it can write, create or remove
   nothing, execute no program, and read only the allowed folders below plus the
   interpreter's standard library and site-packages; it also gets an empty environment and
   may not start processes (resource limit). Without Landlock a root child drops to the

@@ -391,6 +391,7 @@ def test_the_reader_process_runs_under_its_limits():
     (lambda d: d["arrays"][0].update(dtype="|O"), "describes /robot/joint_lower wrongly"),
     (lambda d: d["arrays"].pop(), "lists other members"),
     (lambda d: d["arrays"][7].update(shape=[2**39]), "max_bytes"),
+    (lambda d: d.update(wall=["landlock"]), "names its wall wrongly"),
 ])
 def test_the_parent_checks_the_readers_answer_again(saved, edit, match):
     """A reader that libhdf5 let an attacker control could send anything: the manifest is checked again."""

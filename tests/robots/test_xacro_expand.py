@@ -361,7 +361,7 @@ def test_code_inside_the_sandbox_writes_nothing_and_reads_only_the_allowed_folde
     sibling.mkdir()
     (allowed / "part.txt").write_text("part")
     (sibling / "secret.txt").write_text(SECRET)
-    sandbox = Path(robots.__file__).resolve().parent / "_xacro_sandbox.py"
+    sandbox = Path(robots.__file__).resolve().parent / "_sandbox.py"
     done = subprocess.run([sys.executable, "-I", "-B", "-c", PROBE, str(sandbox), str(allowed), str(sibling)],
                           capture_output=True, text=True, timeout=60, env={},
                           preexec_fn=_limit_resources(XacroLimits()))
@@ -399,7 +399,7 @@ sys.stdout.write(json.dumps(out))
 def test_without_landlock_a_root_child_drops_to_nobody(tmp_path):
     folder = tmp_path / "cell"
     folder.mkdir(mode=0o755)
-    sandbox = Path(robots.__file__).resolve().parent / "_xacro_sandbox.py"
+    sandbox = Path(robots.__file__).resolve().parent / "_sandbox.py"
     done = subprocess.run([sys.executable, "-I", "-B", "-c", FALLBACK, str(sandbox), str(folder)],
                           capture_output=True, text=True, timeout=60, env={})
     assert done.returncode == 0, done.stderr

@@ -1,11 +1,13 @@
-"""The second wall of the xacro child: write nothing, read only the allowed folders.
+"""The second wall of a child process that parses a user's file: write nothing, read only the allowed paths.
 
-Loaded by path by :mod:`pinarms.robots._xacro_worker` (standard library only). After
-:func:`enter_wall` the calling process (and any child it could start) can, whatever code
-it runs:
+Loaded by path (standard library only) by the children that parse users' files:
+:mod:`pinarms.robots._xacro_worker` (xacro files) and :mod:`pinarms.robots._reach_worker`
+(reachability maps). After :func:`enter_wall` the calling process (and any child it could
+start) can, whatever code it runs:
 
-- read files and list folders only below the given folders (the xacro file's folder, the
-  package folders, and the interpreter's standard library and site-packages, read-only);
+- read files and list folders only below the given paths (folders, or single files: the
+  xacro file's folder and the package folders; the one map file) and the interpreter's
+  standard library and site-packages, read-only;
 - create, write, truncate, rename, link or remove nothing anywhere (files already open,
   such as the pipes to the parent, stay usable);
 - execute no file (so it cannot start another program), bind or connect no TCP socket,
@@ -14,15 +16,18 @@ it runs:
 
 The wall is Linux Landlock (kernel ≥ 5.13), set through raw system calls with
 ``no_new_privs``. Without Landlock a process running as root drops to the user ``nobody``
-instead (it can then still read world-readable files); otherwise only the parent's resource
-limits remain. :func:`enter_wall` says which wall is up; the expression whitelist of
-:mod:`pinarms.robots.xacro_eval` is the first wall in every case.
+with a process limit of 0 instead (it can then still read world-readable files, no longer
+files only root may read — a caller opens what it needs first — and start no new process);
+otherwise only the parent's resource limits remain. :func:`enter_wall` says which wall is
+up; for xacro files the expression whitelist of :mod:`pinarms.robots.xacro_eval` is the
+first wall in every case.
 """
 
 from __future__ import annotations
 
 import ctypes
 import os
+import resource
 import sysconfig
 
 __all__ = ["enter_wall", "python_roots"]
@@ -89,6 +94,9 @@ def _landlock(read_roots: list[str]) -> str:
 
 
 def _drop_to_nobody() -> str:
+    # no new processes or threads once it is nobody (root is exempt from the limit; Landlock
+    # needs none); it could still execute a program in place, world-readable files only
+    resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
     os.setgroups([])
     os.setgid(65534)
     os.setuid(65534)
@@ -96,7 +104,7 @@ def _drop_to_nobody() -> str:
 
 
 def enter_wall(read_roots: list[str]) -> str:
-    """Restrict this process to reading ``read_roots`` (and Python's own folders); which wall is up.
+    """Restrict this process to reading ``read_roots`` (folders or files, and Python's own folders); which wall is up.
 
     Returns ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or ``"resource limits only"``.
     """
