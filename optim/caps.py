@@ -21,7 +21,9 @@ from pinarms.optim.errors import SettingOutOfRange
 __all__ = [
     "LIFT_STEP_RANGE", "MAX_LIFT_ATTEMPTS", "MIN_MARGIN", "MAX_DWELL", "MAX_OFFSETS", "MAX_LINE_CYCLE_TIME",
     "MAX_AXIS_VALUES", "MAX_PLACEMENTS", "MAX_POINT_PAIRS", "MAX_REFINE", "MAX_REFINE_EVALUATIONS",
-    "MAX_WORKSPACE_SAMPLES", "count_setting", "number_setting",
+    "MAX_WORKSPACE_SAMPLES", "MAX_PATH_GRID", "MAX_PATH_ROUNDS", "MAX_TIME_SCALED_SAMPLES", "MAX_POPULATION",
+    "MAX_GENERATIONS", "MAX_EXACT_STARTS", "MAX_EXACT_ITERATIONS", "MAX_POLISH_EVALUATIONS",
+    "count_setting", "number_setting",
 ]
 
 #: Range [m] of ``plan_cycle(..., cell=..., lift_step=)``: the rise per re-planning attempt.
@@ -47,6 +49,19 @@ MAX_REFINE = 100
 MAX_REFINE_EVALUATIONS = 10_000
 #: Most workspace samples of a layout search's boundary margins (``workspace_samples``).
 MAX_WORKSPACE_SAMPLES = 10_000_000
+
+#: Most grid intervals and refinement rounds of a time-optimal path timing (``time_optimal(grid=, max_rounds=)``).
+MAX_PATH_GRID = 100_000
+MAX_PATH_ROUNDS = 50
+#: Most instants of a time-scaled path timing (``time_scaled(samples=)``).
+MAX_TIME_SCALED_SAMPLES = 1_000_000
+#: Largest GA population and generation budget (``GASettings``, ``run_ga(max_generations=)``).
+MAX_POPULATION = 10_000
+MAX_GENERATIONS = 1_000_000
+#: Most random starts, SLSQP iterations per start and polishing evaluations of ``solve_exact``.
+MAX_EXACT_STARTS = 1000
+MAX_EXACT_ITERATIONS = 10_000
+MAX_POLISH_EVALUATIONS = 1_000_000
 
 
 def count_setting(value: Any, name: str, least: int, most: int) -> int:

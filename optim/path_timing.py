@@ -42,6 +42,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pinarms.optim.caps import MAX_PATH_GRID, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES, count_setting
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
 from pinarms.optim.reachability import reachability_profile
 from pinarms.planning import Trajectory
@@ -457,8 +458,8 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
         raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
     if not (hasattr(path, "sample") and hasattr(path, "breaks") and hasattr(path, "coefficients")):
         raise InvalidSettings(f"path must be a planning.JointPath, got {type(path).__name__}")
-    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 1:
-        raise InvalidSettings(f"grid must be a positive number of intervals, got {grid!r}")
+    count_setting(grid, "grid (intervals over the path)", 1, MAX_PATH_GRID)
+    count_setting(max_rounds, "max_rounds (grid refinements)", 0, MAX_PATH_ROUNDS)
     for name, value in (("start_speed", start_speed), ("end_speed", end_speed)):
         if not (isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value >= 0.0):
             raise InvalidSettings(f"{name} must be a finite ṡ >= 0, got {value!r}")
@@ -540,8 +541,7 @@ def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str 
         raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
     if shape not in SHAPES:
         raise InvalidSettings(f"shape must be one of {sorted(SHAPES)}, got {shape!r}")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 3:
-        raise InvalidSettings(f"samples must be an integer >= 3, got {samples!r}")
+    count_setting(samples, "samples (instants of the time scaling)", 3, MAX_TIME_SCALED_SAMPLES)
     sig = np.array(SHAPES[shape])
     tau = np.linspace(0.0, 1.0, int(samples))
     d1 = np.polynomial.polynomial.polyval(tau, sig[1:] * np.arange(1, sig.size))
