@@ -107,6 +107,8 @@ def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed
     Each coordinate is a number (fixed) or ``(lo, hi)`` [m, yaw in rad]; the draws are made
     column by column in the order x, y, z, yaw (fixed coordinates draw nothing).
     """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InvalidInput(f"n must be a positive number of placements, got {n!r}")
     n = count_setting(n, "n (random placements)", 1, MAX_PLACEMENTS)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
