@@ -13,6 +13,8 @@ Probabilities are per pair (crossover) and per gene (mutation). The two presets:
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, replace
 
 from pinarms.optim.caps import MAX_GENERATIONS, MAX_POPULATION
@@ -106,7 +108,9 @@ class GASettings:
         def bad(name: str, value: object, what: str) -> InvalidSettings:
             return InvalidSettings(f"GASettings.{name}={value!r}: {what}")
 
-        if int(self.population) != self.population or not 4 <= self.population <= MAX_POPULATION:
+        pop = self.population
+        if isinstance(pop, bool) or not isinstance(pop, numbers.Real) or not math.isfinite(pop) or int(pop) != pop \
+                or not 4 <= pop <= MAX_POPULATION:
             raise bad("population", self.population, f"use an integer from 4 to {MAX_POPULATION:,}")
         if self.selection not in SELECTIONS:
             raise bad("selection", self.selection, f"use one of {SELECTIONS}")

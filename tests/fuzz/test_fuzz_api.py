@@ -396,29 +396,35 @@ def test_schedule_line_settings(line_cycles, data):
         assert result.period > 0 and set(result.offsets) == set(cycles)
 
 
-@settings(max_examples=8 * EXPLORE)
+def _layout_summary(*args, **kwargs):
+    """search_layout's ranking (picks/min is 0 where a placement fails; its cycle time is NaN there by design)."""
+    res = optim.search_layout(*args, **kwargs)
+    return res.failure, res.picks_per_minute, res.best_picks_per_minute, res.margin
+
+
+@settings(max_examples=6 * EXPLORE)
 @given(data=st.data())
 def test_search_layout_settings(arms, data):
     robot = arms["scara_mushroom"]
     arg = Plan(data, ["axis", "refine", "refine_evaluations", "workspace_samples", "chunk_size", "min_margin", "n"])
-    axis = arg("axis", st.sampled_from([0.0, (0.0, 0.05, 0.05)]),
+    axis = arg("axis", st.just(0.0),  # one placement: one cycle per valid call
                st.one_of(st.tuples(st.just(0.0), st.sampled_from([1.0, 1e300]), _huge_or_tiny), _odd_setting))
     if data.draw(st.booleans(), label="random placements"):
-        n = arg("n", st.integers(1, 2), st.one_of(_odd_setting, st.just(10**12)))
+        n = arg("n", st.just(1), st.one_of(_odd_setting, st.just(10**12)))
         bounds = axis if isinstance(axis, float) else (0.0, 0.05)
         cand, err = outcome(optim.random_candidates, n, x=bounds, y=0.0, seed=1)
     else:
         cand, err = outcome(optim.grid_candidates, x=axis, y=0.0)
     if err is not None:
         return
-    kwargs = dict(refine=arg("refine", st.integers(0, 1), st.one_of(_odd_setting, st.just(10**9))),
+    kwargs = dict(refine=arg("refine", st.just(0), st.one_of(_odd_setting, st.just(10**9))),
                   refine_evaluations=arg("refine_evaluations", st.integers(1, 2), _odd_setting),
                   workspace_samples=arg("workspace_samples", st.just(1000), st.one_of(_odd_setting, st.just(10**15))),
                   chunk_size=arg("chunk_size", st.integers(1, 4), _odd_setting),
                   min_margin=arg("min_margin", st.floats(0.0, 0.01), _odd_setting))
-    result, err = outcome(optim.search_layout, robot, _PICK, _PLACE, cand, **kwargs, seconds=40)
+    result, err = outcome(_layout_summary, robot, _PICK, _PLACE, cand, **kwargs, seconds=40)
     if err is None:
-        assert len(result.failure) == len(cand)
+        assert len(result[0]) == len(cand)
 
 
 @settings(max_examples=30 * EXPLORE)
