@@ -74,6 +74,18 @@ def test_a_malformed_scheduler_address_is_one_line(run, address):
     one_error_line(result, repr(address))
 
 
+def test_reach_checks_its_scheduler_address_too(run):
+    one_error_line(run("reach", "scara_mushroom", "--scheduler", "tcp://host:port"), "tcp://host:port")
+
+
+def test_a_line_tolerance_below_a_nanometre_is_refused_at_once(run):
+    t0 = time.perf_counter()
+    result = run("line", "aubo_i3", "--from", "350", "200", "0", "--to", "350", "200", "300", "--mm",
+                 "--tolerance", "1e-300")
+    assert time.perf_counter() - t0 < 5.0
+    one_error_line(result, "tolerance", "1e-09 m")
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
