@@ -19,9 +19,10 @@ import numpy as np
 from pinarms.optim.errors import SettingOutOfRange
 
 __all__ = [
-    "LIFT_STEP_RANGE", "MAX_LIFT_ATTEMPTS", "MIN_MARGIN", "MAX_DWELL", "MAX_OFFSETS", "MAX_LINE_CYCLE_TIME",
+    "LIFT_STEP_RANGE", "MAX_LIFT_ATTEMPTS", "MAX_CLEARANCE", "MIN_MARGIN", "MAX_DWELL", "MAX_OFFSETS", "MAX_LINE_CYCLE_TIME",
     "MAX_AXIS_VALUES", "MAX_PLACEMENTS", "MAX_POINT_PAIRS", "MAX_REFINE", "MAX_REFINE_EVALUATIONS",
-    "MAX_WORKSPACE_SAMPLES", "MAX_PATH_GRID", "MAX_PATH_ROUNDS", "MAX_TIME_SCALED_SAMPLES", "MAX_POPULATION",
+    "MAX_WORKSPACE_SAMPLES", "MAX_PATH_GRID", "MAX_PATH_ROUNDS", "MAX_PATH_GRID_POINTS",
+    "MIN_PATH_KAPPA", "MIN_PATH_RTOL", "MAX_TIME_SCALED_SAMPLES", "MAX_POPULATION",
     "MAX_GENERATIONS", "MAX_EXACT_STARTS", "MAX_EXACT_ITERATIONS", "MAX_POLISH_EVALUATIONS",
     "count_setting", "number_setting",
 ]
@@ -30,6 +31,8 @@ __all__ = [
 LIFT_STEP_RANGE = (1e-3, 1.0)
 #: Raised-lift attempts of one in-cell cycle before via points are tried (50 × 20 mm = 1 m).
 MAX_LIFT_ATTEMPTS = 50
+#: Largest clearance [m] a cycle or a line schedule may ask of fixtures and other arms.
+MAX_CLEARANCE = 1.0
 #: Smallest resolution [m] of the continuous checks of a cycle or a line schedule (``margin``).
 MIN_MARGIN = 1e-3
 #: Longest gripper dwell [s] at the pick and at the place (``PickPlace.dwell``).
@@ -53,6 +56,11 @@ MAX_WORKSPACE_SAMPLES = 10_000_000
 #: Most grid intervals and refinement rounds of a time-optimal path timing (``time_optimal(grid=, max_rounds=)``).
 MAX_PATH_GRID = 100_000
 MAX_PATH_ROUNDS = 50
+#: Most points the grid of a time-optimal path timing may grow to while refining (a named error past it),
+#: and the smallest ``kappa`` and ``rtol`` of that refinement.
+MAX_PATH_GRID_POINTS = 1_000_000
+MIN_PATH_KAPPA = 1e-4
+MIN_PATH_RTOL = 1e-6
 #: Most instants of a time-scaled path timing (``time_scaled(samples=)``).
 MAX_TIME_SCALED_SAMPLES = 1_000_000
 #: Largest GA population and generation budget (``GASettings``, ``run_ga(max_generations=)``).

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_LIFT_ATTEMPTS, MIN_MARGIN, number_setting
+from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MAX_LIFT_ATTEMPTS, MIN_MARGIN, number_setting
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell"]
@@ -133,7 +133,7 @@ def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, ar
     """
     from pinarms.robots.cell import ArmMotion
 
-    clearance = number_setting(clearance, "clearance", 0.0, unit="m")
+    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
     lift_step = number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
     margin = number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
     cell_arm = _arm_of(cell, robot, arm)

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_DWELL, MIN_MARGIN, number_setting
+from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MAX_DWELL, MIN_MARGIN, number_setting
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.problem import check_limit
 from pinarms.optim.timing import TimingResult, minimize_time
@@ -391,7 +391,7 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
             URDF has none.
         InvalidSettings: unknown ``method``; ``SettingOutOfRange``: ``lift_step`` outside
             :data:`optim.caps.LIFT_STEP_RANGE`, ``margin`` below :data:`optim.caps.MIN_MARGIN`,
-            a negative or non-finite ``clearance``, a ``tool_speed`` that is not > 0.
+            a ``clearance`` outside 0 … 1 m, a ``tool_speed`` that is not > 0.
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
@@ -494,7 +494,7 @@ def _check_cycle_settings(*, lift_step: Any, margin: Any, clearance: Any, tool_s
     """The cell and straight-line settings of :func:`plan_cycle`, checked before any work (optim.caps)."""
     number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
     number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
-    number_setting(clearance, "clearance", 0.0, unit="m")
+    number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
     if tool_speed is not None:
         number_setting(tool_speed, "tool_speed", 0.0, open_low=True, unit="m/s")
 

@@ -41,8 +41,8 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.optim.cycle import CYCLE_KINDS, CycleResult, PickPlace, plan_cycle
-from pinarms.optim.caps import (MAX_AXIS_VALUES, MAX_PLACEMENTS, MAX_POINT_PAIRS, MAX_REFINE, MAX_REFINE_EVALUATIONS,
-                               MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
+from pinarms.optim.caps import (MAX_AXIS_VALUES, MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, MAX_REFINE,
+                               MAX_REFINE_EVALUATIONS, MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput, LimitViolation, PinarmsError, UnreachableTarget
 
@@ -659,9 +659,7 @@ def search_layout(
                 raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
             arm = cell.arms[0].name
         robot = cell.arm(arm).robot
-        if not (isinstance(clearance, (int, float, np.integer, np.floating)) and np.isfinite(clearance)
-                and clearance >= 0):
-            raise InvalidInput(f"clearance must be a distance >= 0 in m, got {clearance!r}")
+        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
         for name in carry:
             cell.fixture(name)
         recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),

@@ -25,7 +25,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from pinarms.optim.caps import MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting, number_setting
+from pinarms.optim.caps import MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting, number_setting
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput
 
@@ -176,7 +176,7 @@ def schedule_line(
     if len(names) < 2:
         raise InvalidInput("schedule_line needs the cycles of at least two arms")
     n_offsets = count_setting(n_offsets, "n_offsets (time offsets scanned per arm)", 2, MAX_OFFSETS)
-    clearance = number_setting(clearance, "clearance", 0.0, unit="m")
+    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
     margin = number_setting(margin, "margin (resolution of the continuous checks)", MIN_MARGIN, unit="m")
     for name in names:
         arm = cell.arm(name)

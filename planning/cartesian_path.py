@@ -49,15 +49,13 @@ from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
 from pinarms.robots.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
-__all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE",
-           "MIN_TOLERANCE"]
+__all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
 
 #: Default largest tcp deviation from the tool path [m] (0.1 mm).
 DEFAULT_TOLERANCE = 1e-4
 #: Default smallest singular value of the weighted Jacobian [m/rad] below which the arm counts as singular.
 DEFAULT_SINGULAR_TOLERANCE = 1e-4
-#: Smallest tcp position tolerance [m] of a joint image (1 nm; a tighter one refines for minutes on rounding noise).
-MIN_TOLERANCE = 1e-9
+MIN_TOLERANCE = 1e-9  #: smallest tolerance [m]: a tighter one refines for minutes on rounding noise
 #: Newton's method stops when the position error [m] and the weighted rotation error [m] are below this.
 _NEWTON_TOL = 1e-11
 _NEWTON_ITERATIONS = 8
@@ -428,8 +426,7 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
         robot: a :class:`robots.Robot` (``fk``, ``jacobian``, ``lower``/``upper``, ``ik`` or
             ``ik_branches``, ``ik_failure_reason``).
         path: the :class:`planning.ToolPath` (tcp → base poses, m).
-        tolerance: largest tcp position deviation [m] (default 0.1 mm, at least
-            :data:`MIN_TOLERANCE` = 1 nm); the orientation's is
+        tolerance: largest tcp position deviation [m] (default 0.1 mm); the orientation's is
             ``tolerance / path.weight`` rad.
         q_start: configuration (nq,) selecting the branch: the path starts at the IK solution
             nearest to it (itself if its tcp is at the start pose). Default: each closed-form
@@ -451,9 +448,8 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     if not isinstance(path, ToolPath):
         raise TrajectoryError(f"path must be a planning.ToolPath, got {type(path).__name__}")
     tol = _positive(tolerance, "tolerance [m]")
-    if tol < MIN_TOLERANCE:  # below it the refinement runs for minutes on rounding noise
-        raise TrajectoryError(f"tolerance {tol:g} m is below {MIN_TOLERANCE:g} m (1 nm), finer than the arm's own "
-                              "kinematic accuracy: give 1e-9 m or more")
+    if tol < MIN_TOLERANCE:
+        raise TrajectoryError(f"tolerance {tol:g} m is below {MIN_TOLERANCE:g} m (1 nm): give 1e-9 m or more")
     sing = _positive(singular_tolerance, "singular_tolerance [m/rad]")
     loc = _positive(locate, "locate [m]")
     nq = int(robot.nq)

@@ -208,7 +208,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     if len(tasks) >= 2:
         caps.count_setting(n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
     caps.number_setting(dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
-    caps.number_setting(clearance * k, "--clearance", 0.0, unit="m")
+    caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
     caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
     caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
     c = _load(cell, xacro_args, packages)

@@ -83,7 +83,7 @@ def test_a_line_tolerance_below_a_nanometre_is_refused_at_once(run):
     result = run("line", "aubo_i3", "--from", "350", "200", "0", "--to", "350", "200", "300", "--mm",
                  "--tolerance", "1e-300")
     assert time.perf_counter() - t0 < 5.0
-    one_error_line(result, "tolerance", "1e-09 m")
+    one_error_line(result, "tolerance", "1e-09 m (1 nm)")
 
 
 def _free_port() -> int:

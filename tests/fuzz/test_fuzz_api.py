@@ -386,12 +386,12 @@ def line_cycles():
 def test_schedule_line_settings(line_cycles, data):
     cell, cycles = line_cycles
     arg = Plan(data, ["n_offsets", "margin", "clearance"])
-    # valid scans that finish in about a second (3 offsets of these cycles clear at no period: 11 periods scanned)
-    n_offsets = arg("n_offsets", st.sampled_from([2, 4]), st.one_of(_odd_setting, st.just(10**9)))
+    # valid scans of 2 offsets: a second when the first period clears, 22 checks when none does
+    n_offsets = arg("n_offsets", st.just(2), st.one_of(_odd_setting, st.just(10**9)))
     margin = arg("margin", st.floats(0.01, 0.05), _odd_setting)
     clearance = arg("clearance", st.just(0.0), _odd_setting)
     result, err = outcome(optim.schedule_line, cell, cycles, n_offsets=n_offsets, margin=margin,
-                          clearance=clearance, seconds=30)
+                          clearance=clearance, seconds=60)
     if err is None:
         assert result.period > 0 and set(result.offsets) == set(cycles)
 

@@ -115,6 +115,15 @@ def test_time_optimal_grid_and_time_scaled_samples_are_capped():
     refused_at_once(lambda: optim.time_optimal(path, cons, grid=10**9), "grid", "100,000")
     refused_at_once(lambda: optim.time_optimal(path, cons, max_rounds=10**6), "max_rounds")
     refused_at_once(lambda: optim.time_scaled(path, cons, samples=10**10), "samples")
+    # a tiny kappa or rtol once refined the grid 20 or 50 times over (10^8 points and more)
+    refused_at_once(lambda: optim.time_optimal(path, cons, kappa=5e-324), "kappa", "0.0001")
+    refused_at_once(lambda: optim.time_optimal(path, cons, rtol=1e-300), "rtol", "1e-06")
+
+
+def test_a_clearance_is_at_most_a_metre(scara):
+    spec = optim.PickPlace(PICK, PLACE)
+    refused_at_once(lambda: optim.plan_cycle(scara, spec, clearance=1e300), "clearance", "1 m")
+    refused_at_once(lambda: optim.schedule_line(None, {"a": None, "b": None}, clearance=2.0), "clearance")
 
 
 def test_ga_population_and_generations_are_capped():
