@@ -47,7 +47,8 @@ from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_GRID_POINTS, MAX_PATH_RO
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.optim.reachability import reachability_profile
 from pinarms.planning import Trajectory
-from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples, _limit
+from pinarms.optim.problem import check_limit
+from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 from pinarms.planning.trajectory import taylor_shift
 
@@ -479,7 +480,7 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
     jmax = None
     if jerk is not None:
         try:
-            jmax = _limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]")
+            jmax = check_limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]", required=True)  # in LIMIT_RANGE
         except Exception as exc:
             raise InvalidSettings(str(exc)) from None
         if start_speed or end_speed:

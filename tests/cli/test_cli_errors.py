@@ -86,6 +86,11 @@ def test_a_line_tolerance_below_a_nanometre_is_refused_at_once(run):
     one_error_line(result, "tolerance", "1e-09 m (1 nm)")
 
 
+def test_a_voxel_too_fine_for_memory_is_refused_before_the_sweep(run):
+    # 1e-9 mm voxels once reached a chunk and came back as numpy's "array is too big"
+    one_error_line(run("workspace", "ur5", "--stream", "--voxel", "1e-9", "-n", "1000"), "voxel_size", "1e+08")
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
