@@ -109,8 +109,9 @@ class GASettings:
             return InvalidSettings(f"GASettings.{name}={value!r}: {what}")
 
         pop = self.population
-        if isinstance(pop, bool) or not isinstance(pop, numbers.Real) or not math.isfinite(pop) or int(pop) != pop \
-                or not 4 <= pop <= MAX_POPULATION:
+        if isinstance(pop, bool) or not isinstance(pop, numbers.Real):
+            raise TypeError("population")  # named with the other non-numbers by __post_init__
+        if not math.isfinite(pop) or int(pop) != pop or not 4 <= pop <= MAX_POPULATION:
             raise bad("population", self.population, f"use an integer from 4 to {MAX_POPULATION:,}")
         if self.selection not in SELECTIONS:
             raise bad("selection", self.selection, f"use one of {SELECTIONS}")
