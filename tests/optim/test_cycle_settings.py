@@ -61,9 +61,9 @@ def test_plan_cycle_refuses_a_lift_step_outside_its_range(scara, lift_step):
     refused_at_once(lambda: optim.plan_cycle(scara, spec, lift_step=lift_step), "lift_step", "0.001")
 
 
-@pytest.mark.parametrize("name, value, word", [("margin", 1e-9, "margin"), ("margin", math.nan, "margin"),
-                                               ("clearance", -0.01, "clearance"), ("clearance", math.inf, "clearance"),
-                                               ("tool_speed", 0.0, "tool_speed"), ("tool_speed", math.nan, "tool_speed")])
+@pytest.mark.parametrize("name, value, word", [
+    ("margin", 1e-9, "margin"), ("margin", math.nan, "margin"), ("clearance", -0.01, "clearance"),
+    ("clearance", math.inf, "clearance"), ("tool_speed", 0.0, "tool_speed"), ("tool_speed", math.nan, "tool_speed")])
 def test_plan_cycle_refuses_bad_cell_and_line_settings(scara, name, value, word):
     spec = optim.PickPlace(PICK, PLACE)
     refused_at_once(lambda: optim.plan_cycle(scara, spec, **{name: value}), word)
