@@ -22,7 +22,8 @@ from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
-                                  InvalidSettings, NoPathFound, OptimError, PlanningError, StartInCollision)
+                                  InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
+                                  StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
@@ -76,6 +77,7 @@ __all__ = [
     "InfeasibleProblem",
     "InvalidLimits",
     "InvalidSettings",
+    "SettingOutOfRange",
     "plan_motion",
     "MotionPlan",
     "PlanningError",

@@ -8,7 +8,8 @@ not touch (they are designed close, so no clearance is asked of them). When the 
 fails, the cycle is re-planned, in this order, until it passes:
 
 1. **raise the transfer**: the vertical lift at pick and place grows by ``lift_step``
-   (the transfer then starts and ends higher), up to the highest lift the arm reaches;
+   (the transfer then starts and ends higher), up to the highest lift the arm reaches or
+   :data:`optim.caps.MAX_LIFT_ATTEMPTS` rises;
 2. **add a via point** above the middle of the transfer (between "above pick" and
    "above place", at the highest lifted height plus ``lift_step`` per attempt, three
    heights), then two via points at one and two thirds;
@@ -32,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MAX_LIFT_ATTEMPTS, MIN_MARGIN, number_setting
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell"]
@@ -131,11 +133,9 @@ def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, ar
     """
     from pinarms.robots.cell import ArmMotion
 
-    clearance = float(clearance)
-    if not np.isfinite(clearance) or clearance < 0.0:
-        raise InvalidInput(f"clearance must be a finite number >= 0 [m], got {clearance!r}")
-    if not (np.isfinite(lift_step) and lift_step > 0.0):
-        raise InvalidInput(f"lift_step must be > 0 m, got {lift_step!r}")
+    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+    lift_step = number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
+    margin = number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
     cell_arm = _arm_of(cell, robot, arm)
     external = cell.with_pairs("external")
     own = cell.with_pairs("self") if any(p.kind == "self" and p.owner_a == cell_arm.name for p in cell.pairs) else None
@@ -169,7 +169,9 @@ def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, ar
 
     ok, result, ext = attempt(f"lift {spec.lift:.3f} m", spec)
     lift = spec.lift
-    while not ok:
+    for _ in range(MAX_LIFT_ATTEMPTS):  # bounded: the arm's reach usually ends the rise first
+        if ok:
+            break
         lift += lift_step
         try:
             ok, result, ext = attempt(f"lift {lift:.3f} m", dataclasses.replace(spec, lift=lift))

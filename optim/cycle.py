@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MAX_DWELL, MIN_MARGIN, number_setting
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.problem import check_limit
 from pinarms.optim.timing import TimingResult, minimize_time
@@ -100,7 +101,8 @@ class PickPlace:
         place: where the tcp releases, same form.
         lift: height [m] of the vertical approach and retreat at pick and place (> 0),
             along the base's +z.
-        dwell: time [s] the arm stays at rest at the pick and at the place for the gripper (≥ 0).
+        dwell: time [s] the arm stays at rest at the pick and at the place for the gripper
+            (0 to :data:`optim.caps.MAX_DWELL`).
         via: transfer waypoints between "above pick" and "above place" (positions (3,) or
             poses (4, 4), in order); the return move passes them in reverse.
         orientation: tool orientation (3, 3) of the targets given as positions; default
@@ -108,7 +110,8 @@ class PickPlace:
             the neutral orientation on SCARA, gantry and koji arm).
 
     Raises:
-        InvalidInput: a malformed point, NaN/inf, ``lift <= 0`` or ``dwell < 0``.
+        InvalidInput: a malformed point, NaN/inf, ``lift <= 0``; ``SettingOutOfRange`` (an
+            ``InvalidInput``): ``dwell`` outside 0 … :data:`optim.caps.MAX_DWELL`.
     """
 
     pick: Any
@@ -124,9 +127,7 @@ class PickPlace:
         lift = _finite_number(self.lift, "lift [m]")
         if lift <= 0.0:
             raise InvalidInput(f"lift [m] must be > 0 (the vertical approach/retreat height), got {self.lift!r}")
-        dwell = _finite_number(self.dwell, "dwell [s]")
-        if dwell < 0.0:
-            raise InvalidInput(f"dwell [s] must be >= 0 (gripper time at pick and place), got {self.dwell!r}")
+        dwell = number_setting(self.dwell, "dwell (gripper time at pick and place)", 0.0, MAX_DWELL, unit="s")
         object.__setattr__(self, "lift", lift)
         object.__setattr__(self, "dwell", dwell)
         via = self.via
@@ -388,7 +389,9 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         InvalidInput: ``spec`` is not a :class:`PickPlace`, or a bad ``q_start``/``kind``.
         InvalidLimits: a limit ≤ 0, NaN/inf or of the wrong shape, or no ``vmax`` and the
             URDF has none.
-        InvalidSettings: unknown ``method``.
+        InvalidSettings: unknown ``method``; ``SettingOutOfRange``: ``lift_step`` outside
+            :data:`optim.caps.LIFT_STEP_RANGE`, ``margin`` below :data:`optim.caps.MIN_MARGIN`,
+            a ``clearance`` outside 0 … 1 m, a ``tool_speed`` that is not > 0.
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
@@ -396,6 +399,7 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
             re-planned cycle keeps the clearance; the message names the blocking bodies.
     """
+    _check_cycle_settings(lift_step=lift_step, margin=margin, clearance=clearance, tool_speed=tool_speed)
     if cell is not None:
         from pinarms.optim.cell_cycle import plan_cycle_in_cell
 
@@ -484,6 +488,15 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
         payload=None if loaded is None else loaded.robot.payload,
         torque_limit=None if loaded is None else loaded.limit.copy(),
     )
+
+
+def _check_cycle_settings(*, lift_step: Any, margin: Any, clearance: Any, tool_speed: Any) -> None:
+    """The cell and straight-line settings of :func:`plan_cycle`, checked before any work (optim.caps)."""
+    number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
+    number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
+    number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+    if tool_speed is not None:
+        number_setting(tool_speed, "tool_speed", 0.0, open_low=True, unit="m/s")
 
 
 def _branch_labels(robot: Any, poses: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -22,7 +22,8 @@ import numpy as np
 from pinarms.optim import adaptive, crossover, mutation, selection
 from pinarms.optim.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feasibility_rules,
                                rank_penalty, violation)
-from pinarms.optim.errors import InvalidSettings
+from pinarms.optim.caps import MAX_GENERATIONS
+from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
 from pinarms.optim.settings import GASettings
 
 __all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress", "random_generator"]
@@ -230,6 +231,8 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
     lower, upper = _check_bounds(bounds)
     rng = random_generator(seed)
     G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
+    if G > MAX_GENERATIONS:
+        raise SettingOutOfRange(f"max_generations = {G:,} is more than the {MAX_GENERATIONS:,} allowed")
     stall = (settings.stall_generations if stall_generations is None
              else _count(stall_generations, "stall_generations", 1))
     if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))

@@ -6,9 +6,9 @@ catches everything pinarms raises on purpose.
 
 from __future__ import annotations
 
-from pinarms.robots.errors import CollisionError, PinarmsError
+from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError
 
-__all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "PlanningError",
+__all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "SettingOutOfRange", "PlanningError",
            "EndpointInCollision", "StartInCollision", "GoalInCollision", "NoPathFound"]
 
 
@@ -30,6 +30,14 @@ class InvalidLimits(OptimError, ValueError):
 
 class InvalidSettings(OptimError, ValueError):
     """A GA setting, a bound or an argument of an optimiser is out of range."""
+
+
+class SettingOutOfRange(InvalidSettings, InvalidInput):
+    """A setting (a count, a step, a time, a grid size) is not a finite number inside its cap.
+
+    The message names the setting, its value and the range allowed (:mod:`optim.caps`).
+    Caught by ``except InvalidSettings`` and by ``except InvalidInput`` alike.
+    """
 
 
 class PlanningError(OptimError):

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
+from pinarms.optim.caps import MAX_EXACT_ITERATIONS, MAX_EXACT_STARTS, MAX_POLISH_EVALUATIONS, count_setting
 from pinarms.optim.problem import SAFETY, TimingProblem
 
 __all__ = ["ExactSolution", "solve_exact", "start_ratios", "scaled_to_limits", "polish_durations"]
@@ -137,6 +138,11 @@ def solve_exact(problem: TimingProblem, n_random: int = 0, seed: int = 0,
         maxiter: SLSQP iterations per start.
         polish_evaluations: Nelder-Mead budget (default 150 per segment).
     """
+    count_setting(n_random, "n_random (random starts)", 0, MAX_EXACT_STARTS)
+    count_setting(seed, "seed", 0, 2**64 - 1)
+    count_setting(maxiter, "maxiter (SLSQP iterations per start)", 1, MAX_EXACT_ITERATIONS)
+    if polish_evaluations is not None:
+        count_setting(polish_evaluations, "polish_evaluations", 0, MAX_POLISH_EVALUATIONS)
     before = problem.evaluations
     best_h, best_total, best_ok = None, np.inf, False
     seen: list[np.ndarray] = []

@@ -33,6 +33,7 @@ Units: m, rad, s; yaw about the line frame's vertical axis (the base stands upri
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -40,7 +41,9 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.optim.cycle import CYCLE_KINDS, CycleResult, PickPlace, plan_cycle
-from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
+from pinarms.optim.caps import (MAX_AXIS_VALUES, MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, MAX_REFINE,
+                               MAX_REFINE_EVALUATIONS, MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
+from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput, LimitViolation, PinarmsError, UnreachableTarget
 
 __all__ = [
@@ -75,9 +78,11 @@ def _axis(value: Any, name: str) -> np.ndarray:
         raise InvalidInput(f"{name} must be a number or (lo, hi, step) in {unit}, got {value!r}") from exc
     if not (np.isfinite(lo) and np.isfinite(hi) and np.isfinite(step)) or step <= 0 or hi < lo:
         raise InvalidInput(f"{name} = ({lo}, {hi}, {step}): need finite lo <= hi and step > 0 [{unit}]")
-    count = int(np.floor((hi - lo) / step + 1e-9)) + 1
-    if count > 1_000_000:
-        raise InvalidInput(f"{name} = ({lo}, {hi}, {step}) gives {count} values: use a larger step")
+    span = (hi - lo) / step  # may be inf for a tiny step: compared before any int()
+    if not span < MAX_AXIS_VALUES:
+        raise SettingOutOfRange(f"{name} = ({lo}, {hi}, {step}) gives more than {MAX_AXIS_VALUES:,} values, the most "
+                                "one grid coordinate may have: use a larger step")
+    count = int(np.floor(span + 1e-9)) + 1
     return lo + step * np.arange(count)
 
 
@@ -88,9 +93,10 @@ def grid_candidates(x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0) -> np.ndarray:
     ``x`` varying slowest and ``yaw`` fastest.
     """
     axes = [_axis(v, n) for v, n in zip((x, y, z, yaw), AXES)]
-    count = int(np.prod([a.size for a in axes]))
-    if count > 10_000_000:
-        raise InvalidInput(f"the grid has {count} placements: use larger steps or random_candidates")
+    count = math.prod(int(a.size) for a in axes)  # Python ints: no wrap-around
+    if count > MAX_PLACEMENTS:
+        raise SettingOutOfRange(f"the grid has {count:,} placements, more than the {MAX_PLACEMENTS:,} a layout search "
+                                "takes: use larger steps or random_candidates")
     mesh = np.meshgrid(*axes, indexing="ij")
     return np.column_stack([m.reshape(-1) for m in mesh])
 
@@ -103,6 +109,7 @@ def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise InvalidInput(f"n must be a positive number of placements, got {n!r}")
+    n = count_setting(n, "n (random placements)", 1, MAX_PLACEMENTS)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
     rng = np.random.default_rng(int(seed))
@@ -652,9 +659,7 @@ def search_layout(
                 raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
             arm = cell.arms[0].name
         robot = cell.arm(arm).robot
-        if not (isinstance(clearance, (int, float, np.integer, np.floating)) and np.isfinite(clearance)
-                and clearance >= 0):
-            raise InvalidInput(f"clearance must be a distance >= 0 in m, got {clearance!r}")
+        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
         for name in carry:
             cell.fixture(name)
         recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
@@ -671,11 +676,16 @@ def search_layout(
         raise InvalidInput(f"candidates must be finite placements (M, 4) = (x, y, z, yaw) [m, rad], got shape {cand.shape}")
     if kind not in CYCLE_KINDS:
         raise InvalidSettings(f"kind={kind!r}: use one of {CYCLE_KINDS}")
-    for name, v, least in (("refine", refine, 0), ("refine_evaluations", refine_evaluations, 1),
-                           ("workspace_samples", workspace_samples, 1000), ("chunk_size", chunk_size, 1),
-                           ("seed", seed, 0)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
-            raise InvalidInput(f"{name} must be an integer >= {least}, got {v!r}")
+    if cand.shape[0] > MAX_PLACEMENTS:
+        raise SettingOutOfRange(f"{cand.shape[0]:,} candidates, more than the {MAX_PLACEMENTS:,} a layout search takes")
+    if len(picks_w) * len(places_w) > MAX_POINT_PAIRS:
+        raise SettingOutOfRange(f"{len(picks_w)} picks × {len(places_w)} places = {len(picks_w) * len(places_w):,} "
+                                f"cycles per placement, more than the {MAX_POINT_PAIRS:,} allowed: give fewer points")
+    for name, v, least, most in (("refine", refine, 0, MAX_REFINE),
+                                 ("refine_evaluations", refine_evaluations, 1, MAX_REFINE_EVALUATIONS),
+                                 ("workspace_samples", workspace_samples, 1000, MAX_WORKSPACE_SAMPLES),
+                                 ("chunk_size", chunk_size, 1, MAX_PLACEMENTS), ("seed", seed, 0, 2**64 - 1)):
+        count_setting(v, name, least, most)
     R = None
     if orientation is not None:
         R = np.asarray(orientation, dtype=float)
@@ -683,9 +693,7 @@ def search_layout(
                 or np.linalg.det(R) < 0:
             raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
     PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
-    if not (isinstance(min_margin, (int, float, np.integer, np.floating)) and np.isfinite(min_margin)
-            and min_margin >= 0):
-        raise InvalidInput(f"min_margin must be a distance >= 0 in m, got {min_margin!r}")
+    number_setting(min_margin, "min_margin", 0.0, unit="m")
     st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
     M = cand.shape[0]
 

@@ -42,10 +42,13 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
+from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_GRID_POINTS, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES,
+                               MIN_PATH_KAPPA, MIN_PATH_RTOL, count_setting)
+from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.optim.reachability import reachability_profile
 from pinarms.planning import Trajectory
-from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples, _limit
+from pinarms.optim.problem import check_limit
+from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 from pinarms.planning.trajectory import taylor_shift
 
@@ -185,8 +188,16 @@ def _grid(path: Any, a: float, b: float, total: float, n: int, kappa: float) -> 
         bad = np.abs(dq_end - dq).max(axis=1) > kappa * size
         if not bad.any():
             break
-        g = np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])[bad]]))
+        g = _grown(np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])[bad]])), "kappa")
     return g
+
+
+def _grown(grid: np.ndarray, what: str) -> np.ndarray:
+    """``grid`` unless refining made it larger than the cap (then a named error, never a runaway)."""
+    if grid.size > MAX_PATH_GRID_POINTS:
+        raise SettingOutOfRange(f"the path grid grew past {MAX_PATH_GRID_POINTS:,} points while refining: give a "
+                                f"larger {what} or a smaller grid")
+    return grid
 
 
 def _rows(path: Any, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:
@@ -242,7 +253,7 @@ def _section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray,
         if not bad.any() or rounds >= max_rounds:
             break
         rounds += 1
-        grid = np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]]))
+        grid = _grown(np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]])), "rtol")
     return grid, prof.x, prof.u, float(need.max()), rounds, _ratios(crow, uc, xc, names)
 
 
@@ -457,19 +468,19 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
         raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
     if not (hasattr(path, "sample") and hasattr(path, "breaks") and hasattr(path, "coefficients")):
         raise InvalidSettings(f"path must be a planning.JointPath, got {type(path).__name__}")
-    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 1:
-        raise InvalidSettings(f"grid must be a positive number of intervals, got {grid!r}")
+    count_setting(grid, "grid (intervals over the path)", 1, MAX_PATH_GRID)
+    count_setting(max_rounds, "max_rounds (grid refinements)", 0, MAX_PATH_ROUNDS)
     for name, value in (("start_speed", start_speed), ("end_speed", end_speed)):
         if not (isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value >= 0.0):
             raise InvalidSettings(f"{name} must be a finite ṡ >= 0, got {value!r}")
-    if not (isinstance(rtol, (int, float)) and 0.0 < rtol < 0.5):
-        raise InvalidSettings(f"rtol must be in (0, 0.5), got {rtol!r}")
-    if not (isinstance(kappa, (int, float)) and 0.0 < kappa <= 1.0):
-        raise InvalidSettings(f"kappa must be in (0, 1], got {kappa!r}")
+    if not (isinstance(rtol, (int, float)) and MIN_PATH_RTOL <= rtol < 0.5):
+        raise SettingOutOfRange(f"rtol must be in [{MIN_PATH_RTOL:g}, 0.5), got {rtol!r}")
+    if not (isinstance(kappa, (int, float)) and MIN_PATH_KAPPA <= kappa <= 1.0):
+        raise SettingOutOfRange(f"kappa must be in [{MIN_PATH_KAPPA:g}, 1], got {kappa!r}")
     jmax = None
     if jerk is not None:
         try:
-            jmax = _limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]")
+            jmax = check_limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]", required=True)  # in LIMIT_RANGE
         except Exception as exc:
             raise InvalidSettings(str(exc)) from None
         if start_speed or end_speed:
@@ -540,8 +551,7 @@ def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str 
         raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
     if shape not in SHAPES:
         raise InvalidSettings(f"shape must be one of {sorted(SHAPES)}, got {shape!r}")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 3:
-        raise InvalidSettings(f"samples must be an integer >= 3, got {samples!r}")
+    count_setting(samples, "samples (instants of the time scaling)", 3, MAX_TIME_SCALED_SAMPLES)
     sig = np.array(SHAPES[shape])
     tau = np.linspace(0.0, 1.0, int(samples))
     d1 = np.polynomial.polynomial.polyval(tau, sig[1:] * np.arange(1, sig.size))

@@ -13,8 +13,11 @@ Probabilities are per pair (crossover) and per gene (mutation). The two presets:
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, replace
 
+from pinarms.optim.caps import MAX_GENERATIONS, MAX_POPULATION
 from pinarms.optim.errors import InvalidSettings
 
 __all__ = ["GASettings", "SELECTIONS", "CROSSOVERS", "MUTATIONS", "CONSTRAINT_HANDLINGS"]
@@ -105,8 +108,11 @@ class GASettings:
         def bad(name: str, value: object, what: str) -> InvalidSettings:
             return InvalidSettings(f"GASettings.{name}={value!r}: {what}")
 
-        if int(self.population) != self.population or self.population < 4:
-            raise bad("population", self.population, "use an integer >= 4")
+        pop = self.population
+        if isinstance(pop, bool) or not isinstance(pop, numbers.Real):
+            raise TypeError("population")  # named with the other non-numbers by __post_init__
+        if not math.isfinite(pop) or int(pop) != pop or not 4 <= pop <= MAX_POPULATION:
+            raise bad("population", self.population, f"use an integer from 4 to {MAX_POPULATION:,}")
         if self.selection not in SELECTIONS:
             raise bad("selection", self.selection, f"use one of {SELECTIONS}")
         if self.crossover not in CROSSOVERS:
@@ -137,8 +143,8 @@ class GASettings:
         if self.penalty_increase < 1.0 or self.penalty_decrease < 1.0 or self.penalty_window < 1:
             raise bad("penalty_*", (self.penalty_increase, self.penalty_decrease,
                                     self.penalty_window), "factors >= 1 and window >= 1")
-        if self.max_generations < 1:
-            raise bad("max_generations", self.max_generations, "use >= 1")
+        if not 1 <= self.max_generations <= MAX_GENERATIONS:
+            raise bad("max_generations", self.max_generations, f"use 1 to {MAX_GENERATIONS:,}")
         if self.stall_generations is not None and self.stall_generations < 1:
             raise bad("stall_generations", self.stall_generations, "use >= 1 or None")
 

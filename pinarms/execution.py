@@ -148,6 +148,19 @@ def _failure(index: int, task: Any, what: str, cause: str):
     )
 
 
+def _lost(client: Any, done: int, total: int, cause: str):
+    """The error for a scheduler that went away mid-run (not a fault of any one chunk)."""
+    from pinarms.robots.errors import ExecutionError
+
+    address = getattr(getattr(client, "scheduler", None), "address", None) or "its address"
+    return ExecutionError(
+        f"lost the connection to the Dask scheduler at {address} after {done} of {total} chunks (the scheduler "
+        "stopped, or the network to it failed); nothing was returned. Check that the scheduler and its workers "
+        "are running and run again, or run without a scheduler",
+        cause=cause,
+    )
+
+
 def _one_line(exc: BaseException) -> str:
     text = str(exc).strip().splitlines()
     return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
@@ -186,7 +199,7 @@ def _parse_scheduler(scheduler: Any) -> tuple[str, Any]:
                 raise _invalid(f"scheduler {scheduler!r}: the worker count after 'processes:' must be a positive integer")
             return "processes", int(count)
         if "://" in text:
-            return "address", text
+            return "address", _check_address(text, scheduler)
         raise _invalid(
             f"unknown scheduler {scheduler!r}: use None (serial), 'processes', 'processes:N', "
             "'tcp://HOST:8786', 'env' (DASK_SCHEDULER_ADDRESS) or a distributed.Client"
@@ -349,12 +362,32 @@ def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
         _map_client(client, fn, tasks, on_result, progress)
 
 
+#: Transports a Dask scheduler address may name.
+_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+
+
+def _check_address(text: str, scheduler: Any) -> str:
+    """``scheme://HOST:PORT`` with a known scheme and a port 1-65535, else :class:`InvalidInput` naming it."""
+    scheme, _, rest = text.partition("://")
+    host, sep, port = rest.rpartition(":")
+    if scheme == "inproc" and rest:
+        return text
+    if scheme not in _SCHEMES or not sep or not host.strip("[]") or not port.isdigit() or not 0 < int(port) < 65536:
+        raise _invalid(
+            f"scheduler address {scheduler!r} is not a Dask scheduler address: give scheme://HOST:PORT with a "
+            f"scheme among {', '.join(_SCHEMES)} and a PORT from 1 to 65535, e.g. tcp://127.0.0.1:8786"
+        )
+    return text
+
+
 def _map_address(address, fn, tasks, on_result, progress):
     import dask
     from distributed import Client
 
     try:  # Dask's standard connect timeout (distributed.comm.timeouts.connect, 30 s by default)
         client = Client(address, timeout=dask.config.get("distributed.comm.timeouts.connect"))
+    except ValueError as exc:  # an address Dask cannot parse after all
+        raise _invalid(f"scheduler address {address!r} is not valid: {_one_line(exc)}") from exc
     except (OSError, TimeoutError) as exc:
         from pinarms.robots.errors import ExecutionError
 
@@ -395,6 +428,8 @@ def _map_client(client, fn, tasks, on_result, progress):
                 except KilledWorker as exc:
                     raise _failure(i, tasks[i], "lost its worker (the worker process died)", _one_line(exc)) from exc
                 except FutureCancelledError as exc:
+                    if "connection-lost" in str(getattr(exc, "reason", "")) or client.status != "running":
+                        raise _lost(client, done, total, _one_line(exc)) from exc
                     raise _failure(i, tasks[i], "was cancelled by the cluster", _one_line(exc)) from exc
                 except Exception as exc:
                     raise _failure(i, tasks[i], "raised", _one_line(exc)) from exc
@@ -406,5 +441,5 @@ def _map_client(client, fn, tasks, on_result, progress):
             if progress is not None:
                 progress(done, total)
     finally:
-        if done < total:
+        if done < total and client.status == "running":  # a lost scheduler has nothing left to cancel
             client.cancel([f for f in futures if not f.done()])

@@ -55,6 +55,7 @@ __all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE"
 DEFAULT_TOLERANCE = 1e-4
 #: Default smallest singular value of the weighted Jacobian [m/rad] below which the arm counts as singular.
 DEFAULT_SINGULAR_TOLERANCE = 1e-4
+MIN_TOLERANCE = 1e-9  #: smallest tolerance [m]: a tighter one refines for minutes on rounding noise
 #: Newton's method stops when the position error [m] and the weighted rotation error [m] are below this.
 _NEWTON_TOL = 1e-11
 _NEWTON_ITERATIONS = 8
@@ -447,6 +448,8 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     if not isinstance(path, ToolPath):
         raise TrajectoryError(f"path must be a planning.ToolPath, got {type(path).__name__}")
     tol = _positive(tolerance, "tolerance [m]")
+    if tol < MIN_TOLERANCE:
+        raise TrajectoryError(f"tolerance {tol:g} m is below {MIN_TOLERANCE:g} m (1 nm): give 1e-9 m or more")
     sing = _positive(singular_tolerance, "singular_tolerance [m/rad]")
     loc = _positive(locate, "locate [m]")
     nq = int(robot.nq)

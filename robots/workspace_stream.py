@@ -62,6 +62,7 @@ __all__ = [
     "PILOT_SAMPLES",
     "MIN_DEFAULT_VOXEL",
     "MAX_STREAM_SAMPLES",
+    "MAX_STREAM_VOXELS",
 ]
 
 #: Samples per task (a task evaluates them in blocks and returns reductions only). A task's
@@ -74,6 +75,8 @@ PILOT_SAMPLES = 200_000
 MIN_DEFAULT_VOXEL = 0.01
 #: Largest ``n`` accepted (10¹²).
 MAX_STREAM_SAMPLES = 10**12
+#: Most voxels of a streamed workspace's map (about 2.4 GB of counts, sums and minima).
+MAX_STREAM_VOXELS = 10**8
 _BLOCK = 262_144
 
 
@@ -356,6 +359,11 @@ def stream_workspace(
     if voxel_size is None:
         per_pilot = 10.0 * pilot.n / n  # 10 samples per voxel at n samples
         voxel_size = max(suggest_voxel_size(pilot.points, samples_per_voxel=per_pilot), MIN_DEFAULT_VOXEL)
+    extent = np.ptp(pilot.points, axis=0) * 1.5  # the pilot sees most of the box; the rest stays in the margin
+    n_voxels = float(np.prod(np.floor(extent / float(voxel_size)) + 1.0))
+    if n_voxels > MAX_STREAM_VOXELS:
+        raise InvalidInput(f"voxel_size {float(voxel_size):g} m makes about {n_voxels:.3g} voxels over the workspace, "
+                           f"more than {MAX_STREAM_VOXELS:.0e} (3 arrays of 8 bytes each): give a larger voxel_size")
     spec = _Spec(
         frame=frame,
         voxel_size=float(voxel_size),

@@ -25,7 +25,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from pinarms.optim.errors import InfeasibleProblem
+from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting,
+                               number_setting)
+from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput
 
 __all__ = ["LineSchedule", "schedule_line"]
@@ -159,12 +161,14 @@ def schedule_line(
             order is the order offsets are chosen in.
         clearance: distance every pair must keep [m] (0: no contact).
         margin: resolution of the continuous checks [m].
-        n_offsets: offsets scanned per arm and period.
+        n_offsets: offsets scanned per arm and period (2 to :data:`optim.caps.MAX_OFFSETS`).
         hold: cell configuration of the arms without a cycle (default neutral).
         progress: optional callable ``progress(done, total)`` (for a progress bar).
 
     Raises:
-        InvalidInput: fewer than two arms, an unknown arm, a cycle of the wrong width.
+        InvalidInput: fewer than two arms, an unknown arm, a cycle of the wrong width;
+            ``SettingOutOfRange`` (an ``InvalidInput``): ``n_offsets``, ``clearance``, ``margin``
+            or a cycle time outside its cap (:mod:`optim.caps`).
         InfeasibleProblem: no offset clears even at twice the longest cycle.
     """
     from pinarms.robots.cell import ArmMotion
@@ -172,14 +176,19 @@ def schedule_line(
     names = list(cycles)
     if len(names) < 2:
         raise InvalidInput("schedule_line needs the cycles of at least two arms")
-    if isinstance(n_offsets, bool) or not isinstance(n_offsets, (int, np.integer)) or n_offsets < 2:
-        raise InvalidInput(f"n_offsets must be an integer >= 2, got {n_offsets!r}")
+    n_offsets = count_setting(n_offsets, "n_offsets (time offsets scanned per arm)", 2, MAX_OFFSETS)
+    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+    margin = number_setting(margin, "margin (resolution of the continuous checks)", MIN_MARGIN, unit="m")
     for name in names:
         arm = cell.arm(name)
         if cycles[name].trajectory.n_joints != arm.nq:
             raise InvalidInput(f"the cycle given for arm {name!r} has {cycles[name].trajectory.n_joints} joints, "
                                f"the arm {arm.nq}")
     cycle_times = {n: float(cycles[n].trajectory.duration) for n in names}
+    for n, t in cycle_times.items():
+        if not 0.0 < t <= MAX_LINE_CYCLE_TIME:
+            raise SettingOutOfRange(f"the cycle of arm {n!r} lasts {t:g} s; a line schedule takes cycles of up to "
+                                    f"{MAX_LINE_CYCLE_TIME:g} s: plan a faster cycle (higher limits, shorter dwell)")
     longest = max(cycle_times.values())
     periods = [longest * (1.0 + 0.1 * k) for k in range(11)]
     total = len(periods) * n_offsets * (len(names) - 1)

@@ -20,7 +20,7 @@ from pinarms.robots.robot import Robot
 
 __all__ = ["cli", "main", "json_option", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
            "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
-           "joint_scale_at", "new_session", "save_session", "scheduler_option"]
+           "joint_scale_at", "new_session", "save_session", "scheduler_option", "quiet_dask"]
 
 # numbers may be negative: "-0.5" must reach the command as a value, not as an option
 NUMBERS = {"ignore_unknown_options": True}
@@ -31,12 +31,23 @@ def one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+#: Set this variable (to anything) to see the Python traceback of an unexpected error.
+DEBUG_VARIABLE = "PINARMS_TRACEBACK"
+
+
 class PinarmsGroup(click.Group):
-    """A click group that turns pinarms errors into one-line messages (exit status 1)."""
+    """A click group that turns every error into one line ``Error: ...`` (exit status 1).
+
+    pinarms errors print their message; a missing or unreadable file, a file that is not
+    UTF-8 text and running out of memory say so; anything else is an unexpected error,
+    named by its type (``PINARMS_TRACEBACK=1`` shows its traceback).
+    """
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
+        except (click.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+            raise
         except PinarmsError as exc:
             raise click.ClickException(one_line(exc)) from None
         except FileNotFoundError as exc:
@@ -44,6 +55,18 @@ class PinarmsGroup(click.Group):
         except OSError as exc:
             where = f"{exc.filename}: " if exc.filename else ""
             raise click.ClickException(f"{where}{exc.strerror or one_line(exc)}") from None
+        except UnicodeDecodeError as exc:
+            raise click.ClickException(f"a file is not UTF-8 text ({one_line(exc)}): save it as UTF-8") from None
+        except MemoryError:
+            raise click.ClickException("out of memory: lower the counts or sizes asked for") from None
+        except Exception as exc:
+            import os
+
+            if os.environ.get(DEBUG_VARIABLE):
+                raise
+            raise click.ClickException(
+                f"unexpected {type(exc).__name__}: {one_line(exc)} (a bug in pinarms: set {DEBUG_VARIABLE}=1 "
+                "to see where, and report it)") from None
 
 
 def jsonable(obj: Any) -> Any:
@@ -172,8 +195,37 @@ json_option = click.option("--json", "as_json", is_flag=True, help="Print one JS
 
 #: Where a sweep runs (pinarms.execution): none = here, serially; the standard
 #: DASK_SCHEDULER_ADDRESS variable is read when the option is not given.
+def quiet_dask() -> None:
+    """Silence Dask's own logging for a command-line run: its errors reach the user as one ``Error:`` line.
+
+    Worker processes started here read ``DASK_LOGGING__DISTRIBUTED`` from the environment
+    (unless the user set it); this process's Dask loggers are set to CRITICAL.
+    """
+    import logging
+    import os
+
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "critical")
+    import distributed  # noqa: F401  (it configures its loggers on import: set them afterwards)
+
+    names = [n for n in list(logging.root.manager.loggerDict) if n.split(".")[0] in ("distributed", "tornado")]
+    for name in ("distributed", "tornado", *names):
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+def _scheduler_value(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """Check ``--scheduler`` at once (its form, not the cluster) and quiet Dask when one is used."""
+    if value is None or not value.strip() or value.strip() == "serial":
+        return None if value is None or not value.strip() else value
+    from pinarms.execution import describe_scheduler
+
+    describe_scheduler(value)  # InvalidInput naming a malformed address: one Error line
+    quiet_dask()
+    return value
+
+
 scheduler_option = click.option(
     "--scheduler", default=None, envvar="DASK_SCHEDULER_ADDRESS", show_envvar=True, metavar="ADDRESS",
+    callback=_scheduler_value,
     help="Run the work on Dask: tcp://HOST:8786 (a running `dask scheduler`), or 'processes' / 'processes:N' "
          "(local worker processes). Default: serially here, or DASK_SCHEDULER_ADDRESS when it is set.")
 

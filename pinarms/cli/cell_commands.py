@@ -28,7 +28,11 @@ def _load(cell: str, args: tuple[str, ...], packages: tuple[str, ...]):
         if not sep or not name.strip() or not folder.strip():
             raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
         pkgs[name.strip()] = folder.strip()
-    return load_cell(cell, packages=pkgs or None, xacro_args=parse_xacro_args(args))
+    try:
+        return load_cell(cell, packages=pkgs or None, xacro_args=parse_xacro_args(args))
+    except UnicodeDecodeError as exc:
+        raise InvalidInput(f"cell file {cell!r} is not UTF-8 text (byte {exc.start}: {exc.reason}): save it as "
+                           "UTF-8") from None
 
 
 def _shape_text(shape: Any, k: float, lu: str) -> str:
@@ -192,14 +196,22 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     --task right 50 30 840 220 -680 840 --mm
     """
     from pinarms import optim
+    from pinarms.optim import caps
     from pinarms.robots.cell import ArmMotion
 
-    c = _load(cell, xacro_args, packages)
     k = 1e-3 if mm else 1.0
     lu = "mm" if mm else "m"
     lift = 0.05 / k if lift is None else lift  # all lengths in the user's unit until multiplied by k
     clearance = 0.02 / k if clearance is None else clearance
     margin = 0.005 / k if margin is None else margin
+    # the settings first: a slip in them is an error at once, before the cell loads or a cycle is planned
+    if len(tasks) >= 2:
+        caps.count_setting(n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
+    caps.number_setting(dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
+    caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
+    caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
+    caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
+    c = _load(cell, xacro_args, packages)
     cycles = {}
     data: dict[str, Any] = {"cell": c.name, "clearance_m": clearance * k, "arms": {}}
     lines: list[str] = [f"cell {c.name}: cycles keeping {clearance:g} {lu} from fixtures and other arms"]

@@ -329,3 +329,145 @@ def test_minimize_time_arguments(data):
     result, err = outcome(optim.minimize_time, positions, kind, *limits, **kwargs, seconds=30)
     if err is None:
         assert np.all(np.asarray(result.durations) > 0)
+
+
+# ---------------------------------------------------------------------------- planning and cycle settings
+# Seeded random settings (optim.caps): each call returns a valid result or raises a named
+# PinarmsError within its time bound: never a MemoryError, an OverflowError, a hang.
+_PICK, _PLACE = [0.30, 0.25, 0.10], [-0.20, 0.35, 0.08]
+_huge_or_tiny = st.sampled_from([0, -1, 10**9, 10**18, 2**70, 1e-300, 5e-324, 1e300, np.nan, np.inf, -np.inf])
+_odd_setting = st.one_of(_huge_or_tiny, _scalars)
+
+
+@settings(max_examples=15 * EXPLORE)
+@given(data=st.data())
+def test_plan_cycle_settings(arms, data):
+    robot = arms["scara_mushroom"]
+    arg = Plan(data, ["lift", "dwell", "kind", "vmax", "amax", "jmax", "lift_step", "margin", "clearance",
+                      "tool_speed", "approach", "seed"])
+    spec, err = outcome(optim.PickPlace, _PICK, _PLACE, lift=arg("lift", st.floats(0.01, 0.08), _odd_setting),
+                        dwell=arg("dwell", st.floats(0.0, 1.0), _odd_setting))
+    if err is not None:
+        return
+    limit = st.floats(0.5, 5.0).map(lambda k: k * robot.velocity_limit)
+    kwargs = dict(
+        kind=arg("kind", st.sampled_from(["multi-quintic", "quintic-bspline", "3-5-3"]), _odd_setting),
+        vmax=arg("vmax", limit, st.one_of(_odd_setting, _weird)),
+        amax=arg("amax", st.one_of(st.none(), limit.map(lambda v: 4.0 * v)), st.one_of(_odd_setting, _weird)),
+        jmax=arg("jmax", st.one_of(st.none(), limit.map(lambda v: 40.0 * v)), st.one_of(_odd_setting, _weird)),
+        lift_step=arg("lift_step", st.floats(0.001, 1.0), _odd_setting),
+        margin=arg("margin", st.floats(0.001, 0.05), _odd_setting),
+        clearance=arg("clearance", st.floats(0.0, 0.05), _odd_setting),
+        tool_speed=arg("tool_speed", st.one_of(st.none(), st.floats(0.1, 2.0)), _odd_setting),
+        approach=arg("approach", st.just("joint"), st.sampled_from(["straight", "curved", None])),
+        seed=arg("seed", st.integers(0, 5), _odd_setting),
+    )
+    result, err = outcome(optim.plan_cycle, robot, spec, **kwargs, seconds=30)
+    if err is None:
+        assert result.cycle_time > 0 and np.isfinite(result.cycle_time)
+
+
+@pytest.fixture(scope="module")
+def line_cycles():
+    from pinarms.robots.cell import load_cell
+
+    cell = load_cell("mushroom_line")
+    tasks = {"left": ((-0.05, -0.03, 0.84), (0.22, 0.68, 0.84)), "right": ((0.05, 0.03, 0.84), (0.22, -0.68, 0.84))}
+    cycles = {}
+    for name, (pick, place) in tasks.items():
+        arm = cell.arm(name)
+        spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.09, dwell=0.15)
+        cycles[name] = optim.plan_cycle(arm.robot, spec)
+    return cell, cycles
+
+
+@settings(max_examples=10 * EXPLORE)
+@given(data=st.data())
+def test_schedule_line_settings(line_cycles, data):
+    cell, cycles = line_cycles
+    arg = Plan(data, ["n_offsets", "margin", "clearance"])
+    # valid scans of 2 offsets: a second when the first period clears, 22 checks when none does
+    n_offsets = arg("n_offsets", st.just(2), st.one_of(_odd_setting, st.just(10**9)))
+    margin = arg("margin", st.floats(0.01, 0.05), _odd_setting)
+    clearance = arg("clearance", st.just(0.0), _odd_setting)
+    result, err = outcome(optim.schedule_line, cell, cycles, n_offsets=n_offsets, margin=margin,
+                          clearance=clearance, seconds=60)
+    if err is None:
+        assert result.period > 0 and set(result.offsets) == set(cycles)
+
+
+def _layout_summary(*args, **kwargs):
+    """search_layout's ranking (picks/min is 0 where a placement fails; its cycle time is NaN there by design)."""
+    res = optim.search_layout(*args, **kwargs)
+    return res.failure, res.picks_per_minute, res.best_picks_per_minute, res.margin
+
+
+@settings(max_examples=6 * EXPLORE)
+@given(data=st.data())
+def test_search_layout_settings(arms, data):
+    robot = arms["scara_mushroom"]
+    arg = Plan(data, ["axis", "refine", "refine_evaluations", "workspace_samples", "chunk_size", "min_margin", "n"])
+    axis = arg("axis", st.just(0.0),  # one placement: one cycle per valid call
+               st.one_of(st.tuples(st.just(0.0), st.sampled_from([1.0, 1e300]), _huge_or_tiny), _odd_setting))
+    if data.draw(st.booleans(), label="random placements"):
+        n = arg("n", st.just(1), st.one_of(_odd_setting, st.just(10**12)))
+        bounds = axis if isinstance(axis, float) else (0.0, 0.05)
+        cand, err = outcome(optim.random_candidates, n, x=bounds, y=0.0, seed=1)
+    else:
+        cand, err = outcome(optim.grid_candidates, x=axis, y=0.0)
+    if err is not None:
+        return
+    kwargs = dict(refine=arg("refine", st.just(0), st.one_of(_odd_setting, st.just(10**9))),
+                  refine_evaluations=arg("refine_evaluations", st.integers(1, 2), _odd_setting),
+                  workspace_samples=arg("workspace_samples", st.just(1000), st.one_of(_odd_setting, st.just(10**15))),
+                  chunk_size=arg("chunk_size", st.integers(1, 4), _odd_setting),
+                  min_margin=arg("min_margin", st.floats(0.0, 0.01), _odd_setting))
+    result, err = outcome(_layout_summary, robot, _PICK, _PLACE, cand, **kwargs, seconds=40)
+    if err is None:
+        assert len(result[0]) == len(cand)
+
+
+@settings(max_examples=30 * EXPLORE)
+@given(data=st.data(), which=st.sampled_from(["time_optimal", "time_scaled"]))
+def test_path_timing_settings(data, which):
+    path = planning.joint_spline(np.array([[0.0, 0.0], [0.5, 0.2], [1.0, -0.3]]))
+    cons = [planning.JointVelocityConstraint(np.array([1.0, 1.5])),
+            planning.JointAccelerationConstraint(np.array([4.0, 5.0]))]
+    if which == "time_optimal":
+        arg = Plan(data, ["grid", "max_rounds", "rtol", "kappa", "start_speed", "jerk"])
+        kwargs = dict(grid=arg("grid", st.integers(2, 200), st.one_of(_odd_setting, st.just(10**9))),
+                      max_rounds=arg("max_rounds", st.integers(0, 8), _odd_setting),
+                      rtol=arg("rtol", st.floats(1e-4, 0.4), _odd_setting),
+                      kappa=arg("kappa", st.floats(0.1, 1.0), _odd_setting),
+                      start_speed=arg("start_speed", st.just(0.0), _odd_setting),
+                      jerk=arg("jerk", st.one_of(st.none(), st.floats(10.0, 100.0)), st.one_of(_odd_setting, _weird)))
+        result, err = outcome(optim.time_optimal, path, cons, **kwargs, seconds=20)
+    else:
+        arg = Plan(data, ["samples", "shape"])
+        kwargs = dict(samples=arg("samples", st.integers(3, 3000), st.one_of(_odd_setting, st.just(10**10))),
+                      shape=arg("shape", st.sampled_from(["quintic"]), st.one_of(st.text(max_size=5), _scalars)))
+        result, err = outcome(optim.time_scaled, path, cons, **kwargs, seconds=20)
+    if err is None:
+        assert result.duration > 0 and np.isfinite(result.duration)
+
+
+@settings(max_examples=30 * EXPLORE)
+@given(data=st.data())
+def test_ga_and_exact_settings(data):
+    arg = Plan(data, ["population", "max_generations", "stall", "n_random", "maxiter", "polish"])
+    settings_, err = outcome(optim.GASettings, population=arg("population", st.integers(4, 12), _odd_setting),
+                             max_generations=arg("max_generations", st.integers(1, 5), _odd_setting),
+                             stall_generations=arg("stall", st.one_of(st.none(), st.integers(1, 5)), _odd_setting))
+    if err is None:
+        result, err = outcome(optim.run_ga, lambda x: np.sum(x * x, axis=1), [(-1.0, 1.0), (-1.0, 1.0)],
+                              settings_, max_generations=arg("max_generations", st.integers(1, 5),
+                                                             st.one_of(_odd_setting, st.just(10**12))))
+        if err is None:
+            assert np.isfinite(result.f)
+    problem = optim.TimingProblem(np.array([[0.0], [1.0], [0.5]]), "multi-quintic", 2.0, 8.0)
+    result, err = outcome(optim.solve_exact, problem, n_random=arg("n_random", st.integers(0, 2), _odd_setting),
+                          maxiter=arg("maxiter", st.integers(1, 30), _odd_setting),
+                          polish_evaluations=arg("polish", st.one_of(st.none(), st.integers(0, 50)), _odd_setting),
+                          seconds=20)
+    if err is None:
+        assert result.total > 0
