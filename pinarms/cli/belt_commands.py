@@ -27,7 +27,7 @@ def _figures_lines(res, title: str) -> list[str]:
         f"  arrivals          {f.arrivals_per_minute:.1f} /min",
         f"  picks             {f.picks_per_minute:.1f} /min",
         f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
-        f"  utilisation       " + "  ".join(f"{100 * u:.0f} %" for u in f.utilisation),
+        "  utilisation       " + "  ".join(f"{100 * u:.0f} %" for u in f.utilisation),
         f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
     ]
 
@@ -154,7 +154,7 @@ def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss,
     lines = [f"belt size: {rate:g} items/min at <= {100 * max_miss:g} % miss",
              f"  status            {r.status}",
              f"  arms              {r.arms}",
-             f"  places along belt " + "  ".join(f"{u:.3f}" for u in r.positions) + " m",
+             "  places along belt " + "  ".join(f"{u:.3f}" for u in r.positions) + " m",
              f"  belt speed        {r.speed:.3f} m/s",
              f"  miss rate         {100 * r.miss_rate:.2f} %",
              f"  picks             {r.picks_per_minute:.1f} /min",
