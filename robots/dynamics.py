@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from ._checks import as_batch
 from .errors import InvalidInput, ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -263,9 +264,9 @@ def check_inertials(robot: "Robot") -> None:
     if getattr(robot, "_inertials_checked", False):
         return
     model = robot.model
-    subtree = np.array([model.inertias[i].mass for i in range(model.njoints)], dtype=float)
-    for i in range(model.njoints - 1, 0, -1):
-        subtree[model.parents[i]] += subtree[i]
+    data = model.createData()
+    pin.computeSubtreeMasses(model, data)
+    subtree = np.asarray(data.mass, dtype=float)  # mass supported by each joint (its subtree)
     massless = []
     for i in range(1, model.njoints):
         if "Mimic" in model.joints[i].shortname():
@@ -294,10 +295,8 @@ def _state(robot: "Robot", values: Any, what: str, n: int | None) -> tuple[np.nd
 
 
 def _as_rows(robot: "Robot", values: Any, what: str) -> tuple[np.ndarray, bool]:
-    from .robot import _as_batch
-
     unit = {"qd": "rad/s or m/s", "qdd": "rad/s² or m/s²"}[what]
-    return _as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
+    return as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
 
 
 def _rnea_batch(robot: "Robot", q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -344,13 +343,19 @@ def gravity_torques(robot: "Robot", q: Any) -> np.ndarray:
     return tau[0] if single else tau
 
 
-def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
-    """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body from forward kinematics.
+def _has_mimic(model: pin.Model) -> bool:
+    """Whether the model couples joints (``<mimic>``): Pinocchio's energy algorithms refuse those models."""
+    return any("Mimic" in model.joints[i].shortname() for i in range(1, model.njoints))
 
-    ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (Pinocchio's
-    ``forwardKinematics``, mimic joints followed) and ``Y_i`` its spatial inertia: computed
-    apart from RNEA, so the energy balance checks it. One configuration at a time (a
-    reference for checks, not a batch kernel).
+
+def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
+    """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body (Pinocchio's ``computeKineticEnergy``).
+
+    ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (mimic joints
+    followed) and ``Y_i`` its spatial inertia: computed apart from RNEA, so the energy
+    balance checks it. One configuration at a time (a reference for checks, not a batch kernel).
+    Pinocchio refuses models with mimic joints (the koji arm): for those the same sum is
+    taken body by body after ``forwardKinematics``.
     """
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -359,7 +364,11 @@ def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
     model = robot.model
     data = model.createData()
     out = np.empty(qa.shape[0])
+    mimic = _has_mimic(model)
     for k in range(qa.shape[0]):
+        if not mimic:
+            out[k] = pin.computeKineticEnergy(model, data, qp[k], va[k])
+            continue
         pin.forwardKinematics(model, data, qp[k], va[k])
         out[k] = 0.5 * sum(model.inertias[i].vtiv(data.v[i]) for i in range(1, model.njoints))
     return float(out[0]) if single else out
@@ -368,8 +377,9 @@ def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
 def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
     """Gravitational potential energy ``-Σ m_i g·c_i`` [J] of the moving bodies (zero at the base origin's height).
 
-    From forward kinematics (centres of mass ``c_i`` in the base frame), one configuration at
-    a time (a reference for checks).
+    Pinocchio's ``computePotentialEnergy`` (centres of mass ``c_i`` in the base frame from
+    forward kinematics), one configuration at a time (a reference for checks); body by body
+    after ``forwardKinematics`` for models with mimic joints, which Pinocchio's algorithm refuses.
     """
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -377,7 +387,11 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
     model = robot.model
     data = model.createData()
     out = np.empty(qa.shape[0])
+    mimic = _has_mimic(model)
     for k in range(qa.shape[0]):
+        if not mimic:
+            out[k] = pin.computePotentialEnergy(model, data, qp[k])
+            continue
         pin.forwardKinematics(model, data, qp[k])
         out[k] = -sum(
             model.inertias[i].mass * float(model.gravity.linear @ data.oMi[i].act(model.inertias[i].lever))
