@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import ModelError
+from .so3 import frame_z_to as _rotation_z_to
 
 __all__ = ["KinematicTree", "JointCoordinates"]
 
@@ -30,16 +31,6 @@ _CHUNK = 16384  # samples per block: keeps the working set in cache and memory b
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
 _REVOLUTE, _PRISMATIC = 1, 2
-
-
-def _rotation_z_to(axis: np.ndarray) -> np.ndarray:
-    """A rotation matrix whose third column is the unit vector ``axis``."""
-    z = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    return np.column_stack([x, y, z])
 
 
 @dataclass(frozen=True)
