@@ -275,38 +275,6 @@ class KinematicTree:
                 col[a] = col[a] + (six[a] if k == 1.0 else k * six[a])
         return p, cols
 
-    def pose_and_jacobian(self, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Frame rotation ``(N, 3, 3)``, origin ``(N, 3)`` [m] and Jacobian ``(N, 6, nq)`` of a batch, in one pass.
-
-        The Jacobian is :meth:`frame_jacobian`'s (base axes at the frame origin, linear rows
-        first). One evaluation of the joint poses serves all three (batched IK needs them at
-        every iterate); no threads: the caller chunks.
-        """
-        N = q.shape[0]
-        joint, _, _, fR, fp = self._frames[frame_id]
-        Rs, ps = self._joint_poses(q, joint)
-        Rj = Rs[joint]
-        Rf = _mat_const(Rj, fR)
-        p = _add(ps[joint], _vec_const(Rj, fp))
-        R = np.empty((N, 3, 3))
-        P = np.empty((N, 3))
-        for a in range(3):
-            P[:, a] = p[a]
-            for b in range(3):
-                R[:, a, b] = Rf[a][b]
-        J = np.zeros((N, 6, self.nq))
-        for i in self.ancestors[joint]:
-            w = [Rs[i][k][2] for k in range(3)]
-            if self.kind[i] == _REVOLUTE:
-                d = [p[a] - ps[i][a] for a in range(3)]
-                six = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]] + w
-            else:
-                six = w + [0.0, 0.0, 0.0]
-            k, c = self.scale[i], self.q_index[i]
-            for a in range(6):
-                J[:, a, c] += six[a] if k == 1.0 else k * six[a]
-        return R, P, J
-
     def frame_jacobian(self, q: np.ndarray, frame_id: int) -> np.ndarray:
         """Frame Jacobians ``(N, 6, nq)``: world-aligned axes at the frame origin, linear rows first."""
         N = q.shape[0]
