@@ -7,12 +7,14 @@ Why our own and not toppra: on the benchmark (``benchmarks/topp.py``: a UR5 join
 through 8 waypoints, velocity and acceleration limits, 1354 grid points) the rows plus this
 profile take as long as toppra's ``compute_parameterization`` on the same grid or less
 (0.6-1.0× by the load of the machine: 15.6 ms against 26.2 ms on a quiet one, down from
-80 ms, 3.1×, before the loops below ran on Python floats over the few rows that can bind), with the same duration to 1e-6; it keeps the timings' figures to the last
-bit (toppra's answer differs by its own rounding), needs no compiled extension, and takes
-every :class:`planning.PathConstraint` as rows. The whole timing (:func:`optim.time_optimal`:
+80 ms, 3.1×, before the loops below ran on Python floats over the few rows that can bind),
+with the same duration to 1e-6; it keeps the timings' figures to the last bit (toppra's
+answer differs by its own rounding), needs no compiled extension, and takes every
+:class:`planning.PathConstraint` as rows. The whole timing (:func:`optim.time_optimal`:
 refined grid, checks between grid points, exact joint peaks, q(t) composed exactly) takes
-about 2.5× toppra's ``compute_trajectory``, which does none of that. toppra (test extra) stays the independent
-cross-check (:func:`optim.toppra_path_duration`, ``tests/optim/test_path_timing.py``).
+about 2.5× toppra's ``compute_trajectory``, which does none of that. toppra (test extra)
+stays the independent cross-check (:func:`optim.toppra_path_duration`,
+``tests/optim/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
 control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
