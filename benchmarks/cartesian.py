@@ -8,7 +8,7 @@ Prints, side by side in one run:
   * toppra on the same sampled path: a cubic spline through the joint path's knots (toppra's
     SplineInterpolator, what a toppra user feeds it), parameterised on a grid of the same size;
   * toppra on our path itself (the adapter optim.toppra_path_duration), on our grid;
-  * the reachability analysis alone (optim.reachability on the rows at the grid points) beside
+  * the reachability analysis alone (optim.topp on the rows at the grid points) beside
     toppra's parameterisation on the same grid: algorithm against algorithm (ours then also
     checks between grid points, verifies the exact joint peaks and composes q(t) exactly);
 and the durations, their ratio, and how far the tcp strays from the line on each path
@@ -77,10 +77,10 @@ def main() -> None:
     t_scale = best(lambda: optim.time_optimal(path, cons), 3)
     t_toppra = best(toppra_on_samples, 3)
     t_adapter = best(lambda: optim.toppra_path_duration(path, v, a, grid), 3)
-    from pinarms.optim.reachability import reachability_profile
+    from pinarms.optim.topp import topp_profile
 
     rows = planning.PathRows.concatenate([c.rows(planning.PathSamples.of(path, grid)) for c in cons])
-    t_core = best(lambda: reachability_profile(rows.a, rows.b, rows.lo, rows.hi, grid), 5)
+    t_core = best(lambda: topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid), 5)
     t_rows = best(lambda: planning.PathRows.concatenate([c.rows(planning.PathSamples.of(path, grid)) for c in cons]), 5)
     d_adapter = optim.toppra_path_duration(path, v, a, grid)
     d_dense = optim.toppra_path_duration(path, v, a, np.linspace(0.0, path.length, 3001))

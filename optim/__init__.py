@@ -12,7 +12,7 @@ pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, an
 (many cycles, run through :mod:`pinarms.execution`: serial or on Dask).
 :func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
 Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
-:mod:`optim.reachability`), returning a :class:`PathTiming` with a ``Trajectory``.
+:mod:`optim.topp`), returning a :class:`PathTiming` with a ``Trajectory``.
 :func:`plan_motion` plans a collision-free move of an arm in a cell with OMPL, proves it
 continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """

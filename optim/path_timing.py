@@ -10,7 +10,7 @@ every other (sampling, exact peaks, limit checks, sessions, plots, viewer).
 2. **Grid.** The path's own breaks, each piece cut in equal steps so that the whole path
    has about ``grid`` intervals, then intervals halved until the tangent ``q'`` changes by
    at most ``kappa`` (2 %) of its size across each (dense where the path bends).
-3. **Profile.** :func:`optim.reachability.reachability_profile` (TOPP-RA, interpolation
+3. **Profile.** :func:`optim.topp.topp_profile` (TOPP-RA, interpolation
    discretisation) on the rows of all constraints: ``ṡ²`` at the grid points, constant
    ``s̈`` between.
 4. **Check and refine.** Between grid points the rows are evaluated at 1/4, 1/2, 3/4 and
@@ -45,7 +45,7 @@ import numpy as np
 from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_GRID_POINTS, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES,
                                MIN_PATH_KAPPA, MIN_PATH_RTOL, count_setting)
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
-from pinarms.optim.reachability import reachability_profile
+from pinarms.optim.topp import topp_profile
 from pinarms.planning import Trajectory
 from pinarms.optim.problem import check_limit
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
@@ -237,7 +237,7 @@ def _section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray,
     rounds = 0
     while True:
         rows = _rows(path, constraints, grid, "right")
-        prof = reachability_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
+        prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
         h = np.diff(grid)
         sc = (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
         uc = np.repeat(prof.u, CHECK_FRACTIONS.size)

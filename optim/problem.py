@@ -29,7 +29,8 @@ from typing import Any, Callable, Protocol
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput
-from pinarms.optim.errors import InvalidLimits, InvalidSettings
+from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
+from pinarms.planning.torque import piece_states
 
 __all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
@@ -64,6 +65,38 @@ Builder = Callable[[np.ndarray, np.ndarray], "_TrajectoryLike"]
 
 #: Maps (knot times (P, m+1), positions (m+1, n)) to coefficients (P, m, K+1, n).
 BatchBuilder = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+def path_static_check(torque: Any, times: np.ndarray, coefs: np.ndarray) -> None:
+    """Refuse a path (one timing's pieces) through a pose the arm cannot hold still, naming it.
+
+    Where ``|g(q)| > L`` no timing of that path exists (slower only tends to ``g``).
+    """
+    q, _, _ = piece_states(np.atleast_2d(times)[:1], np.asarray(coefs)[:1], torque.s)
+    q = q[0]  # (m, k, n)
+    g, over = torque.holding_excess(q)
+    if np.any(over):
+        robot = torque.robot
+        seg, k, j = (int(i) for i in np.argwhere(over)[0])
+        raise InfeasibleProblem(
+            f"robot '{robot.name}' cannot hold the path still between via points {seg} and {seg + 1} "
+            f"(at {torque.s[k]:.0%} of that segment, q = {np.round(q[seg, k], 4).tolist()}): joint "
+            f"{robot.joint_names[j]} needs {g[seg, k, j]:.4g} N·m against gravity (payload included), "
+            f"its limit is {torque.limit[j]:.4g}; no timing helps: lighten the payload or change the path"
+        )
+
+
+def static_check(torque: Any, positions: np.ndarray) -> None:
+    """Refuse via points the arm cannot even hold still (``|g(q)| > L``), naming joint and via point."""
+    g, over = torque.holding_excess(positions)
+    if np.any(over):
+        robot = torque.robot
+        k, j = (int(i) for i in np.argwhere(over)[0])
+        raise InfeasibleProblem(
+            f"robot '{robot.name}' cannot hold via point {k} still: joint {robot.joint_names[j]} needs "
+            f"{g[k, j]:.4g} N·m against gravity (payload included), its limit is {torque.limit[j]:.4g}; "
+            "lighten the payload or move the via point closer to the base"
+        )
 
 
 def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndarray | None:
@@ -138,7 +171,7 @@ class TimingProblem:
             ``velocities=0`` for multi-quintic rest at every via point).
         builder: Replace the planning constructor (advanced; tests and custom families).
             A custom builder is called once per individual (no batched form).
-        torque: Joint-torque limits of a robot (:class:`optim.torque.TorqueConstraint`),
+        torque: Joint-torque limits of a robot (:class:`planning.JointTorqueConstraint`),
             checked on a grid per piece beside the exact v/a/jerk peaks, with their own
             scaling law in :meth:`minimal_scale`; None: kinematic limits only.
     """
@@ -188,9 +221,9 @@ class TimingProblem:
             if torque.n_joints != self.n_joints:
                 raise InvalidSettings(f"the torque limits are for {torque.n_joints} joints but the via points have "
                                       f"{self.n_joints}: give every joint of the arm")
-            torque.static_check(q)
+            static_check(torque, q)
             equal = np.full((1, self.n_segments), 1.0 / self.n_segments)
-            torque.path_static_check(*self.coefficients_batch(equal))
+            path_static_check(torque, *self.coefficients_batch(equal))
             self.evaluations = 0
         self.bounds = self._check_bounds(bounds)
 

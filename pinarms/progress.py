@@ -9,15 +9,21 @@ pipe, a file, CI), so machine-readable output and logs stay clean.
 >>> with ProgressBar("workspace samples", enabled=wanted(as_json)) as bar:
 ...     ws = sample_workspace(arm, n=10**7, progress=bar)
 
-The line looks like ``workspace samples  [##########..........]  50 %  5000000/10000000  1.2 s``
-and is redrawn in place at most every 0.1 s; :meth:`ProgressBar.close` ends it.
+The line is drawn by click's progress bar (``click.progressbar``, click being the command
+line's own library) and looks like
+``workspace samples  [############............]  5000000/10000000   50%  1.2 s``; it is
+redrawn in place at most every 0.1 s and :meth:`ProgressBar.close` ends it. What stays here
+is the callback interface, the throttling and the decision whether to draw at all.
 """
 
 from __future__ import annotations
 
+import itertools
 import sys
 import time
 from typing import IO, Any
+
+import click
 
 __all__ = ["ProgressBar", "wanted"]
 
@@ -44,17 +50,32 @@ class ProgressBar:
     def __init__(self, label: str, total: int | None = None, *, enabled: bool = True, stream: IO[str] | None = None,
                  width: int = 24, min_interval: float = 0.1) -> None:
         self.label = label
-        self.total = total
         self.done = 0
         self.note = ""
         self.enabled = bool(enabled)
         self._stream = sys.stderr if stream is None else stream
-        self._width = width
         self._min_interval = min_interval
         self._start = time.perf_counter()
         self._last_draw = -float("inf")
         self._drawn: tuple | None = None  # (done, total, note) last drawn
         self._closed = False
+        # click draws; an endless iterable stands for a total not known yet
+        self._bar = click.progressbar(iterable=None if total else itertools.repeat(None), length=total or None,
+                                      label=label, file=self._stream, width=width, show_pos=True, show_percent=True,
+                                      show_eta=False, fill_char="#", empty_char=".", item_show_func=self._tail)
+
+    @property
+    def total(self) -> int | None:
+        """The amount of work (None while unknown)."""
+        return self._bar.length
+
+    @total.setter
+    def total(self, value: int | None) -> None:
+        self._bar.length = value or None
+
+    def _tail(self, _item: Any) -> str:
+        note = f"  {self.note}" if self.note else ""
+        return f"{time.perf_counter() - self._start:.1f} s{note}"
 
     def __call__(self, done: int, total: int | None = None) -> None:
         """Set the work done so far (and the total, when it becomes known)."""
@@ -77,15 +98,8 @@ class ProgressBar:
 
     def text(self) -> str:
         """The line as drawn now."""
-        elapsed = time.perf_counter() - self._start
-        if self.total:
-            share = min(max(self.done / self.total, 0.0), 1.0)
-            filled = int(round(share * self._width))
-            body = f"[{'#' * filled}{'.' * (self._width - filled)}]  {share:4.0%}  {self.done}/{self.total}"
-        else:
-            body = f"{self.done}"
-        note = f"  {self.note}" if self.note else ""
-        return f"{self.label}  {body}  {elapsed:.1f} s{note}"
+        self._bar.pos = self.done
+        return self._bar.format_progress_line()
 
     def _draw(self, force: bool = False) -> None:
         if not self.enabled or self._closed:
@@ -95,8 +109,8 @@ class ProgressBar:
         if not (force or finished) and now - self._last_draw < self._min_interval:
             return
         self._last_draw = now
-        self._stream.write("\r\x1b[2K" + self.text())
-        self._stream.flush()
+        self._bar.pos = self.done
+        self._bar.render_progress()
         self._drawn = (self.done, self.total, self.note)
 
     def close(self) -> None:
@@ -107,8 +121,7 @@ class ProgressBar:
             if self._drawn != (self.done, self.total, self.note):
                 self._draw(force=True)
             if self._drawn is not None:
-                self._stream.write("\n")
-                self._stream.flush()
+                self._bar.render_finish()
         self._closed = True
 
     def __enter__(self) -> "ProgressBar":

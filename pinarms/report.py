@@ -5,16 +5,23 @@ an absolute tolerance and a one-line reason wherever the two differ. ``status`` 
 ``"agrees"`` (within the tolerance), ``"differs"`` (outside it: the note says why) or
 ``"n/a"`` (no comparable published number: the paper's value is qualitative or its
 inputs are not printed).
+
+The terminal layout (columns, wrapping to a width) is rich's ``Table``; the markdown form
+and the summary line are plain strings.
 """
 
 from __future__ import annotations
 
+import io
 import math
-import textwrap
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
+from rich.box import Box
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
 
 __all__ = ["Row", "format_table", "markdown_table", "summary_line", "splice_table", "TABLE_BEGIN", "TABLE_END"]
 
@@ -108,59 +115,43 @@ HEADER = ["seed", "quantity", "paper", "pinarms", "unit", "tol", "status", "note
 
 
 #: When a table must fit a width: the paper's and pinarms' values (tuples) wrap beyond
-#: _VALUE_WIDTH characters, quantity and note share the room left (in these shares), and no
-#: wrapped column gets fewer than _MIN_WRAPPED characters.
+#: _VALUE_WIDTH characters and the quantity and note wrap at word boundaries; the other
+#: columns never wrap.
 _VALUES = (2, 3)
-_TEXTS = {1: 0.45, 7: 0.55}
+_TEXTS = (1, 7)
 _VALUE_WIDTH = 18
-_MIN_WRAPPED = 10
+
+#: No borders, one rule of dashes under the header (rich's SIMPLE box in ASCII).
+_RULE_BOX = Box("    \n    \n -- \n    \n    \n    \n    \n    \n", ascii=True)
 
 
 def format_table(rows: Sequence[Row], title: str = "paper vs pinarms", width: int | None = None) -> str:
-    """A plain-text table for the terminal.
+    """A plain-text table for the terminal, laid out by rich (``rich.table.Table``).
 
-    ``width``: wrap the ``quantity`` and ``note`` columns (at word boundaries) so that every
-    line fits in that many characters; ``None`` keeps each row on one line. Only the
-    layout changes: every word of every cell is printed (``table.md`` and ``table.json``
-    hold the same rows unwrapped).
+    ``width``: wrap the ``quantity`` and ``note`` columns (at word boundaries) and the two
+    values so that every line fits in that many characters; ``None`` keeps each row on one
+    line. Only the layout changes: every word of every cell is printed (``table.md`` and
+    ``table.json`` hold the same rows unwrapped).
     """
-    cells = [HEADER] + [_cells(r) for r in rows]
-    n = len(HEADER)
-    widths = [max(len(c[i]) for c in cells) for i in range(n)]
-    wrap: set[int] = set()
-    if width is not None:
-        if isinstance(width, bool) or not isinstance(width, int) or width < 40:
-            from pinarms.robots.errors import InvalidInput
+    if width is not None and (isinstance(width, bool) or not isinstance(width, int) or width < 40):
+        from pinarms.robots.errors import InvalidInput
 
-            raise InvalidInput(f"table width must be an integer of at least 40 characters, got {width!r}")
-        if sum(widths) + 2 * (n - 1) > width:
-            wrap = set(_VALUES) | set(_TEXTS)
-            for i in _VALUES:
-                widths[i] = min(widths[i], _VALUE_WIDTH)
-            room = width - 2 * (n - 1) - sum(w for i, w in enumerate(widths) if i not in _TEXTS)
-            natural = {i: widths[i] for i in _TEXTS}
-            for i, share in _TEXTS.items():
-                widths[i] = min(natural[i], max(_MIN_WRAPPED, int(room * share)))
-            spare = room - sum(widths[i] for i in _TEXTS)
-            for i in _TEXTS:  # room one text column does not need goes to the other
-                extra = max(0, min(spare, natural[i] - widths[i]))
-                widths[i] += extra
-                spare -= extra
-            excess = sum(widths) + 2 * (n - 1) - width
-            for i in _VALUES:  # still too wide: narrower value columns
-                cut = max(0, min(excess, widths[i] - _MIN_WRAPPED))
-                widths[i] -= cut
-                excess -= cut
-    lines = [title, "=" * len(title)]
-    for k, c in enumerate(cells):
-        wrapped = [textwrap.wrap(v, widths[i]) or [""] if i in wrap else [v]
-                   for i, v in enumerate(c)]
-        for part in range(max(len(w) for w in wrapped)):
-            parts = [w[part] if part < len(w) else "" for w in wrapped]
-            lines.append("  ".join(v.ljust(w) for v, w in zip(parts[:-1], widths)) + ("  " + parts[-1] if parts[-1] else ""))
-        if k == 0:
-            lines.append("  ".join("-" * w for w in widths[:-1]) + "  ----")
-    lines.append(summary_line(rows))
+        raise InvalidInput(f"table width must be an integer of at least 40 characters, got {width!r}")
+    cells = [_cells(r) for r in rows]
+    natural = sum(max(len(c[i]) for c in [HEADER] + cells) for i in range(len(HEADER))) + 2 * (len(HEADER) - 1)
+    fits = width is None or natural + 2 <= width  # rich adds one column of padding at the end
+    table = Table(box=_RULE_BOX, show_edge=False, pad_edge=False, padding=(0, 1, 0, 0), expand=False)
+    for i, name in enumerate(HEADER):
+        wraps = not fits and (i in _VALUES or i in _TEXTS)
+        table.add_column(Text(name), no_wrap=not wraps, overflow="fold",
+                         max_width=_VALUE_WIDTH if wraps and i in _VALUES else None)
+    for c in cells:
+        table.add_row(*(Text(v) for v in c))
+    out = io.StringIO()
+    console = Console(file=out, width=natural + 8 if width is None else width, color_system=None, force_terminal=False,
+                      highlight=False, emoji=False, markup=False, legacy_windows=False)
+    console.print(table)
+    lines = [title, "=" * len(title)] + out.getvalue().splitlines() + [summary_line(rows)]
     return "\n".join(line.rstrip() for line in lines)
 
 

@@ -1,21 +1,59 @@
-"""Unit conversion at the command-line edge: degrees and millimetres in, SI inside.
+"""Units: SI inside, degrees and millimetres at the edges; the one units module.
 
 pinarms works in SI (m, rad, s) everywhere. The CLI accepts ``--deg`` (revolute joint
 values and roll/pitch/yaw in degrees) and ``--mm`` (prismatic joint values and Cartesian
-positions in millimetres); this module is the one place that converts.
+positions in millimetres), the papers print mm and degrees: this module is the one place
+that converts. Part of the floor every package may import (with :mod:`pinarms.execution`
+and :mod:`pinarms.files`): it imports nothing of pinarms but the error classes (a robot is
+read through its ``nq`` and ``model`` only).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from pinarms.robots.robot import Robot
+from pinarms.robots.errors import InvalidInput
 
-__all__ = ["prismatic_mask", "joints_to_si", "joints_from_si", "length_scale", "angle_scale", "mass_kg",
-           "parse_length", "parse_angle"]
+__all__ = ["deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
+           "joints_from_si", "length_scale", "angle_scale", "mass_kg", "parse_length", "parse_angle"]
 
 
-def prismatic_mask(robot: Robot) -> np.ndarray:
+def _as_float_array(x, what: str) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"{what} must be numeric (a number or an array of numbers), got {x!r}") from exc
+
+
+def deg_to_rad(angle_deg) -> np.ndarray:
+    """Degrees → radians, element-wise (any shape)."""
+    return np.deg2rad(_as_float_array(angle_deg, "angle_deg"))
+
+
+def rad_to_deg(angle_rad) -> np.ndarray:
+    """Radians → degrees, element-wise (any shape)."""
+    return np.rad2deg(_as_float_array(angle_rad, "angle_rad"))
+
+
+def mm_to_m(length_mm) -> np.ndarray:
+    """Millimetres → metres, element-wise (any shape)."""
+    return _as_float_array(length_mm, "length_mm") * 1e-3
+
+
+def m_to_mm(length_m) -> np.ndarray:
+    """Metres → millimetres, element-wise (any shape)."""
+    return _as_float_array(length_m, "length_m") * 1e3
+
+
+def wrap_angle(angle_rad) -> np.ndarray:
+    """Wrap angles (rad) to [−π, π), element-wise."""
+    a = _as_float_array(angle_rad, "angle_rad")
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def prismatic_mask(robot: Any) -> np.ndarray:
     """``(nq,)`` bool: True where the independent joint is prismatic (metres), else revolute (rad)."""
     mask = np.zeros(robot.nq, dtype=bool)
     model = robot.model
@@ -39,13 +77,13 @@ def angle_scale(deg: bool) -> float:
     return np.pi / 180.0 if deg else 1.0
 
 
-def joints_to_si(robot: Robot, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+def joints_to_si(robot: Any, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
     """User joint values (deg/rad for revolute, mm/m for prismatic) → SI, shape kept."""
     scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
     return np.asarray(values, dtype=float) * scale
 
 
-def joints_from_si(robot: Robot, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+def joints_from_si(robot: Any, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
     """SI joint values → user units (inverse of :func:`joints_to_si`)."""
     scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
     return np.asarray(values, dtype=float) / scale
@@ -60,8 +98,6 @@ def mass_kg(text: str) -> float:
     Raises:
         robots.errors.InvalidInput: not a finite number with an optional ``kg``/``g`` unit, or negative.
     """
-    from pinarms.robots.errors import InvalidInput
-
     raw = str(text).strip().lower()
     factor = 1.0
     for unit in ("kg", "g"):
@@ -83,8 +119,6 @@ _ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "°": np.pi / 180.0}
 
 def _quantity(text: str, units: dict, default_unit: str, what: str) -> float:
     import re
-
-    from pinarms.robots.errors import InvalidInput
 
     match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-z°]*)\s*", str(text))
     if not match or (match.group(2) and match.group(2) not in units):

@@ -40,7 +40,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from pinarms.planning import _so3
+from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array, per_joint
 from pinarms.planning.errors import (JointLimitOnPath, PathError, SingularityOnPath, TrajectoryError,
                                      UnreachableOnPath)

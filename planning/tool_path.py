@@ -43,7 +43,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from pinarms.planning import _so3
+from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import BlendTooLarge, TrajectoryError
 

@@ -250,47 +250,137 @@ def torque_dilation(trajectory: Any, robot: Any, limit: Any, samples_per_piece: 
 
 
 class JointTorqueConstraint(PathConstraint):
-    """``|tau_j| <= limit_j`` [N·m or N] along a geometric path, for :func:`optim.time_optimal`.
+    """Joint torque limits ``|tau_j| <= limit_j`` [N·m or N] of one arm: the one torque-limit object.
 
-    With ``u = s̈`` and ``x = ṡ²`` the inverse dynamics along ``q(s)`` is
+    Path timing (:func:`optim.time_optimal`) reads :meth:`rows`: with ``u = s̈`` and
+    ``x = ṡ²`` the inverse dynamics along ``q(s)`` is
     ``tau = M(q) q' u + (M(q) q'' + C(q, q') q') x + g(q)``, so the rows are ``a = M q'``,
-    ``b = M q'' + C(q, q') q'`` and ``-limit - g <= a u + b x <= limit - g``, all from the
-    robot's RNEA (three batched calls per grid). Gravity beyond a limit at some s leaves no
-    feasible speed there (the timing says where).
+    ``b = M q'' + C(q, q') q'`` and ``-limit - g <= a u + b x <= limit - g`` (three batched
+    RNEA calls per grid; the split toppra makes for its own ``JointTorqueConstraint``).
+    Gravity beyond a limit at some s leaves no feasible speed there (the timing says where).
+
+    Segment timing (:func:`optim.minimize_time`, :class:`optim.TimingProblem`) reads
+    :meth:`piece_ratios` and :meth:`minimal_scale` on a grid of ``samples_per_piece``
+    instants per polynomial piece, and :meth:`refined_scale` for the refined peaks. The
+    scaling law: with every duration multiplied by ``s`` the torque is
+    ``tau(s) = (tau_1 - g) / s² + g``, so with ``u = 1 / s²`` every sample gives the linear
+    condition ``-L <= b u + g <= L`` (``b = tau_1 - g``) and the smallest feasible total is
+    ``1 / sqrt(min (L - g) / b  (b > 0)  or  (L + g) / |b|  (b < 0))`` (exact on the grid).
 
     Args:
-        robot: the arm, with its payload (``robot.with_payload``); default the path's robot.
+        robot: the arm, with its payload (``robot.with_payload``); ``None``: the path's robot
+            (path timing only).
         limit: torque limits, scalar or per joint [N·m or N]; ``None``: the robot's URDF efforts.
+        columns: which of the path's joints are the robot's, in its order (a path in the joint
+            space of several arms takes one constraint per arm); ``None``: all of them. With
+            explicit columns the timing checks the rows densely instead of the refined peaks.
+        samples_per_piece: grid instants per polynomial piece in segment timing (ends included).
+
+    Raises:
+        TrajectoryError: not a robot, a wrong-sized or non-positive limit, no URDF effort.
     """
 
     name = "joint torque"
 
-    def __init__(self, robot: Any = None, limit: Any = None) -> None:
+    def __init__(self, robot: Any = None, limit: Any = None, columns: Any = None,
+                 samples_per_piece: int | None = None) -> None:
+        if robot is not None and not hasattr(robot, "inverse_dynamics"):
+            raise TrajectoryError(f"robot must be a robots.Robot (with inverse_dynamics), got {type(robot).__name__}")
         self.robot = robot
         self.limit = limit
+        if robot is not None:
+            self.limit = self._resolve(robot, int(robot.nq))[1]
+        self.columns = None if columns is None else np.asarray(columns, dtype=int).reshape(-1)
+        if robot is not None and self.columns is not None and self.columns.size != int(robot.nq):
+            raise TrajectoryError(f"columns must name the robot's {int(robot.nq)} joints in the path, "
+                                  f"got {self.columns.tolist()}")
+        self.samples_per_piece = SAMPLES_PER_PIECE if samples_per_piece is None else samples_per_piece
+        self.s = grid(self.samples_per_piece)
 
-    def _arm_and_limit(self, robot: Any, n: int) -> tuple[Any, np.ndarray]:
+    def _resolve(self, robot: Any, n: int) -> tuple[Any, np.ndarray]:
         arm = self.robot if self.robot is not None else robot
         if arm is None:
             raise TrajectoryError("JointTorqueConstraint needs a robot: JointTorqueConstraint(robot=arm) or a path with one")
         _robot_joints(arm, n)
-        limit = arm.effort_limit if self.limit is None else self.limit
-        if self.limit is None and not np.all(np.asarray(limit, dtype=float) > 0.0):
+        given = self.limit
+        limit = arm.effort_limit if given is None else given
+        if given is None and not np.all(np.asarray(limit, dtype=float) > 0.0):
             raise TrajectoryError(f"robot '{arm.name}' has no effort limit for some joint in its URDF: give limit=[...]")
         return arm, check_torque_limit(limit, n)
 
+    @property
+    def n_joints(self) -> int:
+        """Joints of the arm."""
+        return int(self.robot.nq)
+
+    # -- path timing --------------------------------------------------------------------
     def rows(self, samples: Any) -> PathRows:
         """Linear bounds on (s̈, ṡ²) at the samples (see the class docstring)."""
-        n = samples.dq.shape[1]
-        arm, L = self._arm_and_limit(getattr(samples.path, "robot", None), n)
-        zero = np.zeros_like(samples.q)
-        g = arm.gravity(samples.q)
-        a = arm.inverse_dynamics(samples.q, zero, samples.dq) - g
-        b = arm.inverse_dynamics(samples.q, samples.dq, samples.ddq) - g
+        c = slice(None) if self.columns is None else self.columns
+        q, dq, ddq = samples.q[:, c], samples.dq[:, c], samples.ddq[:, c]
+        n = q.shape[1]
+        arm, L = self._resolve(getattr(samples.path, "robot", None), n)
+        zero = np.zeros_like(q)
+        g = arm.gravity(q).reshape(q.shape)
+        a = arm.inverse_dynamics(q, zero, dq).reshape(q.shape) - g
+        b = arm.inverse_dynamics(q, dq, ddq).reshape(q.shape) - g
         return PathRows(a, b, -L - g, L - g, tuple(f"torque of joint {j + 1}" for j in range(n)))
 
     def exact_dilation(self, trajectory: Any) -> float:
-        """Uniform dilation making the timed trajectory's refined torque peaks meet the limits (:func:`torque_dilation`)."""
+        """Uniform dilation making the timed trajectory's refined torque peaks meet the limits (:func:`torque_dilation`).
+
+        1 with explicit ``columns`` (the rows are then checked densely by the timing).
+        """
+        if self.columns is not None:
+            return 1.0
         traj = getattr(trajectory, "trajectory", trajectory)
-        arm, L = self._arm_and_limit(None, traj.n_joints)
+        arm, L = self._resolve(None, traj.n_joints)
         return torque_dilation(traj, arm, L)
+
+    # -- segment timing -----------------------------------------------------------------
+    def _grid_torques(self, times: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Torques and positions (P, m, k, n) on the grid."""
+        q, qd, qdd = piece_states(times, coefs, self.s)
+        flat = q.reshape(-1, q.shape[-1])
+        tau = self.robot.inverse_dynamics(flat, qd.reshape(flat.shape), qdd.reshape(flat.shape)).reshape(q.shape)
+        return tau, q
+
+    def piece_ratios(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
+        """``max |tau| / L`` per piece and joint on the grid: (P, m, n)."""
+        tau, _ = self._grid_torques(times, coefs)
+        return np.abs(tau).max(axis=2) / self.limit
+
+    def minimal_scale(self, times: np.ndarray, coefs: np.ndarray) -> np.ndarray:
+        """Smallest time scale s (P,) meeting the torque limits on the grid (class docstring).
+
+        ``times``/``coefs`` describe timings at any total; the answer multiplies those
+        durations. ``inf`` where a sample cannot be held still (``|g| > L``).
+        """
+        tau, q = self._grid_torques(times, coefs)
+        shape = q.shape
+        g = self.robot.gravity(q.reshape(-1, shape[-1])).reshape(shape)
+        P = shape[0]
+        b = (tau - g).reshape(P, -1, shape[-1])
+        g = g.reshape(P, -1, shape[-1])
+        L = self.limit
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.where(b > 0.0, (L - g) / b, np.where(b < 0.0, (L + g) / -b, np.inf))
+        u = np.min(bound.reshape(P, -1), axis=1)
+        static = np.any((np.abs(g) > L).reshape(P, -1), axis=1)
+        u = np.where(static, 0.0, np.maximum(u, 0.0))
+        with np.errstate(divide="ignore"):
+            return np.where(u > 0.0, 1.0 / np.sqrt(u), np.inf)
+
+    def refined_scale(self, trajectory: Any) -> float:
+        """Factor (>= 1) on every duration that brings the *refined* torque peaks under the limits.
+
+        The grid misses the exact peak by a hair; the refined peaks and the scaling law at
+        those instants give the factor (:func:`torque_dilation`).
+        """
+        return torque_dilation(trajectory, self.robot, self.limit, self.samples_per_piece)
+
+    def holding_excess(self, positions: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``|g(q)|`` (..., n) at ``positions`` (..., n) and where it exceeds the limit (no speed helps there)."""
+        q = np.asarray(positions, dtype=float)
+        g = np.abs(self.robot.gravity(q.reshape(-1, q.shape[-1]))).reshape(q.shape)
+        return g, g > self.limit

@@ -1,4 +1,7 @@
-"""Unit conversions at the edges, and the papers' kinematic conventions.
+"""The papers' kinematic conventions (and, from :mod:`pinarms.units`, the unit conversions).
+
+The unit conversions (``deg_to_rad``, ``mm_to_m``, ``wrap_angle``, ...) live in
+:mod:`pinarms.units`, the one units module; they stay importable from here.
 
 Everything inside pinarms is SI (m, rad, s). The papers print millimetres and degrees,
 and two of them use joint conventions that differ from the models':
@@ -27,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput
+from pinarms.units import _as_float_array, deg_to_rad, m_to_mm, mm_to_m, rad_to_deg, wrap_angle
 
 __all__ = [
     "deg_to_rad",
@@ -49,39 +53,6 @@ __all__ = [
     "GANTRY_TRANSMISSION_M_PER_RAD",
     "gantry_motor_to_axis",
 ]
-
-
-def _as_float_array(x, what: str) -> np.ndarray:
-    try:
-        return np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numeric (a number or an array of numbers), got {x!r}") from exc
-
-
-def deg_to_rad(angle_deg) -> np.ndarray:
-    """Degrees → radians, element-wise (any shape)."""
-    return np.deg2rad(_as_float_array(angle_deg, "angle_deg"))
-
-
-def rad_to_deg(angle_rad) -> np.ndarray:
-    """Radians → degrees, element-wise (any shape)."""
-    return np.rad2deg(_as_float_array(angle_rad, "angle_rad"))
-
-
-def mm_to_m(length_mm) -> np.ndarray:
-    """Millimetres → metres, element-wise (any shape)."""
-    return _as_float_array(length_mm, "length_mm") * 1e-3
-
-
-def m_to_mm(length_m) -> np.ndarray:
-    """Metres → millimetres, element-wise (any shape)."""
-    return _as_float_array(length_m, "length_m") * 1e3
-
-
-def wrap_angle(angle_rad) -> np.ndarray:
-    """Wrap angles (rad) to [−π, π), element-wise."""
-    a = _as_float_array(angle_rad, "angle_rad")
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 # ---------------------------------------------------------------------------------------

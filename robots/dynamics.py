@@ -23,15 +23,13 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from ._checks import as_batch
 from .errors import InvalidInput, ModelError
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .robot import Robot
 
 __all__ = [
     "GRAVITY",
@@ -211,7 +209,7 @@ def as_payload(payload: Any, *, com: Any = None, inertia: Any = None, frame: str
 
 
 # --------------------------------------------------------------------------- robots
-def with_payload(robot: "Robot", mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
+def with_payload(robot: Any, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> Any:
     """A copy of ``robot`` carrying a payload; ``robot`` itself is unchanged.
 
     A payload replaces the one ``robot`` already carries (payloads do not stack); ``mass=0``
@@ -254,7 +252,7 @@ def with_payload(robot: "Robot", mass: Any, com: Any = None, inertia: Any = None
     return new
 
 
-def check_inertials(robot: "Robot") -> None:
+def check_inertials(robot: Any) -> None:
     """Raise :class:`MissingInertials` if a joint of ``robot`` moves no mass at all.
 
     Every independent joint must carry some mass beyond it (its links, or a payload): a URDF
@@ -263,9 +261,9 @@ def check_inertials(robot: "Robot") -> None:
     if getattr(robot, "_inertials_checked", False):
         return
     model = robot.model
-    subtree = np.array([model.inertias[i].mass for i in range(model.njoints)], dtype=float)
-    for i in range(model.njoints - 1, 0, -1):
-        subtree[model.parents[i]] += subtree[i]
+    data = model.createData()
+    pin.computeSubtreeMasses(model, data)
+    subtree = np.asarray(data.mass, dtype=float)  # mass supported by each joint (its subtree)
     massless = []
     for i in range(1, model.njoints):
         if "Mimic" in model.joints[i].shortname():
@@ -281,26 +279,24 @@ def check_inertials(robot: "Robot") -> None:
     robot._inertials_checked = True
 
 
-def total_mass(robot: "Robot") -> float:
+def total_mass(robot: Any) -> float:
     """Mass [kg] of every body of ``robot`` (base link and payload included)."""
     return float(sum(robot.model.inertias[i].mass for i in range(robot.model.njoints)))
 
 
-def _state(robot: "Robot", values: Any, what: str, n: int | None) -> tuple[np.ndarray, bool]:
+def _state(robot: Any, values: Any, what: str, n: int | None) -> tuple[np.ndarray, bool]:
     arr, single = robot.check_q(values) if what == "q" else _as_rows(robot, values, what)
     if n is not None and arr.shape[0] != n:
         raise InvalidInput(f"{what} has {arr.shape[0]} rows but q has {n}: give one row per configuration")
     return arr, single
 
 
-def _as_rows(robot: "Robot", values: Any, what: str) -> tuple[np.ndarray, bool]:
-    from .robot import _as_batch
-
+def _as_rows(robot: Any, values: Any, what: str) -> tuple[np.ndarray, bool]:
     unit = {"qd": "rad/s or m/s", "qdd": "rad/s² or m/s²"}[what]
-    return _as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
+    return as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
 
 
-def _rnea_batch(robot: "Robot", q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+def _rnea_batch(robot: Any, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
     """Pinocchio's RNEA on N states at once: (N, nq) each → (N, nq)."""
     n = q.shape[0]
     if n == 0:
@@ -313,7 +309,7 @@ def _rnea_batch(robot: "Robot", q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) 
     return np.ascontiguousarray(np.asarray(tau).reshape(robot.nq, n).T)
 
 
-def inverse_dynamics(robot: "Robot", q: Any, qd: Any, qdd: Any) -> np.ndarray:
+def inverse_dynamics(robot: Any, q: Any, qd: Any, qdd: Any) -> np.ndarray:
     """Joint torques ``tau = M(q) qdd + C(q, qd) qd + g(q)`` (module conventions).
 
     Args:
@@ -335,7 +331,7 @@ def inverse_dynamics(robot: "Robot", q: Any, qd: Any, qdd: Any) -> np.ndarray:
     return tau[0] if single else tau
 
 
-def gravity_torques(robot: "Robot", q: Any) -> np.ndarray:
+def gravity_torques(robot: Any, q: Any) -> np.ndarray:
     """Torques [N·m or N] that hold ``q`` (nq,) or (N, nq) still against gravity: ``g(q)``."""
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -344,13 +340,19 @@ def gravity_torques(robot: "Robot", q: Any) -> np.ndarray:
     return tau[0] if single else tau
 
 
-def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
-    """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body from forward kinematics.
+def _has_mimic(model: pin.Model) -> bool:
+    """Whether the model couples joints (``<mimic>``): Pinocchio's energy algorithms refuse those models."""
+    return any("Mimic" in model.joints[i].shortname() for i in range(1, model.njoints))
 
-    ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (Pinocchio's
-    ``forwardKinematics``, mimic joints followed) and ``Y_i`` its spatial inertia: computed
-    apart from RNEA, so the energy balance checks it. One configuration at a time (a
-    reference for checks, not a batch kernel).
+
+def kinetic_energy(robot: Any, q: Any, qd: Any) -> float | np.ndarray:
+    """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body (Pinocchio's ``computeKineticEnergy``).
+
+    ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (mimic joints
+    followed) and ``Y_i`` its spatial inertia: computed apart from RNEA, so the energy
+    balance checks it. One configuration at a time (a reference for checks, not a batch kernel).
+    Pinocchio refuses models with mimic joints (the koji arm): for those the same sum is
+    taken body by body after ``forwardKinematics``.
     """
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -359,17 +361,22 @@ def kinetic_energy(robot: "Robot", q: Any, qd: Any) -> float | np.ndarray:
     model = robot.model
     data = model.createData()
     out = np.empty(qa.shape[0])
+    mimic = _has_mimic(model)
     for k in range(qa.shape[0]):
+        if not mimic:
+            out[k] = pin.computeKineticEnergy(model, data, qp[k], va[k])
+            continue
         pin.forwardKinematics(model, data, qp[k], va[k])
         out[k] = 0.5 * sum(model.inertias[i].vtiv(data.v[i]) for i in range(1, model.njoints))
     return float(out[0]) if single else out
 
 
-def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
+def potential_energy(robot: Any, q: Any) -> float | np.ndarray:
     """Gravitational potential energy ``-Σ m_i g·c_i`` [J] of the moving bodies (zero at the base origin's height).
 
-    From forward kinematics (centres of mass ``c_i`` in the base frame), one configuration at
-    a time (a reference for checks).
+    Pinocchio's ``computePotentialEnergy`` (centres of mass ``c_i`` in the base frame from
+    forward kinematics), one configuration at a time (a reference for checks); body by body
+    after ``forwardKinematics`` for models with mimic joints, which Pinocchio's algorithm refuses.
     """
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -377,7 +384,11 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
     model = robot.model
     data = model.createData()
     out = np.empty(qa.shape[0])
+    mimic = _has_mimic(model)
     for k in range(qa.shape[0]):
+        if not mimic:
+            out[k] = pin.computePotentialEnergy(model, data, qp[k])
+            continue
         pin.forwardKinematics(model, data, qp[k])
         out[k] = -sum(
             model.inertias[i].mass * float(model.gravity.linear @ data.oMi[i].act(model.inertias[i].lever))
@@ -387,7 +398,7 @@ def potential_energy(robot: "Robot", q: Any) -> float | np.ndarray:
 
 
 def holding_torques(
-    robot: "Robot", n: int = 20000, seed: int = 0, accel_time: float | None = None, starts: int = 3
+    robot: Any, n: int = 20000, seed: int = 0, accel_time: float | None = None, starts: int = 3
 ) -> tuple[np.ndarray, np.ndarray]:
     """Largest torque each joint needs to hold the arm (and its payload) anywhere in its ranges.
 

@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import ModelError
+from .so3 import frame_z_to as _rotation_z_to
 
 __all__ = ["KinematicTree", "JointCoordinates"]
 
@@ -30,16 +31,6 @@ _CHUNK = 16384  # samples per block: keeps the working set in cache and memory b
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
 _REVOLUTE, _PRISMATIC = 1, 2
-
-
-def _rotation_z_to(axis: np.ndarray) -> np.ndarray:
-    """A rotation matrix whose third column is the unit vector ``axis``."""
-    z = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    return np.column_stack([x, y, z])
 
 
 @dataclass(frozen=True)
@@ -283,38 +274,6 @@ class KinematicTree:
             for a in range(6):
                 col[a] = col[a] + (six[a] if k == 1.0 else k * six[a])
         return p, cols
-
-    def pose_and_jacobian(self, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Frame rotation ``(N, 3, 3)``, origin ``(N, 3)`` [m] and Jacobian ``(N, 6, nq)`` of a batch, in one pass.
-
-        The Jacobian is :meth:`frame_jacobian`'s (base axes at the frame origin, linear rows
-        first). One evaluation of the joint poses serves all three (batched IK needs them at
-        every iterate); no threads: the caller chunks.
-        """
-        N = q.shape[0]
-        joint, _, _, fR, fp = self._frames[frame_id]
-        Rs, ps = self._joint_poses(q, joint)
-        Rj = Rs[joint]
-        Rf = _mat_const(Rj, fR)
-        p = _add(ps[joint], _vec_const(Rj, fp))
-        R = np.empty((N, 3, 3))
-        P = np.empty((N, 3))
-        for a in range(3):
-            P[:, a] = p[a]
-            for b in range(3):
-                R[:, a, b] = Rf[a][b]
-        J = np.zeros((N, 6, self.nq))
-        for i in self.ancestors[joint]:
-            w = [Rs[i][k][2] for k in range(3)]
-            if self.kind[i] == _REVOLUTE:
-                d = [p[a] - ps[i][a] for a in range(3)]
-                six = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]] + w
-            else:
-                six = w + [0.0, 0.0, 0.0]
-            k, c = self.scale[i], self.q_index[i]
-            for a in range(6):
-                J[:, a, c] += six[a] if k == 1.0 else k * six[a]
-        return R, P, J
 
     def frame_jacobian(self, q: np.ndarray, frame_id: int) -> np.ndarray:
         """Frame Jacobians ``(N, 6, nq)``: world-aligned axes at the frame origin, linear rows first."""

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InvalidInput, UnreachableTarget
+from .so3 import rot_z as _rot_z
 from .workspace import Workspace, position_dexterity, sample_workspace
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -158,11 +159,6 @@ def _yaw_candidates() -> np.ndarray:
     for k in range(1, 180 // _YAW_STEP_DEG):
         steps += [k * _YAW_STEP_DEG, -k * _YAW_STEP_DEG]
     return np.radians(steps + [180])
-
-
-def _rot_z(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _targets(robot: "Robot", points: Any, orientation: Any) -> np.ndarray:

@@ -34,6 +34,9 @@ from typing import Any
 import numpy as np
 
 from .errors import InvalidInput
+from .so3 import about as _rotation_about
+from .so3 import frame_z_to as _frame_z_to
+from .so3 import from_quaternion as _quat_to_matrix
 
 __all__ = [
     "OrientationSet",
@@ -197,31 +200,6 @@ def _geodesic(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.arccos(np.clip(0.5 * (tr - 1.0), -1.0, 1.0))
 
 
-def _quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(N, 3, 3)`` of unit quaternions ``(N, 4)`` stored ``(x, y, z, w)``."""
-    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    R = np.empty((q.shape[0], 3, 3))
-    R[:, 0, 0] = 1 - 2 * (y * y + z * z)
-    R[:, 0, 1] = 2 * (x * y - z * w)
-    R[:, 0, 2] = 2 * (x * z + y * w)
-    R[:, 1, 0] = 2 * (x * y + z * w)
-    R[:, 1, 1] = 1 - 2 * (x * x + z * z)
-    R[:, 1, 2] = 2 * (y * z - x * w)
-    R[:, 2, 0] = 2 * (x * z - y * w)
-    R[:, 2, 1] = 2 * (y * z + x * w)
-    R[:, 2, 2] = 1 - 2 * (x * x + y * y)
-    return R
-
-
-def _frame_z_to(axis: np.ndarray) -> np.ndarray:
-    """A fixed rotation whose third column is the unit vector ``axis`` (its x, y chosen by a stated rule)."""
-    z = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
-
-
 def _unit(v: Any, what: str) -> np.ndarray:
     try:
         a = np.asarray(v, dtype=float).reshape(-1)
@@ -236,13 +214,6 @@ def _count(n: Any, what: str, low: int = 1) -> int:
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < low or n > MAX_ORIENTATIONS:
         raise InvalidInput(f"{what} must be an integer in [{low}, {MAX_ORIENTATIONS}], got {n!r}")
     return int(n)
-
-
-def _rotation_about(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rodrigues rotations ``(K, 3, 3)`` about the unit ``axis`` by ``angles (K,)`` [rad]."""
-    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 def _align(a: np.ndarray, d: np.ndarray) -> np.ndarray:

@@ -20,8 +20,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ["robots", "planning", "optim", "viz", "pinarms"]
-#: The bottom layer, a module of the ``pinarms`` folder that every package may import.
-BOTTOM = {"pinarms.execution": "execution"}
+#: The floor: modules of the ``pinarms`` folder that every package may import (the execution
+#: layer, atomic file writing, units); each imports nothing of ours but the error classes.
+BOTTOM = {"pinarms.execution": "execution", "pinarms.files": "files", "pinarms.units": "units"}
 ALLOWED = {pkg: set(ORDER[: i + 1]) | set(BOTTOM.values()) for i, pkg in enumerate(ORDER)}
 SUBPACKAGES = set(ORDER[:-1]) | {"urdf"}
 
@@ -90,6 +91,20 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
     # and the errors module it reaches imports nothing of ours
     errors = _imported_modules(ROOT / "robots" / "errors.py")
     assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
+
+
+@pytest.mark.parametrize("floor", ["files", "units"])
+def test_the_floor_imports_nothing_of_ours_but_the_errors(floor):
+    modules = _imported_modules(ROOT / "pinarms" / f"{floor}.py")
+    ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
+    assert ours <= {"pinarms.robots.errors"}, ours
+    assert all(floor in ALLOWED[pkg] for pkg in ORDER)
+
+
+def test_robot_and_its_dynamics_are_no_circle():
+    """robots/robot.py uses robots/dynamics.py; dynamics imports nothing of robot (not even for types)."""
+    assert "robot" not in _relative_imports(ROOT / "robots" / "dynamics.py")
+    assert "pinarms.robots.robot" not in _imported_modules(ROOT / "robots" / "dynamics.py")
 
 
 def test_every_package_may_import_the_execution_layer(tmp_path):

@@ -15,6 +15,11 @@ class _Tty(io.StringIO):
         return True
 
 
+def _last_line(out: _Tty) -> str:
+    """The last state drawn, without click's cursor hide/show sequences."""
+    return out.getvalue().split("\r")[-1].replace("\x1b[?25l", "").replace("\x1b[?25h", "")
+
+
 def test_wanted_only_for_a_terminal_without_json():
     assert wanted(False, _Tty()) is True
     assert wanted(True, _Tty()) is False
@@ -27,8 +32,9 @@ def test_bar_counts_and_ends_its_line():
         for g in range(1, 301):
             bar(g)
     text = out.getvalue()
-    last = text.split("\r\x1b[2K")[-1]
-    assert last.startswith("GA generations  [########################]  100%  300/300") and last.endswith("s\n")
+    last = _last_line(out)
+    assert last.startswith("GA generations  [########################]  300/300  100%") and last.rstrip().endswith(" s")
+    assert last.endswith("\n")
     assert text.count("\n") == 1
 
 
@@ -38,6 +44,15 @@ def test_disabled_bar_writes_nothing():
         bar.advance(note="seed 001")
         bar(4)
     assert out.getvalue() == ""
+
+
+def test_unknown_total_and_notes_are_drawn():
+    out = _Tty()
+    with ProgressBar("planning", stream=out, min_interval=0.0) as bar:
+        bar.step("motion 1")
+        bar.advance(note="motion 2")
+    last = _last_line(out)
+    assert last.startswith("planning  [") and "1  " in last and last.rstrip().endswith("motion 2")
 
 
 def test_redraws_are_throttled():

@@ -37,7 +37,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput, LimitViolation
-from pinarms.viz._atomic import atomic_write
+from pinarms.files import atomic_write
 
 from .errors import InvalidRate, JointMismatch
 

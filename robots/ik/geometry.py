@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import ModelError
+from ..so3 import hat as _skew
 
 __all__ = [
     "ChainAxis",
@@ -115,10 +116,6 @@ def chain_axes(robot, frame: str = "tcp") -> Chain:
 
 
 # ------------------------------------------------------------------ subproblems
-def _skew(w: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-
-
 def rotate(direction: np.ndarray, angle: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Rotate vectors ``x (..., 3)`` by ``angle (...)`` [rad] about the unit ``direction (3,)`` (Rodrigues)."""
     w0, w1, w2 = (float(v) for v in direction)

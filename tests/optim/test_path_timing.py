@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import optim, robots
 from pinarms.optim import InfeasibleProblem, time_optimal, toppra_path_duration
-from pinarms.optim.reachability import reachability_profile
+from pinarms.optim.topp import topp_profile
 from pinarms.planning import (JointAccelerationConstraint, JointLimits, JointVelocityConstraint, PathRows,
                               PathSamples, ToolAccelerationConstraint, ToolSpeedConstraint, Trajectory,
                               cartesian_path, from_definition, joint_spline, tcp_speed)
@@ -71,14 +71,14 @@ def test_within_one_percent_of_toppra_on_the_same_path(timed, limits, lift):
     assert timed.duration >= dense * (1.0 - 1e-3)  # ours is feasible: not faster than the converged optimum
 
 
-def test_reachability_profile_equals_toppra_profile_on_a_grid(lift, limits):
+def test_topp_profile_equals_toppra_profile_on_a_grid(lift, limits):
     v, a = limits
     grid = np.linspace(0.0, lift.length, 61)
     rows = PathRows.concatenate([c.rows(PathSamples.of(lift, grid)) for c in
                                  (JointVelocityConstraint(v), JointAccelerationConstraint(a))])
-    prof = reachability_profile(rows.a, rows.b, rows.lo, rows.hi, grid)
+    prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid)
     assert prof.duration == pytest.approx(toppra_path_duration(lift, v, a, grid), rel=1e-6)
-    coll = reachability_profile(rows.a, rows.b, rows.lo, rows.hi, grid, scheme="collocation")
+    coll = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, scheme="collocation")
     assert coll.duration == pytest.approx(toppra_path_duration(lift, v, a, grid, discretization="collocation"),
                                           rel=1e-6)
 

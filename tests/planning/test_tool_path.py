@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms.planning import BlendTooLarge, TrajectoryError, tool_path
-from pinarms.planning import _so3
+from pinarms.robots import so3 as _so3
 
 
 def pose(p, rotvec=(0.0, 0.0, 0.0)):

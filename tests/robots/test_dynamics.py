@@ -300,3 +300,29 @@ def test_estimated_arms_efforts_follow_the_sizing_rule(name):
     robot = robots.load(name)
     demand, _ = holding_torques(robot.with_payload(RATED_KG[name]), n=4000, accel_time=ACCEL_TIME_S[name])
     np.testing.assert_array_equal(robot.effort_limit, np.maximum(np.ceil(demand), 1.0))
+
+
+@pytest.mark.parametrize("name", ["aubo_i3", "koji_turner"])
+def test_energies_and_subtree_masses_equal_the_body_by_body_sums(name):
+    """Pinocchio's energy and subtree-mass algorithms (or, for mimic joints, the body sum) to 1e-12."""
+    arm = robots.load(name).with_payload(1.5)
+    model = arm.model
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-1.0, 1.0, size=(5, arm.nq))
+    qd = rng.uniform(-1.0, 1.0, size=(5, arm.nq))
+    ke, pe = kinetic_energy(arm, q, qd), potential_energy(arm, q)
+    for k in range(q.shape[0]):
+        qp = arm.q_to_pinocchio(q[k]).reshape(-1)
+        pin.forwardKinematics(model, data, qp, qd[k])
+        ref_ke = 0.5 * sum(model.inertias[i].vtiv(data.v[i]) for i in range(1, model.njoints))
+        ref_pe = -sum(model.inertias[i].mass * float(model.gravity.linear @ data.oMi[i].act(model.inertias[i].lever))
+                      for i in range(1, model.njoints))
+        assert ke[k] == pytest.approx(ref_ke, abs=1e-12 * max(1.0, abs(ref_ke)))
+        assert pe[k] == pytest.approx(ref_pe, abs=1e-12 * max(1.0, abs(ref_pe)))
+    subtree = np.array([model.inertias[i].mass for i in range(model.njoints)])
+    for i in range(model.njoints - 1, 0, -1):
+        subtree[model.parents[i]] += subtree[i]
+    pin.computeSubtreeMasses(model, data)
+    np.testing.assert_allclose(np.asarray(data.mass)[1:], subtree[1:], rtol=0.0, atol=1e-12)
+    assert subtree[1] > 1.5  # the payload is carried by the first joint's subtree

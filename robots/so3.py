@@ -1,4 +1,8 @@
-"""Rotation helpers, vectorised over batches: exp and log of SO(3), the hat and vee maps.
+"""Rotations (SO(3)), vectorised over batches: the one module of rotation helpers.
+
+exp and log of SO(3), the hat and vee maps, the angle of a rotation, rotations about an
+axis, from unit quaternions, about z, and a frame whose z is a given axis. Every package
+above ``robots`` takes its rotations from here.
 
 Rotation vectors ``phi`` (N, 3) [rad] give ``R = exp([phi]x)`` (Rodrigues' formula, with
 Taylor series below 1e-4 rad); ``log`` returns the rotation vector of angle in [0, π]
@@ -9,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hat", "vee", "exp", "log", "angle"]
+__all__ = ["hat", "vee", "exp", "log", "angle", "about", "from_quaternion", "rot_z", "frame_z_to"]
 
 
 def hat(v: np.ndarray) -> np.ndarray:
@@ -71,3 +75,45 @@ def log(R: np.ndarray) -> np.ndarray:
         sign = np.where(np.sum(axis * vn, axis=-1) < 0.0, -1.0, 1.0)
         out[near_pi] = (sign * thn)[:, None] * axis
     return out
+
+
+def about(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rodrigues rotations ``(K, 3, 3)`` about the unit ``axis`` (3,) by ``angles (K,)`` [rad]."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def from_quaternion(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices ``(N, 3, 3)`` of unit quaternions ``(N, 4)`` stored ``(x, y, z, w)``."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    R = np.empty((q.shape[0], 3, 3))
+    R[:, 0, 0] = 1 - 2 * (y * y + z * z)
+    R[:, 0, 1] = 2 * (x * y - z * w)
+    R[:, 0, 2] = 2 * (x * z + y * w)
+    R[:, 1, 0] = 2 * (x * y + z * w)
+    R[:, 1, 1] = 1 - 2 * (x * x + z * z)
+    R[:, 1, 2] = 2 * (y * z - x * w)
+    R[:, 2, 0] = 2 * (x * z - y * w)
+    R[:, 2, 1] = 2 * (y * z + x * w)
+    R[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    return R
+
+
+def rot_z(angle: float) -> np.ndarray:
+    """The rotation (3, 3) by ``angle`` [rad] about z."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def frame_z_to(axis: np.ndarray) -> np.ndarray:
+    """A fixed rotation (3, 3) whose third column is the unit vector of ``axis``.
+
+    Its x is ``helper × z`` normalised, with ``helper`` the x axis unless z is within
+    about 25° of it (then the y axis); its y is ``z × x``.
+    """
+    z = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])

@@ -1,0 +1,136 @@
+"""Atomic file writes, the one writer of the project: a temporary file in the target's folder, then ``os.replace``.
+
+Part of the floor every package may import (with :mod:`pinarms.execution` and
+:mod:`pinarms.units`): it imports nothing of pinarms but the error classes.
+
+A crash or an exception while writing never leaves a partial file at the target path (an
+existing file there stays untouched until the new one is complete). The temporary file is
+``.<name>.<random>.part`` beside the target, locked (``flock``) while it is written. A
+process killed mid-write (SIGKILL, power loss) cannot remove its own; the next save of the
+same target removes every such leftover that no live writer holds and that is older than
+:data:`STALE_AFTER_S`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from pathlib import Path
+from typing import BinaryIO, Callable
+
+from pinarms.robots.errors import InvalidInput
+
+try:  # POSIX; elsewhere leftovers are recognised by age alone
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None  # type: ignore[assignment]
+
+__all__ = ["atomic_write", "write_text", "clean_leftovers", "STALE_AFTER_S"]
+
+STALE_AFTER_S = 2.0
+"""A ``.part`` file is a leftover once unlocked and unmodified for this long (s); without flock: 1 hour."""
+
+
+def _default_mode() -> int:
+    """Permissions a plain ``open(path, "w")`` would give (0o666 minus the umask)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _is_part_of(entry: str, name: str) -> bool:
+    """Whether ``entry`` is a temporary file of :func:`atomic_write` for target ``name``."""
+    prefix = f".{name}."
+    if not (entry.startswith(prefix) and entry.endswith(".part")):
+        return False
+    middle = entry[len(prefix): -len(".part")]
+    return 0 < len(middle) <= 16 and "." not in middle and "/" not in middle
+
+
+def clean_leftovers(target: str | os.PathLike, *, keep: str | None = None) -> list[Path]:
+    """Remove the ``.<name>.*.part`` files a crashed save of ``target`` left; return those removed.
+
+    A file is removed only when no process holds its lock (its writer is gone) and it is
+    older than :data:`STALE_AFTER_S`; ``keep`` names one to leave alone (the caller's own).
+    """
+    target = Path(target)
+    folder = target.parent if str(target.parent) else Path(".")
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    now = time.time()
+    for e in entries:
+        if e.name == keep or not _is_part_of(e.name, target.name):
+            continue
+        try:
+            if not e.is_file(follow_symlinks=False):
+                continue
+            fd = os.open(e.path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+        except OSError:
+            continue
+        try:
+            st = os.fstat(fd)
+            if fcntl is not None:
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                except OSError:
+                    continue  # a live writer holds it
+                if now - st.st_mtime < STALE_AFTER_S:
+                    continue
+            elif now - st.st_mtime < 3600:  # pragma: no cover - Windows
+                continue
+            os.unlink(e.path)
+            removed.append(Path(e.path))
+        except OSError:
+            continue
+        finally:
+            os.close(fd)
+    return removed
+
+
+def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> Path:
+    """Write ``path`` through ``write(fileobj)`` atomically; return the path.
+
+    Leftover temporary files of earlier crashed saves of the same target are removed
+    (see :func:`clean_leftovers`).
+
+    Raises:
+        InvalidInput: the target's folder does not exist or the target is a folder.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InvalidInput(f"a file path must be a str or a path, got {type(path).__name__}")
+    target = Path(path)
+    if "\x00" in str(target) or not target.name or target.name in (".", ".."):
+        raise InvalidInput(f"cannot write {str(target)!r}: not a file name")
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")
+    if target.is_dir():
+        raise InvalidInput(f"cannot write {str(target)!r}: it is a folder; give a file name")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            if fcntl is not None:
+                fcntl.flock(f.fileno(), fcntl.LOCK_EX)  # held until the file is closed: marks a live writer
+            clean_leftovers(target, keep=os.path.basename(tmp))
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+            os.chmod(tmp, _default_mode())
+            os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return target
+
+
+def write_text(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` (UTF-8, ``\n`` line ends) to ``path`` atomically (:func:`atomic_write`); return the path."""
+    data = text.encode("utf-8")
+    return atomic_write(path, lambda f: f.write(data))
