@@ -12,7 +12,7 @@ pipe, a file, CI), so machine-readable output and logs stay clean.
 The line is drawn by click's progress bar (``click.progressbar``, click being the command
 line's own library) and looks like
 ``workspace samples  [############............]  5000000/10000000   50%  1.2 s``; it is
-redrawn in place at most every 0.1 s and :meth:`ProgressBar.close` ends it. What stays here
+redrawn in place (carriage return, erase line) at most every 0.1 s and :meth:`ProgressBar.close` ends it. What stays here
 is the callback interface, the throttling and the decision whether to draw at all.
 """
 
@@ -109,8 +109,10 @@ class ProgressBar:
         if not (force or finished) and now - self._last_draw < self._min_interval:
             return
         self._last_draw = now
-        self._bar.pos = self.done
-        self._bar.render_progress()
+        # click formats the line; it is written here, since whether to draw was decided by ``wanted``
+        # (click itself would print only the label on a stream that is not a terminal)
+        self._stream.write("\r\x1b[2K" + self.text())
+        self._stream.flush()
         self._drawn = (self.done, self.total, self.note)
 
     def close(self) -> None:
@@ -121,7 +123,8 @@ class ProgressBar:
             if self._drawn != (self.done, self.total, self.note):
                 self._draw(force=True)
             if self._drawn is not None:
-                self._bar.render_finish()
+                self._stream.write("\n")
+                self._stream.flush()
         self._closed = True
 
     def __enter__(self) -> "ProgressBar":

@@ -17,7 +17,7 @@ class _Tty(io.StringIO):
 
 def _last_line(out: _Tty) -> str:
     """The last state drawn, without click's cursor hide/show sequences."""
-    return out.getvalue().split("\r")[-1].replace("\x1b[?25l", "").replace("\x1b[?25h", "")
+    return out.getvalue().split("\r")[-1].replace("\x1b[?25l", "").replace("\x1b[?25h", "").replace("\x1b[2K", "")
 
 
 def test_wanted_only_for_a_terminal_without_json():

@@ -294,7 +294,7 @@ def test_workspace_progress_from_a_million_samples(run, monkeypatch):
     monkeypatch.setattr(cli_common, "show_progress", lambda as_json: not as_json)
     assert run("workspace", "gantry_flower", "-n", "20000").stderr == ""
     big = run("workspace", "gantry_flower", "-n", "1000000")
-    assert big.stderr.split("\r\x1b[2K")[-1].startswith("workspace samples  [########################]  100%  1000000/1000000")
+    assert big.stderr.split("\r\x1b[2K")[-1].startswith("workspace samples  [########################]  1000000/1000000  100%")
 
 
 def test_ik_names_closed_form_solutions_just_outside_the_ranges(run):
