@@ -47,6 +47,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms.optim.errors import InvalidSettings
+from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
 from pinarms.robots.errors import InvalidInput
 
 __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS"]
@@ -143,6 +144,8 @@ class MotionChecker:
         step: largest travel [m] of any point between two samples of an edge (default
             ``margin``).
         threads: threads of Pinocchio's batch checks.
+        cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
+            verdicts, coal only where the cover is inconclusive).
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -150,7 +153,7 @@ class MotionChecker:
 
     def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1) -> None:
+                 threads: int = 1, cover: bool = True) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
         self.cell = cell
@@ -188,9 +191,12 @@ class MotionChecker:
         self._travel_t, self._travel_i = self._moving_travel(levers)
         # the pairs that involve a planned arm, each with its margin
         planned = set(self.arms)
-        self.pair_index = np.array([k for k, p in enumerate(cell.pairs) if p.owner_a in planned or p.owner_b in planned],
-                                   dtype=int)
-        self.pairs = tuple(cell.pairs[k] for k in self.pair_index)
+        chosen = [p for p in pairs_for(cell, self.margin + self.step * 2.0 ** (COARSE_LEVELS - 1))
+                  if p.owner_a in planned or p.owner_b in planned]
+        where = {p: k for k, p in enumerate(cell.pairs)}
+        # index into cell.pairs (-1: a pair the cell does not check at zero clearance, bounded exactly)
+        self.pair_index = np.array([where.get(p, -1) for p in chosen], dtype=int)
+        self.pairs = tuple(chosen)
         self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
         gm = cell.collision_model.copy()
         gm.removeAllCollisionPairs()
@@ -208,7 +214,11 @@ class MotionChecker:
         #: Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see :meth:`_calibrate`).
         self.batch_loop: str | None = None
         self._identity = self._pin_is_identity()
-        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0}
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0}
+        #: The sphere cover screening every check (:mod:`robots.cell.cover`): what it proves clear is
+        #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
+        self.cover = link_cover(cell) if cover else None
+        self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -322,6 +332,8 @@ class MotionChecker:
         if not self.within_limits(x[None])[0]:
             return False
         q = self.full(x[None])[0]
+        if self.cover is not None and self.cover.screen(q[None], self._cover_pairs, self.pair_margin)[0]:
+            return True
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
 
     def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
@@ -330,11 +342,20 @@ class MotionChecker:
         stop at the first such row (the rows after it are then reported False)."""
         Q = np.atleast_2d(Q)
         self.counts["configurations"] += Q.shape[0]
+        out = np.zeros(Q.shape[0], dtype=bool)
         if Q.shape[0] == 0:
-            return np.zeros(0, dtype=bool)
-        qp = np.asfortranarray(self._to_pin(Q).T)
-        out = pin.computeCollisionsInParallel(self.threads, self._pool(which), qp, True, bool(stop))
-        return np.asarray(out, dtype=bool).reshape(-1)
+            return out
+        rest = np.arange(Q.shape[0])
+        if self.cover is not None:
+            extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
+            rest = np.flatnonzero(~self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra))
+            self.counts["coal"] += int(rest.size)
+            if rest.size == 0:
+                return out
+        qp = np.asfortranarray(self._to_pin(Q[rest]).T)
+        hit = pin.computeCollisionsInParallel(self.threads, self._pool(which), qp, True, bool(stop))
+        out[rest] = np.asarray(hit, dtype=bool).reshape(-1)
+        return out
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
@@ -349,7 +370,10 @@ class MotionChecker:
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
         N = Q.shape[0]
         self.counts["exact"] += N
-        lb = pair_lower_bounds(self.cell, Q)[:, self.pair_index] - self.pair_margin
+        known = self.pair_index >= 0
+        lb = np.full((N, self.pair_index.size), -np.inf)
+        lb[:, known] = pair_lower_bounds(self.cell, Q)[:, self.pair_index[known]]
+        lb -= self.pair_margin
         if mask is not None:
             lb[:, ~np.asarray(mask, dtype=bool)] = np.inf
         order = np.argsort(lb, axis=1, kind="stable")
@@ -362,7 +386,7 @@ class MotionChecker:
             pin.updateGeometryPlacements(self.model, self._data, gm, gd, qp[i])
             best, k_best, d_best = np.inf, -1, np.inf
             for k in order[i]:
-                if lb[i, k] >= best or not np.isfinite(lb[i, k]):
+                if lb[i, k] >= best:
                     break
                 d = pin.computeDistance(gm, gd, int(k)).min_distance
                 e = d - self.pair_margin[k]

@@ -151,36 +151,52 @@ def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl
 
 @_jit
 def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, radius, start, exact, FR,
-                  Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, bjoint, bcenter, brad, pair_a, pair_b,
-                  threshold, out):
+                  Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, hjoint, hcenter, hrad, group_start, group_a,
+                  group_b, group_t, pair_a, pair_b, threshold, stop, out):
     """``out[i]``: every pair proven more than its threshold apart at ``Q[i]`` (module docstring of :mod:`.cover`).
 
-    Each pair is first tested on the geometries' bounding spheres, then on their covers."""
+    The pairs come in groups (the geometries of one link against those of another); a group
+    is first tested on the two bounding spheres (``hjoint``, ``hcenter``, ``hrad``) at its
+    largest threshold, then pair by pair on the geometries' bounding spheres, then on their
+    covers. ``stop``: return at the first inconclusive row (its index; else −1)."""
     nj = parent.shape[0]
     R = np.empty((nj, 3, 3))
     p = np.empty((nj, 3))
     W = np.empty((joint.shape[0], 3))
     SA = np.empty((sjoint.shape[0], 3))
     SB = np.empty((sjoint.shape[0], 3))
-    BW = np.empty((bjoint.shape[0], 3))
+    HW = np.empty((hjoint.shape[0], 3))
     for i in range(Q.shape[0]):
         _fk(Q[i], parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
         _centers(R, p, joint, center, W)
         _centers(R, p, sjoint, sa_local, SA)
         _centers(R, p, sjoint, sb_local, SB)
-        _centers(R, p, bjoint, bcenter, BW)
+        _centers(R, p, hjoint, hcenter, HW)
         ok = True
-        for k in range(pair_a.shape[0]):
-            ga = pair_a[k]
-            gb = pair_b[k]
-            t = threshold[k]
-            reach = brad[ga] + brad[gb] + t
-            e0 = BW[ga, 0] - BW[gb, 0]
-            e1 = BW[ga, 1] - BW[gb, 1]
-            e2 = BW[ga, 2] - BW[gb, 2]
-            if reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach:
+        for g in range(group_t.shape[0]):
+            if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
                 continue
-            if not _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t):
-                ok = False
+            for k in range(group_start[g], group_start[g + 1]):
+                ga = pair_a[k]
+                gb = pair_b[k]
+                if _apart(HW, hrad, ga, gb, threshold[k]):
+                    continue
+                if not _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb,
+                                   threshold[k]):
+                    ok = False
+                    break
+            if not ok:
                 break
         out[i] = ok
+        if stop and not ok:
+            return i
+    return -1
+
+
+@_jit
+def _apart(HW, hrad, a, b, t):
+    reach = hrad[a] + hrad[b] + t
+    e0 = HW[a, 0] - HW[b, 0]
+    e1 = HW[a, 1] - HW[b, 1]
+    e2 = HW[a, 2] - HW[b, 2]
+    return reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach

@@ -36,7 +36,7 @@ import pinocchio as pin
 
 from ._cover_kernel import screen_kernel
 
-__all__ = ["Cover", "geometry_spheres", "geometry_segments", "link_cover", "pairs_for", "MAX_SPHERES"]
+__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pairs_for", "MAX_SPHERES"]
 
 #: Most spheres per geometry.
 MAX_SPHERES = 12
@@ -175,16 +175,70 @@ class Cover:
         centers_kernel(Q, *self.fk, self.joint, self.center, out)
         return out
 
-    def screen(self, Q: np.ndarray, pair_a: np.ndarray, pair_b: np.ndarray, threshold: np.ndarray) -> np.ndarray:
-        """``(N,)`` bool: True where the cover **proves** every pair ``(pair_a[k], pair_b[k])`` (geometry
-        indices) farther apart than ``threshold[k]`` [m] at cell configuration ``Q[i]``; False:
-        inconclusive (the exact check decides)."""
+    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> "PairSet":
+        """The pairs ``(pair_a[k], pair_b[k])`` (geometry indices) grouped for :meth:`screen`: by the two
+        links (a fixture's geometry alone), each link with one sphere holding its geometries."""
+        pair_a = np.asarray(pair_a, dtype=np.int64)
+        pair_b = np.asarray(pair_b, dtype=np.int64)
+        bjoint, bc, br = self.bounds
+        G = br.size
+        key = np.where(bjoint > 0, bjoint, -np.arange(G) - 1)
+        members: dict[int, list[int]] = {}
+        for g in np.unique(np.concatenate([pair_a, pair_b])):
+            members.setdefault(int(key[g]), []).append(int(g))
+        hjoint, hc, hr, where = list(bjoint), list(bc), list(br), {}
+        for k, gs in members.items():
+            c, r = bc[gs], br[gs]
+            centre = 0.5 * ((c - r[:, None]).min(axis=0) + (c + r[:, None]).max(axis=0))
+            where[k] = len(hr)
+            hjoint.append(int(bjoint[gs[0]]))
+            hc.append(centre)
+            hr.append(float((np.linalg.norm(c - centre, axis=1) + r).max()) * (1.0 + 1e-12))
+        ka, kb = key[pair_a], key[pair_b]
+        order = np.lexsort((kb, ka))
+        ka, kb = ka[order], kb[order]
+        first = np.flatnonzero(np.concatenate([[True], (ka[1:] != ka[:-1]) | (kb[1:] != kb[:-1])])) if order.size \
+            else np.zeros(0, dtype=int)
+        return PairSet(pair_a[order], pair_b[order], order, np.append(first, order.size).astype(np.int64),
+                       np.array([where[int(k)] for k in ka[first]], dtype=np.int64),
+                       np.array([where[int(k)] for k in kb[first]], dtype=np.int64),
+                       np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
+                       np.array(hr))
+
+    def screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: True where the cover **proves** every pair of ``pairs`` (:meth:`prepare`)
+        farther apart than its ``threshold`` [m] (in the order the pairs were given) at cell
+        configuration ``Q[i]``; False: inconclusive (the exact check decides). ``stop``: the rows
+        after the first inconclusive one are not screened (reported False)."""
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.zeros(Q.shape[0], dtype=np.bool_)
-        if Q.shape[0]:
-            screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
-                          self.frame_p, self.size, *self.segments, *self.bounds, pair_a, pair_b, np.asarray(threshold, dtype=float), out)
+        if Q.shape[0] == 0:
+            return out
+        if pairs.pair_a.size == 0:
+            out[:] = True
+            return out
+        t = np.asarray(threshold, dtype=float)[pairs.order]
+        group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
+        screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
+                      self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
+                      pairs.group_start, pairs.group_a, pairs.group_b, group_t, pairs.pair_a, pairs.pair_b, t,
+                      bool(stop), out)
         return out
+
+
+@dataclass(frozen=True, eq=False)
+class PairSet:
+    """Pairs of geometries grouped by link for :meth:`Cover.screen` (built by :meth:`Cover.prepare`)."""
+
+    pair_a: np.ndarray
+    pair_b: np.ndarray
+    order: np.ndarray
+    group_start: np.ndarray
+    group_a: np.ndarray
+    group_b: np.ndarray
+    hjoint: np.ndarray
+    hcenter: np.ndarray
+    hrad: np.ndarray
 
 
 def _fk_arrays(cell: Any) -> tuple:
