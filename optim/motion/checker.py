@@ -57,6 +57,9 @@ __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", 
 MAX_SPLITS = 10
 #: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
 COARSE_LEVELS = 3
+#: Levels up to this one are screened by the sphere cover alone where it is tight
+#: (:attr:`MotionChecker.cover_decides_screens`); finer levels go to coal where it is inconclusive.
+COVER_LEVELS = 0
 
 
 @dataclass(frozen=True)
@@ -474,7 +477,7 @@ class MotionChecker:
         order = order[~self.covered(Q[order], level)]  # what the cover leaves to coal, coarse-first
         if order.size == 0:
             return Verdict(True)
-        tight = self.cover_decides_screens
+        tight = self.cover_decides_screens and level <= COVER_LEVELS
         flags = np.ones(order.size, dtype=bool) if tight else self.coal_collides(Q[order], level, stop=True)
         if not flags.any():
             return Verdict(True)
@@ -520,7 +523,8 @@ class MotionChecker:
             lb = np.concatenate([lb, np.full(len(new_states), -1.0)])
             ends = sorted({k for iv in nxt for k in iv[:2] if lb[k] < s_level})
             Qe = np.array([qs[k] for k in ends])
-            passed = self.covered(Qe, level) if tight else ~self.batch_collides(Qe, level)
+            # the cover alone screens the coarse levels; coal has the last word on the fine ones
+            passed = self.covered(Qe, level) if tight and level <= COVER_LEVELS else ~self.batch_collides(Qe, level)
             for k, ok in zip(ends, passed):
                 if ok:
                     lb[k] = s_level
