@@ -117,9 +117,20 @@ def _cylinder_distance(x, a, b, r):
 
 
 @_jit
-def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t):
+def _exact_distance(x, other, exact, FR, Fp, size, SA, SB, srad, sstart):
+    if exact[other] != 0:
+        return _shape_distance(x, exact[other], FR[other], Fp[other], size[other])
+    k = sstart[other]
+    return _cylinder_distance(x, SA[k], SB[k], srad[k])
+
+
+@_jit
+def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
     """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
-    cylinder or sphere, or a moving cylinder): all more than ``t`` away."""
+    cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
+    ``g`` (``HW[g]``, ``hrad[g]``) first."""
+    if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
+        return True
     for s in range(start[g], start[g + 1]):
         if exact[other] != 0:
             d = _shape_distance(W[s], exact[other], FR[other], Fp[other], size[other])
@@ -132,12 +143,12 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
 
 
 @_jit
-def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t):
+def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
     """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
     if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
-        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t)
+        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
     if exact[ga] != 0 or cyl[ga]:
-        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t)
+        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
     for sa in range(start[ga], start[ga + 1]):
         for sb in range(start[gb], start[gb + 1]):
             reach = radius[sa] + radius[sb] + t
@@ -152,7 +163,7 @@ def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl
 @_jit
 def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, radius, start, exact, FR,
                   Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, hjoint, hcenter, hrad, group_start, group_a,
-                  group_b, group_t, pair_a, pair_b, threshold, stop, out):
+                  group_b, group_fixed, group_t, pair_a, pair_b, threshold, stop, out):
     """``out[i]``: every pair proven more than its threshold apart at ``Q[i]`` (module docstring of :mod:`.cover`).
 
     The pairs come in groups (the geometries of one link against those of another); a group
@@ -176,13 +187,17 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
         for g in range(group_t.shape[0]):
             if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
                 continue
+            fixed = group_fixed[g]
+            if fixed >= 0 and _shape_distance(HW[group_a[g]], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) \
+                    - hrad[group_a[g]] > group_t[g]:
+                continue
             for k in range(group_start[g], group_start[g + 1]):
                 ga = pair_a[k]
                 gb = pair_b[k]
                 if _apart(HW, hrad, ga, gb, threshold[k]):
                     continue
                 if not _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb,
-                                   threshold[k]):
+                                   threshold[k], HW, hrad):
                     ok = False
                     break
             if not ok:

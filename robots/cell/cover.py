@@ -194,14 +194,18 @@ class Cover:
             hjoint.append(int(bjoint[gs[0]]))
             hc.append(centre)
             hr.append(float((np.linalg.norm(c - centre, axis=1) + r).max()) * (1.0 + 1e-12))
+        # an exact fixture goes second in its pairs (its link sphere is the one tested against it)
+        swap = (self.exact[pair_a] != 0) & (self.exact[pair_b] == 0)
+        pair_a, pair_b = np.where(swap, pair_b, pair_a), np.where(swap, pair_a, pair_b)
         ka, kb = key[pair_a], key[pair_b]
         order = np.lexsort((kb, ka))
         ka, kb = ka[order], kb[order]
         first = np.flatnonzero(np.concatenate([[True], (ka[1:] != ka[:-1]) | (kb[1:] != kb[:-1])])) if order.size \
             else np.zeros(0, dtype=int)
+        fixed = np.array([-k - 1 if k < 0 and self.exact[-k - 1] != 0 else -1 for k in kb[first]], dtype=np.int64)
         return PairSet(pair_a[order], pair_b[order], order, np.append(first, order.size).astype(np.int64),
                        np.array([where[int(k)] for k in ka[first]], dtype=np.int64),
-                       np.array([where[int(k)] for k in kb[first]], dtype=np.int64),
+                       np.array([where[int(k)] for k in kb[first]], dtype=np.int64), fixed,
                        np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
                        np.array(hr))
 
@@ -221,7 +225,7 @@ class Cover:
         group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
         screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
                       self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
-                      pairs.group_start, pairs.group_a, pairs.group_b, group_t, pairs.pair_a, pairs.pair_b, t,
+                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t,
                       bool(stop), out)
         return out
 
@@ -236,6 +240,7 @@ class PairSet:
     group_start: np.ndarray
     group_a: np.ndarray
     group_b: np.ndarray
+    group_fixed: np.ndarray
     hjoint: np.ndarray
     hcenter: np.ndarray
     hrad: np.ndarray
