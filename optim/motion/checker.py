@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Sequence
@@ -223,7 +224,10 @@ class MotionChecker:
         self._gd_dist = shared["gd_dist"]
         self._pools: dict[Any, Any] = shared["pools"]
         self._identity = self._pin_is_identity()
-        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0}
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "timeouts": 0}
+        #: ``time.perf_counter()`` after which proofs give up and call their edge not valid (a
+        #: search's time limit; ``None``: never). Giving up never calls anything clear.
+        self.deadline: float | None = None
         #: The sphere cover screening every check (:mod:`robots.cell.cover`): what it proves clear is
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
         self.cover = link_cover(cell) if cover else None
@@ -314,6 +318,13 @@ class MotionChecker:
             pool = self._make_pool(self._shared["loop"], self.pair_margin + extra)
             self._pools[which] = pool
         return pool
+
+    def _timed_out(self) -> bool:
+        """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
+        if self.deadline is None or time.perf_counter() <= self.deadline:
+            return False
+        self.counts["timeouts"] += 1
+        return True
 
     @property
     def cover_decides_screens(self) -> bool:
@@ -467,6 +478,8 @@ class MotionChecker:
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         N = X.shape[0]
+        if self._timed_out():
+            return Verdict(False, -1, 0.0)
         if not convex:
             inside = self.within_limits(X)
             if not inside.all():
@@ -498,7 +511,7 @@ class MotionChecker:
             todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
             if not todo:
                 return Verdict(True, exact=level)
-            if level >= MAX_SPLITS:
+            if level >= MAX_SPLITS or self._timed_out():
                 i = todo[0][3]
                 return Verdict(False, i, todo[0][4], level)
             level += 1
