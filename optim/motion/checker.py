@@ -319,6 +319,16 @@ class MotionChecker:
             self._pools[which] = pool
         return pool
 
+    def warm(self, finest: int = 2) -> None:
+        """Build now what the proofs otherwise build on first use (coal's batch pools of the margins
+        and of the screens down to level ``finest``, the choice of batch loop, whether the cover
+        decides the coarse screens; kept for the next checker of this cell), so that a search's
+        clock measures the search."""
+        self._pool("margin")
+        for level in range(-COARSE_LEVELS, int(finest) + 1):
+            self._pool(level)
+        _ = self.cover_decides_screens
+
     def _timed_out(self) -> bool:
         """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
         if self.deadline is None or time.perf_counter() <= self.deadline:

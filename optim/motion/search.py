@@ -158,8 +158,10 @@ def search(checker: Any, start: np.ndarray, goals: np.ndarray, *, planner: str =
         ss.setPlanner(plan)
         if progress:
             progress(f"searching with {PLANNERS[key]} (at most {time_limit:g} s)")
-        t0 = time.perf_counter()
         inner = getattr(checker, "checker", checker)
+        if hasattr(inner, "warm"):
+            inner.warm()
+        t0 = time.perf_counter()
         if hasattr(inner, "deadline"):  # an edge proof cut short by the limit counts as not valid
             inner.deadline = t0 + float(time_limit)
         try:

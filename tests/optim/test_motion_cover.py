@@ -134,3 +134,20 @@ def test_plan_motion_settings_are_validated_with_their_caps(cells):
             plan_motion(cell, "aubo", qa, qa + 0.1, grid=grid)
     with pytest.raises(InvalidInput, match="the start already is the goal"):
         plan_motion(cell, "aubo", qa, qa.copy())
+
+
+def test_the_search_keeps_its_time_limit(cells):
+    """Edge proofs give up at the limit (the edge counts as not valid): the search ends near it."""
+    from pinarms.optim.errors import NoPathFound
+    from pinarms.optim.motion import scene_queries
+
+    cell = cells["panda_shelf"]
+    queries, hold = scene_queries("panda_shelf", 3, seed=0, margin=MARGIN)
+    limit = 0.05
+    for k, q in enumerate(queries):
+        try:
+            plan = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=limit, seed=k, hold=hold)
+            seconds = plan.seconds["search"]
+        except NoPathFound as err:
+            seconds = err.seconds
+        assert seconds <= 1.1 * limit + 0.05, f"query {k}: the search took {seconds:.3f} s at a {limit} s limit"
