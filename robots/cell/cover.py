@@ -32,11 +32,11 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-import pinocchio as pin
 
 from ._cover_kernel import screen_kernel
 
-__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pairs_for", "MAX_SPHERES"]
+__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
+           "MAX_SPHERES"]
 
 #: Most spheres per geometry.
 MAX_SPHERES = 12
@@ -225,8 +225,8 @@ class Cover:
         group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
         screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
                       self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
-                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t,
-                      bool(stop), out)
+                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
+                      pairs.pair_b, t, bool(stop), out)
         return out
 
 
@@ -312,11 +312,3 @@ def _bounds(objs: list, start: np.ndarray, centers: list, radii: list) -> tuple:
 def pair_arrays(pairs: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
     """Geometry indices ``(pair_a, pair_b)`` of :class:`CollisionPair` s, for :meth:`Cover.screen`."""
     return (np.array([p.index_a for p in pairs], dtype=np.int64), np.array([p.index_b for p in pairs], dtype=np.int64))
-
-
-def placements_of(cell: Any, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """World rotation and position of every geometry at one cell configuration (Pinocchio; for tests)."""
-    data = cell.model.createData()
-    gd = pin.GeometryData(cell.collision_model)
-    pin.updateGeometryPlacements(cell.model, data, cell.collision_model, gd, cell.robot.q_to_pinocchio(q[None])[0])
-    return (np.array([M.rotation for M in gd.oMg]), np.array([M.translation for M in gd.oMg]))
