@@ -58,6 +58,14 @@ __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", 
 MAX_SPLITS = 10
 #: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
 COARSE_LEVELS = 3
+#: Configurations per coal batch while a deadline runs (the clock is read between two).
+COAL_CHUNK = 16
+
+
+class _GiveUp(Exception):
+    """A proof passed its checker's deadline."""
+
+
 #: Levels up to this one are screened by the sphere cover alone where it is tight
 #: (:attr:`MotionChecker.cover_decides_screens`); finer levels go to coal where it is inconclusive.
 COVER_LEVELS = 0
@@ -418,8 +426,21 @@ class MotionChecker:
         if Q.shape[0] == 0:
             return np.zeros(0, dtype=bool)
         qp = np.asfortranarray(self._to_pin(Q).T)
-        hit = pin.computeCollisionsInParallel(self.threads, self._pool(which), qp, True, bool(stop))
-        return np.asarray(hit, dtype=bool).reshape(-1)
+        pool = self._pool(which)
+        if self.deadline is None:
+            hit = pin.computeCollisionsInParallel(self.threads, pool, qp, True, bool(stop))
+            return np.asarray(hit, dtype=bool).reshape(-1)
+        out = np.zeros(Q.shape[0], dtype=bool)
+        for a in range(0, Q.shape[0], COAL_CHUNK):  # under a deadline: in chunks, looking at the clock
+            if self._timed_out():
+                raise _GiveUp
+            chunk = np.asfortranarray(qp[:, a:a + COAL_CHUNK])
+            hit = np.asarray(pin.computeCollisionsInParallel(self.threads, pool, chunk, True, bool(stop)),
+                             dtype=bool).reshape(-1)
+            out[a:a + hit.size] = hit
+            if stop and hit.any():
+                break
+        return out
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
@@ -470,6 +491,14 @@ class MotionChecker:
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
     def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
+        """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin (:meth:`_prove`);
+        past :attr:`deadline` the proof gives up: not valid."""
+        try:
+            return self._prove(X, budgets, midpoint, convex, top)
+        except _GiveUp:
+            return Verdict(False, -1, 0.0)
+
+    def _prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
         """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
 
         ``budgets (N-1,)``: travel bound [m] between consecutive samples (each ≤ ``step``);
