@@ -204,8 +204,8 @@ class MotionChecker:
         self._travel_t, self._travel_i = self._moving_travel(levers)
         # the pairs that involve a planned arm, each with its margin
         planned = set(self.arms)
-        chosen = [p for p in pairs_for(cell, self.margin + self.step * 2.0 ** (COARSE_LEVELS - 1))
-                  if p.owner_a in planned or p.owner_b in planned]
+        widest = max(self.margin, self.self_margin) + self.step * 2.0 ** (COARSE_LEVELS - 1)  # the coarsest screen
+        chosen = [p for p in pairs_for(cell, widest) if p.owner_a in planned or p.owner_b in planned]
         where = {p: k for k, p in enumerate(cell.pairs)}
         # index into cell.pairs (-1: a pair the cell does not check at zero clearance, bounded exactly)
         self.pair_index = np.array([where.get(p, -1) for p in chosen], dtype=int)
