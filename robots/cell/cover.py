@@ -63,7 +63,7 @@ def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if V.shape[0] == 0:
         return None
-    if T.shape[0] == 0:  # a point cloud: every vertex in one group
+    if T.shape[0] == 0:  # a point cloud: each vertex a degenerate triangle
         T = np.repeat(np.arange(V.shape[0])[:, None], 3, axis=1)
     lo, hi = V.min(axis=0), V.max(axis=0)
     ext = hi - lo
