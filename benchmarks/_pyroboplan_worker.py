@@ -53,20 +53,33 @@ def main() -> None:
                                     collision_distance_padding=job["padding"], fast_return=True)
         planner = RRTPlanner(model, gm, options=options)
         t0 = time.perf_counter()
-        with contextlib.redirect_stdout(sys.stderr):  # pyroboplan prints its progress
-            path = planner.plan(q0, q1)
+        try:
+            with contextlib.redirect_stdout(sys.stderr):  # pyroboplan prints its progress
+                path = planner.plan(q0, q1)
+        except Exception as exc:  # noqa: BLE001 - one failing query must not end the run
+            path, error = None, f"{type(exc).__name__}: {exc}"
+        else:
+            error = None
         seconds = time.perf_counter() - t0
-        rec = {"ok": path is not None, "seconds": seconds}
-        if path is not None:
+        # on a timeout pyroboplan's RRT returns [] (not None)
+        ok = path is not None and len(path) > 0
+        rec = {"ok": ok, "seconds": seconds, "timeout": path is not None and not ok}
+        if error:
+            rec["error"] = error
+        if ok:
             P = np.asarray(path)[:, cols]
             rec["length"] = float(np.linalg.norm(np.diff(P, axis=0), axis=1).sum())
             if job.get("shortcut") and shortcut_path is not None:
                 t0 = time.perf_counter()
-                with contextlib.redirect_stdout(sys.stderr):
-                    short = shortcut_path(model, gm, path, max_step_size=job["step"])
-                rec["shortcut_seconds"] = time.perf_counter() - t0
-                S = np.asarray(short)[:, cols]
-                rec["shortcut_length"] = float(np.linalg.norm(np.diff(S, axis=0), axis=1).sum())
+                try:
+                    with contextlib.redirect_stdout(sys.stderr):
+                        short = shortcut_path(model, gm, path, max_step_size=job["step"])
+                except Exception as exc:  # noqa: BLE001
+                    rec["shortcut_error"] = f"{type(exc).__name__}: {exc}"
+                else:
+                    rec["shortcut_seconds"] = time.perf_counter() - t0
+                    S = np.asarray(short)[:, cols]
+                    rec["shortcut_length"] = float(np.linalg.norm(np.diff(S, axis=0), axis=1).sum())
         out.append(rec)
     json.dump({"pin": pin.__version__, "results": out}, sys.stdout)
 

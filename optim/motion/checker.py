@@ -39,6 +39,8 @@ in rad or m; time in s.
 from __future__ import annotations
 
 import math
+import threading
+import time
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Sequence
@@ -47,14 +49,26 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms.optim.errors import InvalidSettings
+from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS"]
+__all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "check_threads"]
 
 #: Finest level of the proof: intervals of ``step / 2^MAX_SPLITS`` travel; still unproven there: invalid.
 MAX_SPLITS = 10
 #: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
 COARSE_LEVELS = 3
+#: Configurations per coal batch while a deadline runs (the clock is read between two).
+COAL_CHUNK = 16
+
+
+class _GiveUp(Exception):
+    """A proof passed its checker's deadline."""
+
+
+#: Levels up to this one are screened by the sphere cover alone where it is tight
+#: (:attr:`MotionChecker.cover_decides_screens`); finer levels go to coal where it is inconclusive.
+COVER_LEVELS = 0
 
 
 @dataclass(frozen=True)
@@ -94,12 +108,6 @@ def _cold(gd: pin.GeometryData) -> pin.GeometryData:
     from pinarms.robots.collision_requests import cold_start
 
     return cold_start(gd, distance_tolerance=1e-10)
-
-
-def _pairs_for(cell: Any, clearance: float) -> tuple:
-    """The cell's pairs a check at ``clearance`` [m] must look at (checked + out-of-reach pairs not proven farther)."""
-    pairs_for = getattr(cell, "pairs_for", None)
-    return pairs_for(clearance) if callable(pairs_for) else cell.pairs
 
 
 def _set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
@@ -149,6 +157,8 @@ class MotionChecker:
         step: largest travel [m] of any point between two samples of an edge (default
             ``margin``).
         threads: threads of Pinocchio's batch checks.
+        cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
+            verdicts, coal only where the cover is inconclusive).
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -156,7 +166,7 @@ class MotionChecker:
 
     def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1) -> None:
+                 threads: int = 1, cover: bool = True) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
         self.cell = cell
@@ -192,31 +202,45 @@ class MotionChecker:
         self.moving_speed = float(sum(np.abs(m.trajectory.peaks().velocity) @ levers[c]
                                       for m, c in zip(self.moving, self._moving_cols)))
         self._travel_t, self._travel_i = self._moving_travel(levers)
-        # the pairs that involve a planned arm, each with its margin: every pair not proven
-        # farther than the larger margin (Cell.pairs_for), indices into that prefix of the candidates
+        # the pairs that involve a planned arm, each with its margin: every pair not proven farther
+        # than the widest screen of either margin (Cell.pairs_for)
         planned = set(self.arms)
-        relevant = _pairs_for(cell, max(self.margin, self.self_margin))
-        self.pair_index = np.array([k for k, p in enumerate(relevant) if p.owner_a in planned or p.owner_b in planned],
-                                   dtype=int)
-        self.pairs = tuple(relevant[k] for k in self.pair_index)
+        widest = max(self.margin, self.self_margin) + self.step * 2.0 ** (COARSE_LEVELS - 1)  # the coarsest screen
+        chosen = [p for p in pairs_for(cell, widest) if p.owner_a in planned or p.owner_b in planned]
+        where = {p: k for k, p in enumerate(cell.pairs)}
+        # index into cell.pairs (-1: a pair the cell does not check at zero clearance, bounded exactly)
+        self.pair_index = np.array([where.get(p, -1) for p in chosen], dtype=int)
+        self.pairs = tuple(chosen)
         self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
-        gm = cell.collision_model.copy()
-        gm.removeAllCollisionPairs()
-        for p in self.pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-        self.geometry = gm
         self.model = cell.model
-        self.threads = int(threads)
+        self.threads = check_threads(threads)
         self._data = self.model.createData()
-        self._gd = _cold(pin.GeometryData(gm))
-        _set_margins(self._gd, self.pair_margin)
-        self._manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(self.model, gm, self._gd)
-        self._gd_dist = _cold(pin.GeometryData(gm))
-        self._pools: dict[Any, Any] = {}
-        #: Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see :meth:`_calibrate`).
-        self.batch_loop: str | None = None
+        shared = _shared(cell, self.pairs, self.pair_margin, self.threads)
+        if "geometry" not in shared:
+            gm = cell.collision_model.copy()
+            gm.removeAllCollisionPairs()
+            for p in self.pairs:
+                gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
+            gd = _cold(pin.GeometryData(gm))
+            _set_margins(gd, self.pair_margin)
+            manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(self.model, gm, gd)
+            shared.update(geometry=gm, gd=gd, manager=manager, gd_dist=_cold(pin.GeometryData(gm)), pools={},
+                          loop=None)
+        self._shared = shared
+        self.geometry = shared["geometry"]
+        self._gd = shared["gd"]
+        self._manager = shared["manager"]
+        self._gd_dist = shared["gd_dist"]
+        self._pools: dict[Any, Any] = shared["pools"]
         self._identity = self._pin_is_identity()
-        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0}
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "timeouts": 0}
+        #: ``time.perf_counter()`` after which proofs give up and call their edge not valid (a
+        #: search's time limit; ``None``: never). Giving up never calls anything clear.
+        self.deadline: float | None = None
+        #: The sphere cover screening every check (:mod:`robots.cell.cover`): what it proves clear is
+        #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
+        self.cover = link_cover(cell) if cover else None
+        self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -297,12 +321,56 @@ class MotionChecker:
     def _pool(self, which: Any):
         pool = self._pools.get(which)
         if pool is None:
-            if self.batch_loop is None:
-                self.batch_loop = self._calibrate()
+            if self._shared["loop"] is None:
+                self._shared["loop"] = self._calibrate()
             extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
-            pool = self._make_pool(self.batch_loop, self.pair_margin + extra)
+            pool = self._make_pool(self._shared["loop"], self.pair_margin + extra)
             self._pools[which] = pool
         return pool
+
+    def warm(self, finest: int = 2) -> None:
+        """Build now what the proofs otherwise build on first use (coal's batch pools of the margins
+        and of the screens down to level ``finest``, the choice of batch loop, whether the cover
+        decides the coarse screens; kept for the next checker of this cell), so that a search's
+        clock measures the search."""
+        self._pool("margin")
+        for level in range(-COARSE_LEVELS, int(finest) + 1):
+            self._pool(level)
+        _ = self.cover_decides_screens
+
+    def _timed_out(self) -> bool:
+        """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
+        if self.deadline is None or time.perf_counter() <= self.deadline:
+            return False
+        self.counts["timeouts"] += 1
+        return True
+
+    @property
+    def cover_decides_screens(self) -> bool:
+        """Whether the cover is used, and then alone screens the coarse raised margins of the proof's
+        ladder (what it does not prove counts as not passing: the interval is split; the margins
+        themselves and the fine screens go to coal where it is inconclusive). Chosen once per
+        cell, pairs and margins: when the cover proves clear at least 97 % of 256 seeded random
+        configurations that coal finds clear (spheres and cylinders: the cover is nearly exact);
+        otherwise (meshes, the AUBO-i3 under the guard plate: 93.5 %) it would mostly add its
+        cost to coal's, and coal alone checks, as without the cover."""
+        if self.cover is None or self.timed:
+            return False
+        tight = self._shared.get("tight")
+        if tight is None:
+            X = self.cell.random_q(256, seed=0)[:, self.cols]
+            Q = self.full(X)
+            clear = ~self.coal_collides(Q, "margin")
+            proven = self.cover.screen(Q, self._cover_pairs, self.pair_margin)
+            tight = bool(proven.sum() >= 0.97 * clear.sum())
+            self._shared["tight"] = tight
+        return tight
+
+    @property
+    def batch_loop(self) -> str | None:
+        """Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see
+        :meth:`_calibrate`); ``None`` until the first batch."""
+        return self._shared["loop"]
 
     def _to_pin(self, Q: np.ndarray) -> np.ndarray:
         return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
@@ -330,6 +398,8 @@ class MotionChecker:
         if not self.within_limits(x[None])[0]:
             return False
         q = self.full(x[None])[0]
+        if self.cover_decides_screens and self.cover.screen(q[None], self._cover_pairs, self.pair_margin)[0]:
+            return True
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
 
     def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
@@ -337,12 +407,43 @@ class MotionChecker:
         margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
         stop at the first such row (the rows after it are then reported False)."""
         Q = np.atleast_2d(Q)
+        out = np.zeros(Q.shape[0], dtype=bool)
+        rest = np.flatnonzero(~self.covered(Q, which))
+        out[rest] = self.coal_collides(Q[rest], which, stop)
+        return out
+
+    def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+        """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
+        or of the margins + ``step / 2^(L+1)`` (``which = L``); False: left to coal."""
+        Q = np.atleast_2d(Q)
         self.counts["configurations"] += Q.shape[0]
+        if Q.shape[0] == 0 or not self.cover_decides_screens:
+            return np.zeros(Q.shape[0], dtype=bool)
+        extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
+        return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
+
+    def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
+        Q = np.atleast_2d(Q)
+        self.counts["coal"] += Q.shape[0]
         if Q.shape[0] == 0:
             return np.zeros(0, dtype=bool)
         qp = np.asfortranarray(self._to_pin(Q).T)
-        out = pin.computeCollisionsInParallel(self.threads, self._pool(which), qp, True, bool(stop))
-        return np.asarray(out, dtype=bool).reshape(-1)
+        pool = self._pool(which)
+        if self.deadline is None:
+            hit = pin.computeCollisionsInParallel(self.threads, pool, qp, True, bool(stop))
+            return np.asarray(hit, dtype=bool).reshape(-1)
+        out = np.zeros(Q.shape[0], dtype=bool)
+        for a in range(0, Q.shape[0], COAL_CHUNK):  # under a deadline: in chunks, looking at the clock
+            if self._timed_out():
+                raise _GiveUp
+            chunk = np.asfortranarray(qp[:, a:a + COAL_CHUNK])
+            hit = np.asarray(pin.computeCollisionsInParallel(self.threads, pool, chunk, True, bool(stop)),
+                             dtype=bool).reshape(-1)
+            out[a:a + hit.size] = hit
+            if stop and hit.any():
+                break
+        return out
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
@@ -357,7 +458,10 @@ class MotionChecker:
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
         N = Q.shape[0]
         self.counts["exact"] += N
-        lb = pair_lower_bounds(self.cell, Q)[:, self.pair_index] - self.pair_margin
+        known = self.pair_index >= 0
+        lb = np.full((N, self.pair_index.size), -np.inf)
+        lb[:, known] = pair_lower_bounds(self.cell, Q)[:, self.pair_index[known]]
+        lb -= self.pair_margin
         if mask is not None:
             lb[:, ~np.asarray(mask, dtype=bool)] = np.inf
         order = np.argsort(lb, axis=1, kind="stable")
@@ -370,7 +474,7 @@ class MotionChecker:
             pin.updateGeometryPlacements(self.model, self._data, gm, gd, qp[i])
             best, k_best, d_best = np.inf, -1, np.inf
             for k in order[i]:
-                if lb[i, k] >= best or not np.isfinite(lb[i, k]):
+                if lb[i, k] >= best:
                     break
                 d = pin.computeDistance(gm, gd, int(k)).min_distance
                 e = d - self.pair_margin[k]
@@ -390,6 +494,14 @@ class MotionChecker:
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
     def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
+        """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin (:meth:`_prove`);
+        past :attr:`deadline` the proof gives up: not valid."""
+        try:
+            return self._prove(X, budgets, midpoint, convex, top)
+        except _GiveUp:
+            return Verdict(False, -1, 0.0)
+
+    def _prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
         """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
 
         ``budgets (N-1,)``: travel bound [m] between consecutive samples (each ≤ ``step``);
@@ -408,14 +520,20 @@ class MotionChecker:
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         N = X.shape[0]
+        if self._timed_out():
+            return Verdict(False, -1, 0.0)
         if not convex:
             inside = self.within_limits(X)
             if not inside.all():
                 return Verdict(False, int(np.argmin(inside)), 0.0)
         Q = self.full(X)
-        order = coarse_first(N - 1)
         level = int(top)
-        flags = self.batch_collides(Q[order], level, stop=True)
+        order = coarse_first(N - 1)
+        order = order[~self.covered(Q[order], level)]  # what the cover leaves to coal, coarse-first
+        if order.size == 0:
+            return Verdict(True)
+        tight = self.cover_decides_screens and level <= COVER_LEVELS
+        flags = np.ones(order.size, dtype=bool) if tight else self.coal_collides(Q[order], level, stop=True)
         if not flags.any():
             return Verdict(True)
         first = int(order[int(np.argmax(flags))])
@@ -427,16 +545,15 @@ class MotionChecker:
         # every sample keeps the margins: prove the intervals between them, level by level
         states = [x for x in X]
         qs = [q for q in Q]
-        lb = np.zeros(N)  # proven lower bound of each sample's excess (all keep the margins)
-        screened = self.batch_collides(Q, level)
-        lb[~screened] = self.step / 2.0 ** (level + 1)
+        lb = np.full(N, self.step / 2.0 ** (level + 1))  # proven lower bound of each sample's excess
+        lb[order if tight else order[self.coal_collides(Q[order], level)]] = 0.0
         # intervals: (left sample, right sample, budget, source interval, fraction a, fraction b)
         todo = [(i, i + 1, float(budgets[i]), i, 0.0, 1.0) for i in range(N - 1)]
         while True:
             todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
             if not todo:
                 return Verdict(True, exact=level)
-            if level >= MAX_SPLITS:
+            if level >= MAX_SPLITS or self._timed_out():
                 i = todo[0][3]
                 return Verdict(False, i, todo[0][4], level)
             level += 1
@@ -461,7 +578,8 @@ class MotionChecker:
             lb = np.concatenate([lb, np.full(len(new_states), -1.0)])
             ends = sorted({k for iv in nxt for k in iv[:2] if lb[k] < s_level})
             Qe = np.array([qs[k] for k in ends])
-            passed = ~self.batch_collides(Qe, level)
+            # the cover alone screens the coarse levels; coal has the last word on the fine ones
+            passed = self.covered(Qe, level) if tight and level <= COVER_LEVELS else ~self.batch_collides(Qe, level)
             for k, ok in zip(ends, passed):
                 if ok:
                     lb[k] = s_level
@@ -572,6 +690,42 @@ class MotionChecker:
             if not v.ok:
                 return Verdict(False, i, v.fraction, v.exact)
         return Verdict(True)
+
+
+#: Most threads of Pinocchio's batch checks.
+MAX_THREADS = 256
+#: Checkers' coal data kept per cell (pairs, margins, threads, calling thread) before the oldest go.
+_SHARED_KEEP = 16
+
+
+def check_threads(threads: Any) -> int:
+    """``threads`` as an int in ``1..MAX_THREADS`` or :class:`InvalidSettings` (0 or fewer crash
+    Pinocchio's batch loop; huge counts overflow its argument)."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
+        raise InvalidSettings(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
+    if not 1 <= int(threads) <= MAX_THREADS:
+        raise InvalidSettings(f"threads must be from 1 to {MAX_THREADS} (threads of the batched collision checks), "
+                              f"got {int(threads)}")
+    return int(threads)
+
+
+_SHARED_LOCK = threading.Lock()
+
+
+def _shared(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
+    """coal data (geometry copy, GeometryData, broad phase, batch pools per screen level) shared by
+    the checkers of one cell with the same pairs, margins and thread count, made in the same
+    thread: making them costs tens of ms per checker (cold-starting every request)."""
+    key = (tuple((p.index_a, p.index_b) for p in pairs), margins.tobytes(), threads, threading.get_ident())
+    with _SHARED_LOCK:
+        store = cell.__dict__.setdefault("_motion_checker_shared", {})
+        entry = store.pop(key, None)
+        if entry is None:
+            entry = {}
+            while len(store) >= _SHARED_KEEP:
+                store.pop(next(iter(store)))
+        store[key] = entry  # most recently used last
+        return entry
 
 
 def check_settings(value: Any, name: str) -> float:

@@ -37,15 +37,18 @@ import numpy as np
 
 from pinarms.optim.errors import (GoalInCollision, InfeasibleProblem, InvalidLimits, InvalidSettings, NoPathFound,
                                   StartInCollision)
-from pinarms.optim.motion.checker import MotionChecker
+from pinarms.optim.motion.checker import MotionChecker, check_threads
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
 from pinarms.optim.motion.search import PLANNERS, search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.planning import JointPath, Trajectory
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["MotionPlan", "ClearanceProfile", "plan_motion", "plan_geometry", "SIMPLIFIER", "time_path",
+__all__ = ["MotionPlan", "ClearanceProfile", "plan_motion", "plan_geometry", "SIMPLIFIER", "MAX_GRID", "time_path",
            "clearance_profile", "cell_trajectory"]
+
+#: Most grid intervals of the time scaling (memory grows about 5.5 kB per interval).
+MAX_GRID = 100_000
 
 #: What shortcuts the path (said in every result).
 SIMPLIFIER = "OMPL PathSimplifier (reduceVertices, partialShortcutPath, ropeShortcutPath), edges proven by pinarms"
@@ -435,8 +438,8 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
             [rad/s² or m/s²] (default none) limits, scalar or per planned joint.
         torque: ``True``: the URDF's effort limits where the arm has inertials; limits per
             planned joint [N·m or N]; ``False``: none.
-        grid: grid intervals of the time scaling.
-        threads: threads of the batched collision checks.
+        grid: grid intervals of the time scaling (1 to :data:`MAX_GRID`).
+        threads: threads of the batched collision checks (1 to :data:`optim.motion.checker.MAX_THREADS`).
         progress: called with a short line at each step.
 
     Raises:
@@ -446,7 +449,9 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         UnreachableTarget: a pose goal without any IK solution.
         NoPathFound: no path within ``time_limit`` (planner, time and states explored said).
         InvalidLimits, InfeasibleProblem: limits missing, or not met along the path.
-        InvalidSettings: an unknown planner, a non-positive time limit.
+        InvalidSettings: an unknown planner, a non-positive time limit, ``grid`` or ``threads``
+            out of their range.
+        InvalidInput: also a goal equal to the start (nothing to plan).
     """
     t_all = time.perf_counter()
     say = progress or (lambda _m: None)
@@ -459,6 +464,10 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         raise InvalidSettings(f"time_limit must be a positive number of seconds, got {time_limit!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
         raise InvalidSettings(f"seed must be an integer, got {seed!r}")
+    threads = check_threads(threads)
+    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 1 <= int(grid) <= MAX_GRID:
+        raise InvalidSettings(f"grid must be an integer from 1 to {MAX_GRID} (intervals of the time scaling; "
+                              f"about 5.5 kB each), got {grid!r}")
     checker = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=hold, threads=threads)
     constraints, limits = _limits(cell, arms, vmax, amax, torque)
     x0 = _joints(cell, arms, start, "start")
@@ -508,6 +517,10 @@ def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray,
     cell = checker.cell
     goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
     G = np.array([g.q for g in goals if g.valid])
+    same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
+    if same.size:
+        raise InvalidInput(f"the start already is the goal (joints {np.round(x0, 6).tolist()}): there is nothing to "
+                           "plan; give a goal different from the start")
     seconds: dict[str, float] = {}
     say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
     result = search(checker, x0, G, planner=planner, time_limit=float(time_limit), seed=int(seed))

@@ -158,8 +158,17 @@ def search(checker: Any, start: np.ndarray, goals: np.ndarray, *, planner: str =
         ss.setPlanner(plan)
         if progress:
             progress(f"searching with {PLANNERS[key]} (at most {time_limit:g} s)")
+        inner = getattr(checker, "checker", checker)
+        if hasattr(inner, "warm"):
+            inner.warm()
         t0 = time.perf_counter()
-        status = ss.solve(float(time_limit))
+        if hasattr(inner, "deadline"):  # an edge proof cut short by the limit counts as not valid
+            inner.deadline = t0 + float(time_limit)
+        try:
+            status = ss.solve(float(time_limit))
+        finally:
+            if hasattr(inner, "deadline"):
+                inner.deadline = None
         seconds = time.perf_counter() - t0
         data = ob.PlannerData(si)
         ss.getPlannerData(data)

@@ -1,0 +1,217 @@
+"""Compiled parts of :mod:`.cover` (numba): batched forward kinematics to the cover's spheres and the screen.
+
+Joints as in :class:`.placements.BatchedPlacements` (the same arrays): joint ``i`` sits at
+``(M_R[i], M_p[i])`` after its parent and rotates about (revolute) or moves along its unit
+``axis[i]`` by ``scale[i]·q[index[i]] + offset[i]``; joint 0 is the world. Cached on disk
+like :mod:`robots.ik._kernel` (compiled per process where no cache location is writable).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+def _jit(function):
+    try:
+        return njit(cache=True, nogil=True)(function)
+    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
+        return njit(nogil=True)(function)
+
+
+@_jit
+def _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p):
+    """World rotation ``R (nj, 3, 3)`` and position ``p (nj, 3)`` of every joint (in place)."""
+    for a in range(3):
+        p[0, a] = 0.0
+        for b in range(3):
+            R[0, a, b] = 1.0 if a == b else 0.0
+    RM = np.empty((3, 3))
+    for i in range(1, parent.shape[0]):
+        par = parent[i]
+        v = scale[i] * q[index[i]] + offset[i]
+        for a in range(3):
+            s = p[par, a]
+            for b in range(3):
+                s += R[par, a, b] * Mp[i, b]
+                t = 0.0
+                for c in range(3):
+                    t += R[par, a, c] * MR[i, c, b]
+                RM[a, b] = t
+            p[i, a] = s
+        ux, uy, uz = axis[i, 0], axis[i, 1], axis[i, 2]
+        if revolute[i]:
+            c = math.cos(v)
+            s = math.sin(v)
+            t = 1.0 - c
+            L00, L01, L02 = t * ux * ux + c, t * ux * uy - s * uz, t * ux * uz + s * uy
+            L10, L11, L12 = t * ux * uy + s * uz, t * uy * uy + c, t * uy * uz - s * ux
+            L20, L21, L22 = t * ux * uz - s * uy, t * uy * uz + s * ux, t * uz * uz + c
+            for a in range(3):
+                x, y, z = RM[a, 0], RM[a, 1], RM[a, 2]
+                R[i, a, 0] = x * L00 + y * L10 + z * L20
+                R[i, a, 1] = x * L01 + y * L11 + z * L21
+                R[i, a, 2] = x * L02 + y * L12 + z * L22
+        else:
+            for a in range(3):
+                for b in range(3):
+                    R[i, a, b] = RM[a, b]
+                p[i, a] += v * (RM[a, 0] * ux + RM[a, 1] * uy + RM[a, 2] * uz)
+
+
+@_jit
+def _centers(R, p, joint, center, W):
+    for s in range(joint.shape[0]):
+        j = joint[s]
+        for a in range(3):
+            W[s, a] = p[j, a] + R[j, a, 0] * center[s, 0] + R[j, a, 1] * center[s, 1] + R[j, a, 2] * center[s, 2]
+
+
+@_jit
+def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, out):
+    """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)``."""
+    nj = parent.shape[0]
+    R = np.empty((nj, 3, 3))
+    p = np.empty((nj, 3))
+    for i in range(Q.shape[0]):
+        _fk(Q[i], parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
+        _centers(R, p, joint, center, out[i])
+
+
+@_jit
+def _shape_distance(x, kind, FR, Fp, size):
+    """Distance [m] from point ``x`` to a static box (1), cylinder (2, axis z) or sphere (3); 0 inside."""
+    l0 = l1 = l2 = 0.0
+    d0, d1, d2 = x[0] - Fp[0], x[1] - Fp[1], x[2] - Fp[2]
+    l0 = FR[0, 0] * d0 + FR[1, 0] * d1 + FR[2, 0] * d2
+    l1 = FR[0, 1] * d0 + FR[1, 1] * d1 + FR[2, 1] * d2
+    l2 = FR[0, 2] * d0 + FR[1, 2] * d1 + FR[2, 2] * d2
+    if kind == 1:
+        o0 = max(abs(l0) - size[0], 0.0)
+        o1 = max(abs(l1) - size[1], 0.0)
+        o2 = max(abs(l2) - size[2], 0.0)
+        return math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+    if kind == 2:
+        dr = max(math.sqrt(l0 * l0 + l1 * l1) - size[0], 0.0)
+        dz = max(abs(l2) - size[1], 0.0)
+        return math.sqrt(dr * dr + dz * dz)
+    return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[0], 0.0)
+
+
+@_jit
+def _cylinder_distance(x, a, b, r):
+    """Distance [m] from point ``x`` to the solid cylinder of axis ``a b`` and radius ``r``; 0 inside."""
+    u0, u1, u2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    w0, w1, w2 = x[0] - a[0], x[1] - a[1], x[2] - a[2]
+    ww = w0 * w0 + w1 * w1 + w2 * w2
+    if L <= 1e-15:
+        return max(math.sqrt(ww) - r, 0.0)
+    t = (w0 * u0 + w1 * u1 + w2 * u2) / L
+    radial = math.sqrt(max(ww - t * t, 0.0))
+    dr = max(radial - r, 0.0)
+    dz = max(abs(t - 0.5 * L) - 0.5 * L, 0.0)
+    return math.sqrt(dr * dr + dz * dz)
+
+
+@_jit
+def _exact_distance(x, other, exact, FR, Fp, size, SA, SB, srad, sstart):
+    if exact[other] != 0:
+        return _shape_distance(x, exact[other], FR[other], Fp[other], size[other])
+    k = sstart[other]
+    return _cylinder_distance(x, SA[k], SB[k], srad[k])
+
+
+@_jit
+def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
+    """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
+    cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
+    ``g`` (``HW[g]``, ``hrad[g]``) first."""
+    if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
+        return True
+    for s in range(start[g], start[g + 1]):
+        if exact[other] != 0:
+            d = _shape_distance(W[s], exact[other], FR[other], Fp[other], size[other])
+        else:
+            k = sstart[other]
+            d = _cylinder_distance(W[s], SA[k], SB[k], srad[k])
+        if d - radius[s] <= t:
+            return False
+    return True
+
+
+@_jit
+def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
+    """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
+    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
+        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
+    if exact[ga] != 0 or cyl[ga]:
+        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
+    for sa in range(start[ga], start[ga + 1]):
+        for sb in range(start[gb], start[gb + 1]):
+            reach = radius[sa] + radius[sb] + t
+            e0 = W[sa, 0] - W[sb, 0]
+            e1 = W[sa, 1] - W[sb, 1]
+            e2 = W[sa, 2] - W[sb, 2]
+            if reach > 0.0 and e0 * e0 + e1 * e1 + e2 * e2 <= reach * reach:
+                return False
+    return True
+
+
+@_jit
+def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, radius, start, exact, FR,
+                  Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, hjoint, hcenter, hrad, group_start, group_a,
+                  group_b, group_fixed, group_t, pair_a, pair_b, threshold, stop, out):
+    """``out[i]``: every pair proven more than its threshold apart at ``Q[i]`` (module docstring of :mod:`.cover`).
+
+    The pairs come in groups (the geometries of one link against those of another); a group
+    is first tested on the two bounding spheres (``hjoint``, ``hcenter``, ``hrad``) at its
+    largest threshold, then pair by pair on the geometries' bounding spheres, then on their
+    covers. ``stop``: return at the first inconclusive row (its index; else −1)."""
+    nj = parent.shape[0]
+    R = np.empty((nj, 3, 3))
+    p = np.empty((nj, 3))
+    W = np.empty((joint.shape[0], 3))
+    SA = np.empty((sjoint.shape[0], 3))
+    SB = np.empty((sjoint.shape[0], 3))
+    HW = np.empty((hjoint.shape[0], 3))
+    for i in range(Q.shape[0]):
+        _fk(Q[i], parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
+        _centers(R, p, joint, center, W)
+        _centers(R, p, sjoint, sa_local, SA)
+        _centers(R, p, sjoint, sb_local, SB)
+        _centers(R, p, hjoint, hcenter, HW)
+        ok = True
+        for g in range(group_t.shape[0]):
+            if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
+                continue
+            fixed = group_fixed[g]
+            if fixed >= 0 and _shape_distance(HW[group_a[g]], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) \
+                    - hrad[group_a[g]] > group_t[g]:
+                continue
+            for k in range(group_start[g], group_start[g + 1]):
+                ga = pair_a[k]
+                gb = pair_b[k]
+                if _apart(HW, hrad, ga, gb, threshold[k]):
+                    continue
+                if not _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb,
+                                   threshold[k], HW, hrad):
+                    ok = False
+                    break
+            if not ok:
+                break
+        out[i] = ok
+        if stop and not ok:
+            return i
+    return -1
+
+
+@_jit
+def _apart(HW, hrad, a, b, t):
+    reach = hrad[a] + hrad[b] + t
+    e0 = HW[a, 0] - HW[b, 0]
+    e1 = HW[a, 1] - HW[b, 1]
+    e2 = HW[a, 2] - HW[b, 2]
+    return reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach

@@ -1,0 +1,314 @@
+"""A conservative sphere cover of every collision geometry of a cell, and compiled screens on it.
+
+Every geometry of :attr:`Cell.collision_model` gets a few spheres, fixed in its parent
+joint's frame, whose union **contains** the geometry (:func:`geometry_spheres`):
+
+- a sphere: itself;
+- a cylinder (radius ``r``, half length ``h``): ``k`` slices of height ``2h/k`` along its
+  axis, each inside the sphere at its centre of radius ``√(r² + (h/k)²)``;
+- a box: ``k`` slices along its longest side, each inside its circumscribed sphere;
+- a mesh (coal ``BVHModel``) or any other shape: its triangles grouped into ``k`` slices
+  along the longest side of its bounding box (by the triangle's centroid), each group inside
+  the sphere about its vertices' box centre through the farthest vertex (a sphere is convex:
+  holding a triangle's three vertices, it holds the triangle);
+- a shape with neither (a convex without triangles, a plane ...): the sphere about its
+  local bounding box.
+
+A static box, cylinder or sphere (parent joint the world: the fixtures) is also kept
+exactly: a sphere's distance to it is computed in closed form, not through its cover.
+
+The screen (:meth:`Cover.screen`) answers, for a batch of cell configurations and a
+threshold per pair, which configurations are **proven** to keep every pair farther apart
+than its threshold: the distance between two covers (or a cover and an exact fixture) is a
+lower bound of the geometries' distance. The rest is *inconclusive*: the exact check (coal)
+decides them. Forward kinematics of the batch and the screen run compiled (numba, cached
+like :mod:`robots.ik._kernel`). Distances in m, the world frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+
+from ._cover_kernel import screen_kernel
+
+__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
+           "MAX_SPHERES"]
+
+#: Most spheres per geometry.
+MAX_SPHERES = 12
+_EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
+
+
+def pairs_for(cell: Any, clearance: float) -> tuple:
+    """The pairs a check at ``clearance`` [m] must look at: ``cell.pairs_for(clearance)`` where the
+    cell has it (pairs proven farther apart than the clearance left out), else every checked pair."""
+    chooser = getattr(cell, "pairs_for", None)
+    return tuple(cell.pairs) if chooser is None else tuple(chooser(float(clearance)))
+
+
+def _slices(length: float, width: float) -> int:
+    return int(min(MAX_SPHERES, max(1, math.ceil(1.5 * length / max(width, 1e-6)))))
+
+
+def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    try:
+        V = np.asarray(geo.vertices(), dtype=float).reshape(-1, 3)
+        T = np.array([[t[0], t[1], t[2]] for t in (geo.tri_indices(i) for i in range(int(geo.num_tris)))],
+                     dtype=int).reshape(-1, 3)
+    except (AttributeError, TypeError, RuntimeError):
+        return None
+    if V.shape[0] == 0:
+        return None
+    if T.shape[0] == 0:  # a point cloud: each vertex a degenerate triangle
+        T = np.repeat(np.arange(V.shape[0])[:, None], 3, axis=1)
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    ext = hi - lo
+    order = np.argsort(ext)
+    axis = int(order[-1])
+    k = _slices(float(ext[axis]), float(ext[order[-2]]))
+    centroid = V[T].mean(axis=1)[:, axis]
+    group = np.minimum(((centroid - lo[axis]) / max(ext[axis], 1e-12) * k).astype(int), k - 1)
+    centers, radii = [], []
+    for s in range(k):
+        idx = np.unique(T[group == s])
+        if idx.size == 0:
+            continue
+        P = V[idx]
+        c = 0.5 * (P.min(axis=0) + P.max(axis=0))
+        centers.append(c)
+        radii.append(float(np.sqrt(((P - c) ** 2).sum(axis=1).max())))
+    return np.array(centers), np.array(radii)
+
+
+def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres ``(centres (k, 3) in the parent joint's frame [m], radii (k,) [m])`` whose union
+    contains the geometry of a Pinocchio ``GeometryObject`` (module docstring)."""
+    geo = geometry_object.geometry
+    kind = type(geo).__name__
+    if kind == "Sphere":
+        c, r = np.zeros((1, 3)), np.array([float(geo.radius)])
+    elif kind == "Cylinder" or kind == "Capsule":
+        r, h = float(geo.radius), float(geo.halfLength)
+        k = int(min(2 * MAX_SPHERES, max(1, math.ceil(3.2 * h / max(r, 1e-6)))))  # radius at most 5 % over r
+        z = -h + (2.0 * np.arange(k) + 1.0) * h / k
+        if kind == "Capsule":  # the end caps: spheres of radius r at the ends of the axis
+            z = np.concatenate([z, [-h, h]])
+            rad = np.concatenate([np.full(k, math.hypot(r, h / k)), [r, r]])
+        else:
+            rad = np.full(k, math.hypot(r, h / k))
+        c, r = np.column_stack([np.zeros(z.size), np.zeros(z.size), z]), rad
+    elif kind == "Box":
+        half = np.asarray(geo.halfSide, dtype=float)
+        order = np.argsort(half)
+        axis = int(order[-1])
+        k = _slices(2.0 * half[axis], 2.0 * half[order[-2]])
+        z = -half[axis] + (2.0 * np.arange(k) + 1.0) * half[axis] / k
+        c = np.zeros((k, 3))
+        c[:, axis] = z
+        slab = half.copy()
+        slab[axis] = half[axis] / k
+        r = np.full(k, float(np.linalg.norm(slab)))
+    else:
+        got = _mesh_spheres(geo)
+        if got is None:
+            geo.computeLocalAABB()
+            lo, hi = np.asarray(geo.aabb_local.min_, dtype=float), np.asarray(geo.aabb_local.max_, dtype=float)
+            got = (0.5 * (lo + hi))[None], np.array([0.5 * float(np.linalg.norm(hi - lo))])
+        c, r = got
+    M = geometry_object.placement
+    centers = np.asarray(c, dtype=float) @ np.asarray(M.rotation).T + np.asarray(M.translation)
+    # a hair of slack over floating-point rounding of the placements
+    return centers, np.asarray(r, dtype=float) * (1.0 + 1e-9) + 1e-9
+
+
+def geometry_segments(geometry_object: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
+    cylinder (taken exactly against the other geometry's spheres); other geometries: their
+    spheres as zero-length axes (unused by the screen)."""
+    geo = geometry_object.geometry
+    if type(geo).__name__ == "Cylinder":
+        M = geometry_object.placement
+        R, p = np.asarray(M.rotation), np.asarray(M.translation)
+        h = float(geo.halfLength)
+        a, b = p - h * R[:, 2], p + h * R[:, 2]
+        return a[None], b[None], np.array([float(geo.radius) * (1.0 + 1e-9) + 1e-9])
+    c, r = geometry_spheres(geometry_object)
+    return c, c.copy(), r
+
+
+@dataclass(frozen=True, eq=False)
+class Cover:
+    """The sphere cover of a cell's geometries (module docstring).
+
+    Attributes:
+        start: ``(G+1,)`` spheres of geometry ``g`` are ``start[g]:start[g+1]``.
+        joint: ``(S,)`` parent joint of each sphere; ``center``: ``(S, 3)`` in that joint's
+            frame [m]; ``radius``: ``(S,)`` [m].
+        exact: ``(G,)`` 0: the geometry is screened through its spheres; 1, 2, 3: a static
+            box, cylinder or sphere screened exactly, ``frame_R (G, 3, 3)``, ``frame_p (G, 3)``
+            its world placement and ``size (G, 3)`` its half sides / (radius, half length, 0)
+            / (radius, 0, 0).
+    """
+
+    start: np.ndarray
+    joint: np.ndarray
+    center: np.ndarray
+    radius: np.ndarray
+    exact: np.ndarray
+    frame_R: np.ndarray
+    frame_p: np.ndarray
+    size: np.ndarray
+    fk: tuple
+    segments: tuple = ()
+    bounds: tuple = ()
+
+    def world_centers(self, Q: np.ndarray) -> np.ndarray:
+        """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
+        from ._cover_kernel import centers_kernel
+
+        Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        out = np.empty((Q.shape[0], self.joint.size, 3))
+        centers_kernel(Q, *self.fk, self.joint, self.center, out)
+        return out
+
+    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> "PairSet":
+        """The pairs ``(pair_a[k], pair_b[k])`` (geometry indices) grouped for :meth:`screen`: by the two
+        links (a fixture's geometry alone), each link with one sphere holding its geometries."""
+        pair_a = np.asarray(pair_a, dtype=np.int64)
+        pair_b = np.asarray(pair_b, dtype=np.int64)
+        bjoint, bc, br = self.bounds
+        G = br.size
+        key = np.where(bjoint > 0, bjoint, -np.arange(G) - 1)
+        members: dict[int, list[int]] = {}
+        for g in np.unique(np.concatenate([pair_a, pair_b])):
+            members.setdefault(int(key[g]), []).append(int(g))
+        hjoint, hc, hr, where = list(bjoint), list(bc), list(br), {}
+        for k, gs in members.items():
+            c, r = bc[gs], br[gs]
+            centre = 0.5 * ((c - r[:, None]).min(axis=0) + (c + r[:, None]).max(axis=0))
+            where[k] = len(hr)
+            hjoint.append(int(bjoint[gs[0]]))
+            hc.append(centre)
+            hr.append(float((np.linalg.norm(c - centre, axis=1) + r).max()) * (1.0 + 1e-12))
+        # an exact fixture goes second in its pairs (its link sphere is the one tested against it)
+        swap = (self.exact[pair_a] != 0) & (self.exact[pair_b] == 0)
+        pair_a, pair_b = np.where(swap, pair_b, pair_a), np.where(swap, pair_a, pair_b)
+        ka, kb = key[pair_a], key[pair_b]
+        order = np.lexsort((kb, ka))
+        ka, kb = ka[order], kb[order]
+        first = np.flatnonzero(np.concatenate([[True], (ka[1:] != ka[:-1]) | (kb[1:] != kb[:-1])])) if order.size \
+            else np.zeros(0, dtype=int)
+        fixed = np.array([-k - 1 if k < 0 and self.exact[-k - 1] != 0 else -1 for k in kb[first]], dtype=np.int64)
+        return PairSet(pair_a[order], pair_b[order], order, np.append(first, order.size).astype(np.int64),
+                       np.array([where[int(k)] for k in ka[first]], dtype=np.int64),
+                       np.array([where[int(k)] for k in kb[first]], dtype=np.int64), fixed,
+                       np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
+                       np.array(hr))
+
+    def screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: True where the cover **proves** every pair of ``pairs`` (:meth:`prepare`)
+        farther apart than its ``threshold`` [m] (in the order the pairs were given) at cell
+        configuration ``Q[i]``; False: inconclusive (the exact check decides). ``stop``: the rows
+        after the first inconclusive one are not screened (reported False)."""
+        Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        out = np.zeros(Q.shape[0], dtype=np.bool_)
+        if Q.shape[0] == 0:
+            return out
+        if pairs.pair_a.size == 0:
+            out[:] = True
+            return out
+        t = np.asarray(threshold, dtype=float)[pairs.order]
+        group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
+        screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
+                      self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
+                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
+                      pairs.pair_b, t, bool(stop), out)
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class PairSet:
+    """Pairs of geometries grouped by link for :meth:`Cover.screen` (built by :meth:`Cover.prepare`)."""
+
+    pair_a: np.ndarray
+    pair_b: np.ndarray
+    order: np.ndarray
+    group_start: np.ndarray
+    group_a: np.ndarray
+    group_b: np.ndarray
+    group_fixed: np.ndarray
+    hjoint: np.ndarray
+    hcenter: np.ndarray
+    hrad: np.ndarray
+
+
+def _fk_arrays(cell: Any) -> tuple:
+    bp = cell._placements
+    return (np.asarray(bp.parent, dtype=np.int64), np.asarray(bp.index, dtype=np.int64), bp.scale.copy(),
+            bp.offset.copy(), bp.revolute.copy(), bp.axis.copy(), bp.M_R.copy(), bp.M_p.copy())
+
+
+def link_cover(cell: Any) -> Cover:
+    """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell)."""
+    cached = getattr(cell, "_sphere_cover", None)
+    if cached is not None:
+        return cached
+    objs = list(cell.collision_model.geometryObjects)
+    G = len(objs)
+    start = np.zeros(G + 1, dtype=np.int64)
+    joints, centers, radii = [], [], []
+    exact = np.zeros(G, dtype=np.int64)
+    frame_R = np.tile(np.eye(3), (G, 1, 1))
+    frame_p = np.zeros((G, 3))
+    size = np.zeros((G, 3))
+    for g, obj in enumerate(objs):
+        c, r = geometry_spheres(obj)
+        joints.append(np.full(r.size, int(obj.parentJoint), dtype=np.int64))
+        centers.append(c)
+        radii.append(r)
+        start[g + 1] = start[g] + r.size
+        kind = type(obj.geometry).__name__
+        if obj.parentJoint == 0 and kind in ("Box", "Cylinder", "Sphere"):
+            frame_R[g] = obj.placement.rotation
+            frame_p[g] = obj.placement.translation
+            if kind == "Box":
+                exact[g], size[g] = _EXACT_BOX, np.asarray(obj.geometry.halfSide, dtype=float)
+            elif kind == "Cylinder":
+                exact[g], size[g] = _EXACT_CYLINDER, [obj.geometry.radius, obj.geometry.halfLength, 0.0]
+            else:
+                exact[g], size[g] = _EXACT_SPHERE, [obj.geometry.radius, 0.0, 0.0]
+    cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
+                  np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
+                  _segments(objs), _bounds(objs, start, centers, radii))
+    cell._sphere_cover = cover
+    return cover
+
+
+def _segments(objs: list) -> tuple:
+    parts = [geometry_segments(obj) for obj in objs]
+    sstart = np.concatenate([[0], np.cumsum([r.size for _, _, r in parts])]).astype(np.int64)
+    sjoint = np.concatenate([np.full(r.size, int(o.parentJoint), dtype=np.int64) for o, (_, _, r) in zip(objs, parts)])
+    return (sjoint, np.ascontiguousarray(np.concatenate([a for a, _, _ in parts])),
+            np.ascontiguousarray(np.concatenate([b for _, b, _ in parts])), np.concatenate([r for _, _, r in parts]),
+            sstart, np.array([type(o.geometry).__name__ == "Cylinder" for o in objs], dtype=np.bool_))
+
+
+def _bounds(objs: list, start: np.ndarray, centers: list, radii: list) -> tuple:
+    """One sphere per geometry holding all its cover spheres (so the geometry)."""
+    G = len(objs)
+    bc = np.zeros((G, 3))
+    br = np.zeros(G)
+    for g in range(G):
+        c, r = centers[g], radii[g]
+        bc[g] = 0.5 * ((c - r[:, None]).min(axis=0) + (c + r[:, None]).max(axis=0))
+        br[g] = float((np.linalg.norm(c - bc[g], axis=1) + r).max()) * (1.0 + 1e-12)
+    return np.array([int(o.parentJoint) for o in objs], dtype=np.int64), bc, br
+
+
+def pair_arrays(pairs: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
+    """Geometry indices ``(pair_a, pair_b)`` of :class:`CollisionPair` s, for :meth:`Cover.screen`."""
+    return (np.array([p.index_a for p in pairs], dtype=np.int64), np.array([p.index_b for p in pairs], dtype=np.int64))
