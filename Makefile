@@ -36,7 +36,7 @@ readme-table: install
 
 # The whole suite in parallel: pytest-xdist with one worker per core (CI has 2). Each test file is an
 # xdist group (tests/conftest.py), so a file runs in one worker and its module fixtures are built
-# once; files with `slow` tests start first. Tests run at the same time as others: a test writes only
+# once; the longest files start first. Tests run at the same time as others: a test writes only
 # under tmp_path, binds only port 0 (any free port), changes the environment only through
 # monkeypatch, and never writes into the repository (rules in tests/README.md).
 # `make test PYTEST_WORKERS=0` runs it in one process. pytest's exit code is kept (.ci/run fails on 5).
