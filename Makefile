@@ -34,8 +34,15 @@ demo-quick: install
 readme-table: install
 	$(VENV)/bin/pinarms demo --out demo-output --readme README.md
 
+# The whole suite in parallel: pytest-xdist with one worker per core (CI has 2). Each test file is an
+# xdist group (tests/conftest.py), so a file runs in one worker and its module fixtures are built
+# once; the longest files start first. Tests run at the same time as others: a test writes only
+# under tmp_path, binds only port 0 (any free port), changes the environment only through
+# monkeypatch, and never writes into the repository (rules in tests/README.md).
+# `make test PYTEST_WORKERS=0` runs it in one process. pytest's exit code is kept (.ci/run fails on 5).
+PYTEST_WORKERS ?= 2
 test: install browser
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup --no-loadscope-reorder tests
 
 # The pictures of README.md and docs/ (viewer pages in headless Chromium, plots), from the tests that check them.
 docs-pictures: install browser

@@ -16,6 +16,10 @@ from pinarms import execution
 from pinarms.execution import chunk_seeds, map_chunks, split_count
 from pinarms.robots.errors import ExecutionError, InvalidInput, PinarmsError
 
+#: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
+#: the fixed 8787 that every other LocalCluster of a parallel run tries first.
+LOOPBACK_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
 # the scheduler's HTTP endpoint moves to a free port when another cluster holds 8787
 pytestmark = pytest.mark.filterwarnings("ignore:Port .* is already in use:UserWarning")
 
@@ -48,7 +52,8 @@ def _tasks(seed=7, n_chunks=6, n=2000):
 def client():
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None,
+        scheduler_kwargs=LOOPBACK_HTTP,
     ) as cluster, distributed.Client(cluster) as c:
         yield c
 
@@ -127,7 +132,8 @@ def test_a_dead_worker_is_a_named_error():
 
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         with distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=LOOPBACK_HTTP,
         ) as cluster, distributed.Client(cluster) as c:
             tasks = [{"n": k, "die": k == 1, "seed": 90 + k} for k in range(3)]
             with pytest.raises(ExecutionError, match="chunk 1 \\(seed 91\\) lost its worker") as info:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import venv
@@ -48,11 +49,21 @@ def _run(cmd: list, cwd: Path, timeout: float = 900) -> subprocess.CompletedProc
     return result
 
 
+def _source_copy(dest: Path) -> Path:
+    """The repository's files as a clone has them, in ``dest``: the wheel is built from there, so that
+    its build/ and pinarms.egg-info/ never land in the repository that the other tests read meanwhile."""
+    junk = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "demo-output", "__pycache__",
+                                  ".pytest_cache", ".hypothesis", "*.pyc")
+    shutil.copytree(ROOT, dest, ignore=junk)
+    return dest
+
+
 @pytest.mark.slow
 def test_wheel_beside_pypi_namesakes_runs_the_quickstart(tmp_path):
     """About 3 minutes with a warm pip cache: the fresh virtualenv gets Pinocchio and all."""
     dist = tmp_path / "dist"
-    _run([sys.executable, "-m", "pip", "wheel", ROOT, "--no-deps", "-w", dist, "-q"], tmp_path)
+    source = _source_copy(tmp_path / "source")
+    _run([sys.executable, "-m", "pip", "wheel", source, "--no-deps", "-w", dist, "-q"], tmp_path)
     (wheel,) = dist.glob("pinarms-*.whl")
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)

@@ -70,12 +70,12 @@ def test_demo_text_table_only_one_study(tmp_path):
     assert any(len(line) > 100 for line in (tmp_path / "table.md").read_text(encoding="utf-8").splitlines())
 
 
-def test_demo_ik_rows_use_the_error_the_paper_states():
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_demo_ik_rows_use_the_error_the_paper_states(quick_study):
     # seed 004 section 3: "the one-decimal position causes 0.1° of error in θ" (not a tolerance fitted to ours)
-    from pinarms.demo import study_004
     from pinarms.papers import SEED004
 
-    rows = [r for r in study_004(quick=True).rows if r.quantity.startswith("IK of")]
+    rows = [r for r in quick_study("004").rows if r.quantity.startswith("IK of")]
     assert len(rows) == 3
     for row, paper in zip(rows, (SEED004.ik_theta1_deg, SEED004.ik_theta2_deg, -SEED004.ik_theta3_down_deg)):
         assert row.paper == paper and row.tolerance == SEED004.ik_stated_error_deg == 0.1
@@ -84,9 +84,9 @@ def test_demo_ik_rows_use_the_error_the_paper_states():
     assert rows[1].pinarms == pytest.approx(25.0011, abs=1e-4)
 
 
-def test_demo_joint_plots_in_degrees_for_seed000_only(tmp_path, monkeypatch):
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_demo_joint_plots_in_degrees_for_seed000_only(tmp_path, monkeypatch, quick_study):
     # seed 000's paper draws joint 1 in degrees; the other studies keep SI (rad, m)
-    from pinarms.demo import study_000, study_004
     from pinarms.viz import plots as vplots
 
     seen = {}
@@ -97,7 +97,7 @@ def test_demo_joint_plots_in_degrees_for_seed000_only(tmp_path, monkeypatch):
         return real(path, trajectory, **options)
 
     monkeypatch.setattr(vplots, "plot_trajectory", spy)
-    for key, study in (("000", study_000(quick=True)), ("004", study_004(quick=True))):
+    for key, study in (("000", quick_study("000")), ("004", quick_study("004"))):
         study.plots["joints"](tmp_path / f"seed{key}_joints.png")
     assert seen == {"seed000_joints.png": True, "seed004_joints.png": False}
     assert (tmp_path / "seed000_joints.png").stat().st_size > 10_000

@@ -34,10 +34,11 @@ def _cells(line: str) -> list[str]:
     return [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
 
 
-def test_readme_table_is_the_code_s_table():
+@pytest.mark.slow
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_readme_table_is_the_code_s_table(quick_study):
     """Every README row that does not depend on the run's budget (GA generations, samples) is
     exactly what the demo's studies print now; the summary line counts the README's rows."""
-    from pinarms.demo import study_000, study_001, study_004
     from pinarms.report import TABLE_BEGIN, TABLE_END, markdown_table
 
     text = README.read_text(encoding="utf-8")
@@ -45,7 +46,7 @@ def test_readme_table_is_the_code_s_table():
     lines = [line for line in block.splitlines() if line.startswith("| 00")]
     budget = ("GA", "reduced by", "workspace sphere", "recommended")
     checked = 0
-    for study in (study_000(quick=True), study_001(quick=True), study_004(quick=True)):
+    for study in (quick_study("000"), quick_study("001"), quick_study("004")):
         for row in study.rows:
             if any(word in row.quantity for word in budget):
                 continue

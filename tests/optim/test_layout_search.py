@@ -9,6 +9,10 @@ from pinarms import optim, robots
 from pinarms.optim.layout_search import base_to_world, grid_candidates, random_candidates, search_layout
 from pinarms.robots.errors import InvalidInput
 
+#: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
+#: the fixed 8787 that every other LocalCluster of a parallel run tries first.
+LOOPBACK_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
 pytestmark = pytest.mark.filterwarnings("ignore:Port .* is already in use:UserWarning")
 
 
@@ -104,7 +108,8 @@ def test_search_on_a_cluster_equals_serial(scara, points):
     kw = dict(lift=0.02, refine=1, refine_evaluations=4, workspace_samples=20_000, chunk_size=1)
     serial = search_layout(scara, pick, place, cand, **kw)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=None,
+                                  scheduler_kwargs=LOOPBACK_HTTP) as cluster, distributed.Client(cluster) as client:
         remote = search_layout(scara, pick, place, cand, scheduler=client, **kw)
     assert serial.cycle_time.tobytes() == remote.cycle_time.tobytes()
     assert serial.failure == remote.failure and list(serial.order) == list(remote.order)

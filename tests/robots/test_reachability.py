@@ -10,6 +10,10 @@ from pinarms.robots.errors import InvalidInput, ModelError, UnreachableTarget
 from pinarms.robots.orientations import so3_orientations, tool_down_orientations
 from pinarms.robots.reachability import reach_bound, reachability_map
 
+#: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
+#: the fixed 8787 that every other LocalCluster of a parallel run tries first.
+LOOPBACK_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
 SHOULDER = np.array([0.0, 0.0, 0.157])  # AUBO-i3: origin of the first joint [m]
 
 
@@ -83,7 +87,8 @@ def test_serial_and_local_cluster_maps_are_bit_identical(aubo):
     distributed = pytest.importorskip("distributed")
     serial = reachability_map(aubo, 0.15, 10, chunk_voxels=100)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=None,
+                                  scheduler_kwargs=LOOPBACK_HTTP) as cluster, distributed.Client(cluster) as client:
         dask_map = reachability_map(aubo, 0.15, 10, chunk_voxels=100, scheduler=client)
     assert serial.n_voxels > 500 and serial.n_reached > 1000
     assert serial.identical(dask_map)

@@ -10,6 +10,10 @@ from pinarms.robots.errors import InvalidInput
 from pinarms.robots.workspace import fit_sphere, hull_points, random_q_slice, sample_workspace
 from pinarms.robots.workspace_stream import stream_workspace
 
+#: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
+#: the fixed 8787 that every other LocalCluster of a parallel run tries first.
+LOOPBACK_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
 pytestmark = pytest.mark.filterwarnings("ignore:Port .* is already in use:UserWarning")
 
 N = 60_000
@@ -79,7 +83,8 @@ def test_streamed_reductions_are_those_of_the_samples(streamed, in_memory):
 def test_streamed_on_a_cluster_equals_serial_bit_for_bit(aubo, streamed):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None,
+        scheduler_kwargs=LOOPBACK_HTTP,
     ) as cluster, distributed.Client(cluster) as client:
         seen = []
         remote = stream_workspace(

@@ -234,11 +234,11 @@ def test_live_viewer(browser, line_session):
     assert not os.path.exists(f"/proc/{pid}"), "the MeshCat server process is still there"
 
 
-def test_demo_seed001_page(browser, tmp_path):
+@pytest.mark.slow
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_demo_seed001_page(browser, tmp_path, quick_study):
     """The first page a user opens (``make demo``: html/seed001.html): the AUBO-i3 inside its workspace cloud."""
-    from pinarms.demo import study_001
-
-    s = study_001(quick=True).session
+    s = quick_study("001").session
     out = viz.export_html(s, tmp_path / "seed001.html")
     page, blocked = _offline_page(browser, Path(out).resolve().as_uri())
     page.wait_for_function("() => document.getElementById('pinarms-title') && viewer.animator.actions.length > 0",

@@ -1,0 +1,78 @@
+"""Suite-wide rules for the parallel run (``make test``: pytest-xdist, ``-n 2 --dist loadgroup``), and
+the demo's quick studies shared by the files that check them.
+
+Every test file is one xdist group, so a file's tests run in one worker, in order, and its
+module- and session-scoped fixtures are built once per run (as ``--dist loadfile`` would);
+a test that names its own ``@pytest.mark.xdist_group("...")`` joins that group instead
+(tests in one group never run at the same time as each other). The longest groups are handed
+out first (:data:`GROUP_SECONDS`, then those holding a test marked ``slow``), so that a long
+file does not start last and leave the other worker idle at the end. The rules a new test follows to be parallel-safe are in
+tests/README.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import pytest
+
+#: The group of the tests that use :func:`quick_study`: one worker builds each study once for all of them.
+DEMO_STUDIES = "demo-studies"
+
+#: Seconds that the longest groups took in one process on a loaded 2-core machine (``--durations``,
+#: 2026-11): only their order matters. A group not listed starts after these when it has a test
+#: marked ``slow`` (weight 30), else in collection order at the end.
+GROUP_SECONDS = {
+    "tests/test_packaging.py": 264.0,  # builds the wheel and installs it with Pinocchio etc. in a fresh venv
+    "tests/cli/test_demo.py": 150.0,  # `pinarms demo --quick` end to end
+    "tests/cli/test_cli.py": 113.0,  # the first IK call compiles the numba kernel in a clean clone
+    DEMO_STUDIES: 110.0,  # the demo's quick studies 000, 001 and 004, built once
+    "tests/optim/test_layout_search.py": 89.0,
+    "tests/robots/test_xacro_expand.py": 69.0,
+    "tests/optim/test_cell_cycle.py": 60.0,
+    "tests/optim/test_motion_cycle.py": 54.0,
+    "tests/test_export_verify.py": 49.0,
+    "tests/test_execution.py": 44.0,
+    "tests/viz/test_browser.py": 26.0,
+    "tests/optim/test_cycle.py": 35.0,
+    "tests/robots/test_descriptions.py": 29.0,
+}
+
+
+def _group_of(item: pytest.Item) -> str:
+    mark = item.get_closest_marker("xdist_group")
+    if mark is None:
+        return item.nodeid.split("::", 1)[0]
+    return str(mark.args[0] if mark.args else mark.kwargs.get("name", "default"))
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the groups
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(_group_of(item)))
+    # the longest groups first (stable: the collection order is kept among equals)
+    slow = {_group_of(item) for item in items if item.get_closest_marker("slow") is not None}
+
+    def weight(item: pytest.Item) -> float:
+        group = _group_of(item)
+        return GROUP_SECONDS.get(group, 30.0 if group in slow else 0.0)
+
+    items.sort(key=weight, reverse=True)
+
+
+@pytest.fixture(scope="session")
+def quick_study() -> Callable[[str], Any]:
+    """``quick_study("001")`` is ``pinarms.demo.study_001(quick=True)``, built once per worker (about
+    40 s for 001 on a loaded machine). Read-only: a test never changes the study it is given. A test
+    that uses it is marked ``@pytest.mark.xdist_group(DEMO_STUDIES)`` so that one worker builds it."""
+    from pinarms import demo
+
+    built: dict[str, Any] = {}
+
+    def get(key: str) -> Any:
+        if key not in built:
+            built[key] = getattr(demo, f"study_{key}")(quick=True)
+        return built[key]
+
+    return get
