@@ -31,6 +31,7 @@ import math
 import os
 import re
 import struct
+import threading
 import zipfile
 import zlib
 from dataclasses import dataclass, field
@@ -115,6 +116,9 @@ DEFAULT_LIMITS = SessionLimits()
 _DEFLATE_MAX_RATIO = 1032
 #: room for an .npy header (numpy pads it to 64 bytes; ours are < 200 bytes)
 _NPY_HEADER_MAX = 4096
+#: numpy parses a .npy header with ``ast``, which CPython 3.11 cannot run from several threads at once
+#: ("AST constructor recursion depth mismatch", CPython gh-106905): one header at a time.
+_NPY_HEADER_LOCK = threading.Lock()
 _TAIL_MAX = 22 + 0xFFFF  # end-of-central-directory record plus the longest comment
 
 
@@ -715,13 +719,14 @@ class _Reader:
         try:
             with self.zf.open(member) as f:
                 try:
-                    version = np.lib.format.read_magic(f)
-                    if version == (1, 0):
-                        shape, fortran, dtype = np.lib.format.read_array_header_1_0(f, max_header_size=_NPY_HEADER_MAX)
-                    elif version == (2, 0):
-                        shape, fortran, dtype = np.lib.format.read_array_header_2_0(f, max_header_size=_NPY_HEADER_MAX)
-                    else:
-                        raise ValueError(f"unknown .npy version {version}")
+                    with _NPY_HEADER_LOCK:
+                        version = np.lib.format.read_magic(f)
+                        if version == (1, 0):
+                            shape, fortran, dtype = np.lib.format.read_array_header_1_0(f, max_header_size=_NPY_HEADER_MAX)
+                        elif version == (2, 0):
+                            shape, fortran, dtype = np.lib.format.read_array_header_2_0(f, max_header_size=_NPY_HEADER_MAX)
+                        else:
+                            raise ValueError(f"unknown .npy version {version}")
                 except (ValueError, EOFError, SyntaxError, TypeError, OverflowError) as exc:
                     raise self.fail(f"member {member!r} is not a readable .npy array ({exc})") from None
                 if dtype.hasobject:
