@@ -52,6 +52,7 @@ class Study:
     session: Any = None  # viz.Session
     plots: dict[str, Callable[[Path], Any]] = field(default_factory=dict)  # name -> writer(path)
     seconds: float = 0.0
+    exports: dict[str, Callable[[Path], list[Path]]] = field(default_factory=dict)  # name -> writer(folder) -> files
 
 
 @dataclass
@@ -882,6 +883,13 @@ def study_line(quick: bool = False) -> Study:
     return demo_study(quick)
 
 
+def study_handoff(quick: bool = False) -> Study:
+    """The hand-off study (:mod:`pinarms.studies.handoff`): MuJoCo re-check, SRDF, controller files."""
+    from pinarms.studies.handoff import demo_study
+
+    return demo_study(quick)
+
+
 STUDIES: dict[str, Callable[[bool], Study]] = {
     "000": study_000,
     "001": study_001,
@@ -889,6 +897,7 @@ STUDIES: dict[str, Callable[[bool], Study]] = {
     "004": study_004,
     "cell": study_cell,
     "line": study_line,
+    "handoff": study_handoff,
 }
 
 
@@ -929,6 +938,8 @@ def run_demo(out_dir: str | Path = "demo-output", *, quick: bool = False, only: 
                 png = out / "plots" / f"{'seed' + key if key.isdigit() else key}_{name}.png"
                 write(png)
                 files.append(png)
+        for name, write in study.exports.items():
+            files += write(out / "export" / name)
         if progress:
             progress(f"seed {key}: done")
     result = DemoResult(studies, files, out)

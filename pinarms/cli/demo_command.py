@@ -17,20 +17,21 @@ from ._common import (
 @cli.command("demo")
 @click.option("--quick", is_flag=True, help="Smaller samples and GA runs: under a minute.")
 @click.option("--out", "out_dir", default="demo-output", show_default=True, type=click.Path(file_okay=False))
-@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell", "line"]), help="Run only these studies.")
+@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell", "line", "handoff"]), help="Run only these studies.")
 @click.option("--readme", "readme", default=None, type=click.Path(exists=True, dir_okay=False),
               help="Also write the table into this markdown file, between its table markers (full run only).")
 @json_option
 def demo_cmd(quick: bool, out_dir: str, only: tuple[str, ...], readme: str | None, as_json: bool) -> None:
-    """Redo the four papers' studies, print the paper-vs-pinarms table and write sessions, HTML and plots."""
-    from pinarms.demo import run_demo
+    """Redo the four papers' studies, the cell, line and hand-off studies; print the paper-vs-pinarms table and write
+    sessions, HTML, plots and export files."""
+    from pinarms.demo import STUDIES, run_demo
     from pinarms.report import splice_table
 
     if readme and (quick or only):
         raise click.UsageError("--readme takes the table of the full run: drop --quick and --only")
     if readme:
         splice_table(Path(readme).read_text(encoding="utf-8"), [])  # markers checked before the long run
-    n_studies = len(only) if only else 4
+    n_studies = len(only) if only else len(STUDIES)
     with common.progress_bar("demo studies", n_studies, as_json) as bar:
         def progress(label: str) -> None:
             bar.step(label)
