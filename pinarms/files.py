@@ -26,7 +26,7 @@ try:  # POSIX; elsewhere leftovers are recognised by age alone
 except ImportError:  # pragma: no cover - Windows
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["atomic_write", "write_text", "clean_leftovers", "STALE_AFTER_S"]
+__all__ = ["atomic_write", "write_text", "temporary_for", "publish", "clean_leftovers", "STALE_AFTER_S"]
 
 STALE_AFTER_S = 2.0
 """A ``.part`` file is a leftover once unlocked and unmodified for this long (s); without flock: 1 hour."""
@@ -91,15 +91,8 @@ def clean_leftovers(target: str | os.PathLike, *, keep: str | None = None) -> li
     return removed
 
 
-def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> Path:
-    """Write ``path`` through ``write(fileobj)`` atomically; return the path.
-
-    Leftover temporary files of earlier crashed saves of the same target are removed
-    (see :func:`clean_leftovers`).
-
-    Raises:
-        InvalidInput: the target's folder does not exist or the target is a folder.
-    """
+def _target(path: str | os.PathLike) -> Path:
+    """``path`` as a writable target: a file name in an existing folder (else :class:`InvalidInput`)."""
     if not isinstance(path, (str, os.PathLike)):
         raise InvalidInput(f"a file path must be a str or a path, got {type(path).__name__}")
     target = Path(path)
@@ -110,6 +103,39 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> 
         raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")
     if target.is_dir():
         raise InvalidInput(f"cannot write {str(target)!r}: it is a folder; give a file name")
+    return target
+
+
+def temporary_for(path: str | os.PathLike) -> tuple[Path, str]:
+    """``(target, temporary path)`` for a writer that needs a file *name* (HDF5): write the
+    temporary, then :func:`publish` it, or remove it on failure. Same checks as :func:`atomic_write`."""
+    target = _target(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
+    os.close(fd)
+    return target, tmp
+
+
+def publish(tmp: str | os.PathLike, target: str | os.PathLike) -> Path:
+    """Make the finished temporary file ``tmp`` the target: flushed to disk, the usual permissions, renamed."""
+    with open(tmp, "rb+") as f:
+        os.fsync(f.fileno())
+    os.chmod(tmp, _default_mode())
+    os.replace(tmp, target)
+    return Path(target)
+
+
+def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> Path:
+    """Write ``path`` through ``write(fileobj)`` atomically; return the path.
+
+    Leftover temporary files of earlier crashed saves of the same target are removed
+    (see :func:`clean_leftovers`).
+
+    Raises:
+        InvalidInput: the target's folder does not exist or the target is a folder.
+    """
+    target = _target(path)
+    folder = target.parent if str(target.parent) else Path(".")
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
     try:
         with os.fdopen(fd, "wb") as f:

@@ -50,12 +50,13 @@ import json
 import math
 import os
 import signal
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from pinarms.files import publish, temporary_for
 
 from .errors import InvalidInput, PinarmsError
 from .orientations import MAX_ORIENTATIONS, OrientationSet
@@ -144,27 +145,6 @@ def _write(h5: Any, m: ReachabilityMap) -> None:
         _write_dataset(g, "manipulability", np.asarray(s.manipulability, dtype="<f8"))
 
 
-def _temporary(path: str | os.PathLike) -> tuple[Path, str]:
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise InvalidInput(f"cannot write {str(target)!r}: folder {str(folder)!r} does not exist; create it first")
-    if target.is_dir():
-        raise InvalidInput(f"cannot write {str(target)!r}: it is a folder; give a file name")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=folder)
-    os.close(fd)
-    return target, tmp
-
-
-def _publish(tmp: str, target: Path) -> None:
-    with open(tmp, "rb+") as f:
-        os.fsync(f.fileno())
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    os.replace(tmp, target)
-
-
 class StreamWriter:
     """Writes a map whose stored solutions arrive chunk by chunk (``reachability_map(out=...)``).
 
@@ -176,7 +156,7 @@ class StreamWriter:
     def __init__(self, path: str | os.PathLike, nq: int) -> None:
         import h5py
 
-        self.target, self.tmp = _temporary(path)
+        self.target, self.tmp = temporary_for(path)
         self.nq = int(nq)
         self.count = 0
         self.h5 = h5py.File(self.tmp, "w")
@@ -209,7 +189,7 @@ class StreamWriter:
             raise InvalidInput(f"{self.count} solutions were streamed for {reach_map.n_reached} reached poses")
         _write(self.h5, reach_map)
         self.h5.close()
-        _publish(self.tmp, self.target)
+        publish(self.tmp, self.target)
         return self.target
 
     def abort(self) -> None:
@@ -234,11 +214,11 @@ def save_reachability(reach_map: ReachabilityMap, path: str | os.PathLike) -> Pa
 
     if not isinstance(reach_map, ReachabilityMap):
         raise InvalidInput(f"save_reachability needs a ReachabilityMap, got {type(reach_map).__name__}")
-    target, tmp = _temporary(path)
+    target, tmp = temporary_for(path)
     try:
         with h5py.File(tmp, "w") as h5:
             _write(h5, reach_map)
-        _publish(tmp, target)
+        publish(tmp, target)
     except BaseException:
         try:
             os.unlink(tmp)
