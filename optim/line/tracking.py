@@ -38,7 +38,7 @@ from pinarms.planning import Trajectory
 from pinarms.planning.joint_path import JointPath
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "TRACK_SAMPLES"]
+__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "TRACK_SAMPLES"]
 
 #: IK instants per tracking segment (spline knots).
 TRACK_SAMPLES = 41
@@ -126,18 +126,24 @@ def _poses(station: Station, p_world: np.ndarray) -> np.ndarray:
     return T
 
 
-def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-    """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget."""
+def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int | None = None) -> np.ndarray:
+    """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget.
+
+    ``branch``: the closed form's branch label to start on (:meth:`robots.Robot.ik_branches`);
+    None: the rest configuration's branch where it reaches, else the nearest solution."""
     robot = station.robot
     if robot.has_analytic_ik:
         sols = robot.ik_all(poses, q_ref=q_ref)
         out = np.empty((poses.shape[0], robot.nq))
         prev = q_ref
         q0, labels = robot.ik_branches(poses[0], q_ref)
-        want = _branch_label(robot, q_ref)
+        want = _branch_label(robot, q_ref) if branch is None else int(branch)
         same = q0[labels == want]
         if same.shape[0]:  # stay on the rest configuration's branch (maps continuous over the belt)
             prev = same[np.argmin(np.abs(same - q_ref).sum(axis=1))]
+        elif branch is not None:
+            raise UnreachableTarget(f"arm {station.name!r} cannot reach tool point "
+                                    f"{np.round(poses[0, :3, 3], 4).tolist()} (base frame) on IK branch {branch}")
         for k, s in enumerate(sols):
             if s.shape[0] == 0:
                 raise UnreachableTarget(f"arm {station.name!r} cannot reach tool point "
@@ -211,10 +217,13 @@ def _check_limits(station: Station, traj: Trajectory, what: str) -> None:
 
 
 def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, *,
-              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None) -> PickPlan:
+              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None, branch: int | None = None) -> PickPlan:
     """Plan one pick whose pre-grasp point is at belt coordinates (``u_pre``, ``w``) (module doc).
 
     ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
+    ``branch``: the closed-form IK branch of the tracking segment (:func:`ik_branch_labels`; what a
+    task map chose there, :meth:`optim.line.TaskMap.branch_at`); None: the rest configuration's
+    branch where it reaches the pre-grasp point, else the nearest solution.
 
     Raises:
         UnreachableTarget: a point of the tracking segment or the box out of reach.
@@ -225,7 +234,7 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     n = TRACK_SAMPLES
     tau = np.linspace(0.0, spec.track_time, n)
     p = tracking_points(belt, spec, u_pre, w, item_height, tau)
-    q = _ik_path(station, _poses(station, p), q_rest)
+    q = _ik_path(station, _poses(station, p), q_rest, branch)
     qd_in = _joint_rates(station, q[0], belt.velocity)
     qd_out = _joint_rates(station, q[-1], belt.velocity)
     spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
@@ -237,6 +246,19 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     times = (tA, spec.track_time, float(leave.duration), spec.release)
     return PickPlan(station.name, float(u_pre), float(w), approach, tracking, leave, q_rest,
                     (tA + spec.descend, tA + spec.descend + spec.grasp), times)
+
+
+def ik_branch_labels(station: Station, points_world: np.ndarray) -> tuple[int, ...]:
+    """The closed-form IK branch labels reaching any of the tool points (N, 3) [m] (world) in
+    the pick's orientation; ``(-1,)`` for an arm without a closed form (one branch)."""
+    robot = station.robot
+    if not robot.has_analytic_ik:
+        return (-1,)
+    poses = _poses(station, np.asarray(points_world, float).reshape(-1, 3))
+    found: set[int] = set()
+    for T in poses:
+        found.update(int(b) for b in robot.ik_branches(T, robot.neutral)[1])
+    return tuple(sorted(found)) or (-1,)
 
 
 def rest_configuration(station: Station) -> np.ndarray:
