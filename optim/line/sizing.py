@@ -3,8 +3,8 @@
 For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`optim.run_ga`) searches the
 gaps between neighbouring arms (each in ``[min_gap, max_gap]`` m) and the belt speed (one of
 the given speeds, a gene rounded to the nearest) for the lowest mean miss rate over the
-seeds (Monte Carlo: every individual of a generation × every seed is one simulation task
-on the execution layer — serial by default, a Dask cluster by address; tasks are pure
+seeds (Monte Carlo: every individual of a generation is one task on the execution layer,
+simulating its seeds in turn — serial by default, a Dask cluster by address; tasks are pure
 functions of their seeds, so the result is the same either way). The first ``n`` whose best
 line misses no more than asked is the answer, with its positions and speed.
 
@@ -87,18 +87,24 @@ def _layout(problem: SizingProblem, genes: np.ndarray) -> tuple[np.ndarray, floa
     return problem.first_u + np.concatenate([[0.0], np.cumsum(gaps)]), float(speeds[k])
 
 
-def _sim_task(task: dict) -> tuple[float, float]:
-    """(miss rate, picks/min) of one layout on one seed: a task of the execution layer."""
+def _sim_task(task: dict) -> list[tuple[float, float]]:
+    """(miss rate, picks/min) of one layout on each of its seeds: a task of the execution layer.
+
+    One task per layout, not per seed: a task then carries the problem (its maps) once for all
+    its seeds and runs long enough (seconds) that the cluster's per-task costs stay small."""
+    from pinarms.optim.line.belt import Belt
+
     p: SizingProblem = task["problem"]
     m = p.maps[task["speed"]]
     arms = [SimArm(f"arm {k + 1}", float(u), (m,), (float(u) + p.rest[0], p.rest[1]))
             for k, u in enumerate(task["positions"])]
-    from pinarms.optim.line.belt import Belt
-
     belt = Belt((0.0, 0.0, 0.0), speed=task["speed"], width=p.width, length=1.0)
-    items = poisson_items(belt, p.rate / 60.0, p.duration, types=(p.item,), seed=task["seed"])
-    r = simulate(arms, items, task["speed"], p.rule, duration=p.duration, width=p.width)
-    return r.miss_rate, r.picks_per_minute
+    out = []
+    for seed in task["seeds"]:
+        items = poisson_items(belt, p.rate / 60.0, p.duration, types=(p.item,), seed=seed)
+        r = simulate(arms, items, task["speed"], p.rule, duration=p.duration, width=p.width)
+        out.append((r.miss_rate, r.picks_per_minute))
+    return out
 
 
 def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple[np.ndarray, float]], *,
@@ -106,8 +112,8 @@ def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple[np.ndarray,
     """Mean (miss rate, picks/min) over the seeds of each ``(positions, speed)``: (len, 2)."""
     from pinarms.execution import map_chunks
 
-    tasks = [{"problem": problem, "positions": [float(x) for x in pos], "speed": speed, "seed": s}
-             for pos, speed in layouts for s in problem.seeds]
+    tasks = [{"problem": problem, "positions": [float(x) for x in pos], "speed": speed,
+              "seeds": list(problem.seeds), "seed": problem.seeds[0]} for pos, speed in layouts]
     out = np.array(map_chunks(_sim_task, tasks, scheduler=scheduler), dtype=float).reshape(len(layouts),
                                                                                           len(problem.seeds), 2)
     return out.mean(axis=1)
