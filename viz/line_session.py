@@ -62,7 +62,7 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
         branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps else None  # the branch the map timed
         try:
             plan = plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
-                             branch=branch)
+                             branch=branch, yaw=float(items.yaw[i]))
         except PinarmsError:
             continue  # drawn on the belt, not marked (NOT_DRAWN)
         s = max(float(run.meet[i]) - plan.times[0], free_at)

@@ -31,7 +31,7 @@ class NeighbourGuard:
 
     def __init__(self, cell: Any, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
                  types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01,
-                 maps: dict | None = None) -> None:
+                 maps: dict | None = None, yaws: Any = None) -> None:
         self.cell, self.belt, self.tracking, self.types = cell, belt, tracking, tuple(types)
         self.stations = {s.name: s for s in stations}
         for s in stations:
@@ -44,6 +44,7 @@ class NeighbourGuard:
         self.clearance, self.margin = float(clearance), float(margin)
         self._plans: dict = {}
         self.maps = maps or {}  # {station: task maps}: each pick on the IK branch its map chose
+        self.yaws = None if yaws is None else np.asarray(yaws, float)  # per item [rad]: the hand turns to it
         self.checks = 0
 
     def _plan(self, pick: tuple) -> Any:
@@ -55,8 +56,9 @@ class NeighbourGuard:
             if name in self.maps:
                 u_base = float(self.belt.to_belt(st.base_to_world[:3, 3])[0])
                 branch = self.maps[name][kind].branch_at(u - u_base, w)
+            yaw = 0.0 if self.yaws is None else float(self.yaws[item])
             self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
-                                         branch=branch)
+                                         branch=branch, yaw=yaw)
         return self._plans[key]
 
     def __call__(self, pick: tuple, other: tuple) -> bool:

@@ -266,7 +266,9 @@ class MapError:
 
 def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
               n: int = 30, item_height: float = 0.04, seed: int = 0) -> MapError:
-    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc)."""
+    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc), each
+    item at a random yaw (the map is built at yaw 0: the hand's turn leaves the time unchanged,
+    tests/optim/line/test_tracking.py)."""
     rng = np.random.default_rng(seed)
     u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(station)
@@ -277,12 +279,13 @@ def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpe
         tries += 1
         du = rng.uniform(task_map.du[0], task_map.du[-1])
         w = rng.uniform(task_map.w[0], task_map.w[-1])
+        yaw = rng.uniform(-np.pi, np.pi)  # the map has no yaw coordinate: the exact plan turns the hand to it
         tA, tC = task_map.times(du, w)
         if not (np.isfinite(tA) and np.isfinite(tC)):
             continue
         try:
             plan = plan_pick(station, belt, spec, u_base + du, w, item_height=item_height, mass=task_map.mass,
-                             q_rest=q_rest, branch=task_map.branch_at(du, w))
+                             q_rest=q_rest, branch=task_map.branch_at(du, w), yaw=yaw)
         except PinarmsError:
             continue
         approx = float(tA + tC) + task_map.track + task_map.release
