@@ -183,6 +183,30 @@ def _cell_branches(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(four).any(axis=0), best, -1)
 
 
+def _refine_at(x: np.ndarray, A: np.ndarray, C: np.ndarray, extra: float, tolerance: float, axis: int) -> np.ndarray:
+    """Midpoints of the intervals of grid ``x`` (along ``axis`` of the (nb, nu, nw) tables: 1 du, 2 w)
+    next to a node where some branch's approach or leave time has a second difference above
+    ``4 × tolerance`` of the task time there: bilinear interpolation errs by about a quarter of it
+    at a kink, an eighth on a smooth bend."""
+    mark = np.zeros(x.size - 1, bool)
+    n = x.size
+    for T in (A, C):
+        T, tot = np.moveaxis(T, axis, 1), np.moveaxis(A + C, axis, 1)
+        d2 = np.abs(T[:, :-2] - 2.0 * T[:, 1:-1] + T[:, 2:])  # NaN where a node is infeasible
+        with np.errstate(invalid="ignore"):
+            bent = np.any(d2 > 4.0 * tolerance * (tot[:, 1:-1] + extra), axis=(0, 2))
+        mark[: n - 2] |= bent
+        mark[1:] |= bent
+    return 0.5 * (x[:-1] + x[1:])[mark]
+
+
+def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: int) -> tuple:
+    """Grid ``x`` with ``new`` points, and each (nb, nu, nw) table with its ``added`` slices, sorted."""
+    order = np.argsort(np.concatenate([x, new]), kind="stable")
+    return (np.concatenate([x, new])[order],
+            *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
+
+
 def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
     """Exact times of one ``du`` column (a task of the execution layer)."""
     st, belt, spec = task["station"], task["belt"], task["spec"]
@@ -205,11 +229,16 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
 def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
                    item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
                    du_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   progress: Any = None) -> TaskMap:
+                   progress: Any = None, refine: int = 0, tolerance: float = 0.005) -> TaskMap:
     """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
 
     ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
     ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
+    ``refine``: passes that add a ``du`` column, then a ``w`` row, at the middle of each interval
+    where a branch's approach or leave time bends more than linear interpolation can follow
+    (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
+    between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
+    Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
@@ -233,11 +262,25 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
     uu, ww = np.meshgrid(u_base + du, w, indexing="ij")
     labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), item_height + spec.lift))
-    tasks = [{"station": station, "belt": belt, "spec": spec, "du": float(d), "w": w.tolist(), "mass": mass,
-              "height": item_height, "seed": 0, "branches": labels} for d in du]
-    cols = map_chunks(_column, tasks, scheduler=scheduler, progress=progress)
+    task = {"station": station, "belt": belt, "spec": spec, "w": w.tolist(), "mass": mass, "height": item_height,
+            "seed": 0, "branches": labels}
+    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler, progress=progress)
     A = np.stack([c[0] for c in cols], axis=1)  # (nb, nu, nw)
     C = np.stack([c[1] for c in cols], axis=1)
+    extra = spec.track_time + spec.release
+    for _ in range(refine):  # along the belt (new du columns), then across (new w rows)
+        new_u = _refine_at(du, A, C, extra, tolerance, 1)
+        if new_u.size:
+            cols = map_chunks(_column, [{**task, "du": float(d), "w": w.tolist()} for d in new_u], scheduler=scheduler,
+                              progress=progress)
+            du, A, C = _merge(du, new_u, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 1)
+        new_w = _refine_at(w, A, C, extra, tolerance, 2)
+        if new_w.size:
+            cols = map_chunks(_column, [{**task, "du": float(d), "w": new_w.tolist()} for d in du], scheduler=scheduler,
+                              progress=progress)
+            w, A, C = _merge(w, new_w, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 2)
+        if new_u.size == 0 and new_w.size == 0:
+            break
     tot = A + C
     best = np.argmin(np.where(np.isfinite(tot), tot, np.inf), axis=0)[None]
     tA = np.take_along_axis(A, best, 0)[0]
