@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pinarms.optim.line.task_maps import TaskMap, build_task_map, map_error
+from pinarms.optim.line.task_maps import TaskMap, _refine_at, build_task_map, map_error
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.optim.line.windows import window_of
 
@@ -64,3 +64,17 @@ def test_map_round_trip_and_window(tmp_path, scara_line, small_map):
     tA, tC = small_map.times(0.1, 0.0)
     assert np.isfinite(tA) and np.isfinite(tC)
     assert np.isnan(small_map.times(0.5, 0.0)[0])  # outside the grid: infeasible, never extrapolated
+
+
+def test_refinement_marks_a_kink_between_nodes_only():
+    """A V-shaped valley of the leave time at one node (slope -1 to +1 s/m on a 0.05 m grid, a
+    second difference of 0.1 s on a 3.1 s task, above 4 x 0.5 %) marks the two intervals beside it;
+    a straight or gently bent table marks none; an infeasible node hides nothing it cannot see."""
+    du = np.linspace(0.0, 0.3, 7)
+    A = np.full((1, 7, 2), 1.5)
+    C = np.tile(1.0 + np.abs(du - 0.15)[None, :, None], (1, 1, 2))
+    assert np.allclose(_refine_at(du, A, C, 0.6, 0.005, 1), [0.125, 0.175])
+    assert _refine_at(du, A, A.copy() + 0.1 * du[None, :, None], 0.6, 0.005, 1).size == 0
+    assert _refine_at(np.array([-0.1, 0.1]), A, C, 0.6, 0.005, 2).size == 0
+    C[0, 3, 0] = np.nan
+    assert _refine_at(du, A, C, 0.6, 0.005, 1).size == 2  # still seen on the other row
