@@ -4,13 +4,13 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
 
 1. ``simulate``: one hour of a four-arm SCARA line at 120 items/min (about 7 200 items),
    maps loaded (seed 000's SCARA, model limits), each rule, one core.
-2. ``maps``: one arm's task-time maps built (24 × 7 exact picks, serial) and their error
-   against exact planning at 30 random picks.
+2. ``maps``: one arm's task-time maps built (24 × 7 grid on each IK branch, refined twice where
+   the times bend, serial) and their error against exact planning at 100 random picks.
 3. ``rules``: look-ahead (horizon 4) against first / nearest / shortest on the same streams:
    one arm below, at and above its capacity; four arms at 60 and 120 items/min.
-4. ``sizing``: a sizing sweep (``optim.line.sizing.evaluate_layouts``: 24 layouts × 4 seeds)
-   serial vs a LocalCluster of two single-thread workers (127.0.0.1, no dashboard); the
-   results must be identical.
+4. ``sizing``: a sizing sweep (``optim.line.sizing.evaluate_layouts``: 24 layouts × 4 seeds,
+   one task per layout) serial vs a LocalCluster of two single-thread workers (127.0.0.1, no
+   dashboard), both sides warmed alike, interleaved; the results must be identical.
 
 Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|all]
 """
@@ -55,10 +55,11 @@ def part_maps() -> None:
     spec = scara_line(1, 60.0)
     st = spec.stations[0]
     t = time.perf_counter()
-    m = build_task_map(st, spec.belt, spec.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=24, nw=7)
-    print(f"[maps] one SCARA, 24 x 7 exact picks: built in {time.perf_counter() - t:.1f} s, "
-          f"{np.isfinite(m.approach).sum()} feasible")
-    e = map_error(m, st, spec.belt, spec.tracking, n=30, item_height=ENOKI.size[2], seed=7)
+    m = build_task_map(st, spec.belt, spec.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=24, nw=7,
+                       refine=2)
+    print(f"[maps] one SCARA, 24 x 7 grid refined to {m.du.size} x {m.w.size}, {len(m.branches)} IK branches: built in "
+          f"{time.perf_counter() - t:.1f} s, {np.isfinite(m.approach).sum()} feasible nodes")
+    e = map_error(m, st, spec.belt, spec.tracking, n=100, item_height=ENOKI.size[2], seed=11)
     print(f"  error vs exact planning at {e.relative.size} random picks: mean {100 * e.mean:.3f} %, "
           f"max {100 * e.max:.3f} %, 95th {100 * np.percentile(e.relative, 95):.3f} % "
           f"({e.planning_seconds / e.relative.size:.2f} s per exact pick)")
@@ -112,31 +113,54 @@ def _layouts(k: int, rng: np.random.Generator):
     return [(0.6 + np.concatenate([[0.0], np.cumsum(rng.uniform(0.9, 1.4, 3))]), 0.2) for _ in range(k)]
 
 
-def _warm() -> None:
-    import pinarms.optim.line.sizing  # noqa: F401
-
-
-def part_sizing() -> None:
-    from dask.distributed import Client, LocalCluster
-
-    from pinarms.optim.line.sizing import SizingProblem, evaluate_layouts
+def _warm_problem():
+    from pinarms.optim.line.sizing import SizingProblem
     from pinarms.studies.line import ENOKI, maps_for, scara_line
 
     spec = scara_line(1, 60.0)
-    problem = SizingProblem({0.2: maps_for(spec)["scara 1"][0]}, 60.0, item=ENOKI, seeds=(0, 1, 2, 3), duration=600.0)
+    return SizingProblem({0.2: maps_for(spec)["scara 1"][0]}, 60.0, item=ENOKI, seeds=(0, 1, 2, 3), duration=600.0)
+
+
+def _warm() -> None:
+    """One small evaluation: imports, first-call costs; run in this process and on each worker alike."""
+    from pinarms.optim.line.sizing import evaluate_layouts
+
+    evaluate_layouts(_warm_problem(), _layouts(1, np.random.default_rng(99)))
+
+
+def part_sizing(rounds: int = 3) -> None:
+    """Serial and two workers interleaved (serial, dask, serial, dask, ...) on equally warm
+    processes: the machine is shared, so each ratio compares runs a few seconds apart."""
+    from dask.distributed import Client, LocalCluster
+
+    from pinarms.optim.line.sizing import evaluate_layouts
+
+    problem = _warm_problem()
     layouts = _layouts(24, np.random.default_rng(0))
-    t = time.perf_counter()
-    serial = evaluate_layouts(problem, layouts)
-    t_serial = time.perf_counter() - t
     with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
                       processes=True) as cluster, Client(cluster) as client:
-        client.run(_warm)  # workers up, pinarms imported, before the clock starts
-        t = time.perf_counter()
-        dask = evaluate_layouts(problem, layouts, scheduler=client)
-        t_dask = time.perf_counter() - t
-    same = np.array_equal(serial, dask)
-    print(f"[sizing] {len(layouts)} layouts x {len(problem.seeds)} seeds (4 SCARAs, 60/min, 600 s): serial {t_serial:.1f} s, "
-          f"2 workers {t_dask:.1f} s, ratio {t_serial / t_dask:.2f}, identical: {same}")
+        _warm()
+        client.run(_warm)  # both sides warm before any clock starts
+        ratios, same = [], True
+        for k in range(rounds):
+            t, c = time.perf_counter(), time.process_time()
+            serial = evaluate_layouts(problem, layouts)
+            t_serial, c_serial = time.perf_counter() - t, time.process_time() - c
+            w0 = client.run(time.process_time)
+            t, c = time.perf_counter(), time.process_time()
+            dask = evaluate_layouts(problem, layouts, scheduler=client)
+            t_dask, c_client = time.perf_counter() - t, time.process_time() - c
+            w1 = client.run(time.process_time)
+            c_workers = [w1[a] - w0[a] for a in w0]
+            same &= bool(np.array_equal(serial, dask))
+            ratios.append(t_serial / t_dask)
+            # CPU seconds: what each side computed; wall / CPU shows the share of the cores it got
+            print(f"[sizing] round {k + 1}: {len(layouts)} layouts x {len(problem.seeds)} seeds (4 SCARAs, 60/min, "
+                  f"600 s), one task per layout: serial {t_serial:.1f} s wall ({c_serial:.1f} s CPU), "
+                  f"2 workers {t_dask:.1f} s wall (CPU per worker {', '.join(f'{x:.1f}' for x in c_workers)} s, "
+                  f"client {c_client:.1f} s), ratio {t_serial / t_dask:.2f}, in CPU terms "
+                  f"{c_serial / max(c_workers):.2f}", flush=True)
+    print(f"[sizing] ratios {', '.join(f'{r:.2f}' for r in ratios)}; identical: {same}")
 
 
 PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,

@@ -43,12 +43,14 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
     return float(start), float(duration)
 
 
-def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float) -> tuple[list, dict]:
+def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float,
+              maps: tuple = ()) -> tuple[list, dict]:
     """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}."""
     from pinarms.optim.line.tracking import plan_pick, rest_configuration
 
     st = spec.stations[k]
     q_rest = rest_configuration(st)
+    u_base = float(spec.belt.to_belt(st.base_to_world[:3, 3])[0])
     tr = spec.tracking
     out, times = [], {}
     free_at = -np.inf
@@ -56,9 +58,11 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
         if run.start[i] >= t_end:
             break
         kind = items.types[int(items.kind[i])]
+        u, w = float(run.u_meet[i]), float(items.w[i])
+        branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps else None  # the branch the map timed
         try:
-            plan = plan_pick(st, spec.belt, tr, float(run.u_meet[i]), float(items.w[i]), item_height=kind.size[2],
-                             mass=kind.mass, q_rest=q_rest)
+            plan = plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
+                             branch=branch, yaw=float(items.yaw[i]))
         except PinarmsError:
             continue  # drawn on the belt, not marked (NOT_DRAWN)
         s = max(float(run.meet[i]) - plan.times[0], free_at)
@@ -112,7 +116,8 @@ def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float
         arms.append(key)
         picks = np.flatnonzero(r.picked_by == k)
         picks = picks[np.argsort(r.start[picks], kind="stable")]
-        plans, times = _plan_arm(spec, k, picks, r, items, t_b)
+        arm_maps = tuple((getattr(result, "maps", None) or {}).get(st.name, ()))
+        plans, times = _plan_arm(spec, k, picks, r, items, t_b, arm_maps)
         grasp.update(times)
         session.add_trajectory(f"{st.name} picks", (t, _arm_samples(rest_configuration(st), plans, t_a + t)), robot=key)
         box = np.eye(4)

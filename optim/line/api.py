@@ -165,7 +165,8 @@ def _run_seed(task: dict) -> SimResult:
         from pinarms.optim.line.neighbours import NeighbourGuard
 
         guard = NeighbourGuard(spec.cell, spec.stations, spec.belt, spec.tracking, spec.stream.types,
-                               clearance=spec.clearance)
+                               clearance=spec.clearance, maps={a.name: a.maps for a in task["arms"]},
+                               yaws=items.yaw)
     return simulate(task["arms"], items, spec.belt.speed, spec.rule, duration=spec.stream.duration,
                     width=spec.belt.width, guard=guard)
 

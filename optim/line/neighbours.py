@@ -30,7 +30,8 @@ class NeighbourGuard:
     the check's time step. ``checks`` counts the continuous checks run."""
 
     def __init__(self, cell: Any, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
-                 types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01) -> None:
+                 types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01,
+                 maps: dict | None = None, yaws: Any = None) -> None:
         self.cell, self.belt, self.tracking, self.types = cell, belt, tracking, tuple(types)
         self.stations = {s.name: s for s in stations}
         for s in stations:
@@ -42,15 +43,22 @@ class NeighbourGuard:
                 raise InvalidInput(f"station {s.name!r} stands elsewhere than the cell's arm of that name")
         self.clearance, self.margin = float(clearance), float(margin)
         self._plans: dict = {}
+        self.maps = maps or {}  # {station: task maps}: each pick on the IK branch its map chose
+        self.yaws = None if yaws is None else np.asarray(yaws, float)  # per item [rad]: the hand turns to it
         self.checks = 0
 
     def _plan(self, pick: tuple) -> Any:
         name, item, _, meet, u, w, kind = pick
         key = (name, item)
         if key not in self._plans:
-            t = self.types[kind]
-            self._plans[key] = plan_pick(self.stations[name], self.belt, self.tracking, u, w,
-                                         item_height=t.size[2], mass=t.mass)
+            t, st = self.types[kind], self.stations[name]
+            branch = None
+            if name in self.maps:
+                u_base = float(self.belt.to_belt(st.base_to_world[:3, 3])[0])
+                branch = self.maps[name][kind].branch_at(u - u_base, w)
+            yaw = 0.0 if self.yaws is None else float(self.yaws[item])
+            self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
+                                         branch=branch, yaw=yaw)
         return self._plans[key]
 
     def __call__(self, pick: tuple, other: tuple) -> bool:

@@ -109,16 +109,18 @@ class _ArmState:
 
     def __init__(self, arm: SimArm, items: Items, speed: float) -> None:
         m0 = arm.maps[0]
-        self.u = arm.u_base + m0.du
+        for m in arm.maps:
+            if m.du.shape != m0.du.shape or np.any(m.du != m0.du):
+                raise InvalidInput(f"arm {arm.name!r}: the maps of all item types must share one du grid")
+        grid = m0.sim_grid(*arm.maps[1:])  # a node twice where the IK branch changes (no interpolation across)
+        self.u = arm.u_base + grid[0]
         n = len(items)
         self.tA = np.empty((n, self.u.size))
         self.tC = np.empty((n, self.u.size))
         self.extra = np.empty(n)
         for k, m in enumerate(arm.maps):
-            if m.du.shape != m0.du.shape or np.any(m.du != m0.du):
-                raise InvalidInput(f"arm {arm.name!r}: the maps of all item types must share one du grid")
             sel = items.kind == k
-            self.tA[sel], self.tC[sel] = m.rows(items.w[sel])
+            self.tA[sel], self.tC[sel] = m.rows(items.w[sel], grid)
             self.extra[sel] = m.track + m.release
         ok = np.isfinite(self.tA) & np.isfinite(self.tC)
         self.tA[~ok] = np.nan
@@ -140,7 +142,7 @@ class _ArmState:
         k = np.argmax(good, axis=1)
         rows = np.arange(idx.size)
         km = np.maximum(k - 1, 0)
-        prev_ok = (k > 0) & np.isfinite(tA[rows, km]) & (g[rows, km] > 0.0)
+        prev_ok = (k > 0) & np.isfinite(tA[rows, km]) & (g[rows, km] > 0.0) & (self.u[k] > self.u[km])
         gp, gk = np.where(prev_ok, g[rows, km], 0.0), g[rows, k]
         with np.errstate(invalid="ignore", divide="ignore"):
             f = np.where(prev_ok, gp / (gp - gk), 1.0)

@@ -3,8 +3,8 @@
 For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`optim.run_ga`) searches the
 gaps between neighbouring arms (each in ``[min_gap, max_gap]`` m) and the belt speed (one of
 the given speeds, a gene rounded to the nearest) for the lowest mean miss rate over the
-seeds (Monte Carlo: every individual of a generation × every seed is one simulation task
-on the execution layer — serial by default, a Dask cluster by address; tasks are pure
+seeds (Monte Carlo: every individual of a generation is one task on the execution layer,
+simulating its seeds in turn — serial by default, a Dask cluster by address; tasks are pure
 functions of their seeds, so the result is the same either way). The first ``n`` whose best
 line misses no more than asked is the answer, with its positions and speed.
 
@@ -34,7 +34,10 @@ class SizingProblem:
     along the belt reuse it); ``rest``: the arm's box relative to its base on the belt
     (du, w) [m]; ``rate``: flow [items/min] (Poisson); ``max_miss``: miss rate asked for;
     ``min_gap``/``max_gap``: distance between neighbouring arms [m]; ``first_u``: the first
-    arm's place along the belt [m]; ``seeds``, ``duration`` [s] of each simulation."""
+    arm's place along the belt [m]; ``seeds``, ``duration`` [s] of each simulation.
+    ``far_maps``: ``{belt speed: TaskMap}`` of the same arm standing on the belt's other side (its
+    box at ``far_rest``): each arm's side is then a gene too. Neighbours on opposite sides keep the
+    same ``min_gap`` along the belt (no arms facing each other: no neighbour check needed)."""
 
     maps: dict
     rate: float
@@ -48,10 +51,17 @@ class SizingProblem:
     rule: Rule = Rule()
     seeds: tuple[int, ...] = (0, 1, 2, 3)
     duration: float = 300.0
+    far_maps: dict | None = None
+    far_rest: tuple[float, float] = (-0.2, -0.45)
 
     def __post_init__(self) -> None:
         if not self.maps or not all(isinstance(m, TaskMap) for m in self.maps.values()):
             raise InvalidInput("maps must be {belt speed: TaskMap}, at least one")
+        if self.far_maps is not None:
+            if set(map(float, self.far_maps)) != set(map(float, self.maps)) or not all(
+                    isinstance(m, TaskMap) and abs(m.speed - float(v)) <= 1e-9 for v, m in self.far_maps.items()):
+                raise InvalidInput("far_maps must be {belt speed: TaskMap} for the same speeds as maps, each built "
+                                   "for its speed (the arm model standing on the belt's other side)")
         for v, m in self.maps.items():
             if abs(m.speed - float(v)) > 1e-9:
                 raise InvalidInput(f"the map given for {v} m/s was built for {m.speed} m/s")
@@ -68,7 +78,7 @@ class SizingResult:
     """``status``: ``"ok"`` or ``"not found"`` (no ``n <= max_arms`` meets the miss rate);
     ``arms``: how many; ``positions``: along the belt [m]; ``speed`` [m/s]; ``miss_rate``:
     mean over the seeds; ``picks_per_minute``; ``tried``: ``{n: best miss rate}``;
-    ``evaluations``: simulations run."""
+    ``evaluations``: simulations run; ``sides``: per arm 0 (near side) or 1 (far side, ``far_maps``)."""
 
     status: str
     arms: int | None
@@ -78,36 +88,48 @@ class SizingResult:
     picks_per_minute: float
     tried: dict = field(default_factory=dict)
     evaluations: int = 0
+    sides: tuple[int, ...] = ()
 
 
-def _layout(problem: SizingProblem, genes: np.ndarray) -> tuple[np.ndarray, float]:
+def _layout(problem: SizingProblem, genes: np.ndarray) -> tuple[np.ndarray, float, tuple[int, ...]]:
+    """(positions, speed, sides) of a genome: gaps, [sides (0 near, 1 far) when two sides], speed index."""
     speeds = problem.speeds
     k = int(np.clip(np.rint(genes[-1]), 0, speeds.size - 1))
-    gaps = genes[:-1]
-    return problem.first_u + np.concatenate([[0.0], np.cumsum(gaps)]), float(speeds[k])
+    n = (genes.size + 1) // 2 if problem.far_maps is not None else genes.size
+    gaps = genes[: n - 1]
+    sides = tuple(int(np.rint(x) > 0) for x in genes[n - 1: -1]) if problem.far_maps is not None else (0,) * n
+    return problem.first_u + np.concatenate([[0.0], np.cumsum(gaps)]), float(speeds[k]), sides
 
 
-def _sim_task(task: dict) -> tuple[float, float]:
-    """(miss rate, picks/min) of one layout on one seed: a task of the execution layer."""
-    p: SizingProblem = task["problem"]
-    m = p.maps[task["speed"]]
-    arms = [SimArm(f"arm {k + 1}", float(u), (m,), (float(u) + p.rest[0], p.rest[1]))
-            for k, u in enumerate(task["positions"])]
+def _sim_task(task: dict) -> list[tuple[float, float]]:
+    """(miss rate, picks/min) of one layout on each of its seeds: a task of the execution layer.
+
+    One task per layout, not per seed: a task then carries the problem (its maps) once for all
+    its seeds and runs long enough (seconds) that the cluster's per-task costs stay small."""
     from pinarms.optim.line.belt import Belt
 
+    p: SizingProblem = task["problem"]
+    sides = task.get("sides") or (0,) * len(task["positions"])
+    maps = (p.maps[task["speed"]], (p.far_maps or p.maps)[task["speed"]])
+    rests = (p.rest, p.far_rest)
+    arms = [SimArm(f"arm {k + 1}", float(u), (maps[s],), (float(u) + rests[s][0], rests[s][1]))
+            for k, (u, s) in enumerate(zip(task["positions"], sides))]
     belt = Belt((0.0, 0.0, 0.0), speed=task["speed"], width=p.width, length=1.0)
-    items = poisson_items(belt, p.rate / 60.0, p.duration, types=(p.item,), seed=task["seed"])
-    r = simulate(arms, items, task["speed"], p.rule, duration=p.duration, width=p.width)
-    return r.miss_rate, r.picks_per_minute
+    out = []
+    for seed in task["seeds"]:
+        items = poisson_items(belt, p.rate / 60.0, p.duration, types=(p.item,), seed=seed)
+        r = simulate(arms, items, task["speed"], p.rule, duration=p.duration, width=p.width)
+        out.append((r.miss_rate, r.picks_per_minute))
+    return out
 
 
-def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple[np.ndarray, float]], *,
-                     scheduler: Any = None) -> np.ndarray:
-    """Mean (miss rate, picks/min) over the seeds of each ``(positions, speed)``: (len, 2)."""
+def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple], *, scheduler: Any = None) -> np.ndarray:
+    """Mean (miss rate, picks/min) over the seeds of each ``(positions, speed[, sides])``: (len, 2)."""
     from pinarms.execution import map_chunks
 
-    tasks = [{"problem": problem, "positions": [float(x) for x in pos], "speed": speed, "seed": s}
-             for pos, speed in layouts for s in problem.seeds]
+    tasks = [{"problem": problem, "positions": [float(x) for x in lay[0]], "speed": lay[1],
+              "sides": [int(s) for s in lay[2]] if len(lay) > 2 else None, "seeds": list(problem.seeds),
+              "seed": problem.seeds[0]} for lay in layouts]
     out = np.array(map_chunks(_sim_task, tasks, scheduler=scheduler), dtype=float).reshape(len(layouts),
                                                                                           len(problem.seeds), 2)
     return out.mean(axis=1)
@@ -128,7 +150,9 @@ def size_line(problem: SizingProblem, *, n_min: int | None = None, max_arms: int
     evals = 0
     best = None
     for n in range(n_min, max_arms + 1):
-        bounds = np.array([[problem.min_gap, problem.max_gap]] * (n - 1) + [[-0.49, problem.speeds.size - 0.51]])
+        side_genes = [[-0.49, 1.49]] * n if problem.far_maps is not None else []
+        bounds = np.array([[problem.min_gap, problem.max_gap]] * (n - 1) + side_genes
+                          + [[-0.49, problem.speeds.size - 0.51]])
         cache: dict = {}
 
         def objective(pop: np.ndarray) -> np.ndarray:
@@ -145,13 +169,15 @@ def size_line(problem: SizingProblem, *, n_min: int | None = None, max_arms: int
         settings = GASettings(population=population, elitism=2)
         ga = run_ga(objective, bounds, settings, seed=seed + n, max_generations=generations,
                     stall_generations=generations)
-        pos, speed = _layout(problem, ga.x)
-        miss, ppm = evaluate_layouts(problem, [(pos, speed)], scheduler=scheduler)[0]
+        pos, speed, sides = _layout(problem, ga.x)
+        miss, ppm = evaluate_layouts(problem, [(pos, speed, sides)], scheduler=scheduler)[0]
         tried[n] = float(miss)
         if progress:
             progress(f"{n} arms: best miss rate {100 * miss:.2f} % at {speed} m/s")
-        best = (n, pos, speed, miss, ppm)
+        best = (n, pos, speed, miss, ppm, sides)
         if miss <= problem.max_miss:
-            return SizingResult("ok", n, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals)
-    n, pos, speed, miss, ppm = best
-    return SizingResult("not found", None, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals)
+            return SizingResult("ok", n, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals,
+                                sides)
+    n, pos, speed, miss, ppm, sides = best
+    return SizingResult("not found", None, tuple(float(x) for x in pos), speed, float(miss), float(ppm), tried, evals,
+                        sides)

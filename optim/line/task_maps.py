@@ -23,7 +23,7 @@ from __future__ import annotations
 import os
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +32,7 @@ import numpy as np
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick, rest_configuration
+from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
 
@@ -42,8 +42,10 @@ __all__ = ["TaskMap", "build_task_map", "map_error", "MapError"]
 @dataclass(frozen=True, eq=False)
 class TaskMap:
     """Task times over the belt (module doc). ``du`` (nu,), ``w`` (nw,) [m]; ``approach``,
-    ``leave`` (nu, nw) [s] (NaN: infeasible); ``track``, ``release`` [s]; ``speed`` [m/s] and
-    ``mass`` [kg] it was built for; ``build_seconds``."""
+    ``leave`` (nu, nw) [s] (NaN: infeasible; the fastest branch at each node); ``track``,
+    ``release`` [s]; ``speed`` [m/s] and ``mass`` [kg] it was built for; ``build_seconds``;
+    ``branches`` (nb,) IK branch labels and ``branch_approach``, ``branch_leave`` (nb, nu, nw)
+    the times on each branch (None: one branch, ``approach`` and ``leave``)."""
 
     station: str
     du: np.ndarray
@@ -55,6 +57,19 @@ class TaskMap:
     speed: float
     mass: float
     build_seconds: float = 0.0
+    branches: tuple[int, ...] = (-1,)
+    branch_approach: np.ndarray | None = field(default=None, repr=False)
+    branch_leave: np.ndarray | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        A = self.approach[None] if self.branch_approach is None else np.asarray(self.branch_approach, float)
+        C = self.leave[None] if self.branch_leave is None else np.asarray(self.branch_leave, float)
+        if A.shape != (len(self.branches), self.du.size, self.w.size) or C.shape != A.shape:
+            raise InvalidInput(f"task map {self.station!r}: branch tables of shape {A.shape}, {C.shape} for "
+                               f"{len(self.branches)} branches on a {self.du.size} x {self.w.size} grid")
+        object.__setattr__(self, "_A", A)
+        object.__setattr__(self, "_C", C)
+        object.__setattr__(self, "_cell", _cell_branches(A, C))
 
     def _weights(self, grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2)
@@ -62,24 +77,66 @@ class TaskMap:
         f = np.where((x < grid[0]) | (x > grid[-1]), np.nan, f)
         return i, f
 
+    def _cell_branch(self, i: np.ndarray, j: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """Table index of the branch of grid cells (i, j) (-1: no branch feasible at its four nodes or ``f`` NaN)."""
+        return np.where(np.isnan(f), -1, self._cell[i, j])
+
     def times(self, du: Any, w: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Interpolated ``(t_A, t_C)`` [s] at points ``du``, ``w`` (broadcast); NaN where infeasible."""
+        """Interpolated ``(t_A, t_C)`` [s] at points ``du``, ``w`` (broadcast); NaN where infeasible.
+
+        Bilinear within one IK branch: each grid cell uses the fastest branch feasible at its
+        four nodes (:meth:`branch_at`), never a mixture of branches."""
         du, w = np.broadcast_arrays(np.asarray(du, float), np.asarray(w, float))
         i, fu = self._weights(self.du, du)
         j, fw = self._weights(self.w, w)
+        b = self._cell_branch(i, j, fu + fw)
+        bb = np.maximum(b, 0)
         out = []
-        for table in (self.approach, self.leave):
-            a, b = table[i, j], table[i + 1, j]
-            c, d = table[i, j + 1], table[i + 1, j + 1]
-            out.append((a * (1 - fu) + b * fu) * (1 - fw) + (c * (1 - fu) + d * fu) * fw)
+        for table in (self._A, self._C):
+            a, c = table[bb, i, j], table[bb, i + 1, j]
+            d, e = table[bb, i, j + 1], table[bb, i + 1, j + 1]
+            v = (a * (1 - fu) + c * fu) * (1 - fw) + (d * (1 - fu) + e * fu) * fw
+            out.append(np.where(b >= 0, v, np.nan))
         return out[0], out[1]
 
-    def rows(self, w: Any) -> tuple[np.ndarray, np.ndarray]:
-        """``(t_A, t_C)`` of shape (len(w), nu) at the grid's ``du`` for items at ``w`` [m] across."""
+    def branch_at(self, du: float, w: float) -> int | None:
+        """The IK branch label the map uses at (``du``, ``w``) [m] (None: the arm has one branch
+        or the point is infeasible); :func:`~.tracking.plan_pick` ``branch=`` plans it exactly."""
+        i, fu = self._weights(self.du, np.asarray(du, float))
         j, fw = self._weights(self.w, np.asarray(w, float))
+        b = int(self._cell_branch(i, j, fu + fw))
+        return None if b < 0 or self.branches[b] < 0 else int(self.branches[b])
+
+    def sim_grid(self, *others: "TaskMap") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The simulator's du nodes: ``(du, node, cell)`` (K,): the grid's nodes in order, a node
+        listed twice (end of the cell before, start of the cell after) where the cells on its
+        two sides use different branches for some w (in this map or ``others``, same du grid),
+        so that piecewise-linear interpolation along du stays within one branch (the time may
+        jump there)."""
+        nodes, cells = [0], [0]
+        for n in range(1, self.du.size - 1):
+            if any(np.any(m._cell[n - 1] != m._cell[n]) for m in (self, *others)):
+                nodes.append(n)
+                cells.append(n - 1)
+            nodes.append(n)
+            cells.append(n)
+        nodes.append(self.du.size - 1)
+        cells.append(self.du.size - 2)
+        node, cell = np.array(nodes), np.array(cells)
+        return self.du[node], node, cell
+
+    def rows(self, w: Any, grid: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(t_A, t_C)`` of shape (len(w), K) at the du nodes of :meth:`sim_grid` (or ``grid``,
+        one of its results) for items at ``w`` [m] across."""
+        _, node, cell = self.sim_grid() if grid is None else grid
+        j, fw = self._weights(self.w, np.asarray(w, float))
+        b = self._cell_branch(cell[None, :], j[:, None], fw[:, None] + np.zeros(cell.size))
+        bb = np.maximum(b, 0)
         out = []
-        for table in (self.approach, self.leave):
-            out.append((table[:, j] * (1 - fw) + table[:, j + 1] * fw).T)
+        for table in (self._A, self._C):
+            n_, j_, f_ = node[None, :], j[:, None], fw[:, None]
+            v = table[bb, n_, j_] * (1 - f_) + table[bb, n_, j_ + 1] * f_
+            out.append(np.where(b >= 0, v, np.nan))
         return out[0], out[1]
 
     def save(self, path: str | Path) -> Path:
@@ -93,7 +150,8 @@ class TaskMap:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
                          scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
-                         station=np.array(self.station))
+                         station=np.array(self.station), branches=np.array(self.branches, dtype=np.int64),
+                         branch_approach=self._A, branch_leave=self._C)
             os.replace(tmp, path)
         finally:
             if os.path.exists(tmp):
@@ -106,11 +164,47 @@ class TaskMap:
         try:
             with np.load(Path(path), allow_pickle=False) as z:
                 du, w, a, c, s, name = (z[k] for k in ("du", "w", "approach", "leave", "scalars", "station"))
-        except (OSError, KeyError, ValueError) as exc:
+                extra = ({"branches": tuple(int(b) for b in z["branches"].ravel()),
+                          "branch_approach": z["branch_approach"], "branch_leave": z["branch_leave"]}
+                         if "branches" in z.files else {})
+        except (OSError, KeyError, ValueError, TypeError) as exc:
             raise InvalidInput(f"{path}: not a task map file ({exc})") from None
         if a.shape != (du.size, w.size) or c.shape != a.shape or s.shape != (5,):
             raise InvalidInput(f"{path}: task map arrays of inconsistent shapes")
-        return cls(str(name), du, w, a, c, *map(float, s))
+        return cls(str(name), du, w, a, c, *map(float, s), **extra)
+
+
+def _cell_branches(A: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """Per grid cell (nu-1, nw-1): the index of the branch feasible at the cell's four nodes with
+    the least total time over them (-1: none)."""
+    tot = A + C
+    four = tot[:, :-1, :-1] + tot[:, 1:, :-1] + tot[:, :-1, 1:] + tot[:, 1:, 1:]  # NaN where any node is infeasible
+    best = np.argmin(np.where(np.isfinite(four), four, np.inf), axis=0)
+    return np.where(np.isfinite(four).any(axis=0), best, -1)
+
+
+def _refine_at(x: np.ndarray, A: np.ndarray, C: np.ndarray, extra: float, tolerance: float, axis: int) -> np.ndarray:
+    """Midpoints of the intervals of grid ``x`` (along ``axis`` of the (nb, nu, nw) tables: 1 du, 2 w)
+    next to a node where some branch's approach or leave time has a second difference above
+    ``4 × tolerance`` of the task time there: bilinear interpolation errs by about a quarter of it
+    at a kink, an eighth on a smooth bend."""
+    mark = np.zeros(x.size - 1, bool)
+    n = x.size
+    for T in (A, C):
+        T, tot = np.moveaxis(T, axis, 1), np.moveaxis(A + C, axis, 1)
+        d2 = np.abs(T[:, :-2] - 2.0 * T[:, 1:-1] + T[:, 2:])  # NaN where a node is infeasible
+        with np.errstate(invalid="ignore"):
+            bent = np.any(d2 > 4.0 * tolerance * (tot[:, 1:-1] + extra), axis=(0, 2))
+        mark[: n - 2] |= bent
+        mark[1:] |= bent
+    return 0.5 * (x[:-1] + x[1:])[mark]
+
+
+def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: int) -> tuple:
+    """Grid ``x`` with ``new`` points, and each (nb, nu, nw) table with its ``added`` slices, sorted."""
+    order = np.argsort(np.concatenate([x, new]), kind="stable")
+    return (np.concatenate([x, new])[order],
+            *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
 
 
 def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -118,26 +212,33 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
     st, belt, spec = task["station"], task["belt"], task["spec"]
     u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
-    tA = np.full(len(task["w"]), np.nan)
-    tC = np.full(len(task["w"]), np.nan)
-    for j, w in enumerate(task["w"]):
-        try:
-            plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
-                             q_rest=q_rest)
-        except (UnreachableTarget, InfeasibleProblem, OptimError):
-            continue
-        tA[j], tC[j] = plan.times[0], plan.times[2]
+    labels = task.get("branches", (-1,))
+    tA = np.full((len(labels), len(task["w"])), np.nan)
+    tC = np.full_like(tA, np.nan)
+    for b, label in enumerate(labels):
+        for j, w in enumerate(task["w"]):
+            try:
+                plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
+                                 q_rest=q_rest, branch=None if label < 0 else label)
+            except (UnreachableTarget, InfeasibleProblem, OptimError):
+                continue
+            tA[b, j], tC[b, j] = plan.times[0], plan.times[2]
     return tA, tC
 
 
 def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
                    item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
                    du_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   progress: Any = None) -> TaskMap:
+                   progress: Any = None, refine: int = 0, tolerance: float = 0.005) -> TaskMap:
     """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
 
     ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
     ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
+    ``refine``: passes that add a ``du`` column, then a ``w`` row, at the middle of each interval
+    where a branch's approach or leave time bends more than linear interpolation can follow
+    (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
+    between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
+    Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
@@ -158,13 +259,34 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     if half <= 0.0:
         raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
     w = np.linspace(-half, half, nw)
-    tasks = [{"station": station, "belt": belt, "spec": spec, "du": float(d), "w": w.tolist(), "mass": mass,
-              "height": item_height, "seed": 0} for d in du]
-    cols = map_chunks(_column, tasks, scheduler=scheduler, progress=progress)
-    tA = np.stack([c[0] for c in cols])
-    tC = np.stack([c[1] for c in cols])
+    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    uu, ww = np.meshgrid(u_base + du, w, indexing="ij")
+    labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), item_height + spec.lift))
+    task = {"station": station, "belt": belt, "spec": spec, "w": w.tolist(), "mass": mass, "height": item_height,
+            "seed": 0, "branches": labels}
+    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler, progress=progress)
+    A = np.stack([c[0] for c in cols], axis=1)  # (nb, nu, nw)
+    C = np.stack([c[1] for c in cols], axis=1)
+    extra = spec.track_time + spec.release
+    for _ in range(refine):  # along the belt (new du columns), then across (new w rows)
+        new_u = _refine_at(du, A, C, extra, tolerance, 1)
+        if new_u.size:
+            cols = map_chunks(_column, [{**task, "du": float(d), "w": w.tolist()} for d in new_u], scheduler=scheduler,
+                              progress=progress)
+            du, A, C = _merge(du, new_u, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 1)
+        new_w = _refine_at(w, A, C, extra, tolerance, 2)
+        if new_w.size:
+            cols = map_chunks(_column, [{**task, "du": float(d), "w": new_w.tolist()} for d in du], scheduler=scheduler,
+                              progress=progress)
+            w, A, C = _merge(w, new_w, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 2)
+        if new_u.size == 0 and new_w.size == 0:
+            break
+    tot = A + C
+    best = np.argmin(np.where(np.isfinite(tot), tot, np.inf), axis=0)[None]
+    tA = np.take_along_axis(A, best, 0)[0]
+    tC = np.take_along_axis(C, best, 0)[0]
     return TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start)
+                   time.perf_counter() - start, labels, A, C)
 
 
 @dataclass(frozen=True)
@@ -187,7 +309,9 @@ class MapError:
 
 def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
               n: int = 30, item_height: float = 0.04, seed: int = 0) -> MapError:
-    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc)."""
+    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc), each
+    item at a random yaw (the map is built at yaw 0: the hand's turn leaves the time unchanged,
+    tests/optim/line/test_tracking.py)."""
     rng = np.random.default_rng(seed)
     u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(station)
@@ -198,12 +322,13 @@ def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpe
         tries += 1
         du = rng.uniform(task_map.du[0], task_map.du[-1])
         w = rng.uniform(task_map.w[0], task_map.w[-1])
+        yaw = rng.uniform(-np.pi, np.pi)  # the map has no yaw coordinate: the exact plan turns the hand to it
         tA, tC = task_map.times(du, w)
         if not (np.isfinite(tA) and np.isfinite(tC)):
             continue
         try:
             plan = plan_pick(station, belt, spec, u_base + du, w, item_height=item_height, mass=task_map.mass,
-                             q_rest=q_rest)
+                             q_rest=q_rest, branch=task_map.branch_at(du, w), yaw=yaw)
         except PinarmsError:
             continue
         approx = float(tA + tC) + task_map.track + task_map.release

@@ -19,7 +19,9 @@ joints are the arm's IK at dense instants (one branch, continuous), a clamped cu
 time whose end velocities are the exact ``J⁺ ṗ``; it is checked against the same limits.
 
 Tool orientation: the arm's default tool orientation (:func:`robots.layout.default_orientation`,
-pointing down on a SCARA), yaw aligned with the belt through the whole pick.
+pointing down on a SCARA) turned about the vertical by the item's yaw (:func:`tool_yaw`, modulo the
+gripper's symmetry) through the whole tracking segment; an arm without a hand rotation (a gantry
+of three slides) grasps at its own fixed yaw.
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ from pinarms.planning import Trajectory
 from pinarms.planning.joint_path import JointPath
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "TRACK_SAMPLES"]
+__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
+           "TRACK_SAMPLES"]
 
 #: IK instants per tracking segment (spline knots).
 TRACK_SAMPLES = 41
@@ -48,15 +51,20 @@ TRACK_SAMPLES = 41
 class TrackingSpec:
     """How the arm picks (module doc): ``lift`` [m] above the grasp point, ``descend`` [s] each
     way, ``grasp`` [s] gripper closing while tracking, ``release`` [s] at the box,
-    ``grid`` TOPP-RA grid intervals per move."""
+    ``grid`` TOPP-RA grid intervals per move, ``yaw_period`` [rad] the gripper's symmetry about
+    the vertical (π: two fingers grip an item at yaw and yaw + π alike; 2π: none)."""
 
     lift: float = 0.03
     descend: float = 0.2
     grasp: float = 0.1
     release: float = 0.1
     grid: int = 40
+    yaw_period: float = float(np.pi)
 
     def __post_init__(self) -> None:
+        if not (0.0 < _number(self.yaw_period, "yaw_period [rad] of the tracking spec") <= 2.0 * np.pi + 1e-12):
+            raise InvalidInput(f"yaw_period [rad] of the tracking spec must be in (0, 2π] (π: a two-finger "
+                               f"gripper), got {self.yaw_period!r}")
         for name in ("lift", "descend"):
             _number(getattr(self, name), f"{name} of the tracking spec", positive=True)
         for name in ("grasp", "release"):
@@ -116,28 +124,58 @@ def tracking_points(belt: Belt, spec: TrackingSpec, u_pre: float, w: float, z_gr
     return belt.to_world(u_pre + belt.speed * tau, w, z_grasp + spec.lift * h)
 
 
-def _poses(station: Station, p_world: np.ndarray) -> np.ndarray:
+def _hand_joints(robot: Any) -> np.ndarray:
+    """(nq,) bool: joints that turn the tool without moving its point at neutral (SCARA joint 4)."""
+    return np.linalg.norm(robot.jacobian(robot.neutral)[:3], axis=0) < 1e-9
+
+
+def can_yaw(robot: Any) -> bool:
+    """Whether the arm can turn its tool about the vertical (a hand joint: SCARA joint 4), i.e. its
+    Jacobian's angular z row is not zero at neutral; a gantry of three slides cannot."""
+    return bool(np.linalg.norm(robot.jacobian(robot.neutral)[5]) > 1e-9)
+
+
+def tool_yaw(station: Station, spec: "TrackingSpec", yaw: float) -> float:
+    """The hand angle [rad] about the vertical, relative to the tool's default, that grasps an item at
+    ``yaw`` [rad] (belt frame): ``yaw`` reduced by the gripper's symmetry ``spec.yaw_period`` into
+    [-period/2, period/2); 0 for an arm that cannot yaw (:func:`can_yaw`: it grasps at its own yaw)."""
+    y = _number(yaw, "item yaw [rad]")
+    if not can_yaw(station.robot):
+        return 0.0
+    per = spec.yaw_period
+    return float((y + per / 2.0) % per - per / 2.0)
+
+
+def _poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarray:
     from pinarms.robots.layout import default_orientation
 
-    R = default_orientation(station.robot)
+    c, s = np.cos(yaw), np.sin(yaw)
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    R = Rz @ default_orientation(station.robot)  # turned about the base's vertical (upright bases)
     T = np.tile(np.eye(4), (p_world.shape[0], 1, 1))
     T[:, :3, :3] = R
     T[:, :3, 3] = station.world_to_base(p_world)
     return T
 
 
-def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-    """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget."""
+def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int | None = None) -> np.ndarray:
+    """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget.
+
+    ``branch``: the closed form's branch label to start on (:meth:`robots.Robot.ik_branches`);
+    None: the rest configuration's branch where it reaches, else the nearest solution."""
     robot = station.robot
     if robot.has_analytic_ik:
         sols = robot.ik_all(poses, q_ref=q_ref)
         out = np.empty((poses.shape[0], robot.nq))
         prev = q_ref
         q0, labels = robot.ik_branches(poses[0], q_ref)
-        want = _branch_label(robot, q_ref)
+        want = _branch_label(robot, q_ref) if branch is None else int(branch)
         same = q0[labels == want]
         if same.shape[0]:  # stay on the rest configuration's branch (maps continuous over the belt)
             prev = same[np.argmin(np.abs(same - q_ref).sum(axis=1))]
+        elif branch is not None:
+            raise UnreachableTarget(f"arm {station.name!r} cannot reach tool point "
+                                    f"{np.round(poses[0, :3, 3], 4).tolist()} (base frame) on IK branch {branch}")
         for k, s in enumerate(sols):
             if s.shape[0] == 0:
                 raise UnreachableTarget(f"arm {station.name!r} cannot reach tool point "
@@ -191,9 +229,12 @@ def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> A
     from pinarms.optim.path_timing import time_optimal
 
     chord = q1 - q0
-    L = float(np.linalg.norm(chord))
+    arm = ~_hand_joints(station.robot)  # the path's scale from the joints that move the tool point,
+    if not np.any(arm):                 # so the hand's angle (the item's yaw) leaves their path unchanged
+        arm = np.ones(chord.size, bool)
+    L = float(np.linalg.norm(chord[arm]))
     moving = qd1 if np.any(qd1) else qd0
-    speed = float(np.linalg.norm(moving))
+    speed = float(np.linalg.norm(moving[arm]))
     k = L / speed if speed > 1e-12 and L > 1e-9 else 1.0
     m0, m1 = (chord, k * qd1) if np.any(qd1) else (k * qd0, chord)
     path = _hermite(q0, m0, q1, m1, station.robot)
@@ -211,10 +252,15 @@ def _check_limits(station: Station, traj: Trajectory, what: str) -> None:
 
 
 def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, *,
-              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None) -> PickPlan:
+              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None, branch: int | None = None,
+              yaw: float = 0.0) -> PickPlan:
     """Plan one pick whose pre-grasp point is at belt coordinates (``u_pre``, ``w``) (module doc).
 
     ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
+    ``branch``: the closed-form IK branch of the tracking segment (:func:`ik_branch_labels`; what a
+    task map chose there, :meth:`optim.line.TaskMap.branch_at`); None: the rest configuration's
+    branch where it reaches the pre-grasp point, else the nearest solution. ``yaw`` [rad]: the
+    item's yaw on the belt; the hand turns to :func:`tool_yaw` for the whole tracking segment.
 
     Raises:
         UnreachableTarget: a point of the tracking segment or the box out of reach.
@@ -225,7 +271,7 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     n = TRACK_SAMPLES
     tau = np.linspace(0.0, spec.track_time, n)
     p = tracking_points(belt, spec, u_pre, w, item_height, tau)
-    q = _ik_path(station, _poses(station, p), q_rest)
+    q = _ik_path(station, _poses(station, p, tool_yaw(station, spec, yaw)), q_rest, branch)
     qd_in = _joint_rates(station, q[0], belt.velocity)
     qd_out = _joint_rates(station, q[-1], belt.velocity)
     spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
@@ -237,6 +283,19 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     times = (tA, spec.track_time, float(leave.duration), spec.release)
     return PickPlan(station.name, float(u_pre), float(w), approach, tracking, leave, q_rest,
                     (tA + spec.descend, tA + spec.descend + spec.grasp), times)
+
+
+def ik_branch_labels(station: Station, points_world: np.ndarray) -> tuple[int, ...]:
+    """The closed-form IK branch labels reaching any of the tool points (N, 3) [m] (world) in
+    the pick's orientation; ``(-1,)`` for an arm without a closed form (one branch)."""
+    robot = station.robot
+    if not robot.has_analytic_ik:
+        return (-1,)
+    poses = _poses(station, np.asarray(points_world, float).reshape(-1, 3))
+    found: set[int] = set()
+    for T in poses:
+        found.update(int(b) for b in robot.ik_branches(T, robot.neutral)[1])
+    return tuple(sorted(found)) or (-1,)
 
 
 def rest_configuration(station: Station) -> np.ndarray:

@@ -87,8 +87,10 @@ def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress
                 elif build:
                     if progress:
                         progress(f"building the task map {name}")
+                    one = len(spec.stream.types) == 1  # refined grids differ between types
                     cache[name] = build_task_map(st, spec.belt, spec.tracking, mass=kind.mass,
-                                                 item_height=kind.size[2], nu=spec.map_grid[0], nw=spec.map_grid[1])
+                                                 item_height=kind.size[2], nu=spec.map_grid[0], nw=spec.map_grid[1],
+                                                 refine=2 if one else 0)
                     if save:
                         DATA.mkdir(exist_ok=True)
                         cache[name].save(path)

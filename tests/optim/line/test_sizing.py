@@ -40,3 +40,24 @@ def test_serial_and_dask_give_identical_results():
     serial = evaluate_layouts(p, layouts)
     dask = evaluate_layouts(p, layouts, scheduler="processes:2")
     assert np.array_equal(serial, dask)
+
+
+def _half_map(side):
+    """Cycle 2.6 s, feasible only on one half of the belt (w >= 0 near side, w <= 0 far side)."""
+    du, w = np.linspace(-0.3, 0.3, 13), np.array([-0.15, 0.0, 0.15])
+    t = np.full((13, 3), 1.0)
+    t[:, 0 if side == 0 else 2] = np.nan
+    return TaskMap("a", du, w, t, t.copy(), 0.5, 0.1, 0.2, 0.1)
+
+
+def test_arms_on_both_sides_when_each_side_reaches_half_the_belt():
+    kw = dict(rate=12.0, max_miss=0.05, item=ItemType("x"), seeds=(0, 1), duration=240.0, min_gap=0.7, max_gap=1.2)
+    one = size_line(SizingProblem({0.2: _half_map(0)}, **kw), n_min=2, max_arms=3, population=6, generations=2)
+    assert one.status == "not found" and min(one.tried.values()) > 0.3  # half the items out of reach
+    two = SizingProblem({0.2: _half_map(0)}, far_maps={0.2: _half_map(1)}, **kw)
+    r = size_line(two, n_min=2, max_arms=3, population=8, generations=3)
+    assert r.status == "ok" and set(r.sides) == {0, 1} and len(r.sides) == r.arms
+    again = evaluate_layouts(two, [(np.array(r.positions), r.speed, r.sides)])[0]
+    assert again[0] == pytest.approx(r.miss_rate, abs=1e-15) and again[0] <= 0.05
+    with pytest.raises(InvalidInput, match="far_maps"):
+        SizingProblem({0.2: _half_map(0)}, far_maps={0.3: _half_map(1)}, rate=10.0)

@@ -6,7 +6,8 @@ import pytest
 from pinarms import robots
 from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick
+from pinarms.optim.line.tracking import TrackingSpec, can_yaw, plan_pick, tool_yaw
+from pinarms.robots.errors import InvalidInput
 
 
 def _tool_world(station, q):
@@ -15,8 +16,8 @@ def _tool_world(station, q):
     return p
 
 
-def _check_rendezvous(station, belt, spec, u_pre, w, height):
-    plan = plan_pick(station, belt, spec, u_pre, w, item_height=height, mass=0.1)
+def _check_rendezvous(station, belt, spec, u_pre, w, height, yaw=0.0):
+    plan = plan_pick(station, belt, spec, u_pre, w, item_height=height, mass=0.1, yaw=yaw)
     traj = plan.trajectory
     t_a = plan.times[0]
     g0, g1 = plan.grasp_window
@@ -53,3 +54,43 @@ def test_gantry_rendezvous_from_fk():
     belt = Belt(origin=(0.0, 0.2, 0.70), speed=0.3, width=0.3, length=2.0)
     station = Station("gantry", robots.load("gantry_flower"), base_pose(0.0, 0.0, 0.65), PlaceBox((0.3, 0.5, 0.90)))
     _check_rendezvous(station, belt, TrackingSpec(), 0.5, 0.05, 0.05)
+
+
+def _hand_angle(station, q):
+    """Tool's x axis angle about the vertical in the world [rad]."""
+    R = station.base_to_world[:3, :3] @ station.robot.fk(q)[..., :3, :3]
+    return np.arctan2(R[..., 1, 0], R[..., 0, 0])
+
+
+def test_scara_hand_matches_the_item_yaw_from_fk(scara_line):
+    belt, station = scara_line
+    spec = TrackingSpec()
+    ref = plan_pick(station, belt, spec, 1.05, -0.05, item_height=0.04, mass=0.1)
+    a0 = _hand_angle(station, ref.trajectory.sample(np.array([ref.grasp_window[0]]))[0])[0]
+    for yaw in (0.6, -1.2, 2.9):  # 2.9 rad: a two-finger gripper takes it at 2.9 - π
+        plan = _check_rendezvous(station, belt, spec, 1.05, -0.05, 0.04, yaw=yaw)
+        t = np.linspace(*plan.grasp_window, 51)
+        turn = _hand_angle(station, plan.trajectory.sample(t)[0]) - a0
+        want = (yaw + np.pi / 2) % np.pi - np.pi / 2
+        assert tool_yaw(station, spec, yaw) == pytest.approx(want)
+        assert np.max(np.abs((turn - want + np.pi) % (2 * np.pi) - np.pi)) < 1e-6  # over the whole dwell
+
+
+def test_item_yaw_is_a_zero_separable_term_of_the_task_time(scara_line):
+    """The map has no yaw coordinate: the hand joint's turn never limits the move. Approach and
+    leave are scaled by the joints that move the tool point, so the hand only adds its own
+    coordinate to the path; at joint-4 limits of 6 rad/s and 60 rad/s² it never binds: the task
+    time is the same at every yaw (to the timing's tolerance), at points on both elbows."""
+    belt, station = scara_line
+    for u, w, branch in ((1.05, -0.05, None), (0.93, 0.03, 1), (1.2, 0.1, 0)):
+        base = plan_pick(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch).duration
+        for yaw in (-np.pi / 2, -0.8, 0.7, np.pi / 2 - 1e-3):
+            t = plan_pick(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch, yaw=yaw).duration
+            assert t == pytest.approx(base, rel=1e-3)
+
+
+def test_gantry_cannot_turn_its_tool():
+    station = Station("gantry", robots.load("gantry_flower"), base_pose(0.0, 0.0, 0.65), PlaceBox((0.3, 0.5, 0.90)))
+    assert not can_yaw(station.robot) and tool_yaw(station, TrackingSpec(), 1.0) == 0.0
+    with pytest.raises(InvalidInput, match="yaw_period"):
+        TrackingSpec(yaw_period=0.0)

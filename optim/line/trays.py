@@ -1,0 +1,157 @@
+"""Place targets on a second moving belt: trays, and the place as a second rendezvous.
+
+A :class:`TrayBelt` is a second :class:`~.belt.Belt` carrying trays at a regular ``pitch``,
+each taking ``capacity`` items at its place point (``w`` across, ``height`` above the belt's
+surface). Placing in a tray is a rendezvous like the pick (:mod:`~.tracking`): after the pick's
+tracking segment the arm moves to the *pre-place* point (``lift`` above the place point) and
+arrives there moving with the tray belt; still moving with it, it descends (``descend`` s),
+opens the gripper (``release`` s) and lifts (``descend`` s); then it returns to rest at its home
+(the station's box position)::
+
+    approach │ pick tracking │ transfer (time-optimal)      │ place tracking            │ return
+    rest ─▶  │ item's belt   │ item's belt ─▶ tray's belt    │ descend · release · lift  │ ─▶ rest
+
+The transfer is a joint-space cubic Hermite path whose end tangents are both tracking segments'
+joint velocities, timed by TOPP-RA with the path speed fixed at both ends (the item as payload);
+the return like the pick's leave move. The hand keeps the pick's turn (the item's yaw) through
+the place. Checked from FK (tests/optim/line/test_trays.py): tool-to-tray distance < 1 mm and
+relative speed < 1 % of the tray belt's speed over the whole release dwell.
+
+Not yet in the task maps nor the simulation (docs/line.md): both still place in fixed boxes.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.station import Station
+from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_limits, _constraints, _hand_joints,
+                                         _hermite, _ik_path, _joint_rates, _poses, _timed_move, plan_pick,
+                                         rest_configuration, tool_yaw, tracking_points)
+from pinarms.planning import Trajectory
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray"]
+
+
+@dataclass(frozen=True, eq=False)
+class TrayBelt:
+    """Trays on a second belt (module doc): ``belt`` (its direction and speed), ``pitch`` [m]
+    between tray centres, ``capacity`` items per tray, ``phase`` [m] the u of tray 0's centre at
+    t = 0, ``w`` [m] across of the place point, ``height`` [m] of the place point above the surface."""
+
+    belt: Belt
+    pitch: float = 0.4
+    capacity: int = 1
+    phase: float = 0.0
+    w: float = 0.0
+    height: float = 0.03
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.belt, Belt):
+            raise InvalidInput(f"belt of the trays must be an optim.line.Belt, got {type(self.belt).__name__}")
+        _number(self.pitch, "tray pitch [m]", positive=True)
+        _number(self.height, "place height above the tray belt [m]")
+        _number(self.phase, "tray phase [m]")
+        if abs(_number(self.w, "place point across the tray belt [m]")) > self.belt.width / 2.0:
+            raise InvalidInput(f"place point w = {self.w} m lies off the tray belt (width {self.belt.width} m)")
+        if not (isinstance(self.capacity, int) and not isinstance(self.capacity, bool) and self.capacity >= 1):
+            raise InvalidInput(f"tray capacity must be an integer >= 1, got {self.capacity!r}")
+
+    def tray_u(self, k: Any, t: Any) -> np.ndarray:
+        """u [m] of tray ``k``'s centre on its belt at time ``t`` [s] (broadcast)."""
+        return self.phase - np.asarray(k, float) * self.pitch + self.belt.speed * np.asarray(t, float)
+
+
+@dataclass(eq=False)
+class TrayPickPlan:
+    """A pick placed in a tray. Times in s from the start of the approach: ``times`` = approach,
+    pick tracking, transfer, place tracking, return; ``grasp_window`` and ``release_window``
+    (start, end) of the gripper closing and opening; ``u_pre``, ``w`` the pick's pre-grasp point,
+    ``u_place`` the pre-place point on the tray belt [m]."""
+
+    station: str
+    u_pre: float
+    w: float
+    u_place: float
+    pieces: tuple
+    q_rest: np.ndarray
+    grasp_window: tuple[float, float]
+    release_window: tuple[float, float]
+    times: tuple[float, float, float, float, float]
+
+    @functools.cached_property
+    def trajectory(self) -> Trajectory:
+        out = self.pieces[0]
+        for p in self.pieces[1:]:
+            out = out.concatenated(p, atol=1e-7)
+        return out
+
+    @property
+    def duration(self) -> float:
+        return float(sum(self.times))
+
+
+def _timed_transfer(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> Any:
+    """Time-optimal move q0 → q1 starting with joint velocity qd0 and ending with qd1 (both moving)."""
+    from pinarms.optim.path_timing import time_optimal
+
+    chord = q1 - q0
+    arm = ~_hand_joints(station.robot)
+    if not np.any(arm):
+        arm = np.ones(chord.size, bool)
+    L = max(float(np.linalg.norm(chord[arm])), 1e-9)
+    k0 = L / max(float(np.linalg.norm(qd0[arm])), 1e-12)
+    k1 = L / max(float(np.linalg.norm(qd1[arm])), 1e-12)
+    path = _hermite(q0, k0 * qd0, q1, k1 * qd1, station.robot)
+    return time_optimal(path, _constraints(station, mass), grid=grid, start_speed=1.0 / k0, end_speed=1.0 / k1)
+
+
+def _segment(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, z: float, yaw: float,
+             q_ref: np.ndarray, branch: Any, what: str) -> tuple[Trajectory, np.ndarray, np.ndarray]:
+    """A tracking segment on ``belt``: its trajectory and its end joint velocities."""
+    tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
+    q = _ik_path(station, _poses(station, tracking_points(belt, spec, u, w, z, tau), yaw), q_ref, branch)
+    qd_in = _joint_rates(station, q[0], belt.velocity)
+    qd_out = _joint_rates(station, q[-1], belt.velocity)
+    spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
+    traj = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
+    _check_limits(station, traj, what)
+    return traj, qd_in, qd_out
+
+
+def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec, u_pre: float, w: float,
+                      u_place: float, *, item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None,
+                      branch: int | None = None, yaw: float = 0.0) -> TrayPickPlan:
+    """Pick at (``u_pre``, ``w``) on ``belt`` and place in the tray whose place point passes
+    ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); arguments as
+    :func:`~.tracking.plan_pick`.
+
+    Raises:
+        UnreachableTarget: a point of either tracking segment out of reach.
+        InfeasibleProblem: a belt too fast for the arm there, or a move beyond its limits.
+    """
+    q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
+    pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
+                     branch=branch, yaw=yaw)
+    q_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[0][0]
+    qd_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[1][0]
+    place_spec = replace(spec, grasp=spec.release)  # the dwell is the gripper opening
+    place, qd_in, qd_out = _segment(station, trays.belt, place_spec, float(u_place), trays.w, trays.height,
+                                    tool_yaw(station, spec, yaw), q_end, None, "place tracking segment")
+    q_place = place.sample(np.array([0.0]))[0][0]
+    transfer = _timed_transfer(station, q_end, qd_end, q_place, qd_in, mass, spec.grid)
+    q_last = place.sample(np.array([place.end_time]))[0][0]
+    ret = _timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
+    tA, tT = pick.times[0], pick.times[1]
+    tX, tP, tR = float(transfer.duration), place_spec.track_time, float(ret.duration)
+    r0 = tA + tT + tX + spec.descend
+    pieces = (pick.approach.trajectory, pick.tracking, transfer.trajectory, place, ret.trajectory)
+    return TrayPickPlan(station.name, float(u_pre), float(w), float(u_place), pieces, q_rest, pick.grasp_window,
+                        (r0, r0 + spec.release), (tA, tT, tX, tP, tR))

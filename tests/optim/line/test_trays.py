@@ -1,0 +1,56 @@
+"""Placing in trays on a second moving belt, checked from FK of the planned joints."""
+
+import numpy as np
+import pytest
+
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.tracking import TrackingSpec
+from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
+from pinarms.robots.errors import InvalidInput
+
+
+def _tool(station, q):
+    T = station.robot.fk(q)
+    return T[..., :3, 3] @ station.base_to_world[:3, :3].T + station.base_to_world[:3, 3]
+
+
+def _velocity(station, q, qd):
+    J = station.robot.jacobian(q)[:, :3, :]
+    return np.einsum("nij,nj->ni", J, qd) @ station.base_to_world[:3, :3].T
+
+
+@pytest.mark.parametrize("direction", [(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0)])
+def test_place_in_a_moving_tray_from_fk(scara_line, direction):
+    belt, station = scara_line
+    tray_belt = Belt((0.0 if direction[0] > 0 else 3.0, 0.52, 0.82), direction=direction, speed=0.1, width=0.2,
+                     length=3.0)
+    trays = TrayBelt(tray_belt, pitch=0.3, w=0.0, height=0.02)
+    u_place = 0.9 if direction[0] > 0 else 2.1  # world x 0.9 either way, beside the arm
+    spec = TrackingSpec()
+    plan = plan_pick_to_tray(station, belt, trays, spec, 1.05, -0.05, u_place, mass=0.1, yaw=0.4)
+    traj = plan.trajectory
+    assert plan.duration == pytest.approx(traj.end_time - traj.start_time, abs=1e-6)
+    # the pick is still a rendezvous with the item
+    g = np.linspace(*plan.grasp_window, 101)
+    q, qd = traj.sample(g)[:2]
+    item = belt.to_world(1.05 + belt.speed * (g - plan.times[0]), -0.05, 0.04)
+    assert np.max(np.linalg.norm(_tool(station, q) - item, axis=1)) < 1e-3
+    # the place: tool at the tray's place point and moving with the tray over the whole release dwell
+    r = np.linspace(*plan.release_window, 101)
+    q, qd = traj.sample(r)[:2]
+    t_place = sum(plan.times[:3])  # the pre-place rendezvous
+    target = tray_belt.to_world(u_place + tray_belt.speed * (r - t_place), trays.w, trays.height)
+    assert np.max(np.linalg.norm(_tool(station, q) - target, axis=1)) < 1e-3
+    rel = np.linalg.norm(_velocity(station, q, qd) - tray_belt.velocity, axis=1)
+    assert np.max(rel) < 0.01 * tray_belt.speed
+    # ends at rest at home, within the joint limits
+    assert np.allclose(traj.sample(np.array([traj.end_time]))[1], 0.0, atol=1e-9)
+    assert np.all(traj.peaks().velocity <= station.limits["vmax"] * (1 + 1e-6))
+
+
+def test_tray_belt_input():
+    b = Belt((0.0, 0.5, 0.8), speed=0.1, width=0.2)
+    assert TrayBelt(b, pitch=0.3, phase=0.1).tray_u(2, 1.0) == pytest.approx(0.1 - 0.6 + 0.1)
+    for bad in (dict(pitch=0.0), dict(capacity=0), dict(w=0.2), dict(pitch=float("nan"))):
+        with pytest.raises(InvalidInput):
+            TrayBelt(b, **bad)
