@@ -96,14 +96,18 @@ def test_cover_clear_states_are_clear_for_coal(cells, name):
     assert np.all(excess >= 0.0), f"{name}: the cover called clear a state {-excess.min() * 1e3:.3f} mm too close"
     for which in ("margin", 0):
         np.testing.assert_array_equal(fast.batch_collides(Q, which), exact.batch_collides(Q, which))
-    if name.startswith("panda") or name == "aubo_two_belt":  # spheres and cylinders: the cover is used
+    if name.startswith("panda"):  # spheres and cylinders: the cover is used
         assert fast.cover_decides_screens
         assert proven.mean() >= 0.9 * (~exact.batch_collides(Q)).mean()  # and decides most states
+    if name == "aubo_two_belt":
+        # each shoulder turns 47 mm above its own stand: a pair the coarsest screen (50 mm) must look at, which the
+        # spheres around the shoulder's cylinder cannot prove clear even at 10 mm, so coal alone screens here
+        assert not fast.cover_decides_screens
     if name.startswith("ur5"):  # meshes: a loose cover, coal alone
         assert not fast.cover_decides_screens and not fast.covered(Q).any()
 
 
-@pytest.mark.parametrize("name", ["panda_table_box", "aubo_two_belt"])
+@pytest.mark.parametrize("name", ["panda_table_box", "panda_shelf"])
 def test_fast_and_exact_edge_proofs_agree(cells, name):
     cell = cells[name]
     fast = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN)
