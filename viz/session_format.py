@@ -44,6 +44,7 @@ from pinarms.robots.errors import InvalidInput
 
 from ._atomic import atomic_write
 from .errors import SessionFormatError
+from .names import NAME_RE
 
 __all__ = [
     "FORMAT_NAME",
@@ -73,9 +74,6 @@ FORMAT_NAME = "pinarms-session"
 FORMAT_VERSION = 1
 JSON_MEMBER = "session.json"
 
-#: names of robots, trajectories, ...: 1-100 printable characters, no "/" (scene path separator),
-#: no lone surrogates (they cannot be written as UTF-8)
-NAME_RE = re.compile(r"^(?=.*\S)[^/\x00-\x1f\x7f\ud800-\udfff]{1,100}$")
 POINT_KINDS = ("via", "target", "contact")
 F8 = np.dtype("<f8")
 
