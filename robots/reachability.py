@@ -682,9 +682,9 @@ class ReachabilityMap:
 
     def save(self, path: Any) -> Any:
         """Write the map to an HDF5 file (atomically; see :mod:`robots.reach_io`); return the path."""
-        from .reach_io import save_reachability
+        from .reach_write import write_map
 
-        return save_reachability(self, path)
+        return write_map(self, path)
 
 
 def _points(points: Any, what: str) -> np.ndarray:
@@ -882,7 +882,7 @@ def reachability_map(
 
     writer = None
     if out is not None:
-        from .reach_io import StreamWriter
+        from .reach_write import StreamWriter
 
         writer = StreamWriter(out, arm.nq)
     acc = _Accumulator(bool(keep_solutions) or writer is not None, writer)
