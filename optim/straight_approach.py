@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.cycle import LINE_SAMPLES, CycleResult, _hold, _segment_distance
+from pinarms.optim.cycle_spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.path_timing import PathTiming, time_optimal
 from pinarms.optim.timing import TimingResult, minimize_time
@@ -158,7 +158,7 @@ def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "
         trajectory = trajectory.concatenated(part)
     P = poses[:, :3, 3]
     ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
-    deviation = np.empty(4)  # in the order of optim.cycle.LINE_NAMES
+    deviation = np.empty(4)  # in the order of optim.cycle_spec.LINE_NAMES
     for i, timing in enumerate((up_pick, down_place, up_place, down_pick)):
         t = np.linspace(0.0, timing.duration, LINE_SAMPLES)
         p = np.asarray(robot.fk(timing.trajectory(t)))[:, :3, 3]
