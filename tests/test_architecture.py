@@ -168,6 +168,6 @@ def test_workspace_analysis_modules_import_one_way():
         "placement": {"layout", "workspace_stream"},
     }
     wrong = {
-        m: sorted(_relative_imports(ROOT / "robots" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+        m: sorted(_relative_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
     }
     assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InvalidInput
+from ..errors import InvalidInput
 
 __all__ = ["StreamWriter", "write_map", "FORMAT_NAME", "FORMAT_VERSION"]
 
