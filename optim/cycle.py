@@ -49,7 +49,7 @@ from pinarms.optim.cycle_spec import (  # noqa: F401  (the spec and result, re-e
     _segment_distance,
 )
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
-from pinarms.optim.problem import check_limit
+from pinarms.optim.ga.problem import check_limit
 from pinarms.optim.timing import minimize_time
 from pinarms.planning import joint_waypoints
 from pinarms.robots.errors import InvalidInput, UnreachableTarget

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from pinarms.optim.caps import MAX_EXACT_ITERATIONS, MAX_EXACT_STARTS, MAX_POLISH_EVALUATIONS, count_setting
-from pinarms.optim.problem import SAFETY, TimingProblem
+from pinarms.optim.ga.problem import SAFETY, TimingProblem
 
 __all__ = ["ExactSolution", "solve_exact", "start_ratios", "scaled_to_limits", "polish_durations"]
 

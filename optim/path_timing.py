@@ -47,7 +47,7 @@ from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_GRID_POINTS, MAX_PATH_RO
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.optim.topp import topp_profile
 from pinarms.planning import Trajectory
-from pinarms.optim.problem import check_limit
+from pinarms.optim.ga.problem import check_limit
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 from pinarms.planning.trajectory import taylor_shift

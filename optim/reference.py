@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.errors import OptimError
-from pinarms.optim.problem import check_limit
+from pinarms.optim.ga.problem import check_limit
 
 __all__ = ["path_velocity_limit", "toppra_limit", "toppra_path_duration", "ruckig_limit", "double_s_limit",
            "MissingReference"]

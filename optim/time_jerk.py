@@ -28,11 +28,11 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from pinarms.optim.engine import GAHistory, random_generator, run_ga
+from pinarms.optim.ga.engine import GAHistory, random_generator, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
 from pinarms.optim.exact import solve_exact
-from pinarms.optim.problem import SAFETY, TimingProblem
-from pinarms.optim.settings import GASettings
+from pinarms.optim.ga.problem import SAFETY, TimingProblem
+from pinarms.optim.ga.settings import GASettings
 from pinarms.optim.timing import minimize_time
 
 __all__ = ["TimeJerkResult", "minimize_time_jerk", "jerk_integral", "jerk_integral_batch"]
