@@ -28,7 +28,7 @@ from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
-from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
+from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.ga.problem import KINDS, TimingProblem
 from pinarms.optim.ga.settings import GASettings
