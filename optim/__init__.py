@@ -25,17 +25,17 @@ from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, Infeasib
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
                                   StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
-from pinarms.optim.exact import ExactSolution, solve_exact
+from pinarms.optim.timing.exact import ExactSolution, solve_exact
 from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.ga.problem import KINDS, TimingProblem
 from pinarms.optim.ga.settings import GASettings
-from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
+from pinarms.optim.timing.reference import (MissingReference, double_s_limit, path_velocity_limit,
                                      ruckig_limit, toppra_limit, toppra_path_duration)
-from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
-from pinarms.optim.timing import TimingResult, minimize_time
+from pinarms.optim.timing.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
+from pinarms.optim.timing.segments import TimingResult, minimize_time
 
 __all__ = [
     "run_ga",

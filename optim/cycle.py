@@ -50,7 +50,7 @@ from pinarms.optim.cycle_spec import (  # noqa: F401  (the spec and result, re-e
 )
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit
-from pinarms.optim.timing import minimize_time
+from pinarms.optim.timing.segments import minimize_time
 from pinarms.planning import joint_waypoints
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ties import argmin_tied

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.caps import MAX_DWELL, number_setting
-from pinarms.optim.timing import TimingResult
+from pinarms.optim.timing.segments import TimingResult
 from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
 from pinarms.robots.errors import InvalidInput

@@ -31,7 +31,7 @@ import numpy as np
 from pinarms.optim.cycle_spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal
-from pinarms.optim.timing import TimingResult, minimize_time
+from pinarms.optim.timing.segments import TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint, JointVelocityConstraint,
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)

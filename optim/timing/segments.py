@@ -16,7 +16,7 @@ import numpy as np
 
 from pinarms.optim.ga.engine import GAHistory, GAProgress, random_generator, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
-from pinarms.optim.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
+from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
 from pinarms.optim.ga.settings import GASettings
 
