@@ -17,7 +17,7 @@ Cartesian line's joint image) under constraint objects by reachability analysis 
 continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """
 
-from pinarms.optim.cell_cycle import CellCycleReport
+from pinarms.optim.cycle.in_cell import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga

@@ -1,6 +1,6 @@
 """The pick-and-place cycle's input and output: :class:`PickPlace` (the spec) and :class:`CycleResult`.
 
-The data of :mod:`optim.cycle` (which plans it: :func:`optim.plan_cycle`), in a module of
+The data of :mod:`optim.cycle.plan` (which plans it: :func:`optim.plan_cycle`), in a module of
 their own so that every way of planning a cycle (joint space, straight vertical approach,
 in a cell, around obstacles) shares them without importing the planner back. Also the
 helpers those planners share: a hold at rest and the tcp's distance from the vertical

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MIN_MARGIN, number_setting
-from pinarms.optim.cycle_spec import (  # noqa: F401  (the spec and result, re-exported here)
+from pinarms.optim.cycle.spec import (  # noqa: F401  (the spec and result, re-exported here)
     CYCLE_APPROACHES,
     CYCLE_KINDS,
     LINE_NAMES,
@@ -129,7 +129,7 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     """
     _check_cycle_settings(lift_step=lift_step, margin=margin, clearance=clearance, tool_speed=tool_speed)
     if cell is not None:
-        from pinarms.optim.cell_cycle import plan_cycle_in_cell
+        from pinarms.optim.cycle.in_cell import plan_cycle_in_cell
 
         return plan_cycle_in_cell(robot, spec, cell=cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
                                   lift_step=lift_step, plan=plan_cycle, plan_transfer=plan_transfer, kind=kind,
@@ -148,7 +148,7 @@ def plan_cycle(robot: Any, spec: PickPlace, *, kind: str = "multi-quintic", vmax
     if approach not in CYCLE_APPROACHES:
         raise InvalidInput(f"approach={approach!r}: use one of {CYCLE_APPROACHES}")
     if approach == "straight":
-        from pinarms.optim.straight_approach import straight_cycle
+        from pinarms.optim.cycle.straight import straight_cycle
 
         joint = plan_cycle(robot, spec, kind=kind, vmax=vmax, amax=amax, jmax=jmax, method=method, seed=seed,
                            q_start=q_start, payload=payload, torque_limits=torque_limits)
