@@ -26,7 +26,7 @@ from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, Infeasib
                                   StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.timing.exact import ExactSolution, solve_exact
-from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
+from pinarms.optim.layout.search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint

@@ -27,7 +27,7 @@ GROUP_SECONDS = {
     "tests/cli/test_demo.py": 150.0,  # `pinarms demo --quick` end to end
     "tests/cli/test_cli.py": 113.0,  # the first IK call compiles the numba kernel in a clean clone
     DEMO_STUDIES: 110.0,  # the demo's quick studies 000, 001 and 004, built once
-    "tests/optim/test_layout_search.py": 89.0,
+    "tests/optim/layout/test_layout_search.py": 89.0,
     "tests/robots/test_xacro_expand.py": 69.0,
     "tests/optim/cycle/test_cell_cycle.py": 60.0,
     "tests/optim/test_motion_cycle.py": 54.0,
