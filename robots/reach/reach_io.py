@@ -58,7 +58,7 @@ import numpy as np
 from ..errors import InvalidInput, PinarmsError
 from .orientations import MAX_ORIENTATIONS, OrientationSet
 from .reach_write import FORMAT_NAME, FORMAT_VERSION, StreamWriter, write_map
-from .reachability import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
 
 __all__ = [
     "ReachabilityFileError",
