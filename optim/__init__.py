@@ -17,25 +17,25 @@ Cartesian line's joint image) under constraint objects by reachability analysis 
 continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """
 
-from pinarms.optim.cell_cycle import CellCycleReport
+from pinarms.optim.cycle.in_cell import CellCycleReport
 from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
 from pinarms.optim.line import LineSchedule, schedule_line
-from pinarms.optim.engine import GAHistory, GAProgress, GAResult, run_ga
+from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
                                   StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
-from pinarms.optim.exact import ExactSolution, solve_exact
-from pinarms.optim.layout_search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
+from pinarms.optim.timing.exact import ExactSolution, solve_exact
+from pinarms.optim.layout.search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
                                          search_layout)
-from pinarms.optim.path_timing import PathTiming, time_optimal, time_scaled
+from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint
-from pinarms.optim.problem import KINDS, TimingProblem
-from pinarms.optim.settings import GASettings
-from pinarms.optim.reference import (MissingReference, double_s_limit, path_velocity_limit,
+from pinarms.optim.ga.problem import KINDS, TimingProblem
+from pinarms.optim.ga.settings import GASettings
+from pinarms.optim.timing.reference import (MissingReference, double_s_limit, path_velocity_limit,
                                      ruckig_limit, toppra_limit, toppra_path_duration)
-from pinarms.optim.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
-from pinarms.optim.timing import TimingResult, minimize_time
+from pinarms.optim.timing.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
+from pinarms.optim.timing.segments import TimingResult, minimize_time
 
 __all__ = [
     "run_ga",

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
-from pinarms.optim.problem import check_limit, path_static_check, static_check
+from pinarms.optim.ga.problem import check_limit, path_static_check, static_check
 from pinarms.planning.torque import JointTorqueConstraint
 
 __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static_check"]

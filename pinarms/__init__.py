@@ -1,0 +1,17 @@
+"""pinarms: handling arms of food and agricultural production lines, on Pinocchio.
+
+Where each family lives (imports go one way, top to bottom of this list read upwards):
+
+- the floor, importable by every package: :mod:`pinarms.errors` (the exception hierarchy),
+  :mod:`pinarms.execution` (serial loop or Dask), :mod:`pinarms.files` (atomic files),
+  :mod:`pinarms.units`;
+- :mod:`pinarms.robots`: registry and ``Robot``, ``ik/``, ``reach/`` (workspace, reachability
+  maps and their files, base placement, table band, layout check), ``cell/``, dynamics;
+- :mod:`pinarms.planning`: trajectories, Cartesian paths, limits as objects;
+- :mod:`pinarms.optim`: ``ga/``, ``timing/`` (segment timing), ``topp/`` (time-optimal along a
+  path), ``cycle/`` (the pick-and-place cycle), ``layout/`` (layout search), ``motion/``
+  (planning around obstacles), ``line/`` (belts and items);
+- :mod:`pinarms.viz`: sessions, MeshCat viewer, standalone HTML, plots;
+- on top: ``cli/``, ``studies/`` (one module per paper study; :mod:`pinarms.demo` lists and
+  runs them), ``export/`` (URDF, SRDF, MJCF, trajectories).
+"""

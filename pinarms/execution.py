@@ -16,11 +16,11 @@ into *tasks*, applied with :func:`map_chunks`. The same call runs
 Results are identical whatever runs them: randomness enters a task only through its own
 seed (:func:`chunk_seeds`), tasks are pure functions of their arguments, and results come
 back in task order. A task that raises, or a worker that dies, gives
-:class:`~pinarms.robots.errors.ExecutionError` with the chunk index and its seed, and no
+:class:`~pinarms.errors.ExecutionError` with the chunk index and its seed, and no
 partial result (callers write files only after a complete result).
 
 This module sits at the bottom of the one-way flow: it imports numpy at module level, Dask
-lazily, and the error class (``pinarms.robots.errors``) lazily when it raises; every package
+lazily, and the error class (``pinarms.errors``) lazily when it raises; every package
 (robots, planning, optim, viz, the CLI) may import it.
 
 Threads: every task runs with the BLAS and OpenMP thread pools limited to one thread
@@ -66,7 +66,7 @@ SEED_BITS = 128
 def __getattr__(name: str):
     # ``pinarms.execution.ExecutionError`` without importing the robots package at import time.
     if name == "ExecutionError":
-        from pinarms.robots.errors import ExecutionError
+        from pinarms.errors import ExecutionError
 
         return ExecutionError
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -88,7 +88,7 @@ def task_threads() -> int | None:
 
 
 def _invalid(message: str) -> Exception:
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     return InvalidInput(message)
 
@@ -135,7 +135,7 @@ def _task_seed(task: Any) -> int | None:
 
 
 def _failure(index: int, task: Any, what: str, cause: str):
-    from pinarms.robots.errors import ExecutionError
+    from pinarms.errors import ExecutionError
 
     seed = _task_seed(task)
     seed_text = f" (seed {seed})" if seed is not None else ""
@@ -150,7 +150,7 @@ def _failure(index: int, task: Any, what: str, cause: str):
 
 def _lost(client: Any, done: int, total: int, cause: str):
     """The error for a scheduler that went away mid-run (not a fault of any one chunk)."""
-    from pinarms.robots.errors import ExecutionError
+    from pinarms.errors import ExecutionError
 
     address = getattr(getattr(client, "scheduler", None), "address", None) or "its address"
     return ExecutionError(
@@ -227,7 +227,7 @@ def map_chunks(
     module docstring. ``progress(done, total)`` is called in this process each time a result
     arrives (and once with ``(0, total)`` before the first).
 
-    Raises :class:`~pinarms.robots.errors.ExecutionError` naming the failing chunk (its index
+    Raises :class:`~pinarms.errors.ExecutionError` naming the failing chunk (its index
     in ``tasks``) and its seed (a task's ``seed`` attribute or ``"seed"`` key) when a task
     raises or its worker dies; the remaining tasks are cancelled and nothing is returned.
     """
@@ -389,7 +389,7 @@ def _map_address(address, fn, tasks, on_result, progress):
     except ValueError as exc:  # an address Dask cannot parse after all
         raise _invalid(f"scheduler address {address!r} is not valid: {_one_line(exc)}") from exc
     except (OSError, TimeoutError) as exc:
-        from pinarms.robots.errors import ExecutionError
+        from pinarms.errors import ExecutionError
 
         raise ExecutionError(
             f"cannot reach the Dask scheduler at {address}: {_one_line(exc)}. Start one with "

@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 from typing import BinaryIO, Callable
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 try:  # POSIX; elsewhere leftovers are recognised by age alone
     import fcntl

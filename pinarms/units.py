@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
            "joints_from_si", "length_scale", "angle_scale", "mass_kg", "parse_length", "parse_angle"]
@@ -96,7 +96,7 @@ def mass_kg(text: str) -> float:
     """A mass given at the command line (``"3kg"``, ``"1.5 kg"``, ``"800g"``, or a bare number of kg) → kg.
 
     Raises:
-        robots.errors.InvalidInput: not a finite number with an optional ``kg``/``g`` unit, or negative.
+        pinarms.errors.InvalidInput: not a finite number with an optional ``kg``/``g`` unit, or negative.
     """
     raw = str(text).strip().lower()
     factor = 1.0

@@ -56,12 +56,12 @@ __all__ = [
 ]
 
 # workspace analysis and station layout
-from .layout import LayoutReport, check_layout  # noqa: E402
-from .placement import RecommendedRegion, recommend_region  # noqa: E402
+from .reach.layout import LayoutReport, check_layout  # noqa: E402
+from .reach.placement import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
-from .voxels import VoxelMap, suggest_voxel_size  # noqa: E402
-from .workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
-from .workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
+from .reach.voxels import VoxelMap, suggest_voxel_size  # noqa: E402
+from .reach.workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
+from .reach.workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
 
 __all__ += [
     "Workspace",
@@ -108,15 +108,15 @@ __all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmM
             "load_cell", "ArmPlacement", "FixturePrimitive", "compose_cell"]
 
 # reachability maps: tool poses per voxel, orientation sets, HDF5 files
-from .orientations import (  # noqa: E402
+from .reach.orientations import (  # noqa: E402
     OrientationSet,
     so3_orientations,
     tool_axis_orientations,
     tool_down_orientations,
 )
-from .reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
-from .reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
-from .base_placement import BasePlacements, base_placements, tool_down_poses  # noqa: E402
+from .reach.reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
+from .reach.reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
+from .reach.base_placement import BasePlacements, base_placements, tool_down_poses  # noqa: E402
 
 __all__ += [
     "ReachabilityMap",

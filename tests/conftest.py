@@ -27,14 +27,14 @@ GROUP_SECONDS = {
     "tests/cli/test_demo.py": 150.0,  # `pinarms demo --quick` end to end
     "tests/cli/test_cli.py": 113.0,  # the first IK call compiles the numba kernel in a clean clone
     DEMO_STUDIES: 110.0,  # the demo's quick studies 000, 001 and 004, built once
-    "tests/optim/test_layout_search.py": 89.0,
+    "tests/optim/layout/test_layout_search.py": 89.0,
     "tests/robots/test_xacro_expand.py": 69.0,
-    "tests/optim/test_cell_cycle.py": 60.0,
+    "tests/optim/cycle/test_cell_cycle.py": 60.0,
     "tests/optim/test_motion_cycle.py": 54.0,
     "tests/test_export_verify.py": 49.0,
     "tests/test_execution.py": 44.0,
     "tests/viz/test_browser.py": 26.0,
-    "tests/optim/test_cycle.py": 35.0,
+    "tests/optim/cycle/test_cycle.py": 35.0,
     "tests/robots/test_descriptions.py": 29.0,
 }
 

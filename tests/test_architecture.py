@@ -1,8 +1,8 @@
 """The one-way flow of the packages: robots → planning → optim → viz → pinarms (CLI, studies).
 
-Below them all sits the execution layer ``pinarms.execution`` (serial loop or Dask): every
-package may import it, and it imports only numpy, Dask, threadpoolctl and the error classes
-(``pinarms.robots.errors``, a module that imports nothing of ours).
+Below them all sits the floor: the error classes (``pinarms.errors``), the execution layer
+``pinarms.execution`` (serial loop or Dask), atomic file writing and units. Every package may
+import it, and it imports nothing of ours but the error classes (which import nothing of ours).
 
 The folders ``robots/``, ``planning/``, ``optim/``, ``viz/`` sit at the repository's top level
 and install as ``pinarms.robots``, ``pinarms.planning``, ... Every module's imports (module
@@ -20,9 +20,15 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ["robots", "planning", "optim", "viz", "pinarms"]
-#: The floor: modules of the ``pinarms`` folder that every package may import (the execution
-#: layer, atomic file writing, units); each imports nothing of ours but the error classes.
-BOTTOM = {"pinarms.execution": "execution", "pinarms.files": "files", "pinarms.units": "units"}
+#: The floor: modules of the ``pinarms`` folder that every package may import (the error
+#: classes, the execution layer, atomic file writing, units); each imports nothing of ours but
+#: the error classes.
+BOTTOM = {
+    "pinarms.errors": "errors",
+    "pinarms.execution": "execution",
+    "pinarms.files": "files",
+    "pinarms.units": "units",
+}
 ALLOWED = {pkg: set(ORDER[: i + 1]) | set(BOTTOM.values()) for i, pkg in enumerate(ORDER)}
 SUBPACKAGES = set(ORDER[:-1]) | {"urdf"}
 
@@ -83,13 +89,13 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
 
     modules = _imported_modules(ROOT / "pinarms" / "execution.py")
     ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
-    assert ours == {"pinarms.robots.errors"}, ours
+    assert ours == {"pinarms.errors"}, ours
     third_party = {
         m.split(".")[0] for m in modules - ours if m.split(".")[0] not in sys.stdlib_module_names
     }
     assert third_party <= {"numpy", "dask", "distributed", "threadpoolctl"}, third_party
     # and the errors module it reaches imports nothing of ours
-    errors = _imported_modules(ROOT / "robots" / "errors.py")
+    errors = _imported_modules(ROOT / "pinarms" / "errors.py")
     assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
 
 
@@ -97,8 +103,16 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
 def test_the_floor_imports_nothing_of_ours_but_the_errors(floor):
     modules = _imported_modules(ROOT / "pinarms" / f"{floor}.py")
     ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
-    assert ours <= {"pinarms.robots.errors"}, ours
+    assert ours <= {"pinarms.errors"}, ours
     assert all(floor in ALLOWED[pkg] for pkg in ORDER)
+
+
+def test_the_old_errors_path_names_the_same_classes():
+    import pinarms.errors as floor
+    import pinarms.robots.errors as old
+
+    assert old.__all__ == floor.__all__
+    assert all(getattr(old, name) is getattr(floor, name) for name in floor.__all__)
 
 
 def test_robot_and_its_dynamics_are_no_circle():
@@ -154,6 +168,6 @@ def test_workspace_analysis_modules_import_one_way():
         "placement": {"layout", "workspace_stream"},
     }
     wrong = {
-        m: sorted(_relative_imports(ROOT / "robots" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+        m: sorted(_relative_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
     }
     assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"

@@ -34,12 +34,16 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["LineRecord", "ITEM_COLUMNS", "MISSED", "NOT_DRAWN", "MAX_LINE_ITEMS", "MAX_LINE_ARMS",
+from .names import NAME_RE
+
+__all__ = ["LineRecord", "BOX_DEPTH", "ITEM_COLUMNS", "MISSED", "NOT_DRAWN", "MAX_LINE_ITEMS", "MAX_LINE_ARMS",
            "MAX_LINE_LENGTH", "check_line", "encode_line", "decode_line"]
 
 ITEM_COLUMNS = ("t0", "w", "yaw", "length", "width", "height", "arm", "t_grasp", "t_release")
 MISSED = -1
 NOT_DRAWN = -2
+#: Depth of the drawn place boxes [m] (the line's session and its scene both use it).
+BOX_DEPTH = 0.08
 #: Most items a line record holds (a window of a line, not an hour of it).
 MAX_LINE_ITEMS = 20_000
 MAX_LINE_ARMS = 64
@@ -135,8 +139,6 @@ def encode_line(r: LineRecord) -> tuple[dict, dict, dict]:
 
 def decode_line(it: Any) -> LineRecord:
     """The record of a validated session item (JSON fields checked here, arrays already read)."""
-    from .session_format import NAME_RE
-
     arms = it.field("arms", list)
     if len(arms) > MAX_LINE_ARMS or not all(isinstance(a, str) and NAME_RE.match(a) for a in arms):
         raise it.fail(f"{it.where}.arms must be a list of at most {MAX_LINE_ARMS} robot keys")

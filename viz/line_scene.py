@@ -25,8 +25,7 @@ import numpy as np
 
 from ._meshcat import mg
 from .errors import ViewerError
-from .line_record import MISSED, NOT_DRAWN
-from .line_session import BOX_DEPTH
+from .line_record import BOX_DEPTH, MISSED, NOT_DRAWN
 
 __all__ = ["draw_lines", "animate_lines", "item_positions", "ITEM_COLOR", "MISSED_COLOR"]
 

@@ -25,12 +25,12 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput, PinarmsError
 
-from .line_record import ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
+from .line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
-#: Depth of the drawn place boxes [m] and the gap between an item's bottom and the box's rim at release [m].
-BOX_DEPTH = 0.08
+#: The gap between an item's bottom and the drawn place box's rim at release [m] (the box's
+#: depth, :data:`BOX_DEPTH`, lives in :mod:`viz.line_record`, shared with the scene).
 BOX_GAP = 0.01
 DEFAULT_WINDOW_S = 20.0
 
@@ -146,29 +146,3 @@ def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float
                     width=belt.width, thickness=thickness, speed=belt.speed, u_miss=u_miss, duration=dur, items=rows)
     session.lines[rec.name] = rec
     return rec
-
-
-def save_line_views(spec: Any, result: Any, *, session: Any = None, html: Any = None, schedule: Any = None,
-                    title: str | None = None, run: int = 0, duration: float = DEFAULT_WINDOW_S) -> list:
-    """Write what a line engineer looks at: the session (``.pinarms``), its standalone page
-    (``.html``) and the schedule plot (``.png``/``.svg``) of run ``run``, window [0, ``duration``] s
-    for the animation and [0, 3 × ``duration``] s for the schedule; each path optional. Returns the paths written."""
-    from .html import export_html
-    from .line_plots import plot_line_schedule
-    from .session import Session
-
-    written = []
-    if session is not None or html is not None:
-        s = Session(title=title or f"belt line: {len(spec.stations)} arm(s), {spec.stream.rate:g} items/min, "
-                                   f"belt {spec.belt.speed:g} m/s")
-        add_line(s, spec, result, run=run, duration=duration)
-        if session is not None:
-            written.append(s.save(session))
-        if html is not None:
-            written.append(export_html(s, html))
-    if schedule is not None:
-        written.append(plot_line_schedule(schedule, result, run=run, window=(0.0, 3.0 * duration)))
-    return written
-
-
-__all__.append("save_line_views")

@@ -139,7 +139,7 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
     trajectory = pieces[0]
     for p in pieces[1:]:
         trajectory = trajectory.concatenated(p, atol=1e-7)
-    from pinarms.optim.cycle import _line_deviation
+    from pinarms.optim.cycle.spec import _line_deviation
 
     P = spec.poses(robot)[:, :3, 3]
     ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])

@@ -376,7 +376,7 @@ def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any)
 
 def time_path(path: JointPath, constraints: Sequence[Any], grid: int = 200) -> Any:
     """:func:`optim.time_optimal` of ``path`` (a clear error if the limits cannot be met)."""
-    from pinarms.optim.path_timing import time_optimal
+    from pinarms.optim.topp.path_timing import time_optimal
 
     try:
         return time_optimal(path, constraints, grid=grid)

@@ -101,7 +101,7 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
     spec = _spec(preset, arms, rate, speed, paper_limit, rule, seeds, duration, arrivals)
     res = run_line(spec, maps=maps_for(spec), scheduler=scheduler)
     if session_path or html_path or plot_path:
-        from pinarms.viz.line_session import save_line_views
+        from pinarms.viz.line_views import save_line_views
 
         save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=window)
     emit(as_json, res.as_dict(), _figures_lines(res, f"belt run: {preset}, {arms} arm(s), rule {rule}"))

@@ -34,7 +34,7 @@ from typing import Any, Mapping
 from pinarms.robots.errors import InvalidInput
 
 from .errors import MeshNotFound
-from .robot import _check_folder, _publish, compile_mjcf, export_urdf
+from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
 from .srdf import geometry_links, srdf_text
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
@@ -259,7 +259,7 @@ def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite:
     result: dict[str, ExportedCell] = {}
 
     def fill(tmp: Path) -> None:
-        staged = export_urdf(robot, tmp / ".staged")
+        staged = write_urdf_folder(robot, tmp / ".staged")
         cell = cell_of_urdf_folder(robot, staged.folder)
         arm_states = None if states is None else {k: {cell.arms[0].name: v} for k, v in states.items()}
         result["cell"] = _write_cell(cell, tmp / "out", srdf=True, mjcf=False, states=arm_states)

@@ -44,7 +44,7 @@ def _station_cycle(station: Any) -> Any:
 
 def _line_cycles(cell: Any, step: Any = None) -> dict[str, Any]:
     from pinarms import optim
-    from pinarms.demo import LINE_TASKS
+    from pinarms.studies.cell import LINE_TASKS
 
     cycles = {}
     for name, (pick, place) in LINE_TASKS.items():
@@ -76,7 +76,7 @@ def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Any = N
     ``progress(done, total)`` is called after each motion is planned.
     """
     from pinarms import optim
-    from pinarms.demo import _planned_move_001
+    from pinarms.studies.seed001_motion import _planned_move_001
     from pinarms.robots.cell import load_cell
 
     total = 5 if line else 2

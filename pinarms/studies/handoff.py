@@ -78,7 +78,7 @@ def _controller_check(cycle: Any, cell: Any, arm: str, folder: Path) -> tuple[li
 
 def demo_study(quick: bool = False) -> Any:
     """The hand-off rows (module doc) and the writers of the export files."""
-    from pinarms.demo import Study
+    from pinarms.studies.study import Study
     from pinarms.export import export_cell, srdf_text
     from pinarms.export.shipped import shipped_motions
     from pinarms.export.srdf import cycle_states

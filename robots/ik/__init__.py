@@ -16,6 +16,7 @@ and :meth:`robots.Robot.ik`.
 
 from __future__ import annotations
 
+from .families import FAMILIES
 from .gantry import GantryIK
 from .koji import KojiIK
 from .near_limits import OutsideLimits, limit_excess, near_limit_solutions
@@ -44,14 +45,6 @@ __all__ = [
     "FK_TOL",
     "LIMIT_TOL",
 ]
-
-#: Closed-form solver classes by family name.
-FAMILIES: dict[str, type[AnalyticIK]] = {
-    "ur_type": URTypeIK,
-    "scara": ScaraIK,
-    "gantry": GantryIK,
-    "koji": KojiIK,
-}
 
 #: Family of each registry robot that has a closed form (koji_turner_rail is redundant: numerical
 #: only). Kept for reference and for callers that look a family up by name; robots get their

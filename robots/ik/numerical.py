@@ -65,9 +65,7 @@ refinement and :meth:`attempt`.
 
 from __future__ import annotations
 
-import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,14 +76,12 @@ from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
 from .._checks import check_seed as _check_seed
 from .._checks import check_tolerance as _check_tolerance
+from .numerical_batch import _ROT_WEIGHT, BatchIKResult, _batch_errors, _seed_int, solve_batch
 
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
 _TABLE = 256  # configurations stored with their poses for the first start (table_start)
-_WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
-_PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
 _POOL = 32  # random starts drawn at once and ranked by their distance to the target
-_ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 _TWO_PI = 2.0 * np.pi
 _MU_MAX = 1e8  # an attempt gives up when no step with μ below this lowers the error
 _FREE, _WINDOW, _CLIP = 0, 1, 2  # free descent; free then wrapped to the ranges' windows; projected descent
@@ -625,152 +621,6 @@ class NumericalIK:
                 if pe <= tol and re <= tol:
                     return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)
-
-
-def _seed_int(seed) -> int:
-    """A 32-bit seed for the compiled solver's generator from ``seed`` (int, ``Generator`` or None)."""
-    if isinstance(seed, np.random.Generator):
-        return int(seed.integers(2**32))
-    if seed is None:
-        return int(np.random.default_rng().integers(2**32))
-    return int(seed) & 0xFFFFFFFF
-
-
-# ------------------------------------------------------------------ batched solver
-@dataclass(frozen=True)
-class BatchIKResult:
-    """Outcome of :meth:`NumericalIK.solve_batch`.
-
-    Attributes:
-        q: ``(N, nq)`` configurations within the limits [rad or m]; a row meets its target
-            only where ``success``.
-        success: ``(N,)`` position and rotation errors within the tolerance, within the limits.
-        position_error: ``(N,)`` [m]; rotation_error: ``(N,)`` [rad] (0 in position-only mode).
-        iterations: Levenberg–Marquardt iterations over all targets.
-    """
-
-    q: np.ndarray
-    success: np.ndarray
-    position_error: np.ndarray
-    rotation_error: np.ndarray
-    iterations: int
-
-
-def _log3(R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation vectors ``(n, 3)`` [rad] of rotation matrices ``(n, 3, 3)`` and their angles ``(n,)``.
-
-    The angle is ``atan2(|w|, (tr R − 1)/2)`` with ``w = vee(R − Rᵀ)/2`` (accurate near 0, where
-    an arccos loses half the digits); within 0.45 rad of π the axis comes from the symmetric part.
-    """
-    w = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=1)
-    c = 0.5 * (R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2] - 1.0)
-    s = np.sqrt(np.einsum("ij,ij->i", w, w))
-    theta = np.arctan2(s, c)
-    k = np.ones_like(theta)
-    np.divide(theta, s, out=k, where=s > 1e-300)
-    out = w * k[:, None]
-    near = c < -0.9  # θ > 2.69 rad: |w| = sin θ is small, take the axis from (R + Rᵀ)/2 − c I = (1 − c) a aᵀ
-    if near.any():
-        Rn, cn, wn, tn = R[near], c[near], w[near], theta[near]
-        B = 0.5 * (Rn + np.swapaxes(Rn, 1, 2)) - cn[:, None, None] * np.eye(3)
-        i = np.argmax(np.diagonal(B, axis1=1, axis2=2), axis=1)
-        col = B[np.arange(i.size), :, i]
-        axis = col / np.sqrt(np.maximum(np.einsum("ij,ij->i", col, col), 1e-300))[:, None]
-        sign = np.where(np.einsum("ij,ij->i", axis, wn) < 0.0, -1.0, 1.0)
-        out[near] = axis * (sign * tn)[:, None]
-    return out, theta
-
-
-def _batch_errors(self, q: np.ndarray, targets: np.ndarray, position_only: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Position [m] and rotation [rad] errors of ``q (N, nq)`` for ``targets (N, 4, 4)`` by a fresh batched FK."""
-    T = self.robot.fk(q, self._frame)
-    pe = np.linalg.norm(T[:, :3, 3] - targets[:, :3, 3], axis=1)
-    if position_only:
-        return pe, np.zeros(q.shape[0])
-    _, theta = _log3(targets[:, :3, :3] @ np.swapaxes(T[:, :3, :3], 1, 2))
-    return pe, theta
-
-
-def solve_batch(
-    self,
-    targets: np.ndarray,
-    q_seed: np.ndarray | None = None,
-    *,
-    position_only: bool = False,
-    tol: float = 1e-10,
-    max_restarts: int = 40,
-    seed: int | np.random.Generator | None = 0,
-) -> BatchIKResult:
-    """Many targets at once: the compiled solver over the batch (in threads), then :meth:`solve` for any left.
-
-    Each target gets the attempts of :meth:`solve` (free descent, projected descent when it
-    meets the target outside the limits) from its start, then up to ``max_restarts`` uniform
-    starts within the limits nearest pose first, the whole loop compiled; target ``k``'s
-    restarts are seeded by ``seed + k`` (for an integer ``seed``: row ``k`` is ``Robot.ik(targets[k],
-    seed=seed + k)``, bit for bit; the thread blocks change nothing).
-
-    Args:
-        targets: checked poses ``(N, 4, 4)`` frame → base [m].
-        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
-            :meth:`table_start` of each target).
-        tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
-        max_restarts, seed: restarts per target, and the seed of all random starts.
-
-    Every success is confirmed by a fresh batched forward kinematics and an exact limit check.
-    """
-    targets = np.asarray(targets, dtype=float)
-    N = targets.shape[0]
-    nq = self.nq
-    tol = float(tol)
-    starts = None
-    if q_seed is not None:
-        starts = np.array(np.broadcast_to(np.asarray(q_seed, dtype=float), (N, nq)))
-    missing = np.arange(N) if starts is None else np.flatnonzero(~np.all(np.isfinite(starts), axis=1))
-    if missing.size:  # no seed (or a NaN row): of the stored table, the configuration whose pose is nearest
-        q_table, p_tab, pp_tab, R_tab = self._start_table()
-        pt = targets[missing, :3, 3]
-        d2 = pp_tab[None, :] - 2.0 * pt @ p_tab.T + np.einsum("ij,ij->i", pt, pt)[:, None]
-        cost = np.sqrt(np.maximum(d2, 0.0))
-        if not position_only:
-            rt = targets[missing, :3, :3].reshape(missing.size, 9)
-            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * rt @ R_tab.T, 0.0))
-        if starts is None:
-            starts = np.empty((N, nq))
-        starts[missing] = q_table[np.argmin(cost, axis=1)]
-    kernel, C, L, P, _ = self._compiled()
-    Rts = np.ascontiguousarray(targets[:, :3, :3])
-    pts = np.ascontiguousarray(targets[:, :3, 3])
-    starts = np.ascontiguousarray(starts)
-    q = np.empty((N, nq))
-    success = np.zeros(N, dtype=bool)
-    pe, re = np.empty(N), np.empty(N)
-    base = _seed_int(seed)  # target k's restarts: seed + k, as solve(targets[k], seed=seed + k); any blocks
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(base)
-    iterations = [0]
-
-    def block(s: int, e: int) -> None:  # compiled and nogil: the blocks run in parallel
-        iterations.append(kernel.solve_many(Rts[s:e], pts[s:e], starts[s:e], C, L, P, bool(position_only), tol,
-                                            int(max_restarts), base + s, q[s:e], success[s:e], pe[s:e], re[s:e]))
-
-    bounds = np.linspace(0, N, min(_WORKERS, max(1, N // _PARALLEL_MIN)) + 1).astype(int)
-    if bounds.size == 2:
-        block(0, N)
-    else:
-        with ThreadPoolExecutor(bounds.size - 1) as pool:
-            list(pool.map(block, bounds[:-1], bounds[1:]))
-    iterations = int(sum(iterations))
-    if success.any():  # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
-        k = np.flatnonzero(success)
-        pe_k, re_k = _batch_errors(self, q[k], targets[k], position_only)
-        inside = np.all((q[k] >= self.lower) & (q[k] <= self.upper), axis=1)
-        success[k[(pe_k > tol) | (re_k > tol) | ~inside]] = False
-    for k in np.flatnonzero(~success):  # the few the batch left: per-target solver with restarts
-        res = self._solve(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
-                          seed=rng, limits=True)
-        q[k] = res.q
-        success[k] = res.success
-    pos_err, rot_err = _batch_errors(self, q, targets, position_only)
-    return BatchIKResult(q, success, pos_err, rot_err, iterations)
 
 
 NumericalIK.solve_batch = solve_batch

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from .families import FAMILIES
 from .geometry import chain_axes
 from .solver import AnalyticIK
 
@@ -69,8 +70,6 @@ def recognise(robot, frame: str = "tcp") -> Recognition:
     Never raises for a model that does not fit: the result then has ``family=None`` and
     says in :attr:`Recognition.rejected` why each family was refused.
     """
-    from . import FAMILIES
-
     kinds, mimics = _signature(robot, frame)
     sig = (kinds["revolute"], kinds["prismatic"], mimics)
     rejected: dict[str, str] = {}

@@ -167,7 +167,7 @@ def test_arms_naming_no_robot_refused_when_drawn(saved, tmp_path):
 
 
 def test_save_line_views_writes_session_page_and_schedule(belt_line, tmp_path):
-    from pinarms.viz.line_session import save_line_views
+    from pinarms.viz.line_views import save_line_views
 
     spec, result = belt_line
     paths = save_line_views(spec, result, session=tmp_path / "l.pinarms", html=tmp_path / "l.html",

@@ -14,11 +14,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.optim.engine import GAHistory, GAProgress, random_generator, run_ga
+from pinarms.optim.ga.engine import GAHistory, GAProgress, random_generator, run_ga
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
-from pinarms.optim.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
-from pinarms.optim.problem import SAFETY, TimingProblem
-from pinarms.optim.settings import GASettings
+from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
+from pinarms.optim.ga.problem import SAFETY, TimingProblem
+from pinarms.optim.ga.settings import GASettings
 
 __all__ = ["TimingResult", "minimize_time", "finish_timing", "rescale_to_limits"]
 

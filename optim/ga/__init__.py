@@ -1,0 +1,13 @@
+"""The genetic algorithm that times trajectories: the engine and its operators.
+
+- :mod:`.engine` (:func:`run_ga`: history, progress, result), :mod:`.settings`
+  (:class:`GASettings`), :mod:`.problem` (:class:`TimingProblem`: segment times under
+  limits, the fitness the GA minimises);
+- operators: :mod:`.selection`, :mod:`.crossover`, :mod:`.mutation`, :mod:`.adaptive`
+  (adaptive rates), :mod:`.constraints` (penalties and feasibility rules).
+
+The public names are re-exported by :mod:`pinarms.optim`; the old paths
+(``pinarms.optim.engine``, ...) keep working.
+"""
+
+__all__: list[str] = []

@@ -1,0 +1,355 @@
+"""The genetic algorithm: a real-coded, bounds-aware, vectorised minimiser.
+
+The engine knows nothing about trajectories. It minimises ``objective(X)`` over the box
+``bounds`` subject to ``constraints(X) <= 0``, where ``X`` is the whole population
+(pop, dim) and both functions answer for all individuals at once ((pop,) and
+(pop, n_con)).
+
+One generation: rank the population (adaptive penalty or feasibility rules), keep the
+elites, select parents (tournament or rank + SUS), cross pairs (SBX / arithmetic /
+blend, fixed or adaptive pc), mutate (non-uniform / polynomial, fixed or adaptive pm),
+evaluate the children.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from pinarms.optim.ga import adaptive, crossover, mutation, selection
+from pinarms.optim.ga.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feasibility_rules,
+                               rank_penalty, violation)
+from pinarms.optim.caps import MAX_GENERATIONS
+from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
+from pinarms.optim.ga.settings import GASettings
+
+__all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress", "random_generator"]
+
+Objective = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class GAHistory:
+    """Per-generation record (index 0 = initial population), for plots.
+
+    Attributes:
+        best: (G+1,) objective of the best-so-far individual (feasibility rules order).
+        mean: (G+1,) mean objective of the whole population (finite values only),
+            infeasible individuals included: their objective is the raw one (no penalty), so
+            when few individuals are feasible this mean can lie *below* ``best`` (they
+            are faster than the limits allow).
+        feasible_share: (G+1,) share of feasible individuals in the population.
+        best_violation: (G+1,) total constraint violation of the best-so-far.
+        feasible_mean: (G+1,) mean objective of the feasible individuals of the
+            generation (``inf`` when none is feasible); never below ``best`` once a
+            feasible individual has been found (the best-so-far is the least of them all).
+    """
+
+    best: np.ndarray
+    mean: np.ndarray
+    feasible_share: np.ndarray
+    best_violation: np.ndarray
+    feasible_mean: np.ndarray
+
+    def as_dict(self) -> dict[str, list[float]]:
+        """JSON-able copy."""
+        return {k: getattr(self, k).tolist()
+                for k in ("best", "mean", "feasible_share", "best_violation", "feasible_mean")}
+
+
+@dataclass(frozen=True)
+class GAProgress:
+    """What the optional callback receives after each generation."""
+
+    generation: int
+    best_x: np.ndarray
+    best_f: float
+    best_feasible: bool
+    evaluations: int
+    elapsed: float
+
+
+@dataclass(frozen=True)
+class GAResult:
+    """Outcome of :func:`run_ga`.
+
+    Attributes:
+        x: (dim,) best individual found (feasible ones beat infeasible ones).
+        f: Its objective value.
+        feasible: Whether ``x`` satisfies every constraint.
+        violation: Its total violation (0 if feasible).
+        history: Per-generation :class:`GAHistory`.
+        generations: Generations run.
+        evaluations: Individuals evaluated (objective calls count rows).
+        stop_reason: ``"max_generations"``, ``"stall"``, ``"time_limit"`` or ``"callback"``.
+        wall_time: Seconds spent.
+    """
+
+    x: np.ndarray
+    f: float
+    feasible: bool
+    violation: float
+    history: GAHistory
+    generations: int
+    evaluations: int
+    stop_reason: str
+    wall_time: float
+
+
+def random_generator(seed: int | np.random.Generator) -> np.random.Generator:
+    """The random generator of a run: a given Generator, or one seeded by a non-negative int."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidSettings(f"seed={seed!r}: give a non-negative integer or a "
+                              "numpy.random.Generator")
+    return np.random.default_rng(int(seed))
+
+
+def _count(value: object, name: str, minimum: int) -> int:
+    """An integer option >= minimum (generations)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise InvalidSettings(f"{name}={value!r}: use an integer >= {minimum}")
+    return int(value)
+
+
+def _check_bounds(bounds: np.ndarray | tuple) -> tuple[np.ndarray, np.ndarray]:
+    b = np.asarray(bounds, dtype=float)
+    if b.ndim == 2 and b.shape[0] == 2 and b.shape[1] != 2:
+        b = b.T
+    if b.ndim != 2 or b.shape[1] != 2 or b.shape[0] < 1:
+        raise InvalidSettings(f"bounds of shape {np.shape(bounds)}: give (dim, 2) rows of "
+                              "(lower, upper)")
+    lower, upper = b[:, 0].copy(), b[:, 1].copy()
+    if not (np.all(np.isfinite(lower)) and np.all(np.isfinite(upper))):
+        raise InvalidSettings(f"bounds {b.tolist()}: every bound must be finite")
+    if np.any(lower > upper):
+        raise InvalidSettings(f"bounds {b.tolist()}: lower > upper in rows "
+                              f"{np.nonzero(lower > upper)[0].tolist()}")
+    return lower, upper
+
+
+class _Evaluator:
+    def __init__(self, objective: Objective, constraints: Objective | None) -> None:
+        self.objective = objective
+        self.constraints = constraints
+        self.count = 0
+
+    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        pop = x.shape[0]
+        f = np.asarray(self.objective(x), dtype=float).reshape(-1)
+        if f.shape[0] != pop:
+            raise InvalidSettings(f"objective returned shape {f.shape} for a population of "
+                                  f"{pop}: return one value per row")
+        v = violation(None if self.constraints is None else self.constraints(x), pop)
+        bad = ~np.isfinite(f) | ~np.isfinite(v)
+        f = np.where(np.isfinite(f), f, np.inf)
+        v = np.where(bad, np.inf, v)
+        self.count += pop
+        return f, v
+
+
+def _better(f_a: float, v_a: float, f_b: float, v_b: float) -> bool:
+    """Deb's order: is (f_a, v_a) strictly better than (f_b, v_b)?"""
+    feas_a, feas_b = v_a <= FEASIBILITY_TOLERANCE, v_b <= FEASIBILITY_TOLERANCE
+    if feas_a != feas_b:
+        return feas_a
+    if feas_a:
+        return f_a < f_b
+    return v_a < v_b
+
+
+def _initial_population(evaluate: _Evaluator, lower: np.ndarray, upper: np.ndarray,
+                        pop: int, initial: np.ndarray | None, rng: np.random.Generator,
+                        draw_feasible: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    dim = lower.shape[0]
+    rows: list[np.ndarray] = []
+    if initial is not None:
+        try:
+            init = np.atleast_2d(np.asarray(initial, dtype=float))
+        except (TypeError, ValueError):
+            raise InvalidSettings(f"initial={initial!r} is not numeric: give (k, {dim}) "
+                                  "individuals") from None
+        if init.ndim != 2 or init.shape[1] != dim:
+            raise InvalidSettings(f"initial of shape {init.shape}: rows must have {dim} genes")
+        if not np.all(np.isfinite(init)):
+            raise InvalidSettings("initial individuals hold NaN or inf: give finite genes")
+        if np.any(init < lower - 1e-12) or np.any(init > upper + 1e-12):
+            raise InvalidSettings("initial individuals must lie within the bounds")
+        rows.append(np.clip(init[:pop], lower, upper))
+    n_given = sum(r.shape[0] for r in rows)
+    x = np.concatenate(rows + [lower + rng.random((pop - n_given, dim)) * (upper - lower)])
+    f, v = evaluate(x)
+    if draw_feasible:
+        # Seed 002: the initial population is drawn to satisfy the constraints. Redraw
+        # the infeasible random rows (a bounded number of times) and keep feasible draws.
+        for _ in range(25):
+            redraw = np.nonzero((v > FEASIBILITY_TOLERANCE) & (np.arange(pop) >= n_given))[0]
+            if redraw.size == 0:
+                break
+            cand = lower + rng.random((4 * redraw.size, dim)) * (upper - lower)
+            fc, vc = evaluate(cand)
+            best = np.argsort(vc, kind="stable")[: redraw.size]
+            take = vc[best] < v[redraw]
+            slot, src = redraw[take], best[take]
+            x[slot], f[slot], v[slot] = cand[src], fc[src], vc[src]
+    return x, f, v
+
+
+def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASettings | None = None,
+           constraints: Objective | None = None, seed: int | np.random.Generator = 0,
+           max_generations: int | None = None, stall_generations: int | None = None,
+           time_limit: float | None = None,
+           callback: Callable[[GAProgress], bool | None] | None = None,
+           initial: np.ndarray | None = None) -> GAResult:
+    """Minimise ``objective`` over a box with a real-coded GA.
+
+    Args:
+        objective: Maps a population (pop, dim) to objective values (pop,). NaN/inf
+            count as infeasible.
+        bounds: (dim, 2) rows of (lower, upper).
+        settings: :class:`GASettings` (default: ``GASettings()``).
+        constraints: Maps (pop, dim) to (pop, n_con), feasible where every entry <= 0.
+        seed: Integer seed or ``numpy.random.Generator``; same seed, same result.
+        max_generations: Generation budget (default ``settings.max_generations``).
+        stall_generations: Stop after this many generations without relative improvement
+            of the best by ``settings.stall_tolerance`` (default from settings).
+        time_limit: Wall-clock budget in seconds (checked after each generation).
+        callback: Called with a :class:`GAProgress` after each generation; returning
+            True stops the run.
+        initial: (k, dim) individuals placed in the initial population (k <= pop).
+
+    Returns:
+        :class:`GAResult`. ``feasible`` is False if no feasible individual was ever seen.
+    """
+    settings = GASettings() if settings is None else settings
+    if not isinstance(settings, GASettings):
+        raise InvalidSettings(f"settings must be an optim.GASettings, got {type(settings).__name__}")
+    lower, upper = _check_bounds(bounds)
+    rng = random_generator(seed)
+    G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
+    if G > MAX_GENERATIONS:
+        raise SettingOutOfRange(f"max_generations = {G:,} is more than the {MAX_GENERATIONS:,} allowed")
+    stall = (settings.stall_generations if stall_generations is None
+             else _count(stall_generations, "stall_generations", 1))
+    if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))
+                                       and np.isfinite(time_limit) and time_limit >= 0):
+        raise InvalidSettings(f"time_limit={time_limit!r}: give a finite number of seconds >= 0 "
+                              "or None")
+    pop = settings.population
+    t0 = time.perf_counter()
+    evaluate = _Evaluator(objective, constraints)
+    penalty = AdaptivePenalty(settings.penalty_initial, settings.penalty_increase,
+                              settings.penalty_decrease, settings.penalty_window)
+    use_penalty = settings.constraint_handling == "adaptive-penalty"
+
+    x, f, v = _initial_population(evaluate, lower, upper, pop, initial, rng,
+                                  draw_feasible=constraints is not None)
+
+    hist_best: list[float] = []
+    hist_mean: list[float] = []
+    hist_feas: list[float] = []
+    hist_viol: list[float] = []
+    hist_feas_mean: list[float] = []
+    best_x, best_f, best_v = x[0].copy(), np.inf, np.inf
+    stall_count = 0
+    stop_reason = "max_generations"
+    generation = 0
+
+    def rank_population() -> tuple[np.ndarray, np.ndarray]:
+        if use_penalty:
+            return rank_penalty(f, v, penalty.lam)
+        return rank_feasibility_rules(f, v)
+
+    while True:
+        # Bookkeeping of the best-so-far (Deb's order, whatever the handling).
+        order_deb = rank_feasibility_rules(f, v)[0]
+        i_best = int(np.argmin(order_deb))
+        improved = False
+        if _better(f[i_best], v[i_best], best_f, best_v):
+            feas_now = v[i_best] <= FEASIBILITY_TOLERANCE
+            was_feas = best_v <= FEASIBILITY_TOLERANCE
+            if feas_now and was_feas and np.isfinite(best_f):
+                improved = best_f - f[i_best] > settings.stall_tolerance * max(abs(best_f), 1e-300)
+            else:
+                improved = True
+            best_x, best_f, best_v = x[i_best].copy(), float(f[i_best]), float(v[i_best])
+        stall_count = 0 if improved else stall_count + 1
+        finite = np.isfinite(f)
+        hist_best.append(best_f)
+        hist_mean.append(float(np.mean(f[finite])) if np.any(finite) else np.inf)
+        feasible_now = (v <= FEASIBILITY_TOLERANCE) & finite
+        hist_feas.append(float(np.mean(v <= FEASIBILITY_TOLERANCE)))
+        hist_feas_mean.append(float(np.mean(f[feasible_now])) if np.any(feasible_now) else np.inf)
+        hist_viol.append(best_v if best_v > FEASIBILITY_TOLERANCE else 0.0)
+
+        elapsed = time.perf_counter() - t0
+        if generation > 0 and callback is not None:
+            if callback(GAProgress(generation, best_x.copy(), best_f,
+                                   best_v <= FEASIBILITY_TOLERANCE, evaluate.count, elapsed)):
+                stop_reason = "callback"
+                break
+        if generation >= G:
+            stop_reason = "max_generations"
+            break
+        if stall is not None and stall_count >= stall:
+            stop_reason = "stall"
+            break
+        if time_limit is not None and elapsed >= time_limit:
+            stop_reason = "time_limit"
+            break
+
+        generation += 1
+        rank, fitness = rank_population()
+        if use_penalty:
+            penalty.update(bool(v[int(np.argmin(rank))] <= FEASIBILITY_TOLERANCE))
+        n_elite = settings.elitism
+        elites = np.argsort(rank, kind="stable")[:n_elite]
+        n_children = pop - n_elite
+        n_pairs = (n_children + 1) // 2
+        if settings.selection == "tournament":
+            parents = selection.tournament(rank, 2 * n_pairs, settings.tournament_size, rng)
+        else:
+            parents = selection.rank_sus(rank, 2 * n_pairs, settings.rank_pressure, rng)
+        ia, ib = parents[:n_pairs], parents[n_pairs:]
+        f_max, f_avg = float(np.max(fitness)), float(np.mean(fitness))
+        if settings.adaptive:
+            pc: float | np.ndarray = adaptive.adaptive_crossover_probability(
+                fitness[ia], fitness[ib], f_max, f_avg, settings.pc1, settings.pc2)
+        else:
+            pc = settings.crossover_probability
+        a, b = x[ia], x[ib]
+        if settings.crossover == "sbx":
+            c1, c2 = crossover.sbx(a, b, lower, upper, pc, settings.sbx_eta, rng)
+        elif settings.crossover == "arithmetic":
+            c1, c2 = crossover.arithmetic(a, b, lower, upper, pc, rng)
+        else:
+            c1, c2 = crossover.blend(a, b, lower, upper, pc, settings.blend_alpha, rng)
+        children = np.concatenate([c1, c2])[:n_children]
+        origin = np.concatenate([ia, ib])[:n_children]
+        if settings.adaptive:
+            pm: float | np.ndarray = adaptive.adaptive_mutation_probability(
+                fitness[origin], f_max, f_avg, settings.pm1, settings.pm2)
+        else:
+            pm = settings.mutation_probability
+        if settings.mutation == "non-uniform":
+            children = mutation.non_uniform(children, lower, upper, pm, generation, G,
+                                            settings.nonuniform_shape, rng)
+        else:
+            children = mutation.polynomial(children, lower, upper, pm,
+                                           settings.polynomial_eta, rng)
+        fc, vc = evaluate(children)
+        x = np.concatenate([x[elites], children])
+        f = np.concatenate([f[elites], fc])
+        v = np.concatenate([v[elites], vc])
+
+    history = GAHistory(np.asarray(hist_best), np.asarray(hist_mean),
+                        np.asarray(hist_feas), np.asarray(hist_viol), np.asarray(hist_feas_mean))
+    feasible = bool(best_v <= FEASIBILITY_TOLERANCE)
+    return GAResult(x=best_x, f=best_f, feasible=feasible,
+                    violation=0.0 if feasible else best_v, history=history,
+                    generations=generation, evaluations=evaluate.count,
+                    stop_reason=stop_reason, wall_time=time.perf_counter() - t0)

@@ -1,0 +1,206 @@
+"""Evaluating one candidate placement of a layout search (stages 2 and 4 of
+:func:`optim.layout.search_layout`): the settings a search passes to its tasks, the cycle
+plans of every (pick, place) pair, the failure classes, and the Nelder-Mead refinement of one
+start. Every task is a pure function of its inputs (the execution layer may run it anywhere).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.cycle import PickPlace, plan_cycle
+from pinarms.optim.errors import InfeasibleProblem
+from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
+
+from .candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
+
+__all__: list[str] = []  # the tasks of a search (private: search_layout runs them)
+
+
+# --------------------------------------------------------------------- settings
+@dataclass(frozen=True)
+class _Settings:
+    """What every candidate's evaluation needs (shipped with each task)."""
+
+    picks: np.ndarray  # (P, 3) line frame
+    places: np.ndarray  # (Q, 3)
+    orientation: np.ndarray | None  # (3, 3) tool orientation in the line frame, or None (robot default)
+    lift: float
+    dwell: float
+    kind: str
+    vmax: Any
+    amax: Any
+    jmax: Any
+    seed: int
+    cell: "_CellRecipe | None" = None
+
+
+@dataclass(frozen=True)
+class _CellRecipe:
+    """How a worker rebuilds the cell (a Cell holds coal objects that do not pickle)."""
+
+    token: str
+    urdf_text: str
+    source: str
+    base_dir: str
+    packages: tuple[tuple[str, str], ...]
+    args: tuple[tuple[str, str], ...]
+    seed: int
+    arm: str
+    carry: tuple[str, ...]
+    clearance: float
+
+
+#: Cells by search token in this process (the caller's own cell, or one rebuilt from its recipe).
+_CELLS: dict[str, Any] = {}
+
+
+def _cell_of(recipe: _CellRecipe) -> Any:
+    if recipe.token not in _CELLS:
+        from pinarms.robots.cell import Cell
+
+        if len(_CELLS) >= 2:
+            _CELLS.pop(next(iter(_CELLS)))
+        _CELLS[recipe.token] = Cell(recipe.urdf_text, source=recipe.source, base_dir=recipe.base_dir,
+                                    packages=dict(recipe.packages), args=dict(recipe.args), seed=recipe.seed)
+    return _CELLS[recipe.token]
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    """One candidate's evaluation."""
+
+    failure: str = ""  # "" when the cycle was planned
+    reason: str = ""
+    cycle_time: float = float("nan")  # mean over the pairs [s]
+    branch: int = -1
+    manipulability: float = float("nan")
+
+    @property
+    def picks_per_minute(self) -> float:
+        return 60.0 / self.cycle_time if not self.failure else 0.0
+
+
+def _classify(exc: PinarmsError) -> str:
+    text = str(exc)
+    if isinstance(exc, LimitViolation) or "outside its limits" in text or "outside their limits" in text:
+        return "joint limit"
+    if isinstance(exc, UnreachableTarget):
+        return "unreachable"
+    if isinstance(exc, InfeasibleProblem):
+        return "timing"
+    if "collision" in type(exc).__name__.lower() or "collid" in text:
+        return "collision"
+    return "timing"
+
+
+def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool = False):
+    """Plan every (pick, place) pair's cycle from this placement; ``_Outcome`` (and the first cycle)."""
+    picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
+    places_b = points_in_base_frame(st.places, placement[None, :])[0]
+    R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
+    in_cell: dict[str, Any] = {}
+    if st.cell is not None:
+        try:
+            moved = _cell_of(st.cell).with_arm_base(st.cell.arm, base_to_world(placement), carry=st.cell.carry)
+        except PinarmsError as exc:
+            return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
+                            f"the cell cannot hold the arm there: {exc}"), None
+        robot = moved.arm(st.cell.arm).robot
+        in_cell = {"cell": moved, "arm": st.cell.arm, "clearance": st.cell.clearance}
+    times, w_min, branch, first = [], np.inf, -1, None
+    for i, pick in enumerate(picks_b):
+        for j, place in enumerate(places_b):
+            spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
+            try:
+                cycle = plan_cycle(robot, spec, kind=st.kind, vmax=st.vmax, amax=st.amax, jmax=st.jmax,
+                                   method="exact", seed=st.seed, **in_cell)
+            except PinarmsError as exc:
+                where = f"pick {i + 1} → place {j + 1}"
+                return _Outcome(_classify(exc), f"{where}: {exc}"), None
+            times.append(cycle.cycle_time)
+            k = len(spec.names) - 1
+            w = robot.manipulability(cycle.q_via[[0, k]], part="position")
+            w_min = min(w_min, float(np.min(w)))
+            if first is None:
+                first, branch = cycle, int(cycle.branches[0])
+    outcome = _Outcome("", "", float(np.mean(times)), branch, w_min)
+    return outcome, (first if keep_cycle else None)
+
+
+#: Robots already used in this process, by search token: a worker unpickles the robot with
+#: every task, but keeps using the first copy, whose IK caches are warm (~10 % of a cycle plan).
+_WARM: dict[str, Any] = {}
+
+
+def _warm(robot: Any, token: str) -> Any:
+    if token not in _WARM:
+        if len(_WARM) >= 4:
+            _WARM.pop(next(iter(_WARM)))
+        _WARM[token] = robot
+    return _WARM[token]
+
+
+@dataclass(frozen=True)
+class _ChunkTask:
+    robot: Any
+    token: str  # one per search (and robot)
+    placements: np.ndarray  # (m, 4)
+    settings: _Settings
+
+
+def _evaluate_chunk(task: _ChunkTask) -> list[_Outcome]:
+    robot = _warm(task.robot, task.token)
+    return [_evaluate(robot, p, task.settings)[0] for p in task.placements]
+
+
+@dataclass(frozen=True)
+class _RefineTask:
+    robot: Any
+    token: str
+    start: np.ndarray  # (4,)
+    free: np.ndarray  # (k,) indices of the free coordinates
+    bounds: np.ndarray  # (4, 2)
+    step: np.ndarray  # (4,) initial simplex step
+    evaluations: int
+    settings: _Settings
+
+
+def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
+    """Bounded Nelder-Mead from ``start`` over the free coordinates: (placement, picks/min, evaluations)."""
+    from scipy.optimize import minimize
+
+    robot = _warm(task.robot, task.token)
+    free, lo, hi = task.free, task.bounds[task.free, 0], task.bounds[task.free, 1]
+    seen: dict[bytes, float] = {}
+    best = {"placement": task.start.copy(), "ppm": None}
+
+    def placement(z: np.ndarray) -> np.ndarray:
+        p = task.start.copy()
+        p[free] = np.clip(z, lo, hi)
+        return p
+
+    def cost(z: np.ndarray) -> float:
+        p = placement(z)
+        key = p.tobytes()
+        if key not in seen:
+            ppm = _evaluate(robot, p, task.settings)[0].picks_per_minute
+            seen[key] = -ppm
+            # strictly better by more than the tie tolerance: the earliest evaluation wins ties
+            if best["ppm"] is None or ppm > best["ppm"] * (1.0 + _PPM_RTOL) + 1e-12:
+                best["placement"], best["ppm"] = p, ppm
+        return seen[key]
+
+    z0 = task.start[free]
+    simplex = [z0]
+    for k in range(free.size):
+        z = z0.copy()
+        z[k] = z[k] + task.step[free][k] if z[k] + task.step[free][k] <= hi[k] else z[k] - task.step[free][k]
+        simplex.append(z)
+    minimize(cost, z0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
+                   options={"initial_simplex": np.array(simplex), "maxfev": task.evaluations,
+                            "xatol": 1e-4, "fatol": 1e-6})
+    return best["placement"], float(best["ppm"]), len(seen)

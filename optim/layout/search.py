@@ -1,0 +1,328 @@
+"""Where to bolt the arm: a search over base placements for the most picks per minute.
+
+A line engineer has pick points (a conveyor segment) and place points (a crate), fixed in
+the **line frame** (world, m), and asks where to put the arm. :func:`search_layout` takes
+candidate base placements ``(x, y, z, yaw)`` of the arm's base frame in the line frame
+(:func:`grid_candidates`, :func:`random_candidates`) and, for each:
+
+1. moves the points into the base frame (``p_base = R_z(-yaw) (p - t)``) and screens every
+   waypoint of the cycle (each pick and place, and the lift points above them) with one
+   batched closed-form IK over all candidates: a candidate with a point beyond reach is
+   ``"unreachable"``, one whose point is within reach but needs a joint outside its limits
+   is ``"joint limit"`` (both named with the point);
+2. plans the time-optimal cycle (:func:`optim.plan_cycle`, ``method="exact"``) of every
+   (pick, place) pair: IK branch, moves, dwells; ``picks_per_minute = 60 / mean cycle time``
+   over the pairs (a line cycling through them); a failing plan is classified the same way
+   (``"timing"`` when no timing meets the limits);
+3. reports the position manipulability at the picks and places (the cycle's own joint
+   values, smallest over the points) and the boundary margin (distance of the points to
+   the edge of the arm's sampled workspace, smallest over the points; one voxel map serves
+   every candidate, since a placement only moves the points in the base frame).
+
+Candidates are ranked by picks/min (larger first; values within 1e-9 relative of each other
+tie), then by boundary margin (larger first), then by index. Then the best ``refine``
+candidates are improved by a bounded Nelder-Mead search over the free coordinates of the
+placement (those the candidates vary), each start one task; the gain is reported.
+
+The cycles run through :func:`pinarms.execution.map_chunks` (``scheduler``: serial, local
+processes or a Dask cluster): results are identical whoever runs them (the plans are
+deterministic and every task is a pure function of its candidates).
+
+Units: m, rad, s; yaw about the line frame's vertical axis (the base stands upright).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from pinarms.optim.caps import (MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, MAX_REFINE,
+                               MAX_REFINE_EVALUATIONS, MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
+from pinarms.optim.cycle import CYCLE_KINDS, PickPlace
+from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
+from pinarms.robots.errors import InvalidInput
+
+from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
+                         points_in_base_frame, random_candidates)
+from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _evaluate, _evaluate_chunk, _RefineTask, _refine, _Settings)
+from .result import LayoutSearch, Refinement
+
+__all__ = [
+    "FAILURES",
+    "LayoutSearch",
+    "Refinement",
+    "grid_candidates",
+    "random_candidates",
+    "base_to_world",
+    "points_in_base_frame",
+    "search_layout",
+]
+
+
+# ------------------------------------------------------------------------ search
+def _points(value: Any, what: str) -> np.ndarray:
+    try:
+        P = np.atleast_2d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"{what} must be points (3,) or (N, 3) in m, got {value!r}") from exc
+    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0:
+        raise InvalidInput(f"{what} must be points (3,) or (N, 3) in m, got shape {np.shape(value)}")
+    if not np.all(np.isfinite(P)):
+        raise InvalidInput(f"{what} holds NaN or inf")
+    return P
+
+
+def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str]]:
+    """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate."""
+    from pinarms.robots.layout import default_orientation
+
+    M = cand.shape[0]
+    failure, reason = [""] * M, [""] * M
+    if not getattr(robot, "has_analytic_ik", False):
+        return failure, reason  # numerical IK: each cycle plan finds and names the problem
+    names = [f"pick {i + 1}" for i in range(len(st.picks))] + [f"place {j + 1}" for j in range(len(st.places))]
+    pts = np.vstack([st.picks, st.places])
+    up = pts + [0.0, 0.0, st.lift]
+    names = names + [f"above {n}" for n in names]  # the user's points first, then the lift points
+    world = np.vstack([pts, up])
+    K = world.shape[0]
+    P = points_in_base_frame(world, cand)  # (M, K, 3)
+    T = np.zeros((M, K, 4, 4))
+    if st.orientation is None:
+        T[:, :, :3, :3] = default_orientation(robot)
+    else:
+        T[:, :, :3, :3] = np.einsum("mij,jk->mik", np.stack([_rot_z(-y) for y in cand[:, 3]]), st.orientation)[:, None]
+    T[:, :, :3, 3] = P
+    T[:, :, 3, 3] = 1.0
+    flat = T.reshape(M * K, 4, 4)
+    sols = robot.ik_all(flat)
+    has = np.array([np.shape(s)[0] > 0 for s in sols]).reshape(M, K)
+    bad = np.flatnonzero(~has.all(axis=1))
+    if bad.size:
+        missing = [(m, int(np.flatnonzero(~has[m])[0])) for m in bad]
+        free = robot.ik_all(np.stack([T[m, k] for m, k in missing]), respect_limits=False)
+        for (m, k), f in zip(missing, free):
+            at = "({:.3f}, {:.3f}, {:.3f}) m".format(*world[k])
+            if np.shape(f)[0]:
+                failure[m] = "joint limit"
+                why = robot.ik_failure_reason(T[m, k]) or "needs a joint outside its limits"
+                reason[m] = f"{names[k]} {at}: {why}"
+            else:
+                failure[m] = "unreachable"
+                reason[m] = f"{names[k]} {at}: beyond the arm's reach from this placement (no IK solution even without joint limits)"
+    return failure, reason
+
+
+def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
+    """Picks/min descending (1e-9 relative ties), then margin descending, then index; failures last."""
+    from pinarms.robots.ties import argsort_tied
+
+    order = argsort_tied(-ppm, rtol=_PPM_RTOL)
+    out, i = [], 0
+    while i < order.size:
+        j = i + 1
+        ref = -ppm[order[i]]
+        while j < order.size and -ppm[order[j]] <= ref + _PPM_RTOL * abs(ref) + 1e-12:
+            j += 1
+        run = sorted(order[i:j].tolist(), key=lambda k: (-margin[k], k))
+        out.extend(run)
+        i = j
+    return np.asarray(out, dtype=np.intp)
+
+
+def search_layout(
+    robot: Any,
+    picks: Any,
+    places: Any,
+    candidates: Any,
+    *,
+    lift: float = 0.05,
+    dwell: float = 0.2,
+    orientation: Any = None,
+    kind: str = "multi-quintic",
+    vmax: Any = None,
+    amax: Any = None,
+    jmax: Any = None,
+    refine: int = 2,
+    refine_evaluations: int = 30,
+    workspace_samples: int = 200_000,
+    seed: int = 0,
+    chunk_size: int = 4,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+    arm: str | None = None,
+    clearance: float = 0.02,
+    carry: tuple[str, ...] = (),
+    min_margin: float = 0.0,
+) -> LayoutSearch:
+    """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
+
+    Args:
+        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
+            then the arm ``arm`` of the cell (its only arm by default) is moved among the
+            cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
+            the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
+            must keep ``clearance`` [m] from the fixtures and the other arms
+            (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
+            points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
+        picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
+            paired with every place.
+        candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
+            [m, rad] (:func:`grid_candidates`, :func:`random_candidates`).
+        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`optim.PickPlace` and
+            :func:`optim.plan_cycle`).
+        orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
+            the robot's (tool down for six-axis arms), in its base frame.
+        min_margin: smallest boundary margin [m] a pick or place may have; candidates below
+            fail as ``"boundary"`` before any cycle is planned (0: no such rule). The fastest
+            cycles are often near the edge of the workspace, where the arm is stretched.
+        refine: how many of the best candidates start a continuous search (0: none).
+        refine_evaluations: cycles each continuous search may plan.
+        workspace_samples: samples of the workspace whose voxel map gives the boundary margins.
+        seed: seed of the workspace samples and of the timing optimiser (results repeat).
+        chunk_size: candidates per task (a task plans ``chunk_size × pairs`` cycles, ~0.5 s each
+            for a six-axis arm).
+        scheduler, progress: see :func:`pinarms.execution.map_chunks` (progress counts the
+            candidate tasks, then the refinement tasks).
+
+    Raises:
+        InvalidInput: malformed points, candidates, orientation or counts.
+        InvalidSettings: unknown ``kind``.
+        ExecutionError: a task failed on the scheduler (chunk index named).
+    """
+    import uuid
+
+    from pinarms.execution import map_chunks
+    from pinarms.robots.workspace import sample_workspace
+
+    token = uuid.uuid4().hex
+    recipe = None
+    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
+        cell = robot
+        if arm is None:
+            if len(cell.arms) != 1:
+                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
+            arm = cell.arms[0].name
+        robot = cell.arm(arm).robot
+        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+        for name in carry:
+            cell.fixture(name)
+        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
+                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
+                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
+                             tuple(carry), float(clearance))
+        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+    elif arm is not None or carry:
+        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
+
+    picks_w, places_w = _points(picks, "picks"), _points(places, "places")
+    cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
+    if cand.ndim != 2 or cand.shape[1] != 4 or cand.shape[0] == 0 or not np.all(np.isfinite(cand)):
+        raise InvalidInput(f"candidates must be finite placements (M, 4) = (x, y, z, yaw) [m, rad], got shape {cand.shape}")
+    if kind not in CYCLE_KINDS:
+        raise InvalidSettings(f"kind={kind!r}: use one of {CYCLE_KINDS}")
+    if cand.shape[0] > MAX_PLACEMENTS:
+        raise SettingOutOfRange(f"{cand.shape[0]:,} candidates, more than the {MAX_PLACEMENTS:,} a layout search takes")
+    if len(picks_w) * len(places_w) > MAX_POINT_PAIRS:
+        raise SettingOutOfRange(f"{len(picks_w)} picks × {len(places_w)} places = {len(picks_w) * len(places_w):,} "
+                                f"cycles per placement, more than the {MAX_POINT_PAIRS:,} allowed: give fewer points")
+    for name, v, least, most in (("refine", refine, 0, MAX_REFINE),
+                                 ("refine_evaluations", refine_evaluations, 1, MAX_REFINE_EVALUATIONS),
+                                 ("workspace_samples", workspace_samples, 1000, MAX_WORKSPACE_SAMPLES),
+                                 ("chunk_size", chunk_size, 1, MAX_PLACEMENTS), ("seed", seed, 0, 2**64 - 1)):
+        count_setting(v, name, least, most)
+    R = None
+    if orientation is not None:
+        R = np.asarray(orientation, dtype=float)
+        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or np.abs(R @ R.T - np.eye(3)).max() > 1e-6 \
+                or np.linalg.det(R) < 0:
+            raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
+    PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
+    number_setting(min_margin, "min_margin", 0.0, unit="m")
+    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
+    M = cand.shape[0]
+
+    failure, reason = _screen(robot, cand, st)
+    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
+    vmap = ws.voxel_map()
+    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
+    point_margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1)
+    margin = point_margin.min(axis=1)
+    if min_margin > 0:
+        names = [f"pick {i + 1}" for i in range(len(picks_w))] + [f"place {j + 1}" for j in range(len(places_w))]
+        for m in np.flatnonzero((margin < min_margin) & np.array([not f for f in failure])):
+            k = int(np.argmin(point_margin[m]))
+            failure[m] = "boundary"
+            reason[m] = (f"{names[k]} is {point_margin[m, k] * 1e3:.0f} mm from the edge of the workspace, "
+                         f"less than min_margin {min_margin * 1e3:.0f} mm")
+    todo = [m for m in range(M) if not failure[m]]
+    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
+    n_refine = int(refine)
+    total = len(tasks) + n_refine
+
+    def phase(offset: int):
+        if progress is None:
+            return None
+        return lambda done, _total: progress(offset + done, total)
+
+    outcomes = [o for chunk in map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=phase(0)) for o in chunk]
+    cycle_time = np.full(M, np.nan)
+    branch = np.full(M, -1)
+    manip = np.full(M, np.nan)
+    for m, o in zip(todo, outcomes):
+        failure[m], reason[m] = o.failure, o.reason
+        if not o.failure:
+            cycle_time[m], branch[m], manip[m] = o.cycle_time, o.branch, o.manipulability
+    ok = np.array([f == "" for f in failure])
+    ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
+
+    order = _ranking(ppm, margin)
+
+    refinement = None
+    best_placement = cand[order[0]].copy() if ok[order[0]] else None
+    best_ppm = float(ppm[order[0]])
+    free = np.flatnonzero(np.ptp(cand, axis=0) > 0)
+    starts = [int(i) for i in order[:n_refine] if ok[i]]
+    if starts and free.size:
+        bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
+        step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
+        rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
+        found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=phase(len(tasks)))
+        refinement = Refinement(
+            starts=np.array(starts),
+            start_picks_per_minute=ppm[starts],
+            placements=np.array([f[0] for f in found]),
+            picks_per_minute=np.array([f[1] for f in found]),
+            evaluations=np.array([f[2] for f in found]),
+            free=tuple(AXES[k] for k in free),
+            margin=vmap.query(points_in_base_frame(np.vstack([picks_w, places_w]),
+                                                   np.array([f[0] for f in found])).reshape(-1, 3))
+            .margin.reshape(len(found), -1).min(axis=1),
+        )
+        eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
+        k = int(np.argmax(eligible))
+        if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
+            best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
+    best_cycle = None
+    if best_placement is not None:
+        best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
+    return LayoutSearch(
+        robot=str(robot.name),
+        picks=picks_w,
+        places=places_w,
+        candidates=cand,
+        failure=tuple(failure),
+        reason=tuple(reason),
+        cycle_time=cycle_time,
+        picks_per_minute=ppm,
+        branch=branch,
+        manipulability=manip,
+        margin=margin,
+        order=order,
+        refinement=refinement,
+        best_placement=best_placement,
+        best_picks_per_minute=best_ppm,
+        best_cycle=best_cycle,
+        seed=int(seed),
+    )

@@ -1,0 +1,128 @@
+"""Exceptions of pinarms.
+
+Every error pinarms raises on purpose derives from :class:`PinarmsError`, so a caller
+can catch the whole family with one ``except``. The hierarchy lives here, in the floor
+that every package may import (with the execution layer, atomic files and units), and
+imports nothing of ours; the packages above derive their own errors from it.
+``pinarms.robots.errors`` re-exports every name, so imports from there keep working.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "PinarmsError",
+    "InvalidInput",
+    "RobotNotFound",
+    "ModelError",
+    "UnreachableTarget",
+    "LimitViolation",
+    "ExecutionError",
+    "XacroError",
+    "XacroForbidden",
+    "XacroLimitExceeded",
+    "XacroArgError",
+    "MissingMesh",
+    "CellError",
+    "CellNotFound",
+    "XacroFileNotFound",
+    "CellTooLarge",
+    "CollisionGeometryError",
+    "CollisionError",
+]
+
+
+class PinarmsError(Exception):
+    """Base of every error pinarms raises on purpose."""
+
+
+class InvalidInput(PinarmsError, ValueError):
+    """An argument has the wrong shape, type or value (NaN, inf, negative count, ...)."""
+
+
+class RobotNotFound(PinarmsError, LookupError):
+    """A robot name is not known to :func:`robots.load`."""
+
+
+class ModelError(PinarmsError):
+    """A robot description (xacro or URDF) is malformed or cannot be modelled."""
+
+
+class UnreachableTarget(PinarmsError):
+    """No configuration within the joint limits reaches the requested target."""
+
+
+class LimitViolation(PinarmsError):
+    """A configuration or trajectory violates the robot's limits."""
+
+
+class ExecutionError(PinarmsError):
+    """A chunk of a sweep failed: its task raised, or the worker running it died.
+
+    Raised by :func:`pinarms.execution.map_chunks` (serial loop or Dask cluster alike) instead
+    of returning a partial result. ``chunk`` is the failing task's index in the task list
+    (``None`` when the cluster itself could not be reached), ``seed`` the task's seed when it
+    carries one, ``cause`` a one-line description of the original error. Re-run the chunk on
+    its own with that seed to reproduce it.
+    """
+
+    def __init__(self, message: str, *, chunk: int | None = None, seed: int | None = None,
+                 cause: str = "") -> None:
+        super().__init__(message)
+        self.chunk = chunk
+        self.seed = seed
+        self.cause = cause
+
+    def __reduce__(self):  # keep the fields when the error crosses a process boundary
+        return (_rebuild_execution_error, (str(self), self.chunk, self.seed, self.cause))
+
+
+def _rebuild_execution_error(message, chunk, seed, cause):
+    return ExecutionError(message, chunk=chunk, seed=seed, cause=cause)
+
+
+class XacroError(ModelError):
+    """xacro cannot expand a file: unknown macro, undefined property, malformed XML, missing file."""
+
+
+class XacroForbidden(XacroError):
+    """A xacro file reads outside its allowed folders or uses a construct pinarms refuses."""
+
+
+class XacroLimitExceeded(XacroError):
+    """Expanding a xacro file took too long, needed too much memory or produced too much text."""
+
+
+class XacroArgError(XacroError, InvalidInput):
+    """A xacro argument is not declared by the file, or is not a number where a number is due."""
+
+
+class MissingMesh(ModelError):
+    """A mesh file named by a description does not exist."""
+
+
+class CellError(ModelError):
+    """A cell description is malformed: duplicate names, no arm, an arm that cannot be modelled."""
+
+
+class CellTooLarge(CellError):
+    """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
+
+
+class CollisionGeometryError(ModelError):
+    """A collision geometry cannot be loaded or a pair of geometries cannot be checked."""
+
+
+class CollisionError(PinarmsError):
+    """A motion cannot be made collision-free; the message says which bodies block it."""
+
+
+class CellNotFound(RobotNotFound):
+    """A cell name is not a built-in cell, or a cell file does not exist."""
+
+
+class XacroFileNotFound(XacroError, CellNotFound):
+    """A xacro file, a file it includes or a yaml file it loads does not exist (the message names it).
+
+    Both a :class:`XacroError` and the not-found error of cells (:class:`CellNotFound`, a
+    ``LookupError``), so a cell whose included arm file is missing is caught either way.
+    """

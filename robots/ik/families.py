@@ -1,0 +1,23 @@
+"""The closed-form solver class of each arm family, by family name.
+
+Its own module so that :func:`robots.ik.recognise` and the package's
+:func:`robots.ik.analytic_solver` read the same table without importing each other.
+"""
+
+from __future__ import annotations
+
+from .gantry import GantryIK
+from .koji import KojiIK
+from .scara import ScaraIK
+from .solver import AnalyticIK
+from .ur_type import URTypeIK
+
+__all__ = ["FAMILIES"]
+
+#: Closed-form solver classes by family name.
+FAMILIES: dict[str, type[AnalyticIK]] = {
+    "ur_type": URTypeIK,
+    "scara": ScaraIK,
+    "gantry": GantryIK,
+    "koji": KojiIK,
+}

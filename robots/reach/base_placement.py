@@ -1,0 +1,390 @@
+"""Inverse reachability: where the base may stand so that every task pose is reachable.
+
+The arm's base stands on a plane at height ``z`` [m] (world frame), at ``(x, y)`` with a yaw
+``ψ`` about the vertical: ``T_base_to_world = Trans(x, y, z) · Rz(ψ)``. A task pose
+``T_task`` (tool frame → world) is, seen from that base, ``T_b = T_base_to_worldᵀ⁻¹ · T_task``.
+
+:func:`base_placements` answers with the inverse of a :class:`~robots.reachability.ReachabilityMap`
+restricted to bases on the plane:
+
+1. **Candidates.** A grid of ``(x, y) = (i, j)·xy_step`` (default step: the map's resolution)
+   over the tasks' bounding box grown by the map's horizontal reach, times yaws ``k·yaw_step``.
+   A base farther (horizontally) from a task than the farthest reachable voxel of the map is
+   dropped at once.
+2. **Map lookups.** For each candidate and task: the voxel of ``T_b``'s position and the set's
+   orientation nearest ``T_b``'s (for *roll-free* tasks, such as a gripper closing on a
+   mushroom with the tool pointing down, only the tool axis matters: a roll-free map's
+   direction group, or for an SO(3) map any of ``roll_steps`` rolls about the tool axis).
+   A candidate is *feasible on the map* when every task is reached there.
+3. **Score and rank.** ``index_sum`` = the sum over tasks of the reached directions (or
+   rotations) of the task's voxel, an integer, i.e. the mean reachability index times the
+   count: how much orientation freedom is left around the tasks; then the smallest best
+   manipulability of the tasks' voxels; then the candidate's grid order (x, then y, then
+   yaw). Manipulabilities within 1e-9 relative count as tied.
+4. **Check.** The ``verify`` best candidates are solved exactly by IK (every closed-form branch
+   within the limits, or the numerical solver) at the exact task poses (rolls tried for
+   roll-free tasks) with the collision checks given; ``verified`` says whether every task has
+   a solution, ``ik_manipulability`` the smallest (over tasks) best manipulability. The final
+   order puts verified candidates first (then the map's order).
+
+The map is a discretisation (voxel centres, a finite orientation set): a candidate feasible on
+the map can fail the exact check near the workspace boundary, which is why the check exists.
+The candidates are what ``optim.search_layout`` can start from (:meth:`BasePlacements.poses`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidInput, ModelError
+from .orientations import _align, _rotation_about
+from .reachability import ReachabilityMap, _collision_free, _manipulability, _urdf_sha256
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..robot import Robot
+
+__all__ = ["BasePlacements", "base_placements", "tool_down_poses", "MAX_CANDIDATES"]
+
+#: Most (x, y, yaw) candidates one call evaluates on the map.
+MAX_CANDIDATES = 20_000_000
+_BLOCK = 250_000
+_DOWN = np.array([0.0, 0.0, -1.0])
+
+
+def tool_down_poses(points: Any, tool_axis: Any = (0.0, 0.0, 1.0)) -> np.ndarray:
+    """Task poses ``(N, 4, 4)`` at ``points (N, 3)`` [m] with ``tool_axis`` (tool frame) pointing straight down.
+
+    Roll zero as in :func:`robots.orientations.tool_axis_orientations` (a fixed rotation taking
+    the tool axis to ``(0, 0, −1)``); a roll-free task ignores it.
+    """
+    P = _as_points(points)
+    axis = np.asarray(tool_axis, dtype=float)
+    if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
+        raise InvalidInput(f"tool_axis must be a finite non-zero 3-vector, got {tool_axis!r}")
+    R = _align(axis / np.linalg.norm(axis), _DOWN[None])[0]
+    T = np.tile(np.eye(4), (P.shape[0], 1, 1))
+    T[:, :3, :3] = R
+    T[:, :3, 3] = P
+    return T
+
+
+def _as_points(points: Any) -> np.ndarray:
+    try:
+        P = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"points must be numbers with shape (N, 3) [m], got {points!r}") from exc
+    P = P.reshape(1, 3) if P.shape == (3,) else P
+    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0 or not np.all(np.isfinite(P)):
+        raise InvalidInput(f"points must be a non-empty finite (N, 3) array [m], got shape {np.shape(points)}")
+    return P
+
+
+def _as_tasks(tasks: Any) -> np.ndarray:
+    try:
+        T = np.asarray(tasks, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"tasks must be poses (N, 4, 4) [m], got {tasks!r}") from exc
+    T = T[None] if T.shape == (4, 4) else T
+    if T.ndim != 3 or T.shape[1:] != (4, 4) or T.shape[0] == 0 or not np.all(np.isfinite(T)):
+        raise InvalidInput(f"tasks must be a non-empty finite array of poses (N, 4, 4), got shape {np.shape(tasks)}")
+    R = T[:, :3, :3]
+    if np.abs(R @ np.swapaxes(R, 1, 2) - np.eye(3)).max() > 1e-6 or np.any(np.linalg.det(R) < 0):
+        raise InvalidInput("tasks: every rotation block must be a proper rotation (orthonormal, det +1)")
+    return T
+
+
+@dataclass(frozen=True, eq=False)
+class BasePlacements:
+    """Base poses from which every task is reachable, best first (see the module doc).
+
+    Attributes:
+        tasks: ``(N, 4, 4)`` task poses, tool frame → world.
+        roll_free: tasks ignore the roll about the tool axis.
+        z: height of the base plane [m]; ``xy_step`` [m], ``yaw_step`` [rad] of the grid.
+        candidates: ``(C, 4)`` ``x, y, z, yaw`` [m, rad] of the bases feasible on the map, best first.
+        index_sum: ``(C,)`` int, reached directions (or rotations) summed over the tasks' voxels.
+        index_mean: ``(C,)`` mean reachability index over the tasks.
+        manipulability: ``(C,)`` smallest best manipulability of the tasks' voxels (map).
+        checked: ``(C,)`` bool, solved exactly by IK; ``verified`` ``(C,)`` every task solved;
+        ik_manipulability: ``(C,)`` smallest over tasks of the best exact manipulability (NaN unchecked).
+        n_grid: candidates in the grid; ``n_lookups`` map lookups made.
+    """
+
+    tasks: np.ndarray = field(repr=False)
+    roll_free: bool
+    z: float
+    xy_step: float
+    yaw_step: float
+    candidates: np.ndarray = field(repr=False)
+    index_sum: np.ndarray = field(repr=False)
+    index_mean: np.ndarray = field(repr=False)
+    manipulability: np.ndarray = field(repr=False)
+    checked: np.ndarray = field(repr=False)
+    verified: np.ndarray = field(repr=False)
+    ik_manipulability: np.ndarray = field(repr=False)
+    n_grid: int = 0
+    n_lookups: int = 0
+
+    def __len__(self) -> int:
+        return int(self.candidates.shape[0])
+
+    @property
+    def best(self) -> np.ndarray | None:
+        """``(x, y, z, yaw)`` of the best verified candidate, or ``None``."""
+        ok = np.flatnonzero(self.verified)
+        return None if ok.size == 0 else self.candidates[ok[0]].copy()
+
+    def poses(self, n: int | None = None) -> np.ndarray:
+        """``(n, 4, 4)`` base → world poses of the first ``n`` candidates (default all)."""
+        c = self.candidates if n is None else self.candidates[: int(n)]
+        T = np.tile(np.eye(4), (c.shape[0], 1, 1))
+        cz, sz = np.cos(c[:, 3]), np.sin(c[:, 3])
+        T[:, 0, 0], T[:, 0, 1], T[:, 1, 0], T[:, 1, 1] = cz, -sz, sz, cz
+        T[:, :3, 3] = c[:, :3]
+        return T
+
+    def text(self, n: int = 5) -> str:
+        """A readable summary (mm, degrees) of the first ``n`` candidates."""
+        lines = [
+            f"base placements on the plane z = {self.z * 1000:.0f} mm for {self.tasks.shape[0]} task poses"
+            f"{' (roll free)' if self.roll_free else ''}: {len(self)} of {self.n_grid} grid candidates feasible on the map, "
+            f"{int(self.verified.sum())} of {int(self.checked.sum())} checked by IK verified",
+            "   x [mm]   y [mm]  yaw [°]  mean index  min w (map)  IK  min w (IK)",
+        ]
+        for c, im, w, ch, v, wi in zip(self.candidates[:n], self.index_mean, self.manipulability, self.checked,
+                                       self.verified, self.ik_manipulability):
+            ik = ("yes" if v else "no") if ch else "-"
+            lines.append(f"  {c[0] * 1000:7.0f}  {c[1] * 1000:7.0f}  {np.degrees(c[3]):7.1f}  {im:10.3f}  {w:11.4g}  "
+                         f"{ik:>3}  {wi:10.4g}")
+        return "\n".join(lines)
+
+
+def _horizontal_reach(m: ReachabilityMap) -> float:
+    c = m.centres(m.voxels[m.index > 0])
+    if c.shape[0] == 0:
+        return 0.0
+    return float(np.hypot(c[:, 0], c[:, 1]).max() + np.sqrt(0.5) * m.resolution)
+
+
+def _tie_ranks(values: np.ndarray) -> np.ndarray:
+    """Ranks of ``values`` descending, values within 1e-9 relative of a run's first sharing its rank."""
+    order = np.argsort(-values, kind="stable")
+    ranks = np.empty(values.size, dtype=np.int64)
+    rank, i = 0, 0
+    v = values[order]
+    while i < v.size:
+        j = i + 1
+        while j < v.size and v[j] >= v[i] - (1e-15 + 1e-9 * abs(v[i])):
+            j += 1
+        ranks[order[i:j]] = rank
+        rank += 1
+        i = j
+    return ranks
+
+
+def base_placements(
+    reach_map: ReachabilityMap,
+    tasks: Any,
+    *,
+    robot: "Robot | None" = None,
+    z: float = 0.0,
+    roll_free: bool = True,
+    xy_step: float | None = None,
+    yaw_step: float = np.radians(10.0),
+    roll_steps: int = 8,
+    verify: int = 20,
+    self_collision: bool = False,
+    collision: Any = None,
+) -> BasePlacements:
+    """Bases ``(x, y, yaw)`` on the plane at ``z`` from which every task pose is reachable (module doc).
+
+    Args:
+        reach_map: the arm's reachability map (its base frame).
+        tasks: task poses ``(N, 4, 4)``, tool frame → world [m] (see :func:`tool_down_poses`).
+        robot: the arm, to check the best candidates by exact IK (its URDF must be the map's).
+        z: height of the base plane in the world [m].
+        roll_free: only the tool axis of each task matters (the map set's tool axis).
+        xy_step: grid step [m] (default the map's resolution); yaw_step [rad].
+        roll_steps: rolls tried per roll-free task on an SO(3) map and in the exact check.
+        verify: how many of the best map candidates to check by IK (needs ``robot``).
+        self_collision, collision: collision checks of the exact IK solutions (as in
+            :func:`robots.reachability_map`).
+
+    Raises:
+        InvalidInput: bad tasks, steps, a grid larger than :data:`MAX_CANDIDATES`.
+        ModelError: ``robot`` is not the robot the map was built for.
+    """
+    if not isinstance(reach_map, ReachabilityMap):
+        raise InvalidInput(f"reach_map must be a ReachabilityMap, got {type(reach_map).__name__}")
+    T_tasks = _as_tasks(tasks)
+    z = float(z)
+    if not np.isfinite(z):
+        raise InvalidInput(f"z must be a finite height in m, got {z!r}")
+    step = float(reach_map.resolution if xy_step is None else xy_step)
+    if not (np.isfinite(step) and step > 0):
+        raise InvalidInput(f"xy_step must be a positive length in m, got {xy_step!r}")
+    if not (np.isfinite(yaw_step) and 0 < yaw_step <= 2 * np.pi):
+        raise InvalidInput(f"yaw_step must be in (0, 2π] rad, got {yaw_step!r}")
+    if isinstance(roll_steps, bool) or not isinstance(roll_steps, (int, np.integer)) or roll_steps < 1:
+        raise InvalidInput(f"roll_steps must be a positive integer, got {roll_steps!r}")
+    if isinstance(verify, bool) or not isinstance(verify, (int, np.integer)) or verify < 0:
+        raise InvalidInput(f"verify must be a non-negative integer, got {verify!r}")
+    if robot is not None and _urdf_sha256(robot) != reach_map.urdf_sha256:
+        raise ModelError(f"the map was built for '{reach_map.robot}' (another URDF than robot '{robot.name}')")
+    if verify and robot is None:
+        raise InvalidInput("pass robot=... to check the best candidates by IK (or verify=0)")
+
+    oset = reach_map.orientations
+    reach = _horizontal_reach(reach_map)
+    P = T_tasks[:, :3, 3]
+    lo, hi = P[:, :2].min(axis=0) - reach, P[:, :2].max(axis=0) + reach
+    # grid aligned on multiples of the step (x = i·step, y = j·step)
+    xs = step * np.arange(int(np.ceil(lo[0] / step)), int(np.floor(hi[0] / step)) + 1)
+    ys = step * np.arange(int(np.ceil(lo[1] / step)), int(np.floor(hi[1] / step)) + 1)
+    yaws = yaw_step * np.arange(int(np.ceil(2 * np.pi / yaw_step - 1e-9)))
+    n_grid = xs.size * ys.size * yaws.size
+    if n_grid > MAX_CANDIDATES:
+        raise InvalidInput(f"{n_grid} candidates (x {xs.size} × y {ys.size} × yaw {yaws.size}); raise xy_step or yaw_step")
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    X, Y = X.reshape(-1), Y.reshape(-1)
+    near = np.all(np.hypot(X[:, None] - P[None, :, 0], Y[:, None] - P[None, :, 1]) <= reach, axis=1)
+    X, Y = X[near], Y[near]
+
+    # tool-axis directions (roll-free tasks) or full rotations of the tasks, per yaw, in base axes
+    tool_axis = oset.tool_axis
+    if roll_free:
+        rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps)
+    group_reached = None
+    if roll_free and oset.roll_free:
+        group_reached = np.zeros((reach_map.n_voxels, oset.n_groups), dtype=bool)
+        for k in range(oset.size):
+            group_reached[:, oset.group[k]] |= reach_map.reached[:, k]
+    if oset.roll_free:
+        count_per_voxel = np.round(reach_map.index * oset.n_index).astype(np.int64)
+    else:
+        count_per_voxel = reach_map.reached.sum(axis=1).astype(np.int64)
+
+    cand_xyyaw, cand_sum, cand_w = [], [], []
+    n_lookups = 0
+    N = T_tasks.shape[0]
+    for yaw in yaws:
+        c, s = np.cos(yaw), np.sin(yaw)
+        Rz_T = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # Rz(yaw)ᵀ
+        R_b = Rz_T @ T_tasks[:, :3, :3]  # (N, 3, 3) task rotations in base axes
+        # orientation lookups do not depend on x, y: once per yaw
+        if roll_free and oset.roll_free:
+            d = R_b @ tool_axis
+            g = np.argmax(d @ oset.directions.T, axis=1)
+            orient = [("group", g)]
+        elif roll_free:
+            ks = [oset.nearest(R_b @ rolls[r])[0] for r in range(roll_steps)]
+            orient = [("rot", np.stack(ks, axis=1))]
+        else:
+            orient = [("rot", oset.nearest(R_b)[0][:, None])]
+        for start in range(0, X.size, _BLOCK):
+            xb, yb = X[start : start + _BLOCK], Y[start : start + _BLOCK]
+            n = xb.size
+            rel = P[None, :, :] - np.stack([xb, yb, np.full(n, z)], axis=1)[:, None, :]  # (n, N, 3)
+            pb = rel @ Rz_T.T
+            rows = reach_map.rows_of(pb.reshape(-1, 3)).reshape(n, N)
+            n_lookups += n * N
+            ok = np.all(rows >= 0, axis=1)
+            if not ok.any():
+                continue
+            r_ok = rows[ok]
+            kind, which = orient[0]
+            if kind == "group":
+                hit = group_reached[r_ok, np.broadcast_to(which, r_ok.shape)]
+            else:
+                hit = np.zeros(r_ok.shape, dtype=bool)
+                for j in range(which.shape[1]):
+                    hit |= reach_map.reached[r_ok, np.broadcast_to(which[:, j], r_ok.shape)]
+            feasible = np.all(hit, axis=1)
+            if not feasible.any():
+                continue
+            idx = np.flatnonzero(ok)[feasible]
+            rf = r_ok[feasible]
+            cand_xyyaw.append(np.column_stack([xb[idx], yb[idx], np.full(idx.size, yaw)]))
+            cand_sum.append(count_per_voxel[rf].sum(axis=1))
+            cand_w.append(np.nanmin(reach_map.best_manipulability[rf], axis=1))
+
+    if cand_xyyaw:
+        xyyaw = np.concatenate(cand_xyyaw)
+        sums = np.concatenate(cand_sum)
+        wmin = np.concatenate(cand_w)
+    else:
+        xyyaw, sums, wmin = np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0)
+    # grid order (x, then y, then yaw) as the last key: candidates were collected yaw-major
+    grid_key = np.lexsort((xyyaw[:, 2], xyyaw[:, 1], xyyaw[:, 0])) if xyyaw.size else np.zeros(0, np.int64)
+    pos = np.empty_like(grid_key)
+    pos[grid_key] = np.arange(grid_key.size)
+    order = np.lexsort((pos, _tie_ranks(wmin) if wmin.size else wmin, -sums))
+    xyyaw, sums, wmin = xyyaw[order], sums[order], wmin[order]
+    C = xyyaw.shape[0]
+    candidates = np.column_stack([xyyaw[:, 0], xyyaw[:, 1], np.full(C, z), xyyaw[:, 2]])
+    checked = np.zeros(C, dtype=bool)
+    verified = np.zeros(C, dtype=bool)
+    ik_w = np.full(C, np.nan)
+    n_check = min(int(verify), C)
+    if n_check:
+        checked[:n_check] = True
+        verified[:n_check], ik_w[:n_check] = _check_exactly(
+            robot, reach_map, candidates[:n_check], T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision
+        )
+        final = np.lexsort((np.arange(C), ~verified))
+        candidates, sums, wmin = candidates[final], sums[final], wmin[final]
+        checked, verified, ik_w = checked[final], verified[final], ik_w[final]
+    index_mean = sums / (N * oset.n_index)
+    return BasePlacements(
+        tasks=T_tasks, roll_free=bool(roll_free), z=z, xy_step=step, yaw_step=float(yaw_step), candidates=candidates,
+        index_sum=sums, index_mean=index_mean, manipulability=wmin, checked=checked, verified=verified,
+        ik_manipulability=ik_w, n_grid=int(n_grid), n_lookups=int(n_lookups),
+    )
+
+
+def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision):
+    """Exact IK at every task from each candidate: ``(verified (n,), min over tasks of best w (n,))``."""
+    from .reachability import ChunkTask, _spec_of
+
+    n, N = candidates.shape[0], T_tasks.shape[0]
+    rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
+    R = rolls.shape[0]
+    B = np.tile(np.eye(4), (n, 1, 1))
+    cz, sz = np.cos(candidates[:, 3]), np.sin(candidates[:, 3])
+    B[:, 0, 0], B[:, 0, 1], B[:, 1, 0], B[:, 1, 1] = cz, -sz, sz, cz
+    B[:, :3, 3] = candidates[:, :3]
+    T_b = np.linalg.inv(B)[:, None] @ T_tasks[None]  # (n, N, 4, 4)
+    T = np.repeat(T_b[:, :, None], R, axis=2)
+    T[..., :3, :3] = T[..., :3, :3] @ rolls[None, None]
+    T = T.reshape(-1, 4, 4)
+    task = ChunkTask(robot=_spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),
+                     rotations=np.eye(3)[None], group=np.zeros(1, np.int64), n_groups=1, roll_free=False,
+                     solver="analytic", manipulability=reach_map.manipulability_kind, restarts=0, tol=1e-9,
+                     self_collision=bool(self_collision), collision=collision, keep_solutions=False, seed=0)
+    best = np.full(T.shape[0], np.nan)
+    if robot.has_analytic_ik and reach_map.solver == "analytic":
+        idx, q = robot._analytic_ik.candidates(T)
+        keep = _collision_free(task, robot, q)
+        idx, q = idx[keep], q[keep]
+        w = _manipulability(robot, q, reach_map.manipulability_kind)
+        top = np.full(T.shape[0], -np.inf)
+        np.maximum.at(top, idx, w)
+        best = np.where(np.isfinite(top), top, np.nan)
+    else:
+        from ..errors import UnreachableTarget
+
+        for k in range(T.shape[0]):
+            try:
+                q = robot.ik(T[k], max_restarts=max(4, int(reach_map.parameters.get("restarts", 2)) * 2), seed=k)
+            except UnreachableTarget:
+                continue
+            if _collision_free(task, robot, q[None])[0]:
+                best[k] = _manipulability(robot, q[None], reach_map.manipulability_kind)[0]
+    per = best.reshape(n, N, R)
+    task_best = np.where(np.isnan(per).all(axis=2), np.nan, np.nanmax(np.where(np.isnan(per), -np.inf, per), axis=2))
+    verified = ~np.isnan(task_best).any(axis=1)
+    wmin = np.where(verified, np.nanmin(np.where(np.isnan(task_best), np.inf, task_best), axis=1), np.nan)
+    return verified, wmin

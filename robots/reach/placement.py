@@ -1,0 +1,251 @@
+"""Where to place the pick/place tables: a radial band of the sampled workspace.
+
+:func:`recommend_region` derives the band from the samples of a
+:class:`~robots.workspace.Workspace` with three criteria, all evaluated per radial shell
+(width ``width``) around the workspace's outer-hull sphere centre (``about="centre"``) or
+around the base's vertical axis (``about="axis"``):
+
+1. **Base plane.** Only samples on the working side of the base plane ``z = 0`` count:
+   ``z > z_clearance`` for a floor-standing arm, ``z < −z_clearance`` for a suspended arm.
+   ``side="auto"`` takes the side holding most samples.
+2. **Outer shell (dexterity).** A shell is rejected when more than ``max_singular_share``
+   of its samples are near-singular (``σ_min/σ_max`` of the position Jacobian below
+   ``singular_threshold``). Near the reach boundary the arm is stretched and this share
+   rises from a few percent to 100 %.
+3. **Crowded centre (own body).** For a seeded sub-sample of ``n_collision`` samples,
+   each configuration is checked for collisions between the arm and its *core* bodies
+   (base, and the bodies carried only by the first ``core_joints`` joints: the turret)
+   with the URDF's collision primitives (:class:`~robots.self_collision.SelfCollision`).
+   A shell is rejected when more than ``max_collision_share`` of its configurations
+   collide so: most ways of reaching it fold the arm onto its own base. Collisions among
+   the moving links (wrist against forearm) are not counted: they depend on the tool
+   orientation, not on where the tool is.
+
+The band is the longest run of consecutive accepted shells. The defaults were chosen from
+the meaning of each share (a usable shell is one where a random configuration is more
+likely usable than not, and at most one in four is near-singular), not from any paper's
+answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidInput
+from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .workspace import Workspace
+
+__all__ = ["RecommendedRegion", "recommend_region"]
+
+
+@dataclass(frozen=True)
+class RecommendedRegion:
+    """A radial band ``r_inner < r < r_outer`` on the working side of the base plane.
+
+    Attributes:
+        robot, frame: what was sampled.
+        about: ``"centre"`` (r = distance to ``origin``) or ``"axis"`` (r = horizontal
+            distance to the vertical line through ``origin``).
+        origin: ``(3,)`` [m].
+        r_inner, r_outer: the band [m] (both NaN when no shell is accepted).
+        side: ``"above"`` (z > z_limit) or ``"below"`` (z < z_limit).
+        z_limit: the plane the band is bounded by [m].
+        edges: ``(k+1,)`` shell radii [m]; ``counts``, ``singular_share``,
+            ``collision_share``, ``collision_checked`` and ``accepted`` are per shell ``(k,)``.
+        criteria: thresholds used (name → value).
+    """
+
+    robot: str
+    frame: str
+    about: str
+    origin: np.ndarray
+    r_inner: float
+    r_outer: float
+    side: str
+    z_limit: float
+    edges: np.ndarray = field(repr=False)
+    counts: np.ndarray = field(repr=False)
+    singular_share: np.ndarray = field(repr=False)
+    collision_share: np.ndarray = field(repr=False)
+    collision_checked: np.ndarray = field(repr=False)
+    accepted: np.ndarray = field(repr=False)
+    criteria: dict = field(default_factory=dict)
+
+    @property
+    def empty(self) -> bool:
+        """True when no shell met the criteria."""
+        return not np.isfinite(self.r_inner)
+
+    def contains(self, points: Any) -> np.ndarray:
+        """``(N,)`` bool: which ``points (N, 3)`` [m] lie in the region."""
+        P = np.atleast_2d(np.asarray(points, dtype=float))
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise InvalidInput(f"points must have shape (N, 3) [m], got {np.shape(points)}")
+        if self.empty:
+            return np.zeros(P.shape[0], dtype=bool)
+        r = radial_distance(P, self.origin, self.about)
+        z_ok = P[:, 2] > self.z_limit if self.side == "above" else P[:, 2] < self.z_limit
+        return (r > self.r_inner) & (r < self.r_outer) & z_ok
+
+    def text(self) -> str:
+        """A readable report (mm)."""
+        mm = 1000.0
+        where = "distance to ({:.0f}, {:.0f}, {:.0f}) mm".format(*(self.origin * mm))
+        if self.about == "axis":
+            where = "horizontal distance to the vertical axis through ({:.0f}, {:.0f}) mm".format(*(self.origin[:2] * mm))
+        head = f"recommended table region of {self.robot} ({self.frame})"
+        if self.empty:
+            return f"{head}: no shell meets the criteria {self.criteria}"
+        lines = [
+            head,
+            f"  z {'>' if self.side == 'above' else '<'} {self.z_limit * mm + 0.0:.0f} mm and "
+            f"{self.r_inner * mm:.0f} mm < r < {self.r_outer * mm:.0f} mm (r = {where})",
+            "  criteria: " + ", ".join(f"{k} = {v:g}" for k, v in self.criteria.items()),
+            "  shell [mm]   samples  near-singular  core collision  accepted",
+        ]
+        for lo, hi, n, s, c, a in zip(
+            self.edges[:-1], self.edges[1:], self.counts, self.singular_share, self.collision_share, self.accepted
+        ):
+            if n:
+                lines.append(f"  {lo * mm:4.0f}-{hi * mm:4.0f}  {n:9d}  {s:12.1%}  {c:14.1%}  {'yes' if a else 'no'}")
+        return "\n".join(lines)
+
+
+def recommend_region(
+    workspace: "Workspace",
+    *,
+    about: str = "centre",
+    origin: Any = None,
+    width: float = 0.025,
+    side: str = "auto",
+    z_clearance: float = 0.0,
+    singular_threshold: float = SINGULAR_INVERSE_CONDITION,
+    max_singular_share: float = 0.25,
+    max_collision_share: float = 0.5,
+    n_collision: int = 10_000,
+    core_joints: int = 1,
+    seed: int = 0,
+) -> RecommendedRegion:
+    """Radial band where tables should stand, from the workspace samples (see the module doc).
+
+    Args:
+        workspace: a sampled workspace (its robot supplies the collision geometry).
+        about: ``"centre"`` (spherical shells) or ``"axis"`` (cylindrical shells).
+        origin: centre of the shells [m]; default: the outer-hull sphere centre (its x, y
+            for ``about="axis"``).
+        width: shell width [m].
+        side: ``"above"``, ``"below"`` or ``"auto"`` (the side of ``z = 0`` with most samples).
+        z_clearance: distance kept from the base plane [m] (≥ 0).
+        singular_threshold, max_singular_share: outer-shell criterion.
+        max_collision_share: crowded-centre criterion; ``n_collision`` samples (seeded by
+            ``seed``) are checked for collisions with the core bodies (base and the
+            bodies of the first ``core_joints`` joints). ``n_collision=0`` skips the check.
+
+    Raises:
+        InvalidInput: an option is out of range.
+    """
+    from ..self_collision import SelfCollision
+
+    if about not in ("centre", "axis"):
+        raise InvalidInput(f"about must be 'centre' or 'axis', got {about!r}")
+    if side not in ("auto", "above", "below"):
+        raise InvalidInput(f"side must be 'auto', 'above' or 'below', got {side!r}")
+    for name, v, lo, hi in (
+        ("width", width, 0.0, np.inf),
+        ("max_singular_share", max_singular_share, 0.0, 1.0),
+        ("max_collision_share", max_collision_share, 0.0, 1.0),
+    ):
+        if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool):
+            raise InvalidInput(f"{name} must be a number, got {v!r}")
+        if name == "width" and not (np.isfinite(v) and v > 0):
+            raise InvalidInput(f"width must be a positive shell width in m, got {v!r}")
+        if name != "width" and not (lo <= v <= hi):
+            raise InvalidInput(f"{name} must be a share in [{lo:g}, {hi:g}], got {v!r}")
+    real = (int, float, np.integer, np.floating)
+    if isinstance(z_clearance, bool) or not isinstance(z_clearance, real) or not (np.isfinite(z_clearance) and z_clearance >= 0):
+        raise InvalidInput(f"z_clearance must be a length ≥ 0 in m, got {z_clearance!r}")
+    singular_threshold = _check_threshold(singular_threshold)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
+    if isinstance(n_collision, bool) or not isinstance(n_collision, (int, np.integer)) or n_collision < 0:
+        raise InvalidInput(f"n_collision must be an integer ≥ 0, got {n_collision!r}")
+
+    P = workspace.points
+    if origin is None:
+        origin = workspace.fit_sphere().centre.copy()
+        if about == "axis":
+            origin[2] = 0.0
+    origin = _as_point(origin, "origin")
+    if side == "auto":
+        side = "above" if np.count_nonzero(P[:, 2] > 0) >= P.shape[0] / 2 else "below"
+    z_limit = z_clearance if side == "above" else -z_clearance
+    side_mask = P[:, 2] > z_limit if side == "above" else P[:, 2] < z_limit
+    keep = np.flatnonzero(side_mask)
+    profile = workspace.radial_profile(
+        origin, about=about, width=width, mask=side_mask, singular_threshold=singular_threshold
+    )
+    edges, counts, singular_share = profile.edges, profile.counts, profile.singular_share
+    k = counts.size
+    shell = np.minimum((radial_distance(P[keep], origin, about) / width).astype(int), k - 1)
+
+    checked = np.zeros(k, dtype=int)
+    collided = np.zeros(k)
+    if n_collision > 0 and keep.size:
+        rng = np.random.default_rng(seed)
+        pick = rng.choice(keep.size, size=min(int(n_collision), keep.size), replace=False)
+        checker = SelfCollision(workspace.robot, seed=seed)
+        hits = checker.in_collision(workspace.q[keep[pick]], pairs=checker.core_pair_mask(core_joints))
+        checked = np.bincount(shell[pick], minlength=k)
+        collided = np.bincount(shell[pick], weights=hits.astype(float), minlength=k)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        collision_share = np.where(checked > 0, collided / np.maximum(checked, 1), np.nan if n_collision else 0.0)
+
+    coll_ok = collision_share <= max_collision_share if n_collision > 0 else np.ones(k, dtype=bool)
+    accepted = (counts > 0) & (singular_share <= max_singular_share) & coll_ok
+    r_in, r_out = _longest_run(accepted, edges)
+    criteria = {
+        "shell width [m]": width,
+        "z clearance [m]": z_clearance,
+        "near-singular sigma_min/sigma_max <": singular_threshold,
+        "max near-singular share": max_singular_share,
+        "max core-collision share": max_collision_share,
+        "core joints": float(core_joints),
+        "self-collision samples": float(min(int(n_collision), keep.size)),
+    }
+    return RecommendedRegion(
+        robot=workspace.robot.name,
+        frame=workspace.frame,
+        about=about,
+        origin=origin,
+        r_inner=r_in,
+        r_outer=r_out,
+        side=side,
+        z_limit=z_limit,
+        edges=edges,
+        counts=counts,
+        singular_share=singular_share,
+        collision_share=collision_share,
+        collision_checked=checked,
+        accepted=accepted,
+        criteria=criteria,
+    )
+
+
+def _longest_run(accepted: np.ndarray, edges: np.ndarray) -> tuple[float, float]:
+    """``(r_inner, r_outer)`` of the longest run of accepted shells (first on ties); NaN if none."""
+    best, start, best_span = None, None, 0
+    for i, a in enumerate(list(accepted) + [False]):
+        if a and start is None:
+            start = i
+        elif not a and start is not None:
+            if i - start > best_span:
+                best, best_span = (start, i), i - start
+            start = None
+    if best is None:
+        return float("nan"), float("nan")
+    return float(edges[best[0]]), float(edges[best[1]])

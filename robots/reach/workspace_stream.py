@@ -1,0 +1,424 @@
+"""Workspaces of 10⁸–10⁹ samples: streamed reductions, flat memory, serial or on Dask.
+
+:func:`stream_workspace` draws the same joint samples as :func:`~robots.workspace.sample_workspace`
+(``robot.random_q(n, seed)``) but never holds them: the samples are cut into tasks of
+``task_samples`` (10⁷ by default, about 10 s each), each task evaluates its samples in
+blocks and returns only reductions, and the reductions are folded **in task order** into
+
+- the bounding box, the mean and maximum position manipulability, the near-singular share;
+- a voxel map (:class:`~robots.voxels.VoxelMap`): samples, mean and minimum manipulability
+  per voxel on a grid anchored at the base origin (voxel ``i`` spans ``[i s, (i+1) s)``),
+  the margin to the boundary as in the in-memory map;
+- the radial profile around a centre fixed before the sweep (see below);
+- the outer-hull sphere: the farthest sample of every direction cell around that centre,
+  then the algebraic sphere through those hull points.
+
+**Same samples, any scheduler.** Task ``k`` draws from the one stream of
+``numpy.random.default_rng(seed)`` jumped ahead (``PCG64.advance``) to its first sample, so
+the samples are those of ``robot.random_q(n, seed)`` whatever the task size, and the folds run
+in task order: the result is identical bit for bit in a serial loop, on local processes or on
+a Dask cluster (:func:`pinarms.execution.map_chunks`).
+
+**Pilot.** The centre of the direction cells and of the radial shells, and the default voxel
+edge, come from a *pilot*: the first ``min(n, 200 000)`` samples of the same stream, held in
+memory (:meth:`~robots.workspace.Workspace.fit_sphere`, :func:`~robots.voxels.suggest_voxel_size`).
+The final sphere is refitted to the hull of all ``n`` samples around the pilot's centre: the
+last of the in-memory fit's iterations. The default voxel edge aims at 10 samples per voxel
+but is never below :data:`MIN_DEFAULT_VOXEL` (memory of the grid: about 40 bytes per voxel of
+the bounding box); pass ``voxel_size`` for a finer map.
+
+Memory: the pilot, the grid, and per task one block of ``block`` samples: flat in ``n``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+
+from ..errors import InvalidInput
+from .voxels import VoxelMap, suggest_voxel_size
+from .workspace import (
+    SINGULAR_INVERSE_CONDITION,
+    RadialProfile,
+    SphereFit,
+    WorkspaceSummary,
+    _check_threshold,
+    _direction_cells,
+    _generator_at,
+    _positions_and_dexterity,
+    fit_sphere,
+    sample_workspace,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..robot import Robot
+
+__all__ = [
+    "StreamedWorkspace",
+    "stream_workspace",
+    "TASK_SAMPLES",
+    "PILOT_SAMPLES",
+    "MIN_DEFAULT_VOXEL",
+    "MAX_STREAM_SAMPLES",
+    "MAX_STREAM_VOXELS",
+]
+
+#: Samples per task (a task evaluates them in blocks and returns reductions only). A task's
+#: result holds its occupied voxels (24 bytes each, up to the whole grid): with 10⁷ samples a
+#: task lasts about 10 s and ships at most a few tens of MB, small beside its work.
+TASK_SAMPLES = 10_000_000
+#: Samples of the in-memory pilot that fixes the shell centre and the default voxel edge.
+PILOT_SAMPLES = 200_000
+#: Smallest default voxel edge [m] (a finer grid must be asked for with ``voxel_size``).
+MIN_DEFAULT_VOXEL = 0.01
+#: Largest ``n`` accepted (10¹²).
+MAX_STREAM_SAMPLES = 10**12
+#: Most voxels of a streamed workspace's map (about 2.4 GB of counts, sums and minima).
+MAX_STREAM_VOXELS = 10**8
+_BLOCK = 262_144
+
+
+# ------------------------------------------------------------------ reductions
+@dataclass
+class _Reduction:
+    """What one task returns and what the folds accumulate (voxels sparse or dense)."""
+
+    n: int = 0
+    bbox_min: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    bbox_max: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
+    sum_w: float = 0.0
+    max_w: float = -np.inf
+    n_singular: int = 0
+    # voxels: dense block ``[lo, lo + shape)`` of global integer indices
+    vox_lo: np.ndarray | None = None
+    vox_count: np.ndarray | None = None
+    vox_sum: np.ndarray | None = None
+    vox_min: np.ndarray | None = None
+    #: what a task ships instead of the dense block: occupied voxels (see :func:`_sparse_voxels`)
+    vox_sparse: tuple | None = None
+    # radial shells around the centre
+    shell_count: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    shell_sum_w: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    shell_singular: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    # direction cells around the centre: farthest sample and samples per cell
+    hull_r: np.ndarray | None = None
+    hull_point: np.ndarray | None = None
+    hull_count: np.ndarray | None = None
+
+
+def _grow(acc: _Reduction, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Make the dense voxel block of ``acc`` cover global indices ``lo … hi`` (inclusive)."""
+    if acc.vox_lo is None:
+        shape = tuple(int(v) for v in hi - lo + 1)
+        acc.vox_lo = lo.copy()
+        acc.vox_count = np.zeros(shape, np.int64)
+        acc.vox_sum = np.zeros(shape)
+        acc.vox_min = np.full(shape, np.inf)
+        return
+    old_lo, old_hi = acc.vox_lo, acc.vox_lo + np.array(acc.vox_count.shape) - 1
+    new_lo, new_hi = np.minimum(old_lo, lo), np.maximum(old_hi, hi)
+    if np.array_equal(new_lo, old_lo) and np.array_equal(new_hi, old_hi):
+        return
+    shape = tuple(int(v) for v in new_hi - new_lo + 1)
+    at = tuple(slice(int(a), int(a) + n) for a, n in zip(old_lo - new_lo, acc.vox_count.shape))
+    for name, fill, dtype in (("vox_count", 0, np.int64), ("vox_sum", 0.0, float), ("vox_min", np.inf, float)):
+        grown = np.full(shape, fill, dtype)
+        grown[at] = getattr(acc, name)
+        setattr(acc, name, grown)
+    acc.vox_lo = new_lo
+
+
+def _add_block(acc: _Reduction, P: np.ndarray, w: np.ndarray, c: np.ndarray, spec: "_Spec") -> None:
+    """Fold one block of samples (points ``P (m, 3)``, manipulability ``w``, inverse condition ``c``)."""
+    m = P.shape[0]
+    singular = c < spec.singular_threshold
+    Pt = np.ascontiguousarray(P.T)  # (3, m): reductions over samples run on contiguous rows
+    acc.n += m
+    acc.bbox_min = np.minimum(acc.bbox_min, Pt.min(axis=1))
+    acc.bbox_max = np.maximum(acc.bbox_max, Pt.max(axis=1))
+    acc.sum_w += float(np.sum(w))
+    acc.max_w = max(acc.max_w, float(np.max(w)))
+    acc.n_singular += int(np.count_nonzero(singular))
+    # voxels on the global grid
+    ijk = np.floor(Pt / spec.voxel_size).astype(np.int64)
+    _grow(acc, ijk.min(axis=1), ijk.max(axis=1))
+    nx, ny, nz = acc.vox_count.shape
+    lo = acc.vox_lo
+    flat = ((ijk[0] - lo[0]) * ny + (ijk[1] - lo[1])) * nz + (ijk[2] - lo[2])
+    size = acc.vox_count.size
+    acc.vox_count.reshape(-1)[:] += np.bincount(flat, minlength=size)
+    acc.vox_sum.reshape(-1)[:] += np.bincount(flat, weights=w, minlength=size)
+    np.minimum.at(acc.vox_min.reshape(-1), flat, w)
+    # radial shells around the centre
+    d0, d1, d2 = Pt[0] - spec.centre[0], Pt[1] - spec.centre[1], Pt[2] - spec.centre[2]
+    r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    shell = (r / spec.width).astype(np.int64)
+    k = int(shell.max()) + 1
+    _pad_shells(acc, k)
+    acc.shell_count[:k] += np.bincount(shell, minlength=k)
+    acc.shell_sum_w[:k] += np.bincount(shell, weights=w, minlength=k)
+    acc.shell_singular[:k] += np.bincount(shell, weights=singular, minlength=k).astype(np.int64)
+    # direction cells: the farthest sample per cell, first sample on ties
+    cell, rc, n_cells = _direction_cells(P, spec.centre, spec.n_dir_bins)
+    if acc.hull_r is None:
+        acc.hull_r = np.full(n_cells, -1.0)
+        acc.hull_point = np.zeros((n_cells, 3))
+        acc.hull_count = np.zeros(n_cells, np.int64)
+    rmax = np.full(n_cells, -1.0)
+    np.maximum.at(rmax, cell, rc)
+    idx = np.flatnonzero(rc == rmax[cell])
+    cells, first = np.unique(cell[idx], return_index=True)
+    better = rmax[cells] > acc.hull_r[cells]
+    acc.hull_r[cells[better]] = rmax[cells[better]]
+    acc.hull_point[cells[better]] = P[idx[first[better]]]
+    acc.hull_count += np.bincount(cell, minlength=n_cells)
+
+
+def _pad_shells(acc: _Reduction, k: int) -> None:
+    if acc.shell_count.size < k:
+        extra = k - acc.shell_count.size
+        acc.shell_count = np.concatenate([acc.shell_count, np.zeros(extra, np.int64)])
+        acc.shell_sum_w = np.concatenate([acc.shell_sum_w, np.zeros(extra)])
+        acc.shell_singular = np.concatenate([acc.shell_singular, np.zeros(extra, np.int64)])
+
+
+def _sparse_voxels(acc: _Reduction) -> tuple:
+    """The occupied voxels of ``acc``, compact for shipping (24 bytes per voxel).
+
+    ``(lo (3,), shape (3,), flat index in that block (int32), count (int32), sum and min of
+    manipulability (float64))``.
+    """
+    flat = np.flatnonzero(acc.vox_count.reshape(-1))
+    index = flat.astype(np.int32) if acc.vox_count.size < 2**31 else flat
+    count = acc.vox_count.reshape(-1)[flat]
+    count = count.astype(np.int32) if count.size and count.max() < 2**31 else count
+    return (acc.vox_lo.copy(), np.array(acc.vox_count.shape), index, count,
+            acc.vox_sum.reshape(-1)[flat], acc.vox_min.reshape(-1)[flat])
+
+
+def _merge(acc: _Reduction, part: _Reduction) -> None:
+    """Fold a task's reduction into the accumulator (the caller keeps task order)."""
+    acc.n += part.n
+    acc.bbox_min = np.minimum(acc.bbox_min, part.bbox_min)
+    acc.bbox_max = np.maximum(acc.bbox_max, part.bbox_max)
+    acc.sum_w += part.sum_w
+    acc.max_w = max(acc.max_w, part.max_w)
+    acc.n_singular += part.n_singular
+    lo, shape, index, count, total, wmin = part.vox_sparse
+    if index.shape[0]:
+        ijk = np.column_stack(np.unravel_index(index.astype(np.int64), tuple(int(v) for v in shape))) + lo
+        _grow(acc, ijk.min(axis=0), ijk.max(axis=0))
+        flat = np.ravel_multi_index((ijk - acc.vox_lo).T, acc.vox_count.shape)
+        acc.vox_count.reshape(-1)[flat] += count
+        acc.vox_sum.reshape(-1)[flat] += total
+        acc.vox_min.reshape(-1)[flat] = np.minimum(acc.vox_min.reshape(-1)[flat], wmin)
+    k = part.shell_count.size
+    _pad_shells(acc, k)
+    acc.shell_count[:k] += part.shell_count
+    acc.shell_sum_w[:k] += part.shell_sum_w
+    acc.shell_singular[:k] += part.shell_singular
+    if acc.hull_r is None:
+        acc.hull_r, acc.hull_point, acc.hull_count = part.hull_r.copy(), part.hull_point.copy(), part.hull_count.copy()
+    else:
+        better = part.hull_r > acc.hull_r  # strict: an earlier task keeps a tie
+        acc.hull_r[better] = part.hull_r[better]
+        acc.hull_point[better] = part.hull_point[better]
+        acc.hull_count += part.hull_count
+
+
+# ------------------------------------------------------------------------ tasks
+@dataclass(frozen=True)
+class _Spec:
+    frame: str
+    voxel_size: float
+    centre: np.ndarray
+    width: float
+    n_dir_bins: int
+    singular_threshold: float
+    block: int
+
+
+@dataclass(frozen=True)
+class WorkspaceTask:
+    """One task of a streamed workspace: samples ``start … start+count-1`` of the seeded stream."""
+
+    robot: Any
+    seed: int
+    start: int
+    count: int
+    spec: _Spec
+
+
+def _run_task(task: WorkspaceTask) -> _Reduction:
+    """Evaluate one task's samples block by block; return its reduction (voxels shipped sparse)."""
+    acc = _Reduction()
+    robot, spec = task.robot, task.spec
+    from pinarms.execution import task_threads
+
+    threads = task_threads()
+    rng = _generator_at(robot, task.seed, task.start)
+    done = 0
+    while done < task.count:
+        m = min(spec.block, task.count - done)
+        q = rng.uniform(robot.lower, robot.upper, size=(m, robot.nq))
+        P, w, c = _positions_and_dexterity(robot, q, spec.frame, threads=threads)
+        _add_block(acc, P, w, c, spec)
+        done += m
+    acc.vox_sparse = _sparse_voxels(acc)
+    acc.vox_lo = acc.vox_count = acc.vox_sum = acc.vox_min = None
+    return acc
+
+
+# ------------------------------------------------------------------------ result
+@dataclass(frozen=True, eq=False)
+class StreamedWorkspace:
+    """Reductions of a streamed workspace (no per-sample arrays).
+
+    Attributes:
+        summary: bounding box, hull sphere, radial profile (around :attr:`centre`),
+            near-singular share, manipulability mean and max (:class:`~robots.workspace.WorkspaceSummary`).
+        voxels: occupancy and manipulability per voxel, margins (:class:`~robots.voxels.VoxelMap`).
+        seed: the seed of the samples (``robot.random_q(n, seed)``).
+        centre: ``(3,)`` centre of the direction cells and of the radial shells [m] (the pilot's hull centre).
+        n_tasks: number of tasks the samples were cut into.
+    """
+
+    summary: WorkspaceSummary
+    voxels: VoxelMap
+    seed: int
+    centre: np.ndarray
+    n_tasks: int
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return self.summary.n
+
+    def text(self) -> str:
+        """The summary's report plus the voxel map's size (mm)."""
+        v = self.voxels
+        return self.summary.text() + (
+            f"\n  voxel map: {v.voxel_size * 1000:.0f} mm voxels, {int(np.count_nonzero(v.reachable))} reachable, "
+            f"reachable volume {v.reachable_volume:.3f} m³"
+        )
+
+
+def stream_workspace(
+    robot: "Robot",
+    n: int,
+    seed: int = 0,
+    frame: str = "tcp",
+    *,
+    voxel_size: float | None = None,
+    width: float = 0.05,
+    singular_threshold: float = SINGULAR_INVERSE_CONDITION,
+    task_samples: int = TASK_SAMPLES,
+    block: int = _BLOCK,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> StreamedWorkspace:
+    """Workspace statistics of ``n`` samples in flat memory (see the module docstring).
+
+    Args:
+        robot: any :class:`~robots.robot.Robot` with finite joint limits.
+        n: number of samples (10⁸ take about 1.5 min on one core for a 6-axis arm).
+        seed: a non-negative integer (the samples are ``robot.random_q(n, seed)``).
+        frame: the frame whose origin is sampled.
+        voxel_size: voxel edge [m]; default from the pilot (≥ :data:`MIN_DEFAULT_VOXEL`).
+        width: radial shell width [m].
+        singular_threshold: ``σ_min/σ_max`` of ``J_v`` below which a sample is near-singular.
+        task_samples: samples per task (a task should last a second or more on a cluster).
+        block: samples evaluated at once inside a task (bounds a task's memory).
+        scheduler, progress: see :func:`pinarms.execution.map_chunks`.
+
+    Raises:
+        InvalidInput: a bad count, seed, size or frame.
+        ExecutionError: a task failed or its worker died (chunk index and start sample named).
+    """
+    from pinarms.execution import reduce_chunks
+
+    for name, v, least in (("n", n, 1), ("task_samples", task_samples, 1), ("block", block, 1)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+            raise InvalidInput(f"{name} must be a positive integer, got {v!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInput(f"a streamed workspace needs an integer seed >= 0 (tasks re-create the stream), got {seed!r}")
+    if not (isinstance(width, (int, float, np.integer, np.floating)) and np.isfinite(width) and width > 0):
+        raise InvalidInput(f"shell width must be a positive length in m, got {width!r}")
+    singular_threshold = _check_threshold(singular_threshold)
+    if voxel_size is not None and not (
+        isinstance(voxel_size, (int, float, np.integer, np.floating)) and np.isfinite(voxel_size) and voxel_size > 0
+    ):
+        raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
+    n, seed = int(n), int(seed)
+    if n > MAX_STREAM_SAMPLES:
+        raise InvalidInput(f"n = {n:,} samples is more than {MAX_STREAM_SAMPLES:,} (about a week on 100 cores)")
+    pilot = sample_workspace(robot, min(n, PILOT_SAMPLES), seed=seed, frame=frame)
+    centre = pilot.fit_sphere().centre
+    if voxel_size is None:
+        per_pilot = 10.0 * pilot.n / n  # 10 samples per voxel at n samples
+        voxel_size = max(suggest_voxel_size(pilot.points, samples_per_voxel=per_pilot), MIN_DEFAULT_VOXEL)
+    extent = np.ptp(pilot.points, axis=0) * 1.5  # the pilot sees most of the box; the rest stays in the margin
+    n_voxels = float(np.prod(np.floor(extent / float(voxel_size)) + 1.0))
+    if n_voxels > MAX_STREAM_VOXELS:
+        raise InvalidInput(f"voxel_size {float(voxel_size):g} m makes about {n_voxels:.3g} voxels over the workspace, "
+                           f"more than {MAX_STREAM_VOXELS:.0e} (3 arrays of 8 bytes each): give a larger voxel_size")
+    spec = _Spec(
+        frame=frame,
+        voxel_size=float(voxel_size),
+        centre=centre,
+        width=float(width),
+        n_dir_bins=int(np.clip(n // 30, 32, 2048)),
+        singular_threshold=singular_threshold,
+        block=int(block),
+    )
+    tasks, start = [], 0
+    while start < n:
+        count = min(int(task_samples), n - start)
+        tasks.append(WorkspaceTask(robot, seed, start, count, spec))
+        start += count
+    acc = reduce_chunks(_run_task, tasks, _merge_into, _Reduction(), scheduler=scheduler, progress=progress)
+    return _finish(robot, frame, seed, n, spec, acc, len(tasks))
+
+
+def _merge_into(acc: _Reduction, part: _Reduction) -> _Reduction:
+    _merge(acc, part)
+    return acc
+
+
+def _finish(robot, frame, seed, n, spec: _Spec, acc: _Reduction, n_tasks: int) -> StreamedWorkspace:
+    # voxel map on the global grid, cropped to the occupied block
+    origin = acc.vox_lo * spec.voxel_size
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(acc.vox_count > 0, acc.vox_sum / acc.vox_count, np.nan)
+    wmin = np.where(acc.vox_count > 0, acc.vox_min, np.nan)
+    voxels = VoxelMap.from_counts(origin, spec.voxel_size, acc.vox_count, mean, wmin)
+    # hull sphere through the farthest sample of each direction cell
+    hull = acc.hull_point[acc.hull_count > 0]
+    fit = fit_sphere(hull)
+    coverage = float(np.count_nonzero(acc.hull_count) / acc.hull_count.size)
+    sphere = SphereFit(fit.centre, fit.radius, fit.rms_residual, fit.max_residual, fit.n_points, "outer-hull", coverage)
+    # radial profile
+    k = acc.shell_count.size
+    edges = np.arange(k + 1) * spec.width
+    vol = 4.0 / 3.0 * np.pi * (edges[1:] ** 3 - edges[:-1] ** 3)
+    counts = acc.shell_count
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean_w = np.where(counts > 0, acc.shell_sum_w / counts, np.nan)
+        sing = np.where(counts > 0, acc.shell_singular / counts, np.nan)
+    profile = RadialProfile("centre", spec.centre.copy(), edges, counts, counts / vol, mean_w, sing)
+    summary = WorkspaceSummary(
+        robot=robot.name,
+        frame=frame,
+        n=n,
+        bbox_min=acc.bbox_min,
+        bbox_max=acc.bbox_max,
+        sphere=sphere,
+        profile=profile,
+        singular_threshold=spec.singular_threshold,
+        singular_share=acc.n_singular / n,
+        manipulability_mean=acc.sum_w / n,
+        manipulability_max=acc.max_w,
+    )
+    return StreamedWorkspace(summary=summary, voxels=voxels, seed=seed, centre=spec.centre.copy(), n_tasks=n_tasks)
