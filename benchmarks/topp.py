@@ -48,24 +48,11 @@ def toppra_algorithm(path, v: np.ndarray, a: np.ndarray, grid: np.ndarray):
     import toppra
     import toppra.algorithm
     import toppra.constraint
-    from toppra.interpolator import AbstractGeometricPath
-
-    class _Adapter(AbstractGeometricPath):
-        def __call__(self, s, order=0):
-            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
-            return out[0] if np.ndim(s) == 0 else out
-
-        @property
-        def dof(self):
-            return path.n_joints
-
-        @property
-        def path_interval(self):
-            return np.array([0.0, path.length])
+    from pinarms.optim.timing.reference import toppra_path
 
     cons = [toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
             toppra.constraint.JointAccelerationConstraint(np.column_stack([-a, a]))]
-    return toppra.algorithm.TOPPRA(cons, _Adapter(), gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    return toppra.algorithm.TOPPRA(cons, toppra_path(path), gridpoints=grid, parametrizer="ParametrizeConstAccel")
 
 
 def main() -> None:

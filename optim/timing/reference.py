@@ -28,7 +28,7 @@ import numpy as np
 from pinarms.optim.errors import OptimError
 from pinarms.optim.ga.problem import check_limit
 
-__all__ = ["path_velocity_limit", "toppra_limit", "toppra_path_duration", "ruckig_limit", "double_s_limit",
+__all__ = ["path_velocity_limit", "toppra_limit", "toppra_path", "toppra_path_duration", "ruckig_limit", "double_s_limit",
            "MissingReference"]
 
 
@@ -141,6 +141,30 @@ def toppra_limit(trajectory: Any, vmax: Any, amax: Any = None, n: int = 400, *, 
     return duration
 
 
+def toppra_path(path: Any) -> Any:
+    """``path`` (a :class:`planning.JointPath`) as toppra's geometric path: toppra reads q, q', q''
+    through ``path.sample(s)`` directly (no spline fitted in between)."""
+    try:
+        from toppra.interpolator import AbstractGeometricPath
+    except ImportError as exc:  # pragma: no cover - toppra is in the test extra
+        raise MissingReference("toppra is not installed: pip install 'pinarms[reference]'") from exc
+
+    class _Adapter(AbstractGeometricPath):
+        def __call__(self, s, order=0):
+            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
+            return out[0] if np.ndim(s) == 0 else out
+
+        @property
+        def dof(self):
+            return path.n_joints
+
+        @property
+        def path_interval(self):
+            return np.array([0.0, path.length])
+
+    return _Adapter()
+
+
 def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, tool_speed: float | None = None,
                          discretization: str = "interpolation") -> float:
     """Duration (s) of toppra's time-optimal parameterisation of ``path`` (a :class:`planning.JointPath`).
@@ -158,22 +182,8 @@ def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, to
         import toppra
         import toppra.algorithm
         import toppra.constraint
-        from toppra.interpolator import AbstractGeometricPath
     except ImportError as exc:  # pragma: no cover - toppra is in the test extra
         raise MissingReference("toppra is not installed: pip install 'pinarms[reference]'") from exc
-
-    class _Adapter(AbstractGeometricPath):
-        def __call__(self, s, order=0):
-            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
-            return out[0] if np.ndim(s) == 0 else out
-
-        @property
-        def dof(self):
-            return path.n_joints
-
-        @property
-        def path_interval(self):
-            return np.array([0.0, path.length])
 
     dof = path.n_joints
     v = check_limit(vmax, dof, "vmax", required=True)
@@ -193,7 +203,7 @@ def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, to
         constraints.append(toppra.constraint.SecondOrderConstraint(
             speed_squared, lambda q: F, lambda q: g, dof, discretization_scheme=scheme))
     grid = np.asarray(gridpoints, dtype=float)
-    algo = toppra.algorithm.TOPPRA(constraints, _Adapter(), gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    algo = toppra.algorithm.TOPPRA(constraints, toppra_path(path), gridpoints=grid, parametrizer="ParametrizeConstAccel")
     out = algo.compute_parameterization(0.0, 0.0)
     sd = out[1] if isinstance(out, tuple) else None
     if sd is None or np.any(~np.isfinite(sd)):

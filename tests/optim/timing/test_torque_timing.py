@@ -140,20 +140,7 @@ def _toppra_torque(path, robot, vmax, grid):
     import toppra
     import toppra.algorithm
     import toppra.constraint
-    from toppra.interpolator import AbstractGeometricPath
-
-    class Adapter(AbstractGeometricPath):
-        def __call__(self, s, order=0):
-            out = path.sample(np.atleast_1d(np.asarray(s, dtype=float)))[order]
-            return out[0] if np.ndim(s) == 0 else out
-
-        @property
-        def dof(self):
-            return path.n_joints
-
-        @property
-        def path_interval(self):
-            return np.array([0.0, path.length])
+    from pinarms.optim.timing.reference import toppra_path
 
     L, v = robot.effort_limit, np.asarray(vmax, dtype=float)
     constraints = [toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
@@ -161,7 +148,7 @@ def _toppra_torque(path, robot, vmax, grid):
                        lambda q, qd, qdd: robot.inverse_dynamics(q, qd, qdd), np.column_stack([-L, L]),
                        np.zeros(path.n_joints),
                        discretization_scheme=toppra.constraint.DiscretizationType.Interpolation)]
-    algo = toppra.algorithm.TOPPRA(constraints, Adapter(), gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    algo = toppra.algorithm.TOPPRA(constraints, toppra_path(path), gridpoints=grid, parametrizer="ParametrizeConstAccel")
     sd = np.asarray(algo.compute_parameterization(0.0, 0.0)[1], dtype=float)
     return float(np.sum(2.0 * np.diff(grid) / (sd[:-1] + sd[1:])))
 
