@@ -14,6 +14,9 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+import distributed  # noqa: F401  (loads distributed's defaults into dask's config before any test overrides a
+#                    key: a first import inside ``dask.config.set`` is undone with it, leaving later tests of the
+#                    worker without any distributed setting)
 import pytest
 
 #: The group of the tests that use :func:`quick_study`: one worker builds each study once for all of them.

@@ -163,6 +163,8 @@ def test_env_scheduler_reads_the_standard_variable(monkeypatch):
 
 def test_unreachable_scheduler_is_a_named_error():
     import dask
+    import distributed  # noqa: F401  (its defaults in dask's config before the override: leaving the override
+    #                                  restores the config as it was, without what a first import added inside it)
 
     # a closed port on this machine; Dask retries until its standard connect timeout
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), pytest.raises(ExecutionError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
