@@ -26,7 +26,7 @@ try:  # POSIX; elsewhere leftovers are recognised by age alone
 except ImportError:  # pragma: no cover - Windows
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["atomic_write", "write_text", "temporary_for", "publish", "clean_leftovers", "STALE_AFTER_S"]
+__all__ = ["atomic_write", "write_text", "temporary_for", "publish", "discard", "clean_leftovers", "STALE_AFTER_S"]
 
 STALE_AFTER_S = 2.0
 """A ``.part`` file is a leftover once unlocked and unmodified for this long (s); without flock: 1 hour."""
@@ -125,6 +125,14 @@ def publish(tmp: str | os.PathLike, target: str | os.PathLike) -> Path:
     return Path(target)
 
 
+def discard(tmp: str | os.PathLike) -> None:
+    """Remove an unfinished temporary file (gone already: nothing to do)."""
+    try:
+        os.unlink(tmp)
+    except FileNotFoundError:
+        pass
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> Path:
     """Write ``path`` through ``write(fileobj)`` atomically; return the path.
 
@@ -148,10 +156,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> 
             os.chmod(tmp, _default_mode())
             os.replace(tmp, target)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        discard(tmp)
         raise
     return target
 

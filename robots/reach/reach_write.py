@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.files import publish, temporary_for
+from pinarms.files import discard, publish, temporary_for
 
 from ..errors import InvalidInput
 
@@ -135,10 +135,7 @@ class StreamWriter:
         try:
             self.h5.close()
         finally:
-            try:
-                os.unlink(self.tmp)
-            except FileNotFoundError:
-                pass
+            discard(self.tmp)
 
 
 def write_map(reach_map: Any, path: str | os.PathLike) -> Path:
@@ -158,9 +155,6 @@ def write_map(reach_map: Any, path: str | os.PathLike) -> Path:
             _write(h5, reach_map)
         publish(tmp, target)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        discard(tmp)
         raise
     return target

@@ -7,26 +7,14 @@ shortened to one microsecond so that threads interleave inside every call.
 
 from __future__ import annotations
 
-import sys
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-import pytest
 
 from pinarms import planning
 from pinarms.robots.cell import ArmMotion, load_cell
 
 MARGINS = (0.0, 0.004, 0.012, 0.03)
-
-
-@pytest.fixture
-def fast_switching():
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
-        yield
-    finally:
-        sys.setswitchinterval(old)
 
 
 def _motion(cell, k):

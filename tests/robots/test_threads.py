@@ -8,7 +8,6 @@ is shortened to one microsecond here, so that threads interleave inside every ca
 
 from __future__ import annotations
 
-import sys
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -16,16 +15,6 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import UnreachableTarget
-
-
-@pytest.fixture
-def fast_switching():
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
-        yield
-    finally:
-        sys.setswitchinterval(old)
 
 
 def _work(robot, q, T, k):
