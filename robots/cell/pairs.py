@@ -144,7 +144,12 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
 
 
 def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
-    """Split every pair of the cell's collision geometries into checked and allowed pairs."""
+    """Split every pair of the cell's collision geometries into checked and allowed pairs.
+
+    The rules by design and the proof of reach first (:func:`_by_design`, :func:`_reach_gaps`),
+    then the seeded sampling of the pairs left (:func:`_sampled_reasons`); the checked pairs
+    come back arm-fixture first, then arm-arm, then self.
+    """
     model, gm = cell.model, cell.collision_model
     objs = list(gm.geometryObjects)
     G = len(objs)
@@ -155,21 +160,76 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     # reach balls of moving geometries, boxes of static ones (world frame, neutral configuration)
     data = model.createData()
     gd = pin.GeometryData(gm)
-    q0 = pin.neutral(model)
-    pin.updateGeometryPlacements(model, data, gm, gd, q0)
-    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
+    pin.updateGeometryPlacements(model, data, gm, gd, pin.neutral(model))
     spheres = [_local_sphere(g.geometry) for g in objs]
-    ball_center = np.zeros((G, 3))
-    ball_radius = np.zeros(G)
+    box_R, box_c, box_half = _neutral_boxes(gd, spheres)
+    ball_center, ball_radius = _reach_balls(model, data, objs, joint, spheres)
+    gaps = _reach_gaps(np.array(joint), ball_center, ball_radius, box_R, box_c, box_half, owner)
+    cylinders = root_cylinders(model, data, objs, joint, ball_radius)
+
+    def placement(k: int) -> coal.Transform3s:
+        return coal.Transform3s(gd.oMg[k].rotation, gd.oMg[k].translation)
+    checked: list[tuple[int, int]] = []
+    allowed: list[AllowedPair] = []
+
+    def allow(a: int, b: int, reason: str, bound: float = float("inf")) -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
+
+    for a in range(G):
+        for b in range(a + 1, G):
+            reason = _by_design(model, a, b, link, owner, eff)
+            if reason is not None:
+                allow(a, b, reason)
+            elif gaps[a, b] > 0.0:
+                allow(a, b, "out of reach", tighter_bound(gaps[a, b], a, b, objs, joint, ball_center, ball_radius,
+                                                          placement, cylinders))
+            else:
+                checked.append((a, b))
+
+    from .limits import check_pairs
+
+    check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
+    keep = []
+    for (a, b), reason in zip(checked, _sampled_reasons(cell, objs, data, checked, seed)):
+        if reason is None:
+            keep.append((a, b))
+        else:
+            allow(a, b, reason)
+
+    pairs = [_pair(a, b, objs, link, owner, is_arm) for a, b in keep]
+    order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
+    pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
+    return tuple(pairs), tuple(allowed)
+
+
+def _neutral_boxes(gd: pin.GeometryData, spheres: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Oriented boxes of every geometry at the neutral configuration: rotations ``(G, 3, 3)``, centres and half extents ``(G, 3)``."""
+    G = len(spheres)
     box_R = np.zeros((G, 3, 3))
     box_c = np.zeros((G, 3))
     box_half = np.zeros((G, 3))
-    for k, g in enumerate(objs):
-        center, radius, half = spheres[k]
+    for k, (center, _, half) in enumerate(spheres):
         M = gd.oMg[k]
         box_R[k], box_c[k], box_half[k] = M.rotation, M.rotation @ center + M.translation, half
+    return box_R, box_c, box_half
+
+
+def _reach_balls(model: pin.Model, data: pin.Data, objs: list, joint: list[int],
+                 spheres: list) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ``(G, 3)`` and radii ``(G,)`` of the balls every moving geometry stays in (0 for static ones).
+
+    The centre is the origin of the geometry's root joint (the arm's first joint, at the
+    neutral ``data``); the radius adds the joint offsets along the chain, the prismatic
+    strokes and the geometry's own bounding sphere (triangle inequality).
+    """
+    G = len(objs)
+    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
+    ball_center = np.zeros((G, 3))
+    ball_radius = np.zeros(G)
+    for k, g in enumerate(objs):
         if joint[k] == 0:
             continue
+        center, radius, _ = spheres[k]
         r = _root_joint(model, joint[k])
         ball_center[k] = data.oMi[r].translation
         total, j = float(np.linalg.norm(g.placement.act(center))) + radius, joint[k]
@@ -184,77 +244,59 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
                 total += scale * stroke
             j = model.parents[j]
         ball_radius[k] = total
+    return ball_center, ball_radius
 
-    gaps = _reach_gaps(np.array(joint), ball_center, ball_radius, box_R, box_c, box_half, owner)
-    cylinders = root_cylinders(model, data, objs, joint, ball_radius)
 
-    def placement(k: int) -> coal.Transform3s:
-        return coal.Transform3s(gd.oMg[k].rotation, gd.oMg[k].translation)
-    checked: list[tuple[int, int]] = []
-    allowed: list[AllowedPair] = []
+def _by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[str], eff: list[int]) -> str | None:
+    """``"same link"``, ``"rigid"`` or ``"adjacent"`` when the structure allows the pair ``(a, b)``, else ``None``."""
+    if link[a] == link[b]:
+        return "same link"
+    ea, eb = eff[a], eff[b]
+    if ea == eb:
+        return "rigid"
+    adjacent = (ea > 0 and eb > 0 and (_effective(model, model.parents[ea]) == eb or _effective(model, model.parents[eb]) == ea))
+    if (ea == 0 or eb == 0) and owner[a] == owner[b]:
+        moving = b if ea == 0 else a
+        adjacent = _effective(model, model.parents[eff[moving]]) == 0
+    return "adjacent" if adjacent else None
 
-    def allow(a: int, b: int, reason: str, bound: float = float("inf")) -> None:
-        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
 
-    for a in range(G):
-        for b in range(a + 1, G):
-            if link[a] == link[b]:
-                allow(a, b, "same link")
-                continue
-            ea, eb = eff[a], eff[b]
-            if ea == eb:
-                allow(a, b, "rigid")
-                continue
-            adjacent = (ea > 0 and eb > 0 and (_effective(model, model.parents[ea]) == eb or _effective(model, model.parents[eb]) == ea))
-            if (ea == 0 or eb == 0) and owner[a] == owner[b]:
-                moving = b if ea == 0 else a
-                adjacent = _effective(model, model.parents[eff[moving]]) == 0
-            if adjacent:
-                allow(a, b, "adjacent")
-                continue
-            gap = gaps[a, b]
-            if gap > 0.0:
-                allow(a, b, "out of reach", tighter_bound(gap, a, b, objs, joint, ball_center, ball_radius, placement,
-                                                          cylinders))
-                continue
-            checked.append((a, b))
+def _sampled_reasons(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
+                     seed: int) -> list[str | None]:
+    """For each pair, ``"always"`` or ``"constant"`` from :data:`ALWAYS_SAMPLES` seeded random configurations, else ``None``.
 
-    from .limits import check_pairs
-
-    check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
-    # "always": pairs in contact in at least ALWAYS_SHARE of random configurations
-    if checked:
-        probe = pin.GeometryModel()
-        for g in objs:
-            probe.addGeometryObject(g)
-        for a, b in checked:
-            probe.addCollisionPair(pin.CollisionPair(a, b))
-        pd = cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
-        qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
-        hits = np.zeros(len(checked))
-        dmin = np.full(len(checked), np.inf)
-        dmax = np.full(len(checked), -np.inf)
-        for q in np.atleast_2d(qs):
-            pin.updateGeometryPlacements(model, data, probe, pd, q)
-            pin.computeCollisions(probe, pd, False)
-            pin.computeDistances(probe, pd)
-            hits += [r.isCollision() for r in pd.collisionResults]
-            d = np.array([r.min_distance for r in pd.distanceResults])
-            dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
-        keep = []
-        for k, ((a, b), h) in enumerate(zip(checked, hits)):
-            if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
-                allow(a, b, "always")
-            elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
-                allow(a, b, "constant")
-            else:
-                keep.append((a, b))
-        checked = keep
-
-    pairs = [_pair(a, b, objs, link, owner, is_arm) for a, b in checked]
-    order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
-    pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
-    return tuple(pairs), tuple(allowed)
+    ``"always"``: in contact in at least :data:`ALWAYS_SHARE` of them; ``"constant"``: apart
+    by the same distance (within 1e-9 m) in all of them.
+    """
+    if not checked:
+        return []
+    model = cell.model
+    probe = pin.GeometryModel()
+    for g in objs:
+        probe.addGeometryObject(g)
+    for a, b in checked:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    pd = cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
+    qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
+    hits = np.zeros(len(checked))
+    dmin = np.full(len(checked), np.inf)
+    dmax = np.full(len(checked), -np.inf)
+    for q in np.atleast_2d(qs):
+        pin.updateGeometryPlacements(model, data, probe, pd, q)
+        pin.computeCollisions(probe, pd, False)
+        pin.computeDistances(probe, pd)
+        hits += [r.isCollision() for r in pd.collisionResults]
+        d = np.array([r.min_distance for r in pd.distanceResults])
+        dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
+    reasons: list[str | None] = []
+    for k, h in enumerate(hits):
+        if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
+            reasons.append("always")
+        elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
+            reasons.append("constant")
+        else:
+            reasons.append(None)
+    return reasons
 
 
 def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
