@@ -20,8 +20,10 @@ from .compose import (
     read_cell_description,
 )
 from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
-from .motion import ArmMotion, Contact, MotionCheck, check_motion
+from .motion import check_motion
+from .motion_report import Contact, MotionCheck
 from .pairs import AllowedPair, CollisionPair
+from .timeline import ArmMotion
 from ..errors import CellTooLarge
 
 __all__ = [
