@@ -8,8 +8,9 @@
 False
 """
 
-from .cell import Cell, CellArm, Fixture, Shape
+from .cell import Cell
 from .collision import Clearance, Collisions
+from .components import CellArm, Fixture, Shape
 from .compose import (
     ArmPlacement,
     CellDescription,

@@ -10,126 +10,29 @@ Collision checks live in :mod:`.collision` (:meth:`Cell.in_collision`,
 :meth:`Cell.collisions`, :meth:`Cell.clearance`) and :mod:`.motion`
 (:meth:`Cell.check_motion`); the pairs they check and the pairs they skip, with the
 reason, in :attr:`Cell.pairs` and :attr:`Cell.allowed` (:mod:`.pairs`); the pairs a check at a
-clearance looks at in :meth:`Cell.pairs_for`.
+clearance looks at in :meth:`Cell.pairs_for`. The arms and fixtures (:class:`~.components.CellArm`,
+:class:`~.components.Fixture`) are in :mod:`.components`, the steps that build them from the
+URDF in :mod:`.assembly`, the URDF edit behind :meth:`Cell.with_arm_base` in :mod:`.move_arm`.
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
-import coal
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
-from ..errors import CellError, CellTooLarge, CollisionGeometryError, InvalidInput
+from ..errors import CellError, CellTooLarge, InvalidInput
 from ..robot import Robot
-from ..xacro_expand import mesh_path
-from .description import ArmSpec, CellSpec, arm_urdf, describe
+from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
+from .components import CellArm, Fixture
+from .description import CellSpec, describe
+from .move_arm import urdf_with_arm_base
 from .placements import BatchedPlacements
 
-__all__ = ["Cell", "CellArm", "Fixture", "Shape"]
-
-
-@dataclass(frozen=True, eq=False)
-class CellArm:
-    """One arm of a cell.
-
-    Attributes:
-        name: the arm's name in the cell (``"left"``).
-        robot: the arm alone (link and joint names without the prefix, its base link as
-            root): IK, limits and trajectories work on it as on any :class:`Robot`.
-        base_to_world: ``(4, 4)`` pose of the arm's base frame in the world [m].
-        q_slice: the arm's coordinates in the cell joint vector.
-        prefix: what the arm's names carry in the cell (``"left_"``).
-        model: the built-in arm it is (``"scara_mushroom"``), told from its kinematics, never
-            from names (:func:`~pinarms.robots.registry.match_builtin`), or ``None``.
-    """
-
-    name: str
-    robot: Robot
-    base_to_world: np.ndarray
-    q_slice: slice
-    prefix: str
-    model: str | None
-
-    @property
-    def nq(self) -> int:
-        """Number of the arm's joint coordinates."""
-        return self.robot.nq
-
-    @property
-    def ik_family(self) -> str | None:
-        """The closed-form IK family recognised from the arm's geometry (``robot.ik_family``), or ``None``."""
-        return self.robot.ik_family
-
-    def to_world(self, pose: Any) -> np.ndarray:
-        """A pose ``(4, 4)`` / ``(N, 4, 4)`` or a point ``(3,)`` / ``(N, 3)`` from the arm's base frame to the world."""
-        arr = np.asarray(pose, dtype=float)
-        if arr.shape[-2:] == (4, 4):
-            return self.base_to_world @ arr
-        if arr.shape[-1:] == (3,):
-            return arr @ self.base_to_world[:3, :3].T + self.base_to_world[:3, 3]
-        raise InvalidInput(f"to_world takes poses (4, 4) or points (3,), got shape {arr.shape}")
-
-    def to_base(self, pose: Any) -> np.ndarray:
-        """Inverse of :meth:`to_world`: world pose(s) or point(s) in the arm's base frame."""
-        inv = np.linalg.inv(self.base_to_world)
-        arr = np.asarray(pose, dtype=float)
-        if arr.shape[-2:] == (4, 4):
-            return inv @ arr
-        if arr.shape[-1:] == (3,):
-            return arr @ inv[:3, :3].T + inv[:3, 3]
-        raise InvalidInput(f"to_base takes poses (4, 4) or points (3,), got shape {arr.shape}")
-
-    def tcp_to_world(self, q_arm: Any) -> np.ndarray:
-        """Pose(s) of the arm's tcp in the world for the arm's own ``q (nq,)`` / ``(N, nq)``."""
-        return self.base_to_world @ self.robot.fk(q_arm)
-
-
-@dataclass(frozen=True, eq=False)
-class Shape:
-    """One collision primitive of a fixture.
-
-    Attributes:
-        kind: ``"box"``, ``"cylinder"``, ``"sphere"``, ``"capsule"`` or ``"mesh"``.
-        size: box ``(sx, sy, sz)``, cylinder and capsule ``(radius, length)`` along local
-            z, sphere ``(radius,)``, mesh its scale ``(x, y, z)`` [m or 1].
-        shape_to_world: ``(4, 4)`` pose of the primitive's centre (mesh: its origin).
-        mesh: the mesh file as the URDF names it (``None`` for primitives).
-        geometry: its name in :attr:`Cell.collision_model`.
-    """
-
-    kind: str
-    size: tuple[float, ...]
-    shape_to_world: np.ndarray
-    mesh: str | None
-    geometry: str
-
-
-@dataclass(frozen=True, eq=False)
-class Fixture:
-    """A fixed body of the cell (a link without joints to the arms): name and shapes."""
-
-    name: str
-    shapes: tuple[Shape, ...]
-
-
-def _shape_of(geometry: Any) -> tuple[str, tuple[float, ...]]:
-    if isinstance(geometry, coal.Box):
-        return "box", tuple(float(v) for v in 2.0 * np.asarray(geometry.halfSide))
-    if isinstance(geometry, coal.Cylinder):
-        return "cylinder", (float(geometry.radius), float(2.0 * geometry.halfLength))
-    if isinstance(geometry, coal.Capsule):
-        return "capsule", (float(geometry.radius), float(2.0 * geometry.halfLength))
-    if isinstance(geometry, coal.Sphere):
-        return "sphere", (float(geometry.radius),)
-    if isinstance(geometry, (coal.BVHModelBase, coal.ConvexBase)):
-        return "mesh", ()
-    return type(geometry).__name__, ()
+__all__ = ["Cell"]
 
 
 class Cell:
@@ -195,127 +98,22 @@ class Cell:
             raise CellError(f"Pinocchio cannot build a model of {source}: {exc}") from exc
         tcp = next((a.prefix + "tcp" for a in spec.arms if model.existFrame(a.prefix + "tcp")), None)
         tcp = tcp or model.frames[len(model.frames) - 1].name
+        dirs = package_dirs(self._base_dir, self._packages)
         self.robot = Robot(model, name=self.name, urdf_text=urdf_text, tcp_frame=tcp, description=f"cell {self.name}",
-                           package_dirs=tuple(self._package_dirs()))
+                           package_dirs=tuple(dirs))
         self.model = model
-        self.arms = tuple(self._build_arm(root, arm) for arm in spec.arms)
-        self.arms = tuple(sorted(self.arms, key=lambda a: a.q_slice.start))
+        arms = tuple(build_arm(model, self.robot, root, arm, source=source, cell_name=self.name, dirs=dirs)
+                     for arm in spec.arms)
+        self.arms = tuple(sorted(arms, key=lambda a: a.q_slice.start))
         self._arm_index = {a.name: k for k, a in enumerate(self.arms)}
-        self.collision_model = self._build_geometry(root)
+        self.collision_model = build_geometry(model, root, source=source, base_dir=self._base_dir,
+                                              packages=self._packages)
         self._placements = BatchedPlacements(model)
-        self._pin_index = self._plain_pin_index()
-        self.fixtures = self._fixtures()
+        self._pin_index = plain_pin_index(model, self.nq)
+        self.fixtures = read_fixtures(model, self.collision_model, spec.fixtures, urdf_text)
         self.pairs, self.allowed = classify_pairs(self, seed=seed)
         self.kinds: tuple[str, ...] = ("self", "arm-arm", "arm-fixture")
         self._finish_geometry()
-
-    # ------------------------------------------------------------------ building
-    def _build_arm(self, root: ET.Element, spec: ArmSpec) -> CellArm:
-        from ..registry import from_urdf_text, match_builtin
-
-        text = arm_urdf(root, spec)
-        # closed-form IK by geometry (robot.ik_family); the built-in it is by kinematics, not names
-        robot = from_urdf_text(text, tcp=None, name=spec.name, source=f"arm {spec.name!r} of {self.source}",
-                               package_dirs=tuple(self._package_dirs()))
-        model_name = match_builtin(robot)
-        robot.description = f"{model_name or 'arm'} {spec.name!r} of cell {self.name}"
-        cell_names = self.robot.joint_names
-        idx = [cell_names.index(spec.prefix + j) if spec.prefix + j in cell_names else -1 for j in robot.joint_names]
-        if -1 in idx or idx != list(range(idx[0], idx[0] + len(idx))):
-            raise CellError(
-                f"{self.source}: the joints of arm {spec.name!r} are not one block of the cell's joint vector "
-                f"(cell joints {list(cell_names)}); an arm must be one subtree below its base"
-            )
-        base_id = self.model.getFrameId(spec.base_link)
-        data = self.model.createData()
-        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
-        base_to_world = data.oMf[base_id].homogeneous.copy()
-        return CellArm(
-            name=spec.name,
-            robot=robot,
-            base_to_world=base_to_world,
-            q_slice=slice(idx[0], idx[0] + len(idx)),
-            prefix=spec.prefix,
-            model=model_name,
-        )
-
-    def _plain_pin_index(self) -> np.ndarray | None:
-        """Where each cell coordinate sits in Pinocchio's q, when every joint stores one value (else ``None``)."""
-        index = np.full(self.nq, -1, dtype=int)
-        for i in range(1, self.model.njoints):
-            joint = self.model.joints[i]
-            if "Mimic" in joint.shortname():
-                continue
-            if joint.nq != 1:
-                return None  # a continuous joint (cos, sin): use Robot.q_to_pinocchio
-            index[joint.idx_v] = joint.idx_q
-        return None if (index < 0).any() else index
-
-    def _package_dirs(self) -> list[str]:
-        from ..xacro_expand import BUILTIN_PACKAGE
-
-        return [str(self._base_dir.resolve()), str(BUILTIN_PACKAGE[1]), *(str(Path(v)) for v in self._packages.values())]
-
-    def _resolved_urdf(self, root: ET.Element) -> str:
-        """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""
-        resolved = ET.fromstring(ET.tostring(root))
-        from .limits import check_mesh_size
-
-        for mesh in resolved.iter("mesh"):
-            path = mesh_path(mesh.get("filename", ""), self._base_dir, self._packages)
-            check_mesh_size(path)  # by stat: a huge mesh is refused unread
-            mesh.set("filename", str(path))
-        return ET.tostring(resolved, encoding="unicode")
-
-    def _build_geometry(self, root: ET.Element) -> pin.GeometryModel:
-        text = self._resolved_urdf(root)
-        try:
-            gm = pin.buildGeomFromUrdfString(self.model, text, pin.COLLISION, package_dirs=self._package_dirs())
-        except Exception as exc:
-            raise CollisionGeometryError(f"cannot load the collision geometry of {self.source}: {exc}") from exc
-        expected: dict[str, int] = {}
-        for link in root.findall("link"):
-            n = len(link.findall("collision"))
-            if n:
-                expected[link.get("name")] = n
-        got: dict[str, int] = {}
-        for g in gm.geometryObjects:
-            link = self.model.frames[g.parentFrame].name
-            got[link] = got.get(link, 0) + 1
-        missing = sorted(link for link, n in expected.items() if got.get(link, 0) < n)
-        if missing:
-            raise CollisionGeometryError(
-                f"{self.source}: the collision geometry of link(s) {', '.join(missing)} did not load "
-                "(an unsupported or empty <geometry>?); every <collision> must give a box, cylinder, sphere, "
-                "capsule or mesh"
-            )
-        self._visual_text = text
-        return gm
-
-    def _fixtures(self) -> tuple[Fixture, ...]:
-        data = self.model.createData()
-        gd = cold_start(pin.GeometryData(self.collision_model))
-        pin.updateGeometryPlacements(self.model, data, self.collision_model, gd, pin.neutral(self.model))
-        by_link: dict[str, list[Shape]] = {name: [] for name in self.spec.fixtures}
-        for k, g in enumerate(self.collision_model.geometryObjects):
-            link = self.model.frames[g.parentFrame].name
-            if link not in by_link:
-                continue
-            kind, size = _shape_of(g.geometry)
-            mesh = None
-            if kind == "mesh":
-                size = tuple(float(v) for v in np.asarray(g.meshScale))
-                mesh = self._mesh_name(link)
-            by_link[link].append(Shape(kind, size, gd.oMg[k].homogeneous.copy(), mesh, g.name))
-        return tuple(Fixture(name, tuple(shapes)) for name, shapes in by_link.items())
-
-    def _mesh_name(self, link: str) -> str | None:
-        root = ET.fromstring(self.urdf_text)
-        for el in root.findall("link"):
-            if el.get("name") == link:
-                mesh = el.find("collision/geometry/mesh")
-                return None if mesh is None else mesh.get("filename")
-        return None
 
     def _finish_geometry(self) -> None:
         """Keep only the checked pairs in the collision model, the candidate pairs, and test every checked pair once."""
@@ -324,21 +122,7 @@ class Cell:
         reach, bounds = reach_pairs(self, self.allowed)
         self._set_candidates(self.pairs, reach, bounds)
         # the checked pairs once each (an out-of-reach pair coal cannot measure is a named error when used)
-        n = len(self.pairs)
-        gm, gd = self._views.geometry(n), self._views.distance_data(n)
-        pin.updateGeometryPlacements(self.model, self._views.data(), gm, gd, pin.neutral(self.model))
-        for k, p in enumerate(self.pairs):
-            try:
-                d = pin.computeDistance(gm, gd, k).min_distance
-                pin.computeCollision(gm, gd, k)
-            except Exception as exc:
-                raise CollisionGeometryError(
-                    f"{self.source}: the pair ({p.body_a}, {p.body_b}) cannot be checked by coal: {exc}"
-                ) from exc
-            if not np.isfinite(d):
-                raise CollisionGeometryError(
-                    f"{self.source}: the distance between {p.body_a} and {p.body_b} is {d}: check their geometry"
-                )
+        probe_pairs(self.model, self._views, self.pairs, self.source)
 
     def _set_candidates(self, pairs: tuple, reach: tuple, bounds: np.ndarray) -> None:
         """Checked pairs, then out-of-reach pairs by increasing bound; the collision model keeps the checked ones."""
@@ -499,38 +283,8 @@ class Cell:
             InvalidInput: unknown arm or fixture, or not a rigid transform.
             CellError: the arm's base (or a carried fixture) is not held by a fixed joint.
         """
-        arm = self.arm(name)
-        T = np.asarray(base_to_world, dtype=float)
-        if T.shape != (4, 4) or not np.all(np.isfinite(T)) or np.abs(T[:3, :3] @ T[:3, :3].T - np.eye(3)).max() > 1e-9 \
-                or np.linalg.det(T[:3, :3]) < 0 or np.abs(T[3] - [0, 0, 0, 1]).max() > 1e-12:
-            raise InvalidInput(f"base_to_world of arm {name!r} must be a rigid transform (4, 4), got {base_to_world!r}")
-        spec = next(a for a in self.spec.arms if a.name == arm.name)
-        for fixture in carry:
-            self.fixture(fixture)  # InvalidInput for an unknown name
-        root = ET.fromstring(self.urdf_text)
-        data = self.model.createData()
-        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
-
-        def world(link: str) -> np.ndarray:
-            return data.oMf[self.model.getFrameId(link)].homogeneous
-
-        def place(link: str, link_to_world: np.ndarray) -> None:
-            holder = next((j for j in root.iter("joint")
-                           if j.find("child") is not None and j.find("child").get("link") == link), None)
-            if holder is None or holder.get("type") != "fixed":
-                raise CellError(f"link {link!r} of cell {self.name!r} is not held by a fixed joint: cannot move it")
-            origin = np.linalg.inv(world(holder.find("parent").get("link"))) @ link_to_world
-            element = holder.find("origin")
-            if element is None:
-                element = ET.SubElement(holder, "origin")
-            element.set("xyz", " ".join(repr(float(v)) for v in origin[:3, 3]))
-            element.set("rpy", " ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(origin[:3, :3])))
-
-        moved = T @ np.linalg.inv(arm.base_to_world)
-        for fixture in carry:
-            place(fixture, moved @ world(fixture))
-        place(spec.base_link, T)
-        return Cell(ET.tostring(root, encoding="unicode"), source=f"{self.source} (arm {name!r} moved)",
+        text = urdf_with_arm_base(self, name, base_to_world, carry)
+        return Cell(text, source=f"{self.source} (arm {name!r} moved)",
                     base_dir=self._base_dir, packages=self._packages, args=self.args, seed=self._seed)
 
     def with_pairs(self, kinds: str | tuple[str, ...] | list[str]) -> "Cell":
