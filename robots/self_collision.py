@@ -15,7 +15,7 @@ motion-planning setup tools (e.g. MoveIt's setup assistant), with pinarms' rules
 :meth:`SelfCollision.in_collision` runs coal's broad phase (a dynamic AABB tree culls the
 pairs whose boxes are apart) through Pinocchio: one call for one configuration (Pinocchio's
 plain loop below 64 pairs, where the tree costs more than it culls), and Pinocchio's C++
-batch (``computeCollisionsInParallel``) for a batch, so no Python runs per configuration. Per-pair answers (:meth:`colliding_pairs`, a ``pairs`` mask) loop in
+batch (``computeCollisionsInParallel``) for a batch, so no Python runs per configuration. Per-pair answers (a ``pairs`` mask) loop in
 Python over the configurations: use them on sub-samples of a few thousand.
 
 *Core* bodies are those fixed to the base or carried only by the first ``core_joints``
@@ -196,9 +196,3 @@ class SelfCollision:
                 cold_start(gd)
         out = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(qp.T), True, False)
         return np.asarray(out, dtype=bool).reshape(-1)
-
-    def colliding_pairs(self, q: Any) -> list[tuple[str, str]]:
-        """Names of the body pairs in contact at one configuration ``q (nq,)``."""
-        arr, single = self.robot.check_q(q)
-        hits = self._pair_hits(arr[:1])[0]
-        return [tuple(p) for p in self.pairs[hits]]
