@@ -17,7 +17,7 @@ from pinarms.robots.cell import Cell
 from pinarms.robots.cell.pairs import BY_DESIGN
 from pinarms.robots.collision_requests import cold_start
 
-SCARA_URDF = Path(__file__).resolve().parent / "data" / "post_scara.urdf"
+SCARA_URDF = Path(__file__).resolve().parent.parent / "data" / "post_scara.urdf"
 #: The post stands this far [m] from the nearest point the upper arm sweeps (its end corners).
 POST_GAP = 0.013
 

@@ -17,7 +17,7 @@ from pinarms.robots.cell.compose_file import MAX_DESCRIPTION_BYTES
 from pinarms.robots.errors import CellError, CellNotFound, XacroForbidden
 from pinarms.robots.registry import builtin_urdf_path
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parent.parent / "data"
 
 TWO_SCARAS = """\
 name = "two_scaras"
