@@ -84,6 +84,48 @@ def describe(root: ET.Element, source: str) -> CellSpec:
         raise CellError(f"{source}: root element is <{root.tag}>, expected <robot>")
     links = _unique(root, "link", source)
     joints = _unique(root, "joint", source)
+    parent_of, children, root_link = _tree(links, joints, source)
+    kind_of = {j: joints[j].get("type") for j in joints}
+    child_of = {j: joints[j].find("child").get("link") for j in joints}
+
+    static: list[str] = []  # links reached through fixed joints only, depth first
+    stack = [root_link]
+    while stack:
+        link = stack.pop()
+        static.append(link)
+        stack.extend(child_of[j] for j in reversed(children[link]) if kind_of[j] == "fixed")
+
+    bases = [link for link in static if any(kind_of[j] in _MOVABLE for j in children[link])]
+    if not bases:
+        raise CellError(f"{source}: no arm found (no movable joint hangs from a fixed link)")
+    order = {name: k for k, name in enumerate(links)}
+    arms = tuple(_arm(root, base, set(bases), joints, parent_of, children, child_of, order) for base in bases)
+    names = [a.name for a in arms]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise CellError(f"{source}: several arms are named {dup[0]!r}; give each arm its own prefix")
+    taken = {link for a in arms for link in a.links}
+    static_set = set(static)
+    fixtures = tuple(
+        link for link in links
+        if link not in taken and link in static_set and links[link].find("collision") is not None
+    )
+    fixture_set = set(fixtures)
+    frames = tuple(link for link in links if link not in taken and link not in fixture_set)
+    moving_outside = [link for link in links if link not in taken and link not in static_set]
+    if moving_outside:  # pragma: no cover - every movable subtree hangs from a static base
+        raise CellError(f"{source}: links {moving_outside} move but belong to no arm")
+    return CellSpec(name=root.get("name", "cell"), root_link=root_link, arms=arms, fixtures=fixtures, frames=frames)
+
+
+def _tree(links: dict[str, ET.Element], joints: dict[str, ET.Element],
+          source: str) -> tuple[dict[str, tuple[str, str]], dict[str, list[str]], str]:
+    """The link tree: each child link's ``(joint, parent link)``, each link's child joints, and the one root link.
+
+    Raises:
+        CellError: an unsupported joint type, a joint naming a missing link, a link with
+            two parents, or not exactly one root.
+    """
     parent_of: dict[str, tuple[str, str]] = {}  # child link -> (joint, parent link)
     children: dict[str, list[str]] = {name: [] for name in links}  # link -> joints
     for jname, joint in joints.items():
@@ -109,68 +151,38 @@ def describe(root: ET.Element, source: str) -> CellSpec:
         raise CellError(
             f"{source}: a cell has one root link (the world); found {len(roots)}: {', '.join(roots) or 'none (a loop)'}"
         )
-    root_link = roots[0]
-    kind_of = {j: joints[j].get("type") for j in joints}
-    child_of = {j: joints[j].find("child").get("link") for j in joints}
+    return parent_of, children, roots[0]
 
-    static: list[str] = []  # links reached through fixed joints only, depth first
-    stack = [root_link]
+
+def _arm(root: ET.Element, base: str, base_set: set[str], joints: dict[str, ET.Element],
+         parent_of: dict[str, tuple[str, str]], children: dict[str, list[str]], child_of: dict[str, str],
+         order: dict[str, int]) -> ArmSpec:
+    """The arm whose base is ``base``: every link below it (up to another arm's base), its joints, name and prefix."""
+    members = [base]
+    stack = [child_of[j] for j in children[base]]
     while stack:
         link = stack.pop()
-        static.append(link)
-        stack.extend(child_of[j] for j in reversed(children[link]) if kind_of[j] == "fixed")
-
-    bases = [link for link in static if any(kind_of[j] in _MOVABLE for j in children[link])]
-    if not bases:
-        raise CellError(f"{source}: no arm found (no movable joint hangs from a fixed link)")
-    base_set = set(bases)
-    order = {name: k for k, name in enumerate(links)}
-    arms: list[ArmSpec] = []
-    taken: set[str] = set()
-    for base in bases:
-        members = [base]
-        stack = [child_of[j] for j in children[base]]
-        while stack:
-            link = stack.pop()
-            if link in base_set:
-                continue  # another arm bolted to this one's base: its own arm
-            members.append(link)
-            stack.extend(child_of[j] for j in children[link])
-        members_set = set(members)
-        arm_joints = [j for j in joints if parent_of[child_of[j]][1] in members_set and child_of[j] in members_set]
-        arm_joints = [j for j in arm_joints if child_of[j] != base]
-        if base.endswith("base_link"):
-            prefix = base[: -len("base_link")]
-            name = prefix.rstrip("_") or root.get("name", "arm")
-        else:
-            prefix, name = "", base
-        if not all(n.startswith(prefix) for n in members + arm_joints):
-            prefix = ""
-        arms.append(
-            ArmSpec(
-                name=name,
-                prefix=prefix,
-                base_link=base,
-                links=tuple(sorted(members, key=lambda n: (n != base, order[n]))),
-                joints=tuple(arm_joints),
-            )
-        )
-        taken |= members_set
-    names = [a.name for a in arms]
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise CellError(f"{source}: several arms are named {dup[0]!r}; give each arm its own prefix")
-    static_set = set(static)
-    fixtures = tuple(
-        link for link in links
-        if link not in taken and link in static_set and links[link].find("collision") is not None
+        if link in base_set:
+            continue  # another arm bolted to this one's base: its own arm
+        members.append(link)
+        stack.extend(child_of[j] for j in children[link])
+    members_set = set(members)
+    arm_joints = [j for j in joints if parent_of[child_of[j]][1] in members_set and child_of[j] in members_set]
+    arm_joints = [j for j in arm_joints if child_of[j] != base]
+    if base.endswith("base_link"):
+        prefix = base[: -len("base_link")]
+        name = prefix.rstrip("_") or root.get("name", "arm")
+    else:
+        prefix, name = "", base
+    if not all(n.startswith(prefix) for n in members + arm_joints):
+        prefix = ""
+    return ArmSpec(
+        name=name,
+        prefix=prefix,
+        base_link=base,
+        links=tuple(sorted(members, key=lambda n: (n != base, order[n]))),
+        joints=tuple(arm_joints),
     )
-    fixture_set = set(fixtures)
-    frames = tuple(link for link in links if link not in taken and link not in fixture_set)
-    moving_outside = [link for link in links if link not in taken and link not in static_set]
-    if moving_outside:  # pragma: no cover - every movable subtree hangs from a static base
-        raise CellError(f"{source}: links {moving_outside} move but belong to no arm")
-    return CellSpec(name=root.get("name", "cell"), root_link=root_link, arms=tuple(arms), fixtures=fixtures, frames=frames)
 
 
 def _strip(name: str, prefix: str) -> str:
