@@ -3,7 +3,9 @@
 - :mod:`.workspace` (sampled workspace, sphere fit), :mod:`.workspace_stream` (streamed, for
   large samples), :mod:`.voxels` (voxel maps of a workspace);
 - :mod:`.orientations` (tool orientation sets), :mod:`.reachability` (reachability maps:
-  how many orientations each voxel reaches), :mod:`.reach_io` (their HDF5 file format, read
+  how many orientations each voxel reaches; built from :mod:`.reach_grid` (the bound and the
+  voxels computed), :mod:`.reach_chunk` (solving one chunk of voxels) and :mod:`.robot_spec`
+  (the robot a worker rebuilds); the map itself is :mod:`.reach_map`), :mod:`.reach_io` (their HDF5 file format, read
   in a bounded child process: :mod:`._reach_child`, :mod:`._reach_worker`) and
   :mod:`.reach_write` (writing it);
 - :mod:`.base_placement` (inverse reach: bases from which an arm reaches a set of poses),

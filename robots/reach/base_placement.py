@@ -41,7 +41,9 @@ import numpy as np
 
 from ..errors import InvalidInput, ModelError
 from .orientations import _align, _rotation_about
-from .reachability import ReachabilityMap, _collision_free, _manipulability, _urdf_sha256
+from .reach_chunk import ChunkTask, collision_free, manipulability_of
+from .reach_map import ReachabilityMap
+from .robot_spec import spec_of, urdf_sha256
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -232,7 +234,7 @@ def base_placements(
         raise InvalidInput(f"roll_steps must be a positive integer, got {roll_steps!r}")
     if isinstance(verify, bool) or not isinstance(verify, (int, np.integer)) or verify < 0:
         raise InvalidInput(f"verify must be a non-negative integer, got {verify!r}")
-    if robot is not None and _urdf_sha256(robot) != reach_map.urdf_sha256:
+    if robot is not None and urdf_sha256(robot) != reach_map.urdf_sha256:
         raise ModelError(f"the map was built for '{reach_map.robot}' (another URDF than robot '{robot.name}')")
     if verify and robot is None:
         raise InvalidInput("pass robot=... to check the best candidates by IK (or verify=0)")
@@ -347,8 +349,6 @@ def base_placements(
 
 def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision):
     """Exact IK at every task from each candidate: ``(verified (n,), min over tasks of best w (n,))``."""
-    from .reachability import ChunkTask, _spec_of
-
     n, N = candidates.shape[0], T_tasks.shape[0]
     rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
     R = rolls.shape[0]
@@ -360,16 +360,16 @@ def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, 
     T = np.repeat(T_b[:, :, None], R, axis=2)
     T[..., :3, :3] = T[..., :3, :3] @ rolls[None, None]
     T = T.reshape(-1, 4, 4)
-    task = ChunkTask(robot=_spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),
+    task = ChunkTask(robot=spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),
                      rotations=np.eye(3)[None], group=np.zeros(1, np.int64), n_groups=1, roll_free=False,
                      solver="analytic", manipulability=reach_map.manipulability_kind, restarts=0, tol=1e-9,
                      self_collision=bool(self_collision), collision=collision, keep_solutions=False, seed=0)
     best = np.full(T.shape[0], np.nan)
     if robot.has_analytic_ik and reach_map.solver == "analytic":
         idx, q = robot._analytic_ik.candidates(T)
-        keep = _collision_free(task, robot, q)
+        keep = collision_free(task, robot, q)
         idx, q = idx[keep], q[keep]
-        w = _manipulability(robot, q, reach_map.manipulability_kind)
+        w = manipulability_of(robot, q, reach_map.manipulability_kind)
         top = np.full(T.shape[0], -np.inf)
         np.maximum.at(top, idx, w)
         best = np.where(np.isfinite(top), top, np.nan)
@@ -381,8 +381,8 @@ def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, 
                 q = robot.ik(T[k], max_restarts=max(4, int(reach_map.parameters.get("restarts", 2)) * 2), seed=k)
             except UnreachableTarget:
                 continue
-            if _collision_free(task, robot, q[None])[0]:
-                best[k] = _manipulability(robot, q[None], reach_map.manipulability_kind)[0]
+            if collision_free(task, robot, q[None])[0]:
+                best[k] = manipulability_of(robot, q[None], reach_map.manipulability_kind)[0]
     per = best.reshape(n, N, R)
     task_best = np.where(np.isnan(per).all(axis=2), np.nan, np.nanmax(np.where(np.isnan(per), -np.inf, per), axis=2))
     verified = ~np.isnan(task_best).any(axis=1)
