@@ -39,7 +39,8 @@ import numpy as np
 
 from ..errors import InvalidInput, UnreachableTarget
 from ..so3 import rot_z as _rot_z
-from .workspace import Workspace, position_dexterity, sample_workspace
+from .dexterity import position_dexterity
+from .workspace import Workspace, sample_workspace
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot

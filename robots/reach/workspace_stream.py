@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from ..errors import InvalidInput
+from .dexterity import positions_and_dexterity
 from .voxels import VoxelMap, suggest_voxel_size
 from .workspace import (
     SINGULAR_INVERSE_CONDITION,
@@ -47,7 +48,6 @@ from .workspace import (
     _check_threshold,
     _direction_cells,
     _generator_at,
-    _positions_and_dexterity,
     fit_sphere,
     sample_workspace,
 )
@@ -263,7 +263,7 @@ def _run_task(task: WorkspaceTask) -> _Reduction:
     while done < task.count:
         m = min(spec.block, task.count - done)
         q = rng.uniform(robot.lower, robot.upper, size=(m, robot.nq))
-        P, w, c = _positions_and_dexterity(robot, q, spec.frame, threads=threads)
+        P, w, c = positions_and_dexterity(robot, q, spec.frame, threads=threads)
         _add_block(acc, P, w, c, spec)
         done += m
     acc.vox_sparse = _sparse_voxels(acc)
