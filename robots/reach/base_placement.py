@@ -21,7 +21,7 @@ restricted to bases on the plane:
    count: how much orientation freedom is left around the tasks; then the smallest best
    manipulability of the tasks' voxels; then the candidate's grid order (x, then y, then
    yaw). Manipulabilities within 1e-9 relative count as tied.
-4. **Check.** The ``verify`` best candidates are solved exactly by IK (every closed-form branch
+4. **Check** (:mod:`robots.reach.base_verify`). The ``verify`` best candidates are solved exactly by IK (every closed-form branch
    within the limits, or the numerical solver) at the exact task poses (rolls tried for
    roll-free tasks) with the collision checks given; ``verified`` says whether every task has
    a solution, ``ik_manipulability`` the smallest (over tasks) best manipulability. The final
@@ -41,9 +41,9 @@ import numpy as np
 
 from ..errors import InvalidInput, ModelError
 from .orientations import _align, _rotation_about
-from .reach_chunk import ChunkTask, collision_free, manipulability_of
+from .base_verify import verify_bases
 from .reach_map import ReachabilityMap
-from .robot_spec import spec_of, urdf_sha256
+from .robot_spec import urdf_sha256
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -387,51 +387,6 @@ def _exact_check(robot: "Robot | None", reach_map: ReachabilityMap, candidates: 
     n_check = min(verify, C)
     if n_check:
         checked[:n_check] = True
-        verified[:n_check], ik_w[:n_check] = _check_exactly(
-            robot, reach_map, candidates[:n_check], T_tasks, roll_free, reach_map.orientations.tool_axis, roll_steps,
-            self_collision, collision
-        )
+        verified[:n_check], ik_w[:n_check] = verify_bases(robot, reach_map, candidates[:n_check], T_tasks, roll_free,
+                                                          roll_steps, self_collision, collision)
     return checked, verified, ik_w
-
-
-def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision):
-    """Exact IK at every task from each candidate: ``(verified (n,), min over tasks of best w (n,))``."""
-    n, N = candidates.shape[0], T_tasks.shape[0]
-    rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
-    R = rolls.shape[0]
-    B = np.tile(np.eye(4), (n, 1, 1))
-    cz, sz = np.cos(candidates[:, 3]), np.sin(candidates[:, 3])
-    B[:, 0, 0], B[:, 0, 1], B[:, 1, 0], B[:, 1, 1] = cz, -sz, sz, cz
-    B[:, :3, 3] = candidates[:, :3]
-    T_b = np.linalg.inv(B)[:, None] @ T_tasks[None]  # (n, N, 4, 4)
-    T = np.repeat(T_b[:, :, None], R, axis=2)
-    T[..., :3, :3] = T[..., :3, :3] @ rolls[None, None]
-    T = T.reshape(-1, 4, 4)
-    task = ChunkTask(robot=spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),
-                     rotations=np.eye(3)[None], group=np.zeros(1, np.int64), n_groups=1, roll_free=False,
-                     solver="analytic", manipulability=reach_map.manipulability_kind, restarts=0, tol=1e-9,
-                     self_collision=bool(self_collision), collision=collision, keep_solutions=False, seed=0)
-    best = np.full(T.shape[0], np.nan)
-    if robot.has_analytic_ik and reach_map.solver == "analytic":
-        idx, q = robot._analytic_ik.candidates(T)
-        keep = collision_free(task, robot, q)
-        idx, q = idx[keep], q[keep]
-        w = manipulability_of(robot, q, reach_map.manipulability_kind)
-        top = np.full(T.shape[0], -np.inf)
-        np.maximum.at(top, idx, w)
-        best = np.where(np.isfinite(top), top, np.nan)
-    else:
-        from ..errors import UnreachableTarget
-
-        for k in range(T.shape[0]):
-            try:
-                q = robot.ik(T[k], max_restarts=max(4, int(reach_map.parameters.get("restarts", 2)) * 2), seed=k)
-            except UnreachableTarget:
-                continue
-            if collision_free(task, robot, q[None])[0]:
-                best[k] = manipulability_of(robot, q[None], reach_map.manipulability_kind)[0]
-    per = best.reshape(n, N, R)
-    task_best = np.where(np.isnan(per).all(axis=2), np.nan, np.nanmax(np.where(np.isnan(per), -np.inf, per), axis=2))
-    verified = ~np.isnan(task_best).any(axis=1)
-    wmin = np.where(verified, np.nanmin(np.where(np.isnan(task_best), np.inf, task_best), axis=1), np.nan)
-    return verified, wmin
