@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import InvalidInput
 from ..robot import MAX_RANDOM_SAMPLES
 from .dexterity import CHUNK, position_dexterity, positions_and_dexterity
+from .joint_samples import random_q_slice
 from .sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
     SPHERE_COVERAGE_MIN, SphereFit, _as_points, _direction_cells, direction_coverage,
     fit_sphere, fit_sphere_to_hull, hull_points)
@@ -332,28 +333,6 @@ def sample_workspace(
         manipulability=w,
         inverse_condition=c,
     )
-
-
-def _generator_at(robot: "Robot", seed: int, start: int) -> np.random.Generator:
-    """``default_rng(seed)`` advanced past the draws of samples ``0 … start-1`` of ``random_q``."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
-    bit = np.random.PCG64(int(seed))
-    bit.advance(int(start) * robot.nq)
-    return np.random.Generator(bit)
-
-
-def random_q_slice(robot: "Robot", seed: int, start: int, count: int) -> np.ndarray:
-    """Samples ``start … start+count-1`` of ``robot.random_q(n, seed)``, without drawing the others.
-
-    ``random_q`` draws ``(n, nq)`` uniforms row by row from ``numpy.random.default_rng(seed)``
-    (PCG64, one 64-bit draw per number), so sample ``i`` starts at draw ``i·nq``: the
-    generator jumps there (``PCG64.advance``) in a few microseconds.
-    """
-    for name, v in (("start", start), ("count", count)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
-            raise InvalidInput(f"{name} must be an integer >= 0, got {v!r}")
-    return _generator_at(robot, seed, start).uniform(robot.lower, robot.upper, size=(int(count), robot.nq))
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import InvalidInput
 from .dexterity import positions_and_dexterity
+from .joint_samples import generator_at
 from .voxels import VoxelMap, suggest_voxel_size
 from .workspace import (
     SINGULAR_INVERSE_CONDITION,
@@ -47,7 +48,6 @@ from .workspace import (
     WorkspaceSummary,
     _check_threshold,
     _direction_cells,
-    _generator_at,
     fit_sphere,
     sample_workspace,
 )
@@ -258,7 +258,7 @@ def _run_task(task: WorkspaceTask) -> _Reduction:
     from pinarms.execution import task_threads
 
     threads = task_threads()
-    rng = _generator_at(robot, task.seed, task.start)
+    rng = generator_at(robot, task.seed, task.start)
     done = 0
     while done < task.count:
         m = min(spec.block, task.count - done)
