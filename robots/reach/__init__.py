@@ -2,8 +2,9 @@
 
 - :mod:`.workspace` (sampled workspace), :mod:`.joint_samples` (slices of the seeded joint
   samples), :mod:`.dexterity` (position manipulability and inverse condition),
-  :mod:`.sphere_fit` (sphere fits), :mod:`.workspace_stream` (streamed, for large samples),
-  :mod:`.voxels` (voxel maps of a workspace);
+  :mod:`.sphere_fit` (sphere fits), :mod:`.workspace_stream` (streamed, for large samples;
+  its mergeable reductions: :mod:`.stream_reduction`), :mod:`.voxels` (voxel maps of a
+  workspace);
 - :mod:`.orientations` (tool orientation sets), :mod:`.reachability` (reachability maps:
   how many orientations each voxel reaches), built from :mod:`.reach_grid` (the reach bound
   and the voxels computed), :mod:`.reach_chunk` (solving one chunk of voxels) and
