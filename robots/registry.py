@@ -10,7 +10,6 @@ import difflib
 import importlib.metadata
 import importlib.resources
 import xml.etree.ElementTree as ET
-import xml.parsers.expat
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -20,6 +19,10 @@ import pinocchio as pin
 
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
+# the URDF checks, under the names robots/cell/compose.py imports from here
+from .urdf_checks import check_limits as _check_limits
+from .urdf_checks import check_tree as _check_tree
+from .urdf_checks import refuse_dtd as _refuse_dtd
 
 __all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest",
            "match_builtin"]
@@ -277,107 +280,6 @@ def from_urdf_text(
 
     attach_analytic_ik(robot)  # by geometry, proven by FK round trips (robot.ik_family)
     return robot
-
-
-def _check_tree(root: ET.Element, source: str) -> None:
-    """ModelError unless the links and joints form one tree (Pinocchio 4.1 crashes the process on a loop).
-
-    Names unique, every joint between two defined links, every link the child of at most
-    one joint, one root, every link reachable from it.
-    """
-    links = [ln.get("name") for ln in root.findall("link")]
-    seen: set = set()
-    for name in links:
-        if not name:
-            raise ModelError(f"{source}: a <link> has no name")
-        if name in seen:
-            raise ModelError(f"{source}: link {name!r} is defined twice")
-        seen.add(name)
-    parent_of: dict[str, str] = {}
-    children: dict[str, list[str]] = {name: [] for name in links}
-    joint_names: set = set()
-    for j in root.findall("joint"):
-        jname = j.get("name")
-        if not jname:
-            raise ModelError(f"{source}: a <joint> has no name")
-        if jname in joint_names:
-            raise ModelError(f"{source}: joint {jname!r} is defined twice")
-        joint_names.add(jname)
-        ends = []
-        for tag in ("parent", "child"):
-            el = j.find(tag)
-            link = None if el is None else el.get("link")
-            if link is None:
-                raise ModelError(f"{source}: joint {jname!r} has no <{tag} link=...>")
-            if link not in children:
-                raise ModelError(f"{source}: joint {jname!r} names {tag} link {link!r}, which is not defined")
-            ends.append(link)
-        parent, child = ends
-        if child in parent_of:
-            raise ModelError(f"{source}: link {child!r} is the child of two joints ({parent_of[child]!r} and "
-                             f"{jname!r}); a URDF is a tree (close loops with constraints, not joints)")
-        parent_of[child] = jname
-        children[parent].append(child)
-    roots = [name for name in links if name not in parent_of]
-    if len(roots) != 1:
-        what = "no root link (the joints form a loop)" if not roots else f"several root links {roots}"
-        raise ModelError(f"{source}: {what}; a URDF is one tree")
-    reached, stack = set(), [roots[0]]
-    while stack:
-        link = stack.pop()
-        if link in reached:
-            continue
-        reached.add(link)
-        stack.extend(children[link])
-    if len(reached) != len(links):
-        lost = [name for name in links if name not in reached]
-        raise ModelError(f"{source}: links {lost} are not connected to the root {roots[0]!r} (a loop); a URDF is one tree")
-
-
-def _refuse_dtd(text: str, source: str) -> None:
-    """ModelError when the XML declares a DOCTYPE or entities (expat reads the prolog only)."""
-
-    def refuse(*_: object) -> None:
-        raise ModelError(
-            f"{source} declares a DOCTYPE or XML entities; URDF uses neither and Pinocchio's parser does not expand "
-            f"them (entity expansion is refused): expand them first, e.g. with xacro"
-        )
-
-    parser = xml.parsers.expat.ParserCreate()
-    parser.StartDoctypeDeclHandler = refuse
-    parser.EntityDeclHandler = refuse
-    parser.StartElementHandler = _stop_at_root
-    try:
-        parser.Parse(text, True)
-    except (xml.parsers.expat.ExpatError, _RootReached):
-        pass  # malformed XML is reported by the parse that follows; the root element ends the prolog
-
-
-class _RootReached(Exception):
-    """Raised by the prolog scan at the first element."""
-
-
-def _stop_at_root(*_: object) -> None:
-    raise _RootReached
-
-
-def _check_limits(model: pin.Model, source: str) -> None:
-    """ModelError for position limits with lower > upper, or negative speed or effort limits."""
-    for i in range(1, model.njoints):
-        j = model.joints[i]
-        if j.nq == 0 or "Mimic" in j.shortname():
-            continue
-        name = model.names[i]
-        lo = model.lowerPositionLimit[j.idx_q: j.idx_q + j.nq]
-        hi = model.upperPositionLimit[j.idx_q: j.idx_q + j.nq]
-        if np.any(lo > hi):
-            raise ModelError(f"{source}: joint {name!r} has lower limit {lo.tolist()} above its upper limit "
-                             f"{hi.tolist()}; swap them")
-        v = model.velocityLimit[j.idx_v: j.idx_v + j.nv]
-        e = model.effortLimit[j.idx_v: j.idx_v + j.nv]
-        if np.any(v < 0) or np.any(e < 0):
-            raise ModelError(f"{source}: joint {name!r} has a negative velocity or effort limit "
-                             f"({v.tolist()}, {e.tolist()}); limits are magnitudes")
 
 
 def from_urdf(

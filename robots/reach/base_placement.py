@@ -21,7 +21,7 @@ restricted to bases on the plane:
    count: how much orientation freedom is left around the tasks; then the smallest best
    manipulability of the tasks' voxels; then the candidate's grid order (x, then y, then
    yaw). Manipulabilities within 1e-9 relative count as tied.
-4. **Check.** The ``verify`` best candidates are solved exactly by IK (every closed-form branch
+4. **Check** (:mod:`robots.reach.base_verify`). The ``verify`` best candidates are solved exactly by IK (every closed-form branch
    within the limits, or the numerical solver) at the exact task poses (rolls tried for
    roll-free tasks) with the collision checks given; ``verified`` says whether every task has
    a solution, ``ik_manipulability`` the smallest (over tasks) best manipulability. The final
@@ -41,7 +41,9 @@ import numpy as np
 
 from ..errors import InvalidInput, ModelError
 from .orientations import _align, _rotation_about
-from .reachability import ReachabilityMap, _collision_free, _manipulability, _urdf_sha256
+from .base_verify import verify_bases
+from .reach_map import ReachabilityMap
+from .robot_spec import urdf_sha256
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -217,6 +219,30 @@ def base_placements(
         InvalidInput: bad tasks, steps, a grid larger than :data:`MAX_CANDIDATES`.
         ModelError: ``robot`` is not the robot the map was built for.
     """
+    T_tasks, z, step = _checked_arguments(reach_map, tasks, robot, z, xy_step, yaw_step, roll_steps, verify)
+    X, Y, yaws, n_grid = _candidate_grid(reach_map, T_tasks[:, :3, 3], step, yaw_step)
+    xyyaw, sums, wmin, n_lookups = _feasible_on_map(reach_map, T_tasks, X, Y, yaws, z, roll_free, roll_steps)
+    order = _map_order(xyyaw, sums, wmin)
+    xyyaw, sums, wmin = xyyaw[order], sums[order], wmin[order]
+    C = xyyaw.shape[0]
+    candidates = np.column_stack([xyyaw[:, 0], xyyaw[:, 1], np.full(C, z), xyyaw[:, 2]])
+    checked, verified, ik_w = _exact_check(robot, reach_map, candidates, T_tasks, int(verify), roll_free, roll_steps,
+                                           self_collision, collision)
+    if checked.any():  # verified candidates first, then the map's order
+        final = np.lexsort((np.arange(C), ~verified))
+        candidates, sums, wmin = candidates[final], sums[final], wmin[final]
+        checked, verified, ik_w = checked[final], verified[final], ik_w[final]
+    index_mean = sums / (T_tasks.shape[0] * reach_map.orientations.n_index)
+    return BasePlacements(
+        tasks=T_tasks, roll_free=bool(roll_free), z=z, xy_step=step, yaw_step=float(yaw_step), candidates=candidates,
+        index_sum=sums, index_mean=index_mean, manipulability=wmin, checked=checked, verified=verified,
+        ik_manipulability=ik_w, n_grid=int(n_grid), n_lookups=int(n_lookups),
+    )
+
+
+def _checked_arguments(reach_map: Any, tasks: Any, robot: "Robot | None", z: Any, xy_step: Any, yaw_step: Any,
+                       roll_steps: Any, verify: Any) -> tuple[np.ndarray, float, float]:
+    """The tasks ``(N, 4, 4)``, the plane's height ``z`` [m] and the grid step [m], every argument checked in order."""
     if not isinstance(reach_map, ReachabilityMap):
         raise InvalidInput(f"reach_map must be a ReachabilityMap, got {type(reach_map).__name__}")
     T_tasks = _as_tasks(tasks)
@@ -232,14 +258,18 @@ def base_placements(
         raise InvalidInput(f"roll_steps must be a positive integer, got {roll_steps!r}")
     if isinstance(verify, bool) or not isinstance(verify, (int, np.integer)) or verify < 0:
         raise InvalidInput(f"verify must be a non-negative integer, got {verify!r}")
-    if robot is not None and _urdf_sha256(robot) != reach_map.urdf_sha256:
+    if robot is not None and urdf_sha256(robot) != reach_map.urdf_sha256:
         raise ModelError(f"the map was built for '{reach_map.robot}' (another URDF than robot '{robot.name}')")
     if verify and robot is None:
         raise InvalidInput("pass robot=... to check the best candidates by IK (or verify=0)")
+    return T_tasks, z, step
 
-    oset = reach_map.orientations
+
+def _candidate_grid(reach_map: ReachabilityMap, P: np.ndarray, step: float,
+                    yaw_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Step 1: base positions ``X, Y (n,)`` within the map's horizontal reach of every task ``P (N, 3)``,
+    the yaws, and the number of grid candidates (x × y × yaw)."""
     reach = _horizontal_reach(reach_map)
-    P = T_tasks[:, :3, 3]
     lo, hi = P[:, :2].min(axis=0) - reach, P[:, :2].max(axis=0) + reach
     # grid aligned on multiples of the step (x = i·step, y = j·step)
     xs = step * np.arange(int(np.ceil(lo[0] / step)), int(np.floor(hi[0] / step)) + 1)
@@ -251,39 +281,28 @@ def base_placements(
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     X, Y = X.reshape(-1), Y.reshape(-1)
     near = np.all(np.hypot(X[:, None] - P[None, :, 0], Y[:, None] - P[None, :, 1]) <= reach, axis=1)
-    X, Y = X[near], Y[near]
+    return X[near], Y[near], yaws, n_grid
 
-    # tool-axis directions (roll-free tasks) or full rotations of the tasks, per yaw, in base axes
-    tool_axis = oset.tool_axis
-    if roll_free:
-        rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps)
-    group_reached = None
-    if roll_free and oset.roll_free:
-        group_reached = np.zeros((reach_map.n_voxels, oset.n_groups), dtype=bool)
-        for k in range(oset.size):
-            group_reached[:, oset.group[k]] |= reach_map.reached[:, k]
-    if oset.roll_free:
-        count_per_voxel = np.round(reach_map.index * oset.n_index).astype(np.int64)
-    else:
-        count_per_voxel = reach_map.reached.sum(axis=1).astype(np.int64)
 
+def _feasible_on_map(reach_map: ReachabilityMap, T_tasks: np.ndarray, X: np.ndarray, Y: np.ndarray, yaws: np.ndarray,
+                     z: float, roll_free: bool, roll_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Step 2: the candidates where the map reaches every task, yaw-major.
+
+    Returns ``(x, y, yaw) (C, 3)``, ``index_sum (C,)``, the smallest best manipulability of the
+    tasks' voxels ``(C,)`` and the number of map lookups made.
+    """
+    oset = reach_map.orientations
+    rolls = _rotation_about(oset.tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else None
+    group_reached, count_per_voxel = _voxel_tables(reach_map, roll_free)
+    P = T_tasks[:, :3, 3]
+    N = T_tasks.shape[0]
     cand_xyyaw, cand_sum, cand_w = [], [], []
     n_lookups = 0
-    N = T_tasks.shape[0]
     for yaw in yaws:
         c, s = np.cos(yaw), np.sin(yaw)
         Rz_T = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # Rz(yaw)ᵀ
-        R_b = Rz_T @ T_tasks[:, :3, :3]  # (N, 3, 3) task rotations in base axes
-        # orientation lookups do not depend on x, y: once per yaw
-        if roll_free and oset.roll_free:
-            d = R_b @ tool_axis
-            g = np.argmax(d @ oset.directions.T, axis=1)
-            orient = [("group", g)]
-        elif roll_free:
-            ks = [oset.nearest(R_b @ rolls[r])[0] for r in range(roll_steps)]
-            orient = [("rot", np.stack(ks, axis=1))]
-        else:
-            orient = [("rot", oset.nearest(R_b)[0][:, None])]
+        # orientation lookups do not depend on x, y: once per yaw (task rotations in base axes)
+        kind, which = _task_orientations(oset, Rz_T @ T_tasks[:, :3, :3], roll_free, rolls)
         for start in range(0, X.size, _BLOCK):
             xb, yb = X[start : start + _BLOCK], Y[start : start + _BLOCK]
             n = xb.size
@@ -295,14 +314,7 @@ def base_placements(
             if not ok.any():
                 continue
             r_ok = rows[ok]
-            kind, which = orient[0]
-            if kind == "group":
-                hit = group_reached[r_ok, np.broadcast_to(which, r_ok.shape)]
-            else:
-                hit = np.zeros(r_ok.shape, dtype=bool)
-                for j in range(which.shape[1]):
-                    hit |= reach_map.reached[r_ok, np.broadcast_to(which[:, j], r_ok.shape)]
-            feasible = np.all(hit, axis=1)
+            feasible = np.all(_tasks_reached(reach_map, group_reached, r_ok, kind, which), axis=1)
             if not feasible.any():
                 continue
             idx = np.flatnonzero(ok)[feasible]
@@ -310,81 +322,71 @@ def base_placements(
             cand_xyyaw.append(np.column_stack([xb[idx], yb[idx], np.full(idx.size, yaw)]))
             cand_sum.append(count_per_voxel[rf].sum(axis=1))
             cand_w.append(np.nanmin(reach_map.best_manipulability[rf], axis=1))
+    if not cand_xyyaw:
+        return np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0), n_lookups
+    return np.concatenate(cand_xyyaw), np.concatenate(cand_sum), np.concatenate(cand_w), n_lookups
 
-    if cand_xyyaw:
-        xyyaw = np.concatenate(cand_xyyaw)
-        sums = np.concatenate(cand_sum)
-        wmin = np.concatenate(cand_w)
+
+def _voxel_tables(reach_map: ReachabilityMap, roll_free: bool) -> tuple[np.ndarray | None, np.ndarray]:
+    """Per map voxel row: the reached direction groups ``(V, G)`` (roll-free tasks on a roll-free map;
+    else ``None``) and the reached directions (or rotations) ``(V,)`` that ``index_sum`` adds up."""
+    oset = reach_map.orientations
+    group_reached = None
+    if roll_free and oset.roll_free:
+        group_reached = np.zeros((reach_map.n_voxels, oset.n_groups), dtype=bool)
+        for k in range(oset.size):
+            group_reached[:, oset.group[k]] |= reach_map.reached[:, k]
+    if oset.roll_free:
+        count_per_voxel = np.round(reach_map.index * oset.n_index).astype(np.int64)
     else:
-        xyyaw, sums, wmin = np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0)
-    # grid order (x, then y, then yaw) as the last key: candidates were collected yaw-major
+        count_per_voxel = reach_map.reached.sum(axis=1).astype(np.int64)
+    return group_reached, count_per_voxel
+
+
+def _task_orientations(oset: Any, R_b: np.ndarray, roll_free: bool, rolls: np.ndarray | None) -> tuple[str, np.ndarray]:
+    """What each task needs of the map, its rotation ``R_b (N, 3, 3)`` seen in base axes:
+    ``("group", (N,))`` the direction group of a roll-free map, or ``("rot", (N, r))`` rotations
+    of the set of which any will do (the nearest of each roll, or of the rotation itself)."""
+    if roll_free and oset.roll_free:
+        d = R_b @ oset.tool_axis
+        return "group", np.argmax(d @ oset.directions.T, axis=1)
+    if roll_free:
+        ks = [oset.nearest(R_b @ rolls[r])[0] for r in range(rolls.shape[0])]
+        return "rot", np.stack(ks, axis=1)
+    return "rot", oset.nearest(R_b)[0][:, None]
+
+
+def _tasks_reached(reach_map: ReachabilityMap, group_reached: np.ndarray | None, rows: np.ndarray, kind: str,
+                   which: np.ndarray) -> np.ndarray:
+    """``(n, N)`` bool: task ``j`` is reached in map voxel row ``rows[i, j]`` (see :func:`_task_orientations`)."""
+    if kind == "group":
+        return group_reached[rows, np.broadcast_to(which, rows.shape)]
+    hit = np.zeros(rows.shape, dtype=bool)
+    for j in range(which.shape[1]):
+        hit |= reach_map.reached[rows, np.broadcast_to(which[:, j], rows.shape)]
+    return hit
+
+
+def _map_order(xyyaw: np.ndarray, sums: np.ndarray, wmin: np.ndarray) -> np.ndarray:
+    """Step 3: most reached directions first, then the largest smallest manipulability (ties within
+    1e-9 relative), then the grid order (x, then y, then yaw; candidates were collected yaw-major)."""
     grid_key = np.lexsort((xyyaw[:, 2], xyyaw[:, 1], xyyaw[:, 0])) if xyyaw.size else np.zeros(0, np.int64)
     pos = np.empty_like(grid_key)
     pos[grid_key] = np.arange(grid_key.size)
-    order = np.lexsort((pos, _tie_ranks(wmin) if wmin.size else wmin, -sums))
-    xyyaw, sums, wmin = xyyaw[order], sums[order], wmin[order]
-    C = xyyaw.shape[0]
-    candidates = np.column_stack([xyyaw[:, 0], xyyaw[:, 1], np.full(C, z), xyyaw[:, 2]])
+    return np.lexsort((pos, _tie_ranks(wmin) if wmin.size else wmin, -sums))
+
+
+def _exact_check(robot: "Robot | None", reach_map: ReachabilityMap, candidates: np.ndarray, T_tasks: np.ndarray,
+                 verify: int, roll_free: bool, roll_steps: int, self_collision: bool,
+                 collision: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Step 4: ``checked``, ``verified`` and ``ik_manipulability`` ``(C,)`` of the first ``verify`` candidates."""
+    C = candidates.shape[0]
     checked = np.zeros(C, dtype=bool)
     verified = np.zeros(C, dtype=bool)
     ik_w = np.full(C, np.nan)
-    n_check = min(int(verify), C)
+    n_check = min(verify, C)
     if n_check:
         checked[:n_check] = True
-        verified[:n_check], ik_w[:n_check] = _check_exactly(
-            robot, reach_map, candidates[:n_check], T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision
-        )
-        final = np.lexsort((np.arange(C), ~verified))
-        candidates, sums, wmin = candidates[final], sums[final], wmin[final]
-        checked, verified, ik_w = checked[final], verified[final], ik_w[final]
-    index_mean = sums / (N * oset.n_index)
-    return BasePlacements(
-        tasks=T_tasks, roll_free=bool(roll_free), z=z, xy_step=step, yaw_step=float(yaw_step), candidates=candidates,
-        index_sum=sums, index_mean=index_mean, manipulability=wmin, checked=checked, verified=verified,
-        ik_manipulability=ik_w, n_grid=int(n_grid), n_lookups=int(n_lookups),
-    )
-
-
-def _check_exactly(robot, reach_map, candidates, T_tasks, roll_free, tool_axis, roll_steps, self_collision, collision):
-    """Exact IK at every task from each candidate: ``(verified (n,), min over tasks of best w (n,))``."""
-    from .reachability import ChunkTask, _spec_of
-
-    n, N = candidates.shape[0], T_tasks.shape[0]
-    rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
-    R = rolls.shape[0]
-    B = np.tile(np.eye(4), (n, 1, 1))
-    cz, sz = np.cos(candidates[:, 3]), np.sin(candidates[:, 3])
-    B[:, 0, 0], B[:, 0, 1], B[:, 1, 0], B[:, 1, 1] = cz, -sz, sz, cz
-    B[:, :3, 3] = candidates[:, :3]
-    T_b = np.linalg.inv(B)[:, None] @ T_tasks[None]  # (n, N, 4, 4)
-    T = np.repeat(T_b[:, :, None], R, axis=2)
-    T[..., :3, :3] = T[..., :3, :3] @ rolls[None, None]
-    T = T.reshape(-1, 4, 4)
-    task = ChunkTask(robot=_spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),
-                     rotations=np.eye(3)[None], group=np.zeros(1, np.int64), n_groups=1, roll_free=False,
-                     solver="analytic", manipulability=reach_map.manipulability_kind, restarts=0, tol=1e-9,
-                     self_collision=bool(self_collision), collision=collision, keep_solutions=False, seed=0)
-    best = np.full(T.shape[0], np.nan)
-    if robot.has_analytic_ik and reach_map.solver == "analytic":
-        idx, q = robot._analytic_ik.candidates(T)
-        keep = _collision_free(task, robot, q)
-        idx, q = idx[keep], q[keep]
-        w = _manipulability(robot, q, reach_map.manipulability_kind)
-        top = np.full(T.shape[0], -np.inf)
-        np.maximum.at(top, idx, w)
-        best = np.where(np.isfinite(top), top, np.nan)
-    else:
-        from ..errors import UnreachableTarget
-
-        for k in range(T.shape[0]):
-            try:
-                q = robot.ik(T[k], max_restarts=max(4, int(reach_map.parameters.get("restarts", 2)) * 2), seed=k)
-            except UnreachableTarget:
-                continue
-            if _collision_free(task, robot, q[None])[0]:
-                best[k] = _manipulability(robot, q[None], reach_map.manipulability_kind)[0]
-    per = best.reshape(n, N, R)
-    task_best = np.where(np.isnan(per).all(axis=2), np.nan, np.nanmax(np.where(np.isnan(per), -np.inf, per), axis=2))
-    verified = ~np.isnan(task_best).any(axis=1)
-    wmin = np.where(verified, np.nanmin(np.where(np.isnan(task_best), np.inf, task_best), axis=1), np.nan)
-    return verified, wmin
+        verified[:n_check], ik_w[:n_check] = verify_bases(robot, reach_map, candidates[:n_check], T_tasks, roll_free,
+                                                          roll_steps, self_collision, collision)
+    return checked, verified, ik_w

@@ -39,7 +39,8 @@ import numpy as np
 
 from ..errors import InvalidInput, UnreachableTarget
 from ..so3 import rot_z as _rot_z
-from .workspace import Workspace, position_dexterity, sample_workspace
+from .dexterity import position_dexterity
+from .workspace import Workspace, sample_workspace
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -246,16 +247,7 @@ def check_layout(
     names = [str(n) for n in names]
     if len(names) != N:
         raise InvalidInput(f"got {len(names)} names for {N} points")
-    if workspace is None:
-        workspace = sample_workspace(robot, 100_000, seed=seed, frame="tcp")
-    elif not isinstance(workspace, Workspace) or workspace.robot.name != robot.name or (
-        workspace.robot.frame_id(workspace.frame) != robot.frame_id("tcp")
-    ):
-        raise InvalidInput(
-            "workspace must be a Workspace sampled for this robot's tcp "
-            f"(sample_workspace({robot.name!r}, frame='tcp')), got "
-            + (f"one of {workspace.robot.name!r} ({workspace.frame})" if isinstance(workspace, Workspace) else type(workspace).__name__)
-        )
+    workspace = _tcp_workspace(robot, workspace, seed)
     median_w = float(np.median(workspace.manipulability))
     vmap = workspace.voxel_map(voxel_size)
     margins = vmap.query(T[:, :3, 3]).margin
@@ -264,41 +256,67 @@ def check_layout(
         method = "analytic"
         sols = [np.asarray(s, dtype=float).reshape(-1, robot.nq) for s in robot.ik_all(T, equivalents=True)]
         if yaw_free:
-            # position-only target of an arm that keeps the tool vertical: its yaw is free
-            R0 = T[:, :3, :3].copy()
-            for yaw in _yaw_candidates()[1:]:
-                todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
-                if not todo:
-                    break
-                Ty = T[todo].copy()
-                Ty[:, :3, :3] = _rot_z(yaw) @ R0[todo]
-                for i, Ti, q in zip(todo, Ty, robot.ik_all(Ty, equivalents=True)):
-                    q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
-                    if q.shape[0]:
-                        sols[i], T[i] = q, Ti
-            # near the limits the usable yaws can be a narrow interval between grid values:
-            # a position-only numerical solve finds one, the closed form then gives its branches
-            todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
-            if todo:
-                for i, q in zip(todo, _numerical_solutions(robot, T[todo], n_seeds, seed, position_only=True)):
-                    if q.shape[0]:
-                        Ti = T[i].copy()
-                        Ti[:3, :3] = robot.fk(q[0])[:3, :3]
-                        exact = np.asarray(robot.ik_all(Ti, equivalents=True), dtype=float).reshape(-1, robot.nq)
-                        sols[i], T[i] = (exact, Ti) if exact.shape[0] else (q[:1], Ti)
+            _solve_with_free_yaw(robot, T, sols, n_seeds, seed)
     else:
         method = "numerical"
         sols = _numerical_solutions(robot, T, n_seeds, seed, position_only=robot.nq < 6)
-
-    checks = []
-    for name, target, q, margin in zip(names, T, sols, margins):
-        if q.shape[0]:
-            J = robot.jacobian(q)[:, :3, :]
-            w, c = position_dexterity(J)
-            best = int(np.argmax(w))
-            ratio = float(w[best] / median_w) if median_w > 0 else float("inf")
-        else:
-            w = c = np.zeros(0)
-            best, ratio = -1, 0.0
-        checks.append(PointCheck(name, target, q, w, c, best, ratio, float(margin)))
+    checks = [_point_check(robot, *row, median_w) for row in zip(names, T, sols, margins)]
     return LayoutReport(robot.name, workspace.frame, method, tuple(checks), median_w)
+
+
+def _tcp_workspace(robot: "Robot", workspace: Workspace | None, seed: int) -> Workspace:
+    """``workspace`` checked to be the robot's tcp workspace, or 100 000 samples seeded ``seed``."""
+    if workspace is None:
+        return sample_workspace(robot, 100_000, seed=seed, frame="tcp")
+    if not isinstance(workspace, Workspace) or workspace.robot.name != robot.name or (
+        workspace.robot.frame_id(workspace.frame) != robot.frame_id("tcp")
+    ):
+        raise InvalidInput(
+            "workspace must be a Workspace sampled for this robot's tcp "
+            f"(sample_workspace({robot.name!r}, frame='tcp')), got "
+            + (f"one of {workspace.robot.name!r} ({workspace.frame})" if isinstance(workspace, Workspace) else type(workspace).__name__)
+        )
+    return workspace
+
+
+def _solve_with_free_yaw(robot: "Robot", T: np.ndarray, sols: list, n_seeds: int, seed: int) -> None:
+    """Position-only targets of an arm that keeps the tool vertical: their yaw is free.
+
+    For each target without a closed-form solution, try the other yaws of the grid, then a
+    position-only numerical solve (near the limits the usable yaws can be a narrow interval
+    between grid values) whose rotation the closed form then solves for its branches.
+    ``T (N, 4, 4)`` and ``sols`` are updated in place with the yaw that worked.
+    """
+    R0 = T[:, :3, :3].copy()
+    for yaw in _yaw_candidates()[1:]:
+        todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
+        if not todo:
+            break
+        Ty = T[todo].copy()
+        Ty[:, :3, :3] = _rot_z(yaw) @ R0[todo]
+        for i, Ti, q in zip(todo, Ty, robot.ik_all(Ty, equivalents=True)):
+            q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
+            if q.shape[0]:
+                sols[i], T[i] = q, Ti
+    todo = [i for i, q in enumerate(sols) if q.shape[0] == 0]
+    if todo:
+        for i, q in zip(todo, _numerical_solutions(robot, T[todo], n_seeds, seed, position_only=True)):
+            if q.shape[0]:
+                Ti = T[i].copy()
+                Ti[:3, :3] = robot.fk(q[0])[:3, :3]
+                exact = np.asarray(robot.ik_all(Ti, equivalents=True), dtype=float).reshape(-1, robot.nq)
+                sols[i], T[i] = (exact, Ti) if exact.shape[0] else (q[:1], Ti)
+
+
+def _point_check(robot: "Robot", name: str, target: np.ndarray, q: np.ndarray, margin: float,
+                 median_w: float) -> PointCheck:
+    """The :class:`PointCheck` of one target: its branches' dexterity, the best branch and its ratio to the median."""
+    if q.shape[0]:
+        J = robot.jacobian(q)[:, :3, :]
+        w, c = position_dexterity(J)
+        best = int(np.argmax(w))
+        ratio = float(w[best] / median_w) if median_w > 0 else float("inf")
+    else:
+        w = c = np.zeros(0)
+        best, ratio = -1, 0.0
+    return PointCheck(name, target, q, w, c, best, ratio, float(margin))

@@ -149,8 +149,53 @@ def recommend_region(
     Raises:
         InvalidInput: an option is out of range.
     """
-    from ..self_collision import SelfCollision
+    singular_threshold = _checked_options(about, side, width, max_singular_share, max_collision_share, z_clearance,
+                                          singular_threshold, seed, n_collision)
+    P = workspace.points
+    origin = _shells_origin(workspace, origin, about)
+    if side == "auto":
+        side = "above" if np.count_nonzero(P[:, 2] > 0) >= P.shape[0] / 2 else "below"
+    z_limit = z_clearance if side == "above" else -z_clearance
+    side_mask = P[:, 2] > z_limit if side == "above" else P[:, 2] < z_limit
+    keep = np.flatnonzero(side_mask)
+    profile = workspace.radial_profile(
+        origin, about=about, width=width, mask=side_mask, singular_threshold=singular_threshold
+    )
+    edges, counts, singular_share = profile.edges, profile.counts, profile.singular_share
+    k = counts.size
+    shell = np.minimum((radial_distance(P[keep], origin, about) / width).astype(int), k - 1)
+    checked, collision_share = _core_collision_share(workspace, keep, shell, k, n_collision, core_joints, seed)
 
+    coll_ok = collision_share <= max_collision_share if n_collision > 0 else np.ones(k, dtype=bool)
+    accepted = (counts > 0) & (singular_share <= max_singular_share) & coll_ok
+    r_in, r_out = _longest_run(accepted, edges)
+    criteria = {
+        "shell width [m]": width,
+        "z clearance [m]": z_clearance,
+        "near-singular sigma_min/sigma_max <": singular_threshold,
+        "max near-singular share": max_singular_share,
+        "max core-collision share": max_collision_share,
+        "core joints": float(core_joints),
+        "self-collision samples": float(min(int(n_collision), keep.size)),
+    }
+    return RecommendedRegion(robot=workspace.robot.name, frame=workspace.frame, about=about, origin=origin,
+                             r_inner=r_in, r_outer=r_out, side=side, z_limit=z_limit, edges=edges, counts=counts,
+                             singular_share=singular_share, collision_share=collision_share, collision_checked=checked,
+                             accepted=accepted, criteria=criteria)
+
+
+def _shells_origin(workspace: "Workspace", origin: Any, about: str) -> np.ndarray:
+    """The shells' centre: ``origin``, by default the outer-hull sphere's centre (at ``z = 0`` for ``about="axis"``)."""
+    if origin is None:
+        origin = workspace.fit_sphere().centre.copy()
+        if about == "axis":
+            origin[2] = 0.0
+    return _as_point(origin, "origin")
+
+
+def _checked_options(about: Any, side: Any, width: Any, max_singular_share: Any, max_collision_share: Any,
+                     z_clearance: Any, singular_threshold: Any, seed: Any, n_collision: Any) -> float:
+    """Check the options of :func:`recommend_region` (raising :class:`InvalidInput`); return the singular threshold."""
     if about not in ("centre", "axis"):
         raise InvalidInput(f"about must be 'centre' or 'axis', got {about!r}")
     if side not in ("auto", "above", "below"):
@@ -174,24 +219,18 @@ def recommend_region(
         raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
     if isinstance(n_collision, bool) or not isinstance(n_collision, (int, np.integer)) or n_collision < 0:
         raise InvalidInput(f"n_collision must be an integer ≥ 0, got {n_collision!r}")
+    return singular_threshold
 
-    P = workspace.points
-    if origin is None:
-        origin = workspace.fit_sphere().centre.copy()
-        if about == "axis":
-            origin[2] = 0.0
-    origin = _as_point(origin, "origin")
-    if side == "auto":
-        side = "above" if np.count_nonzero(P[:, 2] > 0) >= P.shape[0] / 2 else "below"
-    z_limit = z_clearance if side == "above" else -z_clearance
-    side_mask = P[:, 2] > z_limit if side == "above" else P[:, 2] < z_limit
-    keep = np.flatnonzero(side_mask)
-    profile = workspace.radial_profile(
-        origin, about=about, width=width, mask=side_mask, singular_threshold=singular_threshold
-    )
-    edges, counts, singular_share = profile.edges, profile.counts, profile.singular_share
-    k = counts.size
-    shell = np.minimum((radial_distance(P[keep], origin, about) / width).astype(int), k - 1)
+
+def _core_collision_share(workspace: "Workspace", keep: np.ndarray, shell: np.ndarray, k: int, n_collision: int,
+                          core_joints: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Criterion 3: per shell, the configurations checked and the share colliding with the core bodies.
+
+    ``keep`` are the samples on the working side, ``shell (len(keep),)`` their shell among ``k``;
+    ``n_collision`` of them (seeded) are checked. A shell with none checked has share NaN (0 when
+    ``n_collision`` is 0: the check is skipped).
+    """
+    from ..self_collision import SelfCollision
 
     checked = np.zeros(k, dtype=int)
     collided = np.zeros(k)
@@ -204,36 +243,7 @@ def recommend_region(
         collided = np.bincount(shell[pick], weights=hits.astype(float), minlength=k)
     with np.errstate(invalid="ignore", divide="ignore"):
         collision_share = np.where(checked > 0, collided / np.maximum(checked, 1), np.nan if n_collision else 0.0)
-
-    coll_ok = collision_share <= max_collision_share if n_collision > 0 else np.ones(k, dtype=bool)
-    accepted = (counts > 0) & (singular_share <= max_singular_share) & coll_ok
-    r_in, r_out = _longest_run(accepted, edges)
-    criteria = {
-        "shell width [m]": width,
-        "z clearance [m]": z_clearance,
-        "near-singular sigma_min/sigma_max <": singular_threshold,
-        "max near-singular share": max_singular_share,
-        "max core-collision share": max_collision_share,
-        "core joints": float(core_joints),
-        "self-collision samples": float(min(int(n_collision), keep.size)),
-    }
-    return RecommendedRegion(
-        robot=workspace.robot.name,
-        frame=workspace.frame,
-        about=about,
-        origin=origin,
-        r_inner=r_in,
-        r_outer=r_out,
-        side=side,
-        z_limit=z_limit,
-        edges=edges,
-        counts=counts,
-        singular_share=singular_share,
-        collision_share=collision_share,
-        collision_checked=checked,
-        accepted=accepted,
-        criteria=criteria,
-    )
+    return checked, collision_share
 
 
 def _longest_run(accepted: np.ndarray, edges: np.ndarray) -> tuple[float, float]:

@@ -152,11 +152,6 @@ class ReachabilityMap:
         rows = self.rows_of(points)
         return np.where(rows >= 0, self.index[np.maximum(rows, 0)], 0.0)
 
-    def manipulability_at(self, points: Any) -> np.ndarray:
-        """Best manipulability ``(N,)`` of the voxels holding ``points`` (NaN where nothing is reached)."""
-        rows = self.rows_of(points)
-        return np.where(rows >= 0, self.best_manipulability[np.maximum(rows, 0)], np.nan)
-
     def reaches(self, poses: Any) -> np.ndarray:
         """``(N,)`` bool: does the map mark ``poses (N, 4, 4)`` reachable (their voxel, their nearest orientation)?
 
@@ -178,12 +173,6 @@ class ReachabilityMap:
         else:
             out[ok] = self.reached[rows[ok], k]
         return out
-
-    def index_grid(self) -> np.ndarray:
-        """Dense ``(nx, ny, nz)`` reachability index (0 where not computed)."""
-        grid = np.zeros(int(np.prod(self.shape)))
-        grid[self.voxels] = self.index
-        return grid.reshape(self.shape)
 
     def reachable_centres(self, min_index: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Centres ``(k, 3)`` [m] and indices ``(k,)`` of voxels with index ``> min_index``."""
@@ -221,14 +210,6 @@ class ReachabilityMap:
         w = np.where(counts >= 1, w, np.nan).reshape(self.shape)
         return VoxelMap(origin=np.array(self.origin), voxel_size=float(self.resolution), count=counts.reshape(self.shape),
                         mean_manipulability=w, min_manipulability=w.copy(), margin=margin, min_count=min_count)
-
-    def solution(self, voxel_row: int, orientation: int) -> np.ndarray | None:
-        """The stored ``q (nq,)`` of pose ``orientation`` in voxel row ``voxel_row``, or ``None`` (not reached / not kept)."""
-        if self.solutions is None or not self.reached[voxel_row, orientation]:
-            return None
-        s = self.solutions
-        hit = np.flatnonzero((s.voxel == self.voxels[voxel_row]) & (s.orientation == orientation))
-        return None if hit.size == 0 else np.array(s.q[hit[0]])
 
     def pose(self, voxel_row: int, orientation: int) -> np.ndarray:
         """The target pose ``(4, 4)`` (tool frame → base) of a voxel row and orientation."""

@@ -44,22 +44,28 @@ serially by default or on a Dask cluster (``scheduler=``, see :mod:`pinarms.exec
 Workers rebuild the robot from its registry name or URDF text (checked by its SHA-256).
 A map built serially equals the one built on a cluster bit for bit.
 
+Steps 1–2 live in :mod:`robots.reach.reach_grid`, steps 3–4 (one chunk) in
+:mod:`robots.reach.reach_chunk`, the robot a worker rebuilds in :mod:`robots.reach.robot_spec`,
+the map itself in :mod:`robots.reach.reach_map`; this module checks the arguments and runs the
+rounds.
+
 Units: metres, radians; rotations tool frame → base; joint values in the robot's ``q`` order.
 """
 
 from __future__ import annotations
 
-import hashlib
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
-from scipy import ndimage
 
 from ..errors import InvalidInput, ModelError
 from .orientations import OrientationSet, so3_orientations, tool_down_orientations
-from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap, _centres
+from .reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
+from .reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels
+from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from .robot_spec import RobotSpec, spec_of
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -74,417 +80,10 @@ __all__ = [
     "TIE_RTOL",
 ]
 
-#: Relative tolerance under which two solutions' manipulabilities count as tied.
-TIE_RTOL = 1e-9
-_TIE_ATOL = 1e-15
 _POSES_PER_CHUNK = {"analytic": 100_000, "numerical": 10_000}
 
 
-# ----------------------------------------------------------------------------- robot specs
-@dataclass(frozen=True)
-class _RobotSpec:
-    """What a worker needs to rebuild the robot: a registry name, or the URDF text (picklable, small)."""
-
-    name: str
-    sha256: str
-    tcp_frame: str
-    registry: bool
-    urdf_text: str | None
-    package_dirs: tuple[str, ...]
-    family: str | None
-
-
-_ROBOT_CACHE: dict[tuple, Any] = {}
-
-
-def _urdf_sha256(robot: "Robot") -> str:
-    return hashlib.sha256(robot.urdf_text.encode("utf-8")).hexdigest()
-
-
-def _family(robot: "Robot") -> str | None:
-    solver = getattr(robot, "_analytic_ik", None)
-    if solver is None:
-        return None
-    from ..ik import FAMILIES
-
-    for key, cls in FAMILIES.items():
-        if type(solver) is cls:
-            return key
-    raise ModelError(f"robot '{robot.name}' has a closed-form solver of an unknown family ({type(solver).__name__})")
-
-
-def _spec_of(robot: "Robot") -> _RobotSpec:
-    from .. import registry
-
-    sha = _urdf_sha256(robot)
-    family = _family(robot)
-    is_registry = False
-    if robot.name in registry.names():
-        try:
-            ref = registry.load(robot.name)
-            is_registry = _urdf_sha256(ref) == sha and ref.tcp_frame == robot.tcp_frame and _family(ref) == family
-        except Exception:  # a registry robot that cannot load here: ship the URDF text instead
-            is_registry = False
-    spec = _RobotSpec(
-        name=robot.name,
-        sha256=sha,
-        tcp_frame=robot.tcp_frame,
-        registry=is_registry,
-        urdf_text=None if is_registry else robot.urdf_text,
-        package_dirs=tuple(str(p) for p in robot.package_dirs),
-        family=family,
-    )
-    _ROBOT_CACHE.setdefault(_cache_key(spec), robot)
-    return spec
-
-
-def _cache_key(spec: _RobotSpec) -> tuple:
-    return (spec.sha256, spec.tcp_frame, spec.family)
-
-
-def _robot(spec: _RobotSpec) -> "Robot":
-    """The robot of ``spec``, built once per process."""
-    key = _cache_key(spec)
-    robot = _ROBOT_CACHE.get(key)
-    if robot is None:
-        from .. import registry
-        from ..ik import attach_analytic_ik
-
-        if spec.registry:
-            robot = registry.load(spec.name)
-        else:
-            robot = registry.from_urdf_text(spec.urdf_text, tcp=spec.tcp_frame, name=spec.name,
-                                            package_dirs=spec.package_dirs)
-            attach_analytic_ik(robot, spec.family) if spec.family else None
-        if _urdf_sha256(robot) != spec.sha256:
-            raise ModelError(
-                f"robot '{spec.name}' loads here with another URDF (SHA-256 {_urdf_sha256(robot)[:12]}… instead of "
-                f"{spec.sha256[:12]}…): the worker runs another pinarms version"
-            )
-        _ROBOT_CACHE[key] = robot
-    return robot
-
-
-# ----------------------------------------------------------------------------- the bound
-def reach_bound(robot: "Robot", frame: str = "tcp") -> tuple[np.ndarray, float]:
-    """A sphere ``(centre (3,), radius)`` [m] that contains every position of ``frame``'s origin.
-
-    The centre is the origin of the first joint on the chain from the base to ``frame`` (fixed
-    in the base frame for a revolute first joint); the radius adds, by the triangle inequality,
-    the length of every later joint placement's offset, the frame's offset from its joint, and
-    the largest travel ``max(|lower|, |upper|)`` of every prismatic joint on the chain.
-    """
-    model = robot.model
-    fid = robot.frame_id(frame)
-    f = model.frames[fid]
-    chain = []
-    j = f.parentJoint
-    while j > 0:
-        chain.append(j)
-        j = model.parents[j]
-    chain.reverse()
-    if not chain:
-        raise ModelError(f"frame {frame!r} of '{robot.name}' does not move with any joint")
-    centre = np.array(model.jointPlacements[chain[0]].translation, dtype=float)
-    radius = float(np.linalg.norm(f.placement.translation))
-    radius += sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in chain[1:])
-    tree = robot._tree
-    for j in chain:
-        if tree.kind[j] == 2:  # prismatic (mimic prismatic joints move by scale·q + offset)
-            q_index = tree.q_index[j]
-            stroke = max(abs(robot.lower[q_index]), abs(robot.upper[q_index]))
-            radius += abs(float(tree.scale[j])) * stroke + abs(float(tree.offset[j]))
-    return centre, radius
-
-
-# ----------------------------------------------------------------------------- chunk work
-@dataclass(frozen=True)
-class ChunkTask:
-    """One chunk of voxels: everything :func:`solve_chunk` needs (picklable, a few kB).
-
-    ``voxels`` are flat indices (C order) into the grid ``origin``/``resolution``/``shape``.
-    """
-
-    robot: _RobotSpec
-    origin: np.ndarray
-    resolution: float
-    shape: tuple[int, int, int]
-    voxels: np.ndarray
-    rotations: np.ndarray
-    group: np.ndarray
-    n_groups: int
-    roll_free: bool
-    solver: str
-    manipulability: str
-    restarts: int
-    tol: float
-    self_collision: bool
-    collision: Any
-    keep_solutions: bool
-    seed: int
-
-
-def _manipulability(robot: "Robot", q: np.ndarray, part: str) -> np.ndarray:
-    if q.shape[0] == 0:
-        return np.zeros(0)
-    J = robot.jacobian(q)
-    if part == "position":
-        J = J[:, :3, :]
-    m, n = J.shape[1:]
-    if m == n:
-        return np.abs(np.linalg.det(J))
-    G = J @ np.swapaxes(J, 1, 2) if m < n else np.swapaxes(J, 1, 2) @ J
-    return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
-
-
-_COLLISION_CACHE: dict[tuple, Any] = {}
-
-
-def _self_collision(spec: _RobotSpec, robot: "Robot"):
-    key = _cache_key(spec)
-    checker = _COLLISION_CACHE.get(key)
-    if checker is None:
-        from ..self_collision import SelfCollision
-
-        checker = _COLLISION_CACHE[key] = SelfCollision(robot, seed=0)
-    return checker
-
-
-def _collision_free(task: ChunkTask, robot: "Robot", q: np.ndarray) -> np.ndarray:
-    ok = np.ones(q.shape[0], dtype=bool)
-    if q.shape[0] == 0:
-        return ok
-    if task.self_collision:
-        ok &= ~np.asarray(_self_collision(task.robot, robot).in_collision(q), dtype=bool)
-    if task.collision is not None:
-        idx = np.flatnonzero(ok)
-        if idx.size:
-            hit = np.asarray(task.collision.in_collision(q[idx]), dtype=bool).reshape(-1)
-            if hit.shape != idx.shape:
-                raise InvalidInput(
-                    f"collision.in_collision returned shape {hit.shape} for {idx.size} configurations; it must return (N,) bool"
-                )
-            ok[idx[hit]] = False
-    return ok
-
-
-def _best_per_target(idx: np.ndarray, w: np.ndarray, n_targets: int) -> tuple[np.ndarray, np.ndarray]:
-    """For solutions sorted by target ``idx (K,)``: the chosen row per target (−1 if none) and its ``w``.
-
-    Chosen: the first (solver order) among those within ``TIE_RTOL`` of the target's largest ``w``.
-    """
-    choice = np.full(n_targets, -1, dtype=np.int64)
-    best = np.full(n_targets, np.nan)
-    if idx.size == 0:
-        return choice, best
-    starts = np.flatnonzero(np.concatenate(([True], idx[1:] != idx[:-1])))
-    counts = np.diff(np.append(starts, idx.size))
-    wmax = np.repeat(np.maximum.reduceat(w, starts), counts)
-    tied = w >= wmax - (_TIE_ATOL + TIE_RTOL * np.abs(wmax))
-    rows = np.flatnonzero(tied)
-    first = rows[np.concatenate(([True], idx[rows][1:] != idx[rows][:-1]))]
-    choice[idx[first]] = first
-    best[idx[first]] = w[first]
-    return choice, best
-
-
-def _poses(task: ChunkTask) -> np.ndarray:
-    """Targets ``(n·M, 4, 4)``: voxel-major, orientation-minor."""
-    P = _centres(task.origin, task.resolution, task.shape, task.voxels)
-    n, M = P.shape[0], task.rotations.shape[0]
-    T = np.zeros((n, M, 4, 4))
-    T[:, :, :3, :3] = task.rotations[None]
-    T[:, :, :3, 3] = P[:, None, :]
-    T[:, :, 3, 3] = 1.0
-    return T.reshape(n * M, 4, 4)
-
-
-def _solve_analytic(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """``(pose index (K,), q (K, nq), w (K,), n_solutions)``: the chosen solution of each reached pose."""
-    T = _poses(task)
-    idx, q = robot._analytic_ik.candidates(T)
-    n_all = int(idx.size)
-    keep = _collision_free(task, robot, q)
-    idx, q = idx[keep], q[keep]
-    w = _manipulability(robot, q, task.manipulability)
-    choice, best = _best_per_target(idx, w, T.shape[0])
-    reached = np.flatnonzero(choice >= 0)
-    return reached, q[choice[reached]], best[reached], n_all
-
-
-def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """As :func:`_solve_analytic`, one seeded numerical solve per pose (one solution per pose).
-
-    Warm start of pose ``k`` of a voxel: the solution of pose ``k`` in a face neighbour already
-    solved in this chunk (the voxel below, then behind in y, then in x: voxels come in grid
-    order), else the previous roll of the same direction in this voxel; then ``restarts``
-    random starts drawn by the generator seeded with ``(seed, voxel flat index)``.
-    """
-    solver = robot._numerical_ik()
-    T = _poses(task)
-    n, M = task.voxels.size, task.rotations.shape[0]
-    nq = robot.nq
-    ny, nz = task.shape[1], task.shape[2]
-    solved: dict[int, np.ndarray] = {}
-    poses, qs = [], []
-    for r in range(n):
-        v = int(task.voxels[r])
-        rng = np.random.default_rng([task.seed, v])
-        k_idx = v % nz
-        j_idx = (v // nz) % ny
-        neighbours = [solved.get(u) for u, ok in ((v - 1, k_idx > 0), (v - nz, j_idx > 0), (v - ny * nz, True)) if ok]
-        neighbours = [a for a in neighbours if a is not None]
-        here = np.full((M, nq), np.nan)
-        for k in range(M):
-            start = next((a[k] for a in neighbours if np.isfinite(a[k, 0])), None)
-            if start is None and k > 0 and task.group[k] == task.group[k - 1] and np.isfinite(here[k - 1, 0]):
-                start = here[k - 1]  # previous roll of the same direction
-            res = solver._solve(T[r * M + k], start, position_only=False, tol=task.tol,
-                                max_restarts=task.restarts, seed=rng, limits=True)
-            if res.success and _collision_free(task, robot, res.q[None])[0]:
-                here[k] = res.q
-                poses.append(r * M + k)
-                qs.append(res.q)
-        solved[v] = here
-    pose = np.asarray(poses, dtype=np.int64)
-    q = np.asarray(qs, dtype=float).reshape(-1, nq)
-    return pose, q, _manipulability(robot, q, task.manipulability), int(pose.size)
-
-
-def solve_chunk(task: ChunkTask) -> dict:
-    """Reachability of one chunk of voxels (the task function of :func:`reachability_map`).
-
-    Returns a dict of arrays: ``voxels (n,)`` (the task's), ``reached (n, M)`` bool, ``index (n,)``, ``best (n,)`` (NaN where
-    nothing is reached), ``n_solutions`` (every in-limit solution found, before collisions), and
-    with ``keep_solutions`` the reached poses' ``pose_voxel (K,)`` (grid flat index),
-    ``pose_orientation (K,)``, ``q (K, nq)`` and ``w (K,)``.
-    """
-    robot = _robot(task.robot)
-    n, M = task.voxels.size, task.rotations.shape[0]
-    if task.solver == "analytic":
-        pose, q, w, n_all = _solve_analytic(task, robot)
-    else:
-        pose, q, w, n_all = _solve_numerical(task, robot)
-    reached = np.zeros(n * M, dtype=bool)
-    reached[pose] = True
-    reached = reached.reshape(n, M)
-    if task.roll_free:  # a direction counts when any of its rolls is reached
-        per_group = np.zeros((n, task.n_groups), dtype=bool)
-        for k in range(M):
-            per_group[:, task.group[k]] |= reached[:, k]
-        index = per_group.sum(axis=1) / task.n_groups
-    else:
-        index = reached.sum(axis=1) / M
-    best = np.full(n, np.nan)
-    if pose.size:  # pose is sorted: the best manipulability per voxel by one reduceat
-        rows = pose // M
-        starts = np.flatnonzero(np.concatenate(([True], rows[1:] != rows[:-1])))
-        best[rows[starts]] = np.maximum.reduceat(w, starts)
-    out = {"voxels": task.voxels, "reached": reached, "index": index, "best": best, "n_solutions": n_all}
-    if task.keep_solutions:
-        out.update(pose_voxel=task.voxels[pose // M], pose_orientation=(pose % M).astype(np.int32), q=q, w=w)
-    return out
-
-
-# ----------------------------------------------------------------------------- execution
-class _Accumulator:
-    """Folds chunk results in task order (:func:`pinarms.execution.reduce_chunks`): per-voxel arrays
-    in memory, the stored solutions in memory or streamed to a file writer, then dropped."""
-
-    def __init__(self, keep_solutions: bool, writer: Any) -> None:
-        self.keep = keep_solutions and writer is None
-        self.writer = writer
-        self.parts: list[dict] = []
-        self.solutions: list[tuple] = []
-        self.round_reachable: list[np.ndarray] = []
-
-    def __call__(self, acc: "_Accumulator", result: dict) -> "_Accumulator":
-        if "q" in result:
-            sol = (result.pop("pose_voxel"), result.pop("pose_orientation"), result.pop("q"), result.pop("w"))
-            if self.writer is not None:
-                self.writer.append(*sol)
-            elif self.keep:
-                self.solutions.append(sol)
-        self.parts.append(result)
-        self.round_reachable.append(result["voxels"][result["index"] > 0])
-        return self
-
-
-def _fold_round(tasks: list, acc: _Accumulator, scheduler: Any, progress: Callable | None) -> None:
-    from pinarms.execution import reduce_chunks
-
-    reduce_chunks(solve_chunk, tasks, acc, acc, scheduler=scheduler, progress=progress)
-
-
 # ----------------------------------------------------------------------------- building
-def _positive(value: Any, what: str) -> float:
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    v = float(value) if ok else float("nan")
-    if not (np.isfinite(v) and v > 0):
-        raise InvalidInput(f"{what} must be a positive finite number, got {value!r}")
-    return v
-
-
-def _count(value: Any, what: str, low: int = 0) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-        raise InvalidInput(f"{what} must be an integer >= {low}, got {value!r}")
-    return int(value)
-
-
-def _seed_voxels(robot: "Robot", origin: np.ndarray, resolution: float, shape: tuple, n: int, seed: int) -> np.ndarray:
-    """Grid flat indices entered by the tool in ``n`` seeded joint samples (streamed in blocks)."""
-    size = int(np.prod(shape))
-    hit = np.zeros(size, dtype=bool)
-    rng = np.random.default_rng([int(seed), 0x5EED])
-    dims = np.array(shape)
-    for start in range(0, n, 200_000):
-        m = min(200_000, n - start)
-        q = rng.uniform(robot.lower, robot.upper, size=(m, robot.nq))
-        p = robot.position(q)
-        ijk = np.floor((p - origin) / resolution).astype(np.int64)
-        ok = np.all((ijk >= 0) & (ijk < dims), axis=1)
-        ijk = ijk[ok]
-        hit[(ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]] = True
-    return np.flatnonzero(hit)
-
-
-def _dilate(flat: np.ndarray, shape: tuple, allowed: np.ndarray) -> np.ndarray:
-    """``flat`` and its 6 face neighbours, restricted to the bool grid ``allowed``."""
-    grid = np.zeros(int(np.prod(shape)), dtype=bool)
-    grid[flat] = True
-    grown = ndimage.binary_dilation(grid.reshape(shape), structure=ndimage.generate_binary_structure(3, 1))
-    return np.flatnonzero(grown.reshape(-1) & allowed)
-
-
-def _orientation_set(orientations: Any, tool_down: Any, roll_steps: int, tool_axis: Any, robot: "Robot") -> OrientationSet:
-    if isinstance(orientations, OrientationSet):
-        if tool_down is not None:
-            raise InvalidInput("give either an OrientationSet or tool_down=..., not both")
-        return orientations
-    n = _count(orientations, "orientations (poses per voxel, or tool-axis directions with tool_down)", 1)
-    if tool_down is None:
-        return so3_orientations(n)
-    cone = _positive(tool_down, "tool_down cone half-angle [rad]")
-    if cone > np.pi / 2:
-        raise InvalidInput(f"tool_down cone half-angle must be at most π/2 rad (90°), got {tool_down!r} rad")
-    axis = _default_tool_axis(robot, cone) if tool_axis is None else tool_axis
-    return tool_down_orientations(cone, n, _count(roll_steps, "roll_steps", 1), tool_axis=axis)
-
-
-def _default_tool_axis(robot: "Robot", cone: float) -> np.ndarray:
-    """The tool's +z, unless no sampled configuration points +z within ``cone`` of straight down while −z does.
-
-    Rule for arms whose tool frame has z up (a SCARA or gantry modelled with the base's axes):
-    4096 configurations seeded 0 decide.
-    """
-    q = robot.random_q(4096, seed=0)
-    z = robot.fk(q)[:, :3, 2]
-    cos = np.cos(cone) - 1e-9
-    if np.any(-z[:, 2] >= cos) or not np.any(z[:, 2] >= cos):
-        return np.array([0.0, 0.0, 1.0])
-    return np.array([0.0, 0.0, -1.0])
-
-
 def reachability_map(
     arm: "Robot",
     resolution: float = 0.025,
@@ -548,90 +147,22 @@ def reachability_map(
         ModelError: ``ik="analytic"`` for an arm without a closed form.
     """
     t0 = time.perf_counter()
-    resolution = _positive(resolution, "resolution [m]")
-    if ik not in ("auto", "analytic", "numerical"):
-        raise InvalidInput(f"ik must be 'auto', 'analytic' or 'numerical', got {ik!r}")
-    if manipulability not in ("full", "position"):
-        raise InvalidInput(f"manipulability must be 'full' or 'position', got {manipulability!r}")
-    if ik == "analytic" and not arm.has_analytic_ik:
-        raise ModelError(f"robot '{arm.name}' has no closed-form IK; use ik='numerical' (or 'auto')")
-    solver = "analytic" if (ik != "numerical" and arm.has_analytic_ik) else "numerical"
-    restarts = _count(restarts, "restarts")
-    tol = _positive(tol, "tol [m, rad]")
-    seed = _count(seed, "seed")
-    if collision is not None and not callable(getattr(collision, "in_collision", None)):
-        raise InvalidInput("collision must have a method in_collision(q (N, nq)) -> (N,) bool")
-    oset = _orientation_set(orientations, tool_down, roll_steps, tool_axis, arm)
-    M = oset.size
-    if chunk_voxels is None:
-        chunk_voxels = max(1, _POSES_PER_CHUNK[solver] // M)
-    chunk_voxels = _count(chunk_voxels, "chunk_voxels", 1)
-    if not (np.all(np.isfinite(arm.lower)) and np.all(np.isfinite(arm.upper))):
-        raise InvalidInput(f"robot '{arm.name}' has unbounded joint limits; a map needs finite limits")
-
-    # grid: the guaranteed bound
-    centre, radius = reach_bound(arm)
-    lo_i = np.floor((centre - radius) / resolution).astype(np.int64)
-    hi_i = np.ceil((centre + radius) / resolution).astype(np.int64)
-    shape = tuple(int(v) for v in np.maximum(hi_i - lo_i, 1))
-    n_grid = int(np.prod(shape))
-    if n_grid > MAX_GRID_VOXELS:
-        raise InvalidInput(
-            f"resolution {resolution} m gives a grid of {n_grid} voxels around the reach of '{arm.name}' "
-            f"(radius {radius:.3f} m); use a larger resolution (at most {MAX_GRID_VOXELS} voxels)"
-        )
-    origin = lo_i * resolution
-    all_centres_inside = np.zeros(n_grid, dtype=bool)
-    for start in range(0, n_grid, 1 << 21):
-        flat = np.arange(start, min(n_grid, start + (1 << 21)))
-        c = _centres(origin, resolution, shape, flat)
-        all_centres_inside[flat] = np.einsum("ij,ij->i", c - centre, c - centre) <= radius * radius
-    n_sphere = int(all_centres_inside.sum())
-    if samples is None:
-        samples = int(np.clip(2 * n_sphere, 200_000, 5_000_000))
-    samples = _count(samples, "samples", 1)
-
-    spec = _spec_of(arm)
-    base = dict(robot=spec, origin=origin, resolution=resolution, shape=shape, rotations=oset.rotations,
-                group=oset.group, n_groups=oset.n_groups, roll_free=oset.roll_free, solver=solver,
-                manipulability=manipulability, restarts=restarts, tol=tol, self_collision=bool(self_collision),
-                collision=collision, keep_solutions=bool(keep_solutions) or out is not None, seed=seed)
-
+    s = _checked_settings(arm, resolution=resolution, orientations=orientations, tool_down=tool_down,
+                          roll_steps=roll_steps, tool_axis=tool_axis, ik=ik, manipulability=manipulability,
+                          restarts=restarts, tol=tol, self_collision=self_collision, collision=collision,
+                          keep_solutions=keep_solutions, streamed=out is not None, chunk_voxels=chunk_voxels,
+                          samples=samples, seed=seed)
+    spec = spec_of(arm)
     writer = None
     if out is not None:
         from .reach_write import StreamWriter
 
         writer = StreamWriter(out, arm.nq)
-    acc = _Accumulator(bool(keep_solutions) or writer is not None, writer)
+    acc = _Accumulator(s.keep, writer)
     try:
-        todo = _dilate(_seed_voxels(arm, origin, resolution, shape, samples, seed), shape, all_centres_inside)
-        computed = np.zeros(n_grid, dtype=bool)
-        done_voxels, total_voxels, rounds = 0, int(todo.size), 0
-        while todo.size:
-            rounds += 1
-            computed[todo] = True
-            chunks = [todo[s : s + chunk_voxels] for s in range(0, todo.size, chunk_voxels)]
-            tasks = [ChunkTask(voxels=c, **base) for c in chunks]
-            ends = np.cumsum([c.size for c in chunks])
-
-            def report(done: int, total: int, _offset=done_voxels, _ends=ends) -> None:
-                progress(_offset + (int(_ends[done - 1]) if done else 0), total_voxels)
-
-            acc.round_reachable = []
-            _fold_round(tasks, acc, scheduler, report if progress is not None else None)
-            done_voxels += int(todo.size)
-            reachable = np.concatenate(acc.round_reachable) if acc.round_reachable else np.zeros(0, np.int64)
-            frontier = _dilate(reachable, shape, all_centres_inside) if reachable.size else np.zeros(0, np.int64)
-            todo = frontier[~computed[frontier]]
-            total_voxels += int(todo.size)
-
-        params = dict(
-            seed=seed, chunk_voxels=chunk_voxels, restarts=restarts, tol=tol, self_collision=bool(self_collision),
-            collision=None if collision is None else type(collision).__name__, samples=samples, rounds=rounds,
-            bound_centre=centre.tolist(), bound_radius=radius, keep_solutions=bool(keep_solutions) or writer is not None,
-        )
-        m = _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, acc, params,
-                      time.perf_counter() - t0, scheduler)
+        start = face_neighbours(seed_voxels(arm, s.grid, s.samples, s.seed), s.grid)
+        rounds = _compute_in_rounds(start, s.grid, s.task_fields(spec), s.chunk_voxels, acc, scheduler, progress)
+        m = _assemble(arm, spec, s, acc, s.parameters(rounds), time.perf_counter() - t0, scheduler)
         if writer is not None:
             writer.finish(m)
             writer = None
@@ -641,7 +172,193 @@ def reachability_map(
             writer.abort()
 
 
-def _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape, acc, params, seconds, scheduler):
+@dataclass(frozen=True, eq=False)
+class _Settings:
+    """The checked options of :func:`reachability_map` (its arguments, with the defaults resolved)."""
+
+    resolution: float
+    solver: str
+    manipulability: str
+    restarts: int
+    tol: float
+    self_collision: bool
+    collision: Any
+    keep: bool
+    orientations: OrientationSet
+    chunk_voxels: int
+    grid: ReachGrid
+    samples: int
+    seed: int
+
+    def task_fields(self, spec: RobotSpec) -> dict:
+        """The :class:`ChunkTask` fields shared by every chunk (all but ``voxels``)."""
+        oset, grid = self.orientations, self.grid
+        return dict(robot=spec, origin=grid.origin, resolution=self.resolution, shape=grid.shape,
+                    rotations=oset.rotations, group=oset.group, n_groups=oset.n_groups, roll_free=oset.roll_free,
+                    solver=self.solver, manipulability=self.manipulability, restarts=self.restarts, tol=self.tol,
+                    self_collision=self.self_collision, collision=self.collision, keep_solutions=self.keep,
+                    seed=self.seed)
+
+    def parameters(self, rounds: int) -> dict:
+        """How the map was made (:attr:`ReachabilityMap.parameters`, before the statistics)."""
+        collision = None if self.collision is None else type(self.collision).__name__
+        return dict(seed=self.seed, chunk_voxels=self.chunk_voxels, restarts=self.restarts, tol=self.tol,
+                    self_collision=self.self_collision, collision=collision, samples=self.samples, rounds=rounds,
+                    bound_centre=self.grid.centre.tolist(), bound_radius=self.grid.radius, keep_solutions=self.keep)
+
+
+def _checked_settings(arm: "Robot", *, resolution: Any, orientations: Any, tool_down: Any, roll_steps: Any,
+                      tool_axis: Any, ik: Any, manipulability: Any, restarts: Any, tol: Any, self_collision: Any,
+                      collision: Any, keep_solutions: Any, streamed: bool, chunk_voxels: Any, samples: Any,
+                      seed: Any) -> _Settings:
+    """The options of :func:`reachability_map` checked in argument order, the grid around the arm's reach built.
+
+    Raises:
+        InvalidInput, ModelError: as :func:`reachability_map`.
+    """
+    resolution = _positive(resolution, "resolution [m]")
+    solver = _solver(arm, ik, manipulability)
+    restarts = _count(restarts, "restarts")
+    tol = _positive(tol, "tol [m, rad]")
+    seed = _count(seed, "seed")
+    if collision is not None and not callable(getattr(collision, "in_collision", None)):
+        raise InvalidInput("collision must have a method in_collision(q (N, nq)) -> (N,) bool")
+    oset = _orientation_set(orientations, tool_down, roll_steps, tool_axis, arm)
+    if chunk_voxels is None:
+        chunk_voxels = max(1, _POSES_PER_CHUNK[solver] // oset.size)
+    chunk_voxels = _count(chunk_voxels, "chunk_voxels", 1)
+    if not (np.all(np.isfinite(arm.lower)) and np.all(np.isfinite(arm.upper))):
+        raise InvalidInput(f"robot '{arm.name}' has unbounded joint limits; a map needs finite limits")
+    grid = bounding_grid(arm, resolution)
+    if samples is None:
+        samples = int(np.clip(2 * int(grid.inside.sum()), 200_000, 5_000_000))
+    samples = _count(samples, "samples", 1)
+    return _Settings(resolution=resolution, solver=solver, manipulability=manipulability, restarts=restarts, tol=tol,
+                     self_collision=bool(self_collision), collision=collision,
+                     keep=bool(keep_solutions) or streamed, orientations=oset, chunk_voxels=chunk_voxels, grid=grid,
+                     samples=samples, seed=seed)
+
+
+def _solver(arm: "Robot", ik: str, manipulability: str) -> str:
+    """``"analytic"`` or ``"numerical"``: the solver the map uses for ``ik`` (checked with ``manipulability``)."""
+    if ik not in ("auto", "analytic", "numerical"):
+        raise InvalidInput(f"ik must be 'auto', 'analytic' or 'numerical', got {ik!r}")
+    if manipulability not in ("full", "position"):
+        raise InvalidInput(f"manipulability must be 'full' or 'position', got {manipulability!r}")
+    if ik == "analytic" and not arm.has_analytic_ik:
+        raise ModelError(f"robot '{arm.name}' has no closed-form IK; use ik='numerical' (or 'auto')")
+    return "analytic" if (ik != "numerical" and arm.has_analytic_ik) else "numerical"
+
+
+def _compute_in_rounds(todo: np.ndarray, grid: ReachGrid, task: dict, chunk_voxels: int, acc: "_Accumulator",
+                       scheduler: Any, progress: Callable | None) -> int:
+    """Compute the voxels ``todo``, then every face neighbour of a reachable voxel not computed yet,
+    round after round until none is left (step 2 of the module doc); return the number of rounds.
+
+    ``task`` holds the :class:`ChunkTask` fields but ``voxels``; each round's voxels are cut into
+    chunks of ``chunk_voxels`` folded into ``acc``.
+    """
+    computed = np.zeros(grid.inside.size, dtype=bool)
+    done_voxels, total_voxels, rounds = 0, int(todo.size), 0
+    while todo.size:
+        rounds += 1
+        computed[todo] = True
+        chunks = [todo[s : s + chunk_voxels] for s in range(0, todo.size, chunk_voxels)]
+        tasks = [ChunkTask(voxels=c, **task) for c in chunks]
+        ends = np.cumsum([c.size for c in chunks])
+
+        def report(done: int, total: int, _offset=done_voxels, _ends=ends) -> None:
+            progress(_offset + (int(_ends[done - 1]) if done else 0), total_voxels)
+
+        acc.round_reachable = []
+        _fold_round(tasks, acc, scheduler, report if progress is not None else None)
+        done_voxels += int(todo.size)
+        reachable = np.concatenate(acc.round_reachable) if acc.round_reachable else np.zeros(0, np.int64)
+        frontier = face_neighbours(reachable, grid) if reachable.size else np.zeros(0, np.int64)
+        todo = frontier[~computed[frontier]]
+        total_voxels += int(todo.size)
+    return rounds
+
+
+def _positive(value: Any, what: str) -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    v = float(value) if ok else float("nan")
+    if not (np.isfinite(v) and v > 0):
+        raise InvalidInput(f"{what} must be a positive finite number, got {value!r}")
+    return v
+
+
+def _count(value: Any, what: str, low: int = 0) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+        raise InvalidInput(f"{what} must be an integer >= {low}, got {value!r}")
+    return int(value)
+
+
+
+def _orientation_set(orientations: Any, tool_down: Any, roll_steps: int, tool_axis: Any, robot: "Robot") -> OrientationSet:
+    if isinstance(orientations, OrientationSet):
+        if tool_down is not None:
+            raise InvalidInput("give either an OrientationSet or tool_down=..., not both")
+        return orientations
+    n = _count(orientations, "orientations (poses per voxel, or tool-axis directions with tool_down)", 1)
+    if tool_down is None:
+        return so3_orientations(n)
+    cone = _positive(tool_down, "tool_down cone half-angle [rad]")
+    if cone > np.pi / 2:
+        raise InvalidInput(f"tool_down cone half-angle must be at most π/2 rad (90°), got {tool_down!r} rad")
+    axis = _default_tool_axis(robot, cone) if tool_axis is None else tool_axis
+    return tool_down_orientations(cone, n, _count(roll_steps, "roll_steps", 1), tool_axis=axis)
+
+
+def _default_tool_axis(robot: "Robot", cone: float) -> np.ndarray:
+    """The tool's +z, unless no sampled configuration points +z within ``cone`` of straight down while −z does.
+
+    Rule for arms whose tool frame has z up (a SCARA or gantry modelled with the base's axes):
+    4096 configurations seeded 0 decide.
+    """
+    q = robot.random_q(4096, seed=0)
+    z = robot.fk(q)[:, :3, 2]
+    cos = np.cos(cone) - 1e-9
+    if np.any(-z[:, 2] >= cos) or not np.any(z[:, 2] >= cos):
+        return np.array([0.0, 0.0, 1.0])
+    return np.array([0.0, 0.0, -1.0])
+
+
+# ----------------------------------------------------------------------------- execution
+class _Accumulator:
+    """Folds chunk results in task order (:func:`pinarms.execution.reduce_chunks`): per-voxel arrays
+    in memory, the stored solutions in memory or streamed to a file writer, then dropped."""
+
+    def __init__(self, keep_solutions: bool, writer: Any) -> None:
+        self.keep = keep_solutions and writer is None
+        self.writer = writer
+        self.parts: list[dict] = []
+        self.solutions: list[tuple] = []
+        self.round_reachable: list[np.ndarray] = []
+
+    def __call__(self, acc: "_Accumulator", result: dict) -> "_Accumulator":
+        if "q" in result:
+            sol = (result.pop("pose_voxel"), result.pop("pose_orientation"), result.pop("q"), result.pop("w"))
+            if self.writer is not None:
+                self.writer.append(*sol)
+            elif self.keep:
+                self.solutions.append(sol)
+        self.parts.append(result)
+        self.round_reachable.append(result["voxels"][result["index"] > 0])
+        return self
+
+
+def _fold_round(tasks: list, acc: _Accumulator, scheduler: Any, progress: Callable | None) -> None:
+    """Run one round's chunk tasks (serially or on ``scheduler``) and fold them into ``acc`` in task order."""
+    from pinarms.execution import reduce_chunks
+
+    reduce_chunks(solve_chunk, tasks, acc, acc, scheduler=scheduler, progress=progress)
+
+
+def _assemble(arm: "Robot", spec: RobotSpec, s: _Settings, acc: _Accumulator, params: dict, seconds: float,
+              scheduler: Any) -> ReachabilityMap:
+    """The :class:`ReachabilityMap` of the folded chunks, voxels sorted by flat index."""
+    oset, grid = s.orientations, s.grid
     M = oset.size
     parts = acc.parts
     if parts:
@@ -666,9 +383,9 @@ def _assemble(arm, spec, oset, solver, manipulability, origin, resolution, shape
                   scheduler=_describe(scheduler))
     return ReachabilityMap(
         robot=arm.name, urdf_sha256=spec.sha256, tcp_frame=arm.tcp_frame, joint_names=tuple(arm.joint_names),
-        joint_lower=np.array(arm.lower, dtype=float), joint_upper=np.array(arm.upper, dtype=float), solver=solver,
-        manipulability_kind=manipulability, origin=np.array(origin, dtype=float), resolution=float(resolution),
-        shape=tuple(int(v) for v in shape), orientations=oset, voxels=voxels[order],
+        joint_lower=np.array(arm.lower, dtype=float), joint_upper=np.array(arm.upper, dtype=float), solver=s.solver,
+        manipulability_kind=s.manipulability, origin=np.array(grid.origin, dtype=float), resolution=float(s.resolution),
+        shape=tuple(int(v) for v in grid.shape), orientations=oset, voxels=voxels[order],
         reached=np.ascontiguousarray(reached[order]), index=index[order], best_manipulability=best[order],
         solutions=solutions, parameters=params,
     )

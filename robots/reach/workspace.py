@@ -18,15 +18,13 @@ A sample is *near-singular* when its inverse condition is below
 
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
-Where the tables should stand is :func:`robots.placement.recommend_region` (the module above
+The dexterity measures are computed by :mod:`robots.reach.dexterity` (``position_dexterity`` is
+re-exported here). Where the tables should stand is :func:`robots.placement.recommend_region` (the module above
 this one: placement imports workspace, never the other way).
 """
 
 from __future__ import annotations
 
-import os
-import threading
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -34,6 +32,8 @@ import numpy as np
 
 from ..errors import InvalidInput
 from ..robot import MAX_RANDOM_SAMPLES
+from .dexterity import CHUNK, position_dexterity, positions_and_dexterity
+from .joint_samples import random_q_slice
 from .sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
     SPHERE_COVERAGE_MIN, SphereFit, _as_points, _direction_cells, direction_coverage,
     fit_sphere, fit_sphere_to_hull, hull_points)
@@ -60,121 +60,8 @@ __all__ = [
 SINGULAR_INVERSE_CONDITION = 0.1
 """Samples whose ``σ_min/σ_max`` of the position Jacobian is below this are near-singular."""
 
-_CHUNK = 16384
 #: Samples per task when a sweep is cut into tasks (:mod:`pinarms.execution`); about 2 s each.
 TASK_SAMPLES = 2_000_000
-_WORKERS = max(1, min(4, os.cpu_count() or 1))
-
-
-# --------------------------------------------------------------------- dexterity
-def position_dexterity(Jv: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Manipulability and inverse condition of position Jacobians ``J_v (N, 3, nq)``.
-
-    Returns ``(w, c)``: ``w = sqrt(det(J_v J_vᵀ))`` (``sqrt(det(J_vᵀ J_v))`` when
-    ``nq < 3``) and ``c = σ_min / σ_max`` of ``J_v``, each ``(N,)``.
-    """
-    Jv = np.asarray(Jv, dtype=float)
-    if Jv.ndim != 3 or Jv.shape[1] != 3:
-        raise InvalidInput(f"position Jacobians must have shape (N, 3, nq), got {Jv.shape}")
-    nq = Jv.shape[2]
-    if nq < 3:
-        s = np.linalg.svd(Jv, compute_uv=False)
-        w = np.prod(s, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            c = np.where(s[:, 0] > 0, s[:, -1] / s[:, 0], 0.0)
-        return w, c
-    cols = [[Jv[:, a, k] for a in range(3)] for k in range(nq)]
-    return _dexterity_from_columns(cols, Jv.shape[0])
-
-
-def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(w, σ_min/σ_max)`` from the columns of ``J_v`` (list over joints of 3 ``(n,)`` arrays).
-
-    ``G = J_v J_vᵀ`` (3×3 symmetric) is built entry by entry; its eigenvalues come from the
-    closed form for symmetric 3×3 matrices (trigonometric solution of the characteristic
-    cubic), the smallest one as ``det G / (λ1 λ2)`` for accuracy near singularities.
-    """
-    g = {}
-    for a, b in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
-        acc = np.zeros(n)
-        for col in cols:
-            acc += col[a] * col[b]
-        g[a, b] = acc
-    g00, g11, g22, g01, g02, g12 = g[0, 0], g[1, 1], g[2, 2], g[0, 1], g[0, 2], g[1, 2]
-    det = g00 * (g11 * g22 - g12 * g12) - g01 * (g01 * g22 - g12 * g02) + g02 * (g01 * g12 - g11 * g02)
-    det = np.maximum(det, 0.0)
-    w = np.sqrt(det)
-    qm = (g00 + g11 + g22) / 3.0
-    off = g01 * g01 + g02 * g02 + g12 * g12
-    p = np.sqrt(((g00 - qm) ** 2 + (g11 - qm) ** 2 + (g22 - qm) ** 2 + 2.0 * off) / 6.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        inv_p = np.where(p > 0, 1.0 / p, 0.0)
-        b00, b11, b22 = (g00 - qm) * inv_p, (g11 - qm) * inv_p, (g22 - qm) * inv_p
-        b01, b02, b12 = g01 * inv_p, g02 * inv_p, g12 * inv_p
-        r = 0.5 * (b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) + b02 * (b01 * b12 - b11 * b02))
-        phi = np.arccos(np.clip(r, -1.0, 1.0)) / 3.0
-        l1 = qm + 2.0 * p * np.cos(phi)
-        l3 = qm + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
-        l2 = 3.0 * qm - l1 - l3
-        lmin = np.where(l1 * l2 > 0, det / (l1 * l2), 0.0)
-        c = np.where(l1 > 0, np.sqrt(np.clip(lmin / l1, 0.0, 1.0)), 0.0)
-    return w, c
-
-
-def _positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = _CHUNK, progress: Any = None, threads: int | None = None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
-
-    Uses the robot's compiled kinematic tree for one pass over the joints per chunk
-    (positions and the linear Jacobian columns together), on all cores. ``progress(done, N)``
-    is called after each chunk (from the worker threads, one call at a time).
-    """
-    fid = robot.frame_id(frame)
-    N = q.shape[0]
-    points = np.empty((N, 3))
-    w = np.empty(N)
-    c = np.empty(N)
-    tree = getattr(robot, "_tree", None)
-    fast = tree is not None and robot.nq >= 3 and hasattr(tree, "origin_and_columns")
-
-    def block(start: int) -> None:
-        qc = q[start : start + chunk]
-        n = qc.shape[0]
-        if fast:
-            p, cols = _tree_position_and_columns(tree, qc, fid, robot.nq)
-            wc, cc = _dexterity_from_columns(cols, n)
-        else:
-            p = robot.position(qc, frame)
-            p = [p[:, 0], p[:, 1], p[:, 2]]
-            wc, cc = position_dexterity(robot.jacobian(qc, frame)[:, :3, :])
-        for a in range(3):
-            points[start : start + n, a] = p[a]
-        w[start : start + n] = wc
-        c[start : start + n] = cc
-        if progress is not None:
-            with lock:
-                done[0] += n
-                progress(done[0], N)
-
-    lock, done = threading.Lock(), [0]
-    starts = range(0, N, chunk)
-    threads = _WORKERS if threads is None else max(1, int(threads))
-    if len(starts) < 2 or threads == 1:
-        for s in starts:
-            block(s)
-    else:
-        with ThreadPoolExecutor(max_workers=threads) as pool:
-            list(pool.map(block, starts))
-    return points, w, c
-
-
-def _tree_position_and_columns(tree: Any, qc: np.ndarray, frame_id: int, nq: int) -> tuple[list, list]:
-    """Frame origin (3 arrays) and linear Jacobian columns (nq × 3 arrays) of one chunk."""
-    p, cols = tree.origin_and_columns(qc, frame_id)
-    n = qc.shape[0]
-    full = lambda v: np.broadcast_to(v, (n,)) if np.ndim(v) == 0 else v  # noqa: E731
-    return [full(v) for v in p], [[full(v) for v in col[:3]] for col in cols]
 
 
 # ------------------------------------------------------------- radial profile
@@ -386,7 +273,7 @@ def sample_workspace(
     n: int = 100_000,
     seed: int | np.random.Generator | None = 0,
     frame: str = "tcp",
-    chunk: int = _CHUNK,
+    chunk: int = CHUNK,
     *,
     scheduler: Any = None,
     progress: Any = None,
@@ -436,7 +323,7 @@ def sample_workspace(
         q, points, w, c = _sample_in_tasks(robot, int(n), int(seed), frame, int(chunk), int(task_samples), scheduler, progress)
     else:
         q = robot.random_q(int(n), seed=seed)
-        points, w, c = _positions_and_dexterity(robot, q, frame, int(chunk), progress)
+        points, w, c = positions_and_dexterity(robot, q, frame, int(chunk), progress)
     return Workspace(
         robot=robot,
         frame=frame,
@@ -446,28 +333,6 @@ def sample_workspace(
         manipulability=w,
         inverse_condition=c,
     )
-
-
-def _generator_at(robot: "Robot", seed: int, start: int) -> np.random.Generator:
-    """``default_rng(seed)`` advanced past the draws of samples ``0 … start-1`` of ``random_q``."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
-    bit = np.random.PCG64(int(seed))
-    bit.advance(int(start) * robot.nq)
-    return np.random.Generator(bit)
-
-
-def random_q_slice(robot: "Robot", seed: int, start: int, count: int) -> np.ndarray:
-    """Samples ``start … start+count-1`` of ``robot.random_q(n, seed)``, without drawing the others.
-
-    ``random_q`` draws ``(n, nq)`` uniforms row by row from ``numpy.random.default_rng(seed)``
-    (PCG64, one 64-bit draw per number), so sample ``i`` starts at draw ``i·nq``: the
-    generator jumps there (``PCG64.advance``) in a few microseconds.
-    """
-    for name, v in (("start", start), ("count", count)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
-            raise InvalidInput(f"{name} must be an integer >= 0, got {v!r}")
-    return _generator_at(robot, seed, start).uniform(robot.lower, robot.upper, size=(int(count), robot.nq))
 
 
 @dataclass(frozen=True)
@@ -484,7 +349,7 @@ def _sample_task(task: _SampleTask) -> tuple:
     from pinarms.execution import task_threads
 
     q = random_q_slice(task.robot, task.seed, task.start, task.count)
-    return (q, *_positions_and_dexterity(task.robot, q, task.frame, task.chunk, threads=task_threads()))
+    return (q, *positions_and_dexterity(task.robot, q, task.frame, task.chunk, threads=task_threads()))
 
 
 def _sample_in_tasks(robot, n, seed, frame, chunk, task_samples, scheduler, progress) -> tuple:

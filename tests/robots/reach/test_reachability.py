@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput, ModelError, UnreachableTarget
 from pinarms.robots.orientations import so3_orientations, tool_down_orientations
-from pinarms.robots.reachability import reach_bound, reachability_map
+from pinarms.robots.reachability import reachability_map
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.
@@ -145,13 +145,6 @@ def test_lookups_agree_with_the_stored_bits(aubo_map):
     vm = m.voxel_map(0.5)
     q = vm.query(m.centres(m.voxels[[row]]))
     assert q.reachable[0] == (m.index[row] > 0.5)
-
-
-def test_reach_bound_contains_every_sampled_tcp(aubo):
-    centre, radius = reach_bound(aubo)
-    p = aubo.position(aubo.random_q(20_000, seed=2))
-    assert np.linalg.norm(p - centre, axis=1).max() <= radius
-    np.testing.assert_allclose(centre, SHOULDER)
 
 
 def test_orientation_sets_are_spread_evenly():

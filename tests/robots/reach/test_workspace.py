@@ -12,7 +12,6 @@ from pinarms.robots.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,
     fit_sphere_to_hull,
-    position_dexterity,
     sample_workspace,
 )
 
@@ -54,16 +53,6 @@ def test_every_point_is_the_fk_of_its_q_and_dexterity_matches_the_jacobian(name,
     np.testing.assert_allclose(ws.manipulability, robot.manipulability(ws.q, frame, part="position"), rtol=1e-9, atol=1e-12)
     s = np.linalg.svd(robot.jacobian(ws.q, frame)[:, :3, :], compute_uv=False)
     np.testing.assert_allclose(ws.inverse_condition, s[:, -1] / s[:, 0], atol=1e-7)
-
-
-def test_position_dexterity_of_known_jacobians():
-    J = np.zeros((3, 3, 4))
-    J[0, :, :3] = np.diag([2.0, 1.0, 0.5])  # σ = 2, 1, 0.5
-    J[1, :, :3] = np.diag([1.0, 1.0, 0.0])  # singular
-    J[2, :, :3] = np.eye(3)  # isotropic
-    w, c = position_dexterity(J)
-    np.testing.assert_allclose(w, [1.0, 0.0, 1.0], atol=1e-12)
-    np.testing.assert_allclose(c, [0.25, 0.0, 1.0], atol=1e-9)
 
 
 def test_gantry_workspace_is_its_stroke_box():

@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.workspace import fit_sphere, hull_points, random_q_slice, sample_workspace
+from pinarms.robots.workspace import fit_sphere, hull_points, sample_workspace
 from pinarms.robots.workspace_stream import stream_workspace
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
@@ -32,11 +32,6 @@ def streamed(aubo):
 @pytest.fixture(scope="module")
 def in_memory(aubo):
     return sample_workspace(aubo, N, seed=5, frame="flange")
-
-
-def test_slices_of_the_stream_are_the_samples(aubo, in_memory):
-    assert np.array_equal(random_q_slice(aubo, 5, 12_345, 7), in_memory.q[12_345:12_352])
-    assert np.array_equal(random_q_slice(aubo, 5, 0, 3), aubo.random_q(3, seed=5))
 
 
 def test_sample_workspace_in_tasks_equals_one_piece(aubo, in_memory):

@@ -1,0 +1,37 @@
+"""Checks of a URDF around Pinocchio's parse: no DTD, one tree, limits that make sense."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from pinarms import robots
+from pinarms.robots.errors import ModelError
+from pinarms.robots.urdf_checks import check_limits, check_tree, refuse_dtd
+
+TWO_LINKS = """<robot name="r"><link name="a"/><link name="b"/>
+<joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" velocity="1" effort="1"/></joint></robot>"""
+
+
+def test_a_tree_passes_and_a_loop_is_named():
+    check_tree(ET.fromstring(TWO_LINKS), "two.urdf")
+    loop = TWO_LINKS.replace("</robot>", '<joint name="k" type="fixed"><parent link="b"/><child link="a"/></joint></robot>')
+    with pytest.raises(ModelError, match="two.urdf: no root link"):
+        check_tree(ET.fromstring(loop), "two.urdf")
+
+
+def test_a_doctype_is_refused_before_any_parse():
+    refuse_dtd(TWO_LINKS, "two.urdf")
+    with pytest.raises(ModelError, match="two.urdf declares a DOCTYPE"):
+        refuse_dtd('<!DOCTYPE r [<!ENTITY e "x">]>' + TWO_LINKS, "two.urdf")
+
+
+def test_swapped_limits_are_named():
+    robot = robots.from_urdf_text(TWO_LINKS)
+    check_limits(robot.model, "two.urdf")
+    model = robot.model.copy()
+    model.lowerPositionLimit[0], model.upperPositionLimit[0] = 1.0, -1.0
+    with pytest.raises(ModelError, match="joint 'j' has lower limit"):
+        check_limits(model, "two.urdf")
