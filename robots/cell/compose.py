@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 from ..errors import CellError, ModelError, XacroForbidden
+from ..urdf_checks import check_tree, refuse_dtd
 from .cell import Cell
 from .compose_file import (
     _SHAPES,
@@ -119,15 +120,13 @@ def _mesh_ref(filename: str, arm_dir: Path, base_dir: Path, packages: Mapping[st
 
 
 def _parse_arm(path: Path, source: str) -> ET.Element:
-    from ..registry import _check_tree, _refuse_dtd
-
     text = _read_bounded(path, MAX_ARM_BYTES, source)
     try:
-        _refuse_dtd(text, source)
+        refuse_dtd(text, source)
         root = ET.fromstring(text)
         if root.tag != "robot":
             raise ModelError(f"{source} is not a URDF: its root element is <{root.tag}>, expected <robot>")
-        _check_tree(root, source)
+        check_tree(root, source)
     except ET.ParseError as exc:
         raise CellError(f"{source} is not well-formed XML: {exc}") from exc
     except ModelError as exc:
