@@ -28,7 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance
+from pinarms.optim.cycle.joint import joint_cycle
+from pinarms.optim.cycle.request import CycleRequest
+from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance, _vertical_segments
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal
 from pinarms.optim.timing.segments import TimingResult, minimize_time
@@ -37,7 +39,7 @@ from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["StraightMove", "straight_cycle"]
+__all__ = ["StraightMove", "straight_cycle", "approach_cycle"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,8 +158,7 @@ def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "
     trajectory = parts[0]
     for part in parts[1:]:
         trajectory = trajectory.concatenated(part)
-    P = poses[:, :3, 3]
-    ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
+    ends = _vertical_segments(poses)
     deviation = np.empty(4)  # in the order of optim.cycle.LINE_NAMES
     for i, timing in enumerate((up_pick, down_place, up_place, down_pick)):
         t = np.linspace(0.0, timing.duration, LINE_SAMPLES)
@@ -169,3 +170,17 @@ def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "
         line_deviation=deviation, branches=joint.branches, payload=joint.payload, torque_limit=joint.torque_limit,
         approach="straight", joint_cycle_time=joint.cycle_time)
 
+
+def approach_cycle(request: CycleRequest) -> CycleResult:
+    """The cycle of ``request`` ignoring its cell, with the approach it asks for.
+
+    ``"joint"``: the joint-space cycle (:func:`optim.cycle.joint.joint_cycle`); ``"straight"``:
+    that cycle with straight lines at pick and place (:func:`straight_cycle`, on its branch).
+    """
+    joint = joint_cycle(request)
+    if request.approach.approach == "joint":
+        return joint
+    t, load = request.timing, request.load
+    return straight_cycle(request.robot, joint, kind=t.kind, method=t.method, seed=t.seed,
+                          tool_speed=request.approach.tool_speed, payload=load.payload,
+                          torque_limits=load.torque_limits)
