@@ -265,31 +265,19 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
     return refinement, best_placement, best_ppm
 
 
-def search_layout(
-    robot: Any,
-    picks: Any,
-    places: Any,
-    candidates: Any,
-    *,
-    lift: float = 0.05,
-    dwell: float = 0.2,
-    orientation: Any = None,
-    kind: str = "multi-quintic",
-    vmax: Any = None,
-    amax: Any = None,
-    jmax: Any = None,
-    refine: int = 2,
-    refine_evaluations: int = 30,
-    workspace_samples: int = 200_000,
-    seed: int = 0,
-    chunk_size: int = 4,
-    scheduler: Any = None,
-    progress: Callable[[int, int], None] | None = None,
-    arm: str | None = None,
-    clearance: float = 0.02,
-    carry: tuple[str, ...] = (),
-    min_margin: float = 0.0,
-) -> LayoutSearch:
+def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int) -> Any:
+    """The progress callback of one phase of the search (tasks counted from ``offset`` of ``total``), or None."""
+    if progress is None:
+        return None
+    return lambda done, _total: progress(offset + done, total)
+
+
+def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift: float = 0.05, dwell: float = 0.2,
+                  orientation: Any = None, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
+                  jmax: Any = None, refine: int = 2, refine_evaluations: int = 30, workspace_samples: int = 200_000,
+                  seed: int = 0, chunk_size: int = 4, scheduler: Any = None,
+                  progress: Callable[[int, int], None] | None = None, arm: str | None = None,
+                  clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
@@ -343,38 +331,19 @@ def search_layout(
     n_tasks = -(-sum(1 for f in failure if not f) // chunk_size)
     total = n_tasks + int(refine)
 
-    def phase(offset: int):
-        if progress is None:
-            return None
-        return lambda done, _total: progress(offset + done, total)
-
     cycle_time, branch, manip = _plan_candidates(robot, token, cand, st, failure, reason, chunk_size, scheduler,
-                                                 phase(0))
+                                                 _phase(progress, 0, total))
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
     order = _ranking(ppm, margin)
     refinement, best_placement, best_ppm = _refine_best(robot, token, cand, st, ppm, ok, order, int(refine),
                                                         refine_evaluations, vmap, min_margin, scheduler,
-                                                        phase(n_tasks))
+                                                        _phase(progress, n_tasks, total))
     best_cycle = None
     if best_placement is not None:
         best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
-    return LayoutSearch(
-        robot=str(robot.name),
-        picks=picks_w,
-        places=places_w,
-        candidates=cand,
-        failure=tuple(failure),
-        reason=tuple(reason),
-        cycle_time=cycle_time,
-        picks_per_minute=ppm,
-        branch=branch,
-        manipulability=manip,
-        margin=margin,
-        order=order,
-        refinement=refinement,
-        best_placement=best_placement,
-        best_picks_per_minute=best_ppm,
-        best_cycle=best_cycle,
-        seed=int(seed),
-    )
+    return LayoutSearch(robot=str(robot.name), picks=picks_w, places=places_w, candidates=cand, failure=tuple(failure),
+                        reason=tuple(reason), cycle_time=cycle_time, picks_per_minute=ppm, branch=branch,
+                        manipulability=manip, margin=margin, order=order, refinement=refinement,
+                        best_placement=best_placement, best_picks_per_minute=best_ppm, best_cycle=best_cycle,
+                        seed=int(seed))
