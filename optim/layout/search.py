@@ -218,7 +218,8 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
     M = cand.shape[0]
     todo = [m for m in range(M) if not failure[m]]
     tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
-    outcomes = [o for chunk in map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=progress) for o in chunk]
+    chunks = map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=progress)
+    outcomes = [o for chunk in chunks for o in chunk]
     cycle_time = np.full(M, np.nan)
     branch = np.full(M, -1)
     manip = np.full(M, np.nan)
@@ -232,7 +233,11 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
 def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: np.ndarray, ok: np.ndarray,
                  order: np.ndarray, n_refine: int, evaluations: int, vmap: Any, min_margin: float,
                  scheduler: Any, progress: Any) -> tuple[Refinement | None, np.ndarray | None, float]:
-    """Refine the best ``n_refine`` candidates over the free coordinates; (refinement, best placement, its picks/min)."""
+    """Refine the best ``n_refine`` candidates over the free coordinates.
+
+    Returns the :class:`Refinement` (None without one), the best placement (None when every
+    candidate failed) and its picks per minute.
+    """
     from pinarms.execution import map_chunks
 
     M = cand.shape[0]
