@@ -1,6 +1,6 @@
 """The pick-and-place cycle's input and output: :class:`PickPlace` (the spec) and :class:`CycleResult`.
 
-The data of :mod:`optim.cycle.plan` (which plans it: :func:`optim.plan_cycle`), in a module of
+The data of :mod:`optim.cycle` (planned by :func:`optim.plan_cycle`), in a module of
 their own so that every way of planning a cycle (joint space, straight vertical approach,
 in a cell, around obstacles) shares them without importing the planner back. Also the
 helpers those planners share: a hold at rest and the tcp's distance from the vertical
@@ -29,7 +29,7 @@ __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "L
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
 
 #: How the tcp approaches and leaves pick and place: through the lift points in joint space, or on
-#: straight vertical lines (:mod:`optim.straight_approach`).
+#: straight vertical lines (:mod:`optim.cycle.straight`).
 CYCLE_APPROACHES = ("joint", "straight")
 
 #: How a cycle was planned (:attr:`CycleResult.status`): ``"ok"`` as asked (without a cell, or its
@@ -175,13 +175,13 @@ class CycleResult:
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
         approach: ``"joint"`` or ``"straight"`` (straight vertical lines at pick and place;
-            ``moves`` are then :class:`optim.straight_approach.StraightMove`).
+            ``moves`` are then :class:`optim.cycle.straight.StraightMove`).
         joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
             the same limits (None otherwise).
         payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
         cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
-            (:class:`optim.cell_cycle.CellCycleReport`); else None.
+            (:class:`optim.cycle.in_cell.CellCycleReport`); else None.
         status: how it was planned, one of :data:`CYCLE_STATUSES`.
     """
 

@@ -1,7 +1,7 @@
 """The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
 
 :func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
-adding via points (:mod:`optim.cell_cycle`). A crate under a guard, a shelf or the other
+adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
