@@ -38,7 +38,7 @@ __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "C
            "CycleRequest", "CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "plan_cycle"]
 
 
-def plan_cycle(request: CycleRequest | Any, spec: PickPlace | None = None, /, **keywords: Any) -> CycleResult:
+def plan_cycle(request: CycleRequest | Any, /, spec: PickPlace | None = None, **keywords: Any) -> CycleResult:
     """Plan and time one full pick-and-place cycle (module doc).
 
     Call it with one :class:`CycleRequest`::

@@ -120,3 +120,8 @@ def test_the_keyword_form_builds_the_same_request(scara, spec):
     with pytest.raises(SettingOutOfRange, match="margin"):
         CycleRequest.from_keywords(scara, spec, margin=1e-9)
     assert optim.plan_cycle is plan_cycle
+
+
+def test_the_keyword_form_takes_the_spec_by_name_too(scara, spec):
+    by_name = plan_cycle(scara, spec=spec, amax=8.0)
+    assert by_name.cycle_time == plan_cycle(CycleRequest(scara, spec, timing=CycleTiming(amax=8.0))).cycle_time
