@@ -1,11 +1,15 @@
-"""The pick-and-place cycle: one spec in (:class:`PickPlace`), one call (:func:`plan_cycle`), one result out.
+"""The pick-and-place cycle: one request in (:class:`CycleRequest`), one call (:func:`plan_cycle`), one result out.
 
-- :mod:`.spec`: the spec and the result (:class:`PickPlace`, :class:`CycleResult`) and the
-  helpers every way of planning a cycle shares;
-- :mod:`.plan`: :func:`plan_cycle`, the dispatcher: joint-space transfers here, or
+- :mod:`.spec`: the task and the result (:class:`PickPlace`, :class:`CycleResult` with its
+  ``status``) and the helpers every way of planning a cycle shares;
+- :mod:`.request`: :class:`CycleRequest` and its settings groups (:class:`CycleTiming`,
+  :class:`CycleLoad`, :class:`CycleApproach`, :class:`CellSettings`), checked when built;
+- :mod:`.joint`: the joint-space cycle (IK on one branch, time-optimal moves);
 - :mod:`.straight`: straight vertical approach and retreat at pick and place;
 - :mod:`.in_cell`: the cycle planned inside a cell, keeping its clearance
-  (:class:`CellCycleReport`; around obstacles through :mod:`optim.motion.cycle`).
+  (:class:`CellCycleReport`; around obstacles through :mod:`optim.motion.cycle`);
+- :mod:`.plan`: :func:`plan_cycle`, the dispatcher (``plan_cycle(robot, spec, **keywords)``
+  still works: it builds the request).
 
 ``from pinarms.optim.cycle import plan_cycle, PickPlace, ...`` works as before; the old paths
 ``pinarms.optim.cell_cycle`` and ``pinarms.optim.straight_approach`` are the same module objects

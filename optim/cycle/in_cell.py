@@ -1,7 +1,8 @@
 """Pick-and-place cycles that keep a clearance from the cell around the arm.
 
-:func:`plan_cycle` with ``cell=`` lands here. The cycle is first planned as without a cell
-(:mod:`optim.cycle`), then checked continuously in the cell
+:func:`plan_cycle` with a cell (:class:`CellSettings` in the request) lands here. The cycle
+is first planned as without a cell (:func:`optim.cycle.straight.approach_cycle`), then
+checked continuously in the cell
 (:meth:`robots.cell.Cell.check_motion`): every pair of the arm with a fixture or another
 arm (held still at ``hold``) must keep ``clearance`` [m], and the arm's own links must
 not touch (they are designed close, so no clearance is asked of them). When the check
@@ -33,13 +34,16 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.caps import LIFT_STEP_RANGE, MAX_CLEARANCE, MAX_LIFT_ATTEMPTS, MIN_MARGIN, number_setting
+from pinarms.optim.caps import MAX_LIFT_ATTEMPTS
+from pinarms.optim.cycle.request import CycleRequest
+from pinarms.optim.cycle.spec import CycleResult, PickPlace
+from pinarms.optim.cycle.straight import approach_cycle
+from pinarms.optim.errors import PlanningError
+from pinarms.optim.motion.cycle import planned_cycle
+from pinarms.robots.cell import ArmMotion
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell"]
-
-_UP = np.array([0.0, 0.0, 1.0])
-
 
 @dataclass(frozen=True, eq=False)
 class CellCycleReport:
@@ -109,13 +113,6 @@ def _arm_of(cell: Any, robot: Any, arm: str | None):
     )
 
 
-def _verdict(external, own, motion, clearance: float, margin: float, hold: Any):
-    ext = external.check_motion([motion], margin=margin, clearance=clearance, hold=hold)
-    slf = own.check_motion([motion], margin=margin, hold=hold) if own is not None else None
-    ok = ext.clear and (slf is None or slf.collision_free)
-    return ok, ext, slf
-
-
 def _describe(check) -> tuple[float, str, float]:
     """(min clearance, pair text, time) of a check, from its first contact or its closest sample."""
     if check.first_contact is not None:
@@ -125,128 +122,174 @@ def _describe(check) -> tuple[float, str, float]:
     return check.min_clearance, (str(pair) if pair is not None else "none"), check.min_clearance_time
 
 
-def plan_cycle_in_cell(robot: Any, spec: Any, *, cell: Any, clearance: float, arm: str | None, hold: Any,
-                       margin: float, lift_step: float, plan: Any, plan_transfer: bool = True, **plan_kwargs: Any):
-    """Plan ``spec`` for ``robot`` (an arm of ``cell``) keeping ``clearance`` (module doc).
+class _Trials:
+    """The attempts of one in-cell cycle, in order: each cycle checked continuously in the cell.
 
-    ``plan`` is :func:`optim.cycle.plan_cycle` (called without a cell for each attempt).
+    ``external`` holds the arm's pairs with fixtures and other arms (they must keep
+    ``clearance``), ``own`` its own links' pairs (no contact), or None when it has none.
     """
-    from pinarms.robots.cell import ArmMotion
 
-    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
-    lift_step = number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
-    margin = number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
-    cell_arm = _arm_of(cell, robot, arm)
-    external = cell.with_pairs("external")
-    own = cell.with_pairs("self") if any(p.kind == "self" and p.owner_a == cell_arm.name for p in cell.pairs) else None
-    hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+    def __init__(self, request: CycleRequest, cell_arm: Any, hold_q: np.ndarray) -> None:
+        cell = request.cell.cell
+        self.request, self.cell_arm, self.hold_q = request, cell_arm, hold_q
+        self.clearance, self.margin = request.cell.clearance, request.cell.margin
+        self.external = cell.with_pairs("external")
+        self.own = (cell.with_pairs("self") if any(p.kind == "self" and p.owner_a == cell_arm.name for p in cell.pairs)
+                    else None)
+        self.attempts: list[tuple[str, bool, float, str]] = []
+        self.last: tuple[str, float, str, float] | None = None
 
-    base = plan(robot, spec, **plan_kwargs)
-    # the pick and the place themselves must keep the clearance: no re-planning moves them
-    for label, q in (("pick", base.q_via[0]), ("place", base.q_via[len(spec.names) - 1])):
-        q_cell = hold_q.copy()
+    def check(self, description: str, result: CycleResult) -> bool:
+        """Check ``result`` in the cell and record the attempt: whether it keeps the clearance."""
+        motion = ArmMotion(self.cell_arm.name, result.trajectory)
+        ext = self.external.check_motion([motion], margin=self.margin, clearance=self.clearance, hold=self.hold_q)
+        slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) if self.own is not None else None
+        ok = ext.clear and (slf is None or slf.collision_free)
+        bad = ext if not ext.clear or slf is None else slf
+        d, pair, t = _describe(bad if not ok else ext)
+        self.attempts.append((description, bool(ok), float(d), pair))
+        self.last = (description, d, pair, t)
+        return bool(ok)
+
+    def plan(self, description: str, spec: PickPlace) -> tuple[bool, CycleResult]:
+        """Plan ``spec`` as without the cell and check it (UnreachableTarget: the spec is out of reach)."""
+        result = approach_cycle(dataclasses.replace(self.request, spec=spec))
+        return self.check(description, result), result
+
+    def failure(self, cell: Any) -> CollisionError:
+        """The error when no attempt cleared: what blocks, where, after how many attempts."""
+        description, d, pair, t = self.last
+        return CollisionError(
+            f"arm {self.cell_arm.name!r} of cell {cell.name!r} cannot keep {self.clearance * 1e3:.1f} mm: {pair} "
+            f"blocks (closest {d * 1e3:.1f} mm at t = {t:.3f} s of the cycle) after {len(self.attempts)} attempts, "
+            f"the last with {description}; lower the clearance, move the pick/place, or move the fixture"
+        )
+
+
+def _check_ends(trials: _Trials, base: CycleResult) -> None:
+    """The pick and the place themselves must keep the clearance: no re-planning moves them."""
+    cell_arm = trials.cell_arm
+    for label, q in (("pick", base.q_via[0]), ("place", base.q_via[len(base.spec.names) - 1])):
+        q_cell = trials.hold_q.copy()
         q_cell[cell_arm.q_slice] = q
-        cl = external.clearance(q_cell)
-        if cl.distance < clearance:
+        cl = trials.external.clearance(q_cell)
+        if cl.distance < trials.clearance:
             raise CollisionError(
                 f"the {label} pose of arm {cell_arm.name!r} is {cl.distance * 1e3:.1f} mm from {cl.pair_of().body_b} "
-                f"({cl.pair_of()}), less than the clearance {clearance * 1e3:.1f} mm: move the {label} point "
+                f"({cl.pair_of()}), less than the clearance {trials.clearance * 1e3:.1f} mm: move the {label} point "
                 "(re-planning the transfer cannot move it)"
             )
 
-    attempts: list[tuple[str, bool, float, str]] = []
-    last = None
 
-    def attempt(description: str, candidate_spec: Any):
-        nonlocal last
-        result = plan(robot, candidate_spec, **plan_kwargs)
-        ok, ext, slf = _verdict(external, own, ArmMotion(cell_arm.name, result.trajectory), clearance, margin, hold_q)
-        bad = ext if not ext.clear or slf is None else slf
-        d, pair, t = _describe(bad if not ok else ext)
-        attempts.append((description, bool(ok), float(d), pair))
-        last = (description, d, pair, t, ok, result, ext)
-        return ok, result, ext
-
-    ok, result, ext = attempt(f"lift {spec.lift:.3f} m", spec)
-    lift = spec.lift
+def _raise_lift(trials: _Trials, spec: PickPlace, lift_step: float) -> tuple[bool, CycleResult | None, float]:
+    """Step 1: raise the lift by ``lift_step`` until the cycle clears, the arm's reach ends, or the cap."""
+    lift, ok, result = spec.lift, False, None
     for _ in range(MAX_LIFT_ATTEMPTS):  # bounded: the arm's reach usually ends the rise first
-        if ok:
-            break
         lift += lift_step
         try:
-            ok, result, ext = attempt(f"lift {lift:.3f} m", dataclasses.replace(spec, lift=lift))
+            ok, result = trials.plan(f"lift {lift:.3f} m", dataclasses.replace(spec, lift=lift))
         except UnreachableTarget:
             lift -= lift_step
             break
-    vias: tuple = ()
+        if ok:
+            break
+    return ok, result, lift
+
+
+def _add_vias(trials: _Trials, spec: PickPlace, top: float,
+              lift_step: float) -> tuple[bool, CycleResult | None, tuple]:
+    """Step 2: at the highest lift ``top``, one via point mid-transfer, then two at thirds, three heights."""
+    robot = trials.request.robot
+    poses = dataclasses.replace(spec, lift=top).poses(robot)
+    above_pick, above_place = poses[1][:3, 3], poses[-2][:3, 3]
+    height = max(above_pick[2], above_place[2])
+    for k in range(1, 4):
+        for fractions in ((0.5,), (1.0 / 3.0, 2.0 / 3.0)):
+            points = []
+            for f in fractions:
+                p = above_pick + f * (above_place - above_pick)
+                p[2] = height + k * lift_step
+                points.append(p)
+            try:
+                ok, result = trials.plan(
+                    f"lift {top:.3f} m, {len(points)} via point(s) at z = {height + k * lift_step:.3f} m",
+                    dataclasses.replace(spec, lift=top, via=tuple(spec.via) + tuple(points)),
+                )
+            except UnreachableTarget:
+                continue
+            if ok:
+                return True, result, tuple(tuple(float(x) for x in p) for p in points)
+    return False, None, ()
+
+
+def _plan_transfer(trials: _Trials, base: CycleResult) -> tuple[bool, CycleResult | None]:
+    """Step 3: the transfer planned round what blocks (OMPL, :mod:`optim.motion`), checked like the others."""
+    request = trials.request
+    try:
+        result = planned_cycle(request.robot, request.spec, base, cell=request.cell.cell, arm=trials.cell_arm,
+                               clearance=trials.clearance, hold=trials.hold_q, margin=trials.margin,
+                               seed=int(request.timing.seed))
+        move = result.moves[0]
+        ok = trials.check(f"lift {request.spec.lift:.3f} m, transfer planned by {move.planner} ({move.states} states)",
+                          result)
+        return ok, result
+    except (PlanningError, CollisionError) as exc:
+        trials.attempts.append((f"transfer planned around the cell: {exc}", False, float("nan"), ""))
+        return False, None
+
+
+def plan_cycle_in_cell(request: CycleRequest) -> CycleResult:
+    """Plan the cycle of ``request`` (its robot an arm of ``request.cell.cell``) keeping its clearance (module doc).
+
+    Raises:
+        InvalidInput: the robot is not an arm of the cell (or not arm ``request.cell.arm``).
+        CollisionError: the pick or place pose is too close to a fixture, or no re-planned
+            cycle keeps the clearance; the message names the blocking bodies.
+    """
+    settings, spec = request.cell, request.spec
+    cell = settings.cell
+    cell_arm = _arm_of(cell, request.robot, settings.arm)
+    hold_q = cell.neutral if settings.hold is None else cell.robot.check_q(settings.hold)[0][0]
+    trials = _Trials(request, cell_arm, hold_q)
+
+    base = approach_cycle(request)  # the cycle as planned without the cell: the first attempt
+    _check_ends(trials, base)
+    ok, result = trials.check(f"lift {spec.lift:.3f} m", base), base
+    lift, vias, status = spec.lift, (), "ok"
+    if not ok:
+        ok, result, lift = _raise_lift(trials, spec, settings.lift_step)
+        status = "re-planned"
     if not ok:
         top = max(lift, spec.lift)
-        poses = dataclasses.replace(spec, lift=top).poses(robot)
-        above_pick, above_place = poses[1][:3, 3], poses[-2][:3, 3]
-        height = max(above_pick[2], above_place[2])
-        for k in range(1, 4):
-            for fractions in ((0.5,), (1.0 / 3.0, 2.0 / 3.0)):
-                points = []
-                for f in fractions:
-                    p = above_pick + f * (above_place - above_pick)
-                    p[2] = height + k * lift_step
-                    points.append(p)
-                try:
-                    ok, result, ext = attempt(
-                        f"lift {top:.3f} m, {len(points)} via point(s) at z = {height + k * lift_step:.3f} m",
-                        dataclasses.replace(spec, lift=top, via=tuple(spec.via) + tuple(points)),
-                    )
-                except UnreachableTarget:
-                    continue
-                if ok:
-                    lift, vias = top, tuple(tuple(float(x) for x in p) for p in points)
-                    break
-            if ok:
-                break
-    planned_transfer = False
-    if not ok and plan_transfer:
-        # raising the transfer cannot clear: plan it round what blocks (OMPL, optim.motion)
-        from pinarms.optim.errors import PlanningError
-        from pinarms.optim.motion.cycle import planned_cycle
-
-        try:
-            result = planned_cycle(robot, spec, base, cell=cell, arm=cell_arm, clearance=clearance, hold=hold_q,
-                                   margin=margin, seed=int(plan_kwargs.get("seed", 0)))
-            ok, ext, slf = _verdict(external, own, ArmMotion(cell_arm.name, result.trajectory), clearance, margin,
-                                    hold_q)
-            d, pair, t = _describe(ext if ok else (ext if not ext.clear or slf is None else slf))
-            move = result.moves[0]
-            description = f"lift {spec.lift:.3f} m, transfer planned by {move.planner} ({move.states} states)"
-            attempts.append((description, bool(ok), float(d), pair))
-            last = (description, d, pair, t, ok, result, ext)
-            lift, vias, planned_transfer = spec.lift, (), bool(ok)
-        except (PlanningError, CollisionError) as exc:
-            attempts.append((f"transfer planned around the cell: {exc}", False, float("nan"), ""))
+        ok, result, vias = _add_vias(trials, spec, top, settings.lift_step)
+        lift = top if ok else lift
+    if not ok and settings.plan_transfer:
+        ok, result = _plan_transfer(trials, base)
+        lift, vias, status = spec.lift, (), "transfer planned"
     if not ok:
-        description, d, pair, t, _, _, _ = last
-        raise CollisionError(
-            f"arm {cell_arm.name!r} of cell {cell.name!r} cannot keep {clearance * 1e3:.1f} mm: {pair} blocks "
-            f"(closest {d * 1e3:.1f} mm at t = {t:.3f} s of the cycle) after {len(attempts)} attempts, the last with "
-            f"{description}; lower the clearance, move the pick/place, or move the fixture"
-        )
-    # the kept cycle once more with the exact distance at every sample: its true minimum
-    final = external.check_motion([ArmMotion(cell_arm.name, result.trajectory)], margin=margin, clearance=clearance,
-                                  hold=hold_q, curve=True)
+        raise trials.failure(cell)
+    report = _report(trials, result, base, lift, vias, planned_transfer=status == "transfer planned")
+    return dataclasses.replace(result, cell_report=report, status=status)
+
+
+def _report(trials: _Trials, result: CycleResult, base: CycleResult, lift: float, vias: tuple,
+            planned_transfer: bool) -> CellCycleReport:
+    """The kept cycle once more with the exact distance at every sample (its true minimum), and what was tried."""
+    final = trials.external.check_motion([ArmMotion(trials.cell_arm.name, result.trajectory)], margin=trials.margin,
+                                         clearance=trials.clearance, hold=trials.hold_q, curve=True)
     d, pair, _ = _describe(final)
-    ext = final
-    report = CellCycleReport(
-        cell=cell.name,
-        arm=cell_arm.name,
-        clearance=clearance,
-        margin=float(margin),
+    return CellCycleReport(
+        cell=trials.request.cell.cell.name,
+        arm=trials.cell_arm.name,
+        clearance=trials.clearance,
+        margin=float(trials.margin),
         min_clearance=float(d),
         min_clearance_pair=pair,
-        lower_bound=float(ext.lower_bound),
+        lower_bound=float(final.lower_bound),
         lift=float(lift),
         via=vias,
         cycle_time_without_cell=float(base.cycle_time),
         extra_time=float(result.cycle_time - base.cycle_time),
-        attempts=tuple(attempts),
+        attempts=tuple(trials.attempts),
         planned_transfer=planned_transfer,
     )
-    return dataclasses.replace(result, cell_report=report)

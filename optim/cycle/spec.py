@@ -1,6 +1,6 @@
 """The pick-and-place cycle's input and output: :class:`PickPlace` (the spec) and :class:`CycleResult`.
 
-The data of :mod:`optim.cycle.plan` (which plans it: :func:`optim.plan_cycle`), in a module of
+The data of :mod:`optim.cycle` (planned by :func:`optim.plan_cycle`), in a module of
 their own so that every way of planning a cycle (joint space, straight vertical approach,
 in a cell, around obstacles) shares them without importing the planner back. Also the
 helpers those planners share: a hold at rest and the tcp's distance from the vertical
@@ -22,14 +22,21 @@ from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "LINE_NAMES", "LINE_SAMPLES", "CycleResult", "PickPlace"]
+__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
+           "PickPlace"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
 
 #: How the tcp approaches and leaves pick and place: through the lift points in joint space, or on
-#: straight vertical lines (:mod:`optim.straight_approach`).
+#: straight vertical lines (:mod:`optim.cycle.straight`).
 CYCLE_APPROACHES = ("joint", "straight")
+
+#: How a cycle was planned (:attr:`CycleResult.status`): ``"ok"`` as asked (without a cell, or its
+#: first check in the cell passed); ``"re-planned"``: in a cell, the lift was raised or via points
+#: added to keep the clearance; ``"transfer planned"``: in a cell, the transfer was planned round
+#: what blocks (:mod:`optim.motion.cycle`). A cycle that cannot be planned raises instead.
+CYCLE_STATUSES = ("ok", "re-planned", "transfer planned")
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.
 LINE_NAMES = ("lift from pick", "lower to place", "lift from place", "lower to pick")
@@ -168,13 +175,14 @@ class CycleResult:
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
         approach: ``"joint"`` or ``"straight"`` (straight vertical lines at pick and place;
-            ``moves`` are then :class:`optim.straight_approach.StraightMove`).
+            ``moves`` are then :class:`optim.cycle.straight.StraightMove`).
         joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
             the same limits (None otherwise).
         payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
         cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
-            (:class:`optim.cell_cycle.CellCycleReport`); else None.
+            (:class:`optim.cycle.in_cell.CellCycleReport`); else None.
+        status: how it was planned, one of :data:`CYCLE_STATUSES`.
     """
 
     robot: str
@@ -213,6 +221,7 @@ class CycleResult:
             return None
         return np.maximum(*(m.torque_ratios for m in self.moves))
     cell_report: Any = field(default=None, repr=False)
+    status: str = CYCLE_STATUSES[0]
 
     @property
     def one_branch(self) -> bool:
@@ -252,6 +261,7 @@ class CycleResult:
     def as_dict(self) -> dict[str, Any]:
         """JSON-able summary (SI units)."""
         return {
+            "status": self.status,
             "robot": self.robot,
             "waypoints": [{"name": n, "position_m": T[:3, 3].tolist()} for n, T in zip(self.names, self.waypoints)],
             "q_via": self.q_via.tolist(),
@@ -290,6 +300,12 @@ def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray
     ab = b - a
     s = np.clip(np.sum((p - a) * ab, axis=-1) / np.sum(ab * ab, axis=-1), 0.0, 1.0)
     return np.linalg.norm(p - (a + s[..., None] * ab), axis=-1)
+
+
+def _vertical_segments(poses: np.ndarray) -> np.ndarray:
+    """(4, 2, 3) ends [m] of the vertical segments of waypoints ``poses`` (k, 4, 4), in :data:`LINE_NAMES` order."""
+    P = poses[:, :3, 3]
+    return np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
 
 
 def _line_deviation(robot: Any, moves: tuple[TimingResult, TimingResult], ends: np.ndarray) -> np.ndarray:

@@ -28,7 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance
+from pinarms.optim.cycle.joint import joint_cycle
+from pinarms.optim.cycle.request import CycleRequest
+from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance, _vertical_segments
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal
 from pinarms.optim.timing.segments import TimingResult, minimize_time
@@ -37,7 +39,7 @@ from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["StraightMove", "straight_cycle"]
+__all__ = ["StraightMove", "straight_cycle", "approach_cycle"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,68 +106,106 @@ def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "
     if kind == "3-5-3" and k != 6:
         raise InvalidInput(f"kind='3-5-3' times 4 transfer waypoints; with approach='straight' the transfer has {k - 2} "
                            "(above pick, the vias, above place): use 'multi-quintic' or 'quintic-bspline'")
-    v, a, j = joint.vmax, joint.amax, joint.jmax
-    cons = [JointVelocityConstraint(v), JointAccelerationConstraint(a)]
-    if tool_speed is not None:
-        cons.append(ToolSpeedConstraint(tool_speed))
-    loaded = torque_constraint(robot, torque_limits, payload)
-    # (constraints of the lines, robot and limits of the transfer) carrying the payload, then empty
-    if loaded is None:
-        legs = [(cons, {}), (cons, {})]
-    else:
-        empty = torque_constraint(robot, loaded.limit)
-        legs = [(cons + [JointTorqueConstraint(t.robot, t.limit)], {"robot": t.robot, "torque_limits": t.limit})
-                for t in (loaded, empty)]
+    legs = _Legs(robot, joint, kind, method, seed, tool_speed, tolerance, payload, torque_limits)
     poses, q = joint.waypoints[:k], joint.q_via[:k]
-    options = {"velocities": "heuristic"} if kind == "multi-quintic" else None
-
-    def line(frm: np.ndarray, to: np.ndarray, q_from: np.ndarray, leg: int) -> PathTiming:
-        path = cartesian_path(robot, np.stack([frm, to]), q_start=q_from, tolerance=tolerance)
-        return time_optimal(path, legs[leg][0], jerk=j)
-
-    def transfer(q_via: np.ndarray, leg: int) -> TimingResult:
-        return minimize_time(q_via, kind, v, a, j, method=method, seed=seed, trajectory_options=options,
-                             **legs[leg][1])
-
-    def end(timing: PathTiming) -> np.ndarray:
-        return timing.path.q_knots[-1]
-
-    def joint_line(timing: PathTiming, leg: int) -> float:
-        path = joint_spline(timing.path.q_knots[[0, -1]], robot=robot)
-        return time_optimal(path, legs[leg][0], jerk=j).duration
-
-    up_pick = line(poses[0], poses[1], q[0], 0)
-    q_above_pick = end(up_pick)
-    there = transfer(np.vstack([q_above_pick, q[2 : k - 1]]), 0)
-    down_place = line(poses[k - 2], poses[k - 1], q[k - 2], 0)
-    up_place = line(poses[k - 1], poses[k - 2], end(down_place), 1)
-    back = transfer(np.vstack([end(up_place), q[k - 3 : 1 : -1], q_above_pick]), 1)
-    down_pick = line(poses[1], poses[0], q_above_pick, 1)
-    moves = []
-    for leg, (first, middle, last) in enumerate(((up_pick, there, down_place), (up_place, back, down_pick))):
-        traj = first.trajectory.concatenated(middle.trajectory).concatenated(last.trajectory)
-        ratios = None
-        if loaded is not None:
-            arm, limit = legs[leg][1]["robot"], legs[leg][1]["torque_limits"]
-            ratios = torque_peaks(traj, arm).ratios(limit)
-        moves.append(StraightMove((first, last), middle, traj,
-                                  np.array([joint_line(first, leg), joint_line(last, leg)]), ratios))
+    up_pick = legs.line(poses[0], poses[1], q[0], 0)
+    q_above_pick = _end(up_pick)
+    there = legs.transfer(np.vstack([q_above_pick, q[2 : k - 1]]), 0)
+    down_place = legs.line(poses[k - 2], poses[k - 1], q[k - 2], 0)
+    up_place = legs.line(poses[k - 1], poses[k - 2], _end(down_place), 1)
+    back = legs.transfer(np.vstack([_end(up_place), q[k - 3 : 1 : -1], q_above_pick]), 1)
+    down_pick = legs.line(poses[1], poses[0], q_above_pick, 1)
+    moves = [legs.move(leg, *parts) for leg, parts in enumerate(((up_pick, there, down_place),
+                                                                 (up_place, back, down_pick)))]
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
-        parts = [_hold(q[0], spec.dwell), parts[0], _hold(end(down_place), spec.dwell), parts[1]]
+        parts = [_hold(q[0], spec.dwell), parts[0], _hold(_end(down_place), spec.dwell), parts[1]]
     trajectory = parts[0]
     for part in parts[1:]:
         trajectory = trajectory.concatenated(part)
-    P = poses[:, :3, 3]
-    ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
-    deviation = np.empty(4)  # in the order of optim.cycle.LINE_NAMES
-    for i, timing in enumerate((up_pick, down_place, up_place, down_pick)):
-        t = np.linspace(0.0, timing.duration, LINE_SAMPLES)
-        p = np.asarray(robot.fk(timing.trajectory(t)))[:, :3, 3]
-        deviation[i] = _segment_distance(p, ends[i, 0], ends[i, 1]).max()
+    deviation = _line_deviations(robot, (up_pick, down_place, up_place, down_pick), _vertical_segments(poses))
+    v, a, j = joint.vmax, joint.amax, joint.jmax
     return CycleResult(
         robot=joint.robot, spec=spec, names=joint.names, waypoints=joint.waypoints, q_via=joint.q_via,
         moves=tuple(moves), trajectory=trajectory, peaks=trajectory.peaks(), vmax=v, amax=a, jmax=j,
         line_deviation=deviation, branches=joint.branches, payload=joint.payload, torque_limit=joint.torque_limit,
         approach="straight", joint_cycle_time=joint.cycle_time)
 
+
+def _end(timing: PathTiming) -> np.ndarray:
+    """The configuration a timed line ends at."""
+    return timing.path.q_knots[-1]
+
+
+class _Legs:
+    """The two legs of a straight cycle: the move to place (carrying the payload) and the move back (empty).
+
+    Each leg has its path constraints for the lines (joint velocity and acceleration, the tool
+    speed, the torques with or without the payload) and the keywords of its transfer's timing.
+    """
+
+    def __init__(self, robot: Any, joint: CycleResult, kind: str, method: str, seed: int, tool_speed: float | None,
+                 tolerance: float, payload: Any, torque_limits: Any) -> None:
+        self.robot, self.kind, self.method, self.seed, self.tolerance = robot, kind, method, seed, tolerance
+        self.v, self.a, self.j = joint.vmax, joint.amax, joint.jmax
+        cons = [JointVelocityConstraint(self.v), JointAccelerationConstraint(self.a)]
+        if tool_speed is not None:
+            cons.append(ToolSpeedConstraint(tool_speed))
+        self.loaded = torque_constraint(robot, torque_limits, payload)
+        # (constraints of the lines, robot and limits of the transfer) carrying the payload, then empty
+        if self.loaded is None:
+            self.legs = [(cons, {}), (cons, {})]
+        else:
+            empty = torque_constraint(robot, self.loaded.limit)
+            self.legs = [(cons + [JointTorqueConstraint(t.robot, t.limit)],
+                          {"robot": t.robot, "torque_limits": t.limit}) for t in (self.loaded, empty)]
+        self.options = {"velocities": "heuristic"} if kind == "multi-quintic" else None
+
+    def line(self, frm: np.ndarray, to: np.ndarray, q_from: np.ndarray, leg: int) -> PathTiming:
+        """The straight Cartesian line ``frm`` → ``to`` from ``q_from``, time-optimal under the leg's constraints."""
+        path = cartesian_path(self.robot, np.stack([frm, to]), q_start=q_from, tolerance=self.tolerance)
+        return time_optimal(path, self.legs[leg][0], jerk=self.j)
+
+    def transfer(self, q_via: np.ndarray, leg: int) -> TimingResult:
+        """The joint-space transfer through ``q_via``, timed by :func:`optim.minimize_time`."""
+        return minimize_time(q_via, self.kind, self.v, self.a, self.j, method=self.method, seed=self.seed,
+                             trajectory_options=self.options, **self.legs[leg][1])
+
+    def joint_line(self, timing: PathTiming, leg: int) -> float:
+        """Duration [s] of the same line's ends joined in joint space, timed the same way."""
+        path = joint_spline(timing.path.q_knots[[0, -1]], robot=self.robot)
+        return time_optimal(path, self.legs[leg][0], jerk=self.j).duration
+
+    def move(self, leg: int, first: PathTiming, middle: TimingResult, last: PathTiming) -> StraightMove:
+        """Line, transfer, line of one leg as a :class:`StraightMove` (its torque ratios with torque limits)."""
+        traj = first.trajectory.concatenated(middle.trajectory).concatenated(last.trajectory)
+        ratios = None
+        if self.loaded is not None:
+            arm, limit = self.legs[leg][1]["robot"], self.legs[leg][1]["torque_limits"]
+            ratios = torque_peaks(traj, arm).ratios(limit)
+        return StraightMove((first, last), middle, traj,
+                            np.array([self.joint_line(first, leg), self.joint_line(last, leg)]), ratios)
+
+
+def _line_deviations(robot: Any, lines: tuple[PathTiming, ...], ends: np.ndarray) -> np.ndarray:
+    """(4,) largest tcp distance [m] of each timed line from its vertical segment, in :data:`LINE_NAMES` order."""
+    deviation = np.empty(4)
+    for i, timing in enumerate(lines):
+        t = np.linspace(0.0, timing.duration, LINE_SAMPLES)
+        p = np.asarray(robot.fk(timing.trajectory(t)))[:, :3, 3]
+        deviation[i] = _segment_distance(p, ends[i, 0], ends[i, 1]).max()
+    return deviation
+
+def approach_cycle(request: CycleRequest) -> CycleResult:
+    """The cycle of ``request`` ignoring its cell, with the approach it asks for.
+
+    ``"joint"``: the joint-space cycle (:func:`optim.cycle.joint.joint_cycle`); ``"straight"``:
+    that cycle with straight lines at pick and place (:func:`straight_cycle`, on its branch).
+    """
+    joint = joint_cycle(request)
+    if request.approach.approach == "joint":
+        return joint
+    t, load = request.timing, request.load
+    return straight_cycle(request.robot, joint, kind=t.kind, method=t.method, seed=t.seed,
+                          tool_speed=request.approach.tool_speed, payload=load.payload,
+                          torque_limits=load.torque_limits)

@@ -199,6 +199,110 @@ def _initial_population(evaluate: _Evaluator, lower: np.ndarray, upper: np.ndarr
     return x, f, v
 
 
+def _run_budget(settings: GASettings, max_generations: int | None, stall_generations: int | None,
+                time_limit: float | None) -> tuple[int, int | None]:
+    """The generation budget and the stall count of a run, checked (``time_limit`` too)."""
+    G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
+    if G > MAX_GENERATIONS:
+        raise SettingOutOfRange(f"max_generations = {G:,} is more than the {MAX_GENERATIONS:,} allowed")
+    stall = (settings.stall_generations if stall_generations is None
+             else _count(stall_generations, "stall_generations", 1))
+    if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))
+                                       and np.isfinite(time_limit) and time_limit >= 0):
+        raise InvalidSettings(f"time_limit={time_limit!r}: give a finite number of seconds >= 0 "
+                              "or None")
+    return G, stall
+
+
+class _BestSoFar:
+    """The best individual seen (Deb's order, whatever the constraint handling), the stall count
+    and the per-generation history."""
+
+    def __init__(self, x0: np.ndarray, stall_tolerance: float) -> None:
+        self.x, self.f, self.v = x0.copy(), np.inf, np.inf
+        self.stall_tolerance = stall_tolerance
+        self.stall_count = 0
+        self.rows: dict[str, list[float]] = {k: [] for k in ("best", "mean", "feasible_share", "best_violation",
+                                                            "feasible_mean")}
+
+    @property
+    def feasible(self) -> bool:
+        return bool(self.v <= FEASIBILITY_TOLERANCE)
+
+    def record(self, x: np.ndarray, f: np.ndarray, v: np.ndarray) -> None:
+        """Take the generation's best if it beats the best so far, count a stall, append the history."""
+        order_deb = rank_feasibility_rules(f, v)[0]
+        i_best = int(np.argmin(order_deb))
+        improved = False
+        if _better(f[i_best], v[i_best], self.f, self.v):
+            feas_now = v[i_best] <= FEASIBILITY_TOLERANCE
+            was_feas = self.v <= FEASIBILITY_TOLERANCE
+            if feas_now and was_feas and np.isfinite(self.f):
+                improved = self.f - f[i_best] > self.stall_tolerance * max(abs(self.f), 1e-300)
+            else:
+                improved = True
+            self.x, self.f, self.v = x[i_best].copy(), float(f[i_best]), float(v[i_best])
+        self.stall_count = 0 if improved else self.stall_count + 1
+        finite = np.isfinite(f)
+        feasible_now = (v <= FEASIBILITY_TOLERANCE) & finite
+        self.rows["best"].append(self.f)
+        self.rows["mean"].append(float(np.mean(f[finite])) if np.any(finite) else np.inf)
+        self.rows["feasible_share"].append(float(np.mean(v <= FEASIBILITY_TOLERANCE)))
+        self.rows["best_violation"].append(self.v if self.v > FEASIBILITY_TOLERANCE else 0.0)
+        self.rows["feasible_mean"].append(float(np.mean(f[feasible_now])) if np.any(feasible_now) else np.inf)
+
+    def history(self) -> GAHistory:
+        return GAHistory(*(np.asarray(self.rows[k]) for k in ("best", "mean", "feasible_share", "best_violation",
+                                                              "feasible_mean")))
+
+
+def _children(x: np.ndarray, rank: np.ndarray, fitness: np.ndarray, n_children: int, settings: GASettings,
+              lower: np.ndarray, upper: np.ndarray, generation: int, G: int,
+              rng: np.random.Generator) -> np.ndarray:
+    """Select parents, cross them and mutate the children (fixed or adaptive rates), in that draw order."""
+    n_pairs = (n_children + 1) // 2
+    if settings.selection == "tournament":
+        parents = selection.tournament(rank, 2 * n_pairs, settings.tournament_size, rng)
+    else:
+        parents = selection.rank_sus(rank, 2 * n_pairs, settings.rank_pressure, rng)
+    ia, ib = parents[:n_pairs], parents[n_pairs:]
+    f_max, f_avg = float(np.max(fitness)), float(np.mean(fitness))
+    if settings.adaptive:
+        pc: float | np.ndarray = adaptive.adaptive_crossover_probability(
+            fitness[ia], fitness[ib], f_max, f_avg, settings.pc1, settings.pc2)
+    else:
+        pc = settings.crossover_probability
+    a, b = x[ia], x[ib]
+    if settings.crossover == "sbx":
+        c1, c2 = crossover.sbx(a, b, lower, upper, pc, settings.sbx_eta, rng)
+    elif settings.crossover == "arithmetic":
+        c1, c2 = crossover.arithmetic(a, b, lower, upper, pc, rng)
+    else:
+        c1, c2 = crossover.blend(a, b, lower, upper, pc, settings.blend_alpha, rng)
+    children = np.concatenate([c1, c2])[:n_children]
+    origin = np.concatenate([ia, ib])[:n_children]
+    if settings.adaptive:
+        pm: float | np.ndarray = adaptive.adaptive_mutation_probability(
+            fitness[origin], f_max, f_avg, settings.pm1, settings.pm2)
+    else:
+        pm = settings.mutation_probability
+    if settings.mutation == "non-uniform":
+        return mutation.non_uniform(children, lower, upper, pm, generation, G, settings.nonuniform_shape, rng)
+    return mutation.polynomial(children, lower, upper, pm, settings.polynomial_eta, rng)
+
+
+def _stop_reason(generation: int, G: int, stall: int | None, best: _BestSoFar, time_limit: float | None,
+                 elapsed: float) -> str | None:
+    """Why the run stops after this generation (budget, stall, time), or None to go on."""
+    if generation >= G:
+        return "max_generations"
+    if stall is not None and best.stall_count >= stall:
+        return "stall"
+    if time_limit is not None and elapsed >= time_limit:
+        return "time_limit"
+    return None
+
+
 def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASettings | None = None,
            constraints: Objective | None = None, seed: int | np.random.Generator = 0,
            max_generations: int | None = None, stall_generations: int | None = None,
@@ -230,15 +334,7 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
         raise InvalidSettings(f"settings must be an optim.GASettings, got {type(settings).__name__}")
     lower, upper = _check_bounds(bounds)
     rng = random_generator(seed)
-    G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
-    if G > MAX_GENERATIONS:
-        raise SettingOutOfRange(f"max_generations = {G:,} is more than the {MAX_GENERATIONS:,} allowed")
-    stall = (settings.stall_generations if stall_generations is None
-             else _count(stall_generations, "stall_generations", 1))
-    if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))
-                                       and np.isfinite(time_limit) and time_limit >= 0):
-        raise InvalidSettings(f"time_limit={time_limit!r}: give a finite number of seconds >= 0 "
-                              "or None")
+    G, stall = _run_budget(settings, max_generations, stall_generations, time_limit)
     pop = settings.population
     t0 = time.perf_counter()
     evaluate = _Evaluator(objective, constraints)
@@ -248,108 +344,31 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
 
     x, f, v = _initial_population(evaluate, lower, upper, pop, initial, rng,
                                   draw_feasible=constraints is not None)
-
-    hist_best: list[float] = []
-    hist_mean: list[float] = []
-    hist_feas: list[float] = []
-    hist_viol: list[float] = []
-    hist_feas_mean: list[float] = []
-    best_x, best_f, best_v = x[0].copy(), np.inf, np.inf
-    stall_count = 0
-    stop_reason = "max_generations"
+    best = _BestSoFar(x[0], settings.stall_tolerance)
     generation = 0
-
-    def rank_population() -> tuple[np.ndarray, np.ndarray]:
-        if use_penalty:
-            return rank_penalty(f, v, penalty.lam)
-        return rank_feasibility_rules(f, v)
-
     while True:
-        # Bookkeeping of the best-so-far (Deb's order, whatever the handling).
-        order_deb = rank_feasibility_rules(f, v)[0]
-        i_best = int(np.argmin(order_deb))
-        improved = False
-        if _better(f[i_best], v[i_best], best_f, best_v):
-            feas_now = v[i_best] <= FEASIBILITY_TOLERANCE
-            was_feas = best_v <= FEASIBILITY_TOLERANCE
-            if feas_now and was_feas and np.isfinite(best_f):
-                improved = best_f - f[i_best] > settings.stall_tolerance * max(abs(best_f), 1e-300)
-            else:
-                improved = True
-            best_x, best_f, best_v = x[i_best].copy(), float(f[i_best]), float(v[i_best])
-        stall_count = 0 if improved else stall_count + 1
-        finite = np.isfinite(f)
-        hist_best.append(best_f)
-        hist_mean.append(float(np.mean(f[finite])) if np.any(finite) else np.inf)
-        feasible_now = (v <= FEASIBILITY_TOLERANCE) & finite
-        hist_feas.append(float(np.mean(v <= FEASIBILITY_TOLERANCE)))
-        hist_feas_mean.append(float(np.mean(f[feasible_now])) if np.any(feasible_now) else np.inf)
-        hist_viol.append(best_v if best_v > FEASIBILITY_TOLERANCE else 0.0)
-
+        best.record(x, f, v)
         elapsed = time.perf_counter() - t0
-        if generation > 0 and callback is not None:
-            if callback(GAProgress(generation, best_x.copy(), best_f,
-                                   best_v <= FEASIBILITY_TOLERANCE, evaluate.count, elapsed)):
-                stop_reason = "callback"
-                break
-        if generation >= G:
-            stop_reason = "max_generations"
+        if generation > 0 and callback is not None and callback(
+                GAProgress(generation, best.x.copy(), best.f, best.feasible, evaluate.count, elapsed)):
+            stop_reason = "callback"
             break
-        if stall is not None and stall_count >= stall:
-            stop_reason = "stall"
+        stop_reason = _stop_reason(generation, G, stall, best, time_limit, elapsed)
+        if stop_reason is not None:
             break
-        if time_limit is not None and elapsed >= time_limit:
-            stop_reason = "time_limit"
-            break
-
         generation += 1
-        rank, fitness = rank_population()
+        rank, fitness = rank_penalty(f, v, penalty.lam) if use_penalty else rank_feasibility_rules(f, v)
         if use_penalty:
             penalty.update(bool(v[int(np.argmin(rank))] <= FEASIBILITY_TOLERANCE))
-        n_elite = settings.elitism
-        elites = np.argsort(rank, kind="stable")[:n_elite]
-        n_children = pop - n_elite
-        n_pairs = (n_children + 1) // 2
-        if settings.selection == "tournament":
-            parents = selection.tournament(rank, 2 * n_pairs, settings.tournament_size, rng)
-        else:
-            parents = selection.rank_sus(rank, 2 * n_pairs, settings.rank_pressure, rng)
-        ia, ib = parents[:n_pairs], parents[n_pairs:]
-        f_max, f_avg = float(np.max(fitness)), float(np.mean(fitness))
-        if settings.adaptive:
-            pc: float | np.ndarray = adaptive.adaptive_crossover_probability(
-                fitness[ia], fitness[ib], f_max, f_avg, settings.pc1, settings.pc2)
-        else:
-            pc = settings.crossover_probability
-        a, b = x[ia], x[ib]
-        if settings.crossover == "sbx":
-            c1, c2 = crossover.sbx(a, b, lower, upper, pc, settings.sbx_eta, rng)
-        elif settings.crossover == "arithmetic":
-            c1, c2 = crossover.arithmetic(a, b, lower, upper, pc, rng)
-        else:
-            c1, c2 = crossover.blend(a, b, lower, upper, pc, settings.blend_alpha, rng)
-        children = np.concatenate([c1, c2])[:n_children]
-        origin = np.concatenate([ia, ib])[:n_children]
-        if settings.adaptive:
-            pm: float | np.ndarray = adaptive.adaptive_mutation_probability(
-                fitness[origin], f_max, f_avg, settings.pm1, settings.pm2)
-        else:
-            pm = settings.mutation_probability
-        if settings.mutation == "non-uniform":
-            children = mutation.non_uniform(children, lower, upper, pm, generation, G,
-                                            settings.nonuniform_shape, rng)
-        else:
-            children = mutation.polynomial(children, lower, upper, pm,
-                                           settings.polynomial_eta, rng)
+        elites = np.argsort(rank, kind="stable")[:settings.elitism]
+        children = _children(x, rank, fitness, pop - settings.elitism, settings, lower, upper, generation, G, rng)
         fc, vc = evaluate(children)
         x = np.concatenate([x[elites], children])
         f = np.concatenate([f[elites], fc])
         v = np.concatenate([v[elites], vc])
 
-    history = GAHistory(np.asarray(hist_best), np.asarray(hist_mean),
-                        np.asarray(hist_feas), np.asarray(hist_viol), np.asarray(hist_feas_mean))
-    feasible = bool(best_v <= FEASIBILITY_TOLERANCE)
-    return GAResult(x=best_x, f=best_f, feasible=feasible,
-                    violation=0.0 if feasible else best_v, history=history,
+    feasible = best.feasible
+    return GAResult(x=best.x, f=best.f, feasible=feasible,
+                    violation=0.0 if feasible else best.v, history=best.history(),
                     generations=generation, evaluations=evaluate.count,
                     stop_reason=stop_reason, wall_time=time.perf_counter() - t0)

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.optim.cycle import PickPlace, plan_cycle
+from pinarms.optim.cycle import CellSettings, CycleRequest, CycleTiming, PickPlace, plan_cycle
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
 
@@ -102,7 +102,7 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
     picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
     places_b = points_in_base_frame(st.places, placement[None, :])[0]
     R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
-    in_cell: dict[str, Any] = {}
+    in_cell = None
     if st.cell is not None:
         try:
             moved = _cell_of(st.cell).with_arm_base(st.cell.arm, base_to_world(placement), carry=st.cell.carry)
@@ -110,14 +110,14 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
             return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
                             f"the cell cannot hold the arm there: {exc}"), None
         robot = moved.arm(st.cell.arm).robot
-        in_cell = {"cell": moved, "arm": st.cell.arm, "clearance": st.cell.clearance}
+        in_cell = CellSettings(moved, clearance=st.cell.clearance, arm=st.cell.arm)
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
         for j, place in enumerate(places_b):
             spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
             try:
-                cycle = plan_cycle(robot, spec, kind=st.kind, vmax=st.vmax, amax=st.amax, jmax=st.jmax,
-                                   method="exact", seed=st.seed, **in_cell)
+                timing = CycleTiming(st.kind, st.vmax, st.amax, st.jmax, method="exact", seed=st.seed)
+                cycle = plan_cycle(CycleRequest(robot, spec, timing=timing, cell=in_cell))
             except PinarmsError as exc:
                 where = f"pick {i + 1} → place {j + 1}"
                 return _Outcome(_classify(exc), f"{where}: {exc}"), None

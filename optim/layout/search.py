@@ -131,31 +131,158 @@ def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
     return np.asarray(out, dtype=np.intp)
 
 
-def search_layout(
-    robot: Any,
-    picks: Any,
-    places: Any,
-    candidates: Any,
-    *,
-    lift: float = 0.05,
-    dwell: float = 0.2,
-    orientation: Any = None,
-    kind: str = "multi-quintic",
-    vmax: Any = None,
-    amax: Any = None,
-    jmax: Any = None,
-    refine: int = 2,
-    refine_evaluations: int = 30,
-    workspace_samples: int = 200_000,
-    seed: int = 0,
-    chunk_size: int = 4,
-    scheduler: Any = None,
-    progress: Callable[[int, int], None] | None = None,
-    arm: str | None = None,
-    clearance: float = 0.02,
-    carry: tuple[str, ...] = (),
-    min_margin: float = 0.0,
-) -> LayoutSearch:
+def _cell_target(robot: Any, arm: str | None, clearance: float, carry: tuple[str, ...],
+                 token: str) -> tuple[Any, "_CellRecipe | None"]:
+    """The arm to place and, when ``robot`` is a cell, the recipe its workers rebuild the cell from."""
+    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
+        cell = robot
+        if arm is None:
+            if len(cell.arms) != 1:
+                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
+            arm = cell.arms[0].name
+        robot = cell.arm(arm).robot
+        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+        for name in carry:
+            cell.fixture(name)
+        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
+                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
+                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
+                             tuple(carry), float(clearance))
+        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+        return robot, recipe
+    if arm is not None or carry:
+        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
+    return robot, None
+
+
+def _checked_inputs(picks: Any, places: Any, candidates: Any, kind: str, counts: dict[str, int],
+                    orientation: Any, lift: float, dwell: float,
+                    min_margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Points, candidates, orientation and counts of a search, checked before any work (:mod:`optim.caps`)."""
+    picks_w, places_w = _points(picks, "picks"), _points(places, "places")
+    cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
+    if cand.ndim != 2 or cand.shape[1] != 4 or cand.shape[0] == 0 or not np.all(np.isfinite(cand)):
+        raise InvalidInput(f"candidates must be finite placements (M, 4) = (x, y, z, yaw) [m, rad], got shape {cand.shape}")
+    if kind not in CYCLE_KINDS:
+        raise InvalidSettings(f"kind={kind!r}: use one of {CYCLE_KINDS}")
+    if cand.shape[0] > MAX_PLACEMENTS:
+        raise SettingOutOfRange(f"{cand.shape[0]:,} candidates, more than the {MAX_PLACEMENTS:,} a layout search takes")
+    if len(picks_w) * len(places_w) > MAX_POINT_PAIRS:
+        raise SettingOutOfRange(f"{len(picks_w)} picks × {len(places_w)} places = {len(picks_w) * len(places_w):,} "
+                                f"cycles per placement, more than the {MAX_POINT_PAIRS:,} allowed: give fewer points")
+    for name, least, most in (("refine", 0, MAX_REFINE), ("refine_evaluations", 1, MAX_REFINE_EVALUATIONS),
+                              ("workspace_samples", 1000, MAX_WORKSPACE_SAMPLES),
+                              ("chunk_size", 1, MAX_PLACEMENTS), ("seed", 0, 2**64 - 1)):
+        count_setting(counts[name], name, least, most)
+    R = None
+    if orientation is not None:
+        R = np.asarray(orientation, dtype=float)
+        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or np.abs(R @ R.T - np.eye(3)).max() > 1e-6 \
+                or np.linalg.det(R) < 0:
+            raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
+    PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
+    number_setting(min_margin, "min_margin", 0.0, unit="m")
+    return picks_w, places_w, cand, R
+
+
+def _margins(robot: Any, st: _Settings, cand: np.ndarray, samples: int) -> tuple[Any, np.ndarray]:
+    """The workspace's voxel map and the boundary margin of every pick and place (M, P + Q) [m] from each candidate."""
+    from pinarms.robots.workspace import sample_workspace
+
+    ws = sample_workspace(robot, int(samples), seed=int(st.seed), frame="tcp")
+    vmap = ws.voxel_map()
+    pts = points_in_base_frame(np.vstack([st.picks, st.places]), cand)
+    return vmap, vmap.query(pts.reshape(-1, 3)).margin.reshape(cand.shape[0], -1)
+
+
+def _boundary_failures(failure: list[str], reason: list[str], point_margin: np.ndarray, st: _Settings,
+                       min_margin: float) -> None:
+    """Mark the candidates still in the running with a point closer than ``min_margin`` to the edge ``"boundary"``."""
+    margin = point_margin.min(axis=1)
+    names = [f"pick {i + 1}" for i in range(len(st.picks))] + [f"place {j + 1}" for j in range(len(st.places))]
+    for m in np.flatnonzero((margin < min_margin) & np.array([not f for f in failure])):
+        k = int(np.argmin(point_margin[m]))
+        failure[m] = "boundary"
+        reason[m] = (f"{names[k]} is {point_margin[m, k] * 1e3:.0f} mm from the edge of the workspace, "
+                     f"less than min_margin {min_margin * 1e3:.0f} mm")
+
+
+def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, failure: list[str], reason: list[str],
+                     chunk_size: int, scheduler: Any, progress: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Plan the cycles of every candidate still in the running, in tasks of ``chunk_size``; record the failures.
+
+    Returns (M,) mean cycle time [s], IK branch and manipulability (NaN, -1 where it failed).
+    """
+    from pinarms.execution import map_chunks
+
+    M = cand.shape[0]
+    todo = [m for m in range(M) if not failure[m]]
+    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
+    chunks = map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=progress)
+    outcomes = [o for chunk in chunks for o in chunk]
+    cycle_time = np.full(M, np.nan)
+    branch = np.full(M, -1)
+    manip = np.full(M, np.nan)
+    for m, o in zip(todo, outcomes):
+        failure[m], reason[m] = o.failure, o.reason
+        if not o.failure:
+            cycle_time[m], branch[m], manip[m] = o.cycle_time, o.branch, o.manipulability
+    return cycle_time, branch, manip
+
+
+def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: np.ndarray, ok: np.ndarray,
+                 order: np.ndarray, n_refine: int, evaluations: int, vmap: Any, min_margin: float,
+                 scheduler: Any, progress: Any) -> tuple[Refinement | None, np.ndarray | None, float]:
+    """Refine the best ``n_refine`` candidates over the free coordinates.
+
+    Returns the :class:`Refinement` (None without one), the best placement (None when every
+    candidate failed) and its picks per minute.
+    """
+    from pinarms.execution import map_chunks
+
+    M = cand.shape[0]
+    refinement = None
+    best_placement = cand[order[0]].copy() if ok[order[0]] else None
+    best_ppm = float(ppm[order[0]])
+    free = np.flatnonzero(np.ptp(cand, axis=0) > 0)
+    starts = [int(i) for i in order[:n_refine] if ok[i]]
+    if not (starts and free.size):
+        return refinement, best_placement, best_ppm
+    bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
+    step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
+    rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(evaluations), st) for i in starts]
+    found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=progress)
+    refinement = Refinement(
+        starts=np.array(starts),
+        start_picks_per_minute=ppm[starts],
+        placements=np.array([f[0] for f in found]),
+        picks_per_minute=np.array([f[1] for f in found]),
+        evaluations=np.array([f[2] for f in found]),
+        free=tuple(AXES[k] for k in free),
+        margin=vmap.query(points_in_base_frame(np.vstack([st.picks, st.places]),
+                                               np.array([f[0] for f in found])).reshape(-1, 3))
+        .margin.reshape(len(found), -1).min(axis=1),
+    )
+    eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
+    k = int(np.argmax(eligible))
+    if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
+        best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
+    return refinement, best_placement, best_ppm
+
+
+def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int) -> Any:
+    """The progress callback of one phase of the search (tasks counted from ``offset`` of ``total``), or None."""
+    if progress is None:
+        return None
+    return lambda done, _total: progress(offset + done, total)
+
+
+def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift: float = 0.05, dwell: float = 0.2,
+                  orientation: Any = None, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
+                  jmax: Any = None, refine: int = 2, refine_evaluations: int = 30, workspace_samples: int = 200_000,
+                  seed: int = 0, chunk_size: int = 4, scheduler: Any = None,
+                  progress: Callable[[int, int], None] | None = None, arm: str | None = None,
+                  clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
@@ -193,136 +320,35 @@ def search_layout(
     """
     import uuid
 
-    from pinarms.execution import map_chunks
-    from pinarms.robots.workspace import sample_workspace
-
     token = uuid.uuid4().hex
-    recipe = None
-    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
-        cell = robot
-        if arm is None:
-            if len(cell.arms) != 1:
-                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
-            arm = cell.arms[0].name
-        robot = cell.arm(arm).robot
-        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
-        for name in carry:
-            cell.fixture(name)
-        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
-                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
-                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
-                             tuple(carry), float(clearance))
-        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
-    elif arm is not None or carry:
-        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
-
-    picks_w, places_w = _points(picks, "picks"), _points(places, "places")
-    cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
-    if cand.ndim != 2 or cand.shape[1] != 4 or cand.shape[0] == 0 or not np.all(np.isfinite(cand)):
-        raise InvalidInput(f"candidates must be finite placements (M, 4) = (x, y, z, yaw) [m, rad], got shape {cand.shape}")
-    if kind not in CYCLE_KINDS:
-        raise InvalidSettings(f"kind={kind!r}: use one of {CYCLE_KINDS}")
-    if cand.shape[0] > MAX_PLACEMENTS:
-        raise SettingOutOfRange(f"{cand.shape[0]:,} candidates, more than the {MAX_PLACEMENTS:,} a layout search takes")
-    if len(picks_w) * len(places_w) > MAX_POINT_PAIRS:
-        raise SettingOutOfRange(f"{len(picks_w)} picks × {len(places_w)} places = {len(picks_w) * len(places_w):,} "
-                                f"cycles per placement, more than the {MAX_POINT_PAIRS:,} allowed: give fewer points")
-    for name, v, least, most in (("refine", refine, 0, MAX_REFINE),
-                                 ("refine_evaluations", refine_evaluations, 1, MAX_REFINE_EVALUATIONS),
-                                 ("workspace_samples", workspace_samples, 1000, MAX_WORKSPACE_SAMPLES),
-                                 ("chunk_size", chunk_size, 1, MAX_PLACEMENTS), ("seed", seed, 0, 2**64 - 1)):
-        count_setting(v, name, least, most)
-    R = None
-    if orientation is not None:
-        R = np.asarray(orientation, dtype=float)
-        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or np.abs(R @ R.T - np.eye(3)).max() > 1e-6 \
-                or np.linalg.det(R) < 0:
-            raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
-    PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
-    number_setting(min_margin, "min_margin", 0.0, unit="m")
+    robot, recipe = _cell_target(robot, arm, clearance, carry, token)
+    counts = {"refine": refine, "refine_evaluations": refine_evaluations, "workspace_samples": workspace_samples,
+              "chunk_size": chunk_size, "seed": seed}
+    picks_w, places_w, cand, R = _checked_inputs(picks, places, candidates, kind, counts, orientation, lift, dwell,
+                                                 min_margin)
     st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
-    M = cand.shape[0]
 
     failure, reason = _screen(robot, cand, st)
-    ws = sample_workspace(robot, int(workspace_samples), seed=int(seed), frame="tcp")
-    vmap = ws.voxel_map()
-    pts = points_in_base_frame(np.vstack([picks_w, places_w]), cand)
-    point_margin = vmap.query(pts.reshape(-1, 3)).margin.reshape(M, -1)
+    vmap, point_margin = _margins(robot, st, cand, workspace_samples)
     margin = point_margin.min(axis=1)
     if min_margin > 0:
-        names = [f"pick {i + 1}" for i in range(len(picks_w))] + [f"place {j + 1}" for j in range(len(places_w))]
-        for m in np.flatnonzero((margin < min_margin) & np.array([not f for f in failure])):
-            k = int(np.argmin(point_margin[m]))
-            failure[m] = "boundary"
-            reason[m] = (f"{names[k]} is {point_margin[m, k] * 1e3:.0f} mm from the edge of the workspace, "
-                         f"less than min_margin {min_margin * 1e3:.0f} mm")
-    todo = [m for m in range(M) if not failure[m]]
-    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
-    n_refine = int(refine)
-    total = len(tasks) + n_refine
+        _boundary_failures(failure, reason, point_margin, st, min_margin)
+    n_tasks = -(-sum(1 for f in failure if not f) // chunk_size)
+    total = n_tasks + int(refine)
 
-    def phase(offset: int):
-        if progress is None:
-            return None
-        return lambda done, _total: progress(offset + done, total)
-
-    outcomes = [o for chunk in map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=phase(0)) for o in chunk]
-    cycle_time = np.full(M, np.nan)
-    branch = np.full(M, -1)
-    manip = np.full(M, np.nan)
-    for m, o in zip(todo, outcomes):
-        failure[m], reason[m] = o.failure, o.reason
-        if not o.failure:
-            cycle_time[m], branch[m], manip[m] = o.cycle_time, o.branch, o.manipulability
+    cycle_time, branch, manip = _plan_candidates(robot, token, cand, st, failure, reason, chunk_size, scheduler,
+                                                 _phase(progress, 0, total))
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
-
     order = _ranking(ppm, margin)
-
-    refinement = None
-    best_placement = cand[order[0]].copy() if ok[order[0]] else None
-    best_ppm = float(ppm[order[0]])
-    free = np.flatnonzero(np.ptp(cand, axis=0) > 0)
-    starts = [int(i) for i in order[:n_refine] if ok[i]]
-    if starts and free.size:
-        bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
-        step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
-        rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(refine_evaluations), st) for i in starts]
-        found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=phase(len(tasks)))
-        refinement = Refinement(
-            starts=np.array(starts),
-            start_picks_per_minute=ppm[starts],
-            placements=np.array([f[0] for f in found]),
-            picks_per_minute=np.array([f[1] for f in found]),
-            evaluations=np.array([f[2] for f in found]),
-            free=tuple(AXES[k] for k in free),
-            margin=vmap.query(points_in_base_frame(np.vstack([picks_w, places_w]),
-                                                   np.array([f[0] for f in found])).reshape(-1, 3))
-            .margin.reshape(len(found), -1).min(axis=1),
-        )
-        eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
-        k = int(np.argmax(eligible))
-        if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
-            best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
+    refinement, best_placement, best_ppm = _refine_best(robot, token, cand, st, ppm, ok, order, int(refine),
+                                                        refine_evaluations, vmap, min_margin, scheduler,
+                                                        _phase(progress, n_tasks, total))
     best_cycle = None
     if best_placement is not None:
         best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
-    return LayoutSearch(
-        robot=str(robot.name),
-        picks=picks_w,
-        places=places_w,
-        candidates=cand,
-        failure=tuple(failure),
-        reason=tuple(reason),
-        cycle_time=cycle_time,
-        picks_per_minute=ppm,
-        branch=branch,
-        manipulability=manip,
-        margin=margin,
-        order=order,
-        refinement=refinement,
-        best_placement=best_placement,
-        best_picks_per_minute=best_ppm,
-        best_cycle=best_cycle,
-        seed=int(seed),
-    )
+    return LayoutSearch(robot=str(robot.name), picks=picks_w, places=places_w, candidates=cand, failure=tuple(failure),
+                        reason=tuple(reason), cycle_time=cycle_time, picks_per_minute=ppm, branch=branch,
+                        manipulability=manip, margin=margin, order=order, refinement=refinement,
+                        best_placement=best_placement, best_picks_per_minute=best_ppm, best_cycle=best_cycle,
+                        seed=int(seed))

@@ -1,7 +1,7 @@
 """The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
 
 :func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
-adding via points (:mod:`optim.cell_cycle`). A crate under a guard, a shelf or the other
+adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.optim.cycle.spec import _hold, _line_deviation, _vertical_segments
 from pinarms.optim.motion.checker import MotionChecker
 from pinarms.optim.motion.plan import _limits, plan_geometry, time_path
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
@@ -87,10 +88,6 @@ def _lines(base: Any, k: int) -> tuple[list, list]:
             [polyline_path(np.stack([place, up_place])), polyline_path(np.stack([up_pick, pick]))])
 
 
-def _hold(q: np.ndarray, seconds: float) -> Trajectory:
-    return Trajectory([0.0, seconds], np.asarray(q, dtype=float)[None, None, :])
-
-
 def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
                   margin: float, planner: str = "rrtconnect", time_limit: float = 5.0, seed: int = 0) -> Any:
     """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
@@ -139,9 +136,6 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
     trajectory = pieces[0]
     for p in pieces[1:]:
         trajectory = trajectory.concatenated(p, atol=1e-7)
-    from pinarms.optim.cycle.spec import _line_deviation
-
-    P = spec.poses(robot)[:, :3, 3]
-    ends = np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
+    ends = _vertical_segments(spec.poses(robot))
     return dataclasses.replace(base, moves=(m1, m2), trajectory=trajectory, peaks=trajectory.peaks(),
                                line_deviation=_line_deviation(robot, (m1, m2), ends))

@@ -197,6 +197,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     """
     from pinarms import optim
     from pinarms.optim import caps
+    from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.robots.cell import ArmMotion
 
     k = 1e-3 if mm else 1.0
@@ -223,7 +224,8 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         except ValueError:
             raise click.BadParameter(f"--task {name}: the six coordinates must be numbers, got {task[1:]}") from None
         spec = optim.PickPlace(arm.to_base(values[:3]), arm.to_base(values[3:]), lift=lift * k, dwell=dwell)
-        res = optim.plan_cycle(arm.robot, spec, cell=c, clearance=clearance * k, margin=margin * k)
+        res = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(c, clearance=clearance * k,
+                                                                               margin=margin * k)))
         cycles[name] = res
         rep = res.cell_report
         data["arms"][name] = {"cycle": res.as_dict(), "cycle_time_s": res.cycle_time,

@@ -69,6 +69,7 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     Example: pinarms cycle aubo_i3 --pick 350 200 150 --place -100 400 100 --mm --payload 3kg
     """
     from pinarms import optim
+    from pinarms.optim.cycle import CycleApproach, CycleLoad, CycleRequest, CycleTiming
 
     arm = load_robot(robot)
     scale = length_scale(mm)
@@ -79,11 +80,10 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     kg = None if payload is None else mass_kg(payload)
     limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
     torque_limits = limits if limits is not None else (True if (kg is not None or torque) else False)
-    res = optim.plan_cycle(arm, spec, kind=kind, vmax=si_limit(vmax, "--vmax", np.ones(arm.nq)),
-                           amax=si_limit(amax, "--amax", np.ones(arm.nq)), jmax=si_limit(jmax, "--jmax", np.ones(arm.nq)),
-                           method=method, seed=seed, payload=kg, torque_limits=torque_limits,
-                           approach="straight" if straight else "joint",
-                           tool_speed=None if vtool is None else vtool * scale)
+    timing = CycleTiming(kind, si_limit(vmax, "--vmax", np.ones(arm.nq)), si_limit(amax, "--amax", np.ones(arm.nq)),
+                         si_limit(jmax, "--jmax", np.ones(arm.nq)), method=method, seed=seed)
+    shape = CycleApproach("straight" if straight else "joint", None if vtool is None else vtool * scale)
+    res = optim.plan_cycle(CycleRequest(arm, spec, timing=timing, load=CycleLoad(kg, torque_limits), approach=shape))
     data = res.as_dict()
     data["units"] = {"lengths": "m", "times": "s", "limits": "rad or m per s^k", "given_points": lu}
     dev = res.line_deviation / scale

@@ -35,22 +35,24 @@ class ShippedMotion:
 
 def _station_cycle(station: Any) -> Any:
     from pinarms import optim
+    from pinarms.optim.cycle import CellSettings, CycleRequest
 
     arm = station.arm("aubo")
     spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
                            lift=0.05, dwell=0.2)
-    return optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
+    return optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(station, clearance=0.02)))
 
 
 def _line_cycles(cell: Any, step: Any = None) -> dict[str, Any]:
     from pinarms import optim
+    from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.studies.cell import LINE_TASKS
 
     cycles = {}
     for name, (pick, place) in LINE_TASKS.items():
         a = cell.arm(name)
         spec = optim.PickPlace(a.to_base(np.array(pick)), a.to_base(np.array(place)), lift=0.03, dwell=0.15)
-        cycles[name] = optim.plan_cycle(a.robot, spec, cell=cell, clearance=0.02)
+        cycles[name] = optim.plan_cycle(CycleRequest(a.robot, spec, cell=CellSettings(cell, clearance=0.02)))
         if step is not None:
             step(name, cycles[name])
     return cycles

@@ -20,6 +20,7 @@ LINE_TASKS = {"left": ((-0.05, -0.03, 0.84), (0.22, 0.68, 0.84)), "right": ((0.0
 def study_cell(quick: bool = False) -> Study:
     """Cells: the two-SCARA mushroom line scheduled on one belt, and the AUBO-i3 food station's crate cycle."""
     from pinarms import optim, viz
+    from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.robots.cell import ArmMotion, load_cell
     from pinarms.viz import plots as vplots
 
@@ -29,7 +30,7 @@ def study_cell(quick: bool = False) -> Study:
     for name, (pick, place) in LINE_TASKS.items():
         arm = line.arm(name)
         spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.03, dwell=0.15)
-        cycles[name] = optim.plan_cycle(arm.robot, spec, cell=line, clearance=0.02)
+        cycles[name] = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(line, clearance=0.02)))
     for name, res in cycles.items():
         rep = res.cell_report
         rows.append(Row("000", f"mushroom_line, {name} SCARA: cycle keeping 20 mm from belt, box and the other arm",
@@ -51,7 +52,7 @@ def study_cell(quick: bool = False) -> Study:
     arm = station.arm("aubo")
     spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
                            lift=0.05, dwell=0.2)
-    crate = optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
+    crate = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(station, clearance=0.02)))
     rep = crate.cell_report
     rows.append(Row("001", "aubo_food_station: table → crate cycle keeping 20 mm (table and crate in the band)",
                     None, crate.cycle_time, "s", None,

@@ -32,6 +32,7 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
     the arm's real configurations, within ±170°): torques depend on the actual pose.
     """
     from pinarms import optim
+    from pinarms.optim.cycle import CycleLoad, CycleRequest
     from pinarms.robots.ties import near_max
 
     rows: list[Row] = []
@@ -57,12 +58,12 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
                 f"{gens} generations, seed 0; ×{ga.total / ex.total:.3f} the exact optimum above; peak torque/limit "
                 f"{ga.torque_ratios.max():.3f}"))
     spec = optim.PickPlace(AUBO_PICK_M, AUBO_PLACE_M, lift=0.08, dwell=0.3)
-    free = optim.plan_cycle(arm, spec)
+    free = optim.plan_cycle(CycleRequest(arm, spec))
     what = "AUBO-i3 pick-and-place (r ≈ 0.46 m, 115° apart, lift 80 mm, dwell 0.3 s)"
     rows.append(Row("001", f"{what}: cycle time, joint speed only", None, free.cycle_time, "s", None,
                     f"{free.picks_per_minute:.1f} picks/min; the paper gives none"))
     for kg in AUBO_PAYLOADS_KG:
-        cyc = optim.plan_cycle(arm, spec, payload=kg, torque_limits=True)
+        cyc = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(kg, torque_limits=True)))
         tight = [arm.joint_names[k] for k in near_max(cyc.torque_ratios)]
         rows.append(Row(
             "001", f"{what}: cycle time with {kg:g} kg, speed + torque", None, cyc.cycle_time, "s", None,

@@ -22,6 +22,7 @@ BOUNDS_002_S = (SEED002.precision_s, 0.5)
 def study_002(quick: bool = False) -> Study:
     """Flower gantry: quintic B-spline through 10 segments, improved-GA time (and time–jerk) optimisation, cycle."""
     from pinarms import optim, planning
+    from pinarms.optim.cycle import CycleRequest, CycleTiming
     from pinarms.scenarios import GANTRY_PATH_AXIS_M, gantry_path_motor_rad
 
     arm = robots.load("gantry_flower")
@@ -70,8 +71,8 @@ def study_002(quick: bool = False) -> Study:
     transmission = conv.GANTRY_TRANSMISSION_M_PER_RAD
     tcp = arm.position(np.array(GANTRY_PATH_AXIS_M))
     spec = optim.PickPlace(tcp[0], tcp[-1], lift=float(tcp[1, 2] - tcp[0, 2]), dwell=0.2, via=list(tcp[2:-2]))
-    cycle = optim.plan_cycle(arm, spec, kind="quintic-bspline", vmax=arm.velocity_limit,
-                             amax=a * transmission, jmax=j * transmission)
+    timing = CycleTiming("quintic-bspline", arm.velocity_limit, a * transmission, j * transmission)
+    cycle = optim.plan_cycle(CycleRequest(arm, spec, timing=timing))
     what = ("pick-and-place cycle of the gantry (the lift-feed-lower move and back, dwell 0.2 s, axis limits "
             f"{arm.velocity_limit[0]:g} m/s of the model, {a * transmission:g} m/s², {j * transmission:g} m/s³)")
     rows.append(Row("002", f"{what}: cycle time", None, cycle.cycle_time, "s", None,

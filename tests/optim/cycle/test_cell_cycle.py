@@ -47,6 +47,7 @@ def test_a_cycle_through_the_crate_wall_is_replanned_to_clear_it(station, statio
     assert report.attempts[0][1] is False and "crate_wall" in report.attempts[0][3]
     assert report.attempts[-1][1] is True
     assert report.lift > spec.lift
+    assert kept.status == "re-planned" and free.status == "ok"
     assert report.extra_time == pytest.approx(kept.cycle_time - free.cycle_time, abs=1e-12) and report.extra_time > 0
     assert report.min_clearance >= 0.02 and report.lower_bound >= 0.02
     # an independent dense look at the kept cycle: every external distance >= 20 mm
