@@ -18,7 +18,8 @@ continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
 """
 
 from pinarms.optim.cycle.in_cell import CellCycleReport
-from pinarms.optim.cycle import CycleResult, PickPlace, plan_cycle
+from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleResult, CycleTiming, PickPlace,
+                                  plan_cycle)
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
@@ -50,6 +51,11 @@ __all__ = [
     "minimize_time_jerk",
     "PickPlace",
     "CycleResult",
+    "CycleRequest",
+    "CycleTiming",
+    "CycleLoad",
+    "CycleApproach",
+    "CellSettings",
     "plan_cycle",
     "search_layout",
     "LayoutSearch",
