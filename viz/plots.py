@@ -1,63 +1,46 @@
-"""Plots (matplotlib, Agg backend): joint curves, tcp speed, GA convergence, workspace projections,
-clearance over time and multi-arm schedules.
+"""Plots of joint motions (matplotlib, Agg backend): joint curves, trajectories, tcp speed, joint torques.
 
 Figures are drawn on matplotlib's Agg canvas directly (no pyplot state, the user's
 backend is left alone). Every function takes data and an output path ending in ``.png`` or ``.svg``, writes the
 figure atomically and returns the path. Units: the data's SI units (rad, m, s); pass
 ``degrees=True`` to label revolute joints in degrees (conversion happens here, at the edge).
+
+The other plot families have their own modules, re-exported here: searches
+(:mod:`viz.search_plots`: GA convergence, layout search), cells (:mod:`viz.cell_plots`:
+clearance over time, multi-arm schedules), reach (:mod:`viz.reach_plots`: workspace
+projections).
 """
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import matplotlib
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from pinarms.robots.errors import InvalidInput
 
-from ._atomic import atomic_write
+from .cell_plots import plot_clearance, plot_schedule
+from .figure_files import checked_numbers, save_figure
+from .reach_plots import plot_workspace
+from .search_plots import plot_ga_convergence, plot_layout_search
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
            "plot_clearance", "plot_schedule", "plot_torques",
            "plot_layout_search"]
 
+_save = save_figure  # the name viz.line_plots imports
+
 #: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
 #: interval) is drawn without knot markers and lines.
 MAX_DRAWN_KNOTS = 40
 
-_FORMATS = {".png": "png", ".svg": "svg"}
 _ORDERS = ("position", "velocity", "acceleration", "jerk")
 _UNITS = ("", "/s", "/s²", "/s³")
-
-
-def _save(fig: Figure, path: str | Path) -> Path:
-    p = Path(path)
-    fmt = _FORMATS.get(p.suffix.lower())
-    if fmt is None:
-        raise InvalidInput(f"plot path {str(p)!r} must end in .png or .svg")
-    buf = io.BytesIO()
-    FigureCanvasAgg(fig)
-    fig.savefig(buf, format=fmt, dpi=120, bbox_inches="tight", metadata={"Date": None} if fmt == "svg" else None)
-    data = buf.getvalue()
-    return atomic_write(p, lambda f: f.write(data))
-
-
-def _numbers(values: Any, what: str, allow_inf: bool = False) -> np.ndarray:
-    """``values`` as a finite float array (±inf kept if ``allow_inf``), or InvalidInput naming ``what``."""
-    try:
-        arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers, got {type(values).__name__}") from exc
-    if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
-        raise InvalidInput(f"{what} holds NaN{'' if allow_inf else ' or infinite'} values")
-    return arr
 
 
 def _limit_array(limits: Any, kind: str, n: int) -> np.ndarray | None:
@@ -131,14 +114,14 @@ def plot_joint_curves(
     """
     fig = _joint_curves_figure(t, q, qd, qdd, qddd, knot_times=knot_times, limits=limits, robot=robot,
                                joint_names=joint_names, joint_units=joint_units, degrees=degrees, title=title)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_times: Any, limits: Any, robot: Any,
                          joint_names: Sequence[str] | None, joint_units: Sequence[str] | None, degrees: bool,
                          title: str) -> Figure:
     """The figure of :func:`plot_joint_curves` (checked inputs)."""
-    tt = _numbers(t, "t")
+    tt = checked_numbers(t, "t")
     if tt.ndim != 1 or tt.size < 2:
         raise InvalidInput(f"t must be (N,) instants in s with N >= 2, got shape {tt.shape}")
     if np.any(np.diff(tt) <= 0):
@@ -147,7 +130,7 @@ def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_t
     for order, values in enumerate((q, qd, qdd, qddd)):
         if values is None:
             continue
-        arr = _numbers(values, _ORDERS[order])
+        arr = checked_numbers(values, _ORDERS[order])
         arr = arr[:, None] if arr.ndim == 1 else arr
         if arr.ndim != 2 or arr.shape[0] != tt.size:
             raise InvalidInput(f"{_ORDERS[order]} must have shape ({tt.size}, n_joints), got {np.shape(values)}")
@@ -167,7 +150,7 @@ def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_t
     kinds = sorted(set(shown), key=shown.index)
     mixed = len(kinds) > 1
     labels = [f"{name} [{u}]" if mixed else name for name, u in zip(names, shown)]
-    knots = None if knot_times is None else _numbers(knot_times, "knot_times").ravel()
+    knots = None if knot_times is None else checked_numbers(knot_times, "knot_times").ravel()
 
     fig = Figure(figsize=(8.8, 2.3 * len(series) + 0.5), layout="constrained")
     axes = fig.subplots(len(series), 1, sharex=True, squeeze=False)
@@ -238,8 +221,8 @@ def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None
         t: instants (N,) [s]; speed: linear speed (N,) [m/s]; angular: optional (N,) [rad/s]
             (second axis); limit: a tool-speed limit [m/s], drawn dashed.
     """
-    tt = _numbers(t, "t")
-    v = _numbers(speed, "speed")
+    tt = checked_numbers(t, "t")
+    v = checked_numbers(speed, "speed")
     if tt.ndim != 1 or tt.size < 2 or v.shape != tt.shape:
         raise InvalidInput(f"t and speed must be (N,) arrays of the same length, N >= 2; got {tt.shape} and {v.shape}")
     fig = Figure(figsize=(7.5, 3.0))
@@ -251,7 +234,7 @@ def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None
     ax.set_ylabel("tcp speed [m/s]")
     ax.grid(True, alpha=0.3)
     if angular is not None:
-        w = _numbers(angular, "angular")
+        w = checked_numbers(angular, "angular")
         if w.shape != tt.shape:
             raise InvalidInput(f"angular must have the shape of t {tt.shape}, got {w.shape}")
         ax2 = ax.twinx()
@@ -259,169 +242,7 @@ def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None
         ax2.set_ylabel("angular [rad/s]")
     ax.legend(loc="best", fontsize=8)
     ax.set_title(title)
-    return _save(fig, path)
-
-
-def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
-    """Best-so-far and mean objective per generation, and the feasible share when recorded.
-
-    ``history``: a GA history (``best``, ``feasible_mean`` or ``mean``, optional
-    ``feasible_share``), a result with ``.history``, a :class:`viz.HistoryRecord` or a
-    mapping of columns. Generations recorded as ``inf`` (no finite objective) are left as
-    gaps in the curves.
-
-    The mean drawn is that of the *feasible* individuals (``feasible_mean``) when the
-    history has it: never below the best-so-far. The whole population's ``mean`` counts
-    infeasible individuals with their raw objective (faster than the limits allow), so it
-    can dip below the best when few are feasible; drawn only for histories without
-    ``feasible_mean``, and then labelled so.
-    """
-    if hasattr(history, "columns"):
-        history = history.columns
-    elif hasattr(history, "history") and not isinstance(history, Mapping):
-        history = history.history
-    get = (lambda k: history.get(k)) if isinstance(history, Mapping) else (lambda k: getattr(history, k, None))
-    best = get("best")
-    if best is None:
-        raise InvalidInput("history needs a 'best' column (objective of the best individual per generation)")
-    best = _numbers(best, "best", allow_inf=True)
-    if best.ndim != 1 or best.size == 0:
-        raise InvalidInput(f"best must hold one objective per generation (G,) with G >= 1, got shape {best.shape}")
-    gens = np.arange(best.size)
-
-    def column(key: str) -> np.ndarray | None:
-        values = get(key)
-        if values is None:
-            return None
-        arr = _numbers(values, key, allow_inf=True)
-        if arr.shape != best.shape:
-            raise InvalidInput(f"{key} must have one value per generation {best.shape}, got shape {arr.shape}")
-        return arr
-
-    fig = Figure(figsize=(8.8, 3.8), layout="constrained")
-    ax = fig.subplots()
-    lines = ax.plot(gens, best, lw=1.8, label="best so far")
-    feasible_mean, mean = column("feasible_mean"), column("mean")
-    if feasible_mean is not None:
-        gap = "\n(gaps: no feasible individual)" if np.any(~np.isfinite(feasible_mean)) else ""
-        lines += ax.plot(gens, feasible_mean, lw=1.2, ls="--", label=f"mean of the feasible individuals{gap}")
-    elif mean is not None:
-        lines += ax.plot(gens, mean, lw=1.2, ls="--", label="population mean (infeasible ones too:\ncan lie below the best)")
-    feasible = column("feasible_share")
-    if feasible is not None:
-        ax2 = ax.twinx()
-        lines += ax2.plot(gens, feasible, color="0.55", lw=0.9, label="feasible share (right axis)")
-        ax2.set_ylim(0, 1.05)
-        ax2.set_ylabel("feasible share")
-    ax.set_xlabel("generation")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
-    ax.grid(True, alpha=0.3)
-    fig.legend(lines, [ln.get_label() for ln in lines], loc="outside right upper", fontsize=8)
-    return _save(fig, path)
-
-
-def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *, title: str = "workspace",
-                   colormap: str = "viridis", mm: bool = False) -> Path:
-    """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
-
-    ``points`` (n, 3) m (or a ``Workspace``/:class:`viz.WorkspaceRecord` with ``points`` and
-    ``manipulability``); ``mm=True`` labels the axes in millimetres.
-    """
-    if hasattr(points, "points"):
-        points, manipulability = points.points, points.manipulability
-    pts = _numbers(points, "points")
-    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
-        raise InvalidInput(f"points must have shape (n, 3) with n >= 1, got {pts.shape}")
-    if colormap not in matplotlib.colormaps:
-        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
-    w = None if manipulability is None else _numbers(manipulability, "manipulability")
-    if w is not None and w.shape != (pts.shape[0],):
-        raise InvalidInput(f"manipulability must have shape ({pts.shape[0]},), got {w.shape}")
-    k = 1000.0 if mm else 1.0
-    unit = "mm" if mm else "m"
-    fig = Figure(figsize=(10, 4.4))
-    axes = fig.subplots(1, 2)
-    order = np.argsort(w) if w is not None else slice(None)  # high manipulability drawn on top
-    sc = None
-    for ax, (i, j), view in zip(axes, ((0, 1), (0, 2)), ("top view", "side view")):
-        sc = ax.scatter(pts[order, i] * k, pts[order, j] * k, c=None if w is None else w[order], cmap=colormap,
-                        s=3, linewidths=0)
-        ax.set_xlabel(f"{'xyz'[i]} [{unit}]")
-        ax.set_ylabel(f"{'xyz'[j]} [{unit}]")
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_title(f"{title}: {view}")
-        ax.grid(True, alpha=0.3)
-    if w is not None and sc is not None:
-        fig.colorbar(sc, ax=axes, label="manipulability", shrink=0.85)
-    return _save(fig, path)
-
-
-def plot_clearance(path: str | Path, check: Any, *, title: str = "clearance over time", mm: bool = True) -> Path:
-    """Smallest distance over the checked pairs against time, from a cell's motion check.
-
-    ``check`` is a :class:`robots.cell.MotionCheck` (best with ``curve=True``: exact at
-    every sample). Samples in contact are marked red, the required clearance is a dashed
-    line, the closest sample is annotated with its pair.
-    """
-    t = _numbers(getattr(check, "times", None), "check.times")
-    d = _numbers(getattr(check, "clearance", None), "check.clearance")
-    if t.ndim != 1 or t.shape != d.shape or t.size == 0:
-        raise InvalidInput(f"check.times and check.clearance must be equal 1-D arrays, got {t.shape} and {d.shape}")
-    k = 1000.0 if mm else 1.0
-    unit = "mm" if mm else "m"
-    fig = Figure(figsize=(9, 3.6))
-    ax = fig.subplots()
-    exact = np.asarray(getattr(check, "exact", np.ones(t.size, bool)), dtype=bool)
-    ax.plot(t[exact], d[exact] * k, lw=1.0, color="#2a6fb5", label="smallest distance")
-    if (~exact).any():
-        ax.plot(t[~exact], d[~exact] * k, ".", ms=2, color="#9aa7b5", label="screened (at least)")
-    touch = d <= 0.0
-    if touch.any():
-        ax.plot(t[touch], d[touch] * k, ".", ms=4, color="#d62728", label="contact")
-    required = float(getattr(check, "required", 0.0))
-    if required > 0.0:
-        ax.axhline(required * k, ls="--", color="#555555", lw=0.8, label=f"required {required * k:g} {unit}")
-    ax.axhline(0.0, color="black", lw=0.6)
-    i = int(np.argmin(np.where(exact, d, np.inf))) if exact.any() else int(np.argmin(d))
-    pair = getattr(check, "min_clearance_pair", None)
-    if pair is not None:
-        ax.annotate(f"{d[i] * k:.1f} {unit}: {pair}", (t[i], d[i] * k), textcoords="offset points", xytext=(6, 10),
-                    fontsize=8)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel(f"distance [{unit}]")
-    ax.set_title(title)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
-    return _save(fig, path)
-
-
-def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: str | None = None) -> Path:
-    """Each arm's busy intervals in the shared zone over ``periods`` line periods (a Gantt chart).
-
-    ``schedule`` is an :class:`optim.LineSchedule`; each arm's cycle start is marked.
-    """
-    arms = list(getattr(schedule, "arms", ()))
-    period = float(getattr(schedule, "period", float("nan")))
-    if not arms or not math.isfinite(period) or period <= 0.0:
-        raise InvalidInput("schedule must be an optim.LineSchedule with arms and a positive period")
-    if isinstance(periods, bool) or not isinstance(periods, int) or periods < 1:
-        raise InvalidInput(f"periods must be a positive integer, got {periods!r}")
-    colors = ["#2a6fb5", "#e07b19", "#2ca02c", "#9467bd"]
-    fig = Figure(figsize=(9, 1.2 + 0.6 * len(arms)))
-    ax = fig.subplots()
-    for row, name in enumerate(arms):
-        bars = [(a + p * period, b - a) for p in range(periods) for a, b in schedule.busy.get(name, [])]
-        ax.broken_barh(bars, (row - 0.35, 0.7), color=colors[row % len(colors)], alpha=0.85)
-        for p in range(periods):
-            start = schedule.offsets[name] + p * period
-            ax.plot([start, start], [row - 0.45, row + 0.45], color="black", lw=1.2)
-    ax.set_yticks(range(len(arms)), [f"{a} ({schedule.cycle_times[a]:.2f} s)" for a in arms])
-    ax.set_xlim(0.0, periods * period)
-    ax.set_xlabel("time [s]  (bars: tcp in the shared zone; ticks: cycle starts)")
-    ax.set_title(title or f"{schedule.cell}: {schedule.picks_per_minute:.1f} picks/min, period {period:.2f} s")
-    ax.grid(True, axis="x", alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
@@ -438,8 +259,8 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
         series: more curves to compare ``{label: (t (M,), torques (M, n))}`` (e.g. without the
             payload, or a slower timing), drawn thinner.
     """
-    tt = _numbers(t, "t")
-    tau = _numbers(torques, "torques")
+    tt = checked_numbers(t, "t")
+    tau = checked_numbers(torques, "torques")
     if tt.ndim != 1 or tt.size < 2 or np.any(np.diff(tt) <= 0):
         raise InvalidInput("t must be (N,) strictly increasing instants in s with N >= 2")
     tau = tau[:, None] if tau.ndim == 1 else tau
@@ -454,12 +275,12 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
         raise InvalidInput(f"units has {len(unit)} entries for {n} joints")
     lim = None
     if limits is not None:
-        lim = np.broadcast_to(_numbers(limits, "limits", allow_inf=True), (n,))
+        lim = np.broadcast_to(checked_numbers(limits, "limits", allow_inf=True), (n,))
         if np.any(lim <= 0):
             raise InvalidInput(f"limits must be positive, got {lim.tolist()}")
     extra = []
     for label, (te, ve) in (series or {}).items():
-        te, ve = _numbers(te, f"t of {label!r}"), _numbers(ve, f"torques of {label!r}")
+        te, ve = checked_numbers(te, f"t of {label!r}"), checked_numbers(ve, f"torques of {label!r}")
         ve = ve[:, None] if ve.ndim == 1 else ve
         if ve.shape != (te.size, n):
             raise InvalidInput(f"series {label!r} must be (t (M,), torques (M, {n})), got {te.shape} and {ve.shape}")
@@ -495,57 +316,6 @@ def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, 
     fig.legend(handles, texts, loc="outside lower center", ncols=min(len(texts), 3), fontsize=8)
     if title:
         fig.suptitle(title)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
-def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
-                       mm: bool = True) -> Path:
-    """Picks per minute over the (x, y) placements of a layout search (:class:`optim.LayoutSearch`).
-
-    One square per (x, y) of the candidates, coloured by the best picks/min over their z and
-    yaw; placements where no candidate could run the cycle are grey crosses. The picks
-    (triangles), places (squares), the best grid placement (black frame) and the refined one
-    (diamond, when the refinement gained) are marked. Line frame; ``mm`` labels millimetres.
-    """
-    if not all(hasattr(result, a) for a in ("candidates", "picks_per_minute", "picks", "places")):
-        raise InvalidInput(f"result must be an optim.LayoutSearch, got {type(result).__name__}")
-    if colormap not in matplotlib.colormaps:
-        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
-    cand = _numbers(result.candidates, "candidates")
-    ppm = _numbers(result.picks_per_minute, "picks per minute")
-    k = 1000.0 if mm else 1.0
-    unit = "mm" if mm else "m"
-    xy, inverse = np.unique(np.round(cand[:, :2], 9), axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    best = np.zeros(xy.shape[0])
-    np.maximum.at(best, inverse, ppm)
-    ok = best > 0
-    fig = Figure(figsize=(7.5, 6.0))
-    ax = fig.subplots()
-    size = 36.0 if xy.shape[0] > 400 else 90.0
-    sc = ax.scatter(xy[ok, 0] * k, xy[ok, 1] * k, c=best[ok], cmap=colormap, marker="s", s=size, linewidths=0)
-    if (~ok).any():
-        ax.scatter(xy[~ok, 0] * k, xy[~ok, 1] * k, marker="x", s=size * 0.4, color="0.6", linewidths=1.0,
-                   label="cycle not possible")
-    picks, places = _numbers(result.picks, "picks"), _numbers(result.places, "places")
-    ax.scatter(picks[:, 0] * k, picks[:, 1] * k, marker="^", s=80, color="tab:red", edgecolors="k", label="pick")
-    ax.scatter(places[:, 0] * k, places[:, 1] * k, marker="s", s=80, color="tab:orange", edgecolors="k",
-               label="place")
-    index = getattr(result, "best_index", -1)
-    if index >= 0:
-        ax.scatter([cand[index, 0] * k], [cand[index, 1] * k], marker="s", s=size * 2.2, facecolors="none",
-                   edgecolors="k", linewidths=2.0, label=f"best grid placement ({ppm[index]:.1f}/min)")
-    refined = getattr(result, "refinement", None)
-    if refined is not None and refined.gain > 0:
-        j = int(np.argmax(refined.picks_per_minute))
-        ax.scatter([refined.placements[j, 0] * k], [refined.placements[j, 1] * k], marker="D", s=90,
-                   color="magenta", edgecolors="k", label=f"refined ({refined.picks_per_minute[j]:.1f}/min)")
-    if ok.any():
-        fig.colorbar(sc, ax=ax, label="picks per minute (best over z, yaw)", shrink=0.85)
-    ax.set_xlabel(f"base x [{unit}]")
-    ax.set_ylabel(f"base y [{unit}]")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
-    ax.set_title(title or f"layout search of {getattr(result, 'robot', 'the arm')}: picks per minute by base position")
-    return _save(fig, path)

@@ -1,4 +1,6 @@
-"""Plots of reachability maps (matplotlib Agg): the index over a vertical section around the base axis.
+"""Plots of what an arm reaches (matplotlib Agg): workspace clouds, and the reachability index over a section.
+
+:func:`plot_workspace` draws a workspace cloud seen from the top and the side, coloured by manipulability.
 
 :func:`plot_reachability_section` turns a 3-D map into the picture a line engineer reads: the
 horizontal distance ``ρ`` from the base's vertical axis against the height ``z`` (mm), each
@@ -20,10 +22,10 @@ from matplotlib.figure import Figure
 
 from pinarms.robots.errors import InvalidInput
 
-from .plots import _save
+from .figure_files import checked_numbers, save_figure
 from .reach_scene import INDEX_COLORMAP
 
-__all__ = ["plot_reachability_section", "section_index"]
+__all__ = ["plot_workspace", "plot_reachability_section", "section_index"]
 
 
 def section_index(reach_map: Any, cell: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -98,4 +100,40 @@ def plot_reachability_section(
 
     text = title or f"{reach_map.robot}, {reach_map.resolution * 1000:g} mm voxels: {reach_map.orientations.describe()}"
     ax.set_title("\n".join(textwrap.wrap(text, 80)), fontsize=9)
-    return _save(fig, path)
+    return save_figure(fig, path)
+
+
+def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *, title: str = "workspace",
+                   colormap: str = "viridis", mm: bool = False) -> Path:
+    """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
+
+    ``points`` (n, 3) m (or a ``Workspace``/:class:`viz.WorkspaceRecord` with ``points`` and
+    ``manipulability``); ``mm=True`` labels the axes in millimetres.
+    """
+    if hasattr(points, "points"):
+        points, manipulability = points.points, points.manipulability
+    pts = checked_numbers(points, "points")
+    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
+        raise InvalidInput(f"points must have shape (n, 3) with n >= 1, got {pts.shape}")
+    if colormap not in matplotlib.colormaps:
+        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
+    w = None if manipulability is None else checked_numbers(manipulability, "manipulability")
+    if w is not None and w.shape != (pts.shape[0],):
+        raise InvalidInput(f"manipulability must have shape ({pts.shape[0]},), got {w.shape}")
+    k = 1000.0 if mm else 1.0
+    unit = "mm" if mm else "m"
+    fig = Figure(figsize=(10, 4.4))
+    axes = fig.subplots(1, 2)
+    order = np.argsort(w) if w is not None else slice(None)  # high manipulability drawn on top
+    sc = None
+    for ax, (i, j), view in zip(axes, ((0, 1), (0, 2)), ("top view", "side view")):
+        sc = ax.scatter(pts[order, i] * k, pts[order, j] * k, c=None if w is None else w[order], cmap=colormap,
+                        s=3, linewidths=0)
+        ax.set_xlabel(f"{'xyz'[i]} [{unit}]")
+        ax.set_ylabel(f"{'xyz'[j]} [{unit}]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(f"{title}: {view}")
+        ax.grid(True, alpha=0.3)
+    if w is not None and sc is not None:
+        fig.colorbar(sc, ax=axes, label="manipulability", shrink=0.85)
+    return save_figure(fig, path)

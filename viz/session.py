@@ -5,8 +5,9 @@ placements, static boxes (a conveyor, a crate), named trajectories (their defini
 sampled joint positions), workspace clouds with manipulability, via points and targets,
 optimisation histories, and free metadata.
 
-This module builds sessions from the user's objects (checking every argument) and saves
-and loads them; the file format itself (records, the table of member kinds, bounded and
+This module builds sessions from the user's objects (every argument checked by
+:mod:`pinarms.viz.session_inputs`; a cell by :mod:`pinarms.viz.cell_session`) and saves and
+loads them; the file format itself (records, the table of member kinds, bounded and
 validated reading, writing) is :mod:`pinarms.viz.session_format`. Never pickle; written
 atomically; a save/load round trip is exact (arrays bit-equal, JSON equal).
 
@@ -19,8 +20,6 @@ robot are in the world frame.
 from __future__ import annotations
 
 import importlib.metadata
-import json
-import math
 import os
 import threading
 from datetime import datetime, timezone
@@ -34,25 +33,30 @@ from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
 from .errors import SessionFormatError
-from .session_format import (
-    F8 as _F8,
-    FORMAT_NAME,
-    FORMAT_VERSION,
-    KINDS,
-    POINT_KINDS as _POINT_KINDS,
+from .mesh_paths import check_mesh_paths
+from .session_archive import SessionLimits
+from .session_format import read_session, to_document, write_session
+from .session_inputs import (
+    MAX_TRAJECTORY_SAMPLES,
+    box_record,
+    float_array,
+    history_record,
+    json_normalised,
+    pose_array,
+    real_array,
+    trajectory_record,
+    workspace_record,
+)
+from .session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
     RobotEntry,
-    SessionLimits,
     TrajectoryRecord,
     WorkspaceRecord,
-    check_mesh_paths,
     check_name as _check_name,
-    read_session,
-    to_document,
-    write_session,
 )
+from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 __all__ = [
     "FORMAT_NAME",
@@ -69,52 +73,7 @@ __all__ = [
     "MAX_TRAJECTORY_SAMPLES",
 ]
 
-MAX_TRAJECTORY_SAMPLES = 2_000_000
-"""Most samples :meth:`Session.add_trajectory` takes from a Trajectory (duration × hz)."""
-
-
 # ---------------------------------------------------------------------------- helpers
-def _json_normalised(obj: Any, what: str) -> Any:
-    """``obj`` as it will come back from JSON (tuples → lists); rejects NaN and non-JSON values."""
-    try:
-        return json.loads(json.dumps(obj, allow_nan=False, ensure_ascii=False).encode("utf-8"))
-    except (TypeError, ValueError, RecursionError) as exc:  # UnicodeEncodeError (lone surrogates) is a ValueError
-        raise InvalidInput(f"{what} must be JSON-able (dicts, lists, str, finite numbers, bool, None): {exc}") from exc
-
-
-def _real(values: Any, what: str) -> np.ndarray:
-    """``values`` as a fresh float64 array; complex numbers and non-numbers raise InvalidInput."""
-    try:
-        if np.iscomplexobj(values):
-            raise TypeError("complex numbers")
-        return np.array(values, dtype=_F8)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise InvalidInput(f"{what} must be numbers (real), got {type(values).__name__}") from exc
-
-
-def _float_array(values: Any, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
-    """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``); ±inf allowed on request."""
-    arr = _real(values, what)
-    if arr.ndim != ndim or (width is not None and arr.shape[-1] != width):
-        shape = "(N,)" if ndim == 1 else f"(N, {width})"
-        raise InvalidInput(f"{what} must have shape {shape}, got {arr.shape}")
-    if np.any(np.isnan(arr)) if allow_inf else not np.all(np.isfinite(arr)):
-        raise InvalidInput(f"{what} holds NaN{'' if allow_inf else ' or infinite'} values")
-    arr.flags.writeable = False
-    return arr
-
-
-def _pose(values: Any, what: str) -> np.ndarray:
-    T = _real(np.eye(4) if values is None else values, what)
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise InvalidInput(f"{what} must be a finite (4, 4) homogeneous transform, got shape {T.shape}")
-    R = T[:3, :3]
-    if not np.allclose(T[3], [0, 0, 0, 1]) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0:
-        raise InvalidInput(f"{what} must be a rigid transform (orthonormal rotation, last row 0 0 0 1)")
-    T.flags.writeable = False
-    return T
-
-
 def _pinarms_version() -> str:
     try:
         return importlib.metadata.version("pinarms")
@@ -165,7 +124,7 @@ class Session:
             raise InvalidInput(f"title must be a string, got {title!r}")
         if metadata is not None and not isinstance(metadata, Mapping):
             raise InvalidInput(f"metadata must be a mapping (dict) of JSON-able values, got {type(metadata).__name__}")
-        user = _json_normalised(dict(metadata or {}), "metadata")
+        user = json_normalised(dict(metadata or {}), "metadata")
         self.metadata: dict[str, Any] = {
             "title": title,
             "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -223,7 +182,7 @@ class Session:
             name=robot.name,
             tcp_frame=robot.tcp_frame,
             joint_names=tuple(robot.joint_names),
-            base_to_world=_pose(base_to_world, f"base_to_world of robot {key!r}"),
+            base_to_world=pose_array(base_to_world, f"base_to_world of robot {key!r}"),
             urdf_text=None if reg else robot.urdf_text,
             package_dirs=() if reg else tuple(str(p) for p in robot.package_dirs),
             payload=None if robot.payload is None else robot.payload.as_dict(),
@@ -298,34 +257,9 @@ class Session:
         The arms' tcp frames are recorded in ``metadata["cells"][key]`` so that the viewer
         draws each arm's tcp path.
         """
-        from pinarms.robots.cell import Cell
-        from pinarms.robots.cell.motion import sample_motions
+        from .cell_session import add_cell
 
-        if not isinstance(cell, Cell):
-            raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")
-        key = self.add_robot(cell.robot, key=cell.name if key is None else key)
-        self.metadata.setdefault("cells", {})[key] = {
-            "name": cell.name,
-            "args": dict(cell.args),
-            "arms": {a.name: {"tcp_frame": a.prefix + a.robot.tcp_frame, "q_start": a.q_slice.start,
-                              "q_stop": a.q_slice.stop} for a in cell.arms},
-            "fixtures": [f.name for f in cell.fixtures],
-        }
-        if motions is not None:
-            t, q = sample_motions(cell, motions, hz=hz, window=None if check is None else check.window)
-            self.add_trajectory(name, (t, q), robot=key)
-        if check is not None:
-            if motions is None:
-                raise InvalidInput("a check needs the motions it was made of (motions=...)")
-            inside = np.flatnonzero(np.asarray(check.clearance) <= 0.0)
-            if inside.size:  # at most 400 contact samples, evenly spread
-                inside = inside[np.linspace(0, inside.size - 1, min(inside.size, 400)).round().astype(int)]
-                from pinarms.robots.cell.motion import _motions, configurations
-
-                qs = configurations(cell, _motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
-                cl = cell.clearance(qs)
-                self.add_points(f"{name} contacts", 0.5 * (cl.point_a + cl.point_b), kind="contact")
-        return key
+        return add_cell(self, cell, key=key, motions=motions, check=check, name=name, hz=hz)
 
     def cell_tcp_frames(self, key: str) -> dict[str, str]:
         """``{arm: tcp frame}`` of the cell stored under ``key`` (``{}`` for a plain robot)."""
@@ -344,18 +278,8 @@ class Session:
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""
-        name = self._free(self.objects, name, "object")
-        size_arr = _float_array(size, f"size of box {name!r}", 1, 3)
-        if np.any(size_arr <= 0):
-            raise InvalidInput(f"size of box {name!r} must be positive edge lengths in m, got {size_arr.tolist()}")
-        try:
-            rgba = tuple(float(c) for c in _real(color, "color").ravel())
-        except InvalidInput:
-            rgba = ()
-        if len(rgba) != 4 or not all(0.0 <= c <= 1.0 for c in rgba):
-            raise InvalidInput(f"color of box {name!r} must be 4 RGBA values in [0, 1], got {color!r}")
-        box = BoxObject(name, size_arr, _pose(pose, f"pose of box {name!r}"), rgba)
-        self.objects[name] = box
+        box = box_record(self._free(self.objects, name, "object"), size, pose, color)
+        self.objects[box.name] = box
         return box
 
     def add_trajectory(self, name: str, trajectory: Any, *, robot: str | None = None, hz: float = 100.0) -> TrajectoryRecord:
@@ -367,42 +291,8 @@ class Session:
                 (t (N,) s, q (N, nq)).
             hz: sampling rate (1/s) for a Trajectory.
         """
-        name = self._free(self.trajectories, name, "trajectory")
-        entry = self._entry(robot)
-        if isinstance(trajectory, tuple) and len(trajectory) == 2:
-            t, q = trajectory
-            definition, knots = None, None
-        elif hasattr(trajectory, "sample") and hasattr(trajectory, "knot_times"):
-            if not (isinstance(hz, (int, float)) and math.isfinite(hz) and hz > 0):
-                raise InvalidInput(f"hz must be a positive sampling rate in 1/s, got {hz!r}")
-            knots = np.asarray(trajectory.knot_times, dtype=float)
-            n_wanted = (knots[-1] - knots[0]) * hz
-            if not n_wanted < MAX_TRAJECTORY_SAMPLES:
-                raise InvalidInput(
-                    f"trajectory {name!r}: {knots[-1] - knots[0]:g} s at hz={hz:g} gives {n_wanted:.3g} samples, more "
-                    f"than {MAX_TRAJECTORY_SAMPLES:,}; lower hz"
-                )
-            n = max(2, int(math.ceil(n_wanted)) + 1)
-            t = np.union1d(np.linspace(knots[0], knots[-1], n), knots)
-            q = trajectory.sample(t)[0]
-            definition = _json_normalised(trajectory.definition, f"definition of trajectory {name!r}")
-        else:
-            raise InvalidInput(
-                f"trajectory {name!r} must be a planning.Trajectory or a (t, q) pair of arrays, got {type(trajectory).__name__}"
-            )
-        t = _float_array(t, f"t of trajectory {name!r}", 1)
-        q_arr = _real(q, f"q of trajectory {name!r}")
-        if q_arr.ndim == 1 and entry.nq == 1:
-            q_arr = q_arr[:, None]
-        q = _float_array(q_arr, f"q of trajectory {name!r} (robot {entry.key!r} has {entry.nq} joints)", 2, entry.nq)
-        if t.size < 2 or np.any(np.diff(t) <= 0) or q.shape[0] != t.size:
-            raise InvalidInput(
-                f"trajectory {name!r} needs t strictly increasing with at least 2 instants and one q row per instant; "
-                f"got t {t.shape}, q {q.shape}"
-            )
-        knots = _float_array(t[[0, -1]] if knots is None else knots, f"knot_times of trajectory {name!r}", 1)
-        rec = TrajectoryRecord(name, entry.key, t, q, knots, definition)
-        self.trajectories[name] = rec
+        rec = trajectory_record(self._free(self.trajectories, name, "trajectory"), self._entry(robot), trajectory, hz)
+        self.trajectories[rec.name] = rec
         return rec
 
     def add_workspace(self, name: str, workspace: Any = None, *, points: Any = None, manipulability: Any = None,
@@ -411,26 +301,9 @@ class Session:
 
         ``points`` (n, 3) m in the robot's base frame; ``manipulability`` (n,) ≥ 0.
         """
-        name = self._free(self.workspaces, name, "workspace")
-        entry = self._entry(robot)
-        if workspace is not None:
-            if not (hasattr(workspace, "points") and hasattr(workspace, "manipulability")):
-                raise InvalidInput(
-                    f"workspace {name!r} must be a robots.Workspace (points, manipulability), got {type(workspace).__name__}"
-                )
-            points, manipulability = workspace.points, workspace.manipulability
-        if points is None or manipulability is None:
-            raise InvalidInput(f"workspace {name!r}: give a Workspace, or both points= and manipulability=")
-        pts = _float_array(points, f"points of workspace {name!r}", 2, 3)
-        w = _float_array(manipulability, f"manipulability of workspace {name!r}", 1)
-        if pts.shape[0] == 0:
-            raise InvalidInput(f"workspace {name!r} has no points; sample at least one")
-        if w.shape[0] != pts.shape[0] or np.any(w < 0):
-            raise InvalidInput(
-                f"workspace {name!r} needs one manipulability value >= 0 per point; got {w.shape[0]} for {pts.shape[0]} points"
-            )
-        rec = WorkspaceRecord(name, entry.key, pts, w)
-        self.workspaces[name] = rec
+        rec = workspace_record(self._free(self.workspaces, name, "workspace"), self._entry(robot), workspace, points,
+                               manipulability)
+        self.workspaces[rec.name] = rec
         return rec
 
     def add_points(self, name: str, points: Any, *, kind: str = "via", robot: str | None = None) -> PointSet:
@@ -442,8 +315,8 @@ class Session:
         if kind not in _POINT_KINDS:
             raise InvalidInput(f"kind of point set {name!r} must be one of {_POINT_KINDS}, got {kind!r}")
         key = None if robot is None else self._entry(robot).key
-        arr = np.atleast_2d(_real(points, f"points of point set {name!r} (n, 3) in m"))
-        pts = _float_array(arr, f"points of point set {name!r}", 2, 3)
+        arr = np.atleast_2d(real_array(points, f"points of point set {name!r} (n, 3) in m"))
+        pts = float_array(arr, f"points of point set {name!r}", 2, 3)
         if pts.shape[0] == 0:
             raise InvalidInput(f"point set {name!r} has no points; give at least one (n, 3) row in m")
         ps = PointSet(name, kind, key, pts)
@@ -452,31 +325,8 @@ class Session:
 
     def add_history(self, name: str, history: Any) -> HistoryRecord:
         """Add an optimisation history: a GA history (``best``, ``mean``, ...), a result with ``.history``, or a mapping of columns."""
-        name = self._free(self.histories, name, "history")
-        if hasattr(history, "history") and not isinstance(history, Mapping):
-            history = history.history
-        if history is None:
-            raise InvalidInput(f"history {name!r} is None (an exact optimiser records no generations)")
-        if isinstance(history, Mapping):
-            cols = dict(history)
-        elif hasattr(history, "as_dict"):
-            cols = {k: getattr(history, k) for k in history.as_dict()}
-        else:
-            raise InvalidInput(f"history {name!r} must be a GA history, a result with .history, or a mapping of columns")
-        if "best" not in cols:
-            raise InvalidInput(f"history {name!r} needs a 'best' column; got {sorted(cols)}")
-        out: dict[str, np.ndarray] = {}
-        for k, v in cols.items():
-            _check_name(k, f"column of history {name!r}")
-            # a generation without any finite objective records inf (optim's GA does so)
-            out[k] = _float_array(v, f"column {k!r} of history {name!r}", 1, allow_inf=True)
-        lengths = {v.shape[0] for v in out.values()}
-        if 0 in lengths:
-            raise InvalidInput(f"history {name!r} has no generations; record at least one row")
-        if len(lengths) != 1:
-            raise InvalidInput(f"columns of history {name!r} must have equal lengths, got {sorted(lengths)}")
-        rec = HistoryRecord(name, out)
-        self.histories[name] = rec
+        rec = history_record(self._free(self.histories, name, "history"), history)
+        self.histories[rec.name] = rec
         return rec
 
     def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
@@ -487,7 +337,7 @@ class Session:
         from .reach_record import make_record
 
         name = self._free(self.reachability, name, "reachability")
-        rec = make_record(name, self._entry(robot).key, reach_map, min_index, _float_array)
+        rec = make_record(name, self._entry(robot).key, reach_map, min_index, float_array)
         self.reachability[name] = rec
         return rec
 

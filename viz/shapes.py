@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["tube_mesh", "floor_grid", "downsample_polyline", "frame_view", "CAMERA_FOV_DEG"]
+__all__ = ["tube_mesh", "floor_grid", "downsample_polyline", "frame_view", "transform_points", "CAMERA_FOV_DEG"]
 
 #: Vertical field of view of MeshCat's default camera [deg].
 CAMERA_FOV_DEG = 75.0
@@ -106,3 +106,8 @@ def frame_view(points: np.ndarray, toward: np.ndarray | None = None,
     half = min(half_v, np.arctan(np.tan(half_v) * aspect))
     distance = radius / np.sin(half) / 0.85
     return target, target + distance * direction, radius
+
+
+def transform_points(T: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Points ``p (N, 3)`` moved by the homogeneous transform ``T (4, 4)``."""
+    return p @ T[:3, :3].T + T[:3, 3]

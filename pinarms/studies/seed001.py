@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from pinarms import robots
@@ -25,71 +27,21 @@ __all__ = ["study_001"]
 def study_001(quick: bool = False) -> Study:
     """AUBO-i3: workspace and table region, 3-segment quintic vs Table 3, quintic/septic comparison."""
     from pinarms import planning
-    from pinarms.robots.workspace import sample_workspace
 
     arm = robots.load("aubo_i3")
     paper = SEED001
     table2 = paper.table2_joints
-    t3, q3 = paper.table3_t_s, paper.table3_joints_rad
-    rows: list[Row] = []
-    n = paper.workspace_samples if quick else 100_000
-    ws = sample_workspace(arm, n=n, seed=0, frame="flange")
-    sphere = ws.fit_sphere()
-    rows.append(Row("001", f"workspace sphere centre z ({n} samples, flange)", paper.sphere_centre_mm[2],
-                    sphere.centre[2] / MM, "mm", 20.0, "outer-hull sphere fit; the paper reads its centre off a plot"))
-    rows.append(Row("001", "workspace sphere radius", paper.sphere_radius_mm, sphere.radius / MM, "mm", 60.0,
-                    "paper: 'about 600 mm' read off its figure; ours is a least-squares fit to the outer hull"))
-    from pinarms.robots.placement import recommend_region
-
-    region = recommend_region(ws)
-    why = "from sample density, dexterity and self-collision share per shell; thresholds not tuned to the paper"
-    rows.append(Row("001", "recommended table band r_min", paper.table_r_min_mm, region.r_inner / MM, "mm", 50.0, why))
-    rows.append(Row("001", "recommended table band r_max", paper.table_r_max_mm, region.r_outer / MM, "mm", 50.0,
-                    why if abs(region.r_outer / MM - paper.table_r_max_mm) <= 50.0 else
-                    "our rule keeps shells up to 25 % near-singular; the paper's 500 mm is a visual, more cautious pick"))
-    rows.append(Row("001", f"recommended region: z {'>' if region.side == 'above' else '<'}", paper.table_z_min_mm,
-                    region.z_limit / MM, "mm", 1.0, why))
+    rows, ws = _workspace_rows_001(arm, quick)
     layout_rows, layout = _layout_search_001(arm)
     rows.extend(layout_rows)
 
     times = np.array(paper.via_times_s)
     traj = planning.multi_quintic(times, table2)
-    q = traj.sample(t3)[0][:, :3]
-    err = np.abs(q - q3)
-    for t, qi, row, e in zip(t3, q, q3, err.max(axis=1)):
-        note = "" if e <= 1e-4 else "measured on the robot: tracking error (paper: up to 8e-4 rad)"
-        rows.append(Row("001", f"Table 3 J1-J3 at t = {t:.1f} s", tuple(row), tuple(np.round(qi, 4)), "rad", 1e-3, note))
-    rows.append(Row("001", "Table 3 rows within 1e-4 rad", None, int(np.sum(err.max(axis=1) <= 1e-4)), f"of {len(t3)}",
-                    None,
-                    "most rows agree to 1e-4; the rest are the robot's tracking error"))
-
-    # how much of the paper's 4 s the arm's own speed limits leave (issue: optimise P1→P4)
-    from pinarms import optim
-
-    fastest = optim.minimize_time(table2, "multi-quintic", arm.velocity_limit, method="exact")
-    from pinarms.robots.ties import near_max
-
-    at_limit = [arm.joint_names[k] for k in near_max(fastest.peaks.velocity / arm.velocity_limit)]
-    limiting = " and ".join(at_limit) + (" at their limits" if len(at_limit) > 1 else " at its limit")
-    rows.append(Row("001", "time-optimal P1→P4 (3 quintics, at rest at P2/P3, joint speed limits)",
-                    float(times[-1]), fastest.total, "s", None,
-                    f"the paper's 1/2/1 s use a fraction of the {np.degrees(arm.velocity_limit[0]):.0f} °/s limit; "
-                    f"ours {'/'.join(f'{h:.3f}' for h in fastest.durations)} s, {limiting}"))
-
+    rows.extend(_table3_rows_001(traj))
+    rows.append(_time_optimal_row_001(arm, table2, times))
     dyn_rows, dyn_plots = _dynamics_001(arm, table2, quick)
     rows.extend(dyn_rows)
-
-    single = planning.polynomial(times[[0, 3]], table2[[0, 3]], 5)
-    miss = np.abs(single.sample(times[1:3])[0] - table2[1:3]).max()
-    rows.append(Row("001", "single quintic P1→P4 misses P2/P3 by", "misses", float(miss), "rad", None,
-                    "max joint deviation at t = 1 s and 3 s"))
-    septic = planning.polynomial(times, table2, 7)
-    tt = np.linspace(0.0, 4.0, 2001)
-    qs = septic.sample(tt)[0]
-    lo, hi = table2.min(axis=0), table2.max(axis=0)
-    overshoot = float(np.max(np.maximum(qs - hi, lo - qs)))
-    rows.append(Row("001", "septic through P1-P4: overshoot beyond the via range", "wobbles", max(overshoot, 0.0), "rad",
-                    None, "the 7th-order curve leaves the via points' range near the ends"))
+    rows.extend(_polynomial_rows_001(table2, times))
     line_rows, lines = _straight_lines_001(arm, table2, times)
     rows.extend(line_rows)
     fk_mm = conv.aubo_fk_mdh(table2[:2])[:, :3, 3] / MM
@@ -126,3 +78,75 @@ def study_001(quick: bool = False) -> Study:
     plots["layout_search"] = lambda path: vplots.plot_layout_search(
         path, layout, title="seed 001: picks/min by base position (P1 → P4, paper's frame)")
     return Study("001", "AUBO-i3 food handling: workspace, table region, 3-segment quintic", rows, session, plots)
+
+
+def _workspace_rows_001(arm: robots.Robot, quick: bool) -> tuple[list[Row], Any]:
+    """The workspace's outer sphere and the recommended table band against the paper's; and the workspace."""
+    from pinarms.robots.placement import recommend_region
+    from pinarms.robots.workspace import sample_workspace
+
+    paper = SEED001
+    rows: list[Row] = []
+    n = paper.workspace_samples if quick else 100_000
+    ws = sample_workspace(arm, n=n, seed=0, frame="flange")
+    sphere = ws.fit_sphere()
+    rows.append(Row("001", f"workspace sphere centre z ({n} samples, flange)", paper.sphere_centre_mm[2],
+                    sphere.centre[2] / MM, "mm", 20.0, "outer-hull sphere fit; the paper reads its centre off a plot"))
+    rows.append(Row("001", "workspace sphere radius", paper.sphere_radius_mm, sphere.radius / MM, "mm", 60.0,
+                    "paper: 'about 600 mm' read off its figure; ours is a least-squares fit to the outer hull"))
+    region = recommend_region(ws)
+    why = "from sample density, dexterity and self-collision share per shell; thresholds not tuned to the paper"
+    rows.append(Row("001", "recommended table band r_min", paper.table_r_min_mm, region.r_inner / MM, "mm", 50.0, why))
+    rows.append(Row("001", "recommended table band r_max", paper.table_r_max_mm, region.r_outer / MM, "mm", 50.0,
+                    why if abs(region.r_outer / MM - paper.table_r_max_mm) <= 50.0 else
+                    "our rule keeps shells up to 25 % near-singular; the paper's 500 mm is a visual, more cautious pick"))
+    rows.append(Row("001", f"recommended region: z {'>' if region.side == 'above' else '<'}", paper.table_z_min_mm,
+                    region.z_limit / MM, "mm", 1.0, why))
+    return rows, ws
+
+
+def _table3_rows_001(traj: Any) -> list[Row]:
+    """The 3-segment quintic's J1-J3 at the paper's Table 3 instants, row by row, and how many agree to 1e-4 rad."""
+    t3, q3 = SEED001.table3_t_s, SEED001.table3_joints_rad
+    q = traj.sample(t3)[0][:, :3]
+    err = np.abs(q - q3)
+    rows = []
+    for t, qi, row, e in zip(t3, q, q3, err.max(axis=1)):
+        note = "" if e <= 1e-4 else "measured on the robot: tracking error (paper: up to 8e-4 rad)"
+        rows.append(Row("001", f"Table 3 J1-J3 at t = {t:.1f} s", tuple(row), tuple(np.round(qi, 4)), "rad", 1e-3, note))
+    rows.append(Row("001", "Table 3 rows within 1e-4 rad", None, int(np.sum(err.max(axis=1) <= 1e-4)), f"of {len(t3)}",
+                    None,
+                    "most rows agree to 1e-4; the rest are the robot's tracking error"))
+    return rows
+
+
+def _time_optimal_row_001(arm: robots.Robot, table2: np.ndarray, times: np.ndarray) -> Row:
+    """How much of the paper's 4 s the arm's own speed limits leave (3 quintics P1→P4, time-optimal)."""
+    from pinarms import optim
+    from pinarms.robots.ties import near_max
+
+    fastest = optim.minimize_time(table2, "multi-quintic", arm.velocity_limit, method="exact")
+    at_limit = [arm.joint_names[k] for k in near_max(fastest.peaks.velocity / arm.velocity_limit)]
+    limiting = " and ".join(at_limit) + (" at their limits" if len(at_limit) > 1 else " at its limit")
+    return Row("001", "time-optimal P1→P4 (3 quintics, at rest at P2/P3, joint speed limits)",
+               float(times[-1]), fastest.total, "s", None,
+               f"the paper's 1/2/1 s use a fraction of the {np.degrees(arm.velocity_limit[0]):.0f} °/s limit; "
+               f"ours {'/'.join(f'{h:.3f}' for h in fastest.durations)} s, {limiting}")
+
+
+def _polynomial_rows_001(table2: np.ndarray, times: np.ndarray) -> list[Row]:
+    """Why the paper splits the motion: one quintic misses P2/P3, one septic through all four wobbles."""
+    from pinarms import planning
+
+    single = planning.polynomial(times[[0, 3]], table2[[0, 3]], 5)
+    miss = np.abs(single.sample(times[1:3])[0] - table2[1:3]).max()
+    rows = [Row("001", "single quintic P1→P4 misses P2/P3 by", "misses", float(miss), "rad", None,
+                "max joint deviation at t = 1 s and 3 s")]
+    septic = planning.polynomial(times, table2, 7)
+    tt = np.linspace(0.0, 4.0, 2001)
+    qs = septic.sample(tt)[0]
+    lo, hi = table2.min(axis=0), table2.max(axis=0)
+    overshoot = float(np.max(np.maximum(qs - hi, lo - qs)))
+    rows.append(Row("001", "septic through P1-P4: overshoot beyond the via range", "wobbles", max(overshoot, 0.0), "rad",
+                    None, "the 7th-order curve leaves the via points' range near the ends"))
+    return rows

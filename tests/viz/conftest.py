@@ -10,6 +10,8 @@ from pinarms import robots
 from pinarms import viz
 from pinarms.papers import SEED000
 
+from session_files import LEVER_URDF
+
 DEG = np.pi / 180.0
 
 
@@ -54,3 +56,35 @@ def belt_session(belt_line) -> viz.Session:
     s = viz.Session(title="enoki belt line")
     s.add_line(spec, result, duration=8.0, name="belt")
     return s
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return robots.load("ur5")
+
+
+@pytest.fixture()
+def session(ur5):
+    """A UR5 and a lever robot with two trajectories, a cloud, points, a GA history and a box."""
+    s = viz.Session(ur5, title="pick & place", metadata={"line": "enoki", "speeds": (1.5, 2)})
+    times = np.array([0.0, 1.0, 3.0, 4.0])
+    via = ur5.random_q(4, seed=1)
+    s.add_trajectory("P1-P4 quintic", planning.multi_quintic(times, via), hz=50)
+    s.add_trajectory("raw", (np.linspace(0, 1, 7), ur5.random_q(7, seed=2)))
+    q = ur5.random_q(300, seed=3)
+    s.add_workspace("cloud", points=ur5.position(q), manipulability=ur5.manipulability(q))
+    s.add_points("targets", [[0.4, 0.1, 0.2], [0.3, -0.2, 0.25]], kind="target")
+    s.add_points("vias", [[0.1, 0.2, 0.3]], robot="ur5")
+    s.add_history("ga", {"best": [5.0, 4.0, 3.6], "mean": [7.0, 5.5, 4.0], "feasible_share": [0.2, 0.6, 1.0]})
+    lever = robots.from_urdf_text(LEVER_URDF)
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 0.5, 0.0]
+    s.add_robot(lever, base_to_world=T)
+    s.add_box("conveyor", [1.2, 0.3, 0.05], pose=T, color=(0.2, 0.3, 0.8, 0.5))
+    return s
+
+
+@pytest.fixture()
+def saved(session, tmp_path):
+    """:func:`session` saved in ``tmp_path``."""
+    return session.save(tmp_path / "good.pinarms")

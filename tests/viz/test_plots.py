@@ -43,33 +43,6 @@ def test_joint_curves_svg_labels(traj, tmp_path):
     ET.parse(out)  # well-formed XML
 
 
-def test_ga_convergence(tmp_path):
-    hist = {"best": [6.0, 4.1, 3.7, 3.61], "mean": [9.0, 6.0, 4.5, 3.9], "feasible_share": [0.1, 0.5, 0.9, 1.0]}
-    out = viz.plot_ga_convergence(tmp_path / "ga.svg", hist)
-    text = out.read_text()
-    assert "generation" in text and "feasible share" in text and "population mean" in text
-    assert "can lie below the best" in text  # a mean of all individuals says what it counts
-    hist["feasible_mean"] = [7.0, 5.0, 4.0, 3.7]
-    text = viz.plot_ga_convergence(tmp_path / "ga2.svg", hist).read_text()
-    assert "mean of the feasible individuals" in text and "population mean" not in text
-    s = viz.Session()
-    rec = s.add_history("ga", hist)
-    assert Image.open(viz.plot_ga_convergence(tmp_path / "ga.png", rec)).format == "PNG"
-    with pytest.raises(InvalidInput, match="best"):
-        viz.plot_ga_convergence(tmp_path / "x.png", {"mean": [1.0]})
-
-
-def test_workspace_views(tmp_path):
-    rng = np.random.default_rng(0)
-    pts = rng.normal(size=(500, 3)) * 0.3
-    w = np.linalg.norm(pts, axis=1)
-    out = viz.plot_workspace(tmp_path / "ws.svg", pts, w, mm=True)
-    text = out.read_text()
-    assert "top view" in text and "side view" in text and "manipulability" in text and "[mm]" in text
-    with pytest.raises(InvalidInput, match=r"\(500,\)"):
-        viz.plot_workspace(tmp_path / "bad.png", pts, w[:10])
-
-
 def test_bad_suffix_writes_nothing(traj, tmp_path):
     with pytest.raises(InvalidInput, match=".png or .svg"):
         viz.plot_trajectory(tmp_path / "j.pdf", traj)
@@ -84,12 +57,6 @@ def test_bad_suffix_writes_nothing(traj, tmp_path):
         (lambda p: viz.plot_joint_curves(p, "abc", [1.0, 2.0, 3.0]), "t must be numbers"),
         (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": -1.0}), "positive"),
         (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": [1.0, 2.0]}), "one per joint"),
-        (lambda p: viz.plot_ga_convergence(p, {"best": []}), "G >= 1"),
-        (lambda p: viz.plot_ga_convergence(p, {"best": [[1.0, 2.0], [3.0, 4.0]]}), "one objective per generation"),
-        (lambda p: viz.plot_ga_convergence(p, {"best": [1.0, 2.0], "mean": [1.0, 2.0, 3.0]}), "mean must have one value"),
-        (lambda p: viz.plot_ga_convergence(p, {"best": [1.0, float("nan")]}), "NaN"),
-        (lambda p: viz.plot_workspace(p, np.full((3, 3), np.nan)), "NaN"),
-        (lambda p: viz.plot_workspace(p, np.zeros((3, 3)), colormap="nope"), "colormap"),
     ],
 )
 def test_bad_plot_data_raises_invalid_input_and_writes_nothing(call, match, tmp_path):

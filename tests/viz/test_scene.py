@@ -10,7 +10,7 @@ import pytest
 
 from pinarms import viz
 from pinarms.robots.errors import InvalidInput
-from pinarms.viz.scene import build_scene, colors_by_value
+from pinarms.viz.scene import build_scene
 from pinarms.viz.server import MeshcatServer
 
 
@@ -102,14 +102,6 @@ def test_export_html_is_self_contained(line_session, tmp_path):
     assert "src=\"http" not in html and "href=\"http" not in html  # nothing fetched from a server
     assert html.count("fetch(\"data:application/octet-binary;base64,") > 20  # the replayed scene
     assert os.listdir(tmp_path) == ["line.html"]
-
-
-def test_colors_by_value_scale():
-    c = colors_by_value(np.array([0.0, 0.5, 1.0]))
-    assert c.shape == (3, 3)
-    np.testing.assert_allclose(c[0], [0.267004, 0.004874, 0.329415], atol=1e-6)  # viridis(0)
-    np.testing.assert_allclose(c[2], [0.993248, 0.906157, 0.143936], atol=1e-6)  # viridis(1)
-    assert np.all(colors_by_value(np.zeros(4)) == colors_by_value(np.zeros(4))[0])
 
 
 def test_two_robots_with_base_placement(tmp_path):

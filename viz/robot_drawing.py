@@ -1,0 +1,86 @@
+"""One robot's visual geometry in a MeshCat scene: drawn, posed, bounded and animated.
+
+The geometry is Pinocchio's visual model of the robot's URDF, drawn under
+``<root>/robots/<key>/visuals/<geometry>`` by Pinocchio's ``MeshcatVisualizer`` and placed
+at the robot's ``base_to_world``. Frames and units: metres, the robot's base frame unless
+said otherwise.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any, Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from ._meshcat import MeshcatVisualizer, meshcat
+from .errors import ViewerError
+
+__all__ = ["RobotDrawing"]
+
+
+class RobotDrawing:
+    """One robot's visual geometry in the scene, driven by Pinocchio's MeshcatVisualizer."""
+
+    def __init__(self, vis: meshcat.Visualizer, robot: Any, key: str, base_to_world: np.ndarray,
+                 package_dirs: Sequence[str], root: str = "pinarms") -> None:
+        self.robot = robot
+        self.root = f"{root}/robots/{key}"
+        try:
+            visual_model = pin.buildGeomFromUrdfString(
+                robot.model, robot.urdf_text, pin.GeometryType.VISUAL, package_dirs=list(package_dirs)
+            )
+        except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for missing meshes
+            raise ViewerError(
+                f"cannot build the visual geometry of robot {key!r}: {exc}; if its meshes moved, "
+                "pass package_dirs=... to viz.load_session"
+            ) from exc
+        self.pv = MeshcatVisualizer(robot.model, None, visual_model)
+        self.pv.initViewer(viewer=vis)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # unsupported geometry is skipped, not fatal
+            self.pv.loadViewerModel(rootNodeName=self.root)
+        vis[self.root].set_transform(base_to_world)
+        self.geometry_paths = [self.pv.getViewerNodeName(g, pin.GeometryType.VISUAL)
+                               for g in visual_model.geometryObjects]
+
+    def display(self, q: np.ndarray) -> None:
+        """Show configuration ``q (nq,)``."""
+        self.pv.display(self.robot.q_to_pinocchio(q))
+
+    def extent(self, qs: np.ndarray) -> np.ndarray:
+        """Corners of the visual geometries' boxes at each row of ``qs (F, nq)``, ``(8kF, 3)`` in the base frame [m].
+
+        A geometry whose box is unknown contributes its origin. The displayed pose is untouched.
+        """
+        model, gmodel = self.pv.model, self.pv.visual_model
+        data, gdata = model.createData(), gmodel.createData()
+        signs = np.array(np.meshgrid([0, 1], [0, 1], [0, 1])).reshape(3, -1).T
+        local = []
+        for g in gmodel.geometryObjects:
+            try:
+                g.geometry.computeLocalAABB()
+                lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
+                local.append((lo + signs * (hi - lo)) * np.asarray(g.meshScale))
+            except Exception:  # noqa: BLE001 - a geometry coal cannot bound: its origin only
+                local.append(np.zeros((1, 3)))
+        corners = [np.zeros((1, 3))]
+        for qp in np.atleast_2d(self.robot.q_to_pinocchio(qs)):
+            pin.forwardKinematics(model, data, qp)
+            pin.updateGeometryPlacements(model, data, gmodel, gdata)
+            corners += [box @ M.rotation.T + M.translation for box, M in zip(local, gdata.oMg)]
+        return np.vstack(corners)
+
+    def record(self, anim: meshcat.animation.Animation, vis: meshcat.Visualizer, qs: np.ndarray) -> None:
+        """Add one key frame per row of ``qs (F, nq)`` to ``anim`` (rigid poses: tracks hold position + rotation)."""
+        model, data = self.pv.model, self.pv.data
+        gmodel, gdata = self.pv.visual_model, self.pv.visual_data
+        qp = self.robot.q_to_pinocchio(qs)
+        ids = [gmodel.getGeometryId(g.name) for g in gmodel.geometryObjects]
+        for i in range(qp.shape[0]):
+            pin.forwardKinematics(model, data, qp[i])
+            pin.updateGeometryPlacements(model, data, gmodel, gdata)
+            with anim.at_frame(vis, i) as frame:
+                for path, gid in zip(self.geometry_paths, ids):
+                    frame[path].set_transform(gdata.oMg[gid].homogeneous)
