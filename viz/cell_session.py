@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.robots.cell import Cell
-from pinarms.robots.cell.motion import _motions, configurations, sample_motions
+from pinarms.robots.cell.timeline import arm_motions, configurations, sample_motions
 from pinarms.robots.errors import InvalidInput
 
 __all__ = ["add_cell"]
@@ -42,7 +42,7 @@ def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = 
         inside = np.flatnonzero(np.asarray(check.clearance) <= 0.0)
         if inside.size:  # at most 400 contact samples, evenly spread
             inside = inside[np.linspace(0, inside.size - 1, min(inside.size, 400)).round().astype(int)]
-            qs = configurations(cell, _motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
+            qs = configurations(cell, arm_motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
             cl = cell.clearance(qs)
             session.add_points(f"{name} contacts", 0.5 * (cl.point_a + cl.point_b), kind="contact")
     return key

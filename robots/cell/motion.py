@@ -68,9 +68,6 @@ MAX_DISTANCE = 1e3
 #: Largest number of bisection steps locating the first contact (1e-6 s over MAX_TIME needs 41).
 MAX_BISECTIONS = 64
 
-#: The schedule check under the name :mod:`pinarms.viz.session` imports.
-_motions = arm_motions
-
 
 # ------------------------------------------------------------------ the check
 def check_motion(
