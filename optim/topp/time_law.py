@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.planning import Trajectory
-from pinarms.planning.trajectory import taylor_shift
+from pinarms.planning.poly_pieces import taylor_shift
 
 __all__ = ["law_eval", "polyval", "bang_bang", "smoothed", "split_at_breaks", "compose_law", "assemble",
            "scaled_law", "acceleration_jumps"]
