@@ -26,7 +26,7 @@ eigenvalues above; :mod:`planning.extrema`, which also peaks whole populations).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pinarms import planning
-from pinarms.planning import JointLimits, Trajectory
+from pinarms.planning import Trajectory
 from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
 
 
