@@ -6,14 +6,14 @@ based on reachability analysis", IEEE T-RO 34(3), 2018, written here from the pa
 Why our own and not toppra: measured side by side by ``python benchmarks/topp.py`` (a UR5
 joint spline through 8 seeded waypoints, velocity and acceleration limits, the same 1354-point
 grid for both, best of 11 repeats), the rows plus this profile take 44.2 ms against 55.6 ms
-for toppra 0.6.10's ``compute_parameterization`` (0.80×, two shared cores under load; 15.6 ms
-against 26.2 ms on a quiet machine), with the same duration (9.063810 s both). It is as fast
-as toppra, keeps the timings' figures to the last bit (toppra's answer differs by its own
-rounding), needs no compiled extension, and takes every :class:`planning.PathConstraint` as
-rows. The whole timing (:func:`optim.time_optimal`: refined grid, checks between grid points,
-exact joint peaks, q(t) composed exactly) took 187 ms against 56.7 ms for toppra's
-``compute_trajectory`` (3.3×), which does none of that (its duration is 0.034 % shorter: it
-meets the limits at the grid points only). toppra (test extra) stays the independent
+for toppra 0.6.10's ``compute_parameterization`` (0.80×, two shared cores under load; 25.5 ms
+against 30.8 ms, 0.83×, in a quieter run), with the same duration (9.063810 s both). It is
+faster than toppra, keeps the timings' figures to the last bit (toppra's answer differs by
+its own rounding), needs no compiled extension, and takes every :class:`planning.PathConstraint`
+as rows. The whole timing (:func:`optim.time_optimal`: refined grid, checks between grid
+points, exact joint peaks, q(t) composed exactly) takes 3.3–4.4× toppra's
+``compute_trajectory`` (187 ms against 56.7 ms; 129 ms against 29.6 ms), which does none of
+that (its duration is 0.034 % shorter: it meets the limits at the grid points only). toppra (test extra) stays the independent
 cross-check (:func:`optim.toppra_path_duration`, ``tests/optim/topp/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
