@@ -13,8 +13,9 @@ its own rounding), needs no compiled extension, and takes every :class:`planning
 as rows. The whole timing (:func:`optim.time_optimal`: refined grid, checks between grid
 points, exact joint peaks, q(t) composed exactly) takes 3.3–4.4× toppra's
 ``compute_trajectory`` (187 ms against 56.7 ms; 129 ms against 29.6 ms), which does none of
-that (its duration is 0.034 % shorter: it meets the limits at the grid points only). toppra (test extra) stays the independent
-cross-check (:func:`optim.toppra_path_duration`, ``tests/optim/topp/test_path_timing.py``).
+that (its duration is 0.034 % shorter: it meets the limits at the grid points only). toppra
+(test extra) stays the independent cross-check (:func:`optim.toppra_path_duration`,
+``tests/optim/topp/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
 control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
@@ -33,8 +34,8 @@ each grid point the limits are rows ``lo <= a u + b x <= hi``
    the backward loop.
    Each step reads only the rows that can bind there: rows beyond another one over the
    whole range the state can take (``X_{i+1}``, resp. ``K_i`` in step 2) by more than 1e-9
-   are left out before the loop (:func:`optim.topp.row_bounds.prune`, the same min and max to the last bit), and
-   with ``λ = 0`` the λ rows are constants reduced for all points at once.
+   are left out before the loop (:func:`optim.topp.row_bounds.prune`, the same min and max to
+   the last bit), and with ``λ = 0`` the λ rows are constants reduced for all points at once.
 2. **Greedy forward pass.** From ``x_0``, take the largest admissible u that keeps
    ``x_{i+1}`` in ``K_{i+1}``. Every state stays controllable, so the pass never fails, and
    the result is time-optimal on the grid (the paper's theorem).
