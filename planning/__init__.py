@@ -28,7 +28,8 @@ from pinarms.planning.multi_quintic import heuristic_velocities, multi_quintic, 
 from pinarms.planning.piecewise import PRESETS, piecewise_polynomial, piecewise_polynomial_batch
 from pinarms.planning.point_to_point import double_s, trapezoidal
 from pinarms.planning.polynomial import polynomial
-from pinarms.planning.trajectory import LimitReport, Peaks, Trajectory, Violation
+from pinarms.planning.limit_report import LimitReport, Violation
+from pinarms.planning.trajectory import Peaks, Trajectory
 from pinarms.planning.torque import JointTorqueConstraint, TorquePeaks, torque_peaks, torques
 
 __all__ = [

@@ -11,9 +11,9 @@ axes with the angular rows weighted by the path's ``w``; J̇ q' by a central dif
 along q'). Between knots q(s) is the **quintic Hermite** interpolant of (q, q', q'') at
 both ends: C² in s, error O(h⁶).
 
-1. *Continuation, one branch.* From the start configuration each knot is reached by a
-   predictor (Taylor step) and Newton's method on the pose error, so the solution moves
-   continuously and never jumps to another IK branch. A step is refused — and halved —
+1. *Continuation, one branch* (:mod:`planning.ik_continuation`). From the start
+   configuration each knot is reached by a predictor (Taylor step) and Newton's method on
+   the pose error, so the solution moves continuously and never jumps to another IK branch. A step is refused — and halved —
    when Newton does not converge, when the correction or the joint step is large (a jump),
    when a joint leaves its limits, or when the Jacobian's smallest singular value falls
    below ``singular_tolerance``. When the step has shrunk below ``locate`` (10 µm of arc
@@ -44,7 +44,8 @@ from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array, per_joint
 from pinarms.planning.errors import (JointLimitOnPath, PathError, SingularityOnPath, TrajectoryError,
                                      UnreachableOnPath)
-from pinarms.planning.joint_path import JointPath, jacobian_rate
+from pinarms.planning.ik_continuation import MAX_CORRECTION, Knot, PathSolver, Stop, continue_to, solve_knots
+from pinarms.planning.joint_path import JointPath
 from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
 from pinarms.robots.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
@@ -56,13 +57,6 @@ DEFAULT_TOLERANCE = 1e-4
 #: Default smallest singular value of the weighted Jacobian [m/rad] below which the arm counts as singular.
 DEFAULT_SINGULAR_TOLERANCE = 1e-4
 MIN_TOLERANCE = 1e-9  #: smallest tolerance [m]: a tighter one refines for minutes on rounding noise
-#: Newton's method stops when the position error [m] and the weighted rotation error [m] are below this.
-_NEWTON_TOL = 1e-11
-_NEWTON_ITERATIONS = 8
-#: A continuation step is refused when Newton corrects the prediction by more than this [rad or m] ...
-_MAX_CORRECTION = 0.05
-#: ... or when a joint moves more than this in one step [rad or m].
-_MAX_JOINT_STEP = 0.3
 #: Longest initial knot spacing [m of arc length].
 _INITIAL_STEP = 0.1
 #: Check points of the tolerance rule, as fractions of an interval.
@@ -131,106 +125,7 @@ def _eval(c: np.ndarray, sig: np.ndarray) -> np.ndarray:
     return np.einsum("kmd,kdn->kmn", powers, c)
 
 
-class _Solver:
-    """IK along one tool path for one robot: Newton, derivatives, conditioning (batched)."""
-
-    def __init__(self, robot: Any, tool: ToolPath, frame: str, singular_tolerance: float) -> None:
-        self.robot, self.tool, self.frame = robot, tool, frame
-        self.w = tool.weight
-        self.scale = np.array([1.0, 1.0, 1.0, self.w, self.w, self.w])
-        self.singular = singular_tolerance
-        self.lower = np.asarray(robot.lower, dtype=float)
-        self.upper = np.asarray(robot.upper, dtype=float)
-
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
-        return np.asarray(self.robot.jacobian(q, frame=self.frame)) * self.scale[:, None]
-
-    def errors(self, q: np.ndarray, T: np.ndarray) -> np.ndarray:
-        """Weighted pose errors (N, 6) [m]: position, w × rotation vector of T R(q)ᵀ (base axes)."""
-        F = np.asarray(self.robot.fk(q, frame=self.frame))
-        e = np.empty((q.shape[0], 6))
-        e[:, :3] = T[:, :3, 3] - F[:, :3, 3]
-        e[:, 3:] = self.w * _so3.log(T[:, :3, :3] @ np.swapaxes(F[:, :3, :3], 1, 2))
-        return e
-
-    def newton(self, q0: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Solutions near q0 (N, nq) for targets T (N, 4, 4) and a converged flag (N,).
-
-        Chord Newton: the Jacobian's pseudo-inverse is evaluated at the start and refreshed every
-        4 iterations (the predictions start close, so each iteration costs one batched FK).
-        """
-        q = q0.copy()
-        active = np.ones(q.shape[0], dtype=bool)
-        ok = np.zeros(q.shape[0], dtype=bool)
-        pinv = np.zeros((q.shape[0], q.shape[1], 6))
-        for it in range(_NEWTON_ITERATIONS):
-            idx = np.flatnonzero(active)
-            if idx.size == 0:
-                break
-            e = self.errors(q[idx], T[idx])
-            done = np.abs(e).max(axis=1) <= _NEWTON_TOL
-            ok[idx[done]] = True
-            active[idx[done]] = False
-            idx, e = idx[~done], e[~done]
-            if idx.size == 0:
-                break
-            if it % 4 == 0:
-                pinv[idx] = np.linalg.pinv(self.jacobian(q[idx]), rcond=1e-12)
-            q[idx] += (pinv[idx] @ e[:, :, None])[:, :, 0]
-        if active.any():
-            idx = np.flatnonzero(active)
-            ok[idx] = np.abs(self.errors(q[idx], T[idx])).max(axis=1) <= _NEWTON_TOL * 10.0
-        return q, ok
-
-    def derivatives(self, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """q' (N, nq), q'' (N, nq) from the tool path's d1, d2 (N, 6), and σ_min (N,) of the weighted Jacobian."""
-        J = self.jacobian(q)
-        U, S, Vt = np.linalg.svd(J, full_matrices=False)
-        inv = np.where(S > 1e-14 * S[:, :1], 1.0 / np.where(S > 0.0, S, 1.0), 0.0)
-        pinv = np.einsum("nji,nj,nkj->nik", Vt, inv, U)
-        x1 = d1 * self.scale
-        x2 = d2 * self.scale
-        dq = np.einsum("nij,nj->ni", pinv, x1)
-        rate = jacobian_rate(self.robot, q, dq, self.frame) * self.scale
-        ddq = np.einsum("nij,nj->ni", pinv, x2 - rate)
-        return dq, ddq, S[:, -1]
-
-    def outside(self, q: np.ndarray) -> np.ndarray:
-        """Largest excess of each row beyond the joint limits (N,) [rad or m]."""
-        return np.maximum(self.lower - q, q - self.upper).max(axis=1)
-
-
-class _Knot:
-    __slots__ = ("s", "q", "dq", "ddq", "dq_l", "ddq_l", "sigma")
-
-    def __init__(self, s: float, q: np.ndarray, right: tuple, left: tuple, sigma: float) -> None:
-        self.s, self.q, self.sigma = s, q, sigma
-        self.dq, self.ddq = right
-        self.dq_l, self.ddq_l = left
-
-
-def _solve_knots(sv: _Solver, s: np.ndarray, q: np.ndarray) -> list[_Knot]:
-    """Knots at s (N,) for configurations q (N, nq) already on the path (derivatives on both sides)."""
-    tool = sv.tool
-    T, r1, r2 = tool.evaluate(s, "right")
-    _, l1, l2 = tool.evaluate(s, "left")
-    dq_r, ddq_r, sig = sv.derivatives(q, r1, r2)
-    differ = np.abs(l1 - r1).max(axis=1) + np.abs(l2 - r2).max(axis=1) > 0.0
-    dq_l, ddq_l = dq_r.copy(), ddq_r.copy()
-    if differ.any():
-        dq_l[differ], ddq_l[differ], _ = sv.derivatives(q[differ], l1[differ], l2[differ])
-    return [_Knot(float(s[i]), q[i], (dq_r[i], ddq_r[i]), (dq_l[i], ddq_l[i]), float(sig[i])) for i in range(s.size)]
-
-
-class _Stop(Exception):
-    """Internal: the continuation of one start cannot pass arc length ``s`` (diagnosed once, by :func:`_failure`)."""
-
-    def __init__(self, s: float, q_last: np.ndarray, kind: str, detail: str) -> None:
-        super().__init__(detail)
-        self.s, self.q_last, self.kind, self.detail = s, q_last, kind, detail
-
-
-def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) -> PathError:
+def _failure(sv: PathSolver, s: float, q_last: np.ndarray, kind: str, detail: str) -> PathError:
     """The named error for a continuation that cannot get past arc length s."""
     robot, tool = sv.robot, sv.tool
     pose = tool.pose(min(s, tool.length))
@@ -253,46 +148,6 @@ def _failure(sv: _Solver, s: float, q_last: np.ndarray, kind: str, detail: str) 
               "through it without changing IK branch")
     return SingularityOnPath(f"robot '{robot.name}' cannot follow the path {where}: {reason}; move the path away "
                              "from the singularity or split it there", s=s, pose=pose, reason=reason, q=q_last)
-
-
-def _continue(sv: _Solver, start: _Knot, s_end: float, locate: float) -> list[_Knot]:
-    """Knots from ``start`` to ``s_end`` by predictor–corrector continuation (adaptive step), start excluded."""
-    out: list[_Knot] = []
-    cur = start
-    h = s_end - cur.s
-    while s_end - cur.s > 1e-15 * max(1.0, s_end):
-        h = min(h, s_end - cur.s)
-        s_new = cur.s + h if s_end - (cur.s + h) > 1e-12 * max(1.0, s_end) else s_end
-        hh = s_new - cur.s
-        pred = cur.q + cur.dq * hh + 0.5 * cur.ddq * hh * hh
-        T = sv.tool.pose(s_new)[None]
-        q, ok = sv.newton(pred[None], T)
-        q = q[0]
-        kind, detail = "", ""
-        if not ok[0]:
-            kind, detail = "newton", "Newton's method does not converge on the pose"
-        elif np.abs(q - pred).max() > _MAX_CORRECTION or np.abs(q - cur.q).max() > _MAX_JOINT_STEP:
-            kind, detail = "jump", "the IK solution jumps"
-        elif sv.outside(q[None])[0] > 1e-9:
-            j = int(np.argmax(np.maximum(sv.lower - q, q - sv.upper)))
-            side = "upper" if q[j] > sv.upper[j] else "lower"
-            kind = "limit"
-            detail = (f"joint {sv.robot.joint_names[j]} would pass its {side} limit "
-                      f"{(sv.upper if side == 'upper' else sv.lower)[j]:.6g}")
-        if not kind:
-            knot = _solve_knots(sv, np.array([s_new]), q[None])[0]
-            if knot.sigma < sv.singular:
-                kind, detail = "singular", (f"smallest singular value of the weighted Jacobian {knot.sigma:.4g} m/rad "
-                                            f"< singular_tolerance {sv.singular:g}")
-            else:
-                out.append(knot)
-                cur = knot
-                h = 2.0 * hh
-                continue
-        if hh <= locate:
-            raise _Stop(s_new, cur.q, kind, detail)
-        h = 0.5 * hh
-    return out
 
 
 def _labels(robot: Any, pose: np.ndarray, q: np.ndarray) -> int | None:
@@ -323,80 +178,15 @@ def _starts(robot: Any, pose: np.ndarray, q_start: np.ndarray | None) -> list[np
     return [np.asarray(robot.ik(pose, q_seed=q_start), dtype=float).reshape(nq)]
 
 
-def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> CartesianPath:
+def _build(sv: PathSolver, q0: np.ndarray, tolerance: float, locate: float) -> CartesianPath:
+    """The joint path from ``q0`` along the whole tool path (module docstring, steps 1 and 2), on one branch.
+
+    Raises:
+        Stop: where the continuation or the tolerance rule cannot go on (:func:`joint_image` names it).
+    """
     tool = sv.tool
     L = tool.length
-    first = _solve_knots(sv, np.array([0.0]), q0[None])[0]
-    if first.sigma < sv.singular:
-        raise _Stop(0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.4g} "
-                                         f"m/rad < singular_tolerance {sv.singular:g} at the start")
-    # planned knots: the tool path's breaks, each piece cut into steps of at most _INITIAL_STEP
-    planned = [0.0]
-    for a, b in zip(tool.breaks[:-1], tool.breaks[1:]):
-        n = max(1, int(np.ceil((b - a) / _INITIAL_STEP)))
-        planned.extend((a + (b - a) * np.arange(1, n + 1) / n).tolist())
-    planned[-1] = L
-    knots = [first]
-    for target in planned[1:]:
-        knots.extend(_continue(sv, knots[-1], target, locate))
-    # tolerance rule: refine until every interval passes its check points
-    rot_tol = 0.5 * tolerance / sv.w
-    for _ in range(60):
-        s = np.array([k.s for k in knots])
-        coefs = _coefficients(knots)
-        h = np.diff(s)
-        sc = s[:-1, None] + h[:, None] * _CHECKS
-        qc = _eval(coefs, h[:, None] * _CHECKS)  # (K, 3, n)
-        K, C, n = qc.shape
-        flat = qc.reshape(-1, n)
-        ref = tool.pose(sc.reshape(-1))
-        F = np.asarray(sv.robot.fk(flat, frame=sv.frame))
-        pos = np.linalg.norm(F[:, :3, 3] - ref[:, :3, 3], axis=1).reshape(K, C)
-        rot = _so3.angle(np.swapaxes(ref[:, :3, :3], 1, 2) @ F[:, :3, :3]).reshape(K, C)
-        sig_c = np.linalg.svd(sv.jacobian(flat), compute_uv=False)[:, -1].reshape(K, C)
-        sig_k = np.array([k.sigma for k in knots])
-        sig_all = np.concatenate([sig_k[:-1, None], sig_c, sig_k[1:, None]], axis=1)
-        bad = (pos.max(axis=1) > 0.5 * tolerance) | (rot.max(axis=1) > rot_tol) | \
-              (sig_all.max(axis=1) > 2.0 * sig_all.min(axis=1)) | (sv.outside(flat).reshape(K, C).max(axis=1) > 1e-9)
-        if np.any(sig_c < sv.singular):
-            i, c = np.unravel_index(int(np.argmin(sig_c)), sig_c.shape)
-            if h[i] <= locate:
-                raise _Stop(float(sc[i, c]), knots[i].q, "singular",
-                            f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad "
-                            f"< singular_tolerance {sv.singular:g}")
-            bad[i] = True
-        if not bad.any():
-            break
-        idx = np.flatnonzero(bad)
-        tiny = idx[h[idx] <= locate]
-        if tiny.size:
-            i = int(tiny[0])
-            if sv.outside(qc[i]).max() > 1e-9:
-                j = int(np.argmax(np.maximum(sv.lower - qc[i], qc[i] - sv.upper).max(axis=0)))
-                raise _Stop(float(sc[i, 1]), knots[i].q, "limit",
-                               f"joint {sv.robot.joint_names[j]} would pass its limit between knots")
-            raise _Stop(float(sc[i, 1]), knots[i].q, "singular",
-                           f"the tolerance cannot be met: the joint path bends too fast (σ_min {sig_all[i].min():.3g} m/rad)")
-        mids = s[idx] + 0.5 * h[idx]
-        pred = _eval(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
-        q_new, ok = sv.newton(pred, tool.pose(mids))
-        ok &= np.abs(q_new - pred).max(axis=1) <= _MAX_CORRECTION
-        ok &= sv.outside(q_new) <= 1e-9
-        new = _solve_knots(sv, mids[ok], q_new[ok]) if ok.any() else []
-        new = [k for k in new if k.sigma >= sv.singular]
-        inserted = {round(k.s, 15): k for k in new}
-        result = []
-        for i, k in enumerate(knots):
-            result.append(k)
-            if i < len(knots) - 1 and bad[i]:
-                mid = inserted.get(round(s[i] + 0.5 * h[i], 15))
-                if mid is not None:
-                    result.append(mid)
-                else:  # the batch could not solve it: walk the interval step by step (raises where it fails)
-                    result.extend(_continue(sv, k, float(s[i] + 0.5 * h[i]), locate))
-        knots = result
-    else:  # pragma: no cover - 60 halvings of every interval is far below `locate`
-        raise TrajectoryError("the tolerance rule did not converge in 60 refinement rounds")
+    knots, pos, rot = _refined(sv, _walked(sv, q0, locate), tolerance, locate)
     s = np.array([k.s for k in knots])
     s[-1] = L
     q = np.array([k.q for k in knots])
@@ -404,13 +194,123 @@ def _build(sv: _Solver, q0: np.ndarray, tolerance: float, locate: float) -> Cart
     if branch is not None:
         end = _labels(sv.robot, tool.pose(L), q[-1])
         if end is not None and end != branch:
-            raise _Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
+            raise Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
     return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance,
                          q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
                          max_deviation=(float(pos.max()), float(rot.max())))
 
 
-def _coefficients(knots: list[_Knot]) -> np.ndarray:
+def _walked(sv: PathSolver, q0: np.ndarray, locate: float) -> list[Knot]:
+    """Knots from ``q0`` to the path's end by continuation (step 1) through the planned knots: the tool
+    path's breaks, each piece cut into steps of at most ``_INITIAL_STEP``."""
+    tool = sv.tool
+    L = tool.length
+    first = solve_knots(sv, np.array([0.0]), q0[None])[0]
+    if first.sigma < sv.singular:
+        raise Stop(0.0, q0, "singular", f"smallest singular value of the weighted Jacobian {first.sigma:.4g} "
+                                        f"m/rad < singular_tolerance {sv.singular:g} at the start")
+    planned = [0.0]
+    for a, b in zip(tool.breaks[:-1], tool.breaks[1:]):
+        n = max(1, int(np.ceil((b - a) / _INITIAL_STEP)))
+        planned.extend((a + (b - a) * np.arange(1, n + 1) / n).tolist())
+    planned[-1] = L
+    knots = [first]
+    for target in planned[1:]:
+        knots.extend(continue_to(sv, knots[-1], target, locate))
+    return knots
+
+
+def _refined(sv: PathSolver, knots: list[Knot], tolerance: float,
+             locate: float) -> tuple[list[Knot], np.ndarray, np.ndarray]:
+    """The tolerance rule (step 2): intervals halved until every one passes its check points; the knots and
+    the last round's tcp deviations (position [m], rotation [rad]) at the check points."""
+    for _ in range(60):
+        s = np.array([k.s for k in knots])
+        coefs = _coefficients(knots)
+        h = np.diff(s)
+        bad, pos, rot, qc, sc, sig_all = _failing_intervals(sv, knots, s, h, coefs, tolerance, locate)
+        if not bad.any():
+            return knots, pos, rot
+        _stop_where_too_short(sv, knots, bad, h, qc, sc, sig_all, locate)
+        knots = _bisected(sv, knots, bad, s, h, coefs, locate)
+    # 60 halvings of every interval is far below `locate`
+    raise TrajectoryError("the tolerance rule did not converge in 60 refinement rounds")  # pragma: no cover
+
+
+def _failing_intervals(sv: PathSolver, knots: list[Knot], s: np.ndarray, h: np.ndarray, coefs: np.ndarray,
+                       tolerance: float, locate: float) -> tuple[np.ndarray, ...]:
+    """Which intervals fail their check points (too far from the tool path, σ_min changing by more than 2,
+    outside the joint limits, or singular): (bad (K,), pos, rot, q, s, σ_min at the check points and ends).
+
+    Raises:
+        Stop: a check point is singular on an interval already as short as ``locate``.
+    """
+    sc = s[:-1, None] + h[:, None] * _CHECKS
+    qc = _eval(coefs, h[:, None] * _CHECKS)  # (K, 3, n)
+    K, C, n = qc.shape
+    flat = qc.reshape(-1, n)
+    ref = sv.tool.pose(sc.reshape(-1))
+    F = np.asarray(sv.robot.fk(flat, frame=sv.frame))
+    pos = np.linalg.norm(F[:, :3, 3] - ref[:, :3, 3], axis=1).reshape(K, C)
+    rot = _so3.angle(np.swapaxes(ref[:, :3, :3], 1, 2) @ F[:, :3, :3]).reshape(K, C)
+    sig_c = np.linalg.svd(sv.jacobian(flat), compute_uv=False)[:, -1].reshape(K, C)
+    sig_k = np.array([k.sigma for k in knots])
+    sig_all = np.concatenate([sig_k[:-1, None], sig_c, sig_k[1:, None]], axis=1)
+    rot_tol = 0.5 * tolerance / sv.w
+    bad = (pos.max(axis=1) > 0.5 * tolerance) | (rot.max(axis=1) > rot_tol) | \
+          (sig_all.max(axis=1) > 2.0 * sig_all.min(axis=1)) | (sv.outside(flat).reshape(K, C).max(axis=1) > 1e-9)
+    if np.any(sig_c < sv.singular):
+        i, c = np.unravel_index(int(np.argmin(sig_c)), sig_c.shape)
+        if h[i] <= locate:
+            raise Stop(float(sc[i, c]), knots[i].q, "singular",
+                       f"smallest singular value of the weighted Jacobian {sig_c[i, c]:.4g} m/rad "
+                       f"< singular_tolerance {sv.singular:g}")
+        bad[i] = True
+    return bad, pos, rot, qc, sc, sig_all
+
+
+def _stop_where_too_short(sv: PathSolver, knots: list[Knot], bad: np.ndarray, h: np.ndarray, qc: np.ndarray,
+                          sc: np.ndarray, sig_all: np.ndarray, locate: float) -> None:
+    """Raise :class:`Stop` at the first failing interval already as short as ``locate`` (a joint limit
+    between knots, or a joint path that bends too fast); nothing when every failing one can be halved."""
+    idx = np.flatnonzero(bad)
+    tiny = idx[h[idx] <= locate]
+    if tiny.size:
+        i = int(tiny[0])
+        if sv.outside(qc[i]).max() > 1e-9:
+            j = int(np.argmax(np.maximum(sv.lower - qc[i], qc[i] - sv.upper).max(axis=0)))
+            raise Stop(float(sc[i, 1]), knots[i].q, "limit",
+                       f"joint {sv.robot.joint_names[j]} would pass its limit between knots")
+        raise Stop(float(sc[i, 1]), knots[i].q, "singular",
+                   f"the tolerance cannot be met: the joint path bends too fast (σ_min {sig_all[i].min():.3g} m/rad)")
+
+
+def _bisected(sv: PathSolver, knots: list[Knot], bad: np.ndarray, s: np.ndarray, h: np.ndarray, coefs: np.ndarray,
+              locate: float) -> list[Knot]:
+    """The knots with a new one at the middle of every failing interval: solved in one batch from the
+    interpolant's prediction, or by continuation across the interval where the batch fails."""
+    idx = np.flatnonzero(bad)
+    mids = s[idx] + 0.5 * h[idx]
+    pred = _eval(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
+    q_new, ok = sv.newton(pred, sv.tool.pose(mids))
+    ok &= np.abs(q_new - pred).max(axis=1) <= MAX_CORRECTION
+    ok &= sv.outside(q_new) <= 1e-9
+    new = solve_knots(sv, mids[ok], q_new[ok]) if ok.any() else []
+    new = [k for k in new if k.sigma >= sv.singular]
+    inserted = {round(k.s, 15): k for k in new}
+    result = []
+    for i, k in enumerate(knots):
+        result.append(k)
+        if i < len(knots) - 1 and bad[i]:
+            mid = inserted.get(round(s[i] + 0.5 * h[i], 15))
+            if mid is not None:
+                result.append(mid)
+            else:  # the batch could not solve it: walk the interval step by step (raises where it fails)
+                result.extend(continue_to(sv, k, float(s[i] + 0.5 * h[i]), locate))
+    return result
+
+
+def _coefficients(knots: list[Knot]) -> np.ndarray:
     s = np.array([k.s for k in knots])
     a = (np.array([k.q for k in knots[:-1]]), np.array([k.dq for k in knots[:-1]]), np.array([k.ddq for k in knots[:-1]]))
     b = (np.array([k.q for k in knots[1:]]), np.array([k.dq_l for k in knots[1:]]), np.array([k.ddq_l for k in knots[1:]]))
@@ -454,7 +354,7 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     loc = _positive(locate, "locate [m]")
     nq = int(robot.nq)
     q0 = None if q_start is None else per_joint(q_start, nq, "q_start")
-    sv = _Solver(robot, path, frame, sing)
+    sv = PathSolver(robot, path, frame, sing)
     pose0 = path.pose(0.0)
     try:
         starts = _starts(robot, pose0, q0)
@@ -466,11 +366,11 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
         reason = robot.ik_failure_reason(pose0) or "no IK solution"
         raise UnreachableOnPath(f"robot '{robot.name}' cannot reach the start of the path (s = 0): {reason}",
                                 s=0.0, pose=pose0, reason=reason)
-    farthest: _Stop | None = None
+    farthest: Stop | None = None
     for q in starts:
         try:
             return _build(sv, np.asarray(q, dtype=float), tol, loc)
-        except _Stop as stop:
+        except Stop as stop:
             if farthest is None or stop.s > farthest.s + loc:
                 farthest = stop
     assert farthest is not None

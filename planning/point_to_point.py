@@ -23,7 +23,8 @@ import numpy as np
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
-from pinarms.planning.trajectory import MAX_DURATION, Trajectory, stack_joints
+from pinarms.planning.poly_pieces import pad_degree, taylor_shift
+from pinarms.planning.trajectory import MAX_DURATION, Trajectory
 
 __all__ = ["trapezoidal", "double_s", "double_s_phases", "trapezoidal_phases"]
 
@@ -219,3 +220,33 @@ def double_s(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any, *, synchronized:
         "synchronized": bool(synchronized),
     }
     return stack_joints(parts, definition)
+
+
+def stack_joints(parts: list[Trajectory], definition: dict | None = None) -> Trajectory:
+    """Combine single-joint trajectories with the same time range into one multi-joint trajectory.
+
+    The breaks are the union of all parts' breaks (instants closer than 1e-12 of the
+    duration are merged); each part is re-expanded about the union breaks.
+    """
+    t0, t1 = parts[0].start_time, parts[0].end_time
+    tol = 1e-12 * max(1.0, abs(t0), abs(t1))
+    for p in parts[1:]:
+        if abs(p.start_time - t0) > tol or abs(p.end_time - t1) > tol:
+            raise TrajectoryError(
+                f"cannot stack trajectories over different times: [{t0}, {t1}] vs [{p.start_time}, {p.end_time}] s"
+            )
+    allb = np.sort(np.concatenate([p.knot_times for p in parts]))
+    keep = np.concatenate([[True], np.diff(allb) > tol])
+    breaks = allb[keep]
+    breaks[0], breaks[-1] = t0, t1
+    if breaks.size >= 2 and breaks[-1] - breaks[-2] <= tol:
+        breaks = np.delete(breaks, -2)
+    mid = 0.5 * (breaks[:-1] + breaks[1:])
+    width = max(p.degree for p in parts) + 1
+    cols = []
+    for p in parts:
+        knots = p.knot_times
+        seg = np.clip(np.searchsorted(knots, mid, side="right") - 1, 0, p.n_segments - 1)
+        c = pad_degree(p.coefficients, width)[seg]
+        cols.append(taylor_shift(c, breaks[:-1] - knots[seg]))
+    return Trajectory(breaks, np.concatenate(cols, axis=2), definition)

@@ -39,27 +39,19 @@ Units: m, rad; ``s`` in m (weighted, as above).
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Iterable, NamedTuple
 
 import numpy as np
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import BlendTooLarge, TrajectoryError
+from pinarms.planning.tool_pieces import Blend, Line
 
 __all__ = ["ToolPath", "tool_path", "DEFAULT_WEIGHT"]
 
 #: Default weight between rotation and translation in the arc length [m/rad].
 DEFAULT_WEIGHT = 0.1
-
-#: Nodes of the arc-length table of a blend that rotates (its s(ℓ) is integrated numerically).
-_TABLE = 257
-
-
-def _smoothstep(x: np.ndarray) -> np.ndarray:
-    """Quintic smoothstep 10x³ − 15x⁴ + 6x⁵: 0 → 1 with zero first and second derivatives at both ends."""
-    return x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
-
 
 def _check_poses(poses: Any) -> np.ndarray:
     P = finite_array(poses, "poses")
@@ -73,138 +65,6 @@ def _check_poses(poses: Any) -> np.ndarray:
         k = int(bad[0])
         raise TrajectoryError(f"pose {k} is not a homogeneous transform (proper rotation within 1e-6, last row 0 0 0 1)")
     return P.copy()
-
-
-class _Line:
-    """Part ``λ ∈ [lam0, lam1]`` of the segment T_a → T_b (length ``L``); local s = (λ − lam0) L."""
-
-    kind = "line"
-
-    def __init__(self, Ta: np.ndarray, Tb: np.ndarray, phi: np.ndarray, L: float, lam0: float, lam1: float) -> None:
-        self.pa, self.pb = Ta[:3, 3], Tb[:3, 3]
-        self.Ra, self.Rb = Ta[:3, :3], Tb[:3, :3]
-        self.phi, self.L, self.lam0 = phi, L, lam0
-        self.length = (lam1 - lam0) * L
-        self.d1 = np.concatenate([(self.pb - self.pa) / L, self.Ra @ phi / L])
-
-    def evaluate(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        lam = self.lam0 + sigma / self.L
-        n = lam.size
-        T = np.zeros((n, 4, 4))
-        T[:, 3, 3] = 1.0
-        T[:, :3, 3] = (1.0 - lam)[:, None] * self.pa + lam[:, None] * self.pb
-        first = lam <= 0.5  # each half from its own end: exact end poses
-        R = np.empty((n, 3, 3))
-        R[first] = self.Ra @ _so3.exp(lam[first, None] * self.phi)
-        R[~first] = self.Rb @ _so3.exp(-(1.0 - lam[~first])[:, None] * self.phi)
-        T[:, :3, :3] = R
-        return T, np.broadcast_to(self.d1, (n, 6)).copy(), np.zeros((n, 6))
-
-
-class _Blend:
-    """Blend at a corner, local parameter ℓ ∈ [0, ℓ_b] (arc length of the position curve, m).
-
-    ``R1(ℓ) = R_c exp(φ_in (ℓ − b) / d_in)`` and ``R2(ℓ) = R_c exp(φ_out (ℓ − ℓ_b + b) / d_out)``
-    continue the SLERPs of the incoming and outgoing lines (R_c: the corner's orientation).
-    """
-
-    kind = "blend"
-
-    def __init__(self, corner: np.ndarray, e_in: np.ndarray, e_out: np.ndarray, b: float, r: float, arc: bool,
-                 Rc: np.ndarray, phi_in: np.ndarray, d_in: float, phi_out: np.ndarray, d_out: float,
-                 weight: float) -> None:
-        self.corner, self.e_in, self.b, self.r, self.arc = corner, e_in, b, r, arc
-        self.Rc, self.w_in, self.w_out = Rc, phi_in / d_in, phi_out / d_out
-        self.weight = weight
-        if arc:
-            alpha = float(np.arccos(np.clip(e_in @ e_out, -1.0, 1.0)))
-            self.lb = r * alpha
-            inward = e_out - e_in
-            inward /= np.linalg.norm(inward)
-            centre = corner + (r / np.cos(0.5 * alpha)) * inward
-            start = corner - b * e_in
-            self.centre, self.u, self.v = centre, (start - centre) / r, e_in
-        else:
-            self.lb = 2.0 * b
-        self.rotates = bool(np.linalg.norm(self.w_in) + np.linalg.norm(self.w_out) > 0.0)
-        if self.rotates:
-            ell = np.linspace(0.0, self.lb, _TABLE)
-            g = self._speed(ell)
-            # composite Simpson on pairs of table intervals, trapezoid-consistent at odd nodes
-            h = ell[1] - ell[0]
-            s = np.zeros(_TABLE)
-            s[2::2] = np.cumsum(h / 3.0 * (g[0:-2:2] + 4.0 * g[1:-1:2] + g[2::2]))
-            mid = 0.5 * (ell[:-2:2] + ell[1:-1:2])
-            s[1::2] = s[0:-2:2] + h / 6.0 * (g[0:-2:2] + 4.0 * self._speed(mid) + g[1:-1:2])
-            self.table = (s, ell, 1.0 / g)
-            self.length = float(s[-1])
-        else:
-            self.length = self.lb
-
-    # ---------------------------------------------------------------- in ℓ
-    def _rotation(self, ell: np.ndarray) -> np.ndarray:
-        R1 = self.Rc @ _so3.exp((ell - self.b)[:, None] * self.w_in)
-        R2 = self.Rc @ _so3.exp((ell - self.lb + self.b)[:, None] * self.w_out)
-        beta = _smoothstep(ell / self.lb)
-        return R1 @ _so3.exp(beta[:, None] * _so3.log(np.swapaxes(R1, 1, 2) @ R2))
-
-    def _omega(self, ell: np.ndarray, h: float) -> np.ndarray:
-        """Angular rate dθ/dℓ (N, 3) [rad/m] in base axes: central differences, Richardson-extrapolated (O(h⁴))."""
-        def central(step: float) -> np.ndarray:
-            Rp, Rm = self._rotation(ell + step), self._rotation(ell - step)
-            return _so3.log(Rp @ np.swapaxes(Rm, 1, 2)) / (2.0 * step)
-
-        return (4.0 * central(h) - central(2.0 * h)) / 3.0
-
-    def _speed(self, ell: np.ndarray) -> np.ndarray:
-        om = self._omega(ell, 1e-3 * self.lb)
-        return np.sqrt(1.0 + self.weight**2 * np.sum(om * om, axis=1))
-
-    def _ell(self, sigma: np.ndarray) -> np.ndarray:
-        if not self.rotates:
-            return sigma.copy()
-        s, ell, slope = self.table
-        k = np.clip(np.searchsorted(s, sigma, side="right") - 1, 0, s.size - 2)
-        h = s[k + 1] - s[k]
-        t = (sigma - s[k]) / h
-        h00, h10 = (1 + 2 * t) * (1 - t) ** 2, t * (1 - t) ** 2
-        h01, h11 = t * t * (3 - 2 * t), t * t * (t - 1)
-        return h00 * ell[k] + h10 * h * slope[k] + h01 * ell[k + 1] + h11 * h * slope[k + 1]
-
-    def evaluate(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        ell = self._ell(sigma)
-        n = ell.size
-        T = np.zeros((n, 4, 4))
-        T[:, 3, 3] = 1.0
-        if self.arc:
-            c, s_ = np.cos(ell / self.r), np.sin(ell / self.r)
-            T[:, :3, 3] = self.centre + self.r * (c[:, None] * self.u + s_[:, None] * self.v)
-            p1 = -s_[:, None] * self.u + c[:, None] * self.v
-            p2 = -(c[:, None] * self.u + s_[:, None] * self.v) / self.r
-        else:
-            T[:, :3, 3] = self.corner + (ell - self.b)[:, None] * self.e_in
-            p1 = np.broadcast_to(self.e_in, (n, 3))
-            p2 = np.zeros((n, 3))
-        d1, d2 = np.zeros((n, 6)), np.zeros((n, 6))
-        if not self.rotates:
-            T[:, :3, :3] = self.Rc
-            d1[:, :3], d2[:, :3] = p1, p2
-            return T, d1, d2
-        T[:, :3, :3] = self._rotation(ell)
-        h = 1e-3 * self.lb
-        om = self._omega(ell, h)
-        om2 = (8.0 * (self._omega(ell + h, h) - self._omega(ell - h, h))
-               - (self._omega(ell + 2.0 * h, h) - self._omega(ell - 2.0 * h, h))) / (12.0 * h)
-        w2 = self.weight**2
-        g = np.sqrt(1.0 + w2 * np.sum(om * om, axis=1))
-        g1 = w2 * np.sum(om * om2, axis=1) / g
-        l1 = 1.0 / g
-        l2 = -g1 / g**3
-        d1[:, :3] = p1 * l1[:, None]
-        d1[:, 3:] = om * l1[:, None]
-        d2[:, :3] = p2 * (l1 * l1)[:, None] + p1 * l2[:, None]
-        d2[:, 3:] = om2 * (l1 * l1)[:, None] + om * l2[:, None]
-        return T, d1, d2
 
 
 class ToolPath:
@@ -307,7 +167,31 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
             the largest radius that fits.
     """
     P = _check_poses(poses)
-    n = P.shape[0]
+    w, r, stop_set = _options(P.shape[0], blend, weight, stops)
+    seg = _segments(P, w)
+    b, arc, is_stop = _corners(seg, r, stop_set)
+    pieces, via_s, stop_s = _pieces(P, seg, r, b, arc, is_stop, w)
+    return ToolPath(P, pieces, np.array(stop_s), via_s, np.where(b[1:-1] > 0.0, r, 0.0), w)
+
+
+class _Segments(NamedTuple):
+    """The straight segments between consecutive poses: positions p (N, 3) and rotations R (N, 3, 3) of the
+    poses, then per segment its length d [m], body rotation vector φ (N-1, 3) [rad], arc length L [m],
+    whether it translates, unit direction e (N-1, 3) (0 when it only rotates) and unit tangent (N-1, 6)."""
+
+    p: np.ndarray
+    R: np.ndarray
+    d: np.ndarray
+    phi: np.ndarray
+    L: np.ndarray
+    translating: np.ndarray
+    e: np.ndarray
+    tangent: np.ndarray
+
+
+def _options(n: int, blend: Any, weight: float, stops: Iterable[int]) -> tuple[float, np.ndarray, set]:
+    """The weight w [m/rad], one blend radius per interior pose (n-2,) [m] and the set of stop indices,
+    checked (TrajectoryError naming the bad input)."""
     w = float(weight) if isinstance(weight, (int, float, np.floating, np.integer)) and not isinstance(weight, bool) else -1.0
     if not (np.isfinite(w) and w > 0.0):
         raise TrajectoryError(f"weight must be a positive number of m/rad, got {weight!r}")
@@ -321,7 +205,12 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= int(k) <= n - 2:
             raise TrajectoryError(f"stops must be indices of interior poses (1 .. {n - 2}), got {k!r}")
         stop_set.add(int(k))
+    return w, r, stop_set
 
+
+def _segments(P: np.ndarray, w: float) -> _Segments:
+    """The segments between consecutive poses ``P`` (N, 4, 4); equal poses and half-turns are refused."""
+    n = P.shape[0]
     p, R = P[:, :3, 3], P[:, :3, :3]
     d = np.linalg.norm(np.diff(p, axis=0), axis=1)
     phi = _so3.log(np.swapaxes(R[:-1], 1, 2) @ R[1:])  # body rotation vector of each segment
@@ -336,27 +225,43 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
     translating = d > 1e-12
     e = np.where(translating[:, None], np.diff(p, axis=0) / np.where(translating, d, 1.0)[:, None], 0.0)
     tangent = np.concatenate([np.diff(p, axis=0), w * np.einsum("kij,kj->ki", R[:-1], phi)], axis=1) / L[:, None]
+    return _Segments(p, R, d, phi, L, translating, e, tangent)
 
-    # classify the corners: b[k] = tangent length of a blend at pose k (0: none), arc flag
+
+def _corners(seg: _Segments, r: np.ndarray, stop_set: set) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Classify the interior poses (module docstring, corners): per pose (N,) the tangent length b [m] of
+    its blend (0: none), whether the blend is an arc, and whether the tool stops there.
+
+    Raises:
+        BlendTooLarge: two blends, or a blend and a segment's end, need more of a line than it has.
+    """
+    n = seg.p.shape[0]
     b = np.zeros(n)
     arc = np.zeros(n, dtype=bool)
     is_stop = np.zeros(n, dtype=bool)
     used = np.zeros(n)
     for k in range(1, n - 1):
-        if np.linalg.norm(tangent[k - 1] - tangent[k]) <= 1e-9:
+        if np.linalg.norm(seg.tangent[k - 1] - seg.tangent[k]) <= 1e-9:
             continue  # smooth: passed without blend or stop
         rk = r[k - 1]
-        if k in stop_set or rk == 0.0 or not (translating[k - 1] and translating[k]):
+        if k in stop_set or rk == 0.0 or not (seg.translating[k - 1] and seg.translating[k]):
             is_stop[k] = True
             continue
-        alpha = float(np.arccos(np.clip(e[k - 1] @ e[k], -1.0, 1.0)))
+        alpha = float(np.arccos(np.clip(seg.e[k - 1] @ seg.e[k], -1.0, 1.0)))
         if alpha >= np.pi - 1e-6:
             is_stop[k] = True  # reversal: no arc fits
             continue
         arc[k] = alpha > 1e-9
         b[k] = rk * np.tan(0.5 * alpha) if arc[k] else rk
         used[k] = rk
-    for k in range(n - 1):
+    _check_blends_fit(seg, b, arc, used)
+    return b, arc, is_stop
+
+
+def _check_blends_fit(seg: _Segments, b: np.ndarray, arc: np.ndarray, used: np.ndarray) -> None:
+    """BlendTooLarge, with the largest radius that fits, when the blends at both ends of a line overlap."""
+    d, e = seg.d, seg.e
+    for k in range(seg.p.shape[0] - 1):
         if b[k] + b[k + 1] > d[k] * (1.0 + 1e-12) + 1e-15:
             corner = k if b[k] >= b[k + 1] else k + 1
             other = b[k + 1] if corner == k else b[k]
@@ -368,6 +273,13 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
                 f"(poses {k}–{k + 1}, {d[k]:.6g} m long{shared}); use a radius <= {fits:.6g} m there"
             )
 
+
+def _pieces(P: np.ndarray, seg: _Segments, r: np.ndarray, b: np.ndarray, arc: np.ndarray, is_stop: np.ndarray,
+            w: float) -> tuple[list, np.ndarray, list]:
+    """The path's pieces in order (what is left of each line, a blend at each blended corner), the arc
+    length of every pose along the path (N,) [m] (a blend's middle for a blended one) and of every stop."""
+    n = P.shape[0]
+    p, R, d, phi, L, e = seg.p, seg.R, seg.d, seg.phi, seg.L, seg.e
     pieces: list = []
     via_s = np.zeros(n)
     stop_s = []
@@ -376,12 +288,12 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
         lam0 = b[k] / d[k] if b[k] > 0.0 else 0.0
         lam1 = 1.0 - (b[k + 1] / d[k] if b[k + 1] > 0.0 else 0.0)
         if lam1 - lam0 > 1e-12:
-            piece = _Line(P[k], P[k + 1], phi[k], float(L[k]), lam0, lam1)
+            piece = Line(P[k], P[k + 1], phi[k], float(L[k]), lam0, lam1)
             pieces.append(piece)
             s_now += piece.length
         if k + 1 < n - 1:
             if b[k + 1] > 0.0:
-                blend_piece = _Blend(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]),
+                blend_piece = Blend(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]),
                                      R[k + 1], phi[k], float(d[k]), phi[k + 1], float(d[k + 1]), w)
                 pieces.append(blend_piece)
                 via_s[k + 1] = s_now + 0.5 * blend_piece.length
@@ -391,4 +303,4 @@ def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, s
                 if is_stop[k + 1]:
                     stop_s.append(s_now)
     via_s[-1] = s_now
-    return ToolPath(P, pieces, np.array(stop_s), via_s, np.where(b[1:-1] > 0.0, r, 0.0), w)
+    return pieces, via_s, stop_s

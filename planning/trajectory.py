@@ -13,7 +13,9 @@ concatenation are written once and vectorised over instants and joints:
 
 A trajectory knows nothing about limits or optimisers (the split follows toppra: path,
 constraints and algorithm are separate objects). :meth:`Trajectory.check` takes a
-:class:`planning.JointLimits` spec and returns a :class:`LimitReport`.
+:class:`planning.JointLimits` spec and returns a :class:`planning.LimitReport`
+(:mod:`planning.limit_report`). The arithmetic on the coefficient arrays (derivatives,
+re-expansion, blocked products) is :mod:`planning.poly_pieces`.
 
 Peaks are *exact*: on each piece the extrema of ``|d^r q / dt^r|`` are at the piece ends
 or at real roots of the next derivative, which are found for all pieces, joints and
@@ -24,16 +26,19 @@ eigenvalues above; :mod:`planning.extrema`, which also peaks whole populations).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from pinarms.planning._inputs import finite_array, scalar
 from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
+from pinarms.planning.limit_report import (LimitReport, Violation, derivative_violations, limit_report, limited_orders,
+                                           position_violations, torque_violations)
+from pinarms.planning.poly_pieces import derivative_stack, evaluate_by_piece, pad_degree
 
-__all__ = ["Trajectory", "Peaks", "Violation", "LimitReport"]
+__all__ = ["Trajectory", "Peaks"]
 
 #: Most instants :meth:`Trajectory.at_rate` produces (10 million: 1.3 GB for 4 arrays of 4 joints).
 MAX_SAMPLES = 10_000_000
@@ -41,13 +46,6 @@ MAX_SAMPLES = 10_000_000
 #: Longest trajectory accepted (s): 10⁹ s is about 32 years; anything longer comes from limits or
 #: times beyond any physical motion, and its powers of time would overflow float64 when sampled.
 MAX_DURATION = 1e9
-
-#: Names of the derivative orders, as used in :class:`Violation` and the peak report.
-_KIND_BY_ORDER = {1: "velocity", 2: "acceleration", 3: "jerk"}
-# OpenBLAS runs a matrix product on several threads above M·N·K = 4 · 65536: on a busy machine
-# those threads wait for cores and a 10 000 × 6 by 6 × 24 product takes 1-30 ms instead of
-# 0.1 ms. Sampling multiplies in row blocks below that size (one thread each).
-_GEMM_ONE_THREAD = 4 * 65536
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,55 +63,6 @@ class Peaks:
     def as_dict(self) -> dict[str, list[float]]:
         """JSON-able form ``{"velocity": [...], "acceleration": [...], "jerk": [...]}``."""
         return {k: getattr(self, k).tolist() for k in ("velocity", "acceleration", "jerk")}
-
-
-class Violation(NamedTuple):
-    """One limit violation: joint index, time (s) of the worst value, kind, value, limit.
-
-    ``kind`` is one of ``"position_lower"``, ``"position_upper"``, ``"velocity"``,
-    ``"acceleration"``, ``"jerk"``, ``"torque"``. For velocity/acceleration/jerk/torque
-    ``value`` is the peak magnitude on the offending piece; for positions it is the extreme
-    position.
-    """
-
-    joint: int
-    time: float
-    kind: str
-    value: float
-    limit: float
-
-    @property
-    def ratio(self) -> float:
-        """``value / limit`` (how far past the limit; positions: the signed ratio)."""
-        return self.value / self.limit if self.limit != 0.0 else float("inf")
-
-
-@dataclass(frozen=True, eq=False)
-class LimitReport:
-    """Result of :meth:`Trajectory.check`: every violation, at most one per joint, kind and piece."""
-
-    violations: tuple[Violation, ...] = field(default_factory=tuple)
-    joint_names: tuple[str, ...] | None = None
-
-    @property
-    def ok(self) -> bool:
-        """True when no limit is violated."""
-        return not self.violations
-
-    def __bool__(self) -> bool:
-        return self.ok
-
-    def __str__(self) -> str:
-        if self.ok:
-            return "all limits respected"
-        lines = [f"{len(self.violations)} limit violation(s):"]
-        for v in self.violations:
-            name = f" ({self.joint_names[v.joint]})" if self.joint_names and v.joint < len(self.joint_names) else ""
-            ratio = f" (ratio {v.ratio:.4g})" if v.kind in ("velocity", "acceleration", "jerk", "torque") else ""
-            lines.append(
-                f"  joint {v.joint}{name} at t = {v.time:.6g} s: {v.kind} {v.value:.6g} exceeds limit {v.limit:.6g}{ratio}"
-            )
-        return "\n".join(lines)
 
 
 class Trajectory:
@@ -222,17 +171,7 @@ class Trajectory:
     def _derivative_stack(self) -> np.ndarray:
         """(m, K+1, 4*n): coefficients of q, qd, qdd, qddd side by side (cached)."""
         if self._stack is None:
-            c = self._coefs
-            m, width, n = c.shape
-            stack = np.zeros((m, width, 4 * n))
-            k = np.arange(width, dtype=float)
-            falling = np.ones(width)
-            for r in range(4):  # d^r/dτ^r of Σ c_k τ^k: coefficient j is c_(j+r) · (j+r)!/j!
-                if r:
-                    falling = falling[1:] * k[1 : width - r + 1]  # (j+r)!/j! = ((j+1)+(r−1))!/(j+1)! · (j+1)
-                if r < width:
-                    np.multiply(c[:, r:, :], falling[None, :, None], out=stack[:, : width - r, r * n : (r + 1) * n])
-            self._stack = stack
+            self._stack = derivative_stack(self._coefs)
         return self._stack
 
     def _check_times(self, t: Any) -> tuple[np.ndarray, bool]:
@@ -284,7 +223,7 @@ class Trajectory:
         powers = rows.T
         out = np.empty((tt.size, 4 * n))
         with np.errstate(over="ignore", invalid="ignore"):
-            self._evaluate(powers, D, seg, out)
+            evaluate_by_piece(powers, D, seg, out)
             total = np.add.reduce(out, axis=None)  # NaN/inf if any entry is (or if the sum overflows: full check)
         if not math.isfinite(total) and not np.all(np.isfinite(out)):
             i = int(np.argmax(~np.all(np.isfinite(out), axis=1)))
@@ -296,24 +235,6 @@ class Trajectory:
         if scalar:
             return q[0].copy(), qd[0].copy(), qdd[0].copy(), qddd[0].copy()
         return q, qd, qdd, qddd
-
-    def _evaluate(self, powers: np.ndarray, D: np.ndarray, seg: np.ndarray, out: np.ndarray) -> None:
-        """``out[i] = powers[i] @ D[seg[i]]``, grouped by segment."""
-        m = self.n_segments
-        if m == 1:
-            _matmul_rows(powers, D[0], out)
-        else:
-            sorted_input = seg.size < 2 or bool(np.all(seg[1:] >= seg[:-1]))
-            order = None if sorted_input else np.argsort(seg, kind="stable")
-            seg_sorted = seg if order is None else seg[order]
-            edges = np.searchsorted(seg_sorted, np.arange(m + 1))
-            for s in np.flatnonzero(np.diff(edges)):
-                lo, hi = edges[s], edges[s + 1]
-                if order is None:
-                    _matmul_rows(powers[lo:hi], D[s], out[lo:hi])
-                else:
-                    idx = order[lo:hi]
-                    out[idx] = powers[idx] @ D[s]
 
     def __call__(self, t: Any) -> np.ndarray:
         """Positions only: ``sample(t)[0]``."""
@@ -400,42 +321,14 @@ class Trajectory:
 
             lim = limits.for_joints("torque", n)
             peak, when, _ = piece_torque_peaks(self, robot)
-            for seg, j in zip(*np.nonzero(peak > lim[None, :] * (1.0 + rtol))):
-                found.append(Violation(int(j), float(when[seg, j]), "torque", float(peak[seg, j]), float(lim[j])))
-        orders = tuple(r for r, name in _KIND_BY_ORDER.items() if getattr(limits, name) is not None)
+            found += torque_violations(peak, when, lim, rtol)
+        orders = limited_orders(limits)
         if orders:
-            values, times = self._extrema(orders)
-            mag = np.abs(values)
-            best = np.argmax(mag, axis=3)[..., None]
-            peak = np.take_along_axis(mag, best, axis=3)[..., 0]  # (o, m, n)
-            when = np.take_along_axis(times, best, axis=3)[..., 0]
-            for o, r in enumerate(orders):
-                name = _KIND_BY_ORDER[r]
-                lim = limits.for_joints(name, n)
-                bad = peak[o] > lim[None, :] * (1.0 + rtol)
-                for seg, j in zip(*np.nonzero(bad)):
-                    found.append(Violation(int(j), float(when[o, seg, j]), name, float(peak[o, seg, j]), float(lim[j])))
+            found += derivative_violations(*self._extrema(orders), orders, limits, n, rtol)
         if limits.lower is not None or limits.upper is not None:
             values, times = self._extrema((0,))
-            v, tm = values[0], times[0]  # (m, n, C)
-            span = np.maximum(np.abs(v).max(), 1.0)
-            if limits.lower is not None:
-                lo = limits.for_joints("lower", n)
-                idx = np.argmin(v, axis=2)[..., None]
-                vmin = np.take_along_axis(v, idx, axis=2)[..., 0]
-                tmin = np.take_along_axis(tm, idx, axis=2)[..., 0]
-                for seg, j in zip(*np.nonzero(vmin < lo[None, :] - rtol * span)):
-                    found.append(Violation(int(j), float(tmin[seg, j]), "position_lower", float(vmin[seg, j]), float(lo[j])))
-            if limits.upper is not None:
-                hi = limits.for_joints("upper", n)
-                idx = np.argmax(v, axis=2)[..., None]
-                vmax = np.take_along_axis(v, idx, axis=2)[..., 0]
-                tmax = np.take_along_axis(tm, idx, axis=2)[..., 0]
-                for seg, j in zip(*np.nonzero(vmax > hi[None, :] + rtol * span)):
-                    found.append(Violation(int(j), float(tmax[seg, j]), "position_upper", float(vmax[seg, j]), float(hi[j])))
-        found.sort(key=lambda v: (v.time, v.joint, v.kind))
-        names = tuple(robot.joint_names) if robot is not None and getattr(robot, "nq", None) == n else None
-        return LimitReport(tuple(found), names)
+            found += position_violations(values[0], times[0], limits, n, rtol)
+        return limit_report(found, robot, n)
 
     # --------------------------------------------------------------------- torques
     def torques(self, robot: Any, t: Any) -> np.ndarray:
@@ -504,8 +397,8 @@ class Trajectory:
                 f"starts at {float(q_start[j])!r} (|gap| {gap[j]:.3g} > atol {atol:g}); start it where this one ends"
             )
         width = max(self.degree, other.degree) + 1
-        a = _pad_degree(self._coefs, width)
-        b = _pad_degree(other._coefs, width)
+        a = pad_degree(self._coefs, width)
+        b = pad_degree(other._coefs, width)
         breaks = np.concatenate([self._breaks, other._breaks[1:] - other._breaks[0] + self._breaks[-1]])
         parts = []
         for d in (self.definition, other.definition):
@@ -525,65 +418,3 @@ def _json_copy(obj: Any) -> Any:
     if isinstance(obj, np.generic):
         return obj.item()
     return obj
-
-
-def _pad_degree(coefs: np.ndarray, width: int) -> np.ndarray:
-    """Zero-pad coefficients (m, K+1, n) to (m, width, n)."""
-    if coefs.shape[1] == width:
-        return coefs
-    out = np.zeros((coefs.shape[0], width, coefs.shape[2]))
-    out[:, : coefs.shape[1]] = coefs
-    return out
-
-
-def taylor_shift(coefs: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    """Re-expand pieces about a later origin: coefficients of ``q(offset + u)`` in ``u``.
-
-    ``coefs`` (m, K+1, n) ascending powers; ``offset`` (m,) in s. Returns (m, K+1, n).
-    """
-    width = coefs.shape[1]
-    i = np.arange(width)
-    binom = np.array([[math.comb(int(b), int(a)) if b >= a else 0 for b in i] for a in i], dtype=float)
-    expo = np.clip(i[None, :] - i[:, None], 0, None)
-    M = binom[None] * np.asarray(offset, dtype=float)[:, None, None] ** expo[None]
-    M = np.where((i[None, :] >= i[:, None])[None], M, 0.0)
-    return np.einsum("ski,sij->skj", M, coefs)
-
-
-def stack_joints(parts: list[Trajectory], definition: dict | None = None) -> Trajectory:
-    """Combine single-joint trajectories with the same time range into one multi-joint trajectory.
-
-    The breaks are the union of all parts' breaks (instants closer than 1e-12 of the
-    duration are merged); each part is re-expanded about the union breaks.
-    """
-    t0, t1 = parts[0].start_time, parts[0].end_time
-    tol = 1e-12 * max(1.0, abs(t0), abs(t1))
-    for p in parts[1:]:
-        if abs(p.start_time - t0) > tol or abs(p.end_time - t1) > tol:
-            raise TrajectoryError(
-                f"cannot stack trajectories over different times: [{t0}, {t1}] vs [{p.start_time}, {p.end_time}] s"
-            )
-    allb = np.sort(np.concatenate([p._breaks for p in parts]))
-    keep = np.concatenate([[True], np.diff(allb) > tol])
-    breaks = allb[keep]
-    breaks[0], breaks[-1] = t0, t1
-    if breaks.size >= 2 and breaks[-1] - breaks[-2] <= tol:
-        breaks = np.delete(breaks, -2)
-    mid = 0.5 * (breaks[:-1] + breaks[1:])
-    width = max(p.degree for p in parts) + 1
-    cols = []
-    for p in parts:
-        seg = np.clip(np.searchsorted(p._breaks, mid, side="right") - 1, 0, p.n_segments - 1)
-        c = _pad_degree(p._coefs, width)[seg]
-        cols.append(taylor_shift(c, breaks[:-1] - p._breaks[seg]))
-    return Trajectory(breaks, np.concatenate(cols, axis=2), definition)
-
-
-def _matmul_rows(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
-    """``out = a @ b`` in row blocks small enough for OpenBLAS to use one thread (see ``_GEMM_ONE_THREAD``)."""
-    rows = max(1, _GEMM_ONE_THREAD // max(1, a.shape[1] * b.shape[1]))
-    if a.shape[0] <= rows:
-        np.matmul(a, b, out=out)
-        return
-    for s in range(0, a.shape[0], rows):
-        np.matmul(a[s : s + rows], b, out=out[s : s + rows])

@@ -190,37 +190,38 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
             cannot hold a via point still with its payload).
     """
     t0 = time.perf_counter()
-    if method not in METHODS:
-        raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
-    random_generator(seed)  # refuse a bad seed before any work, for both methods
-    from pinarms.optim.torque import torque_constraint
-
-    torque = torque_constraint(robot, torque_limits, payload, torque_samples)
-    if problem is None:
-        problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
-                                trajectory_options=trajectory_options, torque=torque)
-    elif torque is not None:
-        raise InvalidSettings("give torque limits either in the prebuilt problem (TimingProblem(torque=...)) "
-                              "or as keywords, not both")
+    problem = _timing_problem(method, seed, problem, robot, torque_limits, payload, torque_samples,
+                              positions=positions, kind=kind, vmax=vmax, amax=amax, jmax=jmax, bounds=bounds,
+                              trajectory_options=trajectory_options)
     before = problem.evaluations
     if method == "exact":
-        sol = solve_exact(problem, seed=seed)
-        if not sol.feasible:
-            raise _infeasible(problem, "exact")
-        return finish_timing(problem, sol.durations, method="exact", history=None,
-                             evaluations=problem.evaluations - before, t0=t0,
-                             raw_total=sol.total)
+        return _exact_timing(problem, seed, before, t0)
+    return _ga_timing(problem, seed, settings, before, t0, max_generations=max_generations,
+                      stall_generations=stall_generations, time_limit=time_limit, callback=callback,
+                      initial=initial, rescale=rescale, polish=polish)
+
+
+def _exact_timing(problem: TimingProblem, seed: int, before: int, t0: float) -> TimingResult:
+    """``method="exact"``: the exact solver's durations, verified (evaluations counted from ``before``)."""
+    sol = solve_exact(problem, seed=seed)
+    if not sol.feasible:
+        raise _infeasible(problem, "exact")
+    return finish_timing(problem, sol.durations, method="exact", history=None,
+                         evaluations=problem.evaluations - before, t0=t0,
+                         raw_total=sol.total)
+
+
+def _ga_timing(problem: TimingProblem, seed: int, settings: GASettings | None, before: int, t0: float, *,
+               max_generations: int | None, stall_generations: int | None, time_limit: float | None,
+               callback: Callable[[GAProgress], bool | None] | None, initial: Any, rescale: bool,
+               polish: bool) -> TimingResult:
+    """``method="ga"``: the GA's best, rescaled onto the limits and polished if asked, verified."""
     settings = GASettings.seed002() if settings is None else settings
-    if initial is None:
-        # Feasible, informed individuals (seed 002 starts from feasible timings): the
-        # scaling-law starts (equal ratios, ratios from the segment lengths) at s*(r).
-        starts = [scaled_to_limits(problem, r) for r in start_ratios(problem, 0, seed)[:3]]
-        rows = [h for h, ok in starts if ok and np.all(h >= problem.bounds[:, 0])]
-        initial = np.array(rows) if rows else None
     result = run_ga(lambda h: h.sum(axis=1), problem.bounds, settings,
                     constraints=problem.constraints, seed=seed,
                     max_generations=max_generations, stall_generations=stall_generations,
-                    time_limit=time_limit, callback=callback, initial=initial)
+                    time_limit=time_limit, callback=callback,
+                    initial=_scaling_law_starts(problem, seed) if initial is None else initial)
     if not result.feasible:
         raise _infeasible(problem, "ga")
     h = rescale_to_limits(problem, result.x) if rescale else result.x
@@ -234,3 +235,30 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
                          evaluations=problem.evaluations - before, t0=t0,
                          raw_total=float(result.f), stop_reason=result.stop_reason,
                          unpolished_total=unpolished)
+
+
+def _timing_problem(method: str, seed: int, problem: TimingProblem | None, robot: Any, torque_limits: Any,
+                    payload: Any, torque_samples: int | None, **spec: Any) -> TimingProblem:
+    """The problem :func:`minimize_time` solves: ``problem`` itself, or built from ``spec`` (positions,
+    kind, limits, bounds, trajectory options) with the torque constraint; bad settings refused first."""
+    if method not in METHODS:
+        raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
+    random_generator(seed)  # refuse a bad seed before any work, for both methods
+    from pinarms.optim.torque import torque_constraint
+
+    torque = torque_constraint(robot, torque_limits, payload, torque_samples)
+    if problem is None:
+        return TimingProblem(spec["positions"], spec["kind"], spec["vmax"], spec["amax"], spec["jmax"],
+                             bounds=spec["bounds"], trajectory_options=spec["trajectory_options"], torque=torque)
+    if torque is not None:
+        raise InvalidSettings("give torque limits either in the prebuilt problem (TimingProblem(torque=...)) "
+                              "or as keywords, not both")
+    return problem
+
+
+def _scaling_law_starts(problem: TimingProblem, seed: int) -> np.ndarray | None:
+    """Feasible, informed GA individuals (seed 002 starts from feasible timings): the scaling-law
+    starts (equal ratios, ratios from the segment lengths) at s*(r); None when none is feasible."""
+    starts = [scaled_to_limits(problem, r) for r in start_ratios(problem, 0, seed)[:3]]
+    rows = [h for h, ok in starts if ok and np.all(h >= problem.bounds[:, 0])]
+    return np.array(rows) if rows else None

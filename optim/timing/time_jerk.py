@@ -187,21 +187,7 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
         InvalidLimits, InfeasibleProblem, InvalidSettings.
     """
     t0 = time.perf_counter()
-    if mode not in MODES:
-        raise InvalidSettings(f"mode={mode!r}: use one of {MODES}")
-    if method not in ("ga", "exact"):
-        raise InvalidSettings(f"method={method!r}: use 'ga' or 'exact'")
-    random_generator(seed)  # refuse a bad seed before any work
-    def number(value: Any) -> bool:
-        return isinstance(value, (int, float, np.number)) and not isinstance(value, bool) \
-            and bool(np.isfinite(value))
-
-    if mode == "two-stage" and not (number(time_factor) and time_factor >= 1.0):
-        raise InvalidSettings(f"time_factor={time_factor!r}: use a finite value >= 1")
-    if mode == "weighted" and not (number(k_time) and number(k_jerk) and k_time >= 0.0
-                                   and k_jerk >= 0.0 and k_time + k_jerk > 0.0):
-        raise InvalidSettings(f"k_time={k_time!r}, k_jerk={k_jerk!r}: use weights >= 0, "
-                              "not both zero")
+    _check_options(mode, method, seed, time_factor, k_time, k_jerk)
     if problem is None:
         problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
                                 trajectory_options=trajectory_options)
@@ -223,27 +209,8 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
     if method == "exact":
         h = _slsqp_time_jerk(problem, mode, cap, k_time, k_jerk, start)
     else:
-        lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
-        if mode == "two-stage":
-            objective = lambda H: jerk_integral_batch(problem, H)
-
-            def constraints(H: np.ndarray) -> np.ndarray:
-                return np.column_stack([problem.constraints(H), H.sum(axis=1) / cap - 1.0])
-
-            initial = start[None]
-        else:
-            objective = lambda H: k_time * H.sum(axis=1) + k_jerk * jerk_integral_batch(problem, H)
-            constraints = problem.constraints
-            initial = None
-        res = run_ga(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
-                     seed=seed, max_generations=max_generations, time_limit=time_limit,
-                     initial=initial)
-        if not res.feasible:
-            raise InfeasibleProblem("the GA found no timing within the bounds that meets the "
-                                    f"limits{' and the time cap' if cap else ''}; widen the "
-                                    "bounds or relax the limits")
-        h = res.x
-        history = res.history
+        h, history = _ga_time_jerk(problem, mode, cap, start, k_time, k_jerk, settings, seed,
+                                   max_generations, time_limit)
 
     if not problem.is_feasible(h) or (cap is not None and h.sum() > cap * (1 + 1e-12)):
         raise InfeasibleProblem(f"no feasible time-jerk timing found ({mode}, {method}): "
@@ -260,3 +227,49 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
                           k_jerk=k_jerk if mode == "weighted" else None, history=history,
                           evaluations=problem.evaluations - before,
                           wall_time=time.perf_counter() - t0)
+
+
+def _check_options(mode: str, method: str, seed: int, time_factor: float, k_time: float, k_jerk: float) -> None:
+    """Refuse bad options of :func:`minimize_time_jerk` (InvalidSettings naming them) before any work."""
+    if mode not in MODES:
+        raise InvalidSettings(f"mode={mode!r}: use one of {MODES}")
+    if method not in ("ga", "exact"):
+        raise InvalidSettings(f"method={method!r}: use 'ga' or 'exact'")
+    random_generator(seed)  # refuse a bad seed before any work
+    def number(value: Any) -> bool:
+        return isinstance(value, (int, float, np.number)) and not isinstance(value, bool) \
+            and bool(np.isfinite(value))
+
+    if mode == "two-stage" and not (number(time_factor) and time_factor >= 1.0):
+        raise InvalidSettings(f"time_factor={time_factor!r}: use a finite value >= 1")
+    if mode == "weighted" and not (number(k_time) and number(k_jerk) and k_time >= 0.0
+                                   and k_jerk >= 0.0 and k_time + k_jerk > 0.0):
+        raise InvalidSettings(f"k_time={k_time!r}, k_jerk={k_jerk!r}: use weights >= 0, "
+                              "not both zero")
+
+
+def _ga_time_jerk(problem: TimingProblem, mode: str, cap: float | None, start: np.ndarray | None, k_time: float,
+                  k_jerk: float, settings: GASettings, seed: int, max_generations: int | None,
+                  time_limit: float | None) -> tuple[np.ndarray, Any]:
+    """The GA on the durations: the jerk integral under the time cap (two-stage, started from the
+    time-optimal ``start``) or ``k_T T + k_J J`` (weighted); its best durations and history."""
+    lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
+    if mode == "two-stage":
+        objective = lambda H: jerk_integral_batch(problem, H)
+
+        def constraints(H: np.ndarray) -> np.ndarray:
+            return np.column_stack([problem.constraints(H), H.sum(axis=1) / cap - 1.0])
+
+        initial = start[None]
+    else:
+        objective = lambda H: k_time * H.sum(axis=1) + k_jerk * jerk_integral_batch(problem, H)
+        constraints = problem.constraints
+        initial = None
+    res = run_ga(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
+                 seed=seed, max_generations=max_generations, time_limit=time_limit,
+                 initial=initial)
+    if not res.feasible:
+        raise InfeasibleProblem("the GA found no timing within the bounds that meets the "
+                                f"limits{' and the time cap' if cap else ''}; widen the "
+                                "bounds or relax the limits")
+    return res.x, res.history

@@ -4,7 +4,10 @@
   sets, greedy forward pass, interpolated rows), re-exported here, so
   ``from pinarms.optim.topp import topp_profile`` works as before;
 - :mod:`.path_timing`: :func:`time_optimal` and :func:`time_scaled` of a joint path under a list
-  of limits (:class:`PathTiming`).
+  of limits (:class:`PathTiming`), built from :mod:`.grid` (the grid of a section, the profile
+  checked and refined), :mod:`.dense_check` (rows between grid points, exact joint peaks) and
+  :mod:`.time_law` (s(t) as a piecewise polynomial, its smoothing, q(s(t)) composed exactly);
+- :mod:`.row_bounds`: the rows as bounds on the state, pruned and laid out for the profile's loops.
 
 The old path ``pinarms.optim.path_timing`` keeps working (the same module object).
 """

@@ -33,6 +33,12 @@ over τ (still at rest at both ends; τ longer in time). τ starts at the larges
 joint acceleration divided by its jerk limit, and a few multiples are tried; each result is
 slowed uniformly until every joint limit — velocity, acceleration and jerk, exact peaks —
 and every path constraint (dense check) holds, and the shortest is kept.
+
+Where each step lives: :mod:`.grid` (steps 2–4 on one section), :mod:`.profile` (step 3, the
+TOPP-RA algorithm written here rather than toppra's: measured as fast on the same grid and
+rows, bit-reproducible, every constraint object as rows; figures and command there, toppra
+stays the cross-check in the tests), :mod:`.dense_check` (the checks of steps 4 and the
+jerk smoothing), :mod:`.time_law` (step 5 and the smoothing of the law).
 """
 
 from __future__ import annotations
@@ -42,20 +48,19 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_GRID_POINTS, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES,
-                               MIN_PATH_KAPPA, MIN_PATH_RTOL, count_setting)
+from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES, MIN_PATH_KAPPA,
+                               MIN_PATH_RTOL, count_setting)
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
-from pinarms.optim.topp.profile import topp_profile
-from pinarms.planning import Trajectory
 from pinarms.optim.ga.problem import check_limit
-from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
-from pinarms.planning.extrema import normalised_pieces, piece_extrema
-from pinarms.planning.trajectory import taylor_shift
+from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, Peaked, law_check, law_rows, ratios, row_names, rows_at
+from pinarms.optim.topp.grid import path_grid, refined_section
+from pinarms.optim.topp.time_law import (acceleration_jumps, assemble, bang_bang, compose_law, law_eval, scaled_law,
+                                         smoothed)
+from pinarms.planning import Trajectory
+from pinarms.planning.path_constraints import PathConstraint, PathRows
 
 __all__ = ["PathTiming", "time_optimal", "time_scaled", "SHAPES", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
 
-#: Where each grid interval is re-checked, as fractions of its length.
-CHECK_FRACTIONS = np.array([0.25, 0.5, 0.75, 1.0])
 #: Rest-to-rest shapes σ(τ) of :func:`time_scaled`, ascending coefficients in τ ∈ [0, 1]
 #: (cubic: zero end velocity; quintic: zero end velocity and acceleration).
 SHAPES = {"cubic": (0.0, 0.0, 3.0, -2.0), "quintic": (0.0, 0.0, 0.0, 10.0, -15.0, 6.0)}
@@ -101,7 +106,7 @@ class PathTiming:
 
     def state(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Path position s, speed ṡ and acceleration s̈ at instants ``t`` (N,) [s]."""
-        return _law_eval(self.law_breaks, self.law_coefficients, np.atleast_1d(np.asarray(t, dtype=float)))
+        return law_eval(self.law_breaks, self.law_coefficients, np.atleast_1d(np.asarray(t, dtype=float)))
 
     def time_at(self, s: Any) -> np.ndarray:
         """First instants [s] at which the path reaches ``s`` (N,) (bisection on the monotone law)."""
@@ -128,312 +133,86 @@ class PathTiming:
                 "constraints": [c.name for c in self.constraints], "peak_ratios": dict(self.ratios)}
 
 
-class _Peaked:
-    """A trajectory's exact per-joint peaks, each derivative order computed once, on first use.
-
-    Stands for the trajectory in :meth:`PathConstraint.exact_dilation` (``n_joints`` and
-    ``peaks()`` with ``velocity``, ``acceleration``, ``jerk``): every constraint shares one,
-    and orders nobody asks for (jerk, mostly) are never computed.
-    """
-
-    def __init__(self, trajectory: Trajectory) -> None:
-        self.n_joints = trajectory.n_joints
-        self.trajectory = trajectory  # for constraints that need more than the peaks (joint torque)
-        self._coefs = trajectory.coefficients
-        self._h = trajectory.segment_durations
-        self._normalised = None
-        self._cache: dict[int, np.ndarray] = {}
-
-    def _order(self, r: int) -> np.ndarray:
-        if r not in self._cache:
-            if self._normalised is None:
-                self._normalised = normalised_pieces(self._coefs, self._h)
-            values, _ = piece_extrema(self._normalised, self._h, (r,))
-            self._cache[r] = np.abs(values[0]).max(axis=(0, 2))
-        return self._cache[r]
-
-    @property
-    def velocity(self) -> np.ndarray:
-        return self._order(1)
-
-    @property
-    def acceleration(self) -> np.ndarray:
-        return self._order(2)
-
-    @property
-    def jerk(self) -> np.ndarray:
-        return self._order(3)
-
-    def peaks(self) -> "_Peaked":
-        return self
+def _checked_constraints(constraints: Sequence[PathConstraint]) -> tuple:
+    """``constraints`` as a tuple, or InvalidSettings when it is empty or holds something else."""
+    cons = tuple(constraints)
+    if not cons or not all(isinstance(c, PathConstraint) for c in cons):
+        raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
+    return cons
 
 
-def _grid(path: Any, a: float, b: float, total: float, n: int, kappa: float) -> np.ndarray:
-    """Grid of [a, b]: the path breaks inside, each piece cut in steps of about total / n, then
-    intervals halved until the tangent q' changes by at most ``kappa`` of its size across each."""
-    breaks = np.asarray(path.breaks)
-    inner = breaks[(breaks > a) & (breaks < b)]
-    edges = np.concatenate([[a], inner, [b]])
-    step = total / max(n, 1)
-    parts = [np.array([a])]
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        k = max(1, int(np.ceil((hi - lo) / step - 1e-9)))
-        parts.append(lo + (hi - lo) * np.arange(1, k + 1) / k)
-    g = np.concatenate(parts)
-    g[-1] = b
-    for _ in range(20):
-        _, dq, _ = path.sample(g[:-1], "right")
-        _, dq_end, _ = path.sample(g[1:], "left")
-        size = np.maximum(np.abs(dq).max(axis=1), np.abs(dq_end).max(axis=1))
-        bad = np.abs(dq_end - dq).max(axis=1) > kappa * size
-        if not bad.any():
-            break
-        g = _grown(np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])[bad]])), "kappa")
-    return g
+def _checked_settings(path: Any, jerk: Any, grid: int, kappa: float, start_speed: float, end_speed: float,
+                      rtol: float, max_rounds: int) -> np.ndarray | None:
+    """Refuse bad settings of :func:`time_optimal` (named errors); the jerk limit (n,) or None."""
+    if not (hasattr(path, "sample") and hasattr(path, "breaks") and hasattr(path, "coefficients")):
+        raise InvalidSettings(f"path must be a planning.JointPath, got {type(path).__name__}")
+    count_setting(grid, "grid (intervals over the path)", 1, MAX_PATH_GRID)
+    count_setting(max_rounds, "max_rounds (grid refinements)", 0, MAX_PATH_ROUNDS)
+    for name, value in (("start_speed", start_speed), ("end_speed", end_speed)):
+        if not (isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value >= 0.0):
+            raise InvalidSettings(f"{name} must be a finite ṡ >= 0, got {value!r}")
+    if not (isinstance(rtol, (int, float)) and MIN_PATH_RTOL <= rtol < 0.5):
+        raise SettingOutOfRange(f"rtol must be in [{MIN_PATH_RTOL:g}, 0.5), got {rtol!r}")
+    if not (isinstance(kappa, (int, float)) and MIN_PATH_KAPPA <= kappa <= 1.0):
+        raise SettingOutOfRange(f"kappa must be in [{MIN_PATH_KAPPA:g}, 1], got {kappa!r}")
+    if jerk is None:
+        return None
+    try:
+        jmax = check_limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]", required=True)  # in LIMIT_RANGE
+    except Exception as exc:
+        raise InvalidSettings(str(exc)) from None
+    if start_speed or end_speed:
+        raise InvalidSettings("a jerk limit is applied from rest to rest: start_speed and end_speed must be 0")
+    return jmax
 
 
-def _grown(grid: np.ndarray, what: str) -> np.ndarray:
-    """``grid`` unless refining made it larger than the cap (then a named error, never a runaway)."""
-    if grid.size > MAX_PATH_GRID_POINTS:
-        raise SettingOutOfRange(f"the path grid grew past {MAX_PATH_GRID_POINTS:,} points while refining: give a "
-                                f"larger {what} or a smaller grid")
-    return grid
+def _profiled_sections(path: Any, cons: tuple, grid: int, kappa: float, start_speed: float, end_speed: float,
+                       rtol: float, max_rounds: int) -> list[tuple]:
+    """Steps 1–4 on every section between stops: (s, x, u, f², rounds, ratios) each."""
+    sections = path.sections()
+    L = path.length
+    results = []
+    for i, (a, b) in enumerate(sections):
+        g = path_grid(path, a, b, L, grid, kappa)
+        x0 = start_speed**2 if i == 0 else 0.0
+        x1 = end_speed**2 if i == len(sections) - 1 else 0.0
+        results.append(refined_section(path, cons, g, x0, x1, rtol, max_rounds))
+    return results
 
 
-def _rows(path: Any, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:
-    samples = PathSamples.of(path, s, side)
-    return PathRows.concatenate([c.rows(samples) for c in constraints])
+def _smoothest_under_jerk(path: Any, cons: tuple, laws: list, traj: Trajectory,
+                          jmax: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """The bang–bang laws smoothed over each window of :data:`SMOOTHING_FACTORS` (module docstring, jerk),
+    each slowed until every limit holds; the shortest as (window τ [s], its slow-down f, tb, C)."""
+    tau0 = float(np.max(acceleration_jumps(traj) / jmax))
+    best = None
+    for factor in SMOOTHING_FACTORS:
+        tau = tau0 * factor
+        cand = [smoothed(t, c, tau) for t, c in laws]
+        ctb, cC, ctraj = assemble(path, cand)
+        g2 = law_check(path, cons, ctb, cC)
+        peaked = Peaked(ctraj)
+        fj = max(1.0, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0), np.sqrt(g2),
+                 max(c.exact_dilation(peaked) for c in cons))
+        if best is None or ctraj.duration * fj < best[0]:
+            best = (ctraj.duration * fj, tau, fj, ctb, cC)
+    _, smoothing, fj, tb, C = best
+    return smoothing, fj, tb, C
 
 
-def _dilation_needed(rows: PathRows, u: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """f² (N, m) each row needs (1 where satisfied); inf where no dilation helps (a bound excluding 0)."""
-    val = rows.values(u, x)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        over = np.where(val > rows.hi, np.where(rows.hi > 0.0, val / rows.hi, np.inf), 1.0)
-        under = np.where(val < rows.lo, np.where(rows.lo < 0.0, val / rows.lo, np.inf), 1.0)
-    return np.maximum(np.maximum(over, under), 1.0)
+def _exact_dilation(cons: tuple, traj: Trajectory, jmax: np.ndarray | None) -> float:
+    """The uniform slow-down the trajectory's exact joint peaks still need (1 when none)."""
+    peaked = Peaked(traj)
+    f_exact = max(c.exact_dilation(peaked) for c in cons)
+    if jmax is not None:
+        f_exact = max(f_exact, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0))
+    return f_exact
 
 
-def _ratios(rows: PathRows, u: np.ndarray, x: np.ndarray, names: list[str]) -> dict[str, float]:
-    """Largest value / bound per constraint name; for rows without u (speed limits on ṡ²) the
-    square root, so that the ratio is one of speeds."""
-    val = rows.values(u, x)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.maximum(np.where(rows.hi > 0.0, val / rows.hi, 0.0), np.where(rows.lo < 0.0, val / rows.lo, 0.0))
-    first_order = np.all(rows.a == 0.0, axis=0)
-    r = np.where(first_order[None, :], np.sqrt(np.maximum(r, 0.0)), r)
-    out: dict[str, float] = {}
-    for j, name in enumerate(names):
-        out[name] = max(out.get(name, 0.0), float(np.max(r[:, j])) if r.shape[0] else 0.0)
-    return out
-
-
-def _section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
-             rtol: float, max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
-    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios)."""
-    names: list[str] = []
-    for c in constraints:
-        names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
-    rounds = 0
-    while True:
-        rows = _rows(path, constraints, grid, "right")
-        prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
-        h = np.diff(grid)
-        sc = (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
-        uc = np.repeat(prof.u, CHECK_FRACTIONS.size)
-        xc = (prof.x[:-1, None] + 2.0 * prof.u[:, None] * h[:, None] * CHECK_FRACTIONS).reshape(-1)
-        xc = np.maximum(xc, 0.0)
-        crow = _rows(path, constraints, sc, "left")
-        need = _dilation_needed(crow, uc, xc).reshape(h.size, -1).max(axis=1)
-        if np.any(~np.isfinite(need)):
-            k = int(np.argmax(~np.isfinite(need)))
-            raise InfeasibleProblem(f"at s = {grid[k]:.6g} a limit cannot be met at any speed (its bounds exclude 0, "
-                                    "e.g. gravity beyond a torque limit)")
-        bad = need > 1.0 + rtol
-        if not bad.any() or rounds >= max_rounds:
-            break
-        rounds += 1
-        grid = _grown(np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]])), "rtol")
-    return grid, prof.x, prof.u, float(need.max()), rounds, _ratios(crow, uc, xc, names)
-
-
-
-# ------------------------------------------------------------------------ time laws
-def _law_eval(tb: np.ndarray, C: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """s, ṡ, s̈ of the piecewise polynomial law (breaks tb, ascending coefficients C) at instants t."""
-    tt = np.clip(t, tb[0], tb[-1])
-    k = np.clip(np.searchsorted(tb, tt, side="right") - 1, 0, C.shape[0] - 1)
-    tau = tt - tb[k]
-    c = C[k]
-    deg = C.shape[1] - 1
-    out = []
-    for r in range(3):
-        acc = np.zeros_like(tau)
-        for d in range(deg, r - 1, -1):
-            fall = np.prod(np.arange(d, d - r, -1)) if r else 1.0
-            acc = acc * tau + fall * c[:, d]
-        out.append(acc)
-    return out[0], out[1], out[2]
-
-
-def _polyval(C: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Row-wise values of ascending coefficients C (P, k+1) at x (P,)."""
-    out = np.zeros(C.shape[0])
-    for d in range(C.shape[1] - 1, -1, -1):
-        out = out * x + C[:, d]
-    return out
-
-
-def _bang_bang(grid: np.ndarray, x: np.ndarray, u: np.ndarray, f2: float) -> tuple[np.ndarray, np.ndarray]:
-    """The reachability profile as a law: one quadratic per grid interval, dilated by f = √f2."""
-    sd = np.sqrt(np.maximum(x, 0.0) / f2)
-    uu = u / f2
-    dt = 2.0 * np.diff(grid) / (sd[:-1] + sd[1:])
-    tb = np.concatenate([[0.0], np.cumsum(dt)])
-    return tb, np.stack([grid[:-1], sd[:-1], 0.5 * uu], axis=1)
-
-
-def _polyint(C: np.ndarray) -> np.ndarray:
-    """Antiderivatives (zero at the piece start) of ascending coefficients (P, k+1) -> (P, k+2)."""
-    out = np.zeros((C.shape[0], C.shape[1] + 1))
-    out[:, 1:] = C / np.arange(1, C.shape[1] + 1)
-    return out
-
-
-def _smoothed(tb: np.ndarray, C: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
-    """The law averaged over a trailing window τ: ``s_τ(t) = (1/τ) ∫_{t−τ}^{t} s`` on [t0, t_end + τ].
-
-    (Module docstring, jerk.) The law is extended at rest before its start and after its end.
-    """
-    a, b = C[0, 0], _law_eval(tb, C, tb[-1:])[0][0]
-    # the law at rest before its start and after its end, one piece each (length τ)
-    eb = np.concatenate([[tb[0] - tau], tb, [tb[-1] + tau]])
-    width = C.shape[1]
-    EC = np.zeros((C.shape[0] + 2, width))
-    EC[0, 0], EC[1:-1], EC[-1, 0] = a, C, b
-    S = _polyint(EC)  # (P+2, k+2)
-    lengths = np.diff(eb)
-    ends = _polyval(S, lengths)
-    S[:, 0] = np.concatenate([[0.0], np.cumsum(ends)[:-1]])  # continuous antiderivative
-    new = np.unique(np.concatenate([tb, tb + tau]))
-    new = new[(new >= tb[0]) & (new <= tb[-1] + tau)]
-    out = np.zeros((new.size - 1, S.shape[1]))
-    for sign, shift in ((1.0, 0.0), (-1.0, tau)):
-        start = new[:-1] - shift
-        k = np.clip(np.searchsorted(eb, start + 1e-15 * max(1.0, abs(tb[-1])), side="right") - 1, 0, S.shape[0] - 1)
-        local = taylor_shift(S[k][:, :, None], start - eb[k])[:, :, 0]
-        out += sign * local
-    return new, out / tau
-
-
-def _split(tb: np.ndarray, C: np.ndarray, s_breaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cut law pieces where s(t) crosses a path break, so that each piece lies in one path piece."""
-    s0 = C[:, 0]
-    s1 = _polyval(C, np.diff(tb))
-    cuts_t, cuts_k = [], []
-    tol = 1e-12 * max(1.0, float(np.abs(s_breaks).max()) if s_breaks.size else 1.0)
-    for sb in s_breaks:
-        inside = np.flatnonzero((s0 < sb - tol) & (s1 > sb + tol))
-        for i in inside:  # a monotone law crosses once: bisection
-            lo, hi = 0.0, tb[i + 1] - tb[i]
-            for _ in range(80):
-                mid = 0.5 * (lo + hi)
-                if np.polyval(C[i, ::-1], mid) < sb:
-                    lo = mid
-                else:
-                    hi = mid
-            cuts_t.append(tb[i] + 0.5 * (lo + hi))
-            cuts_k.append(i)
-    if not cuts_t:
-        return tb, C
-    new = np.sort(np.concatenate([tb, cuts_t]))
-    k = np.clip(np.searchsorted(tb, new[:-1], side="right") - 1, 0, C.shape[0] - 1)
-    out = taylor_shift(C[k][:, :, None], new[:-1] - tb[k])[:, :, 0]
-    return new, out
-
-
-def _compose_law(path: Any, tb: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Coefficients (P, D·k+1, n) in the local time of q(s(t)) on each law piece (module docstring, step 5)."""
-    breaks, Q = np.asarray(path.breaks), path.coefficients  # (K, D+1, n)
-    h = np.diff(tb)
-    mid = _polyval(C, 0.5 * h)
-    k = np.clip(np.searchsorted(breaks, mid, side="right") - 1, 0, Q.shape[0] - 1)
-    D = Q.shape[1] - 1
-    deg = C.shape[1] - 1
-    width = D * deg + 1
-    sigma = C.copy()
-    sigma[:, 0] -= breaks[k]
-    P = C.shape[0]
-    power = np.zeros((P, width))
-    power[:, 0] = 1.0
-    out = Q[k, 0][:, None, :] * power[:, :, None]
-    for d in range(1, D + 1):
-        nxt = np.zeros((P, width))
-        for j in range(deg + 1):
-            nxt[:, j:] += sigma[:, j : j + 1] * power[:, : width - j]
-        power = nxt
-        out = out + Q[k, d][:, None, :] * power[:, :, None]
-    return out
-
-
-def _law_rows(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray,
-              C: np.ndarray) -> tuple[PathRows, np.ndarray, np.ndarray]:
-    """Rows of the constraints at 0, 1/4 … 1 of every law piece, with the law's (u, x) there.
-
-    A piece's start is evaluated on the path piece that starts there, the other points on the
-    one that ends there (what the law piece lies on; they differ at a stop).
-    """
-    h = np.diff(tb)
-    parts = []
-    for frac, side in ((np.array([0.0]), "right"), (np.concatenate([CHECK_FRACTIONS[:-1], [1.0 - 1e-9]]), "left")):
-        t = (tb[:-1, None] + h[:, None] * frac).reshape(-1)
-        s, sd, sdd = _law_eval(tb, C, t)
-        parts.append((_rows(path, constraints, np.clip(s, 0.0, path.length), side), sdd, sd * sd))
-    return PathRows.concatenate_points([p[0] for p in parts]), np.concatenate([p[1] for p in parts]), \
-        np.concatenate([p[2] for p in parts])
-
-
-def _law_check(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray, C: np.ndarray) -> float:
-    """f² the path constraints need on a law (dense rows)."""
-    rows, u, x = _law_rows(path, constraints, tb, C)
-    need = _dilation_needed(rows, u, x)
-    if np.any(~np.isfinite(need)):
-        raise InfeasibleProblem("a limit cannot be met at any speed on the smoothed timing (its bounds exclude 0)")
-    return float(need.max())
-
-
-def _assemble(path: Any, laws: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, Trajectory]:
-    """Sections' laws end to end (each cut at the path breaks) and the composed trajectory."""
-    tbs, Cs, offset = [], [], 0.0
-    width = max(C.shape[1] for _, C in laws)
-    for tb, C in laws:
-        tb, C = _split(tb, C, np.asarray(path.breaks)[1:-1])
-        pad = np.zeros((C.shape[0], width))
-        pad[:, : C.shape[1]] = C
-        tbs.append(tb - tb[0] + offset)
-        Cs.append(pad)
-        offset = float(tbs[-1][-1])
-    tb = np.concatenate([tbs[0]] + [t[1:] for t in tbs[1:]])
-    C = np.concatenate(Cs)
-    traj = Trajectory(tb, _compose_law(path, tb, C))
-    return tb, C, traj
-
-
-def _scaled_law(tb: np.ndarray, C: np.ndarray, f: float) -> tuple[np.ndarray, np.ndarray]:
-    """The law slowed uniformly by f: t -> f t."""
-    return tb[0] + (tb - tb[0]) * f, C / f ** np.arange(C.shape[1])
-
-
-def _acceleration_jumps(traj: Trajectory) -> np.ndarray:
-    """Largest jump (n,) of each joint's acceleration at the trajectory's breaks (from and to rest included)."""
-    c = traj.coefficients
-    h = traj.segment_durations
-    k = np.arange(2, c.shape[1])
-    start = 2.0 * c[:, 2] if c.shape[1] > 2 else np.zeros((c.shape[0], c.shape[2]))
-    end = np.einsum("mkn,mk->mn", c[:, 2:], (k * (k - 1))[None] * h[:, None] ** (k - 2)[None]) if c.shape[1] > 2 \
-        else np.zeros_like(start)
-    jumps = np.concatenate([start[:1], start[1:] - end[:-1], -end[-1:]])
-    return np.abs(jumps).max(axis=0)
+def _slowed(path: Any, tb: np.ndarray, C: np.ndarray, f: float) -> tuple[np.ndarray, np.ndarray, Trajectory]:
+    """The law slowed uniformly by f and its trajectory composed again."""
+    tb, C = scaled_law(tb, C, f)
+    return tb, C, Trajectory(tb, compose_law(path, tb, C))
 
 
 def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any = None, grid: int = 100,
@@ -463,72 +242,26 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
         InfeasibleProblem: the limits cannot be met along the path (names where).
         InvalidSettings: bad arguments.
     """
-    cons = tuple(constraints)
-    if not cons or not all(isinstance(c, PathConstraint) for c in cons):
-        raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
-    if not (hasattr(path, "sample") and hasattr(path, "breaks") and hasattr(path, "coefficients")):
-        raise InvalidSettings(f"path must be a planning.JointPath, got {type(path).__name__}")
-    count_setting(grid, "grid (intervals over the path)", 1, MAX_PATH_GRID)
-    count_setting(max_rounds, "max_rounds (grid refinements)", 0, MAX_PATH_ROUNDS)
-    for name, value in (("start_speed", start_speed), ("end_speed", end_speed)):
-        if not (isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value >= 0.0):
-            raise InvalidSettings(f"{name} must be a finite ṡ >= 0, got {value!r}")
-    if not (isinstance(rtol, (int, float)) and MIN_PATH_RTOL <= rtol < 0.5):
-        raise SettingOutOfRange(f"rtol must be in [{MIN_PATH_RTOL:g}, 0.5), got {rtol!r}")
-    if not (isinstance(kappa, (int, float)) and MIN_PATH_KAPPA <= kappa <= 1.0):
-        raise SettingOutOfRange(f"kappa must be in [{MIN_PATH_KAPPA:g}, 1], got {kappa!r}")
-    jmax = None
-    if jerk is not None:
-        try:
-            jmax = check_limit(jerk, path.n_joints, "jerk limit [rad/s³ or m/s³]", required=True)  # in LIMIT_RANGE
-        except Exception as exc:
-            raise InvalidSettings(str(exc)) from None
-        if start_speed or end_speed:
-            raise InvalidSettings("a jerk limit is applied from rest to rest: start_speed and end_speed must be 0")
-    sections = path.sections()
-    L = path.length
-    results = []
-    for i, (a, b) in enumerate(sections):
-        g = _grid(path, a, b, L, grid, kappa)
-        x0 = start_speed**2 if i == 0 else 0.0
-        x1 = end_speed**2 if i == len(sections) - 1 else 0.0
-        results.append(_section(path, cons, g, x0, x1, rtol, max_rounds))
+    cons = _checked_constraints(constraints)
+    jmax = _checked_settings(path, jerk, grid, kappa, start_speed, end_speed, rtol, max_rounds)
+    results = _profiled_sections(path, cons, grid, kappa, start_speed, end_speed, rtol, max_rounds)
     f2 = max(1.0, max(r[3] for r in results))
-    laws = [_bang_bang(g, x, u, f2) for g, x, u, _, _, _ in results]
-    tb, C, traj = _assemble(path, laws)
+    laws = [bang_bang(g, x, u, f2) for g, x, u, _, _, _ in results]
+    tb, C, traj = assemble(path, laws)
     smoothing = 0.0
     f = np.sqrt(f2)
     if jmax is not None:
-        tau0 = float(np.max(_acceleration_jumps(traj) / jmax))
-        best = None
-        for factor in SMOOTHING_FACTORS:
-            tau = tau0 * factor
-            cand = [_smoothed(t, c, tau) for t, c in laws]
-            ctb, cC, ctraj = _assemble(path, cand)
-            g2 = _law_check(path, cons, ctb, cC)
-            peaked = _Peaked(ctraj)
-            fj = max(1.0, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0), np.sqrt(g2),
-                     max(c.exact_dilation(peaked) for c in cons))
-            if best is None or ctraj.duration * fj < best[0]:
-                best = (ctraj.duration * fj, tau, fj, ctb, cC)
-        _, smoothing, fj, tb, C = best
-        tb, C = _scaled_law(tb, C, fj)
-        traj = Trajectory(tb, _compose_law(path, tb, C))
+        smoothing, fj, tb, C = _smoothest_under_jerk(path, cons, laws, traj, jmax)
+        tb, C, traj = _slowed(path, tb, C, fj)
         f *= fj
-    peaked = _Peaked(traj)
-    f_exact = max(c.exact_dilation(peaked) for c in cons)
-    if jmax is not None:
-        f_exact = max(f_exact, float(np.max(peaked.jerk / jmax)) ** (1.0 / 3.0))
+    f_exact = _exact_dilation(cons, traj, jmax)
     if f_exact > 1.0 + 1e-12:  # between the check points (or past a rounding): slow once more, exactly
-        tb, C = _scaled_law(tb, C, f_exact)
-        traj = Trajectory(tb, _compose_law(path, tb, C))
+        tb, C, traj = _slowed(path, tb, C, f_exact)
         f *= f_exact
-    names = [c.name for c in cons for _ in range(c.rows(PathSamples.of(path, [0.0])).a.shape[1])]
-    rows, u, x = _law_rows(path, cons, tb, C)
-    ratios = _ratios(rows, u, x, names)
+    rows, u, x = law_rows(path, cons, tb, C)
     grid_all = np.concatenate([r[0] for r in results])
     return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing),
-                      int(sum(r[4] for r in results)), ratios)
+                      int(sum(r[4] for r in results)), ratios(rows, u, x, row_names(path, cons)))
 
 
 def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
@@ -546,39 +279,43 @@ def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str 
         InfeasibleProblem: a row's bounds exclude 0 (no T satisfies it).
         InvalidSettings: an unknown shape, bad arguments.
     """
-    cons = tuple(constraints)
-    if not cons or not all(isinstance(c, PathConstraint) for c in cons):
-        raise InvalidSettings("constraints must be a non-empty list of planning.path_constraints.PathConstraint objects")
+    cons = _checked_constraints(constraints)
     if shape not in SHAPES:
         raise InvalidSettings(f"shape must be one of {sorted(SHAPES)}, got {shape!r}")
     count_setting(samples, "samples (instants of the time scaling)", 3, MAX_TIME_SCALED_SAMPLES)
     sig = np.array(SHAPES[shape])
     tau = np.linspace(0.0, 1.0, int(samples))
-    d1 = np.polynomial.polynomial.polyval(tau, sig[1:] * np.arange(1, sig.size))
-    d2 = np.polynomial.polynomial.polyval(tau, sig[2:] * np.arange(2, sig.size) * np.arange(1, sig.size - 1))
     laws, grids = [], []
     for a, b in path.sections():
-        L = b - a
-        s = a + L * np.polynomial.polynomial.polyval(tau, sig)
-        rows = PathRows.concatenate_points([_rows(path, cons, s[:1], "right"), _rows(path, cons, s[1:], "left")])
-        val = rows.values(L * d2, (L * d1) ** 2)  # a u + b x at T = 1; at T it is val / T²
-        with np.errstate(divide="ignore", invalid="ignore"):
-            up = np.where(val > 0.0, np.where(rows.hi > 0.0, val / rows.hi, np.where(np.isinf(rows.hi), 0.0, np.inf)), 0.0)
-            dn = np.where(val < 0.0, np.where(rows.lo < 0.0, val / rows.lo, np.where(np.isinf(rows.lo), 0.0, np.inf)), 0.0)
-        need = np.maximum(up, dn)
-        if np.any(~np.isfinite(need)):
-            raise InfeasibleProblem(f"a limit cannot be met at any speed on the section [{a:.6g}, {b:.6g}]")
-        T = float(np.sqrt(need.max()))
-        coef = L * sig / T ** np.arange(sig.size)
-        coef[0] += a
-        laws.append((np.array([0.0, T]), coef[None]))
+        s, law = _shaped_section(path, cons, sig, tau, a, b)
+        laws.append(law)
         grids.append(s)
-    tb, C, traj = _assemble(path, laws)
-    peaked = _Peaked(traj)
-    f = max(c.exact_dilation(peaked) for c in cons)
+    tb, C, traj = assemble(path, laws)
+    f = max(c.exact_dilation(Peaked(traj)) for c in cons)
     if f > 1.0 + 1e-12:
-        tb, C = _scaled_law(tb, C, f)
-        traj = Trajectory(tb, _compose_law(path, tb, C))
-    names = [c.name for c in cons for _ in range(c.rows(PathSamples.of(path, [0.0])).a.shape[1])]
-    rows, u, x = _law_rows(path, cons, tb, C)
-    return PathTiming(path, cons, traj, tb, C, np.concatenate(grids), float(f), 0.0, 0, _ratios(rows, u, x, names))
+        tb, C, traj = _slowed(path, tb, C, f)
+    rows, u, x = law_rows(path, cons, tb, C)
+    return PathTiming(path, cons, traj, tb, C, np.concatenate(grids), float(f), 0.0, 0,
+                      ratios(rows, u, x, row_names(path, cons)))
+
+
+def _shaped_section(path: Any, cons: tuple, sig: np.ndarray, tau: np.ndarray, a: float,
+                    b: float) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """The section [a, b] under the shape σ (coefficients ``sig``) with the shortest T its rows allow:
+    the positions s at the instants ``tau`` and the law (tb, C)."""
+    d1 = np.polynomial.polynomial.polyval(tau, sig[1:] * np.arange(1, sig.size))
+    d2 = np.polynomial.polynomial.polyval(tau, sig[2:] * np.arange(2, sig.size) * np.arange(1, sig.size - 1))
+    L = b - a
+    s = a + L * np.polynomial.polynomial.polyval(tau, sig)
+    rows = PathRows.concatenate_points([rows_at(path, cons, s[:1], "right"), rows_at(path, cons, s[1:], "left")])
+    val = rows.values(L * d2, (L * d1) ** 2)  # a u + b x at T = 1; at T it is val / T²
+    with np.errstate(divide="ignore", invalid="ignore"):
+        up = np.where(val > 0.0, np.where(rows.hi > 0.0, val / rows.hi, np.where(np.isinf(rows.hi), 0.0, np.inf)), 0.0)
+        dn = np.where(val < 0.0, np.where(rows.lo < 0.0, val / rows.lo, np.where(np.isinf(rows.lo), 0.0, np.inf)), 0.0)
+    need = np.maximum(up, dn)
+    if np.any(~np.isfinite(need)):
+        raise InfeasibleProblem(f"a limit cannot be met at any speed on the section [{a:.6g}, {b:.6g}]")
+    T = float(np.sqrt(need.max()))
+    coef = L * sig / T ** np.arange(sig.size)
+    coef[0] += a
+    return s, (np.array([0.0, T]), coef[None])

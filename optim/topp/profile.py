@@ -3,18 +3,19 @@
 The algorithm of Pham and Pham, "A new approach to time-optimal path parameterization
 based on reachability analysis", IEEE T-RO 34(3), 2018, written here from the paper.
 
-Why our own and not toppra: on the benchmark (``benchmarks/topp.py``: a UR5 joint spline
-through 8 waypoints, velocity and acceleration limits, 1354 grid points) the rows plus this
-profile take as long as toppra's ``compute_parameterization`` on the same grid or less
-(0.6-1.0× by the load of the machine: 15.6 ms against 26.2 ms on a quiet one, down from
-80 ms, 3.1×, before the loops below ran on Python floats over the few rows that can bind),
-with the same duration to 1e-6; it keeps the timings' figures to the last bit (toppra's
-answer differs by its own rounding), needs no compiled extension, and takes every
-:class:`planning.PathConstraint` as rows. The whole timing (:func:`optim.time_optimal`:
-refined grid, checks between grid points, exact joint peaks, q(t) composed exactly) takes
-about 2.5× toppra's ``compute_trajectory``, which does none of that. toppra (test extra)
-stays the independent cross-check (:func:`optim.toppra_path_duration`,
-``tests/optim/test_path_timing.py``).
+Why our own and not toppra: measured side by side by ``python benchmarks/topp.py`` (a UR5
+joint spline through 8 seeded waypoints, velocity and acceleration limits, the same 1354-point
+grid for both, best of 11 repeats), the rows plus this profile take 44.2 ms against 55.6 ms
+for toppra 0.6.10's ``compute_parameterization`` (0.80×, two shared cores under load; 25.5 ms
+against 30.8 ms, 0.83×, in a quieter run), with the same duration (9.063810 s both). It is
+faster than toppra, keeps the timings' figures to the last bit (toppra's answer differs by
+its own rounding), needs no compiled extension, and takes every :class:`planning.PathConstraint`
+as rows. The whole timing (:func:`optim.time_optimal`: refined grid, checks between grid
+points, exact joint peaks, q(t) composed exactly) takes 3.3–4.4× toppra's
+``compute_trajectory`` (187 ms against 56.7 ms; 129 ms against 29.6 ms), which does none of
+that (its duration is 0.034 % shorter: it meets the limits at the grid points only). toppra
+(test extra) stays the independent cross-check (:func:`optim.toppra_path_duration`,
+``tests/optim/topp/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
 control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
@@ -33,8 +34,8 @@ each grid point the limits are rows ``lo <= a u + b x <= hi``
    the backward loop.
    Each step reads only the rows that can bind there: rows beyond another one over the
    whole range the state can take (``X_{i+1}``, resp. ``K_i`` in step 2) by more than 1e-9
-   are left out before the loop (:func:`_prune`, the same min and max to the last bit), and
-   with ``λ = 0`` the λ rows are constants reduced for all points at once.
+   are left out before the loop (:func:`optim.topp.row_bounds.prune`, the same min and max to
+   the last bit), and with ``λ = 0`` the λ rows are constants reduced for all points at once.
 2. **Greedy forward pass.** From ``x_0``, take the largest admissible u that keeps
    ``x_{i+1}`` in ``K_{i+1}``. Every state stays controllable, so the pass never fails, and
    the result is time-optimal on the grid (the paper's theorem).
@@ -51,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
+from pinarms.optim.topp.row_bounds import prune, row_bounds, stage_lists
 
 __all__ = ["Profile", "feasible_states", "controllable_sets", "greedy_profile", "interpolated_rows",
            "topp_profile", "reachability_profile", "X_CAP"]
@@ -156,73 +158,33 @@ def feasible_states(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray
     return np.stack([xlo, xhi], axis=1)
 
 
-def _bounds(c: np.ndarray, slope: np.ndarray, offset: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Rows ``c x <= slope y + offset`` as ``x <= Su y + Ou`` (c > 0) and ``x >= Sl y + Ol`` (c < 0).
+def _backward_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, two: np.ndarray, X: np.ndarray,
+                   x_end: float) -> tuple[tuple, tuple, tuple[list, list, list]]:
+    """The rows of the backward pass (step 1) as bounds on x, linear in μ and in λ of ``K_{i+1} = [λ, μ]``.
 
-    Rows that do not apply get the neutral offset (+inf for upper, -inf for lower bounds), so
-    that a step of the loops is a min and a max over whole rows. ``c == 0`` rows are returned
-    as ``0 <= slope y + offset`` conditions (``Zs``, ``Zo``; neutral +inf where they do not apply).
+    Returns the μ and the λ bounds as :func:`stage_lists` (rows that cannot bind pruned), and
+    the λ bounds at λ = 0 reduced for every point at once: (x_hi, x_lo, zero) lists (N+1,).
     """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = np.where(c != 0.0, 1.0 / np.where(c != 0.0, c, 1.0), 0.0)
-        up = c > 0.0
-        dn = c < 0.0
-        zero = (c == 0.0) & np.isfinite(offset)
-        Su = np.where(up, slope * inv, 0.0)
-        Ou = np.where(up, offset * inv, np.inf)
-        Sl = np.where(dn, slope * inv, 0.0)
-        Ol = np.where(dn, offset * inv, -np.inf)
-        Zs = np.where(zero, slope, 0.0)
-        Zo = np.where(zero, offset, np.inf)
-    Ou[np.isnan(Ou)] = np.inf
-    Ol[np.isnan(Ol)] = -np.inf
-    return Su, Ou, Sl, Ol, Zs, Zo
-
-
-def _prune(slope: np.ndarray, offset: np.ndarray, x_lo: np.ndarray, x_hi: np.ndarray, upper: bool) -> np.ndarray:
-    """``offset`` with the rows that cannot decide the min (``upper``) or max over ``[x_lo, x_hi]`` made neutral.
-
-    Row r of point i gives ``slope x + offset`` for x in ``[x_lo_i, x_hi_i]`` (N,). It is left
-    out when, at both ends of the range, it is beyond the row that is best at the left end
-    (or the one best at the right end) by more than 1e-9 of the rows' scale: a linear function
-    then stays beyond it over the whole range, far more than the rounding of ``slope x +
-    offset``, so the minimum (maximum) is the same to the last bit without it.
-    """
-    sign = 1.0 if upper else -1.0
-    neutral = np.inf if upper else -np.inf
-    with np.errstate(invalid="ignore", over="ignore"):
-        v_lo = sign * (slope * x_lo[:, None] + offset)
-        v_hi = sign * (slope * x_hi[:, None] + offset)
-        scale = 1e-9 * (np.abs(slope) * np.maximum(np.abs(x_lo), np.abs(x_hi))[:, None] + np.abs(offset))
-        ok = np.isfinite(v_lo) & np.isfinite(v_hi) & np.isfinite(scale)
-        keep = np.ones(slope.shape, dtype=bool)
-        for best in (np.argmin(np.where(ok, v_lo, np.inf), axis=1), np.argmin(np.where(ok, v_hi, np.inf), axis=1)):
-            pick = best[:, None]
-            gap = np.take_along_axis(scale, pick, axis=1) + scale
-            beyond = (v_lo > np.take_along_axis(v_lo, pick, axis=1) + gap) & \
-                     (v_hi > np.take_along_axis(v_hi, pick, axis=1) + gap)
-            keep &= ~(beyond & ok & np.take_along_axis(ok, pick, axis=1))
-    return np.where(keep, offset, neutral)
-
-
-def _stage_lists(*pairs: np.ndarray) -> tuple[tuple[list, list, list], ...]:
-    """The rows that bind at each grid point, as flat Python lists: ``(slopes, offsets, starts)`` per pair.
-
-    ``pairs`` are (slope, offset) arrays (N, m) such as :func:`_bounds` returns. A row whose
-    offset is neutral (+inf for upper and zero rows, -inf for lower rows) cannot change a
-    minimum or maximum and is left out; grid point i's rows are ``slopes[starts[i]:starts[i + 1]]``
-    (written out in the loops: a call or a list per step would cost more than the arithmetic).
-    The loops then run on Python floats: on grids of a few thousand points and a few dozen
-    rows that is several times faster than one numpy reduction per step, with the same
-    arithmetic (a product and a sum per row, exact min and max), so the same bits.
-    """
-    out = []
-    for k in range(0, len(pairs), 2):
-        slope, offset = pairs[k], pairs[k + 1]
-        live = np.isfinite(offset)
-        starts = np.concatenate([[0], np.cumsum(live.sum(axis=1))]).tolist()
-        out.append((slope[live].tolist(), offset[live].tolist(), starts))
-    return tuple(out)
+    with np.errstate(invalid="ignore"):
+        # a lower row of the point with x + 2Δu <= μ:  (a − 2Δ b) x <= a μ − 2Δ lo
+        mu_rows = row_bounds(np.where(np.isfinite(lo), a - two * b, 0.0), np.where(np.isfinite(lo), a, 0.0),
+                             np.where(np.isfinite(lo), -two * lo, np.inf))
+        # x + 2Δu >= λ with an upper row of the point:  (2Δ b − a) x <= 2Δ hi − a λ
+        lam_rows = row_bounds(np.where(np.isfinite(hi), two * b - a, 0.0), np.where(np.isfinite(hi), -a, 0.0),
+                              np.where(np.isfinite(hi), two * hi, np.inf))
+    # μ and λ of K_{i+1} lie in X_{i+1} (and x >= 0): rows that cannot bind there are left out
+    nxt_lo = np.maximum(np.concatenate([X[1:, 0], [x_end]]), 0.0)
+    nxt_hi = np.minimum(np.concatenate([X[1:, 1], [x_end]]), X_CAP)
+    mu_live = (mu_rows[0], prune(mu_rows[0], mu_rows[1], nxt_lo, nxt_hi, True),
+               mu_rows[2], prune(mu_rows[2], mu_rows[3], nxt_lo, nxt_hi, False), mu_rows[4], mu_rows[5])
+    lam_live = (lam_rows[0], prune(lam_rows[0], lam_rows[1], nxt_lo, nxt_hi, True),
+                lam_rows[2], prune(lam_rows[2], lam_rows[3], nxt_lo, nxt_hi, False), lam_rows[4], lam_rows[5])
+    # with λ = 0 (the usual lower end of a controllable set) the λ rows are their offsets: one
+    # vectorised reduction for every point (and the X bounds folded in)
+    up0 = np.minimum(X[:, 1], np.min(lam_rows[1], axis=1)).tolist()
+    dn0 = np.maximum(np.maximum(X[:, 0], 0.0), np.max(lam_rows[3], axis=1)).tolist()
+    zero0 = np.min(lam_rows[5], axis=1).tolist()
+    return stage_lists(*mu_live), stage_lists(*lam_live), (up0, dn0, zero0)
 
 
 def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray,
@@ -248,27 +210,9 @@ def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
         raise InfeasibleProblem(f"the path cannot end with ṡ² = {x_end:g} at s = {s[N]:.6g}: the limits there allow "
                                 f"[{X[N, 0]:.6g}, {X[N, 1]:.6g}]")
     K[N] = (float(x_end), float(x_end))
-    with np.errstate(invalid="ignore"):
-        # a lower row of the point with x + 2Δu <= μ:  (a − 2Δ b) x <= a μ − 2Δ lo
-        mu_rows = _bounds(np.where(np.isfinite(lo), a - two * b, 0.0), np.where(np.isfinite(lo), a, 0.0),
-                          np.where(np.isfinite(lo), -two * lo, np.inf))
-        # x + 2Δu >= λ with an upper row of the point:  (2Δ b − a) x <= 2Δ hi − a λ
-        lam_rows = _bounds(np.where(np.isfinite(hi), two * b - a, 0.0), np.where(np.isfinite(hi), -a, 0.0),
-                           np.where(np.isfinite(hi), two * hi, np.inf))
-    # μ and λ of K_{i+1} lie in X_{i+1} (and x >= 0): rows that cannot bind there are left out
-    nxt_lo = np.maximum(np.concatenate([X[1:, 0], [x_end]]), 0.0)
-    nxt_hi = np.minimum(np.concatenate([X[1:, 1], [x_end]]), X_CAP)
-    mu_live = (mu_rows[0], _prune(mu_rows[0], mu_rows[1], nxt_lo, nxt_hi, True),
-               mu_rows[2], _prune(mu_rows[2], mu_rows[3], nxt_lo, nxt_hi, False), mu_rows[4], mu_rows[5])
-    lam_live = (lam_rows[0], _prune(lam_rows[0], lam_rows[1], nxt_lo, nxt_hi, True),
-                lam_rows[2], _prune(lam_rows[2], lam_rows[3], nxt_lo, nxt_hi, False), lam_rows[4], lam_rows[5])
-    (Pu, Ou, ju), (Pl, Ol, jl), (Pz, Oz, jz) = _stage_lists(*mu_live)
-    (Qu, Vu, ku), (Ql, Vl, kl), (Qz, Vz, kz) = _stage_lists(*lam_live)
-    # with λ = 0 (the usual lower end of a controllable set) the λ rows are their offsets: one
-    # vectorised reduction for every point (and the X bounds folded in)
-    up0 = np.minimum(X[:, 1], np.min(lam_rows[1], axis=1)).tolist()
-    dn0 = np.maximum(np.maximum(X[:, 0], 0.0), np.max(lam_rows[3], axis=1)).tolist()
-    zero0 = np.min(lam_rows[5], axis=1).tolist()
+    mu_lists, lam_lists, (up0, dn0, zero0) = _backward_rows(a, b, lo, hi, two, X, x_end)
+    (Pu, Ou, ju), (Pl, Ol, jl), (Pz, Oz, jz) = mu_lists
+    (Qu, Vu, ku), (Ql, Vl, kl), (Qz, Vz, kz) = lam_lists
     Xl = X.tolist()
     inf = float("inf")
     for i in range(N - 1, -1, -1):
@@ -337,8 +281,8 @@ def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
         dn_o = np.where(act & np.isfinite(lo), lo * inv, -np.inf)
     # x_i lies in K_i: rows that cannot bind there are left out
     k_lo, k_hi = K[:, 0], np.minimum(K[:, 1], X_CAP)
-    (Pu, Ou, ju), (Pl, Ol, jl) = _stage_lists(up_s, _prune(up_s, up_o, k_lo, k_hi, True),
-                                              dn_s, _prune(dn_s, dn_o, k_lo, k_hi, False))
+    (Pu, Ou, ju), (Pl, Ol, jl) = stage_lists(up_s, prune(up_s, up_o, k_lo, k_hi, True),
+                                              dn_s, prune(dn_s, dn_o, k_lo, k_hi, False))
     Kl = K.tolist()
     dl = delta.tolist()
     xs = [float(min(max(x_start, K[0, 0]), K[0, 1]))]

@@ -5,7 +5,8 @@ import pytest
 
 from pinarms import planning
 from pinarms.planning.errors import TrajectoryError
-from pinarms.planning.trajectory import Trajectory, _GEMM_ONE_THREAD
+from pinarms.planning.poly_pieces import GEMM_ONE_THREAD
+from pinarms.planning.trajectory import Trajectory
 
 
 def _reference(traj, t):
@@ -38,7 +39,7 @@ def test_one_piece_sampling_matches_numpy_polynomial(degree, points):
 
 def test_long_sampling_in_row_blocks_equals_one_product():
     traj = planning.quintic_bspline(np.arange(6.0), np.random.default_rng(1).normal(size=(6, 6)))
-    rows = _GEMM_ONE_THREAD // (6 * 24)
+    rows = GEMM_ONE_THREAD // (6 * 24)
     t = np.linspace(0.0, 5.0, 3 * rows + 17)  # several blocks per piece
     got = traj.sample(t)
     pick = np.r_[0:5, rows - 2 : rows + 3, t.size - 5 : t.size]

@@ -1,0 +1,82 @@
+"""The reachability grid of a path section, and the profile on it checked and refined (path_timing, steps 2–4).
+
+:func:`path_grid` places the grid points (the path's breaks, equal steps, halved where the
+tangent bends); :func:`refined_section` runs :func:`optim.topp.topp_profile` on it, checks
+the rows between grid points and splits the intervals that exceed them, until they pass or
+the rounds run out. A grid never grows past :data:`optim.caps.MAX_PATH_GRID_POINTS`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from pinarms.optim.caps import MAX_PATH_GRID_POINTS
+from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
+from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, ratios, rows_at
+from pinarms.optim.topp.profile import topp_profile
+from pinarms.planning.path_constraints import PathConstraint, PathSamples
+
+__all__ = ["path_grid", "refined_section"]
+
+
+def path_grid(path: Any, a: float, b: float, total: float, n: int, kappa: float) -> np.ndarray:
+    """Grid of [a, b]: the path breaks inside, each piece cut in steps of about total / n, then
+    intervals halved until the tangent q' changes by at most ``kappa`` of its size across each."""
+    breaks = np.asarray(path.breaks)
+    inner = breaks[(breaks > a) & (breaks < b)]
+    edges = np.concatenate([[a], inner, [b]])
+    step = total / max(n, 1)
+    parts = [np.array([a])]
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        k = max(1, int(np.ceil((hi - lo) / step - 1e-9)))
+        parts.append(lo + (hi - lo) * np.arange(1, k + 1) / k)
+    g = np.concatenate(parts)
+    g[-1] = b
+    for _ in range(20):
+        _, dq, _ = path.sample(g[:-1], "right")
+        _, dq_end, _ = path.sample(g[1:], "left")
+        size = np.maximum(np.abs(dq).max(axis=1), np.abs(dq_end).max(axis=1))
+        bad = np.abs(dq_end - dq).max(axis=1) > kappa * size
+        if not bad.any():
+            break
+        g = _grown(np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])[bad]])), "kappa")
+    return g
+
+
+def _grown(grid: np.ndarray, what: str) -> np.ndarray:
+    """``grid`` unless refining made it larger than the cap (then a named error, never a runaway)."""
+    if grid.size > MAX_PATH_GRID_POINTS:
+        raise SettingOutOfRange(f"the path grid grew past {MAX_PATH_GRID_POINTS:,} points while refining: give a "
+                                f"larger {what} or a smaller grid")
+    return grid
+
+
+def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
+                    rtol: float, max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
+    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios)."""
+    names: list[str] = []
+    for c in constraints:
+        names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
+    rounds = 0
+    while True:
+        rows = rows_at(path, constraints, grid, "right")
+        prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
+        h = np.diff(grid)
+        sc = (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
+        uc = np.repeat(prof.u, CHECK_FRACTIONS.size)
+        xc = (prof.x[:-1, None] + 2.0 * prof.u[:, None] * h[:, None] * CHECK_FRACTIONS).reshape(-1)
+        xc = np.maximum(xc, 0.0)
+        crow = rows_at(path, constraints, sc, "left")
+        need = dilation_needed(crow, uc, xc).reshape(h.size, -1).max(axis=1)
+        if np.any(~np.isfinite(need)):
+            k = int(np.argmax(~np.isfinite(need)))
+            raise InfeasibleProblem(f"at s = {grid[k]:.6g} a limit cannot be met at any speed (its bounds exclude 0, "
+                                    "e.g. gravity beyond a torque limit)")
+        bad = need > 1.0 + rtol
+        if not bad.any() or rounds >= max_rounds:
+            break
+        rounds += 1
+        grid = _grown(np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]])), "rtol")
+    return grid, prof.x, prof.u, float(need.max()), rounds, ratios(crow, uc, xc, names)
