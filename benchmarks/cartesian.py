@@ -22,7 +22,7 @@ import timeit
 import numpy as np
 
 from pinarms import optim, planning, robots
-from pinarms.robots.layout import default_orientation
+from pinarms.robots.reach.layout import default_orientation
 
 
 def best(fn, number: int) -> float:

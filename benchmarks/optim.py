@@ -22,7 +22,7 @@ sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _HERE]
 
 from pinarms import scenarios
 from pinarms.optim import GASettings, TimingProblem, minimize_time
-from pinarms.optim.reference import path_velocity_limit, ruckig_limit, toppra_limit
+from pinarms.optim.timing.reference import path_velocity_limit, ruckig_limit, toppra_limit
 from pinarms.papers import SEED000
 
 

@@ -51,7 +51,7 @@ def _rss_mb() -> float:
 def child(name: str, args: dict) -> dict:
     """One measurement (runs in its own process)."""
     from pinarms import robots
-    from pinarms.robots.reachability import reachability_map
+    from pinarms.robots.reach.reachability import reachability_map
 
     if args.get("one_core"):
         # one core: no thread pools either (pinarms sizes them by os.cpu_count(), not by the affinity)
@@ -127,7 +127,7 @@ def dask() -> None:
                        opts={"keep_solutions": False}, save=a)
     workers = run_child("aubo-0.01-dask", robot="aubo_i3", resolution=0.01, orientations=50,
                         opts={"keep_solutions": False, "scheduler": "processes:2"}, save=b)
-    from pinarms.robots.reach_io import load_reachability
+    from pinarms.robots.reach.reach_io import load_reachability
 
     same = load_reachability(a).identical(load_reachability(b))
     for p in (a, b):
@@ -176,7 +176,7 @@ def _binned_misses(arm, m, n_samples: int, seed: int, max_checks: int) -> dict:
 
 def panda() -> None:
     from pinarms import robots
-    from pinarms.robots.reach_io import load_reachability
+    from pinarms.robots.reach.reach_io import load_reachability
 
     folder = tempfile.mkdtemp(prefix="reach-bench-")
     results = {}
@@ -227,8 +227,8 @@ def memory() -> None:
 def station() -> None:
     from pinarms import optim, robots
     from pinarms.papers import SEED001
-    from pinarms.robots.base_placement import base_placements, tool_down_poses
-    from pinarms.robots.reachability import reachability_map
+    from pinarms.robots.reach.base_placement import base_placements, tool_down_poses
+    from pinarms.robots.reach.reachability import reachability_map
 
     arm = robots.load("aubo_i3")
     p1, p2 = (np.array(p) * 1e-3 for p in SEED001.table2_p1_p2_mm)

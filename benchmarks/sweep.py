@@ -71,7 +71,7 @@ def child_layout(scheduler: str | None, quick: bool) -> dict:
 
 def child_workspace(scheduler: str | None, n: int) -> dict:
     from pinarms import robots
-    from pinarms.robots.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import stream_workspace
 
     arm = robots.load("aubo_i3")
     t0 = time.perf_counter()
@@ -105,7 +105,7 @@ def child_station(quick: bool) -> dict:
            "best_placement": best.tolist(), "best_ppm": res.best_picks_per_minute,
            "grid_best_ppm": float(res.picks_per_minute[res.best_index]),
            "refine_gain": None if res.refinement is None else res.refinement.gain, "points": {}}
-    from pinarms.optim.layout_search import points_in_base_frame
+    from pinarms.optim.layout.search import points_in_base_frame
 
     for name, p in (("pick P1", p1), ("place P4", place)):
         b = points_in_base_frame(p[None], best[None])[0, 0]

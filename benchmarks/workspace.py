@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms import robots
-from pinarms.robots.workspace import sample_workspace
+from pinarms.robots.reach.workspace import sample_workspace
 
 LOOP_SUBSET = 20_000
 TARGET_S = 3.0

@@ -6,7 +6,7 @@ objectives over a box and knows nothing about trajectories. The timing layer
 (:class:`TimingProblem`, :func:`minimize_time`, :func:`minimize_time_jerk`) turns segment
 durations of a planning trajectory into objective and constraint arrays, and checks every
 GA answer against a deterministic optimiser (``method="exact"``) and the time-optimal
-limit along the same path (:mod:`optim.reference`). :func:`plan_cycle` times a whole
+limit along the same path (:mod:`optim.timing.reference`). :func:`plan_cycle` times a whole
 pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, and back);
 :func:`search_layout` ranks base placements of an arm by the picks per minute of that cycle
 (many cycles, run through :mod:`pinarms.execution`: serial or on Dask).

@@ -1,7 +1,7 @@
 """The second wall of a child process that parses a user's file: write nothing, read only the allowed paths.
 
 Loaded by path (standard library only) by the children that parse users' files:
-:mod:`pinarms.robots._xacro_worker` (xacro files) and :mod:`pinarms.robots._reach_worker`
+:mod:`pinarms.robots._xacro_worker` (xacro files) and :mod:`pinarms.robots.reach._reach_worker`
 (reachability maps). After :func:`enter_wall` the calling process (and any child it could
 start) can, whatever code it runs:
 

@@ -133,7 +133,7 @@ def test_every_package_may_import_the_execution_layer(tmp_path):
 def test_the_checker_sees_function_level_and_top_level_imports(tmp_path):
     module = tmp_path / "m.py"
     module.write_text(
-        "def f():\n    from pinarms import viz\n    from pinarms.optim.engine import run_ga\n"
+        "def f():\n    from pinarms import viz\n    from pinarms.optim.ga.engine import run_ga\n"
         "    import pinarms.planning.trajectory\n    from pinarms.demo import run_demo\n    import robots\n"
     )
     assert _imported_packages(module) == {"viz", "optim", "planning", "pinarms", "top-level robots"}

@@ -31,7 +31,7 @@ def layout_search_session(result: Any, robot: Any, *, title: str | None = None, 
     Raises:
         InvalidInput: no candidate could run the cycle (nothing to place), or a result of another robot.
     """
-    from pinarms.optim.layout_search import base_to_world
+    from pinarms.optim.layout.search import base_to_world
 
     if getattr(result, "best_placement", None) is None:
         raise InvalidInput("the layout search found no placement that runs the cycle: nothing to show")

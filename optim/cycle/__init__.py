@@ -11,9 +11,7 @@
 - :mod:`.plan`: :func:`plan_cycle`, the dispatcher (``plan_cycle(robot, spec, **keywords)``
   still works: it builds the request).
 
-``from pinarms.optim.cycle import plan_cycle, PickPlace, ...`` works as before; the old paths
-``pinarms.optim.cell_cycle`` and ``pinarms.optim.straight_approach`` are the same module objects
-as :mod:`.in_cell` and :mod:`.straight`.
+``from pinarms.optim.cycle import plan_cycle, PickPlace, ...`` works as before.
 """
 
 from .plan import *  # noqa: F401,F403

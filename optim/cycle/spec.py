@@ -89,7 +89,7 @@ class PickPlace:
         via: transfer waypoints between "above pick" and "above place" (positions (3,) or
             poses (4, 4), in order); the return move passes them in reverse.
         orientation: tool orientation (3, 3) of the targets given as positions; default
-            :func:`robots.layout.default_orientation` (tool pointing down on six-axis arms,
+            :func:`robots.reach.layout.default_orientation` (tool pointing down on six-axis arms,
             the neutral orientation on SCARA, gantry and koji arm).
 
     Raises:
@@ -136,7 +136,7 @@ class PickPlace:
         """Waypoints (4 + len(via), 4, 4) of the move to place, tcp → base [m], in :attr:`names` order."""
         R = self.orientation
         if R is None and any(p.shape == (3,) for p in (self.pick, self.place, *self.via)):
-            from pinarms.robots.layout import default_orientation
+            from pinarms.robots.reach.layout import default_orientation
 
             R = default_orientation(robot)
 

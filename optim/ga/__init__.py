@@ -6,8 +6,7 @@
 - operators: :mod:`.selection`, :mod:`.crossover`, :mod:`.mutation`, :mod:`.adaptive`
   (adaptive rates), :mod:`.constraints` (penalties and feasibility rules).
 
-The public names are re-exported by :mod:`pinarms.optim`; the old paths
-(``pinarms.optim.engine``, ...) keep working.
+The public names are re-exported by :mod:`pinarms.optim` (old module paths: docs/README.md).
 """
 
 __all__: list[str] = []

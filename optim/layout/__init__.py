@@ -6,7 +6,6 @@
 - :mod:`.search`: :func:`search_layout`, which screens, plans, ranks and refines (its module
   docstring lists the steps).
 
-The old path ``pinarms.optim.layout_search`` is the same module object as :mod:`.search`.
 """
 
 from .search import (FAILURES, LayoutSearch, Refinement, base_to_world, grid_candidates, points_in_base_frame,

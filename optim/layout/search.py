@@ -75,7 +75,7 @@ def _points(value: Any, what: str) -> np.ndarray:
 
 def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str]]:
     """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate."""
-    from pinarms.robots.layout import default_orientation
+    from pinarms.robots.reach.layout import default_orientation
 
     M = cand.shape[0]
     failure, reason = [""] * M, [""] * M
@@ -187,7 +187,7 @@ def _checked_inputs(picks: Any, places: Any, candidates: Any, kind: str, counts:
 
 def _margins(robot: Any, st: _Settings, cand: np.ndarray, samples: int) -> tuple[Any, np.ndarray]:
     """The workspace's voxel map and the boundary margin of every pick and place (M, P + Q) [m] from each candidate."""
-    from pinarms.robots.workspace import sample_workspace
+    from pinarms.robots.reach.workspace import sample_workspace
 
     ws = sample_workspace(robot, int(samples), seed=int(st.seed), frame="tcp")
     vmap = ws.voxel_map()

@@ -139,8 +139,8 @@ def size_line(problem: SizingProblem, *, n_min: int | None = None, max_arms: int
               generations: int = 8, seed: int = 0, scheduler: Any = None,
               progress: Callable[[str], None] | None = None) -> SizingResult:
     """The fewest arms, their places and the belt speed for ``problem`` (module doc)."""
-    from pinarms.optim.engine import run_ga
-    from pinarms.optim.settings import GASettings
+    from pinarms.optim.ga.engine import run_ga
+    from pinarms.optim.ga.settings import GASettings
 
     if n_min is None:
         m = problem.maps[problem.speeds[-1]]

@@ -18,7 +18,7 @@ has inertials — torque, with the item as payload on the leave move. The tracki
 joints are the arm's IK at dense instants (one branch, continuous), a clamped cubic spline in
 time whose end velocities are the exact ``J⁺ ṗ``; it is checked against the same limits.
 
-Tool orientation: the arm's default tool orientation (:func:`robots.layout.default_orientation`,
+Tool orientation: the arm's default tool orientation (:func:`robots.reach.layout.default_orientation`,
 pointing down on a SCARA) turned about the vertical by the item's yaw (:func:`tool_yaw`, modulo the
 gripper's symmetry) through the whole tracking segment; an arm without a hand rotation (a gantry
 of three slides) grasps at its own fixed yaw.
@@ -147,7 +147,7 @@ def tool_yaw(station: Station, spec: "TrackingSpec", yaw: float) -> float:
 
 
 def _poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarray:
-    from pinarms.robots.layout import default_orientation
+    from pinarms.robots.reach.layout import default_orientation
 
     c, s = np.cos(yaw), np.sin(yaw)
     Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
@@ -214,7 +214,7 @@ def _hermite(q0: np.ndarray, m0: np.ndarray, q1: np.ndarray, m1: np.ndarray, rob
 
 def _constraints(station: Station, mass: float) -> list:
     from pinarms.planning.path_constraints import JointAccelerationConstraint, JointVelocityConstraint
-    from pinarms.planning.path_torque import JointTorqueConstraint
+    from pinarms.planning.torque import JointTorqueConstraint
 
     lim = station.limits
     cons = [JointVelocityConstraint(lim["vmax"]), JointAccelerationConstraint(lim["amax"])]
@@ -226,7 +226,7 @@ def _constraints(station: Station, mass: float) -> list:
 
 def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> Any:
     """Time-optimal move q0 → q1 starting with joint velocity qd0 and ending with qd1 (one of them 0)."""
-    from pinarms.optim.path_timing import time_optimal
+    from pinarms.optim.topp.path_timing import time_optimal
 
     chord = q1 - q0
     arm = ~_hand_joints(station.robot)  # the path's scale from the joints that move the tool point,

@@ -100,7 +100,7 @@ class TrayPickPlan:
 
 def _timed_transfer(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> Any:
     """Time-optimal move q0 → q1 starting with joint velocity qd0 and ending with qd1 (both moving)."""
-    from pinarms.optim.path_timing import time_optimal
+    from pinarms.optim.topp.path_timing import time_optimal
 
     chord = q1 - q0
     arm = ~_hand_joints(station.robot)

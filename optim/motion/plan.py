@@ -319,7 +319,7 @@ def _goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: Any, s
 
 def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any) -> tuple[list, dict]:
     from pinarms.planning.path_constraints import JointAccelerationConstraint, JointVelocityConstraint
-    from pinarms.planning.path_torque import JointTorqueConstraint
+    from pinarms.planning.torque import JointTorqueConstraint
     from pinarms.robots.dynamics import MissingInertials, check_inertials
 
     robots = [cell.arm(a).robot for a in arms]

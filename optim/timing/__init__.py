@@ -7,8 +7,6 @@
   (:func:`minimize_time_jerk`: time and jerk traded), :mod:`.reference` (independent
   references: double-S, path velocity, toppra and ruckig limits).
 
-The old paths ``pinarms.optim.exact``, ``pinarms.optim.time_jerk`` and
-``pinarms.optim.reference`` keep working (the same module objects).
 """
 
 from . import segments as _segments

@@ -8,7 +8,7 @@ forward-difference Jacobians (all perturbed timings evaluated in one batched pea
 converges in a few dozen iterations.
 
 Start points come from the scaling laws: for ratios ``r`` the smallest feasible total is
-``s*(r)`` (see :mod:`optim.problem`), so ``h0 = s*(r) r`` is feasible for equal ratios,
+``s*(r)`` (see :mod:`optim.ga.problem`), so ``h0 = s*(r) r`` is feasible for equal ratios,
 ratios from the segment lengths, their square roots and seeded random ratios. The best
 SLSQP answer is finally rescaled along its own ratios onto the limits
 (``s*(r) (1 + SAFETY)``, within the bounds), which makes it feasible by construction

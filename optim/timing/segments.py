@@ -1,6 +1,6 @@
 """Minimum-time segment timing of a trajectory through via points: GA or exact.
 
-``minimize_time`` is the user-facing entry: it builds a :class:`~optim.problem.TimingProblem`,
+``minimize_time`` is the user-facing entry: it builds a :class:`~optim.ga.problem.TimingProblem`,
 solves it with the GA of this package (``method="ga"``) or with the deterministic
 scaling-law optimiser (``method="exact"``), verifies the answer with planning's exact
 peaks, and never returns an infeasible timing (it raises :class:`InfeasibleProblem`).
@@ -158,7 +158,7 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
         polish: GA only: refine the GA's (rescaled) answer by a local gradient method
-            (SLSQP from it, :func:`optim.exact.polish_durations`) and keep the better of
+            (SLSQP from it, :func:`optim.timing.exact.polish_durations`) and keep the better of
             the two; the result's method is then ``"ga+polish"`` and the GA's own total is
             kept in ``unpolished_total``. Off by default: the default answer is the GA's.
         initial: GA only: (k, m) durations put into the initial population (e.g. the

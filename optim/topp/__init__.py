@@ -9,7 +9,6 @@
   :mod:`.time_law` (s(t) as a piecewise polynomial, its smoothing, q(s(t)) composed exactly);
 - :mod:`.row_bounds`: the rows as bounds on the state, pruned and laid out for the profile's loops.
 
-The old path ``pinarms.optim.path_timing`` keeps working (the same module object).
 """
 
 from . import profile as _profile

@@ -98,7 +98,7 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
     Example: pinarms line aubo_i3 --from 350 200 0 --to 350 200 300 --mm --amax 7 --vtool 500
     """
     from pinarms import optim, planning
-    from pinarms.robots.layout import default_orientation
+    from pinarms.robots.reach.layout import default_orientation
 
     arm = load_robot(robot)
     lu = length_scale(mm)

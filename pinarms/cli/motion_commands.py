@@ -100,7 +100,7 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
         units = np.array([angle_scale(deg) if u == "rad" else lu for u in arm.robot.joint_units])
         q0 = q0 * units
     elif start is not None:
-        from pinarms.robots.layout import default_orientation
+        from pinarms.robots.reach.layout import default_orientation
 
         T0 = _pose(start, "--from", mm, deg, arm.base_to_world[:3, :3] @ default_orientation(arm.robot))
         checker = MotionChecker(c, [arm.name], margin=margin_m)

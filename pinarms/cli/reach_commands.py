@@ -39,7 +39,7 @@ def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: 
     Closed-form arms get every branch; any other URDF the seeded numerical solver. The index of a
     voxel is the fraction of orientations (or tool-down directions) reached.
     """
-    from pinarms.robots.reachability import reachability_map
+    from pinarms.robots.reach.reachability import reachability_map
 
     arm = load_robot(robot)
     res = parse_length(resolution, "--resolution")

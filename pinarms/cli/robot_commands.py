@@ -282,7 +282,7 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
                   voxel_mm: float | None, scheduler: str | None, as_json: bool) -> None:
     """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region.
 
-    The region is robots.placement.recommend_region's radial band on the working side of
+    The region is robots.reach.placement.recommend_region's radial band on the working side of
     the base plane (distances in the JSON in metres). With --stream the samples are
     reduced in tasks of 2e6 (serially, or on Dask with --scheduler) and never held.
     """
@@ -290,8 +290,8 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     if stream:
         _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json)
         return
-    from pinarms.robots.placement import recommend_region
-    from pinarms.robots.workspace import sample_workspace
+    from pinarms.robots.reach.placement import recommend_region
+    from pinarms.robots.reach.workspace import sample_workspace
 
     # a million samples take about a second: a bar from there on
     with common.progress_bar("workspace samples", n, as_json or n < 1_000_000) as bar:
@@ -327,7 +327,7 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
 
 def _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json) -> None:
     from pinarms.execution import describe_scheduler
-    from pinarms.robots.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import stream_workspace
 
     with common.progress_bar("workspace tasks", None, as_json) as bar:
         res = stream_workspace(arm, n, seed=seed, frame=frame,
@@ -373,7 +373,7 @@ def layout_cmd(robot: str, xyz: tuple[float, ...], mm: bool, names: str | None, 
     fewer). An unreachable point is reported, not an error (exit status 0).
     """
     arm = load_robot(robot)
-    from pinarms.robots.workspace import sample_workspace
+    from pinarms.robots.reach.workspace import sample_workspace
 
     values = vectors_from_args(xyz)
     if values.size % 3:

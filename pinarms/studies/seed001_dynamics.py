@@ -93,7 +93,7 @@ def _tool_down_band(arm: Any, quick: bool) -> tuple[list[Row], Any, Callable[[Pa
     tool-down reachability map of the tcp (15° cone, roll free; coarse voxels to stay fast).
 
     ``quick`` is accepted for symmetry with the other helpers; the map is the same either way."""
-    from pinarms.robots.reachability import reachability_map
+    from pinarms.robots.reach.reachability import reachability_map
 
     paper = SEED001
     res = 0.06  # the same map in quick and full runs (about 4 s on one core): the rows are reproducible

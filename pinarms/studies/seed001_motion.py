@@ -98,7 +98,7 @@ def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
     rows.append(Row("001", f"{what}: best picks/min", None, res.best_picks_per_minute, "1/min", None,
                     f"base moved by ({x / MM:.0f}, {y / MM:.0f}) mm; {int(res.ok.sum())} of {len(cand)} run the cycle; "
                     + cycle_note))
-    from pinarms.optim.layout_search import points_in_base_frame
+    from pinarms.optim.layout.search import points_in_base_frame
 
     b = points_in_base_frame(np.vstack([pick, place]), res.best_placement[None])[0]
     r = np.linalg.norm(b - np.array([0.0, 0.0, 0.16]), axis=1) / MM

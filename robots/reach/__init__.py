@@ -15,8 +15,7 @@
   checked by exact IK in :mod:`.base_verify`), :mod:`.placement` (the recommended table
   band), :mod:`.layout` (checking a station's layout).
 
-The public names are re-exported by :mod:`pinarms.robots`; the old paths
-(``pinarms.robots.workspace``, ...) keep working.
+The public names are re-exported by :mod:`pinarms.robots` (old module paths: docs/README.md).
 """
 
 __all__: list[str] = []

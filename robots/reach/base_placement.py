@@ -4,7 +4,7 @@ The arm's base stands on a plane at height ``z`` [m] (world frame), at ``(x, y)`
 ``ψ`` about the vertical: ``T_base_to_world = Trans(x, y, z) · Rz(ψ)``. A task pose
 ``T_task`` (tool frame → world) is, seen from that base, ``T_b = T_base_to_worldᵀ⁻¹ · T_task``.
 
-:func:`base_placements` answers with the inverse of a :class:`~robots.reachability.ReachabilityMap`
+:func:`base_placements` answers with the inverse of a :class:`~robots.reach.reachability.ReachabilityMap`
 restricted to bases on the plane:
 
 1. **Candidates.** A grid of ``(x, y) = (i, j)·xy_step`` (default step: the map's resolution)
@@ -59,7 +59,7 @@ _DOWN = np.array([0.0, 0.0, -1.0])
 def tool_down_poses(points: Any, tool_axis: Any = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Task poses ``(N, 4, 4)`` at ``points (N, 3)`` [m] with ``tool_axis`` (tool frame) pointing straight down.
 
-    Roll zero as in :func:`robots.orientations.tool_axis_orientations` (a fixed rotation taking
+    Roll zero as in :func:`robots.reach.orientations.tool_axis_orientations` (a fixed rotation taking
     the tool axis to ``(0, 0, −1)``); a roll-free task ignores it.
     """
     P = _as_points(points)

@@ -1,7 +1,7 @@
 """Where to place the pick/place tables: a radial band of the sampled workspace.
 
 :func:`recommend_region` derives the band from the samples of a
-:class:`~robots.workspace.Workspace` with three criteria, all evaluated per radial shell
+:class:`~robots.reach.workspace.Workspace` with three criteria, all evaluated per radial shell
 (width ``width``) around the workspace's outer-hull sphere centre (``about="centre"``) or
 around the base's vertical axis (``about="axis"``):
 

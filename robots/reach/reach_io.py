@@ -29,8 +29,8 @@ numbers are needed, indices out of range, a rotation that is not a rotation, an 
 does not follow from the reached bits, or a stored solution outside the joint limits all
 raise :class:`ReachabilityFileError` naming the member and the problem.
 
-The HDF5 library runs in a child process (:mod:`robots._reach_worker`, started by
-:mod:`robots._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
+The HDF5 library runs in a child process (:mod:`robots.reach._reach_worker`, started by
+:mod:`robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
 wall-clock time (``timeout`` for opening the file and checking its layout, then 1 s per
 20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before it
 opens the map the child walls itself in (Landlock, :mod:`robots._sandbox`): it may read

@@ -19,7 +19,7 @@ A sample is *near-singular* when its inverse condition is below
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
 The dexterity measures are computed by :mod:`robots.reach.dexterity` (``position_dexterity`` is
-re-exported here). Where the tables should stand is :func:`robots.placement.recommend_region` (the module above
+re-exported here). Where the tables should stand is :func:`robots.reach.placement.recommend_region` (the module above
 this one: placement imports workspace, never the other way).
 """
 
@@ -258,9 +258,9 @@ class Workspace:
         )
 
     def voxel_map(self, voxel_size: float | None = None, *, min_count: int = 1) -> "VoxelMap":
-        """Voxel reachability map of the samples (see :class:`robots.voxels.VoxelMap`).
+        """Voxel reachability map of the samples (see :class:`robots.reach.voxels.VoxelMap`).
 
-        ``voxel_size`` [m]; default: :func:`robots.voxels.suggest_voxel_size` (about 10
+        ``voxel_size`` [m]; default: :func:`robots.reach.voxels.suggest_voxel_size` (about 10
         samples per reachable voxel, so that chance holes do not fake a boundary).
         """
         if voxel_size is None:
@@ -285,7 +285,7 @@ def sample_workspace(
         robot: any :class:`~robots.robot.Robot`.
         n: number of samples (> 0, at most ``MAX_RANDOM_SAMPLES`` = 5·10⁷ in one call). 10⁶ samples
             take about 100 MB; for 10⁸ and more use
-            :func:`robots.workspace_stream.stream_workspace` (reductions only, flat memory).
+            :func:`robots.reach.workspace_stream.stream_workspace` (reductions only, flat memory).
         seed: seed or ``numpy.random.Generator``; the same seed gives the same samples
             (``q`` equals ``robot.random_q(n, seed)``).
         frame: frame whose origin is sampled (``"tcp"`` = the robot's tool frame).

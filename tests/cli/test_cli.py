@@ -341,8 +341,8 @@ def test_bad_csv_names_row_and_column(run, tmp_path):
 
 
 def test_workspace_prints_the_recommended_table_region(run):
-    from pinarms.robots.placement import recommend_region
-    from pinarms.robots.workspace import sample_workspace
+    from pinarms.robots.reach.placement import recommend_region
+    from pinarms.robots.reach.workspace import sample_workspace
 
     data = as_json(run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange", "--json"))
     region = recommend_region(sample_workspace(robots.load("aubo_i3"), n=3000, seed=0, frame="flange"))
@@ -386,7 +386,7 @@ def test_one_column_json_via_file_plans(run, tmp_path):
 
 
 def test_layout_reports_reachable_and_unreachable_points(run):
-    from pinarms.robots.workspace import sample_workspace
+    from pinarms.robots.reach.workspace import sample_workspace
 
     arm = robots.load("aubo_i3")
     result = run("layout", "aubo_i3", "0.3", "0.2", "0.2", "10", "0", "0", "-n", "5000", "--seed", "2", "--json")

@@ -66,7 +66,7 @@ def test_bad_ranges_are_usage_errors():
 
 
 def test_workspace_stream_option(tmp_path):
-    from pinarms.robots.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import stream_workspace
 
     out = tmp_path / "voxels.pinarms"
     result = CliRunner().invoke(cli, ["workspace", "aubo_i3", "-n", "60000", "--stream", "--voxel", "50",

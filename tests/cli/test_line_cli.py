@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 from pinarms import optim, planning, robots, viz
 from pinarms.cli import cli
-from pinarms.robots.layout import default_orientation
+from pinarms.robots.reach.layout import default_orientation
 
 
 def invoke(*args: str):

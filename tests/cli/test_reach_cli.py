@@ -9,8 +9,8 @@ from click.testing import CliRunner
 
 from pinarms import robots, viz
 from pinarms.cli import cli
-from pinarms.robots.reach_io import load_reachability
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.reach_io import load_reachability
+from pinarms.robots.reach.reachability import reachability_map
 
 
 def invoke(*args: str):

@@ -14,8 +14,8 @@ import pytest
 
 from fuzz_support import EXPLORE, assert_finite
 from pinarms import robots
-from pinarms.robots.reach_io import DEFAULT_TIMEOUT, ReachabilityFileError, load_reachability, save_reachability
-from pinarms.robots.reachability import ReachabilityMap, reachability_map
+from pinarms.robots.reach.reach_io import DEFAULT_TIMEOUT, ReachabilityFileError, load_reachability, save_reachability
+from pinarms.robots.reach.reachability import ReachabilityMap, reachability_map
 
 N_FLIPS = 24 * EXPLORE  # anywhere in the file
 N_HEAD_FLIPS = 10 * EXPLORE  # in the first 4 kB: superblock, object headers, B-trees, the global heap

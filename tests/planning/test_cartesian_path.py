@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.planning import (CartesianPath, JointLimitOnPath, PathError, SingularityOnPath, UnreachableOnPath,
                               cartesian_path, joint_spline)
-from pinarms.robots.layout import default_orientation
+from pinarms.robots.reach.layout import default_orientation
 
 
 def pose(R, p):

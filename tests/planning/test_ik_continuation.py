@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.planning import cartesian_path, tool_path
 from pinarms.planning.ik_continuation import MAX_JOINT_STEP, PathSolver, Stop, continue_to, solve_knots
-from pinarms.robots.layout import default_orientation
+from pinarms.robots.reach.layout import default_orientation
 
 
 def pose(R, p):

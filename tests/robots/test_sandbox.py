@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots import _reach_child, reach_io
-from pinarms.robots.reach_io import load_reachability, save_reachability
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach import _reach_child, reach_io
+from pinarms.robots.reach.reach_io import load_reachability, save_reachability
+from pinarms.robots.reach.reachability import reachability_map
 
 WORKER = _reach_child._WORKER
 SECRET = "not for the reader\n"
@@ -173,7 +173,7 @@ def test_a_whole_load_with_landlock_made_unavailable(monkeypatch, tmp_path, smal
 def test_a_map_that_is_not_a_regular_file_is_refused_before_h5py_opens_it(tmp_path):
     fifo = tmp_path / "map.h5"
     os.mkfifo(fifo)
-    from pinarms.robots._reach_worker import Refused, enter_wall
+    from pinarms.robots.reach._reach_worker import Refused, enter_wall
 
     with pytest.raises(Refused, match="not a regular file"):
         enter_wall(str(fifo))

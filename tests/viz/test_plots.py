@@ -136,7 +136,7 @@ def test_tool_speed_plot_of_a_straight_lift_and_its_joint_curves(tmp_path):
     from pathlib import Path
 
     from pinarms import optim, robots
-    from pinarms.robots.layout import default_orientation
+    from pinarms.robots.reach.layout import default_orientation
 
     arm = robots.load("aubo_i3")
     poses = np.stack([np.eye(4), np.eye(4)])

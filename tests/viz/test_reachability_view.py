@@ -9,7 +9,7 @@ import pytest
 
 from pinarms import robots, viz
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.reachability import reachability_map
 from pinarms.viz.errors import SessionFormatError
 
 CHROMIUM = "/usr/bin/chromium"

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from pinarms.optim import adaptive, crossover, mutation, selection
-from pinarms.optim.constraints import AdaptivePenalty, rank_feasibility_rules, rank_penalty, violation
+from pinarms.optim.ga import adaptive, crossover, mutation, selection
+from pinarms.optim.ga.constraints import AdaptivePenalty, rank_feasibility_rules, rank_penalty, violation
 
 LOWER = np.array([0.0, -1.0, 10.0])
 UPPER = np.array([1.0, 1.0, 20.0])

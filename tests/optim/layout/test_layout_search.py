@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import optim, robots
-from pinarms.optim.layout_search import base_to_world, grid_candidates, random_candidates, search_layout
+from pinarms.optim.layout.search import base_to_world, grid_candidates, random_candidates, search_layout
 from pinarms.robots.errors import InvalidInput
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on

@@ -5,7 +5,7 @@ import pytest
 
 from pinarms import scenarios
 from pinarms.optim import GASettings, TimingProblem, minimize_time
-from pinarms.optim.exact import polish_durations
+from pinarms.optim.timing.exact import polish_durations
 from tests.optim.helpers import dense_peaks
 
 S0 = scenarios.seed000()

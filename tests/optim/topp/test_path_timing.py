@@ -11,7 +11,7 @@ from pinarms.optim.topp import topp_profile
 from pinarms.planning import (JointAccelerationConstraint, JointLimits, JointVelocityConstraint, PathRows,
                               PathSamples, ToolAccelerationConstraint, ToolSpeedConstraint, Trajectory,
                               cartesian_path, from_definition, joint_spline, tcp_speed)
-from pinarms.robots.layout import default_orientation
+from pinarms.robots.reach.layout import default_orientation
 
 
 def pose(R, p):

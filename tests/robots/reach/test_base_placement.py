@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.base_placement import base_placements, tool_down_poses
+from pinarms.robots.reach.base_placement import base_placements, tool_down_poses
 from pinarms.robots.errors import InvalidInput, ModelError
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.reachability import reachability_map
 
 
 @pytest.fixture(scope="module")
@@ -45,7 +45,7 @@ def test_the_best_base_reaches_every_task_by_an_independent_ik(aubo, down_map):
 
 
 def _roll(T, axis, angle):
-    from pinarms.robots.orientations import _rotation_about
+    from pinarms.robots.reach.orientations import _rotation_about
 
     out = T.copy()
     out[:3, :3] = T[:3, :3] @ _rotation_about(np.asarray(axis, float), np.array([angle]))[0]

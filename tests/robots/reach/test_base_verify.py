@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.base_placement import tool_down_poses
+from pinarms.robots.reach.base_placement import tool_down_poses
 from pinarms.robots.reach.base_verify import verify_bases
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.reachability import reachability_map
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
 from pinarms.robots.reach.joint_samples import random_q_slice
-from pinarms.robots.workspace import sample_workspace
+from pinarms.robots.reach.workspace import sample_workspace
 
 
 @pytest.fixture(scope="module")

@@ -7,8 +7,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.layout import check_layout, default_orientation
-from pinarms.robots.workspace import sample_workspace
+from pinarms.robots.reach.layout import check_layout, default_orientation
+from pinarms.robots.reach.workspace import sample_workspace
 
 
 

@@ -14,8 +14,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.reach_io import ReachabilityFileError, load_reachability, save_reachability
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.reach_io import ReachabilityFileError, load_reachability, save_reachability
+from pinarms.robots.reach.reachability import reachability_map
 
 
 @pytest.fixture(scope="module")
@@ -299,7 +299,7 @@ def test_issue_29_hang_and_bombs_are_refused_by_name_within_5_s(saved, tmp_path,
 
 _MEASURE = """
 import json, resource, sys, time
-from pinarms.robots.reach_io import ReachabilityFileError, load_reachability
+from pinarms.robots.reach.reach_io import ReachabilityFileError, load_reachability
 def hwm():  # peak resident set of this process so far [MB]
     for line in open("/proc/self/status"):
         if line.startswith("VmHWM:"):
@@ -324,7 +324,7 @@ def test_the_hostile_maps_stay_under_500_mb_in_a_fresh_process(saved, tmp_path):
     paths = [str(_gcol_flip(saved, tmp_path)), str(_fill_bomb(saved, tmp_path)), str(_pose_rows_bomb(saved, tmp_path, False))]
     # a first import compiles and caches the package's numba kernels (hundreds of MB of LLVM work on a fresh
     # checkout): done once beforehand, so that the figure below is what loading the files costs
-    subprocess.run([sys.executable, "-c", "import pinarms.robots.reach_io"], check=True, timeout=600)
+    subprocess.run([sys.executable, "-c", "import pinarms.robots.reach.reach_io"], check=True, timeout=600)
     proc = subprocess.run([sys.executable, "-c", _MEASURE, *paths], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = json.loads(proc.stdout)
@@ -382,8 +382,8 @@ def test_timeout_is_checked(saved):
 
 
 def test_the_reader_process_runs_under_its_limits():
-    from pinarms.robots import reach_io
-    from pinarms.robots._reach_child import ReaderChild
+    from pinarms.robots.reach import reach_io
+    from pinarms.robots.reach._reach_child import ReaderChild
 
     with ReaderChild(reach_io.READER_MEMORY, 7) as child:
         assert child.frame(time.monotonic() + 60) == (b"R", 0)  # up, waiting for its request
@@ -404,8 +404,8 @@ def test_the_reader_process_runs_under_its_limits():
 ])
 def test_the_parent_checks_the_readers_answer_again(saved, edit, match):
     """A reader that libhdf5 let an attacker control could send anything: the manifest is checked again."""
-    from pinarms.robots import reach_io
-    from pinarms.robots._reach_worker import DATASETS
+    from pinarms.robots.reach import reach_io
+    from pinarms.robots.reach._reach_worker import DATASETS
 
     arrays = [{"name": n, "dtype": np.dtype(t).str, "shape": [{"nq": 6, "M": 8, "G": 8, "V": 428}.get(s, s) for s in shape]}
               for n, t, shape in DATASETS]

@@ -7,8 +7,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput, ModelError, UnreachableTarget
-from pinarms.robots.orientations import so3_orientations, tool_down_orientations
-from pinarms.robots.reachability import reachability_map
+from pinarms.robots.reach.orientations import so3_orientations, tool_down_orientations
+from pinarms.robots.reach.reachability import reachability_map
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.
@@ -152,7 +152,7 @@ def test_orientation_sets_are_spread_evenly():
     rng = np.random.default_rng(0)
     q = rng.normal(size=(50, 4))
     # a random set of the same size leaves bigger holes and nearly coincident members
-    from pinarms.robots.orientations import OrientationSet, _quat_to_matrix
+    from pinarms.robots.reach.orientations import OrientationSet, _quat_to_matrix
 
     R = _quat_to_matrix(q / np.linalg.norm(q, axis=1, keepdims=True))
     r = OrientationSet("so3", R, np.arange(50), 50, False, np.array([0, 0, 1.0]), R[:, :, 2].copy(), {}).spread(5000)

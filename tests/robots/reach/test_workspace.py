@@ -7,8 +7,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.placement import recommend_region
-from pinarms.robots.workspace import (
+from pinarms.robots.reach.placement import recommend_region
+from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,
     fit_sphere_to_hull,
@@ -199,7 +199,7 @@ def test_workspace_arrays_are_read_only(aubo):
 
 def test_default_voxel_size_keeps_the_interior_free_of_chance_holes(aubo):
     """2 cm voxels with 10⁵ samples leave half of the reachable points in empty voxels; the default does not."""
-    from pinarms.robots.voxels import suggest_voxel_size
+    from pinarms.robots.reach.voxels import suggest_voxel_size
 
     ws = sample_workspace(aubo, n=100_000, seed=0)
     vm = ws.voxel_map()
@@ -241,7 +241,7 @@ def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
 
 
 def test_direction_coverage_tells_a_ball_from_a_patch():
-    from pinarms.robots.workspace import direction_coverage
+    from pinarms.robots.reach.workspace import direction_coverage
 
     rng = np.random.default_rng(0)
     d = rng.normal(size=(20000, 3))

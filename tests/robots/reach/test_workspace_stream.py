@@ -7,8 +7,8 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.workspace import fit_sphere, hull_points, sample_workspace
-from pinarms.robots.workspace_stream import stream_workspace
+from pinarms.robots.reach.workspace import fit_sphere, hull_points, sample_workspace
+from pinarms.robots.reach.workspace_stream import stream_workspace
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.
