@@ -125,7 +125,16 @@ class CoalBatches:
             proven = self.cover.screen(Q, self._cover_pairs, self.pair_margin)
             tight = bool(proven.sum() >= 0.97 * clear.sum())
             self._shared["tight"] = tight
+            self._shared["share"] = float(proven.sum() / max(int(clear.sum()), 1))
         return tight
+
+    @property
+    def cover_share(self) -> float:
+        """Share of 256 seeded random configurations coal finds clear that the cover proves clear (0: no cover)."""
+        if self.cover is None or self.timed:
+            return 0.0
+        _ = self.cover_decides_screens
+        return float(self._shared["share"])
 
     @property
     def batch_loop(self) -> str | None:
