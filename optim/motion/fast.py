@@ -33,7 +33,7 @@ from pinarms.optim.motion.search import SearchResult
 __all__ = ["FastCheck", "fast_check", "fast_search", "fast_shortcut", "COMPILED_PLANNER", "TREE_NODES"]
 
 #: The planner named in results found by :func:`fast_search`.
-COMPILED_PLANNER = "RRTConnect (compiled, sphere cover)"
+COMPILED_PLANNER = "RRTConnect"
 #: Clearance above the margins [m] up to which the compiled check looks at pairs (the cell's
 #: ``pairs_for``): the excess bound is capped there, so an edge needs at least one state per
 #: ``2 · REACH`` of travel.

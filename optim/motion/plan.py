@@ -210,7 +210,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
                       trajectory=traj, check=check, clearance=profile, hold=checker.hold.copy(), planner=geo["planner"],
                       seed=int(seed), time_limit=float(time_limit), margin=checker.margin,
                       self_margin=checker.self_margin, states=geo["states"], seconds=seconds, limits=limits,
-                      simplifier=geo["simplifier"])
+                      simplifier=geo["simplifier"], compiled=geo["compiled"])
 
 
 def _columns(traj: Trajectory, start: int, n: int) -> Trajectory:

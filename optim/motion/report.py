@@ -103,6 +103,8 @@ class MotionPlan:
         planner, seed, time_limit, margin, self_margin: what was asked; ``states``: states the
             planner explored; ``seconds``: time per step (``"search"``, ``"shortcut"``,
             ``"smooth"``, ``"time"``, ``"check"``, ``"total"``); ``limits``: the limits timed under.
+        simplifier: what shortcut the path; compiled: whether the compiled search on the sphere
+            cover found it (:mod:`.fast`; else OMPL with the exact checker).
     """
 
     cell: Any = field(repr=False)
@@ -128,6 +130,7 @@ class MotionPlan:
     seconds: dict = field(repr=False)
     limits: dict = field(repr=False)
     simplifier: str = SIMPLIFIER
+    compiled: bool = False
 
     @property
     def duration(self) -> float:
@@ -175,6 +178,7 @@ class MotionPlan:
             "raw_length": self.raw_length,
             "path_length": self.path_length,
             "simplifier": self.simplifier,
+            "compiled_search": self.compiled,
             "smoothing": self.smoothing,
             "duration_s": self.duration,
             "timing": self.timing.as_dict(),
