@@ -54,11 +54,13 @@ def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
 
 
 @_jit
-def edge_proven(xa, xb, ea, eb, levers, min_budget, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
+def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
     """Whether the cover proves the straight edge ``xa → xb`` keeps every threshold (module docstring).
 
     ``ea``, ``eb``: ``E`` at the ends (computed by the caller). ``min_budget``: intervals of
-    less travel still unproven fail the edge (the finest level of the exact proof's ladder)."""
+    less travel still unproven fail the edge (the finest level of the exact proof's ladder);
+    so does an edge that needs more than ``max_states`` states (one that runs long close to
+    something: the search looks elsewhere, never calls it clear)."""
     if ea < 0.0 or eb < 0.0:
         return False
     T = 0.0
@@ -75,8 +77,9 @@ def edge_proven(xa, xb, ea, eb, levers, min_budget, hold, cols, fk, cov, grp, ca
         B = T * (fb - fa)
         if a + b >= B * (1.0 + 1e-9):
             continue
-        if B < min_budget:
+        if B < min_budget or max_states <= 0:
             return False
+        max_states -= 1
         fm = 0.5 * (fa + fb)
         for j in range(xa.shape[0]):
             xm[j] = xa[j] + fm * (xb[j] - xa[j])
@@ -108,8 +111,8 @@ def _nearest(nodes, count, x):
 
 
 @_jit
-def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_budget, hold, cols, fk, cov, grp, cap,
-            work, q, xm, xn, queue):
+def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold, cols, fk, cov,
+            grp, cap, work, q, xm, xn, queue):
     """One RRT step of tree ``t`` towards ``target``: ADVANCED, REACHED or TRAPPED (full tree: TRAPPED)."""
     count = counts[t]
     if count >= nodes.shape[1]:
@@ -126,8 +129,8 @@ def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_bu
     en = state_excess(xn, hold, cols, fk, cov, grp, cap, work, q)
     if en < 0.0:
         return TRAPPED
-    if not edge_proven(nodes[t, near], xn, energy[t, near], en, levers, min_budget, hold, cols, fk, cov, grp, cap, work,
-                       q, xm, queue):
+    if not edge_proven(nodes[t, near], xn, energy[t, near], en, levers, min_budget, max_states, hold, cols, fk, cov,
+                       grp, cap, work, q, xm, queue):
         return TRAPPED
     for j in range(target.shape[0]):
         nodes[t, count, j] = xn[j]
@@ -139,7 +142,7 @@ def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_bu
 
 @_jit
 def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, iterations, levers, min_budget,
-                hold, cols, fk, cov, grp, cap, work):
+                max_states, hold, cols, fk, cov, grp, cap, work):
     """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
 
     ``status (4,) int64``: [found, node of tree 0, node of tree 1, tree that grows next]; the
@@ -157,8 +160,8 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
         b = 1 - a
         for j in range(n):
             xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
-        s = _extend(a, nodes, parent, energy, counts, xr, step_range, levers, min_budget, hold, cols, fk, cov, grp,
-                    cap, work, q, xm, xn, queue)
+        s = _extend(a, nodes, parent, energy, counts, xr, step_range, levers, min_budget, max_states, hold, cols, fk,
+                    cov, grp, cap, work, q, xm, xn, queue)
         status[3] = b
         if s == TRAPPED:
             continue
@@ -167,8 +170,8 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
             target[j] = nodes[a, new_a, j]
         s = ADVANCED
         while s == ADVANCED:
-            s = _extend(b, nodes, parent, energy, counts, target, step_range, levers, min_budget, hold, cols, fk, cov,
-                        grp, cap, work, q, xm, xn, queue)
+            s = _extend(b, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold,
+                        cols, fk, cov, grp, cap, work, q, xm, xn, queue)
         if s == REACHED:
             status[0] = 1
             status[1 + a] = new_a
@@ -178,7 +181,7 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
 
 
 @_jit
-def path_proven(P, levers, min_budget, hold, cols, fk, cov, grp, cap, work):
+def path_proven(P, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Whether the cover proves every edge of the polyline ``P (M, n)``."""
     q = np.empty(hold.shape[0])
     xm = np.empty(P.shape[1])
@@ -186,8 +189,8 @@ def path_proven(P, levers, min_budget, hold, cols, fk, cov, grp, cap, work):
     ea = state_excess(P[0], hold, cols, fk, cov, grp, cap, work, q)
     for i in range(P.shape[0] - 1):
         eb = state_excess(P[i + 1], hold, cols, fk, cov, grp, cap, work, q)
-        if not edge_proven(P[i], P[i + 1], ea, eb, levers, min_budget, hold, cols, fk, cov, grp, cap, work, q, xm,
-                           queue):
+        if not edge_proven(P[i], P[i + 1], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap,
+                           work, q, xm, queue):
             return False
         ea = eb
     return True
@@ -218,7 +221,7 @@ def _point_at(P, s, m, length, out):
 
 
 @_jit
-def shortcut(P, m, rng, tries, levers, min_budget, hold, cols, fk, cov, grp, cap, work):
+def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Random shortcutting of the proven polyline ``P[:m]`` in place; returns its new vertex count.
 
     Each try joins two random points of the path (at random arc lengths) by a straight edge
@@ -245,7 +248,8 @@ def shortcut(P, m, rng, tries, levers, min_budget, hold, cols, fk, cov, grp, cap
             continue
         ea = state_excess(pa, hold, cols, fk, cov, grp, cap, work, q)
         eb = state_excess(pb, hold, cols, fk, cov, grp, cap, work, q)
-        if not edge_proven(pa, pb, ea, eb, levers, min_budget, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
+        if not edge_proven(pa, pb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm,
+                           queue):
             continue
         # P[:ka+1], pa, pb, P[kb+1:m]
         tail = m - (kb + 1)
@@ -264,7 +268,8 @@ def shortcut(P, m, rng, tries, levers, min_budget, hold, cols, fk, cov, grp, cap
     while i + 2 < m:
         ea = state_excess(P[i], hold, cols, fk, cov, grp, cap, work, q)
         eb = state_excess(P[i + 2], hold, cols, fk, cov, grp, cap, work, q)
-        if edge_proven(P[i], P[i + 2], ea, eb, levers, min_budget, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
+        if edge_proven(P[i], P[i + 2], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q,
+                       xm, queue):
             for k in range(i + 1, m - 1):
                 P[k] = P[k + 1]
             m -= 1

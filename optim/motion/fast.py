@@ -38,6 +38,10 @@ COMPILED_PLANNER = "RRTConnect"
 #: ``pairs_for``): the excess bound is capped there, so an edge needs at least one state per
 #: ``2 · REACH`` of travel.
 REACH = 0.25
+#: Most states one compiled edge proof takes before it gives up (the edge then counts as not proven):
+#: an edge running long within millimetres of something needs thousands (tens of ms); the search
+#: and the shortcutting look for others instead.
+EDGE_STATES = 400
 #: Most nodes per tree of the compiled search.
 TREE_NODES = 16384
 
@@ -46,14 +50,15 @@ class FastCheck:
     """The compiled cover check of ``checker`` (module docstring): states, edges and polylines.
 
     ``reach``: the cap of the excess bound [m] (default :data:`REACH`); the pairs of the cell
-    not proven farther apart than the margins plus ``reach`` are checked.
+    not proven farther apart than the margins plus ``reach`` are checked. ``max_states``: most
+    states one edge proof may take (default :data:`EDGE_STATES`).
 
     Raises:
         ValueError: a checker without a cover, or one with arms moving on their own
             trajectories (their checks stay with :meth:`MotionChecker.trajectory_valid`).
     """
 
-    def __init__(self, checker: Any, reach: float | None = None) -> None:
+    def __init__(self, checker: Any, reach: float | None = None, max_states: int | None = None) -> None:
         if checker.cover is None or checker.timed:
             raise ValueError("the compiled check needs a checker with the sphere cover and no moving arms")
         cover = checker.cover
@@ -75,6 +80,11 @@ class FastCheck:
         #: the pairs left out are proven farther apart than this above their margins [m]: E is capped there
         self.cap = reach
         self.min_budget = float(checker.step / 2.0 ** MAX_SPLITS)
+        #: states one edge proof may take before it gives up (not proven: never clear)
+        self.max_states = int(EDGE_STATES if max_states is None else max_states)
+        #: the kernels' arguments after the states: levers, finest budget, states per edge, the cell
+        self.args = (self.levers, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
+                     self.cap, self.work)
         self._q = np.empty(self.hold.size)
         self._xm = np.empty(checker.n)
         self._queue = np.empty((kernel.QUEUE, 4))
@@ -95,17 +105,15 @@ class FastCheck:
         xb = np.ascontiguousarray(xb, dtype=float)
         if not self.checker.within_limits(np.stack([xa, xb])).all():
             return False
-        return bool(kernel.edge_proven(xa, xb, self.excess(xa), self.excess(xb), self.levers, self.min_budget,
-                                       self.hold, self.cols, self.fk, self.cov, self.grp, self.cap, self.work,
-                                       self._q, self._xm, self._queue))
+        return bool(kernel.edge_proven(xa, xb, self.excess(xa), self.excess(xb), *self.args, self._q, self._xm,
+                                       self._queue))
 
     def path_proven(self, P: Any) -> bool:
         """Whether the cover proves every edge of the polyline ``P (M, n)``."""
         P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
         if not self.checker.within_limits(P).all():
             return False
-        return bool(kernel.path_proven(P, self.levers, self.min_budget, self.hold, self.cols, self.fk, self.cov,
-                                       self.grp, self.cap, self.work))
+        return bool(kernel.path_proven(P, *self.args))
 
 
 def fast_check(checker: Any) -> FastCheck | None:
@@ -158,7 +166,7 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     while time.perf_counter() < deadline and counts.min() < TREE_NODES:
         tc = time.perf_counter()
         found = kernel.rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, chunk,
-                                   fc.levers, fc.min_budget, fc.hold, fc.cols, fc.fk, fc.cov, fc.grp, fc.cap, fc.work)
+                                   *fc.args)
         if found:
             break
         spent = time.perf_counter() - tc
@@ -193,6 +201,5 @@ def fast_shortcut(checker: Any, path: Any, *, seed: int = 0, tries: int | None =
     k = int(tries) if tries is not None else max(32, 8 * P.shape[0])
     buf = np.zeros((P.shape[0] + k + 2, P.shape[1]))
     buf[: P.shape[0]] = P
-    m = kernel.shortcut(buf, P.shape[0], _rng(seed + 1), k, fc.levers, fc.min_budget, fc.hold, fc.cols, fc.fk, fc.cov,
-                        fc.grp, fc.cap, fc.work)
+    m = kernel.shortcut(buf, P.shape[0], _rng(seed + 1), k, *fc.args)
     return buf[:m].copy()
