@@ -3,9 +3,10 @@
 A state is the planned arms' joint vector ``x``; the cell configuration is ``hold`` with
 ``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
 (:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b``
-with travel bound ``T = Σ |Δx_j| ℓ_j`` is proven when every interval of a bisection has
+with travel bound ``T = Σ |Δx_j| ℓ_j`` is proven when every interval of a subdivision has
 ``E_a + E_b ≥ B`` (``B`` its travel: the excess is 1-Lipschitz in travel), all ``E ≥ 0``;
-intervals are taken first in, first out (the middle of the edge first, then its quarters:
+an interval not proven is halved (splitting at the middle of the stretch its ends do not
+prove instead checked as many states on the Panda scenes), and intervals are taken first in, first out (the middle of the edge first, then its quarters:
 an edge through an obstacle fails after a few states). The random numbers are a
 SplitMix64 stream held in an array: a search is the same for the same seed, whatever the
 chunks it is run in. Cached on disk like the cover's kernels.
@@ -45,8 +46,13 @@ def _uniform(rng):
 
 @_jit
 def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
-    """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0)."""
-    for i in range(hold.shape[0]):
+    """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0).
+
+    ``q``: scratch cell configuration ``(nq,)``, or ``(nq + 1,)`` whose last entry counts the calls."""
+    n = hold.shape[0]
+    if q.shape[0] > n:
+        q[n] += 1.0
+    for i in range(n):
         q[i] = hold[i]
     for j in range(cols.shape[0]):
         q[cols[j]] = x[j]
@@ -83,7 +89,8 @@ def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, 
         fm = 0.5 * (fa + fb)
         for j in range(xa.shape[0]):
             xm[j] = xa[j] + fm * (xb[j] - xa[j])
-        em = state_excess(xm, hold, cols, fk, cov, grp, c, work, q)
+        # E at the new state is needed up to the larger half's travel, no more (a smaller cap prunes more pairs)
+        em = state_excess(xm, hold, cols, fk, cov, grp, min(c, T * max(fm - fa, fb - fm) + 1e-9), work, q)
         if em < 0.0:
             return False
         queue[tail, 0], queue[tail, 1], queue[tail, 2], queue[tail, 3] = fa, fm, a, em
@@ -145,11 +152,12 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
                 max_states, hold, cols, fk, cov, grp, cap, work):
     """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
 
-    ``status (4,) int64``: [found, node of tree 0, node of tree 1, tree that grows next]; the
+    ``status (5,) int64``: [found, node of tree 0, node of tree 1, tree that grows next, states
+    checked so far]; the
     trees ``nodes (2, cap, n)``, ``parent``, ``energy`` (E of each node), ``counts`` are
     continued from call to call. Returns 1 when connected, 0 otherwise."""
     n = lower.shape[0]
-    q = np.empty(hold.shape[0])
+    q = np.zeros(hold.shape[0] + 1)  # the last entry counts the states checked: status[4]
     xm = np.empty(n)
     xn = np.empty(n)
     xr = np.empty(n)
@@ -176,7 +184,9 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
             status[0] = 1
             status[1 + a] = new_a
             status[1 + b] = counts[b] - 1
+            status[4] += int(q[hold.shape[0]])
             return 1
+    status[4] += int(q[hold.shape[0]])
     return 0
 
 

@@ -159,7 +159,7 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     for i, k in enumerate(keep):
         nodes[1, i], energy[1, i] = G[k], fc.excess(G[k])
     counts = np.array([1, len(keep)], dtype=np.int64)
-    status = np.zeros(4, dtype=np.int64)
+    status = np.zeros(5, dtype=np.int64)
     rng = _rng(seed)
     chunk, found = 1, 0
     deadline = t0 + float(time_limit)
@@ -175,11 +175,11 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     seconds = time.perf_counter() - t0
     states = int(counts.sum())
     if not found:
-        return SearchResult(None, states, seconds, COMPILED_PLANNER, -1, "Timeout")
+        return SearchResult(None, states, seconds, COMPILED_PLANNER, -1, f"Timeout ({int(status[4])} states checked)")
     path = np.concatenate([_branch(nodes[0], parent[0], int(status[1]))[::-1],
                            _branch(nodes[1], parent[1], int(status[2]))[1:]])
     gi = int(np.argmin(np.linalg.norm(G - path[-1], axis=1)))
-    return SearchResult(path, states, seconds, COMPILED_PLANNER, gi, "Exact solution")
+    return SearchResult(path, states, seconds, COMPILED_PLANNER, gi, f"Exact solution ({int(status[4])} states checked)")
 
 
 def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:

@@ -85,12 +85,12 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
 
 
 def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
-                  time_limit: float, seed: int, frame: str | None = None,
+                  time_limit: float, seed: int, frame: str | None = None, compiled: bool = True,
                   say: Callable[[str], None] = lambda _m: None) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
     Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
-    ``states``, ``seconds``, ``simplifier``, ``compiled``.
+    ``states``, ``seconds``, ``simplifier``, ``compiled``. ``compiled=False``: OMPL alone.
     """
     t_start = time.perf_counter()
     cell = checker.cell
@@ -102,7 +102,7 @@ def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any
                            "plan; give a goal different from the start")
     say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
     robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
-    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, say=say)
+    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled, say=say)
     t = time.perf_counter()
     path, method, _ = smooth_path(checker, found["simplified"], robot)
     if found["compiled"] and method != "cubic spline" and not _exact(checker, found["simplified"]):

@@ -119,10 +119,42 @@ def time_path(path: JointPath, constraints: Sequence[Any], grid: int = 200) -> A
 
 
 # ------------------------------------------------------------------ the planner
+def _check_settings(planner: Any, time_limit: Any, seed: Any, grid: Any) -> str:
+    key = str(planner).lower()
+    if key not in PLANNERS:
+        raise InvalidSettings(f"unknown planner {planner!r}; use one of {', '.join(PLANNERS)}")
+    ok = isinstance(time_limit, (int, float, np.integer, np.floating)) and not isinstance(time_limit, bool)
+    if not ok or not np.isfinite(float(time_limit)) or float(time_limit) <= 0.0:
+        raise InvalidSettings(f"time_limit must be a positive number of seconds, got {time_limit!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InvalidSettings(f"seed must be an integer, got {seed!r}")
+    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 1 <= int(grid) <= MAX_GRID:
+        raise InvalidSettings(f"grid must be an integer from 1 to {MAX_GRID} (intervals of the time scaling; "
+                              f"about 5.5 kB each), got {grid!r}")
+    return key
+
+
+def _recheck(cell: Any, arms: tuple[str, ...], checker: MotionChecker, traj: Trajectory) -> tuple[Any, Any]:
+    """The cell's own continuous check of the timed motion (contact-free must be proven) and its clearance profile."""
+    from pinarms.optim.errors import PlanningError
+    from pinarms.robots.cell.motion import ArmMotion
+
+    motions = []
+    start_col = 0
+    for a in arms:
+        n = cell.arm(a).nq
+        motions.append(ArmMotion(a, _columns(traj, start_col, n)))
+        start_col += n
+    check = cell.check_motion(motions, margin=checker.margin, clearance=0.0, hold=checker.hold)
+    if not check.collision_free:
+        raise PlanningError(f"the timed motion failed the cell's continuous check: {check.summary()}")
+    return check, clearance_profile(checker, traj)
+
+
 def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0.01, self_margin: float = 0.0,
                 planner: str = "rrtconnect", time_limit: float = 1.0, seed: int = 0, hold: Any = None,
                 frame: str | None = None, vmax: Any = None, amax: Any = None, torque: Any = True,
-                grid: int = 200, threads: int = 1,
+                grid: int = 200, threads: int = 1, compiled: bool = True, recheck: bool = True,
                 progress: Callable[[str], None] | None = None) -> MotionPlan:
     """Plan a collision-free move of ``arm`` from ``start`` to ``goal`` in ``cell`` (module docstring).
 
@@ -146,6 +178,11 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
             planned joint [N·m or N]; ``False``: none.
         grid: grid intervals of the time scaling (1 to :data:`MAX_GRID`).
         threads: threads of the batched collision checks (1 to :data:`optim.motion.checker.MAX_THREADS`).
+        compiled: search RRT-Connect compiled on the sphere cover first where it is tight
+            (:mod:`.geometry`); ``False``: OMPL with the exact checker alone, as before.
+        recheck: re-check the timed motion by the cell's own continuous check and report its
+            clearance profile (``False``: ``check`` and ``clearance`` are ``None``; the path is
+            proven by the exact checker either way).
         progress: called with a short line at each step.
 
     Raises:
@@ -162,24 +199,14 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     t_all = time.perf_counter()
     say = progress or (lambda _m: None)
     arms = _arms(cell, arm)
-    key = str(planner).lower()
-    if key not in PLANNERS:
-        raise InvalidSettings(f"unknown planner {planner!r}; use one of {', '.join(PLANNERS)}")
-    ok = isinstance(time_limit, (int, float, np.integer, np.floating)) and not isinstance(time_limit, bool)
-    if not ok or not np.isfinite(float(time_limit)) or float(time_limit) <= 0.0:
-        raise InvalidSettings(f"time_limit must be a positive number of seconds, got {time_limit!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise InvalidSettings(f"seed must be an integer, got {seed!r}")
+    key = _check_settings(planner, time_limit, seed, grid)
     threads = check_threads(threads)
-    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 1 <= int(grid) <= MAX_GRID:
-        raise InvalidSettings(f"grid must be an integer from 1 to {MAX_GRID} (intervals of the time scaling; "
-                              f"about 5.5 kB each), got {grid!r}")
     checker = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=hold, threads=threads)
     constraints, limits = _limits(cell, arms, vmax, amax, torque)
     x0 = _joints(cell, arms, start, "start")
     _check_start(checker, x0, "start")
     geo = plan_geometry(checker, arms, x0, goal, planner=key, time_limit=float(time_limit), seed=int(seed), frame=frame,
-                        say=say)
+                        compiled=bool(compiled), say=say)
     seconds = dict(geo["seconds"])
     path, method = geo["path"], geo["smoothing"]
     t = time.perf_counter()
@@ -187,22 +214,11 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     timing = time_path(path, constraints, grid)
     seconds["time"] = time.perf_counter() - t
     t = time.perf_counter()
-    say(f"timed: {timing.duration:.3f} s; checking the timed motion")
-    from pinarms.robots.cell.motion import ArmMotion
-
     traj = timing.trajectory
-    motions = []
-    start_col = 0
-    for a in arms:
-        n = cell.arm(a).nq
-        motions.append(ArmMotion(a, _columns(traj, start_col, n)))
-        start_col += n
-    check = cell.check_motion(motions, margin=checker.margin, clearance=0.0, hold=checker.hold)
-    if not check.collision_free:
-        from pinarms.optim.errors import PlanningError
-
-        raise PlanningError(f"the timed motion failed the cell's continuous check: {check.summary()}")
-    profile = clearance_profile(checker, traj)
+    check, profile = None, None
+    if recheck:
+        say(f"timed: {timing.duration:.3f} s; checking the timed motion")
+        check, profile = _recheck(cell, arms, checker, traj)
     seconds["check"] = time.perf_counter() - t
     seconds["total"] = time.perf_counter() - t_all
     return MotionPlan(cell=cell, arms=arms, start=x0, goal=geo["simplified"][-1], goals=tuple(geo["goals"]),

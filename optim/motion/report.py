@@ -97,8 +97,9 @@ class MotionPlan:
             ``"polyline with stops"``).
         timing: the :class:`optim.PathTiming`; ``trajectory``: the arms' joint trajectory
             (:class:`planning.Trajectory`, the planned arms' joints in order).
-        check: the cell's continuous check of the timed motion (:class:`robots.cell.MotionCheck`).
-        clearance: the distances along it (:class:`ClearanceProfile`).
+        check: the cell's continuous check of the timed motion (:class:`robots.cell.MotionCheck`;
+            ``None`` when planned with ``recheck=False``).
+        clearance: the distances along it (:class:`ClearanceProfile`; ``None`` likewise).
         hold: the cell configuration of the arms not planned.
         planner, seed, time_limit, margin, self_margin: what was asked; ``states``: states the
             planner explored; ``seconds``: time per step (``"search"``, ``"shortcut"``,
@@ -119,7 +120,7 @@ class MotionPlan:
     timing: Any = field(repr=False)
     trajectory: Trajectory = field(repr=False)
     check: Any = field(repr=False)
-    clearance: ClearanceProfile = field(repr=False)
+    clearance: ClearanceProfile | None = field(repr=False)
     hold: np.ndarray = field(repr=False)
     planner: str
     seed: int
@@ -183,11 +184,11 @@ class MotionPlan:
             "duration_s": self.duration,
             "timing": self.timing.as_dict(),
             "limits": {k: (None if v is None else np.asarray(v).tolist()) for k, v in self.limits.items()},
-            "collision_free": bool(self.check.collision_free),
-            "min_clearance_environment_m": c.min_environment,
-            "min_clearance_time_s": c.min_time,
-            "min_clearance_pair": None if c.min_pair is None else list(c.min_pair),
-            "min_clearance_own_links_m": c.min_own,
+            "collision_free": None if self.check is None else bool(self.check.collision_free),
+            "min_clearance_environment_m": None if c is None else c.min_environment,
+            "min_clearance_time_s": None if c is None else c.min_time,
+            "min_clearance_pair": None if c is None or c.min_pair is None else list(c.min_pair),
+            "min_clearance_own_links_m": None if c is None else c.min_own,
             "seconds": {k: round(v, 6) for k, v in self.seconds.items()},
         }
 
