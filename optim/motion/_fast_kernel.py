@@ -4,10 +4,11 @@ A state is the planned arms' joint vector ``x``; the cell configuration is ``hol
 ``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
 (:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b``
 with travel bound ``T = Σ |Δx_j| ℓ_j`` is proven when every interval of a subdivision has
-``E_a + E_b ≥ B`` (``B`` its travel: the excess is 1-Lipschitz in travel), all ``E ≥ 0``;
-an interval not proven is halved (splitting at the middle of the stretch its ends do not
-prove instead checked as many states on the Panda scenes), and intervals are taken first in, first out (the middle of the edge first, then its quarters:
-an edge through an obstacle fails after a few states). The random numbers are a
+``E_a + E_b ≥ B`` (``B`` its travel: the excess is 1-Lipschitz in travel), all ``E ≥ 0``.
+An interval not proven is halved (splitting at the middle of the stretch its ends do not
+prove instead checked as many states on the Panda scenes); intervals are taken first in,
+first out (the middle of the edge first, then its quarters: an edge through an obstacle
+fails after a few states); the new state's ``E`` is capped at the larger half's travel. The random numbers are a
 SplitMix64 stream held in an array: a search is the same for the same seed, whatever the
 chunks it is run in. Cached on disk like the cover's kernels.
 """
