@@ -98,6 +98,13 @@ def test_plan_motion_searches_compiled_where_the_cover_is_tight(table):
     plan = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold)
     assert plan.compiled and plan.planner == "RRTConnect" and plan.as_dict()["compiled_search"]
     assert plan.check.collision_free and plan.clearance.min_environment >= MARGIN
+    quick = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
+                        recheck=False)
+    assert np.array_equal(quick.simplified, plan.simplified)  # the same seed, the same path
+    assert quick.check is None and quick.clearance is None and quick.as_dict()["collision_free"] is None
+    ompl = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
+                       compiled=False, recheck=False)
+    assert not ompl.compiled and ompl.simplifier.startswith("OMPL")
     ur5 = load_scene("ur5_table_box")
     checker = MotionChecker(ur5, ["ur5"], margin=MARGIN)
     from pinarms.optim.motion.geometry import fast_share
