@@ -205,12 +205,12 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:
 
 def fast_shortcut(checker: Any, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
     """Random shortcutting of the cover-proven polyline ``path (M, n)`` on the compiled check (seeded;
-    ``tries`` default: 8 per vertex, at least 32), then every vertex dropped whose neighbours join."""
+    ``tries`` default: 16 and 2 per vertex), then every vertex dropped whose neighbours join."""
     fc = fast_check(checker)
     P = np.atleast_2d(np.asarray(path, dtype=float))
     if fc is None or P.shape[0] <= 2:
         return P.copy()
-    k = int(tries) if tries is not None else max(32, 8 * P.shape[0])
+    k = int(tries) if tries is not None else 16 + 2 * P.shape[0]
     buf = np.zeros((P.shape[0] + k + 2, P.shape[1]))
     buf[: P.shape[0]] = P
     m = kernel.shortcut(buf, P.shape[0], _rng(seed + 1), k, *fc.args)
