@@ -1,4 +1,4 @@
-"""Motion planning in cells: pinarms (OMPL + continuous proof) on seven scenes, pyroboplan beside it.
+"""Motion planning in cells: pinarms (compiled RRT-Connect or OMPL, proven) on seven scenes, pyroboplan beside it.
 
 For every planning scene (optim/motion/scene_files: shelf, table with a box, crate under a
 guard, two arms over one belt; Panda, UR5, AUBO-i3) the same seeded queries
@@ -7,8 +7,12 @@ regions, clear IK solutions) are planned with :func:`optim.plan_motion` (RRT-Con
 margin 10 mm, search time limit ``--time-limit``), and the table gives, per scene:
 
 * success within the time limit (the search), median and p95 search time;
-* median and p95 of the whole plan (search, shortcut, smoothing proven again, time-optimal
-  timing, the cell's own re-check and the clearance profile);
+* median and p95 of the whole plan (search, shortcut, smoothing proven again by the exact
+  checker, time-optimal timing), and with the cell's own re-check and the clearance profile
+  (``+recheck``); how many paths the compiled search found; the median of each step;
+* with ``--compare``, the same queries planned with OMPL and the exact checker alone
+  (``plan_motion(..., compiled=False)``: the planner before the compiled search), query by
+  query interleaved with the default, so that both see the same load;
 * path length in joint space after shortcutting (rad), and the trajectory duration (s,
   time-optimal under the URDF's velocity and torque limits);
 * the smallest clearance to fixtures / the other arm over all plans (must be >= margin).
