@@ -1,9 +1,14 @@
-"""Collision-free motion in a cell (OMPL), proven continuously, timed optimally (docs/motion.md).
+"""Collision-free motion in a cell (compiled RRT-Connect, else OMPL), proven continuously, timed optimally.
+
+See docs/motion.md.
 
 - :func:`plan_motion`: one arm (or two together) from a start to a goal joint vector or
   tool pose, every IK branch a goal; :class:`MotionPlan` (raw, shortcut and smooth paths,
   time-optimal :class:`planning.Trajectory`, the cell's re-check, the clearance profile).
-- :class:`MotionChecker`: state, edge and timed-motion validity (:mod:`.checker`).
+- :class:`MotionChecker`: state, edge and timed-motion validity (:mod:`.checker`), exact (coal
+  where the sphere cover is inconclusive); :func:`fast_check` its compiled side on the cover
+  alone (:class:`FastCheck`: states, edges, polylines proven or not, in µs), which
+  :func:`fast_search` (RRT-Connect) and :func:`fast_shortcut` run on (:mod:`.fast`).
 - :func:`plan_around` / :func:`plan_two_arms`: one arm around the other's timed
   trajectory, or both together (:mod:`.two_arms`).
 - :func:`planned_cycle`: the transfer ``plan_cycle(..., cell=)`` falls back to (:mod:`.cycle`).
@@ -12,6 +17,7 @@
 """
 
 from pinarms.optim.motion.checker import MotionChecker, TimedArm, Verdict
+from pinarms.optim.motion.fast import FastCheck, fast_check, fast_search, fast_shortcut
 from pinarms.optim.motion.goals import GoalCandidate
 from pinarms.optim.motion.plan import ClearanceProfile, MotionPlan, plan_motion
 from pinarms.optim.motion.scenes import SCENES, Query, Region, Scene, load_scene, scene_names, scene_path, scene_queries
@@ -20,5 +26,6 @@ from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, p
 from pinarms.optim.motion.cycle import PlannedMove, planned_cycle
 
 __all__ = ["plan_motion", "MotionPlan", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
+           "FastCheck", "fast_check", "fast_search", "fast_shortcut",
            "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names", "scene_path", "load_scene", "scene_queries",
            "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan", "planned_cycle", "PlannedMove"]

@@ -39,36 +39,19 @@ in rad or m; time in s.
 from __future__ import annotations
 
 import math
-import threading
-import time
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any, Sequence
 
 import numpy as np
 import pinocchio as pin
 
-from pinarms.optim.errors import InvalidSettings
+from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
+from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "check_threads"]
-
-#: Finest level of the proof: intervals of ``step / 2^MAX_SPLITS`` travel; still unproven there: invalid.
-MAX_SPLITS = 10
-#: An edge is first sampled up to ``2^COARSE_LEVELS`` steps apart (screens raised accordingly).
-COARSE_LEVELS = 3
-#: Configurations per coal batch while a deadline runs (the clock is read between two).
-COAL_CHUNK = 16
-
-
-class _GiveUp(Exception):
-    """A proof passed its checker's deadline."""
-
-
-#: Levels up to this one are screened by the sphere cover alone where it is tight
-#: (:attr:`MotionChecker.cover_decides_screens`); finer levels go to coal where it is inconclusive.
-COVER_LEVELS = 0
+__all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "COARSE_LEVELS", "check_threads",
+           "coarse_first"]
 
 
 @dataclass(frozen=True)
@@ -92,57 +75,8 @@ class TimedArm:
         return np.asarray(tr.sample(tau)[0], dtype=float).reshape(np.size(t), -1)
 
 
-@dataclass(frozen=True)
-class Verdict:
-    """What a proof over samples found: ``ok`` and, when not, the first failing sample (index, fraction)."""
 
-    ok: bool
-    first_bad: int = -1
-    fraction: float = 1.0
-    exact: int = 0
-
-
-def _cold(gd: pin.GeometryData) -> pin.GeometryData:
-    """Cold-started GJK (a cached guess from another configuration misses contacts between a
-    planner's far-apart samples: :mod:`robots.collision_requests`), exact distances."""
-    from pinarms.robots.collision_requests import cold_start
-
-    return cold_start(gd, distance_tolerance=1e-10)
-
-
-def _set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
-    for req, m in zip(gd.collisionRequests, margins):
-        req.security_margin = float(m)
-
-
-@lru_cache(maxsize=4096)
-def _coarse_first(n: int) -> np.ndarray:
-    order = _coarse_order(n)
-    order.flags.writeable = False
-    return order
-
-
-def coarse_first(n: int) -> np.ndarray:
-    """Indices 0..n ordered ends first, then midpoints of ever finer halvings (bit-reversed order)."""
-    return _coarse_first(int(n))
-
-
-def _coarse_order(n: int) -> np.ndarray:
-    """Indices 0..n ordered ends first, then midpoints of ever finer halvings (bit-reversed order)."""
-    if n <= 0:
-        return np.zeros(1, dtype=int)
-    bits = max(1, int(math.ceil(math.log2(n))))
-    k = np.arange(1 << bits)
-    rev = np.zeros_like(k)
-    for b in range(bits):
-        rev |= ((k >> b) & 1) << (bits - 1 - b)
-    inner = (rev * n) >> bits  # bit-reversed fractions of the interval, floored to samples
-    order = np.concatenate([[0, n], inner])
-    _, first = np.unique(order, return_index=True)
-    return order[np.sort(first)]
-
-
-class MotionChecker:
+class MotionChecker(CoalBatches, LadderProof):
     """State, edge and path validity of the planned arms of ``cell`` (module docstring).
 
     Args:
@@ -215,16 +149,16 @@ class MotionChecker:
         self.model = cell.model
         self.threads = check_threads(threads)
         self._data = self.model.createData()
-        shared = _shared(cell, self.pairs, self.pair_margin, self.threads)
+        shared = shared_coal(cell, self.pairs, self.pair_margin, self.threads)
         if "geometry" not in shared:
             gm = cell.collision_model.copy()
             gm.removeAllCollisionPairs()
             for p in self.pairs:
                 gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
-            gd = _cold(pin.GeometryData(gm))
-            _set_margins(gd, self.pair_margin)
+            gd = cold(pin.GeometryData(gm))
+            set_margins(gd, self.pair_margin)
             manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(self.model, gm, gd)
-            shared.update(geometry=gm, gd=gd, manager=manager, gd_dist=_cold(pin.GeometryData(gm)), pools={},
+            shared.update(geometry=gm, gd=gd, manager=manager, gd_dist=cold(pin.GeometryData(gm)), pools={},
                           loop=None)
         self._shared = shared
         self.geometry = shared["geometry"]
@@ -284,97 +218,6 @@ class MotionChecker:
         q = self.cell.random_q(3, seed=0)
         return bool(np.array_equal(self.cell.robot.q_to_pinocchio(q), q))
 
-    def _calibrate(self) -> str:
-        """The faster of Pinocchio's two batch loops for this geometry, timed once on a straight edge
-        between two random configurations (the verdicts are the same; only the speed differs):
-        ``"broad phase"`` (dynamic AABB tree: many geometries far apart) or ``"pairs"`` (every
-        checked pair in turn, stopping at the first contact: few pairs, or many overlapping
-        bounding boxes)."""
-        import time as _time
-
-        x = self.cell.random_q(2, seed=0)[:, self.cols]
-        if self.timed:
-            x = np.column_stack([x, np.zeros(2)])
-        Q = self.full(x[0] + np.linspace(0.0, 1.0, 96)[:, None] * (x[1] - x[0]))
-        qp = np.asfortranarray(self._to_pin(Q).T)
-        best, choice = np.inf, "broad phase"
-        for name in ("broad phase", "pairs"):
-            pool = self._make_pool(name, self.pair_margin)
-            pin.computeCollisionsInParallel(self.threads, pool, qp[:, :8], True, False)  # warm up
-            t0 = _time.perf_counter()
-            pin.computeCollisionsInParallel(self.threads, pool, qp, True, False)
-            dt = _time.perf_counter() - t0
-            if dt < best:
-                best, choice = dt, name
-        return choice
-
-    def _make_pool(self, kind: str, margins: np.ndarray):
-        if kind == "pairs":
-            pool = pin.GeometryPool(self.model, self.geometry, self.threads)
-        else:
-            pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.model, self.geometry, self.threads)
-        for gd in pool.getGeometryDatas():
-            _cold(gd)
-            _set_margins(gd, margins)
-        return pool
-
-    def _pool(self, which: Any):
-        pool = self._pools.get(which)
-        if pool is None:
-            if self._shared["loop"] is None:
-                self._shared["loop"] = self._calibrate()
-            extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
-            pool = self._make_pool(self._shared["loop"], self.pair_margin + extra)
-            self._pools[which] = pool
-        return pool
-
-    def warm(self, finest: int = 2) -> None:
-        """Build now what the proofs otherwise build on first use (coal's batch pools of the margins
-        and of the screens down to level ``finest``, the choice of batch loop, whether the cover
-        decides the coarse screens; kept for the next checker of this cell), so that a search's
-        clock measures the search."""
-        self._pool("margin")
-        for level in range(-COARSE_LEVELS, int(finest) + 1):
-            self._pool(level)
-        _ = self.cover_decides_screens
-
-    def _timed_out(self) -> bool:
-        """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
-        if self.deadline is None or time.perf_counter() <= self.deadline:
-            return False
-        self.counts["timeouts"] += 1
-        return True
-
-    @property
-    def cover_decides_screens(self) -> bool:
-        """Whether the cover is used, and then alone screens the coarse raised margins of the proof's
-        ladder (what it does not prove counts as not passing: the interval is split; the margins
-        themselves and the fine screens go to coal where it is inconclusive). Chosen once per
-        cell, pairs and margins: when the cover proves clear at least 97 % of 256 seeded random
-        configurations that coal finds clear (spheres and cylinders: the cover is nearly exact);
-        otherwise (meshes, the AUBO-i3 under the guard plate: 93.5 %) it would mostly add its
-        cost to coal's, and coal alone checks, as without the cover."""
-        if self.cover is None or self.timed:
-            return False
-        tight = self._shared.get("tight")
-        if tight is None:
-            X = self.cell.random_q(256, seed=0)[:, self.cols]
-            Q = self.full(X)
-            clear = ~self.coal_collides(Q, "margin")
-            proven = self.cover.screen(Q, self._cover_pairs, self.pair_margin)
-            tight = bool(proven.sum() >= 0.97 * clear.sum())
-            self._shared["tight"] = tight
-        return tight
-
-    @property
-    def batch_loop(self) -> str | None:
-        """Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see
-        :meth:`_calibrate`); ``None`` until the first batch."""
-        return self._shared["loop"]
-
-    def _to_pin(self, Q: np.ndarray) -> np.ndarray:
-        return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
-
     def full(self, X: Any) -> np.ndarray:
         """Cell configurations ``(N, nq)`` for planned states ``X (N, n[+1])`` (time last when timed)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
@@ -401,49 +244,6 @@ class MotionChecker:
         if self.cover_decides_screens and self.cover.screen(q[None], self._cover_pairs, self.pair_margin)[0]:
             return True
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
-
-    def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
-        """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
-        margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
-        stop at the first such row (the rows after it are then reported False)."""
-        Q = np.atleast_2d(Q)
-        out = np.zeros(Q.shape[0], dtype=bool)
-        rest = np.flatnonzero(~self.covered(Q, which))
-        out[rest] = self.coal_collides(Q[rest], which, stop)
-        return out
-
-    def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
-        """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
-        or of the margins + ``step / 2^(L+1)`` (``which = L``); False: left to coal."""
-        Q = np.atleast_2d(Q)
-        self.counts["configurations"] += Q.shape[0]
-        if Q.shape[0] == 0 or not self.cover_decides_screens:
-            return np.zeros(Q.shape[0], dtype=bool)
-        extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
-        return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
-
-    def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
-        """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
-        Q = np.atleast_2d(Q)
-        self.counts["coal"] += Q.shape[0]
-        if Q.shape[0] == 0:
-            return np.zeros(0, dtype=bool)
-        qp = np.asfortranarray(self._to_pin(Q).T)
-        pool = self._pool(which)
-        if self.deadline is None:
-            hit = pin.computeCollisionsInParallel(self.threads, pool, qp, True, bool(stop))
-            return np.asarray(hit, dtype=bool).reshape(-1)
-        out = np.zeros(Q.shape[0], dtype=bool)
-        for a in range(0, Q.shape[0], COAL_CHUNK):  # under a deadline: in chunks, looking at the clock
-            if self._timed_out():
-                raise _GiveUp
-            chunk = np.asfortranarray(qp[:, a:a + COAL_CHUNK])
-            hit = np.asarray(pin.computeCollisionsInParallel(self.threads, pool, chunk, True, bool(stop)),
-                             dtype=bool).reshape(-1)
-            out[a:a + hit.size] = hit
-            if stop and hit.any():
-                break
-        return out
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
@@ -492,106 +292,6 @@ class MotionChecker:
     def travel(self, xa: np.ndarray, xb: np.ndarray) -> float:
         """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
-
-    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
-        """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin (:meth:`_prove`);
-        past :attr:`deadline` the proof gives up: not valid."""
-        try:
-            return self._prove(X, budgets, midpoint, convex, top)
-        except _GiveUp:
-            return Verdict(False, -1, 0.0)
-
-    def _prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
-        """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin.
-
-        ``budgets (N-1,)``: travel bound [m] between consecutive samples (each ≤ ``step``);
-        ``midpoint(i, a, b, B) -> (x, B_left, B_right)``: the state between fractions ``a`` and
-        ``b`` of interval ``i`` (whose budget is ``B``) and the budgets of the two halves.
-        ``convex``: the samples lie on a straight edge between two states within the joint
-        limits (then every sample is within them: the limits box is convex). ``top``: the
-        level of the given samples (0: budgets ≤ ``step``; −k: budgets ≤ ``step · 2^k``).
-
-        The proof is a ladder of batched screens (module docstring): at level ``L`` an
-        interval's budget is at most ``step / 2^L`` and its two ends are screened with the
-        margins raised by ``s_L = step / 2^(L+1)``; both passing proves the interval (the
-        excess stays ``≥ (s_L + s_L − B)/2 ≥ 0``). An interval not proven is halved; a sample
-        closer than the margins themselves ends the proof (invalid), and so does an interval
-        still unproven at level :data:`MAX_SPLITS`.
-        """
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        N = X.shape[0]
-        if self._timed_out():
-            return Verdict(False, -1, 0.0)
-        if not convex:
-            inside = self.within_limits(X)
-            if not inside.all():
-                return Verdict(False, int(np.argmin(inside)), 0.0)
-        Q = self.full(X)
-        level = int(top)
-        order = coarse_first(N - 1)
-        order = order[~self.covered(Q[order], level)]  # what the cover leaves to coal, coarse-first
-        if order.size == 0:
-            return Verdict(True)
-        tight = self.cover_decides_screens and level <= COVER_LEVELS
-        flags = np.ones(order.size, dtype=bool) if tight else self.coal_collides(Q[order], level, stop=True)
-        if not flags.any():
-            return Verdict(True)
-        first = int(order[int(np.argmax(flags))])
-        if self.batch_collides(Q[first][None], "margin")[0]:
-            return Verdict(False, first)
-        hits = self.batch_collides(Q[order], "margin", stop=True)
-        if hits.any():
-            return Verdict(False, int(order[int(np.argmax(hits))]))
-        # every sample keeps the margins: prove the intervals between them, level by level
-        states = [x for x in X]
-        qs = [q for q in Q]
-        lb = np.full(N, self.step / 2.0 ** (level + 1))  # proven lower bound of each sample's excess
-        lb[order if tight else order[self.coal_collides(Q[order], level)]] = 0.0
-        # intervals: (left sample, right sample, budget, source interval, fraction a, fraction b)
-        todo = [(i, i + 1, float(budgets[i]), i, 0.0, 1.0) for i in range(N - 1)]
-        while True:
-            todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
-            if not todo:
-                return Verdict(True, exact=level)
-            if level >= MAX_SPLITS or self._timed_out():
-                i = todo[0][3]
-                return Verdict(False, i, todo[0][4], level)
-            level += 1
-            s_level = self.step / 2.0 ** (level + 1)
-            nxt = []
-            new_states = []
-            for a, b, B, src, fa, fb in todo:
-                xm, bl, br = midpoint(src, fa, fb, B)
-                m = len(states) + len(new_states)
-                new_states.append(np.asarray(xm, dtype=float))
-                fm = 0.5 * (fa + fb)
-                nxt.append((a, m, float(bl), src, fa, fm))
-                nxt.append((m, b, float(br), src, fm, fb))
-            Xm = np.array(new_states)
-            inside = self.within_limits(Xm)
-            if not inside.all():
-                k = int(np.argmin(inside))
-                return Verdict(False, todo[k][3], 0.5 * (todo[k][4] + todo[k][5]), level)
-            Qm = self.full(Xm)
-            states.extend(Xm)
-            qs.extend(Qm)
-            lb = np.concatenate([lb, np.full(len(new_states), -1.0)])
-            ends = sorted({k for iv in nxt for k in iv[:2] if lb[k] < s_level})
-            Qe = np.array([qs[k] for k in ends])
-            # the cover alone screens the coarse levels; coal has the last word on the fine ones
-            passed = self.covered(Qe, level) if tight and level <= COVER_LEVELS else ~self.batch_collides(Qe, level)
-            for k, ok in zip(ends, passed):
-                if ok:
-                    lb[k] = s_level
-            unknown = [k for k, ok in zip(ends, passed) if not ok and lb[k] < 0.0]
-            if unknown:
-                bad = self.batch_collides(np.array([qs[k] for k in unknown]), "margin")
-                if bad.any():
-                    k = unknown[int(np.argmax(bad))]
-                    iv = next(iv for iv in nxt if k in iv[:2])
-                    return Verdict(False, iv[3], iv[4], level)
-                lb[unknown] = 0.0
-            todo = nxt
 
     def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
         """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
@@ -681,56 +381,3 @@ class MotionChecker:
             tau = np.append(np.repeat(tau[:-1], extra) + k * np.repeat(np.diff(tau) / extra, extra), tau[-1])
             budgets = budget(tau[:-1], tau[1:])
         return self.prove(states(tau), budgets, midpoint)
-
-    def path_valid(self, X: np.ndarray) -> Verdict:
-        """A polyline through states ``X (M, dim)``: every edge :meth:`edge_valid`."""
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        for i in range(X.shape[0] - 1):
-            v = self.edge_valid(X[i], X[i + 1])
-            if not v.ok:
-                return Verdict(False, i, v.fraction, v.exact)
-        return Verdict(True)
-
-
-#: Most threads of Pinocchio's batch checks.
-MAX_THREADS = 256
-#: Checkers' coal data kept per cell (pairs, margins, threads, calling thread) before the oldest go.
-_SHARED_KEEP = 16
-
-
-def check_threads(threads: Any) -> int:
-    """``threads`` as an int in ``1..MAX_THREADS`` or :class:`InvalidSettings` (0 or fewer crash
-    Pinocchio's batch loop; huge counts overflow its argument)."""
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
-        raise InvalidSettings(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
-    if not 1 <= int(threads) <= MAX_THREADS:
-        raise InvalidSettings(f"threads must be from 1 to {MAX_THREADS} (threads of the batched collision checks), "
-                              f"got {int(threads)}")
-    return int(threads)
-
-
-_SHARED_LOCK = threading.Lock()
-
-
-def _shared(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
-    """coal data (geometry copy, GeometryData, broad phase, batch pools per screen level) shared by
-    the checkers of one cell with the same pairs, margins and thread count, made in the same
-    thread: making them costs tens of ms per checker (cold-starting every request)."""
-    key = (tuple((p.index_a, p.index_b) for p in pairs), margins.tobytes(), threads, threading.get_ident())
-    with _SHARED_LOCK:
-        store = cell.__dict__.setdefault("_motion_checker_shared", {})
-        entry = store.pop(key, None)
-        if entry is None:
-            entry = {}
-            while len(store) >= _SHARED_KEEP:
-                store.pop(next(iter(store)))
-        store[key] = entry  # most recently used last
-        return entry
-
-
-def check_settings(value: Any, name: str) -> float:
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    x = float(value) if ok else float("nan")
-    if not math.isfinite(x) or x <= 0.0:
-        raise InvalidSettings(f"{name} must be a positive number, got {value!r}")
-    return x

@@ -131,6 +131,10 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     ``g`` (``HW[g]``, ``hrad[g]``) first."""
     if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
+    if cyl[g] and exact[other] == 1:
+        k = sstart[g]
+        if _cylinder_box_gap(SA[k], SB[k], srad[k], FR[other], Fp[other], size[other]) > t:
+            return True
     for s in range(start[g], start[g + 1]):
         if exact[other] != 0:
             d = _shape_distance(W[s], exact[other], FR[other], Fp[other], size[other])
@@ -215,3 +219,124 @@ def _apart(HW, hrad, a, b, t):
     e1 = HW[a, 1] - HW[b, 1]
     e2 = HW[a, 2] - HW[b, 2]
     return reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach
+
+
+@_jit
+def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad, best):
+    """``min(best, lower bound of distance(g, other) − t)``: the cover spheres of ``g`` against ``other``
+    taken exactly (a static box, cylinder or sphere, or a moving cylinder); its bounding sphere first."""
+    if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] - t >= best:
+        return best
+    gap = -np.inf
+    if cyl[g] and exact[other] == 1:
+        k = sstart[g]
+        gap = _cylinder_box_gap(SA[k], SB[k], srad[k], FR[other], Fp[other], size[other]) - t
+        if gap >= best:
+            return best
+    low = np.inf
+    for s in range(start[g], start[g + 1]):
+        d = _exact_distance(W[s], other, exact, FR, Fp, size, SA, SB, srad, sstart) - radius[s] - t
+        if d < low:
+            low = d
+    return min(best, max(low, gap))
+
+
+@_jit
+def _cylinder_box_gap(a, b, r, FR, Fp, half):
+    """A lower bound [m] of the distance between the solid cylinder of axis ``a b`` and radius ``r`` and a
+    static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
+    projections on the box's three axes (a projection shortens every distance). Exact for a cylinder
+    standing upright over a box's face, where its spheres overshoot by nearly its radius."""
+    u0, u1, u2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    if L > 0.0:
+        u0, u1, u2 = u0 / L, u1 / L, u2 / L
+    gap = -np.inf
+    for i in range(3):
+        n0, n1, n2 = FR[0, i], FR[1, i], FR[2, i]
+        ca = (a[0] - Fp[0]) * n0 + (a[1] - Fp[1]) * n1 + (a[2] - Fp[2]) * n2
+        cb = (b[0] - Fp[0]) * n0 + (b[1] - Fp[1]) * n1 + (b[2] - Fp[2]) * n2
+        un = u0 * n0 + u1 * n1 + u2 * n2
+        rad = r * math.sqrt(max(1.0 - un * un, 0.0))
+        g = max(min(ca, cb) - rad - half[i], -half[i] - max(ca, cb) - rad)
+        if g > gap:
+            gap = g
+    return gap
+
+
+@_jit
+def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad, best):
+    """``min(best, lower bound of distance(ga, gb) − t)`` from the covers (:func:`_pair_clear`'s cases)."""
+    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
+        return _spheres_excess(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
+                               best)
+    if exact[ga] != 0 or cyl[ga]:
+        return _spheres_excess(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
+                               best)
+    for sa in range(start[ga], start[ga + 1]):
+        for sb in range(start[gb], start[gb + 1]):
+            rr = radius[sa] + radius[sb] + t
+            reach = best + rr
+            if reach <= 0.0:
+                continue
+            e0 = W[sa, 0] - W[sb, 0]
+            e1 = W[sa, 1] - W[sb, 1]
+            e2 = W[sa, 2] - W[sb, 2]
+            e = e0 * e0 + e1 * e1 + e2 * e2
+            if e < reach * reach:
+                best = math.sqrt(e) - rr
+    return best
+
+
+@_jit
+def _hd(HW, hrad, a, b):
+    e0 = HW[a, 0] - HW[b, 0]
+    e1 = HW[a, 1] - HW[b, 1]
+    e2 = HW[a, 2] - HW[b, 2]
+    return math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - hrad[a] - hrad[b]
+
+
+@_jit
+def excess_one(q, fk, cov, grp, cap, floor, work):
+    """A lower bound [m] of ``min_k (d_k − t_k)`` over the pairs of ``grp`` at cell configuration ``q``,
+    at most ``cap``; it returns early (some value below ``floor``) once the bound falls below ``floor``.
+
+    ``fk``: :meth:`Cover.fk`'s arrays; ``cov``: the cover's arrays (:meth:`Cover.kernel_arrays`);
+    ``grp``: the pair groups (:meth:`Cover.group_arrays`) with the thresholds ``t`` in their order;
+    ``work``: scratch arrays (:func:`excess_work`). The covers' distances are lower bounds of the
+    geometries' (the containment tests), so the result is a lower bound of the exact excess."""
+    parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
+    hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
+    R, p, W, SA, SB, HW = work
+    _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
+    _centers(R, p, joint, center, W)
+    _centers(R, p, sjoint, sa_local, SA)
+    _centers(R, p, sjoint, sb_local, SB)
+    _centers(R, p, hjoint, hcenter, HW)
+    best = cap
+    for g in range(group_t.shape[0]):
+        a = group_a[g]
+        if _hd(HW, hrad, a, group_b[g]) - group_t[g] >= best:
+            continue
+        fixed = group_fixed[g]
+        if fixed >= 0 and _shape_distance(HW[a], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) - hrad[a] \
+                - group_t[g] >= best:
+            continue
+        for k in range(group_start[g], group_start[g + 1]):
+            ga = pair_a[k]
+            gb = pair_b[k]
+            if _hd(HW, hrad, ga, gb) - t[k] >= best:
+                continue
+            best = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
+                                hrad, best)
+            if best < floor:
+                return best
+    return best
+
+
+@_jit
+def excess_kernel(Q, fk, cov, grp, cap, floor, work, out):
+    """:func:`excess_one` for every row of ``Q (N, nq)`` into ``out (N,)``."""
+    for i in range(Q.shape[0]):
+        out[i] = excess_one(Q[i], fk, cov, grp, cap, floor, work)

@@ -33,7 +33,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._cover_kernel import screen_kernel
+from ._cover_kernel import excess_kernel, screen_kernel
 
 __all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
            "MAX_SPHERES"]
@@ -227,6 +227,39 @@ class Cover:
                       self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
                       pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
                       pairs.pair_b, t, bool(stop), out)
+        return out
+
+    def kernel_arrays(self) -> tuple:
+        """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
+        return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
+                *self.segments)
+
+    def group_arrays(self, pairs: "PairSet", threshold: np.ndarray) -> tuple:
+        """The pair groups of ``pairs`` with their thresholds [m] (given in the pairs' order), for the kernels."""
+        t = np.ascontiguousarray(np.asarray(threshold, dtype=float)[pairs.order])
+        group_t = np.maximum.reduceat(t, pairs.group_start[:-1]) if t.size else np.zeros(0)
+        return (pairs.hjoint, pairs.hcenter, pairs.hrad, pairs.group_start, pairs.group_a, pairs.group_b,
+                pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t)
+
+    def work(self, pairs: "PairSet") -> tuple:
+        """Scratch arrays of one kernel call (joint frames, world centres)."""
+        nj = self.fk[0].shape[0]
+        return (np.empty((nj, 3, 3)), np.empty((nj, 3)), np.empty((self.joint.size, 3)),
+                np.empty((self.segments[0].size, 3)), np.empty((self.segments[0].size, 3)),
+                np.empty((pairs.hjoint.size, 3)))
+
+    def excess(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, cap: float = np.inf,
+               floor: float = -np.inf) -> np.ndarray:
+        """``(N,)`` lower bounds [m] of ``min_k (d_k − threshold_k)`` over ``pairs`` at cell configurations
+        ``Q`` (capped at ``cap``; a row whose bound falls below ``floor`` stops early with some value
+        below it). Positive: the cover proves every pair farther apart than its threshold."""
+        Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        out = np.empty(Q.shape[0])
+        if pairs.pair_a.size == 0:
+            out[:] = cap
+            return out
+        excess_kernel(Q, self.fk, self.kernel_arrays(), self.group_arrays(pairs, threshold), float(cap),
+                      float(floor), self.work(pairs), out)
         return out
 
 

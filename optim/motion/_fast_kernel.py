@@ -1,0 +1,289 @@
+"""Compiled parts of :mod:`.fast` (numba): the edge proof on the cover, RRT-Connect and shortcutting.
+
+A state is the planned arms' joint vector ``x``; the cell configuration is ``hold`` with
+``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
+(:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b``
+with travel bound ``T = Σ |Δx_j| ℓ_j`` is proven when every interval of a subdivision has
+``E_a + E_b ≥ B`` (``B`` its travel: the excess is 1-Lipschitz in travel), all ``E ≥ 0``.
+An interval not proven is halved (splitting at the middle of the stretch its ends do not
+prove instead checked as many states on the Panda scenes); intervals are taken first in,
+first out (the middle of the edge first, then its quarters: an edge through an obstacle
+fails after a few states); the new state's ``E`` is capped at the larger half's travel. The random numbers are a
+SplitMix64 stream held in an array: a search is the same for the same seed, whatever the
+chunks it is run in. Cached on disk like the cover's kernels.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from pinarms.robots.cell._cover_kernel import excess_one
+
+#: Most intervals waiting in one edge proof (more: the edge counts as not proven).
+QUEUE = 4096
+ADVANCED, REACHED, TRAPPED = 0, 1, 2
+
+
+def _jit(function):
+    try:
+        return njit(cache=True, nogil=True)(function)
+    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
+        return njit(nogil=True)(function)
+
+
+@_jit
+def _uniform(rng):
+    """The next number in [0, 1) of the SplitMix64 stream ``rng (1,) uint64``."""
+    rng[0] += np.uint64(0x9E3779B97F4A7C15)
+    z = rng[0]
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@_jit
+def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
+    """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0).
+
+    ``q``: scratch cell configuration ``(nq,)``, or ``(nq + 1,)`` whose last entry counts the calls."""
+    n = hold.shape[0]
+    if q.shape[0] > n:
+        q[n] += 1.0
+    for i in range(n):
+        q[i] = hold[i]
+    for j in range(cols.shape[0]):
+        q[cols[j]] = x[j]
+    return excess_one(q, fk, cov, grp, cap, 0.0, work)
+
+
+@_jit
+def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
+    """Whether the cover proves the straight edge ``xa → xb`` keeps every threshold (module docstring).
+
+    ``ea``, ``eb``: ``E`` at the ends (computed by the caller). ``min_budget``: intervals of
+    less travel still unproven fail the edge (the finest level of the exact proof's ladder);
+    so does an edge that needs more than ``max_states`` states (one that runs long close to
+    something: the search looks elsewhere, never calls it clear)."""
+    if ea < 0.0 or eb < 0.0:
+        return False
+    T = 0.0
+    for j in range(xa.shape[0]):
+        T += abs(xb[j] - xa[j]) * levers[j]
+    if ea + eb >= T * (1.0 + 1e-9):
+        return True
+    c = min(cap, 0.5 * T + 1e-9)
+    head, tail, n = 0, 1, queue.shape[0]
+    queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 1.0, ea, eb
+    while head != tail:
+        fa, fb, a, b = queue[head, 0], queue[head, 1], queue[head, 2], queue[head, 3]
+        head = (head + 1) % n
+        B = T * (fb - fa)
+        if a + b >= B * (1.0 + 1e-9):
+            continue
+        if B < min_budget or max_states <= 0:
+            return False
+        max_states -= 1
+        fm = 0.5 * (fa + fb)
+        for j in range(xa.shape[0]):
+            xm[j] = xa[j] + fm * (xb[j] - xa[j])
+        # E at the new state is needed up to the larger half's travel, no more (a smaller cap prunes more pairs)
+        em = state_excess(xm, hold, cols, fk, cov, grp, min(c, T * max(fm - fa, fb - fm) + 1e-9), work, q)
+        if em < 0.0:
+            return False
+        queue[tail, 0], queue[tail, 1], queue[tail, 2], queue[tail, 3] = fa, fm, a, em
+        tail = (tail + 1) % n
+        if tail == head:  # full: not proven (never called clear)
+            return False
+        queue[tail, 0], queue[tail, 1], queue[tail, 2], queue[tail, 3] = fm, fb, em, b
+        tail = (tail + 1) % n
+        if tail == head:
+            return False
+    return True
+
+
+@_jit
+def _nearest(nodes, count, x):
+    best, arg = np.inf, 0
+    for i in range(count):
+        d = 0.0
+        for j in range(x.shape[0]):
+            e = nodes[i, j] - x[j]
+            d += e * e
+        if d < best:
+            best, arg = d, i
+    return arg
+
+
+@_jit
+def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold, cols, fk, cov,
+            grp, cap, work, q, xm, xn, queue):
+    """One RRT step of tree ``t`` towards ``target``: ADVANCED, REACHED or TRAPPED (full tree: TRAPPED)."""
+    count = counts[t]
+    if count >= nodes.shape[1]:
+        return TRAPPED
+    near = _nearest(nodes[t], count, target)
+    d = 0.0
+    for j in range(target.shape[0]):
+        e = target[j] - nodes[t, near, j]
+        d += e * e
+    d = math.sqrt(d)
+    reach = d <= step_range
+    for j in range(target.shape[0]):
+        xn[j] = target[j] if reach else nodes[t, near, j] + (target[j] - nodes[t, near, j]) * (step_range / d)
+    en = state_excess(xn, hold, cols, fk, cov, grp, cap, work, q)
+    if en < 0.0:
+        return TRAPPED
+    if not edge_proven(nodes[t, near], xn, energy[t, near], en, levers, min_budget, max_states, hold, cols, fk, cov,
+                       grp, cap, work, q, xm, queue):
+        return TRAPPED
+    for j in range(target.shape[0]):
+        nodes[t, count, j] = xn[j]
+    parent[t, count] = near
+    energy[t, count] = en
+    counts[t] = count + 1
+    return REACHED if reach else ADVANCED
+
+
+@_jit
+def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, iterations, levers, min_budget,
+                max_states, hold, cols, fk, cov, grp, cap, work):
+    """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
+
+    ``status (5,) int64``: [found, node of tree 0, node of tree 1, tree that grows next, states
+    checked so far]; the
+    trees ``nodes (2, cap, n)``, ``parent``, ``energy`` (E of each node), ``counts`` are
+    continued from call to call. Returns 1 when connected, 0 otherwise."""
+    n = lower.shape[0]
+    q = np.zeros(hold.shape[0] + 1)  # the last entry counts the states checked: status[4]
+    xm = np.empty(n)
+    xn = np.empty(n)
+    xr = np.empty(n)
+    target = np.empty(n)
+    queue = np.empty((QUEUE, 4))
+    for _ in range(iterations):
+        a = status[3]
+        b = 1 - a
+        for j in range(n):
+            xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
+        s = _extend(a, nodes, parent, energy, counts, xr, step_range, levers, min_budget, max_states, hold, cols, fk,
+                    cov, grp, cap, work, q, xm, xn, queue)
+        status[3] = b
+        if s == TRAPPED:
+            continue
+        new_a = counts[a] - 1
+        for j in range(n):
+            target[j] = nodes[a, new_a, j]
+        s = ADVANCED
+        while s == ADVANCED:
+            s = _extend(b, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold,
+                        cols, fk, cov, grp, cap, work, q, xm, xn, queue)
+        if s == REACHED:
+            status[0] = 1
+            status[1 + a] = new_a
+            status[1 + b] = counts[b] - 1
+            status[4] += int(q[hold.shape[0]])
+            return 1
+    status[4] += int(q[hold.shape[0]])
+    return 0
+
+
+@_jit
+def path_proven(P, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
+    """Whether the cover proves every edge of the polyline ``P (M, n)``."""
+    q = np.empty(hold.shape[0])
+    xm = np.empty(P.shape[1])
+    queue = np.empty((QUEUE, 4))
+    ea = state_excess(P[0], hold, cols, fk, cov, grp, cap, work, q)
+    for i in range(P.shape[0] - 1):
+        eb = state_excess(P[i + 1], hold, cols, fk, cov, grp, cap, work, q)
+        if not edge_proven(P[i], P[i + 1], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap,
+                           work, q, xm, queue):
+            return False
+        ea = eb
+    return True
+
+
+@_jit
+def _cumulative(P, m, out):
+    out[0] = 0.0
+    for i in range(1, m):
+        d = 0.0
+        for j in range(P.shape[1]):
+            e = P[i, j] - P[i - 1, j]
+            d += e * e
+        out[i] = out[i - 1] + math.sqrt(d)
+
+
+@_jit
+def _point_at(P, s, m, length, out):
+    """The point at arc length ``length`` of the polyline's first ``m`` vertices; returns its segment."""
+    k = 0
+    while k < m - 2 and s[k + 1] < length:
+        k += 1
+    h = s[k + 1] - s[k]
+    f = 0.0 if h <= 0.0 else min(max((length - s[k]) / h, 0.0), 1.0)
+    for j in range(P.shape[1]):
+        out[j] = P[k, j] + f * (P[k + 1, j] - P[k, j])
+    return k
+
+
+@_jit
+def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
+    """Random shortcutting of the proven polyline ``P[:m]`` in place; returns its new vertex count.
+
+    Each try joins two random points of the path (at random arc lengths) by a straight edge
+    when the cover proves it and it is shorter than the stretch it replaces; then every
+    vertex is dropped whose neighbours join directly. ``P`` has room for ``m + 2 * tries``
+    rows."""
+    n = P.shape[1]
+    q = np.empty(hold.shape[0])
+    xm = np.empty(n)
+    pa = np.empty(n)
+    pb = np.empty(n)
+    queue = np.empty((QUEUE, 4))
+    s = np.empty(P.shape[0])
+    for _ in range(tries):
+        if m < 3:
+            break
+        _cumulative(P, m, s)
+        u, v = _uniform(rng) * s[m - 1], _uniform(rng) * s[m - 1]
+        if u > v:
+            u, v = v, u
+        ka = _point_at(P, s, m, u, pa)
+        kb = _point_at(P, s, m, v, pb)
+        if kb - ka < 1:  # on one segment: nothing to cut
+            continue
+        ea = state_excess(pa, hold, cols, fk, cov, grp, cap, work, q)
+        eb = state_excess(pb, hold, cols, fk, cov, grp, cap, work, q)
+        if not edge_proven(pa, pb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm,
+                           queue):
+            continue
+        # P[:ka+1], pa, pb, P[kb+1:m]
+        tail = m - (kb + 1)
+        shift = (ka + 3) - (kb + 1)
+        if shift > 0:
+            for i in range(m - 1, kb, -1):
+                P[i + shift] = P[i]
+        elif shift < 0:
+            for i in range(kb + 1, m):
+                P[i + shift] = P[i]
+        P[ka + 1] = pa
+        P[ka + 2] = pb
+        m = ka + 3 + tail
+    # drop vertices whose neighbours join directly
+    i = 0
+    while i + 2 < m:
+        ea = state_excess(P[i], hold, cols, fk, cov, grp, cap, work, q)
+        eb = state_excess(P[i + 2], hold, cols, fk, cov, grp, cap, work, q)
+        if edge_proven(P[i], P[i + 2], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q,
+                       xm, queue):
+            for k in range(i + 1, m - 1):
+                P[k] = P[k + 1]
+            m -= 1
+        else:
+            i += 1
+    return m

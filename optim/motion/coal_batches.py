@@ -1,0 +1,228 @@
+"""coal's side of a :class:`.checker.MotionChecker`: Pinocchio's batch loops, their pools per screen, the deadline.
+
+Every check first asks the sphere cover (:mod:`robots.cell.cover`); what it does not prove
+goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
+per screen level (the margins raised by ``step / 2^(L+1)``) and one at the margins
+themselves. The coal data (geometry copy, cold-started requests, pools) is shared by the
+checkers of one cell with the same pairs, margins and thread count made in the same thread
+(:func:`shared_coal`). Under a deadline the batches run in chunks of :data:`COAL_CHUNK`
+configurations, the clock read between two (:class:`.proof.GiveUp` past it).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from pinarms.optim.errors import InvalidSettings
+from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
+
+__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "check_threads", "shared_coal", "cold", "set_margins"]
+
+#: Configurations per coal batch while a deadline runs (the clock is read between two).
+COAL_CHUNK = 16
+
+
+def cold(gd: pin.GeometryData) -> pin.GeometryData:
+    """Cold-started GJK (a cached guess from another configuration misses contacts between a
+    planner's far-apart samples: :mod:`robots.collision_requests`), exact distances."""
+    from pinarms.robots.collision_requests import cold_start
+
+    return cold_start(gd, distance_tolerance=1e-10)
+
+
+def set_margins(gd: pin.GeometryData, margins: np.ndarray) -> None:
+    for req, m in zip(gd.collisionRequests, margins):
+        req.security_margin = float(m)
+
+
+
+class CoalBatches:
+    """Batched coal checks of a :class:`.checker.MotionChecker` (a mixin: the checker holds the cell, its
+    pairs and margins, the shared coal data, the cover and the deadline)."""
+
+    def _calibrate(self) -> str:
+        """The faster of Pinocchio's two batch loops for this geometry, timed once on a straight edge
+        between two random configurations (the verdicts are the same; only the speed differs):
+        ``"broad phase"`` (dynamic AABB tree: many geometries far apart) or ``"pairs"`` (every
+        checked pair in turn, stopping at the first contact: few pairs, or many overlapping
+        bounding boxes)."""
+        import time as _time
+
+        x = self.cell.random_q(2, seed=0)[:, self.cols]
+        if self.timed:
+            x = np.column_stack([x, np.zeros(2)])
+        Q = self.full(x[0] + np.linspace(0.0, 1.0, 96)[:, None] * (x[1] - x[0]))
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        best, choice = np.inf, "broad phase"
+        for name in ("broad phase", "pairs"):
+            pool = self._make_pool(name, self.pair_margin)
+            pin.computeCollisionsInParallel(self.threads, pool, qp[:, :8], True, False)  # warm up
+            t0 = _time.perf_counter()
+            pin.computeCollisionsInParallel(self.threads, pool, qp, True, False)
+            dt = _time.perf_counter() - t0
+            if dt < best:
+                best, choice = dt, name
+        return choice
+
+    def _make_pool(self, kind: str, margins: np.ndarray):
+        if kind == "pairs":
+            pool = pin.GeometryPool(self.model, self.geometry, self.threads)
+        else:
+            pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(self.model, self.geometry, self.threads)
+        for gd in pool.getGeometryDatas():
+            cold(gd)
+            set_margins(gd, margins)
+        return pool
+
+    def _pool(self, which: Any):
+        pool = self._pools.get(which)
+        if pool is None:
+            if self._shared["loop"] is None:
+                self._shared["loop"] = self._calibrate()
+            extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
+            pool = self._make_pool(self._shared["loop"], self.pair_margin + extra)
+            self._pools[which] = pool
+        return pool
+
+    def warm(self, finest: int = 2) -> None:
+        """Build now what the proofs otherwise build on first use (coal's batch pools of the margins
+        and of the screens down to level ``finest``, the choice of batch loop, whether the cover
+        decides the coarse screens; kept for the next checker of this cell), so that a search's
+        clock measures the search."""
+        self._pool("margin")
+        for level in range(-COARSE_LEVELS, int(finest) + 1):
+            self._pool(level)
+        _ = self.cover_decides_screens
+
+    def _timed_out(self) -> bool:
+        """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
+        if self.deadline is None or time.perf_counter() <= self.deadline:
+            return False
+        self.counts["timeouts"] += 1
+        return True
+
+    @property
+    def cover_decides_screens(self) -> bool:
+        """Whether the cover is used, and then alone screens the coarse raised margins of the proof's
+        ladder (what it does not prove counts as not passing: the interval is split; the margins
+        themselves and the fine screens go to coal where it is inconclusive). Chosen once per
+        cell, pairs and margins: when the cover proves clear at least 97 % of 256 seeded random
+        configurations that coal finds clear (spheres and cylinders: the cover is nearly exact);
+        otherwise (meshes, the AUBO-i3 under the guard plate: 93.5 %) it would mostly add its
+        cost to coal's, and coal alone checks, as without the cover."""
+        if self.cover is None or self.timed:
+            return False
+        tight = self._shared.get("tight")
+        if tight is None:
+            X = self.cell.random_q(256, seed=0)[:, self.cols]
+            Q = self.full(X)
+            clear = ~self.coal_collides(Q, "margin")
+            proven = self.cover.screen(Q, self._cover_pairs, self.pair_margin)
+            tight = bool(proven.sum() >= 0.97 * clear.sum())
+            self._shared["tight"] = tight
+            self._shared["share"] = float(proven.sum() / max(int(clear.sum()), 1))
+        return tight
+
+    @property
+    def cover_share(self) -> float:
+        """Share of 256 seeded random configurations coal finds clear that the cover proves clear (0: no cover)."""
+        if self.cover is None or self.timed:
+            return 0.0
+        _ = self.cover_decides_screens
+        return float(self._shared["share"])
+
+    @property
+    def batch_loop(self) -> str | None:
+        """Pinocchio's batch loop used (``"broad phase"`` or ``"pairs"``, the faster here; see
+        :meth:`_calibrate`); ``None`` until the first batch."""
+        return self._shared["loop"]
+
+    def _to_pin(self, Q: np.ndarray) -> np.ndarray:
+        return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
+
+
+    def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
+        margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
+        stop at the first such row (the rows after it are then reported False)."""
+        Q = np.atleast_2d(Q)
+        out = np.zeros(Q.shape[0], dtype=bool)
+        rest = np.flatnonzero(~self.covered(Q, which))
+        out[rest] = self.coal_collides(Q[rest], which, stop)
+        return out
+
+    def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+        """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
+        or of the margins + ``step / 2^(L+1)`` (``which = L``); False: left to coal."""
+        Q = np.atleast_2d(Q)
+        self.counts["configurations"] += Q.shape[0]
+        if Q.shape[0] == 0 or not self.cover_decides_screens:
+            return np.zeros(Q.shape[0], dtype=bool)
+        extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
+        return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
+
+    def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
+        Q = np.atleast_2d(Q)
+        self.counts["coal"] += Q.shape[0]
+        if Q.shape[0] == 0:
+            return np.zeros(0, dtype=bool)
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        pool = self._pool(which)
+        if self.deadline is None:
+            hit = pin.computeCollisionsInParallel(self.threads, pool, qp, True, bool(stop))
+            return np.asarray(hit, dtype=bool).reshape(-1)
+        out = np.zeros(Q.shape[0], dtype=bool)
+        for a in range(0, Q.shape[0], COAL_CHUNK):  # under a deadline: in chunks, looking at the clock
+            if self._timed_out():
+                raise GiveUp
+            chunk = np.asfortranarray(qp[:, a:a + COAL_CHUNK])
+            hit = np.asarray(pin.computeCollisionsInParallel(self.threads, pool, chunk, True, bool(stop)),
+                             dtype=bool).reshape(-1)
+            out[a:a + hit.size] = hit
+            if stop and hit.any():
+                break
+        return out
+
+
+
+#: Most threads of Pinocchio's batch checks.
+MAX_THREADS = 256
+#: Checkers' coal data kept per cell (pairs, margins, threads, calling thread) before the oldest go.
+_SHARED_KEEP = 16
+
+
+def check_threads(threads: Any) -> int:
+    """``threads`` as an int in ``1..MAX_THREADS`` or :class:`InvalidSettings` (0 or fewer crash
+    Pinocchio's batch loop; huge counts overflow its argument)."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
+        raise InvalidSettings(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
+    if not 1 <= int(threads) <= MAX_THREADS:
+        raise InvalidSettings(f"threads must be from 1 to {MAX_THREADS} (threads of the batched collision checks), "
+                              f"got {int(threads)}")
+    return int(threads)
+
+
+_SHARED_LOCK = threading.Lock()
+
+
+def shared_coal(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
+    """coal data (geometry copy, GeometryData, broad phase, batch pools per screen level) shared by
+    the checkers of one cell with the same pairs, margins and thread count, made in the same
+    thread: making them costs tens of ms per checker (cold-starting every request)."""
+    key = (tuple((p.index_a, p.index_b) for p in pairs), margins.tobytes(), threads, threading.get_ident())
+    with _SHARED_LOCK:
+        store = cell.__dict__.setdefault("_motion_checker_shared", {})
+        entry = store.pop(key, None)
+        if entry is None:
+            entry = {}
+            while len(store) >= _SHARED_KEEP:
+                store.pop(next(iter(store)))
+        store[key] = entry  # most recently used last
+        return entry
+

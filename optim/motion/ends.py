@@ -1,0 +1,119 @@
+"""The ends of a planned motion: the arms, the start and the goal (joints, or a tool pose and its IK branches).
+
+Frames: poses in the world (the cell's root), joint coordinates in rad or m.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from pinarms.optim.errors import GoalInCollision, StartInCollision
+from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
+
+__all__ = ["planned_arms", "arm_joints", "check_end", "goal_candidates"]
+
+
+def _arms(cell: Any, arm: Any) -> tuple[str, ...]:
+    names = (arm,) if isinstance(arm, str) else tuple(arm)
+    if not names or not all(isinstance(a, str) for a in names):
+        raise InvalidInput(f"arm must be an arm name or a sequence of arm names, got {arm!r}")
+    return tuple(cell.arm(a).name for a in names)
+
+
+def _joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarray:
+    """The planned arms' coordinates from an array (concatenated) or ``{arm: q}``."""
+    sizes = [cell.arm(a).nq for a in arms]
+    if isinstance(value, Mapping):
+        missing = [a for a in arms if a not in value]
+        if missing:
+            raise InvalidInput(f"{what} gives no joints for arm(s) {missing}")
+        parts = [np.asarray(value[a], dtype=float).reshape(-1) for a in arms]
+        if any(p.size != n for p, n in zip(parts, sizes)):
+            raise InvalidInput(f"{what}: arm joint counts must be {dict(zip(arms, sizes))}")
+        x = np.concatenate(parts)
+    else:
+        try:
+            x = np.asarray(value, dtype=float).reshape(-1)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInput(f"{what} must be joint coordinates, got {value!r}") from exc
+    if x.size != sum(sizes) or not np.all(np.isfinite(x)):
+        raise InvalidInput(f"{what} must be {sum(sizes)} finite joint coordinates (arms {list(arms)}), got {value!r}")
+    return x
+
+
+def _is_pose(value: Any) -> bool:
+    if isinstance(value, Mapping):
+        return False
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return arr.shape == (4, 4)
+
+
+def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
+    if not checker.within_limits(x[None])[0]:
+        names = checker.cell.joint_names
+        bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
+               for i, c in enumerate(checker.cols) if not checker.lower[i] - 1e-12 <= x[i] <= checker.upper[i] + 1e-12]
+        raise InvalidInput(f"the {label} is outside the joint limits: {'; '.join(bad)}")
+    if not checker.state_valid(x):
+        e, pair, d = checker.closest(x)
+        m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
+        err = StartInCollision if label == "start" else GoalInCollision
+        raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}; move it clear or lower "
+                  f"the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
+
+
+def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
+                     frame: str | None) -> list[GoalCandidate]:
+    cell = checker.cell
+    if not _is_pose(goal):
+        x = _joints(cell, arms, goal, "goal")
+        _check_start(checker, x, "goal")
+        return [GoalCandidate(x, True)]
+    if len(arms) != 1:
+        raise InvalidInput("a pose goal needs one planned arm; give two arms' goals as joint vectors {arm: q}")
+    T = np.asarray(goal, dtype=float)
+    if not np.all(np.isfinite(T)) or np.abs(T[:3, :3] @ T[:3, :3].T - np.eye(3)).max() > 1e-6 or \
+            np.abs(T[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-9:
+        raise InvalidInput("goal pose must be a finite homogeneous transform (4, 4): tool → world [m]")
+    inside = point_in_fixture(cell, T[:3, 3])
+    if inside is not None:
+        raise GoalInCollision(f"the goal point {np.round(T[:3, 3], 4).tolist()} m lies inside fixture {inside[0]!r} "
+                              f"({inside[1] * 1e3:.1f} mm deep): no configuration can reach it clear",
+                              which="goal", pairs=(("tcp", inside[0]),), distances=(-inside[1],))
+    arm = cell.arm(arms[0])
+    robot = arm.robot
+    if frame is not None and frame not in ("tcp", robot.tcp_frame):
+        raise InvalidInput(f"frame {frame!r}: pose goals are for the arm's tcp ({robot.tcp_frame!r})")
+    T_base = arm.to_base(T)
+    q, branch = ik_candidates(robot, T_base, start, seed=seed)
+    if q.shape[0] == 0:
+        reason = robot.ik_failure_reason(T_base) or "no IK solution within the joint limits"
+        raise UnreachableTarget(f"the goal pose at {np.round(T[:3, 3], 4).tolist()} m is unreachable for arm "
+                                f"{arm.name!r}: {reason}")
+    out = []
+    for qi, bi in zip(q, branch):
+        if checker.state_valid(qi):
+            out.append(GoalCandidate(qi, True, "", int(bi)))
+            continue
+        e, pair, d = checker.closest(qi)
+        m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
+        out.append(GoalCandidate(qi, False, describe_pair(pair, d, m), int(bi),
+                                 () if pair is None else pair.bodies, d))
+    if not any(g.valid for g in out):
+        lines = "; ".join(f"branch {g.branch}: {g.reason}" if g.branch >= 0 else g.reason for g in out)
+        raise GoalInCollision(f"every IK solution of the goal pose is in collision ({len(out)} tried): {lines}",
+                              which="goal", pairs=tuple(g.pair for g in out), distances=tuple(g.distance for g in out))
+    return out
+
+
+
+planned_arms = _arms
+arm_joints = _joints
+check_end = _check_start
+goal_candidates = _goal_candidates

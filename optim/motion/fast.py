@@ -1,0 +1,217 @@
+"""The compiled check and search: RRT-Connect and shortcutting on the sphere cover, proven.
+
+:class:`FastCheck` is the cover's side of a :class:`MotionChecker` (its pairs, margins,
+levers, held arms), all in compiled code (:mod:`._fast_kernel`):
+
+- a **state** is proven clear when the cover's lower bound of the excess
+  ``E(x) = min_k (d_k − margin_k)`` is ≥ 0 (the cover contains the geometry: its distances
+  are lower bounds); inconclusive counts as not valid here — never as clear;
+- an **edge** is proven by the Lipschitz rule of the exact proof (every point moves at most
+  ``T = Σ |Δx_j| ℓ_j``, ``E`` is 1-Lipschitz in that travel, so an interval whose ends have
+  ``E_a + E_b ≥ B`` keeps every margin), bisecting where needed down to the exact proof's
+  finest travel ``step / 2^MAX_SPLITS``; ``E`` is capped at the clearance above which the
+  checker left pairs out (they are proven that far apart).
+
+:func:`fast_search` runs RRT-Connect on it (seeded SplitMix64 stream, chunks of iterations
+between which the clock is read: the time limit holds to a chunk, a few ms) and
+:func:`fast_shortcut` shortcuts on it. A path so found is proven; :func:`optim.plan_motion`
+still proves it again with the exact checker before reporting it.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.motion import _fast_kernel as kernel
+from pinarms.optim.motion.proof import MAX_SPLITS
+from pinarms.robots.cell.cover import pair_arrays, pairs_for
+from pinarms.optim.motion.search import SearchResult
+
+__all__ = ["FastCheck", "fast_check", "fast_search", "fast_shortcut", "COMPILED_PLANNER", "TREE_NODES"]
+
+#: The planner named in results found by :func:`fast_search`.
+COMPILED_PLANNER = "RRTConnect"
+#: Clearance above the margins [m] up to which the compiled check looks at pairs (the cell's
+#: ``pairs_for``): the excess bound is capped there, so an edge needs at least one state per
+#: ``2 · REACH`` of travel.
+REACH = 0.25
+#: Most states one compiled edge proof takes before it gives up (the edge then counts as not proven):
+#: an edge running long within millimetres of something needs thousands (tens of ms); the search
+#: and the shortcutting look for others instead.
+EDGE_STATES = 400
+#: Most nodes per tree of the compiled search.
+TREE_NODES = 16384
+
+
+class FastCheck:
+    """The compiled cover check of ``checker`` (module docstring): states, edges and polylines.
+
+    ``reach``: the cap of the excess bound [m] (default :data:`REACH`); the pairs of the cell
+    not proven farther apart than the margins plus ``reach`` are checked. ``max_states``: most
+    states one edge proof may take (default :data:`EDGE_STATES`).
+
+    Raises:
+        ValueError: a checker without a cover, or one with arms moving on their own
+            trajectories (their checks stay with :meth:`MotionChecker.trajectory_valid`).
+    """
+
+    def __init__(self, checker: Any, reach: float | None = None, max_states: int | None = None) -> None:
+        if checker.cover is None or checker.timed:
+            raise ValueError("the compiled check needs a checker with the sphere cover and no moving arms")
+        cover = checker.cover
+        reach = REACH if reach is None else float(reach)
+        planned = set(checker.arms)
+        widest = max(checker.margin, checker.self_margin) + reach
+        chosen = [p for p in pairs_for(checker.cell, widest) if p.owner_a in planned or p.owner_b in planned]
+        margins = np.array([checker.self_margin if p.kind == "self" else checker.margin for p in chosen])
+        pairs = cover.prepare(*pair_arrays(chosen))
+        self.checker = checker
+        self.pairs = tuple(chosen)
+        self.fk = cover.fk
+        self.cov = cover.kernel_arrays()
+        self.grp = cover.group_arrays(pairs, margins)
+        self.work = cover.work(pairs)
+        self.hold = np.ascontiguousarray(checker.hold, dtype=float)
+        self.cols = np.ascontiguousarray(checker.cols, dtype=np.int64)
+        self.levers = np.ascontiguousarray(checker.levers, dtype=float)
+        #: the pairs left out are proven farther apart than this above their margins [m]: E is capped there
+        self.cap = reach
+        self.min_budget = float(checker.step / 2.0 ** MAX_SPLITS)
+        #: states one edge proof may take before it gives up (not proven: never clear)
+        self.max_states = int(EDGE_STATES if max_states is None else max_states)
+        #: the kernels' arguments after the states: levers, finest budget, states per edge, the cell
+        self.args = (self.levers, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
+                     self.cap, self.work)
+        self._q = np.empty(self.hold.size)
+        self._xm = np.empty(checker.n)
+        self._queue = np.empty((kernel.QUEUE, 4))
+        self._load()
+
+    def _load(self) -> None:
+        """Call every kernel once on nothing (loading compiled code from the cache takes tens of ms at
+        a first call): a search's clock then measures the search."""
+        n = self.checker.n
+        x = np.ascontiguousarray(self.checker.lower, dtype=float)
+        kernel.edge_proven(x, x, -1.0, -1.0, *self.args, self._q, self._xm, self._queue)
+        kernel.path_proven(x[None].copy(), *self.args)
+        kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.zeros((2, 1)),
+                           np.ones(2, dtype=np.int64), np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
+        kernel.shortcut(np.zeros((2, n)), 2, _rng(0), 0, *self.args)
+
+    def excess(self, x: Any) -> float:
+        """The cover's lower bound of ``E`` [m] at planned state ``x`` (capped; below 0: not proven)."""
+        return float(kernel.state_excess(np.ascontiguousarray(x, dtype=float), self.hold, self.cols, self.fk, self.cov,
+                                         self.grp, self.cap, self.work, self._q))
+
+    def state_proven(self, x: Any) -> bool:
+        """Whether the cover proves state ``x`` clear of every margin (and ``x`` is within the joint limits)."""
+        x = np.asarray(x, dtype=float)
+        return bool(self.checker.within_limits(x[None])[0]) and self.excess(x) >= 0.0
+
+    def edge_proven(self, xa: Any, xb: Any) -> bool:
+        """Whether the cover proves the straight edge ``xa → xb`` clear of every margin (ends within the limits)."""
+        xa = np.ascontiguousarray(xa, dtype=float)
+        xb = np.ascontiguousarray(xb, dtype=float)
+        if not self.checker.within_limits(np.stack([xa, xb])).all():
+            return False
+        return bool(kernel.edge_proven(xa, xb, self.excess(xa), self.excess(xb), *self.args, self._q, self._xm,
+                                       self._queue))
+
+    def path_proven(self, P: Any) -> bool:
+        """Whether the cover proves every edge of the polyline ``P (M, n)``."""
+        P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
+        if not self.checker.within_limits(P).all():
+            return False
+        return bool(kernel.path_proven(P, *self.args))
+
+
+def fast_check(checker: Any) -> FastCheck | None:
+    """The :class:`FastCheck` of ``checker`` (kept with it), or ``None`` when it has none (no cover, moving arms)."""
+    got = getattr(checker, "_fast", False)
+    if got is False:
+        try:
+            got = FastCheck(checker)
+        except ValueError:
+            got = None
+        checker._fast = got
+    return got
+
+
+def _rng(seed: int) -> np.ndarray:
+    return np.array([(int(seed) * 0x9E3779B97F4A7C15 + 0x2545F4914F6CDD1D) % (1 << 64)], dtype=np.uint64)
+
+
+def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0, seed: int = 0,
+                planner_range: float | None = None) -> SearchResult:
+    """RRT-Connect from ``start (n,)`` to any of ``goals (G, n)`` on the compiled cover check.
+
+    Ends the cover does not prove are left out (a start not proven: nothing searched,
+    ``status`` says so). ``planner_range``: the longest edge added at once [rad or m, joint
+    space] (default OMPL's: a fifth of the diagonal of the joint-limit box). The result's
+    ``path`` is ``None`` when nothing was found within ``time_limit`` [s]."""
+    fc = fast_check(checker)  # built, and its kernels loaded, before the clock starts
+    t0 = time.perf_counter()
+    x0 = np.asarray(start, dtype=float)
+    G = np.atleast_2d(np.asarray(goals, dtype=float))
+    if fc is None or not fc.state_proven(x0):
+        return SearchResult(None, 0, time.perf_counter() - t0, COMPILED_PLANNER, -1, "start not proven by the cover")
+    keep = [k for k, g in enumerate(G) if fc.state_proven(g)]
+    if not keep:
+        return SearchResult(None, 1, time.perf_counter() - t0, COMPILED_PLANNER, -1, "no goal proven by the cover")
+    n = x0.size
+    lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
+    step_range = float(planner_range) if planner_range is not None else 0.2 * float(np.linalg.norm(upper - lower))
+    nodes = np.zeros((2, TREE_NODES, n))
+    parent = np.full((2, TREE_NODES), -1, dtype=np.int64)
+    energy = np.zeros((2, TREE_NODES))
+    nodes[0, 0], energy[0, 0] = x0, fc.excess(x0)
+    for i, k in enumerate(keep):
+        nodes[1, i], energy[1, i] = G[k], fc.excess(G[k])
+    counts = np.array([1, len(keep)], dtype=np.int64)
+    status = np.zeros(5, dtype=np.int64)
+    rng = _rng(seed)
+    chunk, found = 1, 0
+    deadline = t0 + float(time_limit)
+    while time.perf_counter() < deadline and counts.min() < TREE_NODES:
+        tc = time.perf_counter()
+        found = kernel.rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, chunk,
+                                   *fc.args)
+        if found:
+            break
+        spent = time.perf_counter() - tc
+        if spent < 0.002 and spent < 0.02 * float(time_limit):  # chunks of a few ms: the clock read often enough
+            chunk *= 2
+    seconds = time.perf_counter() - t0
+    states = int(counts.sum())
+    if not found:
+        return SearchResult(None, states, seconds, COMPILED_PLANNER, -1, f"Timeout ({int(status[4])} states checked)")
+    path = np.concatenate([_branch(nodes[0], parent[0], int(status[1]))[::-1],
+                           _branch(nodes[1], parent[1], int(status[2]))[1:]])
+    gi = int(np.argmin(np.linalg.norm(G - path[-1], axis=1)))
+    return SearchResult(path, states, seconds, COMPILED_PLANNER, gi, f"Exact solution ({int(status[4])} states checked)")
+
+
+def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:
+    rows = []
+    k = leaf
+    while k >= 0:
+        rows.append(nodes[k])
+        k = int(parent[k])
+    return np.array(rows)
+
+
+def fast_shortcut(checker: Any, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
+    """Random shortcutting of the cover-proven polyline ``path (M, n)`` on the compiled check (seeded;
+    ``tries`` default: 16 and 2 per vertex), then every vertex dropped whose neighbours join."""
+    fc = fast_check(checker)
+    P = np.atleast_2d(np.asarray(path, dtype=float))
+    if fc is None or P.shape[0] <= 2:
+        return P.copy()
+    k = int(tries) if tries is not None else 16 + 2 * P.shape[0]
+    buf = np.zeros((P.shape[0] + k + 2, P.shape[1]))
+    buf[: P.shape[0]] = P
+    m = kernel.shortcut(buf, P.shape[0], _rng(seed + 1), k, *fc.args)
+    return buf[:m].copy()

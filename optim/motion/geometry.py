@@ -1,0 +1,115 @@
+"""Steps 1–4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
+
+The search runs first compiled (:mod:`.fast`: RRT-Connect whose states and edges the sphere
+cover proves) for a share of the time limit (:data:`FAST_SHARE`) when the cover proves at
+least half of the clear states (:func:`fast_share`), then — nothing found, or a planner other than
+RRT-Connect, or arms moving on their own trajectories — OMPL with the exact checker for
+the rest of the time, as before. A compiled path is shortcut on the compiled check; the
+path reported is proven by the exact checker (:meth:`MotionChecker.prove`: the smooth
+spline, or each edge of the polyline when smoothing falls back to it). A path the exact
+proof does not accept (the cover proves what coal proves, so this does not happen in the
+tests) is dropped and OMPL searches.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+from pinarms.optim.errors import NoPathFound
+from pinarms.optim.motion.ends import _goal_candidates
+from pinarms.optim.motion.fast import fast_search, fast_shortcut
+from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
+from pinarms.optim.motion.search import search, shortcut
+from pinarms.optim.motion.smoothing import smooth_path
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["plan_geometry", "find_path", "fast_share", "FAST_SHARE"]
+
+#: Share of the time limit the compiled search may take when the cover proves at least half of the
+#: clear random states (:attr:`MotionChecker.cover_share`); OMPL has the rest. Measured on
+#: ``aubo_crate_guard`` (25 queries, 1 s): 13, 16 and 17 solved at shares 0.25, 0.5 and 0.75;
+#: ``panda_shelf``: 24 at 0.5 and at 0.75 (every one compiled).
+FAST_SHARE = 0.75
+
+
+def fast_share(checker: Any, planner: str) -> float:
+    """Share of the time limit given to the compiled search (0: OMPL alone; module docstring)."""
+    if str(planner).lower() != "rrtconnect" or checker.cover is None or checker.timed:
+        return 0.0
+    return FAST_SHARE if checker.cover_share >= 0.5 else 0.0
+
+
+def _exact(checker: Any, P: np.ndarray) -> bool:
+    """Every edge of the polyline ``P`` proven by the exact checker."""
+    return all(checker.edge_valid(P[i], P[i + 1]).ok for i in range(P.shape[0] - 1))
+
+
+def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
+              compiled: bool = True, say: Callable[[str], None] = lambda _m: None) -> dict:
+    """Search and shortcut (module docstring): a dict with ``result`` (:class:`.search.SearchResult`, its
+    seconds and states those of both searches), ``simplified``, ``simplifier``, ``compiled`` (bool),
+    ``seconds`` (``"search"``, ``"shortcut"``). ``NoPathFound`` when nothing is found in time.
+    ``compiled=False``: OMPL alone."""
+    t0 = time.perf_counter()
+    share = fast_share(checker, planner) if compiled else 0.0
+    spent, states = 0.0, 0
+    if share > 0.0:
+        fast = fast_search(checker, x0, G, time_limit=share * float(time_limit), seed=int(seed))
+        spent, states = fast.seconds, fast.states
+        if fast.path is not None:
+            say(f"path found compiled in {fast.seconds:.4f} s ({fast.states} states); shortcutting")
+            t = time.perf_counter()
+            simplified = fast_shortcut(checker, fast.path, seed=int(seed))
+            return {"result": fast, "simplified": simplified, "simplifier": FAST_SIMPLIFIER, "compiled": True,
+                    "seconds": {"search": fast.seconds, "shortcut": time.perf_counter() - t}}
+    rest = max(float(time_limit) - (time.perf_counter() - t0), 1e-3)
+    result = search(checker, x0, G, planner=planner, time_limit=rest, seed=int(seed))
+    seconds = {"search": spent + result.seconds}
+    if result.path is None:
+        raise NoPathFound(
+            f"{result.planner} found no collision-free path in {float(time_limit):g} s ({result.states + states} "
+            f"states explored, {len(G)} goal configuration(s), margin {checker.margin * 1e3:.1f} mm): raise "
+            "time_limit, try another planner or seed, or lower the margin", planner=result.planner,
+            time_limit=float(time_limit), seconds=spent + result.seconds, states=result.states + states, goals=len(G))
+    say(f"path found by {result.planner} in {result.seconds:.3f} s ({result.states} states); shortcutting")
+    t = time.perf_counter()
+    simplified = shortcut(checker, result.path, seed=int(seed))
+    seconds["shortcut"] = time.perf_counter() - t
+    return {"result": result, "simplified": simplified, "simplifier": SIMPLIFIER, "compiled": False,
+            "seconds": seconds}
+
+
+def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
+                  time_limit: float, seed: int, frame: str | None = None, compiled: bool = True,
+                  say: Callable[[str], None] = lambda _m: None) -> dict:
+    """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
+
+    Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
+    ``states``, ``seconds``, ``simplifier``, ``compiled``. ``compiled=False``: OMPL alone.
+    """
+    t_start = time.perf_counter()
+    cell = checker.cell
+    goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    G = np.array([g.q for g in goals if g.valid])
+    same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
+    if same.size:
+        raise InvalidInput(f"the start already is the goal (joints {np.round(x0, 6).tolist()}): there is nothing to "
+                           "plan; give a goal different from the start")
+    say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
+    robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
+    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled, say=say)
+    t = time.perf_counter()
+    path, method, _ = smooth_path(checker, found["simplified"], robot)
+    if found["compiled"] and method != "cubic spline" and not _exact(checker, found["simplified"]):
+        # the polyline is reported: the exact checker must prove it too (else OMPL, as before)
+        rest = max(float(time_limit) - (time.perf_counter() - t_start), 1e-3)
+        found = find_path(checker, x0, G, planner=planner, time_limit=rest, seed=seed, compiled=False, say=say)
+        path, method, _ = smooth_path(checker, found["simplified"], robot)
+    seconds = dict(found["seconds"], smooth=time.perf_counter() - t)
+    result = found["result"]
+    return {"goals": goals, "raw": result.path, "simplified": found["simplified"], "path": path, "smoothing": method,
+            "planner": result.planner, "states": result.states, "seconds": seconds,
+            "simplifier": found["simplifier"], "compiled": found["compiled"]}

@@ -1,0 +1,137 @@
+"""The compiled check and search (optim.motion.fast): never clear what the exact checker finds too close,
+a found path proven again exactly, seeded, within its time limit; the cover's cylinder-box bound."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion, scene_queries
+from pinarms.optim.motion.ends import goal_candidates
+from pinarms.optim.motion.fast import fast_check, fast_search, fast_shortcut
+from pinarms.robots.cell._cover_kernel import _cylinder_box_gap
+
+MARGIN = 0.01
+
+
+@pytest.fixture(scope="module")
+def table():
+    cell = load_scene("panda_table_box")
+    queries, hold = scene_queries("panda_table_box", 4, seed=0, margin=MARGIN)
+    checker = MotionChecker(cell, ["panda"], margin=MARGIN, hold=hold)
+    goals = [np.array([g.q for g in goal_candidates(checker, ("panda",), q.goal, q.start, k, None) if g.valid])
+             for k, q in enumerate(queries)]
+    return cell, checker, queries, goals, hold
+
+
+@pytest.mark.parametrize("name", ["panda_table_box", "aubo_two_belt"])
+def test_fast_clear_is_exact_clear_on_random_states_and_edges(table, name):
+    """Conservative agreement: every state and edge the cover proves, the exact checker (coal) accepts at the
+    margin; the cover rejects only a small share of what the exact checker accepts (counted)."""
+    if name == "panda_table_box":
+        cell, checker = table[:2]
+    else:
+        cell = load_scene(name)
+        checker = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN)
+    fc = fast_check(checker)
+    X = cell.random_q(200, seed=21)[:, checker.cols]
+    fast = np.array([fc.state_proven(x) for x in X])
+    exact = np.array([checker.state_valid(x) for x in X])
+    assert not np.any(fast & ~exact)
+    excess, _, _ = checker.excess(checker.full(X[fast]))
+    assert np.all(excess >= 0.0)
+    assert fast.sum() >= 0.9 * exact.sum()  # inconclusive on few clear states
+    C = X[fast & exact][:14]
+    rng = np.random.default_rng(3)
+    verdicts = []
+    for i in range(len(C)):
+        for j in (i - 1, i - 4):
+            a, b = C[i], C[i] + rng.uniform(0.05, 1.0) * (C[j] - C[i])
+            verdicts.append((fc.edge_proven(a, b), checker.edge_valid(a, b).ok))
+    verdicts = np.array(verdicts)
+    assert not np.any(verdicts[:, 0] & ~verdicts[:, 1]), "the cover proved an edge the exact proof rejects"
+    assert verdicts[:, 0].any()
+    if name == "panda_table_box":
+        assert (~verdicts[:, 1]).any()  # both kinds of edges were tried
+    rejected = int(np.sum(~verdicts[:, 0] & verdicts[:, 1]))
+    print(f"{name}: states proven {fast.sum()} of {exact.sum()} clear; edges proven {verdicts[:, 0].sum()}, "
+          f"exact {verdicts[:, 1].sum()}, rejected by the cover only {rejected} of {len(verdicts)}")
+    assert rejected <= 0.5 * verdicts[:, 1].sum(), f"the cover rejected {rejected} edges the exact proof accepts"
+
+
+def test_compiled_search_path_is_proven_exactly_and_seeded(table):
+    _, checker, queries, goals, _ = table
+    found = 0
+    for k, q in enumerate(queries):
+        r = fast_search(checker, q.start, goals[k], time_limit=2.0, seed=k)
+        if r.path is None:
+            continue
+        found += 1
+        assert np.array_equal(r.path[0], q.start) and any(np.array_equal(r.path[-1], g) for g in goals[k])
+        assert all(checker.edge_valid(r.path[i], r.path[i + 1]).ok for i in range(len(r.path) - 1))
+        again = fast_search(checker, q.start, goals[k], time_limit=2.0, seed=k)
+        assert np.array_equal(again.path, r.path)  # the same seed, the same path
+        S = fast_shortcut(checker, r.path, seed=k)
+        assert np.array_equal(S, fast_shortcut(checker, r.path, seed=k))
+        assert np.array_equal(S[0], r.path[0]) and np.array_equal(S[-1], r.path[-1])
+        assert np.linalg.norm(np.diff(S, axis=0), axis=1).sum() <= np.linalg.norm(np.diff(r.path, axis=0), axis=1).sum()
+        assert all(checker.edge_valid(S[i], S[i + 1]).ok for i in range(len(S) - 1))
+    assert found >= 3
+
+
+def test_compiled_search_keeps_its_time_limit(table):
+    """The clock is read between chunks of iterations (each a few ms at most: edge proofs are capped)."""
+    _, checker, queries, goals, _ = table
+    for limit in (0.001, 0.01):
+        for k, q in enumerate(queries):
+            t0 = time.perf_counter()
+            r = fast_search(checker, q.start, goals[k], time_limit=limit, seed=k)
+            spent = time.perf_counter() - t0
+            assert r.seconds <= spent and spent <= 1.1 * limit + 0.02, f"{spent:.4f} s at a {limit} s limit"
+
+
+def test_plan_motion_searches_compiled_where_the_cover_is_tight(table):
+    cell, _, queries, _, hold = table
+    q = queries[1]
+    plan = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold)
+    assert plan.compiled and plan.planner == "RRTConnect" and plan.as_dict()["compiled_search"]
+    assert plan.check.collision_free and plan.clearance.min_environment >= MARGIN
+    quick = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
+                        recheck=False)
+    assert np.array_equal(quick.simplified, plan.simplified)  # the same seed, the same path
+    assert quick.check is None and quick.clearance is None and quick.as_dict()["collision_free"] is None
+    ompl = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
+                       compiled=False, recheck=False)
+    assert not ompl.compiled and ompl.simplifier.startswith("OMPL")
+    ur5 = load_scene("ur5_table_box")
+    checker = MotionChecker(ur5, ["ur5"], margin=MARGIN)
+    from pinarms.optim.motion.geometry import fast_share
+
+    assert fast_share(checker, "rrtconnect") == 0.0  # meshes: a loose cover, OMPL with the exact checker alone
+    assert fast_share(MotionChecker(cell, ["panda"], margin=MARGIN), "rrtstar") == 0.0
+
+
+def test_cylinder_box_gap_is_a_lower_bound_of_coal_distance():
+    coal = pytest.importorskip("coal")
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        r, h = rng.uniform(0.02, 0.1), rng.uniform(0.02, 0.2)
+        half = rng.uniform(0.05, 0.3, 3)
+        Rb = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        Rb *= np.sign(np.linalg.det(Rb))
+        pb = rng.normal(size=3) * 0.3
+        Rc = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        Rc *= np.sign(np.linalg.det(Rc))
+        pc = pb + rng.normal(size=3) * 0.4
+        a, b = pc - h * Rc[:, 2], pc + h * Rc[:, 2]
+        gap = _cylinder_box_gap(a, b, r, Rb, pb, half)
+        req, res = coal.DistanceRequest(), coal.DistanceResult()
+        d = coal.distance(coal.Cylinder(r, 2 * h), coal.Transform3s(Rc, pc), coal.Box(*(2 * half)),
+                          coal.Transform3s(Rb, pb), req, res)
+        assert gap <= max(d, 0.0) + 1e-9
+    # upright over a face it is exact
+    gap = _cylinder_box_gap(np.array([0.0, 0.0, 0.15]), np.array([0.0, 0.0, 0.25]), 0.05, np.eye(3), np.zeros(3),
+                            np.array([0.1, 0.1, 0.1]))
+    assert gap == pytest.approx(0.05, abs=1e-12)
