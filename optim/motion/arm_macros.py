@@ -21,12 +21,12 @@ from the registry's URDF.
 
 from __future__ import annotations
 
-import os
 import tempfile
 import xml.etree.ElementTree as ET
 from functools import lru_cache
 from pathlib import Path
 
+from pinarms.files import write_text
 from pinarms.robots import registry
 from pinarms.robots.errors import RobotNotFound
 
@@ -118,10 +118,7 @@ def arm_macro_text(name: str) -> str:
 def _macro_dir() -> Path:
     folder = Path(tempfile.mkdtemp(prefix="pinarms-examples-"))
     for name in MACRO_ARMS:
-        target = folder / f"{name}.xacro"
-        tmp = folder / f".{name}.xacro.tmp"
-        tmp.write_text(arm_macro_text(name), encoding="utf-8")
-        os.replace(tmp, target)
+        write_text(folder / f"{name}.xacro", arm_macro_text(name))
     return folder
 
 
