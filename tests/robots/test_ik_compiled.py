@@ -8,6 +8,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.ik import NumericalIK
+from pinarms.robots.ik import _chain as chain
 
 ARMS = ["scara_mushroom", "gantry_flower", "koji_turner", "koji_turner_rail", "aubo_i3", "ur5", "panda"]
 
@@ -17,14 +18,14 @@ def test_compiled_chain_pose_and_jacobian_match_pinocchio(name):
     """FK and frame Jacobian (base axes at the tcp) of the compiled chain vs Pinocchio, mimic joints included."""
     robot = robots.load(name)
     solver = NumericalIK(robot)
-    kernel, C, _, _, _ = solver._compiled()
+    _, C, _, _, _ = solver._compiled()
     qi, sc, of, rev, LR, Lp, fR, fp = C
     m = qi.shape[0]
     R, p, Z, O, J = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3)), np.empty((6, robot.nq))
     data = robot.model.createData()
     for q in robot.random_q(20, seed=5):
-        kernel._fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, np.empty((3, 7)))
-        kernel._jacobian(qi, sc, rev, Z, O, p, J)
+        chain.fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O)
+        chain.jacobian(qi, sc, rev, Z, O, p, J)
         qp = robot._tree.coordinates.to_pin(q)
         pin.forwardKinematics(robot.model, data, qp)
         M = pin.updateFramePlacement(robot.model, data, solver.frame_id)
