@@ -17,7 +17,6 @@ __all__ = ["BatchIKResult", "solve_batch"]
 
 _WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
 _PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
-_ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 
 
 def _seed_int(seed) -> int:
