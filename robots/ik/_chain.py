@@ -203,3 +203,39 @@ def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
             best, k_best = c, k
             best2 = c * c
     return k_best
+
+
+@jit
+def grid_index(table, Rt, pt, posonly):
+    """Row of the gridded start table nearest ``(Rt, pt)`` among the rows in the target's cell and its 26 neighbours.
+
+    ``table = (q, p, |p|², R rows (n, 9), cell_start, grid)``, rows sorted by cell; ``grid = (x0, y0,
+    z0, 1/size, nx, ny, nz)``; a target outside the grid looks in the nearest border cells. Cost as
+    :func:`table_index`; when those cells are all empty, every row is scanned.
+    """
+    tq, tp, tpp, tR, cell_start, grid = table
+    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
+    cx = min(max(int(math.floor((pt[0] - grid[0]) * grid[3])), 0), nx - 1)
+    cy = min(max(int(math.floor((pt[1] - grid[1]) * grid[3])), 0), ny - 1)
+    cz = min(max(int(math.floor((pt[2] - grid[2]) * grid[3])), 0), nz - 1)
+    best, best2, k_best = np.inf, np.inf, -1
+    for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
+        for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
+            for iz in range(max(cz - 1, 0), min(cz + 2, nz)):
+                cell = (ix * ny + iy) * nz + iz
+                for k in range(cell_start[cell], cell_start[cell + 1]):
+                    d2 = (tp[k, 0] - pt[0]) ** 2 + (tp[k, 1] - pt[1]) ** 2 + (tp[k, 2] - pt[2]) ** 2
+                    if d2 >= best2:  # the position term alone rules the row out
+                        continue
+                    c = math.sqrt(d2)
+                    if not posonly:
+                        dot = 0.0
+                        for a in range(3):
+                            for b in range(3):
+                                dot += tR[k, 3 * a + b] * Rt[a, b]
+                        c += ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+                    if c < best:
+                        best, best2, k_best = c, c * c, k
+    if k_best < 0:
+        return table_index(tq, tp, tpp, tR, Rt, pt, posonly)
+    return k_best

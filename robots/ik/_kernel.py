@@ -23,11 +23,11 @@ import math
 
 import numpy as np
 
-from ._chain import errors, jacobian, jit, pose_cost, pose_error, table_index
+from ._chain import errors, grid_index, jacobian, jit, pose_cost, pose_error, table_index
 from ._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
 
 __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits", "table_index", "solve",
-           "solve_many", "workspace"]
+           "solve_many", "workspace", "grid_index"]
 
 _MU_MAX = 1e8
 _POOL = 32
@@ -333,15 +333,14 @@ def solve_many(Rts, pts, starts, table, C, L, P, posonly, tol, restarts, seed, q
     """:func:`solve` for every target ``k`` (restarts seeded by ``seed + k``); returns the total iterations.
 
     A row of ``starts`` holding a NaN starts from the ``table`` configuration nearest its target
-    (:func:`._chain.table_index`), as a single solve without a seed does.
+    (:func:`._chain.grid_index`), as a single solve without a seed does.
     """
-    tq, tp, tpp, tR = table
     W = workspace(starts.shape[1], C[0].shape[0])
     total = 0
     for k in range(Rts.shape[0]):
         q0 = starts[k]
         if not np.all(np.isfinite(q0)):
-            q0 = tq[table_index(tq, tp, tpp, tR, Rts[k], pts[k], posonly)]
+            q0 = table[0][grid_index(table, Rts[k], pts[k], posonly)]
         o, a, b, _, it = solve_in(q0, C, L, P, Rts[k], pts[k], posonly, tol, restarts, (seed + k) % 4294967296,
                                   q_out[k], W)
         ok[k], pe[k], re[k] = o, a, b

@@ -172,8 +172,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
             )
             P = np.array([self.damping, self.min_damping, self.max_step, self.stall_ratio, self.stall_steps,
                           self.max_iter], dtype=float)
-            q_tab, p_tab, pp_tab, R_tab = self._start_table()
-            args = self._kernel_args = (_kernel, C, L, P, (q_tab, p_tab, pp_tab, R_tab))  # one assignment: thread-safe
+            args = self._kernel_args = (_kernel, C, L, P, self._grid_table())  # one assignment: thread-safe
         return args
 
     def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
@@ -184,11 +183,11 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         A success is confirmed by Pinocchio's forward kinematics of the returned ``q`` and an exact
         limit check (independent of the compiled chain evaluation).
         """
-        kernel, C, L, P, (tq, tp, tpp, tR) = self._compiled()
+        kernel, C, L, P, table = self._compiled()
         Rt = np.ascontiguousarray(target[:3, :3], dtype=float)
         pt = np.ascontiguousarray(target[:3, 3], dtype=float)
         if q_seed is None:
-            q0 = tq[kernel.table_index(tq, tp, tpp, tR, Rt, pt, position_only)]
+            q0 = table[0][kernel.grid_index(table, Rt, pt, position_only)]
         else:
             q0 = np.ascontiguousarray(q_seed, dtype=float)
         q = np.empty(self.nq)
