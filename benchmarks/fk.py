@@ -33,7 +33,7 @@ def per_call(fn, number: int = 2000, repeat: int = 5) -> float:
     return min(timeit.repeat(fn, number=number, repeat=repeat)) / number
 
 
-def interleaved(ours, ref, rounds: int = 15, number: int = 2000) -> tuple[float, float]:
+def interleaved(ours, ref, rounds: int = 31, number: int = 1000) -> tuple[float, float]:
     """Best time of one call [s] of ``ours`` and of ``ref``, measured in alternating rounds.
 
     On a shared machine two figures taken one after the other can differ by 2x; alternating

@@ -239,3 +239,39 @@ def grid_index(table, Rt, pt, posonly):
     if k_best < 0:
         return table_index(tq, tp, tpp, tR, Rt, pt, posonly)
     return k_best
+
+
+@jit
+def grid_neighbours(table, Rt, pt, posonly, count):
+    """Up to ``count`` rows of the gridded start table in the target's cell and its 26 neighbours,
+    nearest pose first (cost as :func:`table_index`); ``int64`` array."""
+    tq, tp, tpp, tR, cell_start, grid = table
+    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
+    cx = min(max(int(math.floor((pt[0] - grid[0]) * grid[3])), 0), nx - 1)
+    cy = min(max(int(math.floor((pt[1] - grid[1]) * grid[3])), 0), ny - 1)
+    cz = min(max(int(math.floor((pt[2] - grid[2]) * grid[3])), 0), nz - 1)
+    n = 0
+    for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
+        for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
+            for iz in range(max(cz - 1, 0), min(cz + 2, nz)):
+                cell = (ix * ny + iy) * nz + iz
+                n += cell_start[cell + 1] - cell_start[cell]
+    rows = np.empty(n, dtype=np.int64)
+    cost = np.empty(n)
+    n = 0
+    for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
+        for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
+            for iz in range(max(cz - 1, 0), min(cz + 2, nz)):
+                cell = (ix * ny + iy) * nz + iz
+                for k in range(cell_start[cell], cell_start[cell + 1]):
+                    c = math.sqrt((tp[k, 0] - pt[0]) ** 2 + (tp[k, 1] - pt[1]) ** 2 + (tp[k, 2] - pt[2]) ** 2)
+                    if not posonly:
+                        dot = 0.0
+                        for a in range(3):
+                            for b in range(3):
+                                dot += tR[k, 3 * a + b] * Rt[a, b]
+                        c += ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+                    rows[n], cost[n] = k, c
+                    n += 1
+    order = np.argsort(cost, kind="mergesort")
+    return rows[order[: min(count, n)]]

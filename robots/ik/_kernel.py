@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ._chain import errors, grid_index, jacobian, jit, pose_cost, pose_error, table_index
+from ._chain import errors, grid_index, grid_neighbours, jacobian, jit, pose_cost, pose_error, table_index
 from ._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
 
 __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits", "table_index", "solve",
@@ -31,6 +31,7 @@ __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits
 
 _MU_MAX = 1e8
 _POOL = 32
+_NEAR = 8  # restarts from the stored poses nearest the target (after the first start) before random draws
 
 # P (float64 array) holds the settings: μ0, λ_min, max_step, stall_ratio, stall_steps, max_iter
 _P_MU0, _P_LAMMIN, _P_STEP, _P_STALLR, _P_STALLN, _P_ITER = 0, 1, 2, 3, 4, 5
@@ -282,7 +283,16 @@ def _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W):
 
 
 @jit
-def solve_in(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
+def _same(a, b):
+    """``a == b`` entry by entry."""
+    for j in range(a.shape[0]):
+        if a[j] != b[j]:
+            return False
+    return True
+
+
+@jit
+def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
     """:func:`solve` with the scratch buffers ``W`` of :func:`workspace`."""
     nq = q0.shape[0]
     q = q0.copy()
@@ -298,12 +308,21 @@ def solve_in(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
     order = np.empty(0, dtype=np.int64)
     k = _POOL
     best_pe, best_re = pe, re
+    near = grid_neighbours(table, Rt, pt, posonly, _NEAR + 1)
+    i_near, used = 0, 0
     while attempts <= restarts:
-        if k == _POOL:
-            order = _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W)
-            k = 0
-        q[:] = pool[order[k]]
-        k += 1
+        while i_near < near.shape[0] and _same(table[0][near[i_near]], q0):
+            i_near += 1  # the first start itself
+        if used < _NEAR and i_near < near.shape[0]:  # the stored poses nearest the target, then random draws
+            q[:] = table[0][near[i_near]]
+            i_near += 1
+            used += 1
+        else:
+            if k == _POOL:
+                order = _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W)
+                k = 0
+            q[:] = pool[order[k]]
+            k += 1
         attempts += 1
         pe, re, it, ok = attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W)
         its += it
@@ -318,14 +337,14 @@ def solve_in(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
 
 
 @jit
-def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
+def solve(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
     """Attempt from ``q0``, then up to ``restarts`` starts drawn within the limits (``seed`` < 2³²), nearest pose first.
 
     Writes the solution (or the best configuration within the limits) to ``q_out``;
     returns ``(ok, pe, re, attempts, iterations)``.
     """
     W = workspace(q0.shape[0], C[0].shape[0])
-    return solve_in(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
+    return solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
 
 
 @jit
@@ -341,7 +360,7 @@ def solve_many(Rts, pts, starts, table, C, L, P, posonly, tol, restarts, seed, q
         q0 = starts[k]
         if not np.all(np.isfinite(q0)):
             q0 = table[0][grid_index(table, Rts[k], pts[k], posonly)]
-        o, a, b, _, it = solve_in(q0, C, L, P, Rts[k], pts[k], posonly, tol, restarts, (seed + k) % 4294967296,
+        o, a, b, _, it = solve_in(q0, table, C, L, P, Rts[k], pts[k], posonly, tol, restarts, (seed + k) % 4294967296,
                                   q_out[k], W)
         ok[k], pe[k], re[k] = o, a, b
         total += it

@@ -191,7 +191,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         else:
             q0 = np.ascontiguousarray(q_seed, dtype=float)
         q = np.empty(self.nq)
-        ok, pe, re, attempts, its = kernel.solve(q0, C, L, P, Rt, pt, position_only, tol, max_restarts,
+        ok, pe, re, attempts, its = kernel.solve(q0, table, C, L, P, Rt, pt, position_only, tol, max_restarts,
                                                  _seed_int(seed), q)
         if ok:
             pe, re = self.errors(q, target, position_only)
