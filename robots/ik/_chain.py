@@ -206,6 +206,16 @@ def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
 
 
 @jit
+def _cell_of(grid, pt):
+    """``(cx, cy, cz, nx, ny, nz)``: the grid cell of the point ``pt`` (clamped to the grid) and the grid's size."""
+    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
+    cx = min(max(int(math.floor((pt[0] - grid[0]) * grid[3])), 0), nx - 1)
+    cy = min(max(int(math.floor((pt[1] - grid[1]) * grid[3])), 0), ny - 1)
+    cz = min(max(int(math.floor((pt[2] - grid[2]) * grid[3])), 0), nz - 1)
+    return cx, cy, cz, nx, ny, nz
+
+
+@jit
 def grid_index(table, Rt, pt, posonly):
     """Row of the gridded start table nearest ``(Rt, pt)`` among the rows in the target's cell and its 26 neighbours.
 
@@ -214,10 +224,7 @@ def grid_index(table, Rt, pt, posonly):
     :func:`table_index`; when those cells are all empty, every row is scanned.
     """
     tq, tp, tpp, tR, cell_start, grid = table
-    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
-    cx = min(max(int(math.floor((pt[0] - grid[0]) * grid[3])), 0), nx - 1)
-    cy = min(max(int(math.floor((pt[1] - grid[1]) * grid[3])), 0), ny - 1)
-    cz = min(max(int(math.floor((pt[2] - grid[2]) * grid[3])), 0), nz - 1)
+    cx, cy, cz, nx, ny, nz = _cell_of(grid, pt)
     best, best2, k_best = np.inf, np.inf, -1
     for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
         for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
@@ -246,10 +253,7 @@ def grid_neighbours(table, Rt, pt, posonly, count):
     """Up to ``count`` rows of the gridded start table in the target's cell and its 26 neighbours,
     nearest pose first (cost as :func:`table_index`); ``int64`` array."""
     tq, tp, tpp, tR, cell_start, grid = table
-    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
-    cx = min(max(int(math.floor((pt[0] - grid[0]) * grid[3])), 0), nx - 1)
-    cy = min(max(int(math.floor((pt[1] - grid[1]) * grid[3])), 0), ny - 1)
-    cz = min(max(int(math.floor((pt[2] - grid[2]) * grid[3])), 0), nz - 1)
+    cx, cy, cz, nx, ny, nz = _cell_of(grid, pt)
     n = 0
     for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
         for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
