@@ -56,7 +56,10 @@ _R, _P, _Z, _O, _ZT, _OT, _E, _ET, _J, _QT, _DQ, _FREE, _G0, _G, _X, _B, _GM, _B
 
 @jit
 def _cholesky_solve(G, b, x):
-    """Solve ``G x = b`` (G symmetric positive definite, overwritten by its factor); False if not SPD."""
+    """Solve ``G x = b`` (G symmetric positive definite, overwritten by its factor); False if not SPD.
+
+    The factor's diagonal is kept inverted (multiplications instead of divisions).
+    """
     n = G.shape[0]
     for j in range(n):
         d = G[j, j]
@@ -64,23 +67,23 @@ def _cholesky_solve(G, b, x):
             d -= G[j, k] * G[j, k]
         if not d > 0.0:
             return False
-        d = math.sqrt(d)
-        G[j, j] = d
+        inv = 1.0 / math.sqrt(d)
+        G[j, j] = inv
         for i in range(j + 1, n):
             s = G[i, j]
             for k in range(j):
                 s -= G[i, k] * G[j, k]
-            G[i, j] = s / d
+            G[i, j] = s * inv
     for i in range(n):
         s = b[i]
         for k in range(i):
             s -= G[i, k] * x[k]
-        x[i] = s / G[i, i]
+        x[i] = s * G[i, i]
     for i in range(n - 1, -1, -1):
         s = x[i]
         for k in range(i + 1, n):
             s -= G[k, i] * x[k]
-        x[i] = s / G[i, i]
+        x[i] = s * G[i, i]
     return True
 
 
