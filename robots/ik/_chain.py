@@ -16,10 +16,46 @@ with the frame Jacobian in base axes at the frame origin (linear rows first), so
 
 from __future__ import annotations
 
+import hashlib
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+from pinarms.files import write_text
+
+#: the compiled solver's modules: their functions call (and inline) each other across files
+KERNEL_MODULES = ("_chain.py", "_limits_kernel.py", "_kernel.py")
+
+
+def drop_stale_caches(here: Path | None = None) -> None:
+    """Delete numba's on-disk caches of :data:`KERNEL_MODULES` (in ``here``, default this folder) when any
+    of their sources changed.
+
+    numba keys a cached function on its own file only: a function of ``_kernel.py`` keeps the
+    compiled code of the ``_chain.py`` functions it calls after ``_chain.py`` changes (a branch
+    switch or an edit), and would run it. A digest of the three sources, kept beside the caches,
+    tells when they must be compiled again. Nothing happens where the cache folder cannot be written
+    (an installed package is compiled afresh in its own place anyway).
+    """
+    here = Path(__file__).resolve().parent if here is None else Path(here)
+    cache = here / "__pycache__"
+    try:
+        digest = hashlib.sha256(b"".join((here / name).read_bytes() for name in KERNEL_MODULES)).hexdigest()
+        mark = cache / "ik_kernels.sha256"
+        if mark.is_file() and mark.read_text() == digest:
+            return
+        for name in KERNEL_MODULES:
+            for stale in cache.glob(name[:-3] + ".*.nb[ic]"):
+                stale.unlink()
+        cache.mkdir(exist_ok=True)
+        write_text(mark, digest)  # atomically
+    except OSError:
+        return
+
+
+drop_stale_caches()
 
 ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 
@@ -33,7 +69,15 @@ def jit(function):
         return njit(nogil=True)(function)
 
 
-@jit
+def jit_inline(function):
+    """:func:`jit` inlined into its callers by numba (no call, no reference counting of its array arguments)."""
+    try:
+        return njit(cache=True, nogil=True, inline="always")(function)
+    except RuntimeError:
+        return njit(nogil=True, inline="always")(function)
+
+
+@jit_inline
 def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
     """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` ``(m, 3)``.
 
@@ -81,7 +125,7 @@ def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
         R[2, b] = r20 * fR[0, b] + r21 * fR[1, b] + r22 * fR[2, b]
 
 
-@jit
+@jit_inline
 def jacobian(qi, sc, rev, Z, O, p, J):
     """Frame Jacobian ``J (6, nq)`` in base axes at the frame origin ``p``, linear rows first."""
     J[:, :] = 0.0
@@ -103,7 +147,7 @@ def jacobian(qi, sc, rev, Z, O, p, J):
             J[2, j] += s * z2
 
 
-@jit
+@jit_inline
 def log3_of(Rt, R, w):
     """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
     m00 = Rt[0, 0] * R[0, 0] + Rt[0, 1] * R[0, 1] + Rt[0, 2] * R[0, 2]
@@ -140,7 +184,7 @@ def log3_of(Rt, R, w):
     return theta
 
 
-@jit
+@jit_inline
 def pose_error(q, C, Rt, pt, posonly, R, p, Z, O, e):
     """Error ``e`` of ``q`` (its pose, axes ``Z`` and origins ``O`` written too): ``(‖e‖², position error², angle)``."""
     qi, sc, of, rev, LR, Lp, fR, fp = C

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ._chain import errors, grid_index, grid_neighbours, jacobian, jit, pose_cost, pose_error, table_index
+from ._chain import errors, grid_index, grid_neighbours, jacobian, jit, jit_inline, pose_cost, pose_error, table_index
 from ._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
 
 __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits", "table_index", "solve",
@@ -87,7 +87,7 @@ def _cholesky_solve(G, b, x):
     return True
 
 
-@jit
+@jit_inline
 def _gram(J, rows, e, free, G0, b):
     """``G0 = A Aᵀ`` (rows × rows; ``AᵀA`` and ``b = Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed."""
     nq = J.shape[1]
@@ -115,7 +115,7 @@ def _gram(J, rows, e, free, G0, b):
             G0[j, i] = s
 
 
-@jit
+@jit_inline
 def _damped_solve(J, rows, e, lam, free, G0, b, G, x, dq):
     """``dq = Aᵀ(G0 + λI)⁻¹e`` (``(G0 + λI)⁻¹b`` when nq < rows) from :func:`_gram`'s ``G0, b``; False if not SPD."""
     nq = J.shape[1]
@@ -138,7 +138,7 @@ def _damped_solve(J, rows, e, lam, free, G0, b, G, x, dq):
     return True
 
 
-@jit
+@jit_inline
 def _step(J, rows, e, lam, q, lo, hi, at_limit, max_step, dq, free, all_free, G0, b, G, x, Gm, bm):
     """The damped step ``dq`` of this ``λ``, with the active set at the limits and the step cap; False if not SPD.
 
@@ -169,7 +169,7 @@ def _step(J, rows, e, lam, q, lo, hi, at_limit, max_step, dq, free, all_free, G0
     return True
 
 
-@jit
+@jit_inline
 def _nielsen(mu, E, E_t, e, J, dq, rows):
     """Nielsen's update of ``μ`` from the gain ratio ρ (actual over predicted decrease of ‖e‖²)."""
     predicted = E

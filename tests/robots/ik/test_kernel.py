@@ -139,3 +139,26 @@ def test_seeded_batch_as_accurate_as_before_in_fewer_iterations(name):
         assert np.linalg.norm(M.translation - Tk[:3, 3]) <= 1e-10
         assert np.linalg.norm(pin.log3(M.rotation.T @ Tk[:3, :3])) <= 1e-10
     assert res.iterations / 200 <= _FORMER_ITERATIONS[name]
+
+
+def test_a_changed_kernel_source_drops_every_kernel_cache(tmp_path):
+    """numba keys a cache on its own file only: a change of any kernel module drops the caches of all three."""
+    from pathlib import Path
+
+    here = Path(chain.__file__).parent
+    for name in chain.KERNEL_MODULES:
+        (tmp_path / name).write_bytes((here / name).read_bytes())
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    stale = [cache / "_kernel.descend-198.py311.nbi", cache / "_chain.fk-92.py311.1.nbc"]
+    other = cache / "numerical.cpython-311.pyc"
+    for f in stale + [other]:
+        f.write_bytes(b"x")
+    chain.drop_stale_caches(tmp_path)  # no digest yet: dropped
+    assert not any(f.exists() for f in stale) and other.exists()
+    stale[0].write_bytes(b"x")
+    chain.drop_stale_caches(tmp_path)  # same sources: kept
+    assert stale[0].exists()
+    (tmp_path / "_chain.py").write_text((here / "_chain.py").read_text() + "\n# changed\n")
+    chain.drop_stale_caches(tmp_path)  # a sibling changed: the _kernel cache goes too
+    assert not stale[0].exists() and other.exists()
