@@ -305,9 +305,8 @@ def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
     attempts = 1
     if ok:
         return True, pe, re, attempts, its
-    np.random.seed(seed)
-    pool = np.empty((_POOL, nq))
-    cost = np.empty(_POOL)
+    pool = np.empty((0, nq))  # the random draws, made (and the generator seeded) only when needed
+    cost = np.empty(0)
     order = np.empty(0, dtype=np.int64)
     k = _POOL
     best_pe, best_re = pe, re
@@ -322,6 +321,9 @@ def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
             used += 1
         else:
             if k == _POOL:
+                if pool.shape[0] == 0:
+                    np.random.seed(seed)
+                    pool, cost = np.empty((_POOL, nq)), np.empty(_POOL)
                 order = _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W)
                 k = 0
             q[:] = pool[order[k]]
