@@ -12,9 +12,15 @@ multiplying ``μ`` by 2, 4, 8, …, a per-joint step cap, stall detection, and t
 for joint limits (a free descent wrapped to the ranges' 2π windows, then a projected descent
 with an active set; see :mod:`._limits_kernel`).
 
+Starts: the first from ``q0`` (a seed, or the stored pose nearest the target, :func:`._chain.grid_index`),
+then the :data:`_NEAR` stored poses next nearest the target, then uniform draws within the limits
+(numba's generator, seeded per target), 32 at a time, nearest pose first.
+
 Costs kept out of the loop: the Gram matrix ``J Jᵀ`` is formed once per iteration (a rejected
 step only adds another ``λ`` to its diagonal); a trial step evaluates the pose and error only,
-the Jacobian is formed once the step is accepted; the scratch buffers are made once per batch.
+the Jacobian is formed once the step is accepted; the scratch buffers are made once per batch;
+the per-iteration helpers are inlined by numba (a call with a dozen array arguments costs as much
+as the 6×6 solve).
 """
 
 from __future__ import annotations
@@ -257,7 +263,7 @@ def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W):
     """Free descent (wrapped), then, met outside the limits, a projected one: ``(pe, re, iterations, ok)``; q in place, within the limits.
 
     An arm with no more joints than task rows has isolated solutions: a projected descent from
-    one more than :data:`_FAR_OUTSIDE` beyond a limit almost never meets the pose (AUBO-i3: 1 of
+    a solution more than :data:`_FAR_OUTSIDE` beyond a limit almost never meets the pose (AUBO-i3: 1 of
     265 attempts), so the next start is tried at once; a solution just past a limit is still
     slid back.
     """
@@ -343,7 +349,8 @@ def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
 
 @jit
 def solve(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
-    """Attempt from ``q0``, then up to ``restarts`` starts drawn within the limits (``seed`` < 2³²), nearest pose first.
+    """Attempt from ``q0``, then up to ``restarts`` more: the stored poses next nearest the target, then
+    starts drawn within the limits (``seed`` < 2³²), nearest pose first.
 
     Writes the solution (or the best configuration within the limits) to ``q_out``;
     returns ``(ok, pe, re, attempts, iterations)``.

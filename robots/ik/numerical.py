@@ -177,8 +177,9 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
 
     def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
                         seed) -> IKResult:
-        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the table's
-        nearest pose), then up to ``max_restarts`` seeded uniform starts nearest pose first.
+        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the nearest of
+        16 384 stored poses), then up to ``max_restarts`` more: the 8 stored poses next nearest the
+        target, then seeded uniform starts nearest pose first.
 
         A success is confirmed by Pinocchio's forward kinematics of the returned ``q`` and an exact
         limit check (independent of the compiled chain evaluation).

@@ -96,15 +96,16 @@ def solve_batch(
     """Many targets at once: the compiled solver over the batch (in threads), then :meth:`solve` for any left.
 
     Each target gets the attempts of :meth:`solve` (free descent, projected descent when it
-    meets the target outside the limits) from its start, then up to ``max_restarts`` uniform
-    starts within the limits nearest pose first, the whole loop compiled; target ``k``'s
+    meets the target outside the limits) from its start, then up to ``max_restarts`` more (the
+    stored poses next nearest the target, then uniform starts within the limits nearest pose
+    first), the whole loop compiled; target ``k``'s
     restarts are seeded by ``seed + k`` (for an integer ``seed``: row ``k`` is ``Robot.ik(targets[k],
     seed=seed + k)``, bit for bit; the thread blocks change nothing).
 
     Args:
         targets: checked poses ``(N, 4, 4)`` frame → base [m].
-        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
-            :meth:`table_start` of each target).
+        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN: the stored
+            configuration whose pose is nearest each target, as :meth:`solve` without a seed).
         tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
         max_restarts, seed: restarts per target, and the seed of all random starts.
 
