@@ -77,7 +77,7 @@ def jit_inline(function):
         return njit(nogil=True, inline="always")(function)
 
 
-@jit_inline
+@jit
 def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
     """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` ``(m, 3)``.
 
@@ -147,7 +147,7 @@ def jacobian(qi, sc, rev, Z, O, p, J):
             J[2, j] += s * z2
 
 
-@jit_inline
+@jit
 def log3_of(Rt, R, w):
     """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
     m00 = Rt[0, 0] * R[0, 0] + Rt[0, 1] * R[0, 1] + Rt[0, 2] * R[0, 2]

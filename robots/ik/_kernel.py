@@ -19,8 +19,8 @@ then the :data:`_NEAR` stored poses next nearest the target, then uniform draws 
 Costs kept out of the loop: the Gram matrix ``J Jᵀ`` is formed once per iteration (a rejected
 step only adds another ``λ`` to its diagonal); a trial step evaluates the pose and error only,
 the Jacobian is formed once the step is accepted; the scratch buffers are made once per batch;
-the per-iteration helpers are inlined by numba (a call with a dozen array arguments costs as much
-as the 6×6 solve).
+the per-iteration helpers with many array arguments are inlined by numba (a call with a dozen array
+arguments costs as much as the 6×6 solve).
 """
 
 from __future__ import annotations
