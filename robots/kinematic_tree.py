@@ -85,70 +85,13 @@ class KinematicTree:
     def __init__(self, model: pin.Model) -> None:
         self.model = model
         n = model.njoints
-        data = model.createData()
-        pin.forwardKinematics(model, data, pin.neutral(model))
-
         self.parent = np.array([model.parents[i] for i in range(n)], dtype=int)
         self.kind = np.zeros(n, dtype=int)
         self.q_index = np.full(n, -1, dtype=int)  # index of the independent coordinate
         self.scale = np.ones(n)
         self.offset = np.zeros(n)
-        axis_rot = np.tile(np.eye(3), (n, 1, 1))  # A_i: z → joint axis, joint frame
-        placement_R = np.tile(np.eye(3), (n, 1, 1))
-        placement_p = np.zeros((n, 3))
-
-        idx_q_pin, unbounded = [], []
-        for i in range(1, n):
-            joint = model.joints[i]
-            short = joint.shortname()
-            is_mimic = "Mimic" in short
-            if is_mimic:
-                mimic = joint.extract()
-                self.scale[i], self.offset[i] = mimic.scaling, mimic.offset
-                if not (np.isfinite(mimic.scaling) and mimic.scaling != 0.0 and np.isfinite(mimic.offset)):
-                    raise ModelError(
-                        f"mimic joint '{model.names[i]}' has multiplier {mimic.scaling!r} and offset "
-                        f"{mimic.offset!r}; a mimic needs a finite, non-zero multiplier (a joint that never "
-                        "moves is a fixed joint)"
-                    )
-            elif joint.nv != 1:
-                raise ModelError(
-                    f"joint '{model.names[i]}' is a {short} with {joint.nv} degrees of freedom; "
-                    "pinarms models arms made of 1-DoF revolute, prismatic and continuous joints "
-                    "(and <mimic> joints of those)"
-                )
-            self.q_index[i] = joint.idx_v
-            if not is_mimic:
-                idx_q_pin.append(joint.idx_q)
-                unbounded.append(joint.nq == 2)
-            motion = np.array(data.joints[i].S).reshape(6, -1)[:, 0] / self.scale[i]
-            linear, angular = motion[:3], motion[3:]
-            if np.linalg.norm(angular) > 1e-12 and np.linalg.norm(linear) < 1e-12:
-                self.kind[i] = _REVOLUTE
-                axis = angular
-            elif np.linalg.norm(linear) > 1e-12 and np.linalg.norm(angular) < 1e-12:
-                self.kind[i] = _PRISMATIC
-                axis = linear
-            else:
-                raise ModelError(
-                    f"joint '{model.names[i]}' ({short}) is neither a pure rotation nor a pure "
-                    "translation; pinarms cannot evaluate it in batch"
-                )
-            axis_rot[i] = _rotation_z_to(axis)
-            M = model.jointPlacements[i]
-            placement_R[i] = M.rotation
-            placement_p[i] = M.translation
-
-        # Fold A_parentᵀ into each child's placement and A_iᵀ... into nothing: joint i's
-        # batched frame is R_i' = R_i · A_i, so a child c sees the placement
-        # A_parentᵀ · M_c, and its own frame gets · A_c.
-        self.local_R = np.empty((n, 3, 3))
-        self.local_p = np.empty((n, 3))
-        for i in range(1, n):
-            Ap = axis_rot[self.parent[i]]
-            self.local_R[i] = Ap.T @ placement_R[i] @ axis_rot[i]
-            self.local_p[i] = Ap.T @ placement_p[i]
-        self.axis_rot = axis_rot
+        axis_rot, placement_R, placement_p, idx_q_pin, unbounded = self._read_joints(model)
+        self._fold_axes(axis_rot, placement_R, placement_p)
         self.coordinates = JointCoordinates(
             nq_pin=model.nq,
             idx_q_pin=np.array(idx_q_pin, dtype=int),
@@ -163,9 +106,78 @@ class KinematicTree:
                 chain.append(j)
                 j = self.parent[j]
             self.ancestors.append(chain[::-1])
-        # Constants of the evaluation, computed once: for every joint the nonzero terms of
-        # its placement (entries within 1e-14 of 0 or ±1 snapped), its coordinate's
-        # index, scale and offset as plain Python numbers; the same for every frame.
+        self._compile_constants()
+
+    def _read_joints(self, model: pin.Model) -> tuple:
+        """Kind, coordinate, mimic scale/offset of every joint (set on ``self``); returns
+        ``(axis_rot, placement_R, placement_p, idx_q_pin, unbounded)``.
+
+        ``axis_rot[i]`` (A_i) takes z to joint i's axis; the placements are the model's.
+        """
+        n = model.njoints
+        data = model.createData()
+        pin.forwardKinematics(model, data, pin.neutral(model))
+        axis_rot = np.tile(np.eye(3), (n, 1, 1))  # A_i: z → joint axis, joint frame
+        placement_R = np.tile(np.eye(3), (n, 1, 1))
+        placement_p = np.zeros((n, 3))
+        idx_q_pin, unbounded = [], []
+        for i in range(1, n):
+            joint = model.joints[i]
+            is_mimic = self._read_coupling(model, i, joint)
+            self.q_index[i] = joint.idx_v
+            if not is_mimic:
+                idx_q_pin.append(joint.idx_q)
+                unbounded.append(joint.nq == 2)
+            motion = np.array(data.joints[i].S).reshape(6, -1)[:, 0] / self.scale[i]
+            self.kind[i], axis = _joint_kind(model.names[i], joint.shortname(), motion)
+            axis_rot[i] = _rotation_z_to(axis)
+            M = model.jointPlacements[i]
+            placement_R[i] = M.rotation
+            placement_p[i] = M.translation
+        return axis_rot, placement_R, placement_p, idx_q_pin, unbounded
+
+    def _read_coupling(self, model: pin.Model, i: int, joint) -> bool:
+        """Whether joint ``i`` is a mimic (its scale and offset set on ``self``); raises for a multi-DoF joint."""
+        short = joint.shortname()
+        if "Mimic" in short:
+            mimic = joint.extract()
+            self.scale[i], self.offset[i] = mimic.scaling, mimic.offset
+            if not (np.isfinite(mimic.scaling) and mimic.scaling != 0.0 and np.isfinite(mimic.offset)):
+                raise ModelError(
+                    f"mimic joint '{model.names[i]}' has multiplier {mimic.scaling!r} and offset "
+                    f"{mimic.offset!r}; a mimic needs a finite, non-zero multiplier (a joint that never "
+                    "moves is a fixed joint)"
+                )
+            return True
+        if joint.nv != 1:
+            raise ModelError(
+                f"joint '{model.names[i]}' is a {short} with {joint.nv} degrees of freedom; "
+                "pinarms models arms made of 1-DoF revolute, prismatic and continuous joints "
+                "(and <mimic> joints of those)"
+            )
+        return False
+
+    def _fold_axes(self, axis_rot: np.ndarray, placement_R: np.ndarray, placement_p: np.ndarray) -> None:
+        """``local_R``, ``local_p``, ``axis_rot``: every joint rewritten to move along or about its own z.
+
+        Fold A_parentᵀ into each child's placement and A_iᵀ... into nothing: joint i's
+        batched frame is R_i' = R_i · A_i, so a child c sees the placement
+        A_parentᵀ · M_c, and its own frame gets · A_c.
+        """
+        n = self.parent.shape[0]
+        self.local_R = np.empty((n, 3, 3))
+        self.local_p = np.empty((n, 3))
+        for i in range(1, n):
+            Ap = axis_rot[self.parent[i]]
+            self.local_R[i] = Ap.T @ placement_R[i] @ axis_rot[i]
+            self.local_p[i] = Ap.T @ placement_p[i]
+        self.axis_rot = axis_rot
+
+    def _compile_constants(self) -> None:
+        """Constants of the evaluation, computed once: for every joint the nonzero terms of
+        its placement (entries within 1e-14 of 0 or ±1 snapped), its coordinate's
+        index, scale and offset as plain Python numbers; the same for every frame."""
+        n = self.parent.shape[0]
         self._steps = [None] + [
             (
                 i,
@@ -181,8 +193,8 @@ class KinematicTree:
         ]
         self._path = [tuple(self._steps[i] for i in chain) for chain in self.ancestors]
         self._frames = []
-        for f in model.frames:
-            A = axis_rot[f.parentJoint]
+        for f in self.model.frames:
+            A = self.axis_rot[f.parentJoint]
             fR = A.T @ f.placement.rotation
             fp = A.T @ f.placement.translation
             self._frames.append((int(f.parentJoint), fR, fp, _matrix_terms(fR), _vector_terms(fp)))
@@ -290,6 +302,19 @@ class KinematicTree:
 
         _run_chunks(block, N)
         return J
+
+
+def _joint_kind(name: str, short: str, motion: np.ndarray) -> tuple[int, np.ndarray]:
+    """``(_REVOLUTE or _PRISMATIC, axis)`` of a 1-DoF joint from its motion subspace ``(6,)`` (linear first)."""
+    linear, angular = motion[:3], motion[3:]
+    if np.linalg.norm(angular) > 1e-12 and np.linalg.norm(linear) < 1e-12:
+        return _REVOLUTE, angular
+    if np.linalg.norm(linear) > 1e-12 and np.linalg.norm(angular) < 1e-12:
+        return _PRISMATIC, linear
+    raise ModelError(
+        f"joint '{name}' ({short}) is neither a pure rotation nor a pure "
+        "translation; pinarms cannot evaluate it in batch"
+    )
 
 
 def _run_chunks(block, N: int) -> None:

@@ -42,14 +42,16 @@ MAX_RANDOM_SAMPLES = 50_000_000
 SMALL_BATCH = 24
 
 _F64 = np.dtype(np.float64)
+_NDARRAY = np.ndarray
 _LWA = pin.LOCAL_WORLD_ALIGNED
+# Pinocchio's calls of the one-configuration fast paths, looked up once
+_pin_fk, _pin_place, _pin_jacobian = pin.forwardKinematics, pin.updateFramePlacement, pin.computeFrameJacobian
 
 
 class _PerThread(threading.local):
-    """Per-thread slot of a Robot's Pinocchio data (``model`` is the model it was made for)."""
+    """Per-thread slot of a Robot's Pinocchio data: ``pair = (model, data)``, the data and the model it was made for."""
 
-    model = None
-    data = None
+    pair = (None, None)
 
 
 _PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
@@ -98,6 +100,8 @@ class Robot(RobotIK):
         #: Pinocchio's configuration vector is pinarms' q itself (no continuous joint)
         self._same_q = (not coords.is_unbounded.any()) and model.nq == self.nq
         self._shape1 = (self.nq,)
+        #: shape of one configuration that Pinocchio takes as it is (None: continuous joints need conversion)
+        self._pin_shape1 = self._shape1 if self._same_q else None
         self._frame_ids: dict[str, int] = {}
         for i, f in enumerate(model.frames):
             self._frame_ids.setdefault(f.name, i)  # the first frame of a name, as Pinocchio's getFrameId
@@ -128,11 +132,11 @@ class Robot(RobotIK):
     # reads (model, limits, compiled constants) is never written after construction.
     def _pin_data(self) -> pin.Data:
         """This thread's Pinocchio data of :attr:`model` (created on first use, again if the model was replaced)."""
-        local = self._local
-        if local.model is not self.model:
-            local.data = self.model.createData()
-            local.model = self.model
-        return local.data
+        model, data = self._local.pair
+        if model is not self.model:
+            data = self.model.createData()
+            self._local.pair = (self.model, data)  # one assignment: the pair is always consistent
+        return data
 
     @property
     def _data(self) -> pin.Data:
@@ -264,13 +268,16 @@ class Robot(RobotIK):
             fid = self._frame_lookup[frame]
         except (KeyError, TypeError):
             fid = self.frame_id(frame)  # raises the named error
-        if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
-            s = q.dot(q)  # the fast path of _one, inlined (a call costs as much as the check)
-            if _isfinite(s):
-                local = self._local
-                data = local.data if local.model is self.model else self._pin_data()
-                pin.forwardKinematics(self.model, data, q)
-                return pin.updateFramePlacement(self.model, data, fid).homogeneous
+        # the fast path of _one, inlined (a call costs as much as the check); finite: the sum of the
+        # entries as Python floats (a NaN or inf makes it non-finite; an overflow goes the slow way)
+        if (q.__class__ is _NDARRAY and q.shape == self._pin_shape1 and q.dtype is _F64
+                and _isfinite(sum(q.tolist()))):
+            model = self.model
+            made_for, data = self._local.pair
+            if made_for is not model:
+                data = self._pin_data()
+            _pin_fk(model, data, q)
+            return _pin_place(model, data, fid).homogeneous
         x = self._one(q)
         if x is not None:
             data = self._pin_data()
@@ -320,13 +327,14 @@ class Robot(RobotIK):
             fid = self._frame_lookup[frame]
         except (KeyError, TypeError):
             fid = self.frame_id(frame)
-        if q.__class__ is np.ndarray and q.shape == self._shape1 and q.dtype is _F64 and self._same_q:
-            s = q.dot(q)  # the fast path of _one, inlined
-            if _isfinite(s):
-                local = self._local
-                data = local.data if local.model is self.model else self._pin_data()
-                J = pin.computeFrameJacobian(self.model, data, q, fid, _LWA)
-                return J if J.ndim == 2 else J.reshape(6, 1)  # Pinocchio gives (6,) for a 1-DoF model
+        if (q.__class__ is _NDARRAY and q.shape == self._pin_shape1 and q.dtype is _F64
+                and _isfinite(sum(q.tolist()))):  # the fast path of fk
+            model = self.model
+            made_for, data = self._local.pair
+            if made_for is not model:
+                data = self._pin_data()
+            J = _pin_jacobian(model, data, q, fid, _LWA)
+            return J if J.ndim == 2 else J.reshape(6, 1)  # Pinocchio gives (6,) for a 1-DoF model
         x = self._one(q)
         if x is not None:
             J = pin.computeFrameJacobian(self.model, self._pin_data(), x, fid, _LWA)

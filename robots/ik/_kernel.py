@@ -2,27 +2,25 @@
 
 A Python step of the solver in :mod:`.numerical` costs ≈ 10 µs (about 15 Pinocchio and numpy
 calls), where the work itself is a few hundred floating-point operations. Here the chain's
-forward kinematics, frame Jacobian, error, damped 6×6 (or nq×nq) Cholesky solve, step
-control, limit handling and restarts run compiled (``nogil``: threads sharing a robot run
-in parallel; every buffer is local to the call, nothing is shared).
+kinematics (:mod:`._chain`), the damped 6×6 (or nq×nq) Cholesky solve, step control, limit
+handling and restarts run compiled (``nogil``: threads sharing a robot run in parallel; every
+buffer belongs to one call, nothing is shared).
 
-The chain is the path from the base to the frame's joint, in :class:`~..kinematic_tree.KinematicTree`'s
-rewritten form: joint ``k`` has the constant placement ``(LR[k], Lp[k])`` after its parent
-and moves about (revolute) or along (prismatic) its own z axis by ``v = sc[k]·q[qi[k]] + of[k]``
-(mimic joints: their master's coordinate, scaled and offset); the frame sits at ``(fR, fp)``
-after the last joint.
+The step control is the one of :meth:`.numerical.NumericalIK._descend`: Sugihara's damping
+``λ = μ‖e‖² + λ_min``, Nielsen's update of ``μ`` from the gain ratio, a rejected step
+multiplying ``μ`` by 2, 4, 8, …, a per-joint step cap, stall detection, and the two phases
+for joint limits (a free descent wrapped to the ranges' 2π windows, then a projected descent
+with an active set; see :mod:`._limits_kernel`).
 
-Error of ``q`` for the target ``(R_t, p_t)`` in base axes::
+Starts: the first from ``q0`` (a seed, or the stored pose nearest the target, :func:`._chain.grid_index`),
+then the :data:`_NEAR` stored poses next nearest the target, then uniform draws within the limits
+(numba's generator, seeded per target), 32 at a time, nearest pose first.
 
-    e = [p_t − p(q);  log3(R_t R(q)ᵀ)]      (6,) [m, rad]  (position only: the first 3)
-
-with the frame Jacobian in base axes at the frame origin (linear rows first), so that
-``e(q + Δq) ≈ e − J Δq`` (to first order in the error; near the solution the rotation term's
-Jacobian tends to the identity, and the steps become Newton's). The step control is the
-one of :meth:`.numerical.NumericalIK._descend`: Sugihara's damping ``λ = μ‖e‖² + λ_min``,
-Nielsen's update of ``μ`` from the gain ratio, a rejected step multiplying ``μ`` by 2, 4,
-8, …, a per-joint step cap, stall detection, and the two phases for joint limits (a free
-descent wrapped to the ranges' 2π windows, then a projected descent with an active set).
+Costs kept out of the loop: the Gram matrix ``J Jᵀ`` is formed once per iteration (a rejected
+step only adds another ``λ`` to its diagonal); a trial step evaluates the pose and error only,
+the Jacobian is formed once the step is accepted; the scratch buffers are made once per batch;
+the per-iteration helpers with many array arguments are inlined by numba (a call with a dozen array
+arguments costs as much as the 6×6 solve).
 """
 
 from __future__ import annotations
@@ -30,149 +28,44 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-FREE, WINDOW, CLIP = 0, 1, 2
+from ._chain import errors, grid_index, grid_neighbours, jacobian, jit, jit_inline, pose_cost, pose_error, table_index
+from ._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
+
+__all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits", "table_index", "solve",
+           "solve_many", "workspace", "grid_index"]
+
 _MU_MAX = 1e8
 _POOL = 32
-_ROT_WEIGHT = 0.1
-_TWO_PI = 2.0 * math.pi
-
-
-
-def _jit(function):
-    """``numba.njit`` with ``nogil``, cached on disk (beside the source, or numba's user cache
-    directory when that is read-only); without any writable cache location, compiled per process."""
-    try:
-        return njit(cache=True, nogil=True)(function)
-    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
-        return njit(nogil=True)(function)
-
+_NEAR = 8  # restarts from the stored poses nearest the target (after the first start) before random draws
 
 # P (float64 array) holds the settings: μ0, λ_min, max_step, stall_ratio, stall_steps, max_iter
 _P_MU0, _P_LAMMIN, _P_STEP, _P_STALLR, _P_STALLN, _P_ITER = 0, 1, 2, 3, 4, 5
+#: a free descent that met the pose this far [rad or m] beyond a limit, on an arm with no more joints
+#: than task rows (no self-motion to slide back along), goes to the next start instead of phase 2
+_FAR_OUTSIDE = 0.01
 
 
-@_jit
-def _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S):
-    """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` (m, 3); ``S`` (3, 7) scratch."""
-    Rc, Rn, pc = S[:, 0:3], S[:, 3:6], S[:, 6]
-    Rc[:, :] = 0.0
-    Rc[0, 0] = Rc[1, 1] = Rc[2, 2] = 1.0
-    pc[:] = 0.0
-    for k in range(qi.shape[0]):
-        for a in range(3):
-            pa = pc[a]
-            for b in range(3):
-                pa += Rc[a, b] * Lp[k, b]
-                s = 0.0
-                for c in range(3):
-                    s += Rc[a, c] * LR[k, c, b]
-                Rn[a, b] = s
-            pc[a] = pa
-        v = sc[k] * q[qi[k]] + of[k]
-        if rev[k]:
-            c = math.cos(v)
-            s = math.sin(v)
-            for a in range(3):
-                x = Rn[a, 0]
-                y = Rn[a, 1]
-                Rc[a, 0] = c * x + s * y
-                Rc[a, 1] = c * y - s * x
-                Rc[a, 2] = Rn[a, 2]
-        else:
-            for a in range(3):
-                Rc[a, 0] = Rn[a, 0]
-                Rc[a, 1] = Rn[a, 1]
-                Rc[a, 2] = Rn[a, 2]
-                pc[a] += v * Rn[a, 2]
-        for a in range(3):
-            Z[k, a] = Rc[a, 2]
-            O[k, a] = pc[a]
-    for a in range(3):
-        pa = pc[a]
-        for b in range(3):
-            pa += Rc[a, b] * fp[b]
-            s = 0.0
-            for c in range(3):
-                s += Rc[a, c] * fR[c, b]
-            R[a, b] = s
-        p[a] = pa
+@jit
+def workspace(nq, m):
+    """Scratch buffers of :func:`descend` for ``nq`` coordinates and a chain of ``m`` joints."""
+    n = max(6, nq)
+    return (np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3)),
+            np.empty(6), np.empty(6), np.empty((6, nq)), np.empty(nq), np.empty(nq), np.ones(nq, dtype=np.bool_),
+            np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(n), np.empty((n, n)), np.empty(n),
+            np.ones(nq, dtype=np.bool_))
 
 
-@_jit
-def _jacobian(qi, sc, rev, Z, O, p, J):
-    """Frame Jacobian ``J (6, nq)`` in base axes at the frame origin ``p``, linear rows first."""
-    J[:, :] = 0.0
-    for k in range(qi.shape[0]):
-        j = qi[k]
-        z0, z1, z2 = Z[k, 0], Z[k, 1], Z[k, 2]
-        s = sc[k]
-        if rev[k]:
-            d0, d1, d2 = p[0] - O[k, 0], p[1] - O[k, 1], p[2] - O[k, 2]
-            J[0, j] += s * (z1 * d2 - z2 * d1)
-            J[1, j] += s * (z2 * d0 - z0 * d2)
-            J[2, j] += s * (z0 * d1 - z1 * d0)
-            J[3, j] += s * z0
-            J[4, j] += s * z1
-            J[5, j] += s * z2
-        else:
-            J[0, j] += s * z0
-            J[1, j] += s * z1
-            J[2, j] += s * z2
+# indices into the workspace tuple
+_R, _P, _Z, _O, _ZT, _OT, _E, _ET, _J, _QT, _DQ, _FREE, _G0, _G, _X, _B, _GM, _BM, _ALL = range(19)
 
 
-@_jit
-def _log3_of(Rt, R, w, M):
-    """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
-    for a in range(3):
-        for b in range(3):
-            M[a, b] = Rt[a, 0] * R[b, 0] + Rt[a, 1] * R[b, 1] + Rt[a, 2] * R[b, 2]
-    w0 = 0.5 * (M[2, 1] - M[1, 2])
-    w1 = 0.5 * (M[0, 2] - M[2, 0])
-    w2 = 0.5 * (M[1, 0] - M[0, 1])
-    c = 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)
-    s = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-    theta = math.atan2(s, c)
-    if c >= -0.9:
-        k = theta / s if s > 1e-300 else 1.0
-        w[0], w[1], w[2] = k * w0, k * w1, k * w2
-        return theta
-    # θ > 2.69 rad: (M + Mᵀ)/2 − c I = (1 − c) a aᵀ
-    best, i = -1.0, 0
-    for a in range(3):
-        d = M[a, a] - c
-        if d > best:
-            best, i = d, a
-    col0 = 0.5 * (M[0, i] + M[i, 0]) - (c if i == 0 else 0.0)
-    col1 = 0.5 * (M[1, i] + M[i, 1]) - (c if i == 1 else 0.0)
-    col2 = 0.5 * (M[2, i] + M[i, 2]) - (c if i == 2 else 0.0)
-    n = math.sqrt(max(col0 * col0 + col1 * col1 + col2 * col2, 1e-300))
-    sign = -1.0 if (col0 * w0 + col1 * w1 + col2 * w2) < 0.0 else 1.0
-    k = sign * theta / n
-    w[0], w[1], w[2] = k * col0, k * col1, k * col2
-    return theta
-
-
-@_jit
-def _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S):
-    """Error ``e``, Jacobian ``J`` of ``q``; returns ``(‖e‖², position error², rotation angle)``; ``S`` (3, 10) scratch."""
-    qi, sc, of, rev, LR, Lp, fR, fp = C
-    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S[:, :7])
-    _jacobian(qi, sc, rev, Z, O, p, J)
-    pe2 = 0.0
-    for a in range(3):
-        e[a] = pt[a] - p[a]
-        pe2 += e[a] * e[a]
-    if posonly:
-        return pe2, pe2, 0.0
-    theta = _log3_of(Rt, R, e[3:], S[:, 7:10])
-    return pe2 + e[3] * e[3] + e[4] * e[4] + e[5] * e[5], pe2, theta
-
-
-@_jit
+@jit
 def _cholesky_solve(G, b, x):
-    """Solve ``G x = b`` (G symmetric positive definite, overwritten by its factor); False if not SPD."""
+    """Solve ``G x = b`` (G symmetric positive definite, overwritten by its factor); False if not SPD.
+
+    The factor's diagonal is kept inverted (multiplications instead of divisions).
+    """
     n = G.shape[0]
     for j in range(n):
         d = G[j, j]
@@ -180,316 +73,269 @@ def _cholesky_solve(G, b, x):
             d -= G[j, k] * G[j, k]
         if not d > 0.0:
             return False
-        d = math.sqrt(d)
-        G[j, j] = d
+        inv = 1.0 / math.sqrt(d)
+        G[j, j] = inv
         for i in range(j + 1, n):
             s = G[i, j]
             for k in range(j):
                 s -= G[i, k] * G[j, k]
-            G[i, j] = s / d
+            G[i, j] = s * inv
     for i in range(n):
         s = b[i]
         for k in range(i):
             s -= G[i, k] * x[k]
-        x[i] = s / G[i, i]
+        x[i] = s * G[i, i]
     for i in range(n - 1, -1, -1):
         s = x[i]
         for k in range(i + 1, n):
             s -= G[k, i] * x[k]
-        x[i] = s / G[i, i]
+        x[i] = s * G[i, i]
     return True
 
 
-@_jit
-def _damped_step(J, rows, e, lam, free, dq, Gs, x):
-    """``dq = Aᵀ(AAᵀ + λI)⁻¹e`` (``(AᵀA + λI)⁻¹Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed.
-
-    ``Gs`` (≥ n, ≥ n) and ``x`` (≥ n) are scratch.
-    """
+@jit_inline
+def _gram(J, rows, e, free, G0, b):
+    """``G0 = A Aᵀ`` (rows × rows; ``AᵀA`` and ``b = Aᵀe`` when nq < rows), A = J[:rows] with columns not ``free`` zeroed."""
     nq = J.shape[1]
     if nq >= rows:
-        G = Gs[:rows, :rows]
         for a in range(rows):
-            for b in range(a + 1):
+            for c in range(a + 1):
                 s = 0.0
                 for j in range(nq):
                     if free[j]:
-                        s += J[a, j] * J[b, j]
-                G[a, b] = s
-                G[b, a] = s
-            G[a, a] += lam
-        if not _cholesky_solve(G, e[:rows], x):
-            return False
-        for j in range(nq):
-            s = 0.0
-            if free[j]:
-                for a in range(rows):
-                    s += J[a, j] * x[a]
-            dq[j] = s
-        return True
-    G = Gs[:nq, :nq]
-    bvec = x
+                        s += J[a, j] * J[c, j]
+                G0[a, c] = s
+                G0[c, a] = s
+        return
     for i in range(nq):
         s = 0.0
         for a in range(rows):
             s += J[a, i] * e[a]
-        bvec[i] = s if free[i] else 0.0
+        b[i] = s if free[i] else 0.0
         for j in range(i + 1):
             s = 0.0
             if free[i] and free[j]:
                 for a in range(rows):
                     s += J[a, i] * J[a, j]
-            G[i, j] = s
-            G[j, i] = s
-        G[i, i] += lam
-    return _cholesky_solve(G, bvec, dq)
+            G0[i, j] = s
+            G0[j, i] = s
 
 
-@_jit
-def _wrap(q, L):
-    lo, hi, full_turn, unbounded, wlow, wturns = L
-    for j in range(q.shape[0]):
-        if unbounded[j]:
-            q[j] = math.pi - (math.pi - q[j]) % _TWO_PI
-        elif wturns[j] > 0.0:
-            q[j] -= _TWO_PI * math.floor((q[j] - wlow[j]) * wturns[j])
-
-
-@_jit
-def _clip(q, L):
-    """Project ``q`` into the limits in place (see ``NumericalIK._clip``); True if a joint was clipped."""
-    lo, hi, full_turn, unbounded, wlow, wturns = L
-    out = False
-    for j in range(q.shape[0]):
-        if unbounded[j]:
-            q[j] = math.pi - (math.pi - q[j]) % _TWO_PI
-    for j in range(q.shape[0]):
-        if q[j] < lo[j] or q[j] > hi[j]:
-            out = True
-    if not out:
+@jit_inline
+def _damped_solve(J, rows, e, lam, free, G0, b, G, x, dq):
+    """``dq = Aᵀ(G0 + λI)⁻¹e`` (``(G0 + λI)⁻¹b`` when nq < rows) from :func:`_gram`'s ``G0, b``; False if not SPD."""
+    nq = J.shape[1]
+    n = rows if nq >= rows else nq
+    Gn = G[:n, :n]
+    for a in range(n):
+        for c in range(n):
+            Gn[a, c] = G0[a, c]
+        Gn[a, a] += lam
+    if nq < rows:
+        return _cholesky_solve(Gn, b, dq)
+    if not _cholesky_solve(Gn, e, x):
         return False
-    at = False
+    for j in range(nq):
+        s = 0.0
+        if free[j]:
+            for a in range(rows):
+                s += J[a, j] * x[a]
+        dq[j] = s
+    return True
+
+
+@jit_inline
+def _step(J, rows, e, lam, q, lo, hi, at_limit, max_step, dq, free, all_free, G0, b, G, x, Gm, bm):
+    """The damped step ``dq`` of this ``λ``, with the active set at the limits and the step cap; False if not SPD.
+
+    ``G0, b``: :func:`_gram` of all joints; ``free``, ``Gm``, ``bm``, ``G``, ``x``: scratch.
+    """
+    if not _damped_solve(J, rows, e, lam, all_free, G0, b, G, x, dq):
+        return False
+    if at_limit:  # joints at a limit pushed outwards: out of the step, solved again
+        nb = 0
+        for j in range(q.shape[0]):
+            blocked = (q[j] <= lo[j] and dq[j] < 0.0) or (q[j] >= hi[j] and dq[j] > 0.0)
+            free[j] = not blocked
+            nb += blocked
+        if nb:
+            _gram(J, rows, e, free, Gm, bm)
+            if not _damped_solve(J, rows, e, lam, free, Gm, bm, G, x, dq):
+                return False
+            for j in range(q.shape[0]):
+                if not free[j]:
+                    dq[j] = 0.0
+    step = 0.0
     for j in range(q.shape[0]):
-        if full_turn[j]:
-            if q[j] > hi[j]:
-                q[j] -= _TWO_PI
-            elif q[j] < lo[j]:
-                q[j] += _TWO_PI
-        if q[j] <= lo[j]:
-            q[j] = lo[j]
-            at = True
-        elif q[j] >= hi[j]:
-            q[j] = hi[j]
-            at = True
-    return at
+        step = max(step, abs(dq[j]))
+    if step > max_step:
+        scale = max_step / step
+        for j in range(q.shape[0]):
+            dq[j] *= scale
+    return True
 
 
-@_jit
-def _in_limits(q, L):
+@jit_inline
+def _nielsen(mu, E, E_t, e, J, dq, rows):
+    """Nielsen's update of ``μ`` from the gain ratio ρ (actual over predicted decrease of ‖e‖²)."""
+    predicted = E
+    for a in range(rows):
+        r = e[a]
+        for j in range(dq.shape[0]):
+            r -= J[a, j] * dq[j]
+        predicted -= r * r
+    rho = (E - E_t) / predicted if predicted > 0.0 else 1.0
+    return max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
+
+
+@jit
+def _start_at_limit(q, L):
+    """Project ``q`` for a projected descent; True if a joint is at a limit."""
+    if clip(q, L):
+        return True
     lo, hi = L[0], L[1]
     for j in range(q.shape[0]):
-        if q[j] < lo[j] or q[j] > hi[j]:
+        if q[j] <= lo[j] or q[j] >= hi[j]:
+            return True
+    return False
+
+
+@jit
+def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience, W):
+    """Levenberg–Marquardt from ``q`` (modified in place): ``(position error [m], rotation error [rad], iterations)``."""
+    rows = 3 if posonly else 6
+    stall_ratio, max_step = P[_P_STALLR], P[_P_STEP]
+    stall_steps, max_iter = int(P[_P_STALLN]) * patience, int(P[_P_ITER]) * patience
+    qi, sc, rev = C[0], C[1], C[3]
+    R, p, Z, O, Z_t, O_t = W[_R], W[_P], W[_Z], W[_O], W[_ZT], W[_OT]
+    e, e_t, J, q_t, dq, free, G0, G, x, b, Gm, bm, all_free = (W[_E], W[_ET], W[_J], W[_QT], W[_DQ], W[_FREE], W[_G0],
+                                                               W[_G], W[_X], W[_B], W[_GM], W[_BM], W[_ALL])
+    lo, hi, lam_min = L[0], L[1], P[_P_LAMMIN]
+    at_limit = _start_at_limit(q, L) if mode == CLIP else False
+    E, pe2, th = pose_error(q, C, Rt, pt, posonly, R, p, Z, O, e)
+    jacobian(qi, sc, rev, Z, O, p, J)
+    mu, nu, it, stall = P[_P_MU0], 2.0, 0, 0
+    done = pe2 <= tol * tol and th <= tol
+    while not done and it < max_iter:
+        it += 1
+        _gram(J, rows, e, all_free, G0, b)  # all joints free: the step's Gram matrix, reused for every λ tried
+        accepted = False
+        while mu < _MU_MAX:
+            if not _step(J, rows, e, mu * E + lam_min, q, lo, hi, at_limit, max_step, dq, free, all_free, G0, b, G, x,
+                         Gm, bm):
+                mu, nu = mu * nu, 2.0 * nu
+                continue
+            for j in range(q.shape[0]):
+                q_t[j] = q[j] + dq[j]
+            clipped = clip(q_t, L) if mode == CLIP else False
+            E_t, pe2_t, th_t = pose_error(q_t, C, Rt, pt, posonly, R, p, Z_t, O_t, e_t)
+            if E_t < E:  # accept
+                mu, nu = _nielsen(mu, E, E_t, e, J, dq, rows), 2.0
+                stall = stall + 1 if E_t > stall_ratio * E else 0
+                q[:] = q_t
+                e, e_t, Z, Z_t, O, O_t = e_t, e, Z_t, Z, O_t, O
+                jacobian(qi, sc, rev, Z, O, p, J)
+                E, pe2, th, at_limit, accepted = E_t, pe2_t, th_t, clipped, True
+                break
+            mu, nu = mu * nu, 2.0 * nu
+        if not accepted or stall >= stall_steps:
+            break
+        done = pe2 <= tol * tol and th <= tol
+    if mode == WINDOW:
+        wrap(q, L)
+    else:
+        wrap_unbounded(q, L)
+    return math.sqrt(pe2), th, it
+
+
+@jit
+def _excess(q, L):
+    """Largest distance of ``q`` beyond a limit [rad or m]."""
+    lo, hi = L[0], L[1]
+    out = 0.0
+    for j in range(q.shape[0]):
+        out = max(out, lo[j] - q[j], q[j] - hi[j])
+    return out
+
+
+@jit
+def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W):
+    """Free descent (wrapped), then, met outside the limits, a projected one: ``(pe, re, iterations, ok)``; q in place, within the limits.
+
+    An arm with no more joints than task rows has isolated solutions: a projected descent from
+    a solution more than :data:`_FAR_OUTSIDE` beyond a limit almost never meets the pose (AUBO-i3: 1 of
+    265 attempts), so the next start is tried at once; a solution just past a limit is still
+    slid back.
+    """
+    pe, re, it = descend(q, C, L, P, Rt, pt, posonly, tol, WINDOW, 1, W)
+    met = pe <= tol and re <= tol
+    if met and in_limits(q, L):
+        return pe, re, it, True
+    far = not met or (q.shape[0] <= (3 if posonly else 6) and _excess(q, L) > _FAR_OUTSIDE)
+    clip(q, L)
+    if far:  # no pose reached, or an isolated solution well outside: report the projection, restart elsewhere
+        pe, re = errors(q, C, Rt, pt, posonly)
+        return pe, re, it, False
+    pe, re, it2 = descend(q, C, L, P, Rt, pt, posonly, tol, CLIP, 1, W)
+    return pe, re, it + it2, pe <= tol and re <= tol
+
+
+@jit
+def _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W):
+    """Fill ``pool`` with uniform draws within the limits (numba's seeded generator); their order, nearest pose first."""
+    lo, hi = L[0], L[1]
+    for i in range(pool.shape[0]):
+        for j in range(pool.shape[1]):
+            pool[i, j] = lo[j] + (hi[j] - lo[j]) * np.random.random()
+        cost[i] = pose_cost(C, pool[i], Rt, pt, posonly, W[_R], W[_P], W[_ZT], W[_OT])
+    return np.argsort(cost, kind="mergesort")
+
+
+@jit
+def _same(a, b):
+    """``a == b`` entry by entry."""
+    for j in range(a.shape[0]):
+        if a[j] != b[j]:
             return False
     return True
 
 
-@_jit
-def descend(q, C, L, P, Rt, pt, posonly, tol, mode, patience):
-    """Levenberg–Marquardt from ``q`` (modified in place): ``(position error [m], rotation error [rad], iterations)``."""
-    lo, hi = L[0], L[1]
-    nq = q.shape[0]
-    rows = 3 if posonly else 6
-    mu0, lam_min, max_step = P[_P_MU0], P[_P_LAMMIN], P[_P_STEP]
-    stall_ratio = P[_P_STALLR]
-    stall_steps = int(P[_P_STALLN]) * patience
-    max_iter = int(P[_P_ITER]) * patience
-    tol2 = tol * tol
-    clip = mode == CLIP
-    m = C[0].shape[0]
-    R, p, Z, O = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3))
-    e, J = np.empty(6), np.empty((6, nq))
-    e_t, J_t = np.empty(6), np.empty((6, nq))
-    q_t = np.empty(nq)
-    dq = np.empty(nq)
-    free = np.ones(nq, dtype=np.bool_)
-    all_free = np.ones(nq, dtype=np.bool_)
-    S = np.empty((3, 10))
-    nb_ = max(rows, nq)
-    Gs, xs = np.empty((nb_, nb_)), np.empty(nb_)
-    at_limit = False
-    if clip:
-        at_limit = _clip(q, L)
-        if not at_limit:
-            for j in range(nq):
-                if q[j] <= lo[j] or q[j] >= hi[j]:
-                    at_limit = True
-    E, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, S)
-    mu, nu = mu0, 2.0
-    it = 0
-    stall = 0
-    done = pe2 <= tol2 and th <= tol
-    while not done and it < max_iter:
-        it += 1
-        accepted = False
-        while mu < _MU_MAX:
-            lam = mu * E + lam_min
-            if not _damped_step(J, rows, e, lam, all_free, dq, Gs, xs):
-                mu *= nu
-                nu *= 2.0
-                continue
-            if at_limit:  # joints at a limit pushed outwards: out of the step, solved again
-                nb = 0
-                for j in range(nq):
-                    blocked = (q[j] <= lo[j] and dq[j] < 0.0) or (q[j] >= hi[j] and dq[j] > 0.0)
-                    free[j] = not blocked
-                    nb += blocked
-                if nb:
-                    if not _damped_step(J, rows, e, lam, free, dq, Gs, xs):
-                        mu *= nu
-                        nu *= 2.0
-                        continue
-                    for j in range(nq):
-                        if not free[j]:
-                            dq[j] = 0.0
-            step = 0.0
-            for j in range(nq):
-                step = max(step, abs(dq[j]))
-            scale = max_step / step if step > max_step else 1.0
-            for j in range(nq):
-                dq[j] *= scale
-                q_t[j] = q[j] + dq[j]
-            clipped = _clip(q_t, L) if clip else False
-            E_t, pe2_t, th_t = _evaluate(q_t, C, Rt, pt, posonly, R, p, Z, O, e_t, J_t, S)
-            if E_t < E:  # accept; Nielsen's update of μ from the gain ratio
-                predicted = E
-                for a in range(rows):
-                    r = e[a]
-                    for j in range(nq):
-                        r -= J[a, j] * dq[j]
-                    predicted -= r * r
-                rho = (E - E_t) / predicted if predicted > 0.0 else 1.0
-                mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
-                nu = 2.0
-                stall = stall + 1 if E_t > stall_ratio * E else 0
-                q[:] = q_t
-                e, e_t = e_t, e
-                J, J_t = J_t, J
-                E, pe2, th = E_t, pe2_t, th_t
-                at_limit = clipped
-                accepted = True
-                break
-            mu *= nu
-            nu *= 2.0
-        if not accepted:
-            break
-        done = pe2 <= tol2 and th <= tol
-        if stall >= stall_steps:
-            break
-    if mode == WINDOW:
-        _wrap(q, L)
-    else:
-        unbounded = L[3]
-        for j in range(nq):
-            if unbounded[j]:
-                q[j] = math.pi - (math.pi - q[j]) % _TWO_PI
-    return math.sqrt(pe2), th, it
-
-
-@_jit
-def errors(q, C, Rt, pt, posonly):
-    """``(position error [m], rotation error [rad])`` of ``q``."""
-    m = C[0].shape[0]
-    R, p, Z, O = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3))
-    e, J = np.empty(6), np.empty((6, q.shape[0]))
-    _, pe2, th = _evaluate(q, C, Rt, pt, posonly, R, p, Z, O, e, J, np.empty((3, 10)))
-    return math.sqrt(pe2), th
-
-
-@_jit
-def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol):
-    """Free descent (wrapped), then, met outside the limits, a projected one: ``(pe, re, iterations, ok)``; q in place, within the limits."""
-    pe, re, it = descend(q, C, L, P, Rt, pt, posonly, tol, WINDOW, 1)
-    met = pe <= tol and re <= tol
-    if met and _in_limits(q, L):
-        return pe, re, it, True
-    _clip(q, L)
-    if not met:
-        pe, re = errors(q, C, Rt, pt, posonly)
-        return pe, re, it, False
-    pe, re, it2 = descend(q, C, L, P, Rt, pt, posonly, tol, CLIP, 1)
-    return pe, re, it + it2, pe <= tol and re <= tol
-
-
-@_jit
-def _cost(C, q, Rt, pt, posonly, R, p, Z, O, S):
-    qi, sc, of, rev, LR, Lp, fR, fp = C
-    _fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O, S)
-    d = math.sqrt((p[0] - pt[0]) ** 2 + (p[1] - pt[1]) ** 2 + (p[2] - pt[2]) ** 2)
-    if posonly:
-        return d
-    f = 0.0
-    for a in range(3):
-        for b in range(3):
-            f += (R[a, b] - Rt[a, b]) ** 2
-    return d + _ROT_WEIGHT * math.sqrt(f)
-
-
-@_jit
-def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
-    """Row of the start table whose pose is nearest ``(Rt, pt)`` (``‖Δp‖ + 0.1 m/rad · ‖ΔR‖_F``)."""
-    best, k_best = np.inf, 0
-    ptp = pt[0] * pt[0] + pt[1] * pt[1] + pt[2] * pt[2]
-    for k in range(tq.shape[0]):
-        d2 = tpp[k] - 2.0 * (tp[k, 0] * pt[0] + tp[k, 1] * pt[1] + tp[k, 2] * pt[2]) + ptp
-        c = math.sqrt(max(d2, 0.0))
-        if not posonly:
-            dot = 0.0
-            for a in range(3):
-                for b in range(3):
-                    dot += tR[k, 3 * a + b] * Rt[a, b]
-            c += _ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
-        if c < best:
-            best, k_best = c, k
-    return k_best
-
-
-@_jit
-def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
-    """Attempt from ``q0``, then up to ``restarts`` starts drawn within the limits (``seed`` < 2³²), nearest pose first.
-
-    Writes the solution (or the best configuration within the limits) to ``q_out``;
-    returns ``(ok, pe, re, attempts, iterations)``.
-    """
-    lo, hi = L[0], L[1]
+@jit
+def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
+    """:func:`solve` with the scratch buffers ``W`` of :func:`workspace`."""
     nq = q0.shape[0]
     q = q0.copy()
-    pe, re, its, ok = attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol)
+    pe, re, its, ok = attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W)
     best = pe + re
     q_out[:] = q
     attempts = 1
     if ok:
         return True, pe, re, attempts, its
-    np.random.seed(seed)
-    m = C[0].shape[0]
-    R, p, Z, O = np.empty((3, 3)), np.empty(3), np.empty((m, 3)), np.empty((m, 3))
-    S = np.empty((3, 7))
-    pool = np.empty((_POOL, nq))
-    cost = np.empty(_POOL)
+    pool = np.empty((0, nq))  # the random draws, made (and the generator seeded) only when needed
+    cost = np.empty(0)
     order = np.empty(0, dtype=np.int64)
     k = _POOL
     best_pe, best_re = pe, re
+    near = grid_neighbours(table, Rt, pt, posonly, _NEAR + 1)
+    i_near, used = 0, 0
     while attempts <= restarts:
-        if k == _POOL:
-            for i in range(_POOL):
-                for j in range(nq):
-                    pool[i, j] = lo[j] + (hi[j] - lo[j]) * np.random.random()
-                cost[i] = _cost(C, pool[i], Rt, pt, posonly, R, p, Z, O, S)
-            order = np.argsort(cost, kind="mergesort")
-            k = 0
-        q[:] = pool[order[k]]
-        k += 1
+        while i_near < near.shape[0] and _same(table[0][near[i_near]], q0):
+            i_near += 1  # the first start itself
+        if used < _NEAR and i_near < near.shape[0]:  # the stored poses nearest the target, then random draws
+            q[:] = table[0][near[i_near]]
+            i_near += 1
+            used += 1
+        else:
+            if k == _POOL:
+                if pool.shape[0] == 0:
+                    np.random.seed(seed)
+                    pool, cost = np.empty((_POOL, nq)), np.empty(_POOL)
+                order = _ranked_pool(C, L, Rt, pt, posonly, pool, cost, W)
+                k = 0
+            q[:] = pool[order[k]]
+            k += 1
         attempts += 1
-        pe, re, it, ok = attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol)
+        pe, re, it, ok = attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W)
         its += it
         if ok:
             q_out[:] = q
@@ -501,13 +347,33 @@ def solve(q0, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
     return False, best_pe, best_re, attempts, its
 
 
-@_jit
-def solve_many(Rts, pts, starts, C, L, P, posonly, tol, restarts, seed, q_out, ok, pe, re):
-    """:func:`solve` for every target ``k`` (restarts seeded by ``seed + k``); returns the total iterations."""
+@jit
+def solve(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out):
+    """Attempt from ``q0``, then up to ``restarts`` more: the stored poses next nearest the target, then
+    starts drawn within the limits (``seed`` < 2³²), nearest pose first.
+
+    Writes the solution (or the best configuration within the limits) to ``q_out``;
+    returns ``(ok, pe, re, attempts, iterations)``.
+    """
+    W = workspace(q0.shape[0], C[0].shape[0])
+    return solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
+
+
+@jit
+def solve_many(Rts, pts, starts, table, C, L, P, posonly, tol, restarts, seed, q_out, ok, pe, re):
+    """:func:`solve` for every target ``k`` (restarts seeded by ``seed + k``); returns the total iterations.
+
+    A row of ``starts`` holding a NaN starts from the ``table`` configuration nearest its target
+    (:func:`._chain.grid_index`), as a single solve without a seed does.
+    """
+    W = workspace(starts.shape[1], C[0].shape[0])
     total = 0
     for k in range(Rts.shape[0]):
-        o, a, b, _, it = solve(starts[k], C, L, P, Rts[k], pts[k], posonly, tol, restarts,
-                          (seed + k) % 4294967296, q_out[k])
+        q0 = starts[k]
+        if not np.all(np.isfinite(q0)):
+            q0 = table[0][grid_index(table, Rts[k], pts[k], posonly)]
+        o, a, b, _, it = solve_in(q0, table, C, L, P, Rts[k], pts[k], posonly, tol, restarts, (seed + k) % 4294967296,
+                                  q_out[k], W)
         ok[k], pe[k], re[k] = o, a, b
         total += it
     return total

@@ -48,19 +48,11 @@ configurations drawn uniformly within the limits by a seeded generator, taken in
 of their pose distance to the target. A success is confirmed on the returned ``q`` by a
 fresh forward kinematics and a limit check.
 
-Speed: one configuration at a time is what IK needs, so the loop calls Pinocchio
-directly: per trial step one ``computeJointJacobians`` (forward kinematics and every
-joint Jacobian at once), ``updateFramePlacement`` and ``log6``; the frame Jacobian of an
-accepted step is then read with ``getFrameJacobian`` without recomputing anything. The
-damped system is 6×6 (or nq×nq) and solved by LAPACK's Cholesky (``posv``). The exact
-errors are computed only once ``‖e‖²`` is small enough for them to possibly meet ``tol``.
-Pinocchio's model is built with ``mimic=True``, so mimic joints (the koji arm's
-parallelogram) are followed and the Jacobian is w.r.t. the independent joints.
-
 :meth:`NumericalIK.solve`, ``Robot.ik`` and :meth:`NumericalIK.solve_batch` run the same
 attempts compiled (:mod:`._kernel`, the whole solve in one native call, ≈ 5× cheaper per
-step); the interpreted descent above remains for failure diagnosis, the closed-form
-refinement and :meth:`attempt`.
+step); the interpreted descent (:mod:`.descent`, step by step through Pinocchio) remains for
+failure diagnosis, the closed-form refinement and :meth:`attempt`. The limit rules live in
+:mod:`.limit_rules`, the starts in :mod:`.starts`.
 """
 
 from __future__ import annotations
@@ -69,22 +61,20 @@ import threading
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
-from scipy.linalg.lapack import dposv as _posv
 
 from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
 from .._checks import check_seed as _check_seed
 from .._checks import check_tolerance as _check_tolerance
-from .numerical_batch import _ROT_WEIGHT, BatchIKResult, _batch_errors, _seed_int, solve_batch
+from .descent import CLIP as _CLIP
+from .descent import FREE as _FREE
+from .descent import LMDescent
+from .limit_rules import JointLimitRules
+from .numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
+from .starts import StartTable
 
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
-_TABLE = 256  # configurations stored with their poses for the first start (table_start)
-_POOL = 32  # random starts drawn at once and ranked by their distance to the target
-_TWO_PI = 2.0 * np.pi
-_MU_MAX = 1e8  # an attempt gives up when no step with μ below this lowers the error
-_FREE, _WINDOW, _CLIP = 0, 1, 2  # free descent; free then wrapped to the ranges' windows; projected descent
 
 
 @dataclass(frozen=True)
@@ -108,7 +98,7 @@ class IKResult:
     iterations: int
 
 
-class NumericalIK:
+class NumericalIK(JointLimitRules, StartTable, LMDescent):
     """Levenberg–Marquardt IK of one robot frame, joint limits respected, seeded random restarts.
 
     Args:
@@ -142,312 +132,15 @@ class NumericalIK:
         self.frame_id = robot.frame_id(frame)
         self._frame = frame
         self.nq = robot.nq
-        tree = robot._tree
-        coords = tree.coordinates
-        self.unbounded = np.array(coords.is_unbounded, dtype=bool)
-        self._any_unbounded = bool(self.unbounded.any())
+        self._init_limits(robot)
         self._identity_coords = (not self._any_unbounded) and self.model.nq == self.nq
-        self._coords = coords
-        self.lower = np.where(self.unbounded, -np.pi, robot.lower)
-        self.upper = np.where(self.unbounded, np.pi, robot.upper)
-        revolute = np.zeros(self.nq, dtype=bool)
-        for i in range(1, self.model.njoints):
-            joint = self.model.joints[i]
-            if "Mimic" not in joint.shortname() and tree.kind[i] == _REVOLUTE:
-                revolute[joint.idx_v] = True
-        #: bounded revolute joints whose range spans a full turn: leaving the range is undone by ∓2π
-        self.full_turn = revolute & ~self.unbounded & (self.upper - self.lower >= _TWO_PI)
-        self._any_full_turn = bool(self.full_turn.any())
-        window = revolute & ~self.unbounded  # wrapped to the 2π window centred on their range
-        self._any_revolute = bool(window.any())
-        self._window_low = np.where(window, 0.5 * (self.lower + self.upper) - np.pi, 0.0)
-        self._window_turns = np.where(window, 1.0 / _TWO_PI, 0.0)  # 0: the joint is never shifted
+        self._coords = robot._tree.coordinates
         self.max_iter = int(max_iter)
         self.damping = float(damping)
         self.min_damping = float(min_damping)
         self.max_step = float(max_step)
         self.stall_ratio = float(stall_ratio)
         self.stall_steps = int(stall_steps)
-
-    @property
-    def data(self) -> pin.Data:
-        """This thread's Pinocchio data (each thread gets its own on first use)."""
-        data = getattr(self._local, "data", None)
-        if data is None:
-            data = self._local.data = self.model.createData()
-        return data
-
-    # ------------------------------------------------------------------ pieces
-    def _pin_q(self, q: np.ndarray) -> np.ndarray:
-        return q if self._identity_coords else self._coords.to_pin(q)
-
-    def errors(self, q: np.ndarray, target: np.ndarray, position_only: bool) -> tuple[float, float]:
-        """``(position error [m], rotation error [rad])`` of ``q`` for ``target`` (4,4)."""
-        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
-        M = pin.updateFramePlacement(self.model, self.data, self.frame_id)
-        dp = float(np.linalg.norm(M.translation - target[:3, 3]))
-        if position_only:
-            return dp, 0.0
-        return dp, float(np.linalg.norm(pin.log3(M.rotation.T @ target[:3, :3])))
-
-    def in_limits(self, q: np.ndarray) -> bool:
-        """``lower ≤ q ≤ upper`` exactly (no tolerance)."""
-        return not ((q < self.lower).any() or (q > self.upper).any())
-
-    def _wrap(self, q: np.ndarray) -> np.ndarray:
-        """Revolute angles of ``q`` (in place) to the ``2π`` window centred on their range, continuous ones to ``(-π, π]``."""
-        if self._any_unbounded:
-            u = self.unbounded
-            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
-        if self._any_revolute:
-            q -= _TWO_PI * np.floor((q - self._window_low) * self._window_turns)
-        return q
-
-    def _clip(self, q: np.ndarray) -> bool:
-        """Project ``q`` into the limits in place; ``True`` if a joint was clipped to a limit.
-
-        Continuous joints are wrapped to ``(-π, π]``; a revolute joint whose range spans a
-        full turn is shifted by ∓2π when it leaves its range; the others are clipped.
-        """
-        if self._any_unbounded:
-            u = self.unbounded
-            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
-        lo, hi = self.lower, self.upper
-        if not ((q < lo).any() or (q > hi).any()):
-            return False
-        if self._any_full_turn:
-            w = self.full_turn
-            q[w & (q > hi)] -= _TWO_PI
-            q[w & (q < lo)] += _TWO_PI
-        np.minimum(np.maximum(q, lo, out=q), hi, out=q)
-        return bool(((q <= lo) | (q >= hi)).any())
-
-    def _target(self, target: np.ndarray, position_only: bool):
-        target = np.asarray(target, dtype=float)
-        p_des = np.array(target[:3, 3])
-        T_des = None if position_only else pin.SE3(np.array(target[:3, :3]), p_des)
-        return T_des, p_des
-
-    def attempt(
-        self, q0: np.ndarray, target: np.ndarray, position_only: bool, tol: float, limits: bool = True
-    ) -> tuple[np.ndarray, float, float, int]:
-        """One Levenberg–Marquardt descent from ``q0`` to ``target`` (4, 4): ``(q, pos_err, rot_err, iterations)``.
-
-        With ``limits`` every iterate is projected into the joint limits; without, joints
-        move freely (continuous joints wrapped), for diagnostics.
-        """
-        T_des, p_des = self._target(target, position_only)
-        mode = _CLIP if limits else _FREE
-        return self._descend(np.array(q0, dtype=float), T_des, p_des, position_only, float(tol), mode)
-
-    def _attempt_within_limits(self, q0, T_des, p_des, position_only: bool, tol: float):
-        """Free descent (angles wrapped to their range's window), then, if it met the target
-        outside the limits, a projected descent from there: ``(q, pos_err, rot_err, its, ok)``.
-
-        A returned ``q`` is always within the limits (projected if the descent ended outside).
-        """
-        q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, _WINDOW)
-        met = pe <= tol and re <= tol
-        if met and self.in_limits(q):
-            return q, pe, re, it, True
-        if not met:  # no pose reached from this start: report its projection, restart elsewhere
-            self._clip(q)
-            pe, re = self._errors_to(q, T_des, p_des, position_only)
-            return q, pe, re, it, False
-        self._clip(q)  # a solution outside the limits: slide back along the limits
-        q, pe, re, it2 = self._descend(q, T_des, p_des, position_only, tol, _CLIP)
-        return q, pe, re, it + it2, pe <= tol and re <= tol
-
-    def _errors_to(self, q, T_des, p_des, position_only: bool) -> tuple[float, float]:
-        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
-        M = pin.updateFramePlacement(self.model, self.data, self.frame_id)
-        d = M.translation - p_des
-        pe = float(np.sqrt(d.dot(d)))
-        if position_only:
-            return pe, 0.0
-        w = pin.log3(M.rotation.T.dot(T_des.rotation))
-        return pe, float(np.sqrt(w.dot(w)))
-
-    def _descend(self, q, T_des, p_des, position_only: bool, tol: float, mode: int, patience: int = 1):
-        """Levenberg–Marquardt from ``q`` (modified in place), projecting each iterate by ``mode``.
-
-        ``patience`` multiplies ``max_iter`` and ``stall_steps`` (a final polish of a failed solve).
-        """
-        model, data, fid = self.model, self.data, self.frame_id
-        jacobians, placement, frame_jacobian = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian
-        log6, jlog6 = pin.log6, pin.Jlog6
-        pin_q = self._pin_q
-        lower, upper = self.lower, self.upper
-        clip = mode == _CLIP
-        rows = 3 if position_only else 6  # task rows
-        wide = self.nq >= rows  # solve the rows×rows system AAᵀ (else the nq×nq system AᵀA)
-        eye = np.eye(rows if wide else self.nq)  # G + λI by one add (a strided in-place add costs 4x more)
-        min_damping, max_step = self.min_damping, self.max_step
-        max_step2 = max_step * max_step
-        stall_ratio, stall_steps = self.stall_ratio, self.stall_steps * patience
-        max_iter = self.max_iter * patience
-        ref = pin.LOCAL_WORLD_ALIGNED if position_only else pin.LOCAL
-        tol2 = tol * tol
-        gate = 4.0 * tol2  # ‖e‖² above this cannot meet tol (|e_lin| ≤ (1 + O(angle)) · position error)
-
-        same_q = self._identity_coords
-
-        def evaluate(x):
-            jacobians(model, data, x if same_q else pin_q(x))
-            M = placement(model, data, fid)
-            if position_only:
-                d = p_des - M.translation
-                return d, None, float(d.dot(d))
-            D = M.actInv(T_des)
-            d = log6(D).vector
-            return d, D, float(d.dot(d))
-
-        def converged(d, D, E):
-            if E > gate:
-                return False
-            if position_only:
-                return True  # E is the squared position error
-            t, w = D.translation, d[3:]  # |D.translation| = ‖p − p_target‖, d[3:] = log3(Rᵀ R_target)
-            return t.dot(t) <= tol2 and w.dot(w) <= tol2
-
-        at_limit = clip and (self._clip(q) or bool(((q <= lower) | (q >= upper)).any()))
-        e, D, E = evaluate(q)
-        mu, nu = self.damping, 2.0
-        it = 0
-        stall = 0
-        done = converged(e, D, E)
-        while not done and it < max_iter:
-            it += 1
-            J = frame_jacobian(model, data, fid, ref)  # data holds the joint Jacobians of q
-            A = J[:3] if position_only else jlog6(D.inverse()).dot(J)
-            gram = A.dot(A.T) if wide else A.T.dot(A)
-            rhs = e if wide else A.T.dot(e)
-            accepted = False
-            while mu < _MU_MAX:
-                lam = mu * E + min_damping
-                _, x, info = _posv(gram + lam * eye, rhs, overwrite_a=1)
-                if info != 0:  # not positive definite in floating point: least squares instead
-                    x = np.linalg.lstsq(gram + lam * np.eye(gram.shape[0]), rhs, rcond=None)[0]
-                dq = A.T.dot(x) if wide else x
-                if at_limit:  # joints at a limit pushed outwards: take them out and re-solve
-                    blocked = ((q <= lower) & (dq < 0.0)) | ((q >= upper) & (dq > 0.0))
-                    if blocked.any():
-                        A_free = A.copy()
-                        A_free[:, blocked] = 0.0
-                        dq = self._step(A_free, e, lam, wide)
-                        dq[blocked] = 0.0
-                if dq.dot(dq) > max_step2:  # cheap test first: the 2-norm bounds every joint's step
-                    step = max(dq.max(), -dq.min())
-                    if step > max_step:
-                        dq *= max_step / step
-                q_try = q + dq
-                clipped = clip and self._clip(q_try)
-                e_t, D_t, E_t = evaluate(q_try)
-                if E_t < E:  # accept; Nielsen's update of μ from the gain ratio ρ
-                    r = e - A.dot(dq)
-                    predicted = E - r.dot(r)
-                    rho = (E - E_t) / predicted if predicted > 0.0 else 1.0
-                    mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
-                    nu = 2.0
-                    stall = stall + 1 if E_t > stall_ratio * E else 0
-                    q, e, D, E, at_limit = q_try, e_t, D_t, E_t, clipped
-                    accepted = True
-                    break
-                mu *= nu
-                nu *= 2.0
-            if not accepted:
-                break
-            done = converged(e, D, E)
-            if stall >= stall_steps:
-                break
-        if mode == _WINDOW:
-            self._wrap(q)
-        elif self._any_unbounded:
-            u = self.unbounded
-            q[u] = np.pi - (np.pi - q[u]) % _TWO_PI
-        if position_only:
-            return q, float(np.sqrt(E)), 0.0, it
-        t, w = D.translation, e[3:]
-        return q, float(np.sqrt(t.dot(t))), float(np.sqrt(w.dot(w))), it
-
-    @staticmethod
-    def _step(A: np.ndarray, e: np.ndarray, lam: float, wide: bool) -> np.ndarray:
-        """Damped least-squares step (LAPACK ``posv`` on the symmetric positive definite system)."""
-        if wide:
-            G = A.dot(A.T)
-            G.flat[:: G.shape[0] + 1] += lam
-            _, x, info = _posv(G, e, overwrite_a=1)
-            if info != 0:
-                x = np.linalg.lstsq(A.dot(A.T) + lam * np.eye(A.shape[0]), e, rcond=None)[0]
-            return A.T.dot(x)
-        G = A.T.dot(A)
-        G.flat[:: G.shape[0] + 1] += lam
-        b = A.T.dot(e)
-        _, dq, info = _posv(G, b, overwrite_a=1)
-        if info != 0:
-            dq = np.linalg.lstsq(A.T.dot(A) + lam * np.eye(A.shape[1]), b, rcond=None)[0]
-        return dq
-
-    def nearest_equivalent(self, q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-        """``q`` ``(nq,)`` or ``(N, nq)`` with each bounded revolute angle at its 2π equivalent within the
-        limits nearest ``q_ref`` (same shape, or ``(nq,)``): the same pose."""
-        if not self._any_revolute:
-            return q
-        turns = self._window_turns > 0.0
-        k = _TWO_PI * np.arange(-2.0, 3.0).reshape((5,) + (1,) * q.ndim)
-        options = q + _TWO_PI * np.round((q_ref - q) / _TWO_PI) + k  # (5, ..., nq)
-        inside = (options >= self.lower) & (options <= self.upper)
-        cost = np.where(inside, np.abs(options - q_ref), np.inf)
-        best = np.argmin(cost, axis=0)[None]
-        pick = np.take_along_axis(options, best, 0)[0]
-        ok = turns & np.isfinite(np.take_along_axis(cost, best, 0)[0])
-        return np.where(ok, pick, q)
-
-    def _start_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """:data:`_TABLE` configurations drawn within the limits (seed 0) with their frame poses, made once."""
-        table = self._table
-        if table is None:
-            q = np.random.default_rng(0).uniform(self.lower, self.upper, size=(_TABLE, self.nq))
-            T = self.robot.fk(q, self._frame)
-            p = np.ascontiguousarray(T[:, :3, 3])
-            R = np.ascontiguousarray(T[:, :3, :3].reshape(-1, 9))
-            table = self._table = (q, p, np.einsum("ij,ij->i", p, p), R)  # one assignment: safe across threads
-        return table
-
-    def table_start(self, target: np.ndarray, position_only: bool = False) -> np.ndarray:
-        """The stored configuration whose frame pose is nearest ``target (4, 4)``: a copy ``(nq,)``.
-
-        Distance ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first
-        term) over :data:`_TABLE` configurations drawn once within the limits; starting there
-        saves 2-4 iterations over the middle of the ranges.
-        """
-        q, p, pp, R = self._start_table()
-        pt = target[:3, 3]
-        d2 = pp - 2.0 * p.dot(pt) + pt.dot(pt)
-        cost = np.sqrt(np.maximum(d2, 0.0))
-        if not position_only:
-            rt = target[:3, :3].reshape(9)
-            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * R.dot(rt), 0.0))
-        return q[int(np.argmin(cost))].copy()
-
-    def _ranked_starts(self, rng: np.random.Generator, target: np.ndarray, position_only: bool) -> np.ndarray:
-        """:data:`_POOL` uniform draws within the limits, closest to the target first.
-
-        Distance: ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first term).
-        """
-        q = rng.uniform(self.lower, self.upper, size=(_POOL, self.nq))
-        model, data, fid = self.model, self.data, self.frame_id
-        p = np.empty((_POOL, 3))
-        R = np.empty((_POOL, 3, 3))
-        for k in range(_POOL):  # one Pinocchio FK each: faster than the batched numpy FK for 32 rows
-            pin.forwardKinematics(model, data, self._pin_q(q[k]))
-            M = pin.updateFramePlacement(model, data, fid)
-            p[k] = M.translation
-            R[k] = M.rotation
-        cost = np.linalg.norm(p - target[:3, 3], axis=1)
-        if not position_only:
-            cost = cost + _ROT_WEIGHT * np.linalg.norm((R - target[:3, :3]).reshape(-1, 9), axis=1)
-        return q[np.argsort(cost, kind="stable")]
 
     # ------------------------------------------------------------------ compiled path
     def _compiled(self) -> tuple:
@@ -479,27 +172,27 @@ class NumericalIK:
             )
             P = np.array([self.damping, self.min_damping, self.max_step, self.stall_ratio, self.stall_steps,
                           self.max_iter], dtype=float)
-            q_tab, p_tab, pp_tab, R_tab = self._start_table()
-            args = self._kernel_args = (_kernel, C, L, P, (q_tab, p_tab, pp_tab, R_tab))  # one assignment: thread-safe
+            args = self._kernel_args = (_kernel, C, L, P, self._grid_table())  # one assignment: thread-safe
         return args
 
     def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
                         seed) -> IKResult:
-        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the table's
-        nearest pose), then up to ``max_restarts`` seeded uniform starts nearest pose first.
+        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the nearest of
+        16 384 stored poses), then up to ``max_restarts`` more: the 8 stored poses next nearest the
+        target, then seeded uniform starts nearest pose first.
 
         A success is confirmed by Pinocchio's forward kinematics of the returned ``q`` and an exact
         limit check (independent of the compiled chain evaluation).
         """
-        kernel, C, L, P, (tq, tp, tpp, tR) = self._compiled()
+        kernel, C, L, P, table = self._compiled()
         Rt = np.ascontiguousarray(target[:3, :3], dtype=float)
         pt = np.ascontiguousarray(target[:3, 3], dtype=float)
         if q_seed is None:
-            q0 = tq[kernel.table_index(tq, tp, tpp, tR, Rt, pt, position_only)]
+            q0 = table[0][kernel.grid_index(table, Rt, pt, position_only)]
         else:
             q0 = np.ascontiguousarray(q_seed, dtype=float)
         q = np.empty(self.nq)
-        ok, pe, re, attempts, its = kernel.solve(q0, C, L, P, Rt, pt, position_only, tol, max_restarts,
+        ok, pe, re, attempts, its = kernel.solve(q0, table, C, L, P, Rt, pt, position_only, tol, max_restarts,
                                                  _seed_int(seed), q)
         if ok:
             pe, re = self.errors(q, target, position_only)

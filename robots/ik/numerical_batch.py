@@ -17,7 +17,6 @@ __all__ = ["BatchIKResult", "solve_batch"]
 
 _WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
 _PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
-_ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 
 
 def _seed_int(seed) -> int:
@@ -97,15 +96,16 @@ def solve_batch(
     """Many targets at once: the compiled solver over the batch (in threads), then :meth:`solve` for any left.
 
     Each target gets the attempts of :meth:`solve` (free descent, projected descent when it
-    meets the target outside the limits) from its start, then up to ``max_restarts`` uniform
-    starts within the limits nearest pose first, the whole loop compiled; target ``k``'s
+    meets the target outside the limits) from its start, then up to ``max_restarts`` more (the
+    stored poses next nearest the target, then uniform starts within the limits nearest pose
+    first), the whole loop compiled; target ``k``'s
     restarts are seeded by ``seed + k`` (for an integer ``seed``: row ``k`` is ``Robot.ik(targets[k],
     seed=seed + k)``, bit for bit; the thread blocks change nothing).
 
     Args:
         targets: checked poses ``(N, 4, 4)`` frame → base [m].
-        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN:
-            :meth:`table_start` of each target).
+        q_seed: starts ``(nq,)`` or ``(N, nq)`` (default, and for rows holding NaN: the stored
+            configuration whose pose is nearest each target, as :meth:`solve` without a seed).
         tol: success when the position error [m] and the rotation error [rad] are both ≤ tol.
         max_restarts, seed: restarts per target, and the seed of all random starts.
 
@@ -115,22 +115,11 @@ def solve_batch(
     N = targets.shape[0]
     nq = self.nq
     tol = float(tol)
-    starts = None
-    if q_seed is not None:
+    if q_seed is None:  # no seed (or a NaN row): the compiled solver starts from the table's nearest pose
+        starts = np.full((N, nq), np.nan)
+    else:
         starts = np.array(np.broadcast_to(np.asarray(q_seed, dtype=float), (N, nq)))
-    missing = np.arange(N) if starts is None else np.flatnonzero(~np.all(np.isfinite(starts), axis=1))
-    if missing.size:  # no seed (or a NaN row): of the stored table, the configuration whose pose is nearest
-        q_table, p_tab, pp_tab, R_tab = self._start_table()
-        pt = targets[missing, :3, 3]
-        d2 = pp_tab[None, :] - 2.0 * pt @ p_tab.T + np.einsum("ij,ij->i", pt, pt)[:, None]
-        cost = np.sqrt(np.maximum(d2, 0.0))
-        if not position_only:
-            rt = targets[missing, :3, :3].reshape(missing.size, 9)
-            cost += _ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * rt @ R_tab.T, 0.0))
-        if starts is None:
-            starts = np.empty((N, nq))
-        starts[missing] = q_table[np.argmin(cost, axis=1)]
-    kernel, C, L, P, _ = self._compiled()
+    kernel, C, L, P, table = self._compiled()
     Rts = np.ascontiguousarray(targets[:, :3, :3])
     pts = np.ascontiguousarray(targets[:, :3, 3])
     starts = np.ascontiguousarray(starts)
@@ -142,7 +131,7 @@ def solve_batch(
     iterations = [0]
 
     def block(s: int, e: int) -> None:  # compiled and nogil: the blocks run in parallel
-        iterations.append(kernel.solve_many(Rts[s:e], pts[s:e], starts[s:e], C, L, P, bool(position_only), tol,
+        iterations.append(kernel.solve_many(Rts[s:e], pts[s:e], starts[s:e], table, C, L, P, bool(position_only), tol,
                                             int(max_restarts), base + s, q[s:e], success[s:e], pe[s:e], re[s:e]))
 
     bounds = np.linspace(0, N, min(_WORKERS, max(1, N // _PARALLEL_MIN)) + 1).astype(int)
@@ -152,15 +141,16 @@ def solve_batch(
         with ThreadPoolExecutor(bounds.size - 1) as pool:
             list(pool.map(block, bounds[:-1], bounds[1:]))
     iterations = int(sum(iterations))
-    if success.any():  # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
-        k = np.flatnonzero(success)
-        pe_k, re_k = _batch_errors(self, q[k], targets[k], position_only)
-        inside = np.all((q[k] >= self.lower) & (q[k] <= self.upper), axis=1)
-        success[k[(pe_k > tol) | (re_k > tol) | ~inside]] = False
-    for k in np.flatnonzero(~success):  # the few the batch left: per-target solver with restarts
+    # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
+    pos_err, rot_err = _batch_errors(self, q, targets, position_only)
+    inside = np.all((q >= self.lower) & (q <= self.upper), axis=1)
+    success &= (pos_err <= tol) & (rot_err <= tol) & inside
+    left = np.flatnonzero(~success)
+    for k in left:  # the few the batch left: per-target solver with restarts
         res = self._solve(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
                           seed=rng, limits=True)
         q[k] = res.q
         success[k] = res.success
-    pos_err, rot_err = _batch_errors(self, q, targets, position_only)
+    if left.size:
+        pos_err[left], rot_err[left] = _batch_errors(self, q[left], targets[left], position_only)
     return BatchIKResult(q, success, pos_err, rot_err, iterations)

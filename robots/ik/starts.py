@@ -1,0 +1,100 @@
+"""Starts of the numerical IK solver: a stored table of poses for the first start, ranked random restarts.
+
+The first attempt starts from ``q_seed`` or, without one, from the configuration (of
+:data:`TABLE_SIZE` drawn once within the limits, seed 0, stored with their frame poses) whose pose
+is nearest the target; restarts from configurations drawn uniformly within the limits by a
+seeded generator, :data:`POOL` at a time, nearest pose first. Distance:
+``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first term).
+
+:class:`StartTable` is a base class of :class:`.numerical.NumericalIK`. Units: m, rad.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+__all__ = ["StartTable", "TABLE_SIZE", "POOL", "ROT_WEIGHT"]
+
+TABLE_SIZE = 256  # configurations stored with their poses for the first start (table_start)
+POOL = 32  # random starts drawn at once and ranked by their distance to the target
+ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
+GRID_TABLE_SIZE = 16384  # configurations of the compiled solver's start table (grid_table)
+_PER_CELL = 2  # mean rows per cell of the grid over the positions' bounding box
+_GRID_SEED = (0x5EED, 0x7AB1E, GRID_TABLE_SIZE)  # seed sequence of the grid table's draws
+
+
+class StartTable:
+    """The start table and the ranked restarts (see the module docstring)."""
+
+    def _start_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:data:`TABLE_SIZE` configurations drawn within the limits (seed 0) with their frame poses, made once."""
+        table = self._table
+        if table is None:
+            q = np.random.default_rng(0).uniform(self.lower, self.upper, size=(TABLE_SIZE, self.nq))
+            T = self.robot.fk(q, self._frame)
+            p = np.ascontiguousarray(T[:, :3, 3])
+            R = np.ascontiguousarray(T[:, :3, :3].reshape(-1, 9))
+            table = self._table = (q, p, np.einsum("ij,ij->i", p, p), R)  # one assignment: safe across threads
+        return table
+
+    def _grid_table(self) -> tuple:
+        """The compiled solver's start table: :data:`GRID_TABLE_SIZE` configurations drawn within the limits
+        (a fixed seed of its own, so that no user's seeded draws coincide with its rows) with their frame poses, rows sorted by the cell of a grid over their positions.
+
+        Returns ``(q, p, |p|², R (n, 9), cell_start, grid)`` as :func:`._chain.grid_index` reads it:
+        the rows of cell ``c`` are ``cell_start[c]:cell_start[c + 1]``; ``grid = (x0, y0, z0, 1/size,
+        nx, ny, nz)``, the cell size giving about 2 rows per cell of the positions' bounding box.
+        """
+        q = np.random.default_rng(_GRID_SEED).uniform(self.lower, self.upper, size=(GRID_TABLE_SIZE, self.nq))
+        T = self.robot.fk(q, self._frame)
+        p = T[:, :3, 3]
+        lo, hi = p.min(axis=0), p.max(axis=0)
+        extent = np.maximum(hi - lo, 1e-6)
+        size = max(float(np.prod(extent) * _PER_CELL / GRID_TABLE_SIZE) ** (1.0 / 3.0), 1e-3)
+        dims = np.maximum(np.ceil(extent / size).astype(np.int64), 1)
+        cells = np.minimum(((p - lo) / size).astype(np.int64), dims - 1)
+        key = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
+        order = np.argsort(key, kind="stable")
+        counts = np.bincount(key, minlength=int(np.prod(dims)))
+        cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        p = np.ascontiguousarray(p[order])
+        R = np.ascontiguousarray(T[order, :3, :3].reshape(-1, 9))
+        grid = np.array([lo[0], lo[1], lo[2], 1.0 / size, dims[0], dims[1], dims[2]], dtype=float)
+        return (np.ascontiguousarray(q[order]), p, np.einsum("ij,ij->i", p, p), R, cell_start, grid)
+
+    def table_start(self, target: np.ndarray, position_only: bool = False) -> np.ndarray:
+        """The stored configuration whose frame pose is nearest ``target (4, 4)``: a copy ``(nq,)``.
+
+        Distance ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first
+        term) over :data:`TABLE_SIZE` configurations drawn once within the limits; starting there
+        saves 2-4 iterations over the middle of the ranges.
+        """
+        q, p, pp, R = self._start_table()
+        pt = target[:3, 3]
+        d2 = pp - 2.0 * p.dot(pt) + pt.dot(pt)
+        cost = np.sqrt(np.maximum(d2, 0.0))
+        if not position_only:
+            rt = target[:3, :3].reshape(9)
+            cost += ROT_WEIGHT * np.sqrt(np.maximum(6.0 - 2.0 * R.dot(rt), 0.0))
+        return q[int(np.argmin(cost))].copy()
+
+    def _ranked_starts(self, rng: np.random.Generator, target: np.ndarray, position_only: bool) -> np.ndarray:
+        """:data:`POOL` uniform draws within the limits, closest to the target first.
+
+        Distance: ``‖p − p_target‖ + 0.1 m/rad · ‖R − R_target‖_F`` (position only: the first term).
+        """
+        q = rng.uniform(self.lower, self.upper, size=(POOL, self.nq))
+        model, data, fid = self.model, self.data, self.frame_id
+        p = np.empty((POOL, 3))
+        R = np.empty((POOL, 3, 3))
+        for k in range(POOL):  # one Pinocchio FK each: faster than the batched numpy FK for 32 rows
+            pin.forwardKinematics(model, data, self._pin_q(q[k]))
+            M = pin.updateFramePlacement(model, data, fid)
+            p[k] = M.translation
+            R[k] = M.rotation
+        cost = np.linalg.norm(p - target[:3, 3], axis=1)
+        if not position_only:
+            cost = cost + ROT_WEIGHT * np.linalg.norm((R - target[:3, :3]).reshape(-1, 9), axis=1)
+        return q[np.argsort(cost, kind="stable")]
+
