@@ -4,7 +4,7 @@ Where each family lives (imports go one way, top to bottom of this list read upw
 
 - the floor, importable by every package: :mod:`pinarms.errors` (the exception hierarchy),
   :mod:`pinarms.execution` (serial loop or Dask), :mod:`pinarms.files` (atomic files),
-  :mod:`pinarms.units`;
+  :mod:`pinarms.units`, :mod:`pinarms.compiled` (numba kernels and their caches);
 - :mod:`pinarms.robots`: registry and ``Robot``, ``ik/``, ``reach/`` (workspace, reachability
   maps and their files, base placement, table band, layout check), ``cell/``, dynamics;
 - :mod:`pinarms.planning`: trajectories, Cartesian paths, limits as objects;

@@ -16,25 +16,24 @@ chunks it is run in. Cached on disk like the cover's kernels.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
-from numba import njit
 
+from pinarms.compiled import drop_stale_caches, jit
+from pinarms.robots.cell import _cover_kernel
 from pinarms.robots.cell._cover_kernel import excess_one
+
+# these kernels call the cover's: its changes must compile them again (pinarms.compiled)
+drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
+                  Path(__file__).resolve().parent / "__pycache__" / "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
 QUEUE = 4096
 ADVANCED, REACHED, TRAPPED = 0, 1, 2
 
 
-def _jit(function):
-    try:
-        return njit(cache=True, nogil=True)(function)
-    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
-        return njit(nogil=True)(function)
-
-
-@_jit
+@jit
 def _uniform(rng):
     """The next number in [0, 1) of the SplitMix64 stream ``rng (1,) uint64``."""
     rng[0] += np.uint64(0x9E3779B97F4A7C15)
@@ -45,7 +44,7 @@ def _uniform(rng):
     return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@_jit
+@jit
 def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
     """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0).
 
@@ -60,7 +59,7 @@ def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
     return excess_one(q, fk, cov, grp, cap, 0.0, work)
 
 
-@_jit
+@jit
 def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
     """Whether the cover proves the straight edge ``xa → xb`` keeps every threshold (module docstring).
 
@@ -105,7 +104,7 @@ def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, 
     return True
 
 
-@_jit
+@jit
 def _nearest(nodes, count, x):
     best, arg = np.inf, 0
     for i in range(count):
@@ -118,7 +117,7 @@ def _nearest(nodes, count, x):
     return arg
 
 
-@_jit
+@jit
 def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold, cols, fk, cov,
             grp, cap, work, q, xm, xn, queue):
     """One RRT step of tree ``t`` towards ``target``: ADVANCED, REACHED or TRAPPED (full tree: TRAPPED)."""
@@ -148,7 +147,7 @@ def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_bu
     return REACHED if reach else ADVANCED
 
 
-@_jit
+@jit
 def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, iterations, levers, min_budget,
                 max_states, hold, cols, fk, cov, grp, cap, work):
     """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
@@ -191,7 +190,7 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
     return 0
 
 
-@_jit
+@jit
 def path_proven(P, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Whether the cover proves every edge of the polyline ``P (M, n)``."""
     q = np.empty(hold.shape[0])
@@ -207,7 +206,7 @@ def path_proven(P, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap
     return True
 
 
-@_jit
+@jit
 def _cumulative(P, m, out):
     out[0] = 0.0
     for i in range(1, m):
@@ -218,7 +217,7 @@ def _cumulative(P, m, out):
         out[i] = out[i - 1] + math.sqrt(d)
 
 
-@_jit
+@jit
 def _point_at(P, s, m, length, out):
     """The point at arc length ``length`` of the polyline's first ``m`` vertices; returns its segment."""
     k = 0
@@ -231,7 +230,7 @@ def _point_at(P, s, m, length, out):
     return k
 
 
-@_jit
+@jit
 def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Random shortcutting of the proven polyline ``P[:m]`` in place; returns its new vertex count.
 

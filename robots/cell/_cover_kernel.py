@@ -11,17 +11,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from pinarms.compiled import jit
 
 
-def _jit(function):
-    try:
-        return njit(cache=True, nogil=True)(function)
-    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
-        return njit(nogil=True)(function)
-
-
-@_jit
+@jit
 def _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p):
     """World rotation ``R (nj, 3, 3)`` and position ``p (nj, 3)`` of every joint (in place)."""
     for a in range(3):
@@ -61,7 +55,7 @@ def _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p):
                 p[i, a] += v * (RM[a, 0] * ux + RM[a, 1] * uy + RM[a, 2] * uz)
 
 
-@_jit
+@jit
 def _centers(R, p, joint, center, W):
     for s in range(joint.shape[0]):
         j = joint[s]
@@ -69,7 +63,7 @@ def _centers(R, p, joint, center, W):
             W[s, a] = p[j, a] + R[j, a, 0] * center[s, 0] + R[j, a, 1] * center[s, 1] + R[j, a, 2] * center[s, 2]
 
 
-@_jit
+@jit
 def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, out):
     """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)``."""
     nj = parent.shape[0]
@@ -80,7 +74,7 @@ def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, join
         _centers(R, p, joint, center, out[i])
 
 
-@_jit
+@jit
 def _shape_distance(x, kind, FR, Fp, size):
     """Distance [m] from point ``x`` to a static box (1), cylinder (2, axis z) or sphere (3); 0 inside."""
     l0 = l1 = l2 = 0.0
@@ -100,7 +94,7 @@ def _shape_distance(x, kind, FR, Fp, size):
     return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[0], 0.0)
 
 
-@_jit
+@jit
 def _cylinder_distance(x, a, b, r):
     """Distance [m] from point ``x`` to the solid cylinder of axis ``a b`` and radius ``r``; 0 inside."""
     u0, u1, u2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
@@ -116,7 +110,7 @@ def _cylinder_distance(x, a, b, r):
     return math.sqrt(dr * dr + dz * dz)
 
 
-@_jit
+@jit
 def _exact_distance(x, other, exact, FR, Fp, size, SA, SB, srad, sstart):
     if exact[other] != 0:
         return _shape_distance(x, exact[other], FR[other], Fp[other], size[other])
@@ -124,7 +118,7 @@ def _exact_distance(x, other, exact, FR, Fp, size, SA, SB, srad, sstart):
     return _cylinder_distance(x, SA[k], SB[k], srad[k])
 
 
-@_jit
+@jit
 def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
     """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
     cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
@@ -146,7 +140,7 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     return True
 
 
-@_jit
+@jit
 def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
     """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
     if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
@@ -164,7 +158,7 @@ def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl
     return True
 
 
-@_jit
+@jit
 def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, radius, start, exact, FR,
                   Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, hjoint, hcenter, hrad, group_start, group_a,
                   group_b, group_fixed, group_t, pair_a, pair_b, threshold, stop, out):
@@ -212,7 +206,7 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
     return -1
 
 
-@_jit
+@jit
 def _apart(HW, hrad, a, b, t):
     reach = hrad[a] + hrad[b] + t
     e0 = HW[a, 0] - HW[b, 0]
@@ -221,7 +215,7 @@ def _apart(HW, hrad, a, b, t):
     return reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach
 
 
-@_jit
+@jit
 def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad, best):
     """``min(best, lower bound of distance(g, other) − t)``: the cover spheres of ``g`` against ``other``
     taken exactly (a static box, cylinder or sphere, or a moving cylinder); its bounding sphere first."""
@@ -241,7 +235,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
     return min(best, max(low, gap))
 
 
-@_jit
+@jit
 def _cylinder_box_gap(a, b, r, FR, Fp, half):
     """A lower bound [m] of the distance between the solid cylinder of axis ``a b`` and radius ``r`` and a
     static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
@@ -264,7 +258,7 @@ def _cylinder_box_gap(a, b, r, FR, Fp, half):
     return gap
 
 
-@_jit
+@jit
 def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad, best):
     """``min(best, lower bound of distance(ga, gb) − t)`` from the covers (:func:`_pair_clear`'s cases)."""
     if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
@@ -288,7 +282,7 @@ def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cy
     return best
 
 
-@_jit
+@jit
 def _hd(HW, hrad, a, b):
     e0 = HW[a, 0] - HW[b, 0]
     e1 = HW[a, 1] - HW[b, 1]
@@ -296,7 +290,7 @@ def _hd(HW, hrad, a, b):
     return math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - hrad[a] - hrad[b]
 
 
-@_jit
+@jit
 def excess_one(q, fk, cov, grp, cap, floor, work):
     """A lower bound [m] of ``min_k (d_k − t_k)`` over the pairs of ``grp`` at cell configuration ``q``,
     at most ``cap``; it returns early (some value below ``floor``) once the bound falls below ``floor``.
@@ -335,7 +329,7 @@ def excess_one(q, fk, cov, grp, cap, floor, work):
     return best
 
 
-@_jit
+@jit
 def excess_kernel(Q, fk, cov, grp, cap, floor, work, out):
     """:func:`excess_one` for every row of ``Q (N, nq)`` into ``out (N,)``."""
     for i in range(Q.shape[0]):

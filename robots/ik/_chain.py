@@ -16,65 +16,28 @@ with the frame Jacobian in base axes at the frame origin (linear rows first), so
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
-from pinarms.files import write_text
+from pinarms import compiled
+from pinarms.compiled import jit, jit_inline
 
 #: the compiled solver's modules: their functions call (and inline) each other across files
 KERNEL_MODULES = ("_chain.py", "_limits_kernel.py", "_kernel.py")
 
 
-def drop_stale_caches(here: Path | None = None) -> None:
-    """Delete numba's on-disk caches of :data:`KERNEL_MODULES` (in ``here``, default this folder) when any
-    of their sources changed.
-
-    numba keys a cached function on its own file only: a function of ``_kernel.py`` keeps the
-    compiled code of the ``_chain.py`` functions it calls after ``_chain.py`` changes (a branch
-    switch or an edit), and would run it. A digest of the three sources, kept beside the caches,
-    tells when they must be compiled again. Nothing happens where the cache folder cannot be written
-    (an installed package is compiled afresh in its own place anyway).
-    """
+def drop_stale_caches(here: Path | None = None) -> bool:
+    """Drop the compiled caches of :data:`KERNEL_MODULES` (in ``here``, default this folder) when
+    any of their sources changed (:func:`pinarms.compiled.drop_stale_caches`)."""
     here = Path(__file__).resolve().parent if here is None else Path(here)
-    cache = here / "__pycache__"
-    try:
-        digest = hashlib.sha256(b"".join((here / name).read_bytes() for name in KERNEL_MODULES)).hexdigest()
-        mark = cache / "ik_kernels.sha256"
-        if mark.is_file() and mark.read_text() == digest:
-            return
-        for name in KERNEL_MODULES:
-            for stale in cache.glob(name[:-3] + ".*.nb[ic]"):
-                stale.unlink()
-        cache.mkdir(exist_ok=True)
-        write_text(mark, digest)  # atomically
-    except OSError:
-        return
+    return compiled.drop_stale_caches([here / name for name in KERNEL_MODULES], here / "__pycache__" / "ik_kernels.sha256")
 
 
 drop_stale_caches()
 
 ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
-
-
-def jit(function):
-    """``numba.njit`` with ``nogil``, cached on disk (beside the source, or numba's user cache
-    directory when that is read-only); without any writable cache location, compiled per process."""
-    try:
-        return njit(cache=True, nogil=True)(function)
-    except RuntimeError:  # numba: "cannot cache function ...: no locator available"
-        return njit(nogil=True)(function)
-
-
-def jit_inline(function):
-    """:func:`jit` inlined into its callers by numba (no call, no reference counting of its array arguments)."""
-    try:
-        return njit(cache=True, nogil=True, inline="always")(function)
-    except RuntimeError:
-        return njit(nogil=True, inline="always")(function)
 
 
 @jit
