@@ -162,7 +162,8 @@ def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = No
         trays = spec.trays_of(st.name)
         if trays is not None:
             t = spec.stream.types[0]
-            key = (_shape_key(st, spec.belt), "trays", id(trays), spec.belt.speed, t.mass, t.size[2], spec.tracking,
+            on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
+            key = (_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
                    spec.tray_grid)
             if key not in cache:
                 from pinarms.optim.line.tray_maps import build_tray_map

@@ -10,8 +10,11 @@ The place coordinate ``dv`` is where the tray's place point is at the place rend
 tray's phase it fixes which tray and when (:mod:`~.tray_sim`). Between nodes the times are
 interpolated (bilinear for ``t_A``, trilinear for ``t_X``, ``t_R``); a point is feasible when all
 the nodes of its cell are. One IK branch: the one :func:`~.trays.plan_pick_to_tray` takes
-(the rest configuration's where it reaches). :func:`tray_map_error` re-plans at seeded random
-points. Built on the execution layer, one task per ``du`` column.
+(the rest configuration's where it reaches) for the pick; the place tracking segment on each
+IK branch (``branches``: the SCARA's elbows), kept apart like the box maps': at a point the map
+takes the fastest branch whose eight cell nodes are feasible (:meth:`TrayMap.branch_at`), never a
+mixture (the place's elbow change costs ~0.7 s on seed 000's SCARA beside its base).
+:func:`tray_map_error` re-plans at seeded random points on the branch the map chose. Built on the execution layer, one task per ``du`` column.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import MapError, TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, rest_configuration
+from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
@@ -43,7 +46,7 @@ def _weights(grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 @dataclass(frozen=True, eq=False)
 class TrayMap:
     """Tray task times (module doc): ``du`` (nu,), ``w`` (nw,), ``dv`` (nv,) [m]; ``approach``
-    (nu, nw), ``transfer`` and ``back`` (nu, nw, nv) [s]; ``track`` the pick's tracking and
+    (nu, nw), ``transfer`` and ``back`` (nb, nu, nw, nv) [s] on each place branch ``branches`` (nb,); ``track`` the pick's tracking and
     ``place`` the place's tracking (descend, release, lift) [s]; ``speed``, ``tray_speed`` [m/s]
     and ``mass`` [kg] it was built for."""
 
@@ -60,15 +63,35 @@ class TrayMap:
     tray_speed: float
     mass: float
     build_seconds: float = 0.0
+    branches: tuple[int, ...] = (-1,)
 
     def __post_init__(self) -> None:
-        shape = (self.du.size, self.w.size, self.dv.size)
-        if self.approach.shape != shape[:2] or self.transfer.shape != shape or self.back.shape != shape:
+        shape = (len(self.branches), self.du.size, self.w.size, self.dv.size)
+        if self.approach.shape != shape[1:3] or self.transfer.shape != shape or self.back.shape != shape:
             raise InvalidInput(f"tray map {self.station!r}: tables of shapes {self.approach.shape}, "
                                f"{self.transfer.shape}, {self.back.shape} for a {shape} grid")
 
     def times(self, du: Any, w: Any, dv: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Interpolated ``(t_A, t_X, t_R)`` [s] at ``du``, ``w``, ``dv`` (broadcast); NaN where infeasible."""
+        """Interpolated ``(t_A, t_X, t_R)`` [s] at ``du``, ``w``, ``dv`` (broadcast) on the branch
+        :meth:`branch_at` names; NaN where infeasible."""
+        tA, X, R = self._interp(du, w, dv)
+        b = self._best(tA, X, R)
+        bb = np.maximum(b, 0)[None]
+        x, r = np.take_along_axis(X, bb, 0)[0], np.take_along_axis(R, bb, 0)[0]
+        return tuple(np.where(b >= 0, v, np.nan) for v in (tA, x, r))
+
+    def branch_at(self, du: float, w: float, dv: float) -> int | None:
+        """The place's IK branch label the map uses at a point (None: one branch, or infeasible)."""
+        b = int(self._best(*self._interp(du, w, dv)))
+        return None if b < 0 or self.branches[b] < 0 else int(self.branches[b])
+
+    @staticmethod
+    def _best(tA: np.ndarray, X: np.ndarray, R: np.ndarray) -> np.ndarray:
+        tot = tA[None] + X + R
+        ok = np.isfinite(tot)
+        return np.where(ok.any(axis=0), np.argmin(np.where(ok, tot, np.inf), axis=0), -1)
+
+    def _interp(self, du: Any, w: Any, dv: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         du, w, dv = np.broadcast_arrays(*(np.asarray(x, float) for x in (du, w, dv)))
         (i, fu), (j, fw), (k, fv) = _weights(self.du, du), _weights(self.w, w), _weights(self.dv, dv)
         a = self.approach
@@ -78,16 +101,15 @@ class TrayMap:
             v = 0.0
             for di, wi in ((0, 1 - fu), (1, fu)):
                 for dj, wj in ((0, 1 - fw), (1, fw)):
-                    v = v + wi * wj * (T[i + di, j + dj, k] * (1 - fv) + T[i + di, j + dj, k + 1] * fv)
+                    v = v + wi * wj * (T[:, i + di, j + dj, k] * (1 - fv) + T[:, i + di, j + dj, k + 1] * fv)
             out.append(v)
-        bad = ~np.isfinite(out[0] + out[1] + out[2])
-        return tuple(np.where(bad, np.nan, x) for x in out)
+        return out[0], out[1], out[2]
 
     @property
     def pick_map(self) -> TaskMap:
         """The pick part as a :class:`TaskMap` (approach; leave 0 where some place is feasible, the
         place's times come from this map): what the simulator's item intercept uses."""
-        ok = np.isfinite(self.approach) & np.isfinite(self.transfer + self.back).any(axis=2)
+        ok = np.isfinite(self.approach) & np.isfinite(self.transfer + self.back).any(axis=(0, 3))
         a = np.where(ok, self.approach, np.nan)
         return TaskMap(self.station, self.du, self.w, a, np.where(ok, 0.0, np.nan), self.track, 0.0, self.speed,
                        self.mass)
@@ -98,16 +120,19 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
-    nw, nv = len(task["w"]), len(task["dv"])
-    A, X, R = np.full(nw, np.nan), np.full((nw, nv), np.nan), np.full((nw, nv), np.nan)
-    for j, w in enumerate(task["w"]):
-        for k, dv in enumerate(task["dv"]):
-            try:
-                p = plan_pick_to_tray(st, belt, trays, spec, u_base + task["du"], w, v_base + dv,
-                                      item_height=task["height"], mass=task["mass"], q_rest=q_rest)
-            except (UnreachableTarget, InfeasibleProblem, OptimError):
-                continue
-            A[j], X[j, k], R[j, k] = p.times[0], p.times[2], p.times[4]
+    nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
+    A = np.full(nw, np.nan)
+    X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
+    for b, label in enumerate(labels):
+        for j, w in enumerate(task["w"]):
+            for k, dv in enumerate(task["dv"]):
+                try:
+                    p = plan_pick_to_tray(st, belt, trays, spec, u_base + task["du"], w, v_base + dv,
+                                          item_height=task["height"], mass=task["mass"], q_rest=q_rest,
+                                          place_branch=None if label < 0 else label)
+                except (UnreachableTarget, InfeasibleProblem, OptimError):
+                    continue
+                A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
     return A, X, R
 
 
@@ -135,13 +160,17 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     if half <= 0.0:
         raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
     du, w, dv = np.linspace(lo, hi, nu), np.linspace(-half, half, nw), np.linspace(vlo, vhi, nv)
+    v_base = float(trays.belt.to_belt(station.base_to_world[:3, 3])[0])
+    vv, zz = np.meshgrid(v_base + dv, np.linspace(-trays.belt.width / 2.0, trays.belt.width / 2.0, 3), indexing="ij")
+    labels = ik_branch_labels(station, trays.belt.to_world(vv.ravel(), zz.ravel(), trays.height + spec.lift))
     task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
-            "mass": mass, "height": item_height, "seed": 0}
+            "mass": mass, "height": item_height, "seed": 0, "branches": labels}
     cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler)
-    A, X, R = (np.stack([c[n] for c in cols]) for n in range(3))
+    A = np.stack([c[0] for c in cols])
+    X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
     place = spec.descend + spec.release + spec.descend
     return TrayMap(station.name, du, w, dv, A, X, R, spec.track_time, place, belt.speed, trays.belt.speed,
-                   float(mass), time.perf_counter() - start)
+                   float(mass), time.perf_counter() - start, labels)
 
 
 def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayBelt,
@@ -163,7 +192,7 @@ def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayB
             continue
         try:
             p = plan_pick_to_tray(station, belt, trays, spec, u_base + du, w, v_base + dv, item_height=item_height,
-                                  mass=m.mass, q_rest=q_rest)
+                                  mass=m.mass, q_rest=q_rest, place_branch=m.branch_at(du, w, dv))
         except PinarmsError:
             continue
         approx = float(tA + tX + tR) + m.track + m.place

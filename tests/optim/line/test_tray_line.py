@@ -18,7 +18,7 @@ V_BASE, V0, V1 = 1.0, 0.0, 0.02  # place window v in [1.0, 1.02] m
 
 def const_tray_map(tray_speed):
     du, w, dv = np.array([U0, U1]), np.array([-0.15, 0.15]), np.array([V0, V1])
-    return TrayMap("a", du, w, dv, np.full((2, 2), TA), np.full((2, 2, 2), TX), np.full((2, 2, 2), TR), TRACK,
+    return TrayMap("a", du, w, dv, np.full((2, 2), TA), np.full((1, 2, 2, 2), TX), np.full((1, 2, 2, 2), TR), TRACK,
                    PLACE, BELT.speed, tray_speed, 0.1)
 
 
@@ -88,8 +88,8 @@ def test_enough_slots_fill_closed_form():
     items = regular_items(BELT, 2.0, 120.0, w=0.0)
     tm = const_tray_map(0.1)
     # a place window as long as a tray pitch: some tray is always there (no hold)
-    tm = TrayMap("a", tm.du, tm.w, np.array([0.0, 0.45]), tm.approach, np.full((2, 2, 2), 0.3),
-                 np.full((2, 2, 2), 0.3), 0.3, 0.3, BELT.speed, 0.1, 0.1)
+    tm = TrayMap("a", tm.du, tm.w, np.array([0.0, 0.45]), tm.approach, np.full((1, 2, 2, 2), 0.3),
+                 np.full((1, 2, 2, 2), 0.3), 0.3, 0.3, BELT.speed, 0.1, 0.1)
     for trays in (trays2, trays4):
         r = simulate([SimArm("a", U_BASE, (tm.pick_map,), place=SimPlace(tm, trays, V_BASE))], items, BELT.speed,
                      duration=120.0)
