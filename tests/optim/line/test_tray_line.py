@@ -6,6 +6,7 @@ import pytest
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import regular_items
 from pinarms.optim.line.simulate import NO_TRAY, SimArm, simulate
+from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.line.tray_maps import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace, tray_counts
 from pinarms.optim.line.trays import TrayBelt
@@ -119,3 +120,83 @@ def test_full_trays_leave_items_unplaced():
 
 def test_tray_counts_without_arms_is_empty():
     assert tray_counts([None], {}, 10.0)[:2] == (0, 0)
+
+
+def _tool(station, q):
+    T = station.robot.fk(q)
+    return T[..., :3, 3] @ station.base_to_world[:3, :3].T + station.base_to_world[:3, 3]
+
+
+def _velocity(station, q, qd):
+    J = station.robot.jacobian(q)[:, :3, :]
+    return np.einsum("nij,nj->ni", J, qd) @ station.base_to_world[:3, :3].T
+
+
+@pytest.fixture(scope="module")
+def tray_scene(scara_line):
+    belt, station = scara_line
+    trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.3, capacity=2, height=0.02)
+    from pinarms.optim.line.tray_maps import build_tray_map
+
+    tm = build_tray_map(station, belt, trays, mass=0.1, nu=2, nw=2, nv=3, margin=0.1, du_range=(0.0, 0.1),
+                        dv_range=(0.05, 0.25))
+    return belt, station, trays, tm
+
+
+@pytest.mark.slow
+def test_simulated_place_tracks_its_tray_from_fk(tray_scene):
+    # a placement chosen by the simulation, planned exactly (pick at its rendezvous, place at its
+    # pre-place point on the branch the map chose), its release dwell put on the simulation's clock:
+    # the tool is on the promised tray's place point and moves with it
+    from pinarms.optim.line.trays import plan_pick_to_tray
+
+    belt, station, trays, tm = tray_scene
+    assert np.isfinite(tm.transfer[:, :, :, 1:]).all()  # both elbows reach the place for dv >= 0.15 m
+    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    v_base = float(trays.belt.to_belt(station.base_to_world[:3, 3])[0])
+    items = regular_items(belt, 4.0, 40.0, w=0.0)
+    r = simulate([SimArm("scara 1", u_base, (tm.pick_map,), place=SimPlace(tm, trays, v_base))], items, belt.speed,
+                 duration=40.0)
+    done = np.flatnonzero(r.picked_by >= 0)
+    assert done.size >= 5
+    i = int(done[np.argmin(r.place_wait[done])])  # a place met at a crossing (no hold) if any
+    du, dv = r.u_meet[i] - u_base, r.u_place[i] - v_base
+    plan = plan_pick_to_tray(station, belt, trays, TrackingSpec(), r.u_meet[i], 0.0, r.u_place[i], mass=0.1,
+                             place_branch=tm.branch_at(du, 0.0, dv))
+    approx = sum(tm.times(du, 0.0, dv)) + tm.track + tm.place
+    assert approx == pytest.approx(plan.duration, rel=0.01)  # the map's time of this placement
+    t_place_plan = sum(plan.times[:3])
+    tau = np.linspace(*plan.release_window, 101)  # plan time
+    q, qd = plan.trajectory.sample(tau)[:2]
+    t_sim = r.place_time[i] + (tau - t_place_plan)  # the simulation's clock at the place
+    slot = trays.belt.to_world(trays.tray_u(r.tray[i], t_sim), trays.w, trays.height)
+    assert np.max(np.linalg.norm(_tool(station, q) - slot, axis=1)) < 1e-3
+    rel = np.linalg.norm(_velocity(station, q, qd) - trays.belt.velocity, axis=1)
+    assert np.max(rel) < 0.01 * trays.belt.speed
+
+
+def test_bad_tray_input(scara_line):
+    from pinarms.optim.line.api import LineSpec
+    from pinarms.optim.line.tray_maps import build_tray_map
+    from pinarms.optim.line.trays import parse_trays
+    from pinarms.optim.line.windows import BeltOutOfReach
+    from pinarms.robots.errors import InvalidInput
+
+    belt, station = scara_line
+    for bad in (0.0, -0.1, float("nan")):
+        with pytest.raises(InvalidInput, match="speed"):
+            TrayBelt(Belt((0.0, 0.52, 0.82), speed=bad, width=0.2))
+    with pytest.raises(InvalidInput, match="capacity"):
+        TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2), capacity=0)
+    with pytest.raises(InvalidInput, match="slots per tray"):
+        parse_trays("0.3,0.1,1.5")
+    far = TrayBelt(Belt((0.0, 3.0, 0.82), speed=0.1, width=0.2), pitch=0.3)
+    with pytest.raises(BeltOutOfReach, match="scara 1"):
+        build_tray_map(station, belt, far)
+    ok = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2))
+    with pytest.raises(InvalidInput, match="not in the line"):
+        LineSpec(belt, (station,), trays={"scara 9": ok})
+    with pytest.raises(InvalidInput, match="look-ahead"):
+        tm = const_tray_map(0.1)
+        simulate([SimArm("a", U_BASE, (tm.pick_map,), place=SimPlace(tm, ok, V_BASE))],
+                 regular_items(BELT, 2.0, 10.0, w=0.0), BELT.speed, "lookahead")
