@@ -200,3 +200,20 @@ def test_bad_tray_input(scara_line):
         tm = const_tray_map(0.1)
         simulate([SimArm("a", U_BASE, (tm.pick_map,), place=SimPlace(tm, ok, V_BASE))],
                  regular_items(BELT, 2.0, 10.0, w=0.0), BELT.speed, "lookahead")
+
+
+def test_line_spec_with_trays_reports_tray_figures(scara_line):
+    from pinarms.optim.line.api import LineSpec, Stream, run_line
+
+    belt, station = scara_line
+    trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.4, capacity=2, phase=0.137)
+    spec = LineSpec(belt, (station,), Stream("regular", rate=30.0, duration=60.0), seeds=(0, 1), trays=trays)
+    res = run_line(spec, maps={station.name: (const_tray_map(0.1),)})
+    f = res.figures
+    assert f.tray_fill_rate is not None and 0.0 < f.tray_fill_rate <= 1.0
+    assert f.trays_unfilled >= 0 and 0.0 <= f.unplaced_rate <= f.miss_rate
+    assert "tray_fill_rate" in f.as_dict()
+    assert all(r.tray is not None for r in res.runs)
+    box = run_line(LineSpec(belt, (station,), Stream("regular", rate=30.0, duration=60.0), seeds=(0,)),
+                   maps={station.name: (const_tray_map(0.1).pick_map,)})
+    assert box.figures.tray_fill_rate is None and "tray_fill_rate" not in box.figures.as_dict()
