@@ -13,7 +13,7 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
    dashboard), both sides warmed alike, interleaved; the results must be identical.
 
 5. ``trays``: a tray map of seed 000's SCARA placing in trays on a second belt (10 × 3 × 8 grid,
-   serial) and its error against exact pick-to-tray planning at 100 random (pick, place) points.
+   or ``trays NU,NW,NV``; each place on both elbows; serial) and its error against exact pick-to-tray planning at 100 random (pick, place) points.
 
 Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|all]
 """
@@ -181,12 +181,14 @@ def tray_scene():
     return belt, station, trays
 
 
-def part_trays() -> None:
+def part_trays(grid=(10, 3, 8)) -> None:
     from pinarms.optim.line.tray_maps import build_tray_map, tray_map_error
 
+    if len(sys.argv) > 2:  # python benchmarks/line.py trays NU,NW,NV
+        grid = tuple(int(x) for x in sys.argv[2].split(","))
     belt, station, trays = tray_scene()
     t = time.perf_counter()
-    m = build_tray_map(station, belt, trays, mass=0.1)
+    m = build_tray_map(station, belt, trays, mass=0.1, nu=grid[0], nw=grid[1], nv=grid[2])
     ok = np.isfinite(m.transfer + m.back)
     print(f"tray map {m.du.size} x {m.w.size} x {m.dv.size}: {time.perf_counter() - t:.1f} s, "
           f"{ok.mean():.0%} of nodes feasible, dv {m.dv[0]:.3f}..{m.dv[-1]:.3f} m")

@@ -13,7 +13,9 @@ the nodes of its cell are. One IK branch: the one :func:`~.trays.plan_pick_to_tr
 (the rest configuration's where it reaches) for the pick; the place tracking segment on each
 IK branch (``branches``: the SCARA's elbows), kept apart like the box maps': at a point the map
 takes the fastest branch whose eight cell nodes are feasible (:meth:`TrayMap.branch_at`), never a
-mixture (the place's elbow change costs ~0.7 s on seed 000's SCARA beside its base).
+mixture (the place's elbow change costs ~0.7 s on seed 000's SCARA beside its base). The pick's
+elbow (``pick_branch``, per node) may change where the rest configuration's stops reaching: a cell
+whose four pick nodes are not on one elbow is infeasible (the arm does not pick there).
 :func:`tray_map_error` re-plans at seeded random points on the branch the map chose. Built on the execution layer, one task per ``du`` column.
 """
 
@@ -29,7 +31,7 @@ from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import MapError, TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, rest_configuration
+from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
@@ -64,12 +66,16 @@ class TrayMap:
     mass: float
     build_seconds: float = 0.0
     branches: tuple[int, ...] = (-1,)
+    pick_branch: np.ndarray | None = None  #: (nu, nw) the pick's IK branch label at each node (None: one)
 
     def __post_init__(self) -> None:
         shape = (len(self.branches), self.du.size, self.w.size, self.dv.size)
         if self.approach.shape != shape[1:3] or self.transfer.shape != shape or self.back.shape != shape:
             raise InvalidInput(f"tray map {self.station!r}: tables of shapes {self.approach.shape}, "
                                f"{self.transfer.shape}, {self.back.shape} for a {shape} grid")
+        P = np.zeros(shape[1:3], int) if self.pick_branch is None else np.asarray(self.pick_branch, int)
+        one = (P[:-1, :-1] == P[1:, :-1]) & (P[:-1, :-1] == P[:-1, 1:]) & (P[:-1, :-1] == P[1:, 1:])
+        object.__setattr__(self, "_one_pick_branch", one)  # cells whose four pick nodes share an elbow
 
     def times(self, du: Any, w: Any, dv: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Interpolated ``(t_A, t_X, t_R)`` [s] at ``du``, ``w``, ``dv`` (broadcast) on the branch
@@ -95,6 +101,7 @@ class TrayMap:
         du, w, dv = np.broadcast_arrays(*(np.asarray(x, float) for x in (du, w, dv)))
         (i, fu), (j, fw), (k, fv) = _weights(self.du, du), _weights(self.w, w), _weights(self.dv, dv)
         a = self.approach
+        fu = np.where(self._one_pick_branch[i, j], fu, np.nan)  # never across the pick's elbow change
         tA = (a[i, j] * (1 - fu) + a[i + 1, j] * fu) * (1 - fw) + (a[i, j + 1] * (1 - fu) + a[i + 1, j + 1] * fu) * fw
         out = [tA]
         for T in (self.transfer, self.back):
@@ -121,7 +128,7 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
     nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
-    A = np.full(nw, np.nan)
+    A, P = np.full(nw, np.nan), np.full(nw, -1)
     X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
     for b, label in enumerate(labels):
         for j, w in enumerate(task["w"]):
@@ -133,7 +140,8 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                 except (UnreachableTarget, InfeasibleProblem, OptimError):
                     continue
                 A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
-    return A, X, R
+                P[j] = _branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
+    return A, X, R, P
 
 
 def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec = TrackingSpec(), *,
@@ -166,11 +174,11 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
             "mass": mass, "height": item_height, "seed": 0, "branches": labels}
     cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler)
-    A = np.stack([c[0] for c in cols])
+    A, P = np.stack([c[0] for c in cols]), np.stack([c[3] for c in cols])
     X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
     place = spec.descend + spec.release + spec.descend
     return TrayMap(station.name, du, w, dv, A, X, R, spec.track_time, place, belt.speed, trays.belt.speed,
-                   float(mass), time.perf_counter() - start, labels)
+                   float(mass), time.perf_counter() - start, labels, P)
 
 
 def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayBelt,
