@@ -19,6 +19,11 @@ exact picks through the cell's continuous check at the clearance), an arm starts
 it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
 choice, or waits until that neighbour's pick ends. Each guarded pair is counted in
 :attr:`SimResult.checks` (checks, blocked).
+
+Arms with a ``place`` (:class:`~.tray_sim.SimPlace`) place in trays on a second belt: a
+candidate item counts only with a free tray slot the arm can reach after the pick, which is
+promised at the decision and sets the pick's end (:mod:`~.tray_sim`); the result then holds
+each item's tray, the trays seen, unfilled and the fill rate.
 """
 
 from __future__ import annotations
@@ -222,7 +227,8 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
                       and states[k].u_min < states[j].u_max] for k in range(len(arms))} if guard else {}
     ongoing: list = [None] * len(arms)
     fill: dict = {}
-    tray_of, u_place, place_time, wait = np.full(n, NO_TRAY, dtype=np.int64), np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    tray_of = np.full(n, NO_TRAY, dtype=np.int64)
+    u_place, place_time, wait = (np.full(n, np.nan) for _ in range(3))
     no_tray = np.zeros(n, dtype=bool)
     places: list = [None] * n
     counts = [0, 0]
