@@ -258,9 +258,10 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         idx, s, m, f, u = idx[ok], s[ok], m[ok], f[ok], u[ok]
         if arms[k].place is not None:
             keep = _places(arms[k], idx, m, u, items.w, f, fill, places, no_tray)
-            if not keep.any():
-                if nxt is not None:
-                    heapq.heappush(heap, (nxt, k))
+            if not keep.any():  # look again when a later tray may be in reach (a quarter tray period)
+                tb = arms[k].place.trays
+                again = t + 0.25 * tb.pitch / tb.belt.speed
+                heapq.heappush(heap, (again if nxt is None else min(nxt, again), k))
                 continue
             idx, s, m, f, u = idx[keep], s[keep], m[keep], f[keep], u[keep]
         if rule.name == "lookahead":
