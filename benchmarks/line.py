@@ -12,7 +12,10 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
    one task per layout) serial vs a LocalCluster of two single-thread workers (127.0.0.1, no
    dashboard), both sides warmed alike, interleaved; the results must be identical.
 
-Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|all]
+5. ``trays``: a tray map of seed 000's SCARA placing in trays on a second belt (10 × 3 × 8 grid,
+   or ``trays NU,NW,NV``; each place on both elbows; serial) and its error against exact pick-to-tray planning at 100 random (pick, place) points.
+
+Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|all]
 """
 
 from __future__ import annotations
@@ -163,8 +166,42 @@ def part_sizing(rounds: int = 3) -> None:
     print(f"[sizing] ratios {', '.join(f'{r:.2f}' for r in ratios)}; identical: {same}")
 
 
+def tray_scene():
+    """Seed 000's SCARA beside the item belt, a tray belt along it on the box side (0.1 m/s)."""
+    from pinarms import robots
+    from pinarms.optim.line.belt import Belt, PlaceBox
+    from pinarms.optim.line.station import Station, base_pose
+    from pinarms.optim.line.trays import TrayBelt
+
+    belt = Belt(origin=(0.0, 0.0, 0.80), speed=0.2, width=0.3, length=3.0)
+    station = Station("scara 1", robots.load("scara_mushroom"), base_pose(1.0, 0.30, 0.78),
+                      PlaceBox((0.8, 0.45, 0.93)))
+    trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.3, capacity=2,
+                     height=0.02)
+    return belt, station, trays
+
+
+def part_trays(grid=(10, 3, 8)) -> None:
+    from pinarms.optim.line.tray_maps import build_tray_map, tray_map_error
+
+    if len(sys.argv) > 2:  # python benchmarks/line.py trays NU,NW,NV
+        grid = tuple(int(x) for x in sys.argv[2].split(","))
+    belt, station, trays = tray_scene()
+    t = time.perf_counter()
+    m = build_tray_map(station, belt, trays, mass=0.1, nu=grid[0], nw=grid[1], nv=grid[2])
+    ok = np.isfinite(m.transfer + m.back)
+    print(f"tray map {m.du.size} x {m.w.size} x {m.dv.size}: {time.perf_counter() - t:.1f} s, "
+          f"{ok.mean():.0%} of nodes feasible, dv {m.dv[0]:.3f}..{m.dv[-1]:.3f} m")
+    e = tray_map_error(m, station, belt, trays, n=100, seed=11)
+    r = e.relative
+    print(f"tray map error, {r.size} random picks (seed 11): mean {100 * r.mean():.3f} %, "
+          f"p95 {100 * np.percentile(r, 95):.3f} %, max {100 * r.max():.3f} % ({e.planning_seconds:.1f} s)")
+    worst = e.points[np.argsort(r)[-3:]]
+    print("worst points (du, w, dv):", np.round(worst, 3).tolist())
+
+
 PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,
-         "sizing": part_sizing}
+         "sizing": part_sizing, "trays": part_trays}
 
 if __name__ == "__main__":
     which = sys.argv[1] if len(sys.argv) > 1 else "all"

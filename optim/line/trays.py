@@ -17,7 +17,7 @@ the return like the pick's leave move. The hand keeps the pick's turn (the item'
 the place. Checked from FK (tests/optim/line/test_trays.py): tool-to-tray distance < 1 mm and
 relative speed < 1 % of the tray belt's speed over the whole release dwell.
 
-Not yet in the task maps nor the simulation (docs/line.md): both still place in fixed boxes.
+Task maps of it: :mod:`~.tray_maps`; in the simulation: :mod:`~.tray_sim`.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_lim
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray"]
+__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "trays_beside", "parse_trays"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +67,31 @@ class TrayBelt:
     def tray_u(self, k: Any, t: Any) -> np.ndarray:
         """u [m] of tray ``k``'s centre on its belt at time ``t`` [s] (broadcast)."""
         return self.phase - np.asarray(k, float) * self.pitch + self.belt.speed * np.asarray(t, float)
+
+
+def trays_beside(belt: Belt, place_world: Any, pitch: float, speed: float, capacity: int, *,
+                 height: float = 0.03, width: float = 0.2) -> TrayBelt:
+    """Trays on a belt parallel to ``belt`` (same direction and length) whose place point passes
+    through ``place_world`` (e.g. the stations' box release point) [m]."""
+    b = belt.to_belt(np.asarray(place_world, float))
+    origin = belt.to_world(0.0, float(b[1]), float(b[2]) - height)
+    return TrayBelt(Belt(origin, belt.direction, speed, width, belt.length), pitch=pitch, capacity=capacity,
+                    height=height)
+
+
+def parse_trays(text: str) -> tuple[float, float, int]:
+    """``"PITCH,SPEED,SLOTS"`` (m, m/s, items per tray) → numbers; InvalidInput naming the field."""
+    parts = str(text).split(",")
+    if len(parts) != 3:
+        raise InvalidInput(f"trays must be PITCH,SPEED,SLOTS (m, m/s, items per tray), got {text!r}")
+    out = []
+    for name, part, kind in zip(("pitch [m]", "speed [m/s]", "slots per tray"), parts, (float, float, int)):
+        try:
+            out.append(kind(part))
+        except ValueError:
+            raise InvalidInput(f"tray {name} must be {'an integer' if kind is int else 'a number'}, "
+                               f"got {part.strip()!r} in {text!r}") from None
+    return out[0], out[1], out[2]
 
 
 @dataclass(eq=False)
@@ -128,10 +153,11 @@ def _segment(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: floa
 
 def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec, u_pre: float, w: float,
                       u_place: float, *, item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None,
-                      branch: int | None = None, yaw: float = 0.0) -> TrayPickPlan:
+                      branch: int | None = None, yaw: float = 0.0, place_branch: int | None = None) -> TrayPickPlan:
     """Pick at (``u_pre``, ``w``) on ``belt`` and place in the tray whose place point passes
     ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); arguments as
-    :func:`~.tracking.plan_pick`.
+    :func:`~.tracking.plan_pick`; ``place_branch``: the IK branch label of the place tracking
+    segment (None: the pick's where it reaches, else the nearest).
 
     Raises:
         UnreachableTarget: a point of either tracking segment out of reach.
@@ -144,7 +170,7 @@ def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: Track
     qd_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[1][0]
     place_spec = replace(spec, grasp=spec.release)  # the dwell is the gripper opening
     place, qd_in, qd_out = _segment(station, trays.belt, place_spec, float(u_place), trays.w, trays.height,
-                                    tool_yaw(station, spec, yaw), q_end, None, "place tracking segment")
+                                    tool_yaw(station, spec, yaw), q_end, place_branch, "place tracking segment")
     q_place = place.sample(np.array([0.0]))[0][0]
     transfer = _timed_transfer(station, q_end, qd_end, q_place, qd_in, mass, spec.grid)
     q_last = place.sample(np.array([place.end_time]))[0][0]

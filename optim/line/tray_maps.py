@@ -1,0 +1,209 @@
+"""Task-time maps of picks placed in trays on a second moving belt, built from exact plans.
+
+A :class:`TrayMap` stores, on a grid of pre-grasp points relative to the arm (``du`` along the
+item belt, ``w`` across it) and of pre-place points along the tray belt (``dv``, from the arm's
+base projected on the tray belt), the exact times of :func:`~.trays.plan_pick_to_tray`: the
+approach ``t_A(du, w)`` (the same as a box pick's), the transfer ``t_X(du, w, dv)`` (from the end
+of the pick's tracking segment to the pre-place point, moving with the tray) and the return
+``t_R(du, w, dv)`` (from the end of the place tracking to rest at home); NaN where infeasible.
+The place coordinate ``dv`` is where the tray's place point is at the place rendezvous: with the
+tray's phase it fixes which tray and when (:mod:`~.tray_sim`). Between nodes the times are
+interpolated (bilinear for ``t_A``, trilinear for ``t_X``, ``t_R``); a point is feasible when all
+the nodes of its cell are. One IK branch: the one :func:`~.trays.plan_pick_to_tray` takes
+(the rest configuration's where it reaches) for the pick; the place tracking segment on each
+IK branch (``branches``: the SCARA's elbows), kept apart like the box maps': at a point the map
+takes the fastest branch whose eight cell nodes are feasible (:meth:`TrayMap.branch_at`), never a
+mixture (the place's elbow change costs ~0.7 s on seed 000's SCARA beside its base). The pick's
+elbow (``pick_branch``, per node) may change where the rest configuration's stops reaching: a cell
+whose four pick nodes are not on one elbow is infeasible (the arm does not pick there).
+:func:`tray_map_error` re-plans at seeded random points on the branch the map chose. Built on the execution layer, one task per ``du`` column.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.errors import InfeasibleProblem, OptimError
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.station import Station
+from pinarms.optim.line.task_maps import MapError, TaskMap
+from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, rest_configuration
+from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
+from pinarms.optim.line.windows import belt_span, check_reach
+from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
+
+__all__ = ["TrayMap", "build_tray_map", "tray_map_error"]
+
+
+def _weights(grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2)
+    f = (x - grid[i]) / (grid[i + 1] - grid[i])
+    return i, np.where((x < grid[0]) | (x > grid[-1]), np.nan, f)
+
+
+@dataclass(frozen=True, eq=False)
+class TrayMap:
+    """Tray task times (module doc): ``du`` (nu,), ``w`` (nw,), ``dv`` (nv,) [m]; ``approach``
+    (nu, nw), ``transfer`` and ``back`` (nb, nu, nw, nv) [s] on each place branch ``branches`` (nb,); ``track`` the pick's tracking and
+    ``place`` the place's tracking (descend, release, lift) [s]; ``speed``, ``tray_speed`` [m/s]
+    and ``mass`` [kg] it was built for."""
+
+    station: str
+    du: np.ndarray
+    w: np.ndarray
+    dv: np.ndarray
+    approach: np.ndarray
+    transfer: np.ndarray
+    back: np.ndarray
+    track: float
+    place: float
+    speed: float
+    tray_speed: float
+    mass: float
+    build_seconds: float = 0.0
+    branches: tuple[int, ...] = (-1,)
+    pick_branch: np.ndarray | None = None  #: (nu, nw) the pick's IK branch label at each node (None: one)
+
+    def __post_init__(self) -> None:
+        shape = (len(self.branches), self.du.size, self.w.size, self.dv.size)
+        if self.approach.shape != shape[1:3] or self.transfer.shape != shape or self.back.shape != shape:
+            raise InvalidInput(f"tray map {self.station!r}: tables of shapes {self.approach.shape}, "
+                               f"{self.transfer.shape}, {self.back.shape} for a {shape} grid")
+        P = np.zeros(shape[1:3], int) if self.pick_branch is None else np.asarray(self.pick_branch, int)
+        one = (P[:-1, :-1] == P[1:, :-1]) & (P[:-1, :-1] == P[:-1, 1:]) & (P[:-1, :-1] == P[1:, 1:])
+        object.__setattr__(self, "_one_pick_branch", one)  # cells whose four pick nodes share an elbow
+
+    def times(self, du: Any, w: Any, dv: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Interpolated ``(t_A, t_X, t_R)`` [s] at ``du``, ``w``, ``dv`` (broadcast) on the branch
+        :meth:`branch_at` names; NaN where infeasible."""
+        tA, X, R = self._interp(du, w, dv)
+        b = self._best(tA, X, R)
+        bb = np.maximum(b, 0)[None]
+        x, r = np.take_along_axis(X, bb, 0)[0], np.take_along_axis(R, bb, 0)[0]
+        return tuple(np.where(b >= 0, v, np.nan) for v in (tA, x, r))
+
+    def branch_at(self, du: float, w: float, dv: float) -> int | None:
+        """The place's IK branch label the map uses at a point (None: one branch, or infeasible)."""
+        b = int(self._best(*self._interp(du, w, dv)))
+        return None if b < 0 or self.branches[b] < 0 else int(self.branches[b])
+
+    @staticmethod
+    def _best(tA: np.ndarray, X: np.ndarray, R: np.ndarray) -> np.ndarray:
+        tot = tA[None] + X + R
+        ok = np.isfinite(tot)
+        return np.where(ok.any(axis=0), np.argmin(np.where(ok, tot, np.inf), axis=0), -1)
+
+    def _interp(self, du: Any, w: Any, dv: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        du, w, dv = np.broadcast_arrays(*(np.asarray(x, float) for x in (du, w, dv)))
+        (i, fu), (j, fw), (k, fv) = _weights(self.du, du), _weights(self.w, w), _weights(self.dv, dv)
+        a = self.approach
+        fu = np.where(self._one_pick_branch[i, j], fu, np.nan)  # never across the pick's elbow change
+        tA = (a[i, j] * (1 - fu) + a[i + 1, j] * fu) * (1 - fw) + (a[i, j + 1] * (1 - fu) + a[i + 1, j + 1] * fu) * fw
+        out = [tA]
+        for T in (self.transfer, self.back):
+            v = 0.0
+            for di, wi in ((0, 1 - fu), (1, fu)):
+                for dj, wj in ((0, 1 - fw), (1, fw)):
+                    v = v + wi * wj * (T[:, i + di, j + dj, k] * (1 - fv) + T[:, i + di, j + dj, k + 1] * fv)
+            out.append(v)
+        return out[0], out[1], out[2]
+
+    @property
+    def pick_map(self) -> TaskMap:
+        """The pick part as a :class:`TaskMap` (approach; leave 0 where some place is feasible, the
+        place's times come from this map): what the simulator's item intercept uses."""
+        ok = np.isfinite(self.approach) & np.isfinite(self.transfer + self.back).any(axis=(0, 3))
+        a = np.where(ok, self.approach, np.nan)
+        return TaskMap(self.station, self.du, self.w, a, np.where(ok, 0.0, np.nan), self.track, 0.0, self.speed,
+                       self.mass)
+
+
+def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    st, belt, trays, spec = task["station"], task["belt"], task["trays"], task["spec"]
+    u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(st)
+    nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
+    A, P = np.full(nw, np.nan), np.full(nw, -1)
+    X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
+    for b, label in enumerate(labels):
+        for j, w in enumerate(task["w"]):
+            for k, dv in enumerate(task["dv"]):
+                try:
+                    p = plan_pick_to_tray(st, belt, trays, spec, u_base + task["du"], w, v_base + dv,
+                                          item_height=task["height"], mass=task["mass"], q_rest=q_rest,
+                                          place_branch=None if label < 0 else label)
+                except (UnreachableTarget, InfeasibleProblem, OptimError):
+                    continue
+                A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
+                P[j] = _branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
+    return A, X, R, P
+
+
+def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec = TrackingSpec(), *,
+                   mass: float = 0.1, item_height: float = 0.04, margin: float = 0.025, nu: int = 10, nw: int = 3,
+                   nv: int = 8, du_range: tuple[float, float] | None = None,
+                   dv_range: tuple[float, float] | None = None, scheduler: Any = None) -> TrayMap:
+    """Plan picks placed in trays exactly on a ``nu`` × ``nw`` × ``nv`` grid (module doc); ``du``
+    and ``dv`` span the arm's sampled workspace over each belt (or the ranges given [m]).
+
+    Raises:
+        BeltOutOfReach: the arm reaches no point of the item belt or of the tray belt (names the arm).
+    """
+    from pinarms.execution import map_chunks
+
+    if not all(isinstance(n, int) and n >= 2 for n in (nu, nw, nv)):
+        raise InvalidInput(f"nu, nw and nv must be integers >= 2, got {nu!r}, {nw!r}, {nv!r}")
+    check_reach(station, belt, item_height)
+    check_reach(station, trays.belt, trays.height)
+    rest_configuration(station)
+    start = time.perf_counter()
+    lo, hi = belt_span(station, belt) if du_range is None else du_range
+    vlo, vhi = belt_span(station, trays.belt) if dv_range is None else dv_range
+    half = belt.width / 2.0 - margin
+    if half <= 0.0:
+        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
+    du, w, dv = np.linspace(lo, hi, nu), np.linspace(-half, half, nw), np.linspace(vlo, vhi, nv)
+    v_base = float(trays.belt.to_belt(station.base_to_world[:3, 3])[0])
+    vv, zz = np.meshgrid(v_base + dv, np.linspace(-trays.belt.width / 2.0, trays.belt.width / 2.0, 3), indexing="ij")
+    labels = ik_branch_labels(station, trays.belt.to_world(vv.ravel(), zz.ravel(), trays.height + spec.lift))
+    task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
+            "mass": mass, "height": item_height, "seed": 0, "branches": labels}
+    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler)
+    A, P = np.stack([c[0] for c in cols]), np.stack([c[3] for c in cols])
+    X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
+    place = spec.descend + spec.release + spec.descend
+    return TrayMap(station.name, du, w, dv, A, X, R, spec.track_time, place, belt.speed, trays.belt.speed,
+                   float(mass), time.perf_counter() - start, labels, P)
+
+
+def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayBelt,
+                   spec: TrackingSpec = TrackingSpec(), *, n: int = 30, item_height: float = 0.04,
+                   seed: int = 0) -> MapError:
+    """Interpolated vs exact task time (pick to tray) at ``n`` seeded random points (du, w, dv)
+    where the map says feasible; ``points`` (n, 3)."""
+    rng = np.random.default_rng(seed)
+    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    v_base = float(trays.belt.to_belt(station.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(station)
+    rel, pts, tries, start = [], [], 0, time.perf_counter()
+    m = tray_map
+    while len(rel) < n and tries < 50 * n:
+        tries += 1
+        du, w, dv = (rng.uniform(g[0], g[-1]) for g in (m.du, m.w, m.dv))
+        tA, tX, tR = m.times(du, w, dv)
+        if not np.isfinite(tA + tX + tR):
+            continue
+        try:
+            p = plan_pick_to_tray(station, belt, trays, spec, u_base + du, w, v_base + dv, item_height=item_height,
+                                  mass=m.mass, q_rest=q_rest, place_branch=m.branch_at(du, w, dv))
+        except PinarmsError:
+            continue
+        approx = float(tA + tX + tR) + m.track + m.place
+        rel.append(abs(approx - p.duration) / p.duration)
+        pts.append((du, w, dv))
+    return MapError(np.array(rel), np.array(pts).reshape(-1, 3), time.perf_counter() - start)
