@@ -91,6 +91,7 @@ class SimResult:
     u_place: np.ndarray | None = None  #: pre-place point on the tray belt [m]
     place_time: np.ndarray | None = None  #: place rendezvous [s]
     place_wait: np.ndarray | None = None  #: time held before the place rendezvous [s]
+    place_branch: np.ndarray | None = None  #: the place's IK branch label in the tray map (-1: one branch)
     no_tray: np.ndarray | None = None  #: an arm could have picked the item but had no free reachable slot
     trays_seen: int = 0  #: trays that crossed every place window within the observed span
     trays_unfilled: int = 0  #: of those, trays that left the last window with a free slot
@@ -229,6 +230,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     fill: dict = {}
     tray_of = np.full(n, NO_TRAY, dtype=np.int64)
     u_place, place_time, wait = (np.full(n, np.nan) for _ in range(3))
+    place_branch = np.full(n, -1, dtype=np.int64)
     no_tray = np.zeros(n, dtype=bool)
     places: list = [None] * n
     counts = [0, 0]
@@ -292,7 +294,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         if arms[k].place is not None:
             pl = places[i]
             fill[(id(arms[k].place.trays), pl.tray)] = fill.get((id(arms[k].place.trays), pl.tray), 0) + 1
-            tray_of[i], u_place[i], place_time[i], wait[i] = pl.tray, pl.v, pl.time, pl.wait
+            tray_of[i], u_place[i], place_time[i], wait[i], place_branch[i] = pl.tray, pl.v, pl.time, pl.wait, pl.branch
         ongoing[k] = (arms[k].name, i, t, float(m[choice]), float(u[choice]), float(items.w[i]), int(items.kind[i]),
                       float(f[choice]))
         heapq.heappush(heap, (float(f[choice]), k))
@@ -310,7 +312,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     from pinarms.optim.line.tray_sim import tray_counts
 
     seen, unfilled, rate = tray_counts([a.place for a in arms], fill, span)
-    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait, no_tray=no_tray,
+    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait, place_branch=place_branch, no_tray=no_tray,
                    trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
 
 

@@ -31,7 +31,7 @@ from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import MapError, TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, rest_configuration
+from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
@@ -112,17 +112,48 @@ class TrayMap:
             out.append(v)
         return out[0], out[1], out[2]
 
+    def place_cells(self, du: float, w: float) -> tuple[np.ndarray, ...]:
+        """The place times along ``dv`` for a pick at (``du``, ``w``), cell by cell on each place
+        branch: ``(X0, X1, R0, R1)`` (nb, nv − 1), transfer and return at the start and the end of
+        each ``dv`` cell, NaN where the cell is infeasible on that branch (one of its eight nodes,
+        or the pick's cell). Within a cell and branch the times are linear in ``dv`` (what
+        :meth:`times` gives there), so the simulator finds its crossings exactly, never across two
+        cells (the branch, or the time, may change at a node)."""
+        (i, fu), (j, fw) = _weights(self.du, np.asarray(du, float)), _weights(self.w, np.asarray(w, float))
+        nc = self.dv.size - 1
+        if not (np.isfinite(fu) and np.isfinite(fw) and self._one_pick_branch[i, j]):
+            nan = np.full((len(self.branches), nc), np.nan)
+            return nan, nan, nan, nan
+        out = []
+        for T in (self.transfer, self.back):
+            v = ((T[:, i, j] * (1 - fu) + T[:, i + 1, j] * fu) * (1 - fw)
+                 + (T[:, i, j + 1] * (1 - fu) + T[:, i + 1, j + 1] * fu) * fw)  # (nb, nv); NaN: a node infeasible
+            bad = ~(np.isfinite(v[:, :-1]) & np.isfinite(v[:, 1:]))
+            out += [np.where(bad, np.nan, v[:, :-1]), np.where(bad, np.nan, v[:, 1:])]
+        return out[0], out[1], out[2], out[3]
+
     @property
     def pick_map(self) -> TaskMap:
         """The pick part as a :class:`TaskMap` (approach; leave 0 where some place is feasible, the
-        place's times come from this map): what the simulator's item intercept uses."""
+        place's times come from this map): what the simulator's item intercept uses. Its branches
+        are the pick's elbows (``pick_branch``), so a cell whose four pick nodes are not on one
+        elbow is infeasible there too, as in this map: the intercept never proposes a pick this map
+        cannot place."""
         ok = np.isfinite(self.approach) & np.isfinite(self.transfer + self.back).any(axis=(0, 3))
-        a = np.where(ok, self.approach, np.nan)
-        return TaskMap(self.station, self.du, self.w, a, np.where(ok, 0.0, np.nan), self.track, 0.0, self.speed,
-                       self.mass)
+        P = np.zeros(self.approach.shape, int) if self.pick_branch is None else np.asarray(self.pick_branch, int)
+        labels = tuple(int(x) for x in np.unique(P[ok & (P >= 0)])) or (0,)
+        A = np.stack([np.where(ok & (P == b), self.approach, np.nan) for b in labels])
+        C = np.where(np.isfinite(A), 0.0, np.nan)
+        best = np.nanmin(np.where(np.isfinite(A), A, np.inf), axis=0)
+        a = np.where(np.isfinite(best), best, np.nan)
+        names = labels if self.pick_branch is not None else (-1,)
+        return TaskMap(self.station, self.du, self.w, a, np.where(np.isfinite(a), 0.0, np.nan), self.track, 0.0,
+                       self.speed, self.mass, branches=names, branch_approach=A, branch_leave=C)
 
 
 def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One ``du`` column: the pick planned once per ``w`` (on the rest configuration's elbow where it
+    reaches), then placed at every ``dv`` on every place branch."""
     st, belt, trays, spec = task["station"], task["belt"], task["trays"], task["spec"]
     u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
@@ -130,13 +161,18 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
     A, P = np.full(nw, np.nan), np.full(nw, -1)
     X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
-    for b, label in enumerate(labels):
-        for j, w in enumerate(task["w"]):
+    for j, w in enumerate(task["w"]):
+        try:
+            pick = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
+                             q_rest=q_rest)
+        except (UnreachableTarget, InfeasibleProblem, OptimError):
+            continue  # no pick here: no place either
+        for b, label in enumerate(labels):
             for k, dv in enumerate(task["dv"]):
                 try:
                     p = plan_pick_to_tray(st, belt, trays, spec, u_base + task["du"], w, v_base + dv,
                                           item_height=task["height"], mass=task["mass"], q_rest=q_rest,
-                                          place_branch=None if label < 0 else label)
+                                          place_branch=None if label < 0 else label, pick=pick)
                 except (UnreachableTarget, InfeasibleProblem, OptimError):
                     continue
                 A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]

@@ -47,44 +47,50 @@ class SimPlace:
 @dataclass(frozen=True)
 class Place:
     """A promised slot: ``tray`` index, ``v`` the pre-place point on the tray belt [m], ``time``
-    of the place rendezvous [s], ``finish`` (at rest at home) [s], ``wait`` held before it [s]."""
+    of the place rendezvous [s], ``finish`` (at rest at home) [s], ``wait`` held before it [s],
+    ``branch`` the place's IK branch label in the map (-1: the arm has one)."""
 
     tray: int
     v: float
     time: float
     finish: float
     wait: float
+    branch: int = -1
 
 
 def find_place(p: SimPlace, du: float, w: float, meet: float, fill: dict, key: int) -> Place | None:
     """The earliest reachable free slot for a pick at ``du`` (from the arm's base), ``w`` meeting
-    its item at ``meet`` (module doc); ``fill[(key, k)]`` the slots taken in tray ``k``."""
+    its item at ``meet`` (module doc); ``fill[(key, k)]`` the slots taken in tray ``k``.
+
+    Along the place grid cell by cell and on each place branch (:meth:`TrayMap.place_cells`: the
+    times are linear in ``v`` there, so the crossing is exact; a cell's last node is its own, not
+    the next, possibly infeasible, cell's), the earliest place over branches and cells."""
     m, tb = p.tray_map, p.trays
-    _, tX, tR = m.times(du, w, m.dv)
-    ok = np.isfinite(tX)
+    X0, X1, R0, R1 = m.place_cells(du, w)
+    ok = np.isfinite(X0)
     if not ok.any():
         return None
     V, v = tb.belt.speed, p.v
+    v0, v1 = v[:-1], v[1:]
     te = meet + m.track
-    k0 = int(np.ceil((V * (te + np.nanmin(tX)) - v[-1] + tb.phase) / tb.pitch - 1e-9))
-    k1 = int(np.floor((V * (te + np.nanmax(tX)) - v[0] + tb.phase) / tb.pitch)) + 1
+    k0 = int(np.ceil((V * (te + np.nanmin(np.fmin(X0, X1))) - v[-1] + tb.phase) / tb.pitch - 1e-9))
+    k1 = int(np.floor((V * (te + np.nanmax(np.fmax(X0, X1))) - v[0] + tb.phase) / tb.pitch)) + 1
     for k in range(k0, max(k0, k1) + 1):  # k1: the first tray to enter the window after the arm can be there
         if fill.get((key, k), 0) >= tb.capacity:
             continue
-        t_k = (v - tb.phase + k * tb.pitch) / V
-        g = te + tX - t_k
-        good = ok & (g <= 0.0)
-        if not good.any():
+        t0, t1 = (v0 - tb.phase + k * tb.pitch) / V, (v1 - tb.phase + k * tb.pitch) / V
+        g0, g1 = te + X0 - t0, te + X1 - t1  # the arm's arrival less the tray's, linear along each cell
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = np.where(ok & (g0 <= 0.0), 0.0, np.where(ok & (g1 <= 0.0), g0 / (g0 - g1), np.nan))
+        if not np.isfinite(f).any():
             continue
-        j = int(np.argmax(good))
-        if j > 0 and ok[j - 1] and g[j - 1] > 0.0:
-            f = g[j - 1] / (g[j - 1] - g[j])
-            vj = v[j - 1] + f * (v[j] - v[j - 1])
-            x, r = tX[j - 1] + f * (tX[j] - tX[j - 1]), tR[j - 1] + f * (tR[j] - tR[j - 1])
-        else:
-            vj, x, r = v[j], tX[j], tR[j]
-        t_place = (vj - tb.phase + k * tb.pitch) / V
-        return Place(k, float(vj), float(t_place), float(t_place + m.place + r), float(max(0.0, t_place - te - x)))
+        t_place = np.where(np.isfinite(f), t0 + f * (t1 - t0), np.inf)
+        b, c = np.unravel_index(int(np.argmin(t_place)), t_place.shape)
+        fc = float(f[b, c])
+        vj = float(v0[c] + fc * (v1[c] - v0[c]))
+        x, r = X0[b, c] + fc * (X1[b, c] - X0[b, c]), R0[b, c] + fc * (R1[b, c] - R0[b, c])
+        t = float(t_place[b, c])
+        return Place(k, vj, t, float(t + m.place + r), float(max(0.0, t - te - x)), int(m.branches[b]))
     return None
 
 

@@ -153,19 +153,23 @@ def _segment(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: floa
 
 def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec, u_pre: float, w: float,
                       u_place: float, *, item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None,
-                      branch: int | None = None, yaw: float = 0.0, place_branch: int | None = None) -> TrayPickPlan:
+                      branch: int | None = None, yaw: float = 0.0, place_branch: int | None = None,
+                      pick: Any = None) -> TrayPickPlan:
     """Pick at (``u_pre``, ``w``) on ``belt`` and place in the tray whose place point passes
     ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); arguments as
     :func:`~.tracking.plan_pick`; ``place_branch``: the IK branch label of the place tracking
-    segment (None: the pick's where it reaches, else the nearest).
+    segment (None: the pick's where it reaches, else the nearest); ``pick``: the
+    :func:`~.tracking.plan_pick` of this very pick when already planned (the tray maps plan it
+    once for every place point), else planned here.
 
     Raises:
         UnreachableTarget: a point of either tracking segment out of reach.
         InfeasibleProblem: a belt too fast for the arm there, or a move beyond its limits.
     """
     q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
-    pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
-                     branch=branch, yaw=yaw)
+    if pick is None:
+        pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
+                         branch=branch, yaw=yaw)
     q_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[0][0]
     qd_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[1][0]
     place_spec = replace(spec, grasp=spec.release)  # the dwell is the gripper opening

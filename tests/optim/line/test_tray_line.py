@@ -162,7 +162,7 @@ def test_simulated_place_tracks_its_tray_from_fk(tray_scene):
     i = int(done[np.argmin(r.place_wait[done])])  # a place met at a crossing (no hold) if any
     du, dv = r.u_meet[i] - u_base, r.u_place[i] - v_base
     plan = plan_pick_to_tray(station, belt, trays, TrackingSpec(), r.u_meet[i], 0.0, r.u_place[i], mass=0.1,
-                             place_branch=tm.branch_at(du, 0.0, dv))
+                             place_branch=int(r.place_branch[i]))
     approx = sum(tm.times(du, 0.0, dv)) + tm.track + tm.place
     assert approx == pytest.approx(plan.duration, rel=0.01)  # the map's time of this placement
     t_place_plan = sum(plan.times[:3])
