@@ -83,7 +83,7 @@ class LineSpec:
     cell: Any = None
     clearance: float = 0.01
     trays: Any = None  #: None (every arm places in its box), a TrayBelt for every arm, or {station name: TrayBelt}
-    tray_grid: tuple[int, int, int] = (10, 3, 8)  #: (nu, nw, nv) of the tray maps
+    tray_grid: tuple[int, int, int] = (10, 5, 8)  #: (nu, nw, nv) of the tray maps (docs/line.md: why 5 across)
 
     def __post_init__(self) -> None:
         if not isinstance(self.belt, Belt):
