@@ -80,11 +80,11 @@ def demo_study(quick: bool = False) -> Any:
     """The hand-off rows (module doc) and the writers of the export files."""
     from pinarms.studies.study import Study
     from pinarms.export import export_cell, srdf_text
-    from pinarms.export.shipped import shipped_motions
+    from pinarms.studies.handoff_plans import handoff_motions
     from pinarms.export.srdf import cycle_states
     from pinarms.report import Row
 
-    motions = shipped_motions(line=True)
+    motions = handoff_motions()  # the cell study's plans when it ran in this process
     rows = _mujoco_rows(motions, samples=200 if quick else 400)
     line = next(m for m in motions if m.name == "line_schedule")
     cell = line.cell
