@@ -154,8 +154,11 @@ def _shape_key(st: Station, belt: Belt) -> tuple:
             tuple(lim["vmax"]), tuple(lim["amax"]), lim["torque"])
 
 
-def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
-    """Task maps of every station, one per item type, built once per distinct station shape."""
+def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None,
+               approach_maps: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
+    """Task maps of every station, one per item type, built once per distinct station shape.
+    ``approach_maps``: ``{station name: (box TaskMap, ...)}`` whose approach times the tray maps
+    take (:func:`~.tray_maps.build_tray_map` ``approach_map``)."""
     cache: dict = {} if known is None else known
     out = {}
     for st in spec.stations:
@@ -163,14 +166,15 @@ def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = No
         if trays is not None:
             t = spec.stream.types[0]
             on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
+            fine = (approach_maps or {}).get(st.name, (None,))[0]
             key = (_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
-                   spec.tray_grid)
+                   spec.tray_grid, id(fine))
             if key not in cache:
                 from pinarms.optim.line.tray_maps import build_tray_map
 
                 nu, nw, nv = spec.tray_grid
                 cache[key] = build_tray_map(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler)
+                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine)
             out[st.name] = (cache[key],)
             continue
         maps = []

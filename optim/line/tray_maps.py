@@ -16,6 +16,9 @@ takes the fastest branch whose eight cell nodes are feasible (:meth:`TrayMap.bra
 mixture (the place's elbow change costs ~0.7 s on seed 000's SCARA beside its base). The pick's
 elbow (``pick_branch``, per node) may change where the rest configuration's stops reaching: a cell
 whose four pick nodes are not on one elbow is infeasible (the arm does not pick there).
+The approach ``t_A`` is a box pick's approach (the item not yet held): with ``approach_map`` (the
+same station's box :class:`~.task_maps.TaskMap`, refined where t_A bends) it is read there on the
+pick's elbow, and the simulator's pick part (:attr:`TrayMap.pick_map`) lies on that finer grid.
 :func:`tray_map_error` re-plans at seeded random points on the branch the map chose. Built on the execution layer, one task per ``du`` column.
 """
 
@@ -67,6 +70,7 @@ class TrayMap:
     build_seconds: float = 0.0
     branches: tuple[int, ...] = (-1,)
     pick_branch: np.ndarray | None = None  #: (nu, nw) the pick's IK branch label at each node (None: one)
+    approach_map: Any = None  #: a finer source of t_A: the same station's box :class:`TaskMap` (module doc)
 
     def __post_init__(self) -> None:
         shape = (len(self.branches), self.du.size, self.w.size, self.dv.size)
@@ -103,6 +107,7 @@ class TrayMap:
         a = self.approach
         fu = np.where(self._one_pick_branch[i, j], fu, np.nan)  # never across the pick's elbow change
         tA = (a[i, j] * (1 - fu) + a[i + 1, j] * fu) * (1 - fw) + (a[i, j + 1] * (1 - fu) + a[i + 1, j + 1] * fu) * fw
+        tA = self._fine_approach(tA, self._pick_label()[i, j], du, w)
         out = [tA]
         for T in (self.transfer, self.back):
             v = 0.0
@@ -111,6 +116,17 @@ class TrayMap:
                     v = v + wi * wj * (T[:, i + di, j + dj, k] * (1 - fv) + T[:, i + di, j + dj, k + 1] * fv)
             out.append(v)
         return out[0], out[1], out[2]
+
+    def _pick_label(self) -> np.ndarray:
+        """(nu, nw) the pick's elbow label at each node (-1: one branch or none)."""
+        return np.full(self.approach.shape, -1) if self.pick_branch is None else np.asarray(self.pick_branch, int)
+
+    def _fine_approach(self, tA: np.ndarray, label: np.ndarray, du: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``tA`` (this grid's) replaced by ``approach_map``'s on the same elbow where both are feasible."""
+        if self.approach_map is None:
+            return tA
+        fine = self.approach_map.approach_on(label, du, w)
+        return np.where(np.isfinite(tA) & np.isfinite(fine), fine, tA)
 
     def place_cells(self, du: float, w: float) -> tuple[np.ndarray, ...]:
         """The place times along ``dv`` for a pick at (``du``, ``w``), cell by cell on each place
@@ -138,17 +154,43 @@ class TrayMap:
         place's times come from this map): what the simulator's item intercept uses. Its branches
         are the pick's elbows (``pick_branch``), so a cell whose four pick nodes are not on one
         elbow is infeasible there too, as in this map: the intercept never proposes a pick this map
-        cannot place."""
+        cannot place. With ``approach_map`` it lies on that map's (finer) grid: its nodes inside
+        this map's feasible cells, each on the cell's elbow, with the finer approach times."""
+        if self.approach_map is not None:
+            return self._fine_pick_map()
         ok = np.isfinite(self.approach) & np.isfinite(self.transfer + self.back).any(axis=(0, 3))
-        P = np.zeros(self.approach.shape, int) if self.pick_branch is None else np.asarray(self.pick_branch, int)
-        labels = tuple(int(x) for x in np.unique(P[ok & (P >= 0)])) or (0,)
+        P = self._pick_label()
+        labels = tuple(int(x) for x in np.unique(P[ok])) or (-1,)
         A = np.stack([np.where(ok & (P == b), self.approach, np.nan) for b in labels])
+        return self._as_task_map(self.du, self.w, labels, A)
+
+    def _fine_pick_map(self) -> TaskMap:
+        """A node of the finer grid holds, on each elbow, the finer t_A when a feasible pick cell
+        of this map on that elbow touches it (a node on a cell border touches both cells)."""
+        fm = self.approach_map
+        du, w = fm.du[(fm.du >= self.du[0]) & (fm.du <= self.du[-1])], fm.w[(fm.w >= self.w[0]) & (fm.w <= self.w[-1])]
+        U, Wm = np.meshgrid(du, w, indexing="ij")
+        X = self.transfer + self.back
+        cube = np.isfinite(X[:, :-1, :-1] + X[:, 1:, :-1] + X[:, :-1, 1:] + X[:, 1:, 1:])  # (nb, nu-1, nw-1, nv)
+        ok = self._one_pick_branch & (cube[..., :-1] & cube[..., 1:]).any(axis=(0, 3))  # pick cells that place
+        label = np.where(ok, self._pick_label()[:-1, :-1], -2)
+        touching = []  # the labels of the feasible cells touching each node
+        for side_u in ("right", "left"):
+            i = np.clip(np.searchsorted(self.du, U, side=side_u) - 1, 0, self.du.size - 2)
+            for side_w in ("right", "left"):
+                j = np.clip(np.searchsorted(self.w, Wm, side=side_w) - 1, 0, self.w.size - 2)
+                touching.append(label[i, j])
+        labels = tuple(int(x) for x in np.unique(label[label > -2])) or (-1,)
+        A = np.stack([np.where(np.any([t == b for t in touching], axis=0), fm.approach_on(b, U, Wm), np.nan)
+                      for b in labels])
+        return self._as_task_map(du, w, labels, A)
+
+    def _as_task_map(self, du: np.ndarray, w: np.ndarray, labels: tuple, A: np.ndarray) -> TaskMap:
         C = np.where(np.isfinite(A), 0.0, np.nan)
-        best = np.nanmin(np.where(np.isfinite(A), A, np.inf), axis=0)
+        best = np.min(np.where(np.isfinite(A), A, np.inf), axis=0)
         a = np.where(np.isfinite(best), best, np.nan)
-        names = labels if self.pick_branch is not None else (-1,)
-        return TaskMap(self.station, self.du, self.w, a, np.where(np.isfinite(a), 0.0, np.nan), self.track, 0.0,
-                       self.speed, self.mass, branches=names, branch_approach=A, branch_leave=C)
+        return TaskMap(self.station, du, w, a, np.where(np.isfinite(a), 0.0, np.nan), self.track, 0.0, self.speed,
+                       self.mass, branches=labels, branch_approach=A, branch_leave=C)
 
 
 def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -180,12 +222,35 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return A, X, R, P
 
 
+#: Half-width [m] of the place-grid cells around the place ending at the arm's home (:func:`_with_home_nodes`).
+HOME_GAP = 0.03
+
+
+def _with_home_nodes(dv: np.ndarray, station: Station, trays: TrayBelt, spec: TrackingSpec,
+                     v_base: float) -> np.ndarray:
+    """The place grid with nodes at and ``HOME_GAP`` either side of the place whose tracking ends
+    just above the arm's home (its box point) when the tray belt passes there: the return time is
+    V-shaped about it (0.16 s there, rising on both sides: linear interpolation across the V erred
+    by up to 1.1 % of the task), and right at it the return (a path of almost no length starting at
+    the tray's speed) has no feasible timing: the node there is infeasible and each side of the V is
+    interpolated on its own."""
+    home = trays.belt.to_belt(station.place.position)
+    if abs(home[1] - trays.w) > 0.05 or abs(home[2] - trays.height - spec.lift) > 0.1:
+        return dv  # the place does not pass the home point: no V
+    kink = float(home[0]) - v_base - trays.belt.speed * (2.0 * spec.descend + spec.release)
+    extra = [x for x in (kink - HOME_GAP, kink, kink + HOME_GAP) if dv[0] < x < dv[-1]]
+    return np.unique(np.concatenate([dv, extra]))
+
+
 def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec = TrackingSpec(), *,
                    mass: float = 0.1, item_height: float = 0.04, margin: float = 0.025, nu: int = 10, nw: int = 3,
                    nv: int = 8, du_range: tuple[float, float] | None = None,
-                   dv_range: tuple[float, float] | None = None, scheduler: Any = None) -> TrayMap:
+                   dv_range: tuple[float, float] | None = None, scheduler: Any = None,
+                   approach_map: TaskMap | None = None) -> TrayMap:
     """Plan picks placed in trays exactly on a ``nu`` × ``nw`` × ``nv`` grid (module doc); ``du``
     and ``dv`` span the arm's sampled workspace over each belt (or the ranges given [m]).
+    ``approach_map``: the same station's box :class:`TaskMap` on this belt (same speed and
+    tracking spec; any item mass: the approach carries none), whose finer grid then gives t_A.
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the item belt or of the tray belt (names the arm).
@@ -194,6 +259,10 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
 
     if not all(isinstance(n, int) and n >= 2 for n in (nu, nw, nv)):
         raise InvalidInput(f"nu, nw and nv must be integers >= 2, got {nu!r}, {nw!r}, {nv!r}")
+    if approach_map is not None and not (isinstance(approach_map, TaskMap) and abs(approach_map.speed - belt.speed)
+                                         <= 1e-9 * max(1.0, belt.speed)):
+        raise InvalidInput(f"approach_map must be the station's TaskMap built at the belt's {belt.speed} m/s, got "
+                           f"{getattr(approach_map, 'speed', type(approach_map).__name__)!r}")
     check_reach(station, belt, item_height)
     check_reach(station, trays.belt, trays.height)
     rest_configuration(station)
@@ -203,8 +272,9 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     half = belt.width / 2.0 - margin
     if half <= 0.0:
         raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
-    du, w, dv = np.linspace(lo, hi, nu), np.linspace(-half, half, nw), np.linspace(vlo, vhi, nv)
+    du, w = np.linspace(lo, hi, nu), np.linspace(-half, half, nw)
     v_base = float(trays.belt.to_belt(station.base_to_world[:3, 3])[0])
+    dv = _with_home_nodes(np.linspace(vlo, vhi, nv), station, trays, spec, v_base)
     vv, zz = np.meshgrid(v_base + dv, np.linspace(-trays.belt.width / 2.0, trays.belt.width / 2.0, 3), indexing="ij")
     labels = ik_branch_labels(station, trays.belt.to_world(vv.ravel(), zz.ravel(), trays.height + spec.lift))
     task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
@@ -214,7 +284,7 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
     place = spec.descend + spec.release + spec.descend
     return TrayMap(station.name, du, w, dv, A, X, R, spec.track_time, place, belt.speed, trays.belt.speed,
-                   float(mass), time.perf_counter() - start, labels, P)
+                   float(mass), time.perf_counter() - start, labels, P, approach_map)
 
 
 def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayBelt,

@@ -110,7 +110,13 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
             raise InvalidInput("--trays with --session, --html or --plot: the views do not show trays yet; drop them")
         tb = trays_beside(spec.belt, spec.stations[0].place.position, *parse_trays(trays))
         spec = replace(spec, trays=tb)
-    res = run_line(spec, maps=None if trays else maps_for(spec), scheduler=scheduler)
+    if trays:  # the tray maps take the approach times from the box maps (finer, refined)
+        from pinarms.optim.line.api import build_maps
+
+        maps = build_maps(spec, scheduler=scheduler, approach_maps=maps_for(spec))
+    else:
+        maps = maps_for(spec)
+    res = run_line(spec, maps=maps, scheduler=scheduler)
     if session_path or html_path or plot_path:
         from pinarms.viz.line_views import save_line_views
 

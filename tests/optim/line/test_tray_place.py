@@ -17,6 +17,7 @@ from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.tray_maps import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace, find_place
 from pinarms.optim.line.trays import TrayBelt
+from pinarms.robots.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 DU, W, DV = np.array([-0.2, 0.0, 0.2]), np.array([-0.1, 0.0, 0.1]), np.linspace(-0.3, 0.3, 6)
@@ -152,3 +153,37 @@ def test_pick_map_refuses_cells_on_two_pick_elbows():
     assert not r.no_tray.any() and r.unplaced == 0
     done = r.picked_by >= 0
     assert np.all(r.u_meet[done] - 1.0 <= 0.05 + 1e-9)
+
+
+def test_approach_from_a_finer_box_map():
+    # the tray map's t_A read from the station's box map on the pick's elbow (its finer grid),
+    # the simulator's pick part on that grid, never beyond the tray map's feasible pick cells
+    from pinarms.optim.line.task_maps import TaskMap
+
+    du, w, dv = np.array([0.0, 0.1, 0.2]), np.array([-0.1, 0.1]), np.array([-0.3, 0.3])
+    P = np.array([[0, 0], [0, 0], [1, 1]])  # cell [0.1, 0.2] on two elbows: infeasible
+    tm = TrayMap("a", du, w, dv, np.full((3, 2), 1.0), np.full((1, 3, 2, 2), 1.0), np.full((1, 3, 2, 2), 0.5), 0.5,
+                 0.5, BELT.speed, 0.1, 0.1, pick_branch=P)
+    fdu, fw = np.linspace(0.0, 0.2, 9), np.linspace(-0.1, 0.1, 5)
+    U, Wm = np.meshgrid(fdu, fw, indexing="ij")
+    A = np.stack([1.2 + U ** 2 + Wm, 2.0 + U + Wm ** 2])  # two elbows, curved (bilinear on 3 nodes misses it)
+    box = TaskMap("a", fdu, fw, A.min(axis=0), np.full(U.shape, 1.0), 0.5, 0.1, BELT.speed, 0.1, branches=(0, 1),
+                  branch_approach=A, branch_leave=np.ones_like(A))
+    from dataclasses import replace
+
+    fine = replace(tm, approach_map=box)
+    x, y = 0.037, 0.023
+    assert fine.times(x, y, 0.0)[0] == pytest.approx(box.approach_on(0, x, y), abs=1e-12)
+    exact = 1.2 + x ** 2 + y
+    assert abs(fine.times(x, y, 0.0)[0] - exact) < abs(tm.times(x, y, 0.0)[0] - exact)  # closer than the coarse
+    assert np.isnan(fine.times(0.15, y, 0.0)[0])  # still infeasible on two elbows
+    pm = fine.pick_map
+    assert np.array_equal(pm.du, fdu) and np.array_equal(pm.w, fw)
+    assert pm.times(x, y)[0] == pytest.approx(box.approach_on(0, x, y), abs=1e-12)
+    assert np.isnan(pm.times(0.15, y)[0]) and np.isnan(pm.times(0.12, y)[0])
+    assert pm.times(0.09, y)[0] == pytest.approx(box.approach_on(0, 0.09, y), abs=1e-12)  # up to the border
+    assert pm.branch_at(x, y) == 0
+    with pytest.raises(InvalidInput, match="approach_map"):
+        from pinarms.optim.line.tray_maps import build_tray_map
+
+        build_tray_map(None, BELT, None, approach_map=replace(box, speed=0.3))
