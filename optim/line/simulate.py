@@ -312,8 +312,8 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     from pinarms.optim.line.tray_sim import tray_counts
 
     seen, unfilled, rate = tray_counts([a.place for a in arms], fill, span)
-    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait, place_branch=place_branch, no_tray=no_tray,
-                   trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
+    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait,
+                   place_branch=place_branch, no_tray=no_tray, trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
 
 
 def _places(arm: SimArm, idx: np.ndarray, meet: np.ndarray, u: np.ndarray, w: np.ndarray, finish: np.ndarray,

@@ -5,6 +5,7 @@ import pytest
 
 from pinarms.robots.errors import InvalidInput
 from pinarms.studies import handoff_plans
+from pinarms.studies.handoff import handoff_motions
 
 
 def test_remember_names_what_it_keeps():
@@ -20,9 +21,9 @@ def test_cell_study_plans_are_reused_and_equal_the_shipped_ones():
     handoff_plans.forget()
     try:
         study_cell(quick=True)
-        kept = dict(handoff_plans._KEPT)
+        kept = handoff_plans.kept()
         assert set(kept) == set(handoff_plans.KEPT_NAMES)
-        reused = handoff_plans.handoff_motions()
+        reused = handoff_motions()
     finally:
         handoff_plans.forget()
     fresh = shipped_motions(line=True)
