@@ -84,3 +84,21 @@ def test_place_hand_takes_the_short_turn_home():
     assert np.max(np.abs(np.diff(out[:, 3]))) < 0.2
     assert np.allclose(out[:, 3], [3.0, 3.1, 3.2, 3.3, 3.4])
     assert np.array_equal(out[:, :3], q[:, :3])
+
+
+def test_place_time_has_no_jump_where_the_hand_turn_switches():
+    # the CLI's tray scene at du 0.038, w -0.02 m: between dv 0.19 and 0.21 m the hand's shorter
+    # travel switches a whole turn (q4 4.42 -> -1.75 rad); taking it alone, transfer + return
+    # jumped 1.883 -> 1.792 s; with both turns planned and the faster kept the time is continuous
+    from pinarms.optim.line.tracking import rest_configuration
+    from pinarms.optim.line.trays import plan_pick_to_tray, trays_beside
+    from pinarms.studies.line import scara_line
+
+    spec = scara_line(1, 10.0)
+    st, belt = spec.stations[0], spec.belt
+    trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
+    u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(st)
+    t = [sum(plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.038, -0.02, u0 + dv, item_height=0.04,
+                               mass=0.1, q_rest=q_rest, place_branch=0).times[2::2]) for dv in (0.19, 0.2, 0.21)]
+    assert abs(t[1] - t[0]) < 0.03 and abs(t[2] - t[1]) < 0.03
