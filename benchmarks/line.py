@@ -12,7 +12,12 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
    one task per layout) serial vs a LocalCluster of two single-thread workers (127.0.0.1, no
    dashboard), both sides warmed alike, interleaved; the results must be identical.
 
-Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|all]
+5. ``trays``: the tray map of the CLI's tray run (seed 000's SCARA, trays on a belt through its
+   box; 10 × 5 × 8 grid or ``trays NU,NW,NV``, ``coarse``: without the box map's approach times;
+   each place on both elbows; serial) and its error against exact pick-to-tray planning at 100
+   random (pick, place) points.
+
+Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|all]
 """
 
 from __future__ import annotations
@@ -128,43 +133,120 @@ def _warm() -> None:
     evaluate_layouts(_warm_problem(), _layouts(1, np.random.default_rng(99)))
 
 
+def _where_the_time_goes(stream: list, wall: float) -> str:
+    """From Dask's task stream of one parallel run: each worker's compute time, the wait before the
+    first task started, the tail (one worker done, the other still computing) and the rest
+    (client, transfers, result gathering)."""
+    spans = [(t["worker"], t["startstops"]) for t in stream]
+    busy: dict = {}
+    first, last, ends = np.inf, -np.inf, {}
+    for worker, ss in spans:
+        for s in ss:
+            if s["action"] != "compute":
+                continue
+            busy[worker] = busy.get(worker, 0.0) + s["stop"] - s["start"]
+            first, last = min(first, s["start"]), max(last, s["stop"])
+            ends[worker] = max(ends.get(worker, -np.inf), s["stop"])
+    tail = max(ends.values()) - min(ends.values()) if len(ends) > 1 else 0.0
+    compute = max(busy.values()) if busy else 0.0
+    return (f"compute per worker {', '.join(f'{v:.2f}' for v in busy.values())} s, makespan {last - first:.2f} s, "
+            f"tail {tail:.2f} s, outside the workers' compute {wall - compute:.2f} s")
+
+
+#: Dask settings of the sizing benchmark's workers: no statistical profiler (a thread taking the
+#: GIL every 10 ms to sample the task's stack; ``sizing profiled`` keeps it on to compare).
+QUIET_WORKERS = {"distributed.worker.profile.enabled": False}
+
+
 def part_sizing(rounds: int = 3) -> None:
     """Serial and two workers interleaved (serial, dask, serial, dask, ...) on equally warm
-    processes: the machine is shared, so each ratio compares runs a few seconds apart."""
-    from dask.distributed import Client, LocalCluster
+    processes: the machine is shared, so each ratio compares runs a few seconds apart; the load
+    average (1 min) is printed with each round, and where the parallel time went (Dask's task
+    stream: compute per worker, the tail, the rest)."""
+    import os
+
+    from dask.distributed import Client, LocalCluster, get_task_stream
 
     from pinarms.optim.line.sizing import evaluate_layouts
 
     problem = _warm_problem()
     layouts = _layouts(24, np.random.default_rng(0))
-    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
-                      processes=True) as cluster, Client(cluster) as client:
+    if len(sys.argv) > 2 and sys.argv[2].isdigit():
+        rounds = int(sys.argv[2])
+    import dask
+
+    quiet = {} if "profiled" in sys.argv else QUIET_WORKERS
+    with dask.config.set(quiet), LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1",
+                                              dashboard_address=None, processes=True) as cluster, \
+            Client(cluster) as client:
         _warm()
         client.run(_warm)  # both sides warm before any clock starts
+        print(f"[sizing] workers' statistical profiler {'on' if not quiet else 'off'} "
+              f"(distributed.worker.profile.enabled)", flush=True)
         ratios, same = [], True
         for k in range(rounds):
+            load = os.getloadavg()[0]
             t, c = time.perf_counter(), time.process_time()
             serial = evaluate_layouts(problem, layouts)
             t_serial, c_serial = time.perf_counter() - t, time.process_time() - c
             w0 = client.run(time.process_time)
-            t, c = time.perf_counter(), time.process_time()
-            dask = evaluate_layouts(problem, layouts, scheduler=client)
-            t_dask, c_client = time.perf_counter() - t, time.process_time() - c
+            with get_task_stream(client) as ts:
+                t, c = time.perf_counter(), time.process_time()
+                parallel = evaluate_layouts(problem, layouts, scheduler=client)
+                t_dask, c_client = time.perf_counter() - t, time.process_time() - c
             w1 = client.run(time.process_time)
             c_workers = [w1[a] - w0[a] for a in w0]
-            same &= bool(np.array_equal(serial, dask))
+            same &= bool(np.array_equal(serial, parallel))
             ratios.append(t_serial / t_dask)
             # CPU seconds: what each side computed; wall / CPU shows the share of the cores it got
-            print(f"[sizing] round {k + 1}: {len(layouts)} layouts x {len(problem.seeds)} seeds (4 SCARAs, 60/min, "
-                  f"600 s), one task per layout: serial {t_serial:.1f} s wall ({c_serial:.1f} s CPU), "
-                  f"2 workers {t_dask:.1f} s wall (CPU per worker {', '.join(f'{x:.1f}' for x in c_workers)} s, "
-                  f"client {c_client:.1f} s), ratio {t_serial / t_dask:.2f}, in CPU terms "
-                  f"{c_serial / max(c_workers):.2f}", flush=True)
+            print(f"[sizing] round {k + 1} (load average {load:.1f} -> {os.getloadavg()[0]:.1f}): {len(layouts)} "
+                  f"layouts x {len(problem.seeds)} seeds (4 SCARAs, 60/min, 600 s), one task per layout: serial "
+                  f"{t_serial:.2f} s wall ({c_serial:.2f} s CPU), 2 workers {t_dask:.2f} s wall (CPU per worker "
+                  f"{', '.join(f'{x:.2f}' for x in c_workers)} s, client {c_client:.2f} s), ratio "
+                  f"{t_serial / t_dask:.2f}, in CPU terms {c_serial / max(c_workers):.2f}", flush=True)
+            print(f"[sizing]   parallel: {_where_the_time_goes(ts.data, t_dask)}", flush=True)
     print(f"[sizing] ratios {', '.join(f'{r:.2f}' for r in ratios)}; identical: {same}")
 
 
+def tray_scene():
+    """The CLI's tray run: seed 000's SCARA of the study's line (belt 0.2 m/s), trays every 0.3 m at
+    0.1 m/s, 2 slots, on a belt along the item belt through its box (``belt run --trays 0.3,0.1,2``)."""
+    from dataclasses import replace
+
+    from pinarms.optim.line.trays import trays_beside
+    from pinarms.studies.line import scara_line
+
+    spec = scara_line(1, 10.0, seeds=(0, 1), duration=300.0)
+    trays = trays_beside(spec.belt, spec.stations[0].place.position, 0.3, 0.1, 2)
+    return replace(spec, trays=trays)
+
+
+def part_trays(grid=(10, 5, 8)) -> None:
+    """``trays [NU,NW,NV] [coarse]``: ``coarse`` leaves out the box map's approach times."""
+    from pinarms.optim.line.tray_maps import build_tray_map, tray_map_error
+    from pinarms.studies.line import maps_for
+
+    if len(sys.argv) > 2:  # python benchmarks/line.py trays NU,NW,NV
+        grid = tuple(int(x) for x in sys.argv[2].split(","))
+    spec = tray_scene()
+    st, belt, trays, kind = spec.stations[0], spec.belt, spec.trays["scara 1"], spec.stream.types[0]
+    fine = None if "coarse" in sys.argv else maps_for(spec)[st.name][0]
+    t = time.perf_counter()
+    m = build_tray_map(st, belt, trays, spec.tracking, mass=kind.mass, item_height=kind.size[2], nu=grid[0],
+                       nw=grid[1], nv=grid[2], approach_map=fine)
+    ok = np.isfinite(m.transfer + m.back)
+    print(f"tray map {m.du.size} x {m.w.size} x {m.dv.size} ({'approach from the box map' if fine else 'coarse'}): "
+          f"{time.perf_counter() - t:.1f} s, {ok.mean():.0%} of nodes feasible, dv {np.round(m.dv, 3).tolist()} m")
+    e = tray_map_error(m, st, belt, trays, spec.tracking, n=100, item_height=kind.size[2], seed=11)
+    r = e.relative
+    print(f"tray map error, {r.size} random picks (seed 11): mean {100 * r.mean():.3f} %, "
+          f"p95 {100 * np.percentile(r, 95):.3f} %, max {100 * r.max():.3f} % ({e.planning_seconds:.1f} s)")
+    worst = e.points[np.argsort(r)[-3:]]
+    print("worst points (du, w, dv):", np.round(worst, 3).tolist())
+
+
 PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,
-         "sizing": part_sizing}
+         "sizing": part_sizing, "trays": part_trays}
 
 if __name__ == "__main__":
     which = sys.argv[1] if len(sys.argv) > 1 else "all"

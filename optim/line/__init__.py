@@ -4,6 +4,7 @@
   pitch, arrivals file), :mod:`~.station` (an arm beside the belt with its box and limits);
 - :mod:`~.tracking` (:func:`plan_pick`: the rendezvous with a moving item, time-optimal),
   :mod:`~.trays` (:func:`plan_pick_to_tray`: the place as a second rendezvous, with a tray on a second belt),
+  :mod:`~.tray_maps` (:class:`TrayMap`: pick-to-tray times), :mod:`~.tray_sim` (tray slots in the simulation),
   :mod:`~.windows` (each arm's pick window), :mod:`~.task_maps` (task times built once,
   interpolated, with their error against exact planning);
 - :mod:`~.rules` (assignment rules), :mod:`~.simulate` (event-based simulation of N arms),
@@ -24,7 +25,9 @@ from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station, base_pose
 from pinarms.optim.line.task_maps import MapError, TaskMap, build_task_map, map_error
 from pinarms.optim.line.tracking import PickPlan, TrackingSpec, plan_pick
-from pinarms.optim.line.trays import TrayBelt, TrayPickPlan, plan_pick_to_tray
+from pinarms.optim.line.tray_maps import TrayMap, build_tray_map, tray_map_error
+from pinarms.optim.line.tray_sim import SimPlace
+from pinarms.optim.line.trays import TrayBelt, TrayPickPlan, plan_pick_to_tray, trays_beside
 from pinarms.optim.line.windows import PickWindow, check_reach
 
 __all__ = [
@@ -34,4 +37,5 @@ __all__ = [
     "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "SimArm", "SimResult", "simulate",
     "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",
+    "TrayMap", "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
 ]

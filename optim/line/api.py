@@ -24,6 +24,7 @@ from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import TaskMap, build_task_map
 from pinarms.optim.line.tracking import TrackingSpec
+from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.robots.errors import InvalidInput
 
@@ -81,6 +82,8 @@ class LineSpec:
     map_grid: tuple[int, int] = (24, 7)
     cell: Any = None
     clearance: float = 0.01
+    trays: Any = None  #: None (every arm places in its box), a TrayBelt for every arm, or {station name: TrayBelt}
+    tray_grid: tuple[int, int, int] = (10, 5, 8)  #: (nu, nw, nv) of the tray maps (docs/line.md: why 5 across)
 
     def __post_init__(self) -> None:
         if not isinstance(self.belt, Belt):
@@ -100,6 +103,26 @@ class LineSpec:
             raise InvalidInput(f"target miss rate must be in [0, 1), got {self.target_miss_rate!r}")
         if isinstance(self.rule, str):
             object.__setattr__(self, "rule", Rule(self.rule))
+        object.__setattr__(self, "trays", _tray_option(self.trays, names))
+        if self.trays and len(self.stream.types) != 1:
+            raise InvalidInput("trays: one item type only (the tray maps have no item-type coordinate)")
+
+    def trays_of(self, station: str) -> TrayBelt | None:
+        """The TrayBelt arm ``station`` places in (None: its box)."""
+        return (self.trays or {}).get(station)
+
+
+def _tray_option(trays: Any, names: list) -> dict | None:
+    if trays is None:
+        return None
+    if isinstance(trays, TrayBelt):
+        return {n: trays for n in names}
+    if not isinstance(trays, dict) or not all(isinstance(v, TrayBelt) or v is None for v in trays.values()):
+        raise InvalidInput("trays must be None, a TrayBelt or a dict {station name: TrayBelt or None}")
+    unknown = sorted(set(trays) - set(names))
+    if unknown:
+        raise InvalidInput(f"trays name stations that are not in the line: {unknown} (stations: {names})")
+    return {n: t for n, t in trays.items() if t is not None} or None
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,11 +154,29 @@ def _shape_key(st: Station, belt: Belt) -> tuple:
             tuple(lim["vmax"]), tuple(lim["amax"]), lim["torque"])
 
 
-def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
-    """Task maps of every station, one per item type, built once per distinct station shape."""
+def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None,
+               approach_maps: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
+    """Task maps of every station, one per item type, built once per distinct station shape.
+    ``approach_maps``: ``{station name: (box TaskMap, ...)}`` whose approach times the tray maps
+    take (:func:`~.tray_maps.build_tray_map` ``approach_map``)."""
     cache: dict = {} if known is None else known
     out = {}
     for st in spec.stations:
+        trays = spec.trays_of(st.name)
+        if trays is not None:
+            t = spec.stream.types[0]
+            on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
+            fine = (approach_maps or {}).get(st.name, (None,))[0]
+            key = (_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
+                   spec.tray_grid, id(fine))
+            if key not in cache:
+                from pinarms.optim.line.tray_maps import build_tray_map
+
+                nu, nw, nv = spec.tray_grid
+                cache[key] = build_tray_map(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2],
+                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine)
+            out[st.name] = (cache[key],)
+            continue
         maps = []
         for t in spec.stream.types:
             key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid)
@@ -153,7 +194,15 @@ def sim_arms(spec: LineSpec, maps: dict[str, tuple[TaskMap, ...]]) -> list[SimAr
     for st in spec.stations:
         u_base = float(spec.belt.to_belt(st.base_to_world[:3, 3])[0])
         rest = spec.belt.to_belt(st.place.position)
-        arms.append(SimArm(st.name, u_base, maps[st.name], (float(rest[0]), float(rest[1]))))
+        trays = spec.trays_of(st.name)
+        if trays is None:
+            arms.append(SimArm(st.name, u_base, maps[st.name], (float(rest[0]), float(rest[1]))))
+            continue
+        from pinarms.optim.line.tray_sim import SimPlace
+
+        tm = maps[st.name][0]
+        place = SimPlace(tm, trays, float(trays.belt.to_belt(st.base_to_world[:3, 3])[0]))
+        arms.append(SimArm(st.name, u_base, (tm.pick_map,), (float(rest[0]), float(rest[1])), place))
     return arms
 
 
@@ -180,11 +229,15 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None)
     runs = map_chunks(_run_seed, [{"spec": spec, "arms": arms, "seed": s} for s in spec.seeds],
                       scheduler=scheduler if spec.cell is None else None)
     figures = summarise(runs)
-    windows = tuple(window_of(st, spec.belt, maps[st.name][0]) for st in spec.stations)
+    windows = tuple(window_of(st, spec.belt, _pick_part(maps[st.name][0])) for st in spec.stations)
     ordered = sorted(windows, key=lambda w: w.u_base)
     overlapping = tuple((a.station, b.station) for a, b in zip(ordered, ordered[1:]) if windows_overlap(a, b))
     status = STATUSES[0] if figures.miss_rate <= spec.target_miss_rate else STATUSES[1]
     return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed)
+
+
+def _pick_part(m: Any) -> TaskMap:
+    return m.pick_map if hasattr(m, "pick_map") else m
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,9 @@ class LineFigures:
         wait_mean_s, wait_p95_s: time items spend on the belt before their rendezvous [s].
         idle_gap_mean_s: mean length of an arm's rest between two picks [s].
         seeds: runs summarised.
+        tray_fill_rate: placed items over the slots of the trays seen (None: boxes only);
+        trays_unfilled: trays that left the last place window with a free slot, per run;
+        unplaced_rate: fraction of items missed for want of a free reachable tray slot.
     """
 
     arms: tuple[str, ...]
@@ -59,9 +62,14 @@ class LineFigures:
     wait_p95_s: float
     idle_gap_mean_s: float
     seeds: int
+    tray_fill_rate: float | None = None
+    trays_unfilled: float | None = None
+    unplaced_rate: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
+        tray = ("tray_fill_rate", "trays_unfilled", "unplaced_rate")
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()
+                if not (k in tray and v is None)}
 
 
 def _idle_gaps(r: SimResult) -> np.ndarray:
@@ -100,7 +108,16 @@ def summarise(results: Sequence[SimResult]) -> LineFigures:
         wait_p95_s=float(np.percentile(waits, 95)) if waits.size else float("nan"),
         idle_gap_mean_s=float(gaps.mean()) if gaps.size else 0.0,
         seeds=len(results),
+        **_tray_figures(results),
     )
+
+
+def _tray_figures(results: Sequence[SimResult]) -> dict[str, Any]:
+    if all(r.tray is None for r in results):
+        return {}
+    return {"tray_fill_rate": float(np.nanmean([r.tray_fill for r in results])),
+            "trays_unfilled": float(np.mean([r.trays_unfilled for r in results])),
+            "unplaced_rate": float(np.mean([r.unplaced / max(r.n_items, 1) for r in results]))}
 
 
 def _t0(r: SimResult) -> np.ndarray:

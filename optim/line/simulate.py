@@ -19,6 +19,11 @@ exact picks through the cell's continuous check at the clearance), an arm starts
 it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
 choice, or waits until that neighbour's pick ends. Each guarded pair is counted in
 :attr:`SimResult.checks` (checks, blocked).
+
+Arms with a ``place`` (:class:`~.tray_sim.SimPlace`) place in trays on a second belt: a
+candidate item counts only with a free tray slot the arm can reach after the pick, which is
+promised at the decision and sets the pick's end (:mod:`~.tray_sim`); the result then holds
+each item's tray, the trays seen, unfilled and the fill rate.
 """
 
 from __future__ import annotations
@@ -34,7 +39,10 @@ from pinarms.optim.line.rules import Candidates, Rule, best_sequence, rank_simpl
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["SimArm", "SimResult", "simulate", "EPS"]
+__all__ = ["SimArm", "SimResult", "simulate", "EPS", "NO_TRAY"]
+
+#: ``SimResult.tray`` of an item placed in no tray (tray indices may be negative: trays ahead at t = 0).
+NO_TRAY = int(np.iinfo(np.int64).min)
 
 #: Time tolerance of "start now" [s].
 EPS = 1e-9
@@ -50,6 +58,7 @@ class SimArm:
     u_base: float
     maps: tuple[TaskMap, ...]
     rest: tuple[float, float] = (0.0, 0.0)
+    place: Any = None  #: :class:`~.tray_sim.SimPlace` when the arm places in trays (None: its box)
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,6 +87,20 @@ class SimResult:
     checks: tuple[int, int] = (0, 0)
     w: np.ndarray = field(default_factory=lambda: np.zeros(0))
     kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    tray: np.ndarray | None = None  #: per item the tray index it was placed in (:data:`NO_TRAY`: none); None: boxes only
+    u_place: np.ndarray | None = None  #: pre-place point on the tray belt [m]
+    place_time: np.ndarray | None = None  #: place rendezvous [s]
+    place_wait: np.ndarray | None = None  #: time held before the place rendezvous [s]
+    place_branch: np.ndarray | None = None  #: the place's IK branch label in the tray map (-1: one branch)
+    no_tray: np.ndarray | None = None  #: an arm could have picked the item but had no free reachable slot
+    trays_seen: int = 0  #: trays that crossed every place window within the observed span
+    trays_unfilled: int = 0  #: of those, trays that left the last window with a free slot
+    tray_fill: float = float("nan")  #: placed items over the slots of the trays seen
+
+    @property
+    def unplaced(self) -> int:
+        """Items missed although an arm could have picked them: no free tray slot within reach."""
+        return 0 if self.no_tray is None else int(np.count_nonzero(self.no_tray & (self.picked_by < 0)))
 
     @property
     def n_items(self) -> int:
@@ -187,6 +210,10 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
             raise InvalidInput(f"arm {a.name!r} has {len(a.maps)} maps for {len(items.types)} item types")
     if rule.name == "bands" and width is None:
         raise InvalidInput("the 'bands' rule needs the belt width")
+    trays = any(a.place is not None for a in arms)
+    if trays and (rule.name == "lookahead" or guard is not None):
+        raise InvalidInput("arms placing in trays: the look-ahead rule and the neighbour check do not plan tray "
+                           "places yet; use another rule and no cell")
     names = tuple(a.name for a in arms)
     order = sorted(range(len(arms)), key=lambda k: arms[k].u_base)
     arms = [arms[k] for k in order]
@@ -200,6 +227,12 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     neighbours = {k: [j for j in range(len(arms)) if j != k and states[j].u_min < states[k].u_max
                       and states[k].u_min < states[j].u_max] for k in range(len(arms))} if guard else {}
     ongoing: list = [None] * len(arms)
+    fill: dict = {}
+    tray_of = np.full(n, NO_TRAY, dtype=np.int64)
+    u_place, place_time, wait = (np.full(n, np.nan) for _ in range(3))
+    place_branch = np.full(n, -1, dtype=np.int64)
+    no_tray = np.zeros(n, dtype=bool)
+    places: list = [None] * n
     counts = [0, 0]
     heap = [(0.0, k) for k in range(len(arms))]
     heapq.heapify(heap)
@@ -225,6 +258,14 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
                 heapq.heappush(heap, (nxt, k))
             continue
         idx, s, m, f, u = idx[ok], s[ok], m[ok], f[ok], u[ok]
+        if arms[k].place is not None:
+            keep = _places(arms[k], idx, m, u, items.w, f, fill, places, no_tray)
+            if not keep.any():  # look again when a later tray may be in reach (a quarter tray period)
+                tb = arms[k].place.trays
+                again = t + 0.25 * tb.pitch / tb.belt.speed
+                heapq.heappush(heap, (again if nxt is None else min(nxt, again), k))
+                continue
+            idx, s, m, f, u = idx[keep], s[keep], m[keep], f[keep], u[keep]
         if rule.name == "lookahead":
             prefs = [_lookahead(st, t, idx, s, t0, rule.horizon)]
         else:
@@ -250,6 +291,10 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         i = int(idx[choice])
         taken[i] = True
         picked_by[i], meet[i], u_meet[i], start[i], finish[i] = order[k], m[choice], u[choice], t, f[choice]
+        if arms[k].place is not None:
+            pl = places[i]
+            fill[(id(arms[k].place.trays), pl.tray)] = fill.get((id(arms[k].place.trays), pl.tray), 0) + 1
+            tray_of[i], u_place[i], place_time[i], wait[i], place_branch[i] = pl.tray, pl.v, pl.time, pl.wait, pl.branch
         ongoing[k] = (arms[k].name, i, t, float(m[choice]), float(u[choice]), float(items.w[i]), int(items.kind[i]),
                       float(f[choice]))
         heapq.heappush(heap, (float(f[choice]), k))
@@ -257,9 +302,34 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     busy = np.zeros(len(names))  # time moving within the observed span [0, span]
     done = picked_by >= 0
     np.add.at(busy, picked_by[done], np.clip(finish[done], 0.0, span) - np.clip(start[done], 0.0, span))
-    return SimResult(names, picked_by, meet, u_meet,
-                     start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]),
-                     items.w, items.kind)
+    out = SimResult(names, picked_by, meet, u_meet,
+                    start, finish, max(span, 1e-9), busy, decisions, t0, (counts[0], counts[1]),
+                    items.w, items.kind)
+    if not trays:
+        return out
+    from dataclasses import replace
+
+    from pinarms.optim.line.tray_sim import tray_counts
+
+    seen, unfilled, rate = tray_counts([a.place for a in arms], fill, span)
+    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait,
+                   place_branch=place_branch, no_tray=no_tray, trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
+
+
+def _places(arm: SimArm, idx: np.ndarray, meet: np.ndarray, u: np.ndarray, w: np.ndarray, finish: np.ndarray,
+            fill: dict, places: list, no_tray: np.ndarray) -> np.ndarray:
+    """Each candidate's earliest free reachable tray slot (:func:`~.tray_sim.find_place`): fills
+    ``places`` and ``finish``; returns which candidates have one, flags the others ``no_tray``."""
+    from pinarms.optim.line.tray_sim import find_place
+
+    keep = np.zeros(idx.size, dtype=bool)
+    for j, i in enumerate(idx):
+        pl = find_place(arm.place, float(u[j] - arm.u_base), float(w[i]), float(meet[j]), fill, id(arm.place.trays))
+        if pl is None:
+            no_tray[i] = True
+            continue
+        places[i], finish[j], keep[j] = pl, pl.finish, True
+    return keep
 
 
 def _blocked(guard: Any, pick: tuple, finish: float, k: int, neighbours: dict, ongoing: list, t: float,

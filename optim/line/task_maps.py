@@ -99,6 +99,23 @@ class TaskMap:
             out.append(np.where(b >= 0, v, np.nan))
         return out[0], out[1]
 
+    def approach_on(self, label: Any, du: Any, w: Any) -> np.ndarray:
+        """The approach time t_A [s] at ``du``, ``w`` on IK branch ``label`` (broadcast; -1: the
+        map's one branch), bilinear on that branch's table; NaN where a node of the cell is
+        infeasible on it or the label is not one of the map's."""
+        label, du, w = np.broadcast_arrays(np.asarray(label, int), np.asarray(du, float), np.asarray(w, float))
+        i, fu = self._weights(self.du, du)
+        j, fw = self._weights(self.w, w)
+        out = np.full(du.shape, np.nan)
+        for b, name in enumerate(self.branches):
+            sel = label == name
+            if not sel.any():
+                continue
+            T, ii, jj, a, c = self._A[b], i[sel], j[sel], fu[sel], fw[sel]
+            out[sel] = (T[ii, jj] * (1 - a) + T[ii + 1, jj] * a) * (1 - c) + (T[ii, jj + 1] * (1 - a)
+                                                                            + T[ii + 1, jj + 1] * a) * c
+        return out
+
     def branch_at(self, du: float, w: float) -> int | None:
         """The IK branch label the map uses at (``du``, ``w``) [m] (None: the arm has one branch
         or the point is infeasible); :func:`~.tracking.plan_pick` ``branch=`` plans it exactly."""

@@ -17,7 +17,7 @@ the return like the pick's leave move. The hand keeps the pick's turn (the item'
 the place. Checked from FK (tests/optim/line/test_trays.py): tool-to-tray distance < 1 mm and
 relative speed < 1 % of the tray belt's speed over the whole release dwell.
 
-Not yet in the task maps nor the simulation (docs/line.md): both still place in fixed boxes.
+Task maps of it: :mod:`~.tray_maps`; in the simulation: :mod:`~.tray_sim`.
 """
 
 from __future__ import annotations
@@ -35,9 +35,10 @@ from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_lim
                                          _hermite, _ik_path, _joint_rates, _poses, _timed_move, plan_pick,
                                          rest_configuration, tool_yaw, tracking_points)
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import InvalidInput
+from pinarms.optim.errors import InfeasibleProblem, OptimError
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray"]
+__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "trays_beside", "parse_trays"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +68,31 @@ class TrayBelt:
     def tray_u(self, k: Any, t: Any) -> np.ndarray:
         """u [m] of tray ``k``'s centre on its belt at time ``t`` [s] (broadcast)."""
         return self.phase - np.asarray(k, float) * self.pitch + self.belt.speed * np.asarray(t, float)
+
+
+def trays_beside(belt: Belt, place_world: Any, pitch: float, speed: float, capacity: int, *,
+                 height: float = 0.03, width: float = 0.2) -> TrayBelt:
+    """Trays on a belt parallel to ``belt`` (same direction and length) whose place point passes
+    through ``place_world`` (e.g. the stations' box release point) [m]."""
+    b = belt.to_belt(np.asarray(place_world, float))
+    origin = belt.to_world(0.0, float(b[1]), float(b[2]) - height)
+    return TrayBelt(Belt(origin, belt.direction, speed, width, belt.length), pitch=pitch, capacity=capacity,
+                    height=height)
+
+
+def parse_trays(text: str) -> tuple[float, float, int]:
+    """``"PITCH,SPEED,SLOTS"`` (m, m/s, items per tray) → numbers; InvalidInput naming the field."""
+    parts = str(text).split(",")
+    if len(parts) != 3:
+        raise InvalidInput(f"trays must be PITCH,SPEED,SLOTS (m, m/s, items per tray), got {text!r}")
+    out = []
+    for name, part, kind in zip(("pitch [m]", "speed [m/s]", "slots per tray"), parts, (float, float, int)):
+        try:
+            out.append(kind(part))
+        except ValueError:
+            raise InvalidInput(f"tray {name} must be {'an integer' if kind is int else 'a number'}, "
+                               f"got {part.strip()!r} in {text!r}") from None
+    return out[0], out[1], out[2]
 
 
 @dataclass(eq=False)
@@ -113,42 +139,106 @@ def _timed_transfer(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) 
     return time_optimal(path, _constraints(station, mass), grid=grid, start_speed=1.0 / k0, end_speed=1.0 / k1)
 
 
-def _segment(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, z: float, yaw: float,
-             q_ref: np.ndarray, branch: Any, what: str) -> tuple[Trajectory, np.ndarray, np.ndarray]:
-    """A tracking segment on ``belt``: its trajectory and its end joint velocities."""
+#: Hand turns whose travel pick → place → home is within this of the shortest [rad] are all planned
+#: and the faster kept (:func:`_hand_turns`).
+TURN_TIE = 1.0
+
+
+def _hand_turns(station: Station, q: np.ndarray, q_ref: np.ndarray, q_home: np.ndarray) -> list[np.ndarray]:
+    """``q`` (N, nq) with each hand joint's angles continuous along the segment (no 2π step between
+    instants) and on the whole turns (multiples of 2π: the same poses) that keep the hand's travel
+    ``q_ref`` → segment → ``q_home`` within :data:`TURN_TIE` of the shortest, within the joint's
+    limits; shortest first (ties: nearest ``q_ref``).
+
+    The nearest-solution IK alone flips the place's hand angle by 2π where its distance to the
+    pick's end crosses π: the return home then turned the hand a whole turn more (1.12 s against
+    0.34 s a node away), a jump of the exact time inside a map cell; and a flip within the segment
+    made it infeasible. Where two turns travel about as far, which is faster depends on the arm's
+    other joints: the caller plans each and keeps the faster, so the time has no jump there."""
+    robot = station.robot
+    options = [q.copy()]
+    for h in np.flatnonzero(_hand_joints(robot)):
+        path, ranked = np.unwrap(q[:, h]), []
+        for turns in range(-3, 4):
+            p = path + 2.0 * np.pi * turns
+            if p.min() >= robot.lower[h] - 1e-9 and p.max() <= robot.upper[h] + 1e-9:
+                ranked.append((abs(p[0] - q_ref[h]) + abs(p[-1] - q_home[h]), abs(p[0] - q_ref[h]), turns, p))
+        if not ranked:
+            raise UnreachableTarget(f"arm {station.name!r}: its hand (joint {h + 1}) cannot follow the place "
+                                    f"within its limits [{robot.lower[h]:.3f}, {robot.upper[h]:.3f}] rad")
+        ranked.sort(key=lambda r: r[:3])
+        keep = [r[3] for r in ranked if r[0] <= ranked[0][0] + TURN_TIE]
+        options = [np.concatenate([o[:, :h], p[:, None], o[:, h + 1:]], axis=1) for o in options for p in keep]
+    return options
+
+
+def _hand_turn(station: Station, q: np.ndarray, q_ref: np.ndarray, q_home: np.ndarray) -> np.ndarray:
+    """The first of :func:`_hand_turns`: the hand's shortest travel."""
+    return _hand_turns(station, q, q_ref, q_home)[0]
+
+
+def _segments(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, z: float, yaw: float,
+              q_ref: np.ndarray, branch: Any, what: str, q_home: np.ndarray) -> list:
+    """The tracking segment on ``belt`` on each hand turn of :func:`_hand_turns`: (trajectory, joint
+    velocities at its start and end) each; the turns beyond a joint's rates are left out."""
     tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
     q = _ik_path(station, _poses(station, tracking_points(belt, spec, u, w, z, tau), yaw), q_ref, branch)
-    qd_in = _joint_rates(station, q[0], belt.velocity)
-    qd_out = _joint_rates(station, q[-1], belt.velocity)
-    spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
-    traj = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
-    _check_limits(station, traj, what)
-    return traj, qd_in, qd_out
+    out, error = [], None
+    for qq in _hand_turns(station, q, q_ref, np.asarray(q_home, float)):
+        qd_in = _joint_rates(station, qq[0], belt.velocity)
+        qd_out = _joint_rates(station, qq[-1], belt.velocity)
+        spline = CubicSpline(tau, qq, axis=0, bc_type=((1, qd_in), (1, qd_out)))
+        traj = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
+        try:
+            _check_limits(station, traj, what)
+        except InfeasibleProblem as exc:
+            error = exc
+            continue
+        out.append((traj, qd_in, qd_out))
+    if not out:
+        raise error
+    return out
 
 
 def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec, u_pre: float, w: float,
                       u_place: float, *, item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None,
-                      branch: int | None = None, yaw: float = 0.0) -> TrayPickPlan:
+                      branch: int | None = None, yaw: float = 0.0, place_branch: int | None = None,
+                      pick: Any = None) -> TrayPickPlan:
     """Pick at (``u_pre``, ``w``) on ``belt`` and place in the tray whose place point passes
     ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); arguments as
-    :func:`~.tracking.plan_pick`.
+    :func:`~.tracking.plan_pick`; ``place_branch``: the IK branch label of the place tracking
+    segment (None: the pick's where it reaches, else the nearest); ``pick``: the
+    :func:`~.tracking.plan_pick` of this very pick when already planned (the tray maps plan it
+    once for every place point), else planned here.
 
     Raises:
         UnreachableTarget: a point of either tracking segment out of reach.
         InfeasibleProblem: a belt too fast for the arm there, or a move beyond its limits.
     """
     q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
-    pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
-                     branch=branch, yaw=yaw)
+    if pick is None:
+        pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
+                         branch=branch, yaw=yaw)
     q_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[0][0]
     qd_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[1][0]
     place_spec = replace(spec, grasp=spec.release)  # the dwell is the gripper opening
-    place, qd_in, qd_out = _segment(station, trays.belt, place_spec, float(u_place), trays.w, trays.height,
-                                    tool_yaw(station, spec, yaw), q_end, None, "place tracking segment")
-    q_place = place.sample(np.array([0.0]))[0][0]
-    transfer = _timed_transfer(station, q_end, qd_end, q_place, qd_in, mass, spec.grid)
-    q_last = place.sample(np.array([place.end_time]))[0][0]
-    ret = _timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
+    best, error = None, None
+    for place, qd_in, qd_out in _segments(station, trays.belt, place_spec, float(u_place), trays.w, trays.height,
+                                          tool_yaw(station, spec, yaw), q_end, place_branch,
+                                          "place tracking segment", q_rest):
+        try:
+            transfer = _timed_transfer(station, q_end, qd_end, place.sample(np.array([0.0]))[0][0], qd_in, mass,
+                                       spec.grid)
+            q_last = place.sample(np.array([place.end_time]))[0][0]
+            ret = _timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
+        except (InfeasibleProblem, OptimError) as exc:
+            error = exc
+            continue
+        if best is None or transfer.duration + ret.duration < best[1].duration + best[2].duration:
+            best = (place, transfer, ret)  # the faster hand turn
+    if best is None:
+        raise error
+    place, transfer, ret = best
     tA, tT = pick.times[0], pick.times[1]
     tX, tP, tR = float(transfer.duration), place_spec.track_time, float(ret.duration)
     r0 = tA + tT + tX + spec.descend

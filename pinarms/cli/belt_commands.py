@@ -29,7 +29,9 @@ def _figures_lines(res, title: str) -> list[str]:
         f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
         "  utilisation       " + "  ".join(f"{100 * u:.0f} %" for u in f.utilisation),
         f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
-    ]
+    ] + ([] if f.tray_fill_rate is None else [
+        f"  tray fill         {100 * f.tray_fill_rate:.1f} %, {f.trays_unfilled:.1f} trays left with a free slot "
+        f"per run, {100 * f.unplaced_rate:.2f} % of items missed for want of a slot"])
 
 
 def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit: bool, rule: str, seeds: int,
@@ -90,16 +92,31 @@ def belt() -> None:
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None,
               help="Also plot who picked what when (.png or .svg; 3 x --window seconds).")
 @click.option("--window", type=float, default=20.0, show_default=True, help="Seconds animated in --session/--html.")
+@click.option("--trays", default=None, help="Place in trays on a second belt through the boxes: PITCH,SPEED,SLOTS "
+              "(m, m/s, items per tray; tray maps built, minutes).")
 @scheduler_option
 @json_option
 def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arrivals, session_path, html_path,
-             plot_path, window, scheduler, as_json) -> None:
+             plot_path, window, trays, scheduler, as_json) -> None:
     """Simulate a line and print picks/min, miss rate, utilisation."""
     from pinarms.optim.line import run_line
     from pinarms.studies.line import maps_for
 
     spec = _spec(preset, arms, rate, speed, paper_limit, rule, seeds, duration, arrivals)
-    res = run_line(spec, maps=maps_for(spec), scheduler=scheduler)
+    if trays:
+        from pinarms.optim.line.trays import parse_trays, trays_beside
+
+        if session_path or html_path or plot_path:
+            raise InvalidInput("--trays with --session, --html or --plot: the views do not show trays yet; drop them")
+        tb = trays_beside(spec.belt, spec.stations[0].place.position, *parse_trays(trays))
+        spec = replace(spec, trays=tb)
+    if trays:  # the tray maps take the approach times from the box maps (finer, refined)
+        from pinarms.optim.line.api import build_maps
+
+        maps = build_maps(spec, scheduler=scheduler, approach_maps=maps_for(spec))
+    else:
+        maps = maps_for(spec)
+    res = run_line(spec, maps=maps, scheduler=scheduler)
     if session_path or html_path or plot_path:
         from pinarms.viz.line_views import save_line_views
 

@@ -7,6 +7,7 @@ import numpy as np
 
 from pinarms.report import Row
 
+from .handoff_plans import remember
 from .study import MM, Study
 
 __all__ = ["study_cell", "LINE_TASKS"]
@@ -58,6 +59,7 @@ def study_cell(quick: bool = False) -> Study:
                     None, crate.cycle_time, "s", None,
                     f"lift 50 → {rep.lift / MM:.0f} mm: +{rep.extra_time:.3f} s against the cycle through the crate wall"))
 
+    remember(line=line, line_cycles=cycles, schedule=schedule, station=station, station_cycle=crate)  # hand-off study
     motions = [ArmMotion(n, cycles[n].trajectory, schedule.offsets[n], schedule.period) for n in schedule.arms]
     session = viz.Session(title="cells: mushroom_line, two SCARAs on one belt")
     session.add_cell(line, motions=motions, name="two-arm schedule", hz=50.0)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["demo_study", "CONTROLLER_RATE_HZ"]
+__all__ = ["demo_study", "handoff_motions", "CONTROLLER_RATE_HZ"]
 
 #: Rate of the demo's controller files [Hz].
 CONTROLLER_RATE_HZ = 500.0
@@ -37,6 +37,28 @@ _WHAT = {
     "line_right_cycle": "mushroom_line right SCARA cycle (20 mm)",
     "line_schedule": "mushroom_line two-arm schedule",
 }
+
+
+def handoff_motions() -> list:
+    """The shipped motions in :func:`~pinarms.export.shipped.shipped_motions`'s order (station
+    cycle, crate-guard move, the line's left and right cycles, the line schedule), taking what the
+    cell study kept (:mod:`~pinarms.studies.handoff_plans`) and planning the rest; the crate-guard
+    move is seed 001's (:func:`~pinarms.studies.seed001_motion._planned_move_001`, planned once per
+    process)."""
+    from pinarms.export.shipped import ShippedMotion, shipped_motions
+    from pinarms.studies.handoff_plans import KEPT_NAMES, kept
+    from pinarms.studies.seed001_motion import _planned_move_001
+
+    plans = kept()
+    if not all(k in plans for k in KEPT_NAMES):
+        return shipped_motions(line=True)
+    plan = _planned_move_001()[1]["plan"]
+    line, cycles = plans["line"], plans["line_cycles"]
+    out = [ShippedMotion("station_cycle", plans["station"], plans["station_cycle"], arm="aubo"),
+           ShippedMotion("crate_guard_move", plan.cell, plan)]
+    out += [ShippedMotion(f"line_{name}_cycle", line, cycle, arm=name) for name, cycle in cycles.items()]
+    out.append(ShippedMotion("line_schedule", line, plans["schedule"], cycles=dict(cycles)))
+    return out
 
 
 def _mujoco_rows(motions: list, samples: int) -> list:
@@ -80,11 +102,10 @@ def demo_study(quick: bool = False) -> Any:
     """The hand-off rows (module doc) and the writers of the export files."""
     from pinarms.studies.study import Study
     from pinarms.export import export_cell, srdf_text
-    from pinarms.export.shipped import shipped_motions
     from pinarms.export.srdf import cycle_states
     from pinarms.report import Row
 
-    motions = shipped_motions(line=True)
+    motions = handoff_motions()  # the cell study's plans when it ran in this process
     rows = _mujoco_rows(motions, samples=200 if quick else 400)
     line = next(m for m in motions if m.name == "line_schedule")
     cell = line.cell

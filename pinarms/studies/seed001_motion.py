@@ -3,6 +3,7 @@ layout search, straight-line moves (:func:`pinarms.studies.seed001.study_001` ca
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from pinarms.robots import conventions as conv
 from .study import MM, _segment_distance
 
 
+@functools.cache  # planned once per process: the hand-off study replays the same plan
 def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     """One planned move in the AUBO-i3 food station with a crate under a guard (optim.plan_motion).
 

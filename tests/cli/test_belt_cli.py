@@ -30,3 +30,10 @@ def test_belt_run_arrivals_file_and_errors(tmp_path):
     assert json.loads(r.stdout)["figures"]["picks_per_minute"] == 4.0  # both picked in 30 s
     r = CliRunner().invoke(cli, ["belt", "run", "--speed", "0"])
     assert r.exit_code == 1 and "belt speed" in r.output
+
+
+def test_belt_run_trays_bad_input():
+    for text, words in (("0.4,0,2", "speed"), ("0.4,0.1,0", "capacity"), ("0.4,0.1", "PITCH,SPEED,SLOTS"),
+                        ("0.4,fast,2", "speed [m/s]"), ("0,0.1,2", "pitch")):
+        r = CliRunner().invoke(cli, ["belt", "run", "--arms", "1", "--trays", text])
+        assert r.exit_code == 1 and words in r.output and "Traceback" not in r.output, (text, r.output)

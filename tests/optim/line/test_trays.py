@@ -54,3 +54,51 @@ def test_tray_belt_input():
     for bad in (dict(pitch=0.0), dict(capacity=0), dict(w=0.2), dict(pitch=float("nan"))):
         with pytest.raises(InvalidInput):
             TrayBelt(b, **bad)
+
+
+def test_place_hand_takes_the_short_turn_home():
+    # the CLI's tray scene: beside w = 0.0625 m the nearest-solution IK put the place's hand a whole
+    # turn away (q4 -3.40 against 2.88 rad, the same pose) and the return home took 1.12 s against
+    # 0.34 s; now both points end within half a turn of home and return alike
+    from pinarms.optim.line.tracking import rest_configuration
+    from pinarms.optim.line.trays import _hand_turn, plan_pick_to_tray, trays_beside
+    from pinarms.studies.line import scara_line
+
+    spec = scara_line(1, 10.0)
+    st, belt = spec.stations[0], spec.belt
+    trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
+    u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(st)
+    back, q4 = [], []
+    for w in (0.0625, 0.125):
+        p = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, w, u0 - 0.391, item_height=0.04,
+                              mass=0.1, q_rest=q_rest, place_branch=0)
+        back.append(p.times[4])
+        q4.append(p.pieces[3].sample(np.array([p.pieces[3].end_time]))[0][0, 3])
+    assert back[1] == pytest.approx(back[0], rel=0.05)
+    assert max(abs(x - q_rest[3]) for x in q4) <= np.pi
+    # a 2π step inside a segment is unwrapped, and the turn stays within the joint's limits
+    q = np.tile(q_rest, (5, 1))
+    q[:, 3] = [3.0, 3.1, 3.2 - 2 * np.pi, 3.3 - 2 * np.pi, 3.4 - 2 * np.pi]
+    out = _hand_turn(st, q, q_rest, q_rest)
+    assert np.max(np.abs(np.diff(out[:, 3]))) < 0.2
+    assert np.allclose(out[:, 3], [3.0, 3.1, 3.2, 3.3, 3.4])
+    assert np.array_equal(out[:, :3], q[:, :3])
+
+
+def test_place_time_has_no_jump_where_the_hand_turn_switches():
+    # the CLI's tray scene at du 0.038, w -0.02 m: between dv 0.19 and 0.21 m the hand's shorter
+    # travel switches a whole turn (q4 4.42 -> -1.75 rad); taking it alone, transfer + return
+    # jumped 1.883 -> 1.792 s; with both turns planned and the faster kept the time is continuous
+    from pinarms.optim.line.tracking import rest_configuration
+    from pinarms.optim.line.trays import plan_pick_to_tray, trays_beside
+    from pinarms.studies.line import scara_line
+
+    spec = scara_line(1, 10.0)
+    st, belt = spec.stations[0], spec.belt
+    trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
+    u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    q_rest = rest_configuration(st)
+    t = [sum(plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.038, -0.02, u0 + dv, item_height=0.04,
+                               mass=0.1, q_rest=q_rest, place_branch=0).times[2::2]) for dv in (0.19, 0.2, 0.21)]
+    assert abs(t[1] - t[0]) < 0.03 and abs(t[2] - t[1]) < 0.03
