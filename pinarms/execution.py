@@ -347,8 +347,12 @@ def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
 
     from distributed import Client, LocalCluster
 
+    import dask
+
     n_workers = min(n_workers, len(tasks))
-    with warnings.catch_warnings():
+    # the workers' statistical profiler (a thread sampling every 10 ms) took 5-10 % of their CPU
+    # on the sizing sweep (benchmarks/line.py sizing): off, as it only feeds the dashboard
+    with warnings.catch_warnings(), dask.config.set({"distributed.worker.profile.enabled": False}):
         # the scheduler's HTTP endpoint moves to a free port when 8787 is taken: not our concern
         warnings.filterwarnings("ignore", message="Port .* is already in use")
         cluster = LocalCluster(

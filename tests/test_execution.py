@@ -171,11 +171,19 @@ def test_unreachable_scheduler_is_a_named_error():
         map_chunks(fail_on_chunk, [{"n": 1, "fail": False}], scheduler="tcp://127.0.0.1:9")
 
 
+def draw_and_profiler(task):
+    """``draw`` and whether the worker runs Dask's statistical profiler."""
+    import dask
+
+    return draw(task), bool(dask.config.get("distributed.worker.profile.enabled"))
+
+
 def test_local_processes_scheduler_runs_the_same():
     tasks = _tasks(seed=3, n_chunks=3, n=500)
     serial = map_chunks(draw, tasks)
-    local = map_chunks(draw, tasks, scheduler="processes:2")
-    assert all(a["sum"].tobytes() == b["sum"].tobytes() for a, b in zip(serial, local))
+    local = map_chunks(draw_and_profiler, tasks, scheduler="processes:2")
+    assert all(a["sum"].tobytes() == b["sum"].tobytes() for a, (b, _) in zip(serial, local))
+    assert not any(profiler for _, profiler in local)  # off in the workers: it cost them 5-10 % of their CPU
 
 
 def test_importing_the_layer_loads_neither_dask_nor_the_robots():
