@@ -21,13 +21,14 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ["robots", "planning", "optim", "viz", "pinarms"]
 #: The floor: modules of the ``pinarms`` folder that every package may import (the error
-#: classes, the execution layer, atomic file writing, units); each imports nothing of ours but
+#: classes, the execution layer, atomic file writing, units, compiled kernels); each imports nothing of ours but
 #: the error classes.
 BOTTOM = {
     "pinarms.errors": "errors",
     "pinarms.execution": "execution",
     "pinarms.files": "files",
     "pinarms.units": "units",
+    "pinarms.compiled": "compiled",
 }
 ALLOWED = {pkg: set(ORDER[: i + 1]) | set(BOTTOM.values()) for i, pkg in enumerate(ORDER)}
 SUBPACKAGES = set(ORDER[:-1]) | {"urdf"}
