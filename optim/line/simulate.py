@@ -196,24 +196,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     Raises:
         InvalidInput: no arms, a speed ≤ 0 or NaN or differing from the maps', bad rule.
     """
-    rule = rule if isinstance(rule, Rule) else Rule(str(rule))
-    if not arms:
-        raise InvalidInput("simulate needs at least one arm")
-    if not (isinstance(speed, (int, float)) and np.isfinite(speed) and speed > 0.0):
-        raise InvalidInput(f"belt speed must be a finite number > 0 [m/s], got {speed!r}")
-    for a in arms:
-        for m in a.maps:
-            if abs(m.speed - speed) > 1e-9 * max(1.0, speed):
-                raise InvalidInput(f"arm {a.name!r}: its task map was built for {m.speed} m/s, the belt runs at "
-                                   f"{speed} m/s: build the map at this speed")
-        if len(a.maps) != len(items.types):
-            raise InvalidInput(f"arm {a.name!r} has {len(a.maps)} maps for {len(items.types)} item types")
-    if rule.name == "bands" and width is None:
-        raise InvalidInput("the 'bands' rule needs the belt width")
-    trays = any(a.place is not None for a in arms)
-    if trays and (rule.name == "lookahead" or guard is not None):
-        raise InvalidInput("arms placing in trays: the look-ahead rule and the neighbour check do not plan tray "
-                           "places yet; use another rule and no cell")
+    rule, trays = _checked(arms, items, speed, rule, width, guard)
     names = tuple(a.name for a in arms)
     order = sorted(range(len(arms)), key=lambda k: arms[k].u_base)
     arms = [arms[k] for k in order]
@@ -224,8 +207,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     meet, u_meet, start, finish = (np.full(n, np.nan) for _ in range(4))
     taken = np.zeros(n, dtype=bool)
     busy = np.zeros(len(arms))
-    neighbours = {k: [j for j in range(len(arms)) if j != k and states[j].u_min < states[k].u_max
-                      and states[k].u_min < states[j].u_max] for k in range(len(arms))} if guard else {}
+    neighbours = _overlapping(states) if guard else {}
     ongoing: list = [None] * len(arms)
     fill: dict = {}
     tray_of = np.full(n, NO_TRAY, dtype=np.int64)
@@ -260,10 +242,8 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         idx, s, m, f, u = idx[ok], s[ok], m[ok], f[ok], u[ok]
         if arms[k].place is not None:
             keep = _places(arms[k], idx, m, u, items.w, f, fill, places, no_tray)
-            if not keep.any():  # look again when a later tray may be in reach (a quarter tray period)
-                tb = arms[k].place.trays
-                again = t + 0.25 * tb.pitch / tb.belt.speed
-                heapq.heappush(heap, (again if nxt is None else min(nxt, again), k))
+            if not keep.any():
+                heapq.heappush(heap, (_tray_retry(arms[k], t, nxt), k))
                 continue
             idx, s, m, f, u = idx[keep], s[keep], m[keep], f[keep], u[keep]
         if rule.name == "lookahead":
@@ -292,9 +272,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         taken[i] = True
         picked_by[i], meet[i], u_meet[i], start[i], finish[i] = order[k], m[choice], u[choice], t, f[choice]
         if arms[k].place is not None:
-            pl = places[i]
-            fill[(id(arms[k].place.trays), pl.tray)] = fill.get((id(arms[k].place.trays), pl.tray), 0) + 1
-            tray_of[i], u_place[i], place_time[i], wait[i], place_branch[i] = pl.tray, pl.v, pl.time, pl.wait, pl.branch
+            _record_place(arms[k], places[i], i, fill, (tray_of, u_place, place_time, wait, place_branch))
         ongoing[k] = (arms[k].name, i, t, float(m[choice]), float(u[choice]), float(items.w[i]), int(items.kind[i]),
                       float(f[choice]))
         heapq.heappush(heap, (float(f[choice]), k))
@@ -307,13 +285,62 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
                     items.w, items.kind)
     if not trays:
         return out
+    return _with_trays(out, arms, fill, span, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait,
+                       place_branch=place_branch, no_tray=no_tray)
+
+
+def _overlapping(states: list) -> dict[int, list[int]]:
+    """For each arm, the arms whose pick windows on the belt overlap its own."""
+    return {k: [j for j in range(len(states)) if j != k and states[j].u_min < states[k].u_max
+                and states[k].u_min < states[j].u_max] for k in range(len(states))}
+
+
+def _tray_retry(arm: SimArm, t: float, nxt: float | None) -> float:
+    """When an arm with no tray slot in reach looks again: a quarter tray period later (or its next wake)."""
+    tb = arm.place.trays
+    again = t + 0.25 * tb.pitch / tb.belt.speed
+    return again if nxt is None else min(nxt, again)
+
+
+def _record_place(arm: SimArm, pl: Any, i: int, fill: dict, columns: tuple[np.ndarray, ...]) -> None:
+    """Item ``i`` placed at ``pl``: one more in its tray, and its tray, place, time, wait and branch columns."""
+    fill[(id(arm.place.trays), pl.tray)] = fill.get((id(arm.place.trays), pl.tray), 0) + 1
+    for column, value in zip(columns, (pl.tray, pl.v, pl.time, pl.wait, pl.branch)):
+        column[i] = value
+
+
+def _checked(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | str, width: float | None,
+             guard: Any) -> tuple[Rule, bool]:
+    """The rule as a :class:`Rule` and whether any arm places in trays; InvalidInput (see :func:`simulate`)."""
+    rule = rule if isinstance(rule, Rule) else Rule(str(rule))
+    if not arms:
+        raise InvalidInput("simulate needs at least one arm")
+    if not (isinstance(speed, (int, float)) and np.isfinite(speed) and speed > 0.0):
+        raise InvalidInput(f"belt speed must be a finite number > 0 [m/s], got {speed!r}")
+    for a in arms:
+        for m in a.maps:
+            if abs(m.speed - speed) > 1e-9 * max(1.0, speed):
+                raise InvalidInput(f"arm {a.name!r}: its task map was built for {m.speed} m/s, the belt runs at "
+                                   f"{speed} m/s: build the map at this speed")
+        if len(a.maps) != len(items.types):
+            raise InvalidInput(f"arm {a.name!r} has {len(a.maps)} maps for {len(items.types)} item types")
+    if rule.name == "bands" and width is None:
+        raise InvalidInput("the 'bands' rule needs the belt width")
+    trays = any(a.place is not None for a in arms)
+    if trays and (rule.name == "lookahead" or guard is not None):
+        raise InvalidInput("arms placing in trays: the look-ahead rule and the neighbour check do not plan tray "
+                           "places yet; use another rule and no cell")
+    return rule, trays
+
+
+def _with_trays(out: SimResult, arms: Sequence[SimArm], fill: dict, span: float, **places: np.ndarray) -> SimResult:
+    """``out`` with the tray places of its items and the trays' counts and fill rate."""
     from dataclasses import replace
 
     from pinarms.optim.line.tray_sim import tray_counts
 
     seen, unfilled, rate = tray_counts([a.place for a in arms], fill, span)
-    return replace(out, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait,
-                   place_branch=place_branch, no_tray=no_tray, trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
+    return replace(out, **places, trays_seen=seen, trays_unfilled=unfilled, tray_fill=rate)
 
 
 def _places(arm: SimArm, idx: np.ndarray, meet: np.ndarray, u: np.ndarray, w: np.ndarray, finish: np.ndarray,

@@ -1,7 +1,7 @@
 """The shipped cells' planned motions (the demo's), for the MuJoCo re-check, the controller files and SRDF states.
 
 - ``aubo_food_station``: the table → crate cycle keeping 20 mm (the demo's cell study);
-- ``aubo_crate_guard``: the planned move food table → crate under the guard (OMPL, seed 0);
+- ``aubo_crate_guard``: the planned move food table → crate under the guard (the fastest of seed 001's seeded searches);
 - ``mushroom_line``: each SCARA's cycle keeping 20 mm, and the two-arm line schedule.
 """
 

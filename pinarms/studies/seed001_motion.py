@@ -16,13 +16,20 @@ from pinarms.robots import conventions as conv
 from .study import MM, _segment_distance
 
 
+#: Seeds of the planned move's searches (the fastest move is kept).
+SEEDS = tuple(range(8))
+
+
 @functools.cache  # planned once per process: the hand-off study replays the same plan
 def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     """One planned move in the AUBO-i3 food station with a crate under a guard (optim.plan_motion).
 
-    From the food table to the crate's far half, under the guard plate: OMPL's RRT-Connect
-    (seed 0), every edge proven to keep 10 mm, shortcut, spline proven again, time-optimal
-    under the URDF's joint speed and torque limits. Beside it the unobstructed move: the
+    From the food table to the crate's far half, under the guard plate: RRT-Connect (the
+    compiled search on the proven cover, OMPL where it finds nothing), every edge proven to
+    keep 10 mm, shortcut, spline proven again, time-optimal under the URDF's joint speed and
+    torque limits. RRT-Connect's paths vary a lot with the seed (a line is planned once, offline):
+    :data:`SEEDS` seeded searches, the fastest move kept (ties: the lowest seed); the row's note
+    gives the median over them. Beside it the unobstructed move: the
     straight joint-space move between the same configurations, timed the same way (it runs
     through the cell: the row names the pair it hits).
     """
@@ -40,7 +47,10 @@ def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     from pinarms.optim.motion.goals import ik_candidates
 
     q0 = next(q for q in ik_candidates(arm.robot, arm.to_base(start_pose), cell.neutral)[0] if checker.state_valid(q))
-    plan = plan_motion(cell, "aubo", q0, goal_pose, margin=0.01, time_limit=60.0, seed=0)
+    plans = [plan_motion(cell, "aubo", q0, goal_pose, margin=0.01, time_limit=60.0, seed=seed) for seed in SEEDS]
+    durations = np.array([p.duration for p in plans])
+    best = int(np.argmin(durations))  # the first of equal minima: the lowest seed
+    plan = plans[best]
     constraints, _ = _limits(cell, ("aubo",), None, None, True)
     straight = time_path(polyline_path(np.stack([q0, plan.goal])), constraints)
     s = np.linspace(0.0, 1.0, 401)[:, None]
@@ -49,10 +59,11 @@ def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     k = int(np.argmin(hit.distance))
     pair = hit.pair_of(k)
     rows = [
-        Row("001", "planned move food table → crate under the guard (OMPL RRT-Connect, 10 mm, time-optimal)",
-            None, round(plan.duration, 3), "s", None,
-            f"{plan.smoothing}, proven clear (min {plan.clearance.min_environment * 1e3:.1f} mm, "
-            f"{plan.clearance.min_pair[0]} – {plan.clearance.min_pair[1]}); search {plan.states} states"),
+        Row("001", f"planned move food table → crate under the guard (RRT-Connect, fastest of {len(SEEDS)} seeds, "
+            "10 mm, time-optimal)", None, round(plan.duration, 3), "s", None,
+            f"seed {SEEDS[best]}, median of the {len(SEEDS)} {np.median(durations):.3f} s; {plan.smoothing}, proven clear "
+            f"(min {plan.clearance.min_environment * 1e3:.1f} mm, {plan.clearance.min_pair[0]} – "
+            f"{plan.clearance.min_pair[1]}); search {plan.states} states"),
         Row("001", "the unobstructed move (straight in joint space, same limits)", None, round(straight.duration, 3),
             "s", None, f"goes {-hit.distance[k] * 1e3:.0f} mm into {pair.body_b} ({pair.body_a}): the detour costs "
             f"{plan.duration - straight.duration:+.3f} s"),
