@@ -227,7 +227,7 @@ def memory() -> None:
 def station() -> None:
     from pinarms import optim, robots
     from pinarms.papers import SEED001
-    from pinarms.robots.reach.base_placement import base_placements, tool_down_poses
+    from pinarms.robots.reach.inverse_reach import base_placements, tool_down_poses
     from pinarms.robots.reach.reachability import reachability_map
 
     arm = robots.load("aubo_i3")

@@ -57,7 +57,7 @@ __all__ = [
 
 # workspace analysis and station layout
 from .reach.layout import LayoutReport, check_layout  # noqa: E402
-from .reach.placement import RecommendedRegion, recommend_region  # noqa: E402
+from .reach.table_band import RecommendedRegion, recommend_region  # noqa: E402
 from .self_collision import SelfCollision  # noqa: E402
 from .reach.voxels import VoxelMap, suggest_voxel_size  # noqa: E402
 from .reach.workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
@@ -116,7 +116,7 @@ from .reach.orientations import (  # noqa: E402
 )
 from .reach.reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
 from .reach.reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
-from .reach.base_placement import BasePlacements, base_placements, tool_down_poses  # noqa: E402
+from .reach.inverse_reach import BasePlacements, base_placements, tool_down_poses  # noqa: E402
 
 __all__ += [
     "ReachabilityMap",

@@ -33,7 +33,7 @@ GROUP_SECONDS = {
     "tests/optim/layout/test_layout_search.py": 89.0,
     "tests/robots/test_xacro_expand.py": 69.0,
     "tests/optim/cycle/test_cell_cycle.py": 60.0,
-    "tests/optim/test_motion_cycle.py": 54.0,
+    "tests/optim/test_motion_transfer.py": 54.0,
     "tests/test_export_verify.py": 49.0,
     "tests/test_execution.py": 44.0,
     "tests/viz/test_browser.py": 26.0,

@@ -7,7 +7,7 @@
 - :mod:`.joint`: the joint-space cycle (IK on one branch, time-optimal moves);
 - :mod:`.straight`: straight vertical approach and retreat at pick and place;
 - :mod:`.in_cell`: the cycle planned inside a cell, keeping its clearance
-  (:class:`CellCycleReport`; around obstacles through :mod:`optim.motion.cycle`);
+  (:class:`CellCycleReport`; around obstacles through :mod:`optim.motion.transfer`);
 - :mod:`.plan`: :func:`plan_cycle`, the dispatcher (``plan_cycle(robot, spec, **keywords)``
   still works: it builds the request).
 

@@ -15,7 +15,7 @@ fails, the cycle is re-planned, in this order, until it passes:
    "above place", at the highest lifted height plus ``lift_step`` per attempt, three
    heights), then two via points at one and two thirds;
 3. **plan the transfer** round what blocks (a crate under a guard, a shelf, the other
-   arm's column): :func:`optim.motion.cycle.planned_cycle` keeps the lift and lowering at
+   arm's column): :func:`optim.motion.transfer.planned_cycle` keeps the lift and lowering at
    the spec's height and plans the transfer between them with OMPL, every edge proven
    continuously (:mod:`optim.motion`).
 
@@ -39,7 +39,7 @@ from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import CycleResult, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
-from pinarms.optim.motion.cycle import planned_cycle
+from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
@@ -60,7 +60,7 @@ class CellCycleReport:
         cycle_time_without_cell: the cycle planned ignoring the cell [s];
             ``extra_time``: the kept cycle's time minus it [s].
         attempts: each attempt in order: ``(description, clear, min clearance [m], pair)``.
-        planned_transfer: the transfer was planned around the cell (:mod:`optim.motion.cycle`)
+        planned_transfer: the transfer was planned around the cell (:mod:`optim.motion.transfer`)
             after raising the lift and via points could not clear.
     """
 

@@ -9,7 +9,7 @@
   (:mod:`optim.cycle.straight`);
 * a cell (:class:`CellSettings`): :func:`optim.cycle.in_cell.plan_cycle_in_cell` — the same
   cycle checked continuously in the cell and re-planned (higher lift, via points, then a
-  transfer planned round what blocks, :mod:`optim.motion.cycle`) until it keeps its clearance.
+  transfer planned round what blocks, :mod:`optim.motion.transfer`) until it keeps its clearance.
 
 ``plan_cycle(robot, spec, **keywords)`` (the former keyword form) builds the request with
 :meth:`CycleRequest.from_keywords` and plans it the same way.

@@ -142,7 +142,7 @@ class CellSettings:
         margin: resolution of the continuous check [m] (≥ :data:`optim.caps.MIN_MARGIN`).
         lift_step: rise of the lift per re-planning attempt [m] (:data:`optim.caps.LIFT_STEP_RANGE`).
         plan_transfer: when raising the lift and via points cannot clear, plan the transfer
-            round what blocks (:mod:`optim.motion.cycle`).
+            round what blocks (:mod:`optim.motion.transfer`).
 
     Raises:
         InvalidInput: no cell. SettingOutOfRange: ``lift_step``, ``margin`` or ``clearance``

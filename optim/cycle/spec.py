@@ -35,7 +35,7 @@ CYCLE_APPROACHES = ("joint", "straight")
 #: How a cycle was planned (:attr:`CycleResult.status`): ``"ok"`` as asked (without a cell, or its
 #: first check in the cell passed); ``"re-planned"``: in a cell, the lift was raised or via points
 #: added to keep the clearance; ``"transfer planned"``: in a cell, the transfer was planned round
-#: what blocks (:mod:`optim.motion.cycle`). A cycle that cannot be planned raises instead.
+#: what blocks (:mod:`optim.motion.transfer`). A cycle that cannot be planned raises instead.
 CYCLE_STATUSES = ("ok", "re-planned", "transfer planned")
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.

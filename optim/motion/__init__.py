@@ -11,7 +11,7 @@ See docs/motion.md.
   :func:`fast_search` (RRT-Connect) and :func:`fast_shortcut` run on (:mod:`.fast`).
 - :func:`plan_around` / :func:`plan_two_arms`: one arm around the other's timed
   trajectory, or both together (:mod:`.two_arms`).
-- :func:`planned_cycle`: the transfer ``plan_cycle(..., cell=)`` falls back to (:mod:`.cycle`).
+- :func:`planned_cycle`: the transfer ``plan_cycle(..., cell=)`` falls back to (:mod:`.transfer`).
 - The planning scenes and their seeded queries (:mod:`.scenes`), example-robot-data arms
   as xacro macros (:mod:`.arm_macros`).
 """
@@ -23,7 +23,7 @@ from pinarms.optim.motion.plan import ClearanceProfile, MotionPlan, plan_motion
 from pinarms.optim.motion.scenes import SCENES, Query, Region, Scene, load_scene, scene_names, scene_path, scene_queries
 from pinarms.optim.motion.search import PLANNERS
 from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, plan_two_arms
-from pinarms.optim.motion.cycle import PlannedMove, planned_cycle
+from pinarms.optim.motion.transfer import PlannedMove, planned_cycle
 
 __all__ = ["plan_motion", "MotionPlan", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
            "FastCheck", "fast_check", "fast_search", "fast_shortcut",

@@ -282,7 +282,7 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
                   voxel_mm: float | None, scheduler: str | None, as_json: bool) -> None:
     """Monte Carlo workspace of ROBOT: extent, sphere fit, manipulability, recommended table region.
 
-    The region is robots.reach.placement.recommend_region's radial band on the working side of
+    The region is robots.reach.table_band.recommend_region's radial band on the working side of
     the base plane (distances in the JSON in metres). With --stream the samples are
     reduced in tasks of 2e6 (serially, or on Dask with --scheduler) and never held.
     """
@@ -290,7 +290,7 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
     if stream:
         _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json)
         return
-    from pinarms.robots.reach.placement import recommend_region
+    from pinarms.robots.reach.table_band import recommend_region
     from pinarms.robots.reach.workspace import sample_workspace
 
     # a million samples take about a second: a bar from there on

@@ -82,7 +82,7 @@ def study_001(quick: bool = False) -> Study:
 
 def _workspace_rows_001(arm: robots.Robot, quick: bool) -> tuple[list[Row], Any]:
     """The workspace's outer sphere and the recommended table band against the paper's; and the workspace."""
-    from pinarms.robots.reach.placement import recommend_region
+    from pinarms.robots.reach.table_band import recommend_region
     from pinarms.robots.reach.workspace import sample_workspace
 
     paper = SEED001

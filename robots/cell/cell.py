@@ -30,7 +30,7 @@ from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, 
 from .components import CellArm, Fixture
 from .description import CellSpec, describe
 from .move_arm import urdf_with_arm_base
-from .placements import BatchedPlacements
+from .batch_fk import BatchedPlacements
 
 __all__ = ["Cell"]
 

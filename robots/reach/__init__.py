@@ -11,8 +11,8 @@
   :mod:`.robot_spec` (the robot a worker rebuilds); :mod:`.reach_map` (the map as data),
   :mod:`.reach_io` (its HDF5 file format, read in a bounded child process:
   :mod:`._reach_child`, :mod:`._reach_worker`) and :mod:`.reach_write` (writing it);
-- :mod:`.base_placement` (inverse reach: bases from which an arm reaches a set of poses,
-  checked by exact IK in :mod:`.base_verify`), :mod:`.placement` (the recommended table
+- :mod:`.inverse_reach` (inverse reach: bases from which an arm reaches a set of poses,
+  checked by exact IK in :mod:`.base_verify`), :mod:`.table_band` (the recommended table
   band), :mod:`.layout` (checking a station's layout).
 
 The public names are re-exported by :mod:`pinarms.robots` (old module paths: docs/README.md).

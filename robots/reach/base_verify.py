@@ -4,7 +4,7 @@
 tasks) seen from each candidate base: every closed-form branch within the limits when the arm
 and the map have a closed form, else the numerical solver (seeded per pose); the collision
 checks of :func:`robots.reach.reachability.reachability_map` drop solutions. Used by
-:func:`robots.reach.base_placement.base_placements`. Units: m, rad.
+:func:`robots.reach.inverse_reach.base_placements`. Units: m, rad.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ A spec is small and picklable: the registry name when the robot is the registry'
 by SHA-256, same tool frame, same closed-form family), else the URDF text itself.
 :func:`robot_of` rebuilds the robot once per process and checks its URDF against the SHA-256.
 Used by the chunk tasks of :func:`robots.reach.reachability.reachability_map` and by the
-exact check of :func:`robots.reach.base_placement.base_placements`.
+exact check of :func:`robots.reach.inverse_reach.base_placements`.
 """
 
 from __future__ import annotations

@@ -19,8 +19,8 @@ A sample is *near-singular* when its inverse condition is below
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
 The dexterity measures are computed by :mod:`robots.reach.dexterity` (``position_dexterity`` is
-re-exported here). Where the tables should stand is :func:`robots.reach.placement.recommend_region` (the module above
-this one: placement imports workspace, never the other way).
+re-exported here). Where the tables should stand is :func:`robots.reach.table_band.recommend_region` (the module above
+this one: table_band imports workspace, never the other way).
 """
 
 from __future__ import annotations

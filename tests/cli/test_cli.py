@@ -341,7 +341,7 @@ def test_bad_csv_names_row_and_column(run, tmp_path):
 
 
 def test_workspace_prints_the_recommended_table_region(run):
-    from pinarms.robots.reach.placement import recommend_region
+    from pinarms.robots.reach.table_band import recommend_region
     from pinarms.robots.reach.workspace import sample_workspace
 
     data = as_json(run("workspace", "aubo_i3", "-n", "3000", "--frame", "flange", "--json"))

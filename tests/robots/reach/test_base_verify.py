@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.reach.base_placement import tool_down_poses
+from pinarms.robots.reach.inverse_reach import tool_down_poses
 from pinarms.robots.reach.base_verify import verify_bases
 from pinarms.robots.reach.reachability import reachability_map
 

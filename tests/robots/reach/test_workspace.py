@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
-from pinarms.robots.reach.placement import recommend_region
+from pinarms.robots.reach.table_band import recommend_region
 from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,

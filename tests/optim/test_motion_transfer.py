@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import optim
 from pinarms.optim.motion import load_scene
-from pinarms.optim.motion.cycle import PlannedMove
+from pinarms.optim.motion.transfer import PlannedMove
 from pinarms.robots.cell.motion import joint_levers
 
 from tests.optim.motion_helpers import BulletScene, dense_times
