@@ -84,11 +84,11 @@ def root_cylinders(model: pin.Model, data: pin.Data, objs: list, joint: list[int
     return out
 
 
-def _distance(shape_a, T_a, shape_b, T_b) -> float:
+def _distance(shape_a, a_to_world, shape_b, b_to_world) -> float:
     request, result = coal.DistanceRequest(), coal.DistanceResult()
     request.gjk_tolerance = 1e-10
     try:
-        d = float(coal.distance(shape_a, T_a, shape_b, T_b, request, result))
+        d = float(coal.distance(shape_a, a_to_world, shape_b, b_to_world, request, result))
     except Exception:  # a pair of shapes coal cannot measure: no bound from it
         return -np.inf
     return d - _EPS if np.isfinite(d) else -np.inf
@@ -105,10 +105,10 @@ def tighter_bound(gap: float, a: int, b: int, objs: list, joint: list[int], ball
             best = max(best, _distance(*cylinders[a], *cylinders[b]))
         return best
     m, s = (a, b) if joint[a] > 0 else (b, a)
-    T_s = placement_of(s)
+    shape_to_world = placement_of(s)
     if not isinstance(objs[s].geometry, coal.Box):  # against a box the ball gap is already exact
         ball = coal.Transform3s(np.eye(3), np.asarray(ball_center[m], dtype=float))
-        best = max(best, _distance(coal.Sphere(float(ball_radius[m])), ball, objs[s].geometry, T_s))
+        best = max(best, _distance(coal.Sphere(float(ball_radius[m])), ball, objs[s].geometry, shape_to_world))
     if cylinders[m] is not None:
-        best = max(best, _distance(*cylinders[m], objs[s].geometry, T_s))
+        best = max(best, _distance(*cylinders[m], objs[s].geometry, shape_to_world))
     return best

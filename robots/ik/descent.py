@@ -68,9 +68,9 @@ class LMDescent:
 
     def _target(self, target: np.ndarray, position_only: bool):
         target = np.asarray(target, dtype=float)
-        p_des = np.array(target[:3, 3])
-        T_des = None if position_only else pin.SE3(np.array(target[:3, :3]), p_des)
-        return T_des, p_des
+        target_in_base = np.array(target[:3, 3])
+        target_to_base = None if position_only else pin.SE3(np.array(target[:3, :3]), target_in_base)
+        return target_to_base, target_in_base
 
     def attempt(
         self, q0: np.ndarray, target: np.ndarray, position_only: bool, tol: float, limits: bool = True
@@ -80,39 +80,39 @@ class LMDescent:
         With ``limits`` every iterate is projected into the joint limits; without, joints
         move freely (continuous joints wrapped), for diagnostics.
         """
-        T_des, p_des = self._target(target, position_only)
+        target_to_base, target_in_base = self._target(target, position_only)
         mode = CLIP if limits else FREE
-        return self._descend(np.array(q0, dtype=float), T_des, p_des, position_only, float(tol), mode)
+        return self._descend(np.array(q0, dtype=float), target_to_base, target_in_base, position_only, float(tol), mode)
 
-    def _attempt_within_limits(self, q0, T_des, p_des, position_only: bool, tol: float):
+    def _attempt_within_limits(self, q0, target_to_base, target_in_base, position_only: bool, tol: float):
         """Free descent (angles wrapped to their range's window), then, if it met the target
         outside the limits, a projected descent from there: ``(q, pos_err, rot_err, its, ok)``.
 
         A returned ``q`` is always within the limits (projected if the descent ended outside).
         """
-        q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, WINDOW)
+        q, pe, re, it = self._descend(q0, target_to_base, target_in_base, position_only, tol, WINDOW)
         met = pe <= tol and re <= tol
         if met and self.in_limits(q):
             return q, pe, re, it, True
         if not met:  # no pose reached from this start: report its projection, restart elsewhere
             self._clip(q)
-            pe, re = self._errors_to(q, T_des, p_des, position_only)
+            pe, re = self._errors_to(q, target_to_base, target_in_base, position_only)
             return q, pe, re, it, False
         self._clip(q)  # a solution outside the limits: slide back along the limits
-        q, pe, re, it2 = self._descend(q, T_des, p_des, position_only, tol, CLIP)
+        q, pe, re, it2 = self._descend(q, target_to_base, target_in_base, position_only, tol, CLIP)
         return q, pe, re, it + it2, pe <= tol and re <= tol
 
-    def _errors_to(self, q, T_des, p_des, position_only: bool) -> tuple[float, float]:
+    def _errors_to(self, q, target_to_base, target_in_base, position_only: bool) -> tuple[float, float]:
         pin.forwardKinematics(self.model, self.data, self._pin_q(q))
         M = pin.updateFramePlacement(self.model, self.data, self.frame_id)
-        d = M.translation - p_des
+        d = M.translation - target_in_base
         pe = float(np.sqrt(d.dot(d)))
         if position_only:
             return pe, 0.0
-        w = pin.log3(M.rotation.T.dot(T_des.rotation))
+        w = pin.log3(M.rotation.T.dot(target_to_base.rotation))
         return pe, float(np.sqrt(w.dot(w)))
 
-    def _evaluator(self, T_des, p_des, position_only: bool):
+    def _evaluator(self, target_to_base, target_in_base, position_only: bool):
         """``evaluate(q) → (e, D, ‖e‖²)``; it leaves the joint Jacobians of ``q`` in this thread's data."""
         model, data, fid = self.model, self.data, self.frame_id
         jacobians, placement, log6 = pin.computeJointJacobians, pin.updateFramePlacement, pin.log6
@@ -123,9 +123,9 @@ class LMDescent:
             jacobians(model, data, x if same_q else pin_q(x))
             M = placement(model, data, fid)
             if position_only:
-                d = p_des - M.translation
+                d = target_in_base - M.translation
                 return d, None, float(d.dot(d))
-            D = M.actInv(T_des)
+            D = M.actInv(target_to_base)
             d = log6(D).vector
             return d, D, float(d.dot(d))
 
@@ -172,7 +172,7 @@ class LMDescent:
         t, w = D.translation, e[3:]
         return q, float(np.sqrt(t.dot(t))), float(np.sqrt(w.dot(w))), it
 
-    def _descend(self, q, T_des, p_des, position_only: bool, tol: float, mode: int, patience: int = 1):
+    def _descend(self, q, target_to_base, target_in_base, position_only: bool, tol: float, mode: int, patience: int = 1):
         """Levenberg–Marquardt from ``q`` (modified in place), projecting each iterate by ``mode``.
 
         ``patience`` multiplies ``max_iter`` and ``stall_steps`` (a final polish of a failed solve).
@@ -183,7 +183,7 @@ class LMDescent:
         eye = np.eye(rows if wide else self.nq)  # G + λI by one add (a strided in-place add costs 4x more)
         stall_steps, max_iter = self.stall_steps * patience, self.max_iter * patience
         tol2 = tol * tol
-        evaluate = self._evaluator(T_des, p_des, position_only)
+        evaluate = self._evaluator(target_to_base, target_in_base, position_only)
         at_limit = clip and (self._clip(q) or bool(((q <= self.lower) | (q >= self.upper)).any()))
         e, D, E = evaluate(q)
         mu, nu = self.damping, 2.0

@@ -256,18 +256,18 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         runs the attempts interpreted (step by step through Pinocchio) instead of :mod:`._kernel`.
         """
         target = np.asarray(target, dtype=float)
-        T_des, p_des = self._target(target, position_only)
+        target_to_base, target_in_base = self._target(target, position_only)
         tol = float(tol)
         if compiled and limits and first:
             res = self._solve_compiled(target, q_seed, bool(position_only), tol, int(max_restarts), seed)
             if res.success or not polish:
                 return res
             # the closest configuration within the limits: a patient projected descent from the best end
-            q, pe, re, it = self._descend(res.q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
+            q, pe, re, it = self._descend(res.q.copy(), target_to_base, target_in_base, position_only, tol, _CLIP, patience=4)
             if pe + re > res.position_error + res.rotation_error:
                 return res
             if pe <= tol and re <= tol:
-                pe, re = self._errors_to(q, T_des, p_des, position_only)
+                pe, re = self._errors_to(q, target_to_base, target_in_base, position_only)
             ok = pe <= tol and re <= tol and self.in_limits(q)
             return IKResult(q, bool(ok), pe, re, res.attempts, res.iterations + it)
         if not first:
@@ -288,13 +288,13 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
                     pool = self._ranked_starts(rng, target, position_only)
                 q0, pool = pool[0].copy(), pool[1:]
             if limits:
-                q, pe, re, it, ok = self._attempt_within_limits(q0, T_des, p_des, position_only, tol)
+                q, pe, re, it, ok = self._attempt_within_limits(q0, target_to_base, target_in_base, position_only, tol)
             else:
-                q, pe, re, it = self._descend(q0, T_des, p_des, position_only, tol, _FREE)
+                q, pe, re, it = self._descend(q0, target_to_base, target_in_base, position_only, tol, _FREE)
                 ok = pe <= tol and re <= tol
             iterations += it
             if ok:  # confirm on the returned q itself (after wrapping) with a fresh FK
-                pe, re = self._errors_to(q, T_des, p_des, position_only)
+                pe, re = self._errors_to(q, target_to_base, target_in_base, position_only)
                 ok = pe <= tol and re <= tol and (not limits or self.in_limits(q))
             if ok:
                 return IKResult(q, True, pe, re, attempt + 1, iterations)
@@ -305,12 +305,12 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
                             np.inf, np.inf, 0, 0)
         q, pe, re = best
         if limits and polish:  # the closest configuration within the limits: a projected descent from the best end
-            q, pe, re, it = self._descend(q.copy(), T_des, p_des, position_only, tol, _CLIP, patience=4)
+            q, pe, re, it = self._descend(q.copy(), target_to_base, target_in_base, position_only, tol, _CLIP, patience=4)
             iterations += it
             if pe + re > best[1] + best[2]:
                 q, pe, re = best
             elif pe <= tol and re <= tol:
-                pe, re = self._errors_to(q, T_des, p_des, position_only)
+                pe, re = self._errors_to(q, target_to_base, target_in_base, position_only)
                 if pe <= tol and re <= tol:
                     return IKResult(q, True, pe, re, int(max_restarts) + 1, iterations)
         return IKResult(q, False, pe, re, int(max_restarts) + 1, iterations)

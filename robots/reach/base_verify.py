@@ -40,8 +40,8 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
     cz, sz = np.cos(candidates[:, 3]), np.sin(candidates[:, 3])
     B[:, 0, 0], B[:, 0, 1], B[:, 1, 0], B[:, 1, 1] = cz, -sz, sz, cz
     B[:, :3, 3] = candidates[:, :3]
-    T_b = np.linalg.inv(B)[:, None] @ T_tasks[None]  # (n, N, 4, 4)
-    T = np.repeat(T_b[:, :, None], R, axis=2)
+    tasks_to_base = np.linalg.inv(B)[:, None] @ T_tasks[None]  # (n, N, 4, 4)
+    T = np.repeat(tasks_to_base[:, :, None], R, axis=2)
     T[..., :3, :3] = T[..., :3, :3] @ rolls[None, None]
     T = T.reshape(-1, 4, 4)
     task = ChunkTask(robot=spec_of(robot), origin=np.zeros(3), resolution=1.0, shape=(1, 1, 1), voxels=np.zeros(0, np.int64),

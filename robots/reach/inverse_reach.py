@@ -2,7 +2,7 @@
 
 The arm's base stands on a plane at height ``z`` [m] (world frame), at ``(x, y)`` with a yaw
 ``ψ`` about the vertical: ``T_base_to_world = Trans(x, y, z) · Rz(ψ)``. A task pose
-``T_task`` (tool frame → world) is, seen from that base, ``T_b = T_base_to_worldᵀ⁻¹ · T_task``.
+``task_to_world`` (tool frame → world) is, seen from that base, ``task_to_base = T_base_to_world⁻¹ · task_to_world``.
 
 :func:`base_placements` answers with the inverse of a :class:`~robots.reach.reachability.ReachabilityMap`
 restricted to bases on the plane:
@@ -11,8 +11,8 @@ restricted to bases on the plane:
    over the tasks' bounding box grown by the map's horizontal reach, times yaws ``k·yaw_step``.
    A base farther (horizontally) from a task than the farthest reachable voxel of the map is
    dropped at once.
-2. **Map lookups.** For each candidate and task: the voxel of ``T_b``'s position and the set's
-   orientation nearest ``T_b``'s (for *roll-free* tasks, such as a gripper closing on a
+2. **Map lookups.** For each candidate and task: the voxel of ``task_to_base``'s position and the set's
+   orientation nearest ``task_to_base``'s (for *roll-free* tasks, such as a gripper closing on a
    mushroom with the tool pointing down, only the tool axis matters: a roll-free map's
    direction group, or for an SO(3) map any of ``roll_steps`` rolls about the tool axis).
    A candidate is *feasible on the map* when every task is reached there.
