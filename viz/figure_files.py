@@ -15,9 +15,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from pinarms.files import atomic_write
 from pinarms.robots.errors import InvalidInput
-
-from ._atomic import atomic_write
 
 __all__ = ["save_figure", "checked_numbers"]
 

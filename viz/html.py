@@ -7,7 +7,8 @@ import io
 from pathlib import Path
 from typing import Any
 
-from ._atomic import atomic_write
+from pinarms.files import atomic_write
+
 from .page import with_page
 from .scene import SceneInfo, build_scene
 from .server import MeshcatServer

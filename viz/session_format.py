@@ -31,9 +31,9 @@ from typing import Any, BinaryIO, Mapping
 
 import numpy as np
 
+from pinarms.files import atomic_write
 from pinarms.robots.errors import InvalidInput
 
-from ._atomic import atomic_write
 from .mesh_paths import check_mesh_paths
 from .session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive
 from .session_document import read_document

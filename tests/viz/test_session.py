@@ -146,7 +146,7 @@ _CRASH = textwrap.dedent("""
 
 
 def test_part_files_of_a_killed_save_are_removed_by_the_next_save(session, tmp_path):
-    from pinarms.viz import _atomic
+    from pinarms import files as _atomic
 
     target = tmp_path / "s.pinarms"
     proc = subprocess.run([sys.executable, "-c", _CRASH, str(target)], capture_output=True, timeout=120)
