@@ -20,8 +20,6 @@ Dask cluster), one task per ``du`` column, same result either way. Saved as ``.n
 
 from __future__ import annotations
 
-import os
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.files import atomic_write
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
@@ -157,23 +156,15 @@ class TaskMap:
         return out[0], out[1]
 
     def save(self, path: str | Path) -> Path:
-        """Write the map as ``.npz`` atomically (a temporary file renamed into place)."""
-        path = Path(path)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # the permissions of a plainly created file, not mkstemp's 0600
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
-                         scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
-                         station=np.array(self.station), branches=np.array(self.branches, dtype=np.int64),
-                         branch_approach=self._A, branch_leave=self._C)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-        return path
+        """Write the map as ``.npz`` atomically (:func:`pinarms.files.atomic_write`)."""
+
+        def write(fh: Any) -> None:
+            np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
+                     scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
+                     station=np.array(self.station), branches=np.array(self.branches, dtype=np.int64),
+                     branch_approach=self._A, branch_leave=self._C)
+
+        return atomic_write(path, write)
 
     @classmethod
     def load(cls, path: str | Path) -> "TaskMap":
