@@ -6,11 +6,14 @@ levers, held arms), all in compiled code (:mod:`._fast_kernel`):
 - a **state** is proven clear when the cover's lower bound of the excess
   ``E(x) = min_k (d_k − margin_k)`` is ≥ 0 (the cover contains the geometry: its distances
   are lower bounds); inconclusive counts as not valid here — never as clear;
-- an **edge** is proven by the Lipschitz rule of the exact proof (every point moves at most
-  ``T = Σ |Δx_j| ℓ_j``, ``E`` is 1-Lipschitz in that travel, so an interval whose ends have
-  ``E_a + E_b ≥ B`` keeps every margin), bisecting where needed down to the exact proof's
-  finest travel ``step / 2^MAX_SPLITS``; ``E`` is capped at the clearance above which the
-  checker left pairs out (they are proven that far apart).
+- an **edge** is proven by the Lipschitz rule of the exact proof taken per pair group: the
+  distance of two links changes along the edge by at most the travel of the joints upstream
+  of one and not the other times their levers to that link's points (``w_g``, at most the
+  whole-arm ``T = Σ |Δx_j| ℓ_j``; :mod:`.link_levers`), so an interval whose ends have
+  ``Ẽ_a + Ẽ_b ≥ s_b − s_a`` on the scaled excess ``Ẽ = min_k ê_k / w_g`` keeps every margin;
+  bisecting where needed down to the exact proof's finest travel ``step / 2^MAX_SPLITS``;
+  ``E`` is capped at the clearance above which the checker left pairs out (they are proven
+  that far apart).
 
 :func:`fast_search` runs RRT-Connect on it (seeded SplitMix64 stream, chunks of iterations
 between which the clock is read: the time limit holds to a chunk, a few ms) and
@@ -26,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.motion import _fast_kernel as kernel
+from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.robots.cell.cover import pair_arrays, pairs_for
 from pinarms.optim.motion.search import SearchResult
@@ -77,17 +81,21 @@ class FastCheck:
         self.hold = np.ascontiguousarray(checker.hold, dtype=float)
         self.cols = np.ascontiguousarray(checker.cols, dtype=np.int64)
         self.levers = np.ascontiguousarray(checker.levers, dtype=float)
+        model = checker.cell.model
+        #: each pair group's levers (G, n): its distance changes at most by ``Σ_j |Δx_j| lam[g, j]``
+        self.lam = group_levers(cover, pairs, model.lowerPositionLimit, model.upperPositionLimit, self.cols)
         #: the pairs left out are proven farther apart than this above their margins [m]: E is capped there
         self.cap = reach
         self.min_budget = float(checker.step / 2.0 ** MAX_SPLITS)
         #: states one edge proof may take before it gives up (not proven: never clear)
         self.max_states = int(EDGE_STATES if max_states is None else max_states)
         #: the kernels' arguments after the states: levers, finest budget, states per edge, the cell
-        self.args = (self.levers, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
+        self.args = (self.levers, self.lam, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
                      self.cap, self.work)
         self._q = np.empty(self.hold.size)
         self._xm = np.empty(checker.n)
         self._queue = np.empty((kernel.QUEUE, 4))
+        self._inv = np.empty(self.lam.shape[0])
         self._load()
 
     def _load(self) -> None:
@@ -95,10 +103,10 @@ class FastCheck:
         a first call): a search's clock then measures the search."""
         n = self.checker.n
         x = np.ascontiguousarray(self.checker.lower, dtype=float)
-        kernel.edge_proven(x, x, -1.0, -1.0, *self.args, self._q, self._xm, self._queue)
+        kernel.edge_proven(x, x, *self.args, self._q, self._xm, self._queue, self._inv)
         kernel.path_proven(x[None].copy(), *self.args)
-        kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.zeros((2, 1)),
-                           np.ones(2, dtype=np.int64), np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
+        kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.ones(2, dtype=np.int64),
+                           np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
         kernel.shortcut(np.zeros((2, n)), 2, _rng(0), 0, *self.args)
 
     def excess(self, x: Any) -> float:
@@ -117,8 +125,7 @@ class FastCheck:
         xb = np.ascontiguousarray(xb, dtype=float)
         if not self.checker.within_limits(np.stack([xa, xb])).all():
             return False
-        return bool(kernel.edge_proven(xa, xb, self.excess(xa), self.excess(xb), *self.args, self._q, self._xm,
-                                       self._queue))
+        return bool(kernel.edge_proven(xa, xb, *self.args, self._q, self._xm, self._queue, self._inv))
 
     def path_proven(self, P: Any) -> bool:
         """Whether the cover proves every edge of the polyline ``P (M, n)``."""
@@ -166,10 +173,8 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     step_range = float(planner_range) if planner_range is not None else 0.2 * float(np.linalg.norm(upper - lower))
     nodes = np.zeros((2, TREE_NODES, n))
     parent = np.full((2, TREE_NODES), -1, dtype=np.int64)
-    energy = np.zeros((2, TREE_NODES))
-    nodes[0, 0], energy[0, 0] = x0, fc.excess(x0)
-    for i, k in enumerate(keep):
-        nodes[1, i], energy[1, i] = G[k], fc.excess(G[k])
+    nodes[0, 0] = x0
+    nodes[1, : len(keep)] = G[keep]
     counts = np.array([1, len(keep)], dtype=np.int64)
     status = np.zeros(5, dtype=np.int64)
     rng = _rng(seed)
@@ -177,7 +182,7 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     deadline = t0 + float(time_limit)
     while time.perf_counter() < deadline and counts.min() < TREE_NODES:
         tc = time.perf_counter()
-        found = kernel.rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, chunk,
+        found = kernel.rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, chunk,
                                    *fc.args)
         if found:
             break
