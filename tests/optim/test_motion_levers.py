@@ -92,3 +92,23 @@ def test_compiled_edge_proof_on_group_bounds_is_exact_clear(name):
     verdicts = np.array(verdicts)
     assert not np.any(verdicts[:, 0] & ~verdicts[:, 1]), "the cover proved an edge the exact proof rejects"
     assert verdicts[:, 0].any() and (~verdicts[:, 0]).any()
+
+
+def test_compiled_search_steps_off_ends_the_cover_does_not_prove():
+    """aubo_crate_guard: starts and goals deep in the crate the spheres do not prove clear (coal does) are
+    joined to the compiled search by exactly proven edges; the path found is proven exactly, end to end."""
+    from pinarms.optim.motion import scene_queries
+    from pinarms.optim.motion.fast import fast_search
+
+    cell = load_scene("aubo_crate_guard")
+    queries, hold = scene_queries("aubo_crate_guard", 8, seed=0, margin=MARGIN)
+    checker = MotionChecker(cell, ["aubo"], margin=MARGIN, hold=hold)
+    fc = fast_check(checker)
+    hard = [k for k, q in enumerate(queries) if not (fc.state_proven(q.start) and fc.state_proven(q.goal))]
+    assert hard, "no query with an end the cover leaves unproven: the test would prove nothing"
+    for k in hard[:2]:
+        q = queries[k]
+        r = fast_search(checker, q.start, np.atleast_2d(q.goal), time_limit=2.0, seed=k)
+        assert r.path is not None, r.status
+        assert np.array_equal(r.path[0], q.start) and np.array_equal(r.path[-1], q.goal)
+        assert all(checker.edge_valid(r.path[i], r.path[i + 1]).ok for i in range(len(r.path) - 1))
