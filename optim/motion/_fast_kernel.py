@@ -93,7 +93,9 @@ def edge_proven(xa, xb, levers, lam, min_budget, max_states, hold, cols, fk, cov
     for g in range(inv.shape[0]):
         w = 0.0
         for j in range(xa.shape[0]):
-            w += abs(xb[j] - xa[j]) * lam[g, j]
+            d = abs(xb[j] - xa[j])
+            if d > 0.0:  # an unbounded lever (inf) of a joint that stays: no travel, not nan
+                w += d * lam[g, j]
         inv[g] = 1.0 / max(min(w, T), 1e-12)  # a larger weight is still a bound
     c = min(cap / T, 1.0)
     eb = state_scaled(xb, inv, hold, cols, fk, cov, grp, c, work, q)  # the new end first: more often not clear
