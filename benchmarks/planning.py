@@ -244,8 +244,8 @@ def goals(rows: list, pyro: dict, time_limit: float) -> list[str]:
         search = pct(rec["search"], 50)
         plan = pct(rec["plan"], 50)
         compiled = rec["compiled"] >= 0.5 * max(rec["ok"], 1)
-        why_search = ("found compiled: each edge proven on the cover needs about T / 2E states (travel over excess, "
-                      "at a 10 mm margin; VAMP samples edges without a margin)" if compiled else
+        why_search = ("found compiled: each edge proven on the cover needs about w / 2E states (a pair group's "
+                      "travel over its excess, at a 10 mm margin; VAMP samples edges without a margin)" if compiled else
                       "found by OMPL with coal: the cover is loose here (UR5 meshes) or proves too few states")
         parts = [f"success {100 * rate:.0f}% {'met' if rate >= GOAL_SUCCESS else 'GAP'} (goal {100 * GOAL_SUCCESS:.0f}%"
                  + ("" if rate >= GOAL_SUCCESS else "; the rest unfinished within the limit: the compiled search, then OMPL "

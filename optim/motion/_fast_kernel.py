@@ -2,15 +2,19 @@
 
 A state is the planned arms' joint vector ``x``; the cell configuration is ``hold`` with
 ``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
-(:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b``
-with travel bound ``T = Σ |Δx_j| ℓ_j`` is proven when every interval of a subdivision has
-``E_a + E_b ≥ B`` (``B`` its travel: the excess is 1-Lipschitz in travel), all ``E ≥ 0``.
+(:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b`` is
+proven on the *scaled* excess ``Ẽ(x) = min_k ê_k(x) / w_g`` (:func:`excess_scaled`): ``w_g``
+bounds how much the distance of the pairs of group ``g`` (two links, or a link and a
+fixture) changes along the whole edge (``Σ_j |Δx_j| λ_{g,j}``, at most the whole-arm travel
+``T = Σ |Δx_j| ℓ_j``; :mod:`.link_levers` states the Lipschitz argument); an interval
+``[s_a, s_b]`` of the edge is proven when ``Ẽ_a + Ẽ_b ≥ s_b − s_a``, all ``Ẽ ≥ 0``; ``Ẽ`` is
+capped at ``cap / T`` (the pairs left out are more than ``cap`` above their thresholds).
 An interval not proven is halved (splitting at the middle of the stretch its ends do not
 prove instead checked as many states on the Panda scenes); intervals are taken first in,
 first out (the middle of the edge first, then its quarters: an edge through an obstacle
-fails after a few states); the new state's ``E`` is capped at the larger half's travel. The random numbers are a
-SplitMix64 stream held in an array: a search is the same for the same seed, whatever the
-chunks it is run in. Cached on disk like the cover's kernels.
+fails after a few states); the new state's ``Ẽ`` is capped at the larger half's length. The
+random numbers are a SplitMix64 stream held in an array: a search is the same for the same
+seed, whatever the chunks it is run in. Cached on disk like the cover's kernels.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 from pinarms.robots.cell import _cover_kernel
-from pinarms.robots.cell._cover_kernel import excess_one
+from pinarms.robots.cell._cover_kernel import excess_one, excess_scaled
 
 # these kernels call the cover's: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
@@ -60,37 +64,64 @@ def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
 
 
 @jit
-def edge_proven(xa, xb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm, queue):
+def state_scaled(x, inv, hold, cols, fk, cov, grp, cap, work, q):
+    """``Ẽ(x)``: the scaled excess at planned state ``x`` with group weights ``1 / inv`` (early out below 0)."""
+    n = hold.shape[0]
+    if q.shape[0] > n:
+        q[n] += 1.0
+    for i in range(n):
+        q[i] = hold[i]
+    for j in range(cols.shape[0]):
+        q[cols[j]] = x[j]
+    return excess_scaled(q, fk, cov, grp, inv, cap, 0.0, work)
+
+
+@jit
+def edge_proven(xa, xb, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm, queue, inv):
     """Whether the cover proves the straight edge ``xa → xb`` keeps every threshold (module docstring).
 
-    ``ea``, ``eb``: ``E`` at the ends (computed by the caller). ``min_budget``: intervals of
-    less travel still unproven fail the edge (the finest level of the exact proof's ladder);
-    so does an edge that needs more than ``max_states`` states (one that runs long close to
-    something: the search looks elsewhere, never calls it clear)."""
-    if ea < 0.0 or eb < 0.0:
-        return False
+    ``lam (G, n)``: the groups' levers (:func:`.link_levers.group_levers`); ``inv (G,)``:
+    scratch. ``min_budget``: intervals of less travel still unproven fail the edge (the finest
+    level of the exact proof's ladder); so does an edge that needs more than ``max_states``
+    states (one that runs long close to something: the search looks elsewhere, never calls it
+    clear)."""
     T = 0.0
     for j in range(xa.shape[0]):
         T += abs(xb[j] - xa[j]) * levers[j]
-    if ea + eb >= T * (1.0 + 1e-9):
+    if T <= 0.0:
+        return state_excess(xa, hold, cols, fk, cov, grp, cap, work, q) >= 0.0
+    for g in range(inv.shape[0]):
+        w = 0.0
+        for j in range(xa.shape[0]):
+            d = abs(xb[j] - xa[j])
+            if d > 0.0:  # an unbounded lever (inf) of a joint that stays: no travel, not nan
+                w += d * lam[g, j]
+        inv[g] = 1.0 / max(min(w, T), 1e-12)  # a larger weight is still a bound
+    c = min(cap / T, 1.0)
+    eb = state_scaled(xb, inv, hold, cols, fk, cov, grp, c, work, q)  # the new end first: more often not clear
+    if eb < 0.0:
+        return False
+    ea = state_scaled(xa, inv, hold, cols, fk, cov, grp, c, work, q)
+    if ea < 0.0:
+        return False
+    if ea + eb >= 1.0 + 1e-9:
         return True
-    c = min(cap, 0.5 * T + 1e-9)
     head, tail, n = 0, 1, queue.shape[0]
     queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 1.0, ea, eb
     while head != tail:
         fa, fb, a, b = queue[head, 0], queue[head, 1], queue[head, 2], queue[head, 3]
         head = (head + 1) % n
-        B = T * (fb - fa)
+        B = fb - fa
         if a + b >= B * (1.0 + 1e-9):
             continue
-        if B < min_budget or max_states <= 0:
+        if T * B < min_budget or max_states <= 0:
             return False
         max_states -= 1
         fm = 0.5 * (fa + fb)
         for j in range(xa.shape[0]):
             xm[j] = xa[j] + fm * (xb[j] - xa[j])
-        # E at the new state is needed up to the larger half's travel, no more (a smaller cap prunes more pairs)
-        em = state_excess(xm, hold, cols, fk, cov, grp, min(c, T * max(fm - fa, fb - fm) + 1e-9), work, q)
+        # Ẽ at the new state is needed up to the larger half's length, no more (a smaller cap prunes more pairs)
+        em = state_scaled(xm, inv, hold, cols, fk, cov, grp, min(c, max(fm - fa, fb - fm)), work, q)
         if em < 0.0:
             return False
         queue[tail, 0], queue[tail, 1], queue[tail, 2], queue[tail, 3] = fa, fm, a, em
@@ -118,8 +149,8 @@ def _nearest(nodes, count, x):
 
 
 @jit
-def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold, cols, fk, cov,
-            grp, cap, work, q, xm, xn, queue):
+def _extend(t, nodes, parent, counts, target, step_range, levers, lam, min_budget, max_states, hold, cols, fk, cov,
+            grp, cap, work, q, xm, xn, queue, inv):
     """One RRT step of tree ``t`` towards ``target``: ADVANCED, REACHED or TRAPPED (full tree: TRAPPED)."""
     count = counts[t]
     if count >= nodes.shape[1]:
@@ -133,28 +164,24 @@ def _extend(t, nodes, parent, energy, counts, target, step_range, levers, min_bu
     reach = d <= step_range
     for j in range(target.shape[0]):
         xn[j] = target[j] if reach else nodes[t, near, j] + (target[j] - nodes[t, near, j]) * (step_range / d)
-    en = state_excess(xn, hold, cols, fk, cov, grp, cap, work, q)
-    if en < 0.0:
-        return TRAPPED
-    if not edge_proven(nodes[t, near], xn, energy[t, near], en, levers, min_budget, max_states, hold, cols, fk, cov,
-                       grp, cap, work, q, xm, queue):
+    if not edge_proven(nodes[t, near], xn, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work,
+                       q, xm, queue, inv):
         return TRAPPED
     for j in range(target.shape[0]):
         nodes[t, count, j] = xn[j]
     parent[t, count] = near
-    energy[t, count] = en
     counts[t] = count + 1
     return REACHED if reach else ADVANCED
 
 
 @jit
-def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, iterations, levers, min_budget,
+def rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, iterations, levers, lam, min_budget,
                 max_states, hold, cols, fk, cov, grp, cap, work):
     """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
 
     ``status (5,) int64``: [found, node of tree 0, node of tree 1, tree that grows next, states
     checked so far]; the
-    trees ``nodes (2, cap, n)``, ``parent``, ``energy`` (E of each node), ``counts`` are
+    trees ``nodes (2, cap, n)``, ``parent``, ``counts`` are
     continued from call to call. Returns 1 when connected, 0 otherwise."""
     n = lower.shape[0]
     q = np.zeros(hold.shape[0] + 1)  # the last entry counts the states checked: status[4]
@@ -163,13 +190,14 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
     xr = np.empty(n)
     target = np.empty(n)
     queue = np.empty((QUEUE, 4))
+    inv = np.empty(lam.shape[0])
     for _ in range(iterations):
         a = status[3]
         b = 1 - a
         for j in range(n):
             xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
-        s = _extend(a, nodes, parent, energy, counts, xr, step_range, levers, min_budget, max_states, hold, cols, fk,
-                    cov, grp, cap, work, q, xm, xn, queue)
+        s = _extend(a, nodes, parent, counts, xr, step_range, levers, lam, min_budget, max_states, hold, cols, fk,
+                    cov, grp, cap, work, q, xm, xn, queue, inv)
         status[3] = b
         if s == TRAPPED:
             continue
@@ -178,8 +206,8 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
             target[j] = nodes[a, new_a, j]
         s = ADVANCED
         while s == ADVANCED:
-            s = _extend(b, nodes, parent, energy, counts, target, step_range, levers, min_budget, max_states, hold,
-                        cols, fk, cov, grp, cap, work, q, xm, xn, queue)
+            s = _extend(b, nodes, parent, counts, target, step_range, levers, lam, min_budget, max_states, hold,
+                        cols, fk, cov, grp, cap, work, q, xm, xn, queue, inv)
         if s == REACHED:
             status[0] = 1
             status[1 + a] = new_a
@@ -191,18 +219,18 @@ def rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_r
 
 
 @jit
-def path_proven(P, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
-    """Whether the cover proves every edge of the polyline ``P (M, n)``."""
+def path_proven(P, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
+    """Whether the cover proves every vertex and edge of the polyline ``P (M, n)``."""
     q = np.empty(hold.shape[0])
     xm = np.empty(P.shape[1])
     queue = np.empty((QUEUE, 4))
-    ea = state_excess(P[0], hold, cols, fk, cov, grp, cap, work, q)
+    inv = np.empty(lam.shape[0])
+    if state_excess(P[0], hold, cols, fk, cov, grp, cap, work, q) < 0.0:
+        return False
     for i in range(P.shape[0] - 1):
-        eb = state_excess(P[i + 1], hold, cols, fk, cov, grp, cap, work, q)
-        if not edge_proven(P[i], P[i + 1], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap,
-                           work, q, xm, queue):
+        if not edge_proven(P[i], P[i + 1], levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q,
+                           xm, queue, inv):
             return False
-        ea = eb
     return True
 
 
@@ -231,7 +259,7 @@ def _point_at(P, s, m, length, out):
 
 
 @jit
-def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
+def shortcut(P, m, rng, tries, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Random shortcutting of the proven polyline ``P[:m]`` in place; returns its new vertex count.
 
     Each try joins two random points of the path (at random arc lengths) by a straight edge
@@ -244,6 +272,7 @@ def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, c
     pa = np.empty(n)
     pb = np.empty(n)
     queue = np.empty((QUEUE, 4))
+    inv = np.empty(lam.shape[0])
     s = np.empty(P.shape[0])
     for _ in range(tries):
         if m < 3:
@@ -256,10 +285,8 @@ def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, c
         kb = _point_at(P, s, m, v, pb)
         if kb - ka < 1:  # on one segment: nothing to cut
             continue
-        ea = state_excess(pa, hold, cols, fk, cov, grp, cap, work, q)
-        eb = state_excess(pb, hold, cols, fk, cov, grp, cap, work, q)
-        if not edge_proven(pa, pb, ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm,
-                           queue):
+        if not edge_proven(pa, pb, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm,
+                           queue, inv):
             continue
         # P[:ka+1], pa, pb, P[kb+1:m]
         tail = m - (kb + 1)
@@ -276,10 +303,8 @@ def shortcut(P, m, rng, tries, levers, min_budget, max_states, hold, cols, fk, c
     # drop vertices whose neighbours join directly
     i = 0
     while i + 2 < m:
-        ea = state_excess(P[i], hold, cols, fk, cov, grp, cap, work, q)
-        eb = state_excess(P[i + 2], hold, cols, fk, cov, grp, cap, work, q)
-        if edge_proven(P[i], P[i + 2], ea, eb, levers, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q,
-                       xm, queue):
+        if edge_proven(P[i], P[i + 2], levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q,
+                       xm, queue, inv):
             for k in range(i + 1, m - 1):
                 P[k] = P[k + 1]
             m -= 1

@@ -6,11 +6,14 @@ levers, held arms), all in compiled code (:mod:`._fast_kernel`):
 - a **state** is proven clear when the cover's lower bound of the excess
   ``E(x) = min_k (d_k − margin_k)`` is ≥ 0 (the cover contains the geometry: its distances
   are lower bounds); inconclusive counts as not valid here — never as clear;
-- an **edge** is proven by the Lipschitz rule of the exact proof (every point moves at most
-  ``T = Σ |Δx_j| ℓ_j``, ``E`` is 1-Lipschitz in that travel, so an interval whose ends have
-  ``E_a + E_b ≥ B`` keeps every margin), bisecting where needed down to the exact proof's
-  finest travel ``step / 2^MAX_SPLITS``; ``E`` is capped at the clearance above which the
-  checker left pairs out (they are proven that far apart).
+- an **edge** is proven by the Lipschitz rule of the exact proof taken per pair group: the
+  distance of two links changes along the edge by at most the travel of the joints upstream
+  of one and not the other times their levers to that link's points (``w_g``, at most the
+  whole-arm ``T = Σ |Δx_j| ℓ_j``; :mod:`.link_levers`), so an interval whose ends have
+  ``Ẽ_a + Ẽ_b ≥ s_b − s_a`` on the scaled excess ``Ẽ = min_k ê_k / w_g`` keeps every margin;
+  bisecting where needed down to the exact proof's finest travel ``step / 2^MAX_SPLITS``;
+  ``E`` is capped at the clearance above which the checker left pairs out (they are proven
+  that far apart).
 
 :func:`fast_search` runs RRT-Connect on it (seeded SplitMix64 stream, chunks of iterations
 between which the clock is read: the time limit holds to a chunk, a few ms) and
@@ -26,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.motion import _fast_kernel as kernel
+from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.robots.cell.cover import pair_arrays, pairs_for
 from pinarms.optim.motion.search import SearchResult
@@ -44,6 +48,18 @@ REACH = 0.25
 EDGE_STATES = 400
 #: Most nodes per tree of the compiled search.
 TREE_NODES = 16384
+#: Longest edge the compiled search adds at once, as a share of the diagonal of the joint-limit box
+#: (OMPL's default is 0.2). Measured (25 queries, 0.75 s, load 2.5–3.5): ``aubo_crate_guard`` 15, 20, 20
+#: solved at 0.2, 0.15, 0.1 (the narrow passage out of the crate), ``panda_shelf`` median 14.8, 10.2,
+#: 11.5 ms, ``panda_table_box`` 0.94, 0.85, 1.10 ms.
+RANGE_SHARE = 0.15
+#: An end the cover does not prove (the spheres overshoot the geometry near a wall) but the exact
+#: checker does is joined to a nearby state the cover proves by an edge the exact checker proves:
+#: random states at these joint-space radii (shares of each joint's range) are tried,
+#: :data:`ESCAPE_SAMPLES` per radius, and at most :data:`ESCAPE_EDGES` exact edge proofs.
+ESCAPE_RADII = (0.01, 0.02, 0.04, 0.08, 0.16)
+ESCAPE_SAMPLES = 12
+ESCAPE_EDGES = 6
 
 
 class FastCheck:
@@ -77,17 +93,21 @@ class FastCheck:
         self.hold = np.ascontiguousarray(checker.hold, dtype=float)
         self.cols = np.ascontiguousarray(checker.cols, dtype=np.int64)
         self.levers = np.ascontiguousarray(checker.levers, dtype=float)
+        model = checker.cell.model
+        #: each pair group's levers (G, n): its distance changes at most by ``Σ_j |Δx_j| lam[g, j]``
+        self.lam = group_levers(cover, pairs, model.lowerPositionLimit, model.upperPositionLimit, self.cols)
         #: the pairs left out are proven farther apart than this above their margins [m]: E is capped there
         self.cap = reach
         self.min_budget = float(checker.step / 2.0 ** MAX_SPLITS)
         #: states one edge proof may take before it gives up (not proven: never clear)
         self.max_states = int(EDGE_STATES if max_states is None else max_states)
         #: the kernels' arguments after the states: levers, finest budget, states per edge, the cell
-        self.args = (self.levers, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
+        self.args = (self.levers, self.lam, self.min_budget, self.max_states, self.hold, self.cols, self.fk, self.cov, self.grp,
                      self.cap, self.work)
         self._q = np.empty(self.hold.size)
         self._xm = np.empty(checker.n)
         self._queue = np.empty((kernel.QUEUE, 4))
+        self._inv = np.empty(self.lam.shape[0])
         self._load()
 
     def _load(self) -> None:
@@ -95,10 +115,10 @@ class FastCheck:
         a first call): a search's clock then measures the search."""
         n = self.checker.n
         x = np.ascontiguousarray(self.checker.lower, dtype=float)
-        kernel.edge_proven(x, x, -1.0, -1.0, *self.args, self._q, self._xm, self._queue)
+        kernel.edge_proven(x, x, *self.args, self._q, self._xm, self._queue, self._inv)
         kernel.path_proven(x[None].copy(), *self.args)
-        kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.zeros((2, 1)),
-                           np.ones(2, dtype=np.int64), np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
+        kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.ones(2, dtype=np.int64),
+                           np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
         kernel.shortcut(np.zeros((2, n)), 2, _rng(0), 0, *self.args)
 
     def excess(self, x: Any) -> float:
@@ -117,8 +137,7 @@ class FastCheck:
         xb = np.ascontiguousarray(xb, dtype=float)
         if not self.checker.within_limits(np.stack([xa, xb])).all():
             return False
-        return bool(kernel.edge_proven(xa, xb, self.excess(xa), self.excess(xb), *self.args, self._q, self._xm,
-                                       self._queue))
+        return bool(kernel.edge_proven(xa, xb, *self.args, self._q, self._xm, self._queue, self._inv))
 
     def path_proven(self, P: Any) -> bool:
         """Whether the cover proves every edge of the polyline ``P (M, n)``."""
@@ -148,28 +167,31 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
                 planner_range: float | None = None) -> SearchResult:
     """RRT-Connect from ``start (n,)`` to any of ``goals (G, n)`` on the compiled cover check.
 
-    Ends the cover does not prove are left out (a start not proven: nothing searched,
-    ``status`` says so). ``planner_range``: the longest edge added at once [rad or m, joint
-    space] (default OMPL's: a fifth of the diagonal of the joint-limit box). The result's
-    ``path`` is ``None`` when nothing was found within ``time_limit`` [s]."""
+    An end the cover does not prove is joined to a nearby state it proves by an edge the exact
+    checker proves (:data:`ESCAPE_RADII`); ends for which none is found are left out (a start:
+    nothing searched, ``status`` says so). ``planner_range``: the longest edge added at once
+    [rad or m, joint space] (default :data:`RANGE_SHARE` of the diagonal of the joint-limit
+    box). The result's ``path`` is ``None`` when nothing was found within ``time_limit`` [s]."""
     fc = fast_check(checker)  # built, and its kernels loaded, before the clock starts
     t0 = time.perf_counter()
     x0 = np.asarray(start, dtype=float)
     G = np.atleast_2d(np.asarray(goals, dtype=float))
-    if fc is None or not fc.state_proven(x0):
+    gen = np.random.default_rng(int(seed))
+    root = None if fc is None else _escape(fc, x0, gen)
+    if root is None:
         return SearchResult(None, 0, time.perf_counter() - t0, COMPILED_PLANNER, -1, "start not proven by the cover")
-    keep = [k for k, g in enumerate(G) if fc.state_proven(g)]
+    ends = [(k, _escape(fc, g, gen)) for k, g in enumerate(G)]
+    keep = [(k, y) for k, y in ends if y is not None]
     if not keep:
         return SearchResult(None, 1, time.perf_counter() - t0, COMPILED_PLANNER, -1, "no goal proven by the cover")
     n = x0.size
     lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
-    step_range = float(planner_range) if planner_range is not None else 0.2 * float(np.linalg.norm(upper - lower))
+    step_range = float(planner_range) if planner_range is not None else \
+        RANGE_SHARE * float(np.linalg.norm(upper - lower))
     nodes = np.zeros((2, TREE_NODES, n))
     parent = np.full((2, TREE_NODES), -1, dtype=np.int64)
-    energy = np.zeros((2, TREE_NODES))
-    nodes[0, 0], energy[0, 0] = x0, fc.excess(x0)
-    for i, k in enumerate(keep):
-        nodes[1, i], energy[1, i] = G[k], fc.excess(G[k])
+    nodes[0, 0] = root
+    nodes[1, : len(keep)] = [y for _, y in keep]
     counts = np.array([1, len(keep)], dtype=np.int64)
     status = np.zeros(5, dtype=np.int64)
     rng = _rng(seed)
@@ -177,7 +199,7 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     deadline = t0 + float(time_limit)
     while time.perf_counter() < deadline and counts.min() < TREE_NODES:
         tc = time.perf_counter()
-        found = kernel.rrt_connect(nodes, parent, energy, counts, status, rng, lower, upper, step_range, chunk,
+        found = kernel.rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, chunk,
                                    *fc.args)
         if found:
             break
@@ -188,10 +210,38 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     states = int(counts.sum())
     if not found:
         return SearchResult(None, states, seconds, COMPILED_PLANNER, -1, f"Timeout ({int(status[4])} states checked)")
-    path = np.concatenate([_branch(nodes[0], parent[0], int(status[1]))[::-1],
-                           _branch(nodes[1], parent[1], int(status[2]))[1:]])
-    gi = int(np.argmin(np.linalg.norm(G - path[-1], axis=1)))
+    tail = _branch(nodes[1], parent[1], int(status[2]))
+    gi = keep[int(np.argmin(np.linalg.norm(np.array([y for _, y in keep]) - tail[-1], axis=1)))][0]
+    parts = [_branch(nodes[0], parent[0], int(status[1]))[::-1], tail[1:]]
+    if not np.array_equal(root, x0):  # the exactly proven edges off the ends
+        parts.insert(0, x0[None])
+    if not np.array_equal(tail[-1], G[gi]):
+        parts.append(G[gi][None])
+    path = np.concatenate(parts)
     return SearchResult(path, states, seconds, COMPILED_PLANNER, gi, f"Exact solution ({int(status[4])} states checked)")
+
+
+def _escape(fc: FastCheck, x: np.ndarray, gen: np.random.Generator) -> np.ndarray | None:
+    """``x`` when the cover proves it; else a nearby state the cover proves joined to ``x`` by an edge
+    the exact checker proves (module constants), or ``None``."""
+    if fc.state_proven(x):
+        return x
+    checker = fc.checker
+    if not checker.state_valid(x):
+        return None
+    lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
+    edges = 0
+    for radius in ESCAPE_RADII:
+        for _ in range(ESCAPE_SAMPLES):
+            y = x + radius * (upper - lower) * gen.uniform(-1.0, 1.0, x.size)
+            if not fc.state_proven(y):  # also outside the limits: not proven
+                continue
+            if checker.edge_valid(x, y).ok:
+                return y
+            edges += 1
+            if edges >= ESCAPE_EDGES:
+                return None
+    return None
 
 
 def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:

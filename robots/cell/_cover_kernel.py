@@ -334,3 +334,42 @@ def excess_kernel(Q, fk, cov, grp, cap, floor, work, out):
     """:func:`excess_one` for every row of ``Q (N, nq)`` into ``out (N,)``."""
     for i in range(Q.shape[0]):
         out[i] = excess_one(Q[i], fk, cov, grp, cap, floor, work)
+
+
+@jit
+def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
+    """:func:`excess_one` with the pairs of group ``g`` weighed by ``inv[g] > 0``: a lower bound of
+    ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
+    proof's scaled excess (``inv``: one over each group's travel weight, :mod:`optim.motion.link_levers`)."""
+    parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
+    hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
+    R, p, W, SA, SB, HW = work
+    _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
+    _centers(R, p, joint, center, W)
+    _centers(R, p, sjoint, sa_local, SA)
+    _centers(R, p, sjoint, sb_local, SB)
+    _centers(R, p, hjoint, hcenter, HW)
+    best = cap
+    for g in range(group_t.shape[0]):
+        a = group_a[g]
+        s = inv[g]
+        if (_hd(HW, hrad, a, group_b[g]) - group_t[g]) * s >= best:
+            continue
+        fixed = group_fixed[g]
+        if fixed >= 0 and (_shape_distance(HW[a], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) - hrad[a]
+                           - group_t[g]) * s >= best:
+            continue
+        for k in range(group_start[g], group_start[g + 1]):
+            ga = pair_a[k]
+            gb = pair_b[k]
+            if (_hd(HW, hrad, ga, gb) - t[k]) * s >= best:
+                continue
+            raw = best / s
+            r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
+                             hrad, raw)
+            if r < raw:
+                best = min(best, r * s)
+            if best < floor:
+                return best
+    return best
