@@ -271,7 +271,7 @@ def part_fixtures() -> None:
     cell, belt, st = _mushroom()
     kw = dict(mass=0.15, item_height=0.04, nu=24, nw=7)
     print("[fixtures] mushroom_line's left SCARA, 24 x 7 grid on both elbows, clearance 10 mm, serial")
-    for label in ("no cell", "fast + exact", "exact alone"):
+    for label in ("no cell", "fast + exact", "exact alone", "no cell", "fast + exact", "exact alone"):
         _CHECKS.clear()
         if label == "exact alone":
             fixture_check(cell, "left", 0.01).fast = None
@@ -279,9 +279,10 @@ def part_fixtures() -> None:
         m = build_task_map(st[0], belt, TrackingSpec(), cell=None if label == "no cell" else cell, clearance=0.01,
                            **kw)
         dt = time.perf_counter() - t
-        counts = {} if label == "no cell" else dict(fixture_check(cell, "left", 0.01).counts)
+        check = None if label == "no cell" else fixture_check(cell, "left", 0.01)
+        extra = "" if check is None else f"   checks {check.seconds:5.1f} s   {check.counts}"
         print(f"  {label:13s} {dt:6.1f} s   feasible nodes {int(np.isfinite(m.branch_approach).sum())}"
-              f"   fixture-infeasible {m.fixture_infeasible}   {counts}")
+              f"   fixture-infeasible {m.fixture_infeasible}{extra}")
 
 
 def part_neighbours() -> None:

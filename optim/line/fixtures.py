@@ -22,6 +22,7 @@ dwell, lift, leave or transfer, place, return). Two routes prove it keeps a clea
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 import numpy as np
@@ -77,16 +78,21 @@ class FixtureCheck:
         self._wide = MotionChecker(view, [arm], margin=self.clearance + self.chord, step=self.clearance)
         self.fast = fast_check(self._wide)
         self.counts = {"fast": 0, "exact": 0, "blocked": 0, "limits": 0}
+        self.seconds = 0.0  #: time spent in :meth:`verdict` [s]
 
     def verdict(self, trajectory: Any) -> str:
         """``"clear"``, ``"limits"`` (the trajectory leaves the arm's joint position limits: exact
         extrema; the checkers count such states as not valid) or ``"fixtures"`` (closer than the
         clearance to a fixture somewhere)."""
-        lo, hi = trajectory.position_range()
-        if np.any(lo < self.exact.lower - 1e-9) or np.any(hi > self.exact.upper + 1e-9):
-            self.counts["limits"] += 1
-            return "limits"
-        return "clear" if self.clear(trajectory) else "fixtures"
+        start = time.perf_counter()
+        try:
+            lo, hi = trajectory.position_range()
+            if np.any(lo < self.exact.lower - 1e-9) or np.any(hi > self.exact.upper + 1e-9):
+                self.counts["limits"] += 1
+                return "limits"
+            return "clear" if self.clear(trajectory) else "fixtures"
+        finally:
+            self.seconds += time.perf_counter() - start
 
     def clear(self, trajectory: Any) -> bool:
         """Whether the arm's joint ``trajectory`` keeps the clearance from every fixture over its whole time
