@@ -47,11 +47,11 @@ def _clearance(value: Any) -> float:
 
 
 def chord_polyline(trajectories: list, levers: np.ndarray, chord: float = CHORD,
-                   span: tuple[float, float] | None = None, times: bool = False) -> Any:
+                   span: tuple[float, float] | None = None, times: bool = False, cuts: Any = ()) -> Any:
     """Samples ``(M, n)`` of the joint trajectories played together (their joints side by side, all
     on one clock from ``span`` = (t0, t1), default their common range), at every knot and on a grid
     fine enough that the motion stays within ``chord`` [m] of the polyline (module doc); with
-    ``times`` also the sample instants ``(M,)``."""
+    ``times`` also the sample instants ``(M,)``; ``cuts``: more instants to sample."""
     t0 = max(float(tr.start_time) for tr in trajectories) if span is None else float(span[0])
     t1 = min(float(tr.end_time) for tr in trajectories) if span is None else float(span[1])
     acc = np.concatenate([np.asarray(tr.peaks().acceleration, float) for tr in trajectories])
@@ -59,7 +59,8 @@ def chord_polyline(trajectories: list, levers: np.ndarray, chord: float = CHORD,
     h = t1 - t0 if bend <= 0.0 else math.sqrt(8.0 * chord / bend)
     n = max(1, int(math.ceil((t1 - t0) / h)))
     knots = np.concatenate([np.asarray(tr.knot_times, float) for tr in trajectories])
-    t = np.unique(np.concatenate([np.linspace(t0, t1, n + 1), knots[(knots >= t0) & (knots <= t1)]]))
+    t = np.unique(np.concatenate([np.linspace(t0, t1, n + 1), knots[(knots >= t0) & (knots <= t1)],
+                                  np.asarray(cuts, float)]))
     P = np.hstack([np.asarray(tr.sample(t)[0], float).reshape(t.size, -1) for tr in trajectories])
     return (P, t) if times else P
 
@@ -183,8 +184,9 @@ class PairCheck:
         todo = list(zip(cuts[:-1], cuts[1:]))
         if self.fast is not None:
             shifted = [m.trajectory.shifted(m.offset) for m in motions]
-            todo = [(a, b) for a, b in todo
-                    if not self.fast.path_proven(chord_polyline(shifted, self._wide.levers, self.chord, (a, b)))]
+            P, t = chord_polyline(shifted, self._wide.levers, self.chord, (t0, t1), times=True, cuts=cuts)
+            at = np.searchsorted(t, cuts)  # the samples include every cut
+            todo = [(a, b) for k, (a, b) in enumerate(todo) if not self.fast.path_proven(P[at[k]: at[k + 1] + 1])]
             if not todo:
                 self.counts["fast"] += 1
                 return True
