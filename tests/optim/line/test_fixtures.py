@@ -111,3 +111,16 @@ def test_fast_route_agrees_with_the_exact_check_and_bad_clearance_is_named():
         FixtureCheck(cell, "left", 0.0)
     with pytest.raises(InvalidInput, match="not an arm of cell"):
         build_task_map(Station("middle", st.robot, st.base_to_world, st.place), belt, cell=cell, **GRID)
+
+
+@pytest.mark.slow
+def test_run_line_with_a_cell_builds_maps_against_it_and_reports_the_count(blocked_line):
+    cell, belt, st, before, after = blocked_line
+    spec = LineSpec(belt, (st,), Stream("poisson", rate=20.0, duration=30.0, types=(ENOKI,)), seeds=(0,),
+                    map_grid=(6, 3), cell=cell, clearance=CLEARANCE)
+    result = run_line(spec)
+    (m,) = result.maps["left"]
+    assert result.fixture_infeasible == {"left": m.fixture_infeasible}
+    assert m.fixture_infeasible >= 1  # the block takes nodes of this grid too
+    assert result.as_dict()["fixture_infeasible"] == {"left": m.fixture_infeasible}
+    assert run_line(LineSpec(belt, (st,), spec.stream, seeds=(0,)), maps=result.maps).fixture_infeasible == {}
