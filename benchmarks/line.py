@@ -17,7 +17,15 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
    each place on both elbows; serial) and its error against exact pick-to-tray planning at 100
    random (pick, place) points.
 
-Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|all]
+6. ``fixtures``: the cost of the fixture clearance on map building: the left SCARA of
+   ``mushroom_line`` (its cell: belt, guards, table, box walls), 24 × 7 grid on both elbows, serial,
+   built without the cell, with it (compiled cover check where it proves, exact elsewhere) and with
+   the exact check alone; the counts of each route.
+7. ``neighbours``: the two facing SCARAs of ``mushroom_line``, 30 items/min Poisson for 120 s, first
+   in window, every start checked against the neighbour's ongoing pick: through the compiled cover
+   check where it proves (exact elsewhere) against the cell's exact check alone.
+
+Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|fixtures|neighbours|all]
 """
 
 from __future__ import annotations
@@ -245,8 +253,62 @@ def part_trays(grid=(10, 5, 8)) -> None:
     print("worst points (du, w, dv):", np.round(worst, 3).tolist())
 
 
+def _mushroom():
+    from pinarms.optim.line import Belt, PlaceBox, Station
+    from pinarms.robots.cell import load_cell
+
+    cell = load_cell("mushroom_line")
+    belt = Belt((-1.0, 0.0, 0.80), speed=0.1, width=0.30, length=2.0)
+    st = [Station(n, cell.arm(n).robot, cell.arm(n).base_to_world, PlaceBox((0.22, s * 0.68, 0.93), f"{n} box"))
+          for n, s in (("left", 1.0), ("right", -1.0))]
+    return cell, belt, st
+
+
+def part_fixtures() -> None:
+    from pinarms.optim.line import TrackingSpec, build_task_map
+    from pinarms.optim.line.fixtures import _CHECKS, fixture_check
+
+    cell, belt, st = _mushroom()
+    kw = dict(mass=0.15, item_height=0.04, nu=24, nw=7)
+    print("[fixtures] mushroom_line's left SCARA, 24 x 7 grid on both elbows, clearance 10 mm, serial")
+    for label in ("no cell", "fast + exact", "exact alone", "no cell", "fast + exact", "exact alone"):
+        _CHECKS.clear()
+        if label == "exact alone":
+            fixture_check(cell, "left", 0.01).fast = None
+        t = time.perf_counter()
+        m = build_task_map(st[0], belt, TrackingSpec(), cell=None if label == "no cell" else cell, clearance=0.01,
+                           **kw)
+        dt = time.perf_counter() - t
+        check = None if label == "no cell" else fixture_check(cell, "left", 0.01)
+        extra = "" if check is None else f"   checks {check.seconds:5.1f} s   {check.counts}"
+        print(f"  {label:13s} {dt:6.1f} s   feasible nodes {int(np.isfinite(m.branch_approach).sum())}"
+              f"   fixture-infeasible {m.fixture_infeasible}{extra}")
+
+
+def part_neighbours() -> None:
+    from pinarms.optim.line import ItemType, TrackingSpec, build_task_map, poisson_items, simulate
+    from pinarms.optim.line.neighbours import NeighbourGuard
+    from pinarms.optim.line.simulate import SimArm
+
+    cell, belt, st = _mushroom()
+    enoki = ItemType("enoki bunch", 0.15, (0.12, 0.06, 0.04))
+    maps = {s.name: (build_task_map(s, belt, TrackingSpec(), mass=0.15, item_height=0.04, nu=12, nw=5),) for s in st}
+    arms = [SimArm(s.name, float(belt.to_belt(s.base_to_world[:3, 3])[0]), maps[s.name]) for s in st]
+    items = poisson_items(belt, 0.5, 120.0, types=(enoki,), seed=3)
+    print(f"[neighbours] mushroom_line's two facing SCARAs, 30 items/min Poisson, 120 s: {len(items)} items")
+    for fast in (True, False, True, False):
+        guard = NeighbourGuard(cell, st, belt, TrackingSpec(), (enoki,), clearance=0.01,
+                               maps={a.name: a.maps for a in arms}, yaws=items.yaw)
+        guard.fast = fast
+        t = time.perf_counter()
+        r = simulate(arms, items, belt.speed, "first", duration=120.0, width=belt.width, guard=guard)
+        dt = time.perf_counter() - t
+        print(f"  {'fast + exact' if fast else 'exact alone':13s} {dt:6.2f} s   picks {int((r.picked_by >= 0).sum())}"
+              f"   checks {guard.checks}   {guard.counts if fast else ''}")
+
+
 PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,
-         "sizing": part_sizing, "trays": part_trays}
+         "sizing": part_sizing, "trays": part_trays, "fixtures": part_fixtures, "neighbours": part_neighbours}
 
 if __name__ == "__main__":
     which = sys.argv[1] if len(sys.argv) > 1 else "all"

@@ -70,7 +70,9 @@ class LineSpec:
     ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`robots.cell.Cell` whose arms
     are the stations (same names and bases) — then neighbours whose windows overlap start a pick
     only when the cell's continuous check proves it keeps ``clearance`` [m] from the neighbour's
-    (:mod:`~.neighbours`; the seeds then run in this process)."""
+    (:mod:`~.neighbours`; the seeds then run in this process), and every map node whose planned pick
+    comes closer than ``clearance`` to the cell's fixtures is infeasible (:mod:`~.fixtures`; the maps
+    are then built per station, its place along the belt mattering)."""
 
     belt: Belt
     stations: tuple[Station, ...]
@@ -129,7 +131,9 @@ def _tray_option(trays: Any, names: list) -> dict | None:
 class LineResult:
     """The line's answer: ``status`` (:data:`STATUSES`), ``figures`` (:class:`LineFigures`),
     ``windows`` (each arm's :class:`PickWindow`), ``overlapping`` (neighbour pairs whose
-    windows overlap), ``runs`` (one :class:`SimResult` per seed), ``maps`` (per station)."""
+    windows overlap), ``runs`` (one :class:`SimResult` per seed), ``maps`` (per station);
+    ``fixture_infeasible``: per station, its maps' nodes closer than the clearance to the cell's
+    fixtures (empty without a cell)."""
 
     status: str
     figures: LineFigures
@@ -138,10 +142,12 @@ class LineResult:
     runs: tuple[SimResult, ...] = field(repr=False)
     maps: dict = field(repr=False, default_factory=dict)
     belt_speed: float = 0.0
+    fixture_infeasible: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
                 "neighbour_checks": [list(r.checks) for r in self.runs],
+                "fixture_infeasible": dict(self.fixture_infeasible),
                 "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
 
 
@@ -161,28 +167,31 @@ def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = No
     take (:func:`~.tray_maps.build_tray_map` ``approach_map``)."""
     cache: dict = {} if known is None else known
     out = {}
+    near = {"cell": spec.cell, "clearance": spec.clearance}
     for st in spec.stations:
         trays = spec.trays_of(st.name)
+        # with a cell the fixtures differ along the belt: the station's own maps
+        own = () if spec.cell is None else (id(spec.cell), spec.clearance, tuple(np.round(st.base_to_world[:3, 3], 9)))
         if trays is not None:
             t = spec.stream.types[0]
             on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
             fine = (approach_maps or {}).get(st.name, (None,))[0]
             key = (_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
-                   spec.tray_grid, id(fine))
+                   spec.tray_grid, id(fine), own)
             if key not in cache:
                 from pinarms.optim.line.tray_maps import build_tray_map
 
                 nu, nw, nv = spec.tray_grid
                 cache[key] = build_tray_map(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine)
+                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine, **near)
             out[st.name] = (cache[key],)
             continue
         maps = []
         for t in spec.stream.types:
-            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid)
+            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own)
             if key not in cache:
                 cache[key] = build_task_map(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler)
+                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler, **near)
             maps.append(cache[key])
         out[st.name] = tuple(maps)
     return out
@@ -233,7 +242,9 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None)
     ordered = sorted(windows, key=lambda w: w.u_base)
     overlapping = tuple((a.station, b.station) for a, b in zip(ordered, ordered[1:]) if windows_overlap(a, b))
     status = STATUSES[0] if figures.miss_rate <= spec.target_miss_rate else STATUSES[1]
-    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed)
+    blocked = ({} if spec.cell is None else
+               {st.name: sum(int(getattr(m, "fixture_infeasible", 0)) for m in maps[st.name]) for st in spec.stations})
+    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed, blocked)
 
 
 def _pick_part(m: Any) -> TaskMap:

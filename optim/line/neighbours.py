@@ -3,9 +3,10 @@
 :class:`NeighbourGuard` is the ``guard`` of :func:`optim.line.simulate.simulate`. For two picks
 (one starting now, one under way at a neighbour) it plans both exactly
 (:func:`optim.line.tracking.plan_pick`, cached per arm and item), places each on the cell's
-clock so that its rendezvous is at the simulated rendezvous time, and runs
-:meth:`robots.cell.Cell.check_motion` over the time both move, at the clearance asked (arm–arm
-and arm–fixture pairs, continuously in time). The stations must be arms of the cell (same
+clock so that its rendezvous is at the simulated rendezvous time, and proves them over the time
+both move at the clearance asked (arm–arm and arm–fixture pairs, continuously in time): the compiled
+cover check (:func:`optim.motion.fast_check`) where it proves, :meth:`robots.cell.Cell.check_motion`
+otherwise (:class:`~.fixtures.PairCheck`). The stations must be arms of the cell (same
 names, same bases). A pick that exact planning cannot make (near the edge of the window, where
 the map interpolates feasibility) is not proven clear: the guard says no.
 """
@@ -27,7 +28,8 @@ __all__ = ["NeighbourGuard"]
 
 class NeighbourGuard:
     """Whether two neighbours' picks keep ``clearance`` [m] (module doc); ``margin`` [m] sets
-    the check's time step. ``checks`` counts the continuous checks run."""
+    the check's time step. ``checks`` counts the continuous checks run; ``counts``: of those, proven
+    by the fast route, sent to the exact one, found not clear."""
 
     def __init__(self, cell: Any, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
                  types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01,
@@ -46,6 +48,16 @@ class NeighbourGuard:
         self.maps = maps or {}  # {station: task maps}: each pick on the IK branch its map chose
         self.yaws = None if yaws is None else np.asarray(yaws, float)  # per item [rad]: the hand turns to it
         self.checks = 0
+        self._pairs: dict = {}
+        self.fast = True  #: False: every check through the cell's exact continuous check alone
+
+    @property
+    def counts(self) -> dict[str, int]:
+        out = {"fast": 0, "exact": 0, "blocked": 0}
+        for p in self._pairs.values():
+            for k in out:
+                out[k] += p.counts[k]
+        return out
 
     def _plan(self, pick: tuple) -> Any:
         name, item, _, meet, u, w, kind = pick
@@ -77,5 +89,12 @@ class NeighbourGuard:
             return True
         motions = [ArmMotion(pick[0], a.trajectory, off_a), ArmMotion(other[0], b.trajectory, off_b)]
         self.checks += 1
-        res = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance, window=(t0, t1))
-        return bool(res.clear if self.clearance > 0 else res.collision_free)
+        if not self.fast:
+            res = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance, window=(t0, t1))
+            return bool(res.clear if self.clearance > 0 else res.collision_free)
+        key = (pick[0], other[0])
+        if key not in self._pairs:
+            from pinarms.optim.line.fixtures import PairCheck
+
+            self._pairs[key] = PairCheck(self.cell, key, self.clearance)
+        return self._pairs[key].clear(motions, (t0, t1), self.margin)

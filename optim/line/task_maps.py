@@ -44,7 +44,8 @@ class TaskMap:
     ``leave`` (nu, nw) [s] (NaN: infeasible; the fastest branch at each node); ``track``,
     ``release`` [s]; ``speed`` [m/s] and ``mass`` [kg] it was built for; ``build_seconds``;
     ``branches`` (nb,) IK branch labels and ``branch_approach``, ``branch_leave`` (nb, nu, nw)
-    the times on each branch (None: one branch, ``approach`` and ``leave``)."""
+    the times on each branch (None: one branch, ``approach`` and ``leave``); ``fixture_infeasible``:
+    grid nodes (over branches) planned but closer than the clearance to the cell's fixtures."""
 
     station: str
     du: np.ndarray
@@ -59,6 +60,7 @@ class TaskMap:
     branches: tuple[int, ...] = (-1,)
     branch_approach: np.ndarray | None = field(default=None, repr=False)
     branch_leave: np.ndarray | None = field(default=None, repr=False)
+    fixture_infeasible: int = 0
 
     def __post_init__(self) -> None:
         A = self.approach[None] if self.branch_approach is None else np.asarray(self.branch_approach, float)
@@ -162,7 +164,8 @@ class TaskMap:
             np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
                      scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
                      station=np.array(self.station), branches=np.array(self.branches, dtype=np.int64),
-                     branch_approach=self._A, branch_leave=self._C)
+                     branch_approach=self._A, branch_leave=self._C,
+                     fixture_infeasible=np.array(self.fixture_infeasible, dtype=np.int64))
 
         return atomic_write(path, write)
 
@@ -175,6 +178,8 @@ class TaskMap:
                 extra = ({"branches": tuple(int(b) for b in z["branches"].ravel()),
                           "branch_approach": z["branch_approach"], "branch_leave": z["branch_leave"]}
                          if "branches" in z.files else {})
+                if "fixture_infeasible" in z.files:
+                    extra["fixture_infeasible"] = int(z["fixture_infeasible"])
         except (OSError, KeyError, ValueError, TypeError) as exc:
             raise InvalidInput(f"{path}: not a task map file ({exc})") from None
         if a.shape != (du.size, w.size) or c.shape != a.shape or s.shape != (5,):
@@ -215,12 +220,24 @@ def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: in
             *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
 
 
-def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
-    """Exact times of one ``du`` column (a task of the execution layer)."""
+def _fixtures(task: dict) -> Any:
+    """The column's :class:`~.fixtures.FixtureCheck` (None: no cell given)."""
+    if task.get("cell") is None:
+        return None
+    from pinarms.optim.line.fixtures import fixture_check
+
+    return fixture_check(task["cell"], task["station"].name, task["clearance"])
+
+
+def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int]:
+    """Exact times of one ``du`` column (a task of the execution layer), and how many of its
+    planned picks came closer than the clearance to the cell's fixtures (their times NaN)."""
     st, belt, spec = task["station"], task["belt"], task["spec"]
     u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
     labels = task.get("branches", (-1,))
+    fixtures = _fixtures(task)
+    blocked = 0
     tA = np.full((len(labels), len(task["w"])), np.nan)
     tC = np.full_like(tA, np.nan)
     for b, label in enumerate(labels):
@@ -230,14 +247,19 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray]:
                                  q_rest=q_rest, branch=None if label < 0 else label)
             except (UnreachableTarget, InfeasibleProblem, OptimError):
                 continue
+            verdict = "clear" if fixtures is None else fixtures.verdict(plan.trajectory)
+            if verdict != "clear":
+                blocked += verdict == "fixtures"
+                continue
             tA[b, j], tC[b, j] = plan.times[0], plan.times[2]
-    return tA, tC
+    return tA, tC, blocked
 
 
 def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
                    item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
                    du_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   progress: Any = None, refine: int = 0, tolerance: float = 0.005) -> TaskMap:
+                   progress: Any = None, refine: int = 0, tolerance: float = 0.005, cell: Any = None,
+                   clearance: float = 0.01) -> TaskMap:
     """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
 
     ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
@@ -247,6 +269,9 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
     between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
     Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
+    ``cell``: a :class:`robots.cell.Cell` with the station as one of its arms (same name and base):
+    a node whose planned pick (the whole trajectory) comes closer than ``clearance`` [m] to the
+    cell's fixtures is infeasible (:mod:`~.fixtures`; counted in ``TaskMap.fixture_infeasible``).
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
@@ -258,6 +283,11 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
         raise InvalidInput(f"nu and nw must be integers >= 2, got {nu!r}, {nw!r}")
     check_reach(station, belt, item_height)
     rest_configuration(station)
+    if cell is not None:
+        from pinarms.optim.line.fixtures import check_in_cell, fixture_check
+
+        check_in_cell(cell, station)
+        fixture_check(cell, station.name, clearance)  # bad clearance: an error before any planning
     start = time.perf_counter()
     lo, hi = belt_span(station, belt) if du_range is None else (float(du_range[0]), float(du_range[1]))
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
@@ -271,8 +301,9 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     uu, ww = np.meshgrid(u_base + du, w, indexing="ij")
     labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), item_height + spec.lift))
     task = {"station": station, "belt": belt, "spec": spec, "w": w.tolist(), "mass": mass, "height": item_height,
-            "seed": 0, "branches": labels}
+            "seed": 0, "branches": labels, "cell": cell, "clearance": clearance}
     cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler, progress=progress)
+    blocked = sum(c[2] for c in cols)
     A = np.stack([c[0] for c in cols], axis=1)  # (nb, nu, nw)
     C = np.stack([c[1] for c in cols], axis=1)
     extra = spec.track_time + spec.release
@@ -281,11 +312,13 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
         if new_u.size:
             cols = map_chunks(_column, [{**task, "du": float(d), "w": w.tolist()} for d in new_u], scheduler=scheduler,
                               progress=progress)
+            blocked += sum(c[2] for c in cols)
             du, A, C = _merge(du, new_u, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 1)
         new_w = _refine_at(w, A, C, extra, tolerance, 2)
         if new_w.size:
             cols = map_chunks(_column, [{**task, "du": float(d), "w": new_w.tolist()} for d in du], scheduler=scheduler,
                               progress=progress)
+            blocked += sum(c[2] for c in cols)
             w, A, C = _merge(w, new_w, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 2)
         if new_u.size == 0 and new_w.size == 0:
             break
@@ -294,7 +327,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     tA = np.take_along_axis(A, best, 0)[0]
     tC = np.take_along_axis(C, best, 0)[0]
     return TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start, labels, A, C)
+                   time.perf_counter() - start, labels, A, C, int(blocked))
 
 
 @dataclass(frozen=True)

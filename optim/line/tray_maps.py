@@ -33,7 +33,7 @@ import numpy as np
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_maps import MapError, TaskMap
+from pinarms.optim.line.task_maps import MapError, TaskMap, _fixtures
 from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
@@ -71,6 +71,7 @@ class TrayMap:
     branches: tuple[int, ...] = (-1,)
     pick_branch: np.ndarray | None = None  #: (nu, nw) the pick's IK branch label at each node (None: one)
     approach_map: Any = None  #: a finer source of t_A: the same station's box :class:`TaskMap` (module doc)
+    fixture_infeasible: int = 0  #: nodes planned but closer than the clearance to the cell's fixtures
 
     def __post_init__(self) -> None:
         shape = (len(self.branches), self.du.size, self.w.size, self.dv.size)
@@ -201,6 +202,8 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
     nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
+    fixtures = _fixtures(task)
+    blocked = 0
     A, P = np.full(nw, np.nan), np.full(nw, -1)
     X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
     for j, w in enumerate(task["w"]):
@@ -217,9 +220,13 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                                           place_branch=None if label < 0 else label, pick=pick)
                 except (UnreachableTarget, InfeasibleProblem, OptimError):
                     continue
+                verdict = "clear" if fixtures is None else fixtures.verdict(p.trajectory)
+                if verdict != "clear":
+                    blocked += verdict == "fixtures"
+                    continue
                 A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
                 P[j] = _branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
-    return A, X, R, P
+    return A, X, R, P, blocked
 
 
 #: Half-width [m] of the place-grid cells around the place ending at the arm's home (:func:`_with_home_nodes`).
@@ -246,11 +253,13 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
                    mass: float = 0.1, item_height: float = 0.04, margin: float = 0.025, nu: int = 10, nw: int = 3,
                    nv: int = 8, du_range: tuple[float, float] | None = None,
                    dv_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   approach_map: TaskMap | None = None) -> TrayMap:
+                   approach_map: TaskMap | None = None, cell: Any = None, clearance: float = 0.01) -> TrayMap:
     """Plan picks placed in trays exactly on a ``nu`` × ``nw`` × ``nv`` grid (module doc); ``du``
     and ``dv`` span the arm's sampled workspace over each belt (or the ranges given [m]).
     ``approach_map``: the same station's box :class:`TaskMap` on this belt (same speed and
     tracking spec; any item mass: the approach carries none), whose finer grid then gives t_A.
+    ``cell``, ``clearance``: as :func:`~.task_maps.build_task_map`'s (the whole pick-to-tray
+    trajectory kept ``clearance`` [m] from the cell's fixtures; ``TrayMap.fixture_infeasible``).
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the item belt or of the tray belt (names the arm).
@@ -266,6 +275,11 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     check_reach(station, belt, item_height)
     check_reach(station, trays.belt, trays.height)
     rest_configuration(station)
+    if cell is not None:
+        from pinarms.optim.line.fixtures import check_in_cell, fixture_check
+
+        check_in_cell(cell, station)
+        fixture_check(cell, station.name, clearance)
     start = time.perf_counter()
     lo, hi = belt_span(station, belt) if du_range is None else du_range
     vlo, vhi = belt_span(station, trays.belt) if dv_range is None else dv_range
@@ -278,13 +292,13 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     vv, zz = np.meshgrid(v_base + dv, np.linspace(-trays.belt.width / 2.0, trays.belt.width / 2.0, 3), indexing="ij")
     labels = ik_branch_labels(station, trays.belt.to_world(vv.ravel(), zz.ravel(), trays.height + spec.lift))
     task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
-            "mass": mass, "height": item_height, "seed": 0, "branches": labels}
+            "mass": mass, "height": item_height, "seed": 0, "branches": labels, "cell": cell, "clearance": clearance}
     cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler)
     A, P = np.stack([c[0] for c in cols]), np.stack([c[3] for c in cols])
     X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
     place = spec.descend + spec.release + spec.descend
     return TrayMap(station.name, du, w, dv, A, X, R, spec.track_time, place, belt.speed, trays.belt.speed,
-                   float(mass), time.perf_counter() - start, labels, P, approach_map)
+                   float(mass), time.perf_counter() - start, labels, P, approach_map, sum(c[4] for c in cols))
 
 
 def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayBelt,

@@ -26,7 +26,7 @@ import numpy as np
 from pinarms import robots
 from pinarms.optim.line import (Belt, ItemType, LineSpec, PlaceBox, Rule, Station, Stream, TaskMap, TrackingSpec,
                                 base_pose, build_task_map, map_error, run_line)
-from pinarms.optim.line.api import _shape_key
+from pinarms.optim.line.api import _shape_key, build_maps
 
 __all__ = ["ENOKI", "FLOWER", "PAPER_J1_DEG_S", "scara_line", "gantry_line", "maps_for", "arms_needed",
            "max_flow", "DATA"]
@@ -74,7 +74,13 @@ def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
 
 
 def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Any = None) -> dict:
-    """Task maps of every station of ``spec`` from :data:`DATA` (built when missing and ``build``)."""
+    """Task maps of every station of ``spec`` from :data:`DATA` (built when missing and ``build``).
+    A spec with a cell gets maps built against the cell's fixtures (:func:`optim.line.build_maps`;
+    not stored: they hold for that cell only)."""
+    if spec.cell is not None:
+        if not build:
+            raise FileNotFoundError("maps against a cell's fixtures are built, never stored: pass build=True")
+        return build_maps(spec)
     out, cache = {}, {}
     for st in spec.stations:
         maps = []
