@@ -41,10 +41,12 @@ from pinarms.planning.joint_path import JointPath
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
-           "TRACK_SAMPLES"]
+           "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError"]
 
 #: IK instants per tracking segment (spline knots).
 TRACK_SAMPLES = 41
+#: How far [rad or m] a planned joint trajectory's exact extrema may pass the position limits.
+POSITION_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -251,6 +253,25 @@ def _check_limits(station: Station, traj: Trajectory, what: str) -> None:
                                 "velocity or acceleration limit (belt too fast here)")
 
 
+class PositionLimitError(InfeasibleProblem):
+    """A planned move's joint trajectory leaves the arm's position limits (an infeasible pick)."""
+
+
+def _check_positions(station: Station, traj: Trajectory, what: str) -> None:
+    """Raise :class:`PositionLimitError` where the exact extrema of ``traj`` leave the position
+    limits by more than :data:`POSITION_TOL` (never clamps)."""
+    lo, hi = traj.position_range()
+    robot = station.robot
+    over = np.flatnonzero((lo < robot.lower - POSITION_TOL) | (hi > robot.upper + POSITION_TOL))
+    if over.size:
+        j = int(over[0])
+        value = lo[j] if lo[j] < robot.lower[j] - POSITION_TOL else hi[j]
+        raise PositionLimitError(
+            f"arm {station.name!r}: the {what} takes joint {j + 1} ({robot.joint_names[j]}) to {value:.6g}, "
+            f"outside its position limits [{robot.lower[j]:.6g}, {robot.upper[j]:.6g}]: no pick here on this "
+            "IK branch (try another branch, or move the arm or its box)")
+
+
 def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, *,
               item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None, branch: int | None = None,
               yaw: float = 0.0) -> PickPlan:
@@ -259,26 +280,53 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
     ``branch``: the closed-form IK branch of the tracking segment (:func:`ik_branch_labels`; what a
     task map chose there, :meth:`optim.line.TaskMap.branch_at`); None: the rest configuration's
-    branch where it reaches the pre-grasp point, else the nearest solution. ``yaw`` [rad]: the
+    branch where it reaches the pre-grasp point, else the nearest solution; when that plan leaves the
+    position limits, the other branches reaching the pre-grasp point are tried in label order and
+    the first within them is returned. ``yaw`` [rad]: the
     item's yaw on the belt; the hand turns to :func:`tool_yaw` for the whole tracking segment.
 
     Raises:
         UnreachableTarget: a point of the tracking segment or the box out of reach.
-        InfeasibleProblem: the belt is too fast for the arm there, or a move cannot meet its limits.
+        InfeasibleProblem: the belt is too fast for the arm there, a move cannot meet its limits, or
+            the planned joint trajectory leaves the arm's position limits (:data:`POSITION_TOL`) on
+            every IK branch tried.
     """
     robot = station.robot
     q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
-    n = TRACK_SAMPLES
-    tau = np.linspace(0.0, spec.track_time, n)
+    tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
     p = tracking_points(belt, spec, u_pre, w, item_height, tau)
-    q = _ik_path(station, _poses(station, p, tool_yaw(station, spec, yaw)), q_rest, branch)
+    poses = _poses(station, p, tool_yaw(station, spec, yaw))
+    args = (station, belt, spec, u_pre, w, poses, mass, q_rest)
+    try:
+        return _plan_on_branch(*args, branch)
+    except PositionLimitError as exc:
+        if branch is not None or not robot.has_analytic_ik:
+            raise
+        first = exc
+    for label in ik_branch_labels(station, p[:1]):  # the other branches at the pre-grasp point
+        try:
+            return _plan_on_branch(*args, label)
+        except (UnreachableTarget, InfeasibleProblem):
+            continue
+    raise first
+
+
+def _plan_on_branch(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, poses: np.ndarray,
+                    mass: float, q_rest: np.ndarray, branch: int | None) -> PickPlan:
+    """:func:`plan_pick` on one IK branch (None: as :func:`_ik_path` chooses), position limits checked."""
+    robot = station.robot
+    tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
+    q = _ik_path(station, poses, q_rest, branch)
     qd_in = _joint_rates(station, q[0], belt.velocity)
     qd_out = _joint_rates(station, q[-1], belt.velocity)
     spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
     tracking = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
     _check_limits(station, tracking, "tracking segment")
+    _check_positions(station, tracking, "tracking segment")
     approach = _timed_move(station, q_rest, np.zeros(robot.nq), q[0], qd_in, 0.0, spec.grid)
+    _check_positions(station, approach.trajectory, "approach move")
     leave = _timed_move(station, q[-1], qd_out, q_rest, np.zeros(robot.nq), mass, spec.grid)
+    _check_positions(station, leave.trajectory, "leave move")
     tA = float(approach.duration)
     times = (tA, spec.track_time, float(leave.duration), spec.release)
     return PickPlan(station.name, float(u_pre), float(w), approach, tracking, leave, q_rest,

@@ -94,3 +94,29 @@ def test_gantry_cannot_turn_its_tool():
     assert not can_yaw(station.robot) and tool_yaw(station, TrackingSpec(), 1.0) == 0.0
     with pytest.raises(InvalidInput, match="yaw_period"):
         TrackingSpec(yaw_period=0.0)
+
+
+def _sampled_out_of_limits(robot, traj, dt=1e-3):
+    """Largest excursion [rad or m] of the trajectory sampled every ``dt`` s past the position limits."""
+    q = np.asarray(traj.sample(np.arange(traj.start_time, traj.end_time, dt))[0])
+    return float(np.max(np.maximum(robot.lower - q, q - robot.upper)))
+
+
+def test_a_pick_beyond_the_position_limits_is_infeasible_and_the_other_branch_is_taken():
+    """``mushroom_line``'s left SCARA, pre-grasp point 0.125 m off the belt's centre line at its base:
+    on IK branch 0 the approach swings joint 1 past its -140° limit (found by sampling the planned
+    trajectory every 1 ms); that branch is infeasible and the default plan is branch 1, within limits."""
+    from pinarms.optim.errors import InfeasibleProblem
+    from pinarms.optim.line.tracking import PositionLimitError
+    from pinarms.robots.cell import load_cell
+
+    cell = load_cell("mushroom_line")
+    belt = Belt((-1.0, 0.0, 0.80), speed=0.1, width=0.30, length=2.0)
+    st = Station("left", cell.arm("left").robot, cell.arm("left").base_to_world, PlaceBox((0.22, 0.68, 0.93), "box"))
+    robot = st.robot
+    with pytest.raises(PositionLimitError, match=r"approach move takes joint 1 .*outside its position limits"):
+        plan_pick(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15, branch=0)
+    assert issubclass(PositionLimitError, InfeasibleProblem)  # the maps' NaN node, as any infeasible pick
+    plan = plan_pick(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15)
+    assert _sampled_out_of_limits(robot, plan.trajectory) <= 1e-9
+    assert plan.approach.trajectory.sample(plan.times[0])[0][1] < 0.0  # elbow the other way (branch 1)

@@ -138,7 +138,9 @@ def tray_scene(scara_line):
     trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.3, capacity=2, height=0.02)
     from pinarms.optim.line.tray_maps import build_tray_map
 
-    tm = build_tray_map(station, belt, trays, mass=0.1, nu=2, nw=2, nv=3, margin=0.1, du_range=(0.0, 0.1),
+    # du from 0.05 m: at du = 0, w = 0.05 m the rest elbow's approach swings joint 1 past its limit
+    # (plan_pick takes the other elbow there, and a cell on two elbows holds no pick)
+    tm = build_tray_map(station, belt, trays, mass=0.1, nu=2, nw=2, nv=3, margin=0.1, du_range=(0.05, 0.1),
                         dv_range=(0.05, 0.25))
     return belt, station, trays, tm
 
