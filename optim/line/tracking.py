@@ -48,6 +48,10 @@ TRACK_SAMPLES = 41
 #: How far [rad or m] a planned joint trajectory's exact extrema may pass the position limits.
 POSITION_TOL = 1e-9
 
+#: Version of the pick planner: stored task maps are keyed on it (raise it when a plan changes,
+#: e.g. 2: picks leaving the joint position limits are infeasible), so none built before is reused.
+PLAN_VERSION = 2
+
 
 @dataclass(frozen=True)
 class TrackingSpec:

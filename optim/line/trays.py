@@ -32,7 +32,7 @@ from scipy.interpolate import CubicSpline
 from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_limits, _constraints, _hand_joints,
-                                         _hermite, _ik_path, _joint_rates, _poses, _timed_move, plan_pick,
+                                         _check_positions, _hermite, _ik_path, _joint_rates, _poses, _timed_move, plan_pick,
                                          rest_configuration, tool_yaw, tracking_points)
 from pinarms.planning import Trajectory
 from pinarms.optim.errors import InfeasibleProblem, OptimError
@@ -231,6 +231,9 @@ def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: Track
                                        spec.grid)
             q_last = place.sample(np.array([place.end_time]))[0][0]
             ret = _timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
+            for piece, what in ((place, "place tracking segment"), (transfer.trajectory, "transfer to the tray"),
+                                (ret.trajectory, "return from the tray")):
+                _check_positions(station, piece, what)
         except (InfeasibleProblem, OptimError) as exc:
             error = exc
             continue

@@ -59,7 +59,8 @@ def test_tray_belt_input():
 def test_place_hand_takes_the_short_turn_home():
     # the CLI's tray scene: beside w = 0.0625 m the nearest-solution IK put the place's hand a whole
     # turn away (q4 -3.40 against 2.88 rad, the same pose) and the return home took 1.12 s against
-    # 0.34 s; now both points end within half a turn of home and return alike
+    # 0.34 s; now both points end within half a turn of home and return alike. (That place, 0.391 m
+    # upstream, is now infeasible: its transfer takes joint 1 past its limit; 0.35 m is checked.)
     from pinarms.optim.line.tracking import rest_configuration
     from pinarms.optim.line.trays import _hand_turn, plan_pick_to_tray, trays_beside
     from pinarms.studies.line import scara_line
@@ -71,7 +72,7 @@ def test_place_hand_takes_the_short_turn_home():
     q_rest = rest_configuration(st)
     back, q4 = [], []
     for w in (0.0625, 0.125):
-        p = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, w, u0 - 0.391, item_height=0.04,
+        p = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, w, u0 - 0.35, item_height=0.04,
                               mass=0.1, q_rest=q_rest, place_branch=0)
         back.append(p.times[4])
         q4.append(p.pieces[3].sample(np.array([p.pieces[3].end_time]))[0][0, 3])
@@ -102,3 +103,24 @@ def test_place_time_has_no_jump_where_the_hand_turn_switches():
     t = [sum(plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.038, -0.02, u0 + dv, item_height=0.04,
                                mass=0.1, q_rest=q_rest, place_branch=0).times[2::2]) for dv in (0.19, 0.2, 0.21)]
     assert abs(t[1] - t[0]) < 0.03 and abs(t[2] - t[1]) < 0.03
+
+
+def test_a_tray_place_whose_transfer_leaves_the_joint_limits_is_infeasible():
+    # the CLI's tray scene, place 0.391 m upstream: the transfer's cubic Hermite swings joint 1 to
+    # 2.517 rad against its 2.443 rad limit (found at the trajectory's exact extrema); no clamping
+    from pinarms.optim.line.tracking import PositionLimitError, rest_configuration
+    from pinarms.optim.line.trays import plan_pick_to_tray, trays_beside
+    from pinarms.studies.line import scara_line
+
+    spec = scara_line(1, 10.0)
+    st, belt = spec.stations[0], spec.belt
+    trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
+    u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
+    with pytest.raises(PositionLimitError, match=r"transfer to the tray takes joint 1 .* outside its position limits"):
+        plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, 0.0625, u0 - 0.391, item_height=0.04,
+                          mass=0.1, q_rest=rest_configuration(st), place_branch=0)
+    ok = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, 0.0625, u0 - 0.35, item_height=0.04,
+                           mass=0.1, q_rest=rest_configuration(st), place_branch=0)
+    t = np.linspace(ok.pieces[2].start_time, ok.pieces[2].end_time, 2001)
+    q = ok.pieces[2].sample(t)[0]
+    assert np.all(q >= st.robot.lower - 1e-9) and np.all(q <= st.robot.upper + 1e-9)
