@@ -26,7 +26,7 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 from pinarms.robots.cell import _cover_kernel
-from pinarms.robots.cell._cover_kernel import excess_one, excess_scaled
+from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_scaled
 
 # these kernels call the cover's: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
@@ -53,19 +53,13 @@ def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
     """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0).
 
     ``q``: scratch cell configuration ``(nq,)``, or ``(nq + 1,)`` whose last entry counts the calls."""
-    n = hold.shape[0]
-    if q.shape[0] > n:
-        q[n] += 1.0
-    for i in range(n):
-        q[i] = hold[i]
-    for j in range(cols.shape[0]):
-        q[cols[j]] = x[j]
-    return excess_one(q, fk, cov, grp, cap, 0.0, work)
+    return state_scaled(x, UNWEIGHTED, hold, cols, fk, cov, grp, cap, work, q)
 
 
 @jit
 def state_scaled(x, inv, hold, cols, fk, cov, grp, cap, work, q):
-    """``Ẽ(x)``: the scaled excess at planned state ``x`` with group weights ``1 / inv`` (early out below 0)."""
+    """``Ẽ(x)``: the scaled excess at planned state ``x`` with group weights ``1 / inv`` (early out below 0;
+    ``inv`` empty: the excess itself, :func:`state_excess`)."""
     n = hold.shape[0]
     if q.shape[0] > n:
         q[n] += 1.0

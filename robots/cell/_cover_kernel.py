@@ -176,11 +176,8 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
     SB = np.empty((sjoint.shape[0], 3))
     HW = np.empty((hjoint.shape[0], 3))
     for i in range(Q.shape[0]):
-        _fk(Q[i], parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
-        _centers(R, p, joint, center, W)
-        _centers(R, p, sjoint, sa_local, SA)
-        _centers(R, p, sjoint, sb_local, SB)
-        _centers(R, p, hjoint, hcenter, HW)
+        _place(Q[i], (parent, index, scale, offset, revolute, axis, MR, Mp), joint, center, sjoint, sa_local, sb_local,
+               hjoint, hcenter, (R, p, W, SA, SB, HW))
         ok = True
         for g in range(group_t.shape[0]):
             if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
@@ -291,6 +288,23 @@ def _hd(HW, hrad, a, b):
 
 
 @jit
+def _place(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work):
+    """Forward kinematics of cell configuration ``q`` and the world centres of the cover's spheres,
+    its cylinders' axis ends and the bounding spheres, into ``work`` (:meth:`Cover.work`'s arrays)."""
+    parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    R, p, W, SA, SB, HW = work
+    _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
+    _centers(R, p, joint, center, W)
+    _centers(R, p, sjoint, sa_local, SA)
+    _centers(R, p, sjoint, sb_local, SB)
+    _centers(R, p, hjoint, hcenter, HW)
+
+
+#: No group weights: :func:`excess_scaled` then bounds the excess itself (every weight 1).
+UNWEIGHTED = np.empty(0)
+
+
+@jit
 def excess_one(q, fk, cov, grp, cap, floor, work):
     """A lower bound [m] of ``min_k (d_k − t_k)`` over the pairs of ``grp`` at cell configuration ``q``,
     at most ``cap``; it returns early (some value below ``floor``) once the bound falls below ``floor``.
@@ -298,35 +312,9 @@ def excess_one(q, fk, cov, grp, cap, floor, work):
     ``fk``: :meth:`Cover.fk`'s arrays; ``cov``: the cover's arrays (:meth:`Cover.kernel_arrays`);
     ``grp``: the pair groups (:meth:`Cover.group_arrays`) with the thresholds ``t`` in their order;
     ``work``: scratch arrays (:func:`excess_work`). The covers' distances are lower bounds of the
-    geometries' (the containment tests), so the result is a lower bound of the exact excess."""
-    parent, index, scale, offset, revolute, axis, MR, Mp = fk
-    joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
-    hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
-    R, p, W, SA, SB, HW = work
-    _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
-    _centers(R, p, joint, center, W)
-    _centers(R, p, sjoint, sa_local, SA)
-    _centers(R, p, sjoint, sb_local, SB)
-    _centers(R, p, hjoint, hcenter, HW)
-    best = cap
-    for g in range(group_t.shape[0]):
-        a = group_a[g]
-        if _hd(HW, hrad, a, group_b[g]) - group_t[g] >= best:
-            continue
-        fixed = group_fixed[g]
-        if fixed >= 0 and _shape_distance(HW[a], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) - hrad[a] \
-                - group_t[g] >= best:
-            continue
-        for k in range(group_start[g], group_start[g + 1]):
-            ga = pair_a[k]
-            gb = pair_b[k]
-            if _hd(HW, hrad, ga, gb) - t[k] >= best:
-                continue
-            best = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
-                                hrad, best)
-            if best < floor:
-                return best
-    return best
+    geometries' (the containment tests), so the result is a lower bound of the exact excess.
+    :func:`excess_scaled` without weights."""
+    return excess_scaled(q, fk, cov, grp, UNWEIGHTED, cap, floor, work)
 
 
 @jit
@@ -340,20 +328,17 @@ def excess_kernel(Q, fk, cov, grp, cap, floor, work, out):
 def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
     """:func:`excess_one` with the pairs of group ``g`` weighed by ``inv[g] > 0``: a lower bound of
     ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
-    proof's scaled excess (``inv``: one over each group's travel weight, :mod:`optim.motion.link_levers`)."""
-    parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    proof's scaled excess (``inv``: one over each group's travel weight, :mod:`optim.motion.link_levers`);
+    ``inv`` empty (:data:`UNWEIGHTED`): every weight 1, the excess itself (:func:`excess_one`)."""
     joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
     hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
-    R, p, W, SA, SB, HW = work
-    _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
-    _centers(R, p, joint, center, W)
-    _centers(R, p, sjoint, sa_local, SA)
-    _centers(R, p, sjoint, sb_local, SB)
-    _centers(R, p, hjoint, hcenter, HW)
+    _place(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work)
+    W, SA, SB, HW = work[2], work[3], work[4], work[5]
+    weighted = inv.shape[0] > 0
     best = cap
     for g in range(group_t.shape[0]):
         a = group_a[g]
-        s = inv[g]
+        s = inv[g] if weighted else 1.0
         if (_hd(HW, hrad, a, group_b[g]) - group_t[g]) * s >= best:
             continue
         fixed = group_fixed[g]
