@@ -186,6 +186,17 @@ def pose_cost(C, q, Rt, pt, posonly, R, p, Z, O):
     return d + ROT_WEIGHT * math.sqrt(f)
 
 
+@jit_inline
+def _row_rotation(tR, k, Rt):
+    """The rotation term of a start-table row's cost: ``0.1 m/rad · ‖R_k − R_t‖_F`` from the rows' flat
+    rotations ``tR (n, 9)`` (``‖A − B‖_F² = 6 − 2 tr(AᵀB)`` for two rotations)."""
+    dot = 0.0
+    for a in range(3):
+        for b in range(3):
+            dot += tR[k, 3 * a + b] * Rt[a, b]
+    return ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+
+
 @jit
 def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
     """Row of the start table whose pose is nearest ``(Rt, pt)`` (``‖Δp‖ + 0.1 m/rad · ‖ΔR‖_F``).
@@ -201,11 +212,7 @@ def table_index(tq, tp, tpp, tR, Rt, pt, posonly):
             continue
         c = math.sqrt(max(d2, 0.0))
         if not posonly:
-            dot = 0.0
-            for a in range(3):
-                for b in range(3):
-                    dot += tR[k, 3 * a + b] * Rt[a, b]
-            c += ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+            c += _row_rotation(tR, k, Rt)
         if c < best:
             best, k_best = c, k
             best2 = c * c
@@ -243,11 +250,7 @@ def grid_index(table, Rt, pt, posonly):
                         continue
                     c = math.sqrt(d2)
                     if not posonly:
-                        dot = 0.0
-                        for a in range(3):
-                            for b in range(3):
-                                dot += tR[k, 3 * a + b] * Rt[a, b]
-                        c += ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+                        c += _row_rotation(tR, k, Rt)
                     if c < best:
                         best, best2, k_best = c, c * c, k
     if k_best < 0:
@@ -277,11 +280,7 @@ def grid_neighbours(table, Rt, pt, posonly, count):
                 for k in range(cell_start[cell], cell_start[cell + 1]):
                     c = math.sqrt((tp[k, 0] - pt[0]) ** 2 + (tp[k, 1] - pt[1]) ** 2 + (tp[k, 2] - pt[2]) ** 2)
                     if not posonly:
-                        dot = 0.0
-                        for a in range(3):
-                            for b in range(3):
-                                dot += tR[k, 3 * a + b] * Rt[a, b]
-                        c += ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+                        c += _row_rotation(tR, k, Rt)
                     rows[n], cost[n] = k, c
                     n += 1
     order = np.argsort(cost, kind="mergesort")
