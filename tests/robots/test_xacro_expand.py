@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import ctypes
 import math
 import os
 import subprocess
@@ -27,24 +26,7 @@ from pinarms.robots.errors import (
 )
 from pinarms.robots.xacro_expand import XacroLimits, expand_xacro, parse_xacro_args
 
-HEAD = '<?xml version="1.0"?>\n<robot name="user_arm" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
-SECRET = "pinarms-secret-7f3a"
-
-SCARA_ON_PEDESTAL = HEAD + """
-  <xacro:arg name="height" default="0.75"/>
-  <xacro:arg name="prefix" default="cell_"/>
-  <xacro:include filename="$(find pinarms)/scara_mushroom.xacro"/>
-  <xacro:pinarms_materials/>
-  <link name="floor"/>
-  <xacro:scara_mushroom prefix="$(arg prefix)" parent="floor" xyz="0.1 0 $(arg height)" rpy="0 0 ${pi / 2}"/>
-</robot>
-"""
-
-
-def write(folder: Path, name: str, text: str) -> Path:
-    path = folder / name
-    path.write_text(text)
-    return path
+from tests.robots.xacro_files import HEAD, SCARA_ON_PEDESTAL, SECRET, write
 
 
 @pytest.fixture()
@@ -324,99 +306,6 @@ def test_allowed_xacro_features_still_work(tmp_path):
     text = expand_xacro(write(tmp_path, "ok.xacro", HEAD + body + "\n</robot>\n")).urdf_text
     assert '<link name="j2_1.2_0.22"/>' in text
     assert f'<link name="{round(math.pi / 2, 4)}_c_{math.pi}"/>' in text
-
-
-# ---- issue 29: the sandbox (the second wall) ---------------------------------------------------------
-
-PROBE = r"""
-import importlib.util, json, os, sys
-spec = importlib.util.spec_from_file_location("sandbox", sys.argv[1])
-sandbox = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sandbox)
-allowed, sibling = sys.argv[2], sys.argv[3]
-out = {"wall": sandbox.enter_wall([allowed])}
-def attempt(name, fn):
-    try:
-        fn()
-        out[name] = "done"
-    except OSError as exc:
-        out[name] = type(exc).__name__
-attempt("read_allowed", lambda: open(os.path.join(allowed, "part.txt")).read())
-attempt("list_allowed", lambda: os.listdir(allowed))
-attempt("read_sibling", lambda: open(os.path.join(sibling, "secret.txt")).read())
-attempt("read_passwd", lambda: open("/etc/passwd").read())
-attempt("create_file", lambda: open(os.path.join(allowed, "new.txt"), "w").close())
-attempt("create_dir", lambda: os.mkdir(os.path.join(allowed, "new_dir")))
-attempt("create_elsewhere", lambda: os.mkdir(os.path.join(os.path.dirname(allowed), "new_dir")))
-attempt("remove_file", lambda: os.unlink(os.path.join(allowed, "part.txt")))
-attempt("run_program", lambda: os.execv("/bin/true", ["/bin/true"]))
-sys.stdout.write(json.dumps(out))
-"""
-
-
-def test_code_inside_the_sandbox_writes_nothing_and_reads_only_the_allowed_folder(tmp_path):
-    from pinarms.robots.xacro_expand import _limit_resources
-
-    allowed, sibling = tmp_path / "cell", tmp_path / "other"
-    allowed.mkdir()
-    sibling.mkdir()
-    (allowed / "part.txt").write_text("part")
-    (sibling / "secret.txt").write_text(SECRET)
-    sandbox = Path(robots.__file__).resolve().parent / "_sandbox.py"
-    done = subprocess.run([sys.executable, "-I", "-B", "-c", PROBE, str(sandbox), str(allowed), str(sibling)],
-                          capture_output=True, text=True, timeout=60, env={},
-                          preexec_fn=_limit_resources(XacroLimits()))
-    assert done.returncode == 0, done.stderr
-    out = __import__("json").loads(done.stdout)
-    if not out["wall"].startswith("landlock"):
-        pytest.skip(f"this kernel has no Landlock (wall: {out['wall']})")
-    assert out.pop("wall").startswith("landlock (ABI ")
-    assert out == {"read_allowed": "done", "list_allowed": "done", "read_sibling": "PermissionError",
-                   "read_passwd": "PermissionError", "create_file": "PermissionError",
-                   "create_dir": "PermissionError", "create_elsewhere": "PermissionError",
-                   "remove_file": "PermissionError", "run_program": "PermissionError"}
-    assert sorted(p.name for p in tmp_path.rglob("*")) == ["cell", "other", "part.txt", "secret.txt"]
-
-
-FALLBACK = r"""
-import importlib.util, json, os, sys
-spec = importlib.util.spec_from_file_location("sandbox", sys.argv[1])
-sandbox = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sandbox)
-def no_landlock(roots):
-    raise OSError("Landlock is not available")
-sandbox._landlock = no_landlock
-out = {"wall": sandbox.enter_wall([sys.argv[2]]), "uid": os.getuid(), "gid": os.getgid()}
-try:
-    os.mkdir(os.path.join(sys.argv[2], "new_dir"))
-    out["create_dir"] = "done"
-except OSError as exc:
-    out["create_dir"] = type(exc).__name__
-sys.stdout.write(json.dumps(out))
-"""
-
-
-@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="the fallback drops root's privileges")
-def test_without_landlock_a_root_child_drops_to_nobody(tmp_path):
-    folder = tmp_path / "cell"
-    folder.mkdir(mode=0o755)
-    sandbox = Path(robots.__file__).resolve().parent / "_sandbox.py"
-    done = subprocess.run([sys.executable, "-I", "-B", "-c", FALLBACK, str(sandbox), str(folder)],
-                          capture_output=True, text=True, timeout=60, env={})
-    assert done.returncode == 0, done.stderr
-    assert __import__("json").loads(done.stdout) == {"wall": "user nobody (no Landlock)", "uid": 65534, "gid": 65534,
-                                                     "create_dir": "PermissionError"}
-    assert list(folder.iterdir()) == []
-
-
-def test_expansions_report_the_wall_they_ran_behind(tmp_path):
-    result = expand_xacro(write(tmp_path, "pedestal.xacro", SCARA_ON_PEDESTAL))
-    assert result.wall.startswith(("landlock", "user nobody", "resource limits only"))
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.syscall.restype = ctypes.c_long
-    abi = libc.syscall(ctypes.c_long(444), None, ctypes.c_size_t(0), ctypes.c_uint32(1))  # landlock_create_ruleset
-    if abi >= 1:  # the kernel offers Landlock: the child must be behind it
-        assert result.wall == f"landlock (ABI {abi})"
 
 
 # ---- issue 24 item 4: errors in included files --------------------------------------------------------
