@@ -42,8 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: floor (errors, execution layer, atomic files, units) may be imported by every package and
 #: imports none of them.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("floor", ("pinarms.execution", "pinarms.units", "pinarms.errors", "pinarms.files", "pinarms.compiled", "pinarms.atomic",
-               "pinarms.floor")),
+    ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.files", "pinarms.units", "pinarms.compiled")),
     ("robots", ("pinarms.robots", "pinarms.urdf")),
     ("planning", ("pinarms.planning",)),
     ("optim", ("pinarms.optim",)),

@@ -1,8 +1,10 @@
 """The one-way flow of the packages: robots → planning → optim → viz → pinarms (CLI, studies).
 
 Below them all sits the floor: the error classes (``pinarms.errors``), the execution layer
-``pinarms.execution`` (serial loop or Dask), atomic file writing and units. Every package may
-import it, and it imports nothing of ours but the error classes (which import nothing of ours).
+``pinarms.execution`` (serial loop or Dask), atomic file writing, units and the compiled-kernel
+decorator. Every package may import it, and it imports nothing of ours but the floor (the error
+classes import nothing of ours). The layers are stated once, in ``benchmarks/architecture.py``
+(:data:`LAYERS`), which the figures test reads too.
 
 The folders ``robots/``, ``planning/``, ``optim/``, ``viz/`` sit at the repository's top level
 and install as ``pinarms.robots``, ``pinarms.planning``, ... Every module's imports (module
@@ -14,22 +16,31 @@ other projects on PyPI).
 from __future__ import annotations
 
 import ast
+import importlib.util
+import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-ORDER = ["robots", "planning", "optim", "viz", "pinarms"]
+
+
+def _architecture():
+    """benchmarks/architecture.py, the one statement of the layers (its :data:`LAYERS`)."""
+    spec = importlib.util.spec_from_file_location("architecture_layers", ROOT / "benchmarks" / "architecture.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up by name
+    spec.loader.exec_module(module)
+    return module
+
+
+LAYERS = _architecture().LAYERS
+#: The packages in their one-way order (the layers above the floor).
+ORDER = [name for name, _ in LAYERS[1:]]
 #: The floor: modules of the ``pinarms`` folder that every package may import (the error
-#: classes, the execution layer, atomic file writing, units, compiled kernels); each imports nothing of ours but
-#: the error classes.
-BOTTOM = {
-    "pinarms.errors": "errors",
-    "pinarms.execution": "execution",
-    "pinarms.files": "files",
-    "pinarms.units": "units",
-    "pinarms.compiled": "compiled",
-}
+#: classes, the execution layer, atomic file writing, units, compiled kernels); they import
+#: nothing of ours but each other (the compiled kernels' cache guard writes through the atomic writer).
+BOTTOM = {prefix: prefix.split(".")[1] for prefix in LAYERS[0][1]}
 ALLOWED = {pkg: set(ORDER[: i + 1]) | set(BOTTOM.values()) for i, pkg in enumerate(ORDER)}
 SUBPACKAGES = set(ORDER[:-1]) | {"urdf"}
 
@@ -100,11 +111,11 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
     assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
 
 
-@pytest.mark.parametrize("floor", ["files", "units"])
-def test_the_floor_imports_nothing_of_ours_but_the_errors(floor):
+@pytest.mark.parametrize("floor", sorted(set(BOTTOM.values()) - {"errors", "execution"}))
+def test_the_floor_imports_nothing_of_ours_but_the_floor(floor):
     modules = _imported_modules(ROOT / "pinarms" / f"{floor}.py")
     ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
-    assert ours <= {"pinarms.errors"}, ours
+    assert ours <= set(BOTTOM) - {f"pinarms.{floor}"}, ours
     assert all(floor in ALLOWED[pkg] for pkg in ORDER)
 
 
