@@ -46,6 +46,7 @@ from pinarms.planning.errors import (JointLimitOnPath, PathError, SingularityOnP
                                      UnreachableOnPath)
 from pinarms.planning.ik_continuation import MAX_CORRECTION, Knot, PathSolver, Stop, continue_to, solve_knots
 from pinarms.planning.joint_path import JointPath
+from pinarms.planning.multi_quintic import quintic_hermite_coefficients
 from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
 from pinarms.robots.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
@@ -106,19 +107,6 @@ class CartesianPath(JointPath):
 
 
 # ---------------------------------------------------------------------------- helpers
-def _hermite(s0: np.ndarray, s1: np.ndarray, a: tuple, b: tuple) -> np.ndarray:
-    """Quintic Hermite coefficients (K, 6, n) on [s0, s1] from (q, q', q'') at both ends (each (K, n))."""
-    h = (s1 - s0)[:, None]
-    q0, v0, a0 = a
-    q1, v1, a1 = b
-    c = np.empty((h.shape[0], 6, q0.shape[1]))
-    c[:, 0], c[:, 1], c[:, 2] = q0, v0, 0.5 * a0
-    c[:, 3] = (20.0 * (q1 - q0) - (8.0 * v1 + 12.0 * v0) * h - (3.0 * a0 - a1) * h * h) / (2.0 * h**3)
-    c[:, 4] = (30.0 * (q0 - q1) + (14.0 * v1 + 16.0 * v0) * h + (3.0 * a0 - 2.0 * a1) * h * h) / (2.0 * h**4)
-    c[:, 5] = (12.0 * (q1 - q0) - 6.0 * (v1 + v0) * h - (a0 - a1) * h * h) / (2.0 * h**5)
-    return c
-
-
 def _eval(c: np.ndarray, sig: np.ndarray) -> np.ndarray:
     """Value of quintic pieces c (K, 6, n) at local offsets sig (K, M) -> (K, M, n)."""
     powers = sig[..., None] ** np.arange(6)
@@ -314,7 +302,7 @@ def _coefficients(knots: list[Knot]) -> np.ndarray:
     s = np.array([k.s for k in knots])
     a = (np.array([k.q for k in knots[:-1]]), np.array([k.dq for k in knots[:-1]]), np.array([k.ddq for k in knots[:-1]]))
     b = (np.array([k.q for k in knots[1:]]), np.array([k.dq_l for k in knots[1:]]), np.array([k.ddq_l for k in knots[1:]]))
-    return _hermite(s[:-1], s[1:], a, b)
+    return quintic_hermite_coefficients(s[1:] - s[:-1], *a, *b)
 
 
 def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
