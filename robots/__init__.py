@@ -81,7 +81,8 @@ __all__ += [
 ]
 
 # dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
-from .dynamics import InvalidPayload, MissingInertials, Payload  # noqa: E402
+from .dynamics import MissingInertials  # noqa: E402
+from .payload import InvalidPayload, Payload  # noqa: E402
 
 __all__ += ["Payload", "InvalidPayload", "MissingInertials"]
 

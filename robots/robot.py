@@ -379,17 +379,17 @@ class Robot(RobotIK):
         return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
 
     # --------------------------------------------------------------- dynamics
-    #: The :class:`robots.dynamics.Payload` this robot carries (``None``: the bare arm).
+    #: The :class:`robots.payload.Payload` this robot carries (``None``: the bare arm).
     payload = None
 
     def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
         """A copy of this robot carrying a payload (this robot is unchanged).
 
-        ``mass`` [kg] (or a :class:`robots.dynamics.Payload`), ``com`` (3,) [m] in ``frame``
+        ``mass`` [kg] (or a :class:`robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
         (default the tcp), ``inertia`` (3, 3) [kg·m²] about the centre of mass (default a point
-        mass). See :func:`robots.dynamics.with_payload`.
+        mass). See :func:`robots.payload.with_payload`.
         """
-        from .dynamics import with_payload
+        from .payload import with_payload
 
         return with_payload(self, mass, com=com, inertia=inertia, frame=frame)
 

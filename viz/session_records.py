@@ -35,7 +35,7 @@ class RobotEntry:
         package_dirs: folders that resolved ``package://`` meshes when saved: a hint shown in
             error messages only; loading never reads meshes from them unless the caller
             passes them (``load_session(..., package_dirs=...)``).
-        payload: the payload the robot carries (:meth:`robots.dynamics.Payload.as_dict`:
+        payload: the payload the robot carries (:meth:`robots.payload.Payload.as_dict`:
             ``mass_kg``, ``com_m``, ``inertia_kg_m2``, ``frame``), or ``None``; reapplied
             with ``robot.with_payload`` when the session reopens.
     """

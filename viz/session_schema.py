@@ -108,7 +108,7 @@ def _decode_robot(it: SessionItem) -> RobotEntry:
         raise it.fail(f"{it.where}.package_dirs must be a list of strings")
     payload = None
     if "payload" in it.obj:
-        from pinarms.robots.dynamics import InvalidPayload, Payload
+        from pinarms.robots.payload import InvalidPayload, Payload
 
         try:
             payload = Payload.from_dict(it.field("payload", dict)).as_dict()
