@@ -170,8 +170,9 @@ class _ScreenRungs:
         self.Q = np.concatenate([self.Q, c.full(self.new)])
         lb = np.concatenate([lb, np.full(len(self.new), -1.0)])
         s_level = c.step / 2.0 ** (level + 1)
-        ends = np.unique(np.concatenate([intervals.left, intervals.right]))
-        ends = ends[lb[ends] < s_level]
+        is_end = np.zeros(lb.size, dtype=bool)
+        is_end[intervals.left] = is_end[intervals.right] = True
+        ends = np.flatnonzero(is_end & (lb < s_level))
         # the cover alone screens the coarse levels; coal has the last word on the fine ones
         Qe = self.Q[ends]
         passed = c.covered(Qe, level) if self.tight and level <= COVER_LEVELS else ~c.batch_collides(Qe, level)

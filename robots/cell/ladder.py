@@ -40,8 +40,8 @@ import numpy as np
 
 __all__ = ["Intervals", "LadderResult", "Rungs", "climb", "interval_bound", "interval_proven", "RELATIVE_SLACK"]
 
-#: Relative slack of the compiled rule: a budget counts ``1 + RELATIVE_SLACK`` times over, so
-#: the rounding of an excess summed over many terms never proves an interval that is not.
+#: Relative slack of the compiled rule: a budget counts ``1 + RELATIVE_SLACK`` times over (a hair
+#: over the rounding of the compiled excess, which sums many terms).
 RELATIVE_SLACK = 1e-9
 
 
@@ -74,45 +74,47 @@ def __getattr__(name: str) -> Any:
 
 @dataclass(frozen=True)
 class Intervals:
-    """Intervals between samples, as parallel arrays of one level.
+    """Intervals between samples of one level: ``index (k, 3)`` [left sample, right sample, source]
+    and ``value (k, 3)`` [budget, fa, fb] (two arrays: a level is taken and halved in a few calls).
 
-    Attributes:
-        left, right: indices of the two end samples (into the excess array of :func:`climb`).
-        budget: the travel bound between them [m].
-        source: the given interval (0-based, in the samples' order) each lies in.
-        fa, fb: its fractions of that interval (``0 ≤ fa < fb ≤ 1``).
+    Attributes (views of those): ``left``, ``right``: the two end samples (indices into the
+    excess array of :func:`climb`); ``budget``: the travel bound between them [m];
+    ``source``: the given interval (0-based, in the samples' order) each lies in; ``fa``,
+    ``fb``: its fractions of that interval (``0 ≤ fa < fb ≤ 1``).
     """
 
-    left: np.ndarray
-    right: np.ndarray
-    budget: np.ndarray
-    source: np.ndarray
-    fa: np.ndarray
-    fb: np.ndarray
+    index: np.ndarray
+    value: np.ndarray
+
+    left = property(lambda self: self.index[:, 0])
+    right = property(lambda self: self.index[:, 1])
+    source = property(lambda self: self.index[:, 2])
+    budget = property(lambda self: self.value[:, 0])
+    fa = property(lambda self: self.value[:, 1])
+    fb = property(lambda self: self.value[:, 2])
 
     @classmethod
     def between(cls, budgets: np.ndarray) -> "Intervals":
         """The intervals between consecutive samples ``0..n`` of travel ``budgets (n,)``."""
         n = budgets.size
         index = np.arange(n)
-        return cls(index, index + 1, np.asarray(budgets, dtype=float), index, np.zeros(n), np.ones(n))
+        return cls(np.column_stack([index, index + 1, index]),
+                   np.column_stack([np.asarray(budgets, dtype=float), np.zeros(n), np.ones(n)]))
 
     def take(self, keep: np.ndarray) -> "Intervals":
         """The intervals where ``keep`` (bool mask or indices)."""
-        return Intervals(self.left[keep], self.right[keep], self.budget[keep], self.source[keep], self.fa[keep],
-                         self.fb[keep])
+        return Intervals(self.index[keep], self.value[keep])
 
     def halves(self, first_new: int, left_budget: np.ndarray, right_budget: np.ndarray) -> "Intervals":
         """Both halves of each interval, in order (left, right, left, ...); the midpoint of interval ``k``
         is sample ``first_new + k``."""
-        mid = first_new + np.arange(self.left.size)
-        fm = 0.5 * (self.fa + self.fb)
-
-        def pair(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-            return np.column_stack([a, b]).reshape(-1)
-
-        return Intervals(pair(self.left, mid), pair(mid, self.right), pair(left_budget, right_budget),
-                         np.repeat(self.source, 2), pair(self.fa, fm), pair(fm, self.fb))
+        k = self.index.shape[0]
+        index = np.repeat(self.index, 2, axis=0)
+        index[0::2, 1] = index[1::2, 0] = first_new + np.arange(k)
+        value = np.repeat(self.value, 2, axis=0)
+        value[0::2, 0], value[1::2, 0] = left_budget, right_budget
+        value[0::2, 2] = value[1::2, 1] = 0.5 * (self.fa + self.fb)
+        return Intervals(index, value)
 
 
 @dataclass(frozen=True)
@@ -171,12 +173,17 @@ def climb(excess: Any, budgets: Any, rungs: Rungs, *, finest: int, level: int = 
     while True:
         e_a, e_b = e[intervals.left], e[intervals.right]
         bound = interval_bound(e_a, e_b, intervals.budget)
-        low = np.minimum(e_a, e_b)
-        touching = low <= contact if contact is not None else np.zeros(low.size, dtype=bool)
-        proven = ~touching & (bound >= (0.0 if target is None else target(low)))
-        lower = min(lower, _smallest(low[touching]), _smallest(bound[proven]))
-        touched = touched or bool(touching.any())
-        open_ = ~touching & ~proven
+        low = np.minimum(e_a, e_b) if contact is not None or target is not None else None
+        proven = bound >= (0.0 if target is None else target(low))
+        if contact is not None:  # a touching end decides its interval: not proven, not halved
+            touching = low <= contact
+            proven &= ~touching
+            lower = min(lower, _smallest(low[touching]))
+            touched = touched or bool(touching.any())
+            open_ = ~touching & ~proven
+        else:
+            open_ = ~proven
+        lower = min(lower, _smallest(bound[proven]))
         if not open_.any():
             return LadderResult(not touched, level, lower)
         if level >= finest or rungs.give_up():
