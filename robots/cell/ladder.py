@@ -97,9 +97,12 @@ class Intervals:
     def between(cls, budgets: np.ndarray) -> "Intervals":
         """The intervals between consecutive samples ``0..n`` of travel ``budgets (n,)``."""
         n = budgets.size
-        index = np.arange(n)
-        return cls(np.column_stack([index, index + 1, index]),
-                   np.column_stack([np.asarray(budgets, dtype=float), np.zeros(n), np.ones(n)]))
+        index = np.empty((n, 3), dtype=int)
+        index[:, 0] = index[:, 2] = np.arange(n)
+        index[:, 1] = index[:, 0] + 1
+        value = np.empty((n, 3))
+        value[:, 0], value[:, 1], value[:, 2] = budgets, 0.0, 1.0
+        return cls(index, value)
 
     def take(self, keep: np.ndarray) -> "Intervals":
         """The intervals where ``keep`` (bool mask or indices)."""
