@@ -14,9 +14,9 @@ or follow their own timed trajectories (:class:`TimedArm`):
   planned arms' geometry moves at most ``T = Σ_j |Δq_j| ℓ_j`` along the edge (the levers
   ``ℓ_j`` of :func:`robots.cell.motion.joint_levers`). The smallest excess
   ``E = min_k (d_k − margin_k)`` is 1-Lipschitz in that travel, so between two samples with
-  travel ``B`` between them ``E ≥ (E_a + E_b − B)/2``. Samples whose pairs all pass with
-  their margins raised by ``s`` have ``E ≥ s``; two such neighbours with ``B ≤ 2s`` prove
-  the interval. The proof is a **ladder of batched screens**: the edge is first cut into
+  travel ``B`` between them ``E ≥ (E_a + E_b − B)/2`` (the rule and its ladder:
+  :mod:`robots.cell.ladder`). Samples whose pairs all pass with their margins raised by
+  ``s`` have ``E ≥ s``; two such neighbours with ``B ≤ 2s`` prove the interval. The proof is a **ladder of batched screens**: the edge is first cut into
   pieces of at most ``step · 2^k`` travel (``k ≤`` :data:`COARSE_LEVELS`; ``step`` defaults
   to the margin: nothing thinner than the margin fits between two samples of the finest
   regular level), **all samples checked as one batch** by Pinocchio's C++ loop

@@ -1,10 +1,12 @@
 """The continuous proof of a :class:`.checker.MotionChecker`: a ladder of batched screens over samples.
 
 Between two samples with travel ``B`` between them the excess ``E = min_k (d_k − margin_k)``
-(1-Lipschitz in travel) keeps ``E ≥ (E_a + E_b − B)/2``; samples that pass with their
-margins raised by ``s`` have ``E ≥ s``. :meth:`LadderProof.prove` screens the samples of a
-motion at the coarsest level, halves the intervals not proven and screens their ends with
-half the raise, down to ``step / 2^MAX_SPLITS`` (the module docstring of :mod:`.checker`).
+(1-Lipschitz in travel) keeps ``E ≥ (E_a + E_b − B)/2`` (the rule and its ladder:
+:mod:`robots.cell.ladder`); samples that pass with their margins raised by ``s`` have
+``E ≥ s``. :meth:`LadderProof.prove` screens the samples of a motion at the coarsest level,
+then climbs the ladder (:func:`robots.cell.ladder.climb`): the intervals not proven are
+halved and their ends screened with half the raise, down to ``step / 2^MAX_SPLITS`` (the
+module docstring of :mod:`.checker`).
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
+
+from pinarms.robots.cell.ladder import Intervals, climb
 
 __all__ = ["LadderProof", "Verdict", "GiveUp", "coarse_first", "MAX_SPLITS", "COARSE_LEVELS", "COVER_LEVELS"]
 
@@ -122,52 +126,65 @@ class LadderProof:
         if hits.any():
             return Verdict(False, int(order[int(np.argmax(hits))]))
         # every sample keeps the margins: prove the intervals between them, level by level
-        states = [x for x in X]
-        qs = [q for q in Q]
         lb = np.full(N, self.step / 2.0 ** (level + 1))  # proven lower bound of each sample's excess
         lb[order if tight else order[self.coal_collides(Q[order], level)]] = 0.0
-        # intervals: (left sample, right sample, budget, source interval, fraction a, fraction b)
-        todo = [(i, i + 1, float(budgets[i]), i, 0.0, 1.0) for i in range(N - 1)]
-        while True:
-            todo = [iv for iv in todo if lb[iv[0]] + lb[iv[1]] < iv[2]]
-            if not todo:
-                return Verdict(True, exact=level)
-            if level >= MAX_SPLITS or self._timed_out():
-                i = todo[0][3]
-                return Verdict(False, i, todo[0][4], level)
-            level += 1
-            s_level = self.step / 2.0 ** (level + 1)
-            nxt = []
-            new_states = []
-            for a, b, B, src, fa, fb in todo:
-                xm, bl, br = midpoint(src, fa, fb, B)
-                m = len(states) + len(new_states)
-                new_states.append(np.asarray(xm, dtype=float))
-                fm = 0.5 * (fa + fb)
-                nxt.append((a, m, float(bl), src, fa, fm))
-                nxt.append((m, b, float(br), src, fm, fb))
-            Xm = np.array(new_states)
-            inside = self.within_limits(Xm)
-            if not inside.all():
-                k = int(np.argmin(inside))
-                return Verdict(False, todo[k][3], 0.5 * (todo[k][4] + todo[k][5]), level)
-            Qm = self.full(Xm)
-            states.extend(Xm)
-            qs.extend(Qm)
-            lb = np.concatenate([lb, np.full(len(new_states), -1.0)])
-            ends = sorted({k for iv in nxt for k in iv[:2] if lb[k] < s_level})
-            Qe = np.array([qs[k] for k in ends])
-            # the cover alone screens the coarse levels; coal has the last word on the fine ones
-            passed = self.covered(Qe, level) if tight and level <= COVER_LEVELS else ~self.batch_collides(Qe, level)
-            for k, ok in zip(ends, passed):
-                if ok:
-                    lb[k] = s_level
-            unknown = [k for k, ok in zip(ends, passed) if not ok and lb[k] < 0.0]
-            if unknown:
-                bad = self.batch_collides(np.array([qs[k] for k in unknown]), "margin")
-                if bad.any():
-                    k = unknown[int(np.argmax(bad))]
-                    iv = next(iv for iv in nxt if k in iv[:2])
-                    return Verdict(False, iv[3], iv[4], level)
-                lb[unknown] = 0.0
-            todo = nxt
+        rungs = _ScreenRungs(self, Q, midpoint, tight)
+        result = climb(lb, np.asarray(budgets, dtype=float), rungs, finest=MAX_SPLITS, level=level)
+        if result.proven:
+            return Verdict(True, exact=result.level)
+        # a midpoint outside the limits is reported where it lies, a failing screen from its interval's start
+        return Verdict(False, result.source, result.fb if rungs.outside else result.fa, result.level)
+
+
+class _ScreenRungs:
+    """The samples of one proof for the ladder (:func:`robots.cell.ladder.climb`): midpoints from the
+    caller's ``midpoint``, and as excess of a sample the raise of the margins its screen passes at
+    each level (``s_L = step / 2^(L+1)``; 0: it keeps the margins only)."""
+
+    def __init__(self, checker: Any, Q: np.ndarray, midpoint: Any, tight: bool) -> None:
+        self.checker, self.midpoint, self.tight = checker, midpoint, tight
+        self.Q = Q  # the cell configuration of every sample
+        self.new = np.empty((0, Q.shape[1]))
+        #: the last failing midpoint was outside the joint limits (not too close)
+        self.outside = False
+
+    def halve(self, intervals: Intervals) -> tuple[np.ndarray, np.ndarray]:
+        states, left, right = [], [], []
+        for src, fa, fb, B in zip(intervals.source.tolist(), intervals.fa.tolist(), intervals.fb.tolist(),
+                                  intervals.budget.tolist()):
+            xm, bl, br = self.midpoint(src, fa, fb, B)
+            states.append(np.asarray(xm, dtype=float))
+            left.append(float(bl))
+            right.append(float(br))
+        self.new = np.array(states)
+        return np.array(left), np.array(right)
+
+    def evaluate(self, lb: np.ndarray, intervals: Intervals, level: int) -> tuple[np.ndarray, int]:
+        """Screen the ends of ``intervals`` not yet proven ``s_L`` clear (the new midpoints first checked
+        against the limits); a midpoint that fails the margins themselves fails the proof."""
+        c = self.checker
+        inside = c.within_limits(self.new)
+        if not inside.all():
+            self.outside = True
+            return lb, lb.size + int(np.argmin(inside))
+        self.Q = np.concatenate([self.Q, c.full(self.new)])
+        lb = np.concatenate([lb, np.full(len(self.new), -1.0)])
+        s_level = c.step / 2.0 ** (level + 1)
+        is_end = np.zeros(lb.size, dtype=bool)
+        is_end[intervals.left] = is_end[intervals.right] = True
+        ends = np.flatnonzero(is_end & (lb < s_level))
+        # the cover alone screens the coarse levels; coal has the last word on the fine ones
+        Qe = self.Q[ends]
+        passed = c.covered(Qe, level) if self.tight and level <= COVER_LEVELS else ~c.batch_collides(Qe, level)
+        lb[ends[passed]] = s_level
+        unknown = ends[~passed & (lb[ends] < 0.0)]
+        if unknown.size:
+            bad = c.batch_collides(self.Q[unknown], "margin")
+            if bad.any():
+                return lb, int(unknown[int(np.argmax(bad))])
+            lb[unknown] = 0.0
+        return lb, -1
+
+    def give_up(self) -> bool:
+        """Past the checker's deadline (:meth:`.coal_batches.CoalBatches._timed_out`)."""
+        return self.checker._timed_out()

@@ -17,7 +17,8 @@ Over a short step ``h`` the speed cannot exceed its larger end value by more tha
 *approach budget* ``∫ V dt`` between two consecutive samples is at most ``margin``:
 dense where the arms move fast, sparse where they dwell. On an interval ``[a, b]`` with
 budget ``B`` the distance of every pair then stays at least ``(d_a + d_b − B) / 2``, where
-``d`` is the smallest distance over the checked pairs at a sample (coal, exact).
+``d`` is the smallest distance over the checked pairs at a sample (coal, exact): the
+Lipschitz rule and its ladder of halvings, stated once in :mod:`.ladder`.
 
 Each sample is first screened by Pinocchio's C++ broad phase with a safety distance
 ``required + margin``: a sample farther than that from every contact has
@@ -36,7 +37,8 @@ and reported with its pair and depth.
 Where the parts live (all importable from here): the schedule of the arms' motions
 (:class:`ArmMotion`, :func:`configurations`, :func:`sample_motions`) in :mod:`.timeline`, the
 speed bound (:func:`joint_levers`) in :mod:`.speed_bound`, the report (:class:`MotionCheck`,
-:class:`Contact`) in :mod:`.motion_report`.
+:class:`Contact`) in :mod:`.motion_report`, the proof between samples (:func:`.ladder.climb`)
+in :mod:`.ladder`.
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ import numpy as np
 
 from ..errors import InvalidInput
 from .collision import _margin, exact_min_distance
+from .ladder import Intervals, climb
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
 from .speed_bound import joint_levers, speed_profile
@@ -151,9 +154,9 @@ class _Schedule:
     speed_bound: float
     window: tuple[float, float]
 
-    def budget_at(self, t: float) -> float:
-        """The approach budget spent from the window's start to ``t`` [m]."""
-        return float(np.interp(t, self.grid, self.budget))
+    def budget_between(self, ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
+        """The approach budget [m] spent between times ``ta`` and ``tb`` [s] (interpolated on the grid)."""
+        return np.interp(tb, self.grid, self.budget) - np.interp(ta, self.grid, self.budget)
 
 
 def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, margin: float) -> _Schedule:
@@ -233,45 +236,42 @@ class _Samples:
                 np.asarray(self.k, dtype=int)[order], np.asarray(self.x, dtype=bool)[order])
 
 
+class _TimeRungs:
+    """The samples of a check for the ladder (:func:`.ladder.climb`): midpoints in time, budgets from the schedule,
+    exact distances (:meth:`_Samples.evaluate`)."""
+
+    def __init__(self, schedule: _Schedule, samples: _Samples) -> None:
+        self.schedule, self.samples = schedule, samples
+        self.t = np.asarray(schedule.times, dtype=float)  # the time of each sample of the ladder [s]
+        self.mids = np.empty(0)
+
+    def halve(self, intervals: Intervals) -> tuple[np.ndarray, np.ndarray]:
+        ta, tb = self.t[intervals.left], self.t[intervals.right]
+        self.mids = 0.5 * (ta + tb)
+        self.t = np.concatenate([self.t, self.mids])
+        return self.schedule.budget_between(ta, self.mids), self.schedule.budget_between(self.mids, tb)
+
+    def evaluate(self, excess: np.ndarray, intervals: Intervals, level: int) -> tuple[np.ndarray, int]:
+        return np.concatenate([excess, self.samples.evaluate(self.mids)[0]]), -1
+
+    def give_up(self) -> bool:
+        return False
+
+
 def _prove(schedule: _Schedule, d: np.ndarray, required: float, samples: _Samples) -> tuple[float, bool]:
     """Prove every interval between samples; the proven lower bound [m] and whether an interval stayed unproven.
 
-    An interval's bound ``(d_a + d_b − B) / 2`` must reach its target (the required
-    clearance, or 0 where a sample is already below it), else it is split in halves, at most
-    :data:`MAX_SPLITS` times; one level at a time, all the midpoints of a level in one
-    batched evaluation. Intervals with a sample in contact are left to :func:`_first_contact`.
+    The ladder of :mod:`.ladder` on the distances: an interval's bound ``(d_a + d_b − B) / 2``
+    must reach its target (the required clearance, or 0 where a sample is already below
+    it), else it is split in halves, at most :data:`MAX_SPLITS` times; one level at a time,
+    all the midpoints of a level in one batched evaluation. Intervals with a sample in
+    contact are left to :func:`_first_contact`.
     """
-    times = schedule.times
-    lower = float(d.min()) if d.size else np.inf
-    unresolved = False
-    level = [(times[i], times[i + 1], d[i], d[i + 1]) for i in range(times.size - 1)]
-    depth = 0
-    while level:
-        split = []
-        for ta, tb, da, db in level:
-            low = min(da, db)
-            if low <= 0.0:
-                lower = min(lower, low)
-                continue  # a sample in contact: reported below
-            target = required if low >= required else 0.0
-            bound = (da + db - (schedule.budget_at(tb) - schedule.budget_at(ta))) / 2.0
-            if bound >= target:
-                lower = min(lower, bound)
-            elif depth >= MAX_SPLITS:
-                unresolved = True
-                lower = min(lower, bound)
-            else:
-                split.append((ta, tb, da, db))
-        if not split:
-            break
-        mids = np.array([0.5 * (ta + tb) for ta, tb, _, _ in split])
-        dm = samples.evaluate(mids)[0]
-        level = []
-        for (ta, tb, da, db), tm, dmid in zip(split, mids, dm):
-            level.append((ta, tm, da, dmid))
-            level.append((tm, tb, dmid, db))
-        depth += 1
-    return lower, unresolved
+    rungs = _TimeRungs(schedule, samples)
+    result = climb(d, schedule.budget_between(rungs.t[:-1], rungs.t[1:]), rungs, finest=MAX_SPLITS,
+                   target=lambda low: np.where(low >= required, required, 0.0), contact=0.0)
+    lower = min(float(d.min()) if d.size else np.inf, result.lower_bound)
+    return lower, result.unresolved
 
 
 def _first_contact(samples: _Samples, pairs: tuple[CollisionPair, ...]) -> Contact | None:
