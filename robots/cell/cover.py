@@ -34,7 +34,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ._cover_kernel import excess_kernel, screen_kernel
-from .mesh_cover import mesh_arrays, mesh_spheres, static_primitive
+from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
 
 __all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
            "MAX_SPHERES"]
@@ -109,25 +109,38 @@ def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
     return centers, np.asarray(r, dtype=float) * (1.0 + 1e-9) + 1e-9
 
 
-def _mesh_cylinder(geometry_object: Any) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """The axis ends (in the geometry's frame) and radius [m] of the cylinder holding a moving mesh, where
-    that cylinder is smaller than the mesh's box (:func:`.mesh_cover.static_primitive`); else None."""
+#: A moving mesh is screened through the cylinder holding it (exact against the other geometry's spheres,
+#: its flat ends against boxes) when that cylinder is at most this many times its box's volume, and
+#: :data:`TURNING_SHARE` times when its axis is its joint's axis (a housing turning about its own axis,
+#: like the UR5's shoulder over its base).
+CYLINDER_SHARE = 1.0
+TURNING_SHARE = 1.3
+
+
+def _mesh_cylinder(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The axis ends (in the geometry's frame) and radius [m] of the cylinder holding a moving mesh where it
+    is used (:data:`CYLINDER_SHARE`; ``joint_axis``: the parent joint's axis in its frame); else None."""
     if int(geometry_object.parentJoint) == 0:
         return None
     got = mesh_arrays(geometry_object.geometry)
     if got is None:
         return None
-    kind, R, centre, size = static_primitive(got[0])
-    if kind != "Cylinder":
-        return None
-    return centre - size[1] * R[:, 2], centre + size[1] * R[:, 2], float(size[0])
+    a, b, radius, share = mesh_cylinder(got[0])
+    if share <= CYLINDER_SHARE:
+        return a, b, radius
+    if joint_axis is not None and share <= TURNING_SHARE:
+        u = np.asarray(geometry_object.placement.rotation) @ (b - a)
+        if abs(float(u @ np.asarray(joint_axis, dtype=float))) >= (1.0 - 1e-6) * float(np.linalg.norm(u)):
+            return a, b, radius
+    return None
 
 
-def geometry_segments(geometry_object: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
     cylinder, or of the cylinder holding a moving mesh where it is smaller than the mesh's box (taken
-    exactly against the other geometry's spheres); other geometries: their spheres as zero-length axes
-    (unused by the screen)."""
+    exactly against the other geometry's spheres; ``joint_axis``: the parent joint's unit axis in its
+    frame, :data:`TURNING_SHARE`); other geometries: their spheres as zero-length axes (unused by the
+    screen)."""
     geo = geometry_object.geometry
     M = geometry_object.placement
     R, p = np.asarray(M.rotation), np.asarray(M.translation)
@@ -135,7 +148,7 @@ def geometry_segments(geometry_object: Any) -> tuple[np.ndarray, np.ndarray, np.
         h = float(geo.halfLength)
         a, b = p - h * R[:, 2], p + h * R[:, 2]
         return a[None], b[None], np.array([float(geo.radius) * (1.0 + 1e-9) + 1e-9])
-    held = _mesh_cylinder(geometry_object)
+    held = _mesh_cylinder(geometry_object, joint_axis)
     if held is not None:
         a, b, radius = held
         return (R @ a + p)[None], (R @ b + p)[None], np.array([radius * (1.0 + 1e-9) + 1e-9])
@@ -311,7 +324,7 @@ def link_cover(cell: Any) -> Cover:
             exact[g], frame_R[g], frame_p[g], size[g] = _static_shape(obj)
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
-                  _segments(objs), _bounds(objs, start, centers, radii))
+                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
     cell._sphere_cover = cover
     return cover
 
@@ -338,14 +351,16 @@ def _static_shape(obj: Any) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
     return (_EXACT_BOX if shape == "Box" else _EXACT_CYLINDER), R @ R_local, R @ centre + p, half
 
 
-def _segments(objs: list) -> tuple:
-    parts = [geometry_segments(obj) for obj in objs]
+def _segments(objs: list, axes: np.ndarray) -> tuple:
+    """The cover's cylinders (:func:`geometry_segments`; ``axes (nj, 3)``: each joint's axis in its frame)."""
+    turning = [axes[int(o.parentJoint)] if int(o.parentJoint) > 0 else None for o in objs]
+    parts = [geometry_segments(obj, u) for obj, u in zip(objs, turning)]
     sstart = np.concatenate([[0], np.cumsum([r.size for _, _, r in parts])]).astype(np.int64)
     sjoint = np.concatenate([np.full(r.size, int(o.parentJoint), dtype=np.int64) for o, (_, _, r) in zip(objs, parts)])
+    cyl = [type(o.geometry).__name__ == "Cylinder" or _mesh_cylinder(o, u) is not None for o, u in zip(objs, turning)]
     return (sjoint, np.ascontiguousarray(np.concatenate([a for a, _, _ in parts])),
             np.ascontiguousarray(np.concatenate([b for _, b, _ in parts])), np.concatenate([r for _, _, r in parts]),
-            sstart, np.array([type(o.geometry).__name__ == "Cylinder" or _mesh_cylinder(o) is not None for o in objs],
-                             dtype=np.bool_))
+            sstart, np.array(cyl, dtype=np.bool_))
 
 
 def _bounds(objs: list, start: np.ndarray, centers: list, radii: list) -> tuple:

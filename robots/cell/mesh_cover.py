@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mesh_arrays", "split_triangles", "mesh_spheres", "static_primitive", "SPLIT_EDGE"]
+__all__ = ["mesh_arrays", "split_triangles", "mesh_spheres", "mesh_cylinder", "static_primitive", "SPLIT_EDGE"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
@@ -208,3 +208,13 @@ def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.nda
                 R[:, 0] *= -1.0
             best = ("Cylinder", R, centre, np.array([radius, half[axis], 0.0]), volume)
     return best[:4]
+
+
+def mesh_cylinder(V: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The smallest cylinder along one of the axes holding the vertices ``V (n, 3)``: its axis ends
+    ``a, b (3,)``, radius [m], and its volume over the vertices' box's volume."""
+    V = np.asarray(V, dtype=float)
+    volume, axis, centre, radius, lo, hi = _cylinder(V, refine=True)
+    a, b = centre.copy(), centre.copy()
+    a[axis], b[axis] = lo, hi
+    return a, b, radius, float(volume / max(np.prod(V.max(axis=0) - V.min(axis=0)), 1e-300))
