@@ -7,15 +7,17 @@ joint's frame, whose union **contains** the geometry (:func:`geometry_spheres`):
 - a cylinder (radius ``r``, half length ``h``): ``k`` slices of height ``2h/k`` along its
   axis, each inside the sphere at its centre of radius ``√(r² + (h/k)²)``;
 - a box: ``k`` slices along its longest side, each inside its circumscribed sphere;
-- a mesh (coal ``BVHModel``) or any other shape: its triangles grouped into ``k`` slices
-  along the longest side of its bounding box (by the triangle's centroid), each group inside
-  the sphere about its vertices' box centre through the farthest vertex (a sphere is convex:
-  holding a triangle's three vertices, it holds the triangle);
+- a mesh (coal ``BVHModel``): at most :data:`MESH_SPHERES` spheres on the axes of its
+  cylinder-like parts, holding every piece of its triangles (:func:`.mesh_cover.mesh_spheres`);
 - a shape with neither (a convex without triangles, a plane ...): the sphere about its
   local bounding box.
 
 A static box, cylinder or sphere (parent joint the world: the fixtures) is also kept
-exactly: a sphere's distance to it is computed in closed form, not through its cover.
+exactly: a sphere's distance to it is computed in closed form, not through its cover; a
+static mesh (an arm's base) is kept exactly as the smaller of the box and the cylinders
+holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, and a moving
+mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
+taken exactly against the other geometry's spheres (:func:`geometry_segments`).
 
 The screen (:meth:`Cover.screen`) answers, for a batch of cell configurations and a
 threshold per pair, which configurations are **proven** to keep every pair farther apart
@@ -37,12 +39,12 @@ from ._cover_kernel import excess_kernel, screen_kernel
 from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
 
 __all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
-           "MAX_SPHERES"]
+           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE"]
 
 #: Most spheres per box geometry.
 MAX_SPHERES = 12
 #: Spheres per mesh (:func:`.mesh_cover.mesh_spheres`).
-MESH_SPHERES = 24
+MESH_SPHERES = 16
 _MESH_CACHE: dict = {}
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 

@@ -1,27 +1,24 @@
 """Tight covers of triangle meshes for :mod:`.cover`: spheres fitted to a mesh's parts, and the
-smallest box or cylinder holding a static mesh.
+box or cylinder holding a mesh.
 
-**Spheres** (:func:`mesh_spheres`): the mesh's triangles are first cut (longest edge halved,
-again and again: :func:`split_triangles`) until no edge is longer than ``edge``: the pieces
-tile each triangle exactly, and a long sliver along a tube no longer forces one sphere to
-span the tube. The pieces are then grouped top down: the group whose sphere overshoots the
-mesh most is cut in two by a plane across one of its axes (the cut whose worse half
-overshoots least), until there are ``count`` groups. Each group's sphere is centred on its
-vertices' box and reaches its farthest vertex: a sphere is convex, so holding a piece's
-three vertices it holds the piece, and the union of the spheres holds every triangle (the
-containment proof in the tests checks every piece's vertices against its sphere).
+**Spheres** (:func:`mesh_spheres`): the mesh's triangles are first cut (each halved across its
+longest edge, again and again: :func:`split_triangles`) until no edge is longer than
+:data:`SPLIT_EDGE`: the pieces tile each triangle exactly, and a long sliver along an arm's
+tube no longer forces one sphere to span the tube. The pieces are grouped into **parts**
+along the mesh's longest side, each close to a cylinder along one of the mesh's axes (an
+arm link: a joint housing, the tube, the next housing; the cuts minimise the parts' cylinder
+volumes), and each part's cylinder is sliced across its axis, one sphere per slice centred
+on the axis. A sphere reaches the farthest vertex of the pieces whose centres lie in its
+slice: holding a piece's three vertices it holds the piece (a sphere is convex), so the
+union of the spheres holds every triangle.
 
-How far a sphere ``(c, r)`` overshoots the mesh is bounded by ``r − ρ`` when ``c`` is inside
-the mesh (``ρ``: distance from ``c`` to the nearest triangle; the sphere of radius ``ρ``
-about ``c`` is inside the solid) and by ``r + ρ`` when ``c`` is outside (inside: generalised
-winding number above one half).
+**Primitives**: :func:`static_primitive` gives the smaller of the box and the cylinders (along
+the mesh's axes) holding all vertices, screened exactly for a mesh fixed in the world (an
+arm's base); :func:`mesh_cylinder` the smallest such cylinder, screened exactly for a moving
+mesh where it is tight (:data:`.cover.CYLINDER_SHARE`). A box or a cylinder is convex:
+holding the vertices it holds the mesh.
 
-**Static meshes** (:func:`static_primitive`): a mesh fixed in the world (an arm's base)
-is screened exactly as the smaller of its box (about its local axes) and its cylinder
-(axis along one of them, through the centre of the vertices' box across that axis) — a box
-or a cylinder is convex: holding the vertices it holds the mesh.
-
-Lengths in m, in the geometry's own frame.
+Lengths in m, in the mesh's own frame.
 """
 
 from __future__ import annotations
@@ -165,7 +162,9 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
     P = np.asarray(V, dtype=float)[np.asarray(T, dtype=np.int64)]
     S, _ = split_triangles(P, edge)
     mid = S.mean(axis=1)
-    parts = _parts(S, mid)[: int(count)]
+    parts = _parts(S, mid)
+    if len(parts) > int(count):  # more parts than spheres: one part
+        parts = [np.arange(S.shape[0])]
     cyls = [_cylinder(S[idx].reshape(-1, 3), refine=True) for idx in parts]
     low, high = 1e-5, 1.0
     for _ in range(40):  # the smallest overshoot whose slices fit the count
