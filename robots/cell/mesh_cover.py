@@ -151,8 +151,8 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
     vertices ``V (n, 3)`` and triangles ``T (m, 3)``, in the mesh's frame.
 
     The triangles are cut into pieces (:func:`split_triangles`), the pieces grouped into parts
-    each close to a cylinder along one of the mesh's axes (a part is cut in two where the two
-    cylinders are much smaller), and each part's cylinder sliced across its axis, one sphere
+    each close to a cylinder along one of the mesh's axes (the cuts across its longest side that
+    minimise the parts' cylinder volumes, :func:`_parts`), and each part's cylinder sliced across its axis, one sphere
     per slice centred on the axis: the slices are as thick as the overshoot over the
     cylinder's radius allows, the smallest overshoot for which all parts take at most
     ``count`` slices. Each sphere reaches the farthest vertex of the pieces whose centres lie
@@ -187,26 +187,22 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
-    """The smaller (by volume) of the box and the cylinders holding the vertices ``V (n, 3)``:
-    ``(kind "Box" or "Cylinder", rotation (3, 3), centre (3,), size (3,))`` in the mesh's frame;
-    size: the box's half sides, or ``(radius, half length, 0)`` with the cylinder's axis the
+    """The smaller (by volume) of the box and the cylinders (along the axes) holding the vertices
+    ``V (n, 3)``: ``(kind "Box" or "Cylinder", rotation (3, 3), centre (3,), size (3,))`` in the mesh's
+    frame; size: the box's half sides, or ``(radius, half length, 0)`` with the cylinder's axis the
     rotation's z column."""
     V = np.asarray(V, dtype=float)
     lo, hi = V.min(axis=0), V.max(axis=0)
     half = 0.5 * (hi - lo)
-    best = ("Box", np.eye(3), 0.5 * (lo + hi), half, float(np.prod(2.0 * half)))
-    for axis in range(3):
-        u, w = (axis + 1) % 3, (axis + 2) % 3
-        centre = 0.5 * (lo + hi)
-        radius = float(np.sqrt((V[:, u] - centre[u]) ** 2 + (V[:, w] - centre[w]) ** 2).max())
-        volume = np.pi * radius ** 2 * 2.0 * half[axis]
-        if volume < best[4]:
-            R = np.zeros((3, 3))
-            R[u, 0], R[w, 1], R[axis, 2] = 1.0, 1.0, 1.0
-            if np.linalg.det(R) < 0.0:
-                R[:, 0] *= -1.0
-            best = ("Cylinder", R, centre, np.array([radius, half[axis], 0.0]), volume)
-    return best[:4]
+    volume, axis, centre, radius, a, b = _cylinder(V, refine=True)
+    if float(np.prod(2.0 * half)) <= volume:
+        return "Box", np.eye(3), 0.5 * (lo + hi), half
+    u, w = (axis + 1) % 3, (axis + 2) % 3
+    R = np.zeros((3, 3))
+    R[u, 0], R[w, 1], R[axis, 2] = 1.0, 1.0, 1.0  # a cyclic turn of the axes: a rotation
+    centre = centre.copy()
+    centre[axis] = 0.5 * (a + b)
+    return "Cylinder", R, centre, np.array([radius, 0.5 * (b - a), 0.0])
 
 
 def mesh_cylinder(V: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
