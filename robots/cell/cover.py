@@ -7,15 +7,17 @@ joint's frame, whose union **contains** the geometry (:func:`geometry_spheres`):
 - a cylinder (radius ``r``, half length ``h``): ``k`` slices of height ``2h/k`` along its
   axis, each inside the sphere at its centre of radius ``√(r² + (h/k)²)``;
 - a box: ``k`` slices along its longest side, each inside its circumscribed sphere;
-- a mesh (coal ``BVHModel``) or any other shape: its triangles grouped into ``k`` slices
-  along the longest side of its bounding box (by the triangle's centroid), each group inside
-  the sphere about its vertices' box centre through the farthest vertex (a sphere is convex:
-  holding a triangle's three vertices, it holds the triangle);
+- a mesh (coal ``BVHModel``): at most :data:`MESH_SPHERES` spheres on the axes of its
+  cylinder-like parts, holding every piece of its triangles (:func:`.mesh_cover.mesh_spheres`);
 - a shape with neither (a convex without triangles, a plane ...): the sphere about its
   local bounding box.
 
 A static box, cylinder or sphere (parent joint the world: the fixtures) is also kept
-exactly: a sphere's distance to it is computed in closed form, not through its cover.
+exactly: a sphere's distance to it is computed in closed form, not through its cover; a
+static mesh (an arm's base) is kept exactly as the smaller of the box and the cylinders
+holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, and a moving
+mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
+taken exactly against the other geometry's spheres (:func:`geometry_segments`).
 
 The screen (:meth:`Cover.screen`) answers, for a batch of cell configurations and a
 threshold per pair, which configurations are **proven** to keep every pair farther apart
@@ -34,12 +36,16 @@ from typing import Any, Sequence
 import numpy as np
 
 from ._cover_kernel import excess_kernel, screen_kernel
+from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
 
 __all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
-           "MAX_SPHERES"]
+           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE"]
 
-#: Most spheres per geometry.
+#: Most spheres per box geometry.
 MAX_SPHERES = 12
+#: Spheres per mesh (:func:`.mesh_cover.mesh_spheres`).
+MESH_SPHERES = 16
+_MESH_CACHE: dict = {}
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 
 
@@ -55,33 +61,13 @@ def _slices(length: float, width: float) -> int:
 
 
 def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
-    try:
-        V = np.asarray(geo.vertices(), dtype=float).reshape(-1, 3)
-        T = np.array([[t[0], t[1], t[2]] for t in (geo.tri_indices(i) for i in range(int(geo.num_tris)))],
-                     dtype=int).reshape(-1, 3)
-    except (AttributeError, TypeError, RuntimeError):
+    got = mesh_arrays(geo)
+    if got is None:
         return None
-    if V.shape[0] == 0:
-        return None
-    if T.shape[0] == 0:  # a point cloud: each vertex a degenerate triangle
-        T = np.repeat(np.arange(V.shape[0])[:, None], 3, axis=1)
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    ext = hi - lo
-    order = np.argsort(ext)
-    axis = int(order[-1])
-    k = _slices(float(ext[axis]), float(ext[order[-2]]))
-    centroid = V[T].mean(axis=1)[:, axis]
-    group = np.minimum(((centroid - lo[axis]) / max(ext[axis], 1e-12) * k).astype(int), k - 1)
-    centers, radii = [], []
-    for s in range(k):
-        idx = np.unique(T[group == s])
-        if idx.size == 0:
-            continue
-        P = V[idx]
-        c = 0.5 * (P.min(axis=0) + P.max(axis=0))
-        centers.append(c)
-        radii.append(float(np.sqrt(((P - c) ** 2).sum(axis=1).max())))
-    return np.array(centers), np.array(radii)
+    key = (got[0].tobytes(), got[1].tobytes(), MESH_SPHERES)
+    if key not in _MESH_CACHE:
+        _MESH_CACHE[key] = mesh_spheres(*got, MESH_SPHERES)
+    return _MESH_CACHE[key]
 
 
 def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -125,17 +111,49 @@ def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
     return centers, np.asarray(r, dtype=float) * (1.0 + 1e-9) + 1e-9
 
 
-def geometry_segments(geometry_object: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+#: A moving mesh is screened through the cylinder holding it (exact against the other geometry's spheres,
+#: its flat ends against boxes) when that cylinder is at most this many times its box's volume, and
+#: :data:`TURNING_SHARE` times when its axis is its joint's axis (a housing turning about its own axis,
+#: like the UR5's shoulder over its base).
+CYLINDER_SHARE = 1.0
+TURNING_SHARE = 1.3
+
+
+def _mesh_cylinder(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The axis ends (in the geometry's frame) and radius [m] of the cylinder holding a moving mesh where it
+    is used (:data:`CYLINDER_SHARE`; ``joint_axis``: the parent joint's axis in its frame); else None."""
+    if int(geometry_object.parentJoint) == 0:
+        return None
+    got = mesh_arrays(geometry_object.geometry)
+    if got is None:
+        return None
+    a, b, radius, share = mesh_cylinder(got[0])
+    if share <= CYLINDER_SHARE:
+        return a, b, radius
+    if joint_axis is not None and share <= TURNING_SHARE:
+        u = np.asarray(geometry_object.placement.rotation) @ (b - a)
+        if abs(float(u @ np.asarray(joint_axis, dtype=float))) >= (1.0 - 1e-6) * float(np.linalg.norm(u)):
+            return a, b, radius
+    return None
+
+
+def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
-    cylinder (taken exactly against the other geometry's spheres); other geometries: their
-    spheres as zero-length axes (unused by the screen)."""
+    cylinder, or of the cylinder holding a moving mesh where it is smaller than the mesh's box (taken
+    exactly against the other geometry's spheres; ``joint_axis``: the parent joint's unit axis in its
+    frame, :data:`TURNING_SHARE`); other geometries: their spheres as zero-length axes (unused by the
+    screen)."""
     geo = geometry_object.geometry
+    M = geometry_object.placement
+    R, p = np.asarray(M.rotation), np.asarray(M.translation)
     if type(geo).__name__ == "Cylinder":
-        M = geometry_object.placement
-        R, p = np.asarray(M.rotation), np.asarray(M.translation)
         h = float(geo.halfLength)
         a, b = p - h * R[:, 2], p + h * R[:, 2]
         return a[None], b[None], np.array([float(geo.radius) * (1.0 + 1e-9) + 1e-9])
+    held = _mesh_cylinder(geometry_object, joint_axis)
+    if held is not None:
+        a, b, radius = held
+        return (R @ a + p)[None], (R @ b + p)[None], np.array([radius * (1.0 + 1e-9) + 1e-9])
     c, r = geometry_spheres(geometry_object)
     return c, c.copy(), r
 
@@ -304,30 +322,47 @@ def link_cover(cell: Any) -> Cover:
         centers.append(c)
         radii.append(r)
         start[g + 1] = start[g] + r.size
-        kind = type(obj.geometry).__name__
-        if obj.parentJoint == 0 and kind in ("Box", "Cylinder", "Sphere"):
-            frame_R[g] = obj.placement.rotation
-            frame_p[g] = obj.placement.translation
-            if kind == "Box":
-                exact[g], size[g] = _EXACT_BOX, np.asarray(obj.geometry.halfSide, dtype=float)
-            elif kind == "Cylinder":
-                exact[g], size[g] = _EXACT_CYLINDER, [obj.geometry.radius, obj.geometry.halfLength, 0.0]
-            else:
-                exact[g], size[g] = _EXACT_SPHERE, [obj.geometry.radius, 0.0, 0.0]
+        if obj.parentJoint == 0:
+            exact[g], frame_R[g], frame_p[g], size[g] = _static_shape(obj)
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
-                  _segments(objs), _bounds(objs, start, centers, radii))
+                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
     cell._sphere_cover = cover
     return cover
 
 
-def _segments(objs: list) -> tuple:
-    parts = [geometry_segments(obj) for obj in objs]
+def _static_shape(obj: Any) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """``(kind, world rotation, world centre, size)`` of a static geometry screened exactly (kind 0: not,
+    screened through its spheres): a box, cylinder or sphere itself; a mesh the smaller of the box and the
+    cylinders holding its vertices (:func:`.mesh_cover.static_primitive`)."""
+    geo, M = obj.geometry, obj.placement
+    R, p = np.asarray(M.rotation, dtype=float), np.asarray(M.translation, dtype=float)
+    kind = type(geo).__name__
+    if kind == "Box":
+        return _EXACT_BOX, R, p, np.asarray(geo.halfSide, dtype=float)
+    if kind == "Cylinder":
+        return _EXACT_CYLINDER, R, p, np.array([geo.radius, geo.halfLength, 0.0])
+    if kind == "Sphere":
+        return _EXACT_SPHERE, R, p, np.array([geo.radius, 0.0, 0.0])
+    got = mesh_arrays(geo)
+    if got is None:
+        return 0, np.eye(3), np.zeros(3), np.zeros(3)
+    shape, R_local, centre, half = static_primitive(got[0])
+    # a hair of slack over floating-point rounding of the placement
+    half = np.where(np.arange(3) < (3 if shape == "Box" else 2), half * (1.0 + 1e-9) + 1e-9, 0.0)
+    return (_EXACT_BOX if shape == "Box" else _EXACT_CYLINDER), R @ R_local, R @ centre + p, half
+
+
+def _segments(objs: list, axes: np.ndarray) -> tuple:
+    """The cover's cylinders (:func:`geometry_segments`; ``axes (nj, 3)``: each joint's axis in its frame)."""
+    turning = [axes[int(o.parentJoint)] if int(o.parentJoint) > 0 else None for o in objs]
+    parts = [geometry_segments(obj, u) for obj, u in zip(objs, turning)]
     sstart = np.concatenate([[0], np.cumsum([r.size for _, _, r in parts])]).astype(np.int64)
     sjoint = np.concatenate([np.full(r.size, int(o.parentJoint), dtype=np.int64) for o, (_, _, r) in zip(objs, parts)])
+    cyl = [type(o.geometry).__name__ == "Cylinder" or _mesh_cylinder(o, u) is not None for o, u in zip(objs, turning)]
     return (sjoint, np.ascontiguousarray(np.concatenate([a for a, _, _ in parts])),
             np.ascontiguousarray(np.concatenate([b for _, b, _ in parts])), np.concatenate([r for _, _, r in parts]),
-            sstart, np.array([type(o.geometry).__name__ == "Cylinder" for o in objs], dtype=np.bool_))
+            sstart, np.array(cyl, dtype=np.bool_))
 
 
 def _bounds(objs: list, start: np.ndarray, centers: list, radii: list) -> tuple:
