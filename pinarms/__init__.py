@@ -6,7 +6,9 @@ Where each family lives (imports go one way, top to bottom of this list read upw
   :mod:`pinarms.execution` (serial loop or Dask), :mod:`pinarms.files` (atomic files),
   :mod:`pinarms.units`, :mod:`pinarms.compiled` (numba kernels and their caches);
 - :mod:`pinarms.robots`: registry and ``Robot``, ``ik/``, ``reach/`` (workspace, reachability
-  maps and their files, base placement, table band, layout check), ``cell/``, dynamics;
+  maps and their files, base placement, table band, layout check), ``cell/`` (cell, pairs with
+  proven bounds, collision state, the one continuous motion check and its proof ladder
+  ``cell/ladder.py``, the sphere cover of every geometry, scene files), payloads, dynamics;
 - :mod:`pinarms.planning`: trajectories, Cartesian paths, limits as objects;
 - :mod:`pinarms.optim`: ``ga/``, ``timing/`` (segment timing), ``topp/`` (time-optimal along a
   path), ``cycle/`` (the pick-and-place cycle), ``layout/`` (layout search), ``motion/``
