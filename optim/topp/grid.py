@@ -16,7 +16,7 @@ from pinarms.optim.caps import MAX_PATH_GRID_POINTS
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, ratios, rows_at
 from pinarms.optim.topp.profile import topp_profile
-from pinarms.planning.path_constraints import PathConstraint, PathSamples
+from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
 __all__ = ["path_grid", "refined_section"]
 
@@ -53,22 +53,58 @@ def _grown(grid: np.ndarray, what: str) -> np.ndarray:
     return grid
 
 
+def _check_points(grid: np.ndarray) -> np.ndarray:
+    """The check positions of every interval of ``grid``: (intervals · len(CHECK_FRACTIONS),)."""
+    h = np.diff(grid)
+    return (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
+
+
+def _merged(old: PathRows, keep: np.ndarray, fresh: PathRows) -> PathRows:
+    """Rows at the points of a refined grid: ``old``'s rows where ``keep`` (in order), ``fresh`` elsewhere."""
+    parts = []
+    for k in ("a", "b", "lo", "hi"):
+        o, f = getattr(old, k), getattr(fresh, k)
+        out = np.empty((keep.size, o.shape[1]))
+        out[keep] = o
+        out[~keep] = f
+        parts.append(out)
+    return PathRows(*parts, old.labels)
+
+
+def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, new: np.ndarray,
+                  rows: PathRows, crow: PathRows) -> tuple[np.ndarray, PathRows, PathRows]:
+    """The grid with the points ``new`` added, its rows and its check rows: the rows of the points and
+    intervals kept are reused (their positions are the same floats), only the new ones are evaluated."""
+    refined = _grown(np.sort(np.concatenate([grid, new])), "rtol")
+    old_point = np.zeros(refined.size, dtype=bool)
+    old_point[np.searchsorted(refined, grid)] = True
+    rows = _merged(rows, old_point, rows_at(path, constraints, refined[~old_point], "right"))
+    # an interval whose two ends are old points was not split: its check rows are unchanged
+    kept = np.repeat(old_point[:-1] & old_point[1:], CHECK_FRACTIONS.size)
+    fresh = _check_points(refined)[~kept]
+    was = np.flatnonzero(np.repeat(np.diff(np.flatnonzero(old_point)) == 1, CHECK_FRACTIONS.size))
+    old_crow = PathRows(crow.a[was], crow.b[was], crow.lo[was], crow.hi[was], crow.labels)
+    return refined, rows, _merged(old_crow, kept, rows_at(path, constraints, fresh, "left"))
+
+
 def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
                     rtol: float, max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
-    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios)."""
+    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios).
+
+    The rows depend on the positions only: a round re-evaluates them at the new grid points and in
+    the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all)."""
     names: list[str] = []
     for c in constraints:
         names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
     rounds = 0
+    rows = rows_at(path, constraints, grid, "right")
+    crow = rows_at(path, constraints, _check_points(grid), "left")
     while True:
-        rows = rows_at(path, constraints, grid, "right")
         prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
         h = np.diff(grid)
-        sc = (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
         uc = np.repeat(prof.u, CHECK_FRACTIONS.size)
         xc = (prof.x[:-1, None] + 2.0 * prof.u[:, None] * h[:, None] * CHECK_FRACTIONS).reshape(-1)
         xc = np.maximum(xc, 0.0)
-        crow = rows_at(path, constraints, sc, "left")
         need = dilation_needed(crow, uc, xc).reshape(h.size, -1).max(axis=1)
         if np.any(~np.isfinite(need)):
             k = int(np.argmax(~np.isfinite(need)))
@@ -78,5 +114,5 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
         if not bad.any() or rounds >= max_rounds:
             break
         rounds += 1
-        grid = _grown(np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]])), "rtol")
+        grid, rows, crow = _refined_rows(path, constraints, grid, grid[:-1][bad] + 0.5 * h[bad], rows, crow)
     return grid, prof.x, prof.u, float(need.max()), rounds, ratios(crow, uc, xc, names)
