@@ -53,10 +53,18 @@ def _grown(grid: np.ndarray, what: str) -> np.ndarray:
     return grid
 
 
-def _check_points(grid: np.ndarray) -> np.ndarray:
-    """The check positions of every interval of ``grid``: (intervals · len(CHECK_FRACTIONS),)."""
+#: The check fractions inside an interval; the last one, 1, is the interval's end (a grid point).
+_INNER = CHECK_FRACTIONS[:-1]
+
+
+def _inner_points(grid: np.ndarray) -> np.ndarray:
+    """The check positions inside every interval of ``grid``: (intervals · len(_INNER),)."""
     h = np.diff(grid)
-    return (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
+    return (grid[:-1, None] + h[:, None] * _INNER).reshape(-1)
+
+
+def _taken(rows: PathRows, index: np.ndarray) -> PathRows:
+    return PathRows(rows.a[index], rows.b[index], rows.lo[index], rows.hi[index], rows.labels)
 
 
 def _merged(old: PathRows, keep: np.ndarray, fresh: PathRows) -> PathRows:
@@ -71,20 +79,36 @@ def _merged(old: PathRows, keep: np.ndarray, fresh: PathRows) -> PathRows:
     return PathRows(*parts, old.labels)
 
 
+def _check_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, rows: PathRows,
+                inner: PathRows) -> PathRows:
+    """The rows at every check position, interval after interval: the ``inner`` ones, then the interval's
+    end from the left — the grid point's own rows (the same piece) except on a path break."""
+    ends = _taken(rows, np.arange(1, grid.size))
+    on_break = np.isin(grid[1:], np.asarray(path.breaks)[1:-1])
+    if on_break.any():
+        ends = _merged(_taken(ends, ~on_break), ~on_break, rows_at(path, constraints, grid[1:][on_break], "left"))
+    k = _INNER.size
+    parts = []
+    for name in ("a", "b", "lo", "hi"):
+        i, e = getattr(inner, name), getattr(ends, name)
+        both = np.concatenate([i.reshape(grid.size - 1, k, -1), e[:, None, :]], axis=1)
+        parts.append(both.reshape(-1, i.shape[1]))
+    return PathRows(*parts, rows.labels)
+
+
 def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, new: np.ndarray,
-                  rows: PathRows, crow: PathRows) -> tuple[np.ndarray, PathRows, PathRows]:
-    """The grid with the points ``new`` added, its rows and its check rows: the rows of the points and
-    intervals kept are reused (their positions are the same floats), only the new ones are evaluated."""
+                  rows: PathRows, inner: PathRows) -> tuple[np.ndarray, PathRows, PathRows]:
+    """The grid with the points ``new`` added, its rows and its inner check rows: the rows of the points
+    and intervals kept are reused (their positions are the same floats), only the new ones are evaluated."""
     refined = _grown(np.sort(np.concatenate([grid, new])), "rtol")
     old_point = np.zeros(refined.size, dtype=bool)
     old_point[np.searchsorted(refined, grid)] = True
     rows = _merged(rows, old_point, rows_at(path, constraints, refined[~old_point], "right"))
     # an interval whose two ends are old points was not split: its check rows are unchanged
-    kept = np.repeat(old_point[:-1] & old_point[1:], CHECK_FRACTIONS.size)
-    fresh = _check_points(refined)[~kept]
-    was = np.flatnonzero(np.repeat(np.diff(np.flatnonzero(old_point)) == 1, CHECK_FRACTIONS.size))
-    old_crow = PathRows(crow.a[was], crow.b[was], crow.lo[was], crow.hi[was], crow.labels)
-    return refined, rows, _merged(old_crow, kept, rows_at(path, constraints, fresh, "left"))
+    kept = np.repeat(old_point[:-1] & old_point[1:], _INNER.size)
+    fresh = _inner_points(refined)[~kept]
+    was = np.flatnonzero(np.repeat(np.diff(np.flatnonzero(old_point)) == 1, _INNER.size))
+    return refined, rows, _merged(_taken(inner, was), kept, rows_at(path, constraints, fresh, "left"))
 
 
 def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
@@ -92,14 +116,16 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
     """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios).
 
     The rows depend on the positions only: a round re-evaluates them at the new grid points and in
-    the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all)."""
+    the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all),
+    and the check at an interval's end reads the grid point's own rows (:func:`_check_rows`)."""
     names: list[str] = []
     for c in constraints:
         names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
     rounds = 0
     rows = rows_at(path, constraints, grid, "right")
-    crow = rows_at(path, constraints, _check_points(grid), "left")
+    inner = rows_at(path, constraints, _inner_points(grid), "left")
     while True:
+        crow = _check_rows(path, constraints, grid, rows, inner)
         prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
         h = np.diff(grid)
         uc = np.repeat(prof.u, CHECK_FRACTIONS.size)
@@ -114,5 +140,5 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
         if not bad.any() or rounds >= max_rounds:
             break
         rounds += 1
-        grid, rows, crow = _refined_rows(path, constraints, grid, grid[:-1][bad] + 0.5 * h[bad], rows, crow)
+        grid, rows, inner = _refined_rows(path, constraints, grid, grid[:-1][bad] + 0.5 * h[bad], rows, inner)
     return grid, prof.x, prof.u, float(need.max()), rounds, ratios(crow, uc, xc, names)
