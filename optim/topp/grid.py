@@ -112,15 +112,15 @@ def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.nda
 
 
 def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
-                    rtol: float, max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
+                    rtol: float, max_rounds: int,
+                    with_ratios: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
     """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios).
+
+    ``with_ratios=False``: the ratios per constraint are not computed (an empty dict).
 
     The rows depend on the positions only: a round re-evaluates them at the new grid points and in
     the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all),
     and the check at an interval's end reads the grid point's own rows (:func:`_check_rows`)."""
-    names: list[str] = []
-    for c in constraints:
-        names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
     rounds = 0
     rows = rows_at(path, constraints, grid, "right")
     inner = rows_at(path, constraints, _inner_points(grid), "left")
@@ -141,4 +141,7 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
             break
         rounds += 1
         grid, rows, inner = _refined_rows(path, constraints, grid, grid[:-1][bad] + 0.5 * h[bad], rows, inner)
+    if not with_ratios:
+        return grid, prof.x, prof.u, float(need.max()), rounds, {}
+    names = [c.name for c in constraints for _ in range(c.rows(PathSamples.of(path, grid[:1])).a.shape[1])]
     return grid, prof.x, prof.u, float(need.max()), rounds, ratios(crow, uc, xc, names)

@@ -178,7 +178,8 @@ def _checked_settings(path: Any, jerk: Any, grid: int, kappa: float, start_speed
 
 def _profiled_sections(path: Any, cons: tuple, grid: int, kappa: float, start_speed: float, end_speed: float,
                        rtol: float, max_rounds: int) -> list[tuple]:
-    """Steps 1–4 on every section between stops: (s, x, u, f², rounds, ratios) each."""
+    """Steps 1–4 on every section between stops: (s, x, u, f², rounds, {}) each (the reported ratios are
+    those of the final law, :attr:`PathTiming.ratios`)."""
     sections = path.sections()
     L = path.length
     results = []
@@ -186,7 +187,7 @@ def _profiled_sections(path: Any, cons: tuple, grid: int, kappa: float, start_sp
         g = path_grid(path, a, b, L, grid, kappa)
         x0 = start_speed**2 if i == 0 else 0.0
         x1 = end_speed**2 if i == len(sections) - 1 else 0.0
-        results.append(refined_section(path, cons, g, x0, x1, rtol, max_rounds))
+        results.append(refined_section(path, cons, g, x0, x1, rtol, max_rounds, with_ratios=False))
     return results
 
 
