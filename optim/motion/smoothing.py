@@ -10,12 +10,15 @@ a cumulative bound ``T(s)``; the samples are placed at equal steps of T, and eve
 the proof halves gets the bound of its own half from T). Where the proof fails the
 polyline edges around the failing piece get vertices at their quarter points, which pulls
 the spline towards the proven polyline, and the spline is proven again
-(:data:`REFINE_ROUNDS` rounds at most). If that does not succeed, the polyline itself is
-the path, with stops at its corners: slower, but proven by the search.
+(:data:`REFINE_ROUNDS` rounds at most; the pieces around the new vertices are proven first,
+so that a spline failing there again is refused before the rest is proven). If that does not
+succeed, the polyline itself is the path, with stops at its corners: slower, but proven by
+the search.
 """
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from typing import Any
 
 import numpy as np
@@ -101,26 +104,71 @@ def _samples(checker: Any, path: JointPath) -> tuple[np.ndarray, np.ndarray, tup
     return s, np.diff(np.interp(s, nodes, T)), (nodes, T)
 
 
-def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None) -> Any:
+class _PointEvaluator:
+    """One point at a time, as the proof's bisection asks for them: ``q(s)`` (Horner on the piece) and
+    the cumulative travel bound ``T(s)`` (linear between its nodes), in plain Python floats and
+    one small array (a call of :meth:`JointPath.sample` per point costs several times more)."""
+
+    def __init__(self, path: JointPath, nodes: np.ndarray, T: np.ndarray) -> None:
+        self.breaks = np.asarray(path.breaks, dtype=float).tolist()
+        self.coefs = path.coefficients
+        self.nodes, self.T = nodes.tolist(), T.tolist()
+
+    def q(self, s: float) -> np.ndarray:
+        k = min(max(bisect_right(self.breaks, s) - 1, 0), len(self.breaks) - 2)
+        sigma = s - self.breaks[k]
+        c = self.coefs[k]
+        out = c[-1].copy()
+        for d in range(c.shape[0] - 2, -1, -1):
+            out *= sigma
+            out += c[d]
+        return out
+
+    def bound(self, s: float) -> float:
+        nodes, T = self.nodes, self.T
+        j = min(max(bisect_right(nodes, s) - 1, 0), len(nodes) - 2)
+        width = nodes[j + 1] - nodes[j]
+        t = min(max((s - nodes[j]) / width, 0.0), 1.0) if width > 0.0 else 1.0
+        return T[j] + (T[j + 1] - T[j]) * t
+
+
+def _runs(s: np.ndarray, focus: tuple[float, float] | None) -> list[tuple[int, int]]:
+    """Runs of sample intervals ``(first sample, last sample)`` to prove in turn: those meeting ``focus``
+    (a range of s) first, then the rest before and after it; the whole path when ``focus`` is None."""
+    last = s.size - 1
+    if focus is None:
+        return [(0, last)]
+    a = int(np.clip(np.searchsorted(s, focus[0], side="right") - 1, 0, last - 1))
+    b = int(np.clip(np.searchsorted(s, focus[1], side="left"), a + 1, last))
+    return [(a, b)] + [(i, j) for i, j in ((0, a), (b, last)) if j > i]
+
+
+def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None, *,
+               focus: tuple[float, float] | None = None) -> Any:
     """Prove that every configuration of ``path`` keeps the checker's margins (module docstring).
 
-    ``extra``: per-path-joint lever additions (unused for a planned arm's own path).
+    Returns ``(verdict, piece)``: the piece of the first interval found not proven (``None`` when
+    proven). ``focus``: a range of s proven first (where the path last changed: a failure there
+    is found before the rest is proven). ``extra``: per-path-joint lever additions (unused for a
+    planned arm's own path).
     """
     s, budgets, (nodes, T) = _samples(checker, path)
     X = path(s)
+    at = _PointEvaluator(path, nodes, T)
+    verdict = None
+    for first, last in _runs(s, focus):
+        def midpoint(i: int, fa: float, fb: float, B: float, first: int = first):
+            lo, hi = float(s[first + i]), float(s[first + i + 1])
+            sa, sm, sb = lo + fa * (hi - lo), lo + 0.5 * (fa + fb) * (hi - lo), lo + fb * (hi - lo)
+            Tm = at.bound(sm)  # each half's own bound
+            return at.q(sm), min(Tm - at.bound(sa), B), min(at.bound(sb) - Tm, B)
 
-    def midpoint(i: int, fa: float, fb: float, B: float):
-        lo, hi = s[i], s[i + 1]
-        at = np.array([lo + fa * (hi - lo), lo + 0.5 * (fa + fb) * (hi - lo), lo + fb * (hi - lo)])
-        left, right = np.diff(np.interp(at, nodes, T))  # each half's own bound
-        return path(at[1:2])[0], min(float(left), B), min(float(right), B)
-
-    verdict = checker.prove(X, budgets, midpoint, top=-COARSE)
-    if verdict.ok:
-        return verdict, None
-    i = max(0, min(int(verdict.first_bad), budgets.size - 1))
-    piece = np.searchsorted(path.breaks, 0.5 * (s[i] + s[i + 1]), side="right") - 1
-    return verdict, int(np.clip(piece, 0, len(path.breaks) - 2))
+        verdict = checker.prove(X[first : last + 1], budgets[first:last], midpoint, top=-COARSE)
+        if not verdict.ok:
+            i = first + max(0, min(int(verdict.first_bad), last - first - 1))
+            piece = np.searchsorted(path.breaks, 0.5 * (s[i] + s[i + 1]), side="right") - 1
+            return verdict, int(np.clip(piece, 0, len(path.breaks) - 2))
+    return verdict, None
 
 
 def polyline_path(waypoints: np.ndarray, robot: Any = None) -> JointPath:
@@ -146,9 +194,12 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None) -> tuple
     W = W[np.concatenate([[True], step > 1e-12])]
     if W.shape[0] <= 2:
         return polyline_path(W, robot), "straight line", 0
+    changed = None  # the pieces of the spline around the last vertices inserted: proven first
     for rounds in range(REFINE_ROUNDS + 1):
         path = joint_spline(W, robot=robot)
-        verdict, piece = prove_path(checker, path)
+        focus = None if changed is None else \
+            (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
+        verdict, piece = prove_path(checker, path, focus=focus)
         if verdict.ok:
             return path, "cubic spline", rounds
         # pull the spline towards the proven polyline around the failing piece
@@ -159,4 +210,5 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None) -> tuple
             rows.append(np.stack([a + 0.25 * (b - a), a + 0.75 * (b - a), b]))
         rows.append(W[hi + 2:])
         W = np.concatenate(rows)
+        changed = (lo, lo + 3 * (hi - lo + 1))
     return polyline_path(waypoints, robot), "polyline with stops", REFINE_ROUNDS

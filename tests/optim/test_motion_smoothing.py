@@ -70,3 +70,19 @@ def test_a_spline_through_the_wall_is_refused_and_a_clear_one_proven(checker):
     near = joint_spline(np.stack([qa, qa + 0.02, qa + 0.03]))
     verdict, piece = prove_path(checker, near)
     assert verdict.ok and piece is None
+
+
+def test_the_bisection_reads_the_path_and_the_bound_as_the_arrays_do(checker, spline):
+    from pinarms.optim.motion.smoothing import _PointEvaluator
+
+    nodes, T = _travel_bound(checker, spline)
+    at = _PointEvaluator(spline, nodes, T)
+    for s in np.random.default_rng(2).uniform(0.0, spline.length, 50).tolist() + list(spline.breaks):
+        np.testing.assert_allclose(at.q(s), spline(s), rtol=0.0, atol=1e-12)
+        assert at.bound(s) == pytest.approx(float(np.interp(s, nodes, T)), rel=1e-12, abs=1e-15)
+
+
+def test_a_focus_first_proves_the_same_path(checker, spline):
+    whole, _ = prove_path(checker, spline)
+    focused, _ = prove_path(checker, spline, focus=(0.3 * spline.length, 0.6 * spline.length))
+    assert whole.ok == focused.ok
