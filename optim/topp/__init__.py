@@ -7,7 +7,7 @@
   of limits (:class:`PathTiming`), built from :mod:`.grid` (the grid of a section, the profile
   checked and refined), :mod:`.dense_check` (rows between grid points, exact joint peaks) and
   :mod:`.time_law` (s(t) as a piecewise polynomial, its smoothing, q(s(t)) composed exactly);
-- :mod:`.row_bounds`: the rows as bounds on the state, pruned and laid out for the profile's loops.
+- :mod:`.row_bounds`: the rows as bounds on the state; :mod:`._profile_kernel`: the profile's loops, compiled.
 
 """
 

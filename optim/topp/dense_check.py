@@ -10,6 +10,8 @@ as f²) and how close each constraint comes to its bound (:func:`ratios`). For j
 
 from __future__ import annotations
 
+from functools import lru_cache
+from math import comb
 from typing import Any, Sequence
 
 import numpy as np
@@ -17,7 +19,7 @@ import numpy as np
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.topp.time_law import law_eval
 from pinarms.planning import Trajectory
-from pinarms.planning.extrema import normalised_pieces, piece_extrema
+from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
 __all__ = ["CHECK_FRACTIONS", "Peaked", "rows_at", "row_names", "dilation_needed", "ratios", "law_rows", "law_check"]
@@ -46,8 +48,7 @@ class Peaked:
         if r not in self._cache:
             if self._normalised is None:
                 self._normalised = normalised_pieces(self._coefs, self._h)
-            values, _ = piece_extrema(self._normalised, self._h, (r,))
-            self._cache[r] = np.abs(values[0]).max(axis=(0, 2))
+            self._cache[r] = _exact_peaks(self._normalised, self._h, r)
         return self._cache[r]
 
     @property
@@ -64,6 +65,40 @@ class Peaked:
 
     def peaks(self) -> "Peaked":
         return self
+
+
+@lru_cache(maxsize=16)
+def _to_bernstein(width: int) -> np.ndarray:
+    """(W, W): ascending power coefficients on [0, 1] times it are the Bernstein coefficients of degree W − 1."""
+    d = width - 1
+    out = np.zeros((width, width))
+    for k in range(width):
+        for i in range(k, width):
+            out[k, i] = comb(i, k) / comb(d, k)
+    return out
+
+
+def _exact_peaks(normalised: np.ndarray, h: np.ndarray, r: int) -> np.ndarray:
+    """Per joint, the exact peak of ``|d^r q / dt^r|`` over every piece (n,).
+
+    A piece whose bound ``h^-r max_i |b_i|`` (b: the derivative's Bernstein coefficients in
+    normalised time s ∈ [0, 1]; the polynomial lies in their convex hull) is below the largest value some piece takes at one of
+    its ends cannot hold the peak: only the other (piece, joint) rows get their exact extrema
+    (roots of the next derivative), the same arithmetic row by row as for all of them.
+    """
+    M, n, width = normalised.shape
+    deriv = derivative_coefficients(normalised, r, axis=-1)  # (M, n, W) in s
+    scale = (h ** -float(r))[:, None]
+    ends = np.maximum(np.abs(deriv[:, :, 0]), np.abs(deriv.sum(axis=-1))) * scale  # |p(0)|, |p(1)|
+    floor = ends.max(axis=0)  # (n,): reached at some piece end
+    bound = np.abs(deriv @ _to_bernstein(width)).max(axis=-1) * scale * (1.0 + 1e-9) + 1e-300
+    keep_piece, keep_joint = np.nonzero(bound >= floor[None, :])
+    peaks = np.zeros(n)  # the piece reaching ``floor`` is kept: every peak comes from piece_extrema
+    if keep_piece.size:
+        sel = normalised[keep_piece, keep_joint][:, None, :]  # (K, 1, W)
+        values, _ = piece_extrema(sel, h[keep_piece], (r,))
+        np.maximum.at(peaks, keep_joint, np.abs(values[0, :, 0]).max(axis=-1))
+    return peaks
 
 
 def rows_at(path: Any, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:

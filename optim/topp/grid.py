@@ -16,7 +16,7 @@ from pinarms.optim.caps import MAX_PATH_GRID_POINTS
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, ratios, rows_at
 from pinarms.optim.topp.profile import topp_profile
-from pinarms.planning.path_constraints import PathConstraint, PathSamples
+from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
 __all__ = ["path_grid", "refined_section"]
 
@@ -53,22 +53,84 @@ def _grown(grid: np.ndarray, what: str) -> np.ndarray:
     return grid
 
 
+#: The check fractions inside an interval; the last one, 1, is the interval's end (a grid point).
+_INNER = CHECK_FRACTIONS[:-1]
+
+
+def _inner_points(grid: np.ndarray) -> np.ndarray:
+    """The check positions inside every interval of ``grid``: (intervals · len(_INNER),)."""
+    h = np.diff(grid)
+    return (grid[:-1, None] + h[:, None] * _INNER).reshape(-1)
+
+
+def _taken(rows: PathRows, index: np.ndarray) -> PathRows:
+    return PathRows(rows.a[index], rows.b[index], rows.lo[index], rows.hi[index], rows.labels)
+
+
+def _merged(old: PathRows, keep: np.ndarray, fresh: PathRows) -> PathRows:
+    """Rows at the points of a refined grid: ``old``'s rows where ``keep`` (in order), ``fresh`` elsewhere."""
+    parts = []
+    for k in ("a", "b", "lo", "hi"):
+        o, f = getattr(old, k), getattr(fresh, k)
+        out = np.empty((keep.size, o.shape[1]))
+        out[keep] = o
+        out[~keep] = f
+        parts.append(out)
+    return PathRows(*parts, old.labels)
+
+
+def _check_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, rows: PathRows,
+                inner: PathRows) -> PathRows:
+    """The rows at every check position, interval after interval: the ``inner`` ones, then the interval's
+    end from the left — the grid point's own rows (the same piece) except on a path break."""
+    ends = _taken(rows, np.arange(1, grid.size))
+    on_break = np.isin(grid[1:], np.asarray(path.breaks)[1:-1])
+    if on_break.any():
+        ends = _merged(_taken(ends, ~on_break), ~on_break, rows_at(path, constraints, grid[1:][on_break], "left"))
+    k = _INNER.size
+    parts = []
+    for name in ("a", "b", "lo", "hi"):
+        i, e = getattr(inner, name), getattr(ends, name)
+        both = np.concatenate([i.reshape(grid.size - 1, k, -1), e[:, None, :]], axis=1)
+        parts.append(both.reshape(-1, i.shape[1]))
+    return PathRows(*parts, rows.labels)
+
+
+def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, new: np.ndarray,
+                  rows: PathRows, inner: PathRows) -> tuple[np.ndarray, PathRows, PathRows]:
+    """The grid with the points ``new`` added, its rows and its inner check rows: the rows of the points
+    and intervals kept are reused (their positions are the same floats), only the new ones are evaluated."""
+    refined = _grown(np.sort(np.concatenate([grid, new])), "rtol")
+    old_point = np.zeros(refined.size, dtype=bool)
+    old_point[np.searchsorted(refined, grid)] = True
+    rows = _merged(rows, old_point, rows_at(path, constraints, refined[~old_point], "right"))
+    # an interval whose two ends are old points was not split: its check rows are unchanged
+    kept = np.repeat(old_point[:-1] & old_point[1:], _INNER.size)
+    fresh = _inner_points(refined)[~kept]
+    was = np.flatnonzero(np.repeat(np.diff(np.flatnonzero(old_point)) == 1, _INNER.size))
+    return refined, rows, _merged(_taken(inner, was), kept, rows_at(path, constraints, fresh, "left"))
+
+
 def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
-                    rtol: float, max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
-    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios)."""
-    names: list[str] = []
-    for c in constraints:
-        names.extend([c.name] * c.rows(PathSamples.of(path, grid[:1])).a.shape[1])
+                    rtol: float, max_rounds: int,
+                    with_ratios: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
+    """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios).
+
+    ``with_ratios=False``: the ratios per constraint are not computed (an empty dict).
+
+    The rows depend on the positions only: a round re-evaluates them at the new grid points and in
+    the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all),
+    and the check at an interval's end reads the grid point's own rows (:func:`_check_rows`)."""
     rounds = 0
+    rows = rows_at(path, constraints, grid, "right")
+    inner = rows_at(path, constraints, _inner_points(grid), "left")
     while True:
-        rows = rows_at(path, constraints, grid, "right")
+        crow = _check_rows(path, constraints, grid, rows, inner)
         prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
         h = np.diff(grid)
-        sc = (grid[:-1, None] + h[:, None] * CHECK_FRACTIONS).reshape(-1)
         uc = np.repeat(prof.u, CHECK_FRACTIONS.size)
         xc = (prof.x[:-1, None] + 2.0 * prof.u[:, None] * h[:, None] * CHECK_FRACTIONS).reshape(-1)
         xc = np.maximum(xc, 0.0)
-        crow = rows_at(path, constraints, sc, "left")
         need = dilation_needed(crow, uc, xc).reshape(h.size, -1).max(axis=1)
         if np.any(~np.isfinite(need)):
             k = int(np.argmax(~np.isfinite(need)))
@@ -78,5 +140,8 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
         if not bad.any() or rounds >= max_rounds:
             break
         rounds += 1
-        grid = _grown(np.sort(np.concatenate([grid, grid[:-1][bad] + 0.5 * h[bad]])), "rtol")
+        grid, rows, inner = _refined_rows(path, constraints, grid, grid[:-1][bad] + 0.5 * h[bad], rows, inner)
+    if not with_ratios:
+        return grid, prof.x, prof.u, float(need.max()), rounds, {}
+    names = [c.name for c in constraints for _ in range(c.rows(PathSamples.of(path, grid[:1])).a.shape[1])]
     return grid, prof.x, prof.u, float(need.max()), rounds, ratios(crow, uc, xc, names)

@@ -85,7 +85,9 @@ class PathTiming:
         smoothing: the averaging window τ [s] (0 without a jerk limit).
         rounds: grid refinements made.
         ratios: per constraint name, the largest value / bound of the dense check (<= 1; for
-            speed limits the ratio of speeds, not of their squares).
+            speed limits the ratio of speeds, not of their squares): the rows at 0, 1/4 … 1 of
+            every law piece, evaluated on first use (a planner that never reads them does not
+            pay for them; the limits themselves were checked before the timing was returned).
     """
 
     path: Any = field(repr=False)
@@ -97,7 +99,15 @@ class PathTiming:
     dilation: float = 1.0
     smoothing: float = 0.0
     rounds: int = 0
-    ratios: dict = field(default_factory=dict)
+    given_ratios: dict | None = field(default=None, repr=False)
+
+    @property
+    def ratios(self) -> dict:
+        """Largest value / bound per constraint name (class docstring), computed once on first use."""
+        if self.given_ratios is None:
+            rows, u, x = law_rows(self.path, self.constraints, self.law_breaks, self.law_coefficients)
+            object.__setattr__(self, "given_ratios", ratios(rows, u, x, row_names(self.path, self.constraints)))
+        return self.given_ratios
 
     @property
     def duration(self) -> float:
@@ -168,7 +178,8 @@ def _checked_settings(path: Any, jerk: Any, grid: int, kappa: float, start_speed
 
 def _profiled_sections(path: Any, cons: tuple, grid: int, kappa: float, start_speed: float, end_speed: float,
                        rtol: float, max_rounds: int) -> list[tuple]:
-    """Steps 1–4 on every section between stops: (s, x, u, f², rounds, ratios) each."""
+    """Steps 1–4 on every section between stops: (s, x, u, f², rounds, {}) each (the reported ratios are
+    those of the final law, :attr:`PathTiming.ratios`)."""
     sections = path.sections()
     L = path.length
     results = []
@@ -176,7 +187,7 @@ def _profiled_sections(path: Any, cons: tuple, grid: int, kappa: float, start_sp
         g = path_grid(path, a, b, L, grid, kappa)
         x0 = start_speed**2 if i == 0 else 0.0
         x1 = end_speed**2 if i == len(sections) - 1 else 0.0
-        results.append(refined_section(path, cons, g, x0, x1, rtol, max_rounds))
+        results.append(refined_section(path, cons, g, x0, x1, rtol, max_rounds, with_ratios=False))
     return results
 
 
@@ -258,10 +269,8 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
     if f_exact > 1.0 + 1e-12:  # between the check points (or past a rounding): slow once more, exactly
         tb, C, traj = _slowed(path, tb, C, f_exact)
         f *= f_exact
-    rows, u, x = law_rows(path, cons, tb, C)
     grid_all = np.concatenate([r[0] for r in results])
-    return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing),
-                      int(sum(r[4] for r in results)), ratios(rows, u, x, row_names(path, cons)))
+    return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing), int(sum(r[4] for r in results)))
 
 
 def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
@@ -294,9 +303,7 @@ def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str 
     f = max(c.exact_dilation(Peaked(traj)) for c in cons)
     if f > 1.0 + 1e-12:
         tb, C, traj = _slowed(path, tb, C, f)
-    rows, u, x = law_rows(path, cons, tb, C)
-    return PathTiming(path, cons, traj, tb, C, np.concatenate(grids), float(f), 0.0, 0,
-                      ratios(rows, u, x, row_names(path, cons)))
+    return PathTiming(path, cons, traj, tb, C, np.concatenate(grids), float(f), 0.0, 0)
 
 
 def _shaped_section(path: Any, cons: tuple, sig: np.ndarray, tau: np.ndarray, a: float,

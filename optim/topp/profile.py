@@ -5,17 +5,16 @@ based on reachability analysis", IEEE T-RO 34(3), 2018, written here from the pa
 
 Why our own and not toppra: measured side by side by ``python benchmarks/topp.py`` (a UR5
 joint spline through 8 seeded waypoints, velocity and acceleration limits, the same 1354-point
-grid for both, best of 11 repeats), the rows plus this profile take 44.2 ms against 55.6 ms
-for toppra 0.6.10's ``compute_parameterization`` (0.80×, two shared cores under load; 25.5 ms
-against 30.8 ms, 0.83×, in a quieter run), with the same duration (9.063810 s both). It is
-faster than toppra, keeps the timings' figures to the last bit (toppra's answer differs by
-its own rounding), needs no compiled extension, and takes every :class:`planning.PathConstraint`
-as rows. The whole timing (:func:`optim.time_optimal`: refined grid, checks between grid
-points, exact joint peaks, q(t) composed exactly) takes 3.3–4.4× toppra's
-``compute_trajectory`` (187 ms against 56.7 ms; 129 ms against 29.6 ms), which does none of
-that (its duration is 0.034 % shorter: it meets the limits at the grid points only). toppra
-(test extra) stays the independent cross-check (:func:`optim.toppra_path_duration`,
-``tests/optim/topp/test_path_timing.py``).
+grid for both, best of 11 repeats), the rows plus this profile take 5.03 ms against 65.0 ms
+for toppra 0.6.10's ``compute_parameterization`` (0.08×, two shared cores, load 4.8; before
+the loops were compiled: 44.2 ms against 55.6 ms, 0.80×), with the same duration (9.063810 s
+both). It is faster than toppra, keeps the timings' figures to the last bit (toppra's answer
+differs by its own rounding), and takes every :class:`planning.PathConstraint` as rows. The
+whole timing (:func:`optim.time_optimal`: refined grid, checks between grid points, exact
+joint peaks, q(t) composed exactly) takes 1.9× toppra's ``compute_trajectory`` (56.6 ms
+against 30.4 ms, same run; 3.3–4.4× before), which does none of that (its duration is 0.034 %
+shorter: it meets the limits at the grid points only). toppra (test extra) stays the
+independent cross-check (:func:`optim.toppra_path_duration`, ``tests/optim/topp/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
 control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
@@ -32,10 +31,10 @@ each grid point the limits are rows ``lo <= a u + b x <= hi``
    point's own rows are the same for every step and are evaluated for all points at once
    (:func:`feasible_states`); only the pairs with the two ``K_{i+1}`` rows are computed in
    the backward loop.
-   Each step reads only the rows that can bind there: rows beyond another one over the
-   whole range the state can take (``X_{i+1}``, resp. ``K_i`` in step 2) by more than 1e-9
-   are left out before the loop (:func:`optim.topp.row_bounds.prune`, the same min and max to
-   the last bit), and with ``λ = 0`` the λ rows are constants reduced for all points at once.
+   The loops over the grid points (both passes) and the pairs of the point's own rows are
+   compiled (:mod:`._profile_kernel`, numba): each step is a minimum and a maximum over the
+   point's rows, the same product and sum per row as written in Python, so the same bits;
+   with ``λ = 0`` the λ rows are constants reduced for all points at once.
 2. **Greedy forward pass.** From ``x_0``, take the largest admissible u that keeps
    ``x_{i+1}`` in ``K_{i+1}``. Every state stays controllable, so the pass never fails, and
    the result is time-optimal on the grid (the paper's theorem).
@@ -52,7 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.optim.topp.row_bounds import prune, row_bounds, stage_lists
+from pinarms.optim.topp._profile_kernel import backward_pass, forward_pass, pair_states
+from pinarms.optim.topp.row_bounds import row_bounds
 
 __all__ = ["Profile", "feasible_states", "controllable_sets", "greedy_profile", "interpolated_rows",
            "topp_profile", "reachability_profile", "X_CAP"]
@@ -129,41 +129,16 @@ def feasible_states(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray
     L = (~free) & np.isfinite(lo)
     U = (~free) & np.isfinite(hi)
     if L.any() and U.any():
-        # only the columns that hold some lower (upper) row: the others pair with nothing
-        lc, uc = np.flatnonzero(L.any(axis=0)), np.flatnonzero(U.any(axis=0))
-        aL, bL, loL, L = a[:, lc], b[:, lc], lo[:, lc], L[:, lc]
-        aU, bU, hiU, U = a[:, uc], b[:, uc], hi[:, uc], U[:, uc]
-        pair = None if L.all() and U.all() else L[:, :, None] & U[:, None, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # (N, lower, upper), in place: a few arrays of this size instead of a dozen
-            c = np.multiply(aL[:, :, None], bU[:, None, :])
-            t = np.multiply(aU[:, None, :], bL[:, :, None])
-            c -= t
-            d = np.multiply(aL[:, :, None], np.where(U, hiU, 0.0)[:, None, :])
-            np.multiply(aU[:, None, :], np.where(L, loL, 0.0)[:, :, None], out=t)
-            d -= t
-            ratio = np.divide(d, c, out=t)
-            pos = c > 0.0
-            neg = c < 0.0
-            if pair is not None:
-                pos &= pair
-                neg &= pair
-            xhi = np.minimum(xhi, np.min(ratio, axis=(1, 2), initial=np.inf, where=pos))
-            xlo = np.maximum(xlo, np.max(ratio, axis=(1, 2), initial=-np.inf, where=neg))
-        bad = (c == 0.0) & (d < 0.0)
-        if pair is not None:
-            bad &= pair
-        if bad.any():
-            xlo[np.any(bad, axis=(1, 2))] = np.inf
+        pair_states(*(np.ascontiguousarray(v) for v in (a, b, lo, hi, L, U)), xlo, xhi)
     return np.stack([xlo, xhi], axis=1)
 
 
-def _backward_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, two: np.ndarray, X: np.ndarray,
-                   x_end: float) -> tuple[tuple, tuple, tuple[list, list, list]]:
+def _backward_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, two: np.ndarray,
+                   X: np.ndarray) -> tuple[tuple, tuple, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """The rows of the backward pass (step 1) as bounds on x, linear in μ and in λ of ``K_{i+1} = [λ, μ]``.
 
-    Returns the μ and the λ bounds as :func:`stage_lists` (rows that cannot bind pruned), and
-    the λ bounds at λ = 0 reduced for every point at once: (x_hi, x_lo, zero) lists (N+1,).
+    Returns the μ and the λ bounds as :func:`row_bounds` gives them, and the λ bounds at λ = 0
+    reduced for every point at once: (x_hi, x_lo, zero) (N+1,).
     """
     with np.errstate(invalid="ignore"):
         # a lower row of the point with x + 2Δu <= μ:  (a − 2Δ b) x <= a μ − 2Δ lo
@@ -172,19 +147,12 @@ def _backward_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
         # x + 2Δu >= λ with an upper row of the point:  (2Δ b − a) x <= 2Δ hi − a λ
         lam_rows = row_bounds(np.where(np.isfinite(hi), two * b - a, 0.0), np.where(np.isfinite(hi), -a, 0.0),
                               np.where(np.isfinite(hi), two * hi, np.inf))
-    # μ and λ of K_{i+1} lie in X_{i+1} (and x >= 0): rows that cannot bind there are left out
-    nxt_lo = np.maximum(np.concatenate([X[1:, 0], [x_end]]), 0.0)
-    nxt_hi = np.minimum(np.concatenate([X[1:, 1], [x_end]]), X_CAP)
-    mu_live = (mu_rows[0], prune(mu_rows[0], mu_rows[1], nxt_lo, nxt_hi, True),
-               mu_rows[2], prune(mu_rows[2], mu_rows[3], nxt_lo, nxt_hi, False), mu_rows[4], mu_rows[5])
-    lam_live = (lam_rows[0], prune(lam_rows[0], lam_rows[1], nxt_lo, nxt_hi, True),
-                lam_rows[2], prune(lam_rows[2], lam_rows[3], nxt_lo, nxt_hi, False), lam_rows[4], lam_rows[5])
     # with λ = 0 (the usual lower end of a controllable set) the λ rows are their offsets: one
     # vectorised reduction for every point (and the X bounds folded in)
-    up0 = np.minimum(X[:, 1], np.min(lam_rows[1], axis=1)).tolist()
-    dn0 = np.maximum(np.maximum(X[:, 0], 0.0), np.max(lam_rows[3], axis=1)).tolist()
-    zero0 = np.min(lam_rows[5], axis=1).tolist()
-    return stage_lists(*mu_live), stage_lists(*lam_live), (up0, dn0, zero0)
+    up0 = np.minimum(X[:, 1], np.min(lam_rows[1], axis=1))
+    dn0 = np.maximum(np.maximum(X[:, 0], 0.0), np.max(lam_rows[3], axis=1))
+    zero0 = np.min(lam_rows[5], axis=1)
+    return mu_rows, lam_rows, (up0, dn0, zero0)
 
 
 def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray,
@@ -203,56 +171,21 @@ def controllable_sets(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
     X = feasible_states(a, b, lo, hi) if feasible is None else feasible
     N = s.size - 1
     two = np.concatenate([2.0 * np.diff(s), [1.0]])[:, None]
-    K = [(0.0, 0.0)] * (N + 1)
     tol = 1e-9
     end_lo, end_hi = max(X[N, 0], x_end), min(X[N, 1], x_end)
     if end_lo > end_hi + tol * max(1.0, x_end):
         raise InfeasibleProblem(f"the path cannot end with ṡ² = {x_end:g} at s = {s[N]:.6g}: the limits there allow "
                                 f"[{X[N, 0]:.6g}, {X[N, 1]:.6g}]")
-    K[N] = (float(x_end), float(x_end))
-    mu_lists, lam_lists, (up0, dn0, zero0) = _backward_rows(a, b, lo, hi, two, X, x_end)
-    (Pu, Ou, ju), (Pl, Ol, jl), (Pz, Oz, jz) = mu_lists
-    (Qu, Vu, ku), (Ql, Vl, kl), (Qz, Vz, kz) = lam_lists
-    Xl = X.tolist()
-    inf = float("inf")
-    for i in range(N - 1, -1, -1):
-        lam, mu = K[i + 1]
-        if lam == 0.0:
-            xhi, xlo, zero = up0[i], dn0[i], zero0[i]
-        else:
-            xhi, xlo, zero = Xl[i][1], max(Xl[i][0], 0.0), inf
-            for k in range(ku[i], ku[i + 1]):
-                v = Qu[k] * lam + Vu[k]
-                if v < xhi:
-                    xhi = v
-            for k in range(kl[i], kl[i + 1]):
-                v = Ql[k] * lam + Vl[k]
-                if v > xlo:
-                    xlo = v
-            for k in range(kz[i], kz[i + 1]):
-                v = Qz[k] * lam + Vz[k]
-                if v < zero:
-                    zero = v
-        for k in range(ju[i], ju[i + 1]):
-            v = Pu[k] * mu + Ou[k]
-            if v < xhi:
-                xhi = v
-        for k in range(jl[i], jl[i + 1]):
-            v = Pl[k] * mu + Ol[k]
-            if v > xlo:
-                xlo = v
-        for k in range(jz[i], jz[i + 1]):
-            v = Pz[k] * mu + Oz[k]
-            if v < zero:
-                zero = v
-        if zero < -tol * max(1.0, abs(mu)) or mu < lam - tol * max(1.0, mu):
-            xlo = np.inf
-        if xlo > xhi + tol * max(1.0, abs(xhi)):
-            raise InfeasibleProblem(
-                f"no admissible speed at s = {s[i]:.6g} (grid point {i} of {N}): the limits cannot bring the "
-                f"motion to the path's end from there; relax the limits or change the path")
-        K[i] = (xlo, max(xlo, xhi))
-    return np.array(K, dtype=float)
+    mu_rows, lam_rows, reduced = _backward_rows(a, b, lo, hi, two, X)
+    K = np.zeros((N + 1, 2))
+    K[N] = float(x_end)
+    rows = [np.ascontiguousarray(r) for r in (*mu_rows, *lam_rows, *reduced)]
+    i = backward_pass(*rows, np.ascontiguousarray(X, dtype=float), tol, K)
+    if i >= 0:
+        raise InfeasibleProblem(
+            f"no admissible speed at s = {s[i]:.6g} (grid point {i} of {N}): the limits cannot bring the "
+            f"motion to the path's end from there; relax the limits or change the path")
+    return K
 
 
 def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, s: np.ndarray, K: np.ndarray,
@@ -279,34 +212,10 @@ def greedy_profile(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
         up_o = np.where(act & np.isfinite(hi), hi * inv, np.inf)
         dn_s = np.where(act & np.isfinite(lo), -b * inv, 0.0)  # u >= dn_s x + dn_o
         dn_o = np.where(act & np.isfinite(lo), lo * inv, -np.inf)
-    # x_i lies in K_i: rows that cannot bind there are left out
-    k_lo, k_hi = K[:, 0], np.minimum(K[:, 1], X_CAP)
-    (Pu, Ou, ju), (Pl, Ol, jl) = stage_lists(up_s, prune(up_s, up_o, k_lo, k_hi, True),
-                                              dn_s, prune(dn_s, dn_o, k_lo, k_hi, False))
-    Kl = K.tolist()
-    dl = delta.tolist()
-    xs = [float(min(max(x_start, K[0, 0]), K[0, 1]))]
-    us = []
-    xi = xs[0]
-    for i in range(N):
-        two = 2.0 * dl[i]
-        k_lo, k_hi = Kl[i + 1]
-        upper = (k_hi - xi) / two
-        for k in range(ju[i], ju[i + 1]):
-            v = Pu[k] * xi + Ou[k]
-            if v < upper:
-                upper = v
-        lower = (k_lo - xi) / two
-        for k in range(jl[i], jl[i + 1]):
-            v = Pl[k] * xi + Ol[k]
-            if v > lower:
-                lower = v
-        ui = lower if upper < lower else upper  # rounding only: stay controllable
-        xn = min(max(xi + two * ui, k_lo), k_hi, X_CAP)
-        us.append((xn - xi) / two)
-        xs.append(xn)
-        xi = xn
-    return np.array(xs), np.array(us)
+    xs, us = np.empty(N + 1), np.empty(N)
+    forward_pass(*(np.ascontiguousarray(r) for r in (up_s, up_o, dn_s, dn_o)), np.ascontiguousarray(delta),
+                 np.ascontiguousarray(K, dtype=float), float(min(max(x_start, K[0, 0]), K[0, 1])), X_CAP, xs, us)
+    return xs, us
 
 
 def interpolated_rows(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,

@@ -38,3 +38,18 @@ def test_peaked_gives_the_trajectory_exact_peaks_once_per_order():
     np.testing.assert_array_equal(peaked.acceleration, exact.acceleration)
     assert peaked.peaks() is peaked and peaked.n_joints == 2
     assert 3 not in peaked._cache  # jerk not asked for: never computed
+
+
+def test_exact_peaks_skip_only_pieces_that_cannot_hold_the_peak():
+    """The pruned peaks equal the extrema of every piece, bit for bit, on many short pieces."""
+    from pinarms.optim.topp.dense_check import _exact_peaks
+    from pinarms.planning.extrema import normalised_pieces, piece_extrema
+
+    rng = np.random.default_rng(3)
+    knots = np.cumsum(rng.uniform(0.05, 0.3, 41))
+    traj = quintic_bspline(knots - knots[0], rng.normal(size=(41, 3)))
+    h = traj.segment_durations
+    nz = normalised_pieces(traj.coefficients, h)
+    for r in (1, 2, 3):
+        values, _ = piece_extrema(nz, h, (r,))
+        np.testing.assert_array_equal(_exact_peaks(nz, h, r), np.abs(values[0]).max(axis=(0, 2)))
