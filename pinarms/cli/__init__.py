@@ -32,6 +32,6 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     workspace_commands,
 )
 from ._common import cli, main
-from .trajectory_commands import read_via_file
+from .via_points import read_via_file
 
 __all__ = ["cli", "main", "read_via_file"]
