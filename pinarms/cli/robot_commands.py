@@ -175,17 +175,7 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
             sols = np.atleast_2d(accepted[0])
         if position_only and accepted:  # asked for: the closed form (orientation as the base's) within --limit-tol
             sols = np.atleast_2d(accepted[0])
-    rows = []
-    for q in sols:
-        T_q = arm.fk(q)
-        outside = _outside(arm, q, user)
-        rows.append(
-            {
-                "q": joints_from_si(arm, q, deg=deg, mm=mm),
-                "position_error_m": float(np.linalg.norm(T_q[:3, 3] - T[:3, 3])),
-                "outside_limits": outside,
-            }
-        )
+    rows = _solution_rows(arm, sols, T, user, deg, mm)
     lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
     data = {
         "robot": arm.name,
@@ -208,8 +198,32 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
         reason = arm.ik_failure_reason(T)
         data["reason"] = reason
         lines.append(f"  none within the joint limits: {reason}")
+    lines += _near_limit_notes(arm, rows, data["near_limit_solutions"], kinds, user)
+    emit(as_json, data, lines)
+
+
+def _solution_rows(arm, sols: np.ndarray, T: np.ndarray, user: np.ndarray, deg: bool, mm: bool) -> list[dict]:
+    """One row per solution: ``q`` in the user's units, its tcp position error [m], the joints outside their range."""
+    rows = []
+    for q in sols:
+        T_q = arm.fk(q)
+        outside = _outside(arm, q, user)
+        rows.append(
+            {
+                "q": joints_from_si(arm, q, deg=deg, mm=mm),
+                "position_error_m": float(np.linalg.norm(T_q[:3, 3] - T[:3, 3])),
+                "outside_limits": outside,
+            }
+        )
+    return rows
+
+
+def _near_limit_notes(arm, rows: list[dict], near: list[dict], kinds: list[str], user: np.ndarray) -> list[str]:
+    """A note per closed-form solution just outside the joint ranges (and not listed): which joints miss, by how
+    much, and the --limit-tol that accepts it."""
+    lines = []
     taken = [r["q"] for r in rows]
-    for s, d in zip(near, data["near_limit_solutions"]):
+    for d in near:
         if any(np.allclose(d["q"], q, atol=1e-9) for q in taken):
             continue
         misses = ", ".join(f"{j} by {abs(e):.4g} {kinds[arm.joint_names.index(j)]} "
@@ -219,7 +233,7 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
         lines.append(f"  note: the closed-form solution ({fmt(d['q'])}) lies outside the joint ranges: {misses}; "
                      f"--limit-tol {float(np.format_float_positional(need * 1.01, precision=2, fractional=False))} "
                      "accepts it")
-    emit(as_json, data, lines)
+    return lines
 
 
 def _outside(arm, q: np.ndarray, user: np.ndarray) -> dict[str, float]:
