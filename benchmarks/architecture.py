@@ -42,7 +42,8 @@ ROOT = Path(__file__).resolve().parents[1]
 #: floor (errors, execution layer, atomic files, units) may be imported by every package and
 #: imports none of them.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.files", "pinarms.units", "pinarms.compiled")),
+    ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
+               "pinarms.units", "pinarms.compiled")),
     ("robots", ("pinarms.robots", "pinarms.urdf")),
     ("planning", ("pinarms.planning",)),
     ("optim", ("pinarms.optim",)),

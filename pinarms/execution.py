@@ -14,7 +14,9 @@ into *tasks*, applied with :func:`map_chunks`. The same call runs
   CLI's ``--scheduler`` option), so a library call never leaves the machine by surprise.
 
 Results are identical whatever runs them: randomness enters a task only through its own
-seed (:func:`chunk_seeds`), tasks are pure functions of their arguments, and results come
+seed (:func:`chunk_seeds`; cutting a sweep into chunks is :mod:`pinarms.chunks`, the
+``scheduler`` argument is checked and described by :mod:`pinarms.schedulers`; both names are
+importable from here too), tasks are pure functions of their arguments, and results come
 back in task order. A task that raises, or a worker that dies, gives
 :class:`~pinarms.errors.ExecutionError` with the chunk index and its seed, and no
 partial result (callers write files only after a complete result).
@@ -49,6 +51,9 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.chunks import chunk_seeds, split_count
+from pinarms.schedulers import describe_scheduler, parse_scheduler
+
 __all__ = [
     "chunk_seeds",
     "split_count",
@@ -58,9 +63,6 @@ __all__ = [
     "task_threads",
     "ExecutionError",
 ]
-
-#: Bits of each chunk seed drawn from the chunk's SeedSequence (two 64-bit words).
-SEED_BITS = 128
 
 
 def __getattr__(name: str):
@@ -91,41 +93,6 @@ def _invalid(message: str) -> Exception:
     from pinarms.errors import InvalidInput
 
     return InvalidInput(message)
-
-
-def chunk_seeds(seed: int, n_chunks: int) -> list[int]:
-    """Independent seeds of ``n_chunks`` chunks of one seeded sweep.
-
-    Rule: chunk ``k``'s seed is the 128-bit integer made of the first two 64-bit words of
-    ``numpy.random.SeedSequence(seed).spawn(n_chunks)[k].generate_state(2, numpy.uint64)``
-    (word 0 the low word). A spawned child depends only on ``seed`` and ``k``, so chunk ``k``
-    has the same seed whatever the number of chunks; a task makes its generator with
-    ``numpy.random.default_rng(chunk_seed)``.
-    """
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise _invalid(f"seed must be a non-negative integer, got {seed!r}")
-    if isinstance(n_chunks, bool) or not isinstance(n_chunks, (int, np.integer)) or n_chunks < 0:
-        raise _invalid(f"n_chunks must be a non-negative integer, got {n_chunks!r}")
-    children = np.random.SeedSequence(int(seed)).spawn(int(n_chunks))
-    out = []
-    for child in children:
-        low, high = child.generate_state(2, dtype=np.uint64)
-        out.append(int(low) | (int(high) << 64))
-    return out
-
-
-def split_count(n: int, chunk_size: int) -> list[int]:
-    """Sizes of the chunks of ``n`` items, ``chunk_size`` each and the remainder last.
-
-    ``split_count(10, 4) == [4, 4, 2]``; ``split_count(0, 4) == []``.
-    """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
-        raise _invalid(f"n must be a non-negative integer, got {n!r}")
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
-        raise _invalid(f"chunk_size must be a positive integer, got {chunk_size!r}")
-    n, chunk_size = int(n), int(chunk_size)
-    full, rest = divmod(n, chunk_size)
-    return [chunk_size] * full + ([rest] if rest else [])
 
 
 def _task_seed(task: Any) -> int | None:
@@ -164,53 +131,6 @@ def _lost(client: Any, done: int, total: int, cause: str):
 def _one_line(exc: BaseException) -> str:
     text = str(exc).strip().splitlines()
     return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
-
-
-def describe_scheduler(scheduler: Any = None) -> str:
-    """A short text naming where :func:`map_chunks` would run with this ``scheduler``."""
-    kind, arg = _parse_scheduler(scheduler)
-    if kind == "serial":
-        return "serial (this process)"
-    if kind == "processes":
-        return f"local Dask cluster, {arg} worker process{'es' if arg != 1 else ''}"
-    if kind == "address":
-        return f"Dask cluster at {arg}"
-    return f"Dask client {getattr(arg, 'scheduler', None) and arg.scheduler.address}"
-
-
-def _parse_scheduler(scheduler: Any) -> tuple[str, Any]:
-    if scheduler is None or scheduler == "serial":
-        return "serial", None
-    if isinstance(scheduler, str):
-        text = scheduler.strip()
-        if text == "env":
-            address = os.environ.get("DASK_SCHEDULER_ADDRESS", "").strip()
-            if not address:
-                raise _invalid(
-                    'scheduler="env" reads DASK_SCHEDULER_ADDRESS, which is not set: export '
-                    "DASK_SCHEDULER_ADDRESS=tcp://HOST:8786 or pass the address itself"
-                )
-            return _parse_scheduler(address)
-        if text == "processes" or text.startswith("processes:"):
-            count = text.partition(":")[2]
-            if not count:
-                return "processes", max(1, os.cpu_count() or 1)
-            if not count.isdigit() or int(count) < 1:
-                raise _invalid(f"scheduler {scheduler!r}: the worker count after 'processes:' must be a positive integer")
-            return "processes", int(count)
-        if "://" in text:
-            return "address", _check_address(text, scheduler)
-        raise _invalid(
-            f"unknown scheduler {scheduler!r}: use None (serial), 'processes', 'processes:N', "
-            "'tcp://HOST:8786', 'env' (DASK_SCHEDULER_ADDRESS) or a distributed.Client"
-        )
-    try:
-        from distributed import Client
-    except ImportError:  # pragma: no cover - dask[distributed] is a dependency
-        Client = ()  # noqa: N806
-    if Client and isinstance(scheduler, Client):
-        return "client", scheduler
-    raise _invalid(f"scheduler must be None, a string or a distributed.Client, got {type(scheduler).__name__}")
 
 
 def map_chunks(
@@ -278,7 +198,7 @@ def reduce_chunks(
 def _run(fn, tasks, on_result, scheduler, progress) -> None:
     if not callable(fn):
         raise _invalid(f"fn must be callable, got {type(fn).__name__}")
-    kind, arg = _parse_scheduler(scheduler)
+    kind, arg = parse_scheduler(scheduler)
     total = len(tasks)
     if progress is not None:
         progress(0, total)
@@ -364,24 +284,6 @@ def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
         )
     with cluster, Client(cluster) as client:
         _map_client(client, fn, tasks, on_result, progress)
-
-
-#: Transports a Dask scheduler address may name.
-_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
-
-
-def _check_address(text: str, scheduler: Any) -> str:
-    """``scheme://HOST:PORT`` with a known scheme and a port 1-65535, else :class:`InvalidInput` naming it."""
-    scheme, _, rest = text.partition("://")
-    host, sep, port = rest.rpartition(":")
-    if scheme == "inproc" and rest:
-        return text
-    if scheme not in _SCHEMES or not sep or not host.strip("[]") or not port.isdigit() or not 0 < int(port) < 65536:
-        raise _invalid(
-            f"scheduler address {scheduler!r} is not a Dask scheduler address: give scheme://HOST:PORT with a "
-            f"scheme among {', '.join(_SCHEMES)} and a PORT from 1 to 65535, e.g. tcp://127.0.0.1:8786"
-        )
-    return text
 
 
 def _map_address(address, fn, tasks, on_result, progress):

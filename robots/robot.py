@@ -14,7 +14,6 @@ Conventions
 
 from __future__ import annotations
 
-import math
 from math import isfinite as _isfinite
 import threading
 from pathlib import Path
@@ -22,13 +21,13 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg.lapack import dpotrf as _potrf
 
 from ._checks import as_batch as _as_batch
 from ._checks import as_generator as _as_generator
 from ._checks import check_tolerance as _check_tolerance
 from .errors import InvalidInput, ModelError
 from .kinematic_tree import KinematicTree
+from .manipulability import manipulability_of_jacobian
 from .robot_ik import RobotIK
 
 __all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
@@ -52,9 +51,6 @@ class _PerThread(threading.local):
     """Per-thread slot of a Robot's Pinocchio data: ``pair = (model, data)``, the data and the model it was made for."""
 
     pair = (None, None)
-
-
-_PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
 
 
 class Robot(RobotIK):
@@ -360,23 +356,10 @@ class Robot(RobotIK):
                 ellipsoid within the arm's own motion space.
 
         Returns:
-            a float for one ``q (nq,)``, an array ``(N,)`` for a batch.
+            a float for one ``q (nq,)``, an array ``(N,)`` for a batch
+            (:func:`robots.manipulability.manipulability_of_jacobian`).
         """
-        J = self.jacobian(q, frame)
-        rows = _PARTS.get(part) if isinstance(part, str) else None
-        if rows is None:
-            raise InvalidInput(f"part must be one of {sorted(_PARTS)}, got {part!r}")
-        J = J[..., rows, :]
-        m, n = J.shape[-2:]
-        if J.ndim == 2:  # one configuration: sqrt(det G) is the product of G's Cholesky diagonal
-            G = J.dot(J.T) if m <= n else J.T.dot(J)
-            L, info = _potrf(G, overwrite_a=1)
-            if info == 0:
-                return math.prod(L.diagonal().tolist())
-            G = J.dot(J.T) if m <= n else J.T.dot(J)  # singular in floating point: as the batch does
-            return float(np.sqrt(max(np.linalg.det(G), 0.0)))
-        G = J @ np.swapaxes(J, -1, -2) if m <= n else np.swapaxes(J, -1, -2) @ J
-        return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
+        return manipulability_of_jacobian(self.jacobian(q, frame), part)
 
     # --------------------------------------------------------------- dynamics
     #: The :class:`robots.payload.Payload` this robot carries (``None``: the bare arm).

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pinarms import execution
-from pinarms.execution import chunk_seeds, map_chunks, split_count
+from pinarms.execution import chunk_seeds, map_chunks
 from pinarms.robots.errors import ExecutionError, InvalidInput, PinarmsError
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
@@ -56,29 +56,6 @@ def client():
         scheduler_kwargs=LOOPBACK_HTTP,
     ) as cluster, distributed.Client(cluster) as c:
         yield c
-
-
-def test_chunk_seeds_follow_the_seed_sequence_rule():
-    seeds = chunk_seeds(2024, 3)
-    child = np.random.SeedSequence(2024).spawn(3)[1]
-    low, high = child.generate_state(2, dtype=np.uint64)
-    assert seeds[1] == int(low) | (int(high) << 64)
-    assert len(set(seeds)) == 3
-    # chunk k's seed does not depend on how many chunks there are
-    assert chunk_seeds(2024, 5)[:3] == seeds
-    assert chunk_seeds(2025, 3) != seeds
-    with pytest.raises(InvalidInput, match="seed"):
-        chunk_seeds(-1, 3)
-    with pytest.raises(InvalidInput, match="n_chunks"):
-        chunk_seeds(1, 2.5)
-
-
-def test_split_count():
-    assert split_count(10, 4) == [4, 4, 2]
-    assert split_count(8, 4) == [4, 4]
-    assert split_count(0, 4) == []
-    with pytest.raises(InvalidInput, match="chunk_size"):
-        split_count(10, 0)
 
 
 def test_serial_results_in_task_order_with_progress():
@@ -141,23 +118,16 @@ def test_a_dead_worker_is_a_named_error():
             assert info.value.chunk == 1
 
 
-def test_scheduler_strings():
-    assert execution.describe_scheduler(None) == "serial (this process)"
-    assert execution.describe_scheduler("processes:3") == "local Dask cluster, 3 worker processes"
-    assert execution.describe_scheduler("tcp://10.0.0.5:8786") == "Dask cluster at tcp://10.0.0.5:8786"
+def test_map_chunks_checks_its_scheduler(monkeypatch):
     with pytest.raises(InvalidInput, match="unknown scheduler"):
         map_chunks(fail_on_chunk, [], scheduler="threads")
     with pytest.raises(InvalidInput, match="positive integer"):
         map_chunks(fail_on_chunk, [], scheduler="processes:0")
-
-
-def test_env_scheduler_reads_the_standard_variable(monkeypatch):
     monkeypatch.delenv("DASK_SCHEDULER_ADDRESS", raising=False)
     with pytest.raises(InvalidInput, match="DASK_SCHEDULER_ADDRESS"):
         map_chunks(fail_on_chunk, [], scheduler="env")
-    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://192.0.2.1:8786")
-    assert execution.describe_scheduler("env") == "Dask cluster at tcp://192.0.2.1:8786"
     # None never reads the variable: a library call stays on this machine
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://192.0.2.1:8786")
     assert map_chunks(fail_on_chunk, [{"n": 3, "fail": False}]) == [6]
 
 

@@ -16,7 +16,8 @@ Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
   horizontal layer each (:mod:`viz.reach_scene`; the page's slice control shows/hides them).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
-robot) play together from time 0, sampled at ``fps`` frames per second, looping.
+robot) play together from time 0, sampled at ``fps`` frames per second, looping
+(:mod:`viz.trajectory_scene`).
 
 What the page around the scene shows (title, colour bar, framing, controls: see
 :mod:`viz.page`) is stored on the scene root as the property ``pinarms_page`` (JSON), so
@@ -39,6 +40,7 @@ from .cloud_scene import draw_clouds, cloud_colorbar
 from .page import PAGE_PROPERTY
 from .robot_drawing import RobotDrawing
 from .shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
+from .trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
@@ -85,11 +87,6 @@ class SceneInfo:
     camera: np.ndarray
     page: dict[str, Any]
     reachability: dict[str, list[str]] = field(default_factory=dict)
-
-
-def _interp_rows(t_new: np.ndarray, t: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Linear interpolation of each column of ``q (N, n)`` at ``t_new`` (held at the ends)."""
-    return np.stack([np.interp(t_new, t, q[:, j]) for j in range(q.shape[1])], axis=1)
 
 
 def _sphere_set(vis: meshcat.Visualizer, base: str, points: np.ndarray, radius: float, color: int) -> list[str]:
@@ -154,9 +151,9 @@ def build_scene(
 
     line_lines = draw_lines(vis, session, ROOT, bounds)
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
-    tcp_paths, knots = _tcp_paths(session, drawings, bounds, framed)
-    animated = _animated(session, animate)
-    _show_start_poses(session, drawings, animated, framed)
+    tcp_paths, knots = world_tcp_paths(session, drawings, bounds, framed)
+    animated = animated_trajectories(session, animate)
+    show_start_poses(session, drawings, animated, framed)
 
     lo, hi, target, camera, radius = _frame(session, bounds, framed, tcp_paths)
 
@@ -166,7 +163,7 @@ def build_scene(
                                 _POINT_COLORS[ps.kind]) for name, ps in session.point_sets.items()}
     paths = _draw_tcp_paths(vis, tcp_paths, knots, sphere_radius)
 
-    duration, n_frames = _animate(vis, session, drawings, animated, bool(line_lines), fps, play)
+    duration, n_frames = animate_scene(vis, session, ROOT, drawings, animated, bool(line_lines), fps, play)
 
     _place_camera(vis, camera)
     floor_note = _dress_stage(vis, np.vstack(framed) if framed else np.vstack([lo, hi]), hide_background)
@@ -233,54 +230,6 @@ def _draw_boxes(vis: meshcat.Visualizer, session: Any, bounds: list[np.ndarray])
         bounds.append(transform_points(box.pose, corners))
 
 
-def _tcp_paths(session: Any, drawings: dict[str, RobotDrawing], bounds: list[np.ndarray],
-               framed: list[np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """World tcp paths of the trajectories and the tcp at their knots, by label (a cell: one per arm)."""
-    tcp_paths, knots = {}, {}
-    for name, rec in session.trajectories.items():
-        robot = drawings[rec.robot].robot
-        T_base = session.robots[rec.robot].base_to_world
-        q_knots = _interp_rows(rec.knot_times, rec.t, rec.q)
-        # a cell: one tcp path per arm; a robot: its tcp
-        frames = {arm: f for arm, f in session.cell_tcp_frames(rec.robot).items() if f in robot.frame_names}
-        for arm, frame in (frames.items() if frames else [(None, "tcp")]):
-            label = name if arm is None else f"{name}: {arm}"
-            tcp_paths[label] = transform_points(T_base, robot.position(rec.q, frame))
-            knots[label] = transform_points(T_base, robot.position(q_knots, frame))
-            bounds.append(tcp_paths[label])
-            framed.append(tcp_paths[label])
-    return tcp_paths, knots
-
-
-def _animated(session: Any, animate: Sequence[str] | None) -> tuple[str, ...]:
-    """The trajectories that play: ``animate`` checked (at most one per robot), default the first of each robot."""
-    if animate is None:
-        chosen: dict[str, str] = {}
-        for name, rec in session.trajectories.items():
-            chosen.setdefault(rec.robot, name)
-        return tuple(chosen.values())
-    animated = tuple(animate)
-    unknown = [n for n in animated if n not in session.trajectories]
-    if unknown:
-        raise InvalidInput(f"cannot animate {unknown}: trajectories are {list(session.trajectories)}")
-    owners = [session.trajectories[n].robot for n in animated]
-    if len(set(owners)) != len(owners):
-        raise InvalidInput(f"animate at most one trajectory per robot; got {list(animated)} (robots {owners})")
-    return animated
-
-
-def _show_start_poses(session: Any, drawings: dict[str, RobotDrawing], animated: tuple[str, ...],
-                      framed: list[np.ndarray]) -> None:
-    """Pose each robot at the start of its animated (else first) trajectory, else neutral; frame its motion."""
-    for key, drawing in drawings.items():
-        recs = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
-        recs = recs or [r for r in session.trajectories.values() if r.robot == key]
-        drawing.display(recs[0].q[0] if recs else drawing.robot.neutral)
-        # framed over the whole motion: the pose at 9 instants of its (first) trajectory
-        poses = recs[0].q[np.linspace(0, recs[0].q.shape[0] - 1, 9).round().astype(int)] if recs else drawing.robot.neutral
-        framed.append(transform_points(session.robots[key].base_to_world, drawing.extent(poses)))
-
-
 def _draw_tcp_paths(vis: meshcat.Visualizer, tcp_paths: dict[str, np.ndarray], knots: dict[str, Any],
                     sphere_radius: float) -> dict[str, str]:
     """Each tcp path as a tube (a dot when the tcp stands still), its knots as spheres (``knots`` → their paths)."""
@@ -312,34 +261,6 @@ def _frame(session: Any, bounds: list[np.ndarray], framed: list[np.ndarray],
     toward = np.vstack(list(tcp_paths.values())).mean(axis=0) - bases.mean(axis=0) if tcp_paths and bases.size else None
     target, camera, radius = frame_view(line_focus(session, np.vstack(framed) if framed else everything), toward)
     return lo, hi, target, camera, radius
-
-
-def _animate(vis: meshcat.Visualizer, session: Any, drawings: dict[str, RobotDrawing], animated: tuple[str, ...],
-             lines: bool, fps: float, play: bool) -> tuple[float, int]:
-    """One looping animation of the ``animated`` trajectories and the belt ``lines``; return (duration, frames)."""
-    from .line_scene import animate_lines, line_duration
-
-    if not (animated or lines):
-        return 0.0, 0
-    duration = max([float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated]
-                   + [line_duration(session)])
-    times = _frame_times(duration, fps)
-    anim = meshcat.animation.Animation(default_framerate=fps)
-    for name in animated:
-        rec = session.trajectories[name]
-        drawings[rec.robot].record(anim, vis, _interp_rows(rec.t[0] + times, rec.t, rec.q))
-    animate_lines(vis, anim, session, ROOT, times, animated, drawings)
-    vis.set_animation(anim, play=play, repetitions=float("inf"))
-    return duration, times.size
-
-
-def _frame_times(duration: float, fps: float) -> np.ndarray:
-    """Animation instants from 0 at ``fps``, ending exactly on ``duration``."""
-    n_frames = int(np.floor(duration * fps + 1e-9)) + 1
-    times = np.minimum(np.arange(n_frames) / fps, duration)
-    if times[-1] < duration:  # end exactly on the last pose
-        times = np.append(times, duration)
-    return times
 
 
 def _dress_stage(vis: meshcat.Visualizer, content: np.ndarray, hide_background: bool) -> str:

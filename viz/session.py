@@ -6,7 +6,8 @@ sampled joint positions), workspace clouds with manipulability, via points and t
 optimisation histories, and free metadata.
 
 This module builds sessions from the user's objects (every argument checked by
-:mod:`pinarms.viz.session_inputs`; a cell by :mod:`pinarms.viz.cell_session`) and saves and
+:mod:`pinarms.viz.session_inputs`; a cell by :mod:`pinarms.viz.cell_session`; a robot stored
+and rebuilt by :mod:`pinarms.viz.session_robots`) and saves and
 loads them; the file format itself (records, the table of member kinds, bounded and
 validated reading, writing) is :mod:`pinarms.viz.session_format`. Never pickle; written
 atomically; a save/load round trip is exact (arrays bit-equal, JSON equal).
@@ -29,11 +30,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.robots.errors import InvalidInput
 from pinarms.robots.robot import Robot
 
-from .errors import SessionFormatError
-from .mesh_paths import check_mesh_paths
 from .session_archive import SessionLimits
 from .session_format import read_session, to_document, write_session
 from .session_inputs import (
@@ -42,7 +41,6 @@ from .session_inputs import (
     float_array,
     history_record,
     json_normalised,
-    pose_array,
     real_array,
     trajectory_record,
     workspace_record,
@@ -56,6 +54,7 @@ from .session_records import (
     WorkspaceRecord,
     check_name as _check_name,
 )
+from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 __all__ = [
@@ -79,19 +78,6 @@ def _pinarms_version() -> str:
         return importlib.metadata.version("pinarms")
     except importlib.metadata.PackageNotFoundError:  # pragma: no cover - running from a bare checkout
         return "unknown"
-
-
-def _registry_name(robot: Robot) -> str | None:
-    """``robot.name`` when ``robots.load(robot.name)`` rebuilds exactly this robot, else ``None``."""
-    if robot.name not in robots.names():
-        return None
-    try:
-        ref = robots.load(robot.name)
-    except PinarmsError:
-        return None
-    if ref.urdf_text == robot.urdf_text and ref.tcp_frame == robot.tcp_frame:
-        return robot.name  # a payload is stored beside the name (RobotEntry.payload)
-    return None
 
 
 # ---------------------------------------------------------------------------- session
@@ -175,18 +161,7 @@ class Session:
         key = _check_name(robot.name if key is None else key, "robot key")
         if key in self.robots:
             raise InvalidInput(f"robot key {key!r} is already used in this session; pass key=... to add another one")
-        reg = _registry_name(robot)
-        self.robots[key] = RobotEntry(
-            key=key,
-            source="registry" if reg else "urdf",
-            name=robot.name,
-            tcp_frame=robot.tcp_frame,
-            joint_names=tuple(robot.joint_names),
-            base_to_world=pose_array(base_to_world, f"base_to_world of robot {key!r}"),
-            urdf_text=None if reg else robot.urdf_text,
-            package_dirs=() if reg else tuple(str(p) for p in robot.package_dirs),
-            payload=None if robot.payload is None else robot.payload.as_dict(),
-        )
+        self.robots[key] = robot_entry(robot, key, base_to_world)
         self._loaded[key] = robot
         return key
 
@@ -201,25 +176,7 @@ class Session:
 
     def _load_robot(self, entry: RobotEntry) -> Robot:
         if entry.key not in self._loaded:
-            if entry.source == "registry":
-                rob = robots.load(entry.name)
-            else:
-                # an embedded URDF comes from a file: its meshes must stay inside the folders the caller
-                # allowed; the folders the file names (entry.package_dirs) only appear in the message
-                dirs = check_mesh_paths(entry.urdf_text, self.mesh_dirs, f"session robot {entry.key!r}",
-                                        recorded=entry.package_dirs)
-                rob = robots.from_urdf_text(
-                    entry.urdf_text, tcp=entry.tcp_frame, name=entry.name, source=f"session robot {entry.key!r}",
-                    package_dirs=tuple(dirs),
-                )
-            if entry.payload is not None:
-                rob = rob.with_payload(entry.payload)
-            if tuple(rob.joint_names) != entry.joint_names:
-                raise SessionFormatError(
-                    f"robot {entry.key!r} ({entry.name}) was saved with joints {list(entry.joint_names)} but now loads "
-                    f"with {list(rob.joint_names)}; the registry's model changed since the session was saved"
-                )
-            self._loaded[entry.key] = rob
+            self._loaded[entry.key] = rebuild_robot(entry, self.mesh_dirs)
         return self._loaded[entry.key]
 
     def _entry(self, key: str | None) -> RobotEntry:
@@ -407,12 +364,5 @@ def load_session(path: str | os.PathLike, *, package_dirs: tuple[str, ...] | lis
     for kind in KINDS:
         setattr(s, kind.attr, contents.tables[kind.attr])
     own = str(Path(path).resolve().parent)
-    s.mesh_dirs = tuple(dict.fromkeys([own, *(os.fspath(d) for d in (package_dirs or ())), *_shipped_model_dirs()]))
+    s.mesh_dirs = tuple(dict.fromkeys([own, *(os.fspath(d) for d in (package_dirs or ())), *shipped_model_dirs()]))
     return s
-
-
-def _shipped_model_dirs() -> tuple[str, ...]:
-    """pinarms' own model folders (built-in URDFs and cells with their meshes, the xacro macros): always allowed."""
-    import pinarms.urdf
-
-    return (str(Path(pinarms.urdf.__file__).resolve().parent), str(Path(robots.__file__).resolve().parent / "xacro"))

@@ -7,7 +7,8 @@ until checked, so :func:`open_archive` and :class:`ArchiveReader`:
 - look at the zip's end-of-directory record before :mod:`zipfile` parses the directory
   (a directory of millions of entries is refused before it fills memory);
 - parse ``session.json`` under a size cap, refusing NaN/Infinity, duplicate keys, lone
-  surrogates and nesting deeper than :attr:`SessionLimits.max_json_depth`;
+  surrogates and nesting deeper than :attr:`SessionLimits.max_json_depth`
+  (:mod:`viz.session_json`);
 - check each member reference against the zip directory (one entry per member, a known
   compression, a declared size that the reference's shape explains and that deflate can
   produce from the stored bytes) and the total against :class:`SessionLimits`, before
@@ -23,7 +24,6 @@ Every problem raises :class:`SessionFormatError` naming the file, the member or 
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import os
 import re
@@ -41,6 +41,7 @@ from pinarms.robots.errors import InvalidInput
 
 from .errors import SessionFormatError
 from .names import NAME_RE
+from .session_json import JSON_MEMBER, parse_document
 
 if TYPE_CHECKING:  # pragma: no cover
     from .session_schema import ArraySpec
@@ -48,7 +49,6 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["JSON_MEMBER", "F8", "SessionLimits", "DEFAULT_LIMITS", "ArrayRef", "ArchiveReader", "open_archive",
            "invalid_session"]
 
-JSON_MEMBER = "session.json"
 F8 = np.dtype("<f8")
 
 MiB = 1 << 20
@@ -118,40 +118,6 @@ def _directory_size(fp: BinaryIO) -> tuple[int, int] | None:
             if rec[:4] == b"PK\x06\x06":
                 entries, cd_size = struct.unpack("<QQ", rec[32:48])
     return entries, cd_size
-
-
-def _check_json_values(doc: Any, path: Path, max_depth: int) -> None:
-    """Depth, finite numbers and UTF-8-writable strings, without recursion."""
-    stack = [(doc, 1)]
-    while stack:
-        obj, depth = stack.pop()
-        if isinstance(obj, (dict, list)):
-            if depth > max_depth:
-                raise invalid_session(path, f"{JSON_MEMBER} nests deeper than {max_depth} levels")
-            values = obj.values() if isinstance(obj, dict) else obj
-            stack.extend((v, depth + 1) for v in values)
-            if isinstance(obj, dict):
-                stack.extend((k, depth) for k in obj)
-        elif isinstance(obj, float) and not math.isfinite(obj):
-            raise invalid_session(path, f"{JSON_MEMBER} holds a number too large for float64")
-        elif isinstance(obj, str):
-            try:
-                obj.encode("utf-8")
-            except UnicodeEncodeError:
-                raise invalid_session(path, f"{JSON_MEMBER} holds a string with a lone surrogate ({obj[:40]!r})") from None
-
-
-def _no_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict:
-    out = dict(pairs)
-    if len(out) != len(pairs):
-        seen: set = set()
-        dup = next(k for k, _ in pairs if k in seen or seen.add(k))
-        raise ValueError(f"duplicate key {dup!r} in one object")
-    return out
-
-
-def _bad_constant(name: str) -> Any:
-    raise ValueError(f"{name} is not allowed (JSON has no NaN or Infinity)")
 
 
 def _valid_member_name(member: str) -> bool:
@@ -361,15 +327,7 @@ class ArchiveReader:
             raise self.fail(f"member {JSON_MEMBER!r} is missing (the file is incomplete)")
         self.info(JSON_MEMBER, "the archive")
         raw = self.read_bytes(JSON_MEMBER, info, self.limits.max_json_bytes, JSON_MEMBER)
-        try:
-            doc = json.loads(raw.decode("utf-8"), object_pairs_hook=_no_duplicate_keys, parse_constant=_bad_constant)
-        except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError and int digit limits are ValueErrors
-            raise self.fail(f"{JSON_MEMBER} is not valid UTF-8 JSON ({str(exc)[:200]})") from None
-        except RecursionError:
-            raise self.fail(f"{JSON_MEMBER} nests deeper than {self.limits.max_json_depth} levels") from None
-        _check_json_values(doc, self.path, self.limits.max_json_depth)
-        return doc
-
+        return parse_document(raw, self.fail, self.limits.max_json_depth)
 
 @contextlib.contextmanager
 def open_archive(path: str | os.PathLike, limits: SessionLimits) -> Iterator[ArchiveReader]:

@@ -9,8 +9,8 @@ At a decision at time ``t`` an arm computes, for every item not yet taken near i
 **earliest reachable intercept**: along its map's grid of pre-grasp points ``u`` (ascending
 downstream), the first ``u`` where ``t + t_A(u) ≤ t0 + u / v`` (the arm, leaving now, is at
 ``u`` no later than the item), refined linearly between grid points; the arm leaves at
-``start = t0 + u/v − t_A(u) ≥ t`` so that it meets the item exactly. Items whose start is
-``t`` can be started now; the rule (:mod:`optim.line.rules`) picks one, or, when only later
+``start = t0 + u/v − t_A(u) ≥ t`` so that it meets the item exactly (:class:`~.sim_arm.ArmState`).
+Items whose start is ``t`` can be started now; the rule (:mod:`optim.line.rules`) picks one, or, when only later
 starts exist, the arm sleeps until the earliest. An item that no arm takes is **missed** (it
 leaves the last window).
 
@@ -36,7 +36,7 @@ import numpy as np
 
 from pinarms.optim.line.items import Items
 from pinarms.optim.line.rules import Candidates, Rule, best_sequence, rank_simple
-from pinarms.optim.line.task_maps import TaskMap
+from pinarms.optim.line.sim_arm import ArmState, SimArm
 from pinarms.robots.errors import InvalidInput
 
 __all__ = ["SimArm", "SimResult", "simulate", "EPS", "NO_TRAY"]
@@ -46,19 +46,6 @@ NO_TRAY = int(np.iinfo(np.int64).min)
 
 #: Time tolerance of "start now" [s].
 EPS = 1e-9
-
-
-@dataclass(frozen=True, eq=False)
-class SimArm:
-    """One arm as the simulator sees it: ``name``, ``u_base`` (its base projected on the belt,
-    m), ``maps`` (one :class:`TaskMap` per item type, in the stream's type order) and
-    ``rest`` (the tool at rest at its box, belt coordinates u, w [m], for the "nearest" rule)."""
-
-    name: str
-    u_base: float
-    maps: tuple[TaskMap, ...]
-    rest: tuple[float, float] = (0.0, 0.0)
-    place: Any = None  #: :class:`~.tray_sim.SimPlace` when the arm places in trays (None: its box)
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,57 +114,6 @@ class SimResult:
         return self.busy / self.duration
 
 
-class _ArmState:
-    """Per arm: the grid of pre-grasp points (absolute u) and every item's times on it."""
-
-    def __init__(self, arm: SimArm, items: Items, speed: float) -> None:
-        m0 = arm.maps[0]
-        for m in arm.maps:
-            if m.du.shape != m0.du.shape or np.any(m.du != m0.du):
-                raise InvalidInput(f"arm {arm.name!r}: the maps of all item types must share one du grid")
-        grid = m0.sim_grid(*arm.maps[1:])  # a node twice where the IK branch changes (no interpolation across)
-        self.u = arm.u_base + grid[0]
-        n = len(items)
-        self.tA = np.empty((n, self.u.size))
-        self.tC = np.empty((n, self.u.size))
-        self.extra = np.empty(n)
-        for k, m in enumerate(arm.maps):
-            sel = items.kind == k
-            self.tA[sel], self.tC[sel] = m.rows(items.w[sel], grid)
-            self.extra[sel] = m.track + m.release
-        ok = np.isfinite(self.tA) & np.isfinite(self.tC)
-        self.tA[~ok] = np.nan
-        cols = np.flatnonzero(ok.any(axis=0))
-        if cols.size == 0:
-            raise InvalidInput(f"arm {arm.name!r}: its maps hold no feasible pick")
-        self.u_min, self.u_max = float(self.u[cols[0]]), float(self.u[cols[-1]])
-        self.max_tA = float(np.nanmax(self.tA)) if np.isfinite(self.tA).any() else 0.0
-        self.speed = speed
-        self.rest = np.array(arm.rest)
-
-    def intercept(self, t: float, idx: np.ndarray, t0: np.ndarray) -> tuple[np.ndarray, ...]:
-        """(ok, start, meet, finish, u) of items ``idx`` for the arm ready at ``t``."""
-        tA, tC = self.tA[idx], self.tC[idx]
-        t_item = t0[idx, None] + self.u[None, :] / self.speed
-        g = t + tA - t_item
-        good = np.isfinite(tA) & (g <= 0.0)
-        ok = good.any(axis=1)
-        k = np.argmax(good, axis=1)
-        rows = np.arange(idx.size)
-        km = np.maximum(k - 1, 0)
-        prev_ok = (k > 0) & np.isfinite(tA[rows, km]) & (g[rows, km] > 0.0) & (self.u[k] > self.u[km])
-        gp, gk = np.where(prev_ok, g[rows, km], 0.0), g[rows, k]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            f = np.where(prev_ok, gp / (gp - gk), 1.0)
-        u = np.where(prev_ok, self.u[km] + f * (self.u[k] - self.u[km]), self.u[k])
-        a = np.where(prev_ok, tA[rows, km] + f * (tA[rows, k] - tA[rows, km]), tA[rows, k])
-        c = np.where(prev_ok, tC[rows, km] + f * (tC[rows, k] - tC[rows, km]), tC[rows, k])
-        meet = t0[idx] + u / self.speed
-        start = np.maximum(meet - a, t)
-        finish = meet + self.extra[idx] + c
-        return ok, start, meet, finish, u
-
-
 def _eligible(rule: Rule, arm_index: int, n_arms: int, idx: np.ndarray, w: np.ndarray, width: float) -> np.ndarray:
     if rule.name == "bands":
         band = np.clip(((w[idx] + width / 2.0) / width * n_arms).astype(int), 0, n_arms - 1)
@@ -202,7 +138,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
     arms = [arms[k] for k in order]
     n = len(items)
     t0 = items.t0
-    states = [_ArmState(a, items, speed) for a in arms]
+    states = [ArmState(a, items, speed) for a in arms]
     picked_by = np.full(n, -1)
     meet, u_meet, start, finish = (np.full(n, np.nan) for _ in range(4))
     taken = np.zeros(n, dtype=bool)
@@ -377,7 +313,7 @@ def _blocked(guard: Any, pick: tuple, finish: float, k: int, neighbours: dict, o
     return until
 
 
-def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: _ArmState, speed: float, rule: Rule,
+def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: ArmState, speed: float, rule: Rule,
                k: int, n_arms: int, items: Items, width: float | None) -> float | None:
     """When the arm should look again if nothing can start now: the next item beyond the range."""
     rest = np.arange(hi, min(hi + 64, t0.size))
@@ -388,7 +324,7 @@ def _next_wake(t: float, hi: int, taken: np.ndarray, t0: np.ndarray, st: _ArmSta
     return max(t + 1e-6, float(t0[j] + st.u_min / speed - st.max_tA))
 
 
-def _lookahead(st: _ArmState, t: float, idx: np.ndarray, s: np.ndarray, t0: np.ndarray, horizon: int) -> int:
+def _lookahead(st: ArmState, t: float, idx: np.ndarray, s: np.ndarray, t0: np.ndarray, horizon: int) -> int:
     order = np.argsort(s, kind="stable")[:horizon]
     pool = [int(idx[j]) for j in order]
 

@@ -29,8 +29,9 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     trajectory_commands,
     urdf_commands,
     verify_commands,
+    workspace_commands,
 )
 from ._common import cli, main
-from .trajectory_commands import read_via_file
+from .via_points import read_via_file
 
 __all__ = ["cli", "main", "read_via_file"]

@@ -27,7 +27,8 @@ outside the file (external storage, virtual datasets), an unknown compression fi
 array larger than ``max_bytes`` in memory, a shape that disagrees with the others, NaN where
 numbers are needed, indices out of range, a rotation that is not a rotation, an index that
 does not follow from the reached bits, or a stored solution outside the joint limits all
-raise :class:`ReachabilityFileError` naming the member and the problem.
+raise :class:`ReachabilityFileError` naming the member and the problem (the checks of the
+content are :mod:`robots.reach.reach_check`; this module writes, and reads through a child).
 
 The HDF5 library runs in a child process (:mod:`robots.reach._reach_worker`, started by
 :mod:`robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
@@ -55,10 +56,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput, PinarmsError
-from .orientations import MAX_ORIENTATIONS, OrientationSet
+from ..errors import InvalidInput
+from .orientations import MAX_ORIENTATIONS
+from .reach_check import MAX_JOINTS, MapChecker, ReachabilityFileError, check_map
 from .reach_write import FORMAT_NAME, FORMAT_VERSION, StreamWriter, write_map
-from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from .reach_map import MAX_GRID_VOXELS, ReachabilityMap
 
 __all__ = [
     "ReachabilityFileError",
@@ -74,14 +76,8 @@ __all__ = [
 
 #: Largest total size of the arrays :func:`load_reachability` accepts by default [bytes].
 DEFAULT_MAX_BYTES = 4 * 1024**3
-_MAX_TEXT = 1_000_000
-_MAX_JOINTS = 64
 #: HDF5 filters a map file may use: deflate (gzip), shuffle, fletcher32, LZF.
 _ALLOWED_FILTERS = {1, 2, 3, 32000}
-
-
-class ReachabilityFileError(PinarmsError):
-    """A reachability map file is not one pinarms can trust: what is wrong and where is in the message."""
 
 
 def save_reachability(reach_map: ReachabilityMap, path: str | os.PathLike) -> Path:
@@ -104,7 +100,7 @@ _MIN_RATE = 20e6  # bytes/s: the slowest data rate accepted before the reader is
 #: Address space of the reader process [bytes]: it streams data in slices, so this does not grow with the map.
 READER_MEMORY = 448 * 2**20
 _CHILD_LIMITS = {"max_chunk_bytes": 16 * 2**20, "max_chunks": 1 << 20, "slice_bytes": 16 * 2**20,
-                 "max_grid_voxels": MAX_GRID_VOXELS, "max_joints": _MAX_JOINTS, "max_orientations": MAX_ORIENTATIONS}
+                 "max_grid_voxels": MAX_GRID_VOXELS, "max_joints": MAX_JOINTS, "max_orientations": MAX_ORIENTATIONS}
 _MAX_MANIFEST = 32 * 2**20
 
 
@@ -138,7 +134,7 @@ def load_reachability(path: str | os.PathLike, *, solutions: bool = True, max_by
                "limits": _CHILD_LIMITS}
     cpu = int(_STARTUP_TIMEOUT + timeout + max_bytes / _MIN_RATE) + 1
     attrs, arrays, wall = _receive(p, request, float(timeout), cpu)
-    return _check(_Checker(p, attrs, arrays, wall), bool(solutions))
+    return check_map(MapChecker(p, attrs, arrays, wall), bool(solutions))
 
 
 def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, dict[str, np.ndarray], str]:
@@ -255,169 +251,3 @@ def _manifest(p: Path, raw: bytes, request: dict) -> dict:
             raise bad(f"declares more than max_bytes = {request['max_bytes']}")
         arrays[name] = np.empty(tuple(got), dtype=dtype)
     return {"attrs": attrs, "arrays": arrays, "wall": wall}
-
-
-class _Checker:
-    """The attributes and arrays the reader sent; each problem becomes a :class:`ReachabilityFileError`."""
-
-    def __init__(self, path: Path, attrs: dict, arrays: dict[str, np.ndarray], wall: str = "") -> None:
-        self.path, self.attrs, self.arrays, self.wall = path, attrs, arrays, wall
-
-    def fail(self, what: str) -> ReachabilityFileError:
-        return ReachabilityFileError(f"{str(self.path)!r} is not a valid pinarms reachability map: {what}")
-
-    def attr(self, group: str, key: str, kind: type) -> Any:
-        where = "the file" if group == "/" else group
-        values = self.attrs.get(group)
-        value = values.get(key) if isinstance(values, dict) else None
-        ok = {str: lambda v: isinstance(v, str) and len(v) <= _MAX_TEXT, bool: lambda v: isinstance(v, bool),
-              int: lambda v: isinstance(v, int) and not isinstance(v, bool),
-              float: lambda v: isinstance(v, (int, float)) and not isinstance(v, bool),
-              list: lambda v: isinstance(v, list) and len(v) <= 16 and all(isinstance(x, int) for x in v)}[kind]
-        if not ok(value):
-            raise self.fail(f"attribute {key!r} of {where} is missing or not a {kind.__name__}")
-        return float(value) if kind is float else value
-
-    def json(self, group: str, key: str, kind: type) -> Any:
-        where = "the file" if group == "/" else group
-        try:
-            value = json.loads(self.attr(group, key, str))
-        except (json.JSONDecodeError, RecursionError):
-            raise self.fail(f"attribute {key!r} of {where} is not valid JSON") from None
-        if not isinstance(value, kind):
-            raise self.fail(f"attribute {key!r} of {where} must be a JSON {kind.__name__}")
-        return value
-
-    def finite(self, name: str, *, nan_ok: bool = False) -> np.ndarray:
-        arr = self.arrays[name]
-        bad = np.isinf(arr) if nan_ok else ~np.isfinite(arr)
-        if np.any(bad):
-            raise self.fail(f"dataset /{name} holds {'infinite' if nan_ok else 'NaN or infinite'} values")
-        return arr
-
-
-def _check(r: _Checker, want_solutions: bool) -> ReachabilityMap:
-    fmt, version = r.attr("/", "format", str), r.attr("/", "version", int)
-    if fmt != FORMAT_NAME or not 1 <= version <= FORMAT_VERSION:
-        raise r.fail(f"format {fmt!r} version {version} is not this pinarms' map format")
-    sha = r.attr("/", "urdf_sha256", str)
-    if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
-        raise r.fail("urdf_sha256 is not a SHA-256 hex digest")
-    solver = r.attr("/", "solver", str)
-    if solver not in ("analytic", "numerical"):
-        raise r.fail(f"solver must be 'analytic' or 'numerical', got {solver!r}")
-    manip = r.attr("/", "manipulability", str)
-    if manip not in ("full", "position"):
-        raise r.fail(f"manipulability must be 'full' or 'position', got {manip!r}")
-    resolution = r.attr("/", "resolution", float)
-    if not (np.isfinite(resolution) and resolution > 0):
-        raise r.fail(f"resolution must be a positive length in m, got {resolution!r}")
-    shape = r.attr("/", "shape", list)
-    if len(shape) != 3 or min(shape) < 1 or math.prod(shape) > MAX_GRID_VOXELS:
-        raise r.fail(f"shape must be 3 positive integers with at most {MAX_GRID_VOXELS} voxels, got {shape}")
-    joint_names = r.json("/robot", "joint_names", list)
-    nq = len(joint_names)
-    if not (1 <= nq <= _MAX_JOINTS) or not all(isinstance(j, str) and 0 < len(j) <= 200 for j in joint_names):
-        raise r.fail(f"/robot joint_names must list 1 to {_MAX_JOINTS} joint names")
-    lower, upper = r.finite("robot/joint_lower"), r.finite("robot/joint_upper")
-    if lower.size != nq:
-        raise r.fail(f"dataset /robot/joint_lower holds {lower.size} limits for the {nq} joint names")
-    if np.any(lower > upper):
-        raise r.fail("/robot joint limits have lower > upper")
-    oset = _check_orientations(r)
-    flat, reached, index, best = _check_voxels(r, oset, math.prod(shape))
-    sols = _check_poses(r, flat, reached, lower, upper) if want_solutions and "poses/voxel" in r.arrays else None
-    return ReachabilityMap(
-        robot=r.attr("/", "robot", str), urdf_sha256=sha, tcp_frame=r.attr("/", "tcp_frame", str),
-        joint_names=tuple(joint_names), joint_lower=lower, joint_upper=upper, solver=solver,
-        manipulability_kind=manip, origin=r.finite("grid/origin"), resolution=resolution,
-        shape=(int(shape[0]), int(shape[1]), int(shape[2])), orientations=oset, voxels=flat, reached=reached,
-        index=index, best_manipulability=best, solutions=sols, parameters=r.json("/", "parameters", dict),
-        reader_wall=r.wall,
-    )
-
-
-def _check_orientations(r: _Checker) -> OrientationSet:
-    kind = r.attr("/orientations", "kind", str)
-    if kind not in ("so3", "tool_axis"):
-        raise r.fail(f"/orientations kind must be 'so3' or 'tool_axis', got {kind!r}")
-    roll_free = r.attr("/orientations", "roll_free", bool)
-    n_groups = r.attr("/orientations", "n_groups", int)
-    oparams = r.json("/orientations", "parameters", dict)
-    rot = r.finite("orientations/rotations")
-    M = rot.shape[0]
-    if not (1 <= M <= MAX_ORIENTATIONS) or not (1 <= n_groups <= MAX_ORIENTATIONS):
-        raise r.fail(f"/orientations holds {M} rotations in {n_groups} groups; expected 1 to {MAX_ORIENTATIONS}")
-    ortho = np.abs(rot @ np.swapaxes(rot, 1, 2) - np.eye(3)).max()
-    if ortho > 1e-9 or np.any(np.linalg.det(rot) < 0.0):
-        raise r.fail("/orientations/rotations holds a matrix that is not a proper rotation")
-    group = r.arrays["orientations/group"].astype(np.int64)  # M ≤ 10⁵ entries
-    if np.any(group < 0) or np.any(group >= n_groups) or np.any(np.diff(group) < 0) or np.unique(group).size != n_groups:
-        raise r.fail("/orientations/group must number the directions 0..n_groups-1 in order, each used")
-    directions, tool_axis = r.finite("orientations/directions"), r.finite("orientations/tool_axis")
-    if directions.shape[0] != n_groups:
-        raise r.fail(f"dataset /orientations/directions holds {directions.shape[0]} rows for {n_groups} groups")
-    if kind == "so3" and (n_groups != M or roll_free):
-        raise r.fail("/orientations of kind 'so3' must have one group per rotation and roll_free false")
-    return OrientationSet(kind, rot, group, n_groups, roll_free, tool_axis, directions, oparams)
-
-
-def _check_voxels(r: _Checker, o: OrientationSet, n_grid: int) -> tuple[np.ndarray, ...]:
-    flat = r.arrays["voxels/flat"]
-    V = flat.size
-    if V and (flat[0] < 0 or flat[-1] >= n_grid or np.any(flat[1:] <= flat[:-1])):
-        raise r.fail(f"/voxels/flat must be strictly increasing flat indices in [0, {n_grid})")
-    index = r.finite("voxels/index")
-    best = r.finite("voxels/best_manipulability", nan_ok=True)
-    reached_u1 = r.arrays["voxels/reached"]
-    if reached_u1.size and reached_u1.max() > 1:
-        raise r.fail("/voxels/reached must hold only 0 and 1")
-    reached = reached_u1.view(bool)  # 0/1 bytes are valid booleans: no copy
-    M, G = reached.shape[1], o.n_groups
-    if o.roll_free:
-        per_group = np.zeros((V, G), dtype=bool)
-        for k in range(M):
-            per_group[:, o.group[k]] |= reached[:, k]
-        expect = per_group.sum(axis=1) / G
-    else:
-        expect = np.count_nonzero(reached, axis=1) / M
-    if not np.array_equal(expect, index):
-        row = int(np.flatnonzero(expect != index)[0])
-        raise r.fail(f"/voxels/index does not follow from /voxels/reached (row {row}: {index[row]!r} vs {expect[row]!r})")
-    any_reached = reached.any(axis=1)
-    if np.any(np.isnan(best) == any_reached) or np.any(best[any_reached] < 0):
-        raise r.fail("/voxels/best_manipulability must be >= 0 where a pose is reached and NaN elsewhere")
-    n_reached = r.attrs["/"].get("n_reached")  # optional (files of pinarms 0.1 lack it)
-    if n_reached is not None and (not isinstance(n_reached, int) or n_reached != int(np.count_nonzero(reached))):
-        raise r.fail(f"the file declares n_reached = {n_reached} but /voxels/reached marks "
-                     f"{int(np.count_nonzero(reached))} poses")
-    return flat, reached, index, best
-
-
-def _check_poses(r: _Checker, flat: np.ndarray, reached: np.ndarray, lower: np.ndarray,
-                 upper: np.ndarray) -> PoseSolutions:
-    pv, po_i4 = r.arrays["poses/voxel"], r.arrays["poses/orientation"]
-    q, w = r.finite("poses/q"), r.finite("poses/manipulability")
-    K, (V, M) = pv.size, reached.shape
-    rows = np.searchsorted(flat, pv)
-    po = po_i4.astype(np.int64)
-    ok = (rows < V) & (po >= 0) & (po < M)
-    ok[ok] &= flat[rows[ok]] == pv[ok]
-    if not ok.all():
-        raise r.fail(f"/poses entry {int(np.flatnonzero(~ok)[0])} names a voxel or orientation the map does not have")
-    key = rows * M + po
-    del rows, po, ok
-    hit = reached.reshape(-1)[key]
-    if not hit.all():
-        raise r.fail(f"/poses entry {int(np.flatnonzero(~hit)[0])} stores a solution of a pose marked unreached")
-    seen = np.zeros(V * M, dtype=bool)
-    seen[key] = True
-    if int(np.count_nonzero(seen)) != K or K != int(np.count_nonzero(reached)):
-        raise r.fail("/poses must hold exactly one solution per reached pose")
-    del seen, key
-    out = (q < lower - 1e-9) | (q > upper + 1e-9)
-    if out.any():
-        raise r.fail(f"/poses/q entry {int(np.flatnonzero(out.any(axis=1))[0])} lies outside the joint limits")
-    if np.any(w < 0):
-        raise r.fail("/poses/manipulability holds a negative value")
-    return PoseSolutions(pv, po_i4, q, w)
