@@ -3,7 +3,8 @@
 Where each family lives (imports go one way, top to bottom of this list read upwards):
 
 - the floor, importable by every package: :mod:`pinarms.errors` (the exception hierarchy),
-  :mod:`pinarms.execution` (serial loop or Dask), :mod:`pinarms.files` (atomic files),
+  :mod:`pinarms.execution` (serial loop or Dask) with :mod:`pinarms.chunks` (chunk seeds and
+  sizes) and :mod:`pinarms.schedulers` (the ``scheduler`` argument), :mod:`pinarms.files` (atomic files),
   :mod:`pinarms.units`, :mod:`pinarms.compiled` (numba kernels and their caches);
 - :mod:`pinarms.robots`: registry and ``Robot``, ``ik/``, ``reach/`` (workspace, reachability
   maps and their files, base placement, table band, layout check), ``cell/`` (cell, pairs with
