@@ -36,6 +36,7 @@ class _Settings:
     jmax: Any
     seed: int
     cell: "_CellRecipe | None" = None
+    screen: bool = True  # CellSettings.screen of every cycle in the cell
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,8 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
             return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
                             f"the cell cannot hold the arm there: {exc}"), None
         robot = moved.arm(st.cell.arm).robot
-        in_cell = CellSettings(moved, clearance=st.cell.clearance, arm=st.cell.arm)
+        in_cell = CellSettings(moved, clearance=st.cell.clearance, arm=st.cell.arm, screen=st.screen,
+                               recheck=keep_cycle)
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
         for j, place in enumerate(places_b):
