@@ -1,0 +1,113 @@
+"""Benchmark of optim/layout in a cell: candidates per second, screened vs not, serial vs 2 workers.
+
+Run: ``python benchmarks/layout.py [--serial 4] [--workers 16] [--no-workers]``. The cell is the
+planning scene ``aubo_crate_guard`` (the AUBO-i3 food station with a guard plate over the
+crate's near half): picking on the food table and placing in the crate's far half, no lift or
+via point clears the plate from most placements, so their cycle ends with a planned transfer
+(:mod:`optim.motion.transfer`). Candidates: 1 000 seeded random placements (x, y within ±80 mm
+of the scene's base, yaw within ±0.3 rad, the stand carried along); the benchmark times the
+first few and extrapolates to 1 000 (stated).
+
+1. **Serial**, one process, interleaved in blocks of two candidates: ``search_layout(...,
+   screen=False)`` (every re-planning attempt timed and checked in full) and ``screen=True``
+   (attempts rejected by exact distances at their via points and timed states first);
+   their outcomes must agree (failure class and cycle time).
+2. **Two workers** (``scheduler="processes:2"``, a local Dask cluster; its start, the cell
+   rebuilt on each worker and the compiled kernels loaded there are counted), screened.
+
+The machine's load (``os.getloadavg``) is printed with every figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+# This file's folder holds scripts named like packages: keep it off the import path.
+_HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _HERE]
+
+import numpy as np  # noqa: E402
+
+from pinarms import optim  # noqa: E402
+
+PICK = np.array([0.40, 0.10, 0.78])  # on the food table [m, world]
+PLACE = np.array([0.0, -0.46, 0.78])  # in the crate's far half, beyond the guard plate's edge
+TOTAL = 1000
+
+
+def _load() -> str:
+    return "load {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+
+
+def _cell():
+    from pinarms.optim.motion.scenes import scene_path
+    from pinarms.robots.cell import load_cell
+
+    return load_cell(scene_path("aubo_crate_guard"))
+
+
+def _search(cell, cand: np.ndarray, screen: bool, scheduler=None):
+    return optim.search_layout(cell, PICK, PLACE, cand, refine=0, carry=("stand",), workspace_samples=2000,
+                               chunk_size=1, screen=screen, scheduler=scheduler)
+
+
+def serial(cell, cand: np.ndarray) -> float:
+    """Screened vs not, interleaved in blocks of two; returns the screened candidates per second."""
+    spent = {False: 0.0, True: 0.0}
+    outcomes: dict[bool, list] = {False: [], True: []}
+    for s in range(0, cand.shape[0], 2):
+        block = cand[s : s + 2]
+        for screen in (False, True):
+            t = time.perf_counter()
+            res = _search(cell, block, screen)
+            spent[screen] += time.perf_counter() - t
+            outcomes[screen] += list(zip(res.failure, res.cycle_time))
+    n = cand.shape[0]
+    same = all(a[0] == b[0] and (a[0] or abs(a[1] - b[1]) <= 1e-9 * abs(a[1]))
+               for a, b in zip(outcomes[False], outcomes[True]))
+    kinds = sorted({f or "clear" for f, _ in outcomes[True]})
+    print(f"serial, {n} candidates ({', '.join(kinds)}); outcomes of both agree: {same}  [{_load()}]")
+    for screen in (False, True):
+        rate = n / spent[screen]
+        print(f"  screen={str(screen):5s}  {spent[screen] / n:6.2f} s/candidate  {rate:6.3f} candidates/s  "
+              f"1 000 placements ≈ {TOTAL / rate / 60:6.1f} min (extrapolated)")
+    print(f"  ratio (not screened / screened): {spent[False] / spent[True]:.2f}x")
+    return n / spent[True]
+
+
+def workers(cell, cand: np.ndarray, serial_rate: float | None) -> None:
+    """Screened, on a local Dask cluster of two single-thread workers (start-up counted)."""
+    t = time.perf_counter()
+    try:
+        res = _search(cell, cand, True, scheduler="processes:2")
+    except Exception as exc:  # a cluster that cannot start is reported, not fatal
+        print(f"2 workers: failed ({type(exc).__name__}: {exc})")
+        return
+    wall = time.perf_counter() - t
+    rate = cand.shape[0] / wall
+    ok = sum(1 for f in res.failure if not f)
+    print(f"2 workers, {cand.shape[0]} candidates ({ok} clear), screened: {wall:.1f} s wall incl. cluster start, "
+          f"{rate:.3f} candidates/s, 1 000 placements ≈ {TOTAL / rate / 60:.1f} min (extrapolated)  [{_load()}]")
+    if serial_rate:
+        print(f"  speed-up over serial (screened): {rate / serial_rate:.2f}x")
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--serial", type=int, default=4, help="candidates timed serially per mode (default 4)")
+    ap.add_argument("--workers", type=int, default=16, help="candidates on 2 workers (default 16)")
+    ap.add_argument("--no-workers", action="store_true", help="skip the Dask run")
+    args = ap.parse_args(argv)
+    cand = optim.random_candidates(TOTAL, x=(-0.08, 0.08), y=(-0.08, 0.08), z=0.7, yaw=(-0.3, 0.3), seed=1)
+    cell = _cell()
+    _search(cell, cand[-1:], True)  # compiled kernels loaded, caches warm: not timed
+    rate = serial(cell, cand[: args.serial]) if args.serial > 0 else None
+    if not args.no_workers and args.workers > 0:
+        workers(cell, cand[args.serial : args.serial + args.workers], rate)
+
+
+if __name__ == "__main__":
+    main()
