@@ -147,8 +147,9 @@ class CellSettings:
             before timing it or checking it continuously (proofs of failure only: the same
             verdicts and kept cycle; ``False``: every attempt timed and checked in full).
         recheck: report the kept cycle's clearance from a second continuous check with the
-            exact distance at every sample (``False``: from the check that kept it; a layout
-            search's candidates need no more).
+            exact distance at every sample (``False``: from the check that kept it, which
+            may stop at a proven bound below the true minimum; a layout search's candidates
+            need no more).
 
     Raises:
         InvalidInput: no cell. SettingOutOfRange: ``lift_step``, ``margin`` or ``clearance``
