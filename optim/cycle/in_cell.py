@@ -111,16 +111,17 @@ class CellCycleReport:
 
 
 class _KnownPeaks(Trajectory):
-    """A cycle's trajectory handed to the continuous checks with its exact peaks computed once.
+    """A cycle's trajectory handed to the continuous checks with its exact peaks known (``CycleResult.peaks``,
+    the trajectory's own ``peaks()``, computed when the cycle was made).
 
     Each check asks for the peaks twice (speed bound and acceleration bound), and an attempt is
     checked for external and own pairs: four root searches over every piece (a tenth of a second
     each on a planned transfer's time-optimal pieces) become one. Shares the trajectory's arrays.
     """
 
-    def __init__(self, trajectory: Trajectory) -> None:  # noqa: D107 - no Trajectory.__init__: nothing copied
+    def __init__(self, trajectory: Trajectory, peaks: Peaks) -> None:  # noqa: D107 - shares, copies nothing
         vars(self).update(vars(trajectory))
-        self._known = trajectory.peaks()
+        self._known = peaks
 
     def peaks(self) -> Peaks:
         k = self._known
@@ -197,7 +198,7 @@ class _Trials:
             t = np.linspace(traj.start_time, traj.end_time, SCREEN_SAMPLES)
             if not self.screened(description, np.asarray(traj.sample(t)[0], dtype=float), t - traj.start_time):
                 return False
-        motion = ArmMotion(self.cell_arm.name, _KnownPeaks(result.trajectory))
+        motion = ArmMotion(self.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
         ext = self.external.check_motion([motion], margin=self.margin, clearance=self.clearance, hold=self.hold_q)
         slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) if self.own is not None else None
         ok = ext.clear and (slf is None or slf.collision_free)
@@ -345,9 +346,9 @@ def _report(trials: _Trials, result: CycleResult, base: CycleResult, lift: float
     Without ``CellSettings.recheck``: the kept cycle's own continuous check (its samples' minimum)."""
     final = trials.kept
     if trials.request.cell.recheck or final is None:
-        final = trials.external.check_motion([ArmMotion(trials.cell_arm.name, _KnownPeaks(result.trajectory))],
-                                             margin=trials.margin, clearance=trials.clearance, hold=trials.hold_q,
-                                             curve=True)
+        motion = ArmMotion(trials.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
+        final = trials.external.check_motion([motion], margin=trials.margin, clearance=trials.clearance,
+                                             hold=trials.hold_q, curve=True)
     d, pair, _ = _describe(final)
     return CellCycleReport(
         cell=trials.request.cell.cell.name,

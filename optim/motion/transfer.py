@@ -100,7 +100,8 @@ def _joined(pieces: list, atol: float = 1e-7) -> Trajectory:
     for prev, nxt in zip(pieces, pieces[1:]):
         gap = np.abs(prev.sample(prev.end_time)[0] - nxt.sample(nxt.start_time)[0])
         if np.any(gap > atol):
-            raise TrajectoryError(f"position jump of {gap.max():.3g} at a junction of the planned cycle (atol {atol:g})")
+            raise TrajectoryError(f"position jump of {gap.max():.3g} at a junction of the planned cycle "
+                                  f"(atol {atol:g})")
         k = nxt.knot_times
         breaks = np.concatenate([breaks, k[1:] - k[0] + breaks[-1]])
         coefs.append(pad_degree(nxt.coefficients, width))
