@@ -14,6 +14,9 @@ first few and extrapolates to 1 000 (stated).
    their outcomes must agree (failure class and cycle time).
 2. **Two workers** (``scheduler="processes:2"``, a local Dask cluster; its start, the cell
    rebuilt on each worker and the compiled kernels loaded there are counted), screened.
+3. **Two arms** (``--two-arms``): ``plan_around`` on the scene ``aubo_two_belt`` (the right
+   arm reaches across the shared belt and back; the left arm must wait for it), its start
+   delays screened or each proven in turn, interleaved, median of the repetitions.
 
 The machine's load (``os.getloadavg``) is printed with every figure.
 """
@@ -95,12 +98,68 @@ def workers(cell, cand: np.ndarray, serial_rate: float | None) -> None:
         print(f"  speed-up over serial (screened): {rate / serial_rate:.2f}x")
 
 
+def _belt_query():
+    """The shared-belt query of the two-arm tests: (cell, hold, B's start and goal, A's trajectory)."""
+    from pinarms import planning
+    from pinarms.optim.motion import MotionChecker, load_scene
+    from pinarms.optim.motion.goals import ik_candidates
+    from pinarms.optim.motion.scenes import Region, region_pose
+
+    belt = load_scene("aubo_two_belt")
+    box = Region("r", (0, 0, 0), (1, 1, 1))
+
+    def ik(arm, point, hold):
+        checker = MotionChecker(belt, [arm], margin=0.01, hold=hold)
+        a = belt.arm(arm)
+        q, _ = ik_candidates(a.robot, a.to_base(region_pose(box, np.asarray(point, dtype=float))),
+                             belt.neutral[a.q_slice])
+        return [x for x in q if checker.state_valid(x)][0]
+
+    def quintic(q0, q1, v):
+        return planning.polynomial([0.0, float(np.max(1.875 * np.abs(q1 - q0) / v)) * 1.2], np.stack([q0, q1]), 5)
+
+    hold = belt.neutral.copy()
+    hold[belt.arm("right").q_slice] = qa0 = ik("right", (0.0, -0.78, 0.84), hold)
+    hold[belt.arm("left").q_slice] = qb0 = ik("left", (0.0, 0.78, 0.84), hold)
+    qa1 = ik("right", (0.0, 0.10, 0.84), hold)
+    v = belt.arm("right").robot.velocity_limit
+    there = quintic(qa0, qa1, v)
+    A = there.concatenated(quintic(qa1, qa0, v).shifted(there.duration))
+    return belt, hold, qb0, ik("left", (0.05, 0.10, 0.86), hold), A
+
+
+def two_arms(reps: int) -> None:
+    """``plan_around`` with its delays screened or each proven in turn, interleaved."""
+    import statistics
+
+    from pinarms.optim.motion.two_arms import plan_around
+
+    belt, hold, qb0, qb1, A = _belt_query()
+    wall: dict[bool, list[float]] = {False: [], True: []}
+    kept = set()
+    for _ in range(reps):
+        for screen in (False, True):
+            t = time.perf_counter()
+            plan = plan_around(belt, "left", qb0, qb1, {"right": A}, hold=hold, seed=0, time_limit=20.0,
+                               screen=screen)
+            wall[screen].append(time.perf_counter() - t)
+            kept.add((plan.delay, plan.delays_tried, float(plan.trajectory.end_time)))
+    print(f"two arms, plan_around on aubo_two_belt, {reps} repetitions; the same delay every time: "
+          f"{len(kept) == 1} (delay {sorted(kept)[0][0]:.2f} s)  [{_load()}]")
+    for screen in (False, True):
+        print(f"  screen={str(screen):5s}  median {statistics.median(wall[screen]) * 1e3:6.0f} ms  "
+              f"min {min(wall[screen]) * 1e3:6.0f} ms")
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--serial", type=int, default=4, help="candidates timed serially per mode (default 4)")
     ap.add_argument("--workers", type=int, default=16, help="candidates on 2 workers (default 16)")
     ap.add_argument("--no-workers", action="store_true", help="skip the Dask run")
+    ap.add_argument("--two-arms", type=int, default=5, help="plan_around repetitions per mode (0: skip; default 5)")
     args = ap.parse_args(argv)
+    if args.two_arms > 0:
+        two_arms(args.two_arms)
     cand = optim.random_candidates(TOTAL, x=(-0.08, 0.08), y=(-0.08, 0.08), z=0.7, yaw=(-0.3, 0.3), seed=1)
     cell = _cell()
     _search(cell, cand[-1:], True)  # compiled kernels loaded, caches warm: not timed

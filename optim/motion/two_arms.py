@@ -152,7 +152,7 @@ def _screened_delays(together: MotionChecker, trajectory: Trajectory, x0: np.nda
 def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: float = 0.0, margin: float = 0.01,
                 self_margin: float = 0.0, planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0,
                 hold: Any = None, vmax: Any = None, amax: Any = None, torque: Any = True, delay_step: float = 0.05,
-                grid: int = 200, progress: Callable[[str], None] | None = None) -> AroundPlan:
+                grid: int = 200, screen: bool = True, progress: Callable[[str], None] | None = None) -> AroundPlan:
     """Plan ``arm`` from ``start`` (ready at cell time ``t0``) to ``goal`` around the ``moving`` arms.
 
     Args:
@@ -161,6 +161,8 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
             trajectory time − its start; they hold their ends outside).
         t0: when B may leave its start [s, cell time].
         delay_step: resolution of the start delay [s].
+        screen: screen the delays in batches before proving them (module docstring; proofs of
+            failure only, the same delay kept); ``False``: every delay proven in turn.
         Others as :func:`plan_motion` (``hold``: the cell configuration of the other arms).
 
     Raises:
@@ -203,7 +205,9 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
     for k, d in enumerate(delays):
         if k == rejected.size:  # the next block of delays screened at once
             block = delays[k : k + DELAY_BLOCK]
-            rejected = np.append(rejected, _screened_delays(together, plan.trajectory, x0, float(t0), block, t_end))
+            more = (_screened_delays(together, plan.trajectory, x0, float(t0), block, t_end) if screen
+                    else np.zeros(block.size, dtype=bool))
+            rejected = np.append(rejected, more)
         if rejected[k]:
             continue
         candidate = _waiting(plan.trajectory, x0, float(t0), float(d))
