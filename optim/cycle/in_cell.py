@@ -20,6 +20,12 @@ fails, the cycle is re-planned, in this order, until it passes:
    continuously (:mod:`optim.motion`).
 
 Each re-planned cycle is re-timed (time-optimal under the same limits) and re-checked.
+With ``CellSettings.screen`` (default), an attempt is first screened by exact distances at a few
+of its states, which can only reject it: its joint via points before it is timed (the timed
+cycle passes through them), then :data:`SCREEN_SAMPLES` instants of the timed cycle before the
+continuous check. A state closer than the clearance (by more than :data:`SCREEN_TOL`) proves
+the attempt cannot clear, so the screens change no verdict and no kept cycle; a cycle kept is
+always the one the continuous check proved.
 The result carries a :class:`CellCycleReport`: what was tried, the lift and via points
 kept, the smallest clearance, and the extra time against the cycle planned without the
 cell. If the pick or the place itself is closer than ``clearance`` to a fixture, or no
@@ -35,15 +41,23 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.caps import MAX_LIFT_ATTEMPTS
+from pinarms.optim.cycle.joint import _via_points
 from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import CycleResult, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
+from pinarms.planning import Trajectory
+from pinarms.planning.trajectory import Peaks
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
-__all__ = ["CellCycleReport", "plan_cycle_in_cell"]
+__all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL"]
+
+#: Instants of a timed attempt whose exact distances screen it before the continuous check.
+SCREEN_SAMPLES = 48
+#: A screened state rejects an attempt only when it is closer than the clearance by more than this [m].
+SCREEN_TOL = 1e-6
 
 @dataclass(frozen=True, eq=False)
 class CellCycleReport:
@@ -96,6 +110,24 @@ class CellCycleReport:
         }
 
 
+class _KnownPeaks(Trajectory):
+    """A cycle's trajectory handed to the continuous checks with its exact peaks known (``CycleResult.peaks``,
+    the trajectory's own ``peaks()``, computed when the cycle was made).
+
+    Each check asks for the peaks twice (speed bound and acceleration bound), and an attempt is
+    checked for external and own pairs: four root searches over every piece (a tenth of a second
+    each on a planned transfer's time-optimal pieces) become one. Shares the trajectory's arrays.
+    """
+
+    def __init__(self, trajectory: Trajectory, peaks: Peaks) -> None:  # noqa: D107 - shares, copies nothing
+        vars(self).update(vars(trajectory))
+        self._known = peaks
+
+    def peaks(self) -> Peaks:
+        k = self._known
+        return Peaks(velocity=k.velocity.copy(), acceleration=k.acceleration.copy(), jerk=k.jerk.copy())
+
+
 def _arm_of(cell: Any, robot: Any, arm: str | None):
     if arm is not None:
         found = cell.arm(arm)
@@ -138,10 +170,35 @@ class _Trials:
                     else None)
         self.attempts: list[tuple[str, bool, float, str]] = []
         self.last: tuple[str, float, str, float] | None = None
+        self.screen = bool(request.cell.screen)
+        self.kept = None  # the continuous check of the last attempt checked
+
+    def screened(self, description: str, q: np.ndarray, t: np.ndarray | None = None) -> bool:
+        """Whether every state ``q (N, n)`` of the arm keeps the clearance (exact distances, module doc).
+
+        A state that does not proves the attempt fails: it is recorded as the attempt, and False
+        returned. ``t``: the states' instants in the cycle [s] (None: via points, not yet timed).
+        """
+        Q = np.repeat(self.hold_q[None], q.shape[0], axis=0)
+        Q[:, self.cell_arm.q_slice] = q
+        cl = self.external.clearance(Q)
+        d = np.atleast_1d(np.asarray(cl.distance, dtype=float))
+        k = int(np.argmin(d))
+        if d[k] >= self.clearance - SCREEN_TOL:
+            return True
+        pair = str(cl.pair_of(k))
+        self.attempts.append((description, False, float(d[k]), pair))
+        self.last = (description, float(d[k]), pair, float("nan") if t is None else float(t[k]))
+        return False
 
     def check(self, description: str, result: CycleResult) -> bool:
         """Check ``result`` in the cell and record the attempt: whether it keeps the clearance."""
-        motion = ArmMotion(self.cell_arm.name, result.trajectory)
+        if self.screen:
+            traj = result.trajectory
+            t = np.linspace(traj.start_time, traj.end_time, SCREEN_SAMPLES)
+            if not self.screened(description, np.asarray(traj.sample(t)[0], dtype=float), t - traj.start_time):
+                return False
+        motion = ArmMotion(self.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
         ext = self.external.check_motion([motion], margin=self.margin, clearance=self.clearance, hold=self.hold_q)
         slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) if self.own is not None else None
         ok = ext.clear and (slf is None or slf.collision_free)
@@ -149,19 +206,29 @@ class _Trials:
         d, pair, t = _describe(bad if not ok else ext)
         self.attempts.append((description, bool(ok), float(d), pair))
         self.last = (description, d, pair, t)
+        self.kept = ext
         return bool(ok)
 
-    def plan(self, description: str, spec: PickPlace) -> tuple[bool, CycleResult]:
-        """Plan ``spec`` as without the cell and check it (UnreachableTarget: the spec is out of reach)."""
-        result = approach_cycle(dataclasses.replace(self.request, spec=spec))
+    def plan(self, description: str, spec: PickPlace) -> tuple[bool, CycleResult | None]:
+        """Plan ``spec`` as without the cell and check it (UnreachableTarget: the spec is out of reach).
+
+        Screened first (joint approach): a via point closer than the clearance rejects it untimed (None)."""
+        request = dataclasses.replace(self.request, spec=spec)
+        if self.screen and request.approach.approach == "joint":
+            robot = request.robot
+            q = _via_points(robot, spec.poses(robot), spec.names, request.q_start)[0]  # as the cycle will have them
+            if not self.screened(description, q):
+                return False, None
+        result = approach_cycle(request)
         return self.check(description, result), result
 
     def failure(self, cell: Any) -> CollisionError:
         """The error when no attempt cleared: what blocks, where, after how many attempts."""
         description, d, pair, t = self.last
+        when = f"t = {t:.3f} s of the cycle" if np.isfinite(t) else "a via point"
         return CollisionError(
             f"arm {self.cell_arm.name!r} of cell {cell.name!r} cannot keep {self.clearance * 1e3:.1f} mm: {pair} "
-            f"blocks (closest {d * 1e3:.1f} mm at t = {t:.3f} s of the cycle) after {len(self.attempts)} attempts, "
+            f"blocks (closest {d * 1e3:.1f} mm at {when}) after {len(self.attempts)} attempts, "
             f"the last with {description}; lower the clearance, move the pick/place, or move the fixture"
         )
 
@@ -274,9 +341,14 @@ def plan_cycle_in_cell(request: CycleRequest) -> CycleResult:
 
 def _report(trials: _Trials, result: CycleResult, base: CycleResult, lift: float, vias: tuple,
             planned_transfer: bool) -> CellCycleReport:
-    """The kept cycle once more with the exact distance at every sample (its true minimum), and what was tried."""
-    final = trials.external.check_motion([ArmMotion(trials.cell_arm.name, result.trajectory)], margin=trials.margin,
-                                         clearance=trials.clearance, hold=trials.hold_q, curve=True)
+    """The kept cycle once more with the exact distance at every sample (its true minimum), and what was tried.
+
+    Without ``CellSettings.recheck``: the kept cycle's own continuous check (its samples' minimum)."""
+    final = trials.kept
+    if trials.request.cell.recheck or final is None:
+        motion = ArmMotion(trials.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
+        final = trials.external.check_motion([motion], margin=trials.margin, clearance=trials.clearance,
+                                             hold=trials.hold_q, curve=True)
     d, pair, _ = _describe(final)
     return CellCycleReport(
         cell=trials.request.cell.cell.name,

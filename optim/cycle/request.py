@@ -143,6 +143,13 @@ class CellSettings:
         lift_step: rise of the lift per re-planning attempt [m] (:data:`optim.caps.LIFT_STEP_RANGE`).
         plan_transfer: when raising the lift and via points cannot clear, plan the transfer
             round what blocks (:mod:`optim.motion.transfer`).
+        screen: reject an attempt by exact distances at its via points and a few timed states
+            before timing it or checking it continuously (proofs of failure only: the same
+            verdicts and kept cycle; ``False``: every attempt timed and checked in full).
+        recheck: report the kept cycle's clearance from a second continuous check with the
+            exact distance at every sample (``False``: from the check that kept it, which
+            may stop at a proven bound below the true minimum; a layout search's candidates
+            need no more).
 
     Raises:
         InvalidInput: no cell. SettingOutOfRange: ``lift_step``, ``margin`` or ``clearance``
@@ -156,6 +163,8 @@ class CellSettings:
     margin: float = 0.005
     lift_step: float = 0.02
     plan_transfer: bool = True
+    screen: bool = True
+    recheck: bool = True
 
     def __post_init__(self) -> None:
         if self.cell is None or not hasattr(self.cell, "arms"):

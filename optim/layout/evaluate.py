@@ -36,6 +36,7 @@ class _Settings:
     jmax: Any
     seed: int
     cell: "_CellRecipe | None" = None
+    screen: bool = True  # CellSettings.screen of every cycle in the cell
 
 
 @dataclass(frozen=True)
@@ -109,8 +110,10 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
         except PinarmsError as exc:
             return _Outcome("collision" if "collision" in str(exc).lower() else "timing",
                             f"the cell cannot hold the arm there: {exc}"), None
-        robot = moved.arm(st.cell.arm).robot
-        in_cell = CellSettings(moved, clearance=st.cell.clearance, arm=st.cell.arm)
+        # ``robot`` stays the task's own (warm IK caches): the arm's kinematics in its base frame
+        # do not change when its base moves, and the cell's arm is named
+        in_cell = CellSettings(moved, clearance=st.cell.clearance, arm=st.cell.arm, screen=st.screen,
+                               recheck=keep_cycle)
     times, w_min, branch, first = [], np.inf, -1, None
     for i, pick in enumerate(picks_b):
         for j, place in enumerate(places_b):

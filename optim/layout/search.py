@@ -282,7 +282,8 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
                   jmax: Any = None, refine: int = 2, refine_evaluations: int = 30, workspace_samples: int = 200_000,
                   seed: int = 0, chunk_size: int = 4, scheduler: Any = None,
                   progress: Callable[[int, int], None] | None = None, arm: str | None = None,
-                  clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0) -> LayoutSearch:
+                  clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0,
+                  screen: bool = True) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
@@ -293,6 +294,9 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
             must keep ``clearance`` [m] from the fixtures and the other arms
             (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
             points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
+            ``screen``: each re-planning attempt is first screened by exact distances at its
+            via points and a few timed states (:class:`optim.CellSettings`; proofs of failure
+            only, so the same verdicts; ``False``: every attempt timed and checked in full).
         picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
             paired with every place.
         candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
@@ -326,7 +330,8 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
               "chunk_size": chunk_size, "seed": seed}
     picks_w, places_w, cand, R = _checked_inputs(picks, places, candidates, kind, counts, orientation, lift, dwell,
                                                  min_margin)
-    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe)
+    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe,
+                   bool(screen))
 
     failure, reason = _screen(robot, cand, st)
     vmap, point_margin = _margins(robot, st, cand, workspace_samples)

@@ -88,6 +88,30 @@ def _lines(base: Any, k: int) -> tuple[list, list]:
             [polyline_path(np.stack([place, up_place])), polyline_path(np.stack([up_pick, pick]))])
 
 
+def _joined(pieces: list, atol: float = 1e-7) -> Trajectory:
+    """The trajectories one after the other, as :meth:`Trajectory.concatenated` in turn gives them, with
+    each piece's definition copied once (a timed path's definition is long: copying the growing
+    concatenation at every step took a third of a planned transfer)."""
+    from pinarms.planning.errors import TrajectoryError
+    from pinarms.planning.poly_pieces import pad_degree
+
+    width = max(p.degree for p in pieces) + 1
+    breaks, coefs = pieces[0].knot_times, [pad_degree(pieces[0].coefficients, width)]
+    for prev, nxt in zip(pieces, pieces[1:]):
+        gap = np.abs(prev.sample(prev.end_time)[0] - nxt.sample(nxt.start_time)[0])
+        if np.any(gap > atol):
+            raise TrajectoryError(f"position jump of {gap.max():.3g} at a junction of the planned cycle "
+                                  f"(atol {atol:g})")
+        k = nxt.knot_times
+        breaks = np.concatenate([breaks, k[1:] - k[0] + breaks[-1]])
+        coefs.append(pad_degree(nxt.coefficients, width))
+    parts: list = []
+    for p in pieces:
+        d = p.definition
+        parts.extend(d["parts"] if d.get("kind") == "concatenated" else [d])
+    return Trajectory(breaks, np.concatenate(coefs, axis=0), {"kind": "concatenated", "parts": parts})
+
+
 def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
                   margin: float, planner: str = "rrtconnect", time_limit: float = 5.0, seed: int = 0) -> Any:
     """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
@@ -123,9 +147,7 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
 
     def move(paths: list) -> PlannedMove:
         parts = tuple(time_path(p, constraints) for p in paths)
-        traj = parts[0].trajectory
-        for p in parts[1:]:
-            traj = traj.concatenated(p.trajectory, atol=1e-7)
+        traj = _joined([p.trajectory for p in parts])
         return PlannedMove(parts, traj, geo["planner"], geo["states"], arm.robot, base.torque_limit)
 
     m1 = move([there[0], transfer, there[1]])
@@ -133,9 +155,7 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
     pieces = [m1.trajectory, m2.trajectory]
     if spec.dwell > 0.0:
         pieces = [_hold(q[0], spec.dwell), pieces[0], _hold(q[k - 1], spec.dwell), pieces[1]]
-    trajectory = pieces[0]
-    for p in pieces[1:]:
-        trajectory = trajectory.concatenated(p, atol=1e-7)
+    trajectory = _joined(pieces)
     ends = _vertical_segments(spec.poses(robot))
     return dataclasses.replace(base, moves=(m1, m2), trajectory=trajectory, peaks=trajectory.peaks(),
                                line_deviation=_line_deviation(robot, (m1, m2), ends))

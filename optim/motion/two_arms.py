@@ -10,7 +10,10 @@
    continuous proof with A **at the same instants** accepts the whole motion: B waiting at
    its start, then moving, against A moving (:meth:`MotionChecker.trajectory_valid`: samples
    every ``margin`` of the two arms' combined travel, A's travel bounded from its exact
-   speeds and accelerations). A start inside A's sweep has no such instant.
+   speeds and accelerations). A start inside A's sweep has no such instant. The delays are
+   first screened in batches of :data:`DELAY_BLOCK` (:data:`DELAY_SAMPLES` instants each, the
+   sphere cover then coal, :meth:`MotionChecker.batch_collides`): a delay with an instant
+   closer than the margin is proven not to clear and skips its proof.
 
 :func:`plan_two_arms` tries :func:`plan_around` and, when it finds nothing (no path, or no
 start instant up to A's end), plans both arms in their joint space (:func:`plan_motion`
@@ -33,7 +36,12 @@ from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_mo
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms"]
+__all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms", "DELAY_SAMPLES"]
+
+#: Instants per start delay at which :func:`plan_around` screens the delays before proving them.
+DELAY_SAMPLES = 64
+#: Start delays screened in one batch (the first that clears is usually among the first few blocks).
+DELAY_BLOCK = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,10 +134,25 @@ def _waiting(trajectory: Trajectory, q0: np.ndarray, t0: float, delay: float) ->
     return Trajectory(np.concatenate([[t0], knots + t0 + delay]), np.concatenate([wait, C]))
 
 
+def _screened_delays(together: MotionChecker, trajectory: Trajectory, x0: np.ndarray, t0: float,
+                     delays: np.ndarray, t_end: float) -> np.ndarray:
+    """``(K,)`` bool: the start delays with an instant (of :data:`DELAY_SAMPLES` from ``t0`` to the
+    later end) at which B, leaving after that delay, is closer than the margin to something (A
+    at the same instant included): proven not to clear. One batch for every delay."""
+    rows = []
+    for d in delays:
+        moved = _waiting(trajectory, x0, float(t0), float(d))
+        t = np.linspace(float(t0), max(float(moved.end_time), float(t_end)), DELAY_SAMPLES)
+        q = np.asarray(moved.sample(np.minimum(t, moved.end_time))[0], dtype=float).reshape(t.size, -1)
+        rows.append(np.column_stack([q, t]))
+    X = np.concatenate(rows)
+    return together.batch_collides(together.full(X)).reshape(len(delays), DELAY_SAMPLES).any(axis=1)
+
+
 def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: float = 0.0, margin: float = 0.01,
                 self_margin: float = 0.0, planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0,
                 hold: Any = None, vmax: Any = None, amax: Any = None, torque: Any = True, delay_step: float = 0.05,
-                grid: int = 200, progress: Callable[[str], None] | None = None) -> AroundPlan:
+                grid: int = 200, screen: bool = True, progress: Callable[[str], None] | None = None) -> AroundPlan:
     """Plan ``arm`` from ``start`` (ready at cell time ``t0``) to ``goal`` around the ``moving`` arms.
 
     Args:
@@ -138,6 +161,8 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
             trajectory time − its start; they hold their ends outside).
         t0: when B may leave its start [s, cell time].
         delay_step: resolution of the start delay [s].
+        screen: screen the delays in batches before proving them (module docstring; proofs of
+            failure only, the same delay kept); ``False``: every delay proven in turn.
         Others as :func:`plan_motion` (``hold``: the cell configuration of the other arms).
 
     Raises:
@@ -164,9 +189,10 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
     _check_start(together, np.append(x0, t0), "start")
     say("planning the path around the other arm(s) parked at the end of their motion")
     try:
+        # no re-check of the motion against A parked: the motion kept is checked against A moving
         plan = plan_motion(cell, arms[0], x0, goal, margin=margin, self_margin=self_margin, planner=planner,
                            time_limit=time_limit, seed=seed, hold=parked, vmax=vmax, amax=amax, torque=torque,
-                           grid=grid)
+                           grid=grid, recheck=False)
     except StartInCollision as exc:
         raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({exc}): it "
                           "cannot wait there; plan both arms together", planner="", time_limit=float(time_limit)) \
@@ -175,7 +201,15 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
     t_end = max(m.offset + m.trajectory.duration for m in timed)
     delays = np.arange(0.0, max(t_end - t0, 0.0) + delay_step, delay_step)
     chosen = None
+    rejected = np.zeros(0, dtype=bool)
     for k, d in enumerate(delays):
+        if k == rejected.size:  # the next block of delays screened at once
+            block = delays[k : k + DELAY_BLOCK]
+            more = (_screened_delays(together, plan.trajectory, x0, float(t0), block, t_end) if screen
+                    else np.zeros(block.size, dtype=bool))
+            rejected = np.append(rejected, more)
+        if rejected[k]:
+            continue
         candidate = _waiting(plan.trajectory, x0, float(t0), float(d))
         if together.trajectory_valid(candidate, float(t0)).ok:
             chosen = (k, float(d), candidate)
