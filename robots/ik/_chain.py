@@ -44,11 +44,19 @@ ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
     """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` ``(m, 3)``.
 
-    The running rotation and position are held in scalars (registers), one joint after the other.
+    The cosines and sines of the joint angles are taken first (held in ``Z[k, 0]``, ``Z[k, 1]``
+    until the chain's pass writes joint ``k``'s axis), so that the pass itself calls no function
+    and keeps the running rotation and position in registers.
     """
+    m = qi.shape[0]
+    for k in range(m):
+        if rev[k]:
+            v = sc[k] * q[qi[k]] + of[k]
+            Z[k, 0] = math.cos(v)
+            Z[k, 1] = math.sin(v)
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     p0 = p1 = p2 = 0.0
-    for k in range(qi.shape[0]):
+    for k in range(m):
         a0, a1, a2 = Lp[k, 0], Lp[k, 1], Lp[k, 2]
         p0 = p0 + r00 * a0 + r01 * a1 + r02 * a2
         p1 = p1 + r10 * a0 + r11 * a1 + r12 * a2
@@ -63,14 +71,14 @@ def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
         n20 = r20 * M[0, 0] + r21 * M[1, 0] + r22 * M[2, 0]
         n21 = r20 * M[0, 1] + r21 * M[1, 1] + r22 * M[2, 1]
         n22 = r20 * M[0, 2] + r21 * M[1, 2] + r22 * M[2, 2]
-        v = sc[k] * q[qi[k]] + of[k]
         if rev[k]:
-            c = math.cos(v)
-            s = math.sin(v)
+            c = Z[k, 0]
+            s = Z[k, 1]
             r00, r01 = c * n00 + s * n01, c * n01 - s * n00
             r10, r11 = c * n10 + s * n11, c * n11 - s * n10
             r20, r21 = c * n20 + s * n21, c * n21 - s * n20
         else:
+            v = sc[k] * q[qi[k]] + of[k]
             r00, r01, r10, r11, r20, r21 = n00, n01, n10, n11, n20, n21
             p0 += v * n02
             p1 += v * n12

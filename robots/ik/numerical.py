@@ -57,6 +57,7 @@ failure diagnosis, the closed-form refinement and :meth:`attempt`. The limit rul
 
 from __future__ import annotations
 
+import hashlib
 import threading
 from dataclasses import dataclass
 
@@ -172,13 +173,15 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
             )
             P = np.array([self.damping, self.min_damping, self.max_step, self.stall_ratio, self.stall_steps,
                           self.max_iter], dtype=float)
-            args = self._kernel_args = (_kernel, C, L, P, self._grid_table())  # one assignment: thread-safe
+            digest = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in C + L))
+            table = self._grid_table(digest.hexdigest())
+            args = self._kernel_args = (_kernel, C, L, P, table)  # one assignment: thread-safe
         return args
 
     def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
                         seed) -> IKResult:
         """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the nearest of
-        16 384 stored poses), then up to ``max_restarts`` more: the 8 stored poses next nearest the
+        32 768 stored poses), then up to ``max_restarts`` more: the 8 stored poses next nearest the
         target, then seeded uniform starts nearest pose first.
 
         A success is confirmed by Pinocchio's forward kinematics of the returned ``q`` and an exact

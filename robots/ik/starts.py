@@ -11,6 +11,8 @@ seeded generator, :data:`POOL` at a time, nearest pose first. Distance:
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pinocchio as pin
 
@@ -19,13 +21,16 @@ __all__ = ["StartTable", "TABLE_SIZE", "POOL", "ROT_WEIGHT", "LIMIT_PENALTY", "L
 TABLE_SIZE = 256  # configurations stored with their poses for the first start (table_start)
 POOL = 32  # random starts drawn at once and ranked by their distance to the target
 ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
-GRID_TABLE_SIZE = 16384  # configurations of the compiled solver's start table (grid_table)
+GRID_TABLE_SIZE = 32768  # configurations of the compiled solver's start table (grid_table)
 _PER_CELL = 2  # mean rows per cell of the grid over the positions' bounding box
 _GRID_SEED = (0x5EED, 0x7AB1E, GRID_TABLE_SIZE)  # seed sequence of the grid table's draws
 #: [m] added to a grid-table row's cost when a joint sits at its limit, falling linearly to 0 at
 #: :data:`LIMIT_MARGIN` from it: a start near a limit often descends to a solution beyond it
 LIMIT_PENALTY = 0.2
 LIMIT_MARGIN = 0.6  # [rad] (at most a quarter of the range; prismatic joints: a tenth of the range)
+_TABLES: dict[str, tuple] = {}  # grid tables by the digest of the chain and limits they were made for
+_TABLES_KEPT = 8  # the most recent ones (≈ 5 MB each)
+_TABLES_LOCK = threading.Lock()
 
 
 class StartTable:
@@ -42,15 +47,29 @@ class StartTable:
             table = self._table = (q, p, np.einsum("ij,ij->i", p, p), R)  # one assignment: safe across threads
         return table
 
-    def _grid_table(self) -> tuple:
+    def _grid_table(self, key: str | None = None) -> tuple:
         """The compiled solver's start table: :data:`GRID_TABLE_SIZE` configurations drawn within the limits
         (a fixed seed of its own, so that no user's seeded draws coincide with its rows) with their frame poses, rows sorted by the cell of a grid over their positions.
 
         Returns ``(q, p, |p|², R (n, 9), cell_start, grid, penalty)`` as :func:`._chain.grid_index` reads it:
         the rows of cell ``c`` are ``cell_start[c]:cell_start[c + 1]``; ``grid = (x0, y0, z0, 1/size,
         nx, ny, nz)``, the cell size giving about 2 rows per cell of the positions' bounding box;
-        ``penalty (n,)`` [m] is :meth:`_limit_penalty` of each row.
+        ``penalty (n,)`` [m] is :meth:`_limit_penalty` of each row. With ``key`` (a digest of
+        everything the table depends on: the chain to the frame and the limits), a table made for the
+        same key in this process is reused (read only; the :data:`_TABLES_KEPT` latest are kept).
         """
+        table = _TABLES.get(key) if key is not None else None
+        if table is None:
+            table = self._make_grid_table()
+            if key is not None:
+                with _TABLES_LOCK:
+                    while len(_TABLES) >= _TABLES_KEPT:
+                        del _TABLES[next(iter(_TABLES))]
+                    _TABLES[key] = table
+        return table
+
+    def _make_grid_table(self) -> tuple:
+        """The table of :meth:`_grid_table`, drawn and sorted."""
         q = np.random.default_rng(_GRID_SEED).uniform(self.lower, self.upper, size=(GRID_TABLE_SIZE, self.nq))
         T = self.robot.fk(q, self._frame)
         p = T[:, :3, 3]

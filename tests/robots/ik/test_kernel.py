@@ -208,3 +208,15 @@ def test_a_changed_kernel_source_drops_every_kernel_cache(tmp_path):
     (tmp_path / "_chain.py").write_text((here / "_chain.py").read_text() + "\n# changed\n")
     chain.drop_stale_caches(tmp_path)  # a sibling changed: the _kernel cache goes too
     assert not stale[0].exists() and other.exists()
+
+
+def test_start_table_is_shared_by_arms_of_the_same_kinematics_and_limits():
+    """The 32 768-row table is made once per chain and limits in a process (read only), not per robot."""
+    a, b = NumericalIK(robots.load("aubo_i3")), NumericalIK(robots.load("aubo_i3"))
+    assert a._compiled()[4] is b._compiled()[4]
+    narrow = robots.load("aubo_i3")
+    narrow.upper = np.minimum(narrow.upper, 2.0)  # other limits: a table of their own
+    narrow_table = NumericalIK(narrow)._compiled()[4]
+    assert narrow_table is not a._compiled()[4]
+    assert (narrow_table[0] <= 2.0).all() and (a._compiled()[4][0] > 2.0).any()
+    assert a._compiled()[4][0].shape == (32768, 6)
