@@ -195,24 +195,43 @@ def pose_cost(C, q, Rt, pt, posonly, R, p, Z, O):
 
 
 @jit_inline
-def _row_rotation(tR, k, Rt):
-    """The rotation term of a start-table row's cost: ``0.1 m/rad · ‖R_k − R_t‖_F`` from the rows' flat
-    rotations ``tR (n, 9)`` (``‖A − B‖_F² = 6 − 2 tr(AᵀB)`` for two rotations)."""
-    dot = 0.0
-    for a in range(3):
-        for b in range(3):
-            dot += tR[k, 3 * a + b] * Rt[a, b]
-    return ROT_WEIGHT * math.sqrt(max(6.0 - 2.0 * dot, 0.0))
+def _quaternion(Rt):
+    """A unit quaternion ``(w, x, y, z)`` of the rotation ``Rt`` (Shepperd: from its largest diagonal term; either sign)."""
+    t = Rt[0, 0] + Rt[1, 1] + Rt[2, 2]
+    if t >= Rt[0, 0] and t >= Rt[1, 1] and t >= Rt[2, 2]:
+        r = math.sqrt(1.0 + t)
+        f = 0.5 / r
+        return 0.5 * r, (Rt[2, 1] - Rt[1, 2]) * f, (Rt[0, 2] - Rt[2, 0]) * f, (Rt[1, 0] - Rt[0, 1]) * f
+    if Rt[0, 0] >= Rt[1, 1] and Rt[0, 0] >= Rt[2, 2]:
+        r = math.sqrt(max(1.0 + Rt[0, 0] - Rt[1, 1] - Rt[2, 2], 1e-300))
+        f = 0.5 / r
+        return (Rt[2, 1] - Rt[1, 2]) * f, 0.5 * r, (Rt[0, 1] + Rt[1, 0]) * f, (Rt[0, 2] + Rt[2, 0]) * f
+    if Rt[1, 1] >= Rt[2, 2]:
+        r = math.sqrt(max(1.0 - Rt[0, 0] + Rt[1, 1] - Rt[2, 2], 1e-300))
+        f = 0.5 / r
+        return (Rt[0, 2] - Rt[2, 0]) * f, (Rt[0, 1] + Rt[1, 0]) * f, 0.5 * r, (Rt[1, 2] + Rt[2, 1]) * f
+    r = math.sqrt(max(1.0 - Rt[0, 0] - Rt[1, 1] + Rt[2, 2], 1e-300))
+    f = 0.5 / r
+    return (Rt[1, 0] - Rt[0, 1]) * f, (Rt[0, 2] + Rt[2, 0]) * f, (Rt[1, 2] + Rt[2, 1]) * f, 0.5 * r
+
+
+@jit_inline
+def _row_rotation(tQ, k, w, x, y, z):
+    """The rotation term of a start-table row's cost, ``0.1 m/rad · ‖R_k − R_t‖_F``, from the rows' unit quaternions
+    ``tQ (n, 4)`` and the target's ``(w, x, y, z)``: ``‖A − B‖_F² = 6 − 2 tr(AᵀB) = 8 (1 − (q_A·q_B)²)``."""
+    dot = tQ[k, 0] * w + tQ[k, 1] * x + tQ[k, 2] * y + tQ[k, 3] * z
+    return ROT_WEIGHT * math.sqrt(max(8.0 * (1.0 - dot * dot), 0.0))
 
 
 @jit
-def table_index(tq, tp, tpp, tR, pen, Rt, pt, posonly):
+def table_index(tq, tp, tpp, tQ, pen, Rt, pt, posonly):
     """Row of the start table whose pose is nearest ``(Rt, pt)`` (``‖Δp‖ + 0.1 m/rad · ‖ΔR‖_F + pen[k]``).
 
     A row whose position distance alone is no better than the best so far is passed over
     without its other terms (the cost only grows with them): the row of the full scan (up to rounding ties).
     """
     best, best2, k_best = np.inf, np.inf, 0
+    w, x, y, z = _quaternion(Rt)
     ptp = pt[0] * pt[0] + pt[1] * pt[1] + pt[2] * pt[2]
     for k in range(tq.shape[0]):
         d2 = tpp[k] - 2.0 * (tp[k, 0] * pt[0] + tp[k, 1] * pt[1] + tp[k, 2] * pt[2]) + ptp
@@ -220,7 +239,7 @@ def table_index(tq, tp, tpp, tR, pen, Rt, pt, posonly):
             continue
         c = math.sqrt(max(d2, 0.0)) + pen[k]
         if not posonly:
-            c += _row_rotation(tR, k, Rt)
+            c += _row_rotation(tQ, k, w, x, y, z)
         if c < best:
             best, k_best = c, k
             best2 = c * c
@@ -241,12 +260,13 @@ def _cell_of(grid, pt):
 def grid_index(table, Rt, pt, posonly):
     """Row of the gridded start table nearest ``(Rt, pt)`` among the rows in the target's cell and its 26 neighbours.
 
-    ``table = (q, p, |p|², R rows (n, 9), cell_start, grid, penalty)``, rows sorted by cell; ``grid = (x0,
+    ``table = (q, p, |p|², unit quaternions (n, 4), cell_start, grid, penalty)``, rows sorted by cell; ``grid = (x0,
     y0, z0, 1/size, nx, ny, nz)``; a target outside the grid looks in the nearest border cells. Cost as
     :func:`table_index` (the row's limit penalty included); when those cells are all empty, every row is scanned.
     """
-    tq, tp, tpp, tR, cell_start, grid, pen = table
+    tq, tp, tpp, tQ, cell_start, grid, pen = table
     cx, cy, cz, nx, ny, nz = _cell_of(grid, pt)
+    w, x, y, z = _quaternion(Rt)
     best, best2, k_best = np.inf, np.inf, -1
     for ix in range(max(cx - 1, 0), min(cx + 2, nx)):
         for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
@@ -258,11 +278,11 @@ def grid_index(table, Rt, pt, posonly):
                         continue
                     c = math.sqrt(d2) + pen[k]
                     if not posonly:
-                        c += _row_rotation(tR, k, Rt)
+                        c += _row_rotation(tQ, k, w, x, y, z)
                     if c < best:
                         best, best2, k_best = c, c * c, k
     if k_best < 0:
-        return table_index(tq, tp, tpp, tR, pen, Rt, pt, posonly)
+        return table_index(tq, tp, tpp, tQ, pen, Rt, pt, posonly)
     return k_best
 
 
@@ -275,9 +295,10 @@ def grid_neighbours(table, Rt, pt, posonly, count):
     better than the worst of them is passed over (the former full sort of the 100-1 000 rows of
     the 27 cells cost ≈ 10 µs).
     """
-    tq, tp, tpp, tR, cell_start, grid, pen = table
+    tq, tp, tpp, tQ, cell_start, grid, pen = table
     count = max(count, 1)
     cx, cy, cz, nx, ny, nz = _cell_of(grid, pt)
+    w, x, y, z = _quaternion(Rt)
     rows = np.empty(count, dtype=np.int64)
     cost = np.empty(count)
     n = 0
@@ -292,7 +313,7 @@ def grid_neighbours(table, Rt, pt, posonly, count):
                         continue
                     c = math.sqrt(d2) + pen[k]
                     if not posonly:
-                        c += _row_rotation(tR, k, Rt)
+                        c += _row_rotation(tQ, k, w, x, y, z)
                     if n == count and c >= worst:
                         continue
                     i = min(n, count - 1)  # insert after the held rows of equal or lower cost

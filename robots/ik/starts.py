@@ -15,6 +15,7 @@ import threading
 
 import numpy as np
 import pinocchio as pin
+from scipy.spatial.transform import Rotation
 
 __all__ = ["StartTable", "TABLE_SIZE", "POOL", "ROT_WEIGHT", "LIMIT_PENALTY", "LIMIT_MARGIN"]
 
@@ -51,7 +52,7 @@ class StartTable:
         """The compiled solver's start table: :data:`GRID_TABLE_SIZE` configurations drawn within the limits
         (a fixed seed of its own, so that no user's seeded draws coincide with its rows) with their frame poses, rows sorted by the cell of a grid over their positions.
 
-        Returns ``(q, p, |p|², R (n, 9), cell_start, grid, penalty)`` as :func:`._chain.grid_index` reads it:
+        Returns ``(q, p, |p|², unit quaternions (n, 4) (w, x, y, z), cell_start, grid, penalty)`` as :func:`._chain.grid_index` reads it:
         the rows of cell ``c`` are ``cell_start[c]:cell_start[c + 1]``; ``grid = (x0, y0, z0, 1/size,
         nx, ny, nz)``, the cell size giving about 2 rows per cell of the positions' bounding box;
         ``penalty (n,)`` [m] is :meth:`_limit_penalty` of each row. With ``key`` (a digest of
@@ -83,10 +84,10 @@ class StartTable:
         counts = np.bincount(key, minlength=int(np.prod(dims)))
         cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         p = np.ascontiguousarray(p[order])
-        R = np.ascontiguousarray(T[order, :3, :3].reshape(-1, 9))
+        wxyz = Rotation.from_matrix(T[order, :3, :3]).as_quat()[:, [3, 0, 1, 2]]  # scipy: (x, y, z, w)
         grid = np.array([lo[0], lo[1], lo[2], 1.0 / size, dims[0], dims[1], dims[2]], dtype=float)
         q = np.ascontiguousarray(q[order])
-        return (q, p, np.einsum("ij,ij->i", p, p), R, cell_start, grid, self._limit_penalty(q))
+        return (q, p, np.einsum("ij,ij->i", p, p), np.ascontiguousarray(wxyz), cell_start, grid, self._limit_penalty(q))
 
     def _limit_penalty(self, q: np.ndarray) -> np.ndarray:
         """Start cost ``(N,)`` [m] of configurations ``q (N, nq)`` near a joint limit.

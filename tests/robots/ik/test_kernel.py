@@ -91,9 +91,9 @@ def test_rotation_error_near_half_a_turn_matches_pinocchio():
             np.testing.assert_allclose(pin.exp3(w), Rt @ R.T, atol=1e-9)
 
 
-def _rows_and_costs(table, Tk):
+def _rows_and_costs(robot, table, Tk):
     """Rows of the 27 cells around the target ``Tk`` and their start costs (position + 0.1 m/rad rotation + penalty)."""
-    tq, tp, _, tR, cell_start, grid, pen = table
+    tq, tp, _, _, cell_start, grid, pen = table
     nx, ny, nz = (int(v) for v in grid[4:])
     pt, Rt = Tk[:3, 3], Tk[:3, :3]
     c = np.clip(np.floor((pt - grid[:3]) * grid[3]).astype(int), 0, [nx - 1, ny - 1, nz - 1])
@@ -104,7 +104,8 @@ def _rows_and_costs(table, Tk):
         for iz in range(max(c[2] - 1, 0), min(c[2] + 2, nz))
         for k in range(cell_start[(ix * ny + iy) * nz + iz], cell_start[(ix * ny + iy) * nz + iz + 1])
     ]
-    cost = np.linalg.norm(tp[rows] - pt, axis=1) + 0.1 * np.linalg.norm(tR[rows] - Rt.reshape(9), axis=1) + pen[rows]
+    R = robot.fk(tq[rows])[:, :3, :3]  # the rows' rotations (the table holds them as quaternions)
+    cost = np.linalg.norm(tp[rows] - pt, axis=1) + 0.1 * np.linalg.norm(R - Rt, axis=(1, 2)) + pen[rows]
     return rows, cost
 
 
@@ -113,13 +114,15 @@ def test_grid_start_is_the_nearest_row_of_the_neighbouring_cells(name):
     robot = robots.load(name)
     solver = NumericalIK(robot)
     _, _, _, _, table = solver._compiled()
-    tq, tp, _, tR, _, _, pen = table
+    tq, tp, _, tQ, _, _, pen = table
     for k in np.flatnonzero(pen == 0.0)[[0, 777, -1]]:  # a row's own pose (no limit penalty): that row (cost 0)
-        Rt = np.ascontiguousarray(tR[k].reshape(3, 3))
+        Rt = np.ascontiguousarray(robot.fk(tq[k])[:3, :3])
         assert chain.grid_index(table, Rt, np.ascontiguousarray(tp[k]), False) == k
+        w, x, y, z = chain._quaternion(Rt)  # the row's quaternion, up to its sign
+        assert abs(abs(np.dot([w, x, y, z], tQ[k])) - 1.0) <= 1e-12
     for Tk in robot.fk(robot.random_q(40, seed=61)):  # random targets: the smallest cost among the 27 cells' rows
         pt, Rt = np.ascontiguousarray(Tk[:3, 3]), np.ascontiguousarray(Tk[:3, :3])
-        rows, cost = _rows_and_costs(table, Tk)
+        rows, cost = _rows_and_costs(robot, table, Tk)
         k = chain.grid_index(table, Rt, pt, False)
         assert k in rows
         assert abs(cost[rows.index(k)] - cost.min()) <= 1e-12
@@ -220,3 +223,15 @@ def test_start_table_is_shared_by_arms_of_the_same_kinematics_and_limits():
     assert narrow_table is not a._compiled()[4]
     assert (narrow_table[0] <= 2.0).all() and (a._compiled()[4][0] > 2.0).any()
     assert a._compiled()[4][0].shape == (32768, 6)
+
+
+def test_start_cost_quaternion_gives_the_frobenius_distance_on_every_branch():
+    """Shepperd's four branches (trace largest, or one diagonal term): ‖A − B‖_F² = 8 (1 − (q_A·q_B)²)."""
+    rng = np.random.default_rng(3)
+    rotations = [pin.exp3(rng.standard_normal(3)) for _ in range(20)]
+    rotations += [pin.exp3(np.pi * 0.999 * np.eye(3)[i]) for i in range(3)] + [np.eye(3)]
+    quats = [np.array(chain._quaternion(np.ascontiguousarray(R))) for R in rotations]
+    for R, qa in zip(rotations, quats):
+        assert abs(np.linalg.norm(qa) - 1.0) <= 1e-12
+        for S, qb in zip(rotations, quats):
+            assert abs(8.0 * (1.0 - qa.dot(qb) ** 2) - np.linalg.norm(R - S) ** 2) <= 1e-12
