@@ -40,7 +40,7 @@ drop_stale_caches()
 ROT_WEIGHT = 0.1  # [m/rad] weight of the rotation distance when ranking starts
 
 
-@jit
+@jit_inline
 def fk(q, qi, sc, of, rev, LR, Lp, fR, fp, R, p, Z, O):
     """Frame rotation ``R`` and origin ``p`` (written in place); joint axes ``Z`` and origins ``O`` ``(m, 3)``.
 
@@ -118,7 +118,7 @@ def jacobian(qi, sc, rev, Z, O, p, J):
             J[2, j] += s * z2
 
 
-@jit
+@jit_inline
 def log3_of(Rt, R, w):
     """``w = log3(Rt Rᵀ)`` (3,) in place; returns the angle [rad] (atan2 form; axis from the symmetric part near π)."""
     m00 = Rt[0, 0] * R[0, 0] + Rt[0, 1] * R[0, 1] + Rt[0, 2] * R[0, 2]
