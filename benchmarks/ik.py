@@ -342,7 +342,7 @@ def main() -> None:
         robot.ik(T[-1])  # warm-up, not timed below: the process's first call loads the compiled solver
         if len(samples) == 1:
             print(f"(first Robot.ik call of this process: {time.perf_counter() - t0:.2f} s, numba loading the compiled "
-                  "solver from its cache; a fresh install compiles it once, ~40-90 s)")
+                  "solver from its cache; a fresh install compiles it once, ~1-2.5 min)")
         if ets is not None:
             ets.ik_LM(T[-1], tol=5e-13, joint_limits=True)
     if "2" in args.sections:
