@@ -9,7 +9,8 @@ Targets are the FK of random in-limit configurations (reachable by construction)
    its own random starts, ``tol = 5e-13``), both judged by the same strict check (1e-6 m,
    1e-6 rad, joint limits); median, p95 and mean, after one warm-up call each.
 3. Batched: ``Robot.ik(T (N, 4, 4))`` per target (total time / N), beside ``ik_LM``'s median
-   and mean per target.
+   and mean per target, in ``--rounds`` interleaved rounds (the ratio's median over them, both
+   tools' success shares, iterations per target of both).
 4. ``NumericalIK`` alone on random starts (no closed form anywhere), and ikpy on the first
    ``--ikpy-n`` poses when installed (ikpy takes tens of ms per solve).
 
@@ -18,7 +19,7 @@ limits; batched at least 5x faster per target than ``ik_LM``'s median; ``ik_all`
 Section 3 also prints CPU times (the batch's over all its threads, ``ik_LM``'s per call), which do
 not depend on the machine's load as wall times do.
 
-    python benchmarks/ik.py [--n 300] [--n-batch 2000] [--n-analytic 100000] [--ikpy-n 0]
+    python benchmarks/ik.py [--n 300] [--n-batch 2000] [--n-analytic 100000] [--ikpy-n 0] [--rounds 3] [--sections 1234]
 """
 
 from __future__ import annotations
@@ -202,27 +203,114 @@ def one_at_a_time(robot, ets, T) -> dict:
         ok += strict_ok(robot, q, T[k])
     out["pinarms"] = (np.median(times), np.quantile(times, 0.95), ok / len(T), np.mean(times))
     if ets is not None:
-        times, cpu, ok = [], [], 0
+        times, cpu, ok, its, searches = [], [], 0, [], []
         for k in range(len(T)):
             t0, c0 = time.perf_counter(), time.thread_time()
             sol = ets.ik_LM(T[k], tol=5e-13, joint_limits=True)
             cpu.append(time.thread_time() - c0)
             times.append(time.perf_counter() - t0)
             ok += strict_ok(robot, np.asarray(sol[0], dtype=float), T[k])
+            its.append(getattr(sol, "iterations", np.nan))
+            searches.append(getattr(sol, "searches", np.nan))
         out["rtb"] = (np.median(times), np.quantile(times, 0.95), ok / len(T), np.mean(times), np.median(cpu))
+        out["rtb_work"] = (float(np.mean(its)), float(np.mean(searches)))
     return out
 
 
-def batch(robot, T, repeat: int = 2) -> tuple[float, float, float]:
+#: pinarms' tolerance per error (position [m], rotation [rad]) at which ``|e| <= 1e-6``, ik_LM's own criterion
+#: at ``tol = 5e-13`` (it tests 1/2 |e|^2 with e the 6-vector of both errors)
+SAME_AS_IK_LM = 1e-6 / np.sqrt(2.0)
+
+
+def batch(robot, T, repeat: int = 2, tol: float = 1e-10) -> tuple[float, float, float]:
     """Wall time per target [s] (best of ``repeat``), success share, CPU time per target [s] (all threads)."""
     best, cpu, q = np.inf, np.inf, None
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
-        q = robot.ik(T)
+        q = robot.ik(T, tol=tol)
         best = min(best, time.perf_counter() - t0)
         cpu = min(cpu, time.process_time() - c0)
     ok = np.mean([strict_ok(robot, q[k], T[k]) for k in range(len(T))])
     return best / len(T), ok, cpu / len(T)
+
+
+def closed_form(n: int, seed: int) -> None:
+    """Section 1: batched ``ik_all`` of the two UR-type arms."""
+    print(f"1. closed form, batched ik_all, {n:,} random reachable poses (best of 3)")
+    for name in ("ur5", "aubo_i3"):
+        a = analytic(n, seed, name=name)
+        print(f"  {name:<8} {a['poses_per_s']:>10,.0f} poses/s (goal >= 100,000)  solved {100 * a['solved']:.2f} %  "
+              f"{a['mean_solutions']:.2f} branches/pose  max FK error {a['max_pos_err']:.1e} m {a['max_rot_err']:.1e} rad  "
+              f"within limits: {a['in_limits']}")
+    print()
+
+
+def single_targets(samples: dict, n: int) -> None:
+    """Section 2: one target at a time, pinarms beside ik_LM."""
+    print(f"2. one target at a time, {n} random reachable poses per arm, strict check (1e-6 m, 1e-6 rad, limits)")
+    print(f"  {'arm':<9} {'pinarms median':>15} {'p95':>8} {'mean':>8} {'ok':>7} | {'ik_LM median':>13} {'p95':>8} "
+          f"{'mean':>8} {'ok':>7} | {'ik_LM/pinarms median, mean':>26}")
+    for name, (robot, T, ets) in samples.items():
+        r = one_at_a_time(robot, ets, T[:n])
+        med, p95, ok, mean = r["pinarms"]
+        line = f"  {name:<9} {med * 1e3:13.3f}ms {p95 * 1e3:7.2f}ms {mean * 1e3:7.3f}ms {100 * ok:6.1f}%"
+        if "rtb" in r:
+            rm, rp, rok, rmean, _ = r["rtb"]
+            line += (f" | {rm * 1e3:11.3f}ms {rp * 1e3:7.2f}ms {rmean * 1e3:7.3f}ms {100 * rok:6.1f}% | "
+                     f"{rm / med:12.2f}x {rmean / mean:12.2f}x")
+        print(line + "   (goal: ratio >= 1)")
+    print()
+
+
+def batched_rounds(samples: dict, n_batch: int, n_peer: int, rounds: int) -> None:
+    """Section 3: batched ``Robot.ik`` beside ``ik_LM`` one target at a time, in interleaved rounds (each round,
+    arm after arm: the batch at pinarms' default tolerance, the batch at ik_LM's, then the ``ik_LM`` calls); the
+    median ratio per arm over the rounds."""
+    print(f"3. batched Robot.ik(T (N, 4, 4)), N = {n_batch}, time per target (best of 2) beside ik_LM one target at a "
+          f"time (the first {n_peer} targets, measured again in each round): its median per call; CPU: the batch's "
+          f"(all threads) per target beside ik_LM's median per call. {rounds} interleaved rounds. pinarms at tol 1e-10 "
+          f"(its default, stricter than ik_LM) and at tol {SAME_AS_IK_LM:.3g} per error (|e| <= 1e-6, ik_LM's criterion)")
+    rows = {name: {"1e-10": [], "same": [], "cpu": [], "cpu_same": [], "ok": [], "ok_same": [], "peer_ok": []}
+            for name in samples}
+    for r in range(rounds):
+        for name, (robot, T, ets) in samples.items():
+            row = rows[name]
+            per, ok, cpu = batch(robot, T[:n_batch])
+            per_same, ok_same, cpu_same = batch(robot, T[:n_batch], tol=SAME_AS_IK_LM)
+            row["ok"].append(ok)
+            row["ok_same"].append(ok_same)
+            line = (f"  round {r + 1}  {name:<9} {per * 1e6:6.1f} / {per_same * 1e6:6.1f} us/target (tol 1e-10 / same), "
+                    f"CPU {cpu * 1e6:5.1f} / {cpu_same * 1e6:5.1f} us, ok {100 * ok:6.2f} / {100 * ok_same:6.2f}%")
+            if ets is not None:
+                peer = one_at_a_time(robot, ets, T[:n_peer])["rtb"]
+                row["1e-10"].append(peer[0] / per)
+                row["same"].append(peer[0] / per_same)
+                row["cpu"].append(peer[4] / cpu)
+                row["cpu_same"].append(peer[4] / cpu_same)
+                row["peer_ok"].append(peer[2])
+                line += (f" | ik_LM median {peer[0] * 1e6:6.1f} us (CPU {peer[4] * 1e6:6.1f} us), ok {100 * peer[2]:5.1f}% | "
+                         f"ratio {row['1e-10'][-1]:5.2f}x / {row['same'][-1]:5.2f}x, CPU {row['cpu'][-1]:5.2f}x / "
+                         f"{row['cpu_same'][-1]:5.2f}x")
+            print(line + f"  ({_load()})")
+    print("  per arm, over the rounds (ratio: ik_LM's median per call / pinarms' batch per target):")
+    for name, (robot, T, ets) in samples.items():
+        row = rows[name]
+        its = NumericalIK(robot).solve_batch(T[:n_batch], seed=0).iterations / n_batch
+        its_same = NumericalIK(robot).solve_batch(T[:n_batch], seed=0, tol=SAME_AS_IK_LM).iterations / n_batch
+        line = (f"  {name:<9} ok {100 * min(row['ok']):.2f} / {100 * min(row['ok_same']):.2f}% (lowest round), "
+                f"{its:5.2f} / {its_same:5.2f} iterations per target")
+        if row["1e-10"]:
+            peer_its, searches = one_at_a_time(robot, ets, T[:n_peer])["rtb_work"]
+            med, med_same = float(np.median(row["1e-10"])), float(np.median(row["same"]))
+            line += (f" | ik_LM ok {100 * min(row['peer_ok']):.1f}%, {peer_its:5.1f} iterations, {searches:4.2f} searches "
+                     f"per target | median ratio {med:5.2f}x at 1e-10, {med_same:5.2f}x at the same tolerance "
+                     f"(rounds {min(row['same']):.2f}-{max(row['same']):.2f}x; goal >= 5x: "
+                     f"{'met' if med_same >= 5.0 else 'not met'}), CPU {float(np.median(row['cpu'])):5.2f}x / "
+                     f"{float(np.median(row['cpu_same'])):5.2f}x")
+        print(line)
+    print(f"  ({_load()}, {os.cpu_count()} cores. The batch runs on {min(4, os.cpu_count() or 1)} threads: with its "
+          "cores free, its wall time per target is its CPU time / threads; on a loaded machine a long batch gets a "
+          "smaller share of the cores than one short ik_LM call, so a gap in the wall-time ratio there is the load's)")
 
 
 def main() -> None:
@@ -232,6 +320,8 @@ def main() -> None:
     parser.add_argument("--n-analytic", type=int, default=100_000)
     parser.add_argument("--arms", nargs="+", default=["panda", "ur5", "aubo_i3"])
     parser.add_argument("--runs", type=int, default=1, help="runs of the NumericalIK-alone table")
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds of the batched comparison")
+    parser.add_argument("--sections", default="1234", help="sections to run, e.g. 3 (default: all)")
     parser.add_argument("--ikpy-n", type=int, default=0, help="poses per arm given to ikpy (first ones; 0: skip)")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
@@ -240,16 +330,8 @@ def main() -> None:
     print(f"{os.cpu_count()} cores, {_load()}; " + (f"Robotics Toolbox for Python {version}" if version else absent_line()))
     print(FAIRNESS)
     print()
-    print(f"1. closed form, batched ik_all, {args.n_analytic:,} random reachable poses (best of 3)")
-    for name in ("ur5", "aubo_i3"):
-        a = analytic(args.n_analytic, args.seed, name=name)
-        print(f"  {name:<8} {a['poses_per_s']:>10,.0f} poses/s (goal >= 100,000)  solved {100 * a['solved']:.2f} %  "
-              f"{a['mean_solutions']:.2f} branches/pose  max FK error {a['max_pos_err']:.1e} m {a['max_rot_err']:.1e} rad  "
-              f"within limits: {a['in_limits']}")
-    print()
-    print(f"2. one target at a time, {args.n} random reachable poses per arm, strict check (1e-6 m, 1e-6 rad, limits)")
-    print(f"  {'arm':<9} {'pinarms median':>15} {'p95':>8} {'mean':>8} {'ok':>7} | {'ik_LM median':>13} {'p95':>8} "
-          f"{'mean':>8} {'ok':>7} | {'ik_LM/pinarms median, mean':>26}")
+    if "1" in args.sections:
+        closed_form(args.n_analytic, args.seed)
     samples = {}
     for name in args.arms:
         robot = robots.load(name)
@@ -259,54 +341,28 @@ def main() -> None:
         t0 = time.perf_counter()
         robot.ik(T[-1])  # warm-up, not timed below: the process's first call loads the compiled solver
         if len(samples) == 1:
-            print(f"  (first Robot.ik call of this process: {time.perf_counter() - t0:.2f} s, numba loading the compiled "
-                  "solver from its cache; a fresh install compiles it once, ~40-90 s)")
+            print(f"(first Robot.ik call of this process: {time.perf_counter() - t0:.2f} s, numba loading the compiled "
+                  "solver from its cache; a fresh install compiles it once, ~1-2.5 min)")
         if ets is not None:
             ets.ik_LM(T[-1], tol=5e-13, joint_limits=True)
-        r = one_at_a_time(robot, ets, T[: args.n])
-        med, p95, ok, mean = r["pinarms"]
-        line = f"  {name:<9} {med * 1e3:13.3f}ms {p95 * 1e3:7.2f}ms {mean * 1e3:7.3f}ms {100 * ok:6.1f}%"
-        if "rtb" in r:
-            rm, rp, rok, rmean, _ = r["rtb"]
-            line += (f" | {rm * 1e3:11.3f}ms {rp * 1e3:7.2f}ms {rmean * 1e3:7.3f}ms {100 * rok:6.1f}% | "
-                     f"{rm / med:12.2f}x {rmean / mean:12.2f}x")
-        print(line + "   (goal: ratio >= 1)")
-    print()
-    print(f"3. batched Robot.ik(T (N, 4, 4)), N = {args.n_batch}, time per target (best of 2) beside ik_LM one target at "
-          f"a time (the first {min(args.n, 300)} targets, measured again now): its median, and its mean (total time / N, "
-          f"what a loop over the batch costs); then CPU time: the batch's (all threads) per target beside ik_LM's median "
-          f"per call (independent of the machine's load)")
-    for name in args.arms:
-        robot, T, ets = samples[name]
-        per, ok, cpu = batch(robot, T[: args.n_batch])
-        line = f"  {name:<9} {per * 1e6:10.1f} us/target  ok {100 * ok:6.2f}%"
-        if ets is not None:
-            r = one_at_a_time(robot, ets, T[: min(args.n, 300)])
-            ratio = r["rtb"][0] / per
-            line += (f" | ik_LM median {r['rtb'][0] * 1e6:8.1f} us  ratio {ratio:6.2f}x (goal >= 5x: "
-                     f"{'met' if ratio >= 5.0 else 'not met'});  mean {r['rtb'][3] * 1e6:8.1f} us  ratio "
-                     f"{r['rtb'][3] / per:6.2f}x | CPU {cpu * 1e6:6.1f} us/target vs ik_LM {r['rtb'][4] * 1e6:6.1f} us: "
-                     f"{r['rtb'][4] / cpu:5.2f}x")
-        print(line)
-    if samples and next(iter(samples.values()))[2] is not None:
-        print(f"  ({_load()}, {os.cpu_count()} cores. The batch runs on {min(4, os.cpu_count() or 1)} threads: with its "
-              "cores free, its wall time per target is its CPU time / threads; on a loaded machine a long batch gets a "
-              "smaller share of the cores than one short ik_LM call, so a gap in the wall-time ratio there is the load's, "
-              "the CPU-time ratio times the threads is what free cores give)")
-    print()
-    print(f"4. NumericalIK alone from random starts (tol 1e-10), {args.n} poses per arm"
-          + (f"; ikpy on the first {args.ikpy_n}" if args.ikpy_n else ""))
-    for name in args.arms:
-        robot, T, _ = samples[name]
-        starts = robot.random_q(args.n, seed=args.seed + 2)
-        ours = numerical(robot, T[: args.n], starts, runs=args.runs)
-        line = (f"  {name:<9} {100 * ours['success']:6.1f}%  median {ours['median_ms']:.3f} ms  p90 {ours['p90_ms']:.2f} ms  "
-                f"{ours['mean_starts']:.2f} starts  {ours['mean_iterations']:.1f} iterations  "
-                f"{ours['us_per_iteration']:.1f} us/iteration")
-        if args.ikpy_n:
-            peer = ikpy_run(robot, T[: args.ikpy_n], starts[: args.ikpy_n])
-            line += f" | ikpy {100 * peer['success']:.1f}% median {peer['median_ms']:.2f} ms"
-        print(line)
+    if "2" in args.sections:
+        single_targets(samples, args.n)
+    if "3" in args.sections:
+        batched_rounds(samples, args.n_batch, min(args.n, 300), args.rounds)
+        print()
+    if "4" in args.sections:
+        print(f"4. NumericalIK alone from random starts (tol 1e-10), {args.n} poses per arm"
+              + (f"; ikpy on the first {args.ikpy_n}" if args.ikpy_n else ""))
+        for name, (robot, T, _) in samples.items():
+            starts = robot.random_q(args.n, seed=args.seed + 2)
+            ours = numerical(robot, T[: args.n], starts, runs=args.runs)
+            line = (f"  {name:<9} {100 * ours['success']:6.1f}%  median {ours['median_ms']:.3f} ms  p90 "
+                    f"{ours['p90_ms']:.2f} ms  {ours['mean_starts']:.2f} starts  {ours['mean_iterations']:.1f} iterations  "
+                    f"{ours['us_per_iteration']:.1f} us/iteration")
+            if args.ikpy_n:
+                peer = ikpy_run(robot, T[: args.ikpy_n], starts[: args.ikpy_n])
+                line += f" | ikpy {100 * peer['success']:.1f}% median {peer['median_ms']:.2f} ms"
+            print(line)
     print(_load(), flush=True)
 
 

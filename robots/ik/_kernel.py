@@ -12,9 +12,11 @@ multiplying ``μ`` by 2, 4, 8, …, a per-joint step cap, stall detection, and t
 for joint limits (a free descent wrapped to the ranges' 2π windows, then a projected descent
 with an active set; see :mod:`._limits_kernel`).
 
-Starts: the first from ``q0`` (a seed, or the stored pose nearest the target, :func:`._chain.grid_index`),
-then the :data:`_NEAR` stored poses next nearest the target, then uniform draws within the limits
-(numba's generator, seeded per target), 32 at a time, nearest pose first.
+Starts: the first from ``q0`` (a seed, or the stored pose nearest the target, :func:`._chain.grid_index`,
+stored poses near a joint limit ranked lower), then up to :data:`_NEAR` stored poses next nearest the
+target (for an arm with isolated solutions only those :data:`_DIVERSE` away from every start tried),
+then uniform draws within the limits (numba's generator, seeded per target), 32 at a time, nearest
+pose first.
 
 Costs kept out of the loop: the Gram matrix ``J Jᵀ`` is formed once per iteration (a rejected
 step only adds another ``λ`` to its diagonal); a trial step evaluates the pose and error only,
@@ -38,6 +40,13 @@ __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits
 _MU_MAX = 1e8
 _POOL = 32
 _NEAR = 8  # restarts from the stored poses nearest the target (after the first start) before random draws
+#: [rad] an arm with isolated solutions (no more joints than task rows) restarts only from stored poses
+#: this far from every start tried, in some revolute joint (modulo 2π): a nearby start descends to
+#: the same solution (outside the limits) or the same local minimum; among the :data:`_CANDIDATES`
+#: stored poses nearest the target
+_DIVERSE = 1.5
+_CANDIDATES = 32
+_TWO_PI = 2.0 * math.pi
 
 # P (float64 array) holds the settings: μ0, λ_min, max_step, stall_ratio, stall_steps, max_iter
 _P_MU0, _P_LAMMIN, _P_STEP, _P_STALLR, _P_STALLN, _P_ITER = 0, 1, 2, 3, 4, 5
@@ -301,6 +310,35 @@ def _same(a, b):
 
 
 @jit
+def _apart(a, tried, n, L, d_min):
+    """True if ``a`` differs from each of ``tried[:n]`` by at least ``d_min`` [rad] in some revolute joint (modulo 2π)."""
+    unbounded, turns = L[3], L[5]
+    for i in range(n):
+        far = False
+        for j in range(a.shape[0]):
+            if unbounded[j] or turns[j] > 0.0:
+                d = abs(a[j] - tried[i, j]) % _TWO_PI
+                if min(d, _TWO_PI - d) >= d_min:
+                    far = True
+                    break
+        if not far:
+            return False
+    return True
+
+
+@jit
+def _diverse_restarts(L, nq, posonly):
+    """The distance [rad] between restarts from stored poses: :data:`_DIVERSE` for an arm with isolated
+    solutions and a revolute joint, else 0 (the next-nearest poses, whatever their distance)."""
+    if nq > (3 if posonly else 6):
+        return 0.0
+    for j in range(nq):
+        if L[3][j] or L[5][j] > 0.0:
+            return _DIVERSE
+    return 0.0
+
+
+@jit
 def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W):
     """:func:`solve` with the scratch buffers ``W`` of :func:`workspace`."""
     nq = q0.shape[0]
@@ -316,15 +354,20 @@ def solve_in(q0, table, C, L, P, Rt, pt, posonly, tol, restarts, seed, q_out, W)
     order = np.empty(0, dtype=np.int64)
     k = _POOL
     best_pe, best_re = pe, re
-    near = grid_neighbours(table, Rt, pt, posonly, _NEAR + 1)
+    d_min = _diverse_restarts(L, nq, posonly)
+    near = grid_neighbours(table, Rt, pt, posonly, _CANDIDATES if d_min > 0.0 else _NEAR + 1)
+    tried = np.empty((_NEAR + 1, nq))  # the starts tried so far (the first, then stored poses)
+    tried[0] = q0
     i_near, used = 0, 0
     while attempts <= restarts:
-        while i_near < near.shape[0] and _same(table[0][near[i_near]], q0):
-            i_near += 1  # the first start itself
+        while i_near < near.shape[0] and (_same(table[0][near[i_near]], q0) or (
+                d_min > 0.0 and not _apart(table[0][near[i_near]], tried, used + 1, L, d_min))):
+            i_near += 1  # the first start itself, or (isolated solutions) a pose near a start tried
         if used < _NEAR and i_near < near.shape[0]:  # the stored poses nearest the target, then random draws
             q[:] = table[0][near[i_near]]
             i_near += 1
             used += 1
+            tried[used] = q
         else:
             if k == _POOL:
                 if pool.shape[0] == 0:

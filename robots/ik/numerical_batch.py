@@ -6,6 +6,7 @@ Functions of a :class:`robots.ik.numerical.NumericalIK` (``self``), attached to 
 
 from __future__ import annotations
 
+import itertools
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ __all__ = ["BatchIKResult", "solve_batch"]
 
 _WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
 _PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
+_CHUNK = 64  # targets per block of a threaded batch (blocks are taken in turn: the threads stay balanced)
 
 
 def _seed_int(seed) -> int:
@@ -134,12 +136,22 @@ def solve_batch(
         iterations.append(kernel.solve_many(Rts[s:e], pts[s:e], starts[s:e], table, C, L, P, bool(position_only), tol,
                                             int(max_restarts), base + s, q[s:e], success[s:e], pe[s:e], re[s:e]))
 
-    bounds = np.linspace(0, N, min(_WORKERS, max(1, N // _PARALLEL_MIN)) + 1).astype(int)
-    if bounds.size == 2:
+    workers = min(_WORKERS, max(1, N // _PARALLEL_MIN))
+    if workers == 1:
         block(0, N)
-    else:
-        with ThreadPoolExecutor(bounds.size - 1) as pool:
-            list(pool.map(block, bounds[:-1], bounds[1:]))
+    else:  # blocks of _CHUNK targets taken in turn by each thread: a thread the machine holds back takes fewer
+        chunks = itertools.count()
+        n_chunks = -(-N // _CHUNK)
+
+        def worker() -> None:
+            for c in iter(chunks.__next__, None):  # itertools.count's next is atomic under the GIL
+                if c >= n_chunks:
+                    return
+                block(c * _CHUNK, min(N, (c + 1) * _CHUNK))
+
+        with ThreadPoolExecutor(workers) as pool:
+            for f in [pool.submit(worker) for _ in range(workers)]:
+                f.result()
     iterations = int(sum(iterations))
     # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
     pos_err, rot_err = _batch_errors(self, q, targets, position_only)
