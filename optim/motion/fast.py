@@ -31,6 +31,7 @@ import numpy as np
 from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
+from pinarms.robots.cell._cover_kernel import _place
 from pinarms.robots.cell.cover import pair_arrays, pairs_for
 from pinarms.optim.motion.search import SearchResult
 
@@ -89,7 +90,7 @@ class FastCheck:
         self.fk = cover.fk
         self.cov = cover.kernel_arrays()
         self.grp = cover.group_arrays(pairs, margins)
-        self.work = cover.work(pairs)
+        self.work = _moving_work(cover, pairs, checker.hold, checker.cols)
         self.hold = np.ascontiguousarray(checker.hold, dtype=float)
         self.cols = np.ascontiguousarray(checker.cols, dtype=np.int64)
         self.levers = np.ascontiguousarray(checker.levers, dtype=float)
@@ -157,6 +158,24 @@ def fast_check(checker: Any) -> FastCheck | None:
             got = None
         checker._fast = got
     return got
+
+
+def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
+    """The kernels' scratch arrays placed at ``hold`` once, with what moves with the planned columns ``cols``
+    (:func:`robots.cell._cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
+    spheres and cylinder axes on those joints. The held arms and the fixtures stay where they were placed."""
+    parent, index = cover.fk[0], cover.fk[1]
+    planned = set(int(c) for c in cols)
+    moves = np.zeros(parent.size, dtype=bool)
+    for i in range(1, parent.size):  # a joint's parent comes before it
+        moves[i] = int(index[i]) in planned or moves[parent[i]]
+    work = cover.work(pairs)
+    hold = np.ascontiguousarray(hold, dtype=float)
+    _place(hold, cover.fk, cover.joint, cover.center, cover.segments[0], cover.segments[1], cover.segments[2],
+           pairs.hjoint, pairs.hcenter, work)
+    moving = (np.flatnonzero(moves), np.flatnonzero(moves[pairs.hjoint]), np.flatnonzero(moves[cover.joint]),
+              np.flatnonzero(moves[cover.segments[0]]), np.empty((3, 3)))
+    return (*work, tuple(np.ascontiguousarray(m, dtype=np.int64) for m in moving[:4]) + (moving[4],))
 
 
 def _rng(seed: int) -> np.ndarray:
