@@ -117,6 +117,7 @@ class FastCheck:
         n = self.checker.n
         x = np.ascontiguousarray(self.checker.lower, dtype=float)
         kernel.edge_proven(x, x, *self.args, self._q, self._xm, self._queue, self._inv)
+        self.excess(x)  # the search's ends are checked with it, on the search's clock
         kernel.path_proven(x[None].copy(), *self.args)
         kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.ones(2, dtype=np.int64),
                            np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
