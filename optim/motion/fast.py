@@ -49,6 +49,9 @@ REACH = 0.25
 EDGE_STATES = 400
 #: Most nodes per tree of the compiled search.
 TREE_NODES = 16384
+#: Iterations of the compiled search's first chunk (the chunks double while one takes under 2 ms): most
+#: queries of the Panda and AUBO-i3 scenes are solved in one call (each call costs tens of µs).
+FIRST_CHUNK = 4
 #: Longest edge the compiled search adds at once, as a share of the diagonal of the joint-limit box
 #: (OMPL's default is 0.2). Measured (25 queries, 0.75 s, load 2.5–3.5): ``aubo_crate_guard`` 15, 20, 20
 #: solved at 0.2, 0.15, 0.1 (the narrow passage out of the crate), ``panda_shelf`` median 14.8, 10.2,
@@ -109,6 +112,7 @@ class FastCheck:
         self._xm = np.empty(checker.n)
         self._queue = np.empty((kernel.QUEUE, 4))
         self._inv = np.empty(self.lam.shape[0])
+        self._trees: tuple[np.ndarray, np.ndarray] | None = None
         self._load()
 
     def _load(self) -> None:
@@ -122,6 +126,15 @@ class FastCheck:
         kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.ones(2, dtype=np.int64),
                            np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
         kernel.shortcut(np.zeros((2, n)), 2, _rng(0), 0, *self.args)
+
+    def trees(self) -> tuple[np.ndarray, np.ndarray]:
+        """The compiled search's tree arrays ``nodes (2, TREE_NODES, n)`` and ``parent (2, TREE_NODES)``,
+        made once per check and reused by each search (one search at a time per checker, like the
+        kernels' scratch arrays)."""
+        if self._trees is None:
+            n = self.checker.n
+            self._trees = (np.zeros((2, TREE_NODES, n)), np.full((2, TREE_NODES), -1, dtype=np.int64))
+        return self._trees
 
     def excess(self, x: Any) -> float:
         """The cover's lower bound of ``E`` [m] at planned state ``x`` (capped; below 0: not proven)."""
@@ -208,14 +221,15 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
     step_range = float(planner_range) if planner_range is not None else \
         RANGE_SHARE * float(np.linalg.norm(upper - lower))
-    nodes = np.zeros((2, TREE_NODES, n))
-    parent = np.full((2, TREE_NODES), -1, dtype=np.int64)
+    nodes, parent = fc.trees()  # rows past a tree's count are never read
     nodes[0, 0] = root
     nodes[1, : len(keep)] = [y for _, y in keep]
+    parent[0, 0] = -1
+    parent[1, : len(keep)] = -1
     counts = np.array([1, len(keep)], dtype=np.int64)
     status = np.zeros(5, dtype=np.int64)
     rng = _rng(seed)
-    chunk, found = 1, 0
+    chunk, found = FIRST_CHUNK, 0
     deadline = t0 + float(time_limit)
     while time.perf_counter() < deadline and counts.min() < TREE_NODES:
         tc = time.perf_counter()
