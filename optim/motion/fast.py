@@ -205,7 +205,9 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     nothing searched, ``status`` says so). ``planner_range``: the longest edge added at once
     [rad or m, joint space] (default :data:`RANGE_SHARE` of the diagonal of the joint-limit
     box). The result's ``path`` is ``None`` when nothing was found within ``time_limit`` [s]."""
-    fc = fast_check(checker)  # built, and its kernels loaded, before the clock starts
+    fc = fast_check(checker)  # built, its kernels loaded and its trees made before the clock starts
+    if fc is not None:
+        fc.trees()
     t0 = time.perf_counter()
     x0 = np.asarray(start, dtype=float)
     G = np.atleast_2d(np.asarray(goals, dtype=float))
