@@ -200,6 +200,8 @@ def state_speed(name: str, edges: int = 400, seed: int = 0) -> dict:
     reach = RANGE_SHARE * float(np.linalg.norm(upper - lower))
     X = cell.random_q(20 * edges, seed=seed)[:, checker.cols]
     A = np.array([x for x in X if fc.excess(x) >= 0.0][:edges])
+    if len(A) == 0:
+        raise ValueError(f"the cover proves none of {len(X)} random states (a loose cover: OMPL with coal plans here)")
     D = np.random.default_rng(seed).uniform(lower, upper, A.shape) - A
     B = A + D * np.minimum(1.0, reach / np.linalg.norm(D, axis=1))[:, None]
     q = np.zeros(fc.hold.size + 1)  # the last entry counts the states checked
