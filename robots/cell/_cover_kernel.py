@@ -230,9 +230,28 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
         if gap >= best:
             return best
     low = np.inf
+    if exact[other] != 0:
+        for s in range(start[g], start[g + 1]):
+            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
+            if d < low:
+                low = d
+        return min(best, max(low, gap))
+    # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
+    k = sstart[other]
+    a0, a1, a2, r = SA[k, 0], SA[k, 1], SA[k, 2], srad[k]
+    u0, u1, u2 = SB[k, 0] - a0, SB[k, 1] - a1, SB[k, 2] - a2
+    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
     for s in range(start[g], start[g + 1]):
-        d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) \
-            - radius[s] - t
+        w0, w1, w2 = W[s, 0] - a0, W[s, 1] - a1, W[s, 2] - a2
+        ww = w0 * w0 + w1 * w1 + w2 * w2
+        if L <= 1e-15:
+            d = max(math.sqrt(ww) - r, 0.0)
+        else:
+            h = (w0 * u0 + w1 * u1 + w2 * u2) / L
+            dr = max(math.sqrt(max(ww - h * h, 0.0)) - r, 0.0)
+            dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
+            d = math.sqrt(dr * dr + dz * dz)
+        d = d - radius[s] - t
         if d < low:
             low = d
     return min(best, max(low, gap))
