@@ -67,7 +67,7 @@ def state_scaled(x, inv, hold, cols, fk, cov, grp, cap, work, q):
         q[i] = hold[i]
     for j in range(cols.shape[0]):
         q[cols[j]] = x[j]
-    # work: placed at hold (FastCheck); only the planned arms' joints and the geometries the pairs need move
+    # work: placed at hold once (FastCheck); per state only the planned arms' joints and the points on them
     place_moving(q, fk, cov, grp, work, work[6])
     return excess_placed(cov, grp, inv, cap, 0.0, work)
 

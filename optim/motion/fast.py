@@ -50,7 +50,7 @@ EDGE_STATES = 400
 #: Most nodes per tree of the compiled search.
 TREE_NODES = 16384
 #: Iterations of the compiled search's first chunk (the chunks double while one takes under 2 ms): most
-#: queries of the Panda and AUBO-i3 scenes are solved in one call (each call costs tens of µs).
+#: queries of the Panda and AUBO-i3 scenes are solved in one or two calls (a call costs 5–10 µs).
 FIRST_CHUNK = 4
 #: Longest edge the compiled search adds at once, as a share of the diagonal of the joint-limit box
 #: (OMPL's default is 0.2). Measured (25 queries, 0.75 s, load 2.5–3.5): ``aubo_crate_guard`` 15, 20, 20
