@@ -35,6 +35,7 @@ Pinocchio's ``computeCollisions`` (stop at first collision; default and cold-sta
 on the same pairs, margins and configurations.
 
     python benchmarks/planning.py [--queries 50] [--time-limit 1.0] [--scenes a,b] [--pyroboplan PY] [--compare]
+    python benchmarks/planning.py --state-speed [--scenes a,b]    # the compiled check's cost per state alone
 """
 
 from __future__ import annotations
@@ -182,6 +183,35 @@ def checker_speed(name: str, queries, hold, repeat: int = 3) -> dict:
     return out
 
 
+def state_speed(name: str, edges: int = 400, seed: int = 0) -> dict:
+    """The compiled check's cost per state [µs, thread time] on the edge proofs of ``edges`` random
+    RRT-Connect-like edges (from a state the cover proves, towards a uniform sample, at most the
+    compiled search's range), the held arms at the queries' hold; each edge proof called from Python."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+    from pinarms.optim.motion.fast import RANGE_SHARE, fast_check
+
+    cell = load_scene(name)
+    _, hold = scene_queries(name, 1, seed=0, margin=MARGIN)
+    checker = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, hold=hold)
+    fc = fast_check(checker)
+    if fc is None:
+        raise ValueError("no compiled check here (no sphere cover)")
+    lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
+    reach = RANGE_SHARE * float(np.linalg.norm(upper - lower))
+    X = cell.random_q(20 * edges, seed=seed)[:, checker.cols]
+    A = np.array([x for x in X if fc.excess(x) >= 0.0][:edges])
+    if len(A) == 0:
+        raise ValueError(f"the cover proves none of {len(X)} random states (a loose cover: OMPL with coal plans here)")
+    D = np.random.default_rng(seed).uniform(lower, upper, A.shape) - A
+    B = A + D * np.minimum(1.0, reach / np.linalg.norm(D, axis=1))[:, None]
+    q = np.zeros(fc.hold.size + 1)  # the last entry counts the states checked
+    xm, queue, inv = np.empty(checker.n), np.empty((kernel.QUEUE, 4)), np.empty(fc.lam.shape[0])
+    t0 = time.thread_time()
+    proven = sum(bool(kernel.edge_proven(a, b, *fc.args, q, xm, queue, inv)) for a, b in zip(A, B))
+    seconds = time.thread_time() - t0
+    return {"edges": len(A), "proven": proven, "states": int(q[-1]), "us_per_state": 1e6 * seconds / max(q[-1], 1)}
+
+
 def pinarms_row(name: str, rec: dict, seconds: float | None = None) -> str:
     if rec["absent"]:
         return f"{name:<18} no clear queries: {rec['absent']}"
@@ -279,10 +309,23 @@ def main() -> None:
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--pyroboplan", default=DEFAULT_PYROBOPLAN, help="Python of pyroboplan's virtual environment")
     ap.add_argument("--checker-speed", action="store_true", help="also time the validity checker against plain loops")
+    ap.add_argument("--state-speed", action="store_true",
+                    help="only the compiled check's cost per state on random edges of each scene (no planning)")
     ap.add_argument("--compare", action="store_true",
                     help="also plan every query with OMPL and the exact checker alone (compiled=False), interleaved")
     args = ap.parse_args()
     names = [s for s in args.scenes.split(",") if s]
+    if args.state_speed:
+        print(f"compiled check per state (thread time, load average {os.getloadavg()[0]:.1f}):")
+        for name in names:
+            try:
+                r = state_speed(name)
+            except (PinarmsError, ValueError) as exc:  # no cover, no clear queries
+                print(f"  {name:<18} -: {exc}")
+                continue
+            print(f"  {name:<18} {r['us_per_state']:6.2f} us/state ({r['states']} states, {r['proven']} of "
+                  f"{r['edges']} edges proven)")
+        return
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"motion planning, {args.queries} seeded queries per scene, margin {MARGIN * 1e3:.0f} mm, search limit "
           f"{args.time_limit:g} s, load average {load:.1f} on {os.cpu_count()} cores")

@@ -26,7 +26,7 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 from pinarms.robots.cell import _cover_kernel
-from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_scaled
+from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_placed, place_moving
 
 # these kernels call the cover's: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
@@ -67,7 +67,9 @@ def state_scaled(x, inv, hold, cols, fk, cov, grp, cap, work, q):
         q[i] = hold[i]
     for j in range(cols.shape[0]):
         q[cols[j]] = x[j]
-    return excess_scaled(q, fk, cov, grp, inv, cap, 0.0, work)
+    # work: placed at hold once (FastCheck); per state only the planned arms' joints and the points on them
+    place_moving(q, fk, cov, grp, work, work[6])
+    return excess_placed(cov, grp, inv, cap, 0.0, work)
 
 
 @jit

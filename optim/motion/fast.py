@@ -31,6 +31,7 @@ import numpy as np
 from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
+from pinarms.robots.cell._cover_kernel import _place
 from pinarms.robots.cell.cover import pair_arrays, pairs_for
 from pinarms.optim.motion.search import SearchResult
 
@@ -48,6 +49,9 @@ REACH = 0.25
 EDGE_STATES = 400
 #: Most nodes per tree of the compiled search.
 TREE_NODES = 16384
+#: Iterations of the compiled search's first chunk (the chunks double while one takes under 2 ms): most
+#: queries of the Panda and AUBO-i3 scenes are solved in one or two calls (a call costs 5–10 µs).
+FIRST_CHUNK = 4
 #: Longest edge the compiled search adds at once, as a share of the diagonal of the joint-limit box
 #: (OMPL's default is 0.2). Measured (25 queries, 0.75 s, load 2.5–3.5): ``aubo_crate_guard`` 15, 20, 20
 #: solved at 0.2, 0.15, 0.1 (the narrow passage out of the crate), ``panda_shelf`` median 14.8, 10.2,
@@ -89,7 +93,7 @@ class FastCheck:
         self.fk = cover.fk
         self.cov = cover.kernel_arrays()
         self.grp = cover.group_arrays(pairs, margins)
-        self.work = cover.work(pairs)
+        self.work = _moving_work(cover, pairs, checker.hold, checker.cols)
         self.hold = np.ascontiguousarray(checker.hold, dtype=float)
         self.cols = np.ascontiguousarray(checker.cols, dtype=np.int64)
         self.levers = np.ascontiguousarray(checker.levers, dtype=float)
@@ -108,6 +112,7 @@ class FastCheck:
         self._xm = np.empty(checker.n)
         self._queue = np.empty((kernel.QUEUE, 4))
         self._inv = np.empty(self.lam.shape[0])
+        self._trees: tuple[np.ndarray, np.ndarray] | None = None
         self._load()
 
     def _load(self) -> None:
@@ -116,10 +121,20 @@ class FastCheck:
         n = self.checker.n
         x = np.ascontiguousarray(self.checker.lower, dtype=float)
         kernel.edge_proven(x, x, *self.args, self._q, self._xm, self._queue, self._inv)
+        self.excess(x)  # the search's ends are checked with it, on the search's clock
         kernel.path_proven(x[None].copy(), *self.args)
         kernel.rrt_connect(np.zeros((2, 1, n)), np.zeros((2, 1), dtype=np.int64), np.ones(2, dtype=np.int64),
                            np.zeros(5, dtype=np.int64), _rng(0), x, x, 1.0, 0, *self.args)
         kernel.shortcut(np.zeros((2, n)), 2, _rng(0), 0, *self.args)
+
+    def trees(self) -> tuple[np.ndarray, np.ndarray]:
+        """The compiled search's tree arrays ``nodes (2, TREE_NODES, n)`` and ``parent (2, TREE_NODES)``,
+        made once per check and reused by each search (one search at a time per checker, like the
+        kernels' scratch arrays)."""
+        if self._trees is None:
+            n = self.checker.n
+            self._trees = (np.zeros((2, TREE_NODES, n)), np.full((2, TREE_NODES), -1, dtype=np.int64))
+        return self._trees
 
     def excess(self, x: Any) -> float:
         """The cover's lower bound of ``E`` [m] at planned state ``x`` (capped; below 0: not proven)."""
@@ -159,6 +174,24 @@ def fast_check(checker: Any) -> FastCheck | None:
     return got
 
 
+def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
+    """The kernels' scratch arrays placed at ``hold`` once, with what moves with the planned columns ``cols``
+    (:func:`robots.cell._cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
+    spheres and cylinder axes on those joints. The held arms and the fixtures stay where they were placed."""
+    parent, index = cover.fk[0], cover.fk[1]
+    planned = set(int(c) for c in cols)
+    moves = np.zeros(parent.size, dtype=bool)
+    for i in range(1, parent.size):  # a joint's parent comes before it
+        moves[i] = int(index[i]) in planned or moves[parent[i]]
+    work = cover.work(pairs)
+    hold = np.ascontiguousarray(hold, dtype=float)
+    _place(hold, cover.fk, cover.joint, cover.center, cover.segments[0], cover.segments[1], cover.segments[2],
+           pairs.hjoint, pairs.hcenter, work)
+    moving = (np.flatnonzero(moves), np.flatnonzero(moves[pairs.hjoint]), np.flatnonzero(moves[cover.joint]),
+              np.flatnonzero(moves[cover.segments[0]]), np.empty((3, 3)))
+    return (*work, tuple(np.ascontiguousarray(m, dtype=np.int64) for m in moving[:4]) + (moving[4],))
+
+
 def _rng(seed: int) -> np.ndarray:
     return np.array([(int(seed) * 0x9E3779B97F4A7C15 + 0x2545F4914F6CDD1D) % (1 << 64)], dtype=np.uint64)
 
@@ -172,7 +205,9 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     nothing searched, ``status`` says so). ``planner_range``: the longest edge added at once
     [rad or m, joint space] (default :data:`RANGE_SHARE` of the diagonal of the joint-limit
     box). The result's ``path`` is ``None`` when nothing was found within ``time_limit`` [s]."""
-    fc = fast_check(checker)  # built, and its kernels loaded, before the clock starts
+    fc = fast_check(checker)  # built, its kernels loaded and its trees made before the clock starts
+    if fc is not None:
+        fc.trees()
     t0 = time.perf_counter()
     x0 = np.asarray(start, dtype=float)
     G = np.atleast_2d(np.asarray(goals, dtype=float))
@@ -188,14 +223,15 @@ def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0
     lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
     step_range = float(planner_range) if planner_range is not None else \
         RANGE_SHARE * float(np.linalg.norm(upper - lower))
-    nodes = np.zeros((2, TREE_NODES, n))
-    parent = np.full((2, TREE_NODES), -1, dtype=np.int64)
+    nodes, parent = fc.trees()  # rows past a tree's count are never read
     nodes[0, 0] = root
     nodes[1, : len(keep)] = [y for _, y in keep]
+    parent[0, 0] = -1
+    parent[1, : len(keep)] = -1
     counts = np.array([1, len(keep)], dtype=np.int64)
     status = np.zeros(5, dtype=np.int64)
     rng = _rng(seed)
-    chunk, found = 1, 0
+    chunk, found = FIRST_CHUNK, 0
     deadline = t0 + float(time_limit)
     while time.perf_counter() < deadline and counts.min() < TREE_NODES:
         tc = time.perf_counter()

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from pinarms.compiled import jit
+from pinarms.compiled import jit, jit_inline
 
 
 @jit
@@ -24,35 +24,41 @@ def _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p):
             R[0, a, b] = 1.0 if a == b else 0.0
     RM = np.empty((3, 3))
     for i in range(1, parent.shape[0]):
-        par = parent[i]
-        v = scale[i] * q[index[i]] + offset[i]
+        _fk_joint(i, q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p, RM)
+
+
+@jit_inline
+def _fk_joint(i, q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p, RM):
+    """Joint ``i``'s world placement from its parent's (``RM (3, 3)``: scratch)."""
+    par = parent[i]
+    v = scale[i] * q[index[i]] + offset[i]
+    for a in range(3):
+        s = p[par, a]
+        for b in range(3):
+            s += R[par, a, b] * Mp[i, b]
+            t = 0.0
+            for c in range(3):
+                t += R[par, a, c] * MR[i, c, b]
+            RM[a, b] = t
+        p[i, a] = s
+    ux, uy, uz = axis[i, 0], axis[i, 1], axis[i, 2]
+    if revolute[i]:
+        c = math.cos(v)
+        s = math.sin(v)
+        t = 1.0 - c
+        L00, L01, L02 = t * ux * ux + c, t * ux * uy - s * uz, t * ux * uz + s * uy
+        L10, L11, L12 = t * ux * uy + s * uz, t * uy * uy + c, t * uy * uz - s * ux
+        L20, L21, L22 = t * ux * uz - s * uy, t * uy * uz + s * ux, t * uz * uz + c
         for a in range(3):
-            s = p[par, a]
+            x, y, z = RM[a, 0], RM[a, 1], RM[a, 2]
+            R[i, a, 0] = x * L00 + y * L10 + z * L20
+            R[i, a, 1] = x * L01 + y * L11 + z * L21
+            R[i, a, 2] = x * L02 + y * L12 + z * L22
+    else:
+        for a in range(3):
             for b in range(3):
-                s += R[par, a, b] * Mp[i, b]
-                t = 0.0
-                for c in range(3):
-                    t += R[par, a, c] * MR[i, c, b]
-                RM[a, b] = t
-            p[i, a] = s
-        ux, uy, uz = axis[i, 0], axis[i, 1], axis[i, 2]
-        if revolute[i]:
-            c = math.cos(v)
-            s = math.sin(v)
-            t = 1.0 - c
-            L00, L01, L02 = t * ux * ux + c, t * ux * uy - s * uz, t * ux * uz + s * uy
-            L10, L11, L12 = t * ux * uy + s * uz, t * uy * uy + c, t * uy * uz - s * ux
-            L20, L21, L22 = t * ux * uz - s * uy, t * uy * uz + s * ux, t * uz * uz + c
-            for a in range(3):
-                x, y, z = RM[a, 0], RM[a, 1], RM[a, 2]
-                R[i, a, 0] = x * L00 + y * L10 + z * L20
-                R[i, a, 1] = x * L01 + y * L11 + z * L21
-                R[i, a, 2] = x * L02 + y * L12 + z * L22
-        else:
-            for a in range(3):
-                for b in range(3):
-                    R[i, a, b] = RM[a, b]
-                p[i, a] += v * (RM[a, 0] * ux + RM[a, 1] * uy + RM[a, 2] * uz)
+                R[i, a, b] = RM[a, b]
+            p[i, a] += v * (RM[a, 0] * ux + RM[a, 1] * uy + RM[a, 2] * uz)
 
 
 @jit
@@ -74,32 +80,32 @@ def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, join
         _centers(R, p, joint, center, out[i])
 
 
-@jit
-def _shape_distance(x, kind, FR, Fp, size):
-    """Distance [m] from point ``x`` to a static box (1), cylinder (2, axis z) or sphere (3); 0 inside."""
-    l0 = l1 = l2 = 0.0
-    d0, d1, d2 = x[0] - Fp[0], x[1] - Fp[1], x[2] - Fp[2]
-    l0 = FR[0, 0] * d0 + FR[1, 0] * d1 + FR[2, 0] * d2
-    l1 = FR[0, 1] * d0 + FR[1, 1] * d1 + FR[2, 1] * d2
-    l2 = FR[0, 2] * d0 + FR[1, 2] * d1 + FR[2, 2] * d2
+@jit_inline
+def _fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
+    """Distance [m] from point ``x`` to the static box (1), cylinder (2, axis z) or sphere (3) ``o``
+    (world rotation ``FR[o]``, centre ``Fp[o]``, ``size[o]``); 0 inside."""
+    d0, d1, d2 = x0 - Fp[o, 0], x1 - Fp[o, 1], x2 - Fp[o, 2]
+    l0 = FR[o, 0, 0] * d0 + FR[o, 1, 0] * d1 + FR[o, 2, 0] * d2
+    l1 = FR[o, 0, 1] * d0 + FR[o, 1, 1] * d1 + FR[o, 2, 1] * d2
+    l2 = FR[o, 0, 2] * d0 + FR[o, 1, 2] * d1 + FR[o, 2, 2] * d2
     if kind == 1:
-        o0 = max(abs(l0) - size[0], 0.0)
-        o1 = max(abs(l1) - size[1], 0.0)
-        o2 = max(abs(l2) - size[2], 0.0)
+        o0 = max(abs(l0) - size[o, 0], 0.0)
+        o1 = max(abs(l1) - size[o, 1], 0.0)
+        o2 = max(abs(l2) - size[o, 2], 0.0)
         return math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
     if kind == 2:
-        dr = max(math.sqrt(l0 * l0 + l1 * l1) - size[0], 0.0)
-        dz = max(abs(l2) - size[1], 0.0)
+        dr = max(math.sqrt(l0 * l0 + l1 * l1) - size[o, 0], 0.0)
+        dz = max(abs(l2) - size[o, 1], 0.0)
         return math.sqrt(dr * dr + dz * dz)
-    return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[0], 0.0)
+    return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[o, 0], 0.0)
 
 
-@jit
-def _cylinder_distance(x, a, b, r):
-    """Distance [m] from point ``x`` to the solid cylinder of axis ``a b`` and radius ``r``; 0 inside."""
-    u0, u1, u2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+@jit_inline
+def _cylinder_distance(x0, x1, x2, SA, SB, k, r):
+    """Distance [m] from point ``x`` to the solid cylinder of axis ``SA[k] SB[k]`` and radius ``r``; 0 inside."""
+    u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
     L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    w0, w1, w2 = x[0] - a[0], x[1] - a[1], x[2] - a[2]
+    w0, w1, w2 = x0 - SA[k, 0], x1 - SA[k, 1], x2 - SA[k, 2]
     ww = w0 * w0 + w1 * w1 + w2 * w2
     if L <= 1e-15:
         return max(math.sqrt(ww) - r, 0.0)
@@ -110,37 +116,34 @@ def _cylinder_distance(x, a, b, r):
     return math.sqrt(dr * dr + dz * dz)
 
 
-@jit
-def _exact_distance(x, other, exact, FR, Fp, size, SA, SB, srad, sstart):
+@jit_inline
+def _exact_distance(x0, x1, x2, other, exact, FR, Fp, size, SA, SB, srad, sstart):
+    """Distance [m] from point ``x`` to geometry ``other`` taken exactly (a static shape, or a moving cylinder)."""
     if exact[other] != 0:
-        return _shape_distance(x, exact[other], FR[other], Fp[other], size[other])
+        return _fixture_distance(x0, x1, x2, exact[other], FR, Fp, size, other)
     k = sstart[other]
-    return _cylinder_distance(x, SA[k], SB[k], srad[k])
+    return _cylinder_distance(x0, x1, x2, SA, SB, k, srad[k])
 
 
-@jit
+@jit_inline
 def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
     """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
     cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
     ``g`` (``HW[g]``, ``hrad[g]``) first."""
-    if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
+    if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
     if cyl[g] and exact[other] == 1:
         k = sstart[g]
-        if _cylinder_box_gap(SA[k], SB[k], srad[k], FR[other], Fp[other], size[other]) > t:
+        if _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) > t:
             return True
     for s in range(start[g], start[g + 1]):
-        if exact[other] != 0:
-            d = _shape_distance(W[s], exact[other], FR[other], Fp[other], size[other])
-        else:
-            k = sstart[other]
-            d = _cylinder_distance(W[s], SA[k], SB[k], srad[k])
+        d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
             return False
     return True
 
 
-@jit
+@jit_inline
 def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
     """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
     if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
@@ -183,8 +186,9 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
             if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
                 continue
             fixed = group_fixed[g]
-            if fixed >= 0 and _shape_distance(HW[group_a[g]], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) \
-                    - hrad[group_a[g]] > group_t[g]:
+            ha = group_a[g]
+            if fixed >= 0 and _fixture_distance(HW[ha, 0], HW[ha, 1], HW[ha, 2], exact[fixed], FR, Fp, size, fixed) \
+                    - hrad[ha] > group_t[g]:
                 continue
             for k in range(group_start[g], group_start[g + 1]):
                 ga = pair_a[k]
@@ -212,21 +216,42 @@ def _apart(HW, hrad, a, b, t):
     return reach < 0.0 or e0 * e0 + e1 * e1 + e2 * e2 > reach * reach
 
 
-@jit
+@jit_inline
 def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad, best):
     """``min(best, lower bound of distance(g, other) − t)``: the cover spheres of ``g`` against ``other``
     taken exactly (a static box, cylinder or sphere, or a moving cylinder); its bounding sphere first."""
-    if _exact_distance(HW[g], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] - t >= best:
+    if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] \
+            - t >= best:
         return best
     gap = -np.inf
     if cyl[g] and exact[other] == 1:
         k = sstart[g]
-        gap = _cylinder_box_gap(SA[k], SB[k], srad[k], FR[other], Fp[other], size[other]) - t
+        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) - t
         if gap >= best:
             return best
     low = np.inf
+    if exact[other] != 0:
+        for s in range(start[g], start[g + 1]):
+            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
+            if d < low:
+                low = d
+        return min(best, max(low, gap))
+    # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
+    k = sstart[other]
+    a0, a1, a2, r = SA[k, 0], SA[k, 1], SA[k, 2], srad[k]
+    u0, u1, u2 = SB[k, 0] - a0, SB[k, 1] - a1, SB[k, 2] - a2
+    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
     for s in range(start[g], start[g + 1]):
-        d = _exact_distance(W[s], other, exact, FR, Fp, size, SA, SB, srad, sstart) - radius[s] - t
+        w0, w1, w2 = W[s, 0] - a0, W[s, 1] - a1, W[s, 2] - a2
+        ww = w0 * w0 + w1 * w1 + w2 * w2
+        if L <= 1e-15:
+            d = max(math.sqrt(ww) - r, 0.0)
+        else:
+            h = (w0 * u0 + w1 * u1 + w2 * u2) / L
+            dr = max(math.sqrt(max(ww - h * h, 0.0)) - r, 0.0)
+            dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
+            d = math.sqrt(dr * dr + dz * dz)
+        d = d - radius[s] - t
         if d < low:
             low = d
     return min(best, max(low, gap))
@@ -238,24 +263,31 @@ def _cylinder_box_gap(a, b, r, FR, Fp, half):
     static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
     projections on the box's three axes (a projection shortens every distance). Exact for a cylinder
     standing upright over a box's face, where its spheres overshoot by nearly its radius."""
-    u0, u1, u2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    return _box_gap(a.reshape((1, 3)), b.reshape((1, 3)), 0, r, FR.reshape((1, 3, 3)), Fp.reshape((1, 3)),
+                    half.reshape((1, 3)), 0)
+
+
+@jit_inline
+def _box_gap(SA, SB, k, r, FR, Fp, half, o):
+    """:func:`_cylinder_box_gap` of the cylinder ``SA[k] SB[k]`` and the box ``o`` (``FR[o]``, ``Fp[o]``, ``half[o]``)."""
+    u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
     L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
     if L > 0.0:
         u0, u1, u2 = u0 / L, u1 / L, u2 / L
     gap = -np.inf
     for i in range(3):
-        n0, n1, n2 = FR[0, i], FR[1, i], FR[2, i]
-        ca = (a[0] - Fp[0]) * n0 + (a[1] - Fp[1]) * n1 + (a[2] - Fp[2]) * n2
-        cb = (b[0] - Fp[0]) * n0 + (b[1] - Fp[1]) * n1 + (b[2] - Fp[2]) * n2
+        n0, n1, n2 = FR[o, 0, i], FR[o, 1, i], FR[o, 2, i]
+        ca = (SA[k, 0] - Fp[o, 0]) * n0 + (SA[k, 1] - Fp[o, 1]) * n1 + (SA[k, 2] - Fp[o, 2]) * n2
+        cb = (SB[k, 0] - Fp[o, 0]) * n0 + (SB[k, 1] - Fp[o, 1]) * n1 + (SB[k, 2] - Fp[o, 2]) * n2
         un = u0 * n0 + u1 * n1 + u2 * n2
         rad = r * math.sqrt(max(1.0 - un * un, 0.0))
-        g = max(min(ca, cb) - rad - half[i], -half[i] - max(ca, cb) - rad)
+        g = max(min(ca, cb) - rad - half[o, i], -half[o, i] - max(ca, cb) - rad)
         if g > gap:
             gap = g
     return gap
 
 
-@jit
+@jit_inline
 def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad, best):
     """``min(best, lower bound of distance(ga, gb) − t)`` from the covers (:func:`_pair_clear`'s cases)."""
     if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
@@ -330,9 +362,51 @@ def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
     ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
     proof's scaled excess (``inv``: one over each group's travel weight, :mod:`optim.motion.link_levers`);
     ``inv`` empty (:data:`UNWEIGHTED`): every weight 1, the excess itself (:func:`excess_one`)."""
+    _place(q, fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+    return excess_placed(cov, grp, inv, cap, floor, work)
+
+
+@jit
+def place_moving(q, fk, cov, grp, work, moving):
+    """Place cell configuration ``q`` into ``work`` (:meth:`Cover.work`'s arrays) already placed at a
+    configuration that differs from ``q`` only in the joints ``moving[0]`` (ascending; the joints
+    below them included): their frames, then the bounding spheres ``moving[1]``, the cover spheres
+    ``moving[2]`` and the cylinder axes ``moving[3]`` on them (``moving[4] (3, 3)``: scratch). The
+    compiled search's states: the held arms and the fixtures are placed once, not at every state."""
+    parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    R, p, W, SA, SB, HW = work[0], work[1], work[2], work[3], work[4], work[5]
+    mjoint, mbound, msphere, mseg, RM = moving
+    for k in range(mjoint.shape[0]):
+        _fk_joint(mjoint[k], q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p, RM)
+    hjoint, hcenter = grp[0], grp[1]
+    joint, center, sjoint, sa_local, sb_local = cov[0], cov[1], cov[8], cov[9], cov[10]
+    # one loop per kind of point, written out (a call per point costs more than the point)
+    for k in range(mbound.shape[0]):
+        s = mbound[k]
+        j = hjoint[s]
+        for a in range(3):
+            HW[s, a] = p[j, a] + R[j, a, 0] * hcenter[s, 0] + R[j, a, 1] * hcenter[s, 1] + R[j, a, 2] * hcenter[s, 2]
+    for k in range(msphere.shape[0]):
+        s = msphere[k]
+        j = joint[s]
+        for a in range(3):
+            W[s, a] = p[j, a] + R[j, a, 0] * center[s, 0] + R[j, a, 1] * center[s, 1] + R[j, a, 2] * center[s, 2]
+    for k in range(mseg.shape[0]):
+        s = mseg[k]
+        j = sjoint[s]
+        for a in range(3):
+            SA[s, a] = p[j, a] + R[j, a, 0] * sa_local[s, 0] + R[j, a, 1] * sa_local[s, 1] + R[j, a, 2] * sa_local[s, 2]
+            SB[s, a] = p[j, a] + R[j, a, 0] * sb_local[s, 0] + R[j, a, 1] * sb_local[s, 1] + R[j, a, 2] * sb_local[s, 2]
+
+
+@jit
+def excess_placed(cov, grp, inv, cap, floor, work):
+    """:func:`excess_scaled` on ``work`` already placed (:func:`_place` or :func:`place_moving`).
+
+    The group and pair tests run on the bounding spheres; the pairs they do not prune are
+    computed inline (:func:`_pair_excess`: a call with its many arrays cost more than the pair)."""
     joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
     hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
-    _place(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work)
     W, SA, SB, HW = work[2], work[3], work[4], work[5]
     weighted = inv.shape[0] > 0
     best = cap
@@ -342,8 +416,8 @@ def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
         if (_hd(HW, hrad, a, group_b[g]) - group_t[g]) * s >= best:
             continue
         fixed = group_fixed[g]
-        if fixed >= 0 and (_shape_distance(HW[a], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) - hrad[a]
-                           - group_t[g]) * s >= best:
+        if fixed >= 0 and (_fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed)
+                           - hrad[a] - group_t[g]) * s >= best:
             continue
         for k in range(group_start[g], group_start[g + 1]):
             ga = pair_a[k]
