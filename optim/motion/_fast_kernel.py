@@ -7,7 +7,8 @@ proven on the *scaled* excess ``Ẽ(x) = min_k ê_k(x) / w_g`` (:func:`excess_sc
 bounds how much the distance of the pairs of group ``g`` (two links, or a link and a
 fixture) changes along the whole edge (``Σ_j |Δx_j| λ_{g,j}``, at most the whole-arm travel
 ``T = Σ |Δx_j| ℓ_j``; :mod:`.link_levers` states the Lipschitz argument); an interval
-``[s_a, s_b]`` of the edge is proven when ``Ẽ_a + Ẽ_b ≥ s_b − s_a``, all ``Ẽ ≥ 0``; ``Ẽ`` is
+``[s_a, s_b]`` of the edge is proven when ``Ẽ_a + Ẽ_b ≥ s_b − s_a``, all ``Ẽ ≥ 0`` (the ladder's rule,
+:func:`robots.cell.ladder.interval_proven`, where the argument is written); ``Ẽ`` is
 capped at ``cap / T`` (the pairs left out are more than ``cap`` above their thresholds).
 An interval not proven is halved (splitting at the middle of the stretch its ends do not
 prove instead checked as many states on the Panda scenes); intervals are taken first in,
@@ -25,11 +26,12 @@ from pathlib import Path
 import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
-from pinarms.robots.cell import _cover_kernel
+from pinarms.robots.cell import _cover_kernel, ladder
 from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_placed, place_moving
+from pinarms.robots.cell.ladder import interval_proven
 
-# these kernels call the cover's: its changes must compile them again (pinarms.compiled)
-drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
+# these kernels call the cover's and the ladder's rule: their changes must compile them again (pinarms.compiled)
+drop_stale_caches([Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
                   Path(__file__).resolve().parent / "__pycache__" / "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
@@ -100,7 +102,7 @@ def edge_proven(xa, xb, levers, lam, min_budget, max_states, hold, cols, fk, cov
     ea = state_scaled(xa, inv, hold, cols, fk, cov, grp, c, work, q)
     if ea < 0.0:
         return False
-    if ea + eb >= 1.0 + 1e-9:
+    if interval_proven(ea, eb, 1.0):
         return True
     head, tail, n = 0, 1, queue.shape[0]
     queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 1.0, ea, eb
@@ -108,7 +110,7 @@ def edge_proven(xa, xb, levers, lam, min_budget, max_states, hold, cols, fk, cov
         fa, fb, a, b = queue[head, 0], queue[head, 1], queue[head, 2], queue[head, 3]
         head = (head + 1) % n
         B = fb - fa
-        if a + b >= B * (1.0 + 1e-9):
+        if interval_proven(a, b, B):
             continue
         if T * B < min_budget or max_states <= 0:
             return False
