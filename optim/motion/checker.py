@@ -45,6 +45,7 @@ from typing import Any, Sequence
 import numpy as np
 import pinocchio as pin
 
+from pinarms.optim.motion import coal_batches
 from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
@@ -93,6 +94,9 @@ class MotionChecker(CoalBatches, LadderProof):
         threads: threads of Pinocchio's batch checks.
         cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
             verdicts, coal only where the cover is inconclusive).
+        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal computes only
+            the pairs the cover does not prove (per state), not every pair of a state the cover
+            does not prove as a whole; the same verdicts.
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -100,7 +104,7 @@ class MotionChecker(CoalBatches, LadderProof):
 
     def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1, cover: bool = True) -> None:
+                 threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
         self.cell = cell
@@ -167,7 +171,8 @@ class MotionChecker(CoalBatches, LadderProof):
         self._gd_dist = shared["gd_dist"]
         self._pools: dict[Any, Any] = shared["pools"]
         self._identity = self._pin_is_identity()
-        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "timeouts": 0}
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "coal_pairs": 0,
+                       "timeouts": 0}
         #: ``time.perf_counter()`` after which proofs give up and call their edge not valid (a
         #: search's time limit; ``None``: never). Giving up never calls anything clear.
         self.deadline: float | None = None
@@ -175,6 +180,12 @@ class MotionChecker(CoalBatches, LadderProof):
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
         self.cover = link_cover(cell) if cover else None
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
+        #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
+        self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
+        #: ``(P,)`` proven lower bound [m] of each pair's distance over every configuration (0: none): a
+        #: pair whose bound exceeds a check's threshold is proven there without coal or cover.
+        self.pair_floor = np.zeros(len(self.pairs))
+        self._screeners: dict[Any, tuple] = {}  # per threshold level: the cover's prepared per-pair screen
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -241,9 +252,25 @@ class MotionChecker(CoalBatches, LadderProof):
         if not self.within_limits(x[None])[0]:
             return False
         q = self.full(x[None])[0]
+        if self.pairwise:
+            return not self._state_pairs(q)
         if self.cover_decides_screens and self.cover.screen(q[None], self._cover_pairs, self.pair_margin)[0]:
             return True
+        self.counts["coal"] += 1
+        self.counts["coal_pairs"] += len(self.pairs)
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
+
+    def _state_pairs(self, q: np.ndarray) -> bool:
+        """Whether cell configuration ``q`` is closer than the margins on a pair, by the per-pair route: coal
+        (one call per pair, stopping at the first too close) on the pairs the cover leaves open only."""
+        want = np.flatnonzero(self.open_pairs(q[None], "margin")[0])
+        if want.size == 0:
+            return False
+        self.counts["coal"] += 1
+        self.counts["coal_pairs"] += int(want.size)
+        gm, gd = self.geometry, self._gd
+        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
+        return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,

@@ -21,10 +21,14 @@ import pinocchio as pin
 from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
 
-__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "check_threads", "shared_coal", "cold", "set_margins"]
+__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
+           "set_margins"]
 
 #: Configurations per coal batch while a deadline runs (the clock is read between two).
 COAL_CHUNK = 16
+#: Default of :class:`.checker.MotionChecker`'s ``pairwise``: coal computes only the pairs the cover
+#: does not prove (False: every pair of a configuration the cover does not prove as a whole).
+PAIRWISE = True
 
 
 def cold(gd: pin.GeometryData) -> pin.GeometryData:
@@ -149,12 +153,92 @@ class CoalBatches:
     def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
         margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
-        stop at the first such row (the rows after it are then reported False)."""
+        stop at the first such row (the rows after it are then reported False). With
+        :attr:`pairwise` the per-pair route (:meth:`pair_collides`), else the cover per
+        configuration and coal on every pair of the configurations it does not prove."""
+        if self.pairwise:
+            return self.pair_collides(Q, which, stop)
         Q = np.atleast_2d(Q)
         out = np.zeros(Q.shape[0], dtype=bool)
         rest = np.flatnonzero(~self.covered(Q, which))
         out[rest] = self.coal_collides(Q[rest], which, stop)
         return out
+
+    def _thresholds(self, which: Any) -> np.ndarray:
+        """Each pair's threshold [m] at the margins (``"margin"``) or at screen level ``which``."""
+        return self.pair_margin + (0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1))
+
+    def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+        """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those
+        neither the cover (:meth:`robots.cell.cover.Cover.pair_screen`) nor a proven lower bound of
+        their distance (:attr:`pair_floor`) keeps farther apart than their threshold (``which``: the
+        margins, or a screen level)."""
+        Q = np.atleast_2d(Q)
+        got = self._screeners.get(which)
+        if got is None:
+            t = self._thresholds(which)
+            got = (None if self.cover is None else self.cover.pair_screener(self._cover_pairs, t), self.pair_floor <= t)
+            self._screeners[which] = got
+        screen, left = got
+        if screen is None:
+            return np.broadcast_to(left, (Q.shape[0], left.size)).copy()
+        return ~screen(Q) & left
+
+    def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open
+        (:meth:`open_pairs`); a configuration with none open is proven clear without coal."""
+        Q = np.atleast_2d(Q)
+        self.counts["configurations"] += Q.shape[0]
+        out = np.zeros(Q.shape[0], dtype=bool)
+        if Q.shape[0] == 0:
+            return out
+        want = self.open_pairs(Q, which)
+        rows = np.flatnonzero(want.any(axis=1))
+        out[rows] = self.coal_pairs(Q[rows], want[rows], which, stop)
+        return out
+
+    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: configuration ``Q[i]`` closer than its threshold on one of the pairs ``want[i]``
+        (``(N, P)`` bool) — coal on those pairs only, through Pinocchio's batch loop: the configurations
+        with the same open pairs in one batch, :data:`COAL_CHUNK` configurations at a time in their
+        order (``stop``: the rows after the first hit are reported False)."""
+        Q = np.atleast_2d(Q)
+        N = Q.shape[0]
+        out = np.zeros(N, dtype=bool)
+        if N == 0:
+            return out
+        self.counts["coal"] += N
+        self.counts["coal_pairs"] += int(want.sum())
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        pool = self._pair_pool(which)
+        datas = pool.getGeometryDatas()
+        chunk = COAL_CHUNK if (stop or self.deadline is not None) else N
+        for a in range(0, N, chunk):
+            if self.deadline is not None and self._timed_out():
+                raise GiveUp
+            masks, group = np.unique(want[a:a + chunk], axis=0, return_inverse=True)
+            group = group.reshape(-1)
+            for m in range(masks.shape[0]):
+                for gd in datas:
+                    gd.deactivateAllCollisionPairs()
+                    for k in np.flatnonzero(masks[m]).tolist():
+                        gd.activateCollisionPair(k)
+                cols = a + np.flatnonzero(group == m)
+                hit = pin.computeCollisionsInParallel(self.threads, pool, np.asfortranarray(qp[:, cols]), True, False)
+                out[cols] = np.asarray(hit, dtype=bool).reshape(-1)
+            if stop and out[a:a + chunk].any():
+                out[a + int(np.argmax(out[a:a + chunk])) + 1:] = False
+                break
+        return out
+
+    def _pair_pool(self, which: Any):
+        """The pool of the per-pair route at ``which`` (Pinocchio's pair loop: it honours each data's active pairs)."""
+        key = ("pairwise", which)
+        pool = self._pools.get(key)
+        if pool is None:
+            pool = self._make_pool("pairs", self._thresholds(which))
+            self._pools[key] = pool
+        return pool
 
     def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
         """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
@@ -166,10 +250,16 @@ class CoalBatches:
         extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
         return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
 
+    def exact_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` for configurations the cover did not prove as a whole: the per-pair route
+        (:meth:`pair_collides`) with :attr:`pairwise`, else coal on every pair (:meth:`coal_collides`)."""
+        return self.pair_collides(Q, which, stop) if self.pairwise else self.coal_collides(Q, which, stop)
+
     def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
         Q = np.atleast_2d(Q)
         self.counts["coal"] += Q.shape[0]
+        self.counts["coal_pairs"] += Q.shape[0] * len(self.pairs)
         if Q.shape[0] == 0:
             return np.zeros(0, dtype=bool)
         qp = np.asfortranarray(self._to_pin(Q).T)
