@@ -186,22 +186,38 @@ class CoalBatches:
 
     def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open
-        (:meth:`open_pairs`); a configuration with none open is proven clear without coal."""
+        (:meth:`open_pairs`); a configuration with none open is proven clear without coal. With ``stop``
+        (or a deadline) a few configurations at a time, cover then coal, in their order (with ``stop`` 1, 2,
+        4, ... up to :data:`COAL_CHUNK`: an edge through an obstacle often fails on its first sample)."""
         Q = np.atleast_2d(Q)
-        self.counts["configurations"] += Q.shape[0]
-        out = np.zeros(Q.shape[0], dtype=bool)
-        if Q.shape[0] == 0:
-            return out
-        want = self.open_pairs(Q, which)
-        rows = np.flatnonzero(want.any(axis=1))
-        out[rows] = self.coal_pairs(Q[rows], want[rows], which, stop)
+        N = Q.shape[0]
+        self.counts["configurations"] += N
+        out = np.zeros(N, dtype=bool)
+        chunked = stop or self.deadline is not None
+        a, chunk = 0, (1 if stop else COAL_CHUNK) if chunked else max(N, 1)
+        while a < N:
+            if self.deadline is not None and self._timed_out():
+                raise GiveUp
+            a0 = a
+            want = self.open_pairs(Q[a0:a0 + chunk], which)
+            a += chunk
+            if chunked:
+                chunk = min(2 * chunk, COAL_CHUNK)
+            rows = np.flatnonzero(want.any(axis=1))
+            if rows.size == 0:
+                continue
+            hit = self.coal_pairs(Q[a0 + rows], want[rows], which, stop)
+            out[a0 + rows] = hit
+            if stop and hit.any():
+                out[a0 + int(rows[int(np.argmax(hit))]) + 1:] = False
+                break
         return out
 
     def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: configuration ``Q[i]`` closer than its threshold on one of the pairs ``want[i]``
         (``(N, P)`` bool) — coal on those pairs only, through Pinocchio's batch loop: the configurations
-        with the same open pairs in one batch, :data:`COAL_CHUNK` configurations at a time in their
-        order (``stop``: the rows after the first hit are reported False)."""
+        with the same open pairs in one batch (``stop``: the rows after the first hit are reported False;
+        the caller gives few rows at a time, :meth:`pair_collides`)."""
         Q = np.atleast_2d(Q)
         N = Q.shape[0]
         out = np.zeros(N, dtype=bool)
@@ -212,23 +228,19 @@ class CoalBatches:
         qp = np.asfortranarray(self._to_pin(Q).T)
         pool = self._pair_pool(which)
         datas = pool.getGeometryDatas()
-        chunk = COAL_CHUNK if (stop or self.deadline is not None) else N
-        for a in range(0, N, chunk):
-            if self.deadline is not None and self._timed_out():
-                raise GiveUp
-            masks, group = np.unique(want[a:a + chunk], axis=0, return_inverse=True)
-            group = group.reshape(-1)
-            for m in range(masks.shape[0]):
-                for gd in datas:
-                    gd.deactivateAllCollisionPairs()
-                    for k in np.flatnonzero(masks[m]).tolist():
-                        gd.activateCollisionPair(k)
-                cols = a + np.flatnonzero(group == m)
-                hit = pin.computeCollisionsInParallel(self.threads, pool, np.asfortranarray(qp[:, cols]), True, False)
-                out[cols] = np.asarray(hit, dtype=bool).reshape(-1)
-            if stop and out[a:a + chunk].any():
-                out[a + int(np.argmax(out[a:a + chunk])) + 1:] = False
-                break
+        groups: dict[bytes, list[int]] = {}
+        for i, key in enumerate(np.packbits(want, axis=1)):
+            groups.setdefault(key.tobytes(), []).append(i)
+        for rows in groups.values():
+            for gd in datas:
+                gd.deactivateAllCollisionPairs()
+                for k in np.flatnonzero(want[rows[0]]).tolist():
+                    gd.activateCollisionPair(k)
+            cols = np.array(rows)
+            hit = pin.computeCollisionsInParallel(self.threads, pool, np.asfortranarray(qp[:, cols]), True, False)
+            out[cols] = np.asarray(hit, dtype=bool).reshape(-1)
+        if stop and out.any():
+            out[int(np.argmax(out)) + 1:] = False
         return out
 
     def _pair_pool(self, which: Any):
