@@ -31,6 +31,13 @@ or follow their own timed trajectories (:class:`TimedArm`):
   arms' (:meth:`MotionChecker.moving_travel`, per time bin from their exact speeds and
   acceleration peaks) stays within a step between two, through the same proof.
 
+**Per-pair route** (``pairwise``, the default): every check asks the sphere cover for its
+verdict *per pair* (:meth:`robots.cell.cover.Cover.pair_screen`; a pair group proven on its
+bounding spheres proves all its pairs), and coal computes only the pairs left open — the
+configurations with the same open pairs in one batch of Pinocchio's pair loop (each data's
+active pairs). A configuration is reported clear only when every pair is proven by the cover
+or by coal at its threshold: the verdicts are those of coal on every pair.
+
 Exact distances (:meth:`MotionChecker.excess`, coal) serve the reports: which pair is
 closest, the clearance along a motion. Distances in m, the world frame; joint coordinates
 in rad or m; time in s.
@@ -259,18 +266,6 @@ class MotionChecker(CoalBatches, LadderProof):
         self.counts["coal"] += 1
         self.counts["coal_pairs"] += len(self.pairs)
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
-
-    def _state_pairs(self, q: np.ndarray) -> bool:
-        """Whether cell configuration ``q`` is closer than the margins on a pair, by the per-pair route: coal
-        (one call per pair, stopping at the first too close) on the pairs the cover leaves open only."""
-        want = np.flatnonzero(self.open_pairs(q[None], "margin")[0])
-        if want.size == 0:
-            return False
-        self.counts["coal"] += 1
-        self.counts["coal_pairs"] += int(want.size)
-        gm, gd = self.geometry, self._gd
-        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
-        return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,

@@ -1,7 +1,8 @@
 """coal's side of a :class:`.checker.MotionChecker`: Pinocchio's batch loops, their pools per screen, the deadline.
 
-Every check first asks the sphere cover (:mod:`robots.cell.cover`); what it does not prove
-goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
+Every check first asks the sphere cover (:mod:`robots.cell.cover`); with the per-pair route
+(:attr:`PAIRWISE`) coal computes only the pairs the cover does not prove, per configuration
+(:meth:`CoalBatches.pair_collides`); otherwise what it does not prove as a whole goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
 per screen level (the margins raised by ``step / 2^(L+1)``) and one at the margins
 themselves. The coal data (geometry copy, cold-started requests, pools) is shared by the
 checkers of one cell with the same pairs, margins and thread count made in the same thread
@@ -183,6 +184,18 @@ class CoalBatches:
         if screen is None:
             return np.broadcast_to(left, (Q.shape[0], left.size)).copy()
         return ~screen(Q) & left
+
+    def _state_pairs(self, q: np.ndarray) -> bool:
+        """Whether cell configuration ``q`` is closer than the margins on a pair, by the per-pair route: coal
+        (one call per pair, stopping at the first too close) on the pairs the cover leaves open only."""
+        want = np.flatnonzero(self.open_pairs(q[None], "margin")[0])
+        if want.size == 0:
+            return False
+        self.counts["coal"] += 1
+        self.counts["coal_pairs"] += int(want.size)
+        gm, gd = self.geometry, self._gd
+        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
+        return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
     def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open

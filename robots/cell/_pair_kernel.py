@@ -10,13 +10,16 @@ through :mod:`._cover_kernel`'s own helpers. Cached on disk like the other kerne
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 
 from . import _cover_kernel
 from ._cover_kernel import _apart, _pair_clear, _place, _shape_distance
 
-__all__ = ["pair_screen_kernel", "compiled_entry"]
+__all__ = ["pair_screen_kernel", "pair_screener", "compiled_entry"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
@@ -55,8 +58,6 @@ def compiled_entry(kernel, args: tuple):
     """``kernel``'s compiled code for arguments like ``(Q (N, nq) float, *args, out (N, P) bool)``, called
     without numba's matching of argument types (tens of µs for nested tuples of arrays); the dispatcher
     itself where numba does not expose it."""
-    import numpy as np
-
     probe = (np.zeros((0, 1)), *args, np.zeros((0, 0), dtype=np.bool_))
     try:
         kernel(*probe)  # compiled (or loaded from the disk cache) for these types
@@ -64,3 +65,25 @@ def compiled_entry(kernel, args: tuple):
         return kernel.overloads[signature].entry_point
     except (AttributeError, KeyError, TypeError):
         return kernel
+
+
+def pair_screener(cover: Any, pairs: Any, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """:meth:`.cover.Cover.pair_screen` of ``cover`` for ``pairs`` (:meth:`.cover.Cover.prepare`) at
+    ``threshold`` [m], its arrays prepared once: a function of the configurations ``Q (N, nq)`` alone
+    returning ``(N, P)`` bool in the order the pairs were given."""
+    P = pairs.pair_a.size
+    args = (cover.fk, cover.kernel_arrays(), cover.group_arrays(pairs, threshold), cover.work(pairs))
+    order = pairs.order
+    kernel = compiled_entry(pair_screen_kernel, args)
+
+    def screen(Q: np.ndarray) -> np.ndarray:
+        Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        if Q.shape[0] == 0 or P == 0:
+            return np.ones((Q.shape[0], P), dtype=np.bool_)
+        got = np.empty((Q.shape[0], P), dtype=np.bool_)
+        kernel(Q, *args, got)
+        out = np.empty_like(got)
+        out[:, order] = got
+        return out
+
+    return screen

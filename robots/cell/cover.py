@@ -257,24 +257,9 @@ class Cover:
     def pair_screener(self, pairs: "PairSet", threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
         the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
-        from ._pair_kernel import compiled_entry, pair_screen_kernel
+        from ._pair_kernel import pair_screener
 
-        P = pairs.pair_a.size
-        args = (self.fk, self.kernel_arrays(), self.group_arrays(pairs, threshold), self.work(pairs))
-        order = pairs.order
-        kernel = compiled_entry(pair_screen_kernel, args)
-
-        def screen(Q: np.ndarray) -> np.ndarray:
-            Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
-            if Q.shape[0] == 0 or P == 0:
-                return np.ones((Q.shape[0], P), dtype=np.bool_)
-            got = np.empty((Q.shape[0], P), dtype=np.bool_)
-            kernel(Q, *args, got)
-            out = np.empty_like(got)
-            out[:, order] = got
-            return out
-
-        return screen
+        return pair_screener(self, pairs, threshold)
 
     def kernel_arrays(self) -> tuple:
         """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
