@@ -189,9 +189,10 @@ class MotionChecker(CoalBatches, LadderProof):
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
         #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
         self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
-        #: ``(P,)`` proven lower bound [m] of each pair's distance over every configuration (0: none): a
-        #: pair whose bound exceeds a check's threshold is proven there without coal or cover.
-        self.pair_floor = np.zeros(len(self.pairs))
+        #: While an edge is proven by the per-pair route: each pair's share ``(P,)`` of the edge's travel
+        #: (``optim.motion.link_levers``), which scales its raise on the ladder's screens; else None.
+        self._share: np.ndarray | None = None
+        self._pair_rows: np.ndarray | None = None
         self._screeners: dict[Any, tuple] = {}  # per threshold level: the cover's prepared per-pair screen
 
     # ------------------------------------------------------------------ plumbing
@@ -345,10 +346,34 @@ class MotionChecker(CoalBatches, LadderProof):
             f = (i + 0.5 * (a + b)) / n
             return xa + f * (xb - xa), 0.5 * B, 0.5 * B
 
-        v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
+        self._share = self._travel_share(xa, xb) if self.pairwise else None
+        try:
+            v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
+        finally:
+            self._share = None
         if v.ok:
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
+
+    def _travel_share(self, xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
+        """``(P,)`` in [0, 1]: how far each pair's distance can change along the edge ``xa → xb`` (the joints
+        upstream of one of its links and not of the other, :func:`optim.motion.link_levers.group_levers`)
+        over the edge's travel ``T``. Two samples whose pair ``k`` keeps ``share_k · s`` above its margin,
+        with travel ``B ≤ 2s`` between them, keep it above its margin in between: the ladder's raise is
+        scaled per pair (:meth:`_thresholds`)."""
+        from pinarms.optim.motion.link_levers import group_levers
+
+        if self._pair_rows is None:
+            ps = self._cover_pairs
+            G = group_levers(self.cover, ps, self.model.lowerPositionLimit, self.model.upperPositionLimit, self.cols)
+            rows = np.empty((len(self.pairs), self.n))
+            rows[ps.order] = np.repeat(G, np.diff(ps.group_start), axis=0)
+            self._pair_rows = rows
+        dx = np.abs(xb[: self.n] - xa[: self.n])
+        T = float(dx @ self.levers)
+        if T <= 0.0:
+            return np.ones(len(self.pairs))
+        return np.minimum(self._pair_rows @ dx / T, 1.0)
 
     def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
         """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,

@@ -166,24 +166,26 @@ class CoalBatches:
         return out
 
     def _thresholds(self, which: Any) -> np.ndarray:
-        """Each pair's threshold [m] at the margins (``"margin"``) or at screen level ``which``."""
-        return self.pair_margin + (0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1))
+        """Each pair's threshold [m] at the margins (``"margin"``) or at screen level ``which``: the raise
+        ``step / 2^(L+1)`` scaled by the pair's share of the edge's travel while an edge is proven by the
+        per-pair route (:meth:`.checker.MotionChecker.edge_valid`), else whole."""
+        if which == "margin":
+            return self.pair_margin
+        extra = self.step * 2.0 ** (-int(which) - 1)
+        return self.pair_margin + (extra if self._share is None else extra * self._share)
 
     def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
-        """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those
-        neither the cover (:meth:`robots.cell.cover.Cover.pair_screen`) nor a proven lower bound of
-        their distance (:attr:`pair_floor`) keeps farther apart than their threshold (``which``: the
-        margins, or a screen level)."""
+        """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
+        cover (:meth:`robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
+        threshold (``which``: the margins, or a screen level; :meth:`_thresholds`)."""
         Q = np.atleast_2d(Q)
-        got = self._screeners.get(which)
-        if got is None:
-            t = self._thresholds(which)
-            got = (None if self.cover is None else self.cover.pair_screener(self._cover_pairs, t), self.pair_floor <= t)
-            self._screeners[which] = got
-        screen, left = got
+        P = len(self.pairs)
+        if self.cover is None:
+            return np.ones((Q.shape[0], P), dtype=bool)
+        screen = self._screeners.get("cover")
         if screen is None:
-            return np.broadcast_to(left, (Q.shape[0], left.size)).copy()
-        return ~screen(Q) & left
+            screen = self._screeners["cover"] = self.cover.pair_screener(self._cover_pairs, self.pair_margin)
+        return ~screen(Q, self._thresholds(which))
 
     def _state_pairs(self, q: np.ndarray) -> bool:
         """Whether cell configuration ``q`` is closer than the margins on a pair, by the per-pair route: coal
@@ -241,14 +243,17 @@ class CoalBatches:
         qp = np.asfortranarray(self._to_pin(Q).T)
         pool = self._pair_pool(which)
         datas = pool.getGeometryDatas()
+        t = self._thresholds(which).tolist()
         groups: dict[bytes, list[int]] = {}
         for i, key in enumerate(np.packbits(want, axis=1)):
             groups.setdefault(key.tobytes(), []).append(i)
         for rows in groups.values():
             for gd in datas:
                 gd.deactivateAllCollisionPairs()
+                requests = gd.collisionRequests
                 for k in np.flatnonzero(want[rows[0]]).tolist():
                     gd.activateCollisionPair(k)
+                    requests[k].security_margin = t[k]
             cols = np.array(rows)
             hit = pin.computeCollisionsInParallel(self.threads, pool, np.asfortranarray(qp[:, cols]), True, False)
             out[cols] = np.asarray(hit, dtype=bool).reshape(-1)
@@ -257,12 +262,11 @@ class CoalBatches:
         return out
 
     def _pair_pool(self, which: Any):
-        """The pool of the per-pair route at ``which`` (Pinocchio's pair loop: it honours each data's active pairs)."""
-        key = ("pairwise", which)
-        pool = self._pools.get(key)
+        """The pool of the per-pair route (Pinocchio's pair loop: it honours each data's active pairs; their
+        security margins are set at every batch, :meth:`coal_pairs`)."""
+        pool = self._pools.get("pairwise")
         if pool is None:
-            pool = self._make_pool("pairs", self._thresholds(which))
-            self._pools[key] = pool
+            pool = self._pools["pairwise"] = self._make_pool("pairs", self.pair_margin)
         return pool
 
     def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:

@@ -69,19 +69,20 @@ def compiled_entry(kernel, args: tuple):
 
 def pair_screener(cover: Any, pairs: Any, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
     """:meth:`.cover.Cover.pair_screen` of ``cover`` for ``pairs`` (:meth:`.cover.Cover.prepare`) at
-    ``threshold`` [m], its arrays prepared once: a function of the configurations ``Q (N, nq)`` alone
-    returning ``(N, P)`` bool in the order the pairs were given."""
+    ``threshold`` [m], its arrays prepared once: a function of the configurations ``Q (N, nq)`` (and,
+    optionally, other thresholds ``(P,)`` [m]) returning ``(N, P)`` bool in the order the pairs were given."""
     P = pairs.pair_a.size
     args = (cover.fk, cover.kernel_arrays(), cover.group_arrays(pairs, threshold), cover.work(pairs))
     order = pairs.order
     kernel = compiled_entry(pair_screen_kernel, args)
 
-    def screen(Q: np.ndarray) -> np.ndarray:
+    def screen(Q: np.ndarray, threshold: np.ndarray | None = None) -> np.ndarray:
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         if Q.shape[0] == 0 or P == 0:
             return np.ones((Q.shape[0], P), dtype=np.bool_)
         got = np.empty((Q.shape[0], P), dtype=np.bool_)
-        kernel(Q, *args, got)
+        grp = args[2] if threshold is None else cover.group_arrays(pairs, threshold)
+        kernel(Q, args[0], args[1], grp, args[3], got)
         out = np.empty_like(got)
         out[:, order] = got
         return out
