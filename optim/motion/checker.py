@@ -193,7 +193,7 @@ class MotionChecker(CoalBatches, LadderProof):
         #: (``optim.motion.link_levers``), which scales its raise on the ladder's screens; else None.
         self._share: np.ndarray | None = None
         self._pair_rows: np.ndarray | None = None
-        self._screeners: dict[Any, tuple] = {}  # per threshold level: the cover's prepared per-pair screen
+        self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
