@@ -31,12 +31,9 @@ or follow their own timed trajectories (:class:`TimedArm`):
   arms' (:meth:`MotionChecker.moving_travel`, per time bin from their exact speeds and
   acceleration peaks) stays within a step between two, through the same proof.
 
-**Per-pair route** (``pairwise``, the default): every check asks the sphere cover for its
-verdict *per pair* (:meth:`robots.cell.cover.Cover.pair_screen`; a pair group proven on its
-bounding spheres proves all its pairs), and coal computes only the pairs left open — the
-configurations with the same open pairs in one batch of Pinocchio's pair loop (each data's
-active pairs). A configuration is reported clear only when every pair is proven by the cover
-or by coal at its threshold: the verdicts are those of coal on every pair.
+**Per-pair route** (``pairwise``, the default; :mod:`.coal_batches`): the cover's verdict per
+pair, coal only on the pairs it leaves open; clear only when every pair is proven by one of
+them at its threshold. An edge's screens raise each pair's margin by its share of the travel.
 
 Exact distances (:meth:`MotionChecker.excess`, coal) serve the reports: which pair is
 closest, the clearance along a motion. Distances in m, the world frame; joint coordinates
@@ -101,9 +98,8 @@ class MotionChecker(CoalBatches, LadderProof):
         threads: threads of Pinocchio's batch checks.
         cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
             verdicts, coal only where the cover is inconclusive).
-        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal computes only
-            the pairs the cover does not prove (per state), not every pair of a state the cover
-            does not prove as a whole; the same verdicts.
+        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal only on the
+            pairs the cover does not prove, not on every pair of a state it does not prove.
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -189,9 +185,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
         #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
         self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
-        #: While an edge is proven by the per-pair route: each pair's share ``(P,)`` of the edge's travel
-        #: (``optim.motion.link_levers``), which scales its raise on the ladder's screens; else None.
-        self._share: np.ndarray | None = None
+        self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
 
@@ -354,26 +348,6 @@ class MotionChecker(CoalBatches, LadderProof):
         if v.ok:
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
-
-    def _travel_share(self, xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
-        """``(P,)`` in [0, 1]: how far each pair's distance can change along the edge ``xa → xb`` (the joints
-        upstream of one of its links and not of the other, :func:`optim.motion.link_levers.group_levers`)
-        over the edge's travel ``T``. Two samples whose pair ``k`` keeps ``share_k · s`` above its margin,
-        with travel ``B ≤ 2s`` between them, keep it above its margin in between: the ladder's raise is
-        scaled per pair (:meth:`_thresholds`)."""
-        from pinarms.optim.motion.link_levers import group_levers
-
-        if self._pair_rows is None:
-            ps = self._cover_pairs
-            G = group_levers(self.cover, ps, self.model.lowerPositionLimit, self.model.upperPositionLimit, self.cols)
-            rows = np.empty((len(self.pairs), self.n))
-            rows[ps.order] = np.repeat(G, np.diff(ps.group_start), axis=0)
-            self._pair_rows = rows
-        dx = np.abs(xb[: self.n] - xa[: self.n])
-        T = float(dx @ self.levers)
-        if T <= 0.0:
-            return np.ones(len(self.pairs))
-        return np.minimum(self._pair_rows @ dx / T, 1.0)
 
     def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
         """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,

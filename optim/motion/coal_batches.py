@@ -174,6 +174,26 @@ class CoalBatches:
         extra = self.step * 2.0 ** (-int(which) - 1)
         return self.pair_margin + (extra if self._share is None else extra * self._share)
 
+    def _travel_share(self, xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
+        """``(P,)`` in [0, 1]: how far each pair's distance can change along the edge ``xa → xb`` (the joints
+        upstream of one of its links and not of the other, :func:`optim.motion.link_levers.group_levers`)
+        over the edge's travel ``T``. Two samples whose pair ``k`` keeps ``share_k · s`` above its margin,
+        with travel ``B ≤ 2s`` between them, keep it above its margin in between: the ladder's raise is
+        scaled per pair (:meth:`_thresholds`)."""
+        from pinarms.optim.motion.link_levers import group_levers
+
+        if self._pair_rows is None:
+            ps = self._cover_pairs
+            G = group_levers(self.cover, ps, self.model.lowerPositionLimit, self.model.upperPositionLimit, self.cols)
+            rows = np.empty((len(self.pairs), self.n))
+            rows[ps.order] = np.repeat(G, np.diff(ps.group_start), axis=0)
+            self._pair_rows = rows
+        dx = np.abs(xb[: self.n] - xa[: self.n])
+        T = float(dx @ self.levers)
+        if T <= 0.0:
+            return np.ones(len(self.pairs))
+        return np.minimum(self._pair_rows @ dx / T, 1.0)
+
     def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
         """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
         cover (:meth:`robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
