@@ -31,6 +31,10 @@ or follow their own timed trajectories (:class:`TimedArm`):
   arms' (:meth:`MotionChecker.moving_travel`, per time bin from their exact speeds and
   acceleration peaks) stays within a step between two, through the same proof.
 
+**Per-pair route** (``pairwise``, the default; :mod:`.coal_batches`): the cover's verdict per
+pair, coal only on the pairs it leaves open; clear only when every pair is proven by one of
+them at its threshold. An edge's screens raise each pair's margin by its share of the travel.
+
 Exact distances (:meth:`MotionChecker.excess`, coal) serve the reports: which pair is
 closest, the clearance along a motion. Distances in m, the world frame; joint coordinates
 in rad or m; time in s.
@@ -45,6 +49,7 @@ from typing import Any, Sequence
 import numpy as np
 import pinocchio as pin
 
+from pinarms.optim.motion import coal_batches
 from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
@@ -93,6 +98,8 @@ class MotionChecker(CoalBatches, LadderProof):
         threads: threads of Pinocchio's batch checks.
         cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
             verdicts, coal only where the cover is inconclusive).
+        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal only on the
+            pairs the cover does not prove, not on every pair of a state it does not prove.
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -100,7 +107,7 @@ class MotionChecker(CoalBatches, LadderProof):
 
     def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1, cover: bool = True) -> None:
+                 threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
         self.cell = cell
@@ -167,7 +174,8 @@ class MotionChecker(CoalBatches, LadderProof):
         self._gd_dist = shared["gd_dist"]
         self._pools: dict[Any, Any] = shared["pools"]
         self._identity = self._pin_is_identity()
-        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "timeouts": 0}
+        self.counts = {"states": 0, "edges": 0, "configurations": 0, "exact": 0, "coal": 0, "coal_pairs": 0,
+                       "timeouts": 0}
         #: ``time.perf_counter()`` after which proofs give up and call their edge not valid (a
         #: search's time limit; ``None``: never). Giving up never calls anything clear.
         self.deadline: float | None = None
@@ -175,6 +183,11 @@ class MotionChecker(CoalBatches, LadderProof):
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
         self.cover = link_cover(cell) if cover else None
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
+        #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
+        self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
+        self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
+        self._pair_rows: np.ndarray | None = None
+        self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -241,8 +254,12 @@ class MotionChecker(CoalBatches, LadderProof):
         if not self.within_limits(x[None])[0]:
             return False
         q = self.full(x[None])[0]
+        if self.pairwise:
+            return not self._state_pairs(q)
         if self.cover_decides_screens and self.cover.screen(q[None], self._cover_pairs, self.pair_margin)[0]:
             return True
+        self.counts["coal"] += 1
+        self.counts["coal_pairs"] += len(self.pairs)
         return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -323,7 +340,11 @@ class MotionChecker(CoalBatches, LadderProof):
             f = (i + 0.5 * (a + b)) / n
             return xa + f * (xb - xa), 0.5 * B, 0.5 * B
 
-        v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
+        self._share = self._travel_share(xa, xb) if self.pairwise else None
+        try:
+            v = self.prove(X, budgets, midpoint, convex=bool(self.within_limits(np.stack([xa, xb])).all()), top=top)
+        finally:
+            self._share = None
         if v.ok:
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)

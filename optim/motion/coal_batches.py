@@ -1,7 +1,8 @@
 """coal's side of a :class:`.checker.MotionChecker`: Pinocchio's batch loops, their pools per screen, the deadline.
 
-Every check first asks the sphere cover (:mod:`robots.cell.cover`); what it does not prove
-goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
+Every check first asks the sphere cover (:mod:`robots.cell.cover`); with the per-pair route
+(:attr:`PAIRWISE`) coal computes only the pairs the cover does not prove, per configuration
+(:meth:`CoalBatches.pair_collides`); otherwise what it does not prove as a whole goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
 per screen level (the margins raised by ``step / 2^(L+1)``) and one at the margins
 themselves. The coal data (geometry copy, cold-started requests, pools) is shared by the
 checkers of one cell with the same pairs, margins and thread count made in the same thread
@@ -21,10 +22,14 @@ import pinocchio as pin
 from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
 
-__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "check_threads", "shared_coal", "cold", "set_margins"]
+__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
+           "set_margins"]
 
 #: Configurations per coal batch while a deadline runs (the clock is read between two).
 COAL_CHUNK = 16
+#: Default of :class:`.checker.MotionChecker`'s ``pairwise``: coal computes only the pairs the cover
+#: does not prove (False: every pair of a configuration the cover does not prove as a whole).
+PAIRWISE = True
 
 
 def cold(gd: pin.GeometryData) -> pin.GeometryData:
@@ -149,12 +154,140 @@ class CoalBatches:
     def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
         margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
-        stop at the first such row (the rows after it are then reported False)."""
+        stop at the first such row (the rows after it are then reported False). With
+        :attr:`pairwise` the per-pair route (:meth:`pair_collides`), else the cover per
+        configuration and coal on every pair of the configurations it does not prove."""
+        if self.pairwise:
+            return self.pair_collides(Q, which, stop)
         Q = np.atleast_2d(Q)
         out = np.zeros(Q.shape[0], dtype=bool)
         rest = np.flatnonzero(~self.covered(Q, which))
         out[rest] = self.coal_collides(Q[rest], which, stop)
         return out
+
+    def _thresholds(self, which: Any) -> np.ndarray:
+        """Each pair's threshold [m] at the margins (``"margin"``) or at screen level ``which``: the raise
+        ``step / 2^(L+1)`` scaled by the pair's share of the edge's travel while an edge is proven by the
+        per-pair route (:meth:`.checker.MotionChecker.edge_valid`), else whole."""
+        if which == "margin":
+            return self.pair_margin
+        extra = self.step * 2.0 ** (-int(which) - 1)
+        return self.pair_margin + (extra if self._share is None else extra * self._share)
+
+    def _travel_share(self, xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
+        """``(P,)`` in [0, 1]: how far each pair's distance can change along the edge ``xa → xb`` (the joints
+        upstream of one of its links and not of the other, :func:`optim.motion.link_levers.group_levers`)
+        over the edge's travel ``T``. Two samples whose pair ``k`` keeps ``share_k · s`` above its margin,
+        with travel ``B ≤ 2s`` between them, keep it above its margin in between: the ladder's raise is
+        scaled per pair (:meth:`_thresholds`)."""
+        from pinarms.optim.motion.link_levers import group_levers
+
+        if self._pair_rows is None:
+            ps = self._cover_pairs
+            G = group_levers(self.cover, ps, self.model.lowerPositionLimit, self.model.upperPositionLimit, self.cols)
+            rows = np.empty((len(self.pairs), self.n))
+            rows[ps.order] = np.repeat(G, np.diff(ps.group_start), axis=0)
+            self._pair_rows = rows
+        dx = np.abs(xb[: self.n] - xa[: self.n])
+        T = float(dx @ self.levers)
+        if T <= 0.0:
+            return np.ones(len(self.pairs))
+        return np.minimum(self._pair_rows @ dx / T, 1.0)
+
+    def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+        """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
+        cover (:meth:`robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
+        threshold (``which``: the margins, or a screen level; :meth:`_thresholds`)."""
+        Q = np.atleast_2d(Q)
+        P = len(self.pairs)
+        if self.cover is None:
+            return np.ones((Q.shape[0], P), dtype=bool)
+        screen = self._screeners.get("cover")
+        if screen is None:
+            screen = self._screeners["cover"] = self.cover.pair_screener(self._cover_pairs, self.pair_margin)
+        return ~screen(Q, self._thresholds(which))
+
+    def _state_pairs(self, q: np.ndarray) -> bool:
+        """Whether cell configuration ``q`` is closer than the margins on a pair, by the per-pair route: coal
+        (one call per pair, stopping at the first too close) on the pairs the cover leaves open only."""
+        want = np.flatnonzero(self.open_pairs(q[None], "margin")[0])
+        if want.size == 0:
+            return False
+        self.counts["coal"] += 1
+        self.counts["coal_pairs"] += int(want.size)
+        gm, gd = self.geometry, self._gd
+        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
+        return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
+
+    def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open
+        (:meth:`open_pairs`); a configuration with none open is proven clear without coal. With ``stop``
+        (or a deadline) a few configurations at a time, cover then coal, in their order (with ``stop`` 1, 2,
+        4, ... up to :data:`COAL_CHUNK`: an edge through an obstacle often fails on its first sample)."""
+        Q = np.atleast_2d(Q)
+        N = Q.shape[0]
+        self.counts["configurations"] += N
+        out = np.zeros(N, dtype=bool)
+        chunked = stop or self.deadline is not None
+        a, chunk = 0, (1 if stop else COAL_CHUNK) if chunked else max(N, 1)
+        while a < N:
+            if self.deadline is not None and self._timed_out():
+                raise GiveUp
+            a0 = a
+            want = self.open_pairs(Q[a0:a0 + chunk], which)
+            a += chunk
+            if chunked:
+                chunk = min(2 * chunk, COAL_CHUNK)
+            rows = np.flatnonzero(want.any(axis=1))
+            if rows.size == 0:
+                continue
+            hit = self.coal_pairs(Q[a0 + rows], want[rows], which, stop)
+            out[a0 + rows] = hit
+            if stop and hit.any():
+                out[a0 + int(rows[int(np.argmax(hit))]) + 1:] = False
+                break
+        return out
+
+    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """``(N,)`` bool: configuration ``Q[i]`` closer than its threshold on one of the pairs ``want[i]``
+        (``(N, P)`` bool) — coal on those pairs only, through Pinocchio's batch loop: the configurations
+        with the same open pairs in one batch (``stop``: the rows after the first hit are reported False;
+        the caller gives few rows at a time, :meth:`pair_collides`)."""
+        Q = np.atleast_2d(Q)
+        N = Q.shape[0]
+        out = np.zeros(N, dtype=bool)
+        if N == 0:
+            return out
+        self.counts["coal"] += N
+        self.counts["coal_pairs"] += int(want.sum())
+        qp = np.asfortranarray(self._to_pin(Q).T)
+        pool = self._pair_pool(which)
+        datas = pool.getGeometryDatas()
+        t = self._thresholds(which).tolist()
+        groups: dict[bytes, list[int]] = {}
+        for i, key in enumerate(np.packbits(want, axis=1)):
+            groups.setdefault(key.tobytes(), []).append(i)
+        for rows in groups.values():
+            for gd in datas:
+                gd.deactivateAllCollisionPairs()
+                requests = gd.collisionRequests
+                for k in np.flatnonzero(want[rows[0]]).tolist():
+                    gd.activateCollisionPair(k)
+                    requests[k].security_margin = t[k]
+            cols = np.array(rows)
+            hit = pin.computeCollisionsInParallel(self.threads, pool, np.asfortranarray(qp[:, cols]), True, False)
+            out[cols] = np.asarray(hit, dtype=bool).reshape(-1)
+        if stop and out.any():
+            out[int(np.argmax(out)) + 1:] = False
+        return out
+
+    def _pair_pool(self, which: Any):
+        """The pool of the per-pair route (Pinocchio's pair loop: it honours each data's active pairs; their
+        security margins are set at every batch, :meth:`coal_pairs`)."""
+        pool = self._pools.get("pairwise")
+        if pool is None:
+            pool = self._pools["pairwise"] = self._make_pool("pairs", self.pair_margin)
+        return pool
 
     def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
         """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
@@ -166,10 +299,16 @@ class CoalBatches:
         extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
         return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
 
+    def exact_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+        """:meth:`batch_collides` for configurations the cover did not prove as a whole: the per-pair route
+        (:meth:`pair_collides`) with :attr:`pairwise`, else coal on every pair (:meth:`coal_collides`)."""
+        return self.pair_collides(Q, which, stop) if self.pairwise else self.coal_collides(Q, which, stop)
+
     def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
         Q = np.atleast_2d(Q)
         self.counts["coal"] += Q.shape[0]
+        self.counts["coal_pairs"] += Q.shape[0] * len(self.pairs)
         if Q.shape[0] == 0:
             return np.zeros(0, dtype=bool)
         qp = np.asfortranarray(self._to_pin(Q).T)

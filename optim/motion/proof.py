@@ -116,7 +116,7 @@ class LadderProof:
         if order.size == 0:
             return Verdict(True)
         tight = self.cover_decides_screens and level <= COVER_LEVELS
-        flags = np.ones(order.size, dtype=bool) if tight else self.coal_collides(Q[order], level, stop=True)
+        flags = np.ones(order.size, dtype=bool) if tight else self.exact_collides(Q[order], level, stop=True)
         if not flags.any():
             return Verdict(True)
         first = int(order[int(np.argmax(flags))])
@@ -127,7 +127,7 @@ class LadderProof:
             return Verdict(False, int(order[int(np.argmax(hits))]))
         # every sample keeps the margins: prove the intervals between them, level by level
         lb = np.full(N, self.step / 2.0 ** (level + 1))  # proven lower bound of each sample's excess
-        lb[order if tight else order[self.coal_collides(Q[order], level)]] = 0.0
+        lb[order if tight else order[self.exact_collides(Q[order], level)]] = 0.0
         rungs = _ScreenRungs(self, Q, midpoint, tight)
         result = climb(lb, np.asarray(budgets, dtype=float), rungs, finest=MAX_SPLITS, level=level)
         if result.proven:

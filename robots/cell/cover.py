@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -246,6 +246,20 @@ class Cover:
                       pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
                       pairs.pair_b, t, bool(stop), out)
         return out
+
+    def pair_screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray) -> np.ndarray:
+        """``(N, P)`` bool: True where the cover **proves** pair ``k`` of ``pairs`` (:meth:`prepare`; in the
+        order the pairs were given) farther apart than its ``threshold[k]`` [m] at cell configuration
+        ``Q[i]``; False: inconclusive (the exact check decides that pair). A row all True is what
+        :meth:`screen` calls proven. :meth:`pair_screener` for many calls with one threshold."""
+        return self.pair_screener(pairs, threshold)(Q)
+
+    def pair_screener(self, pairs: "PairSet", threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
+        the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
+        from ._pair_kernel import pair_screener
+
+        return pair_screener(self, pairs, threshold)
 
     def kernel_arrays(self) -> tuple:
         """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
