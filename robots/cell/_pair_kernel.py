@@ -17,7 +17,7 @@ import numpy as np
 from pinarms.compiled import drop_stale_caches, jit
 
 from . import _cover_kernel
-from ._cover_kernel import _apart, _pair_clear, _place, _shape_distance
+from ._cover_kernel import _apart, _fixture_distance, _pair_clear, _place
 
 __all__ = ["pair_screen_kernel", "pair_screener", "compiled_entry"]
 
@@ -44,8 +44,8 @@ def pair_screen_kernel(Q, fk, cov, grp, work, out):
             whole = _apart(HW, hrad, a, group_b[g], group_t[g])
             fixed = group_fixed[g]
             if not whole and fixed >= 0:
-                whole = _shape_distance(HW[a], exact[fixed], FR[fixed], Fp[fixed], size[fixed]) - hrad[a] \
-                    > group_t[g]
+                whole = _fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed) \
+                    - hrad[a] > group_t[g]
             for k in range(group_start[g], group_start[g + 1]):
                 if whole or _apart(HW, hrad, pair_a[k], pair_b[k], t[k]):
                     out[i, k] = True
