@@ -16,25 +16,18 @@ other projects on PyPI).
 from __future__ import annotations
 
 import ast
-import importlib.util
 import sys
 from pathlib import Path
 
 import pytest
 
+from tests.architecture_script import architecture
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _architecture():
-    """benchmarks/architecture.py, the one statement of the layers (its :data:`LAYERS`)."""
-    spec = importlib.util.spec_from_file_location("architecture_layers", ROOT / "benchmarks" / "architecture.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up by name
-    spec.loader.exec_module(module)
-    return module
-
-
-LAYERS = _architecture().LAYERS
+#: benchmarks/architecture.py's layers: the one statement of them.
+LAYERS = architecture().LAYERS
 #: The packages in their one-way order (the layers above the floor).
 ORDER = [name for name, _ in LAYERS[1:]]
 #: The floor: modules of the ``pinarms`` folder that every package may import (the error
@@ -97,7 +90,6 @@ def _imported_modules(path: Path) -> set[str]:
 
 
 def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_errors():
-    import sys
 
     modules = _imported_modules(ROOT / "pinarms" / "execution.py")
     ours = {m for m in modules if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}
@@ -120,8 +112,9 @@ def test_the_floor_imports_nothing_of_ours_but_the_floor(floor):
 
 
 def test_the_old_errors_path_names_the_same_classes():
-    import pinarms.errors as floor
     import pinarms.robots.errors as old
+
+    import pinarms.errors as floor
 
     assert old.__all__ == floor.__all__
     assert all(getattr(old, name) is getattr(floor, name) for name in floor.__all__)

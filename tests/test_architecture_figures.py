@@ -10,23 +10,19 @@ function over 100 lines (``python benchmarks/architecture.py`` prints the figure
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 import textwrap
 from pathlib import Path
 
 import pytest
+
+from tests.architecture_script import architecture
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
 def arch():
-    spec = importlib.util.spec_from_file_location("architecture_figures", ROOT / "benchmarks" / "architecture.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up by name
-    spec.loader.exec_module(module)
-    return module
+    return architecture()
 
 
 def _write(folder: Path, name: str, text: str) -> None:

@@ -4,24 +4,7 @@ from __future__ import annotations
 
 import json
 
-import pytest
-from click.testing import CliRunner
-
 from pinarms import viz
-from pinarms.cli import cli
-
-
-@pytest.fixture
-def run():
-    runner = CliRunner()
-
-    def invoke(*args: str, ok: bool = True):
-        result = runner.invoke(cli, list(args))
-        if ok:
-            assert result.exit_code == 0, (result.output, result.stderr, result.exception)
-        return result
-
-    return invoke
 
 
 def user_error(result, *fragments: str) -> None:

@@ -6,41 +6,13 @@ import json
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 from pinarms import robots
-from pinarms.cli import cli, read_via_file
+from pinarms.cli import read_via_file
 from pinarms.papers import SEED000 as PAPER000
+from tests.cli.cli_results import as_json, assert_user_error
 
 SEED000 = [arg for deg in PAPER000.path_deg for arg in ("--via", f"{deg:g}")]  # --via 55.5 --via 69.7 ...
-
-
-@pytest.fixture
-def run():
-    runner = CliRunner()
-
-    def invoke(*args: str, ok: bool = True):
-        result = runner.invoke(cli, list(args))
-        if ok:
-            assert result.exit_code == 0, (result.output, result.stderr, result.exception)
-        return result
-
-    return invoke
-
-
-def as_json(result) -> dict:
-    return json.loads(result.stdout)
-
-
-def assert_user_error(result, code: int, *fragments: str) -> None:
-    """Non-zero exit, one 'Error:' line on stderr, no traceback."""
-    assert result.exit_code == code, (result.output, result.exception)
-    assert "Traceback" not in result.output
-    assert not isinstance(result.exception, Exception) or isinstance(result.exception, SystemExit)
-    err = result.stderr
-    assert "Error:" in err
-    for fragment in fragments:
-        assert fragment in err, err
 
 
 def test_robots_lists_every_name_with_dof(run):
@@ -253,8 +225,8 @@ def test_ik_seed_q_of_the_wrong_size_is_a_one_line_error(run):
 def test_optimize_progress_bar_spans_the_default_generation_budget(run, monkeypatch):
     import re
 
-    from pinarms import optim
     import pinarms.cli._common as cli_common
+    from pinarms import optim
 
     monkeypatch.setattr(cli_common, "show_progress", lambda as_json: not as_json)  # as on a terminal
     budget = optim.GASettings.seed002().max_generations

@@ -2,42 +2,11 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 from pinarms import robots
-from pinarms.cli import cli
-
-
-@pytest.fixture
-def run():
-    runner = CliRunner()
-
-    def invoke(*args: str, ok: bool = True):
-        result = runner.invoke(cli, list(args))
-        if ok:
-            assert result.exit_code == 0, (result.output, result.stderr, result.exception)
-        return result
-
-    return invoke
-
-
-def as_json(result) -> dict:
-    return json.loads(result.stdout)
-
-
-def assert_user_error(result, code: int, *fragments: str) -> None:
-    """Non-zero exit, one 'Error:' line on stderr, no traceback."""
-    assert result.exit_code == code, (result.output, result.exception)
-    assert "Traceback" not in result.output
-    assert not isinstance(result.exception, Exception) or isinstance(result.exception, SystemExit)
-    err = result.stderr
-    assert "Error:" in err
-    for fragment in fragments:
-        assert fragment in err, err
+from tests.cli.cli_results import as_json, assert_user_error
 
 
 def test_workspace_json_and_session(run, tmp_path):
