@@ -12,7 +12,17 @@ import numpy as np
 
 from .errors import InvalidInput
 
-__all__ = ["as_batch", "check_seed", "as_generator", "check_tolerance"]
+__all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance"]
+
+
+def real_array(values: Any, what: str) -> np.ndarray:
+    """``values`` as a float array; complex numbers, text and other objects are :class:`InvalidInput` naming ``what``."""
+    try:
+        if np.iscomplexobj(values):
+            raise TypeError("complex numbers")
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInput(f"{what} must be numbers (real), got {values!r}") from exc
 
 
 def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
@@ -20,12 +30,7 @@ def as_batch(values: Any, width: int, what: str) -> tuple[np.ndarray, bool]:
 
     Returns the ``(N, width)`` array and whether the input was a single vector.
     """
-    try:
-        if np.iscomplexobj(values):
-            raise TypeError("complex numbers")
-        arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be numbers (real), got {values!r}") from exc
+    arr = real_array(values, what)
     single = arr.ndim == 1
     if single:
         arr = arr[None, :]

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import real_array
 from .errors import InvalidInput
 
 __all__ = ["check_ik_target"]
@@ -37,12 +38,7 @@ def check_ik_target(target: Any, *, position_only: bool = False) -> tuple[np.nda
             det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
             if ortho <= 1e-6 and det > 0.0:
                 return target[None], True
-    try:
-        if np.iscomplexobj(target):
-            raise TypeError("complex numbers")
-        arr = np.asarray(target, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"IK target must be numbers (real), got {target!r}") from exc
+    arr = real_array(target, "IK target")
     if position_only and arr.shape[-1:] == (3,) and arr.ndim in (1, 2):
         single = arr.ndim == 1
         pts = arr.reshape(-1, 3)
