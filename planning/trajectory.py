@@ -102,6 +102,7 @@ class Trajectory:
         self._definition = definition
         self._stack: np.ndarray | None = None
         self._norm: np.ndarray | None = None
+        self._peaks: np.ndarray | None = None
 
     # ------------------------------------------------------------------ basic data
     @property
@@ -283,9 +284,14 @@ class Trajectory:
         return values, times
 
     def peaks(self) -> Peaks:
-        """Exact per-joint maxima of |velocity|, |acceleration| and |jerk| over the whole duration."""
-        values, _ = self._extrema((1, 2, 3), with_times=False)
-        top = np.abs(values).max(axis=(1, 3))  # (3, n)
+        """Exact per-joint maxima of |velocity|, |acceleration| and |jerk| over the whole duration.
+
+        Found once per trajectory (it is immutable: the root searches over every piece are its
+        costliest query); each call returns its own arrays."""
+        if self._peaks is None:
+            values, _ = self._extrema((1, 2, 3), with_times=False)
+            self._peaks = np.abs(values).max(axis=(1, 3))  # (3, n)
+        top = self._peaks.copy()
         return Peaks(velocity=top[0], acceleration=top[1], jerk=top[2])
 
     def position_range(self) -> tuple[np.ndarray, np.ndarray]:

@@ -47,8 +47,6 @@ from pinarms.optim.cycle.spec import CycleResult, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
-from pinarms.planning import Trajectory
-from pinarms.planning.trajectory import Peaks
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
 
@@ -108,24 +106,6 @@ class CellCycleReport:
             "attempts": [{"what": a, "clear": c, "min_clearance_m": d, "pair": p} for a, c, d, p in self.attempts],
             "planned_transfer": self.planned_transfer,
         }
-
-
-class _KnownPeaks(Trajectory):
-    """A cycle's trajectory handed to the continuous checks with its exact peaks known (``CycleResult.peaks``,
-    the trajectory's own ``peaks()``, computed when the cycle was made).
-
-    Each check asks for the peaks twice (speed bound and acceleration bound), and an attempt is
-    checked for external and own pairs: four root searches over every piece (a tenth of a second
-    each on a planned transfer's time-optimal pieces) become one. Shares the trajectory's arrays.
-    """
-
-    def __init__(self, trajectory: Trajectory, peaks: Peaks) -> None:  # noqa: D107 - shares, copies nothing
-        vars(self).update(vars(trajectory))
-        self._known = peaks
-
-    def peaks(self) -> Peaks:
-        k = self._known
-        return Peaks(velocity=k.velocity.copy(), acceleration=k.acceleration.copy(), jerk=k.jerk.copy())
 
 
 def _arm_of(cell: Any, robot: Any, arm: str | None):
@@ -198,7 +178,7 @@ class _Trials:
             t = np.linspace(traj.start_time, traj.end_time, SCREEN_SAMPLES)
             if not self.screened(description, np.asarray(traj.sample(t)[0], dtype=float), t - traj.start_time):
                 return False
-        motion = ArmMotion(self.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
+        motion = ArmMotion(self.cell_arm.name, result.trajectory)
         ext = self.external.check_motion([motion], margin=self.margin, clearance=self.clearance, hold=self.hold_q)
         slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) if self.own is not None else None
         ok = ext.clear and (slf is None or slf.collision_free)
@@ -346,7 +326,7 @@ def _report(trials: _Trials, result: CycleResult, base: CycleResult, lift: float
     Without ``CellSettings.recheck``: the kept cycle's own continuous check (its samples' minimum)."""
     final = trials.kept
     if trials.request.cell.recheck or final is None:
-        motion = ArmMotion(trials.cell_arm.name, _KnownPeaks(result.trajectory, result.peaks))
+        motion = ArmMotion(trials.cell_arm.name, result.trajectory)
         final = trials.external.check_motion([motion], margin=trials.margin, clearance=trials.clearance,
                                              hold=trials.hold_q, curve=True)
     d, pair, _ = _describe(final)

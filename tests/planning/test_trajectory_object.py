@@ -104,6 +104,21 @@ def test_peaks_of_a_known_quintic():
     assert p.as_dict()["velocity"] == pytest.approx([15 * D / (8 * T)])
 
 
+def test_peaks_are_found_once_and_each_call_gets_its_own_arrays(monkeypatch):
+    traj = planning.polynomial([0.0, 1.5], [0.0, 2.0], 5)
+    first = traj.peaks()
+    searches = []
+    original = Trajectory._extrema
+    monkeypatch.setattr(Trajectory, "_extrema", lambda self, *a, **k: searches.append(a) or original(self, *a, **k))
+    first.velocity[:] = -1.0  # a caller editing its copy changes nothing for the next one
+    again = traj.peaks()
+    assert not searches
+    assert again.velocity[0] == pytest.approx(15 * 2.0 / (8 * 1.5), rel=1e-12)
+    fresh = planning.polynomial([0.0, 1.5], [0.0, 2.0], 5).peaks()
+    np.testing.assert_array_equal(again.acceleration, fresh.acceleration)
+    assert len(searches) == 1  # the new trajectory searched its own
+
+
 def test_scaled_divides_derivatives_by_powers_of_the_factor():
     traj = random_bspline(3)
     slow = traj.scaled(2.0)
