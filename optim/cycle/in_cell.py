@@ -21,8 +21,9 @@ fails, the cycle is re-planned, in this order, until it passes:
 
 Each re-planned cycle is re-timed (time-optimal under the same limits) and re-checked.
 With ``CellSettings.screen`` (default), an attempt is first screened by exact distances at a few
-of its states, which can only reject it: its joint via points before it is timed (the timed
-cycle passes through them), then :data:`SCREEN_SAMPLES` instants of the timed cycle before the
+of its states, which can only reject it: every closed-form IK solution of its lifted and via
+waypoints (:data:`SCREEN_BRANCHES`: its via points are among them), its joint via points before
+it is timed (the timed cycle passes through them), then :data:`SCREEN_SAMPLES` instants of the timed cycle before the
 continuous check. A state closer than the clearance (by more than :data:`SCREEN_TOL`) proves
 the attempt cannot clear, so the screens change no verdict and no kept cycle; a cycle kept is
 always the one the continuous check proved.
@@ -48,14 +49,18 @@ from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
-from pinarms.robots.errors import CollisionError, InvalidInput, UnreachableTarget
+from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
 
-__all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL"]
+__all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES"]
 
 #: Instants of a timed attempt whose exact distances screen it before the continuous check.
 SCREEN_SAMPLES = 48
 #: A screened state rejects an attempt only when it is closer than the clearance by more than this [m].
 SCREEN_TOL = 1e-6
+#: With ``CellSettings.screen``, an attempt is first screened at every closed-form IK solution of its
+#: lifted and via waypoints (a batched IK and one batch of distances, ~5 ms on the AUBO-i3, against
+#: ~13 ms for its via points on one branch); ``False``: at its via points only (the route before).
+SCREEN_BRANCHES = True
 
 @dataclass(frozen=True, eq=False)
 class CellCycleReport:
@@ -171,6 +176,46 @@ class _Trials:
         self.last = (description, float(d[k]), pair, float("nan") if t is None else float(t[k]))
         return False
 
+    def branches_screened(self, description: str, poses: np.ndarray) -> bool:
+        """Whether each waypoint pose ``(K, 4, 4)`` has an IK solution keeping the clearance (module doc).
+
+        The via points are solved on one branch among the closed form's solutions: when every
+        solution of one pose is closer than the clearance, so is the attempt's via point, and the
+        attempt is recorded as failing (with the best solution's distance) and False returned. Only
+        poses whose solutions do not depend on the reference configuration (two references, the
+        same solutions: not at a singularity, where a free joint follows the reference) count; a pose
+        without a solution, or an arm without a closed form, leaves the verdict to the via points."""
+        robot = self.request.robot
+        if not getattr(robot, "has_analytic_ik", False) or poses.shape[0] == 0:
+            return True
+        other = np.clip(np.asarray(robot.neutral, dtype=float) + 1.0, robot.lower, robot.upper)
+        try:
+            sols = robot.ik_all(poses, equivalents=True)
+            again = robot.ik_all(poses, q_ref=other, equivalents=True)
+        except PinarmsError:
+            return True
+        keep = [k for k, (a, b) in enumerate(zip(sols, again)) if a.shape[0] and _same_rows(a, b)]
+        if len(keep) < poses.shape[0] and any(s.shape[0] == 0 for s in sols):
+            return True  # unreachable: the via points name the pose
+        if not keep:
+            return True
+        rows = np.concatenate([sols[k] for k in keep])
+        Q = np.repeat(self.hold_q[None], rows.shape[0], axis=0)
+        Q[:, self.cell_arm.q_slice] = rows
+        cl = self.external.clearance(Q)
+        d = np.atleast_1d(np.asarray(cl.distance, dtype=float))
+        start = 0
+        for k in keep:
+            n = sols[k].shape[0]
+            best = start + int(np.argmax(d[start : start + n]))
+            if d[best] < self.clearance - SCREEN_TOL:
+                pair = str(cl.pair_of(best))
+                self.attempts.append((description, False, float(d[best]), pair))
+                self.last = (description, float(d[best]), pair, float("nan"))
+                return False
+            start += n
+        return True
+
     def check(self, description: str, result: CycleResult) -> bool:
         """Check ``result`` in the cell and record the attempt: whether it keeps the clearance."""
         if self.screen:
@@ -196,6 +241,8 @@ class _Trials:
         request = dataclasses.replace(self.request, spec=spec)
         if self.screen and request.approach.approach == "joint":
             robot = request.robot
+            if SCREEN_BRANCHES and not self.branches_screened(description, spec.poses(robot)[1:-1]):
+                return False, None
             q = _via_points(robot, spec.poses(robot), spec.names, request.q_start)[0]  # as the cycle will have them
             if not self.screened(description, q):
                 return False, None
@@ -211,6 +258,13 @@ class _Trials:
             f"blocks (closest {d * 1e3:.1f} mm at {when}) after {len(self.attempts)} attempts, "
             f"the last with {description}; lower the clearance, move the pick/place, or move the fixture"
         )
+
+
+def _same_rows(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two solution sets ``(k, n)`` hold the same rows (any order, within 1e-9)."""
+    if a.shape != b.shape:
+        return False
+    return bool(np.allclose(a[np.lexsort(a.T[::-1])], b[np.lexsort(b.T[::-1])], rtol=0.0, atol=1e-9))
 
 
 def _check_ends(trials: _Trials, base: CycleResult) -> None:

@@ -104,3 +104,36 @@ def test_layout_search_screened_and_not_agree_on_every_candidate(station):
     ok = np.array([not f for f in fast.failure])
     assert ok.sum() >= 3
     assert np.array_equal(fast.cycle_time[ok], full.cycle_time[ok])
+
+
+def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
+    """Every IK solution of a waypoint closer than the clearance: so is the via point on the cycle's branch."""
+    from pinarms.optim.cycle import in_cell
+
+    cell = load_cell(scene_path("aubo_crate_guard"))
+    arm = cell.arm("aubo")
+    spec = optim.PickPlace(arm.to_base(np.array([0.40, 0.10, 0.78])), arm.to_base(np.array([0.0, -0.46, 0.78])),
+                           lift=0.05, dwell=0.2)
+    settings = CellSettings(cell, clearance=0.02, plan_transfer=False)
+    reports = {}
+    for branches in (False, True):
+        monkeypatch.setattr(in_cell, "SCREEN_BRANCHES", branches)
+        with pytest.raises(CollisionError, match="guard_plate blocks") as err:
+            optim.plan_cycle(CycleRequest(arm.robot, spec, cell=settings))
+        reports[branches] = str(err.value)
+    # the same attempts, each failing: the error counts them and names the last
+    count = [int(reports[b].split(" after ")[1].split()[0]) for b in (False, True)]
+    assert count[0] == count[1] >= 10
+    assert reports[False].split(", the last with ")[1] == reports[True].split(", the last with ")[1]
+    # the best solution of a rejected waypoint is at least as far as the one the via points take
+    trials = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    last = dataclasses.replace(spec, lift=0.05 + 0.02 * 9)
+    assert not trials.branches_screened("lift", last.poses(arm.robot)[1:-1])
+    from pinarms.optim.cycle.joint import _via_points
+
+    q = _via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
+    Q = np.repeat(cell.neutral[None], len(q), axis=0)
+    Q[:, arm.q_slice] = q
+    assert trials.attempts[-1][2] >= cell.with_pairs("external").clearance(Q).distance.min() - 1e-12
+    # the pick's own solutions: one of them keeps the clearance (the pick is proven clear), so no rejection
+    assert trials.branches_screened("pick", last.poses(arm.robot)[:1])
