@@ -47,7 +47,8 @@ from pinarms.robots.errors import InvalidInput
 
 from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
-from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _evaluate, _evaluate_chunk, _RefineTask, _refine, _Settings)
+from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
+                       _Settings)
 from .result import LayoutSearch, Refinement
 
 __all__ = [
@@ -298,20 +299,13 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
     return refinement, best_placement, best_ppm
 
 
-class _Clock:
-    """Wall and CPU seconds (this process) of a search's phases: ``laps[name] = (wall, cpu)``."""
+def _lower_bounds(robot: Any, st: _Settings, targets: np.ndarray | None, M: int) -> np.ndarray:
+    """Each candidate's lower bound of its cycle time [s] (:mod:`.bound`; 0 without a closed form)."""
+    from .bound import cycle_lower_bounds
 
-    def __init__(self) -> None:
-        import time
-
-        self._time = time
-        self.laps: dict[str, tuple[float, float]] = {}
-        self._at = (time.perf_counter(), time.process_time())
-
-    def lap(self, name: str) -> None:
-        now = (self._time.perf_counter(), self._time.process_time())
-        self.laps[name] = (now[0] - self._at[0], now[1] - self._at[1])
-        self._at = now
+    if targets is None:
+        return np.zeros(M)
+    return cycle_lower_bounds(robot, targets[:, : len(st.picks) + len(st.places)], len(st.picks), st.dwell, st.vmax)
 
 
 def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int) -> Any:
@@ -384,13 +378,7 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
 
     clock = _Clock()
     failure, reason, targets = _screen(robot, cand, st)
-    lower = None
-    if bound:
-        from .bound import cycle_lower_bounds
-
-        n_points = len(st.picks) + len(st.places)
-        lower = np.zeros(cand.shape[0]) if targets is None else \
-            cycle_lower_bounds(robot, targets[:, :n_points], len(st.picks), st.dwell, st.vmax)
+    lower = _lower_bounds(robot, st, targets, cand.shape[0]) if bound else None
     vmap, point_margin = _margins(robot, st, cand, workspace_samples)
     margin = point_margin.min(axis=1)
     if min_margin > 0:
