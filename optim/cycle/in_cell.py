@@ -23,8 +23,9 @@ Each re-planned cycle is re-timed (time-optimal under the same limits) and re-ch
 With ``CellSettings.screen`` (default), an attempt is first screened by exact distances at a few
 of its states, which can only reject it: every closed-form IK solution of its lifted and via
 waypoints (:data:`SCREEN_BRANCHES`: its via points are among them), its joint via points before
-it is timed (the timed cycle passes through them), then :data:`SCREEN_SAMPLES` instants of the timed cycle before the
-continuous check. A state closer than the clearance (by more than :data:`SCREEN_TOL`) proves
+it is timed (the timed cycle passes through them), its move to place at :data:`SCREEN_SAMPLES` / 2
+instants before its move back is timed, then :data:`SCREEN_SAMPLES` instants of the timed cycle
+before the continuous check. A state closer than the clearance (by more than :data:`SCREEN_TOL`) proves
 the attempt cannot clear, so the screens change no verdict and no kept cycle; a cycle kept is
 always the one the continuous check proved.
 The result carries a :class:`CellCycleReport`: what was tried, the lift and via points
@@ -42,7 +43,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.caps import MAX_LIFT_ATTEMPTS
-from pinarms.optim.cycle.joint import _via_points
+from pinarms.optim.cycle.joint import _via_points, joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import CycleResult, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
@@ -216,6 +217,12 @@ class _Trials:
             start += n
         return True
 
+    def move_screened(self, description: str, move: Any, offset: float) -> bool:
+        """:meth:`screened` at :data:`SCREEN_SAMPLES` / 2 instants of the timed move to place (``offset`` [s]:
+        its start in the cycle, after the dwell at the pick)."""
+        t = np.linspace(move.start_time, move.end_time, SCREEN_SAMPLES // 2)
+        return self.screened(description, np.asarray(move.sample(t)[0], dtype=float), t - move.start_time + offset)
+
     def check(self, description: str, result: CycleResult) -> bool:
         """Check ``result`` in the cell and record the attempt: whether it keeps the clearance."""
         if self.screen:
@@ -243,9 +250,14 @@ class _Trials:
             robot = request.robot
             if SCREEN_BRANCHES and not self.branches_screened(description, spec.poses(robot)[1:-1]):
                 return False, None
-            q = _via_points(robot, spec.poses(robot), spec.names, request.q_start)[0]  # as the cycle will have them
-            if not self.screened(description, q):
+            via = _via_points(robot, spec.poses(robot), spec.names, request.q_start)  # as the cycle will have them
+            if not self.screened(description, via[0]):
                 return False, None
+            result = joint_cycle(request, via=via,
+                                 there_clear=lambda move: self.move_screened(description, move, spec.dwell))
+            if result is None:  # the move to place is closer than the clearance: the move back untimed
+                return False, None
+            return self.check(description, result), result
         result = approach_cycle(request)
         return self.check(description, result), result
 

@@ -137,3 +137,21 @@ def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
     assert trials.attempts[-1][2] >= cell.with_pairs("external").clearance(Q).distance.min() - 1e-12
     # the pick's own solutions: one of them keeps the clearance (the pick is proven clear), so no rejection
     assert trials.branches_screened("pick", last.poses(arm.robot)[:1])
+
+
+def test_a_cycle_stopped_after_its_move_to_place_is_the_same_cycle_when_let_through(station):
+    """joint_cycle's hook: the move to place first (the screen may stop it there), then the move back."""
+    from pinarms.optim.cycle.joint import _via_points, joint_cycle
+
+    arm = station.arm("aubo")
+    spec = optim.PickPlace(arm.to_base(PICK), arm.to_base(CRATE), lift=0.05, dwell=0.2)
+    request = CycleRequest(arm.robot, spec)
+    seen = []
+    assert joint_cycle(request, there_clear=lambda move: seen.append(move) or False) is None
+    whole = joint_cycle(request)
+    via = _via_points(arm.robot, spec.poses(arm.robot), spec.names, None)
+    let = joint_cycle(request, via=via, there_clear=lambda move: True)
+    assert let.cycle_time == whole.cycle_time and np.array_equal(let.q_via, whole.q_via)
+    # the move it was shown is the cycle's move to place
+    move = whole.moves[0].trajectory
+    assert seen[0].end_time - seen[0].start_time == move.end_time - move.start_time
