@@ -9,9 +9,11 @@ planned transfer (:mod:`optim.motion.transfer`). Candidates: 1 000 seeded random
 benchmark times the first few and extrapolates to 1 000 (stated).
 
 1. **Serial**, one process, interleaved in blocks of two candidates: the route before
-   (``in_cell.SCREEN_BRANCHES = False``: attempts screened at their via points only;
-   ``bound=False``) and now (every IK branch of an attempt's waypoints screened first;
-   ``bound=True``, branch and bound over the candidates); ``--unscreened`` adds
+   (``in_cell.SCREEN_BRANCHES = SCREEN_MOVES = False``: attempts screened at their via points
+   and timed whole; ``bound=False``) and now (every IK branch of an attempt's waypoints
+   screened first, its move to place screened before its move back is timed; ``bound=True``,
+   branch and bound over the candidates; the planned transfer's definitions copied once is in
+   both); ``--unscreened`` adds
    ``screen=False`` (every attempt timed and checked in full). Their outcomes must agree
    (failure class and cycle time). Per candidate: the search's ``"cycles"`` phase
    (:attr:`LayoutSearch.seconds`); the one-offs (the reach screen and bounds of all 1 000,
@@ -63,19 +65,19 @@ def _search(cell, cand: np.ndarray, screen: bool, scheduler=None, bound: bool = 
                                chunk_size=1, screen=screen, scheduler=scheduler, bound=bound)
 
 
-#: The serial routes: (label, screen, branch screen of the attempts, bound).
+#: The serial routes: (screen, the attempts' branch and move-to-place screens, bound).
 ROUTES = {"before": (True, False, False), "now": (True, True, True), "unscreened": (False, False, False)}
 
 
 def _route(cell, block: np.ndarray, name: str):
     from pinarms.optim.cycle import in_cell
 
-    screen, branches, bound = ROUTES[name]
-    in_cell.SCREEN_BRANCHES = branches
+    screen, new_screens, bound = ROUTES[name]
+    in_cell.SCREEN_BRANCHES = in_cell.SCREEN_MOVES = new_screens
     try:
         return _search(cell, block, screen, bound=bound)
     finally:
-        in_cell.SCREEN_BRANCHES = True
+        in_cell.SCREEN_BRANCHES = in_cell.SCREEN_MOVES = True
 
 
 def _one_offs(cell, cand: np.ndarray) -> tuple[float, np.ndarray]:

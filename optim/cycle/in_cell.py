@@ -52,7 +52,7 @@ from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
 
-__all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES"]
+__all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES", "SCREEN_MOVES"]
 
 #: Instants of a timed attempt whose exact distances screen it before the continuous check.
 SCREEN_SAMPLES = 48
@@ -62,6 +62,10 @@ SCREEN_TOL = 1e-6
 #: lifted and via waypoints (a batched IK and one batch of distances, ~5 ms on the AUBO-i3, against
 #: ~13 ms for its via points on one branch); ``False``: at its via points only (the route before).
 SCREEN_BRANCHES = True
+#: With ``CellSettings.screen``, an attempt's move to place is screened at ``SCREEN_SAMPLES / 2`` instants
+#: before its move back is timed (an exact timing, ~0.1 s on the AUBO-i3); ``False``: the whole cycle
+#: timed first (the route before).
+SCREEN_MOVES = True
 
 @dataclass(frozen=True, eq=False)
 class CellCycleReport:
@@ -253,8 +257,8 @@ class _Trials:
             via = _via_points(robot, spec.poses(robot), spec.names, request.q_start)  # as the cycle will have them
             if not self.screened(description, via[0]):
                 return False, None
-            result = joint_cycle(request, via=via,
-                                 there_clear=lambda move: self.move_screened(description, move, spec.dwell))
+            there_clear = (lambda move: self.move_screened(description, move, spec.dwell)) if SCREEN_MOVES else None
+            result = joint_cycle(request, via=via, there_clear=there_clear)
             if result is None:  # the move to place is closer than the clearance: the move back untimed
                 return False, None
             return self.check(description, result), result
