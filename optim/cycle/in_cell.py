@@ -66,6 +66,8 @@ SCREEN_BRANCHES = True
 #: before its move back is timed (an exact timing, ~0.1 s on the AUBO-i3); ``False``: the whole cycle
 #: timed first (the route before).
 SCREEN_MOVES = True
+#: Rises of the lift whose branch screens are done in one batch.
+AHEAD = 8
 
 @dataclass(frozen=True, eq=False)
 class CellCycleReport:
@@ -162,6 +164,7 @@ class _Trials:
         self.last: tuple[str, float, str, float] | None = None
         self.screen = bool(request.cell.screen)
         self.kept = None  # the continuous check of the last attempt checked
+        self._ahead: dict[str, tuple[bytes, tuple[float, str] | None]] = {}  # branch screens done ahead
 
     def screened(self, description: str, q: np.ndarray, t: np.ndarray | None = None) -> bool:
         """Whether every state ``q (N, n)`` of the arm keeps the clearance (exact distances, module doc).
@@ -181,45 +184,69 @@ class _Trials:
         self.last = (description, float(d[k]), pair, float("nan") if t is None else float(t[k]))
         return False
 
+    def prescreen(self, items: list[tuple[str, PickPlace]]) -> None:
+        """The branch screens (:meth:`branches_screened`) of the coming attempts ``(description, spec)`` in one
+        batch (one IK, one batch of distances), kept until each attempt is planned."""
+        robot = self.request.robot
+        if not (self.screen and SCREEN_BRANCHES and self.request.approach.approach == "joint"):
+            return
+        poses = [spec.poses(robot)[1:-1] for _, spec in items]
+        for (description, _), p, verdict in zip(items, poses, self._branch_rejections(poses)):
+            self._ahead[description] = (p.tobytes(), verdict)
+
     def branches_screened(self, description: str, poses: np.ndarray) -> bool:
         """Whether each waypoint pose ``(K, 4, 4)`` has an IK solution keeping the clearance (module doc).
 
         The via points are solved on one branch among the closed form's solutions: when every
         solution of one pose is closer than the clearance, so is the attempt's via point, and the
-        attempt is recorded as failing (with the best solution's distance) and False returned. Only
-        poses whose solutions do not depend on the reference configuration (two references, the
-        same solutions: not at a singularity, where a free joint follows the reference) count; a pose
-        without a solution, or an arm without a closed form, leaves the verdict to the via points."""
-        robot = self.request.robot
-        if not getattr(robot, "has_analytic_ik", False) or poses.shape[0] == 0:
+        attempt is recorded as failing (with the best solution's distance) and False returned."""
+        known = self._ahead.pop(description, None)
+        verdict = known[1] if known is not None and known[0] == poses.tobytes() else \
+            self._branch_rejections([poses])[0]
+        if verdict is None:
             return True
+        self.attempts.append((description, False, verdict[0], verdict[1]))
+        self.last = (description, verdict[0], verdict[1], float("nan"))
+        return False
+
+    def _branch_rejections(self, pose_sets: list[np.ndarray]) -> list[tuple[float, str] | None]:
+        """For each set of waypoint poses: (distance [m], pair) of the first pose every IK solution of which is
+        closer than the clearance (the best solution's), or None. Only poses whose solutions do not depend on
+        the reference configuration (two references, the same solutions: not at a singularity, where a free
+        joint follows the reference) count; a set with a pose without solution, and an arm without a
+        closed form, give None (the via points decide and name the pose)."""
+        robot = self.request.robot
+        out: list[tuple[float, str] | None] = [None] * len(pose_sets)
+        sizes = [p.shape[0] for p in pose_sets]
+        if not getattr(robot, "has_analytic_ik", False) or sum(sizes) == 0:
+            return out
+        flat = np.concatenate(pose_sets)
         other = np.clip(np.asarray(robot.neutral, dtype=float) + 1.0, robot.lower, robot.upper)
         try:
-            sols = robot.ik_all(poses, equivalents=True)
-            again = robot.ik_all(poses, q_ref=other, equivalents=True)
+            sols = robot.ik_all(flat, equivalents=True)
+            again = robot.ik_all(flat, q_ref=other, equivalents=True)
         except PinarmsError:
-            return True
-        keep = [k for k, (a, b) in enumerate(zip(sols, again)) if a.shape[0] and _same_rows(a, b)]
-        if len(keep) < poses.shape[0] and any(s.shape[0] == 0 for s in sols):
-            return True  # unreachable: the via points name the pose
-        if not keep:
-            return True
-        rows = np.concatenate([sols[k] for k in keep])
-        Q = np.repeat(self.hold_q[None], rows.shape[0], axis=0)
-        Q[:, self.cell_arm.q_slice] = rows
+            return out
+        bounds = np.cumsum([0] + sizes)
+        keep = [[k for k in range(bounds[i], bounds[i + 1]) if sols[k].shape[0] and _same_rows(sols[k], again[k])]
+                if all(sols[k].shape[0] for k in range(bounds[i], bounds[i + 1])) else []
+                for i in range(len(pose_sets))]
+        rows = [sols[k] for ks in keep for k in ks]
+        if not rows:
+            return out
+        Q = np.repeat(self.hold_q[None], sum(r.shape[0] for r in rows), axis=0)
+        Q[:, self.cell_arm.q_slice] = np.concatenate(rows)
         cl = self.external.clearance(Q)
         d = np.atleast_1d(np.asarray(cl.distance, dtype=float))
         start = 0
-        for k in keep:
-            n = sols[k].shape[0]
-            best = start + int(np.argmax(d[start : start + n]))
-            if d[best] < self.clearance - SCREEN_TOL:
-                pair = str(cl.pair_of(best))
-                self.attempts.append((description, False, float(d[best]), pair))
-                self.last = (description, float(d[best]), pair, float("nan"))
-                return False
-            start += n
-        return True
+        for i, ks in enumerate(keep):
+            for k in ks:
+                n = sols[k].shape[0]
+                best = start + int(np.argmax(d[start : start + n]))
+                start += n
+                if out[i] is None and d[best] < self.clearance - SCREEN_TOL:
+                    out[i] = (float(d[best]), str(cl.pair_of(best)))
+        return out
 
     def move_screened(self, description: str, move: Any, offset: float) -> bool:
         """:meth:`screened` at :data:`SCREEN_SAMPLES` / 2 instants of the timed move to place (``offset`` [s]:
@@ -301,7 +328,13 @@ def _check_ends(trials: _Trials, base: CycleResult) -> None:
 def _raise_lift(trials: _Trials, spec: PickPlace, lift_step: float) -> tuple[bool, CycleResult | None, float]:
     """Step 1: raise the lift by ``lift_step`` until the cycle clears, the arm's reach ends, or the cap."""
     lift, ok, result = spec.lift, False, None
-    for _ in range(MAX_LIFT_ATTEMPTS):  # bounded: the arm's reach usually ends the rise first
+    for i in range(MAX_LIFT_ATTEMPTS):  # bounded: the arm's reach usually ends the rise first
+        if i % AHEAD == 0:  # the next few rises' branch screens in one batch
+            ahead, lifts = lift, []
+            for _ in range(min(AHEAD, MAX_LIFT_ATTEMPTS - i)):
+                ahead += lift_step
+                lifts.append(ahead)
+            trials.prescreen([(f"lift {x:.3f} m", dataclasses.replace(spec, lift=x)) for x in lifts])
         lift += lift_step
         try:
             ok, result = trials.plan(f"lift {lift:.3f} m", dataclasses.replace(spec, lift=lift))
@@ -320,6 +353,7 @@ def _add_vias(trials: _Trials, spec: PickPlace, top: float,
     poses = dataclasses.replace(spec, lift=top).poses(robot)
     above_pick, above_place = poses[1][:3, 3], poses[-2][:3, 3]
     height = max(above_pick[2], above_place[2])
+    tries = []
     for k in range(1, 4):
         for fractions in ((0.5,), (1.0 / 3.0, 2.0 / 3.0)):
             points = []
@@ -327,15 +361,16 @@ def _add_vias(trials: _Trials, spec: PickPlace, top: float,
                 p = above_pick + f * (above_place - above_pick)
                 p[2] = height + k * lift_step
                 points.append(p)
-            try:
-                ok, result = trials.plan(
-                    f"lift {top:.3f} m, {len(points)} via point(s) at z = {height + k * lift_step:.3f} m",
-                    dataclasses.replace(spec, lift=top, via=tuple(spec.via) + tuple(points)),
-                )
-            except UnreachableTarget:
-                continue
-            if ok:
-                return True, result, tuple(tuple(float(x) for x in p) for p in points)
+            tries.append((f"lift {top:.3f} m, {len(points)} via point(s) at z = {height + k * lift_step:.3f} m",
+                          dataclasses.replace(spec, lift=top, via=tuple(spec.via) + tuple(points)), points))
+    trials.prescreen([(description, attempt) for description, attempt, _ in tries])
+    for description, attempt, points in tries:
+        try:
+            ok, result = trials.plan(description, attempt)
+        except UnreachableTarget:
+            continue
+        if ok:
+            return True, result, tuple(tuple(float(x) for x in p) for p in points)
     return False, None, ()
 
 

@@ -137,6 +137,15 @@ def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
     assert trials.attempts[-1][2] >= cell.with_pairs("external").clearance(Q).distance.min() - 1e-12
     # the pick's own solutions: one of them keeps the clearance (the pick is proven clear), so no rejection
     assert trials.branches_screened("pick", last.poses(arm.robot)[:1])
+    # screened ahead in one batch: the same verdicts and records as one at a time
+    ahead = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    lifts = [dataclasses.replace(spec, lift=0.05 + 0.02 * k) for k in (1, 9, 2)]
+    ahead.prescreen([(f"lift {k}", s) for k, s in enumerate(lifts)])
+    alone = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    for k, s in enumerate(lifts):
+        poses = s.poses(arm.robot)[1:-1]
+        assert ahead.branches_screened(f"lift {k}", poses) == alone.branches_screened(f"lift {k}", poses)
+    assert ahead.attempts == alone.attempts and len(ahead.attempts) >= 1 and not ahead._ahead
 
 
 def test_a_cycle_stopped_after_its_move_to_place_is_the_same_cycle_when_let_through(station):
