@@ -212,7 +212,9 @@ class _Trials:
                 return False
         motion = ArmMotion(self.cell_arm.name, result.trajectory)
         ext = self.external.check_motion([motion], margin=self.margin, clearance=self.clearance, hold=self.hold_q)
-        slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) if self.own is not None else None
+        # the arm's own links only when the fixtures and other arms are kept clear (else the attempt fails anyway)
+        slf = self.own.check_motion([motion], margin=self.margin, hold=self.hold_q) \
+            if self.own is not None and ext.clear else None
         ok = ext.clear and (slf is None or slf.collision_free)
         bad = ext if not ext.clear or slf is None else slf
         d, pair, t = _describe(bad if not ok else ext)
