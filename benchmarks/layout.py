@@ -1,17 +1,25 @@
-"""Benchmark of optim/layout in a cell: candidates per second, screened vs not, serial vs 2 workers.
+"""Benchmark of optim/layout in a cell: candidates per second, before and after, serial vs 2 workers.
 
-Run: ``python benchmarks/layout.py [--serial 4] [--workers 16] [--no-workers]``. The cell is the
-planning scene ``aubo_crate_guard`` (the AUBO-i3 food station with a guard plate over the
-crate's near half): picking on the food table and placing in the crate's far half, no lift or
-via point clears the plate from most placements, so their cycle ends with a planned transfer
-(:mod:`optim.motion.transfer`). Candidates: 1 000 seeded random placements (x, y within ±80 mm
-of the scene's base, yaw within ±0.3 rad, the stand carried along); the benchmark times the
-first few and extrapolates to 1 000 (stated).
+Run: ``python benchmarks/layout.py [--serial 4] [--workers 16] [--no-workers] [--unscreened]``.
+The cell is the planning scene ``aubo_crate_guard`` (the AUBO-i3 food station with a guard
+plate over the crate's near half): picking on the food table and placing in the crate's far
+half, no lift or via point clears the plate from most placements, so their cycle ends with a
+planned transfer (:mod:`optim.motion.transfer`). Candidates: 1 000 seeded random placements
+(x, y within ±80 mm of the scene's base, yaw within ±0.3 rad, the stand carried along); the
+benchmark times the first few and extrapolates to 1 000 (stated).
 
-1. **Serial**, one process, interleaved in blocks of two candidates: ``search_layout(...,
-   screen=False)`` (every re-planning attempt timed and checked in full) and ``screen=True``
-   (attempts rejected by exact distances at their via points and timed states first);
-   their outcomes must agree (failure class and cycle time).
+1. **Serial**, one process, interleaved in blocks of two candidates: the route before
+   (``in_cell.SCREEN_BRANCHES = SCREEN_MOVES = False``: attempts screened at their via points
+   and timed whole; ``bound=False``) and now (every IK branch of an attempt's waypoints
+   screened first, its move to place screened before its move back is timed; ``bound=True``,
+   branch and bound over the candidates; the planned transfer's definitions copied once is in
+   both); ``--unscreened`` adds
+   ``screen=False`` (every attempt timed and checked in full). Their outcomes must agree
+   (failure class and cycle time). Per candidate: the search's ``"cycles"`` phase
+   (:attr:`LayoutSearch.seconds`); the one-offs (the reach screen and bounds of all 1 000,
+   the best placement planned again with its report) are timed apart and added once to the
+   extrapolation. The lower bounds of all 1 000 candidates are printed against the best cycle
+   found: what branch and bound can skip on this cell.
 2. **Two workers** (``scheduler="processes:2"``, a local Dask cluster; its start, the cell
    rebuilt on each worker and the compiled kernels loaded there are counted), screened.
 3. **Two arms** (``--two-arms``): ``plan_around`` on the scene ``aubo_two_belt`` (the right
@@ -52,43 +60,89 @@ def _cell():
     return load_cell(scene_path("aubo_crate_guard"))
 
 
-def _search(cell, cand: np.ndarray, screen: bool, scheduler=None):
+def _search(cell, cand: np.ndarray, screen: bool, scheduler=None, bound: bool = False):
     return optim.search_layout(cell, PICK, PLACE, cand, refine=0, carry=("stand",), workspace_samples=2000,
-                               chunk_size=1, screen=screen, scheduler=scheduler)
+                               chunk_size=1, screen=screen, scheduler=scheduler, bound=bound)
 
 
-def serial(cell, cand: np.ndarray) -> float:
-    """Screened vs not, interleaved in blocks of two; returns the screened candidates per second."""
-    spent = {False: 0.0, True: 0.0}
-    cpu = {False: 0.0, True: 0.0}
-    outcomes: dict[bool, list] = {False: [], True: []}
+#: The serial routes: (screen, the attempts' branch and move-to-place screens, bound).
+ROUTES = {"before": (True, False, False), "now": (True, True, True), "unscreened": (False, False, False)}
+
+
+def _route(cell, block: np.ndarray, name: str):
+    from pinarms.optim.cycle import in_cell
+
+    screen, new_screens, bound = ROUTES[name]
+    in_cell.SCREEN_BRANCHES = in_cell.SCREEN_MOVES = new_screens
+    try:
+        return _search(cell, block, screen, bound=bound)
+    finally:
+        in_cell.SCREEN_BRANCHES = in_cell.SCREEN_MOVES = True
+
+
+def _one_offs(cell, cand: np.ndarray) -> tuple[float, np.ndarray]:
+    """CPU seconds of the reach screen, bounds and margins of all candidates, and their lower bounds [s]."""
+    from pinarms.optim.layout import search as layout_search
+
+    planned = layout_search._plan_candidates
+    layout_search._plan_candidates = lambda *a, **k: (np.full(cand.shape[0], np.nan), np.full(cand.shape[0], -1),
+                                                      np.full(cand.shape[0], np.nan))
+    try:  # the search without its cycles: what it does once for all candidates
+        res = _search(cell, cand, True, bound=True)
+    finally:
+        layout_search._plan_candidates = planned
+    return res.seconds["screen"][1], res.lower_bound
+
+
+def serial(cell, cand: np.ndarray, everything: np.ndarray, routes: tuple[str, ...]) -> float:
+    """The routes interleaved in blocks of two; returns the candidates per second of the route now."""
+    wall = {r: 0.0 for r in routes}
+    cpu = {r: 0.0 for r in routes}
+    whole = {r: 0.0 for r in routes}
+    best = {r: 0.0 for r in routes}
+    outcomes: dict[str, list] = {r: [] for r in routes}
     for s in range(0, cand.shape[0], 2):
         block = cand[s : s + 2]
-        for screen in (False, True):
-            t, c = time.perf_counter(), time.process_time()
-            res = _search(cell, block, screen)
-            spent[screen] += time.perf_counter() - t
-            cpu[screen] += time.process_time() - c
-            outcomes[screen] += list(zip(res.failure, res.cycle_time))
+        for r in routes:
+            c = time.process_time()
+            res = _route(cell, block, r)
+            whole[r] += time.process_time() - c
+            wall[r] += res.seconds["cycles"][0]
+            cpu[r] += res.seconds["cycles"][1]
+            best[r] += res.seconds["best"][1]
+            outcomes[r] += list(zip(res.failure, res.cycle_time))
     n = cand.shape[0]
-    same = all(a[0] == b[0] and (a[0] or abs(a[1] - b[1]) <= 1e-9 * abs(a[1]))
-               for a, b in zip(outcomes[False], outcomes[True]))
-    kinds = sorted({f or "clear" for f, _ in outcomes[True]})
-    print(f"serial, {n} candidates ({', '.join(kinds)}); outcomes of both agree: {same}  [{_load()}]")
-    for screen in (False, True):
-        rate = n / spent[screen]
-        print(f"  screen={str(screen):5s}  {spent[screen] / n:6.2f} s/candidate ({cpu[screen] / n:5.2f} s CPU)  "
-              f"{rate:6.3f} candidates/s  1 000 placements ≈ {TOTAL / rate / 60:6.1f} min (extrapolated; on two "
-              f"idle cores from the CPU time ≈ {TOTAL * cpu[screen] / n / 2 / 60:5.1f} min)")
-    print(f"  ratio (not screened / screened): {spent[False] / spent[True]:.2f}x")
-    return n / spent[True]
+    ref = outcomes[routes[0]]
+    same = all(all(a[0] == b[0] and (a[0] or abs(a[1] - b[1]) <= 1e-9 * abs(a[1])) for a, b in zip(ref, outcomes[r]))
+               for r in routes)
+    kinds = sorted({f or "clear" for f, _ in outcomes["now"]})
+    screen_cpu, lower = _one_offs(cell, everything)
+    once = screen_cpu + best["now"] / (n / 2)
+    print(f"serial, {n} candidates ({', '.join(kinds)}); outcomes of every route agree: {same}  [{_load()}]")
+    print(f"  once per search: reach screen, bounds and margins of {everything.shape[0]} candidates {screen_cpu:.2f} s "
+          f"CPU; the best placement planned again with its report {best['now'] / (n / 2):.2f} s CPU")
+    for r in routes:
+        rate = n / wall[r]
+        total = TOTAL * cpu[r] / n + once
+        print(f"  {r:10s}  {wall[r] / n:6.2f} s/candidate ({cpu[r] / n:5.2f} s CPU; whole searches of 2: "
+              f"{whole[r] / n:5.2f} s CPU per candidate)  {rate:6.3f} candidates/s  1 000 placements ≈ "
+              f"{TOTAL / rate / 60:6.1f} min (extrapolated; on two idle cores from the CPU time ≈ {total / 2 / 60:5.1f} min)")
+    if "before" in routes:
+        print(f"  CPU per candidate, before / now: {cpu['before'] / cpu['now']:.2f}x")
+    times = np.array([t for f, t in outcomes["now"] if not f])
+    if times.size:
+        skip = int(np.sum(lower > times.min()))
+        print(f"  lower bounds of the {lower.size} candidates {lower.min():.2f} … {lower.max():.2f} s (median "
+              f"{np.median(lower):.2f}); cycles planned {times.min():.2f} … {times.max():.2f} s: {skip} of "
+              f"{lower.size} candidates' bounds exceed the best cycle found (what branch and bound skips)")
+    return n / wall["now"]
 
 
 def workers(cell, cand: np.ndarray, serial_rate: float | None) -> None:
     """Screened, on a local Dask cluster of two single-thread workers (start-up counted)."""
     t = time.perf_counter()
     try:
-        res = _search(cell, cand, True, scheduler="processes:2")
+        res = _search(cell, cand, True, scheduler="processes:2", bound=True)
     except Exception as exc:  # a cluster that cannot start is reported, not fatal
         print(f"2 workers: failed ({type(exc).__name__}: {exc})")
         return
@@ -159,6 +213,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--serial", type=int, default=4, help="candidates timed serially per mode (default 4)")
     ap.add_argument("--workers", type=int, default=16, help="candidates on 2 workers (default 16)")
     ap.add_argument("--no-workers", action="store_true", help="skip the Dask run")
+    ap.add_argument("--unscreened", action="store_true", help="also time screen=False (slow: ~16 s per candidate)")
     ap.add_argument("--two-arms", type=int, default=5, help="plan_around repetitions per mode (0: skip; default 5)")
     args = ap.parse_args(argv)
     if args.two_arms > 0:
@@ -166,7 +221,8 @@ def main(argv: list[str] | None = None) -> None:
     cand = optim.random_candidates(TOTAL, x=(-0.08, 0.08), y=(-0.08, 0.08), z=0.7, yaw=(-0.3, 0.3), seed=1)
     cell = _cell()
     _search(cell, cand[-1:], True)  # compiled kernels loaded, caches warm: not timed
-    rate = serial(cell, cand[: args.serial]) if args.serial > 0 else None
+    routes = ("before", "now") + (("unscreened",) if args.unscreened else ())
+    rate = serial(cell, cand[: args.serial], cand, routes) if args.serial > 0 else None
     if not args.no_workers and args.workers > 0:
         workers(cell, cand[args.serial : args.serial + args.workers], rate)
 

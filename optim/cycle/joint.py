@@ -32,7 +32,7 @@ Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -47,8 +47,14 @@ from pinarms.robots.ties import argmin_tied
 __all__ = ["joint_cycle"]
 
 
-def joint_cycle(request: CycleRequest) -> CycleResult:
+def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | None = None,
+                there_clear: Callable[[Any], bool] | None = None) -> CycleResult | None:
     """Plan and time the cycle of ``request`` in joint space, ignoring its approach and cell (module doc).
+
+    ``via``: the joint via points and branch labels of the move to place, when the caller has
+    them (:func:`_via_points` of the request: the same). ``there_clear``: called with the move
+    to place's trajectory once it is timed; when it says False the move back is not timed and
+    None is returned (:mod:`optim.cycle.in_cell` screens an attempt so).
 
     Raises:
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
@@ -58,8 +64,11 @@ def joint_cycle(request: CycleRequest) -> CycleResult:
     """
     robot, spec = request.robot, request.spec
     poses = spec.poses(robot)
-    q_out, branches = _via_points(robot, poses, spec.names, request.q_start)
-    moves = _timed_moves(request, q_out)
+    q_out, branches = _via_points(robot, poses, spec.names, request.q_start) if via is None else via
+    there = _timed_move(request, q_out, back=False)
+    if there_clear is not None and not there_clear(there.trajectory):
+        return None
+    moves = (there, _timed_move(request, q_out, back=True))
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
         parts = [_hold(q_out[0], spec.dwell), parts[0], _hold(q_out[-1], spec.dwell), parts[1]]
@@ -109,24 +118,21 @@ def _via_points(robot: Any, poses: np.ndarray, names: tuple[str, ...],
         raise
 
 
-def _timed_moves(request: CycleRequest, q_out: np.ndarray) -> tuple[TimingResult, TimingResult]:
-    """The move to place (carrying the payload) and the move back (empty), each timed optimally."""
+def _timed_move(request: CycleRequest, q_out: np.ndarray, back: bool) -> TimingResult:
+    """The move to place (carrying the payload) or, ``back``, the move back (empty), timed optimally."""
     t = request.timing
     v, a, j = request.vmax, request.amax, request.jmax
     options = {"velocities": "heuristic"} if t.kind == "multi-quintic" else None
+    q = q_out[::-1] if back else q_out
     loaded = request.torque
     if loaded is None:
-        return (
-            minimize_time(q_out, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options),
-            minimize_time(q_out[::-1], t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options),
-        )
-    empty = torque_constraint(request.robot, loaded.limit)  # the same limits, nothing in the gripper
-    return (
-        minimize_time(q_out, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
-                      robot=loaded.robot, torque_limits=loaded.limit),
-        minimize_time(q_out[::-1], t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
-                      robot=empty.robot, torque_limits=empty.limit),
-    )
+        return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options)
+    if back:
+        empty = torque_constraint(request.robot, loaded.limit)  # the same limits, nothing in the gripper
+        return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
+                             robot=empty.robot, torque_limits=empty.limit)
+    return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
+                         robot=loaded.robot, torque_limits=loaded.limit)
 
 
 def _branch_labels(robot: Any, poses: np.ndarray, q: np.ndarray) -> np.ndarray:

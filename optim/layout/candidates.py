@@ -16,8 +16,9 @@ from pinarms.robots.errors import InvalidInput
 
 __all__ = ["FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame"]
 
-#: Why a candidate fails, in the order they are checked.
-FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing")
+#: Why a candidate fails, in the order they are checked (``"outranked"``: not planned, its cycle
+#: cannot beat the best ones; ``search_layout(..., bound=True)``).
+FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing", "outranked")
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
 _PPM_RTOL = 1e-9

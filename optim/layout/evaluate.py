@@ -39,6 +39,22 @@ class _Settings:
     screen: bool = True  # CellSettings.screen of every cycle in the cell
 
 
+class _Clock:
+    """Wall and CPU seconds (this process) of a search's phases: ``laps[name] = (wall, cpu)``."""
+
+    def __init__(self) -> None:
+        import time
+
+        self._time = time
+        self.laps: dict[str, tuple[float, float]] = {}
+        self._at = (time.perf_counter(), time.process_time())
+
+    def lap(self, name: str) -> None:
+        now = (self._time.perf_counter(), self._time.process_time())
+        self.laps[name] = (now[0] - self._at[0], now[1] - self._at[1])
+        self._at = now
+
+
 @dataclass(frozen=True)
 class _CellRecipe:
     """How a worker rebuilds the cell (a Cell holds coal objects that do not pickle)."""

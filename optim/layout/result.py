@@ -68,6 +68,11 @@ class LayoutSearch:
         best_picks_per_minute: its picks/min (0 if no candidate succeeded).
         best_cycle: its first pair's cycle (:class:`optim.CycleResult`, in the base frame), or None.
         seed: seed of the search (optimiser starts; random candidates are drawn by the caller).
+        lower_bound: ``(M,)`` each candidate's proven lower bound of its cycle time [s] with
+            ``bound=True`` (:mod:`optim.layout.bound`; 0 where none), else None.
+        seconds: the search's phases (``"screen"``, ``"cycles"``, ``"refine"``, ``"best"``: the
+            best placement's cycle planned again with its report) as ``(wall, CPU)`` seconds; the
+            CPU is this process's (a cluster's workers are not counted).
     """
 
     robot: str
@@ -87,6 +92,8 @@ class LayoutSearch:
     best_picks_per_minute: float
     best_cycle: CycleResult | None = field(repr=False)
     seed: int = 0
+    lower_bound: np.ndarray | None = field(default=None, repr=False)
+    seconds: dict = field(default_factory=dict, repr=False)
 
     @property
     def ok(self) -> np.ndarray:

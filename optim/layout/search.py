@@ -13,7 +13,9 @@ candidate base placements ``(x, y, z, yaw)`` of the arm's base frame in the line
 2. plans the time-optimal cycle (:func:`optim.plan_cycle`, ``method="exact"``) of every
    (pick, place) pair: IK branch, moves, dwells; ``picks_per_minute = 60 / mean cycle time``
    over the pairs (a line cycling through them); a failing plan is classified the same way
-   (``"timing"`` when no timing meets the limits);
+   (``"timing"`` when no timing meets the limits); with ``bound=True`` in increasing order of a
+   proven lower bound of the cycle time, skipping those that cannot reach the top of the
+   ranking (:mod:`.bound`, branch and bound: they fail as ``"outranked"``);
 3. reports the position manipulability at the picks and places (the cycle's own joint
    values, smallest over the points) and the boundary margin (distance of the points to
    the edge of the arm's sampled workspace, smallest over the points; one voxel map serves
@@ -45,7 +47,8 @@ from pinarms.robots.errors import InvalidInput
 
 from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
-from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _evaluate, _evaluate_chunk, _RefineTask, _refine, _Settings)
+from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
+                       _Settings)
 from .result import LayoutSearch, Refinement
 
 __all__ = [
@@ -73,14 +76,16 @@ def _points(value: Any, what: str) -> np.ndarray:
     return P
 
 
-def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str]]:
-    """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate."""
+def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str], np.ndarray | None]:
+    """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate,
+    and the tcp poses ``(M, K, 4, 4)`` of the picks, places and lift points in each base frame (None
+    without a closed form)."""
     from pinarms.robots.reach.layout import default_orientation
 
     M = cand.shape[0]
     failure, reason = [""] * M, [""] * M
     if not getattr(robot, "has_analytic_ik", False):
-        return failure, reason  # numerical IK: each cycle plan finds and names the problem
+        return failure, reason, None  # numerical IK: each cycle plan finds and names the problem
     names = [f"pick {i + 1}" for i in range(len(st.picks))] + [f"place {j + 1}" for j in range(len(st.places))]
     pts = np.vstack([st.picks, st.places])
     up = pts + [0.0, 0.0, st.lift]
@@ -111,7 +116,7 @@ def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], lis
             else:
                 failure[m] = "unreachable"
                 reason[m] = f"{names[k]} {at}: beyond the arm's reach from this placement (no IK solution even without joint limits)"
-    return failure, reason
+    return failure, reason, T
 
 
 def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
@@ -208,25 +213,49 @@ def _boundary_failures(failure: list[str], reason: list[str], point_margin: np.n
 
 
 def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, failure: list[str], reason: list[str],
-                     chunk_size: int, scheduler: Any, progress: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     chunk_size: int, scheduler: Any, progress: Any,
+                     lower: np.ndarray | None = None, keep: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Plan the cycles of every candidate still in the running, in tasks of ``chunk_size``; record the failures.
 
-    Returns (M,) mean cycle time [s], IK branch and manipulability (NaN, -1 where it failed).
+    ``lower``: each candidate's lower bound [s]: branch and bound (:mod:`.bound`), the ``keep``
+    best kept. Returns (M,) mean cycle time [s], IK branch and manipulability (NaN, -1 where it failed).
     """
     from pinarms.execution import map_chunks
 
+    from .bound import SLACK, outranked, threshold, wave_size
+
     M = cand.shape[0]
     todo = [m for m in range(M) if not failure[m]]
-    tasks = [_ChunkTask(robot, token, cand[todo[s : s + chunk_size]], st) for s in range(0, len(todo), chunk_size)]
-    chunks = map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=progress)
-    outcomes = [o for chunk in chunks for o in chunk]
     cycle_time = np.full(M, np.nan)
     branch = np.full(M, -1)
     manip = np.full(M, np.nan)
-    for m, o in zip(todo, outcomes):
-        failure[m], reason[m] = o.failure, o.reason
-        if not o.failure:
-            cycle_time[m], branch[m], manip[m] = o.cycle_time, o.branch, o.manipulability
+    n_tasks = -(-len(todo) // chunk_size)
+    size = len(todo) if lower is None else wave_size(scheduler, chunk_size) or len(todo)
+    if lower is not None:
+        todo.sort(key=lambda m: (lower[m], m))
+    times: list[float] = []
+    done, i = 0, 0
+    while i < len(todo):
+        limit = threshold(times, keep)
+        wave = todo[i : i + max(size, 1)]
+        if lower is not None:  # sorted: the first that cannot win ends the wave, and the search
+            wave = wave[: next((k for k, m in enumerate(wave) if lower[m] > limit * (1.0 + SLACK)), len(wave))]
+        if not wave:
+            for m in todo[i:]:
+                failure[m], reason[m] = "outranked", outranked(float(lower[m]), limit, keep)
+            if progress is not None:
+                progress(n_tasks, n_tasks)
+            break
+        i += len(wave)
+        tasks = [_ChunkTask(robot, token, cand[wave[s : s + chunk_size]], st) for s in range(0, len(wave), chunk_size)]
+        step = None if progress is None else (lambda d, _t, o=done: progress(o + d, n_tasks))
+        chunks = map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=step)
+        done += len(tasks)
+        for m, o in zip(wave, (o for chunk in chunks for o in chunk)):
+            failure[m], reason[m] = o.failure, o.reason
+            if not o.failure:
+                cycle_time[m], branch[m], manip[m] = o.cycle_time, o.branch, o.manipulability
+                times.append(float(o.cycle_time))
     return cycle_time, branch, manip
 
 
@@ -270,6 +299,15 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
     return refinement, best_placement, best_ppm
 
 
+def _lower_bounds(robot: Any, st: _Settings, targets: np.ndarray | None, M: int) -> np.ndarray:
+    """Each candidate's lower bound of its cycle time [s] (:mod:`.bound`; 0 without a closed form)."""
+    from .bound import cycle_lower_bounds
+
+    if targets is None:
+        return np.zeros(M)
+    return cycle_lower_bounds(robot, targets[:, : len(st.picks) + len(st.places)], len(st.picks), st.dwell, st.vmax)
+
+
 def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int) -> Any:
     """The progress callback of one phase of the search (tasks counted from ``offset`` of ``total``), or None."""
     if progress is None:
@@ -283,7 +321,7 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
                   seed: int = 0, chunk_size: int = 4, scheduler: Any = None,
                   progress: Callable[[int, int], None] | None = None, arm: str | None = None,
                   clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0,
-                  screen: bool = True) -> LayoutSearch:
+                  screen: bool = True, bound: bool = False) -> LayoutSearch:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
@@ -316,6 +354,11 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
             for a six-axis arm).
         scheduler, progress: see :func:`pinarms.execution.map_chunks` (progress counts the
             candidate tasks, then the refinement tasks).
+        bound: branch and bound (:mod:`optim.layout.bound`): the candidates are planned in
+            increasing order of a proven lower bound of their cycle time, and those that cannot
+            reach the first ``max(1, refine)`` places of the ranking are not planned (they fail
+            as ``"outranked"``): the best placement, the refinement starts and every planned
+            candidate's outcome are those of the exhaustive search (``False``, default).
 
     Raises:
         InvalidInput: malformed points, candidates, orientation or counts.
@@ -333,27 +376,34 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
     st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe,
                    bool(screen))
 
-    failure, reason = _screen(robot, cand, st)
+    clock = _Clock()
+    failure, reason, targets = _screen(robot, cand, st)
+    lower = _lower_bounds(robot, st, targets, cand.shape[0]) if bound else None
     vmap, point_margin = _margins(robot, st, cand, workspace_samples)
     margin = point_margin.min(axis=1)
     if min_margin > 0:
         _boundary_failures(failure, reason, point_margin, st, min_margin)
-    n_tasks = -(-sum(1 for f in failure if not f) // chunk_size)
+    plan_chunk = 1 if bound and scheduler in (None, "serial") else chunk_size  # serial: a bound checked per candidate
+    n_tasks = -(-sum(1 for f in failure if not f) // plan_chunk)
     total = n_tasks + int(refine)
+    clock.lap("screen")
 
-    cycle_time, branch, manip = _plan_candidates(robot, token, cand, st, failure, reason, chunk_size, scheduler,
-                                                 _phase(progress, 0, total))
+    cycle_time, branch, manip = _plan_candidates(robot, token, cand, st, failure, reason, plan_chunk, scheduler,
+                                                 _phase(progress, 0, total), lower, max(1, int(refine)))
+    clock.lap("cycles")
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
     order = _ranking(ppm, margin)
     refinement, best_placement, best_ppm = _refine_best(robot, token, cand, st, ppm, ok, order, int(refine),
                                                         refine_evaluations, vmap, min_margin, scheduler,
                                                         _phase(progress, n_tasks, total))
+    clock.lap("refine")
     best_cycle = None
     if best_placement is not None:
         best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
+    clock.lap("best")
     return LayoutSearch(robot=str(robot.name), picks=picks_w, places=places_w, candidates=cand, failure=tuple(failure),
                         reason=tuple(reason), cycle_time=cycle_time, picks_per_minute=ppm, branch=branch,
                         manipulability=manip, margin=margin, order=order, refinement=refinement,
                         best_placement=best_placement, best_picks_per_minute=best_ppm, best_cycle=best_cycle,
-                        seed=int(seed))
+                        seed=int(seed), lower_bound=lower, seconds=clock.laps)

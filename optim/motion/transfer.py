@@ -88,10 +88,19 @@ def _lines(base: Any, k: int) -> tuple[list, list]:
             [polyline_path(np.stack([place, up_place])), polyline_path(np.stack([up_pick, pick]))])
 
 
-def _joined(pieces: list, atol: float = 1e-7) -> Trajectory:
-    """The trajectories one after the other, as :meth:`Trajectory.concatenated` in turn gives them, with
-    each piece's definition copied once (a timed path's definition is long: copying the growing
-    concatenation at every step took a third of a planned transfer)."""
+def _parts_of(piece: Trajectory) -> list:
+    """The definitions of ``piece``'s parts (one copy of its definition; a concatenation gives its parts)."""
+    d = piece.definition
+    return d["parts"] if d.get("kind") == "concatenated" else [d]
+
+
+def _joined(pieces: list, parts: list | None = None, atol: float = 1e-7) -> Trajectory:
+    """The trajectories one after the other, as :meth:`Trajectory.concatenated` in turn gives them.
+
+    ``parts``: each piece's part definitions (:func:`_parts_of`), when the caller has them: a
+    timed path's definition is long, and a trajectory's definition is copied at each reading
+    (copying the growing concatenation at every step took a third of a planned transfer; the
+    cycle and its two moves share the copies, a trajectory never changes its definition)."""
     from pinarms.planning.errors import TrajectoryError
     from pinarms.planning.poly_pieces import pad_degree
 
@@ -105,11 +114,9 @@ def _joined(pieces: list, atol: float = 1e-7) -> Trajectory:
         k = nxt.knot_times
         breaks = np.concatenate([breaks, k[1:] - k[0] + breaks[-1]])
         coefs.append(pad_degree(nxt.coefficients, width))
-    parts: list = []
-    for p in pieces:
-        d = p.definition
-        parts.extend(d["parts"] if d.get("kind") == "concatenated" else [d])
-    return Trajectory(breaks, np.concatenate(coefs, axis=0), {"kind": "concatenated", "parts": parts})
+    parts = [_parts_of(p) for p in pieces] if parts is None else parts
+    return Trajectory(breaks, np.concatenate(coefs, axis=0),
+                      {"kind": "concatenated", "parts": [d for piece in parts for d in piece]})
 
 
 def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
@@ -145,17 +152,20 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
                                                                        if base.torque_limit is not None else False)
     constraints, _ = _limits(cell, (arm.name,), base.vmax, amax, torque)
 
-    def move(paths: list) -> PlannedMove:
+    def move(paths: list) -> tuple[PlannedMove, list]:
         parts = tuple(time_path(p, constraints) for p in paths)
-        traj = _joined([p.trajectory for p in parts])
-        return PlannedMove(parts, traj, geo["planner"], geo["states"], arm.robot, base.torque_limit)
+        defs = [_parts_of(p.trajectory) for p in parts]
+        traj = _joined([p.trajectory for p in parts], defs)
+        return PlannedMove(parts, traj, geo["planner"], geo["states"], arm.robot, base.torque_limit), \
+            [d for part in defs for d in part]
 
-    m1 = move([there[0], transfer, there[1]])
-    m2 = move([back[0], reverse, back[1]])
-    pieces = [m1.trajectory, m2.trajectory]
+    (m1, d1), (m2, d2) = move([there[0], transfer, there[1]]), move([back[0], reverse, back[1]])
+    pieces, defs = [m1.trajectory, m2.trajectory], [d1, d2]
     if spec.dwell > 0.0:
-        pieces = [_hold(q[0], spec.dwell), pieces[0], _hold(q[k - 1], spec.dwell), pieces[1]]
-    trajectory = _joined(pieces)
+        holds = [_hold(q[0], spec.dwell), _hold(q[k - 1], spec.dwell)]
+        pieces = [holds[0], pieces[0], holds[1], pieces[1]]
+        defs = [_parts_of(holds[0]), d1, _parts_of(holds[1]), d2]
+    trajectory = _joined(pieces, defs)
     ends = _vertical_segments(spec.poses(robot))
     return dataclasses.replace(base, moves=(m1, m2), trajectory=trajectory, peaks=trajectory.peaks(),
                                line_deviation=_line_deviation(robot, (m1, m2), ends))

@@ -104,3 +104,63 @@ def test_layout_search_screened_and_not_agree_on_every_candidate(station):
     ok = np.array([not f for f in fast.failure])
     assert ok.sum() >= 3
     assert np.array_equal(fast.cycle_time[ok], full.cycle_time[ok])
+
+
+def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
+    """Every IK solution of a waypoint closer than the clearance: so is the via point on the cycle's branch."""
+    from pinarms.optim.cycle import in_cell
+
+    cell = load_cell(scene_path("aubo_crate_guard"))
+    arm = cell.arm("aubo")
+    spec = optim.PickPlace(arm.to_base(np.array([0.40, 0.10, 0.78])), arm.to_base(np.array([0.0, -0.46, 0.78])),
+                           lift=0.05, dwell=0.2)
+    settings = CellSettings(cell, clearance=0.02, plan_transfer=False)
+    reports = {}
+    for branches in (False, True):
+        monkeypatch.setattr(in_cell, "SCREEN_BRANCHES", branches)
+        with pytest.raises(CollisionError, match="guard_plate blocks") as err:
+            optim.plan_cycle(CycleRequest(arm.robot, spec, cell=settings))
+        reports[branches] = str(err.value)
+    # the same attempts, each failing: the error counts them and names the last
+    count = [int(reports[b].split(" after ")[1].split()[0]) for b in (False, True)]
+    assert count[0] == count[1] >= 10
+    assert reports[False].split(", the last with ")[1] == reports[True].split(", the last with ")[1]
+    # the best solution of a rejected waypoint is at least as far as the one the via points take
+    trials = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    last = dataclasses.replace(spec, lift=0.05 + 0.02 * 9)
+    assert not trials.branches_screened("lift", last.poses(arm.robot)[1:-1])
+    from pinarms.optim.cycle.joint import _via_points
+
+    q = _via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
+    Q = np.repeat(cell.neutral[None], len(q), axis=0)
+    Q[:, arm.q_slice] = q
+    assert trials.attempts[-1][2] >= cell.with_pairs("external").clearance(Q).distance.min() - 1e-12
+    # the pick's own solutions: one of them keeps the clearance (the pick is proven clear), so no rejection
+    assert trials.branches_screened("pick", last.poses(arm.robot)[:1])
+    # screened ahead in one batch: the same verdicts and records as one at a time
+    ahead = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    lifts = [dataclasses.replace(spec, lift=0.05 + 0.02 * k) for k in (1, 9, 2)]
+    ahead.prescreen([(f"lift {k}", s) for k, s in enumerate(lifts)])
+    alone = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
+    for k, s in enumerate(lifts):
+        poses = s.poses(arm.robot)[1:-1]
+        assert ahead.branches_screened(f"lift {k}", poses) == alone.branches_screened(f"lift {k}", poses)
+    assert ahead.attempts == alone.attempts and len(ahead.attempts) >= 1 and not ahead._ahead
+
+
+def test_a_cycle_stopped_after_its_move_to_place_is_the_same_cycle_when_let_through(station):
+    """joint_cycle's hook: the move to place first (the screen may stop it there), then the move back."""
+    from pinarms.optim.cycle.joint import _via_points, joint_cycle
+
+    arm = station.arm("aubo")
+    spec = optim.PickPlace(arm.to_base(PICK), arm.to_base(CRATE), lift=0.05, dwell=0.2)
+    request = CycleRequest(arm.robot, spec)
+    seen = []
+    assert joint_cycle(request, there_clear=lambda move: seen.append(move) or False) is None
+    whole = joint_cycle(request)
+    via = _via_points(arm.robot, spec.poses(arm.robot), spec.names, None)
+    let = joint_cycle(request, via=via, there_clear=lambda move: True)
+    assert let.cycle_time == whole.cycle_time and np.array_equal(let.q_via, whole.q_via)
+    # the move it was shown is the cycle's move to place
+    move = whole.moves[0].trajectory
+    assert seen[0].end_time - seen[0].start_time == move.end_time - move.start_time
