@@ -99,13 +99,30 @@ def edge_proven(xa, xb, levers, lam, min_budget, max_states, hold, cols, fk, cov
     eb = state_scaled(xb, inv, hold, cols, fk, cov, grp, c, work, q)  # the new end first: more often not clear
     if eb < 0.0:
         return False
-    ea = state_scaled(xa, inv, hold, cols, fk, cov, grp, c, work, q)
-    if ea < 0.0:
-        return False
-    if interval_proven(ea, eb, 1.0):
-        return True
-    head, tail, n = 0, 1, queue.shape[0]
-    queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 1.0, ea, eb
+    tail = 1
+    if interval_proven(c, eb, 1.0):  # Ẽ_a ≤ c: the whole edge may be proven by its ends
+        ea = state_scaled(xa, inv, hold, cols, fk, cov, grp, c, work, q)
+        if ea < 0.0:
+            return False
+        if interval_proven(ea, eb, 1.0):
+            return True
+        queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 1.0, ea, eb
+    else:  # no Ẽ_a proves [0, 1]: its middle is needed anyway, and fails an edge through something before its start
+        if T < min_budget or max_states <= 0:
+            return False
+        max_states -= 1
+        for j in range(xa.shape[0]):
+            xm[j] = xa[j] + 0.5 * (xb[j] - xa[j])  # as the loop below places a middle
+        em = state_scaled(xm, inv, hold, cols, fk, cov, grp, min(c, 0.5), work, q)
+        if em < 0.0:
+            return False
+        ea = state_scaled(xa, inv, hold, cols, fk, cov, grp, c, work, q)
+        if ea < 0.0:
+            return False
+        queue[0, 0], queue[0, 1], queue[0, 2], queue[0, 3] = 0.0, 0.5, ea, em
+        queue[1, 0], queue[1, 1], queue[1, 2], queue[1, 3] = 0.5, 1.0, em, eb
+        tail = 2
+    head, n = 0, queue.shape[0]
     while head != tail:
         fa, fb, a, b = queue[head, 0], queue[head, 1], queue[head, 2], queue[head, 3]
         head = (head + 1) % n
