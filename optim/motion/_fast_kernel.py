@@ -194,8 +194,8 @@ def rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, it
                 max_states, hold, cols, fk, cov, grp, cap, work):
     """``iterations`` rounds of RRT-Connect between tree 0 (the start) and tree 1 (the goals).
 
-    ``status (5,) int64``: [found, node of tree 0, node of tree 1, tree that grows next, states
-    checked so far]; the
+    ``status (5,) int64``: [found, node of tree 0, node of tree 1, tree that grows next when the two
+    are of one size, states checked so far]; the
     trees ``nodes (2, cap, n)``, ``parent``, ``counts`` are
     continued from call to call. Returns 1 when connected, 0 otherwise."""
     n = lower.shape[0]
@@ -207,7 +207,9 @@ def rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, it
     queue = np.empty((QUEUE, 4))
     inv = np.empty(lam.shape[0])
     for _ in range(iterations):
-        a = status[3]
+        # the smaller tree grows (ties: in turn): a tree stuck in a narrow passage (an end deep in a crate)
+        # gets the samples it needs instead of half of them going to the other tree's aimless growth
+        a = 0 if counts[0] < counts[1] else 1 if counts[1] < counts[0] else status[3]
         b = 1 - a
         for j in range(n):
             xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
