@@ -13,8 +13,9 @@ capped at ``cap / T`` (the pairs left out are more than ``cap`` above their thre
 An interval not proven is halved (splitting at the middle of the stretch its ends do not
 prove instead checked as many states on the Panda scenes); intervals are taken first in,
 first out (the middle of the edge first, then its quarters: an edge through an obstacle
-fails after a few states); the new state's ``Ẽ`` is capped at the larger half's length. The
-random numbers are a SplitMix64 stream held in an array: a search is the same for the same
+fails after a few states; the middle even before the edge's start when the ends cannot prove the
+whole edge: the same states and verdict, one state fewer when the middle fails); the new state's
+``Ẽ`` is capped at the larger half's length. The random numbers are a SplitMix64 stream held in an array: a search is the same for the same
 seed, whatever the chunks it is run in. Cached on disk like the cover's kernels.
 """
 
@@ -276,13 +277,14 @@ def _point_at(P, s, m, length, out):
 
 
 @jit
-def shortcut(P, m, rng, tries, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
+def shortcut(P, m, rng, tries, min_gain, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work):
     """Random shortcutting of the proven polyline ``P[:m]`` in place; returns its new vertex count.
 
     Each try joins two random points of the path (at random arc lengths) by a straight edge
-    when the cover proves it and it is shorter than the stretch it replaces; then every
-    vertex is dropped whose neighbours join directly. ``P`` has room for ``m + 2 * tries``
-    rows."""
+    when the cover proves it and it is shorter than the stretch it replaces by at least
+    ``min_gain`` times the path's length (a try that would gain less is not proven: its proof
+    costs as much as a useful one); then every vertex is dropped whose neighbours join
+    directly. ``P`` has room for ``m + 2 * tries`` rows."""
     n = P.shape[1]
     q = np.empty(hold.shape[0])
     xm = np.empty(n)
@@ -301,6 +303,11 @@ def shortcut(P, m, rng, tries, levers, lam, min_budget, max_states, hold, cols, 
         ka = _point_at(P, s, m, u, pa)
         kb = _point_at(P, s, m, v, pb)
         if kb - ka < 1:  # on one segment: nothing to cut
+            continue
+        chord = 0.0
+        for j in range(n):
+            chord += (pb[j] - pa[j]) ** 2
+        if (v - u) - math.sqrt(chord) < min_gain * s[m - 1]:
             continue
         if not edge_proven(pa, pb, levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work, q, xm,
                            queue, inv):
