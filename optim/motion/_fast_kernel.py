@@ -38,6 +38,14 @@ drop_stale_caches([Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__f
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
 QUEUE = 4096
 ADVANCED, REACHED, TRAPPED = 0, 1, 2
+#: When the smaller tree grows, this share of its samples is drawn near one of its own nodes (a random one):
+#: within ``LOCAL_SPREAD`` times the search's range of it in every joint (inside the limits). A tree deep in
+#: a narrow passage (an end in a crate under a guard) finds the way out sooner than from uniform samples,
+#: most of whose long steps leave the passage through its walls. Measured over 100 searches per scene
+#: (25 queries, 4 seeds each; states checked): ``aubo_crate_guard`` median 2856 -> 2441, mean 3866 -> 3407;
+#: ``panda_shelf`` 482 -> 437, 558 -> 530.
+LOCAL_SHARE = 0.5
+LOCAL_SPREAD = 0.5
 
 
 @jit
@@ -212,8 +220,14 @@ def rrt_connect(nodes, parent, counts, status, rng, lower, upper, step_range, it
         # gets the samples it needs instead of half of them going to the other tree's aimless growth
         a = 0 if counts[0] < counts[1] else 1 if counts[1] < counts[0] else status[3]
         b = 1 - a
-        for j in range(n):
-            xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
+        if counts[a] < counts[b] and _uniform(rng) < LOCAL_SHARE:  # near a node of the smaller tree
+            i = min(int(_uniform(rng) * counts[a]), counts[a] - 1)
+            for j in range(n):
+                x = nodes[a, i, j] + LOCAL_SPREAD * step_range * (2.0 * _uniform(rng) - 1.0)
+                xr[j] = min(max(x, lower[j]), upper[j])
+        else:
+            for j in range(n):
+                xr[j] = lower[j] + _uniform(rng) * (upper[j] - lower[j])
         s = _extend(a, nodes, parent, counts, xr, step_range, levers, lam, min_budget, max_states, hold, cols, fk,
                     cov, grp, cap, work, q, xm, xn, queue, inv)
         status[3] = b
