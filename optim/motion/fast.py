@@ -15,8 +15,9 @@ levers, held arms), all in compiled code (:mod:`._fast_kernel`):
   ``E`` is capped at the clearance above which the checker left pairs out (they are proven
   that far apart).
 
-:func:`fast_search` runs RRT-Connect on it (the smaller tree grows next, ties in turn: an end deep
-in a crate gets the samples it needs; seeded SplitMix64 stream, chunks of iterations between which
+:func:`fast_search` runs RRT-Connect on it (the smaller tree grows next, ties in turn, half of its
+samples near one of its own nodes: an end deep in a crate gets the samples it needs,
+:data:`._fast_kernel.LOCAL_SHARE`; seeded SplitMix64 stream, chunks of iterations between which
 the clock is read: the time limit holds to a chunk, a few ms) and
 :func:`fast_shortcut` shortcuts on it. A path so found is proven; :func:`optim.plan_motion`
 still proves it again with the exact checker before reporting it.
