@@ -273,3 +273,29 @@ def test_compiled_search_out_of_the_crate_is_proven_and_seeded_whatever_the_chun
             third = fast_search(checker, q.start, q.goal[None], time_limit=2.0, seed=k)
             monkeypatch.undo()
             assert np.array_equal(again.path, r.path) and np.array_equal(third.path, r.path)
+
+
+def test_compiled_shortcut_skips_tries_that_gain_too_little(table):
+    """A shortcut try is proven only when it would shorten the path by ``min_gain`` of its length: with a gain
+    no try can reach, only the vertex-dropping pass runs (the same path as with no tries); with none, the
+    tries shorten the path."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+    from pinarms.optim.motion.fast import _rng
+
+    _, checker, queries, goals, _ = table
+    fc = fast_check(checker)
+    q = queries[0]
+    P = fast_search(checker, q.start, goals[0], time_limit=2.0, seed=0).path
+    detour = np.insert(P, 1, P[0] + 0.5 * (P[1] - P[0]) + 0.05, axis=0)  # a kink: room to shorten
+    assert fc.path_proven(detour)
+
+    def run(tries, gain):
+        buf = np.zeros((detour.shape[0] + tries + 2, detour.shape[1]))
+        buf[: detour.shape[0]] = detour
+        return buf[: kernel.shortcut(buf, detour.shape[0], _rng(1), tries, gain, *fc.args)].copy()
+
+    def length(X):
+        return float(np.linalg.norm(np.diff(X, axis=0), axis=1).sum())
+
+    assert np.array_equal(run(40, 1.0), run(0, 0.0))
+    assert length(run(40, 0.0)) < length(run(0, 0.0)) <= length(detour)
