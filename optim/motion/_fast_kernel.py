@@ -15,8 +15,9 @@ prove instead checked as many states on the Panda scenes); intervals are taken f
 first out (the middle of the edge first, then its quarters: an edge through an obstacle
 fails after a few states; the middle even before the edge's start when the ends cannot prove the
 whole edge: the same states and verdict, one state fewer when the middle fails); the new state's
-``Ẽ`` is capped at the larger half's length. The random numbers are a SplitMix64 stream held in an array: a search is the same for the same
-seed, whatever the chunks it is run in. Cached on disk like the cover's kernels.
+``Ẽ`` is capped at the larger half's length. The random numbers are a SplitMix64 stream held in
+an array: a search is the same for the same seed, whatever the chunks it is run in. Cached on
+disk like the cover's kernels.
 """
 
 from __future__ import annotations
@@ -41,9 +42,10 @@ ADVANCED, REACHED, TRAPPED = 0, 1, 2
 #: When the smaller tree grows, this share of its samples is drawn near one of its own nodes (a random one):
 #: within ``LOCAL_SPREAD`` times the search's range of it in every joint (inside the limits). A tree deep in
 #: a narrow passage (an end in a crate under a guard) finds the way out sooner than from uniform samples,
-#: most of whose long steps leave the passage through its walls. Measured over 100 searches per scene
-#: (25 queries, 4 seeds each; states checked): ``aubo_crate_guard`` median 2856 -> 2441, mean 3866 -> 3407;
-#: ``panda_shelf`` 482 -> 437, 558 -> 530.
+#: most of whose long steps leave the passage through its walls. Measured (states checked per search,
+#: median of the benchmark's 25 queries; in brackets of 100 searches, 4 seeds each): ``aubo_crate_guard``
+#: 2266 -> 1612 (2856 -> 2441), ``panda_shelf`` 465 -> 385 (482 -> 437), ``aubo_two_belt`` 116 -> 103
+#: (115 -> 106), ``panda_table_box`` 67 -> 88 (70 -> 76: searches of two or three rounds).
 LOCAL_SHARE = 0.5
 LOCAL_SPREAD = 0.5
 
