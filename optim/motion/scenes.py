@@ -21,6 +21,17 @@ scene                  arm         what is in the way
 ``aubo_two_belt``      AUBO-i3 x2  the other arm, holding over the shared belt
 =====================  ==========  ===========================================================
 
+``panda_crate_guard`` has no clear query at a 10 mm margin, and its regions cannot give it one:
+every Panda IK solution in the crate's far half touches something (20 of 20 targets solved, none
+clear) — the hand (two 50 mm spheres 150 mm apart, 100 mm wide across) and link 7's 70 mm spheres
+against the crate's far wall (the far half is 120 mm wide inside: the hand fits only centred,
+turned along x, with no slack beyond the two margins), and with the tool higher links 5–7 against
+the guard plate 0.50 m above the table (none clear on a grid of 192 tcp positions and turns in and
+above the far half, tcp 0.84–1.08 m, 6 targets each; a plate at 0.60 or 0.70 m: 0–1 of 8
+targets; a plate at 0.80 m and the crate 0.36 m across, centred at y = −0.60: 1–5 of 8). A
+solvable Panda crate needs another cell, not other regions; :func:`scene_queries` says so
+(``UnreachableTarget``) and the benchmark reports it.
+
 The Panda and UR5 are example-robot-data's, placed by the macros of
 :mod:`~pinarms.optim.motion.arm_macros` (the Panda's collision model is spheres and
 cylinders, the UR5's meshes).

@@ -157,3 +157,145 @@ def test_compiled_state_check_places_only_the_planned_arm_and_agrees_bit_for_bit
                                  cap=fc.cap, floor=0.0)
     assert np.array_equal(fast, whole)
     assert (fast >= 0.0).any() and (fast < 0.0).any()  # both verdicts occur
+
+
+def test_compiled_search_grows_the_smaller_tree(table):
+    """RRT-Connect's next extension goes to the tree with fewer nodes (in turn when both are of one size): with
+    one start node and three goal nodes, the start's tree grows even when the goals' tree was next in turn."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+    from pinarms.optim.motion.fast import RANGE_SHARE, _rng
+
+    _, checker, queries, goals, _ = table
+    fc = fast_check(checker)
+    lower, upper = np.asarray(checker.lower, dtype=float), np.asarray(checker.upper, dtype=float)
+    step = RANGE_SHARE * float(np.linalg.norm(upper - lower))
+    grown = 0
+    for k, q in enumerate(queries):
+        n = q.start.size
+        nodes, parent = np.zeros((2, 64, n)), np.full((2, 64), -1, dtype=np.int64)
+        nodes[0, 0] = q.start
+        nodes[1, :3] = goals[k][0]
+        counts = np.array([1, 3], dtype=np.int64)
+        status = np.array([0, 0, 0, 1, 0], dtype=np.int64)  # the goals' tree next in turn
+        kernel.rrt_connect(nodes, parent, counts, status, _rng(k), lower, upper, step, 1, *fc.args)
+        assert status[3] == 1, "the larger tree (the goals') was extended"
+        grown += int(counts[0] > 1)
+        assert counts[0] > 1 or counts[1] == 3  # the start's tree grew, or its extension was trapped
+    assert grown >= 1
+
+
+def _edge_proven_fifo(fc, xa, xb):
+    """The edge proof's rule written plainly (ends, then intervals first in first out, each halved at its
+    middle): its verdict and the states it checks."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+    from pinarms.robots.cell.ladder import interval_proven
+
+    levers, lam, min_budget, max_states, hold, cols, fk, cov, grp, cap, work = fc.args
+    q = np.zeros(hold.size + 1)
+    T = float(np.sum(np.abs(xb - xa) * levers))
+    d = np.abs(xb - xa)
+    w = np.array([sum(d[j] * lam[g, j] for j in range(d.size) if d[j] > 0.0) for g in range(lam.shape[0])])
+    inv = 1.0 / np.maximum(np.minimum(w, T), 1e-12)
+    c = min(cap / T, 1.0)
+
+    def e(x, cap_):
+        return kernel.state_scaled(x, inv, hold, cols, fk, cov, grp, cap_, work, q)
+
+    eb = e(xb, c)
+    ea = e(xa, c) if eb >= 0.0 else -1.0
+    if eb < 0.0 or ea < 0.0:
+        return False, int(q[-1])
+    queue = [(0.0, 1.0, ea, eb)]
+    while queue:
+        fa, fb, a, b = queue.pop(0)
+        if interval_proven(a, b, fb - fa):
+            continue
+        if T * (fb - fa) < min_budget or max_states <= 0:
+            return False, int(q[-1])
+        max_states -= 1
+        fm = 0.5 * (fa + fb)
+        em = e(xa + fm * (xb - xa), min(c, max(fm - fa, fb - fm)))
+        if em < 0.0:
+            return False, int(q[-1])
+        queue += [(fa, fm, a, em), (fm, fb, em, b)]
+    return True, int(q[-1])
+
+
+def test_compiled_edge_proof_checks_the_middle_first_with_the_same_verdicts():
+    """The compiled edge proof checks an edge's middle before its start when the ends cannot prove the whole
+    edge: the verdict is the plain rule's on every edge, with no more states (fewer on some edges that fail)."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+
+    cell = load_scene("panda_shelf")
+    _, hold = scene_queries("panda_shelf", 1, seed=0, margin=MARGIN)
+    checker = MotionChecker(cell, ["panda"], margin=MARGIN, hold=hold)
+    fc = fast_check(checker)
+    X = cell.random_q(400, seed=4)[:, checker.cols]
+    A = np.array([x for x in X if fc.excess(x) >= 0.0][:60])
+    B = A[::-1] + 0.5 * (A - A[::-1]) * np.random.default_rng(2).uniform(0.0, 1.0, (len(A), 1))
+    q, xm, queue, inv = np.zeros(fc.hold.size + 1), np.empty(checker.n), np.empty((kernel.QUEUE, 4)), np.empty(
+        fc.lam.shape[0])
+    fewer = 0
+    verdicts = []
+    for a, b in zip(A, B):
+        before = q[-1]
+        got = bool(kernel.edge_proven(a, b, *fc.args, q, xm, queue, inv))
+        states = int(q[-1] - before)
+        want, plain = _edge_proven_fifo(fc, a, b)
+        assert got == want and states <= plain
+        fewer += states < plain
+        verdicts.append(got)
+    assert any(verdicts) and not all(verdicts) and fewer >= 1
+
+
+@pytest.fixture(scope="module")
+def crate():
+    cell = load_scene("aubo_crate_guard")
+    queries, hold = scene_queries("aubo_crate_guard", 6, seed=0, margin=MARGIN)
+    return cell, MotionChecker(cell, ["aubo"], margin=MARGIN, hold=hold), queries
+
+
+def test_compiled_search_out_of_the_crate_is_proven_and_seeded_whatever_the_chunks(crate, monkeypatch):
+    """aubo_crate_guard (an end in the crate under the guard plate): every query solved well within the limit,
+    the path accepted edge by edge by the exact checker, the same path when the search runs in other chunks."""
+    from pinarms.optim.motion import fast
+
+    _, checker, queries = crate
+    for k, q in enumerate(queries):
+        r = fast_search(checker, q.start, q.goal[None], time_limit=2.0, seed=k)
+        assert r.path is not None and r.seconds < 1.0, r.status
+        assert np.array_equal(r.path[0], q.start) and np.array_equal(r.path[-1], q.goal)
+        assert all(checker.edge_valid(r.path[i], r.path[i + 1]).ok for i in range(len(r.path) - 1))
+        if k < 2:
+            monkeypatch.setattr(fast, "FIRST_CHUNK", 1)
+            again = fast_search(checker, q.start, q.goal[None], time_limit=2.0, seed=k)
+            monkeypatch.setattr(fast, "FIRST_CHUNK", 64)
+            third = fast_search(checker, q.start, q.goal[None], time_limit=2.0, seed=k)
+            monkeypatch.undo()
+            assert np.array_equal(again.path, r.path) and np.array_equal(third.path, r.path)
+
+
+def test_compiled_shortcut_skips_tries_that_gain_too_little(table):
+    """A shortcut try is proven only when it would shorten the path by ``min_gain`` of its length: with a gain
+    no try can reach, only the vertex-dropping pass runs (the same path as with no tries); with none, the
+    tries shorten the path."""
+    from pinarms.optim.motion import _fast_kernel as kernel
+    from pinarms.optim.motion.fast import _rng
+
+    _, checker, queries, goals, _ = table
+    fc = fast_check(checker)
+    q = queries[0]
+    P = fast_search(checker, q.start, goals[0], time_limit=2.0, seed=0).path
+    detour = np.insert(P, 1, P[0] + 0.5 * (P[1] - P[0]) + 0.05, axis=0)  # a kink: room to shorten
+    assert fc.path_proven(detour)
+
+    def run(tries, gain):
+        buf = np.zeros((detour.shape[0] + tries + 2, detour.shape[1]))
+        buf[: detour.shape[0]] = detour
+        return buf[: kernel.shortcut(buf, detour.shape[0], _rng(1), tries, gain, *fc.args)].copy()
+
+    def length(X):
+        return float(np.linalg.norm(np.diff(X, axis=0), axis=1).sum())
+
+    assert np.array_equal(run(40, 1.0), run(0, 0.0))
+    assert length(run(40, 0.0)) < length(run(0, 0.0)) <= length(detour)
