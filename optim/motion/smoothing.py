@@ -228,11 +228,13 @@ def polyline_path(waypoints: np.ndarray, robot: Any = None) -> JointPath:
     return JointPath(s, coefs, stops=s[1:-1], robot=robot)
 
 
-def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None) -> tuple[JointPath, str, int]:
+def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
+                compiled: bool = True) -> tuple[JointPath, str, int]:
     """A proven joint path through the polyline ``waypoints``: ``(path, method, rounds)``.
 
     ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven, after
-    ``rounds`` vertex insertions) or ``"polyline with stops"`` (the fallback).
+    ``rounds`` vertex insertions) or ``"polyline with stops"`` (the fallback). ``compiled``: each
+    spline proven on the compiled cover first (:func:`prove_path`); ``False``: the exact proof alone.
     """
     W = np.asarray(waypoints, dtype=float)
     step = np.linalg.norm(np.diff(W, axis=0), axis=1)
@@ -244,7 +246,7 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None) -> tuple
         path = joint_spline(W, robot=robot)
         focus = None if changed is None else \
             (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
-        verdict, piece = prove_path(checker, path, focus=focus)
+        verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
         if verdict.ok:
             return path, "cubic spline", rounds
         # pull the spline towards the proven polyline around the failing piece
