@@ -101,41 +101,48 @@ def _push(queue, tail, sa, sb, ea, eb, block):
     return (tail + 1) % queue.shape[0]
 
 
+#: The fields of a proof's state array ``st (6,) int64`` (kept between calls of :func:`spline_open`).
+HEAD, TAIL, SIZE, COUNT, STATES, STARTED = range(6)
+
+
 @jit
 def spline_open(breaks, coefs, nodes, T, s0, block, inv, lower, upper, min_budget, max_states, hold, cols, fk, cov,
-                grp, cap, work, opened, used):
+                grp, cap, work, opened, queue, st, stop):
     """Prove the path between the samples ``s0`` (ascending, its ends included) on the cover (module docstring).
 
     ``inv (B, G)``: the groups' inverse weights of each block of first intervals, ``block (n0,)``
     the block of each (:func:`.spline_proof._group_weights`): on a block, the distance of the
     pairs of group ``g`` changes at most ``1 / inv[b, g]`` times as fast as ``T``, so the scaled
     excess ``min_k inv · ê_k`` is 1-Lipschitz in ``T`` there. ``opened (M, 2)``: receives the
-    ranges ``[s_a, s_b]`` left to the exact proof. Returns how many, or −1 when they did not fit
-    (then nothing is proven here). ``min_budget``: intervals of less travel still unproven are
-    left open; ``max_states``: most states evaluated (the intervals left then are open);
-    ``used (1,)``: receives the states evaluated."""
+    ranges ``[s_a, s_b]`` left to the exact proof. ``min_budget``: intervals of less travel still
+    unproven are left open; ``max_states``: most states evaluated (the intervals left then are open).
+
+    ``queue (QUEUE, 5)`` and ``st`` (:data:`HEAD` …: all 0 at first) hold the proof between calls: a
+    call returns once ``stop`` ranges are open in all (or the queue is empty: ``st[SIZE] == 0``) and
+    the next call goes on from there. Returns the ranges open so far, or −1 when they did not fit
+    (then nothing is proven here)."""
     n = cols.shape[0]
     q = np.empty(hold.shape[0])
     x = np.empty(n)
-    queue = np.empty((QUEUE, 5))
-    count, head, tail, size = 0, 0, 0, 0
-    states, last = 0, -1
-    eb = 0.0
-    for i in range(s0.shape[0] - 1):
-        b = block[i]
-        if b != last:  # the start of a block: its first end under the block's weights
-            eb = _excess(s0[i], breaks, coefs, lower, upper, inv[b], hold, cols, fk, cov, grp, cap, work, q, x)
+    head, tail, size, count, states = st[HEAD], st[TAIL], st[SIZE], st[COUNT], st[STATES]
+    if st[STARTED] == 0:
+        st[STARTED] = 1
+        last = -1
+        eb = 0.0
+        for i in range(s0.shape[0] - 1):
+            b = block[i]
+            if b != last:  # the start of a block: its first end under the block's weights
+                eb = _excess(s0[i], breaks, coefs, lower, upper, inv[b], hold, cols, fk, cov, grp, cap, work, q, x)
+                states += 1
+                last = b
+            ea = eb
+            eb = _excess(s0[i + 1], breaks, coefs, lower, upper, inv[b], hold, cols, fk, cov, grp, cap, work, q, x)
             states += 1
-            last = b
-        ea = eb
-        eb = _excess(s0[i + 1], breaks, coefs, lower, upper, inv[b], hold, cols, fk, cov, grp, cap, work, q, x)
-        states += 1
-        if size == QUEUE:
-            return -1
-        tail = _push(queue, tail, s0[i], s0[i + 1], ea, eb, b)
-        size += 1
-    used[0] = states
-    while size > 0:
+            if size == QUEUE:
+                return -1
+            tail = _push(queue, tail, s0[i], s0[i + 1], ea, eb, b)
+            size += 1
+    while size > 0 and count < stop:
         sa, sb, ea, eb, b = queue[head, 0], queue[head, 1], queue[head, 2], queue[head, 3], int(queue[head, 4])
         head = (head + 1) % QUEUE
         size -= 1
@@ -150,7 +157,6 @@ def spline_open(breaks, coefs, nodes, T, s0, block, inv, lower, upper, min_budge
             # Ẽ at the midpoint is needed up to the larger half's travel, no more (a smaller cap prunes more pairs)
             em = _excess(sm, breaks, coefs, lower, upper, inv[b], hold, cols, fk, cov, grp, min(cap, half), work, q, x)
             states += 1
-            used[0] = states
         if em < 0.0:
             if count == opened.shape[0]:
                 return -1
@@ -160,4 +166,56 @@ def spline_open(breaks, coefs, nodes, T, s0, block, inv, lower, upper, min_budge
         tail = _push(queue, tail, sa, sm, ea, em, b)
         tail = _push(queue, tail, sm, sb, em, eb, b)
         size += 2
+    st[HEAD], st[TAIL], st[SIZE], st[COUNT], st[STATES] = head, tail, size, count, states
     return count
+
+
+@jit
+def _slope_peak(c1, c2, c3, a, b):
+    """``max |c1 + 2 c2 t + 3 c3 t²|`` over ``[a, b]``: at an end or at the vertex of the quadratic."""
+    best = max(abs(c1 + a * (2.0 * c2 + 3.0 * c3 * a)), abs(c1 + b * (2.0 * c2 + 3.0 * c3 * b)))
+    if c3 != 0.0:
+        v = -c2 / (3.0 * c3)
+        if a < v < b:
+            best = max(best, abs(c1 + v * (2.0 * c2 + 3.0 * c3 * v)))
+    return best
+
+
+@jit
+def travel_parts(breaks, coefs, levers, step, fine, safety):
+    """:func:`.smoothing._travel_parts` of a path of degree ≤ 3: ``(nodes (M+1,), T (M+1,), V (M, n))``.
+
+    Piece ``k`` is cut in ``max(1, ⌈fine · P_k h_k / step⌉)`` equal parts (``P_k``: the piece's peak of
+    ``Σ_j ℓ_j |q_j'|``); on each, ``V`` holds every joint's exact peak of ``|q_j'|`` (the quadratic's
+    ends and vertex) and ``T`` grows by ``safety · (V · ℓ) ·`` the part's length."""
+    K, W, n = coefs.shape
+    m = np.empty(K, dtype=np.int64)
+    total = 0
+    for k in range(K):
+        h = breaks[k + 1] - breaks[k]
+        peak = 0.0
+        for j in range(n):
+            c2 = coefs[k, 2, j] if W > 2 else 0.0
+            c3 = coefs[k, 3, j] if W > 3 else 0.0
+            peak += _slope_peak(coefs[k, 1, j], c2, c3, 0.0, h) * levers[j]
+        m[k] = max(1, int(np.ceil(fine * peak * h / step * (1.0 + 1e-12))))
+        total += m[k]
+    nodes = np.empty(total + 1)
+    T = np.empty(total + 1)
+    V = np.empty((total, n))
+    nodes[0], T[0] = breaks[0], 0.0
+    p = 0
+    for k in range(K):
+        h = breaks[k + 1] - breaks[k]
+        for i in range(m[k]):
+            t0, t1 = h * i / m[k], h * (i + 1) / m[k]
+            density = 0.0
+            for j in range(n):
+                c2 = coefs[k, 2, j] if W > 2 else 0.0
+                c3 = coefs[k, 3, j] if W > 3 else 0.0
+                V[p, j] = _slope_peak(coefs[k, 1, j], c2, c3, t0, t1)
+                density += V[p, j] * levers[j]
+            nodes[p + 1] = breaks[k + 1] if i == m[k] - 1 else breaks[k] + t1  # a piece's last part ends on its break
+            T[p + 1] = T[p] + density * (nodes[p + 1] - nodes[p]) * safety
+            p += 1
+    return nodes, T, V

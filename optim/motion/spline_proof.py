@@ -22,7 +22,7 @@ import numpy as np
 from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
-__all__ = ["open_ranges", "MAX_STATES", "FIRST_STEP"]
+__all__ = ["CoverProof", "cover_proof", "open_ranges", "merged", "MAX_STATES", "FIRST_STEP"]
 
 #: Most states one compiled spline proof evaluates (about 5 µs each); the intervals left then go to
 #: the exact proof.
@@ -37,8 +37,6 @@ CHUNK = 16
 _HUGE = 1e300
 #: Most ranges the compiled proof hands to the exact one (more: the whole path goes to it).
 MAX_OPEN = 4096
-#: The states the last compiled proof evaluated (read by the benchmarks of this module).
-_USED = np.zeros(1, dtype=np.int64)
 
 
 def _outside_limits(checker: Any, path: Any) -> np.ndarray:
@@ -95,35 +93,78 @@ def _group_weights(levers: np.ndarray, lam: np.ndarray, nodes: np.ndarray, V: np
     return block, 1.0 / np.maximum(kappa, 1e-12)
 
 
-def open_ranges(checker: Any, path: Any, nodes: np.ndarray, T: np.ndarray, V: np.ndarray) -> np.ndarray | None:
-    """The ranges ``[s_a, s_b]`` (M, 2) of ``path`` the compiled cover proof leaves to the exact proof
-    (sorted, disjoint; empty: the whole path is proven), or ``None`` when the checker has no compiled
-    check (no cover, moving arms) or the ranges did not fit: then the exact proof takes the whole path.
+class CoverProof:
+    """The compiled cover proof of one path, run in steps (:meth:`advance`): the ranges it leaves open
+    are handed out as they are found, so that the exact proof can refuse a path at its first one.
 
-    ``nodes``, ``T``, ``V``: the path's cumulative travel bound and the joint speed bounds of its parts
-    (:func:`.smoothing._travel_parts`)."""
-    from pinarms.optim.motion import _spline_kernel as kernel
+    ``limits``: the ranges of the pieces whose exact joint extrema leave the joint limits (left to
+    the exact proof from the start)."""
+
+    def __init__(self, fc: Any, checker: Any, path: Any, nodes: np.ndarray, T: np.ndarray, V: np.ndarray) -> None:
+        from pinarms.optim.motion import _spline_kernel as kernel
+
+        self._kernel = kernel
+        breaks = np.ascontiguousarray(path.breaks, dtype=float)
+        n0 = max(1, int(np.ceil(T[-1] / FIRST_STEP)))
+        s0 = np.interp(T[-1] * np.arange(n0 + 1) / n0, T, nodes)
+        s0[0], s0[-1] = breaks[0], breaks[-1]
+        s0 = np.maximum.accumulate(s0)
+        block, inv = _group_weights(fc.levers, fc.lam, nodes, V, s0)
+        self._args = (breaks, np.ascontiguousarray(path.coefficients, dtype=float),
+                      np.ascontiguousarray(nodes, dtype=float), np.ascontiguousarray(T, dtype=float), s0, block, inv,
+                      np.ascontiguousarray(checker.lower, dtype=float), np.ascontiguousarray(checker.upper, dtype=float),
+                      float(checker.step / 2.0 ** MAX_SPLITS), MAX_STATES, fc.hold, fc.cols, fc.fk, fc.cov, fc.grp,
+                      fc.cap, fc.work)
+        self._opened = np.empty((MAX_OPEN, 2))
+        self._queue = np.empty((kernel.QUEUE, 5))
+        self._st = np.zeros(6, dtype=np.int64)
+        self._given = 0
+        outside = np.flatnonzero(_outside_limits(checker, path))
+        self.limits = np.column_stack([breaks[outside], breaks[outside + 1]])
+
+    @property
+    def done(self) -> bool:
+        """Every interval decided (proven or handed out)."""
+        return bool(self._st[self._kernel.STARTED] == 1 and self._st[self._kernel.SIZE] == 0)
+
+    @property
+    def states(self) -> int:
+        """The states evaluated so far."""
+        return int(self._st[self._kernel.STATES])
+
+    def advance(self, stop: int = MAX_OPEN) -> np.ndarray | None:
+        """Go on until ``stop`` ranges in all are open or the proof is done; the ranges found since the last
+        call ``(k, 2)``, or ``None`` when they did not fit (nothing is proven by this proof then)."""
+        count = self._kernel.spline_open(*self._args, self._opened, self._queue, self._st, int(stop))
+        if count < 0:
+            return None
+        new = self._opened[self._given:count].copy()
+        self._given = count
+        return new
+
+
+def cover_proof(checker: Any, path: Any, nodes: np.ndarray, T: np.ndarray, V: np.ndarray) -> CoverProof | None:
+    """The :class:`CoverProof` of ``path``, or ``None`` when the checker has no compiled check (no cover,
+    moving arms) or the path is not one of its planned joints. ``nodes``, ``T``, ``V``: the path's
+    cumulative travel bound and the joint speed bounds of its parts (:func:`.smoothing._travel_parts`)."""
     from pinarms.optim.motion.fast import fast_check
 
     fc = fast_check(checker)
     if fc is None or path.coefficients.shape[2] != checker.n:
         return None
-    breaks = np.ascontiguousarray(path.breaks, dtype=float)
-    coefs = np.ascontiguousarray(path.coefficients, dtype=float)
-    n0 = max(1, int(np.ceil(T[-1] / FIRST_STEP)))
-    s0 = np.interp(T[-1] * np.arange(n0 + 1) / n0, T, nodes)
-    s0[0], s0[-1] = breaks[0], breaks[-1]
-    s0 = np.maximum.accumulate(s0)
-    block, inv = _group_weights(fc.levers, fc.lam, nodes, V, s0)
-    opened = np.empty((MAX_OPEN, 2))
-    count = kernel.spline_open(breaks, coefs, np.ascontiguousarray(nodes, dtype=float),
-                               np.ascontiguousarray(T, dtype=float), s0, block, inv,
-                               np.ascontiguousarray(checker.lower, dtype=float),
-                               np.ascontiguousarray(checker.upper, dtype=float),
-                               float(checker.step / 2.0 ** MAX_SPLITS), MAX_STATES, fc.hold, fc.cols, fc.fk, fc.cov,
-                               fc.grp, fc.cap, fc.work, opened, _USED)
-    if count < 0:
-        return None
-    outside = np.flatnonzero(_outside_limits(checker, path))
-    pieces = np.column_stack([breaks[outside], breaks[outside + 1]])
-    return _merged(np.concatenate([opened[:count], pieces]))
+    return CoverProof(fc, checker, path, nodes, T, V)
+
+
+def merged(ranges: Any) -> np.ndarray:
+    """``ranges`` (a list of (k, 2) arrays) sorted and the overlapping or touching ones joined: (M, 2)."""
+    parts = [np.asarray(r, dtype=float).reshape(-1, 2) for r in ranges]
+    return _merged(np.concatenate(parts) if parts else np.empty((0, 2)))
+
+
+def open_ranges(checker: Any, path: Any, nodes: np.ndarray, T: np.ndarray, V: np.ndarray) -> np.ndarray | None:
+    """The ranges ``[s_a, s_b]`` (M, 2) of ``path`` the compiled cover proof leaves to the exact proof, the
+    joint limits' included (sorted, disjoint; empty: the whole path is proven), or ``None`` when there is
+    no compiled check or the ranges did not fit: then the exact proof takes the whole path."""
+    proof = cover_proof(checker, path, nodes, T, V)
+    got = None if proof is None else proof.advance()
+    return None if got is None else merged([got, proof.limits])
