@@ -219,3 +219,42 @@ def travel_parts(breaks, coefs, levers, step, fine, safety):
             T[p + 1] = T[p] + density * (nodes[p + 1] - nodes[p]) * safety
             p += 1
     return nodes, T, V
+
+
+@jit
+def _cubic_at(c0, c1, c2, c3, t):
+    return c0 + t * (c1 + t * (c2 + t * c3))
+
+
+@jit
+def outside_limits(breaks, coefs, lower, upper, out):
+    """``out[k]``: whether piece ``k`` of a path of degree ≤ 3 leaves ``[lower, upper]`` in some joint (its
+    extrema: the piece's ends and the real roots of the quadratic ``q'`` inside it)."""
+    K, W, n = coefs.shape
+    for k in range(K):
+        h = breaks[k + 1] - breaks[k]
+        out[k] = False
+        for j in range(n):
+            c0 = coefs[k, 0, j]
+            c1 = coefs[k, 1, j] if W > 1 else 0.0
+            c2 = coefs[k, 2, j] if W > 2 else 0.0
+            c3 = coefs[k, 3, j] if W > 3 else 0.0
+            lo = min(c0, _cubic_at(c0, c1, c2, c3, h))
+            hi = max(c0, _cubic_at(c0, c1, c2, c3, h))
+            a, b, c = 3.0 * c3, 2.0 * c2, c1  # q' = a t² + b t + c
+            if a != 0.0:
+                disc = b * b - 4.0 * a * c
+                if disc >= 0.0:
+                    r = np.sqrt(disc)
+                    for t in ((-b - r) / (2.0 * a), (-b + r) / (2.0 * a)):
+                        if 0.0 < t < h:
+                            v = _cubic_at(c0, c1, c2, c3, t)
+                            lo, hi = min(lo, v), max(hi, v)
+            elif b != 0.0:
+                t = -c / b
+                if 0.0 < t < h:
+                    v = _cubic_at(c0, c1, c2, c3, t)
+                    lo, hi = min(lo, v), max(hi, v)
+            if lo < lower[j] or hi > upper[j]:
+                out[k] = True
+                break

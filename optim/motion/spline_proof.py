@@ -41,6 +41,20 @@ MAX_OPEN = 4096
 
 def _outside_limits(checker: Any, path: Any) -> np.ndarray:
     """The pieces of ``path`` whose exact joint extrema leave the checker's joint limits (bool per piece)."""
+    if path.coefficients.shape[1] <= 4:  # compiled: the ends and the roots of the quadratic q'
+        from pinarms.optim.motion._spline_kernel import outside_limits
+
+        out = np.empty(path.coefficients.shape[0], dtype=np.bool_)
+        outside_limits(np.ascontiguousarray(path.breaks, dtype=float),
+                       np.ascontiguousarray(path.coefficients, dtype=float),
+                       np.ascontiguousarray(checker.lower, dtype=float), np.ascontiguousarray(checker.upper, dtype=float),
+                       out)
+        return out
+    return _outside_limits_arrays(checker, path)
+
+
+def _outside_limits_arrays(checker: Any, path: Any) -> np.ndarray:
+    """:func:`_outside_limits` from :func:`planning.extrema.piece_extrema` (any degree)."""
     h = np.diff(np.asarray(path.breaks, dtype=float))
     values, _ = piece_extrema(normalised_pieces(path.coefficients, h), h, (0,))
     lo = np.nanmin(values[0], axis=-1)

@@ -114,6 +114,9 @@ def test_a_piece_leaving_the_joint_limits_is_left_to_the_exact_proof(checker, si
     W[2, 1] += 0.2
     path = joint_spline(W)
     outside = _outside_limits(checker, path)
+    from pinarms.optim.motion.spline_proof import _outside_limits_arrays
+
+    assert np.array_equal(outside, _outside_limits_arrays(checker, path))  # compiled and piece_extrema agree
     assert outside.any() and float(path(np.linspace(0.0, path.length, 2001))[:, 0].max()) > top[0]
     ranges = _ranges(checker, path)
     k = int(np.flatnonzero(outside)[0])
@@ -172,10 +175,12 @@ def test_benchmark_paths_smooth_the_same_with_or_without_the_compiled_route(name
         assert method == "cubic spline" and prove_path(checker, probed, compiled=False)[0].ok
 
 
-def test_the_compiled_travel_bound_is_the_arrays_one(checker, sides):
+def test_the_compiled_travel_bound_and_limit_check_are_the_arrays_ones(checker, sides):
     from pinarms.optim.motion.smoothing import _travel_parts_arrays
+    from pinarms.optim.motion.spline_proof import _outside_limits_arrays
 
     for path in _splines(checker, sides, 4):
+        assert np.array_equal(_outside_limits(checker, path), _outside_limits_arrays(checker, path))
         got, want = _travel_parts(checker, path), _travel_parts_arrays(checker, path)
         for g, w in zip(got, want):
             assert g.shape == w.shape
