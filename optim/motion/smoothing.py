@@ -7,7 +7,10 @@ scaling passes without stopping. A spline is not the polyline that was proven: i
 **proven again** (:func:`prove_path`) with the same continuous rule as the edges, its travel
 bound taken from the exact peaks of ``|q'(s)|`` on parts of every piece (:func:`_travel_bound`:
 a cumulative bound ``T(s)``; the samples are placed at equal steps of T, and every interval
-the proof halves gets the bound of its own half from T). Where the proof fails the
+the proof halves gets the bound of its own half from T). The proof runs first compiled on the
+sphere cover (:mod:`.spline_proof`: the same rule on the same ``T``, the cover's lower bound of
+the excess at each state); the exact proof (the ladder, coal where the cover is inconclusive)
+takes only the sample intervals around the ranges the cover leaves open. Where the proof fails the
 polyline edges around the failing piece get vertices at their quarter points, which pulls
 the spline towards the proven polyline, and the spline is proven again
 (:data:`REFINE_ROUNDS` rounds at most; the pieces around the new vertices are proven first,
