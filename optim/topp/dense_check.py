@@ -22,7 +22,7 @@ from pinarms.planning import Trajectory
 from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
-__all__ = ["CHECK_FRACTIONS", "Peaked", "rows_at", "row_names", "dilation_needed", "ratios", "law_rows", "law_check"]
+__all__ = ["CHECK_FRACTIONS", "Peaked", "rows_at", "rows_at_sets", "row_names", "dilation_needed", "ratios", "law_rows", "law_check"]
 
 #: Where each grid interval is re-checked, as fractions of its length.
 CHECK_FRACTIONS = np.array([0.25, 0.5, 0.75, 1.0])
@@ -103,8 +103,15 @@ def _exact_peaks(normalised: np.ndarray, h: np.ndarray, r: int) -> np.ndarray:
 
 def rows_at(path: Any, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:
     """The rows of all ``constraints`` at path positions ``s``, pieces taken on ``side`` of a break."""
-    samples = PathSamples.of(path, s, side)
-    return PathRows.concatenate([c.rows(samples) for c in constraints])
+    return rows_at_sets(path, constraints, [(s, side)])[0]
+
+
+def rows_at_sets(path: Any, constraints: Sequence[PathConstraint], sets: Sequence[tuple[np.ndarray, str]]) -> list[PathRows]:
+    """:func:`rows_at` at several ``(s, side)`` at once: the joint torque rows of all in one batched call
+    (:mod:`.torque_rows`; the same rows, bit for bit)."""
+    from pinarms.optim.topp.torque_rows import rows_of_samplings
+
+    return rows_of_samplings(constraints, [PathSamples.of(path, s, side) for s, side in sets])
 
 
 def row_names(path: Any, constraints: Sequence[PathConstraint]) -> list[str]:
@@ -143,13 +150,14 @@ def law_rows(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray,
     one that ends there (what the law piece lies on; they differ at a stop).
     """
     h = np.diff(tb)
-    parts = []
+    sets, u, x = [], [], []
     for frac, side in ((np.array([0.0]), "right"), (np.concatenate([CHECK_FRACTIONS[:-1], [1.0 - 1e-9]]), "left")):
         t = (tb[:-1, None] + h[:, None] * frac).reshape(-1)
         s, sd, sdd = law_eval(tb, C, t)
-        parts.append((rows_at(path, constraints, np.clip(s, 0.0, path.length), side), sdd, sd * sd))
-    return PathRows.concatenate_points([p[0] for p in parts]), np.concatenate([p[1] for p in parts]), \
-        np.concatenate([p[2] for p in parts])
+        sets.append((np.clip(s, 0.0, path.length), side))
+        u.append(sdd)
+        x.append(sd * sd)
+    return PathRows.concatenate_points(rows_at_sets(path, constraints, sets)), np.concatenate(u), np.concatenate(x)
 
 
 def law_check(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray, C: np.ndarray) -> float:

@@ -14,7 +14,7 @@ import numpy as np
 
 from pinarms.optim.caps import MAX_PATH_GRID_POINTS
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
-from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, ratios, rows_at
+from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, ratios, rows_at_sets
 from pinarms.optim.topp.profile import topp_profile
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
@@ -79,14 +79,20 @@ def _merged(old: PathRows, keep: np.ndarray, fresh: PathRows) -> PathRows:
     return PathRows(*parts, old.labels)
 
 
-def _check_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, rows: PathRows,
-                inner: PathRows) -> PathRows:
+def _on_break(path: Any, grid: np.ndarray) -> np.ndarray:
+    """Which interval ends ``grid[1:]`` are inner breaks of the path (the same in every round: breaks stay grid points)."""
+    return np.isin(grid[1:], np.asarray(path.breaks)[1:-1])
+
+
+def _check_rows(path: Any, grid: np.ndarray, rows: PathRows, inner: PathRows,
+                break_rows: PathRows | None) -> PathRows:
     """The rows at every check position, interval after interval: the ``inner`` ones, then the interval's
-    end from the left — the grid point's own rows (the same piece) except on a path break."""
+    end from the left — the grid point's own rows (the same piece) except on a path break, where
+    ``break_rows`` (the rows at the section's inner breaks from the left, in order) are read."""
     ends = _taken(rows, np.arange(1, grid.size))
-    on_break = np.isin(grid[1:], np.asarray(path.breaks)[1:-1])
+    on_break = _on_break(path, grid)
     if on_break.any():
-        ends = _merged(_taken(ends, ~on_break), ~on_break, rows_at(path, constraints, grid[1:][on_break], "left"))
+        ends = _merged(_taken(ends, ~on_break), ~on_break, break_rows)
     k = _INNER.size
     parts = []
     for name in ("a", "b", "lo", "hi"):
@@ -103,12 +109,12 @@ def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.nda
     refined = _grown(np.sort(np.concatenate([grid, new])), "rtol")
     old_point = np.zeros(refined.size, dtype=bool)
     old_point[np.searchsorted(refined, grid)] = True
-    rows = _merged(rows, old_point, rows_at(path, constraints, refined[~old_point], "right"))
     # an interval whose two ends are old points was not split: its check rows are unchanged
     kept = np.repeat(old_point[:-1] & old_point[1:], _INNER.size)
     fresh = _inner_points(refined)[~kept]
     was = np.flatnonzero(np.repeat(np.diff(np.flatnonzero(old_point)) == 1, _INNER.size))
-    return refined, rows, _merged(_taken(inner, was), kept, rows_at(path, constraints, fresh, "left"))
+    at_points, at_inner = rows_at_sets(path, constraints, [(refined[~old_point], "right"), (fresh, "left")])
+    return refined, _merged(rows, old_point, at_points), _merged(_taken(inner, was), kept, at_inner)
 
 
 def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
@@ -122,10 +128,12 @@ def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.n
     the split intervals alone (:func:`_refined_rows`; the same rows, bit for bit, as evaluating all),
     and the check at an interval's end reads the grid point's own rows (:func:`_check_rows`)."""
     rounds = 0
-    rows = rows_at(path, constraints, grid, "right")
-    inner = rows_at(path, constraints, _inner_points(grid), "left")
+    breaks = grid[1:][_on_break(path, grid)]
+    sets = [(grid, "right"), (_inner_points(grid), "left")] + ([(breaks, "left")] if breaks.size else [])
+    rows, inner, *rest = rows_at_sets(path, constraints, sets)
+    break_rows = rest[0] if rest else None
     while True:
-        crow = _check_rows(path, constraints, grid, rows, inner)
+        crow = _check_rows(path, grid, rows, inner, break_rows)
         prof = topp_profile(rows.a, rows.b, rows.lo, rows.hi, grid, x0, x1)
         h = np.diff(grid)
         uc = np.repeat(prof.u, CHECK_FRACTIONS.size)

@@ -52,7 +52,8 @@ from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_ROUNDS, MAX_TIME_SCALED_
                                MIN_PATH_RTOL, count_setting)
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.optim.ga.problem import check_limit
-from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, Peaked, law_check, law_rows, ratios, row_names, rows_at
+from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, Peaked, law_check, law_rows, ratios, row_names, \
+    rows_at_sets
 from pinarms.optim.topp.grid import path_grid, refined_section
 from pinarms.optim.topp.time_law import (acceleration_jumps, assemble, bang_bang, compose_law, law_eval, scaled_law,
                                          smoothed)
@@ -314,7 +315,7 @@ def _shaped_section(path: Any, cons: tuple, sig: np.ndarray, tau: np.ndarray, a:
     d2 = np.polynomial.polynomial.polyval(tau, sig[2:] * np.arange(2, sig.size) * np.arange(1, sig.size - 1))
     L = b - a
     s = a + L * np.polynomial.polynomial.polyval(tau, sig)
-    rows = PathRows.concatenate_points([rows_at(path, cons, s[:1], "right"), rows_at(path, cons, s[1:], "left")])
+    rows = PathRows.concatenate_points(rows_at_sets(path, cons, [(s[:1], "right"), (s[1:], "left")]))
     val = rows.values(L * d2, (L * d1) ** 2)  # a u + b x at T = 1; at T it is val / T²
     with np.errstate(divide="ignore", invalid="ignore"):
         up = np.where(val > 0.0, np.where(rows.hi > 0.0, val / rows.hi, np.where(np.isinf(rows.hi), 0.0, np.inf)), 0.0)
