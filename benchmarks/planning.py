@@ -84,7 +84,7 @@ def _record(rec: dict, plan) -> None:
     rec["ok"] += 1
     rec["search"].append(sec["search"])
     rec["total"].append(sec["total"])
-    rec["plan"].append(sec["total"] - sec["check"])  # search, shortcut, smoothing with its exact proof, timing
+    rec["plan"].append(sec["total"] - sec["check"])  # search, shortcut, smoothing with its proof, timing
     for k in ("shortcut", "smooth", "time", "check"):
         rec["stages"].setdefault(k, []).append(sec[k])
     rec["compiled"] += int(plan.compiled)
@@ -342,7 +342,7 @@ def main() -> None:
             print(pinarms_row(name + " OMPL", old), flush=True)
             before.append((name, old))
         rows.append((name, rec))
-    print("\nmedian of each step [ms] ('plan' = search + shortcut + smooth (its exact proof) + time; 'check' = the "
+    print("\nmedian of each step [ms] ('plan' = search + shortcut + smooth (its proof: the cover compiled, coal where it is open) + time; 'check' = the "
           "cell's own re-check and the clearance profile):")
     for name, rec in rows:
         print("  " + stages_row(name, rec))
