@@ -79,3 +79,15 @@ def test_workspace_stream_option(tmp_path):
     assert data["voxels"]["reachable"] == int(api.voxels.reachable.sum())
     cloud = viz.load_session(out).workspaces["workspace_voxels"]
     assert cloud.points.shape == (int(api.voxels.reachable.sum()), 3)
+
+
+def test_layout_search_bound_keeps_the_best_placement():
+    args = ["layout-search", "scara_mushroom", "--pick", "-200", "0", "140", "--place", "200", "0", "140", "--mm",
+            "--lift", "20", "--dwell", "0.05", "--x", "0:0:1", "--y", "50:400:50", "--yaw", "-90:-90:1", "--deg",
+            "--refine", "0", "--json"]
+    full = CliRunner().invoke(cli, args)
+    bounded = CliRunner().invoke(cli, [*args, "--bound"])
+    assert full.exit_code == 0 and bounded.exit_code == 0, (full.output, bounded.output)
+    a, b = json.loads(full.stdout), json.loads(bounded.stdout)
+    assert b["failures"].get("outranked", 0) >= 1 and "outranked" not in a["failures"]
+    assert b["best"] == a["best"]
