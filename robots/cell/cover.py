@@ -30,22 +30,25 @@ like :mod:`robots.ik._kernel`). Distances in m, the world frame.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from ._cover_kernel import excess_kernel, screen_kernel
 from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
+from .pair_tables import PairTables, no_tables, pair_tables
 
 __all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
-           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE"]
+           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE", "TABLES"]
 
 #: Most spheres per box geometry.
 MAX_SPHERES = 12
 #: Spheres per mesh (:func:`.mesh_cover.mesh_spheres`).
 MESH_SPHERES = 16
 _MESH_CACHE: dict = {}
+#: Whether :func:`link_cover` gives pairs close in the chain their distance tables (:mod:`.pair_tables`).
+TABLES = True
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 
 
@@ -183,6 +186,7 @@ class Cover:
     fk: tuple
     segments: tuple = ()
     bounds: tuple = ()
+    tables: PairTables = field(default_factory=no_tables)
 
     def world_centers(self, Q: np.ndarray) -> np.ndarray:
         """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
@@ -225,7 +229,7 @@ class Cover:
                        np.array([where[int(k)] for k in ka[first]], dtype=np.int64),
                        np.array([where[int(k)] for k in kb[first]], dtype=np.int64), fixed,
                        np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
-                       np.array(hr))
+                       np.array(hr), self.tables.of_pairs(pair_a[order], pair_b[order]))
 
     def screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: True where the cover **proves** every pair of ``pairs`` (:meth:`prepare`)
@@ -239,12 +243,8 @@ class Cover:
         if pairs.pair_a.size == 0:
             out[:] = True
             return out
-        t = np.asarray(threshold, dtype=float)[pairs.order]
-        group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
-        screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
-                      self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
-                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
-                      pairs.pair_b, t, bool(stop), out)
+        screen_kernel(Q, self.fk, self.kernel_arrays(), self.group_arrays(pairs, threshold), self.work(pairs),
+                      bool(stop), out)
         return out
 
     def pair_screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray) -> np.ndarray:
@@ -264,14 +264,14 @@ class Cover:
     def kernel_arrays(self) -> tuple:
         """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
         return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
-                *self.segments)
+                *self.segments, self.tables.arrays())
 
     def group_arrays(self, pairs: "PairSet", threshold: np.ndarray) -> tuple:
         """The pair groups of ``pairs`` with their thresholds [m] (given in the pairs' order), for the kernels."""
         t = np.ascontiguousarray(np.asarray(threshold, dtype=float)[pairs.order])
         group_t = np.maximum.reduceat(t, pairs.group_start[:-1]) if t.size else np.zeros(0)
         return (pairs.hjoint, pairs.hcenter, pairs.hrad, pairs.group_start, pairs.group_a, pairs.group_b,
-                pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t)
+                pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t, pairs.table)
 
     def work(self, pairs: "PairSet") -> tuple:
         """Scratch arrays of one kernel call (joint frames, world centres)."""
@@ -309,6 +309,7 @@ class PairSet:
     hjoint: np.ndarray
     hcenter: np.ndarray
     hrad: np.ndarray
+    table: np.ndarray
 
 
 def _fk_arrays(cell: Any) -> tuple:
@@ -340,7 +341,8 @@ def link_cover(cell: Any) -> Cover:
             exact[g], frame_R[g], frame_p[g], size[g] = _static_shape(obj)
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
-                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
+                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii),
+                  pair_tables(cell, [(p.index_a, p.index_b) for p in cell.pairs]) if TABLES else no_tables())
     cell._sphere_cover = cover
     return cover
 
