@@ -212,7 +212,7 @@ def pair_proven(cov, grp, work, k):
 
 @jit_inline
 def _angle(R, tabs, t, i):
-    """Angle [rad] of axis ``i`` of table ``t`` from the placed joint frames ``R`` (:class:`.pair_tables.PairTables`)."""
+    """Angle [rad] of axis ``i`` of table ``t`` from the placed joint frames ``R`` (:mod:`.pair_tables`)."""
     j, par, ea, eb, e = tabs[0][t, i], tabs[1][t, i], tabs[2], tabs[3], tabs[4]
     c = 0.0
     s = 0.0
@@ -276,8 +276,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
             d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
-            if d < low:
-                low = d
+            low = min(low, d)
         return min(best, max(low, gap))
     # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
     k = sstart[other]
@@ -295,8 +294,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
             d = math.sqrt(dr * dr + dz * dz)
         d = d - radius[s] - t
-        if d < low:
-            low = d
+        low = min(low, d)
     return min(best, max(low, gap))
 
 
@@ -325,8 +323,7 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
         un = u0 * n0 + u1 * n1 + u2 * n2
         rad = r * math.sqrt(max(1.0 - un * un, 0.0))
         g = max(min(ca, cb) - rad - half[o, i], -half[o, i] - max(ca, cb) - rad)
-        if g > gap:
-            gap = g
+        gap = max(gap, g)
     return gap
 
 

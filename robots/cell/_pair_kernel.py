@@ -10,8 +10,9 @@ through :mod:`._cover_kernel`'s own helpers. Cached on disk like the other kerne
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from pinarms.compiled import drop_stale_caches, jit
 from . import _cover_kernel
 from ._cover_kernel import _apart, _fixture_distance, _place, pair_proven
 
-__all__ = ["pair_screen_kernel", "pair_screener", "compiled_entry"]
+__all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],

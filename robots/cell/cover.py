@@ -30,8 +30,9 @@ like :mod:`robots.ik._kernel`). Distances in m, the world frame.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -39,8 +40,20 @@ from ._cover_kernel import excess_kernel, screen_kernel
 from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
 from .pair_tables import PairTables, no_tables, pair_tables
 
-__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
-           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE", "TABLES"]
+__all__ = [
+    "CYLINDER_SHARE",
+    "MAX_SPHERES",
+    "MESH_SPHERES",
+    "TABLES",
+    "TURNING_SHARE",
+    "Cover",
+    "PairSet",
+    "geometry_segments",
+    "geometry_spheres",
+    "link_cover",
+    "pair_arrays",
+    "pairs_for",
+]
 
 #: Most spheres per box geometry.
 MAX_SPHERES = 12
@@ -197,7 +210,7 @@ class Cover:
         centers_kernel(Q, *self.fk, self.joint, self.center, out)
         return out
 
-    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> "PairSet":
+    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> PairSet:
         """The pairs ``(pair_a[k], pair_b[k])`` (geometry indices) grouped for :meth:`screen`: by the two
         links (a fixture's geometry alone), each link with one sphere holding its geometries."""
         pair_a = np.asarray(pair_a, dtype=np.int64)
@@ -231,7 +244,7 @@ class Cover:
                        np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
                        np.array(hr), self.tables.of_pairs(pair_a[order], pair_b[order]))
 
-    def screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, stop: bool = False) -> np.ndarray:
+    def screen(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray, stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: True where the cover **proves** every pair of ``pairs`` (:meth:`prepare`)
         farther apart than its ``threshold`` [m] (in the order the pairs were given) at cell
         configuration ``Q[i]``; False: inconclusive (the exact check decides). ``stop``: the rows
@@ -247,14 +260,14 @@ class Cover:
                       bool(stop), out)
         return out
 
-    def pair_screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray) -> np.ndarray:
+    def pair_screen(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray) -> np.ndarray:
         """``(N, P)`` bool: True where the cover **proves** pair ``k`` of ``pairs`` (:meth:`prepare`; in the
         order the pairs were given) farther apart than its ``threshold[k]`` [m] at cell configuration
         ``Q[i]``; False: inconclusive (the exact check decides that pair). A row all True is what
         :meth:`screen` calls proven. :meth:`pair_screener` for many calls with one threshold."""
         return self.pair_screener(pairs, threshold)(Q)
 
-    def pair_screener(self, pairs: "PairSet", threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    def pair_screener(self, pairs: PairSet, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
         the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
         from ._pair_kernel import pair_screener
@@ -266,21 +279,21 @@ class Cover:
         return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
                 *self.segments, self.tables.arrays())
 
-    def group_arrays(self, pairs: "PairSet", threshold: np.ndarray) -> tuple:
+    def group_arrays(self, pairs: PairSet, threshold: np.ndarray) -> tuple:
         """The pair groups of ``pairs`` with their thresholds [m] (given in the pairs' order), for the kernels."""
         t = np.ascontiguousarray(np.asarray(threshold, dtype=float)[pairs.order])
         group_t = np.maximum.reduceat(t, pairs.group_start[:-1]) if t.size else np.zeros(0)
         return (pairs.hjoint, pairs.hcenter, pairs.hrad, pairs.group_start, pairs.group_a, pairs.group_b,
                 pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t, pairs.table)
 
-    def work(self, pairs: "PairSet") -> tuple:
+    def work(self, pairs: PairSet) -> tuple:
         """Scratch arrays of one kernel call (joint frames, world centres)."""
         nj = self.fk[0].shape[0]
         return (np.empty((nj, 3, 3)), np.empty((nj, 3)), np.empty((self.joint.size, 3)),
                 np.empty((self.segments[0].size, 3)), np.empty((self.segments[0].size, 3)),
                 np.empty((pairs.hjoint.size, 3)))
 
-    def excess(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, cap: float = np.inf,
+    def excess(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray, cap: float = np.inf,
                floor: float = -np.inf) -> np.ndarray:
         """``(N,)`` lower bounds [m] of ``min_k (d_k − threshold_k)`` over ``pairs`` at cell configurations
         ``Q`` (capped at ``cap``; a row whose bound falls below ``floor`` stops early with some value
