@@ -175,8 +175,9 @@ class _Pair:
 
     def evaluate(self, V: np.ndarray, W: np.ndarray, parent_low: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per node (centres ``V (N, 2)``, widths ``W (N, 2)``): the bound of each part pair ``(N, P)`` and the
-        exact meshes' distance bound ``(N,)`` (−inf where not taken). A part pair whose parent bound
-        ``parent_low (N, P)`` leaves it far from binding keeps that bound (valid on the child's cell)."""
+        exact meshes' distance bound ``(N,)`` (−inf where not taken). The part pairs are taken in the order of
+        their parent bounds ``parent_low (N, P)``; once that bound is above the node's least so far, the rest
+        keep their parents' bounds (valid on the child's cell, and above the node's bound)."""
         import coal
 
         A, B = self.A, self.B
@@ -187,11 +188,12 @@ class _Pair:
         exact = np.full(V.shape[0], -np.inf)
         nb = len(B.shapes)
         for n in range(V.shape[0]):
-            floor = float(parent_low[n].min())
-            reach = floor + 2.0 * float(loss[n].max()) + TOL + REL * max(floor, 0.0)
             Ta: dict = {}
             Tb: dict = {}
-            for k in np.flatnonzero(parent_low[n] <= reach):
+            best = np.inf
+            for k in np.argsort(parent_low[n], kind="stable"):
+                if parent_low[n, k] >= best:  # it and the rest keep their parents' bounds, above the node's
+                    break
                 i, m = divmod(int(k), nb)
                 if i not in Ta:
                     Ta[i] = coal.Transform3s(Ra[n] @ A.frames[i][0], Ra[n] @ A.frames[i][1] + pa[n])
@@ -199,6 +201,7 @@ class _Pair:
                     Tb[m] = coal.Transform3s(Rb[n] @ B.frames[m][0], Rb[n] @ B.frames[m][1] + pb[n])
                 d = max(coal.distance(A.shapes[i], Ta[i], B.shapes[m], Tb[m], self.req, coal.DistanceResult()), 0.0)
                 low[n, k] = max(parent_low[n, k], d - loss[n, k])
+                best = min(best, low[n, k])
             whole = 0.5 * float(W[n] @ self.whole)
             if low[n].min() <= 1e-3 and whole <= EXACT_LOSS and (A.exact is not None or B.exact is not None):
                 ga, Ga = (A.exact, A.M) if A.exact is not None else (A.shapes[0], A.frames[0])

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -360,8 +360,9 @@ def link_cover(cell: Any) -> Cover:
             exact[g], frame_R[g], frame_p[g], size[g] = _static_shape(obj)
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
-                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii),
-                  pair_tables(cell, [(p.index_a, p.index_b) for p in cell.pairs]) if TABLES else no_tables())
+                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
+    if TABLES:  # the pairs close in the chain that the spheres leave loose get their distance tables
+        cover = replace(cover, tables=pair_tables(cell, [(p.index_a, p.index_b) for p in cell.pairs], cover))
     cell._sphere_cover = cover
     return cover
 

@@ -92,6 +92,11 @@ __all__ = [
     "table_paths",
 ]
 
+#: :func:`loose_pairs`: seeded random configurations, the share of them a pair's cover must leave open
+#: where it is clear, and the thresholds [m] tried.
+NEED_STATES = 256
+NEED_SHARE = 0.01
+NEED_THRESHOLDS = (0.0, 0.01)
 _VERSION = 1
 _MEMORY: dict = {}
 _DISK = Path(__file__).resolve().parent / "__pycache__" / "pair_tables"
@@ -260,10 +265,42 @@ def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict,
     return got, seconds
 
 
-def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]]) -> PairTables:
-    """The tables of the geometry pairs ``(a, b)`` of ``cell`` that qualify (:func:`table_paths`), from the
-    caches where they were built before (module docstring)."""
+def loose_pairs(cell: Any, cover: Any, found: list) -> list:
+    """The pairs of ``found`` (:func:`table_paths`) whose sphere ``cover`` (without tables) leaves open at least
+    :data:`NEED_SHARE` of :data:`NEED_STATES` seeded random configurations where coal finds the pair more than
+    2 mm beyond the threshold, at the thresholds :data:`NEED_THRESHOLDS` (a self margin, a usual margin):
+    only those are worth a table's build."""
+    import coal
+
+    if not found:
+        return []
+    objs = cell.collision_model.geometryObjects
+    a = np.array([f[0] for f in found], dtype=np.int64)
+    b = np.array([f[1] for f in found], dtype=np.int64)
+    Q = cell.random_q(NEED_STATES, seed=0)
+    pairs = cover.prepare(a, b)
+    opened = [~cover.pair_screen(Q, pairs, np.full(a.size, t)) for t in NEED_THRESHOLDS]
+    Rg, pg = cell.geometry_placements(Q)
+    req = coal.DistanceRequest()
+    keep = []
+    for k in range(len(found)):
+        ga, gb = int(a[k]), int(b[k])
+        rows = np.flatnonzero(np.any([o[:, k] for o in opened], axis=0))
+        d = np.array([coal.distance(objs[ga].geometry, coal.Transform3s(Rg[i, ga], pg[i, ga]), objs[gb].geometry,
+                                    coal.Transform3s(Rg[i, gb], pg[i, gb]), req, coal.DistanceResult()) for i in rows])
+        loose = [int(np.sum(o[rows, k] & (d > t + 2e-3))) for o, t in zip(opened, NEED_THRESHOLDS)]
+        if max(loose, default=0) >= NEED_SHARE * NEED_STATES:
+            keep.append(found[k])
+    return keep
+
+
+def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]], cover: Any = None) -> PairTables:
+    """The tables of the geometry pairs ``(a, b)`` of ``cell`` that qualify (:func:`table_paths`) and, given the
+    cell's sphere ``cover`` without tables, that it leaves loose (:func:`loose_pairs`), from the caches where
+    they were built before (module docstring)."""
     found = table_paths(cell, pairs)
+    if cover is not None:
+        found = loose_pairs(cell, cover, found)
     tabs, seconds = [], 0.0
     for a, b, side_a, side_b in found:
         got, s = _table(cell, a, b, side_a, side_b)

@@ -82,7 +82,7 @@ def near_contact(ur5):
     """Seeded random UR5 states (many near contact: the UR5's own links are a few mm apart) and the checker."""
     cell, _ = ur5
     ch = MotionChecker(cell, ["ur5"])
-    return ch, ch.full(cell.random_q(1500, seed=5)[:, ch.cols])
+    return ch, ch.full(cell.random_q(1000, seed=5)[:, ch.cols])
 
 
 def test_the_cover_with_tables_never_clears_a_state_closer_than_the_margin(ur5, near_contact):
@@ -91,7 +91,7 @@ def test_the_cover_with_tables_never_clears_a_state_closer_than_the_margin(ur5, 
     pairs = cover.prepare(*pair_arrays(ch.pairs))
     proven = cover.screen(Q, pairs, ch.pair_margin)
     collides = ch.coal_collides(Q, "margin")
-    assert collides.sum() > 150 and proven.sum() > 150  # both kinds well represented
+    assert collides.sum() > 100 and proven.sum() > 100  # both kinds well represented
     assert not np.any(proven & collides)
     # the per-pair screen: a pair it proves is farther than its margin (coal, pair by pair)
     per_pair = cover.pair_screen(Q, pairs, ch.pair_margin)
