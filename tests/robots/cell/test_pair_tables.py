@@ -134,3 +134,27 @@ def test_the_disk_cache_round_trips_and_rejects_a_bad_file(ur5, tmp_path, monkey
     assert pt._load(key) is None
     (tmp_path / f"{key}.npz").write_bytes(b"not an npz")
     assert pt._load(key) is None
+
+
+@pytest.mark.slow
+def test_a_table_of_the_aubo_food_station_stays_below_coal():
+    """Another arm with a mesh: the AUBO-i3's upper arm against the food station's hopper (a fixed mesh)."""
+    from pinarms.robots import load_cell
+
+    cell = load_cell("aubo_food_station")
+    objs = cell.collision_model.geometryObjects
+    found = pt.table_paths(cell, [(p.index_a, p.index_b) for p in cell.pairs])
+    assert [(objs[a].name, objs[b].name) for a, b, _, _ in found] == [("aubo_upperArm_Link_2", "hopper_0")]
+    a, b, side_a, side_b = found[0]
+    got = pt._build_one(cell, a, b, side_a, side_b)
+    tables = pt.PairTables(np.array([a]), np.array([b]), got["joint"][None], got["parent"][None], got["e"][None],
+                           got["ea"][None], got["eb"][None], np.zeros(1, dtype=np.int64), got["child"], got["split"],
+                           got["low"])
+    Q = cell.random_q(N, seed=12)
+    bound = tables.bound(0, _angles(cell, tables, 0, Q))
+    Rg, pg = cell.geometry_placements(Q)
+    req = coal.DistanceRequest()
+    d = np.array([coal.distance(objs[a].geometry, coal.Transform3s(Rg[i, a], pg[i, a]), objs[b].geometry,
+                                coal.Transform3s(Rg[i, b], pg[i, b]), req, coal.DistanceResult()) for i in range(N)])
+    assert np.all(bound <= np.maximum(d, 0.0) + 1e-9)
+    assert np.mean(bound > 0.0) > 0.5
