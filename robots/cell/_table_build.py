@@ -11,7 +11,7 @@ import numpy as np
 
 from .mesh_cover import mesh_arrays, split_triangles
 
-__all__: list[str] = []
+__all__ = ["axis_arrays"]
 
 #: Loss [m] a cell may keep at zero distance; :data:`REL` times the distance is added.
 TOL = 1.5e-3
@@ -245,17 +245,27 @@ def _build_one(cell: Any, a: int, b: int, side_a: list, side_b: list, turning: t
         lo2[np.arange(lo2.shape[0]), s2] += np.tile([0.0, 1.0], g.size) * w2[np.arange(w2.shape[0]), s2]
         lo, w = lo2, w2
         parent_low, up = np.repeat(part[g], 2, axis=0), np.repeat(bound[g], 2)
+    path = side_a + side_b
+    axis = np.array([path.index(j) for j in pair.axes] + [-1] * (2 - len(pair.axes)), dtype=np.int64)
+    return {"axis": axis, "child": np.array(child, dtype=np.int64), "split": np.array(split, dtype=np.int64),
+            "low": np.array(low) - SLACK}
+
+
+def axis_arrays(bp: Any, path: list, axis: np.ndarray) -> tuple:
+    """``(joint, parent (2,), e, ea, eb (2, 3))`` of a table's axes ``axis`` (positions in ``path``, −1: none) in a
+    cell's joints ``bp`` (:class:`.pair_tables.PairTables`)."""
     e_, ea, eb = np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3))
-    joint, par = np.full(2, -1), np.full(2, -1)
-    bp = pair.bp
-    for i, j in enumerate(pair.axes):
+    joint, par = np.full(2, -1, dtype=np.int64), np.full(2, -1, dtype=np.int64)
+    for i, k in enumerate(axis):
+        if k < 0:
+            continue
+        j = int(path[int(k)])
         u = np.asarray(bp.axis[j], dtype=float)
         e = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
         e /= np.linalg.norm(e)
         e_[i], ea[i], eb[i] = e, np.asarray(bp.M_R[j]) @ e, np.asarray(bp.M_R[j]) @ np.cross(u, e)
         joint[i], par[i] = j, int(bp.parent[j])
-    return {"joint": joint, "parent": par, "e": e_, "ea": ea, "eb": eb, "child": np.array(child, dtype=np.int64),
-            "split": np.array(split, dtype=np.int64), "low": np.array(low) - SLACK}
+    return joint, par, e_, ea, eb
 
 
 def _turning(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[bool, bool]:

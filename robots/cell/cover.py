@@ -361,8 +361,9 @@ def link_cover(cell: Any) -> Cover:
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
                   _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
-    if TABLES:  # the pairs close in the chain that the spheres leave loose get their distance tables
-        cover = replace(cover, tables=pair_tables(cell, [(p.index_a, p.index_b) for p in cell.pairs], cover))
+    if TABLES:  # an arm's own pairs close in the chain that the spheres leave loose get distance tables
+        own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
+        cover = replace(cover, tables=pair_tables(cell, own, cover))
     cell._sphere_cover = cover
     return cover
 

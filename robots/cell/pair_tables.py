@@ -88,6 +88,7 @@ from ._table_build import (
     _build_one,
     _points,
     _turning,
+    axis_arrays,
 )
 from .mesh_cover import mesh_arrays
 
@@ -115,7 +116,7 @@ __all__ = [
 NEED_STATES = 256
 NEED_SHARE = 0.01
 NEED_THRESHOLDS = (0.0, 0.01)
-_VERSION = 1
+_VERSION = 2
 _MEMORY: dict = {}
 _DISK = Path(__file__).resolve().parent / "__pycache__" / "pair_tables"
 
@@ -218,6 +219,12 @@ def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
     h = hashlib.sha256(repr((_VERSION, TOL, REL, CAP, CONTACT_TOL, TURNING, TURN_SAMPLES, TURN_NEAR, SLACK, MAX_NODES,
                              EXACT_LOSS, PART_LENGTH, MAX_PARTS, len(side_a),
                              len(side_b))).encode())
+    path = side_a + side_b
+    root = next((j for j in path if int(bp.parent[j]) == 0), None)
+    if root is not None:  # a chain from the world: all relative to the root joint's placement (a moved base)
+        G = np.eye(4)
+        G[:3, :3], G[:3, 3] = bp.M_R[root], bp.M_p[root]
+        G = np.linalg.inv(G)
     for g in (a, b):
         obj = objs[g]
         got = mesh_arrays(obj.geometry)
@@ -225,15 +232,16 @@ def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
             h.update(_points(obj).tobytes())
         else:
             h.update(got[0].tobytes() + got[1].tobytes())
-        h.update(np.asarray(obj.placement.homogeneous, dtype=float).tobytes())
-    for j in side_a + side_b:
-        h.update(np.concatenate([np.asarray(bp.M_R[j]).ravel(), bp.M_p[j], bp.axis[j]]).astype(float).tobytes())
+        M = np.asarray(obj.placement.homogeneous, dtype=float)
+        h.update(np.round(G @ M if root is not None and int(obj.parentJoint) == 0 else M, 12).tobytes())
+    for j in path:
+        M = [] if j == root else [np.asarray(bp.M_R[j]).ravel(), bp.M_p[j]]
+        h.update(np.concatenate([*M, bp.axis[j]]).astype(float).tobytes())
     return h.hexdigest()
 
 
-_FIELDS = {"joint": (np.int64, (2,)), "parent": (np.int64, (2,)), "e": (np.float64, (2, 3)),
-           "ea": (np.float64, (2, 3)), "eb": (np.float64, (2, 3)), "child": (np.int64, None),
-           "split": (np.int64, None), "low": (np.float64, None)}
+_FIELDS = {"axis": (np.int64, (2,)), "child": (np.int64, None), "split": (np.int64, None),
+           "low": (np.float64, None)}
 
 
 def _load(key: str) -> dict | None:
@@ -250,6 +258,8 @@ def _load(key: str) -> dict | None:
                                                                                       got[k].shape != (n,)):
             return None
     c = got["child"]
+    if np.any((got["axis"] < -1) | (got["axis"] > 1)):
+        return None
     if n == 0 or np.any((c != -1) & ((c <= np.arange(n)) | (c + 1 >= n))) or np.any((got["split"] < 0) |
                                                                                        (got["split"] > 1)):
         return None
@@ -324,16 +334,23 @@ def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]], cover: Any = None) 
         got, s = _table(cell, a, b, side_a, side_b)
         tabs.append(got)
         seconds += s
+    return assemble(cell, found, tabs, seconds)
+
+
+def assemble(cell: Any, found: list, tabs: list, seconds: float = 0.0) -> PairTables:
+    """The :class:`PairTables` of the pairs ``found`` (:func:`table_paths`) and their tables ``tabs`` (axes as
+    positions on the pair's path, so that a table serves every cell of the same content)."""
     sizes = np.array([t["child"].size for t in tabs], dtype=np.int64)
     root = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if tabs else np.zeros(0, dtype=np.int64)
     child = [np.where(t["child"] >= 0, t["child"] + r, -1) for t, r in zip(tabs, root)]
+    axes = [axis_arrays(cell._placements, f[2] + f[3], t["axis"]) for f, t in zip(found, tabs)]
 
-    def cat(name: str, shape: tuple, dtype: Any) -> np.ndarray:
-        return np.ascontiguousarray(np.stack([t[name] for t in tabs]) if tabs else np.zeros(shape, dtype=dtype))
+    def cat(i: int, shape: tuple, dtype: Any) -> np.ndarray:
+        return np.ascontiguousarray(np.stack([x[i] for x in axes]) if tabs else np.zeros(shape, dtype=dtype))
 
     return PairTables(np.array([f[0] for f in found], dtype=np.int64), np.array([f[1] for f in found], dtype=np.int64),
-                      cat("joint", (0, 2), np.int64), cat("parent", (0, 2), np.int64), cat("e", (0, 2, 3), float),
-                      cat("ea", (0, 2, 3), float), cat("eb", (0, 2, 3), float), root,
+                      cat(0, (0, 2), np.int64), cat(1, (0, 2), np.int64), cat(2, (0, 2, 3), float),
+                      cat(3, (0, 2, 3), float), cat(4, (0, 2, 3), float), root,
                       np.concatenate(child).astype(np.int64) if tabs else np.zeros(0, dtype=np.int64),
                       np.concatenate([t["split"] for t in tabs]).astype(np.int64) if tabs else np.zeros(0, np.int64),
                       np.concatenate([t["low"] for t in tabs]) if tabs else np.zeros(0), seconds)
