@@ -19,11 +19,11 @@ holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, 
 mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
 taken exactly against the other geometry's spheres (:func:`geometry_segments`).
 
-Two geometries whose relative placement depends on at most two revolute joints, one of them a
-mesh (the UR5's forearm and wrist_2, its base and upper arm, an upper arm over a fixed table)
-also get a **distance table** (:mod:`.pair_tables`): a proven lower bound of their distance
-over cells of those joints' angles. Such a pair's bound is the larger of its table's and its
-cover's (:data:`TABLES`).
+Two geometries of one arm whose relative placement depends on at most two revolute joints, one
+of them a mesh, that the spheres leave loose (the UR5's forearm and wrist_2, wrist_1 and wrist_3,
+its base and upper arm) also get a **distance table** (:mod:`.pair_tables`): a proven lower
+bound of their distance over cells of those joints' angles. Such a pair's bound is the larger
+of its table's and its cover's (:data:`TABLES`).
 
 The screen (:meth:`Cover.screen`) answers, for a batch of cell configurations and a
 threshold per pair, which configurations are **proven** to keep every pair farther apart

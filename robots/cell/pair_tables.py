@@ -1,16 +1,17 @@
 """Distance tables for pairs of geometries close in the kinematic chain: a proven lower bound of
 their distance, looked up from the joint angles, for :mod:`.cover`'s screens.
 
-**Which pairs** (:func:`table_paths`, :func:`loose_pairs`). Two geometries whose relative
-placement depends on at most two revolute joints (the joints on the tree path between their
-parent joints: the UR5's forearm and wrist_2 on ``q4, q5``, wrist_1 and wrist_3 on ``q5, q6``,
-its base and upper arm on ``q1, q2``, an upper arm and a fixed table on ``q1, q2``), at least
-one of them a triangle mesh (spheres round a slice of a housing overshoot its flat end by
+**Which pairs** (:func:`table_paths`, :func:`loose_pairs`; :func:`.cover.link_cover` passes an
+arm's own pairs). Two geometries whose relative placement depends on at most two revolute
+joints (the joints on the tree path between their parent joints: the UR5's forearm and wrist_2
+on ``q4, q5``, wrist_1 and wrist_3 on ``q5, q6``, its base and upper arm on ``q1, q2``), at
+least one of them a triangle mesh (spheres round a slice of a housing overshoot its flat end by
 nearly its radius; the covers of primitives are already tight), and that the sphere cover
 leaves loose: open on at least :data:`NEED_SHARE` of :data:`NEED_STATES` seeded random
 configurations where coal finds the pair 2 mm beyond a threshold of :data:`NEED_THRESHOLDS`.
-No Panda or AUBO-i3 scene has such a pair (primitives, a mesh base alone): their covers are
-unchanged.
+A pair of an arm and a fixture is left to the cover: its table would be built again at every
+placement of the arm's base (a layout search). No Panda or AUBO-i3 scene has such a pair
+(primitives, a mesh base alone): their covers are unchanged.
 
 **What is tabulated.** Each side is cut into convex **parts**: a mesh's triangles into pieces
 (:func:`.mesh_cover.split_triangles`) grouped in slabs of at most :data:`PART_LENGTH` along its
@@ -48,15 +49,16 @@ values are passed, the kernels' signatures are unchanged). Any lower bound at a 
 edge proofs (the Lipschitz ladder, the per-group levers) valid: they need only ``d ≥ bound``
 at their samples.
 
-**Measured** (2 cores shared, load 2.5–4): the share of 600 seeded clear states the cover
-proves whole goes from 21 % to 79 % on ``ur5_table_box`` and from 19 % to 82 % on
+**Measured** (2 cores shared, load 1.5–2.7): the share of 600 seeded clear states the cover
+proves whole goes from 21 % to 77 % on ``ur5_table_box`` and from 19 % to 81 % on
 ``ur5_shelf`` (MotionChecker margin 10 mm, self margin 0; none called clear that coal finds
-closer). Five tables per UR5 scene, 114 000 nodes (2.7 MB); built cold in 7 s
-(``ur5_table_box``; 3.5 s more for ``ur5_shelf``'s pedestal), from the disk cache in 0.03 s.
-Tables are kept per content (meshes, placements, axes, the constants here) in memory and on
-disk (``__pycache__/pair_tables/<sha256>.npz`` beside this file, written atomically, read
-with ``allow_pickle=False`` and checked: names, types, shapes, the tree's links; a bad or
-unwritable file only costs the build). Angles in rad, lengths in m.
+closer). Four tables per UR5, 84 000 nodes (2 MB); built cold in 4 s, from the disk cache in
+0.03 s. Tables are kept per content in memory and on disk (``__pycache__/pair_tables/
+<sha256>.npz`` beside this file, written atomically, read with ``allow_pickle=False`` and
+checked: names, types, shapes, the tree's links; a bad or unwritable file only costs the
+build). The content is taken relative to the chain's root joint and the axes as positions on
+the pair's path, so a table serves every placement of the arm and every arm of the same model
+(the UR5 on the shelf's pedestal reuses the table scene's). Angles in rad, lengths in m.
 """
 
 from __future__ import annotations
