@@ -120,6 +120,7 @@ NEED_SHARE = 0.01
 NEED_THRESHOLDS = (0.0, 0.01)
 _VERSION = 2
 _MEMORY: dict = {}
+_LOOSE: dict = {}
 _DISK = Path(__file__).resolve().parent / "__pycache__" / "pair_tables"
 
 
@@ -329,8 +330,12 @@ def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]], cover: Any = None) 
     cell's sphere ``cover`` without tables, that it leaves loose (:func:`loose_pairs`), from the caches where
     they were built before (module docstring)."""
     found = table_paths(cell, pairs)
-    if cover is not None:
-        found = loose_pairs(cell, cover, found)
+    if cover is not None:  # decided once per content (a moved base keeps its arm's pairs' verdicts)
+        keys = [_key(cell, *f) for f in found]
+        todo = [f for f, k in zip(found, keys) if k not in _LOOSE]
+        loose = {id(f) for f in loose_pairs(cell, cover, todo)}
+        _LOOSE.update({k: id(f) in loose for f, k in zip(found, keys) if k not in _LOOSE})
+        found = [f for f, k in zip(found, keys) if _LOOSE[k]]
     tabs, seconds = [], 0.0
     for a, b, side_a, side_b in found:
         got, s = _table(cell, a, b, side_a, side_b)
