@@ -162,25 +162,19 @@ def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl
 
 
 @jit
-def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, radius, start, exact, FR,
-                  Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl, hjoint, hcenter, hrad, group_start, group_a,
-                  group_b, group_fixed, group_t, pair_a, pair_b, threshold, stop, out):
-    """``out[i]``: every pair proven more than its threshold apart at ``Q[i]`` (module docstring of :mod:`.cover`).
+def screen_kernel(Q, fk, cov, grp, work, stop, out):
+    """``out[i]``: every pair proven more than its threshold apart at ``Q[i]`` (module docstring of :mod:`.cover`;
+    the arrays as :func:`excess_one`'s).
 
     The pairs come in groups (the geometries of one link against those of another); a group
-    is first tested on the two bounding spheres (``hjoint``, ``hcenter``, ``hrad``) at its
-    largest threshold, then pair by pair on the geometries' bounding spheres, then on their
-    covers. ``stop``: return at the first inconclusive row (its index; else −1)."""
-    nj = parent.shape[0]
-    R = np.empty((nj, 3, 3))
-    p = np.empty((nj, 3))
-    W = np.empty((joint.shape[0], 3))
-    SA = np.empty((sjoint.shape[0], 3))
-    SB = np.empty((sjoint.shape[0], 3))
-    HW = np.empty((hjoint.shape[0], 3))
+    is first tested on the two bounding spheres at its largest threshold, then pair by pair on
+    the geometries' bounding spheres, their distance table (:mod:`.pair_tables`) where they have
+    one, then their covers. ``stop``: return at the first inconclusive row (its index; else −1)."""
+    exact, FR, Fp, size = cov[4], cov[5], cov[6], cov[7]
+    hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
+    HW = work[5]
     for i in range(Q.shape[0]):
-        _place(Q[i], (parent, index, scale, offset, revolute, axis, MR, Mp), joint, center, sjoint, sa_local, sb_local,
-               hjoint, hcenter, (R, p, W, SA, SB, HW))
+        _place(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
         ok = True
         for g in range(group_t.shape[0]):
             if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
@@ -191,12 +185,7 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
                     - hrad[ha] > group_t[g]:
                 continue
             for k in range(group_start[g], group_start[g + 1]):
-                ga = pair_a[k]
-                gb = pair_b[k]
-                if _apart(HW, hrad, ga, gb, threshold[k]):
-                    continue
-                if not _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb,
-                                   threshold[k], HW, hrad):
+                if not pair_proven(cov, grp, work, k):
                     ok = False
                     break
             if not ok:
@@ -205,6 +194,60 @@ def screen_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint
         if stop and not ok:
             return i
     return -1
+
+
+@jit_inline
+def pair_proven(cov, grp, work, k):
+    """Whether pair ``k`` (the groups' order) is proven more than its threshold apart on ``work`` placed:
+    its bounding spheres, its table (:func:`table_low`), its covers (:func:`_pair_clear`)."""
+    ga, gb, t = grp[8][k], grp[9][k], grp[10][k]
+    if _apart(work[5], grp[2], ga, gb, t):
+        return True
+    tab = grp[11][k]
+    if tab >= 0 and table_low(work[0], cov[14], tab) > t:
+        return True
+    return _pair_clear(work[2], cov[2], cov[3], cov[4], cov[5], cov[6], cov[7], work[3], work[4], cov[11], cov[12],
+                       cov[13], ga, gb, t, work[5], grp[2])
+
+
+@jit_inline
+def _angle(R, tabs, t, i):
+    """Angle [rad] of axis ``i`` of table ``t`` from the placed joint frames ``R`` (:mod:`.pair_tables`)."""
+    j, par, ea, eb, e = tabs[0][t, i], tabs[1][t, i], tabs[2], tabs[3], tabs[4]
+    c = 0.0
+    s = 0.0
+    for a in range(3):
+        w = R[j, a, 0] * e[t, i, 0] + R[j, a, 1] * e[t, i, 1] + R[j, a, 2] * e[t, i, 2]
+        c += w * (R[par, a, 0] * ea[t, i, 0] + R[par, a, 1] * ea[t, i, 1] + R[par, a, 2] * ea[t, i, 2])
+        s += w * (R[par, a, 0] * eb[t, i, 0] + R[par, a, 1] * eb[t, i, 1] + R[par, a, 2] * eb[t, i, 2])
+    return math.atan2(s, c)
+
+
+@jit_inline
+def table_low(R, tabs, t):
+    """Table ``t``'s proven lower bound [m] of its pair's distance at the joint frames ``R`` (its k-d tree over the
+    angles of its joints, :mod:`.pair_tables`)."""
+    v0 = _angle(R, tabs, t, 0) if tabs[0][t, 0] >= 0 else 0.0
+    v1 = _angle(R, tabs, t, 1) if tabs[0][t, 1] >= 0 else 0.0
+    child, split = tabs[6], tabs[7]
+    lo0 = -math.pi
+    lo1 = -math.pi
+    w0 = 2.0 * math.pi
+    w1 = 2.0 * math.pi
+    n = tabs[5][t]
+    while child[n] >= 0:
+        if split[n] == 0:
+            w0 *= 0.5
+            up = v0 >= lo0 + w0
+            if up:
+                lo0 += w0
+        else:
+            w1 *= 0.5
+            up = v1 >= lo1 + w1
+            if up:
+                lo1 += w1
+        n = child[n] + (1 if up else 0)
+    return tabs[8][n]
 
 
 @jit
@@ -233,8 +276,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
             d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
-            if d < low:
-                low = d
+            low = min(low, d)
         return min(best, max(low, gap))
     # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
     k = sstart[other]
@@ -252,8 +294,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
             d = math.sqrt(dr * dr + dz * dz)
         d = d - radius[s] - t
-        if d < low:
-            low = d
+        low = min(low, d)
     return min(best, max(low, gap))
 
 
@@ -282,8 +323,7 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
         un = u0 * n0 + u1 * n1 + u2 * n2
         rad = r * math.sqrt(max(1.0 - un * un, 0.0))
         g = max(min(ca, cb) - rad - half[o, i], -half[o, i] - max(ca, cb) - rad)
-        if g > gap:
-            gap = g
+        gap = max(gap, g)
     return gap
 
 
@@ -343,8 +383,9 @@ def excess_one(q, fk, cov, grp, cap, floor, work):
 
     ``fk``: :meth:`Cover.fk`'s arrays; ``cov``: the cover's arrays (:meth:`Cover.kernel_arrays`);
     ``grp``: the pair groups (:meth:`Cover.group_arrays`) with the thresholds ``t`` in their order;
-    ``work``: scratch arrays (:func:`excess_work`). The covers' distances are lower bounds of the
-    geometries' (the containment tests), so the result is a lower bound of the exact excess.
+    ``work``: scratch arrays (:meth:`Cover.work`). The covers' distances and the distance tables'
+    bounds (:mod:`.pair_tables`, ``cov[14]``, ``grp[11]``) are lower bounds of the geometries'
+    distances, so the result is a lower bound of the exact excess.
     :func:`excess_scaled` without weights."""
     return excess_scaled(q, fk, cov, grp, UNWEIGHTED, cap, floor, work)
 
@@ -403,10 +444,14 @@ def place_moving(q, fk, cov, grp, work, moving):
 def excess_placed(cov, grp, inv, cap, floor, work):
     """:func:`excess_scaled` on ``work`` already placed (:func:`_place` or :func:`place_moving`).
 
-    The group and pair tests run on the bounding spheres; the pairs they do not prune are
-    computed inline (:func:`_pair_excess`: a call with its many arrays cost more than the pair)."""
-    joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
-    hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
+    The group and pair tests run on the bounding spheres; a pair with a distance table takes the
+    larger of its table's bound and its cover's (the table first: a pair it keeps above the
+    running bound costs no cover test); the others are computed inline (:func:`_pair_excess`).
+    Any lower bound keeps the edge proofs valid: they need ``d ≥ bound`` at their samples only."""
+    radius, start, exact, FR, Fp, size = cov[2], cov[3], cov[4], cov[5], cov[6], cov[7]
+    srad, sstart, cyl = cov[11], cov[12], cov[13]
+    hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
+    pair_a, pair_b, t, table = grp[8], grp[9], grp[10], grp[11]
     W, SA, SB, HW = work[2], work[3], work[4], work[5]
     weighted = inv.shape[0] > 0
     best = cap
@@ -424,11 +469,15 @@ def excess_placed(cov, grp, inv, cap, floor, work):
             gb = pair_b[k]
             if (_hd(HW, hrad, ga, gb) - t[k]) * s >= best:
                 continue
+            tab = table[k]
+            low = table_low(work[0], cov[14], tab) - t[k] if tab >= 0 else -np.inf
+            if low * s >= best:
+                continue
             raw = best / s
             r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
                              hrad, raw)
             if r < raw:
-                best = min(best, r * s)
+                best = min(best, max(r, low) * s)
             if best < floor:
                 return best
     return best

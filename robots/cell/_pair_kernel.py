@@ -3,23 +3,25 @@
 :func:`._cover_kernel.screen_kernel` answers per configuration (every pair proven, or not);
 :func:`pair_screen_kernel` answers per pair, so that the exact check (coal) needs to look
 only at the pairs the cover leaves open. The same tests in the same order (the group's two
-bounding spheres, a fixture's exact shape, each pair's bounding spheres, then its covers),
+bounding spheres, a fixture's exact shape, each pair's bounding spheres, its distance table where it
+has one, then its covers),
 through :mod:`._cover_kernel`'s own helpers. Cached on disk like the other kernels.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 
 from . import _cover_kernel
-from ._cover_kernel import _apart, _fixture_distance, _pair_clear, _place
+from ._cover_kernel import _apart, _fixture_distance, _place, pair_proven
 
-__all__ = ["pair_screen_kernel", "pair_screener", "compiled_entry"]
+__all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
 drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
@@ -34,11 +36,11 @@ def pair_screen_kernel(Q, fk, cov, grp, work, out):
     ``fk``, ``cov``, ``grp``, ``work``: as :func:`._cover_kernel.excess_one` (:meth:`Cover.group_arrays`
     with the thresholds). A group proven on its two bounding spheres, or on its link's bounding sphere
     against its fixture's exact shape, at its largest threshold proves all its pairs."""
-    joint, center, radius, start, exact, FR, Fp, size, sjoint, sa_local, sb_local, srad, sstart, cyl = cov
-    hjoint, hcenter, hrad, group_start, group_a, group_b, group_fixed, group_t, pair_a, pair_b, t = grp
+    exact, FR, Fp, size = cov[4], cov[5], cov[6], cov[7]
+    hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
     for i in range(Q.shape[0]):
-        _place(Q[i], fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work)
-        W, SA, SB, HW = work[2], work[3], work[4], work[5]
+        _place(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+        HW = work[5]
         for g in range(group_t.shape[0]):
             a = group_a[g]
             whole = _apart(HW, hrad, a, group_b[g], group_t[g])
@@ -47,12 +49,7 @@ def pair_screen_kernel(Q, fk, cov, grp, work, out):
                 whole = _fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed) \
                     - hrad[a] > group_t[g]
             for k in range(group_start[g], group_start[g + 1]):
-                if whole or _apart(HW, hrad, pair_a[k], pair_b[k], t[k]):
-                    out[i, k] = True
-                else:
-                    out[i, k] = _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl,
-                                            pair_a[k], pair_b[k], t[k], HW, hrad)
-
+                out[i, k] = whole or pair_proven(cov, grp, work, k)
 
 def compiled_entry(kernel, args: tuple):
     """``kernel``'s compiled code for arguments like ``(Q (N, nq) float, *args, out (N, P) bool)``, called

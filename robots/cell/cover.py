@@ -19,6 +19,12 @@ holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, 
 mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
 taken exactly against the other geometry's spheres (:func:`geometry_segments`).
 
+Two geometries of one arm whose relative placement depends on at most two revolute joints, one
+of them a mesh, that the spheres leave loose (the UR5's forearm and wrist_2, wrist_1 and wrist_3,
+its base and upper arm) also get a **distance table** (:mod:`.pair_tables`): a proven lower
+bound of their distance over cells of those joints' angles. Such a pair's bound is the larger
+of its table's and its cover's (:data:`TABLES`).
+
 The screen (:meth:`Cover.screen`) answers, for a batch of cell configurations and a
 threshold per pair, which configurations are **proven** to keep every pair farther apart
 than its threshold: the distance between two covers (or a cover and an exact fixture) is a
@@ -30,22 +36,38 @@ like :mod:`robots.ik._kernel`). Distances in m, the world frame.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
 from ._cover_kernel import excess_kernel, screen_kernel
 from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
+from .pair_tables import PairTables, no_tables, pair_tables
 
-__all__ = ["Cover", "PairSet", "geometry_spheres", "geometry_segments", "link_cover", "pair_arrays", "pairs_for",
-           "MAX_SPHERES", "MESH_SPHERES", "CYLINDER_SHARE", "TURNING_SHARE"]
+__all__ = [
+    "CYLINDER_SHARE",
+    "MAX_SPHERES",
+    "MESH_SPHERES",
+    "TABLES",
+    "TURNING_SHARE",
+    "Cover",
+    "PairSet",
+    "geometry_segments",
+    "geometry_spheres",
+    "link_cover",
+    "pair_arrays",
+    "pairs_for",
+]
 
 #: Most spheres per box geometry.
 MAX_SPHERES = 12
 #: Spheres per mesh (:func:`.mesh_cover.mesh_spheres`).
 MESH_SPHERES = 16
 _MESH_CACHE: dict = {}
+#: Whether :func:`link_cover` gives pairs close in the chain their distance tables (:mod:`.pair_tables`).
+TABLES = True
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 
 
@@ -183,6 +205,7 @@ class Cover:
     fk: tuple
     segments: tuple = ()
     bounds: tuple = ()
+    tables: PairTables = field(default_factory=no_tables)
 
     def world_centers(self, Q: np.ndarray) -> np.ndarray:
         """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
@@ -193,7 +216,7 @@ class Cover:
         centers_kernel(Q, *self.fk, self.joint, self.center, out)
         return out
 
-    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> "PairSet":
+    def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> PairSet:
         """The pairs ``(pair_a[k], pair_b[k])`` (geometry indices) grouped for :meth:`screen`: by the two
         links (a fixture's geometry alone), each link with one sphere holding its geometries."""
         pair_a = np.asarray(pair_a, dtype=np.int64)
@@ -225,9 +248,9 @@ class Cover:
                        np.array([where[int(k)] for k in ka[first]], dtype=np.int64),
                        np.array([where[int(k)] for k in kb[first]], dtype=np.int64), fixed,
                        np.array(hjoint, dtype=np.int64), np.ascontiguousarray(np.array(hc).reshape(-1, 3)),
-                       np.array(hr))
+                       np.array(hr), self.tables.of_pairs(pair_a[order], pair_b[order]))
 
-    def screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, stop: bool = False) -> np.ndarray:
+    def screen(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray, stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: True where the cover **proves** every pair of ``pairs`` (:meth:`prepare`)
         farther apart than its ``threshold`` [m] (in the order the pairs were given) at cell
         configuration ``Q[i]``; False: inconclusive (the exact check decides). ``stop``: the rows
@@ -239,22 +262,18 @@ class Cover:
         if pairs.pair_a.size == 0:
             out[:] = True
             return out
-        t = np.asarray(threshold, dtype=float)[pairs.order]
-        group_t = np.maximum.reduceat(t, pairs.group_start[:-1])
-        screen_kernel(Q, *self.fk, self.joint, self.center, self.radius, self.start, self.exact, self.frame_R,
-                      self.frame_p, self.size, *self.segments, pairs.hjoint, pairs.hcenter, pairs.hrad,
-                      pairs.group_start, pairs.group_a, pairs.group_b, pairs.group_fixed, group_t, pairs.pair_a,
-                      pairs.pair_b, t, bool(stop), out)
+        screen_kernel(Q, self.fk, self.kernel_arrays(), self.group_arrays(pairs, threshold), self.work(pairs),
+                      bool(stop), out)
         return out
 
-    def pair_screen(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray) -> np.ndarray:
+    def pair_screen(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray) -> np.ndarray:
         """``(N, P)`` bool: True where the cover **proves** pair ``k`` of ``pairs`` (:meth:`prepare`; in the
         order the pairs were given) farther apart than its ``threshold[k]`` [m] at cell configuration
         ``Q[i]``; False: inconclusive (the exact check decides that pair). A row all True is what
         :meth:`screen` calls proven. :meth:`pair_screener` for many calls with one threshold."""
         return self.pair_screener(pairs, threshold)(Q)
 
-    def pair_screener(self, pairs: "PairSet", threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    def pair_screener(self, pairs: PairSet, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
         the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
         from ._pair_kernel import pair_screener
@@ -264,23 +283,23 @@ class Cover:
     def kernel_arrays(self) -> tuple:
         """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
         return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
-                *self.segments)
+                *self.segments, self.tables.arrays())
 
-    def group_arrays(self, pairs: "PairSet", threshold: np.ndarray) -> tuple:
+    def group_arrays(self, pairs: PairSet, threshold: np.ndarray) -> tuple:
         """The pair groups of ``pairs`` with their thresholds [m] (given in the pairs' order), for the kernels."""
         t = np.ascontiguousarray(np.asarray(threshold, dtype=float)[pairs.order])
         group_t = np.maximum.reduceat(t, pairs.group_start[:-1]) if t.size else np.zeros(0)
         return (pairs.hjoint, pairs.hcenter, pairs.hrad, pairs.group_start, pairs.group_a, pairs.group_b,
-                pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t)
+                pairs.group_fixed, group_t, pairs.pair_a, pairs.pair_b, t, pairs.table)
 
-    def work(self, pairs: "PairSet") -> tuple:
+    def work(self, pairs: PairSet) -> tuple:
         """Scratch arrays of one kernel call (joint frames, world centres)."""
         nj = self.fk[0].shape[0]
         return (np.empty((nj, 3, 3)), np.empty((nj, 3)), np.empty((self.joint.size, 3)),
                 np.empty((self.segments[0].size, 3)), np.empty((self.segments[0].size, 3)),
                 np.empty((pairs.hjoint.size, 3)))
 
-    def excess(self, Q: np.ndarray, pairs: "PairSet", threshold: np.ndarray, cap: float = np.inf,
+    def excess(self, Q: np.ndarray, pairs: PairSet, threshold: np.ndarray, cap: float = np.inf,
                floor: float = -np.inf) -> np.ndarray:
         """``(N,)`` lower bounds [m] of ``min_k (d_k − threshold_k)`` over ``pairs`` at cell configurations
         ``Q`` (capped at ``cap``; a row whose bound falls below ``floor`` stops early with some value
@@ -309,6 +328,7 @@ class PairSet:
     hjoint: np.ndarray
     hcenter: np.ndarray
     hrad: np.ndarray
+    table: np.ndarray
 
 
 def _fk_arrays(cell: Any) -> tuple:
@@ -341,6 +361,9 @@ def link_cover(cell: Any) -> Cover:
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
                   _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
+    if TABLES:  # an arm's own pairs close in the chain that the spheres leave loose get distance tables
+        own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
+        cover = replace(cover, tables=pair_tables(cell, own, cover))
     cell._sphere_cover = cover
     return cover
 

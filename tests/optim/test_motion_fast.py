@@ -109,7 +109,7 @@ def test_plan_motion_searches_compiled_where_the_cover_is_tight(table):
     checker = MotionChecker(ur5, ["ur5"], margin=MARGIN)
     from pinarms.optim.motion.geometry import fast_share
 
-    assert fast_share(checker, "rrtconnect") == 0.0  # meshes: a loose cover, OMPL with the exact checker alone
+    assert fast_share(checker, "rrtconnect") > 0.0  # meshes: the cover with its distance tables proves most states
     assert fast_share(MotionChecker(cell, ["panda"], margin=MARGIN), "rrtstar") == 0.0
 
 
