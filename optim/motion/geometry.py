@@ -5,10 +5,10 @@ cover proves) for a share of the time limit (:data:`FAST_SHARE`) when the cover 
 least half of the clear states (:func:`fast_share`), then — nothing found, or a planner other than
 RRT-Connect, or arms moving on their own trajectories — OMPL with the exact checker for
 the rest of the time, as before. A compiled path is shortcut on the compiled check; the
-path reported is proven by the exact checker (:meth:`MotionChecker.prove`: the smooth
-spline, or each edge of the polyline when smoothing falls back to it). A path the exact
-proof does not accept (the cover proves what coal proves, so this does not happen in the
-tests) is dropped and OMPL searches.
+smooth spline reported is proven by :func:`.smoothing.prove_path` (the cover compiled first,
+the exact checker on the ranges it leaves open), and a polyline with stops edge by edge by
+the exact checker. A polyline the exact proof does not accept (the cover proves what coal
+proves, so this does not happen in the tests) is dropped and OMPL searches.
 """
 
 from __future__ import annotations
