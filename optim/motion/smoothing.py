@@ -31,7 +31,8 @@ from pinarms.optim.motion.spline_proof import MAX_OPEN, cover_proof, merged
 from pinarms.planning import JointPath, joint_spline
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
-__all__ = ["REFINE_ROUNDS", "prove_path", "polyline_path", "smooth_path", "path_speed_bounds"]
+__all__ = ["REFINE_ROUNDS", "LIMIT_TOL", "prove_path", "polyline_path", "smooth_path", "path_speed_bounds",
+           "within_limits"]
 
 #: The compiled proof stops at the first range it leaves open, which the exact proof takes at once (a
 #: spline failing there is refused before the rest is proven), then goes on. Measured on the simplified
@@ -51,6 +52,8 @@ SAFETY = 1.0 + 1e-9
 #: planner paths of the four benchmark scenes (best of 3, interleaved, load 5.8–6.3): 1 045, 895 and
 #: 869 ms in all at 0, 1 and 2 (1 120 ms before the travel bound per part), 1 the steadier per scene.
 COARSE = 1
+#: Tolerance [rad or m] of the joint limits on a path's exact extrema (that of :meth:`MotionChecker.within_limits`).
+LIMIT_TOL = 1e-12
 
 
 def path_speed_bounds(path: JointPath) -> np.ndarray:
@@ -58,6 +61,87 @@ def path_speed_bounds(path: JointPath) -> np.ndarray:
     h = np.diff(path.breaks)
     values, _ = piece_extrema(normalised_pieces(path.coefficients, h), h, (1,))
     return np.nanmax(np.abs(values[0]), axis=-1)
+
+
+def _joint_extrema(breaks: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact smallest and largest value of every joint on every piece of a path of degree ≤ 3: ``(K, n)`` each
+    (the piece's ends and the real roots of the quadratic ``q'`` inside it)."""
+    h = np.diff(breaks)[:, None]
+    W = C.shape[1]
+    c = [C[:, d] if d < W else np.zeros_like(C[:, 0]) for d in range(4)]
+
+    def at(t: np.ndarray) -> np.ndarray:
+        return c[0] + t * (c[1] + t * (c[2] + t * c[3]))
+
+    end = at(np.broadcast_to(h, c[0].shape))
+    lo, hi = np.minimum(c[0], end), np.maximum(c[0], end)
+    a, b = 3.0 * c[3], 2.0 * c[2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.sqrt(np.maximum(b * b - 4.0 * a * c[1], 0.0))
+        real = b * b - 4.0 * a * c[1] >= 0.0
+        roots = [np.where(a != 0.0, (-b - r) / (2.0 * a), np.where(b != 0.0, -c[1] / b, np.nan)),
+                 np.where(a != 0.0, (-b + r) / (2.0 * a), np.nan)]
+    for t in roots:
+        inside = real & (t > 0.0) & (t < h)
+        v = at(np.where(inside, t, 0.0))
+        lo, hi = np.where(inside, np.minimum(lo, v), lo), np.where(inside, np.maximum(hi, v), hi)
+    return lo, hi
+
+
+def _outside(path: JointPath, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """``(K, n)``: whether piece k of ``path`` leaves joint j's limits (exact extrema, :data:`LIMIT_TOL`)."""
+    lo, hi = _joint_extrema(np.asarray(path.breaks, dtype=float), path.coefficients)
+    return (lo < lower - LIMIT_TOL) | (hi > upper + LIMIT_TOL)
+
+
+def _hermite(s: np.ndarray, y: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Coefficients (K, 4) ascending of the cubic Hermite pieces through ``y`` (K+1,) with slopes ``m`` (K+1,)."""
+    h = np.diff(s)
+    delta = np.diff(y) / h
+    return np.stack([y[:-1], m[:-1], (3.0 * delta - 2.0 * m[:-1] - m[1:]) / h,
+                     (m[:-1] + m[1:] - 2.0 * delta) / h ** 2], axis=1)
+
+
+def within_limits(path: JointPath, waypoints: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> JointPath:
+    """The spline ``path`` through ``waypoints`` kept inside the joint limits where it leaves them.
+
+    A C² spline through vertices at or near a joint limit overshoots it (a vertex on the limit
+    where the joint turns: the spline's slope is not 0 there). For every joint whose piece leaves
+    its limits, the slopes at both ends of that piece become the monotone (PCHIP,
+    Fritsch–Carlson) slopes of that joint's waypoints, which keep a piece between its end values;
+    repeated until no piece of the joint leaves (at worst every slope of the joint: its PCHIP).
+    The other joints and slopes stay: C² except at the changed knots, C¹ there. ``path`` itself
+    when no piece leaves. The result is proven like any spline (:func:`prove_path` refuses a
+    piece whose exact extrema leave the limits).
+    """
+    bad = _outside(path, lower, upper)
+    if not bad.any():
+        return path
+    from scipy.interpolate import PchipInterpolator
+
+    s = np.asarray(path.breaks, dtype=float)
+    C = path.coefficients.copy()
+    W = np.asarray(waypoints, dtype=float)
+    h = s[-1] - s[-2]
+    slopes = np.concatenate([C[:, 1], (C[-1, 1] + h * (2.0 * C[-1, 2] + 3.0 * C[-1, 3] * h))[None]])
+    for j in np.flatnonzero(bad.any(axis=0)):
+        monotone = PchipInterpolator(s, W[:, j]).derivative()(s)
+        m, changed = slopes[:, j].copy(), np.zeros(s.size, dtype=bool)
+        piece_bad = bad[:, j]
+        # first the knots of the bad pieces that lie on a limit alone (slope 0 there: PCHIP's own), then both ends
+        on = (W[:, j] <= lower[j] + LIMIT_TOL) | (W[:, j] >= upper[j] - LIMIT_TOL)
+        first = True
+        while piece_bad.any() and not changed.all():
+            ends = np.zeros(s.size, dtype=bool)
+            ends[:-1] |= piece_bad
+            ends[1:] |= piece_bad
+            changed |= ends & on if first and (ends & on & ~changed).any() else ends
+            first = False
+            m[changed] = monotone[changed]
+            C[:, :, j] = _hermite(s, W[:, j], m)
+            lo, hi = _joint_extrema(s, C[:, :, j:j + 1])
+            piece_bad = ((lo < lower[j] - LIMIT_TOL) | (hi > upper[j] + LIMIT_TOL))[:, 0]
+    return JointPath(s, C, robot=path.robot, frame=path.frame)
 
 
 def _speed_bound(C: np.ndarray, k: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
@@ -206,6 +290,10 @@ def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None, *
     failing there is refused before the rest is proven; then the others in one proof, the
     intervals between them counted as proven: travel 0); ``False``: the exact proof alone.
     """
+    if path.coefficients.shape[1] <= 4 and path.coefficients.shape[2] == checker.n:
+        outside = np.flatnonzero(_outside(path, checker.lower, checker.upper).any(axis=1))
+        if outside.size:  # a piece whose exact extrema leave the joint limits: refused at once
+            return Verdict(False), int(outside[0])
     nodes, T, V = _travel_parts(checker, path)
     s, budgets, _ = _samples(checker, path, (nodes, T))
     at = _PointEvaluator(path, nodes, T)
@@ -262,6 +350,18 @@ def polyline_path(waypoints: np.ndarray, robot: Any = None) -> JointPath:
     return JointPath(s, coefs, stops=s[1:-1], robot=robot)
 
 
+def _refined(W: np.ndarray, piece: int) -> tuple[np.ndarray, tuple[int, int]]:
+    """``W`` with vertices at the quarter points of the edges around ``piece`` (the spline pulled towards the
+    proven polyline there), and the range of pieces changed."""
+    lo, hi = max(0, piece - 1), min(W.shape[0] - 2, piece + 1)
+    rows = [W[: lo + 1]]
+    for k in range(lo, hi + 1):
+        a, b = W[k], W[k + 1]
+        rows.append(np.stack([a + 0.25 * (b - a), a + 0.75 * (b - a), b]))
+    rows.append(W[hi + 2:])
+    return np.concatenate(rows), (lo, lo + 3 * (hi - lo + 1))
+
+
 def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
                 compiled: bool = True) -> tuple[JointPath, str, int]:
     """A proven joint path through the polyline ``waypoints``: ``(path, method, rounds)``.
@@ -269,27 +369,30 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
     ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven, after
     ``rounds`` vertex insertions) or ``"polyline with stops"`` (the fallback). ``compiled``: each
     spline proven on the compiled cover first (:func:`prove_path`); ``False``: the exact proof alone.
+
+    The C² spline is refined up to :data:`REFINE_ROUNDS` times; if it is still not proven and the
+    spline through ``waypoints`` leaves the joint limits, the same again with the spline kept inside
+    them (:func:`within_limits`: a vertex on a joint limit, which no refinement pulls the spline back to).
     """
-    W = np.asarray(waypoints, dtype=float)
-    step = np.linalg.norm(np.diff(W, axis=0), axis=1)
-    W = W[np.concatenate([[True], step > 1e-12])]
-    if W.shape[0] <= 2:
-        return polyline_path(W, robot), "straight line", 0
-    changed = None  # the pieces of the spline around the last vertices inserted: proven first
-    for rounds in range(REFINE_ROUNDS + 1):
-        path = joint_spline(W, robot=robot)
-        focus = None if changed is None else \
-            (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
-        verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
-        if verdict.ok:
-            return path, "cubic spline", rounds
-        # pull the spline towards the proven polyline around the failing piece
-        lo, hi = max(0, piece - 1), min(W.shape[0] - 2, piece + 1)
-        rows = [W[: lo + 1]]
-        for k in range(lo, hi + 1):
-            a, b = W[k], W[k + 1]
-            rows.append(np.stack([a + 0.25 * (b - a), a + 0.75 * (b - a), b]))
-        rows.append(W[hi + 2:])
-        W = np.concatenate(rows)
-        changed = (lo, lo + 3 * (hi - lo + 1))
-    return polyline_path(waypoints, robot), "polyline with stops", REFINE_ROUNDS
+    W0 = np.asarray(waypoints, dtype=float)
+    step = np.linalg.norm(np.diff(W0, axis=0), axis=1)
+    W0 = W0[np.concatenate([[True], step > 1e-12])]
+    if W0.shape[0] <= 2:
+        return polyline_path(W0, robot), "straight line", 0
+    rounds = 0
+    for limited in (False, True):
+        W, changed = W0, None  # changed: the pieces around the last vertices inserted, proven first
+        if limited and not _outside(joint_spline(W0), checker.lower, checker.upper).any():
+            break  # the same splines again
+        for r in range(REFINE_ROUNDS + 1):
+            path = joint_spline(W, robot=robot)
+            if limited:
+                path = within_limits(path, W, checker.lower, checker.upper)
+            focus = None if changed is None else \
+                (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
+            verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
+            if verdict.ok:
+                return path, "cubic spline", rounds + r
+            W, changed = _refined(W, piece)
+        rounds += REFINE_ROUNDS
+    return polyline_path(waypoints, robot), "polyline with stops", rounds
