@@ -366,13 +366,14 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
                 compiled: bool = True) -> tuple[JointPath, str, int]:
     """A proven joint path through the polyline ``waypoints``: ``(path, method, rounds)``.
 
-    ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven, after
-    ``rounds`` vertex insertions) or ``"polyline with stops"`` (the fallback). ``compiled``: each
+    ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven after ``rounds``
+    splines refused) or ``"polyline with stops"`` (the fallback, ``rounds`` splines refused). ``compiled``: each
     spline proven on the compiled cover first (:func:`prove_path`); ``False``: the exact proof alone.
 
-    The C² spline is refined up to :data:`REFINE_ROUNDS` times; if it is still not proven and the
-    spline through ``waypoints`` leaves the joint limits, the same again with the spline kept inside
-    them (:func:`within_limits`: a vertex on a joint limit, which no refinement pulls the spline back to).
+    The C² spline is refined up to :data:`REFINE_ROUNDS` times (at once when a piece leaves a joint
+    limit next to a vertex on it, which no refinement pulls the spline back to); if it is still not
+    proven and the spline through ``waypoints`` leaves the joint limits, the same again with the
+    spline kept inside them (:func:`within_limits`).
     """
     W0 = np.asarray(waypoints, dtype=float)
     step = np.linalg.norm(np.diff(W0, axis=0), axis=1)
@@ -393,6 +394,17 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
             verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
             if verdict.ok:
                 return path, "cubic spline", rounds + r
+            if not limited and _on_limit(path, W, piece, checker.lower, checker.upper):
+                rounds += r + 1
+                break  # the spline leaves a limit next to a vertex on it: no vertex insertion removes that
             W, changed = _refined(W, piece)
-        rounds += REFINE_ROUNDS
+        else:
+            rounds += REFINE_ROUNDS + 1
     return polyline_path(waypoints, robot), "polyline with stops", rounds
+
+
+def _on_limit(path: JointPath, W: np.ndarray, piece: int, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether ``piece`` of the spline through ``W`` leaves the limits of a joint at an end vertex on that limit."""
+    bad = _outside(path, lower, upper)[piece]
+    ends = W[piece:piece + 2][:, bad]
+    return bool(np.any((ends <= lower[bad] + LIMIT_TOL) | (ends >= upper[bad] - LIMIT_TOL)))
