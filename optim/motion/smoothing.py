@@ -14,9 +14,13 @@ takes only the sample intervals around the ranges the cover leaves open. Where t
 polyline edges around the failing piece get vertices at their quarter points, which pulls
 the spline towards the proven polyline, and the spline is proven again
 (:data:`REFINE_ROUNDS` rounds at most; the pieces around the new vertices are proven first,
-so that a spline failing there again is refused before the rest is proven). If that does not
-succeed, the polyline itself is the path, with stops at its corners: slower, but proven by
-the search.
+so that a spline failing there again is refused before the rest is proven). A piece whose exact
+joint extrema leave the joint limits (by more than :data:`LIMIT_TOL`) is refused before anything
+else is proven. A spline through a vertex on a joint limit where the joint turns leaves the limit
+next to it, which no vertex insertion removes: then (or after the rounds, when the spline leaves a
+limit anywhere) the spline kept inside the limits (:func:`within_limits`: monotone slopes at the
+pieces that leave) is refined the same way. If that does not succeed either, the polyline
+itself is the path, with stops at its corners, proven by the search.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.motion.proof import Verdict
-from pinarms.optim.motion.spline_proof import MAX_OPEN, cover_proof, merged
+from pinarms.optim.motion.spline_proof import LIMIT_TOL, MAX_OPEN, cover_proof, joint_extrema, merged, outside_joints
 from pinarms.planning import JointPath, joint_spline
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
@@ -52,8 +56,6 @@ SAFETY = 1.0 + 1e-9
 #: planner paths of the four benchmark scenes (best of 3, interleaved, load 5.8–6.3): 1 045, 895 and
 #: 869 ms in all at 0, 1 and 2 (1 120 ms before the travel bound per part), 1 the steadier per scene.
 COARSE = 1
-#: Tolerance [rad or m] of the joint limits on a path's exact extrema (that of :meth:`MotionChecker.within_limits`).
-LIMIT_TOL = 1e-12
 
 
 def path_speed_bounds(path: JointPath) -> np.ndarray:
@@ -61,37 +63,6 @@ def path_speed_bounds(path: JointPath) -> np.ndarray:
     h = np.diff(path.breaks)
     values, _ = piece_extrema(normalised_pieces(path.coefficients, h), h, (1,))
     return np.nanmax(np.abs(values[0]), axis=-1)
-
-
-def _joint_extrema(breaks: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Exact smallest and largest value of every joint on every piece of a path of degree ≤ 3: ``(K, n)`` each
-    (the piece's ends and the real roots of the quadratic ``q'`` inside it)."""
-    h = np.diff(breaks)[:, None]
-    W = C.shape[1]
-    c = [C[:, d] if d < W else np.zeros_like(C[:, 0]) for d in range(4)]
-
-    def at(t: np.ndarray) -> np.ndarray:
-        return c[0] + t * (c[1] + t * (c[2] + t * c[3]))
-
-    end = at(np.broadcast_to(h, c[0].shape))
-    lo, hi = np.minimum(c[0], end), np.maximum(c[0], end)
-    a, b = 3.0 * c[3], 2.0 * c[2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.sqrt(np.maximum(b * b - 4.0 * a * c[1], 0.0))
-        real = b * b - 4.0 * a * c[1] >= 0.0
-        roots = [np.where(a != 0.0, (-b - r) / (2.0 * a), np.where(b != 0.0, -c[1] / b, np.nan)),
-                 np.where(a != 0.0, (-b + r) / (2.0 * a), np.nan)]
-    for t in roots:
-        inside = real & (t > 0.0) & (t < h)
-        v = at(np.where(inside, t, 0.0))
-        lo, hi = np.where(inside, np.minimum(lo, v), lo), np.where(inside, np.maximum(hi, v), hi)
-    return lo, hi
-
-
-def _outside(path: JointPath, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-    """``(K, n)``: whether piece k of ``path`` leaves joint j's limits (exact extrema, :data:`LIMIT_TOL`)."""
-    lo, hi = _joint_extrema(np.asarray(path.breaks, dtype=float), path.coefficients)
-    return (lo < lower - LIMIT_TOL) | (hi > upper + LIMIT_TOL)
 
 
 def _hermite(s: np.ndarray, y: np.ndarray, m: np.ndarray) -> np.ndarray:
@@ -114,7 +85,7 @@ def within_limits(path: JointPath, waypoints: np.ndarray, lower: np.ndarray, upp
     when no piece leaves. The result is proven like any spline (:func:`prove_path` refuses a
     piece whose exact extrema leave the limits).
     """
-    bad = _outside(path, lower, upper)
+    bad = outside_joints(path, lower, upper)
     if not bad.any():
         return path
     from scipy.interpolate import PchipInterpolator
@@ -139,7 +110,7 @@ def within_limits(path: JointPath, waypoints: np.ndarray, lower: np.ndarray, upp
             first = False
             m[changed] = monotone[changed]
             C[:, :, j] = _hermite(s, W[:, j], m)
-            lo, hi = _joint_extrema(s, C[:, :, j:j + 1])
+            lo, hi = joint_extrema(s, C[:, :, j:j + 1])
             piece_bad = ((lo < lower[j] - LIMIT_TOL) | (hi > upper[j] + LIMIT_TOL))[:, 0]
     return JointPath(s, C, robot=path.robot, frame=path.frame)
 
@@ -289,9 +260,11 @@ def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None, *
     ranges it leaves open (the first one found, and the joint limits', as soon as found: a path
     failing there is refused before the rest is proven; then the others in one proof, the
     intervals between them counted as proven: travel 0); ``False``: the exact proof alone.
+    First of all, a path of degree ≤ 3 whose exact joint extrema leave the checker's joint limits
+    (:func:`.spline_proof.outside_joints`) is refused at its first such piece.
     """
     if path.coefficients.shape[1] <= 4 and path.coefficients.shape[2] == checker.n:
-        outside = np.flatnonzero(_outside(path, checker.lower, checker.upper).any(axis=1))
+        outside = np.flatnonzero(outside_joints(path, checker.lower, checker.upper).any(axis=1))
         if outside.size:  # a piece whose exact extrema leave the joint limits: refused at once
             return Verdict(False), int(outside[0])
     nodes, T, V = _travel_parts(checker, path)
@@ -383,7 +356,7 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
     rounds = 0
     for limited in (False, True):
         W, changed = W0, None  # changed: the pieces around the last vertices inserted, proven first
-        if limited and not _outside(joint_spline(W0), checker.lower, checker.upper).any():
+        if limited and not outside_joints(joint_spline(W0), checker.lower, checker.upper).any():
             break  # the same splines again
         for r in range(REFINE_ROUNDS + 1):
             path = joint_spline(W, robot=robot)
@@ -405,6 +378,6 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
 
 def _on_limit(path: JointPath, W: np.ndarray, piece: int, lower: np.ndarray, upper: np.ndarray) -> bool:
     """Whether ``piece`` of the spline through ``W`` leaves the limits of a joint at an end vertex on that limit."""
-    bad = _outside(path, lower, upper)[piece]
+    bad = outside_joints(path, lower, upper)[piece]
     ends = W[piece:piece + 2][:, bad]
     return bool(np.any((ends <= lower[bad] + LIMIT_TOL) | (ends >= upper[bad] - LIMIT_TOL)))
