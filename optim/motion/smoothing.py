@@ -343,37 +343,45 @@ def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
     splines refused) or ``"polyline with stops"`` (the fallback, ``rounds`` splines refused). ``compiled``: each
     spline proven on the compiled cover first (:func:`prove_path`); ``False``: the exact proof alone.
 
-    The C² spline is refined up to :data:`REFINE_ROUNDS` times (at once when a piece leaves a joint
+    The C² spline is refined up to :data:`REFINE_ROUNDS` times (no more once a piece leaves a joint
     limit next to a vertex on it, which no refinement pulls the spline back to); if it is still not
-    proven and the spline through ``waypoints`` leaves the joint limits, the same again with the
-    spline kept inside them (:func:`within_limits`).
+    proven and a refused spline left the joint limits, the same rounds again with the splines kept
+    inside them (:func:`within_limits`).
     """
     W0 = np.asarray(waypoints, dtype=float)
     step = np.linalg.norm(np.diff(W0, axis=0), axis=1)
     W0 = W0[np.concatenate([[True], step > 1e-12])]
     if W0.shape[0] <= 2:
         return polyline_path(W0, robot), "straight line", 0
-    rounds = 0
-    for limited in (False, True):
-        W, changed = W0, None  # changed: the pieces around the last vertices inserted, proven first
-        if limited and not outside_joints(joint_spline(W0), checker.lower, checker.upper).any():
-            break  # the same splines again
-        for r in range(REFINE_ROUNDS + 1):
-            path = joint_spline(W, robot=robot)
-            if limited:
-                path = within_limits(path, W, checker.lower, checker.upper)
-            focus = None if changed is None else \
-                (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
-            verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
-            if verdict.ok:
-                return path, "cubic spline", rounds + r
-            if not limited and _on_limit(path, W, piece, checker.lower, checker.upper):
-                rounds += r + 1
-                break  # the spline leaves a limit next to a vertex on it: no vertex insertion removes that
-            W, changed = _refined(W, piece)
-        else:
-            rounds += REFINE_ROUNDS + 1
+    path, rounds, left = _rounds(checker, W0, robot, compiled, limited=False)
+    if path is None and left:  # a refused spline left a joint limit: the splines kept inside them
+        path, more, _ = _rounds(checker, W0, robot, compiled, limited=True)
+        rounds += more
+    if path is not None:
+        return path, "cubic spline", rounds
     return polyline_path(waypoints, robot), "polyline with stops", rounds
+
+
+def _rounds(checker: Any, W: np.ndarray, robot: Any, compiled: bool, *,
+            limited: bool) -> tuple[JointPath | None, int, bool]:
+    """The refinement rounds of :func:`smooth_path` on the splines through ``W`` (``limited``: each kept inside
+    the joint limits, :func:`within_limits`): ``(proven path or None, splines refused, whether a refused
+    spline left a joint limit)``. Unlimited, the rounds end at a piece leaving a limit next to a vertex on it."""
+    changed, left = None, False  # changed: the pieces around the last vertices inserted, proven first
+    for r in range(REFINE_ROUNDS + 1):
+        path = joint_spline(W, robot=robot)
+        if limited:
+            path = within_limits(path, W, checker.lower, checker.upper)
+        focus = None if changed is None else \
+            (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
+        verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
+        if verdict.ok:
+            return path, r, left
+        left = left or bool(outside_joints(path, checker.lower, checker.upper).any())
+        if not limited and _on_limit(path, W, piece, checker.lower, checker.upper):
+            return None, r + 1, left  # no vertex insertion removes that
+        W, changed = _refined(W, piece)
+    return None, REFINE_ROUNDS + 1, left
 
 
 def _on_limit(path: JointPath, W: np.ndarray, piece: int, lower: np.ndarray, upper: np.ndarray) -> bool:
