@@ -14,9 +14,13 @@ takes only the sample intervals around the ranges the cover leaves open. Where t
 polyline edges around the failing piece get vertices at their quarter points, which pulls
 the spline towards the proven polyline, and the spline is proven again
 (:data:`REFINE_ROUNDS` rounds at most; the pieces around the new vertices are proven first,
-so that a spline failing there again is refused before the rest is proven). If that does not
-succeed, the polyline itself is the path, with stops at its corners: slower, but proven by
-the search.
+so that a spline failing there again is refused before the rest is proven). A piece whose exact
+joint extrema leave the joint limits (by more than :data:`LIMIT_TOL`) is refused before anything
+else is proven. A spline through a vertex on a joint limit where the joint turns leaves the limit
+next to it, which no vertex insertion removes: then (or after the rounds, when the spline leaves a
+limit anywhere) the spline kept inside the limits (:func:`within_limits`: monotone slopes at the
+pieces that leave) is refined the same way. If that does not succeed either, the polyline
+itself is the path, with stops at its corners, proven by the search.
 """
 
 from __future__ import annotations
@@ -27,11 +31,12 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.motion.proof import Verdict
-from pinarms.optim.motion.spline_proof import MAX_OPEN, cover_proof, merged
+from pinarms.optim.motion.spline_proof import LIMIT_TOL, MAX_OPEN, cover_proof, joint_extrema, merged, outside_joints
 from pinarms.planning import JointPath, joint_spline
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
-__all__ = ["REFINE_ROUNDS", "prove_path", "polyline_path", "smooth_path", "path_speed_bounds"]
+__all__ = ["REFINE_ROUNDS", "LIMIT_TOL", "prove_path", "polyline_path", "smooth_path", "path_speed_bounds",
+           "within_limits"]
 
 #: The compiled proof stops at the first range it leaves open, which the exact proof takes at once (a
 #: spline failing there is refused before the rest is proven), then goes on. Measured on the simplified
@@ -58,6 +63,56 @@ def path_speed_bounds(path: JointPath) -> np.ndarray:
     h = np.diff(path.breaks)
     values, _ = piece_extrema(normalised_pieces(path.coefficients, h), h, (1,))
     return np.nanmax(np.abs(values[0]), axis=-1)
+
+
+def _hermite(s: np.ndarray, y: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Coefficients (K, 4) ascending of the cubic Hermite pieces through ``y`` (K+1,) with slopes ``m`` (K+1,)."""
+    h = np.diff(s)
+    delta = np.diff(y) / h
+    return np.stack([y[:-1], m[:-1], (3.0 * delta - 2.0 * m[:-1] - m[1:]) / h,
+                     (m[:-1] + m[1:] - 2.0 * delta) / h ** 2], axis=1)
+
+
+def within_limits(path: JointPath, waypoints: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> JointPath:
+    """The spline ``path`` through ``waypoints`` kept inside the joint limits where it leaves them.
+
+    A C² spline through vertices at or near a joint limit overshoots it (a vertex on the limit
+    where the joint turns: the spline's slope is not 0 there). For every joint whose piece leaves
+    its limits, the slopes at both ends of that piece become the monotone (PCHIP,
+    Fritsch–Carlson) slopes of that joint's waypoints, which keep a piece between its end values;
+    repeated until no piece of the joint leaves (at worst every slope of the joint: its PCHIP).
+    The other joints and slopes stay: C² except at the changed knots, C¹ there. ``path`` itself
+    when no piece leaves. The result is proven like any spline (:func:`prove_path` refuses a
+    piece whose exact extrema leave the limits).
+    """
+    bad = outside_joints(path, lower, upper)
+    if not bad.any():
+        return path
+    from scipy.interpolate import PchipInterpolator
+
+    s = np.asarray(path.breaks, dtype=float)
+    C = path.coefficients.copy()
+    W = np.asarray(waypoints, dtype=float)
+    h = s[-1] - s[-2]
+    slopes = np.concatenate([C[:, 1], (C[-1, 1] + h * (2.0 * C[-1, 2] + 3.0 * C[-1, 3] * h))[None]])
+    for j in np.flatnonzero(bad.any(axis=0)):
+        monotone = PchipInterpolator(s, W[:, j]).derivative()(s)
+        m, changed = slopes[:, j].copy(), np.zeros(s.size, dtype=bool)
+        piece_bad = bad[:, j]
+        # first the knots of the bad pieces that lie on a limit alone (slope 0 there: PCHIP's own), then both ends
+        on = (W[:, j] <= lower[j] + LIMIT_TOL) | (W[:, j] >= upper[j] - LIMIT_TOL)
+        first = True
+        while piece_bad.any() and not changed.all():
+            ends = np.zeros(s.size, dtype=bool)
+            ends[:-1] |= piece_bad
+            ends[1:] |= piece_bad
+            changed |= ends & on if first and (ends & on & ~changed).any() else ends
+            first = False
+            m[changed] = monotone[changed]
+            C[:, :, j] = _hermite(s, W[:, j], m)
+            lo, hi = joint_extrema(s, C[:, :, j:j + 1])
+            piece_bad = ((lo < lower[j] - LIMIT_TOL) | (hi > upper[j] + LIMIT_TOL))[:, 0]
+    return JointPath(s, C, robot=path.robot, frame=path.frame)
 
 
 def _speed_bound(C: np.ndarray, k: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
@@ -205,7 +260,13 @@ def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None, *
     ranges it leaves open (the first one found, and the joint limits', as soon as found: a path
     failing there is refused before the rest is proven; then the others in one proof, the
     intervals between them counted as proven: travel 0); ``False``: the exact proof alone.
+    First of all, a path of degree ≤ 3 whose exact joint extrema leave the checker's joint limits
+    (:func:`.spline_proof.outside_joints`) is refused at its first such piece.
     """
+    if path.coefficients.shape[1] <= 4 and path.coefficients.shape[2] == checker.n:
+        outside = np.flatnonzero(outside_joints(path, checker.lower, checker.upper).any(axis=1))
+        if outside.size:  # a piece whose exact extrema leave the joint limits: refused at once
+            return Verdict(False), int(outside[0])
     nodes, T, V = _travel_parts(checker, path)
     s, budgets, _ = _samples(checker, path, (nodes, T))
     at = _PointEvaluator(path, nodes, T)
@@ -262,34 +323,69 @@ def polyline_path(waypoints: np.ndarray, robot: Any = None) -> JointPath:
     return JointPath(s, coefs, stops=s[1:-1], robot=robot)
 
 
+def _refined(W: np.ndarray, piece: int) -> tuple[np.ndarray, tuple[int, int]]:
+    """``W`` with vertices at the quarter points of the edges around ``piece`` (the spline pulled towards the
+    proven polyline there), and the range of pieces changed."""
+    lo, hi = max(0, piece - 1), min(W.shape[0] - 2, piece + 1)
+    rows = [W[: lo + 1]]
+    for k in range(lo, hi + 1):
+        a, b = W[k], W[k + 1]
+        rows.append(np.stack([a + 0.25 * (b - a), a + 0.75 * (b - a), b]))
+    rows.append(W[hi + 2:])
+    return np.concatenate(rows), (lo, lo + 3 * (hi - lo + 1))
+
+
 def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
                 compiled: bool = True) -> tuple[JointPath, str, int]:
     """A proven joint path through the polyline ``waypoints``: ``(path, method, rounds)``.
 
-    ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven, after
-    ``rounds`` vertex insertions) or ``"polyline with stops"`` (the fallback). ``compiled``: each
+    ``method`` is ``"straight line"`` (two waypoints), ``"cubic spline"`` (proven after ``rounds``
+    splines refused) or ``"polyline with stops"`` (the fallback, ``rounds`` splines refused). ``compiled``: each
     spline proven on the compiled cover first (:func:`prove_path`); ``False``: the exact proof alone.
+
+    The C² spline is refined up to :data:`REFINE_ROUNDS` times (no more once a piece leaves a joint
+    limit next to a vertex on it, which no refinement pulls the spline back to); if it is still not
+    proven and a refused spline left the joint limits, the same rounds again with the splines kept
+    inside them (:func:`within_limits`).
     """
-    W = np.asarray(waypoints, dtype=float)
-    step = np.linalg.norm(np.diff(W, axis=0), axis=1)
-    W = W[np.concatenate([[True], step > 1e-12])]
-    if W.shape[0] <= 2:
-        return polyline_path(W, robot), "straight line", 0
-    changed = None  # the pieces of the spline around the last vertices inserted: proven first
-    for rounds in range(REFINE_ROUNDS + 1):
+    W0 = np.asarray(waypoints, dtype=float)
+    step = np.linalg.norm(np.diff(W0, axis=0), axis=1)
+    W0 = W0[np.concatenate([[True], step > 1e-12])]
+    if W0.shape[0] <= 2:
+        return polyline_path(W0, robot), "straight line", 0
+    path, rounds, left = _rounds(checker, W0, robot, compiled, limited=False)
+    if path is None and left:  # a refused spline left a joint limit: the splines kept inside them
+        path, more, _ = _rounds(checker, W0, robot, compiled, limited=True)
+        rounds += more
+    if path is not None:
+        return path, "cubic spline", rounds
+    return polyline_path(waypoints, robot), "polyline with stops", rounds
+
+
+def _rounds(checker: Any, W: np.ndarray, robot: Any, compiled: bool, *,
+            limited: bool) -> tuple[JointPath | None, int, bool]:
+    """The refinement rounds of :func:`smooth_path` on the splines through ``W`` (``limited``: each kept inside
+    the joint limits, :func:`within_limits`): ``(proven path or None, splines refused, whether a refused
+    spline left a joint limit)``. Unlimited, the rounds end at a piece leaving a limit next to a vertex on it."""
+    changed, left = None, False  # changed: the pieces around the last vertices inserted, proven first
+    for r in range(REFINE_ROUNDS + 1):
         path = joint_spline(W, robot=robot)
+        if limited:
+            path = within_limits(path, W, checker.lower, checker.upper)
         focus = None if changed is None else \
             (path.breaks[max(0, changed[0] - 1)], path.breaks[min(len(path.breaks) - 1, changed[1] + 1)])
         verdict, piece = prove_path(checker, path, focus=focus, compiled=compiled)
         if verdict.ok:
-            return path, "cubic spline", rounds
-        # pull the spline towards the proven polyline around the failing piece
-        lo, hi = max(0, piece - 1), min(W.shape[0] - 2, piece + 1)
-        rows = [W[: lo + 1]]
-        for k in range(lo, hi + 1):
-            a, b = W[k], W[k + 1]
-            rows.append(np.stack([a + 0.25 * (b - a), a + 0.75 * (b - a), b]))
-        rows.append(W[hi + 2:])
-        W = np.concatenate(rows)
-        changed = (lo, lo + 3 * (hi - lo + 1))
-    return polyline_path(waypoints, robot), "polyline with stops", REFINE_ROUNDS
+            return path, r, left
+        left = left or bool(outside_joints(path, checker.lower, checker.upper).any())
+        if not limited and _on_limit(path, W, piece, checker.lower, checker.upper):
+            return None, r + 1, left  # no vertex insertion removes that
+        W, changed = _refined(W, piece)
+    return None, REFINE_ROUNDS + 1, left
+
+
+def _on_limit(path: JointPath, W: np.ndarray, piece: int, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether ``piece`` of the spline through ``W`` leaves the limits of a joint at an end vertex on that limit."""
+    bad = outside_joints(path, lower, upper)[piece]
+    ends = W[piece:piece + 2][:, bad]
+    return bool(np.any((ends <= lower[bad] + LIMIT_TOL) | (ends >= upper[bad] - LIMIT_TOL)))

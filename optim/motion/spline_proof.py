@@ -10,7 +10,9 @@ closer than the margin is called clear: the cover contains the geometry, so its 
 lower bound of the exact one.
 
 The joint limits are checked exactly: a piece whose exact joint extrema leave the limits is
-left open (the exact proof checks its samples against them, as before).
+left open (the exact proof checks its samples against them, as before); :func:`joint_extrema` /
+:func:`outside_joints` give those extrema per joint, with which :func:`.smoothing.prove_path`
+refuses such a piece before any sample is proven (a spline may leave a limit between samples).
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ import numpy as np
 from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
 
-__all__ = ["CoverProof", "cover_proof", "open_ranges", "merged", "MAX_STATES", "FIRST_STEP"]
+__all__ = ["CoverProof", "cover_proof", "open_ranges", "merged", "joint_extrema", "outside_joints", "MAX_STATES",
+           "FIRST_STEP", "LIMIT_TOL"]
 
 #: Most states one compiled spline proof evaluates (about 5 µs each); the intervals left then go to
 #: the exact proof.
@@ -37,6 +40,8 @@ CHUNK = 16
 _HUGE = 1e300
 #: Most ranges the compiled proof hands to the exact one (more: the whole path goes to it).
 MAX_OPEN = 4096
+#: Tolerance [rad or m] of the joint limits on a path's exact extrema (that of :meth:`MotionChecker.within_limits`).
+LIMIT_TOL = 1e-12
 
 
 def _outside_limits(checker: Any, path: Any) -> np.ndarray:
@@ -182,3 +187,34 @@ def open_ranges(checker: Any, path: Any, nodes: np.ndarray, T: np.ndarray, V: np
     proof = cover_proof(checker, path, nodes, T, V)
     got = None if proof is None else proof.advance()
     return None if got is None else merged([got, proof.limits])
+
+
+def joint_extrema(breaks: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact smallest and largest value of every joint on every piece of a path of degree ≤ 3: ``(K, n)`` each
+    (the piece's ends and the real roots of the quadratic ``q'`` inside it)."""
+    h = np.diff(breaks)[:, None]
+    W = C.shape[1]
+    c = [C[:, d] if d < W else np.zeros_like(C[:, 0]) for d in range(4)]
+
+    def at(t: np.ndarray) -> np.ndarray:
+        return c[0] + t * (c[1] + t * (c[2] + t * c[3]))
+
+    end = at(np.broadcast_to(h, c[0].shape))
+    lo, hi = np.minimum(c[0], end), np.maximum(c[0], end)
+    a, b = 3.0 * c[3], 2.0 * c[2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.sqrt(np.maximum(b * b - 4.0 * a * c[1], 0.0))
+        real = b * b - 4.0 * a * c[1] >= 0.0
+        roots = [np.where(a != 0.0, (-b - r) / (2.0 * a), np.where(b != 0.0, -c[1] / b, np.nan)),
+                 np.where(a != 0.0, (-b + r) / (2.0 * a), np.nan)]
+    for t in roots:
+        inside = real & (t > 0.0) & (t < h)
+        v = at(np.where(inside, t, 0.0))
+        lo, hi = np.where(inside, np.minimum(lo, v), lo), np.where(inside, np.maximum(hi, v), hi)
+    return lo, hi
+
+
+def outside_joints(path: Any, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """``(K, n)``: whether piece k of ``path`` leaves joint j's limits (exact extrema, :data:`LIMIT_TOL`)."""
+    lo, hi = joint_extrema(np.asarray(path.breaks, dtype=float), path.coefficients)
+    return (lo < lower - LIMIT_TOL) | (hi > upper + LIMIT_TOL)
