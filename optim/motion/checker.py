@@ -55,6 +55,11 @@ from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, V
 from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
 from pinarms.robots.errors import InvalidInput
 
+#: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
+#: :meth:`MotionChecker.trajectory_valid` (the rounding of a time scaling's re-expanded
+#: polynomials, not a physical excursion).
+TIMED_LIMIT_TOL = 1e-9
+
 __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "COARSE_LEVELS", "check_threads",
            "coarse_first"]
 
@@ -359,10 +364,15 @@ class MotionChecker(CoalBatches, LadderProof):
 
         Samples uniform in time so that the planned arms' travel (exact velocity peaks times
         the levers) plus the moving arms' (:meth:`moving_travel`) is at most ``step`` between
-        two; a halved interval gets each half's own budget."""
+        two; a halved interval gets each half's own budget. The joint limits are checked at the
+        trajectory's exact per-joint extremes first (within :data:`TIMED_LIMIT_TOL`): a timed motion
+        may pass a limit between two samples."""
         from pinarms.planning import Trajectory
 
         tr = trajectory
+        low, high = tr.position_range()
+        if np.any(low < self.lower - TIMED_LIMIT_TOL) or np.any(high > self.upper + TIMED_LIMIT_TOL):
+            return Verdict(False, 0, 0.0)
         vb = float(np.abs(np.asarray(tr.peaks().velocity, dtype=float)) @ self.levers)
         if until is None and self.timed:
             until = max(m.offset + m.trajectory.end_time - m.trajectory.start_time for m in self.moving)

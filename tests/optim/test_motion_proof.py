@@ -86,3 +86,25 @@ def test_a_proof_past_its_deadline_is_not_valid(checker, states):
     finally:
         checker.deadline = None
     assert not verdict.ok and checker.counts["timeouts"] > before
+
+
+def test_a_timed_motion_passing_a_joint_limit_between_samples_is_refused(checker, states):
+    """A joint rising to its upper limit and back: 1e-6 below it the timed proof runs (and proves it),
+    1e-6 beyond it the motion is refused at its exact extremes, whatever the samples."""
+    from pinarms.planning import Trajectory
+
+    xa = states[0]
+    j = int(np.argmax(checker.upper - checker.lower))
+    T = 1.0
+    verdicts = []
+    for beyond in (-1e-6, 1e-6):
+        start = xa.copy()
+        start[j] = checker.upper[j] - 0.01
+        k = 4.0 * (checker.upper[j] + beyond - start[j]) / T ** 2
+        coefs = np.zeros((1, 3, xa.size))
+        coefs[0, 0] = start
+        coefs[0, 1, j], coefs[0, 2, j] = k * T, -k
+        tr = Trajectory([0.0, T], coefs)
+        assert tr.position_range()[1][j] == pytest.approx(checker.upper[j] + beyond, abs=1e-12)
+        verdicts.append(checker.trajectory_valid(tr).ok)
+    assert verdicts == [True, False]
