@@ -26,7 +26,7 @@ from pinarms.optim.motion.search import search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["plan_geometry", "find_path", "fast_share", "FAST_SHARE"]
+__all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAST_SHARE"]
 
 #: Share of the time limit the compiled search may take when the cover proves at least half of the
 #: clear random states (:attr:`MotionChecker.cover_share`); OMPL has the rest. Measured on
@@ -47,12 +47,49 @@ def _exact(checker: Any, P: np.ndarray) -> bool:
     return all(checker.edge_valid(P[i], P[i + 1]).ok for i in range(P.shape[0] - 1))
 
 
+def travel_time_bound(P: np.ndarray, vmax: np.ndarray) -> float:
+    """A lower bound [s] of the time to follow the polyline ``P (k, n)`` at joint speeds ``vmax (n,)``: each
+    edge takes at least its slowest joint's travel at full speed."""
+    P = np.asarray(P, dtype=float)
+    if P.shape[0] < 2:
+        return 0.0
+    return float(np.sum(np.max(np.abs(np.diff(P, axis=0)) / vmax, axis=1)))
+
+
+def _best_goal(checker: Any, x0: np.ndarray, G: np.ndarray, found: np.ndarray, vmax: np.ndarray, seed: int,
+               deadline: float) -> tuple[np.ndarray, int, int]:
+    """The shortcut path to the goal branch whose path has the smallest :func:`travel_time_bound`: each other
+    goal, in increasing order of its straight move's bound, is searched alone (compiled) while that bound is
+    below the best path's (no later goal can beat it) and the clock is before ``deadline``. Returns the path,
+    the searches run and their states."""
+    best, best_bound = found, travel_time_bound(found, vmax)
+    straight = np.max(np.abs(G - x0) / vmax, axis=1)
+    runs = states = 0
+    for g in np.argsort(straight, kind="stable"):
+        if straight[g] >= best_bound or time.perf_counter() >= deadline:
+            break
+        if np.array_equal(G[g], best[-1]):
+            continue
+        r = fast_search(checker, x0, G[g][None], time_limit=max(deadline - time.perf_counter(), 1e-4), seed=int(seed))
+        runs, states = runs + 1, states + r.states
+        if r.path is None:
+            continue
+        P = fast_shortcut(checker, r.path, seed=int(seed))
+        bound = travel_time_bound(P, vmax)
+        if bound < best_bound:
+            best, best_bound = P, bound
+    return best, runs, states
+
+
 def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
-              compiled: bool = True, say: Callable[[str], None] = lambda _m: None) -> dict:
+              compiled: bool = True, say: Callable[[str], None] = lambda _m: None,
+              best_goal: np.ndarray | None = None) -> dict:
     """Search and shortcut (module docstring): a dict with ``result`` (:class:`.search.SearchResult`, its
     seconds and states those of both searches), ``simplified``, ``simplifier``, ``compiled`` (bool),
     ``seconds`` (``"search"``, ``"shortcut"``). ``NoPathFound`` when nothing is found in time.
-    ``compiled=False``: OMPL alone."""
+    ``compiled=False``: OMPL alone. ``best_goal``: the planned joints' speed limits ``(n,)``: with several
+    goal configurations, a compiled path is compared with paths searched to each other goal within the
+    compiled search's share of the time limit (:func:`_best_goal`); ``None``: the first goal reached."""
     t0 = time.perf_counter()
     share = fast_share(checker, planner) if compiled else 0.0
     spent, states = 0.0, 0
@@ -63,6 +100,10 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
             say(f"path found compiled in {fast.seconds:.4f} s ({fast.states} states); shortcutting")
             t = time.perf_counter()
             simplified = fast_shortcut(checker, fast.path, seed=int(seed))
+            if best_goal is not None and len(G) > 1:
+                simplified, runs, more = _best_goal(checker, x0, G, simplified, np.asarray(best_goal, dtype=float),
+                                                    int(seed), t0 + share * float(time_limit))
+                say(f"{runs} other goal(s) searched ({more} states); the path with the shortest time bound kept")
             return {"result": fast, "simplified": simplified, "simplifier": FAST_SIMPLIFIER, "compiled": True,
                     "seconds": {"search": fast.seconds, "shortcut": time.perf_counter() - t}}
     rest = max(float(time_limit) - (time.perf_counter() - t0), 1e-3)
@@ -84,7 +125,7 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
 
 def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
                   time_limit: float, seed: int, frame: str | None = None, compiled: bool = True,
-                  say: Callable[[str], None] = lambda _m: None) -> dict:
+                  say: Callable[[str], None] = lambda _m: None, best_goal: np.ndarray | None = None) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
     Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
@@ -100,7 +141,8 @@ def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any
                            "plan; give a goal different from the start")
     say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
     robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
-    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled, say=say)
+    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled, say=say,
+                      best_goal=best_goal)
     t = time.perf_counter()
     path, method, _ = smooth_path(checker, found["simplified"], robot)
     if found["compiled"] and method != "cubic spline" and not _exact(checker, found["simplified"]):

@@ -155,7 +155,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
                 planner: str = "rrtconnect", time_limit: float = 1.0, seed: int = 0, hold: Any = None,
                 frame: str | None = None, vmax: Any = None, amax: Any = None, torque: Any = True,
                 grid: int = 200, threads: int = 1, compiled: bool = True, recheck: bool = True,
-                progress: Callable[[str], None] | None = None) -> MotionPlan:
+                goals: str = "first", progress: Callable[[str], None] | None = None) -> MotionPlan:
     """Plan a collision-free move of ``arm`` from ``start`` to ``goal`` in ``cell`` (module docstring).
 
     Args:
@@ -183,6 +183,12 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         recheck: re-check the timed motion by the cell's own continuous check and report its
             clearance profile (``False``: ``check`` and ``clearance`` are ``None``; the path is
             proven by the exact checker either way).
+        goals: with several goal configurations (the IK branches of a pose goal): ``"first"``,
+            the path to the first one reached; ``"best"``, each other goal is also searched
+            (compiled, within the compiled search's share of ``time_limit``, in increasing order
+            of its straight move's time bound, while it could still win) and the path with the
+            shortest time bound (each edge at its slowest joint's speed limit) is kept: for a
+            move planned once and run many times.
         progress: called with a short line at each step.
 
     Raises:
@@ -200,13 +206,16 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     say = progress or (lambda _m: None)
     arms = _arms(cell, arm)
     key = _check_settings(planner, time_limit, seed, grid)
+    if goals not in ("first", "best"):
+        raise InvalidSettings(f"goals must be 'first' or 'best', got {goals!r}")
     threads = check_threads(threads)
     checker = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=hold, threads=threads)
     constraints, limits = _limits(cell, arms, vmax, amax, torque)
     x0 = _joints(cell, arms, start, "start")
     _check_start(checker, x0, "start")
+    speed = constraints[0].vmax if goals == "best" else None  # the joint velocity limits come first
     geo = plan_geometry(checker, arms, x0, goal, planner=key, time_limit=float(time_limit), seed=int(seed), frame=frame,
-                        compiled=bool(compiled), say=say)
+                        compiled=bool(compiled), say=say, best_goal=speed)
     seconds = dict(geo["seconds"])
     path, method = geo["path"], geo["smoothing"]
     t = time.perf_counter()

@@ -51,6 +51,9 @@ def load_any_cell(name: str) -> Any:
 @click.option("--planner", default="rrtconnect", show_default=True, help="OMPL planner (rrtconnect, rrt, prm, ...).")
 @click.option("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take.")
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of the search (same seed, same path).")
+@click.option("--goals", "goal_choice", type=click.Choice(["first", "best"]), default="first", show_default=True,
+              help="With several clear IK branches of the goal: the path to the first one reached, or each searched "
+                   "and the path with the shortest time bound kept (a move planned once, run many times).")
 @click.option("--amax", default=None, help="Joint acceleration limit(s) [rad/s² or m/s²] (torque limits apply too).")
 @click.option("--no-torque", is_flag=True, help="Time under velocity (and --amax) limits only, not the URDF's torques.")
 @click.option("--deg", is_flag=True, help="ROLL PITCH YAW and --from-q in degrees.")
@@ -61,8 +64,8 @@ def load_any_cell(name: str) -> Any:
               help="Write the clearance-over-time plot (PNG).")
 @json_option
 def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, start_q: str | None, margin: float,
-               planner: str, time_limit: float, seed: int, amax: str | None, no_torque: bool, deg: bool, mm: bool,
-               session_path: str | None, plot_path: str | None, as_json: bool) -> None:
+               planner: str, time_limit: float, seed: int, goal_choice: str, amax: str | None, no_torque: bool,
+               deg: bool, mm: bool, session_path: str | None, plot_path: str | None, as_json: bool) -> None:
     """Plan a collision-free move of an arm in CELL to a tool pose, prove it clear, time it optimally.
 
     CELL is a planning scene (aubo_crate_guard, panda_shelf, ...), a built-in cell
@@ -117,7 +120,7 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
     a = None if amax is None else floats(amax, "--amax")
     plan = plan_motion(c, arm.name, q0, T, margin=margin_m, planner=planner, time_limit=time_limit, seed=seed,
                        amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque,
-                       progress=progress)
+                       goals=goal_choice, progress=progress)
     u = "mm" if mm else "m"
     cl = plan.clearance
     data: dict[str, Any] = {"cell": c.name, "arm": arm.name, **plan.as_dict(),

@@ -40,3 +40,16 @@ def test_motion_goal_inside_the_wall_is_one_error_line():
 def test_motion_needs_an_arm_in_a_two_arm_cell():
     result = CliRunner().invoke(cli, ["motion", "mushroom_line", "--to", "0", "0", "0.9"])
     assert result.exit_code == 1 and "give --arm" in result.stderr
+
+
+def test_motion_goals_best_is_never_slower_in_bound_and_stays_proven():
+    args = ["motion", "aubo_crate_guard", "--from", "0.41", "0.10", "0.79", "--to", "0", "-0.465", "0.78",
+            "--time-limit", "10", "--json"]
+    first = CliRunner().invoke(cli, args)
+    best = CliRunner().invoke(cli, [*args, "--goals", "best"])
+    assert first.exit_code == 0 and best.exit_code == 0, (first.output, best.output)
+    a, b = json.loads(first.stdout), json.loads(best.stdout)
+    assert b["collision_free"] and b["min_clearance_environment_m"] >= 0.01
+    assert b["duration_s"] < a["duration_s"]  # seed 0: the first goal reached is the long way round
+    bad = CliRunner().invoke(cli, [*args, "--goals", "all"])
+    assert bad.exit_code != 0 and "'first', 'best'" in bad.output

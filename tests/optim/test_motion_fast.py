@@ -299,3 +299,32 @@ def test_compiled_shortcut_skips_tries_that_gain_too_little(table):
 
     assert np.array_equal(run(40, 1.0), run(0, 0.0))
     assert length(run(40, 0.0)) < length(run(0, 0.0)) <= length(detour)
+
+
+def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
+    """``plan_motion(goals="best")`` on the crate scene: the kept path ends at a clear goal branch, is proven,
+    and its time bound is below that of the first goal's path (seed 0 reaches the long way round first);
+    a bad choice is refused."""
+    from pinarms.optim.errors import InvalidSettings
+    from pinarms.optim.motion import SCENES, load_scene, plan_motion
+    from pinarms.optim.motion.geometry import travel_time_bound
+    from pinarms.optim.motion.goals import ik_candidates
+    from pinarms.optim.motion.scenes import region_pose
+
+    cell = load_scene("aubo_crate_guard")
+    arm = cell.arm("aubo")
+    table, crate = SCENES["aubo_crate_guard"].regions
+    checker = MotionChecker(cell, ["aubo"], margin=0.01)
+    q0 = next(q for q in ik_candidates(arm.robot, arm.to_base(region_pose(table, 0.5 * (np.array(table.lo) +
+                                                                                        np.array(table.hi)))),
+                                       cell.neutral)[0] if checker.state_valid(q))
+    goal = region_pose(crate, 0.5 * (np.array(crate.lo) + np.array(crate.hi)))
+    v = arm.robot.velocity_limit
+    first = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False)
+    best = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, goals="best")
+    assert best.check.collision_free and best.compiled
+    assert travel_time_bound(best.simplified, v) < travel_time_bound(first.simplified, v)
+    G = np.array([g.q for g in best.goals if g.valid])
+    assert len(G) > 1 and any(np.array_equal(best.simplified[-1], g) for g in G)
+    with pytest.raises(InvalidSettings, match="goals must be"):
+        plan_motion(cell, "aubo", q0, goal, goals="all")
