@@ -9,11 +9,13 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
+import pinocchio as pin
 
 from pinarms.optim.motion.goals import GoalCandidate
 from pinarms.planning import JointPath, Trajectory
 
-__all__ = ["MotionPlan", "ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory"]
+__all__ = ["MotionPlan", "ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
+           "pair_speeds", "sample_times"]
 
 #: What shortcuts a path found by OMPL (said in every result).
 SIMPLIFIER = "OMPL PathSimplifier (reduceVertices, partialShortcutPath, ropeShortcutPath), edges proven by pinarms"
@@ -205,19 +207,141 @@ def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold
 
 
 def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
-    """Distances along ``trajectory`` (planned arms' joints; time last for none): one sample per
-    ``margin`` of travel of the fastest point (at least 20, at most 4000)."""
-    t0, t1 = trajectory.start_time, trajectory.end_time
-    peaks = np.asarray(trajectory.peaks().velocity, dtype=float)
-    travel = float(peaks @ checker.levers) * (t1 - t0)
-    n = samples or int(np.clip(np.ceil(travel / checker.margin), 20, 4000))
-    t = np.linspace(t0, t1, n + 1)
-    X = np.asarray(trajectory.sample(t)[0], dtype=float).reshape(t.size, -1)
-    if checker.timed:
-        X = np.column_stack([X, t])
-    Q = checker.full(X)
-    own = np.array([p.kind == "self" for p in checker.pairs])
-    env_e, env_k, env_d = checker.excess(Q, mask=~own)
-    own_e, own_k, own_d = checker.excess(Q, mask=own) if own.any() else (None, None, np.full(t.size, np.inf))
-    return ClearanceProfile(t, env_d, env_k, own_d, checker.pairs, checker.margin)
+    """Exact distances (coal) along ``trajectory`` (planned arms' joints; time last for none).
 
+    The samples are placed every ``margin`` of *travel* (:func:`sample_times`: how far any point
+    of the planned arms can move, from the trajectory's exact speeds and acceleration peaks), at
+    least 20 intervals; ``samples``: that many uniform intervals in time instead. Between two
+    samples every distance changes by at most ``margin``, so the smallest distance of the
+    motion lies at most ``margin / 2`` below the smallest sampled one. Each sample's smallest
+    distances are exact (:class:`_Distances`: a pair is skipped only when proven no closer than
+    the best of its kind).
+    """
+    peaks = np.abs(np.asarray(trajectory.peaks().velocity, dtype=float))
+    if samples is not None:
+        t = np.linspace(trajectory.start_time, trajectory.end_time, int(samples) + 1)
+    else:
+        t = sample_times(trajectory, checker.levers, checker.margin, float(checker.moving_speed))
+    env, env_k, own = _Distances(checker, peaks).at(trajectory, t)
+    return ClearanceProfile(t, env, env_k, own, checker.pairs, checker.margin)
+
+
+#: Fewest and most intervals of :func:`sample_times` (a longer motion: more travel per interval).
+MIN_INTERVALS, MAX_INTERVALS = 20, 4000
+
+
+def sample_times(trajectory: Trajectory, levers: np.ndarray, margin: float, extra_speed: float = 0.0) -> np.ndarray:
+    """Times [s] along ``trajectory`` with at most ``margin`` [m] of travel between two (module rule).
+
+    Travel speed ``v(t) = Σ_j |q̇_j(t)| ℓ_j + extra_speed``; on a grid step ``h`` it is at most
+    the larger end value plus ``A h / 2`` (``A = Σ_j max|q̈_j| ℓ_j``, the exact acceleration
+    peaks) and at most the cap ``Σ_j max|q̇_j| ℓ_j + extra_speed`` (the exact velocity peaks);
+    the grid step is ``margin`` over the cap, then the samples are kept greedily. At least
+    :data:`MIN_INTERVALS` uniform intervals; at most :data:`MAX_INTERVALS` (then uniform, each
+    with more travel).
+    """
+    t0, t1 = float(trajectory.start_time), float(trajectory.end_time)
+    peaks = trajectory.peaks()
+    cap = float(np.abs(np.asarray(peaks.velocity, dtype=float)) @ levers) + extra_speed
+    n = int(np.clip(np.ceil(cap * (t1 - t0) / margin), MIN_INTERVALS, MAX_INTERVALS))
+    grid = np.linspace(t0, t1, n + 1)
+    if n == MIN_INTERVALS or n == MAX_INTERVALS:
+        return grid
+    qd = np.asarray(trajectory.sample(grid)[1], dtype=float).reshape(grid.size, -1)
+    v = np.abs(qd) @ levers + extra_speed
+    h = np.diff(grid)
+    A = float(np.abs(np.asarray(peaks.acceleration, dtype=float)) @ levers)
+    step = np.minimum(np.maximum(v[:-1], v[1:]) + A * h / 2.0, cap)
+    budget = np.concatenate([[0.0], np.cumsum(step * h)])
+    keep = [0]
+    for i in range(1, grid.size):
+        if budget[i] - budget[keep[-1]] > margin * (1.0 + 1e-12):
+            keep.append(i - 1)
+    if keep[-1] != grid.size - 1:
+        keep.append(grid.size - 1)
+    times = grid[np.unique(keep)]
+    return times if times.size > MIN_INTERVALS else np.linspace(t0, t1, MIN_INTERVALS + 1)
+
+
+def pair_speeds(checker: Any, peaks: np.ndarray) -> np.ndarray:
+    """``(P,)`` bounds [m/s] of how fast the distance of each of the checker's pairs changes, from the
+    planned joints' speed peaks ``peaks (n,)`` [rad/s or m/s].
+
+    Only the joints on the kinematic path between the pair's two geometries move one relative
+    to the other (a geometry of a held arm or a fixture does not move): the distance changes at
+    most at ``Σ_{j on the path} |q̇_j| ℓ_j`` (the checker's levers ``ℓ``); the other arms' own
+    timed motions (``checker.moving_speed``) are added whole.
+    """
+    model, gm = checker.model, checker.geometry
+    column = {int(c): i for i, c in enumerate(checker.cols)}
+    per_joint = np.zeros(model.njoints)
+    for j in range(1, model.njoints):
+        i = column.get(int(model.joints[j].idx_v), -1)
+        if i >= 0:  # a joint of a planned arm (a mimic joint: its master's column, whose lever counts it)
+            per_joint[j] = peaks[i] * checker.levers[i]
+    support = [set(int(j) for j in model.supports[j]) - {0} for j in range(model.njoints)]
+    out = np.empty(len(gm.collisionPairs))
+    for k, cp in enumerate(gm.collisionPairs):
+        ja = int(gm.geometryObjects[cp.first].parentJoint)
+        jb = int(gm.geometryObjects[cp.second].parentJoint)
+        out[k] = sum(per_joint[j] for j in support[ja] ^ support[jb])
+    return out + float(checker.moving_speed)
+
+
+class _Distances:
+    """Exact smallest distances of a checker's pairs along one trajectory, for the environment and the own
+    links in one pass per configuration (:meth:`at`, samples in time order).
+
+    coal's distance of a pair is computed only when its lower bound is below an upper bound of
+    the smallest distance of its kind; both bounds come from the pair's last exact distance
+    ``d`` at time ``s``: ``d ∓ v_k |t − s|`` (``v_k`` from :func:`pair_speeds`); a pair never
+    computed has no bound. So each sample's smallest distances are exact, not sampled.
+    """
+
+    def __init__(self, checker: Any, peaks: np.ndarray) -> None:
+        self.checker = checker
+        self.speed = pair_speeds(checker, peaks)
+        self.own = np.array([p.kind == "self" for p in checker.pairs], dtype=bool)
+        self.last_d = np.full(self.own.size, np.nan)
+        self.last_t = np.zeros(self.own.size)
+        self.calls = 0  # coal distance calls
+
+    def at(self, trajectory: Trajectory, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Smallest distance to the environment [m] and its pair (−1: none), and between own links [m], at ``t``."""
+        c = self.checker
+        X = np.asarray(trajectory.sample(t)[0], dtype=float).reshape(t.size, -1)
+        if c.timed:
+            X = np.column_stack([X, t])
+        qp = c._to_pin(c.full(X))
+        N = t.size
+        env, env_k, own_d = np.full(N, np.inf), np.full(N, -1, dtype=int), np.full(N, np.inf)
+        kinds = (np.flatnonzero(~self.own), np.flatnonzero(self.own))
+        for i in range(N):
+            pin.updateGeometryPlacements(c.model, c._data, c.geometry, c._gd_dist, qp[i])
+            slack = self.speed * np.abs(t[i] - self.last_t)
+            known = ~np.isnan(self.last_d)
+            low = np.where(known, self.last_d - slack, -np.inf)
+            high = np.where(known, self.last_d + slack, np.inf)
+            best = [(np.inf, -1), (np.inf, -1)]
+            for kind, idx in enumerate(kinds):
+                if idx.size:
+                    best[kind] = self._smallest(idx, low[idx], float(high[idx].min()), float(t[i]))
+            (env[i], env_k[i]), own_d[i] = best[0], best[1][0]
+        return env, env_k, own_d
+
+    def _smallest(self, idx: np.ndarray, low: np.ndarray, high: float, t: float) -> tuple[float, int]:
+        """The smallest exact distance over pairs ``idx`` (bounds ``low``; ``high`` bounds their minimum) and its pair."""
+        c = self.checker
+        cand = np.flatnonzero(low <= high)
+        cand = cand[np.argsort(low[cand], kind="stable")]
+        best, arg = np.inf, -1
+        for r in cand:
+            if low[r] >= best:
+                break
+            k = int(idx[r])
+            d = float(pin.computeDistance(c.geometry, c._gd_dist, k).min_distance)
+            self.calls += 1
+            self.last_d[k], self.last_t[k] = d, t
+            if d < best:
+                best, arg = d, k
+        return best, arg
