@@ -13,6 +13,7 @@ import pinocchio as pin
 
 from pinarms.optim.motion.goals import GoalCandidate
 from pinarms.planning import JointPath, Trajectory
+from pinarms.robots.cell.ladder import interval_bound
 
 __all__ = ["MotionPlan", "ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
            "pair_speeds", "sample_times"]
@@ -206,24 +207,56 @@ def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold
     return Trajectory(trajectory.knot_times, out)
 
 
+#: Travel between two samples of the first pass of :func:`clearance_profile`, in margins.
+COARSE = 4.0
+#: Most halvings of an interval of the first pass.
+MAX_HALVINGS = 12
+
+
 def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
     """Exact distances (coal) along ``trajectory`` (planned arms' joints; time last for none).
 
-    The samples are placed every ``margin`` of *travel* (:func:`sample_times`: how far any point
-    of the planned arms can move, from the trajectory's exact speeds and acceleration peaks), at
-    least 20 intervals; ``samples``: that many uniform intervals in time instead. Between two
-    samples every distance changes by at most ``margin``, so the smallest distance of the
-    motion lies at most ``margin / 2`` below the smallest sampled one. Each sample's smallest
-    distances are exact (:class:`_Distances`: a pair is skipped only when proven no closer than
-    the best of its kind).
+    A first pass samples every :data:`COARSE` margins of *travel* (:func:`sample_times`: how
+    far any point of the planned arms can move, from the trajectory's exact speeds and
+    acceleration peaks). Each pair's distance changes at most at its own speed bound
+    (:func:`pair_speeds`), so between two samples it stays at least ``(d_a + d_b − v_k Δt) / 2``
+    (``d`` its distance or a lower bound of it at the samples); an interval where that could
+    fall more than ``margin / 2`` below the smallest sampled distance (of the environment, or
+    of the own links) is halved, level by level. So the smallest distance of the motion lies
+    at most ``margin / 2`` below the reported minimum (as with a sample every margin of
+    travel), and the samples are dense only where the distance comes close. Each sample's
+    smallest distances are exact (:class:`_Distances`). ``samples``: that many uniform
+    intervals in time instead (no halving).
     """
     peaks = np.abs(np.asarray(trajectory.peaks().velocity, dtype=float))
-    if samples is not None:
+    dist = _Distances(checker, peaks)
+    if samples:
         t = np.linspace(trajectory.start_time, trajectory.end_time, int(samples) + 1)
-    else:
-        t = sample_times(trajectory, checker.levers, checker.margin, float(checker.moving_speed))
-    env, env_k, own = _Distances(checker, peaks).at(trajectory, t)
+        env, env_k, own, _ = dist.at(trajectory, t)
+        return ClearanceProfile(t, env, env_k, own, checker.pairs, checker.margin)
+    t = sample_times(trajectory, checker.levers, COARSE * checker.margin, float(checker.moving_speed))
+    env, env_k, own, bounds = dist.at(trajectory, t)
+    for _ in range(MAX_HALVINGS):
+        open_ = _open_intervals(t, bounds, dist, env, own, checker.margin / 2.0)
+        if not open_.any():
+            break
+        mid = 0.5 * (t[:-1][open_] + t[1:][open_])
+        parts = (t, env, env_k, own, bounds), (mid, *dist.at(trajectory, mid))
+        order = np.argsort(np.concatenate([parts[0][0], parts[1][0]]), kind="stable")
+        t, env, env_k, own, bounds = (np.concatenate([x, y])[order] for x, y in zip(*parts))
     return ClearanceProfile(t, env, env_k, own, checker.pairs, checker.margin)
+
+
+def _open_intervals(t: np.ndarray, bounds: np.ndarray, dist: "_Distances", env: np.ndarray, own: np.ndarray,
+                    tol: float) -> np.ndarray:
+    """``(len(t) - 1,)`` bool: the intervals where some pair's bound may fall ``tol`` below its kind's smallest sample."""
+    pair_bound = interval_bound(bounds[:-1], bounds[1:], dist.speed * np.diff(t)[:, None])
+    out = np.zeros(t.size - 1, dtype=bool)
+    for mask, curve in ((~dist.own, env), (dist.own, own)):
+        finite = np.isfinite(curve)
+        if mask.any() and finite.any():
+            out |= pair_bound[:, mask].min(axis=1) < float(curve[finite].min()) - tol
+    return out
 
 
 #: Fewest and most intervals of :func:`sample_times` (a longer motion: more travel per interval).
@@ -306,28 +339,44 @@ class _Distances:
         self.last_t = np.zeros(self.own.size)
         self.calls = 0  # coal distance calls
 
-    def at(self, trajectory: Trajectory, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Smallest distance to the environment [m] and its pair (−1: none), and between own links [m], at ``t``."""
+    def _bounds(self, Q: np.ndarray) -> np.ndarray:
+        """``(N, P)`` numpy lower bounds of the pairs' distances (:func:`robots.cell.collision.pair_lower_bounds`)."""
+        from pinarms.robots.cell.collision import pair_lower_bounds
+
+        c = self.checker
+        lb = np.full((Q.shape[0], self.own.size), -np.inf)
+        known = c.pair_index >= 0
+        if known.any():
+            lb[:, known] = pair_lower_bounds(c.cell, Q, int(c.pair_index.max()) + 1)[:, c.pair_index[known]]
+        return lb
+
+    def at(self, trajectory: Trajectory, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Smallest distance to the environment [m] and its pair (−1: none), and between own links [m], at ``t``
+        (increasing); and ``(len(t), P)`` each pair's distance where computed, else a lower bound of it [m]."""
         c = self.checker
         X = np.asarray(trajectory.sample(t)[0], dtype=float).reshape(t.size, -1)
         if c.timed:
             X = np.column_stack([X, t])
-        qp = c._to_pin(c.full(X))
+        Q = c.full(X)
+        qp = c._to_pin(Q)
         N = t.size
+        geo = self._bounds(Q)
         env, env_k, own_d = np.full(N, np.inf), np.full(N, -1, dtype=int), np.full(N, np.inf)
+        bounds = np.empty((N, self.own.size))
         kinds = (np.flatnonzero(~self.own), np.flatnonzero(self.own))
         for i in range(N):
             pin.updateGeometryPlacements(c.model, c._data, c.geometry, c._gd_dist, qp[i])
             slack = self.speed * np.abs(t[i] - self.last_t)
             known = ~np.isnan(self.last_d)
-            low = np.where(known, self.last_d - slack, -np.inf)
+            low = np.maximum(geo[i], np.where(known, self.last_d - slack, -np.inf))
             high = np.where(known, self.last_d + slack, np.inf)
             best = [(np.inf, -1), (np.inf, -1)]
             for kind, idx in enumerate(kinds):
                 if idx.size:
                     best[kind] = self._smallest(idx, low[idx], float(high[idx].min()), float(t[i]))
             (env[i], env_k[i]), own_d[i] = best[0], best[1][0]
-        return env, env_k, own_d
+            bounds[i] = np.where(self.last_t == t[i], self.last_d, low)  # exact where just computed
+        return env, env_k, own_d, bounds
 
     def _smallest(self, idx: np.ndarray, low: np.ndarray, high: float, t: float) -> tuple[float, int]:
         """The smallest exact distance over pairs ``idx`` (bounds ``low``; ``high`` bounds their minimum) and its pair."""

@@ -20,7 +20,9 @@ budget ``B`` the distance of every pair then stays at least ``(d_a + d_b − B) 
 ``d`` is the smallest distance over the checked pairs at a sample (coal, exact): the
 Lipschitz rule and its ladder of halvings, stated once in :mod:`.ladder`.
 
-Each sample is first screened by Pinocchio's C++ broad phase with a safety distance
+Each sample is first screened on the conservative sphere cover (:mod:`.cover`, compiled: it
+contains every geometry, so what it proves is proven), then, where the cover is
+inconclusive, by Pinocchio's C++ broad phase, with a safety distance
 ``required + margin``: a sample farther than that from every contact has
 ``d ≥ required + margin`` and needs no exact distance (its interval bound is then at least
 ``required``). The others get coal's exact smallest distance. An interval whose bound is

@@ -90,6 +90,8 @@ def test_profile_is_exact_at_its_samples_and_agrees_with_dense_sampling(scene):
     own = np.array([p.kind == "self" for p in checker.pairs])
     for traj in trajs[:2]:
         profile = clearance_profile(checker, traj)
+        assert np.all(np.diff(profile.times) > 0)
+        assert profile.times[0] == traj.start_time and profile.times[-1] == traj.end_time
         # exact at every sample: the pruned pass equals every pair's distance, smallest taken (coal's GJK
         # tolerance apart: its own data here, cold-started)
         D = _dense_distances(checker, traj, profile.times)
