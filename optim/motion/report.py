@@ -305,20 +305,27 @@ def pair_speeds(checker: Any, peaks: np.ndarray) -> np.ndarray:
     most at ``Σ_{j on the path} |q̇_j| ℓ_j`` (the checker's levers ``ℓ``); the other arms' own
     timed motions (``checker.moving_speed``) are added whole.
     """
+    return _pair_paths(checker) @ (np.asarray(peaks, dtype=float) * checker.levers) + float(checker.moving_speed)
+
+
+def _pair_paths(checker: Any) -> np.ndarray:
+    """``(P, n)``: how many joints of each planned column lie on the kinematic path between each pair's geometries."""
     model, gm = checker.model, checker.geometry
-    column = {int(c): i for i, c in enumerate(checker.cols)}
-    per_joint = np.zeros(model.njoints)
-    for j in range(1, model.njoints):
-        i = column.get(int(model.joints[j].idx_v), -1)
-        if i >= 0:  # a joint of a planned arm (a mimic joint: its master's column, whose lever counts it)
-            per_joint[j] = peaks[i] * checker.levers[i]
-    support = [set(int(j) for j in model.supports[j]) - {0} for j in range(model.njoints)]
-    out = np.empty(len(gm.collisionPairs))
-    for k, cp in enumerate(gm.collisionPairs):
-        ja = int(gm.geometryObjects[cp.first].parentJoint)
-        jb = int(gm.geometryObjects[cp.second].parentJoint)
-        out[k] = sum(per_joint[j] for j in support[ja] ^ support[jb])
-    return out + float(checker.moving_speed)
+    nj = model.njoints
+    supports = np.zeros((nj, nj), dtype=bool)  # supports[j, i]: joint i is on the way from the root to joint j
+    for j in range(1, nj):
+        supports[j, [int(i) for i in model.supports[j] if int(i) > 0]] = True
+    to_col = np.zeros((nj, len(checker.cols)))  # joint -> planned column (a mimic joint: its master's)
+    where = {int(c): i for i, c in enumerate(checker.cols)}
+    for j in range(1, nj):
+        i = where.get(int(model.joints[j].idx_v), -1)
+        if i >= 0:
+            to_col[j, i] = 1.0
+    parent = np.array([int(g.parentJoint) for g in gm.geometryObjects], dtype=int)
+    first = np.array([int(cp.first) for cp in gm.collisionPairs], dtype=int)
+    second = np.array([int(cp.second) for cp in gm.collisionPairs], dtype=int)
+    path = supports[parent[first]] ^ supports[parent[second]]
+    return path.astype(float) @ to_col
 
 
 class _Distances:
