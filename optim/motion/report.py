@@ -26,7 +26,7 @@ FAST_SIMPLIFIER = "random shortcuts then vertex removal, edges proven on the sph
 
 @dataclass(frozen=True, eq=False)
 class ClearanceProfile:
-    """Distances along a timed motion, sampled every ``margin`` of travel of the fastest point.
+    """coal's exact distances along a timed motion, dense where they come close (:func:`clearance_profile`).
 
     Attributes:
         times: ``(M,)`` [s]; ``environment``: ``(M,)`` smallest distance [m] between a planned
@@ -34,6 +34,9 @@ class ClearanceProfile:
             ``pairs`` (−1 when there is none); ``own``: ``(M,)`` smallest distance between
             two links of one planned arm [m].
         pairs: the pairs checked (those involving a planned arm); ``required``: the margin [m].
+
+    The smallest distance of the whole motion lies at most ``required / 2`` below
+    ``min_environment`` (and ``min_own``): the samples are placed to prove it.
 
     ``viz.plot_clearance(path, profile)`` draws it over time.
     """
@@ -209,8 +212,9 @@ def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold
 
 #: Travel between two samples of the first pass of :func:`clearance_profile`, in margins.
 COARSE = 4.0
-#: Most halvings of an interval of the first pass.
-MAX_HALVINGS = 12
+#: Most halvings of an interval of the first pass (each halves its time; an interval is closed at
+#: the latest once its time times the fastest pair's speed bound is at most the margin).
+MAX_HALVINGS = 30
 
 
 def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
