@@ -211,7 +211,7 @@ def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold
 
 
 #: Travel between two samples of the first pass of :func:`clearance_profile`, in margins.
-COARSE = 4.0
+COARSE = 8.0
 #: Most halvings of an interval of the first pass (each halves its time; an interval is closed at
 #: the latest once its time times the fastest pair's speed bound is at most the margin).
 MAX_HALVINGS = 30
@@ -222,8 +222,10 @@ def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | No
 
     A first pass samples every :data:`COARSE` margins of *travel* (:func:`sample_times`: how
     far any point of the planned arms can move, from the trajectory's exact speeds and
-    acceleration peaks). Each pair's distance changes at most at its own speed bound
-    (:func:`pair_speeds`), so between two samples it stays at least ``(d_a + d_b − v_k Δt) / 2``
+    acceleration peaks). Each pair's distance changes at most at its own speed bound on each
+    interval (only the joints between its two bodies count, each at its larger end speed plus
+    its acceleration peak's share, :func:`_interval_speeds`), so between two samples it stays
+    at least ``(d_a + d_b − v_k Δt) / 2``
     (``d`` its distance or a lower bound of it at the samples); an interval where that could
     fall more than ``margin / 2`` below the smallest sampled distance (of the environment, or
     of the own links) is halved, level by level. So the smallest distance of the motion lies
@@ -236,25 +238,41 @@ def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | No
     dist = _Distances(checker, peaks)
     if samples:
         t = np.linspace(trajectory.start_time, trajectory.end_time, int(samples) + 1)
-        env, env_k, own, _ = dist.at(trajectory, t)
+        env, env_k, own = dist.at(trajectory, t)[:3]
         return ClearanceProfile(t, env, env_k, own, checker.pairs, checker.margin)
     t = sample_times(trajectory, checker.levers, COARSE * checker.margin, float(checker.moving_speed))
-    env, env_k, own, bounds = dist.at(trajectory, t)
+    env, env_k, own, bounds, rates = dist.at(trajectory, t)
+    acc = np.abs(np.asarray(trajectory.peaks().acceleration, dtype=float))
     for _ in range(MAX_HALVINGS):
-        open_ = _open_intervals(t, bounds, dist, env, own, checker.margin / 2.0)
+        open_ = _open_intervals(t, bounds, _interval_speeds(dist, rates, peaks, acc, np.diff(t)), dist, env, own,
+                                checker.margin / 2.0)
         if not open_.any():
             break
         mid = 0.5 * (t[:-1][open_] + t[1:][open_])
-        parts = (t, env, env_k, own, bounds), (mid, *dist.at(trajectory, mid))
+        parts = (t, env, env_k, own, bounds, rates), (mid, *dist.at(trajectory, mid))
         order = np.argsort(np.concatenate([parts[0][0], parts[1][0]]), kind="stable")
-        t, env, env_k, own, bounds = (np.concatenate([x, y])[order] for x, y in zip(*parts))
+        t, env, env_k, own, bounds, rates = (np.concatenate([x, y])[order] for x, y in zip(*parts))
     return ClearanceProfile(t, env, env_k, own, checker.pairs, checker.margin)
 
 
-def _open_intervals(t: np.ndarray, bounds: np.ndarray, dist: "_Distances", env: np.ndarray, own: np.ndarray,
-                    tol: float) -> np.ndarray:
+def _interval_speeds(dist: "_Distances", rates: np.ndarray, peaks: np.ndarray, acc: np.ndarray,
+                     dt: np.ndarray) -> np.ndarray:
+    """``(len(dt), P)`` bounds [m/s] of each pair's distance rate on each interval between samples.
+
+    A joint's speed on an interval is at most its larger end speed plus ``max|q̈| Δt / 2`` (the
+    exact acceleration peak) and at most its exact peak; a pair's rate is the levers' sum of
+    those over the joints between its geometries (:func:`pair_speeds`), plus the other arms'
+    timed motions whole.
+    """
+    joint = np.minimum(np.maximum(rates[:-1], rates[1:]) + acc * dt[:, None] / 2.0, peaks)
+    c = dist.checker
+    return (joint * c.levers) @ dist.paths.T + float(c.moving_speed)
+
+
+def _open_intervals(t: np.ndarray, bounds: np.ndarray, speeds: np.ndarray, dist: "_Distances", env: np.ndarray,
+                    own: np.ndarray, tol: float) -> np.ndarray:
     """``(len(t) - 1,)`` bool: the intervals where some pair's bound may fall ``tol`` below its kind's smallest sample."""
-    pair_bound = interval_bound(bounds[:-1], bounds[1:], dist.speed * np.diff(t)[:, None])
+    pair_bound = interval_bound(bounds[:-1], bounds[1:], speeds * np.diff(t)[:, None])
     out = np.zeros(t.size - 1, dtype=bool)
     for mask, curve in ((~dist.own, env), (dist.own, own)):
         finite = np.isfinite(curve)
@@ -344,7 +362,8 @@ class _Distances:
 
     def __init__(self, checker: Any, peaks: np.ndarray) -> None:
         self.checker = checker
-        self.speed = pair_speeds(checker, peaks)
+        self.paths = _pair_paths(checker)
+        self.speed = self.paths @ (np.asarray(peaks, dtype=float) * checker.levers) + float(checker.moving_speed)
         self.own = np.array([p.kind == "self" for p in checker.pairs], dtype=bool)
         self.last_d = np.full(self.own.size, np.nan)
         self.last_t = np.zeros(self.own.size)
@@ -365,7 +384,9 @@ class _Distances:
         """Smallest distance to the environment [m] and its pair (−1: none), and between own links [m], at ``t``
         (increasing); and ``(len(t), P)`` each pair's distance where computed, else a lower bound of it [m]."""
         c = self.checker
-        X = np.asarray(trajectory.sample(t)[0], dtype=float).reshape(t.size, -1)
+        sampled = trajectory.sample(t)
+        X = np.asarray(sampled[0], dtype=float).reshape(t.size, -1)
+        rates = np.abs(np.asarray(sampled[1], dtype=float).reshape(t.size, -1))
         if c.timed:
             X = np.column_stack([X, t])
         Q = c.full(X)
@@ -387,7 +408,7 @@ class _Distances:
                     best[kind] = self._smallest(idx, low[idx], float(high[idx].min()), float(t[i]))
             (env[i], env_k[i]), own_d[i] = best[0], best[1][0]
             bounds[i] = np.where(self.last_t == t[i], self.last_d, low)  # exact where just computed
-        return env, env_k, own_d, bounds
+        return env, env_k, own_d, bounds, rates
 
     def _smallest(self, idx: np.ndarray, low: np.ndarray, high: float, t: float) -> tuple[float, int]:
         """The smallest exact distance over pairs ``idx`` (bounds ``low``; ``high`` bounds their minimum) and its pair."""

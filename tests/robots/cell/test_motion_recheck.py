@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion, scene_queries
-from pinarms.optim.motion.report import clearance_profile, pair_speeds, sample_times
+from pinarms.optim.motion.report import _Distances, _interval_speeds, clearance_profile, pair_speeds, sample_times
 from pinarms.planning import multi_quintic
 from pinarms.robots.cell import motion as cell_motion
 from pinarms.robots.cell.motion import ArmMotion
@@ -122,6 +122,13 @@ def test_pair_speeds_bound_every_distance_rate(scene):
     # coal's GJK tolerance (a few 1e-7 m between two calls on meshes that do not move) allowed
     assert np.all(change <= speeds * np.diff(t)[:, None] * (1 + 1e-9) + 5e-6)
     assert np.any(change > 1e-3)  # something moves
+    # on each interval, from the end speeds and the acceleration peaks (what the profile's halving uses)
+    dist = _Distances(checker, np.abs(traj.peaks().velocity))
+    rates = np.abs(np.asarray(traj.sample(t)[1]))
+    per_interval = _interval_speeds(dist, rates, np.abs(traj.peaks().velocity), np.abs(traj.peaks().acceleration),
+                                    np.diff(t))
+    assert np.all(change <= per_interval * np.diff(t)[:, None] * (1 + 1e-9) + 5e-6)
+    assert np.all(per_interval <= speeds * (1 + 1e-12))
     own = np.array([p.kind == "self" for p in checker.pairs])
     whole = float(np.abs(traj.peaks().velocity) @ checker.levers)
     assert np.all(speeds <= whole * (1 + 1e-12))
