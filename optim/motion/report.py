@@ -365,8 +365,13 @@ class _Distances:
         self.paths = _pair_paths(checker)
         self.speed = self.paths @ (np.asarray(peaks, dtype=float) * checker.levers) + float(checker.moving_speed)
         self.own = np.array([p.kind == "self" for p in checker.pairs], dtype=bool)
-        self.last_d = np.full(self.own.size, np.nan)
+        # each pair's last exact distance as a lower and an upper bound (none yet: -inf, inf), its time
+        # and the row it was computed at
+        self.last_low = np.full(self.own.size, -np.inf)
+        self.last_high = np.full(self.own.size, np.inf)
         self.last_t = np.zeros(self.own.size)
+        self.stamp = np.full(self.own.size, -1)
+        self.row = -1
         self.calls = 0  # coal distance calls
 
     def _bounds(self, Q: np.ndarray) -> np.ndarray:
@@ -398,16 +403,16 @@ class _Distances:
         kinds = (np.flatnonzero(~self.own), np.flatnonzero(self.own))
         for i in range(N):
             pin.updateGeometryPlacements(c.model, c._data, c.geometry, c._gd_dist, qp[i])
+            self.row += 1
             slack = self.speed * np.abs(t[i] - self.last_t)
-            known = ~np.isnan(self.last_d)
-            low = np.maximum(geo[i], np.where(known, self.last_d - slack, -np.inf))
-            high = np.where(known, self.last_d + slack, np.inf)
+            low = np.maximum(geo[i], self.last_low - slack)
+            high = self.last_high + slack
             best = [(np.inf, -1), (np.inf, -1)]
             for kind, idx in enumerate(kinds):
                 if idx.size:
                     best[kind] = self._smallest(idx, low[idx], float(high[idx].min()), float(t[i]))
             (env[i], env_k[i]), own_d[i] = best[0], best[1][0]
-            bounds[i] = np.where(self.last_t == t[i], self.last_d, low)  # exact where just computed
+            bounds[i] = np.where(self.stamp == self.row, self.last_low, low)  # exact where just computed
         return env, env_k, own_d, bounds, rates
 
     def _smallest(self, idx: np.ndarray, low: np.ndarray, high: float, t: float) -> tuple[float, int]:
@@ -422,7 +427,8 @@ class _Distances:
             k = int(idx[r])
             d = float(pin.computeDistance(c.geometry, c._gd_dist, k).min_distance)
             self.calls += 1
-            self.last_d[k], self.last_t[k] = d, t
+            self.last_low[k] = self.last_high[k] = d
+            self.last_t[k], self.stamp[k] = t, self.row
             if d < best:
                 best, arg = d, k
         return best, arg

@@ -111,6 +111,26 @@ def test_profile_is_exact_at_its_samples_and_agrees_with_dense_sampling(scene):
         assert profile.min_environment >= MARGIN  # the planned path keeps the margin
 
 
+def test_pruned_pairs_keep_true_lower_bounds(scene):
+    cell, arm, hold, trajs, _ = scene
+    checker = MotionChecker(cell, [arm], margin=MARGIN, hold=hold)
+    traj = trajs[0]
+    dist = _Distances(checker, np.abs(traj.peaks().velocity))
+    t = np.linspace(traj.start_time, traj.end_time, 60)
+    env, _, own_d, bounds, _ = dist.at(traj, t)
+    D = _dense_distances(checker, traj, t)
+    assert np.all(np.isfinite(bounds))
+    assert np.all(bounds <= D + 5e-6)  # a bound never above the distance (coal's tolerance)
+    assert dist.calls < D.size / 2  # and most pairs were not computed
+    # a second batch between the first one's samples uses the bounds carried over from them
+    mid = 0.5 * (t[:-1] + t[1:])
+    env_mid, _, _, bounds_mid, _ = dist.at(traj, mid)
+    D_mid = _dense_distances(checker, traj, mid)
+    own = np.array([p.kind == "self" for p in checker.pairs])
+    np.testing.assert_allclose(env_mid, D_mid[:, ~own].min(axis=1), rtol=0, atol=5e-6)
+    assert np.all(bounds_mid <= D_mid + 5e-6)
+
+
 def test_pair_speeds_bound_every_distance_rate(scene):
     cell, arm, hold, trajs, _ = scene
     checker = MotionChecker(cell, [arm], margin=MARGIN, hold=hold)
