@@ -266,7 +266,8 @@ def _interval_speeds(dist: "_Distances", rates: np.ndarray, peaks: np.ndarray, a
     """
     joint = np.minimum(np.maximum(rates[:-1], rates[1:]) + acc * dt[:, None] / 2.0, peaks)
     c = dist.checker
-    return (joint * c.levers) @ dist.paths_t + float(c.moving_speed)
+    # einsum, not BLAS: a few joints, and BLAS threads stall on a busy machine
+    return np.einsum("ij,jk->ik", joint * c.levers, dist.paths_t) + float(c.moving_speed)
 
 
 def _open_intervals(t: np.ndarray, bounds: np.ndarray, speeds: np.ndarray, dist: "_Distances", env: np.ndarray,
@@ -363,7 +364,7 @@ class _Distances:
     def __init__(self, checker: Any, peaks: np.ndarray) -> None:
         self.checker = checker
         self.paths = _pair_paths(checker)
-        self.paths_t = np.ascontiguousarray(self.paths.T)  # (a transposed view makes the product ~100x slower)
+        self.paths_t = np.ascontiguousarray(self.paths.T)
         self.speed = self.paths @ (np.asarray(peaks, dtype=float) * checker.levers) + float(checker.moving_speed)
         self.own = np.array([p.kind == "self" for p in checker.pairs], dtype=bool)
         # each pair's last exact distance as a lower and an upper bound (none yet: -inf, inf), its time
