@@ -20,7 +20,9 @@ budget ``B`` the distance of every pair then stays at least ``(d_a + d_b − B) 
 ``d`` is the smallest distance over the checked pairs at a sample (coal, exact): the
 Lipschitz rule and its ladder of halvings, stated once in :mod:`.ladder`.
 
-Each sample is first screened by Pinocchio's C++ broad phase with a safety distance
+Each sample is first screened on the conservative sphere cover (:mod:`.cover`, compiled: it
+contains every geometry, so what it proves is proven), then, where the cover is
+inconclusive, by Pinocchio's C++ broad phase, with a safety distance
 ``required + margin``: a sample farther than that from every contact has
 ``d ≥ required + margin`` and needs no exact distance (its interval bound is then at least
 ``required``). The others get coal's exact smallest distance. An interval whose bound is
@@ -211,7 +213,7 @@ class _Samples:
         Returns the distances ``(len(times),)``: exact, or ``screen`` where the screen cleared the sample.
         """
         Q = self.configurations(times)
-        exact = np.ones(times.size, dtype=bool) if curve else self.cell.in_collision(Q, margin=screen + 1e-6)
+        exact = np.ones(times.size, dtype=bool) if curve else self.flag(Q, screen + 1e-6)
         d = np.full(times.size, screen)
         k = np.full(times.size, -1, dtype=int)
         if exact.any():
@@ -219,6 +221,21 @@ class _Samples:
             d[exact], k[exact] = de, ke
         self.t, self.d, self.k, self.x = list(times), list(d), list(k), list(exact)
         return d
+
+    def flag(self, Q: np.ndarray, screen: float) -> np.ndarray:
+        """``(N,)`` bool: the configurations not proven farther than ``screen`` [m] from every contact.
+
+        The sphere cover first (:mod:`.cover`: it contains every geometry, so a configuration it
+        proves is proven), then Pinocchio's broad phase at ``screen`` on the rest: the same rows
+        as the broad phase alone, fewer of them checked by it.
+        """
+        flagged = np.ones(Q.shape[0], dtype=bool)
+        if Q.shape[0] >= COVER_ROWS:
+            cover, pair_set = _cover_pairs(self.cell, self.n_pairs)
+            flagged = ~cover.screen(Q, pair_set, np.full(self.n_pairs, screen))
+        if flagged.any():
+            flagged[flagged] = self.cell.in_collision(Q[flagged], margin=screen)
+        return flagged
 
     def evaluate(self, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Exact smallest distances and closest pairs at extra times ``ts`` (kept as samples)."""
@@ -234,6 +251,24 @@ class _Samples:
         order = np.argsort(np.asarray(self.t), kind="stable")
         return (np.asarray(self.t)[order], np.asarray(self.d)[order],
                 np.asarray(self.k, dtype=int)[order], np.asarray(self.x, dtype=bool)[order])
+
+
+#: Fewest samples screened on the sphere cover first (fewer: the broad phase alone).
+COVER_ROWS = 8
+
+
+def _cover_pairs(cell: "Cell", n_pairs: int) -> tuple[Any, Any]:
+    """The cell's sphere cover and its :class:`.cover.PairSet` of the first ``n_pairs`` candidates (kept with the cell)."""
+    from .cover import link_cover, pair_arrays
+
+    # keyed by the pairs themselves: a view of the cell (Cell.only) shares this dict, not its pairs
+    pair_a, pair_b = pair_arrays(cell._candidates[:n_pairs])
+    key = (pair_a.tobytes(), pair_b.tobytes())
+    cache = cell.__dict__.setdefault("_motion_cover_pairs", {})
+    if key not in cache:
+        cover = link_cover(cell)
+        cache[key] = (cover, cover.prepare(pair_a, pair_b))
+    return cache[key]
 
 
 class _TimeRungs:
