@@ -145,7 +145,8 @@ def _recheck(cell: Any, arms: tuple[str, ...], checker: MotionChecker, traj: Tra
         n = cell.arm(a).nq
         motions.append(ArmMotion(a, _columns(traj, start_col, n)))
         start_col += n
-    check = cell.check_motion(motions, margin=checker.margin, clearance=0.0, hold=checker.hold)
+    # the path was proven on the cover: the re-check shares no code with it (broad phase and coal alone)
+    check = cell.check_motion(motions, margin=checker.margin, clearance=0.0, hold=checker.hold, cover=False)
     if not check.collision_free:
         raise PlanningError(f"the timed motion failed the cell's continuous check: {check.summary()}")
     return check, clearance_profile(checker, traj)

@@ -84,6 +84,7 @@ def check_motion(
     window: tuple[float, float] | None = None,
     hold: Any = None,
     curve: bool = False,
+    cover: bool = True,
 ) -> MotionCheck:
     """Check the arms' motions together, continuously in time (module doc: the rule).
 
@@ -97,6 +98,9 @@ def check_motion(
         hold: cell configuration ``(nq,)`` of the arms without a motion (default neutral).
         curve: compute the exact smallest distance at every sample (for a clearance-over-
             time plot) instead of only at the samples the screen flags.
+        cover: screen the samples on the sphere cover before the broad phase (same verdicts,
+            faster); ``False``: the broad phase and coal alone — a check that shares no code
+            with the cover, as :func:`optim.plan_motion`'s re-check of a path the cover proved.
 
     Raises:
         InvalidInput: an unknown arm, a trajectory of the wrong width, bad numbers, or a
@@ -113,7 +117,7 @@ def check_motion(
     n_pairs = cell._n_for(screen + 1e-6)
     pairs = cell._candidates[:n_pairs]
     left_out = cell._reach_bounds[n_pairs - len(cell.pairs):]
-    samples = _Samples(cell, motions, hold_q, n_pairs)
+    samples = _Samples(cell, motions, hold_q, n_pairs, bool(cover))
     d = samples.screen(schedule.times, screen, curve)
     lower, unresolved = _prove(schedule, d, required, samples)
     first = _first_contact(samples, pairs)
@@ -196,8 +200,9 @@ def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, marg
 class _Samples:
     """Every sample of one check: time [s], smallest distance [m], closest pair (−1: screened), exact or not."""
 
-    def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int) -> None:
-        self.cell, self.motions, self.hold_q, self.n_pairs = cell, motions, hold_q, n_pairs
+    def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
+                 cover: bool = True) -> None:
+        self.cell, self.motions, self.hold_q, self.n_pairs, self.cover = cell, motions, hold_q, n_pairs, cover
         self.t: list = []
         self.d: list = []
         self.k: list = []
@@ -230,7 +235,7 @@ class _Samples:
         as the broad phase alone, fewer of them checked by it.
         """
         flagged = np.ones(Q.shape[0], dtype=bool)
-        if Q.shape[0] >= COVER_ROWS:
+        if self.cover and Q.shape[0] >= COVER_ROWS:
             cover, pair_set = _cover_pairs(self.cell, self.n_pairs)
             flagged = ~cover.screen(Q, pair_set, np.full(self.n_pairs, screen))
         if flagged.any():

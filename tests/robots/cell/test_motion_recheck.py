@@ -62,6 +62,9 @@ def test_cover_screen_keeps_every_verdict_and_sample(scene, monkeypatch):
         np.testing.assert_array_equal(new.clearance, old.clearance)
         np.testing.assert_array_equal(new.exact, old.exact)
         assert (new.first_contact is None) == (old.first_contact is None)
+        plain = cell.check_motion([ArmMotion(arm, traj)], margin=MARGIN, clearance=clearance, hold=hold, cover=False)
+        np.testing.assert_array_equal(plain.exact, old.exact)  # cover=False: the broad phase alone
+        assert plain.lower_bound == old.lower_bound
         if old.first_contact is not None:
             assert new.first_contact.time == old.first_contact.time
         verdicts.add((old.collision_free, old.clear))
