@@ -126,16 +126,14 @@ def _exact_distance(x0, x1, x2, other, exact, FR, Fp, size, SA, SB, srad, sstart
 
 
 @jit_inline
-def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
+def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW, hrad):
     """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
     cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
     ``g`` (``HW[g]``, ``hrad[g]``) first."""
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
-    if cyl[g] and exact[other] == 1:
-        k = sstart[g]
-        if _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) > t:
-            return True
+    if cyl[g] != 0 and exact[other] == 1:
+        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -144,12 +142,14 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
 
 
 @jit_inline
-def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
+def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, ga, gb, t, HW, hrad):
     """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
-    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
-        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
-    if exact[ga] != 0 or cyl[ga]:
-        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
+    if exact[gb] != 0 or (cyl[gb] == 1 and exact[ga] == 0):
+        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                              hrad)
+    if exact[ga] != 0 or cyl[ga] == 1:
+        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                              hrad)
     for sa in range(start[ga], start[ga + 1]):
         for sb in range(start[gb], start[gb + 1]):
             reach = radius[sa] + radius[sb] + t
@@ -207,7 +207,7 @@ def pair_proven(cov, grp, work, k):
     if tab >= 0 and table_low(work[0], cov[14], tab) > t:
         return True
     return _pair_clear(work[2], cov[2], cov[3], cov[4], cov[5], cov[6], cov[7], work[3], work[4], cov[11], cov[12],
-                       cov[13], ga, gb, t, work[5], grp[2])
+                       cov[13], cov[15], ga, gb, t, work[5], grp[2])
 
 
 @jit_inline
@@ -260,24 +260,21 @@ def _apart(HW, hrad, a, b, t):
 
 
 @jit_inline
-def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad, best):
+def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad,                     best):
     """``min(best, lower bound of distance(g, other) − t)``: the cover spheres of ``g`` against ``other``
     taken exactly (a static box, cylinder or sphere, or a moving cylinder); its bounding sphere first."""
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] \
             - t >= best:
         return best
-    gap = -np.inf
-    if cyl[g] and exact[other] == 1:
-        k = sstart[g]
-        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) - t
-        if gap >= best:
-            return best
+    if cyl[g] != 0 and exact[other] == 1:
+        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf) - t)
     low = np.inf
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
-            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
-            low = min(low, d)
-        return min(best, max(low, gap))
+            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other)
+            low = min(low, d - radius[s] - t)
+        return min(best, low)
     # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
     k = sstart[other]
     a0, a1, a2, r = SA[k, 0], SA[k, 1], SA[k, 2], srad[k]
@@ -293,9 +290,8 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             dr = max(math.sqrt(max(ww - h * h, 0.0)) - r, 0.0)
             dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
             d = math.sqrt(dr * dr + dz * dz)
-        d = d - radius[s] - t
-        low = min(low, d)
-    return min(best, max(low, gap))
+        low = min(low, d - radius[s] - t)
+    return min(best, low)
 
 
 @jit
@@ -328,14 +324,34 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
 
 
 @jit_inline
-def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad, best):
+def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, stop):
+    """A lower bound [m] of the distance from moving geometry ``g`` held by its cylinders (:mod:`.cover`) to the static
+    box ``o``: the least over cylinders ``k`` of the larger of its :func:`_box_gap` and the distances of the spheres
+    ``spart[k]`` holding its part. Returns at the first cylinder at most ``stop`` (then it means only ``≤ stop``)."""
+    low = np.inf
+    for k in range(sstart[g], sstart[g + 1]):
+        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, half, o)
+        near = np.inf
+        for s in range(spart[k, 0], spart[k, 1]):
+            near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
+            if near <= gap:
+                break
+        low = min(low, max(gap, near))
+        if low <= stop:
+            return low
+    return low
+
+
+@jit_inline
+def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, ga, gb, t, HW, hrad,
+                 best):
     """``min(best, lower bound of distance(ga, gb) − t)`` from the covers (:func:`_pair_clear`'s cases)."""
-    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
-        return _spheres_excess(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
-                               best)
-    if exact[ga] != 0 or cyl[ga]:
-        return _spheres_excess(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
-                               best)
+    if exact[gb] != 0 or (cyl[gb] == 1 and exact[ga] == 0):
+        return _spheres_excess(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad, best)
+    if exact[ga] != 0 or cyl[ga] == 1:
+        return _spheres_excess(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad, best)
     for sa in range(start[ga], start[ga + 1]):
         for sb in range(start[gb], start[gb + 1]):
             rr = radius[sa] + radius[sb] + t
@@ -474,8 +490,8 @@ def excess_placed(cov, grp, inv, cap, floor, work):
             if low * s >= best:
                 continue
             raw = best / s
-            r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
-                             hrad, raw)
+            r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, cov[15], ga, gb, t[k],
+                             HW, hrad, raw)
             if r < raw:
                 best = min(best, max(r, low) * s)
             if best < floor:

@@ -15,8 +15,9 @@ union of the spheres holds every triangle.
 **Primitives**: :func:`static_primitive` gives the smaller of the box and the cylinders (along
 the mesh's axes) holding all vertices, screened exactly for a mesh fixed in the world (an
 arm's base); :func:`mesh_cylinder` the smallest such cylinder, screened exactly for a moving
-mesh where it is tight (:data:`.cover.CYLINDER_SHARE`). A box or a cylinder is convex:
-holding the vertices it holds the mesh.
+mesh where it is tight (:data:`.cover.CYLINDER_SHARE`); :func:`mesh_parts` the cylinders of the
+parts the spheres slice, screened exactly against static boxes for a moving mesh that one cylinder
+holds loosely. A box or a cylinder is convex: holding the vertices it holds the mesh.
 
 Lengths in m, in the mesh's own frame.
 """
@@ -27,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mesh_arrays", "split_triangles", "mesh_spheres", "mesh_cylinder", "static_primitive", "SPLIT_EDGE"]
+__all__ = ["mesh_arrays", "split_triangles", "mesh_spheres", "mesh_parts", "mesh_cylinder", "static_primitive", "SPLIT_EDGE"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
@@ -146,6 +147,30 @@ def _slices(cyl: tuple, bulge: float) -> int:
     return max(1, int(np.ceil((hi - lo) / t)))
 
 
+def _part_cylinders(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple:
+    """The mesh's pieces ``S``, their centres, its parts (piece indices, :func:`_parts`; one part where
+    there are more than ``count``) and each part's cylinder (:func:`_cylinder`, holding its pieces' vertices)."""
+    if int(count) < 1:
+        raise ValueError(f"count must be at least 1, got {count!r}")
+    P = np.asarray(V, dtype=float)[np.asarray(T, dtype=np.int64)]
+    S, _ = split_triangles(P, edge)
+    mid = S.mean(axis=1)
+    parts = _parts(S, mid)
+    if len(parts) > int(count):  # more parts than spheres: one part
+        parts = [np.arange(S.shape[0])]
+    return S, mid, parts, [_cylinder(S[idx].reshape(-1, 3), refine=True) for idx in parts]
+
+
+def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_spheres` ``(centres (k, 3), radii (k,))`` and beside each sphere the cylinder of its
+    slice: axis ends ``a, b (k, 3)`` on its part's axis and radius ``(k,)`` [m], in the mesh's frame.
+    Each cylinder holds the vertices its sphere holds (the pieces of its slice), so (convex) those
+    pieces: the union of the cylinders holds every triangle, and a slice is held by the intersection
+    of its sphere and its cylinder. Screened exactly against static boxes
+    (:func:`._cover_kernel._held_low`): the cylinder's flat ends where the sphere overshoots them."""
+    return _sphere_cover(V, T, count, edge)
+
+
 def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, np.ndarray]:
     """At most ``count`` spheres ``(centres (k, 3), radii (k,))`` [m] whose union holds the mesh of
     vertices ``V (n, 3)`` and triangles ``T (m, 3)``, in the mesh's frame.
@@ -157,24 +182,22 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
     cylinder's radius allows, the smallest overshoot for which all parts take at most
     ``count`` slices. Each sphere reaches the farthest vertex of the pieces whose centres lie
     in its slice: holding a piece's vertices it holds the piece (a sphere is convex)."""
-    if int(count) < 1:
-        raise ValueError(f"count must be at least 1, got {count!r}")
-    P = np.asarray(V, dtype=float)[np.asarray(T, dtype=np.int64)]
-    S, _ = split_triangles(P, edge)
-    mid = S.mean(axis=1)
-    parts = _parts(S, mid)
-    if len(parts) > int(count):  # more parts than spheres: one part
-        parts = [np.arange(S.shape[0])]
-    cyls = [_cylinder(S[idx].reshape(-1, 3), refine=True) for idx in parts]
+    return _sphere_cover(V, T, count, edge)[:2]
+
+
+def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_parts` (:func:`mesh_spheres` its first two arrays)."""
+    S, mid, parts, cyls = _part_cylinders(V, T, count, edge)
     low, high = 1e-5, 1.0
     for _ in range(40):  # the smallest overshoot whose slices fit the count
         b = np.sqrt(low * high)
         low, high = (b, high) if sum(_slices(c, b) for c in cyls) > int(count) else (low, b)
-    centres, radii = [], []
+    centres, radii, a, b, rad = [], [], [], [], []
     for idx, cyl in zip(parts, cyls):
         _, axis, centre, _, lo, hi = cyl
         k = _slices(cyl, high)
         at = np.minimum(((mid[idx, axis] - lo) / max(hi - lo, 1e-12) * k).astype(np.int64), k - 1)
+        u, w = (axis + 1) % 3, (axis + 2) % 3
         for j in range(k):
             X = S[idx[at == j]].reshape(-1, 3)
             if X.shape[0] == 0:
@@ -183,7 +206,12 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
             c[axis] = 0.5 * (X[:, axis].min() + X[:, axis].max())
             centres.append(c)
             radii.append(float(np.sqrt(((X - c) ** 2).sum(axis=1).max())))
-    return np.array(centres), np.array(radii)
+            # the slice's own cylinder about the part's axis: the same vertices, so it holds the same pieces
+            a.append(c.copy())
+            b.append(c.copy())
+            a[-1][axis], b[-1][axis] = X[:, axis].min(), X[:, axis].max()
+            rad.append(float(np.sqrt(((X[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
+    return np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad)
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
