@@ -9,10 +9,18 @@ like :mod:`robots.ik._kernel` (compiled per process where no cache location is w
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
-from pinarms.compiled import jit, jit_inline
+from pinarms.compiled import drop_stale_caches, jit, jit_inline
+
+from . import _box_kernel
+from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
+
+# these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
+drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
+                  Path(__file__).resolve().parent / "__pycache__" / "cover_kernels.sha256")
 
 
 @jit
@@ -81,26 +89,6 @@ def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, join
 
 
 @jit_inline
-def _fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
-    """Distance [m] from point ``x`` to the static box (1), cylinder (2, axis z) or sphere (3) ``o``
-    (world rotation ``FR[o]``, centre ``Fp[o]``, ``size[o]``); 0 inside."""
-    d0, d1, d2 = x0 - Fp[o, 0], x1 - Fp[o, 1], x2 - Fp[o, 2]
-    l0 = FR[o, 0, 0] * d0 + FR[o, 1, 0] * d1 + FR[o, 2, 0] * d2
-    l1 = FR[o, 0, 1] * d0 + FR[o, 1, 1] * d1 + FR[o, 2, 1] * d2
-    l2 = FR[o, 0, 2] * d0 + FR[o, 1, 2] * d1 + FR[o, 2, 2] * d2
-    if kind == 1:
-        o0 = max(abs(l0) - size[o, 0], 0.0)
-        o1 = max(abs(l1) - size[o, 1], 0.0)
-        o2 = max(abs(l2) - size[o, 2], 0.0)
-        return math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-    if kind == 2:
-        dr = max(math.sqrt(l0 * l0 + l1 * l1) - size[o, 0], 0.0)
-        dz = max(abs(l2) - size[o, 1], 0.0)
-        return math.sqrt(dr * dr + dz * dz)
-    return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[o, 0], 0.0)
-
-
-@jit_inline
 def _cylinder_distance(x0, x1, x2, SA, SB, k, r):
     """Distance [m] from point ``x`` to the solid cylinder of axis ``SA[k] SB[k]`` and radius ``r``; 0 inside."""
     u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
@@ -133,7 +121,7 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
     if cyl[g] != 0 and exact[other] == 1:
-        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t) > t
+        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, True) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -268,7 +256,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             - t >= best:
         return best
     if cyl[g] != 0 and exact[other] == 1:
-        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf) - t)
+        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, False) - t)
     low = np.inf
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
@@ -292,54 +280,6 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             d = math.sqrt(dr * dr + dz * dz)
         low = min(low, d - radius[s] - t)
     return min(best, low)
-
-
-@jit
-def _cylinder_box_gap(a, b, r, FR, Fp, half):
-    """A lower bound [m] of the distance between the solid cylinder of axis ``a b`` and radius ``r`` and a
-    static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
-    projections on the box's three axes (a projection shortens every distance). Exact for a cylinder
-    standing upright over a box's face, where its spheres overshoot by nearly its radius."""
-    return _box_gap(a.reshape((1, 3)), b.reshape((1, 3)), 0, r, FR.reshape((1, 3, 3)), Fp.reshape((1, 3)),
-                    half.reshape((1, 3)), 0)
-
-
-@jit_inline
-def _box_gap(SA, SB, k, r, FR, Fp, half, o):
-    """:func:`_cylinder_box_gap` of the cylinder ``SA[k] SB[k]`` and the box ``o`` (``FR[o]``, ``Fp[o]``, ``half[o]``)."""
-    u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
-    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    if L > 0.0:
-        u0, u1, u2 = u0 / L, u1 / L, u2 / L
-    gap = -np.inf
-    for i in range(3):
-        n0, n1, n2 = FR[o, 0, i], FR[o, 1, i], FR[o, 2, i]
-        ca = (SA[k, 0] - Fp[o, 0]) * n0 + (SA[k, 1] - Fp[o, 1]) * n1 + (SA[k, 2] - Fp[o, 2]) * n2
-        cb = (SB[k, 0] - Fp[o, 0]) * n0 + (SB[k, 1] - Fp[o, 1]) * n1 + (SB[k, 2] - Fp[o, 2]) * n2
-        un = u0 * n0 + u1 * n1 + u2 * n2
-        rad = r * math.sqrt(max(1.0 - un * un, 0.0))
-        g = max(min(ca, cb) - rad - half[o, i], -half[o, i] - max(ca, cb) - rad)
-        gap = max(gap, g)
-    return gap
-
-
-@jit_inline
-def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, stop):
-    """A lower bound [m] of the distance from moving geometry ``g`` held by its cylinders (:mod:`.cover`) to the static
-    box ``o``: the least over cylinders ``k`` of the larger of its :func:`_box_gap` and the distances of the spheres
-    ``spart[k]`` holding its part. Returns at the first cylinder at most ``stop`` (then it means only ``≤ stop``)."""
-    low = np.inf
-    for k in range(sstart[g], sstart[g + 1]):
-        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, half, o)
-        near = np.inf
-        for s in range(spart[k, 0], spart[k, 1]):
-            near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
-            if near <= gap:
-                break
-        low = min(low, max(gap, near))
-        if low <= stop:
-            return low
-    return low
 
 
 @jit_inline

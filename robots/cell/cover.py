@@ -106,7 +106,7 @@ def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _mesh_parts(geo: Any) -> tuple[np.ndarray, ...] | None:
-    """The slice cylinders ``(a, b, radius)`` of a mesh, one per cover sphere (:func:`.mesh_cover.mesh_parts`), or None."""
+    """The slice cylinders ``(a, b, radius, sphere)`` of a mesh (:func:`.mesh_cover.mesh_parts`), or None."""
     got = _mesh_cover(geo)
     return None if got is None else got[2:]
 
@@ -198,7 +198,7 @@ def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.
         return (R @ a + p)[None], (R @ b + p)[None], np.array([radius * (1.0 + 1e-9) + 1e-9])
     parts = _mesh_parts(geo) if int(geometry_object.parentJoint) > 0 else None
     if parts is not None:
-        a, b, radius = parts
+        a, b, radius, _ = parts
         return a @ R.T + p, b @ R.T + p, radius * (1.0 + 1e-9) + 1e-9
     c, r = geometry_spheres(geometry_object)
     return c, c.copy(), r
@@ -427,8 +427,8 @@ def _segments(objs: list, axes: np.ndarray, start: np.ndarray) -> tuple:
     spart = []  # a mesh's slice cylinder k holds with its sphere k; one cylinder with all the geometry's spheres
     for g in range(len(objs)):
         n = int(sstart[g + 1] - sstart[g])
-        spart += ([(start[g] + i, start[g] + i + 1) for i in range(n)] if cyl[g] == _HELD_PARTS
-                  else [(start[g], start[g + 1])] * n)
+        spart += ([(start[g] + i, start[g] + i + 1) for i in _mesh_parts(objs[g].geometry)[3]]
+                  if cyl[g] == _HELD_PARTS else [(start[g], start[g + 1])] * n)
     return (sjoint, np.ascontiguousarray(np.concatenate([a for a, _, _ in parts])),
             np.ascontiguousarray(np.concatenate([b for _, b, _ in parts])), np.concatenate([r for _, _, r in parts]),
             sstart, np.array(cyl, dtype=np.int64), np.array(spart, dtype=np.int64).reshape(-1, 2))

@@ -101,6 +101,9 @@ def _cylinder(X: np.ndarray, refine: bool = False) -> tuple[float, int, np.ndarr
     return best
 
 
+#: Cylinders each sphere's slice is cut into along its part's axis (:func:`mesh_parts`).
+SLICE_CYLINDERS = 4
+
 #: Places along a mesh's longest side where :func:`_parts` may cut it, and what each extra part costs
 #: (a share of the whole mesh's cylinder volume).
 PART_CUTS = 24
@@ -162,12 +165,14 @@ def _part_cylinders(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tu
 
 
 def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, ...]:
-    """:func:`mesh_spheres` ``(centres (k, 3), radii (k,))`` and beside each sphere the cylinder of its
-    slice: axis ends ``a, b (k, 3)`` on its part's axis and radius ``(k,)`` [m], in the mesh's frame.
-    Each cylinder holds the vertices its sphere holds (the pieces of its slice), so (convex) those
-    pieces: the union of the cylinders holds every triangle, and a slice is held by the intersection
-    of its sphere and its cylinder. Screened exactly against static boxes
-    (:func:`._cover_kernel._held_low`): the cylinder's flat ends where the sphere overshoots them."""
+    """:func:`mesh_spheres` ``(centres (k, 3), radii (k,))`` and the cylinders of the slices: each sphere's
+    slice cut across its part's axis into at most :data:`SLICE_CYLINDERS` groups of pieces (by their
+    centres), each group held by a cylinder on that axis: axis ends ``a, b (c, 3)``, radii ``(c,)`` [m] in
+    the mesh's frame, and ``sphere (c,)``: the sphere holding the same pieces. A cylinder holds its
+    pieces' vertices, so (convex) the pieces: the union of the cylinders holds every triangle, and
+    each group lies in the intersection of its cylinder and its sphere. Screened exactly against
+    static boxes (:func:`._cover_kernel._held_low`): a cylinder's flat ends where the sphere
+    overshoots them, and a flaring housing in thin cylinders."""
     return _sphere_cover(V, T, count, edge)
 
 
@@ -192,7 +197,7 @@ def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tupl
     for _ in range(40):  # the smallest overshoot whose slices fit the count
         b = np.sqrt(low * high)
         low, high = (b, high) if sum(_slices(c, b) for c in cyls) > int(count) else (low, b)
-    centres, radii, a, b, rad = [], [], [], [], []
+    centres, radii, a, b, rad, sphere = [], [], [], [], [], []
     for idx, cyl in zip(parts, cyls):
         _, axis, centre, _, lo, hi = cyl
         k = _slices(cyl, high)
@@ -206,12 +211,20 @@ def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tupl
             c[axis] = 0.5 * (X[:, axis].min() + X[:, axis].max())
             centres.append(c)
             radii.append(float(np.sqrt(((X - c) ** 2).sum(axis=1).max())))
-            # the slice's own cylinder about the part's axis: the same vertices, so it holds the same pieces
-            a.append(c.copy())
-            b.append(c.copy())
-            a[-1][axis], b[-1][axis] = X[:, axis].min(), X[:, axis].max()
-            rad.append(float(np.sqrt(((X[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
-    return np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad)
+            # the slice cut again into cylinders about the part's axis, each holding its pieces' vertices
+            inside = idx[at == j]
+            sub = np.minimum(((mid[inside, axis] - mid[inside, axis].min())
+                              / max(np.ptp(mid[inside, axis]), 1e-12) * SLICE_CYLINDERS).astype(np.int64),
+                             SLICE_CYLINDERS - 1)
+            for m in np.unique(sub):
+                Y = S[inside[sub == m]].reshape(-1, 3)
+                a.append(c.copy())
+                b.append(c.copy())
+                a[-1][axis], b[-1][axis] = Y[:, axis].min(), Y[:, axis].max()
+                rad.append(float(np.sqrt(((Y[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
+                sphere.append(len(radii) - 1)
+    return (np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad),
+            np.array(sphere, dtype=np.int64))
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
