@@ -63,21 +63,24 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
 
 
 @jit_inline
-def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, clear):
+def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut):
     """A lower bound [m] of the distance from moving geometry ``g`` held by its cylinders (:mod:`.cover`) to the static
     box ``o``: the least over cylinders ``k`` of the larger of its gaps (:func:`_box_gap`, :func:`_toward_gap`) and
-    the distances of the spheres ``spart[k]`` holding its pieces. ``clear``: only whether it exceeds ``t`` is meant
-    (an early answer)."""
+    the distances of the spheres ``spart[k]`` holding its pieces. Only a bound at most ``cut`` is meant: a cylinder
+    whose spheres are farther is passed over (so ``inf`` where none is nearer), and at one at most ``t`` (with
+    ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early."""
     low = np.inf
+    near = np.inf
     for k in range(sstart[g], sstart[g + 1]):
-        near = np.inf
-        for s in range(spart[k, 0], spart[k, 1]):
-            near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
-        if near >= low or (clear and near > t):
+        if k == sstart[g] or spart[k, 0] != spart[k - 1, 0] or spart[k, 1] != spart[k - 1, 1]:
+            near = np.inf  # a new sphere (a slice's cylinders follow each other, sharing their sphere)
+            for s in range(spart[k, 0], spart[k, 1]):
+                near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
+        if near >= low or near > cut:
             continue
         gap = max(_box_gap(SA, SB, k, srad[k], FR, Fp, half, o), _toward_gap(SA, SB, k, srad[k], FR, Fp, half, o))
         low = min(low, max(near, gap))
-        if clear and low <= t:
+        if low <= t and t >= cut:
             return low
     return low
 

@@ -121,7 +121,7 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
     if cyl[g] != 0 and exact[other] == 1:
-        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, True) > t
+        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, t) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -256,7 +256,8 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             - t >= best:
         return best
     if cyl[g] != 0 and exact[other] == 1:
-        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, False) - t)
+        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf,
+                                   t + best) - t)
     low = np.inf
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):

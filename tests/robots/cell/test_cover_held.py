@@ -112,7 +112,7 @@ def test_arm_box_bounds_stay_below_coal_and_the_screen_clears_nothing_closer(sce
     assert np.all(excess[proven] > 0.0) and not np.any(excess[~proven] > 0.0)
 
 
-def test_held_low_answers_early_only_below_its_threshold():
+def test_held_low_answers_early_and_passes_over_far_cylinders():
     cell = load_scene("ur5_shelf")
     cover = link_cover(cell)
     names = [o.name for o in cell.collision_model.geometryObjects]
@@ -125,9 +125,9 @@ def test_held_low_answers_early_only_below_its_threshold():
         W[:] = np.einsum("sab,sb->sa", R[cover.joint], cover.center) + p[cover.joint]
         SA[:] = np.einsum("sab,sb->sa", R[sjoint], sa) + p[sjoint]
         SB[:] = np.einsum("sab,sb->sa", R[sjoint], sb) + p[sjoint]
-        full = _held_low(W, cover.radius, SA, SB, srad, sstart, spart, ua, cover.frame_R, cover.frame_p, cover.size,
-                         fx, 0.0, False)
+        args = (W, cover.radius, SA, SB, srad, sstart, spart, ua, cover.frame_R, cover.frame_p, cover.size, fx)
+        full = _held_low(*args, -np.inf, np.inf)
         for t in (full - 1e-3, full + 1e-3):
-            early = _held_low(W, cover.radius, SA, SB, srad, sstart, spart, ua, cover.frame_R, cover.frame_p,
-                              cover.size, fx, t, True)
-            assert (early > t) == (full > t)
+            assert (_held_low(*args, t, t) > t) == (full > t)  # the screen's question, answered early
+            cut = _held_low(*args, -np.inf, t)  # the excess: the bound where it is at most the cut, else above it
+            assert cut == full if full <= t else cut > t
