@@ -18,9 +18,11 @@ static mesh (an arm's base) is kept exactly as the smaller of the box and the cy
 holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, and a moving
 mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
 taken exactly against the other geometry's spheres (:func:`geometry_segments`). Any other moving
-mesh is also held by the cylinders of its parts (:func:`.mesh_cover.mesh_parts`): against a static
-box its bound is the larger of its spheres' and the least of the parts' projection gaps
-(:func:`._cover_kernel._box_gap`; the flat end of a housing over a table or a pedestal).
+mesh is also held by thin cylinders, each with the sphere of its slice (:func:`.mesh_cover.mesh_parts`):
+against a static box its bound is the least over the cylinders of the larger of its sphere's
+distance and the gaps of the cylinder's projections on the box's axes and on the line to the box's
+nearest point (:func:`._box_kernel._held_low`; the flat end of a housing over a table, a flaring
+housing beside a pedestal's edge).
 
 Two geometries of one arm whose relative placement depends on at most two revolute joints, one
 of them a mesh, that the spheres leave loose (the UR5's forearm and wrist_2, wrist_1 and wrist_3,
@@ -73,8 +75,8 @@ _MESH_CACHE: dict = {}
 TABLES = True
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 #: How a moving geometry's segments hold it (the kernels' ``cyl``): one cylinder, taken exactly against the
-#: other geometry's spheres and through its projections against static boxes; or the cylinders of its parts
-#: (a mesh), whose union holds it: against a static box the least of their projection gaps.
+#: other geometry's spheres and through its projections against static boxes; or a mesh's slice cylinders,
+#: each with its slice's sphere (``spart``), whose union holds it: against a static box only.
 _HELD_ONE, _HELD_PARTS = 1, 2
 
 
@@ -182,7 +184,7 @@ def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.
     """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
     cylinder, or of the cylinder holding a moving mesh where it is smaller than the mesh's box (taken
     exactly against the other geometry's spheres; ``joint_axis``: the parent joint's unit axis in its
-    frame, :data:`TURNING_SHARE`); another moving mesh: the cylinders of its parts (:func:`.mesh_cover.mesh_parts`,
+    frame, :data:`TURNING_SHARE`); another moving mesh: its slices' cylinders (:func:`.mesh_cover.mesh_parts`,
     screened against static boxes, :data:`_HELD_PARTS`); other geometries: their spheres as zero-length axes
     (unused by the screen)."""
     geo = geometry_object.geometry
@@ -416,7 +418,7 @@ def _static_shape(obj: Any) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
 
 def _segments(objs: list, axes: np.ndarray, start: np.ndarray) -> tuple:
     """The cover's cylinders (:func:`geometry_segments`; ``axes (nj, 3)``: each joint's axis in its frame) and,
-    last, the cover spheres ``spart (n, 2)`` each cylinder holds with (a part's, else all its geometry's)."""
+    last, the cover spheres ``spart (n, 2)`` each cylinder holds with (its slice's, else all its geometry's)."""
     turning = [axes[int(o.parentJoint)] if int(o.parentJoint) > 0 else None for o in objs]
     parts = [geometry_segments(obj, u) for obj, u in zip(objs, turning)]
     sstart = np.concatenate([[0], np.cumsum([r.size for _, _, r in parts])]).astype(np.int64)

@@ -15,9 +15,9 @@ union of the spheres holds every triangle.
 **Primitives**: :func:`static_primitive` gives the smaller of the box and the cylinders (along
 the mesh's axes) holding all vertices, screened exactly for a mesh fixed in the world (an
 arm's base); :func:`mesh_cylinder` the smallest such cylinder, screened exactly for a moving
-mesh where it is tight (:data:`.cover.CYLINDER_SHARE`); :func:`mesh_parts` the cylinders of the
-parts the spheres slice, screened exactly against static boxes for a moving mesh that one cylinder
-holds loosely. A box or a cylinder is convex: holding the vertices it holds the mesh.
+mesh where it is tight (:data:`.cover.CYLINDER_SHARE`); :func:`mesh_parts` the spheres with thin
+cylinders on their parts' axes, each holding a group of a slice's pieces, screened exactly against
+static boxes for a moving mesh that one cylinder holds loosely. A box or a cylinder is convex: holding the vertices it holds the mesh.
 
 Lengths in m, in the mesh's own frame.
 """
