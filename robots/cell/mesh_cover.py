@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_spheres", "split_triangles", "static_primitive"]
+__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_spheres", "split_triangles",
+           "static_primitive"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
