@@ -71,15 +71,22 @@ def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut
     ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early."""
     low = np.inf
     near = np.inf
+    held = -1
     for k in range(sstart[g], sstart[g + 1]):
-        if k == sstart[g] or spart[k, 0] != spart[k - 1, 0] or spart[k, 1] != spart[k - 1, 1]:
-            near = np.inf  # a new sphere (a slice's cylinders follow each other, sharing their sphere)
+        many = spart[k, 1] - spart[k, 0] > 1  # a whole cylinder's spheres: its cheap gap first
+        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, half, o) if many else -np.inf
+        if gap >= low or gap > cut:
+            continue
+        if spart[k, 0] != held or k == sstart[g]:
+            held = spart[k, 0]  # a new sphere (a slice's cylinders follow each other, sharing their sphere)
+            near = np.inf
             for s in range(spart[k, 0], spart[k, 1]):
                 near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
         if near >= low or near > cut:
             continue
-        gap = max(_box_gap(SA, SB, k, srad[k], FR, Fp, half, o), _toward_gap(SA, SB, k, srad[k], FR, Fp, half, o))
-        low = min(low, max(near, gap))
+        if not many:
+            gap = _box_gap(SA, SB, k, srad[k], FR, Fp, half, o)
+        low = min(low, max(near, gap, _toward_gap(SA, SB, k, srad[k], FR, Fp, half, o)))
         if low <= t and t >= cut:
             return low
     return low
