@@ -9,10 +9,18 @@ like :mod:`robots.ik._kernel` (compiled per process where no cache location is w
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
-from pinarms.compiled import jit, jit_inline
+from pinarms.compiled import drop_stale_caches, jit, jit_inline
+
+from . import _box_kernel
+from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
+
+# these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
+drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
+                  Path(__file__).resolve().parent / "__pycache__" / "cover_kernels.sha256")
 
 
 @jit
@@ -81,26 +89,6 @@ def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, join
 
 
 @jit_inline
-def _fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
-    """Distance [m] from point ``x`` to the static box (1), cylinder (2, axis z) or sphere (3) ``o``
-    (world rotation ``FR[o]``, centre ``Fp[o]``, ``size[o]``); 0 inside."""
-    d0, d1, d2 = x0 - Fp[o, 0], x1 - Fp[o, 1], x2 - Fp[o, 2]
-    l0 = FR[o, 0, 0] * d0 + FR[o, 1, 0] * d1 + FR[o, 2, 0] * d2
-    l1 = FR[o, 0, 1] * d0 + FR[o, 1, 1] * d1 + FR[o, 2, 1] * d2
-    l2 = FR[o, 0, 2] * d0 + FR[o, 1, 2] * d1 + FR[o, 2, 2] * d2
-    if kind == 1:
-        o0 = max(abs(l0) - size[o, 0], 0.0)
-        o1 = max(abs(l1) - size[o, 1], 0.0)
-        o2 = max(abs(l2) - size[o, 2], 0.0)
-        return math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-    if kind == 2:
-        dr = max(math.sqrt(l0 * l0 + l1 * l1) - size[o, 0], 0.0)
-        dz = max(abs(l2) - size[o, 1], 0.0)
-        return math.sqrt(dr * dr + dz * dz)
-    return max(math.sqrt(l0 * l0 + l1 * l1 + l2 * l2) - size[o, 0], 0.0)
-
-
-@jit_inline
 def _cylinder_distance(x0, x1, x2, SA, SB, k, r):
     """Distance [m] from point ``x`` to the solid cylinder of axis ``SA[k] SB[k]`` and radius ``r``; 0 inside."""
     u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
@@ -126,16 +114,14 @@ def _exact_distance(x0, x1, x2, other, exact, FR, Fp, size, SA, SB, srad, sstart
 
 
 @jit_inline
-def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad):
+def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW, hrad):
     """Cover spheres of geometry ``g`` against geometry ``other`` taken exactly (a static box,
     cylinder or sphere, or a moving cylinder): all more than ``t`` away. The bounding sphere of
     ``g`` (``HW[g]``, ``hrad[g]``) first."""
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
-    if cyl[g] and exact[other] == 1:
-        k = sstart[g]
-        if _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) > t:
-            return True
+    if cyl[g] != 0 and exact[other] == 1:
+        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, t) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -144,12 +130,14 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
 
 
 @jit_inline
-def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad):
+def _pair_clear(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, ga, gb, t, HW, hrad):
     """Whether the cover proves geometries ``ga`` and ``gb`` more than ``t`` apart."""
-    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
-        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
-    if exact[ga] != 0 or cyl[ga]:
-        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad)
+    if exact[gb] != 0 or (cyl[gb] == 1 and exact[ga] == 0):
+        return _spheres_clear(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                              hrad)
+    if exact[ga] != 0 or cyl[ga] == 1:
+        return _spheres_clear(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                              hrad)
     for sa in range(start[ga], start[ga + 1]):
         for sb in range(start[gb], start[gb + 1]):
             reach = radius[sa] + radius[sb] + t
@@ -207,7 +195,7 @@ def pair_proven(cov, grp, work, k):
     if tab >= 0 and table_low(work[0], cov[14], tab) > t:
         return True
     return _pair_clear(work[2], cov[2], cov[3], cov[4], cov[5], cov[6], cov[7], work[3], work[4], cov[11], cov[12],
-                       cov[13], ga, gb, t, work[5], grp[2])
+                       cov[13], cov[15], ga, gb, t, work[5], grp[2])
 
 
 @jit_inline
@@ -260,24 +248,22 @@ def _apart(HW, hrad, a, b, t):
 
 
 @jit_inline
-def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad, best):
+def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad,                     best):
     """``min(best, lower bound of distance(g, other) − t)``: the cover spheres of ``g`` against ``other``
     taken exactly (a static box, cylinder or sphere, or a moving cylinder); its bounding sphere first."""
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] \
             - t >= best:
         return best
-    gap = -np.inf
-    if cyl[g] and exact[other] == 1:
-        k = sstart[g]
-        gap = _box_gap(SA, SB, k, srad[k], FR, Fp, size, other) - t
-        if gap >= best:
-            return best
+    if cyl[g] != 0 and exact[other] == 1:
+        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf,
+                                   t + best) - t)
     low = np.inf
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
-            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other) - radius[s] - t
-            low = min(low, d)
-        return min(best, max(low, gap))
+            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other)
+            low = min(low, d - radius[s] - t)
+        return min(best, low)
     # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
     k = sstart[other]
     a0, a1, a2, r = SA[k, 0], SA[k, 1], SA[k, 2], srad[k]
@@ -293,49 +279,20 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             dr = max(math.sqrt(max(ww - h * h, 0.0)) - r, 0.0)
             dz = max(abs(h - 0.5 * L) - 0.5 * L, 0.0)
             d = math.sqrt(dr * dr + dz * dz)
-        d = d - radius[s] - t
-        low = min(low, d)
-    return min(best, max(low, gap))
-
-
-@jit
-def _cylinder_box_gap(a, b, r, FR, Fp, half):
-    """A lower bound [m] of the distance between the solid cylinder of axis ``a b`` and radius ``r`` and a
-    static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
-    projections on the box's three axes (a projection shortens every distance). Exact for a cylinder
-    standing upright over a box's face, where its spheres overshoot by nearly its radius."""
-    return _box_gap(a.reshape((1, 3)), b.reshape((1, 3)), 0, r, FR.reshape((1, 3, 3)), Fp.reshape((1, 3)),
-                    half.reshape((1, 3)), 0)
+        low = min(low, d - radius[s] - t)
+    return min(best, low)
 
 
 @jit_inline
-def _box_gap(SA, SB, k, r, FR, Fp, half, o):
-    """:func:`_cylinder_box_gap` of the cylinder ``SA[k] SB[k]`` and the box ``o`` (``FR[o]``, ``Fp[o]``, ``half[o]``)."""
-    u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
-    L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    if L > 0.0:
-        u0, u1, u2 = u0 / L, u1 / L, u2 / L
-    gap = -np.inf
-    for i in range(3):
-        n0, n1, n2 = FR[o, 0, i], FR[o, 1, i], FR[o, 2, i]
-        ca = (SA[k, 0] - Fp[o, 0]) * n0 + (SA[k, 1] - Fp[o, 1]) * n1 + (SA[k, 2] - Fp[o, 2]) * n2
-        cb = (SB[k, 0] - Fp[o, 0]) * n0 + (SB[k, 1] - Fp[o, 1]) * n1 + (SB[k, 2] - Fp[o, 2]) * n2
-        un = u0 * n0 + u1 * n1 + u2 * n2
-        rad = r * math.sqrt(max(1.0 - un * un, 0.0))
-        g = max(min(ca, cb) - rad - half[o, i], -half[o, i] - max(ca, cb) - rad)
-        gap = max(gap, g)
-    return gap
-
-
-@jit_inline
-def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t, HW, hrad, best):
+def _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, ga, gb, t, HW, hrad,
+                 best):
     """``min(best, lower bound of distance(ga, gb) − t)`` from the covers (:func:`_pair_clear`'s cases)."""
-    if exact[gb] != 0 or (cyl[gb] and exact[ga] == 0):
-        return _spheres_excess(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
-                               best)
-    if exact[ga] != 0 or cyl[ga]:
-        return _spheres_excess(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, t, HW, hrad,
-                               best)
+    if exact[gb] != 0 or (cyl[gb] == 1 and exact[ga] == 0):
+        return _spheres_excess(W, radius, start, ga, gb, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad, best)
+    if exact[ga] != 0 or cyl[ga] == 1:
+        return _spheres_excess(W, radius, start, gb, ga, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, spart, t, HW,
+                               hrad, best)
     for sa in range(start[ga], start[ga + 1]):
         for sb in range(start[gb], start[gb + 1]):
             rr = radius[sa] + radius[sb] + t
@@ -474,8 +431,8 @@ def excess_placed(cov, grp, inv, cap, floor, work):
             if low * s >= best:
                 continue
             raw = best / s
-            r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, ga, gb, t[k], HW,
-                             hrad, raw)
+            r = _pair_excess(W, radius, start, exact, FR, Fp, size, SA, SB, srad, sstart, cyl, cov[15], ga, gb, t[k],
+                             HW, hrad, raw)
             if r < raw:
                 best = min(best, max(r, low) * s)
             if best < floor:

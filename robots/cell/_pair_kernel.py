@@ -18,13 +18,13 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 
-from . import _cover_kernel
+from . import _box_kernel, _cover_kernel
 from ._cover_kernel import _apart, _fixture_distance, _place, pair_proven
 
 __all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
-drop_stale_caches([Path(_cover_kernel.__file__), Path(__file__)],
+drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(__file__)],
                   Path(__file__).resolve().parent / "__pycache__" / "pair_kernels.sha256")
 
 

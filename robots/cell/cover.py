@@ -17,7 +17,12 @@ exactly: a sphere's distance to it is computed in closed form, not through its c
 static mesh (an arm's base) is kept exactly as the smaller of the box and the cylinders
 holding its vertices (:func:`.mesh_cover.static_primitive`). A moving cylinder, and a moving
 mesh whose holding cylinder is tight (:data:`CYLINDER_SHARE`, :data:`TURNING_SHARE`), is
-taken exactly against the other geometry's spheres (:func:`geometry_segments`).
+taken exactly against the other geometry's spheres (:func:`geometry_segments`). Any other moving
+mesh is also held by thin cylinders, each with the sphere of its slice (:func:`.mesh_cover.mesh_parts`):
+against a static box its bound is the least over the cylinders of the larger of its sphere's
+distance and the gaps of the cylinder's projections on the box's axes and on the line to the box's
+nearest point (:func:`._box_kernel._held_low`; the flat end of a housing over a table, a flaring
+housing beside a pedestal's edge).
 
 Two geometries of one arm whose relative placement depends on at most two revolute joints, one
 of them a mesh, that the spheres leave loose (the UR5's forearm and wrist_2, wrist_1 and wrist_3,
@@ -43,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from ._cover_kernel import excess_kernel, screen_kernel
-from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_spheres, static_primitive
+from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
 from .pair_tables import PairTables, no_tables, pair_tables
 
 __all__ = [
@@ -69,6 +74,10 @@ _MESH_CACHE: dict = {}
 #: Whether :func:`link_cover` gives pairs close in the chain their distance tables (:mod:`.pair_tables`).
 TABLES = True
 _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
+#: How a moving geometry's segments hold it (the kernels' ``cyl``): one cylinder, taken exactly against the
+#: other geometry's spheres and through its projections against static boxes; or a mesh's slice cylinders,
+#: each with its slice's sphere (``spart``), whose union holds it: against a static box only.
+_HELD_ONE, _HELD_PARTS = 1, 2
 
 
 def pairs_for(cell: Any, clearance: float) -> tuple:
@@ -82,14 +91,26 @@ def _slices(length: float, width: float) -> int:
     return int(min(MAX_SPHERES, max(1, math.ceil(1.5 * length / max(width, 1e-6)))))
 
 
-def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
+def _mesh_cover(geo: Any) -> tuple[np.ndarray, ...] | None:
+    """:func:`.mesh_cover.mesh_parts` of a mesh (kept per content), or None for a shape without triangles."""
     got = mesh_arrays(geo)
     if got is None:
         return None
     key = (got[0].tobytes(), got[1].tobytes(), MESH_SPHERES)
     if key not in _MESH_CACHE:
-        _MESH_CACHE[key] = mesh_spheres(*got, MESH_SPHERES)
+        _MESH_CACHE[key] = mesh_parts(*got, MESH_SPHERES)
     return _MESH_CACHE[key]
+
+
+def _mesh_spheres(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    got = _mesh_cover(geo)
+    return None if got is None else got[:2]
+
+
+def _mesh_parts(geo: Any) -> tuple[np.ndarray, ...] | None:
+    """The slice cylinders ``(a, b, radius, sphere)`` of a mesh (:func:`.mesh_cover.mesh_parts`), or None."""
+    got = _mesh_cover(geo)
+    return None if got is None else got[2:]
 
 
 def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -163,8 +184,9 @@ def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.
     """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
     cylinder, or of the cylinder holding a moving mesh where it is smaller than the mesh's box (taken
     exactly against the other geometry's spheres; ``joint_axis``: the parent joint's unit axis in its
-    frame, :data:`TURNING_SHARE`); other geometries: their spheres as zero-length axes (unused by the
-    screen)."""
+    frame, :data:`TURNING_SHARE`); another moving mesh: its slices' cylinders (:func:`.mesh_cover.mesh_parts`,
+    screened against static boxes, :data:`_HELD_PARTS`); other geometries: their spheres as zero-length axes
+    (unused by the screen)."""
     geo = geometry_object.geometry
     M = geometry_object.placement
     R, p = np.asarray(M.rotation), np.asarray(M.translation)
@@ -176,6 +198,10 @@ def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.
     if held is not None:
         a, b, radius = held
         return (R @ a + p)[None], (R @ b + p)[None], np.array([radius * (1.0 + 1e-9) + 1e-9])
+    parts = _mesh_parts(geo) if int(geometry_object.parentJoint) > 0 else None
+    if parts is not None:
+        a, b, radius, _ = parts
+        return a @ R.T + p, b @ R.T + p, radius * (1.0 + 1e-9) + 1e-9
     c, r = geometry_spheres(geometry_object)
     return c, c.copy(), r
 
@@ -283,7 +309,7 @@ class Cover:
     def kernel_arrays(self) -> tuple:
         """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
         return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
-                *self.segments, self.tables.arrays())
+                *self.segments[:6], self.tables.arrays(), self.segments[6])
 
     def group_arrays(self, pairs: PairSet, threshold: np.ndarray) -> tuple:
         """The pair groups of ``pairs`` with their thresholds [m] (given in the pairs' order), for the kernels."""
@@ -360,7 +386,7 @@ def link_cover(cell: Any) -> Cover:
             exact[g], frame_R[g], frame_p[g], size[g] = _static_shape(obj)
     cover = Cover(start, np.concatenate(joints), np.ascontiguousarray(np.concatenate(centers)),
                   np.concatenate(radii), exact, np.ascontiguousarray(frame_R), frame_p, size, _fk_arrays(cell),
-                  _segments(objs, _fk_arrays(cell)[5]), _bounds(objs, start, centers, radii))
+                  _segments(objs, _fk_arrays(cell)[5], start), _bounds(objs, start, centers, radii))
     if TABLES:  # an arm's own pairs close in the chain that the spheres leave loose get distance tables
         own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
         cover = replace(cover, tables=pair_tables(cell, own, cover))
@@ -390,16 +416,24 @@ def _static_shape(obj: Any) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
     return (_EXACT_BOX if shape == "Box" else _EXACT_CYLINDER), R @ R_local, R @ centre + p, half
 
 
-def _segments(objs: list, axes: np.ndarray) -> tuple:
-    """The cover's cylinders (:func:`geometry_segments`; ``axes (nj, 3)``: each joint's axis in its frame)."""
+def _segments(objs: list, axes: np.ndarray, start: np.ndarray) -> tuple:
+    """The cover's cylinders (:func:`geometry_segments`; ``axes (nj, 3)``: each joint's axis in its frame) and,
+    last, the cover spheres ``spart (n, 2)`` each cylinder holds with (its slice's, else all its geometry's)."""
     turning = [axes[int(o.parentJoint)] if int(o.parentJoint) > 0 else None for o in objs]
     parts = [geometry_segments(obj, u) for obj, u in zip(objs, turning)]
     sstart = np.concatenate([[0], np.cumsum([r.size for _, _, r in parts])]).astype(np.int64)
     sjoint = np.concatenate([np.full(r.size, int(o.parentJoint), dtype=np.int64) for o, (_, _, r) in zip(objs, parts)])
-    cyl = [type(o.geometry).__name__ == "Cylinder" or _mesh_cylinder(o, u) is not None for o, u in zip(objs, turning)]
+    cyl = [_HELD_ONE if type(o.geometry).__name__ == "Cylinder" or _mesh_cylinder(o, u) is not None
+           else _HELD_PARTS if int(o.parentJoint) > 0 and _mesh_parts(o.geometry) is not None else 0
+           for o, u in zip(objs, turning)]
+    spart = []  # a mesh's slice cylinder k holds with its sphere k; one cylinder with all the geometry's spheres
+    for g in range(len(objs)):
+        n = int(sstart[g + 1] - sstart[g])
+        spart += ([(start[g] + i, start[g] + i + 1) for i in _mesh_parts(objs[g].geometry)[3]]
+                  if cyl[g] == _HELD_PARTS else [(start[g], start[g + 1])] * n)
     return (sjoint, np.ascontiguousarray(np.concatenate([a for a, _, _ in parts])),
             np.ascontiguousarray(np.concatenate([b for _, b, _ in parts])), np.concatenate([r for _, _, r in parts]),
-            sstart, np.array(cyl, dtype=np.bool_))
+            sstart, np.array(cyl, dtype=np.int64), np.array(spart, dtype=np.int64).reshape(-1, 2))
 
 
 def _bounds(objs: list, start: np.ndarray, centers: list, radii: list) -> tuple:

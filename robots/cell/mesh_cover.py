@@ -15,8 +15,9 @@ union of the spheres holds every triangle.
 **Primitives**: :func:`static_primitive` gives the smaller of the box and the cylinders (along
 the mesh's axes) holding all vertices, screened exactly for a mesh fixed in the world (an
 arm's base); :func:`mesh_cylinder` the smallest such cylinder, screened exactly for a moving
-mesh where it is tight (:data:`.cover.CYLINDER_SHARE`). A box or a cylinder is convex:
-holding the vertices it holds the mesh.
+mesh where it is tight (:data:`.cover.CYLINDER_SHARE`); :func:`mesh_parts` the spheres with thin
+cylinders on their parts' axes, each holding a group of a slice's pieces, screened exactly against
+static boxes for a moving mesh that one cylinder holds loosely. A box or a cylinder is convex: holding the vertices it holds the mesh.
 
 Lengths in m, in the mesh's own frame.
 """
@@ -27,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mesh_arrays", "split_triangles", "mesh_spheres", "mesh_cylinder", "static_primitive", "SPLIT_EDGE"]
+__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_spheres", "split_triangles",
+           "static_primitive"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
@@ -100,6 +102,9 @@ def _cylinder(X: np.ndarray, refine: bool = False) -> tuple[float, int, np.ndarr
     return best
 
 
+#: Cylinders each sphere's slice is cut into along its part's axis (:func:`mesh_parts`).
+SLICE_CYLINDERS = 4
+
 #: Places along a mesh's longest side where :func:`_parts` may cut it, and what each extra part costs
 #: (a share of the whole mesh's cylinder volume).
 PART_CUTS = 24
@@ -146,6 +151,32 @@ def _slices(cyl: tuple, bulge: float) -> int:
     return max(1, int(np.ceil((hi - lo) / t)))
 
 
+def _part_cylinders(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple:
+    """The mesh's pieces ``S``, their centres, its parts (piece indices, :func:`_parts`; one part where
+    there are more than ``count``) and each part's cylinder (:func:`_cylinder`, holding its pieces' vertices)."""
+    if int(count) < 1:
+        raise ValueError(f"count must be at least 1, got {count!r}")
+    P = np.asarray(V, dtype=float)[np.asarray(T, dtype=np.int64)]
+    S, _ = split_triangles(P, edge)
+    mid = S.mean(axis=1)
+    parts = _parts(S, mid)
+    if len(parts) > int(count):  # more parts than spheres: one part
+        parts = [np.arange(S.shape[0])]
+    return S, mid, parts, [_cylinder(S[idx].reshape(-1, 3), refine=True) for idx in parts]
+
+
+def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_spheres` ``(centres (k, 3), radii (k,))`` and the cylinders of the slices: each sphere's
+    slice cut across its part's axis into at most :data:`SLICE_CYLINDERS` groups of pieces (by their
+    centres), each group held by a cylinder on that axis: axis ends ``a, b (c, 3)``, radii ``(c,)`` [m] in
+    the mesh's frame, and ``sphere (c,)``: the sphere holding the same pieces. A cylinder holds its
+    pieces' vertices, so (convex) the pieces: the union of the cylinders holds every triangle, and
+    each group lies in the intersection of its cylinder and its sphere. Screened exactly against
+    static boxes (:func:`._cover_kernel._held_low`): a cylinder's flat ends where the sphere
+    overshoots them, and a flaring housing in thin cylinders."""
+    return _sphere_cover(V, T, count, edge)
+
+
 def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, np.ndarray]:
     """At most ``count`` spheres ``(centres (k, 3), radii (k,))`` [m] whose union holds the mesh of
     vertices ``V (n, 3)`` and triangles ``T (m, 3)``, in the mesh's frame.
@@ -157,24 +188,22 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
     cylinder's radius allows, the smallest overshoot for which all parts take at most
     ``count`` slices. Each sphere reaches the farthest vertex of the pieces whose centres lie
     in its slice: holding a piece's vertices it holds the piece (a sphere is convex)."""
-    if int(count) < 1:
-        raise ValueError(f"count must be at least 1, got {count!r}")
-    P = np.asarray(V, dtype=float)[np.asarray(T, dtype=np.int64)]
-    S, _ = split_triangles(P, edge)
-    mid = S.mean(axis=1)
-    parts = _parts(S, mid)
-    if len(parts) > int(count):  # more parts than spheres: one part
-        parts = [np.arange(S.shape[0])]
-    cyls = [_cylinder(S[idx].reshape(-1, 3), refine=True) for idx in parts]
+    return _sphere_cover(V, T, count, edge)[:2]
+
+
+def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_parts` (:func:`mesh_spheres` its first two arrays)."""
+    S, mid, parts, cyls = _part_cylinders(V, T, count, edge)
     low, high = 1e-5, 1.0
     for _ in range(40):  # the smallest overshoot whose slices fit the count
         b = np.sqrt(low * high)
         low, high = (b, high) if sum(_slices(c, b) for c in cyls) > int(count) else (low, b)
-    centres, radii = [], []
+    centres, radii, a, b, rad, sphere = [], [], [], [], [], []
     for idx, cyl in zip(parts, cyls):
         _, axis, centre, _, lo, hi = cyl
         k = _slices(cyl, high)
         at = np.minimum(((mid[idx, axis] - lo) / max(hi - lo, 1e-12) * k).astype(np.int64), k - 1)
+        u, w = (axis + 1) % 3, (axis + 2) % 3
         for j in range(k):
             X = S[idx[at == j]].reshape(-1, 3)
             if X.shape[0] == 0:
@@ -183,7 +212,20 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
             c[axis] = 0.5 * (X[:, axis].min() + X[:, axis].max())
             centres.append(c)
             radii.append(float(np.sqrt(((X - c) ** 2).sum(axis=1).max())))
-    return np.array(centres), np.array(radii)
+            # the slice cut again into cylinders about the part's axis, each holding its pieces' vertices
+            inside = idx[at == j]
+            sub = np.minimum(((mid[inside, axis] - mid[inside, axis].min())
+                              / max(np.ptp(mid[inside, axis]), 1e-12) * SLICE_CYLINDERS).astype(np.int64),
+                             SLICE_CYLINDERS - 1)
+            for m in np.unique(sub):
+                Y = S[inside[sub == m]].reshape(-1, 3)
+                a.append(c.copy())
+                b.append(c.copy())
+                a[-1][axis], b[-1][axis] = Y[:, axis].min(), Y[:, axis].max()
+                rad.append(float(np.sqrt(((Y[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
+                sphere.append(len(radii) - 1)
+    return (np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad),
+            np.array(sphere, dtype=np.int64))
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
