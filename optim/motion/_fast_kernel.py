@@ -28,12 +28,12 @@ from pathlib import Path
 import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
-from pinarms.robots.cell import _cover_kernel, ladder
+from pinarms.robots.cell import _box_kernel, _cover_kernel, ladder
 from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_placed, place_moving
 from pinarms.robots.cell.ladder import interval_proven
 
 # these kernels call the cover's and the ladder's rule: their changes must compile them again (pinarms.compiled)
-drop_stale_caches([Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
+drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
                   Path(__file__).resolve().parent / "__pycache__" / "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
