@@ -57,20 +57,21 @@ def travel_time_bound(P: np.ndarray, vmax: np.ndarray) -> float:
 
 
 def _best_goal(checker: Any, x0: np.ndarray, G: np.ndarray, found: np.ndarray, vmax: np.ndarray, seed: int,
-               deadline: float) -> tuple[np.ndarray, int, int]:
+               limit: float) -> tuple[np.ndarray, int, int]:
     """The shortcut path to the goal branch whose path has the smallest :func:`travel_time_bound`: each other
-    goal, in increasing order of its straight move's bound, is searched alone (compiled) while that bound is
-    below the best path's (no later goal can beat it) and the clock is before ``deadline``. Returns the path,
-    the searches run and their states."""
+    goal, in increasing order of its straight move's bound, is searched alone (compiled, ``limit`` seconds
+    each, like the first search: the same seed gives the same path whatever the clock read before) while
+    that bound is below the best path's (no later goal can beat it). Returns the path, the searches run and
+    their states."""
     best, best_bound = found, travel_time_bound(found, vmax)
     straight = np.max(np.abs(G - x0) / vmax, axis=1)
     runs = states = 0
     for g in np.argsort(straight, kind="stable"):
-        if straight[g] >= best_bound or time.perf_counter() >= deadline:
+        if straight[g] >= best_bound:
             break
         if np.array_equal(G[g], best[-1]):
             continue
-        r = fast_search(checker, x0, G[g][None], time_limit=max(deadline - time.perf_counter(), 1e-4), seed=int(seed))
+        r = fast_search(checker, x0, G[g][None], time_limit=limit, seed=int(seed))
         runs, states = runs + 1, states + r.states
         if r.path is None:
             continue
@@ -88,8 +89,8 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
     seconds and states those of both searches), ``simplified``, ``simplifier``, ``compiled`` (bool),
     ``seconds`` (``"search"``, ``"shortcut"``). ``NoPathFound`` when nothing is found in time.
     ``compiled=False``: OMPL alone. ``best_goal``: the planned joints' speed limits ``(n,)``: with several
-    goal configurations, a compiled path is compared with paths searched to each other goal within the
-    compiled search's share of the time limit (:func:`_best_goal`); ``None``: the first goal reached."""
+    goal configurations, a compiled path is compared with paths searched to each other goal, each with
+    the compiled search's share of the time limit (:func:`_best_goal`); ``None``: the first goal reached."""
     t0 = time.perf_counter()
     share = fast_share(checker, planner) if compiled else 0.0
     spent, states = 0.0, 0
@@ -102,7 +103,7 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
             simplified = fast_shortcut(checker, fast.path, seed=int(seed))
             if best_goal is not None and len(G) > 1:
                 simplified, runs, more = _best_goal(checker, x0, G, simplified, np.asarray(best_goal, dtype=float),
-                                                    int(seed), t0 + share * float(time_limit))
+                                                    int(seed), share * float(time_limit))
                 say(f"{runs} other goal(s) searched ({more} states); the path with the shortest time bound kept")
             return {"result": fast, "simplified": simplified, "simplifier": FAST_SIMPLIFIER, "compiled": True,
                     "seconds": {"search": fast.seconds, "shortcut": time.perf_counter() - t}}

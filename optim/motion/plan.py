@@ -186,7 +186,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
             proven by the exact checker either way).
         goals: with several goal configurations (the IK branches of a pose goal): ``"first"``,
             the path to the first one reached; ``"best"``, each other goal is also searched
-            (compiled, within the compiled search's share of ``time_limit``, in increasing order
+            (compiled, each with the compiled search's share of ``time_limit``, in increasing order
             of its straight move's time bound, while it could still win) and the path with the
             shortest time bound (each edge at its slowest joint's speed limit) is kept: for a
             move planned once and run many times.
