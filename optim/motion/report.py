@@ -14,6 +14,7 @@ import pinocchio as pin
 from pinarms.optim.motion.goals import GoalCandidate
 from pinarms.planning import JointPath, Trajectory
 from pinarms.robots.cell.ladder import interval_bound
+from pinarms.robots.cell.speed_bound import travel_stops
 
 __all__ = ["MotionPlan", "ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
            "pair_speeds", "sample_times"]
@@ -309,13 +310,7 @@ def sample_times(trajectory: Trajectory, levers: np.ndarray, margin: float, extr
     A = float(np.abs(np.asarray(peaks.acceleration, dtype=float)) @ levers)
     step = np.minimum(np.maximum(v[:-1], v[1:]) + A * h / 2.0, cap)
     budget = np.concatenate([[0.0], np.cumsum(step * h)])
-    keep = [0]
-    for i in range(1, grid.size):
-        if budget[i] - budget[keep[-1]] > margin * (1.0 + 1e-12):
-            keep.append(i - 1)
-    if keep[-1] != grid.size - 1:
-        keep.append(grid.size - 1)
-    times = grid[np.unique(keep)]
+    times = grid[travel_stops(budget, margin)]
     return times if times.size > MIN_INTERVALS else np.linspace(t0, t1, MIN_INTERVALS + 1)
 
 

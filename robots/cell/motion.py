@@ -56,7 +56,7 @@ from .collision import _margin, exact_min_distance
 from .ladder import Intervals, climb
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
-from .speed_bound import joint_levers, speed_profile
+from .speed_bound import joint_levers, speed_profile, travel_stops
 from .timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
                        motion_window, sample_motions)
 
@@ -187,14 +187,7 @@ def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, marg
         grid = np.linspace(t0, t1, n + 1)
         V, _ = speed_profile(cell, motions, grid)
         budget = np.concatenate([[0.0], np.cumsum(V * np.diff(grid))])
-    keep = [0]
-    for i in range(1, grid.size):
-        if budget[i] - budget[keep[-1]] > margin * (1.0 + 1e-12):
-            keep.append(i - 1)
-    if keep[-1] != grid.size - 1:
-        keep.append(grid.size - 1)
-    idx = np.array(sorted(set(keep)), dtype=int)
-    return _Schedule(grid, budget, grid[idx], dt, V_global, (t0, t1))
+    return _Schedule(grid, budget, grid[travel_stops(budget, margin)], dt, V_global, (t0, t1))
 
 
 class _Samples:

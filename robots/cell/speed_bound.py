@@ -5,7 +5,9 @@ with ``ℓ_j`` the *lever* of joint ``j`` (:func:`joint_levers`: 1 for a prismat
 revolute joint, a bound of the distance from its origin to any point of the geometry it
 carries, from the joint offsets, strokes and bounding spheres downstream). Two bodies
 approach each other at most at ``V(t) = 2 max_arms v(t)``; :func:`speed_profile` bounds ``V``
-on each step of a time grid (see :mod:`.motion` for the rule and its use).
+on each step of a time grid (see :mod:`.motion` for the rule and its use), and
+:func:`travel_stops` keeps the grid points a sampling needs so that no two neighbours are more
+than a given travel apart.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from .timeline import ArmMotion
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["joint_levers", "peak_speed", "speed_profile"]
+__all__ = ["joint_levers", "peak_speed", "speed_profile", "travel_stops"]
 
 
 def joint_levers(cell: "Cell") -> np.ndarray:
@@ -119,3 +121,18 @@ def speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> t
         per_arm.append(cell_v)
     V = 2.0 * np.max(np.vstack(per_arm), axis=0) if per_arm else np.zeros(h.size)
     return V, 2.0 * global_v
+
+
+def travel_stops(budget: np.ndarray, step: float) -> np.ndarray:
+    """Indices ``(k,)`` (sorted, unique) of the grid points kept so that between two kept neighbours the
+    travel bound grows by at most ``step``, where it can: ``budget (N,)`` is the cumulative travel bound
+    [m] at the grid points (non-decreasing, ``budget[0] = 0``). Greedy from the start: the last point
+    before the budget passes ``step`` is kept (a single grid interval longer than ``step`` keeps both
+    its ends); the first and last points always."""
+    keep = [0]
+    for i in range(1, budget.size):
+        if budget[i] - budget[keep[-1]] > step * (1.0 + 1e-12):
+            keep.append(i - 1)
+    if keep[-1] != budget.size - 1:
+        keep.append(budget.size - 1)
+    return np.unique(np.asarray(keep, dtype=int))
