@@ -13,6 +13,8 @@ from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_check, fast_search, fast_shortcut
 from pinarms.robots.cell._cover_kernel import _cylinder_box_gap
 
+from tests.robots.cell.random_shapes import cylinder_and_box
+
 MARGIN = 0.01
 
 
@@ -117,14 +119,7 @@ def test_cylinder_box_gap_is_a_lower_bound_of_coal_distance():
     coal = pytest.importorskip("coal")
     rng = np.random.default_rng(0)
     for _ in range(300):
-        r, h = rng.uniform(0.02, 0.1), rng.uniform(0.02, 0.2)
-        half = rng.uniform(0.05, 0.3, 3)
-        Rb = np.linalg.qr(rng.normal(size=(3, 3)))[0]
-        Rb *= np.sign(np.linalg.det(Rb))
-        pb = rng.normal(size=3) * 0.3
-        Rc = np.linalg.qr(rng.normal(size=(3, 3)))[0]
-        Rc *= np.sign(np.linalg.det(Rc))
-        pc = pb + rng.normal(size=3) * 0.4
+        r, h, half, Rb, pb, Rc, pc = cylinder_and_box(rng, 0.02)
         a, b = pc - h * Rc[:, 2], pc + h * Rc[:, 2]
         gap = _cylinder_box_gap(a, b, r, Rb, pb, half)
         req, res = coal.DistanceRequest(), coal.DistanceResult()

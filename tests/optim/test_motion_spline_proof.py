@@ -10,25 +10,16 @@ sample closer than the margin.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from pinarms import robots
 from pinarms.optim.motion import MotionChecker
 from pinarms.optim.motion import _spline_kernel as kernel
 from pinarms.optim.motion.smoothing import _travel_parts, prove_path, smooth_path
 from pinarms.optim.motion.spline_proof import _group_weights, _outside_limits, open_ranges
 from pinarms.planning import joint_spline
 
-DATA = Path(__file__).parent / "data"
-
-
-@pytest.fixture(scope="module")
-def checker():
-    cell = robots.load_cell(DATA / "aubo_wall.urdf.xacro")
-    return MotionChecker(cell, ["aubo"], margin=0.01)
+from tests.optim.test_motion_smoothing import checker  # noqa: F401 (fixture: the AUBO-i3 by the wall)
 
 
 @pytest.fixture(scope="module")

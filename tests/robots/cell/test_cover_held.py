@@ -18,6 +18,8 @@ from pinarms.robots.cell.mesh_cover import (
     split_triangles,
 )
 
+from tests.robots.cell.random_shapes import cylinder_and_box
+
 TOL = 1e-12  # m: containment up to floating-point rounding
 
 
@@ -53,14 +55,7 @@ def test_the_projection_toward_the_nearest_box_point_is_a_lower_bound_of_coal():
     rng = np.random.default_rng(3)
     tight = 0
     for _ in range(400):
-        r, h = rng.uniform(0.02, 0.1), rng.uniform(0.0, 0.2)
-        half = rng.uniform(0.05, 0.3, 3)
-        Rb = np.linalg.qr(rng.normal(size=(3, 3)))[0]
-        Rb *= np.sign(np.linalg.det(Rb))
-        pb = rng.normal(size=3) * 0.3
-        Rc = np.linalg.qr(rng.normal(size=(3, 3)))[0]
-        Rc *= np.sign(np.linalg.det(Rc))
-        pc = pb + rng.normal(size=3) * 0.4
+        r, h, half, Rb, pb, Rc, pc = cylinder_and_box(rng, 0.0)
         SA, SB = (pc - h * Rc[:, 2])[None], (pc + h * Rc[:, 2])[None]
         gap = _toward_gap(SA, SB, 0, r, Rb[None], pb[None], half[None], 0)
         d = coal.distance(coal.Cylinder(r, max(2 * h, 1e-9)), coal.Transform3s(Rc, pc), coal.Box(*(2 * half)),
