@@ -26,14 +26,22 @@ first wall in every case.
 from __future__ import annotations
 
 import ctypes
+import errno
+import importlib.util
 import os
 import resource
 import sysconfig
+from pathlib import Path
 
-__all__ = ["enter_wall", "python_roots"]
+__all__ = ["enter_wall", "python_roots", "capabilities"]
 
 _SYS_CREATE_RULESET, _SYS_ADD_RULE, _SYS_RESTRICT_SELF = 444, 445, 446  # same on x86_64 and aarch64
 _PR_SET_NO_NEW_PRIVS = 38
+_PR_CAPBSET_READ, _PR_CAPBSET_DROP, _PR_SET_SECUREBITS, _PR_CAP_AMBIENT, _PR_CAP_AMBIENT_CLEAR_ALL = 23, 24, 28, 47, 4
+# SECBIT_NOROOT and its lock, the setuid fix-up and keep-caps locked in their default (off: setuid clears
+# capabilities), SECBIT_NO_CAP_AMBIENT_RAISE and its lock
+_SECUREBITS_LOCKED_NOROOT = 0b11 | 0b1000 | 0b100000 | 0b11000000
+_CAP_VERSION_3 = 0x20080522
 _CREATE_RULESET_VERSION = 1
 _RULE_PATH_BENEATH = 1
 _READ_FILE, _READ_DIR = 1 << 2, 1 << 3
@@ -84,8 +92,6 @@ def _landlock(read_roots: list[str]) -> str:
                     raise OSError(ctypes.get_errno(), f"landlock_add_rule failed for {root}")
             finally:
                 os.close(fd)
-        if libc.prctl(_PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0:
-            raise OSError(ctypes.get_errno(), "prctl(PR_SET_NO_NEW_PRIVS) failed")
         if libc.syscall(ctypes.c_long(_SYS_RESTRICT_SELF), ctypes.c_int(ruleset), ctypes.c_uint32(0)) < 0:
             raise OSError(ctypes.get_errno(), "landlock_restrict_self failed")
     finally:
@@ -95,7 +101,7 @@ def _landlock(read_roots: list[str]) -> str:
 
 def _drop_to_nobody() -> str:
     # no new processes or threads once it is nobody (root is exempt from the limit; Landlock
-    # needs none); it could still execute a program in place, world-readable files only
+    # needs none); seccomp refuses execve and fork besides
     resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
     os.setgroups([])
     os.setgid(65534)
@@ -103,19 +109,83 @@ def _drop_to_nobody() -> str:
     return "user nobody (no Landlock)"
 
 
+class _CapHeader(ctypes.Structure):
+    _fields_ = [("version", ctypes.c_uint32), ("pid", ctypes.c_int)]
+
+
+class _CapData(ctypes.Structure):
+    _fields_ = [("effective", ctypes.c_uint32), ("permitted", ctypes.c_uint32), ("inheritable", ctypes.c_uint32)]
+
+
+def _drop_bounding_set(libc) -> None:
+    """Empty the bounding set and lock root's special treatment off (needs CAP_SETPCAP, which only root has)."""
+    if libc.prctl(_PR_SET_SECUREBITS, _SECUREBITS_LOCKED_NOROOT, 0, 0, 0) != 0:
+        if ctypes.get_errno() != errno.EPERM:
+            raise OSError(ctypes.get_errno(), "prctl(PR_SET_SECUREBITS) failed")
+        return  # no CAP_SETPCAP: an unprivileged process; exec can gain nothing under no_new_privs
+    for cap in range(64):
+        if libc.prctl(_PR_CAPBSET_DROP, cap, 0, 0, 0) != 0 and ctypes.get_errno() != errno.EINVAL:
+            raise OSError(ctypes.get_errno(), f"prctl(PR_CAPBSET_DROP, {cap}) failed")
+
+
+def _drop_capabilities(libc) -> None:
+    """Clear the ambient, effective, permitted and inheritable sets of this thread."""
+    if libc.prctl(_PR_CAP_AMBIENT, _PR_CAP_AMBIENT_CLEAR_ALL, 0, 0, 0) != 0 and ctypes.get_errno() != errno.EINVAL:
+        raise OSError(ctypes.get_errno(), "prctl(PR_CAP_AMBIENT_CLEAR_ALL) failed")
+    data = (_CapData * 2)()
+    if libc.capset(ctypes.byref(_CapHeader(_CAP_VERSION_3, 0)), data) != 0:
+        raise OSError(ctypes.get_errno(), "capset failed")
+
+
+def capabilities() -> dict[str, int]:
+    """This thread's capability sets as bit masks (``effective``, ``permitted``, ``inheritable``, ``bounding``)."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    data = (_CapData * 2)()
+    if libc.capget(ctypes.byref(_CapHeader(_CAP_VERSION_3, 0)), data) != 0:
+        raise OSError(ctypes.get_errno(), "capget failed")
+    out = {k: data[0].__getattribute__(k) | data[1].__getattribute__(k) << 32
+           for k in ("effective", "permitted", "inheritable")}
+    out["bounding"] = sum(1 << cap for cap in range(64) if libc.prctl(_PR_CAPBSET_READ, cap, 0, 0, 0) == 1)
+    return out
+
+
+def _load_seccomp():
+    spec = importlib.util.spec_from_file_location(f"{__name__}_seccomp", Path(__file__).with_name("_seccomp.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def enter_wall(read_roots: list[str]) -> str:
     """Restrict this process to reading ``read_roots`` (folders or files, and Python's own folders); which wall is up.
 
-    Returns ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or ``"resource limits only"``.
+    The steps, in order: ``no_new_privs``; Landlock (unless the kernel lacks it, or
+    ``PINARMS_SANDBOX_NO_LANDLOCK=1`` is in this process's environment: a switch for tests);
+    the bounding set emptied (root); without Landlock a root process becomes ``nobody``;
+    every capability dropped; the seccomp filter of :mod:`pinarms.robots._seccomp`.
+    Everything the process will import must be imported before.
+
+    Returns the steps taken, e.g. ``"landlock (ABI 7), no capabilities, seccomp"``; the
+    first part is ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or ``"resource
+    limits only"``, the last ``"seccomp"`` or ``"no seccomp (reason)"``.
     """
     roots = sorted({os.path.realpath(r) for r in (*read_roots, *python_roots()) if os.path.exists(r)})
-    try:
-        return _landlock(roots)
-    except (OSError, AttributeError):
-        pass
-    if os.geteuid() == 0:
+    seccomp = _load_seccomp()
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(_PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0:
+        raise OSError(ctypes.get_errno(), "prctl(PR_SET_NO_NEW_PRIVS) failed")
+    wall = None
+    if os.environ.get("PINARMS_SANDBOX_NO_LANDLOCK") != "1":
         try:
-            return _drop_to_nobody()
-        except OSError:
+            wall = _landlock(roots)
+        except (OSError, AttributeError):
             pass
-    return "resource limits only"
+    _drop_bounding_set(libc)
+    if wall is None and os.geteuid() == 0:
+        wall = _drop_to_nobody()
+    _drop_capabilities(libc)
+    try:
+        filtered = seccomp.install()
+    except seccomp.Unsupported as exc:
+        filtered = f"no seccomp ({exc})"
+    return f"{wall or 'resource limits only'}, no capabilities, {filtered}"
