@@ -1,25 +1,28 @@
-"""The second wall of a child process that parses a user's file: write nothing, read only the allowed paths.
+"""The second wall of a child process that parses a user's file: write nothing, read only the allowed paths,
+no capability, no network, no control of other processes.
 
 Loaded by path (standard library only) by the children that parse users' files:
-:mod:`pinarms.robots._xacro_worker` (xacro files) and :mod:`pinarms.robots.reach._reach_worker`
-(reachability maps). After :func:`enter_wall` the calling process (and any child it could
-start) can, whatever code it runs:
+:mod:`pinarms.robots._xacro_worker` (xacro files; it reads them through its parent and
+allows no folder) and :mod:`pinarms.robots.reach._reach_worker` (reachability maps). After
+:func:`enter_wall` the calling process (and any child it could start) can, whatever code it
+runs:
 
-- read files and list folders only below the given paths (folders, or single files: the
-  xacro file's folder and the package folders; the one map file) and the interpreter's
-  standard library and site-packages, read-only;
+- read files and list folders only below the given paths and the interpreter's standard
+  library and site-packages, read-only (Landlock);
 - create, write, truncate, rename, link or remove nothing anywhere (files already open,
   such as the pipes to the parent, stay usable);
-- execute no file (so it cannot start another program), bind or connect no TCP socket,
-  signal no process outside itself, reach no abstract Unix socket (as far as the kernel's
-  Landlock version supports each of these).
+- execute no file, start no process, open no network socket, signal, renice or trace no
+  other process, chroot or mount nothing, change no file's mode, owner, times or
+  extended attributes (seccomp, :mod:`pinarms.robots._seccomp`; x86_64 only);
+- use no capability: the bounding, effective, permitted, inheritable and ambient sets are
+  emptied, ``no_new_privs`` is set, and root's special treatment at exec is locked off.
 
-The wall is Linux Landlock (kernel ≥ 5.13), set through raw system calls with
-``no_new_privs``. Without Landlock a process running as root drops to the user ``nobody``
-with a process limit of 0 instead (it can then still read world-readable files, no longer
-files only root may read — a caller opens what it needs first — and start no new process);
-otherwise only the parent's resource limits remain. :func:`enter_wall` says which wall is
-up; for xacro files the expression whitelist of :mod:`pinarms.robots.xacro_eval` is the
+Landlock (kernel >= 5.13) is set through raw system calls. Without it (or with
+``PINARMS_SANDBOX_NO_LANDLOCK=1`` in the environment: a switch for tests) a process running
+as root drops to the user ``nobody`` with a process limit of 0 instead: it can then still
+read world-readable files, no longer files only root may read (a caller opens what it needs
+first, and imports every module it will use). :func:`enter_wall` says which steps were
+taken; for xacro files the expression whitelist of :mod:`pinarms.robots.xacro_eval` is the
 first wall in every case.
 """
 

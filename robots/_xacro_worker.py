@@ -7,25 +7,30 @@ standard library, ``xacro`` and ``yaml``, and loads two sibling files by path:
 ``xacro_eval.py`` (the expression whitelist) and ``_sandbox.py`` (the Landlock wall, shared
 with the map reader), never pinarms itself (nor Pinocchio).
 
-Protocol: one JSON request on stdin::
+Protocol: JSON lines. The request, one line on stdin::
 
     {"path": "/abs/file.xacro", "args": {"name": "value"}, "roots": ["/abs/dir", ...],
      "packages": {"pkg": "/abs/dir"}, "header": ["comment text", ...]}
 
-and one JSON answer on stdout: ``{"ok": true, "urdf": "...", "files": [...],
-"declared": {"arg": "default"}, "wall": "..."}`` or ``{"ok": false, "kind": "forbidden" |
-"limit" | "not_found" | "xacro" | "args" | "memory", "message": "...", ...}``.
+then, for every file xacro opens, a question on stdout ``{"op": "read", "path", "what"}``
+(or ``{"op": "glob", "pattern"}`` for an include pattern) and the parent's answer on stdin
+(:mod:`pinarms.robots._xacro_child`: ``{"text"}``, ``{"names"}``, ``{"forbidden"}``,
+``{"limit"}`` or ``{"errno", "message"}``); the child opens no file of the request itself.
+Last, the answer on stdout: ``{"ok": true, "urdf": "...", "declared": {"arg": "default"},
+"wall": "..."}`` or ``{"ok": false, "kind": "forbidden" | "limit" | "not_found" | "xacro" |
+"args" | "memory", "message": "...", ...}``.
 
 The walls, in order:
 
 1. every ``${...}`` goes through :func:`xacro_eval.evaluate` (xacro's ``safe_eval`` is
    replaced; the name ``eval`` inside xacro's modules refuses), never Python's ``eval``;
-2. every file xacro opens (the input, ``<xacro:include>`` files, ``load_yaml``) must lie,
-   after resolving symbolic links, inside one of the allowed ``roots``; ``$(find PKG)``
-   resolves only the packages named; ``$(env)``, ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse;
-3. before any file of the request is read, the process walls itself in
-   (:func:`_sandbox.enter_wall`): it can then write nothing and read only the roots
-   and Python's own folders, whatever code might run.
+2. every file xacro opens (the input, ``<xacro:include>`` files and patterns, ``load_yaml``)
+   is served by the parent only if it lies, after resolving symbolic links, inside one of
+   the allowed ``roots``; ``$(find PKG)`` resolves only the packages named; ``$(env)``,
+   ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse; a ``DOCTYPE`` in any file refuses;
+3. before the first file is asked for, the process imports everything it uses and walls
+   itself in (:func:`_sandbox.enter_wall`, with no folder to read): no write, no network,
+   no capability, no other process, whatever code might run.
 """
 
 from __future__ import annotations

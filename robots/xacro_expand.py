@@ -8,12 +8,14 @@ machine's files or hang it, so :func:`expand_xacro` runs xacro in a child proces
 - **time**: a wall-clock timeout and a CPU-time limit (:attr:`XacroLimits.timeout_s`);
 - **memory**: an address-space limit (:attr:`XacroLimits.memory_bytes`) and a cap on the
   size of the URDF text (:attr:`XacroLimits.output_bytes`);
-- **a sandbox**: before reading any file of the request the child walls itself in with
-  Linux Landlock (:mod:`pinarms.robots._sandbox`): it can write, create or remove
-  nothing, execute no program, and read only the allowed folders below plus the
-  interpreter's standard library and site-packages; it also gets an empty environment and
-  may not start processes (resource limit). Without Landlock a root child drops to the
-  user ``nobody``; :attr:`XacroResult.wall` says which wall was up;
+- **a sandbox**: the child reads no file of the request itself (this process serves each
+  one after checking it, :mod:`pinarms.robots._xacro_child`) and, before asking for the
+  first, walls itself in (:mod:`pinarms.robots._sandbox`): Linux Landlock (it can write,
+  create or remove nothing, execute no program, read only the interpreter's folders), no
+  capability, ``no_new_privs``, and a seccomp filter (no network, no metadata change, no
+  control of other processes); it gets an empty environment and may not start processes.
+  Without Landlock a root child drops to the user ``nobody``; :attr:`XacroResult.wall`
+  lists the steps taken;
 - **files**: the input, its includes and ``load_yaml`` files must lie (symbolic links
   resolved) inside the file's own folder or a package folder the caller names;
   ``$(find PKG)`` resolves only those packages (``pinarms`` is always given: the folder
@@ -97,8 +99,9 @@ class XacroResult:
         files: every file read (the input, includes, yaml), resolved paths, sorted.
         args: the ``xacro:arg`` values used (declared defaults, overridden by the caller's).
         declared: the file's ``xacro:arg`` declarations and their defaults.
-        wall: the sandbox the expansion ran in: ``"landlock (ABI n)"``, ``"user nobody
-            (no Landlock)"`` or ``"resource limits only"``.
+        wall: the sandbox the expansion ran in, e.g. ``"landlock (ABI 7), no capabilities,
+            seccomp"`` (first part ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or
+            ``"resource limits only"``).
     """
 
     urdf_text: str
@@ -179,8 +182,10 @@ def expand_xacro(
         limits: time, memory and size bounds (default :class:`XacroLimits`).
 
     Raises:
-        XacroForbidden: the file reads outside its folders or uses a refused construct.
-        XacroLimitExceeded: time, memory or output size exceeded.
+        XacroForbidden: the file reads outside its folders (also by an include pattern),
+            declares a DOCTYPE, or uses a refused construct.
+        XacroLimitExceeded: time, memory or output size exceeded (the output is read only
+            up to ``limits.output_bytes``).
         XacroArgError: an argument the file does not declare, or a non-number for a
             numeric one.
         XacroFileNotFound: the file, a file it includes or a yaml file it loads is missing.
