@@ -64,9 +64,12 @@ class _Files:
                              f"the packages given: {', '.join(sorted(self.packages)) or 'none'})"}
 
     def answer(self, request: dict) -> dict:
+        name = str(request.get("pattern" if request.get("op") == "glob" else "path", ""))
+        if "\0" in name:
+            return {"errno": 22, "message": "the name holds a NUL character"}
         if request.get("op") == "glob":
-            return self.glob(str(request.get("pattern", "")))
-        path, what = str(request.get("path", "")), str(request.get("what", "file"))
+            return self.glob(name)
+        path, what = name, str(request.get("what", "file"))
         real = os.path.realpath(path)
         if not self.inside(real):
             return self.outside(what, path)

@@ -467,3 +467,12 @@ def test_an_include_pattern_inside_the_folder_includes_its_files_in_order(tmp_pa
     assert text.index('name="link_a"') < text.index('name="link_b"')
     assert expand_xacro(path).files == tuple(str((tmp_path / n).resolve())
                                              for n in ("cell.xacro", "part_a.xacro", "part_b.xacro"))
+
+
+@pytest.mark.parametrize("use", ['<xacro:include filename="${{\'a\\x00{s}.xacro\'}}"/>',
+                                 '<link name="${{load_yaml(\'a\\x00{s}.yaml\')}}"/>'])
+@pytest.mark.parametrize("star", ["", "*"], ids=["name", "pattern"])
+def test_a_file_name_with_a_nul_character_is_a_named_error(tmp_path, use, star):
+    path = write(tmp_path, "nul.xacro", HEAD + use.format(s=star) + '<link name="a"/></robot>\n')
+    with pytest.raises(XacroError, match="NUL character"):
+        expand_xacro(path)
