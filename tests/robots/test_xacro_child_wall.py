@@ -197,3 +197,13 @@ def test_the_fallback_expands_every_shipped_xacro_as_landlock_does(monkeypatch):
         assert got.wall == "user nobody (no Landlock), no capabilities, seccomp", path.name
         assert (got.urdf_text, got.files, dict(got.declared)) == (expected.urdf_text, expected.files,
                                                                   dict(expected.declared)), path.name
+
+
+def test_on_another_architecture_the_filter_is_refused_by_name(monkeypatch):
+    import platform
+
+    from pinarms.robots import _seccomp
+
+    monkeypatch.setattr(platform, "machine", lambda: "aarch64")
+    with pytest.raises(_seccomp.Unsupported, match=r"no seccomp filter for aarch64 \(x86_64 only\)"):
+        _seccomp.install()
