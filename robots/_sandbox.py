@@ -166,12 +166,21 @@ def enter_wall(read_roots: list[str]) -> str:
     ``PINARMS_SANDBOX_NO_LANDLOCK=1`` is in this process's environment: a switch for tests);
     the bounding set emptied (root); without Landlock a root process becomes ``nobody``;
     every capability dropped; the seccomp filter of :mod:`pinarms.robots._seccomp`.
-    Everything the process will import must be imported before.
+    Everything the process will import must be imported before, and the process must have
+    one thread (else ``OSError``, before any step: Landlock and capabilities bind only the
+    calling thread).
 
     Returns the steps taken, e.g. ``"landlock (ABI 7), no capabilities, seccomp"``; the
     first part is ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or ``"resource
     limits only"``, the last ``"seccomp"`` or ``"no seccomp (reason)"``.
     """
+    try:
+        threads = len(os.listdir("/proc/self/task"))
+    except OSError:  # no /proc: nothing to count with
+        threads = 1
+    if threads > 1:
+        raise OSError(f"the wall needs a single-threaded process, this one has {threads} threads "
+                      "(Landlock and capabilities bind only the calling thread)")
     roots = sorted({os.path.realpath(r) for r in (*read_roots, *python_roots()) if os.path.exists(r)})
     seccomp = _load_seccomp()
     libc = ctypes.CDLL(None, use_errno=True)
