@@ -14,7 +14,6 @@ Every read of the child's output has the wall-clock deadline, and no line may ex
 
 from __future__ import annotations
 
-import fcntl
 import glob
 import json
 import os
@@ -135,38 +134,59 @@ def run_worker(request: dict, *, cwd: str, timeout_s: float, output_bytes: int,
 def _serve(proc: subprocess.Popen, files: _Files, request: dict, deadline: float, output_bytes: int) -> dict:
     out_fd, err_fd, in_fd = proc.stdout.fileno(), proc.stderr.fileno(), proc.stdin.fileno()
     for fd in (out_fd, err_fd, in_fd):
-        fl = fcntl.fcntl(fd, fcntl.F_GETFL)
-        fcntl.fcntl(fd, fcntl.F_SETFL, fl | os.O_NONBLOCK)
+        os.set_blocking(fd, False)
     pending = bytearray(json.dumps(request).encode("utf-8") + b"\n")
-    line, err = bytearray(), bytearray()
-    open_fds = {out_fd, err_fd}
+    parts, size, err = [], 0, bytearray()  # the pieces of the line being received, their size
+    poller = select.poll()
+    for fd in (out_fd, err_fd):
+        poller.register(fd, select.POLLIN)
+    poller.register(in_fd, select.POLLOUT)
+    in_open, open_fds = True, {out_fd, err_fd}
     while out_fd in open_fds:
         left = deadline - time.monotonic()
         if left <= 0:
             raise WorkerTimeout()
-        readable, writable, _ = select.select(list(open_fds), [in_fd] if pending else [], [], left)
-        if writable:
+        for fd, event in poller.poll(max(1, int(left * 1000))):
+            if fd == in_fd:
+                if event & (select.POLLERR | select.POLLHUP):  # the child closed its stdin
+                    poller.unregister(in_fd)
+                    in_open = False
+                    continue
+                try:
+                    del pending[: os.write(in_fd, pending[: 1 << 16])]
+                except BlockingIOError:
+                    continue
+                if not pending:
+                    poller.modify(in_fd, 0)
+                continue
             try:
-                del pending[: os.write(in_fd, pending[: 1 << 16])]
-            except BrokenPipeError:
-                pending.clear()
-        for fd in readable:
-            chunk = os.read(fd, 1 << 16)
+                chunk = os.read(fd, 1 << 16)
+            except BlockingIOError:
+                continue
             if not chunk:
                 open_fds.discard(fd)
+                poller.unregister(fd)
             elif fd == err_fd:
                 err = (err + chunk)[-_STDERR_KEPT:]
             else:
-                line += chunk
-                while b"\n" in line:
-                    head, _, rest = bytes(line).partition(b"\n")
-                    line = bytearray(rest)
-                    message = _decode(head)
+                end = chunk.find(b"\n")
+                while end >= 0:  # only the new bytes are searched
+                    if size + end > output_bytes:
+                        raise WorkerOutputTooLarge(size + end)
+                    message = _decode(b"".join(parts) + chunk[:end])
+                    parts, size, chunk = [], 0, chunk[end + 1:]
                     if "op" not in message:
                         return message
-                    pending += json.dumps(files.answer(message)).encode("utf-8") + b"\n"
-                if len(line) > output_bytes:
-                    raise WorkerOutputTooLarge(len(line))
+                    if in_open:
+                        pending += json.dumps(files.answer(message)).encode("utf-8") + b"\n"
+                        poller.modify(in_fd, select.POLLOUT)
+                    end = chunk.find(b"\n")
+                if chunk:
+                    parts.append(chunk)
+                    size += len(chunk)
+                if size > output_bytes:
+                    raise WorkerOutputTooLarge(size)
+    line = b"".join(parts)
     if line.strip():
         message = _decode(bytes(line))
         if "op" not in message:
