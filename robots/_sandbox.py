@@ -146,7 +146,7 @@ def capabilities() -> dict[str, int]:
     data = (_CapData * 2)()
     if libc.capget(ctypes.byref(_CapHeader(_CAP_VERSION_3, 0)), data) != 0:
         raise OSError(ctypes.get_errno(), "capget failed")
-    out = {k: data[0].__getattribute__(k) | data[1].__getattribute__(k) << 32
+    out = {k: getattr(data[0], k) | getattr(data[1], k) << 32
            for k in ("effective", "permitted", "inheritable")}
     out["bounding"] = sum(1 << cap for cap in range(64) if libc.prctl(_PR_CAPBSET_READ, cap, 0, 0, 0) == 1)
     return out
