@@ -7,25 +7,30 @@ standard library, ``xacro`` and ``yaml``, and loads two sibling files by path:
 ``xacro_eval.py`` (the expression whitelist) and ``_sandbox.py`` (the Landlock wall, shared
 with the map reader), never pinarms itself (nor Pinocchio).
 
-Protocol: one JSON request on stdin::
+Protocol: JSON lines. The request, one line on stdin::
 
     {"path": "/abs/file.xacro", "args": {"name": "value"}, "roots": ["/abs/dir", ...],
      "packages": {"pkg": "/abs/dir"}, "header": ["comment text", ...]}
 
-and one JSON answer on stdout: ``{"ok": true, "urdf": "...", "files": [...],
-"declared": {"arg": "default"}, "wall": "..."}`` or ``{"ok": false, "kind": "forbidden" |
-"limit" | "not_found" | "xacro" | "args" | "memory", "message": "...", ...}``.
+then, for every file xacro opens, a question on stdout ``{"op": "read", "path", "what"}``
+(or ``{"op": "glob", "pattern"}`` for an include pattern) and the parent's answer on stdin
+(:mod:`pinarms.robots._xacro_child`: ``{"text"}``, ``{"names"}``, ``{"forbidden"}``,
+``{"limit"}`` or ``{"errno", "message"}``); the child opens no file of the request itself.
+Last, the answer on stdout: ``{"ok": true, "urdf": "...", "declared": {"arg": "default"},
+"wall": "..."}`` or ``{"ok": false, "kind": "forbidden" | "limit" | "not_found" | "xacro" |
+"args" | "memory", "message": "...", ...}``.
 
 The walls, in order:
 
 1. every ``${...}`` goes through :func:`xacro_eval.evaluate` (xacro's ``safe_eval`` is
    replaced; the name ``eval`` inside xacro's modules refuses), never Python's ``eval``;
-2. every file xacro opens (the input, ``<xacro:include>`` files, ``load_yaml``) must lie,
-   after resolving symbolic links, inside one of the allowed ``roots``; ``$(find PKG)``
-   resolves only the packages named; ``$(env)``, ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse;
-3. before any file of the request is read, the process walls itself in
-   (:func:`_sandbox.enter_wall`): it can then write nothing and read only the roots
-   and Python's own folders, whatever code might run.
+2. every file xacro opens (the input, ``<xacro:include>`` files and patterns, ``load_yaml``)
+   is served by the parent only if it lies, after resolving symbolic links, inside one of
+   the allowed ``roots``; ``$(find PKG)`` resolves only the packages named; ``$(env)``,
+   ``$(optenv)``, ``$(eval)``, ``$(cwd)`` refuse; a ``DOCTYPE`` in any file refuses;
+3. before the first file is asked for, the process imports everything it uses and walls
+   itself in (:func:`_sandbox.enter_wall`, with no folder to read): no write, no network,
+   no capability, no other process, whatever code might run.
 """
 
 from __future__ import annotations
@@ -84,41 +89,72 @@ def _location(xacro) -> str:
     return ", ".join(parts)
 
 
+class _Parent:
+    """The pipe to the parent: one JSON line each way; the parent serves every file of the request."""
+
+    def ask(self, message: dict) -> dict:
+        sys.stdout.write(json.dumps(message) + "\n")
+        sys.stdout.flush()
+        return json.loads(sys.stdin.readline())
+
+
 class _Hooks:
     """xacro's file, expression and substitution entry points, walled."""
 
-    def __init__(self, xacro, subst, whitelist, roots: list[str], packages: dict[str, str]) -> None:
-        self.xacro, self.subst, self.whitelist = xacro, subst, whitelist
-        self.roots, self.packages = roots, packages
-        self.original_parse, self.original_load_yaml = xacro.parse, xacro.load_yaml
+    def __init__(self, xacro, subst, whitelist, parent: _Parent, packages: dict[str, str]) -> None:
+        self.xacro, self.subst, self.whitelist, self.parent = xacro, subst, whitelist, parent
+        self.packages = packages
+        self.original_parse = xacro.parse
         self.functions = {
             **whitelist.FUNCTIONS,
             "xacro.arg": self.arg, "xacro.tokenize": self.tokenize,
             "load_yaml": self.load_yaml, "xacro.load_yaml": self.load_yaml,
         }
 
-    def inside(self, path: str) -> bool:
-        real = os.path.realpath(path)
-        return any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in self.roots)
+    def _checked(self, reply: dict, path: str):
+        if "forbidden" in reply:
+            raise Forbidden(reply["forbidden"])
+        if "limit" in reply:
+            raise TooLarge(reply["limit"])
+        if "errno" in reply:
+            raise OSError(reply["errno"], reply["message"], path)
+        return reply
 
-    def check_path(self, path: str, what: str) -> str:
-        if not self.inside(path):
-            raise Forbidden(
-                f"{what} '{path}' is outside the folders this file may read "
-                f"(its own folder and the packages given: {', '.join(sorted(self.packages)) or 'none'})"
-            )
-        return path
+    def read(self, path: str, what: str) -> str:
+        """The text of ``path``, from the parent (which checks that it lies in the allowed folders)."""
+        return self._checked(self.parent.ask({"op": "read", "path": path, "what": what}), path)["text"]
+
+    def glob(self, pattern: str) -> list[str]:
+        pattern = os.path.abspath(pattern)
+        return self._checked(self.parent.ask({"op": "glob", "pattern": pattern}), pattern)["names"]
 
     def parse(self, inp, filename=None):
         if inp is None and filename is not None:
-            self.check_path(os.path.join(self.xacro.root_dir, filename), "file")
-        return self.original_parse(inp, filename)
+            full = os.path.join(self.xacro.root_dir, filename)
+            try:
+                inp = self.read(full, "file")
+            except OSError as exc:  # as xacro reports it: not "in file" the missing one
+                self.xacro.filestack.pop()
+                raise self.xacro.XacroException(f"{exc.strerror}: {exc.filename}", exc=exc) from None
+        doc = self.original_parse(inp, filename)
+        if getattr(doc, "doctype", None) is not None:
+            raise Forbidden(f"'{filename or 'the file'}' declares a DOCTYPE ('{doc.doctype.name}'); DOCTYPE "
+                            "declarations and entities are not allowed in pinarms' xacro (remove the declaration)")
+        return doc
 
     def load_yaml(self, filename):
         if not isinstance(filename, str):
             raise TypeError(f"load_yaml() takes a file name, got {type(filename).__name__}")
-        self.check_path(self.xacro.abs_filename_spec(filename), "yaml file")
-        return self.original_load_yaml(filename)
+        import yaml
+
+        full = self.xacro.abs_filename_spec(filename)
+        text = self.read(full, "yaml file")
+        self.xacro.filestack.append(full)
+        try:
+            return self.xacro.YamlListWrapper.wrap(yaml.safe_load(text))
+        finally:
+            self.xacro.filestack.pop()
+            self.xacro.all_includes.append(full)
 
     def arg(self, name):
         return self.xacro.substitution_args_context["arg"][name]
@@ -151,6 +187,10 @@ class _Hooks:
         return self.original_eval_extension(s)
 
     def install(self) -> None:
+        import types
+
+        import yaml
+
         xacro, subst = self.xacro, self.subst
 
         def refuse(what):
@@ -159,8 +199,11 @@ class _Hooks:
 
             return fn
 
+        for unit in xacro.ConstructUnits:  # xacro's !radians / !degrees yaml tags, registered once
+            yaml.SafeLoader.add_constructor(unit.value.tag, unit.constructor)
         self.original_eval_extension = xacro.eval_extension
         xacro.parse, xacro.load_yaml, xacro.safe_eval = self.parse, self.load_yaml, self.safe_eval
+        xacro.glob = types.SimpleNamespace(glob=self.glob)  # include patterns are listed by the parent
         xacro.eval_extension = self.eval_extension
         xacro._global_symbols = xacro.create_global_symbols()  # picks up the checked load_yaml
         xacro.eval = subst.eval = refuse("Python's eval")  # any path left to eval() inside xacro refuses
@@ -201,27 +244,38 @@ def _failure(exc: BaseException, xacro, declared: dict) -> dict:
     return {"ok": False, "kind": "xacro", "message": message, "declared": declared}
 
 
-def main() -> int:
-    request = json.loads(sys.stdin.read())
-    roots = [os.path.realpath(r) for r in request["roots"]]
-    packages = {k: os.path.realpath(v) for k, v in request.get("packages", {}).items()}
+def prepare(request: dict):
+    """Import everything, hook xacro and enter the wall; ``(xacro, hooks, wall)``.
 
-    import xml.dom.minidom
-    import xml.parsers.expat  # noqa: F401 - imported before the wall, with everything xacro needs
+    Everything the expansion imports is imported before the wall: a child that became
+    ``nobody`` may not be able to read the standard library any more.
+    """
+    packages = {k: os.path.realpath(v) for k, v in request.get("packages", {}).items()}
+    import types  # noqa: F401
+    import xml.dom.expatbuilder  # noqa: F401 - minidom imports it at the first parse
+    import xml.dom.minidom  # noqa: F401
+    import xml.dom.xmlbuilder  # noqa: F401
+    import xml.parsers.expat  # noqa: F401
 
     import xacro
     import xacro.substitution_args as subst
     import yaml  # noqa: F401
 
     whitelist = _load_sibling("xacro_eval")
-    hooks = _Hooks(xacro, subst, whitelist, roots, packages)
+    hooks = _Hooks(xacro, subst, whitelist, _Parent(), packages)
     hooks.install()
-    wall = _load_sibling("_sandbox").enter_wall(roots)
+    wall = _load_sibling("_sandbox").enter_wall([])  # the parent serves the files: no folder to read
+    return xacro, hooks, wall
 
+
+def main() -> int:
+    import xml.dom.minidom
+
+    request = json.loads(sys.stdin.readline())
+    xacro, _, wall = prepare(request)
     args = RecordingArgs({str(k): str(v) for k, v in request.get("args", {}).items()})
     path = request["path"]
     try:
-        hooks.check_path(path, "file")
         doc = xacro.process_file(path, mappings=args)
     except Forbidden as exc:
         return _answer({"ok": False, "kind": "forbidden", "message": str(exc), "declared": args.declared})
@@ -243,13 +297,11 @@ def main() -> int:
     first = doc.firstChild
     for text in request.get("header", []):
         doc.insertBefore(xml.dom.minidom.Comment(text), first)
-    files = sorted({os.path.realpath(f) for f in xacro.all_includes} | {os.path.realpath(path)})
-    return _answer({"ok": True, "urdf": doc.toprettyxml(indent="  "), "files": files, "declared": args.declared,
-                    "wall": wall})
+    return _answer({"ok": True, "urdf": doc.toprettyxml(indent="  "), "declared": args.declared, "wall": wall})
 
 
 def _answer(obj: dict) -> int:
-    sys.stdout.write(json.dumps(obj))
+    sys.stdout.write(json.dumps(obj) + "\n")
     sys.stdout.flush()
     return 0
 

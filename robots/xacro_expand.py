@@ -8,12 +8,14 @@ machine's files or hang it, so :func:`expand_xacro` runs xacro in a child proces
 - **time**: a wall-clock timeout and a CPU-time limit (:attr:`XacroLimits.timeout_s`);
 - **memory**: an address-space limit (:attr:`XacroLimits.memory_bytes`) and a cap on the
   size of the URDF text (:attr:`XacroLimits.output_bytes`);
-- **a sandbox**: before reading any file of the request the child walls itself in with
-  Linux Landlock (:mod:`pinarms.robots._sandbox`): it can write, create or remove
-  nothing, execute no program, and read only the allowed folders below plus the
-  interpreter's standard library and site-packages; it also gets an empty environment and
-  may not start processes (resource limit). Without Landlock a root child drops to the
-  user ``nobody``; :attr:`XacroResult.wall` says which wall was up;
+- **a sandbox**: the child reads no file of the request itself (this process serves each
+  one after checking it, :mod:`pinarms.robots._xacro_child`) and, before asking for the
+  first, walls itself in (:mod:`pinarms.robots._sandbox`): Linux Landlock (it can write,
+  create or remove nothing, execute no program, read only the interpreter's folders), no
+  capability, ``no_new_privs``, and a seccomp filter (no network, no metadata change, no
+  control of other processes); it gets an empty environment and may not start processes.
+  Without Landlock a root child drops to the user ``nobody``; :attr:`XacroResult.wall`
+  lists the steps taken;
 - **files**: the input, its includes and ``load_yaml`` files must lie (symbolic links
   resolved) inside the file's own folder or a package folder the caller names;
   ``$(find PKG)`` resolves only those packages (``pinarms`` is always given: the folder
@@ -43,16 +45,14 @@ See docs/files.md.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import signal
-import subprocess
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from ._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
 from .errors import (
     InvalidInput,
     MissingMesh,
@@ -67,8 +67,6 @@ __all__ = ["XacroLimits", "XacroResult", "expand_xacro", "BUILTIN_PACKAGE", "par
 
 #: ``$(find pinarms)``: the folder of the built-in arms' xacro macros.
 BUILTIN_PACKAGE = ("pinarms", Path(__file__).resolve().parent / "xacro")
-
-_WORKER = Path(__file__).resolve().parent / "_xacro_worker.py"
 
 
 @dataclass(frozen=True)
@@ -101,8 +99,9 @@ class XacroResult:
         files: every file read (the input, includes, yaml), resolved paths, sorted.
         args: the ``xacro:arg`` values used (declared defaults, overridden by the caller's).
         declared: the file's ``xacro:arg`` declarations and their defaults.
-        wall: the sandbox the expansion ran in: ``"landlock (ABI n)"``, ``"user nobody
-            (no Landlock)"`` or ``"resource limits only"``.
+        wall: the sandbox the expansion ran in, e.g. ``"landlock (ABI 7), no capabilities,
+            seccomp"`` (first part ``"landlock (ABI n)"``, ``"user nobody (no Landlock)"`` or
+            ``"resource limits only"``).
     """
 
     urdf_text: str
@@ -183,8 +182,10 @@ def expand_xacro(
         limits: time, memory and size bounds (default :class:`XacroLimits`).
 
     Raises:
-        XacroForbidden: the file reads outside its folders or uses a refused construct.
-        XacroLimitExceeded: time, memory or output size exceeded.
+        XacroForbidden: the file reads outside its folders (also by an include pattern),
+            declares a DOCTYPE, or uses a refused construct.
+        XacroLimitExceeded: time, memory or output size exceeded (the output is read only
+            up to ``limits.output_bytes``).
         XacroArgError: an argument the file does not declare, or a non-number for a
             numeric one.
         XacroFileNotFound: the file, a file it includes or a yaml file it loads is missing.
@@ -208,38 +209,29 @@ def expand_xacro(
     roots = [str(path.resolve().parent), *pkgs.values()]
     request = {"path": str(path.resolve()), "args": given, "roots": roots, "packages": pkgs, "header": list(header)}
     try:
-        proc = subprocess.run(
-            [sys.executable, "-I", "-B", str(_WORKER)],
-            input=json.dumps(request),
-            capture_output=True,
-            text=True,
-            timeout=limits.timeout_s,
-            env={},
-            cwd=str(path.resolve().parent),
-            preexec_fn=_limit_resources(limits),
-            start_new_session=True,
-        )
-    except subprocess.TimeoutExpired:
+        answer, files = run_worker(request, cwd=str(path.resolve().parent), timeout_s=limits.timeout_s,
+                                   output_bytes=int(limits.output_bytes), preexec=_limit_resources(limits))
+    except WorkerTimeout:
         raise XacroLimitExceeded(
             f"xacro on {str(path)!r} did not finish within {limits.timeout_s:g} s "
             "(an expression or macro that never ends?); pinarms stopped it"
         ) from None
-    if proc.returncode != 0 or not proc.stdout:
-        text = proc.stderr or ""
-        if "MemoryError" in text or proc.returncode == -signal.SIGKILL:
+    except WorkerOutputTooLarge:
+        raise XacroLimitExceeded(
+            f"xacro on {str(path)!r} produced more than the {limits.output_bytes / 2**20:g} MiB allowed; "
+            "pinarms stopped it there"
+        ) from None
+    except WorkerFailed as exc:
+        status, text = exc.args
+        if "MemoryError" in text or status == -signal.SIGKILL:
             raise XacroLimitExceeded(
                 f"xacro on {str(path)!r} needed more than {limits.memory_bytes / 2**20:g} MiB of memory; pinarms stopped it"
-            )
-        if proc.returncode == -signal.SIGXCPU:
-            raise XacroLimitExceeded(f"xacro on {str(path)!r} used more than {limits.timeout_s:g} s of CPU; pinarms stopped it")
-        last = " ".join(text.strip().splitlines()[-1:]) or f"exit status {proc.returncode}"
-        raise XacroError(f"xacro on {str(path)!r} failed: {last}")
-    if len(proc.stdout) > limits.output_bytes:
-        raise XacroLimitExceeded(
-            f"xacro on {str(path)!r} produced {len(proc.stdout) / 2**20:.1f} MiB, more than the "
-            f"{limits.output_bytes / 2**20:g} MiB allowed"
-        )
-    answer = json.loads(proc.stdout)
+            ) from None
+        if status == -signal.SIGXCPU:
+            raise XacroLimitExceeded(
+                f"xacro on {str(path)!r} used more than {limits.timeout_s:g} s of CPU; pinarms stopped it") from None
+        last = " ".join(text.strip().splitlines()[-1:]) or f"exit status {status}"
+        raise XacroError(f"xacro on {str(path)!r} failed: {last}") from None
     declared = {k: v for k, v in answer.get("declared", {}).items()}
     _check_numeric_args(path, given, declared)
     if not answer["ok"]:
@@ -252,7 +244,7 @@ def expand_xacro(
                "not_found": XacroFileNotFound}.get(kind, XacroError)
         raise cls(f"xacro on {str(path)!r}: {message}")
     used = {k: given.get(k, v) for k, v in declared.items()}
-    return XacroResult(answer["urdf"], tuple(answer["files"]), used, declared, answer.get("wall", ""))
+    return XacroResult(answer["urdf"], tuple(files), used, declared, answer.get("wall", ""))
 
 
 def _check_numeric_args(path: Path, given: dict[str, str], declared: dict[str, str | None]) -> None:

@@ -4,7 +4,7 @@ Files are put together from fragments a user (or an attacker) might write: prope
 arguments, macros (recursive, with missing or extra parameters), ``${}`` expressions
 (arithmetic, undefined names, huge powers, dunder access, lambdas, comprehensions,
 division by zero), ``$()`` substitutions (env, find of unknown packages, eval), includes
-(missing, ``..``, absolute, the built-in arms), conditionals, meshes, DOCTYPE/entities, and
+(missing, ``..``, absolute, patterns inside and outside, a NUL character, the built-in arms), conditionals, meshes, DOCTYPE/entities, and
 truncation; with random arguments. Each expansion runs in xacro's child process (about
 0.25 s), so the example count is small. Nothing may be written anywhere.
 """
@@ -38,6 +38,7 @@ _sub = st.sampled_from([
 _include = st.sampled_from([
     "missing.xacro", "../outside.xacro", "/etc/passwd", "$(find pinarms)/scara_mushroom.xacro",
     "$(find nothing)/x.xacro", "$(env HOME)/x.xacro", "sub/../../outside.xacro", "fuzz.xacro",
+    "../*.xacro", "*.xacro", "/etc/pass*", "${'a\\x00.xacro'}",
 ])
 _mesh = st.sampled_from(["package://fuzz/m.stl", "m.stl", "/etc/hostname", "file:///etc/hostname",
                          "package://pinarms/../../x.stl", "http://example.com/m.stl"])
@@ -105,6 +106,9 @@ _LIMITS = XacroLimits(timeout_s=5.0, memory_bytes=256 * 2**20, output_bytes=4 * 
 @example(text=HEAD + ARM.format(x="${().__class__.__bases__}") + "</robot>", args={})
 @example(text=HEAD + '<xacro:arg name="height" default="0.5"/>' + ARM.format(x="$(arg height)") + "</robot>",
          args={"height": "high"})
+@example(text='<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY % p SYSTEM "http://example.com/x.dtd"> %p;]>\n'
+          + HEAD.split("\n", 1)[1] + ARM.format(x="0.1") + "</robot>", args={})
+@example(text=HEAD + '<xacro:include filename="../*.xacro"/>' + ARM.format(x="0.1") + "</robot>", args={})
 def test_malformed_xacro(tmp_path_factory, text, args):
     root = tmp_path_factory.mktemp("x")
     user = root / "user"

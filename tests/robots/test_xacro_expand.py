@@ -401,3 +401,78 @@ def test_every_shipped_xacro_expands_byte_identically(stock_expansions, path):
     if committed is not None:
         text = (committed / path.name.replace(".urdf.xacro", ".urdf")).read_text(encoding="utf-8")
         assert text.split("-->\n", 2)[-1] == result.urdf_text.split("?>\n", 1)[-1]  # same bytes under the header
+
+
+# ---- issue 35, item 12: DOCTYPEs refused, the output read only up to its bound, include patterns in the wall ----
+
+PARAMETER_ENTITY = ('<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY % remote SYSTEM "http://example.com/x.dtd"> '
+                    '%remote;]>\n')
+
+
+def test_a_doctype_with_a_parameter_entity_is_refused_not_passed_into_the_urdf(tmp_path):
+    path = write(tmp_path, "dtd.urdf.xacro", PARAMETER_ENTITY + '<robot name="x"><link name="a"/></robot>\n')
+    with pytest.raises(XacroForbidden, match=r"dtd\.urdf\.xacro' declares a DOCTYPE \('robot'\)"):
+        expand_xacro(path)
+    out = tmp_path / "out.urdf"
+    done = subprocess.run([sys.executable, "-m", "pinarms.cli", "urdf", "build", str(path), "-o", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode != 0 and not out.exists()
+    assert done.stderr.strip().splitlines() == [done.stderr.strip().splitlines()[0]]
+    assert done.stderr.startswith("Error: ") and "DOCTYPE" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_doctype_in_an_included_file_is_refused(tmp_path):
+    write(tmp_path, "part.xacro", '<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY n "b">]>\n'
+                                  '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="&n;"/></robot>\n')
+    path = write(tmp_path, "main.xacro", HEAD + '<xacro:include filename="part.xacro"/></robot>\n')
+    with pytest.raises(XacroForbidden, match=r"part\.xacro' declares a DOCTYPE"):
+        expand_xacro(path)
+
+
+FLOOD = r"""
+import sys, time
+sys.stdin.readline()
+sys.stdout.write("x" * (2 << 20))
+sys.stdout.flush()
+time.sleep(60)
+"""
+
+
+def test_the_childs_output_is_read_only_up_to_the_bound(monkeypatch, tmp_path):
+    from pinarms.robots import _xacro_child
+
+    script = write(tmp_path, "flood.py", FLOOD)  # a child that floods its pipe and never ends
+    monkeypatch.setattr(_xacro_child, "_WORKER", script)
+    path = write(tmp_path, "arm.xacro", SCARA_ON_PEDESTAL)
+    start = time.monotonic()
+    with pytest.raises(XacroLimitExceeded, match="more than the 1 MiB allowed; pinarms stopped it there"):
+        expand_xacro(path, limits=XacroLimits(timeout_s=20, output_bytes=1 << 20))
+    assert time.monotonic() - start < 10  # stopped at the bound, not at the 20 s deadline
+
+
+def test_an_include_pattern_outside_the_folder_is_refused_by_name(tmp_path):
+    (tmp_path / "user").mkdir()
+    (tmp_path / "other").mkdir()
+    write(tmp_path / "other", "secret.xacro", HEAD + "<link name='secret'/></robot>")
+    path = write(tmp_path / "user", "cell.xacro", HEAD + '<xacro:include filename="../other/*.xacro"/></robot>\n')
+    with pytest.raises(XacroForbidden, match=r"include pattern '.*/other/\*\.xacro' is outside the folders"):
+        expand_xacro(path)
+
+
+def test_an_include_pattern_inside_the_folder_includes_its_files_in_order(tmp_path):
+    for name in ("b", "a"):
+        write(tmp_path, f"part_{name}.xacro", HEAD + f'<link name="link_{name}"/></robot>')
+    path = write(tmp_path, "cell.xacro", HEAD + '<xacro:include filename="part_*.xacro"/></robot>\n')
+    text = expand_xacro(path).urdf_text
+    assert text.index('name="link_a"') < text.index('name="link_b"')
+    assert expand_xacro(path).files == tuple(str((tmp_path / n).resolve())
+                                             for n in ("cell.xacro", "part_a.xacro", "part_b.xacro"))
+
+
+@pytest.mark.parametrize("use", ['<xacro:include filename="${{\'a\\x00{s}.xacro\'}}"/>',
+                                 '<link name="${{load_yaml(\'a\\x00{s}.yaml\')}}"/>'])
+@pytest.mark.parametrize("star", ["", "*"], ids=["name", "pattern"])
+def test_a_file_name_with_a_nul_character_is_a_named_error(tmp_path, use, star):
+    path = write(tmp_path, "nul.xacro", HEAD + use.format(s=star) + '<link name="a"/></robot>\n')
+    with pytest.raises(XacroError, match="NUL character"):
+        expand_xacro(path)

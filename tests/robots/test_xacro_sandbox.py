@@ -94,7 +94,8 @@ def test_without_landlock_a_root_child_drops_to_nobody(tmp_path):
     done = subprocess.run([sys.executable, "-I", "-B", "-c", FALLBACK, str(sandbox), str(folder)],
                           capture_output=True, text=True, timeout=60, env={})
     assert done.returncode == 0, done.stderr
-    assert __import__("json").loads(done.stdout) == {"wall": "user nobody (no Landlock)", "uid": 65534, "gid": 65534,
+    assert __import__("json").loads(done.stdout) == {"wall": "user nobody (no Landlock), no capabilities, seccomp",
+                                                     "uid": 65534, "gid": 65534,
                                                      "create_dir": "PermissionError"}
     assert list(folder.iterdir()) == []
 
@@ -106,4 +107,31 @@ def test_expansions_report_the_wall_they_ran_behind(tmp_path):
     libc.syscall.restype = ctypes.c_long
     abi = libc.syscall(ctypes.c_long(444), None, ctypes.c_size_t(0), ctypes.c_uint32(1))  # landlock_create_ruleset
     if abi >= 1:  # the kernel offers Landlock: the child must be behind it
-        assert result.wall == f"landlock (ABI {abi})"
+        assert result.wall == f"landlock (ABI {abi}), no capabilities, seccomp"
+
+
+THREADED = r"""
+import importlib.util, json, sys, threading
+spec = importlib.util.spec_from_file_location("sandbox", sys.argv[1])
+sandbox = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(sandbox)
+stop = threading.Event()
+threading.Thread(target=stop.wait).start()
+try:
+    sandbox.enter_wall([])
+    out = "walled"
+except OSError as exc:
+    out = str(exc)
+stop.set()
+sys.stdout.write(json.dumps({"out": out, "caps": sandbox.capabilities()["effective"] != 0 or __import__("os").getuid() != 0}))
+"""
+
+
+def test_a_process_with_a_second_thread_is_refused_before_any_step(tmp_path):
+    sandbox = Path(robots.__file__).resolve().parent / "_sandbox.py"
+    done = subprocess.run([sys.executable, "-I", "-B", "-c", THREADED, str(sandbox)],
+                          capture_output=True, text=True, timeout=60, env={})
+    assert done.returncode == 0, done.stderr
+    out = __import__("json").loads(done.stdout)
+    assert out == {"out": "the wall needs a single-threaded process, this one has 2 threads (Landlock and "
+                          "capabilities bind only the calling thread)", "caps": True}
