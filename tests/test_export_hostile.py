@@ -108,6 +108,17 @@ def test_a_cell_name_never_leaves_the_output_folder(tmp_path, received):
     assert {out.urdf.name, out.srdf.name, out.mjcf.name} == {"_evil_cell.urdf", "_evil_cell.srdf", "_evil_cell.xml"}
 
 
+def test_a_xacro_cell_name_never_leaves_the_output_folder(tmp_path, received):
+    text = _cell("${'../' + 'evil_xacro'}").replace("<robot ", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" ')
+    (received / "cell.urdf.xacro").write_text(text)
+    (tmp_path / "o").mkdir()
+    before = _files(tmp_path)
+    run = _export(str(received / "cell.urdf.xacro"), str(tmp_path / "o" / "out"), "--cell", "--srdf", "--json")
+    assert run.exit_code == 0, run.output
+    assert all(p.startswith("o/out") for p in _files(tmp_path) - before), _files(tmp_path) - before
+    assert Path(json.loads(run.output)["srdf"]) == tmp_path / "o" / "out" / "_evil_xacro.srdf"
+
+
 # --------------------------------------------------------------------------- meshes (items 3, 4)
 def test_a_package_path_through_a_symlinked_folder_is_refused(tmp_path, received):
     deep = tmp_path / "d1" / "d2" / "d3"
