@@ -144,8 +144,9 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
         emit(
             as_json,
             {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "mjcf": result.mjcf,
-             "sites": list(result.sites), "meshes": list(result.meshes)},
-            [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)"],
+             "sites": list(result.sites), "meshes": list(result.meshes), "notes": list(result.notes)},
+            [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)",
+             *(f"note: {n}" for n in result.notes)],
         )
         return
     if study_poses:
@@ -163,7 +164,8 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
     result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf, packages=pkgs)
     emit(
         as_json,
-        {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes)},
+        {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes),
+         "notes": list(result.notes)},
         [f"wrote {result.urdf}{'' if result.srdf is None else f' and {result.srdf}'} and "
-         f"{len(result.meshes)} mesh file(s)"],
+         f"{len(result.meshes)} mesh file(s)", *(f"note: {n}" for n in result.notes)],
     )

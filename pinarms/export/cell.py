@@ -37,7 +37,7 @@ from pinarms.robots.errors import InvalidInput
 from .errors import MeshNotFound
 from .mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
 from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
-from .srdf import geometry_links, srdf_text
+from .srdf import geometry_links, home_notes, srdf_text
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
 
@@ -52,6 +52,8 @@ class ExportedCell:
         meshes: the copied mesh files, relative to ``folder`` (POSIX paths), sorted.
         sites: the MuJoCo sites (each arm's flange and tcp).
         geometry_links: ``{pinarms geometry name: exported link name}``.
+        notes: what the export left out and why (an arm without a home state:
+            :func:`pinarms.export.srdf.home_notes`).
     """
 
     folder: Path
@@ -61,6 +63,7 @@ class ExportedCell:
     meshes: tuple[str, ...]
     sites: tuple[str, ...]
     geometry_links: dict[str, str]
+    notes: tuple[str, ...] = ()
 
 
 def _parse(text: str) -> ET.Element:
@@ -182,7 +185,8 @@ def _write_cell(cell: Any, folder: Path, *, srdf: bool, mjcf: bool,
         mjcf_path = path_inside(folder, f"{name}.xml")
         compile_mjcf(mujoco, urdf, meshes, mjcf_path, sites, f"cell {cell.name!r}",
                      geom_names={link: geometry for geometry, link in links.items()})
-    return ExportedCell(folder, urdf, srdf_path, mjcf_path, meshes, sites if mjcf else (), links)
+    notes = home_notes(cell, states=states) if srdf else ()
+    return ExportedCell(folder, urdf, srdf_path, mjcf_path, meshes, sites if mjcf else (), links, notes)
 
 
 def _mujoco():
@@ -239,7 +243,8 @@ def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = T
     _publish(out, fill)
     r = result["cell"]
     move = lambda p: None if p is None else out / p.name  # noqa: E731
-    return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links)
+    return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links,
+                        r.notes)
 
 
 def cell_of_urdf_folder(robot: Any, folder: Path):
@@ -270,4 +275,4 @@ def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite:
 
     _publish(out, fill)
     r = result["cell"]
-    return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links)
+    return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links, r.notes)

@@ -54,7 +54,9 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
             classification). The URDF then gives every collision element its own link
             (:func:`pinarms.export.cell.one_collision_per_link`) instead of being kept byte
             for byte, so that the SRDF can name every pair.
-        states: with ``srdf``, extra named states ``{name: q (nq,)}`` [rad or m].
+        states: with ``srdf``, extra named states ``{name: q (nq,)}`` [rad or m]; ``home``
+            is the arm's home (else the all-zero pose where the limits allow it, else no
+            home: ``notes`` says so).
         packages: ``{NAME: folder}`` for ``package://NAME/`` meshes. Meshes are copied only
             from the URDF's folder, ``robot.package_dirs`` and these (:mod:`.mesh_sources`).
 
@@ -76,7 +78,7 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
         raise InvalidInput(f"export_urdf takes a robots.Robot or a robot name, got {robot_or_name!r}")
     if srdf:
         done = export_robot_with_srdf(robot, out_dir, overwrite=overwrite, states=states, packages=packages)
-        return ExportedURDF(folder=done.folder, urdf=done.urdf, meshes=done.meshes, srdf=done.srdf)
+        return ExportedURDF(folder=done.folder, urdf=done.urdf, meshes=done.meshes, srdf=done.srdf, notes=done.notes)
     return write_urdf_folder(robot, out_dir, overwrite, packages=packages)
 
 

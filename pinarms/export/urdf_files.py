@@ -36,12 +36,15 @@ class ExportedURDF:
         folder: the export folder.
         urdf: the URDF file inside it.
         meshes: the copied files, relative to ``folder`` (POSIX paths), sorted.
+        srdf: the SRDF file (``srdf=True``), else ``None``.
+        notes: what the export left out and why (an arm without a home state).
     """
 
     folder: Path
     urdf: Path
     meshes: tuple[str, ...]
     srdf: Path | None = None
+    notes: tuple[str, ...] = ()
 
 
 def mesh_references(urdf_text: str) -> list[str]:
