@@ -119,8 +119,9 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
     soft constraint lets the koji arm's linkage sag by 0.8° under its own weight.
 
     COLLADA (``.dae``) meshes, which MuJoCo cannot read, are left out of the visual geometry
-    (``discardvisual``); the collision meshes stay. Needs the ``mujoco`` package
-    (``pip install mujoco``, or pinarms' ``mujoco`` extra). The folder, the file name and the
+    (``discardvisual``); COLLADA collision meshes are converted to OBJ files beside them
+    (:mod:`pinarms.export.mesh_convert`, trimesh with pycollada). Needs the ``mujoco``
+    package (``pip install 'pinarms[mujoco]'``: mujoco, trimesh, pycollada). The folder, the file name and the
     meshes follow :func:`export_urdf` (``packages`` likewise).
 
     Raises:

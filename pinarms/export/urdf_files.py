@@ -19,6 +19,7 @@ from pinarms.robots.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
 from .errors import ExportError, MeshNotAllowed
+from .mesh_convert import collada_collision_meshes, collada_to_obj, converted_name
 from .mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
 
 __all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
@@ -163,8 +164,9 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
 
     Every link stays a body (``fusestatic="false"``), a site named like each frame of
     ``sites`` sits at the origin of its body, joint equalities (``<mimic>``) are made as
-    stiff as the time step allows, mesh paths are made relative, and the meshes MuJoCo
-    reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
+    stiff as the time step allows, mesh paths are made relative, COLLADA collision meshes
+    are converted to OBJ beside them (:mod:`.mesh_convert`; COLLADA visuals are
+    discarded), and the meshes MuJoCo reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
     body (``{body: name}``). Returns the meshes copied (POSIX paths relative to the folder).
     """
     folder = urdf.parent
@@ -172,6 +174,12 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
     extension = (f'<mujoco><compiler fusestatic="false" discardvisual="{"true" if dae else "false"}" '
                  'strippath="false"/></mujoco>')
     text = urdf.read_text(encoding="utf-8")
+    converted = {}
+    for mesh in collada_collision_meshes(text):  # MuJoCo reads no COLLADA: OBJ beside it (.mesh_convert)
+        converted[mesh] = converted_name(mesh)
+        copy_new_file(folder, converted[mesh], path_inside(folder, mesh), MAX_COPY_BYTES,
+                      transform=lambda data, m=mesh: collada_to_obj(data, m))
+    text = _rewrite_filenames(text, converted) if converted else text
     head, end, tail = text.rpartition("</robot>")
     path_inside(target.parent, target.name)
     compiled = write_new_file(folder, urdf.stem + ".mujoco.urdf", f"{head}{extension}\n{end}{tail}".encode("utf-8"))
@@ -204,7 +212,7 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
             joint.set("solimp", "0.99 0.999 0.001")
     ET.indent(tree)
     tree.write(target, encoding="unicode")
-    kept = [m for m in meshes if not (dae and m.lower().endswith(".dae"))]
+    kept = [m for m in meshes if not (dae and m.lower().endswith(".dae"))] + list(converted.values())
     if Path(os.path.realpath(target.parent)) != Path(os.path.realpath(folder)):
         for mesh in kept:
             copy_new_file(target.parent, mesh, path_inside(folder, mesh), MAX_COPY_BYTES)
