@@ -263,3 +263,21 @@ def test_a_symlinked_output_folder_keeps_its_files_without_overwrite(tmp_path):
         export_urdf("aubo_i3", tmp_path / "link")
     assert (real / "mine.txt").read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
+def test_a_link_to_nothing_as_output_folder_is_refused(tmp_path):
+    (tmp_path / "link").symlink_to(tmp_path / "missing", target_is_directory=True)
+    with pytest.raises(InvalidInput, match="does not exist"):
+        export_urdf("aubo_i3", tmp_path / "link")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link"]
+
+
+def test_a_link_inside_the_allowed_folder_is_followed_and_copied(tmp_path, received):
+    (received / "parts").mkdir()
+    (received / "parts" / "link1.stl").write_text(STL)
+    (received / "same.stl").symlink_to(received / "parts" / "link1.stl")
+    (received / "recv.urdf").write_text(_arm("arm", ("same.stl",)))
+    result = export_urdf(robots.from_urdf(received / "recv.urdf"), tmp_path / "out")
+    assert result.meshes == ("meshes/parts/link1.stl",)
+    copy = result.folder / result.meshes[0]
+    assert not copy.is_symlink() and copy.read_text() == STL
