@@ -3,6 +3,7 @@ and MuJoCo's mesh then has coal's vertices."""
 
 from __future__ import annotations
 
+import struct
 import sys
 
 import mujoco  # a test dependency (the project's [test] extra)
@@ -33,7 +34,8 @@ DAE = ('<?xml version="1.0" encoding="utf-8"?>'
 
 
 def _urdf(name: str) -> str:
-    return (f'<robot name="{name}"><link name="base_link"/><link name="l1">'
+    return (f'<robot name="{name}"><link name="base_link"><collision><geometry><mesh filename="box.stl"/>'
+            '</geometry></collision></link><link name="l1">'
             '<visual><geometry><mesh filename="tet.dae"/></geometry></visual>'
             '<collision><geometry><mesh filename="tet.dae"/></geometry></collision>'
             '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>'
@@ -54,6 +56,9 @@ def received(tmp_path):
     folder = tmp_path / "recv"
     folder.mkdir()
     (folder / "tet.dae").write_text(DAE)
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]  # the tetrahedron again, as binary STL
+    body = b"".join(np.vstack([np.zeros(3), VERTICES[list(f)]]).astype("<f4").tobytes() + b"\0\0" for f in faces)
+    (folder / "box.stl").write_bytes(b"binary".ljust(80) + struct.pack("<I", len(faces)) + body)
     (folder / "arm.urdf").write_text(_urdf("arm"))
     return folder
 
@@ -65,7 +70,8 @@ def test_an_arm_with_a_collada_collision_mesh_exports_to_mujoco(tmp_path, receiv
     data = mujoco.MjData(model)
     data.qpos[:] = 0.4
     mujoco.mj_kinematics(model, data)
-    meshes = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
+    meshes = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH
+              and model.geom_bodyid[g] == model.body("l1").id]
     assert len(meshes) == 1
     expected = VERTICES @ robot.fk(np.array([0.4]), "l1")[:3, :3].T + robot.fk(np.array([0.4]), "l1")[:3, 3]
     got = _world_vertices(model, data, meshes[0])
@@ -76,15 +82,15 @@ def test_an_arm_with_a_collada_collision_mesh_exports_to_mujoco(tmp_path, receiv
 
 
 def test_a_cell_with_a_collada_collision_mesh_exports_to_mujoco(tmp_path, received):
-    text = _urdf("c").replace('<link name="base_link"/>',
-                              '<link name="world"/><link name="arm_base_link"/><joint name="mount" type="fixed">'
-                              '<parent link="world"/><child link="arm_base_link"/></joint>')
+    text = _urdf("c").replace('<link name="base_link">',
+                              '<link name="world"/><joint name="mount" type="fixed"><parent link="world"/>'
+                              '<child link="arm_base_link"/></joint><link name="arm_base_link">')
     text = text.replace('<parent link="base_link"/>', '<parent link="arm_base_link"/>')
     (received / "cell.urdf").write_text(text)
     cell = load_cell(str(received / "cell.urdf"))
     out = export_cell(cell, tmp_path / "out", srdf=False)
     model = mujoco.MjModel.from_xml_path(str(out.mjcf))
-    assert sum(model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH for g in range(model.ngeom)) == 1
+    assert sum(model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH for g in range(model.ngeom)) == 2
     assert (out.folder / "meshes" / "tet.dae").is_file()  # the URDF keeps the COLLADA mesh
 
 

@@ -106,12 +106,13 @@ def copy_files(folder: Path, copies: Mapping[str, Path]) -> None:
         copy_new_file(folder, dest, source, MAX_COPY_BYTES)
 
 
-def _rewrite_filenames(urdf_text: str, mapping: dict[str, str]) -> str:
+def _rewrite_filenames(urdf_text: str, mapping: dict[str, str], *, complete: bool = False) -> str:
     """Replace the mesh ``filename`` attribute values (and only those) in the raw text.
 
     Raises:
-        ExportError: a mesh reference the text spells otherwise (XML character references) was
-            not replaced: the URDF would point outside its folder.
+        ExportError: with ``complete``, a mesh reference left that is not one of the new values
+            (the text spells it otherwise, with XML character references): the URDF would point
+            outside its folder.
     """
 
     def repl(match: re.Match) -> str:
@@ -122,7 +123,7 @@ def _rewrite_filenames(urdf_text: str, mapping: dict[str, str]) -> str:
 
     pattern = re.compile(r"(<mesh\b[^>]*?\bfilename\s*=\s*)([\"'])(.*?)\2", re.DOTALL)
     text = pattern.sub(repl, urdf_text)
-    left = [ref for ref in mesh_references(text) if ref not in mapping.values()]
+    left = [ref for ref in mesh_references(text) if ref not in mapping.values()] if complete else []
     if left:
         raise ExportError(f"mesh reference {left[0][:200]!r} could not be rewritten to its copy; "
                           "write it without XML character references")
@@ -147,7 +148,7 @@ def write_urdf_folder(robot: Robot, out_dir: str | os.PathLike, overwrite: bool 
     """The URDF folder of :func:`pinarms.export.export_urdf` without an SRDF (``robot`` already loaded)."""
     out = _check_folder(out_dir, overwrite)
     mapping, copies = plan_copies(mesh_references(robot.urdf_text), robot_folders(robot, packages))
-    text = _rewrite_filenames(robot.urdf_text, mapping)
+    text = _rewrite_filenames(robot.urdf_text, mapping, complete=True)
     urdf_name = f"{safe_file_name(robot.name, 'robot')}.urdf"
 
     def fill(tmp: Path) -> None:
