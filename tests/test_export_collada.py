@@ -102,3 +102,16 @@ def test_without_pycollada_the_error_says_what_to_do(tmp_path, received, monkeyp
     run = CliRunner().invoke(cli, ["urdf", "export", str(received / "arm.urdf"), str(tmp_path / "out"), "--mjcf"])
     assert run.exit_code == 1 and run.output.startswith("Error: ") and len(run.output.splitlines()) == 1, run.output
     assert "STL or OBJ" in run.output
+
+
+def test_an_arm_with_an_ascii_stl_mesh_exports_to_mujoco(tmp_path, received):
+    """MuJoCo reads binary STL only; the cell export already wrote ASCII STL as binary, the arm export now too."""
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    facets = "".join("facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x:g} {y:g} {z:g}\n" for x, y, z in
+                                                                 VERTICES[list(f)]) + "endloop\nendfacet\n"
+                     for f in faces)
+    (received / "box.stl").write_text(f"solid tet\n{facets}endsolid tet\n")
+    robot = robots.from_urdf(received / "arm.urdf")
+    out = export_mjcf(robot, tmp_path / "out")
+    model = mujoco.MjModel.from_xml_path(str(out.mjcf))
+    assert sum(model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH for g in range(model.ngeom)) == 2

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import struct
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,7 +33,7 @@ from typing import Any, Mapping
 from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
 from pinarms.robots.errors import InvalidInput
 
-from .errors import MeshNotFound
+from .mesh_convert import binary_stl
 from .mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
 from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
 from .srdf import geometry_links, home_notes, srdf_text
@@ -107,33 +106,6 @@ def cell_folders(cell: Any, packages: Mapping[str, str | os.PathLike] | None = N
     return MeshFolders(owner=f"cell {cell.name!r}", own=cell.base_dir, packages=named)
 
 
-def _binary_stl(data: bytes, name: str) -> bytes:
-    """An ASCII STL file as binary STL (MuJoCo reads binary STL only); binary STL as it is."""
-    head = data[:512].lstrip().lower()
-    if not head.startswith(b"solid") or b"facet" not in data[:4096].lower():
-        return data
-    words = data.decode("ascii", errors="replace").split()
-    facets = []
-    try:
-        for i, w in enumerate(words):
-            if w == "normal":
-                normal = [float(v) for v in words[i + 1 : i + 4]]
-            elif w == "vertex":
-                facets.append((normal, [float(v) for v in words[i + 1 : i + 4]]))
-    except (ValueError, UnboundLocalError) as exc:
-        raise MeshNotFound(f"mesh {name} is not a readable ASCII STL file ({exc})") from exc
-    if not facets or len(facets) % 3:
-        raise MeshNotFound(f"mesh {name} is not a readable ASCII STL file (vertices not in triangles)")
-    out = bytearray(b"binary STL written by pinarms".ljust(80, b" "))
-    out += struct.pack("<I", len(facets) // 3)
-    for k in range(0, len(facets), 3):
-        out += struct.pack("<3f", *facets[k][0])
-        for _, vertex in facets[k : k + 3]:
-            out += struct.pack("<3f", *vertex)
-        out += b"\x00\x00"
-    return bytes(out)
-
-
 def _copy_meshes(root: ET.Element, folders: MeshFolders, folder: Path) -> tuple[str, ...]:
     """Copy every mesh ``root`` references (checked: :mod:`.mesh_sources`) into ``folder/meshes`` as
     ``meshes/<stem>.<suffix>`` (numbered when two share a name) and point the URDF at the copies.
@@ -150,7 +122,7 @@ def _copy_meshes(root: ET.Element, folders: MeshFolders, folder: Path) -> tuple[
                 name = f"meshes/{stem}_{k}{suffix}"
             used.add(name)
             dest_of[source] = name
-            stl = (lambda data, n=source.name: _binary_stl(data, n)) if suffix == ".stl" else None
+            stl = (lambda data, n=source.name: binary_stl(data, n)) if suffix == ".stl" else None
             copy_new_file(folder, name, source, MAX_COPY_BYTES, transform=stl)
         mesh.set("filename", dest_of[source])
     return tuple(sorted(dest_of.values()))

@@ -120,7 +120,8 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
 
     COLLADA (``.dae``) meshes, which MuJoCo cannot read, are left out of the visual geometry
     (``discardvisual``); COLLADA collision meshes are converted to OBJ files beside them
-    (:mod:`pinarms.export.mesh_convert`, trimesh with pycollada). Needs the ``mujoco``
+    (:mod:`pinarms.export.mesh_convert`, trimesh with pycollada), ASCII STL meshes to binary
+    STL. Needs the ``mujoco``
     package (``pip install 'pinarms[mujoco]'``: mujoco, trimesh, pycollada). The folder, the file name and the
     meshes follow :func:`export_urdf` (``packages`` likewise).
 

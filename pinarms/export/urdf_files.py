@@ -19,7 +19,7 @@ from pinarms.robots.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
 from .errors import ExportError, MeshNotAllowed
-from .mesh_convert import collada_collision_meshes, collada_to_obj, converted_name
+from .mesh_convert import mujoco_conversions
 from .mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
 
 __all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
@@ -166,8 +166,8 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
     Every link stays a body (``fusestatic="false"``), a site named like each frame of
     ``sites`` sits at the origin of its body, joint equalities (``<mimic>``) are made as
     stiff as the time step allows, mesh paths are made relative, COLLADA collision meshes
-    are converted to OBJ beside them (:mod:`.mesh_convert`; COLLADA visuals are
-    discarded), and the meshes MuJoCo reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
+    and ASCII STL meshes are converted beside them (:mod:`.mesh_convert`; COLLADA visuals
+    are discarded), and the meshes MuJoCo reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
     body (``{body: name}``). Returns the meshes copied (POSIX paths relative to the folder).
     """
     folder = urdf.parent
@@ -176,10 +176,9 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
                  'strippath="false"/></mujoco>')
     text = urdf.read_text(encoding="utf-8")
     converted = {}
-    for mesh in collada_collision_meshes(text):  # MuJoCo reads no COLLADA: OBJ beside it (.mesh_convert)
-        converted[mesh] = converted_name(mesh)
-        copy_new_file(folder, converted[mesh], path_inside(folder, mesh), MAX_COPY_BYTES,
-                      transform=lambda data, m=mesh: collada_to_obj(data, m))
+    for mesh, new, convert in mujoco_conversions(text, folder):  # COLLADA, ASCII STL (.mesh_convert)
+        converted[mesh] = new
+        copy_new_file(folder, new, path_inside(folder, mesh), MAX_COPY_BYTES, transform=convert)
     text = _rewrite_filenames(text, converted) if converted else text
     head, end, tail = text.rpartition("</robot>")
     path_inside(target.parent, target.name)
