@@ -9,11 +9,20 @@ existing file there stays untouched until the new one is complete). The temporar
 process killed mid-write (SIGKILL, power loss) cannot remove its own; the next save of the
 same target removes every such leftover that no live writer holds and that is older than
 :data:`STALE_AFTER_S`.
+
+Whole folders (exports) are written the same way: :func:`publish_folder` fills a new folder
+beside the target and renames it into place; inside it, :func:`write_new_file` and
+:func:`copy_new_file` create each file new at a path :func:`path_inside` proved inside the
+folder, and :func:`safe_file_name` turns a received name into a plain file name. Folders get
+the umask's permissions (:func:`folder_mode`).
 """
 
 from __future__ import annotations
 
 import os
+import re
+import shutil
+import stat
 import tempfile
 import time
 from pathlib import Path
@@ -131,6 +140,146 @@ def discard(tmp: str | os.PathLike) -> None:
         os.unlink(tmp)
     except FileNotFoundError:
         pass
+
+
+# --------------------------------------------------------------------------- whole folders (exports)
+# A folder of files is written as one: filled under a temporary name beside the target, then
+# renamed into place (publish_folder). Inside the folder being filled, every file is new
+# (write_new_file, copy_new_file) and its path is proven to lie inside the folder.
+
+_SAFE_NAME = re.compile(r"(?:[^A-Za-z0-9_.-]|\.{2,})+")
+MAX_NAME_LENGTH = 100
+"""Longest file name :func:`safe_file_name` returns (characters), suffixes excluded."""
+
+
+def folder_mode() -> int:
+    """Permissions a plain ``os.mkdir`` would give (0o777 minus the umask)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o777 & ~umask
+
+
+def safe_file_name(text: str, fallback: str) -> str:
+    """``text`` as one file name: each run of characters outside ``A-Z a-z 0-9 _ . -`` (and of ``..``)
+    becomes one ``_``, leading ``.`` and ``-`` are dropped, the rest cut to :data:`MAX_NAME_LENGTH`; ``fallback`` when
+    nothing is left. ``"../other/evil"`` → ``"_other_evil"``, ``"/tmp/x"`` → ``"_tmp_x"``."""
+    name = _SAFE_NAME.sub("_", str(text)).lstrip(".-")[:MAX_NAME_LENGTH]
+    return name or fallback
+
+
+def output_folder(path: str | os.PathLike) -> Path:
+    """The real folder a whole-folder writer fills for ``path``: symbolic links in it followed (a link to
+    a folder is that folder, written through and kept as a link).
+
+    Raises:
+        InvalidInput: ``path`` is a file, a NUL byte, or a symbolic link to nothing.
+    """
+    text = os.fspath(path)
+    if not isinstance(text, str) or "\x00" in text or not text:
+        raise InvalidInput(f"cannot write the folder {text!r}: not a folder name")
+    if os.path.islink(text) and not os.path.exists(text):
+        raise InvalidInput(f"folder {text!r} is a symbolic link to {os.readlink(text)!r}, which does not exist; "
+                           "create that folder or give another one")
+    real = Path(os.path.realpath(text))
+    if real.exists() and not real.is_dir():
+        raise InvalidInput(f"folder {text!r} is a file; give a folder path")
+    return real
+
+
+def path_inside(folder: str | os.PathLike, relative: str) -> Path:
+    """``folder/relative``, proven to lie inside ``folder``: ``relative`` is a POSIX path of plain names
+    (no absolute path, no ``.`` or ``..``, no empty or hidden part, no control character), and its
+    longest existing part, symbolic links resolved, lies inside ``folder`` resolved.
+
+    Raises:
+        InvalidInput: naming ``relative`` and the folder.
+    """
+    parts = str(relative).split("/")
+    if any(not p or p.startswith(".") or any(ord(c) < 32 for c in p) for p in parts):
+        raise InvalidInput(f"cannot write {str(relative)!r} into {os.fspath(folder)!r}: not a path of plain names")
+    root = Path(os.path.realpath(folder))
+    target = root.joinpath(*parts)
+    existing = target
+    while not os.path.lexists(existing):
+        existing = existing.parent
+    if not Path(os.path.realpath(existing)).is_relative_to(root):
+        raise InvalidInput(f"cannot write {str(relative)!r} into {str(root)!r}: it resolves outside that folder")
+    return target
+
+
+def write_new_file(folder: str | os.PathLike, relative: str, data: bytes) -> Path:
+    """Write ``data`` as the new file ``folder/relative`` (:func:`path_inside`; its folders created with the
+    umask's permissions); an existing entry there, a link included, is an error, never followed."""
+    target = path_inside(folder, relative)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    path_inside(folder, relative)  # its folders, now made, still inside
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    fd = os.open(target, flags, 0o666)  # the umask applies
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    return target
+
+
+def copy_new_file(folder: str | os.PathLike, relative: str, source: str | os.PathLike, max_bytes: int,
+                  transform: Callable[[bytes], bytes] | None = None) -> Path:
+    """Copy the regular file ``source`` (its last part not a link) of at most ``max_bytes`` to the new file
+    ``folder/relative`` (:func:`write_new_file`), through ``transform(data)`` when given.
+
+    Raises:
+        InvalidInput: ``source`` is not a regular file (a link, a device, a FIFO) or is larger than ``max_bytes``.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(source, flags)
+    except OSError as exc:
+        raise InvalidInput(f"cannot copy {os.fspath(source)!r}: {exc.strerror or exc}") from exc
+    with os.fdopen(fd, "rb") as f:
+        st = os.fstat(f.fileno())
+        if not stat.S_ISREG(st.st_mode):
+            raise InvalidInput(f"cannot copy {os.fspath(source)!r}: not a regular file")
+        if st.st_size > max_bytes:
+            raise InvalidInput(f"cannot copy {os.fspath(source)!r}: {st.st_size} bytes, above the limit of {max_bytes}")
+        data = f.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise InvalidInput(f"cannot copy {os.fspath(source)!r}: above the limit of {max_bytes} bytes")
+    return write_new_file(folder, relative, data if transform is None else transform(data))
+
+
+def publish_folder(out: str | os.PathLike, fill: Callable[[Path], None]) -> Path:
+    """Fill a new temporary folder beside ``out`` with ``fill(tmp)``, then rename it to ``out``; return ``out``.
+
+    ``out`` is taken through :func:`output_folder` (a link to a folder: that folder, the link kept).
+    The new folder gets the umask's permissions. A failure leaves no half-written folder and
+    ``out`` untouched; an existing ``out`` is replaced only once the new one is complete (and put
+    back if the rename fails), and nothing of it is left beside ``out``.
+    """
+    real = output_folder(out)
+    real.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{real.name}.", suffix=".partial", dir=real.parent))
+    try:
+        os.chmod(tmp, folder_mode())  # mkdtemp makes it 0700
+        fill(tmp)
+        old = None
+        if real.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{real.name}.", suffix=".old", dir=real.parent))
+            os.rmdir(old)
+            os.rename(real, old)
+        try:
+            os.rename(tmp, real)
+        except OSError:
+            if old is not None:
+                os.rename(old, real)  # put the previous folder back
+            raise
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return real
+
+
+__all__ += ["folder_mode", "safe_file_name", "output_folder", "path_inside", "write_new_file", "copy_new_file",
+            "publish_folder", "MAX_NAME_LENGTH"]
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], None]) -> Path:

@@ -62,18 +62,24 @@ def urdf_build_cmd(source: str | None, xacro_args: tuple[str, ...], packages: tu
     emit(as_json, {"written": [str(p) for p in written]}, [f"wrote {p}" for p in written])
 
 
+def _packages(items: tuple[str, ...]) -> dict[str, str]:
+    """``--package NAME=FOLDER`` values as ``{NAME: FOLDER}``."""
+    pkgs = {}
+    for item in items:
+        name, sep, folder = item.partition("=")
+        if not sep or not name.strip() or not folder.strip():
+            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
+        pkgs[name.strip()] = folder.strip()
+    return pkgs
+
+
 def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
                       as_json: bool) -> None:
     from pinarms.robots.urdf_build import write_atomic
     from pinarms.robots.xacro_expand import check_mesh_files, expand_xacro, parse_xacro_args
 
     args = parse_xacro_args(xacro_args)
-    pkgs = {}
-    for item in packages:
-        name, sep, folder = item.partition("=")
-        if not sep or not name.strip() or not folder.strip():
-            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
-        pkgs[name.strip()] = folder.strip()
+    pkgs = _packages(packages)
     header = (f" Generated from {Path(source).name} by `pinarms urdf build` (pinarms). ",)
     result = expand_xacro(source, args, packages=pkgs, header=header)
     check_mesh_files(result.urdf_text, source, pkgs)
@@ -103,35 +109,44 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
               help="ROBOT is a cell file (a built-in cell name is recognised without it).")
 @click.option("--study-poses", is_flag=True,
               help="With --srdf, a built-in cell: also the demo's pick/place poses as named states (plans its cycles).")
+@click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+              help="A folder for package://NAME/ meshes (repeatable). Meshes are copied only from ROBOT's own "
+                   "folder and these.")
 @json_option
 def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf: bool, is_cell: bool,
-                    study_poses: bool, as_json: bool) -> None:
+                    study_poses: bool, packages: tuple[str, ...], as_json: bool) -> None:
     """Write ROBOT (an arm or a whole cell) as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
     With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
     at the flange and at the tcp, mimic joints as equality constraints. With --srdf it also
     holds ROBOT.srdf; the URDF then gives each collision element its own link. A cell
     (a built-in cell name, or --cell FILE) is written as URDF, plus SRDF and MJCF when asked.
+
+    Files are named after the robot or cell, made a plain file name; meshes and COLLADA
+    textures are copied only from ROBOT's folder and the --package folders (docs/files.md).
+    An OUT_DIR that is a link to a folder is written through.
     """
     from pinarms.export import export_cell, export_mjcf, export_urdf
     from pinarms.robots.cell import cell_names, load_cell
 
     if study_poses and not srdf:
         raise click.UsageError("--study-poses are SRDF states: add --srdf")
+    pkgs = _packages(packages)
     if is_cell or robot in cell_names():
-        cell = load_cell(robot)
+        cell = load_cell(robot, packages=pkgs)
         states = None
         if study_poses:
             from pinarms.export.shipped import study_states
 
             states = study_states(cell)
-        result = export_cell(cell, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite, states=states)
+        result = export_cell(cell, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite, states=states, packages=pkgs)
         files = [p for p in (result.urdf, result.srdf, result.mjcf) if p is not None]
         emit(
             as_json,
             {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "mjcf": result.mjcf,
-             "sites": list(result.sites), "meshes": list(result.meshes)},
-            [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)"],
+             "sites": list(result.sites), "meshes": list(result.meshes), "notes": list(result.notes)},
+            [f"wrote {', '.join(str(p) for p in files)} and {len(result.meshes)} mesh file(s)",
+             *(f"note: {n}" for n in result.notes)],
         )
         return
     if study_poses:
@@ -139,17 +154,18 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
     if mjcf:
         if srdf:
             raise click.UsageError("--srdf goes with the URDF export (run it once without --mjcf)")
-        result = export_mjcf(load_robot(robot), out_dir, overwrite=overwrite)
+        result = export_mjcf(load_robot(robot), out_dir, overwrite=overwrite, packages=pkgs)
         emit(
             as_json,
             {"folder": result.folder, "mjcf": result.mjcf, "sites": list(result.sites), "meshes": list(result.meshes)},
             [f"wrote {result.mjcf} (sites: {', '.join(result.sites)}) and {len(result.meshes)} mesh file(s)"],
         )
         return
-    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf)
+    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf, packages=pkgs)
     emit(
         as_json,
-        {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes)},
+        {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes),
+         "notes": list(result.notes)},
         [f"wrote {result.urdf}{'' if result.srdf is None else f' and {result.srdf}'} and "
-         f"{len(result.meshes)} mesh file(s)"],
+         f"{len(result.meshes)} mesh file(s)", *(f"note: {n}" for n in result.notes)],
     )

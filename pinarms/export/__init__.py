@@ -7,6 +7,8 @@
   pinarms' proven pair classification);
 - :mod:`.trajectory`: planned trajectories as ROS 2 ``JointTrajectory`` YAML and CSV at a
   controller rate, and their readers;
+- :mod:`.mesh_sources`: which mesh and texture files an export may copy (the allowed
+  folders, the suffixes) and their names in the folder;
 - :mod:`.verify`: a planned motion replayed in MuJoCo through the exported MJCF, distances
   compared with pinarms' (coal's).
 
@@ -14,7 +16,7 @@ docs/export.md shows the commands and what each consumer does with the files.
 """
 
 from .cell import ExportedCell, export_cell
-from .errors import ExportError, InvalidRate, JointMismatch, MeshNotFound
+from .errors import ExportError, InvalidRate, JointMismatch, MeshNotAllowed, MeshNotFound
 from .robot import SITE_SIZE_M, ExportedMJCF, ExportedURDF, export_mjcf, export_urdf, mesh_references
 from .srdf import SRDF_REASON, contact_pairs, cycle_states, srdf_text
 from .trajectory import (
@@ -50,6 +52,7 @@ __all__ = [
     "compare_in_mujoco",
     "ExportError",
     "MeshNotFound",
+    "MeshNotAllowed",
     "InvalidRate",
     "JointMismatch",
 ]

@@ -25,17 +25,18 @@ from __future__ import annotations
 
 import os
 import shutil
-import struct
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any, Mapping
 
+from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
 from pinarms.robots.errors import InvalidInput
 
-from .errors import MeshNotFound
+from .mesh_convert import binary_stl
+from .mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
 from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
-from .srdf import geometry_links, srdf_text
+from .srdf import geometry_links, home_notes, srdf_text
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
 
@@ -50,6 +51,8 @@ class ExportedCell:
         meshes: the copied mesh files, relative to ``folder`` (POSIX paths), sorted.
         sites: the MuJoCo sites (each arm's flange and tcp).
         geometry_links: ``{pinarms geometry name: exported link name}``.
+        notes: what the export left out and why (an arm without a home state:
+            :func:`pinarms.export.srdf.home_notes`).
     """
 
     folder: Path
@@ -59,6 +62,7 @@ class ExportedCell:
     meshes: tuple[str, ...]
     sites: tuple[str, ...]
     geometry_links: dict[str, str]
+    notes: tuple[str, ...] = ()
 
 
 def _parse(text: str) -> ET.Element:
@@ -93,74 +97,33 @@ def one_collision_per_link(root: ET.Element) -> dict[str, str]:
     return added
 
 
-def _mesh_source(reference: str, cell: Any) -> Path:
-    """The file a mesh reference of ``cell`` names (relative paths: the cell's folder; ``package://``: its packages)."""
-    dirs = [Path(d) for d in cell.robot.package_dirs]
-    if reference.startswith("package://"):
-        rel = reference[len("package://"):].partition("/")[2]
-        candidates = [d / rel for d in dirs]
-    elif reference.startswith("file://"):
-        candidates = [Path(reference[len("file://"):])]
-    else:
-        candidates = [Path(reference)] if os.path.isabs(reference) else [dirs[0] / reference] if dirs else []
-    for path in candidates:
-        if path.is_file():
-            return path
-    raise MeshNotFound(
-        f"cell {cell.name!r}: mesh {reference!r} cannot be found (looked at {', '.join(str(c) for c in candidates) or 'nothing'}); "
-        "put the mesh file back or load the cell with the packages that hold it (load_cell(path, packages=...))"
-    )
+def cell_folders(cell: Any, packages: Mapping[str, str | os.PathLike] | None = None) -> MeshFolders:
+    """The folders a cell's export may copy meshes from: its folder, pinarms' package, its packages and ``packages``."""
+    from pinarms.robots.xacro_expand import BUILTIN_PACKAGE
+
+    named = {BUILTIN_PACKAGE[0]: Path(BUILTIN_PACKAGE[1]), **cell.packages,
+             **{str(k): Path(v) for k, v in (packages or {}).items()}}
+    return MeshFolders(owner=f"cell {cell.name!r}", own=cell.base_dir, packages=named)
 
 
-def _binary_stl(source: Path) -> bytes | None:
-    """An ASCII STL file as binary STL (MuJoCo reads binary STL only), or ``None`` if already binary."""
-    data = source.read_bytes()
-    head = data[:512].lstrip().lower()
-    if not head.startswith(b"solid") or b"facet" not in data[:4096].lower():
-        return None
-    words = data.decode("ascii", errors="replace").split()
-    facets = []
-    try:
-        for i, w in enumerate(words):
-            if w == "normal":
-                normal = [float(v) for v in words[i + 1 : i + 4]]
-            elif w == "vertex":
-                facets.append((normal, [float(v) for v in words[i + 1 : i + 4]]))
-    except (ValueError, UnboundLocalError) as exc:
-        raise MeshNotFound(f"mesh {source} is not a readable ASCII STL file ({exc})") from exc
-    if not facets or len(facets) % 3:
-        raise MeshNotFound(f"mesh {source} is not a readable ASCII STL file (vertices not in triangles)")
-    out = bytearray(b"binary STL written by pinarms".ljust(80, b" "))
-    out += struct.pack("<I", len(facets) // 3)
-    for k in range(0, len(facets), 3):
-        out += struct.pack("<3f", *facets[k][0])
-        for _, vertex in facets[k : k + 3]:
-            out += struct.pack("<3f", *vertex)
-        out += b"\x00\x00"
-    return bytes(out)
-
-
-def _copy_meshes(root: ET.Element, cell: Any, folder: Path) -> tuple[str, ...]:
-    """Copy every mesh ``root`` references into ``folder/meshes`` and point the URDF at the copies."""
+def _copy_meshes(root: ET.Element, folders: MeshFolders, folder: Path) -> tuple[str, ...]:
+    """Copy every mesh ``root`` references (checked: :mod:`.mesh_sources`) into ``folder/meshes`` as
+    ``meshes/<stem>.<suffix>`` (numbered when two share a name) and point the URDF at the copies.
+    COLLADA textures are not copied (MuJoCo discards COLLADA visuals)."""
     dest_of: dict[Path, str] = {}
     used: set[str] = set()
     for mesh in root.iter("mesh"):
-        source = _mesh_source(mesh.get("filename", ""), cell).resolve()
+        source = mesh_source(mesh.get("filename", ""), folders).real
         if source not in dest_of:
-            stem, suffix, k = source.stem, source.suffix, 0
+            stem, suffix, k = safe_file_name(source.stem, "mesh"), source.suffix.lower(), 0
             name = f"meshes/{stem}{suffix}"
             while name in used:
                 k += 1
                 name = f"meshes/{stem}_{k}{suffix}"
             used.add(name)
             dest_of[source] = name
-            target = folder / Path(*PurePosixPath(name).parts)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            binary = _binary_stl(source) if suffix.lower() == ".stl" else None
-            if binary is None:
-                shutil.copyfile(source, target)
-            else:
-                target.write_bytes(binary)
+            stl = (lambda data, n=source.name: binary_stl(data, n)) if suffix == ".stl" else None
+            copy_new_file(folder, name, source, MAX_COPY_BYTES, transform=stl)
         mesh.set("filename", dest_of[source])
     return tuple(sorted(dest_of.values()))
 
@@ -172,28 +135,30 @@ def _sites(cell: Any, root: ET.Element) -> tuple[str, ...]:
 
 
 def _write_cell(cell: Any, folder: Path, *, srdf: bool, mjcf: bool,
-                states: Mapping[str, Mapping[str, Any]] | None) -> ExportedCell:
-    """Write the cell's files into the (new, empty) ``folder``."""
+                states: Mapping[str, Mapping[str, Any]] | None, folders: MeshFolders) -> ExportedCell:
+    """Write the cell's files into the (new, empty) ``folder``; they are named after the cell, made a plain
+    file name (:func:`pinarms.files.safe_file_name`)."""
     folder.mkdir(parents=True, exist_ok=True)
+    name = safe_file_name(cell.name, "cell")
     root = _parse(cell.urdf_text)
-    meshes = _copy_meshes(root, cell, folder)
+    meshes = _copy_meshes(root, folders, folder)
     one_collision_per_link(root)
     links = geometry_links(cell)
     ET.indent(root)
-    urdf = folder / f"{cell.name}.urdf"
-    urdf.write_text('<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n", encoding="utf-8")
+    text = '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    urdf = write_new_file(folder, f"{name}.urdf", text.encode("utf-8"))
     srdf_path = None
     if srdf:
-        srdf_path = folder / f"{cell.name}.srdf"
-        srdf_path.write_text(srdf_text(cell, states=states), encoding="utf-8")
+        srdf_path = write_new_file(folder, f"{name}.srdf", srdf_text(cell, states=states).encode("utf-8"))
     sites = _sites(cell, root)
     mjcf_path = None
     if mjcf:
         mujoco = _mujoco()
-        mjcf_path = folder / f"{cell.name}.xml"
+        mjcf_path = path_inside(folder, f"{name}.xml")
         compile_mjcf(mujoco, urdf, meshes, mjcf_path, sites, f"cell {cell.name!r}",
                      geom_names={link: geometry for geometry, link in links.items()})
-    return ExportedCell(folder, urdf, srdf_path, mjcf_path, meshes, sites if mjcf else (), links)
+    notes = home_notes(cell, states=states) if srdf else ()
+    return ExportedCell(folder, urdf, srdf_path, mjcf_path, meshes, sites if mjcf else (), links, notes)
 
 
 def _mujoco():
@@ -207,62 +172,74 @@ def _mujoco():
     return mujoco
 
 
-def _load(cell_or_name: Any):
+def _load(cell_or_name: Any, packages: Mapping[str, str | os.PathLike] | None = None):
     from pinarms.robots.cell import Cell, load_cell
 
-    cell = load_cell(cell_or_name) if isinstance(cell_or_name, (str, os.PathLike)) else cell_or_name
+    cell = (load_cell(cell_or_name, packages=packages) if isinstance(cell_or_name, (str, os.PathLike))
+            else cell_or_name)
     if not isinstance(cell, Cell):
         raise InvalidInput(f"export_cell takes a robots.cell.Cell, a built-in cell name or a cell file, got {cell_or_name!r}")
     return cell
 
 
 def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
-                states: Mapping[str, Mapping[str, Any]] | None = None, overwrite: bool = False) -> ExportedCell:
+                states: Mapping[str, Mapping[str, Any]] | None = None, overwrite: bool = False,
+                packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """Write a whole cell (URDF + SRDF + MJCF + meshes) into ``out_dir`` (module doc).
 
     Args:
         cell_or_name: a :class:`pinarms.robots.cell.Cell`, a built-in cell name or a cell file.
         srdf, mjcf: write the SRDF, the MJCF (the latter needs ``mujoco``).
         states: extra named SRDF states ``{name: {arm: q_arm}}`` (:func:`srdf.cycle_states`).
-        overwrite: replace a non-empty ``out_dir`` (only once the new one is complete).
+        overwrite: replace a non-empty ``out_dir`` (only once the new one is complete). A
+            symbolic link to a folder is written through (the link stays); the folder gets the
+            umask's permissions.
+        packages: ``{NAME: folder}`` for ``package://NAME/`` files (a cell name or file is
+            loaded with them). Meshes are copied only from the cell's folder, pinarms' package,
+            the cell's packages and these (:mod:`.mesh_sources`).
 
     Raises:
         CellNotFound: unknown cell name. InvalidInput: ``out_dir`` is a file or not empty
         (without ``overwrite``); a bad state. MeshNotFound: a mesh cannot be found.
+        MeshNotAllowed: a mesh outside the allowed folders or not a mesh file.
         ModelError: MuJoCo is missing or refuses the model.
     """
-    cell = _load(cell_or_name)
+    cell = _load(cell_or_name, packages)
     out = _check_folder(out_dir, overwrite)
     result: dict[str, ExportedCell] = {}
+    folders = cell_folders(cell, packages)
 
     def fill(tmp: Path) -> None:
-        result["cell"] = _write_cell(cell, tmp, srdf=srdf, mjcf=mjcf, states=states)
+        result["cell"] = _write_cell(cell, tmp, srdf=srdf, mjcf=mjcf, states=states, folders=folders)
 
     _publish(out, fill)
     r = result["cell"]
     move = lambda p: None if p is None else out / p.name  # noqa: E731
-    return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links)
+    return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links,
+                        r.notes)
 
 
 def cell_of_urdf_folder(robot: Any, folder: Path):
     """A one-arm :class:`Cell` of ``robot`` built from its exported (self-contained) URDF folder."""
     from pinarms.robots.cell import Cell
 
-    text = (folder / f"{robot.name}.urdf").read_text(encoding="utf-8")
+    text = (folder / f"{safe_file_name(robot.name, 'robot')}.urdf").read_text(encoding="utf-8")
     return Cell(text, source=f"robot {robot.name!r}", base_dir=folder)
 
 
 def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite: bool = False,
-                           states: Mapping[str, Any] | None = None) -> ExportedCell:
+                           states: Mapping[str, Any] | None = None,
+                           packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """One arm as a folder with its URDF (one collision per link) and SRDF (one-arm cell rules)."""
     out = _check_folder(out_dir, overwrite)
     result: dict[str, ExportedCell] = {}
 
     def fill(tmp: Path) -> None:
-        staged = write_urdf_folder(robot, tmp / ".staged")
+        staged = write_urdf_folder(robot, tmp / "staged", packages=packages)
         cell = cell_of_urdf_folder(robot, staged.folder)
         arm_states = None if states is None else {k: {cell.arms[0].name: v} for k, v in states.items()}
-        result["cell"] = _write_cell(cell, tmp / "out", srdf=True, mjcf=False, states=arm_states)
+        result["cell"] = _write_cell(cell, tmp / "out", srdf=True, mjcf=False, states=arm_states,
+                                     folders=cell_folders(cell))
         for entry in (tmp / "out").iterdir():
             os.rename(entry, tmp / entry.name)
         (tmp / "out").rmdir()
@@ -270,4 +247,4 @@ def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite:
 
     _publish(out, fill)
     r = result["cell"]
-    return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links)
+    return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links, r.notes)

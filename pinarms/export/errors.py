@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pinarms.robots.errors import InvalidInput, MissingMesh, PinarmsError
 
-__all__ = ["ExportError", "MeshNotFound", "InvalidRate", "JointMismatch"]
+__all__ = ["ExportError", "MeshNotFound", "MeshNotAllowed", "InvalidRate", "JointMismatch"]
 
 
 class ExportError(PinarmsError):
@@ -13,6 +13,11 @@ class ExportError(PinarmsError):
 
 class MeshNotFound(ExportError, MissingMesh):
     """A mesh the exported description references cannot be found (the folder would not load elsewhere)."""
+
+
+class MeshNotAllowed(ExportError, InvalidInput):
+    """A mesh or texture an export may not copy: outside the allowed folders (links followed), not a mesh or
+    image file by its suffix, or not a regular file. The message names the reference and what to pass."""
 
 
 class InvalidRate(ExportError, InvalidInput):

@@ -23,8 +23,10 @@ import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Mapping
 
 from pinarms import robots
+from pinarms.files import safe_file_name
 from pinarms.robots.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
@@ -36,12 +38,15 @@ __all__ = ["ExportedURDF", "ExportedMJCF", "export_urdf", "export_mjcf", "mesh_r
 
 
 def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overwrite: bool = False,
-                srdf: bool = False, states: dict | None = None) -> ExportedURDF:
+                srdf: bool = False, states: dict | None = None,
+                packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedURDF:
     """Write a self-contained URDF folder for ``robot_or_name`` into ``out_dir``.
 
     Args:
         robot_or_name: a :class:`robots.Robot` or a name :func:`robots.load` accepts.
-        out_dir: the folder to create. It must not exist or be empty, unless ``overwrite``.
+        out_dir: the folder to create. It must not exist or be empty, unless ``overwrite``. A
+            symbolic link to a folder is written through (the link stays). The folder gets the
+            umask's permissions.
         overwrite: replace an existing non-empty folder (the old one is removed only
             after the new one is complete).
         srdf: also write ``<name>.srdf`` (:mod:`pinarms.export.srdf`: the arm's group,
@@ -49,7 +54,14 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
             classification). The URDF then gives every collision element its own link
             (:func:`pinarms.export.cell.one_collision_per_link`) instead of being kept byte
             for byte, so that the SRDF can name every pair.
-        states: with ``srdf``, extra named states ``{name: q (nq,)}`` [rad or m].
+        states: with ``srdf``, extra named states ``{name: q (nq,)}`` [rad or m]; ``home``
+            is the arm's home (else the all-zero pose where the limits allow it, else no
+            home: ``notes`` says so).
+        packages: ``{NAME: folder}`` for ``package://NAME/`` meshes. Meshes are copied only
+            from the URDF's folder, ``robot.package_dirs`` and these (:mod:`.mesh_sources`).
+
+    The URDF file is named after the robot, made a plain file name
+    (:func:`pinarms.files.safe_file_name`: ``<robot name="../x">`` gives ``_x.urdf``).
 
     Returns:
         :class:`ExportedURDF` with the folder, the URDF path and the copied mesh files.
@@ -58,15 +70,16 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
         RobotNotFound: unknown robot name.
         InvalidInput: ``out_dir`` exists and is not empty (and ``overwrite`` is false),
             or is a file.
-        ModelError: a referenced mesh cannot be found.
+        MeshNotFound: a referenced mesh cannot be found.
+        MeshNotAllowed: a mesh or texture outside the allowed folders, or not a mesh file.
     """
     robot = robots.load(robot_or_name) if isinstance(robot_or_name, str) else robot_or_name
     if not isinstance(robot, Robot):
         raise InvalidInput(f"export_urdf takes a robots.Robot or a robot name, got {robot_or_name!r}")
     if srdf:
-        done = export_robot_with_srdf(robot, out_dir, overwrite=overwrite, states=states)
-        return ExportedURDF(folder=done.folder, urdf=done.urdf, meshes=done.meshes, srdf=done.srdf)
-    return write_urdf_folder(robot, out_dir, overwrite)
+        done = export_robot_with_srdf(robot, out_dir, overwrite=overwrite, states=states, packages=packages)
+        return ExportedURDF(folder=done.folder, urdf=done.urdf, meshes=done.meshes, srdf=done.srdf, notes=done.notes)
+    return write_urdf_folder(robot, out_dir, overwrite, packages=packages)
 
 
 # --------------------------------------------------------------------------- MuJoCo
@@ -90,7 +103,7 @@ class ExportedMJCF:
 
 
 def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites: tuple[str, ...] | None = None,
-                overwrite: bool = False) -> ExportedMJCF:
+                overwrite: bool = False, packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedMJCF:
     """Write ``robot_or_name`` as a MuJoCo model (MJCF) that keeps the tool point, into ``out_dir``.
 
     MuJoCo reads URDF itself, and turns ``<mimic>`` into joint equality constraints, but by
@@ -106,8 +119,11 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
     soft constraint lets the koji arm's linkage sag by 0.8° under its own weight.
 
     COLLADA (``.dae``) meshes, which MuJoCo cannot read, are left out of the visual geometry
-    (``discardvisual``); the collision meshes stay. Needs the ``mujoco`` package
-    (``pip install mujoco``, or pinarms' ``mujoco`` extra).
+    (``discardvisual``); COLLADA collision meshes are converted to OBJ files beside them
+    (:mod:`pinarms.export.mesh_convert`, trimesh with pycollada), ASCII STL meshes to binary
+    STL. Needs the ``mujoco``
+    package (``pip install 'pinarms[mujoco]'``: mujoco, trimesh, pycollada). The folder, the file name and the
+    meshes follow :func:`export_urdf` (``packages`` likewise).
 
     Raises:
         InvalidInput: ``out_dir`` is a file, or not empty (without ``overwrite``); a frame
@@ -129,11 +145,11 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
     for frame in sites:
         if frame not in links:
             raise InvalidInput(f"site {frame!r} is not a link of robot '{robot.name}'; links: {', '.join(sorted(links))}")
-    name = f"{robot.name}.xml"
+    name = f"{safe_file_name(robot.name, 'robot')}.xml"
     written: dict[str, tuple[str, ...]] = {}
 
     def fill(tmp: Path) -> None:
-        staged = write_urdf_folder(robot, tmp / "urdf")
+        staged = write_urdf_folder(robot, tmp / "urdf", packages=packages)
         written["meshes"] = compile_mjcf(mujoco, staged.urdf, staged.meshes, tmp / name, sites, f"robot '{robot.name}'")
         shutil.rmtree(staged.folder)
 

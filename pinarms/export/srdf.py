@@ -1,8 +1,8 @@
 """SRDF (MoveIt's semantic robot description) of an arm or a cell, from pinarms' pair classification.
 
 One planning group per arm (a chain from its base link to its tool link), a one-link group
-for the tool and an ``end_effector`` on it, named states (``home``: every joint at 0, and
-any poses given), and the ``disable_collisions`` list. MoveIt's setup assistant samples
+for the tool and an ``end_effector`` on it, named states (``home``: the caller's, else every
+joint at 0 where the limits allow it, else none; and any poses given), and the ``disable_collisions`` list. MoveIt's setup assistant samples
 random configurations (10 000 by default) to call a pair "never in collision"; here every
 pair comes from :mod:`pinarms.robots.cell.pairs`, where "never" is a proof:
 
@@ -37,7 +37,7 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "cycle_states"]
+__all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "home_notes", "cycle_states"]
 
 #: SRDF ``reason`` of each pinarms reason for not checking a pair.
 SRDF_REASON = {
@@ -91,18 +91,48 @@ def _state_joints(cell: Any, arm: Any, q: Any, state: str) -> list[tuple[str, fl
     return [(arm.prefix + name, float(v)) for name, v in zip(arm.robot.joint_names, arr)]
 
 
-def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> list[tuple[str, str, list]]:
-    """``(state name, group, [(joint, value)])``: ``home`` for every arm, then the given states."""
+def _zero_outside(arm: Any) -> str | None:
+    """Why the all-zero pose of ``arm`` is no home (a joint whose limits exclude 0), or ``None``."""
+    lo, hi = arm.robot.lower, arm.robot.upper
+    bad = np.flatnonzero((lo > 1e-12) | (hi < -1e-12))
+    if not bad.size:
+        return None
+    j = int(bad[0])
+    return (f"joint {arm.prefix}{arm.robot.joint_names[j]} = 0 is outside its limits "
+            f"[{float(lo[j])!r}, {float(hi[j])!r}]")
+
+
+def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
+    """``([(state name, group, [(joint, value)])], notes)``: the homes, then the given states.
+
+    A home the caller gives (``home``, or ``ARM_home`` in a cell of several arms) is written
+    as given; otherwise the all-zero pose, only where it lies inside the joint limits; an arm
+    whose limits exclude 0 gets no home, and a note says why.
+    """
     several = len(cell.arms) > 1
-    out = []
-    if several:
-        out.append(("home", "cell", [j for arm in cell.arms for j in _state_joints(cell, arm, np.zeros(arm.nq), "home")]))
+    given = dict(states or {})
+    for name in given:
+        if not isinstance(name, str) or not _STATE_NAME.match(name):
+            raise InvalidInput(f"state name {name!r} must be an identifier (letters, digits, _ . -)")
+    why = {arm.name: _zero_outside(arm) for arm in cell.arms}
+    out, notes = [], []
+    how = "give your own: states={{{!r}: ...}} of export_urdf / export_cell (a home of zeros is never forced)"
+    if several and "home" not in given:
+        if all(w is None for w in why.values()):
+            out.append(("home", "cell", [j for arm in cell.arms for j in _state_joints(cell, arm, np.zeros(arm.nq),
+                                                                                      "home")]))
+        else:
+            arm = next(a for a in cell.arms if why[a.name] is not None)
+            notes.append(f"no home state 'home' of group 'cell': {why[arm.name]}; {how.format('home')}")
     for arm in cell.arms:
-        out.append((f"{arm.name}_home" if several else "home", arm.name,
-                    _state_joints(cell, arm, np.zeros(arm.nq), "home")))
-    for name, per_arm in (states or {}).items():
-        if not isinstance(name, str) or not _STATE_NAME.match(name) or any(name == s[0] for s in out):
-            raise InvalidInput(f"state name {name!r} must be a new identifier (letters, digits, _ . -)")
+        name = f"{arm.name}_home" if several else "home"
+        if name in given:
+            continue
+        if why[arm.name] is None:
+            out.append((name, arm.name, _state_joints(cell, arm, np.zeros(arm.nq), name)))
+        else:
+            notes.append(f"no home state {name!r} of arm {arm.name!r}: {why[arm.name]}; {how.format(name)}")
+    for name, per_arm in given.items():
         if not isinstance(per_arm, Mapping) or not per_arm:
             raise InvalidInput(f"state {name!r} must map arm names to joint values, got {per_arm!r}")
         joints = [j for arm_name, q in per_arm.items() for j in _state_joints(cell, cell.arm(arm_name), q, name)]
@@ -110,7 +140,12 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> list[t
         if group == "cell" and not several:
             group = cell.arms[0].name
         out.append((name, group, joints))
-    return out
+    return out, notes
+
+
+def home_notes(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
+    """Why :func:`srdf_text` writes no home for an arm (its limits exclude the all-zero pose and no home is given)."""
+    return tuple(_states(cell, states)[1])
 
 
 def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
@@ -118,11 +153,14 @@ def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = Non
 
     Args:
         states: extra named states ``{name: {arm name: q_arm (nq_arm,)}}`` [rad or m]
-            (a study's pick and place poses, :func:`cycle_states`).
+            (a study's pick and place poses, :func:`cycle_states`). A state named ``home``
+            (``ARM_home`` in a cell of several arms) is that arm's home; without it the home
+            is the all-zero pose where it lies inside the limits, and none otherwise (an XML
+            comment and :func:`home_notes` say why).
 
     Raises:
         InvalidInput: a state with an unknown arm, a wrong length, a value outside the
-            joint limits, or a name already used.
+            joint limits, or a name that is not an identifier.
     """
     links = geometry_links(cell)
     root = ET.Element("robot", {"name": cell.name})
@@ -138,7 +176,10 @@ def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = Non
         everything = ET.SubElement(root, "group", {"name": "cell"})
         for arm in cell.arms:
             ET.SubElement(everything, "group", {"name": arm.name})
-    for name, group, joints in _states(cell, states):
+    entries, notes = _states(cell, states)
+    for note in notes:
+        root.append(ET.Comment(f" pinarms: {note.replace('--', '- -')} "))
+    for name, group, joints in entries:
         element = ET.SubElement(root, "group_state", {"name": name, "group": group})
         for joint, value in joints:
             ET.SubElement(element, "joint", {"name": joint, "value": repr(value)})

@@ -9,17 +9,21 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
-import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
-from typing import Callable
+from typing import Callable, Mapping
 
+from pinarms.files import copy_new_file, output_folder, path_inside, publish_folder, safe_file_name, write_new_file
 from pinarms.robots.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
-__all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "SITE_SIZE_M"]
+from .errors import ExportError, MeshNotAllowed
+from .mesh_convert import mujoco_conversions
+from .mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
+
+__all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
+           "copy_files", "SITE_SIZE_M"]
 
 #: Radius of the exported sites [m] (they are markers: no mass, no collision).
 SITE_SIZE_M = 0.01
@@ -33,12 +37,15 @@ class ExportedURDF:
         folder: the export folder.
         urdf: the URDF file inside it.
         meshes: the copied files, relative to ``folder`` (POSIX paths), sorted.
+        srdf: the SRDF file (``srdf=True``), else ``None``.
+        notes: what the export left out and why (an arm without a home state).
     """
 
     folder: Path
     urdf: Path
     meshes: tuple[str, ...]
     srdf: Path | None = None
+    notes: tuple[str, ...] = ()
 
 
 def mesh_references(urdf_text: str) -> list[str]:
@@ -55,52 +62,58 @@ def mesh_references(urdf_text: str) -> list[str]:
     return list(seen)
 
 
-def _resolve(reference: str, robot: Robot) -> tuple[Path, PurePosixPath]:
-    """Source file of a mesh reference and its destination under ``meshes/``."""
-    if reference.startswith("package://"):
-        rest = PurePosixPath(reference[len("package://") :])
-        for base in robot.package_dirs:
-            candidate = Path(base) / rest
-            if candidate.is_file():
-                return candidate, PurePosixPath("meshes") / rest
-        raise ModelError(
-            f"robot '{robot.name}': mesh {reference!r} not found in its package folders "
-            f"{list(robot.package_dirs)}; load it with robots.from_urdf(path, package_dirs=...)"
-        )
-    path_text = reference[len("file://") :] if reference.startswith("file://") else reference
-    path = Path(path_text)
-    if not path.is_absolute():
-        if robot.urdf_path is None:
-            raise ModelError(
-                f"robot '{robot.name}': relative mesh {reference!r} but the URDF has no file to resolve it from"
-            )
-        path = Path(robot.urdf_path).parent / path
-    if not path.is_file():
-        raise ModelError(f"robot '{robot.name}': mesh file {reference!r} does not exist ({path})")
-    # keep the last folders of the original path so that equal file names stay distinct
-    tail = PurePosixPath(*path.resolve().parts[-3:])
-    return path, PurePosixPath("meshes") / "files" / tail
+def robot_folders(robot: Robot, packages: Mapping[str, str | os.PathLike] | None = None) -> MeshFolders:
+    """The folders a robot's export may copy meshes from: its URDF's folder, the folders it was loaded with
+    (``robot.package_dirs``) and ``packages`` (:mod:`.mesh_sources`)."""
+    own = None if robot.urdf_path is None else Path(robot.urdf_path).parent
+    return MeshFolders(owner=f"robot {robot.name!r}", own=own,
+                       packages={str(k): Path(v) for k, v in (packages or {}).items()},
+                       search=tuple(Path(d) for d in robot.package_dirs))
 
 
-_IMAGE_RE = re.compile(r"<init_from>\s*([^<\s]+)\s*</init_from>")
+def plan_copies(references: list[str], folders: MeshFolders) -> tuple[dict[str, str], dict[str, Path]]:
+    """``({reference: its path in the export}, {path in the export: real source})`` of meshes and their textures.
+
+    Raises:
+        MeshNotAllowed, MeshNotFound: see :func:`.mesh_sources.mesh_source`.
+    """
+    mapping: dict[str, str] = {}
+    copies: dict[str, Path] = {}
+
+    def take(source: MeshSource) -> str:
+        dest, k = source.dest, 0
+        while dest in copies and copies[dest] != source.real:  # two files, one name: number the later one
+            k += 1
+            stem, dot, suffix = source.dest.rpartition(".")
+            dest = f"{stem}_{k}{dot}{suffix}"
+        copies[dest] = source.real
+        return dest
+
+    for ref in references:
+        source = mesh_source(ref, folders)
+        mapping[ref] = take(source)
+        for texture in collada_textures(MeshSource(source.real, mapping[ref]), folders):
+            if copies.get(texture.dest, texture.real) != texture.real:
+                raise MeshNotAllowed(f"{folders.owner}: texture {texture.dest!r} of mesh {ref[:200]!r} would replace "
+                                     f"another file of the export ({copies[texture.dest]})")
+            copies[texture.dest] = texture.real
+    return mapping, copies
 
 
-def _collada_images(mesh_file: Path) -> list[str]:
-    """Relative image files a COLLADA (.dae) mesh refers to."""
-    if mesh_file.suffix.lower() != ".dae":
-        return []
-    text = mesh_file.read_text(encoding="utf-8", errors="replace")
-    out = []
-    for ref in _IMAGE_RE.findall(text):
-        if "://" in ref or ref.startswith("/") or ref.startswith("#"):
-            continue
-        if Path(ref).suffix.lower() in (".png", ".jpg", ".jpeg", ".tga", ".bmp", ".tif", ".tiff"):
-            out.append(ref)
-    return out
+def copy_files(folder: Path, copies: Mapping[str, Path]) -> None:
+    """Copy each real source to its path in ``folder`` (each proven inside it, each a new file)."""
+    for dest, source in copies.items():
+        copy_new_file(folder, dest, source, MAX_COPY_BYTES)
 
 
-def _rewrite_filenames(urdf_text: str, mapping: dict[str, str]) -> str:
-    """Replace the mesh ``filename`` attribute values (and only those) in the raw text."""
+def _rewrite_filenames(urdf_text: str, mapping: dict[str, str], *, complete: bool = False) -> str:
+    """Replace the mesh ``filename`` attribute values (and only those) in the raw text.
+
+    Raises:
+        ExportError: with ``complete``, a mesh reference left that is not one of the new values
+            (the text spells it otherwise, with XML character references): the URDF would point
+            outside its folder.
+    """
 
     def repl(match: re.Match) -> str:
         quote, value = match.group(2), match.group(3)
@@ -109,75 +122,41 @@ def _rewrite_filenames(urdf_text: str, mapping: dict[str, str]) -> str:
         return f"{match.group(1)}{quote}{mapping[value]}{quote}"
 
     pattern = re.compile(r"(<mesh\b[^>]*?\bfilename\s*=\s*)([\"'])(.*?)\2", re.DOTALL)
-    return pattern.sub(repl, urdf_text)
+    text = pattern.sub(repl, urdf_text)
+    left = [ref for ref in mesh_references(text) if ref not in mapping.values()] if complete else []
+    if left:
+        raise ExportError(f"mesh reference {left[0][:200]!r} could not be rewritten to its copy; "
+                          "write it without XML character references")
+    return text
 
 
 def _check_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InvalidInput(f"export folder {str(out)!r} is a file; give a folder path")
+    """The real export folder of ``out_dir`` (a link to a folder: that folder), refused when not empty."""
+    out = output_folder(out_dir)
     if out.is_dir() and any(out.iterdir()) and not overwrite:
-        raise InvalidInput(f"export folder {str(out)!r} is not empty; choose another folder or pass overwrite=True")
+        raise InvalidInput(f"export folder {str(out_dir)!r} is not empty; choose another folder or pass overwrite=True")
     return out
 
 
 def _publish(out: Path, fill: Callable[[Path], None]) -> None:
-    """Fill a temporary sibling folder with ``fill(tmp)``, then rename it to ``out``.
-
-    A failure leaves no half-written folder; an existing ``out`` is removed only after the
-    new one is in place (and put back if the rename fails).
-    """
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
-    try:
-        fill(tmp)
-        old = None
-        if out.exists():
-            if any(out.iterdir()):
-                old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-                old.rmdir()
-                os.rename(out, old)
-            else:
-                out.rmdir()
-        try:
-            os.rename(tmp, out)
-        except OSError:
-            if old is not None:
-                os.rename(old, out)  # put the previous export back
-            raise
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+    """Fill a temporary sibling folder with ``fill(tmp)``, then rename it to ``out`` (:func:`pinarms.files.publish_folder`)."""
+    publish_folder(out, fill)
 
 
-def write_urdf_folder(robot: Robot, out_dir: str | os.PathLike, overwrite: bool = False) -> ExportedURDF:
+def write_urdf_folder(robot: Robot, out_dir: str | os.PathLike, overwrite: bool = False,
+                      packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedURDF:
     """The URDF folder of :func:`pinarms.export.export_urdf` without an SRDF (``robot`` already loaded)."""
     out = _check_folder(out_dir, overwrite)
-    mapping: dict[str, str] = {}
-    copies: dict[PurePosixPath, Path] = {}
-    for ref in mesh_references(robot.urdf_text):
-        source, dest = _resolve(ref, robot)
-        mapping[ref] = str(dest)
-        copies[dest] = source
-        for image in _collada_images(source):
-            image_source = source.parent / image
-            if image_source.is_file():
-                copies[dest.parent / PurePosixPath(image)] = image_source
-    text = _rewrite_filenames(robot.urdf_text, mapping)
-
-    urdf_name = f"{robot.name}.urdf"
+    mapping, copies = plan_copies(mesh_references(robot.urdf_text), robot_folders(robot, packages))
+    text = _rewrite_filenames(robot.urdf_text, mapping, complete=True)
+    urdf_name = f"{safe_file_name(robot.name, 'robot')}.urdf"
 
     def fill(tmp: Path) -> None:
-        (tmp / urdf_name).write_text(text, encoding="utf-8")
-        for dest, source in copies.items():
-            target = tmp / Path(*dest.parts)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(source, target)
+        write_new_file(tmp, urdf_name, text.encode("utf-8"))
+        copy_files(tmp, copies)
 
     _publish(out, fill)
-    return ExportedURDF(folder=out, urdf=out / urdf_name, meshes=tuple(sorted(str(d) for d in copies)))
+    return ExportedURDF(folder=out, urdf=out / urdf_name, meshes=tuple(sorted(copies)))
 
 
 def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, sites: tuple[str, ...] | list[str],
@@ -186,8 +165,9 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
 
     Every link stays a body (``fusestatic="false"``), a site named like each frame of
     ``sites`` sits at the origin of its body, joint equalities (``<mimic>``) are made as
-    stiff as the time step allows, mesh paths are made relative, and the meshes MuJoCo
-    reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
+    stiff as the time step allows, mesh paths are made relative, COLLADA collision meshes
+    and ASCII STL meshes are converted beside them (:mod:`.mesh_convert`; COLLADA visuals
+    are discarded), and the meshes MuJoCo reads are copied beside ``target``. ``geom_names`` names the one collision geom of a
     body (``{body: name}``). Returns the meshes copied (POSIX paths relative to the folder).
     """
     folder = urdf.parent
@@ -195,9 +175,14 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
     extension = (f'<mujoco><compiler fusestatic="false" discardvisual="{"true" if dae else "false"}" '
                  'strippath="false"/></mujoco>')
     text = urdf.read_text(encoding="utf-8")
+    converted = {}
+    for mesh, new, convert in mujoco_conversions(text, folder):  # COLLADA, ASCII STL (.mesh_convert)
+        converted[mesh] = new
+        copy_new_file(folder, new, path_inside(folder, mesh), MAX_COPY_BYTES, transform=convert)
+    text = _rewrite_filenames(text, converted) if converted else text
     head, end, tail = text.rpartition("</robot>")
-    compiled = folder / (urdf.stem + ".mujoco.urdf")
-    compiled.write_text(f"{head}{extension}\n{end}{tail}", encoding="utf-8")
+    path_inside(target.parent, target.name)
+    compiled = write_new_file(folder, urdf.stem + ".mujoco.urdf", f"{head}{extension}\n{end}{tail}".encode("utf-8"))
     try:
         model = mujoco.MjModel.from_xml_path(str(compiled))
         mujoco.mj_saveLastXML(str(target), model)
@@ -227,13 +212,10 @@ def compile_mjcf(mujoco, urdf: Path, meshes: tuple[str, ...], target: Path, site
             joint.set("solimp", "0.99 0.999 0.001")
     ET.indent(tree)
     tree.write(target, encoding="unicode")
-    kept = [m for m in meshes if not (dae and m.lower().endswith(".dae"))]
-    for mesh in kept:
-        dest = target.parent / Path(*PurePosixPath(mesh).parts)
-        if dest.resolve() == (folder / Path(*PurePosixPath(mesh).parts)).resolve():
-            continue
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(folder / Path(*PurePosixPath(mesh).parts), dest)
+    kept = [m for m in meshes if not (dae and m.lower().endswith(".dae"))] + list(converted.values())
+    if Path(os.path.realpath(target.parent)) != Path(os.path.realpath(folder)):
+        for mesh in kept:
+            copy_new_file(target.parent, mesh, path_inside(folder, mesh), MAX_COPY_BYTES)
     return tuple(sorted(kept))
 
 def _mesh_paths_relative_to(tree: ET.ElementTree, source: Path, target: Path) -> None:

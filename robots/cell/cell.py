@@ -172,6 +172,16 @@ class Cell:
         return self.robot.nq
 
     @property
+    def packages(self) -> dict[str, Path]:
+        """``{name: folder}`` of the ``package://name/`` files it was loaded with (a copy)."""
+        return {str(k): Path(v) for k, v in self._packages.items()}
+
+    @property
+    def base_dir(self) -> Path:
+        """The folder its relative mesh paths resolve against (its file's folder)."""
+        return self._base_dir
+
+    @property
     def joint_names(self) -> tuple[str, ...]:
         """Names of the cell's joints (with the arms' prefixes), in ``q`` order."""
         return self.robot.joint_names
