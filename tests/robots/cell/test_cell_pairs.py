@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,7 +12,8 @@ from pinarms import planning
 from pinarms.optim.motion.scenes import load_scene, scene_names
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.collision import exact_min_distance
-from pinarms.robots.errors import InvalidInput
+from pinarms.robots.cell.pairs import PairReason
+from pinarms.robots.errors import CellError, InvalidInput, PlacementError
 
 from _cells import POST_GAP, Reference, facing_cell_text, make_cell, post_cell_text
 
@@ -160,3 +164,97 @@ def _bounds_hold(cell):
         smallest = np.minimum(smallest, [r.min_distance for r in gd.distanceResults])
     assert np.all(bounds > 0.0)
     assert np.all(smallest >= bounds - 1e-9), [(reach[k].body_a, reach[k].body_b) for k in np.flatnonzero(smallest < bounds)]
+
+
+# ----------------------------------------------- fixtures through an arm (issue 35 item 1)
+SCARA_000 = Path(__file__).resolve().parents[3] / "urdf" / "scara_mushroom.urdf"
+
+
+def _scara_with(tmp_path, fixture: str, extra: str = "") -> Path:
+    """A cell description of seed 000's SCARA at the origin and one fixture (TOML lines ``fixture``)."""
+    shutil.copy(SCARA_000, tmp_path / "scara.urdf")
+    path = tmp_path / "cell.toml"
+    path.write_text(f'name = "scara_fixture"\n[[arm]]\nname = "arm"\nurdf = "scara.urdf"\n[[fixture]]\n{fixture}\n'
+                    f"{extra}", encoding="utf-8")
+    return path
+
+
+def test_a_table_through_the_scaras_links_is_a_placement_error_naming_the_pairs_and_depth(tmp_path):
+    path = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.30]')
+    with pytest.raises(PlacementError) as err:
+        load_cell(path)
+    text = str(err.value)
+    for link in ("arm_upper_arm_link", "arm_forearm_link", "arm_quill_link", "arm_j2_drive"):
+        assert f"{link} – table" in text, text
+    assert "in collision" in text and "mm deep" in text and "disable_collisions" in text
+    deepest = {(a, b): depth for a, b, share, depth in err.value.pairs}
+    assert deepest[("arm_upper_arm_link", "table")] == pytest.approx(0.02, abs=1e-6)  # box top 0.30, table bottom 0.28
+    assert all(share >= 0.95 for _, _, share, _ in err.value.pairs)
+
+
+def test_a_sphere_fixture_around_the_whole_arm_is_a_placement_error(tmp_path):
+    with pytest.raises(PlacementError, match="arm_forearm_link – ball"):
+        load_cell(_scara_with(tmp_path, 'name = "ball"\nsphere = 3.0\nxyz = [0.0, 0.0, 0.3]'))
+
+
+def test_a_base_mounted_on_its_table_is_allowed_as_rigid_and_the_links_above_are_checked(tmp_path):
+    cell = load_cell(_scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.10]'))
+    reasons = {(p.body_a, p.body_b): p.reason for p in cell.allowed}
+    assert reasons[("arm_base_link", "table")] == PairReason.RIGID
+    assert not any(p.reason not in PairReason.__members__.values() for p in cell.allowed)
+
+
+def test_a_declared_contact_is_allowed_by_name_and_an_unknown_link_is_refused(tmp_path):
+    declared = ('\n[[disable_collisions]]\nlink1 = "arm_upper_arm_link"\nlink2 = "table"\n'
+                'reason = "the slab is cut out for the arm"\n')
+    table = 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.30]'
+    with pytest.raises(PlacementError) as err:  # the other links are still through the table
+        load_cell(_scara_with(tmp_path, table, declared))
+    assert "arm_upper_arm_link – table" not in str(err.value) and "arm_forearm_link – table" in str(err.value)
+    cell_text = post_cell_text().replace(
+        "</robot>", '<disable_collisions link1="post" link2="arm_forearm" reason="by design"/></robot>')
+    cell = make_cell(cell_text, "declared")
+    declared_pairs = [p for p in cell.allowed if p.reason == PairReason.DECLARED]
+    assert {(p.body_a, p.body_b) for p in declared_pairs} == {("arm_forearm", "post")}
+    assert all(p.note == "by design" and p.distance_bound == np.inf for p in declared_pairs)
+    with pytest.raises(CellError, match="disable_collisions.*'nowhere'"):
+        make_cell(post_cell_text().replace("</robot>", '<disable_collisions link1="post" link2="nowhere"/></robot>'),
+                  "unknown")
+
+
+def test_a_shape_turning_about_its_own_axis_is_coaxial_and_proven_not_sampled():
+    """A cylinder along the first joint's axis fills the same space at every angle: in contact with the table it
+    stands on by design; the box on the same link is not (a placement error)."""
+    def arm(shapes: str) -> str:
+        return ('<robot name="hub"><link name="world"/>'
+                '<link name="table"><collision><geometry><box size="1 1 0.1"/></geometry></collision></link>'
+                '<joint name="table_joint" type="fixed"><parent link="world"/><child link="table"/>'
+                '<origin xyz="0 0 -0.05"/></joint><link name="hub_base_link"/>'
+                '<joint name="hub_mount" type="fixed"><parent link="world"/><child link="hub_base_link"/></joint>'
+                f'<link name="hub_link1">{shapes}</link>'
+                '<joint name="hub_j1" type="revolute"><parent link="hub_base_link"/><child link="hub_link1"/>'
+                '<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint></robot>')
+
+    hub = '<collision><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.05" length="0.2"/></geometry></collision>'
+    cell = make_cell(arm(hub), "hub")
+    (pair,) = [p for p in cell.allowed if {p.body_a, p.body_b} == {"hub_link1", "table"}]
+    assert pair.reason == PairReason.COAXIAL
+    bar = '<collision><origin xyz="0.2 0 0"/><geometry><box size="0.3 0.05 0.05"/></geometry></collision>'
+    with pytest.raises(PlacementError, match="hub_link1 – table"):
+        make_cell(arm(hub + bar), "bar")
+
+
+def test_cell_show_lists_the_skipped_pairs_with_their_reason(tmp_path):
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    path = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.10]')
+    out = CliRunner().invoke(cli, ["cell", "show", str(path)])
+    assert out.exit_code == 0, out.output
+    assert "skipped (rigid): arm_base_link – table" in out.stdout
+    assert "skipped (adjacent): arm_base_link – arm_upper_arm_link" in out.stdout
+    bad = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.30]')
+    out = CliRunner().invoke(cli, ["cell", "check", str(bad), "--random", "200"])
+    assert out.exit_code == 1 and out.stderr.startswith("Error:") and out.stderr.count("\n") == 1, out.output
+    assert "arm_upper_arm_link – table" in out.stderr
