@@ -75,9 +75,9 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
 from ..errors import PlacementError
 from .coaxial import still_frames
+from .pair_samples import SAMPLES, sample_pairs
 from .reach import root_cylinders, tighter_bound
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -104,8 +104,8 @@ BY_DESIGN = tuple(r for r in PairReason if r is not PairReason.OUT_OF_REACH)
 
 #: Share of random configurations in contact at and above which a pair is a placement error.
 ALWAYS_SHARE = 0.95
-#: Random configurations sampled for that rule and for ``constant``.
-ALWAYS_SAMPLES = 200
+#: Random configurations sampled for that rule and for ``constant`` (:mod:`.pair_samples`).
+ALWAYS_SAMPLES = SAMPLES
 
 
 @dataclass(frozen=True)
@@ -355,29 +355,10 @@ def _by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[st
 
 def _sampled_reasons(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
                      seed: int) -> list[tuple[PairReason | None, float, float]]:
-    """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations: ``"constant"`` (apart by the same
-    distance, within 1e-9 m, in all of them) or ``None``, the share of them in contact, and the deepest
-    penetration found [m] (0 if none)."""
-    if not checked:
-        return []
-    model = cell.model
-    probe = pin.GeometryModel()
-    for g in objs:
-        probe.addGeometryObject(g)
-    for a, b in checked:
-        probe.addCollisionPair(pin.CollisionPair(a, b))
-    pd = cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
-    qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
-    hits = np.zeros(len(checked))
-    dmin = np.full(len(checked), np.inf)
-    dmax = np.full(len(checked), -np.inf)
-    for q in np.atleast_2d(qs):
-        pin.updateGeometryPlacements(model, data, probe, pd, q)
-        pin.computeCollisions(probe, pd, False)
-        pin.computeDistances(probe, pd)
-        hits += [r.isCollision() for r in pd.collisionResults]
-        d = np.array([r.min_distance for r in pd.distanceResults])
-        dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
+    """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations (:mod:`.pair_samples`, cached by
+    content): ``"constant"`` (apart by the same distance, within 1e-9 m, in all of them) or ``None``, the share
+    of them in contact, and the deepest penetration found [m] (0 if none)."""
+    hits, dmin, dmax = sample_pairs(cell, objs, data, checked, seed)
     out: list[tuple[PairReason | None, float, float]] = []
     for k, h in enumerate(hits):
         constant = dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9

@@ -258,3 +258,26 @@ def test_cell_show_lists_the_skipped_pairs_with_their_reason(tmp_path):
     out = CliRunner().invoke(cli, ["cell", "check", str(bad), "--random", "200"])
     assert out.exit_code == 1 and out.stderr.startswith("Error:") and out.stderr.count("\n") == 1, out.output
     assert "arm_upper_arm_link – table" in out.stderr
+
+
+def test_the_sampled_pair_reasons_are_cached_by_content_and_a_poisoned_file_is_sampled_again(tmp_path, monkeypatch):
+    """Issue 36 item 8: the 200-configuration sampling is kept in the user's cache folder; a planted file that
+    calls every pair constant (never checked) is refused by the check of its first configurations."""
+    from pinarms.robots.cell import pair_samples
+
+    monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path))
+    clean = make_cell(post_cell_text(), "post")
+    (path,) = (tmp_path / "pair_samples").glob("*.npz")
+    again = make_cell(post_cell_text(), "post")
+    assert again.pairs == clean.pairs and again.allowed == clean.allowed
+    calls, measure = [], pair_samples._measure
+    monkeypatch.setattr(pair_samples, "_measure", lambda *a: calls.append(1) or measure(*a))
+    with np.load(path) as z:
+        stored = {k: np.array(z[k]) for k in z.files}
+    P = stored["hits"].size
+    poison = dict(stored, hits=np.zeros(P), dmin=np.full(P, 1.0), dmax=np.full(P, 1.0),
+                  first_d=np.full_like(stored["first_d"], 1.0), first_hit=np.zeros_like(stored["first_hit"]))
+    np.savez(path, **poison)
+    sampled = make_cell(post_cell_text(), "post")
+    assert calls == [1] and sampled.pairs == clean.pairs and sampled.allowed == clean.allowed
+    assert make_cell(post_cell_text(), "post").pairs == clean.pairs and calls == [1]  # the rewritten file is used
