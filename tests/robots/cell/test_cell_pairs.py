@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -249,11 +250,18 @@ def test_cell_show_lists_the_skipped_pairs_with_their_reason(tmp_path):
 
     from pinarms.cli import cli
 
-    path = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.10]')
+    declared = '[[disable_collisions]]\nlink1 = "arm_hand_link"\nlink2 = "table"\nreason = "a soft pad"\n'
+    path = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.10]', declared)
     out = CliRunner().invoke(cli, ["cell", "show", str(path)])
     assert out.exit_code == 0, out.output
     assert "skipped (rigid): arm_base_link – table" in out.stdout
     assert "skipped (adjacent): arm_base_link – arm_upper_arm_link" in out.stdout
+    assert "skipped (declared): arm_hand_link – table (a soft pad)" in out.stdout
+    data = json.loads(CliRunner().invoke(cli, ["cell", "show", str(path), "--json"]).stdout)
+    rows = {tuple(r["bodies"]): r for r in data["allowed"]}
+    assert rows[("arm_base_link", "table")]["reason"] == "rigid" and rows[("arm_base_link", "table")][
+        "distance_bound_m"] is None
+    assert rows[("arm_hand_link", "table")]["note"] == "a soft pad"
     bad = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.30]')
     out = CliRunner().invoke(cli, ["cell", "check", str(bad), "--random", "200"])
     assert out.exit_code == 1 and out.stderr.startswith("Error:") and out.stderr.count("\n") == 1, out.output
