@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import io
 import os
+import stat
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
@@ -62,8 +63,10 @@ def read_arrays(path: Path, names: Sequence[str]) -> dict[str, np.ndarray] | Non
     """The arrays ``names`` of the ``.npz`` file ``path`` (no pickles, at most :data:`MAX_FILE_BYTES`); ``None``
     when absent, unreadable, too large, not a regular file or missing a name."""
     try:
-        with open(path, "rb") as fh:
-            if not os.path.isfile(path) or os.fstat(fh.fileno()).st_size > MAX_FILE_BYTES:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO planted there never blocks
+        with os.fdopen(fd, "rb") as fh:
+            info = os.fstat(fh.fileno())
+            if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_FILE_BYTES:
                 return None
             data = fh.read(MAX_FILE_BYTES + 1)
         if len(data) > MAX_FILE_BYTES:
