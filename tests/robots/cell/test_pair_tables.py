@@ -212,3 +212,20 @@ def test_a_table_of_the_aubo_food_station_stays_below_coal():
                                 coal.Transform3s(Rg[i, b], pg[i, b]), req, coal.DistanceResult()) for i in range(N)])
     assert np.all(bound <= np.maximum(d, 0.0) + 1e-9)
     assert np.mean(bound > 0.0) > 0.5
+
+
+def test_the_cache_reader_skips_a_fifo_a_large_file_and_a_pickle(tmp_path, monkeypatch):
+    import os
+
+    from pinarms.robots.cell import disk_cache
+
+    fifo = tmp_path / "fifo.npz"
+    os.mkfifo(fifo)
+    assert disk_cache.read_arrays(fifo, ["low"]) is None  # returns at once: no writer is waited for
+    disk_cache.write_arrays(tmp_path / "sub" / "ok.npz", {"low": np.arange(3.0)})
+    assert (tmp_path / "sub").stat().st_mode & 0o777 == 0o700
+    np.testing.assert_array_equal(disk_cache.read_arrays(tmp_path / "sub" / "ok.npz", ["low"])["low"], np.arange(3.0))
+    np.savez(tmp_path / "pickled.npz", low=np.array([{"a": 1}], dtype=object))
+    assert disk_cache.read_arrays(tmp_path / "pickled.npz", ["low"]) is None
+    monkeypatch.setattr(disk_cache, "MAX_FILE_BYTES", 10)
+    assert disk_cache.read_arrays(tmp_path / "sub" / "ok.npz", ["low"]) is None
