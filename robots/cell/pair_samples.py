@@ -11,7 +11,8 @@ size, mesh vertices and triangles, placement, parent joint), the pairs sampled, 
 count, this module's and the joint sampler's source files, and the versions of coal,
 Pinocchio and numpy.
 
-A file is never trusted: besides its structure, :data:`VERIFY` of the same seeded
+Only a sampling that took at least :data:`MIN_SECONDS` is written (a cell of primitives samples
+in milliseconds; a layout search builds one cell per base placement). A file is never trusted: besides its structure, :data:`VERIFY` of the same seeded
 configurations (the first ones) are measured again and must give the stored distances
 (within 1e-9 m) and contacts, inside the stored extremes and counts; a file that fails is
 sampled again and overwritten.
@@ -20,6 +21,7 @@ sampled again and overwritten.
 from __future__ import annotations
 
 import hashlib
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,12 +37,14 @@ from .mesh_cover import mesh_arrays
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["SAMPLES", "VERIFY", "sample_pairs"]
+__all__ = ["SAMPLES", "VERIFY", "MIN_SECONDS", "sample_pairs"]
 
 #: Seeded random configurations measured per cell.
 SAMPLES = 200
 #: Of them, the first ones measured again to check a cached file.
 VERIFY = 8
+#: A sampling quicker than this [s] is not written to the disk (cells of primitives take milliseconds).
+MIN_SECONDS = 0.5
 _CODE = (Path(__file__), Path(_robot.__file__))
 _NAMES = ("hits", "dmin", "dmax", "first_d", "first_hit")
 
@@ -57,8 +61,10 @@ def sample_pairs(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[i
     got = read_arrays(path, _NAMES)
     if got is not None and _trusted(got, cell.model, data, probe, qs, len(checked)):
         return got["hits"], got["dmin"], got["dmax"]
+    t0 = time.perf_counter()
     got = _measure(cell.model, data, probe, qs, len(checked))
-    write_arrays(path, got)
+    if time.perf_counter() - t0 >= MIN_SECONDS:  # a quick sampling is not worth a file (a layout's many cells)
+        write_arrays(path, got)
     return got["hits"], got["dmin"], got["dmax"]
 
 

@@ -274,6 +274,9 @@ def test_the_sampled_pair_reasons_are_cached_by_content_and_a_poisoned_file_is_s
     from pinarms.robots.cell import pair_samples
 
     monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path))
+    make_cell(post_cell_text(), "post")
+    assert not (tmp_path / "pair_samples").exists()  # sampled in milliseconds: not worth a file
+    monkeypatch.setattr(pair_samples, "MIN_SECONDS", 0.0)
     clean = make_cell(post_cell_text(), "post")
     (path,) = (tmp_path / "pair_samples").glob("*.npz")
     again = make_cell(post_cell_text(), "post")
