@@ -160,10 +160,12 @@ def test_the_cache_lives_in_the_users_cache_folder_keyed_by_the_code_that_built_
     assert pt._key(cell, *found) != key
 
 
+@pytest.mark.slow
 def test_a_poisoned_cache_is_rebuilt_and_the_verdict_is_unchanged(ur5, near_contact, tmp_path, monkeypatch):
-    """Issue 35 item 5: every stored bound raised to 5 m (a stale or planted file under the right names) is
-    refused by the value check; the tables are built again, equal to the clean ones, and the cover proves
-    exactly the states it proved before."""
+    """Issue 35 item 5: every stored bound raised to 5 m (a stale or planted file under the right name) is
+    refused by the value check, for each of the UR5's tables; planted, it is built again, equal to the clean
+    one, and the cover proves exactly the states it proved before. (With the value check off, the same planted
+    tables let the cover prove 15 of 659 colliding states of this sample clear.)"""
     from dataclasses import replace
 
     cell, cover = ur5
@@ -174,14 +176,16 @@ def test_a_poisoned_cache_is_rebuilt_and_the_verdict_is_unchanged(ur5, near_cont
     found = [f for f in pt.table_paths(cell, own) if frozenset(f[:2]) in
              {frozenset((int(a), int(b))) for a, b in zip(cover.tables.pair_a, cover.tables.pair_b)}]
     assert len(found) == cover.tables.pair_a.size >= 3
-    clean = {}
+    clean = {pt._key(cell, *f): pt._MEMORY[pt._key(cell, *f)] for f in found}
     for f in found:
         key = pt._key(cell, *f)
-        clean[key] = pt._MEMORY[key]
         poison = dict(clean[key], low=np.full_like(clean[key]["low"], 5.0))
         assert not pt._trusted(cell, *f, poison) and pt._trusted(cell, *f, clean[key])
-        pt._save(key, poison)
-        assert pt._load(key) is not None  # structurally sound: only its values give it away
+    # the smallest table planted poisoned (rebuilt: one build, to keep the test short), the others clean
+    planted = min(clean, key=lambda k: clean[k]["child"].size)
+    for key, table in clean.items():
+        pt._save(key, dict(table, low=np.full_like(table["low"], 5.0)) if key == planted else table)
+    assert pt._load(planted) is not None  # structurally sound: only its values give it away
     monkeypatch.setattr(pt, "_MEMORY", {})
     tables = pt.pair_tables(cell, own, bare)
     np.testing.assert_array_equal(tables.low, cover.tables.low)
@@ -189,8 +193,7 @@ def test_a_poisoned_cache_is_rebuilt_and_the_verdict_is_unchanged(ur5, near_cont
     again = replace(cover, tables=tables)
     np.testing.assert_array_equal(again.screen(Q, again.prepare(*pair_arrays(ch.pairs)), ch.pair_margin),
                                   cover.screen(Q, pairs, ch.pair_margin))
-    for key in clean:  # the poisoned files were overwritten by the rebuilt tables
-        np.testing.assert_array_equal(pt._load(key)["low"], clean[key]["low"])
+    np.testing.assert_array_equal(pt._load(planted)["low"], clean[planted]["low"])  # overwritten by the rebuild
 
 
 @pytest.mark.slow
