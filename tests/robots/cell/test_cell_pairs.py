@@ -292,3 +292,17 @@ def test_the_sampled_pair_reasons_are_cached_by_content_and_a_poisoned_file_is_s
     sampled = make_cell(post_cell_text(), "post")
     assert calls == [1] and sampled.pairs == clean.pairs and sampled.allowed == clean.allowed
     assert make_cell(post_cell_text(), "post").pairs == clean.pairs and calls == [1]  # the rewritten file is used
+
+
+@pytest.mark.parametrize("entry, fragment", [
+    ('link1 = "table"\nlink2 = "table"', "two different link names"),
+    ('link1 = "table"\nlink2 = "arm_base_link"\nwhy = "typo"', "unknown key(s) why"),
+    ('link1 = "table"\nlink2 = 3', "two different link names"),
+    ('link1 = "table"\nlink2 = "arm_nowhere"', "'arm_nowhere'"),
+])
+def test_a_bad_declared_contact_in_a_description_is_a_cell_error(tmp_path, entry, fragment):
+    path = _scara_with(tmp_path, 'name = "table"\nbox = [1.6, 1.6, 0.04]\nxyz = [0.0, 0.0, 0.10]',
+                       f"[[disable_collisions]]\n{entry}\n")
+    with pytest.raises(CellError, match="disable_collisions") as err:
+        load_cell(path)
+    assert fragment in str(err.value)
