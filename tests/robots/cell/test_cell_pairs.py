@@ -306,3 +306,29 @@ def test_a_bad_declared_contact_in_a_description_is_a_cell_error(tmp_path, entry
     with pytest.raises(CellError, match="disable_collisions") as err:
         load_cell(path)
     assert fragment in str(err.value)
+
+
+def test_two_links_of_one_arm_overlapping_away_from_their_joint_are_a_placement_error():
+    """Self pairs: allowed only when joined by one joint; link 1's wide plate holds link 3 (two joints away) in every
+    configuration: not adjacent, so never dropped because a sample found it in contact."""
+    def link(name: str, shape: str, xyz: str = "0 0 0") -> str:
+        return f'<link name="{name}"><collision><origin xyz="{xyz}"/><geometry>{shape}</geometry></collision></link>'
+
+    def joint(name: str, parent: str, child: str, xyz: str) -> str:
+        return (f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+                f'<origin xyz="{xyz}"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/>'
+                "</joint>")
+
+    text = ('<robot name="plate"><link name="world"/><link name="p_base_link"/>'
+            '<joint name="p_mount" type="fixed"><parent link="world"/><child link="p_base_link"/></joint>'
+            + link("p_link1", '<box size="2 2 0.1"/>', "0 0 0.5") + joint("p_j1", "p_base_link", "p_link1", "0 0 0")
+            + link("p_link2", '<sphere radius="0.01"/>', "0 0 0.3") + joint("p_j2", "p_link1", "p_link2", "0.1 0 0")
+            + link("p_link3", '<box size="0.05 0.05 0.05"/>', "0 0 0.5") + joint("p_j3", "p_link2", "p_link3", "0.1 0 0")
+            + "</robot>")
+    with pytest.raises(PlacementError, match="p_link1 – p_link3 in 100% of 200") as err:
+        make_cell(text, "plate")
+    assert [(a, b) for a, b, _, _ in err.value.pairs] == [("p_link1", "p_link3")]
+    assert err.value.pairs[0][3] == pytest.approx(0.075, abs=1e-6)  # inside the 100 mm plate: 75 mm to push it out
+    allowed = make_cell(text.replace("</robot>", '<disable_collisions link1="p_link3" link2="p_link1"/></robot>'),
+                        "plate declared")
+    assert {(p.body_a, p.body_b): p.reason for p in allowed.allowed}[("p_link1", "p_link3")] == PairReason.DECLARED
