@@ -26,6 +26,7 @@ __all__ = [
     "CellNotFound",
     "XacroFileNotFound",
     "CellTooLarge",
+    "PlacementError",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -106,6 +107,26 @@ class CellError(ModelError):
 
 class CellTooLarge(CellError):
     """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
+
+
+class PlacementError(CellError):
+    """A fixture or an arm meets a moving link in (almost) every configuration: placed through it.
+
+    ``pairs`` holds ``(body_a, body_b, share, depth)`` per pair of links: the share of the
+    sampled configurations in contact and the deepest penetration found [m]. Move the fixture
+    or the arm, or declare the contact by name in the cell file (``<disable_collisions>``).
+    """
+
+    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
+        super().__init__(message)
+        self.pairs = tuple(pairs)
+
+    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
+        return (_rebuild_placement_error, (str(self), self.pairs))
+
+
+def _rebuild_placement_error(message, pairs):
+    return PlacementError(message, pairs=pairs)
 
 
 class CollisionGeometryError(ModelError):

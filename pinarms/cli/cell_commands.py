@@ -78,7 +78,9 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
     reasons = Counter(a.reason for a in c.allowed)
     data = {"cell": c.name, "source": c.source, "args": c.args, "nq": c.nq, "joint_names": list(c.joint_names),
             "arms": arms, "fixtures": fixtures, "pairs_checked": dict(kinds), "pairs_allowed": dict(reasons),
-            "allowed": [{"bodies": [a.body_a, a.body_b], "reason": a.reason} for a in c.allowed]}
+            "allowed": [{"bodies": [a.body_a, a.body_b], "geometries": [a.geometry_a, a.geometry_b],
+                         "reason": str(a.reason), "distance_bound_m": a.distance_bound, "note": a.note}
+                        for a in c.allowed]}
     args_text = "; args " + ", ".join(f"{a}={v}" for a, v in c.args.items()) if c.args else ""
     lines = [f"cell {c.name} ({c.source}){args_text}", f"{len(c.arms)} arm(s), {c.nq} joints in the cell vector:"]
     for a in c.arms:
@@ -90,6 +92,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
         lines.append(f"  {f.name}: {', '.join(_shape_text(s, k, lu) for s in f.shapes)}")
     lines.append("pairs checked: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items())))
     lines.append("pairs allowed: " + ", ".join(f"{n} {r}" for r, n in sorted(reasons.items())))
+    lines.extend(_skipped_lines(c.allowed, k, lu))
     if session_path or html_path:
         from pinarms import viz
 
@@ -102,6 +105,27 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
             data["html"] = html_path
             lines.append(f"page written: {html_path}")
     emit(as_json, data, lines)
+
+
+def _skipped_lines(allowed: Any, k: float, lu: str) -> list[str]:
+    """One line per reason: the pairs of links never checked for it (``out of reach``: with the smallest proven bound,
+    checked again at a clearance above it), each pair of links once."""
+    by_reason: dict[str, dict[tuple[str, str], float]] = {}
+    for a in allowed:
+        bodies = by_reason.setdefault(str(a.reason), {})
+        key = (a.body_a, a.body_b) if (a.body_b, a.body_a) not in bodies else (a.body_b, a.body_a)
+        bodies[key] = min(bodies.get(key, np.inf), a.distance_bound)
+    lines = []
+    for reason in sorted(by_reason):
+        pairs = by_reason[reason]
+        if reason == "out of reach":
+            text = ", ".join(f"{a} – {b} (>= {d * k:.4g} {lu})" for (a, b), d in sorted(pairs.items(), key=lambda x: x[1]))
+            lines.append(f"skipped while proven farther than the clearance (out of reach): {text}")
+        else:
+            notes = {(a.body_a, a.body_b): a.note for a in allowed if a.note}
+            text = ", ".join(f"{a} – {b}" + (f" ({notes[(a, b)]})" if notes.get((a, b)) else "") for a, b in pairs)
+            lines.append(f"skipped ({reason}): {text}")
+    return lines
 
 
 # --------------------------------------------------------------------------- check

@@ -45,7 +45,8 @@ SRDF_REASON = {
     "same link": "Adjacent",
     "adjacent": "Adjacent",
     "rigid": "Default",
-    "always": "Default",
+    "coaxial": "Default",
+    "declared": "User",
     "constant": "Default",
 }
 

@@ -23,9 +23,9 @@ from .compose import (
 from .library import build_cell, build_cells, cell_names, cell_source_path, cell_urdf_path, load_cell, stale_cells
 from .motion import check_motion
 from .motion_report import Contact, MotionCheck
-from .pairs import AllowedPair, CollisionPair
+from .pairs import AllowedPair, CollisionPair, PairReason
 from .timeline import ArmMotion
-from ..errors import CellTooLarge
+from ..errors import CellTooLarge, PlacementError
 
 __all__ = [
     "load_cell",
@@ -41,6 +41,7 @@ __all__ = [
     "Shape",
     "CollisionPair",
     "AllowedPair",
+    "PairReason",
     "Collisions",
     "Clearance",
     "ArmMotion",
@@ -55,4 +56,5 @@ __all__ = [
     "load_cell_description",
     "read_cell_description",
     "CellTooLarge",
+    "PlacementError",
 ]

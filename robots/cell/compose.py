@@ -255,12 +255,15 @@ def compose_cell_urdf(
     base_dir: str | os.PathLike = ".",
     packages: Mapping[str, str | os.PathLike] | None = None,
     strict: bool = False,
+    declared: Sequence[tuple[str, str, str]] = (),
 ) -> str:
     """The cell URDF of ``arms`` (each prefixed ``<name>_``, mounted at its pose) and primitive ``fixtures``.
 
     Arm files resolve against ``base_dir`` (or ``package://PKG/``) and must lie inside it or
     a package folder; ``strict`` (used for description files) also refuses absolute paths
-    and ``..``. Relative mesh paths are rewritten to resolve from ``base_dir``.
+    and ``..``. Relative mesh paths are rewritten to resolve from ``base_dir``. ``declared``:
+    ``(link1, link2, reason)`` pairs of the cell's links in contact by design, written as
+    ``<disable_collisions>`` elements (checked against the links when the cell is loaded).
 
     Raises:
         CellError: bad names or sizes, an arm file that is too large, malformed, not one
@@ -279,6 +282,8 @@ def compose_cell_urdf(
         robot.extend(_arm_elements(arm, path, base, pkgs))
     for fixture in fixtures:
         robot.extend(_fixture_elements(fixture))
+    for a, b, note in declared:
+        ET.SubElement(robot, "disable_collisions", {"link1": str(a), "link2": str(b), "reason": str(note)})
     ET.indent(robot, space="  ")
     return ET.tostring(robot, encoding="unicode") + "\n"
 
@@ -307,5 +312,5 @@ def load_cell_description(
     """
     desc = read_cell_description(path)
     text = compose_cell_urdf(desc.arms, desc.fixtures, name=desc.name, base_dir=desc.base_dir, packages=packages,
-                             strict=True)
+                             strict=True, declared=desc.declared)
     return Cell(text, source=str(path), base_dir=desc.base_dir, packages=packages, seed=seed)

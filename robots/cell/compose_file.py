@@ -25,6 +25,7 @@ __all__ = [
     "MAX_ARM_BYTES",
     "MAX_ARMS",
     "MAX_FIXTURES",
+    "MAX_DECLARED",
 ]
 
 #: Largest cell description read [bytes].
@@ -34,6 +35,8 @@ MAX_ARM_BYTES = 16 * 1024 * 1024
 #: Most arms and fixtures in one description.
 MAX_ARMS = 16
 MAX_FIXTURES = 1000
+#: Most ``[[disable_collisions]]`` entries in one description.
+MAX_DECLARED = 10_000
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
 _SHAPES = {"box": 3, "cylinder": 2, "sphere": 1}
@@ -83,6 +86,7 @@ class CellDescription:
     arms: tuple[ArmPlacement, ...]
     fixtures: tuple[FixturePrimitive, ...]
     base_dir: Path
+    declared: tuple[tuple[str, str, str], ...] = ()
 
 
 
@@ -171,7 +175,7 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
         raise CellError(f"cell description {str(path)!r} is not valid TOML: {exc}") from exc
     except RecursionError:
         raise CellError(f"cell description {str(path)!r} nests arrays or tables too deeply") from None
-    _keys(doc, {"name", "arm", "fixture"}, {"arm"}, f"cell description {str(path)!r}")
+    _keys(doc, {"name", "arm", "fixture", "disable_collisions"}, {"arm"}, f"cell description {str(path)!r}")
     default = re.sub(r"\W", "_", path.name.split(".")[0])
     name = _name(doc.get("name", default if _NAME.match(default) else "cell"), str(path))
     arm_tables, fixture_tables = doc["arm"], doc.get("fixture", [])
@@ -190,6 +194,23 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
                                  _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
                                  _triple(table.get("rpy", [0, 0, 0]), "rpy", where)))
     fixtures = [_fixture_of(t, f"{path} fixture #{k + 1}") for k, t in enumerate(fixture_tables)]
-    return CellDescription(name, tuple(arms), tuple(fixtures), path.resolve().parent)
+    declared = _declared_of(doc.get("disable_collisions", []), path)
+    return CellDescription(name, tuple(arms), tuple(fixtures), path.resolve().parent, declared)
+
+
+def _declared_of(tables: Any, path: Path) -> tuple[tuple[str, str, str], ...]:
+    """The ``[[disable_collisions]]`` tables (``link1``, ``link2`` the cell's link names, ``reason`` optional)."""
+    if not isinstance(tables, list) or len(tables) > MAX_DECLARED:
+        raise CellError(f"{path}: write declared contacts as [[disable_collisions]] tables (at most {MAX_DECLARED})")
+    out = []
+    for k, table in enumerate(tables):
+        where = f"{path} disable_collisions #{k + 1}"
+        _keys(table, {"link1", "link2", "reason"}, {"link1", "link2"}, where)
+        a, b, note = table["link1"], table["link2"], table.get("reason", "")
+        if not all(isinstance(v, str) for v in (a, b, note)) or not a or not b or a == b:
+            raise CellError(f"{where}: link1 and link2 must be two different link names of the cell (strings), "
+                            f"reason a string; got {a!r}, {b!r}, {note!r}")
+        out.append((a, b, note))
+    return tuple(out)
 
 

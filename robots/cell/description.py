@@ -13,6 +13,9 @@ Rules (docs/cells.md, "How a cell file is read"):
   geometry (``world``, mounting frames) are plain frames.
 - Link and joint names must be unique; joints may be fixed, revolute, continuous or
   prismatic (``<mimic>`` allowed).
+- ``<disable_collisions link1="A" link2="B" reason="..."/>`` (the SRDF element, at the top
+  level of the cell URDF) declares two links in contact by design: their pairs are never
+  checked (:mod:`.pairs`, reason ``declared``). Pinocchio ignores the element.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ class CellSpec:
     arms: tuple[ArmSpec, ...]
     fixtures: tuple[str, ...]
     frames: tuple[str, ...]
+    declared: tuple[tuple[str, str, str], ...] = ()
 
 
 def _unique(root: ET.Element, tag: str, source: str) -> dict[str, ET.Element]:
@@ -115,7 +119,28 @@ def describe(root: ET.Element, source: str) -> CellSpec:
     moving_outside = [link for link in links if link not in taken and link not in static_set]
     if moving_outside:  # pragma: no cover - every movable subtree hangs from a static base
         raise CellError(f"{source}: links {moving_outside} move but belong to no arm")
-    return CellSpec(name=root.get("name", "cell"), root_link=root_link, arms=arms, fixtures=fixtures, frames=frames)
+    return CellSpec(name=root.get("name", "cell"), root_link=root_link, arms=arms, fixtures=fixtures, frames=frames,
+                    declared=_declared(root, links, source))
+
+
+def _declared(root: ET.Element, links: dict[str, ET.Element], source: str) -> tuple[tuple[str, str, str], ...]:
+    """The ``<disable_collisions link1 link2 reason>`` elements: ``(link1, link2, reason)`` each.
+
+    Raises:
+        CellError: an element without two distinct link names, or naming a link the file does not define.
+    """
+    out = []
+    for el in root.findall("disable_collisions"):
+        a, b, note = el.get("link1"), el.get("link2"), el.get("reason", "")
+        if not a or not b or a == b:
+            raise CellError(f"{source}: a <disable_collisions> needs two different links, link1=\"...\" and "
+                            f"link2=\"...\"; got link1={a!r}, link2={b!r}")
+        for name in (a, b):
+            if name not in links:
+                raise CellError(f"{source}: <disable_collisions> names link {name!r}, which the cell does not define; "
+                                "name two links of the cell (arm links with their prefix)")
+        out.append((a, b, note))
+    return tuple(out)
 
 
 def _tree(links: dict[str, ET.Element], joints: dict[str, ET.Element],

@@ -38,7 +38,7 @@ MAX_FIXTURES = 500
 #: Most collision geometries (``<collision>`` elements) in one cell (so at most 179 700 pairs to classify).
 MAX_GEOMETRIES = 600
 #: Most pairs of collision geometries left to check after the proven rules (each is sampled
-#: 200 times by the "always" rule at load, and checked by every query).
+#: 200 times by the sampled rules at load, and checked by every query).
 MAX_GEOMETRY_PAIRS = 5000
 
 

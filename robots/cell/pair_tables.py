@@ -53,10 +53,16 @@ at their samples.
 proves whole goes from 21 % to 77 % on ``ur5_table_box`` and from 19 % to 81 % on
 ``ur5_shelf`` (MotionChecker margin 10 mm, self margin 0; none called clear that coal finds
 closer). Four tables per UR5, 84 000 nodes (2 MB); built cold in 4 s, from the disk cache in
-0.03 s. Tables are kept per content in memory and on disk (``__pycache__/pair_tables/
-<sha256>.npz`` beside this file, written atomically, read with ``allow_pickle=False`` and
-checked: names, types, shapes, the tree's links; a bad or unwritable file only costs the
-build). The content is taken relative to the chain's root joint and the axes as positions on
+0.03 s. Tables are kept per content in memory and on disk, in the user's cache folder
+(:mod:`.disk_cache`: ``$PINARMS_CACHE_DIR``, ``$XDG_CACHE_HOME/pinarms`` or ``~/.cache/pinarms``,
+then ``pair_tables/<sha256>.npz``), never in the package folder. The name digests the content
+**and** the source files that build a table (this module, :mod:`._table_build`,
+:mod:`.mesh_cover`) and coal's version: a table built by other code is never found. A file is
+read with ``allow_pickle=False`` and checked before use: names, types, shapes, the tree's links,
+then its **values** — at :data:`CHECK_STATES` seeded random configurations of the cell its bound
+must not exceed coal's exact distance of the pair (+ :data:`CHECK_TOL`). A file that fails (a
+stale, damaged or planted table) is built again and overwritten, never used; a bad or
+unwritable file only costs the build (4 s for the UR5's four). The content is taken relative to the chain's root joint and the axes as positions on
 the pair's path, so a table serves every placement of the arm and every arm of the same model
 (the UR5 on the shelf's pedestal reuses the table scene's). Angles in rad, lengths in m.
 """
@@ -64,7 +70,6 @@ the pair's path, so a table serves every placement of the arm and every arm of t
 from __future__ import annotations
 
 import hashlib
-import io
 import math
 import time
 from collections.abc import Sequence
@@ -92,6 +97,8 @@ from ._table_build import (
     _turning,
     axis_arrays,
 )
+from . import _table_build, mesh_cover
+from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
 from .mesh_cover import mesh_arrays
 
 __all__ = [
@@ -118,10 +125,15 @@ __all__ = [
 NEED_STATES = 256
 NEED_SHARE = 0.01
 NEED_THRESHOLDS = (0.0, 0.01)
-_VERSION = 2
+#: A table read from the disk is used only if, at this many seeded random configurations of the cell, its bound
+#: is at most coal's exact distance of the pair plus :data:`CHECK_TOL` [m].
+CHECK_STATES = 48
+CHECK_TOL = 1e-7
+_VERSION = 3
 _MEMORY: dict = {}
 _LOOSE: dict = {}
-_DISK = Path(__file__).resolve().parent / "__pycache__" / "pair_tables"
+#: The source files whose code builds a table: their digest is part of every table's name on disk.
+_CODE = (Path(__file__), Path(_table_build.__file__), Path(mesh_cover.__file__))
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,19 +175,24 @@ class PairTables:
 
     def bound(self, t: int, angles: np.ndarray) -> np.ndarray:
         """``(N,)`` table ``t``'s bound [m] at joint angles ``angles (N, 2)`` [rad] (numpy; its unused axis ignored)."""
-        A = np.atleast_2d(np.asarray(angles, dtype=float))
-        out = np.empty(A.shape[0])
-        for i, v in enumerate(A):
-            v = np.mod(v + math.pi, 2.0 * math.pi) - math.pi
-            lo, w, n = np.full(2, -math.pi), np.full(2, 2.0 * math.pi), int(self.root[t])
-            while self.child[n] >= 0:
-                s = int(self.split[n])
-                w[s] *= 0.5
-                up = v[s] >= lo[s] + w[s]
-                lo[s] += w[s] if up else 0.0
-                n = int(self.child[n]) + int(up)
-            out[i] = self.low[n]
-        return out
+        return _lookup(self.child, self.split, self.low, int(self.root[t]), angles)
+
+
+def _lookup(child: np.ndarray, split: np.ndarray, low: np.ndarray, root: int, angles: np.ndarray) -> np.ndarray:
+    """``(N,)`` the bound [m] of the tree from node ``root`` at joint angles ``angles (N, 2)`` [rad]."""
+    A = np.atleast_2d(np.asarray(angles, dtype=float))
+    out = np.empty(A.shape[0])
+    for i, v in enumerate(A):
+        v = np.mod(v + math.pi, 2.0 * math.pi) - math.pi
+        lo, w, n = np.full(2, -math.pi), np.full(2, 2.0 * math.pi), root
+        while child[n] >= 0:
+            s = int(split[n])
+            w[s] *= 0.5
+            up = v[s] >= lo[s] + w[s]
+            lo[s] += w[s] if up else 0.0
+            n = int(child[n]) + int(up)
+        out[i] = low[n]
+    return out
 
 
 def no_tables() -> PairTables:
@@ -216,12 +233,14 @@ def table_paths(cell: Any, pairs: Sequence[tuple[int, int]]) -> list[tuple[int, 
 
 def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
     """A digest of what a table depends on: both geometries (vertices, triangles or shape and size, placements),
-    the path joints' placements and axes, and the build's constants."""
+    the path joints' placements and axes, the build's constants, its code (:data:`_CODE`) and coal's version."""
+    import coal
+
     bp = cell._placements
     objs = cell.collision_model.geometryObjects
     h = hashlib.sha256(repr((_VERSION, TOL, REL, CAP, CONTACT_TOL, TURNING, TURN_SAMPLES, TURN_NEAR, SLACK, MAX_NODES,
-                             EXACT_LOSS, PART_LENGTH, MAX_PARTS, len(side_a),
-                             len(side_b))).encode())
+                             EXACT_LOSS, PART_LENGTH, MAX_PARTS, len(side_a), len(side_b), code_digest(_CODE),
+                             getattr(coal, "__version__", ""))).encode())
     path = side_a + side_b
     root = next((j for j in path if int(bp.parent[j]) == 0), None)
     if root is not None:  # a chain from the world: all relative to the root joint's placement (a moved base)
@@ -247,13 +266,16 @@ _FIELDS = {"axis": (np.int64, (2,)), "child": (np.int64, None), "split": (np.int
            "low": (np.float64, None)}
 
 
+def _path(key: str) -> Path:
+    """The disk cache file of the table ``key`` (:mod:`.disk_cache`)."""
+    return cache_folder("pair_tables") / f"{key}.npz"
+
+
 def _load(key: str) -> dict | None:
-    """A table from the disk cache, checked (names, types, shapes, the tree's links); None if absent or bad."""
-    path = _DISK / f"{key}.npz"
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            got = {k: np.array(z[k]) for k in _FIELDS}
-    except (OSError, KeyError, ValueError):
+    """A table from the disk cache, its structure checked (names, types, shapes, the tree's links); None if absent
+    or bad. Its values are checked by :func:`_trusted`."""
+    got = read_arrays(_path(key), list(_FIELDS))
+    if got is None:
         return None
     n = got["child"].size
     for k, (dtype, shape) in _FIELDS.items():
@@ -269,23 +291,42 @@ def _load(key: str) -> dict | None:
     return got
 
 
-def _save(key: str, table: dict) -> None:
-    from pinarms.files import atomic_write
+def _trusted(cell: Any, a: int, b: int, side_a: list, side_b: list, table: dict) -> bool:
+    """Whether ``table``'s bound stays at most coal's exact distance of the pair ``(a, b)`` (+ :data:`CHECK_TOL`)
+    at :data:`CHECK_STATES` seeded random configurations of ``cell`` (NaN bounds fail)."""
+    import coal
 
-    try:
-        _DISK.mkdir(parents=True, exist_ok=True)
-        buf = io.BytesIO()
-        np.savez(buf, **table)
-        atomic_write(_DISK / f"{key}.npz", lambda f: f.write(buf.getvalue()))
-    except OSError:
-        pass
+    bp = cell._placements
+    path = side_a + side_b
+    Q = cell.random_q(CHECK_STATES, seed=1)
+    angles = np.zeros((CHECK_STATES, 2))
+    for i, k in enumerate(table["axis"]):
+        if k >= 0:
+            j = path[int(k)]
+            angles[:, i] = bp.scale[j] * Q[:, bp.index[j]] + bp.offset[j]
+    low = _lookup(table["child"], table["split"], table["low"], 0, angles)
+    Rg, pg = cell.geometry_placements(Q)
+    objs = cell.collision_model.geometryObjects
+    req = coal.DistanceRequest()
+    d = np.array([coal.distance(objs[a].geometry, coal.Transform3s(Rg[i, a], pg[i, a]), objs[b].geometry,
+                                coal.Transform3s(Rg[i, b], pg[i, b]), req, coal.DistanceResult())
+                  for i in range(CHECK_STATES)])
+    return bool(np.all(low <= np.maximum(d, 0.0) + CHECK_TOL))
+
+
+def _save(key: str, table: dict) -> None:
+    write_arrays(_path(key), table)
 
 
 def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict, float]:
+    """The table of the pair: from memory, else from the disk cache if its values hold (:func:`_trusted`), else
+    built (and saved)."""
     key = _key(cell, a, b, side_a, side_b)
     got = _MEMORY.get(key)
     if got is None:
         got = _load(key)
+        if got is not None and not _trusted(cell, a, b, side_a, side_b, got):
+            got = None  # stale, damaged or planted: built again, never used
     seconds = 0.0
     if got is None:
         t0 = time.perf_counter()

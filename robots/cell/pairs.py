@@ -26,23 +26,48 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     Such a pair is dropped only from checks whose clearance or margin is below that bound:
     :meth:`Cell.pairs_for` brings it back for any larger one, and :meth:`Cell.clearance`
     computes it whenever its bound is below the smallest distance found;
-``always``
-    in contact in at least 95 % of 200 seeded random configurations of the cell (parts of
-    one assembly that overlap whatever the joints do);
+``declared``
+    named in the cell file (``<disable_collisions link1= link2= reason=/>``, or a
+    description's ``[[disable_collisions]]``): the user's statement that the two links touch
+    by design; :attr:`AllowedPair.note` keeps the reason given;
+``coaxial``
+    in contact in (almost) every sampled configuration, and proven to be: one of the two turns
+    only about its own axis of symmetry relative to the other (a sphere centred on every joint
+    axis between them, a cylinder, capsule or cone along it, :mod:`.coaxial`), so it fills the
+    same space at every angle and their distance never changes (the Panda's link-1 capsule
+    standing on its table, the SCARA's shoulder hub);
 ``constant``
-    apart by the same distance (within 1e-9 m) in all those configurations: primitives
-    coaxial with every joint between them (a base and the shoulder housing turning about
-    it), whose gap is a design constant, not something a motion can close.
+    apart by the same distance (within 1e-9 m) in all :data:`ALWAYS_SAMPLES` seeded random
+    configurations: shapes coaxial with every joint between them that :mod:`.coaxial` cannot
+    prove (meshes), whose gap is a design constant, not something a motion can close.
+
+**Proven or assumed.** ``same link``, ``rigid``, ``coaxial`` and ``out of reach`` are proven
+from the structure and the shapes. ``adjacent`` is the usual assumption of SRDF files (two
+links joined by a joint are designed to touch at it), taken only from the structure, never
+from a sample; for a pair in contact in (almost) every sample, a shape turning about its own
+axis counts as part of the link it is fixed to (:mod:`.coaxial`: the Panda's link-3 sphere at
+joint 2 is adjacent to link 1). ``declared`` is the user's word. ``constant`` is sampled (never
+in contact, one distance in 200 draws). The sample only selects the pairs that must be
+explained (in contact in at least :data:`ALWAYS_SHARE` of them); it never allows one alone.
+
+**No pair is dropped because a sample found it in contact.** A pair the rules above leave
+(``coaxial`` and ``adjacent`` through a turning shape included) and that is in contact in at least :data:`ALWAYS_SHARE` of the :data:`ALWAYS_SAMPLES` seeded
+configurations (a table slab through a SCARA's links, a fixture around the arm, two arms
+through each other, two links of one arm whose shapes overlap) is a
+:class:`~pinarms.errors.PlacementError` naming each pair of links, the share and the deepest
+penetration: move the fixture or the arm, or declare the pair if the contact is by design.
+A pair in contact less often is checked like any other (a check reports its contacts).
 
 Unlike the sampled "never in collision" of setup assistants, a pair is only dropped as
 "never" when it is proven (``out of reach``): a sample can miss a rare contact, a bound cannot.
 Every other pair is a :class:`CollisionPair` and is checked. Pairs allowed by design
-(``same link``, ``rigid``, ``adjacent``, ``always``, ``constant``) are never checked at any
-clearance: their distance does not depend on a motion, or they touch by construction.
+(:data:`BY_DESIGN`: every reason but ``out of reach``) are never checked at any clearance:
+their distance does not depend on a motion, or they touch by construction.
 """
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -50,22 +75,37 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
+from ..errors import PlacementError
+from .coaxial import still_frames
+from .pair_samples import SAMPLES, sample_pairs
 from .reach import root_cylinders, tighter_bound
 
 if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
-__all__ = ["CollisionPair", "AllowedPair", "classify_pairs", "reach_pairs", "ALWAYS_SHARE", "ALWAYS_SAMPLES",
-           "BY_DESIGN"]
+__all__ = ["CollisionPair", "AllowedPair", "PairReason", "classify_pairs", "reach_pairs", "ALWAYS_SHARE",
+           "ALWAYS_SAMPLES", "BY_DESIGN"]
+
+
+class PairReason(enum.StrEnum):
+    """Why a pair is not checked (module doc); equal to its text (``PairReason.RIGID == "rigid"``)."""
+
+    SAME_LINK = "same link"
+    RIGID = "rigid"
+    COAXIAL = "coaxial"
+    ADJACENT = "adjacent"
+    DECLARED = "declared"
+    OUT_OF_REACH = "out of reach"
+    CONSTANT = "constant"
+
 
 #: Reasons of the pairs allowed by design: never checked, at any clearance.
-BY_DESIGN = ("same link", "rigid", "adjacent", "always", "constant")
+BY_DESIGN = tuple(r for r in PairReason if r is not PairReason.OUT_OF_REACH)
 
-#: Share of random configurations in contact above which a pair is "always" touching.
+#: Share of random configurations in contact at and above which a pair is a placement error.
 ALWAYS_SHARE = 0.95
-#: Random configurations sampled for the "always" rule.
-ALWAYS_SAMPLES = 200
+#: Random configurations sampled for that rule and for ``constant`` (:mod:`.pair_samples`).
+ALWAYS_SAMPLES = SAMPLES
 
 
 @dataclass(frozen=True)
@@ -104,6 +144,7 @@ class AllowedPair:
     """A pair of geometries the cell does not check at clearance 0, and why (see the module doc).
 
     Attributes:
+        reason: a :class:`PairReason`.
         distance_bound: for ``"out of reach"``: a proven lower bound (> 0) of the pair's
             distance in every configuration [m]; checks at a clearance or margin at least
             this large include the pair (:meth:`Cell.pairs_for`). ``inf`` for the pairs
@@ -111,16 +152,18 @@ class AllowedPair:
             ``[p for p in cell.allowed if p.distance_bound <= c]`` is exactly the allowed
             pairs a check at ``c`` must bring back.
         index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
+        note: for ``"declared"``: the reason the cell file gives (may be empty).
     """
 
     geometry_a: str
     geometry_b: str
     body_a: str
     body_b: str
-    reason: str
+    reason: PairReason
     distance_bound: float = float("inf")
     index_a: int = -1
     index_b: int = -1
+    note: str = ""
 
 
 def _effective(model: pin.Model, j: int) -> int:
@@ -146,9 +189,12 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
 def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
     """Split every pair of the cell's collision geometries into checked and allowed pairs.
 
-    The rules by design and the proof of reach first (:func:`_by_design`, :func:`_reach_gaps`),
-    then the seeded sampling of the pairs left (:func:`_sampled_reasons`); the checked pairs
-    come back arm-fixture first, then arm-arm, then self.
+    The rules by design, the declared pairs and the proof of reach first (:func:`_by_design`,
+    :func:`_reach_gaps`), then the seeded sampling of the pairs left (:func:`_sampled_reasons`);
+    the checked pairs come back arm-fixture first, then arm-arm, then self.
+
+    Raises:
+        PlacementError: pairs left in contact in at least :data:`ALWAYS_SHARE` of the samples.
     """
     model, gm = cell.model, cell.collision_model
     objs = list(gm.geometryObjects)
@@ -156,11 +202,13 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     link, owner, is_arm = _owners(cell)
     joint = [int(g.parentJoint) for g in objs]
     eff = [_effective(model, j) for j in joint]
+    declared = _declared(cell)
 
     # reach balls of moving geometries, boxes of static ones (world frame, neutral configuration)
     data = model.createData()
     gd = pin.GeometryData(gm)
     pin.updateGeometryPlacements(model, data, gm, gd, pin.neutral(model))
+    still = [tuple(_effective(model, j) for j in frames) for frames in still_frames(model, data, objs)]
     spheres = [_local_sphere(g.geometry) for g in objs]
     box_R, box_c, box_half = _neutral_boxes(gd, spheres)
     ball_center, ball_radius = _reach_balls(model, data, objs, joint, spheres)
@@ -172,34 +220,71 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     checked: list[tuple[int, int]] = []
     allowed: list[AllowedPair] = []
 
-    def allow(a: int, b: int, reason: str, bound: float = float("inf")) -> None:
-        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b))
+    def allow(a: int, b: int, reason: PairReason, bound: float = float("inf"), note: str = "") -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, float(bound), a, b, note))
 
+    plain = [(e,) for e in eff]
     for a in range(G):
         for b in range(a + 1, G):
-            reason = _by_design(model, a, b, link, owner, eff)
+            reason = _by_design(model, a, b, link, owner, eff, plain)
+            note = declared.get(frozenset((link[a], link[b]))) if reason is None else None
             if reason is not None:
                 allow(a, b, reason)
-            elif gaps[a, b] > 0.0:
-                allow(a, b, "out of reach", tighter_bound(gaps[a, b], a, b, objs, joint, ball_center, ball_radius,
-                                                          placement, cylinders))
+            elif note is not None:
+                allow(a, b, PairReason.DECLARED, note=note)
+            elif gaps[a, b] > 0.0:  # proven apart: kept as such (it comes back at a larger clearance)
+                allow(a, b, PairReason.OUT_OF_REACH, tighter_bound(gaps[a, b], a, b, objs, joint, ball_center,
+                                                                   ball_radius, placement, cylinders))
             else:
                 checked.append((a, b))
 
     from .limits import check_pairs
 
     check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
-    keep = []
-    for (a, b), reason in zip(checked, _sampled_reasons(cell, objs, data, checked, seed)):
-        if reason is None:
+    keep, through = [], []
+    for (a, b), (reason, share, depth) in zip(checked, _sampled_reasons(cell, objs, data, checked, seed)):
+        if share >= ALWAYS_SHARE:  # in contact whatever the joints do: explained by the shapes, or an error
+            reason = _by_design(model, a, b, link, owner, eff, still)
+            if reason is None:
+                through.append((a, b, share, depth))
+            else:
+                allow(a, b, reason)
+        elif reason is None:
             keep.append((a, b))
         else:
             allow(a, b, reason)
+    if through:
+        raise _placement_error(cell, objs, link, owner, is_arm, through)
 
     pairs = [_pair(a, b, objs, link, owner, is_arm) for a, b in keep]
     order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
     pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
     return tuple(pairs), tuple(allowed)
+
+
+def _declared(cell: "Cell") -> dict[frozenset, str]:
+    """The pairs of links the cell file declares in contact by design (names checked by :func:`.description.describe`),
+    with the reason given."""
+    return {frozenset((a, b)): note for a, b, note in cell.spec.declared}
+
+
+def _placement_error(cell: "Cell", objs: list, link: list[str], owner: list[str], is_arm: list[bool],
+                     through: list[tuple[int, int, float, float]]) -> PlacementError:
+    """The :class:`PlacementError` of the geometry pairs ``through`` ``(a, b, share, depth)``, by pair of links."""
+    worst: dict[tuple[str, str], tuple[float, float]] = {}
+    for a, b, share, depth in through:
+        p = _pair(a, b, objs, link, owner, is_arm)
+        s0, d0 = worst.get(p.bodies, (0.0, 0.0))
+        worst[p.bodies] = (max(s0, share), max(d0, depth))
+    rows = tuple((a, b, s, d) for (a, b), (s, d) in sorted(worst.items(), key=lambda kv: -kv[1][1]))
+    shown = "; ".join(f"{a} – {b} in {s:.0%} of {ALWAYS_SAMPLES} configurations, up to {d * 1e3:.1f} mm deep"
+                      for a, b, s, d in rows[:8])
+    more = f"; and {len(rows) - 8} more pair(s)" if len(rows) > 8 else ""
+    return PlacementError(
+        f"{cell.source}: placed through a moving link, in collision in (almost) every configuration: {shown}{more}. "
+        "Move the fixture (or the arm's base) clear of the arm, or, if the contact is by design, declare the pair "
+        'in the cell file: <disable_collisions link1="A" link2="B" reason="..."/> (a description: '
+        "[[disable_collisions]] with link1, link2, reason)", pairs=rows)
 
 
 def _neutral_boxes(gd: pin.GeometryData, spheres: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -247,56 +332,38 @@ def _reach_balls(model: pin.Model, data: pin.Data, objs: list, joint: list[int],
     return ball_center, ball_radius
 
 
-def _by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[str], eff: list[int]) -> str | None:
-    """``"same link"``, ``"rigid"`` or ``"adjacent"`` when the structure allows the pair ``(a, b)``, else ``None``."""
+def _by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[str], eff: list[int],
+               still: list[tuple[int, ...]]) -> PairReason | None:
+    """The :class:`PairReason` when the structure allows the pair ``(a, b)`` (same link, rigid, coaxial, adjacent),
+    else ``None``. ``still``: per geometry, the joints in whose frames it is fixed (its own joint alone, or with
+    those of :mod:`.coaxial`); two geometries fixed in one frame are ``coaxial``, joined by one joint ``adjacent``."""
     if link[a] == link[b]:
-        return "same link"
-    ea, eb = eff[a], eff[b]
-    if ea == eb:
-        return "rigid"
-    adjacent = (ea > 0 and eb > 0 and (_effective(model, model.parents[ea]) == eb or _effective(model, model.parents[eb]) == ea))
-    if (ea == 0 or eb == 0) and owner[a] == owner[b]:
-        moving = b if ea == 0 else a
-        adjacent = _effective(model, model.parents[eff[moving]]) == 0
-    return "adjacent" if adjacent else None
+        return PairReason.SAME_LINK
+    if eff[a] == eff[b]:
+        return PairReason.RIGID
+    if set(still[a]) & set(still[b]):
+        return PairReason.COAXIAL
+    for ea in still[a]:
+        for eb in still[b]:
+            if (ea == 0 or eb == 0) and owner[a] != owner[b]:
+                continue  # a fixture or another arm's base is never adjacent to an arm's link
+            if (ea > 0 and _effective(model, model.parents[ea]) == eb) or (eb > 0 and
+                                                                            _effective(model, model.parents[eb]) == ea):
+                return PairReason.ADJACENT
+    return None
 
 
 def _sampled_reasons(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
-                     seed: int) -> list[str | None]:
-    """For each pair, ``"always"`` or ``"constant"`` from :data:`ALWAYS_SAMPLES` seeded random configurations, else ``None``.
-
-    ``"always"``: in contact in at least :data:`ALWAYS_SHARE` of them; ``"constant"``: apart
-    by the same distance (within 1e-9 m) in all of them.
-    """
-    if not checked:
-        return []
-    model = cell.model
-    probe = pin.GeometryModel()
-    for g in objs:
-        probe.addGeometryObject(g)
-    for a, b in checked:
-        probe.addCollisionPair(pin.CollisionPair(a, b))
-    pd = cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
-    qs = cell.robot.q_to_pinocchio(cell.random_q(ALWAYS_SAMPLES, seed=seed))
-    hits = np.zeros(len(checked))
-    dmin = np.full(len(checked), np.inf)
-    dmax = np.full(len(checked), -np.inf)
-    for q in np.atleast_2d(qs):
-        pin.updateGeometryPlacements(model, data, probe, pd, q)
-        pin.computeCollisions(probe, pd, False)
-        pin.computeDistances(probe, pd)
-        hits += [r.isCollision() for r in pd.collisionResults]
-        d = np.array([r.min_distance for r in pd.distanceResults])
-        dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
-    reasons: list[str | None] = []
+                     seed: int) -> list[tuple[PairReason | None, float, float]]:
+    """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations (:mod:`.pair_samples`, cached by
+    content): ``"constant"`` (apart by the same distance, within 1e-9 m, in all of them) or ``None``, the share
+    of them in contact, and the deepest penetration found [m] (0 if none)."""
+    hits, dmin, dmax = sample_pairs(cell, objs, data, checked, seed)
+    out: list[tuple[PairReason | None, float, float]] = []
     for k, h in enumerate(hits):
-        if h / ALWAYS_SAMPLES >= ALWAYS_SHARE:
-            reasons.append("always")
-        elif dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9:
-            reasons.append("constant")
-        else:
-            reasons.append(None)
-    return reasons
+        constant = dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9
+        out.append((PairReason.CONSTANT if constant else None, float(h) / ALWAYS_SAMPLES, max(0.0, -float(dmin[k]))))
+    return out
 
 
 def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
@@ -327,7 +394,7 @@ def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[C
     """The ``"out of reach"`` pairs as :class:`CollisionPair` s, in increasing order of their bound, and the bounds [m]."""
     objs = list(cell.collision_model.geometryObjects)
     link, owner, is_arm = _owners(cell)
-    reach = sorted((p for p in allowed if p.reason == "out of reach"), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
+    reach = sorted((p for p in allowed if p.reason == PairReason.OUT_OF_REACH), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
     pairs = tuple(_pair(p.index_a, p.index_b, objs, link, owner, is_arm) for p in reach)
     return pairs, np.array([p.distance_bound for p in reach], dtype=float)
 

@@ -2,7 +2,7 @@
 
 The reference is plain Pinocchio + coal: a GeometryModel of its own with *every* pair of the
 cell's collision geometries, minus only the pairs the cell allows by design (same link,
-rigid, adjacent, always touching, constant gap) — not the project's pair list.
+rigid, coaxial, adjacent, declared, constant gap) — not the project's pair list.
 """
 
 from __future__ import annotations

@@ -115,7 +115,7 @@ def test_every_pair_is_checked_or_allowed_with_a_reason(line):
     assert len(line.pairs) + len(line.allowed) == G * (G - 1) // 2
     assert len(line.collision_model.collisionPairs) == len(line.pairs)
     reasons = {a.reason for a in line.allowed}
-    assert reasons <= {"same link", "rigid", "adjacent", "out of reach", "always", "constant"}
+    assert reasons <= {"same link", "rigid", "coaxial", "adjacent", "declared", "out of reach", "constant"}
     allowed = {(a.body_a, a.body_b): a.reason for a in line.allowed}
     assert allowed[("left_base_link", "left_upper_arm_link")] == "adjacent"
     assert allowed.get(("conveyor_belt", "left_pedestal"), allowed.get(("left_pedestal", "conveyor_belt"))) == "rigid"

@@ -5,6 +5,8 @@ whole-state screens and the excess agreeing, and the disk cache checked."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import coal
 import numpy as np
 import pytest
@@ -121,7 +123,7 @@ def test_tables_only_raise_the_excess(ur5, near_contact):
 
 def test_the_disk_cache_round_trips_and_rejects_a_bad_file(ur5, tmp_path, monkeypatch):
     cell, _ = ur5
-    monkeypatch.setattr(pt, "_DISK", tmp_path)
+    monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path))
     objs = cell.collision_model.geometryObjects
     names = [o.name for o in objs]
     a, b = names.index("ur5_wrist_1_link_0"), names.index("ur5_ee_link_0")
@@ -135,8 +137,63 @@ def test_the_disk_cache_round_trips_and_rejects_a_bad_file(ur5, tmp_path, monkey
     bad = dict(table, child=np.full_like(table["child"], 0))  # children pointing backwards
     pt._save(key, bad)
     assert pt._load(key) is None
-    (tmp_path / f"{key}.npz").write_bytes(b"not an npz")
+    (tmp_path / "pair_tables" / f"{key}.npz").write_bytes(b"not an npz")
     assert pt._load(key) is None
+
+
+def test_the_cache_lives_in_the_users_cache_folder_keyed_by_the_code_that_built_it(ur5, tmp_path, monkeypatch):
+    """Issue 35 item 5: not in the package folder, and a change to the builder's code gives other names."""
+    cell, _ = ur5
+    package = Path(pt.__file__).resolve().parent
+    monkeypatch.delenv("PINARMS_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert pt._path("0" * 64) == tmp_path / "xdg" / "pinarms" / "pair_tables" / f"{'0' * 64}.npz"
+    monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path / "own"))
+    assert pt._path("0" * 64).parent == tmp_path / "own" / "pair_tables"
+    assert package not in pt._path("0" * 64).parents
+    names = [o.name for o in cell.collision_model.geometryObjects]
+    (found,) = pt.table_paths(cell, [(names.index("ur5_wrist_1_link_0"), names.index("ur5_ee_link_0"))])
+    key = pt._key(cell, *found)
+    edited = tmp_path / "_table_build.py"
+    edited.write_text(Path(pt._CODE[1]).read_text(encoding="utf-8") + "\n# edited\n", encoding="utf-8")
+    monkeypatch.setattr(pt, "_CODE", (pt._CODE[0], edited, pt._CODE[2]))
+    assert pt._key(cell, *found) != key
+
+
+@pytest.mark.slow
+def test_a_poisoned_cache_is_rebuilt_and_the_verdict_is_unchanged(ur5, near_contact, tmp_path, monkeypatch):
+    """Issue 35 item 5: every stored bound raised to 5 m (a stale or planted file under the right name) is
+    refused by the value check, for each of the UR5's tables; planted, it is built again, equal to the clean
+    one, and the cover proves exactly the states it proved before. (With the value check off, the same planted
+    tables let the cover prove 15 of 659 colliding states of this sample clear.)"""
+    from dataclasses import replace
+
+    cell, cover = ur5
+    ch, Q = near_contact
+    monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path))
+    own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
+    bare = replace(cover, tables=pt.no_tables())
+    found = [f for f in pt.table_paths(cell, own) if frozenset(f[:2]) in
+             {frozenset((int(a), int(b))) for a, b in zip(cover.tables.pair_a, cover.tables.pair_b)}]
+    assert len(found) == cover.tables.pair_a.size >= 3
+    clean = {pt._key(cell, *f): pt._MEMORY[pt._key(cell, *f)] for f in found}
+    for f in found:
+        key = pt._key(cell, *f)
+        poison = dict(clean[key], low=np.full_like(clean[key]["low"], 5.0))
+        assert not pt._trusted(cell, *f, poison) and pt._trusted(cell, *f, clean[key])
+    # the smallest table planted poisoned (rebuilt: one build, to keep the test short), the others clean
+    planted = min(clean, key=lambda k: clean[k]["child"].size)
+    for key, table in clean.items():
+        pt._save(key, dict(table, low=np.full_like(table["low"], 5.0)) if key == planted else table)
+    assert pt._load(planted) is not None  # structurally sound: only its values give it away
+    monkeypatch.setattr(pt, "_MEMORY", {})
+    tables = pt.pair_tables(cell, own, bare)
+    np.testing.assert_array_equal(tables.low, cover.tables.low)
+    pairs = cover.prepare(*pair_arrays(ch.pairs))
+    again = replace(cover, tables=tables)
+    np.testing.assert_array_equal(again.screen(Q, again.prepare(*pair_arrays(ch.pairs)), ch.pair_margin),
+                                  cover.screen(Q, pairs, ch.pair_margin))
+    np.testing.assert_array_equal(pt._load(planted)["low"], clean[planted]["low"])  # overwritten by the rebuild
 
 
 @pytest.mark.slow
@@ -158,3 +215,20 @@ def test_a_table_of_the_aubo_food_station_stays_below_coal():
                                 coal.Transform3s(Rg[i, b], pg[i, b]), req, coal.DistanceResult()) for i in range(N)])
     assert np.all(bound <= np.maximum(d, 0.0) + 1e-9)
     assert np.mean(bound > 0.0) > 0.5
+
+
+def test_the_cache_reader_skips_a_fifo_a_large_file_and_a_pickle(tmp_path, monkeypatch):
+    import os
+
+    from pinarms.robots.cell import disk_cache
+
+    fifo = tmp_path / "fifo.npz"
+    os.mkfifo(fifo)
+    assert disk_cache.read_arrays(fifo, ["low"]) is None  # returns at once: no writer is waited for
+    disk_cache.write_arrays(tmp_path / "sub" / "ok.npz", {"low": np.arange(3.0)})
+    assert (tmp_path / "sub").stat().st_mode & 0o777 == 0o700
+    np.testing.assert_array_equal(disk_cache.read_arrays(tmp_path / "sub" / "ok.npz", ["low"])["low"], np.arange(3.0))
+    np.savez(tmp_path / "pickled.npz", low=np.array([{"a": 1}], dtype=object))
+    assert disk_cache.read_arrays(tmp_path / "pickled.npz", ["low"]) is None
+    monkeypatch.setattr(disk_cache, "MAX_FILE_BYTES", 10)
+    assert disk_cache.read_arrays(tmp_path / "sub" / "ok.npz", ["low"]) is None

@@ -1,0 +1,137 @@
+"""The seeded sampling of the pair classification (:mod:`.pairs`), cached by content on disk.
+
+For the pairs no rule of structure or reach settles, coal measures every pair at
+:data:`SAMPLES` seeded random configurations of the cell: how many are in contact, the
+smallest and largest distance [m]. :mod:`.pairs` reads ``constant`` and the placement errors
+from these. A cell with mesh arms spends most of its load here (200 configurations × a few
+hundred mesh pairs: 15 s for ``ur5_table_box`` on the shared machine), so the result is kept
+in the user's cache folder (:mod:`.disk_cache`, ``pair_samples/<sha256>.npz``), named by a
+digest of everything it depends on: the cell's URDF text, every collision geometry (shape,
+size, mesh vertices and triangles, placement, parent joint), the pairs sampled, the seed, the
+count, this module's and the joint sampler's source files, and the versions of coal,
+Pinocchio and numpy.
+
+Only a sampling that took at least :data:`MIN_SECONDS` is written (a cell of primitives samples
+in milliseconds; a layout search builds one cell per base placement). A file is never trusted: besides its structure, :data:`VERIFY` of the same seeded
+configurations (the first ones) are measured again and must give the stored distances
+(within 1e-9 m) and contacts, inside the stored extremes and counts; a file that fails is
+sampled again and overwritten.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from .. import robot as _robot
+from ..collision_requests import cold_start
+from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
+from .mesh_cover import mesh_arrays
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .cell import Cell
+
+__all__ = ["SAMPLES", "VERIFY", "MIN_SECONDS", "sample_pairs"]
+
+#: Seeded random configurations measured per cell.
+SAMPLES = 200
+#: Of them, the first ones measured again to check a cached file.
+VERIFY = 8
+#: A sampling quicker than this [s] is not written to the disk (cells of primitives take milliseconds).
+MIN_SECONDS = 0.5
+_CODE = (Path(__file__), Path(_robot.__file__))
+_NAMES = ("hits", "dmin", "dmax", "first_d", "first_hit")
+
+
+def sample_pairs(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
+                 seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(hits, dmin, dmax)`` per pair of ``checked`` over :data:`SAMPLES` seeded configurations: contacts counted,
+    smallest and largest distance [m]; from the disk cache when a file of the same content passes its check."""
+    if not checked:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    path = cache_folder("pair_samples") / f"{_key(cell, objs, checked, seed)}.npz"
+    probe = _probe(cell, objs, checked)
+    qs = np.atleast_2d(cell.robot.q_to_pinocchio(cell.random_q(SAMPLES, seed=seed)))
+    got = read_arrays(path, _NAMES)
+    if got is not None and _trusted(got, cell.model, data, probe, qs, len(checked)):
+        return got["hits"], got["dmin"], got["dmax"]
+    t0 = time.perf_counter()
+    got = _measure(cell.model, data, probe, qs, len(checked))
+    if time.perf_counter() - t0 >= MIN_SECONDS:  # a quick sampling is not worth a file (a layout's many cells)
+        write_arrays(path, got)
+    return got["hits"], got["dmin"], got["dmax"]
+
+
+def _probe(cell: "Cell", objs: list, checked: list[tuple[int, int]]) -> tuple[pin.GeometryModel, pin.GeometryData]:
+    probe = pin.GeometryModel()
+    for g in objs:
+        probe.addGeometryObject(g)
+    for a, b in checked:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    return probe, cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
+
+
+def _at(model: pin.Model, data: pin.Data, probe: tuple, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Contacts ``(P,)`` bool and distances ``(P,)`` [m] of the probe's pairs at one Pinocchio configuration."""
+    gm, gd = probe
+    pin.updateGeometryPlacements(model, data, gm, gd, q)
+    pin.computeCollisions(gm, gd, False)
+    pin.computeDistances(gm, gd)
+    return (np.array([r.isCollision() for r in gd.collisionResults], dtype=bool),
+            np.array([r.min_distance for r in gd.distanceResults], dtype=float))
+
+
+def _measure(model: pin.Model, data: pin.Data, probe: tuple, qs: np.ndarray, P: int) -> dict[str, np.ndarray]:
+    hits = np.zeros(P)
+    dmin, dmax = np.full(P, np.inf), np.full(P, -np.inf)
+    first_d, first_hit = np.zeros((VERIFY, P)), np.zeros((VERIFY, P), dtype=bool)
+    for i, q in enumerate(qs):
+        hit, d = _at(model, data, probe, q)
+        hits += hit
+        dmin, dmax = np.minimum(dmin, d), np.maximum(dmax, d)
+        if i < VERIFY:
+            first_d[i], first_hit[i] = d, hit
+    return {"hits": hits, "dmin": dmin, "dmax": dmax, "first_d": first_d, "first_hit": first_hit}
+
+
+def _trusted(got: dict, model: pin.Model, data: pin.Data, probe: tuple, qs: np.ndarray, P: int) -> bool:
+    """Whether a cached file has the right shapes and agrees with coal at the first :data:`VERIFY` configurations."""
+    shapes = {"hits": (P,), "dmin": (P,), "dmax": (P,), "first_d": (VERIFY, P), "first_hit": (VERIFY, P)}
+    if any(got[k].shape != s for k, s in shapes.items()) or got["first_hit"].dtype != bool:
+        return False
+    if any(got[k].dtype != np.float64 for k in ("hits", "dmin", "dmax", "first_d")):
+        return False
+    hits, dmin, dmax = got["hits"], got["dmin"], got["dmax"]
+    if not (np.all(np.isfinite(dmin)) and np.all(np.isfinite(dmax)) and np.all(hits == np.round(hits))):
+        return False
+    for i in range(VERIFY):
+        hit, d = _at(model, data, probe, qs[i])
+        if not (np.array_equal(hit, got["first_hit"][i]) and np.allclose(d, got["first_d"][i], rtol=0.0, atol=1e-9)):
+            return False
+    seen = got["first_hit"].sum(axis=0)
+    return bool(np.all(dmin <= got["first_d"].min(axis=0)) and np.all(dmax >= got["first_d"].max(axis=0))
+                and np.all(hits >= seen) and np.all(SAMPLES - hits >= VERIFY - seen))
+
+
+def _key(cell: "Cell", objs: list, checked: list[tuple[int, int]], seed: int) -> str:
+    """A digest of everything the sampling depends on (module docstring)."""
+    h = hashlib.sha256(repr((SAMPLES, VERIFY, int(seed), code_digest(_CODE), getattr(coal, "__version__", ""),
+                             pin.__version__, np.__version__)).encode())
+    h.update(cell.urdf_text.encode("utf-8"))
+    for g in objs:
+        geo = g.geometry
+        geo.computeLocalAABB()
+        h.update(repr((g.name, type(geo).__name__, int(g.parentJoint))).encode())
+        h.update(np.asarray(g.placement.homogeneous, dtype=float).tobytes())
+        h.update(np.concatenate([np.asarray(geo.aabb_local.min_), np.asarray(geo.aabb_local.max_)]).tobytes())
+        mesh = mesh_arrays(geo)
+        if mesh is not None:
+            h.update(mesh[0].tobytes() + mesh[1].tobytes())
+    h.update(np.asarray(checked, dtype=np.int64).tobytes())
+    return h.hexdigest()
