@@ -26,6 +26,7 @@ __all__ = [
     "CellNotFound",
     "XacroFileNotFound",
     "CellTooLarge",
+    "ArmStateError",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -106,6 +107,11 @@ class CellError(ModelError):
 
 class CellTooLarge(CellError):
     """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
+
+
+class ArmStateError(CellError):
+    """A cell arm's named state, hold pose or frozen joint value is outside its joint limits, has the
+    wrong number of values, or names a state the arm does not have (the message names the arm and the joint)."""
 
 
 class CollisionGeometryError(ModelError):
