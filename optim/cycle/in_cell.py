@@ -352,7 +352,7 @@ def plan_cycle_in_cell(request: CycleRequest) -> CycleResult:
     settings, spec = request.cell, request.spec
     cell = settings.cell
     cell_arm = _arm_of(cell, request.robot, settings.arm)
-    hold_q = cell.neutral if settings.hold is None else cell.robot.check_q(settings.hold)[0][0]
+    hold_q = cell.hold if settings.hold is None else cell.robot.check_q(settings.hold)[0][0]
     trials = _Trials(request, cell_arm, hold_q)
 
     base = approach_cycle(request)  # the cycle as planned without the cell: the first attempt

@@ -13,7 +13,7 @@ from pinarms.optim.errors import GoalInCollision, StartInCollision
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["planned_arms", "arm_joints", "check_end", "goal_candidates"]
+__all__ = ["planned_arms", "arm_joints", "check_end", "check_hold", "goal_candidates"]
 
 
 def _arms(cell: Any, arm: Any) -> tuple[str, ...]:
@@ -54,6 +54,74 @@ def _is_pose(value: Any) -> bool:
     return arr.shape == (4, 4)
 
 
+def _idle_arms(checker: Any) -> tuple[str, ...]:
+    """The cell's arms neither planned nor moving on their own trajectory: they stay at the hold pose."""
+    moving = {m.arm for m in checker.moving}
+    return tuple(a.name for a in checker.cell.arms if a.name not in checker.arms and a.name not in moving)
+
+
+def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
+    """``"; b_link2 belongs to arm 'b', idle at its hold pose ..."`` when the pair touches an idle arm."""
+    if pair is None:
+        return ""
+    for body, owner in ((pair.body_a, pair.owner_a), (pair.body_b, pair.owner_b)):
+        if owner in idle:
+            return (f"; {body} belongs to arm {owner!r}, idle at its hold pose (give it another: hold in the cell "
+                    f"description, --hold {owner}=Q1,Q2,..., or hold=)")
+    return ""
+
+
+def _pair_distances(cell: Any, q: np.ndarray, pairs: list) -> tuple[float, ...]:
+    """Signed distances [m] of ``pairs`` at the cell configuration ``q`` (negative: penetration depth), by coal."""
+    import coal
+    import pinocchio as pin
+
+    from pinarms.robots.collision_requests import cold_start
+
+    model, gm = cell.model, cell.collision_model
+    gd = cold_start(pin.GeometryData(gm))
+    pin.updateGeometryPlacements(model, model.createData(), gm, gd, cell.robot.q_to_pinocchio(q))
+
+    def placed(i: int) -> Any:
+        return coal.Transform3s(gd.oMg[i].rotation, gd.oMg[i].translation)
+
+    out = []
+    for p in pairs:
+        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        request.enable_signed_distance = True
+        out.append(float(coal.distance(gm.geometryObjects[p.index_a].geometry, placed(p.index_a),
+                                       gm.geometryObjects[p.index_b].geometry, placed(p.index_b), request, result)))
+    return tuple(out)
+
+
+def _check_hold(checker: Any) -> None:
+    """The arms that stay at their hold pose must touch nothing there.
+
+    The planner checks only the pairs of the planned arms; a contact between an idle arm and
+    a fixture (or itself, or another idle arm) would otherwise surface only when the timed
+    motion is re-checked, after the whole search, as a failure of "the timed motion".
+
+    Raises:
+        StartInCollision: ``which="hold"``, naming the idle arm and the pairs in contact.
+    """
+    idle = _idle_arms(checker)
+    if not idle:
+        return
+    cell = checker.cell
+    skip = set(checker.arms) | {m.arm for m in checker.moving}
+    touching = [p for p in cell.collisions(checker.hold).pairs_at(0) if p.owner_a not in skip and p.owner_b not in skip]
+    if not touching:
+        return
+    distances = _pair_distances(cell, checker.hold, touching)
+    arms = sorted({o for p in touching for o in (p.owner_a, p.owner_b) if o in idle})
+    pairs = ", ".join(f"{p.body_a} – {p.body_b} ({'overlap ' if d < 0 else ''}{abs(d) * 1e3:.1f} mm)"
+                      for p, d in zip(touching, distances))
+    raise StartInCollision(
+        f"idle arm {arms[0]!r} is in collision at its hold pose: {pairs}; it does not move during the motion: give it a "
+        f"clear hold pose (hold in the cell description, --hold {arms[0]}=Q1,Q2,..., or hold=)",
+        which="hold", pairs=tuple(p.bodies for p in touching), distances=distances)
+
+
 def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
@@ -64,8 +132,8 @@ def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
         e, pair, d = checker.closest(x)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
         err = StartInCollision if label == "start" else GoalInCollision
-        raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}; move it clear or lower "
-                  f"the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
+        raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}"
+                  f"{_idle_note(pair, _idle_arms(checker))}; move it clear or lower the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
 
 
 def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
@@ -103,7 +171,7 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
             continue
         e, pair, d = checker.closest(qi)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
-        out.append(GoalCandidate(qi, False, describe_pair(pair, d, m), int(bi),
+        out.append(GoalCandidate(qi, False, describe_pair(pair, d, m) + _idle_note(pair, _idle_arms(checker)), int(bi),
                                  () if pair is None else pair.bodies, d))
     if not any(g.valid for g in out):
         lines = "; ".join(f"branch {g.branch}: {g.reason}" if g.branch >= 0 else g.reason for g in out)
@@ -116,4 +184,5 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
 planned_arms = _arms
 arm_joints = _joints
 check_end = _check_start
+check_hold = _check_hold
 goal_candidates = _goal_candidates

@@ -1,0 +1,77 @@
+"""The idle arm at its hold pose: planning, checks and sessions use the cell's hold; an idle arm in collision is named."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pinarms import planning, viz
+from pinarms.optim import GoalInCollision, StartInCollision, plan_motion
+from pinarms.optim.motion import MotionChecker
+from pinarms.robots import load_cell
+
+DATA = Path(__file__).resolve().parents[1] / "robots" / "data"
+
+# arm "b" stands before a table its upper arm lies in at q = 0; j2 = -1.2 rad lifts it clear
+CELL = """\
+name = "bent_pair"
+
+[[arm]]
+name = "a"
+urdf = "bent_arm.urdf"
+xyz = [0.0, {a_y}, 0.45]
+
+[[arm]]
+name = "b"
+urdf = "bent_arm.urdf"
+xyz = [0.0, -0.6, 0.45]
+freeze = {{ finger_joint = 0.0 }}
+{hold}
+
+[[fixture]]
+name = "table"
+box = [0.4, 0.4, 0.06]
+xyz = [0.4, -0.6, 0.53]
+"""
+
+
+def _cell(tmp_path: Path, hold: str = "", a_y: float = 0.6) -> object:
+    shutil.copy(DATA / "bent_arm.urdf", tmp_path / "bent_arm.urdf")
+    (tmp_path / "pair.toml").write_text(CELL.format(hold=hold, a_y=a_y), encoding="utf-8")
+    return load_cell(tmp_path / "pair.toml")
+
+
+def test_an_idle_arm_in_collision_at_its_hold_is_named_before_any_search(tmp_path):
+    cell = _cell(tmp_path)  # b holds at neutral: in the table
+    with pytest.raises(StartInCollision, match=r"idle arm 'b'.*b_link2 – table.*hold") as info:
+        plan_motion(cell, "a", [0.0, -1.0, 0.0], [0.5, -1.0, 0.0], time_limit=1.0, amax=2.0)
+    assert info.value.which == "hold" and ("b_link2", "table") in info.value.pairs
+    assert min(info.value.distances) < 0.0  # penetration depth, from coal
+
+
+def test_a_goal_that_touches_the_idle_arm_names_it(tmp_path):
+    cell = _cell(tmp_path, "hold = [1.5707963267948966, 0.0]", a_y=0.2)  # b's upper arm turned towards a, flat
+    checker = MotionChecker(cell, ["a"])
+    np.testing.assert_array_equal(checker.hold, cell.hold)  # the default hold is the cell's
+    goal = [-1.5707963267948966, 0.0, 0.0]  # a's upper arm towards b: the two forearms meet
+    assert cell.in_collision(cell.q_from_arms({"a": goal}))
+    with pytest.raises(GoalInCollision, match=r"arm 'b', idle at its hold pose"):
+        plan_motion(cell, "a", [0.0, -1.0, 0.0], goal, time_limit=1.0, amax=2.0)
+
+
+def test_checks_and_sessions_hold_the_idle_arm_at_the_cells_hold(tmp_path):
+    cell = _cell(tmp_path, "hold = [0.0, -1.2]")
+    a, b = cell.arm("a"), cell.arm("b")
+    traj = planning.multi_quintic([0.0, 1.0], np.array([[0.0, -1.0, 0.0], [0.5, -1.0, 0.0]]))
+    check = cell.check_motion({"a": traj}, margin=0.01)
+    assert check.collision_free  # with b at neutral, in the table, it would not be
+    assert not cell.check_motion({"a": traj}, margin=0.01, hold=cell.neutral).collision_free
+    session = viz.Session(title="hold")
+    key = session.add_cell(cell, motions={"a": traj}, check=check)
+    q = session.trajectories["cell motion"].q
+    np.testing.assert_array_equal(q[:, b.q_slice], np.tile([0.0, -1.2], (q.shape[0], 1)))
+    assert session.metadata["cells"][key]["hold"] == [float(v) for v in cell.hold]
+    assert q[:, a.q_slice].std(axis=0)[0] > 0.1
