@@ -41,6 +41,20 @@ def _shape_text(shape: Any, k: float, lu: str) -> str:
     return f"{shape.kind} {' x '.join(f'{v * k:.4g}' for v in shape.size)} {lu}"
 
 
+def _arm_keys_text(cell: Any, arm: Any) -> list[str]:
+    """An arm's tool point, frozen joints, hold pose and named states, one line each (docs/cells.md)."""
+    placement = next((p for p in cell.arm_placements if p.name == arm.name), None)
+    held = placement.hold if placement is not None else None
+    why = f"state {held}" if isinstance(held, str) else ("neutral" if held is None else "given")
+    out = [f"    tcp: {arm.tcp_choice}"]
+    if arm.frozen:
+        out.append("    frozen: " + ", ".join(f"{j} = {v:g}" for j, v in arm.frozen.items()))
+    out.append(f"    hold: ({', '.join(f'{v:.4g}' for v in arm.hold)}) rad/m ({why})")
+    if arm.states:
+        out.append("    states: " + ", ".join(arm.states))
+    return out
+
+
 def _cell_options(fn):
     fn = click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER", help=_PKG_HELP)(fn)
     fn = click.option("--arg", "xacro_args", multiple=True, metavar="NAME=VALUE", help=_ARG_HELP)(fn)
@@ -70,7 +84,10 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
     c = _load(cell, xacro_args, packages)
     k, lu = (1000.0, "mm") if mm else (1.0, "m")
     arms = [{"name": a.name, "model": a.model, "prefix": a.prefix, "joints": list(a.robot.joint_names),
-             "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world} for a in c.arms]
+             "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world,
+             "tcp_frame": a.robot.tcp_frame, "tcp": a.tcp_choice, "frozen": dict(a.frozen),
+             "hold": [float(v) for v in a.hold], "states": {n: [float(v) for v in q] for n, q in a.states.items()}}
+            for a in c.arms]
     fixtures = [{"name": f.name, "shapes": [{"kind": s.kind, "size": list(s.size), "mesh": s.mesh,
                                              "position_m": s.shape_to_world[:3, 3]} for s in f.shapes]}
                 for f in c.fixtures]
@@ -85,6 +102,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
         p = a.base_to_world[:3, 3] * k
         lines.append(f"  {a.name}: {a.model or 'arm'}, joints {a.q_slice.start}-{a.q_slice.stop - 1} "
                      f"({', '.join(a.robot.joint_names)}), base at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) {lu}")
+        lines += _arm_keys_text(c, a)
     lines.append(f"{len(c.fixtures)} fixture(s):")
     for f in c.fixtures:
         lines.append(f"  {f.name}: {', '.join(_shape_text(s, k, lu) for s in f.shapes)}")
