@@ -235,6 +235,18 @@ class Session:
                 out[arm] = frame
         return out
 
+    def cell_hold(self, key: str) -> np.ndarray | None:
+        """The hold pose ``(nq,)`` of the cell stored under ``key``: where its arms rest when nothing
+        animates them (``None`` for a plain robot, or a stored value that is not ``nq`` finite numbers)."""
+        entry = self.metadata.get("cells", {})
+        info = entry.get(key) if isinstance(entry, dict) else None
+        hold = info.get("hold") if isinstance(info, dict) else None
+        if not isinstance(hold, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in hold):
+            return None
+        q = np.asarray(hold, dtype=float)
+        nq = self.robot(key).nq
+        return q if q.shape == (nq,) and np.all(np.isfinite(q)) else None
+
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""

@@ -75,3 +75,17 @@ def test_checks_and_sessions_hold_the_idle_arm_at_the_cells_hold(tmp_path):
     np.testing.assert_array_equal(q[:, b.q_slice], np.tile([0.0, -1.2], (q.shape[0], 1)))
     assert session.metadata["cells"][key]["hold"] == [float(v) for v in cell.hold]
     assert q[:, a.q_slice].std(axis=0)[0] > 0.1
+
+
+def test_a_saved_cell_without_motions_rests_at_its_hold(tmp_path):
+    cell = _cell(tmp_path, "hold = [0.0, -1.2]")
+    session = viz.Session(title="rest")
+    key = session.add_cell(cell)
+    session.save(tmp_path / "s.pinarms")
+    loaded = viz.load_session(tmp_path / "s.pinarms")
+    np.testing.assert_array_equal(loaded.cell_hold(key), cell.hold)
+    assert not cell.in_collision(loaded.cell_hold(key))
+    loaded.metadata["cells"][key]["hold"] = [0.0, "x"]  # a hostile file's value: ignored, never drawn
+    assert loaded.cell_hold(key) is None
+    loaded.metadata["cells"][key]["hold"] = [0.0] * (cell.nq + 1)
+    assert loaded.cell_hold(key) is None
