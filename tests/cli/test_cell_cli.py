@@ -65,42 +65,15 @@ def test_cell_errors_are_one_line(run):
                    "--mm", ok=False), "place pose of arm 'aubo'", "crate_wall_xpos")
 
 
-BENT_PAIR = """\
-name = "bent_pair"
+def bent_pair_cell(folder) -> str:
+    from tests.robots.cell.bent_pair import bent_pair
 
-[[arm]]
-name = "a"
-urdf = "bent_arm.urdf"
-xyz = [0.0, 0.6, 0.45]
-
-[[arm]]
-name = "b"
-urdf = "bent_arm.urdf"
-xyz = [0.0, -0.6, 0.45]
-tcp = { link = "flange", xyz = [0.05, 0.0, 0.0] }
-freeze = { finger_joint = 0.02 }
-states = { home = [0.0, -1.2], ready = [0.5, -1.0] }
-hold = "home"
-
-[[fixture]]
-name = "table"
-box = [0.4, 0.4, 0.06]
-xyz = [0.4, -0.6, 0.53]
-"""
-
-
-def bent_pair(folder) -> str:
-    """Two bent arms (tests/robots/data/bent_arm.urdf); b's neutral pose lies in the table, its hold clears it."""
-    import shutil
-    from pathlib import Path
-
-    shutil.copy(Path(__file__).resolve().parents[1] / "robots" / "data" / "bent_arm.urdf", folder / "bent_arm.urdf")
-    (folder / "pair.toml").write_text(BENT_PAIR, encoding="utf-8")
-    return str(folder / "pair.toml")
+    return str(bent_pair(folder, 'tcp = { link = "flange", xyz = [0.05, 0.0, 0.0] }\nfreeze = { finger_joint = 0.02 }\n'
+                                 'states = { home = [0.0, -1.2], ready = [0.5, -1.0] }\nhold = "home"'))
 
 
 def test_cell_show_prints_each_arms_tool_point_frozen_joints_hold_and_states(run, tmp_path):
-    path = bent_pair(tmp_path)
+    path = bent_pair_cell(tmp_path)
     text = run("cell", "show", path).stdout
     assert "    tcp: finger (the last link; no tcp given)" in text
     assert "    hold: (0, 0, 0) rad/m (neutral)" in text

@@ -56,16 +56,9 @@ def test_motion_goals_best_is_never_slower_in_bound_and_stays_proven():
 
 
 def _bent_pair(folder: Path, hold: str = "") -> str:
-    """Two bent arms (tests/robots/data/bent_arm.urdf): b's neutral pose lies in the table, j2 = -1.2 clears it."""
-    import shutil
+    from tests.robots.cell.bent_pair import bent_pair
 
-    shutil.copy(Path(__file__).resolve().parents[1] / "robots" / "data" / "bent_arm.urdf", folder / "bent_arm.urdf")
-    (folder / "pair.toml").write_text(
-        'name = "bent_pair"\n[[arm]]\nname = "a"\nurdf = "bent_arm.urdf"\nxyz = [0.0, 0.6, 0.45]\n'
-        '[[arm]]\nname = "b"\nurdf = "bent_arm.urdf"\nxyz = [0.0, -0.6, 0.45]\n'
-        'states = { home = [0.0, -1.2, 0.0] }\n' + hold +
-        '[[fixture]]\nname = "table"\nbox = [0.4, 0.4, 0.06]\nxyz = [0.4, -0.6, 0.53]\n', encoding="utf-8")
-    return str(folder / "pair.toml")
+    return str(bent_pair(folder, "states = { home = [0.0, -1.2, 0.0] }\n" + hold))
 
 
 def _one_error_line(result, *fragments: str) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -12,36 +11,10 @@ from pinarms import planning, viz
 from pinarms.optim import GoalInCollision, StartInCollision, plan_motion
 from pinarms.optim.motion import MotionChecker
 from pinarms.robots import load_cell
-
-DATA = Path(__file__).resolve().parents[1] / "robots" / "data"
-
-# arm "b" stands before a table its upper arm lies in at q = 0; j2 = -1.2 rad lifts it clear
-CELL = """\
-name = "bent_pair"
-
-[[arm]]
-name = "a"
-urdf = "bent_arm.urdf"
-xyz = [0.0, {a_y}, 0.45]
-
-[[arm]]
-name = "b"
-urdf = "bent_arm.urdf"
-xyz = [0.0, -0.6, 0.45]
-freeze = {{ finger_joint = 0.0 }}
-{hold}
-
-[[fixture]]
-name = "table"
-box = [0.4, 0.4, 0.06]
-xyz = [0.4, -0.6, 0.53]
-"""
-
+from tests.robots.cell.bent_pair import bent_pair
 
 def _cell(tmp_path: Path, hold: str = "", a_y: float = 0.6) -> object:
-    shutil.copy(DATA / "bent_arm.urdf", tmp_path / "bent_arm.urdf")
-    (tmp_path / "pair.toml").write_text(CELL.format(hold=hold, a_y=a_y), encoding="utf-8")
-    return load_cell(tmp_path / "pair.toml")
+    return load_cell(bent_pair(tmp_path, "freeze = { finger_joint = 0.0 }\n" + hold, a_y=a_y))
 
 
 def test_an_idle_arm_in_collision_at_its_hold_is_named_before_any_search(tmp_path):

@@ -12,36 +12,12 @@ import pytest
 from pinarms import robots
 from pinarms.robots import ArmPlacement, FixturePrimitive, ToolPoint, compose_cell, load_cell
 from pinarms.robots.errors import ArmStateError, CellError
+from tests.robots.cell.bent_pair import bent_pair
 
 DATA = Path(__file__).parent.parent / "data"
 
-# arm "b" stands before a table that its upper arm lies in at q = 0 (j2 = -1.2 rad lifts it clear)
-TWO_ARMS = """\
-name = "bent_pair"
-
-[[arm]]
-name = "a"
-urdf = "bent_arm.urdf"
-xyz = [0.0, 0.6, 0.45]
-
-[[arm]]
-name = "b"
-urdf = "bent_arm.urdf"
-xyz = [0.0, -0.6, 0.45]
-{b_keys}
-
-[[fixture]]
-name = "table"
-box = [0.4, 0.4, 0.06]
-xyz = [0.4, -0.6, 0.53]
-"""
-
-
 def _write(tmp_path: Path, b_keys: str = "") -> Path:
-    shutil.copy(DATA / "bent_arm.urdf", tmp_path / "bent_arm.urdf")
-    path = tmp_path / "pair.toml"
-    path.write_text(TWO_ARMS.format(b_keys=b_keys), encoding="utf-8")
-    return path
+    return bent_pair(tmp_path, b_keys)
 
 
 def _pose(xyz, rpy) -> np.ndarray:
