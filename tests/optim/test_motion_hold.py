@@ -62,3 +62,19 @@ def test_a_saved_cell_without_motions_rests_at_its_hold(tmp_path):
     assert loaded.cell_hold(key) is None
     loaded.metadata["cells"][key]["hold"] = [0.0] * (cell.nq + 1)
     assert loaded.cell_hold(key) is None
+
+
+def test_a_layout_worker_rebuilds_the_cell_with_its_hold(tmp_path):
+    import pickle
+
+    from pinarms.optim.layout.evaluate import _CELLS, _cell_of
+    from pinarms.optim.layout.search import _cell_target
+
+    cell = _cell(tmp_path, "hold = [0.0, -1.2]")
+    _, recipe = _cell_target(cell, "a", 0.02, (), "hold-test-token")
+    _CELLS.pop("hold-test-token")  # as in a worker process: the cell is rebuilt from the (pickled) recipe
+    rebuilt = _cell_of(pickle.loads(pickle.dumps(recipe)))
+    _CELLS.pop("hold-test-token")
+    assert rebuilt is not cell
+    np.testing.assert_array_equal(rebuilt.hold, cell.hold)
+    assert dict(rebuilt.arm("b").frozen) == {"finger_joint": 0.0}
