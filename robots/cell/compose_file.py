@@ -91,6 +91,9 @@ class ArmPlacement:
         if self.tcp is not None and not isinstance(self.tcp, ToolPoint):
             raise CellError(f"{where}: tcp must be a ToolPoint(link, xyz, rpy), got {self.tcp!r}")
         freeze = dict(self.freeze)
+        for k, v in freeze.items():
+            if isinstance(v, (list, tuple)):
+                raise CellError(f"{where}: freeze {k} takes one value [rad or m], got {v!r}")
         object.__setattr__(self, "freeze", tuple((str(k), _numbers(v, f"freeze {k}", where)[0])
                                                  for k, v in freeze.items()))
         states = dict(self.states)

@@ -75,6 +75,8 @@ def test_freeze_refuses_values_outside_the_limits_and_unknown_joints(tmp_path):
         load_cell(_write(tmp_path, "freeze = { finger_joint = 0.05 }"))
     with pytest.raises(CellError, match=r"arm 'b'.*'thumb'.*finger_joint"):
         load_cell(_write(tmp_path, "freeze = { thumb = 0.0 }"))
+    with pytest.raises(CellError, match=r"arm 'b'.*freeze finger_joint takes one value"):
+        load_cell(_write(tmp_path, "freeze = { finger_joint = [0.0, 0.01] }"))
 
 
 # ------------------------------------------------------------ states and hold
