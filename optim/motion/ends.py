@@ -71,29 +71,6 @@ def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
     return ""
 
 
-def _pair_distances(cell: Any, q: np.ndarray, pairs: list) -> tuple[float, ...]:
-    """Signed distances [m] of ``pairs`` at the cell configuration ``q`` (negative: penetration depth), by coal."""
-    import coal
-    import pinocchio as pin
-
-    from pinarms.robots.collision_requests import cold_start
-
-    model, gm = cell.model, cell.collision_model
-    gd = cold_start(pin.GeometryData(gm))
-    pin.updateGeometryPlacements(model, model.createData(), gm, gd, cell.robot.q_to_pinocchio(q))
-
-    def placed(i: int) -> Any:
-        return coal.Transform3s(gd.oMg[i].rotation, gd.oMg[i].translation)
-
-    out = []
-    for p in pairs:
-        request, result = coal.DistanceRequest(), coal.DistanceResult()
-        request.enable_signed_distance = True
-        out.append(float(coal.distance(gm.geometryObjects[p.index_a].geometry, placed(p.index_a),
-                                       gm.geometryObjects[p.index_b].geometry, placed(p.index_b), request, result)))
-    return tuple(out)
-
-
 def _check_hold(checker: Any) -> None:
     """The arms that stay at their hold pose must touch nothing there.
 
@@ -104,22 +81,13 @@ def _check_hold(checker: Any) -> None:
     Raises:
         StartInCollision: ``which="hold"``, naming the idle arm and the pairs in contact.
     """
-    idle = _idle_arms(checker)
-    if not idle:
-        return
-    cell = checker.cell
-    skip = set(checker.arms) | {m.arm for m in checker.moving}
-    touching = [p for p in cell.collisions(checker.hold).pairs_at(0) if p.owner_a not in skip and p.owner_b not in skip]
-    if not touching:
-        return
-    distances = _pair_distances(cell, checker.hold, touching)
-    arms = sorted({o for p in touching for o in (p.owner_a, p.owner_b) if o in idle})
-    pairs = ", ".join(f"{p.body_a} – {p.body_b} ({'overlap ' if d < 0 else ''}{abs(d) * 1e3:.1f} mm)"
-                      for p, d in zip(touching, distances))
-    raise StartInCollision(
-        f"idle arm {arms[0]!r} is in collision at its hold pose: {pairs}; it does not move during the motion: give it a "
-        f"clear hold pose (hold in the cell description, --hold {arms[0]}=Q1,Q2,..., or hold=)",
-        which="hold", pairs=tuple(p.bodies for p in touching), distances=distances)
+    from pinarms.robots.cell.idle import idle_contacts
+
+    found = idle_contacts(checker.cell, checker.hold, set(checker.arms) | {m.arm for m in checker.moving})
+    if found:
+        raise StartInCollision(found.message(f"hold in the cell description, --hold {found.arms[0]}=Q1,Q2,..., "
+                                             "or hold="),
+                               which="hold", pairs=tuple(p.bodies for p in found.pairs), distances=found.distances)
 
 
 def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:

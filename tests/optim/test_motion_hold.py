@@ -78,3 +78,14 @@ def test_a_layout_worker_rebuilds_the_cell_with_its_hold(tmp_path):
     assert rebuilt is not cell
     np.testing.assert_array_equal(rebuilt.hold, cell.hold)
     assert dict(rebuilt.arm("b").frozen) == {"finger_joint": 0.0}
+
+
+def test_a_cycle_next_to_an_idle_arm_in_collision_names_it_before_any_attempt(tmp_path):
+    from pinarms import optim
+    from pinarms.robots.errors import CollisionError
+
+    cell = _cell(tmp_path)  # b at neutral, in the table
+    a = cell.arm("a")
+    spec = optim.PickPlace(pick=[0.3, 0.1, 0.1], place=[0.3, -0.1, 0.1], lift=0.03)
+    with pytest.raises(CollisionError, match=r"idle arm 'b' is in collision at its hold pose: b_link2 – table"):
+        optim.plan_cycle(a.robot, spec, cell=cell, clearance=0.01)
