@@ -89,3 +89,13 @@ def test_a_cycle_next_to_an_idle_arm_in_collision_names_it_before_any_attempt(tm
     spec = optim.PickPlace(pick=[0.3, 0.1, 0.1], place=[0.3, -0.1, 0.1], lift=0.03)
     with pytest.raises(CollisionError, match=r"idle arm 'b' is in collision at its hold pose: b_link2 – table"):
         optim.plan_cycle(a.robot, spec, cell=cell, clearance=0.01)
+
+
+@pytest.mark.slow
+def test_a_motion_beside_an_arm_held_clear_of_the_table_is_planned_and_proven(tmp_path):
+    cell = _cell(tmp_path, "hold = [0.0, -1.2]")  # at neutral, b lies in the table: the re-check failed after the search
+    plan = plan_motion(cell, "a", [0.0, -1.0, 0.0], [0.8, -0.6, 0.0], amax=2.0, time_limit=5.0)
+    assert plan.check.collision_free
+    np.testing.assert_array_equal(plan.hold, cell.hold)
+    q = plan.cell_trajectory().sample(np.linspace(0.0, plan.duration, 20))[0]
+    np.testing.assert_array_equal(q[:, cell.arm("b").q_slice], np.tile([0.0, -1.2], (20, 1)))
