@@ -33,7 +33,11 @@ _JOINT_ONLY = ("mimic", "limit", "axis", "dynamics", "safety_controller", "calib
 
 
 def _floats(text: str | None, default: tuple[float, ...]) -> np.ndarray:
-    return np.array([float(v) for v in text.split()] if text else default, dtype=float)
+    """Three finite numbers from an attribute (``"0 0 0.1"``), else ``default``; ValueError otherwise."""
+    out = np.array([float(v) for v in text.split()] if text else default, dtype=float)
+    if out.shape != (3,) or not np.all(np.isfinite(out)):
+        raise ValueError(f"{text!r} is not three finite numbers")
+    return out
 
 
 def _origin(joint: ET.Element) -> pin.SE3:
@@ -62,6 +66,8 @@ def _limits_of(joint: ET.Element) -> tuple[float, float] | None:
 def _fix(joint: ET.Element, value: float) -> None:
     """Turn a movable joint into a fixed one at ``value`` [rad or m]: origin ∘ motion(value)."""
     axis = _floats(joint.find("axis").get("xyz") if joint.find("axis") is not None else None, (1.0, 0.0, 0.0))
+    if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0.0:
+        raise ValueError(f"joint {joint.get('name')!r} has axis {axis.tolist()}, not a non-zero 3-vector")
     axis = axis / np.linalg.norm(axis)
     if joint.get("type") == "prismatic":
         motion = pin.SE3(np.eye(3), value * axis)
@@ -123,10 +129,14 @@ def rewrite_arm(root: ET.Element, placement: ArmPlacement, source: str) -> None:
             tcp key on a file that has its own ``tcp`` link.
         ArmStateError: a frozen value outside its joint's limits.
     """
-    if placement.freeze:
-        _freeze(root, tuple(placement.freeze), source)
-    if placement.tcp is not None:
-        _add_tool_point(root, placement.tcp, source)
+    try:
+        if placement.freeze:
+            _freeze(root, tuple(placement.freeze), source)
+        if placement.tcp is not None:
+            _add_tool_point(root, placement.tcp, source)
+    except (ValueError, IndexError) as exc:  # an origin, axis or limit that is not numbers
+        raise CellError(f"{source}: cannot apply freeze/tcp: a joint's origin, axis or limit is not a valid list of "
+                        f"numbers ({exc})") from exc
 
 
 def _fmt(values: Any) -> str:

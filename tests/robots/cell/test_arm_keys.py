@@ -157,3 +157,16 @@ def test_a_crate_with_walls_thicker_than_half_its_width_is_refused(tmp_path):
                                      encoding="utf-8")
     with pytest.raises(CellError, match=r"fixture #1 \('crate'\).*wall 0.12.*floor"):
         robots.load_cell(tmp_path / "c.toml")
+
+
+@pytest.mark.parametrize("edit", [('<origin xyz="0.02 0 0"/><axis xyz="0 1 0"/>', '<origin xyz="0.02 0"/><axis xyz="0 1 0"/>'),
+                                  ('<origin xyz="0.02 0 0"/><axis xyz="0 1 0"/>', '<origin xyz="0.02 0 0"/><axis xyz="0 0 0"/>'),
+                                  ('<origin xyz="0.02 0 0"/><axis xyz="0 1 0"/>', '<origin xyz="a b c"/><axis xyz="0 1 0"/>')])
+def test_freezing_a_joint_with_a_malformed_origin_or_axis_is_a_named_error(tmp_path, edit):
+    path = _write(tmp_path, "freeze = { finger_joint = 0.01 }")
+    urdf = tmp_path / "bent_arm.urdf"
+    text = urdf.read_text(encoding="utf-8")
+    assert edit[0] in text
+    urdf.write_text(text.replace(edit[0], edit[1]), encoding="utf-8")
+    with pytest.raises(CellError, match=r"arm 'b'.*cannot apply freeze/tcp"):
+        load_cell(path)
