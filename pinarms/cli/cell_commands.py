@@ -192,6 +192,9 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
               help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm].")
 @click.option("--margin", default=None, type=float,
               help="Resolution of the continuous checks [default 0.005 m, 5 mm].")
+@click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
+              help="Where an arm without a --task stays (repeatable): joint values (rad and m; m as mm with --mm) or a "
+                   "named state of the cell description (default: the description's hold, else neutral).")
 @click.option("--offsets", "n_offsets", default=24, show_default=True, type=int,
               help="Time offsets scanned per arm (two or more arms).")
 @click.option("--mm", is_flag=True, help="Points, lift, clearance and margin in millimetres.")
@@ -202,7 +205,7 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
 @click.option("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
               help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms).")
 @json_option
-def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, n_offsets, mm, session_path,
+def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, holds, n_offsets, mm, session_path,
                    plot_clearance, plot_schedule, as_json) -> None:
     """Collision-aware pick-and-place cycles of CELL's arms and, for two or more arms, their schedule.
 
@@ -231,6 +234,9 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
     caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
     c = _load(cell, xacro_args, packages)
+    from .motion_commands import hold_option
+
+    hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}
     data: dict[str, Any] = {"cell": c.name, "clearance_m": clearance * k, "arms": {}}
     lines: list[str] = [f"cell {c.name}: cycles keeping {clearance:g} {lu} from fixtures and other arms"]
@@ -243,7 +249,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
             raise click.BadParameter(f"--task {name}: the six coordinates must be numbers, got {task[1:]}") from None
         spec = optim.PickPlace(arm.to_base(values[:3]), arm.to_base(values[3:]), lift=lift * k, dwell=dwell)
         res = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(c, clearance=clearance * k,
-                                                                               margin=margin * k)))
+                                                                               margin=margin * k, hold=hold)))
         cycles[name] = res
         rep = res.cell_report
         data["arms"][name] = {"cycle": res.as_dict(), "cycle_time_s": res.cycle_time,
@@ -262,7 +268,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         try:
             progress = (lambda done, _total: bar.update(1)) if bar is not None else None
             schedule = optim.schedule_line(c, cycles, margin=max(margin * k, 0.005), n_offsets=n_offsets,
-                                           progress=progress)
+                                           progress=progress, hold=hold)
         finally:
             if bar is not None:
                 bar.__exit__(None, None, None)
@@ -288,7 +294,8 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         from pinarms.viz import plots
 
         if check is None:
-            check = c.with_pairs("external").check_motion(motions, margin=margin * k, clearance=clearance * k, curve=True)
+            check = c.with_pairs("external").check_motion(motions, margin=margin * k, clearance=clearance * k, curve=True,
+                                                          hold=hold)
         plots.plot_clearance(plot_clearance, check)
         data["clearance_plot"] = plot_clearance
         lines.append(f"clearance plot written: {plot_clearance}")
@@ -296,6 +303,6 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         from pinarms import viz
 
         session = viz.Session(title=f"cell {c.name}: cycles")
-        session.add_cell(c, motions=motions, name="cycles")
+        session.add_cell(c, motions=motions, name="cycles", hold=hold)
         save_session(session, session_path, data, lines)
     emit(as_json, data, lines)

@@ -22,12 +22,15 @@ from .line_commands import _pose, _PoseCommand
 __all__ = ["load_any_cell", "hold_option"]
 
 
-def hold_option(cell: Any, holds: tuple[str, ...], planned: str, deg: bool, mm: bool) -> np.ndarray:
+def hold_option(cell: Any, holds: tuple[str, ...], planned: str | tuple[str, ...], deg: bool, mm: bool,
+                why: str = "give its start with --from or --from-q") -> np.ndarray:
     """The cell configuration of the arms that do not move: :attr:`Cell.hold` with each ``--hold ARM=...`` applied.
 
     ``ARM=Q1,Q2,...`` gives joint values (rad and m; degrees with ``deg``, millimetres with
-    ``mm``), ``ARM=STATE`` one of the arm's named states. Every error names ``--hold``.
+    ``mm``), ``ARM=STATE`` one of the arm's named states. Every error names ``--hold``; an
+    arm of ``planned`` (it moves) is refused, saying ``why``.
     """
+    moving = (planned,) if isinstance(planned, str) else tuple(planned)
     q = cell.hold
     for item in holds:
         name, sep, value = item.partition("=")
@@ -37,8 +40,8 @@ def hold_option(cell: Any, holds: tuple[str, ...], planned: str, deg: bool, mm: 
         if name not in {a.name for a in cell.arms}:
             raise InvalidInput(f"--hold: cell {cell.name!r} has no arm {name!r}; arms: {', '.join(a.name for a in cell.arms)}")
         arm = cell.arm(name)
-        if name == planned:
-            raise InvalidInput(f"--hold {name}: arm {name!r} is the arm planned; give its start with --from or --from-q")
+        if name in moving:
+            raise InvalidInput(f"--hold {name}: arm {name!r} is the arm planned; {why}")
         if value[0].isalpha():
             if value not in arm.states:
                 raise InvalidInput(f"--hold {name}: arm {name!r} has no state {value!r}; states: "

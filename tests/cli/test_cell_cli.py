@@ -86,3 +86,16 @@ def test_cell_show_prints_each_arms_tool_point_frozen_joints_hold_and_states(run
     assert b["tcp_frame"] == "tcp" and b["tcp"] == "flange + xyz (0.05, 0, 0) m, rpy (0, 0, 0) rad"
     assert b["frozen"] == {"finger_joint": 0.02} and b["hold"] == [0.0, -1.2]
     assert b["states"] == {"home": [0.0, -1.2], "ready": [0.5, -1.0]}
+
+
+def test_cell_cycle_names_the_idle_arm_in_collision_and_takes_its_hold(run, tmp_path):
+    from tests.robots.cell.bent_pair import bent_pair
+
+    path = str(bent_pair(tmp_path, "states = { home = [0.0, -1.2, 0.0] }"))  # b at neutral: in the table
+    cycle = ("cell", "cycle", path, "--task", "a", "0.3", "0.8", "0.8", "0.3", "0.5", "0.8")
+    user_error(run(*cycle, ok=False), "idle arm 'b' is in collision at its hold pose: b_link2 – table")
+    user_error(run(*cycle, "--hold", "b=0,2.5,0", ok=False), "--hold b", "j2 = 2.5 outside [-2, 2]")
+    user_error(run(*cycle, "--hold", "a=home", ok=False), "--hold a", "it has a --task")
+    held = run(*cycle, "--hold", "b=home", ok=False)  # b clear: the cycle itself is planned (this arm cannot reach it)
+    user_error(held, "unreachable")
+    assert "idle arm" not in held.stderr
