@@ -13,6 +13,7 @@ import numpy as np
 from pinarms.robots.errors import InvalidInput
 
 from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option, save_session, show_progress
+from .motion_commands import hold_option
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."
@@ -234,8 +235,6 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
     caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
     c = _load(cell, xacro_args, packages)
-    from .motion_commands import hold_option
-
     hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}
     data: dict[str, Any] = {"cell": c.name, "clearance_m": clearance * k, "arms": {}}
