@@ -209,6 +209,8 @@ def _fixture_of(table: dict, where: str) -> FixturePrimitive:
     extra = [k for k in ("wall", "floor") if k in table]
     if extra and kind != "crate":
         raise CellError(f"{where} ({name!r}): {' and '.join(extra)} belong to a crate, not a {kind}")
+    if any(isinstance(table.get(k), list) for k in ("wall", "floor")):
+        raise CellError(f"{where} ({name!r}): wall and floor take one number each [m]")
     wall, floor = (_numbers(table.get(k, 0.01), k, where)[0] for k in ("wall", "floor"))
     fixture = FixturePrimitive(name, kind, size, _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
                                _triple(table.get("rpy", [0, 0, 0]), "rpy", where), wall, floor)

@@ -150,6 +150,19 @@ def test_a_crate_fixture_is_a_floor_and_four_walls_like_the_xacro_macro(tmp_path
         np.testing.assert_allclose(a.shape_to_world, b.shape_to_world, atol=1e-12)
 
 
+@pytest.mark.parametrize("shape, match", [
+    ("crate = [0.30, 0.22, 0.16]\nwall = [0.01, 0.02]", "one number each"),
+    ("crate = [0.30, 0.22, 0.16]\nfloor = 0.2", "floor 0.2 m"),
+    ("box = [0.1, 0.1, 0.1]\nwall = 0.01", "wall belong to a crate, not a box"),
+])
+def test_crate_keys_are_checked(tmp_path, shape, match):
+    shutil.copy(DATA / "bent_arm.urdf", tmp_path / "bent_arm.urdf")
+    (tmp_path / "c.toml").write_text(f'[[arm]]\nname = "b"\nurdf = "bent_arm.urdf"\n[[fixture]]\nname = "crate"\n{shape}\n',
+                                     encoding="utf-8")
+    with pytest.raises(CellError, match=match):
+        robots.load_cell(tmp_path / "c.toml")
+
+
 def test_a_crate_with_walls_thicker_than_half_its_width_is_refused(tmp_path):
     shutil.copy(DATA / "bent_arm.urdf", tmp_path / "bent_arm.urdf")
     (tmp_path / "c.toml").write_text('[[arm]]\nname = "b"\nurdf = "bent_arm.urdf"\n'
