@@ -48,7 +48,8 @@ class EndpointInCollision(PlanningError, CollisionError):
     """The start or the goal of a motion is itself too close to something.
 
     Attributes:
-        which: ``"start"`` or ``"goal"``.
+        which: ``"start"``, ``"goal"``, or ``"hold"`` (an arm that does not move touches
+            something at its hold pose; the message names the arm).
         pairs: ``(body_a, body_b)`` of the pair nearest its margin, one per configuration
             tried (one for a joint goal, one per IK branch for a pose goal).
         distances: their distances [m] (negative: penetration depth).

@@ -27,6 +27,7 @@ __all__ = [
     "XacroFileNotFound",
     "CellTooLarge",
     "PlacementError",
+    "ArmStateError",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -127,6 +128,11 @@ class PlacementError(CellError):
 
 def _rebuild_placement_error(message, pairs):
     return PlacementError(message, pairs=pairs)
+
+
+class ArmStateError(CellError):
+    """A cell arm's named state, hold pose or frozen joint value is outside its joint limits, has the
+    wrong number of values, or names a state the arm does not have (the message names the arm and the joint)."""
 
 
 class CollisionGeometryError(ModelError):

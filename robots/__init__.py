@@ -103,10 +103,10 @@ from .cell import (  # noqa: E402
     cell_names,
     load_cell,
 )
-from .cell.compose import ArmPlacement, FixturePrimitive, compose_cell  # noqa: E402
+from .cell.compose import ArmPlacement, FixturePrimitive, ToolPoint, compose_cell  # noqa: E402
 
 __all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
-            "load_cell", "ArmPlacement", "FixturePrimitive", "compose_cell"]
+            "load_cell", "ArmPlacement", "FixturePrimitive", "ToolPoint", "compose_cell"]
 
 # reachability maps: tool poses per voxel, orientation sets, HDF5 files
 from .reach.orientations import (  # noqa: E402

@@ -21,10 +21,11 @@ __all__ = ["add_cell"]
 
 
 def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
-             name: str = "cell motion", hz: float = 100.0) -> str:
+             name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
     """Add ``cell`` to ``session`` (:meth:`viz.Session.add_cell` says how); return its robot key."""
     if not isinstance(cell, Cell):
         raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")
+    hold_q = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]
     key = session.add_robot(cell.robot, key=cell.name if key is None else key)
     session.metadata.setdefault("cells", {})[key] = {
         "name": cell.name,
@@ -32,9 +33,10 @@ def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = 
         "arms": {a.name: {"tcp_frame": a.prefix + a.robot.tcp_frame, "q_start": a.q_slice.start,
                           "q_stop": a.q_slice.stop} for a in cell.arms},
         "fixtures": [f.name for f in cell.fixtures],
+        "hold": [float(v) for v in hold_q],
     }
     if motions is not None:
-        t, q = sample_motions(cell, motions, hz=hz, window=None if check is None else check.window)
+        t, q = sample_motions(cell, motions, hz=hz, window=None if check is None else check.window, hold=hold_q)
         session.add_trajectory(name, (t, q), robot=key)
     if check is not None:
         if motions is None:
@@ -42,7 +44,7 @@ def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = 
         inside = np.flatnonzero(np.asarray(check.clearance) <= 0.0)
         if inside.size:  # at most 400 contact samples, evenly spread
             inside = inside[np.linspace(0, inside.size - 1, min(inside.size, 400)).round().astype(int)]
-            qs = configurations(cell, arm_motions(cell, motions), np.asarray(check.times)[inside], cell.neutral)
+            qs = configurations(cell, arm_motions(cell, motions), np.asarray(check.times)[inside], hold_q)
             cl = cell.clearance(qs)
             session.add_points(f"{name} contacts", 0.5 * (cl.point_a + cl.point_b), kind="contact")
     return key

@@ -197,7 +197,7 @@ class Session:
         return name
 
     def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
-                 name: str = "cell motion", hz: float = 100.0) -> str:
+                 name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
         """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
         Args:
@@ -210,13 +210,16 @@ class Session:
             check: a :class:`robots.cell.MotionCheck` of those motions: its samples in
                 contact become the point set ``"<name> contacts"`` (kind ``"contact"``, drawn
                 red), at the middle of the contact pair's nearest points.
+            hold: cell configuration ``(nq,)`` of the arms without a motion (default
+                :attr:`Cell.hold`: each arm's hold pose from the cell description, else
+                neutral); the check must have been made with the same hold.
 
-        The arms' tcp frames are recorded in ``metadata["cells"][key]`` so that the viewer
-        draws each arm's tcp path.
+        The arms' tcp frames and the hold are recorded in ``metadata["cells"][key]`` so that
+        the viewer draws each arm's tcp path.
         """
         from .cell_session import add_cell
 
-        return add_cell(self, cell, key=key, motions=motions, check=check, name=name, hz=hz)
+        return add_cell(self, cell, key=key, motions=motions, check=check, name=name, hz=hz, hold=hold)
 
     def cell_tcp_frames(self, key: str) -> dict[str, str]:
         """``{arm: tcp frame}`` of the cell stored under ``key`` (``{}`` for a plain robot)."""
@@ -231,6 +234,18 @@ class Session:
             if isinstance(arm, str) and isinstance(frame, str):
                 out[arm] = frame
         return out
+
+    def cell_hold(self, key: str) -> np.ndarray | None:
+        """The hold pose ``(nq,)`` of the cell stored under ``key``: where its arms rest when nothing
+        animates them (``None`` for a plain robot, or a stored value that is not ``nq`` finite numbers)."""
+        entry = self.metadata.get("cells", {})
+        info = entry.get(key) if isinstance(entry, dict) else None
+        hold = info.get("hold") if isinstance(info, dict) else None
+        if not isinstance(hold, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in hold):
+            return None
+        q = np.asarray(hold, dtype=float)
+        nq = self.robot(key).nq
+        return q if q.shape == (nq,) and np.all(np.isfinite(q)) else None
 
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:

@@ -66,13 +66,16 @@ def animated_trajectories(session: Any, animate: Sequence[str] | None) -> tuple[
 
 def show_start_poses(session: Any, drawings: dict[str, RobotDrawing], animated: tuple[str, ...],
                       framed: list[np.ndarray]) -> None:
-    """Pose each robot at the start of its animated (else first) trajectory, else neutral; frame its motion."""
+    """Pose each robot at the start of its animated (else first) trajectory, else its rest pose (a cell's
+    hold, :meth:`Session.cell_hold`; else neutral); frame its motion."""
     for key, drawing in drawings.items():
         recs = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
         recs = recs or [r for r in session.trajectories.values() if r.robot == key]
-        drawing.display(recs[0].q[0] if recs else drawing.robot.neutral)
+        hold = session.cell_hold(key)
+        rest = drawing.robot.neutral if hold is None else hold
+        drawing.display(recs[0].q[0] if recs else rest)
         # framed over the whole motion: the pose at 9 instants of its (first) trajectory
-        poses = recs[0].q[np.linspace(0, recs[0].q.shape[0] - 1, 9).round().astype(int)] if recs else drawing.robot.neutral
+        poses = recs[0].q[np.linspace(0, recs[0].q.shape[0] - 1, 9).round().astype(int)] if recs else rest
         framed.append(transform_points(session.robots[key].base_to_world, drawing.extent(poses)))
 
 

@@ -50,6 +50,7 @@ from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
+from pinarms.robots.cell.idle import idle_contacts
 from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES", "SCREEN_MOVES"]
@@ -347,12 +348,16 @@ def plan_cycle_in_cell(request: CycleRequest) -> CycleResult:
     Raises:
         InvalidInput: the robot is not an arm of the cell (or not arm ``request.cell.arm``).
         CollisionError: the pick or place pose is too close to a fixture, or no re-planned
-            cycle keeps the clearance; the message names the blocking bodies.
+            cycle keeps the clearance; the message names the blocking bodies. An arm that does
+            not move touching something at its hold pose: the message names the idle arm.
     """
     settings, spec = request.cell, request.spec
     cell = settings.cell
     cell_arm = _arm_of(cell, request.robot, settings.arm)
-    hold_q = cell.neutral if settings.hold is None else cell.robot.check_q(settings.hold)[0][0]
+    hold_q = cell.hold if settings.hold is None else cell.robot.check_q(settings.hold)[0][0]
+    idle = idle_contacts(cell, hold_q, [cell_arm.name])
+    if idle:  # every attempt would fail on the idle arm: name it now
+        raise CollisionError(idle.message("hold in the cell description, or CellSettings(hold=...)"))
     trials = _Trials(request, cell_arm, hold_q)
 
     base = approach_cycle(request)  # the cycle as planned without the cell: the first attempt

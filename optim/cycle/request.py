@@ -138,7 +138,7 @@ class CellSettings:
         cell: a :class:`robots.cell.Cell` holding the request's robot (``cell.arm(name).robot``);
             ``arm`` names the arm when the robot is not the cell's object.
         clearance: distance kept from the fixtures and the other arms [m] (0 … 1).
-        hold: cell configuration of the other arms (default the cell's neutral).
+        hold: cell configuration of the other arms (default :attr:`Cell.hold`).
         margin: resolution of the continuous check [m] (≥ :data:`optim.caps.MIN_MARGIN`).
         lift_step: rise of the lift per re-planning attempt [m] (:data:`optim.caps.LIFT_STEP_RANGE`).
         plan_transfer: when raising the lift and via points cannot clear, plan the transfer

@@ -69,6 +69,7 @@ class _CellRecipe:
     arm: str
     carry: tuple[str, ...]
     clearance: float
+    placements: tuple = ()  # the ArmPlacements of a composed cell (tcp, freeze, states, hold)
 
 
 #: Cells by search token in this process (the caller's own cell, or one rebuilt from its recipe).
@@ -82,7 +83,8 @@ def _cell_of(recipe: _CellRecipe) -> Any:
         if len(_CELLS) >= 2:
             _CELLS.pop(next(iter(_CELLS)))
         _CELLS[recipe.token] = Cell(recipe.urdf_text, source=recipe.source, base_dir=recipe.base_dir,
-                                    packages=dict(recipe.packages), args=dict(recipe.args), seed=recipe.seed)
+                                    packages=dict(recipe.packages), args=dict(recipe.args), seed=recipe.seed,
+                                    placements=recipe.placements)
     return _CELLS[recipe.token]
 
 

@@ -152,7 +152,7 @@ def _cell_target(robot: Any, arm: str | None, clearance: float, carry: tuple[str
         recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
                              tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
                              tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
-                             tuple(carry), float(clearance))
+                             tuple(carry), float(clearance), tuple(cell.arm_placements))
         _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
         return robot, recipe
     if arm is not None or carry:

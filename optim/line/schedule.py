@@ -162,7 +162,7 @@ def schedule_line(
         clearance: distance every pair must keep [m] (0: no contact).
         margin: resolution of the continuous checks [m].
         n_offsets: offsets scanned per arm and period (2 to :data:`optim.caps.MAX_OFFSETS`).
-        hold: cell configuration of the arms without a cycle (default neutral).
+        hold: cell configuration of the arms without a cycle (default :attr:`Cell.hold`).
         progress: optional callable ``progress(done, total)`` (for a progress bar).
 
     Raises:

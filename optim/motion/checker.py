@@ -94,8 +94,8 @@ class MotionChecker(CoalBatches, LadderProof):
         arms: the planned arms' names (their coordinates, in this order, make ``x``).
         margin: clearance every pair with a fixture or another arm keeps [m] (> 0).
         self_margin: clearance between two links of one planned arm [m] (≥ 0).
-        hold: cell configuration ``(nq,)`` of the arms not planned (default the cell's
-            neutral); the planned arms' entries are ignored.
+        hold: cell configuration ``(nq,)`` of the arms not planned (default :attr:`Cell.hold`,
+            each arm's hold pose); the planned arms' entries are ignored.
         moving: :class:`TimedArm` s that follow trajectories meanwhile: then ``x`` ends
             with the time [s] and their configuration at that time is used.
         step: largest travel [m] of any point between two samples of an edge (default
@@ -135,7 +135,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self.n = int(self.cols.size)
         self.lower = np.asarray(cell.lower, dtype=float)[self.cols]
         self.upper = np.asarray(cell.upper, dtype=float)[self.cols]
-        base = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+        base = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]
         self.hold = np.array(base, dtype=float)
         self.moving = tuple(moving)
         for m in self.moving:

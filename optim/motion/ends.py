@@ -13,7 +13,7 @@ from pinarms.optim.errors import GoalInCollision, StartInCollision
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["planned_arms", "arm_joints", "check_end", "goal_candidates"]
+__all__ = ["planned_arms", "arm_joints", "check_end", "check_hold", "goal_candidates"]
 
 
 def _arms(cell: Any, arm: Any) -> tuple[str, ...]:
@@ -54,6 +54,42 @@ def _is_pose(value: Any) -> bool:
     return arr.shape == (4, 4)
 
 
+def _idle_arms(checker: Any) -> tuple[str, ...]:
+    """The cell's arms neither planned nor moving on their own trajectory: they stay at the hold pose."""
+    moving = {m.arm for m in checker.moving}
+    return tuple(a.name for a in checker.cell.arms if a.name not in checker.arms and a.name not in moving)
+
+
+def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
+    """``"; b_link2 belongs to arm 'b', idle at its hold pose ..."`` when the pair touches an idle arm."""
+    if pair is None:
+        return ""
+    for body, owner in ((pair.body_a, pair.owner_a), (pair.body_b, pair.owner_b)):
+        if owner in idle:
+            return (f"; {body} belongs to arm {owner!r}, idle at its hold pose (give it another: hold in the cell "
+                    f"description, --hold {owner}=Q1,Q2,..., or hold=)")
+    return ""
+
+
+def _check_hold(checker: Any) -> None:
+    """The arms that stay at their hold pose must touch nothing there.
+
+    The planner checks only the pairs of the planned arms; a contact between an idle arm and
+    a fixture (or itself, or another idle arm) would otherwise surface only when the timed
+    motion is re-checked, after the whole search, as a failure of "the timed motion".
+
+    Raises:
+        StartInCollision: ``which="hold"``, naming the idle arm and the pairs in contact.
+    """
+    from pinarms.robots.cell.idle import idle_contacts
+
+    found = idle_contacts(checker.cell, checker.hold, set(checker.arms) | {m.arm for m in checker.moving})
+    if found:
+        raise StartInCollision(found.message(f"hold in the cell description, --hold {found.arms[0]}=Q1,Q2,..., "
+                                             "or hold="),
+                               which="hold", pairs=tuple(p.bodies for p in found.pairs), distances=found.distances)
+
+
 def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
@@ -64,8 +100,8 @@ def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
         e, pair, d = checker.closest(x)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
         err = StartInCollision if label == "start" else GoalInCollision
-        raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}; move it clear or lower "
-                  f"the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
+        raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}"
+                  f"{_idle_note(pair, _idle_arms(checker))}; move it clear or lower the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
 
 
 def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
@@ -103,7 +139,7 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
             continue
         e, pair, d = checker.closest(qi)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
-        out.append(GoalCandidate(qi, False, describe_pair(pair, d, m), int(bi),
+        out.append(GoalCandidate(qi, False, describe_pair(pair, d, m) + _idle_note(pair, _idle_arms(checker)), int(bi),
                                  () if pair is None else pair.bodies, d))
     if not any(g.valid for g in out):
         lines = "; ".join(f"branch {g.branch}: {g.reason}" if g.branch >= 0 else g.reason for g in out)
@@ -116,4 +152,5 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
 planned_arms = _arms
 arm_joints = _joints
 check_end = _check_start
+check_hold = _check_hold
 goal_candidates = _goal_candidates

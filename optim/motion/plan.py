@@ -36,7 +36,7 @@ import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 from pinarms.optim.motion.checker import MotionChecker, check_threads
-from pinarms.optim.motion.ends import _arms, _check_start, _goal_candidates, _joints
+from pinarms.optim.motion.ends import _arms, _check_hold, _check_start, _goal_candidates, _joints
 from pinarms.optim.motion.geometry import plan_geometry
 from pinarms.optim.motion.report import SIMPLIFIER, ClearanceProfile, MotionPlan, cell_trajectory, clearance_profile
 from pinarms.optim.motion.search import PLANNERS
@@ -171,7 +171,8 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         planner: an OMPL planner, one of :data:`optim.motion.search.PLANNERS` (default RRT-Connect).
         time_limit: seconds the search may take.
         seed: seed of the search and the shortcutting (same seed, same path).
-        hold: cell configuration of the arms not planned (default the cell's neutral).
+        hold: cell configuration of the arms not planned (default :attr:`Cell.hold`, each arm's
+            hold pose from the cell description, else neutral).
         frame: the tool frame of a pose goal (default the arm's tcp).
         vmax, amax: joint velocity [rad/s or m/s] (default the URDF's) and acceleration
             [rad/s² or m/s²] (default none) limits, scalar or per planned joint.
@@ -195,7 +196,9 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     Raises:
         InvalidInput: unknown arm, malformed start/goal, a start outside the joint limits.
         StartInCollision, GoalInCollision: an end that is itself too close to something
-            (the pair named; a pose goal lists every IK branch and why).
+            (the pair named, and the idle arm when it is one of the pair; a pose goal lists
+            every IK branch and why). ``StartInCollision`` with ``which="hold"``: an arm
+            not planned touches something at its hold pose (named, before any search).
         UnreachableTarget: a pose goal without any IK solution.
         NoPathFound: no path within ``time_limit`` (planner, time and states explored said).
         InvalidLimits, InfeasibleProblem: limits missing, or not met along the path.
@@ -213,6 +216,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     checker = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=hold, threads=threads)
     constraints, limits = _limits(cell, arms, vmax, amax, torque)
     x0 = _joints(cell, arms, start, "start")
+    _check_hold(checker)  # an idle arm in collision: named now, not after the search
     _check_start(checker, x0, "start")
     speed = constraints[0].vmax if goals == "best" else None  # the joint velocity limits come first
     geo = plan_geometry(checker, arms, x0, goal, planner=key, time_limit=float(time_limit), seed=int(seed), frame=frame,

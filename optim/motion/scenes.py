@@ -218,7 +218,7 @@ def scene_queries(name: str, n: int = 50, *, seed: int = 0, margin: float = 0.01
 
     cell = cell if cell is not None else load_scene(name)
     rng = np.random.default_rng(seed)
-    hold = cell.neutral.copy()
+    hold = cell.hold
     for other, region in scene.hold.items():
         held = MotionChecker(cell, [other], margin=margin, hold=hold)
         for _ in range(200):

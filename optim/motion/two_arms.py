@@ -180,7 +180,7 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
     ok = isinstance(delay_step, (int, float)) and not isinstance(delay_step, bool) and np.isfinite(delay_step)
     if not ok or delay_step <= 0.0:
         raise InvalidSettings(f"delay_step must be a positive number of seconds, got {delay_step!r}")
-    base = cell.neutral.copy() if hold is None else np.array(cell.robot.check_q(hold)[0][0], dtype=float)
+    base = cell.hold if hold is None else np.array(cell.robot.check_q(hold)[0][0], dtype=float)
     parked = base.copy()
     for m in timed:
         parked[cell.arm(m.arm).q_slice] = m.trajectory.sample(m.trajectory.end_time)[0]

@@ -13,6 +13,7 @@ import numpy as np
 from pinarms.robots.errors import InvalidInput
 
 from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option, save_session, show_progress
+from .motion_commands import hold_option
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."
@@ -39,6 +40,20 @@ def _shape_text(shape: Any, k: float, lu: str) -> str:
     if shape.kind == "mesh":
         return f"mesh {shape.mesh} (scale {' x '.join(f'{v:g}' for v in shape.size)})"
     return f"{shape.kind} {' x '.join(f'{v * k:.4g}' for v in shape.size)} {lu}"
+
+
+def _arm_keys_text(cell: Any, arm: Any) -> list[str]:
+    """An arm's tool point, frozen joints, hold pose and named states, one line each (docs/cells.md)."""
+    placement = next((p for p in cell.arm_placements if p.name == arm.name), None)
+    held = placement.hold if placement is not None else None
+    why = f"state {held}" if isinstance(held, str) else ("neutral" if held is None else "given")
+    out = [f"    tcp: {arm.tcp_choice}"]
+    if arm.frozen:
+        out.append("    frozen: " + ", ".join(f"{j} = {v:g}" for j, v in arm.frozen.items()))
+    out.append(f"    hold: ({', '.join(f'{v:.4g}' for v in arm.hold)}) rad/m ({why})")
+    if arm.states:
+        out.append("    states: " + ", ".join(arm.states))
+    return out
 
 
 def _cell_options(fn):
@@ -70,7 +85,10 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
     c = _load(cell, xacro_args, packages)
     k, lu = (1000.0, "mm") if mm else (1.0, "m")
     arms = [{"name": a.name, "model": a.model, "prefix": a.prefix, "joints": list(a.robot.joint_names),
-             "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world} for a in c.arms]
+             "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world,
+             "tcp_frame": a.robot.tcp_frame, "tcp": a.tcp_choice, "frozen": dict(a.frozen),
+             "hold": [float(v) for v in a.hold], "states": {n: [float(v) for v in q] for n, q in a.states.items()}}
+            for a in c.arms]
     fixtures = [{"name": f.name, "shapes": [{"kind": s.kind, "size": list(s.size), "mesh": s.mesh,
                                              "position_m": s.shape_to_world[:3, 3]} for s in f.shapes]}
                 for f in c.fixtures]
@@ -87,6 +105,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
         p = a.base_to_world[:3, 3] * k
         lines.append(f"  {a.name}: {a.model or 'arm'}, joints {a.q_slice.start}-{a.q_slice.stop - 1} "
                      f"({', '.join(a.robot.joint_names)}), base at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) {lu}")
+        lines += _arm_keys_text(c, a)
     lines.append(f"{len(c.fixtures)} fixture(s):")
     for f in c.fixtures:
         lines.append(f"  {f.name}: {', '.join(_shape_text(s, k, lu) for s in f.shapes)}")
@@ -198,6 +217,9 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
               help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm].")
 @click.option("--margin", default=None, type=float,
               help="Resolution of the continuous checks [default 0.005 m, 5 mm].")
+@click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
+              help="Where an arm without a --task stays (repeatable): joint values (rad and m; m as mm with --mm) or a "
+                   "named state of the cell description (default: the description's hold, else neutral).")
 @click.option("--offsets", "n_offsets", default=24, show_default=True, type=int,
               help="Time offsets scanned per arm (two or more arms).")
 @click.option("--mm", is_flag=True, help="Points, lift, clearance and margin in millimetres.")
@@ -208,7 +230,7 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
 @click.option("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
               help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms).")
 @json_option
-def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, n_offsets, mm, session_path,
+def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, holds, n_offsets, mm, session_path,
                    plot_clearance, plot_schedule, as_json) -> None:
     """Collision-aware pick-and-place cycles of CELL's arms and, for two or more arms, their schedule.
 
@@ -237,6 +259,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
     caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
     c = _load(cell, xacro_args, packages)
+    hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}
     data: dict[str, Any] = {"cell": c.name, "clearance_m": clearance * k, "arms": {}}
     lines: list[str] = [f"cell {c.name}: cycles keeping {clearance:g} {lu} from fixtures and other arms"]
@@ -249,7 +272,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
             raise click.BadParameter(f"--task {name}: the six coordinates must be numbers, got {task[1:]}") from None
         spec = optim.PickPlace(arm.to_base(values[:3]), arm.to_base(values[3:]), lift=lift * k, dwell=dwell)
         res = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(c, clearance=clearance * k,
-                                                                               margin=margin * k)))
+                                                                               margin=margin * k, hold=hold)))
         cycles[name] = res
         rep = res.cell_report
         data["arms"][name] = {"cycle": res.as_dict(), "cycle_time_s": res.cycle_time,
@@ -268,7 +291,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         try:
             progress = (lambda done, _total: bar.update(1)) if bar is not None else None
             schedule = optim.schedule_line(c, cycles, margin=max(margin * k, 0.005), n_offsets=n_offsets,
-                                           progress=progress)
+                                           progress=progress, hold=hold)
         finally:
             if bar is not None:
                 bar.__exit__(None, None, None)
@@ -294,7 +317,8 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         from pinarms.viz import plots
 
         if check is None:
-            check = c.with_pairs("external").check_motion(motions, margin=margin * k, clearance=clearance * k, curve=True)
+            check = c.with_pairs("external").check_motion(motions, margin=margin * k, clearance=clearance * k, curve=True,
+                                                          hold=hold)
         plots.plot_clearance(plot_clearance, check)
         data["clearance_plot"] = plot_clearance
         lines.append(f"clearance plot written: {plot_clearance}")
@@ -302,6 +326,6 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         from pinarms import viz
 
         session = viz.Session(title=f"cell {c.name}: cycles")
-        session.add_cell(c, motions=motions, name="cycles")
+        session.add_cell(c, motions=motions, name="cycles", hold=hold)
         save_session(session, session_path, data, lines)
     emit(as_json, data, lines)

@@ -19,7 +19,46 @@ from pinarms.units import angle_scale, length_scale
 from ._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
 from .line_commands import _pose, _PoseCommand
 
-__all__ = ["load_any_cell"]
+__all__ = ["load_any_cell", "hold_option"]
+
+
+def hold_option(cell: Any, holds: tuple[str, ...], planned: str | tuple[str, ...], deg: bool, mm: bool,
+                why: str = "give its start with --from or --from-q") -> np.ndarray:
+    """The cell configuration of the arms that do not move: :attr:`Cell.hold` with each ``--hold ARM=...`` applied.
+
+    ``ARM=Q1,Q2,...`` gives joint values (rad and m; degrees with ``deg``, millimetres with
+    ``mm``), ``ARM=STATE`` one of the arm's named states. Every error names ``--hold``; an
+    arm of ``planned`` (it moves) is refused, saying ``why``.
+    """
+    moving = (planned,) if isinstance(planned, str) else tuple(planned)
+    q = cell.hold
+    for item in holds:
+        name, sep, value = item.partition("=")
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
+            raise InvalidInput(f"--hold must be ARM=Q1,Q2,... or ARM=STATE, got {item!r}")
+        if name not in {a.name for a in cell.arms}:
+            raise InvalidInput(f"--hold: cell {cell.name!r} has no arm {name!r}; arms: {', '.join(a.name for a in cell.arms)}")
+        arm = cell.arm(name)
+        if name in moving:
+            raise InvalidInput(f"--hold {name}: arm {name!r} is the arm planned; {why}")
+        if value[0].isalpha():
+            if value not in arm.states:
+                raise InvalidInput(f"--hold {name}: arm {name!r} has no state {value!r}; states: "
+                                   f"{', '.join(arm.states) or 'none (states in the cell description)'}")
+            q[arm.q_slice] = arm.states[value]
+            continue
+        values = floats(value, f"--hold {name}")
+        if values.size != arm.nq:
+            raise InvalidInput(f"--hold {name} needs {arm.nq} values ({', '.join(arm.robot.joint_names)}), got {values.size}")
+        units = np.array([angle_scale(deg) if u == "rad" else length_scale(mm) for u in arm.robot.joint_units])
+        values = values * units
+        bad = [f"{j} = {v:g} outside [{lo:g}, {hi:g}]" for j, v, lo, hi in
+               zip(arm.robot.joint_names, values, arm.robot.lower, arm.robot.upper) if not lo - 1e-9 <= v <= hi + 1e-9]
+        if bad:
+            raise InvalidInput(f"--hold {name} is outside the joint limits [rad or m]: {'; '.join(bad)}")
+        q[arm.q_slice] = values
+    return q
 
 
 def load_any_cell(name: str) -> Any:
@@ -45,7 +84,11 @@ def load_any_cell(name: str) -> Any:
 @click.option("--from", "start", default=None,
               help="X Y Z [ROLL PITCH YAW] of the start pose (the clear IK solution nearest the arm's neutral; "
                    "without ROLL PITCH YAW the tool points down on six-axis arms).")
-@click.option("--from-q", "start_q", default=None, help="Comma-separated joint values of the start (default: neutral).")
+@click.option("--from-q", "start_q", default=None,
+              help="Comma-separated joint values of the start (default: the arm's hold pose, else neutral).")
+@click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
+              help="Where an arm that does not move stays (repeatable): its joint values (rad and m, or --deg/--mm) "
+                   "or a named state of the cell description (default: the description's hold, else neutral).")
 @click.option("--margin", default=0.01, show_default=True, type=float,
               help="Clearance kept to fixtures and other arms [m, or mm with --mm].")
 @click.option("--planner", default="rrtconnect", show_default=True, help="OMPL planner (rrtconnect, rrt, prm, ...).")
@@ -63,7 +106,8 @@ def load_any_cell(name: str) -> Any:
 @click.option("--plot", "plot_path", default=None, type=click.Path(dir_okay=False),
               help="Write the clearance-over-time plot (PNG).")
 @json_option
-def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, start_q: str | None, margin: float,
+def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, start_q: str | None,
+               holds: tuple[str, ...], margin: float,
                planner: str, time_limit: float, seed: int, goal_choice: str, amax: str | None, no_torque: bool,
                deg: bool, mm: bool, session_path: str | None, plot_path: str | None, as_json: bool) -> None:
     """Plan a collision-free move of an arm in CELL to a tool pose, prove it clear, time it optimally.
@@ -95,6 +139,7 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
     margin_m = margin * lu
     if start is not None and start_q is not None:
         raise click.UsageError("give --from (a pose) or --from-q (joint values), not both")
+    hold = hold_option(c, holds, arm.name, deg, mm)
     if start_q is not None:
         q0 = floats(start_q, "--from-q")
         if q0.size != arm.nq:
@@ -106,19 +151,19 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
         from pinarms.robots.reach.layout import default_orientation
 
         T0 = _pose(start, "--from", mm, deg, arm.base_to_world[:3, :3] @ default_orientation(arm.robot))
-        checker = MotionChecker(c, [arm.name], margin=margin_m)
-        cands, _ = ik_candidates(arm.robot, arm.to_base(T0), c.neutral[arm.q_slice], seed=seed)
+        checker = MotionChecker(c, [arm.name], margin=margin_m, hold=hold)
+        cands, _ = ik_candidates(arm.robot, arm.to_base(T0), arm.hold, seed=seed)
         clear = [q for q in cands if checker.state_valid(q)]
         if not clear:
             raise InvalidInput(f"--from: no clear IK solution of arm {arm.name!r} reaches "
                                f"{np.round(T0[:3, 3], 4).tolist()} m ({len(cands)} solutions tried)")
         q0 = clear[0]
     else:
-        q0 = np.array(c.neutral[arm.q_slice])
+        q0 = np.array(arm.hold)
     R0 = arm.tcp_to_world(q0)[:3, :3]
     T = _pose(goal, "--to", mm, deg, R0)
     a = None if amax is None else floats(amax, "--amax")
-    plan = plan_motion(c, arm.name, q0, T, margin=margin_m, planner=planner, time_limit=time_limit, seed=seed,
+    plan = plan_motion(c, arm.name, q0, T, margin=margin_m, planner=planner, time_limit=time_limit, seed=seed, hold=hold,
                        amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque,
                        goals=goal_choice, progress=progress)
     u = "mm" if mm else "m"

@@ -19,15 +19,17 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
 from ..errors import CellError, CellTooLarge, InvalidInput
 from ..robot import Robot
+from .arm_keys import arm_with_keys
 from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
 from .components import CellArm, Fixture
+from .compose_file import ArmPlacement
 from .description import CellSpec, describe
 from .move_arm import urdf_with_arm_base
 from .batch_fk import BatchedPlacements
@@ -49,7 +51,10 @@ class Cell:
             poses in the world): batched FK of any frame, limits, random configurations.
         model: its Pinocchio model; ``collision_model``: the coal geometry
             (``pin.GeometryModel``) with the checked pairs as its collision pairs.
-        arms: the arms (:class:`CellArm`), in joint-vector order.
+        arms: the arms (:class:`CellArm`), in joint-vector order, each with its tool point
+            (``tcp_choice``), named ``states``, ``hold`` pose and ``frozen`` joints.
+        arm_placements: the :class:`~.compose_file.ArmPlacement` s a composed cell (a
+            description file, :func:`~.compose.compose_cell`) was made of; empty otherwise.
         fixtures: the fixtures (:class:`Fixture`), in document order.
         pairs: the checked pairs (:class:`~.pairs.CollisionPair`).
         allowed: the pairs not checked at clearance 0, each with its reason
@@ -69,6 +74,7 @@ class Cell:
         packages: Mapping[str, str | Path] | None = None,
         args: Mapping[str, str] | None = None,
         seed: int = 0,
+        placements: Sequence[ArmPlacement] = (),
     ) -> None:
         from .pairs import classify_pairs
 
@@ -104,7 +110,16 @@ class Cell:
         self.model = model
         arms = tuple(build_arm(model, self.robot, root, arm, source=source, cell_name=self.name, dirs=dirs)
                      for arm in spec.arms)
+        #: The arm placements the cell was composed from (tcp, freeze, states, hold), in the
+        #: description's order; empty for a xacro or URDF cell.
+        self.arm_placements: tuple[ArmPlacement, ...] = tuple(placements)
+        by_name = {p.name: p for p in self.arm_placements}
+        arms = tuple(arm_with_keys(a, by_name.get(a.name), source) for a in arms)
         self.arms = tuple(sorted(arms, key=lambda a: a.q_slice.start))
+        self._hold = self.robot.neutral.copy()
+        for a in self.arms:
+            self._hold[a.q_slice] = a.hold
+        self._hold.setflags(write=False)
         self._arm_index = {a.name: k for k, a in enumerate(self.arms)}
         self.collision_model = build_geometry(model, root, source=source, base_dir=self._base_dir,
                                               packages=self._packages)
@@ -201,6 +216,15 @@ class Cell:
         """Every arm at its neutral configuration."""
         return self.robot.neutral
 
+    @property
+    def hold(self) -> np.ndarray:
+        """Every arm at its hold pose (:attr:`CellArm.hold`: the description's ``hold``, else neutral).
+
+        What an arm that does not move is set to, everywhere: planning, motion checks,
+        cycles, schedules and sessions (their ``hold`` arguments default to it).
+        """
+        return self._hold.copy()
+
     def random_q(self, n: int, seed: int | np.random.Generator | None = 0) -> np.ndarray:
         """``n`` cell configurations ``(n, nq)`` drawn uniformly within the joint limits."""
         return self.robot.random_q(n, seed=seed)
@@ -221,7 +245,7 @@ class Cell:
     def q_from_arms(self, arm_q: Mapping[str, Any], base: Any = None) -> np.ndarray:
         """A cell joint vector from ``{arm name: q_arm (nq_arm,) or (N, nq_arm)}``.
 
-        Arms not named keep ``base`` (default :attr:`neutral`). Batches of the named arms
+        Arms not named keep ``base`` (default :attr:`hold`). Batches of the named arms
         must have the same ``N``; the result is ``(nq,)`` or ``(N, nq)``.
         """
         rows = None
@@ -234,7 +258,7 @@ class Cell:
                 if rows not in (None, arr.shape[0]):
                     raise InvalidInput(f"arm batches differ in length: {rows} and {arr.shape[0]}")
                 rows = arr.shape[0]
-        q0 = self.neutral if base is None else self.robot.check_q(base)[0][0]
+        q0 = self.hold if base is None else self.robot.check_q(base)[0][0]
         out = np.tile(q0, (rows or 1, 1))
         for arm, arr in parts.values():
             out[:, arm.q_slice] = arr
@@ -295,7 +319,8 @@ class Cell:
         """
         text = urdf_with_arm_base(self, name, base_to_world, carry)
         return Cell(text, source=f"{self.source} (arm {name!r} moved)",
-                    base_dir=self._base_dir, packages=self._packages, args=self.args, seed=self._seed)
+                    base_dir=self._base_dir, packages=self._packages, args=self.args, seed=self._seed,
+                    placements=self.arm_placements)
 
     def with_pairs(self, kinds: str | tuple[str, ...] | list[str]) -> "Cell":
         """The same cell checking only the pairs of the given kinds.

@@ -6,8 +6,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -30,6 +30,13 @@ class CellArm:
         prefix: what the arm's names carry in the cell (``"left_"``).
         model: the built-in arm it is (``"scara_mushroom"``), told from its kinematics, never
             from names (:func:`~pinarms.robots.registry.match_builtin`), or ``None``.
+        states: the arm's named states ``{name: q (nq,)}`` [rad or m] from the cell
+            description (each within the limits; empty when none is given: no ``home`` is implied).
+        hold: the arm's configuration ``(nq,)`` whenever it does not move (the description's
+            ``hold``, else :attr:`Robot.neutral`): planning, checks, cycles and sessions use it.
+        frozen: ``{joint: value}`` of the joints the description freezes (no longer in ``q``).
+        tcp_choice: which frame is the tool point and why, in words (``"flange + xyz (0.05, 0, 0) m,
+            rpy (0, 0, 0) rad"``, ``"finger (the last link; no tcp given)"``).
     """
 
     name: str
@@ -38,6 +45,10 @@ class CellArm:
     q_slice: slice
     prefix: str
     model: str | None
+    states: Mapping[str, np.ndarray] = field(default_factory=dict)
+    hold: np.ndarray | None = None
+    frozen: Mapping[str, float] = field(default_factory=dict)
+    tcp_choice: str = ""
 
     @property
     def nq(self) -> int:

@@ -50,14 +50,18 @@ from .compose_file import (
     ArmPlacement,
     CellDescription,
     FixturePrimitive,
+    ToolPoint,
     _name,
+    check_crate,
     _read_bounded,
     read_cell_description,
 )
+from .arm_keys import rewrite_arm
 from .description import _MOVABLE
 
 __all__ = [
     "ArmPlacement",
+    "ToolPoint",
     "FixturePrimitive",
     "CellDescription",
     "read_cell_description",
@@ -162,6 +166,7 @@ def _arm_elements(arm: ArmPlacement, path: Path, base_dir: Path, packages: Mappi
         raise CellError(f"{source} is a xacro file: expand it first (`pinarms urdf build {path.name} -o arm.urdf`) "
                         "or place it from a xacro cell")
     root = _parse_arm(path, source)
+    rewrite_arm(root, arm, source)  # frozen joints fixed at their values, the tool point as a link "tcp"
     root_link, base = _base_of(root, source)
     link_names = {ln.get("name") for ln in root.findall("link")}
     rename = {}
@@ -200,7 +205,27 @@ def _arm_elements(arm: ArmPlacement, path: Path, base_dir: Path, packages: Mappi
     return out + [mount]
 
 
+def _crate_elements(fixture: FixturePrimitive) -> list[ET.Element]:
+    """A crate as the ``fixture_crate`` macro makes it: the floor slab (its frame) and four walls on it."""
+    sx, sy, h = fixture.size
+    wall, floor = fixture.wall, fixture.floor
+    parts = [(fixture.name, (sx, sy, floor), fixture.xyz, fixture.rpy, "world")]
+    for side, size, xyz in (("xpos", (wall, sy), ((sx - wall) / 2.0, 0.0)), ("xneg", (wall, sy), (-(sx - wall) / 2.0, 0.0)),
+                            ("ypos", (sx - 2.0 * wall, wall), (0.0, (sy - wall) / 2.0)),
+                            ("yneg", (sx - 2.0 * wall, wall), (0.0, -(sy - wall) / 2.0))):
+        parts.append((f"{fixture.name}_wall_{side}", (*size, h - floor), (*xyz, h / 2.0), (0.0, 0.0, 0.0), fixture.name))
+    out = []
+    for name, size, xyz, rpy, parent in parts:
+        box = FixturePrimitive(name, "box", tuple(float(v) for v in size), xyz, rpy)
+        link, joint = _fixture_elements(box)
+        joint.find("parent").set("link", parent)
+        out += [link, joint]
+    return out
+
+
 def _fixture_elements(fixture: FixturePrimitive) -> list[ET.Element]:
+    if fixture.kind == "crate":
+        return _crate_elements(fixture)
     link = ET.Element("link", {"name": fixture.name})
     for tag in ("visual", "collision"):
         part = ET.SubElement(link, tag)
@@ -234,6 +259,7 @@ def _check_entries(arms: Sequence[ArmPlacement], fixtures: Sequence[FixturePrimi
         if f.kind not in _SHAPES or len(f.size) != _SHAPES[f.kind] or min(f.size) <= 0.0:
             raise CellError(f"fixture {f.name!r}: a {f.kind!r} needs {_SHAPES.get(f.kind, '?')} positive size(s); "
                             f"kinds: {', '.join(_SHAPES)}")
+        check_crate(f, f"fixture {f.name!r}")
         for a in arms:
             if f.name == a.name or f.name.startswith(a.name + "_"):
                 raise CellError(f"fixture {f.name!r} clashes with the names of arm {a.name!r} (prefix {a.name + '_'!r})")
@@ -299,7 +325,8 @@ def compose_cell(
 ) -> Cell:
     """A :class:`~.cell.Cell` of any URDF arms under their prefixes (see :func:`compose_cell_urdf`)."""
     text = compose_cell_urdf(arms, fixtures, name=name, base_dir=base_dir, packages=packages)
-    return Cell(text, source=f"composed cell {name!r}", base_dir=Path(base_dir).resolve(), packages=packages, seed=seed)
+    return Cell(text, source=f"composed cell {name!r}", base_dir=Path(base_dir).resolve(), packages=packages, seed=seed,
+                placements=arms)
 
 
 def load_cell_description(
@@ -313,4 +340,4 @@ def load_cell_description(
     desc = read_cell_description(path)
     text = compose_cell_urdf(desc.arms, desc.fixtures, name=desc.name, base_dir=desc.base_dir, packages=packages,
                              strict=True, declared=desc.declared)
-    return Cell(text, source=str(path), base_dir=desc.base_dir, packages=packages, seed=seed)
+    return Cell(text, source=str(path), base_dir=desc.base_dir, packages=packages, seed=seed, placements=desc.arms)

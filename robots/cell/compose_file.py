@@ -12,12 +12,13 @@ import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping, Sequence
 
 from ..errors import CellError, CellNotFound
 
 __all__ = [
     "ArmPlacement",
+    "ToolPoint",
     "FixturePrimitive",
     "CellDescription",
     "read_cell_description",
@@ -39,7 +40,24 @@ MAX_FIXTURES = 1000
 MAX_DECLARED = 10_000
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
-_SHAPES = {"box": 3, "cylinder": 2, "sphere": 1}
+_SHAPES = {"box": 3, "cylinder": 2, "sphere": 1, "crate": 3}
+_ARM_KEYS = {"name", "urdf", "xyz", "rpy", "tcp", "freeze", "states", "hold"}
+
+
+@dataclass(frozen=True)
+class ToolPoint:
+    """Where an arm's tool point (tcp) is: a link of the arm file and an offset from it.
+
+    Attributes:
+        link: the link's name in the arm file (without the cell's prefix).
+        xyz: position of the tcp in that link's frame [m].
+        rpy: its roll, pitch, yaw in that frame [rad]; the tcp's z axis is the tool axis
+            (a "tool down" pose points it along the world's -z, docs/workspace.md).
+    """
+
+    link: str
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -51,12 +69,43 @@ class ArmPlacement:
         urdf: the arm's URDF file: a path, or ``package://PKG/path`` in a package folder.
         xyz: position of the arm's root link in the world [m].
         rpy: its roll, pitch, yaw [rad] (URDF convention).
+        tcp: the arm's tool point (:class:`ToolPoint`); ``None``: the file's ``tcp`` link if it
+            has one, else its last link (deepest in the tree), as :attr:`CellArm.tcp_choice` says.
+        freeze: ``{joint: value}`` [rad or m] of joints held fixed (gripper fingers): they leave
+            the arm's joint vector; each value within the joint's limits.
+        states: ``{name: joint values}`` [rad or m], in the arm's joint order after freezing
+            (``cell.arm(name).robot.joint_names``); each within the limits. No state is implied:
+            a ``home`` exists only when given.
+        hold: the arm's configuration whenever it does not move (planning, checks, cycles,
+            sessions): a state's name or joint values; ``None``: the neutral configuration.
     """
 
     name: str
     urdf: str | os.PathLike
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    tcp: ToolPoint | None = None
+    freeze: Mapping[str, float] | tuple[tuple[str, float], ...] = ()
+    states: Mapping[str, Sequence[float]] | tuple[tuple[str, tuple[float, ...]], ...] = ()
+    hold: str | Sequence[float] | None = None
+
+    def __post_init__(self) -> None:  # mappings kept as tuples of pairs: the placement stays hashable
+        where = f"arm {self.name!r}"
+        if self.tcp is not None and not isinstance(self.tcp, ToolPoint):
+            raise CellError(f"{where}: tcp must be a ToolPoint(link, xyz, rpy), got {self.tcp!r}")
+        freeze = dict(self.freeze)
+        for k, v in freeze.items():
+            if isinstance(v, (list, tuple)):
+                raise CellError(f"{where}: freeze {k} takes one value [rad or m], got {v!r}")
+        object.__setattr__(self, "freeze", tuple((str(k), _numbers(v, f"freeze {k}", where)[0])
+                                                 for k, v in freeze.items()))
+        states = dict(self.states)
+        for state in states:
+            _name(state, f"{where} state")
+        object.__setattr__(self, "states", tuple((k, _numbers(list(v), f"state {k!r}", where))
+                                                 for k, v in states.items()))
+        if self.hold is not None and not isinstance(self.hold, str):
+            object.__setattr__(self, "hold", _numbers(list(self.hold), "hold", where))
 
 
 @dataclass(frozen=True)
@@ -65,10 +114,14 @@ class FixturePrimitive:
 
     Attributes:
         name: the fixture's link name.
-        kind: ``"box"`` (size x y z), ``"cylinder"`` (radius, length along local z) or
-            ``"sphere"`` (radius) [m].
+        kind: ``"box"`` (size x y z), ``"cylinder"`` (radius, length along local z),
+            ``"sphere"`` (radius) or ``"crate"`` (outer x y and height: a floor slab and four
+            walls, like the ``fixture_crate`` macro) [m].
         size: the dimensions above.
-        xyz, rpy: the primitive's centre in the world [m] and orientation [rad].
+        xyz, rpy: the primitive's centre (a crate: the centre of its floor slab) in the world
+            [m] and orientation [rad].
+        wall, floor: a crate's wall and floor thickness [m]; its links are ``name`` (the floor)
+            and ``name_wall_xpos``, ``_xneg``, ``_ypos``, ``_yneg``, so a contact names the wall.
     """
 
     name: str
@@ -76,6 +129,8 @@ class FixturePrimitive:
     size: tuple[float, ...]
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    wall: float = 0.01
+    floor: float = 0.01
 
 
 @dataclass(frozen=True)
@@ -146,7 +201,7 @@ def _name(value: Any, where: str) -> str:
 
 
 def _fixture_of(table: dict, where: str) -> FixturePrimitive:
-    _keys(table, {"name", "xyz", "rpy", *_SHAPES}, {"name"}, where)
+    _keys(table, {"name", "xyz", "rpy", "wall", "floor", *_SHAPES}, {"name"}, where)
     name = _name(table["name"], where)
     kinds = [k for k in _SHAPES if k in table]
     if len(kinds) != 1:
@@ -155,8 +210,58 @@ def _fixture_of(table: dict, where: str) -> FixturePrimitive:
     size = _numbers(table[kind], kind, where)
     if len(size) != _SHAPES[kind] or min(size) <= 0.0:
         raise CellError(f"{where} ({name!r}): {kind} takes {_SHAPES[kind]} positive number(s) [m], got {table[kind]!r}")
-    return FixturePrimitive(name, kind, size, _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
-                            _triple(table.get("rpy", [0, 0, 0]), "rpy", where))
+    extra = [k for k in ("wall", "floor") if k in table]
+    if extra and kind != "crate":
+        raise CellError(f"{where} ({name!r}): {' and '.join(extra)} belong to a crate, not a {kind}")
+    if any(isinstance(table.get(k), list) for k in ("wall", "floor")):
+        raise CellError(f"{where} ({name!r}): wall and floor take one number each [m]")
+    wall, floor = (_numbers(table.get(k, 0.01), k, where)[0] for k in ("wall", "floor"))
+    fixture = FixturePrimitive(name, kind, size, _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
+                               _triple(table.get("rpy", [0, 0, 0]), "rpy", where), wall, floor)
+    check_crate(fixture, f"{where} ({name!r})")
+    return fixture
+
+
+def check_crate(fixture: FixturePrimitive, where: str) -> None:
+    """A crate's walls and floor must be thinner than it: ``0 < 2 wall < min(x, y)``, ``0 < floor < height``."""
+    if fixture.kind != "crate":
+        return
+    sx, sy, h = fixture.size
+    if not (0.0 < 2.0 * fixture.wall < min(sx, sy) and 0.0 < fixture.floor < h):
+        raise CellError(f"{where}: a crate's wall {fixture.wall:g} m and floor {fixture.floor:g} m must be > 0, two "
+                        f"walls thinner than its width {min(sx, sy):g} m and the floor thinner than its height {h:g} m")
+
+
+def _tool_point(value: Any, where: str) -> ToolPoint:
+    if isinstance(value, str):
+        value = {"link": value}
+    _keys(value, {"link", "xyz", "rpy"}, {"link"}, f"{where} tcp")
+    if not isinstance(value["link"], str) or not value["link"]:
+        raise CellError(f"{where}: tcp link must be a link name, got {value['link']!r}")
+    return ToolPoint(value["link"], _triple(value.get("xyz", [0, 0, 0]), "tcp xyz", where),
+                     _triple(value.get("rpy", [0, 0, 0]), "tcp rpy", where))
+
+
+def _arm_of(table: Any, where: str) -> ArmPlacement:
+    """One ``[[arm]]`` table: name, urdf, pose, and the optional tcp, freeze, states and hold."""
+    _keys(table, _ARM_KEYS, {"name", "urdf"}, where)
+    if not isinstance(table["urdf"], str):
+        raise CellError(f"{where}: urdf must be a string (a path), got {table['urdf']!r}")
+    freeze, states = table.get("freeze", {}), table.get("states", {})
+    for key, value in (("freeze", freeze), ("states", states)):
+        if not isinstance(value, dict):
+            raise CellError(f"{where}: write {key} as a table ({key} = {{ name = ... }}), got {value!r}")
+    hold = table.get("hold")
+    if hold is not None and not isinstance(hold, (str, list)):
+        raise CellError(f"{where}: hold must be a state's name or a list of joint values, got {hold!r}")
+    tcp = _tool_point(table["tcp"], where) if "tcp" in table else None
+    for key, value in states.items():
+        if not isinstance(value, list):
+            raise CellError(f"{where}: state {key!r} must be a list of joint values, got {value!r}")
+    return ArmPlacement(_name(table["name"], where), table["urdf"],
+                        _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
+                        _triple(table.get("rpy", [0, 0, 0]), "rpy", where),
+                        tcp=tcp, freeze=freeze, states=states, hold=hold)
 
 
 def read_cell_description(path: str | os.PathLike) -> CellDescription:
@@ -184,15 +289,7 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
     if not 1 <= len(arm_tables) <= MAX_ARMS or len(fixture_tables) > MAX_FIXTURES:
         raise CellError(f"{path}: {len(arm_tables)} arms and {len(fixture_tables)} fixtures; a description holds "
                         f"1 to {MAX_ARMS} arms and at most {MAX_FIXTURES} fixtures")
-    arms = []
-    for k, table in enumerate(arm_tables):
-        where = f"{path} arm #{k + 1}"
-        _keys(table, {"name", "urdf", "xyz", "rpy"}, {"name", "urdf"}, where)
-        if not isinstance(table["urdf"], str):
-            raise CellError(f"{where}: urdf must be a string (a path), got {table['urdf']!r}")
-        arms.append(ArmPlacement(_name(table["name"], where), table["urdf"],
-                                 _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
-                                 _triple(table.get("rpy", [0, 0, 0]), "rpy", where)))
+    arms = [_arm_of(table, f"{path} arm #{k + 1}") for k, table in enumerate(arm_tables)]
     fixtures = [_fixture_of(t, f"{path} fixture #{k + 1}") for k, t in enumerate(fixture_tables)]
     declared = _declared_of(doc.get("disable_collisions", []), path)
     return CellDescription(name, tuple(arms), tuple(fixtures), path.resolve().parent, declared)

@@ -95,7 +95,8 @@ def check_motion(
         clearance: the distance every pair must keep [m] (``clear`` tells if proven).
         window: ``(t_start, t_end)`` [s]; default: from the earliest start to the latest
             end of the motions, or ``(0, longest period)`` when a motion is periodic.
-        hold: cell configuration ``(nq,)`` of the arms without a motion (default neutral).
+        hold: cell configuration ``(nq,)`` of the arms without a motion (default :attr:`Cell.hold`:
+            each arm's hold pose).
         curve: compute the exact smallest distance at every sample (for a clearance-over-
             time plot) instead of only at the samples the screen flags.
         cover: screen the samples on the sphere cover before the broad phase (same verdicts,
@@ -108,7 +109,7 @@ def check_motion(
     """
     margin, required = _distances(margin, clearance)
     motions = arm_motions(cell, motions)
-    hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+    hold_q = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]
     t0, t1 = _window(motions, window)
     schedule = _schedule(cell, motions, t0, t1, margin)
     screen = required + margin

@@ -166,5 +166,5 @@ def sample_motions(cell: "Cell", motions: Any, *, hz: float = 100.0, window: tup
     if n > MAX_SAMPLES:
         raise InvalidInput(f"{n} samples at {hz!r} Hz over {t1 - t0:.3g} s: at most {MAX_SAMPLES}; lower hz or the window")
     times = np.linspace(t0, t1, n)
-    hold_q = cell.neutral if hold is None else cell.robot.check_q(hold)[0][0]
+    hold_q = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]
     return times, configurations(cell, motions, times, hold_q)

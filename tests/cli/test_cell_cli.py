@@ -63,3 +63,39 @@ def test_cell_errors_are_one_line(run):
                "no arm 'middle'")
     user_error(run("cell", "cycle", "aubo_food_station", "--task", "aubo", "360", "0", "750", "120", "-420", "770",
                    "--mm", ok=False), "place pose of arm 'aubo'", "crate_wall_xpos")
+
+
+def bent_pair_cell(folder) -> str:
+    from tests.robots.cell.bent_pair import bent_pair
+
+    return str(bent_pair(folder, 'tcp = { link = "flange", xyz = [0.05, 0.0, 0.0] }\nfreeze = { finger_joint = 0.02 }\n'
+                                 'states = { home = [0.0, -1.2], ready = [0.5, -1.0] }\nhold = "home"'))
+
+
+def test_cell_show_prints_each_arms_tool_point_frozen_joints_hold_and_states(run, tmp_path):
+    path = bent_pair_cell(tmp_path)
+    text = run("cell", "show", path).stdout
+    assert "    tcp: finger (the last link; no tcp given)" in text
+    assert "    hold: (0, 0, 0) rad/m (neutral)" in text
+    assert "    tcp: flange + xyz (0.05, 0, 0) m, rpy (0, 0, 0) rad" in text
+    assert "    frozen: finger_joint = 0.02" in text
+    assert "    hold: (0, -1.2) rad/m (state home)" in text and "    states: home, ready" in text
+    data = json.loads(run("cell", "show", path, "--json").stdout)
+    a, b = data["arms"]
+    assert a["tcp_frame"] == "finger" and a["states"] == {} and a["frozen"] == {} and a["hold"] == [0.0, 0.0, 0.0]
+    assert b["tcp_frame"] == "tcp" and b["tcp"] == "flange + xyz (0.05, 0, 0) m, rpy (0, 0, 0) rad"
+    assert b["frozen"] == {"finger_joint": 0.02} and b["hold"] == [0.0, -1.2]
+    assert b["states"] == {"home": [0.0, -1.2], "ready": [0.5, -1.0]}
+
+
+def test_cell_cycle_names_the_idle_arm_in_collision_and_takes_its_hold(run, tmp_path):
+    from tests.robots.cell.bent_pair import bent_pair
+
+    path = str(bent_pair(tmp_path, "states = { home = [0.0, -1.2, 0.0] }"))  # b at neutral: in the table
+    cycle = ("cell", "cycle", path, "--task", "a", "0.3", "0.8", "0.8", "0.3", "0.5", "0.8")
+    user_error(run(*cycle, ok=False), "idle arm 'b' is in collision at its hold pose: b_link2 – table")
+    user_error(run(*cycle, "--hold", "b=0,2.5,0", ok=False), "--hold b", "j2 = 2.5 outside [-2, 2]")
+    user_error(run(*cycle, "--hold", "a=home", ok=False), "--hold a", "it has a --task")
+    held = run(*cycle, "--hold", "b=home", ok=False)  # b clear: the cycle itself is planned (this arm cannot reach it)
+    user_error(held, "unreachable")
+    assert "idle arm" not in held.stderr

@@ -53,3 +53,44 @@ def test_motion_goals_best_is_never_slower_in_bound_and_stays_proven():
     assert b["duration_s"] < a["duration_s"]  # seed 0: the first goal reached is the long way round
     bad = CliRunner().invoke(cli, [*args, "--goals", "all"])
     assert bad.exit_code != 0 and "'first', 'best'" in bad.output
+
+
+def _bent_pair(folder: Path, hold: str = "") -> str:
+    from tests.robots.cell.bent_pair import bent_pair
+
+    return str(bent_pair(folder, "states = { home = [0.0, -1.2, 0.0] }\n" + hold))
+
+
+def _one_error_line(result, *fragments: str) -> None:
+    assert result.exit_code == 1, (result.output, result.exception)
+    assert "Traceback" not in result.output and result.stderr.startswith("Error:") and result.stderr.count("\n") == 1
+    for fragment in fragments:
+        assert fragment in result.stderr, result.stderr
+
+
+def test_motion_names_the_idle_arm_in_collision_at_once_and_hold_moves_it_clear(tmp_path):
+    cell = _bent_pair(tmp_path)
+    base = ["motion", cell, "--arm", "a", "--from-q", "0,-1,0", "--amax", "2"]
+    inside_table = ["--to", "0.4", "-0.6", "0.53"]  # a goal inside the table: refused once b is clear
+    _one_error_line(CliRunner().invoke(cli, [*base, "--to", "0.3", "0.6", "0.8"]),
+                    "idle arm 'b' is in collision at its hold pose", "b_link2 – table", "--hold b=")
+    for hold in ("b=0,-1.2,0", "b=home"):
+        _one_error_line(CliRunner().invoke(cli, [*base, *inside_table, "--hold", hold]), "inside fixture 'table'")
+    deg = ["motion", cell, "--arm", "a", "--from-q", "0,-57.3,0", "--amax", "2", "--deg", *inside_table]
+    _one_error_line(CliRunner().invoke(cli, [*deg, "--hold", "b=0,-68.755,0"]), "inside fixture 'table'")
+    _one_error_line(CliRunner().invoke(cli, [*deg, "--hold", "b=0,-1.2,0"]), "idle arm 'b'")  # -1.2 deg: in the table
+    # a hold in the description does the same without the flag
+    held = _bent_pair(tmp_path, 'hold = "home"\n')
+    _one_error_line(CliRunner().invoke(cli, ["motion", held, "--arm", "a", "--from-q", "0,-1,0", "--amax", "2",
+                                             *inside_table]), "inside fixture 'table'")
+
+
+def test_motion_hold_errors_name_the_flag(tmp_path):
+    cell = _bent_pair(tmp_path)
+    base = ["motion", cell, "--arm", "a", "--to", "0.3", "0.6", "0.8", "--amax", "2"]
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b"]), "--hold", "ARM=Q1,Q2,...")
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "c=0,0,0"]), "--hold", "no arm 'c'", "a, b")
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b=0,-1.2"]), "--hold b", "3 values", "j1, j2, finger_joint")
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b=0,2.5,0"]), "--hold b", "j2 = 2.5 outside [-2, 2]")
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b=rest"]), "--hold b", "no state 'rest'", "home")
+    _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "a=0,0,0"]), "--hold a", "the arm planned", "--from-q")
