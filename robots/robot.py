@@ -30,7 +30,12 @@ from .kinematic_tree import KinematicTree
 from .manipulability import manipulability_of_jacobian
 from .robot_ik import RobotIK
 
-__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES", "ACCELERATION_RISE_TIME"]
+
+ACCELERATION_RISE_TIME = 0.25
+"""Time [s] from rest to the velocity limit under the default acceleration limit: a URDF has no
+acceleration field, so :attr:`Robot.acceleration_limit` is ``velocity_limit / 0.25 s`` unless set (the
+rule the built-in arms' efforts are sized by, docs/dynamics.md)."""
 
 MAX_RANDOM_SAMPLES = 50_000_000
 """Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
@@ -65,6 +70,8 @@ class Robot(RobotIK):
         joint_names: names of the independent joints, in ``q`` order.
         lower, upper: joint position limits ``(nq,)`` [rad or m].
         velocity_limit: joint speed limits ``(nq,)`` [rad/s or m/s].
+        acceleration_limit: joint acceleration limits ``(nq,)`` [rad/s² or m/s²]: by default
+            ``velocity_limit /`` :data:`ACCELERATION_RISE_TIME`; ``acceleration_source`` says which.
         effort_limit: joint effort limits ``(nq,)`` [N·m or N].
         urdf_text: the URDF the model was built from.
         urdf_path: its file, when it came from one.
@@ -116,6 +123,10 @@ class Robot(RobotIK):
         self.lower = lo
         self.upper = hi
         self.velocity_limit = np.array(model.velocityLimit, dtype=float)
+        #: joint acceleration limits [rad/s² or m/s²]: the stated default rule unless set (then say so in
+        #: :attr:`acceleration_source`); 0 where the URDF gives no velocity limit
+        self.acceleration_limit = self.velocity_limit / ACCELERATION_RISE_TIME
+        self.acceleration_source = f"default: velocity limit / {ACCELERATION_RISE_TIME:g} s"
         self.effort_limit = np.array(model.effortLimit, dtype=float)
         self.tcp_frame = tcp_frame
         self._analytic_ik = None  # set by the registry for arms with a closed form
