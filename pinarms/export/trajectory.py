@@ -115,8 +115,8 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
         for name in source.arms:
             a = cell.arm(name)
             names += [a.prefix + j for j in a.robot.joint_names]
-            lo.append(a.robot.lower)
-            hi.append(a.robot.upper)
+            lo.append(a.robot.position_limits[0])  # continuous joints: none
+            hi.append(a.robot.position_limits[1])
             vmax.append(a.robot.velocity_limit)
         traj = source.trajectory
         limits = (np.concatenate(lo), np.concatenate(hi), np.concatenate(vmax))
@@ -154,7 +154,7 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
 
 
 def _limits(robot: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return robot.lower, robot.upper, np.asarray(robot.velocity_limit, dtype=float)
+    return (*robot.position_limits, np.asarray(robot.velocity_limit, dtype=float))  # continuous joints: no position limit
 
 
 def _check_width(n: int, robot: Any, what: str) -> None:
