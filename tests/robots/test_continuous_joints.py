@@ -75,22 +75,38 @@ def test_kinova_jaco2_wrist_beyond_pi_is_within_its_limits():
     assert jaco.limit_violations(q) == ["j2s6s200_joint_2 = 0.5 outside [0.820305, 5.46288]"]
 
 
-def test_srdf_state_of_a_continuous_joint_is_written_wrapped(tmp_path):
-    """An SRDF state may hold the wrist at 3.23083 rad: written as the same pose in (-π, π], MoveIt's bounds."""
+@pytest.fixture(scope="module")
+def turner_cell(tmp_path_factory):
+    """The turner as arm ``arm`` of a cell (its upper arm a box), from a file under tmp_path."""
     import re
 
-    from pinarms.export.srdf import srdf_text
     from pinarms.robots.cell import load_cell
 
     body = WRIST_URDF.split("\n", 1)[1].rsplit("</robot>", 1)[0]
     body = re.sub(r'(name|link)="([^"]+)"', r'\1="arm_\2"', body).replace(
         '<link name="arm_upper"/>',
         '<link name="arm_upper"><collision><geometry><box size="0.4 0.05 0.05"/></geometry></collision></link>')
-    path = tmp_path / "turner_cell.urdf"
+    path = tmp_path_factory.mktemp("turner_cell") / "turner_cell.urdf"
     path.write_text('<robot name="turner_cell"><link name="world"/><joint name="arm_mount" type="fixed">'
                     f'<parent link="world"/><child link="arm_base_link"/></joint>{body}</robot>')
-    cell = load_cell(path)
-    assert cell.robot.continuous.tolist() == [False, True]
-    text = srdf_text(cell, states={"turned": {"arm": np.array([0.2, 3.23083])}})
+    return load_cell(path)
+
+
+def test_srdf_state_of_a_continuous_joint_is_written_wrapped(turner_cell):
+    """An SRDF state may hold the wrist at 3.23083 rad: written as the same pose in (-π, π], MoveIt's bounds."""
+    from pinarms.export.srdf import srdf_text
+
+    assert turner_cell.robot.continuous.tolist() == [False, True]
+    text = srdf_text(turner_cell, states={"turned": {"arm": np.array([0.2, 3.23083])}})
     turned = text.split('group_state name="turned"')[1].split("</group_state>")[0]
     assert f'<joint name="arm_wrist" value="{3.23083 - 2.0 * np.pi!r}" />' in turned
+
+
+def test_plan_motion_start_beyond_pi_says_to_give_the_same_pose_in_one_turn(turner_cell):
+    """plan_motion searches a continuous joint in one turn (docs/ik.md): a start beyond it is refused before any
+    search, with the same pose inside it."""
+    from pinarms.optim.motion import plan_motion
+    from pinarms.robots.errors import InvalidInput
+
+    with pytest.raises(InvalidInput, match=r"arm_wrist is continuous: .* \(3\.23083 → -3\.05236\)"):
+        plan_motion(turner_cell, "arm", np.array([0.2, 3.23083]), np.array([0.3, 1.0]), amax=1.0, torque=False)
