@@ -14,7 +14,7 @@ margin 10 mm, search time limit ``--time-limit``), and the table gives, per scen
   (``plan_motion(..., compiled=False)``: the planner before the compiled search), query by
   query interleaved with the default, so that both see the same load;
 * path length in joint space after shortcutting (rad), and the trajectory duration (s,
-  time-optimal under the URDF's velocity and torque limits);
+  time-optimal under the URDF's velocity and torque limits and the default acceleration limits);
 * the smallest clearance to fixtures / the other arm over all plans (must be >= margin).
 
 pyroboplan's RRT-Connect runs on the Panda scenes, same queries, same collision geometry

@@ -29,7 +29,8 @@ class JointLimits:
         velocity: max |qd| (rad/s or m/s), scalar or (n_joints,), > 0.
         acceleration: max |qdd| (rad/s² or m/s²), optional, > 0.
         jerk: max |qddd| (rad/s³ or m/s³), optional, > 0.
-        lower, upper: position bounds (rad or m), optional; ``lower < upper``.
+        lower, upper: position bounds (rad or m), optional; ``lower < upper``; ``-inf`` / ``inf``
+            for a joint without that bound (a continuous joint: :meth:`from_robot` gives it none).
         torque: max |joint torque| (N·m, or N for prismatic joints), optional, > 0; checking it
             needs the robot whose inverse dynamics give the torques
             (:meth:`planning.Trajectory.check` with ``robot=``).
@@ -49,7 +50,7 @@ class JointLimits:
                 if name == "velocity":
                     raise TrajectoryError("velocity limit is required (rad/s or m/s per joint)")
                 continue
-            arr = finite_array(value, f"{name} limit")
+            arr = _bound_array(value, name) if name in ("lower", "upper") else finite_array(value, f"{name} limit")
             if arr.ndim > 1:
                 raise TrajectoryError(f"{name} limit must be a scalar or a 1-D per-joint array, got shape {arr.shape}")
             if name in _POSITIVE and np.any(arr <= 0.0):
@@ -86,7 +87,7 @@ class JointLimits:
 
     @classmethod
     def from_robot(cls, robot: Any, acceleration: Any = None, jerk: Any = None, torque: Any = None) -> "JointLimits":
-        """Velocity and position limits of a robot (``velocity_limit``, ``lower``, ``upper``), plus optional ones.
+        """Velocity and position limits of a robot (``velocity_limit``, ``position_limits`` or ``lower``, ``upper``), plus optional ones.
 
         ``torque=True`` takes the URDF's joint ``effort`` limits (``robot.effort_limit``);
         a number or array gives them explicitly (N·m or N).
@@ -102,15 +103,32 @@ class JointLimits:
             torque = effort
         elif torque is False:
             torque = None
+        # a Robot's position_limits: its continuous joints -inf..inf (none); a robot-like object: lower, upper
+        bounds = getattr(robot, "position_limits", None) or (robot.lower, robot.upper)
         return cls(
             velocity=np.asarray(robot.velocity_limit, dtype=float),
             acceleration=acceleration,
             jerk=jerk,
-            lower=np.asarray(robot.lower, dtype=float),
-            upper=np.asarray(robot.upper, dtype=float),
+            lower=np.asarray(bounds[0], dtype=float),
+            upper=np.asarray(bounds[1], dtype=float),
             torque=torque,
         )
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-able form (``None`` for unset limits)."""
-        return {k: (None if getattr(self, k) is None else getattr(self, k).tolist()) for k in _FIELDS}
+        out = {k: (None if getattr(self, k) is None else getattr(self, k).tolist()) for k in _FIELDS}
+        for k in ("lower", "upper"):  # no bound (a continuous joint): None, as JSON has no infinity
+            arr = getattr(self, k)
+            if arr is not None and not np.all(np.isfinite(arr)):
+                out[k] = [x if np.isfinite(x) else None for x in np.atleast_1d(arr).tolist()]
+        return out
+
+
+def _bound_array(value: Any, name: str) -> np.ndarray:
+    """A position bound: finite values, or ``-inf`` (lower) / ``inf`` (upper) for none; NaN and the wrong infinity refused."""
+    try:
+        raw = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return finite_array(value, f"{name} limit")  # raises with the project's message
+    free = raw == (-np.inf if name == "lower" else np.inf)
+    return np.where(free, raw, finite_array(np.where(free, 0.0, raw), f"{name} limit"))

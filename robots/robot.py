@@ -30,7 +30,12 @@ from .kinematic_tree import KinematicTree
 from .manipulability import manipulability_of_jacobian
 from .robot_ik import RobotIK
 
-__all__ = ["Robot", "MAX_RANDOM_SAMPLES"]
+__all__ = ["Robot", "MAX_RANDOM_SAMPLES", "ACCELERATION_RISE_TIME"]
+
+ACCELERATION_RISE_TIME = 0.25
+"""Time [s] from rest to the velocity limit under the default acceleration limit: a URDF has no
+acceleration field, so :attr:`Robot.acceleration_limit` is ``velocity_limit / 0.25 s`` unless set (the
+rule the built-in arms' efforts are sized by, docs/dynamics.md)."""
 
 MAX_RANDOM_SAMPLES = 50_000_000
 """Most configurations :meth:`Robot.random_q` (and so ``sample_workspace``) draws at once (about 5 GB of work)."""
@@ -63,8 +68,13 @@ class Robot(RobotIK):
         model: the Pinocchio model (``<mimic>`` joints honoured).
         nq: number of independent joints.
         joint_names: names of the independent joints, in ``q`` order.
-        lower, upper: joint position limits ``(nq,)`` [rad or m].
+        lower, upper: joint position limits ``(nq,)`` [rad or m]; a continuous joint has none and
+            holds ``±π`` here: the one-turn window that sampling and IK wrap into (limit checks
+            use :attr:`position_limits`).
+        continuous: continuous joints ``(nq,)`` bool (URDF ``type="continuous"``: unlimited).
         velocity_limit: joint speed limits ``(nq,)`` [rad/s or m/s].
+        acceleration_limit: joint acceleration limits ``(nq,)`` [rad/s² or m/s²]: by default
+            ``velocity_limit /`` :data:`ACCELERATION_RISE_TIME`; ``acceleration_source`` says which.
         effort_limit: joint effort limits ``(nq,)`` [N·m or N].
         urdf_text: the URDF the model was built from.
         urdf_path: its file, when it came from one.
@@ -110,12 +120,19 @@ class Robot(RobotIK):
         coords = self._tree.coordinates
         lo = np.array(model.lowerPositionLimit)[coords.idx_q_pin]
         hi = np.array(model.upperPositionLimit)[coords.idx_q_pin]
-        # continuous joints: Pinocchio stores cos/sin limits; pinarms uses one turn
-        lo[coords.is_unbounded] = -np.pi
-        hi[coords.is_unbounded] = np.pi
+        # continuous joints: Pinocchio stores cos/sin limits; pinarms keeps one angle, no position limit,
+        # and ±π as the window that sampling and IK wrap into (docs/ik.md, "Continuous joints")
+        #: continuous joints ``(nq,)`` bool: one angle each (any real value, the same pose every 2π), unlimited
+        self.continuous = np.array(coords.is_unbounded, dtype=bool)
+        lo[self.continuous] = -np.pi
+        hi[self.continuous] = np.pi
         self.lower = lo
         self.upper = hi
         self.velocity_limit = np.array(model.velocityLimit, dtype=float)
+        #: joint acceleration limits [rad/s² or m/s²]: the stated default rule unless set (then say so in
+        #: :attr:`acceleration_source`); 0 where the URDF gives no velocity limit
+        self.acceleration_limit = self.velocity_limit / ACCELERATION_RISE_TIME
+        self.acceleration_source = f"default: velocity limit / {ACCELERATION_RISE_TIME:g} s"
         self.effort_limit = np.array(model.effortLimit, dtype=float)
         self.tcp_frame = tcp_frame
         self._analytic_ik = None  # set by the registry for arms with a closed form
@@ -223,11 +240,18 @@ class Robot(RobotIK):
         return np.clip(np.zeros(self.nq), self.lower, self.upper)
 
     # ----------------------------------------------------------------- limits
+    @property
+    def position_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(lower, upper)`` ``(nq,)`` [rad or m] that a configuration must keep: :attr:`lower` and
+        :attr:`upper` with ``∓inf`` at continuous joints (the URDF gives them no limit)."""
+        return np.where(self.continuous, -np.inf, self.lower), np.where(self.continuous, np.inf, self.upper)
+
     def within_limits(self, q: Any, tol: float = 1e-9) -> bool | np.ndarray:
-        """Whether ``q`` lies within the position limits (``tol`` in rad or m); never clamps."""
+        """Whether ``q`` lies within the position limits (``tol`` in rad or m; continuous joints: any angle); never clamps."""
         arr, single = self.check_q(q)
         tol = _check_tolerance(tol, "limit tolerance tol [rad or m]")
-        ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=1)
+        lower, upper = self.position_limits
+        ok = np.all((arr >= lower - tol) & (arr <= upper + tol), axis=1)
         return bool(ok[0]) if single else ok
 
     def limit_violations(self, q: Any, tol: float = 1e-9) -> list[str]:
@@ -237,7 +261,7 @@ class Robot(RobotIK):
             raise InvalidInput("limit_violations takes one configuration of shape (nq,)")
         tol = _check_tolerance(tol, "limit tolerance tol [rad or m]")
         out = []
-        for name, v, lo, hi in zip(self.joint_names, arr[0], self.lower, self.upper):
+        for name, v, lo, hi in zip(self.joint_names, arr[0], *self.position_limits):
             if v < lo - tol or v > hi + tol:
                 out.append(f"{name} = {v:.6g} outside [{lo:.6g}, {hi:.6g}]")
         return out

@@ -123,3 +123,25 @@ def test_too_fast_is_refused(scara, move):
     assert peak > 1.0
     with pytest.raises(LimitViolation, match="velocity limit"):
         controller_trajectory(fast, 125, robot=scara)
+
+
+def test_accelerations_beyond_the_arms_limits_are_flagged(scara, move):
+    """A move timed without acceleration limits (0.2 s for a small step: half the velocity limit, about twice
+    the acceleration limit) is flagged by a warning naming the joint and by ``over_acceleration``; the slow
+    move is not."""
+    import warnings
+
+    from pinarms.export.acceleration_check import AccelerationWarning
+
+    q0 = np.zeros(scara.nq)
+    step = 0.5 * scara.velocity_limit * 0.2 / 1.875  # a quintic's peak speed is 1.875 d / T
+    jerky = multi_quintic([0.0, 0.2], np.stack([q0, q0 + step]))
+    ratio = jerky.peaks().acceleration / scara.acceleration_limit
+    assert np.all(jerky.peaks().velocity < scara.velocity_limit) and np.all(ratio > 1.5)
+    with pytest.warns(AccelerationWarning, match=r"x its acceleration limit .* re-time it"):
+        sampled = controller_trajectory(jerky, 500, robot=scara)
+    assert sampled.over_acceleration == scara.joint_names
+    assert np.all(move.peaks().acceleration < scara.acceleration_limit)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert controller_trajectory(move, 125, robot=scara).over_acceleration == ()

@@ -266,13 +266,14 @@ def _check_positions(station: Station, traj: Trajectory, what: str) -> None:
     limits by more than :data:`POSITION_TOL` (never clamps)."""
     lo, hi = traj.position_range()
     robot = station.robot
-    over = np.flatnonzero((lo < robot.lower - POSITION_TOL) | (hi > robot.upper + POSITION_TOL))
+    lower, upper = robot.position_limits  # continuous joints: none
+    over = np.flatnonzero((lo < lower - POSITION_TOL) | (hi > upper + POSITION_TOL))
     if over.size:
         j = int(over[0])
-        value = lo[j] if lo[j] < robot.lower[j] - POSITION_TOL else hi[j]
+        value = lo[j] if lo[j] < lower[j] - POSITION_TOL else hi[j]
         raise PositionLimitError(
             f"arm {station.name!r}: the {what} takes joint {j + 1} ({robot.joint_names[j]}) to {value:.6g}, "
-            f"outside its position limits [{robot.lower[j]:.6g}, {robot.upper[j]:.6g}]: no pick here on this "
+            f"outside its position limits [{lower[j]:.6g}, {upper[j]:.6g}]: no pick here on this "
             "IK branch (try another branch, or move the arm or its box)")
 
 

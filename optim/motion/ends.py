@@ -95,7 +95,10 @@ def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
         names = checker.cell.joint_names
         bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
                for i, c in enumerate(checker.cols) if not checker.lower[i] - 1e-12 <= x[i] <= checker.upper[i] + 1e-12]
-        raise InvalidInput(f"the {label} is outside the joint limits: {'; '.join(bad)}")
+        turn = [f"{names[c]} is continuous: the search keeps it in one turn [-π, π], give the same pose there "
+                f"({x[i]:.6g} → {np.pi - np.mod(np.pi - x[i], 2.0 * np.pi):.6g})"
+                for i, c in enumerate(checker.cols) if checker.cell.robot.continuous[c] and not -np.pi <= x[i] <= np.pi]
+        raise InvalidInput(f"the {label} is outside the joint limits: {'; '.join(bad + turn)}")
     if not checker.state_valid(x):
         e, pair, d = checker.closest(x)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin

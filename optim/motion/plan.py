@@ -16,7 +16,7 @@ The steps, each reported in :class:`MotionPlan`:
 4. **Smooth.** The cubic spline through the shortcut path, proven again; vertices are
    added where it strays, the polyline with stops is the fallback (:mod:`.smoothing`).
 5. **Time.** :func:`optim.time_optimal` along the smooth path (TOPP-RA written here) under
-   the joint velocity limits, joint acceleration limits if given, and joint torque limits
+   the joint velocity limits, joint acceleration limits (the arms' by default), and joint torque limits
    (the URDF's efforts, the arm's inertials) by default: the time-optimal ``s(t)`` of the
    fixed path (bang–bang: jerk is not limited).
 6. **Check and report.** The timed motion is re-checked by the cell's own continuous time
@@ -71,7 +71,18 @@ def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any)
     v = vec(vmax, "vmax") if vmax is not None else np.concatenate([r.velocity_limit for r in robots])
     if not np.all(v > 0.0):
         raise InvalidLimits("the URDF gives no velocity limit for some planned joint: pass vmax [rad/s or m/s]")
-    a = vec(amax, "amax")
+    if amax is None:  # the arms' acceleration limits (the stated default rule unless set on the robot)
+        a = np.concatenate([np.asarray(r.acceleration_limit, dtype=float) for r in robots])
+        a_source = "; ".join(dict.fromkeys(r.acceleration_source for r in robots))
+        if not np.all(a > 0.0):
+            raise InvalidLimits("some planned joint has no acceleration limit (its URDF gives no velocity limit): "
+                                "pass amax [rad/s² or m/s²], or amax=False to time under torques alone")
+    elif amax is True:
+        raise InvalidLimits("amax must be None (the arms' limits), False (none) or limits [rad/s² or m/s²], got True")
+    elif amax is False:
+        a, a_source = None, "none (amax=False)"
+    else:
+        a, a_source = vec(amax, "amax"), "given (amax)"
     cons = [JointVelocityConstraint(v)]
     if a is not None:
         cons.append(JointAccelerationConstraint(a))
@@ -105,7 +116,7 @@ def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any)
     if a is None and len(cons) == 1:
         raise InvalidLimits("the motion would be timed under velocity limits alone (infinite accelerations): give amax "
                             "[rad/s² or m/s²], or torque limits on an arm with inertials")
-    return cons, {"vmax": v, "amax": a, "torque": tau_used}
+    return cons, {"vmax": v, "amax": a, "torque": tau_used, "amax_source": a_source}
 
 
 def time_path(path: JointPath, constraints: Sequence[Any], grid: int = 200) -> Any:
@@ -156,7 +167,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
                 planner: str = "rrtconnect", time_limit: float = 1.0, seed: int = 0, hold: Any = None,
                 frame: str | None = None, vmax: Any = None, amax: Any = None, torque: Any = True,
                 grid: int = 200, threads: int = 1, compiled: bool = True, recheck: bool = True,
-                goals: str = "first", progress: Callable[[str], None] | None = None) -> MotionPlan:
+                goals: str = "best", progress: Callable[[str], None] | None = None) -> MotionPlan:
     """Plan a collision-free move of ``arm`` from ``start`` to ``goal`` in ``cell`` (module docstring).
 
     Args:
@@ -175,7 +186,9 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
             hold pose from the cell description, else neutral).
         frame: the tool frame of a pose goal (default the arm's tcp).
         vmax, amax: joint velocity [rad/s or m/s] (default the URDF's) and acceleration
-            [rad/s² or m/s²] (default none) limits, scalar or per planned joint.
+            [rad/s² or m/s²] limits, scalar or per planned joint; ``amax`` default: the arms'
+            ``Robot.acceleration_limit`` (velocity limit / 0.25 s unless set), ``False``: none
+            (torques alone). ``plan.limits["amax_source"]`` says which.
         torque: ``True``: the URDF's effort limits where the arm has inertials; limits per
             planned joint [N·m or N]; ``False``: none.
         grid: grid intervals of the time scaling (1 to :data:`MAX_GRID`).
@@ -185,12 +198,12 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         recheck: re-check the timed motion by the cell's own continuous check and report its
             clearance profile (``False``: ``check`` and ``clearance`` are ``None``; the path is
             proven by the exact checker either way).
-        goals: with several goal configurations (the IK branches of a pose goal): ``"first"``,
-            the path to the first one reached; ``"best"``, each other goal is also searched
+        goals: with several goal configurations (the IK branches of a pose goal): ``"best"``
+            (default), each other goal is also searched
             (compiled, each with the compiled search's share of ``time_limit``, in increasing order
             of its straight move's time bound, while it could still win) and the path with the
-            shortest time bound (each edge at its slowest joint's speed limit) is kept: for a
-            move planned once and run many times.
+            shortest time bound (each edge at its slowest joint's speed limit) is kept;
+            ``"first"``, the path to the first one reached (a little less planning time).
         progress: called with a short line at each step.
 
     Raises:

@@ -94,10 +94,11 @@ def load_any_cell(name: str) -> Any:
 @click.option("--planner", default="rrtconnect", show_default=True, help="OMPL planner (rrtconnect, rrt, prm, ...).")
 @click.option("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take.")
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of the search (same seed, same path).")
-@click.option("--goals", "goal_choice", type=click.Choice(["first", "best"]), default="first", show_default=True,
-              help="With several clear IK branches of the goal: the path to the first one reached, or each searched "
-                   "and the path with the shortest time bound kept (a move planned once, run many times).")
-@click.option("--amax", default=None, help="Joint acceleration limit(s) [rad/s² or m/s²] (torque limits apply too).")
+@click.option("--goals", "goal_choice", type=click.Choice(["first", "best"]), default="best", show_default=True,
+              help="With several clear IK branches of the goal: each searched and the path with the shortest time "
+                   "bound kept, or the path to the first one reached (a little less planning).")
+@click.option("--amax", default=None, help="Joint acceleration limit(s) [rad/s² or m/s²] (torque limits apply too; "
+                                            "default: each arm's, velocity limit / 0.25 s unless set).")
 @click.option("--no-torque", is_flag=True, help="Time under velocity (and --amax) limits only, not the URDF's torques.")
 @click.option("--deg", is_flag=True, help="ROLL PITCH YAW and --from-q in degrees.")
 @click.option("--mm", is_flag=True, help="Positions and --margin in millimetres.")
@@ -177,8 +178,8 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
         f"  search: {plan.planner} in {plan.seconds['search']:.3f} s, {plan.states} states; path "
         f"{plan.raw_length:.3f} → {plan.path_length:.3f} rad after shortcutting, {plan.smoothing}",
         f"  time-optimal: {plan.duration:.4f} s under "
-        + ", ".join(k for k, v in plan.limits.items() if v is not None)
-        + " limits; limit use " + ", ".join(f"{k} {100 * r:.1f} %" for k, r in plan.timing.ratios.items()),
+        + ", ".join(k for k, v in plan.limits.items() if v is not None and k != "amax_source")
+        + f" limits (amax: {plan.limits['amax_source']}); limit use " + ", ".join(f"{k} {100 * r:.1f} %" for k, r in plan.timing.ratios.items()),
         f"  clearance: {cl.min_environment / lu:.4g} {u} at t = {cl.min_time:.3f} s"
         + (f" ({cl.min_pair[0]} – {cl.min_pair[1]})" if cl.min_pair else "")
         + f", margin {margin_m / lu:g} {u}; proven continuously, re-checked by the cell ({plan.check.n_samples} samples)",

@@ -15,6 +15,7 @@
 docs/export.md shows the commands and what each consumer does with the files.
 """
 
+from .acceleration_check import AccelerationWarning
 from .cell import ExportedCell, export_cell
 from .errors import ExportError, InvalidRate, JointMismatch, MeshNotAllowed, MeshNotFound
 from .robot import SITE_SIZE_M, ExportedMJCF, ExportedURDF, export_mjcf, export_urdf, mesh_references
@@ -30,6 +31,7 @@ from .trajectory import (
 from .verify import EngineComparison, compare_in_mujoco
 
 __all__ = [
+    "AccelerationWarning",
     "ExportedURDF",
     "ExportedMJCF",
     "ExportedCell",

@@ -83,7 +83,8 @@ def _state_joints(cell: Any, arm: Any, q: Any, state: str) -> list[tuple[str, fl
     arr = np.asarray(q, dtype=float)
     if arr.shape != (arm.nq,) or not np.all(np.isfinite(arr)):
         raise InvalidInput(f"state {state!r} of arm {arm.name!r}: expected {arm.nq} finite joint values, got {q!r}")
-    lo, hi = arm.robot.lower, arm.robot.upper
+    lo, hi = arm.robot.position_limits  # continuous joints: any angle, written wrapped to (-π, π] as MoveIt bounds them
+    arr = np.where(arm.robot.continuous, np.pi - np.mod(np.pi - arr, 2.0 * np.pi), arr)
     bad = np.flatnonzero((arr < lo - 1e-12) | (arr > hi + 1e-12))
     if bad.size:
         j = int(bad[0])

@@ -7,7 +7,8 @@ whole nanoseconds (``time_from_start`` is ``{sec, nanosec}``), and every point i
 trajectory evaluated at exactly its written instant: positions, velocities and
 accelerations reproduce it to float precision, far below 1e-9. Every position is checked
 against the joint limits and every velocity against the URDF's velocity limits (a
-violation is an error, never clamped).
+violation is an error, never clamped); accelerations beyond the arms' acceleration limits are
+flagged (:mod:`.acceleration_check`: a warning and ``over_acceleration``).
 
 Sources: a :class:`pinarms.planning.Trajectory` with its robot, a planned cycle
 (:class:`pinarms.optim.CycleResult`, with its robot or cell arm), a planned move
@@ -39,6 +40,7 @@ import numpy as np
 from pinarms.robots.errors import InvalidInput, LimitViolation
 from pinarms.files import atomic_write
 
+from .acceleration_check import acceleration_limits_of, flag_accelerations
 from .errors import InvalidRate, JointMismatch
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
@@ -56,6 +58,8 @@ class ControllerTrajectory:
         joint_names: the controller's joint names.
         time_ns: ``(N,)`` instants from the start [ns] (integers).
         positions, velocities, accelerations: ``(N, n)`` [rad or m, /s, /s²].
+        over_acceleration: joints whose accelerations exceed their arm's acceleration limit
+            (flagged with a warning, :mod:`.acceleration_check`); empty when read from a file.
     """
 
     joint_names: tuple[str, ...]
@@ -63,6 +67,7 @@ class ControllerTrajectory:
     positions: np.ndarray
     velocities: np.ndarray
     accelerations: np.ndarray
+    over_acceleration: tuple[str, ...] = ()
 
     @property
     def times(self) -> np.ndarray:
@@ -110,8 +115,8 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
         for name in source.arms:
             a = cell.arm(name)
             names += [a.prefix + j for j in a.robot.joint_names]
-            lo.append(a.robot.lower)
-            hi.append(a.robot.upper)
+            lo.append(a.robot.position_limits[0])  # continuous joints: none
+            hi.append(a.robot.position_limits[1])
             vmax.append(a.robot.velocity_limit)
         traj = source.trajectory
         limits = (np.concatenate(lo), np.concatenate(hi), np.concatenate(vmax))
@@ -149,7 +154,7 @@ def _source(source: Any, robot: Any, arm: str | None, cycles: Mapping[str, Any] 
 
 
 def _limits(robot: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return robot.lower, robot.upper, np.asarray(robot.velocity_limit, dtype=float)
+    return (*robot.position_limits, np.asarray(robot.velocity_limit, dtype=float))  # continuous joints: no position limit
 
 
 def _check_width(n: int, robot: Any, what: str) -> None:
@@ -197,7 +202,8 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
         i, j = (int(v[0]) for v in np.nonzero(fast))
         raise LimitViolation(f"joint {names[j]} moves at {float(qd[i, j])!r} at t = {t[i] - start:.9f} s, beyond its "
                              f"velocity limit {float(limit[j])!r}: re-time the trajectory under the robot's limits")
-    return ControllerTrajectory(names, ticks, q, qd, qdd)
+    over = flag_accelerations(names, qdd, acceleration_limits_of(source, robot, arm))
+    return ControllerTrajectory(names, ticks, q, qd, qdd, over)
 
 
 def _yaml_float(value: float) -> str:

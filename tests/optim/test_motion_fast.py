@@ -299,8 +299,9 @@ def test_compiled_shortcut_skips_tries_that_gain_too_little(table):
 def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
     """``plan_motion(goals="best")`` on the crate scene: the kept path ends at a clear goal branch, is proven,
     and its time bound is below that of the first goal's path (seed 0 reaches the long way round first);
-    a bad choice is refused."""
-    from pinarms.optim.errors import InvalidSettings
+    it is the default (a faster move than the first branch's), timed under the default acceleration limits
+    (before, torques alone: peaks of 164 rad/s² where the limit rule gives 14.7); bad choices are refused."""
+    from pinarms.optim.errors import InvalidLimits, InvalidSettings
     from pinarms.optim.motion import SCENES, load_scene, plan_motion
     from pinarms.optim.motion.geometry import travel_time_bound
     from pinarms.optim.motion.goals import ik_candidates
@@ -315,10 +316,19 @@ def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
                                        cell.neutral)[0] if checker.state_valid(q))
     goal = region_pose(crate, 0.5 * (np.array(crate.lo) + np.array(crate.hi)))
     v = arm.robot.velocity_limit
-    first = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False)
+    first = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False, goals="first")
     best = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, goals="best")
+    default = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False)
     assert best.check.collision_free and best.compiled
     assert travel_time_bound(best.simplified, v) < travel_time_bound(first.simplified, v)
+    assert np.array_equal(default.simplified, best.simplified)  # the default is the fastest clear branch
+    assert round(default.duration, 3) == round(best.duration, 3) < round(first.duration, 3)
+    # accelerations limited by default (velocity limit / 0.25 s), and the plan says so
+    assert default.limits["amax_source"] == "default: velocity limit / 0.25 s"
+    np.testing.assert_allclose(default.limits["amax"], v / 0.25)
+    assert np.all(default.trajectory.peaks().acceleration <= v / 0.25 * (1 + 1e-6))
+    with pytest.raises(InvalidLimits, match="amax must be None"):
+        plan_motion(cell, "aubo", q0, goal, amax=True)
     G = np.array([g.q for g in best.goals if g.valid])
     assert len(G) > 1 and any(np.array_equal(best.simplified[-1], g) for g in G)
     with pytest.raises(InvalidSettings, match="goals must be"):
