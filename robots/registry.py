@@ -20,6 +20,7 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 # the URDF checks, under the names robots/cell/compose.py imports from here
+from .urdf_checks import check_inertials as _check_inertials
 from .urdf_checks import check_limits as _check_limits
 from .urdf_checks import check_tree as _check_tree
 from .urdf_checks import refuse_dtd as _refuse_dtd
@@ -255,6 +256,7 @@ def from_urdf_text(
     if not root.findall("link"):
         raise ModelError(f"{source} defines no <link>")
     _check_tree(root, source)
+    _check_inertials(root, source)
     if freeze:
         _freeze_joints(root, tuple(freeze), source)
         urdf_text = ET.tostring(root, encoding="unicode")
