@@ -12,7 +12,11 @@ import numpy as np
 
 from .errors import InvalidInput
 
-__all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance"]
+__all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance", "check_restarts", "MAX_RESTARTS"]
+
+#: Most random restarts of one numerical IK solve (default 40; one restart costs up to a few
+#: ms, so the cap bounds an unreachable target at a few seconds).
+MAX_RESTARTS = 1000
 
 
 def real_array(values: Any, what: str) -> np.ndarray:
@@ -71,3 +75,11 @@ def check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
         sign = "positive" if positive else "non-negative"
         raise InvalidInput(f"{what} must be a finite {sign} number, got {tol!r}")
     return value
+
+
+def check_restarts(value: Any, what: str = "max_restarts") -> int:
+    """``value`` as an int from 0 to :data:`MAX_RESTARTS`; else :class:`InvalidInput` naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= MAX_RESTARTS:
+        raise InvalidInput(f"{what} must be an integer from 0 to {MAX_RESTARTS} (random restarts of the numerical "
+                           f"IK per target), got {value!r}")
+    return int(value)
