@@ -53,3 +53,11 @@ def test_motion_goals_best_is_never_slower_in_bound_and_stays_proven():
     assert b["duration_s"] < a["duration_s"]  # seed 0: the first goal reached is the long way round
     bad = CliRunner().invoke(cli, [*args, "--goals", "all"])
     assert bad.exit_code != 0 and "'first', 'best'" in bad.output
+
+
+def test_the_help_example_plans_a_proven_move():
+    from test_help_examples import EXAMPLES
+
+    result = CliRunner().invoke(cli, EXAMPLES["motion"])  # once "unreachable": it had no --from
+    assert result.exit_code == 0, (result.output, result.stderr)
+    assert "proven continuously" in result.output and "clearance:" in result.output
