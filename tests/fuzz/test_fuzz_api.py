@@ -522,3 +522,12 @@ def test_plan_motion_seed_outside_its_range_is_a_named_error(crate_guard, seed):
     arm = cell.arms[0]
     start = arm.robot.neutral
     _quickly(lambda: plan_motion(cell, arm.name, start, start + 0.1, seed=seed), InvalidSettings, "seed")
+
+
+@pytest.mark.parametrize("path", ["arm\0.urdf", "a" * 300 + ".urdf", "d/" * 3000 + "arm.urdf"])
+@pytest.mark.parametrize("load", ["from_urdf", "load_cell", "from_xacro"])
+def test_a_description_path_with_a_nul_byte_or_too_long_is_a_named_error(load, path):
+    from pinarms.robots.errors import InvalidInput
+
+    path = path.replace(".urdf", ".xacro") if load == "from_xacro" else path
+    _quickly(lambda: getattr(robots, load)(path), InvalidInput, "NUL byte|too long")
