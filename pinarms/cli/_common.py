@@ -52,8 +52,7 @@ class PinarmsGroup(click.Group):
 
         if ctx.parent is not None:  # a nested group: the outermost one catches and reports
             return self._invoke(ctx)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("default")
+        with warnings.catch_warnings(record=True) as caught:  # the filters in force decide what is recorded
             result = self._invoke(ctx)  # on an error, its one Error: line is all the user sees
         for text in dict.fromkeys(f"{w.category.__name__}: {' '.join(str(w.message).split())}" for w in caught):
             click.echo(f"Warning: {text}", err=True)  # one line each, without Python's source lines
