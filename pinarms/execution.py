@@ -272,7 +272,12 @@ def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
     n_workers = min(n_workers, len(tasks))
     # the workers' statistical profiler (a thread sampling every 10 ms) took 5-10 % of their CPU
     # on the sizing sweep (benchmarks/line.py sizing): off, as it only feeds the dashboard
-    with warnings.catch_warnings(), dask.config.set({"distributed.worker.profile.enabled": False}):
+    # one task at a time per worker (the default saturation 1.1 sends a second one ahead): a worker
+    # process that dies then takes only the chunk that killed it, and only that chunk is blamed
+    # (with 1.1, a chunk queued beside the killer on each dying worker was retried as often and
+    # could be named instead of it)
+    settings = {"distributed.worker.profile.enabled": False, "distributed.scheduler.worker-saturation": 1.0}
+    with warnings.catch_warnings(), dask.config.set(settings):
         # the scheduler's HTTP endpoint moves to a free port when 8787 is taken: not our concern
         warnings.filterwarnings("ignore", message="Port .* is already in use")
         cluster = LocalCluster(

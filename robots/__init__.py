@@ -117,10 +117,12 @@ from .reach.orientations import (  # noqa: E402
 )
 from .reach.reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
 from .reach.reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
+from ._checks import MAX_RESTARTS  # noqa: E402
 from .reach.inverse_reach import BasePlacements, base_placements, tool_down_poses  # noqa: E402
 
 __all__ += [
     "ReachabilityMap",
+    "MAX_RESTARTS",
     "reachability_map",
     "reach_bound",
     "OrientationSet",

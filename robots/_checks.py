@@ -12,7 +12,11 @@ import numpy as np
 
 from .errors import InvalidInput
 
-__all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance"]
+__all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance", "check_restarts", "MAX_RESTARTS", "check_path_name"]
+
+#: Most random restarts of one numerical IK solve (default 40; one restart costs up to a few
+#: ms, so the cap bounds an unreachable target at a few seconds).
+MAX_RESTARTS = 1000
 
 
 def real_array(values: Any, what: str) -> np.ndarray:
@@ -71,3 +75,28 @@ def check_tolerance(tol: Any, what: str, *, positive: bool = False) -> float:
         sign = "positive" if positive else "non-negative"
         raise InvalidInput(f"{what} must be a finite {sign} number, got {tol!r}")
     return value
+
+
+def check_restarts(value: Any, what: str = "max_restarts") -> int:
+    """``value`` as an int from 0 to :data:`MAX_RESTARTS`; else :class:`InvalidInput` naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= MAX_RESTARTS:
+        raise InvalidInput(f"{what} must be an integer from 0 to {MAX_RESTARTS} (random restarts of the numerical "
+                           f"IK per target), got {value!r}")
+    return int(value)
+
+
+def check_path_name(path: Any, what: str) -> None:
+    """:class:`InvalidInput` for a path no file can have: a NUL byte in it, or a name the system
+    refuses as too long (``ENAMETOOLONG``: a part over 255 bytes or the whole over 4096 on Linux)."""
+    import errno
+    import os
+
+    text = os.fsdecode(os.fspath(path))
+    if "\0" in text:
+        raise InvalidInput(f"{what} {text!r} contains a NUL byte: no file has such a name; check the path")
+    try:
+        os.stat(text)
+    except OSError as exc:
+        if exc.errno == errno.ENAMETOOLONG:
+            raise InvalidInput(f"{what} {text[:80]!r}... ({len(text)} characters) is too long a path for this "
+                               "system (a part over 255 bytes or the whole over 4096): check the path") from None

@@ -20,6 +20,8 @@ import pinocchio as pin
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 # the URDF checks, under the names robots/cell/compose.py imports from here
+from ._checks import check_path_name
+from .urdf_checks import check_inertials as _check_inertials
 from .urdf_checks import check_limits as _check_limits
 from .urdf_checks import check_tree as _check_tree
 from .urdf_checks import refuse_dtd as _refuse_dtd
@@ -255,6 +257,7 @@ def from_urdf_text(
     if not root.findall("link"):
         raise ModelError(f"{source} defines no <link>")
     _check_tree(root, source)
+    _check_inertials(root, source)
     if freeze:
         _freeze_joints(root, tuple(freeze), source)
         urdf_text = ET.tostring(root, encoding="unicode")
@@ -304,6 +307,7 @@ def from_urdf(
     Raises:
         ModelError: the file is missing, not XML, not a URDF, or Pinocchio rejects it.
     """
+    check_path_name(path, "URDF file")
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -357,6 +361,7 @@ def from_xacro(
     """
     from .xacro_expand import check_mesh_files, expand_xacro
 
+    check_path_name(path, "xacro file")
     path = Path(path)
     all_args = {**(xacro_args or {}), **args}
     result = expand_xacro(path, all_args, packages=packages, limits=limits)

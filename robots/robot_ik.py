@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import check_restarts as _check_restarts
 from ._checks import check_seed as _check_seed
 from ._checks import check_tolerance as _check_tolerance
 from .errors import InvalidInput, ModelError, UnreachableTarget
@@ -260,8 +261,7 @@ class RobotIK:
         """
         T, single = self.check_target(target, position_only=position_only)
         tol = _check_tolerance(tol, "tol [m, rad]", positive=True)
-        if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
-            raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+        _check_restarts(max_restarts)
         _check_seed(seed)
         limit_tol = _limit_tolerance(limit_tolerance)
         if not single:

@@ -4,8 +4,12 @@
   parser would not expand them);
 - :func:`check_tree`: the links and joints form one tree (Pinocchio crashes the process on a
   loop);
-- :func:`check_limits`: the model's position limits have lower ≤ upper and its speed and
-  effort limits are magnitudes.
+- :func:`check_limits`: the model's position limits have lower ≤ upper within
+  ±:data:`MAX_POSITION_LIMIT`, its speed and effort limits are magnitudes up to
+  :data:`MAX_SPEED_LIMIT` and :data:`MAX_EFFORT_LIMIT` (or "none given"), and every link's
+  mass is finite and ≥ 0 with a finite inertia;
+- :func:`check_inertials`: every ``<mass value>`` is a finite number ≥ 0 (urdfdom drops an
+  inertial whose mass is ``nan`` or ``inf`` with a message on stderr and loads the link massless).
 
 Each raises :class:`~robots.errors.ModelError` naming the file (``source``) and the problem.
 """
@@ -20,7 +24,16 @@ import pinocchio as pin
 
 from .errors import ModelError
 
-__all__ = ["refuse_dtd", "check_tree", "check_limits"]
+__all__ = ["refuse_dtd", "check_tree", "check_limits", "check_inertials", "MAX_POSITION_LIMIT", "MAX_SPEED_LIMIT", "MAX_EFFORT_LIMIT"]
+
+#: Largest magnitude of a position limit [rad or m]. A URDF writes ±1e9 for "practically none"
+#: (1.6e8 turns; a double still resolves 1.2e-7 there); beyond, spans overflow (1e308 − (−1e308)
+#: is inf) and samples, equivalents and distances in joint space stop being numbers.
+MAX_POSITION_LIMIT = 1e9
+#: Largest velocity limit [rad/s or m/s] and effort limit [N·m or N] a URDF may give (as large
+#: as "none"); Pinocchio's +inf for a joint without ``<limit>`` stays "none given".
+MAX_SPEED_LIMIT = 1e9
+MAX_EFFORT_LIMIT = 1e9
 
 
 def check_tree(root: ET.Element, source: str) -> None:
@@ -106,7 +119,7 @@ def _stop_at_root(*_: object) -> None:
 
 
 def check_limits(model: pin.Model, source: str) -> None:
-    """ModelError for position limits with lower > upper, or negative speed or effort limits."""
+    """ModelError for a limit or a link mass that makes no sense (module doc), naming the joint or link."""
     for i in range(1, model.njoints):
         j = model.joints[i]
         if j.nq == 0 or "Mimic" in j.shortname():
@@ -117,8 +130,43 @@ def check_limits(model: pin.Model, source: str) -> None:
         if np.any(lo > hi):
             raise ModelError(f"{source}: joint {name!r} has lower limit {lo.tolist()} above its upper limit "
                              f"{hi.tolist()}; swap them")
+        bounded = j.nq == j.nv == 1 and "RUB" not in j.shortname()  # revolute or prismatic with a range
+        if bounded and not (np.all(np.abs(lo) <= MAX_POSITION_LIMIT) and np.all(np.abs(hi) <= MAX_POSITION_LIMIT)):
+            raise ModelError(f"{source}: joint {name!r} has a position limit beyond ±{MAX_POSITION_LIMIT:g} "
+                             f"([{lo.tolist()}, {hi.tolist()}]); give its real range (a continuous joint has none)")
         v = model.velocityLimit[j.idx_v: j.idx_v + j.nv]
         e = model.effortLimit[j.idx_v: j.idx_v + j.nv]
         if np.any(v < 0) or np.any(e < 0):
             raise ModelError(f"{source}: joint {name!r} has a negative velocity or effort limit "
                              f"({v.tolist()}, {e.tolist()}); limits are magnitudes")
+        for key, values, cap in (("velocity", v, MAX_SPEED_LIMIT), ("effort", e, MAX_EFFORT_LIMIT)):
+            if np.any((values > cap) & np.isfinite(values)) or np.any(np.isnan(values)):
+                raise ModelError(f"{source}: joint {name!r} has a {key} limit {values.tolist()} beyond {cap:g} "
+                                 "(SI units); give the arm's real limit")
+    _check_masses(model, source)
+
+
+def _check_masses(model: pin.Model, source: str) -> None:
+    for i in range(1, model.njoints):
+        inertia = model.inertias[i]
+        mass = float(inertia.mass)
+        if not (np.isfinite(mass) and mass >= 0.0) or not np.all(np.isfinite(inertia.inertia)) \
+                or not np.all(np.isfinite(inertia.lever)):
+            links = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == i]
+            where = f"link {links[0]!r}" if len(links) == 1 else f"the links of joint {model.names[i]!r} ({links})"
+            raise ModelError(f"{source}: {where} has mass {mass!r} kg or a non-finite inertia; an <inertial> needs "
+                             "a finite mass >= 0 and a finite inertia")
+
+
+def check_inertials(root: ET.Element, source: str) -> None:
+    """ModelError unless every link's ``<inertial><mass value>`` is a finite number >= 0 [kg]."""
+    for link in root.findall("link"):
+        for mass in link.findall("inertial/mass"):
+            text = mass.get("value", "")
+            try:
+                value = float(text)
+            except ValueError:
+                value = float("nan")
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ModelError(f"{source}: link {link.get('name')!r} has mass {text!r} kg; an <inertial> needs a "
+                                 "finite mass >= 0")

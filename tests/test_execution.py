@@ -175,3 +175,14 @@ def test_reduce_chunks_folds_in_task_order(client):
     assert execution.reduce_chunks(fail_on_chunk, tasks, fold, [], scheduler=client) == [0, 2, 4, 6, 8, 10, 12]
     with pytest.raises(InvalidInput, match="combine"):
         execution.reduce_chunks(fail_on_chunk, tasks, None, [])
+
+
+@pytest.mark.slow
+def test_a_dead_worker_is_blamed_on_the_chunk_that_killed_it():
+    """Default retries (the killer is re-run on 4 workers in all): a chunk queued beside it on a dying
+    worker is innocent and must not be named (chunk 2 was, for a killer at chunk 3)."""
+    pytest.importorskip("distributed")
+    tasks = [{"n": k, "die": k == 3, "seed": 40 + k} for k in range(12)]
+    with pytest.raises(ExecutionError, match="chunk 3 \\(seed 43\\) lost its worker") as info:
+        map_chunks(die_on_chunk, tasks, scheduler="processes:2")
+    assert info.value.chunk == 3

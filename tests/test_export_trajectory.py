@@ -145,3 +145,89 @@ def test_accelerations_beyond_the_arms_limits_are_flagged(scara, move):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert controller_trajectory(move, 125, robot=scara).over_acceleration == ()
+
+
+def _renamed(sampled, names):
+    from pinarms.export import ControllerTrajectory
+
+    return ControllerTrajectory(tuple(names), sampled.time_ns, sampled.positions, sampled.velocities,
+                                sampled.accelerations)
+
+
+@pytest.mark.parametrize("name", ["x', 'y", 'a"b', "j: 1", "#j", "- j", "j\nk", "1joint", "", "joint-1", "a b"])
+def test_a_joint_name_outside_the_ros_rule_is_refused(scara, move, name, tmp_path):
+    from pinarms.export import InvalidJointName
+
+    sampled = _renamed(controller_trajectory(move, 125, robot=scara), ("j1", name, "j3", "j4"))
+    with pytest.raises(InvalidJointName, match="joint name"):
+        write_trajectory_yaml(tmp_path / "m.yaml", sampled)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_names_and_frame_round_trip_through_the_yaml_emitter(scara, move, tmp_path):
+    names = ("/left/j1", "left/j_2", "J3", "a/b/c4")
+    sampled = _renamed(controller_trajectory(move, 125, robot=scara), names)
+    path = write_trajectory_yaml(tmp_path / "m.yaml", sampled, frame_id="x', 'y: #z")
+    doc = yaml.safe_load(path.read_text())
+    assert doc["header"]["frame_id"] == "x', 'y: #z"
+    assert read_trajectory_yaml(path).joint_names == names
+
+
+def _yaml_file(tmp_path, text):
+    path = tmp_path / "t.yaml"
+    path.write_text(text)
+    return path
+
+
+GOOD = ("joint_names: [a, b]\npoints:\n- positions: [0.0, 1.0]\n  velocities: [0.0, 0.0]\n"
+        "  accelerations: [0.0, 0.0]\n  time_from_start: {sec: 0, nanosec: 0}\n")
+
+
+@pytest.mark.parametrize("text, what", [
+    ("joint_names: ['x', 'y\n", "not valid YAML"),
+    ("joint_names: [a, b]\npoints: 'x\"", "not valid YAML"),
+    ("\x00", "not valid YAML"),
+    (GOOD.replace("[0.0, 1.0]", "!!binary AAAA"), "binary"),
+    (GOOD.replace("[a, b]", "!!python/tuple [a, b]"), "python/tuple"),
+    (GOOD.replace("{sec: 0, nanosec: 0}", "!!timestamp 2001-12-14"), "timestamp"),
+    ("joint_names: &n [a, b]\npoints:\n- positions: *n\n", "alias"),
+    (GOOD.replace("[a, b]", "[1, 2]"), "joint_names"),
+    (GOOD.replace("[0.0, 1.0]", "[0.0, .nan]"), "finite"),
+    (GOOD.replace("[0.0, 1.0]", "[0.0, 1.0, 2.0]"), "positions"),
+    (GOOD.replace("sec: 0,", "sec: -1,"), "time_from_start"),
+    ("[1, 2]", "JointTrajectory"),
+])
+def test_a_malformed_yaml_file_is_a_named_error(tmp_path, text, what):
+    from pinarms.export import TrajectoryFileError
+
+    with pytest.raises(TrajectoryFileError, match=what) as info:
+        read_trajectory_yaml(_yaml_file(tmp_path, text))
+    assert "t.yaml" in str(info.value)
+
+
+def test_a_well_formed_foreign_yaml_file_reads(tmp_path):
+    back = read_trajectory_yaml(_yaml_file(tmp_path, GOOD))
+    assert back.joint_names == ("a", "b") and back.positions.tolist() == [[0.0, 1.0]]
+
+
+def test_trajectory_files_are_bounded_before_reading(tmp_path, monkeypatch):
+    from pinarms.export import TrajectoryFileError, trajectory_read
+
+    monkeypatch.setattr(trajectory_read, "MAX_FILE_BYTES", 100)
+    big = _yaml_file(tmp_path, GOOD + "#" * 200)
+    with pytest.raises(TrajectoryFileError, match="100 bytes"):
+        read_trajectory_yaml(big)
+    with pytest.raises(TrajectoryFileError, match="not a regular file"):
+        read_trajectory_csv(tmp_path)
+
+
+def test_a_csv_field_over_the_csv_limit_is_a_named_error(tmp_path):
+    from pinarms.export import TrajectoryFileError
+
+    path = tmp_path / "t.csv"
+    path.write_text("time_s,pos:a,vel:a,acc:a\n0.0,\"" + "1" * (200 * 1024) + "\",0,0\n")
+    with pytest.raises(TrajectoryFileError, match="t.csv"):
+        read_trajectory_csv(path)
+    path.write_text("time_s,pos:a,vel:a,acc:a\n0.0,x,0,0\n")
+    with pytest.raises(TrajectoryFileError, match="row 1"):
+        read_trajectory_csv(path)

@@ -137,8 +137,8 @@ def _check_settings(planner: Any, time_limit: Any, seed: Any, grid: Any) -> str:
     ok = isinstance(time_limit, (int, float, np.integer, np.floating)) and not isinstance(time_limit, bool)
     if not ok or not np.isfinite(float(time_limit)) or float(time_limit) <= 0.0:
         raise InvalidSettings(f"time_limit must be a positive number of seconds, got {time_limit!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise InvalidSettings(f"seed must be an integer, got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) < 2**63:
+        raise InvalidSettings(f"seed must be an integer from 0 to 2**63 - 1, got {seed!r}")
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 1 <= int(grid) <= MAX_GRID:
         raise InvalidSettings(f"grid must be an integer from 1 to {MAX_GRID} (intervals of the time scaling; "
                               f"about 5.5 kB each), got {grid!r}")
@@ -181,7 +181,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         self_margin: clearance [m] kept between two links of one arm (default 0: no contact).
         planner: an OMPL planner, one of :data:`optim.motion.search.PLANNERS` (default RRT-Connect).
         time_limit: seconds the search may take.
-        seed: seed of the search and the shortcutting (same seed, same path).
+        seed: seed of the search and the shortcutting, 0 to 2**63 − 1 (same seed, same path).
         hold: cell configuration of the arms not planned (default :attr:`Cell.hold`, each arm's
             hold pose from the cell description, else neutral).
         frame: the tool frame of a pose goal (default the arm's tcp).

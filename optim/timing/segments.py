@@ -15,7 +15,8 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.optim.ga.engine import GAHistory, GAProgress, random_generator, run_ga
-from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
+from pinarms.optim.caps import MAX_GENERATIONS
+from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
 from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
 from pinarms.optim.ga.settings import GASettings
@@ -154,7 +155,8 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
             Default: ``[s0 / (20 m), 1.001 min(s0, 4 s0 / m)]`` per segment, s0 the minimal
             total with equal durations (so equal durations s0/m are inside and feasible).
             Pass wider bounds if one segment may need more than 4x the average.
-        max_generations, stall_generations, time_limit: GA stopping rules.
+        max_generations, stall_generations, time_limit: GA stopping rules (``max_generations``
+            1 to :data:`optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
         polish: GA only: refine the GA's (rescaled) answer by a local gradient method
@@ -190,6 +192,11 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
             cannot hold a via point still with its payload).
     """
     t0 = time.perf_counter()
+    if max_generations is not None and not (isinstance(max_generations, (int, np.integer))
+                                            and not isinstance(max_generations, bool)
+                                            and 1 <= max_generations <= MAX_GENERATIONS):
+        raise SettingOutOfRange(f"max_generations = {max_generations!r} is outside 1 to {MAX_GENERATIONS:,} "
+                                "(the generations of the timing GA)")
     problem = _timing_problem(method, seed, problem, robot, torque_limits, payload, torque_samples,
                               positions=positions, kind=kind, vmax=vmax, amax=amax, jmax=jmax, bounds=bounds,
                               trajectory_options=trajectory_options)

@@ -40,12 +40,34 @@ class PinarmsGroup(click.Group):
 
     pinarms errors print their message; a missing or unreadable file, a file that is not
     UTF-8 text and running out of memory say so; anything else is an unexpected error,
-    named by its type (``PINARMS_TRACEBACK=1`` shows its traceback).
+    named by its type (``PINARMS_TRACEBACK=1`` shows its traceback). Python warnings (NumPy's
+    overflow or division warnings) raised by a command that fails are dropped, the ``Error:``
+    line says what went wrong; after a command that succeeds each distinct one is a
+    ``Warning: ...`` line on stderr. An unknown option that names an existing file says how
+    to give it (``./--c.toml`` or ``-- --c.toml``).
     """
 
     def invoke(self, ctx: click.Context) -> Any:
+        import warnings
+
+        if ctx.parent is not None:  # a nested group: the outermost one catches and reports
+            return self._invoke(ctx)
+        with warnings.catch_warnings(record=True) as caught:  # the filters in force decide what is recorded
+            result = self._invoke(ctx)  # on an error, its one Error: line is all the user sees
+        for text in dict.fromkeys(f"{w.category.__name__}: {' '.join(str(w.message).split())}" for w in caught):
+            click.echo(f"Warning: {text}", err=True)  # one line each, without Python's source lines
+        return result
+
+    def _invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
+        except click.NoSuchOption as exc:
+            import os
+
+            if exc.option_name and os.path.exists(exc.option_name):
+                exc.message = (f"{exc.message.rstrip('.')}; to name the file {exc.option_name!r}, write "
+                               f"./{exc.option_name} or put -- before it")
+            raise
         except (click.ClickException, click.exceptions.Exit, click.exceptions.Abort):
             raise
         except PinarmsError as exc:

@@ -117,7 +117,7 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
     (aubo_food_station, mushroom_line) or a cell file. Poses are in the world frame; a pose
     without ROLL PITCH YAW keeps the tool's orientation at the start.
 
-    Example: pinarms motion aubo_crate_guard --to 0 -0.46 0.78 --margin 0.01
+    Example: pinarms motion aubo_crate_guard --from 0.41 0.10 0.79 --to 0 -0.465 0.78 --margin 0.01
     """
     import sys
 

@@ -6,7 +6,7 @@
 - :mod:`.srdf`: the SRDF (groups, end effectors, named states, disable_collisions from
   pinarms' proven pair classification);
 - :mod:`.trajectory`: planned trajectories as ROS 2 ``JointTrajectory`` YAML and CSV at a
-  controller rate, and their readers;
+  controller rate; :mod:`.trajectory_read`: their readers, bounded;
 - :mod:`.mesh_sources`: which mesh and texture files an export may copy (the allowed
   folders, the suffixes) and their names in the folder;
 - :mod:`.verify`: a planned motion replayed in MuJoCo through the exported MJCF, distances
@@ -17,17 +17,17 @@ docs/export.md shows the commands and what each consumer does with the files.
 
 from .acceleration_check import AccelerationWarning
 from .cell import ExportedCell, export_cell
-from .errors import ExportError, InvalidRate, JointMismatch, MeshNotAllowed, MeshNotFound
+from .errors import ExportError, InvalidJointName, InvalidRate, JointMismatch, MeshNotAllowed, MeshNotFound, TrajectoryFileError
 from .robot import SITE_SIZE_M, ExportedMJCF, ExportedURDF, export_mjcf, export_urdf, mesh_references
 from .srdf import SRDF_REASON, contact_pairs, cycle_states, srdf_text
 from .trajectory import (
     ControllerTrajectory,
+    check_joint_names,
     controller_trajectory,
-    read_trajectory_csv,
-    read_trajectory_yaml,
     write_trajectory_csv,
     write_trajectory_yaml,
 )
+from .trajectory_read import read_trajectory_csv, read_trajectory_yaml
 from .verify import EngineComparison, compare_in_mujoco
 
 __all__ = [
@@ -57,4 +57,7 @@ __all__ = [
     "MeshNotAllowed",
     "InvalidRate",
     "JointMismatch",
+    "InvalidJointName",
+    "TrajectoryFileError",
+    "check_joint_names",
 ]

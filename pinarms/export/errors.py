@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pinarms.robots.errors import InvalidInput, MissingMesh, PinarmsError
 
-__all__ = ["ExportError", "MeshNotFound", "MeshNotAllowed", "InvalidRate", "JointMismatch"]
+__all__ = ["ExportError", "MeshNotFound", "MeshNotAllowed", "InvalidRate", "JointMismatch", "InvalidJointName", "TrajectoryFileError"]
 
 
 class ExportError(PinarmsError):
@@ -26,3 +26,11 @@ class InvalidRate(ExportError, InvalidInput):
 
 class JointMismatch(ExportError, InvalidInput):
     """A trajectory whose joints are not those of the robot or arm it is written for."""
+
+
+class InvalidJointName(ExportError, InvalidInput):
+    """A joint name a controller file cannot carry: outside the ROS name rule (``[A-Za-z/][A-Za-z0-9_/]*``)."""
+
+
+class TrajectoryFileError(ExportError, InvalidInput):
+    """A trajectory file (YAML or CSV) that is not what the readers accept (the message names the file)."""

@@ -23,7 +23,7 @@ Files: :func:`write_trajectory_yaml` writes a ``trajectory_msgs/JointTrajectory`
 ``ros2 action send_goal`` and a ``JointTrajectoryController`` accept;
 :func:`write_trajectory_csv` one row per instant: ``time_s``, then ``pos:<joint>``,
 ``vel:<joint>``, ``acc:<joint>`` (SI units). Both are written atomically and read back by
-:func:`read_trajectory_yaml` / :func:`read_trajectory_csv`.
+:func:`~.trajectory_read.read_trajectory_yaml` / :func:`~.trajectory_read.read_trajectory_csv`.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ import csv
 import io
 import math
 import os
+import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -41,10 +42,10 @@ from pinarms.robots.errors import InvalidInput, LimitViolation
 from pinarms.files import atomic_write
 
 from .acceleration_check import acceleration_limits_of, flag_accelerations
-from .errors import InvalidRate, JointMismatch
+from .errors import InvalidJointName, InvalidRate, JointMismatch
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
-           "read_trajectory_yaml", "read_trajectory_csv", "line_arm_sampler"]
+           "line_arm_sampler", "check_joint_names", "ROS_NAME"]
 
 #: Most points one file may hold.
 MAX_POINTS = 2_000_000
@@ -206,8 +207,24 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
     return ControllerTrajectory(names, ticks, q, qd, qdd, over)
 
 
+#: The ROS graph resource name rule (wiki.ros.org/Names, "Valid Names": a letter, ``~`` or ``/``
+#: first, then letters, digits, ``_`` and ``/``), without the private ``~``; at most 255 characters.
+ROS_NAME = re.compile(r"[A-Za-z/][A-Za-z0-9_/]{0,254}")
+
+
+def check_joint_names(names: Any) -> tuple[str, ...]:
+    """``names`` as a tuple, each a ROS name (:data:`ROS_NAME`); else :class:`InvalidJointName` naming it."""
+    out = tuple(names)
+    for name in out:
+        if not isinstance(name, str) or ROS_NAME.fullmatch(name) is None:
+            raise InvalidJointName(f"joint name {name!r} is not a ROS name (a letter or '/' first, then letters, "
+                                   "digits, '_' and '/', at most 255 characters): rename the joint in the URDF "
+                                   "(a controller matches these names to its own)")
+    return out
+
+
 def _yaml_float(value: float) -> str:
-    text = repr(float(value))
+    text = repr(float(value))  # finite (checked): a YAML float as PyYAML's emitter writes it
     mantissa, e, exponent = text.partition("e")
     if e and "." not in mantissa:  # YAML 1.1 readers need a dot in 1.0e-05
         text = f"{mantissa}.0e{exponent}"
@@ -219,11 +236,25 @@ def _yaml_list(values: np.ndarray) -> str:
 
 
 def write_trajectory_yaml(path: str | os.PathLike, trajectory: ControllerTrajectory, *, frame_id: str = "") -> os.PathLike:
-    """Write ``trajectory`` as a ROS 2 ``trajectory_msgs/JointTrajectory`` YAML document, atomically."""
+    """Write ``trajectory`` as a ROS 2 ``trajectory_msgs/JointTrajectory`` YAML document, atomically.
+
+    Joint names must follow the ROS name rule (:data:`ROS_NAME`); the names and ``frame_id`` are
+    written by PyYAML's safe emitter, so they read back as written. Every value must be finite.
+
+    Raises:
+        InvalidJointName: a joint name outside the rule. InvalidInput: a value that is NaN or infinite.
+    """
+    import yaml
+
+    names = check_joint_names(trajectory.joint_names)
+    for key in ("positions", "velocities", "accelerations"):
+        if not np.all(np.isfinite(getattr(trajectory, key))):
+            raise InvalidInput(f"the trajectory's {key} hold NaN or infinite values: sample a finite trajectory")
+    head = {"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": str(frame_id)}, "joint_names": list(names)}
     out = io.StringIO()
     out.write("# trajectory_msgs/JointTrajectory written by pinarms (SI units: rad, m, s)\n")
-    out.write(f"header:\n  stamp: {{sec: 0, nanosec: 0}}\n  frame_id: '{frame_id}'\n")
-    out.write("joint_names: [" + ", ".join(f"'{n}'" for n in trajectory.joint_names) + "]\npoints:\n")
+    out.write(yaml.safe_dump(head, sort_keys=False, default_flow_style=None, allow_unicode=True, width=1 << 30))
+    out.write("points:\n")
     for k, ns in enumerate(trajectory.time_ns):
         sec, nanosec = divmod(int(ns), 1_000_000_000)
         out.write(f"- positions: {_yaml_list(trajectory.positions[k])}\n"
@@ -247,43 +278,3 @@ def write_trajectory_csv(path: str | os.PathLike, trajectory: ControllerTrajecto
                         + [repr(float(v)) for v in trajectory.accelerations[k]])
     data = out.getvalue().encode("utf-8")
     return atomic_write(path, lambda f: f.write(data))
-
-
-def _expect(names: tuple[str, ...], joint_names: Any, path: Any) -> None:
-    if joint_names is not None and tuple(joint_names) != names:
-        raise JointMismatch(f"{path}: the file's joints {list(names)} are not the expected {list(joint_names)}")
-
-
-def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) -> ControllerTrajectory:
-    """Read a file of :func:`write_trajectory_yaml` (any JointTrajectory YAML with those fields)."""
-    import yaml
-
-    with open(path, encoding="utf-8") as f:
-        doc = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml when present
-    try:
-        names = tuple(str(n) for n in doc["joint_names"])
-        points = doc["points"]
-        ns = np.array([int(p["time_from_start"]["sec"]) * 1_000_000_000 + int(p["time_from_start"]["nanosec"])
-                       for p in points], dtype=np.int64)
-        arrays = [np.array([[float(v) for v in p[key]] for p in points]).reshape(len(points), len(names))
-                  for key in ("positions", "velocities", "accelerations")]
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InvalidInput(f"{path} is not a JointTrajectory document ({exc!r})") from exc
-    _expect(names, joint_names, path)
-    return ControllerTrajectory(names, ns, *arrays)
-
-
-def read_trajectory_csv(path: str | os.PathLike, *, joint_names: Any = None) -> ControllerTrajectory:
-    """Read a file of :func:`write_trajectory_csv`."""
-    with open(path, encoding="utf-8", newline="") as f:
-        rows = list(csv.reader(f))
-    header = rows[0] if rows else []
-    n = (len(header) - 1) // 3
-    names = tuple(h[len("pos:"):] for h in header[1 : 1 + n])
-    if not header or header[0] != "time_s" or len(header) != 1 + 3 * n or \
-            header[1 + n :] != [f"vel:{x}" for x in names] + [f"acc:{x}" for x in names]:
-        raise InvalidInput(f"{path} is not a pinarms trajectory CSV (header {header[:4]}...)")
-    values = np.array([[float(v) for v in row] for row in rows[1:]]).reshape(-1, 1 + 3 * n)
-    _expect(names, joint_names, path)
-    ns = np.round(values[:, 0] * 1e9).astype(np.int64)
-    return ControllerTrajectory(names, ns, values[:, 1 : 1 + n], values[:, 1 + n : 1 + 2 * n], values[:, 1 + 2 * n :])

@@ -88,7 +88,7 @@ class Cell:
             root = ET.fromstring(urdf_text)
         except ET.ParseError as exc:
             raise CellError(f"{source} is not well-formed XML: {exc}") from exc
-        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_geometry
+        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_extent, check_geometry
 
         if len(urdf_text) > MAX_CELL_FILE_BYTES:
             raise CellTooLarge(f"{source}: the cell's URDF is {len(urdf_text)} characters; the limit is {MAX_CELL_FILE_BYTES}")
@@ -123,6 +123,7 @@ class Cell:
         self._arm_index = {a.name: k for k, a in enumerate(self.arms)}
         self.collision_model = build_geometry(model, root, source=source, base_dir=self._base_dir,
                                               packages=self._packages)
+        check_extent(model, self.collision_model, spec.fixtures, source)
         self._placements = BatchedPlacements(model)
         self._pin_index = plain_pin_index(model, self.nq)
         self.fixtures = read_fixtures(model, self.collision_model, spec.fixtures, urdf_text)

@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from .._checks import check_path_name
 from ..errors import CellNotFound, InvalidInput, ModelError
 from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
 from ..xacro_expand import XacroLimits, expand_xacro
@@ -136,6 +137,7 @@ def load_cell(
         declared = {}
         return Cell(urdf.read_text(encoding="utf-8"), source=f"builtin:{text_or_path}", base_dir=CELL_URDF_DIR,
                     packages=packages, args=declared, seed=seed)
+    check_path_name(path_or_name, "cell file")
     path = Path(path_or_name)
     if not path.is_file():
         raise CellNotFound(f"cell file {str(path)!r} does not exist; built-in cells: {', '.join(cell_names())}")

@@ -8,9 +8,11 @@ arms, fixtures, collision geometries and geometry pairs are taken from the XML b
 Pinocchio builds anything. Every refusal is a :class:`~pinarms.robots.errors.CellTooLarge`
 stating the limit.
 
-Collision primitives must have finite, positive sizes (a box of size −0.2 or 0 is no
-obstacle coal can check): :func:`check_geometry` raises
-:class:`~pinarms.robots.errors.CollisionGeometryError` naming the fixture (or link).
+Collision primitives must have finite, positive sizes up to :data:`MAX_CELL_EXTENT` (a box of
+size −0.2 or 0 is no obstacle coal can check): :func:`check_geometry` raises
+:class:`~pinarms.robots.errors.CollisionGeometryError` naming the fixture (or link); so does
+:func:`check_extent` for a geometry placed farther than :data:`MAX_CELL_EXTENT` from the world
+origin (coal's broadphase fails on a box at 1e15 m: "negative volume").
 """
 
 from __future__ import annotations
@@ -19,12 +21,14 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 from ..errors import CellTooLarge, CollisionGeometryError, ModelError
 
 __all__ = [
     "MAX_CELL_FILE_BYTES", "MAX_MESH_BYTES", "MAX_ARMS", "MAX_FIXTURES", "MAX_GEOMETRIES", "MAX_GEOMETRY_PAIRS",
     "read_cell_file", "check_file_size", "check_counts", "check_pairs", "check_geometry", "check_mesh_size",
+    "MAX_CELL_EXTENT", "check_extent",
 ]
 
 #: Largest cell file (URDF or xacro) read [bytes].
@@ -40,6 +44,10 @@ MAX_GEOMETRIES = 600
 #: Most pairs of collision geometries left to check after the proven rules (each is sampled
 #: 200 times by the sampled rules at load, and checked by every query).
 MAX_GEOMETRY_PAIRS = 5000
+#: Largest size of a primitive and largest distance of a collision geometry from the world
+#: origin at the neutral configuration [m]. A production cell spans tens of metres; at 1 km a
+#: double still resolves 1e-13 m, while coal's bounding volumes break down long before 1e15 m.
+MAX_CELL_EXTENT = 1000.0
 
 
 def check_file_size(path: str | os.PathLike, limit: int, what: str) -> int:
@@ -121,12 +129,32 @@ def check_geometry(root: ET.Element, fixtures: tuple[str, ...], source: str) -> 
                 else:
                     continue
                 for attr, vals in values.items():
-                    if not all(math.isfinite(v) and v > 0.0 for v in vals):
+                    if not all(math.isfinite(v) and 0.0 < v <= MAX_CELL_EXTENT for v in vals):
                         raise CollisionGeometryError(
-                            f"{where}: {shape.tag} {attr} must be finite and > 0 [m], got {shape.get(attr)!r}"
+                            f"{where}: {shape.tag} {attr} must be finite, > 0 and at most {MAX_CELL_EXTENT:g} [m], "
+                            f"got {shape.get(attr)!r}"
                         )
 
 
 def check_mesh_size(path: Path) -> None:
     """:class:`CellTooLarge` when a mesh file is above :data:`MAX_MESH_BYTES` (by ``stat``, unread)."""
     check_file_size(path, MAX_MESH_BYTES, "mesh")
+
+
+def check_extent(model: Any, geometry_model: Any, fixtures: tuple[str, ...], source: str) -> None:
+    """:class:`CollisionGeometryError` naming the fixture (or link) of a collision geometry placed
+    farther than :data:`MAX_CELL_EXTENT` from the world origin at the neutral configuration."""
+    import numpy as np
+    import pinocchio as pin
+
+    data, gdata = model.createData(), geometry_model.createData()
+    pin.updateGeometryPlacements(model, data, geometry_model, gdata, pin.neutral(model))
+    fixture_set = set(fixtures)
+    for k, placement in enumerate(gdata.oMg):
+        far = float(np.max(np.abs(placement.translation))) if np.all(np.isfinite(placement.translation)) else math.inf
+        if far > MAX_CELL_EXTENT:
+            link = model.frames[geometry_model.geometryObjects[k].parentFrame].name
+            owner = f"fixture {link!r}" if link in fixture_set else f"link {link!r}"
+            raise CollisionGeometryError(
+                f"{source}: {owner} is placed {far:g} m from the world origin; a cell may extend at most "
+                f"{MAX_CELL_EXTENT:g} m: check the origin's units (metres) and the arm's base")

@@ -65,6 +65,7 @@ import numpy as np
 
 from ..errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
+from .._checks import check_restarts as _check_restarts
 from .._checks import check_seed as _check_seed
 from .._checks import check_tolerance as _check_tolerance
 from .descent import CLIP as _CLIP
@@ -248,8 +249,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
             raise InvalidInput("NumericalIK.solve takes one target: a pose (4, 4) (or a position (3,) with position_only)")
         if q_seed is not None:
             q_seed = robot.check_q(q_seed)[0][0]
-        if isinstance(max_restarts, bool) or not isinstance(max_restarts, (int, np.integer)) or max_restarts < 0:
-            raise InvalidInput(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+        _check_restarts(max_restarts)
         return self._solve(
             T[0], q_seed, position_only=position_only, tol=_check_tolerance(tol, "tol [m, rad]", positive=True),
             max_restarts=int(max_restarts), seed=_check_seed(seed), limits=bool(limits),

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._checks import check_restarts
+
 
 __all__ = ["BatchIKResult", "solve_batch"]
 
@@ -116,6 +118,7 @@ def solve_batch(
     targets = np.asarray(targets, dtype=float)
     N = targets.shape[0]
     nq = self.nq
+    max_restarts = check_restarts(max_restarts)
     tol = float(tol)
     if q_seed is None:  # no seed (or a NaN row): the compiled solver starts from the table's nearest pose
         starts = np.full((N, nq), np.nan)

@@ -60,6 +60,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from .._checks import check_restarts
 from ..errors import InvalidInput, ModelError
 from .orientations import OrientationSet, so3_orientations, tool_down_orientations
 from .reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
@@ -218,7 +219,7 @@ def _checked_settings(arm: "Robot", *, resolution: Any, orientations: Any, tool_
     """
     resolution = _positive(resolution, "resolution [m]")
     solver = _solver(arm, ik, manipulability)
-    restarts = _count(restarts, "restarts")
+    restarts = check_restarts(restarts, "restarts")
     tol = _positive(tol, "tol [m, rad]")
     seed = _count(seed, "seed")
     if collision is not None and not callable(getattr(collision, "in_collision", None)):

@@ -148,3 +148,34 @@ def test_an_unexpected_exception_is_one_line_and_the_traceback_is_on_request(mon
     monkeypatch.setenv(DEBUG_VARIABLE, "1")
     result = CliRunner().invoke(group, ["divide"])
     assert isinstance(result.exception, ZeroDivisionError)
+
+
+def _pinarms(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    """The installed command in a child process (pytest's own warning capture does not hide anything there)."""
+    env = {k: v for k, v in os.environ.items() if k not in (DEBUG_VARIABLE, "PYTHONWARNINGS")}
+    return subprocess.run([sys.executable, "-m", "pinarms.cli", *args], capture_output=True, text=True, timeout=120,
+                          cwd=cwd, env=env)
+
+
+def test_numpy_warnings_do_not_precede_the_error_line():
+    result = _pinarms("plan", "--kind", "multi-quintic", "--times", "0,1e-320", "--via", "0", "--via", "1")
+    assert result.returncode == 1
+    one_error_line(result.stderr, "finite")
+
+
+def test_a_cell_file_named_with_a_leading_dash_loads_after_double_dash_or_by_path(tmp_path):
+    source = (os.path.dirname(__file__) + "/../robots/data/user_scara.urdf")
+    (tmp_path / "user_scara.urdf").write_text(open(source, encoding="utf-8").read(), encoding="utf-8")
+    (tmp_path / "--c.toml").write_text('name = "c"\n[[arm]]\nname = "left"\nurdf = "user_scara.urdf"\n'
+                                       'xyz = [0.0, 0.0, 0.0]\nrpy = [0.0, 0.0, 0.0]\n')
+    runner = CliRunner()
+    with runner.isolated_filesystem(temp_dir=tmp_path) as here:
+        os.replace(tmp_path / "--c.toml", os.path.join(here, "--c.toml"))
+        os.replace(tmp_path / "user_scara.urdf", os.path.join(here, "user_scara.urdf"))
+        for args in (["cell", "show", "--", "--c.toml"], ["cell", "show", "./--c.toml"]):
+            result = runner.invoke(cli, args)
+            assert result.exit_code == 0, (args, result.output)
+            assert "left: arm" in result.output
+        result = runner.invoke(cli, ["cell", "show", "--c.toml"])
+        assert result.exit_code == 2
+        assert "./--c.toml" in result.stderr and "put -- before it" in result.stderr

@@ -94,3 +94,11 @@ def test_motion_hold_errors_name_the_flag(tmp_path):
     _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b=0,2.5,0"]), "--hold b", "j2 = 2.5 outside [-2, 2]")
     _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "b=rest"]), "--hold b", "no state 'rest'", "home")
     _one_error_line(CliRunner().invoke(cli, [*base, "--hold", "a=0,0,0"]), "--hold a", "the arm planned", "--from-q")
+
+
+def test_the_help_example_plans_a_proven_move():
+    from test_help_examples import EXAMPLES
+
+    result = CliRunner().invoke(cli, EXAMPLES["motion"])  # once "unreachable": it had no --from
+    assert result.exit_code == 0, (result.output, result.stderr)
+    assert "proven continuously" in result.output and "clearance:" in result.output

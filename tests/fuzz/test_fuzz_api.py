@@ -471,3 +471,63 @@ def test_ga_and_exact_settings(data):
                           seconds=20)
     if err is None:
         assert result.total > 0
+
+
+# ---------------------------------------------------------------- counts and seeds past their range
+def _quickly(call, error, match):
+    import time
+
+    t0 = time.perf_counter()
+    with pytest.raises(error, match=match):
+        call()
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_ik_restarts_past_the_cap_are_refused_at_once(arms):
+    from pinarms.robots import MAX_RESTARTS
+    from pinarms.robots.errors import InvalidInput
+    from pinarms.robots.ik import NumericalIK
+
+    ur5 = arms["ur5"]
+    far = ur5.fk(ur5.neutral)
+    far[0, 3] = 5.0  # out of reach: every restart would run
+    _quickly(lambda: ur5.ik(far, max_restarts=10**9), InvalidInput, f"max_restarts.*{MAX_RESTARTS}")
+    _quickly(lambda: ur5.ik(np.stack([far, far]), max_restarts=MAX_RESTARTS + 1), InvalidInput, "max_restarts")
+    _quickly(lambda: NumericalIK(ur5).solve(far, max_restarts=10**9), InvalidInput, "max_restarts")
+    _quickly(lambda: robots.reachability_map(ur5, 0.5, restarts=10**9), InvalidInput, "restarts")
+
+
+def test_minimize_time_max_generations_outside_its_documented_range_is_refused():
+    from pinarms.optim.errors import SettingOutOfRange
+
+    via = np.array([[0.0], [1.0], [0.5]])
+    for bad in (0, -1, 10**9):
+        _quickly(lambda bad=bad: optim.minimize_time(via, "multi-quintic", 1.0, max_generations=bad),
+                 SettingOutOfRange, "max_generations")
+
+
+@pytest.fixture(scope="module")
+def crate_guard():
+    from pinarms.optim.motion.scenes import load_scene
+
+    return load_scene("aubo_crate_guard")
+
+
+@pytest.mark.parametrize("seed", [-1, 2**64, 1.5])
+def test_plan_motion_seed_outside_its_range_is_a_named_error(crate_guard, seed):
+    from pinarms.optim.errors import InvalidSettings
+    from pinarms.optim.motion import plan_motion
+
+    cell = crate_guard
+    arm = cell.arms[0]
+    start = arm.robot.neutral
+    _quickly(lambda: plan_motion(cell, arm.name, start, start + 0.1, seed=seed), InvalidSettings, "seed")
+
+
+@pytest.mark.parametrize("path", ["arm\0.urdf", "a" * 300 + ".urdf", "d/" * 3000 + "arm.urdf"])
+@pytest.mark.parametrize("load", ["from_urdf", "load_cell", "from_xacro"])
+def test_a_description_path_with_a_nul_byte_or_too_long_is_a_named_error(load, path):
+    from pinarms.robots.errors import InvalidInput
+
+    path = path.replace(".urdf", ".xacro") if load == "from_xacro" else path
+    _quickly(lambda: getattr(robots, load)(path), InvalidInput, "NUL byte|too long")

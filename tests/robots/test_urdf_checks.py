@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -35,3 +36,28 @@ def test_swapped_limits_are_named():
     model.lowerPositionLimit[0], model.upperPositionLimit[0] = 1.0, -1.0
     with pytest.raises(ModelError, match="joint 'j' has lower limit"):
         check_limits(model, "two.urdf")
+
+
+@pytest.mark.parametrize("mass", ["-1", "nan", "inf"])
+def test_a_negative_or_non_finite_link_mass_is_named(mass):
+    text = TWO_LINKS.replace('<link name="b"/>', f'<link name="b"><inertial><mass value="{mass}"/>'
+                             '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>')
+    with pytest.raises(ModelError, match="link 'b' has mass"):
+        robots.from_urdf_text(text, name="two")
+
+
+@pytest.mark.parametrize("lower, upper", [("-1e308", "1e308"), ("-1e10", "1"), ("-1", "1e10")])
+def test_a_position_limit_beyond_the_bound_is_named(lower, upper):
+    from pinarms.robots.urdf_checks import MAX_POSITION_LIMIT
+
+    text = TWO_LINKS.replace('lower="-1" upper="1"', f'lower="{lower}" upper="{upper}"')
+    with pytest.raises(ModelError, match=re.escape(f"joint 'j' has a position limit beyond ±{MAX_POSITION_LIMIT:g}")):
+        robots.from_urdf_text(text, name="two")
+
+
+@pytest.mark.parametrize("attr", ['velocity="1e308"', 'effort="1e308"'])
+def test_a_speed_or_effort_limit_beyond_the_bound_is_named(attr):
+    key = attr.split("=")[0]
+    text = TWO_LINKS.replace(f'{key}="1"', attr)
+    with pytest.raises(ModelError, match=f"joint 'j' has a {key} limit"):
+        robots.from_urdf_text(text, name="two")

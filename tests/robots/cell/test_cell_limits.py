@@ -43,6 +43,25 @@ def test_bad_fixture_geometry_is_refused_naming_the_fixture(geometry, what):
         make_cell(_cell(_fixture("crate", geometry)), "bad")
 
 
+@pytest.mark.parametrize("geometry, xyz, what", [
+    ('<box size="0.2 0.2 0.2"/>', "1e15 0 0.2", "placed 1e\\+15 m"),
+    ('<box size="0.2 0.2 0.2"/>', "0 -2e3 0", "placed 2000 m"),
+    ('<sphere radius="1e15"/>', "1 1 0.2", "sphere radius"),
+    ('<box size="0.2 5e3 0.2"/>', "1 1 0.2", "box size"),
+])
+def test_a_fixture_beyond_the_cells_extent_is_refused_naming_it(geometry, xyz, what):
+    t0 = time.perf_counter()
+    with pytest.raises(CollisionGeometryError, match=rf"fixture 'crate'.*{what}"):
+        make_cell(_cell(_fixture("crate", geometry, xyz)), "far")
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_an_arm_based_beyond_the_cells_extent_is_refused():
+    text = f'<robot name="c"><link name="world"/>{prefixed_scara("arm_", (1e15, 0, 0))}</robot>'
+    with pytest.raises(CollisionGeometryError, match=r"link 'arm_.*placed 1e\+15 m"):
+        make_cell(text, "far")
+
+
 def test_a_positive_box_where_the_negative_one_was_gives_contact():
     cell = make_cell(_cell(_fixture("crate", '<box size="0.2 0.2 0.2"/>', "0.3 0 0.45")), "box")
     assert cell.in_collision(np.zeros(cell.nq))
