@@ -27,6 +27,7 @@ __all__ = [
     "XacroFileNotFound",
     "CellTooLarge",
     "PlacementError",
+    "SelfContactError",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -127,6 +128,26 @@ class PlacementError(CellError):
 
 def _rebuild_placement_error(message, pairs):
     return PlacementError(message, pairs=pairs)
+
+
+class SelfContactError(ModelError):
+    """Two links of one arm are in contact in (almost) every configuration, and no proof explains it.
+
+    ``pairs`` holds ``(body_a, body_b, share, depth)`` per pair of links: the share of the sampled
+    configurations in contact and the deepest penetration found [m]. Fix the collision shapes, or
+    declare the contact by name in the URDF (``<disable_collisions link1= link2= reason=/>``).
+    """
+
+    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
+        super().__init__(message)
+        self.pairs = tuple(pairs)
+
+    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
+        return (_rebuild_self_contact_error, (str(self), self.pairs))
+
+
+def _rebuild_self_contact_error(message, pairs):
+    return SelfContactError(message, pairs=pairs)
 
 
 class CollisionGeometryError(ModelError):
