@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pickle
 
+import numpy as np
+
 import pytest
 
 from pinarms import robots
@@ -80,3 +82,23 @@ def test_every_shipped_arm_loads_and_gives_each_skipped_pair_a_reason(name):
                                               PairReason.ADJACENT, PairReason.DECLARED}
     checked = {frozenset(p) for p in sc.pairs.tolist()}
     assert not checked & {frozenset((p.geometry_a, p.geometry_b)) for p in sc.allowed}
+
+
+def test_a_pair_in_contact_at_the_neutral_configuration_only_is_checked_not_dropped():
+    # link 2's cube, 0.12 m out along y, dips into the plate only while j2 is near 0 (the neutral configuration)
+    text = _arm('<box size="0.04 0.04 0.04"/>').replace(
+        '<link name="link2"><collision>', '<link name="link2"><collision><origin xyz="0 0.12 0.11"/>')
+    arm = robots.from_urdf_text(text, tcp="tool")
+    sc = SelfCollision(arm)
+    assert {frozenset(p) for p in sc.pairs.tolist()} == {frozenset(("base_link_0", "link2_0"))}
+    assert sc.in_collision(arm.neutral) is True
+    assert sc.in_collision(np.array([0.0, 0.3])) is False
+
+
+@pytest.mark.parametrize("name, links", [("gantry_flower", ("x_carriage_link", "z_ram_link")),
+                                         ("panda", ("panda_link5", "panda_link7")),
+                                         ("panda", ("panda_hand", "panda_link5"))])
+def test_the_shipped_contacts_at_neutral_are_declared_with_a_reason(name, links):
+    sc = SelfCollision(robots.load(name))
+    (pair,) = [p for p in sc.allowed if {p.body_a, p.body_b} == set(links)]
+    assert pair.reason == PairReason.DECLARED and len(pair.note) > 20
