@@ -34,6 +34,7 @@ where the tool is, and a planner avoids them by choosing another orientation.
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -241,8 +242,6 @@ def _classify(robot: "Robot", gm: pin.GeometryModel, seed: int) -> tuple[list[tu
 
 def _declared(robot: "Robot") -> dict[frozenset, str]:
     """The URDF's ``<disable_collisions>`` pairs of links, with the reason given."""
-    import xml.etree.ElementTree as ET
-
     root = ET.fromstring(robot.urdf_text)
     links = [el.get("name") for el in root.findall("link")]
     source = str(robot.urdf_path) if robot.urdf_path is not None else f"the URDF of {robot.name!r}"
