@@ -19,3 +19,13 @@ def test_pairs_lists_each_skipped_pair_of_links_with_its_reason_and_note(run):
 
 def test_pairs_of_an_unknown_robot_is_one_error_line(run):
     assert_user_error(run("pairs", "gantry_flowr", ok=False), 1, "gantry_flower")
+
+
+def test_pairs_of_a_urdf_with_a_link_through_its_base_is_one_error_line_naming_them(run, tmp_path):
+    from tests.robots.test_self_collision import _arm
+
+    text = _arm('<box size="0.04 0.04 0.04"/>').replace(
+        '<link name="link2"><collision>', '<link name="link2"><collision><origin xyz="0.1 0.05 0"/>')
+    path = tmp_path / "plate_arm.urdf"
+    path.write_text(text, encoding="utf-8")
+    assert_user_error(run("pairs", str(path), ok=False), 1, "base_link – link2", "mm deep", "<disable_collisions")
