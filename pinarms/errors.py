@@ -28,6 +28,7 @@ __all__ = [
     "CellTooLarge",
     "PlacementError",
     "ArmStateError",
+    "SelfContactError",
     "CollisionGeometryError",
     "CollisionError",
 ]
@@ -133,6 +134,26 @@ def _rebuild_placement_error(message, pairs):
 class ArmStateError(CellError):
     """A cell arm's named state, hold pose or frozen joint value is outside its joint limits, has the
     wrong number of values, or names a state the arm does not have (the message names the arm and the joint)."""
+
+
+class SelfContactError(ModelError):
+    """Two links of one arm are in contact in (almost) every configuration, and no proof explains it.
+
+    ``pairs`` holds ``(body_a, body_b, share, depth)`` per pair of links: the share of the sampled
+    configurations in contact and the deepest penetration found [m]. Fix the collision shapes, or
+    declare the contact by name in the URDF (``<disable_collisions link1= link2= reason=/>``).
+    """
+
+    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
+        super().__init__(message)
+        self.pairs = tuple(pairs)
+
+    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
+        return (_rebuild_self_contact_error, (str(self), self.pairs))
+
+
+def _rebuild_self_contact_error(message, pairs):
+    return SelfContactError(message, pairs=pairs)
 
 
 class CollisionGeometryError(ModelError):

@@ -40,6 +40,9 @@ class RobotInfo:
     urdf_relpath: str  # inside urdf/ (built-in) or example-robot-data's robots/ folder
     tcp: str = "tcp"
     frozen_joints: tuple[str, ...] = ()  # joints fixed at zero (grippers of example robots)
+    #: contacts by design of a URDF that is not ours, ``(link1, link2, reason)``: added to it as
+    #: ``<disable_collisions>`` elements (a built-in arm declares its own in its xacro)
+    declared: tuple[tuple[str, str, str], ...] = ()
 
 
 _BUILTIN = {
@@ -52,6 +55,13 @@ _BUILTIN = {
         RobotInfo("koji_turner_rail", "pinarms", "koji turning arm on its two overhead-rail slides (seed 004)", "koji_turner_rail.urdf"),
     )
 }
+
+#: Why the Panda's wrist meshes are declared in contact (example-robot-data's URDF, not ours): seeded samples put
+#: link 5's mesh into link 7's in 90 % of the configurations with joint 6 within 0.12 rad of its lower limit
+#: (the neutral configuration among them), 20-30 % up to 0.4 rad, 1-2 % beyond; Drake's Panda model filters
+#: the link5-link7 pair too (RobotLocomotion/drake, manipulation/models/franka_description/README.md).
+_PANDA_WRIST = ("the convex collision meshes of link 5 and the wrist overlap near joint 6's lower limit "
+                "(Drake's Panda model filters link5-link7 too)")
 
 _EXAMPLE = {
     info.name: info
@@ -66,6 +76,7 @@ _EXAMPLE = {
             "panda_description/urdf/panda.urdf",
             tcp="panda_hand_tcp",
             frozen_joints=("panda_finger_joint1", "panda_finger_joint2"),
+            declared=tuple((link, "panda_link5", _PANDA_WRIST) for link in ("panda_link7", "panda_hand")),
         ),
     )
 }
@@ -162,6 +173,7 @@ def load(name: str) -> Robot:
             package_dirs=(str(share.parent),),
             freeze=entry.frozen_joints,
             description=entry.description,
+            declare=entry.declared,
         )
     return robot  # its closed-form IK (if any) was recognised by from_urdf_text
 
@@ -233,6 +245,7 @@ def from_urdf_text(
     package_dirs: tuple[str, ...] = (),
     freeze: tuple[str, ...] = (),
     description: str = "",
+    declare: tuple[tuple[str, str, str], ...] = (),
 ) -> Robot:
     """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
 
@@ -260,6 +273,9 @@ def from_urdf_text(
     _check_inertials(root, source)
     if freeze:
         _freeze_joints(root, tuple(freeze), source)
+    for link1, link2, reason in declare:  # read back by robots.SelfCollision
+        ET.SubElement(root, "disable_collisions", {"link1": link1, "link2": link2, "reason": reason})
+    if freeze or declare:
         urdf_text = ET.tostring(root, encoding="unicode")
     try:
         model = pin.buildModelFromXML(urdf_text, mimic=True)
@@ -293,6 +309,7 @@ def from_urdf(
     package_dirs: tuple[str, ...] = (),
     freeze: tuple[str, ...] = (),
     description: str = "",
+    declare: tuple[tuple[str, str, str], ...] = (),
 ) -> Robot:
     """Load any URDF file (closed-form IK attached when its geometry matches a family: ``robot.ik_family``).
 
@@ -303,6 +320,8 @@ def from_urdf(
         name: robot name (default: the URDF's ``<robot name>``).
         package_dirs: folders that resolve ``package://`` mesh paths (for the viewer).
         freeze: joints to fix at zero (e.g. gripper fingers).
+        declare: pairs of links in contact by design, ``(link1, link2, reason)``, added as
+            ``<disable_collisions>`` elements (:class:`~robots.SelfCollision` skips them).
 
     Raises:
         ModelError: the file is missing, not XML, not a URDF, or Pinocchio rejects it.
@@ -324,6 +343,7 @@ def from_urdf(
         package_dirs=tuple(package_dirs),
         freeze=tuple(freeze),
         description=description,
+        declare=tuple(declare),
     )
 
 

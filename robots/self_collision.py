@@ -2,15 +2,21 @@
 
 :class:`SelfCollision` loads the ``<collision>`` geometry of a robot's URDF, keeps the
 pairs of bodies that can really touch, and tells for a batch of configurations which
-ones bring two bodies into contact. The pair filter follows the usual practice of
-motion-planning setup tools (e.g. MoveIt's setup assistant), with pinarms' rules:
+ones bring two bodies into contact. A pair is skipped only for a reason
+(:class:`~robots.pair_rules.PairReason`, the same as a cell's, :mod:`robots.pair_rules`), listed
+per pair in :attr:`SelfCollision.allowed`:
 
-1. *adjacent* bodies are never checked: bodies on the same joint, or on joints directly
-   connected, where ``<mimic>`` joints count as part of the joint they hang from (a
-   parallelogram's passive links touch their neighbours by design);
-2. *default* collisions: pairs already in contact at the neutral configuration;
-3. *always* collisions: pairs in contact in at least 95 % of 200 random configurations
-   (seeded), i.e. overlapping primitives of one rigid assembly.
+1. ``same link``, ``rigid`` (no joint between them) or ``adjacent`` (bodies on joints directly
+   connected, where ``<mimic>`` joints count as part of the joint they hang from: a
+   parallelogram's passive links touch their neighbours by design), from the structure;
+2. ``declared``: named by a ``<disable_collisions link1= link2= reason=/>`` element at the top
+   level of the URDF (the SRDF element; Pinocchio ignores it);
+3. for a pair in contact in at least :data:`~robots.pair_rules.ALWAYS_SHARE` of
+   :data:`ALWAYS_SAMPLES` seeded random configurations: ``coaxial`` or ``adjacent`` through a
+   shape that turns about its own axis (:mod:`robots.coaxial`, proven from the shapes). Such a
+   pair with no reason is a :class:`~pinarms.errors.SelfContactError` naming the links, the
+   share and the deepest penetration: the sample selects the pairs to explain, it never skips
+   one alone. A pair in contact at the neutral configuration is checked like any other.
 
 :meth:`SelfCollision.in_collision` runs coal's broad phase (a dynamic AABB tree culls the
 pairs whose boxes are apart) through Pinocchio: one call for one configuration (Pinocchio's
@@ -28,24 +34,27 @@ where the tool is, and a planner avoids them by choosing another orientation.
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
 
+from .coaxial import still_frames
 from .collision_requests import cold_start
-from .errors import InvalidInput, ModelError
+from .errors import InvalidInput, ModelError, SelfContactError
+from .pair_rules import ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint
 
 if TYPE_CHECKING:  # pragma: no cover
     from .robot import Robot
 
-__all__ = ["SelfCollision"]
+__all__ = ["SelfCollision", "ALWAYS_SAMPLES"]
 
-_ALWAYS_SHARE = 0.95
 #: From this many checked pairs on, one configuration is checked through the broad phase
 #: (below it, the AABB tree costs more than it culls: AUBO-i3, 50 pairs).
 BROAD_PHASE_PAIRS = 64
-_ALWAYS_SAMPLES = 200
+#: Seeded random configurations sampled to find the pairs in contact in (almost) all of them.
+ALWAYS_SAMPLES = 200
 
 
 class SelfCollision:
@@ -53,11 +62,15 @@ class SelfCollision:
 
     Attributes:
         robot: the robot.
-        pairs: ``(k, 2)`` names of the body pairs that are checked.
+        pairs: ``(k, 2)`` names of the geometry pairs that are checked.
+        allowed: the pairs that are not checked, each with its reason (:class:`~robots.pair_rules.AllowedPair`).
         n_geometries: number of collision primitives.
 
     Raises:
-        ModelError: Pinocchio cannot read the collision geometry (e.g. a mesh file is missing).
+        ModelError: Pinocchio cannot read the collision geometry (e.g. a mesh file is missing), or a
+            ``<disable_collisions>`` element names a link the URDF does not define.
+        SelfContactError: two links are in contact in at least ``ALWAYS_SHARE`` of the samples
+            without a reason (module doc).
     """
 
     def __init__(self, robot: "Robot", seed: int = 0) -> None:
@@ -68,25 +81,13 @@ class SelfCollision:
         except Exception as exc:  # Pinocchio raises ValueError/RuntimeError with its own text
             raise ModelError(f"cannot load the collision geometry of '{robot.name}': {exc}") from exc
         self.n_geometries = len(gm.geometryObjects)
-        eff = [self._effective_joint(model, g.parentJoint) for g in gm.geometryObjects]
-        for a in range(self.n_geometries):
-            for b in range(a + 1, self.n_geometries):
-                ja, jb = eff[a], eff[b]
-                adjacent = ja == jb or self._effective_joint(model, model.parents[ja]) == jb or (
-                    self._effective_joint(model, model.parents[jb]) == ja
-                )
-                if not adjacent:
-                    gm.addCollisionPair(pin.CollisionPair(a, b))
+        eff = [effective_joint(model, g.parentJoint) for g in gm.geometryObjects]
+        checked, self.allowed = _classify(robot, gm, seed)
+        for a, b in checked:
+            gm.addCollisionPair(pin.CollisionPair(a, b))
         self._gm = gm
         self._gd = cold_start(pin.GeometryData(gm))
         self._data = model.createData()
-        # default and always-colliding pairs
-        q_probe = np.vstack([robot.neutral[None, :], robot.random_q(_ALWAYS_SAMPLES, seed=seed)])
-        hits = self._pair_hits(q_probe)
-        drop = hits[0] | (hits[1:].mean(axis=0) >= _ALWAYS_SHARE) if hits.size else np.zeros(0, bool)
-        for k in sorted(np.flatnonzero(drop), reverse=True):
-            gm.removeCollisionPair(gm.collisionPairs[int(k)])
-        self._gd = cold_start(pin.GeometryData(gm))
         names = [g.name for g in gm.geometryObjects]
         self.pairs = np.array([(names[p.first], names[p.second]) for p in gm.collisionPairs], dtype=object).reshape(-1, 2)
         self._pair_joints = np.array(
@@ -135,13 +136,6 @@ class SelfCollision:
         chain = [j for j in reversed(chain) if "Mimic" not in model.joints[j].shortname()]
         core = {0, *chain[: int(core_joints)]}
         return np.isin(self._pair_joints, list(core)).any(axis=1)
-
-    @staticmethod
-    def _effective_joint(model: pin.Model, j: int) -> int:
-        """``j``, or the first non-mimic ancestor when ``j`` is a mimic joint."""
-        while j > 0 and "Mimic" in model.joints[j].shortname():
-            j = model.parents[j]
-        return j
 
     def _pair_hits(self, q: np.ndarray) -> np.ndarray:
         """``(N, k)`` bool: which checked pairs touch in each configuration."""
@@ -196,3 +190,102 @@ class SelfCollision:
                 cold_start(gd)
         out = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(qp.T), True, False)
         return np.asarray(out, dtype=bool).reshape(-1)
+
+
+def _classify(robot: "Robot", gm: pin.GeometryModel, seed: int) -> tuple[list[tuple[int, int]], tuple[AllowedPair, ...]]:
+    """The geometry pairs of ``gm`` to check, and the others with their reason (module doc).
+
+    Raises:
+        ModelError: a ``<disable_collisions>`` element naming a link the URDF does not define.
+        SelfContactError: pairs in contact in at least ``ALWAYS_SHARE`` of the samples without a reason.
+    """
+    model, objs = robot.model, list(gm.geometryObjects)
+    link = [model.frames[g.parentFrame].name for g in objs]
+    owner = [robot.name] * len(objs)
+    eff = [effective_joint(model, int(g.parentJoint)) for g in objs]
+    declared = _declared(robot)
+    allowed: list[AllowedPair] = []
+
+    def allow(a: int, b: int, reason: PairReason, note: str = "") -> None:
+        allowed.append(AllowedPair(objs[a].name, objs[b].name, link[a], link[b], reason, index_a=a, index_b=b, note=note))
+
+    plain = [(e,) for e in eff]
+    candidates = []
+    for a in range(len(objs)):
+        for b in range(a + 1, len(objs)):
+            reason = by_design(model, a, b, link, owner, eff, plain)
+            note = declared.get(frozenset((link[a], link[b]))) if reason is None else None
+            if reason is not None:
+                allow(a, b, reason)
+            elif note is not None:
+                allow(a, b, PairReason.DECLARED, note=note)
+            else:
+                candidates.append((a, b))
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    still = [tuple(effective_joint(model, j) for j in frames) for frames in still_frames(model, data, objs)]
+    q = np.atleast_2d(robot.q_to_pinocchio(robot.random_q(ALWAYS_SAMPLES, seed=seed)))
+    share = _contact_share(model, objs, candidates, q)
+    checked, through = [], []
+    for (a, b), s in zip(candidates, share):
+        reason = by_design(model, a, b, link, owner, eff, still) if s >= ALWAYS_SHARE else None
+        if reason is not None:
+            allow(a, b, reason)
+        elif s >= ALWAYS_SHARE:
+            through.append((a, b, float(s)))
+        else:
+            checked.append((a, b))
+    if through:
+        raise _contact_error(robot, model, objs, link, through, q)
+    return checked, tuple(allowed)
+
+
+def _declared(robot: "Robot") -> dict[frozenset, str]:
+    """The URDF's ``<disable_collisions>`` pairs of links, with the reason given."""
+    root = ET.fromstring(robot.urdf_text)
+    links = [el.get("name") for el in root.findall("link")]
+    source = str(robot.urdf_path) if robot.urdf_path is not None else f"the URDF of {robot.name!r}"
+    return {frozenset((a, b)): note for a, b, note in declared_pairs(root, links, source, ModelError)}
+
+
+def _probe(objs: list, pairs: list[tuple[int, int]]) -> tuple[pin.GeometryModel, pin.GeometryData]:
+    probe = pin.GeometryModel()
+    for g in objs:
+        probe.addGeometryObject(g)
+    for a, b in pairs:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    return probe, cold_start(pin.GeometryData(probe), distance_tolerance=1e-9)
+
+
+def _contact_share(model: pin.Model, objs: list, pairs: list[tuple[int, int]], q: np.ndarray) -> np.ndarray:
+    """``(len(pairs),)``: the share of the configurations ``q`` (Pinocchio's, ``(N, nq)``) where each pair touches."""
+    if not pairs:
+        return np.zeros(0)
+    probe, gd = _probe(objs, pairs)
+    data = model.createData()
+    hits = np.zeros(len(pairs))
+    for qp in q:
+        pin.updateGeometryPlacements(model, data, probe, gd, qp)
+        pin.computeCollisions(probe, gd, False)
+        hits += [r.isCollision() for r in gd.collisionResults]
+    return hits / q.shape[0]
+
+
+def _contact_error(robot: "Robot", model: pin.Model, objs: list, link: list[str],
+                   through: list[tuple[int, int, float]], q: np.ndarray) -> SelfContactError:
+    """The :class:`SelfContactError` of the geometry pairs ``through`` ``(a, b, share)``, with the deepest
+    penetration of each over the configurations ``q``, by pair of links (deepest first)."""
+    probe, gd = _probe(objs, [(a, b) for a, b, _ in through])
+    data = model.createData()
+    depth = np.zeros(len(through))
+    for qp in q:
+        pin.updateGeometryPlacements(model, data, probe, gd, qp)
+        pin.computeDistances(probe, gd)
+        depth = np.maximum(depth, [-r.min_distance for r in gd.distanceResults])
+    rows, shown = contact_rows([(link[a], link[b], share, float(d)) for (a, b, share), d in zip(through, depth)],
+                               ALWAYS_SAMPLES)
+    source = robot.urdf_path or robot.name
+    return SelfContactError(
+        f"{source}: links in contact in (almost) every configuration, and no joint between them turns a shape "
+        f"about its own axis: {shown}. Fix the collision shapes, or, if the contact is by design, declare "
+        'the pair in the URDF: <disable_collisions link1="A" link2="B" reason="..."/>', pairs=rows)

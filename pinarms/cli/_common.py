@@ -18,7 +18,7 @@ from pinarms import robots
 from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
-__all__ = ["cli", "main", "json_option", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
+__all__ = ["cli", "main", "json_option", "skipped_pair_lines", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
            "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
            "joint_scale_at", "new_session", "save_session", "scheduler_option", "quiet_dask"]
 
@@ -266,3 +266,22 @@ def save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
     lines.append(f"session written: {path}")
 
 
+def skipped_pair_lines(allowed: Any, k: float, lu: str) -> list[str]:
+    """One line per reason: the pairs of links never checked for it (``out of reach``: with the smallest proven bound,
+    checked again at a clearance above it), each pair of links once."""
+    by_reason: dict[str, dict[tuple[str, str], float]] = {}
+    for a in allowed:
+        bodies = by_reason.setdefault(str(a.reason), {})
+        key = (a.body_a, a.body_b) if (a.body_b, a.body_a) not in bodies else (a.body_b, a.body_a)
+        bodies[key] = min(bodies.get(key, np.inf), a.distance_bound)
+    lines = []
+    for reason in sorted(by_reason):
+        pairs = by_reason[reason]
+        if reason == "out of reach":
+            text = ", ".join(f"{a} – {b} (>= {d * k:.4g} {lu})" for (a, b), d in sorted(pairs.items(), key=lambda x: x[1]))
+            lines.append(f"skipped while proven farther than the clearance (out of reach): {text}")
+        else:
+            notes = {(a.body_a, a.body_b): a.note for a in allowed if a.note}
+            text = ", ".join(f"{a} – {b}" + (f" ({notes[(a, b)]})" if notes.get((a, b)) else "") for a, b in pairs)
+            lines.append(f"skipped ({reason}): {text}")
+    return lines

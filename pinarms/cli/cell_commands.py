@@ -12,7 +12,7 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option, save_session, show_progress
+from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option, save_session, show_progress, skipped_pair_lines
 from .motion_commands import hold_option
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
@@ -111,7 +111,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
         lines.append(f"  {f.name}: {', '.join(_shape_text(s, k, lu) for s in f.shapes)}")
     lines.append("pairs checked: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items())))
     lines.append("pairs allowed: " + ", ".join(f"{n} {r}" for r, n in sorted(reasons.items())))
-    lines.extend(_skipped_lines(c.allowed, k, lu))
+    lines.extend(skipped_pair_lines(c.allowed, k, lu))
     if session_path or html_path:
         from pinarms import viz
 
@@ -124,27 +124,6 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
             data["html"] = html_path
             lines.append(f"page written: {html_path}")
     emit(as_json, data, lines)
-
-
-def _skipped_lines(allowed: Any, k: float, lu: str) -> list[str]:
-    """One line per reason: the pairs of links never checked for it (``out of reach``: with the smallest proven bound,
-    checked again at a clearance above it), each pair of links once."""
-    by_reason: dict[str, dict[tuple[str, str], float]] = {}
-    for a in allowed:
-        bodies = by_reason.setdefault(str(a.reason), {})
-        key = (a.body_a, a.body_b) if (a.body_b, a.body_a) not in bodies else (a.body_b, a.body_a)
-        bodies[key] = min(bodies.get(key, np.inf), a.distance_bound)
-    lines = []
-    for reason in sorted(by_reason):
-        pairs = by_reason[reason]
-        if reason == "out of reach":
-            text = ", ".join(f"{a} – {b} (>= {d * k:.4g} {lu})" for (a, b), d in sorted(pairs.items(), key=lambda x: x[1]))
-            lines.append(f"skipped while proven farther than the clearance (out of reach): {text}")
-        else:
-            notes = {(a.body_a, a.body_b): a.note for a in allowed if a.note}
-            text = ", ".join(f"{a} – {b}" + (f" ({notes[(a, b)]})" if notes.get((a, b)) else "") for a, b in pairs)
-            lines.append(f"skipped ({reason}): {text}")
-    return lines
 
 
 # --------------------------------------------------------------------------- check

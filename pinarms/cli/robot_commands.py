@@ -1,4 +1,4 @@
-"""Commands about one robot's kinematics: ``robots``, ``fk``, ``ik`` (where it reaches: :mod:`.workspace_commands`)."""
+"""Commands about one robot's kinematics: ``robots``, ``pairs``, ``fk``, ``ik`` (where it reaches: :mod:`.workspace_commands`)."""
 
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ from ._common import (
     fmt,
     json_option,
     load_robot,
+    skipped_pair_lines,
     vectors_from_args,
 )
 
@@ -51,6 +52,29 @@ def robots_cmd(as_json: bool) -> None:
     lines = [f"{'name':<{width}}  dof  source              description"]
     lines += [f"{r['name']:<{width}}  {r['dof']:>3}  {r['source']:<18}  {r['description']}" for r in rows]
     emit(as_json, {"robots": rows}, lines)
+
+
+# --------------------------------------------------------------------------- pairs
+@cli.command("pairs")
+@click.argument("robot")
+@json_option
+def pairs_cmd(robot: str, as_json: bool) -> None:
+    """The self-collision pairs of ROBOT (a name or a .urdf file): how many are checked, and why each other
+    pair of links is skipped (same link, rigid, adjacent, coaxial, declared in the URDF)."""
+    from collections import Counter
+
+    arm = load_robot(robot)
+    sc = robots.SelfCollision(arm)
+    reasons = Counter(str(a.reason) for a in sc.allowed)
+    data = {"robot": arm.name, "geometries": sc.n_geometries, "pairs_checked": sc.n_pairs,
+            "checked": [list(p) for p in sc.pairs.tolist()], "pairs_allowed": dict(reasons),
+            "allowed": [{"bodies": [a.body_a, a.body_b], "geometries": [a.geometry_a, a.geometry_b],
+                         "reason": str(a.reason), "note": a.note} for a in sc.allowed]}
+    lines = [f"robot {arm.name}: {sc.n_geometries} collision geometries",
+             f"pairs checked: {sc.n_pairs}",
+             "pairs allowed: " + ", ".join(f"{n} {r}" for r, n in sorted(reasons.items()))]
+    lines.extend(skipped_pair_lines(sc.allowed, 1.0, "m"))
+    emit(as_json, data, lines)
 
 
 # --------------------------------------------------------------------------- fk

@@ -160,7 +160,7 @@ def _base_of(root: ET.Element, source: str) -> tuple[str, str]:
 
 
 def _arm_elements(arm: ArmPlacement, path: Path, base_dir: Path, packages: Mapping[str, Path]) -> list[ET.Element]:
-    """The arm's materials, links and joints, prefixed, and the fixed joint that mounts it in the world."""
+    """The arm's materials, links, joints and ``<disable_collisions>``, prefixed, and the fixed joint that mounts it."""
     source = f"URDF {str(path)!r} of arm {arm.name!r}"
     if path.name.endswith(".xacro"):
         raise CellError(f"{source} is a xacro file: expand it first (`pinarms urdf build {path.name} -o arm.urdf`) "
@@ -182,6 +182,10 @@ def _arm_elements(arm: ArmPlacement, path: Path, base_dir: Path, packages: Mappi
 
     out = []
     for el in root:
+        if el.tag == "disable_collisions":  # the arm's own contacts by design, under the cell's link names
+            out.append(ET.Element("disable_collisions", {"link1": link(el.get("link1", "")),
+                                                         "link2": link(el.get("link2", "")), "reason": el.get("reason", "")}))
+            continue
         if el.tag not in ("material", "link", "joint"):
             continue  # transmissions, gazebo and control tags: not part of the cell's model
         el = ET.fromstring(ET.tostring(el))

@@ -24,6 +24,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from ..errors import CellError
+from ..pair_rules import declared_pairs
 
 __all__ = ["ArmSpec", "CellSpec", "describe", "arm_urdf"]
 
@@ -129,18 +130,7 @@ def _declared(root: ET.Element, links: dict[str, ET.Element], source: str) -> tu
     Raises:
         CellError: an element without two distinct link names, or naming a link the file does not define.
     """
-    out = []
-    for el in root.findall("disable_collisions"):
-        a, b, note = el.get("link1"), el.get("link2"), el.get("reason", "")
-        if not a or not b or a == b:
-            raise CellError(f"{source}: a <disable_collisions> needs two different links, link1=\"...\" and "
-                            f"link2=\"...\"; got link1={a!r}, link2={b!r}")
-        for name in (a, b):
-            if name not in links:
-                raise CellError(f"{source}: <disable_collisions> names link {name!r}, which the cell does not define; "
-                                "name two links of the cell (arm links with their prefix)")
-        out.append((a, b, note))
-    return tuple(out)
+    return declared_pairs(root, links, source, CellError, "name two links of the cell (arm links with their prefix)")
 
 
 def _tree(links: dict[str, ET.Element], joints: dict[str, ET.Element],

@@ -33,19 +33,19 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
 ``coaxial``
     in contact in (almost) every sampled configuration, and proven to be: one of the two turns
     only about its own axis of symmetry relative to the other (a sphere centred on every joint
-    axis between them, a cylinder, capsule or cone along it, :mod:`.coaxial`), so it fills the
+    axis between them, a cylinder, capsule or cone along it, :mod:`robots.coaxial`), so it fills the
     same space at every angle and their distance never changes (the Panda's link-1 capsule
     standing on its table, the SCARA's shoulder hub);
 ``constant``
     apart by the same distance (within 1e-9 m) in all :data:`ALWAYS_SAMPLES` seeded random
-    configurations: shapes coaxial with every joint between them that :mod:`.coaxial` cannot
+    configurations: shapes coaxial with every joint between them that :mod:`robots.coaxial` cannot
     prove (meshes), whose gap is a design constant, not something a motion can close.
 
 **Proven or assumed.** ``same link``, ``rigid``, ``coaxial`` and ``out of reach`` are proven
 from the structure and the shapes. ``adjacent`` is the usual assumption of SRDF files (two
 links joined by a joint are designed to touch at it), taken only from the structure, never
 from a sample; for a pair in contact in (almost) every sample, a shape turning about its own
-axis counts as part of the link it is fixed to (:mod:`.coaxial`: the Panda's link-3 sphere at
+axis counts as part of the link it is fixed to (:mod:`robots.coaxial`: the Panda's link-3 sphere at
 joint 2 is adjacent to link 1). ``declared`` is the user's word. ``constant`` is sampled (never
 in contact, one distance in 200 draws). The sample only selects the pairs that must be
 explained (in contact in at least :data:`ALWAYS_SHARE` of them); it never allows one alone.
@@ -67,7 +67,6 @@ their distance does not depend on a motion, or they touch by construction.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -75,8 +74,9 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from ..coaxial import still_frames
 from ..errors import PlacementError
-from .coaxial import still_frames
+from ..pair_rules import ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint
 from .pair_samples import SAMPLES, sample_pairs
 from .reach import root_cylinders, tighter_bound
 
@@ -87,24 +87,10 @@ __all__ = ["CollisionPair", "AllowedPair", "PairReason", "classify_pairs", "reac
            "ALWAYS_SAMPLES", "BY_DESIGN"]
 
 
-class PairReason(enum.StrEnum):
-    """Why a pair is not checked (module doc); equal to its text (``PairReason.RIGID == "rigid"``)."""
-
-    SAME_LINK = "same link"
-    RIGID = "rigid"
-    COAXIAL = "coaxial"
-    ADJACENT = "adjacent"
-    DECLARED = "declared"
-    OUT_OF_REACH = "out of reach"
-    CONSTANT = "constant"
-
-
 #: Reasons of the pairs allowed by design: never checked, at any clearance.
 BY_DESIGN = tuple(r for r in PairReason if r is not PairReason.OUT_OF_REACH)
 
-#: Share of random configurations in contact at and above which a pair is a placement error.
-ALWAYS_SHARE = 0.95
-#: Random configurations sampled for that rule and for ``constant`` (:mod:`.pair_samples`).
+#: Random configurations sampled for the :data:`ALWAYS_SHARE` rule and for ``constant`` (:mod:`.pair_samples`).
 ALWAYS_SAMPLES = SAMPLES
 
 
@@ -139,39 +125,6 @@ class CollisionPair:
         return f"{self.body_a} – {self.body_b}"
 
 
-@dataclass(frozen=True)
-class AllowedPair:
-    """A pair of geometries the cell does not check at clearance 0, and why (see the module doc).
-
-    Attributes:
-        reason: a :class:`PairReason`.
-        distance_bound: for ``"out of reach"``: a proven lower bound (> 0) of the pair's
-            distance in every configuration [m]; checks at a clearance or margin at least
-            this large include the pair (:meth:`Cell.pairs_for`). ``inf`` for the pairs
-            allowed by design (:data:`BY_DESIGN`): never checked, at any clearance — so
-            ``[p for p in cell.allowed if p.distance_bound <= c]`` is exactly the allowed
-            pairs a check at ``c`` must bring back.
-        index_a, index_b: geometry indices in :attr:`Cell.collision_model`.
-        note: for ``"declared"``: the reason the cell file gives (may be empty).
-    """
-
-    geometry_a: str
-    geometry_b: str
-    body_a: str
-    body_b: str
-    reason: PairReason
-    distance_bound: float = float("inf")
-    index_a: int = -1
-    index_b: int = -1
-    note: str = ""
-
-
-def _effective(model: pin.Model, j: int) -> int:
-    while j > 0 and "Mimic" in model.joints[j].shortname():
-        j = model.parents[j]
-    return j
-
-
 def _root_joint(model: pin.Model, j: int) -> int:
     while j > 0 and model.parents[j] > 0:
         j = model.parents[j]
@@ -189,7 +142,7 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
 def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
     """Split every pair of the cell's collision geometries into checked and allowed pairs.
 
-    The rules by design, the declared pairs and the proof of reach first (:func:`_by_design`,
+    The rules by design, the declared pairs and the proof of reach first (:func:`robots.pair_rules.by_design`,
     :func:`_reach_gaps`), then the seeded sampling of the pairs left (:func:`_sampled_reasons`);
     the checked pairs come back arm-fixture first, then arm-arm, then self.
 
@@ -201,14 +154,14 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     G = len(objs)
     link, owner, is_arm = _owners(cell)
     joint = [int(g.parentJoint) for g in objs]
-    eff = [_effective(model, j) for j in joint]
+    eff = [effective_joint(model, j) for j in joint]
     declared = _declared(cell)
 
     # reach balls of moving geometries, boxes of static ones (world frame, neutral configuration)
     data = model.createData()
     gd = pin.GeometryData(gm)
     pin.updateGeometryPlacements(model, data, gm, gd, pin.neutral(model))
-    still = [tuple(_effective(model, j) for j in frames) for frames in still_frames(model, data, objs)]
+    still = [tuple(effective_joint(model, j) for j in frames) for frames in still_frames(model, data, objs)]
     spheres = [_local_sphere(g.geometry) for g in objs]
     box_R, box_c, box_half = _neutral_boxes(gd, spheres)
     ball_center, ball_radius = _reach_balls(model, data, objs, joint, spheres)
@@ -226,7 +179,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     plain = [(e,) for e in eff]
     for a in range(G):
         for b in range(a + 1, G):
-            reason = _by_design(model, a, b, link, owner, eff, plain)
+            reason = by_design(model, a, b, link, owner, eff, plain)
             note = declared.get(frozenset((link[a], link[b]))) if reason is None else None
             if reason is not None:
                 allow(a, b, reason)
@@ -244,7 +197,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     keep, through = [], []
     for (a, b), (reason, share, depth) in zip(checked, _sampled_reasons(cell, objs, data, checked, seed)):
         if share >= ALWAYS_SHARE:  # in contact whatever the joints do: explained by the shapes, or an error
-            reason = _by_design(model, a, b, link, owner, eff, still)
+            reason = by_design(model, a, b, link, owner, eff, still)
             if reason is None:
                 through.append((a, b, share, depth))
             else:
@@ -271,17 +224,10 @@ def _declared(cell: "Cell") -> dict[frozenset, str]:
 def _placement_error(cell: "Cell", objs: list, link: list[str], owner: list[str], is_arm: list[bool],
                      through: list[tuple[int, int, float, float]]) -> PlacementError:
     """The :class:`PlacementError` of the geometry pairs ``through`` ``(a, b, share, depth)``, by pair of links."""
-    worst: dict[tuple[str, str], tuple[float, float]] = {}
-    for a, b, share, depth in through:
-        p = _pair(a, b, objs, link, owner, is_arm)
-        s0, d0 = worst.get(p.bodies, (0.0, 0.0))
-        worst[p.bodies] = (max(s0, share), max(d0, depth))
-    rows = tuple((a, b, s, d) for (a, b), (s, d) in sorted(worst.items(), key=lambda kv: -kv[1][1]))
-    shown = "; ".join(f"{a} – {b} in {s:.0%} of {ALWAYS_SAMPLES} configurations, up to {d * 1e3:.1f} mm deep"
-                      for a, b, s, d in rows[:8])
-    more = f"; and {len(rows) - 8} more pair(s)" if len(rows) > 8 else ""
+    rows, shown = contact_rows([(*_pair(a, b, objs, link, owner, is_arm).bodies, share, depth)
+                                for a, b, share, depth in through], ALWAYS_SAMPLES)
     return PlacementError(
-        f"{cell.source}: placed through a moving link, in collision in (almost) every configuration: {shown}{more}. "
+        f"{cell.source}: placed through a moving link, in collision in (almost) every configuration: {shown}. "
         "Move the fixture (or the arm's base) clear of the arm, or, if the contact is by design, declare the pair "
         'in the cell file: <disable_collisions link1="A" link2="B" reason="..."/> (a description: '
         "[[disable_collisions]] with link1, link2, reason)", pairs=rows)
@@ -330,27 +276,6 @@ def _reach_balls(model: pin.Model, data: pin.Data, objs: list, joint: list[int],
             j = model.parents[j]
         ball_radius[k] = total
     return ball_center, ball_radius
-
-
-def _by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[str], eff: list[int],
-               still: list[tuple[int, ...]]) -> PairReason | None:
-    """The :class:`PairReason` when the structure allows the pair ``(a, b)`` (same link, rigid, coaxial, adjacent),
-    else ``None``. ``still``: per geometry, the joints in whose frames it is fixed (its own joint alone, or with
-    those of :mod:`.coaxial`); two geometries fixed in one frame are ``coaxial``, joined by one joint ``adjacent``."""
-    if link[a] == link[b]:
-        return PairReason.SAME_LINK
-    if eff[a] == eff[b]:
-        return PairReason.RIGID
-    if set(still[a]) & set(still[b]):
-        return PairReason.COAXIAL
-    for ea in still[a]:
-        for eb in still[b]:
-            if (ea == 0 or eb == 0) and owner[a] != owner[b]:
-                continue  # a fixture or another arm's base is never adjacent to an arm's link
-            if (ea > 0 and _effective(model, model.parents[ea]) == eb) or (eb > 0 and
-                                                                            _effective(model, model.parents[eb]) == ea):
-                return PairReason.ADJACENT
-    return None
 
 
 def _sampled_reasons(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],

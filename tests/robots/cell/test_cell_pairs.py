@@ -332,3 +332,12 @@ def test_two_links_of_one_arm_overlapping_away_from_their_joint_are_a_placement_
     allowed = make_cell(text.replace("</robot>", '<disable_collisions link1="p_link3" link2="p_link1"/></robot>'),
                         "plate declared")
     assert {(p.body_a, p.body_b): p.reason for p in allowed.allowed}[("p_link1", "p_link3")] == PairReason.DECLARED
+
+
+def test_an_arm_files_own_declared_contacts_come_with_it_into_a_composed_cell(tmp_path):
+    shutil.copy(SCARA_000.with_name("gantry_flower.urdf"), tmp_path / "gantry.urdf")
+    path = tmp_path / "cell.toml"
+    path.write_text('name = "one_gantry"\n[[arm]]\nname = "g"\nurdf = "gantry.urdf"\n', encoding="utf-8")
+    cell = load_cell(path)
+    (pair,) = [p for p in cell.allowed if {p.body_a, p.body_b} == {"g_x_carriage_link", "g_z_ram_link"}]
+    assert pair.reason == PairReason.DECLARED and "10 mm" in pair.note

@@ -9,7 +9,7 @@ Prismatic joints and other shapes (boxes, meshes) stop the climb. Tolerance: 1e-
 distance of the centre from the axis, 1e-9 on the sine of the angle between the two axes.
 
 :func:`still_frames` gives, per geometry, the joints in whose frames it is fixed: its own
-parent joint and every joint up to where the climb stops. :mod:`.pairs` calls two geometries
+parent joint and every joint up to where the climb stops. :mod:`.pair_rules` calls two geometries
 with a frame in common ``coaxial`` (their distance never changes) and uses the frames for
 adjacency (the Panda's link-3 sphere at joint 2 is part of link 2 as far as distances go).
 """
