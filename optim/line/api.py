@@ -17,7 +17,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from pinarms.optim.line.belt import Belt, _number
-from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
+from pinarms.optim.line.items import MAX_ITEMS, ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
 from pinarms.optim.line.rules import Rule
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
@@ -52,8 +52,12 @@ class Stream:
             raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
         if self.kind == "file" and not self.path:
             raise InvalidInput("a 'file' stream needs the path of its arrivals file")
-        _number(self.rate, "stream rate [items/min]", positive=True)
-        _number(self.duration, "stream duration [s]", positive=True)
+        rate = _number(self.rate, "stream rate [items/min]", positive=True)
+        duration = _number(self.duration, "stream duration [s]", positive=True)
+        expected = rate / 60.0 * duration
+        if self.kind != "file" and not expected <= MAX_ITEMS:
+            raise InvalidInput(f"a stream of {rate:g} items/min over {duration:g} s is {expected:.3g} items; a stream "
+                               f"holds at most {MAX_ITEMS} items: lower the rate or the duration")
         object.__setattr__(self, "types", tuple(self.types))
 
     def items(self, belt: Belt, seed: int) -> Items:
