@@ -34,6 +34,7 @@ import errno
 import importlib.util
 import json
 import os
+import stat
 import sys
 from pathlib import Path
 
@@ -107,6 +108,12 @@ class _Hooks:
                 f"{what} '{path}' is outside the folders this file may read "
                 f"(its own folder and the packages given: {', '.join(sorted(self.packages)) or 'none'})"
             )
+        try:
+            mode = os.stat(path).st_mode
+        except OSError:
+            return path  # missing: xacro reports it by name
+        if not stat.S_ISREG(mode):  # a FIFO would block the read, a device (/dev/zero) never end
+            raise Forbidden(f"{what} '{path}' is not a regular file (a FIFO, a device, a socket or a folder)")
         return path
 
     def parse(self, inp, filename=None):

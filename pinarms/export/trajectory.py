@@ -37,7 +37,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput, LimitViolation
-from pinarms.files import atomic_write
+from pinarms.files import atomic_write, read_bounded_text
 
 from .errors import InvalidRate, JointMismatch
 
@@ -46,6 +46,8 @@ __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_ya
 
 #: Most points one file may hold.
 MAX_POINTS = 2_000_000
+#: Largest trajectory file read back [bytes] (a regular file; FIFOs and devices are refused unread).
+MAX_TRAJECTORY_FILE_BYTES = 64 * 2**20
 
 
 @dataclass(frozen=True, eq=False)
@@ -252,7 +254,7 @@ def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) ->
     """Read a file of :func:`write_trajectory_yaml` (any JointTrajectory YAML with those fields)."""
     import yaml
 
-    with open(path, encoding="utf-8") as f:
+    with io.StringIO(read_bounded_text(path, MAX_TRAJECTORY_FILE_BYTES, "trajectory file")) as f:
         doc = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml when present
     try:
         names = tuple(str(n) for n in doc["joint_names"])
@@ -269,7 +271,7 @@ def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) ->
 
 def read_trajectory_csv(path: str | os.PathLike, *, joint_names: Any = None) -> ControllerTrajectory:
     """Read a file of :func:`write_trajectory_csv`."""
-    with open(path, encoding="utf-8", newline="") as f:
+    with io.StringIO(read_bounded_text(path, MAX_TRAJECTORY_FILE_BYTES, "trajectory file"), newline="") as f:
         rows = list(csv.reader(f))
     header = rows[0] if rows else []
     n = (len(header) - 1) // 3

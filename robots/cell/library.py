@@ -14,6 +14,8 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from pinarms.files import check_regular
+
 from ..errors import CellNotFound, InvalidInput, ModelError
 from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
 from ..xacro_expand import XacroLimits, expand_xacro
@@ -137,8 +139,9 @@ def load_cell(
         return Cell(urdf.read_text(encoding="utf-8"), source=f"builtin:{text_or_path}", base_dir=CELL_URDF_DIR,
                     packages=packages, args=declared, seed=seed)
     path = Path(path_or_name)
-    if not path.is_file():
+    if not path.exists():
         raise CellNotFound(f"cell file {str(path)!r} does not exist; built-in cells: {', '.join(cell_names())}")
+    check_regular(path, "cell file", error=ModelError, missing=CellNotFound)  # a FIFO or a device: refused unread
     if path.name.endswith(".toml"):  # a cell description: arms by URDF file under prefixes (compose.py)
         if all_args:
             raise InvalidInput(f"{str(path)!r} is a cell description: it takes no xacro arguments")
