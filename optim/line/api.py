@@ -16,6 +16,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pinarms.optim.caps import count_setting
 from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.items import MAX_ITEMS, ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
@@ -28,9 +29,13 @@ from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve"]
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve",
+           "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
+#: Most arms (stations) along one line, and most seeds (Monte Carlo runs) of one line result.
+MAX_LINE_ARMS = 64
+MAX_LINE_SEEDS = 10_000
 #: ``"ok"``: the miss rate's mean is within the target; ``"misses above target"``: it is not.
 STATUSES = ("ok", "misses above target")
 
@@ -95,6 +100,8 @@ class LineSpec:
         if not isinstance(self.belt, Belt):
             raise InvalidInput("belt must be a Belt")
         st = tuple(self.stations)
+        count_setting(len(st), "the number of stations", 1, MAX_LINE_ARMS)
+        count_setting(len(tuple(self.seeds)), "the number of seeds", 1, MAX_LINE_SEEDS)
         if not st or not all(isinstance(s, Station) for s in st):
             raise InvalidInput("stations must be a non-empty sequence of Station")
         names = [s.name for s in st]

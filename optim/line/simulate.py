@@ -159,8 +159,9 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         t, k = heapq.heappop(heap)
         st = states[k]
         decisions += 1
-        lo = int(np.searchsorted(t0, t - st.u_max / speed))
-        hi = int(np.searchsorted(t0, t - st.u_min / speed + st.max_tA, side="right"))
+        slack = EPS + 4.0 * float(np.spacing(abs(t)))  # rounding must not drop an item at the window's edge
+        lo = int(np.searchsorted(t0, t - st.u_max / speed - slack))
+        hi = int(np.searchsorted(t0, t - st.u_min / speed + st.max_tA + slack, side="right"))
         if rule.name == "lookahead":
             hi = max(hi, min(n, lo + rule.horizon))
         idx = np.arange(lo, hi)
