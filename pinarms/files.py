@@ -188,7 +188,7 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Exc
     try:
         fd = os.open(name, flags)
     except FileNotFoundError:
-        raise (missing or error)(f"{what} {name!r} does not exist") from None
+        raise (missing or error)(f"cannot read {what} {name!r}: it does not exist") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise error(f"cannot read {what} {name!r}: {reason}") from None
