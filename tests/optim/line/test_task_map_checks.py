@@ -19,7 +19,6 @@ from pinarms.optim.line.errors import TaskMapError
 from pinarms.optim.line.items import regular_items
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.task_maps import MAX_MAP_VALUES, TaskMap
-from pinarms.robots.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 DU = np.array([0.0, 0.1, 0.2])
