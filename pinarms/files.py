@@ -314,3 +314,93 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
     """Write ``text`` (UTF-8, ``\n`` line ends) to ``path`` atomically (:func:`atomic_write`); return the path."""
     data = text.encode("utf-8")
     return atomic_write(path, lambda f: f.write(data))
+
+
+# ----------------------------------------------------------------- reading: regular files only, size-bounded
+def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Exception] = InvalidInput,
+                 missing: type[Exception] | None = None) -> BinaryIO:
+    """``path`` opened for binary reading, only when it is a regular file (links followed).
+
+    The file is opened with ``O_NONBLOCK`` (a FIFO with no writer then opens at once instead of
+    waiting) and checked with ``fstat`` on the open descriptor, so what is checked is what is read:
+    a FIFO, a device (``/dev/zero``), a socket or a folder is refused before a byte is read.
+
+    Raises:
+        error: not a path, not a regular file, or unreadable (the message names ``what`` and the path).
+        missing: the file does not exist (default: ``error``).
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise error(f"{what} must be given as a path, got {type(path).__name__}")
+    name = os.fspath(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(name, flags)
+    except FileNotFoundError:
+        raise (missing or error)(f"cannot read {what} {name!r}: it does not exist") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise error(f"cannot read {what} {name!r}: {reason}") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise error(f"{what} {name!r} is not a regular file ({_kind_of(mode)}): give the path of a file")
+        if fcntl is not None:  # back to blocking reads for the caller
+            fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~getattr(os, "O_NONBLOCK", 0))
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def _kind_of(mode: int) -> str:
+    """What a non-regular file is, in words."""
+    for test, word in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return word
+    return "not a file"
+
+
+def check_regular(path: str | os.PathLike, what: str = "file", *, error: type[Exception] = InvalidInput,
+                  missing: type[Exception] | None = None, limit: int | None = None) -> int:
+    """The size [bytes] of ``path`` after :func:`open_regular`'s checks, for a file another
+    library or process opens by name (HDF5, xacro); ``error`` above ``limit`` bytes."""
+    with open_regular(path, what, error=error, missing=missing) as fh:
+        size = os.fstat(fh.fileno()).st_size
+    if limit is not None and size > limit:
+        raise error(f"{what} {os.fspath(path)!r} is {size} bytes; the limit is {limit} bytes")
+    return size
+
+
+def read_bounded(path: str | os.PathLike, limit: int, what: str = "file", *, error: type[Exception] = InvalidInput,
+                 missing: type[Exception] | None = None, too_large: type[Exception] | None = None) -> bytes:
+    """The bytes of the regular file ``path`` (:func:`open_regular`), at most ``limit`` of them:
+    sized by ``fstat`` first, then read up to ``limit + 1`` bytes only (a file that grows while it
+    is read is refused too). ``too_large`` (default ``error``) when over the limit."""
+    with open_regular(path, what, error=error, missing=missing) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        big = too_large or error
+        if size > limit:
+            raise big(f"{what} {os.fspath(path)!r} is {size} bytes; the limit is {limit} bytes "
+                      f"(larger than that is refused unread)")
+        try:
+            data = fh.read(limit + 1)
+        except OSError as exc:
+            raise error(f"cannot read {what} {os.fspath(path)!r}: {exc.strerror or exc}") from None
+    if len(data) > limit:
+        raise big(f"{what} {os.fspath(path)!r} is larger than the limit of {limit} bytes")
+    return data
+
+
+def read_bounded_text(path: str | os.PathLike, limit: int, what: str = "file", *,
+                      error: type[Exception] = InvalidInput, missing: type[Exception] | None = None,
+                      too_large: type[Exception] | None = None) -> str:
+    """:func:`read_bounded`, decoded as UTF-8 (a leading byte-order mark dropped); ``error`` when not UTF-8."""
+    data = read_bounded(path, limit, what, error=error, missing=missing, too_large=too_large)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"{what} {os.fspath(path)!r} is not UTF-8 text (byte {exc.start}): save it as UTF-8") from None
+
+
+__all__ += ["open_regular", "check_regular", "read_bounded", "read_bounded_text"]

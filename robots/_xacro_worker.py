@@ -39,6 +39,7 @@ import errno
 import importlib.util
 import json
 import os
+import stat
 import sys
 from pathlib import Path
 

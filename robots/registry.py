@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from pinarms.files import read_bounded_text
+
 from .errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 # the URDF checks, under the names robots/cell/compose.py imports from here
@@ -27,7 +29,10 @@ from .urdf_checks import check_tree as _check_tree
 from .urdf_checks import refuse_dtd as _refuse_dtd
 
 __all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest",
-           "match_builtin"]
+           "match_builtin", "MAX_URDF_BYTES"]
+
+#: Largest URDF file :func:`from_urdf` reads [bytes] (as much as a xacro expansion may produce).
+MAX_URDF_BYTES = 64 * 2**20
 
 
 @dataclass(frozen=True)
@@ -324,14 +329,12 @@ def from_urdf(
             ``<disable_collisions>`` elements (:class:`~robots.SelfCollision` skips them).
 
     Raises:
-        ModelError: the file is missing, not XML, not a URDF, or Pinocchio rejects it.
+        ModelError: the file is missing, not a regular file, larger than :data:`MAX_URDF_BYTES`,
+            not XML, not a URDF, or Pinocchio rejects it.
     """
     check_path_name(path, "URDF file")
+    text = read_bounded_text(path, MAX_URDF_BYTES, "URDF file", error=ModelError)
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ModelError(f"cannot read URDF file {str(path)!r}: {exc.strerror or exc}") from exc
     if not package_dirs:
         package_dirs = (str(path.parent),)
     return from_urdf_text(

@@ -52,6 +52,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from pinarms.files import check_regular
+
 from ._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
 from .errors import (
     InvalidInput,
@@ -196,9 +198,8 @@ def expand_xacro(
     limits = limits if limits is not None else XacroLimits()
     if not isinstance(limits, XacroLimits):
         raise InvalidInput(f"limits must be a XacroLimits, got {type(limits).__name__}")
+    check_regular(path, "xacro file", error=XacroError, missing=XacroFileNotFound)  # a FIFO would block the child
     path = Path(path)
-    if not path.is_file():
-        raise XacroFileNotFound(f"xacro file {str(path)!r} does not exist")
     given = {str(k): _arg_text(str(k), v) for k, v in (args or {}).items()}
     pkgs = {BUILTIN_PACKAGE[0]: str(BUILTIN_PACKAGE[1])}
     for name, folder in (packages or {}).items():

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO, Iterator
 
 import numpy as np
 
+from pinarms.files import open_regular
 from pinarms.robots.errors import InvalidInput
 
 from .errors import SessionFormatError
@@ -341,10 +342,8 @@ def open_archive(path: str | os.PathLike, limits: SessionLimits) -> Iterator[Arc
         InvalidInput: ``path`` does not exist or is a folder.
     """
     p = Path(path)
-    if not p.is_file():
-        raise InvalidInput(f"session file {str(p)!r} does not exist (or is not a file)")
-    try:
-        fp = open(p, "rb")
+    try:  # checked on the open file: a FIFO, a device or a folder is refused unread
+        fp = open_regular(p, "session file", error=InvalidInput)
     except OSError as exc:
         raise SessionFormatError(f"cannot read session {str(p)!r}: {exc}") from None
     with fp:

@@ -16,8 +16,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pinarms.optim.caps import count_setting
 from pinarms.optim.line.belt import Belt, _number
-from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
+from pinarms.optim.line.items import MAX_ITEMS, ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
 from pinarms.optim.line.rules import Rule
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
@@ -28,9 +29,13 @@ from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve"]
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve",
+           "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
+#: Most arms (stations) along one line, and most seeds (Monte Carlo runs) of one line result.
+MAX_LINE_ARMS = 64
+MAX_LINE_SEEDS = 10_000
 #: ``"ok"``: the miss rate's mean is within the target; ``"misses above target"``: it is not.
 STATUSES = ("ok", "misses above target")
 
@@ -52,8 +57,12 @@ class Stream:
             raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
         if self.kind == "file" and not self.path:
             raise InvalidInput("a 'file' stream needs the path of its arrivals file")
-        _number(self.rate, "stream rate [items/min]", positive=True)
-        _number(self.duration, "stream duration [s]", positive=True)
+        rate = _number(self.rate, "stream rate [items/min]", positive=True)
+        duration = _number(self.duration, "stream duration [s]", positive=True)
+        expected = rate / 60.0 * duration
+        if self.kind != "file" and not expected <= MAX_ITEMS:
+            raise InvalidInput(f"a stream of {rate:g} items/min over {duration:g} s is {expected:.3g} items; a stream "
+                               f"holds at most {MAX_ITEMS} items: lower the rate or the duration")
         object.__setattr__(self, "types", tuple(self.types))
 
     def items(self, belt: Belt, seed: int) -> Items:
@@ -91,6 +100,8 @@ class LineSpec:
         if not isinstance(self.belt, Belt):
             raise InvalidInput("belt must be a Belt")
         st = tuple(self.stations)
+        count_setting(len(st), "the number of stations", 1, MAX_LINE_ARMS)
+        count_setting(len(tuple(self.seeds)), "the number of seeds", 1, MAX_LINE_SEEDS)
         if not st or not all(isinstance(s, Station) for s in st):
             raise InvalidInput("stations must be a non-empty sequence of Station")
         names = [s.name for s in st]

@@ -14,17 +14,23 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
+import math
+import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
+from pinarms.files import read_bounded
 from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.errors import ArrivalsFileError
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["ItemType", "Items", "poisson_items", "regular_items", "read_arrivals", "MAX_ITEMS", "MAX_FILE_BYTES"]
+__all__ = ["ItemType", "Items", "poisson_items", "regular_items", "read_arrivals", "MAX_ITEMS", "MAX_FILE_BYTES",
+           "MAX_FIELD_CHARS"]
 
 #: Largest arrivals file read [bytes] and most items in a stream.
 MAX_FILE_BYTES = 64 * 1024 * 1024
@@ -119,8 +125,15 @@ def poisson_items(belt: Belt, rate: float, duration: float, *, types: Sequence[I
     rate = _number(rate, "rate [items/s]", positive=True)
     duration = _number(duration, "duration [s]", positive=True)
     tt = _types(types)
+    expected = rate * duration
+    if not expected <= MAX_ITEMS:  # inf too; checked before numpy draws or allocates
+        raise InvalidInput(f"{rate:g} items/s over {duration:g} s is {expected:.3g} items expected; a stream holds "
+                           f"at most {MAX_ITEMS} items: lower the rate or simulate a shorter time")
     rng = np.random.default_rng(seed)
-    n = int(rng.poisson(rate * duration))
+    n = int(rng.poisson(expected))
+    if n > MAX_ITEMS:
+        raise InvalidInput(f"the Poisson draw gave {n} items; a stream holds at most {MAX_ITEMS} items: "
+                           f"lower the rate or simulate a shorter time")
     t0 = np.sort(rng.uniform(0.0, duration, n))
     kind = rng.integers(0, len(tt), n)
     w = _lateral(rng, n, belt, tt, kind)
@@ -135,6 +148,10 @@ def regular_items(belt: Belt, period: float, duration: float, *, w: float | None
     period = _number(period, "period [s]", positive=True)
     duration = _number(duration, "duration [s]", positive=True)
     tt = _types(types)
+    count = math.ceil(duration / period) if duration / period < 2.0 * MAX_ITEMS else math.inf
+    if count > MAX_ITEMS:  # counted before numpy allocates
+        raise InvalidInput(f"one item every {period:g} s over {duration:g} s is {duration / period:.3g} items; a "
+                           f"stream holds at most {MAX_ITEMS} items: a longer period or a shorter time")
     rng = np.random.default_rng(seed)
     t0 = np.arange(0.0, duration, period)
     kind = np.zeros(t0.size, dtype=int)
@@ -145,34 +162,112 @@ def regular_items(belt: Belt, period: float, duration: float, *, w: float | None
 def read_arrivals(path: str | Path, belt: Belt, types: Sequence[ItemType]) -> Items:
     """Items from an arrivals file (module doc).
 
+    The file is read in blocks of rows, each checked at once (a row at a time only to name the
+    first bad row of a block), and reading stops at the first row past :data:`MAX_ITEMS`.
+
     Raises:
-        ArrivalsFileError: unreadable, too large, a missing column, a bad value (row and column named).
+        ArrivalsFileError: unreadable, not a regular file, too large, a missing or repeated column,
+            a field over :data:`MAX_FIELD_CHARS` characters, a bad value (row and column named).
         InvalidInput: an item off the belt.
     """
     tt = _types(types)
-    names = {t.name: k for k, t in enumerate(tt)}
-    p = Path(path)
-    try:
-        if p.stat().st_size > MAX_FILE_BYTES:
-            raise ArrivalsFileError(f"arrivals file {p} is larger than {MAX_FILE_BYTES} bytes")
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ArrivalsFileError(f"cannot read arrivals file {p}: {exc}") from None
-    reader = csv.reader(io.StringIO(text))
-    header = [h.strip() for h in next(reader, [])]
+    p = Path(path) if isinstance(path, (str, os.PathLike)) else path
+    data = read_bounded(p, MAX_FILE_BYTES, "arrivals file", error=ArrivalsFileError)
+    if b"\r" in data:  # csv ends a row at \r, \n or \r\n alike: one line end for the count below
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    lines = data.count(b"\n") + 1
+    if lines > MAX_ITEMS + 1 and lines - len(_BLANK_LINE.findall(data)) > MAX_ITEMS + 1:  # counted before parsing
+        raise ArrivalsFileError(f"arrivals file {p}: more than {MAX_ITEMS} rows (non-blank lines after the header); "
+                                f"split the file")
+    # decoded as it is parsed: the text is never held whole (a str of it can take 4 bytes a character)
+    reader = csv.reader(io.TextIOWrapper(io.BytesIO(data), encoding="utf-8-sig", newline=""))
+    header = [h.strip() for h in (_block(reader, p, 1) or [[]])[0]]
     for col in ("time", "across", "type"):
         if col not in header:
             raise ArrivalsFileError(f"arrivals file {p}: header lacks column {col!r} (need time,across,type[,yaw])")
-    idx = {h: i for i, h in enumerate(header)}
-    rows: list[tuple[float, float, int, float]] = []
-    last = 0.0
-    for r, row in enumerate(reader, start=1):
-        if not row or all(not c.strip() for c in row):
-            continue
-        if len(rows) >= MAX_ITEMS:
-            raise ArrivalsFileError(f"arrivals file {p}: more than {MAX_ITEMS} rows")
-        if len(row) != len(header):
-            raise ArrivalsFileError(f"arrivals file {p}, row {r}: {len(row)} columns, the header has {len(header)}")
+    seen = set()
+    for h in header:
+        if h in seen:
+            raise ArrivalsFileError(f"arrivals file {p}: the header names column {h!r} twice; name each column once")
+        seen.add(h)
+    table = _Table(p, {h: i for i, h in enumerate(header)}, belt, tt)
+    r = 0  # data rows before the block, blank ones included (1 = the first data row)
+    while chunk := _block(reader, p, _BLOCK_ROWS):
+        table.add(r + 1, chunk)
+        r += len(chunk)
+    return _checked(belt, *table.arrays(), tt)
+
+
+#: A line of an arrivals file that holds no value (blank, or only separators).
+_BLANK_LINE = re.compile(rb"^[ \t\f\v,]*$", re.MULTILINE)
+#: Rows checked together by :func:`read_arrivals`.
+_BLOCK_ROWS = 65_536
+#: Longest field of an arrivals file [characters] (the ``csv`` module's own limit).
+MAX_FIELD_CHARS = csv.field_size_limit()
+
+
+def _block(reader: Any, p: Any, n: int) -> list[list[str]]:
+    """The next ``n`` rows of a CSV reader (fewer at the end); csv's and UTF-8's errors named by row."""
+    try:
+        return list(itertools.islice(reader, n))
+    except csv.Error as exc:
+        what = f"a field longer than {MAX_FIELD_CHARS} characters" if "field larger" in str(exc) else str(exc)
+        raise ArrivalsFileError(f"arrivals file {p}, row {reader.line_num - 1}: {what}; this is not an arrivals "
+                                f"list") from None
+    except UnicodeDecodeError:
+        raise ArrivalsFileError(f"arrivals file {p}: not UTF-8 text (near row {reader.line_num}); save it as "
+                                f"UTF-8") from None
+
+
+class _Table:
+    """The columns of an arrivals file, filled a block of rows at a time (:func:`read_arrivals`)."""
+
+    def __init__(self, p: Any, idx: dict[str, int], belt: Belt, types: tuple[ItemType, ...]) -> None:
+        self.p, self.idx, self.belt, self.types = p, idx, belt, types
+        self.names = {t.name: k for k, t in enumerate(types)}
+        self.half = np.array([t.size[1] for t in types]) / 2.0
+        self.parts: list[np.ndarray] = []
+        self.count = 0
+        self.last = 0.0
+
+    def add(self, first: int, chunk: list[list[str]]) -> None:
+        """Check the rows ``chunk`` (numbered from ``first``) at once; on any fault, row by row, to
+        name the first bad row. Blank rows are skipped; past :data:`MAX_ITEMS` rows, refused."""
+        rows = [row for row in chunk if "".join(row).strip()]
+        if self.count + len(rows) > MAX_ITEMS:
+            r = first + [k for k, row in enumerate(chunk) if "".join(row).strip()][MAX_ITEMS - self.count]
+            raise ArrivalsFileError(f"arrivals file {self.p}: more than {MAX_ITEMS} rows (row {r}); split the file")
+        self.count += len(rows)
+        try:
+            a = self._fast(rows) if rows else np.zeros((0, 4))
+        except (ValueError, KeyError, IndexError):
+            a = None
+        if a is None:  # raises at the first bad row
+            a = np.array([self._row(first + k, row) for k, row in enumerate(chunk) if "".join(row).strip()],
+                         dtype=float).reshape(-1, 4)
+        self.parts.append(a)
+        if a.size:
+            self.last = float(a[-1, 0])
+
+    def _fast(self, rows: list[list[str]]) -> np.ndarray | None:
+        n_cols, n = len(self.idx), len(rows)
+        if any(len(row) != n_cols for row in rows):
+            return None
+        col = {h: [row[i] for row in rows] for h, i in self.idx.items()}
+        t = np.fromiter(map(float, col["time"]), float, n)
+        w = np.fromiter(map(float, col["across"]), float, n)
+        yaw = np.fromiter(map(float, col["yaw"]), float, n) if "yaw" in col else np.zeros(n)
+        kind = np.fromiter((self.names[k.strip()] for k in col["type"]), float, n)
+        good = (np.all(np.isfinite(t)) and np.all(np.isfinite(w)) and np.all(np.isfinite(yaw)) and t[0] >= self.last
+                and np.all(np.diff(t) >= 0.0)
+                and np.all(np.abs(w) + self.half[kind.astype(int)] <= self.belt.width / 2.0 + 1e-12))
+        return np.column_stack([t, w, kind, yaw]) if good else None
+
+    def _row(self, r: int, row: list[str]) -> tuple[float, float, int, float]:
+        """One row checked: ``(time, across, type, yaw)`` (else ArrivalsFileError naming it and the column)."""
+        p, idx, tt = self.p, self.idx, self.types
+        if len(row) != len(idx):
+            raise ArrivalsFileError(f"arrivals file {p}, row {r}: {len(row)} columns, the header has {len(idx)}")
 
         def num(col: str) -> float:
             try:
@@ -185,19 +280,22 @@ def read_arrivals(path: str | Path, belt: Belt, types: Sequence[ItemType]) -> It
             return x
 
         t = num("time")
-        if t < 0.0 or t < last:
+        if t < 0.0 or t < self.last:
             raise ArrivalsFileError(f"arrivals file {p}, row {r}, column 'time': {t} s must be >= 0 and not "
-                                    f"before the previous row ({last} s)")
-        last = t
+                                    f"before the previous row ({self.last} s)")
+        self.last = t
         kind = row[idx["type"]].strip()
-        if kind not in names:
+        if kind not in self.names:
             raise ArrivalsFileError(f"arrivals file {p}, row {r}, column 'type': unknown type {kind!r}; "
-                                    f"known: {sorted(names)}")
+                                    f"known: {sorted(self.names)}")
         yaw = num("yaw") if "yaw" in idx else 0.0
         w = num("across")
-        if abs(w) + tt[names[kind]].size[1] / 2.0 > belt.width / 2.0 + 1e-12:
+        if abs(w) + tt[self.names[kind]].size[1] / 2.0 > self.belt.width / 2.0 + 1e-12:
             raise ArrivalsFileError(f"arrivals file {p}, row {r}, column 'across': the item at {w} m is off the "
-                                    f"belt (width {belt.width} m, item {tt[names[kind]].size[1]} m wide)")
-        rows.append((t, w, names[kind], yaw))
-    a = np.array(rows, dtype=float).reshape(-1, 4)
-    return _checked(belt, a[:, 0], a[:, 1], a[:, 2].astype(int), a[:, 3], tt)
+                                    f"belt (width {self.belt.width} m, item {tt[self.names[kind]].size[1]} m wide)")
+        return t, w, self.names[kind], yaw
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(t0, w, kind, yaw)`` of every row read."""
+        a = np.concatenate(self.parts) if self.parts else np.zeros((0, 4))
+        return a[:, 0], a[:, 1], a[:, 2].astype(int), a[:, 3]

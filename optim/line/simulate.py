@@ -159,8 +159,7 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         t, k = heapq.heappop(heap)
         st = states[k]
         decisions += 1
-        lo = int(np.searchsorted(t0, t - st.u_max / speed))
-        hi = int(np.searchsorted(t0, t - st.u_min / speed + st.max_tA, side="right"))
+        lo, hi = _candidates(t, t0, st, speed)
         if rule.name == "lookahead":
             hi = max(hi, min(n, lo + rule.horizon))
         idx = np.arange(lo, hi)
@@ -223,6 +222,16 @@ def simulate(arms: Sequence[SimArm], items: Items, speed: float, rule: Rule | st
         return out
     return _with_trays(out, arms, fill, span, tray=tray_of, u_place=u_place, place_time=place_time, place_wait=wait,
                        place_branch=place_branch, no_tray=no_tray)
+
+
+def _candidates(t: float, t0: np.ndarray, st: ArmState, speed: float) -> tuple[int, int]:
+    """``(lo, hi)``: the items an arm deciding at ``t`` may meet (arrivals ``t0[lo:hi]``), widened by a
+    rounding slack so that an item whose start is ``t`` (a window as narrow as a nanometre) is never
+    rounded out; the intercept decides which of them are met."""
+    slack = EPS + 4.0 * float(np.spacing(abs(t)))
+    lo = int(np.searchsorted(t0, t - st.u_max / speed - slack))
+    hi = int(np.searchsorted(t0, t - st.u_min / speed + st.max_tA + slack, side="right"))
+    return lo, hi
 
 
 def _overlapping(states: list) -> dict[int, list[int]]:

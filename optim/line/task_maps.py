@@ -29,13 +29,16 @@ import numpy as np
 
 from pinarms.files import atomic_write
 from pinarms.optim.errors import InfeasibleProblem, OptimError
+from pinarms.optim.line.errors import TaskMapError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
+from pinarms.optim.line.task_map_checks import MAX_MAP_VALUES, MAX_TASK_TIME, check_grid, check_scalar, check_sizes, check_times
+from pinarms.optim.line.task_map_file import map_members, read_map_file
 from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
 
-__all__ = ["TaskMap", "build_task_map", "map_error", "MapError"]
+__all__ = ["TaskMap", "build_task_map", "map_error", "MapError", "MAX_MAP_VALUES"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,11 +66,39 @@ class TaskMap:
     fixture_infeasible: int = 0
 
     def __post_init__(self) -> None:
-        A = self.approach[None] if self.branch_approach is None else np.asarray(self.branch_approach, float)
-        C = self.leave[None] if self.branch_leave is None else np.asarray(self.branch_leave, float)
-        if A.shape != (len(self.branches), self.du.size, self.w.size) or C.shape != A.shape:
-            raise InvalidInput(f"task map {self.station!r}: branch tables of shape {A.shape}, {C.shape} for "
-                               f"{len(self.branches)} branches on a {self.du.size} x {self.w.size} grid")
+        """Every field checked (:mod:`~.task_map_checks`; TaskMapError naming the field and the node)."""
+        name = self.station
+        if not isinstance(name, str) or len(name) > 256:
+            raise TaskMapError(f"a task map's station must be a name of at most 256 characters, got {name!r:.80}")
+        du, w = check_grid(self.du, "du", name), check_grid(self.w, "w", name)
+        try:
+            branches = tuple(int(b) for b in self.branches)
+        except (TypeError, ValueError):
+            raise TaskMapError(f"task map {name!r}: branches must be integer labels, got {self.branches!r:.80}") from None
+        if len(set(branches)) != len(branches):
+            raise TaskMapError(f"task map {name!r}: branch labels {branches} repeat one")
+        check_sizes(len(branches), du.size, w.size, name)  # from the grids, before any table is looked at
+        grid = (du.size, w.size)
+        fields = {"du": du, "w": w, "branches": branches,
+                  "approach": check_times(self.approach, "approach", name, grid),
+                  "leave": check_times(self.leave, "leave", name, grid),
+                  "track": check_scalar(self.track, "track time [s]", name, high=MAX_TASK_TIME),
+                  "release": check_scalar(self.release, "release time [s]", name, high=MAX_TASK_TIME),
+                  "speed": check_scalar(self.speed, "belt speed [m/s]", name, open_low=True),
+                  "mass": check_scalar(self.mass, "item mass [kg]", name),
+                  "build_seconds": check_scalar(self.build_seconds, "build_seconds [s]", name),
+                  "fixture_infeasible": int(check_scalar(self.fixture_infeasible, "fixture_infeasible", name))}
+        shape = (len(branches), *grid)
+        for key in ("branch_approach", "branch_leave"):
+            table = getattr(self, key)
+            fields[key] = None if table is None else check_times(table, key, name, shape)
+        for key, value in fields.items():
+            object.__setattr__(self, key, value)
+        A = self.approach[None] if self.branch_approach is None else self.branch_approach
+        C = self.leave[None] if self.branch_leave is None else self.branch_leave
+        if A.shape != shape or C.shape != shape:
+            raise TaskMapError(f"task map {name!r}: branch tables of shape {A.shape}, {C.shape} for "
+                               f"{len(branches)} branches on a {du.size} x {w.size} grid")
         object.__setattr__(self, "_A", A)
         object.__setattr__(self, "_C", C)
         object.__setattr__(self, "_cell", _cell_branches(A, C))
@@ -157,34 +188,43 @@ class TaskMap:
             out.append(np.where(b >= 0, v, np.nan))
         return out[0], out[1]
 
+    @property
+    def checksum(self) -> str:
+        """SHA-256 of every value of the map (:func:`~.task_map_file.map_checksum`), stored in its file."""
+        return str(map_members(self)["checksum"])
+
     def save(self, path: str | Path) -> Path:
-        """Write the map as ``.npz`` atomically (:func:`pinarms.files.atomic_write`)."""
-
-        def write(fh: Any) -> None:
-            np.savez(fh, du=self.du, w=self.w, approach=self.approach, leave=self.leave,
-                     scalars=np.array([self.track, self.release, self.speed, self.mass, self.build_seconds]),
-                     station=np.array(self.station), branches=np.array(self.branches, dtype=np.int64),
-                     branch_approach=self._A, branch_leave=self._C,
-                     fixture_infeasible=np.array(self.fixture_infeasible, dtype=np.int64))
-
-        return atomic_write(path, write)
+        """Write the map as ``.npz`` with its checksum, atomically (:func:`pinarms.files.atomic_write`)."""
+        members = map_members(self)
+        return atomic_write(path, lambda fh: np.savez(fh, **members))
 
     @classmethod
     def load(cls, path: str | Path) -> "TaskMap":
-        """Read a map written by :meth:`save` (no pickle); InvalidInput when malformed."""
-        try:
-            with np.load(Path(path), allow_pickle=False) as z:
-                du, w, a, c, s, name = (z[k] for k in ("du", "w", "approach", "leave", "scalars", "station"))
-                extra = ({"branches": tuple(int(b) for b in z["branches"].ravel()),
-                          "branch_approach": z["branch_approach"], "branch_leave": z["branch_leave"]}
-                         if "branches" in z.files else {})
-                if "fixture_infeasible" in z.files:
-                    extra["fixture_infeasible"] = int(z["fixture_infeasible"])
-        except (OSError, KeyError, ValueError, TypeError) as exc:
-            raise InvalidInput(f"{path}: not a task map file ({exc})") from None
-        if a.shape != (du.size, w.size) or c.shape != a.shape or s.shape != (5,):
-            raise InvalidInput(f"{path}: task map arrays of inconsistent shapes")
-        return cls(str(name), du, w, a, c, *map(float, s), **extra)
+        """Read a map written by :meth:`save` (no pickle; sizes bounded before inflating, every value
+        checked, the checksum compared: :mod:`~.task_map_file`).
+
+        Raises:
+            TaskMapError: not a regular file, too large, not a task map file, a value out of range,
+                a checksum that does not match (the file was changed or damaged).
+        """
+        z = read_map_file(path)
+        s = z["scalars"]
+        if s.shape != (5,):
+            raise TaskMapError(f"{str(path)!r} is not a task map file: scalars of shape {s.shape}, not (5,)")
+        extra: dict[str, Any] = {}
+        if "branches" in z:
+            extra = {"branches": tuple(int(b) for b in z["branches"].ravel()),
+                     "branch_approach": z.get("branch_approach"), "branch_leave": z.get("branch_leave")}
+        if "fixture_infeasible" in z:
+            extra["fixture_infeasible"] = int(z["fixture_infeasible"].ravel()[0]) if z["fixture_infeasible"].size else -1
+        m = cls(str(z["station"]), z["du"], z["w"], z["approach"], z["leave"], *map(float, s), **extra)
+        if "checksum" not in z:
+            raise TaskMapError(f"task map file {str(path)!r} has no checksum (written before pinarms checked its "
+                               "values, or not by TaskMap.save): rebuild it, or load it once with numpy and save it")
+        if str(z["checksum"]) != m.checksum:
+            raise TaskMapError(f"task map file {str(path)!r}: its values do not match its checksum (the file was "
+                               "changed or damaged): rebuild the map")
+        return m
 
 
 def _cell_branches(A: np.ndarray, C: np.ndarray) -> np.ndarray:

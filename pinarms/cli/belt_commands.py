@@ -39,8 +39,16 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
     from pinarms.optim.line import Stream
     from pinarms.studies.line import gantry_line, scara_line
 
-    if seeds < 1:
-        raise InvalidInput(f"--seeds must be >= 1, got {seeds}")
+    from pinarms.optim.caps import count_setting
+    from pinarms.optim.line.api import MAX_LINE_ARMS, MAX_LINE_SEEDS
+    from pinarms.optim.line.items import MAX_ITEMS
+
+    count_setting(seeds, "--seeds", 1, MAX_LINE_SEEDS)  # before any station or map is made
+    count_setting(arms, "--arms", 1, MAX_LINE_ARMS)
+    expected = rate / 60.0 * duration
+    if not arrivals and not expected <= MAX_ITEMS:
+        raise InvalidInput(f"--rate {rate:g} items/min over --duration {duration:g} s is {expected:.3g} items; a stream "
+                           f"holds at most {MAX_ITEMS}: lower --rate or --duration")
     kw = {"seeds": tuple(range(seeds)), "duration": duration}
     if preset == "scara":
         spec = scara_line(arms, rate, rule=rule, paper_limit=paper_limit, **kw, **({} if speed is None else {"speed": speed}))
@@ -135,6 +143,10 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
 
     if preset != "scara":
         raise InvalidInput("belt arms adds SCARAs along the belt: use --preset scara")
+    from pinarms.optim.caps import count_setting
+    from pinarms.optim.line.api import MAX_LINE_ARMS
+
+    count_setting(max_arms, "--max-arms", 1, MAX_LINE_ARMS)
     for n in range(1, max_arms + 1):
         spec = _spec(preset, n, rate, speed, paper_limit, rule, seeds, duration, None)
         res = run_line(spec, maps=maps_for(spec))

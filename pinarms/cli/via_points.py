@@ -17,11 +17,15 @@ from typing import Any
 import click
 import numpy as np
 
+from pinarms.files import read_bounded_text
 from pinarms.robots.errors import InvalidInput
 
 from ._common import floats
 
 __all__ = ["TRAJECTORY_KINDS", "read_via_file", "via_input"]
+
+#: Largest via-point file read [bytes].
+MAX_VIA_FILE_BYTES = 16 * 2**20
 
 #: Trajectory kinds of ``pinarms plan --kind`` (and of a via-point file's ``kind``).
 TRAJECTORY_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline", "polynomial", "piecewise")
@@ -35,7 +39,7 @@ def read_via_file(path: str) -> dict[str, Any]:
     holds knot times, every other column is one joint; one row per via point.
     """
     file = Path(path)
-    text = file.read_text(encoding="utf-8")
+    text = read_bounded_text(file, MAX_VIA_FILE_BYTES, "via-point file")  # a regular file: a FIFO never blocks
     if file.suffix.lower() == ".json":
         try:
             doc = json.loads(text)

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import csv
 import os
-import stat
 from typing import Any
 
 import numpy as np
+
+from pinarms.files import read_bounded_text
 
 from .errors import JointMismatch, TrajectoryFileError
 from .trajectory import MAX_POINTS, ControllerTrajectory
@@ -29,29 +30,9 @@ MAX_JOINTS = 1000
 
 
 def _read_text(path: Any) -> str:
-    """The UTF-8 text of regular file ``path``, bounded by :data:`MAX_FILE_BYTES` before reading."""
-    try:
-        info = os.stat(path)
-    except FileNotFoundError as exc:
-        raise TrajectoryFileError(f"trajectory file {os.fspath(path)!r} does not exist") from exc
-    except (OSError, ValueError) as exc:  # a NUL byte, a name too long, no permission
-        raise TrajectoryFileError(f"cannot read trajectory file {os.fspath(path)!r}: {exc}") from exc
-    if not stat.S_ISREG(info.st_mode):
-        raise TrajectoryFileError(f"{os.fspath(path)!r} is not a regular file: give a trajectory file")
-    if info.st_size > MAX_FILE_BYTES:
-        raise TrajectoryFileError(f"trajectory file {os.fspath(path)!r} has {info.st_size} bytes, more than the "
-                                  f"{MAX_FILE_BYTES} bytes allowed: write a shorter motion or a lower rate")
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise TrajectoryFileError(f"cannot read trajectory file {os.fspath(path)!r}: {exc}") from exc
-    if len(data) > MAX_FILE_BYTES:
-        raise TrajectoryFileError(f"trajectory file {os.fspath(path)!r} grew past {MAX_FILE_BYTES} bytes while read")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise TrajectoryFileError(f"trajectory file {os.fspath(path)!r} is not UTF-8 text ({exc})") from exc
+    """The UTF-8 text of regular file ``path`` (a FIFO or a device refused unopened), at most
+    :data:`MAX_FILE_BYTES` bytes (:func:`pinarms.files.read_bounded_text`)."""
+    return read_bounded_text(path, MAX_FILE_BYTES, "trajectory file", error=TrajectoryFileError)
 
 
 def _loader_class() -> type:

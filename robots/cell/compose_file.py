@@ -14,6 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+from pinarms.files import read_bounded_text
+
 from ..errors import CellError, CellNotFound
 
 __all__ = [
@@ -147,21 +149,7 @@ class CellDescription:
 
 # ----------------------------------------------------------------- reading files
 def _read_bounded(path: Path, limit: int, what: str) -> str:
-    if path.exists() and not path.is_file():
-        raise CellError(f"{what} {str(path)!r} is not a regular file")
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(limit + 1)
-    except FileNotFoundError:
-        raise CellNotFound(f"{what} {str(path)!r} does not exist") from None
-    except OSError as exc:
-        raise CellError(f"cannot read {what} {str(path)!r}: {exc.strerror or exc}") from exc
-    if len(data) > limit:
-        raise CellError(f"{what} {str(path)!r} is larger than {limit} bytes; refusing to read it")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise CellError(f"{what} {str(path)!r} is not UTF-8 text: {exc}") from exc
+    return read_bounded_text(path, limit, what, error=CellError, missing=CellNotFound)
 
 
 def _triple(value: Any, key: str, where: str) -> tuple[float, float, float]:

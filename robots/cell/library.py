@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from pinarms.files import check_regular
 from .._checks import check_path_name
 from ..errors import CellNotFound, InvalidInput, ModelError
 from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
@@ -139,8 +140,9 @@ def load_cell(
                     packages=packages, args=declared, seed=seed)
     check_path_name(path_or_name, "cell file")
     path = Path(path_or_name)
-    if not path.is_file():
+    if not path.exists():
         raise CellNotFound(f"cell file {str(path)!r} does not exist; built-in cells: {', '.join(cell_names())}")
+    check_regular(path, "cell file", error=ModelError, missing=CellNotFound)  # a FIFO or a device: refused unread
     if path.name.endswith(".toml"):  # a cell description: arms by URDF file under prefixes (compose.py)
         if all_args:
             raise InvalidInput(f"{str(path)!r} is a cell description: it takes no xacro arguments")

@@ -23,6 +23,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
+from pinarms.files import read_bounded_text
+
 from ..errors import CellTooLarge, CollisionGeometryError, ModelError
 
 __all__ = [
@@ -62,19 +64,9 @@ def check_file_size(path: str | os.PathLike, limit: int, what: str) -> int:
 
 
 def read_cell_file(path: str | os.PathLike) -> str:
-    """The text of a cell file, sized first and read up to :data:`MAX_CELL_FILE_BYTES` only (UTF-8)."""
-    check_file_size(path, MAX_CELL_FILE_BYTES, "cell file")
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_CELL_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ModelError(f"cannot read cell file {str(path)!r}: {exc.strerror or exc}") from exc
-    if len(raw) > MAX_CELL_FILE_BYTES:  # grew after the stat
-        raise CellTooLarge(f"cell file {str(path)!r} is larger than the limit of {MAX_CELL_FILE_BYTES} bytes")
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"cell file {str(path)!r} is not UTF-8 text (byte {exc.start}): save it as UTF-8") from exc
+    """The text of a cell file: a regular file (not a FIFO or a device), sized first and read up
+    to :data:`MAX_CELL_FILE_BYTES` only (UTF-8)."""
+    return read_bounded_text(path, MAX_CELL_FILE_BYTES, "cell file", error=ModelError, too_large=CellTooLarge)
 
 
 def check_counts(root: ET.Element, n_arms: int, n_fixtures: int, source: str) -> None:

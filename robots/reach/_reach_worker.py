@@ -49,6 +49,7 @@ ATTRIBUTES = (
     ("/", "robot", "str", True), ("/", "urdf_sha256", "str", True), ("/", "tcp_frame", "str", True),
     ("/", "solver", "str", True), ("/", "manipulability", "str", True), ("/", "resolution", "float", True),
     ("/", "shape", "ints", True), ("/", "parameters", "str", True), ("/", "n_reached", "int", False),
+    ("/", "checksum", "str", False), ("/", "poses_checksum", "str", False),
     ("/robot", "joint_names", "str", True),
     ("/orientations", "kind", "str", True), ("/orientations", "roll_free", "bool", True),
     ("/orientations", "n_groups", "int", True), ("/orientations", "parameters", "str", True),

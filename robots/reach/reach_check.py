@@ -20,15 +20,21 @@ import numpy as np
 
 from ..errors import PinarmsError
 from .orientations import MAX_ORIENTATIONS, OrientationSet
+from .reach_digest import PosesDigest, map_checksum
 from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
 from .reach_write import FORMAT_NAME, FORMAT_VERSION
 
-__all__ = ["ReachabilityFileError", "MapChecker", "check_map", "MAX_JOINTS", "MAX_TEXT"]
+__all__ = ["ReachabilityFileError", "MapChecker", "check_map", "MAX_JOINTS", "MAX_TEXT", "MIN_RESOLUTION",
+           "MAX_RESOLUTION", "MAX_EXTENT"]
 
 #: Longest text attribute a map may hold [characters].
 MAX_TEXT = 1_000_000
 #: Most joints a map's robot may have.
 MAX_JOINTS = 64
+#: Voxel edges a map may have [m], and how far its grid may reach from the robot's base [m].
+MIN_RESOLUTION = 1e-4
+MAX_RESOLUTION = 10.0
+MAX_EXTENT = 1000.0
 
 
 class ReachabilityFileError(PinarmsError):
@@ -89,11 +95,15 @@ def check_map(r: MapChecker, want_solutions: bool) -> ReachabilityMap:
     if manip not in ("full", "position"):
         raise r.fail(f"manipulability must be 'full' or 'position', got {manip!r}")
     resolution = r.attr("/", "resolution", float)
-    if not (np.isfinite(resolution) and resolution > 0):
-        raise r.fail(f"resolution must be a positive length in m, got {resolution!r}")
+    if not (np.isfinite(resolution) and MIN_RESOLUTION <= resolution <= MAX_RESOLUTION):
+        raise r.fail(f"resolution must be a length from {MIN_RESOLUTION:g} to {MAX_RESOLUTION:g} m, got {resolution!r}")
     shape = r.attr("/", "shape", list)
     if len(shape) != 3 or min(shape) < 1 or math.prod(shape) > MAX_GRID_VOXELS:
         raise r.fail(f"shape must be 3 positive integers with at most {MAX_GRID_VOXELS} voxels, got {shape}")
+    origin = r.finite("grid/origin")
+    if max(shape) * resolution > MAX_EXTENT or np.any(np.abs(origin) > MAX_EXTENT):
+        raise r.fail(f"the grid (origin {origin.tolist()} m, {shape} voxels of {resolution:g} m) reaches beyond "
+                     f"{MAX_EXTENT:g} m of the robot's base")
     joint_names = r.json("/robot", "joint_names", list)
     nq = len(joint_names)
     if not (1 <= nq <= MAX_JOINTS) or not all(isinstance(j, str) and 0 < len(j) <= 200 for j in joint_names):
@@ -106,14 +116,34 @@ def check_map(r: MapChecker, want_solutions: bool) -> ReachabilityMap:
     oset = _check_orientations(r)
     flat, reached, index, best = _check_voxels(r, oset, math.prod(shape))
     sols = _check_poses(r, flat, reached, lower, upper) if want_solutions and "poses/voxel" in r.arrays else None
-    return ReachabilityMap(
+    m = ReachabilityMap(
         robot=r.attr("/", "robot", str), urdf_sha256=sha, tcp_frame=r.attr("/", "tcp_frame", str),
         joint_names=tuple(joint_names), joint_lower=lower, joint_upper=upper, solver=solver,
-        manipulability_kind=manip, origin=r.finite("grid/origin"), resolution=resolution,
+        manipulability_kind=manip, origin=origin, resolution=resolution,
         shape=(int(shape[0]), int(shape[1]), int(shape[2])), orientations=oset, voxels=flat, reached=reached,
         index=index, best_manipulability=best, solutions=sols, parameters=r.json("/", "parameters", dict),
         reader_wall=r.wall,
     )
+    _check_checksums(r, m, sols)
+    return m
+
+
+def _check_checksums(r: MapChecker, m: ReachabilityMap, sols: PoseSolutions | None) -> None:
+    """The values read against the checksums the writer stored (:mod:`~.reach_digest`)."""
+    stored = r.attrs["/"].get("checksum")
+    if not isinstance(stored, str):
+        raise r.fail("it holds no checksum of its values (written by an older pinarms): rebuild it with "
+                     "reachability_map(..., out=...) or save_reachability")
+    if stored != map_checksum(m):
+        raise r.fail("its values do not match the checksum stored with them (a byte was changed or damaged): "
+                     "rebuild the map")
+    if sols is None:
+        return
+    digest = PosesDigest()
+    digest.update(sols.voxel, sols.orientation, sols.q, sols.manipulability)
+    if r.attrs["/"].get("poses_checksum") != digest.hexdigest():
+        raise r.fail("its stored solutions (/poses) do not match their checksum (a byte was changed or damaged, or "
+                     "the checksum is missing): rebuild the map, or load it with solutions=False")
 
 
 def _check_orientations(r: MapChecker) -> OrientationSet:

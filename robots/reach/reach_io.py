@@ -56,6 +56,8 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.files import check_regular
+
 from ..errors import InvalidInput
 from .orientations import MAX_ORIENTATIONS
 from .reach_check import MAX_JOINTS, MapChecker, ReachabilityFileError, check_map
@@ -123,9 +125,8 @@ def load_reachability(path: str | os.PathLike, *, solutions: bool = True, max_by
         ReachabilityFileError: anything wrong with the file's content, a reader that runs
             over its time or memory.
     """
+    check_regular(path, "reachability map file")  # a FIFO or a device is refused before the reader opens it
     p = Path(path)
-    if not p.is_file():
-        raise InvalidInput(f"reachability map file {str(p)!r} does not exist (or is not a file)")
     if isinstance(max_bytes, bool) or not isinstance(max_bytes, (int, np.integer)) or max_bytes <= 0:
         raise InvalidInput(f"max_bytes must be a positive integer, got {max_bytes!r}")
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 3600:

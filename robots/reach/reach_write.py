@@ -19,6 +19,7 @@ import numpy as np
 from pinarms.files import discard, publish, temporary_for
 
 from ..errors import InvalidInput
+from .reach_digest import PosesDigest, map_checksum
 
 __all__ = ["StreamWriter", "write_map", "FORMAT_NAME", "FORMAT_VERSION"]
 
@@ -41,7 +42,12 @@ def _write_dataset(group: Any, name: str, data: np.ndarray) -> None:
     group.create_dataset(name, data=data, **opts)
 
 
-def _write(h5: Any, m: Any) -> None:
+def _write(h5: Any, m: Any, poses: str | None = None) -> None:
+    """Every member of map ``m``; ``poses``: the checksum of solutions streamed before (else of ``m``'s own)."""
+    if poses is None and m.solutions is not None:
+        digest = PosesDigest()
+        digest.update(m.solutions.voxel, m.solutions.orientation, m.solutions.q, m.solutions.manipulability)
+        poses = digest.hexdigest()
     h5.attrs["format"] = FORMAT_NAME
     h5.attrs["version"] = FORMAT_VERSION
     h5.attrs["pinarms_version"] = _version()
@@ -54,6 +60,9 @@ def _write(h5: Any, m: Any) -> None:
     h5.attrs["shape"] = np.asarray(m.shape, dtype="<i8")
     h5.attrs["parameters"] = json.dumps(m.parameters, allow_nan=False, sort_keys=True)
     h5.attrs["n_reached"] = int(m.n_reached)  # the reader checks /poses' declared rows against it
+    h5.attrs["checksum"] = map_checksum(m)  # the loader recomputes both from what it read
+    if poses is not None:
+        h5.attrs["poses_checksum"] = poses
     g = h5.create_group("robot")
     g.attrs["joint_names"] = json.dumps(list(m.joint_names))
     _write_dataset(g, "joint_lower", np.asarray(m.joint_lower, dtype="<f8"))
@@ -97,6 +106,7 @@ class StreamWriter:
         self.target, self.tmp = temporary_for(path)
         self.nq = int(nq)
         self.count = 0
+        self.digest = PosesDigest()
         self.h5 = h5py.File(self.tmp, "w")
         g = self.h5.create_group("poses")
         rows = 1 << 16
@@ -117,6 +127,7 @@ class StreamWriter:
                            ("q", np.asarray(q, "<f8").reshape(k, self.nq)), ("manipulability", np.asarray(w, "<f8"))):
             g[name].resize(end, axis=0)
             g[name][self.count : end] = data
+        self.digest.update(voxel, orientation, np.asarray(q, "<f8").reshape(k, self.nq), w)
         self.count = end
 
     def finish(self, reach_map: Any) -> Path:
@@ -125,7 +136,7 @@ class StreamWriter:
             raise InvalidInput("a streamed map keeps its solutions in the file, not in memory")
         if self.count != reach_map.n_reached:
             raise InvalidInput(f"{self.count} solutions were streamed for {reach_map.n_reached} reached poses")
-        _write(self.h5, reach_map)
+        _write(self.h5, reach_map, self.digest.hexdigest())
         self.h5.close()
         publish(self.tmp, self.target)
         return self.target

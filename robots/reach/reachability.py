@@ -68,6 +68,9 @@ from .reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, 
 from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
 from .robot_spec import RobotSpec, spec_of
 
+#: Most joint samples :func:`reachability_map` draws to mark its first voxels (``samples=``).
+MAX_SEED_SAMPLES = 50_000_000
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
 
@@ -234,6 +237,9 @@ def _checked_settings(arm: "Robot", *, resolution: Any, orientations: Any, tool_
     if samples is None:
         samples = int(np.clip(2 * int(grid.inside.sum()), 200_000, 5_000_000))
     samples = _count(samples, "samples", 1)
+    if samples > MAX_SEED_SAMPLES:  # each sample is a joint vector: refused before any is drawn
+        raise InvalidInput(f"samples = {samples:,} is more than the {MAX_SEED_SAMPLES:,} allowed (the default is "
+                           f"2 per voxel, 200 000 to 5 000 000): give fewer")
     return _Settings(resolution=resolution, solver=solver, manipulability=manipulability, restarts=restarts, tol=tol,
                      self_collision=bool(self_collision), collision=collision,
                      keep=bool(keep_solutions) or streamed, orientations=oset, chunk_voxels=chunk_voxels, grid=grid,

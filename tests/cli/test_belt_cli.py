@@ -37,3 +37,19 @@ def test_belt_run_trays_bad_input():
                         ("0.4,fast,2", "speed [m/s]"), ("0,0.1,2", "pitch")):
         r = CliRunner().invoke(cli, ["belt", "run", "--arms", "1", "--trays", text])
         assert r.exit_code == 1 and words in r.output and "Traceback" not in r.output, (text, r.output)
+
+
+def test_belt_counts_and_rates_are_capped_before_any_work():
+    """`--arms 1000000`, `--seeds 1000000` and `--rate 1e8` (7.45 GiB asked for) once ran away;
+    each is one error line naming the flag, at once."""
+    import time
+
+    for args, flag in ((["--arms", "1000000"], "--arms"), (["--seeds", "1000000"], "--seeds"),
+                       (["--rate", "1e8"], "--rate"), (["--arms", "0"], "--arms"), (["--seeds", "0"], "--seeds")):
+        t0 = time.perf_counter()
+        r = CliRunner().invoke(cli, ["belt", "run", *args])
+        assert time.perf_counter() - t0 < 5.0
+        assert r.exit_code == 1 and r.output.startswith("Error: ") and r.output.count("\n") == 1, r.output
+        assert flag in r.output and "Traceback" not in r.output
+    r = CliRunner().invoke(cli, ["belt", "arms", "--max-arms", "1000000"])
+    assert r.exit_code == 1 and "--max-arms" in r.output

@@ -66,3 +66,64 @@ def test_a_damaged_map_loads_checked_or_is_refused_by_name_in_time(base, tmp_pat
         assert np.all((back.index >= 0) & (back.index <= 1))
         assert_finite(back.index, "index")
         assert back.n_reached == back.solutions.voxel.size
+
+
+def test_a_flipped_value_byte_is_refused_by_the_checksum(base, tmp_path):
+    """Small datasets are stored uncompressed and unchecked by HDF5: one flipped bit of
+    ``best_manipulability`` once changed the map silently (issue 35)."""
+    m, data = base
+    value = m.best_manipulability[np.isfinite(m.best_manipulability)][0]
+    k = data.find(np.float64(value).tobytes())
+    assert k >= 0
+    damaged = bytearray(data)
+    damaged[k] ^= 0x01  # the lowest bit of the mantissa: still a valid, plausible value
+    path = tmp_path / "flipped.h5"
+    path.write_bytes(bytes(damaged))
+    with pytest.raises(ReachabilityFileError, match="do not match the checksum"):
+        load_reachability(path)
+
+
+def test_a_value_rewritten_through_hdf5_is_refused_and_the_poses_too(base, tmp_path):
+    import h5py
+
+    m, data = base
+    for member in ("voxels/best_manipulability", "poses/manipulability"):
+        path = tmp_path / "edited.h5"
+        path.write_bytes(data)
+        with h5py.File(path, "r+") as h5:
+            values = h5[member][...]
+            values[np.isfinite(values)] *= 1.5
+            h5[member][...] = values
+        with pytest.raises(ReachabilityFileError, match="checksum"):
+            load_reachability(path)
+    back = load_reachability(path, solutions=False)  # the map's own values are intact
+    assert np.array_equal(back.index, m.index)
+
+
+@pytest.mark.parametrize("key, value, match", [
+    ("resolution", 1e300, "resolution must be a length from"),
+    ("resolution", 1e-9, "resolution must be a length from"),
+    ("checksum", None, "holds no checksum"),
+])
+def test_attributes_out_of_bounds_are_refused(base, tmp_path, key, value, match):
+    import h5py
+
+    _, data = base
+    path = tmp_path / "attr.h5"
+    path.write_bytes(data)
+    with h5py.File(path, "r+") as h5:
+        if value is None:
+            del h5.attrs[key]
+        else:
+            h5.attrs[key] = value
+    with pytest.raises(ReachabilityFileError, match=match):
+        load_reachability(path)
+
+
+def test_seed_samples_are_capped_before_any_is_drawn():
+    from pinarms.robots.errors import InvalidInput
+
+    t0 = time.perf_counter()
+    with pytest.raises(InvalidInput, match="samples = 1,000,000,000,000 is more than"):
+        reachability_map(robots.load("aubo_i3"), 0.2, 8, samples=10**12)
+    assert time.perf_counter() - t0 < 5.0
