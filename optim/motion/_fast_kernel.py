@@ -34,7 +34,7 @@ from pinarms.robots.cell.ladder import interval_proven
 
 # these kernels call the cover's and the ladder's rule: their changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "fast_kernels.sha256")
+                  "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
 QUEUE = 4096

@@ -20,7 +20,7 @@ from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa
 
 # these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "cover_kernels.sha256")
+                  "cover_kernels.sha256")
 
 
 @jit
