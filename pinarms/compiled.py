@@ -30,6 +30,7 @@ from typing import Any
 from numba import njit
 from numba.core import caching
 
+import pinarms.compile_notice as compile_notice
 from pinarms.files import write_text
 
 __all__ = ["jit", "jit_inline", "drop_stale_caches", "cache_folder", "STARTED"]
@@ -103,3 +104,6 @@ def drop_stale_caches(sources: Sequence[str | Path], mark: str | Path) -> bool:
     except OSError:
         return False
     return True
+
+
+compile_notice.attach()  # a progress line started by the command line before numba was imported
