@@ -1,0 +1,90 @@
+"""pinarms.warmup (``pinarms warm``): every kernel compiled ahead into numba's cache, loaded afterwards.
+
+The warm-up's coverage is checked by numba's own counters, not by timing: after :func:`warm`, a
+new process that warms up again and then plans in another scene compiles no kernel (every
+signature it needs is a cache hit) and no kernel is left without a signature.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pinarms import warmup
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the repository's folders and the packages they install as (pyproject.toml's package-dir)
+FOLDERS = {"pinarms": "pinarms", "robots": "pinarms.robots", "planning": "pinarms.planning",
+           "optim": "pinarms.optim", "viz": "pinarms.viz"}
+
+
+def _modules_that_compile() -> set[str]:
+    """Modules whose source decorates or wraps a function with pinarms.compiled's ``jit`` / ``jit_inline``
+    (read as text: nothing imported)."""
+    found = set()
+    for folder, package in FOLDERS.items():
+        for path in (ROOT / folder).rglob("*.py"):
+            text = path.read_text(encoding="utf-8")
+            if path.name != "compiled.py" and re.search(r"^@jit(_inline)?\s*$|\bjit\(", text, re.MULTILINE):
+                parts = path.relative_to(ROOT / folder).with_suffix("").parts
+                found.add(".".join((package, *parts)))
+    return found
+
+
+def test_every_module_that_compiles_kernels_is_warmed():
+    assert _modules_that_compile() == set(warmup.KERNEL_MODULES)
+
+
+def test_cached_signatures_are_read_from_numbas_index():
+    descend = warmup.kernels()["pinarms.robots.ik._kernel.descend"]
+    assert warmup.cached_signatures(descend) == len(descend._cache._cache_file._load_index())
+    assert warmup.cached_signatures(object()) == 0
+
+
+def test_every_kernel_module_holds_kernels_compiled_on_their_own():
+    names = warmup.kernels()
+    for module in warmup.KERNEL_MODULES:
+        assert any(n.startswith(module + ".") for n in names), module
+    assert "pinarms.robots.cell.ladder.interval_proven" in names
+    inlined = set(warmup.kernels(inlined=True)) - set(names)
+    assert "pinarms.robots.ik._chain.fk" in inlined  # inlined into its callers, never compiled alone
+
+
+_SECOND_PROCESS = """
+import json
+import numpy as np
+from pinarms import optim, robots, warmup
+from pinarms.optim.motion import SCENES, load_scene
+from pinarms.optim.motion.scenes import region_pose
+
+result = warmup.warm()
+# another arm and another cell than the warm-up's own calls
+panda = robots.load("panda")
+T = panda.fk(panda.neutral)
+panda.ik(T), panda.ik(np.stack([T, T]), position_only=True)
+scene = SCENES["panda_table_box"]
+cell = load_scene(scene.name)
+region = scene.region("table right")
+goal = region_pose(region, [(a + b) / 2 for a, b in zip(region.lo, region.hi)])
+optim.plan_motion(cell, scene.arm, cell.neutral, goal, margin=0.01, time_limit=1.0, seed=1)
+print(json.dumps({"warm": result.as_dict(), "compiled": result.compiled, "after": warmup.cache_misses()}))
+"""
+
+
+@pytest.mark.slow
+def test_after_the_warm_up_no_kernel_compiles_again():
+    """Warm up here (minutes on a fresh checkout, seconds once cached), then a new process loads every kernel
+    it needs, for the warm-up's calls and another arm and cell, from numba's cache."""
+    first = warmup.warm()
+    assert first.missing == ()
+    out = subprocess.run([sys.executable, "-c", _SECOND_PROCESS], capture_output=True, text=True, timeout=600,
+                         cwd=ROOT)
+    assert out.returncode == 0, out.stderr[-2000:]
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got["compiled"] == 0 and got["warm"]["missing"] == []
+    assert got["after"] == 0, "a later call compiled a kernel signature the warm-up did not"
