@@ -40,9 +40,18 @@ def test_every_module_that_compiles_kernels_is_warmed():
     assert _modules_that_compile() == set(warmup.KERNEL_MODULES)
 
 
-def test_cached_signatures_are_read_from_numbas_index():
-    descend = warmup.kernels()["pinarms.robots.ik._kernel.descend"]
-    assert warmup.cached_signatures(descend) == len(descend._cache._cache_file._load_index())
+def test_cached_signatures_counts_what_numba_keeps_on_disk(tmp_path, monkeypatch):
+    """A kernel called with an int and then a float is cached for two signatures."""
+    import importlib
+
+    (tmp_path / "one_kernel.py").write_text("from pinarms.compiled import jit\n\n@jit\ndef twice(x):\n    return 2 * x\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    module = importlib.import_module("one_kernel")
+    assert warmup.cached_signatures(module.twice) == 0
+    module.twice(1)
+    assert warmup.cached_signatures(module.twice) == 1
+    module.twice(1.5)
+    assert warmup.cached_signatures(module.twice) == 2
     assert warmup.cached_signatures(object()) == 0
 
 
