@@ -1,7 +1,7 @@
 """pinarms.warmup (``pinarms warm``): every kernel compiled ahead into numba's cache, loaded afterwards.
 
 The warm-up's coverage is checked by numba's own counters, not by timing: after :func:`warm`, a
-new process that warms up again and then plans in another scene compiles no kernel (every
+new process that warms up again and then solves and plans other problems compiles no kernel (every
 signature it needs is a cache hit) and no kernel is left without a signature.
 """
 
@@ -72,15 +72,15 @@ from pinarms.optim.motion import SCENES, load_scene
 from pinarms.optim.motion.scenes import region_pose
 
 result = warmup.warm()
-# another arm and another cell than the warm-up's own calls
+# another arm, another goal, every goal branch searched
 panda = robots.load("panda")
 T = panda.fk(panda.neutral)
 panda.ik(T), panda.ik(np.stack([T, T]), position_only=True)
-scene = SCENES["panda_table_box"]
+scene = SCENES["aubo_crate_guard"]
 cell = load_scene(scene.name)
-region = scene.region("table right")
+region = scene.region("food table")
 goal = region_pose(region, [(a + b) / 2 for a, b in zip(region.lo, region.hi)])
-optim.plan_motion(cell, scene.arm, cell.neutral, goal, margin=0.01, time_limit=1.0, seed=1)
+optim.plan_motion(cell, scene.arm, cell.neutral, goal, margin=0.02, time_limit=1.0, seed=1, goals="best")
 print(json.dumps({"warm": result.as_dict(), "compiled": result.compiled, "after": warmup.cache_misses()}))
 """
 
@@ -88,9 +88,13 @@ print(json.dumps({"warm": result.as_dict(), "compiled": result.compiled, "after"
 @pytest.mark.slow
 def test_after_the_warm_up_no_kernel_compiles_again():
     """Warm up here (minutes on a fresh checkout, seconds once cached), then a new process loads every kernel
-    it needs, for the warm-up's calls and another arm and cell, from numba's cache."""
+    it needs, for the warm-up's calls and for other calls (another arm's IK, another plan), from numba's cache."""
     first = warmup.warm()
     assert first.missing == ()
+    # one compile per kernel: the IK descent was compiled once per phase constant (numba literals), the cover's
+    # excess once more for a module's read-only empty array, the spline proof's search for a path's read-only breaks;
+    # left: the cover's excess, for the cover's scratch arrays and for the search's (which hold the moving arm's too)
+    assert set(first.repeated) <= {"pinarms.robots.cell._cover_kernel.excess_placed"}
     out = subprocess.run([sys.executable, "-c", _SECOND_PROCESS], capture_output=True, text=True, timeout=600,
                          cwd=ROOT)
     assert out.returncode == 0, out.stderr[-2000:]
