@@ -142,8 +142,8 @@ class WarmStep:
 @dataclass(frozen=True)
 class WarmResult:
     """What :func:`warm` did; ``missing``: kernels that no step called (each is compiled on its first real use);
-    ``repeated``: kernels compiled for several signatures (each one more compile: a literal argument, an array
-    of another layout)."""
+    ``repeated``: kernels this run compiled for several signatures (each one more compile: a literal argument,
+    a read-only array; seen only where they were not cached yet)."""
 
     steps: tuple[WarmStep, ...]
     kernels: int
@@ -166,7 +166,7 @@ class WarmResult:
         if self.missing:
             out.append("not compiled ahead (compiled on first use): " + ", ".join(self.missing))
         if self.repeated:
-            out.append("compiled for several signatures: " + ", ".join(self.repeated))
+            out.append("compiled for several signatures in this run: " + ", ".join(self.repeated))
         return out
 
     def as_dict(self) -> dict[str, Any]:
@@ -188,5 +188,6 @@ def warm(progress: Callable[[str], None] | None = None) -> WarmResult:
     found = kernels()
     # a kernel called only by kernels loaded from the cache has no signature in memory, but one on disk
     missing = tuple(sorted(name for name, k in found.items() if not k.signatures and not cached_signatures(k)))
-    repeated = tuple(sorted(name for name, k in found.items() if cached_signatures(k) > 1))
+    # compiled more than once in this run (signatures another process or a test cached are not counted)
+    repeated = tuple(sorted(name for name, k in found.items() if sum(k.stats.cache_misses.values()) > 1))
     return WarmResult(tuple(steps), len(found) - len(missing), missing, repeated)

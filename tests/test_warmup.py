@@ -91,9 +91,10 @@ def test_after_the_warm_up_no_kernel_compiles_again():
     it needs, for the warm-up's calls and for other calls (another arm's IK, another plan), from numba's cache."""
     first = warmup.warm()
     assert first.missing == ()
-    # one compile per kernel: the IK descent was compiled once per phase constant (numba literals), the cover's
-    # excess once more for a module's read-only empty array, the spline proof's search for a path's read-only breaks;
-    # left: the cover's excess, for the cover's scratch arrays and for the search's (which hold the moving arm's too)
+    # one compile per kernel (checked where this warm-up compiles, as on a fresh checkout): the IK descent was
+    # compiled once per phase constant (numba literals), the cover's excess once more for a module's read-only empty
+    # array, the spline proof's search for a path's read-only breaks; left: the cover's excess, for the cover's
+    # scratch arrays and for the search's (which hold the moving arm's too)
     assert set(first.repeated) <= {"pinarms.robots.cell._cover_kernel.excess_placed"}
     out = subprocess.run([sys.executable, "-c", _SECOND_PROCESS], capture_output=True, text=True, timeout=600,
                          cwd=ROOT)
