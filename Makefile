@@ -6,9 +6,12 @@ STAMP  := $(VENV)/.pinarms-installed
 
 .PHONY: install demo demo-quick readme-table test browser urdf bench clean docs-pictures
 
-# Create .venv if missing and install the project with its test and benchmark extras.
+# Create .venv if missing and install the project with its test and benchmark extras, then compile
+# every numba kernel into numba's disk cache (`pinarms warm`: minutes the first time, a few seconds
+# once they are cached), so that no later process compiles them on first use.
 # Idempotent: re-runs pip only when pyproject.toml changed.
 install: $(STAMP)
+	$(VENV)/bin/pinarms warm
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)

@@ -43,7 +43,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: imports none of them.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
-               "pinarms.units", "pinarms.compiled")),
+               "pinarms.units", "pinarms.compiled", "pinarms.compile_notice")),
     ("robots", ("pinarms.robots", "pinarms.urdf")),
     ("planning", ("pinarms.planning",)),
     ("optim", ("pinarms.optim",)),

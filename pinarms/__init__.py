@@ -5,7 +5,8 @@ Where each family lives (imports go one way, top to bottom of this list read upw
 - the floor, importable by every package: :mod:`pinarms.errors` (the exception hierarchy),
   :mod:`pinarms.execution` (serial loop or Dask) with :mod:`pinarms.chunks` (chunk seeds and
   sizes) and :mod:`pinarms.schedulers` (the ``scheduler`` argument), :mod:`pinarms.files` (atomic files),
-  :mod:`pinarms.units`, :mod:`pinarms.compiled` (numba kernels and their caches);
+  :mod:`pinarms.units`, :mod:`pinarms.compiled` (numba kernels and their caches) with
+  :mod:`pinarms.compile_notice` (the command line's line while numba compiles);
 - :mod:`pinarms.robots`: registry and ``Robot``, ``ik/``, ``reach/`` (workspace, reachability
   maps and their files, base placement, table band, layout check), ``cell/`` (cell, pairs with
   proven bounds, collision state, the one continuous motion check and its proof ladder
@@ -16,5 +17,6 @@ Where each family lives (imports go one way, top to bottom of this list read upw
   (planning around obstacles), ``line/`` (belts and items);
 - :mod:`pinarms.viz`: sessions, MeshCat viewer, standalone HTML, plots;
 - on top: ``cli/``, ``studies/`` (one module per paper study; :mod:`pinarms.demo` lists and
-  runs them), ``export/`` (URDF, SRDF, MJCF, trajectories).
+  runs them), ``export/`` (URDF, SRDF, MJCF, trajectories), :mod:`pinarms.warmup` (every kernel
+  compiled ahead, ``pinarms warm``).
 """

@@ -15,8 +15,8 @@ plots. The runner writes, into ``out_dir``::
 
 The ``cell`` study (docs/cells.md) plans the two SCARAs of ``mushroom_line`` on one belt and
 the AUBO-i3's crate cycle in ``aubo_food_station``, its rows filed under seeds 000 and 001.
-``quick`` uses fewer samples and GA generations (under a minute on two cores); the
-published numbers compared are the same. They all come from :mod:`pinarms.papers`; seed
+``quick`` uses fewer samples and GA generations (3 to 5 minutes on two cores once the kernels are
+compiled, docs/first_use.md); the published numbers compared are the same. They all come from :mod:`pinarms.papers`; seed
 002's via points (the paper prints none) are pinarms's representative path
 :data:`pinarms.scenarios.GANTRY_PATH_AXIS_M`.
 """

@@ -29,12 +29,12 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 from pinarms.robots.cell import _box_kernel, _cover_kernel, ladder
-from pinarms.robots.cell._cover_kernel import UNWEIGHTED, excess_placed, place_moving
+from pinarms.robots.cell._cover_kernel import excess_placed, place_moving
 from pinarms.robots.cell.ladder import interval_proven
 
 # these kernels call the cover's and the ladder's rule: their changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "fast_kernels.sha256")
+                  "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).
 QUEUE = 4096
@@ -66,7 +66,7 @@ def state_excess(x, hold, cols, fk, cov, grp, cap, work, q):
     """``E(x)``: the cover's lower bound of the excess at planned state ``x`` (early out below 0).
 
     ``q``: scratch cell configuration ``(nq,)``, or ``(nq + 1,)`` whose last entry counts the calls."""
-    return state_scaled(x, UNWEIGHTED, hold, cols, fk, cov, grp, cap, work, q)
+    return state_scaled(x, np.empty(0), hold, cols, fk, cov, grp, cap, work, q)  # not UNWEIGHTED: see there
 
 
 @jit

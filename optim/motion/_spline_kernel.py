@@ -28,7 +28,7 @@ from pinarms.robots.cell.ladder import interval_proven
 # these kernels call the search's state check, the cover's kernels and the ladder's rule (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__),
                    Path(_fast_kernel.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "spline_kernels.sha256")
+                  "spline_kernels.sha256")
 
 #: Most intervals waiting at once (more: the rest is left to the exact proof).
 QUEUE = 1 << 15

@@ -123,15 +123,17 @@ class CoverProof:
         from pinarms.optim.motion import _spline_kernel as kernel
 
         self._kernel = kernel
-        breaks = np.ascontiguousarray(path.breaks, dtype=float)
+        # own writable copies: numba types a read-only array apart (a path's frozen arrays would compile the
+        # kernels once more)
+        breaks = np.array(path.breaks, dtype=float)
         n0 = max(1, int(np.ceil(T[-1] / FIRST_STEP)))
         s0 = np.interp(T[-1] * np.arange(n0 + 1) / n0, T, nodes)
         s0[0], s0[-1] = breaks[0], breaks[-1]
         s0 = np.maximum.accumulate(s0)
         block, inv = _group_weights(fc.levers, fc.lam, nodes, V, s0)
-        self._args = (breaks, np.ascontiguousarray(path.coefficients, dtype=float),
-                      np.ascontiguousarray(nodes, dtype=float), np.ascontiguousarray(T, dtype=float), s0, block, inv,
-                      np.ascontiguousarray(checker.lower, dtype=float), np.ascontiguousarray(checker.upper, dtype=float),
+        self._args = (breaks, np.array(path.coefficients, dtype=float),
+                      np.array(nodes, dtype=float), np.array(T, dtype=float), s0, block, inv,
+                      np.array(checker.lower, dtype=float), np.array(checker.upper, dtype=float),
                       float(checker.step / 2.0 ** MAX_SPLITS), MAX_STATES, fc.hold, fc.cols, fc.fk, fc.cov, fc.grp,
                       fc.cap, fc.work)
         self._opened = np.empty((MAX_OPEN, 2))

@@ -29,6 +29,7 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     trajectory_commands,
     urdf_commands,
     verify_commands,
+    warm_command,
     workspace_commands,
 )
 from ._common import cli, main

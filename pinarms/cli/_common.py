@@ -209,8 +209,14 @@ def cli() -> None:
 
 
 def main() -> None:
-    """Console-script entry point (``pinarms``)."""
-    cli(prog_name="pinarms")
+    """Console-script entry point (``pinarms``): a line on stderr while numba compiles kernels for over 2 s."""
+    import sys
+
+    from pinarms.compile_notice import CompileNotice
+    from pinarms.progress import wanted
+
+    with CompileNotice(enabled=wanted("--json" in sys.argv[1:])):
+        cli(prog_name="pinarms")
 
 
 json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON document instead of text.")

@@ -20,7 +20,7 @@ from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa
 
 # these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "cover_kernels.sha256")
+                  "cover_kernels.sha256")
 
 
 @jit
@@ -329,7 +329,9 @@ def _place(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, wo
     _centers(R, p, hjoint, hcenter, HW)
 
 
-#: No group weights: :func:`excess_scaled` then bounds the excess itself (every weight 1).
+#: No group weights: :func:`excess_scaled` then bounds the excess itself (every weight 1). Inside a kernel, write
+#: ``np.empty(0)``: numba passes a module's array as a read-only constant, another type than the weights'
+#: array, and compiles every kernel it reaches once more for it.
 UNWEIGHTED = np.empty(0)
 
 
@@ -344,7 +346,7 @@ def excess_one(q, fk, cov, grp, cap, floor, work):
     bounds (:mod:`.pair_tables`, ``cov[14]``, ``grp[11]``) are lower bounds of the geometries'
     distances, so the result is a lower bound of the exact excess.
     :func:`excess_scaled` without weights."""
-    return excess_scaled(q, fk, cov, grp, UNWEIGHTED, cap, floor, work)
+    return excess_scaled(q, fk, cov, grp, np.empty(0), cap, floor, work)  # not UNWEIGHTED (above)
 
 
 @jit

@@ -25,7 +25,7 @@ __all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(__file__)],
-                  Path(__file__).resolve().parent / "__pycache__" / "pair_kernels.sha256")
+                  "pair_kernels.sha256")
 
 
 @jit

@@ -32,7 +32,7 @@ def drop_stale_caches(here: Path | None = None) -> bool:
     """Drop the compiled caches of :data:`KERNEL_MODULES` (in ``here``, default this folder) when
     any of their sources changed (:func:`pinarms.compiled.drop_stale_caches`)."""
     here = Path(__file__).resolve().parent if here is None else Path(here)
-    return compiled.drop_stale_caches([here / name for name in KERNEL_MODULES], here / "__pycache__" / "ik_kernels.sha256")
+    return compiled.drop_stale_caches([here / name for name in KERNEL_MODULES], "ik_kernels.sha256")
 
 
 drop_stale_caches()

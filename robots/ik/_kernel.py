@@ -276,7 +276,9 @@ def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W):
     265 attempts), so the next start is tried at once; a solution just past a limit is still
     slid back.
     """
-    pe, re, it = descend(q, C, L, P, Rt, pt, posonly, tol, WINDOW, 1, W)
+    # the modes as int64, not as numba's literals of the module's constants: one compile of the descent, not one
+    # per mode (the same code either way)
+    pe, re, it = descend(q, C, L, P, Rt, pt, posonly, tol, np.int64(WINDOW), 1, W)
     met = pe <= tol and re <= tol
     if met and in_limits(q, L):
         return pe, re, it, True
@@ -285,7 +287,7 @@ def attempt_within_limits(q, C, L, P, Rt, pt, posonly, tol, W):
     if far:  # no pose reached, or an isolated solution well outside: report the projection, restart elsewhere
         pe, re = errors(q, C, Rt, pt, posonly)
         return pe, re, it, False
-    pe, re, it2 = descend(q, C, L, P, Rt, pt, posonly, tol, CLIP, 1, W)
+    pe, re, it2 = descend(q, C, L, P, Rt, pt, posonly, tol, np.int64(CLIP), 1, W)
     return pe, re, it + it2, pe <= tol and re <= tol
 
 

@@ -192,7 +192,10 @@ def test_seeded_batch_as_accurate_as_before_in_fewer_iterations(name):
 
 def test_a_changed_kernel_source_drops_every_kernel_cache(tmp_path):
     """numba keys a cache on its own file only: a change of any kernel module drops the caches of all three."""
+    import os
     from pathlib import Path
+
+    from pinarms import compiled
 
     here = Path(chain.__file__).parent
     for name in chain.KERNEL_MODULES:
@@ -201,11 +204,15 @@ def test_a_changed_kernel_source_drops_every_kernel_cache(tmp_path):
     cache.mkdir()
     stale = [cache / "_kernel.descend-198.py311.nbi", cache / "_chain.fk-92.py311.1.nbc"]
     other = cache / "numerical.cpython-311.pyc"
-    for f in stale + [other]:
+    def earlier(f):  # a file of an earlier process (one written by this process is kept: pinarms.compiled)
         f.write_bytes(b"x")
+        os.utime(f, (compiled.STARTED - 60.0, compiled.STARTED - 60.0))
+
+    for f in stale + [other]:
+        earlier(f)
     chain.drop_stale_caches(tmp_path)  # no digest yet: dropped
     assert not any(f.exists() for f in stale) and other.exists()
-    stale[0].write_bytes(b"x")
+    earlier(stale[0])
     chain.drop_stale_caches(tmp_path)  # same sources: kept
     assert stale[0].exists()
     (tmp_path / "_chain.py").write_text((here / "_chain.py").read_text() + "\n# changed\n")
