@@ -18,16 +18,22 @@ _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."
 
 
-def _load(cell: str, args: tuple[str, ...], packages: tuple[str, ...]):
-    from pinarms.robots.cell import load_cell
-    from pinarms.robots.xacro_expand import parse_xacro_args
-
+def package_map(packages: tuple[str, ...]) -> dict[str, str]:
+    """``--package NAME=FOLDER`` values as ``{NAME: FOLDER}``."""
     pkgs = {}
     for item in packages:
         name, sep, folder = item.partition("=")
         if not sep or not name.strip() or not folder.strip():
             raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
         pkgs[name.strip()] = folder.strip()
+    return pkgs
+
+
+def _load(cell: str, args: tuple[str, ...], packages: tuple[str, ...]):
+    from pinarms.robots.cell import load_cell
+    from pinarms.robots.xacro_expand import parse_xacro_args
+
+    pkgs = package_map(packages)
     try:
         return load_cell(cell, packages=pkgs or None, xacro_args=parse_xacro_args(args))
     except UnicodeDecodeError as exc:

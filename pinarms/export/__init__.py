@@ -27,7 +27,7 @@ from .trajectory import (
     write_trajectory_csv,
     write_trajectory_yaml,
 )
-from .verify import EngineComparison, compare_in_mujoco
+from .verify import EngineComparison, compare_configurations_in_mujoco, compare_in_mujoco
 
 __all__ = [
     "ExportedURDF",
@@ -50,6 +50,7 @@ __all__ = [
     "read_trajectory_csv",
     "EngineComparison",
     "compare_in_mujoco",
+    "compare_configurations_in_mujoco",
     "ExportError",
     "MeshNotFound",
     "MeshNotAllowed",

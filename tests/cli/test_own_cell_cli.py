@@ -1,0 +1,117 @@
+"""A user's own cell from the command line: `verify cell` (MuJoCo re-check), `cell show --html` with the
+user's package meshes, errors naming the flag (never Python advice). The cell is built in ``tmp_path``:
+a two-joint arm over a table whose mesh lives in a package folder apart from the cell file."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from pinarms.robots.cell import load_cell
+from pinarms.export import compare_configurations_in_mujoco
+from pinarms.robots.errors import InvalidInput
+
+# the table: a closed box 0.4 x 0.4 x 0.05 m as ASCII STL (two triangles per face)
+_QUADS = (((-1, -1, -1), (-1, 1, -1), (1, 1, -1), (1, -1, -1)), ((-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)),
+          ((-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1)), ((-1, 1, -1), (-1, 1, 1), (1, 1, 1), (1, 1, -1)),
+          ((-1, -1, -1), (-1, -1, 1), (-1, 1, 1), (-1, 1, -1)), ((1, -1, -1), (1, 1, -1), (1, 1, 1), (1, -1, 1)))
+HALF = (0.2, 0.2, 0.025)
+
+
+def _stl() -> str:
+    out = ["solid table"]
+    for a, b, c, d in _QUADS:
+        for tri in ((a, b, c), (a, c, d)):
+            out += ["facet normal 0 0 0", "outer loop",
+                    *(f"vertex {p[0] * HALF[0]:g} {p[1] * HALF[1]:g} {p[2] * HALF[2]:g}" for p in tri),
+                    "endloop", "endfacet"]
+    return "\n".join([*out, "endsolid table", ""])
+
+
+CELL = """<robot name="own"><link name="world"/>
+<link name="arm_base_link"/><joint name="arm_mount" type="fixed"><parent link="world"/><child link="arm_base_link"/>
+</joint>
+<link name="arm_l1"><collision><origin xyz="0 0 0.1"/><geometry><box size="0.05 0.05 0.2"/></geometry></collision>
+</link>
+<joint name="arm_j1" type="revolute"><parent link="arm_base_link"/><child link="arm_l1"/><origin xyz="0 0 0.3"/>
+<axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="10" velocity="2"/></joint>
+<link name="arm_l2"><collision><origin xyz="0.15 0 0"/><geometry><box size="0.3 0.04 0.04"/></geometry></collision>
+</link>
+<joint name="arm_j2" type="revolute"><parent link="arm_l1"/><child link="arm_l2"/><origin xyz="0 0 0.2"/>
+<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="10" velocity="2"/></joint>
+<link name="table"><visual><geometry><mesh filename="package://vendor/meshes/table.stl"/></geometry></visual>
+<collision><geometry><mesh filename="package://vendor/meshes/table.stl"/></geometry></collision></link>
+<joint name="table_mount" type="fixed"><parent link="world"/><child link="table"/><origin xyz="0.3 0 0.35"/></joint>
+</robot>
+"""
+
+
+@pytest.fixture(scope="module")
+def own(tmp_path_factory):
+    """``(cell file, --package value)``: the cell in its folder, the package in another one (named otherwise)."""
+    root = tmp_path_factory.mktemp("own")
+    (root / "cell").mkdir()
+    (root / "cell" / "own.urdf").write_text(CELL)
+    vendor = root / "elsewhere" / "vendor_description"
+    (vendor / "meshes").mkdir(parents=True)
+    (vendor / "meshes" / "table.stl").write_text(_stl())
+    return str(root / "cell" / "own.urdf"), f"vendor={vendor}"
+
+
+def _one_error_line(result) -> str:
+    assert result.exit_code == 1, (result.output, result.exception)
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
+    return lines[0]
+
+
+# --------------------------------------------------------------------------- verify cell
+def test_verify_cell_compares_random_configurations_in_mujoco(run, own):
+    cell, package = own
+    result = run("verify", "cell", cell, "--package", package, "--samples", "12", "--json")
+    data = json.loads(result.output)["configurations"]
+    assert data["samples"] == 12 and data["pairs"] == 2 and data["sampled"] == "configurations"
+    assert data["mujoco_only"] == 0 and data["agrees"] is True
+    assert data["max_abs_difference"] <= data["tolerance"]
+    text = run("verify", "cell", cell, "--package", package, "--samples", "12").output
+    assert "12 random configurations (seed 0) in own: 12 configurations x 2 pairs" in text
+    assert text.rstrip().endswith("-> agree")
+
+
+def test_verify_cell_sees_the_contacts_pinarms_sees(own):
+    """Configurations with the arm's link in the table mesh: both engines report the same contacts."""
+    cell, package = own
+    name, folder = package.split("=")
+    c = load_cell(cell, packages={name: folder})
+    qs = [[0.0, 0.0], [0.0, 0.6], [0.3, 0.6], [0.0, -1.0]]  # level; down into the table (twice); up
+    result = compare_configurations_in_mujoco(c, qs, packages={name: folder})
+    assert result.samples == 4 and result.contacts_pinarms == 2 and result.contacts_mujoco == 2
+    assert result.mujoco_only == 0 and result.min_pinarms < 0 and result.min_mujoco < 0
+    with pytest.raises(InvalidInput, match=r"\(N, 2\)"):
+        compare_configurations_in_mujoco(c, [[0.0, 0.0, 0.0]])
+
+
+@pytest.mark.slow
+def test_verify_cell_replays_a_planned_move_between_named_states_and_values(run, own):
+    cell, package = own
+    result = run("verify", "cell", cell, "--package", package, "--samples", "10", "--plan", "neutral", "1.0,-0.3",
+                 "--amax", "5", "--json")
+    data = json.loads(result.output)
+    assert data["plan"]["label"] == "planned move (arm)" and data["plan"]["samples"] == 10
+    assert data["plan"]["agrees"] is True and data["plan"]["contacts_pinarms"] == 0
+    assert data["plan"]["min_pinarms"] >= 0.01 - 1e-9  # the default --margin held
+
+
+@pytest.mark.parametrize("args, flag", [
+    (("--plan", "neutral", "1.0"), "--plan TO"),
+    (("--plan", "park", "neutral"), "--plan FROM"),
+    (("--plan", "neutral", "1.0,-0.3", "--arm", "left"), "--arm"),
+    (("--amax", "5"), "--plan"),
+    (("--samples", "1"), "--samples"),
+    (("--plan", "neutral", "1.0,-0.3"), "--amax"),  # no acceleration limit, no inertials: --amax named
+])
+def test_verify_cell_errors_name_the_flag(run, own, args, flag):
+    cell, package = own
+    result = run("verify", "cell", cell, "--package", package, "--samples", "4", *args, ok=False)
+    assert flag in _one_error_line(result)
