@@ -5,7 +5,9 @@ a two-joint arm over a table whose mesh lives in a package folder apart from the
 from __future__ import annotations
 
 import json
+import re
 
+import numpy as np
 import pytest
 
 from pinarms.robots.cell import load_cell
@@ -115,3 +117,30 @@ def test_verify_cell_errors_name_the_flag(run, own, args, flag):
     cell, package = own
     result = run("verify", "cell", cell, "--package", package, "--samples", "4", *args, ok=False)
     assert flag in _one_error_line(result)
+
+
+# --------------------------------------------------------------------------- cell show --html
+def _page_meshes(html: str) -> dict[str, bytes]:
+    """``{scene path: mesh file bytes}`` of a MeshCat page (its scene commands are base64 msgpack)."""
+    import base64
+
+    import umsgpack
+
+    out = {}
+    for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", html):
+        command = umsgpack.unpackb(base64.b64decode(blob))
+        if command.get("type") == "set_object":
+            for geometry in command["object"].get("geometries", []):
+                if geometry.get("type") == "_meshfile":
+                    out[command["path"]] = geometry["data"].data
+    return out
+
+
+def test_cell_show_html_draws_the_mesh_of_a_package_apart_from_the_cell(run, own, tmp_path):
+    """The page holds the table mesh from the --package folder (named otherwise than the package)."""
+    cell, package = own
+    out = tmp_path / "own.html"
+    result = run("cell", "show", cell, "--package", package, "--html", str(out))
+    assert f"page written: {out}" in result.output
+    meshes = _page_meshes(out.read_text())
+    assert meshes == {"/meshcat/pinarms/robots/own/visuals/table_0": _stl().encode()}, list(meshes)
