@@ -64,7 +64,7 @@ class RobotDrawing:
         except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for missing meshes
             raise ViewerError(
                 f"cannot build the visual geometry of robot {key!r}: {exc}; if its meshes moved, "
-                "pass package_dirs=... to viz.load_session"
+                "pass package_dirs=... to viz.load_session (on the command line --package-dir FOLDER)"
             ) from exc
         self.pv = MeshcatVisualizer(robot.model, None, visual_model)
         self.pv.initViewer(viewer=vis)

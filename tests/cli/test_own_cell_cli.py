@@ -144,3 +144,41 @@ def test_cell_show_html_draws_the_mesh_of_a_package_apart_from_the_cell(run, own
     assert f"page written: {out}" in result.output
     meshes = _page_meshes(out.read_text())
     assert meshes == {"/meshcat/pinarms/robots/own/visuals/table_0": _stl().encode()}, list(meshes)
+
+
+# --------------------------------------------------------------------------- errors name the flag
+ARM = ('<robot name="vendor_arm"><link name="base"/><link name="l1"><collision><geometry><box size="0.1 0.1 0.1"/>'
+       '</geometry></collision></link><joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>'
+       '<axis xyz="0 0 1"/><origin xyz="0 0 0.2"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+       '</robot>')
+
+
+@pytest.mark.parametrize("command", [("verify", "cell"), ("cell", "show"), ("cell", "check")])
+def test_a_missing_package_names_the_flag(run, own, command):
+    """A package:// mesh of a cell loaded without its --package: the line names the flag to add."""
+    cell, _ = own
+    extra = ("--random", "3") if command[1] == "check" else ("--samples", "4") if command[0] == "verify" else ()
+    line = _one_error_line(run(*command, cell, *extra, ok=False))
+    assert "(on the command line --package vendor=FOLDER)" in line, line
+
+
+def test_a_toml_arm_in_a_package_names_the_flag(run, tmp_path):
+    (tmp_path / "cell.toml").write_text('name = "t"\n[[arm]]\nname = "a"\nurdf = "package://vendor/arm.urdf"\n')
+    line = _one_error_line(run("cell", "show", str(tmp_path / "cell.toml"), ok=False))
+    assert "(on the command line --package vendor=FOLDER)" in line, line
+
+
+def test_a_xacro_find_names_the_flag(run, tmp_path):
+    (tmp_path / "cell.urdf.xacro").write_text(
+        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="$(find vendor)/arm.xacro"/><link name="world"/></robot>')
+    line = _one_error_line(run("cell", "show", str(tmp_path / "cell.urdf.xacro"), ok=False))
+    assert "(on the command line --package vendor=FOLDER)" in line, line
+
+
+def test_an_export_into_a_full_folder_names_overwrite(run, tmp_path):
+    (tmp_path / "arm.urdf").write_text(ARM)
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "keep.txt").write_text("mine")
+    line = _one_error_line(run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "out"), ok=False))
+    assert "(on the command line --overwrite)" in line, line
