@@ -182,3 +182,32 @@ def test_an_export_into_a_full_folder_names_overwrite(run, tmp_path):
     (tmp_path / "out" / "keep.txt").write_text("mine")
     line = _one_error_line(run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "out"), ok=False))
     assert "(on the command line --overwrite)" in line, line
+
+
+def test_an_srdf_home_is_given_with_state_the_note_names_it(run, tmp_path):
+    """An arm whose limits exclude 0 has no home of zeros: the note names --state, which gives one."""
+    (tmp_path / "arm.urdf").write_text(ARM.replace('lower="-1"', 'lower="0.5"'))
+    result = run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "a"), "--srdf")
+    assert "on the command line --state home=V1,V2,..." in result.output, result.output
+    run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "b"), "--srdf", "--state", "home=0.7",
+        "--state", "park=0.9")
+    srdf = (tmp_path / "b" / "vendor_arm.srdf").read_text()
+    assert re.search(r'<group_state name="home" group="[^"]+">\s*<joint name="j1" value="0.7"', srdf), srdf
+    assert re.search(r'<group_state name="park" group="[^"]+">\s*<joint name="j1" value="0.9"', srdf), srdf
+    line = _one_error_line(run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "c"), "--srdf",
+                               "--state", "home=0.1", ok=False))
+    assert "home" in line and "0.1" in line, line
+    line = _one_error_line(run("urdf", "export", str(tmp_path / "arm.urdf"), str(tmp_path / "c"), "--srdf",
+                               "--state", "home", ok=False))
+    assert "--state" in line, line
+
+
+def test_a_cell_state_names_its_arm(run, own, tmp_path):
+    cell, package = own
+    run("urdf", "export", cell, str(tmp_path / "o"), "--cell", "--srdf", "--package", package,
+        "--state", "reach=arm:0.2,0.3")
+    srdf = (tmp_path / "o" / "own.srdf").read_text()
+    assert re.search(r'<group_state name="reach" group="arm">\s*<joint name="arm_j1" value="0.2"', srdf), srdf
+    line = _one_error_line(run("urdf", "export", cell, str(tmp_path / "p"), "--cell", "--srdf", "--package", package,
+                               "--state", "reach=left:0.2,0.3", ok=False))
+    assert "--state reach" in line and "left" in line, line
