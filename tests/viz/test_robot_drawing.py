@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from viz.robot_drawing import resolved_package_meshes
+from pinarms.viz.robot_drawing import resolved_package_meshes
 
 
 def test_package_meshes_resolve_by_either_folder_convention_and_stay_inside(tmp_path):
