@@ -211,3 +211,13 @@ def test_a_cell_state_names_its_arm(run, own, tmp_path):
     line = _one_error_line(run("urdf", "export", cell, str(tmp_path / "p"), "--cell", "--srdf", "--package", package,
                                "--state", "reach=left:0.2,0.3", ok=False))
     assert "--state reach" in line and "left" in line, line
+
+
+def test_motion_loads_a_cell_with_its_packages(run, own):
+    """`pinarms motion` takes --package as `cell` and `verify cell` do: the cell loads, the goal is judged."""
+    cell, package = own
+    line = _one_error_line(run("motion", cell, "--to", "3", "0", "0.5", ok=False))  # no --package: named
+    assert "(on the command line --package vendor=FOLDER)" in line, line
+    line = _one_error_line(run("motion", cell, "--package", package, "--to", "3", "0", "0.5", "--amax", "5",
+                               ok=False))
+    assert "vendor" not in line and "3" in line, line  # out of reach (3 m): the cell loaded, the goal refused
