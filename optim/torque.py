@@ -55,7 +55,7 @@ def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,
         missing = [n for n, e in zip(robot.joint_names, effort) if not e > 0.0]
         if missing:
             raise InvalidLimits(f"robot '{robot.name}' has no effort limit for joint(s) {missing} in its URDF: "
-                                "pass torque_limits=[...] (N·m or N per joint)")
+                                "pass torque_limits=[...] (N·m or N per joint; on the command line --torque-max)")
         torque_limits = effort
     if not hasattr(robot, "inverse_dynamics"):
         raise InvalidSettings(f"robot must be a robots.Robot, got {type(robot).__name__}")

@@ -98,7 +98,7 @@ class JointLimits:
             if missing:
                 raise TrajectoryError(
                     f"robot '{robot.name}' has no effort limit for joint(s) {missing} in its URDF: "
-                    "pass torque=[...] (N·m or N per joint)"
+                    "pass torque=[...] (N·m or N per joint; on the command line --torque-max)"
                 )
             torque = effort
         elif torque is False:

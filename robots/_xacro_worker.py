@@ -178,7 +178,8 @@ class _Hooks:
         if pkg not in self.packages:
             raise Forbidden(
                 f"$(find {pkg}): package '{pkg}' is not among the packages given "
-                f"({', '.join(sorted(self.packages)) or 'none'}); pass it in packages={{'{pkg}': folder}}"
+                f"({', '.join(sorted(self.packages)) or 'none'}); pass it in packages={{'{pkg}': folder}} "
+                f"(on the command line --package {pkg}=FOLDER)"
             )
         return self.packages[pkg]
 

@@ -276,7 +276,7 @@ def mesh_path(filename: str, base_dir: str | os.PathLike, packages: Mapping[str,
         if pkg not in pkgs:
             raise XacroForbidden(
                 f"mesh {text!r}: package {pkg!r} is not among the packages given ({', '.join(sorted(pkgs))}); "
-                f"pass packages={{{pkg!r}: folder}}"
+                f"pass packages={{{pkg!r}: folder}} (on the command line --package {pkg}=FOLDER)"
             )
         target = pkgs[pkg] / rel
     elif text.startswith("file://"):

@@ -8,7 +8,10 @@ said otherwise.
 
 from __future__ import annotations
 
+import os
+import re
 import warnings
+from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
@@ -17,7 +20,33 @@ import pinocchio as pin
 from ._meshcat import MeshcatVisualizer, meshcat
 from .errors import ViewerError
 
-__all__ = ["RobotDrawing"]
+__all__ = ["RobotDrawing", "resolved_package_meshes"]
+
+_PACKAGE_MESH = re.compile(r'(filename\s*=\s*)(["\'])(?:package|model)://([^/"\']+)/([^"\']+)\2')
+
+
+def resolved_package_meshes(urdf_text: str, package_dirs: Sequence[str]) -> str:
+    """``urdf_text`` with each ``package://NAME/rel`` mesh found in ``package_dirs`` given as its absolute path.
+
+    A package folder is found either way a caller may list it: as the folder that holds
+    ``NAME/`` (Pinocchio's convention, ``<dir>/NAME/rel``) or as the package folder itself
+    (``--package NAME=FOLDER``: ``<dir>/rel``, the convention of :mod:`viz.mesh_paths`). Only
+    files inside those folders are named; a mesh found nowhere is left for Pinocchio to report.
+    """
+    roots = [Path(d) for d in package_dirs if d]
+
+    def resolve(match: re.Match) -> str:
+        name, rel = match.group(3), match.group(4)
+        if ".." in Path(rel).parts:
+            return match.group(0)
+        for root in roots:
+            for cand in (root / name / rel, root / rel):
+                real = Path(os.path.realpath(cand))
+                if real.is_file() and real.is_relative_to(Path(os.path.realpath(root))):
+                    return f"{match.group(1)}{match.group(2)}{real}{match.group(2)}"
+        return match.group(0)
+
+    return _PACKAGE_MESH.sub(resolve, urdf_text)
 
 
 class RobotDrawing:
@@ -29,12 +58,13 @@ class RobotDrawing:
         self.root = f"{root}/robots/{key}"
         try:
             visual_model = pin.buildGeomFromUrdfString(
-                robot.model, robot.urdf_text, pin.GeometryType.VISUAL, package_dirs=list(package_dirs)
+                robot.model, resolved_package_meshes(robot.urdf_text, package_dirs), pin.GeometryType.VISUAL,
+                package_dirs=list(package_dirs)
             )
         except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for missing meshes
             raise ViewerError(
                 f"cannot build the visual geometry of robot {key!r}: {exc}; if its meshes moved, "
-                "pass package_dirs=... to viz.load_session"
+                "pass package_dirs=... to viz.load_session (on the command line --package-dir FOLDER)"
             ) from exc
         self.pv = MeshcatVisualizer(robot.model, None, visual_model)
         self.pv.initViewer(viewer=vis)

@@ -114,8 +114,8 @@ def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any)
             parts.append(limit)
         tau_used = np.concatenate(parts) if len(parts) == len(robots) else None
     if a is None and len(cons) == 1:
-        raise InvalidLimits("the motion would be timed under velocity limits alone (infinite accelerations): give amax "
-                            "[rad/s² or m/s²], or torque limits on an arm with inertials")
+        raise InvalidLimits("the motion would be timed under velocity limits alone (infinite accelerations): give amax= "
+                            "[rad/s² or m/s²] (on the command line --amax), or torque limits on an arm with inertials")
     return cons, {"vmax": v, "amax": a, "torque": tau_used, "amax_source": a_source}
 
 

@@ -18,7 +18,7 @@ from pinarms import robots
 from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
-__all__ = ["cli", "main", "json_option", "skipped_pair_lines", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
+__all__ = ["cli", "main", "json_option", "skipped_pair_lines", "package_map", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
            "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
            "joint_scale_at", "new_session", "save_session", "scheduler_option", "quiet_dask"]
 
@@ -291,3 +291,14 @@ def skipped_pair_lines(allowed: Any, k: float, lu: str) -> list[str]:
             text = ", ".join(f"{a} – {b}" + (f" ({notes[(a, b)]})" if notes.get((a, b)) else "") for a, b in pairs)
             lines.append(f"skipped ({reason}): {text}")
     return lines
+
+
+def package_map(packages: tuple[str, ...]) -> dict[str, str]:
+    """``--package NAME=FOLDER`` values as ``{NAME: FOLDER}``."""
+    pkgs = {}
+    for item in packages:
+        name, sep, folder = item.partition("=")
+        if not sep or not name.strip() or not folder.strip():
+            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
+        pkgs[name.strip()] = folder.strip()
+    return pkgs

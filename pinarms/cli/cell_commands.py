@@ -12,7 +12,8 @@ import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 
-from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option, save_session, show_progress, skipped_pair_lines
+from ._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
+                      skipped_pair_lines)
 from .motion_commands import hold_option
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
@@ -23,12 +24,7 @@ def _load(cell: str, args: tuple[str, ...], packages: tuple[str, ...]):
     from pinarms.robots.cell import load_cell
     from pinarms.robots.xacro_expand import parse_xacro_args
 
-    pkgs = {}
-    for item in packages:
-        name, sep, folder = item.partition("=")
-        if not sep or not name.strip() or not folder.strip():
-            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
-        pkgs[name.strip()] = folder.strip()
+    pkgs = package_map(packages)
     try:
         return load_cell(cell, packages=pkgs or None, xacro_args=parse_xacro_args(args))
     except UnicodeDecodeError as exc:

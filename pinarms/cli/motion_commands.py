@@ -17,6 +17,7 @@ from pinarms.robots.errors import InvalidInput
 from pinarms.units import angle_scale, length_scale
 
 from ._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
+from ._common import package_map
 from .line_commands import _pose, _PoseCommand
 
 __all__ = ["load_any_cell", "hold_option"]
@@ -61,10 +62,11 @@ def hold_option(cell: Any, holds: tuple[str, ...], planned: str | tuple[str, ...
     return q
 
 
-def load_any_cell(name: str) -> Any:
-    """A planning scene (``aubo_crate_guard`` ...), a built-in cell, or a cell file (.xacro/.urdf).
+def load_any_cell(name: str, packages: dict[str, str] | None = None) -> Any:
+    """A planning scene (``aubo_crate_guard`` ...), a built-in cell, or a cell file (.xacro/.urdf/.toml).
 
-    Cell files may place example-robot-data arms with ``$(find pinarms_examples)/<arm>.xacro``.
+    Cell files may place example-robot-data arms with ``$(find pinarms_examples)/<arm>.xacro``,
+    and read the folders of ``packages`` (``--package NAME=FOLDER``) besides.
     """
     from pinarms import robots
     from pinarms.optim.motion.arm_macros import example_packages
@@ -72,13 +74,15 @@ def load_any_cell(name: str) -> Any:
 
     if name in scene_names():
         return load_scene(name)
-    if name.endswith((".xacro", ".urdf")) or "/" in name:
-        return robots.load_cell(name, packages=example_packages())
-    return robots.load_cell(name)
+    if name.endswith((".xacro", ".urdf", ".toml")) or "/" in name:
+        return robots.load_cell(name, packages={**example_packages(), **(packages or {})})
+    return robots.load_cell(name, packages=packages or None)
 
 
 @cli.command("motion", cls=_PoseCommand, context_settings=NUMBERS)
 @click.argument("cell")
+@click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+              help="A folder for $(find NAME) and package://NAME/ in CELL (repeatable).")
 @click.option("--arm", "arm_name", default=None, help="The arm to move (default: the cell's only arm).")
 @click.option("--to", "goal", required=True, help="X Y Z [ROLL PITCH YAW] of the goal (tcp in the world frame).")
 @click.option("--from", "start", default=None,
@@ -107,8 +111,8 @@ def load_any_cell(name: str) -> Any:
 @click.option("--plot", "plot_path", default=None, type=click.Path(dir_okay=False),
               help="Write the clearance-over-time plot (PNG).")
 @json_option
-def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, start_q: str | None,
-               holds: tuple[str, ...], margin: float,
+def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal: str, start: str | None,
+               start_q: str | None, holds: tuple[str, ...], margin: float,
                planner: str, time_limit: float, seed: int, goal_choice: str, amax: str | None, no_torque: bool,
                deg: bool, mm: bool, session_path: str | None, plot_path: str | None, as_json: bool) -> None:
     """Plan a collision-free move of an arm in CELL to a tool pose, prove it clear, time it optimally.
@@ -130,7 +134,7 @@ def motion_cmd(cell: str, arm_name: str | None, goal: str, start: str | None, st
             sys.stderr.flush()
 
     progress(f"loading {cell}")
-    c = load_any_cell(cell)
+    c = load_any_cell(cell, package_map(packages))
     if arm_name is None:
         if len(c.arms) != 1:
             raise InvalidInput(f"cell {c.name!r} has several arms ({', '.join(a.name for a in c.arms)}): give --arm")

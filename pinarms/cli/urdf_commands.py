@@ -5,14 +5,19 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
+import numpy as np
+
+from pinarms.robots.errors import InvalidInput
 
 from ._common import (
     PinarmsGroup,
     cli,
     emit,
+    floats,
     json_option,
     load_robot,
 )
+from ._common import package_map
 
 
 # --------------------------------------------------------------------------- urdf
@@ -62,15 +67,33 @@ def urdf_build_cmd(source: str | None, xacro_args: tuple[str, ...], packages: tu
     emit(as_json, {"written": [str(p) for p in written]}, [f"wrote {p}" for p in written])
 
 
-def _packages(items: tuple[str, ...]) -> dict[str, str]:
-    """``--package NAME=FOLDER`` values as ``{NAME: FOLDER}``."""
-    pkgs = {}
+def _parse_states(items: tuple[str, ...]) -> dict[str, dict[str | None, np.ndarray]]:
+    """``--state NAME=[ARM:]V1,V2,...`` values as ``{NAME: {ARM or None: values}}``."""
+    out: dict[str, dict[str | None, np.ndarray]] = {}
     for item in items:
-        name, sep, folder = item.partition("=")
-        if not sep or not name.strip() or not folder.strip():
-            raise click.BadParameter(f"--package must be NAME=FOLDER, got {item!r}")
-        pkgs[name.strip()] = folder.strip()
-    return pkgs
+        name, sep, rest = item.partition("=")
+        arm, colon, values = rest.partition(":")
+        if not sep or not name.strip() or not rest.strip():
+            raise InvalidInput(f"--state must be NAME=V1,V2,... or NAME=ARM:V1,V2,..., got {item!r}")
+        arm_name = arm.strip() if colon else None
+        out.setdefault(name.strip(), {})[arm_name] = floats(values if colon else rest, f"--state {name.strip()}")
+    return out
+
+
+def _cell_states(items: tuple[str, ...], cell) -> dict[str, dict[str, np.ndarray]]:
+    """``--state`` values of a cell, each arm named (the only arm when none is given)."""
+    arms = [a.name for a in cell.arms]
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for name, per_arm in _parse_states(items).items():
+        for arm, q in per_arm.items():
+            if arm is None and len(arms) != 1:
+                raise InvalidInput(f"--state {name}: cell {cell.name!r} has arms {', '.join(arms)}: "
+                                   f"give {name}=ARM:V1,V2,...")
+            arm = arms[0] if arm is None else arm
+            if arm not in arms:
+                raise InvalidInput(f"--state {name}: cell {cell.name!r} has no arm {arm!r}; arms: {', '.join(arms)}")
+            out.setdefault(name, {})[arm] = q
+    return out
 
 
 def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], output: str | None,
@@ -79,7 +102,7 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
     from pinarms.robots.xacro_expand import check_mesh_files, expand_xacro, parse_xacro_args
 
     args = parse_xacro_args(xacro_args)
-    pkgs = _packages(packages)
+    pkgs = package_map(packages)
     header = (f" Generated from {Path(source).name} by `pinarms urdf build` (pinarms). ",)
     result = expand_xacro(source, args, packages=pkgs, header=header)
     check_mesh_files(result.urdf_text, source, pkgs)
@@ -112,9 +135,12 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
 @click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
               help="A folder for package://NAME/ meshes (repeatable). Meshes are copied only from ROBOT's own "
                    "folder and these.")
+@click.option("--state", "state_items", multiple=True, metavar="NAME=[ARM:]V1,V2,...",
+              help="With --srdf, a named state (repeatable): joint values [rad or m]; in a cell of several arms "
+                   "NAME=ARM:V1,... (repeat NAME for each arm of a whole-cell state). 'home' is the arm's home.")
 @json_option
 def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf: bool, is_cell: bool,
-                    study_poses: bool, packages: tuple[str, ...], as_json: bool) -> None:
+                    study_poses: bool, packages: tuple[str, ...], state_items: tuple[str, ...], as_json: bool) -> None:
     """Write ROBOT (an arm or a whole cell) as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
     With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
@@ -131,7 +157,9 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
 
     if study_poses and not srdf:
         raise click.UsageError("--study-poses are SRDF states: add --srdf")
-    pkgs = _packages(packages)
+    if state_items and not srdf:
+        raise InvalidInput("--state gives SRDF states: add --srdf")
+    pkgs = package_map(packages)
     if is_cell or robot in cell_names():
         cell = load_cell(robot, packages=pkgs)
         states = None
@@ -139,6 +167,8 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
             from pinarms.export.shipped import study_states
 
             states = study_states(cell)
+        if state_items:
+            states = {**(states or {}), **_cell_states(state_items, cell)}
         result = export_cell(cell, out_dir, srdf=srdf, mjcf=mjcf, overwrite=overwrite, states=states, packages=pkgs)
         files = [p for p in (result.urdf, result.srdf, result.mjcf) if p is not None]
         emit(
@@ -152,7 +182,7 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
     if study_poses:
         raise click.UsageError("--study-poses apply to the built-in cells")
     if mjcf:
-        if srdf:
+        if srdf or state_items:
             raise click.UsageError("--srdf goes with the URDF export (run it once without --mjcf)")
         result = export_mjcf(load_robot(robot), out_dir, overwrite=overwrite, packages=pkgs)
         emit(
@@ -161,7 +191,12 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
             [f"wrote {result.mjcf} (sites: {', '.join(result.sites)}) and {len(result.meshes)} mesh file(s)"],
         )
         return
-    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf, packages=pkgs)
+    parsed = _parse_states(state_items)
+    for name, per_arm in parsed.items():
+        if set(per_arm) != {None}:
+            raise InvalidInput(f"--state {name}: {robot} is one arm, not a cell: give {name}=V1,V2,... (no ARM:)")
+    states = {name: per_arm[None] for name, per_arm in parsed.items()} or None
+    result = export_urdf(load_robot(robot), out_dir, overwrite=overwrite, srdf=srdf, packages=pkgs, states=states)
     emit(
         as_json,
         {"folder": result.folder, "urdf": result.urdf, "srdf": result.srdf, "meshes": list(result.meshes),

@@ -6,12 +6,114 @@ from pathlib import Path
 
 import click
 
-from ._common import PinarmsGroup, cli, emit, json_option
+from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
 
 
 @cli.group("verify", cls=PinarmsGroup)
 def verify_group() -> None:
-    """Re-check planned motions in MuJoCo through the exported MJCF (docs/export.md)."""
+    """Re-check cells and planned motions in MuJoCo through the exported MJCF (docs/export.md).
+
+    `verify cell CELL` re-checks any cell (yours, with --package), `verify shipped` the demo's motions.
+    """
+
+
+@verify_group.command("cell", context_settings=NUMBERS)
+@click.argument("cell")
+@click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+              help="A folder for $(find NAME) and package://NAME/ in CELL (repeatable).")
+@click.option("--arg", "xacro_args", multiple=True, metavar="NAME=VALUE", help="A xacro:arg value of CELL (repeatable).")
+@click.option("--samples", default=200, show_default=True, type=int,
+              help="Random cell configurations compared (seeded), and instants of the planned move with --plan.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Seed of the random configurations and the search.")
+@click.option("--plan", "plan_ends", nargs=2, default=None, metavar="FROM TO",
+              help="Also plan a move of --arm from FROM to TO and replay it: each comma-separated joint values "
+                   "[rad or m] or a named state (neutral, or a state of the arm in the cell description).")
+@click.option("--arm", "arm_name", default=None, help="The arm --plan moves (default: the cell's only arm).")
+@click.option("--margin", default=0.01, show_default=True, type=float,
+              help="Clearance the planned move keeps to fixtures and other arms [m].")
+@click.option("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take.")
+@click.option("--amax", default=None,
+              help="Joint acceleration limit(s) of the planned move [rad/s² or m/s²] (torque limits apply too).")
+@json_option
+def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str, ...], samples: int, seed: int,
+                    plan_ends: tuple[str, str] | None, arm_name: str | None, margin: float, time_limit: float,
+                    amax: str | None, as_json: bool) -> None:
+    """Compare CELL's collision state in pinarms and MuJoCo (exported MJCF) at random configurations.
+
+    With --plan FROM TO, also plan a collision-free move of --arm (pinarms motion's planner)
+    and replay it in MuJoCo. Prints the agreement figures; exit status 1 when the engines
+    disagree. Example: pinarms verify cell my_cell.urdf --package vendor=./vendor --plan neutral 0.5,1.0
+    """
+    from pinarms.export.verify import compare_configurations_in_mujoco, compare_in_mujoco
+
+    from ._common import package_map
+    from .cell_commands import _load
+
+    from pinarms.robots.errors import InvalidInput
+
+    if samples < 2:
+        raise InvalidInput(f"--samples must be 2 or more, got {samples}")
+    c = _load(cell, xacro_args, packages)
+    pkgs = package_map(packages)
+    results = [("configurations", compare_configurations_in_mujoco(
+        c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", packages=pkgs))]
+    if plan_ends is not None:
+        a = None if amax is None else floats(amax, "--amax")
+        plan = _plan_between(c, arm_name, plan_ends, margin=margin, time_limit=time_limit, seed=seed,
+                             amax=None if a is None else (float(a[0]) if a.size == 1 else a))
+        results.append(("plan", compare_in_mujoco(c, plan, samples=samples, packages=pkgs)))
+    elif arm_name is not None or amax is not None:
+        raise InvalidInput("--arm and --amax apply to the move of --plan FROM TO: add --plan")
+    lines = [line for _, r in results for line in r.lines()]
+    emit(as_json, {"cell": c.name, **{name: r.as_dict() for name, r in results}}, lines)
+    if not all(r.agrees for _, r in results):
+        raise SystemExit(1)
+
+
+def _arm_state(c, arm, text: str, end: str):
+    """A --plan end: a named state of ``arm`` or its comma-separated joint values, checked against its length."""
+    import numpy as np
+
+    from pinarms.robots.errors import InvalidInput
+
+    states = {"neutral": np.array(c.neutral[arm.q_slice]), **dict(getattr(arm, "states", None) or {})}
+    if text.strip() in states:
+        return np.asarray(states[text.strip()], dtype=float)
+    if not any(ch.isdigit() for ch in text):
+        raise InvalidInput(f"--plan {end}: arm {arm.name!r} has no state {text!r}; states: {', '.join(states)} "
+                           f"(or {arm.nq} comma-separated joint values)")
+    q = floats(text, f"--plan {end}")
+    if q.size != arm.nq:
+        raise InvalidInput(f"--plan {end} needs {arm.nq} values for arm {arm.name!r} "
+                           f"({', '.join(arm.robot.joint_names)}), got {q.size}")
+    return q
+
+
+def _plan_between(c, arm_name: str | None, ends: tuple[str, str], *, margin: float, time_limit: float, seed: int,
+                  amax):
+    """The planned move of ``--plan FROM TO`` (errors name --plan, --arm, --margin or --time-limit)."""
+    from pinarms.optim.errors import GoalInCollision, NoPathFound, StartInCollision
+    from pinarms.optim.motion import plan_motion
+    from pinarms.robots.errors import InvalidInput
+
+    if arm_name is None:
+        if len(c.arms) != 1:
+            raise InvalidInput(f"cell {c.name!r} has several arms ({', '.join(a.name for a in c.arms)}): "
+                               "give --arm with --plan")
+        arm_name = c.arms[0].name
+    names = [a.name for a in c.arms]
+    if arm_name not in names:
+        raise InvalidInput(f"--arm: cell {c.name!r} has no arm {arm_name!r}; arms: {', '.join(names)}")
+    arm = c.arm(arm_name)
+    q0, q1 = _arm_state(c, arm, ends[0], "FROM"), _arm_state(c, arm, ends[1], "TO")
+    try:
+        return plan_motion(c, arm.name, q0, q1, margin=margin, time_limit=time_limit, seed=seed, amax=amax)
+    except StartInCollision as exc:
+        raise InvalidInput(f"--plan FROM: {exc} (choose another start, or lower --margin)") from None
+    except GoalInCollision as exc:
+        raise InvalidInput(f"--plan TO: {exc} (choose another goal, or lower --margin)") from None
+    except NoPathFound as exc:
+        raise InvalidInput(f"--plan: {exc} (raise --time-limit, or lower --margin)") from None
 
 
 @verify_group.command("shipped")

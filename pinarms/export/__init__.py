@@ -28,7 +28,7 @@ from .trajectory import (
     write_trajectory_yaml,
 )
 from .trajectory_read import read_trajectory_csv, read_trajectory_yaml
-from .verify import EngineComparison, compare_in_mujoco
+from .verify import EngineComparison, compare_configurations_in_mujoco, compare_in_mujoco
 
 __all__ = [
     "AccelerationWarning",
@@ -52,6 +52,7 @@ __all__ = [
     "read_trajectory_csv",
     "EngineComparison",
     "compare_in_mujoco",
+    "compare_configurations_in_mujoco",
     "ExportError",
     "MeshNotFound",
     "MeshNotAllowed",

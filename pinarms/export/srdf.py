@@ -118,7 +118,8 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[
             raise InvalidInput(f"state name {name!r} must be an identifier (letters, digits, _ . -)")
     why = {arm.name: _zero_outside(arm) for arm in cell.arms}
     out, notes = [], []
-    how = "give your own: states={{{!r}: ...}} of export_urdf / export_cell (a home of zeros is never forced)"
+    how = ("give your own: states={{{0!r}: ...}} of export_urdf / export_cell, on the command line --state "
+           "{0}=V1,V2,... (--state NAME=ARM:V1,V2,... for an arm of a cell); a home of zeros is never forced")
     if several and "home" not in given:
         if all(w is None for w in why.values()):
             out.append(("home", "cell", [j for arm in cell.arms for j in _state_joints(cell, arm, np.zeros(arm.nq),

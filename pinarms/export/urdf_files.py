@@ -134,7 +134,8 @@ def _check_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
     """The real export folder of ``out_dir`` (a link to a folder: that folder), refused when not empty."""
     out = output_folder(out_dir)
     if out.is_dir() and any(out.iterdir()) and not overwrite:
-        raise InvalidInput(f"export folder {str(out_dir)!r} is not empty; choose another folder or pass overwrite=True")
+        raise InvalidInput(f"export folder {str(out_dir)!r} is not empty; choose another folder or pass "
+                           "overwrite=True (on the command line --overwrite)")
     return out
 
 

@@ -24,6 +24,7 @@ The comparison passes when MuJoCo finds no contact where pinarms says clear (dis
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tempfile
 from dataclasses import dataclass
@@ -38,7 +39,7 @@ from pinarms.robots.errors import InvalidInput, ModelError
 
 from .srdf import contact_pairs
 
-__all__ = ["EngineComparison", "compare_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
+__all__ = ["EngineComparison", "compare_in_mujoco", "compare_configurations_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
 
 #: Agreement asked of the two engines on a pair of primitives [m] (both iterate to ~1e-6 m or better).
 TOLERANCE_M = 1e-6
@@ -52,7 +53,7 @@ class EngineComparison:
 
     Attributes:
         label: what was replayed; ``cell``: the cell's name; ``mjcf``: the model replayed.
-        samples: instants compared; ``pairs``: pairs per instant.
+        samples: instants (or configurations, as ``sampled`` says) compared; ``pairs``: pairs per sample.
         min_pinarms, min_mujoco: smallest distance over the pairs and the instants [m], and
             their pairs (``min_pinarms_pair``, ``min_mujoco_pair``).
         max_abs_difference: largest ``|d_mujoco − d_pinarms|`` over primitive pairs [m];
@@ -81,6 +82,8 @@ class EngineComparison:
     contacts_mujoco: int
     mujoco_only: int
     tolerance: float = TOLERANCE_M
+    #: what a sample is: ``instants`` of a motion, or ``configurations``
+    sampled: str = "instants"
 
     @property
     def agrees(self) -> bool:
@@ -93,7 +96,7 @@ class EngineComparison:
 
     def lines(self) -> list[str]:
         return [
-            f"{self.label} in {self.cell}: {self.samples} instants x {self.pairs} pairs",
+            f"{self.label} in {self.cell}: {self.samples} {self.sampled} x {self.pairs} pairs",
             f"  min distance  pinarms (coal) {self.min_pinarms * 1e3:9.4f} mm  ({self.min_pinarms_pair})",
             f"  min distance  MuJoCo         {self.min_mujoco * 1e3:9.4f} mm  ({self.min_mujoco_pair})",
             f"  max |difference| primitives  {self.max_abs_difference:.3e} m (tolerance {self.tolerance:g} m)",
@@ -155,7 +158,8 @@ def _mujoco_setter(model: Any, cell: Any):
 
 
 def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles: Mapping[str, Any] | None = None,
-                      samples: int = 200, mjcf: str | Path | None = None) -> EngineComparison:
+                      samples: int = 200, mjcf: str | Path | None = None,
+                      packages: Mapping[str, str | Path] | None = None) -> EngineComparison:
     """Replay ``source`` in MuJoCo and compare with pinarms (module doc).
 
     Args:
@@ -163,19 +167,47 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
         source: a CycleResult (with ``arm``), a MotionPlan, or a LineSchedule (with ``cycles``).
         samples: evenly spaced instants, ends included (≥ 2).
         mjcf: an MJCF exported from this cell (default: exported to a temporary folder).
+        packages: ``{NAME: FOLDER}`` of the cell's ``package://`` meshes, for that export.
     """
+    _check_samples(samples, 2)
+    label, start, end, q_of_t = motion_sampler(source, cell, arm=arm, cycles=cycles)
+    qs = np.atleast_2d(q_of_t(np.linspace(start, end, int(samples))))
+    return _compare(cell, label, qs, mjcf, packages)
+
+
+def compare_configurations_in_mujoco(cell: Any, qs: Any, *, label: str = "configurations",
+                                     mjcf: str | Path | None = None,
+                                     packages: Mapping[str, str | Path] | None = None) -> EngineComparison:
+    """Compare pinarms and MuJoCo at the cell configurations ``qs (N, nq)`` (module doc; ``samples`` = N).
+
+    The collision state of a cell itself, without a motion: e.g. at ``cell.random_q(N, seed=...)``.
+
+    Raises:
+        InvalidInput: ``qs`` is not ``(N, nq)`` finite numbers with N ≥ 1.
+    """
+    q = np.asarray(qs, dtype=float)
+    q = q[None] if q.ndim == 1 else q
+    if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] != cell.nq or not np.all(np.isfinite(q)):
+        raise InvalidInput(f"configurations must be (N, {cell.nq}) finite numbers with N >= 1, got shape "
+                           f"{np.shape(qs)}")
+    return dataclasses.replace(_compare(cell, label, q, mjcf, packages), sampled="configurations")
+
+
+def _check_samples(samples: Any, least: int) -> None:
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < least:
+        raise InvalidInput(f"samples must be an integer >= {least}, got {samples!r}")
+
+
+def _compare(cell: Any, label: str, qs: np.ndarray, mjcf: str | Path | None,
+             packages: Mapping[str, str | Path] | None) -> EngineComparison:
+    """Both engines' distances and contacts over the pinarms contact pairs at the configurations ``qs``."""
     import mujoco
 
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
-        raise InvalidInput(f"samples must be an integer >= 2, got {samples!r}")
-    label, start, end, q_of_t = motion_sampler(source, cell, arm=arm, cycles=cycles)
-    t = np.linspace(start, end, int(samples))
-    qs = np.atleast_2d(q_of_t(t))
     with tempfile.TemporaryDirectory() as tmp:
         if mjcf is None:
             from .cell import export_cell
 
-            mjcf_path = export_cell(cell, Path(tmp) / "cell", srdf=False).mjcf
+            mjcf_path = export_cell(cell, Path(tmp) / "cell", srdf=False, packages=packages).mjcf
         else:
             mjcf_path = Path(mjcf)
         model = mujoco.MjModel.from_xml_path(str(mjcf_path))
@@ -206,7 +238,7 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
     i_pin, i_mj = np.unravel_index(np.argmin(d_pin), d_pin.shape), np.unravel_index(np.argmin(d_mj), d_mj.shape)
     name = lambda k: f"{pairs[k].geometry_a} - {pairs[k].geometry_b}"  # noqa: E731
     return EngineComparison(
-        label=label, cell=cell.name, mjcf=str(mjcf_path), samples=int(samples), pairs=len(pairs),
+        label=label, cell=cell.name, mjcf=str(mjcf_path), samples=len(qs), pairs=len(pairs),
         min_pinarms=float(d_pin[i_pin]), min_pinarms_pair=name(i_pin[1]),
         min_mujoco=float(d_mj[i_mj]), min_mujoco_pair=name(i_mj[1]),
         max_abs_difference=float(np.abs(diff[prim]).max()) if prim.any() else 0.0,

@@ -85,7 +85,8 @@ def _arm_file(ref: str | os.PathLike, base_dir: Path, packages: Mapping[str, Pat
         pkg, _, rel = text[len("package://"):].partition("/")
         if pkg not in packages:
             raise XacroForbidden(f"{where}: urdf {text!r} names package {pkg!r}, which is not among the packages "
-                                 f"given ({', '.join(sorted(packages)) or 'none'}); pass packages={{{pkg!r}: folder}}")
+                                 f"given ({', '.join(sorted(packages)) or 'none'}); pass packages={{{pkg!r}: folder}} "
+                                 f"(on the command line --package {pkg}=FOLDER)")
         root, rel_path = packages[pkg], rel
     else:
         root, rel_path = base_dir, text
