@@ -89,6 +89,20 @@ class ClearanceProfile:
         """Smallest distance between two links of one planned arm [m]."""
         return float(np.min(self.own)) if self.own.size else float("inf")
 
+    @property
+    def curves(self) -> dict[str, np.ndarray]:
+        """What the clearance plot draws: ``{"<arm> ↔ fixtures, other arms": environment, "<arm>: own links": own}``
+        (a curve without any pair left out)."""
+        arms = " + ".join(dict.fromkeys(p.owner_a for p in self.pairs if p.kind == "self")) or "planned arm"
+        out = {f"{arms} ↔ fixtures, other arms": self.environment, f"{arms}: own links": self.own}
+        return {k: v for k, v in out.items() if v.size and np.isfinite(v).any()}
+
+    @property
+    def curve_pairs(self) -> dict[str, Any]:
+        """``{curve: (body_a, body_b)}`` of the environment's closest pair."""
+        name = next(iter(self.curves), None)
+        return {} if name is None or self.min_pair is None else {name: f"{self.min_pair[0]} ↔ {self.min_pair[1]}"}
+
 
 
 @dataclass(frozen=True, eq=False)

@@ -45,6 +45,7 @@ in :mod:`.ladder`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -52,8 +53,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInput
-from .collision import _margin, exact_min_distance
+from .collision import _margin, exact_min_distance, pair_lower_bounds
 from .ladder import Intervals, climb
+from .motion_curves import moving_arm_curves
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
 from .speed_bound import joint_levers, speed_profile, travel_stops
@@ -96,8 +98,10 @@ def check_motion(
         window: ``(t_start, t_end)`` [s]; default: from the earliest start to the latest
             end of the motions, or ``(0, longest period)`` when a motion is periodic.
         hold: cell configuration ``(nq,)`` of the arms without a motion (default neutral).
-        curve: compute the exact smallest distance at every sample (for a clearance-over-
-            time plot) instead of only at the samples the screen flags.
+        curve: compute the exact smallest distance at every sample instead of only at the
+            samples the screen flags, and each moving arm's distance to everything else per
+            group of pairs (:attr:`MotionCheck.curves`, :mod:`.motion_curves`): what the
+            clearance-over-time plot draws.
         cover: screen the samples on the sphere cover before the broad phase (same verdicts,
             faster); ``False``: the broad phase and coal alone — a check that shares no code
             with the cover, as :func:`optim.plan_motion`'s re-check of a path the cover proved.
@@ -121,7 +125,11 @@ def check_motion(
     d = samples.screen(schedule.times, screen, curve)
     lower, unresolved = _prove(schedule, d, required, samples)
     first = _first_contact(samples, pairs)
-    return _report(samples, pairs, first, lower, unresolved, left_out, schedule, margin, required)
+    report = _report(samples, pairs, first, lower, unresolved, left_out, schedule, margin, required)
+    if curve:  # the moving arms against everything else, at every sample (the clearance plot)
+        curves, closest = moving_arm_curves(cell, [m.arm for m in motions], samples.configurations(report.times))
+        report = dataclasses.replace(report, curves=curves, curve_pairs=closest)
+    return report
 
 
 def _distances(margin: Any, clearance: Any) -> tuple[float, float]:
@@ -387,8 +395,6 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
     (coal), until the next bound is no smaller than the smallest distance found. ``(inf, t0,
     None)`` for a cell without pairs.
     """
-    from .collision import pair_lower_bounds
-
     cell = samples.cell
     exact_d = np.where(exact, d, np.inf)
     i = int(np.argmin(exact_d))

@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -62,6 +62,10 @@ class MotionCheck:
             ``margin`` and ``required`` [m]; ``window``: ``(t_start, t_end)`` [s].
         pairs: the pairs looked at (:meth:`Cell.pairs_for` at ``required + margin``); the
             pairs left out are proven farther than that in every configuration.
+        curves: with ``curve=True``, ``{group: (M,) exact distance [m] at times}``: each moving
+            arm against the fixtures, against each other arm, and between its own links
+            (:func:`.motion_curves.moving_arm_curves`; shapes that do not move left out); else
+            empty. ``curve_pairs``: ``{group: CollisionPair}`` the closest pair of each group.
 
     ``repr`` is :meth:`summary`.
     """
@@ -84,6 +88,8 @@ class MotionCheck:
     required: float
     window: tuple[float, float]
     pairs: tuple[CollisionPair, ...]
+    curves: dict[str, np.ndarray] = field(default_factory=dict)
+    curve_pairs: dict[str, CollisionPair] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
