@@ -410,7 +410,7 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
         lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
         return Q, lb
 
-    row_lb = np.concatenate([bounds(np.arange(a, min(a + BOUND_ROWS, t.size)))[1].min(axis=1)
+    row_lb = np.concatenate([_row_bounds(samples, t[a:a + BOUND_ROWS], bounds, np.arange(a, min(a + BOUND_ROWS, t.size)))
                              for a in range(0, t.size, BOUND_ROWS)])
     order = np.argsort(row_lb, kind="stable")
     best, best_row, best_k = float("inf"), int(order[0]), -1
@@ -425,3 +425,16 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
         if dist[j] < best:
             best, best_row, best_k = float(dist[j]), int(rows[j]), int(pair[j])
     return best, float(t[best_row]), cell._candidates[best_k] if best_k >= 0 else None
+
+
+def _row_bounds(samples: _Samples, ts: np.ndarray, bounds: Any, rows: np.ndarray) -> np.ndarray:
+    """``(len(ts),)`` lower bounds [m] of each sample's smallest distance over every candidate pair.
+
+    On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
+    else the bounding spheres and boxes (``bounds(rows)``, numpy): a check run with
+    ``cover=False`` shares no code with the cover, its minimum included.
+    """
+    if samples.cover and ts.size >= COVER_ROWS:
+        cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
+        return cover.excess(samples.configurations(ts), pair_set, np.zeros(len(samples.cell._candidates)))
+    return bounds(rows)[1].min(axis=1)
