@@ -56,3 +56,17 @@ def test_schedule_plot_draws_every_arm(tmp_path):
     assert "a (2.00 s)" in text and "b (1.50 s)" in text and "60.0 picks/min" in text
     with pytest.raises(InvalidInput, match="periods"):
         plot_schedule(tmp_path / "s.png", schedule, periods=0)
+
+
+def test_clearance_plot_of_a_planned_motion_draws_the_arm_to_the_rest_and_its_own_links(tmp_path):
+    from pinarms.optim.motion import ClearanceProfile
+
+    cell = load_cell("mushroom_line")
+    pairs = tuple(p for p in cell.pairs_for(float("inf")) if "left" in (p.owner_a, p.owner_b))
+    env_k = next(k for k, p in enumerate(pairs) if p.kind == "arm-fixture")
+    t = np.linspace(0.0, 1.0, 11)
+    profile = ClearanceProfile(t, 0.05 + 0.01 * t, np.full(11, env_k), np.full(11, 0.08), pairs, 0.01)
+    assert list(profile.curves) == ["left ↔ fixtures, other arms", "left: own links"]
+    text = plot_clearance(tmp_path / "plan.svg", profile).read_text()
+    assert "left ↔ fixtures, other arms" in text and "left: own links" in text
+    assert f"50.0 mm: {pairs[env_k].body_a} ↔ {pairs[env_k].body_b}" in text
