@@ -99,7 +99,7 @@ class ClearanceProfile:
 
     @property
     def curve_pairs(self) -> dict[str, Any]:
-        """``{curve: (body_a, body_b)}`` of the environment's closest pair."""
+        """``{curve: "body_a ↔ body_b"}``: the environment curve's closest pair (what the plot names)."""
         name = next(iter(self.curves), None)
         return {} if name is None or self.min_pair is None else {name: f"{self.min_pair[0]} ↔ {self.min_pair[1]}"}
 
