@@ -22,42 +22,72 @@ __all__ = ["plot_clearance", "plot_schedule"]
 
 
 def plot_clearance(path: str | Path, check: Any, *, title: str = "clearance over time", mm: bool = True) -> Path:
-    """Smallest distance over the checked pairs against time, from a cell's motion check.
+    """Each moving arm's distance to everything else against time, one curve per group of pairs.
 
-    ``check`` is a :class:`robots.cell.MotionCheck` (best with ``curve=True``: exact at
-    every sample). Samples in contact are marked red, the required clearance is a dashed
-    line, the closest sample is annotated with its pair.
+    ``check`` is a :class:`robots.cell.MotionCheck` checked with ``curve=True`` (its
+    ``curves``: each moving arm against the fixtures, each other arm and its own links, shapes
+    that do not move left out, so an idle arm's constant distance never hides the moving
+    one's) or a planned motion's :class:`optim.motion.ClearanceProfile`. A check without
+    curves draws its smallest distance over every pair (screened samples as dots: at least
+    that far). Samples in contact are marked red, the required clearance is a dashed line,
+    the closest point is annotated with its pair.
     """
     t = checked_numbers(getattr(check, "times", None), "check.times")
-    d = checked_numbers(getattr(check, "clearance", None), "check.clearance")
-    if t.ndim != 1 or t.shape != d.shape or t.size == 0:
-        raise InvalidInput(f"check.times and check.clearance must be equal 1-D arrays, got {t.shape} and {d.shape}")
+    curves = {str(k): checked_numbers(v, f"check.curves[{k!r}]") for k, v in (getattr(check, "curves", None) or {}).items()}
+    if not curves:
+        curves = {"smallest distance (every pair)": checked_numbers(getattr(check, "clearance", None), "check.clearance")}
+    for name, d in curves.items():
+        if t.ndim != 1 or t.shape != d.shape or t.size == 0:
+            raise InvalidInput(f"check.times and the curve {name!r} must be equal 1-D arrays, got {t.shape} and {d.shape}")
     k = 1000.0 if mm else 1.0
     unit = "mm" if mm else "m"
     fig = Figure(figsize=(9, 3.6))
     ax = fig.subplots()
+    colors = ["#2a6fb5", "#e07b19", "#2ca02c", "#9467bd", "#8c564b", "#17becf"]
     exact = np.asarray(getattr(check, "exact", np.ones(t.size, bool)), dtype=bool)
-    ax.plot(t[exact], d[exact] * k, lw=1.0, color="#2a6fb5", label="smallest distance")
+    if getattr(check, "curves", None):
+        exact = np.ones(t.size, dtype=bool)  # every curve is exact at every sample
+    lowest = (np.inf, "", 0)
+    for n, (name, d) in enumerate(curves.items()):
+        ax.plot(t[exact], d[exact] * k, lw=1.0, color=colors[n % len(colors)], label=name)
+        finite = np.where(exact, d, np.inf)
+        i = int(np.argmin(finite))
+        if finite[i] < lowest[0]:
+            lowest = (float(finite[i]), name, i)
+        touch = d <= 0.0
+        if touch.any():
+            ax.plot(t[touch], d[touch] * k, ".", ms=4, color="#d62728", label="contact" if n == 0 else None)
     if (~exact).any():
+        d = next(iter(curves.values()))
         ax.plot(t[~exact], d[~exact] * k, ".", ms=2, color="#9aa7b5", label="screened (at least)")
-    touch = d <= 0.0
-    if touch.any():
-        ax.plot(t[touch], d[touch] * k, ".", ms=4, color="#d62728", label="contact")
     required = float(getattr(check, "required", 0.0))
     if required > 0.0:
         ax.axhline(required * k, ls="--", color="#555555", lw=0.8, label=f"required {required * k:g} {unit}")
     ax.axhline(0.0, color="black", lw=0.6)
-    i = int(np.argmin(np.where(exact, d, np.inf))) if exact.any() else int(np.argmin(d))
-    pair = getattr(check, "min_clearance_pair", None)
-    if pair is not None:
-        ax.annotate(f"{d[i] * k:.1f} {unit}: {pair}", (t[i], d[i] * k), textcoords="offset points", xytext=(6, 10),
-                    fontsize=8)
+    _annotate_closest(ax, check, t, lowest, k, unit)
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"distance [{unit}]")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
     return save_figure(fig, path)
+
+
+def _annotate_closest(ax: Any, check: Any, t: np.ndarray, lowest: tuple, k: float, unit: str) -> None:
+    """Name the pair at the closest point drawn: a curve's closest pair, or the check's."""
+    value, name, i = lowest
+    if not np.isfinite(value):
+        return
+    pair = (getattr(check, "curve_pairs", None) or {}).get(name)
+    if pair is None and not getattr(check, "curves", None):
+        pair = getattr(check, "min_clearance_pair", None)
+        if pair is not None and math.isfinite(getattr(check, "min_clearance", math.nan)):
+            value, i = float(check.min_clearance), int(np.argmin(np.abs(t - check.min_clearance_time)))
+    if pair is None:
+        return
+    text = pair if isinstance(pair, str) else f"{pair.body_a} ↔ {pair.body_b}"
+    ax.annotate(f"{value * k:.1f} {unit}: {text}", (t[i], value * k), textcoords="offset points", xytext=(6, 10),
+                fontsize=8)
 
 
 def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: str | None = None) -> Path:

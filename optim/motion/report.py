@@ -89,6 +89,20 @@ class ClearanceProfile:
         """Smallest distance between two links of one planned arm [m]."""
         return float(np.min(self.own)) if self.own.size else float("inf")
 
+    @property
+    def curves(self) -> dict[str, np.ndarray]:
+        """What the clearance plot draws: ``{"<arm> ↔ fixtures, other arms": environment, "<arm>: own links": own}``
+        (a curve without any pair left out)."""
+        arms = " + ".join(dict.fromkeys(p.owner_a for p in self.pairs if p.kind == "self")) or "planned arm"
+        out = {f"{arms} ↔ fixtures, other arms": self.environment, f"{arms}: own links": self.own}
+        return {k: v for k, v in out.items() if v.size and np.isfinite(v).any()}
+
+    @property
+    def curve_pairs(self) -> dict[str, Any]:
+        """``{curve: "body_a ↔ body_b"}``: the environment curve's closest pair (what the plot names)."""
+        name = next(iter(self.curves), None)
+        return {} if name is None or self.min_pair is None else {name: f"{self.min_pair[0]} ↔ {self.min_pair[1]}"}
+
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,6 +179,26 @@ class MotionPlan:
         t = np.linspace(self.trajectory.start_time, self.trajectory.end_time, samples)
         q = self.cell_trajectory().sample(t)[0]
         return self.cell.world_pose(q, self.cell.arm(name).prefix + "tcp")[:, :3, 3]
+
+    def clearance_summary(self) -> str:
+        """One line in plain words: the smallest clearance (coal, exact) and where, whether the margin held, and
+        what the cell's independent re-check proved.
+
+        E.g. ``smallest clearance 32.2 mm (forearm ↔ table at t = 0.410 s); the 10 mm margin holds along the whole
+        motion (proven on the path by the planner; re-checked by the cell: no contact, no two shapes closer than
+        5.0 mm at its 10 mm resolution)``. ``None`` parts (planned with ``recheck=False``) are left out.
+        """
+        held = f"the {self.margin * 1e3:g} mm margin holds along the whole motion (proven on the path by the planner"
+        c, check = self.clearance, self.check
+        if check is not None:
+            held += (f"; re-checked by the cell: no contact, no two shapes closer than {check.lower_bound * 1e3:.1f} mm"
+                     f" at its {check.margin * 1e3:g} mm resolution")
+        held += ")"
+        if c is None:
+            return held
+        where = "" if c.min_pair is None else f" ({c.min_pair[0]} ↔ {c.min_pair[1]} at t = {c.min_time:.3f} s)"
+        own = "" if not np.isfinite(c.min_own) else f"; own links closest {c.min_own * 1e3:.1f} mm"
+        return f"smallest clearance {c.min_environment * 1e3:.1f} mm{where}; {held}{own}"
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-able summary (SI units)."""

@@ -182,6 +182,14 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
 
 
 # --------------------------------------------------------------------------- cycle
+def _closest_arms(check: Any, k: float, lu: str) -> str:
+    """Where two arms come closest (a check of the arm–arm pairs): the true distance, its pair and time, the proof."""
+    pair = check.min_clearance_pair
+    where = "" if pair is None else f"{pair.body_a} ↔ {pair.body_b} "
+    return (f"the arms come closest at {check.min_clearance / k:.4g} {lu} ({where}at t = {check.min_clearance_time:.3f} s;"
+            f" proven never closer than {check.lower_bound / k:.4g} {lu})")
+
+
 @cell_group.command("cycle", context_settings=NUMBERS)
 @_cell_options
 @click.option("--task", "tasks", nargs=7, multiple=True, required=True, metavar="ARM PX PY PZ QX QY QZ",
@@ -276,8 +284,8 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
                      + f"; {schedule.picks_per_minute:.2f} picks/min against "
                      + ", ".join(f"{v:.2f}" for v in schedule.single_arm_picks_per_minute.values())
                      + " for one arm alone")
-        lines.append(f"  {int(schedule.clear.sum())} of {schedule.clear.size} offsets clear; arms at least "
-                     f"{schedule.arm_check.min_clearance / k:.4g} {lu} apart")
+        lines.append(f"  {int(schedule.clear.sum())} of {schedule.clear.size} offsets clear; "
+                     + _closest_arms(schedule.arm_check, k, lu))
         motions = [ArmMotion(n, cycles[n].trajectory, schedule.offsets[n], schedule.period) for n in schedule.arms]
         check = schedule.arm_check
         if plot_schedule:

@@ -184,9 +184,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
         f"  time-optimal: {plan.duration:.4f} s under "
         + ", ".join(k for k, v in plan.limits.items() if v is not None and k != "amax_source")
         + f" limits (amax: {plan.limits['amax_source']}); limit use " + ", ".join(f"{k} {100 * r:.1f} %" for k, r in plan.timing.ratios.items()),
-        f"  clearance: {cl.min_environment / lu:.4g} {u} at t = {cl.min_time:.3f} s"
-        + (f" ({cl.min_pair[0]} – {cl.min_pair[1]})" if cl.min_pair else "")
-        + f", margin {margin_m / lu:g} {u}; proven continuously, re-checked by the cell ({plan.check.n_samples} samples)",
+        f"  {plan.clearance_summary()}; {plan.check.n_samples} samples",
         f"  total {plan.seconds['total']:.3f} s (search {plan.seconds['search']:.3f}, shortcut "
         f"{plan.seconds['shortcut']:.3f}, smooth {plan.seconds['smooth']:.3f}, time {plan.seconds['time']:.3f}, "
         f"check {plan.seconds['check']:.3f})",

@@ -45,6 +45,7 @@ in :mod:`.ladder`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -52,8 +53,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInput
-from .collision import _margin, exact_min_distance
+from .collision import _margin, exact_min_distance, pair_lower_bounds
 from .ladder import Intervals, climb
+from .motion_curves import moving_arm_curves
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
 from .speed_bound import joint_levers, speed_profile, travel_stops
@@ -97,8 +99,10 @@ def check_motion(
             end of the motions, or ``(0, longest period)`` when a motion is periodic.
         hold: cell configuration ``(nq,)`` of the arms without a motion (default :attr:`Cell.hold`:
             each arm's hold pose).
-        curve: compute the exact smallest distance at every sample (for a clearance-over-
-            time plot) instead of only at the samples the screen flags.
+        curve: compute the exact smallest distance at every sample instead of only at the
+            samples the screen flags, and each moving arm's distance to everything else per
+            group of pairs (:attr:`MotionCheck.curves`, :mod:`.motion_curves`): what the
+            clearance-over-time plot draws.
         cover: screen the samples on the sphere cover before the broad phase (same verdicts,
             faster); ``False``: the broad phase and coal alone — a check that shares no code
             with the cover, as :func:`optim.plan_motion`'s re-check of a path the cover proved.
@@ -122,7 +126,11 @@ def check_motion(
     d = samples.screen(schedule.times, screen, curve)
     lower, unresolved = _prove(schedule, d, required, samples)
     first = _first_contact(samples, pairs)
-    return _report(samples, pairs, first, lower, unresolved, left_out, schedule, margin, required)
+    report = _report(samples, pairs, first, lower, unresolved, left_out, schedule, margin, required)
+    if curve:  # the moving arms against everything else, at every sample (the clearance plot)
+        curves, closest = moving_arm_curves(cell, [m.arm for m in motions], samples.configurations(report.times))
+        report = dataclasses.replace(report, curves=curves, curve_pairs=closest)
+    return report
 
 
 def _distances(margin: Any, clearance: Any) -> tuple[float, float]:
@@ -347,8 +355,7 @@ def _report(samples: _Samples, pairs: tuple[CollisionPair, ...], first: Contact 
     lower = min(lower, float(all_d.min()))
     if left_out.size:  # the pairs left out are proven at least this far apart
         lower = min(lower, float(left_out[0]))
-    exact_d = np.where(all_x, all_d, np.inf)
-    i_min = int(np.argmin(exact_d)) if np.isfinite(exact_d).any() else int(np.argmin(all_d))
+    d_min, t_min, pair_min = _smallest(samples, all_t, all_d, all_k, all_x, margin + required)
     collision_free = first is None and lower > 0.0
     clear = first is None and lower >= required and not unresolved
     return MotionCheck(
@@ -356,9 +363,9 @@ def _report(samples: _Samples, pairs: tuple[CollisionPair, ...], first: Contact 
         clear=bool(clear),
         first_contact=first,
         max_depth=float(max(0.0, -all_d.min())),
-        min_clearance=float(all_d[i_min]),
-        min_clearance_time=float(all_t[i_min]),
-        min_clearance_pair=pairs[int(all_k[i_min])] if all_k[i_min] >= 0 else None,
+        min_clearance=d_min,
+        min_clearance_time=t_min,
+        min_clearance_pair=pair_min,
         lower_bound=float(lower),
         times=all_t,
         clearance=all_d,
@@ -371,3 +378,64 @@ def _report(samples: _Samples, pairs: tuple[CollisionPair, ...], first: Contact 
         window=schedule.window,
         pairs=pairs,
     )
+
+
+#: Samples evaluated together while :func:`_smallest` searches the true minimum; rows of lower bounds per block.
+SMALLEST_BATCH, BOUND_ROWS = 16, 4096
+
+
+def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, exact: np.ndarray,
+              screen: float) -> tuple[float, float, CollisionPair | None]:
+    """The smallest exact distance at the samples [m] over every candidate pair of the cell, its time [s] and pair.
+
+    A sample computed exactly below the ``screen`` distance holds it: the samples the screen
+    cleared are at least ``screen`` away, the pairs the check left out proven farther. Else
+    (every sample at least ``screen``): the samples in increasing order of a lower bound of
+    their distance (bounding spheres and boxes, the left-out pairs' proven bounds,
+    :func:`.collision.pair_lower_bounds`), each computed exactly over every candidate pair
+    (coal), until the next bound is no smaller than the smallest distance found. ``(inf, t0,
+    None)`` for a cell without pairs.
+    """
+    cell = samples.cell
+    exact_d = np.where(exact, d, np.inf)
+    i = int(np.argmin(exact_d))
+    if exact_d[i] < screen:
+        return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
+    n_all, n0 = len(cell._candidates), len(cell.pairs)
+    if n_all == 0:
+        return float("inf"), float(t[0]), None
+
+    def bounds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        Q = samples.configurations(t[rows])
+        lb = pair_lower_bounds(cell, Q)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        return Q, lb
+
+    row_lb = np.concatenate([_row_bounds(samples, t[a:a + BOUND_ROWS], bounds, np.arange(a, min(a + BOUND_ROWS, t.size)))
+                             for a in range(0, t.size, BOUND_ROWS)])
+    order = np.argsort(row_lb, kind="stable")
+    best, best_row, best_k = float("inf"), int(order[0]), -1
+    for a in range(0, order.size, SMALLEST_BATCH):
+        rows = order[a:a + SMALLEST_BATCH]
+        rows = rows[row_lb[rows] < best]
+        if not rows.size:
+            break
+        Q, lb = bounds(rows)
+        dist, pair, _, _ = exact_min_distance(cell, Q, lb=lb, n=n_all)
+        j = int(np.argmin(dist))
+        if dist[j] < best:
+            best, best_row, best_k = float(dist[j]), int(rows[j]), int(pair[j])
+    return best, float(t[best_row]), cell._candidates[best_k] if best_k >= 0 else None
+
+
+def _row_bounds(samples: _Samples, ts: np.ndarray, bounds: Any, rows: np.ndarray) -> np.ndarray:
+    """``(len(ts),)`` lower bounds [m] of each sample's smallest distance over every candidate pair.
+
+    On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
+    else the bounding spheres and boxes (``bounds(rows)``, numpy): a check run with
+    ``cover=False`` shares no code with the cover, its minimum included.
+    """
+    if samples.cover and ts.size >= COVER_ROWS:
+        cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
+        return cover.excess(samples.configurations(ts), pair_set, np.zeros(len(samples.cell._candidates)))
+    return bounds(rows)[1].min(axis=1)

@@ -6,7 +6,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -41,26 +42,30 @@ class MotionCheck:
         clear: proven: every distance stays ≥ ``required`` [m] in the window.
         first_contact: the first contact (:class:`Contact`) or ``None``.
         max_depth: the largest penetration depth seen at a sample [m] (0 when none).
-        min_clearance: the smallest distance at the samples [m] (negative: overlap), its
-            time [s] and pair (``min_clearance_time``, ``min_clearance_pair``).
-        lower_bound: when no contact is found, a proven lower bound of the distance over
-            the whole window [m]; with a contact, the deepest sample.
+        min_clearance: the true smallest distance found [m]: coal's exact distance, over every
+            pair of the cell, at the sample where it is smallest (negative: overlap, the
+            deepest sample); ``min_clearance_time`` [s] and ``min_clearance_pair`` (the two
+            shapes; ``None`` only in a cell without pairs) say where. Always a distance, never
+            a bound: the motion's true minimum lies between :attr:`lower_bound` and it.
+        lower_bound: a proven lower bound of every distance over the whole window [m] (no
+            two shapes come closer, between the samples too), at the check's resolution
+            ``margin``: once ``required`` is proven the proof stops there, so it is a
+            guarantee, not a distance; with a contact, the deepest sample.
         times: ``(M,)`` sample times [s] (refinement samples included, sorted);
             ``clearance``: ``(M,)`` smallest distance at each [m], exact where ``exact``
-            ``(M,)`` is true, else the screen's bound ``required + margin`` (the sample is at
-            least that far from every contact); ``pair_index``: ``(M,)`` index into
-            ``pairs`` of the closest pair (−1 where not exact).
-        min_clearance: the smallest value of ``clearance``: an exact distance when
-            :attr:`min_clearance_is_exact` (then ``min_clearance_pair`` is its pair), else
-            — no sample came within ``required + margin`` of a contact and ``curve`` was
-            off — the screening *bound* ``required + margin`` and ``min_clearance_pair`` is
-            ``None``. Quote :attr:`min_sample_distance` for a distance and
-            :attr:`lower_bound` for a proven bound.
+            ``(M,)`` is true, else the :attr:`screening_bound` ``required + margin`` (the
+            sample is at least that far from every contact, not computed further);
+            ``pair_index``: ``(M,)`` index into ``pairs`` of the closest pair (−1 where not
+            exact).
         dt: the finest time step [s] (at the global speed bound); ``speed_bound``: that
             bound ``V`` [m/s];
             ``margin`` and ``required`` [m]; ``window``: ``(t_start, t_end)`` [s].
         pairs: the pairs looked at (:meth:`Cell.pairs_for` at ``required + margin``); the
             pairs left out are proven farther than that in every configuration.
+        curves: with ``curve=True``, ``{group: (M,) exact distance [m] at times}``: each moving
+            arm against the fixtures, against each other arm, and between its own links
+            (:func:`.motion_curves.moving_arm_curves`; shapes that do not move left out); else
+            empty. ``curve_pairs``: ``{group: CollisionPair}`` the closest pair of each group.
 
     ``repr`` is :meth:`summary`.
     """
@@ -83,6 +88,8 @@ class MotionCheck:
     required: float
     window: tuple[float, float]
     pairs: tuple[CollisionPair, ...]
+    curves: dict[str, np.ndarray] = field(default_factory=dict)
+    curve_pairs: dict[str, CollisionPair] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
@@ -91,14 +98,17 @@ class MotionCheck:
 
     @property
     def min_clearance_is_exact(self) -> bool:
-        """Whether :attr:`min_clearance` is an exact distance (else the screening bound)."""
+        """Deprecated: :attr:`min_clearance` is always an exact distance now (``True`` but in a cell without pairs)."""
+        warnings.warn("MotionCheck.min_clearance_is_exact is deprecated: min_clearance is always an exact distance",
+                      DeprecationWarning, stacklevel=2)
         return self.min_clearance_pair is not None
 
     @property
     def min_sample_distance(self) -> float:
-        """The smallest exact distance at a sample [m] (coal); ``nan`` when every sample was screened clear."""
-        d = self.clearance[self.exact]
-        return float(d.min()) if d.size else float("nan")
+        """Deprecated: the same as :attr:`min_clearance` (the smallest exact distance at a sample) [m]."""
+        warnings.warn("MotionCheck.min_sample_distance is deprecated: read min_clearance (always an exact distance)",
+                      DeprecationWarning, stacklevel=2)
+        return self.min_clearance
 
     @property
     def screening_bound(self) -> float:
@@ -114,17 +124,36 @@ class MotionCheck:
         return self.clearance <= 0.0
 
     def summary(self) -> str:
-        """One line: verdict, first contact or minimum clearance, samples and step."""
+        """One line in plain words: the smallest clearance and where, whether the clearance held (and what is proven).
+
+        E.g. ``smallest clearance 32.2 mm (forearm ↔ table at t = 0.410 s); the 10 mm clearance holds
+        along the whole motion (proven: no two shapes closer than 10.0 mm); 507 samples, ...``.
+        """
+        return f"{self.verdict()}; {self.n_samples} samples, dt = {self.dt * 1e3:.3f} ms, speed bound {self.speed_bound:.2f} m/s"
+
+    def verdict(self) -> str:
+        """The summary without the sampling figures: the smallest clearance, then what held and what is proven."""
         if self.first_contact is not None:
             c = self.first_contact
-            head = f"contact at t = {c.time:.4f} s: {c.pair} (depth {c.depth * 1e3:.1f} mm)"
-        elif self.min_clearance_pair is None:
-            head = (f"{'clear' if self.clear else 'NOT proven clear'}: every sample at least {self.min_clearance * 1e3:.1f} mm"
-                    f" (screening bound), proven lower bound {self.lower_bound * 1e3:.1f} mm")
-        else:
-            head = (
-                f"{'clear' if self.clear else 'NOT proven clear'}: smallest sampled distance {self.min_clearance * 1e3:.1f} mm"
-                f" at t = {self.min_clearance_time:.4f} s ({self.min_clearance_pair}), proven lower bound "
-                f"{self.lower_bound * 1e3:.1f} mm"
-            )
-        return f"{head}; {self.n_samples} samples, dt = {self.dt * 1e3:.3f} ms, speed bound {self.speed_bound:.2f} m/s"
+            return (f"CONTACT at t = {c.time:.4f} s: {_pair_text(c.pair)} (depth {c.depth * 1e3:.1f} mm, deepest "
+                    f"{self.max_depth * 1e3:.1f} mm)")
+        where = ("" if self.min_clearance_pair is None else
+                 f" ({_pair_text(self.min_clearance_pair)} at t = {self.min_clearance_time:.3f} s)")
+        head = f"smallest clearance {_mm(self.min_clearance)}{where}"
+        proven = f"proven: no two shapes closer than {_mm(self.lower_bound)}"
+        if self.required > 0.0:
+            asked = f"the {self.required * 1e3:g} mm clearance"
+            if self.clear:
+                return f"{head}; {asked} holds along the whole motion ({proven})"
+            return f"{head}; {asked} is NOT proven along the whole motion ({proven})"
+        if self.collision_free:
+            return f"{head}; no contact along the whole motion ({proven})"
+        return f"{head}; contact-free NOT proven between the samples ({proven})"
+
+
+def _mm(x: float) -> str:
+    return "inf" if not np.isfinite(x) else f"{x * 1e3:.1f} mm"
+
+
+def _pair_text(pair: CollisionPair) -> str:
+    return f"{pair.body_a} ↔ {pair.body_b}"

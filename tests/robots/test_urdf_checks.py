@@ -61,3 +61,26 @@ def test_a_speed_or_effort_limit_beyond_the_bound_is_named(attr):
     text = TWO_LINKS.replace(f'{key}="1"', attr)
     with pytest.raises(ModelError, match=f"joint 'j' has a {key} limit"):
         robots.from_urdf_text(text, name="two")
+
+
+@pytest.mark.parametrize("doctype", [
+    '<!DOCTYPE robot [<!ENTITY % p SYSTEM "{dtd}"> %p;]>',  # external parameter entity
+    '<!DOCTYPE robot SYSTEM "{dtd}">',                        # external DTD
+    '<!DOCTYPE robot [<!ENTITY x SYSTEM "{dtd}">]>',          # external general entity
+])
+def test_a_plain_urdf_with_an_external_doctype_is_refused_by_from_urdf_and_fk(tmp_path, doctype):
+    """Issue 35 item 12: a DOCTYPE in a plain .urdf gets the same named error as in a xacro file, no model."""
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    dtd = tmp_path / "names.dtd"
+    dtd.write_text('<!ENTITY name "b">')
+    path = tmp_path / "recv.urdf"
+    path.write_text('<?xml version="1.0"?>\n' + doctype.format(dtd=dtd.as_uri()) + "\n" + TWO_LINKS)
+    with pytest.raises(ModelError, match="recv.urdf declares a DOCTYPE"):
+        robots.from_urdf(path)
+    result = CliRunner().invoke(cli, ["fk", str(path), "0"])
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert result.stderr.startswith("Error:") and "declares a DOCTYPE" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1

@@ -56,7 +56,7 @@ def test_a_move_through_the_packing_box_wall_reports_the_wall_first(line):
     first_dense = t[np.argmax(d <= 0.0)]
     assert abs(contact.time - first_dense) <= 2e-4 + 1e-6
     assert result.max_depth > 0.005
-    assert "contact at t" in result.summary()
+    assert "CONTACT at t = " in result.summary() and str(contact.pair.body_b) in result.summary()
 
 
 def test_the_lifted_cycle_is_proven_clear_and_the_proof_holds_densely(line, cycles):

@@ -59,18 +59,37 @@ def test_pairs_for_refuses_what_is_not_a_clearance(post, bad):
 def test_a_sweep_past_the_post_is_not_clear_at_20_mm_and_reports_13_mm(post):
     result = post.check_motion({"arm": SWEEP}, margin=0.01, clearance=0.02)
     assert not result.clear and result.collision_free
-    assert result.min_clearance_is_exact
     assert result.min_clearance_pair.bodies == ("arm_upper_arm", "post")
-    assert abs(result.min_sample_distance - POST_GAP) < 3e-4
+    assert abs(result.min_clearance - POST_GAP) < 3e-4
     assert result.lower_bound <= POST_GAP
-    assert "NOT proven clear" in repr(result) and "13.0 mm" in repr(result)
-    # at clearance 0 the post pair is proven farther than the screen: contact-free, and the bound is honest
-    free = post.check_motion({"arm": SWEEP}, margin=0.005, clearance=0.0)
-    assert free.collision_free and free.clear
-    assert free.lower_bound <= POST_GAP + 1e-9
-    if not free.min_clearance_is_exact:
-        assert "screening bound" in free.summary()
-        assert np.isnan(free.min_sample_distance) or free.min_sample_distance >= free.screening_bound - 1e-12
+    assert "smallest clearance 13.0 mm (arm_upper_arm ↔ post at t = 0.53" in repr(result)
+    assert "the 20 mm clearance is NOT proven along the whole motion" in repr(result)
+
+
+@pytest.mark.parametrize("margin, clearance, curve", [(0.005, 0.0, False), (0.005, 0.0, True), (0.01, 0.01, False)])
+def test_the_smallest_clearance_is_the_true_distance_never_the_screening_bound(post, margin, clearance, curve):
+    """Issue 36 item 11: with every sample screened clear, min_clearance was the screen's 5 mm, not the 13 mm."""
+    result = post.check_motion({"arm": SWEEP}, margin=margin, clearance=clearance, curve=curve)
+    assert result.collision_free and result.clear
+    assert result.min_clearance_pair.bodies == ("arm_upper_arm", "post")
+    assert abs(result.min_clearance - POST_GAP) < 3e-4  # the post pair is left out of the screen, not of the minimum
+    assert 0.0 < result.lower_bound <= result.min_clearance
+    # the true minimum at the samples: coal over every candidate pair, at the time reported
+    q = post.robot.check_q(np.array([float(SWEEP.sample(np.array([result.min_clearance_time]))[0][0, 0]), 0, 0, 0]))
+    assert post.clearance(q[0][0]).distance == pytest.approx(result.min_clearance, abs=1e-9)
+    assert "screening" not in result.summary()
+    assert f"smallest clearance {result.min_clearance * 1e3:.1f} mm (arm_upper_arm ↔ post" in result.summary()
+    held = ("no contact along the whole motion" if clearance == 0.0 else
+            f"the {clearance * 1e3:g} mm clearance holds along the whole motion")
+    assert f"{held} (proven: no two shapes closer than {result.lower_bound * 1e3:.1f} mm)" in result.summary()
+
+
+def test_the_old_names_of_the_minimum_warn_and_agree(post):
+    result = post.check_motion({"arm": SWEEP}, margin=0.01, clearance=0.02)
+    with pytest.deprecated_call():
+        assert result.min_sample_distance == result.min_clearance
+    with pytest.deprecated_call():
+        assert result.min_clearance_is_exact
 
 
 def test_in_collision_and_collisions_at_a_margin_see_the_post(post):
