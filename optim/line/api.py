@@ -155,6 +155,28 @@ class LineResult:
     belt_speed: float = 0.0
     fixture_infeasible: dict = field(default_factory=dict)
 
+    def summary(self, title: str = "line") -> str:
+        """The figures as text, one per line (what ``pinarms belt run`` prints): status, arms, belt
+        speed, arrivals and picks per minute, miss rate with its 95 % interval, utilisation per arm,
+        item wait (and the tray figures when the line places in trays)."""
+        f = self.figures
+        lo, hi = f.miss_rate_ci
+        lines = [
+            title,
+            f"  status            {self.status}",
+            f"  arms              {len(f.arms)}",
+            f"  belt speed        {self.belt_speed:.3f} m/s",
+            f"  arrivals          {f.arrivals_per_minute:.1f} /min",
+            f"  picks             {f.picks_per_minute:.1f} /min",
+            f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
+            "  utilisation       " + "  ".join(f"{a} {100 * u:.0f} %" for a, u in zip(f.arms, f.utilisation)),
+            f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
+        ]
+        if f.tray_fill_rate is not None:
+            lines.append(f"  tray fill         {100 * f.tray_fill_rate:.1f} %, {f.trays_unfilled:.1f} trays left with a "
+                         f"free slot per run, {100 * f.unplaced_rate:.2f} % of items missed for want of a slot")
+        return "\n".join(lines)
+
     def as_dict(self) -> dict[str, Any]:
         return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
                 "neighbour_checks": [list(r.checks) for r in self.runs],
