@@ -42,12 +42,13 @@ STATUSES = ("ok", "misses above target")
 
 @dataclass(frozen=True)
 class Stream:
-    """The items: ``kind`` ``"poisson"`` (``rate`` items/min at random), ``"regular"`` (one every
-    60/``rate`` s) or ``"file"`` (``path`` of an arrivals file); ``duration`` [s] simulated;
-    ``types`` of items (one :class:`ItemType` by default)."""
+    """The items: ``kind`` ``"poisson"`` (``rate_per_s`` items/s at random, as
+    :func:`~.items.poisson_items` takes it), ``"regular"`` (one every 1/``rate_per_s`` s) or
+    ``"file"`` (``path`` of an arrivals file); ``duration`` [s] simulated; ``types`` of items (one
+    :class:`ItemType` by default). Items per minute only at the edges (``pinarms belt --rate``)."""
 
     kind: str = "poisson"
-    rate: float = 60.0
+    rate_per_s: float = 1.0
     duration: float = 600.0
     path: str | None = None
     types: tuple[ItemType, ...] = (ItemType("item"),)
@@ -57,19 +58,19 @@ class Stream:
             raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
         if self.kind == "file" and not self.path:
             raise InvalidInput("a 'file' stream needs the path of its arrivals file")
-        rate = _number(self.rate, "stream rate [items/min]", positive=True)
+        rate = _number(self.rate_per_s, "stream rate_per_s [items/s]", positive=True)
         duration = _number(self.duration, "stream duration [s]", positive=True)
-        expected = rate / 60.0 * duration
+        expected = rate * duration
         if self.kind != "file" and not expected <= MAX_ITEMS:
-            raise InvalidInput(f"a stream of {rate:g} items/min over {duration:g} s is {expected:.3g} items; a stream "
+            raise InvalidInput(f"a stream of {rate:g} items/s over {duration:g} s is {expected:.3g} items; a stream "
                                f"holds at most {MAX_ITEMS} items: lower the rate or the duration")
         object.__setattr__(self, "types", tuple(self.types))
 
     def items(self, belt: Belt, seed: int) -> Items:
         if self.kind == "poisson":
-            return poisson_items(belt, self.rate / 60.0, self.duration, types=self.types, seed=seed)
+            return poisson_items(belt, self.rate_per_s, self.duration, types=self.types, seed=seed)
         if self.kind == "regular":
-            return regular_items(belt, 60.0 / self.rate, self.duration, types=self.types, seed=seed)
+            return regular_items(belt, 1.0 / self.rate_per_s, self.duration, types=self.types, seed=seed)
         return read_arrivals(Path(self.path), belt, self.types)
 
 

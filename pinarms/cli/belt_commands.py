@@ -40,7 +40,7 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
         spec = gantry_line(rate, **kw, **({} if speed is None else {"speed": speed}))
         spec = replace(spec, rule=replace(spec.rule, name=rule))
     if arrivals:
-        spec = replace(spec, stream=Stream("file", rate, duration, path=arrivals, types=spec.stream.types), seeds=(0,))
+        spec = replace(spec, stream=Stream("file", rate / 60.0, duration, path=arrivals, types=spec.stream.types), seeds=(0,))
     return spec
 
 
