@@ -170,7 +170,7 @@ class LineResult:
             f"  arrivals          {f.arrivals_per_minute:.1f} /min",
             f"  picks             {f.picks_per_minute:.1f} /min",
             f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
-            "  utilisation       " + "  ".join(f"{a} {100 * u:.0f} %" for a, u in zip(f.arms, f.utilisation)),
+            "  utilisation       " + ", ".join(f"{a}: {100 * u:.0f} %" for a, u in zip(f.arms, f.utilisation)),
             f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
         ]
         if f.tray_fill_rate is not None:

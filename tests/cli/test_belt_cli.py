@@ -69,6 +69,6 @@ def test_belt_run_prints_the_results_summary():
     assert r.stdout.strip() == text
     f = res.figures
     for part in (f"picks             {f.picks_per_minute:.1f} /min", f"miss rate         {100 * f.miss_rate:.2f} %",
-                 f"{f.arms[0]} {100 * f.utilisation[0]:.0f} %", f"{f.arms[1]} {100 * f.utilisation[1]:.0f} %",
+                 f"{f.arms[0]}: {100 * f.utilisation[0]:.0f} %", f"{f.arms[1]}: {100 * f.utilisation[1]:.0f} %",
                  "belt speed        0.200 m/s", "status"):
         assert part in text, (part, text)
