@@ -1,6 +1,6 @@
-"""Every ``pinarms.x.y`` / ``x.y.name`` the docs name in their code spans and blocks resolves: an
-import of the module and the attributes after it (the "Modules that moved" tables name the old,
-removed paths and are skipped)."""
+"""Every ``pinarms.x.y`` / ``x.y.name`` the docs name in their code spans and blocks, and every name
+their code blocks import from pinarms, resolves: an import of the module and the attributes after
+it (the "Modules that moved" tables name the old, removed paths and are skipped)."""
 
 import importlib
 import pkgutil
@@ -42,10 +42,17 @@ def _resolve(name: str) -> object:
     raise ModuleNotFoundError(name)
 
 
+#: ``from pinarms.x import a, b`` (parenthesised over lines too): each name imported
+IMPORT = re.compile(r"^\s*from pinarms\.([\w.]+) import (\([^)]*\)|[^\n]+)", re.M)
+
+
 def _names(path: Path) -> list[str]:
     found = []
     for part in _code(path.read_text(encoding="utf-8")):
         found += [m.group(1) for m in NAME.finditer(part) if m.group(1).rsplit(".", 1)[-1] not in SUFFIXES]
+        for m in IMPORT.finditer(part):
+            imported = re.split(r"[\s,()]+", re.sub(r"\bas\s+\w+", "", m.group(2).split("#")[0]))
+            found += [f"{m.group(1)}.{n}" for n in imported if n.isidentifier()]
     return sorted(set(found))
 
 
@@ -64,5 +71,6 @@ def test_the_check_sees_the_names():
     """The scan finds names (so the test above can fail): line.md names the line's API."""
     names = _names(ROOT / "docs" / "line.md")
     assert "optim.line.line_curve" in names and len(names) > 5
+    assert "optim.line.Stream" in names  # from its code block's import line
     with pytest.raises(AttributeError):
         _resolve("viz.line_session.no_such_function")
