@@ -23,7 +23,7 @@ def save_line_views(spec: Any, result: Any, *, session: Any = None, html: Any = 
     for the animation and [0, 3 × ``duration``] s for the schedule; each path optional. Returns the paths written."""
     written = []
     if session is not None or html is not None:
-        s = Session(title=title or f"belt line: {len(spec.stations)} arm(s), {spec.stream.rate:g} items/min, "
+        s = Session(title=title or f"belt line: {len(spec.stations)} arm(s), {60.0 * spec.stream.rate_per_s:g} items/min, "
                                    f"belt {spec.belt.speed:g} m/s")
         add_line(s, spec, result, run=run, duration=duration)
         if session is not None:

@@ -42,12 +42,13 @@ STATUSES = ("ok", "misses above target")
 
 @dataclass(frozen=True)
 class Stream:
-    """The items: ``kind`` ``"poisson"`` (``rate`` items/min at random), ``"regular"`` (one every
-    60/``rate`` s) or ``"file"`` (``path`` of an arrivals file); ``duration`` [s] simulated;
-    ``types`` of items (one :class:`ItemType` by default)."""
+    """The items: ``kind`` ``"poisson"`` (``rate_per_s`` items/s at random, as
+    :func:`~.items.poisson_items` takes it), ``"regular"`` (one every 1/``rate_per_s`` s) or
+    ``"file"`` (``path`` of an arrivals file); ``duration`` [s] simulated; ``types`` of items (one
+    :class:`ItemType` by default). Items per minute only at the edges (``pinarms belt --rate``)."""
 
     kind: str = "poisson"
-    rate: float = 60.0
+    rate_per_s: float = 1.0
     duration: float = 600.0
     path: str | None = None
     types: tuple[ItemType, ...] = (ItemType("item"),)
@@ -57,19 +58,19 @@ class Stream:
             raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
         if self.kind == "file" and not self.path:
             raise InvalidInput("a 'file' stream needs the path of its arrivals file")
-        rate = _number(self.rate, "stream rate [items/min]", positive=True)
+        rate = _number(self.rate_per_s, "stream rate_per_s [items/s]", positive=True)
         duration = _number(self.duration, "stream duration [s]", positive=True)
-        expected = rate / 60.0 * duration
+        expected = rate * duration
         if self.kind != "file" and not expected <= MAX_ITEMS:
-            raise InvalidInput(f"a stream of {rate:g} items/min over {duration:g} s is {expected:.3g} items; a stream "
+            raise InvalidInput(f"a stream of {rate:g} items/s over {duration:g} s is {expected:.3g} items; a stream "
                                f"holds at most {MAX_ITEMS} items: lower the rate or the duration")
         object.__setattr__(self, "types", tuple(self.types))
 
     def items(self, belt: Belt, seed: int) -> Items:
         if self.kind == "poisson":
-            return poisson_items(belt, self.rate / 60.0, self.duration, types=self.types, seed=seed)
+            return poisson_items(belt, self.rate_per_s, self.duration, types=self.types, seed=seed)
         if self.kind == "regular":
-            return regular_items(belt, 60.0 / self.rate, self.duration, types=self.types, seed=seed)
+            return regular_items(belt, 1.0 / self.rate_per_s, self.duration, types=self.types, seed=seed)
         return read_arrivals(Path(self.path), belt, self.types)
 
 
@@ -154,6 +155,28 @@ class LineResult:
     maps: dict = field(repr=False, default_factory=dict)
     belt_speed: float = 0.0
     fixture_infeasible: dict = field(default_factory=dict)
+
+    def summary(self, title: str = "line") -> str:
+        """The figures as text, one per line (what ``pinarms belt run`` prints): status, arms, belt
+        speed, arrivals and picks per minute, miss rate with its 95 % interval, utilisation per arm,
+        item wait (and the tray figures when the line places in trays)."""
+        f = self.figures
+        lo, hi = f.miss_rate_ci
+        lines = [
+            title,
+            f"  status            {self.status}",
+            f"  arms              {len(f.arms)}",
+            f"  belt speed        {self.belt_speed:.3f} m/s",
+            f"  arrivals          {f.arrivals_per_minute:.1f} /min",
+            f"  picks             {f.picks_per_minute:.1f} /min",
+            f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
+            "  utilisation       " + ", ".join(f"{a}: {100 * u:.0f} %" for a, u in zip(f.arms, f.utilisation)),
+            f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
+        ]
+        if f.tray_fill_rate is not None:
+            lines.append(f"  tray fill         {100 * f.tray_fill_rate:.1f} %, {f.trays_unfilled:.1f} trays left with a "
+                         f"free slot per run, {100 * f.unplaced_rate:.2f} % of items missed for want of a slot")
+        return "\n".join(lines)
 
     def as_dict(self) -> dict[str, Any]:
         return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),

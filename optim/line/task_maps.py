@@ -41,7 +41,7 @@ from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
 __all__ = ["TaskMap", "build_task_map", "map_error", "MapError", "MAX_MAP_VALUES"]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class TaskMap:
     """Task times over the belt (module doc). ``du`` (nu,), ``w`` (nw,) [m]; ``approach``,
     ``leave`` (nu, nw) [s] (NaN: infeasible; the fastest branch at each node); ``track``,
@@ -102,6 +102,15 @@ class TaskMap:
         object.__setattr__(self, "_A", A)
         object.__setattr__(self, "_C", C)
         object.__setattr__(self, "_cell", _cell_branches(A, C))
+
+    def __repr__(self) -> str:
+        """One line: the grid, its ranges, the times' ranges and what the map was built for."""
+        tot = self._A + self._C
+        bad = int(np.sum(~np.isfinite(tot).any(axis=0)))
+        return (f"TaskMap({self.station!r}, {self.du.size} x {self.w.size} nodes, du {_span(self.du)} m, "
+                f"w {_span(self.w)} m, approach {_span(self.approach)} s, leave {_span(self.leave)} s, "
+                f"{len(self.branches)} branch{'es' if len(self.branches) != 1 else ''}, {bad} infeasible, "
+                f"speed {self.speed:.3g} m/s, mass {self.mass:.3g} kg)")
 
     def _weights(self, grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2)
@@ -370,7 +379,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
                    time.perf_counter() - start, labels, A, C, int(blocked))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class MapError:
     """Interpolated vs exact task time at random feasible points: ``relative`` (n,) errors of
     the task time (approach + tracking + leave + release), ``max``, ``mean``, ``points`` (n, 2)."""
@@ -386,6 +395,20 @@ class MapError:
     @property
     def mean(self) -> float:
         return float(np.mean(self.relative)) if self.relative.size else float("nan")
+
+    def __repr__(self) -> str:
+        """One line: how many points, the max, mean and 95th percentile of the relative error [%]."""
+        if not self.relative.size:
+            return f"MapError(0 points, {self.planning_seconds:.1f} s of planning)"
+        p95 = float(np.percentile(self.relative, 95))
+        return (f"MapError({self.relative.size} points, max {100 * self.max:.2f} %, mean {100 * self.mean:.2f} %, "
+                f"p95 {100 * p95:.2f} %, {self.planning_seconds:.1f} s of planning)")
+
+
+def _span(values: np.ndarray) -> str:
+    """``lo..hi`` of the finite values at 3 significant digits (``none`` when none is finite)."""
+    finite = np.asarray(values)[np.isfinite(values)]
+    return f"{finite.min():.3g}..{finite.max():.3g}" if finite.size else "none"
 
 
 def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,

@@ -248,13 +248,26 @@ def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> A
     return time_optimal(path, _constraints(station, mass), grid=grid, **ends)
 
 
-def _check_limits(station: Station, traj: Trajectory, what: str) -> None:
+def _check_limits(station: Station, traj: Trajectory, what: str, spec: TrackingSpec, speed: float) -> None:
+    """InfeasibleProblem when ``traj`` (a tracking segment) needs a joint beyond its velocity or
+    acceleration limit, with the figures and the descend [s] that would lower the worst of them to
+    its limit if it all came from the vertical move (acceleration ∝ 1/descend², velocity ∝ 1/descend)."""
     peaks = traj.peaks()
     lim = station.limits
-    over = np.flatnonzero((peaks.velocity > lim["vmax"] * (1 + 1e-9)) | (peaks.acceleration > lim["amax"] * (1 + 1e-9)))
-    if over.size:
-        raise InfeasibleProblem(f"arm {station.name!r}: the {what} needs joint {int(over[0]) + 1} beyond its "
-                                "velocity or acceleration limit (belt too fast here)")
+    ratios = np.stack([peaks.velocity / lim["vmax"], peaks.acceleration / lim["amax"]])
+    if not np.any(ratios > 1 + 1e-9):
+        return
+    kind, j = np.unravel_index(int(np.argmax(ratios)), ratios.shape)
+    unit = station.robot.joint_units[j]
+    peak, limit, rate = ((peaks.velocity[j], lim["vmax"][j], f"{unit}/s") if kind == 0 else
+                         (peaks.acceleration[j], lim["amax"][j], f"{unit}/s²"))
+    longer = spec.descend * float(ratios[kind, j]) ** (1.0 if kind == 0 else 0.5)
+    longer = np.ceil(longer * 1.05 * 100.0) / 100.0  # 5 % over, to the next 10 ms
+    raise InfeasibleProblem(
+        f"arm {station.name!r}: the {what} needs joint {j + 1} ({station.robot.joint_names[j]}) at {peak:.3g} {rate} "
+        f"against its limit {limit:.3g} {rate} (belt too fast here for its descend): lengthen the descend "
+        f"(TrackingSpec.descend, now {spec.descend:g} s) to {longer:g} s or more, or slow the belt (--speed, "
+        f"Belt.speed, now {speed:g} m/s); the part of the motion that follows the belt only a slower belt lowers")
 
 
 class PositionLimitError(InfeasibleProblem):
@@ -326,7 +339,7 @@ def _plan_on_branch(station: Station, belt: Belt, spec: TrackingSpec, u_pre: flo
     qd_out = _joint_rates(station, q[-1], belt.velocity)
     spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
     tracking = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
-    _check_limits(station, tracking, "tracking segment")
+    _check_limits(station, tracking, "tracking segment", spec, belt.speed)
     _check_positions(station, tracking, "tracking segment")
     approach = _timed_move(station, q_rest, np.zeros(robot.nq), q[0], qd_in, 0.0, spec.grid)
     _check_positions(station, approach.trajectory, "approach move")

@@ -190,7 +190,7 @@ def _segments(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: flo
         spline = CubicSpline(tau, qq, axis=0, bc_type=((1, qd_in), (1, qd_out)))
         traj = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
         try:
-            _check_limits(station, traj, what)
+            _check_limits(station, traj, what, spec, belt.speed)
         except InfeasibleProblem as exc:
             error = exc
             continue

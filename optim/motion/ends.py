@@ -107,6 +107,14 @@ def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
                   f"{_idle_note(pair, _idle_arms(checker))}; move it clear or lower the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
 
 
+def _q_text(robot: Any, q: np.ndarray) -> str:
+    """``[0.2676, -0.5556] rad`` (4 digits; each value with its unit when the joints mix rad and m)."""
+    units = robot.joint_units
+    if len(set(units)) == 1:
+        return "[" + ", ".join(f"{v:.4g}" for v in q) + f"] {units[0]}"
+    return "[" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + "]"
+
+
 def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
                      frame: str | None) -> list[GoalCandidate]:
     cell = checker.cell
@@ -145,7 +153,8 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
         out.append(GoalCandidate(qi, False, describe_pair(pair, d, m) + _idle_note(pair, _idle_arms(checker)), int(bi),
                                  () if pair is None else pair.bodies, d))
     if not any(g.valid for g in out):
-        lines = "; ".join(f"branch {g.branch}: {g.reason}" if g.branch >= 0 else g.reason for g in out)
+        lines = "; ".join(f"{f'branch {g.branch} ' if g.branch >= 0 else ''}(q = {_q_text(robot, g.q)}): {g.reason}"
+                          for g in out)
         raise GoalInCollision(f"every IK solution of the goal pose is in collision ({len(out)} tried): {lines}",
                               which="goal", pairs=tuple(g.pair for g in out), distances=tuple(g.distance for g in out))
     return out

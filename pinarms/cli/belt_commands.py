@@ -16,24 +16,6 @@ from ._common import cli, emit, json_option, scheduler_option
 PRESETS = ("scara", "gantry")
 
 
-def _figures_lines(res, title: str) -> list[str]:
-    f = res.figures
-    lo, hi = f.miss_rate_ci
-    return [
-        title,
-        f"  status            {res.status}",
-        f"  arms              {len(f.arms)}",
-        f"  belt speed        {res.belt_speed:.3f} m/s",
-        f"  arrivals          {f.arrivals_per_minute:.1f} /min",
-        f"  picks             {f.picks_per_minute:.1f} /min",
-        f"  miss rate         {100 * f.miss_rate:.2f} %  (95 % CI {100 * lo:.2f} - {100 * hi:.2f} %, {f.seeds} seeds)",
-        "  utilisation       " + "  ".join(f"{100 * u:.0f} %" for u in f.utilisation),
-        f"  item wait         mean {f.wait_mean_s:.2f} s, p95 {f.wait_p95_s:.2f} s",
-    ] + ([] if f.tray_fill_rate is None else [
-        f"  tray fill         {100 * f.tray_fill_rate:.1f} %, {f.trays_unfilled:.1f} trays left with a free slot "
-        f"per run, {100 * f.unplaced_rate:.2f} % of items missed for want of a slot"])
-
-
 def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit: bool, rule: str, seeds: int,
           duration: float, arrivals: str | None):
     from pinarms.optim.line import Stream
@@ -58,7 +40,7 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
         spec = gantry_line(rate, **kw, **({} if speed is None else {"speed": speed}))
         spec = replace(spec, rule=replace(spec.rule, name=rule))
     if arrivals:
-        spec = replace(spec, stream=Stream("file", rate, duration, path=arrivals, types=spec.stream.types), seeds=(0,))
+        spec = replace(spec, stream=Stream("file", rate / 60.0, duration, path=arrivals, types=spec.stream.types), seeds=(0,))
     return spec
 
 
@@ -129,7 +111,7 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
         from pinarms.viz.line_views import save_line_views
 
         save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=window)
-    emit(as_json, res.as_dict(), _figures_lines(res, f"belt run: {preset}, {arms} arm(s), rule {rule}"))
+    emit(as_json, res.as_dict(), res.summary(f"belt run: {preset}, {arms} arm(s), rule {rule}").splitlines())
 
 
 @belt.command("arms")
@@ -153,8 +135,8 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
         if res.status == "ok":
             break
     data = {"arms_needed": n if res.status == "ok" else None, **res.as_dict()}
-    lines = _figures_lines(res, f"belt arms: {rate:g} items/min at <= 1 % miss -> "
-                                f"{n if res.status == 'ok' else f'more than {max_arms}'} arm(s)")
+    lines = res.summary(f"belt arms: {rate:g} items/min at <= 1 % miss -> "
+                        f"{n if res.status == 'ok' else f'more than {max_arms}'} arm(s)").splitlines()
     emit(as_json, data, lines)
 
 

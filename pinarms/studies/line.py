@@ -54,7 +54,7 @@ def scara_line(n_arms: int, rate: float, *, speed: float = 0.2, paper_limit: boo
                 vmax=vmax, amax=10.0 * np.array(robot.velocity_limit))
         for k in range(n_arms))
     belt = Belt((0.0, 0.0, 0.80), speed=speed, width=0.3, length=0.6 + SCARA_SPACING * n_arms + 0.5)
-    return LineSpec(belt, stations, Stream("poisson", rate, duration, types=(ENOKI,)), TrackingSpec(), Rule(rule),
+    return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(ENOKI,)), TrackingSpec(), Rule(rule),
                     seeds, 0.01, (24, 7))
 
 
@@ -64,7 +64,7 @@ def gantry_line(rate: float, *, kind: str = "poisson", speed: float = 0.3, seeds
     robot = robots.load("gantry_flower")
     belt = Belt((-0.5, 0.2, 0.70), speed=speed, width=0.3, length=2.5)
     station = Station("gantry", robot, base_pose(0.0, 0.0, 0.65), PlaceBox((0.6, 0.5, 0.90), "box"))
-    return LineSpec(belt, (station,), Stream(kind, rate, duration, types=(FLOWER,)), TrackingSpec(), Rule("first"),
+    return LineSpec(belt, (station,), Stream(kind, rate / 60.0, duration, types=(FLOWER,)), TrackingSpec(), Rule("first"),
                     seeds, 0.01, (24, 5))
 
 
@@ -154,7 +154,7 @@ def study(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), durat
         one = scara_line(1, rate, paper_limit=paper, seeds=seeds, duration=duration)
         m = maps_for(one)["scara 1"][0]
         err = map_error(m, one.stations[0], one.belt, one.tracking, n=check_points, item_height=ENOKI.size[2])
-        single = run_line(replace(one, stream=Stream("regular", 120.0, 120.0, types=(ENOKI,)), seeds=(0,)),
+        single = run_line(replace(one, stream=Stream("regular", 2.0, 120.0, types=(ENOKI,)), seeds=(0,)),
                           maps={"scara 1": (m,)})
         # no fewer arms than the flow over one saturated arm's rate
         start = max(1, int(np.ceil(rate / single.figures.picks_per_minute)) - 1)

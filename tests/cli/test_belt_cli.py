@@ -53,3 +53,22 @@ def test_belt_counts_and_rates_are_capped_before_any_work():
         assert flag in r.output and "Traceback" not in r.output
     r = CliRunner().invoke(cli, ["belt", "arms", "--max-arms", "1000000"])
     assert r.exit_code == 1 and "--max-arms" in r.output
+
+
+def test_belt_run_prints_the_results_summary():
+    """The CLI prints LineResult.summary(): the Python figures and the printed ones cannot drift."""
+    from pinarms.optim.line import run_line
+    from pinarms.studies.line import maps_for, scara_line
+
+    args = ["belt", "run", "--arms", "2", "--rate", "20", "--seeds", "1", "--duration", "60"]
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 0, (r.output, r.exception)
+    spec = scara_line(2, 20.0, seeds=(0,), duration=60.0)
+    res = run_line(spec, maps=maps_for(spec))
+    text = res.summary("belt run: scara, 2 arm(s), rule first")
+    assert r.stdout.strip() == text
+    f = res.figures
+    for part in (f"picks             {f.picks_per_minute:.1f} /min", f"miss rate         {100 * f.miss_rate:.2f} %",
+                 f"{f.arms[0]}: {100 * f.utilisation[0]:.0f} %", f"{f.arms[1]}: {100 * f.utilisation[1]:.0f} %",
+                 "belt speed        0.200 m/s", "status"):
+        assert part in text, (part, text)

@@ -160,6 +160,13 @@ def test_every_ik_branch_in_collision_lists_each_reason(wall, across):
     with pytest.raises(GoalInCollision, match="every IK solution") as err:
         plan_motion(wall, "aubo", qa, T, margin=MARGIN)
     assert len(err.value.pairs) >= 2 and all("wall" in p for p in err.value.pairs)
+    # each branch with its joint values (rad, 4 digits): branches that read alike are told apart
+    arm = wall.arm("aubo")
+    q, labels = ik_candidates(arm.robot, arm.to_base(T), qa, seed=0)
+    text = str(err.value)
+    for qi, b in zip(q, labels):
+        values = ", ".join(f"{v:.4g}" for v in qi)
+        assert f"branch {b} (q = [{values}] rad)" in text, (b, values, text)
 
 
 def test_no_path_within_the_time_limit_is_a_named_error(wall, across):

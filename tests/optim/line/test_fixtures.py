@@ -82,7 +82,7 @@ def test_the_simulation_never_picks_where_the_block_is(blocked_line):
     cell, belt, st, before, after = blocked_line
     gone = np.isfinite(before.branch_approach) & ~np.isfinite(after.branch_approach)
     gone = gone.any(axis=0)  # (nu, nw): a node lost on some branch
-    spec = LineSpec(belt, (st,), Stream("poisson", rate=40.0, duration=60.0, types=(ENOKI,)), seeds=(0,),
+    spec = LineSpec(belt, (st,), Stream("poisson", rate_per_s=40.0 / 60.0, duration=60.0, types=(ENOKI,)), seeds=(0,),
                     map_grid=(6, 3))
     for maps, expect_inside in (({"left": (before,)}, True), ({"left": (after,)}, False)):
         run = run_line(spec, maps=maps).runs[0]
@@ -116,7 +116,7 @@ def test_fast_route_agrees_with_the_exact_check_and_bad_clearance_is_named():
 @pytest.mark.slow
 def test_run_line_with_a_cell_builds_maps_against_it_and_reports_the_count(blocked_line):
     cell, belt, st, before, after = blocked_line
-    spec = LineSpec(belt, (st,), Stream("poisson", rate=20.0, duration=30.0, types=(ENOKI,)), seeds=(0,),
+    spec = LineSpec(belt, (st,), Stream("poisson", rate_per_s=20.0 / 60.0, duration=30.0, types=(ENOKI,)), seeds=(0,),
                     map_grid=(6, 3), cell=cell, clearance=CLEARANCE)
     result = run_line(spec)
     (m,) = result.maps["left"]

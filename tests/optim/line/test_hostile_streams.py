@@ -52,10 +52,10 @@ def test_a_stream_just_under_the_cap_is_made():
 
 def test_a_stream_description_past_the_cap_is_refused_when_made():
     with pytest.raises(InvalidInput, match=r"1e\+09 items.*at most 2000000"):
-        Stream("poisson", 1e8, 600.0)
+        Stream("poisson", 1e8 / 60.0, 600.0)
     with pytest.raises(InvalidInput, match="at most 2000000"):
-        Stream("regular", 1e8, 600.0)
-    Stream("file", 1e8, 600.0, path="arrivals.csv")  # a file's rows are counted when it is read
+        Stream("regular", 1e8 / 60.0, 600.0)
+    Stream("file", 1e8 / 60.0, 600.0, path="arrivals.csv")  # a file's rows are counted when it is read
 
 
 def _write(tmp_path, text: str | bytes):
@@ -104,3 +104,16 @@ def test_arrivals_rows_are_stored_compactly(tmp_path):
     items = read_arrivals(p, BELT, TYPES)
     assert len(items) == 50 and items.t0[-1] == 24.5 and items.w[4] == 0.01 and items.yaw[6] == 0.6
     assert np.all(items.kind == 0)
+
+
+def test_a_stream_rate_is_per_second_as_poisson_items_takes_it():
+    """``Stream.rate_per_s`` [items/s], the unit of ``poisson_items(rate=)``; one every 1/rate s when regular."""
+    s = Stream("poisson", rate_per_s=2.0, duration=60.0)
+    assert s.rate_per_s == 2.0
+    items = s.items(BELT, seed=3)
+    assert np.array_equal(items.t0, poisson_items(BELT, 2.0, 60.0, seed=3).t0)
+    assert 90 < len(items) < 150  # about 2/s × 60 s
+    regular = Stream("regular", rate_per_s=4.0, duration=10.0).items(BELT, seed=0)
+    assert np.allclose(np.diff(regular.t0), 0.25)
+    with pytest.raises(InvalidInput, match=r"rate_per_s \[items/s\]"):
+        Stream("poisson", rate_per_s=-1.0)

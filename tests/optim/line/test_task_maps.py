@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pinarms.optim.line.task_maps import TaskMap, _refine_at, build_task_map, map_error
+from pinarms.optim.line.task_maps import MapError, TaskMap, _refine_at, build_task_map, map_error
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.optim.line.windows import window_of
 
@@ -78,3 +78,22 @@ def test_refinement_marks_a_kink_between_nodes_only():
     assert _refine_at(np.array([-0.1, 0.1]), A, C, 0.6, 0.005, 2).size == 0
     C[0, 3, 0] = np.nan
     assert _refine_at(du, A, C, 0.6, 0.005, 1).size == 2  # still seen on the other row
+
+
+def test_reprs_are_short_and_give_the_figures():
+    du, w = np.linspace(0.0, 0.6, 31), np.linspace(-0.2, 0.2, 21)
+    a = np.full((31, 21), 0.4)
+    a[0, 0] = np.nan
+    m = TaskMap("a", du, w, a, a + 0.1, 0.5, 0.1, 0.2, 0.25, branches=(0, 1),
+                branch_approach=np.stack([a, a + 0.2]), branch_leave=np.stack([a + 0.1, a + 0.3]))
+    text = repr(m)
+    assert len(text) < 300 and "array" not in text and "\n" not in text
+    for part in ("'a'", "31 x 21", "du 0..0.6 m", "w -0.2..0.2 m", "approach 0.4..0.4 s", "leave 0.5..0.5 s",
+                 "2 branches", "1 infeasible", "speed 0.2 m/s", "mass 0.25 kg"):
+        assert part in text, (part, text)
+    e = MapError(np.linspace(0.0, 0.02, 50), np.zeros((50, 2)), 3.25)
+    text = repr(e)
+    assert len(text) < 200 and "array" not in text
+    for part in ("50 points", "max 2.00 %", "mean 1.00 %", "p95 1.90 %", "3.2 s"):
+        assert part in text, (part, text)
+    assert "0 points" in repr(MapError(np.zeros(0), np.zeros((0, 2)), 0.0))

@@ -1,9 +1,12 @@
 """Conveyor tracking checked from FK of the planned joint trajectory (independent of the planner)."""
 
+import re
+
 import numpy as np
 import pytest
 
 from pinarms import robots
+from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.station import Station, base_pose
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw, plan_pick, tool_yaw
@@ -120,3 +123,22 @@ def test_a_pick_beyond_the_position_limits_is_infeasible_and_the_other_branch_is
     plan = plan_pick(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15)
     assert _sampled_out_of_limits(robot, plan.trajectory) <= 1e-9
     assert plan.approach.trajectory.sample(plan.times[0])[0][1] < 0.0  # elbow the other way (branch 1)
+
+
+def test_belt_too_fast_says_which_descend_fixes_it():
+    """Joint 3 (the SCARA's vertical axis) slowed to 2 m/s²: the default 0.2 s descend needs about 4.3;
+    the message names the figures and the descend that fixes it, and that descend plans."""
+    belt = Belt(origin=(0.0, 0.0, 0.80), speed=0.2, width=0.3, length=3.0)
+    station = Station("scara 1", robots.load("scara_mushroom"), base_pose(1.0, 0.30, 0.78),
+                      PlaceBox((0.8, 0.45, 0.93)), amax=[30.0, 30.0, 2.0, 60.0])
+    with pytest.raises(InfeasibleProblem) as info:
+        plan_pick(station, belt, TrackingSpec(), 1.05, -0.05, item_height=0.04)
+    text = str(info.value)
+    m = re.search(r"joint 3 \(\w+\) at ([\d.]+) m/s² against its limit 2 m/s².*descend \(TrackingSpec.descend, "
+                  r"now 0.2 s\) to ([\d.]+) s.*--speed.*0.2 m/s", text)
+    assert m, text
+    assert 4.0 < float(m.group(1)) < 4.7
+    descend = float(m.group(2))
+    assert 0.25 < descend < 0.4
+    plan = plan_pick(station, belt, TrackingSpec(descend=descend), 1.05, -0.05, item_height=0.04)
+    assert plan.tracking.peaks().acceleration[2] <= 2.0 * (1 + 1e-9)

@@ -209,13 +209,13 @@ def test_line_spec_with_trays_reports_tray_figures(scara_line):
 
     belt, station = scara_line
     trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.4, capacity=2, phase=0.137)
-    spec = LineSpec(belt, (station,), Stream("regular", rate=30.0, duration=60.0), seeds=(0, 1), trays=trays)
+    spec = LineSpec(belt, (station,), Stream("regular", rate_per_s=0.5, duration=60.0), seeds=(0, 1), trays=trays)
     res = run_line(spec, maps={station.name: (const_tray_map(0.1),)})
     f = res.figures
     assert f.tray_fill_rate is not None and 0.0 < f.tray_fill_rate <= 1.0
     assert f.trays_unfilled >= 0 and 0.0 <= f.unplaced_rate <= f.miss_rate
     assert "tray_fill_rate" in f.as_dict()
     assert all(r.tray is not None for r in res.runs)
-    box = run_line(LineSpec(belt, (station,), Stream("regular", rate=30.0, duration=60.0), seeds=(0,)),
+    box = run_line(LineSpec(belt, (station,), Stream("regular", rate_per_s=0.5, duration=60.0), seeds=(0,)),
                    maps={station.name: (const_tray_map(0.1).pick_map,)})
     assert box.figures.tray_fill_rate is None and "tray_fill_rate" not in box.figures.as_dict()
