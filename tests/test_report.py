@@ -44,3 +44,11 @@ def test_bad_width():
     for bad in (10, 80.0, True):
         with pytest.raises(InvalidInput, match="width"):
             format_table(ROWS, width=bad)
+
+
+def test_signed_percent_prints_one_text_for_a_zero_of_either_sign():
+    """A ratio of float noise (1e-12 either way) printed "-0.0 %" on one processor and "+0.0 %" on another."""
+    from pinarms.report import signed_percent
+
+    assert signed_percent(-1e-12) == signed_percent(1e-12) == signed_percent(-0.0004) == "+0.0 %"
+    assert signed_percent(0.0123) == "+1.2 %" and signed_percent(-0.0123) == "-1.2 %"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
+import numpy as np
 
 from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
 
@@ -59,6 +60,9 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
         c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", packages=pkgs))]
     if plan_ends is not None:
         a = None if amax is None else floats(amax, "--amax")
+        if a is not None and not (a.size and np.all(np.isfinite(a)) and np.all(a > 0.0)):
+            raise InvalidInput(f"--amax must be one positive acceleration limit or one per planned joint "
+                               f"[rad/s² or m/s²], got {amax!r}")
         plan = _plan_between(c, arm_name, plan_ends, margin=margin, time_limit=time_limit, seed=seed,
                              amax=None if a is None else (float(a[0]) if a.size == 1 else a))
         results.append(("plan", compare_in_mujoco(c, plan, samples=samples, packages=pkgs)))

@@ -9,7 +9,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.papers import SEED001
-from pinarms.report import Row
+from pinarms.report import Row, signed_percent
 from pinarms.robots import conventions as conv
 
 from .study import DEG, MM
@@ -46,7 +46,7 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
         ref = optim.toppra_limit(ex.trajectory, v, robot=arm, payload=kg, torque_limits=True)
         rows.append(Row(
             "001", f"P1→P4 with {kg:g} kg: time-optimal under joint speed + torque (exact)", None, ex.total, "s", None,
-            f"speed only {speed.total:.3f} s ({100.0 * (ex.total / speed.total - 1.0):+.1f} %); peak torque/limit "
+            f"speed only {speed.total:.3f} s ({signed_percent(ex.total / speed.total - 1.0)}); peak torque/limit "
             f"{ratios.max():.3f} ({', '.join(tight)}); TOPP-RA along the same path {ref:.3f} s "
             f"(bang-bang, the path's optimum: ×{ex.total / ref:.2f})"))
         if kg == AUBO_PAYLOADS_KG[-1]:
@@ -67,7 +67,7 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
         tight = [arm.joint_names[k] for k in near_max(cyc.torque_ratios)]
         rows.append(Row(
             "001", f"{what}: cycle time with {kg:g} kg, speed + torque", None, cyc.cycle_time, "s", None,
-            f"{cyc.picks_per_minute:.1f} picks/min ({100.0 * (cyc.cycle_time / free.cycle_time - 1.0):+.1f} %); "
+            f"{cyc.picks_per_minute:.1f} picks/min ({signed_percent(cyc.cycle_time / free.cycle_time - 1.0)}); "
             f"loaded move {cyc.move_times[0]:.3f} s, empty return {cyc.move_times[1]:.3f} s; peak torque/limit "
             f"{cyc.torque_ratios.max():.3f} ({', '.join(tight)})"))
 

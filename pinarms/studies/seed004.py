@@ -8,7 +8,7 @@ import numpy as np
 
 from pinarms import robots
 from pinarms.papers import SEED004
-from pinarms.report import Row
+from pinarms.report import Row, signed_percent
 from pinarms.robots import conventions as conv
 
 from .study import DEG, MM, Study, _plots, _segment_distance, _session
@@ -158,7 +158,7 @@ def _koji_block_rows(arm: Any) -> list[Row]:
     rows.append(Row("004", f"{what}: cycle time with one {KOJI_BLOCK_KG:g} kg block, speed + torque", None,
                     loaded.cycle_time, "s", None,
                     f"block mass assumed (0.32 × 0.19 × 0.055 m of pressed moist koji, ≈1.2 kg/dm³); "
-                    f"{100.0 * (loaded.cycle_time / free.cycle_time - 1.0):+.1f} %; peak torque/limit "
+                    f"{signed_percent(loaded.cycle_time / free.cycle_time - 1.0)}; peak torque/limit "
                     f"{loaded.torque_ratios.max():.3f} ({', '.join(tight)})"))
     try:
         optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(2 * KOJI_BLOCK_KG, torque_limits=True)))

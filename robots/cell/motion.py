@@ -398,7 +398,7 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
     """
     cell = samples.cell
     exact_d = np.where(exact, d, np.inf)
-    i = int(np.argmin(exact_d))
+    i = _earliest_of_smallest(t, exact_d)
     if exact_d[i] < screen:
         return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
     n_all, n0 = len(cell._candidates), len(cell.pairs)
@@ -414,18 +414,32 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
     row_lb = np.concatenate([_row_bounds(samples, t[a:a + BOUND_ROWS], bounds, np.arange(a, min(a + BOUND_ROWS, t.size)))
                              for a in range(0, t.size, BOUND_ROWS)])
     order = np.argsort(row_lb, kind="stable")
-    best, best_row, best_k = float("inf"), int(order[0]), -1
+    found_d = np.full(t.size, np.inf)
+    found_k = np.full(t.size, -1)
+    best = float("inf")
     for a in range(0, order.size, SMALLEST_BATCH):
         rows = order[a:a + SMALLEST_BATCH]
-        rows = rows[row_lb[rows] < best]
+        rows = rows[row_lb[rows] <= best + TIE_M]  # a sample that may tie the smallest is computed too
         if not rows.size:
             break
         Q, lb = bounds(rows)
         dist, pair, _, _ = exact_min_distance(cell, Q, lb=lb, n=n_all)
-        j = int(np.argmin(dist))
-        if dist[j] < best:
-            best, best_row, best_k = float(dist[j]), int(rows[j]), int(pair[j])
-    return best, float(t[best_row]), cell._candidates[best_k] if best_k >= 0 else None
+        found_d[rows], found_k[rows] = dist, pair
+        best = min(best, float(np.min(dist)))
+    i = _earliest_of_smallest(t, found_d)
+    return float(found_d[i]), float(t[i]), cell._candidates[int(found_k[i])] if found_k[i] >= 0 else None
+
+
+#: Distances [m] closer than this to the smallest count as ties: the earliest sample of them is
+#: reported (a motion symmetric about an obstacle reaches its smallest distance twice, and which of
+#: two equal distances coal returns smaller is float noise that may differ between runs).
+TIE_M = 1e-9
+
+
+def _earliest_of_smallest(t: np.ndarray, d: np.ndarray) -> int:
+    """The index of the earliest time ``t`` whose ``d`` is within :data:`TIE_M` of the smallest ``d``."""
+    ties = np.flatnonzero(d <= np.min(d) + TIE_M)
+    return int(ties[np.argmin(t[ties])]) if ties.size else 0
 
 
 def _row_bounds(samples: _Samples, ts: np.ndarray, bounds: Any, rows: np.ndarray) -> np.ndarray:

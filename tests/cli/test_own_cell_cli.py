@@ -111,7 +111,7 @@ def test_verify_cell_replays_a_planned_move_between_named_states_and_values(run,
     (("--plan", "neutral", "1.0,-0.3", "--arm", "left"), "--arm"),
     (("--amax", "5"), "--plan"),
     (("--samples", "1"), "--samples"),
-    (("--plan", "neutral", "1.0,-0.3"), "--amax"),  # no acceleration limit, no inertials: --amax named
+    (("--plan", "neutral", "1.0,-0.3", "--amax", "-1"), "--amax"),  # a negative acceleration limit: --amax named
 ])
 def test_verify_cell_errors_name_the_flag(run, own, args, flag):
     cell, package = own
