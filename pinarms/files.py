@@ -41,11 +41,24 @@ STALE_AFTER_S = 2.0
 """A ``.part`` file is a leftover once unlocked and unmodified for this long (s); without flock: 1 hour."""
 
 
+def _umask() -> int:
+    """The process's umask, read from ``/proc/self/status`` (Linux): setting it to read it, as
+    ``os.umask`` must, would leave a moment in which another thread creates files with umask 0."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    umask = os.umask(0o077)  # elsewhere: the strictest value for the moment it takes
+    os.umask(umask)
+    return umask
+
+
 def _default_mode() -> int:
     """Permissions a plain ``open(path, "w")`` would give (0o666 minus the umask)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
+    return 0o666 & ~_umask()
 
 
 def _is_part_of(entry: str, name: str) -> bool:
@@ -154,9 +167,7 @@ MAX_NAME_LENGTH = 100
 
 def folder_mode() -> int:
     """Permissions a plain ``os.mkdir`` would give (0o777 minus the umask)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o777 & ~umask
+    return 0o777 & ~_umask()
 
 
 def safe_file_name(text: str, fallback: str) -> str:
