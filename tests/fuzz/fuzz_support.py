@@ -95,3 +95,17 @@ def listing(*folders: Path) -> dict[str, set[str]]:
     for folder in folders:
         out[str(folder)] = {str(p.relative_to(folder)) for p in Path(folder).rglob("*")}
     return out
+
+
+def damaged_file(folder: Path, name: str, data: bytes, kind: str, offset: int, xor: int) -> Path:
+    """``data`` with one byte flipped (``kind == "flip"``: xor ``xor`` at ``offset`` modulo its
+    length) or cut at ``offset`` (``"cut"``), written to ``folder / name``."""
+    data = bytearray(data)
+    offset %= len(data)
+    if kind == "flip":
+        data[offset] ^= xor
+    else:
+        del data[offset:]
+    path = folder / name
+    path.write_bytes(bytes(data))
+    return path

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fuzz_support import EXPLORE, time_bound
+from fuzz_support import EXPLORE, damaged_file, time_bound
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.errors import ArrivalsFileError, TaskMapError
 from pinarms.optim.line.items import ItemType, read_arrivals
@@ -41,14 +41,7 @@ def _map_cases():
 @pytest.mark.parametrize("kind, offset, xor", _map_cases())
 def test_a_damaged_task_map_loads_checked_or_is_refused_by_name(map_bytes, tmp_path, kind, offset, xor):
     m, data = map_bytes
-    data = bytearray(data)
-    offset %= len(data)
-    if kind == "flip":
-        data[offset] ^= xor
-    else:
-        del data[offset:]
-    path = tmp_path / "damaged.npz"
-    path.write_bytes(bytes(data))
+    path = damaged_file(tmp_path, "damaged.npz", data, kind, offset, xor)
     with time_bound(1.0):
         try:
             back = TaskMap.load(path)

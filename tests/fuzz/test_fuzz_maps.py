@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from fuzz_support import EXPLORE, assert_finite
+from fuzz_support import EXPLORE, assert_finite, damaged_file
 from pinarms import robots
 from pinarms.robots.reach.reach_io import DEFAULT_TIMEOUT, ReachabilityFileError, load_reachability, save_reachability
 from pinarms.robots.reach.reachability import ReachabilityMap, reachability_map
@@ -44,14 +44,7 @@ def _cases() -> list[tuple[str, int, int]]:
 @pytest.mark.parametrize("kind, offset, xor", _cases())
 def test_a_damaged_map_loads_checked_or_is_refused_by_name_in_time(base, tmp_path, kind, offset, xor):
     m, data = base
-    data = bytearray(data)
-    offset %= len(data)
-    if kind == "flip":
-        data[offset] ^= xor
-    else:
-        del data[offset:]
-    path = tmp_path / "damaged.h5"
-    path.write_bytes(bytes(data))
+    path = damaged_file(tmp_path, "damaged.h5", data, kind, offset, xor)
     t0 = time.perf_counter()
     try:
         back = load_reachability(path)
