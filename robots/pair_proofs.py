@@ -86,7 +86,8 @@ def _absorbed(model: pin.Model, data: pin.Data, geometry, placement: pin.SE3, up
 
 def invariant_pair(model: pin.Model, data: pin.Data, obj_a, obj_b) -> bool:
     """Whether no joint angle changes the placement of ``obj_a``'s shape relative to ``obj_b``'s (as sets of points):
-    every joint between them is absorbed by one shape or the other (module docstring). Any prismatic joint: ``False``."""
+    every joint between them is absorbed by one shape or the other (module docstring); a prismatic joint
+    between them: ``False``."""
     up_a, up_b = joint_path(model, int(obj_a.parentJoint), int(obj_b.parentJoint))
     total = len(up_a) + len(up_b)
     if total == 0:

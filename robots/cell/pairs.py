@@ -343,7 +343,8 @@ def _pair(a: int, b: int, objs: list, link: list[str], owner: list[str], is_arm:
 
 
 def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
-    """The ``"out of reach"`` pairs as :class:`CollisionPair` s, in increasing order of their bound, and the bounds [m]."""
+    """The ``"out of reach"`` and ``"constant"`` pairs (:data:`BOUNDED`) as :class:`CollisionPair` s, in increasing order of
+    their bound, and the bounds [m]."""
     objs = list(cell.collision_model.geometryObjects)
     link, owner, is_arm = _owners(cell)
     reach = sorted((p for p in allowed if p.reason in BOUNDED), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
