@@ -123,3 +123,15 @@ def test_a_pair_at_one_distance_in_every_sample_but_not_in_every_configuration_i
     assert cell.clearance(top).distance == pytest.approx(np.hypot(0.1, 0.005), abs=1e-7)
     assert cell.clearance(np.array([0.0])).distance == pytest.approx(0.1, abs=1e-7)
     assert cell.in_collision(np.array([0.0]), margin=0.1001) and not cell.in_collision(top, margin=0.1001)
+
+
+def test_a_motion_check_leaves_out_a_constant_pair_only_while_it_keeps_its_margin():
+    from pinarms.robots.cell.cover import motion_pairs
+
+    station = load_cell("aubo_food_station")
+    (arm,) = (a.name for a in station.arms)
+    key = {"aubo_base_link_0", "aubo_upperArm_Link_1"}  # 3 mm apart in every configuration
+    assert any({p.geometry_a, p.geometry_b} == key for p in station.pairs_for(0.05))
+    kept = motion_pairs(station, 0.05, {arm}, 0.0, 0.01)
+    assert not any({p.geometry_a, p.geometry_b} == key for p in kept)
+    assert any({p.geometry_a, p.geometry_b} == key for p in motion_pairs(station, 0.05, {arm}, 0.004, 0.01))
