@@ -20,13 +20,13 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["still_frames", "AXIS_TOL"]
+__all__ = ["still_frames", "revolute_axis", "symmetry", "AXIS_TOL"]
 
 #: Distance [m] of a centre from an axis, and sine of the angle between two axes, taken as zero.
 AXIS_TOL = 1e-9
 
 
-def _revolute_axis(data: pin.Data, j: int) -> np.ndarray | None:
+def revolute_axis(data: pin.Data, j: int) -> np.ndarray | None:
     """Unit axis of joint ``j`` in its own frame (through the frame's origin), ``None`` if not a rotation."""
     motion = np.array(data.joints[j].S).reshape(6, -1)
     if motion.shape[1] != 1:
@@ -38,7 +38,7 @@ def _revolute_axis(data: pin.Data, j: int) -> np.ndarray | None:
     return angular / norm
 
 
-def _symmetry(geometry: coal.CollisionGeometry, placement: pin.SE3) -> tuple[np.ndarray, np.ndarray | None] | None:
+def symmetry(geometry: coal.CollisionGeometry, placement: pin.SE3) -> tuple[np.ndarray, np.ndarray | None] | None:
     """``(centre, axis)`` in the parent joint's frame: a sphere's centre (axis ``None``: any axis through it), a
     cylinder's, capsule's or cone's centre and local z axis; ``None`` for a shape without a turning symmetry."""
     if isinstance(geometry, coal.Sphere):
@@ -54,9 +54,9 @@ def still_frames(model: pin.Model, data: pin.Data, objs: list) -> list[tuple[int
     for g in objs:
         j = int(g.parentJoint)
         frames = [j]
-        sym = _symmetry(g.geometry, g.placement)
+        sym = symmetry(g.geometry, g.placement)
         while sym is not None and j > 0:
-            u = _revolute_axis(data, j)
+            u = revolute_axis(data, j)
             if u is None:
                 break
             centre, axis = sym

@@ -32,7 +32,8 @@ class PairReason(enum.StrEnum):
     ``coaxial``: one turns only about its own axis of symmetry relative to the other
     (:mod:`.coaxial`); ``adjacent``: their links are joined by one joint (``<mimic>`` joints
     count as part of the joint they follow); ``declared``: named by the description's author;
-    ``out of reach`` and ``constant``: a cell's proven and sampled gaps (:mod:`robots.cell.pairs`).
+    ``out of reach`` and ``constant``: a cell's proven gaps, kept with their bound and checked again at a
+    clearance above it (:mod:`robots.cell.pairs`, :mod:`.pair_proofs`).
     """
 
     SAME_LINK = "same link"
@@ -53,9 +54,11 @@ class AllowedPair:
         body_a, body_b: link names.
         reason: a :class:`PairReason`.
         distance_bound: for a cell's ``"out of reach"``: a proven lower bound (> 0) of the pair's
-            distance in every configuration [m]; ``inf`` for the pairs allowed by design.
+            distance in every configuration [m]; for ``"constant"``: its proven constant distance (less
+            1e-9 m); ``inf`` for the pairs allowed by design.
+        note: for ``"declared"``: the reason the description gives (may be empty); for an ``"out of reach"``
+            pair proven by its gap along a joint axis: ``"axial gap"``.
         index_a, index_b: geometry indices in the collision model.
-        note: for ``"declared"``: the reason the description gives (may be empty).
     """
 
     geometry_a: str

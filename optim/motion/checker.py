@@ -52,7 +52,7 @@ import pinocchio as pin
 from pinarms.optim.motion import coal_batches
 from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
-from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
+from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
 from pinarms.robots.errors import InvalidInput
 
 #: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
@@ -148,11 +148,11 @@ class MotionChecker(CoalBatches, LadderProof):
         self.moving_speed = float(sum(np.abs(m.trajectory.peaks().velocity) @ levers[c]
                                       for m, c in zip(self.moving, self._moving_cols)))
         self._travel_t, self._travel_i = self._moving_travel(levers)
-        # the pairs that involve a planned arm, each with its margin: every pair not proven farther
-        # than the widest screen of either margin (Cell.pairs_for)
+        # the pairs that involve a planned arm, each with its margin: every pair not proven farther than the
+        # widest screen of either margin (Cell.pairs_for), less the constant ones at least their margin apart
         planned = set(self.arms)
         widest = max(self.margin, self.self_margin) + self.step * 2.0 ** (COARSE_LEVELS - 1)  # the coarsest screen
-        chosen = [p for p in pairs_for(cell, widest) if p.owner_a in planned or p.owner_b in planned]
+        chosen = motion_pairs(cell, widest, planned, self.self_margin, self.margin)
         where = {p: k for k, p in enumerate(cell.pairs)}
         # index into cell.pairs (-1: a pair the cell does not check at zero clearance, bounded exactly)
         self.pair_index = np.array([where.get(p, -1) for p in chosen], dtype=int)

@@ -34,7 +34,7 @@ from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.robots.cell._cover_kernel import _place
-from pinarms.robots.cell.cover import pair_arrays, pairs_for
+from pinarms.robots.cell.cover import motion_pairs, pair_arrays
 from pinarms.optim.motion.search import SearchResult
 
 __all__ = ["FastCheck", "fast_check", "fast_search", "fast_shortcut", "COMPILED_PLANNER", "TREE_NODES"]
@@ -93,7 +93,7 @@ class FastCheck:
         reach = REACH if reach is None else float(reach)
         planned = set(checker.arms)
         widest = max(checker.margin, checker.self_margin) + reach
-        chosen = [p for p in pairs_for(checker.cell, widest) if p.owner_a in planned or p.owner_b in planned]
+        chosen = motion_pairs(checker.cell, widest, planned, checker.self_margin, checker.margin)
         margins = np.array([checker.self_margin if p.kind == "self" else checker.margin for p in chosen])
         pairs = cover.prepare(*pair_arrays(chosen))
         self.checker = checker

@@ -273,8 +273,8 @@ def save_session(session: Any, path: str, data: dict, lines: list[str]) -> None:
 
 
 def skipped_pair_lines(allowed: Any, k: float, lu: str) -> list[str]:
-    """One line per reason: the pairs of links never checked for it (``out of reach``: with the smallest proven bound,
-    checked again at a clearance above it), each pair of links once."""
+    """One line per reason: the pairs of links never checked for it (``out of reach`` and ``constant``: with the
+    smallest proven bound, checked again at a clearance above it), each pair of links once."""
     by_reason: dict[str, dict[tuple[str, str], float]] = {}
     for a in allowed:
         bodies = by_reason.setdefault(str(a.reason), {})
@@ -283,9 +283,9 @@ def skipped_pair_lines(allowed: Any, k: float, lu: str) -> list[str]:
     lines = []
     for reason in sorted(by_reason):
         pairs = by_reason[reason]
-        if reason == "out of reach":
+        if reason in ("out of reach", "constant"):
             text = ", ".join(f"{a} – {b} (>= {d * k:.4g} {lu})" for (a, b), d in sorted(pairs.items(), key=lambda x: x[1]))
-            lines.append(f"skipped while proven farther than the clearance (out of reach): {text}")
+            lines.append(f"skipped while proven farther than the clearance ({reason}): {text}")
         else:
             notes = {(a.body_a, a.body_b): a.note for a in allowed if a.note}
             text = ", ".join(f"{a} – {b}" + (f" ({notes[(a, b)]})" if notes.get((a, b)) else "") for a, b in pairs)

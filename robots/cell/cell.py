@@ -58,8 +58,8 @@ class Cell:
         fixtures: the fixtures (:class:`Fixture`), in document order.
         pairs: the checked pairs (:class:`~.pairs.CollisionPair`).
         allowed: the pairs not checked at clearance 0, each with its reason
-            (:class:`~.pairs.AllowedPair`); the ``"out of reach"`` ones carry a proven
-            ``distance_bound`` and come back in checks at a larger clearance
+            (:class:`~.pairs.AllowedPair`); the ``"out of reach"`` and ``"constant"`` ones carry a
+            proven ``distance_bound`` and come back in checks at a larger clearance
             (:meth:`pairs_for`).
 
     Thread-safe: each thread uses its own Pinocchio and coal data (:mod:`.views`).
@@ -165,7 +165,7 @@ class Cell:
     def pairs_for(self, clearance: float) -> tuple:
         """The pairs a check at ``clearance`` (or margin) [m] must look at.
 
-        The checked pairs (:attr:`pairs`) followed by every ``"out of reach"`` pair whose
+        The checked pairs (:attr:`pairs`) followed by every ``"out of reach"`` or ``"constant"`` pair whose
         proven distance bound (:attr:`AllowedPair.distance_bound`) is at most ``clearance``,
         in increasing order of that bound: the pairs left out are proven farther than
         ``clearance`` in every configuration. ``pairs_for(0.0)`` is :attr:`pairs`; the

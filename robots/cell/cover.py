@@ -64,6 +64,7 @@ __all__ = [
     "link_cover",
     "pair_arrays",
     "pairs_for",
+    "motion_pairs",
 ]
 
 #: Most spheres per box geometry.
@@ -85,6 +86,24 @@ def pairs_for(cell: Any, clearance: float) -> tuple:
     cell has it (pairs proven farther apart than the clearance left out), else every checked pair."""
     chooser = getattr(cell, "pairs_for", None)
     return tuple(cell.pairs) if chooser is None else tuple(chooser(float(clearance)))
+
+
+def motion_pairs(cell: Any, widest: float, planned: set, self_margin: float, margin: float) -> list:
+    """The pairs a motion check of the ``planned`` arms looks at: :func:`pairs_for` ``(widest)`` (its coarsest
+    screen) with a planned arm, less the ``constant`` pairs proven at least their margin apart (``self_margin``
+    for one arm's links, else ``margin``): their distance never changes, so no motion and no screen raised for
+    the travel can bring them closer. A constant pair below its margin stays: every state fails on it."""
+    bound = {frozenset((a.index_a, a.index_b)): a.distance_bound for a in getattr(cell, "allowed", ())
+             if a.reason == "constant"}
+    out = []
+    for p in pairs_for(cell, widest):
+        if p.owner_a not in planned and p.owner_b not in planned:
+            continue
+        d = bound.get(frozenset((p.index_a, p.index_b)))
+        if d is not None and d >= (self_margin if p.kind == "self" else margin):
+            continue
+        out.append(p)
+    return out
 
 
 def _slices(length: float, width: float) -> int:

@@ -14,12 +14,17 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     follow, so a parallelogram's links are adjacent to their neighbours), or one is the
     arm's own base and the other is carried by the arm's first joint;
 ``out of reach``
-    proven never to touch: every point of a moving geometry stays within a ball around the
-    origin of its arm's first joint (radius: the joint offsets along the chain, the
-    prismatic strokes and the geometry's own bounding sphere, by the triangle inequality),
-    and that ball does not reach the other geometry's bounding box (a fixture) or ball
-    (another arm). The pair keeps :attr:`AllowedPair.distance_bound`, a proven lower bound
-    of its distance in every configuration: the largest of that gap, coal's exact distance
+    proven never to touch, by one of two proofs. *Reach*: every point of a moving geometry
+    stays within a ball around the origin of its arm's first joint (radius: the joint offsets
+    along the chain, the prismatic strokes and the geometry's own bounding sphere, by the
+    triangle inequality), and that ball does not reach the other geometry's bounding box (a
+    fixture) or ball (another arm). *Axial gap* (:attr:`AllowedPair.note` :data:`AXIAL_GAP`,
+    :mod:`robots.pair_proofs`): every joint between the two that neither shape turns about its
+    own axis of symmetry is revolute about one common line, so each shape's projection onto
+    that line never changes, and the two projections (computed from the shapes: box corners,
+    cylinder end discs, mesh vertices, ...) are apart (the SCARA's upper arm turning above its
+    pedestal). The pair keeps :attr:`AllowedPair.distance_bound`, a proven lower bound
+    of its distance in every configuration: the axial gap, or the largest of the ball gap, coal's exact distance
     from the ball to a fixture's own shape, and coal's distance between the solid cylinder
     an arm's revolute first joint sweeps the geometry through and the fixture (or the other
     arm's cylinder), see :mod:`.reach`.
@@ -37,18 +42,23 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     same space at every angle and their distance never changes (the Panda's link-1 capsule
     standing on its table, the SCARA's shoulder hub);
 ``constant``
-    apart by the same distance (within 1e-9 m) in all :data:`ALWAYS_SAMPLES` seeded random
-    configurations: shapes coaxial with every joint between them that :mod:`robots.coaxial` cannot
-    prove (meshes), whose gap is a design constant, not something a motion can close.
+    proven apart by one distance in every configuration (:func:`robots.pair_proofs.invariant_pair`):
+    walking the joints between the two, each is one about which the shape on its moving side
+    is symmetric (a sphere centred on its axis, a cylinder, capsule or cone along it), taken from
+    either end, so no joint moves one shape relative to the other (the AUBO base and its upper
+    arm's housing, 3 mm apart). coal measures the distance once, at the neutral configuration;
+    it is the pair's :attr:`AllowedPair.distance_bound` (less 1e-9 m), and like an ``out of reach``
+    pair it is checked again at any clearance or margin above it (:data:`BOUNDED`).
 
-**Proven or assumed.** ``same link``, ``rigid``, ``coaxial`` and ``out of reach`` are proven
-from the structure and the shapes. ``adjacent`` is the usual assumption of SRDF files (two
+**Proven or assumed.** ``same link``, ``rigid``, ``coaxial``, ``out of reach`` and ``constant``
+are proven from the structure and the shapes. ``adjacent`` is the usual assumption of SRDF files (two
 links joined by a joint are designed to touch at it), taken only from the structure, never
 from a sample; for a pair in contact in (almost) every sample, a shape turning about its own
 axis counts as part of the link it is fixed to (:mod:`robots.coaxial`: the Panda's link-3 sphere at
-joint 2 is adjacent to link 1). ``declared`` is the user's word. ``constant`` is sampled (never
-in contact, one distance in 200 draws). The sample only selects the pairs that must be
-explained (in contact in at least :data:`ALWAYS_SHARE` of them); it never allows one alone.
+joint 2 is adjacent to link 1). ``declared`` is the user's word. The sample only selects the
+pairs that must be explained (in contact in at least :data:`ALWAYS_SHARE` of them); it never
+skips one: a pair found at one distance in every sample but covered by no proof (a quill
+sliding beside a drive housing) is checked.
 
 **No pair is dropped because a sample found it in contact.** A pair the rules above leave
 (``coaxial`` and ``adjacent`` through a turning shape included) and that is in contact in at least :data:`ALWAYS_SHARE` of the :data:`ALWAYS_SAMPLES` seeded
@@ -59,10 +69,10 @@ penetration: move the fixture or the arm, or declare the pair if the contact is 
 A pair in contact less often is checked like any other (a check reports its contacts).
 
 Unlike the sampled "never in collision" of setup assistants, a pair is only dropped as
-"never" when it is proven (``out of reach``): a sample can miss a rare contact, a bound cannot.
+"never" when it is proven (``out of reach``, ``constant``): a sample can miss a rare contact, a bound cannot.
 Every other pair is a :class:`CollisionPair` and is checked. Pairs allowed by design
-(:data:`BY_DESIGN`: every reason but ``out of reach``) are never checked at any clearance:
-their distance does not depend on a motion, or they touch by construction.
+(:data:`BY_DESIGN`: every reason but ``out of reach`` and ``constant``) are never checked at any
+clearance: they touch by construction, or keep a contact no motion changes.
 """
 
 from __future__ import annotations
@@ -76,6 +86,7 @@ import pinocchio as pin
 
 from ..coaxial import still_frames
 from ..errors import PlacementError
+from ..pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
 from ..pair_rules import ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint
 from .pair_samples import SAMPLES, sample_pairs
 from .reach import root_cylinders, tighter_bound
@@ -84,11 +95,17 @@ if TYPE_CHECKING:  # pragma: no cover
     from .cell import Cell
 
 __all__ = ["CollisionPair", "AllowedPair", "PairReason", "classify_pairs", "reach_pairs", "ALWAYS_SHARE",
-           "ALWAYS_SAMPLES", "BY_DESIGN"]
+           "ALWAYS_SAMPLES", "BY_DESIGN", "BOUNDED", "AXIAL_GAP"]
 
 
 #: Reasons of the pairs allowed by design: never checked, at any clearance.
-BY_DESIGN = tuple(r for r in PairReason if r is not PairReason.OUT_OF_REACH)
+BY_DESIGN = tuple(r for r in PairReason if r not in (PairReason.OUT_OF_REACH, PairReason.CONSTANT))
+
+#: :attr:`AllowedPair.note` of an ``"out of reach"`` pair proven by its gap along the common joint axis.
+AXIAL_GAP = "axial gap"
+
+#: Reasons of the pairs skipped only while their proven distance bound is above the clearance asked.
+BOUNDED = (PairReason.OUT_OF_REACH, PairReason.CONSTANT)
 
 #: Random configurations sampled for the :data:`ALWAYS_SHARE` rule and for ``constant`` (:mod:`.pair_samples`).
 ALWAYS_SAMPLES = SAMPLES
@@ -143,7 +160,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     """Split every pair of the cell's collision geometries into checked and allowed pairs.
 
     The rules by design, the declared pairs and the proof of reach first (:func:`robots.pair_rules.by_design`,
-    :func:`_reach_gaps`), then the seeded sampling of the pairs left (:func:`_sampled_reasons`);
+    :func:`_reach_gaps`), then the seeded sampling of the pairs left (:func:`_sampled_contacts`);
     the checked pairs come back arm-fixture first, then arm-arm, then self.
 
     Raises:
@@ -189,23 +206,25 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
                 allow(a, b, PairReason.OUT_OF_REACH, tighter_bound(gaps[a, b], a, b, objs, joint, ball_center,
                                                                    ball_radius, placement, cylinders))
             else:
-                checked.append((a, b))
+                proven = _proven_gap(model, data, objs, gd, a, b)
+                if proven is None:
+                    checked.append((a, b))
+                else:
+                    allow(a, b, *proven)
 
     from .limits import check_pairs
 
     check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
     keep, through = [], []
-    for (a, b), (reason, share, depth) in zip(checked, _sampled_reasons(cell, objs, data, checked, seed)):
+    for (a, b), (share, depth) in zip(checked, _sampled_contacts(cell, objs, data, checked, seed)):
         if share >= ALWAYS_SHARE:  # in contact whatever the joints do: explained by the shapes, or an error
             reason = by_design(model, a, b, link, owner, eff, still)
             if reason is None:
                 through.append((a, b, share, depth))
             else:
                 allow(a, b, reason)
-        elif reason is None:
-            keep.append((a, b))
         else:
-            allow(a, b, reason)
+            keep.append((a, b))
     if through:
         raise _placement_error(cell, objs, link, owner, is_arm, through)
 
@@ -213,6 +232,18 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     order = {"arm-fixture": 0, "arm-arm": 1, "self": 2}
     pairs.sort(key=lambda p: (order[p.kind], min(p.index_a, p.index_b), max(p.index_a, p.index_b)))
     return tuple(pairs), tuple(allowed)
+
+
+def _proven_gap(model: pin.Model, data: pin.Data, objs: list, gd: pin.GeometryData, a: int,
+               b: int) -> tuple[PairReason, float, str] | None:
+    """``("constant", distance)`` for a pair proven apart at one distance in every configuration, ``("out of reach",
+    gap)`` for one proven apart along the common axis of every joint between them (:mod:`robots.pair_proofs`; the
+    neutral ``data`` and ``gd``), else ``None`` (the pair is checked). A bound is kept only when it is > 0."""
+    if invariant_pair(model, data, objs[a], objs[b]):
+        d = neutral_distance(objs[a].geometry, gd.oMg[a], objs[b].geometry, gd.oMg[b]) - SAFETY
+        return (PairReason.CONSTANT, d, "") if d > 0.0 else None  # in contact: the sampled rule below explains it
+    gap = axial_gap(model, data, objs[a], gd.oMg[a], objs[b], gd.oMg[b])
+    return (PairReason.OUT_OF_REACH, gap, AXIAL_GAP) if gap > 0.0 else None
 
 
 def _declared(cell: "Cell") -> dict[frozenset, str]:
@@ -278,17 +309,13 @@ def _reach_balls(model: pin.Model, data: pin.Data, objs: list, joint: list[int],
     return ball_center, ball_radius
 
 
-def _sampled_reasons(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
-                     seed: int) -> list[tuple[PairReason | None, float, float]]:
+def _sampled_contacts(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
+                      seed: int) -> list[tuple[float, float]]:
     """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations (:mod:`.pair_samples`, cached by
-    content): ``"constant"`` (apart by the same distance, within 1e-9 m, in all of them) or ``None``, the share
-    of them in contact, and the deepest penetration found [m] (0 if none)."""
-    hits, dmin, dmax = sample_pairs(cell, objs, data, checked, seed)
-    out: list[tuple[PairReason | None, float, float]] = []
-    for k, h in enumerate(hits):
-        constant = dmin[k] > 0.0 and dmax[k] - dmin[k] < 1e-9
-        out.append((PairReason.CONSTANT if constant else None, float(h) / ALWAYS_SAMPLES, max(0.0, -float(dmin[k]))))
-    return out
+    content): the share of them in contact and the deepest penetration found [m] (0 if none). Only for the
+    :data:`ALWAYS_SHARE` rule: a sample never skips a pair."""
+    hits, dmin, _ = sample_pairs(cell, objs, data, checked, seed)
+    return [(float(h) / ALWAYS_SAMPLES, max(0.0, -float(dmin[k]))) for k, h in enumerate(hits)]
 
 
 def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
@@ -316,10 +343,11 @@ def _pair(a: int, b: int, objs: list, link: list[str], owner: list[str], is_arm:
 
 
 def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
-    """The ``"out of reach"`` pairs as :class:`CollisionPair` s, in increasing order of their bound, and the bounds [m]."""
+    """The ``"out of reach"`` and ``"constant"`` pairs (:data:`BOUNDED`) as :class:`CollisionPair` s, in increasing order of
+    their bound, and the bounds [m]."""
     objs = list(cell.collision_model.geometryObjects)
     link, owner, is_arm = _owners(cell)
-    reach = sorted((p for p in allowed if p.reason == PairReason.OUT_OF_REACH), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
+    reach = sorted((p for p in allowed if p.reason in BOUNDED), key=lambda p: (p.distance_bound, p.index_a, p.index_b))
     pairs = tuple(_pair(p.index_a, p.index_b, objs, link, owner, is_arm) for p in reach)
     return pairs, np.array([p.distance_bound for p in reach], dtype=float)
 

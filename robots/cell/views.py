@@ -1,7 +1,7 @@
 """The pairs a check looks at, as coal models, and each thread's own collision data.
 
 A cell's *candidate pairs* are its checked pairs (:attr:`Cell.pairs`) followed by its
-``"out of reach"`` pairs in increasing order of their proven distance bound. A check at a
+``"out of reach"`` and ``"constant"`` pairs (:data:`.pairs.BOUNDED`) in increasing order of their proven distance bound. A check at a
 clearance or margin ``c`` looks at a prefix of them (:meth:`Cell.pairs_for`): every checked
 pair and every out-of-reach pair whose bound is at most ``c``. :class:`PairViews` keeps one
 ``pin.GeometryModel`` per prefix length used (built once, shared, never written after) and,
