@@ -18,7 +18,7 @@ from typing import Iterable
 
 import pinocchio as pin
 
-__all__ = ["PairReason", "AllowedPair", "ALWAYS_SHARE", "effective_joint", "by_design", "declared_pairs", "contact_rows"]
+__all__ = ["PairReason", "AllowedPair", "ALWAYS_SHARE", "effective_joint", "by_design", "structural_reason", "declared_pairs", "contact_rows"]
 
 #: Share of seeded random configurations in contact at and above which a pair must be explained
 #: (a reason of :func:`by_design` through turning shapes, or a declaration), else it is an error.
@@ -104,6 +104,17 @@ def by_design(model: pin.Model, a: int, b: int, link: list[str], owner: list[str
                 return PairReason.ADJACENT
     return None
 
+
+
+def structural_reason(model: pin.Model, a: int, b: int, link: list[str], owner: list[str], eff: list[int],
+                      still: list[tuple[int, ...]], declared: dict) -> tuple[PairReason, str] | None:
+    """``(reason, note)`` when the structure (:func:`by_design`) or the user's declaration
+    (``declared``: ``{frozenset((link1, link2)): reason given}``) allows the pair ``(a, b)``, else ``None``."""
+    reason = by_design(model, a, b, link, owner, eff, still)
+    if reason is not None:
+        return reason, ""
+    note = declared.get(frozenset((link[a], link[b])))
+    return None if note is None else (PairReason.DECLARED, note)
 
 def declared_pairs(root: ET.Element, links: Iterable[str], source: str, error: type[Exception],
                    hint: str = "name two of its links") -> tuple[tuple[str, str, str], ...]:

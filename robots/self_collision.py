@@ -43,7 +43,8 @@ import pinocchio as pin
 from .coaxial import still_frames
 from .collision_requests import cold_start
 from .errors import InvalidInput, ModelError, SelfContactError
-from .pair_rules import ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint
+from .pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
+                         structural_reason)
 
 if TYPE_CHECKING:  # pragma: no cover
     from .robot import Robot
@@ -213,12 +214,9 @@ def _classify(robot: "Robot", gm: pin.GeometryModel, seed: int) -> tuple[list[tu
     candidates = []
     for a in range(len(objs)):
         for b in range(a + 1, len(objs)):
-            reason = by_design(model, a, b, link, owner, eff, plain)
-            note = declared.get(frozenset((link[a], link[b]))) if reason is None else None
-            if reason is not None:
-                allow(a, b, reason)
-            elif note is not None:
-                allow(a, b, PairReason.DECLARED, note=note)
+            found = structural_reason(model, a, b, link, owner, eff, plain, declared)
+            if found is not None:
+                allow(a, b, found[0], note=found[1])
             else:
                 candidates.append((a, b))
     data = model.createData()

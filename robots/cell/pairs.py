@@ -87,7 +87,8 @@ import pinocchio as pin
 from ..coaxial import still_frames
 from ..errors import PlacementError
 from ..pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
-from ..pair_rules import ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint
+from ..pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
+                          structural_reason)
 from .pair_samples import SAMPLES, sample_pairs
 from .reach import root_cylinders, tighter_bound
 
@@ -196,12 +197,9 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
     plain = [(e,) for e in eff]
     for a in range(G):
         for b in range(a + 1, G):
-            reason = by_design(model, a, b, link, owner, eff, plain)
-            note = declared.get(frozenset((link[a], link[b]))) if reason is None else None
-            if reason is not None:
-                allow(a, b, reason)
-            elif note is not None:
-                allow(a, b, PairReason.DECLARED, note=note)
+            found = structural_reason(model, a, b, link, owner, eff, plain, declared)
+            if found is not None:
+                allow(a, b, found[0], note=found[1])
             elif gaps[a, b] > 0.0:  # proven apart: kept as such (it comes back at a larger clearance)
                 allow(a, b, PairReason.OUT_OF_REACH, tighter_bound(gaps[a, b], a, b, objs, joint, ball_center,
                                                                    ball_radius, placement, cylinders))
