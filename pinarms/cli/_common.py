@@ -18,7 +18,7 @@ from pinarms import robots
 from pinarms.robots.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
-__all__ = ["cli", "main", "json_option", "skipped_pair_lines", "package_map", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
+__all__ = ["cli", "main", "json_option", "skipped_pair_lines", "package_map", "PinarmsCommand", "name_the_flag", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
            "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
            "joint_scale_at", "new_session", "save_session", "scheduler_option", "quiet_dask"]
 
@@ -35,6 +35,27 @@ def one_line(exc: BaseException) -> str:
 DEBUG_VARIABLE = "PINARMS_TRACEBACK"
 
 
+def name_the_flag(text: str, params: list[click.Parameter]) -> str:
+    """``text`` with its first word, when it is the Python name of one of ``params``' options
+    (``amax must be ...``), replaced by the option's flag (``--amax must be ...``): the library
+    names its parameters, the command line must name the flag that fixes the error."""
+    head, sep, rest = text.partition(" ")
+    for p in params:
+        if isinstance(p, click.Option) and p.name == head and p.opts:
+            return max(p.opts, key=len) + sep + rest
+    return text
+
+
+class PinarmsCommand(click.Command):
+    """A command whose pinarms errors name its flags (:func:`name_the_flag`); one ``Error:`` line."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except PinarmsError as exc:
+            raise click.ClickException(name_the_flag(one_line(exc), self.params)) from None
+
+
 class PinarmsGroup(click.Group):
     """A click group that turns every error into one line ``Error: ...`` (exit status 1).
 
@@ -44,8 +65,10 @@ class PinarmsGroup(click.Group):
     overflow or division warnings) raised by a command that fails are dropped, the ``Error:``
     line says what went wrong; after a command that succeeds each distinct one is a
     ``Warning: ...`` line on stderr. An unknown option that names an existing file says how
-    to give it (``./--c.toml`` or ``-- --c.toml``).
+    to give it (``./--c.toml`` or ``-- --c.toml``). Its commands are :class:`PinarmsCommand`.
     """
+
+    command_class = PinarmsCommand
 
     def invoke(self, ctx: click.Context) -> Any:
         import warnings

@@ -10,13 +10,14 @@ import numpy as np
 from pinarms.robots.errors import InvalidInput
 from pinarms.units import angle_scale, joints_from_si, joints_to_si, length_scale
 
-from ._common import NUMBERS, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session, si_limit
+from ._common import (NUMBERS, PinarmsCommand, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
+                      si_limit)
 
 #: Options that take a pose: X Y Z, optionally followed by ROLL PITCH YAW.
 POSE_OPTIONS = ("--from", "--to", "--via")
 
 
-class _PoseCommand(click.Command):
+class _PoseCommand(PinarmsCommand):
     """A command whose pose options take 3 or 6 numbers (``--from X Y Z [R P Y]``).
 
     Before click parses, the numbers following a pose option are joined into one value

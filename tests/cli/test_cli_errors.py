@@ -179,3 +179,26 @@ def test_a_cell_file_named_with_a_leading_dash_loads_after_double_dash_or_by_pat
         result = runner.invoke(cli, ["cell", "show", "--c.toml"])
         assert result.exit_code == 2
         assert "./--c.toml" in result.stderr and "put -- before it" in result.stderr
+
+
+def test_a_library_error_names_the_flag_not_the_python_parameter():
+    """The library says ``time_limit must be ...``; on the command line that is ``--time-limit``."""
+    from click.testing import CliRunner
+
+    from pinarms.cli import cli
+
+    result = CliRunner().invoke(cli, ["motion", "aubo_crate_guard", "--from", "0.41", "0.10", "0.79", "--to", "0",
+                                      "-0.465", "0.78", "--time-limit", "-1"])
+    assert result.exit_code == 1 and result.stderr.startswith("Error: --time-limit must be a positive number")
+    assert result.stderr.count("\n") == 1
+
+
+def test_name_the_flag_replaces_only_a_leading_option_name():
+    import click
+
+    from pinarms.cli._common import name_the_flag
+
+    params = [click.Option(["--time-limit", "-t"]), click.Option(["--amax"]), click.Argument(["cell"])]
+    assert name_the_flag("time_limit must be positive", params) == "--time-limit must be positive"
+    assert name_the_flag("cell must exist", params) == "cell must exist"  # an argument has no flag
+    assert name_the_flag("the amax is too large", params) == "the amax is too large"
