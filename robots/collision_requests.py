@@ -17,7 +17,7 @@ import warnings
 import coal
 import pinocchio as pin
 
-__all__ = ["cold_start"]
+__all__ = ["cold_start", "pair_probe"]
 
 # ``warnings.catch_warnings`` swaps the process-wide filter list: two threads inside it at once
 # restore each other's filters mid-block (a thread then meets coal's DeprecationWarning under
@@ -43,3 +43,15 @@ def cold_start(gd: pin.GeometryData, *, distance_tolerance: float | None = None)
         for req in gd.distanceRequests:
             req.gjk_tolerance = distance_tolerance
     return gd
+
+
+def pair_probe(objs: list, pairs: list[tuple[int, int]], distance_tolerance: float
+               ) -> tuple[pin.GeometryModel, pin.GeometryData]:
+    """A geometry model of the geometry objects ``objs`` with only the collision ``pairs``
+    (indices into ``objs``), and its data started cold with ``distance_tolerance`` [m]."""
+    probe = pin.GeometryModel()
+    for g in objs:
+        probe.addGeometryObject(g)
+    for a, b in pairs:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    return probe, cold_start(pin.GeometryData(probe), distance_tolerance=distance_tolerance)

@@ -41,7 +41,7 @@ import numpy as np
 import pinocchio as pin
 
 from .coaxial import still_frames
-from .collision_requests import cold_start
+from .collision_requests import cold_start, pair_probe
 from .errors import InvalidInput, ModelError, SelfContactError
 from .pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
                          structural_reason)
@@ -246,20 +246,11 @@ def _declared(robot: "Robot") -> dict[frozenset, str]:
     return {frozenset((a, b)): note for a, b, note in declared_pairs(root, links, source, ModelError)}
 
 
-def _probe(objs: list, pairs: list[tuple[int, int]]) -> tuple[pin.GeometryModel, pin.GeometryData]:
-    probe = pin.GeometryModel()
-    for g in objs:
-        probe.addGeometryObject(g)
-    for a, b in pairs:
-        probe.addCollisionPair(pin.CollisionPair(a, b))
-    return probe, cold_start(pin.GeometryData(probe), distance_tolerance=1e-9)
-
-
 def _contact_share(model: pin.Model, objs: list, pairs: list[tuple[int, int]], q: np.ndarray) -> np.ndarray:
     """``(len(pairs),)``: the share of the configurations ``q`` (Pinocchio's, ``(N, nq)``) where each pair touches."""
     if not pairs:
         return np.zeros(0)
-    probe, gd = _probe(objs, pairs)
+    probe, gd = pair_probe(objs, pairs, 1e-9)
     data = model.createData()
     hits = np.zeros(len(pairs))
     for qp in q:
@@ -273,7 +264,7 @@ def _contact_error(robot: "Robot", model: pin.Model, objs: list, link: list[str]
                    through: list[tuple[int, int, float]], q: np.ndarray) -> SelfContactError:
     """The :class:`SelfContactError` of the geometry pairs ``through`` ``(a, b, share)``, with the deepest
     penetration of each over the configurations ``q``, by pair of links (deepest first)."""
-    probe, gd = _probe(objs, [(a, b) for a, b, _ in through])
+    probe, gd = pair_probe(objs, [(a, b) for a, b, _ in through], 1e-9)
     data = model.createData()
     depth = np.zeros(len(through))
     for qp in q:

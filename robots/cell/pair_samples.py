@@ -30,7 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from .. import robot as _robot
-from ..collision_requests import cold_start
+from ..collision_requests import pair_probe
 from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
 from .mesh_cover import mesh_arrays
 
@@ -56,7 +56,7 @@ def sample_pairs(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[i
     if not checked:
         return np.zeros(0), np.zeros(0), np.zeros(0)
     path = cache_folder("pair_samples") / f"{_key(cell, objs, checked, seed)}.npz"
-    probe = _probe(cell, objs, checked)
+    probe = pair_probe(objs, checked, 1e-12)
     qs = np.atleast_2d(cell.robot.q_to_pinocchio(cell.random_q(SAMPLES, seed=seed)))
     got = read_arrays(path, _NAMES)
     if got is not None and _trusted(got, cell.model, data, probe, qs, len(checked)):
@@ -66,15 +66,6 @@ def sample_pairs(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[i
     if time.perf_counter() - t0 >= MIN_SECONDS:  # a quick sampling is not worth a file (a layout's many cells)
         write_arrays(path, got)
     return got["hits"], got["dmin"], got["dmax"]
-
-
-def _probe(cell: "Cell", objs: list, checked: list[tuple[int, int]]) -> tuple[pin.GeometryModel, pin.GeometryData]:
-    probe = pin.GeometryModel()
-    for g in objs:
-        probe.addGeometryObject(g)
-    for a, b in checked:
-        probe.addCollisionPair(pin.CollisionPair(a, b))
-    return probe, cold_start(pin.GeometryData(probe), distance_tolerance=1e-12)
 
 
 def _at(model: pin.Model, data: pin.Data, probe: tuple, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
