@@ -111,7 +111,23 @@ class CellTooLarge(CellError):
     """A cell file, mesh, or the cell's count of arms, fixtures or geometries is above pinarms' limit."""
 
 
-class PlacementError(CellError):
+class _PairsInContact(Exception):
+    """An error carrying ``pairs``: ``(body_a, body_b, share, depth)`` per pair of links, the share of
+    the sampled configurations in contact and the deepest penetration found [m]."""
+
+    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
+        super().__init__(message)
+        self.pairs = tuple(pairs)
+
+    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
+        return (_rebuild_pairs_error, (type(self), str(self), self.pairs))
+
+
+def _rebuild_pairs_error(cls: type, message: str, pairs: tuple) -> Exception:
+    return cls(message, pairs=pairs)
+
+
+class PlacementError(_PairsInContact, CellError):
     """A fixture or an arm meets a moving link in (almost) every configuration: placed through it.
 
     ``pairs`` holds ``(body_a, body_b, share, depth)`` per pair of links: the share of the
@@ -119,41 +135,19 @@ class PlacementError(CellError):
     or the arm, or declare the contact by name in the cell file (``<disable_collisions>``).
     """
 
-    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
-        super().__init__(message)
-        self.pairs = tuple(pairs)
-
-    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
-        return (_rebuild_placement_error, (str(self), self.pairs))
-
-
-def _rebuild_placement_error(message, pairs):
-    return PlacementError(message, pairs=pairs)
-
 
 class ArmStateError(CellError):
     """A cell arm's named state, hold pose or frozen joint value is outside its joint limits, has the
     wrong number of values, or names a state the arm does not have (the message names the arm and the joint)."""
 
 
-class SelfContactError(ModelError):
+class SelfContactError(_PairsInContact, ModelError):
     """Two links of one arm are in contact in (almost) every configuration, and no proof explains it.
 
     ``pairs`` holds ``(body_a, body_b, share, depth)`` per pair of links: the share of the sampled
     configurations in contact and the deepest penetration found [m]. Fix the collision shapes, or
     declare the contact by name in the URDF (``<disable_collisions link1= link2= reason=/>``).
     """
-
-    def __init__(self, message: str, *, pairs: tuple = ()) -> None:
-        super().__init__(message)
-        self.pairs = tuple(pairs)
-
-    def __reduce__(self):  # keep the pairs when the error crosses a process boundary
-        return (_rebuild_self_contact_error, (str(self), self.pairs))
-
-
-def _rebuild_self_contact_error(message, pairs):
-    return SelfContactError(message, pairs=pairs)
 
 
 class CollisionGeometryError(ModelError):
