@@ -26,7 +26,7 @@ DEMO_STUDIES = "demo-studies"
 #: 2026-11): only their order matters. A group not listed starts after these when it has a test
 #: marked ``slow`` (weight 30), else in collection order at the end.
 GROUP_SECONDS = {
-    "tests/test_packaging.py": 264.0,  # builds the wheel and installs it with Pinocchio etc. in a fresh venv
+    "tests/test_packaging.py": 60.0,  # builds the wheel, installs it beside the namesakes in a fresh venv
     "tests/cli/test_demo.py": 150.0,  # `pinarms demo --quick` end to end
     "tests/cli/test_cli.py": 113.0,  # the first IK call compiles the numba kernel in a clean clone
     DEMO_STUDIES: 110.0,  # the demo's quick studies 000, 001 and 004, built once

@@ -1,12 +1,20 @@
 """Packaging: one import namespace. The wheel installs next to PyPI's own ``robots``, ``optim``,
 ``planning`` and ``viz`` in a fresh virtualenv, and the README's quickstart runs there from
 outside the repository; the editable install maps the repository's folders to ``pinarms.*``.
+
+The fresh virtualenv takes pinarms' dependencies (Pinocchio, coal, numba, ...) from the
+environment running the tests, behind its own site-packages, instead of installing them again
+(minutes): what is checked is the wheel's content and its namespace beside the namesakes. That the
+wheel asks for the same dependencies as ``pyproject.toml`` is checked on its metadata.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import site
+import tomllib
+import zipfile
 import re
 import shutil
 import subprocess
@@ -58,19 +66,40 @@ def _source_copy(dest: Path) -> Path:
     return dest
 
 
+def _requirements(wheel: Path) -> set[str]:
+    """The ``Requires-Dist`` lines of the wheel's metadata without extras markers (its run-time dependencies)."""
+    with zipfile.ZipFile(wheel) as archive:
+        (name,) = [n for n in archive.namelist() if n.endswith(".dist-info/METADATA")]
+        metadata = archive.read(name).decode("utf-8")
+    lines = re.findall(r"^Requires-Dist: (.+)$", metadata, flags=re.MULTILINE)
+    return {line.replace(" ", "") for line in lines if "extra ==" not in line}
+
+
+def _dependencies_behind(env_dir: Path) -> None:
+    """Make the test environment's packages importable in ``env_dir``, after its own site-packages
+    (a ``.pth`` line run by ``site``; the ``.pth`` files there, e.g. Pinocchio's, are processed too)."""
+    (own,) = (env_dir / "lib").glob("python3*/site-packages")
+    folders = [f for f in site.getsitepackages() if Path(f).is_dir()]
+    lines = "".join(f"import site; site.addsitedir({folder!r})\n" for folder in folders)
+    (own / "zz_test_dependencies.pth").write_text(lines, encoding="utf-8")
+
+
 @pytest.mark.slow
 def test_wheel_beside_pypi_namesakes_runs_the_quickstart(tmp_path):
-    """About 3 minutes with a warm pip cache: the fresh virtualenv gets Pinocchio and all."""
+    """About half a minute with a warm pip cache (the dependencies come from the test environment)."""
     dist = tmp_path / "dist"
     source = _source_copy(tmp_path / "source")
     _run([sys.executable, "-m", "pip", "wheel", source, "--no-deps", "-w", dist, "-q"], tmp_path)
     (wheel,) = dist.glob("pinarms-*.whl")
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["dependencies"]
+    assert _requirements(wheel) == {d.replace(" ", "") for d in declared}
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     py = env_dir / "bin" / "python"
     # pinarms first, then the namesakes: pip would silently overwrite a top-level package of the same name
-    _run([py, "-m", "pip", "install", "-q", "--no-compile", wheel], tmp_path)
+    _run([py, "-m", "pip", "install", "-q", "--no-compile", "--no-deps", wheel], tmp_path)
     _run([py, "-m", "pip", "install", "-q", "--no-compile", *NAMESAKES], tmp_path)
+    _dependencies_behind(env_dir)
     work = tmp_path / "outside"
     work.mkdir()
     found = json.loads(_run([py, "-c", PROBE], work).stdout)
