@@ -12,7 +12,10 @@ from .family import family_closures
 from .geometry import LEG_COUNT, DeltaGeometry
 from .kinematics import (BRANCH_COUNT, PRIMARY_BRANCH, branch_signs, elbow_positions, forward_position,
                          inverse_position, inverse_position_branches, virtual_elbows)
+from .jacobian import constraint_matrices, platform_jacobian, platform_jacobian_pinocchio
 from .model import DeltaRobot, MotorLimits
+from .singularities import SingularityReport, singularities
+from .workspace import CylinderDome, WorkspaceSamples, cylinder_dome, reachable, sample_workspace
 from .shipped import DeltaInfo, delta_from_files, delta_info, delta_names, load_delta
 
 __all__ = [
@@ -20,6 +23,8 @@ __all__ = [
     "delta_names", "delta_info", "LoopClosure", "ClosureSet", "MAX_CLOSURES", "MAX_CLOSURES_BYTES", "CLOSURE_TYPES",
     "parse_closures", "read_closures", "closures_to_xml", "write_closures", "constraint_models", "family_closures",
     "forward_position", "inverse_position", "inverse_position_branches", "elbow_positions", "virtual_elbows",
-    "branch_signs", "BRANCH_COUNT", "PRIMARY_BRANCH",
+    "branch_signs", "BRANCH_COUNT", "PRIMARY_BRANCH", "constraint_matrices", "platform_jacobian",
+    "platform_jacobian_pinocchio", "SingularityReport", "singularities", "CylinderDome", "WorkspaceSamples",
+    "cylinder_dome", "reachable", "sample_workspace",
     "ClosuresFileError", "NotADelta", "DeltaUnreachable", "ProjectionFailed", "DeltaInputError",
 ]

@@ -171,32 +171,39 @@ class DeltaRobot:
         return out[0] if single else out
 
     def _newton(self, q_start: np.ndarray, theta: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, float]:
-        """Newton's projection with the motors at ``theta``; returns the configuration and its largest residual."""
+        """Newton's projection with the motors at ``theta``; returns the configuration and its largest residual.
+
+        Each step solves ``J_passive dq = -r`` (Pinocchio's constraint Jacobian and residual at q),
+        halved until the residual norm decreases."""
         q = q_start.copy()
         q[self.motor_q] = theta
-        r = np.concatenate(self._residual_parts(q))
+        cols = self.passive_q
+        r, jac = self._evaluate(q)
         for _ in range(max_iter):
             if np.abs(r).max() <= tol:
                 break
-            q, r = self._newton_step(q, r, self.passive_q)
+            try:
+                step = np.linalg.solve(jac[:, cols], r)    # square for a delta: 9 equations, 9 passive joints
+            except np.linalg.LinAlgError:
+                step = np.linalg.lstsq(jac[:, cols], r, rcond=None)[0]
+            norm = np.linalg.norm(r)
+            for _ in range(30):
+                trial = q.copy()
+                trial[cols] -= step
+                r_trial, jac_trial = self._evaluate(trial)
+                if np.linalg.norm(r_trial) < norm:
+                    break
+                step *= 0.5
+            q, r, jac = trial, r_trial, jac_trial
         return q, float(np.abs(r).max())
 
-    def _newton_step(self, q: np.ndarray, r: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """One Gauss-Newton step on the passive columns, halved until the residual decreases."""
-        jac = self.constraint_jacobian(q)[:, cols]
-        try:
-            step = np.linalg.solve(jac, r)     # square for a delta: 9 closure equations, 9 passive joints
-        except np.linalg.LinAlgError:
-            step = np.linalg.lstsq(jac, r, rcond=None)[0]
-        norm = np.linalg.norm(r)
-        for _ in range(30):
-            trial = q.copy()
-            trial[cols] -= step
-            r_trial = np.concatenate(self._residual_parts(trial))
-            if np.linalg.norm(r_trial) < norm:
-                return trial, r_trial
-            step *= 0.5
-        return trial, r_trial
+    def _evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Closure residual (frame1 - frame2 in frame1's axes, stacked) and constraint Jacobian at ``q``."""
+        pin.computeJointJacobians(self.model, self._data, q)       # forward kinematics included
+        for cm, cd in zip(self.constraint_models, self._cdata):
+            cm.calc(self.model, self._data, cd)
+        r = np.concatenate([-cd.c1Mc2.translation for cd in self._cdata])
+        return r, pin.getConstraintsJacobian(self.model, self._data, self.constraint_models, self._cdata)
 
     def home(self) -> np.ndarray:
         """Configuration at motor angles midway between their limits (closed form)."""
