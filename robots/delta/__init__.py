@@ -9,12 +9,14 @@ from .closures import (CLOSURE_TYPES, MAX_CLOSURES, MAX_CLOSURES_BYTES, ClosureS
                        constraint_models, parse_closures, read_closures, write_closures)
 from .errors import ClosuresFileError, DeltaInputError, DeltaUnreachable, NotADelta, ProjectionFailed
 from .family import family_closures
+from .dynamics import ClosedChainState, check_with_constraint_dynamics, closed_chain_state, motor_torques
 from .geometry import LEG_COUNT, DeltaGeometry
 from .kinematics import (BRANCH_COUNT, PRIMARY_BRANCH, branch_signs, elbow_positions, forward_position,
                          inverse_position, inverse_position_branches, virtual_elbows)
 from .jacobian import constraint_matrices, platform_jacobian, platform_jacobian_pinocchio
 from .model import DeltaRobot, MotorLimits
 from .singularities import SingularityReport, singularities
+from .virtual_work import body_frames, virtual_work_torques
 from .workspace import CylinderDome, WorkspaceSamples, cylinder_dome, reachable, sample_workspace
 from .shipped import DeltaInfo, delta_from_files, delta_info, delta_names, load_delta
 
@@ -25,6 +27,7 @@ __all__ = [
     "forward_position", "inverse_position", "inverse_position_branches", "elbow_positions", "virtual_elbows",
     "branch_signs", "BRANCH_COUNT", "PRIMARY_BRANCH", "constraint_matrices", "platform_jacobian",
     "platform_jacobian_pinocchio", "SingularityReport", "singularities", "CylinderDome", "WorkspaceSamples",
-    "cylinder_dome", "reachable", "sample_workspace",
+    "cylinder_dome", "reachable", "sample_workspace", "ClosedChainState", "closed_chain_state", "motor_torques",
+    "check_with_constraint_dynamics", "body_frames", "virtual_work_torques",
     "ClosuresFileError", "NotADelta", "DeltaUnreachable", "ProjectionFailed", "DeltaInputError",
 ]
