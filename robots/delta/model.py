@@ -46,8 +46,11 @@ class DeltaRobot:
     """
 
     def __init__(self, model: pin.Model, closures: ClosureSet, *, name: str, acceleration: float,
-                 source: str = "", description: str = "") -> None:
+                 source: str = "", description: str = "", urdf_text: str = "") -> None:
         self.model = model
+        self.urdf_text = urdf_text   # the open tree's URDF (exports)
+        #: point masses added by :meth:`with_payload`: ``(mass [kg], offset from the tcp [m])``
+        self.payloads: tuple[tuple[float, tuple[float, float, float]], ...] = ()
         self.name = name
         self.source = source
         self.description = description
@@ -227,5 +230,7 @@ class DeltaRobot:
         frame = model.frames[self.tcp_frame]
         com = frame.placement.act(np.asarray(offset, dtype=float))
         model.inertias[frame.parentJoint] += pin.Inertia(float(mass), com, np.zeros((3, 3)))
-        return DeltaRobot(model, self.closures, name=self.name, acceleration=self.limits.acceleration,
-                          source=self.source, description=self.description)
+        loaded = DeltaRobot(model, self.closures, name=self.name, acceleration=self.limits.acceleration,
+                            source=self.source, description=self.description, urdf_text=self.urdf_text)
+        loaded.payloads = (*self.payloads, (float(mass), tuple(float(v) for v in np.asarray(offset, dtype=float))))
+        return loaded

@@ -118,4 +118,4 @@ def delta_from_files(urdf: str | os.PathLike, closures: str | os.PathLike, *, ac
     except Exception as exc:  # Pinocchio raises RuntimeError/ValueError with its own message
         raise ModelError(f"Pinocchio cannot build a model from {urdf}: {exc}") from exc
     return DeltaRobot(model, closure_set, name=root.get("name"), acceleration=float(acceleration),
-                      source=str(closures), description=description)
+                      source=str(closures), description=description, urdf_text=text)
