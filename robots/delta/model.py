@@ -161,11 +161,15 @@ class DeltaRobot:
         out = np.empty((len(th), self.model.nq))
         for n, tn in enumerate(th):
             q0 = out[n - 1] if chain and n else start[min(n, len(start) - 1)]
-            q, res = self._newton(q0, tn, tol, max_iter)
+            if chain and n:   # predictor: the passive joints' first-order change with the motors' (J_c dq = 0)
+                q0 = q0.copy()
+                step = jac[:, self.motor_q] @ (tn - q0[self.motor_q])
+                q0[self.passive_q] -= np.linalg.solve(jac[:, self.passive_q], step)
+            q, res, jac = self._newton(q0, tn, tol, max_iter)
             if res > tol:  # far from the start: walk the motors there in steps (a homotopy), projecting at each
                 q = q0.copy()
                 for frac in np.linspace(0.125, 1.0, 8):
-                    q, res = self._newton(q, (1.0 - frac) * q0[self.motor_q] + frac * tn, tol, max_iter)
+                    q, res, jac = self._newton(q, (1.0 - frac) * q0[self.motor_q] + frac * tn, tol, max_iter)
             if res > tol:
                 raise ProjectionFailed(f"{self.name}: projection of row {n} (theta = {tn.tolist()} rad) did not "
                                        f"reach {tol} m in {max_iter} iterations (residual {res:.3g} m): a singular "
@@ -173,8 +177,10 @@ class DeltaRobot:
             out[n] = q
         return out[0] if single else out
 
-    def _newton(self, q_start: np.ndarray, theta: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, float]:
-        """Newton's projection with the motors at ``theta``; returns the configuration and its largest residual.
+    def _newton(self, q_start: np.ndarray, theta: np.ndarray, tol: float, max_iter: int
+                ) -> tuple[np.ndarray, float, np.ndarray]:
+        """Newton's projection with the motors at ``theta``; returns the configuration, its largest residual
+        and the constraint Jacobian there.
 
         Each step solves ``J_passive dq = -r`` (Pinocchio's constraint Jacobian and residual at q),
         halved until the residual norm decreases."""
@@ -198,7 +204,7 @@ class DeltaRobot:
                     break
                 step *= 0.5
             q, r, jac = trial, r_trial, jac_trial
-        return q, float(np.abs(r).max())
+        return q, float(np.abs(r).max()), jac
 
     def _evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Closure residual (frame1 - frame2 in frame1's axes, stacked) and constraint Jacobian at ``q``."""
