@@ -108,3 +108,10 @@ def test_a_tree_that_is_not_the_family_is_not_a_delta(tmp_path):
     closures = write_closures(tmp_path / "arm.closures.xml", ClosureSet("arm", (LoopClosure("c", "a", "b"),)))
     with pytest.raises(NotADelta, match="leg1"):
         delta_from_files(urdf, closures, acceleration=100.0)
+
+
+def test_build_check_reports_fresh_files(capsys):
+    from pinarms.robots.delta.build import main
+
+    assert main(["--check"]) == 0
+    assert capsys.readouterr().out == ""
