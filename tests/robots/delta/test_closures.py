@@ -115,3 +115,16 @@ def test_build_check_reports_fresh_files(capsys):
 
     assert main(["--check"]) == 0
     assert capsys.readouterr().out == ""
+
+
+def test_unknown_delta_and_bad_payload_are_named_errors(delta):
+    from pinarms.errors import RobotNotFound
+    from pinarms.robots.delta import DeltaInputError, load_delta
+
+    with pytest.raises(RobotNotFound, match="shipped deltas: delta_flexpicker"):
+        load_delta("flexpicker")
+    with pytest.raises(DeltaInputError, match="payload mass"):
+        delta.with_payload(-1.0)
+    with pytest.raises(DeltaInputError, match="acceleration"):
+        delta_from_files(delta_info("delta_flexpicker").urdf_path, delta_info("delta_flexpicker").closures_path,
+                         acceleration=0.0)

@@ -81,3 +81,22 @@ def test_an_unreachable_sample_is_named(delta):
     zero = np.zeros((1, 3))
     with pytest.raises(DeltaUnreachable, match="out of the delta's reach"):
         closed_chain_state(delta, [[0.0, 0.0, -3.0]], zero, zero)
+
+
+def test_pinocchio_constraint_dynamics_derivatives_invert_the_closed_chain_torques(loaded):
+    """At rest, the platform acceleration per motor torque (Pinocchio's computeConstraintDynamicsDerivatives)
+    is the inverse of the torque per platform acceleration that motor_torques gives (its linear part)."""
+    import pinocchio as pin
+
+    p, zero = np.array([[0.1, -0.1, -1.1]]), np.zeros((1, 3))
+    gravity, _ = motor_torques(loaded, closed_chain_state(loaded, p, zero, zero))
+    per_acc = np.stack([motor_torques(loaded, closed_chain_state(loaded, p, zero, np.eye(3)[k][None]))[0][0]
+                        - gravity[0] for k in range(3)], axis=1)            # d tau / d p_ddot, (3, 3)
+    model, data = loaded.model, loaded.model.createData()
+    cdatas = [cm.createData() for cm in loaded.constraint_models]
+    pin.initConstraintDynamics(model, data, loaded.constraint_models, cdatas)
+    q = closed_chain_state(loaded, p, zero, zero).q[0]
+    pin.constraintDynamics(model, data, q, np.zeros(model.nv), np.zeros(model.nv), loaded.constraint_models, cdatas)
+    pin.computeConstraintDynamicsDerivatives(model, data, loaded.constraint_models, cdatas)
+    acc_per_tau = data.ddq_dtau[np.ix_(loaded.platform_q, loaded.motor_q)]
+    assert np.abs(acc_per_tau @ per_acc - np.eye(3)).max() <= 1e-9
