@@ -15,6 +15,7 @@ from .kinematics import (BRANCH_COUNT, PRIMARY_BRANCH, branch_signs, elbow_posit
                          inverse_position, inverse_position_branches, virtual_elbows)
 from .jacobian import constraint_matrices, platform_jacobian, platform_jacobian_pinocchio
 from .model import DeltaRobot, MotorLimits
+from .rods import rod_endpoints
 from .singularities import SingularityReport, singularities
 from .virtual_work import body_frames, virtual_work_torques
 from .workspace import CylinderDome, WorkspaceSamples, cylinder_dome, reachable, sample_workspace
@@ -28,6 +29,6 @@ __all__ = [
     "branch_signs", "BRANCH_COUNT", "PRIMARY_BRANCH", "constraint_matrices", "platform_jacobian",
     "platform_jacobian_pinocchio", "SingularityReport", "singularities", "CylinderDome", "WorkspaceSamples",
     "cylinder_dome", "reachable", "sample_workspace", "ClosedChainState", "closed_chain_state", "motor_torques",
-    "check_with_constraint_dynamics", "body_frames", "virtual_work_torques",
+    "check_with_constraint_dynamics", "body_frames", "virtual_work_torques", "rod_endpoints",
     "ClosuresFileError", "NotADelta", "DeltaUnreachable", "ProjectionFailed", "DeltaInputError",
 ]

@@ -75,3 +75,17 @@ def test_out_of_reach_and_bad_input_are_named_errors(delta):
         forward_position(g, [0.1, 0.2])
     with pytest.raises(DeltaInputError, match="not finite"):
         inverse_position(g, [0.0, np.nan, -1.0])
+
+
+def test_the_six_rods_are_parallelograms_of_the_forearm_length(delta):
+    from pinarms.robots.delta import rod_endpoints
+
+    g = delta.geometry
+    q = delta.configuration(np.random.default_rng(4).uniform(delta.limits.lower, delta.limits.upper, size=(50, 3)))
+    ends = rod_endpoints(delta, q)                                       # (N, leg, rod, end, xyz)
+    rods = ends[:, :, :, 1] - ends[:, :, :, 0]
+    assert np.abs(np.linalg.norm(rods, axis=-1) - g.forearm).max() < 1e-12
+    assert np.abs(rods[:, :, 0] - rods[:, :, 1]).max() < 1e-12          # the two rods of a leg are parallel
+    spacing = np.linalg.norm(ends[:, :, 0, 0] - ends[:, :, 1, 0], axis=-1)
+    assert np.abs(spacing - g.rod_spacing).max() < 1e-12
+    assert rod_endpoints(delta, q[0]).shape == (3, 2, 2, 3)
