@@ -43,6 +43,15 @@ class DeltaRobot:
     """A delta: Pinocchio model of the open tree + its loop-closure constraint models + the closed form.
 
     Build it with :func:`~.shipped.load_delta` or :func:`~.shipped.delta_from_files`.
+
+    Attributes:
+        model: the tree (``pin.Model``); ``constraint_models``: one ``RigidConstraintModel`` per closure.
+        closures: the :class:`~.closures.ClosureSet` read from the closures file.
+        geometry: :class:`~.geometry.DeltaGeometry`; ``limits``: :class:`MotorLimits`.
+        motor_q, fold_q, swing_q, platform_q: indices in ``q`` (and ``v``: nq = nv) of the three
+            motors, the elbows' fold and swing angles, the platform's x, y, z; ``passive_q`` all
+            the passive ones sorted; ``tool_q`` the fourth axis or None.
+        urdf_text: the tree's URDF (exports); ``payloads``: the masses added by :meth:`with_payload`.
     """
 
     def __init__(self, model: pin.Model, closures: ClosureSet, *, name: str, acceleration: float,

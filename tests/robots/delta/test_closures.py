@@ -128,3 +128,14 @@ def test_unknown_delta_and_bad_payload_are_named_errors(delta):
     with pytest.raises(DeltaInputError, match="acceleration"):
         delta_from_files(delta_info("delta_flexpicker").urdf_path, delta_info("delta_flexpicker").closures_path,
                          acceleration=0.0)
+
+
+def test_a_urdf_with_a_doctype_is_refused_before_pinocchio(tmp_path):
+    entry = delta_info("delta_flexpicker")
+    text = entry.urdf_path.read_text(encoding="utf-8")
+    hostile = tmp_path / "delta_flexpicker.urdf"
+    hostile.write_text(text.replace("<robot ", '<!DOCTYPE robot [<!ENTITY x "y">]>\n<robot ', 1), encoding="utf-8")
+    from pinarms.errors import ModelError
+
+    with pytest.raises(ModelError, match="DOCTYPE"):
+        delta_from_files(hostile, entry.closures_path, acceleration=100.0)
