@@ -40,7 +40,7 @@ from pinarms.studies.study import Study
 from .report import Row, format_table, markdown_table
 
 __all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004",
-           "study_cell", "study_line"]
+           "study_cell", "study_line", "study_delta"]
 
 
 @dataclass
@@ -75,6 +75,13 @@ def study_line(quick: bool = False) -> Study:
     return demo_study(quick)
 
 
+def study_delta(quick: bool = False) -> Study:
+    """The delta study (:mod:`pinarms.studies.delta_cycle`): the standard pick cycle vs ABB's datasheet."""
+    from pinarms.studies.delta_cycle import study_delta as _study
+
+    return _study(quick)
+
+
 def study_handoff(quick: bool = False) -> Study:
     """The hand-off study (:mod:`pinarms.studies.handoff`): MuJoCo re-check, SRDF, controller files."""
     from pinarms.studies.handoff import demo_study
@@ -90,6 +97,7 @@ STUDIES: dict[str, Callable[[bool], Study]] = {
     "cell": study_cell,
     "line": study_line,
     "handoff": study_handoff,
+    "delta": study_delta,
 }
 
 

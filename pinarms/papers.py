@@ -26,7 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ScaraPaper", "AuboPaper", "GantryPaper", "KojiPaper", "SEED000", "SEED001", "SEED002", "SEED004"]
+__all__ = ["ScaraPaper", "AuboPaper", "GantryPaper", "KojiPaper", "SEED000", "SEED001", "SEED002", "SEED004",
+           "DeltaDatasheet", "IRB360_1600"]
 
 _DEG = math.pi / 180.0
 _MM = 1e-3
@@ -312,3 +313,33 @@ SEED000 = ScaraPaper()
 SEED001 = AuboPaper()
 SEED002 = GantryPaper()
 SEED004 = KojiPaper()
+
+
+@dataclass(frozen=True)
+class DeltaDatasheet:
+    """A delta's published standard-cycle rates (not a paper: a manufacturer's product specification).
+
+    ABB IRB 360 product specification, document 3HAC079010-001 ("Cycle 1 is a 25 - 305 - 25
+    movement, with 90 degrees rotation of axis 4"; 35 ms of air activation at the pick and 35 ms
+    at the place included), as quoted in public notes on arm selection: the IRB 360-6/1600 runs
+    140, 125 and 100 picks/min at 1.0, 3.0 and 6.0 kg. Its working range, Ø1600 mm, is the
+    cylinder pinarms measures on the geometry Williams (2015) prints for the FlexPicker
+    (docs/delta.md).
+    """
+
+    model: str = "ABB IRB 360-6/1600"
+    payloads_kg: tuple[float, ...] = (1.0, 3.0, 6.0)
+    picks_per_min: tuple[float, ...] = (140.0, 125.0, 100.0)
+    air_activation_s: float = 0.035      # at the pick, and again at the place, inside the cycle time
+    axis4_rotation_deg: float = 90.0
+    up_mm: float = 25.0
+    across_mm: float = 305.0
+    down_mm: float = 25.0
+
+    @property
+    def cycle_s(self) -> tuple[float, ...]:
+        """Seconds per cycle (one pick and one place: there and back), 60 / rate."""
+        return tuple(60.0 / r for r in self.picks_per_min)
+
+
+IRB360_1600 = DeltaDatasheet()

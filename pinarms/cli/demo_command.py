@@ -19,7 +19,7 @@ from ._common import (
               help="Smaller samples and GA runs: 3 to 5 minutes on two cores (measured 186 s and, on a loaded machine, "
                    "290 s), once `pinarms warm` has compiled the kernels (make install does; else minutes more, once).")
 @click.option("--out", "out_dir", default="demo-output", show_default=True, type=click.Path(file_okay=False))
-@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell", "line", "handoff"]), help="Run only these studies.")
+@click.option("--only", multiple=True, type=click.Choice(["000", "001", "002", "004", "cell", "line", "handoff", "delta"]), help="Run only these studies.")
 @click.option("--readme", "readme", default=None, type=click.Path(exists=True, dir_okay=False),
               help="Also write the table into this markdown file, between its table markers (full run only).")
 @json_option

@@ -1,0 +1,17 @@
+"""The standard pick cycle (25 mm up, 305 mm across, 25 mm down and back), time-optimal, for any arm.
+
+- :mod:`.path`: the gate (:class:`StandardCycle`, rounded corners) and its points;
+- :mod:`.timing`: rows of speed, acceleration and torque limits along a joint path, and the
+  project's TOPP-RA on them (:func:`time_rows`, :class:`GateTiming`);
+- :mod:`.delta_cycle`: a delta robot (closed form + closed-chain torques);
+- :mod:`.serial_cycle`: a serial arm (its IK and RNEA).
+"""
+
+from .delta_cycle import delta_gate_rows, delta_standard_cycle
+from .path import StandardCycle, gate_breaks, gate_length, gate_points
+from .serial_cycle import serial_gate_rows, serial_standard_cycle
+from .timing import GateTiming, JointPathRows, limit_usage, time_rows
+
+__all__ = ["StandardCycle", "gate_length", "gate_points", "gate_breaks", "GateTiming", "JointPathRows",
+           "time_rows", "limit_usage", "delta_gate_rows", "delta_standard_cycle",
+           "serial_gate_rows", "serial_standard_cycle"]
