@@ -27,8 +27,8 @@ from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, Infeasib
                                   StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.timing.exact import ExactSolution, solve_exact
-from pinarms.optim.layout.search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
-                                         search_layout)
+from pinarms.optim.layout.search import (CandidateFailure, LayoutRequest, LayoutSearch, LayoutStatus, Refinement,
+                                         grid_candidates, random_candidates, search_layout)
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.ga.problem import KINDS, TimingProblem
@@ -36,7 +36,7 @@ from pinarms.optim.ga.settings import GASettings
 from pinarms.optim.timing.reference import (MissingReference, double_s_limit, path_velocity_limit,
                                      ruckig_limit, toppra_limit, toppra_path_duration)
 from pinarms.optim.timing.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
-from pinarms.optim.timing.segments import TimingResult, minimize_time
+from pinarms.optim.timing.segments import TimingRequest, TimingResult, TimingStatus, minimize_time
 
 __all__ = [
     "run_ga",
@@ -48,6 +48,8 @@ __all__ = [
     "KINDS",
     "TimingResult",
     "minimize_time",
+    "TimingRequest",
+    "TimingStatus",
     "minimize_time_jerk",
     "PickPlace",
     "CycleResult",
@@ -58,6 +60,9 @@ __all__ = [
     "CellSettings",
     "plan_cycle",
     "search_layout",
+    "LayoutRequest",
+    "LayoutStatus",
+    "CandidateFailure",
     "LayoutSearch",
     "Refinement",
     "grid_candidates",

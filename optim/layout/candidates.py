@@ -12,13 +12,33 @@ import numpy as np
 
 from pinarms.optim.caps import MAX_AXIS_VALUES, MAX_PLACEMENTS, count_setting
 from pinarms.optim.errors import SettingOutOfRange
+from pinarms.optim.status import Status
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame"]
+__all__ = ["CandidateFailure", "FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world",
+           "points_in_base_frame"]
 
-#: Why a candidate fails, in the order they are checked (``"outranked"``: not planned, its cycle
-#: cannot beat the best ones; ``search_layout(..., bound=True)``).
-FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing", "outranked")
+
+
+class CandidateFailure(Status):
+    """Why one candidate placement of a layout search fails (the value is the word printed)."""
+
+    #: a pick, place or lift point is beyond the arm's reach from the placement
+    UNREACHABLE = "unreachable"
+    #: a point is within reach but needs a joint outside its limits
+    JOINT_LIMIT = "joint limit"
+    #: a pick or place is closer than ``min_margin`` to the edge of the workspace
+    BOUNDARY = "boundary"
+    #: no cycle keeps the clearance from the cell's fixtures and other arms
+    COLLISION = "collision"
+    #: no timing meets the limits
+    TIMING = "timing"
+    #: not planned: its proven lower bound cannot beat the best ones (``LayoutRequest(bound=True)``)
+    OUTRANKED = "outranked"
+
+
+#: The failures in the order they are checked.
+FAILURES = tuple(CandidateFailure)
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
 _PPM_RTOL = 1e-9

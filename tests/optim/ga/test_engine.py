@@ -90,9 +90,9 @@ def test_feasible_mean_never_dips_below_the_best_where_the_population_mean_does(
     from pinarms.scenarios import gantry_path_motor_rad
 
     v, a, j = SEED002.limits_motor
-    r = optim.minimize_time(gantry_path_motor_rad(), "quintic-bspline", v, a, j, method="ga", seed=0,
+    r = optim.minimize_time(optim.TimingRequest(gantry_path_motor_rad(), "quintic-bspline", v, a, j, method="ga", seed=0,
                             settings=GASettings.seed002(), max_generations=150,
-                            initial=SEED002.initial_durations_s[None, :], bounds=BOUNDS_002_S)
+                            initial=SEED002.initial_durations_s[None, :], bounds=BOUNDS_002_S))
     h = r.history
     dips = np.flatnonzero(h.mean < h.best)
     # measured: generations 107-110, 0-2 % of the population feasible
