@@ -22,6 +22,7 @@ from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRe
                                   plan_cycle)
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
+from pinarms.optim.ga.request import GARequest, GAStop
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
                                   StartInCollision)
@@ -40,6 +41,8 @@ from pinarms.optim.timing.segments import TimingRequest, TimingResult, TimingSta
 
 __all__ = [
     "run_ga",
+    "GARequest",
+    "GAStop",
     "GASettings",
     "GAResult",
     "GAHistory",

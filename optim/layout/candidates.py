@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.optim.types import AxisRange, Placement
+
 from pinarms.optim.caps import MAX_AXIS_VALUES, MAX_PLACEMENTS, count_setting
 from pinarms.optim.errors import SettingOutOfRange
 from pinarms.optim.status import Status
@@ -66,7 +68,7 @@ def _axis(value: Any, name: str) -> np.ndarray:
     return lo + step * np.arange(count)
 
 
-def grid_candidates(x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0) -> np.ndarray:
+def grid_candidates(x: AxisRange, y: AxisRange, z: AxisRange = 0.0, yaw: AxisRange = 0.0) -> np.ndarray:
     """Base placements ``(M, 4)`` = every combination of the coordinates' values.
 
     Each coordinate is a number or ``(lo, hi, step)`` [m, yaw in rad]; rows are ordered with
@@ -81,7 +83,8 @@ def grid_candidates(x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0) -> np.ndarray:
     return np.column_stack([m.reshape(-1) for m in mesh])
 
 
-def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed: int = 0) -> np.ndarray:
+def random_candidates(n: int, x: AxisRange, y: AxisRange, z: AxisRange = 0.0, yaw: AxisRange = 0.0,
+                      seed: int = 0) -> np.ndarray:
     """``n`` base placements ``(n, 4)`` uniform within bounds, from ``numpy.random.default_rng(seed)``.
 
     Each coordinate is a number (fixed) or ``(lo, hi)`` [m, yaw in rad]; the draws are made
@@ -110,7 +113,7 @@ def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed
     return out
 
 
-def base_to_world(placement: Any) -> np.ndarray:
+def base_to_world(placement: Placement) -> np.ndarray:
     """``T_base_to_world (4, 4)`` of a placement ``(x, y, z, yaw)`` (or ``(N, 4, 4)`` for ``(N, 4)``)."""
     P = np.asarray(placement, dtype=float)
     single = P.ndim == 1

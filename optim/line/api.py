@@ -16,9 +16,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
+
+from pinarms.optim.types import Scheduler
 
 from pinarms.optim.caps import count_setting
 from pinarms.optim.line.belt import Belt, _number
@@ -208,7 +210,7 @@ def _shape_key(st: Station, belt: Belt) -> tuple:
             tuple(lim["vmax"]), tuple(lim["amax"]), lim["torque"])
 
 
-def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None,
+def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | None = None,
                approach_maps: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
     """Task maps of every station, one per item type, built once per distinct station shape.
     ``approach_maps``: ``{station name: (box TaskMap, ...)}`` whose approach times the tray maps
@@ -277,7 +279,7 @@ def _run_seed(task: dict) -> SimResult:
                     width=spec.belt.width, guard=guard)
 
 
-def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None) -> LineResult:
+def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Scheduler = None) -> LineResult:
     """Simulate the line on every seed and summarise (module doc)."""
     from pinarms.execution import map_chunks
 
@@ -317,8 +319,9 @@ class LineCurve:
     arrivals_per_minute: np.ndarray
 
 
-def line_curve(make_spec: Any, parameter: str, values: Sequence[float], maps: Any, *,
-               scheduler: Any = None) -> LineCurve:
+def line_curve(make_spec: Callable[[float], LineSpec], parameter: str, values: Sequence[float],
+               maps: Callable[[LineSpec], dict], *,
+               scheduler: Scheduler = None) -> LineCurve:
     """Run ``make_spec(value)`` (a :class:`LineSpec`) for each value; ``maps(spec)`` gives its
     task maps (e.g. :func:`pinarms.studies.line.maps_for`, or :func:`build_maps`)."""
     if parameter not in ("rate", "speed", "arms"):

@@ -25,6 +25,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from pinarms.optim.types import Scheduler
+
 from pinarms.optim.caps import MAX_GENERATIONS, MAX_POPULATION, count_setting, number_setting
 from pinarms.optim.line.items import ItemType, poisson_items
 from pinarms.optim.line.rules import Rule
@@ -162,7 +164,7 @@ def _sim_task(task: dict) -> list[tuple[float, float]]:
     return out
 
 
-def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple], *, scheduler: Any = None) -> np.ndarray:
+def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple], *, scheduler: Scheduler = None) -> np.ndarray:
     """Mean (miss rate, picks/min) over the seeds of each ``(positions, speed[, sides])``: (len, 2)."""
     from pinarms.execution import map_chunks
 
@@ -174,7 +176,7 @@ def evaluate_layouts(problem: SizingProblem, layouts: Sequence[tuple], *, schedu
     return out.mean(axis=1)
 
 
-def size_line(problem: SizingProblem, *, scheduler: Any = None,
+def size_line(problem: SizingProblem, *, scheduler: Scheduler = None,
               progress: Callable[[str], None] | None = None) -> SizingResult:
     """The fewest arms, their places and the belt speed for ``problem`` (module doc).
 
@@ -182,6 +184,7 @@ def size_line(problem: SizingProblem, *, scheduler: Any = None,
     result anywhere); ``progress``: called with one line per number of arms tried.
     """
     from pinarms.optim.ga.engine import run_ga
+    from pinarms.optim.ga.request import GARequest
     from pinarms.optim.ga.settings import GASettings
 
     n_min = problem.n_min
@@ -207,8 +210,8 @@ def size_line(problem: SizingProblem, *, scheduler: Any = None,
             return res[:, 0] + 1e-4 * span + 1e-5 * np.array([lay[1] for lay in layouts])
 
         settings = GASettings(population=problem.population, elitism=2)
-        ga = run_ga(objective, bounds, settings, seed=problem.seed + n, max_generations=problem.generations,
-                    stall_generations=problem.generations)
+        ga = run_ga(GARequest(objective, bounds, settings, seed=problem.seed + n, max_generations=problem.generations,
+                              stall_generations=problem.generations))
         pos, speed, sides = _layout(problem, ga.x)
         miss, ppm = evaluate_layouts(problem, [(pos, speed, sides)], scheduler=scheduler)[0]
         tried[n] = float(miss)

@@ -19,7 +19,7 @@ import numpy as np
 
 from pinarms.optim.caps import MAX_GENERATIONS
 from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
-from pinarms.optim.ga.engine import random_generator
+from pinarms.optim.ga.request import checked_initial, random_generator
 from pinarms.optim.ga.problem import TimingProblem
 from pinarms.optim.ga.settings import GASettings
 from pinarms.optim.status import Status
@@ -142,3 +142,5 @@ class TimingRequest:
         elif torque is not None:
             raise InvalidSettings("give torque limits either in the prebuilt problem (TimingProblem(torque=...)) "
                                   "or in the request (torque_limits=), not both")
+        if self.initial is not None:  # the GA's initial individuals, checked against the durations' bounds
+            checked_initial(self.initial, self.problem.bounds)

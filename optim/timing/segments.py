@@ -19,6 +19,7 @@ import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.ga.engine import GAHistory, GAProgress, run_ga
+from pinarms.optim.ga.request import GARequest
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
 from pinarms.optim.ga.settings import GASettings
 from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
@@ -185,11 +186,11 @@ def _ga_timing(problem: TimingProblem, seed: int, settings: GASettings | None, b
                polish: bool) -> TimingResult:
     """``method="ga"``: the GA's best, rescaled onto the limits and polished if asked, verified."""
     settings = GASettings.seed002() if settings is None else settings
-    result = run_ga(lambda h: h.sum(axis=1), problem.bounds, settings,
-                    constraints=problem.constraints, seed=seed,
-                    max_generations=max_generations, stall_generations=stall_generations,
-                    time_limit=time_limit, callback=callback,
-                    initial=_scaling_law_starts(problem, seed) if initial is None else initial)
+    request = GARequest(lambda h: h.sum(axis=1), problem.bounds, settings, constraints=problem.constraints,
+                        seed=seed, max_generations=max_generations, stall_generations=stall_generations,
+                        time_limit=time_limit,
+                        initial=_scaling_law_starts(problem, seed) if initial is None else initial)
+    result = run_ga(request, callback=callback)
     if not result.feasible:
         raise _infeasible(problem, "ga")
     h = rescale_to_limits(problem, result.x) if rescale else result.x

@@ -28,12 +28,16 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
 from scipy.optimize import minimize
 
-from pinarms.optim.ga.engine import GAHistory, random_generator, run_ga
+from pinarms.optim.ga.engine import GAHistory, run_ga
+from pinarms.optim.ga.request import GARequest, random_generator
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
 from pinarms.optim.timing.exact import solve_exact
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
@@ -86,7 +90,7 @@ def _gauss_legendre(width: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (nodes + 1.0), 0.5 * weights  # on [0, 1]
 
 
-def jerk_integral(trajectory: Any) -> float:
+def jerk_integral(trajectory: Trajectory) -> float:
     """Sum over joints of the exact integral of jerk^2 over the trajectory."""
     return float(_jerk_integrals(np.asarray(trajectory.coefficients, dtype=float)[None],
                                  np.diff(np.asarray(trajectory.knot_times, dtype=float))[None])[0])
@@ -266,9 +270,8 @@ def _ga_time_jerk(problem: TimingProblem, mode: str, cap: float | None, start: n
         objective = lambda H: k_time * H.sum(axis=1) + k_jerk * jerk_integral_batch(problem, H)
         constraints = problem.constraints
         initial = None
-    res = run_ga(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
-                 seed=seed, max_generations=max_generations, time_limit=time_limit,
-                 initial=initial)
+    res = run_ga(GARequest(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
+                           seed=seed, max_generations=max_generations, time_limit=time_limit, initial=initial))
     if not res.feasible:
         raise InfeasibleProblem("the GA found no timing within the bounds that meets the "
                                 f"limits{' and the time cap' if cap else ''}; widen the "

@@ -459,7 +459,8 @@ def test_ga_and_exact_settings(data):
                              max_generations=arg("max_generations", st.integers(1, 5), _odd_setting),
                              stall_generations=arg("stall", st.one_of(st.none(), st.integers(1, 5)), _odd_setting))
     if err is None:
-        result, err = outcome(optim.run_ga, lambda x: np.sum(x * x, axis=1), [(-1.0, 1.0), (-1.0, 1.0)],
+        result, err = outcome(lambda *args, **kwargs: optim.run_ga(optim.GARequest(*args, **kwargs)),
+                              lambda x: np.sum(x * x, axis=1), [(-1.0, 1.0), (-1.0, 1.0)],
                               settings_, max_generations=arg("max_generations", st.integers(1, 5),
                                                              st.one_of(_odd_setting, st.just(10**12))))
         if err is None:

@@ -131,5 +131,5 @@ def test_ga_population_and_generations_are_capped():
         optim.GASettings(population=10**9)
     with pytest.raises(InvalidSettings, match="1,000,000"):
         optim.GASettings(max_generations=10**12)
-    refused_at_once(lambda: optim.run_ga(lambda x: x.sum(axis=1), [(0.0, 1.0)], max_generations=10**12),
+    refused_at_once(lambda: optim.run_ga(optim.GARequest(lambda x: x.sum(axis=1), [(0.0, 1.0)], max_generations=10**12)),
                     "max_generations")
