@@ -124,6 +124,12 @@ class TimingRequest:
     torque_samples: int | None = None
 
     def __post_init__(self) -> None:
+        for name in ("positions", "bounds", "initial", "vmax", "amax", "jmax"):
+            value = getattr(self, name)
+            if isinstance(value, np.ndarray):  # the request owns its arrays: a copy the caller cannot change
+                value = value.copy()
+                value.setflags(write=False)
+                object.__setattr__(self, name, value)
         g = self.max_generations
         if g is not None and not (isinstance(g, (int, np.integer)) and not isinstance(g, bool)
                                   and 1 <= g <= MAX_GENERATIONS):

@@ -186,8 +186,13 @@ def test_a_timing_request_refuses_bad_settings_when_built_and_holds_its_problem(
         TimingRequest(S0.positions, S0.kind, S0.vmax, max_generations=0)
     with pytest.raises(InvalidSettings, match="not both"):
         TimingRequest(problem=TimingProblem(S0.positions, S0.kind, S0.vmax), robot=_scara(), torque_limits=True)
-    request = TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact")
+    positions = np.array(S0.positions, dtype=float)
+    request = TimingRequest(positions, S0.kind, S0.vmax, method="exact")
     assert isinstance(request.problem, TimingProblem) and request.problem.kind == S0.kind
+    positions[:] = 0.0  # the request and its problem keep their own read-only copy
+    assert not request.positions.flags.writeable
+    assert minimize_time(request).total == minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax,
+                                                                       method="exact")).total
 
 
 def test_the_status_says_how_the_optimiser_ended():
