@@ -46,9 +46,9 @@ def main() -> None:
               f"loop of pin.rnea {t_loop / n * 1e6:.2f} us/state, ratio {t_loop / t_batch:.2f}x")
 
     arm = robots.load("aubo_i3")
-    t_kin = best(lambda: optim.minimize_time(VIA, "multi-quintic", arm.velocity_limit, 8.0, method="exact"), 1)
-    t_tau = best(lambda: optim.minimize_time(VIA, "multi-quintic", arm.velocity_limit, 8.0, method="exact",
-                                             robot=arm, payload=3.0, torque_limits=True), 1)
+    t_kin = best(lambda: optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", arm.velocity_limit, 8.0, method="exact")), 1)
+    t_tau = best(lambda: optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", arm.velocity_limit, 8.0, method="exact",
+                                             robot=arm, payload=3.0, torque_limits=True)), 1)
     print(f"exact timing, 3 segments, AUBO-i3: kinematic {t_kin:.3f} s, with torque limits and 3 kg {t_tau:.3f} s "
           f"(ratio {t_tau / t_kin:.2f}x)")
     move = planning.multi_quintic([0.0, 0.35, 0.8, 1.1], VIA)

@@ -61,8 +61,8 @@ def _cell():
 
 
 def _search(cell, cand: np.ndarray, screen: bool, scheduler=None, bound: bool = False):
-    return optim.search_layout(cell, PICK, PLACE, cand, refine=0, carry=("stand",), workspace_samples=2000,
-                               chunk_size=1, screen=screen, scheduler=scheduler, bound=bound)
+    return optim.search_layout(optim.LayoutRequest(cell, PICK, PLACE, cand, refine=0, carry=("stand",), workspace_samples=2000,
+                               chunk_size=1, screen=screen, bound=bound), scheduler=scheduler)
 
 
 #: The serial routes: (screen, the attempts' branch and move-to-place screens, bound).

@@ -21,7 +21,7 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _HERE]
 
 from pinarms import scenarios
-from pinarms.optim import GASettings, TimingProblem, minimize_time
+from pinarms.optim import GASettings, TimingProblem, TimingRequest, minimize_time
 from pinarms.optim.timing.reference import path_velocity_limit, ruckig_limit, toppra_limit
 from pinarms.papers import SEED000
 
@@ -74,11 +74,11 @@ def main() -> int:
     ok = True
     s0 = scenarios.seed000()
     p0 = TimingProblem(s0.positions, s0.kind, s0.vmax)
-    exact0 = minimize_time(None, None, None, method="exact", problem=p0)
+    exact0 = minimize_time(TimingRequest(method="exact", problem=p0))
     gaps, walls, raws = [], [], []
     for seed in range(10):
-        r = minimize_time(None, None, None, method="ga", problem=p0, seed=seed,
-                          settings=GASettings.seed000(), max_generations=60)
+        r = minimize_time(TimingRequest(method="ga", problem=p0, seed=seed,
+                          settings=GASettings.seed000(), max_generations=60))
         gaps.append(r.total / exact0.total - 1)
         raws.append(r.raw_total / exact0.total - 1)
         walls.append(r.wall_time)
@@ -97,8 +97,8 @@ def main() -> int:
 
     s2 = scenarios.seed002()
     p2 = TimingProblem(s2.positions, s2.kind, s2.vmax, s2.amax, s2.jmax)
-    exact2 = minimize_time(None, None, None, method="exact", problem=p2)
-    runs = [minimize_time(None, None, None, method="ga", problem=p2, seed=seed, polish=True)
+    exact2 = minimize_time(TimingRequest(method="exact", problem=p2))
+    runs = [minimize_time(TimingRequest(method="ga", problem=p2, seed=seed, polish=True))
             for seed in range(10)]  # preset: 600 generations
     ga_gaps = [100 * (r.unpolished_total / exact2.total - 1) for r in runs]
     pol_gaps = [100 * (r.total / exact2.total - 1) for r in runs]

@@ -237,7 +237,7 @@ def station() -> None:
     heights = (0.0, 0.1, 0.2)
     grid = optim.grid_candidates(x=(-0.2, 0.7, 0.05), y=(-0.3, 0.7, 0.05), z=(0.0, 0.2, 0.1))
     t0 = time.perf_counter()
-    blind = optim.search_layout(arm, p1, place, grid, lift=lift, refine=0)
+    blind = optim.search_layout(optim.LayoutRequest(arm, p1, place, grid, lift=lift, refine=0))
     t_blind = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -253,7 +253,7 @@ def station() -> None:
     cand = np.vstack(chosen)
     t_place = time.perf_counter() - t0
     t0 = time.perf_counter()
-    seeded = optim.search_layout(arm, p1, place, cand, lift=lift, refine=0)
+    seeded = optim.search_layout(optim.LayoutRequest(arm, p1, place, cand, lift=lift, refine=0))
     t_seeded = time.perf_counter() - t0
 
     def best(res):

@@ -62,7 +62,7 @@ def child_layout(scheduler: str | None, quick: bool) -> dict:
     step = 0.1 if quick else 0.05
     cand = optim.grid_candidates(x=(-0.8, 0.8, step), y=(-0.6, 1.0, step))
     t0 = time.perf_counter()
-    res = optim.search_layout(arm, PICK, PLACE, cand, refine=0, scheduler=scheduler, chunk_size=4)
+    res = optim.search_layout(optim.LayoutRequest(arm, PICK, PLACE, cand, refine=0, chunk_size=4), scheduler=scheduler)
     wall = time.perf_counter() - t0
     return {"wall_s": wall, "candidates": len(cand), "planned": int(res.ok.sum()), "failures": res.failures(),
             "digest": hashlib.sha256(res.cycle_time.tobytes() + res.order.tobytes()).hexdigest(),
@@ -96,8 +96,8 @@ def child_station(quick: bool) -> dict:
     step = 0.1 if quick else 0.05
     cand = optim.grid_candidates(x=(-0.2, 0.7, step), y=(-0.3, 0.7, step), z=(0.0, 0.2, 0.1))
     t0 = time.perf_counter()
-    res = optim.search_layout(arm, p1, place, cand, lift=lift, refine=0 if quick else 2, refine_evaluations=30,
-                              scheduler="processes:2")
+    res = optim.search_layout(optim.LayoutRequest(arm, p1, place, cand, lift=lift, refine=0 if quick else 2,
+                                                  refine_evaluations=30), scheduler="processes:2")
     wall = time.perf_counter() - t0
     best = res.best_placement
     centre = np.array([0.0, 0.0, 0.16])

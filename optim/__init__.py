@@ -22,13 +22,14 @@ from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRe
                                   plan_cycle)
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
+from pinarms.optim.ga.request import GARequest, GAStop
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
                                   StartInCollision)
 from pinarms.optim.motion import MotionPlan, plan_motion
 from pinarms.optim.timing.exact import ExactSolution, solve_exact
-from pinarms.optim.layout.search import (LayoutSearch, Refinement, grid_candidates, random_candidates,
-                                         search_layout)
+from pinarms.optim.layout.search import (CandidateFailure, LayoutRequest, LayoutSearch, LayoutStatus, Refinement,
+                                         grid_candidates, random_candidates, search_layout)
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal, time_scaled
 from pinarms.optim.torque import TorqueConstraint
 from pinarms.optim.ga.problem import KINDS, TimingProblem
@@ -36,10 +37,12 @@ from pinarms.optim.ga.settings import GASettings
 from pinarms.optim.timing.reference import (MissingReference, double_s_limit, path_velocity_limit,
                                      ruckig_limit, toppra_limit, toppra_path_duration)
 from pinarms.optim.timing.time_jerk import TimeJerkResult, jerk_integral, minimize_time_jerk
-from pinarms.optim.timing.segments import TimingResult, minimize_time
+from pinarms.optim.timing.segments import TimingRequest, TimingResult, TimingStatus, minimize_time
 
 __all__ = [
     "run_ga",
+    "GARequest",
+    "GAStop",
     "GASettings",
     "GAResult",
     "GAHistory",
@@ -48,6 +51,8 @@ __all__ = [
     "KINDS",
     "TimingResult",
     "minimize_time",
+    "TimingRequest",
+    "TimingStatus",
     "minimize_time_jerk",
     "PickPlace",
     "CycleResult",
@@ -58,6 +63,9 @@ __all__ = [
     "CellSettings",
     "plan_cycle",
     "search_layout",
+    "LayoutRequest",
+    "LayoutStatus",
+    "CandidateFailure",
     "LayoutSearch",
     "Refinement",
     "grid_candidates",

@@ -64,7 +64,7 @@ MIN_PATH_KAPPA = 1e-4
 MIN_PATH_RTOL = 1e-6
 #: Most instants of a time-scaled path timing (``time_scaled(samples=)``).
 MAX_TIME_SCALED_SAMPLES = 1_000_000
-#: Largest GA population and generation budget (``GASettings``, ``run_ga(max_generations=)``).
+#: Largest GA population and generation budget (``GASettings``, ``GARequest(max_generations=)``).
 MAX_POPULATION = 10_000
 MAX_GENERATIONS = 1_000_000
 #: Most random starts, SLSQP iterations per start and polishing evaluations of ``solve_exact``.

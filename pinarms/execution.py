@@ -47,14 +47,22 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 
 from pinarms.chunks import chunk_seeds, split_count
 from pinarms.schedulers import describe_scheduler, parse_scheduler
 
+if TYPE_CHECKING:
+    from distributed import Client
+
+#: Where tasks run (module docstring): None or ``"serial"``, ``"processes:N"``, a scheduler
+#: address ``"tcp://host:port"``, or a ``distributed.Client``.
+Scheduler = Union[str, "Client", None]
+
 __all__ = [
+    "Scheduler",
     "chunk_seeds",
     "split_count",
     "map_chunks",
@@ -137,7 +145,7 @@ def map_chunks(
     fn: Callable[[Any], Any],
     tasks: Sequence,
     *,
-    scheduler: Any = None,
+    scheduler: Scheduler = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list:
     """``[fn(task) for task in tasks]``, run serially or on Dask, results in task order.
@@ -167,7 +175,7 @@ def reduce_chunks(
     combine: Callable[[Any, Any], Any],
     initial: Any,
     *,
-    scheduler: Any = None,
+    scheduler: Scheduler = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Any:
     """``combine(... combine(combine(initial, fn(t0)), fn(t1)) ..., fn(tn))``, folded in task order.

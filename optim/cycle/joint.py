@@ -38,7 +38,7 @@ import numpy as np
 
 from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import CycleResult, _hold, _line_deviation, _vertical_segments
-from pinarms.optim.timing.segments import TimingResult, minimize_time
+from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import joint_waypoints
 from pinarms.robots.errors import UnreachableTarget
@@ -126,13 +126,14 @@ def _timed_move(request: CycleRequest, q_out: np.ndarray, back: bool) -> TimingR
     q = q_out[::-1] if back else q_out
     loaded = request.torque
     if loaded is None:
-        return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options)
+        return minimize_time(TimingRequest(q, t.kind, v, a, j, method=t.method, seed=t.seed,
+                                           trajectory_options=options))
     if back:
         empty = torque_constraint(request.robot, loaded.limit)  # the same limits, nothing in the gripper
-        return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
-                             robot=empty.robot, torque_limits=empty.limit)
-    return minimize_time(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
-                         robot=loaded.robot, torque_limits=loaded.limit)
+        return minimize_time(TimingRequest(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
+                             robot=empty.robot, torque_limits=empty.limit))
+    return minimize_time(TimingRequest(q, t.kind, v, a, j, method=t.method, seed=t.seed, trajectory_options=options,
+                         robot=loaded.robot, torque_limits=loaded.limit))
 
 
 def _branch_labels(robot: Any, poses: np.ndarray, q: np.ndarray) -> np.ndarray:

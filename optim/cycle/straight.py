@@ -33,7 +33,7 @@ from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance, _vertical_segments
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal
-from pinarms.optim.timing.segments import TimingResult, minimize_time
+from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint, JointVelocityConstraint,
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
@@ -168,8 +168,8 @@ class _Legs:
 
     def transfer(self, q_via: np.ndarray, leg: int) -> TimingResult:
         """The joint-space transfer through ``q_via``, timed by :func:`optim.minimize_time`."""
-        return minimize_time(q_via, self.kind, self.v, self.a, self.j, method=self.method, seed=self.seed,
-                             trajectory_options=self.options, **self.legs[leg][1])
+        return minimize_time(TimingRequest(q_via, self.kind, self.v, self.a, self.j, method=self.method, seed=self.seed,
+                             trajectory_options=self.options, **self.legs[leg][1]))
 
     def joint_line(self, timing: PathTiming, leg: int) -> float:
         """Duration [s] of the same line's ends joined in joint space, timed the same way."""

@@ -1,6 +1,7 @@
 """The genetic algorithm that times trajectories: the engine and its operators.
 
-- :mod:`.engine` (:func:`run_ga`: history, progress, result), :mod:`.settings`
+- :mod:`.request` (:class:`GARequest`: objective, bounds and budgets, checked when built;
+  :class:`GAStop`), :mod:`.engine` (:func:`run_ga`: history, progress, result), :mod:`.settings`
   (:class:`GASettings`), :mod:`.problem` (:class:`TimingProblem`: segment times under
   limits, the fitness the GA minimises);
 - operators: :mod:`.selection`, :mod:`.crossover`, :mod:`.mutation`, :mod:`.adaptive`

@@ -9,6 +9,10 @@ One generation: rank the population (adaptive penalty or feasibility rules), kee
 elites, select parents (tournament or rank + SUS), cross pairs (SBX / arithmetic /
 blend, fixed or adaptive pc), mutate (non-uniform / polynomial, fixed or adaptive pm),
 evaluate the children.
+
+:func:`run_ga` takes one :class:`~optim.ga.request.GARequest` (checked when built: bad bounds,
+settings, seed or budgets raise there) and returns a :class:`GAResult` whose ``stop_reason``
+is a :class:`~optim.ga.request.GAStop` (:mod:`optim.status`).
 """
 
 from __future__ import annotations
@@ -22,13 +26,11 @@ import numpy as np
 from pinarms.optim.ga import adaptive, crossover, mutation, selection
 from pinarms.optim.ga.constraints import (FEASIBILITY_TOLERANCE, AdaptivePenalty, rank_feasibility_rules,
                                rank_penalty, violation)
-from pinarms.optim.caps import MAX_GENERATIONS
-from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
+from pinarms.optim.errors import InvalidSettings
+from pinarms.optim.ga.request import GARequest, GAStop, Objective, random_generator, run_budget
 from pinarms.optim.ga.settings import GASettings
 
-__all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress", "random_generator"]
-
-Objective = Callable[[np.ndarray], np.ndarray]
+__all__ = ["run_ga", "GAResult", "GAHistory", "GAProgress"]
 
 
 @dataclass(frozen=True)
@@ -84,7 +86,8 @@ class GAResult:
         history: Per-generation :class:`GAHistory`.
         generations: Generations run.
         evaluations: Individuals evaluated (objective calls count rows).
-        stop_reason: ``"max_generations"``, ``"stall"``, ``"time_limit"`` or ``"callback"``.
+        stop_reason: why the run stopped (:class:`GAStop`: ``"max_generations"``, ``"stall"``,
+            ``"time_limit"`` or ``"callback"``).
         wall_time: Seconds spent.
     """
 
@@ -95,41 +98,8 @@ class GAResult:
     history: GAHistory
     generations: int
     evaluations: int
-    stop_reason: str
+    stop_reason: GAStop
     wall_time: float
-
-
-def random_generator(seed: int | np.random.Generator) -> np.random.Generator:
-    """The random generator of a run: a given Generator, or one seeded by a non-negative int."""
-    if isinstance(seed, np.random.Generator):
-        return seed
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidSettings(f"seed={seed!r}: give a non-negative integer or a "
-                              "numpy.random.Generator")
-    return np.random.default_rng(int(seed))
-
-
-def _count(value: object, name: str, minimum: int) -> int:
-    """An integer option >= minimum (generations)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise InvalidSettings(f"{name}={value!r}: use an integer >= {minimum}")
-    return int(value)
-
-
-def _check_bounds(bounds: np.ndarray | tuple) -> tuple[np.ndarray, np.ndarray]:
-    b = np.asarray(bounds, dtype=float)
-    if b.ndim == 2 and b.shape[0] == 2 and b.shape[1] != 2:
-        b = b.T
-    if b.ndim != 2 or b.shape[1] != 2 or b.shape[0] < 1:
-        raise InvalidSettings(f"bounds of shape {np.shape(bounds)}: give (dim, 2) rows of "
-                              "(lower, upper)")
-    lower, upper = b[:, 0].copy(), b[:, 1].copy()
-    if not (np.all(np.isfinite(lower)) and np.all(np.isfinite(upper))):
-        raise InvalidSettings(f"bounds {b.tolist()}: every bound must be finite")
-    if np.any(lower > upper):
-        raise InvalidSettings(f"bounds {b.tolist()}: lower > upper in rows "
-                              f"{np.nonzero(lower > upper)[0].tolist()}")
-    return lower, upper
 
 
 class _Evaluator:
@@ -167,19 +137,8 @@ def _initial_population(evaluate: _Evaluator, lower: np.ndarray, upper: np.ndarr
                         draw_feasible: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     dim = lower.shape[0]
     rows: list[np.ndarray] = []
-    if initial is not None:
-        try:
-            init = np.atleast_2d(np.asarray(initial, dtype=float))
-        except (TypeError, ValueError):
-            raise InvalidSettings(f"initial={initial!r} is not numeric: give (k, {dim}) "
-                                  "individuals") from None
-        if init.ndim != 2 or init.shape[1] != dim:
-            raise InvalidSettings(f"initial of shape {init.shape}: rows must have {dim} genes")
-        if not np.all(np.isfinite(init)):
-            raise InvalidSettings("initial individuals hold NaN or inf: give finite genes")
-        if np.any(init < lower - 1e-12) or np.any(init > upper + 1e-12):
-            raise InvalidSettings("initial individuals must lie within the bounds")
-        rows.append(np.clip(init[:pop], lower, upper))
+    if initial is not None:  # checked by GARequest
+        rows.append(np.clip(initial[:pop], lower, upper))
     n_given = sum(r.shape[0] for r in rows)
     x = np.concatenate(rows + [lower + rng.random((pop - n_given, dim)) * (upper - lower)])
     f, v = evaluate(x)
@@ -197,21 +156,6 @@ def _initial_population(evaluate: _Evaluator, lower: np.ndarray, upper: np.ndarr
             slot, src = redraw[take], best[take]
             x[slot], f[slot], v[slot] = cand[src], fc[src], vc[src]
     return x, f, v
-
-
-def _run_budget(settings: GASettings, max_generations: int | None, stall_generations: int | None,
-                time_limit: float | None) -> tuple[int, int | None]:
-    """The generation budget and the stall count of a run, checked (``time_limit`` too)."""
-    G = settings.max_generations if max_generations is None else _count(max_generations, "max_generations", 0)
-    if G > MAX_GENERATIONS:
-        raise SettingOutOfRange(f"max_generations = {G:,} is more than the {MAX_GENERATIONS:,} allowed")
-    stall = (settings.stall_generations if stall_generations is None
-             else _count(stall_generations, "stall_generations", 1))
-    if time_limit is not None and not (isinstance(time_limit, (int, float, np.number))
-                                       and np.isfinite(time_limit) and time_limit >= 0):
-        raise InvalidSettings(f"time_limit={time_limit!r}: give a finite number of seconds >= 0 "
-                              "or None")
-    return G, stall
 
 
 class _BestSoFar:
@@ -292,52 +236,37 @@ def _children(x: np.ndarray, rank: np.ndarray, fitness: np.ndarray, n_children: 
 
 
 def _stop_reason(generation: int, G: int, stall: int | None, best: _BestSoFar, time_limit: float | None,
-                 elapsed: float) -> str | None:
+                 elapsed: float) -> GAStop | None:
     """Why the run stops after this generation (budget, stall, time), or None to go on."""
     if generation >= G:
-        return "max_generations"
+        return GAStop.MAX_GENERATIONS
     if stall is not None and best.stall_count >= stall:
-        return "stall"
+        return GAStop.STALL
     if time_limit is not None and elapsed >= time_limit:
-        return "time_limit"
+        return GAStop.TIME_LIMIT
     return None
 
 
-def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASettings | None = None,
-           constraints: Objective | None = None, seed: int | np.random.Generator = 0,
-           max_generations: int | None = None, stall_generations: int | None = None,
-           time_limit: float | None = None,
-           callback: Callable[[GAProgress], bool | None] | None = None,
-           initial: np.ndarray | None = None) -> GAResult:
-    """Minimise ``objective`` over a box with a real-coded GA.
+def run_ga(request: GARequest, *, callback: Callable[[GAProgress], bool | None] | None = None) -> GAResult:
+    """Minimise ``request.objective`` over its box with a real-coded GA.
 
     Args:
-        objective: Maps a population (pop, dim) to objective values (pop,). NaN/inf
-            count as infeasible.
-        bounds: (dim, 2) rows of (lower, upper).
-        settings: :class:`GASettings` (default: ``GASettings()``).
-        constraints: Maps (pop, dim) to (pop, n_con), feasible where every entry <= 0.
-        seed: Integer seed or ``numpy.random.Generator``; same seed, same result.
-        max_generations: Generation budget (default ``settings.max_generations``).
-        stall_generations: Stop after this many generations without relative improvement
-            of the best by ``settings.stall_tolerance`` (default from settings).
-        time_limit: Wall-clock budget in seconds (checked after each generation).
+        request: objective, bounds, constraints, settings, seed, budgets and initial
+            individuals (:class:`GARequest`, checked when built).
         callback: Called with a :class:`GAProgress` after each generation; returning
-            True stops the run.
-        initial: (k, dim) individuals placed in the initial population (k <= pop).
+            True stops the run (``stop_reason`` :attr:`GAStop.CALLBACK`).
 
     Returns:
         :class:`GAResult`. ``feasible`` is False if no feasible individual was ever seen.
     """
-    settings = GASettings() if settings is None else settings
-    if not isinstance(settings, GASettings):
-        raise InvalidSettings(f"settings must be an optim.GASettings, got {type(settings).__name__}")
-    lower, upper = _check_bounds(bounds)
-    rng = random_generator(seed)
-    G, stall = _run_budget(settings, max_generations, stall_generations, time_limit)
+    settings, constraints = request.settings, request.constraints
+    time_limit, initial = request.time_limit, request.initial
+    lower, upper = request.bounds[:, 0].copy(), request.bounds[:, 1].copy()
+    rng = random_generator(request.seed)
+    G, stall = run_budget(settings, request.max_generations, request.stall_generations, time_limit)
     pop = settings.population
     t0 = time.perf_counter()
-    evaluate = _Evaluator(objective, constraints)
+    evaluate = _Evaluator(request.objective, constraints)
     penalty = AdaptivePenalty(settings.penalty_initial, settings.penalty_increase,
                               settings.penalty_decrease, settings.penalty_window)
     use_penalty = settings.constraint_handling == "adaptive-penalty"
@@ -351,7 +280,7 @@ def run_ga(objective: Objective, bounds: np.ndarray | tuple, settings: GASetting
         elapsed = time.perf_counter() - t0
         if generation > 0 and callback is not None and callback(
                 GAProgress(generation, best.x.copy(), best.f, best.feasible, evaluate.count, elapsed)):
-            stop_reason = "callback"
+            stop_reason = GAStop.CALLBACK
             break
         stop_reason = _stop_reason(generation, G, stall, best, time_limit, elapsed)
         if stop_reason is not None:

@@ -24,13 +24,17 @@ where ``v, a, k`` are the peaks at total 1.
 from __future__ import annotations
 
 import inspect
-from typing import Any, Callable, Protocol
+from typing import TYPE_CHECKING, Any, Callable, Protocol
 
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 from pinarms.planning.torque import piece_states
+from pinarms.optim.types import JointLimit
+
+if TYPE_CHECKING:
+    from pinarms.planning.torque import JointTorqueConstraint
 
 __all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
@@ -67,7 +71,7 @@ Builder = Callable[[np.ndarray, np.ndarray], "_TrajectoryLike"]
 BatchBuilder = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
-def path_static_check(torque: Any, times: np.ndarray, coefs: np.ndarray) -> None:
+def path_static_check(torque: JointTorqueConstraint, times: np.ndarray, coefs: np.ndarray) -> None:
     """Refuse a path (one timing's pieces) through a pose the arm cannot hold still, naming it.
 
     Where ``|g(q)| > L`` no timing of that path exists (slower only tends to ``g``).
@@ -86,7 +90,7 @@ def path_static_check(torque: Any, times: np.ndarray, coefs: np.ndarray) -> None
         )
 
 
-def static_check(torque: Any, positions: np.ndarray) -> None:
+def static_check(torque: JointTorqueConstraint, positions: np.ndarray) -> None:
     """Refuse via points the arm cannot even hold still (``|g(q)| > L``), naming joint and via point."""
     g, over = torque.holding_excess(positions)
     if np.any(over):
@@ -99,7 +103,7 @@ def static_check(torque: Any, positions: np.ndarray) -> None:
         )
 
 
-def check_limit(value: Any, n_joints: int, name: str, required: bool) -> np.ndarray | None:
+def check_limit(value: JointLimit | None, n_joints: int, name: str, required: bool) -> np.ndarray | None:
     """A per-joint limit (scalar or (n_joints,)) as a (n_joints,) positive finite array.
 
     Raises :class:`InvalidLimits` for <= 0, NaN/inf, values outside :data:`LIMIT_RANGE`, or a
@@ -176,10 +180,10 @@ class TimingProblem:
             scaling law in :meth:`minimal_scale`; None: kinematic limits only.
     """
 
-    def __init__(self, positions: Any, kind: str, vmax: Any, amax: Any = None,
-                 jmax: Any = None, bounds: Any = None,
-                 trajectory_options: dict[str, Any] | None = None,
-                 builder: Builder | None = None, torque: Any = None) -> None:
+    def __init__(self, positions: np.ndarray, kind: str, vmax: JointLimit | None, amax: JointLimit | None = None,
+                 jmax: JointLimit | None = None, bounds: np.ndarray | tuple[float, float] | None = None,
+                 trajectory_options: dict[str, object] | None = None,
+                 builder: Builder | None = None, torque: JointTorqueConstraint | None = None) -> None:
         try:
             if np.iscomplexobj(positions):
                 raise TypeError("complex numbers")

@@ -27,9 +27,14 @@ Only analytic-IK arms have a bound (0 otherwise: nothing is skipped).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+from pinarms.optim.types import JointLimit, Scheduler
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 from .candidates import _PPM_RTOL
 
@@ -48,7 +53,8 @@ def _travel(a: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray) 
     return np.where(turn, np.minimum(wrapped, 2.0 * np.pi - wrapped), d)
 
 
-def cycle_lower_bounds(robot: Any, targets: np.ndarray, n_picks: int, dwell: float, vmax: Any) -> np.ndarray:
+def cycle_lower_bounds(robot: Robot, targets: np.ndarray, n_picks: int, dwell: float,
+                       vmax: JointLimit | None) -> np.ndarray:
     """The lower bound [s] (module docstring) of each candidate's mean cycle time, ``(M,)``.
 
     ``targets (M, P + Q, 4, 4)``: the tcp poses of the picks, then the places, in each
@@ -74,7 +80,7 @@ def cycle_lower_bounds(robot: Any, targets: np.ndarray, n_picks: int, dwell: flo
     return out
 
 
-def wave_size(scheduler: Any, chunk_size: int) -> int | None:
+def wave_size(scheduler: Scheduler, chunk_size: int) -> int | None:
     """Candidates per wave: one task serially, a task per worker thread of a Dask client, else None (one wave)."""
     if scheduler is None or scheduler == "serial":
         return int(chunk_size)

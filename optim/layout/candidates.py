@@ -10,15 +10,37 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.optim.types import AxisRange, Placement
+
 from pinarms.optim.caps import MAX_AXIS_VALUES, MAX_PLACEMENTS, count_setting
 from pinarms.optim.errors import SettingOutOfRange
+from pinarms.optim.status import Status
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame"]
+__all__ = ["CandidateFailure", "FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world",
+           "points_in_base_frame"]
 
-#: Why a candidate fails, in the order they are checked (``"outranked"``: not planned, its cycle
-#: cannot beat the best ones; ``search_layout(..., bound=True)``).
-FAILURES = ("unreachable", "joint limit", "boundary", "collision", "timing", "outranked")
+
+
+class CandidateFailure(Status):
+    """Why one candidate placement of a layout search fails (the value is the word printed)."""
+
+    #: a pick, place or lift point is beyond the arm's reach from the placement
+    UNREACHABLE = "unreachable"
+    #: a point is within reach but needs a joint outside its limits
+    JOINT_LIMIT = "joint limit"
+    #: a pick or place is closer than ``min_margin`` to the edge of the workspace
+    BOUNDARY = "boundary"
+    #: no cycle keeps the clearance from the cell's fixtures and other arms
+    COLLISION = "collision"
+    #: no timing meets the limits
+    TIMING = "timing"
+    #: not planned: its proven lower bound cannot beat the best ones (``LayoutRequest(bound=True)``)
+    OUTRANKED = "outranked"
+
+
+#: The failures in the order they are checked.
+FAILURES = tuple(CandidateFailure)
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
 _PPM_RTOL = 1e-9
@@ -46,7 +68,7 @@ def _axis(value: Any, name: str) -> np.ndarray:
     return lo + step * np.arange(count)
 
 
-def grid_candidates(x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0) -> np.ndarray:
+def grid_candidates(x: AxisRange, y: AxisRange, z: AxisRange = 0.0, yaw: AxisRange = 0.0) -> np.ndarray:
     """Base placements ``(M, 4)`` = every combination of the coordinates' values.
 
     Each coordinate is a number or ``(lo, hi, step)`` [m, yaw in rad]; rows are ordered with
@@ -61,7 +83,8 @@ def grid_candidates(x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0) -> np.ndarray:
     return np.column_stack([m.reshape(-1) for m in mesh])
 
 
-def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed: int = 0) -> np.ndarray:
+def random_candidates(n: int, x: AxisRange, y: AxisRange, z: AxisRange = 0.0, yaw: AxisRange = 0.0,
+                      seed: int = 0) -> np.ndarray:
     """``n`` base placements ``(n, 4)`` uniform within bounds, from ``numpy.random.default_rng(seed)``.
 
     Each coordinate is a number (fixed) or ``(lo, hi)`` [m, yaw in rad]; the draws are made
@@ -90,7 +113,7 @@ def random_candidates(n: int, x: Any, y: Any, z: Any = 0.0, yaw: Any = 0.0, seed
     return out
 
 
-def base_to_world(placement: Any) -> np.ndarray:
+def base_to_world(placement: Placement) -> np.ndarray:
     """``T_base_to_world (4, 4)`` of a placement ``(x, y, z, yaw)`` (or ``(N, 4, 4)`` for ``(N, 4)``)."""
     P = np.asarray(placement, dtype=float)
     single = P.ndim == 1

@@ -12,7 +12,8 @@ import numpy as np
 
 from pinarms.optim.cycle import CycleResult
 
-from .candidates import FAILURES
+from .candidates import FAILURES, CandidateFailure
+from .request import LayoutStatus
 
 __all__ = ["LayoutSearch", "Refinement"]
 
@@ -55,7 +56,7 @@ class LayoutSearch:
         robot: name of the arm.
         picks, places: ``(P, 3)``, ``(Q, 3)`` points in the line frame [m].
         candidates: ``(M, 4)`` placements ``(x, y, z, yaw)`` of the base in the line frame [m, rad].
-        failure: per candidate ``""`` (planned) or one of :data:`FAILURES`.
+        failure: per candidate None (planned) or its :class:`CandidateFailure`.
         reason: per candidate, why it failed (names the point) or ``""``.
         cycle_time: mean cycle time over the (pick, place) pairs [s] (NaN when failed).
         picks_per_minute: ``60 / cycle_time`` (0 when failed).
@@ -73,13 +74,15 @@ class LayoutSearch:
         seconds: the search's phases (``"screen"``, ``"cycles"``, ``"refine"``, ``"best"``: the
             best placement's cycle planned again with its report) as ``(wall, CPU)`` seconds; the
             CPU is this process's (a cluster's workers are not counted).
+        status: :attr:`LayoutStatus.FOUND` (a best placement) or :attr:`LayoutStatus.NO_PLACEMENT`.
+        status_reason: why not found (the failures counted by kind), ``""`` when found.
     """
 
     robot: str
     picks: np.ndarray = field(repr=False)
     places: np.ndarray = field(repr=False)
     candidates: np.ndarray = field(repr=False)
-    failure: tuple[str, ...] = field(repr=False)
+    failure: tuple[CandidateFailure | None, ...] = field(repr=False)
     reason: tuple[str, ...] = field(repr=False)
     cycle_time: np.ndarray = field(repr=False)
     picks_per_minute: np.ndarray = field(repr=False)
@@ -94,11 +97,13 @@ class LayoutSearch:
     seed: int = 0
     lower_bound: np.ndarray | None = field(default=None, repr=False)
     seconds: dict = field(default_factory=dict, repr=False)
+    status: LayoutStatus = LayoutStatus.FOUND
+    status_reason: str = ""
 
     @property
     def ok(self) -> np.ndarray:
         """``(M,)`` bool: the cycle was planned."""
-        return np.array([f == "" for f in self.failure], dtype=bool)
+        return np.array([f is None for f in self.failure], dtype=bool)
 
     @property
     def best_index(self) -> int:
@@ -108,7 +113,7 @@ class LayoutSearch:
     def failures(self) -> dict[str, int]:
         """Number of candidates per failure kind (only kinds that occur)."""
         counts = Counter(f for f in self.failure if f)
-        return {k: counts[k] for k in FAILURES if counts[k]}
+        return {k.value: counts[k] for k in FAILURES if counts[k]}
 
     def table(self, top: int = 10, *, failed: int = 3) -> str:
         """The ranked table (mm, degrees): the ``top`` candidates and the first ``failed`` failures."""
@@ -152,8 +157,8 @@ class LayoutSearch:
             rows.append({
                 "index": int(i),
                 "placement": dict(zip(("x_m", "y_m", "z_m", "yaw_rad"), self.candidates[i].tolist())),
-                "ok": self.failure[i] == "",
-                "failure": self.failure[i] or None,
+                "ok": self.failure[i] is None,
+                "failure": None if self.failure[i] is None else self.failure[i].value,
                 "reason": self.reason[i] or None,
                 "cycle_time_s": None if self.failure[i] else float(self.cycle_time[i]),
                 "picks_per_minute": float(self.picks_per_minute[i]),
@@ -163,6 +168,8 @@ class LayoutSearch:
             })
         out: dict[str, Any] = {
             "robot": self.robot,
+            "status": self.status.value,
+            "status_reason": self.status_reason or None,
             "picks_m": self.picks.tolist(),
             "places_m": self.places.tolist(),
             "seed": self.seed,

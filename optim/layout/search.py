@@ -30,29 +30,37 @@ The cycles run through :func:`pinarms.execution.map_chunks` (``scheduler``: seri
 processes or a Dask cluster): results are identical whoever runs them (the plans are
 deterministic and every task is a pure function of its candidates).
 
+One input, one result (:mod:`optim.status`): :func:`search_layout` takes a
+:class:`LayoutRequest` (checked when built: bad input raises there, naming the field) and
+returns a :class:`LayoutSearch` whose ``status`` is :attr:`LayoutStatus.FOUND` or, when every
+candidate failed, :attr:`LayoutStatus.NO_PLACEMENT` with a ``status_reason``; per candidate,
+``failure`` is a :class:`CandidateFailure` (None where the cycle was planned).
+
 Units: m, rad, s; yaw about the line frame's vertical axis (the base stands upright).
 """
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from pinarms.optim.caps import (MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, MAX_REFINE,
-                               MAX_REFINE_EVALUATIONS, MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
-from pinarms.optim.cycle import CYCLE_KINDS, PickPlace
-from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
-
-from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
+from .candidates import (_PPM_RTOL, AXES, FAILURES, CandidateFailure, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
 from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
                        _Settings)
+from .request import LayoutRequest, LayoutStatus, is_cell
 from .result import LayoutSearch, Refinement
+
+if TYPE_CHECKING:
+    from pinarms.execution import Scheduler
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "FAILURES",
+    "CandidateFailure",
+    "LayoutRequest",
+    "LayoutStatus",
     "LayoutSearch",
     "Refinement",
     "grid_candidates",
@@ -64,19 +72,7 @@ __all__ = [
 
 
 # ------------------------------------------------------------------------ search
-def _points(value: Any, what: str) -> np.ndarray:
-    try:
-        P = np.atleast_2d(np.asarray(value, dtype=float))
-    except (TypeError, ValueError) as exc:
-        raise InvalidInput(f"{what} must be points (3,) or (N, 3) in m, got {value!r}") from exc
-    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0:
-        raise InvalidInput(f"{what} must be points (3,) or (N, 3) in m, got shape {np.shape(value)}")
-    if not np.all(np.isfinite(P)):
-        raise InvalidInput(f"{what} holds NaN or inf")
-    return P
-
-
-def _screen(robot: Any, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str], np.ndarray | None]:
+def _screen(robot: Robot, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str], np.ndarray | None]:
     """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate,
     and the tcp poses ``(M, K, 4, 4)`` of the picks, places and lift points in each base frame (None
     without a closed form)."""
@@ -136,58 +132,17 @@ def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
     return np.asarray(out, dtype=np.intp)
 
 
-def _cell_target(robot: Any, arm: str | None, clearance: float, carry: tuple[str, ...],
-                 token: str) -> tuple[Any, "_CellRecipe | None"]:
-    """The arm to place and, when ``robot`` is a cell, the recipe its workers rebuild the cell from."""
-    if hasattr(robot, "arms") and hasattr(robot, "with_arm_base"):  # a cell
-        cell = robot
-        if arm is None:
-            if len(cell.arms) != 1:
-                raise InvalidInput(f"cell {cell.name!r} has arms {[a.name for a in cell.arms]}: name the one to place (arm=)")
-            arm = cell.arms[0].name
-        robot = cell.arm(arm).robot
-        number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
-        for name in carry:
-            cell.fixture(name)
-        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
-                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
-                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
-                             tuple(carry), float(clearance), tuple(cell.arm_placements))
-        _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
-        return robot, recipe
-    if arm is not None or carry:
-        raise InvalidInput("arm= and carry= name an arm and fixtures of a cell: pass the cell as the first argument")
-    return robot, None
-
-
-def _checked_inputs(picks: Any, places: Any, candidates: Any, kind: str, counts: dict[str, int],
-                    orientation: Any, lift: float, dwell: float,
-                    min_margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """Points, candidates, orientation and counts of a search, checked before any work (:mod:`optim.caps`)."""
-    picks_w, places_w = _points(picks, "picks"), _points(places, "places")
-    cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
-    if cand.ndim != 2 or cand.shape[1] != 4 or cand.shape[0] == 0 or not np.all(np.isfinite(cand)):
-        raise InvalidInput(f"candidates must be finite placements (M, 4) = (x, y, z, yaw) [m, rad], got shape {cand.shape}")
-    if kind not in CYCLE_KINDS:
-        raise InvalidSettings(f"kind={kind!r}: use one of {CYCLE_KINDS}")
-    if cand.shape[0] > MAX_PLACEMENTS:
-        raise SettingOutOfRange(f"{cand.shape[0]:,} candidates, more than the {MAX_PLACEMENTS:,} a layout search takes")
-    if len(picks_w) * len(places_w) > MAX_POINT_PAIRS:
-        raise SettingOutOfRange(f"{len(picks_w)} picks × {len(places_w)} places = {len(picks_w) * len(places_w):,} "
-                                f"cycles per placement, more than the {MAX_POINT_PAIRS:,} allowed: give fewer points")
-    for name, least, most in (("refine", 0, MAX_REFINE), ("refine_evaluations", 1, MAX_REFINE_EVALUATIONS),
-                              ("workspace_samples", 1000, MAX_WORKSPACE_SAMPLES),
-                              ("chunk_size", 1, MAX_PLACEMENTS), ("seed", 0, 2**64 - 1)):
-        count_setting(counts[name], name, least, most)
-    R = None
-    if orientation is not None:
-        R = np.asarray(orientation, dtype=float)
-        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or np.abs(R @ R.T - np.eye(3)).max() > 1e-6 \
-                or np.linalg.det(R) < 0:
-            raise InvalidInput(f"orientation must be a (3, 3) proper rotation matrix, got {orientation!r}")
-    PickPlace(picks_w[0], places_w[0], lift=lift, dwell=dwell)  # checks lift and dwell (names them)
-    number_setting(min_margin, "min_margin", 0.0, unit="m")
-    return picks_w, places_w, cand, R
+def _cell_recipe(request: LayoutRequest, token: str) -> "_CellRecipe | None":
+    """When ``request.robot`` is a cell, the recipe its workers rebuild the cell from (None for a robot)."""
+    if not is_cell(request.robot):
+        return None
+    cell = request.robot
+    recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
+                         tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
+                         tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(request.arm),
+                         tuple(request.carry), float(request.clearance), tuple(cell.arm_placements))
+    _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+    return recipe
 
 
 def _margins(robot: Any, st: _Settings, cand: np.ndarray, samples: int) -> tuple[Any, np.ndarray]:
@@ -315,95 +270,69 @@ def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int)
     return lambda done, _total: progress(offset + done, total)
 
 
-def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift: float = 0.05, dwell: float = 0.2,
-                  orientation: Any = None, kind: str = "multi-quintic", vmax: Any = None, amax: Any = None,
-                  jmax: Any = None, refine: int = 2, refine_evaluations: int = 30, workspace_samples: int = 200_000,
-                  seed: int = 0, chunk_size: int = 4, scheduler: Any = None,
-                  progress: Callable[[int, int], None] | None = None, arm: str | None = None,
-                  clearance: float = 0.02, carry: tuple[str, ...] = (), min_margin: float = 0.0,
-                  screen: bool = True, bound: bool = False) -> LayoutSearch:
-    """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
+def search_layout(request: LayoutRequest, *, scheduler: Scheduler = None,
+                  progress: Callable[[int, int], None] | None = None) -> LayoutSearch:
+    """Rank the base placements of ``request`` by the picks per minute of its pick-and-place cycle.
 
     Args:
-        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
-            then the arm ``arm`` of the cell (its only arm by default) is moved among the
-            cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
-            the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
-            must keep ``clearance`` [m] from the fixtures and the other arms
-            (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
-            points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
-            ``screen``: each re-planning attempt is first screened by exact distances at its
-            via points and a few timed states (:class:`optim.CellSettings`; proofs of failure
-            only, so the same verdicts; ``False``: every attempt timed and checked in full).
-        picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
-            paired with every place.
-        candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
-            [m, rad] (:func:`grid_candidates`, :func:`random_candidates`).
-        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`optim.PickPlace` and
-            :func:`optim.plan_cycle`).
-        orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
-            the robot's (tool down for six-axis arms), in its base frame.
-        min_margin: smallest boundary margin [m] a pick or place may have; candidates below
-            fail as ``"boundary"`` before any cycle is planned (0: no such rule). The fastest
-            cycles are often near the edge of the workspace, where the arm is stretched.
-        refine: how many of the best candidates start a continuous search (0: none).
-        refine_evaluations: cycles each continuous search may plan.
-        workspace_samples: samples of the workspace whose voxel map gives the boundary margins.
-        seed: seed of the workspace samples and of the timing optimiser (results repeat).
-        chunk_size: candidates per task (a task plans ``chunk_size × pairs`` cycles, ~0.5 s each
-            for a six-axis arm).
+        request: the arm (or cell), points, candidates and cycle (:class:`LayoutRequest`,
+            checked when built).
         scheduler, progress: see :func:`pinarms.execution.map_chunks` (progress counts the
-            candidate tasks, then the refinement tasks).
-        bound: branch and bound (:mod:`optim.layout.bound`): the candidates are planned in
-            increasing order of a proven lower bound of their cycle time, and those that cannot
-            reach the first ``max(1, refine)`` places of the ranking are not planned (they fail
-            as ``"outranked"``): the best placement, the refinement starts and every planned
-            candidate's outcome are those of the exhaustive search (``False``, default).
+            candidate tasks, then the refinement tasks); the result is the same on any scheduler.
+
+    Returns:
+        :class:`LayoutSearch`: ``status`` :attr:`LayoutStatus.FOUND` with the best placement, or
+        :attr:`LayoutStatus.NO_PLACEMENT` (every candidate failed; ``status_reason`` counts why).
 
     Raises:
-        InvalidInput: malformed points, candidates, orientation or counts.
-        InvalidSettings: unknown ``kind``.
         ExecutionError: a task failed on the scheduler (chunk index named).
     """
     import uuid
 
+    rq = request
     token = uuid.uuid4().hex
-    robot, recipe = _cell_target(robot, arm, clearance, carry, token)
-    counts = {"refine": refine, "refine_evaluations": refine_evaluations, "workspace_samples": workspace_samples,
-              "chunk_size": chunk_size, "seed": seed}
-    picks_w, places_w, cand, R = _checked_inputs(picks, places, candidates, kind, counts, orientation, lift, dwell,
-                                                 min_margin)
-    st = _Settings(picks_w, places_w, R, float(lift), float(dwell), kind, vmax, amax, jmax, int(seed), recipe,
-                   bool(screen))
+    robot = rq.arm_robot
+    recipe = _cell_recipe(rq, token)
+    cand = rq.candidates
+    st = _Settings(rq.picks, rq.places, rq.orientation, float(rq.lift), float(rq.dwell), rq.kind, rq.vmax, rq.amax,
+                   rq.jmax, int(rq.seed), recipe, bool(rq.screen))
 
     clock = _Clock()
     failure, reason, targets = _screen(robot, cand, st)
-    lower = _lower_bounds(robot, st, targets, cand.shape[0]) if bound else None
-    vmap, point_margin = _margins(robot, st, cand, workspace_samples)
+    lower = _lower_bounds(robot, st, targets, cand.shape[0]) if rq.bound else None
+    vmap, point_margin = _margins(robot, st, cand, rq.workspace_samples)
     margin = point_margin.min(axis=1)
-    if min_margin > 0:
-        _boundary_failures(failure, reason, point_margin, st, min_margin)
-    plan_chunk = 1 if bound and scheduler in (None, "serial") else chunk_size  # serial: a bound checked per candidate
+    if rq.min_margin > 0:
+        _boundary_failures(failure, reason, point_margin, st, rq.min_margin)
+    plan_chunk = 1 if rq.bound and scheduler in (None, "serial") else rq.chunk_size  # serial: a bound per candidate
     n_tasks = -(-sum(1 for f in failure if not f) // plan_chunk)
-    total = n_tasks + int(refine)
+    total = n_tasks + int(rq.refine)
     clock.lap("screen")
 
     cycle_time, branch, manip = _plan_candidates(robot, token, cand, st, failure, reason, plan_chunk, scheduler,
-                                                 _phase(progress, 0, total), lower, max(1, int(refine)))
+                                                 _phase(progress, 0, total), lower, max(1, int(rq.refine)))
     clock.lap("cycles")
     ok = np.array([f == "" for f in failure])
     ppm = np.where(ok, 60.0 / np.where(ok, cycle_time, 1.0), 0.0)
     order = _ranking(ppm, margin)
-    refinement, best_placement, best_ppm = _refine_best(robot, token, cand, st, ppm, ok, order, int(refine),
-                                                        refine_evaluations, vmap, min_margin, scheduler,
+    refinement, best_placement, best_ppm = _refine_best(robot, token, cand, st, ppm, ok, order, int(rq.refine),
+                                                        rq.refine_evaluations, vmap, rq.min_margin, scheduler,
                                                         _phase(progress, n_tasks, total))
     clock.lap("refine")
     best_cycle = None
     if best_placement is not None:
         best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
     clock.lap("best")
-    return LayoutSearch(robot=str(robot.name), picks=picks_w, places=places_w, candidates=cand, failure=tuple(failure),
+    failed = tuple(CandidateFailure(f) if f else None for f in failure)
+    status, why = LayoutStatus.FOUND, ""
+    if best_placement is None:
+        counts = {k: sum(f is k for f in failed) for k in CandidateFailure}
+        status = LayoutStatus.NO_PLACEMENT
+        why = (f"every one of the {cand.shape[0]} candidates failed ("
+               + ", ".join(f"{n} {k}" for k, n in counts.items() if n)
+               + "): move the candidates nearer the points or relax the cycle")
+    return LayoutSearch(robot=str(robot.name), picks=rq.picks, places=rq.places, candidates=cand, failure=failed,
                         reason=tuple(reason), cycle_time=cycle_time, picks_per_minute=ppm, branch=branch,
                         manipulability=manip, margin=margin, order=order, refinement=refinement,
                         best_placement=best_placement, best_picks_per_minute=best_ppm, best_cycle=best_cycle,
-                        seed=int(seed), lower_bound=lower, seconds=clock.laps)
+                        seed=int(rq.seed), lower_bound=lower, seconds=clock.laps, status=status, status_reason=why)

@@ -14,7 +14,8 @@
 - :mod:`~.schedule` keeps the time offsets of several arms cycling together (:func:`schedule_line`).
 """
 
-from pinarms.optim.line.api import LineCurve, LineResult, LineSpec, Stream, build_maps, line_curve, run_line
+from pinarms.optim.line.api import (LineCurve, LineResult, LineSpec, LineStatus, Stream, build_maps, line_curve,
+                                    run_line)
 from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
 from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
@@ -35,7 +36,7 @@ __all__ = [
     "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
     "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
     "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "SimArm", "SimResult", "simulate",
-    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "run_line", "build_maps", "LineCurve", "line_curve",
+    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",
     "TrayMap", "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
 ]

@@ -6,15 +6,21 @@ asked for. :func:`run_line` builds each station's task-time maps (once per disti
 shape: stations that differ only by their place along the belt share them), simulates every
 seed on the execution layer (serial by default, a Dask cluster by address; same results
 either way) and returns a :class:`LineResult` with a status and the figures.
+
+Statuses and exceptions (:mod:`optim.status`): a malformed :class:`LineSpec` raises when it is
+built; a line that runs but misses more items than ``target_miss_rate`` is a result with
+``status`` :attr:`LineStatus.MISSES_ABOVE_TARGET` and a ``status_reason``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
+
+from pinarms.optim.types import Scheduler
 
 from pinarms.optim.caps import count_setting
 from pinarms.optim.line.belt import Belt, _number
@@ -27,17 +33,25 @@ from pinarms.optim.line.task_maps import TaskMap, build_task_map
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
+from pinarms.optim.status import Status
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve",
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "LineStatus", "LineCurve", "line_curve",
            "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
 #: Most arms (stations) along one line, and most seeds (Monte Carlo runs) of one line result.
 MAX_LINE_ARMS = 64
 MAX_LINE_SEEDS = 10_000
-#: ``"ok"``: the miss rate's mean is within the target; ``"misses above target"``: it is not.
-STATUSES = ("ok", "misses above target")
+
+
+class LineStatus(Status):
+    """How a line did against its target miss rate (the value is the word printed)."""
+
+    #: the miss rate's mean over the seeds is within ``LineSpec.target_miss_rate``
+    OK = "ok"
+    #: it is not (``LineResult.status_reason`` gives both figures)
+    MISSES_ABOVE_TARGET = "misses above target"
 
 
 @dataclass(frozen=True)
@@ -141,13 +155,14 @@ def _tray_option(trays: Any, names: list) -> dict | None:
 
 @dataclass(frozen=True, eq=False)
 class LineResult:
-    """The line's answer: ``status`` (:data:`STATUSES`), ``figures`` (:class:`LineFigures`),
+    """The line's answer: ``status`` (:class:`LineStatus`), ``status_reason`` (why, when not
+    ``OK``; ``""`` otherwise), ``figures`` (:class:`LineFigures`),
     ``windows`` (each arm's :class:`PickWindow`), ``overlapping`` (neighbour pairs whose
     windows overlap), ``runs`` (one :class:`SimResult` per seed), ``maps`` (per station);
     ``fixture_infeasible``: per station, its maps' nodes closer than the clearance to the cell's
     fixtures (empty without a cell)."""
 
-    status: str
+    status: LineStatus
     figures: LineFigures
     windows: tuple[PickWindow, ...]
     overlapping: tuple[tuple[str, str], ...]
@@ -155,6 +170,7 @@ class LineResult:
     maps: dict = field(repr=False, default_factory=dict)
     belt_speed: float = 0.0
     fixture_infeasible: dict = field(default_factory=dict)
+    status_reason: str = ""
 
     def summary(self, title: str = "line") -> str:
         """The figures as text, one per line (what ``pinarms belt run`` prints): status, arms, belt
@@ -179,7 +195,7 @@ class LineResult:
         return "\n".join(lines)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"status": self.status, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
+        return {"status": self.status.value, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
                 "neighbour_checks": [list(r.checks) for r in self.runs],
                 "fixture_infeasible": dict(self.fixture_infeasible),
                 "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
@@ -194,7 +210,7 @@ def _shape_key(st: Station, belt: Belt) -> tuple:
             tuple(lim["vmax"]), tuple(lim["amax"]), lim["torque"])
 
 
-def build_maps(spec: LineSpec, *, scheduler: Any = None, known: dict | None = None,
+def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | None = None,
                approach_maps: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
     """Task maps of every station, one per item type, built once per distinct station shape.
     ``approach_maps``: ``{station name: (box TaskMap, ...)}`` whose approach times the tray maps
@@ -263,7 +279,7 @@ def _run_seed(task: dict) -> SimResult:
                     width=spec.belt.width, guard=guard)
 
 
-def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None) -> LineResult:
+def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Scheduler = None) -> LineResult:
     """Simulate the line on every seed and summarise (module doc)."""
     from pinarms.execution import map_chunks
 
@@ -275,10 +291,13 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Any = None)
     windows = tuple(window_of(st, spec.belt, _pick_part(maps[st.name][0])) for st in spec.stations)
     ordered = sorted(windows, key=lambda w: w.u_base)
     overlapping = tuple((a.station, b.station) for a, b in zip(ordered, ordered[1:]) if windows_overlap(a, b))
-    status = STATUSES[0] if figures.miss_rate <= spec.target_miss_rate else STATUSES[1]
+    ok = figures.miss_rate <= spec.target_miss_rate
+    status = LineStatus.OK if ok else LineStatus.MISSES_ABOVE_TARGET
+    reason = "" if ok else (f"mean miss rate {100 * figures.miss_rate:.2f} % over {figures.seeds} seeds is above the "
+                            f"target {100 * spec.target_miss_rate:.2f} %: add an arm, slow the belt or lower the flow")
     blocked = ({} if spec.cell is None else
                {st.name: sum(int(getattr(m, "fixture_infeasible", 0)) for m in maps[st.name]) for st in spec.stations})
-    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed, blocked)
+    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed, blocked, reason)
 
 
 def _pick_part(m: Any) -> TaskMap:
@@ -300,8 +319,9 @@ class LineCurve:
     arrivals_per_minute: np.ndarray
 
 
-def line_curve(make_spec: Any, parameter: str, values: Sequence[float], maps: Any, *,
-               scheduler: Any = None) -> LineCurve:
+def line_curve(make_spec: Callable[[float], LineSpec], parameter: str, values: Sequence[float],
+               maps: Callable[[LineSpec], dict], *,
+               scheduler: Scheduler = None) -> LineCurve:
     """Run ``make_spec(value)`` (a :class:`LineSpec`) for each value; ``maps(spec)`` gives its
     task maps (e.g. :func:`pinarms.studies.line.maps_for`, or :func:`build_maps`)."""
     if parameter not in ("rate", "speed", "arms"):

@@ -21,9 +21,17 @@ B-splines) are smooth polynomials and cannot reach a bang-bang profile.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from pinarms.optim.types import JointLimit, JointVector
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.payload import Payload
+    from pinarms.robots.robot import Robot
 
 from pinarms.optim.errors import OptimError
 from pinarms.optim.ga.problem import check_limit
@@ -42,7 +50,7 @@ def _dense(trajectory: Any, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return t, q, qd
 
 
-def path_velocity_limit(trajectory: Any, vmax: Any, n: int = 20001) -> float:
+def path_velocity_limit(trajectory: Trajectory, vmax: JointLimit, n: int = 20001) -> float:
     """Minimal duration (s) along the trajectory's path under velocity limits only."""
     t, _, qd = _dense(trajectory, n)
     v = check_limit(vmax, qd.shape[1], "vmax", required=True)
@@ -75,8 +83,9 @@ def _arc_length_section(trajectory: Any, t0: float, t1: float, n: int) -> tuple[
     return s, trajectory.sample(t)[0]
 
 
-def toppra_limit(trajectory: Any, vmax: Any, amax: Any = None, n: int = 400, *, robot: Any = None,
-                 torque_limits: Any = None, payload: Any = None) -> float:
+def toppra_limit(trajectory: Trajectory, vmax: JointLimit, amax: JointLimit | None = None, n: int = 400, *,
+                 robot: Robot | None = None, torque_limits: bool | JointLimit | None = None,
+                 payload: float | Payload | dict | None = None) -> float:
     """Minimal duration (s) along the trajectory's geometric path under velocity, acceleration
     and joint-torque limits (TOPP-RA on about ``n`` grid points).
 
@@ -141,7 +150,7 @@ def toppra_limit(trajectory: Any, vmax: Any, amax: Any = None, n: int = 400, *, 
     return duration
 
 
-def toppra_path(path: Any) -> Any:
+def toppra_path(path: JointPath) -> Any:
     """``path`` (a :class:`planning.JointPath`) as toppra's geometric path: toppra reads q, q', q''
     through ``path.sample(s)`` directly (no spline fitted in between)."""
     try:
@@ -165,7 +174,7 @@ def toppra_path(path: Any) -> Any:
     return _Adapter()
 
 
-def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, tool_speed: float | None = None,
+def toppra_path_duration(path: JointPath, vmax: JointLimit, amax: JointLimit, gridpoints: np.ndarray, *, tool_speed: float | None = None,
                          discretization: str = "interpolation") -> float:
     """Duration (s) of toppra's time-optimal parameterisation of ``path`` (a :class:`planning.JointPath`).
 
@@ -212,7 +221,7 @@ def toppra_path_duration(path: Any, vmax: Any, amax: Any, gridpoints: Any, *, to
     return float(np.sum(2.0 * np.diff(grid) / (sd[:-1] + sd[1:])))
 
 
-def ruckig_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:
+def ruckig_limit(q0: JointVector, q1: JointVector, vmax: JointLimit, amax: JointLimit, jmax: JointLimit) -> float:
     """Time-optimal rest-to-rest duration (s) from q0 to q1, synchronised, by ruckig."""
     try:
         import ruckig
@@ -236,7 +245,8 @@ def ruckig_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:
     return float(traj.duration)
 
 
-def double_s_limit(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any) -> float:
+def double_s_limit(q0: JointVector, q1: JointVector, vmax: JointLimit, amax: JointLimit,
+                   jmax: JointLimit) -> float:
     """Rest-to-rest double-S duration (s) from q0 to q1 (planning's profile, synchronised)."""
     from pinarms import planning
 

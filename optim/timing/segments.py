@@ -1,9 +1,12 @@
 """Minimum-time segment timing of a trajectory through via points: GA or exact.
 
-``minimize_time`` is the user-facing entry: it builds a :class:`~optim.ga.problem.TimingProblem`,
-solves it with the GA of this package (``method="ga"``) or with the deterministic
-scaling-law optimiser (``method="exact"``), verifies the answer with planning's exact
-peaks, and never returns an infeasible timing (it raises :class:`InfeasibleProblem`).
+``minimize_time`` is the user-facing entry: it takes a :class:`~optim.timing.request.TimingRequest`
+(checked when built, with its :class:`~optim.ga.problem.TimingProblem`), solves it with the GA
+of this package (``method="ga"``) or with the deterministic scaling-law optimiser
+(``method="exact"``), verifies the answer with planning's exact peaks, and returns a
+:class:`TimingResult` whose ``status`` (:class:`TimingStatus`) says how the optimiser ended. It
+never returns an infeasible timing: with none within the bounds it raises
+:class:`InfeasibleProblem` (there is no trajectory to return; :mod:`optim.status`).
 """
 
 from __future__ import annotations
@@ -14,16 +17,21 @@ from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.optim.ga.engine import GAHistory, GAProgress, random_generator, run_ga
-from pinarms.optim.caps import MAX_GENERATIONS
-from pinarms.optim.errors import InfeasibleProblem, InvalidSettings, SettingOutOfRange
-from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
+from pinarms.optim.errors import InfeasibleProblem
+from pinarms.optim.ga.engine import GAHistory, GAProgress, run_ga
+from pinarms.optim.ga.request import GARequest
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
 from pinarms.optim.ga.settings import GASettings
+from pinarms.optim.timing.exact import polish_durations, scaled_to_limits, solve_exact, start_ratios
+from pinarms.optim.timing.request import METHODS, TimingRequest, TimingStatus
 
-__all__ = ["TimingResult", "minimize_time", "finish_timing", "rescale_to_limits"]
+__all__ = ["TimingRequest", "TimingStatus", "TimingResult", "minimize_time", "finish_timing", "rescale_to_limits",
+           "METHODS"]
 
-METHODS = ("ga", "exact")
+_WHY = {TimingStatus.TIME_LIMIT: "the GA stopped at its time_limit: the timing is feasible but may not be the "
+                                 "shortest; raise time_limit or use method='exact'",
+        TimingStatus.CALLBACK: "the callback stopped the GA: the timing is its best so far (feasible, maybe not the "
+                               "shortest)"}
 
 
 @dataclass(frozen=True)
@@ -49,6 +57,10 @@ class TimingResult:
         torque_peaks: with torque limits, the refined per-joint torque peaks of
             ``trajectory`` (:class:`planning.TorquePeaks`, N·m or N); None otherwise.
         torque_limit: the torque limits (n,) used [N·m or N], or None.
+        status: how the optimiser ended (:class:`TimingStatus`: ``SOLVED`` for the exact
+            solver, else the GA's stop reason); the timing is verified in every case.
+        status_reason: for a GA stopped by its time limit or a callback, that its best may
+            not be the shortest; ``""`` otherwise.
     """
 
     durations: np.ndarray
@@ -65,6 +77,8 @@ class TimingResult:
     unpolished_total: float | None = None
     torque_peaks: Any = None
     torque_limit: np.ndarray | None = None
+    status: TimingStatus = TimingStatus.SOLVED
+    status_reason: str = ""
 
     @property
     def torque_ratios(self) -> np.ndarray | None:
@@ -97,6 +111,7 @@ def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
                   raw_total: float, stop_reason: str = "",
                   unpolished_total: float | None = None) -> TimingResult:
     """Build the final trajectory, verify it with its exact peaks, wrap the result."""
+    status = TimingStatus(stop_reason) if stop_reason else TimingStatus.SOLVED
     h = np.asarray(durations, dtype=float)
     torque = getattr(problem, "torque", None)
     if torque is not None:
@@ -117,7 +132,8 @@ def finish_timing(problem: TimingProblem, durations: np.ndarray, *, method: str,
                         wall_time=time.perf_counter() - t0, raw_total=raw_total,
                         kind=problem.kind, stop_reason=stop_reason,
                         unpolished_total=unpolished_total, torque_peaks=tq_peaks,
-                        torque_limit=None if torque is None else torque.limit.copy())
+                        torque_limit=None if torque is None else torque.limit.copy(), status=status,
+                        status_reason=_WHY.get(status, ""))
 
 
 def _infeasible(problem: TimingProblem, method: str) -> InfeasibleProblem:
@@ -128,84 +144,30 @@ def _infeasible(problem: TimingProblem, method: str) -> InfeasibleProblem:
         "upper bounds or relax vmax/amax/jmax")
 
 
-def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: Any = None,
-                  method: str = "ga", seed: int = 0, settings: GASettings | None = None,
-                  bounds: Any = None, *, max_generations: int | None = None,
-                  stall_generations: int | None = None, time_limit: float | None = None,
-                  rescale: bool = True, polish: bool = False, initial: Any = None,
-                  callback: Callable[[GAProgress], bool | None] | None = None,
-                  trajectory_options: dict[str, Any] | None = None,
-                  problem: TimingProblem | None = None, robot: Any = None, payload: Any = None,
-                  torque_limits: Any = False, torque_samples: int | None = None) -> TimingResult:
-    """Shortest segment durations through via points under per-joint limits.
-
-    Minimises ``T = h_1 + ... + h_m`` subject to max|velocity| <= vmax, and optionally
-    max|acceleration| <= amax and max|jerk| <= jmax, for every joint over the whole
-    trajectory (exact peaks), with the same durations for all joints.
+def minimize_time(request: TimingRequest, *,
+                  callback: Callable[[GAProgress], bool | None] | None = None) -> TimingResult:
+    """Shortest segment durations through the request's via points under its limits.
 
     Args:
-        positions: (m+1, n_joints) or (m+1,) via points (rad or m).
-        kind: ``"3-5-3"`` (exactly 4 via points), ``"multi-quintic"`` or ``"quintic-bspline"``.
-        vmax, amax, jmax: Limits per joint (scalar or (n_joints,)), SI (rad/s, rad/s^2,
-            rad/s^3 or m/...). ``vmax`` is required; None leaves a limit out.
-        method: ``"ga"`` (the GA of this package) or ``"exact"`` (scaling-law optimiser).
-        seed: Seed of the GA (or of the exact optimiser's random starts).
-        settings: GA settings (default :meth:`GASettings.seed002`).
-        bounds: Segment-duration bounds (s): one (lower, upper) pair or (m, 2) rows.
-            Default: ``[s0 / (20 m), 1.001 min(s0, 4 s0 / m)]`` per segment, s0 the minimal
-            total with equal durations (so equal durations s0/m are inside and feasible).
-            Pass wider bounds if one segment may need more than 4x the average.
-        max_generations, stall_generations, time_limit: GA stopping rules (``max_generations``
-            1 to :data:`optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
-        rescale: GA only: scale the GA's best (same ratios) down until the first limit is
-            reached; the unscaled total is kept in ``raw_total``.
-        polish: GA only: refine the GA's (rescaled) answer by a local gradient method
-            (SLSQP from it, :func:`optim.timing.exact.polish_durations`) and keep the better of
-            the two; the result's method is then ``"ga+polish"`` and the GA's own total is
-            kept in ``unpolished_total``. Off by default: the default answer is the GA's.
-        initial: GA only: (k, m) durations put into the initial population (e.g. the
-            paper's initial times).
-        callback: GA progress callback (see :func:`optim.run_ga`).
-        trajectory_options: Extra keyword arguments of the planning constructor.
-        problem: A prebuilt :class:`TimingProblem` (then positions/kind/limits/bounds
-            are ignored).
-        robot: The arm (a :class:`robots.Robot`) whose joints the via points are; needed
-            for torque limits.
-        payload: What the tcp carries: a mass [kg], a :class:`robots.Payload` or its dict
-            form (``robot.with_payload``); only with ``torque_limits``.
-        torque_limits: ``True``: also limit every joint's torque to the URDF's ``effort``
-            (``robot.effort_limit``, N·m or N); or limits per joint; ``False``: kinematic
-            limits only. The torques (inverse dynamics of the robot with its payload) are
-            checked on ``torque_samples`` instants per piece (default 48) with their own
-            scaling law (:mod:`optim.torque`), and the answer is finally stretched onto the
-            refined torque peaks, so it is feasible when re-checked densely. A torque-limited
-            timing is never shorter than the kinematic one.
-        torque_samples: Grid instants per polynomial piece for the torque constraint.
+        request: what to time and how (:class:`TimingRequest`, checked when built).
+        callback: GA progress callback (see :func:`optim.run_ga`); returning True stops the GA
+            (status :attr:`TimingStatus.CALLBACK`).
 
     Returns:
-        :class:`TimingResult`, verified against the limits.
+        :class:`TimingResult`, verified against the limits, with its ``status``.
 
     Raises:
-        InvalidLimits: A limit is <= 0, NaN/inf or has the wrong shape.
-        InvalidSettings: torque limits without a robot, a payload without torque limits.
-        InfeasibleProblem: No timing within the bounds meets the limits (also: the arm
-            cannot hold a via point still with its payload).
+        InfeasibleProblem: No timing within the bounds meets the limits.
     """
     t0 = time.perf_counter()
-    if max_generations is not None and not (isinstance(max_generations, (int, np.integer))
-                                            and not isinstance(max_generations, bool)
-                                            and 1 <= max_generations <= MAX_GENERATIONS):
-        raise SettingOutOfRange(f"max_generations = {max_generations!r} is outside 1 to {MAX_GENERATIONS:,} "
-                                "(the generations of the timing GA)")
-    problem = _timing_problem(method, seed, problem, robot, torque_limits, payload, torque_samples,
-                              positions=positions, kind=kind, vmax=vmax, amax=amax, jmax=jmax, bounds=bounds,
-                              trajectory_options=trajectory_options)
+    rq = request
+    problem = rq.problem
     before = problem.evaluations
-    if method == "exact":
-        return _exact_timing(problem, seed, before, t0)
-    return _ga_timing(problem, seed, settings, before, t0, max_generations=max_generations,
-                      stall_generations=stall_generations, time_limit=time_limit, callback=callback,
-                      initial=initial, rescale=rescale, polish=polish)
+    if rq.method == "exact":
+        return _exact_timing(problem, rq.seed, before, t0)
+    return _ga_timing(problem, rq.seed, rq.settings, before, t0, max_generations=rq.max_generations,
+                      stall_generations=rq.stall_generations, time_limit=rq.time_limit, callback=callback,
+                      initial=rq.initial, rescale=rq.rescale, polish=rq.polish)
 
 
 def _exact_timing(problem: TimingProblem, seed: int, before: int, t0: float) -> TimingResult:
@@ -224,11 +186,11 @@ def _ga_timing(problem: TimingProblem, seed: int, settings: GASettings | None, b
                polish: bool) -> TimingResult:
     """``method="ga"``: the GA's best, rescaled onto the limits and polished if asked, verified."""
     settings = GASettings.seed002() if settings is None else settings
-    result = run_ga(lambda h: h.sum(axis=1), problem.bounds, settings,
-                    constraints=problem.constraints, seed=seed,
-                    max_generations=max_generations, stall_generations=stall_generations,
-                    time_limit=time_limit, callback=callback,
-                    initial=_scaling_law_starts(problem, seed) if initial is None else initial)
+    request = GARequest(lambda h: h.sum(axis=1), problem.bounds, settings, constraints=problem.constraints,
+                        seed=seed, max_generations=max_generations, stall_generations=stall_generations,
+                        time_limit=time_limit,
+                        initial=_scaling_law_starts(problem, seed) if initial is None else initial)
+    result = run_ga(request, callback=callback)
     if not result.feasible:
         raise _infeasible(problem, "ga")
     h = rescale_to_limits(problem, result.x) if rescale else result.x
@@ -242,25 +204,6 @@ def _ga_timing(problem: TimingProblem, seed: int, settings: GASettings | None, b
                          evaluations=problem.evaluations - before, t0=t0,
                          raw_total=float(result.f), stop_reason=result.stop_reason,
                          unpolished_total=unpolished)
-
-
-def _timing_problem(method: str, seed: int, problem: TimingProblem | None, robot: Any, torque_limits: Any,
-                    payload: Any, torque_samples: int | None, **spec: Any) -> TimingProblem:
-    """The problem :func:`minimize_time` solves: ``problem`` itself, or built from ``spec`` (positions,
-    kind, limits, bounds, trajectory options) with the torque constraint; bad settings refused first."""
-    if method not in METHODS:
-        raise InvalidSettings(f"method={method!r}: use one of {METHODS}")
-    random_generator(seed)  # refuse a bad seed before any work, for both methods
-    from pinarms.optim.torque import torque_constraint
-
-    torque = torque_constraint(robot, torque_limits, payload, torque_samples)
-    if problem is None:
-        return TimingProblem(spec["positions"], spec["kind"], spec["vmax"], spec["amax"], spec["jmax"],
-                             bounds=spec["bounds"], trajectory_options=spec["trajectory_options"], torque=torque)
-    if torque is not None:
-        raise InvalidSettings("give torque limits either in the prebuilt problem (TimingProblem(torque=...)) "
-                              "or as keywords, not both")
-    return problem
 
 
 def _scaling_law_starts(problem: TimingProblem, seed: int) -> np.ndarray | None:

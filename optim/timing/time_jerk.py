@@ -17,22 +17,32 @@ gradients of all perturbed timings in one batched evaluation), started from the 
 time-optimal answer (weighted: the time-optimal timing; two-stage: T* scaled up to the
 cap). For ratios r and total s, J = J1(r) s^-5 (J1 the cost at total 1), so the
 two-stage optimum uses the whole allowed time (unless the upper bounds stop it). ``method="ga"`` runs the GA on h.
+
+:func:`minimize_time_jerk` takes the same :class:`~optim.timing.request.TimingRequest` as
+:func:`minimize_time` (via points, limits, method, seed, GA settings) and the trade's own
+options; bad input raises when the request is built or before any work, and no feasible
+timing raises :class:`InfeasibleProblem` (:mod:`optim.status`).
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
 from scipy.optimize import minimize
 
-from pinarms.optim.ga.engine import GAHistory, random_generator, run_ga
+from pinarms.optim.ga.engine import GAHistory, run_ga
+from pinarms.optim.ga.request import GARequest, random_generator
 from pinarms.optim.errors import InfeasibleProblem, InvalidSettings
 from pinarms.optim.timing.exact import solve_exact
 from pinarms.optim.ga.problem import SAFETY, TimingProblem
 from pinarms.optim.ga.settings import GASettings
+from pinarms.optim.timing.request import TimingRequest
 from pinarms.optim.timing.segments import minimize_time
 
 __all__ = ["TimeJerkResult", "minimize_time_jerk", "jerk_integral", "jerk_integral_batch"]
@@ -80,7 +90,7 @@ def _gauss_legendre(width: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (nodes + 1.0), 0.5 * weights  # on [0, 1]
 
 
-def jerk_integral(trajectory: Any) -> float:
+def jerk_integral(trajectory: Trajectory) -> float:
     """Sum over joints of the exact integral of jerk^2 over the trajectory."""
     return float(_jerk_integrals(np.asarray(trajectory.coefficients, dtype=float)[None],
                                  np.diff(np.asarray(trajectory.knot_times, dtype=float))[None])[0])
@@ -161,44 +171,39 @@ def _slsqp_time_jerk(problem: TimingProblem, mode: str, cap: float | None, k_tim
     return h
 
 
-def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
-                       jmax: Any = None, *, mode: str = "two-stage", method: str = "ga",
-                       k_time: float = 1.0, k_jerk: float = 1.0, time_factor: float = 1.05,
-                       seed: int = 0, settings: GASettings | None = None, bounds: Any = None,
-                       max_generations: int | None = None, time_limit: float | None = None,
-                       trajectory_options: dict[str, Any] | None = None,
-                       problem: TimingProblem | None = None) -> TimeJerkResult:
+def minimize_time_jerk(request: TimingRequest, *, mode: str = "two-stage", k_time: float = 1.0,
+                       k_jerk: float = 1.0, time_factor: float = 1.05) -> TimeJerkResult:
     """Timing that trades total time against the jerk integral.
 
     Args:
-        positions, kind, vmax, amax, jmax, bounds, trajectory_options, problem: as in
-            :func:`optim.minimize_time`.
+        request: the via points, limits, bounds (or prebuilt problem), ``method`` (``"ga"``, or
+            ``"exact"``: SLSQP from the exact time-optimal timing), ``seed``, ``settings``
+            (default :meth:`GASettings.seed002`), ``max_generations`` and ``time_limit`` of
+            :class:`TimingRequest`; stage one of the two-stage mode uses the same method and seed.
+            Its other GA options (``stall_generations``, ``rescale``, ``polish``, ``initial``)
+            are not used here.
         mode: ``"two-stage"`` (seed 002: time-optimal first, then minimum jerk with
             ``T <= time_factor * T*``) or ``"weighted"`` (min ``k_time T + k_jerk J``).
-        method: ``"ga"`` or ``"exact"`` (SLSQP from the exact time-optimal timing).
         k_time: Weight of the total time (1/s units of the objective).
         k_jerk: Weight of the jerk integral (objective units per unit^2/s^5).
         time_factor: Two-stage: allowed total over the time-optimal total (>= 1).
-        seed, settings, max_generations, time_limit: GA controls (settings default
-            :meth:`GASettings.seed002`). Stage one of the two-stage mode uses the same
-            method and seed.
 
     Raises:
-        InvalidLimits, InfeasibleProblem, InvalidSettings.
+        InvalidSettings: a bad mode, weights or time factor.
+        InfeasibleProblem: no timing meets the limits (and the time cap).
     """
+    method, seed = request.method, request.seed
+    max_generations, time_limit = request.max_generations, request.time_limit
     t0 = time.perf_counter()
     _check_options(mode, method, seed, time_factor, k_time, k_jerk)
-    if problem is None:
-        problem = TimingProblem(positions, kind, vmax, amax, jmax, bounds=bounds,
-                                trajectory_options=trajectory_options)
+    problem = request.problem
     before = problem.evaluations
-    settings = GASettings.seed002() if settings is None else settings
+    settings = GASettings.seed002() if request.settings is None else request.settings
     t_star = None
     history = None
     if mode == "two-stage":
-        first = minimize_time(None, kind, None, method=method, seed=seed, settings=settings,
-                              max_generations=max_generations, time_limit=time_limit,
-                              problem=problem)
+        first = minimize_time(TimingRequest(method=method, seed=seed, settings=settings,
+                                            max_generations=max_generations, time_limit=time_limit, problem=problem))
         t_star = first.total
         cap = time_factor * t_star
         start = first.durations
@@ -265,9 +270,8 @@ def _ga_time_jerk(problem: TimingProblem, mode: str, cap: float | None, start: n
         objective = lambda H: k_time * H.sum(axis=1) + k_jerk * jerk_integral_batch(problem, H)
         constraints = problem.constraints
         initial = None
-    res = run_ga(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
-                 seed=seed, max_generations=max_generations, time_limit=time_limit,
-                 initial=initial)
+    res = run_ga(GARequest(objective, np.column_stack([lo, hi]), settings, constraints=constraints,
+                           seed=seed, max_generations=max_generations, time_limit=time_limit, initial=initial))
     if not res.feasible:
         raise InfeasibleProblem("the GA found no timing within the bounds that meets the "
                                 f"limits{' and the time cap' if cap else ''}; widen the "

@@ -120,7 +120,7 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
 @json_option
 def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms, as_json) -> None:
     """Fewest SCARAs (preset scara) whose miss rate is <= 1 % at the flow."""
-    from pinarms.optim.line import run_line
+    from pinarms.optim.line import LineStatus, run_line
     from pinarms.studies.line import maps_for
 
     if preset != "scara":
@@ -132,11 +132,11 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
     for n in range(1, max_arms + 1):
         spec = _spec(preset, n, rate, speed, paper_limit, rule, seeds, duration, None)
         res = run_line(spec, maps=maps_for(spec))
-        if res.status == "ok":
+        if res.status is LineStatus.OK:
             break
-    data = {"arms_needed": n if res.status == "ok" else None, **res.as_dict()}
+    data = {"arms_needed": n if res.status is LineStatus.OK else None, **res.as_dict()}
     lines = res.summary(f"belt arms: {rate:g} items/min at <= 1 % miss -> "
-                        f"{n if res.status == 'ok' else f'more than {max_arms}'} arm(s)").splitlines()
+                        f"{n if res.status is LineStatus.OK else f'more than {max_arms}'} arm(s)").splitlines()
     emit(as_json, data, lines)
 
 
@@ -159,9 +159,8 @@ def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss,
     speeds = [0.2] if speed is None else [speed]
     maps = {v: maps_for(_spec(preset, 1, rate, v, paper_limit, rule, 1, duration, None))["scara 1"][0] for v in speeds}
     problem = SizingProblem(maps, rate, max_miss, item=ENOKI, rule=Rule(rule), seeds=tuple(range(seeds)),
-                            duration=duration)
-    r = size_line(problem, population=population, generations=generations, scheduler=scheduler,
-                  progress=None if as_json else click.echo)
+                            duration=duration, population=population, generations=generations)
+    r = size_line(problem, scheduler=scheduler, progress=None if as_json else click.echo)
     lines = [f"belt size: {rate:g} items/min at <= {100 * max_miss:g} % miss",
              f"  status            {r.status}",
              f"  arms              {r.arms}",
@@ -170,4 +169,6 @@ def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss,
              f"  miss rate         {100 * r.miss_rate:.2f} %",
              f"  picks             {r.picks_per_minute:.1f} /min",
              f"  simulations       {r.evaluations}"]
-    emit(as_json, r.__dict__, lines)
+    if r.status_reason:
+        lines.insert(2, f"  why               {r.status_reason}")
+    emit(as_json, {**r.__dict__, "status": r.status.value}, lines)

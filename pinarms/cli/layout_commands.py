@@ -122,15 +122,15 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
         candidates = optim.grid_candidates(**axes)
     picks, places = np.array(pick) * k, np.array(place) * k
     ones = np.ones(arm.nq)
+    request = optim.LayoutRequest(
+        cell if cell is not None else arm, picks, places, candidates,
+        lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
+        vmax=si_limit(vmax, "--vmax", ones), amax=si_limit(amax, "--amax", ones),
+        jmax=si_limit(jmax, "--jmax", ones), refine=refine, refine_evaluations=refine_evaluations, seed=seed,
+        chunk_size=chunk_size, min_margin=min_margin * k, bound=bound, **in_cell,
+    )
     with progress_bar(f"{arm.name}: placements", len(candidates), as_json) as bar:
-        res = optim.search_layout(
-            cell if cell is not None else arm, picks, places, candidates,
-            lift=0.05 if lift is None else lift * k, dwell=dwell, kind=kind,
-            vmax=si_limit(vmax, "--vmax", ones), amax=si_limit(amax, "--amax", ones),
-            jmax=si_limit(jmax, "--jmax", ones), refine=refine, refine_evaluations=refine_evaluations, seed=seed,
-            chunk_size=chunk_size, scheduler=scheduler, progress=bar if bar.enabled else None,
-            min_margin=min_margin * k, bound=bound, **in_cell,
-        )
+        res = optim.search_layout(request, scheduler=scheduler, progress=bar if bar.enabled else None)
     data = res.as_dict()
     from pinarms.execution import describe_scheduler
 
@@ -146,7 +146,7 @@ def layout_search_cmd(robot, pick, place, x_range, y_range, z_range, yaw_range, 
     if session_path:
         from pinarms import viz
 
-        if res.best_placement is None:
+        if res.status is optim.LayoutStatus.NO_PLACEMENT:
             raise InvalidInput("no placement runs the cycle: there is no best placement to save in a session")
         save_session(viz.layout_search_session(res, arm, cell=cell, carry=tuple(carry)), session_path, data, lines)
     emit(as_json, data, lines)

@@ -235,6 +235,7 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     if v is None:
         raise click.UsageError("give a velocity limit with --vmax (or --robot)")
     kwargs: dict[str, Any] = {}
+    callback = None
     if generations is not None and method == "ga":
         kwargs["max_generations"] = generations
     if payload is not None or torque or torque_max is not None:
@@ -248,9 +249,10 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
     bar = common.progress_bar("GA generations", budget, as_json or method != "ga")
     if bar.enabled:
-        kwargs["callback"] = lambda _state: bar.advance()
+        callback = lambda _state: bar.advance()  # noqa: E731
+    request = optim.TimingRequest(positions * scale, kind, v, a, j, method=method, seed=seed, **kwargs)
     try:
-        result = optim.minimize_time(positions * scale, kind, v, a, j, method=method, seed=seed, **kwargs)
+        result = optim.minimize_time(request, callback=callback)
     finally:
         bar.close()
     data = {

@@ -119,7 +119,7 @@ def arms_needed(rate: float, *, paper_limit: bool, max_arms: int = 20, start: in
 def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: int = 1,
                   **kw: Any) -> tuple[int | None, Any, Any]:
     """:func:`arms_needed` and the curve (:class:`optim.line.LineCurve`) of the lines tried."""
-    from pinarms.optim.line import LineCurve
+    from pinarms.optim.line import LineCurve, LineStatus
 
     last, tried = None, []
     found = None
@@ -128,7 +128,7 @@ def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: 
         last = run_line(spec, maps=maps_for(spec))
         f = last.figures
         tried.append((n, f.picks_per_minute, f.miss_rate, *f.miss_rate_ci, f.arrivals_per_minute))
-        if last.status == "ok":
+        if last.status is LineStatus.OK:
             found = n
             break
     a = np.array(tried, dtype=float)

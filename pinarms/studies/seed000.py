@@ -41,9 +41,9 @@ def study_000(quick: bool = False) -> Study:
 
     settings = optim.GASettings.seed000()
     gens = 60 if quick else 200
-    ga = optim.minimize_time(path, "3-5-3", vmax, method="ga", seed=0, settings=settings,
-                             max_generations=gens, initial=np.array([paper.initial_times_s]))
-    exact = optim.minimize_time(path, "3-5-3", vmax, method="exact", seed=0)
+    ga = optim.minimize_time(optim.TimingRequest(path, "3-5-3", vmax, method="ga", seed=0, settings=settings,
+                             max_generations=gens, initial=np.array([paper.initial_times_s])))
+    exact = optim.minimize_time(optim.TimingRequest(path, "3-5-3", vmax, method="exact", seed=0))
     rows.append(Row("000", "initial total time", paper.initial_total_s, float(initial.duration), "s", 1e-12))
     rows.append(Row("000", "GA optimised total time", total_printed, ga.total, "s", 0.05,
                     "" if abs(ga.total - total_printed) <= 0.05 else

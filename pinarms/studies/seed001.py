@@ -125,7 +125,7 @@ def _time_optimal_row_001(arm: robots.Robot, table2: np.ndarray, times: np.ndarr
     from pinarms import optim
     from pinarms.robots.ties import near_max
 
-    fastest = optim.minimize_time(table2, "multi-quintic", arm.velocity_limit, method="exact")
+    fastest = optim.minimize_time(optim.TimingRequest(table2, "multi-quintic", arm.velocity_limit, method="exact"))
     at_limit = [arm.joint_names[k] for k in near_max(fastest.peaks.velocity / arm.velocity_limit)]
     limiting = " and ".join(at_limit) + (" at their limits" if len(at_limit) > 1 else " at its limit")
     return Row("001", "time-optimal P1→P4 (3 quintics, at rest at P2/P3, joint speed limits)",

@@ -38,9 +38,10 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
     rows: list[Row] = []
     q = conv.aubo_mdh_to_joint(table2)
     v = arm.velocity_limit
-    speed = optim.minimize_time(q, "multi-quintic", v, method="exact")
+    speed = optim.minimize_time(optim.TimingRequest(q, "multi-quintic", v, method="exact"))
     for kg in AUBO_PAYLOADS_KG:
-        ex = optim.minimize_time(q, "multi-quintic", v, method="exact", robot=arm, payload=kg, torque_limits=True)
+        ex = optim.minimize_time(optim.TimingRequest(q, "multi-quintic", v, method="exact", robot=arm, payload=kg,
+                                                     torque_limits=True))
         ratios = ex.torque_ratios
         tight = [arm.joint_names[k] for k in near_max(ratios)]
         ref = optim.toppra_limit(ex.trajectory, v, robot=arm, payload=kg, torque_limits=True)
@@ -51,8 +52,8 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
             f"(bang-bang, the path's optimum: ×{ex.total / ref:.2f})"))
         if kg == AUBO_PAYLOADS_KG[-1]:
             gens = 30 if quick else 120
-            ga = optim.minimize_time(q, "multi-quintic", v, method="ga", seed=0, max_generations=gens,
-                                     robot=arm, payload=kg, torque_limits=True)
+            ga = optim.minimize_time(optim.TimingRequest(q, "multi-quintic", v, method="ga", seed=0, max_generations=gens,
+                                     robot=arm, payload=kg, torque_limits=True))
             rows.append(Row(
                 "001", f"P1→P4 with {kg:g} kg: GA under joint speed + torque", None, ga.total, "s", None,
                 f"{gens} generations, seed 0; ×{ga.total / ex.total:.3f} the exact optimum above; peak torque/limit "
@@ -72,8 +73,9 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
             f"{cyc.torque_ratios.max():.3f} ({', '.join(tight)})"))
 
     heavy = arm.with_payload(AUBO_PAYLOADS_KG[-1])
-    limited = optim.minimize_time(q, "multi-quintic", v, method="exact", robot=arm, payload=AUBO_PAYLOADS_KG[-1],
-                                  torque_limits=True).trajectory
+    limited = optim.minimize_time(optim.TimingRequest(q, "multi-quintic", v, method="exact", robot=arm,
+                                                      payload=AUBO_PAYLOADS_KG[-1],
+                                  torque_limits=True)).trajectory
 
     def write(path: Path) -> Any:
         from pinarms.viz import plots as vplots

@@ -93,21 +93,22 @@ def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
     lift = (paper.table2_p1_p2_mm[1][2] - paper.table2_p1_p2_mm[0][2]) * MM
     place = np.array([42.0, 222.0, 244.0]) * MM  # Table 2's P4, printed "(42222244)"
     cand = optim.grid_candidates(x=(-0.1, 0.1, 0.1), y=(-0.1, 0.1, 0.1), z=0.0, yaw=np.pi)
-    res = optim.search_layout(arm, pick, place, cand, lift=lift, refine=0, workspace_samples=50_000)
+    res = optim.search_layout(optim.LayoutRequest(arm, pick, place, cand, lift=lift, refine=0,
+                                                  workspace_samples=50_000))
     what = f"layout search ({len(cand)} base positions on a 100 mm grid around the paper's; pick P1 → place P4)"
     rows = []
     at_paper = int(np.flatnonzero(np.all(np.isclose(cand[:, :2], 0.0), axis=1))[0])
     cycle_note = (f"time-optimal cycle under the joint speed limits, tool pointing down, lift {lift / MM:.0f} mm, "
                   "dwell 0.2 s (optim.plan_cycle)")
     if res.failure[at_paper]:
-        rows.append(Row("001", f"{what}: cycle at the paper's placement", None, res.failure[at_paper], "", None,
+        rows.append(Row("001", f"{what}: cycle at the paper's placement", None, res.failure[at_paper].value, "", None,
                         res.reason[at_paper].split(" (no IK")[0] + " (our tcp, tool pointing down)"))
     else:
         rows.append(Row("001", f"{what}: picks/min at the paper's placement", None,
                         float(res.picks_per_minute[at_paper]), "1/min", None, cycle_note))
-    if res.best_placement is None:
+    if res.status is optim.LayoutStatus.NO_PLACEMENT:
         rows.append(Row("001", f"{what}: best placement", None, "none", "", None,
-                        "; ".join(sorted(set(f for f in res.failure if f)))))
+                        "; ".join(sorted(set(f.value for f in res.failure if f)))))
         return rows, res
     x, y = res.best_placement[:2]
     rows.append(Row("001", f"{what}: best picks/min", None, res.best_picks_per_minute, "1/min", None,

@@ -37,9 +37,9 @@ def study_002(quick: bool = False) -> Study:
     settings = optim.GASettings.seed002()
     totals = []
     for k in range(3):
-        res = optim.minimize_time(path[:, k], "quintic-bspline", v, a, j, method="ga", seed=k,
+        res = optim.minimize_time(optim.TimingRequest(path[:, k], "quintic-bspline", v, a, j, method="ga", seed=k,
                                   settings=settings, max_generations=gens, initial=h0[None, :],
-                                  bounds=BOUNDS_002_S)
+                                  bounds=BOUNDS_002_S))
         totals.append(res.total)
         rows.append(Row("002", f"time-optimal total, joint {k + 1} alone", paper.per_joint_totals_s[k], res.total, "s",
                         None, "the paper's via points are not printed: ours is a representative path"))
@@ -47,11 +47,13 @@ def study_002(quick: bool = False) -> Study:
         rows.append(Row("002", f"time saved vs 1.89 s, joint {k + 1}",
                         100.0 * (1 - paper.per_joint_totals_s[k] / t0_printed), 100.0 * (1 - totals[k] / t0_printed),
                         "%", None, "depends on the unpublished via points"))
-    together = optim.minimize_time(path, "quintic-bspline", v, a, j, method="ga", seed=0, settings=settings,
-                                   max_generations=gens, initial=h0[None, :], bounds=BOUNDS_002_S)
+    together = optim.minimize_time(optim.TimingRequest(path, "quintic-bspline", v, a, j, method="ga", seed=0,
+                                                       settings=settings,
+                                   max_generations=gens, initial=h0[None, :], bounds=BOUNDS_002_S))
     rows.append(Row("002", "time-optimal total, 3 joints together", None, together.total, "s", None,
                     "one timing shared by all axes (what a real gantry runs)"))
-    exact = optim.minimize_time(path, "quintic-bspline", v, a, j, method="exact", seed=0, bounds=BOUNDS_002_S)
+    exact = optim.minimize_time(optim.TimingRequest(path, "quintic-bspline", v, a, j, method="exact", seed=0,
+                                                    bounds=BOUNDS_002_S))
     rows.append(Row("002", "time-optimal total, 3 joints, deterministic optimiser", None, exact.total, "s", None,
                     "reference for the GA row above (GA ≥ this; equal when converged)"))
     # jerk continuity of the quintic B-spline at the interior knots (C^4: jerk continuous)
@@ -62,8 +64,8 @@ def study_002(quick: bool = False) -> Study:
     jump = float(np.max(np.abs(jr - jl)) / j)
     rows.append(Row("002", "jerk jump at interior knots / jerk limit", 0.0, jump, "-", 1e-4,
                     "quintic B-spline is C4: jerk continuous"))
-    tj = optim.minimize_time_jerk(path, "quintic-bspline", v, a, j, seed=0, settings=settings,
-                                  max_generations=gens, bounds=BOUNDS_002_S)
+    tj = optim.minimize_time_jerk(optim.TimingRequest(path, "quintic-bspline", v, a, j, seed=0, settings=settings,
+                                  max_generations=gens, bounds=BOUNDS_002_S))
     rows.append(Row("002", "time–jerk two-stage: total", None, float(tj.total), "s", None,
                     "minimum jerk with the total at most 1.05 × its own stage-one optimum"))
 

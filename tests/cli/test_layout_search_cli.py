@@ -19,8 +19,8 @@ def test_layout_search_json_plot_and_session(tmp_path):
     result = CliRunner().invoke(cli, [*SCARA, "--refine", "0", "--json", "--plot", str(plot), "--session", str(session)])
     assert result.exit_code == 0, (result.output, result.exception)
     data = json.loads(result.stdout)
-    api = optim.search_layout(robots.load("scara_mushroom"), [0.426, 0.096, 0.14], [0.228, 0.372, 0.14],
-                              optim.grid_candidates(x=(-0.1, 0.1, 0.1), y=(0.0, 0.1, 0.1)), lift=0.02, refine=0)
+    api = optim.search_layout(optim.LayoutRequest(robots.load("scara_mushroom"), [0.426, 0.096, 0.14], [0.228, 0.372, 0.14],
+                              optim.grid_candidates(x=(-0.1, 0.1, 0.1), y=(0.0, 0.1, 0.1)), lift=0.02, refine=0))
     assert data["failures"] == api.failures() == {"unreachable": 2}
     assert [c["index"] for c in data["candidates"]] == api.order.tolist()
     best = data["candidates"][0]

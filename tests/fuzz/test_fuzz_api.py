@@ -398,7 +398,7 @@ def test_schedule_line_settings(line_cycles, data):
 
 def _layout_summary(*args, **kwargs):
     """search_layout's ranking (picks/min is 0 where a placement fails; its cycle time is NaN there by design)."""
-    res = optim.search_layout(*args, **kwargs)
+    res = optim.search_layout(optim.LayoutRequest(*args, **kwargs))
     return res.failure, res.picks_per_minute, res.best_picks_per_minute, res.margin
 
 
@@ -459,7 +459,8 @@ def test_ga_and_exact_settings(data):
                              max_generations=arg("max_generations", st.integers(1, 5), _odd_setting),
                              stall_generations=arg("stall", st.one_of(st.none(), st.integers(1, 5)), _odd_setting))
     if err is None:
-        result, err = outcome(optim.run_ga, lambda x: np.sum(x * x, axis=1), [(-1.0, 1.0), (-1.0, 1.0)],
+        result, err = outcome(lambda *args, **kwargs: optim.run_ga(optim.GARequest(*args, **kwargs)),
+                              lambda x: np.sum(x * x, axis=1), [(-1.0, 1.0), (-1.0, 1.0)],
                               settings_, max_generations=arg("max_generations", st.integers(1, 5),
                                                              st.one_of(_odd_setting, st.just(10**12))))
         if err is None:
@@ -502,7 +503,7 @@ def test_minimize_time_max_generations_outside_its_documented_range_is_refused()
 
     via = np.array([[0.0], [1.0], [0.5]])
     for bad in (0, -1, 10**9):
-        _quickly(lambda bad=bad: optim.minimize_time(via, "multi-quintic", 1.0, max_generations=bad),
+        _quickly(lambda bad=bad: optim.minimize_time(optim.TimingRequest(via, "multi-quintic", 1.0, max_generations=bad)),
                  SettingOutOfRange, "max_generations")
 
 

@@ -69,9 +69,9 @@ CORPUS = [
      "q_seed"),
     ("random-q-1e15", lambda: ur5().random_q(10**15), InvalidInput, "more than 50,000,000"),
     ("workspace-1e15", lambda: robots.sample_workspace(ur5(), 10**15), InvalidInput, "more than 50,000,000"),
-    ("minimize-time-complex-limit", lambda: optim.minimize_time([[0.0] * 6, [1.0] * 6], "multi-quintic", _C),
+    ("minimize-time-complex-limit", lambda: optim.minimize_time(optim.TimingRequest([[0.0] * 6, [1.0] * 6], "multi-quintic", _C)),
      InvalidLimits, "not numeric"),
-    ("minimize-time-vmax-5e-324", lambda: optim.minimize_time([[0.0], [1.0]], "multi-quintic", 5e-324),
+    ("minimize-time-vmax-5e-324", lambda: optim.minimize_time(optim.TimingRequest([[0.0], [1.0]], "multi-quintic", 5e-324)),
      InvalidLimits, "outside [1e-09, 1e+12]"),
     ("urdf-mimic-multiplier-0", lambda: robots.from_urdf_text(
         '<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'

@@ -43,7 +43,7 @@ def test_timing_where_two_joints_tie_names_both():
     q[1, 0] = 0.7 * v[0]
     q[1, 2] = 0.7 * v[2]  # same ratio as joint 0
     q[1, 1] = 0.3 * v[1]
-    best = optim.minimize_time(q, "multi-quintic", v, method="exact")
+    best = optim.minimize_time(optim.TimingRequest(q, "multi-quintic", v, method="exact"))
     ratio = best.peaks.velocity / v
     assert np.isclose(ratio[0], 1.0) and np.isclose(ratio[2], 1.0)
     assert near_max(ratio).tolist() == [0, 2]

@@ -23,3 +23,19 @@ def test_scara_line_through_the_api():
                      maps=maps_for(scara_line(2, 20.0, paper_limit=True), build=False))
     assert paper.figures.picks_per_minute < f.picks_per_minute  # 55 deg/s on joint 1 is slower
     assert res.as_dict()["figures"]["utilisation"] == pytest.approx(list(f.utilisation))
+
+
+def test_line_status_is_an_enum_with_a_reason_and_keeps_its_word():
+    import dataclasses
+    import json
+
+    from pinarms.optim.line import LineStatus
+
+    spec = scara_line(1, 60.0, seeds=(0,), duration=120.0)  # one arm cannot take 60 items/min
+    res = run_line(spec, maps=maps_for(spec, build=False))
+    assert res.status is LineStatus.MISSES_ABOVE_TARGET and res.figures.miss_rate > spec.target_miss_rate
+    assert "above the target 1.00 %" in res.status_reason and "add an arm" in res.status_reason
+    assert json.loads(json.dumps(res.as_dict()))["status"] == "misses above target"
+    assert "  status            misses above target" in res.summary().splitlines()
+    easy = run_line(dataclasses.replace(spec, target_miss_rate=0.99), maps=maps_for(spec, build=False))
+    assert easy.status is LineStatus.OK and easy.status_reason == ""

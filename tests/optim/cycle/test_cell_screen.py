@@ -97,10 +97,10 @@ def test_layout_search_screened_and_not_agree_on_every_candidate(station):
     cand = np.vstack([[[0.0, 0.0, 0.7, 0.0], [0.0, -0.25, 0.7, 0.0], [0.9, 0.0, 0.7, 0.0]],
                       optim.random_candidates(3, x=(-0.06, 0.06), y=(-0.06, 0.06), z=0.7, yaw=(-0.2, 0.2), seed=3)])
     kw = dict(refine=0, carry=("stand",), workspace_samples=2000)
-    fast = optim.search_layout(station, PICK, CRATE, cand, **kw)
-    full = optim.search_layout(station, PICK, CRATE, cand, screen=False, **kw)
+    fast = optim.search_layout(optim.LayoutRequest(station, PICK, CRATE, cand, **kw))
+    full = optim.search_layout(optim.LayoutRequest(station, PICK, CRATE, cand, screen=False, **kw))
     assert fast.failure == full.failure
-    assert fast.failure[:3] == ("", "collision", "unreachable")
+    assert fast.failure[:3] == (None, "collision", "unreachable")
     ok = np.array([not f for f in fast.failure])
     assert ok.sum() >= 3
     assert np.array_equal(fast.cycle_time[ok], full.cycle_time[ok])

@@ -99,13 +99,13 @@ def test_random_placements_are_capped():
                                          ("workspace_samples", 10**12), ("chunk_size", 10**12), ("seed", 2**70)])
 def test_search_layout_counts_are_capped(scara, name, value):
     cand = optim.grid_candidates(x=0.0, y=0.0)
-    refused_at_once(lambda: optim.search_layout(scara, PICK, PLACE, cand, **{name: value}), name)
+    refused_at_once(lambda: optim.search_layout(optim.LayoutRequest(scara, PICK, PLACE, cand, **{name: value})), name)
 
 
 def test_search_layout_caps_the_pairs_of_points(scara):
     picks = np.tile(PICK, (40, 1))
     places = np.tile(PLACE, (40, 1))
-    refused_at_once(lambda: optim.search_layout(scara, picks, places, np.zeros((1, 4))), "1,600", "1,000")
+    refused_at_once(lambda: optim.search_layout(optim.LayoutRequest(scara, picks, places, np.zeros((1, 4)))), "1,600", "1,000")
 
 
 def test_time_optimal_grid_and_time_scaled_samples_are_capped():
@@ -131,5 +131,5 @@ def test_ga_population_and_generations_are_capped():
         optim.GASettings(population=10**9)
     with pytest.raises(InvalidSettings, match="1,000,000"):
         optim.GASettings(max_generations=10**12)
-    refused_at_once(lambda: optim.run_ga(lambda x: x.sum(axis=1), [(0.0, 1.0)], max_generations=10**12),
+    refused_at_once(lambda: optim.run_ga(optim.GARequest(lambda x: x.sum(axis=1), [(0.0, 1.0)], max_generations=10**12)),
                     "max_generations")

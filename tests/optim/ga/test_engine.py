@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pinarms.optim import GASettings, InvalidSettings, run_ga
+from pinarms.optim import GARequest, GASettings, GAStop, InvalidSettings, run_ga
 
 PRESETS = {
     "default": GASettings(),
@@ -18,7 +18,7 @@ def sphere(x):
 
 @pytest.mark.parametrize("name", list(PRESETS))
 def test_sphere_minimum_found(name):
-    r = run_ga(sphere, [(-5.0, 5.0)] * 4, PRESETS[name], seed=0, max_generations=150)
+    r = run_ga(GARequest(sphere, [(-5.0, 5.0)] * 4, PRESETS[name], seed=0, max_generations=150))
     assert r.feasible
     np.testing.assert_allclose(r.x, 0.3, atol=1e-2)
     assert r.f < 1e-4
@@ -40,8 +40,8 @@ def _g08_con(x):
 @pytest.mark.parametrize("handling", ["adaptive-penalty", "feasibility-rules"])
 def test_g08_constrained_optimum(handling):
     s = GASettings(constraint_handling=handling)
-    r = run_ga(_g08, [(0.1, 10.0), (0.1, 10.0)], s, constraints=_g08_con, seed=3,
-               max_generations=150)
+    r = run_ga(GARequest(_g08, [(0.1, 10.0), (0.1, 10.0)], s, constraints=_g08_con, seed=3,
+               max_generations=150))
     assert r.feasible and np.all(_g08_con(r.x[None]) <= 0.0)
     assert r.f == pytest.approx(-0.0958250415, rel=1e-3)
     np.testing.assert_allclose(r.x, [1.2279713, 4.2453733], atol=2e-3)
@@ -50,28 +50,28 @@ def test_g08_constrained_optimum(handling):
 @pytest.mark.parametrize("name", list(PRESETS))
 def test_active_constraint_analytic_optimum(name):
     """min x + y s.t. x y >= 1: optimum 2 at (1, 1), on the constraint."""
-    r = run_ga(lambda x: x.sum(axis=1), [(0.1, 5.0), (0.1, 5.0)], PRESETS[name],
+    r = run_ga(GARequest(lambda x: x.sum(axis=1), [(0.1, 5.0), (0.1, 5.0)], PRESETS[name],
                constraints=lambda x: (1.0 - x[:, 0] * x[:, 1])[:, None], seed=1,
-               max_generations=200)
+               max_generations=200))
     assert r.feasible and r.x[0] * r.x[1] >= 1.0
     assert r.f == pytest.approx(2.0, rel=5e-3)
 
 
 def test_same_seed_same_result_and_generator_accepted():
     s = GASettings.seed002()
-    a = run_ga(sphere, [(-5, 5)] * 3, s, seed=42, max_generations=30)
-    b = run_ga(sphere, [(-5, 5)] * 3, s, seed=42, max_generations=30)
-    c = run_ga(sphere, [(-5, 5)] * 3, s, seed=43, max_generations=30)
+    a = run_ga(GARequest(sphere, [(-5, 5)] * 3, s, seed=42, max_generations=30))
+    b = run_ga(GARequest(sphere, [(-5, 5)] * 3, s, seed=42, max_generations=30))
+    c = run_ga(GARequest(sphere, [(-5, 5)] * 3, s, seed=43, max_generations=30))
     np.testing.assert_array_equal(a.x, b.x)
     np.testing.assert_array_equal(a.history.best, b.history.best)
     assert not np.array_equal(a.x, c.x)
-    d = run_ga(sphere, [(-5, 5)] * 3, s, seed=np.random.default_rng(42), max_generations=30)
+    d = run_ga(GARequest(sphere, [(-5, 5)] * 3, s, seed=np.random.default_rng(42), max_generations=30))
     np.testing.assert_array_equal(a.x, d.x)
 
 
 def test_history_is_monotone_and_sized():
-    r = run_ga(sphere, [(-5, 5)] * 3, GASettings(), seed=0, max_generations=40,
-               stall_generations=1000)
+    r = run_ga(GARequest(sphere, [(-5, 5)] * 3, GASettings(), seed=0, max_generations=40,
+               stall_generations=1000))
     assert r.generations == 40 and r.stop_reason == "max_generations"
     for arr in (r.history.best, r.history.mean, r.history.feasible_share):
         assert arr.shape == (41,)
@@ -90,9 +90,9 @@ def test_feasible_mean_never_dips_below_the_best_where_the_population_mean_does(
     from pinarms.scenarios import gantry_path_motor_rad
 
     v, a, j = SEED002.limits_motor
-    r = optim.minimize_time(gantry_path_motor_rad(), "quintic-bspline", v, a, j, method="ga", seed=0,
+    r = optim.minimize_time(optim.TimingRequest(gantry_path_motor_rad(), "quintic-bspline", v, a, j, method="ga", seed=0,
                             settings=GASettings.seed002(), max_generations=150,
-                            initial=SEED002.initial_durations_s[None, :], bounds=BOUNDS_002_S)
+                            initial=SEED002.initial_durations_s[None, :], bounds=BOUNDS_002_S))
     h = r.history
     dips = np.flatnonzero(h.mean < h.best)
     # measured: generations 107-110, 0-2 % of the population feasible
@@ -103,11 +103,11 @@ def test_feasible_mean_never_dips_below_the_best_where_the_population_mean_does(
 
 
 def test_stall_time_limit_and_callback_stop():
-    flat = run_ga(lambda x: np.ones(x.shape[0]), [(0, 1)] * 2, GASettings(), seed=0,
-                  max_generations=500, stall_generations=7)
+    flat = run_ga(GARequest(lambda x: np.ones(x.shape[0]), [(0, 1)] * 2, GASettings(), seed=0,
+                  max_generations=500, stall_generations=7))
     assert flat.stop_reason == "stall" and flat.generations == 7
-    slow = run_ga(sphere, [(-5, 5)] * 2, GASettings(), seed=0, max_generations=10**6,
-                  stall_generations=10**6, time_limit=0.2)
+    slow = run_ga(GARequest(sphere, [(-5, 5)] * 2, GASettings(), seed=0, max_generations=10**6,
+                  stall_generations=10**6, time_limit=0.2))
     assert slow.stop_reason == "time_limit" and slow.wall_time < 2.0
     seen = []
 
@@ -115,33 +115,33 @@ def test_stall_time_limit_and_callback_stop():
         seen.append(progress.generation)
         return progress.generation >= 5
 
-    cb = run_ga(sphere, [(-5, 5)] * 2, GASettings(), seed=0, callback=stop_at_5)
+    cb = run_ga(GARequest(sphere, [(-5, 5)] * 2, GASettings(), seed=0), callback=stop_at_5)
     assert cb.stop_reason == "callback" and seen == [1, 2, 3, 4, 5]
 
 
 def test_initial_population_drawn_feasible_and_seeded():
     # Feasible only in a thin shell: x^2 + y^2 within [0.9, 1.0] inside [-1, 1]^2 (~15 %).
     con = lambda x: np.stack([np.sum(x**2, 1) - 1.0, 0.9 - np.sum(x**2, 1)], axis=1)
-    r = run_ga(sphere, [(-1, 1), (-1, 1)], GASettings(), constraints=con, seed=0,
-               max_generations=0)
+    r = run_ga(GARequest(sphere, [(-1, 1), (-1, 1)], GASettings(), constraints=con, seed=0,
+               max_generations=0))
     assert r.history.feasible_share[0] > 0.9
     given = np.array([[0.3, 0.3]])
-    r = run_ga(sphere, [(-1, 1), (-1, 1)], GASettings(), seed=0, max_generations=0,
-               initial=given)
+    r = run_ga(GARequest(sphere, [(-1, 1), (-1, 1)], GASettings(), seed=0, max_generations=0,
+               initial=given))
     np.testing.assert_array_equal(r.x, given[0])
 
 
 def test_no_feasible_point_is_reported():
-    r = run_ga(sphere, [(0, 1)], GASettings(), constraints=lambda x: 2.0 - x, seed=0,
-               max_generations=20)
+    r = run_ga(GARequest(sphere, [(0, 1)], GASettings(), constraints=lambda x: 2.0 - x, seed=0,
+               max_generations=20))
     assert not r.feasible and r.violation == pytest.approx(1.0, abs=1e-6)
 
 
 def test_bad_bounds_and_settings_raise():
     with pytest.raises(InvalidSettings, match="lower > upper"):
-        run_ga(sphere, [(1.0, 0.0)], GASettings())
+        GARequest(sphere, [(1.0, 0.0)], GASettings())
     with pytest.raises(InvalidSettings, match="finite"):
-        run_ga(sphere, [(0.0, np.inf)], GASettings())
+        GARequest(sphere, [(0.0, np.inf)], GASettings())
     with pytest.raises(InvalidSettings, match="population"):
         GASettings(population=2)
     with pytest.raises(InvalidSettings, match="pc1 >= pc2"):
@@ -175,10 +175,23 @@ def test_presets_match_papers():
 def test_bad_run_options_raise_named_errors(kwargs, message):
     # A NaN time limit used to be ignored silently (elapsed >= nan is never true).
     with pytest.raises(InvalidSettings, match=message.replace("(", r"\(").replace(".", r"\.")):
-        run_ga(sphere, [(-1, 1), (-1, 1)], **{"settings": GASettings(), **kwargs})
+        GARequest(sphere, [(-1, 1), (-1, 1)], **{"settings": GASettings(), **kwargs})
 
 
 @pytest.mark.parametrize("field", ["population", "crossover_probability", "elitism"])
 def test_settings_with_non_numbers_raise_named_errors(field):
     with pytest.raises(InvalidSettings, match=f"'{field}': None"):
         GASettings(**{field: None})
+
+
+def test_a_ga_request_is_checked_when_built_and_the_stop_is_an_enum():
+    with pytest.raises(InvalidSettings, match="objective must be callable"):
+        GARequest("sphere", [(0.0, 1.0)])
+    with pytest.raises(InvalidSettings, match="initial of shape"):
+        GARequest(sphere, [(0.0, 1.0)] * 2, initial=[[0.5, 0.5, 0.5]])
+    bounds = np.array([[-5.0, 5.0]] * 2)
+    request = GARequest(sphere, bounds, seed=0, max_generations=3, stall_generations=100)
+    bounds[0, 0] = 0.0  # the request keeps its own read-only copy
+    assert request.bounds[0, 0] == -5.0 and not request.bounds.flags.writeable
+    r = run_ga(request)
+    assert r.stop_reason is GAStop.MAX_GENERATIONS and f"{r.stop_reason}" == "max_generations"

@@ -8,7 +8,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.optim.layout.bound import _travel, cycle_lower_bounds, threshold
-from pinarms.optim.layout.search import search_layout
+from pinarms.optim.layout.search import LayoutRequest, search_layout
 
 PICK, PLACE = np.array([-0.2, 0.0, 0.14]), np.array([0.2, 0.0, 0.14])
 
@@ -28,8 +28,8 @@ def candidates():
 
 def test_the_bounded_search_agrees_with_the_exhaustive_one(scara, candidates):
     kw = dict(lift=0.02, dwell=0.05, refine=2, refine_evaluations=2, workspace_samples=2000)
-    full = search_layout(scara, PICK, PLACE, candidates, **kw)
-    fast = search_layout(scara, PICK, PLACE, candidates, bound=True, **kw)
+    full = search_layout(LayoutRequest(scara, PICK, PLACE, candidates, **kw))
+    fast = search_layout(LayoutRequest(scara, PICK, PLACE, candidates, bound=True, **kw))
     planned = [i for i, f in enumerate(fast.failure) if f != "outranked"]
     assert fast.failure.count("outranked") >= 1  # something was skipped: the test can tell the routes apart
     assert "not planned" in fast.reason[fast.failure.index("outranked")]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from pinarms import scenarios
-from pinarms.optim import GASettings, TimingProblem, minimize_time
+from pinarms.optim import GASettings, TimingProblem, TimingRequest, minimize_time
 from pinarms.optim.timing.exact import polish_durations
 from tests.optim.helpers import dense_peaks
 
@@ -63,10 +63,10 @@ def test_custom_builder_still_evaluated_one_by_one():
 
 def test_ga_polish_reaches_the_exact_optimum_and_keeps_the_ga_total():
     settings = GASettings.seed000()
-    plain = minimize_time(S0.positions, S0.kind, S0.vmax, method="ga", settings=settings, seed=4,
-                          max_generations=15)
-    polished = minimize_time(S0.positions, S0.kind, S0.vmax, method="ga", settings=settings, seed=4,
-                             max_generations=15, polish=True)
+    plain = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="ga", settings=settings, seed=4,
+                          max_generations=15))
+    polished = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="ga", settings=settings, seed=4,
+                             max_generations=15, polish=True))
     assert plain.method == "ga" and plain.unpolished_total is None
     assert polished.method == "ga+polish"
     # Same seed, same GA: the polish starts from exactly the plain GA answer.
@@ -88,9 +88,9 @@ def test_polish_never_worsens_and_respects_bounds():
 @pytest.mark.slow
 def test_seed002_ga_with_and_without_polish():
     p = TimingProblem(S2.positions, S2.kind, S2.vmax, S2.amax, S2.jmax)
-    exact = minimize_time(None, None, None, method="exact", problem=p)
-    ga = minimize_time(None, None, None, method="ga", problem=p, seed=0, max_generations=150)
-    gp = minimize_time(None, None, None, method="ga", problem=p, seed=0, max_generations=150, polish=True)
+    exact = minimize_time(TimingRequest(method="exact", problem=p))
+    ga = minimize_time(TimingRequest(method="ga", problem=p, seed=0, max_generations=150))
+    gp = minimize_time(TimingRequest(method="ga", problem=p, seed=0, max_generations=150, polish=True))
     assert gp.unpolished_total == pytest.approx(ga.total, rel=1e-12)
     assert exact.total * (1 - 1e-9) <= gp.total <= ga.total
     assert gp.total <= exact.total * 1.001  # the polish lands on the exact optimum's basin here

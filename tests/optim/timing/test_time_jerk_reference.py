@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pinarms.optim import (InvalidSettings, jerk_integral, minimize_time, minimize_time_jerk,
+from pinarms.optim import (InvalidSettings, TimingRequest, jerk_integral, minimize_time, minimize_time_jerk,
                    path_velocity_limit, ruckig_limit, double_s_limit, toppra_limit)
 from pinarms import scenarios
 from tests.optim.helpers import dense_peaks
@@ -13,7 +13,7 @@ S0 = scenarios.seed000()
 
 
 def test_jerk_integral_is_exact():
-    traj = minimize_time(S0.positions, S0.kind, S0.vmax, method="exact").trajectory
+    traj = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact")).trajectory
     # Independent: fine trapezoid per piece (jerk is discontinuous at the knots).
     total = 0.0
     for a, b in zip(traj.knot_times[:-1], traj.knot_times[1:]):
@@ -24,19 +24,19 @@ def test_jerk_integral_is_exact():
 
 @pytest.mark.parametrize("method", ["exact", pytest.param("ga", marks=pytest.mark.slow)])
 def test_two_stage_holds_time_cap_and_lowers_jerk(method):
-    r = minimize_time_jerk(S0.positions, S0.kind, S0.vmax, mode="two-stage", method=method,
-                           time_factor=1.1, max_generations=40)
+    r = minimize_time_jerk(TimingRequest(S0.positions, S0.kind, S0.vmax, method=method, max_generations=40),
+                           mode="two-stage", time_factor=1.1)
     assert r.total <= 1.1 * r.time_optimal_total * (1 + 1e-9)
-    fastest = minimize_time(S0.positions, S0.kind, S0.vmax, method="exact")
+    fastest = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact"))
     assert r.jerk_integral < jerk_integral(fastest.trajectory)
     assert np.all(dense_peaks(r.trajectory)[0] <= S0.vmax * (1 + 1e-9))
 
 
 def test_weighted_exact_closed_form_scale_and_ga_agree():
     kw = dict(mode="weighted", k_time=1.0, k_jerk=1e-3)
-    ex = minimize_time_jerk(S1.positions, S1.kind, S1.vmax, method="exact", **kw)
-    ga = minimize_time_jerk(S1.positions, S1.kind, S1.vmax, method="ga", seed=0,
-                            max_generations=80, **kw)
+    ex = minimize_time_jerk(TimingRequest(S1.positions, S1.kind, S1.vmax, method="exact"), **kw)
+    ga = minimize_time_jerk(TimingRequest(S1.positions, S1.kind, S1.vmax, method="ga", seed=0, max_generations=80),
+                            **kw)
     assert ex.objective <= ga.objective * (1 + 1e-6)
     assert ga.objective <= ex.objective * 1.02
     assert ex.objective == pytest.approx(ex.total + 1e-3 * ex.jerk_integral)
@@ -45,13 +45,13 @@ def test_weighted_exact_closed_form_scale_and_ga_agree():
 
 def test_time_jerk_arguments_checked():
     with pytest.raises(InvalidSettings):
-        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, time_factor=0.9)
+        minimize_time_jerk(TimingRequest(S0.positions, S0.kind, S0.vmax), time_factor=0.9)
     with pytest.raises(InvalidSettings):
-        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, mode="pareto")
+        minimize_time_jerk(TimingRequest(S0.positions, S0.kind, S0.vmax), mode="pareto")
 
 
 def test_references_bound_the_polynomial_timing():
-    r = minimize_time(S0.positions, S0.kind, S0.vmax, method="exact")
+    r = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact"))
     # Monotone single-joint path at 55 deg/s: 69 deg / 55 deg/s.
     assert path_velocity_limit(r.trajectory, S0.vmax) == pytest.approx(69.0 / 55.0, rel=1e-6)
     a = 4.0

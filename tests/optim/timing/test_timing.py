@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from pinarms.optim import (GASettings, InfeasibleProblem, InvalidLimits, TimingProblem, minimize_time)
+from pinarms.optim import (GASettings, InfeasibleProblem, InvalidLimits, TimingProblem, TimingRequest, TimingStatus,
+                           minimize_time)
 from pinarms import scenarios
 from tests.optim.helpers import build_353, dense_peaks
 
@@ -25,7 +26,7 @@ def _assert_feasible(result, vmax, amax=None, jmax=None):
 
 @pytest.fixture(scope="module")
 def seed000_exact():
-    return minimize_time(S0.positions, S0.kind, S0.vmax, method="exact")
+    return minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact"))
 
 
 def test_seed000_exact_optimum_is_below_paper(seed000_exact):
@@ -48,8 +49,8 @@ def test_seed000_paper_times_give_44_deg_s_not_54():
 
 
 def test_seed000_ga_within_half_percent_of_exact():
-    r = minimize_time(S0.positions, S0.kind, S0.vmax, method="ga",
-                      settings=GASettings.seed000(), seed=0, max_generations=40)
+    r = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="ga",
+                      settings=GASettings.seed000(), seed=0, max_generations=40))
     _assert_feasible(r, S0.vmax)
     assert r.total <= SEED000_OPTIMUM * 1.005
     assert r.total >= SEED000_OPTIMUM * (1 - 1e-6)  # nobody beats the optimum
@@ -68,12 +69,12 @@ def test_planning_353_matches_independent_builder():
 
 def test_seed001_closed_form_rest_to_rest_quintics():
     s = scenarios.seed001()
-    r = minimize_time(s.positions, s.kind, s.vmax, method="exact")
+    r = minimize_time(TimingRequest(s.positions, s.kind, s.vmax, method="exact"))
     # At rest at every via point each quintic peaks at 15/8 * dq / h.
     expected = 1.875 * np.max(np.abs(np.diff(s.positions, axis=0)) / s.vmax, axis=1)
     np.testing.assert_allclose(r.durations, expected, rtol=1e-6)
     _assert_feasible(r, s.vmax)
-    g = minimize_time(s.positions, s.kind, s.vmax, method="ga", seed=1, max_generations=60)
+    g = minimize_time(TimingRequest(s.positions, s.kind, s.vmax, method="ga", seed=1, max_generations=60))
     _assert_feasible(g, s.vmax)
     assert g.total <= r.total * 1.01
 
@@ -81,29 +82,29 @@ def test_seed001_closed_form_rest_to_rest_quintics():
 @pytest.mark.parametrize("bad", [0.0, -1.0, np.nan, np.inf, [1.0, 2.0], "fast"])
 def test_invalid_limits_raise(bad):
     with pytest.raises(InvalidLimits):
-        minimize_time(S0.positions, S0.kind, bad)
+        TimingRequest(S0.positions, S0.kind, bad)
     with pytest.raises(InvalidLimits):
-        minimize_time(S0.positions, S0.kind, 1.0, amax=bad)
+        TimingRequest(S0.positions, S0.kind, 1.0, amax=bad)
 
 
 def test_missing_vmax_and_bad_kind():
     with pytest.raises(InvalidLimits, match="vmax is required"):
-        minimize_time(S0.positions, S0.kind, None)
+        TimingRequest(S0.positions, S0.kind, None)
     with pytest.raises(ValueError, match="kind"):
-        minimize_time(S0.positions, "septic", 1.0)
+        TimingRequest(S0.positions, "septic", 1.0)
 
 
 @pytest.mark.parametrize("method", ["ga", "exact"])
 def test_no_feasible_timing_within_bounds_says_so(method):
     # Upper bounds sum to 1.5 s < 2.608 s needed: no feasible timing exists.
     with pytest.raises(InfeasibleProblem, match="bounds"):
-        minimize_time(S0.positions, S0.kind, S0.vmax, method=method, bounds=(0.1, 0.5),
-                      max_generations=15)
+        minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method=method, bounds=(0.1, 0.5),
+                      max_generations=15))
 
 
 def test_bounds_respected_when_active():
-    r = minimize_time(S0.positions, S0.kind, S0.vmax, method="exact",
-                      bounds=[(0.1, 3.0), (1.0, 3.0), (0.1, 3.0)])
+    r = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact",
+                      bounds=[(0.1, 3.0), (1.0, 3.0), (0.1, 3.0)]))
     assert r.durations[1] >= 1.0 - 1e-12
     assert r.total > SEED000_OPTIMUM  # the unconstrained optimum has h2 = 0.708 s
     _assert_feasible(r, S0.vmax)
@@ -115,10 +116,10 @@ def test_seed002_gantry_exact_and_ga_feasible():
     p = TimingProblem(s.positions, s.kind, s.vmax, s.amax, s.jmax)
     # The paper's initial times break the jerk limit on this path (documented).
     assert p.limit_ratios(s.initial_durations).max() > 1.0
-    ex = minimize_time(None, None, None, method="exact", problem=p)
+    ex = minimize_time(TimingRequest(method="exact", problem=p))
     _assert_feasible(ex, s.vmax, s.amax, s.jmax)
     assert ex.total == pytest.approx(1.4830, abs=2e-3)
-    ga = minimize_time(None, None, None, method="ga", problem=p, seed=0, max_generations=80)
+    ga = minimize_time(TimingRequest(method="ga", problem=p, seed=0, max_generations=80))
     _assert_feasible(ga, s.vmax, s.amax, s.jmax)
     assert ex.total <= ga.total * (1 + 1e-6) and ga.total < 1.89
 
@@ -128,7 +129,7 @@ def test_seed002_gantry_exact_and_ga_feasible():
 def test_single_segment_point_to_point_is_solved(kind, method):
     # One rest-to-rest quintic peaks at 15/8 d/T: with d = 0.8 rad, vmax 2 rad/s the
     # minimum time is 0.75 s. The default bounds used to stop just below it (infeasible).
-    r = minimize_time([0.2, 1.0], kind, 2.0, method=method, seed=0, max_generations=20)
+    r = minimize_time(TimingRequest([0.2, 1.0], kind, 2.0, method=method, seed=0, max_generations=20))
     assert r.total == pytest.approx(15 / 8 * 0.8 / 2.0, rel=1e-8)
     _assert_feasible(r, 2.0)
 
@@ -138,7 +139,7 @@ def test_353_needs_exactly_four_via_points():
 
     for q in ([0.0, 1.0], [0.0, 1.0, 2.0], [0.0, 1.0, 2.0, 3.0, 4.0]):
         with pytest.raises(InvalidInput, match=f"needs 4 via points, got {len(q)}"):
-            minimize_time(q, "3-5-3", 1.0, method="exact")
+            TimingRequest(q, "3-5-3", 1.0, method="exact")
 
 
 def test_non_numeric_positions_bounds_and_unknown_options_are_named():
@@ -146,15 +147,15 @@ def test_non_numeric_positions_bounds_and_unknown_options_are_named():
     from pinarms.robots.errors import InvalidInput
 
     with pytest.raises(InvalidInput, match="positions=.*not numeric"):
-        minimize_time(["a", "b"], "multi-quintic", 1.0)
+        TimingRequest(["a", "b"], "multi-quintic", 1.0)
     with pytest.raises(InvalidSettings, match="bounds='short' are not numeric"):
-        minimize_time(S0.positions, S0.kind, S0.vmax, bounds="short")
+        TimingRequest(S0.positions, S0.kind, S0.vmax, bounds="short")
     with pytest.raises(InvalidSettings, match=r"\['speed'\] are not options of the 'multi-quintic'"):
-        minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, trajectory_options={"speed": 1})
+        TimingRequest([0.0, 1.0, 2.0], "multi-quintic", 1.0, trajectory_options={"speed": 1})
     # Known options still pass through (heuristic via velocities change the optimum).
-    rest = minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact")
-    moving = minimize_time([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact",
-                           trajectory_options={"velocities": "heuristic"})
+    rest = minimize_time(TimingRequest([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact"))
+    moving = minimize_time(TimingRequest([0.0, 1.0, 2.0], "multi-quintic", 1.0, method="exact",
+                           trajectory_options={"velocities": "heuristic"}))
     assert moving.total < rest.total * 0.9
 
 
@@ -163,9 +164,43 @@ def test_bad_seed_is_refused_before_any_work(method):
     from pinarms.optim import InvalidSettings, minimize_time_jerk
 
     with pytest.raises(InvalidSettings, match="seed=-1"):
-        minimize_time(S0.positions, S0.kind, S0.vmax, method=method, seed=-1)
+        TimingRequest(S0.positions, S0.kind, S0.vmax, method=method, seed=-1)
     with pytest.raises(InvalidSettings, match="time_factor='a'"):
-        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, method=method, time_factor="a")
+        minimize_time_jerk(TimingRequest(S0.positions, S0.kind, S0.vmax, method=method), time_factor="a")
     with pytest.raises(InvalidSettings, match="k_time='a'"):
-        minimize_time_jerk(S0.positions, S0.kind, S0.vmax, method=method, mode="weighted",
-                           k_time="a")
+        minimize_time_jerk(TimingRequest(S0.positions, S0.kind, S0.vmax, method=method), mode="weighted", k_time="a")
+
+
+def _scara():
+    from pinarms import robots
+
+    return robots.load("scara_mushroom")
+
+
+def test_a_timing_request_refuses_bad_settings_when_built_and_holds_its_problem():
+    from pinarms.optim import InvalidSettings, SettingOutOfRange
+
+    with pytest.raises(InvalidSettings, match="method='fast'"):
+        TimingRequest(S0.positions, S0.kind, S0.vmax, method="fast")
+    with pytest.raises(SettingOutOfRange, match="max_generations = 0"):
+        TimingRequest(S0.positions, S0.kind, S0.vmax, max_generations=0)
+    with pytest.raises(InvalidSettings, match="not both"):
+        TimingRequest(problem=TimingProblem(S0.positions, S0.kind, S0.vmax), robot=_scara(), torque_limits=True)
+    positions = np.array(S0.positions, dtype=float)
+    request = TimingRequest(positions, S0.kind, S0.vmax, method="exact")
+    assert isinstance(request.problem, TimingProblem) and request.problem.kind == S0.kind
+    positions[:] = 0.0  # the request and its problem keep their own read-only copy
+    assert not request.positions.flags.writeable
+    assert minimize_time(request).total == minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax,
+                                                                       method="exact")).total
+
+
+def test_the_status_says_how_the_optimiser_ended():
+    exact = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, method="exact"))
+    assert exact.status is TimingStatus.SOLVED and exact.status_reason == "" and f"{exact.status}" == "solved"
+    ga = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, seed=0, max_generations=3, stall_generations=50))
+    assert ga.status is TimingStatus.MAX_GENERATIONS and ga.status == ga.stop_reason == "max_generations"
+    stopped = minimize_time(TimingRequest(S0.positions, S0.kind, S0.vmax, seed=0, max_generations=50),
+                            callback=lambda progress: True)
+    assert stopped.status is TimingStatus.CALLBACK and "best so far" in stopped.status_reason
+    _assert_feasible(stopped, S0.vmax)  # a stopped GA still returns a verified timing

@@ -23,7 +23,7 @@ def aubo():
 
 @pytest.fixture(scope="module")
 def kinematic(aubo):
-    return optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="exact")
+    return optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="exact"))
 
 
 @pytest.fixture(scope="module")
@@ -42,15 +42,15 @@ def _dense_ratio(robot, trajectory, limit, n=100_001):
 
 @pytest.mark.parametrize("method", ["exact", "ga"])
 def test_torque_limited_timing_is_feasible_densely_and_never_shorter(aubo, kinematic, tight_limits, method):
-    res = optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method=method, seed=1,
-                              max_generations=40, robot=aubo, payload=3.0, torque_limits=tight_limits)
+    res = optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method=method, seed=1,
+                              max_generations=40, robot=aubo, payload=3.0, torque_limits=tight_limits))
     loaded = aubo.with_payload(3.0)
     dense = _dense_ratio(loaded, res.trajectory, tight_limits)
     assert np.all(dense <= 1.0 + 1e-9)
     np.testing.assert_allclose(res.torque_ratios, res.torque_peaks.torque / tight_limits)
     assert np.all(res.torque_ratios <= 1.0 + 1e-9)
-    reference = kinematic.total if method == "exact" else optim.minimize_time(
-        VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="ga", seed=1, max_generations=40).total
+    reference = kinematic.total if method == "exact" else optim.minimize_time(optim.TimingRequest(
+        VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="ga", seed=1, max_generations=40)).total
     assert res.total >= reference * (1.0 - 1e-9)
     assert res.total > reference * 1.01  # the limits bind: a real slow-down, not round-off
     if method == "exact":
@@ -59,8 +59,8 @@ def test_torque_limited_timing_is_feasible_densely_and_never_shorter(aubo, kinem
 
 
 def test_generous_limits_leave_the_kinematic_optimum(aubo, kinematic):
-    res = optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="exact",
-                              robot=aubo, torque_limits=np.full(6, 1e4))
+    res = optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, 8.0, method="exact",
+                              robot=aubo, torque_limits=np.full(6, 1e4)))
     assert res.total == pytest.approx(kinematic.total, rel=1e-9)
     assert res.torque_ratios.max() < 0.1
 
@@ -86,21 +86,21 @@ def test_the_scaling_law_equals_a_bisection_on_the_grid(aubo, tight_limits):
 
 def test_an_arm_that_cannot_hold_the_load_is_named(aubo):
     with pytest.raises(InfeasibleProblem, match=r"cannot hold via point 0 still: joint upperArm_joint"):
-        optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, method="exact", robot=aubo,
-                            payload=3.0, torque_limits=[100.0, 1.0, 100.0, 100.0, 100.0, 100.0])
+        optim.minimize_time(optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, method="exact", robot=aubo,
+                            payload=3.0, torque_limits=[100.0, 1.0, 100.0, 100.0, 100.0, 100.0]))
 
 
 def test_torque_keywords_are_checked(aubo):
     with pytest.raises(InvalidSettings, match="robot=arm"):
-        optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, torque_limits=True)
+        optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, torque_limits=True)
     with pytest.raises(InvalidSettings, match="payload changes only the torques"):
-        optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, payload=1.0)
+        optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, payload=1.0)
     with pytest.raises(InvalidLimits, match="torque limit"):
-        optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, torque_limits=[1.0, -2.0])
+        optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, torque_limits=[1.0, -2.0])
     with pytest.raises(robots.InvalidPayload, match="negative mass"):
-        optim.minimize_time(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, payload=-1.0, torque_limits=True)
+        optim.TimingRequest(VIA, "multi-quintic", aubo.velocity_limit, robot=aubo, payload=-1.0, torque_limits=True)
     with pytest.raises(InvalidSettings, match="via points have 2"):
-        optim.minimize_time(VIA[:, :2], "multi-quintic", 1.0, robot=aubo, torque_limits=True)
+        optim.TimingRequest(VIA[:, :2], "multi-quintic", 1.0, robot=aubo, torque_limits=True)
 
 
 def test_urdf_without_efforts_asks_for_limits():
@@ -111,7 +111,7 @@ def test_urdf_without_efforts_asks_for_limits():
         "<limit lower='-1' upper='1' effort='0' velocity='1'/></joint>"
         "<joint name='t' type='fixed'><parent link='a'/><child link='tcp'/><origin xyz='0.2 0 0'/></joint></robot>")
     with pytest.raises(InvalidLimits, match=r"no effort limit for joint\(s\) \['j'\]"):
-        optim.minimize_time([[0.0], [0.5]], "multi-quintic", 1.0, robot=bare, torque_limits=True)
+        optim.TimingRequest([[0.0], [0.5]], "multi-quintic", 1.0, robot=bare, torque_limits=True)
 
 
 def test_cycle_carries_the_payload_to_the_place_only(aubo):
@@ -168,8 +168,8 @@ def test_toppra_agrees_with_the_exact_time_optimal_scaling_on_one_segment(aubo, 
     assert ours.duration == pytest.approx(reference, rel=0.02)
     dense = _dense_ratio(loaded, ours.trajectory, aubo.effort_limit, 50_001)
     assert np.all(dense <= 1.0 + 1e-9) and dense.max() > 0.999  # feasible and tight
-    poly = optim.minimize_time(VIA[[0, 2]], "multi-quintic", aubo.velocity_limit, method="exact",
-                               robot=aubo, payload=payload, torque_limits=True)
+    poly = optim.minimize_time(optim.TimingRequest(VIA[[0, 2]], "multi-quintic", aubo.velocity_limit, method="exact",
+                               robot=aubo, payload=payload, torque_limits=True))
     assert poly.total >= ours.duration
     # the reference on the polynomial's own path (spline of its samples, cut at rests) says the same
     assert optim.toppra_limit(poly.trajectory, aubo.velocity_limit, robot=aubo, payload=payload,
@@ -195,5 +195,5 @@ def test_a_path_through_a_pose_the_arm_cannot_hold_is_named(aubo):
     for method in ("exact", "ga"):
         with pytest.raises(InfeasibleProblem, match=r"cannot hold the path still between via points 0 and 1 .* "
                                                     r"joint upperArm_joint needs"):
-            optim.minimize_time(np.array([q0, q1]), "multi-quintic", aubo.velocity_limit, method=method,
-                                max_generations=5, robot=aubo, payload=3.0, torque_limits=limits)
+            optim.minimize_time(optim.TimingRequest(np.array([q0, q1]), "multi-quintic", aubo.velocity_limit, method=method,
+                                max_generations=5, robot=aubo, payload=3.0, torque_limits=limits))

@@ -83,5 +83,5 @@ def test_candidates_feed_search_layout_directly(aubo, down_map):
                             down_map.orientations.tool_axis)
     bp = base_placements(down_map, tasks, robot=aubo, z=0.0, yaw_step=2 * np.pi, verify=3)
     assert bp.verified[:3].all() and np.all(bp.candidates[:, 3] == 0.0)
-    res = optim.search_layout(aubo, pick, place, bp.candidates[:3], lift=0.05, refine=0)
+    res = optim.search_layout(optim.LayoutRequest(aubo, pick, place, bp.candidates[:3], lift=0.05, refine=0))
     assert res.ok.all() and res.best_picks_per_minute > 0
