@@ -1,11 +1,11 @@
-"""The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
+"""The planned transfer: what ``plan_cycle`` in a cell falls back to when raising it cannot clear.
 
 :func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
 adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
-plans the transfer between "above pick" and "above place" with :func:`plan_motion`'s
+plans the transfer between "above pick" and "above place" with :func:`optim.plan_motion`'s
 search, shortcut and smoothing (OMPL, every edge proven continuously); the move back runs
 the same path in reverse. Each part is timed optimally from rest to rest under the cycle's
 limits (joint velocity and acceleration; the URDF's torque limits when no acceleration
@@ -23,7 +23,9 @@ import numpy as np
 
 from pinarms.optim.cycle.spec import _hold, _line_deviation, _vertical_segments
 from pinarms.optim.motion.checker import MotionChecker
-from pinarms.optim.motion.plan import _limits, plan_geometry, time_path
+from pinarms.optim.motion.geometry import plan_geometry
+from pinarms.optim.motion.plan import time_path
+from pinarms.optim.motion.request import MotionLimits, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import CollisionError
@@ -150,7 +152,7 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
     amax = base.amax
     torque = True if amax is None and base.torque_limit is None else (base.torque_limit
                                                                        if base.torque_limit is not None else False)
-    constraints, _ = _limits(cell, (arm.name,), base.vmax, amax, torque)
+    constraints, _ = motion_constraints(cell, (arm.name,), MotionLimits(vmax=base.vmax, amax=amax, torque=torque))
 
     def move(paths: list) -> tuple[PlannedMove, list]:
         parts = tuple(time_path(p, constraints) for p in paths)

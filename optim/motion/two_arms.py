@@ -30,9 +30,12 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError, StartInCollision
+from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError
 from pinarms.optim.motion.checker import MotionChecker, TimedArm
-from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_motion
+from pinarms.optim.motion.ends import arm_joints, check_end
+from pinarms.optim.motion.plan import plan_motion
+from pinarms.optim.motion.request import MotionLimits, MotionOptions, MotionRequest
+from pinarms.optim.motion.result import MotionPlan, MotionStatus
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import InvalidInput
 
@@ -185,18 +188,19 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
     for m in timed:
         parked[cell.arm(m.arm).q_slice] = m.trajectory.sample(m.trajectory.end_time)[0]
     together = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=base, moving=timed)
-    x0 = _joints(cell, arms, start, "start")
-    _check_start(together, np.append(x0, t0), "start")
+    x0 = arm_joints(cell, arms, start, "start")
+    check_end(together, np.append(x0, t0), "start")
     say("planning the path around the other arm(s) parked at the end of their motion")
-    try:
-        # no re-check of the motion against A parked: the motion kept is checked against A moving
-        plan = plan_motion(cell, arms[0], x0, goal, margin=margin, self_margin=self_margin, planner=planner,
-                           time_limit=time_limit, seed=seed, hold=parked, vmax=vmax, amax=amax, torque=torque,
-                           grid=grid, recheck=False)
-    except StartInCollision as exc:
-        raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({exc}): it "
-                          "cannot wait there; plan both arms together", planner="", time_limit=float(time_limit)) \
-            from exc
+    # no re-check of the motion against A parked: the motion kept is checked against A moving
+    options = MotionOptions(margin=margin, self_margin=self_margin, planner=planner, time_limit=time_limit, seed=seed,
+                            recheck=False)
+    plan = plan_motion(MotionRequest(cell, arms[0], x0, goal, options=options, hold=parked,
+                                     limits=MotionLimits(vmax=vmax, amax=amax, torque=torque, grid=grid)))
+    if plan.status is MotionStatus.START_IN_COLLISION:
+        raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({plan.reason}): "
+                          "it cannot wait there; plan both arms together", planner="",
+                          time_limit=float(time_limit)) from plan.error
+    plan.raise_for_status()
     t = time.perf_counter()
     t_end = max(m.offset + m.trajectory.duration for m in timed)
     delays = np.arange(0.0, max(t_end - t0, 0.0) + delay_step, delay_step)
@@ -272,12 +276,13 @@ def plan_two_arms(cell: Any, arm: str, start: Any, goal: Any, other: str, other_
     now = float(np.clip(t0 - other_offset + tr.start_time, tr.start_time, tr.end_time))
     a_start = np.asarray(tr.sample(now)[0], dtype=float)  # where A is when both leave
     a_end = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
-    b_start = _joints(cell, (cell.arm(arm).name,), start, "start")
+    b_start = arm_joints(cell, (cell.arm(arm).name,), start, "start")
     b_goal = goal[arm] if isinstance(goal, Mapping) else goal
-    joint = plan_motion(cell, (other, arm), {other: a_start, arm: b_start},
-                        {other: a_end, arm: np.asarray(b_goal, dtype=float)}, margin=margin, self_margin=self_margin,
-                        planner=planner, time_limit=time_limit, seed=seed, hold=hold, vmax=vmax, amax=amax,
-                        torque=torque, progress=progress)
+    options = MotionOptions(margin=margin, self_margin=self_margin, planner=planner, time_limit=time_limit, seed=seed)
+    request = MotionRequest(cell, (other, arm), {other: a_start, arm: b_start},
+                            {other: a_end, arm: np.asarray(b_goal, dtype=float)}, options=options, hold=hold,
+                            limits=MotionLimits(vmax=vmax, amax=amax, torque=torque))
+    joint = plan_motion(request, progress=progress).raise_for_status()
     attempts.append(("joint", f"both arms together, {joint.duration:.3f} s"))
     na = cell.arm(other).nq
     traj = joint.trajectory

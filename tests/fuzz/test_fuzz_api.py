@@ -377,7 +377,7 @@ def line_cycles():
     for name, (pick, place) in tasks.items():
         arm = cell.arm(name)
         spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.09, dwell=0.15)
-        cycles[name] = optim.plan_cycle(arm.robot, spec)
+        cycles[name] = optim.plan_cycle(optim.CycleRequest(arm.robot, spec))
     return cell, cycles
 
 
@@ -514,14 +514,11 @@ def crate_guard():
 
 
 @pytest.mark.parametrize("seed", [-1, 2**64, 1.5])
-def test_plan_motion_seed_outside_its_range_is_a_named_error(crate_guard, seed):
+def test_plan_motion_seed_outside_its_range_is_a_named_error(seed):
     from pinarms.optim.errors import InvalidSettings
-    from pinarms.optim.motion import plan_motion
+    from pinarms.optim.motion import MotionOptions
 
-    cell = crate_guard
-    arm = cell.arms[0]
-    start = arm.robot.neutral
-    _quickly(lambda: plan_motion(cell, arm.name, start, start + 0.1, seed=seed), InvalidSettings, "seed")
+    _quickly(lambda: MotionOptions(seed=seed), InvalidSettings, "seed")
 
 
 @pytest.mark.parametrize("path", ["arm\0.urdf", "a" * 300 + ".urdf", "d/" * 3000 + "arm.urdf"])
