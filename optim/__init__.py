@@ -19,8 +19,8 @@ a :class:`MotionPlan` with a :class:`MotionStatus` out), proves it continuously 
 """
 
 from pinarms.optim.cycle.in_cell import CellCycleReport
-from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleResult, CycleTiming, PickPlace,
-                                  plan_cycle)
+from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleResult, CycleStatus,
+                                  CycleTiming, PickPlace, plan_cycle)
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
@@ -52,6 +52,7 @@ __all__ = [
     "minimize_time_jerk",
     "PickPlace",
     "CycleResult",
+    "CycleStatus",
     "CycleRequest",
     "CycleTiming",
     "CycleLoad",
