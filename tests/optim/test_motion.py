@@ -14,12 +14,13 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.optim import GoalInCollision, InvalidLimits, InvalidSettings, NoPathFound, StartInCollision
+from pinarms.optim import (GoalInCollision, InfeasibleProblem, InvalidLimits, InvalidSettings, NoPathFound,
+                           StartInCollision)
 from pinarms.optim.motion import MotionChecker, MotionLimits, MotionOptions, MotionRequest, MotionStatus, plan_motion
 from pinarms.optim.motion.goals import ik_candidates
 from pinarms.optim.motion.scenes import Region, region_pose
 from pinarms.robots.cell.motion import joint_levers
-from pinarms.robots.errors import InvalidInput
+from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
 from tests.optim.motion_helpers import BulletScene, dense_times
 
@@ -213,3 +214,25 @@ def test_bad_arguments(wall, across):
         MotionRequest(wall, "aubo", qa, qb, options={"margin": 0.01})
     with pytest.raises(InvalidInput, match="plan_motion takes one MotionRequest"):
         plan_motion(wall)
+
+
+def test_an_unreachable_pose_goal_is_a_status_found_before_any_search(wall, across):
+    qa, _, _ = across
+    T = region_pose(Region("r", (0, 0, 0), (1, 1, 1)), [3.0, 0.0, 0.80])  # 3 m away: beyond the arm's reach
+    plan = _plan(wall, qa, T, margin=MARGIN)
+    assert plan.status is MotionStatus.GOAL_UNREACHABLE and plan.states == 0 and "unreachable" in plan.reason
+    assert plan.as_dict()["status"] == "goal unreachable" and plan.as_dict()["goal"] is None
+    with pytest.raises(UnreachableTarget, match="unreachable for arm 'aubo'"):
+        plan.raise_for_status()
+
+
+def test_a_path_that_cannot_be_timed_under_the_limits_is_a_status(wall, across):
+    """Torque limits far below what holds the arm against gravity: the path is found, its timing is not."""
+    qa, qb, _ = across
+    request = MotionRequest(wall, "aubo", qa, qb, options=MotionOptions(margin=MARGIN, seed=0, time_limit=30.0),
+                            limits=MotionLimits(amax=False, torque=1e-3))
+    plan = plan_motion(request)
+    assert plan.status is MotionStatus.LIMITS_NOT_MET and "cannot be timed under the limits" in plan.reason
+    assert plan.trajectory is None and plan.seconds["total"] > 0.0
+    with pytest.raises(InfeasibleProblem):
+        plan.raise_for_status()
