@@ -5,7 +5,7 @@ Frames: poses in the world (the cell's root), joint coordinates in rad or m.
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
@@ -13,17 +13,21 @@ from pinarms.optim.errors import GoalInCollision, StartInCollision
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.robots.cell import Cell
+
 __all__ = ["planned_arms", "arm_joints", "is_pose", "check_end", "check_hold", "goal_candidates"]
 
 
-def planned_arms(cell: Any, arm: Any) -> tuple[str, ...]:
+def planned_arms(cell: Cell, arm: str | Sequence[str]) -> tuple[str, ...]:
     names = (arm,) if isinstance(arm, str) else tuple(arm)
     if not names or not all(isinstance(a, str) for a in names):
         raise InvalidInput(f"arm must be an arm name or a sequence of arm names, got {arm!r}")
     return tuple(cell.arm(a).name for a in names)
 
 
-def arm_joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarray:
+def arm_joints(cell: Cell, arms: tuple[str, ...], value: np.ndarray | Mapping[str, np.ndarray], what: str) -> np.ndarray:
     """The planned arms' coordinates from an array (concatenated) or ``{arm: q}``."""
     sizes = [cell.arm(a).nq for a in arms]
     if isinstance(value, Mapping):
@@ -44,7 +48,7 @@ def arm_joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.nd
     return x
 
 
-def is_pose(value: Any) -> bool:
+def is_pose(value: object) -> bool:
     if isinstance(value, Mapping):
         return False
     try:
@@ -71,7 +75,7 @@ def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
     return ""
 
 
-def check_hold(checker: Any) -> None:
+def check_hold(checker: MotionChecker) -> None:
     """The arms that stay at their hold pose must touch nothing there.
 
     The planner checks only the pairs of the planned arms; a contact between an idle arm and
@@ -91,7 +95,7 @@ def check_hold(checker: Any) -> None:
                                configurations=checker.hold)
 
 
-def check_end(checker: Any, x: np.ndarray, label: str = "start") -> None:
+def check_end(checker: MotionChecker, x: np.ndarray, label: str = "start") -> None:
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
         bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
@@ -117,7 +121,8 @@ def _q_text(robot: Any, q: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + "]"
 
 
-def goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
+def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndarray | Mapping[str, np.ndarray],
+                    start: np.ndarray, seed: int,
                      frame: str | None) -> list[GoalCandidate]:
     cell = checker.cell
     if not is_pose(goal):

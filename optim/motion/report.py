@@ -6,7 +6,7 @@ Distances in m (the world frame), joint coordinates in rad or m, times in s.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -14,6 +14,10 @@ import pinocchio as pin
 from pinarms.planning import Trajectory
 from pinarms.robots.cell.ladder import interval_bound
 from pinarms.robots.cell.speed_bound import travel_stops
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.robots.cell import Cell
 
 __all__ = ["ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
            "pair_speeds", "sample_times"]
@@ -97,13 +101,13 @@ class ClearanceProfile:
         return {k: v for k, v in out.items() if v.size and np.isfinite(v).any()}
 
     @property
-    def curve_pairs(self) -> dict[str, Any]:
+    def curve_pairs(self) -> dict[str, str]:
         """``{curve: "body_a ↔ body_b"}``: the environment curve's closest pair (what the plot names)."""
         name = next(iter(self.curves), None)
         return {} if name is None or self.min_pair is None else {name: f"{self.min_pair[0]} ↔ {self.min_pair[1]}"}
 
 
-def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold: np.ndarray) -> Trajectory:
+def cell_trajectory(cell: Cell, arms: Sequence[str], trajectory: Trajectory, hold: np.ndarray) -> Trajectory:
     """A trajectory of the planned arms' joints as one of the whole cell (the other arms held at ``hold``)."""
     C = trajectory.coefficients
     out = np.zeros((C.shape[0], C.shape[1], cell.nq))
@@ -120,7 +124,7 @@ COARSE = 8.0
 MAX_HALVINGS = 30
 
 
-def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
+def clearance_profile(checker: MotionChecker, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
     """Exact distances (coal) along ``trajectory`` (planned arms' joints; time last for none).
 
     A first pass samples every :data:`COARSE` margins of *travel* (:func:`sample_times`: how
@@ -216,7 +220,7 @@ def sample_times(trajectory: Trajectory, levers: np.ndarray, margin: float, extr
     return times if times.size > MIN_INTERVALS else np.linspace(t0, t1, MIN_INTERVALS + 1)
 
 
-def pair_speeds(checker: Any, peaks: np.ndarray) -> np.ndarray:
+def pair_speeds(checker: MotionChecker, peaks: np.ndarray) -> np.ndarray:
     """``(P,)`` bounds [m/s] of how fast the distance of each of the checker's pairs changes, from the
     planned joints' speed peaks ``peaks (n,)`` [rad/s or m/s].
 

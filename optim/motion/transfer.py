@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,6 +29,11 @@ from pinarms.optim.motion.request import MotionLimits, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import CollisionError
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult, PickPlace
+    from pinarms.robots import Robot
+    from pinarms.robots.cell import Cell, CellArm
 
 __all__ = ["PlannedMove", "planned_cycle"]
 
@@ -47,8 +52,8 @@ class PlannedMove:
     trajectory: Trajectory = field(repr=False)
     planner: str = ""
     states: int = 0
-    robot: Any = field(default=None, repr=False)
-    torque_limit: Any = field(default=None, repr=False)
+    robot: Robot | None = field(default=None, repr=False)
+    torque_limit: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def durations(self) -> np.ndarray:
@@ -121,8 +126,9 @@ def _joined(pieces: list, parts: list | None = None, atol: float = 1e-7) -> Traj
                       {"kind": "concatenated", "parts": [d for piece in parts for d in piece]})
 
 
-def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
-                  margin: float, planner: str = "rrtconnect", time_limit: float = 5.0, seed: int = 0) -> Any:
+def planned_cycle(robot: Robot, spec: PickPlace, base: CycleResult, *, cell: Cell, arm: CellArm, clearance: float,
+                  hold: np.ndarray, margin: float, planner: str = "rrtconnect", time_limit: float = 5.0,
+                  seed: int = 0) -> CycleResult:
     """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
 
     Args:

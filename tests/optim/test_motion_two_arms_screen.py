@@ -18,7 +18,8 @@ def test_screened_delays_fail_the_proof_and_the_first_clear_delay_is_kept(belt, 
     there = _quintic(qa0, qa1, vA)
     A = there.concatenated(_quintic(qa1, qa0, vA).shifted(there.duration))
     qb1 = _ik(belt, "left", (0.05, 0.10, 0.86), hold)
-    around = plan_around(belt, "left", qb0, qb1, {"right": A}, hold=hold, seed=0, time_limit=20.0)
+    request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
+    around = plan_around(request, {"right": A})
     assert around.delay > 0.0 and around.check.collision_free
 
     # the same path, every delay up to the kept one proven in turn, without the screen
