@@ -310,7 +310,10 @@ class MotionRequest:
         goal.setflags(write=False)
         object.__setattr__(self, "goal", goal)
         if self.hold is not None:
-            hold = np.array(self.cell.robot.check_q(self.hold)[0][0], dtype=float)
+            try:
+                hold = np.array(self.cell.robot.check_q(self.hold)[0][0], dtype=float)
+            except InvalidInput as exc:
+                raise InvalidInput(f"hold (the cell configuration of the arms not planned): {exc}") from exc
             hold.setflags(write=False)
             object.__setattr__(self, "hold", hold)
         constraints, values = motion_constraints(self.cell, arms, self.limits)
