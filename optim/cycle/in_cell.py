@@ -330,9 +330,7 @@ def _plan_transfer(trials: _Trials, base: CycleResult) -> tuple[bool, CycleResul
     """Step 3: the transfer planned round what blocks (OMPL, :mod:`optim.motion`), checked like the others."""
     request = trials.request
     try:
-        result = planned_cycle(request.robot, request.spec, base, cell=request.cell.cell, arm=trials.cell_arm,
-                               clearance=trials.clearance, hold=trials.hold_q, margin=trials.margin,
-                               seed=int(request.timing.seed))
+        result = planned_cycle(request, base, arm=trials.cell_arm, hold=trials.hold_q)
         move = result.moves[0]
         ok = trials.check(f"lift {request.spec.lift:.3f} m, transfer planned by {move.planner} ({move.states} states)",
                           result)

@@ -31,7 +31,8 @@ from pinarms.optim.motion.search import PLANNERS
 from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, plan_two_arms
 from pinarms.optim.motion.transfer import PlannedMove, planned_cycle
 
-__all__ = ["plan_motion", "MotionRequest", "MotionOptions", "MotionLimits", "MotionPlan", "MotionStatus", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
+__all__ = ["plan_motion", "MotionRequest", "MotionOptions", "MotionLimits", "MotionPlan", "MotionStatus",
+           "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
            "FastCheck", "fast_check", "fast_search", "fast_shortcut",
            "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names", "scene_path", "load_scene", "scene_queries",
            "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan", "planned_cycle", "PlannedMove"]

@@ -27,7 +27,8 @@ def planned_arms(cell: Cell, arm: str | Sequence[str]) -> tuple[str, ...]:
     return tuple(cell.arm(a).name for a in names)
 
 
-def arm_joints(cell: Cell, arms: tuple[str, ...], value: np.ndarray | Mapping[str, np.ndarray], what: str) -> np.ndarray:
+def arm_joints(cell: Cell, arms: tuple[str, ...], value: np.ndarray | Mapping[str, np.ndarray],
+               what: str) -> np.ndarray:
     """The planned arms' coordinates from an array (concatenated) or ``{arm: q}``."""
     sizes = [cell.arm(a).nq for a in arms]
     if isinstance(value, Mapping):

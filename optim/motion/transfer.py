@@ -28,12 +28,13 @@ from pinarms.optim.motion.plan import time_path
 from pinarms.optim.motion.request import MotionLimits, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import CollisionError
+from pinarms.robots.errors import CollisionError, InvalidInput
 
 if TYPE_CHECKING:
-    from pinarms.optim.cycle.spec import CycleResult, PickPlace
+    from pinarms.optim.cycle.request import CycleRequest
+    from pinarms.optim.cycle.spec import CycleResult
     from pinarms.robots import Robot
-    from pinarms.robots.cell import Cell, CellArm
+    from pinarms.robots.cell import CellArm
 
 __all__ = ["PlannedMove", "planned_cycle"]
 
@@ -126,22 +127,28 @@ def _joined(pieces: list, parts: list | None = None, atol: float = 1e-7) -> Traj
                       {"kind": "concatenated", "parts": [d for piece in parts for d in piece]})
 
 
-def planned_cycle(robot: Robot, spec: PickPlace, base: CycleResult, *, cell: Cell, arm: CellArm, clearance: float,
-                  hold: np.ndarray, margin: float, planner: str = "rrtconnect", time_limit: float = 5.0,
-                  seed: int = 0) -> CycleResult:
-    """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
+def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hold: np.ndarray,
+                  planner: str = "rrtconnect", time_limit: float = 5.0) -> CycleResult:
+    """The cycle ``base`` (the request planned without its cell) with its transfer planned around the cell.
 
     Args:
-        base: the :class:`optim.CycleResult` of ``spec`` without the cell (its via points fix
-            the IK branch; its limits are used).
-        arm: the :class:`robots.cell.CellArm`; ``clearance``: distance kept from fixtures and
-            other arms [m] (the arm's own links: no contact); ``hold``: the cell configuration
-            of the other arms; ``margin``: the check's resolution when ``clearance`` is 0.
+        request: the cycle's :class:`optim.CycleRequest`, with its :class:`optim.CellSettings`:
+            ``clearance`` kept from fixtures and other arms [m] (the arm's own links: no
+            contact), ``margin`` the check's resolution when ``clearance`` is 0; the search is
+            seeded with ``request.timing.seed``.
+        base: the :class:`optim.CycleResult` of the request without the cell (its via points
+            fix the IK branch; its limits are used).
+        arm: the :class:`robots.cell.CellArm`; ``hold``: the cell configuration of the other arms.
 
     Raises:
+        InvalidInput: a request without a cell.
         CollisionError: a vertical move itself is too close to something (no transfer can
             help), or :class:`optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
     """
+    if request.cell is None:
+        raise InvalidInput("planned_cycle plans a cycle in a cell: give the request a CellSettings")
+    robot, spec, cell, seed = request.robot, request.spec, request.cell.cell, int(request.timing.seed)
+    clearance, margin = request.cell.clearance, request.cell.margin
     k = len(spec.names)
     q = base.q_via
     checker = MotionChecker(cell, [arm.name], margin=clearance if clearance > 0.0 else margin, hold=hold)
