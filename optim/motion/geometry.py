@@ -14,7 +14,7 @@ proves, so this does not happen in the tests) is dropped and OMPL searches.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -25,6 +25,10 @@ from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
 from pinarms.optim.motion.search import search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.optim.motion.request import MotionOptions
 
 __all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAST_SHARE"]
 
@@ -124,14 +128,16 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
             "seconds": seconds}
 
 
-def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
-                  time_limit: float, seed: int, frame: str | None = None, compiled: bool = True,
-                  say: Callable[[str], None] = lambda _m: None, best_goal: np.ndarray | None = None) -> dict:
+def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray, goal: np.ndarray,
+                  options: MotionOptions, *, frame: str | None = None, say: Callable[[str], None] = lambda _m: None,
+                  best_goal: np.ndarray | None = None) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
-    Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
-    ``states``, ``seconds``, ``simplifier``, ``compiled``. ``compiled=False``: OMPL alone.
+    ``options``: the planner, time limit, seed and ``compiled`` (``False``: OMPL alone) of
+    :class:`.request.MotionOptions`. Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``,
+    ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``, ``compiled``.
     """
+    planner, time_limit, seed, compiled = options.planner, options.time_limit, options.seed, options.compiled
     t_start = time.perf_counter()
     cell = checker.cell
     goals = goal_candidates(checker, arms, goal, x0, int(seed), frame)

@@ -134,8 +134,7 @@ def plan_motion(request: MotionRequest, *, progress: Callable[[str], None] | Non
         check_hold(checker)  # an idle arm in collision: named now, not after the search
         check_end(checker, x0, "start")
         speed = request.constraints[0].vmax if o.goals == "best" else None  # the velocity limits come first
-        geo = plan_geometry(checker, arms, x0, request.goal, planner=o.planner, time_limit=o.time_limit, seed=o.seed,
-                            frame=request.frame, compiled=o.compiled, say=say, best_goal=speed)
+        geo = plan_geometry(checker, arms, x0, np.array(request.goal), o, frame=request.frame, say=say, best_goal=speed)
         seconds = dict(geo["seconds"])
         path, method = geo["path"], geo["smoothing"]
         t = time.perf_counter()

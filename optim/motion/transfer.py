@@ -25,7 +25,7 @@ from pinarms.optim.cycle.spec import _hold, _line_deviation, _vertical_segments
 from pinarms.optim.motion.checker import MotionChecker
 from pinarms.optim.motion.geometry import plan_geometry
 from pinarms.optim.motion.plan import time_path
-from pinarms.optim.motion.request import MotionLimits, motion_constraints
+from pinarms.optim.motion.request import MotionLimits, MotionOptions, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import CollisionError, InvalidInput
@@ -159,7 +159,8 @@ def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hol
             raise CollisionError(f"the {label} of arm {arm.name!r} itself comes closer than "
                                  f"{checker.margin * 1e3:.1f} mm to something: no transfer can clear it; move the "
                                  "pick/place or lower the lift")
-    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], planner=planner, time_limit=time_limit, seed=seed)
+    options = MotionOptions(margin=checker.margin, planner=planner, time_limit=time_limit, seed=seed)
+    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], options)
     transfer = geo["path"]
     reverse, _, _ = smooth_path(checker, geo["simplified"][::-1], arm.robot)
     amax = base.amax
