@@ -39,7 +39,7 @@ __all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAS
 FAST_SHARE = 0.75
 
 
-def fast_share(checker: Any, planner: str) -> float:
+def fast_share(checker: MotionChecker, planner: str) -> float:
     """Share of the time limit given to the compiled search (0: OMPL alone; module docstring)."""
     if str(planner).lower() != "rrtconnect" or checker.cover is None or checker.timed:
         return 0.0
@@ -86,7 +86,7 @@ def _best_goal(checker: Any, x0: np.ndarray, G: np.ndarray, found: np.ndarray, v
     return best, runs, states
 
 
-def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
+def find_path(checker: MotionChecker, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
               compiled: bool = True, say: Callable[[str], None] = lambda _m: None,
               best_goal: np.ndarray | None = None) -> dict:
     """Search and shortcut (module docstring): a dict with ``result`` (:class:`.search.SearchResult`, its
