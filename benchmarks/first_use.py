@@ -53,7 +53,8 @@ from pinarms.optim.motion.scenes import region_pose
 cell = load_scene("aubo_crate_guard")
 goal = region_pose(SCENES["aubo_crate_guard"].regions[1], [0.0, -0.465, 0.78])
 start = time.perf_counter()
-optim.plan_motion(cell, "aubo", cell.neutral, goal, margin=0.01, planner="rrtconnect", time_limit=2.0, seed=0)
+options = optim.MotionOptions(margin=0.01, planner="rrtconnect", time_limit=2.0, seed=0)
+optim.plan_motion(optim.MotionRequest(cell, "aubo", cell.neutral, goal, options=options))
 print(time.perf_counter() - start)
 """
 

@@ -189,6 +189,7 @@ def two_arms(reps: int) -> None:
     """``plan_around`` with its delays screened or each proven in turn, interleaved."""
     import statistics
 
+    from pinarms.optim.motion import MotionOptions, MotionRequest
     from pinarms.optim.motion.two_arms import plan_around
 
     belt, hold, qb0, qb1, A = _belt_query()
@@ -197,8 +198,8 @@ def two_arms(reps: int) -> None:
     for _ in range(reps):
         for screen in (False, True):
             t = time.perf_counter()
-            plan = plan_around(belt, "left", qb0, qb1, {"right": A}, hold=hold, seed=0, time_limit=20.0,
-                               screen=screen)
+            request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
+            plan = plan_around(request, {"right": A}, screen=screen)
             wall[screen].append(time.perf_counter() - t)
             kept.add((plan.delay, plan.delays_tried, float(plan.trajectory.end_time)))
     print(f"two arms, plan_around on aubo_two_belt, {reps} repetitions; the same delay every time: "

@@ -11,7 +11,7 @@ margin 10 mm, search time limit ``--time-limit``), and the table gives, per scen
   checker, time-optimal timing), and with the cell's own re-check and the clearance profile
   (``+recheck``); how many paths the compiled search found; the median of each step;
 * with ``--compare``, the same queries planned with OMPL and the exact checker alone
-  (``plan_motion(..., compiled=False)``: the planner before the compiled search), query by
+  (``MotionOptions(compiled=False)``: the planner before the compiled search), query by
   query interleaved with the default, so that both see the same load;
 * path length in joint space after shortcutting (rad), and the trajectory duration (s,
   time-optimal under the URDF's velocity and torque limits and the default acceleration limits);
@@ -52,8 +52,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms.robots.errors import PinarmsError
-from pinarms.optim.errors import PlanningError
-from pinarms.optim.motion import MotionChecker, SCENES, load_scene, plan_motion, scene_queries
+from pinarms.optim.motion import SCENES, MotionChecker, MotionOptions, MotionRequest, load_scene, plan_motion, scene_queries
 from pinarms.robots.collision_requests import cold_start
 
 MARGIN = 0.01
@@ -116,13 +115,12 @@ def run_pinarms(name: str, n: int, time_limit: float, compare: bool = False) -> 
     for k, q in enumerate(queries):
         for compiled in ((True, False) if compare else (True,)):
             rec = recs[compiled]
-            try:
-                plan = plan_motion(cell, scene.arm, q.start, q.goal, margin=MARGIN, time_limit=time_limit, seed=k,
-                                   hold=hold, compiled=compiled)
-            except PlanningError as exc:
+            options = MotionOptions(margin=MARGIN, time_limit=time_limit, seed=k, compiled=compiled)
+            plan = plan_motion(MotionRequest(cell, scene.arm, q.start, q.goal, options=options, hold=hold))
+            if not plan.ok:
                 rec["fail"] += 1
-                if getattr(exc, "seconds", None) is not None:
-                    rec.setdefault("failed_search", []).append(float(exc.seconds))
+                if "search" in plan.seconds:
+                    rec.setdefault("failed_search", []).append(float(plan.seconds["search"]))
                 continue
             _record(rec, plan)
     for rec in recs.values():

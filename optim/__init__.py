@@ -13,20 +13,21 @@ pick-and-place cycle (:class:`PickPlace`: pick, lift, transfer, lower, place, an
 :func:`time_optimal` times a geometric path (:class:`planning.JointPath`, e.g. a straight
 Cartesian line's joint image) under constraint objects by reachability analysis (TOPP-RA,
 :mod:`optim.topp`), returning a :class:`PathTiming` with a ``Trajectory``.
-:func:`plan_motion` plans a collision-free move of an arm in a cell with OMPL, proves it
-continuously and times it with :func:`time_optimal` (:mod:`optim.motion`).
+:func:`plan_motion` plans a collision-free move of an arm in a cell (one :class:`MotionRequest` in,
+a :class:`MotionPlan` with a :class:`MotionStatus` out), proves it continuously and times it with
+:func:`time_optimal` (:mod:`optim.motion`).
 """
 
 from pinarms.optim.cycle.in_cell import CellCycleReport
-from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleResult, CycleTiming, PickPlace,
-                                  plan_cycle)
+from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleResult, CycleStatus,
+                                  CycleTiming, PickPlace, plan_cycle)
 from pinarms.optim.line import LineSchedule, schedule_line
 from pinarms.optim.ga.engine import GAHistory, GAProgress, GAResult, run_ga
 from pinarms.optim.ga.request import GARequest, GAStop
 from pinarms.optim.errors import (EndpointInCollision, GoalInCollision, InfeasibleProblem, InvalidLimits,
                                   InvalidSettings, NoPathFound, OptimError, PlanningError, SettingOutOfRange,
                                   StartInCollision)
-from pinarms.optim.motion import MotionPlan, plan_motion
+from pinarms.optim.motion import MotionLimits, MotionOptions, MotionPlan, MotionRequest, MotionStatus, plan_motion
 from pinarms.optim.timing.exact import ExactSolution, solve_exact
 from pinarms.optim.layout.search import (CandidateFailure, LayoutRequest, LayoutSearch, LayoutStatus, Refinement,
                                          grid_candidates, random_candidates, search_layout)
@@ -56,6 +57,7 @@ __all__ = [
     "minimize_time_jerk",
     "PickPlace",
     "CycleResult",
+    "CycleStatus",
     "CycleRequest",
     "CycleTiming",
     "CycleLoad",
@@ -93,7 +95,11 @@ __all__ = [
     "InvalidSettings",
     "SettingOutOfRange",
     "plan_motion",
+    "MotionRequest",
+    "MotionOptions",
+    "MotionLimits",
     "MotionPlan",
+    "MotionStatus",
     "PlanningError",
     "EndpointInCollision",
     "StartInCollision",

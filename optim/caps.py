@@ -28,7 +28,7 @@ __all__ = [
     "count_setting", "number_setting",
 ]
 
-#: Range [m] of ``plan_cycle(..., cell=..., lift_step=)``: the rise per re-planning attempt.
+#: Range [m] of ``CellSettings(lift_step=)`` (``plan_cycle`` in a cell): the rise per re-planning attempt.
 LIFT_STEP_RANGE = (1e-3, 1.0)
 #: Raised-lift attempts of one in-cell cycle before via points are tried (50 × 20 mm = 1 m).
 MAX_LIFT_ATTEMPTS = 50

@@ -6,6 +6,8 @@ catches everything pinarms raises on purpose.
 
 from __future__ import annotations
 
+import numpy as np
+
 from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError
 
 __all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "SettingOutOfRange", "PlanningError",
@@ -53,13 +55,18 @@ class EndpointInCollision(PlanningError, CollisionError):
         pairs: ``(body_a, body_b)`` of the pair nearest its margin, one per configuration
             tried (one for a joint goal, one per IK branch for a pose goal).
         distances: their distances [m] (negative: penetration depth).
+        configurations: the joint values in collision, one row per configuration tried
+            (``(k, n)`` planned joints; ``(1, nq)`` the cell configuration for ``"hold"``), or
+            ``None`` (a goal point inside a fixture: no configuration was solved).
     """
 
-    def __init__(self, message: str, *, which: str = "", pairs: tuple = (), distances: tuple = ()) -> None:
+    def __init__(self, message: str, *, which: str = "", pairs: tuple = (), distances: tuple = (),
+                 configurations: np.ndarray | None = None) -> None:
         super().__init__(message)
         self.which = which
         self.pairs = tuple(pairs)
         self.distances = tuple(distances)
+        self.configurations = None if configurations is None else np.array(configurations, dtype=float, ndmin=2)
 
 
 class StartInCollision(EndpointInCollision):

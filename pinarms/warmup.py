@@ -103,7 +103,8 @@ def _plan() -> None:
     cell = load_scene("aubo_crate_guard")
     crate = SCENES["aubo_crate_guard"].regions[1]
     goal = region_pose(crate, [0.0, -0.465, 0.78])
-    optim.plan_motion(cell, "aubo", cell.neutral, goal, margin=0.01, planner="rrtconnect", time_limit=2.0, seed=0)
+    options = optim.MotionOptions(margin=0.01, planner="rrtconnect", time_limit=2.0, seed=0)
+    optim.plan_motion(optim.MotionRequest(cell, "aubo", cell.neutral, goal, options=options))
 
 
 def _cover() -> None:

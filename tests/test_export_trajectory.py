@@ -96,7 +96,7 @@ def test_cycle_in_a_cell_uses_the_arms_prefixed_joints(tmp_path):
     arm = cell.arm("aubo")
     spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
                            lift=0.05, dwell=0.2)
-    cycle = optim.plan_cycle(arm.robot, spec)
+    cycle = optim.plan_cycle(optim.CycleRequest(arm.robot, spec))
     sampled = controller_trajectory(cycle, 250, robot=cell, arm="aubo")
     assert sampled.joint_names == tuple("aubo_" + j for j in arm.robot.joint_names)
     back = read_trajectory_yaml(write_trajectory_yaml(tmp_path / "c.yaml", sampled))

@@ -28,7 +28,7 @@ def free_cycles(line):
     for name, (pick, place) in LINE_TASKS.items():
         arm = line.arm(name)
         spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.03, dwell=0.15)
-        out[name] = optim.plan_cycle(arm.robot, spec)
+        out[name] = optim.plan_cycle(optim.CycleRequest(arm.robot, spec))
     return out
 
 

@@ -80,7 +80,8 @@ scene = SCENES["aubo_crate_guard"]
 cell = load_scene(scene.name)
 region = scene.region("food table")
 goal = region_pose(region, [(a + b) / 2 for a, b in zip(region.lo, region.hi)])
-optim.plan_motion(cell, scene.arm, cell.neutral, goal, margin=0.02, time_limit=1.0, seed=1, goals="best")
+options = optim.MotionOptions(margin=0.02, time_limit=1.0, seed=1, goals="best")
+optim.plan_motion(optim.MotionRequest(cell, scene.arm, cell.neutral, goal, options=options))
 print(json.dumps({"warm": result.as_dict(), "compiled": result.compiled, "after": warmup.cache_misses()}))
 """
 

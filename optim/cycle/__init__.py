@@ -8,8 +8,7 @@
 - :mod:`.straight`: straight vertical approach and retreat at pick and place;
 - :mod:`.in_cell`: the cycle planned inside a cell, keeping its clearance
   (:class:`CellCycleReport`; around obstacles through :mod:`optim.motion.transfer`);
-- :mod:`.plan`: :func:`plan_cycle`, the dispatcher (``plan_cycle(robot, spec, **keywords)``
-  still works: it builds the request).
+- :mod:`.plan`: :func:`plan_cycle`, the dispatcher (``plan_cycle(CycleRequest(robot, spec, ...))``).
 
 ``from pinarms.optim.cycle import plan_cycle, PickPlace, ...`` works as before.
 """

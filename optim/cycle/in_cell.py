@@ -45,7 +45,7 @@ from pinarms.optim.caps import MAX_LIFT_ATTEMPTS
 from pinarms.optim.cycle.cell_report import CellCycleReport
 from pinarms.optim.cycle.joint import _via_points, joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
-from pinarms.optim.cycle.spec import CycleResult, PickPlace
+from pinarms.optim.cycle.spec import CycleResult, CycleStatus, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
@@ -330,9 +330,7 @@ def _plan_transfer(trials: _Trials, base: CycleResult) -> tuple[bool, CycleResul
     """Step 3: the transfer planned round what blocks (OMPL, :mod:`optim.motion`), checked like the others."""
     request = trials.request
     try:
-        result = planned_cycle(request.robot, request.spec, base, cell=request.cell.cell, arm=trials.cell_arm,
-                               clearance=trials.clearance, hold=trials.hold_q, margin=trials.margin,
-                               seed=int(request.timing.seed))
+        result = planned_cycle(request, base, arm=trials.cell_arm, hold=trials.hold_q)
         move = result.moves[0]
         ok = trials.check(f"lift {request.spec.lift:.3f} m, transfer planned by {move.planner} ({move.states} states)",
                           result)
@@ -363,20 +361,20 @@ def plan_cycle_in_cell(request: CycleRequest) -> CycleResult:
     base = approach_cycle(request)  # the cycle as planned without the cell: the first attempt
     _check_ends(trials, base)
     ok, result = trials.check(f"lift {spec.lift:.3f} m", base), base
-    lift, vias, status = spec.lift, (), "ok"
+    lift, vias, status = spec.lift, (), CycleStatus.OK
     if not ok:
         ok, result, lift = _raise_lift(trials, spec, settings.lift_step)
-        status = "re-planned"
+        status = CycleStatus.REPLANNED
     if not ok:
         top = max(lift, spec.lift)
         ok, result, vias = _add_vias(trials, spec, top, settings.lift_step)
         lift = top if ok else lift
     if not ok and settings.plan_transfer:
         ok, result = _plan_transfer(trials, base)
-        lift, vias, status = spec.lift, (), "transfer planned"
+        lift, vias, status = spec.lift, (), CycleStatus.TRANSFER_PLANNED
     if not ok:
         raise trials.failure(cell)
-    report = _report(trials, result, base, lift, vias, planned_transfer=status == "transfer planned")
+    report = _report(trials, result, base, lift, vias, planned_transfer=status is CycleStatus.TRANSFER_PLANNED)
     return dataclasses.replace(result, cell_report=report, status=status)
 
 

@@ -14,8 +14,7 @@ Each group checks its own values in its constructor (the project's errors, the c
 :mod:`optim.caps`), and the request checks what needs the robot: the limits per joint
 (``vmax`` defaults to the URDF's) and the torque limits with the payload. A request that
 exists is a valid one; what is left for planning is what only planning can find out (no IK
-solution, no timing, no clearance). ``plan_cycle(robot, spec, **keywords)`` builds the same
-request from the former keyword arguments (:meth:`CycleRequest.from_keywords`).
+solution, no timing, no clearance).
 
 Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 """
@@ -23,7 +22,7 @@ Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
@@ -34,6 +33,11 @@ from pinarms.optim.ga.problem import check_limit
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning.torque import JointTorqueConstraint
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots import Robot
+    from pinarms.robots.cell import Cell
+    from pinarms.robots.payload import Payload
 
 __all__ = ["CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "CycleRequest"]
 
@@ -59,9 +63,9 @@ class CycleTiming:
     """
 
     kind: str = "multi-quintic"
-    vmax: Any = None
-    amax: Any = None
-    jmax: Any = None
+    vmax: float | np.ndarray | None = None
+    amax: float | np.ndarray | None = None
+    jmax: float | np.ndarray | None = None
     method: str = "exact"
     seed: int = 0
 
@@ -86,8 +90,8 @@ class CycleLoad:
         InvalidSettings: a payload without torque limits (a payload changes only torques).
     """
 
-    payload: Any = None
-    torque_limits: Any = False
+    payload: float | Payload | Mapping[str, object] | None = None
+    torque_limits: bool | float | np.ndarray = False
 
     def __post_init__(self) -> None:
         if (self.torque_limits is None or self.torque_limits is False) and self.payload is not None:
@@ -117,12 +121,12 @@ class CycleApproach:
             raise InvalidInput(f"approach={self.approach!r}: use one of {CYCLE_APPROACHES}")
 
 
-def _check_tool_speed(tool_speed: Any) -> None:
+def _check_tool_speed(tool_speed: float | None) -> None:
     if tool_speed is not None:
         number_setting(tool_speed, "tool_speed", 0.0, open_low=True, unit="m/s")
 
 
-def check_cell_numbers(clearance: Any, margin: Any, lift_step: Any) -> tuple[float, float, float]:
+def check_cell_numbers(clearance: float, margin: float, lift_step: float) -> tuple[float, float, float]:
     """``(clearance, margin, lift_step)`` as floats in their ranges (:mod:`optim.caps`), lift_step checked first."""
     lift_step = number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
     margin = number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
@@ -156,10 +160,10 @@ class CellSettings:
             outside its range.
     """
 
-    cell: Any
+    cell: Cell
     clearance: float = 0.02
     arm: str | None = None
-    hold: Any = None
+    hold: np.ndarray | None = None
     margin: float = 0.005
     lift_step: float = 0.02
     plan_transfer: bool = True
@@ -175,7 +179,7 @@ class CellSettings:
         object.__setattr__(self, "lift_step", lift_step)
 
 
-def _velocity_limit(robot: Any, vmax: Any) -> Any:
+def _velocity_limit(robot: Robot, vmax: float | np.ndarray | None) -> float | np.ndarray:
     """``vmax``, or the robot's URDF velocity limits when None (every joint must have one)."""
     if vmax is not None:
         return vmax
@@ -213,13 +217,13 @@ class CycleRequest:
         InvalidSettings: torque limits for an object that is not a robot.
     """
 
-    robot: Any
+    robot: Robot
     spec: PickPlace
     timing: CycleTiming = field(default_factory=CycleTiming)
     load: CycleLoad = field(default_factory=CycleLoad)
     approach: CycleApproach = field(default_factory=CycleApproach)
     cell: CellSettings | None = None
-    q_start: Any = None
+    q_start: np.ndarray | None = None
     vmax: np.ndarray = field(init=False, repr=False)
     amax: np.ndarray | None = field(init=False, repr=False)
     jmax: np.ndarray | None = field(init=False, repr=False)
@@ -242,30 +246,3 @@ class CycleRequest:
         object.__setattr__(self, "amax", check_limit(t.amax, nq, "amax", required=False))
         object.__setattr__(self, "jmax", check_limit(t.jmax, nq, "jmax", required=False))
         object.__setattr__(self, "torque", torque_constraint(self.robot, self.load.torque_limits, self.load.payload))
-
-    @classmethod
-    def from_keywords(cls, robot: Any, spec: Any, *, kind: str = "multi-quintic", vmax: Any = None,
-                      amax: Any = None, jmax: Any = None, method: str = "exact", seed: int = 0,
-                      q_start: Any = None, payload: Any = None, torque_limits: Any = False,
-                      approach: str = "joint", tool_speed: float | None = None, cell: Any = None,
-                      clearance: float = 0.02, arm: str | None = None, hold: Any = None, margin: float = 0.005,
-                      lift_step: float = 0.02, plan_transfer: bool = True) -> "CycleRequest":
-        """The request of ``plan_cycle(robot, spec, **keywords)`` (the keywords as documented there).
-
-        The checks run in the order the keyword form always had: the cell settings
-        (``lift_step``, ``margin``, ``clearance``; with or without a cell) and ``tool_speed``
-        first, then the spec, ``kind``, ``method``, ``approach``, the limits and the torques.
-        """
-        cell_numbers = check_cell_numbers(clearance, margin, lift_step)
-        _check_tool_speed(tool_speed)
-        if not isinstance(spec, PickPlace):
-            raise InvalidInput(f"spec must be a PickPlace, got {type(spec).__name__}")
-        timing = CycleTiming(kind, vmax, amax, jmax, method, seed)
-        shape = CycleApproach(approach, tool_speed)
-        cell_settings = None
-        if cell is not None:
-            clearance, margin, lift_step = cell_numbers
-            cell_settings = CellSettings(cell, clearance=clearance, arm=arm, hold=hold, margin=margin,
-                                         lift_step=lift_step, plan_transfer=plan_transfer)
-        return cls(robot, spec, timing=timing,
-                   load=CycleLoad(payload, torque_limits), approach=shape, cell=cell_settings, q_start=q_start)

@@ -11,8 +11,9 @@ Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,7 +23,12 @@ from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.cell_report import CellCycleReport
+    from pinarms.robots import Robot
+    from pinarms.robots.payload import Payload
+
+__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
            "PickPlace"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
@@ -32,11 +38,21 @@ CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
 #: straight vertical lines (:mod:`optim.cycle.straight`).
 CYCLE_APPROACHES = ("joint", "straight")
 
-#: How a cycle was planned (:attr:`CycleResult.status`): ``"ok"`` as asked (without a cell, or its
-#: first check in the cell passed); ``"re-planned"``: in a cell, the lift was raised or via points
-#: added to keep the clearance; ``"transfer planned"``: in a cell, the transfer was planned round
-#: what blocks (:mod:`optim.motion.transfer`). A cycle that cannot be planned raises instead.
-CYCLE_STATUSES = ("ok", "re-planned", "transfer planned")
+
+class CycleStatus(enum.Enum):
+    """How a cycle was planned (:attr:`CycleResult.status`; the value is the word the reports print).
+
+    A cycle that cannot be planned raises instead (no IK solution at a waypoint, no timing, no
+    re-planned cycle that keeps the cell's clearance: :func:`optim.plan_cycle`).
+    """
+
+    #: as asked (without a cell, or its first check in the cell passed)
+    OK = "ok"
+    #: in a cell, the lift was raised or via points added to keep the clearance
+    REPLANNED = "re-planned"
+    #: in a cell, the transfer was planned round what blocks (:mod:`optim.motion.transfer`)
+    TRANSFER_PLANNED = "transfer planned"
+
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.
 LINE_NAMES = ("lift from pick", "lower to place", "lift from place", "lower to pick")
@@ -97,12 +113,12 @@ class PickPlace:
             ``InvalidInput``): ``dwell`` outside 0 … :data:`optim.caps.MAX_DWELL`.
     """
 
-    pick: Any
-    place: Any
+    pick: np.ndarray
+    place: np.ndarray
     lift: float = 0.05
     dwell: float = 0.2
     via: tuple = ()
-    orientation: Any = field(default=None)
+    orientation: np.ndarray | None = field(default=None)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "pick", _point(self.pick, "pick"))
@@ -132,7 +148,7 @@ class PickPlace:
         """Labels of the waypoints of the move to place: pick, above pick, via 1 …, above place, place."""
         return ("pick", "above pick", *(f"via {k + 1}" for k in range(len(self.via))), "above place", "place")
 
-    def poses(self, robot: Any) -> np.ndarray:
+    def poses(self, robot: Robot) -> np.ndarray:
         """Waypoints (4 + len(via), 4, 4) of the move to place, tcp → base [m], in :attr:`names` order."""
         R = self.orientation
         if R is None and any(p.shape == (3,) for p in (self.pick, self.place, *self.via)):
@@ -180,9 +196,9 @@ class CycleResult:
             the same limits (None otherwise).
         payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
-        cell_report: with ``plan_cycle(..., cell=...)``, how the cycle keeps its clearance
+        cell_report: planned in a cell (:class:`optim.CellSettings`), how the cycle keeps its clearance
             (:class:`optim.cycle.in_cell.CellCycleReport`); else None.
-        status: how it was planned, one of :data:`CYCLE_STATUSES`.
+        status: how it was planned (:class:`CycleStatus`).
     """
 
     robot: str
@@ -198,7 +214,7 @@ class CycleResult:
     jmax: np.ndarray | None = field(repr=False)
     line_deviation: np.ndarray = field(repr=False)
     branches: np.ndarray = field(repr=False)
-    payload: Any = None
+    payload: Payload | None = None
     torque_limit: np.ndarray | None = field(default=None, repr=False)
     approach: str = "joint"
     joint_cycle_time: float | None = None
@@ -220,8 +236,8 @@ class CycleResult:
         if self.torque_limit is None:
             return None
         return np.maximum(*(m.torque_ratios for m in self.moves))
-    cell_report: Any = field(default=None, repr=False)
-    status: str = CYCLE_STATUSES[0]
+    cell_report: CellCycleReport | None = field(default=None, repr=False)
+    status: CycleStatus = CycleStatus.OK
 
     @property
     def one_branch(self) -> bool:
@@ -261,7 +277,7 @@ class CycleResult:
     def as_dict(self) -> dict[str, Any]:
         """JSON-able summary (SI units)."""
         return {
-            "status": self.status,
+            "status": self.status.value,
             "robot": self.robot,
             "waypoints": [{"name": n, "position_m": T[:3, 3].tolist()} for n, T in zip(self.names, self.waypoints)],
             "q_via": self.q_via.tolist(),

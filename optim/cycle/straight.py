@@ -1,4 +1,4 @@
-"""Straight vertical approach and retreat for a pick-and-place cycle (``plan_cycle(approach="straight")``).
+"""Straight vertical approach and retreat for a pick-and-place cycle (``CycleApproach("straight")``).
 
 Each move of the cycle becomes *line, transfer, line*::
 

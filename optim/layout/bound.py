@@ -1,4 +1,4 @@
-"""Branch and bound over the candidates of a layout search (``search_layout(..., bound=True)``).
+"""Branch and bound over the candidates of a layout search (``LayoutRequest(..., bound=True)``).
 
 A candidate's cycle cannot be shorter than its **lower bound**: each (pick, place) pair's
 cycle holds the dwell at the pick and at the place and moves the arm from its pick
@@ -105,4 +105,4 @@ def outranked(lower_bound: float, limit: float, keep: int) -> str:
     which = "best cycle" if keep == 1 else f"{keep}th best cycle"
     return (f"its cycle takes at least {lower_bound:.3f} s (dwells, and the joint travel from pick to place and "
             f"back at the velocity limits), longer than the {which} planned ({limit:.3f} s): not planned "
-            "(search_layout(bound=False) plans every candidate)")
+            "(LayoutRequest(bound=False) plans every candidate)")

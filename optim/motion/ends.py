@@ -5,7 +5,7 @@ Frames: poses in the world (the cell's root), joint coordinates in rad or m.
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
@@ -13,17 +13,22 @@ from pinarms.optim.errors import GoalInCollision, StartInCollision
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["planned_arms", "arm_joints", "check_end", "check_hold", "goal_candidates"]
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.robots.cell import Cell
+
+__all__ = ["planned_arms", "arm_joints", "is_pose", "check_end", "check_hold", "goal_candidates"]
 
 
-def _arms(cell: Any, arm: Any) -> tuple[str, ...]:
+def planned_arms(cell: Cell, arm: str | Sequence[str]) -> tuple[str, ...]:
     names = (arm,) if isinstance(arm, str) else tuple(arm)
     if not names or not all(isinstance(a, str) for a in names):
         raise InvalidInput(f"arm must be an arm name or a sequence of arm names, got {arm!r}")
     return tuple(cell.arm(a).name for a in names)
 
 
-def _joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarray:
+def arm_joints(cell: Cell, arms: tuple[str, ...], value: np.ndarray | Mapping[str, np.ndarray],
+               what: str) -> np.ndarray:
     """The planned arms' coordinates from an array (concatenated) or ``{arm: q}``."""
     sizes = [cell.arm(a).nq for a in arms]
     if isinstance(value, Mapping):
@@ -44,7 +49,7 @@ def _joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarr
     return x
 
 
-def _is_pose(value: Any) -> bool:
+def is_pose(value: object) -> bool:
     if isinstance(value, Mapping):
         return False
     try:
@@ -71,7 +76,7 @@ def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
     return ""
 
 
-def _check_hold(checker: Any) -> None:
+def check_hold(checker: MotionChecker) -> None:
     """The arms that stay at their hold pose must touch nothing there.
 
     The planner checks only the pairs of the planned arms; a contact between an idle arm and
@@ -87,10 +92,11 @@ def _check_hold(checker: Any) -> None:
     if found:
         raise StartInCollision(found.message(f"hold in the cell description, --hold {found.arms[0]}=Q1,Q2,..., "
                                              "or hold="),
-                               which="hold", pairs=tuple(p.bodies for p in found.pairs), distances=found.distances)
+                               which="hold", pairs=tuple(p.bodies for p in found.pairs), distances=found.distances,
+                               configurations=checker.hold)
 
 
-def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
+def check_end(checker: MotionChecker, x: np.ndarray, label: str = "start") -> None:
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
         bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
@@ -104,7 +110,8 @@ def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
         err = StartInCollision if label == "start" else GoalInCollision
         raise err(f"the {label} configuration is in collision: {describe_pair(pair, d, m)}"
-                  f"{_idle_note(pair, _idle_arms(checker))}; move it clear or lower the margin", which=label, pairs=(None if pair is None else pair.bodies,), distances=(d,))
+                  f"{_idle_note(pair, _idle_arms(checker))}; move it clear or lower the margin", which=label,
+                  pairs=(None if pair is None else pair.bodies,), distances=(d,), configurations=x)
 
 
 def _q_text(robot: Any, q: np.ndarray) -> str:
@@ -115,12 +122,13 @@ def _q_text(robot: Any, q: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + "]"
 
 
-def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
+def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndarray | Mapping[str, np.ndarray],
+                    start: np.ndarray, seed: int,
                      frame: str | None) -> list[GoalCandidate]:
     cell = checker.cell
-    if not _is_pose(goal):
-        x = _joints(cell, arms, goal, "goal")
-        _check_start(checker, x, "goal")
+    if not is_pose(goal):
+        x = arm_joints(cell, arms, goal, "goal")
+        check_end(checker, x, "goal")
         return [GoalCandidate(x, True)]
     if len(arms) != 1:
         raise InvalidInput("a pose goal needs one planned arm; give two arms' goals as joint vectors {arm: q}")
@@ -156,13 +164,7 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
         lines = "; ".join(f"{f'branch {g.branch} ' if g.branch >= 0 else ''}(q = {_q_text(robot, g.q)}): {g.reason}"
                           for g in out)
         raise GoalInCollision(f"every IK solution of the goal pose is in collision ({len(out)} tried): {lines}",
-                              which="goal", pairs=tuple(g.pair for g in out), distances=tuple(g.distance for g in out))
+                              which="goal", pairs=tuple(g.pair for g in out), distances=tuple(g.distance for g in out),
+                              configurations=np.array([g.q for g in out]))
     return out
 
-
-
-planned_arms = _arms
-arm_joints = _joints
-check_end = _check_start
-check_hold = _check_hold
-goal_candidates = _goal_candidates

@@ -14,17 +14,21 @@ proves, so this does not happen in the tests) is dropped and OMPL searches.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from pinarms.optim.errors import NoPathFound
-from pinarms.optim.motion.ends import _goal_candidates
+from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_search, fast_shortcut
 from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
 from pinarms.optim.motion.search import search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.optim.motion.request import MotionOptions
 
 __all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAST_SHARE"]
 
@@ -35,7 +39,7 @@ __all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAS
 FAST_SHARE = 0.75
 
 
-def fast_share(checker: Any, planner: str) -> float:
+def fast_share(checker: MotionChecker, planner: str) -> float:
     """Share of the time limit given to the compiled search (0: OMPL alone; module docstring)."""
     if str(planner).lower() != "rrtconnect" or checker.cover is None or checker.timed:
         return 0.0
@@ -82,7 +86,7 @@ def _best_goal(checker: Any, x0: np.ndarray, G: np.ndarray, found: np.ndarray, v
     return best, runs, states
 
 
-def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
+def find_path(checker: MotionChecker, x0: np.ndarray, G: np.ndarray, *, planner: str, time_limit: float, seed: int,
               compiled: bool = True, say: Callable[[str], None] = lambda _m: None,
               best_goal: np.ndarray | None = None) -> dict:
     """Search and shortcut (module docstring): a dict with ``result`` (:class:`.search.SearchResult`, its
@@ -124,17 +128,19 @@ def find_path(checker: Any, x0: np.ndarray, G: np.ndarray, *, planner: str, time
             "seconds": seconds}
 
 
-def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any, *, planner: str,
-                  time_limit: float, seed: int, frame: str | None = None, compiled: bool = True,
-                  say: Callable[[str], None] = lambda _m: None, best_goal: np.ndarray | None = None) -> dict:
+def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray, goal: np.ndarray,
+                  options: MotionOptions, *, frame: str | None = None, say: Callable[[str], None] = lambda _m: None,
+                  best_goal: np.ndarray | None = None) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
-    Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``,
-    ``states``, ``seconds``, ``simplifier``, ``compiled``. ``compiled=False``: OMPL alone.
+    ``options``: the planner, time limit, seed and ``compiled`` (``False``: OMPL alone) of
+    :class:`.request.MotionOptions`. Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``,
+    ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``, ``compiled``.
     """
+    planner, time_limit, seed, compiled = options.planner, options.time_limit, options.seed, options.compiled
     t_start = time.perf_counter()
     cell = checker.cell
-    goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame)
     G = np.array([g.q for g in goals if g.valid])
     same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
     if same.size:

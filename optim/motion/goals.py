@@ -4,9 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pinarms.robots import Robot
+    from pinarms.robots.cell import Cell
+    from pinarms.robots.cell.pairs import CollisionPair
 
 __all__ = ["closed_form", "GoalCandidate", "describe_pair", "point_in_fixture", "ik_candidates"]
 
@@ -25,7 +30,7 @@ def _families_by_joints() -> dict[tuple[str, ...], str]:
     return out
 
 
-def closed_form(robot: Any) -> Any:
+def closed_form(robot: Robot) -> Robot:
     """``robot`` with its closed-form IK attached when its joints are those of a known arm family.
 
     A cell's arms get the closed form of pinarms' built-in arms; an example-robot-data arm
@@ -58,7 +63,7 @@ class GoalCandidate:
     distance: float = float("nan")
 
 
-def describe_pair(pair: Any, distance: float, margin: float) -> str:
+def describe_pair(pair: CollisionPair | None, distance: float, margin: float) -> str:
     """``"aubo_wrist1_Link – guard_plate 3.2 mm apart (margin 10 mm)"`` or ``"... overlap by 4.1 mm"``."""
     if pair is None:
         return "no checked pair"
@@ -68,7 +73,7 @@ def describe_pair(pair: Any, distance: float, margin: float) -> str:
     return f"{what} {distance * 1e3:.1f} mm apart (margin {margin * 1e3:.1f} mm)"
 
 
-def point_in_fixture(cell: Any, point: np.ndarray) -> tuple[str, float] | None:
+def point_in_fixture(cell: Cell, point: np.ndarray) -> tuple[str, float] | None:
     """``(fixture, depth [m])`` when the world point lies inside a fixture's box, cylinder,
     sphere or capsule (the deepest), else ``None``. Meshes are not tested (a surface has no inside)."""
     best = None
@@ -95,7 +100,7 @@ def point_in_fixture(cell: Any, point: np.ndarray) -> tuple[str, float] | None:
     return best
 
 
-def ik_candidates(robot: Any, T_base: np.ndarray, q_ref: np.ndarray, *, seed: int = 0,
+def ik_candidates(robot: Robot, T_base: np.ndarray, q_ref: np.ndarray, *, seed: int = 0,
                   attempts: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``(k, nq)`` reaching ``T_base`` (arm base frame) and their branch labels ``(k,)``.
 

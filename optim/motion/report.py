@@ -1,22 +1,25 @@
-"""What :func:`.plan.plan_motion` reports: the :class:`MotionPlan` and the :class:`ClearanceProfile` along it.
+"""The clearance along a planned motion (:class:`ClearanceProfile`) and the shortcutters a plan names.
 
 Distances in m (the world frame), joint coordinates in rad or m, times in s.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 import pinocchio as pin
 
-from pinarms.optim.motion.goals import GoalCandidate
-from pinarms.planning import JointPath, Trajectory
+from pinarms.planning import Trajectory
 from pinarms.robots.cell.ladder import interval_bound
 from pinarms.robots.cell.speed_bound import travel_stops
 
-__all__ = ["MotionPlan", "ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.robots.cell import Cell
+
+__all__ = ["ClearanceProfile", "SIMPLIFIER", "FAST_SIMPLIFIER", "clearance_profile", "cell_trajectory",
            "pair_speeds", "sample_times"]
 
 #: What shortcuts a path found by OMPL (said in every result).
@@ -98,144 +101,13 @@ class ClearanceProfile:
         return {k: v for k, v in out.items() if v.size and np.isfinite(v).any()}
 
     @property
-    def curve_pairs(self) -> dict[str, Any]:
+    def curve_pairs(self) -> dict[str, str]:
         """``{curve: "body_a ↔ body_b"}``: the environment curve's closest pair (what the plot names)."""
         name = next(iter(self.curves), None)
         return {} if name is None or self.min_pair is None else {name: f"{self.min_pair[0]} ↔ {self.min_pair[1]}"}
 
 
-
-@dataclass(frozen=True, eq=False)
-class MotionPlan:
-    """A planned, proven and timed motion (see the module docstring).
-
-    Attributes:
-        arms: the planned arms; ``start``/``goal``: their joint coordinates ``(n,)``.
-        goals: every goal configuration tried (:class:`GoalCandidate`: valid or why not).
-        raw_path: ``(M, n)`` the planner's path; ``simplified``: ``(K, n)`` after shortcutting
-            (:data:`SIMPLIFIER`); ``path``: the smooth :class:`planning.JointPath` that was
-            timed, ``smoothing`` how it was made (``"cubic spline"``, ``"straight line"`` or
-            ``"polyline with stops"``).
-        timing: the :class:`optim.PathTiming`; ``trajectory``: the arms' joint trajectory
-            (:class:`planning.Trajectory`, the planned arms' joints in order).
-        check: the cell's continuous check of the timed motion (:class:`robots.cell.MotionCheck`;
-            ``None`` when planned with ``recheck=False``).
-        clearance: the distances along it (:class:`ClearanceProfile`; ``None`` likewise).
-        hold: the cell configuration of the arms not planned.
-        planner, seed, time_limit, margin, self_margin: what was asked; ``states``: states the
-            planner explored; ``seconds``: time per step (``"search"``, ``"shortcut"``,
-            ``"smooth"``, ``"time"``, ``"check"``, ``"total"``); ``limits``: the limits timed under.
-        simplifier: what shortcut the path; compiled: whether the compiled search on the sphere
-            cover found it (:mod:`.fast`; else OMPL with the exact checker).
-    """
-
-    cell: Any = field(repr=False)
-    arms: tuple[str, ...]
-    start: np.ndarray = field(repr=False)
-    goal: np.ndarray = field(repr=False)
-    goals: tuple[GoalCandidate, ...] = field(repr=False)
-    raw_path: np.ndarray = field(repr=False)
-    simplified: np.ndarray = field(repr=False)
-    path: JointPath = field(repr=False)
-    smoothing: str
-    timing: Any = field(repr=False)
-    trajectory: Trajectory = field(repr=False)
-    check: Any = field(repr=False)
-    clearance: ClearanceProfile | None = field(repr=False)
-    hold: np.ndarray = field(repr=False)
-    planner: str
-    seed: int
-    time_limit: float
-    margin: float
-    self_margin: float
-    states: int
-    seconds: dict = field(repr=False)
-    limits: dict = field(repr=False)
-    simplifier: str = SIMPLIFIER
-    compiled: bool = False
-
-    @property
-    def duration(self) -> float:
-        """Time of the motion [s]."""
-        return float(self.trajectory.duration)
-
-    @property
-    def path_length(self) -> float:
-        """Joint-space length of the shortcut path [rad or m, Euclidean]."""
-        return float(np.linalg.norm(np.diff(self.simplified, axis=0), axis=1).sum())
-
-    @property
-    def raw_length(self) -> float:
-        """Joint-space length of the planner's path [rad or m]."""
-        return float(np.linalg.norm(np.diff(self.raw_path, axis=0), axis=1).sum())
-
-    def cell_trajectory(self) -> Trajectory:
-        """The motion as a trajectory of the whole cell joint vector (arms not planned held)."""
-        return cell_trajectory(self.cell, self.arms, self.trajectory, self.hold)
-
-    def tool_path(self, arm: str | None = None, samples: int = 200) -> np.ndarray:
-        """tcp positions ``(samples, 3)`` [m, world] of ``arm`` (default the first planned arm) along the motion."""
-        name = self.arms[0] if arm is None else arm
-        t = np.linspace(self.trajectory.start_time, self.trajectory.end_time, samples)
-        q = self.cell_trajectory().sample(t)[0]
-        return self.cell.world_pose(q, self.cell.arm(name).prefix + "tcp")[:, :3, 3]
-
-    def clearance_summary(self) -> str:
-        """One line in plain words: the smallest clearance (coal, exact) and where, whether the margin held, and
-        what the cell's independent re-check proved.
-
-        E.g. ``smallest clearance 32.2 mm (forearm ↔ table at t = 0.410 s); the 10 mm margin holds along the whole
-        motion (proven on the path by the planner; re-checked by the cell: no contact, no two shapes closer than
-        5.0 mm at its 10 mm resolution)``. ``None`` parts (planned with ``recheck=False``) are left out.
-        """
-        held = f"the {self.margin * 1e3:g} mm margin holds along the whole motion (proven on the path by the planner"
-        c, check = self.clearance, self.check
-        if check is not None:
-            held += (f"; re-checked by the cell: no contact, no two shapes closer than {check.lower_bound * 1e3:.1f} mm"
-                     f" at its {check.margin * 1e3:g} mm resolution")
-        held += ")"
-        if c is None:
-            return held
-        where = "" if c.min_pair is None else f" ({c.min_pair[0]} ↔ {c.min_pair[1]} at t = {c.min_time:.3f} s)"
-        own = "" if not np.isfinite(c.min_own) else f"; own links closest {c.min_own * 1e3:.1f} mm"
-        return f"smallest clearance {c.min_environment * 1e3:.1f} mm{where}; {held}{own}"
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-able summary (SI units)."""
-        c = self.clearance
-        return {
-            "arms": list(self.arms),
-            "planner": self.planner,
-            "seed": self.seed,
-            "time_limit_s": self.time_limit,
-            "margin_m": self.margin,
-            "self_margin_m": self.self_margin,
-            "start": self.start.tolist(),
-            "goal": self.goal.tolist(),
-            "goal_candidates": [{"q": g.q.tolist(), "valid": g.valid, "reason": g.reason, "branch": g.branch}
-                                for g in self.goals],
-            "states_explored": self.states,
-            "raw_path": self.raw_path.tolist(),
-            "simplified_path": self.simplified.tolist(),
-            "raw_length": self.raw_length,
-            "path_length": self.path_length,
-            "simplifier": self.simplifier,
-            "compiled_search": self.compiled,
-            "smoothing": self.smoothing,
-            "duration_s": self.duration,
-            "timing": self.timing.as_dict(),
-            "limits": {k: (None if v is None else np.asarray(v).tolist()) for k, v in self.limits.items()},
-            "collision_free": None if self.check is None else bool(self.check.collision_free),
-            "min_clearance_environment_m": None if c is None else c.min_environment,
-            "min_clearance_time_s": None if c is None else c.min_time,
-            "min_clearance_pair": None if c is None or c.min_pair is None else list(c.min_pair),
-            "min_clearance_own_links_m": None if c is None else c.min_own,
-            "seconds": {k: round(v, 6) for k, v in self.seconds.items()},
-        }
-
-
-
-def cell_trajectory(cell: Any, arms: Sequence[str], trajectory: Trajectory, hold: np.ndarray) -> Trajectory:
+def cell_trajectory(cell: Cell, arms: Sequence[str], trajectory: Trajectory, hold: np.ndarray) -> Trajectory:
     """A trajectory of the planned arms' joints as one of the whole cell (the other arms held at ``hold``)."""
     C = trajectory.coefficients
     out = np.zeros((C.shape[0], C.shape[1], cell.nq))
@@ -252,7 +124,7 @@ COARSE = 8.0
 MAX_HALVINGS = 30
 
 
-def clearance_profile(checker: Any, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
+def clearance_profile(checker: MotionChecker, trajectory: Trajectory, *, samples: int | None = None) -> ClearanceProfile:
     """Exact distances (coal) along ``trajectory`` (planned arms' joints; time last for none).
 
     A first pass samples every :data:`COARSE` margins of *travel* (:func:`sample_times`: how
@@ -348,7 +220,7 @@ def sample_times(trajectory: Trajectory, levers: np.ndarray, margin: float, extr
     return times if times.size > MIN_INTERVALS else np.linspace(t0, t1, MIN_INTERVALS + 1)
 
 
-def pair_speeds(checker: Any, peaks: np.ndarray) -> np.ndarray:
+def pair_speeds(checker: MotionChecker, peaks: np.ndarray) -> np.ndarray:
     """``(P,)`` bounds [m/s] of how fast the distance of each of the checker's pairs changes, from the
     planned joints' speed peaks ``peaks (n,)`` [rad/s or m/s].
 

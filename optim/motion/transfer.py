@@ -1,11 +1,11 @@
-"""The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
+"""The planned transfer: what ``plan_cycle`` in a cell falls back to when raising it cannot clear.
 
 :func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
 adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
-plans the transfer between "above pick" and "above place" with :func:`plan_motion`'s
+plans the transfer between "above pick" and "above place" with :func:`optim.plan_motion`'s
 search, shortcut and smoothing (OMPL, every edge proven continuously); the move back runs
 the same path in reverse. Each part is timed optimally from rest to rest under the cycle's
 limits (joint velocity and acceleration; the URDF's torque limits when no acceleration
@@ -17,16 +17,24 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from pinarms.optim.cycle.spec import _hold, _line_deviation, _vertical_segments
 from pinarms.optim.motion.checker import MotionChecker
-from pinarms.optim.motion.plan import _limits, plan_geometry, time_path
+from pinarms.optim.motion.geometry import plan_geometry
+from pinarms.optim.motion.plan import time_path
+from pinarms.optim.motion.request import MotionLimits, MotionOptions, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import CollisionError
+from pinarms.robots.errors import CollisionError, InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.request import CycleRequest
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.robots import Robot
+    from pinarms.robots.cell import CellArm
 
 __all__ = ["PlannedMove", "planned_cycle"]
 
@@ -45,8 +53,8 @@ class PlannedMove:
     trajectory: Trajectory = field(repr=False)
     planner: str = ""
     states: int = 0
-    robot: Any = field(default=None, repr=False)
-    torque_limit: Any = field(default=None, repr=False)
+    robot: Robot | None = field(default=None, repr=False)
+    torque_limit: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def durations(self) -> np.ndarray:
@@ -119,21 +127,28 @@ def _joined(pieces: list, parts: list | None = None, atol: float = 1e-7) -> Traj
                       {"kind": "concatenated", "parts": [d for piece in parts for d in piece]})
 
 
-def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clearance: float, hold: np.ndarray,
-                  margin: float, planner: str = "rrtconnect", time_limit: float = 5.0, seed: int = 0) -> Any:
-    """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
+def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hold: np.ndarray,
+                  planner: str = "rrtconnect", time_limit: float = 5.0) -> CycleResult:
+    """The cycle ``base`` (the request planned without its cell) with its transfer planned around the cell.
 
     Args:
-        base: the :class:`optim.CycleResult` of ``spec`` without the cell (its via points fix
-            the IK branch; its limits are used).
-        arm: the :class:`robots.cell.CellArm`; ``clearance``: distance kept from fixtures and
-            other arms [m] (the arm's own links: no contact); ``hold``: the cell configuration
-            of the other arms; ``margin``: the check's resolution when ``clearance`` is 0.
+        request: the cycle's :class:`optim.CycleRequest`, with its :class:`optim.CellSettings`:
+            ``clearance`` kept from fixtures and other arms [m] (the arm's own links: no
+            contact), ``margin`` the check's resolution when ``clearance`` is 0; the search is
+            seeded with ``request.timing.seed``.
+        base: the :class:`optim.CycleResult` of the request without the cell (its via points
+            fix the IK branch; its limits are used).
+        arm: the :class:`robots.cell.CellArm`; ``hold``: the cell configuration of the other arms.
 
     Raises:
+        InvalidInput: a request without a cell.
         CollisionError: a vertical move itself is too close to something (no transfer can
             help), or :class:`optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
     """
+    if request.cell is None:
+        raise InvalidInput("planned_cycle plans a cycle in a cell: give the request a CellSettings")
+    robot, spec, cell, seed = request.robot, request.spec, request.cell.cell, int(request.timing.seed)
+    clearance, margin = request.cell.clearance, request.cell.margin
     k = len(spec.names)
     q = base.q_via
     checker = MotionChecker(cell, [arm.name], margin=clearance if clearance > 0.0 else margin, hold=hold)
@@ -144,13 +159,14 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
             raise CollisionError(f"the {label} of arm {arm.name!r} itself comes closer than "
                                  f"{checker.margin * 1e3:.1f} mm to something: no transfer can clear it; move the "
                                  "pick/place or lower the lift")
-    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], planner=planner, time_limit=time_limit, seed=seed)
+    options = MotionOptions(margin=checker.margin, planner=planner, time_limit=time_limit, seed=seed)
+    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], options)
     transfer = geo["path"]
     reverse, _, _ = smooth_path(checker, geo["simplified"][::-1], arm.robot)
     amax = base.amax
     torque = True if amax is None and base.torque_limit is None else (base.torque_limit
                                                                        if base.torque_limit is not None else False)
-    constraints, _ = _limits(cell, (arm.name,), base.vmax, amax, torque)
+    constraints, _ = motion_constraints(cell, (arm.name,), MotionLimits(vmax=base.vmax, amax=amax, torque=torque))
 
     def move(paths: list) -> tuple[PlannedMove, list]:
         parts = tuple(time_path(p, constraints) for p in paths)

@@ -24,17 +24,25 @@ Every result is re-checked by the cell's own continuous time check with both arm
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError, StartInCollision
+from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError
 from pinarms.optim.motion.checker import MotionChecker, TimedArm
-from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_motion
+from pinarms.optim.motion.ends import check_end
+from pinarms.optim.motion.plan import plan_motion
+from pinarms.optim.motion.request import MotionRequest
+from pinarms.optim.motion.result import MotionPlan, MotionStatus
 from pinarms.planning import Trajectory
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell import Cell
+    from pinarms.robots.cell.motion_report import MotionCheck
 
 __all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms", "DELAY_SAMPLES"]
 
@@ -59,14 +67,14 @@ class AroundPlan:
         delays_tried: the start delays proven not to clear, before the one used.
     """
 
-    cell: Any = field(repr=False)
+    cell: Cell = field(repr=False)
     arm: str
     moving: tuple
     t0: float
     delay: float
     plan: MotionPlan = field(repr=False)
     trajectory: Trajectory = field(repr=False)
-    check: Any = field(repr=False)
+    check: MotionCheck = field(repr=False)
     delays_tried: int
     seconds: dict = field(repr=False)
 
@@ -103,7 +111,7 @@ class TwoArmPlan:
     around: AroundPlan | None = field(repr=False)
     joint: MotionPlan | None = field(repr=False)
     attempts: tuple
-    check: Any = field(repr=False)
+    check: MotionCheck = field(repr=False)
 
     @property
     def end_time(self) -> float:
@@ -149,13 +157,15 @@ def _screened_delays(together: MotionChecker, trajectory: Trajectory, x0: np.nda
     return together.batch_collides(together.full(X)).reshape(len(delays), DELAY_SAMPLES).any(axis=1)
 
 
-def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: float = 0.0, margin: float = 0.01,
-                self_margin: float = 0.0, planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0,
-                hold: Any = None, vmax: Any = None, amax: Any = None, torque: Any = True, delay_step: float = 0.05,
-                grid: int = 200, screen: bool = True, progress: Callable[[str], None] | None = None) -> AroundPlan:
-    """Plan ``arm`` from ``start`` (ready at cell time ``t0``) to ``goal`` around the ``moving`` arms.
+def plan_around(request: MotionRequest,
+                moving: Mapping[str, Trajectory | tuple[Trajectory, float]] | Sequence[TimedArm], *,
+                t0: float = 0.0, delay_step: float = 0.05, screen: bool = True,
+                progress: Callable[[str], None] | None = None) -> AroundPlan:
+    """Plan the request's arm (B) from its start (ready at cell time ``t0``) to its goal around the ``moving`` arms.
 
     Args:
+        request: B's motion (one arm; :class:`.request.MotionRequest`: its options and limits,
+            ``hold`` the cell configuration of the arms neither planned nor moving).
         moving: ``{arm: trajectory}``, ``{arm: (trajectory, offset)}`` or :class:`TimedArm` s:
             the arms that follow their own trajectories meanwhile (cell time = offset +
             trajectory time − its start; they hold their ends outside).
@@ -163,40 +173,41 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
         delay_step: resolution of the start delay [s].
         screen: screen the delays in batches before proving them (module docstring; proofs of
             failure only, the same delay kept); ``False``: every delay proven in turn.
-        Others as :func:`plan_motion` (``hold``: the cell configuration of the other arms).
 
     Raises:
+        InvalidInput: a request for two arms, no moving arm.
         StartInCollision: B's start touches a moving arm at ``t0``.
         NoPathFound: no path around the moving arms' end configuration, or no start delay up
             to their end that clears their motion (the message says which).
-        GoalInCollision, InvalidInput, ...: as :func:`plan_motion`.
+        GoalInCollision, ...: the other statuses of :func:`plan_motion`, raised
+            (:meth:`.result.MotionPlan.raise_for_status`).
     """
     t_all = time.perf_counter()
     say = progress or (lambda _m: None)
-    arms = (cell.arm(arm).name,)
+    if not isinstance(request, MotionRequest) or len(request.arms) != 1:
+        raise InvalidInput("plan_around takes the MotionRequest of one arm (plan both together with plan_motion)")
+    cell, arms, o = request.cell, request.arms, request.options
     timed = _timed_arms(cell, moving)
     if not timed:
         raise InvalidInput("plan_around needs at least one moving arm (use plan_motion otherwise)")
     ok = isinstance(delay_step, (int, float)) and not isinstance(delay_step, bool) and np.isfinite(delay_step)
     if not ok or delay_step <= 0.0:
         raise InvalidSettings(f"delay_step must be a positive number of seconds, got {delay_step!r}")
-    base = cell.hold if hold is None else np.array(cell.robot.check_q(hold)[0][0], dtype=float)
+    base = cell.hold if request.hold is None else np.array(request.hold)
     parked = base.copy()
     for m in timed:
         parked[cell.arm(m.arm).q_slice] = m.trajectory.sample(m.trajectory.end_time)[0]
-    together = MotionChecker(cell, arms, margin=margin, self_margin=self_margin, hold=base, moving=timed)
-    x0 = _joints(cell, arms, start, "start")
-    _check_start(together, np.append(x0, t0), "start")
+    together = MotionChecker(cell, arms, margin=o.margin, self_margin=o.self_margin, hold=base, moving=timed)
+    x0 = np.array(request.start)
+    check_end(together, np.append(x0, t0), "start")
     say("planning the path around the other arm(s) parked at the end of their motion")
-    try:
-        # no re-check of the motion against A parked: the motion kept is checked against A moving
-        plan = plan_motion(cell, arms[0], x0, goal, margin=margin, self_margin=self_margin, planner=planner,
-                           time_limit=time_limit, seed=seed, hold=parked, vmax=vmax, amax=amax, torque=torque,
-                           grid=grid, recheck=False)
-    except StartInCollision as exc:
-        raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({exc}): it "
-                          "cannot wait there; plan both arms together", planner="", time_limit=float(time_limit)) \
-            from exc
+    # no re-check of the motion against A parked: the motion kept is checked against A moving
+    plan = plan_motion(dataclasses.replace(request, hold=parked, options=dataclasses.replace(o, recheck=False)))
+    if plan.status is MotionStatus.START_IN_COLLISION:
+        raise NoPathFound(f"arm {arms[0]!r} starts where {[m.arm for m in timed]} end their motion ({plan.reason}): "
+                          "it cannot wait there; plan both arms together", planner="",
+                          time_limit=o.time_limit) from plan.error
+    plan.raise_for_status()
     t = time.perf_counter()
     t_end = max(m.offset + m.trajectory.duration for m in timed)
     delays = np.arange(0.0, max(t_end - t0, 0.0) + delay_step, delay_step)
@@ -220,7 +231,7 @@ def plan_around(cell: Any, arm: str, start: Any, goal: Any, moving: Any, *, t0: 
         raise NoPathFound(
             f"arm {arms[0]!r}: its path around {[m.arm for m in timed]} parked at their ends is clear, but no start "
             f"delay from 0 to {delays[-1]:.2f} s (step {delay_step:g} s) keeps the margin while they move: its start "
-            "lies in their sweep", planner=plan.planner, time_limit=float(time_limit), seconds=plan.seconds["search"],
+            "lies in their sweep", planner=plan.planner, time_limit=o.time_limit, seconds=plan.seconds["search"],
             states=plan.states, goals=1)
     k, d, trajectory = chosen
     say(f"leaves {d:.2f} s after {t0:.2f} s; checking both arms together")
@@ -243,23 +254,27 @@ def _check_together(cell: Any, planned: Mapping[str, tuple], timed: tuple, check
     return check
 
 
-def plan_two_arms(cell: Any, arm: str, start: Any, goal: Any, other: str, other_trajectory: Trajectory, *,
-                  other_offset: float = 0.0, t0: float = 0.0, margin: float = 0.01, self_margin: float = 0.0,
-                  planner: str = "rrtconnect", time_limit: float = 2.0, seed: int = 0, hold: Any = None,
-                  vmax: Any = None, amax: Any = None, torque: Any = True,
-                  progress: Callable[[str], None] | None = None) -> TwoArmPlan:
-    """Plan ``arm`` (B) while ``other`` (A) follows ``other_trajectory``; both together if that fails.
+def plan_two_arms(request: MotionRequest, other: str, other_trajectory: Trajectory, *, other_offset: float = 0.0,
+                  t0: float = 0.0, progress: Callable[[str], None] | None = None) -> TwoArmPlan:
+    """Plan the request's arm (B) while ``other`` (A) follows ``other_trajectory``; both together if that fails.
 
     First :func:`plan_around` (A keeps its trajectory). If it finds nothing, both arms are
-    planned in their joint space with :func:`plan_motion`, both leaving at ``t0``: A from
-    where its trajectory has it at ``t0`` to the trajectory's last configuration, B from
-    ``start`` to ``goal`` (a joint goal). A's own path and timing are then replaced.
+    planned in their joint space with :func:`plan_motion` (the request's options and limits),
+    both leaving at ``t0``: A from where its trajectory has it at ``t0`` to the trajectory's
+    last configuration, B from its start to its goal (a joint goal). A's own path and timing
+    are then replaced.
+
+    Raises:
+        InvalidInput: a request for two arms, or a pose goal when both must be planned together.
+        NoPathFound, GoalInCollision, ...: the joint plan's status, raised
+            (:meth:`.result.MotionPlan.raise_for_status`).
     """
+    if not isinstance(request, MotionRequest) or len(request.arms) != 1:
+        raise InvalidInput("plan_two_arms takes the MotionRequest of one arm (B); A is other and other_trajectory")
+    cell, arm = request.cell, request.arms[0]
     attempts = []
     try:
-        around = plan_around(cell, arm, start, goal, {other: (other_trajectory, other_offset)}, t0=t0, margin=margin,
-                             self_margin=self_margin, planner=planner, time_limit=time_limit, seed=seed, hold=hold,
-                             vmax=vmax, amax=amax, torque=torque, progress=progress)
+        around = plan_around(request, {other: (other_trajectory, other_offset)}, t0=t0, progress=progress)
         attempts.append(("around", f"leaves after {around.delay:.2f} s, arrives at {around.end_time:.3f} s"))
         return TwoArmPlan("around", {arm: around.trajectory, other: other_trajectory},
                           {arm: around.trajectory.start_time, other: other_offset}, around, None, tuple(attempts),
@@ -272,12 +287,10 @@ def plan_two_arms(cell: Any, arm: str, start: Any, goal: Any, other: str, other_
     now = float(np.clip(t0 - other_offset + tr.start_time, tr.start_time, tr.end_time))
     a_start = np.asarray(tr.sample(now)[0], dtype=float)  # where A is when both leave
     a_end = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
-    b_start = _joints(cell, (cell.arm(arm).name,), start, "start")
-    b_goal = goal[arm] if isinstance(goal, Mapping) else goal
-    joint = plan_motion(cell, (other, arm), {other: a_start, arm: b_start},
-                        {other: a_end, arm: np.asarray(b_goal, dtype=float)}, margin=margin, self_margin=self_margin,
-                        planner=planner, time_limit=time_limit, seed=seed, hold=hold, vmax=vmax, amax=amax,
-                        torque=torque, progress=progress)
+    both = MotionRequest(cell, (other, arm), {other: a_start, arm: np.array(request.start)},
+                         {other: a_end, arm: np.array(request.goal)}, options=request.options, hold=request.hold,
+                         limits=request.limits)
+    joint = plan_motion(both, progress=progress).raise_for_status()
     attempts.append(("joint", f"both arms together, {joint.duration:.3f} s"))
     na = cell.arm(other).nq
     traj = joint.trajectory

@@ -125,7 +125,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     """
     import sys
 
-    from pinarms.optim.motion import MotionChecker, plan_motion
+    from pinarms.optim.motion import MotionChecker, MotionLimits, MotionOptions, MotionRequest, plan_motion
     from pinarms.optim.motion.goals import ik_candidates
 
     def progress(message: str) -> None:
@@ -168,9 +168,10 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     R0 = arm.tcp_to_world(q0)[:3, :3]
     T = _pose(goal, "--to", mm, deg, R0)
     a = None if amax is None else floats(amax, "--amax")
-    plan = plan_motion(c, arm.name, q0, T, margin=margin_m, planner=planner, time_limit=time_limit, seed=seed, hold=hold,
-                       amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque,
-                       goals=goal_choice, progress=progress)
+    options = MotionOptions(margin=margin_m, planner=planner, time_limit=time_limit, seed=seed, goals=goal_choice)
+    limits = MotionLimits(amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque)
+    plan = plan_motion(MotionRequest(c, arm.name, q0, T, options=options, limits=limits, hold=hold),
+                       progress=progress).raise_for_status()  # not solved: one Error line saying why
     u = "mm" if mm else "m"
     cl = plan.clearance
     data: dict[str, Any] = {"cell": c.name, "arm": arm.name, **plan.as_dict(),

@@ -96,8 +96,7 @@ def _arm_state(c, arm, text: str, end: str):
 def _plan_between(c, arm_name: str | None, ends: tuple[str, str], *, margin: float, time_limit: float, seed: int,
                   amax):
     """The planned move of ``--plan FROM TO`` (errors name --plan, --arm, --margin or --time-limit)."""
-    from pinarms.optim.errors import GoalInCollision, NoPathFound, StartInCollision
-    from pinarms.optim.motion import plan_motion
+    from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest, MotionStatus, plan_motion
     from pinarms.robots.errors import InvalidInput
 
     if arm_name is None:
@@ -110,14 +109,15 @@ def _plan_between(c, arm_name: str | None, ends: tuple[str, str], *, margin: flo
         raise InvalidInput(f"--arm: cell {c.name!r} has no arm {arm_name!r}; arms: {', '.join(names)}")
     arm = c.arm(arm_name)
     q0, q1 = _arm_state(c, arm, ends[0], "FROM"), _arm_state(c, arm, ends[1], "TO")
-    try:
-        return plan_motion(c, arm.name, q0, q1, margin=margin, time_limit=time_limit, seed=seed, amax=amax)
-    except StartInCollision as exc:
-        raise InvalidInput(f"--plan FROM: {exc} (choose another start, or lower --margin)") from None
-    except GoalInCollision as exc:
-        raise InvalidInput(f"--plan TO: {exc} (choose another goal, or lower --margin)") from None
-    except NoPathFound as exc:
-        raise InvalidInput(f"--plan: {exc} (raise --time-limit, or lower --margin)") from None
+    request = MotionRequest(c, arm.name, q0, q1, options=MotionOptions(margin=margin, time_limit=time_limit, seed=seed),
+                            limits=MotionLimits(amax=amax))
+    plan = plan_motion(request)
+    what = {MotionStatus.START_IN_COLLISION: "--plan FROM: {} (choose another start, or lower --margin)",
+            MotionStatus.GOAL_IN_COLLISION: "--plan TO: {} (choose another goal, or lower --margin)",
+            MotionStatus.NO_PATH: "--plan: {} (raise --time-limit, or lower --margin)"}.get(plan.status)
+    if what is not None:
+        raise InvalidInput(what.format(plan.reason))
+    return plan.raise_for_status()
 
 
 @verify_group.command("shipped")

@@ -5,7 +5,7 @@ follow, so every trajectory sampled for a controller (:func:`.trajectory.control
 has its accelerations compared with the acceleration limits of the arms it is for
 (``Robot.acceleration_limit``: ``velocity_limit / 0.25 s`` by default, see
 :data:`pinarms.robots.robot.ACCELERATION_RISE_TIME`). A sample beyond them (a motion timed
-without acceleration limits, ``plan_motion(amax=False)``, or under larger ones) is **flagged**: an
+without acceleration limits, ``MotionLimits(amax=False)``, or under larger ones) is **flagged**: an
 :class:`AccelerationWarning` names the joint, the peak, the limit and how to re-time, and
 ``ControllerTrajectory.over_acceleration`` lists the joints beyond. The file is still written (the
 limits are a stated rule, not the drive's): re-time under ``amax`` before sending it.
@@ -56,6 +56,6 @@ def flag_accelerations(names: tuple[str, ...], accelerations: np.ndarray, limits
     warnings.warn(AccelerationWarning(
         f"joint {names[j]} accelerates at up to {peak[j]:.4g}, {peak[j] / lim[j]:.1f}x its acceleration limit "
         f"{lim[j]:.4g} [rad/s² or m/s²] ({len(over)} joint(s) beyond their limit): the motion was timed without "
-        "these limits; re-time it under them (plan_motion(amax=None), CycleTiming(amax=...)) before sending it"),
+        "these limits; re-time it under them (MotionLimits(amax=None), CycleTiming(amax=...)) before sending it"),
         stacklevel=3)
     return tuple(names[int(k)] for k in over)

@@ -34,8 +34,9 @@ def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     straight joint-space move between the same configurations, timed the same way (it runs
     through the cell: the row names the pair it hits).
     """
-    from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion
-    from pinarms.optim.motion.plan import _limits, time_path
+    from pinarms.optim.motion import SCENES, MotionChecker, MotionOptions, MotionRequest, load_scene, plan_motion
+    from pinarms.optim.motion.plan import time_path
+    from pinarms.optim.motion.request import MotionLimits, motion_constraints
     from pinarms.optim.motion.scenes import region_pose
     from pinarms.optim.motion.smoothing import polyline_path
 
@@ -48,12 +49,13 @@ def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
     from pinarms.optim.motion.goals import ik_candidates
 
     q0 = next(q for q in ik_candidates(arm.robot, arm.to_base(start_pose), cell.neutral)[0] if checker.state_valid(q))
-    plans = [plan_motion(cell, "aubo", q0, goal_pose, margin=0.01, time_limit=60.0, seed=seed, goals="best")
+    plans = [plan_motion(MotionRequest(cell, "aubo", q0, goal_pose,
+                                       options=MotionOptions(margin=0.01, time_limit=60.0, seed=seed, goals="best")))
              for seed in SEEDS]
     durations = np.array([p.duration for p in plans])
     best = int(np.argmin(durations))  # the first of equal minima: the lowest seed
     plan = plans[best]
-    constraints, _ = _limits(cell, ("aubo",), None, None, True)
+    constraints, _ = motion_constraints(cell, ("aubo",), MotionLimits())
     straight = time_path(polyline_path(np.stack([q0, plan.goal])), constraints)
     s = np.linspace(0.0, 1.0, 401)[:, None]
     line = cell.q_from_arms({"aubo": q0 + s * (plan.goal - q0)})

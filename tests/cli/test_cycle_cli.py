@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 from pinarms import robots
-from pinarms.optim.cycle import PickPlace, plan_cycle
+from pinarms.optim.cycle import CycleRequest, PickPlace, plan_cycle
 from pinarms.cli import cli
 
 AUBO = ["aubo_i3", "--pick", "350", "200", "150", "--place", "-100", "400", "100", "--mm"]
@@ -22,7 +22,7 @@ def invoke(*args: str):
 def test_cycle_text_reports_moves_cycle_time_picks_and_straightness():
     result = invoke(*AUBO)
     assert result.exit_code == 0, (result.output, result.exception)
-    api = plan_cycle(robots.load("aubo_i3"), PickPlace([0.35, 0.2, 0.15], [-0.1, 0.4, 0.1]))
+    api = plan_cycle(CycleRequest(robots.load("aubo_i3"), PickPlace([0.35, 0.2, 0.15], [-0.1, 0.4, 0.1])))
     out = result.stdout
     assert f"move to place: {api.move_times[0]:.4f} s" in out
     assert f"move to pick:  {api.move_times[1]:.4f} s" in out

@@ -343,26 +343,28 @@ _odd_setting = st.one_of(_huge_or_tiny, _scalars)
 @given(data=st.data())
 def test_plan_cycle_settings(arms, data):
     robot = arms["scara_mushroom"]
-    arg = Plan(data, ["lift", "dwell", "kind", "vmax", "amax", "jmax", "lift_step", "margin", "clearance",
-                      "tool_speed", "approach", "seed"])
+    arg = Plan(data, ["lift", "dwell", "kind", "vmax", "amax", "jmax", "tool_speed", "approach", "seed"])
     spec, err = outcome(optim.PickPlace, _PICK, _PLACE, lift=arg("lift", st.floats(0.01, 0.08), _odd_setting),
                         dwell=arg("dwell", st.floats(0.0, 1.0), _odd_setting))
     if err is not None:
         return
     limit = st.floats(0.5, 5.0).map(lambda k: k * robot.velocity_limit)
-    kwargs = dict(
+    timing = dict(
         kind=arg("kind", st.sampled_from(["multi-quintic", "quintic-bspline", "3-5-3"]), _odd_setting),
         vmax=arg("vmax", limit, st.one_of(_odd_setting, _weird)),
         amax=arg("amax", st.one_of(st.none(), limit.map(lambda v: 4.0 * v)), st.one_of(_odd_setting, _weird)),
         jmax=arg("jmax", st.one_of(st.none(), limit.map(lambda v: 40.0 * v)), st.one_of(_odd_setting, _weird)),
-        lift_step=arg("lift_step", st.floats(0.001, 1.0), _odd_setting),
-        margin=arg("margin", st.floats(0.001, 0.05), _odd_setting),
-        clearance=arg("clearance", st.floats(0.0, 0.05), _odd_setting),
-        tool_speed=arg("tool_speed", st.one_of(st.none(), st.floats(0.1, 2.0)), _odd_setting),
-        approach=arg("approach", st.just("joint"), st.sampled_from(["straight", "curved", None])),
         seed=arg("seed", st.integers(0, 5), _odd_setting),
     )
-    result, err = outcome(optim.plan_cycle, robot, spec, **kwargs, seconds=30)
+    approach = dict(approach=arg("approach", st.just("joint"), st.sampled_from(["straight", "curved", None])),
+                    tool_speed=arg("tool_speed", st.one_of(st.none(), st.floats(0.1, 2.0)), _odd_setting))
+
+    def plan_cycle() -> optim.CycleResult:  # the settings checked when the request is built, then planned
+        request = optim.CycleRequest(robot, spec, timing=optim.CycleTiming(**timing),
+                                     approach=optim.CycleApproach(**approach))
+        return optim.plan_cycle(request)
+
+    result, err = outcome(plan_cycle, seconds=30)
     if err is None:
         assert result.cycle_time > 0 and np.isfinite(result.cycle_time)
 
@@ -377,7 +379,7 @@ def line_cycles():
     for name, (pick, place) in tasks.items():
         arm = cell.arm(name)
         spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.09, dwell=0.15)
-        cycles[name] = optim.plan_cycle(arm.robot, spec)
+        cycles[name] = optim.plan_cycle(optim.CycleRequest(arm.robot, spec))
     return cell, cycles
 
 
@@ -515,14 +517,11 @@ def crate_guard():
 
 
 @pytest.mark.parametrize("seed", [-1, 2**64, 1.5])
-def test_plan_motion_seed_outside_its_range_is_a_named_error(crate_guard, seed):
+def test_plan_motion_seed_outside_its_range_is_a_named_error(seed):
     from pinarms.optim.errors import InvalidSettings
-    from pinarms.optim.motion import plan_motion
+    from pinarms.optim.motion import MotionOptions
 
-    cell = crate_guard
-    arm = cell.arms[0]
-    start = arm.robot.neutral
-    _quickly(lambda: plan_motion(cell, arm.name, start, start + 0.1, seed=seed), InvalidSettings, "seed")
+    _quickly(lambda: MotionOptions(seed=seed), InvalidSettings, "seed")
 
 
 @pytest.mark.parametrize("path", ["arm\0.urdf", "a" * 300 + ".urdf", "d/" * 3000 + "arm.urdf"])

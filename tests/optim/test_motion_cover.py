@@ -8,7 +8,8 @@ import pinocchio as pin
 import pytest
 
 from pinarms.optim import InvalidSettings
-from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion
+from pinarms.optim.motion import (SCENES, MotionChecker, MotionLimits, MotionOptions, MotionRequest, load_scene,
+                                   plan_motion)
 from pinarms.robots import load_cell
 from pinarms.robots.cell.cover import geometry_spheres, link_cover, pair_arrays, pairs_for
 from pinarms.robots.errors import InvalidInput
@@ -135,26 +136,24 @@ def test_plan_motion_settings_are_validated_with_their_caps(cells):
     qa = cell.neutral[checker.cols]
     for threads in (0, -1, 10**9, 1.5, True):
         with pytest.raises(InvalidSettings, match="threads must be"):
-            plan_motion(cell, "aubo", qa, qa + 0.1, threads=threads)
+            MotionOptions(threads=threads)
     for grid in (0, 10**9, 2.5):
         with pytest.raises(InvalidSettings, match="grid must be an integer from 1 to 100000"):
-            plan_motion(cell, "aubo", qa, qa + 0.1, grid=grid)
+            MotionLimits(grid=grid)
     with pytest.raises(InvalidInput, match="the start already is the goal"):
-        plan_motion(cell, "aubo", qa, qa.copy())
+        MotionRequest(cell, "aubo", qa, qa.copy())
 
 
 def test_the_search_keeps_its_time_limit(cells):
     """Edge proofs give up at the limit (the edge counts as not valid): the search ends near it."""
-    from pinarms.optim.errors import NoPathFound
-    from pinarms.optim.motion import scene_queries
+    from pinarms.optim.motion import MotionStatus, scene_queries
 
     cell = cells["panda_shelf"]
     queries, hold = scene_queries("panda_shelf", 3, seed=0, margin=MARGIN)
     limit = 0.05
     for k, q in enumerate(queries):
-        try:
-            plan = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=limit, seed=k, hold=hold)
-            seconds = plan.seconds["search"]
-        except NoPathFound as err:
-            seconds = err.seconds
+        options = MotionOptions(margin=MARGIN, time_limit=limit, seed=k)
+        plan = plan_motion(MotionRequest(cell, "panda", q.start, q.goal, options=options, hold=hold))
+        assert plan.status in (MotionStatus.SOLVED, MotionStatus.NO_PATH)
+        seconds = plan.seconds["search"]
         assert seconds <= 1.1 * limit + 0.05, f"query {k}: the search took {seconds:.3f} s at a {limit} s limit"

@@ -8,7 +8,8 @@ import time
 import numpy as np
 import pytest
 
-from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion, scene_queries
+from pinarms.optim.motion import (SCENES, MotionChecker, MotionLimits, MotionOptions, MotionRequest, load_scene,
+                                   plan_motion, scene_queries)
 from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_check, fast_search, fast_shortcut
 from pinarms.robots.cell._cover_kernel import _cylinder_box_gap
@@ -97,15 +98,17 @@ def test_compiled_search_keeps_its_time_limit(table):
 def test_plan_motion_searches_compiled_where_the_cover_is_tight(table):
     cell, _, queries, _, hold = table
     q = queries[1]
-    plan = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold)
+    options = MotionOptions(margin=MARGIN, time_limit=2.0, seed=1)
+    plan = plan_motion(MotionRequest(cell, "panda", q.start, q.goal, options=options, hold=hold))
     assert plan.compiled and plan.planner == "RRTConnect" and plan.as_dict()["compiled_search"]
     assert plan.check.collision_free and plan.clearance.min_environment >= MARGIN
-    quick = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
-                        recheck=False)
+    quick = plan_motion(MotionRequest(cell, "panda", q.start, q.goal, hold=hold,
+                                      options=MotionOptions(margin=MARGIN, time_limit=2.0, seed=1, recheck=False)))
     assert np.array_equal(quick.simplified, plan.simplified)  # the same seed, the same path
     assert quick.check is None and quick.clearance is None and quick.as_dict()["collision_free"] is None
-    ompl = plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, time_limit=2.0, seed=1, hold=hold,
-                       compiled=False, recheck=False)
+    ompl = plan_motion(MotionRequest(cell, "panda", q.start, q.goal, hold=hold,
+                                     options=MotionOptions(margin=MARGIN, time_limit=2.0, seed=1, compiled=False,
+                                                           recheck=False)))
     assert not ompl.compiled and ompl.simplifier.startswith("OMPL")
     ur5 = load_scene("ur5_table_box")
     checker = MotionChecker(ur5, ["ur5"], margin=MARGIN)
@@ -297,12 +300,11 @@ def test_compiled_shortcut_skips_tries_that_gain_too_little(table):
 
 
 def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
-    """``plan_motion(goals="best")`` on the crate scene: the kept path ends at a clear goal branch, is proven,
+    """``MotionOptions(goals="best")`` on the crate scene: the kept path ends at a clear goal branch, is proven,
     and its time bound is below that of the first goal's path (seed 0 reaches the long way round first);
     it is the default (a faster move than the first branch's), timed under the default acceleration limits
     (before, torques alone: peaks of 164 rad/s² where the limit rule gives 14.7); bad choices are refused."""
     from pinarms.optim.errors import InvalidLimits, InvalidSettings
-    from pinarms.optim.motion import SCENES, load_scene, plan_motion
     from pinarms.optim.motion.geometry import travel_time_bound
     from pinarms.optim.motion.goals import ik_candidates
     from pinarms.optim.motion.scenes import region_pose
@@ -316,9 +318,14 @@ def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
                                        cell.neutral)[0] if checker.state_valid(q))
     goal = region_pose(crate, 0.5 * (np.array(crate.lo) + np.array(crate.hi)))
     v = arm.robot.velocity_limit
-    first = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False, goals="first")
-    best = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, goals="best")
-    default = plan_motion(cell, "aubo", q0, goal, time_limit=10.0, seed=0, recheck=False)
+
+    def plan(**options):
+        return plan_motion(MotionRequest(cell, "aubo", q0, goal, options=MotionOptions(time_limit=10.0, seed=0,
+                                                                                       **options)))
+
+    first = plan(recheck=False, goals="first")
+    best = plan(goals="best")
+    default = plan(recheck=False)
     assert best.check.collision_free and best.compiled
     assert travel_time_bound(best.simplified, v) < travel_time_bound(first.simplified, v)
     assert np.array_equal(default.simplified, best.simplified)  # the default is the fastest clear branch
@@ -328,8 +335,8 @@ def test_goals_best_keeps_the_path_with_the_shortest_time_bound():
     np.testing.assert_allclose(default.limits["amax"], v / 0.25)
     assert np.all(default.trajectory.peaks().acceleration <= v / 0.25 * (1 + 1e-6))
     with pytest.raises(InvalidLimits, match="amax must be None"):
-        plan_motion(cell, "aubo", q0, goal, amax=True)
+        MotionLimits(amax=True)
     G = np.array([g.q for g in best.goals if g.valid])
     assert len(G) > 1 and any(np.array_equal(best.simplified[-1], g) for g in G)
     with pytest.raises(InvalidSettings, match="goals must be"):
-        plan_motion(cell, "aubo", q0, goal, goals="all")
+        MotionOptions(goals="all")

@@ -9,7 +9,7 @@ import pytest
 
 from pinarms import planning, viz
 from pinarms.optim import GoalInCollision, StartInCollision, plan_motion
-from pinarms.optim.motion import MotionChecker
+from pinarms.optim.motion import MotionChecker, MotionLimits, MotionOptions, MotionRequest, MotionStatus
 from pinarms.robots import load_cell
 from tests.robots.cell.bent_pair import bent_pair
 
@@ -19,10 +19,14 @@ def _cell(tmp_path: Path, hold: str = "", a_y: float = 0.6) -> object:
 
 def test_an_idle_arm_in_collision_at_its_hold_is_named_before_any_search(tmp_path):
     cell = _cell(tmp_path)  # b holds at neutral: in the table
+    plan = plan_motion(MotionRequest(cell, "a", [0.0, -1.0, 0.0], [0.5, -1.0, 0.0],
+                                     options=MotionOptions(time_limit=1.0), limits=MotionLimits(amax=2.0)))
+    assert plan.status is MotionStatus.HOLD_IN_COLLISION and plan.which == "hold" and plan.states == 0
+    assert ("b_link2", "table") in plan.pairs and min(plan.distances) < 0.0  # penetration depth, from coal
+    np.testing.assert_array_equal(plan.configurations, cell.hold[None])  # the cell configuration in collision
     with pytest.raises(StartInCollision, match=r"idle arm 'b'.*b_link2 – table.*hold") as info:
-        plan_motion(cell, "a", [0.0, -1.0, 0.0], [0.5, -1.0, 0.0], time_limit=1.0, amax=2.0)
-    assert info.value.which == "hold" and ("b_link2", "table") in info.value.pairs
-    assert min(info.value.distances) < 0.0  # penetration depth, from coal
+        plan.raise_for_status()
+    assert info.value.which == "hold" and info.value.pairs == plan.pairs
 
 
 def test_a_goal_that_touches_the_idle_arm_names_it(tmp_path):
@@ -31,8 +35,11 @@ def test_a_goal_that_touches_the_idle_arm_names_it(tmp_path):
     np.testing.assert_array_equal(checker.hold, cell.hold)  # the default hold is the cell's
     goal = [-1.5707963267948966, 0.0, 0.0]  # a's upper arm towards b: the two forearms meet
     assert cell.in_collision(cell.q_from_arms({"a": goal}))
+    plan = plan_motion(MotionRequest(cell, "a", [0.0, -1.0, 0.0], goal, options=MotionOptions(time_limit=1.0),
+                                     limits=MotionLimits(amax=2.0)))
+    assert plan.status is MotionStatus.GOAL_IN_COLLISION and "arm 'b', idle at its hold pose" in plan.reason
     with pytest.raises(GoalInCollision, match=r"arm 'b', idle at its hold pose"):
-        plan_motion(cell, "a", [0.0, -1.0, 0.0], goal, time_limit=1.0, amax=2.0)
+        plan.raise_for_status()
 
 
 def test_checks_and_sessions_hold_the_idle_arm_at_the_cells_hold(tmp_path):
@@ -88,13 +95,14 @@ def test_a_cycle_next_to_an_idle_arm_in_collision_names_it_before_any_attempt(tm
     a = cell.arm("a")
     spec = optim.PickPlace(pick=[0.3, 0.1, 0.1], place=[0.3, -0.1, 0.1], lift=0.03)
     with pytest.raises(CollisionError, match=r"idle arm 'b' is in collision at its hold pose: b_link2 – table"):
-        optim.plan_cycle(a.robot, spec, cell=cell, clearance=0.01)
+        optim.plan_cycle(optim.CycleRequest(a.robot, spec, cell=optim.CellSettings(cell, clearance=0.01)))
 
 
 @pytest.mark.slow
 def test_a_motion_beside_an_arm_held_clear_of_the_table_is_planned_and_proven(tmp_path):
     cell = _cell(tmp_path, "hold = [0.0, -1.2]")  # at neutral, b lies in the table: the re-check failed after the search
-    plan = plan_motion(cell, "a", [0.0, -1.0, 0.0], [0.8, -0.6, 0.0], amax=2.0, time_limit=5.0)
+    plan = plan_motion(MotionRequest(cell, "a", [0.0, -1.0, 0.0], [0.8, -0.6, 0.0],
+                                     options=MotionOptions(time_limit=5.0), limits=MotionLimits(amax=2.0)))
     assert plan.check.collision_free
     np.testing.assert_array_equal(plan.hold, cell.hold)
     q = plan.cell_trajectory().sample(np.linspace(0.0, plan.duration, 20))[0]

@@ -22,9 +22,10 @@ def test_crate_under_a_guard_gets_a_planned_transfer():
     pick = arm.to_base(np.array([0.40, 0.10, 0.78]))  # on the food table
     place = arm.to_base(np.array([0.0, -0.46, 0.78]))  # in the crate's far half, past the guard plate
     spec = optim.PickPlace(pick, place, lift=0.05)
-    result = optim.plan_cycle(arm.robot, spec, cell=cell, clearance=CLEARANCE, amax=10.0, lift_step=0.1)
+    result = optim.plan_cycle(optim.CycleRequest(arm.robot, spec, timing=optim.CycleTiming(amax=10.0),
+                                                 cell=optim.CellSettings(cell, clearance=CLEARANCE, lift_step=0.1)))
     report = result.cell_report
-    assert report.planned_transfer and result.status == "transfer planned"
+    assert report.planned_transfer and result.status is optim.CycleStatus.TRANSFER_PLANNED
     # raising the transfer and via points were tried first, and none cleared
     assert len(report.attempts) >= 3 and not any(a[1] for a in report.attempts[:-1])
     assert "RRTConnect" in report.attempts[-1][0] and report.attempts[-1][1]

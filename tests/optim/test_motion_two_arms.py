@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pinarms import planning
-from pinarms.optim.motion import MotionChecker, load_scene
+from pinarms.optim.motion import MotionChecker, MotionOptions, MotionRequest, load_scene
 from pinarms.optim.motion.goals import ik_candidates
 from pinarms.optim.motion.scenes import Region, region_pose
 from pinarms.optim.motion.two_arms import plan_two_arms
@@ -81,7 +81,8 @@ def test_b_waits_for_a_to_leave_the_shared_belt(belt, stations):
     there = _quintic(qa0, qa1, vA)
     A = there.concatenated(_quintic(qa1, qa0, vA).shifted(there.duration))  # ... and goes back
     qb1 = _ik(belt, "left", (0.05, 0.10, 0.86), hold)  # B's goal: where A was
-    plan = plan_two_arms(belt, "left", qb0, qb1, "right", A, hold=hold, seed=0, time_limit=20.0)
+    request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
+    plan = plan_two_arms(request, "right", A)
     assert plan.method == "around"
     around = plan.around
     assert around.delay > 0.0  # B must wait for A
@@ -117,7 +118,8 @@ def test_start_in_a_s_way_falls_back_to_both_arms_together(belt, stations):
     ok_now = ~clear_now.batch_collides(clear_now.full(X))
     in_way = clear_end.batch_collides(clear_end.full(X))
     qbs = X[np.flatnonzero(ok_now & in_way)[0]]  # clear of A now, but where A ends
-    plan = plan_two_arms(belt, "left", qbs, qb0, "right", A, other_offset=offset, hold=hold, seed=0, time_limit=20.0)
+    request = MotionRequest(belt, "left", qbs, qb0, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
+    plan = plan_two_arms(request, "right", A, other_offset=offset)
     assert plan.method == "joint"
     assert plan.attempts[0][0] == "around" and "plan both arms together" in plan.attempts[0][1]
     assert plan.joint.arms == ("right", "left")

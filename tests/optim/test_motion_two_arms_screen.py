@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinarms.optim.motion import MotionChecker, plan_motion
+from pinarms.optim.motion import MotionChecker, MotionOptions, MotionRequest, plan_motion
 from pinarms.optim.motion.checker import TimedArm
 from pinarms.optim.motion.two_arms import _screened_delays, _waiting, plan_around
 
@@ -18,13 +18,15 @@ def test_screened_delays_fail_the_proof_and_the_first_clear_delay_is_kept(belt, 
     there = _quintic(qa0, qa1, vA)
     A = there.concatenated(_quintic(qa1, qa0, vA).shifted(there.duration))
     qb1 = _ik(belt, "left", (0.05, 0.10, 0.86), hold)
-    around = plan_around(belt, "left", qb0, qb1, {"right": A}, hold=hold, seed=0, time_limit=20.0)
+    request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
+    around = plan_around(request, {"right": A})
     assert around.delay > 0.0 and around.check.collision_free
 
     # the same path, every delay up to the kept one proven in turn, without the screen
     parked = hold.copy()
     parked[belt.arm("right").q_slice] = A.sample(A.end_time)[0]
-    path = plan_motion(belt, "left", qb0, qb1, margin=MARGIN, hold=parked, seed=0, time_limit=20.0, recheck=False)
+    options = MotionOptions(margin=MARGIN, seed=0, time_limit=20.0, recheck=False)
+    path = plan_motion(MotionRequest(belt, "left", qb0, qb1, options=options, hold=parked))
     assert np.array_equal(path.trajectory.coefficients, around.plan.trajectory.coefficients)
     together = MotionChecker(belt, ["left"], margin=MARGIN, hold=hold, moving=(TimedArm("right", A, 0.0),))
     delays = np.arange(0.0, A.duration + 0.05, 0.05)

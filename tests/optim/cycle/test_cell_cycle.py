@@ -33,7 +33,8 @@ def crate_spec(arm, lift=0.05):
 def station_cycles(station):
     arm = station.arm("aubo")
     spec = crate_spec(arm)
-    return spec, optim.plan_cycle(arm.robot, spec), optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
+    free = optim.plan_cycle(optim.CycleRequest(arm.robot, spec))
+    return spec, free, optim.plan_cycle(optim.CycleRequest(arm.robot, spec, cell=optim.CellSettings(station, clearance=0.02)))
 
 
 def test_a_cycle_through_the_crate_wall_is_replanned_to_clear_it(station, station_cycles):
@@ -47,7 +48,8 @@ def test_a_cycle_through_the_crate_wall_is_replanned_to_clear_it(station, statio
     assert report.attempts[0][1] is False and "crate_wall" in report.attempts[0][3]
     assert report.attempts[-1][1] is True
     assert report.lift > spec.lift
-    assert kept.status == "re-planned" and free.status == "ok"
+    assert kept.status is optim.CycleStatus.REPLANNED and free.status is optim.CycleStatus.OK
+    assert kept.as_dict()["status"] == "re-planned"
     assert report.extra_time == pytest.approx(kept.cycle_time - free.cycle_time, abs=1e-12) and report.extra_time > 0
     assert report.min_clearance >= 0.02 and report.lower_bound >= 0.02
     # an independent dense look at the kept cycle: every external distance >= 20 mm
@@ -63,7 +65,7 @@ def test_a_place_too_close_to_a_wall_is_a_collision_error(station):
     spec = optim.PickPlace(pick=arm.to_base(np.array([0.36, 0.0, 0.75])),
                            place=arm.to_base(np.array([0.12, -0.42, 0.77])), lift=0.05, dwell=0.2)
     with pytest.raises(CollisionError, match=r"place pose of arm 'aubo' is .* mm from crate_wall_xpos"):
-        optim.plan_cycle(arm.robot, spec, cell=station, clearance=0.02)
+        optim.plan_cycle(optim.CycleRequest(arm.robot, spec, cell=optim.CellSettings(station, clearance=0.02)))
 
 
 @pytest.mark.slow
@@ -84,15 +86,18 @@ def test_a_transfer_no_lift_can_clear_names_what_blocks(tmp_path):
     spec = optim.PickPlace(pick=arm.to_base(np.array([0.40, 0.0, 0.78])),
                            place=arm.to_base(np.array([0.0, -0.40, 0.78])), lift=0.05, dwell=0.2)
     with pytest.raises(CollisionError, match="tall_wall blocks"):
-        optim.plan_cycle(arm.robot, spec, cell=cell, clearance=0.02, lift_step=0.15, plan_transfer=False)
+        blocked = optim.CellSettings(cell, clearance=0.02, lift_step=0.15, plan_transfer=False)
+        optim.plan_cycle(optim.CycleRequest(arm.robot, spec, cell=blocked))
     # the transfer planned round the wall's end (optim.motion) clears it
-    around = optim.plan_cycle(arm.robot, spec, cell=cell, clearance=0.02, lift_step=0.15, amax=10.0)
+    around = optim.plan_cycle(optim.CycleRequest(arm.robot, spec, timing=optim.CycleTiming(amax=10.0),
+                                                 cell=optim.CellSettings(cell, clearance=0.02, lift_step=0.15)))
     assert around.cell_report.planned_transfer and around.cell_report.min_clearance >= 0.02
 
 
 def test_the_robot_must_be_an_arm_of_the_cell(station, line):
     with pytest.raises(InvalidInput, match="not an arm of cell"):
-        optim.plan_cycle(line.arm("left").robot, crate_spec(station.arm("aubo")), cell=station)
+        optim.plan_cycle(optim.CycleRequest(line.arm("left").robot, crate_spec(station.arm("aubo")),
+                                            cell=optim.CellSettings(station)))
 
 
 @pytest.fixture(scope="module")
@@ -102,7 +107,8 @@ def line_schedule(line):
         arm = line.arm(name)
         spec = optim.PickPlace(pick=arm.to_base(np.array(pick)), place=arm.to_base(np.array(place)), lift=0.09,
                                dwell=0.15)
-        cycles[name] = optim.plan_cycle(arm.robot, spec, cell=line, clearance=0.02)
+        cycles[name] = optim.plan_cycle(optim.CycleRequest(arm.robot, spec,
+                                                           cell=optim.CellSettings(line, clearance=0.02)))
     return cycles, optim.schedule_line(line, cycles, margin=0.01)
 
 

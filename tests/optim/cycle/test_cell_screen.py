@@ -33,7 +33,7 @@ def _plan(cell, pick, place, **settings):
 def test_screened_and_unscreened_cycles_are_the_same(station):
     full = _plan(station, PICK, CRATE, screen=False)
     fast = _plan(station, PICK, CRATE, recheck=False)
-    assert fast.status == full.status == "re-planned"
+    assert fast.status is full.status is optim.CycleStatus.REPLANNED
     assert fast.cycle_time == full.cycle_time  # bit for bit: the same attempt kept, timed alike
     assert np.array_equal(fast.q_via, full.q_via)
     assert [a[1] for a in fast.cell_report.attempts] == [a[1] for a in full.cell_report.attempts]

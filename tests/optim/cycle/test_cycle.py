@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.optim.cycle import LINE_NAMES, PickPlace, plan_cycle
+from pinarms.optim.cycle import LINE_NAMES, CycleApproach, CycleLoad, CycleRequest, CycleTiming, PickPlace, plan_cycle
 from pinarms.optim.errors import InvalidLimits
 from pinarms.planning import JointLimits
 from pinarms.robots.errors import InvalidInput, UnreachableTarget
@@ -24,7 +24,7 @@ def planned(request):
     pick, place = POINTS[request.param]
     spec = PickPlace(pick, place, lift=0.05, dwell=0.2)
     limits = {"vmax": arm.velocity_limit, "amax": 4.0 * arm.velocity_limit, "jmax": 40.0 * arm.velocity_limit}
-    return arm, spec, limits, plan_cycle(arm, spec, **limits)
+    return arm, spec, limits, plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(**limits)))
 
 
 def test_waypoints_are_the_cycle_and_met_by_fk_of_the_joint_via_points(planned):
@@ -103,8 +103,8 @@ def test_straightness_is_measured_on_the_vertical_segments(planned):
 def test_doubling_vmax_halves_a_velocity_limited_cycle(name):
     arm = robots.load(name)
     spec = PickPlace(*POINTS[name], lift=0.05, dwell=0.0)
-    slow = plan_cycle(arm, spec, vmax=0.5 * arm.velocity_limit)
-    fast = plan_cycle(arm, spec, vmax=arm.velocity_limit)
+    slow = plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(vmax=0.5 * arm.velocity_limit)))
+    fast = plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(vmax=arm.velocity_limit)))
     assert fast.cycle_time == pytest.approx(slow.cycle_time / 2, rel=1e-6)
     assert fast.limit_ratios["velocity"].max() == pytest.approx(1.0, abs=1e-6)
 
@@ -115,7 +115,7 @@ def test_transfer_vias_and_the_gantry_path():
     arm = robots.load("gantry_flower")
     P = arm.position(GANTRY_PATH_AXIS_M)
     spec = PickPlace(P[0], P[-1], lift=0.10, dwell=0.1, via=list(P[2:-2]))
-    res = plan_cycle(arm, spec, amax=15.0, jmax=200.0)
+    res = plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(amax=15.0, jmax=200.0)))
     assert res.names[:3] == ("pick", "above pick", "via 1") and len(res.names) == 2 * len(P) - 1
     np.testing.assert_allclose(res.q_via[: len(P)], GANTRY_PATH_AXIS_M, atol=1e-12)
     np.testing.assert_allclose(res.q_via[len(P) - 1:], GANTRY_PATH_AXIS_M[::-1], atol=1e-12)
@@ -125,10 +125,10 @@ def test_transfer_vias_and_the_gantry_path():
 def test_unreachable_place_raises_naming_it():
     arm = robots.load("aubo_i3")
     with pytest.raises(UnreachableTarget, match=r"the place point \[1\.5, 0\.0, 0\.2\] m .*out of reach"):
-        plan_cycle(arm, PickPlace([0.35, 0.2, 0.15], [1.5, 0.0, 0.2]))
+        plan_cycle(CycleRequest(arm, PickPlace([0.35, 0.2, 0.15], [1.5, 0.0, 0.2])))
     scara = robots.load("scara_mushroom")
     with pytest.raises(UnreachableTarget, match="the above place point"):  # the lift leaves the J3 stroke
-        plan_cycle(scara, PickPlace(POINTS["scara_mushroom"][0], [-0.2, 0.35, 0.17]))
+        plan_cycle(CycleRequest(scara, PickPlace(POINTS["scara_mushroom"][0], [-0.2, 0.35, 0.17])))
 
 
 @pytest.mark.parametrize(
@@ -156,18 +156,18 @@ def test_bad_spec_raises_invalid_input(kwargs, match):
 def test_bad_limits_raise_invalid_limits(limits):
     arm = robots.load("scara_mushroom")
     with pytest.raises(InvalidLimits):
-        plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), **limits)
+        plan_cycle(CycleRequest(arm, PickPlace(*POINTS["scara_mushroom"]), timing=CycleTiming(**limits)))
 
 
 def test_bad_arguments():
     arm = robots.load("scara_mushroom")
     spec = PickPlace(*POINTS["scara_mushroom"], via=[[0.1, 0.35, 0.15]])
     with pytest.raises(InvalidInput, match="3-5-3"):
-        plan_cycle(arm, spec, kind="3-5-3")
+        plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(kind="3-5-3")))
     with pytest.raises(InvalidInput, match="kind"):
-        plan_cycle(arm, spec, kind="cubic")
+        plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(kind="cubic")))
     with pytest.raises(InvalidInput, match="PickPlace"):
-        plan_cycle(arm, {"pick": [0.3, 0.25, 0.1]})
+        plan_cycle(CycleRequest(arm, {"pick": [0.3, 0.25, 0.1]}))
 
 
 # ------------------------------------------------------------------ straight approach and retreat
@@ -176,14 +176,15 @@ def straight_aubo():
     arm = robots.load("aubo_i3")
     pick, place = POINTS["aubo_i3"]
     spec = PickPlace(pick, place, lift=0.05, dwell=0.2)
-    return arm, plan_cycle(arm, spec, amax=2.0 * arm.velocity_limit, approach="straight", tool_speed=0.5)
+    return arm, plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(amax=2.0 * arm.velocity_limit),
+                                        approach=CycleApproach(approach="straight", tool_speed=0.5)))
 
 
 def test_straight_approach_keeps_the_tcp_on_the_vertical_lines(straight_aubo):
     arm, res = straight_aubo
     assert res.approach == "straight"
     assert res.max_line_deviation < 1e-4  # within the Cartesian path's 0.1 mm tolerance
-    joint = plan_cycle(arm, res.spec, amax=res.amax)
+    joint = plan_cycle(CycleRequest(arm, res.spec, timing=CycleTiming(amax=res.amax)))
     assert joint.max_line_deviation > 1e-3  # the joint-space lift bows by more than 1 mm on this arm
     assert res.joint_cycle_time == pytest.approx(joint.cycle_time, rel=1e-12)
     assert res.straight_cost == pytest.approx(res.cycle_time - joint.cycle_time)
@@ -207,9 +208,9 @@ def test_straight_cycle_is_one_feasible_closed_trajectory(straight_aubo):
 def test_straight_approach_needs_an_acceleration_limit():
     arm = robots.load("scara_mushroom")
     with pytest.raises(InvalidLimits, match="amax"):
-        plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="straight")
+        plan_cycle(CycleRequest(arm, PickPlace(*POINTS["scara_mushroom"]), approach=CycleApproach(approach="straight")))
     with pytest.raises(InvalidInput, match="approach"):
-        plan_cycle(arm, PickPlace(*POINTS["scara_mushroom"]), approach="diagonal")
+        plan_cycle(CycleRequest(arm, PickPlace(*POINTS["scara_mushroom"]), approach=CycleApproach(approach="diagonal")))
 
 
 @pytest.mark.slow
@@ -219,7 +220,9 @@ def test_straight_approach_with_a_payload_under_torque_limits():
     arm = robots.load("scara_mushroom")
     spec = PickPlace(*POINTS["scara_mushroom"], lift=0.04, dwell=0.1)
     amax = 20.0 * arm.velocity_limit
-    res = plan_cycle(arm, spec, amax=amax, approach="straight", payload=0.5, torque_limits=True)
+    res = plan_cycle(CycleRequest(arm, spec, timing=CycleTiming(amax=amax),
+                                  load=CycleLoad(payload=0.5, torque_limits=True),
+                                  approach=CycleApproach(approach="straight")))
     assert res.payload is not None and res.torque_limit is not None
     ratios = res.torque_ratios
     assert ratios.max() <= 1.0 + 1e-6  # refined torque peaks of both moves, lines included

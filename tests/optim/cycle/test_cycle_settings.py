@@ -55,18 +55,28 @@ def test_the_error_is_both_invalid_settings_and_invalid_input():
     assert caps.number_setting(np.float32(0.5), "x", 0.0, 1.0) == 0.5
 
 
+@pytest.fixture(scope="module")
+def station():
+    from pinarms.robots.cell import load_cell
+
+    return load_cell("aubo_food_station")
+
+
 @pytest.mark.parametrize("lift_step", [1e-7, 0.0, -0.02, math.nan, math.inf, 5.0])
-def test_plan_cycle_refuses_a_lift_step_outside_its_range(scara, lift_step):
-    spec = optim.PickPlace(PICK, PLACE)
-    refused_at_once(lambda: optim.plan_cycle(scara, spec, lift_step=lift_step), "lift_step", "0.001")
+def test_cell_settings_refuse_a_lift_step_outside_its_range(station, lift_step):
+    refused_at_once(lambda: optim.CellSettings(station, lift_step=lift_step), "lift_step", "0.001")
 
 
 @pytest.mark.parametrize("name, value, word", [
     ("margin", 1e-9, "margin"), ("margin", math.nan, "margin"), ("clearance", -0.01, "clearance"),
-    ("clearance", math.inf, "clearance"), ("tool_speed", 0.0, "tool_speed"), ("tool_speed", math.nan, "tool_speed")])
-def test_plan_cycle_refuses_bad_cell_and_line_settings(scara, name, value, word):
-    spec = optim.PickPlace(PICK, PLACE)
-    refused_at_once(lambda: optim.plan_cycle(scara, spec, **{name: value}), word)
+    ("clearance", math.inf, "clearance")])
+def test_cell_settings_refuse_bad_values(station, name, value, word):
+    refused_at_once(lambda: optim.CellSettings(station, **{name: value}), word)
+
+
+@pytest.mark.parametrize("value", [0.0, math.nan])
+def test_a_straight_approach_refuses_a_bad_tool_speed(value):
+    refused_at_once(lambda: optim.CycleApproach("straight", tool_speed=value), "tool_speed")
 
 
 @pytest.mark.parametrize("dwell", [math.nan, math.inf, -0.1, 1e9])
@@ -120,9 +130,8 @@ def test_time_optimal_grid_and_time_scaled_samples_are_capped():
     refused_at_once(lambda: optim.time_optimal(path, cons, rtol=1e-300), "rtol", "1e-06")
 
 
-def test_a_clearance_is_at_most_a_metre(scara):
-    spec = optim.PickPlace(PICK, PLACE)
-    refused_at_once(lambda: optim.plan_cycle(scara, spec, clearance=1e300), "clearance", "1 m")
+def test_a_clearance_is_at_most_a_metre(station):
+    refused_at_once(lambda: optim.CellSettings(station, clearance=1e300), "clearance", "1 m")
     refused_at_once(lambda: optim.schedule_line(None, {"a": None, "b": None}, clearance=2.0), "clearance")
 
 

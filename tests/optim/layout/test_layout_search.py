@@ -57,7 +57,7 @@ def test_failures_say_why_and_the_planned_cycle_is_plan_cycles(scara, points):
     assert "pick 1 (0.426, 0.096, 0.140) m" in res.reason[1] and "beyond the arm's reach" in res.reason[1]
     assert "j1" in res.reason[2] and "outside" in res.reason[2]
     assert res.failures() == {"unreachable": 1, "joint limit": 1}
-    direct = optim.plan_cycle(scara, optim.PickPlace(pick, place, lift=0.02, dwell=0.2))
+    direct = optim.plan_cycle(optim.CycleRequest(scara, optim.PickPlace(pick, place, lift=0.02, dwell=0.2)))
     assert res.cycle_time[0] == direct.cycle_time
     assert res.picks_per_minute[0] == pytest.approx(60.0 / direct.cycle_time, rel=1e-15)
     assert res.picks_per_minute[1] == 0.0 and np.isnan(res.cycle_time[2])
@@ -80,7 +80,7 @@ def test_a_placement_moves_the_points_into_the_base_frame(scara, points):
     # the line points that sit where pick/place sit for a base at the origin
     pick_w, place_w = ((T @ np.append(p, 1.0))[:3] for p in (pick, place))
     res = search_layout(LayoutRequest(scara, pick_w, place_w, placement[None], lift=0.02, refine=0, workspace_samples=20_000))
-    direct = optim.plan_cycle(scara, optim.PickPlace(pick, place, lift=0.02, dwell=0.2))
+    direct = optim.plan_cycle(optim.CycleRequest(scara, optim.PickPlace(pick, place, lift=0.02, dwell=0.2)))
     assert res.cycle_time[0] == pytest.approx(direct.cycle_time, rel=1e-9)
 
 
@@ -144,8 +144,8 @@ def test_in_a_cell_a_candidate_that_collides_fails_as_collision():
     assert res.failure == (None, "collision", "unreachable")
     assert "crate_wall" in res.reason[1] and "clearance 20.0 mm" in res.reason[1]
     arm = station.arm("aubo")
-    direct = optim.plan_cycle(arm.robot, optim.PickPlace(arm.to_base(pick), arm.to_base(place)), cell=station,
-                              clearance=0.02)
+    direct = optim.plan_cycle(optim.CycleRequest(arm.robot, optim.PickPlace(arm.to_base(pick), arm.to_base(place)),
+                                                 cell=optim.CellSettings(station, clearance=0.02)))
     assert res.cycle_time[0] == pytest.approx(direct.cycle_time, rel=1e-12) and direct.cell_report.extra_time > 0
     assert res.best_cycle.cell_report.lift == direct.cell_report.lift
     with pytest.raises(InvalidInput, match="carry"):

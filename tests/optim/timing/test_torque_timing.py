@@ -116,12 +116,12 @@ def test_urdf_without_efforts_asks_for_limits():
 
 def test_cycle_carries_the_payload_to_the_place_only(aubo):
     spec = optim.PickPlace([0.35, -0.25, 0.15], [0.05, 0.45, 0.15], lift=0.06, dwell=0.2)
-    free = optim.plan_cycle(aubo, spec)
+    free = optim.plan_cycle(optim.CycleRequest(aubo, spec))
     q = free.q_via[: len(spec.names)]
     t = np.linspace(0.0, free.moves[0].total, 2001)
     g = np.abs(aubo.with_payload(3.0).gravity(free.moves[0].trajectory.sample(t)[0])).max(axis=0)
     limits = 1.25 * g + 0.5
-    cycle = optim.plan_cycle(aubo, spec, payload=3.0, torque_limits=limits)
+    cycle = optim.plan_cycle(optim.CycleRequest(aubo, spec, load=optim.CycleLoad(payload=3.0, torque_limits=limits)))
     np.testing.assert_allclose(cycle.q_via[: len(spec.names)], q)
     # loaded there, empty back: the same path reversed takes longer with the load
     assert cycle.move_times[0] > cycle.move_times[1] * 1.01

@@ -7,7 +7,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from pinarms.optim.motion import SCENES, MotionChecker, load_scene, plan_motion, scene_queries
+from pinarms.optim.motion import (SCENES, MotionChecker, MotionOptions, MotionRequest, load_scene, plan_motion,
+                                   scene_queries)
 from pinarms.optim.motion.report import _Distances, _interval_speeds, clearance_profile, pair_speeds, sample_times
 from pinarms.planning import multi_quintic
 from pinarms.robots.cell import motion as cell_motion
@@ -22,7 +23,8 @@ def scene():
     cell = load_scene(SCENE)
     queries, hold = scene_queries(SCENE, 3, seed=0, margin=MARGIN, cell=cell)
     arm = SCENES[SCENE].arm
-    plans = [plan_motion(cell, arm, q.start, q.goal, margin=MARGIN, seed=k, hold=hold, recheck=False)
+    plans = [plan_motion(MotionRequest(cell, arm, q.start, q.goal, hold=hold,
+                                       options=MotionOptions(margin=MARGIN, seed=k, recheck=False)))
              for k, q in enumerate(queries)]
     # a timed straight joint line from a start into a seeded configuration in contact
     rng = np.random.default_rng(0)
