@@ -37,7 +37,7 @@ from pinarms.optim.line.rules.split import Split
 from pinarms.robots.errors import InvalidInput
 
 __all__ = ["RULES", "Rule", "AssignmentRule", "Candidates", "Decision", "KernelForm", "FirstInWindow", "Nearest",
-           "Shortest", "Bands", "Split", "LookAhead", "best_sequence", "assignment_rule", "rank_simple"]
+           "Shortest", "Bands", "Split", "LookAhead", "best_sequence", "assignment_rule"]
 
 #: The built-in rules by name.
 BUILT_IN: dict[str, type[AssignmentRule]] = {c.name: c for c in (FirstInWindow, Nearest, Shortest, Bands, Split,
@@ -81,10 +81,3 @@ def assignment_rule(rule: "Rule | str | AssignmentRule") -> AssignmentRule:
     raise InvalidInput(f"an assignment rule is a name ({', '.join(RULES)}), a Rule or an AssignmentRule, "
                        f"got {type(rule).__name__}")
 
-
-def rank_simple(rule: str, c: Candidates) -> np.ndarray:
-    """Positions in ``c`` in a simple rule's order of preference (``c`` holds startable items only)."""
-    if rule not in RULES or rule == "lookahead":
-        raise InvalidInput(f"rule {rule!r} is not a simple rule")
-    d = Decision(float(np.max(c.start)) if c.start.size else 0.0, 0, 1, c, lambda ready, i: None)
-    return BUILT_IN[rule]().prefer(d)

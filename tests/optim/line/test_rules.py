@@ -108,3 +108,14 @@ def test_spacing_is_numpys():
     x = np.concatenate([[0.0, 5e-324, 1e-310, 0.5, 1.0, 2.0, 3600.0, 2.0 ** 40],
                         np.random.default_rng(0).uniform(0.0, 1e6, 200)])
     assert [spacing.py_func(float(v)) for v in x] == [float(np.spacing(v)) for v in x]
+
+
+def test_a_line_spec_takes_a_rule_object(scara_line):
+    from pinarms.optim.line.api import LineSpec, Stream, run_line
+
+    belt, station = scara_line
+    spec = LineSpec(BELT, (station,), Stream("poisson", 0.6, 120.0), rule=LastInWindow(), seeds=(0, 1))
+    result = run_line(spec, maps={station.name: (leave_map(),)})
+    assert spec.rule.name == "last" and all(r.picks > 0 for r in result.runs)
+    with pytest.raises(InvalidInput, match="rule must be a rule name, a Rule or an AssignmentRule, got int"):
+        LineSpec(belt, (station,), rule=3)
