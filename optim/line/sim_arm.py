@@ -16,6 +16,7 @@ from typing import Any, NamedTuple, Sequence
 import numpy as np
 
 from pinarms.optim.line.items import Items
+from pinarms.optim.line.map_rows import map_rows
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.robots.errors import InvalidInput
 
@@ -59,10 +60,6 @@ class Intercepts(NamedTuple):
     u: np.ndarray
 
 
-#: Items whose rows one call of :meth:`TaskMap.rows` computes (bounds its temporary arrays).
-ROWS_CHUNK = 65536
-
-
 def sim_grid(arm: SimArm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The arm's pre-grasp nodes (:meth:`TaskMap.sim_grid` over its maps).
 
@@ -87,9 +84,7 @@ def item_rows(arm: SimArm, items: Items) -> ItemRows:
     tA, tC, extra = np.empty((n, K)), np.empty((n, K)), np.empty(n)
     for k, m in enumerate(arm.maps):
         sel = np.flatnonzero(items.kind == k)
-        for a in range(0, sel.size, ROWS_CHUNK):
-            part = sel[a:a + ROWS_CHUNK]
-            tA[part], tC[part] = m.rows(items.w[part], grid)
+        tA[sel], tC[sel] = map_rows(m, grid, items.w[sel])
         extra[sel] = m.track + m.release
     ok = np.isfinite(tA) & np.isfinite(tC)
     tA[~ok] = np.nan
