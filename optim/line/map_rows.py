@@ -16,6 +16,7 @@ a map it cannot cut (another kind of map) or any difference sends every item thr
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import replace
 from typing import Any
 
@@ -58,16 +59,18 @@ class CellRows:
         return e[0, j] * (1 - f) + e[1, j] * f, e[2, j] * (1 - f) + e[3, j] * f
 
 
+#: {task map: {grid key: CellRows or None (its cells do not reproduce its rows)}}, dropped with the map
+_CELLS: "weakref.WeakKeyDictionary[Any, dict]" = weakref.WeakKeyDictionary()
+
+
 def _same(a: tuple, b: tuple) -> bool:
     return all(np.array_equal(x, y, equal_nan=True) for x, y in zip(a, b))
 
 
 def map_rows(task_map: Any, grid: tuple, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``task_map.rows(w, grid)`` for a long ``w`` (module doc)."""
-    try:
-        cells = CellRows(task_map, grid)
-    except (PinarmsError, TypeError, ValueError):
-        cells = None
+    """``task_map.rows(w, grid)`` for a long ``w`` (module doc). The cells of a map are read once per
+    grid and kept while the map lives; every call compares them with the map at a spread of its items."""
+    cells = _cells(task_map, grid)
     if cells is not None:
         probe = np.unique(np.concatenate([w[np.linspace(0, w.size - 1, min(w.size, CHECKED_ITEMS)).astype(int)]
                                           if w.size else w, task_map.w]))
@@ -77,3 +80,18 @@ def map_rows(task_map: Any, grid: tuple, w: np.ndarray) -> tuple[np.ndarray, np.
     for a in range(0, w.size, ROWS_CHUNK):
         out[0][a:a + ROWS_CHUNK], out[1][a:a + ROWS_CHUNK] = task_map.rows(w[a:a + ROWS_CHUNK], grid)
     return out[0], out[1]
+
+
+def _cells(task_map: Any, grid: tuple) -> CellRows | None:
+    """The map's :class:`CellRows` on ``grid`` (None: a map it cannot cut), read once per map and grid."""
+    key = tuple(np.asarray(g).tobytes() for g in grid)
+    try:
+        known = _CELLS.setdefault(task_map, {})
+    except TypeError:  # a map that cannot be weakly referenced: read each time
+        known = {}
+    if key not in known:
+        try:
+            known[key] = CellRows(task_map, grid)
+        except (PinarmsError, TypeError, ValueError):
+            known[key] = None
+    return known[key]

@@ -38,9 +38,11 @@ class SimArm:
 
 class ItemRows(NamedTuple):
     """Every item's times at an arm's pre-grasp nodes, shared by the arms with the same maps:
-    ``tA``, ``tC`` (n, K) approach and leave [s] (NaN where the pick is infeasible), ``extra`` (n,)
-    track + release [s], ``feasible`` (K,) nodes feasible for some item, ``max_tA`` [s]."""
+    ``du`` (K,) the nodes from the arm's base [m] (:func:`sim_grid`), ``tA``, ``tC`` (n, K) approach
+    and leave [s] (NaN where the pick is infeasible), ``extra`` (n,) track + release [s],
+    ``feasible`` (K,) nodes feasible for some item, ``max_tA`` [s]."""
 
+    du: np.ndarray
     tA: np.ndarray
     tC: np.ndarray
     extra: np.ndarray
@@ -92,7 +94,7 @@ def item_rows(arm: SimArm, items: Items) -> ItemRows:
     if not feasible.any():
         raise InvalidInput(f"arm {arm.name!r}: its maps hold no feasible pick")
     max_tA = float(np.nanmax(tA)) if np.isfinite(tA).any() else 0.0
-    return ItemRows(tA, tC, extra, feasible, max_tA)
+    return ItemRows(grid[0], tA, tC, extra, feasible, max_tA)
 
 
 class ArmState:
@@ -106,7 +108,7 @@ class ArmState:
     def __init__(self, arm: SimArm, items: Items, speed: float, rows: ItemRows | None = None) -> None:
         rows = item_rows(arm, items) if rows is None else rows
         self.rows = rows
-        self.u = arm.u_base + sim_grid(arm)[0]
+        self.u = arm.u_base + rows.du
         self.tA, self.tC, self.extra = rows.tA, rows.tC, rows.extra
         cols = np.flatnonzero(rows.feasible)
         self.u_min, self.u_max = float(self.u[cols[0]]), float(self.u[cols[-1]])
