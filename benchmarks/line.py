@@ -59,6 +59,7 @@ def part_simulate() -> None:
     arms = sim_arms(spec, maps)
     print(f"[simulate] 4 SCARAs, 120 items/min Poisson, 1 h: {len(items)} items")
     with threadpool_limits(1):
+        simulate(arms, items, spec.belt.speed, "first", duration=3600.0, width=spec.belt.width)  # numba's cache loaded
         for rule in ("first", "nearest", "shortest", "split", "bands", Rule("lookahead", 8)):
             t = time.perf_counter()
             r = simulate(arms, items, spec.belt.speed, rule, duration=3600.0, width=spec.belt.width)

@@ -23,7 +23,7 @@ import numpy as np
 
 from pinarms.compiled import jit, jit_inline
 
-__all__ = ["run_events", "spacing"]
+__all__ = ["run_events", "cell_rows", "spacing"]
 
 EPS = 1e-9  # the same as optim.line.rules.base.EPS
 
@@ -264,3 +264,21 @@ def run_events(t0, w, speed, width, group, RA, RC, EX, U, u_min, u_max, max_tA, 
         picked_by[i], meet[i], u_meet[i], start[i], finish[i] = k, cm[c], cu[c], t, cf[c]
         next_t[k], active[k] = cf[c], True
     return decisions
+
+
+@jit
+def cell_rows(w, sel, g, ends, tA, tC):
+    """Rows ``sel`` of ``tA``, ``tC`` (n, K) for items at ``w[sel]``: :meth:`~optim.line.map_rows.CellRows.rows`
+    item by item (the cell ``j`` and place ``f`` of numpy's ``searchsorted`` and division, then
+    ``T_j · (1 − f) + T_j+1 · f`` per node; NaN off the grid)."""
+    nc, K = ends.shape[1], ends.shape[2]
+    for x in range(sel.size):
+        i = sel[x]
+        wi = w[i]
+        j = min(max(_right(g, wi) - 1, 0), nc - 1)
+        f = (wi - g[j]) / (g[j + 1] - g[j])
+        if wi < g[0] or wi > g[g.size - 1]:
+            f = np.nan
+        for k in range(K):
+            tA[i, k] = ends[0, j, k] * (1 - f) + ends[1, j, k] * f
+            tC[i, k] = ends[2, j, k] * (1 - f) + ends[3, j, k] * f

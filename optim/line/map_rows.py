@@ -6,10 +6,11 @@ that cell uses, ``T_j · (1 − f) + T_j+1 · f`` (``f`` the item's place in the
 cell has no feasible branch or ``w`` is off the grid). :class:`CellRows` reads the two ends
 ``T_j``, ``T_j+1`` of every cell once, from the map itself (``TaskMap.rows`` of the map cut to that
 one cell, at ``f = 0`` and ``f = 1``, where the sum is exact), and then evaluates every item with
-the same products and sum: the same bits, about forty times faster on a long stream (a gather of
-two rows per item instead of a branch lookup per item and node).
+the same products and sum: the same bits, many times faster on a long stream (compiled, item by
+item: two rows of cell ends per item instead of a branch lookup per item and node).
 
-Before it is used, its rows are compared with :meth:`TaskMap.rows` at a spread of the items;
+Before it is used, its rows (numpy and compiled) are compared with :meth:`TaskMap.rows` at a spread
+of the items and at the grid's nodes;
 a map it cannot cut (another kind of map) or any difference sends every item through
 :meth:`TaskMap.rows` instead.
 """
@@ -50,13 +51,21 @@ class CellRows:
             self.ends[:, j] = a[0], a[1], c[0], c[1]
 
     def rows(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(t_A, t_C)`` (len(w), K) as :meth:`TaskMap.rows` gives them."""
+        """``(t_A, t_C)`` (len(w), K) as :meth:`TaskMap.rows` gives them (numpy; :meth:`fill` compiled)."""
         g = self.w
         j = np.clip(np.searchsorted(g, w, side="right") - 1, 0, g.size - 2)
         f = (w - g[j]) / (g[j + 1] - g[j])
         f = np.where((w < g[0]) | (w > g[-1]), np.nan, f)[:, None]
         e = self.ends
         return e[0, j] * (1 - f) + e[1, j] * f, e[2, j] * (1 - f) + e[3, j] * f
+
+    def fill(self, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray) -> None:
+        """Rows ``sel`` of ``tA``, ``tC`` for the items at ``w[sel]``: :meth:`rows` item by item, compiled
+        (:func:`~._sim_kernel.cell_rows`: the same products and sum, no temporary arrays)."""
+        from pinarms.optim.line._sim_kernel import cell_rows
+
+        cell_rows(np.ascontiguousarray(w, dtype=float), np.ascontiguousarray(sel, dtype=np.int64),
+                  np.ascontiguousarray(self.w, dtype=float), self.ends, tA, tC)
 
 
 #: {task map: {grid key: CellRows or None (its cells do not reproduce its rows)}}, dropped with the map
@@ -67,19 +76,23 @@ def _same(a: tuple, b: tuple) -> bool:
     return all(np.array_equal(x, y, equal_nan=True) for x, y in zip(a, b))
 
 
-def map_rows(task_map: Any, grid: tuple, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``task_map.rows(w, grid)`` for a long ``w`` (module doc). The cells of a map are read once per
-    grid and kept while the map lives; every call compares them with the map at a spread of its items."""
+def map_rows(task_map: Any, grid: tuple, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray) -> None:
+    """Rows ``sel`` of ``tA``, ``tC`` (n, K): ``task_map.rows(w[sel], grid)`` (module doc). The cells of a
+    map are read once per grid and kept while the map lives; every call compares them, in numpy and
+    compiled, with the map at a spread of its items."""
     cells = _cells(task_map, grid)
-    if cells is not None:
-        probe = np.unique(np.concatenate([w[np.linspace(0, w.size - 1, min(w.size, CHECKED_ITEMS)).astype(int)]
-                                          if w.size else w, task_map.w]))
-        if _same(cells.rows(probe), task_map.rows(probe, grid)):
-            return cells.rows(w)
-    out = [np.empty((w.size, grid[0].size)) for _ in range(2)]
-    for a in range(0, w.size, ROWS_CHUNK):
-        out[0][a:a + ROWS_CHUNK], out[1][a:a + ROWS_CHUNK] = task_map.rows(w[a:a + ROWS_CHUNK], grid)
-    return out[0], out[1]
+    if cells is not None and sel.size:
+        spread = sel[np.linspace(0, sel.size - 1, min(sel.size, CHECKED_ITEMS)).astype(int)]
+        probe = np.unique(np.concatenate([w[spread], task_map.w]))
+        ref = task_map.rows(probe, grid)
+        compiled = [np.empty((probe.size, grid[0].size)) for _ in range(2)]
+        cells.fill(probe, np.arange(probe.size), *compiled)
+        if _same(cells.rows(probe), ref) and _same(compiled, ref):
+            cells.fill(w, sel, tA, tC)
+            return
+    for a in range(0, sel.size, ROWS_CHUNK):
+        part = sel[a:a + ROWS_CHUNK]
+        tA[part], tC[part] = task_map.rows(w[part], grid)
 
 
 def _cells(task_map: Any, grid: tuple) -> CellRows | None:

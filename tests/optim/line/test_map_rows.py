@@ -7,6 +7,13 @@ from pinarms.optim.line.map_rows import CellRows, map_rows
 from pinarms.optim.line.task_maps import TaskMap
 
 
+def read(m, grid, w):
+    """:func:`map_rows` of every item into new tables."""
+    tA, tC = np.empty((w.size, grid[0].size)), np.empty((w.size, grid[0].size))
+    map_rows(m, grid, w, np.arange(w.size), tA, tC)
+    return tA, tC
+
+
 def branchy_map(seed: int) -> TaskMap:
     """Two IK branches with random times and holes, an uneven grid across the belt."""
     rng = np.random.default_rng(seed)
@@ -33,7 +40,10 @@ def test_cells_give_the_same_bits_as_the_map(seed):
     assert np.isfinite(ref[0]).any() and np.isnan(ref[0]).any()
     for a, b in zip(ref, fast):
         assert np.array_equal(a, b, equal_nan=True)
-    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, map_rows(m, grid, w)))
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, read(m, grid, w)))
+    compiled = np.full((w.size, grid[0].size), -1.0), np.full((w.size, grid[0].size), -1.0)
+    CellRows(m, grid).fill(w, np.arange(w.size), *compiled)
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, compiled))
 
 
 def test_a_map_the_cells_do_not_reproduce_is_read_itself():
@@ -51,4 +61,4 @@ def test_a_map_the_cells_do_not_reproduce_is_read_itself():
     w = np.random.default_rng(3).uniform(-0.15, 0.15, 500)
     ref = m.rows(w, grid)
     assert not np.array_equal(CellRows(m, grid).rows(w)[0], ref[0], equal_nan=True)
-    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, map_rows(m, grid, w)))
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, read(m, grid, w)))
