@@ -16,7 +16,7 @@ exist, the arm sleeps until the earliest its rule prefers. An item that no arm t
 (it leaves the last window).
 
 Two loops run this: :mod:`~.sim_loop` in Python (any rule object, the guard, trays) and
-:mod:`~._sim_kernel` compiled (the built-in rules without guard or trays, about a microsecond a
+:mod:`~._sim_kernel` compiled (the built-in rules without guard or trays, a few microseconds a
 decision); they give the same runs (``tests/optim/line/test_simulate_recorded.py``).
 
 Neighbouring arms whose windows overlap: with a ``guard`` (:class:`optim.line.neighbours.NeighbourGuard`:
