@@ -25,7 +25,13 @@ Parts (figures printed, not timed tests; docs/line.md quotes a full run):
    in window, every start checked against the neighbour's ongoing pick: through the compiled cover
    check where it proves (exact elsewhere) against the cell's exact check alone.
 
-Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|fixtures|neighbours|all]
+8. ``speed``: the simulator against issue 39's goals, each printed met or with its gap and reason:
+   <= 20 µs per decision (one hour of four SCARAs, 120 items/min, each rule, the whole ``simulate``
+   call and its loop alone), the look-ahead (horizon 8) over that hour < 2 s, 10^6 items on seven
+   SCARAs < 30 s. The Python loop (every rule object runs there) is the peer, interleaved with the
+   compiled loop on the same items (Python, compiled, Python, compiled); both must give the same runs.
+
+Run: python benchmarks/line.py [simulate|maps|rules|synthetic|sizing|trays|fixtures|neighbours|speed|all]
 """
 
 from __future__ import annotations
@@ -44,7 +50,7 @@ def _scara(n: int, rate: float, duration: float = 3600.0, seeds=(0,), rule: str 
 
 
 def part_simulate() -> None:
-    from pinarms.optim.line import simulate
+    from pinarms.optim.line import Rule, simulate
     from pinarms.optim.line.api import sim_arms
     from threadpoolctl import threadpool_limits
 
@@ -53,11 +59,12 @@ def part_simulate() -> None:
     arms = sim_arms(spec, maps)
     print(f"[simulate] 4 SCARAs, 120 items/min Poisson, 1 h: {len(items)} items")
     with threadpool_limits(1):
-        for rule in ("first", "nearest", "shortest", "split", "bands"):
+        simulate(arms, items, spec.belt.speed, "first", duration=3600.0, width=spec.belt.width)  # numba's cache loaded
+        for rule in ("first", "nearest", "shortest", "split", "bands", Rule("lookahead", 8)):
             t = time.perf_counter()
             r = simulate(arms, items, spec.belt.speed, rule, duration=3600.0, width=spec.belt.width)
             dt = time.perf_counter() - t
-            print(f"  {rule:9s} {dt:6.2f} s   picks/min {r.picks_per_minute:6.1f}   miss {100 * r.miss_rate:5.1f} %"
+            print(f"  {getattr(rule, 'name', rule):9s} {dt:6.2f} s   picks/min {r.picks_per_minute:6.1f}   miss {100 * r.miss_rate:5.1f} %"
                   f"   decisions {r.decisions}")
 
 
@@ -307,8 +314,89 @@ def part_neighbours() -> None:
               f"   checks {guard.checks}   {guard.counts if fast else ''}")
 
 
+def _in_python(rule):
+    """``rule`` as a rule object the compiled loop does not know: the same choices, in the Python loop."""
+    from pinarms.optim.line.rules import AssignmentRule
+
+    class InPython(AssignmentRule):
+        name, needs_width = rule.name, rule.needs_width
+        looks_beyond = rule.looks_beyond
+
+        def prefer(self, d):
+            return rule.prefer(d)
+
+        def takes(self, arm, n_arms, index, w, width):
+            return rule.takes(arm, n_arms, index, w, width)
+
+    return InPython()
+
+
+def _goal(label: str, value: float, goal: float, unit: str, reason: str) -> None:
+    verdict = "met" if value <= goal else f"NOT met: {value / goal:.1f}x the goal ({reason})"
+    print(f"  goal {label}: {value:.3g} {unit} against <= {goal:g} {unit}: {verdict}")
+
+
+def part_speed() -> None:
+    import os
+
+    from threadpoolctl import threadpool_limits
+
+    from pinarms.optim.line import Rule, simulate
+    from pinarms.optim.line.api import sim_arms
+    from pinarms.optim.line.sim_arm import arm_states
+    from pinarms.optim.line.sim_compiled import run_compiled
+
+    spec, maps = _scara(4, 120.0)
+    items = spec.stream.items(spec.belt, 0)
+    arms = sim_arms(spec, maps)
+    run = dict(duration=3600.0, width=spec.belt.width)
+    print(f"[speed] 4 SCARAs, 120 items/min Poisson, 1 h: {len(items)} items; load average {os.getloadavg()[0]:.1f}")
+    with threadpool_limits(1):
+        simulate(arms, items, spec.belt.speed, "first", **run)  # numba's cache loaded, imports done
+        t = time.perf_counter()
+        states = arm_states(sorted(arms, key=lambda a: a.u_base), items, spec.belt.speed)
+        print(f"  item rows (the maps read at every item, shared by the four arms): {time.perf_counter() - t:.3f} s")
+        worst, t_la = ("", 0.0, 0.0), 0.0
+        for name in ("first", "nearest", "shortest", "bands", "split", "lookahead"):
+            rule = Rule(name, 8).build()
+            times: dict = {"python": [], "compiled": [], "loop": []}
+            runs = {}
+            for side in ("python", "compiled", "loop", "python", "compiled", "loop"):
+                t = time.perf_counter()
+                if side == "loop":
+                    run_compiled(states, items, spec.belt.speed, rule.kernel_form(), spec.belt.width)
+                else:
+                    runs[side] = simulate(arms, items, spec.belt.speed,
+                                          _in_python(rule) if side == "python" else rule, **run)
+                times[side].append(time.perf_counter() - t)
+            same = all(np.array_equal(getattr(runs["python"], c), getattr(runs["compiled"], c), equal_nan=True)
+                       for c in ("picked_by", "meet", "start", "finish"))
+            n = runs["compiled"].decisions
+            py, co, loop = (min(times[k]) for k in ("python", "compiled", "loop"))
+            worst = max(worst, (name, 1e6 * co / n, 1e6 * loop / n), key=lambda x: x[1])
+            t_la = co if name == "lookahead" else t_la
+            print(f"  {name:9s} {n} decisions: compiled {co:6.3f} s ({1e6 * co / n:5.1f} µs a decision, the loop alone "
+                  f"{1e6 * loop / n:5.1f} µs), Python loop {py:6.2f} s ({1e6 * py / n:6.1f} µs), ratio {py / co:5.1f}, "
+                  f"same runs: {same}")
+    load = os.getloadavg()[0]
+    _goal(f"per decision (whole call, worst rule: {worst[0]})", worst[1], 20.0, "µs",
+          f"its loop alone takes {worst[2]:.1f} µs a decision (the look-ahead: a branch and bound over up to 8! "
+          f"orders), the rest reading the maps at every item; load average {load:.1f} on two cores")
+    _goal("look-ahead, horizon 8, one hour of four arms", t_la, 2.0, "s", f"load average {load:.1f}")
+    big, bmaps = _scara(7, 240.0, duration=250_000.0)
+    items = big.stream.items(big.belt, 0)
+    arms = sim_arms(big, bmaps)
+    with threadpool_limits(1):
+        t = time.perf_counter()
+        r = simulate(arms, items, big.belt.speed, "first", duration=250_000.0, width=big.belt.width)
+        dt = time.perf_counter() - t
+    print(f"  {len(items)} items on seven SCARAs (240 items/min, first in window): {dt:.1f} s, {r.decisions} "
+          f"decisions, {r.picks} picks")
+    _goal("10^6 items on seven arms", dt, 30.0, "s", f"load average {os.getloadavg()[0]:.1f} on two cores")
+
+
 PARTS = {"simulate": part_simulate, "maps": part_maps, "rules": part_rules, "synthetic": part_rules_synthetic,
-         "sizing": part_sizing, "trays": part_trays, "fixtures": part_fixtures, "neighbours": part_neighbours}
+         "sizing": part_sizing, "trays": part_trays, "fixtures": part_fixtures, "neighbours": part_neighbours, "speed": part_speed}
 
 if __name__ == "__main__":
     which = sys.argv[1] if len(sys.argv) > 1 else "all"

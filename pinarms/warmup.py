@@ -40,6 +40,7 @@ KERNEL_MODULES = (
     "pinarms.optim.motion._fast_kernel",
     "pinarms.optim.motion._spline_kernel",
     "pinarms.optim.topp._profile_kernel",
+    "pinarms.optim.line._sim_kernel",
 )
 
 
@@ -123,11 +124,24 @@ def _cover() -> None:
                       np.full(3, 0.1))
 
 
+def _line() -> None:
+    """The line simulator's compiled loop: two arms on a synthetic map, first in window and look-ahead."""
+    from pinarms.optim.line import Belt, Rule, SimArm, TaskMap, poisson_items, simulate
+
+    belt = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
+    du, w = np.linspace(-0.3, 0.3, 5), np.array([-0.15, 0.15])
+    m = TaskMap("warm", du, w, np.full((5, 2), 0.4), np.tile([0.3, 1.5], (5, 1)), 0.5, 0.1, 0.2, 0.1)
+    arms = [SimArm("a", 1.0, (m,)), SimArm("b", 1.8, (m,))]
+    for rule in ("first", Rule("lookahead", 3)):
+        simulate(arms, poisson_items(belt, 1.0, 20.0, seed=0), 0.2, rule, duration=20.0)
+
+
 #: What :func:`warm` runs, in order: (label, call).
 STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("inverse kinematics", _ik),
     ("motion planning", _plan),
     ("sphere cover", _cover),
+    ("line simulation", _line),
 )
 
 

@@ -7,7 +7,8 @@
   :mod:`~.tray_maps` (:class:`TrayMap`: pick-to-tray times), :mod:`~.tray_sim` (tray slots in the simulation),
   :mod:`~.windows` (each arm's pick window), :mod:`~.task_maps` (task times built once,
   interpolated, with their error against exact planning);
-- :mod:`~.rules` (assignment rules), :mod:`~.simulate` (event-based simulation of N arms),
+- :mod:`~.rules` (assignment rules, one class each), :mod:`~.simulate` (event-based simulation of N arms;
+  its loops :mod:`~.sim_loop` and, compiled, :mod:`~._sim_kernel`),
   :mod:`~.report` (picks/min, miss rate with its interval, utilisation, waits);
 - :mod:`~.api` (:func:`run_line`: one :class:`LineSpec` in, one :class:`LineResult` out),
   :mod:`~.sizing` (fewest arms, positions and belt speed for a flow);
@@ -20,7 +21,7 @@ from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
 from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
-from pinarms.optim.line.rules import RULES, Rule
+from pinarms.optim.line.rules import RULES, AssignmentRule, Rule
 from pinarms.optim.line.schedule import LineSchedule, schedule_line
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station, base_pose
@@ -35,7 +36,8 @@ __all__ = [
     "LineSchedule", "schedule_line",
     "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
     "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
-    "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "SimArm", "SimResult", "simulate",
+    "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "AssignmentRule",
+    "SimArm", "SimResult", "simulate",
     "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",
     "TrayMap", "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",

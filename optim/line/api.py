@@ -26,7 +26,7 @@ from pinarms.optim.caps import count_setting
 from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.items import MAX_ITEMS, ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
-from pinarms.optim.line.rules import Rule
+from pinarms.optim.line.rules import AssignmentRule, Rule
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import TaskMap, build_task_map
@@ -102,7 +102,7 @@ class LineSpec:
     stations: tuple[Station, ...]
     stream: Stream = Stream()
     tracking: TrackingSpec = TrackingSpec()
-    rule: Rule = Rule()
+    rule: Rule | AssignmentRule = Rule()
     seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
     target_miss_rate: float = 0.01
     map_grid: tuple[int, int] = (24, 7)
@@ -131,6 +131,8 @@ class LineSpec:
             raise InvalidInput(f"target miss rate must be in [0, 1), got {self.target_miss_rate!r}")
         if isinstance(self.rule, str):
             object.__setattr__(self, "rule", Rule(self.rule))
+        elif not isinstance(self.rule, (Rule, AssignmentRule)):
+            raise InvalidInput(f"rule must be a rule name, a Rule or an AssignmentRule, got {type(self.rule).__name__}")
         object.__setattr__(self, "trays", _tray_option(self.trays, names))
         if self.trays and len(self.stream.types) != 1:
             raise InvalidInput("trays: one item type only (the tray maps have no item-type coordinate)")

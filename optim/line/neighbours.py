@@ -19,6 +19,7 @@ import numpy as np
 
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType
+from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.robots.errors import InvalidInput, PinarmsError
@@ -59,8 +60,9 @@ class NeighbourGuard:
                 out[k] += p.counts[k]
         return out
 
-    def _plan(self, pick: tuple) -> Any:
-        name, item, _, meet, u, w, kind = pick
+    def _plan(self, pick: Pick | tuple) -> Any:
+        pick = Pick(*pick)
+        name, item, u, w, kind = pick.arm, pick.item, pick.u, pick.w, pick.kind
         key = (name, item)
         if key not in self._plans:
             t, st = self.types[kind], self.stations[name]
@@ -73,7 +75,9 @@ class NeighbourGuard:
                                          branch=branch, yaw=yaw)
         return self._plans[key]
 
-    def __call__(self, pick: tuple, other: tuple) -> bool:
+    def __call__(self, pick: Pick | tuple, other: Pick | tuple) -> bool:
+        """Whether ``pick`` (starting now) keeps the clearance from ``other`` (under way): each a
+        :class:`~.sim_loop.Pick` or a tuple of its seven fields in order."""
         from pinarms.robots.cell import ArmMotion
 
         try:
@@ -82,17 +86,18 @@ class NeighbourGuard:
             return False  # exact planning fails where the map interpolates: not proven clear
 
         # each pick on the cell's clock with its rendezvous at the simulated time
-        off_a, off_b = pick[3] - a.times[0], other[3] - b.times[0]
+        pick, other = Pick(*pick), Pick(*other)
+        off_a, off_b = pick.meet - a.times[0], other.meet - b.times[0]
         t0 = max(off_a, off_b)
         t1 = min(off_a + a.duration, off_b + b.duration)
         if t1 <= t0:
             return True
-        motions = [ArmMotion(pick[0], a.trajectory, off_a), ArmMotion(other[0], b.trajectory, off_b)]
+        motions = [ArmMotion(pick.arm, a.trajectory, off_a), ArmMotion(other.arm, b.trajectory, off_b)]
         self.checks += 1
         if not self.fast:
             res = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance, window=(t0, t1))
             return bool(res.clear if self.clearance > 0 else res.collision_free)
-        key = (pick[0], other[0])
+        key = (pick.arm, other.arm)
         if key not in self._pairs:
             from pinarms.optim.line.fixtures import PairCheck
 

@@ -21,7 +21,7 @@ over one period, for the schedule plot.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
@@ -173,50 +173,16 @@ def schedule_line(
     """
     from pinarms.robots.cell import ArmMotion
 
-    names = list(cycles)
-    if len(names) < 2:
-        raise InvalidInput("schedule_line needs the cycles of at least two arms")
-    n_offsets = count_setting(n_offsets, "n_offsets (time offsets scanned per arm)", 2, MAX_OFFSETS)
-    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
-    margin = number_setting(margin, "margin (resolution of the continuous checks)", MIN_MARGIN, unit="m")
-    for name in names:
-        arm = cell.arm(name)
-        if cycles[name].trajectory.n_joints != arm.nq:
-            raise InvalidInput(f"the cycle given for arm {name!r} has {cycles[name].trajectory.n_joints} joints, "
-                               f"the arm {arm.nq}")
-    cycle_times = {n: float(cycles[n].trajectory.duration) for n in names}
-    for n, t in cycle_times.items():
-        if not 0.0 < t <= MAX_LINE_CYCLE_TIME:
-            raise SettingOutOfRange(f"the cycle of arm {n!r} lasts {t:g} s; a line schedule takes cycles of up to "
-                                    f"{MAX_LINE_CYCLE_TIME:g} s: plan a faster cycle (higher limits, shorter dwell)")
+    names, cycle_times, n_offsets, clearance, margin = _settings(cell, cycles, n_offsets, clearance, margin)
     longest = max(cycle_times.values())
     periods = [longest * (1.0 + 0.1 * k) for k in range(11)]
-    total = len(periods) * n_offsets * (len(names) - 1)
-    done = 0
+    scan = _OffsetScan(cell, cycles, names, n_offsets, clearance, margin, hold, progress,
+                       len(periods) * n_offsets * (len(names) - 1))
     tried = []
     for period in periods:
         tried.append(period)
-        offsets = {names[0]: 0.0}
-        ok = True
-        for name in names[1:]:
-            grid = np.arange(n_offsets) * (period / n_offsets)
-            clear = np.zeros(n_offsets, dtype=bool)
-            closest = np.zeros(n_offsets)
-            for k, phi in enumerate(grid):
-                motions = [ArmMotion(n, cycles[n].trajectory, offsets[n], period) for n in offsets]
-                motions.append(ArmMotion(name, cycles[name].trajectory, float(phi), period))
-                result = cell.check_motion(motions, margin=margin, clearance=clearance, window=(0.0, period), hold=hold)
-                clear[k] = result.clear if clearance > 0 else result.collision_free
-                closest[k] = result.min_clearance
-                done += 1
-                if progress is not None:
-                    progress(done, total)
-            chosen = _widest_run_centre(clear, grid, period)
-            if chosen is None:
-                ok = False
-                break
-            offsets[name] = chosen
-        if ok:
+        offsets, last = scan.period(period)
+        if offsets is not None:
             break
     else:
         raise InfeasibleProblem(
@@ -236,11 +202,89 @@ def schedule_line(
         offsets={k: float(v) for k, v in offsets.items()},
         picks_per_minute=len(names) * 60.0 / period,
         single_arm_picks_per_minute={n: 60.0 / cycle_times[n] for n in names},
-        scanned=grid,
-        clear=clear,
-        min_clearance=closest,
+        scanned=last.grid,
+        clear=last.clear,
+        min_clearance=last.closest,
         check=final,
         arm_check=between,
         busy=_busy_intervals(cell, motions, period),
         periods_tried=tuple(tried),
     )
+
+
+def _settings(cell: Any, cycles: Mapping[str, Any], n_offsets: int, clearance: float,
+              margin: float) -> tuple[list[str], dict[str, float], int, float, float]:
+    """(arm names, cycle times [s], n_offsets, clearance, margin) checked (see :func:`schedule_line`)."""
+    names = list(cycles)
+    if len(names) < 2:
+        raise InvalidInput("schedule_line needs the cycles of at least two arms")
+    n_offsets = count_setting(n_offsets, "n_offsets (time offsets scanned per arm)", 2, MAX_OFFSETS)
+    clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
+    margin = number_setting(margin, "margin (resolution of the continuous checks)", MIN_MARGIN, unit="m")
+    for name in names:
+        arm = cell.arm(name)
+        if cycles[name].trajectory.n_joints != arm.nq:
+            raise InvalidInput(f"the cycle given for arm {name!r} has {cycles[name].trajectory.n_joints} joints, "
+                               f"the arm {arm.nq}")
+    cycle_times = {n: float(cycles[n].trajectory.duration) for n in names}
+    for n, t in cycle_times.items():
+        if not 0.0 < t <= MAX_LINE_CYCLE_TIME:
+            raise SettingOutOfRange(f"the cycle of arm {n!r} lasts {t:g} s; a line schedule takes cycles of up to "
+                                    f"{MAX_LINE_CYCLE_TIME:g} s: plan a faster cycle (higher limits, shorter dwell)")
+    return names, cycle_times, n_offsets, clearance, margin
+
+
+class ScannedOffsets(NamedTuple):
+    """One arm's scan over a period: ``grid`` (K,) offsets [s], ``clear`` (K,) proven clear,
+    ``closest`` (K,) smallest distance at the samples [m]."""
+
+    grid: np.ndarray
+    clear: np.ndarray
+    closest: np.ndarray
+
+
+@dataclass(eq=False)
+class _OffsetScan:
+    """The offsets of each next arm scanned over one period, the arms before it at their offsets kept."""
+
+    cell: Any
+    cycles: Mapping[str, Any]
+    names: list[str]
+    n_offsets: int
+    clearance: float
+    margin: float
+    hold: Any
+    progress: Any
+    total: int
+    done: int = 0
+
+    def period(self, period: float) -> tuple[dict[str, float] | None, ScannedOffsets | None]:
+        """The offsets of every arm at ``period`` (None when some arm has no clear offset) and the last scan."""
+        offsets = {self.names[0]: 0.0}
+        scan = None
+        for name in self.names[1:]:
+            scan = self.arm(name, offsets, period)
+            chosen = _widest_run_centre(scan.clear, scan.grid, period)
+            if chosen is None:
+                return None, scan
+            offsets[name] = chosen
+        return offsets, scan
+
+    def arm(self, name: str, offsets: dict[str, float], period: float) -> ScannedOffsets:
+        """Arm ``name``'s offsets over ``[0, period)`` checked against the arms of ``offsets``."""
+        from pinarms.robots.cell import ArmMotion
+
+        grid = np.arange(self.n_offsets) * (period / self.n_offsets)
+        clear = np.zeros(self.n_offsets, dtype=bool)
+        closest = np.zeros(self.n_offsets)
+        for k, phi in enumerate(grid):
+            motions = [ArmMotion(n, self.cycles[n].trajectory, offsets[n], period) for n in offsets]
+            motions.append(ArmMotion(name, self.cycles[name].trajectory, float(phi), period))
+            result = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance,
+                                            window=(0.0, period), hold=self.hold)
+            clear[k] = result.clear if self.clearance > 0 else result.collision_free
+            closest[k] = result.min_clearance
+            self.done += 1
+            if self.progress is not None:
+                self.progress(self.done, self.total)
+        return ScannedOffsets(grid, clear, closest)

@@ -98,7 +98,7 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
 
     Example: pinarms line aubo_i3 --from 350 200 0 --to 350 200 300 --mm --amax 7 --vtool 500
     """
-    from pinarms import optim, planning
+    from pinarms import planning
     from pinarms.robots.reach.layout import default_orientation
 
     arm = load_robot(robot)
@@ -106,17 +106,39 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
     R = default_orientation(arm)
     poses = np.stack([_pose(start, "--from", mm, deg, R), *(_pose(v, "--via", mm, deg, R) for v in via),
                       _pose(goal, "--to", mm, deg, R)])
-    q0 = None
-    if q_start is not None:
-        values = floats(q_start, "--q-start")
-        if values.size != arm.nq:
-            raise InvalidInput(f"--q-start needs {arm.nq} values for {arm.name} ({', '.join(arm.joint_names)}), "
-                               f"got {values.size}")
-        q0 = joints_to_si(arm, values, deg=deg, mm=mm)
+    q0 = _q_start(arm, q_start, deg, mm)
     tol = 1e-4 if tolerance is None else tolerance * lu
     stops = range(1, poses.shape[0] - 1) if stop_at_vias else ()
     path = planning.cartesian_path(arm, poses, blend=blend * lu, weight=weight, stops=stops, tolerance=tol,
                                    q_start=q0)
+    timing, law = _timed(arm, path, vmax, amax, jmax, None if vtool is None else vtool * lu,
+                         None if atool is None else atool * lu)
+    data, lines = _line_report(arm, poses, path, timing, law, tol, mm, deg)
+    if session_path:
+        session = new_session(arm, f"{arm.name}: straight tcp lines")
+        session.add_trajectory("line", timing.trajectory, hz=200.0)
+        session.add_points("poses", poses[:, :3, 3], kind="via")
+        save_session(session, session_path, data, lines)
+    emit(as_json, data, lines)
+
+
+def _q_start(arm: Any, q_start: str | None, deg: bool, mm: bool) -> np.ndarray | None:
+    """``--q-start`` in SI units (None: not given); InvalidInput naming the flag for a wrong count."""
+    if q_start is None:
+        return None
+    values = floats(q_start, "--q-start")
+    if values.size != arm.nq:
+        raise InvalidInput(f"--q-start needs {arm.nq} values for {arm.name} ({', '.join(arm.joint_names)}), "
+                           f"got {values.size}")
+    return joints_to_si(arm, values, deg=deg, mm=mm)
+
+
+def _timed(arm: Any, path: Any, vmax: str | None, amax: str | None, jmax: str | None, vtool: float | None,
+           atool: float | None) -> tuple[Any, str]:
+    """The timing of ``path`` under the limits of the flags (tool limits in SI units) and its law in words:
+    time-optimal with ``--amax``, else the fastest rest-to-rest quintic time law."""
+    from pinarms import optim, planning
+
     v = si_limit(vmax, "--vmax", 1.0)
     v = np.asarray(arm.velocity_limit, dtype=float) if v is None else v
     a = si_limit(amax, "--amax", 1.0)
@@ -127,15 +149,19 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
     if a is not None:
         constraints.append(planning.JointAccelerationConstraint(a))
     if vtool is not None:
-        constraints.append(planning.ToolSpeedConstraint(vtool * lu))
+        constraints.append(planning.ToolSpeedConstraint(vtool))
     if atool is not None:
-        constraints.append(planning.ToolAccelerationConstraint(atool * lu))
+        constraints.append(planning.ToolAccelerationConstraint(atool))
     if a is None:
-        timing = optim.time_scaled(path, constraints, shape="quintic")
-        law = "quintic time law"
-    else:
-        timing = optim.time_optimal(path, constraints, jerk=j)
-        law = "time-optimal (TOPP-RA)" + (" smoothed for the jerk limit" if j is not None else "")
+        return optim.time_scaled(path, constraints, shape="quintic"), "quintic time law"
+    law = "time-optimal (TOPP-RA)" + (" smoothed for the jerk limit" if j is not None else "")
+    return optim.time_optimal(path, constraints, jerk=j), law
+
+
+def _line_report(arm: Any, poses: np.ndarray, path: Any, timing: Any, law: str, tol: float, mm: bool,
+                 deg: bool) -> tuple[dict[str, Any], list[str]]:
+    """What ``pinarms line`` reports: the JSON data and the text lines."""
+    lu = length_scale(mm)
     traj = timing.trajectory
     s = np.linspace(0.0, path.length, 10 * (path.breaks.size - 1) + 1)
     dev, rot = path.deviation(s)
@@ -177,9 +203,4 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
         + ", ".join(f"{k} {100 * r:.1f} %" for k, r in timing.ratios.items()),
         f"  joint peak |v| [rad/s or m/s]: {fmt(peaks.velocity, 4)}",
     ]
-    if session_path:
-        session = new_session(arm, f"{arm.name}: straight tcp lines")
-        session.add_trajectory("line", traj, hz=200.0)
-        session.add_points("poses", poses[:, :3, 3], kind="via")
-        save_session(session, session_path, data, lines)
-    emit(as_json, data, lines)
+    return data, lines

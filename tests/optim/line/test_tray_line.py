@@ -198,10 +198,12 @@ def test_bad_tray_input(scara_line):
     ok = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2))
     with pytest.raises(InvalidInput, match="not in the line"):
         LineSpec(belt, (station,), trays={"scara 9": ok})
-    with pytest.raises(InvalidInput, match="look-ahead"):
-        tm = const_tray_map(0.1)
-        simulate([SimArm("a", U_BASE, (tm.pick_map,), place=SimPlace(tm, ok, V_BASE))],
-                 regular_items(BELT, 2.0, 10.0, w=0.0), BELT.speed, "lookahead")
+    tm = const_tray_map(0.1)
+    placing = [SimArm("a", U_BASE, (tm.pick_map,), place=SimPlace(tm, ok, V_BASE))]
+    with pytest.raises(InvalidInput, match="'lookahead' rule does not plan tray places"):
+        simulate(placing, regular_items(BELT, 2.0, 10.0, w=0.0), BELT.speed, "lookahead")
+    with pytest.raises(InvalidInput, match="neighbour check does not plan tray places yet; use no cell"):
+        simulate(placing, regular_items(BELT, 2.0, 10.0, w=0.0), BELT.speed, "first", guard=lambda a, b: True)
 
 
 def test_line_spec_with_trays_reports_tray_figures(scara_line):
