@@ -1,0 +1,126 @@
+"""The true smallest clearance at the samples of a motion check (:func:`.motion.check_motion`).
+
+Every sample the check kept is either exact over the checked pairs or cleared at the screen
+distance; what the report states as the smallest clearance is coal's exact smallest distance
+over *every* candidate pair at the samples, with its time and pair. Computing it at every
+sample (hundreds of pairs each) is most of a check's time, so the samples are searched as a
+branch and bound in time:
+
+* the smallest distance over every pair, ``D(t)``, changes at most at the approach speed
+  bound ``V(t)`` of the check's schedule (the rule its proof rests on, :mod:`.motion`), so an
+  exact ``D(s)`` at one sample bounds every other sample from below:
+  ``D(t) ≥ D(s) − |∫_s^t V dt|`` (the approach budget between them);
+* where the check screens on the sphere cover, each sample also starts from the cover's
+  lower bound (compiled, tight); with ``cover=False`` the search uses coal and the budget alone
+  (it shares no code with the cover);
+* the samples still open are swept by Pinocchio's broad phase (coal's collision test at a
+  security margin) at the smallest distance found: a sample without any pair within it
+  cannot hold the minimum;
+* rounds of :data:`SMALLEST_BATCH` samples, spread evenly in time over the samples still
+  open (their bound not above the smallest distance found), are computed exactly over every
+  candidate pair (coal, pairs ordered by their bounding spheres and boxes), until none is open.
+
+The result is the same exact minimum as computing every sample: a sample is skipped only
+when a proven bound shows it cannot come within :data:`TIE_M` of the smallest found.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .collision import exact_min_distance, pair_lower_bounds
+from .pairs import CollisionPair
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .motion import _Samples, _Schedule
+
+__all__ = ["smallest_clearance", "SMALLEST_BATCH", "TIE_M"]
+
+#: Samples evaluated together in one round of the search; rows of cover bounds per block.
+SMALLEST_BATCH, BOUND_ROWS = 16, 4096
+#: Distances [m] closer than this to the smallest count as ties: the earliest sample of them is
+#: reported (a motion symmetric about an obstacle reaches its smallest distance twice, and which of
+#: two equal distances coal returns smaller is float noise that may differ between runs).
+TIE_M = 1e-9
+#: A sample the broad phase finds no pair within ``best + SWEEP_M`` of [m] is dropped (more than
+#: :data:`TIE_M`: coal's collision test at a security margin is not exact to the nanometre).
+SWEEP_M = 1e-6
+
+
+def smallest_clearance(samples: "_Samples", schedule: "_Schedule", t: np.ndarray, d: np.ndarray, k: np.ndarray,
+                       exact: np.ndarray, screen: float) -> tuple[float, float, CollisionPair | None]:
+    """The smallest exact distance at the samples [m] over every candidate pair of the cell, its time [s] and pair.
+
+    ``t, d, k, exact``: every sample of the check in time order (its distance, pair, exact
+    or not). A sample computed exactly below the ``screen`` distance holds it: the samples
+    the screen cleared are at least ``screen`` away, the pairs the check left out proven
+    farther. Else the branch and bound of the module doc. ``(inf, t0, None)`` for a cell
+    without pairs.
+    """
+    cell = samples.cell
+    exact_d = np.where(exact, d, np.inf)
+    i = earliest_of_smallest(t, exact_d)
+    if exact_d[i] < screen:
+        return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
+    n_all, n0 = len(cell._candidates), len(cell.pairs)
+    if n_all == 0:
+        return float("inf"), float(t[0]), None
+
+    def bounds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        Q = samples.configurations(t[rows])
+        lb = pair_lower_bounds(cell, Q)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        return Q, lb
+
+    row_lb = _cover_bounds(samples, t)
+    budget = np.interp(t, schedule.grid, schedule.budget)  # ∫ V dt from the window's start [m]
+    found_d = np.full(t.size, np.inf)
+    found_k = np.full(t.size, -1)
+    done = np.zeros(t.size, dtype=bool)
+    best, swept = float("inf"), float("inf")
+    while True:
+        open_ = np.flatnonzero(~done & (row_lb <= best + TIE_M))
+        if open_.size > SMALLEST_BATCH and best < swept:  # the broad phase drops the samples farther than best
+            swept = best
+            near = cell.in_collision(samples.configurations(t[open_]), margin=best + SWEEP_M)
+            row_lb[open_[~near]] = np.maximum(row_lb[open_[~near]], best + SWEEP_M)
+            open_ = open_[near]
+        if not open_.size:
+            break
+        # spread over the open samples in time: each exact one bounds its neighbours
+        rows = open_[np.unique(np.linspace(0, open_.size - 1, min(SMALLEST_BATCH, open_.size)).round().astype(int))]
+        Q, lb = bounds(rows)
+        # a sample's distance matters only below the smallest found (ties included): above it, a bound will do
+        dist, pair, _, _ = exact_min_distance(cell, Q, lb=lb, n=n_all, cap=best + TIE_M)
+        found_d[rows], found_k[rows], done[rows] = dist, pair, True
+        best = min(best, float(np.min(dist)))
+        reach = np.max(dist[:, None] - np.abs(budget[None, :] - budget[rows][:, None]), axis=0)
+        row_lb = np.maximum(row_lb, reach)
+    i = earliest_of_smallest(t, found_d)
+    return float(found_d[i]), float(t[i]), cell._candidates[int(found_k[i])] if found_k[i] >= 0 else None
+
+
+def earliest_of_smallest(t: np.ndarray, d: np.ndarray) -> int:
+    """The index of the earliest time ``t`` whose ``d`` is within :data:`TIE_M` of the smallest ``d``."""
+    ties = np.flatnonzero(d <= np.min(d) + TIE_M)
+    return int(ties[np.argmin(t[ties])]) if ties.size else 0
+
+
+def _cover_bounds(samples: "_Samples", t: np.ndarray) -> np.ndarray:
+    """``(len(t),)`` lower bounds [m] of each sample's smallest distance over every candidate pair, from the start.
+
+    On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
+    else ``-inf`` (a check run with ``cover=False`` shares no code with the cover, its minimum
+    included: the search then bounds the samples by the approach budget alone).
+    """
+    from .motion import COVER_ROWS, _cover_pairs
+
+    if not (samples.cover and t.size >= COVER_ROWS):
+        return np.full(t.size, -np.inf)
+    cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
+    n = len(samples.cell._candidates)
+    return np.concatenate([cover.excess(samples.configurations(t[a:a + BOUND_ROWS]), pair_set, np.zeros(n))
+                           for a in range(0, t.size, BOUND_ROWS)])
+
