@@ -10,10 +10,11 @@ For each arm, the speed of every point of its collision geometry is at most
 ``v(t) = Σ_j |q̇_j(t)| · ℓ_j``, with ``ℓ_j`` the *lever* of joint ``j`` (1 for a prismatic
 joint; for a revolute joint, a bound of the distance from its origin to any point of the
 geometry it carries, from the joint offsets, strokes and bounding spheres downstream, see
-:func:`joint_levers`). Two bodies approach each other at most at ``V(t) = 2 max_arms v(t)``.
+:func:`joint_levers`). Two bodies approach each other at most at ``V(t) = v_1(t) + v_2(t)``,
+the two fastest arms' bounds (one moving arm: its ``v(t)``; :mod:`.speed_bound` says why).
 Over a short step ``h`` the speed cannot exceed its larger end value by more than
 ``A h / 2`` (``A = Σ_j max|q̈_j| ℓ_j``, from the trajectory's exact acceleration peaks), nor
-``2 Σ_j max|q̇_j| ℓ_j`` (the exact velocity peaks). The samples are placed so that the
+its arm's cap ``Σ_j max|q̇_j| ℓ_j`` (the exact velocity peaks). The samples are placed so that the
 *approach budget* ``∫ V dt`` between two consecutive samples is at most ``margin``:
 dense where the arms move fast, sparse where they dwell. On an interval ``[a, b]`` with
 budget ``B`` the distance of every pair then stays at least ``(d_a + d_b − B) / 2``, where

@@ -233,3 +233,19 @@ def test_a_capped_distance_is_exact_below_the_cap_and_a_lower_bound_above(scene)
     np.testing.assert_array_equal(capped[below], exact[below])
     np.testing.assert_array_equal(capped_pair[below], pair[below])
     assert np.all(capped[~below] >= cap) and np.all(capped[~below] <= exact[~below])
+
+
+def test_one_moving_arm_approaches_at_most_at_its_own_speed_bound(scene):
+    """One moving arm (the other held): the approach budget is the arm's own bound, not twice it, and no candidate
+    pair's distance (its own links, the held arm, the fixtures) changes faster on a dense grid."""
+    from pinarms.robots.cell.speed_bound import joint_levers
+    from tests.robots.cell.test_cell_motion import approach_budget_holds
+
+    cell, arm, hold, trajs, straight = scene
+    levers = joint_levers(cell)[cell.arm(arm).q_slice]
+    for traj in (trajs[0], straight):
+        motion = [ArmMotion(arm, traj)]
+        schedule, change, allowed = approach_budget_holds(cell, motion, (traj.start_time, traj.end_time),
+                                                          traj.duration / 400, hold)
+        assert change.max() > 0.05 * allowed.max()  # the arm does move towards things
+        assert schedule.speed_bound == pytest.approx(float(np.abs(traj.peaks().velocity) @ levers), rel=1e-12)
