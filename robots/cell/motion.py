@@ -57,7 +57,7 @@ from ..errors import InvalidInput
 from .collision import _margin, exact_min_distance
 from .ladder import Intervals, climb
 from .motion_curves import moving_arm_curves
-from .motion_minimum import TIE_M, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
+from .motion_minimum import TIE_M, FirstRound, first_round, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
 from .speed_bound import joint_levers, speed_profile, travel_stops
@@ -207,6 +207,7 @@ class _Samples:
     def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
                  cover: bool = True) -> None:
         self.cell, self.motions, self.hold_q, self.n_pairs, self.cover = cell, motions, hold_q, n_pairs, cover
+        self.first: FirstRound | None = None  # the smallest clearance's first round (.motion_minimum)
         self.t: list = []
         self.d: list = []
         self.k: list = []
@@ -222,7 +223,15 @@ class _Samples:
         Returns the distances ``(len(times),)``: exact, or ``screen`` where the screen cleared the sample.
         """
         Q = self.configurations(times)
-        exact = np.ones(times.size, dtype=bool) if curve else self.flag(Q, screen + 1e-6)
+        # without the cover: the smallest clearance's first round and sweep (one broad-phase pass at the
+        # smallest distance found) first; a sample it clears is farther than the screen too
+        near = np.ones(times.size, dtype=bool)
+        if not curve and not (self.cover and times.size >= COVER_ROWS):
+            self.first = first_round(self.cell, Q, times, screen)
+            near = self.first.near
+        exact = np.ones(times.size, dtype=bool) if curve else np.zeros(times.size, dtype=bool)
+        if not curve and near.any():
+            exact[near] = self.flag(Q[near], screen + 1e-6)
         d = np.full(times.size, screen)
         k = np.full(times.size, -1, dtype=int)
         if exact.any():

@@ -249,3 +249,25 @@ def test_one_moving_arm_approaches_at_most_at_its_own_speed_bound(scene):
                                                           traj.duration / 400, hold)
         assert change.max() > 0.05 * allowed.max()  # the arm does move towards things
         assert schedule.speed_bound == pytest.approx(float(np.abs(traj.peaks().velocity) @ levers), rel=1e-12)
+
+
+def test_the_first_rounds_sweep_stands_in_for_the_screen_and_clears_only_far_samples(table):
+    """Without the cover, one broad-phase pass at the first round's smallest distance replaces the screen's pass:
+    the same samples flagged as by the screen over every sample, and every sample it clears farther than that
+    distance by coal (every candidate pair)."""
+    from pinarms.robots.cell.collision import exact_min_distance
+    from pinarms.robots.cell.motion_minimum import first_round
+
+    cell, arm, hold, trajs = table
+    for traj in trajs:
+        motion = [ArmMotion(arm, traj)]
+        check = cell.check_motion(motion, margin=MARGIN, hold=hold, cover=False)
+        schedule = cell_motion._schedule(cell, motion, traj.start_time, traj.end_time, MARGIN)
+        Q = cell_motion.configurations(cell, motion, schedule.times, hold)
+        at = np.searchsorted(check.times, schedule.times)
+        assert np.array_equal(check.times[at], schedule.times)
+        np.testing.assert_array_equal(check.exact[at], cell.in_collision(Q, margin=MARGIN + 1e-6))
+        first = first_round(cell, Q, schedule.times, MARGIN)
+        assert np.isfinite(first.swept) and (~first.near).sum() > schedule.times.size / 2  # it stood in, cleared most
+        d, _, _, _ = exact_min_distance(cell, Q[~first.near], n=len(cell._candidates))
+        assert np.all(d > first.swept)
