@@ -255,6 +255,20 @@ class _Samples:
             flagged[flagged] = self.cell.in_collision(Q[flagged], margin=screen)
         return flagged
 
+    def cover_bounds(self, ts: np.ndarray) -> np.ndarray:
+        """``(len(ts),)`` lower bounds [m] of each sample's smallest distance over every candidate pair.
+
+        On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
+        else ``-inf`` (a check run with ``cover=False`` shares no code with the cover, its minimum
+        included: :mod:`.motion_minimum` then bounds the samples by the broad phase and the budget).
+        """
+        if not (self.cover and ts.size >= COVER_ROWS):
+            return np.full(ts.size, -np.inf)
+        n = len(self.cell._candidates)
+        cover, pair_set = _cover_pairs(self.cell, n)
+        return np.concatenate([cover.excess(self.configurations(ts[a:a + BOUND_ROWS]), pair_set, np.zeros(n))
+                               for a in range(0, ts.size, BOUND_ROWS)])
+
     def evaluate(self, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Exact smallest distances and closest pairs at extra times ``ts`` (kept as samples)."""
         ds, ks, _, _ = exact_min_distance(self.cell, self.configurations(ts), n=self.n_pairs)
@@ -271,8 +285,8 @@ class _Samples:
                 np.asarray(self.k, dtype=int)[order], np.asarray(self.x, dtype=bool)[order])
 
 
-#: Fewest samples screened on the sphere cover first (fewer: the broad phase alone).
-COVER_ROWS = 8
+#: Fewest samples screened on the sphere cover first (fewer: the broad phase alone); rows of cover bounds per block.
+COVER_ROWS, BOUND_ROWS = 8, 4096
 
 
 def _cover_pairs(cell: "Cell", n_pairs: int) -> tuple[Any, Any]:

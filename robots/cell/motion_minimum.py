@@ -44,8 +44,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["smallest_clearance", "first_round", "FirstRound", "SMALLEST_BATCH", "TIE_M"]
 
-#: Samples evaluated together in one round of the search; rows of cover bounds per block.
-SMALLEST_BATCH, BOUND_ROWS = 16, 4096
+#: Samples evaluated together in one round of the search.
+SMALLEST_BATCH = 16
 #: Distances [m] closer than this to the smallest count as ties: the earliest sample of them is
 #: reported (a motion symmetric about an obstacle reaches its smallest distance twice, and which of
 #: two equal distances coal returns smaller is float noise that may differ between runs).
@@ -80,7 +80,7 @@ def smallest_clearance(samples: "_Samples", schedule: "_Schedule", t: np.ndarray
         lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
         return Q, lb
 
-    row_lb = _cover_bounds(samples, t)
+    row_lb = samples.cover_bounds(t)
     budget = np.interp(t, schedule.grid, schedule.budget)  # ∫ V dt from the window's start [m]
     found_d = np.full(t.size, np.inf)
     found_k = np.full(t.size, -1)
@@ -174,21 +174,3 @@ def earliest_of_smallest(t: np.ndarray, d: np.ndarray) -> int:
     """The index of the earliest time ``t`` whose ``d`` is within :data:`TIE_M` of the smallest ``d``."""
     ties = np.flatnonzero(d <= np.min(d) + TIE_M)
     return int(ties[np.argmin(t[ties])]) if ties.size else 0
-
-
-def _cover_bounds(samples: "_Samples", t: np.ndarray) -> np.ndarray:
-    """``(len(t),)`` lower bounds [m] of each sample's smallest distance over every candidate pair, from the start.
-
-    On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
-    else ``-inf`` (a check run with ``cover=False`` shares no code with the cover, its minimum
-    included: the search then bounds the samples by the approach budget alone).
-    """
-    from .motion import COVER_ROWS, _cover_pairs
-
-    if not (samples.cover and t.size >= COVER_ROWS):
-        return np.full(t.size, -np.inf)
-    cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
-    n = len(samples.cell._candidates)
-    return np.concatenate([cover.excess(samples.configurations(t[a:a + BOUND_ROWS]), pair_set, np.zeros(n))
-                           for a in range(0, t.size, BOUND_ROWS)])
-
