@@ -11,8 +11,8 @@ branch and bound in time:
   exact ``D(s)`` at one sample bounds every other sample from below:
   ``D(t) ≥ D(s) − |∫_s^t V dt|`` (the approach budget between them);
 * where the check screens on the sphere cover, each sample also starts from the cover's
-  lower bound (compiled, tight); with ``cover=False`` the search uses coal and the budget alone
-  (it shares no code with the cover);
+  lower bound (compiled, tight); with ``cover=False`` the search uses the broad phase, coal and
+  the budget alone (it shares no code with the cover);
 * without the cover, a first round of :data:`SMALLEST_BATCH` samples and one broad-phase pass at
   its smallest distance run before the check's screen (:func:`first_round`): a sample without
   any pair within that distance has none within the screen distance either, so the screen
