@@ -7,7 +7,8 @@ Targets are the FK of random in-limit configurations (reachable by construction)
 2. One target at a time: ``Robot.ik`` (the compiled Levenberg–Marquardt solver, seeded restarts;
    the interpreted path with closed-form branches only if that fails) beside ``ik_LM`` (C++,
    its own random starts, ``tol = 5e-13``), both judged by the same strict check (1e-6 m,
-   1e-6 rad, joint limits); median, p95 and mean, after one warm-up call each.
+   1e-6 rad, joint limits); median, p95 and mean, after one warm-up call each; interleaved target
+   by target (the first tool alternating), so that both see the same load.
 3. Batched: ``Robot.ik(T (N, 4, 4))`` per target (total time / N), beside ``ik_LM``'s median
    and mean per target, in ``--rounds`` interleaved rounds (the ratio's median over them, both
    tools' success shares, iterations per target of both).
@@ -190,29 +191,41 @@ def strict_ok(robot, q, T, tol: float = 1e-6) -> bool:
 
 
 def one_at_a_time(robot, ets, T) -> dict:
-    """Median, p95, success share, mean [s] (and, for ik_LM, the median CPU time of a call) of single solves."""
-    out = {}
-    times, ok = [], 0
-    for k in range(len(T)):
+    """Median, p95, success share, mean [s] (and, for ik_LM, the median CPU time of a call) of single solves.
+
+    Interleaved target by target (which tool goes first alternates), so that a burst of load
+    lands on both tools alike instead of on one whole side.
+    """
+    ours, ok = [], 0
+    times, cpu, rok, its, searches = [], [], 0, [], []
+
+    def pinarms_call(k: int) -> None:
+        nonlocal ok
         t0 = time.perf_counter()
         try:
             q = robot.ik(T[k], seed=k)
         except UnreachableTarget:
             q = None
-        times.append(time.perf_counter() - t0)
+        ours.append(time.perf_counter() - t0)
         ok += strict_ok(robot, q, T[k])
-    out["pinarms"] = (np.median(times), np.quantile(times, 0.95), ok / len(T), np.mean(times))
+
+    def rtb_call(k: int) -> None:
+        nonlocal rok
+        t0, c0 = time.perf_counter(), time.thread_time()
+        sol = ets.ik_LM(T[k], tol=5e-13, joint_limits=True)
+        cpu.append(time.thread_time() - c0)
+        times.append(time.perf_counter() - t0)
+        rok += strict_ok(robot, np.asarray(sol[0], dtype=float), T[k])
+        its.append(getattr(sol, "iterations", np.nan))
+        searches.append(getattr(sol, "searches", np.nan))
+
+    for k in range(len(T)):
+        calls = (pinarms_call,) if ets is None else ((pinarms_call, rtb_call) if k % 2 == 0 else (rtb_call, pinarms_call))
+        for call in calls:
+            call(k)
+    out = {"pinarms": (np.median(ours), np.quantile(ours, 0.95), ok / len(T), np.mean(ours))}
     if ets is not None:
-        times, cpu, ok, its, searches = [], [], 0, [], []
-        for k in range(len(T)):
-            t0, c0 = time.perf_counter(), time.thread_time()
-            sol = ets.ik_LM(T[k], tol=5e-13, joint_limits=True)
-            cpu.append(time.thread_time() - c0)
-            times.append(time.perf_counter() - t0)
-            ok += strict_ok(robot, np.asarray(sol[0], dtype=float), T[k])
-            its.append(getattr(sol, "iterations", np.nan))
-            searches.append(getattr(sol, "searches", np.nan))
-        out["rtb"] = (np.median(times), np.quantile(times, 0.95), ok / len(T), np.mean(times), np.median(cpu))
+        out["rtb"] = (np.median(times), np.quantile(times, 0.95), rok / len(T), np.mean(times), np.median(cpu))
         out["rtb_work"] = (float(np.mean(its)), float(np.mean(searches)))
     return out
 
@@ -247,7 +260,8 @@ def closed_form(n: int, seed: int) -> None:
 
 def single_targets(samples: dict, n: int) -> None:
     """Section 2: one target at a time, pinarms beside ik_LM."""
-    print(f"2. one target at a time, {n} random reachable poses per arm, strict check (1e-6 m, 1e-6 rad, limits)")
+    print(f"2. one target at a time, {n} random reachable poses per arm, strict check (1e-6 m, 1e-6 rad, limits); "
+          "interleaved target by target")
     print(f"  {'arm':<9} {'pinarms median':>15} {'p95':>8} {'mean':>8} {'ok':>7} | {'ik_LM median':>13} {'p95':>8} "
           f"{'mean':>8} {'ok':>7} | {'ik_LM/pinarms median, mean':>26}")
     for name, (robot, T, ets) in samples.items():

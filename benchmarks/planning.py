@@ -17,6 +17,12 @@ margin 10 mm, search time limit ``--time-limit``), and the table gives, per scen
   time-optimal under the URDF's velocity and torque limits and the default acceleration limits);
 * the smallest clearance to fixtures / the other arm over all plans (must be >= margin).
 
+Goals printed at the end, each met or its gap and the largest step: the default call
+(``+recheck``: re-check and clearance profile included) median <= 30 ms on panda_table_box,
+60 ms on panda_shelf, 80 ms on aubo_crate_guard; the search median within 10x of VAMP's on the
+Panda scenes; >= 99 % solved within the time limit. VAMP is not run here (``VAMP_WHY``): its
+figures are printed as what they are, published or from an earlier source build.
+
 pyroboplan's RRT-Connect runs on the Panda scenes, same queries, same collision geometry
 (the same cell URDF), in its own virtual environment (pyroboplan pins pin 4.0.0)::
 
@@ -71,11 +77,20 @@ GOAL_SUCCESS = 0.99
 GOAL_PLAN = 0.050
 GOAL_VS_PYROBOPLAN = 10.0
 GOAL_OVERRUN = 0.10
+#: Goals of the default call (issue 39): ``plan_motion`` as called by default, the cell's re-check and the
+#: clearance profile included, median [s] per scene.
+GOAL_DEFAULT = {"panda_table_box": 0.030, "panda_shelf": 0.060, "aubo_crate_guard": 0.080}
 #: VAMP (Thomason, Kingston, Kavraki, "Motions in Microseconds via Vectorized Sampling-Based Planning",
 #: ICRA 2024): its RRT-Connect median search, published (MotionBenchMaker problems, one core of a
-#: Ryzen 9 7950X) and measured from its source on this project's Panda scenes rebuilt as boxes
-#: (no margin, spheres, sampled edges: an easier problem). It cannot be installed from the package index.
+#: Ryzen 9 7950X) and measured once from its source (0.6.4) on this project's Panda scenes rebuilt as boxes
+#: (no margin, spheres, sampled edges: an easier problem). Not re-run here: see VAMP_WHY.
 VAMP = {"published MotionBenchMaker": 35e-6, "panda_table_box": 22e-6, "panda_shelf": 117e-6}
+#: Why VAMP is not measured by this benchmark (checked with ``pip download vamp-planner``, 0.6.4).
+VAMP_WHY = ("vamp-planner 0.6.4 is on PyPI as a source package only; its build downloads nigh, pdqsort, SIMDxorshift and "
+            "nanobind from GitHub (CPM), which a machine reaching PyPI and Debian alone cannot: the figures are the "
+            "published one and an earlier source build's on these scenes, not measured in this run")
+#: Search median goal [s]: within 10x of VAMP's median on the same scene (its source build, the figures above).
+GOAL_VS_VAMP = {name: 10.0 * v for name, v in (("panda_table_box", 25e-6), ("panda_shelf", 90e-6))}
 
 
 def _record(rec: dict, plan) -> None:
@@ -289,6 +304,18 @@ def goals(rows: list, pyro: dict, time_limit: float) -> list[str]:
                      f" (goal {1e3 * GOAL_PLAN:g} ms" + ("" if plan <= GOAL_PLAN or not rec["ok"] else
                                                          f"; largest step {worst_step} {1e3 * steps[worst_step]:.0f} ms")
                      + ")")
+        if name in GOAL_DEFAULT:
+            total, goal = pct(rec["total"], 50), GOAL_DEFAULT[name]
+            steps["check"] = pct(rec["stages"].get("check", []), 50)
+            worst = max(steps, key=lambda k: steps[k]) if rec["ok"] else "-"
+            parts.append(f"default call (re-check included) median {1e3 * total:.0f} ms "
+                         f"{'met' if total <= goal else 'GAP x%.1f' % (total / goal)} (goal {1e3 * goal:g} ms"
+                         + ("" if total <= goal or not rec["ok"] else f"; largest step {worst} {1e3 * steps[worst]:.0f} ms")
+                         + ")")
+        if name in GOAL_VS_VAMP:
+            goal = GOAL_VS_VAMP[name]
+            parts.append(f"search within 10x of VAMP {'met' if search <= goal else 'GAP x%.1f' % (search / goal)} "
+                         f"(goal {1e3 * goal:g} ms, VAMP's figure not re-run)")
         if name in pyro and np.isfinite(pyro[name]):
             ratio = pyro[name] / search
             parts.append(f"vs pyroboplan {ratio:.1f}x {'met' if ratio >= GOAL_VS_PYROBOPLAN else 'GAP'}"
@@ -348,7 +375,7 @@ def main() -> None:
         print("  " + stages_row(name + " OMPL", rec))
     panda = [(name, rec) for name, rec in rows if SCENES[name].arm == "panda"]
     pyro = pyroboplan_rows(args, panda) if panda and os.path.exists(args.pyroboplan) else {}
-    print("\nVAMP (not installable here; figures stated, not run): RRT-Connect median search "
+    print("\nVAMP, not run here (" + VAMP_WHY + "): RRT-Connect median search "
           + ", ".join(f"{k} {1e6 * v:.0f} us" for k, v in VAMP.items())
           + " — spheres, no margin, edges sampled (pinarms proves every edge at a 10 mm margin)")
     print("\ngoals:")

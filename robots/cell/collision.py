@@ -318,11 +318,15 @@ def _finite(cell: "Cell", d: float, k: int) -> float:
     return float(d)
 
 
-def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None, n: int | None = None):
+def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None, n: int | None = None,
+                       cap: float = np.inf):
     """Exact smallest distance over the first ``n`` candidate pairs (default: the checked pairs) per row of ``arr (N, nq)``.
 
     Returns ``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``; ``pair`` indexes
     :meth:`Cell.pairs_for` (a prefix of the candidates). ``inf`` and pair −1 when ``n`` is 0.
+    ``cap`` [m]: a row stops once the next pair's bound reaches it; a distance below ``cap``
+    is exact, one at or above it only a lower bound of the row's smallest distance (its pair
+    and points those of the smallest computed, −1 and nan when none was).
     """
     N = arr.shape[0]
     n = len(cell.pairs) if n is None else int(n)
@@ -349,13 +353,16 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
         for r in range(P):
             if row_lb[r] >= best:
                 break
+            if row_lb[r] >= cap:  # every pair left is at least row_lb[r] >= cap away: a bound
+                best = min(best, float(row_lb[r]))
+                break
             k = int(row[r])
             res = pin.computeDistance(gm, gd, k)
             d = _finite(cell, res.min_distance, k)
             if d < best:
                 best, arg, res_best = d, k, (np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2()))
         dist[i], best_pair[i] = best, arg
-        pa[i], pb[i] = res_best
+        pa[i], pb[i] = res_best if res_best is not None else (np.full(3, np.nan), np.full(3, np.nan))
     return dist, best_pair, pa, pb
 
 

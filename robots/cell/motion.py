@@ -10,10 +10,11 @@ For each arm, the speed of every point of its collision geometry is at most
 ``v(t) = Σ_j |q̇_j(t)| · ℓ_j``, with ``ℓ_j`` the *lever* of joint ``j`` (1 for a prismatic
 joint; for a revolute joint, a bound of the distance from its origin to any point of the
 geometry it carries, from the joint offsets, strokes and bounding spheres downstream, see
-:func:`joint_levers`). Two bodies approach each other at most at ``V(t) = 2 max_arms v(t)``.
+:func:`joint_levers`). Two bodies approach each other at most at ``V(t) = v_1(t) + v_2(t)``,
+the two fastest arms' bounds (one moving arm: its ``v(t)``; :mod:`.speed_bound` says why).
 Over a short step ``h`` the speed cannot exceed its larger end value by more than
 ``A h / 2`` (``A = Σ_j max|q̈_j| ℓ_j``, from the trajectory's exact acceleration peaks), nor
-``2 Σ_j max|q̇_j| ℓ_j`` (the exact velocity peaks). The samples are placed so that the
+its arm's cap ``Σ_j max|q̇_j| ℓ_j`` (the exact velocity peaks). The samples are placed so that the
 *approach budget* ``∫ V dt`` between two consecutive samples is at most ``margin``:
 dense where the arms move fast, sparse where they dwell. On an interval ``[a, b]`` with
 budget ``B`` the distance of every pair then stays at least ``(d_a + d_b − B) / 2``, where
@@ -53,9 +54,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInput
-from .collision import _margin, exact_min_distance, pair_lower_bounds
+from .collision import _margin, exact_min_distance
 from .ladder import Intervals, climb
 from .motion_curves import moving_arm_curves
+from .motion_minimum import TIE_M, FirstRound, first_round, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
 from .motion_report import Contact, MotionCheck
 from .pairs import CollisionPair
 from .speed_bound import joint_levers, speed_profile, travel_stops
@@ -205,6 +207,7 @@ class _Samples:
     def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
                  cover: bool = True) -> None:
         self.cell, self.motions, self.hold_q, self.n_pairs, self.cover = cell, motions, hold_q, n_pairs, cover
+        self.first: FirstRound | None = None  # the smallest clearance's first round (.motion_minimum)
         self.t: list = []
         self.d: list = []
         self.k: list = []
@@ -220,7 +223,15 @@ class _Samples:
         Returns the distances ``(len(times),)``: exact, or ``screen`` where the screen cleared the sample.
         """
         Q = self.configurations(times)
-        exact = np.ones(times.size, dtype=bool) if curve else self.flag(Q, screen + 1e-6)
+        # without the cover: the smallest clearance's first round and sweep (one broad-phase pass at the
+        # smallest distance found) first; a sample it clears is farther than the screen too
+        near = np.ones(times.size, dtype=bool)
+        if not curve and not (self.cover and times.size >= COVER_ROWS):
+            self.first = first_round(self.cell, Q, times, screen)
+            near = self.first.near
+        exact = np.ones(times.size, dtype=bool) if curve else np.zeros(times.size, dtype=bool)
+        if not curve and near.any():
+            exact[near] = self.flag(Q[near], screen + 1e-6)
         d = np.full(times.size, screen)
         k = np.full(times.size, -1, dtype=int)
         if exact.any():
@@ -244,6 +255,20 @@ class _Samples:
             flagged[flagged] = self.cell.in_collision(Q[flagged], margin=screen)
         return flagged
 
+    def cover_bounds(self, ts: np.ndarray) -> np.ndarray:
+        """``(len(ts),)`` lower bounds [m] of each sample's smallest distance over every candidate pair.
+
+        On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
+        else ``-inf`` (a check run with ``cover=False`` shares no code with the cover, its minimum
+        included: :mod:`.motion_minimum` then bounds the samples by the broad phase and the budget).
+        """
+        if not (self.cover and ts.size >= COVER_ROWS):
+            return np.full(ts.size, -np.inf)
+        n = len(self.cell._candidates)
+        cover, pair_set = _cover_pairs(self.cell, n)
+        return np.concatenate([cover.excess(self.configurations(ts[a:a + BOUND_ROWS]), pair_set, np.zeros(n))
+                               for a in range(0, ts.size, BOUND_ROWS)])
+
     def evaluate(self, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Exact smallest distances and closest pairs at extra times ``ts`` (kept as samples)."""
         ds, ks, _, _ = exact_min_distance(self.cell, self.configurations(ts), n=self.n_pairs)
@@ -260,8 +285,8 @@ class _Samples:
                 np.asarray(self.k, dtype=int)[order], np.asarray(self.x, dtype=bool)[order])
 
 
-#: Fewest samples screened on the sphere cover first (fewer: the broad phase alone).
-COVER_ROWS = 8
+#: Fewest samples screened on the sphere cover first (fewer: the broad phase alone); rows of cover bounds per block.
+COVER_ROWS, BOUND_ROWS = 8, 4096
 
 
 def _cover_pairs(cell: "Cell", n_pairs: int) -> tuple[Any, Any]:
@@ -355,7 +380,7 @@ def _report(samples: _Samples, pairs: tuple[CollisionPair, ...], first: Contact 
     lower = min(lower, float(all_d.min()))
     if left_out.size:  # the pairs left out are proven at least this far apart
         lower = min(lower, float(left_out[0]))
-    d_min, t_min, pair_min = _smallest(samples, all_t, all_d, all_k, all_x, margin + required)
+    d_min, t_min, pair_min = smallest_clearance(samples, schedule, all_t, all_d, all_k, all_x, margin + required)
     collision_free = first is None and lower > 0.0
     clear = first is None and lower >= required and not unresolved
     return MotionCheck(
@@ -378,78 +403,3 @@ def _report(samples: _Samples, pairs: tuple[CollisionPair, ...], first: Contact 
         window=schedule.window,
         pairs=pairs,
     )
-
-
-#: Samples evaluated together while :func:`_smallest` searches the true minimum; rows of lower bounds per block.
-SMALLEST_BATCH, BOUND_ROWS = 16, 4096
-
-
-def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, exact: np.ndarray,
-              screen: float) -> tuple[float, float, CollisionPair | None]:
-    """The smallest exact distance at the samples [m] over every candidate pair of the cell, its time [s] and pair.
-
-    A sample computed exactly below the ``screen`` distance holds it: the samples the screen
-    cleared are at least ``screen`` away, the pairs the check left out proven farther. Else
-    (every sample at least ``screen``): the samples in increasing order of a lower bound of
-    their distance (bounding spheres and boxes, the left-out pairs' proven bounds,
-    :func:`.collision.pair_lower_bounds`), each computed exactly over every candidate pair
-    (coal), until the next bound is no smaller than the smallest distance found. ``(inf, t0,
-    None)`` for a cell without pairs.
-    """
-    cell = samples.cell
-    exact_d = np.where(exact, d, np.inf)
-    i = _earliest_of_smallest(t, exact_d)
-    if exact_d[i] < screen:
-        return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
-    n_all, n0 = len(cell._candidates), len(cell.pairs)
-    if n_all == 0:
-        return float("inf"), float(t[0]), None
-
-    def bounds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        Q = samples.configurations(t[rows])
-        lb = pair_lower_bounds(cell, Q)
-        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
-        return Q, lb
-
-    row_lb = np.concatenate([_row_bounds(samples, t[a:a + BOUND_ROWS], bounds, np.arange(a, min(a + BOUND_ROWS, t.size)))
-                             for a in range(0, t.size, BOUND_ROWS)])
-    order = np.argsort(row_lb, kind="stable")
-    found_d = np.full(t.size, np.inf)
-    found_k = np.full(t.size, -1)
-    best = float("inf")
-    for a in range(0, order.size, SMALLEST_BATCH):
-        rows = order[a:a + SMALLEST_BATCH]
-        rows = rows[row_lb[rows] <= best + TIE_M]  # a sample that may tie the smallest is computed too
-        if not rows.size:
-            break
-        Q, lb = bounds(rows)
-        dist, pair, _, _ = exact_min_distance(cell, Q, lb=lb, n=n_all)
-        found_d[rows], found_k[rows] = dist, pair
-        best = min(best, float(np.min(dist)))
-    i = _earliest_of_smallest(t, found_d)
-    return float(found_d[i]), float(t[i]), cell._candidates[int(found_k[i])] if found_k[i] >= 0 else None
-
-
-#: Distances [m] closer than this to the smallest count as ties: the earliest sample of them is
-#: reported (a motion symmetric about an obstacle reaches its smallest distance twice, and which of
-#: two equal distances coal returns smaller is float noise that may differ between runs).
-TIE_M = 1e-9
-
-
-def _earliest_of_smallest(t: np.ndarray, d: np.ndarray) -> int:
-    """The index of the earliest time ``t`` whose ``d`` is within :data:`TIE_M` of the smallest ``d``."""
-    ties = np.flatnonzero(d <= np.min(d) + TIE_M)
-    return int(ties[np.argmin(t[ties])]) if ties.size else 0
-
-
-def _row_bounds(samples: _Samples, ts: np.ndarray, bounds: Any, rows: np.ndarray) -> np.ndarray:
-    """``(len(ts),)`` lower bounds [m] of each sample's smallest distance over every candidate pair.
-
-    On the sphere cover where the check screens on it (compiled, tight: a bound ``min_k d_k``),
-    else the bounding spheres and boxes (``bounds(rows)``, numpy): a check run with
-    ``cover=False`` shares no code with the cover, its minimum included.
-    """
-    if samples.cover and ts.size >= COVER_ROWS:
-        cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
-        return cover.excess(samples.configurations(ts), pair_set, np.zeros(len(samples.cell._candidates)))
-    return bounds(rows)[1].min(axis=1)

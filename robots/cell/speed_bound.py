@@ -4,7 +4,11 @@ The speed of every point of an arm's collision geometry is at most ``v(t) = Σ_j
 with ``ℓ_j`` the *lever* of joint ``j`` (:func:`joint_levers`: 1 for a prismatic joint; for a
 revolute joint, a bound of the distance from its origin to any point of the geometry it
 carries, from the joint offsets, strokes and bounding spheres downstream). Two bodies
-approach each other at most at ``V(t) = 2 max_arms v(t)``; :func:`speed_profile` bounds ``V``
+approach each other at most at ``V(t) = v_1(t) + v_2(t)``, the two fastest arms' bounds (one
+moving arm: ``v(t)`` alone): seen from the nearest link both share, a point of either link moves
+only by the joints between that link and it, and the two sets of joints are disjoint, so two
+links of one arm approach at most at ``v``; an arm and a fixture or a held arm likewise; links
+of two arms at most at the sum of theirs. :func:`speed_profile` bounds ``V``
 on each step of a time grid (see :mod:`.motion` for the rule and its use), and
 :func:`travel_stops` keeps the grid points a sampling needs so that no two neighbours are more
 than a given travel apart.
@@ -91,12 +95,13 @@ def speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> t
     """Bound of the approach speed ``V`` [m/s] on each step of ``grid`` ``(len(grid) - 1,)``, and the global bound.
 
     Per arm: the larger end speed plus ``A h / 2`` (``A`` from the exact acceleration peaks),
-    never above the cap ``Σ_j max|q̇_j| ℓ_j``; ``V`` is twice the largest over the arms.
+    never above the cap ``Σ_j max|q̇_j| ℓ_j``; ``V`` is the sum of the two largest over the
+    arms (one moving arm: its own), the global bound the sum of the two largest caps.
     """
     levers = joint_levers(cell)
     h = np.diff(grid)
     per_arm = []
-    global_v = 0.0
+    caps_seen = []
     for m in motions:
         arm = cell.arm(m.arm)
         lev = levers[arm.q_slice]
@@ -104,7 +109,7 @@ def speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> t
         peaks = getattr(m.trajectory, "peaks", None)
         peak_a = np.asarray(peaks().acceleration, dtype=float) if callable(peaks) else None
         v_cap = float(peak_v @ lev)
-        global_v = max(global_v, v_cap)
+        caps_seen.append(v_cap)
         qd = np.asarray(m.trajectory.sample(m.local_time(grid))[1], dtype=float).reshape(grid.size, -1)
         v = np.abs(qd) @ lev
         if peak_a is None or not np.all(np.isfinite(peak_a)):
@@ -119,8 +124,13 @@ def speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> t
         moving = (tau[:-1] > m.trajectory.start_time) | (tau[1:] > m.trajectory.start_time)
         cell_v = np.where(jump & moving, v_cap, cell_v)
         per_arm.append(cell_v)
-    V = 2.0 * np.max(np.vstack(per_arm), axis=0) if per_arm else np.zeros(h.size)
-    return V, 2.0 * global_v
+    if not per_arm:
+        return np.zeros(h.size), 0.0
+    # the two fastest arms at each step: two links of one arm, or an arm and something held, approach at
+    # most at that arm's v; links of two arms at most at the sum of theirs
+    fastest = np.sort(np.vstack(per_arm + [np.zeros(h.size)]), axis=0)
+    caps = sorted(caps_seen)
+    return fastest[-1] + fastest[-2], float(sum(caps[-2:]))
 
 
 def travel_stops(budget: np.ndarray, step: float) -> np.ndarray:

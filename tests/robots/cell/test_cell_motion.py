@@ -125,3 +125,44 @@ def test_motion_inputs_are_checked(line, cycles):
         line.check_motion({"left": left}, margin=0.0)
     with pytest.raises(InvalidInput, match="period"):
         line.check_motion([ArmMotion("left", left, 0.0, 1.0)])
+
+
+def every_pair_distance(cell, motions, t, hold):
+    """``(len(t), P)``: coal's distance of every candidate pair of the cell (no pruning) at times ``t``."""
+    import pinocchio as pin
+
+    n = len(cell._candidates)
+    Q = cell.robot.q_to_pinocchio(configurations(cell, motions, t, hold))
+    gm, gd, data = cell._views.geometry(n), cell._views.distance_data(n), cell._views.data()
+    out = np.empty((t.size, n))
+    for i in range(t.size):
+        pin.updateGeometryPlacements(cell.model, data, gm, gd, Q[i])
+        pin.computeDistances(gm, gd)
+        out[i] = [r.min_distance for r in gd.distanceResults]
+    return out
+
+
+def approach_budget_holds(cell, motions, window, step, hold=None):
+    """Every candidate pair's distance changes between two dense times by at most the check's approach budget."""
+    from pinarms.robots.cell import motion as cell_motion
+
+    schedule = cell_motion._schedule(cell, motions, window[0], window[1], 0.01)
+    t = np.arange(window[0], window[1] + step / 2, step)
+    D = every_pair_distance(cell, motions, t, cell.neutral if hold is None else hold)
+    allowed = schedule.budget_between(t[:-1], t[1:])
+    change = np.abs(np.diff(D, axis=0))
+    assert np.all(change <= allowed[:, None] * (1 + 1e-9) + 5e-6)  # coal's GJK tolerance
+    return schedule, change, allowed
+
+
+def test_two_arms_approach_at_most_at_the_sum_of_their_speed_bounds(line, cycles):
+    """The approach budget of two moving arms is their two bounds summed, and no pair's distance outruns it."""
+    from pinarms.robots.cell.speed_bound import joint_levers
+
+    left, right = cycles
+    motions = [ArmMotion("left", left, 0.0, 3.2), ArmMotion("right", right, 1.6, 3.2)]
+    schedule, change, allowed = approach_budget_holds(line, motions, (0.0, 3.2), 4e-3)
+    levers = joint_levers(line)
+    caps = [float(np.abs(tr.peaks().velocity) @ levers[line.arm(a).q_slice]) for a, tr in (("left", left), ("right", right))]
+    assert schedule.speed_bound == pytest.approx(sum(caps), rel=1e-12)  # not twice the faster one
+    assert change.max() > 0.2 * allowed.max()  # the arms do move towards things

@@ -175,3 +175,101 @@ def test_sample_times_keep_the_travel_between_samples_within_the_margin(scene):
     assert between.max() <= MARGIN * (1 + 1e-3)
     uniform = int(np.ceil(float(np.abs(traj.peaks().velocity) @ checker.levers) * traj.duration / MARGIN))
     assert t.size - 1 <= uniform  # never more samples than one per margin at the peak speed
+
+
+
+@pytest.fixture(scope="module")
+def table():
+    """panda_table_box and two planned motions whose smallest clearance varies along them (no constant pair ties)."""
+    cell = load_scene("panda_table_box")
+    queries, hold = scene_queries("panda_table_box", 2, seed=0, margin=MARGIN, cell=cell)
+    plans = [plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, seed=k, hold=hold, recheck=False)
+             for k, q in enumerate(queries)]
+    return cell, "panda", hold, [p.trajectory for p in plans]
+
+
+@pytest.mark.slow
+def test_smallest_clearance_is_every_samples_exact_minimum_with_few_samples_computed(table, monkeypatch):
+    """The report's smallest clearance (every candidate pair, coal) equals the minimum over every sample computed
+    exactly, with or without the cover, while most samples are never computed (broad phase, approach budget)."""
+    from pinarms.robots.cell import motion_minimum
+    from pinarms.robots.cell.collision import exact_min_distance
+
+    cell, arm, hold, trajs = table
+    n_all = len(cell._candidates)
+    computed = []
+    real = motion_minimum.exact_min_distance
+
+    def counting(cell_, Q, **kw):
+        computed.append(len(Q))
+        return real(cell_, Q, **kw)
+
+    monkeypatch.setattr(motion_minimum, "exact_min_distance", counting)
+    for traj in trajs[:2]:
+        motion = [ArmMotion(arm, traj)]
+        schedule = cell_motion._schedule(cell, motion, traj.start_time, traj.end_time, MARGIN)
+        t = schedule.times
+        Q = cell_motion.configurations(cell, motion, t, hold)
+        d, k, _, _ = exact_min_distance(cell, Q, n=n_all)  # every sample, exact over every candidate pair
+        i = int(np.flatnonzero(d <= d.min() + 1e-9)[0])  # the earliest of ties (times in order)
+        for cover in (False, True):
+            computed.clear()
+            samples = cell_motion._Samples(cell, motion, hold, n_all, cover)
+            # nothing known from a screen: the search alone finds the minimum
+            got = motion_minimum.smallest_clearance(samples, schedule, t, np.zeros(t.size), np.full(t.size, -1),
+                                                    np.zeros(t.size, dtype=bool), 0.0)
+            assert got == (d[i], t[i], cell._candidates[int(k[i])])
+            assert sum(computed) < t.size / 4, (cover, sum(computed), t.size)
+
+def test_a_capped_distance_is_exact_below_the_cap_and_a_lower_bound_above(scene):
+    from pinarms.robots.cell.collision import exact_min_distance
+
+    cell = scene[0]
+    Q = cell.random_q(40, seed=3)
+    n_all = len(cell._candidates)
+    exact, pair, _, _ = exact_min_distance(cell, Q, n=n_all)
+    cap = float(np.median(exact))
+    capped, capped_pair, _, _ = exact_min_distance(cell, Q, n=n_all, cap=cap)
+    below = exact < cap
+    assert below.any() and (~below).any()
+    np.testing.assert_array_equal(capped[below], exact[below])
+    np.testing.assert_array_equal(capped_pair[below], pair[below])
+    assert np.all(capped[~below] >= cap) and np.all(capped[~below] <= exact[~below])
+
+
+def test_one_moving_arm_approaches_at_most_at_its_own_speed_bound(scene):
+    """One moving arm (the other held): the approach budget is the arm's own bound, not twice it, and no candidate
+    pair's distance (its own links, the held arm, the fixtures) changes faster on a dense grid."""
+    from pinarms.robots.cell.speed_bound import joint_levers
+    from tests.robots.cell.test_cell_motion import approach_budget_holds
+
+    cell, arm, hold, trajs, straight = scene
+    levers = joint_levers(cell)[cell.arm(arm).q_slice]
+    for traj in (trajs[0], straight):
+        motion = [ArmMotion(arm, traj)]
+        schedule, change, allowed = approach_budget_holds(cell, motion, (traj.start_time, traj.end_time),
+                                                          traj.duration / 400, hold)
+        assert change.max() > 0.05 * allowed.max()  # the arm does move towards things
+        assert schedule.speed_bound == pytest.approx(float(np.abs(traj.peaks().velocity) @ levers), rel=1e-12)
+
+
+def test_the_first_rounds_sweep_stands_in_for_the_screen_and_clears_only_far_samples(table):
+    """Without the cover, one broad-phase pass at the first round's smallest distance replaces the screen's pass:
+    the same samples flagged as by the screen over every sample, and every sample it clears farther than that
+    distance by coal (every candidate pair)."""
+    from pinarms.robots.cell.collision import exact_min_distance
+    from pinarms.robots.cell.motion_minimum import first_round
+
+    cell, arm, hold, trajs = table
+    for traj in trajs:
+        motion = [ArmMotion(arm, traj)]
+        check = cell.check_motion(motion, margin=MARGIN, hold=hold, cover=False)
+        schedule = cell_motion._schedule(cell, motion, traj.start_time, traj.end_time, MARGIN)
+        Q = cell_motion.configurations(cell, motion, schedule.times, hold)
+        at = np.searchsorted(check.times, schedule.times)
+        assert np.array_equal(check.times[at], schedule.times)
+        np.testing.assert_array_equal(check.exact[at], cell.in_collision(Q, margin=MARGIN + 1e-6))
+        first = first_round(cell, Q, schedule.times, MARGIN)
+        assert np.isfinite(first.swept) and (~first.near).sum() > schedule.times.size / 2  # it stood in, cleared most
+        d, _, _, _ = exact_min_distance(cell, Q[~first.near], n=len(cell._candidates))
+        assert np.all(d > first.swept)
