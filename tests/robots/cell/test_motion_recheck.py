@@ -183,7 +183,8 @@ def table():
     """panda_table_box and two planned motions whose smallest clearance varies along them (no constant pair ties)."""
     cell = load_scene("panda_table_box")
     queries, hold = scene_queries("panda_table_box", 2, seed=0, margin=MARGIN, cell=cell)
-    plans = [plan_motion(cell, "panda", q.start, q.goal, margin=MARGIN, seed=k, hold=hold, recheck=False)
+    plans = [plan_motion(MotionRequest(cell, "panda", q.start, q.goal, hold=hold,
+                                       options=MotionOptions(margin=MARGIN, seed=k, recheck=False)))
              for k, q in enumerate(queries)]
     return cell, "panda", hold, [p.trajectory for p in plans]
 
