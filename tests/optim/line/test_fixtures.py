@@ -11,7 +11,7 @@ import pytest
 
 from pinarms.optim.line import Belt, ItemType, LineSpec, PlaceBox, Station, Stream, TrackingSpec, run_line
 from pinarms.optim.line.fixtures import FixtureCheck, chord_polyline
-from pinarms.optim.line.task_maps import build_task_map
+from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.tracking import plan_pick
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.cell import Cell

@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from pinarms.optim.line.task_maps import MapError, TaskMap, _refine_at, build_task_map, map_error
+from pinarms.optim.line.task_map_build import _refine_at, build_task_map
+from pinarms.optim.line.task_map_error import MapError, map_error
+from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.optim.line.windows import window_of
 
