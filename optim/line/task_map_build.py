@@ -137,12 +137,13 @@ class _Planner:
 
 
 def _spread(A: np.ndarray, C: np.ndarray, zero: int, extra: float) -> float:
-    """Largest relative change of the fastest branch's task time over the yaw layers of (ny, nb, nu, nw)
-    tables against the layer ``zero`` (0 where no node is feasible at two yaws)."""
-    tot = np.where(np.isfinite(A + C), A + C, np.inf).min(axis=1) + extra  # (ny, nu, nw)
-    ref = tot[zero]
+    """Largest relative change of the task time over the yaw layers of (ny, nb, nu, nw) tables against
+    the layer ``zero``, on each IK branch where it is feasible at both yaws (0 where none is): what
+    interpolating a map without yaw on its branch errs by. A branch that is feasible at one yaw
+    and not at another (a joint limit reached as the hand turns) is not counted here."""
+    tot = A + C + extra
     with np.errstate(invalid="ignore"):
-        rel = np.abs(tot - ref) / ref
+        rel = np.abs(tot - tot[zero]) / tot[zero]
     rel = rel[np.isfinite(rel)]
     return float(rel.max()) if rel.size else 0.0
 
