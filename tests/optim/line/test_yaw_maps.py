@@ -170,7 +170,9 @@ def test_a_line_result_says_when_a_map_ignores_yaw(slow_hand):
                    yaw_spread=0.17)
     spec = LineSpec(belt, (station,), Stream("regular", 0.5, 20.0), seeds=(0,))
     assert map_warnings(spec, {station.name: (flat,)}) == flat.warnings()
-    res = run_line(spec, maps={station.name: (flat,)})
+    calls = []
+    res = run_line(spec, maps={station.name: (flat,)}, progress=lambda *a: calls.append(a))
+    assert calls[-1] == (1, 1, "seeds")  # run_line reports its steps: the seeds here (the maps were given)
     assert res.map_warnings == flat.warnings()
     assert "warning           task map 'slow hand': the task time changes by 17.0 %" in res.summary()
     assert res.as_dict()["map_warnings"] == list(flat.warnings())
@@ -183,7 +185,10 @@ def test_a_map_at_yaw_0_is_wrong_for_a_slow_hand_and_a_yaw_axis_fixes_it(slow_ha
     belt, station = slow_hand
     flat = build_task_map(station, belt, TrackingSpec(), yaw="none", **GRID)
     assert flat.yaw is None and "never measured" in flat.warnings()[0]
-    auto = build_task_map(station, belt, TrackingSpec(), yaw_nodes=9, yaw_refine=0, **GRID)
+    calls = []
+    auto = build_task_map(station, belt, TrackingSpec(), yaw_nodes=9, yaw_refine=0,
+                          progress=lambda done, total: calls.append((done, total)), **GRID)
+    assert calls[-1] == (2 * 9, 2 * 9) and all(d <= t for d, t in calls)  # every column at every yaw node
     assert auto.yaw is not None and auto.yaw.size == 9 and auto.yaw_spread > 0.05 and auto.warnings() == ()
     rng = np.random.default_rng(5)
     before, after = [], []
