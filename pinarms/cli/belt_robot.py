@@ -47,7 +47,7 @@ robot_options = [
     click.option("--base-offset", type=float, default=0.4, show_default=True,
                  help="--robot: the arms' bases from the belt's centre line, across [m]."),
     click.option("--box", "box", default="-0.1,0.25,0.15", show_default=True, metavar="DX,DY,DZ",
-                 help="--robot: each arm's box from its base [m] (x along the belt, y away from it, z up)."),
+                 help="--robot: each arm's box from its base [m] (world x along the belt, y across, z up)."),
     click.option("--base-height", type=float, default=0.0, show_default=True,
                  help="--robot: the arms' bases above the belt's surface [m] (negative: below)."),
     click.option("--spacing", type=float, default=1.0, show_default=True, help="--robot: distance between arms [m]."),
