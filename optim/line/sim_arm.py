@@ -55,7 +55,7 @@ class ArmState:
         self.extra = np.empty(n)
         for k, m in enumerate(arm.maps):
             sel = items.kind == k
-            self.tA[sel], self.tC[sel] = m.rows(items.w[sel], grid)
+            self.tA[sel], self.tC[sel] = m.rows(items.w[sel], grid, items.yaw[sel])  # per item: its yaw
             self.extra[sel] = m.track + m.release
         ok = np.isfinite(self.tA) & np.isfinite(self.tC)
         self.tA[~ok] = np.nan

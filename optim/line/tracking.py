@@ -191,8 +191,12 @@ def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int
         return out
     out = np.empty((poses.shape[0], robot.nq))
     prev = q_ref
+    turn = np.asarray(getattr(robot, "continuous", np.zeros(robot.nq, bool)), bool)
     for k in range(poses.shape[0]):
-        out[k] = prev = robot.ik(poses[k], prev)
+        q = robot.ik(poses[k], prev)
+        # the solver wraps continuous joints into (-π, π]: the turn nearest the previous angle keeps the path continuous
+        q[turn] = prev[turn] + (q[turn] - prev[turn] + np.pi) % (2.0 * np.pi) - np.pi
+        out[k] = prev = q
     return out
 
 
