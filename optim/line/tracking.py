@@ -137,7 +137,11 @@ def _hand_joints(robot: Any) -> np.ndarray:
 
 def can_yaw(robot: Any) -> bool:
     """Whether the arm can turn its tool about the vertical (a hand joint: SCARA joint 4), i.e. its
-    Jacobian's angular z row is not zero at neutral; a gantry of three slides cannot."""
+    Jacobian's angular z row is not zero at neutral; a gantry of three slides cannot. An arm that says
+    so itself (a ``can_yaw`` attribute: a delta's fourth axis, :class:`~.delta_tracking.DeltaArm`) is taken at its word."""
+    own = getattr(robot, "can_yaw", None)
+    if isinstance(own, bool):
+        return own
     return bool(np.linalg.norm(robot.jacobian(robot.neutral)[5]) > 1e-9)
 
 

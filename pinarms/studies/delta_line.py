@@ -1,0 +1,107 @@
+"""SCARA or delta, and how many: seed 000's enoki stream picked by deltas above the belt.
+
+The same belt, stream and rule as seed 000's SCAR line (:func:`pinarms.studies.line.scara_line`:
+enoki bunches, 0.15 kg, Poisson, a 0.3 m belt at 0.2 m/s, first in window, 5 seeds × 600 s), picked
+by copies of a shipped delta (``delta_flexpicker``, docs/delta.md) hung above the belt's centre line,
+``DELTA_SPACING`` m apart (each pick window is about 1.5 m of belt: the windows do not overlap), each
+base ``DELTA_HEIGHT`` m above the belt's surface and its box beside the belt. The delta's task maps
+(:func:`optim.line.delta_maps.build_delta_map`) are built, not stored (about 20 s a map): one map
+serves every delta of a line (the same shape shifted along the belt).
+
+:func:`delta_arms_needed` is :func:`pinarms.studies.line.arms_needed` for deltas; :func:`choice` puts
+both side by side (the rows of the demo's line study).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.line import Belt, LineSpec, PlaceBox, Rule, Station, Stream, TrackingSpec, base_pose, run_line
+from pinarms.optim.line.delta_maps import build_delta_map
+from pinarms.optim.line.delta_tracking import DeltaArm
+from pinarms.robots.delta import delta_names, load_delta
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "choice", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
+
+#: Distance between deltas along the belt [m].
+DELTA_SPACING = 1.6
+#: Height of a delta's base (the plane of its motor axes) above the belt's surface [m].
+DELTA_HEIGHT = 1.1
+#: A delta's box from its base (along the belt, across, up) [m]: beside the belt, 0.1 m above it.
+DELTA_BOX = (0.0, 0.45, -1.0)
+
+
+def delta_line(n_arms: int, rate: float, *, name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
+               seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, spacing: float = DELTA_SPACING,
+               height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
+               item: Any = None) -> LineSpec:
+    """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min (module doc).
+
+    Raises:
+        InvalidInput: a name that is not a shipped delta (names them)."""
+    from pinarms.studies.line import ENOKI
+
+    if name not in delta_names():
+        raise InvalidInput(f"{name!r} is not a shipped delta; shipped: {', '.join(delta_names())}")
+    arm = DeltaArm(load_delta(name))
+    z = 0.80
+    stations = tuple(Station(f"delta {k + 1}", arm, base_pose(first + spacing * k, 0.0, z + height),
+                             PlaceBox((first + spacing * k + box[0], box[1], z + height + box[2]), f"box {k + 1}"),
+                             vmax=arm.velocity_limit, amax=arm.acceleration_limit)
+                     for k in range(int(n_arms)))
+    belt = Belt((0.0, 0.0, z), speed=speed, width=0.3, length=first + spacing * int(n_arms) + 0.5)
+    kind = ENOKI if item is None else item
+    return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(kind,)), TrackingSpec(), Rule(rule),
+                    seeds, 0.01, (12, 5))
+
+
+def delta_maps(spec: LineSpec, *, n: int = 24, progress: Any = None) -> dict:
+    """``{station: (TaskMap,)}``: one map built for the first delta (:func:`build_delta_map`), shared by
+    every delta of ``spec`` (same arm, height, box and belt speed; shifted along the belt)."""
+    st = spec.stations[0]
+    kind = spec.stream.types[0]
+    m = build_delta_map(st, spec.belt, spec.tracking, mass=kind.mass, item_height=kind.size[2],
+                        nu=spec.map_grid[0], nw=spec.map_grid[1], n=n, progress=progress)
+    return {s.name: (m,) for s in spec.stations}
+
+
+def delta_arms_needed(rate: float, *, max_arms: int = 20, maps: Any = None, **kw: Any) -> tuple[int | None, Any, Any]:
+    """Fewest deltas whose mean miss rate is ≤ 1 % at ``rate`` items/min: (arms or None, that line's
+    result, the map used)."""
+    last, one = None, maps
+    for k in range(1, max_arms + 1):
+        spec = delta_line(k, rate, **kw)
+        one = one or delta_maps(spec)[spec.stations[0].name]
+        last = run_line(spec, maps={st.name: one for st in spec.stations})
+        if last.status == "ok":
+            return k, last, one
+    return None, last, one
+
+
+def choice(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0) -> dict[str, Any]:
+    """SCARAs (seed 000, the model's limits) or deltas for ``rate`` enoki bunches/min at ≤ 1 % miss:
+    arms, picks/min, miss rate and interval, belt speed, and one delta saturated (regular flow)."""
+    from dataclasses import replace
+
+    from pinarms.studies.line import ENOKI, arms_needed
+
+    out: dict[str, Any] = {}
+    n, res = arms_needed(rate, paper_limit=False, seeds=seeds, duration=duration, start=6)
+    out["scara"] = _figures(n, res)
+    k, dres, m = delta_arms_needed(rate, seeds=seeds, duration=duration)
+    out["delta"] = _figures(k, dres)
+    out["delta"]["yaw_spread"] = m[0].yaw_spread
+    one = delta_line(1, rate, seeds=(0,), duration=120.0)
+    sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(ENOKI,))), maps={"delta 1": m})
+    out["delta"]["one_arm_saturated_picks_per_min"] = sat.figures.picks_per_minute
+    return out
+
+
+def _figures(n: int | None, res: Any) -> dict[str, Any]:
+    f = res.figures
+    return {"arms": n, "picks_per_min": f.picks_per_minute, "miss_rate": f.miss_rate,
+            "miss_rate_ci": tuple(float(x) for x in f.miss_rate_ci), "belt_speed_m_s": res.belt_speed,
+            "places_m": tuple(float(np.round(w.u_base, 3)) for w in res.windows)}
