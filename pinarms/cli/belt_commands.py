@@ -36,7 +36,13 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
         raise InvalidInput(f"--rate {rate:g} items/min over --duration {duration:g} s is {expected:.3g} items; a stream "
                            f"holds at most {MAX_ITEMS}: lower --rate or --duration")
     kw = {"seeds": tuple(range(seeds)), "duration": duration}
-    if robot is not None:
+    if robot is not None and "delta" in robot:
+        from pinarms.studies.delta_line import delta_line
+
+        if paper_limit:
+            raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
+        spec = delta_line(arms, rate, name=robot["delta"], rule=rule, map_grid=robot["map_grid"], **kw, **({} if speed is None else {"speed": speed}))
+    elif robot is not None:
         from pinarms.studies.arm_line import arm_line
 
         if paper_limit:
@@ -82,6 +88,14 @@ def _robot(kw: dict) -> dict | None:
             flag = (given or ["--tool-axis"])[0].replace("--packages", "--package")
             raise InvalidInput(f"{flag} describes the arm of --robot URDF: give --robot, or drop {flag}")
         return None
+    from pinarms.robots.delta import delta_names
+
+    if opts["robot_urdf"] in delta_names():  # a shipped delta, above the belt (pinarms.studies.delta_line)
+        given = [f"--{k.replace('_', '-')}" for k in ("packages", "tcp", "tcp_offset") if opts[k]]
+        if given or opts["tool_axis"] != "z":
+            flag = (given or ["--tool-axis"])[0].replace("--packages", "--package")
+            raise InvalidInput(f"{flag} describes a URDF arm; --robot {opts['robot_urdf']} is a shipped delta: drop {flag}")
+        return {"delta": opts["robot_urdf"], "map_grid": grid_value(opts["map_grid"])}
     robot = load_belt_robot(opts["robot_urdf"], opts["packages"], opts["tcp"], opts["tcp_offset"], opts["tool_axis"])
     return {"robot": robot, "base_offset": opts["base_offset"], "base_height": opts["base_height"],
             "box": box_value(opts["box"]), "spacing": opts["spacing"], "descend": opts["descend"],
@@ -96,6 +110,15 @@ def _maps(spec, robot: dict | None, as_json: bool, scheduler=None) -> dict:
 
     if robot is None:
         return maps_for(spec)
+    if "delta" in robot:
+        from pinarms.optim.line.errors import BeltOutOfReach
+        from pinarms.studies.delta_line import delta_maps
+
+        with _progress(as_json) as step:
+            try:
+                return delta_maps(spec, progress=lambda done, total: step(done, total, f"task map of {robot['delta']}"))
+            except BeltOutOfReach as exc:
+                raise InvalidInput(f"--speed: {' '.join(str(exc).split())}") from None
     from pinarms.optim.line.errors import BeltOutOfReach
     from pinarms.robots.errors import UnreachableTarget
 
@@ -197,7 +220,7 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
         from pinarms.viz.line_views import save_line_views
 
         save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=window)
-    what = preset if robot is None else f"{robot['robot'].name} (--robot)"
+    what = preset if robot is None else f"{robot['delta'] if 'delta' in robot else robot['robot'].name} (--robot)"
     emit(as_json, res.as_dict(), res.summary(f"belt run: {what}, {arms} arm(s), rule {rule}").splitlines())
 
 
@@ -222,7 +245,7 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
         if robot is None:
             maps = _maps(spec, None, as_json)
         else:
-            one = one or _maps(spec, robot, as_json)["arm 1"]
+            one = one or _maps(spec, robot, as_json)[spec.stations[0].name]
             maps = {st.name: one for st in spec.stations}
         res = run_line(spec, maps=maps)
         if res.status == "ok":
@@ -250,7 +273,7 @@ def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss,
     robot = _robot(kw)
     if preset != "scara" and robot is None:
         raise InvalidInput("belt size places SCARAs along the belt: use --preset scara (or --robot URDF)")
-    speeds = [0.2 if robot is None else 0.1] if speed is None else [speed]
+    speeds = [0.2 if robot is None or "delta" in robot else 0.1] if speed is None else [speed]
     maps, item, extra = {}, ENOKI, {}
     for v in speeds:
         spec = _spec(preset, 1, rate, v, paper_limit, rule, 1, duration, None, robot)
@@ -259,8 +282,11 @@ def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss,
         st = spec.stations[0]
         u0, rest = spec.belt.to_belt(st.base_to_world[:3, 3]), spec.belt.to_belt(st.place.position)
         item = spec.stream.types[0]
+        from pinarms.studies.delta_line import DELTA_SPACING
+
+        gap = DELTA_SPACING if "delta" in robot else robot["spacing"]
         extra = {"rest": (float(rest[0] - u0[0]), float(rest[1])), "first_u": float(u0[0]),
-                 "min_gap": robot["spacing"], "max_gap": 1.5 * robot["spacing"]}
+                 "min_gap": gap, "max_gap": 1.5 * gap}
     problem = SizingProblem(maps, rate, max_miss, item=item, rule=Rule(rule), seeds=tuple(range(seeds)),
                             duration=duration, **extra)
     r = size_line(problem, population=population, generations=generations, scheduler=scheduler,

@@ -34,7 +34,8 @@ TOOL_LINK = "belt_tool_point"
 robot_options = [
     click.option("--robot", "robot_urdf", type=click.Path(dir_okay=False), default=None, metavar="URDF",
                  help="Your arm's URDF file: copies of it along the belt instead of --preset (maps built, minutes "
-                      "for a 6-axis arm; a progress line shows)."),
+                      "for a 6-axis arm; a progress line shows); or a shipped delta's name (delta_flexpicker): "
+                      "deltas above the belt's centre line, the layout of pinarms.studies.delta_line."),
     click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
                  help="A folder for package://NAME/ in --robot's file (repeatable; the belt needs no meshes)."),
     click.option("--tcp", "tcp", default=None, metavar="LINK",

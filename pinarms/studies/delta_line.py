@@ -37,7 +37,7 @@ DELTA_BOX = (0.0, 0.45, -1.0)
 def delta_line(n_arms: int, rate: float, *, name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
                seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, spacing: float = DELTA_SPACING,
                height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
-               item: Any = None) -> LineSpec:
+               item: Any = None, map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
     """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min (module doc).
 
     Raises:
@@ -55,7 +55,7 @@ def delta_line(n_arms: int, rate: float, *, name: str = "delta_flexpicker", spee
     belt = Belt((0.0, 0.0, z), speed=speed, width=0.3, length=first + spacing * int(n_arms) + 0.5)
     kind = ENOKI if item is None else item
     return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(kind,)), TrackingSpec(), Rule(rule),
-                    seeds, 0.01, (12, 5))
+                    seeds, 0.01, tuple(map_grid))
 
 
 def delta_maps(spec: LineSpec, *, n: int = 24, progress: Any = None) -> dict:
