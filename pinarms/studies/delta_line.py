@@ -24,7 +24,7 @@ from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.robots.delta import delta_names, load_delta
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "choice", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
+__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "choice", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
 
 #: Distance between deltas along the belt [m].
 DELTA_SPACING = 1.6
@@ -105,3 +105,30 @@ def _figures(n: int | None, res: Any) -> dict[str, Any]:
     return {"arms": n, "picks_per_min": f.picks_per_minute, "miss_rate": f.miss_rate,
             "miss_rate_ci": tuple(float(x) for x in f.miss_rate_ci), "belt_speed_m_s": res.belt_speed,
             "places_m": tuple(float(np.round(w.u_base, 3)) for w in res.windows)}
+
+
+def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4),
+               duration: float = 600.0, map_grid: tuple[int, int] = (12, 5)) -> list[Any]:
+    """The rows "SCARA or delta" of the demo's line study: deltas needed for ``rate`` bunches/min at
+    ≤ 1 % miss beside ``scara`` (the line study's figures of seed 000's SCARAs at the model's limits:
+    ``arms``, ``picks_per_min``, ``miss_rate``), and one delta saturated."""
+    from dataclasses import replace
+
+    from pinarms.report import Row
+    from pinarms.studies.line import ENOKI
+
+    k, res, m = delta_arms_needed(rate, seeds=seeds, duration=duration, map_grid=map_grid)
+    f = res.figures
+    places = ", ".join(f"{w.u_base:.1f}" for w in res.windows)
+    note = (f"delta_flexpicker (docs/delta.md, motor limits assumed) above the belt's centre line, {DELTA_SPACING} m apart "
+            f"(bases at {places} m along the belt), same Poisson {rate:g} bunches/min, belt {res.belt_speed} m/s, "
+            f"rule first-in-window: {f.picks_per_minute:.1f} picks/min, miss {100 * f.miss_rate:.2f} % (95 % CI "
+            f"{100 * f.miss_rate_ci[0]:.2f}-{100 * f.miss_rate_ci[1]:.2f} %, {len(seeds)} seeds); against "
+            f"{scara['arms']} SCARAs ({scara['picks_per_min']:.1f} picks/min, miss {100 * scara['miss_rate']:.2f} %); "
+            f"task times depend on the item's yaw by up to {100 * m[0].yaw_spread:.0f} % (fourth axis)")
+    one = delta_line(1, rate, seeds=(0,), duration=120.0)
+    sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(ENOKI,))), maps={"delta 1": m})
+    return [Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss", None, k, "arms", None, note),
+            Row("000", "one delta saturated on the belt", None, sat.figures.picks_per_minute, "picks/min", None,
+                "conveyor tracking, box beside the belt; timed in the motors' space under speed, acceleration "
+                "and torque limits with the bunch as payload")]

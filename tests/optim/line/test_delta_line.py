@@ -104,3 +104,14 @@ def test_line_one_delta_misses_two_do_not(line, small_map):
     sat = run_line(replace(one, stream=Stream("regular", 4.0, 60.0, types=(ENOKI,)), seeds=(0,)),
                    maps={"delta 1": (small_map,)})
     assert 45.0 < sat.figures.picks_per_minute < 75.0  # about one pick a second
+
+
+def test_demo_rows_scara_or_delta():
+    """The demo's rows: deltas needed beside the SCARAs' figures, one delta saturated (a coarse map, short runs)."""
+    from pinarms.studies.delta_line import delta_rows
+
+    scara = {"arms": 7, "picks_per_min": 59.8, "miss_rate": 0.0049}
+    rows = delta_rows(scara, 60.0, seeds=(0, 1), duration=120.0, map_grid=(5, 3))
+    need, sat = rows
+    assert need.unit == "arms" and need.pinarms == 2 and "7 SCARAs" in need.note and "0.2 m/s" in need.note
+    assert sat.unit == "picks/min" and 45.0 < sat.pinarms < 75.0
