@@ -41,7 +41,9 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
 
         if paper_limit:
             raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
-        spec = delta_line(arms, rate, name=robot["delta"], rule=rule, map_grid=robot["map_grid"], **kw, **({} if speed is None else {"speed": speed}))
+        from pinarms.studies.line import ENOKI
+
+        spec = delta_line(arms, rate, item=ENOKI, name=robot["delta"], rule=rule, map_grid=robot["map_grid"], **kw, **({} if speed is None else {"speed": speed}))
     elif robot is not None:
         from pinarms.studies.arm_line import arm_line
 

@@ -1,6 +1,6 @@
 """SCARA or delta, and how many: seed 000's enoki stream picked by deltas above the belt.
 
-The same belt, stream and rule as seed 000's SCAR line (:func:`pinarms.studies.line.scara_line`:
+The same belt, stream and rule as seed 000's SCARA line (:func:`pinarms.studies.line.scara_line`:
 enoki bunches, 0.15 kg, Poisson, a 0.3 m belt at 0.2 m/s, first in window, 5 seeds × 600 s), picked
 by copies of a shipped delta (``delta_flexpicker``, docs/delta.md) hung above the belt's centre line,
 ``DELTA_SPACING`` m apart (each pick window is about 1.5 m of belt: the windows do not overlap), each
@@ -8,15 +8,13 @@ base ``DELTA_HEIGHT`` m above the belt's surface and its box beside the belt. Th
 (:func:`optim.line.delta_maps.build_delta_map`) are built, not stored (about 20 s a map): one map
 serves every delta of a line (the same shape shifted along the belt).
 
-:func:`delta_arms_needed` is :func:`pinarms.studies.line.arms_needed` for deltas; :func:`choice` puts
-both side by side (the rows of the demo's line study).
+:func:`delta_arms_needed` is :func:`pinarms.studies.line.arms_needed` for deltas; :func:`delta_rows`
+puts deltas beside the SCARAs (the rows of the demo's line study).
 """
 
 from __future__ import annotations
 
 from typing import Any
-
-import numpy as np
 
 from pinarms.optim.line import Belt, LineSpec, PlaceBox, Rule, Station, Stream, TrackingSpec, base_pose, run_line
 from pinarms.optim.line.delta_maps import build_delta_map
@@ -24,7 +22,7 @@ from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.robots.delta import delta_names, load_delta
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "choice", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
+__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
 
 #: Distance between deltas along the belt [m].
 DELTA_SPACING = 1.6
@@ -34,16 +32,15 @@ DELTA_HEIGHT = 1.1
 DELTA_BOX = (0.0, 0.45, -1.0)
 
 
-def delta_line(n_arms: int, rate: float, *, name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
+def delta_line(n_arms: int, rate: float, *, item: Any, name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
                seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, spacing: float = DELTA_SPACING,
                height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
-               item: Any = None, map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
-    """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min (module doc).
+               map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
+    """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min of ``item``
+    (an :class:`optim.line.ItemType`; the study: :data:`pinarms.studies.line.ENOKI`) (module doc).
 
     Raises:
         InvalidInput: a name that is not a shipped delta (names them)."""
-    from pinarms.studies.line import ENOKI
-
     if name not in delta_names():
         raise InvalidInput(f"{name!r} is not a shipped delta; shipped: {', '.join(delta_names())}")
     arm = DeltaArm(load_delta(name))
@@ -53,8 +50,7 @@ def delta_line(n_arms: int, rate: float, *, name: str = "delta_flexpicker", spee
                              vmax=arm.velocity_limit, amax=arm.acceleration_limit)
                      for k in range(int(n_arms)))
     belt = Belt((0.0, 0.0, z), speed=speed, width=0.3, length=first + spacing * int(n_arms) + 0.5)
-    kind = ENOKI if item is None else item
-    return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(kind,)), TrackingSpec(), Rule(rule),
+    return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(item,)), TrackingSpec(), Rule(rule),
                     seeds, 0.01, tuple(map_grid))
 
 
@@ -81,33 +77,7 @@ def delta_arms_needed(rate: float, *, max_arms: int = 20, maps: Any = None, **kw
     return None, last, one
 
 
-def choice(rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0) -> dict[str, Any]:
-    """SCARAs (seed 000, the model's limits) or deltas for ``rate`` enoki bunches/min at ≤ 1 % miss:
-    arms, picks/min, miss rate and interval, belt speed, and one delta saturated (regular flow)."""
-    from dataclasses import replace
-
-    from pinarms.studies.line import ENOKI, arms_needed
-
-    out: dict[str, Any] = {}
-    n, res = arms_needed(rate, paper_limit=False, seeds=seeds, duration=duration, start=6)
-    out["scara"] = _figures(n, res)
-    k, dres, m = delta_arms_needed(rate, seeds=seeds, duration=duration)
-    out["delta"] = _figures(k, dres)
-    out["delta"]["yaw_spread"] = m[0].yaw_spread
-    one = delta_line(1, rate, seeds=(0,), duration=120.0)
-    sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(ENOKI,))), maps={"delta 1": m})
-    out["delta"]["one_arm_saturated_picks_per_min"] = sat.figures.picks_per_minute
-    return out
-
-
-def _figures(n: int | None, res: Any) -> dict[str, Any]:
-    f = res.figures
-    return {"arms": n, "picks_per_min": f.picks_per_minute, "miss_rate": f.miss_rate,
-            "miss_rate_ci": tuple(float(x) for x in f.miss_rate_ci), "belt_speed_m_s": res.belt_speed,
-            "places_m": tuple(float(np.round(w.u_base, 3)) for w in res.windows)}
-
-
-def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 1, 2, 3, 4),
+def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, item: Any, seeds: tuple[int, ...] = (0, 1, 2, 3, 4),
                duration: float = 600.0, map_grid: tuple[int, int] = (12, 5)) -> list[Any]:
     """The rows "SCARA or delta" of the demo's line study: deltas needed for ``rate`` bunches/min at
     ≤ 1 % miss beside ``scara`` (the line study's figures of seed 000's SCARAs at the model's limits:
@@ -115,9 +85,8 @@ def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, seeds: tuple[int, .
     from dataclasses import replace
 
     from pinarms.report import Row
-    from pinarms.studies.line import ENOKI
 
-    k, res, m = delta_arms_needed(rate, seeds=seeds, duration=duration, map_grid=map_grid)
+    k, res, m = delta_arms_needed(rate, item=item, seeds=seeds, duration=duration, map_grid=map_grid)
     f = res.figures
     places = ", ".join(f"{w.u_base:.1f}" for w in res.windows)
     note = (f"delta_flexpicker (docs/delta.md, motor limits assumed) above the belt's centre line, {DELTA_SPACING} m apart "
@@ -126,8 +95,8 @@ def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, seeds: tuple[int, .
             f"{100 * f.miss_rate_ci[0]:.2f}-{100 * f.miss_rate_ci[1]:.2f} %, {len(seeds)} seeds); against "
             f"{scara['arms']} SCARAs ({scara['picks_per_min']:.1f} picks/min, miss {100 * scara['miss_rate']:.2f} %); "
             f"task times depend on the item's yaw by up to {100 * m[0].yaw_spread:.0f} % (fourth axis)")
-    one = delta_line(1, rate, seeds=(0,), duration=120.0)
-    sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(ENOKI,))), maps={"delta 1": m})
+    one = delta_line(1, rate, item=item, seeds=(0,), duration=120.0)
+    sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(item,))), maps={"delta 1": m})
     return [Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss", None, k, "arms", None, note),
             Row("000", "one delta saturated on the belt", None, sat.figures.picks_per_minute, "picks/min", None,
                 "conveyor tracking, box beside the belt; timed in the motors' space under speed, acceleration "
