@@ -7,7 +7,7 @@ motor axis to its elbow (:func:`~pinarms.robots.delta.elbow_positions`) and the 
 closed-form forward position (:func:`~pinarms.robots.delta.forward_position`).
 
 Scene paths, under ``pinarms/deltas/<name>``: ``upper_arm_<i>``, ``rod_<i><a|b>`` (cylinders,
-MeshCat's axis y along the part), ``platform`` (a disk). :func:`delta_poses` gives their world
+MeshCat's axis y along the part), ``platform`` (a disk), sized as the collision bodies (:mod:`pinarms.robots.delta.collision`). :func:`delta_poses` gives their world
 transforms per frame (the scene data; no viewer needed); :func:`draw_delta` and
 :func:`animate_delta` put them in a MeshCat scene; :func:`delta_page` writes one standalone page.
 """
@@ -24,6 +24,7 @@ import numpy as np
 
 from pinarms.files import atomic_write
 from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position, rod_endpoints
+from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
 from pinarms.robots.errors import InvalidInput
 
 from ._meshcat import meshcat, mg
@@ -51,9 +52,9 @@ def _segment(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
 def delta_parts(delta: DeltaRobot) -> dict[str, tuple[str, float, float]]:
     """``{part: (kind, length [m], radius [m])}`` of every drawn part (kind: upper_arm, rod, platform)."""
     g = delta.geometry
-    parts = {f"upper_arm_{i}": ("upper_arm", g.upper_arm, 0.025) for i in (1, 2, 3)}
-    parts.update({f"rod_{i}{r}": ("rod", g.forearm, 0.008) for i in (1, 2, 3) for r in "ab"})
-    parts["platform"] = ("platform", 0.02, g.platform_radius + 0.5 * g.rod_spacing)
+    parts = {f"upper_arm_{i}": ("upper_arm", g.upper_arm, PART_RADII["upper_arm"]) for i in (1, 2, 3)}
+    parts.update({f"rod_{i}{r}": ("rod", g.forearm, PART_RADII["rod"]) for i in (1, 2, 3) for r in "ab"})
+    parts["platform"] = ("platform", PLATFORM_THICKNESS, g.platform_radius + 0.5 * g.rod_spacing)
     return parts
 
 
