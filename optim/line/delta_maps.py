@@ -27,12 +27,13 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.delta_tracking import DeltaArm, delta_pick_times, tool_turn_time
 from pinarms.optim.line.errors import BeltOutOfReach
 from pinarms.optim.line.station import Station
+from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.robots.delta import inverse_position
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["build_delta_map", "delta_span", "yaw_layers"]
+__all__ = ["build_delta_map", "delta_span", "yaw_layers", "delta_map_error"]
 
 _SPAN_STEP = 0.005  # [m] sampling of the reach along the belt
 
@@ -120,3 +121,38 @@ def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingS
             fields.update(yaw=yaw, yaw_approach=YA[:, None], yaw_leave=YC[:, None])
     return TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass),
                    time.perf_counter() - start, yaw_period=spec.yaw_period, **fields)
+
+
+def delta_map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
+                    n: int = 30, item_height: float = 0.04, seed: int = 0, grid: int = 24) -> MapError:
+    """The map against exact timing (:func:`~.delta_tracking.delta_pick_times` with ``grid`` TOPP intervals,
+    the tool's turn exact) at ``n`` seeded random feasible points, each item at a random yaw (as
+    :func:`~.task_map_error.map_error` does for serial arms)."""
+    rng = np.random.default_rng(seed)
+    arm: DeltaArm = station.robot
+    u0 = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    period = spec.yaw_period
+    rel, pts, yaws = [], [], []
+    start = time.perf_counter()
+    for _ in range(50 * n):
+        if len(rel) >= n:
+            break
+        du, w = rng.uniform(task_map.du[0], task_map.du[-1]), rng.uniform(task_map.w[0], task_map.w[-1])
+        yaw = rng.uniform(-np.pi, np.pi)
+        tA, tC = task_map.times(du, w, yaw)
+        if not (np.isfinite(tA) and np.isfinite(tC)):
+            continue
+        try:
+            a, c = delta_pick_times(station, belt, spec, u0 + du, w, mass=task_map.mass, item_height=item_height,
+                                    n=grid)
+        except InfeasibleProblem:
+            continue
+        tool = (yaw + period / 2.0) % period - period / 2.0 if arm.can_yaw else 0.0
+        if arm.can_yaw:
+            turn = tool_turn_time(tool, float(arm.velocity_limit[3]), float(arm.acceleration_limit[3]))
+            a, c = max(a, turn), max(c, turn)
+        exact = a + c + task_map.track + task_map.release
+        rel.append(abs(float(tA + tC) + task_map.track + task_map.release - exact) / exact)
+        pts.append((du, w))
+        yaws.append(tool)
+    return MapError(np.array(rel), np.array(pts).reshape(-1, 2), time.perf_counter() - start, np.array(yaws), period)

@@ -115,3 +115,13 @@ def test_demo_rows_scara_or_delta():
     need, sat = rows
     assert need.unit == "arms" and need.pinarms == 2 and "7 SCARAs" in need.note and "0.2 m/s" in need.note
     assert sat.unit == "picks/min" and 45.0 < sat.pinarms < 75.0
+
+
+def test_map_error_against_exact_timing(line, small_map):
+    """Interpolated (du, w, yaw) against exact timing at random points, items at random yaw (a 5 x 3 map)."""
+    from pinarms.optim.line.delta_maps import delta_map_error
+
+    err = delta_map_error(small_map, line.stations[0], line.belt, line.tracking, n=6, item_height=ENOKI.size[2],
+                          grid=12)
+    assert err.relative.size == 6 and np.ptp(err.yaws) > 0.5
+    assert err.max < 0.02, err.relative
