@@ -7,7 +7,8 @@ motor axis to its elbow (:func:`~pinarms.robots.delta.elbow_positions`) and the 
 closed-form forward position (:func:`~pinarms.robots.delta.forward_position`).
 
 Scene paths, under ``pinarms/deltas/<name>``: ``upper_arm_<i>``, ``rod_<i><a|b>`` (cylinders,
-MeshCat's axis y along the part), ``platform`` (a disk), sized as the collision bodies (:mod:`pinarms.robots.delta.collision`). :func:`delta_poses` gives their world
+MeshCat's axis y along the part), ``platform`` (a disk), sized as the collision bodies
+(:mod:`pinarms.robots.delta.collision`). :func:`delta_poses` gives their world
 transforms per frame (the scene data; no viewer needed); :func:`draw_delta` and
 :func:`animate_delta` put them in a MeshCat scene; :func:`delta_page` writes one standalone page.
 """

@@ -110,7 +110,8 @@ def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_d
     if length < 1e-6:
         raise InfeasibleProblem(f"{arm.name}: the box is at the pick point; move the box")
     along = length * belt_dir
-    points = hermite_points(start, end, chord, along, length) if onto else hermite_points(start, end, along, chord, length)
+    tangents = (chord, along) if onto else (along, chord)
+    points = hermite_points(start, end, *tangents, length)
     s = np.linspace(0.0, length, n + 1)
     delta = arm.carrying(mass)
     q = inverse_position(delta.geometry, points(s)[0])

@@ -32,7 +32,8 @@ DELTA_HEIGHT = 1.1
 DELTA_BOX = (0.0, 0.45, -1.0)
 
 
-def delta_line(n_arms: int, rate: float, *, item: Any, name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
+def delta_line(n_arms: int, rate: float, *, item: Any,
+               name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
                seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, spacing: float = DELTA_SPACING,
                height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
                map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
@@ -78,10 +79,12 @@ def delta_arms_needed(rate: float, *, max_arms: int = 20, maps: Any = None, **kw
 
 
 def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, item: Any, seeds: tuple[int, ...] = (0, 1, 2, 3, 4),
-               duration: float = 600.0, map_grid: tuple[int, int] = (12, 5)) -> list[Any]:
+               duration: float = 600.0, map_grid: tuple[int, int] = (12, 5),
+               faster: tuple[float, ...] = (0.6,)) -> list[Any]:
     """The rows "SCARA or delta" of the demo's line study: deltas needed for ``rate`` bunches/min at
     ≤ 1 % miss beside ``scara`` (the line study's figures of seed 000's SCARAs at the model's limits:
-    ``arms``, ``picks_per_min``, ``miss_rate``), and one delta saturated."""
+    ``arms``, ``picks_per_min``, ``miss_rate``), one delta saturated, and the deltas needed on a belt at
+    each speed of ``faster`` [m/s] (a map each)."""
     from dataclasses import replace
 
     from pinarms.report import Row
@@ -89,7 +92,8 @@ def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, item: Any, seeds: t
     k, res, m = delta_arms_needed(rate, item=item, seeds=seeds, duration=duration, map_grid=map_grid)
     f = res.figures
     places = ", ".join(f"{w.u_base:.1f}" for w in res.windows)
-    note = (f"delta_flexpicker (docs/delta.md, motor limits assumed) above the belt's centre line, {DELTA_SPACING} m apart "
+    note = (f"delta_flexpicker (docs/delta.md, motor limits assumed) above the belt's centre line, {DELTA_SPACING} m "
+            f"apart "
             f"(bases at {places} m along the belt), same Poisson {rate:g} bunches/min, belt {res.belt_speed} m/s, "
             f"rule first-in-window: {f.picks_per_minute:.1f} picks/min, miss {100 * f.miss_rate:.2f} % (95 % CI "
             f"{100 * f.miss_rate_ci[0]:.2f}-{100 * f.miss_rate_ci[1]:.2f} %, {len(seeds)} seeds); against "
@@ -97,7 +101,15 @@ def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, item: Any, seeds: t
             f"task times depend on the item's yaw by up to {100 * m[0].yaw_spread:.0f} % (fourth axis)")
     one = delta_line(1, rate, item=item, seeds=(0,), duration=120.0)
     sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(item,))), maps={"delta 1": m})
-    return [Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss", None, k, "arms", None, note),
+    rows = [Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss", None, k, "arms", None, note),
             Row("000", "one delta saturated on the belt", None, sat.figures.picks_per_minute, "picks/min", None,
                 "conveyor tracking, box beside the belt; timed in the motors' space under speed, acceleration "
                 "and torque limits with the bunch as payload")]
+    for v in faster:
+        kv, rv, _ = delta_arms_needed(rate, item=item, seeds=seeds, duration=duration, map_grid=map_grid, speed=v)
+        fv = rv.figures
+        rows.append(Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss, belt {v:g} m/s", None,
+                        kv, "arms", None, f"as above on a belt at {v:g} m/s: {fv.picks_per_minute:.1f} picks/min, miss "
+                                         f"{100 * fv.miss_rate:.2f} % (95 % CI {100 * fv.miss_rate_ci[0]:.2f}-"
+                                         f"{100 * fv.miss_rate_ci[1]:.2f} %)"))
+    return rows

@@ -111,7 +111,7 @@ def test_demo_rows_scara_or_delta():
     from pinarms.studies.delta_line import delta_rows
 
     scara = {"arms": 7, "picks_per_min": 59.8, "miss_rate": 0.0049}
-    rows = delta_rows(scara, 60.0, item=ENOKI, seeds=(0, 1), duration=120.0, map_grid=(5, 3))
+    rows = delta_rows(scara, 60.0, item=ENOKI, seeds=(0, 1), duration=120.0, map_grid=(5, 3), faster=())
     need, sat = rows
     assert need.unit == "arms" and need.pinarms == 2 and "7 SCARAs" in need.note and "0.2 m/s" in need.note
     assert sat.unit == "picks/min" and 45.0 < sat.pinarms < 75.0
