@@ -45,16 +45,19 @@ class ProgressBar:
         stream: where to draw (default ``sys.stderr``).
         width: characters of the bar itself.
         min_interval: seconds between two redraws (the last state is always drawn).
+        after: seconds of work before the first draw (a step done sooner draws nothing; the command
+            line's long steps use 2 s).
     """
 
     def __init__(self, label: str, total: int | None = None, *, enabled: bool = True, stream: IO[str] | None = None,
-                 width: int = 24, min_interval: float = 0.1) -> None:
+                 width: int = 24, min_interval: float = 0.1, after: float = 0.0) -> None:
         self.label = label
         self.done = 0
         self.note = ""
         self.enabled = bool(enabled)
         self._stream = sys.stderr if stream is None else stream
         self._min_interval = min_interval
+        self.after = float(after)
         self._start = time.perf_counter()
         self._last_draw = -float("inf")
         self._drawn: tuple | None = None  # (done, total, note) last drawn
@@ -105,6 +108,8 @@ class ProgressBar:
         if not self.enabled or self._closed:
             return
         now = time.perf_counter()
+        if now - self._start < self.after:
+            return
         finished = self.total is not None and self.done >= self.total
         if not (force or finished) and now - self._last_draw < self._min_interval:
             return

@@ -71,3 +71,21 @@ def test_workspace_sampling_reports_every_sample():
     assert sorted(d for d, _ in calls) == [d for d, _ in calls] and calls[-1][0] == 70_000
     quiet = robots.sample_workspace(robots.load("aubo_i3"), n=70_000, seed=0, chunk=16384)
     np.testing.assert_array_equal(ws.points, quiet.points)
+
+
+def test_a_bar_with_after_draws_only_once_its_step_has_taken_that_long():
+    """The command line's long steps (the belt's maps for --robot) draw after 2 s: a quick step
+    leaves stderr empty, a long one draws its line."""
+    import time
+
+    quick = _Tty()
+    with ProgressBar("task map 'arm 1' (item)", 10, stream=quick, min_interval=0.0, after=2.0) as bar:
+        for k in range(1, 11):
+            bar(k)
+    assert quick.getvalue() == ""
+    slow = _Tty()
+    with ProgressBar("task map 'arm 1' (item)", 10, stream=slow, min_interval=0.0, after=0.05) as bar:
+        bar(1)
+        time.sleep(0.06)
+        bar(2)
+    assert _last_line(slow).startswith("task map 'arm 1' (item)") and "2/10" in _last_line(slow)

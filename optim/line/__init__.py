@@ -25,7 +25,9 @@ from pinarms.optim.line.rules import RULES, AssignmentRule, Rule
 from pinarms.optim.line.schedule import LineSchedule, schedule_line
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.task_maps import MapError, TaskMap, build_task_map, map_error
+from pinarms.optim.line.task_map_build import build_task_map, measure_yaw
+from pinarms.optim.line.task_map_error import MapError, map_error
+from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import PickPlan, TrackingSpec, plan_pick
 from pinarms.optim.line.tray_maps import TrayMap, build_tray_map, tray_map_error
 from pinarms.optim.line.tray_sim import SimPlace
@@ -36,7 +38,7 @@ __all__ = [
     "LineSchedule", "schedule_line",
     "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
     "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
-    "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "AssignmentRule",
+    "TaskMap", "build_task_map", "measure_yaw", "map_error", "MapError", "Rule", "RULES", "AssignmentRule",
     "SimArm", "SimResult", "simulate",
     "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",

@@ -29,15 +29,16 @@ from pinarms.optim.line.report import LineFigures, summarise
 from pinarms.optim.line.rules import AssignmentRule, Rule
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_maps import TaskMap, build_task_map
-from pinarms.optim.line.tracking import TrackingSpec
+from pinarms.optim.line.task_map_build import YAW_MODES, build_task_map
+from pinarms.optim.line.task_maps import TaskMap
+from pinarms.optim.line.tracking import TrackingSpec, can_yaw
 from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.optim.status import Status
 from pinarms.robots.errors import InvalidInput
 
-__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "LineStatus", "LineCurve", "line_curve",
-           "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
+__all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "map_warnings", "sim_arms", "LineStatus",
+           "LineCurve", "line_curve", "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
 #: Most arms (stations) along one line, and most seeds (Monte Carlo runs) of one line result.
@@ -110,6 +111,7 @@ class LineSpec:
     clearance: float = 0.01
     trays: Any = None  #: None (every arm places in its box), a TrayBelt for every arm, or {station name: TrayBelt}
     tray_grid: tuple[int, int, int] = (10, 5, 8)  #: (nu, nw, nv) of the tray maps (docs/line.md: why 5 across)
+    map_yaw: str = "auto"  #: the task maps' yaw coordinate (:data:`~.task_map_build.YAW_MODES`)
 
     def __post_init__(self) -> None:
         if not isinstance(self.belt, Belt):
@@ -136,6 +138,8 @@ class LineSpec:
         object.__setattr__(self, "trays", _tray_option(self.trays, names))
         if self.trays and len(self.stream.types) != 1:
             raise InvalidInput("trays: one item type only (the tray maps have no item-type coordinate)")
+        if self.map_yaw not in YAW_MODES:
+            raise InvalidInput(f"map_yaw must be one of {YAW_MODES}, got {self.map_yaw!r}")
 
     def trays_of(self, station: str) -> TrayBelt | None:
         """The TrayBelt arm ``station`` places in (None: its box)."""
@@ -162,7 +166,9 @@ class LineResult:
     ``windows`` (each arm's :class:`PickWindow`), ``overlapping`` (neighbour pairs whose
     windows overlap), ``runs`` (one :class:`SimResult` per seed), ``maps`` (per station);
     ``fixture_infeasible``: per station, its maps' nodes closer than the clearance to the cell's
-    fixtures (empty without a cell)."""
+    fixtures (empty without a cell); ``map_warnings``: why a station's task times may be off (a map
+    that ignores a yaw dependence it has, or never measured it: :meth:`TaskMap.warnings`), empty
+    when none."""
 
     status: LineStatus
     figures: LineFigures
@@ -173,6 +179,7 @@ class LineResult:
     belt_speed: float = 0.0
     fixture_infeasible: dict = field(default_factory=dict)
     status_reason: str = ""
+    map_warnings: tuple[str, ...] = ()
 
     def summary(self, title: str = "line") -> str:
         """The figures as text, one per line (what ``pinarms belt run`` prints): status, arms, belt
@@ -194,12 +201,13 @@ class LineResult:
         if f.tray_fill_rate is not None:
             lines.append(f"  tray fill         {100 * f.tray_fill_rate:.1f} %, {f.trays_unfilled:.1f} trays left with a "
                          f"free slot per run, {100 * f.unplaced_rate:.2f} % of items missed for want of a slot")
+        lines += [f"  warning           {w}" for w in self.map_warnings]
         return "\n".join(lines)
 
     def as_dict(self) -> dict[str, Any]:
         return {"status": self.status.value, "belt_speed_m_s": self.belt_speed, "figures": self.figures.as_dict(),
                 "neighbour_checks": [list(r.checks) for r in self.runs],
-                "fixture_infeasible": dict(self.fixture_infeasible),
+                "fixture_infeasible": dict(self.fixture_infeasible), "map_warnings": list(self.map_warnings),
                 "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
 
 
@@ -213,10 +221,12 @@ def _shape_key(st: Station, belt: Belt) -> tuple:
 
 
 def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | None = None,
-               approach_maps: dict | None = None) -> dict[str, tuple[TaskMap, ...]]:
+               approach_maps: dict | None = None,
+               progress: Callable[..., None] | None = None) -> dict[str, tuple[TaskMap, ...]]:
     """Task maps of every station, one per item type, built once per distinct station shape.
     ``approach_maps``: ``{station name: (box TaskMap, ...)}`` whose approach times the tray maps
-    take (:func:`~.tray_maps.build_tray_map` ``approach_map``)."""
+    take (:func:`~.tray_maps.build_tray_map` ``approach_map``). ``progress(done, total, note)``:
+    the map under way (``note``, e.g. ``"task map 'arm 1' (item)"``) and its columns planned so far."""
     cache: dict = {} if known is None else known
     out = {}
     near = {"cell": spec.cell, "clearance": spec.clearance}
@@ -235,15 +245,19 @@ def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | Non
 
                 nu, nw, nv = spec.tray_grid
                 cache[key] = build_tray_map(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine, **near)
+                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine,
+                                            progress=_noted(progress, f"tray map {st.name!r}"), **near)
             out[st.name] = (cache[key],)
             continue
         maps = []
         for t in spec.stream.types:
-            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own)
+            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own,
+                   spec.map_yaw)
             if key not in cache:
                 cache[key] = build_task_map(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler, **near)
+                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler,
+                                            yaw=spec.map_yaw, progress=_noted(progress, f"task map {st.name!r} ({t.name})"),
+                                            **near)
             maps.append(cache[key])
         out[st.name] = tuple(maps)
     return out
@@ -281,14 +295,37 @@ def _run_seed(task: dict) -> SimResult:
                     width=spec.belt.width, guard=guard)
 
 
-def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Scheduler = None) -> LineResult:
-    """Simulate the line on every seed and summarise (module doc)."""
+def _noted(progress: Callable[..., None] | None, note: str) -> Callable[..., None] | None:
+    """``progress`` as a ``(done, total)`` callback that names the step (None stays None)."""
+    if progress is None:
+        return None
+    return lambda done, total=None: progress(done, total, note)
+
+
+def map_warnings(spec: LineSpec, maps: dict) -> tuple[str, ...]:
+    """What the stations' maps say makes their times doubtful (:meth:`TaskMap.warnings`), once each;
+    none for an arm that cannot turn its tool (its time cannot depend on the item's yaw)."""
+    out: list[str] = []
+    for st in spec.stations:
+        if not can_yaw(st.robot):
+            continue
+        for m in maps.get(st.name, ()):
+            for text in _pick_part(m).warnings():
+                if text not in out:
+                    out.append(text)
+    return tuple(out)
+
+
+def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Scheduler = None,
+             progress: Callable[..., None] | None = None) -> LineResult:
+    """Simulate the line on every seed and summarise (module doc). ``progress(done, total, note)``:
+    the step under way (``note``: a map being built, ``"seeds"``) and how far it is."""
     from pinarms.execution import map_chunks
 
-    maps = build_maps(spec, scheduler=scheduler) if maps is None else maps
+    maps = build_maps(spec, scheduler=scheduler, progress=progress) if maps is None else maps
     arms = sim_arms(spec, maps)
     runs = map_chunks(_run_seed, [{"spec": spec, "arms": arms, "seed": s} for s in spec.seeds],
-                      scheduler=scheduler if spec.cell is None else None)
+                      scheduler=scheduler if spec.cell is None else None, progress=_noted(progress, "seeds"))
     figures = summarise(runs)
     windows = tuple(window_of(st, spec.belt, _pick_part(maps[st.name][0])) for st in spec.stations)
     ordered = sorted(windows, key=lambda w: w.u_base)
@@ -299,7 +336,8 @@ def run_line(spec: LineSpec, *, maps: dict | None = None, scheduler: Scheduler =
                             f"target {100 * spec.target_miss_rate:.2f} %: add an arm, slow the belt or lower the flow")
     blocked = ({} if spec.cell is None else
                {st.name: sum(int(getattr(m, "fixture_infeasible", 0)) for m in maps[st.name]) for st in spec.stations})
-    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed, blocked, reason)
+    return LineResult(status, figures, windows, overlapping, tuple(runs), maps, spec.belt.speed, blocked, reason,
+                      map_warnings(spec, maps))
 
 
 def _pick_part(m: Any) -> TaskMap:

@@ -11,7 +11,8 @@ item: two rows of cell ends per item instead of a branch lookup per item and nod
 
 Before it is used, its rows (numpy and compiled) are compared with :meth:`TaskMap.rows` at a spread
 of the items and at the grid's nodes;
-a map it cannot cut (another kind of map) or any difference sends every item through
+a map it cannot cut (another kind of map), a map with a yaw coordinate (its times depend on each
+item's yaw, which the cells do not hold) or any difference sends every item through
 :meth:`TaskMap.rows` instead.
 """
 
@@ -76,10 +77,17 @@ def _same(a: tuple, b: tuple) -> bool:
     return all(np.array_equal(x, y, equal_nan=True) for x, y in zip(a, b))
 
 
-def map_rows(task_map: Any, grid: tuple, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray) -> None:
-    """Rows ``sel`` of ``tA``, ``tC`` (n, K): ``task_map.rows(w[sel], grid)`` (module doc). The cells of a
-    map are read once per grid and kept while the map lives; every call compares them, in numpy and
-    compiled, with the map at a spread of its items."""
+def map_rows(task_map: Any, grid: tuple, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray,
+             yaw: np.ndarray | None = None) -> None:
+    """Rows ``sel`` of ``tA``, ``tC`` (n, K): ``task_map.rows(w[sel], grid, yaw[sel])`` (module doc). The
+    cells of a map are read once per grid and kept while the map lives; every call compares them, in
+    numpy and compiled, with the map at a spread of its items. ``yaw`` (n,) [rad]: each item's yaw,
+    read only by a map with a yaw coordinate (None: 0)."""
+    if getattr(task_map, "yaw", None) is not None:  # times per item's yaw: the map itself, chunk by chunk
+        for a in range(0, sel.size, ROWS_CHUNK):
+            part = sel[a:a + ROWS_CHUNK]
+            tA[part], tC[part] = task_map.rows(w[part], grid, None if yaw is None else yaw[part])
+        return
     cells = _cells(task_map, grid)
     if cells is not None and sel.size:
         spread = sel[np.linspace(0, sel.size - 1, min(sel.size, CHECKED_ITEMS)).astype(int)]

@@ -69,7 +69,7 @@ class NeighbourGuard:
             branch = None
             if name in self.maps:
                 u_base = float(self.belt.to_belt(st.base_to_world[:3, 3])[0])
-                branch = self.maps[name][kind].branch_at(u - u_base, w)
+                branch = self.maps[name][kind].branch_at(u - u_base, w, None if self.yaws is None else self.yaws[item])
             yaw = 0.0 if self.yaws is None else float(self.yaws[item])
             self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
                                          branch=branch, yaw=yaw)

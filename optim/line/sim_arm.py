@@ -86,7 +86,7 @@ def item_rows(arm: SimArm, items: Items) -> ItemRows:
     tA, tC, extra = np.empty((n, K)), np.empty((n, K)), np.empty(n)
     for k, m in enumerate(arm.maps):
         sel = np.flatnonzero(items.kind == k)
-        map_rows(m, grid, items.w, sel, tA, tC)
+        map_rows(m, grid, items.w, sel, tA, tC, yaw=items.yaw)  # per item: its yaw
         extra[sel] = m.track + m.release
     ok = np.isfinite(tA) & np.isfinite(tC)
     tA[~ok] = np.nan

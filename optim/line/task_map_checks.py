@@ -7,7 +7,9 @@ once made the simulator pick nothing, silently). Times [s]: NaN where a pick is 
 otherwise finite, ≥ 0 and at most :data:`MAX_TASK_TIME`. ``track`` and ``release`` [s] the same
 (never NaN); ``speed`` [m/s] finite and > 0; ``mass`` [kg] finite and ≥ 0. Sizes: at most
 :data:`MAX_GRID_NODES` nodes along each grid, at most :data:`MAX_MAP_VALUES` values in one
-table (branches × du × w), counted from the grids before any table is looked at.
+table (yaw nodes × branches × du × w), counted from the grids before any table is looked at.
+The yaw grid [rad] (:func:`check_yaw`): a grid as above, at most :data:`MAX_YAW_NODES` nodes,
+from exactly -period/2 to +period/2 with a node at 0 (the layer the 2-D tables hold).
 Every fault is a :class:`~.errors.TaskMapError` naming the map, the field and the node.
 """
 
@@ -19,8 +21,8 @@ import numpy as np
 
 from pinarms.optim.line.errors import TaskMapError
 
-__all__ = ["check_grid", "check_times", "check_scalar", "check_sizes", "MAX_TASK_TIME", "MAX_GRID_NODES",
-           "MAX_MAP_VALUES", "MAX_BRANCHES"]
+__all__ = ["check_grid", "check_times", "check_scalar", "check_sizes", "check_yaw", "MAX_TASK_TIME", "MAX_GRID_NODES",
+           "MAX_MAP_VALUES", "MAX_BRANCHES", "MAX_YAW_NODES"]
 
 #: Longest approach, leave, tracking or release time a map may hold [s] (a line's cycle is at most 600 s).
 MAX_TASK_TIME = 600.0
@@ -30,6 +32,8 @@ MAX_GRID_NODES = 100_000
 MAX_MAP_VALUES = 2**20
 #: Most IK branches a map tables.
 MAX_BRANCHES = 64
+#: Most nodes of a map's yaw grid.
+MAX_YAW_NODES = 361
 
 
 def check_grid(values: Any, name: str, station: str) -> np.ndarray:
@@ -55,12 +59,27 @@ def check_grid(values: Any, name: str, station: str) -> np.ndarray:
     return g
 
 
-def check_sizes(n_branches: int, nu: int, nw: int, station: str) -> None:
-    """TaskMapError when the tables would hold more than :data:`MAX_MAP_VALUES` values or branches."""
+def check_yaw(values: Any, period: float, station: str) -> np.ndarray:
+    """The yaw grid [rad] as float64 (else TaskMapError): a grid (:func:`check_grid`) of at most
+    :data:`MAX_YAW_NODES` nodes from -``period``/2 to +``period``/2 (1e-9 rad) through 0."""
+    g = check_grid(values, "yaw [rad]", station)
+    if g.size > MAX_YAW_NODES:
+        raise TaskMapError(f"task map {station!r}: grid yaw [rad] has {g.size} nodes; a map has at most {MAX_YAW_NODES}")
+    if abs(g[0] + period / 2.0) > 1e-9 or abs(g[-1] - period / 2.0) > 1e-9 or not np.any(g == 0.0):
+        raise TaskMapError(f"task map {station!r}: grid yaw [rad] must run from -{period / 2.0:.6g} to "
+                           f"{period / 2.0:.6g} (half the yaw period) through 0, got {float(g[0])!r} .. {float(g[-1])!r}")
+    return g
+
+
+def check_sizes(n_branches: int, nu: int, nw: int, station: str, ny: int = 1) -> None:
+    """TaskMapError when the tables would hold more than :data:`MAX_MAP_VALUES` values (``ny`` yaw
+    layers of ``n_branches`` × ``nu`` × ``nw``) or more than :data:`MAX_BRANCHES` branches."""
     if not 1 <= n_branches <= MAX_BRANCHES:
         raise TaskMapError(f"task map {station!r}: {n_branches} IK branches; a map has 1 to {MAX_BRANCHES}")
-    if n_branches * nu * nw > MAX_MAP_VALUES:
-        raise TaskMapError(f"task map {station!r}: {n_branches} branches x {nu} x {nw} nodes = {n_branches * nu * nw} "
+    total = ny * n_branches * nu * nw
+    if total > MAX_MAP_VALUES:
+        layers = f"{ny} yaw nodes x " if ny > 1 else ""
+        raise TaskMapError(f"task map {station!r}: {layers}{n_branches} branches x {nu} x {nw} nodes = {total} "
                            f"values; a table holds at most {MAX_MAP_VALUES}: a coarser grid")
 
 

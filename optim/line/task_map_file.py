@@ -4,7 +4,11 @@ A zip archive of ``.npy`` members (no pickle): ``du``, ``w``, ``approach``, ``le
 ``branch_approach``, ``branch_leave`` (float64), ``scalars`` (track, release, speed, mass,
 build seconds), ``branches``, ``fixture_infeasible`` (int64), ``station`` and ``checksum``
 (text): the SHA-256 of every value (:func:`map_checksum`), checked on load, so a flipped byte
-is found instead of silently changing a pick time.
+is found instead of silently changing a pick time. Since maps measure their dependence on the
+item's yaw: ``yaw_scalars`` (yaw period [rad], measured yaw spread) and, for a map with a yaw
+coordinate, ``yaw`` (ny,) and ``yaw_approach``, ``yaw_leave`` (ny, nb, nu, nw) (float64), in the
+checksum after the others; a file without them (written before) reads as a map without a yaw
+coordinate whose yaw dependence was never measured.
 
 Reading (:func:`read_map_file`): a regular file of at most :data:`MAX_FILE_BYTES`; the zip's
 end record read first (at most :data:`MAX_MEMBERS` members); each member's declared size
@@ -36,11 +40,12 @@ __all__ = ["map_checksum", "map_members", "read_map_file", "MAX_FILE_BYTES", "MA
 MAX_FILE_BYTES = 64 * 2**20
 #: Largest member, uncompressed [bytes]: a full table and its ``.npy`` header.
 MAX_MEMBER_BYTES = 8 * MAX_MAP_VALUES + 4096
-#: All members together, uncompressed [bytes].
-MAX_TOTAL_BYTES = 4 * MAX_MEMBER_BYTES + 2**21
+#: All members together, uncompressed [bytes]: six tables at most (two per yaw layers, branches, best).
+MAX_TOTAL_BYTES = 6 * MAX_MEMBER_BYTES + 2**21
 #: Most members in the archive.
 MAX_MEMBERS = 16
 _FLOATS = ("du", "w", "approach", "leave", "scalars", "branch_approach", "branch_leave")
+_YAW_FLOATS = ("yaw_scalars", "yaw", "yaw_approach", "yaw_leave")  # after the others: old files keep their checksum
 _INTS = ("branches", "fixture_infeasible")
 _TEXTS = ("station", "checksum")
 _NEEDED = ("du", "w", "approach", "leave", "scalars", "station")
@@ -49,8 +54,8 @@ _NEEDED = ("du", "w", "approach", "leave", "scalars", "station")
 def map_checksum(fields: dict[str, Any]) -> str:
     """SHA-256 (hex) of a map's values: name, dtype, shape and little-endian bytes of each field."""
     h = hashlib.sha256(b"pinarms-task-map-1")
-    for key in (*_FLOATS, *_INTS):
-        a = np.ascontiguousarray(fields[key], dtype="<f8" if key in _FLOATS else "<i8")
+    for key in (*_FLOATS, *_INTS, *(k for k in _YAW_FLOATS if k in fields)):
+        a = np.ascontiguousarray(fields[key], dtype="<i8" if key in _INTS else "<f8")
         h.update(f"|{key}|{a.shape}|".encode())
         h.update(a.tobytes())
     h.update(b"|station|" + str(fields["station"]).encode("utf-8", "surrogatepass"))
@@ -66,6 +71,10 @@ def map_members(m: Any) -> dict[str, np.ndarray]:
               "branches": np.array(m.branches, dtype=np.int64), "fixture_infeasible": np.array(m.fixture_infeasible,
                                                                                                   dtype=np.int64),
               "station": np.array(m.station)}
+    if m.yaw is not None or not np.isnan(m.yaw_spread):  # a map read from an older file is written as it was
+        fields["yaw_scalars"] = np.array([m.yaw_period, m.yaw_spread])
+    if m.yaw is not None:
+        fields.update(yaw=m.yaw, yaw_approach=m.yaw_approach, yaw_leave=m.yaw_leave)
     return {**fields, "checksum": np.array(map_checksum(fields))}
 
 
@@ -114,7 +123,7 @@ def _checked_infos(z: zipfile.ZipFile, path: Any) -> dict[str, zipfile.ZipInfo]:
     total = 0
     for info in infos:
         name = info.filename[:-4] if info.filename.endswith(".npy") else ""
-        if name not in (*_FLOATS, *_INTS, *_TEXTS) or name in out:
+        if name not in (*_FLOATS, *_YAW_FLOATS, *_INTS, *_TEXTS) or name in out:
             raise _bad(path, f"unexpected or repeated member {info.filename!r}")
         if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
             raise _bad(path, f"member {info.filename!r} is compressed with method {info.compress_type}")
@@ -149,7 +158,7 @@ def _array(data: bytes, name: str, path: Any) -> np.ndarray:
                                  else np.lib.format.read_array_header_2_0(buf))
     except (ValueError, SyntaxError, TypeError) as exc:
         raise _bad(path, f"member {name}.npy has no valid .npy header ({exc})") from None
-    want = "<f8" if name in _FLOATS else "<i8" if name in _INTS else None
+    want = "<f8" if name in (*_FLOATS, *_YAW_FLOATS) else "<i8" if name in _INTS else None
     if (dtype.str != want) if want else (dtype.kind != "U" or dtype.itemsize > 4 * 256 or shape != ()):
         raise _bad(path, f"member {name}.npy has dtype {dtype.str} and shape {shape}")
     count = int(np.prod(shape, dtype=object))

@@ -10,17 +10,23 @@ grid points the times are interpolated bilinearly; a point is feasible when its 
 surrounding grid points are. :func:`map_error` compares the interpolation with exact
 planning at seeded random points.
 
+The item's yaw: the hand turns to it (:func:`~.tracking.tool_yaw`, reduced by the gripper's
+symmetry into [-period/2, period/2)). Where the arm's task time depends on it (a 6-axis arm whose
+wrist is slow), the map has a third coordinate ``yaw`` (tool-yaw nodes spanning
+[-period/2, period/2], one ``(nb, nu, nw)`` layer of times per node, linear between layers);
+where it does not (measured when the map is built: ``yaw_spread``, the largest relative change
+of the task time over yaw at probed nodes), the map has none and holds at every yaw.
+
 A map holds for one arm model, limits, lateral offset and height of the base, box position
 relative to the base, belt speed, tracking spec and item mass: moving the arm (and its box)
 along the belt keeps it valid, which is what the sizing search uses.
 
-Built on the execution layer (:func:`pinarms.execution.map_chunks`: serial by default, or a
-Dask cluster), one task per ``du`` column, same result either way. Saved as ``.npz`` (no pickle).
+Built by :func:`~.task_map_build.build_task_map` on the execution layer, checked against exact
+planning by :func:`~.task_map_error.map_error`. Saved as ``.npz`` (no pickle; :mod:`~.task_map_file`).
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -28,17 +34,16 @@ from typing import Any
 import numpy as np
 
 from pinarms.files import atomic_write
-from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.errors import TaskMapError
-from pinarms.optim.line.belt import Belt
-from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_map_checks import MAX_MAP_VALUES, MAX_TASK_TIME, check_grid, check_scalar, check_sizes, check_times
+from pinarms.optim.line.task_map_checks import (MAX_MAP_VALUES, MAX_TASK_TIME, check_grid, check_scalar, check_sizes,
+                                                check_times, check_yaw)
 from pinarms.optim.line.task_map_file import map_members, read_map_file
-from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, plan_pick, rest_configuration
-from pinarms.optim.line.windows import belt_span, check_reach
-from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
 
-__all__ = ["TaskMap", "build_task_map", "map_error", "MapError", "MAX_MAP_VALUES"]
+__all__ = ["TaskMap", "MAX_MAP_VALUES", "YAW_TOLERANCE"]
+
+#: Largest relative change of the task time over the item's yaw a map without a yaw coordinate may
+#: ignore (:attr:`TaskMap.yaw_spread`): above it the map says so (:meth:`TaskMap.warnings`).
+YAW_TOLERANCE = 0.005
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -48,7 +53,12 @@ class TaskMap:
     ``release`` [s]; ``speed`` [m/s] and ``mass`` [kg] it was built for; ``build_seconds``;
     ``branches`` (nb,) IK branch labels and ``branch_approach``, ``branch_leave`` (nb, nu, nw)
     the times on each branch (None: one branch, ``approach`` and ``leave``); ``fixture_infeasible``:
-    grid nodes (over branches) planned but closer than the clearance to the cell's fixtures."""
+    grid nodes (over branches) planned but closer than the clearance to the cell's fixtures.
+
+    Yaw (module doc): ``yaw`` (ny,) tool-yaw nodes [rad] from -``yaw_period``/2 to +``yaw_period``/2
+    through 0, with ``yaw_approach``, ``yaw_leave`` (ny, nb, nu, nw) [s] (the tables above are the
+    layer at yaw 0); None: no yaw coordinate. ``yaw_spread``: the measured largest relative change
+    of the task time over yaw (NaN: not measured, a file written before pinarms measured it)."""
 
     station: str
     du: np.ndarray
@@ -64,6 +74,11 @@ class TaskMap:
     branch_approach: np.ndarray | None = field(default=None, repr=False)
     branch_leave: np.ndarray | None = field(default=None, repr=False)
     fixture_infeasible: int = 0
+    yaw: np.ndarray | None = None
+    yaw_approach: np.ndarray | None = field(default=None, repr=False)
+    yaw_leave: np.ndarray | None = field(default=None, repr=False)
+    yaw_period: float = float(np.pi)
+    yaw_spread: float = float("nan")
 
     def __post_init__(self) -> None:
         """Every field checked (:mod:`~.task_map_checks`; TaskMapError naming the field and the node)."""
@@ -77,9 +92,15 @@ class TaskMap:
             raise TaskMapError(f"task map {name!r}: branches must be integer labels, got {self.branches!r:.80}") from None
         if len(set(branches)) != len(branches):
             raise TaskMapError(f"task map {name!r}: branch labels {branches} repeat one")
-        check_sizes(len(branches), du.size, w.size, name)  # from the grids, before any table is looked at
+        period = check_scalar(self.yaw_period, "yaw_period [rad]", name, high=2.0 * np.pi + 1e-12, open_low=True)
+        yaw = None if self.yaw is None else check_yaw(self.yaw, period, name)
+        ny = 1 if yaw is None else yaw.size
+        check_sizes(len(branches), du.size, w.size, name, ny)  # from the grids, before any table is looked at
         grid = (du.size, w.size)
-        fields = {"du": du, "w": w, "branches": branches,
+        spread = self.yaw_spread
+        fields = {"du": du, "w": w, "branches": branches, "yaw": yaw, "yaw_period": period,
+                  "yaw_spread": float("nan") if isinstance(spread, float) and np.isnan(spread) else
+                  check_scalar(spread, "yaw_spread", name, high=MAX_TASK_TIME),
                   "approach": check_times(self.approach, "approach", name, grid),
                   "leave": check_times(self.leave, "leave", name, grid),
                   "track": check_scalar(self.track, "track time [s]", name, high=MAX_TASK_TIME),
@@ -92,6 +113,11 @@ class TaskMap:
         for key in ("branch_approach", "branch_leave"):
             table = getattr(self, key)
             fields[key] = None if table is None else check_times(table, key, name, shape)
+        for key in ("yaw_approach", "yaw_leave"):
+            table = getattr(self, key)
+            if (table is None) != (yaw is None):
+                raise TaskMapError(f"task map {name!r}: {key} must be given exactly when the map has a yaw grid")
+            fields[key] = None if table is None else check_times(table, key, name, (ny, *shape))
         for key, value in fields.items():
             object.__setattr__(self, key, value)
         A = self.approach[None] if self.branch_approach is None else self.branch_approach
@@ -99,18 +125,45 @@ class TaskMap:
         if A.shape != shape or C.shape != shape:
             raise TaskMapError(f"task map {name!r}: branch tables of shape {A.shape}, {C.shape} for "
                                f"{len(branches)} branches on a {du.size} x {w.size} grid")
+        if yaw is not None:
+            zero = int(np.flatnonzero(yaw == 0.0)[0])
+            if not (np.array_equal(self.yaw_approach[zero], A, equal_nan=True)
+                    and np.array_equal(self.yaw_leave[zero], C, equal_nan=True)):
+                raise TaskMapError(f"task map {name!r}: the yaw layer at yaw 0 differs from the branch tables "
+                                   "(they are that layer): rebuild the map")
+        LA = A[None] if yaw is None else self.yaw_approach
+        LC = C[None] if yaw is None else self.yaw_leave
         object.__setattr__(self, "_A", A)
         object.__setattr__(self, "_C", C)
         object.__setattr__(self, "_cell", _cell_branches(A, C))
+        object.__setattr__(self, "_LA", LA)  # (ny, nb, nu, nw): one layer per yaw node
+        object.__setattr__(self, "_LC", LC)
+        object.__setattr__(self, "_Lcell", np.stack([_cell_branches(a, c) for a, c in zip(LA, LC)]))
+        object.__setattr__(self, "_zero", 0 if yaw is None else int(np.flatnonzero(yaw == 0.0)[0]))
 
     def __repr__(self) -> str:
         """One line: the grid, its ranges, the times' ranges and what the map was built for."""
-        tot = self._A + self._C
-        bad = int(np.sum(~np.isfinite(tot).any(axis=0)))
-        return (f"TaskMap({self.station!r}, {self.du.size} x {self.w.size} nodes, du {_span(self.du)} m, "
+        tot = self._LA + self._LC
+        bad = int(np.sum(~np.isfinite(tot).any(axis=1)))
+        yaw = "" if self.yaw is None else f" x {self.yaw.size} yaw"
+        spread = "not measured" if np.isnan(self.yaw_spread) else f"{100 * self.yaw_spread:.2f} %"
+        return (f"TaskMap({self.station!r}, {self.du.size} x {self.w.size}{yaw} nodes, du {_span(self.du)} m, "
                 f"w {_span(self.w)} m, approach {_span(self.approach)} s, leave {_span(self.leave)} s, "
                 f"{len(self.branches)} branch{'es' if len(self.branches) != 1 else ''}, {bad} infeasible, "
-                f"speed {self.speed:.3g} m/s, mass {self.mass:.3g} kg)")
+                f"yaw spread {spread}, speed {self.speed:.3g} m/s, mass {self.mass:.3g} kg)")
+
+    def warnings(self, tolerance: float = YAW_TOLERANCE) -> tuple[str, ...]:
+        """What makes the map's times doubtful, in words (empty: nothing): a yaw dependence never
+        measured, or ignored although the task time changes by more than ``tolerance`` over yaw."""
+        if self.yaw is not None:
+            return ()
+        if np.isnan(self.yaw_spread):
+            return (f"task map {self.station!r}: its dependence on the item's yaw was never measured (a map file "
+                    "written before pinarms measured it): measure it (measure_yaw) or rebuild the map (build_task_map)",)
+        if self.yaw_spread > tolerance:
+            return (f"task map {self.station!r}: the task time changes by {100 * self.yaw_spread:.1f} % over the item's "
+                    "yaw but the map has no yaw coordinate: rebuild it with yaw='auto'",)
+        return ()
 
     def _weights(self, grid: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2)
@@ -118,31 +171,62 @@ class TaskMap:
         f = np.where((x < grid[0]) | (x > grid[-1]), np.nan, f)
         return i, f
 
-    def _cell_branch(self, i: np.ndarray, j: np.ndarray, f: np.ndarray) -> np.ndarray:
-        """Table index of the branch of grid cells (i, j) (-1: no branch feasible at its four nodes or ``f`` NaN)."""
-        return np.where(np.isnan(f), -1, self._cell[i, j])
+    def _yaw_weights(self, yaw: Any, shape: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """Layer index k and weight f in [0, 1) of layer k + 1 at item yaws ``yaw`` [rad] (broadcast
+        to ``shape``): the yaw reduced by the gripper's symmetry (:func:`~.tracking.tool_yaw`); the
+        layer at yaw 0 for a map without yaw or ``yaw`` None."""
+        if self.yaw is None or yaw is None:
+            return np.full(shape, self._zero), np.zeros(shape)
+        p = self.yaw_period
+        t = np.broadcast_to((np.asarray(yaw, float) + p / 2.0) % p - p / 2.0, shape)
+        k = np.clip(np.searchsorted(self.yaw, t, side="right") - 1, 0, self.yaw.size - 2)
+        return k, (t - self.yaw[k]) / (self.yaw[k + 1] - self.yaw[k])
 
-    def times(self, du: Any, w: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Interpolated ``(t_A, t_C)`` [s] at points ``du``, ``w`` (broadcast); NaN where infeasible.
+    def _on_layers(self, k: np.ndarray, fy: np.ndarray, one: Any) -> Any:
+        """``one(layer index)`` blended linearly between layers k and k + 1 by ``fy`` (each value a
+        tuple of arrays; NaN where the other layer is needed and infeasible)."""
+        lo = one(k)
+        if self.yaw is None or not np.any(fy > 0.0):
+            return lo
+        hi = one(np.minimum(k + 1, self.yaw.size - 1))
+        return tuple(np.where(fy > 0.0, (1.0 - fy) * a + fy * b, a) for a, b in zip(lo, hi))
+
+    def _cell_branch(self, i: np.ndarray, j: np.ndarray, f: np.ndarray, k: Any = None) -> np.ndarray:
+        """Table index of the branch of grid cells (i, j) on yaw layer k (None: yaw 0) (-1: no branch
+        feasible at its four nodes or ``f`` NaN)."""
+        cell = self._cell[i, j] if k is None else self._Lcell[k, i, j]
+        return np.where(np.isnan(f), -1, cell)
+
+    def times(self, du: Any, w: Any, yaw: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """Interpolated ``(t_A, t_C)`` [s] at points ``du``, ``w`` [m] and item yaw ``yaw`` [rad]
+        (broadcast; None: yaw 0); NaN where infeasible.
 
         Bilinear within one IK branch: each grid cell uses the fastest branch feasible at its
-        four nodes (:meth:`branch_at`), never a mixture of branches."""
+        four nodes (:meth:`branch_at`), never a mixture of branches; linear between yaw layers."""
         du, w = np.broadcast_arrays(np.asarray(du, float), np.asarray(w, float))
+        if yaw is not None:
+            du, w, _ = np.broadcast_arrays(du, w, np.asarray(yaw, float))
         i, fu = self._weights(self.du, du)
         j, fw = self._weights(self.w, w)
-        b = self._cell_branch(i, j, fu + fw)
-        bb = np.maximum(b, 0)
-        out = []
-        for table in (self._A, self._C):
-            a, c = table[bb, i, j], table[bb, i + 1, j]
-            d, e = table[bb, i, j + 1], table[bb, i + 1, j + 1]
-            v = (a * (1 - fu) + c * fu) * (1 - fw) + (d * (1 - fu) + e * fu) * fw
-            out.append(np.where(b >= 0, v, np.nan))
-        return out[0], out[1]
+        k, fy = self._yaw_weights(yaw, du.shape)
+
+        def one(kk: np.ndarray) -> tuple:
+            b = self._cell_branch(i, j, fu + fw, kk)
+            bb = np.maximum(b, 0)
+            out = []
+            for table in (self._LA, self._LC):
+                a, c = table[kk, bb, i, j], table[kk, bb, i + 1, j]
+                d, e = table[kk, bb, i, j + 1], table[kk, bb, i + 1, j + 1]
+                v = (a * (1 - fu) + c * fu) * (1 - fw) + (d * (1 - fu) + e * fu) * fw
+                out.append(np.where(b >= 0, v, np.nan))
+            return tuple(out)
+
+        tA, tC = self._on_layers(k, fy, one)
+        return tA, tC
 
     def approach_on(self, label: Any, du: Any, w: Any) -> np.ndarray:
         """The approach time t_A [s] at ``du``, ``w`` on IK branch ``label`` (broadcast; -1: the
-        map's one branch), bilinear on that branch's table; NaN where a node of the cell is
+        map's one branch), bilinear on that branch's table at yaw 0; NaN where a node of the cell is
         infeasible on it or the label is not one of the map's."""
         label, du, w = np.broadcast_arrays(np.asarray(label, int), np.asarray(du, float), np.asarray(w, float))
         i, fu = self._weights(self.du, du)
@@ -157,23 +241,25 @@ class TaskMap:
                                                                             + T[ii + 1, jj + 1] * a) * c
         return out
 
-    def branch_at(self, du: float, w: float) -> int | None:
-        """The IK branch label the map uses at (``du``, ``w``) [m] (None: the arm has one branch
-        or the point is infeasible); :func:`~.tracking.plan_pick` ``branch=`` plans it exactly."""
+    def branch_at(self, du: float, w: float, yaw: float | None = None) -> int | None:
+        """The IK branch label the map uses at (``du``, ``w``) [m] and item yaw ``yaw`` [rad] (the
+        nearer yaw layer; None: yaw 0) (None: the arm has one branch or the point is infeasible);
+        :func:`~.tracking.plan_pick` ``branch=`` plans it exactly."""
         i, fu = self._weights(self.du, np.asarray(du, float))
         j, fw = self._weights(self.w, np.asarray(w, float))
-        b = int(self._cell_branch(i, j, fu + fw))
+        k, fy = self._yaw_weights(yaw, np.shape(i))
+        b = int(self._cell_branch(i, j, fu + fw, np.where(fy > 0.5, k + 1, k)))
         return None if b < 0 or self.branches[b] < 0 else int(self.branches[b])
 
     def sim_grid(self, *others: "TaskMap") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The simulator's du nodes: ``(du, node, cell)`` (K,): the grid's nodes in order, a node
         listed twice (end of the cell before, start of the cell after) where the cells on its
-        two sides use different branches for some w (in this map or ``others``, same du grid),
-        so that piecewise-linear interpolation along du stays within one branch (the time may
-        jump there)."""
+        two sides use different branches for some w and yaw layer (in this map or ``others``, same
+        du grid), so that piecewise-linear interpolation along du stays within one branch (the time
+        may jump there)."""
         nodes, cells = [0], [0]
         for n in range(1, self.du.size - 1):
-            if any(np.any(m._cell[n - 1] != m._cell[n]) for m in (self, *others)):
+            if any(np.any(m._Lcell[:, n - 1] != m._Lcell[:, n]) for m in (self, *others)):
                 nodes.append(n)
                 cells.append(n - 1)
             nodes.append(n)
@@ -183,19 +269,27 @@ class TaskMap:
         node, cell = np.array(nodes), np.array(cells)
         return self.du[node], node, cell
 
-    def rows(self, w: Any, grid: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def rows(self, w: Any, grid: tuple | None = None, yaw: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """``(t_A, t_C)`` of shape (len(w), K) at the du nodes of :meth:`sim_grid` (or ``grid``,
-        one of its results) for items at ``w`` [m] across."""
+        one of its results) for items at ``w`` [m] across and yaw ``yaw`` [rad] (len(w),) (None: 0)."""
         _, node, cell = self.sim_grid() if grid is None else grid
-        j, fw = self._weights(self.w, np.asarray(w, float))
-        b = self._cell_branch(cell[None, :], j[:, None], fw[:, None] + np.zeros(cell.size))
-        bb = np.maximum(b, 0)
-        out = []
-        for table in (self._A, self._C):
-            n_, j_, f_ = node[None, :], j[:, None], fw[:, None]
-            v = table[bb, n_, j_] * (1 - f_) + table[bb, n_, j_ + 1] * f_
-            out.append(np.where(b >= 0, v, np.nan))
-        return out[0], out[1]
+        w = np.asarray(w, float)
+        j, fw = self._weights(self.w, w)
+        k, fy = self._yaw_weights(None if yaw is None else np.asarray(yaw, float), w.shape)
+        k, fy = k[:, None] + np.zeros(cell.size, int), fy[:, None] + np.zeros(cell.size)
+
+        def one(kk: np.ndarray) -> tuple:
+            b = self._cell_branch(cell[None, :], j[:, None], fw[:, None] + np.zeros(cell.size), kk)
+            bb = np.maximum(b, 0)
+            out = []
+            for table in (self._LA, self._LC):
+                n_, j_, f_ = node[None, :], j[:, None], fw[:, None]
+                v = table[kk, bb, n_, j_] * (1 - f_) + table[kk, bb, n_, j_ + 1] * f_
+                out.append(np.where(b >= 0, v, np.nan))
+            return tuple(out)
+
+        tA, tC = self._on_layers(k, fy, one)
+        return tA, tC
 
     @property
     def checksum(self) -> str:
@@ -214,7 +308,9 @@ class TaskMap:
 
         Raises:
             TaskMapError: not a regular file, too large, not a task map file, a value out of range,
-                a checksum that does not match (the file was changed or damaged).
+                a checksum that does not match (the file was changed or damaged). A file written
+                before maps had a yaw coordinate is read as a map without one whose yaw dependence
+                was never measured (:meth:`warnings` says so).
         """
         z = read_map_file(path)
         s = z["scalars"]
@@ -226,6 +322,7 @@ class TaskMap:
                      "branch_approach": z.get("branch_approach"), "branch_leave": z.get("branch_leave")}
         if "fixture_infeasible" in z:
             extra["fixture_infeasible"] = int(z["fixture_infeasible"].ravel()[0]) if z["fixture_infeasible"].size else -1
+        extra.update(_yaw_members(z, path))
         m = cls(str(z["station"]), z["du"], z["w"], z["approach"], z["leave"], *map(float, s), **extra)
         if "checksum" not in z:
             raise TaskMapError(f"task map file {str(path)!r} has no checksum (written before pinarms checked its "
@@ -245,197 +342,27 @@ def _cell_branches(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(four).any(axis=0), best, -1)
 
 
-def _refine_at(x: np.ndarray, A: np.ndarray, C: np.ndarray, extra: float, tolerance: float, axis: int) -> np.ndarray:
-    """Midpoints of the intervals of grid ``x`` (along ``axis`` of the (nb, nu, nw) tables: 1 du, 2 w)
-    next to a node where some branch's approach or leave time has a second difference above
-    ``4 × tolerance`` of the task time there: bilinear interpolation errs by about a quarter of it
-    at a kink, an eighth on a smooth bend."""
-    mark = np.zeros(x.size - 1, bool)
-    n = x.size
-    for T in (A, C):
-        T, tot = np.moveaxis(T, axis, 1), np.moveaxis(A + C, axis, 1)
-        d2 = np.abs(T[:, :-2] - 2.0 * T[:, 1:-1] + T[:, 2:])  # NaN where a node is infeasible
-        with np.errstate(invalid="ignore"):
-            bent = np.any(d2 > 4.0 * tolerance * (tot[:, 1:-1] + extra), axis=(0, 2))
-        mark[: n - 2] |= bent
-        mark[1:] |= bent
-    return 0.5 * (x[:-1] + x[1:])[mark]
 
 
-def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: int) -> tuple:
-    """Grid ``x`` with ``new`` points, and each (nb, nu, nw) table with its ``added`` slices, sorted."""
-    order = np.argsort(np.concatenate([x, new]), kind="stable")
-    return (np.concatenate([x, new])[order],
-            *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
-
-
-def _fixtures(task: dict) -> Any:
-    """The column's :class:`~.fixtures.FixtureCheck` (None: no cell given)."""
-    if task.get("cell") is None:
-        return None
-    from pinarms.optim.line.fixtures import fixture_check
-
-    return fixture_check(task["cell"], task["station"].name, task["clearance"])
-
-
-def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int]:
-    """Exact times of one ``du`` column (a task of the execution layer), and how many of its
-    planned picks came closer than the clearance to the cell's fixtures (their times NaN)."""
-    st, belt, spec = task["station"], task["belt"], task["spec"]
-    u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
-    q_rest = rest_configuration(st)
-    labels = task.get("branches", (-1,))
-    fixtures = _fixtures(task)
-    blocked = 0
-    tA = np.full((len(labels), len(task["w"])), np.nan)
-    tC = np.full_like(tA, np.nan)
-    for b, label in enumerate(labels):
-        for j, w in enumerate(task["w"]):
-            try:
-                plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
-                                 q_rest=q_rest, branch=None if label < 0 else label)
-            except (UnreachableTarget, InfeasibleProblem, OptimError):
-                continue
-            verdict = "clear" if fixtures is None else fixtures.verdict(plan.trajectory)
-            if verdict != "clear":
-                blocked += verdict == "fixtures"
-                continue
-            tA[b, j], tC[b, j] = plan.times[0], plan.times[2]
-    return tA, tC, blocked
-
-
-def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
-                   item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
-                   du_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   progress: Any = None, refine: int = 0, tolerance: float = 0.005, cell: Any = None,
-                   clearance: float = 0.01) -> TaskMap:
-    """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
-
-    ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
-    ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
-    ``refine``: passes that add a ``du`` column, then a ``w`` row, at the middle of each interval
-    where a branch's approach or leave time bends more than linear interpolation can follow
-    (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
-    between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
-    Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
-    ``cell``: a :class:`robots.cell.Cell` with the station as one of its arms (same name and base):
-    a node whose planned pick (the whole trajectory) comes closer than ``clearance`` [m] to the
-    cell's fixtures is infeasible (:mod:`~.fixtures`; counted in ``TaskMap.fixture_infeasible``).
-
-    Raises:
-        BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
-        UnreachableTarget: the arm cannot reach its box.
-    """
-    from pinarms.execution import map_chunks
-
-    if not (isinstance(nu, int) and isinstance(nw, int) and nu >= 2 and nw >= 2):
-        raise InvalidInput(f"nu and nw must be integers >= 2, got {nu!r}, {nw!r}")
-    check_reach(station, belt, item_height)
-    rest_configuration(station)
-    if cell is not None:
-        from pinarms.optim.line.fixtures import check_in_cell, fixture_check
-
-        check_in_cell(cell, station)
-        fixture_check(cell, station.name, clearance)  # bad clearance: an error before any planning
-    start = time.perf_counter()
-    lo, hi = belt_span(station, belt) if du_range is None else (float(du_range[0]), float(du_range[1]))
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise InvalidInput(f"du_range must be two finite numbers, low < high [m], got {du_range!r}")
-    du = np.linspace(lo, hi, nu)
-    half = belt.width / 2.0 - margin
-    if half <= 0.0:
-        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
-    w = np.linspace(-half, half, nw)
-    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
-    uu, ww = np.meshgrid(u_base + du, w, indexing="ij")
-    labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), item_height + spec.lift))
-    task = {"station": station, "belt": belt, "spec": spec, "w": w.tolist(), "mass": mass, "height": item_height,
-            "seed": 0, "branches": labels, "cell": cell, "clearance": clearance}
-    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler, progress=progress)
-    blocked = sum(c[2] for c in cols)
-    A = np.stack([c[0] for c in cols], axis=1)  # (nb, nu, nw)
-    C = np.stack([c[1] for c in cols], axis=1)
-    extra = spec.track_time + spec.release
-    for _ in range(refine):  # along the belt (new du columns), then across (new w rows)
-        new_u = _refine_at(du, A, C, extra, tolerance, 1)
-        if new_u.size:
-            cols = map_chunks(_column, [{**task, "du": float(d), "w": w.tolist()} for d in new_u], scheduler=scheduler,
-                              progress=progress)
-            blocked += sum(c[2] for c in cols)
-            du, A, C = _merge(du, new_u, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 1)
-        new_w = _refine_at(w, A, C, extra, tolerance, 2)
-        if new_w.size:
-            cols = map_chunks(_column, [{**task, "du": float(d), "w": new_w.tolist()} for d in du], scheduler=scheduler,
-                              progress=progress)
-            blocked += sum(c[2] for c in cols)
-            w, A, C = _merge(w, new_w, (A, C), tuple(np.stack([c[k] for c in cols], axis=1) for k in (0, 1)), 2)
-        if new_u.size == 0 and new_w.size == 0:
-            break
-    tot = A + C
-    best = np.argmin(np.where(np.isfinite(tot), tot, np.inf), axis=0)[None]
-    tA = np.take_along_axis(A, best, 0)[0]
-    tC = np.take_along_axis(C, best, 0)[0]
-    return TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start, labels, A, C, int(blocked))
-
-
-@dataclass(frozen=True, repr=False)
-class MapError:
-    """Interpolated vs exact task time at random feasible points: ``relative`` (n,) errors of
-    the task time (approach + tracking + leave + release), ``max``, ``mean``, ``points`` (n, 2)."""
-
-    relative: np.ndarray
-    points: np.ndarray
-    planning_seconds: float
-
-    @property
-    def max(self) -> float:
-        return float(np.max(self.relative)) if self.relative.size else float("nan")
-
-    @property
-    def mean(self) -> float:
-        return float(np.mean(self.relative)) if self.relative.size else float("nan")
-
-    def __repr__(self) -> str:
-        """One line: how many points, the max, mean and 95th percentile of the relative error [%]."""
-        if not self.relative.size:
-            return f"MapError(0 points, {self.planning_seconds:.1f} s of planning)"
-        p95 = float(np.percentile(self.relative, 95))
-        return (f"MapError({self.relative.size} points, max {100 * self.max:.2f} %, mean {100 * self.mean:.2f} %, "
-                f"p95 {100 * p95:.2f} %, {self.planning_seconds:.1f} s of planning)")
+def _yaw_members(z: dict, path: Any) -> dict[str, Any]:
+    """The yaw fields of a map file's members (none in a file written before maps measured yaw)."""
+    if "yaw_scalars" not in z:
+        if any(k in z for k in ("yaw", "yaw_approach", "yaw_leave")):
+            raise TaskMapError(f"{str(path)!r} is not a task map file: yaw tables without yaw_scalars.npy; "
+                               "rebuild the map")
+        return {}
+    ys = z["yaw_scalars"]
+    if ys.shape != (2,):
+        raise TaskMapError(f"{str(path)!r} is not a task map file: yaw_scalars of shape {ys.shape}, not (2,)")
+    out: dict[str, Any] = {"yaw_period": float(ys[0]), "yaw_spread": float(ys[1])}
+    if "yaw" in z:
+        out.update(yaw=z["yaw"], yaw_approach=z.get("yaw_approach"), yaw_leave=z.get("yaw_leave"))
+    elif "yaw_approach" in z or "yaw_leave" in z:
+        raise TaskMapError(f"{str(path)!r} is not a task map file: yaw tables without a yaw grid; rebuild the map")
+    return out
 
 
 def _span(values: np.ndarray) -> str:
     """``lo..hi`` of the finite values at 3 significant digits (``none`` when none is finite)."""
     finite = np.asarray(values)[np.isfinite(values)]
     return f"{finite.min():.3g}..{finite.max():.3g}" if finite.size else "none"
-
-
-def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
-              n: int = 30, item_height: float = 0.04, seed: int = 0) -> MapError:
-    """Exact re-planning at ``n`` seeded random points where the map says feasible (module doc), each
-    item at a random yaw (the map is built at yaw 0: the hand's turn leaves the time unchanged,
-    tests/optim/line/test_tracking.py)."""
-    rng = np.random.default_rng(seed)
-    u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
-    q_rest = rest_configuration(station)
-    rel, pts = [], []
-    tries = 0
-    start = time.perf_counter()
-    while len(rel) < n and tries < 50 * n:
-        tries += 1
-        du = rng.uniform(task_map.du[0], task_map.du[-1])
-        w = rng.uniform(task_map.w[0], task_map.w[-1])
-        yaw = rng.uniform(-np.pi, np.pi)  # the map has no yaw coordinate: the exact plan turns the hand to it
-        tA, tC = task_map.times(du, w)
-        if not (np.isfinite(tA) and np.isfinite(tC)):
-            continue
-        try:
-            plan = plan_pick(station, belt, spec, u_base + du, w, item_height=item_height, mass=task_map.mass,
-                             q_rest=q_rest, branch=task_map.branch_at(du, w), yaw=yaw)
-        except PinarmsError:
-            continue
-        approx = float(tA + tC) + task_map.track + task_map.release
-        rel.append(abs(approx - plan.duration) / plan.duration)
-        pts.append((du, w))
-    return MapError(np.array(rel), np.array(pts).reshape(-1, 2), time.perf_counter() - start)

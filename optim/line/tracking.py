@@ -137,7 +137,11 @@ def _hand_joints(robot: Any) -> np.ndarray:
 
 def can_yaw(robot: Any) -> bool:
     """Whether the arm can turn its tool about the vertical (a hand joint: SCARA joint 4), i.e. its
-    Jacobian's angular z row is not zero at neutral; a gantry of three slides cannot."""
+    Jacobian's angular z row is not zero at neutral; a gantry of three slides cannot. An arm that says
+    so itself (a ``can_yaw`` attribute: a delta's fourth axis, :class:`~.delta_tracking.DeltaArm`) is taken at its word."""
+    own = getattr(robot, "can_yaw", None)
+    if isinstance(own, bool):
+        return own
     return bool(np.linalg.norm(robot.jacobian(robot.neutral)[5]) > 1e-9)
 
 
@@ -191,8 +195,12 @@ def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int
         return out
     out = np.empty((poses.shape[0], robot.nq))
     prev = q_ref
+    turn = np.asarray(getattr(robot, "continuous", np.zeros(robot.nq, bool)), bool)
     for k in range(poses.shape[0]):
-        out[k] = prev = robot.ik(poses[k], prev)
+        q = robot.ik(poses[k], prev)
+        # the solver wraps continuous joints into (-π, π]: the turn nearest the previous angle keeps the path continuous
+        q[turn] = prev[turn] + (q[turn] - prev[turn] + np.pi) % (2.0 * np.pi) - np.pi
+        out[k] = prev = q
     return out
 
 

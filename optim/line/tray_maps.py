@@ -33,7 +33,9 @@ import numpy as np
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_maps import MapError, TaskMap, _fixtures
+from pinarms.optim.line.task_map_build import _fixtures
+from pinarms.optim.line.task_map_error import MapError
+from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
@@ -253,12 +255,14 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
                    mass: float = 0.1, item_height: float = 0.04, margin: float = 0.025, nu: int = 10, nw: int = 3,
                    nv: int = 8, du_range: tuple[float, float] | None = None,
                    dv_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   approach_map: TaskMap | None = None, cell: Any = None, clearance: float = 0.01) -> TrayMap:
+                   approach_map: TaskMap | None = None, cell: Any = None, clearance: float = 0.01,
+                   progress: Any = None) -> TrayMap:
     """Plan picks placed in trays exactly on a ``nu`` × ``nw`` × ``nv`` grid (module doc); ``du``
     and ``dv`` span the arm's sampled workspace over each belt (or the ranges given [m]).
     ``approach_map``: the same station's box :class:`TaskMap` on this belt (same speed and
     tracking spec; any item mass: the approach carries none), whose finer grid then gives t_A.
-    ``cell``, ``clearance``: as :func:`~.task_maps.build_task_map`'s (the whole pick-to-tray
+    ``progress(done, total)``: ``du`` columns planned. ``cell``, ``clearance``: as
+    :func:`~.task_map_build.build_task_map`'s (the whole pick-to-tray
     trajectory kept ``clearance`` [m] from the cell's fixtures; ``TrayMap.fixture_infeasible``).
 
     Raises:
@@ -293,7 +297,7 @@ def build_tray_map(station: Station, belt: Belt, trays: TrayBelt, spec: Tracking
     labels = ik_branch_labels(station, trays.belt.to_world(vv.ravel(), zz.ravel(), trays.height + spec.lift))
     task = {"station": station, "belt": belt, "trays": trays, "spec": spec, "w": w.tolist(), "dv": dv.tolist(),
             "mass": mass, "height": item_height, "seed": 0, "branches": labels, "cell": cell, "clearance": clearance}
-    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler)
+    cols = map_chunks(_column, [{**task, "du": float(d)} for d in du], scheduler=scheduler, progress=progress)
     A, P = np.stack([c[0] for c in cols]), np.stack([c[3] for c in cols])
     X, R = (np.stack([c[n] for c in cols], axis=1) for n in (1, 2))
     place = spec.descend + spec.release + spec.descend

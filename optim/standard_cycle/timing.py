@@ -61,10 +61,12 @@ def limit_usage(path: JointPathRows, x: np.ndarray, u: np.ndarray, vmax, amax, t
             "torque": float(np.max(np.abs(path.torque_a * uu + path.torque_b * sd ** 2 + path.torque_c) / tmax))}
 
 
-def time_rows(path: JointPathRows, vmax, amax, tmax) -> GateTiming:
-    """Time-optimal rest-to-rest profile along ``path`` under per-joint limits (scalars or (n,))."""
+def time_rows(path: JointPathRows, vmax, amax, tmax, *, sd_start: float = 0.0, sd_end: float = 0.0) -> GateTiming:
+    """Time-optimal profile along ``path`` under per-joint limits (scalars or (n,)), rest to rest, or
+    with the path speed ``sd_start`` / ``sd_end`` [s-units/s] imposed at its ends (a move onto or off a belt)."""
     n_joints = path.dq.shape[1]
     vmax, amax, tmax = (np.broadcast_to(np.asarray(v, dtype=float), (n_joints,)) for v in (vmax, amax, tmax))
-    profile = topp_profile(*_rows(path, vmax, amax, tmax), path.s)
+    profile = topp_profile(*_rows(path, vmax, amax, tmax), path.s, x_start=float(sd_start) ** 2,
+                           x_end=float(sd_end) ** 2)
     return GateTiming(profile.duration, profile.s, profile.sd, profile.u,
                       limit_usage(path, profile.x, profile.u, vmax, amax, tmax))

@@ -206,6 +206,9 @@ def demo_study(quick: bool = False) -> Any:
                         note))
         rows.append(Row("000", f"one SCARA saturated on the belt ({label})", None,
                         d["one_arm_saturated_picks_per_min"], "picks/min", None, "conveyor tracking, box beside the arm"))
+    from pinarms.studies.delta_line import delta_rows
+
+    rows += delta_rows(out["model limits"], 60.0, item=ENOKI, seeds=seeds, duration=600.0)  # SCARA or delta (docs/line.md)
     g = out["gantry"]
     rows.append(Row("002", "gantry fed by a belt: picks/min saturated", 60.0, g["saturated_picks_per_min"], "picks/min",
                     None, f"belt {g['belt_speed_m_s']} m/s, tracking pick, the model's limits (1 m/s per axis); "

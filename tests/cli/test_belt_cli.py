@@ -72,3 +72,22 @@ def test_belt_run_prints_the_results_summary():
                  f"{f.arms[0]}: {100 * f.utilisation[0]:.0f} %", f"{f.arms[1]}: {100 * f.utilisation[1]:.0f} %",
                  "belt speed        0.200 m/s", "status"):
         assert part in text, (part, text)
+
+
+def test_belt_arms_with_a_shipped_delta():
+    """`--robot delta_flexpicker`: deltas above the belt; at 60 bunches/min one misses, two do not."""
+    r = CliRunner().invoke(cli, ["belt", "arms", "--robot", "delta_flexpicker", "--rate", "60", "--seeds", "2",
+                                 "--duration", "120", "--map-grid", "5,3", "--max-arms", "3", "--json"])
+    assert r.exit_code == 0, (r.output, r.exception)
+    data = json.loads(r.stdout)
+    assert data["arms_needed"] == 2 and data["belt_speed_m_s"] == 0.2
+    assert data["figures"]["arms"] == ["delta 1", "delta 2"]
+    assert data["figures"]["miss_rate"] <= 0.01
+
+
+def test_belt_delta_bad_flags_are_one_error_line():
+    for extra, flag in ((["--tcp", "tool"], "--tcp"), (["--paper-limit"], "--paper-limit"),
+                        (["--html", "x.html"], "--html")):
+        r = CliRunner().invoke(cli, ["belt", "run", "--robot", "delta_flexpicker", "--arms", "1", *extra])
+        assert r.exit_code == 1 and flag in r.output and "Traceback" not in r.output, r.output
+        assert r.output.startswith("Error:") and len(r.output.strip().splitlines()) == 1, r.output

@@ -11,7 +11,8 @@ from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
 from pinarms.optim.line.items import ItemType, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.task_maps import TaskMap, build_task_map
+from pinarms.optim.line.task_map_build import build_task_map
+from pinarms.optim.line.task_maps import TaskMap
 from pinarms.robots.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)

@@ -11,7 +11,7 @@ import pytest
 
 from pinarms.optim.line import Belt, ItemType, LineSpec, PlaceBox, Station, Stream, TrackingSpec, run_line
 from pinarms.optim.line.fixtures import FixtureCheck, chord_polyline
-from pinarms.optim.line.task_maps import build_task_map
+from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.tracking import plan_pick
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.cell import Cell
@@ -20,7 +20,7 @@ from pinarms.robots.errors import InvalidInput
 ENOKI = ItemType("enoki bunch", 0.15, (0.12, 0.06, 0.04))
 CLEARANCE = 0.01
 BAND = 0.004
-GRID = dict(mass=0.15, item_height=0.04, nu=6, nw=3, du_range=(-0.2, 0.3))
+GRID = dict(mass=0.15, item_height=0.04, nu=6, nw=3, du_range=(-0.2, 0.3), yaw="none")  # the SCARA: test_yaw_maps.py
 #: a 10 × 15 × 5 cm block standing on the far half of the belt (w < 0) just downstream of the left arm
 BLOCK = """  <link name="block"><collision><origin rpy="0 0 0" xyz="0 0 0"/>
     <geometry><box size="0.10 0.15 0.05"/></geometry></collision></link>
@@ -117,7 +117,7 @@ def test_fast_route_agrees_with_the_exact_check_and_bad_clearance_is_named():
 def test_run_line_with_a_cell_builds_maps_against_it_and_reports_the_count(blocked_line):
     cell, belt, st, before, after = blocked_line
     spec = LineSpec(belt, (st,), Stream("poisson", rate_per_s=20.0 / 60.0, duration=30.0, types=(ENOKI,)), seeds=(0,),
-                    map_grid=(6, 3), cell=cell, clearance=CLEARANCE)
+                    map_grid=(6, 3), cell=cell, clearance=CLEARANCE, map_yaw="none")
     result = run_line(spec)
     (m,) = result.maps["left"]
     assert result.fixture_infeasible == {"left": m.fixture_infeasible}

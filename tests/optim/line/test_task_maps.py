@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from pinarms.optim.line.task_maps import MapError, TaskMap, _refine_at, build_task_map, map_error
+from pinarms.optim.line.task_map_build import _refine_at, build_task_map
+from pinarms.optim.line.task_map_error import MapError, map_error
+from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.optim.line.windows import window_of
 
@@ -12,7 +14,8 @@ from pinarms.optim.line.windows import window_of
 def small_map(scara_line):
     belt, station = scara_line
     # part of the window (0.04 m grid along, 0.05 m across): a few seconds to build
-    return build_task_map(station, belt, TrackingSpec(), nu=6, nw=3, du_range=(0.0, 0.2), margin=0.075)
+    # yaw="none": the SCARA's independence of yaw is measured in test_yaw_maps.py
+    return build_task_map(station, belt, TrackingSpec(), nu=6, nw=3, du_range=(0.0, 0.2), margin=0.075, yaw="none")
 
 
 def test_map_nodes_are_exact_plans(scara_line, small_map):

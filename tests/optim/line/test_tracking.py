@@ -142,3 +142,22 @@ def test_belt_too_fast_says_which_descend_fixes_it():
     assert 0.25 < descend < 0.4
     plan = plan_pick(station, belt, TrackingSpec(descend=descend), 1.05, -0.05, item_height=0.04)
     assert plan.tracking.peaks().acceleration[2] <= 2.0 * (1 + 1e-9)
+
+
+@pytest.mark.slow
+def test_a_continuous_wrist_stays_on_one_turn_through_the_tracking_segment():
+    """The Kinova Jaco2 (example-robot-data; joints 1, 4, 6 continuous): its numeric IK returns each
+    continuous angle in (-π, π], so a wrist near ±π jumped a whole turn between two samples of the
+    tracking segment (joint 6 at 1.31e4 rad/s², the pick infeasible). Each sample now takes the turn
+    nearest the previous one: the tracking segment is smooth and within the limits."""
+    from pinarms.robots.registry import _example_robot_data_share
+
+    share = _example_robot_data_share()
+    jaco = robots.from_urdf(share / "robots" / "kinova_description" / "robots" / "kinova.urdf",
+                            tcp="j2s6s200_end_effector", package_dirs=(str(share.parent),))
+    belt = Belt((0.0, 0.0, 0.80), speed=0.1, width=0.3, length=2.0)
+    station = Station("jaco", jaco, base_pose(1.0, 0.40, 0.80), PlaceBox((0.9, 0.65, 0.95), "box"))
+    plan = plan_pick(station, belt, TrackingSpec(descend=0.6), 1.0, 0.05, item_height=0.04, mass=0.1)
+    q = plan.tracking.sample(np.linspace(0.0, plan.tracking.duration, 200))[0]
+    assert np.abs(np.diff(q, axis=0)).max() < 0.1  # no jump of a turn between two samples
+    assert np.all(plan.tracking.peaks().acceleration <= station.limits["amax"] * (1 + 1e-9))

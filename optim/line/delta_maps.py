@@ -1,0 +1,158 @@
+"""Task maps of a delta above the belt: the same :class:`~.task_maps.TaskMap` the simulator reads.
+
+:func:`build_delta_map` plans the delta's pick (:func:`~.delta_tracking.delta_pick_times`) at
+every node of a ``nu`` × ``nw`` grid of pre-grasp points: ``du`` along the belt over the span the
+delta reaches at the pre-grasp height (the closed-form IK within the motors' range, sampled every
+5 mm), ``w`` across the belt less ``margin`` at each edge. One IK branch (the primary: every elbow
+outward), so the map has no branch tables.
+
+The item's yaw: the fourth axis turns the tool during the approach and back during the leave,
+each taking the longer of the platform's and the tool's time (:func:`~.delta_tracking.tool_turn_time`,
+exact, not planned). The spread over yaw (:attr:`TaskMap.yaw_spread`: largest relative change of the
+task time against yaw 0 over every node and yaw node) is measured on every node; above
+:data:`~.task_maps.YAW_TOLERANCE` the map holds ``yaw_nodes`` yaw layers (linear between them; the
+tool time bends where it overtakes the platform's, hence many nodes: they cost nothing to compute).
+A delta without the fourth axis grasps at its own yaw: spread 0, no yaw coordinate.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from pinarms.optim.errors import InfeasibleProblem
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.delta_tracking import DeltaArm, delta_pick_times, tool_turn_time
+from pinarms.optim.line.errors import BeltOutOfReach
+from pinarms.optim.line.station import Station
+from pinarms.optim.line.task_map_error import MapError
+from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
+from pinarms.optim.line.tracking import TrackingSpec
+from pinarms.robots.delta import inverse_position
+from pinarms.robots.errors import InvalidInput
+
+__all__ = ["build_delta_map", "delta_span", "yaw_layers", "delta_map_error"]
+
+_SPAN_STEP = 0.005  # [m] sampling of the reach along the belt
+
+
+def delta_span(station: Station, belt: Belt, height: float, w: np.ndarray) -> tuple[float, float]:
+    """(low, high) [m] of ``du`` (from the base along the belt) where the platform reaches a point at
+    ``height`` [m] above the belt at every ``w`` (IK within the motors' range).
+
+    Raises:
+        BeltOutOfReach: no such point."""
+    arm: DeltaArm = station.robot
+    u0 = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    du = np.arange(-2.5, 2.5 + 1e-9, _SPAN_STEP)
+    ok = np.ones(du.size, bool)
+    lim = arm.delta.limits
+    for wi in w:
+        p = station.world_to_base(belt.to_world(u0 + du, np.full(du.size, wi), height)) - arm.tcp_offset
+        q = inverse_position(arm.delta.geometry, p)
+        with np.errstate(invalid="ignore"):
+            ok &= np.all(np.isfinite(q) & (q >= lim.lower) & (q <= lim.upper), axis=1)
+    if not ok.any():
+        raise BeltOutOfReach(f"arm {station.name!r} ({arm.name}) reaches no point {height:.3f} m above the belt across "
+                             f"w = {float(w[0]):.3f} .. {float(w[-1]):.3f} m: lower its base or bring it over the belt")
+    idx = np.flatnonzero(ok)
+    return float(du[idx[0]]), float(du[idx[-1]])
+
+
+def yaw_layers(arm: DeltaArm, approach: np.ndarray, leave: np.ndarray, yaw: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """(ny, nu, nw) approach and leave times at each tool yaw: the longer of the platform's and the
+    fourth axis' (module doc)."""
+    v, a = float(arm.velocity_limit[3]), float(arm.acceleration_limit[3])
+    turn = np.array([tool_turn_time(y, v, a) for y in yaw])[:, None, None]
+    return np.maximum(approach[None], turn), np.maximum(leave[None], turn)
+
+
+def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.0,
+                    item_height: float = 0.04, margin: float = 0.025, nu: int = 12, nw: int = 5, n: int = 24,
+                    yaw_nodes: int = 33, progress: Any = None) -> TaskMap:
+    """The delta's task map (module doc); ``n`` TOPP grid intervals per move; ``progress(done, total)``
+    after each du column.
+
+    Raises:
+        InvalidInput: a grid size or margin out of its domain, a station without a delta.
+        BeltOutOfReach: the delta reaches no pick on the belt."""
+    if not isinstance(station.robot, DeltaArm):
+        raise InvalidInput(f"station {station.name!r} holds no delta (optim.line.delta_tracking.DeltaArm)")
+    for name, value, low in (("nu", nu, 2), ("nw", nw, 2), ("n", n, 4), ("yaw_nodes", yaw_nodes, 3)):
+        if not (isinstance(value, int) and value >= low):
+            raise InvalidInput(f"{name} must be an integer >= {low}, got {value!r}")
+    if yaw_nodes % 2 != 1:
+        raise InvalidInput(f"yaw_nodes must be odd (0 is the middle node), got {yaw_nodes}")
+    half = belt.width / 2.0 - margin
+    if not half > 0.0:
+        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
+    start = time.perf_counter()
+    w = np.linspace(-half, half, nw)
+    lo, hi = delta_span(station, belt, item_height + spec.lift, w)
+    du = np.linspace(lo, hi, nu)
+    u0 = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    A, C = np.full((nu, nw), np.nan), np.full((nu, nw), np.nan)
+    for i, d in enumerate(du):
+        for j, wj in enumerate(w):
+            try:
+                A[i, j], C[i, j] = delta_pick_times(station, belt, spec, u0 + d, wj, mass=mass,
+                                                    item_height=item_height, n=n)
+            except InfeasibleProblem:
+                pass
+        if progress is not None:
+            progress(i + 1, nu)
+    if not np.isfinite(A).any():
+        raise BeltOutOfReach(f"arm {station.name!r}: no pick on the belt is feasible at {belt.speed} m/s "
+                             f"(slow the belt or lengthen the tracking's descend)")
+    extra = spec.track_time + spec.release
+    fields: dict[str, Any] = {"yaw_spread": 0.0}
+    if station.robot.can_yaw:
+        yaw = np.linspace(-spec.yaw_period / 2.0, spec.yaw_period / 2.0, yaw_nodes)
+        yaw[yaw_nodes // 2] = 0.0
+        YA, YC = yaw_layers(station.robot, A, C, yaw)
+        with np.errstate(invalid="ignore"):
+            rel = np.abs(YA + YC - A - C) / (A + C + extra)
+        spread = float(np.nanmax(rel)) if np.isfinite(rel).any() else 0.0
+        fields = {"yaw_spread": spread}
+        if spread > YAW_TOLERANCE:
+            fields.update(yaw=yaw, yaw_approach=YA[:, None], yaw_leave=YC[:, None])
+    return TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass),
+                   time.perf_counter() - start, yaw_period=spec.yaw_period, **fields)
+
+
+def delta_map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
+                    n: int = 30, item_height: float = 0.04, seed: int = 0, grid: int = 24) -> MapError:
+    """The map against exact timing (:func:`~.delta_tracking.delta_pick_times` with ``grid`` TOPP intervals,
+    the tool's turn exact) at ``n`` seeded random feasible points, each item at a random yaw (as
+    :func:`~.task_map_error.map_error` does for serial arms)."""
+    rng = np.random.default_rng(seed)
+    arm: DeltaArm = station.robot
+    u0 = float(belt.to_belt(station.base_to_world[:3, 3])[0])
+    period = spec.yaw_period
+    rel, pts, yaws = [], [], []
+    start = time.perf_counter()
+    for _ in range(50 * n):
+        if len(rel) >= n:
+            break
+        du, w = rng.uniform(task_map.du[0], task_map.du[-1]), rng.uniform(task_map.w[0], task_map.w[-1])
+        yaw = rng.uniform(-np.pi, np.pi)
+        tA, tC = task_map.times(du, w, yaw)
+        if not (np.isfinite(tA) and np.isfinite(tC)):
+            continue
+        try:
+            a, c = delta_pick_times(station, belt, spec, u0 + du, w, mass=task_map.mass, item_height=item_height,
+                                    n=grid)
+        except InfeasibleProblem:
+            continue
+        tool = (yaw + period / 2.0) % period - period / 2.0 if arm.can_yaw else 0.0
+        if arm.can_yaw:
+            turn = tool_turn_time(tool, float(arm.velocity_limit[3]), float(arm.acceleration_limit[3]))
+            a, c = max(a, turn), max(c, turn)
+        exact = a + c + task_map.track + task_map.release
+        rel.append(abs(float(tA + tC) + task_map.track + task_map.release - exact) / exact)
+        pts.append((du, w))
+        yaws.append(tool)
+    return MapError(np.array(rel), np.array(pts).reshape(-1, 2), time.perf_counter() - start, np.array(yaws), period)

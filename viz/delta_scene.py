@@ -1,0 +1,132 @@
+"""A delta robot drawn and animated as its closed chain: upper arms, the six rods, the platform.
+
+The URDF's forearm is the mid-line of each parallelogram (docs/delta.md), not a body: the page
+draws the two rods of every leg from :func:`pinarms.robots.delta.rod_endpoints` (the ball centres
+of the tree at the closed configuration :meth:`DeltaRobot.configuration`), each upper arm from its
+motor axis to its elbow (:func:`~pinarms.robots.delta.elbow_positions`) and the platform at the
+closed-form forward position (:func:`~pinarms.robots.delta.forward_position`).
+
+Scene paths, under ``pinarms/deltas/<name>``: ``upper_arm_<i>``, ``rod_<i><a|b>`` (cylinders,
+MeshCat's axis y along the part), ``platform`` (a disk), sized as the collision bodies
+(:mod:`pinarms.robots.delta.collision`). :func:`delta_poses` gives their world
+transforms per frame (the scene data; no viewer needed); :func:`draw_delta` and
+:func:`animate_delta` put them in a MeshCat scene; :func:`delta_page` writes one standalone page.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pinarms.files import atomic_write
+from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position, rod_endpoints
+from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
+from pinarms.robots.errors import InvalidInput
+
+from ._meshcat import meshcat, mg
+
+__all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT"]
+
+#: Scene folder of the deltas.
+DELTA_ROOT = "pinarms/deltas"
+_COLORS = {"upper_arm": 0x4A6FA5, "rod": 0xC8C8C8, "platform": 0x8C8C8C}
+
+
+def _segment(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """(F, 4, 4): a rigid frame at the segment's middle whose y axis runs p0 → p1."""
+    d = p1 - p0
+    y = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    helper = np.where(np.abs(y[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    x = np.cross(y, helper)
+    x /= np.linalg.norm(x, axis=-1, keepdims=True)
+    z = np.cross(x, y)
+    T = np.zeros(p0.shape[:-1] + (4, 4))
+    T[..., :3, 0], T[..., :3, 1], T[..., :3, 2], T[..., :3, 3], T[..., 3, 3] = x, y, z, 0.5 * (p0 + p1), 1.0
+    return T
+
+
+def delta_parts(delta: DeltaRobot) -> dict[str, tuple[str, float, float]]:
+    """``{part: (kind, length [m], radius [m])}`` of every drawn part (kind: upper_arm, rod, platform)."""
+    g = delta.geometry
+    parts = {f"upper_arm_{i}": ("upper_arm", g.upper_arm, PART_RADII["upper_arm"]) for i in (1, 2, 3)}
+    parts.update({f"rod_{i}{r}": ("rod", g.forearm, PART_RADII["rod"]) for i in (1, 2, 3) for r in "ab"})
+    parts["platform"] = ("platform", PLATFORM_THICKNESS, g.platform_radius + 0.5 * g.rod_spacing)
+    return parts
+
+
+def delta_poses(delta: DeltaRobot, theta: Any, base_to_world: Any = None) -> dict[str, np.ndarray]:
+    """World transforms (F, 4, 4) of every part (module doc) at motor angles ``theta`` (F, 3) [rad].
+
+    Raises:
+        InvalidInput: ``theta`` not (F, 3) finite, or a row the delta cannot assemble."""
+    th = np.asarray(theta, dtype=float)
+    if th.ndim != 2 or th.shape[1] != 3 or not np.all(np.isfinite(th)):
+        raise InvalidInput(f"theta must be (F, 3) finite motor angles [rad], got shape {th.shape}")
+    T = np.eye(4) if base_to_world is None else np.asarray(base_to_world, dtype=float)
+    p = forward_position(delta.geometry, th)
+    if not np.all(np.isfinite(p)):
+        raise InvalidInput(f"{delta.name}: motor angles in row {int(np.flatnonzero(~np.isfinite(p[:, 0]))[0])} "
+                           "do not assemble (the forearms' spheres do not meet)")
+    rods = rod_endpoints(delta, delta.configuration(th))  # (F, 3 legs, 2 rods, 2 ends, 3), base frame
+    elbows = elbow_positions(delta.geometry, th)          # (F, 3, 3)
+    motors = delta.geometry.base_radius * delta.geometry.radial  # (3, 3)
+    out: dict[str, np.ndarray] = {}
+    for i in range(3):
+        out[f"upper_arm_{i + 1}"] = _segment(np.broadcast_to(motors[i], elbows[:, i].shape), elbows[:, i])
+        for r, tag in enumerate("ab"):
+            out[f"rod_{i + 1}{tag}"] = _segment(rods[:, i, r, 0], rods[:, i, r, 1])
+    plat = np.zeros((th.shape[0], 4, 4))
+    plat[:, :3, :3] = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]  # the disk's axis (y) vertical
+    plat[:, :3, 3], plat[:, 3, 3] = p, 1.0
+    out["platform"] = plat
+    return {k: T[None] @ v for k, v in out.items()}
+
+
+def draw_delta(vis: Any, name: str, delta: DeltaRobot, poses: dict[str, np.ndarray]) -> str:
+    """Draw the parts of ``delta`` under ``DELTA_ROOT/name`` at the first frame of ``poses``; return the folder."""
+    root = f"{DELTA_ROOT}/{name}"
+    for part, (kind, length, radius) in delta_parts(delta).items():
+        node = vis[f"{root}/{part}"]
+        node.set_object(mg.Cylinder(length, radius), mg.MeshLambertMaterial(color=_COLORS[kind]))
+        node.set_transform(poses[part][0])
+    return root
+
+
+def animate_delta(anim: Any, vis: Any, root: str, poses: dict[str, np.ndarray]) -> None:
+    """One animation frame per row of ``poses`` (the animation's frame rate sets the time)."""
+    frames = next(iter(poses.values())).shape[0]
+    for k in range(frames):
+        with anim.at_frame(vis, k) as frame:
+            for part, T in poses.items():
+                frame[f"{root}/{part}"].set_transform(T[k])
+
+
+def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 30.0, title: str | None = None,
+               base_to_world: Any = None) -> Path:
+    """A standalone page (HTML, written atomically) of ``delta`` moving through ``theta`` (F, 3) [rad],
+    one row a frame at ``fps``; return the path."""
+    from .page import PAGE_PROPERTY, with_page
+    from .scene import ROOT
+    from .server import MeshcatServer
+
+    poses = delta_poses(delta, theta, base_to_world)
+    frames = next(iter(poses.values())).shape[0]
+    centre = poses["platform"][:, :3, 3].mean(axis=0)
+    page = {"title": title or f"{delta.name}: the closed chain", "lines": [f"{delta.name}: {frames} frames"],
+            "target": centre.tolist(), "camera": (centre + [1.6, -1.6, 1.0]).tolist(),
+            "animation": {"duration": (frames - 1) / fps, "playing": True}}
+    with MeshcatServer() as server, contextlib.redirect_stdout(io.StringIO()):
+        vis = server.visualizer
+        root = draw_delta(vis, delta.name, delta, poses)
+        anim = meshcat.animation.Animation(default_framerate=fps)
+        animate_delta(anim, vis, root, poses)
+        vis.set_animation(anim, play=True, repetitions=float("inf"))
+        vis[ROOT].set_property(PAGE_PROPERTY, json.dumps(page))
+        text = with_page(server.static_html(), page["title"])
+    data = text.encode("utf-8")
+    return atomic_write(path, lambda f: f.write(data))
