@@ -10,7 +10,7 @@ candidate base placements ``(x, y, z, yaw)`` of the arm's base frame in the line
    batched closed-form IK over all candidates: a candidate with a point beyond reach is
    ``"unreachable"``, one whose point is within reach but needs a joint outside its limits
    is ``"joint limit"`` (both named with the point);
-2. plans the time-optimal cycle (:func:`optim.plan_cycle`, ``method="exact"``) of every
+2. plans the time-optimal cycle (:func:`pinarms.optim.plan_cycle`, ``method="exact"``) of every
    (pick, place) pair: IK branch, moves, dwells; ``picks_per_minute = 60 / mean cycle time``
    over the pairs (a line cycling through them); a failing plan is classified the same way
    (``"timing"`` when no timing meets the limits); with ``bound=True`` in increasing order of a
@@ -149,9 +149,9 @@ def _cell_target(robot: Any, arm: str | None, clearance: float, carry: tuple[str
         number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
         for name in carry:
             cell.fixture(name)
-        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
-                             tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
-                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(arm),
+        recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell.base_dir),
+                             tuple(sorted((k, str(v)) for k, v in cell.packages.items())),
+                             tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell.seed), str(arm),
                              tuple(carry), float(clearance), tuple(cell.arm_placements))
         _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
         return robot, recipe
@@ -163,7 +163,7 @@ def _cell_target(robot: Any, arm: str | None, clearance: float, carry: tuple[str
 def _checked_inputs(picks: Any, places: Any, candidates: Any, kind: str, counts: dict[str, int],
                     orientation: Any, lift: float, dwell: float,
                     min_margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """Points, candidates, orientation and counts of a search, checked before any work (:mod:`optim.caps`)."""
+    """Points, candidates, orientation and counts of a search, checked before any work (:mod:`pinarms.optim.caps`)."""
     picks_w, places_w = _points(picks, "picks"), _points(places, "places")
     cand = np.asarray(candidates, dtype=float) if not isinstance(candidates, str) else np.zeros(0)
     if cand.ndim != 2 or cand.shape[1] != 4 or cand.shape[0] == 0 or not np.all(np.isfinite(cand)):
@@ -325,22 +325,22 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
     """Rank base placements of ``robot`` by the picks per minute of its pick-and-place cycle.
 
     Args:
-        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
+        robot: a :class:`pinarms.robots.Robot` (the arm to place), or a :class:`pinarms.robots.cell.Cell`:
             then the arm ``arm`` of the cell (its only arm by default) is moved among the
             cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
             the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
             must keep ``clearance`` [m] from the fixtures and the other arms
-            (:func:`optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
+            (:func:`pinarms.optim.plan_cycle` with ``cell=``: re-planned with a higher lift or via
             points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
             ``screen``: each re-planning attempt is first screened by exact distances at its
-            via points and a few timed states (:class:`optim.CellSettings`; proofs of failure
+            via points and a few timed states (:class:`pinarms.optim.CellSettings`; proofs of failure
             only, so the same verdicts; ``False``: every attempt timed and checked in full).
         picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
             paired with every place.
         candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
             [m, rad] (:func:`grid_candidates`, :func:`random_candidates`).
-        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`optim.PickPlace` and
-            :func:`optim.plan_cycle`).
+        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`pinarms.optim.PickPlace` and
+            :func:`pinarms.optim.plan_cycle`).
         orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
             the robot's (tool down for six-axis arms), in its base frame.
         min_margin: smallest boundary margin [m] a pick or place may have; candidates below
@@ -354,7 +354,7 @@ def search_layout(robot: Any, picks: Any, places: Any, candidates: Any, *, lift:
             for a six-axis arm).
         scheduler, progress: see :func:`pinarms.execution.map_chunks` (progress counts the
             candidate tasks, then the refinement tasks).
-        bound: branch and bound (:mod:`optim.layout.bound`): the candidates are planned in
+        bound: branch and bound (:mod:`pinarms.optim.layout.bound`): the candidates are planned in
             increasing order of a proven lower bound of their cycle time, and those that cannot
             reach the first ``max(1, refine)`` places of the ranking are not planned (they fail
             as ``"outranked"``): the best placement, the refinement starts and every planned

@@ -35,7 +35,7 @@ threshold per pair, which configurations are **proven** to keep every pair farth
 than its threshold: the distance between two covers (or a cover and an exact fixture) is a
 lower bound of the geometries' distance. The rest is *inconclusive*: the exact check (coal)
 decides them. Forward kinematics of the batch and the screen run compiled (numba, cached
-like :mod:`robots.ik._kernel`). Distances in m, the world frame.
+like :mod:`pinarms.robots.ik._kernel`). Distances in m, the world frame.
 """
 
 from __future__ import annotations
@@ -377,16 +377,17 @@ class PairSet:
 
 
 def _fk_arrays(cell: Any) -> tuple:
-    bp = cell._placements
+    bp = cell.batched_placements
     return (np.asarray(bp.parent, dtype=np.int64), np.asarray(bp.index, dtype=np.int64), bp.scale.copy(),
             bp.offset.copy(), bp.revolute.copy(), bp.axis.copy(), bp.M_R.copy(), bp.M_p.copy())
 
 
 def link_cover(cell: Any) -> Cover:
-    """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell)."""
-    cached = getattr(cell, "_sphere_cover", None)
-    if cached is not None:
-        return cached
+    """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell: :meth:`Cell.memo`)."""
+    return cell.memo("sphere cover", lambda: _build_cover(cell))
+
+
+def _build_cover(cell: Any) -> Cover:
     objs = list(cell.collision_model.geometryObjects)
     G = len(objs)
     start = np.zeros(G + 1, dtype=np.int64)
@@ -409,7 +410,6 @@ def link_cover(cell: Any) -> Cover:
     if TABLES:  # an arm's own pairs close in the chain that the spheres leave loose get distance tables
         own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
         cover = replace(cover, tables=pair_tables(cell, own, cover))
-    cell._sphere_cover = cover
     return cover
 
 

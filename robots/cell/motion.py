@@ -48,7 +48,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -62,8 +62,7 @@ from .speed_bound import joint_levers, speed_profile, travel_stops
 from .timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
                        motion_window, sample_motions)
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from .cell_model import CellModel
 
 __all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers", "motion_window", "sample_motions"]
 
@@ -78,7 +77,7 @@ MAX_BISECTIONS = 64
 
 # ------------------------------------------------------------------ the check
 def check_motion(
-    cell: "Cell",
+    cell: "CellModel",
     motions: Any,
     *,
     margin: float = 0.01,
@@ -105,7 +104,7 @@ def check_motion(
             clearance-over-time plot draws.
         cover: screen the samples on the sphere cover before the broad phase (same verdicts,
             faster); ``False``: the broad phase and coal alone — a check that shares no code
-            with the cover, as :func:`optim.plan_motion`'s re-check of a path the cover proved.
+            with the cover, as :func:`pinarms.optim.plan_motion`'s re-check of a path the cover proved.
 
     Raises:
         InvalidInput: an unknown arm, a trajectory of the wrong width, bad numbers, or a
@@ -119,9 +118,9 @@ def check_motion(
     screen = required + margin
     # every pair not proven farther than the screen distance (Cell.pairs_for): the pairs left
     # out keep a distance above `screen` >= `required` in every configuration
-    n_pairs = cell._n_for(screen + 1e-6)
-    pairs = cell._candidates[:n_pairs]
-    left_out = cell._reach_bounds[n_pairs - len(cell.pairs):]
+    n_pairs = cell.pair_count(screen + 1e-6)
+    pairs = cell.candidates[:n_pairs]
+    left_out = cell.reach_bounds[n_pairs - len(cell.pairs):]
     samples = _Samples(cell, motions, hold_q, n_pairs, bool(cover))
     d = samples.screen(schedule.times, screen, curve)
     lower, unresolved = _prove(schedule, d, required, samples)
@@ -174,7 +173,7 @@ class _Schedule:
         return np.interp(tb, self.grid, self.budget) - np.interp(ta, self.grid, self.budget)
 
 
-def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, margin: float) -> _Schedule:
+def _schedule(cell: "CellModel", motions: list[ArmMotion], t0: float, t1: float, margin: float) -> _Schedule:
     """A fine grid at the global speed bound's step, then a sample every ``margin`` of approach budget.
 
     Raises:
@@ -202,7 +201,7 @@ def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, marg
 class _Samples:
     """Every sample of one check: time [s], smallest distance [m], closest pair (−1: screened), exact or not."""
 
-    def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
+    def __init__(self, cell: "CellModel", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
                  cover: bool = True) -> None:
         self.cell, self.motions, self.hold_q, self.n_pairs, self.cover = cell, motions, hold_q, n_pairs, cover
         self.t: list = []
@@ -264,14 +263,14 @@ class _Samples:
 COVER_ROWS = 8
 
 
-def _cover_pairs(cell: "Cell", n_pairs: int) -> tuple[Any, Any]:
+def _cover_pairs(cell: "CellModel", n_pairs: int) -> tuple[Any, Any]:
     """The cell's sphere cover and its :class:`.cover.PairSet` of the first ``n_pairs`` candidates (kept with the cell)."""
     from .cover import link_cover, pair_arrays
 
-    # keyed by the pairs themselves: a view of the cell (Cell.only) shares this dict, not its pairs
-    pair_a, pair_b = pair_arrays(cell._candidates[:n_pairs])
+    # keyed by the pairs themselves: a cell of fewer pairs (Cell.with_pairs) shares this dict, not its pairs
+    pair_a, pair_b = pair_arrays(cell.candidates[:n_pairs])
     key = (pair_a.tobytes(), pair_b.tobytes())
-    cache = cell.__dict__.setdefault("_motion_cover_pairs", {})
+    cache = cell.memo("motion cover pairs", dict)
     if key not in cache:
         cover = link_cover(cell)
         cache[key] = (cover, cover.prepare(pair_a, pair_b))
@@ -400,15 +399,15 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
     exact_d = np.where(exact, d, np.inf)
     i = _earliest_of_smallest(t, exact_d)
     if exact_d[i] < screen:
-        return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
-    n_all, n0 = len(cell._candidates), len(cell.pairs)
+        return float(d[i]), float(t[i]), cell.candidates[int(k[i])]
+    n_all, n0 = len(cell.candidates), len(cell.pairs)
     if n_all == 0:
         return float("inf"), float(t[0]), None
 
     def bounds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Q = samples.configurations(t[rows])
         lb = pair_lower_bounds(cell, Q)
-        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell.reach_bounds)
         return Q, lb
 
     row_lb = np.concatenate([_row_bounds(samples, t[a:a + BOUND_ROWS], bounds, np.arange(a, min(a + BOUND_ROWS, t.size)))
@@ -427,7 +426,7 @@ def _smallest(samples: _Samples, t: np.ndarray, d: np.ndarray, k: np.ndarray, ex
         found_d[rows], found_k[rows] = dist, pair
         best = min(best, float(np.min(dist)))
     i = _earliest_of_smallest(t, found_d)
-    return float(found_d[i]), float(t[i]), cell._candidates[int(found_k[i])] if found_k[i] >= 0 else None
+    return float(found_d[i]), float(t[i]), cell.candidates[int(found_k[i])] if found_k[i] >= 0 else None
 
 
 #: Distances [m] closer than this to the smallest count as ties: the earliest sample of them is
@@ -450,6 +449,6 @@ def _row_bounds(samples: _Samples, ts: np.ndarray, bounds: Any, rows: np.ndarray
     ``cover=False`` shares no code with the cover, its minimum included.
     """
     if samples.cover and ts.size >= COVER_ROWS:
-        cover, pair_set = _cover_pairs(samples.cell, len(samples.cell._candidates))
-        return cover.excess(samples.configurations(ts), pair_set, np.zeros(len(samples.cell._candidates)))
+        cover, pair_set = _cover_pairs(samples.cell, len(samples.cell.candidates))
+        return cover.excess(samples.configurations(ts), pair_set, np.zeros(len(samples.cell.candidates)))
     return bounds(rows)[1].min(axis=1)
