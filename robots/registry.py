@@ -190,7 +190,7 @@ def _kinematics(robot: Robot) -> tuple[tuple[int, ...], np.ndarray]:
     Returns ``(integers, floats)``: parents, kinds and coordinate indices; then every
     joint's placement and axis, mimic multiplier and offset, the limits and the tcp.
     """
-    tree, model = robot._tree, robot.model
+    tree, model = robot.kinematic_tree, robot.model
     n = model.njoints
     ints = (n, *tree.parent.tolist(), *tree.kind.tolist(), *tree.q_index.tolist())
     place = [np.asarray(model.jointPlacements[i].homogeneous[:3]).ravel() for i in range(1, n)]
@@ -255,7 +255,7 @@ def from_urdf_text(
     """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
 
     Its closed-form IK, when its kinematic structure matches a family, is attached
-    (:func:`robots.ik.recognise`; ``robot.ik_family``).
+    (:func:`pinarms.robots.ik.recognise`; ``robot.ik_family``).
 
     Raises:
         InvalidInput: ``urdf_text`` is not a string.
@@ -326,7 +326,7 @@ def from_urdf(
         package_dirs: folders that resolve ``package://`` mesh paths (for the viewer).
         freeze: joints to fix at zero (e.g. gripper fingers).
         declare: pairs of links in contact by design, ``(link1, link2, reason)``, added as
-            ``<disable_collisions>`` elements (:class:`~robots.SelfCollision` skips them).
+            ``<disable_collisions>`` elements (:class:`~pinarms.robots.SelfCollision` skips them).
 
     Raises:
         ModelError: the file is missing, not a regular file, larger than :data:`MAX_URDF_BYTES`,

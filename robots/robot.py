@@ -61,7 +61,7 @@ class _PerThread(threading.local):
 class Robot(RobotIK):
     """A robot arm: Pinocchio model plus batched kinematics.
 
-    Build one with :func:`robots.load` (by name) or :func:`robots.from_urdf` (any URDF).
+    Build one with :func:`pinarms.robots.load` (by name) or :func:`pinarms.robots.from_urdf` (any URDF).
 
     Attributes:
         name: registry name, or the URDF's robot name.
@@ -193,6 +193,11 @@ class Robot(RobotIK):
             from .ik import attach_analytic_ik  # the closed form was proven for the old tcp: recognise again
 
             attach_analytic_ik(self)
+
+    @property
+    def kinematic_tree(self) -> KinematicTree:
+        """The joint tree behind batched FK and Jacobians (:class:`~pinarms.robots.kinematic_tree.KinematicTree`)."""
+        return self._tree
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame`` (``"tcp"`` means :attr:`tcp_frame`)."""
@@ -381,20 +386,20 @@ class Robot(RobotIK):
 
         Returns:
             a float for one ``q (nq,)``, an array ``(N,)`` for a batch
-            (:func:`robots.manipulability.manipulability_of_jacobian`).
+            (:func:`pinarms.robots.manipulability.manipulability_of_jacobian`).
         """
         return manipulability_of_jacobian(self.jacobian(q, frame), part)
 
     # --------------------------------------------------------------- dynamics
-    #: The :class:`robots.payload.Payload` this robot carries (``None``: the bare arm).
+    #: The :class:`pinarms.robots.payload.Payload` this robot carries (``None``: the bare arm).
     payload = None
 
     def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
         """A copy of this robot carrying a payload (this robot is unchanged).
 
-        ``mass`` [kg] (or a :class:`robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
+        ``mass`` [kg] (or a :class:`pinarms.robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
         (default the tcp), ``inertia`` (3, 3) [kg·m²] about the centre of mass (default a point
-        mass). See :func:`robots.payload.with_payload`.
+        mass). See :func:`pinarms.robots.payload.with_payload`.
         """
         from .payload import with_payload
 
@@ -403,7 +408,7 @@ class Robot(RobotIK):
     def inverse_dynamics(self, q: Any, qd: Any, qdd: Any) -> np.ndarray:
         """Joint torques [N·m or N] for ``q, qd, qdd`` (each (nq,) or (N, nq)), by Pinocchio's RNEA.
 
-        See :func:`robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
+        See :func:`pinarms.robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
         mapped onto the independent joints).
         """
         from .dynamics import inverse_dynamics

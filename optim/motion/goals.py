@@ -41,7 +41,7 @@ def closed_form(robot: Any) -> Any:
         try:
             attach_analytic_ik(robot, family)
         except ModelError:
-            robot._analytic_ik = None
+            robot.set_analytic_ik(None)
     return robot
 
 
@@ -99,7 +99,7 @@ def ik_candidates(robot: Any, T_base: np.ndarray, q_ref: np.ndarray, *, seed: in
                   attempts: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``(k, nq)`` reaching ``T_base`` (arm base frame) and their branch labels ``(k,)``.
 
-    A closed-form arm: every branch once (:meth:`robots.Robot.ik_branches`, each angle at its
+    A closed-form arm: every branch once (:meth:`pinarms.robots.Robot.ik_branches`, each angle at its
     2π equivalent nearest ``q_ref``). Otherwise the numerical solver from ``q_ref`` and from
     ``attempts − 1`` seeded random starts, distinct solutions only (1e-3 rad apart), branch −1.
     """

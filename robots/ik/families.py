@@ -1,7 +1,7 @@
 """The closed-form solver class of each arm family, by family name.
 
-Its own module so that :func:`robots.ik.recognise` and the package's
-:func:`robots.ik.analytic_solver` read the same table without importing each other.
+Its own module so that :func:`pinarms.robots.ik.recognise` and the package's
+:func:`pinarms.robots.ik.analytic_solver` read the same table without importing each other.
 """
 
 from __future__ import annotations

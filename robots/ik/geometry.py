@@ -86,7 +86,7 @@ def chain_axes(robot, frame: str = "tcp") -> Chain:
         ModelError: a joint on the path is not a 1-DoF revolute/prismatic joint.
     """
     model = robot.model
-    tree = robot._tree
+    tree = robot.kinematic_tree
     fid = robot.frame_id(frame)
     data = model.createData()
     q0 = robot.q_to_pinocchio(np.zeros(robot.nq))

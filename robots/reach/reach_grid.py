@@ -4,7 +4,7 @@
 sphere's bounding box on a grid of edge ``resolution`` aligned so that voxel centres lie at
 ``(i + ½)·resolution``; :func:`seed_voxels` marks the voxels seeded joint samples enter, and
 :func:`face_neighbours` grows a set of voxels by its 6 face neighbours inside the sphere (steps 1
-and 2 of the method in :mod:`robots.reach.reachability`). Units: m.
+and 2 of the method in :mod:`pinarms.robots.reach.reachability`). Units: m.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def reach_bound(robot: "Robot", frame: str = "tcp") -> tuple[np.ndarray, float]:
     centre = np.array(model.jointPlacements[chain[0]].translation, dtype=float)
     radius = float(np.linalg.norm(f.placement.translation))
     radius += sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in chain[1:])
-    tree = robot._tree
+    tree = robot.kinematic_tree
     for j in chain:
         if tree.kind[j] == 2:  # prismatic (mimic prismatic joints move by scale·q + offset)
             q_index = tree.q_index[j]

@@ -28,13 +28,13 @@ array larger than ``max_bytes`` in memory, a shape that disagrees with the other
 numbers are needed, indices out of range, a rotation that is not a rotation, an index that
 does not follow from the reached bits, or a stored solution outside the joint limits all
 raise :class:`ReachabilityFileError` naming the member and the problem (the checks of the
-content are :mod:`robots.reach.reach_check`; this module writes, and reads through a child).
+content are :mod:`pinarms.robots.reach.reach_check`; this module writes, and reads through a child).
 
-The HDF5 library runs in a child process (:mod:`robots.reach._reach_worker`, started by
-:mod:`robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
+The HDF5 library runs in a child process (:mod:`pinarms.robots.reach._reach_worker`, started by
+:mod:`pinarms.robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
 wall-clock time (``timeout`` for opening the file and checking its layout, then 1 s per
 20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before it
-opens the map the child walls itself in (Landlock, :mod:`robots._sandbox`): it may read
+opens the map the child walls itself in (Landlock, :mod:`pinarms.robots._sandbox`): it may read
 only the map file and Python's folders and write or execute nothing;
 :attr:`ReachabilityMap.reader_wall` says which wall was up. Before any
 data is read, the declared dtypes and shapes are checked against each other (joints,

@@ -3,8 +3,8 @@
 A spec is small and picklable: the registry name when the robot is the registry's (same URDF
 by SHA-256, same tool frame, same closed-form family), else the URDF text itself.
 :func:`robot_of` rebuilds the robot once per process and checks its URDF against the SHA-256.
-Used by the chunk tasks of :func:`robots.reach.reachability.reachability_map` and by the
-exact check of :func:`robots.reach.inverse_reach.base_placements`.
+Used by the chunk tasks of :func:`pinarms.robots.reach.reachability.reachability_map` and by the
+exact check of :func:`pinarms.robots.reach.inverse_reach.base_placements`.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ def urdf_sha256(robot: "Robot") -> str:
 
 
 def _family(robot: "Robot") -> str | None:
-    solver = getattr(robot, "_analytic_ik", None)
+    solver = getattr(robot, "analytic_ik", None)
     if solver is None:
         return None
     from ..ik import FAMILIES

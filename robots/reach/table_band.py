@@ -1,7 +1,7 @@
 """Where to place the pick/place tables: a radial band of the sampled workspace.
 
 :func:`recommend_region` derives the band from the samples of a
-:class:`~robots.reach.workspace.Workspace` with three criteria, all evaluated per radial shell
+:class:`~pinarms.robots.reach.workspace.Workspace` with three criteria, all evaluated per radial shell
 (width ``width``) around the workspace's outer-hull sphere centre (``about="centre"``) or
 around the base's vertical axis (``about="axis"``):
 
@@ -15,7 +15,7 @@ around the base's vertical axis (``about="axis"``):
 3. **Crowded centre (own body).** For a seeded sub-sample of ``n_collision`` samples,
    each configuration is checked for collisions between the arm and its *core* bodies
    (base, and the bodies carried only by the first ``core_joints`` joints: the turret)
-   with the URDF's collision primitives (:class:`~robots.self_collision.SelfCollision`).
+   with the URDF's collision primitives (:class:`~pinarms.robots.self_collision.SelfCollision`).
    A shell is rejected when more than ``max_collision_share`` of its configurations
    collide so: most ways of reaching it fold the arm onto its own base. Collisions among
    the moving links (wrist against forearm) are not counted: they depend on the tool

@@ -91,7 +91,7 @@ def test_aubo_solution_counts_match_a_numerical_search():
     T = _AUBO.fk(q4)
     _, free = _AUBO._analytic_ik.candidates(T[None], respect_limits=False)
     assert free.shape[0] == 4
-    solver = _AUBO._numerical_ik()
+    solver = _AUBO.numerical_ik()
     rng = np.random.default_rng(0)
     found = []
     for _ in range(120):
