@@ -5,134 +5,98 @@
 >>> T = arm.fk(arm.neutral)          # (4, 4) tcp → base
 """
 
-from .errors import (
-    ExecutionError,
-    InvalidInput,
-    CellError,
-    CellNotFound,
-    CollisionError,
-    CollisionGeometryError,
-    LimitViolation,
-    MissingMesh,
-    ModelError,
-    PinarmsError,
-    RobotNotFound,
-    UnreachableTarget,
-    XacroArgError,
-    XacroError,
-    XacroFileNotFound,
-    XacroForbidden,
-    XacroLimitExceeded,
-)
-from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
-from .robot import Robot
+from __future__ import annotations
+
+from ..lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "ExecutionError": ".errors",
+    "InvalidInput": ".errors",
+    "CellError": ".errors",
+    "CellNotFound": ".errors",
+    "CollisionError": ".errors",
+    "CollisionGeometryError": ".errors",
+    "LimitViolation": ".errors",
+    "MissingMesh": ".errors",
+    "ModelError": ".errors",
+    "PinarmsError": ".errors",
+    "RobotNotFound": ".errors",
+    "UnreachableTarget": ".errors",
+    "XacroArgError": ".errors",
+    "XacroError": ".errors",
+    "XacroFileNotFound": ".errors",
+    "XacroForbidden": ".errors",
+    "XacroLimitExceeded": ".errors",
+    "builtin_names": ".registry",
+    "from_urdf": ".registry",
+    "from_urdf_text": ".registry",
+    "from_xacro": ".registry",
+    "info": ".registry",
+    "load": ".registry",
+    "names": ".registry",
+    "Robot": ".robot",
+    "LayoutReport": ".reach.layout",
+    "check_layout": ".reach.layout",
+    "RecommendedRegion": ".reach.table_band",
+    "recommend_region": ".reach.table_band",
+    "SelfCollision": ".self_collision",
+    "VoxelMap": ".reach.voxels",
+    "suggest_voxel_size": ".reach.voxels",
+    "SphereFit": ".reach.sphere_fit",
+    "Workspace": ".reach.workspace",
+    "WorkspaceSummary": ".reach.workspace",
+    "fit_sphere": ".reach.sphere_fit",
+    "sample_workspace": ".reach.workspace",
+    "StreamedWorkspace": ".reach.workspace_stream",
+    "stream_workspace": ".reach.workspace_stream",
+    "MissingInertials": ".dynamics",
+    "InvalidPayload": ".payload",
+    "Payload": ".payload",
+    "XacroLimits": ".xacro_expand",
+    "expand_xacro": ".xacro_expand",
+    "ArmMotion": ".cell.timeline",
+    "Cell": ".cell.cell",
+    "CellArm": ".cell.components",
+    "Clearance": ".cell.collision",
+    "Collisions": ".cell.collision",
+    "CollisionPair": ".cell.pairs",
+    "MotionCheck": ".cell.motion_report",
+    "cell_names": ".cell.library",
+    "load_cell": ".cell.library",
+    "ArmPlacement": ".cell.compose_file",
+    "FixturePrimitive": ".cell.compose_file",
+    "ToolPoint": ".cell.compose_file",
+    "compose_cell": ".cell.compose",
+    "OrientationSet": ".reach.orientations",
+    "so3_orientations": ".reach.orientations",
+    "tool_axis_orientations": ".reach.orientations",
+    "tool_down_orientations": ".reach.orientations",
+    "ReachabilityFileError": ".reach.reach_check",
+    "load_reachability": ".reach.reach_io",
+    "save_reachability": ".reach.reach_io",
+    "ReachabilityMap": ".reach.reach_map",
+    "reach_bound": ".reach.reach_grid",
+    "reachability_map": ".reach.reachability",
+    "MAX_RESTARTS": "._checks",
+    "BasePlacements": ".reach.inverse_reach",
+    "base_placements": ".reach.inverse_reach",
+    "tool_down_poses": ".reach.inverse_reach",
+}
 
 __all__ = [
-    "Robot",
-    "load",
-    "names",
-    "builtin_names",
-    "info",
-    "from_urdf",
-    "from_urdf_text",
-    "from_xacro",
-    "PinarmsError",
-    "InvalidInput",
-    "RobotNotFound",
-    "ModelError",
-    "UnreachableTarget",
-    "LimitViolation",
-    "ExecutionError",
-    "XacroError",
-    "XacroForbidden",
-    "XacroFileNotFound",
-    "XacroLimitExceeded",
-    "XacroArgError",
-    "MissingMesh",
-    "CellError",
-    "CellNotFound",
-    "CollisionGeometryError",
-    "CollisionError",
-]
-
-# workspace analysis and station layout
-from .reach.layout import LayoutReport, check_layout  # noqa: E402
-from .reach.table_band import RecommendedRegion, recommend_region  # noqa: E402
-from .self_collision import SelfCollision  # noqa: E402
-from .reach.voxels import VoxelMap, suggest_voxel_size  # noqa: E402
-from .reach.workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
-from .reach.workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
-
-__all__ += [
-    "Workspace",
-    "WorkspaceSummary",
-    "SphereFit",
-    "sample_workspace",
-    "fit_sphere",
-    "StreamedWorkspace",
-    "stream_workspace",
-    "VoxelMap",
-    "suggest_voxel_size",
-    "RecommendedRegion",
-    "recommend_region",
-    "SelfCollision",
-    "LayoutReport",
-    "check_layout",
-]
-
-# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
-from .dynamics import MissingInertials  # noqa: E402
-from .payload import InvalidPayload, Payload  # noqa: E402
-
-__all__ += ["Payload", "InvalidPayload", "MissingInertials"]
-
-# users' xacro files, expanded behind a wall
-from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
-
-__all__ += ["XacroLimits", "expand_xacro"]
-
-# cells: several arms, fixtures, collision checks
-from .cell import (  # noqa: E402
-    ArmMotion,
-    Cell,
-    CellArm,
-    Clearance,
-    Collisions,
-    CollisionPair,
-    MotionCheck,
-    cell_names,
-    load_cell,
-)
-from .cell.compose import ArmPlacement, FixturePrimitive, ToolPoint, compose_cell  # noqa: E402
-
-__all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
-            "load_cell", "ArmPlacement", "FixturePrimitive", "ToolPoint", "compose_cell"]
-
-# reachability maps: tool poses per voxel, orientation sets, HDF5 files
-from .reach.orientations import (  # noqa: E402
-    OrientationSet,
-    so3_orientations,
-    tool_axis_orientations,
-    tool_down_orientations,
-)
-from .reach.reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
-from .reach.reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
-from ._checks import MAX_RESTARTS  # noqa: E402
-from .reach.inverse_reach import BasePlacements, base_placements, tool_down_poses  # noqa: E402
-
-__all__ += [
-    "ReachabilityMap",
-    "MAX_RESTARTS",
-    "reachability_map",
-    "reach_bound",
-    "OrientationSet",
-    "so3_orientations",
-    "tool_axis_orientations",
-    "tool_down_orientations",
-    "ReachabilityFileError",
-    "save_reachability",
-    "load_reachability",
-    "BasePlacements",
-    "base_placements",
+    "Robot", "load", "names", "builtin_names", "info", "from_urdf", "from_urdf_text", "from_xacro", "PinarmsError",
+    "InvalidInput", "RobotNotFound", "ModelError", "UnreachableTarget", "LimitViolation", "ExecutionError",
+    "XacroError", "XacroForbidden", "XacroFileNotFound", "XacroLimitExceeded", "XacroArgError", "MissingMesh",
+    "CellError", "CellNotFound", "CollisionGeometryError", "CollisionError", "Workspace", "WorkspaceSummary",
+    "SphereFit", "sample_workspace", "fit_sphere", "StreamedWorkspace", "stream_workspace", "VoxelMap",
+    "suggest_voxel_size", "RecommendedRegion", "recommend_region", "SelfCollision", "LayoutReport", "check_layout",
+    "Payload", "InvalidPayload", "MissingInertials", "XacroLimits", "expand_xacro", "Cell", "CellArm", "Clearance",
+    "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names", "load_cell", "ArmPlacement",
+    "FixturePrimitive", "ToolPoint", "compose_cell", "ReachabilityMap", "MAX_RESTARTS", "reachability_map",
+    "reach_bound", "OrientationSet", "so3_orientations", "tool_axis_orientations", "tool_down_orientations",
+    "ReachabilityFileError", "save_reachability", "load_reachability", "BasePlacements", "base_placements",
     "tool_down_poses",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

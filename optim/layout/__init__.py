@@ -8,8 +8,25 @@
 
 """
 
-from .search import (FAILURES, LayoutSearch, Refinement, base_to_world, grid_candidates, points_in_base_frame,
-                     random_candidates, search_layout)
+from __future__ import annotations
 
-__all__ = ["FAILURES", "LayoutSearch", "Refinement", "grid_candidates", "random_candidates", "base_to_world",
-           "points_in_base_frame", "search_layout"]
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "FAILURES": ".search",
+    "LayoutSearch": ".result",
+    "Refinement": ".result",
+    "base_to_world": ".candidates",
+    "grid_candidates": ".candidates",
+    "points_in_base_frame": ".candidates",
+    "random_candidates": ".candidates",
+    "search_layout": ".search",
+}
+
+__all__ = [
+    "FAILURES", "LayoutSearch", "Refinement", "grid_candidates", "random_candidates", "base_to_world",
+    "points_in_base_frame", "search_layout",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

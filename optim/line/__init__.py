@@ -14,28 +14,65 @@
 - :mod:`~.schedule` keeps the time offsets of several arms cycling together (:func:`schedule_line`).
 """
 
-from pinarms.optim.line.api import LineCurve, LineResult, LineSpec, Stream, build_maps, line_curve, run_line
-from pinarms.optim.line.belt import Belt, PlaceBox
-from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
-from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
-from pinarms.optim.line.report import LineFigures, summarise
-from pinarms.optim.line.rules import RULES, Rule
-from pinarms.optim.line.schedule import LineSchedule, schedule_line
-from pinarms.optim.line.simulate import SimArm, SimResult, simulate
-from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.task_maps import MapError, TaskMap, build_task_map, map_error
-from pinarms.optim.line.tracking import PickPlan, TrackingSpec, plan_pick
-from pinarms.optim.line.tray_maps import TrayMap, build_tray_map, tray_map_error
-from pinarms.optim.line.tray_sim import SimPlace
-from pinarms.optim.line.trays import TrayBelt, TrayPickPlan, plan_pick_to_tray, trays_beside
-from pinarms.optim.line.windows import PickWindow, check_reach
+from __future__ import annotations
+
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "LineCurve": ".api",
+    "LineResult": ".api",
+    "LineSpec": ".api",
+    "Stream": ".api",
+    "build_maps": ".api",
+    "line_curve": ".api",
+    "run_line": ".api",
+    "Belt": ".belt",
+    "PlaceBox": ".belt",
+    "ArrivalsFileError": ".errors",
+    "BeltOutOfReach": ".errors",
+    "ItemType": ".items",
+    "Items": ".items",
+    "poisson_items": ".items",
+    "read_arrivals": ".items",
+    "regular_items": ".items",
+    "LineFigures": ".report",
+    "summarise": ".report",
+    "RULES": ".rules",
+    "Rule": ".rules",
+    "LineSchedule": ".schedule",
+    "schedule_line": ".schedule",
+    "SimArm": ".sim_arm",
+    "SimResult": ".simulate",
+    "simulate": ".simulate",
+    "Station": ".station",
+    "base_pose": ".station",
+    "MapError": ".task_maps",
+    "TaskMap": ".task_maps",
+    "build_task_map": ".task_maps",
+    "map_error": ".task_maps",
+    "PickPlan": ".tracking",
+    "TrackingSpec": ".tracking",
+    "plan_pick": ".tracking",
+    "TrayMap": ".tray_maps",
+    "build_tray_map": ".tray_maps",
+    "tray_map_error": ".tray_maps",
+    "SimPlace": ".tray_sim",
+    "TrayBelt": ".trays",
+    "TrayPickPlan": ".trays",
+    "plan_pick_to_tray": ".trays",
+    "trays_beside": ".trays",
+    "PickWindow": ".windows",
+    "check_reach": ".windows",
+}
 
 __all__ = [
-    "LineSchedule", "schedule_line",
-    "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
-    "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
+    "LineSchedule", "schedule_line", "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items",
+    "read_arrivals", "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
     "TaskMap", "build_task_map", "map_error", "MapError", "Rule", "RULES", "SimArm", "SimResult", "simulate",
-    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "run_line", "build_maps", "LineCurve", "line_curve",
-    "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",
-    "TrayMap", "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
+    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "run_line", "build_maps", "LineCurve",
+    "line_curve", "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "TrayMap",
+    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

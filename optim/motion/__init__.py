@@ -4,7 +4,7 @@ See docs/motion.md.
 
 - :func:`plan_motion`: one arm (or two together) from a start to a goal joint vector or
   tool pose, every IK branch a goal; :class:`MotionPlan` (raw, shortcut and smooth paths,
-  time-optimal :class:`planning.Trajectory`, the cell's re-check, the clearance profile).
+  time-optimal :class:`pinarms.planning.Trajectory`, the cell's re-check, the clearance profile).
 - :class:`MotionChecker`: state, edge and timed-motion validity (:mod:`.checker`), exact (coal
   where the sphere cover is inconclusive); :func:`fast_check` its compiled side on the cover
   alone (:class:`FastCheck`: states, edges, polylines proven or not, in µs), which
@@ -16,16 +16,45 @@ See docs/motion.md.
   as xacro macros (:mod:`.arm_macros`).
 """
 
-from pinarms.optim.motion.checker import MotionChecker, TimedArm, Verdict
-from pinarms.optim.motion.fast import FastCheck, fast_check, fast_search, fast_shortcut
-from pinarms.optim.motion.goals import GoalCandidate
-from pinarms.optim.motion.plan import ClearanceProfile, MotionPlan, plan_motion
-from pinarms.optim.motion.scenes import SCENES, Query, Region, Scene, load_scene, scene_names, scene_path, scene_queries
-from pinarms.optim.motion.search import PLANNERS
-from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, plan_two_arms
-from pinarms.optim.motion.transfer import PlannedMove, planned_cycle
+from __future__ import annotations
 
-__all__ = ["plan_motion", "MotionPlan", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
-           "FastCheck", "fast_check", "fast_search", "fast_shortcut",
-           "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names", "scene_path", "load_scene", "scene_queries",
-           "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan", "planned_cycle", "PlannedMove"]
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "MotionChecker": ".checker",
+    "TimedArm": ".checker",
+    "Verdict": ".proof",
+    "FastCheck": ".fast",
+    "fast_check": ".fast",
+    "fast_search": ".fast",
+    "fast_shortcut": ".fast",
+    "GoalCandidate": ".goals",
+    "ClearanceProfile": ".report",
+    "MotionPlan": ".report",
+    "plan_motion": ".plan",
+    "SCENES": ".scenes",
+    "Query": ".scenes",
+    "Region": ".scenes",
+    "Scene": ".scenes",
+    "load_scene": ".scenes",
+    "scene_names": ".scenes",
+    "scene_path": ".scenes",
+    "scene_queries": ".scenes",
+    "PLANNERS": ".search",
+    "AroundPlan": ".two_arms",
+    "TwoArmPlan": ".two_arms",
+    "plan_around": ".two_arms",
+    "plan_two_arms": ".two_arms",
+    "PlannedMove": ".transfer",
+    "planned_cycle": ".transfer",
+}
+
+__all__ = [
+    "plan_motion", "MotionPlan", "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
+    "FastCheck", "fast_check", "fast_search", "fast_shortcut", "PLANNERS", "SCENES", "Scene", "Region", "Query",
+    "scene_names", "scene_path", "load_scene", "scene_queries", "plan_around", "plan_two_arms", "AroundPlan",
+    "TwoArmPlan", "planned_cycle", "PlannedMove",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -11,7 +11,25 @@
 
 """
 
-from . import profile as _profile
-from .profile import *  # noqa: F401,F403
+from __future__ import annotations
 
-__all__ = list(_profile.__all__)
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "Profile": ".profile",
+    "feasible_states": ".profile",
+    "controllable_sets": ".profile",
+    "greedy_profile": ".profile",
+    "interpolated_rows": ".profile",
+    "topp_profile": ".profile",
+    "reachability_profile": ".profile",
+    "X_CAP": ".profile",
+}
+
+__all__ = [
+    "Profile", "feasible_states", "controllable_sets", "greedy_profile", "interpolated_rows", "topp_profile",
+    "reachability_profile", "X_CAP",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -15,50 +15,51 @@
 docs/export.md shows the commands and what each consumer does with the files.
 """
 
-from .acceleration_check import AccelerationWarning
-from .cell import ExportedCell, export_cell
-from .errors import ExportError, InvalidJointName, InvalidRate, JointMismatch, MeshNotAllowed, MeshNotFound, TrajectoryFileError
-from .robot import SITE_SIZE_M, ExportedMJCF, ExportedURDF, export_mjcf, export_urdf, mesh_references
-from .srdf import SRDF_REASON, contact_pairs, cycle_states, srdf_text
-from .trajectory import (
-    ControllerTrajectory,
-    check_joint_names,
-    controller_trajectory,
-    write_trajectory_csv,
-    write_trajectory_yaml,
-)
-from .trajectory_read import read_trajectory_csv, read_trajectory_yaml
-from .verify import EngineComparison, compare_configurations_in_mujoco, compare_in_mujoco
+from __future__ import annotations
+
+from ..lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "AccelerationWarning": ".acceleration_check",
+    "ExportedCell": ".cell",
+    "export_cell": ".cell",
+    "ExportError": ".errors",
+    "InvalidJointName": ".errors",
+    "InvalidRate": ".errors",
+    "JointMismatch": ".errors",
+    "MeshNotAllowed": ".errors",
+    "MeshNotFound": ".errors",
+    "TrajectoryFileError": ".errors",
+    "SITE_SIZE_M": ".robot",
+    "ExportedMJCF": ".robot",
+    "ExportedURDF": ".urdf_files",
+    "export_mjcf": ".robot",
+    "export_urdf": ".robot",
+    "mesh_references": ".urdf_files",
+    "SRDF_REASON": ".srdf",
+    "contact_pairs": ".srdf",
+    "cycle_states": ".srdf",
+    "srdf_text": ".srdf",
+    "ControllerTrajectory": ".trajectory",
+    "check_joint_names": ".trajectory",
+    "controller_trajectory": ".trajectory",
+    "write_trajectory_csv": ".trajectory",
+    "write_trajectory_yaml": ".trajectory",
+    "read_trajectory_csv": ".trajectory_read",
+    "read_trajectory_yaml": ".trajectory_read",
+    "EngineComparison": ".verify",
+    "compare_configurations_in_mujoco": ".verify",
+    "compare_in_mujoco": ".verify",
+}
 
 __all__ = [
-    "AccelerationWarning",
-    "ExportedURDF",
-    "ExportedMJCF",
-    "ExportedCell",
-    "export_urdf",
-    "export_mjcf",
-    "export_cell",
-    "mesh_references",
-    "SITE_SIZE_M",
-    "srdf_text",
-    "cycle_states",
-    "contact_pairs",
-    "SRDF_REASON",
-    "ControllerTrajectory",
-    "controller_trajectory",
-    "write_trajectory_yaml",
-    "write_trajectory_csv",
-    "read_trajectory_yaml",
-    "read_trajectory_csv",
-    "EngineComparison",
-    "compare_in_mujoco",
-    "compare_configurations_in_mujoco",
-    "ExportError",
-    "MeshNotFound",
-    "MeshNotAllowed",
-    "InvalidRate",
-    "JointMismatch",
-    "InvalidJointName",
-    "TrajectoryFileError",
-    "check_joint_names",
+    "AccelerationWarning", "ExportedURDF", "ExportedMJCF", "ExportedCell", "export_urdf", "export_mjcf",
+    "export_cell", "mesh_references", "SITE_SIZE_M", "srdf_text", "cycle_states", "contact_pairs", "SRDF_REASON",
+    "ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
+    "read_trajectory_yaml", "read_trajectory_csv", "EngineComparison", "compare_in_mujoco",
+    "compare_configurations_in_mujoco", "ExportError", "MeshNotFound", "MeshNotAllowed", "InvalidRate",
+    "JointMismatch", "InvalidJointName", "TrajectoryFileError", "check_joint_names",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
