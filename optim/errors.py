@@ -1,6 +1,6 @@
 """Exceptions of the optimisation package.
 
-All derive from :class:`robots.errors.PinarmsError`, so one ``except PinarmsError``
+All derive from :class:`pinarms.errors.PinarmsError`, so one ``except PinarmsError``
 catches everything pinarms raises on purpose.
 """
 
@@ -35,13 +35,13 @@ class InvalidSettings(OptimError, ValueError):
 class SettingOutOfRange(InvalidSettings, InvalidInput):
     """A setting (a count, a step, a time, a grid size) is not a finite number inside its cap.
 
-    The message names the setting, its value and the range allowed (:mod:`optim.caps`).
+    The message names the setting, its value and the range allowed (:mod:`pinarms.optim.caps`).
     Caught by ``except InvalidSettings`` and by ``except InvalidInput`` alike.
     """
 
 
 class PlanningError(OptimError):
-    """A collision-free motion could not be planned (:func:`optim.plan_motion`)."""
+    """A collision-free motion could not be planned (:func:`pinarms.optim.plan_motion`)."""
 
 
 class EndpointInCollision(PlanningError, CollisionError):

@@ -4,7 +4,7 @@
 under :mod:`pinarms.studies` (``seed000`` ... ``seed004``, ``cell``, ``line``, ``handoff``;
 this module only lists them in :data:`STUDIES`). A study builds its
 robot, redoes the paper's computation with pinarms and returns the rows of the
-paper-vs-pinarms table (:class:`pinarms.report.Row`), a :class:`viz.Session` and the
+paper-vs-pinarms table (:class:`pinarms.report.Row`), a :class:`pinarms.viz.Session` and the
 plots. The runner writes, into ``out_dir``::
 
     table.md, table.json       the paper-vs-pinarms table

@@ -43,7 +43,7 @@ class InvalidInput(PinarmsError, ValueError):
 
 
 class RobotNotFound(PinarmsError, LookupError):
-    """A robot name is not known to :func:`robots.load`."""
+    """A robot name is not known to :func:`pinarms.robots.load`."""
 
 
 class ModelError(PinarmsError):

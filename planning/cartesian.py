@@ -108,7 +108,7 @@ def joint_path_from_waypoints(
     """Joint trajectory through TCP waypoints: IK per pose (:func:`joint_waypoints`), then ``kind``.
 
     Args:
-        robot: a :class:`robots.Robot` (or an object with the same IK/FK methods).
+        robot: a :class:`pinarms.robots.Robot` (or an object with the same IK/FK methods).
         poses: (N, 4, 4) TCP poses in the base frame (m).
         times: (N,) knot times (s), strictly increasing.
         kind: ``"multi-quintic"`` (default), ``"quintic-bspline"``, ``"piecewise-polynomial"``

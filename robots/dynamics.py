@@ -1,4 +1,4 @@
-"""Rigid-body dynamics of a :class:`robots.Robot`: joint torques, energies, holding torques.
+"""Rigid-body dynamics of a :class:`pinarms.robots.Robot`: joint torques, energies, holding torques.
 
 Conventions
 -----------

@@ -87,7 +87,7 @@ def build_file(path: str | os.PathLike, source_label: str | None = None) -> str:
 
     Raises:
         ModelError: the file is missing, is not well-formed XML, xacro fails on it, or
-            its root element is not ``<robot>`` (a :class:`~pinarms.robots.errors.XacroError`
+            its root element is not ``<robot>`` (a :class:`~pinarms.errors.XacroError`
             naming the file and quoting xacro's message).
     """
     from .xacro_expand import expand_xacro

@@ -11,7 +11,7 @@
 - :func:`check_inertials`: every ``<mass value>`` is a finite number ≥ 0 (urdfdom drops an
   inertial whose mass is ``nan`` or ``inf`` with a message on stderr and loads the link massless).
 
-Each raises :class:`~robots.errors.ModelError` naming the file (``source``) and the problem.
+Each raises :class:`~pinarms.errors.ModelError` naming the file (``source``) and the problem.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Exceptions of :mod:`viz`, derived from :class:`robots.errors.PinarmsError`."""
+"""Exceptions of :mod:`viz`, derived from :class:`pinarms.errors.PinarmsError`."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """What a line engineer looks at, written in one call: a session, its standalone page, the schedule plot.
 
-Sits above the session, the HTML export and the plots (:mod:`viz.line_session` only adds a
+Sits above the session, the HTML export and the plots (:mod:`pinarms.viz.line_session` only adds a
 line to a session it is handed, so it imports none of them).
 """
 

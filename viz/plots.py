@@ -6,8 +6,8 @@ figure atomically and returns the path. Units: the data's SI units (rad, m, s); 
 ``degrees=True`` to label revolute joints in degrees (conversion happens here, at the edge).
 
 The other plot families have their own modules, re-exported here: searches
-(:mod:`viz.search_plots`: GA convergence, layout search), cells (:mod:`viz.cell_plots`:
-clearance over time, multi-arm schedules), reach (:mod:`viz.reach_plots`: workspace
+(:mod:`pinarms.viz.search_plots`: GA convergence, layout search), cells (:mod:`pinarms.viz.cell_plots`:
+clearance over time, multi-arm schedules), reach (:mod:`pinarms.viz.reach_plots`: workspace
 projections).
 """
 
@@ -215,7 +215,7 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
 
 def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
                     title: str = "tcp speed") -> Path:
-    """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
+    """The tcp's Cartesian speed versus time (e.g. from :func:`pinarms.planning.tcp_speed`).
 
     Args:
         t: instants (N,) [s]; speed: linear speed (N,) [m/s]; angular: optional (N,) [rad/s]

@@ -107,7 +107,7 @@ def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *,
                    colormap: str = "viridis", mm: bool = False) -> Path:
     """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
 
-    ``points`` (n, 3) m (or a ``Workspace``/:class:`viz.WorkspaceRecord` with ``points`` and
+    ``points`` (n, 3) m (or a ``Workspace``/:class:`pinarms.viz.WorkspaceRecord` with ``points`` and
     ``manipulability``); ``mm=True`` labels the axes in millimetres.
     """
     if hasattr(points, "points"):

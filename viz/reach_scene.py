@@ -4,7 +4,7 @@ Scene paths (under MeshCat's root ``/meshcat``):
 ``pinarms/reachability/<name>/layers/z<mm>mm`` — the voxels of one horizontal layer (their
 centres' height in the robot's base frame, in mm) as square points the size of a voxel,
 coloured by reachability index on a fixed scale (0 → the colormap's low end, 1 → its high
-end). One object per layer is what the page's slice control switches (:mod:`viz.page`, key
+end). One object per layer is what the page's slice control switches (:mod:`pinarms.viz.page`, key
 ``"reachability"``): all layers, the layers up to a height, or one layer; MeshCat's own
 Controls panel lists them too.
 """

@@ -90,7 +90,7 @@ class Session:
     >>> s2 = load_session("study.pinarms")
 
     Args:
-        robot: first robot (a :class:`robots.Robot` or a registry name), or ``None``.
+        robot: first robot (a :class:`pinarms.robots.Robot` or a registry name), or ``None``.
         title: human title, stored in the metadata.
         metadata: free JSON-able metadata (stored under ``metadata["user"]``).
         base_to_world: pose of the first robot's base in the world frame (4, 4); default identity.
@@ -166,7 +166,7 @@ class Session:
         return key
 
     def robot(self, key: str | None = None) -> Robot:
-        """The :class:`robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
+        """The :class:`pinarms.robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
         entry = self._entry(key)
         rob = self._loaded.get(entry.key)
         if rob is not None:
@@ -198,16 +198,16 @@ class Session:
 
     def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
                  name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
-        """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
+        """Add a :class:`pinarms.robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
         Args:
             cell: the cell; its joint vector is the robot's, poses are in the world frame
                 (``base_to_world`` is the identity).
             key: its key (default: the cell's name).
-            motions: the arms' motions (:class:`robots.cell.ArmMotion` objects or
+            motions: the arms' motions (:class:`pinarms.robots.cell.ArmMotion` objects or
                 ``{arm: trajectory}``), stored as one trajectory ``name`` of the whole cell,
                 sampled at ``hz`` over their window: the viewer animates all arms together.
-            check: a :class:`robots.cell.MotionCheck` of those motions: its samples in
+            check: a :class:`pinarms.robots.cell.MotionCheck` of those motions: its samples in
                 contact become the point set ``"<name> contacts"`` (kind ``"contact"``, drawn
                 red), at the middle of the contact pair's nearest points.
             hold: cell configuration ``(nq,)`` of the arms without a motion (default
@@ -258,7 +258,7 @@ class Session:
         """Add a trajectory of robot ``robot`` (default: the only robot).
 
         Args:
-            trajectory: a :class:`planning.Trajectory` (its ``definition`` is kept and it is
+            trajectory: a :class:`pinarms.planning.Trajectory` (its ``definition`` is kept and it is
                 sampled at ``hz``, knots included), or a pair ``(t, q)`` of samples
                 (t (N,) s, q (N, nq)).
             hz: sampling rate (1/s) for a Trajectory.
@@ -302,9 +302,9 @@ class Session:
         return rec
 
     def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
-        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+        """Add the voxels of a :class:`pinarms.robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
 
-        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`pinarms.viz.reach_record`).
         """
         from .reach_record import make_record
 
@@ -314,7 +314,7 @@ class Session:
         return rec
 
     def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
-        """Add an animated window of a simulated belt line (:func:`viz.line_session.add_line`)."""
+        """Add an animated window of a simulated belt line (:func:`pinarms.viz.line_session.add_line`)."""
         from .line_session import add_line
 
         return add_line(self, spec, result, **options)

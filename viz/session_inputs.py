@@ -1,6 +1,6 @@
 """The user's values checked and turned into session records (boxes, trajectories, workspaces, histories).
 
-What :class:`viz.Session`'s ``add_*`` methods take is checked here: numbers real and finite
+What :class:`pinarms.viz.Session`'s ``add_*`` methods take is checked here: numbers real and finite
 (±inf only where a history allows it), shapes, rigid poses, JSON-able metadata; every array
 kept is a fresh read-only float64 copy. Errors are :class:`InvalidInput` naming the value.
 

@@ -4,7 +4,7 @@ A robot that ``robots.load(name)`` rebuilds exactly is stored by name; any other
 URDF text embedded (with the folders its meshes came from, recorded for messages only) so
 that the session reopens anywhere. A payload is stored beside it and reapplied. Rebuilding an
 embedded URDF reads meshes only from the folders the caller allowed
-(:func:`viz.mesh_paths.check_mesh_paths`), pinarms' own model folders among them.
+(:func:`pinarms.viz.mesh_paths.check_mesh_paths`), pinarms' own model folders among them.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def robot_entry(robot: Robot, key: str, base_to_world: Any) -> RobotEntry:
 
 
 def rebuild_robot(entry: RobotEntry, mesh_dirs: tuple[str, ...]) -> Robot:
-    """The :class:`robots.Robot` of ``entry``, its meshes read only from ``mesh_dirs``, its payload reapplied.
+    """The :class:`pinarms.robots.Robot` of ``entry``, its meshes read only from ``mesh_dirs``, its payload reapplied.
 
     Raises:
         SessionFormatError: a mesh outside ``mesh_dirs``, or the robot now loads with other joints.

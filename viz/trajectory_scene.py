@@ -1,6 +1,6 @@
 """The trajectories of a scene: their world tcp paths, which of them play, and the one looping animation.
 
-:func:`viz.scene.build_scene` draws what these compute: the tcp path of each trajectory in
+:func:`pinarms.viz.scene.build_scene` draws what these compute: the tcp path of each trajectory in
 the world frame (one per arm for a cell) with the tcp at its knots, the trajectories that
 play (default: the first of each robot; at most one per robot), each robot posed at the
 start of its motion, and one MeshCat animation of them all (and of the belt lines) from

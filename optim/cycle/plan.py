@@ -3,13 +3,13 @@
 :func:`plan_cycle` picks the planner the request asks for, each in a module below this one
 (plain imports, no callbacks):
 
-* no cell: :func:`optim.cycle.straight.approach_cycle` — the joint-space cycle
-  (:mod:`optim.cycle.joint`: IK on one branch, time-optimal moves through the lift points),
+* no cell: :func:`pinarms.optim.cycle.straight.approach_cycle` — the joint-space cycle
+  (:mod:`pinarms.optim.cycle.joint`: IK on one branch, time-optimal moves through the lift points),
   or, with ``approach="straight"``, that cycle with straight vertical lines at pick and place
-  (:mod:`optim.cycle.straight`);
-* a cell (:class:`CellSettings`): :func:`optim.cycle.in_cell.plan_cycle_in_cell` — the same
+  (:mod:`pinarms.optim.cycle.straight`);
+* a cell (:class:`CellSettings`): :func:`pinarms.optim.cycle.in_cell.plan_cycle_in_cell` — the same
   cycle checked continuously in the cell and re-planned (higher lift, via points, then a
-  transfer planned round what blocks, :mod:`optim.motion.transfer`) until it keeps its clearance.
+  transfer planned round what blocks, :mod:`pinarms.optim.motion.transfer`) until it keeps its clearance.
 
 ``plan_cycle(robot, spec, **keywords)`` (the former keyword form) builds the request with
 :meth:`CycleRequest.from_keywords` and plans it the same way.
@@ -64,13 +64,13 @@ def plan_cycle(request: CycleRequest | Any, /, spec: PickPlace | None = None, **
         InvalidLimits: a limit ≤ 0, NaN/inf or of the wrong shape, or no ``vmax`` and the
             URDF has none; with ``approach="straight"``, no ``amax``.
         InvalidSettings: unknown ``method``, a payload without torque limits;
-            ``SettingOutOfRange``: ``lift_step`` outside :data:`optim.caps.LIFT_STEP_RANGE`,
-            ``margin`` below :data:`optim.caps.MIN_MARGIN`, a ``clearance`` outside 0 … 1 m, a
+            ``SettingOutOfRange``: ``lift_step`` outside :data:`pinarms.optim.caps.LIFT_STEP_RANGE`,
+            ``margin`` below :data:`pinarms.optim.caps.MIN_MARGIN`, a ``clearance`` outside 0 … 1 m, a
             ``tool_speed`` that is not > 0.
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
-        InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        InfeasibleProblem: no timing found (from :func:`pinarms.optim.minimize_time`).
         CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
             re-planned cycle keeps the clearance; the message names the blocking bodies.
     """

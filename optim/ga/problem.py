@@ -8,7 +8,7 @@ between trajectories and the optimisers: the GA sees only arrays.
 A population of durations (P, m) is evaluated in a few numpy calls: planning's batched
 constructor (``piecewise_polynomial_batch``, ``multi_quintic_batch``,
 ``quintic_bspline_batch``) gives the coefficients of all P trajectories from one batched
-solve, and :func:`planning.piece_peaks_batch` peaks every piece of every individual in
+solve, and :func:`pinarms.planning.piece_peaks_batch` peaks every piece of every individual in
 one pass. Single timings go through the same code with P = 1.
 
 Scaling laws used by the exact optimiser and by the final rescaling: with durations
@@ -34,7 +34,7 @@ from pinarms.planning.torque import piece_states
 
 __all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
-#: Trajectory families known to :func:`optim.minimize_time`.
+#: Trajectory families known to :func:`pinarms.optim.minimize_time`.
 KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
 
 #: Relative margin under the limits kept by rescaled answers (round-off safety).
@@ -51,7 +51,7 @@ class _PeaksLike(Protocol):
 
 
 class _TrajectoryLike(Protocol):
-    """What a custom builder must return (a :class:`planning.Trajectory` does)."""
+    """What a custom builder must return (a :class:`pinarms.planning.Trajectory` does)."""
 
     knot_times: np.ndarray
     coefficients: np.ndarray
@@ -171,7 +171,7 @@ class TimingProblem:
             ``velocities=0`` for multi-quintic rest at every via point).
         builder: Replace the planning constructor (advanced; tests and custom families).
             A custom builder is called once per individual (no batched form).
-        torque: Joint-torque limits of a robot (:class:`planning.JointTorqueConstraint`),
+        torque: Joint-torque limits of a robot (:class:`pinarms.planning.JointTorqueConstraint`),
             checked on a grid per piece beside the exact v/a/jerk peaks, with their own
             scaling law in :meth:`minimal_scale`; None: kinematic limits only.
     """
@@ -286,7 +286,7 @@ class TimingProblem:
         """Exact peaks per polynomial piece, (pop, 3, pieces, n_joints), for durations (pop, m).
 
         The coefficients of all individuals come from :meth:`coefficients_batch`; the exact
-        peak search (:func:`planning.piece_peaks_batch`) then runs once for the whole
+        peak search (:func:`pinarms.planning.piece_peaks_batch`) then runs once for the whole
         population.
         """
         from pinarms import planning

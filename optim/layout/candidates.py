@@ -1,5 +1,5 @@
 """Candidate base placements of a layout search, and the frames they define (stage 0 of
-:func:`optim.layout.search_layout`): grids, seeded random samples, ``base_to_world`` and the
+:func:`pinarms.optim.layout.search_layout`): grids, seeded random samples, ``base_to_world`` and the
 points moved into each candidate's base frame. Units: m, rad.
 """
 

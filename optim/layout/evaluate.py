@@ -1,5 +1,5 @@
 """Evaluating one candidate placement of a layout search (stages 2 and 4 of
-:func:`optim.layout.search_layout`): the settings a search passes to its tasks, the cycle
+:func:`pinarms.optim.layout.search_layout`): the settings a search passes to its tasks, the cycle
 plans of every (pick, place) pair, the failure classes, and the Nelder-Mead refinement of one
 start. Every task is a pure function of its inputs (the execution layer may run it anywhere).
 """

@@ -77,7 +77,7 @@ class Stream:
 @dataclass(frozen=True, eq=False)
 class LineSpec:
     """A line (module doc). ``target_miss_rate``: the miss rate asked for (fraction);
-    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`robots.cell.Cell` whose arms
+    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`pinarms.robots.cell.Cell` whose arms
     are the stations (same names and bases) — then neighbours whose windows overlap start a pick
     only when the cell's continuous check proves it keeps ``clearance`` [m] from the neighbour's
     (:mod:`~.neighbours`; the seeds then run in this process), and every map node whose planned pick

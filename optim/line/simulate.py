@@ -10,11 +10,11 @@ At a decision at time ``t`` an arm computes, for every item not yet taken near i
 downstream), the first ``u`` where ``t + t_A(u) ≤ t0 + u / v`` (the arm, leaving now, is at
 ``u`` no later than the item), refined linearly between grid points; the arm leaves at
 ``start = t0 + u/v − t_A(u) ≥ t`` so that it meets the item exactly (:class:`~.sim_arm.ArmState`).
-Items whose start is ``t`` can be started now; the rule (:mod:`optim.line.rules`) picks one, or, when only later
+Items whose start is ``t`` can be started now; the rule (:mod:`pinarms.optim.line.rules`) picks one, or, when only later
 starts exist, the arm sleeps until the earliest. An item that no arm takes is **missed** (it
 leaves the last window).
 
-Neighbouring arms whose windows overlap: with a ``guard`` (:class:`optim.line.neighbours.NeighbourGuard`:
+Neighbouring arms whose windows overlap: with a ``guard`` (:class:`pinarms.optim.line.neighbours.NeighbourGuard`:
 exact picks through the cell's continuous check at the clearance), an arm starts a pick only when
 it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
 choice, or waits until that neighbour's pick ends. Each guarded pair is counted in

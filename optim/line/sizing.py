@@ -1,6 +1,6 @@
 """Sizing a line: the fewest arms, their places along the belt and the belt speed for a flow.
 
-For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`optim.run_ga`) searches the
+For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`pinarms.optim.run_ga`) searches the
 gaps between neighbouring arms (each in ``[min_gap, max_gap]`` m) and the belt speed (one of
 the given speeds, a gene rounded to the nearest) for the lowest mean miss rate over the
 seeds (Monte Carlo: every individual of a generation is one task on the execution layer,

@@ -1,6 +1,6 @@
 """Per-arm task-time maps: pick times over the belt, built once from exact planning, interpolated.
 
-Planning a pick exactly (:func:`optim.line.tracking.plan_pick`: IK of the tracking segment and
+Planning a pick exactly (:func:`pinarms.optim.line.tracking.plan_pick`: IK of the tracking segment and
 two time-optimal moves) takes about 0.2 s; a simulation asks for millions. A :class:`TaskMap`
 stores, on a grid of pre-grasp points relative to the arm (``du`` along the belt from the
 arm's base, ``w`` across), the approach time ``t_A`` (from rest at the box to the pre-grasp
@@ -318,7 +318,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
     between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
     Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
-    ``cell``: a :class:`robots.cell.Cell` with the station as one of its arms (same name and base):
+    ``cell``: a :class:`pinarms.robots.cell.Cell` with the station as one of its arms (same name and base):
     a node whose planned pick (the whole trajectory) comes closer than ``clearance`` [m] to the
     cell's fixtures is infeasible (:mod:`~.fixtures`; counted in ``TaskMap.fixture_infeasible``).
 

@@ -15,12 +15,12 @@ The steps, each reported in :class:`MotionPlan`:
 3. **Shortcut.** OMPL's path simplifier, every new edge proven by the same rule.
 4. **Smooth.** The cubic spline through the shortcut path, proven again; vertices are
    added where it strays, the polyline with stops is the fallback (:mod:`.smoothing`).
-5. **Time.** :func:`optim.time_optimal` along the smooth path (TOPP-RA written here) under
+5. **Time.** :func:`pinarms.optim.time_optimal` along the smooth path (TOPP-RA written here) under
    the joint velocity limits, joint acceleration limits (the arms' by default), and joint torque limits
    (the URDF's efforts, the arm's inertials) by default: the time-optimal ``s(t)`` of the
    fixed path (bang–bang: jerk is not limited).
 6. **Check and report.** The timed motion is re-checked by the cell's own continuous time
-   check (:func:`robots.cell.check_motion`, an independent code path: contact-free must be
+   check (:func:`pinarms.robots.cell.check_motion`, an independent code path: contact-free must be
    proven) and its clearance is reported over time: the smallest distance to a fixture or
    another arm, and between links of the arm, with the pairs (:class:`ClearanceProfile`).
 
@@ -120,7 +120,7 @@ def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any)
 
 
 def time_path(path: JointPath, constraints: Sequence[Any], grid: int = 200) -> Any:
-    """:func:`optim.time_optimal` of ``path`` (a clear error if the limits cannot be met)."""
+    """:func:`pinarms.optim.time_optimal` of ``path`` (a clear error if the limits cannot be met)."""
     from pinarms.optim.topp.path_timing import time_optimal
 
     try:
@@ -171,7 +171,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
     """Plan a collision-free move of ``arm`` from ``start`` to ``goal`` in ``cell`` (module docstring).
 
     Args:
-        cell: a :class:`robots.Cell`.
+        cell: a :class:`pinarms.robots.Cell`.
         arm: the arm's name, or two names to plan both arms together in their joint space.
         start: the arm's joint coordinates ``(n,)`` (two arms: concatenated or ``{arm: q}``).
         goal: joint coordinates like ``start``, or a tcp pose ``(4, 4)`` in the world (one arm):
@@ -179,7 +179,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         margin: clearance [m] kept to fixtures and other arms everywhere along the motion (> 0);
             it also sets the step of the continuous check.
         self_margin: clearance [m] kept between two links of one arm (default 0: no contact).
-        planner: an OMPL planner, one of :data:`optim.motion.search.PLANNERS` (default RRT-Connect).
+        planner: an OMPL planner, one of :data:`pinarms.optim.motion.search.PLANNERS` (default RRT-Connect).
         time_limit: seconds the search may take.
         seed: seed of the search and the shortcutting, 0 to 2**63 − 1 (same seed, same path).
         hold: cell configuration of the arms not planned (default :attr:`Cell.hold`, each arm's
@@ -192,7 +192,7 @@ def plan_motion(cell: Any, arm: Any, start: Any, goal: Any, *, margin: float = 0
         torque: ``True``: the URDF's effort limits where the arm has inertials; limits per
             planned joint [N·m or N]; ``False``: none.
         grid: grid intervals of the time scaling (1 to :data:`MAX_GRID`).
-        threads: threads of the batched collision checks (1 to :data:`optim.motion.checker.MAX_THREADS`).
+        threads: threads of the batched collision checks (1 to :data:`pinarms.optim.motion.checker.MAX_THREADS`).
         compiled: search RRT-Connect compiled on the sphere cover first where it is tight
             (:mod:`.geometry`); ``False``: OMPL with the exact checker alone, as before.
         recheck: re-check the timed motion by the cell's own continuous check and report its

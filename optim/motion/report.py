@@ -113,12 +113,12 @@ class MotionPlan:
         arms: the planned arms; ``start``/``goal``: their joint coordinates ``(n,)``.
         goals: every goal configuration tried (:class:`GoalCandidate`: valid or why not).
         raw_path: ``(M, n)`` the planner's path; ``simplified``: ``(K, n)`` after shortcutting
-            (:data:`SIMPLIFIER`); ``path``: the smooth :class:`planning.JointPath` that was
+            (:data:`SIMPLIFIER`); ``path``: the smooth :class:`pinarms.planning.JointPath` that was
             timed, ``smoothing`` how it was made (``"cubic spline"``, ``"straight line"`` or
             ``"polyline with stops"``).
-        timing: the :class:`optim.PathTiming`; ``trajectory``: the arms' joint trajectory
-            (:class:`planning.Trajectory`, the planned arms' joints in order).
-        check: the cell's continuous check of the timed motion (:class:`robots.cell.MotionCheck`;
+        timing: the :class:`pinarms.optim.PathTiming`; ``trajectory``: the arms' joint trajectory
+            (:class:`pinarms.planning.Trajectory`, the planned arms' joints in order).
+        check: the cell's continuous check of the timed motion (:class:`pinarms.robots.cell.MotionCheck`;
             ``None`` when planned with ``recheck=False``).
         clearance: the distances along it (:class:`ClearanceProfile`; ``None`` likewise).
         hold: the cell configuration of the arms not planned.
@@ -406,7 +406,7 @@ class _Distances:
         self.calls = 0  # coal distance calls
 
     def _bounds(self, Q: np.ndarray) -> np.ndarray:
-        """``(N, P)`` numpy lower bounds of the pairs' distances (:func:`robots.cell.collision.pair_lower_bounds`)."""
+        """``(N, P)`` numpy lower bounds of the pairs' distances (:func:`pinarms.robots.cell.collision.pair_lower_bounds`)."""
         from pinarms.robots.cell.collision import pair_lower_bounds
 
         c = self.checker

@@ -1,7 +1,7 @@
 """The planned transfer: what ``plan_cycle(..., cell=)`` falls back to when raising it cannot clear.
 
-:func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
-adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
+:func:`pinarms.optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
+adding via points (:mod:`pinarms.optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
@@ -10,7 +10,7 @@ search, shortcut and smoothing (OMPL, every edge proven continuously); the move 
 the same path in reverse. Each part is timed optimally from rest to rest under the cycle's
 limits (joint velocity and acceleration; the URDF's torque limits when no acceleration
 limit is given) and the parts are joined at rest. The cycle (dwells, move to place, move
-back) is returned as a :class:`optim.CycleResult` whose moves are :class:`PlannedMove` s.
+back) is returned as a :class:`pinarms.optim.CycleResult` whose moves are :class:`PlannedMove` s.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ class PlannedMove:
     """One move of a cycle with a planned transfer: the lift, the transfer, the lowering (at rest between).
 
     Attributes:
-        parts: the three timings (:class:`optim.PathTiming`).
+        parts: the three timings (:class:`pinarms.optim.PathTiming`).
         trajectory: the three concatenated.
         planner: the OMPL planner that found the transfer; ``states``: the states it explored.
     """
@@ -124,15 +124,15 @@ def planned_cycle(robot: Any, spec: Any, base: Any, *, cell: Any, arm: Any, clea
     """The cycle ``base`` (planned without the cell) with its transfer planned around the cell.
 
     Args:
-        base: the :class:`optim.CycleResult` of ``spec`` without the cell (its via points fix
+        base: the :class:`pinarms.optim.CycleResult` of ``spec`` without the cell (its via points fix
             the IK branch; its limits are used).
-        arm: the :class:`robots.cell.CellArm`; ``clearance``: distance kept from fixtures and
+        arm: the :class:`pinarms.robots.cell.CellArm`; ``clearance``: distance kept from fixtures and
             other arms [m] (the arm's own links: no contact); ``hold``: the cell configuration
             of the other arms; ``margin``: the check's resolution when ``clearance`` is 0.
 
     Raises:
         CollisionError: a vertical move itself is too close to something (no transfer can
-            help), or :class:`optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
+            help), or :class:`pinarms.optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
     """
     k = len(spec.names)
     q = base.q_via

@@ -1,6 +1,6 @@
 """Minimum-time segment timing of a trajectory through via points: GA or exact.
 
-``minimize_time`` is the user-facing entry: it builds a :class:`~optim.ga.problem.TimingProblem`,
+``minimize_time`` is the user-facing entry: it builds a :class:`~pinarms.optim.ga.problem.TimingProblem`,
 solves it with the GA of this package (``method="ga"``) or with the deterministic
 scaling-law optimiser (``method="exact"``), verifies the answer with planning's exact
 peaks, and never returns an infeasible timing (it raises :class:`InfeasibleProblem`).
@@ -47,7 +47,7 @@ class TimingResult:
         unpolished_total: ``"ga+polish"``: total (s) of the GA's answer (rescaled onto the
             limits) before the local polish; None otherwise.
         torque_peaks: with torque limits, the refined per-joint torque peaks of
-            ``trajectory`` (:class:`planning.TorquePeaks`, N·m or N); None otherwise.
+            ``trajectory`` (:class:`pinarms.planning.TorquePeaks`, N·m or N); None otherwise.
         torque_limit: the torque limits (n,) used [N·m or N], or None.
     """
 
@@ -156,28 +156,28 @@ def minimize_time(positions: Any, kind: str, vmax: Any, amax: Any = None, jmax: 
             total with equal durations (so equal durations s0/m are inside and feasible).
             Pass wider bounds if one segment may need more than 4x the average.
         max_generations, stall_generations, time_limit: GA stopping rules (``max_generations``
-            1 to :data:`optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
+            1 to :data:`pinarms.optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
         polish: GA only: refine the GA's (rescaled) answer by a local gradient method
-            (SLSQP from it, :func:`optim.timing.exact.polish_durations`) and keep the better of
+            (SLSQP from it, :func:`pinarms.optim.timing.exact.polish_durations`) and keep the better of
             the two; the result's method is then ``"ga+polish"`` and the GA's own total is
             kept in ``unpolished_total``. Off by default: the default answer is the GA's.
         initial: GA only: (k, m) durations put into the initial population (e.g. the
             paper's initial times).
-        callback: GA progress callback (see :func:`optim.run_ga`).
+        callback: GA progress callback (see :func:`pinarms.optim.run_ga`).
         trajectory_options: Extra keyword arguments of the planning constructor.
         problem: A prebuilt :class:`TimingProblem` (then positions/kind/limits/bounds
             are ignored).
-        robot: The arm (a :class:`robots.Robot`) whose joints the via points are; needed
+        robot: The arm (a :class:`pinarms.robots.Robot`) whose joints the via points are; needed
             for torque limits.
-        payload: What the tcp carries: a mass [kg], a :class:`robots.Payload` or its dict
+        payload: What the tcp carries: a mass [kg], a :class:`pinarms.robots.Payload` or its dict
             form (``robot.with_payload``); only with ``torque_limits``.
         torque_limits: ``True``: also limit every joint's torque to the URDF's ``effort``
             (``robot.effort_limit``, N·m or N); or limits per joint; ``False``: kinematic
             limits only. The torques (inverse dynamics of the robot with its payload) are
             checked on ``torque_samples`` instants per piece (default 48) with their own
-            scaling law (:mod:`optim.torque`), and the answer is finally stretched onto the
+            scaling law (:mod:`pinarms.optim.torque`), and the answer is finally stretched onto the
             refined torque peaks, so it is feasible when re-checked densely. A torque-limited
             timing is never shorter than the kinematic one.
         torque_samples: Grid instants per polynomial piece for the torque constraint.

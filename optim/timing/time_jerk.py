@@ -172,7 +172,7 @@ def minimize_time_jerk(positions: Any, kind: str, vmax: Any, amax: Any = None,
 
     Args:
         positions, kind, vmax, amax, jmax, bounds, trajectory_options, problem: as in
-            :func:`optim.minimize_time`.
+            :func:`pinarms.optim.minimize_time`.
         mode: ``"two-stage"`` (seed 002: time-optimal first, then minimum jerk with
             ``T <= time_factor * T*``) or ``"weighted"`` (min ``k_time T + k_jerk J``).
         method: ``"ga"`` or ``"exact"`` (SLSQP from the exact time-optimal timing).

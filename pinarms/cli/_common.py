@@ -282,7 +282,7 @@ scheduler_option = click.option(
 
 
 def new_session(robot: Robot | str | None, title: str):
-    """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
+    """A :class:`pinarms.viz.Session` for ``robot`` (built-in name or any URDF)."""
     from pinarms import viz
 
     return viz.Session(robot=robot, title=title)

@@ -163,7 +163,7 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
     """Replay ``source`` in MuJoCo and compare with pinarms (module doc).
 
     Args:
-        cell: the :class:`robots.cell.Cell` the motion was planned in.
+        cell: the :class:`pinarms.robots.cell.Cell` the motion was planned in.
         source: a CycleResult (with ``arm``), a MotionPlan, or a LineSchedule (with ``cycles``).
         samples: evenly spaced instants, ends included (≥ 2).
         mjcf: an MJCF exported from this cell (default: exported to a temporary folder).
