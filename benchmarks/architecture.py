@@ -47,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: floor (errors, execution layer, atomic files, units) may be imported by every package and
 #: imports none of them.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
+    ("floor", ("pinarms.errors", "pinarms.lazy", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
                "pinarms.units", "pinarms.compiled", "pinarms.compile_notice")),
     ("robots", ("pinarms.robots", "pinarms.urdf")),
     ("planning", ("pinarms.planning",)),

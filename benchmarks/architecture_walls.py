@@ -158,15 +158,13 @@ class Reference:
 
 
 def _defined_names(tree: ast.Module) -> dict[str, set[str]]:
-    """``{"": top-level names, "Class": its attributes and methods}`` of a module."""
+    """``{"": top-level names, "Class": its attributes and methods}`` of a module (names a lazy
+    ``_EXPORTS`` table offers count as top-level names)."""
     out: dict[str, set[str]] = {"": set()}
     for node in tree.body:
-        targets: list[ast.AST] = []
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            out[""].add(node.name)
-        elif isinstance(node, ast.ClassDef):
-            out[""].add(node.name)
+        if isinstance(node, ast.ClassDef):
             members = out.setdefault(node.name, set())
+            out.setdefault(" bases " + node.name, set()).update(b.id for b in node.bases if isinstance(b, ast.Name))
             for item in ast.walk(node):
                 if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                     members.add(item.name)
@@ -174,26 +172,53 @@ def _defined_names(tree: ast.Module) -> dict[str, set[str]]:
                     members.add(item.target.id)
                 elif isinstance(item, ast.Assign):
                     members.update(t.id for t in item.targets if isinstance(t, ast.Name))
-                elif isinstance(item, (ast.Attribute,)) and isinstance(item.ctx, ast.Store):
+                elif isinstance(item, ast.Attribute) and isinstance(item.ctx, ast.Store):
                     members.add(item.attr)
-        elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
-            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-        elif isinstance(node, (ast.Import, ast.ImportFrom)):
-            out[""].update((a.asname or a.name).split(".")[0] for a in node.names)
-        elif isinstance(node, (ast.If, ast.Try)):
-            for sub in ast.walk(node):
-                if isinstance(sub, (ast.Import, ast.ImportFrom)):
-                    out[""].update((a.asname or a.name).split(".")[0] for a in sub.names)
-                elif isinstance(sub, (ast.FunctionDef, ast.ClassDef)):
-                    out[""].add(sub.name)
-                elif isinstance(sub, ast.Name) and isinstance(sub.ctx, ast.Store):
-                    out[""].add(sub.id)
-        for t in targets:
-            out[""].update(n.id for n in ast.walk(t) if isinstance(n, ast.Name))
+        if isinstance(node, ast.Assign):  # Class.method = function, at module level; names listed in __all__
+            for t in node.targets:
+                if isinstance(t, ast.Attribute) and isinstance(t.value, ast.Name):
+                    out.setdefault(t.value.id, set()).add(t.attr)
+                elif isinstance(t, ast.Name) and t.id == "__all__" and isinstance(node.value, (ast.List, ast.Tuple)):
+                    out[""].update(e.value for e in node.value.elts if isinstance(e, ast.Constant))
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "_EXPORTS" for t in node.targets) \
+                and isinstance(node.value, ast.Dict):
+            out[""].update(k.value for k in node.value.keys if isinstance(k, ast.Constant))
+        for sub in ast.walk(node) if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) \
+                else [node]:
+            if isinstance(sub, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                out[""].add(sub.name)
+            elif isinstance(sub, (ast.Import, ast.ImportFrom)):
+                out[""].update((a.asname or a.name).split(".")[0] for a in sub.names)
+            elif isinstance(sub, ast.Name) and isinstance(sub.ctx, ast.Store):
+                out[""].add(sub.id)
     return out
 
 
-def _resolves(text: str, known: set[str], names: dict[str, dict[str, set[str]]]) -> bool:
+def _homes(modules: dict[str, Path], trees: dict[str, ast.Module]) -> dict[tuple[str, str], str]:
+    """``{(module, name): module it comes from}`` for names a module imports or offers lazily."""
+    out: dict[tuple[str, str], str] = {}
+    for name, tree in trees.items():
+        is_package = modules[name].name == "__init__.py"
+        for node in tree.body:
+            if isinstance(node, ast.ImportFrom):
+                base = _resolve(name, is_package, node)
+                for a in node.names:
+                    out[(name, a.asname or a.name)] = base
+            elif isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "_EXPORTS"
+                                                      for t in node.targets) and isinstance(node.value, ast.Dict):
+                for k, v in zip(node.value.keys, node.value.values):
+                    if isinstance(k, ast.Constant) and isinstance(v, ast.Constant):
+                        where = v.value.partition(":")[0]
+                        if where.startswith("."):
+                            level = len(where) - len(where.lstrip("."))
+                            parts = name.split(".") if is_package else name.split(".")[:-1]
+                            where = ".".join(parts[: len(parts) - (level - 1)] + [where.lstrip(".")])
+                        out[(name, k.value)] = where
+    return out
+
+
+def _resolves(text: str, known: set[str], names: dict[str, dict[str, set[str]]],
+              homes: dict[tuple[str, str], str] | None = None, depth: int = 0) -> bool:
     parts = text.split(".")
     for k in range(len(parts), 0, -1):
         module = ".".join(parts[:k])
@@ -202,9 +227,18 @@ def _resolves(text: str, known: set[str], names: dict[str, dict[str, set[str]]])
             if not rest:
                 return True
             defined = names[module]
-            if rest[0] in defined[""] or ".".join([module, rest[0]]) in known:
-                return len(rest) == 1 or rest[1] in defined.get(rest[0], set()) or len(rest) > 2
-            return False
+            if rest[0] not in defined[""] and ".".join([module, rest[0]]) not in known:
+                return False
+            if len(rest) == 1 or rest[1] in defined.get(rest[0], set()):
+                return True
+            for base in defined.get(" bases " + rest[0], ()):  # a member inherited from a base class
+                where = (homes or {}).get((module, base), module)
+                if depth < 5 and _resolves(".".join([where, base, *rest[1:]]), known, names, homes, depth + 1):
+                    return True
+            home = (homes or {}).get((module, rest[0]))
+            if home and depth < 5:
+                return _resolves(".".join([home, *rest]), known, names, homes, depth + 1)
+            return len(rest) > 2
     return False
 
 
@@ -220,6 +254,7 @@ def docstring_references(modules: dict[str, Path], roots: tuple[str, ...] | None
     pattern = re.compile(r":(?:py:)?(?:%s):`~?([A-Za-z_][\w.]*)`" % "|".join(_ROLES))
     trees = {name: _parse(path) for name, path in modules.items()}
     names = {name: _defined_names(tree) for name, tree in trees.items()}
+    homes = _homes(modules, trees)
     out: list[Reference] = []
     for name, tree in trees.items():
         for node in ast.walk(tree):
@@ -233,7 +268,7 @@ def docstring_references(modules: dict[str, Path], roots: tuple[str, ...] | None
                 text = match.group(1)
                 if "." in text and text.split(".")[0] in roots:
                     line = first + doc[: match.start()].count("\n")
-                    out.append(Reference(name, line, text, _resolves(text, known, names)))
+                    out.append(Reference(name, line, text, _resolves(text, known, names, homes)))
             # comments with #: above constants are not docstrings; they are left out
     return sorted(out, key=lambda r: (r.module, r.lineno, r.text))
 
