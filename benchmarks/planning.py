@@ -51,7 +51,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion import MotionChecker, SCENES, load_scene, plan_motion, scene_queries
 from pinarms.robots.collision_requests import cold_start

@@ -6,7 +6,7 @@ catches everything pinarms raises on purpose.
 
 from __future__ import annotations
 
-from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError
+from pinarms.errors import CollisionError, InvalidInput, PinarmsError
 
 __all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "SettingOutOfRange", "PlanningError",
            "EndpointInCollision", "StartInCollision", "GoalInCollision", "NoPathFound"]

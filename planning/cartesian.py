@@ -30,7 +30,7 @@ from pinarms.planning.multi_quintic import multi_quintic
 from pinarms.planning.piecewise import piecewise_polynomial
 from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import Trajectory
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "tcp_speed", "PATH_KINDS"]
@@ -61,7 +61,7 @@ def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
     the module docstring).
 
     Raises:
-        robots.errors.UnreachableTarget: naming the waypoint index that has no solution.
+        pinarms.errors.UnreachableTarget: naming the waypoint index that has no solution.
     """
     P = _poses(poses)
     nq = int(robot.nq)

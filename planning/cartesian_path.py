@@ -48,7 +48,7 @@ from pinarms.planning.ik_continuation import MAX_CORRECTION, Knot, PathSolver, S
 from pinarms.planning.joint_path import JointPath
 from pinarms.planning.multi_quintic import quintic_hermite_coefficients
 from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
+from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
 __all__ = ["TrajectoryError", "ConditionCountError", "OutOfTimeRange", "BlendTooLarge", "PathError",
            "SingularityOnPath", "JointLimitOnPath", "UnreachableOnPath"]

@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import as_batch
-from .errors import InvalidInput, ModelError
+from ..errors import InvalidInput, ModelError
 
 __all__ = [
     "GRAVITY",

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import real_array
-from .errors import InvalidInput
+from ..errors import InvalidInput
 
 __all__ = ["check_ik_target"]
 

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .errors import ModelError
+from ..errors import ModelError
 from .so3 import frame_z_to as _rotation_z_to
 
 __all__ = ["KinematicTree", "JointCoordinates"]

@@ -19,7 +19,7 @@ import pinocchio as pin
 
 from pinarms.files import read_bounded_text
 
-from .errors import InvalidInput, ModelError, RobotNotFound
+from ..errors import InvalidInput, ModelError, RobotNotFound
 from .robot import Robot
 # the URDF checks, under the names robots/cell/compose.py imports from here
 from ._checks import check_path_name

@@ -25,7 +25,7 @@ import pinocchio as pin
 from ._checks import as_batch as _as_batch
 from ._checks import as_generator as _as_generator
 from ._checks import check_tolerance as _check_tolerance
-from .errors import InvalidInput, ModelError
+from ..errors import InvalidInput, ModelError
 from .kinematic_tree import KinematicTree
 from .manipulability import manipulability_of_jacobian
 from .robot_ik import RobotIK

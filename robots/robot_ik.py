@@ -14,7 +14,7 @@ import numpy as np
 from ._checks import check_restarts as _check_restarts
 from ._checks import check_seed as _check_seed
 from ._checks import check_tolerance as _check_tolerance
-from .errors import InvalidInput, ModelError, UnreachableTarget
+from ..errors import InvalidInput, ModelError, UnreachableTarget
 from .ik.numerical import NumericalIK
 from .ik.solver import LIMIT_TOL, split_by_target
 from .ik_target import check_ik_target

@@ -42,7 +42,7 @@ import pinocchio as pin
 
 from .coaxial import still_frames
 from .collision_requests import cold_start, pair_probe
-from .errors import InvalidInput, ModelError, SelfContactError
+from ..errors import InvalidInput, ModelError, SelfContactError
 from .pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
                          structural_reason)
 

@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from pinarms.files import write_text
-from pinarms.robots.errors import ModelError, RobotNotFound
+from ..errors import ModelError, RobotNotFound
 
 __all__ = [
     "XACRO_DIR",

@@ -55,7 +55,7 @@ from typing import Any, Mapping
 from pinarms.files import check_regular
 
 from ._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
-from .errors import (
+from ..errors import (
     InvalidInput,
     MissingMesh,
     XacroArgError,

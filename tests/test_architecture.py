@@ -98,9 +98,11 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
         m.split(".")[0] for m in modules - ours if m.split(".")[0] not in sys.stdlib_module_names
     }
     assert third_party <= {"numpy", "dask", "distributed", "threadpoolctl"}, third_party
-    # and the errors module it reaches imports nothing of ours
+    # and the errors module it reaches imports nothing of ours but the floor's lazy loading (the areas'
+    # errors it offers load on first use)
     errors = _imported_modules(ROOT / "pinarms" / "errors.py")
-    assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
+    assert {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}} == {"pinarms.lazy"}, errors
+    assert _imported_modules(ROOT / "pinarms" / "lazy.py") <= sys.stdlib_module_names | {"__future__"}
 
 
 @pytest.mark.parametrize("floor", sorted(set(BOTTOM.values()) - {"errors", "execution"}))
@@ -111,13 +113,28 @@ def test_the_floor_imports_nothing_of_ours_but_the_floor(floor):
     assert all(floor in ALLOWED[pkg] for pkg in ORDER)
 
 
-def test_the_old_errors_path_names_the_same_classes():
-    import pinarms.robots.errors as old
+def test_one_errors_module_offers_every_error():
+    """``pinarms.errors`` offers every exception class of every area's ``errors`` module (the same class
+    objects); no other module re-exports them (the old ``pinarms.robots.errors`` is gone)."""
+    import importlib
 
-    import pinarms.errors as floor
+    import pinarms.errors as errors
 
-    assert old.__all__ == floor.__all__
-    assert all(getattr(old, name) is getattr(floor, name) for name in floor.__all__)
+    assert not (ROOT / "robots" / "errors.py").exists()
+    defined = {}
+    for path in sorted(ROOT.glob("**/errors.py")):
+        if ".venv" in path.parts or "tests" in path.parts:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        assert not [n for n in tree.body if isinstance(n, ast.ImportFrom) and any(a.name == "*" for a in n.names)], path
+        for node in tree.body:
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                defined[node.name] = path
+    assert len(defined) >= 50
+    for name, path in defined.items():
+        assert name in errors.__all__, f"{name} ({path}) is missing from pinarms.errors"
+        home = importlib.import_module(getattr(errors, name).__module__)
+        assert getattr(home, name) is getattr(errors, name)
 
 
 def test_robot_and_its_dynamics_are_no_circle():

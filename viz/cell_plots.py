@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .figure_files import checked_numbers, save_figure
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from pinarms.robots.cell import Cell
 from pinarms.robots.cell.timeline import arm_motions, configurations, sample_motions
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["add_cell"]
 

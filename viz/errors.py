@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 
 __all__ = ["VizError", "SessionFormatError", "ViewerError"]
 

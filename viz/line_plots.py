@@ -21,7 +21,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .plots import _save
 

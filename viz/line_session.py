@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
 from .line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
 

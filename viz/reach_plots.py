@@ -20,7 +20,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .figure_files import checked_numbers, save_figure
 from .reach_scene import INDEX_COLORMAP

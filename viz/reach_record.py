@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["ReachabilityRecord", "make_record", "encode_reachability", "decode_reachability", "MAX_DESCRIPTION"]
 

@@ -33,7 +33,7 @@ from typing import Any, Sequence
 import matplotlib
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._meshcat import meshcat, mg
 from .cloud_scene import draw_clouds, cloud_colorbar

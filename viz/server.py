@@ -16,7 +16,7 @@ import weakref
 from pathlib import Path
 from typing import Any
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._meshcat import ViewerWindow, meshcat
 from .errors import ViewerError

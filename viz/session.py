@@ -30,7 +30,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
 
 from .session_archive import SessionLimits

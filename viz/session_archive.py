@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO, Iterator
 import numpy as np
 
 from pinarms.files import open_regular
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .errors import SessionFormatError
 from .names import NAME_RE

@@ -32,7 +32,7 @@ from typing import Any, BinaryIO, Mapping
 import numpy as np
 
 from pinarms.files import atomic_write
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .mesh_paths import check_mesh_paths
 from .session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive

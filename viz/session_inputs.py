@@ -15,7 +15,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .session_archive import F8
 from .session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name

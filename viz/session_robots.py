@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from pinarms import robots
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 from pinarms.robots.robot import Robot
 
 from .errors import SessionFormatError

@@ -13,7 +13,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._meshcat import meshcat
 from .robot_drawing import RobotDrawing

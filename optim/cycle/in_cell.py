@@ -51,7 +51,7 @@ from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.cell.idle import idle_contacts
-from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
+from pinarms.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES", "SCREEN_MOVES"]
 

@@ -41,7 +41,7 @@ from pinarms.optim.cycle.spec import CycleResult, _hold, _line_deviation, _verti
 from pinarms.optim.timing.segments import TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import joint_waypoints
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["joint_cycle"]

@@ -32,7 +32,7 @@ from pinarms.optim.cycle.spec import (  # noqa: F401  (the spec and result, re-e
     PickPlace,
 )
 from pinarms.optim.cycle.straight import approach_cycle
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "CycleResult", "PickPlace",
            "CycleRequest", "CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "plan_cycle"]

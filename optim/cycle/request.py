@@ -33,7 +33,7 @@ from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning.torque import JointTorqueConstraint
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "CycleRequest"]
 

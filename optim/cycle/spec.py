@@ -20,7 +20,7 @@ from pinarms.optim.caps import MAX_DWELL, number_setting
 from pinarms.optim.timing.segments import TimingResult
 from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CYCLE_STATUSES", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
            "PickPlace"]

@@ -37,7 +37,7 @@ from pinarms.optim.timing.segments import TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint, JointVelocityConstraint,
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["StraightMove", "straight_cycle", "approach_cycle"]
 

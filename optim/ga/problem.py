@@ -28,7 +28,7 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 from pinarms.planning.torque import piece_states
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from pinarms.optim.caps import MAX_AXIS_VALUES, MAX_PLACEMENTS, count_setting
 from pinarms.optim.errors import SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame"]
 

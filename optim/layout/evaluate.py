@@ -13,7 +13,7 @@ import numpy as np
 
 from pinarms.optim.cycle import CellSettings, CycleRequest, CycleTiming, PickPlace, plan_cycle
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
+from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
 from .candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
 

@@ -43,7 +43,7 @@ from pinarms.optim.caps import (MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, 
                                MAX_REFINE_EVALUATIONS, MAX_WORKSPACE_SAMPLES, count_setting, number_setting)
 from pinarms.optim.cycle import CYCLE_KINDS, PickPlace
 from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)

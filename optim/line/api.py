@@ -27,7 +27,7 @@ from pinarms.optim.line.task_maps import TaskMap, build_task_map
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "sim_arms", "STATUSES", "LineCurve", "line_curve",
            "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["FixtureCheck", "PairCheck", "CHORD", "chord_polyline", "fixture_check", "check_in_cell"]
 
@@ -134,7 +134,7 @@ _CHECKS: dict = {}
 
 def check_in_cell(cell: Any, station: Any) -> None:
     """InvalidInput unless ``station`` is an arm of ``cell`` (same name, same base)."""
-    from pinarms.robots.errors import PinarmsError
+    from pinarms.errors import PinarmsError
 
     try:
         arm = cell.arm(station.name)

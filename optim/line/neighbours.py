@@ -21,7 +21,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
 __all__ = ["NeighbourGuard"]
 

@@ -24,7 +24,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["RULES", "Rule", "Candidates", "choose_simple", "rank_simple", "best_sequence"]
 

@@ -28,7 +28,7 @@ import numpy as np
 from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting,
                                number_setting)
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["LineSchedule", "schedule_line"]
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from pinarms.optim.line.items import Items
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SimArm", "ArmState"]
 

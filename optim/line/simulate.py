@@ -37,7 +37,7 @@ import numpy as np
 from pinarms.optim.line.items import Items
 from pinarms.optim.line.rules import Candidates, Rule, best_sequence, rank_simple
 from pinarms.optim.line.sim_arm import ArmState, SimArm
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SimArm", "SimResult", "simulate", "EPS", "NO_TRAY"]
 

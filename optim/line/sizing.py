@@ -23,7 +23,7 @@ from pinarms.optim.line.items import ItemType, poisson_items
 from pinarms.optim.line.rules import Rule
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SizingProblem", "SizingResult", "size_line", "evaluate_layouts"]
 

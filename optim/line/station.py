@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.line.belt import PlaceBox
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["Station", "ACCELERATION_FACTOR", "base_pose"]
 

@@ -36,7 +36,7 @@ from pinarms.optim.line.task_map_checks import MAX_MAP_VALUES, MAX_TASK_TIME, ch
 from pinarms.optim.line.task_map_file import map_members, read_map_file
 from pinarms.optim.line.tracking import TrackingSpec, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
-from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
+from pinarms.errors import InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["TaskMap", "build_task_map", "map_error", "MapError", "MAX_MAP_VALUES"]
 

@@ -38,7 +38,7 @@ from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.station import Station
 from pinarms.planning import Trajectory
 from pinarms.planning.joint_path import JointPath
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
            "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError"]

@@ -53,7 +53,7 @@ from pinarms.optim.motion import coal_batches
 from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 #: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
 #: :meth:`MotionChecker.trajectory_valid` (the rounding of a time scaling's re-expanded

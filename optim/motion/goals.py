@@ -36,7 +36,7 @@ def closed_form(robot: Any) -> Any:
     family = _families_by_joints().get(tuple(robot.joint_names))
     if family is not None:
         from pinarms.robots.ik import attach_analytic_ik
-        from pinarms.robots.errors import ModelError
+        from pinarms.errors import ModelError
 
         try:
             attach_analytic_ik(robot, family)
@@ -109,7 +109,7 @@ def ik_candidates(robot: Any, T_base: np.ndarray, q_ref: np.ndarray, *, seed: in
         q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
         ok = np.asarray(robot.within_limits(q), dtype=bool).reshape(-1) if q.shape[0] else np.zeros(0, bool)
         return q[ok], np.asarray(branch, dtype=int).reshape(-1)[ok]
-    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.errors import UnreachableTarget
 
     rng = np.random.default_rng(seed)
     found: list[np.ndarray] = []

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import CellNotFound, InvalidInput, UnreachableTarget
+from pinarms.errors import CellNotFound, InvalidInput, UnreachableTarget
 
 __all__ = ["Region", "Scene", "Query", "SCENES", "SCENE_DIR", "scene_names", "scene_path", "load_scene",
            "scene_queries", "region_pose", "valid_ik"]

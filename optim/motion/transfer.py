@@ -26,7 +26,7 @@ from pinarms.optim.motion.checker import MotionChecker
 from pinarms.optim.motion.plan import _limits, plan_geometry, time_path
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import CollisionError
+from pinarms.errors import CollisionError
 
 __all__ = ["PlannedMove", "planned_cycle"]
 

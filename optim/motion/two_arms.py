@@ -34,7 +34,7 @@ from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError, St
 from pinarms.optim.motion.checker import MotionChecker, TimedArm
 from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_motion
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms", "DELAY_SAMPLES"]
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import click
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._common import cli, emit, json_option, scheduler_option
 

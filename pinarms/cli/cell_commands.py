@@ -10,7 +10,7 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
                       skipped_pair_lines)

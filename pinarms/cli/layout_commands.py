@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._common import (
     NUMBERS,

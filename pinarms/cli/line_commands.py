@@ -7,7 +7,7 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import angle_scale, joints_from_si, joints_to_si, length_scale
 
 from ._common import (NUMBERS, PinarmsCommand, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,

@@ -13,7 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import angle_scale, length_scale
 
 from ._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress

@@ -8,7 +8,7 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
 from pinarms.units import (
     angle_scale,

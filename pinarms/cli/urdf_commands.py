@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._common import (
     PinarmsGroup,

@@ -18,7 +18,7 @@ import click
 import numpy as np
 
 from pinarms.files import read_bounded_text
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from ._common import floats
 

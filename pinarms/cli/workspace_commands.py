@@ -7,7 +7,7 @@ import click
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import length_scale
 
 from . import _common as common

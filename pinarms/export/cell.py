@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .mesh_convert import binary_stl
 from .mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
@@ -165,7 +165,7 @@ def _mujoco():
     try:
         import mujoco
     except ImportError as exc:
-        from pinarms.robots.errors import ModelError
+        from pinarms.errors import ModelError
 
         raise ModelError("the MJCF export needs MuJoCo's Python package: pip install mujoco "
                          "(or pip install 'pinarms[mujoco]')") from exc

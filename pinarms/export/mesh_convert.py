@@ -21,7 +21,7 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Iterator
 
 from pinarms.files import path_inside
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 
 from .errors import MeshNotFound
 

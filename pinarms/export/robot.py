@@ -27,7 +27,7 @@ from typing import Mapping
 
 from pinarms import robots
 from pinarms.files import safe_file_name
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
 from .cell import export_robot_with_srdf

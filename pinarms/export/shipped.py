@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from .srdf import cycle_states
 

@@ -38,7 +38,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput, LimitViolation
+from pinarms.errors import InvalidInput, LimitViolation
 from pinarms.files import atomic_write
 
 from .acceleration_check import acceleration_limits_of, flag_accelerations

@@ -15,7 +15,7 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Mapping
 
 from pinarms.files import copy_new_file, output_folder, path_inside, publish_folder, safe_file_name, write_new_file
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
 from .errors import ExportError, MeshNotAllowed

@@ -35,7 +35,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms.robots.collision_requests import cold_start
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 
 from .srdf import contact_pairs
 

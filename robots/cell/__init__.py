@@ -42,8 +42,8 @@ _EXPORTS = {
     "CollisionPair": ".pairs",
     "PairReason": ".pairs",
     "ArmMotion": ".timeline",
-    "CellTooLarge": "..errors",
-    "PlacementError": "..errors",
+    "CellTooLarge": "pinarms.errors",
+    "PlacementError": "pinarms.errors",
 }
 
 __all__ = [

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ArmStateError, CellError
+from ...errors import ArmStateError, CellError
 from .components import CellArm
 from .compose_file import ArmPlacement, ToolPoint
 

@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision_requests import cold_start
-from ..errors import CellError, CollisionGeometryError
+from ...errors import CellError, CollisionGeometryError
 from ..robot import Robot
 from ..xacro_expand import mesh_path
 from .components import CellArm, Fixture, Shape

@@ -24,7 +24,7 @@ from typing import Any, Callable, Mapping, Sequence, TypeVar
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CellError, CellTooLarge, InvalidInput
+from ...errors import CellError, CellTooLarge, InvalidInput
 from ..robot import Robot
 from .arm_keys import arm_with_keys
 from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures

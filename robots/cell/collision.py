@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CollisionGeometryError, InvalidInput
+from ...errors import CollisionGeometryError, InvalidInput
 from .pairs import CollisionPair
 
 from .cell_model import CellModel

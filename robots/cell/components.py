@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from ..robot import Robot
 
 __all__ = ["CellArm", "Fixture", "Shape"]

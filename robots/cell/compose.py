@@ -39,7 +39,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ..errors import CellError, ModelError, XacroForbidden
+from ...errors import CellError, ModelError, XacroForbidden
 from ..urdf_checks import check_tree, refuse_dtd
 from .cell import Cell
 from .compose_file import (

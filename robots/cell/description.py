@@ -23,7 +23,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-from ..errors import CellError
+from ...errors import CellError
 from ..pair_rules import declared_pairs
 
 __all__ = ["ArmSpec", "CellSpec", "describe", "arm_urdf"]

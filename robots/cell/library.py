@@ -16,7 +16,7 @@ from typing import Any, Mapping
 
 from pinarms.files import check_regular
 from .._checks import check_path_name
-from ..errors import CellNotFound, InvalidInput, ModelError
+from ...errors import CellNotFound, InvalidInput, ModelError
 from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
 from ..xacro_expand import XacroLimits, expand_xacro
 from .cell import Cell

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .collision import _margin, exact_min_distance, pair_lower_bounds
 from .ladder import Intervals, climb
 from .motion_curves import moving_arm_curves

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CellError, InvalidInput
+from ...errors import CellError, InvalidInput
 
 from .cell_model import CellModel
 

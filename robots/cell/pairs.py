@@ -84,7 +84,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..coaxial import still_frames
-from ..errors import PlacementError
+from ...errors import PlacementError
 from ..pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
 from ..pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
                           structural_reason)

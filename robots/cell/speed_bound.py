@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .timeline import ArmMotion
 
 from .cell_model import CellModel

@@ -16,7 +16,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 
 from .cell_model import CellModel
 

@@ -67,7 +67,7 @@ def analytic_solver(robot, family: str, frame: str = "tcp") -> AnalyticIK:
         InvalidInput: unknown family.
         ModelError: the robot does not have the structure the family's solver assumes.
     """
-    from ..errors import InvalidInput
+    from ...errors import InvalidInput
 
     if family not in FAMILIES:
         raise InvalidInput(f"unknown IK family {family!r}; known: {', '.join(FAMILIES)}")

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ModelError
+from ...errors import ModelError
 from ..so3 import hat as _skew
 
 __all__ = [

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ...errors import ModelError
 from .geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link, rotate, solve_cos_sin
 from .solver import AnalyticIK
 

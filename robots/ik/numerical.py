@@ -63,7 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from ..kinematic_tree import _REVOLUTE
 from .._checks import check_restarts as _check_restarts
 from .._checks import check_seed as _check_seed

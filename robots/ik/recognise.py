@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError
+from ...errors import ModelError
 from .families import FAMILIES
 from .geometry import chain_axes
 from .solver import AnalyticIK

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ...errors import ModelError
 from .geometry import (
     STRUCTURE_TOL,
     angle_about,

@@ -58,7 +58,7 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
         np.maximum.at(top, idx, w)
         best = np.where(np.isfinite(top), top, np.nan)
     else:
-        from ..errors import UnreachableTarget
+        from ...errors import UnreachableTarget
 
         for k in range(T.shape[0]):
             try:

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput, ModelError
+from ...errors import InvalidInput, ModelError
 from .orientations import _align, _rotation_about
 from .base_verify import verify_bases
 from .reach_map import ReachabilityMap

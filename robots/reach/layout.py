@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput, UnreachableTarget
+from ...errors import InvalidInput, UnreachableTarget
 from ..so3 import rot_z as _rot_z
 from .dexterity import position_dexterity
 from .workspace import Workspace, sample_workspace

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from ..so3 import about as _rotation_about
 from ..so3 import frame_z_to as _frame_z_to
 from ..so3 import from_quaternion as _quat_to_matrix

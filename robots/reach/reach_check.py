@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import PinarmsError
+from ...errors import PinarmsError
 from .orientations import MAX_ORIENTATIONS, OrientationSet
 from .reach_digest import PosesDigest, map_checksum
 from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap

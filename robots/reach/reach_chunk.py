@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .reach_map import _centres
 from .robot_spec import RobotSpec, robot_of, spec_key
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from ..errors import InvalidInput, ModelError
+from ...errors import InvalidInput, ModelError
 from .reach_map import MAX_GRID_VOXELS, _centres
 
 if TYPE_CHECKING:  # pragma: no cover

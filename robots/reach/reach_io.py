@@ -58,7 +58,7 @@ import numpy as np
 
 from pinarms.files import check_regular
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .orientations import MAX_ORIENTATIONS
 from .reach_check import MAX_JOINTS, MapChecker, ReachabilityFileError, check_map
 from .reach_write import FORMAT_NAME, FORMAT_VERSION, StreamWriter, write_map

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import ndimage
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .orientations import OrientationSet
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -18,7 +18,7 @@ import numpy as np
 
 from pinarms.files import discard, publish, temporary_for
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .reach_digest import PosesDigest, map_checksum
 
 __all__ = ["StreamWriter", "write_map", "FORMAT_NAME", "FORMAT_VERSION"]

@@ -61,7 +61,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from .._checks import check_restarts
-from ..errors import InvalidInput, ModelError
+from ...errors import InvalidInput, ModelError
 from .orientations import OrientationSet, so3_orientations, tool_down_orientations
 from .reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
 from .reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels

@@ -13,7 +13,7 @@ import hashlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ModelError
+from ...errors import ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from ..robot import MAX_RANDOM_SAMPLES
 from .dexterity import CHUNK, position_dexterity, positions_and_dexterity
 from .joint_samples import random_q_slice

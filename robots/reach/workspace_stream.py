@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ...errors import InvalidInput
 from .dexterity import positions_and_dexterity
 from .joint_samples import generator_at
 from .stream_reduction import Reduction, ReductionSpec, add_block, merge, sparse_voxels

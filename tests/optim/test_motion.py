@@ -19,7 +19,7 @@ from pinarms.optim.motion import MotionChecker, plan_motion
 from pinarms.optim.motion.goals import ik_candidates
 from pinarms.optim.motion.scenes import Region, region_pose
 from pinarms.robots.cell.motion import joint_levers
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 from tests.optim.motion_helpers import BulletScene, dense_times
 

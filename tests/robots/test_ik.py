@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from pinarms import robots
 from pinarms.robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.papers import SEED001
 from pinarms.robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
 

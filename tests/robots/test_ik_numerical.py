@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ik import NumericalIK
 
 ALL_ARMS = ["scara_mushroom", "gantry_flower", "koji_turner", "koji_turner_rail", "aubo_i3", "ur5", "panda"]

@@ -16,7 +16,7 @@ import pytest
 
 from pinarms import robots
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz import SessionFormatError
 
 from session_files import document, npy_bytes, rewrite

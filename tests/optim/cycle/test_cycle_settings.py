@@ -18,7 +18,7 @@ import pytest
 from pinarms import optim, planning, robots
 from pinarms.optim import caps
 from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 PICK, PLACE = [0.30, 0.25, 0.10], [-0.20, 0.35, 0.08]
 

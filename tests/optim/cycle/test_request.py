@@ -17,7 +17,7 @@ from pinarms import optim, robots
 from pinarms.optim.cycle import (CYCLE_STATUSES, CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleTiming,
                                  PickPlace, plan_cycle)
 from pinarms.optim.errors import InvalidLimits, InvalidSettings, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 PICK, PLACE = [0.30, 0.25, 0.10], [-0.20, 0.35, 0.08]
 
