@@ -37,7 +37,7 @@ from pinarms.studies.seed002 import BOUNDS_002_S, study_002  # noqa: F401  (old 
 from pinarms.studies.seed004 import study_004
 from pinarms.studies.study import Study
 
-from .report import Row, format_table, markdown_table
+from pinarms.report import Row, format_table, markdown_table
 
 __all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004",
            "study_cell", "study_line"]

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import real_array
-from ..errors import InvalidInput
+from pinarms.robots._checks import real_array
+from pinarms.errors import InvalidInput
 
 __all__ = ["check_ik_target"]
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.linalg.lapack import dpotrf as _potrf
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["PARTS", "manipulability_of_jacobian"]
 

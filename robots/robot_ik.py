@@ -11,13 +11,13 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._checks import check_restarts as _check_restarts
-from ._checks import check_seed as _check_seed
-from ._checks import check_tolerance as _check_tolerance
-from ..errors import InvalidInput, ModelError, UnreachableTarget
-from .ik.numerical import NumericalIK
-from .ik.solver import LIMIT_TOL, split_by_target
-from .ik_target import check_ik_target
+from pinarms.robots._checks import check_restarts as _check_restarts
+from pinarms.robots._checks import check_seed as _check_seed
+from pinarms.robots._checks import check_tolerance as _check_tolerance
+from pinarms.errors import InvalidInput, ModelError, UnreachableTarget
+from pinarms.robots.ik.numerical import NumericalIK
+from pinarms.robots.ik.solver import LIMIT_TOL, split_by_target
+from pinarms.robots.ik_target import check_ik_target
 
 
 __all__: list[str] = []
@@ -374,7 +374,7 @@ class RobotIK:
             return res.q
         bad = np.flatnonzero(~ok)
         k = int(bad[0])
-        from .ik.numerical import IKResult
+        from pinarms.robots.ik.numerical import IKResult
 
         first = IKResult(res.q[k], False, float(res.position_error[k]), float(res.rotation_error[k]), 1 + max_restarts, 0)
         exc = UnreachableTarget(

@@ -40,14 +40,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .coaxial import still_frames
-from .collision_requests import cold_start, pair_probe
-from ..errors import InvalidInput, ModelError, SelfContactError
-from .pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
+from pinarms.robots.coaxial import still_frames
+from pinarms.robots.collision_requests import cold_start, pair_probe
+from pinarms.errors import InvalidInput, ModelError, SelfContactError
+from pinarms.robots.pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
                          structural_reason)
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["SelfCollision", "ALWAYS_SAMPLES"]
 

@@ -22,7 +22,7 @@ import xml.parsers.expat
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ModelError
+from pinarms.errors import ModelError
 
 __all__ = ["refuse_dtd", "check_tree", "check_limits", "check_inertials", "MAX_POSITION_LIMIT", "MAX_SPEED_LIMIT", "MAX_EFFORT_LIMIT"]
 

@@ -54,8 +54,8 @@ from typing import Any, Mapping
 
 from pinarms.files import check_regular
 
-from ._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
-from ..errors import (
+from pinarms.robots._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
+from pinarms.errors import (
     InvalidInput,
     MissingMesh,
     XacroArgError,

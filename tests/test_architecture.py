@@ -139,7 +139,7 @@ def test_one_errors_module_offers_every_error():
 
 def test_robot_and_its_dynamics_are_no_circle():
     """robots/robot.py uses robots/dynamics.py; dynamics imports nothing of robot (not even for types)."""
-    assert "robot" not in _relative_imports(ROOT / "robots" / "dynamics.py")
+    assert "robot" not in _sibling_imports(ROOT / "robots" / "dynamics.py")
     assert "pinarms.robots.robot" not in _imported_modules(ROOT / "robots" / "dynamics.py")
 
 
@@ -171,13 +171,14 @@ def test_tests_and_benchmarks_import_the_namespace_only():
     assert not offenders, f"import pinarms.robots etc., not top-level robots: {offenders}"
 
 
-def _relative_imports(path: Path) -> set[str]:
-    """Sibling modules a module of ``robots/`` imports (``from .x import``, at any level)."""
+def _sibling_imports(path: Path) -> set[str]:
+    """Sibling modules a module of ``robots/`` imports (``from pinarms.robots.reach.x import``: ``x``)."""
+    package = "pinarms." + ".".join(path.relative_to(ROOT).parent.parts)
     tree = ast.parse(path.read_text(encoding="utf-8"))
     return {
-        node.module.split(".")[0]
+        node.module[len(package) + 1:].split(".")[0]
         for node in ast.walk(tree)
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith(package + ".")
     }
 
 
@@ -190,6 +191,22 @@ def test_workspace_analysis_modules_import_one_way():
         "table_band": {"layout", "workspace_stream"},
     }
     wrong = {
-        m: sorted(_relative_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+        m: sorted(_sibling_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
     }
     assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"
+
+
+def test_one_import_style_absolute():
+    """Every import of our own code names the importable module (``from pinarms.robots.cell.cell import Cell``):
+    the folders install under ``pinarms.`` (pyproject.toml's package-dir), so a relative import hides where a
+    module lives; the lazy tables of the package ``__init__`` s name absolute modules too."""
+    relative = []
+    for folder in ("pinarms", *SUBPACKAGES):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            relative += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree)
+                         if isinstance(n, ast.ImportFrom) and n.level > 0]
+            relative += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree) if isinstance(n, ast.Constant)
+                         and isinstance(n.value, str) and path.name == "__init__.py" and n.value.startswith(".")
+                         and n.value[1:2].isalpha()]
+    assert relative == [], relative[:20]

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 
 from pinarms.errors import InvalidInput
 
-from .figure_files import checked_numbers, save_figure
+from pinarms.viz.figure_files import checked_numbers, save_figure
 
 __all__ = ["plot_clearance", "plot_schedule"]
 

@@ -9,9 +9,9 @@ from typing import Any
 
 from pinarms.files import atomic_write
 
-from .page import with_page
-from .scene import SceneInfo, build_scene
-from .server import MeshcatServer
+from pinarms.viz.page import with_page
+from pinarms.viz.scene import SceneInfo, build_scene
+from pinarms.viz.server import MeshcatServer
 
 __all__ = ["export_html", "scene_html"]
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from .session import Session
+from pinarms.viz.session import Session
 
 __all__ = ["layout_search_session"]
 

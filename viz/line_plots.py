@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 
 from pinarms.errors import InvalidInput
 
-from .plots import _save
+from pinarms.viz.plots import _save
 
 __all__ = ["schedule_figure", "plot_line_schedule", "sizing_figure", "plot_line_sizing", "line_curve",
            "MAX_LABELLED_PICKS"]

@@ -34,7 +34,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from .names import NAME_RE
+from pinarms.viz.names import NAME_RE
 
 __all__ = ["LineRecord", "BOX_DEPTH", "ITEM_COLUMNS", "MISSED", "NOT_DRAWN", "MAX_LINE_ITEMS", "MAX_LINE_ARMS",
            "MAX_LINE_LENGTH", "check_line", "encode_line", "decode_line"]

@@ -25,7 +25,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput, PinarmsError
 
-from .line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
+from pinarms.viz.line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 

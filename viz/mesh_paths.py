@@ -14,7 +14,7 @@ import re
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from .errors import SessionFormatError
+from pinarms.viz.errors import SessionFormatError
 
 __all__ = ["check_mesh_paths", "MESH_SUFFIXES"]
 

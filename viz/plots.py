@@ -24,10 +24,10 @@ from matplotlib.lines import Line2D
 
 from pinarms.errors import InvalidInput
 
-from .cell_plots import plot_clearance, plot_schedule
-from .figure_files import checked_numbers, save_figure
-from .reach_plots import plot_workspace
-from .search_plots import plot_ga_convergence, plot_layout_search
+from pinarms.viz.cell_plots import plot_clearance, plot_schedule
+from pinarms.viz.figure_files import checked_numbers, save_figure
+from pinarms.viz.reach_plots import plot_workspace
+from pinarms.viz.search_plots import plot_ga_convergence, plot_layout_search
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
            "plot_clearance", "plot_schedule", "plot_torques",

@@ -22,8 +22,8 @@ from matplotlib.figure import Figure
 
 from pinarms.errors import InvalidInput
 
-from .figure_files import checked_numbers, save_figure
-from .reach_scene import INDEX_COLORMAP
+from pinarms.viz.figure_files import checked_numbers, save_figure
+from pinarms.viz.reach_scene import INDEX_COLORMAP
 
 __all__ = ["plot_workspace", "plot_reachability_section", "section_index"]
 

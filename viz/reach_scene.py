@@ -16,7 +16,7 @@ from typing import Any
 import matplotlib
 import numpy as np
 
-from ._meshcat import mg
+from pinarms.viz._meshcat import mg
 
 __all__ = ["draw_reachability", "layer_name", "INDEX_COLORMAP"]
 
@@ -40,7 +40,7 @@ def draw_reachability(vis: Any, session: Any, root: str, bounds: list) -> tuple[
     ``description``, ``label``, ``colors``, ``layers``: ``path`` and ``z_mm``). ``bounds``
     (a list of ``(n, 3)`` world points) is extended with each map's voxels.
     """
-    from .page import colorbar_stops
+    from pinarms.viz.page import colorbar_stops
 
     out: dict[str, list[str]] = {}
     page: list[dict] = []

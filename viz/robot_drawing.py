@@ -17,8 +17,8 @@ from typing import Any, Sequence
 import numpy as np
 import pinocchio as pin
 
-from ._meshcat import MeshcatVisualizer, meshcat
-from .errors import ViewerError
+from pinarms.viz._meshcat import MeshcatVisualizer, meshcat
+from pinarms.viz.errors import ViewerError
 
 __all__ = ["RobotDrawing", "resolved_package_meshes"]
 

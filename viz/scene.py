@@ -35,12 +35,12 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from ._meshcat import meshcat, mg
-from .cloud_scene import draw_clouds, cloud_colorbar
-from .page import PAGE_PROPERTY
-from .robot_drawing import RobotDrawing
-from .shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
-from .trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
+from pinarms.viz._meshcat import meshcat, mg
+from pinarms.viz.cloud_scene import draw_clouds, cloud_colorbar
+from pinarms.viz.page import PAGE_PROPERTY
+from pinarms.viz.robot_drawing import RobotDrawing
+from pinarms.viz.shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
+from pinarms.viz.trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
@@ -144,10 +144,10 @@ def build_scene(
     _draw_boxes(vis, session, bounds)
     clouds = draw_clouds(vis, session, ROOT, bounds, colormap=colormap, point_pixels=point_pixels,
                           cloud_opacity=cloud_opacity, show_clouds=show_clouds, max_cloud_points=max_cloud_points)
-    from .reach_scene import draw_reachability  # voxel layers coloured by reachability index
+    from pinarms.viz.reach_scene import draw_reachability  # voxel layers coloured by reachability index
 
     reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
-    from .line_scene import draw_lines  # belt lines: belt, items
+    from pinarms.viz.line_scene import draw_lines  # belt lines: belt, items
 
     line_lines = draw_lines(vis, session, ROOT, bounds)
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
@@ -252,7 +252,7 @@ def _draw_tcp_paths(vis: meshcat.Visualizer, tcp_paths: dict[str, np.ndarray], k
 def _frame(session: Any, bounds: list[np.ndarray], framed: list[np.ndarray],
            tcp_paths: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """``(lo, hi)`` of everything drawn and the view ``(target, camera, radius)`` framed on the robots and paths."""
-    from .line_scene import line_focus  # a long belt line: its first arms
+    from pinarms.viz.line_scene import line_focus  # a long belt line: its first arms
 
     parts = bounds + [_point_set_world(session, n) for n in session.point_sets]
     everything = np.vstack(parts) if parts else np.zeros((1, 3))

@@ -18,8 +18,8 @@ from typing import Any
 
 from pinarms.errors import InvalidInput
 
-from ._meshcat import ViewerWindow, meshcat
-from .errors import ViewerError
+from pinarms.viz._meshcat import ViewerWindow, meshcat
+from pinarms.viz.errors import ViewerError
 
 __all__ = ["MeshcatServer"]
 

@@ -33,9 +33,9 @@ from pinarms import robots
 from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
 
-from .session_archive import SessionLimits
-from .session_format import read_session, to_document, write_session
-from .session_inputs import (
+from pinarms.viz.session_archive import SessionLimits
+from pinarms.viz.session_format import read_session, to_document, write_session
+from pinarms.viz.session_inputs import (
     MAX_TRAJECTORY_SAMPLES,
     box_record,
     float_array,
@@ -45,7 +45,7 @@ from .session_inputs import (
     trajectory_record,
     workspace_record,
 )
-from .session_records import (
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -54,8 +54,8 @@ from .session_records import (
     WorkspaceRecord,
     check_name as _check_name,
 )
-from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
+from pinarms.viz.session_robots import rebuild_robot, robot_entry, shipped_model_dirs
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 __all__ = [
     "FORMAT_NAME",
@@ -217,7 +217,7 @@ class Session:
         The arms' tcp frames and the hold are recorded in ``metadata["cells"][key]`` so that
         the viewer draws each arm's tcp path.
         """
-        from .cell_session import add_cell
+        from pinarms.viz.cell_session import add_cell
 
         return add_cell(self, cell, key=key, motions=motions, check=check, name=name, hz=hz, hold=hold)
 
@@ -306,7 +306,7 @@ class Session:
 
         The viewer and the standalone page draw them as coloured voxels (see :mod:`pinarms.viz.reach_record`).
         """
-        from .reach_record import make_record
+        from pinarms.viz.reach_record import make_record
 
         name = self._free(self.reachability, name, "reachability")
         rec = make_record(name, self._entry(robot).key, reach_map, min_index, float_array)
@@ -315,7 +315,7 @@ class Session:
 
     def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
         """Add an animated window of a simulated belt line (:func:`pinarms.viz.line_session.add_line`)."""
-        from .line_session import add_line
+        from pinarms.viz.line_session import add_line
 
         return add_line(self, spec, result, **options)
 

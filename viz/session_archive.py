@@ -40,12 +40,12 @@ import numpy as np
 from pinarms.files import open_regular
 from pinarms.errors import InvalidInput
 
-from .errors import SessionFormatError
-from .names import NAME_RE
-from .session_json import JSON_MEMBER, parse_document
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.names import NAME_RE
+from pinarms.viz.session_json import JSON_MEMBER, parse_document
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .session_specs import ArraySpec
+    from pinarms.viz.session_specs import ArraySpec
 
 __all__ = ["JSON_MEMBER", "F8", "SessionLimits", "DEFAULT_LIMITS", "ArrayRef", "ArchiveReader", "open_archive",
            "invalid_session"]

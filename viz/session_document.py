@@ -13,10 +13,10 @@ from __future__ import annotations
 import zipfile
 from typing import Any
 
-from .errors import SessionFormatError
-from .names import NAME_RE
-from .session_archive import JSON_MEMBER, ArchiveReader
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.names import NAME_RE
+from pinarms.viz.session_archive import JSON_MEMBER, ArchiveReader
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
 
 __all__ = ["SessionItem", "read_document"]
 

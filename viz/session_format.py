@@ -34,10 +34,10 @@ import numpy as np
 from pinarms.files import atomic_write
 from pinarms.errors import InvalidInput
 
-from .mesh_paths import check_mesh_paths
-from .session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive
-from .session_document import read_document
-from .session_records import (
+from pinarms.viz.mesh_paths import check_mesh_paths
+from pinarms.viz.session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive
+from pinarms.viz.session_document import read_document
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -46,8 +46,8 @@ from .session_records import (
     WorkspaceRecord,
     check_name,
 )
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
-from .session_specs import ArraySpec, TextSpec
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
+from pinarms.viz.session_specs import ArraySpec, TextSpec
 
 __all__ = [
     "FORMAT_NAME",

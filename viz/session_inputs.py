@@ -17,8 +17,8 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from .session_archive import F8
-from .session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
+from pinarms.viz.session_archive import F8
+from pinarms.viz.session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
 
 __all__ = ["MAX_TRAJECTORY_SAMPLES", "json_normalised", "real_array", "float_array", "pose_array", "box_record",
            "trajectory_record", "workspace_record", "history_record"]

@@ -14,7 +14,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from .names import NAME_RE
+from pinarms.viz.names import NAME_RE
 
 __all__ = ["RobotEntry", "BoxObject", "TrajectoryRecord", "WorkspaceRecord", "PointSet", "HistoryRecord", "check_name"]
 

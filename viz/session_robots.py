@@ -16,10 +16,10 @@ from pinarms import robots
 from pinarms.errors import PinarmsError
 from pinarms.robots.robot import Robot
 
-from .errors import SessionFormatError
-from .mesh_paths import check_mesh_paths
-from .session_inputs import pose_array
-from .session_records import RobotEntry
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.mesh_paths import check_mesh_paths
+from pinarms.viz.session_inputs import pose_array
+from pinarms.viz.session_records import RobotEntry
 
 __all__ = ["robot_entry", "rebuild_robot", "shipped_model_dirs"]
 

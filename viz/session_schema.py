@@ -18,9 +18,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .line_record import decode_line, encode_line  # a belt line: its own module
-from .reach_record import decode_reachability, encode_reachability  # a kind defined in its own module
-from .session_records import (
+from pinarms.viz.line_record import decode_line, encode_line  # a belt line: its own module
+from pinarms.viz.reach_record import decode_reachability, encode_reachability  # a kind defined in its own module
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -29,7 +29,7 @@ from .session_records import (
     WorkspaceRecord,
 )
 
-from .session_specs import ArraySpec, SessionItemView, TextSpec
+from pinarms.viz.session_specs import ArraySpec, SessionItemView, TextSpec
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "POINT_KINDS", "Kind", "KINDS", "SessionContents"]
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from .scene import SceneInfo, build_scene
-from .server import MeshcatServer
+from pinarms.viz.scene import SceneInfo, build_scene
+from pinarms.viz.server import MeshcatServer
 
 __all__ = ["Viewer", "show"]
 

@@ -20,19 +20,19 @@ from pinarms.lazy import lazy_exports
 
 #: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
 _EXPORTS = {
-    "CYCLE_KINDS": ".plan",
-    "CYCLE_APPROACHES": ".plan",
-    "CYCLE_STATUSES": ".plan",
-    "LINE_NAMES": ".plan",
-    "CycleResult": ".spec",
-    "PickPlace": ".spec",
-    "CycleRequest": ".request",
-    "CycleTiming": ".request",
-    "CycleLoad": ".request",
-    "CycleApproach": ".request",
-    "CellSettings": ".request",
-    "plan_cycle": ".plan",
-    "LINE_SAMPLES": ".spec",
+    "CYCLE_KINDS": "pinarms.optim.cycle.plan",
+    "CYCLE_APPROACHES": "pinarms.optim.cycle.plan",
+    "CYCLE_STATUSES": "pinarms.optim.cycle.plan",
+    "LINE_NAMES": "pinarms.optim.cycle.plan",
+    "CycleResult": "pinarms.optim.cycle.spec",
+    "PickPlace": "pinarms.optim.cycle.spec",
+    "CycleRequest": "pinarms.optim.cycle.request",
+    "CycleTiming": "pinarms.optim.cycle.request",
+    "CycleLoad": "pinarms.optim.cycle.request",
+    "CycleApproach": "pinarms.optim.cycle.request",
+    "CellSettings": "pinarms.optim.cycle.request",
+    "plan_cycle": "pinarms.optim.cycle.plan",
+    "LINE_SAMPLES": "pinarms.optim.cycle.spec",
 }
 
 __all__ = [

@@ -14,14 +14,14 @@ from pinarms.lazy import lazy_exports
 
 #: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
 _EXPORTS = {
-    "FAILURES": ".search",
-    "LayoutSearch": ".result",
-    "Refinement": ".result",
-    "base_to_world": ".candidates",
-    "grid_candidates": ".candidates",
-    "points_in_base_frame": ".candidates",
-    "random_candidates": ".candidates",
-    "search_layout": ".search",
+    "FAILURES": "pinarms.optim.layout.search",
+    "LayoutSearch": "pinarms.optim.layout.result",
+    "Refinement": "pinarms.optim.layout.result",
+    "base_to_world": "pinarms.optim.layout.candidates",
+    "grid_candidates": "pinarms.optim.layout.candidates",
+    "points_in_base_frame": "pinarms.optim.layout.candidates",
+    "random_candidates": "pinarms.optim.layout.candidates",
+    "search_layout": "pinarms.optim.layout.search",
 }
 
 __all__ = [

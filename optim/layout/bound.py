@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .candidates import _PPM_RTOL
+from pinarms.optim.layout.candidates import _PPM_RTOL
 
 __all__: list[str] = []  # search_layout's (bound=True)
 

@@ -15,7 +15,7 @@ from pinarms.optim.cycle import CellSettings, CycleRequest, CycleTiming, PickPla
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
-from .candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
+from pinarms.optim.layout.candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
 
 __all__: list[str] = []  # the tasks of a search (private: search_layout runs them)
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from pinarms.optim.cycle import CycleResult
 
-from .candidates import FAILURES
+from pinarms.optim.layout.candidates import FAILURES
 
 __all__ = ["LayoutSearch", "Refinement"]
 

@@ -45,11 +45,11 @@ from pinarms.optim.cycle import CYCLE_KINDS, PickPlace
 from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
 from pinarms.errors import InvalidInput
 
-from .candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
+from pinarms.optim.layout.candidates import (_PPM_RTOL, AXES, FAILURES, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
-from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
+from pinarms.optim.layout.evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
                        _Settings)
-from .result import LayoutSearch, Refinement
+from pinarms.optim.layout.result import LayoutSearch, Refinement
 
 __all__ = [
     "FAILURES",
@@ -222,7 +222,7 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
     """
     from pinarms.execution import map_chunks
 
-    from .bound import SLACK, outranked, threshold, wave_size
+    from pinarms.optim.layout.bound import SLACK, outranked, threshold, wave_size
 
     M = cand.shape[0]
     todo = [m for m in range(M) if not failure[m]]
@@ -301,7 +301,7 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
 
 def _lower_bounds(robot: Any, st: _Settings, targets: np.ndarray | None, M: int) -> np.ndarray:
     """Each candidate's lower bound of its cycle time [s] (:mod:`.bound`; 0 without a closed form)."""
-    from .bound import cycle_lower_bounds
+    from pinarms.optim.layout.bound import cycle_lower_bounds
 
     if targets is None:
         return np.zeros(M)

@@ -15,10 +15,10 @@ from pinarms.lazy import lazy_exports
 
 #: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
 _EXPORTS = {
-    "TimingResult": ".segments",
-    "minimize_time": ".segments",
-    "finish_timing": ".segments",
-    "rescale_to_limits": ".segments",
+    "TimingResult": "pinarms.optim.timing.segments",
+    "minimize_time": "pinarms.optim.timing.segments",
+    "finish_timing": "pinarms.optim.timing.segments",
+    "rescale_to_limits": "pinarms.optim.timing.segments",
 }
 
 __all__ = [

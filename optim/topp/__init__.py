@@ -17,14 +17,14 @@ from pinarms.lazy import lazy_exports
 
 #: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
 _EXPORTS = {
-    "Profile": ".profile",
-    "feasible_states": ".profile",
-    "controllable_sets": ".profile",
-    "greedy_profile": ".profile",
-    "interpolated_rows": ".profile",
-    "topp_profile": ".profile",
-    "reachability_profile": ".profile",
-    "X_CAP": ".profile",
+    "Profile": "pinarms.optim.topp.profile",
+    "feasible_states": "pinarms.optim.topp.profile",
+    "controllable_sets": "pinarms.optim.topp.profile",
+    "greedy_profile": "pinarms.optim.topp.profile",
+    "interpolated_rows": "pinarms.optim.topp.profile",
+    "topp_profile": "pinarms.optim.topp.profile",
+    "reachability_profile": "pinarms.optim.topp.profile",
+    "X_CAP": "pinarms.optim.topp.profile",
 }
 
 __all__ = [

@@ -11,7 +11,7 @@ import click
 
 from pinarms.errors import InvalidInput
 
-from ._common import cli, emit, json_option, scheduler_option
+from pinarms.cli._common import cli, emit, json_option, scheduler_option
 
 PRESETS = ("scara", "gantry")
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from ._common import (
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

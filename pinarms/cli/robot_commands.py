@@ -15,7 +15,7 @@ from pinarms.units import (
     prismatic_mask,
 )
 
-from ._common import (
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
+from pinarms.cli._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
 
 
 @cli.group("verify", cls=PinarmsGroup)
@@ -47,8 +47,8 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
     """
     from pinarms.export.verify import compare_configurations_in_mujoco, compare_in_mujoco
 
-    from ._common import package_map
-    from .cell_commands import _load
+    from pinarms.cli._common import package_map
+    from pinarms.cli.cell_commands import _load
 
     from pinarms.errors import InvalidInput
 

@@ -10,8 +10,8 @@ from pinarms import robots
 from pinarms.errors import InvalidInput
 from pinarms.units import length_scale
 
-from . import _common as common
-from ._common import (
+from pinarms.cli import _common as common
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

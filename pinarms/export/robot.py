@@ -30,9 +30,9 @@ from pinarms.files import safe_file_name
 from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
-from .cell import export_robot_with_srdf
-from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
-from .urdf_files import SITE_SIZE_M, ExportedURDF, mesh_references  # noqa: F401  (public names of this module)
+from pinarms.export.cell import export_robot_with_srdf
+from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
+from pinarms.export.urdf_files import SITE_SIZE_M, ExportedURDF, mesh_references  # noqa: F401  (public names of this module)
 
 __all__ = ["ExportedURDF", "ExportedMJCF", "export_urdf", "export_mjcf", "mesh_references"]
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from pinarms.errors import InvalidInput
 
-from .srdf import cycle_states
+from pinarms.export.srdf import cycle_states
 
 __all__ = ["ShippedMotion", "shipped_motions", "study_states", "STUDY_CELLS"]
 

@@ -41,8 +41,8 @@ import numpy as np
 from pinarms.errors import InvalidInput, LimitViolation
 from pinarms.files import atomic_write
 
-from .acceleration_check import acceleration_limits_of, flag_accelerations
-from .errors import InvalidJointName, InvalidRate, JointMismatch
+from pinarms.export.acceleration_check import acceleration_limits_of, flag_accelerations
+from pinarms.export.errors import InvalidJointName, InvalidRate, JointMismatch
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
            "line_arm_sampler", "check_joint_names", "ROS_NAME"]

@@ -37,7 +37,7 @@ import pinocchio as pin
 from pinarms.robots.collision_requests import cold_start
 from pinarms.errors import InvalidInput, ModelError
 
-from .srdf import contact_pairs
+from pinarms.export.srdf import contact_pairs
 
 __all__ = ["EngineComparison", "compare_in_mujoco", "compare_configurations_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
 
@@ -205,7 +205,7 @@ def _compare(cell: Any, label: str, qs: np.ndarray, mjcf: str | Path | None,
 
     with tempfile.TemporaryDirectory() as tmp:
         if mjcf is None:
-            from .cell import export_cell
+            from pinarms.export.cell import export_cell
 
             mjcf_path = export_cell(cell, Path(tmp) / "cell", srdf=False, packages=packages).mjcf
         else:

@@ -15,8 +15,8 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit, jit_inline
 
-from . import _box_kernel
-from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
+from pinarms.robots.cell import _box_kernel
+from pinarms.robots.cell._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
 
 # these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],

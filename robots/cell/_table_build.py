@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .mesh_cover import mesh_arrays, split_triangles
+from pinarms.robots.cell.mesh_cover import mesh_arrays, split_triangles
 
 __all__ = ["axis_arrays"]
 

@@ -24,15 +24,15 @@ from typing import Any, Callable, Mapping, Sequence, TypeVar
 import numpy as np
 import pinocchio as pin
 
-from ...errors import CellError, CellTooLarge, InvalidInput
-from ..robot import Robot
-from .arm_keys import arm_with_keys
-from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
-from .components import CellArm, Fixture
-from .compose_file import ArmPlacement
-from .description import CellSpec, describe
-from .move_arm import urdf_with_arm_base
-from .batch_fk import BatchedPlacements
+from pinarms.errors import CellError, CellTooLarge, InvalidInput
+from pinarms.robots.robot import Robot
+from pinarms.robots.cell.arm_keys import arm_with_keys
+from pinarms.robots.cell.assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
+from pinarms.robots.cell.components import CellArm, Fixture
+from pinarms.robots.cell.compose_file import ArmPlacement
+from pinarms.robots.cell.description import CellSpec, describe
+from pinarms.robots.cell.move_arm import urdf_with_arm_base
+from pinarms.robots.cell.batch_fk import BatchedPlacements
 
 __all__ = ["Cell", "GEOMETRY_MEMOS"]
 
@@ -83,7 +83,7 @@ class Cell:
         seed: int = 0,
         placements: Sequence[ArmPlacement] = (),
     ) -> None:
-        from .pairs import classify_pairs
+        from pinarms.robots.cell.pairs import classify_pairs
 
         self.source = source
         self.urdf_text = urdf_text
@@ -95,7 +95,7 @@ class Cell:
             root = ET.fromstring(urdf_text)
         except ET.ParseError as exc:
             raise CellError(f"{source} is not well-formed XML: {exc}") from exc
-        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_extent, check_geometry
+        from pinarms.robots.cell.limits import MAX_CELL_FILE_BYTES, check_counts, check_extent, check_geometry
 
         if len(urdf_text) > MAX_CELL_FILE_BYTES:
             raise CellTooLarge(f"{source}: the cell's URDF is {len(urdf_text)} characters; the limit is {MAX_CELL_FILE_BYTES}")
@@ -140,7 +140,7 @@ class Cell:
 
     def _finish_geometry(self) -> None:
         """Keep only the checked pairs in the collision model, the candidate pairs, and test every checked pair once."""
-        from .pairs import reach_pairs
+        from pinarms.robots.cell.pairs import reach_pairs
 
         reach, bounds = reach_pairs(self, self.allowed)
         self._set_candidates(self.pairs, reach, bounds)
@@ -149,7 +149,7 @@ class Cell:
 
     def _set_candidates(self, pairs: tuple, reach: tuple, bounds: np.ndarray) -> None:
         """Checked pairs, then out-of-reach pairs by increasing bound; the collision model keeps the checked ones."""
-        from .views import PairViews
+        from pinarms.robots.cell.views import PairViews
 
         self.pairs = tuple(pairs)
         self._reach = tuple(reach)
@@ -179,7 +179,7 @@ class Cell:
 
     def cover(self):
         """The sphere cover of every collision geometry (:func:`~pinarms.robots.cell.cover.link_cover`), built once."""
-        from .cover import link_cover
+        from pinarms.robots.cell.cover import link_cover
 
         return link_cover(self)
 
@@ -422,13 +422,13 @@ class Cell:
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
-        from .collision import in_collision
+        from pinarms.robots.cell.collision import in_collision
 
         return in_collision(self, q, margin=margin, threads=threads)
 
     def collisions(self, q: Any, *, margin: float = 0.0):
         """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
-        from .collision import collisions
+        from pinarms.robots.cell.collision import collisions
 
         return collisions(self, q, margin=margin)
 
@@ -438,7 +438,7 @@ class Cell:
         The checked pairs and every out-of-reach pair whose bound is below the smallest
         distance found: the true minimum over all pairs but those allowed by design.
         """
-        from .collision import clearance
+        from pinarms.robots.cell.collision import clearance
 
         return clearance(self, q, margin=margin)
 
@@ -447,6 +447,6 @@ class Cell:
 
         See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
         """
-        from .motion import check_motion
+        from pinarms.robots.cell.motion import check_motion
 
         return check_motion(self, motions, margin=margin, **kwargs)

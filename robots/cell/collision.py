@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ...errors import CollisionGeometryError, InvalidInput
-from .pairs import CollisionPair
+from pinarms.errors import CollisionGeometryError, InvalidInput
+from pinarms.robots.cell.pairs import CollisionPair
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["Collisions", "Clearance", "in_collision", "collisions", "clearance", "pair_lower_bounds"]
 

@@ -47,9 +47,9 @@ from typing import Any
 
 import numpy as np
 
-from ._cover_kernel import excess_kernel, screen_kernel
-from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
-from .pair_tables import PairTables, no_tables, pair_tables
+from pinarms.robots.cell._cover_kernel import excess_kernel, screen_kernel
+from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
+from pinarms.robots.cell.pair_tables import PairTables, no_tables, pair_tables
 
 __all__ = [
     "CYLINDER_SHARE",
@@ -254,7 +254,7 @@ class Cover:
 
     def world_centers(self, Q: np.ndarray) -> np.ndarray:
         """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
-        from ._cover_kernel import centers_kernel
+        from pinarms.robots.cell._cover_kernel import centers_kernel
 
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.empty((Q.shape[0], self.joint.size, 3))
@@ -321,7 +321,7 @@ class Cover:
     def pair_screener(self, pairs: PairSet, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
         the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
-        from ._pair_kernel import pair_screener
+        from pinarms.robots.cell._pair_kernel import pair_screener
 
         return pair_screener(self, pairs, threshold)
 

@@ -13,9 +13,9 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from .pairs import CollisionPair
+from pinarms.robots.cell.pairs import CollisionPair
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["IdleContacts", "idle_contacts"]
 
@@ -52,7 +52,7 @@ def _pair_distances(cell: "CellModel", q: np.ndarray, pairs: Iterable[CollisionP
     import coal
     import pinocchio as pin
 
-    from ..collision_requests import cold_start
+    from pinarms.robots.collision_requests import cold_start
 
     model, gm = cell.model, cell.collision_model
     gd = cold_start(pin.GeometryData(gm))

@@ -25,7 +25,7 @@ from typing import Any
 
 from pinarms.files import read_bounded_text
 
-from ...errors import CellTooLarge, CollisionGeometryError, ModelError
+from pinarms.errors import CellTooLarge, CollisionGeometryError, ModelError
 
 __all__ = [
     "MAX_CELL_FILE_BYTES", "MAX_MESH_BYTES", "MAX_ARMS", "MAX_FIXTURES", "MAX_GEOMETRIES", "MAX_GEOMETRY_PAIRS",

@@ -52,17 +52,17 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InvalidInput
-from .collision import _margin, exact_min_distance, pair_lower_bounds
-from .ladder import Intervals, climb
-from .motion_curves import moving_arm_curves
-from .motion_report import Contact, MotionCheck
-from .pairs import CollisionPair
-from .speed_bound import joint_levers, speed_profile, travel_stops
-from .timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
+from pinarms.errors import InvalidInput
+from pinarms.robots.cell.collision import _margin, exact_min_distance, pair_lower_bounds
+from pinarms.robots.cell.ladder import Intervals, climb
+from pinarms.robots.cell.motion_curves import moving_arm_curves
+from pinarms.robots.cell.motion_report import Contact, MotionCheck
+from pinarms.robots.cell.pairs import CollisionPair
+from pinarms.robots.cell.speed_bound import joint_levers, speed_profile, travel_stops
+from pinarms.robots.cell.timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
                        motion_window, sample_motions)
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers", "motion_window", "sample_motions"]
 
@@ -265,7 +265,7 @@ COVER_ROWS = 8
 
 def _cover_pairs(cell: "CellModel", n_pairs: int) -> tuple[Any, Any]:
     """The cell's sphere cover and its :class:`.cover.PairSet` of the first ``n_pairs`` candidates (kept with the cell)."""
-    from .cover import link_cover, pair_arrays
+    from pinarms.robots.cell.cover import link_cover, pair_arrays
 
     # keyed by the pairs themselves: a cell of fewer pairs (Cell.with_pairs) shares this dict, not its pairs
     pair_a, pair_b = pair_arrays(cell.candidates[:n_pairs])

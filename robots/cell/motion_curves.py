@@ -20,9 +20,9 @@ from typing import Sequence
 
 import numpy as np
 
-from .collision import exact_min_distance, pair_lower_bounds
+from pinarms.robots.cell.collision import exact_min_distance, pair_lower_bounds
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["moving_arm_groups", "moving_arm_curves"]
 

@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ...errors import CellError, InvalidInput
+from pinarms.errors import CellError, InvalidInput
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["urdf_with_arm_base"]
 

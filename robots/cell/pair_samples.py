@@ -28,12 +28,12 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .. import robot as _robot
-from ..collision_requests import pair_probe
-from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
-from .mesh_cover import mesh_arrays
+from pinarms.robots import robot as _robot
+from pinarms.robots.collision_requests import pair_probe
+from pinarms.robots.cell.disk_cache import cache_folder, code_digest, read_arrays, write_arrays
+from pinarms.robots.cell.mesh_cover import mesh_arrays
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["SAMPLES", "VERIFY", "MIN_SECONDS", "sample_pairs"]
 

@@ -79,7 +79,7 @@ from typing import Any
 
 import numpy as np
 
-from ._table_build import (
+from pinarms.robots.cell._table_build import (
     CAP,
     CONTACT_TOL,
     EXACT_LOSS,
@@ -97,9 +97,9 @@ from ._table_build import (
     _turning,
     axis_arrays,
 )
-from . import _table_build, mesh_cover
-from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
-from .mesh_cover import mesh_arrays
+from pinarms.robots.cell import _table_build, mesh_cover
+from pinarms.robots.cell.disk_cache import cache_folder, code_digest, read_arrays, write_arrays
+from pinarms.robots.cell.mesh_cover import mesh_arrays
 
 __all__ = [
     "CAP",

@@ -83,15 +83,15 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..coaxial import still_frames
-from ...errors import PlacementError
-from ..pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
-from ..pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
+from pinarms.robots.coaxial import still_frames
+from pinarms.errors import PlacementError
+from pinarms.robots.pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
+from pinarms.robots.pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
                           structural_reason)
-from .pair_samples import SAMPLES, sample_pairs
-from .reach import root_cylinders, tighter_bound
+from pinarms.robots.cell.pair_samples import SAMPLES, sample_pairs
+from pinarms.robots.cell.reach import root_cylinders, tighter_bound
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["CollisionPair", "AllowedPair", "PairReason", "classify_pairs", "reach_pairs", "ALWAYS_SHARE",
            "ALWAYS_SAMPLES", "BY_DESIGN", "BOUNDED", "AXIAL_GAP"]
@@ -208,7 +208,7 @@ def classify_pairs(cell: "CellModel", seed: int = 0) -> tuple[tuple[CollisionPai
                 else:
                     allow(a, b, *proven)
 
-    from .limits import check_pairs
+    from pinarms.robots.cell.limits import check_pairs
 
     check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
     keep, through = [], []

@@ -17,10 +17,10 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ...errors import InvalidInput
-from .timeline import ArmMotion
+from pinarms.errors import InvalidInput
+from pinarms.robots.cell.timeline import ArmMotion
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["joint_levers", "peak_speed", "speed_profile", "travel_stops"]
 

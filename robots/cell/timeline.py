@@ -16,9 +16,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ...errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .cell_model import CellModel
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["ArmMotion", "arm_motions", "as_time", "configurations", "motion_window", "sample_motions", "MAX_SAMPLES",
            "MAX_TIME"]

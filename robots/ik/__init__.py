@@ -16,15 +16,15 @@ and :meth:`pinarms.robots.Robot.ik`.
 
 from __future__ import annotations
 
-from .families import FAMILIES
-from .gantry import GantryIK
-from .koji import KojiIK
-from .near_limits import OutsideLimits, limit_excess, near_limit_solutions
-from .numerical import IKResult, NumericalIK
-from .recognise import Recognition, recognise
-from .scara import ScaraIK
-from .solver import FK_TOL, LIMIT_TOL, AnalyticIK
-from .ur_type import URTypeIK
+from pinarms.robots.ik.families import FAMILIES
+from pinarms.robots.ik.gantry import GantryIK
+from pinarms.robots.ik.koji import KojiIK
+from pinarms.robots.ik.near_limits import OutsideLimits, limit_excess, near_limit_solutions
+from pinarms.robots.ik.numerical import IKResult, NumericalIK
+from pinarms.robots.ik.recognise import Recognition, recognise
+from pinarms.robots.ik.scara import ScaraIK
+from pinarms.robots.ik.solver import FK_TOL, LIMIT_TOL, AnalyticIK
+from pinarms.robots.ik.ur_type import URTypeIK
 
 __all__ = [
     "attach_analytic_ik",
@@ -67,7 +67,7 @@ def analytic_solver(robot, family: str, frame: str = "tcp") -> AnalyticIK:
         InvalidInput: unknown family.
         ModelError: the robot does not have the structure the family's solver assumes.
     """
-    from ...errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     if family not in FAMILIES:
         raise InvalidInput(f"unknown IK family {family!r}; known: {', '.join(FAMILIES)}")

@@ -6,11 +6,11 @@ Its own module so that :func:`pinarms.robots.ik.recognise` and the package's
 
 from __future__ import annotations
 
-from .gantry import GantryIK
-from .koji import KojiIK
-from .scara import ScaraIK
-from .solver import AnalyticIK
-from .ur_type import URTypeIK
+from pinarms.robots.ik.gantry import GantryIK
+from pinarms.robots.ik.koji import KojiIK
+from pinarms.robots.ik.scara import ScaraIK
+from pinarms.robots.ik.solver import AnalyticIK
+from pinarms.robots.ik.ur_type import URTypeIK
 
 __all__ = ["FAMILIES"]
 

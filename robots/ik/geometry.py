@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...errors import ModelError
-from ..so3 import hat as _skew
+from pinarms.errors import ModelError
+from pinarms.robots.so3 import hat as _skew
 
 __all__ = [
     "ChainAxis",

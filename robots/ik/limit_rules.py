@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematic_tree import _REVOLUTE
+from pinarms.robots.kinematic_tree import _REVOLUTE
 
 __all__ = ["JointLimitRules"]
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["OutsideLimits", "limit_excess", "near_limit_solutions"]
 

@@ -63,17 +63,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InvalidInput
-from ..kinematic_tree import _REVOLUTE
-from .._checks import check_restarts as _check_restarts
-from .._checks import check_seed as _check_seed
-from .._checks import check_tolerance as _check_tolerance
-from .descent import CLIP as _CLIP
-from .descent import FREE as _FREE
-from .descent import LMDescent
-from .limit_rules import JointLimitRules
-from .numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
-from .starts import StartTable
+from pinarms.errors import InvalidInput
+from pinarms.robots.kinematic_tree import _REVOLUTE
+from pinarms.robots._checks import check_restarts as _check_restarts
+from pinarms.robots._checks import check_seed as _check_seed
+from pinarms.robots._checks import check_tolerance as _check_tolerance
+from pinarms.robots.ik.descent import CLIP as _CLIP
+from pinarms.robots.ik.descent import FREE as _FREE
+from pinarms.robots.ik.descent import LMDescent
+from pinarms.robots.ik.limit_rules import JointLimitRules
+from pinarms.robots.ik.numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
+from pinarms.robots.ik.starts import StartTable
 
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
@@ -156,7 +156,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         """``(kernel module, C, L, P, table)``: the chain, limits and settings as arrays for :mod:`._kernel`, made once."""
         args = self._kernel_args
         if args is None:
-            from . import _kernel  # numba: imported (and its functions loaded from the cache) on first use
+            from pinarms.robots.ik import _kernel  # numba: imported (and its functions loaded from the cache) on first use
 
             tree = self.robot.kinematic_tree
             joint, fR, fp = tree.frame_of(self.frame_id)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import check_restarts
+from pinarms.robots._checks import check_restarts
 
 
 __all__ = ["BatchIKResult", "solve_batch"]

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import ModelError
-from .geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link
-from .solver import AnalyticIK
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["ScaraIK"]
 

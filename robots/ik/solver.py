@@ -23,8 +23,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ...errors import ModelError
-from ..ties import argsort_tied
+from pinarms.errors import ModelError
+from pinarms.robots.ties import argsort_tied
 
 __all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL", "split_by_target"]
 
@@ -140,7 +140,7 @@ class AnalyticIK:
         ranges = self._shift_ranges(limit_tol)
         total = float(np.prod([k1 - k0 + 1.0 for _, k0, k1 in ranges]))
         if total > MAX_EQUIVALENTS:
-            from ...errors import InvalidInput
+            from pinarms.errors import InvalidInput
 
             raise InvalidInput(
                 f"robot '{self.robot.name}': its joint ranges hold {total:.3g} combinations of 2π equivalents per "

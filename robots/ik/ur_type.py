@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import ModelError
-from .geometry import (
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import (
     STRUCTURE_TOL,
     angle_about,
     chain_axes,
@@ -34,7 +34,7 @@ from .geometry import (
     rotate_const,
     solve_cos_sin,
 )
-from .solver import AnalyticIK
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["URTypeIK"]
 

@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .orientations import _rotation_about
-from .reach_chunk import ChunkTask, collision_free, manipulability_of
-from .reach_map import ReachabilityMap
-from .robot_spec import spec_of
+from pinarms.robots.reach.orientations import _rotation_about
+from pinarms.robots.reach.reach_chunk import ChunkTask, collision_free, manipulability_of
+from pinarms.robots.reach.reach_map import ReachabilityMap
+from pinarms.robots.reach.robot_spec import spec_of
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["verify_bases"]
 
@@ -58,7 +58,7 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
         np.maximum.at(top, idx, w)
         best = np.where(np.isfinite(top), top, np.nan)
     else:
-        from ...errors import UnreachableTarget
+        from pinarms.errors import UnreachableTarget
 
         for k in range(T.shape[0]):
             try:

@@ -39,14 +39,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...errors import InvalidInput, ModelError
-from .orientations import _align, _rotation_about
-from .base_verify import verify_bases
-from .reach_map import ReachabilityMap
-from .robot_spec import urdf_sha256
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.orientations import _align, _rotation_about
+from pinarms.robots.reach.base_verify import verify_bases
+from pinarms.robots.reach.reach_map import ReachabilityMap
+from pinarms.robots.reach.robot_spec import urdf_sha256
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["BasePlacements", "base_placements", "tool_down_poses", "MAX_CANDIDATES"]
 

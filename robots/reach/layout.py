@@ -37,13 +37,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...errors import InvalidInput, UnreachableTarget
-from ..so3 import rot_z as _rot_z
-from .dexterity import position_dexterity
-from .workspace import Workspace, sample_workspace
+from pinarms.errors import InvalidInput, UnreachableTarget
+from pinarms.robots.so3 import rot_z as _rot_z
+from pinarms.robots.reach.dexterity import position_dexterity
+from pinarms.robots.reach.workspace import Workspace, sample_workspace
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["PointCheck", "LayoutReport", "check_layout", "default_orientation"]
 

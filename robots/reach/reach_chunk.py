@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...errors import InvalidInput
-from .reach_map import _centres
-from .robot_spec import RobotSpec, robot_of, spec_key
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.reach_map import _centres
+from pinarms.robots.reach.robot_spec import RobotSpec, robot_of, spec_key
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["ChunkTask", "solve_chunk", "manipulability_of", "collision_free", "TIE_RTOL"]
 
@@ -79,7 +79,7 @@ def _self_collision(spec: RobotSpec, robot: "Robot"):
     key = spec_key(spec)
     checker = _COLLISION_CACHE.get(key)
     if checker is None:
-        from ..self_collision import SelfCollision
+        from pinarms.robots.self_collision import SelfCollision
 
         checker = _COLLISION_CACHE[key] = SelfCollision(robot, seed=0)
     return checker

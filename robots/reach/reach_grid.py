@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from ...errors import InvalidInput, ModelError
-from .reach_map import MAX_GRID_VOXELS, _centres
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, _centres
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["reach_bound", "ReachGrid", "bounding_grid", "seed_voxels", "face_neighbours"]
 

@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import ndimage
 
-from ...errors import InvalidInput
-from .orientations import OrientationSet
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.orientations import OrientationSet
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .voxels import VoxelMap
+    from pinarms.robots.reach.voxels import VoxelMap
 
 __all__ = ["ReachabilityMap", "PoseSolutions", "MAX_GRID_VOXELS"]
 
@@ -195,7 +195,7 @@ class ReachabilityMap:
         ``min_manipulability`` both hold the voxel's *best* manipulability; ``margin`` the
         distance to the nearest voxel at or below ``min_index`` (minus half a voxel) [m].
         """
-        from .voxels import VoxelMap
+        from pinarms.robots.reach.voxels import VoxelMap
 
         G = self.orientations.n_index
         counts = np.zeros(int(np.prod(self.shape)), dtype=np.int64)
@@ -269,7 +269,7 @@ class ReachabilityMap:
 
     def save(self, path: Any) -> Any:
         """Write the map to an HDF5 file (atomically; see :mod:`pinarms.robots.reach.reach_io`); return the path."""
-        from .reach_write import write_map
+        from pinarms.robots.reach.reach_write import write_map
 
         return write_map(self, path)
 

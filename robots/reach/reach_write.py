@@ -18,8 +18,8 @@ import numpy as np
 
 from pinarms.files import discard, publish, temporary_for
 
-from ...errors import InvalidInput
-from .reach_digest import PosesDigest, map_checksum
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.reach_digest import PosesDigest, map_checksum
 
 __all__ = ["StreamWriter", "write_map", "FORMAT_NAME", "FORMAT_VERSION"]
 

@@ -60,19 +60,19 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .._checks import check_restarts
-from ...errors import InvalidInput, ModelError
-from .orientations import OrientationSet, so3_orientations, tool_down_orientations
-from .reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
-from .reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels
-from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
-from .robot_spec import RobotSpec, spec_of
+from pinarms.robots._checks import check_restarts
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.orientations import OrientationSet, so3_orientations, tool_down_orientations
+from pinarms.robots.reach.reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
+from pinarms.robots.reach.reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from pinarms.robots.reach.robot_spec import RobotSpec, spec_of
 
 #: Most joint samples :func:`reachability_map` draws to mark its first voxels (``samples=``).
 MAX_SEED_SAMPLES = 50_000_000
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "ReachabilityMap",
@@ -159,7 +159,7 @@ def reachability_map(
     spec = spec_of(arm)
     writer = None
     if out is not None:
-        from .reach_write import StreamWriter
+        from pinarms.robots.reach.reach_write import StreamWriter
 
         writer = StreamWriter(out, arm.nq)
     acc = _Accumulator(s.keep, writer)

@@ -13,10 +13,10 @@ import hashlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ...errors import ModelError
+from pinarms.errors import ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["RobotSpec", "spec_of", "robot_of", "spec_key", "urdf_sha256"]
 
@@ -46,7 +46,7 @@ def _family(robot: "Robot") -> str | None:
     solver = getattr(robot, "analytic_ik", None)
     if solver is None:
         return None
-    from ..ik import FAMILIES
+    from pinarms.robots.ik import FAMILIES
 
     for key, cls in FAMILIES.items():
         if type(solver) is cls:
@@ -56,7 +56,7 @@ def _family(robot: "Robot") -> str | None:
 
 def spec_of(robot: "Robot") -> RobotSpec:
     """The spec of ``robot`` (the robot itself is cached for this process under the spec's key)."""
-    from .. import registry
+    from pinarms.robots import registry
 
     sha = urdf_sha256(robot)
     family = _family(robot)
@@ -90,8 +90,8 @@ def robot_of(spec: RobotSpec) -> "Robot":
     key = spec_key(spec)
     robot = _ROBOT_CACHE.get(key)
     if robot is None:
-        from .. import registry
-        from ..ik import attach_analytic_ik
+        from pinarms.robots import registry
+        from pinarms.robots.ik import attach_analytic_ik
 
         if spec.registry:
             robot = registry.load(spec.name)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SPHERE_COVERAGE_MIN", "SphereFit", "fit_sphere", "fit_sphere_to_hull", "hull_points", "direction_coverage"]
 

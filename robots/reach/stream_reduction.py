@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .sphere_fit import _direction_cells
+from pinarms.robots.reach.sphere_fit import _direction_cells
 
 __all__ = ["Reduction", "ReductionSpec", "add_block", "merge", "sparse_voxels"]
 

@@ -34,11 +34,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...errors import InvalidInput
-from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .workspace import Workspace
+    from pinarms.robots.reach.workspace import Workspace
 
 __all__ = ["RecommendedRegion", "recommend_region"]
 
@@ -230,7 +230,7 @@ def _core_collision_share(workspace: "Workspace", keep: np.ndarray, shell: np.nd
     ``n_collision`` of them (seeded) are checked. A shell with none checked has share NaN (0 when
     ``n_collision`` is 0: the check is skipped).
     """
-    from ..self_collision import SelfCollision
+    from pinarms.robots.self_collision import SelfCollision
 
     checked = np.zeros(k, dtype=int)
     collided = np.zeros(k)

@@ -30,17 +30,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...errors import InvalidInput
-from ..robot import MAX_RANDOM_SAMPLES
-from .dexterity import CHUNK, position_dexterity, positions_and_dexterity
-from .joint_samples import random_q_slice
-from .sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
+from pinarms.errors import InvalidInput
+from pinarms.robots.robot import MAX_RANDOM_SAMPLES
+from pinarms.robots.reach.dexterity import CHUNK, position_dexterity, positions_and_dexterity
+from pinarms.robots.reach.joint_samples import random_q_slice
+from pinarms.robots.reach.sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
     SPHERE_COVERAGE_MIN, SphereFit, _as_points, _direction_cells, direction_coverage,
     fit_sphere, fit_sphere_to_hull, hull_points)
-from .voxels import VoxelMap, suggest_voxel_size
+from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",

@@ -37,12 +37,12 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from ...errors import InvalidInput
-from .dexterity import positions_and_dexterity
-from .joint_samples import generator_at
-from .stream_reduction import Reduction, ReductionSpec, add_block, merge, sparse_voxels
-from .voxels import VoxelMap, suggest_voxel_size
-from .workspace import (
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.dexterity import positions_and_dexterity
+from pinarms.robots.reach.joint_samples import generator_at
+from pinarms.robots.reach.stream_reduction import Reduction, ReductionSpec, add_block, merge, sparse_voxels
+from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
+from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,
     RadialProfile,
     SphereFit,
@@ -53,7 +53,7 @@ from .workspace import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "StreamedWorkspace",
