@@ -16,14 +16,14 @@ from pinarms.errors import InvalidInput, UnreachableTarget
 __all__ = ["planned_arms", "arm_joints", "check_end", "check_hold", "goal_candidates"]
 
 
-def _arms(cell: Any, arm: Any) -> tuple[str, ...]:
+def planned_arms(cell: Any, arm: Any) -> tuple[str, ...]:
     names = (arm,) if isinstance(arm, str) else tuple(arm)
     if not names or not all(isinstance(a, str) for a in names):
         raise InvalidInput(f"arm must be an arm name or a sequence of arm names, got {arm!r}")
     return tuple(cell.arm(a).name for a in names)
 
 
-def _joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarray:
+def arm_joints(cell: Any, arms: tuple[str, ...], value: Any, what: str) -> np.ndarray:
     """The planned arms' coordinates from an array (concatenated) or ``{arm: q}``."""
     sizes = [cell.arm(a).nq for a in arms]
     if isinstance(value, Mapping):
@@ -71,7 +71,7 @@ def _idle_note(pair: Any, idle: tuple[str, ...]) -> str:
     return ""
 
 
-def _check_hold(checker: Any) -> None:
+def check_hold(checker: Any) -> None:
     """The arms that stay at their hold pose must touch nothing there.
 
     The planner checks only the pairs of the planned arms; a contact between an idle arm and
@@ -90,7 +90,7 @@ def _check_hold(checker: Any) -> None:
                                which="hold", pairs=tuple(p.bodies for p in found.pairs), distances=found.distances)
 
 
-def _check_start(checker: Any, x: np.ndarray, label: str = "start") -> None:
+def check_end(checker: Any, x: np.ndarray, label: str = "start") -> None:
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
         bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
@@ -115,12 +115,12 @@ def _q_text(robot: Any, q: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + "]"
 
 
-def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
+def goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.ndarray, seed: int,
                      frame: str | None) -> list[GoalCandidate]:
     cell = checker.cell
     if not _is_pose(goal):
-        x = _joints(cell, arms, goal, "goal")
-        _check_start(checker, x, "goal")
+        x = arm_joints(cell, arms, goal, "goal")
+        check_end(checker, x, "goal")
         return [GoalCandidate(x, True)]
     if len(arms) != 1:
         raise InvalidInput("a pose goal needs one planned arm; give two arms' goals as joint vectors {arm: q}")
@@ -158,11 +158,3 @@ def _goal_candidates(checker: Any, arms: tuple[str, ...], goal: Any, start: np.n
         raise GoalInCollision(f"every IK solution of the goal pose is in collision ({len(out)} tried): {lines}",
                               which="goal", pairs=tuple(g.pair for g in out), distances=tuple(g.distance for g in out))
     return out
-
-
-
-planned_arms = _arms
-arm_joints = _joints
-check_end = _check_start
-check_hold = _check_hold
-goal_candidates = _goal_candidates

@@ -19,7 +19,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.optim.errors import NoPathFound
-from pinarms.optim.motion.ends import _goal_candidates
+from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_search, fast_shortcut
 from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
 from pinarms.optim.motion.search import search, shortcut
@@ -134,7 +134,7 @@ def plan_geometry(checker: Any, arms: tuple[str, ...], x0: np.ndarray, goal: Any
     """
     t_start = time.perf_counter()
     cell = checker.cell
-    goals = _goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame)
     G = np.array([g.q for g in goals if g.valid])
     same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
     if same.size:

@@ -36,7 +36,8 @@ import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 from pinarms.optim.motion.checker import MotionChecker, check_threads
-from pinarms.optim.motion.ends import _arms, _check_hold, _check_start, _goal_candidates, _joints
+from pinarms.optim.motion.ends import arm_joints as _joints, check_end as _check_start, check_hold as _check_hold, \
+    planned_arms as _arms
 from pinarms.optim.motion.geometry import plan_geometry
 from pinarms.optim.motion.report import SIMPLIFIER, ClearanceProfile, MotionPlan, cell_trajectory, clearance_profile
 from pinarms.optim.motion.search import PLANNERS
@@ -47,8 +48,6 @@ __all__ = ["MotionPlan", "ClearanceProfile", "plan_motion", "plan_geometry", "SI
 
 #: Most grid intervals of the time scaling (memory grows about 5.5 kB per interval).
 MAX_GRID = 100_000
-# the ends' helpers, imported from here by other modules
-_ = (_check_start, _goal_candidates, _joints)
 
 
 def _limits(cell: Any, arms: tuple[str, ...], vmax: Any, amax: Any, torque: Any) -> tuple[list, dict]:

@@ -32,7 +32,8 @@ import numpy as np
 
 from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError, StartInCollision
 from pinarms.optim.motion.checker import MotionChecker, TimedArm
-from pinarms.optim.motion.plan import MotionPlan, _check_start, _joints, plan_motion
+from pinarms.optim.motion.ends import arm_joints as _joints, check_end as _check_start
+from pinarms.optim.motion.plan import MotionPlan, plan_motion
 from pinarms.planning import Trajectory
 from pinarms.errors import InvalidInput
 
