@@ -12,10 +12,15 @@ folders (``[tool.setuptools.package-dir]`` of pyproject.toml: ``pinarms/``, ``ro
   ``import`` and ``from … import`` statement, those inside functions included
   (``from package import submodule`` is an edge to the submodule; imports under
   ``if TYPE_CHECKING:`` never run and are left out);
+- the same circles when the imports under ``if TYPE_CHECKING:`` count too (two modules that
+  each need the other's types are one concept or need a third module for what they share);
 - the upward imports: a module importing one of a layer above its own, in the one-way
   order of the architecture document (floor → robots → planning → optim → viz → the CLI,
   studies and export in ``pinarms``): :data:`LAYERS`;
 
+then the walls between modules and the front door (:mod:`architecture_walls`: uses of another
+module's private names, docstring references that cannot be imported, long signatures and the
+share of parameters typed ``Any``, the import time of the event simulator); all
 with the goals of the restructuring (no circle, no upward import, no module over 500
 lines, no function over 100) and whether each is met. The analysis functions take the
 folders and the layers as arguments, so they work on any package (the tests use a small
@@ -42,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: floor (errors, execution layer, atomic files, units) may be imported by every package and
 #: imports none of them.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("floor", ("pinarms.errors", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
+    ("floor", ("pinarms.errors", "pinarms.lazy", "pinarms.execution", "pinarms.chunks", "pinarms.schedulers", "pinarms.files",
                "pinarms.units", "pinarms.compiled", "pinarms.compile_notice")),
     ("robots", ("pinarms.robots", "pinarms.urdf")),
     ("planning", ("pinarms.planning",)),
@@ -95,6 +100,8 @@ class Figures:
     circles: list[tuple[str, ...]]
     upward: list[Import]
     layers: dict[str, str] = field(default_factory=dict)
+    #: The circles when the imports for type checkers count too.
+    typed_circles: list[tuple[str, ...]] = field(default_factory=list)
 
     @property
     def total_lines(self) -> int:
@@ -110,6 +117,7 @@ class Figures:
         """``(goal, today's figure, met)`` for each goal of the restructuring."""
         return [
             ("no import circle", len(self.circles), not self.circles),
+            ("no circle counting type-only imports", len(self.typed_circles), not self.typed_circles),
             ("no upward import", len(self.upward), not self.upward),
             ("no module over 500 lines", self.modules_over(500), self.modules_over(500) == 0),
             ("no function over 100 lines", self.functions_over(100), self.functions_over(100) == 0),
@@ -200,8 +208,12 @@ def _target(name: str, known: set[str]) -> str | None:
     return None
 
 
-def import_graph(modules: dict[str, Path]) -> list[Import]:
-    """Every import of one module of the code by another (module level and inside functions)."""
+def import_graph(modules: dict[str, Path], type_checking: bool = False) -> list[Import]:
+    """Every import of one module of the code by another (module level and inside functions).
+
+    ``type_checking``: also the imports under ``if TYPE_CHECKING:`` (they never run, but a circle
+    through them is still two modules that each need the other to be understood).
+    """
     known = set(modules)
     edges: list[Import] = []
     for name, path in modules.items():
@@ -210,7 +222,7 @@ def import_graph(modules: dict[str, Path]) -> list[Import]:
 
         def visit(node: ast.AST, in_function: bool) -> None:
             for child in ast.iter_child_nodes(node):
-                if isinstance(child, ast.If) and _is_type_checking(child):
+                if isinstance(child, ast.If) and _is_type_checking(child) and not type_checking:
                     for other in child.orelse:
                         visit(other, in_function)
                     continue
@@ -314,6 +326,7 @@ def figures(package_dirs: dict[str, Path] | None = None,
         functions=function_sizes(modules),
         imports=imports,
         circles=import_circles(imports),
+        typed_circles=import_circles(import_graph(modules, type_checking=True)),
         upward=upward_imports(imports, layers),
         layers={m: (layer_of(m, layers) or (0, "?"))[1] for m in modules},
     )
@@ -343,6 +356,8 @@ def report(fig: Figures, top: int = 10) -> list[str]:
     lines += [f"functions over {n} lines: {fig.functions_over(n)}" for n in FUNCTION_LINES]
     lines += ["", f"import circles: {len(fig.circles)}"]
     lines += [f"  {len(c)} modules: " + ", ".join(c) for c in fig.circles]
+    lines += ["", f"import circles counting type-only imports: {len(fig.typed_circles)}"]
+    lines += [f"  {len(c)} modules: " + ", ".join(c) for c in fig.typed_circles]
     lines += ["", f"upward imports: {len(fig.upward)}"]
     lines += [f"  {e.source} ({fig.layers.get(e.source)}) -> {e.target} ({fig.layers.get(e.target)}), "
               f"line {e.lineno}{' in a function' if e.in_function else ''}" for e in fig.upward]
@@ -366,6 +381,10 @@ def main(argv: list[str] | None = None) -> int:
         print(json.dumps(doc, indent=2))
     else:
         print("\n".join(report(fig, args.top)))
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        import architecture_walls
+
+        print("\n".join(["", *architecture_walls.report(find_modules(package_dirs_of(ROOT)), args.top)]))
     return 0
 
 

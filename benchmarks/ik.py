@@ -42,7 +42,7 @@ print = functools.partial(print, flush=True)  # noqa: A001 - progress visible wh
 from _peers import FAIRNESS, absent_line, rtb_ets, rtb_version  # noqa: E402
 
 from pinarms import robots  # noqa: E402
-from pinarms.robots.errors import UnreachableTarget  # noqa: E402
+from pinarms.errors import UnreachableTarget  # noqa: E402
 from pinarms.robots.ik import NumericalIK  # noqa: E402
 
 
@@ -105,7 +105,7 @@ def numerical(robot: robots.Robot, T: np.ndarray, starts: np.ndarray, tol: float
 
 def robot_ik(robot: robots.Robot, T: np.ndarray, starts: np.ndarray, tol: float = 1e-10, runs: int = 3) -> dict:
     """``Robot.ik`` (closed-form solution nearest the start, refined; numerical fallback)."""
-    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.errors import UnreachableTarget
 
     best = None
     for _ in range(runs):

@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 from pinarms.optim.motion import SCENES, MotionChecker, MotionOptions, MotionRequest, load_scene, plan_motion, scene_queries
 from pinarms.robots.collision_requests import cold_start
 

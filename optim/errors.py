@@ -1,6 +1,6 @@
 """Exceptions of the optimisation package.
 
-All derive from :class:`robots.errors.PinarmsError`, so one ``except PinarmsError``
+All derive from :class:`pinarms.errors.PinarmsError`, so one ``except PinarmsError``
 catches everything pinarms raises on purpose.
 """
 
@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError
+from pinarms.errors import CollisionError, InvalidInput, PinarmsError
 
 __all__ = ["OptimError", "InfeasibleProblem", "InvalidLimits", "InvalidSettings", "SettingOutOfRange", "PlanningError",
            "EndpointInCollision", "StartInCollision", "GoalInCollision", "NoPathFound"]
 
 
 class OptimError(PinarmsError):
-    """Base of the errors raised by :mod:`optim`."""
+    """Base of the errors raised by :mod:`pinarms.optim`."""
 
 
 class InfeasibleProblem(OptimError):
@@ -37,13 +37,13 @@ class InvalidSettings(OptimError, ValueError):
 class SettingOutOfRange(InvalidSettings, InvalidInput):
     """A setting (a count, a step, a time, a grid size) is not a finite number inside its cap.
 
-    The message names the setting, its value and the range allowed (:mod:`optim.caps`).
+    The message names the setting, its value and the range allowed (:mod:`pinarms.optim.caps`).
     Caught by ``except InvalidSettings`` and by ``except InvalidInput`` alike.
     """
 
 
 class PlanningError(OptimError):
-    """A collision-free motion could not be planned (:func:`optim.plan_motion`)."""
+    """A collision-free motion could not be planned (:func:`pinarms.optim.plan_motion`)."""
 
 
 class EndpointInCollision(PlanningError, CollisionError):

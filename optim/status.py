@@ -1,6 +1,6 @@
 """Statuses of the optimisers' results: enums whose value is the word printed and written to JSON.
 
-Every big call of :mod:`optim` takes one frozen input object (checked in its
+Every big call of :mod:`pinarms.optim` takes one frozen input object (checked in its
 ``__post_init__``) and returns a result whose ``status`` is a member of a :class:`Status`
 subclass (as toppra's ``ParameterizationReturnCode`` and ruckig's ``Result``), with
 ``status_reason`` saying why where it did not fully succeed:
@@ -19,7 +19,7 @@ call                      input                       status
 
 The rule for what is a status and what stays an exception:
 
-- **bad input raises** (a named exception of :mod:`optim.errors` or ``InvalidInput``, from the
+- **bad input raises** (a named exception of :mod:`pinarms.optim.errors` or ``InvalidInput``, from the
   input object's ``__post_init__``, before any work): the caller must change what it asked;
 - **an answer that falls short is a status**: the call has something to return (the ranking
   of every candidate, the best line tried, a feasible timing from a GA stopped early) and
@@ -27,7 +27,7 @@ The rule for what is a status and what stays an exception:
   meets the miss rate, the line misses more than asked, the GA hit its time limit);
 - **no answer at all raises**: where the call cannot build the object it promises (no timing
   within the bounds meets the limits, so there is no trajectory) it raises a named exception
-  (:class:`~optim.errors.InfeasibleProblem`), listed in its docstring;
+  (:class:`~pinarms.optim.errors.InfeasibleProblem`), listed in its docstring;
 - a failure of the machinery (a task failing on a cluster) raises
   (:class:`pinarms.errors.ExecutionError`).
 

@@ -1,6 +1,6 @@
 """Joint-torque limits in segment timing: the keywords, and the checks that no timing can meet.
 
-The torque-limit object is :class:`planning.JointTorqueConstraint` (one class for segment
+The torque-limit object is :class:`pinarms.planning.JointTorqueConstraint` (one class for segment
 timing and path timing; its docstring gives the scaling law ``tau(s) = (tau_1 - g) / s² + g``
 and the grid). :data:`TorqueConstraint` is that class under its former name here.
 :func:`torque_constraint` builds it from ``minimize_time``/``plan_cycle`` keywords (limits
@@ -22,19 +22,19 @@ from pinarms.planning.torque import JointTorqueConstraint
 
 __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static_check"]
 
-#: The former name of :class:`planning.JointTorqueConstraint` in segment timing.
+#: The former name of :class:`pinarms.planning.JointTorqueConstraint` in segment timing.
 TorqueConstraint = JointTorqueConstraint
 
 
 def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,
                       samples_per_piece: int | None = None) -> JointTorqueConstraint | None:
-    """The :class:`planning.JointTorqueConstraint` asked for by ``minimize_time``/``plan_cycle`` keywords, or None.
+    """The :class:`pinarms.planning.JointTorqueConstraint` asked for by ``minimize_time``/``plan_cycle`` keywords, or None.
 
     Args:
         robot: the arm (required when torque limits are asked for).
         torque_limits: ``False``/``None`` (no torque limits), ``True`` (the URDF's joint
             ``effort`` limits, ``robot.effort_limit``) or limits per joint [N·m or N].
-        payload: ``None``, a mass [kg], a :class:`robots.Payload` or its dict form; the
+        payload: ``None``, a mass [kg], a :class:`pinarms.robots.Payload` or its dict form; the
             robot carries it (``robot.with_payload``).
 
     Raises:

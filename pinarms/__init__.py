@@ -20,3 +20,28 @@ Where each family lives (imports go one way, top to bottom of this list read upw
   runs them), ``export/`` (URDF, SRDF, MJCF, trajectories), :mod:`pinarms.warmup` (every kernel
   compiled ahead, ``pinarms warm``).
 """
+
+from pinarms.lazy import lazy_exports
+
+#: The front door: the names a user starts with, each loaded on first use (PEP 562), so that
+#: ``import pinarms`` costs nothing and ``import pinarms.optim.line`` loads no planner.
+_EXPORTS = {
+    "load": "pinarms.robots.registry",
+    "Robot": "pinarms.robots.robot",
+    "load_cell": "pinarms.robots.cell.library",
+    "Cell": "pinarms.robots.cell.cell",
+    "plan_motion": "pinarms.optim.motion.plan",
+    "MotionPlan": "pinarms.optim.motion.result",
+    "plan_cycle": "pinarms.optim.cycle.plan",
+    "CycleRequest": "pinarms.optim.cycle.request",
+    "CycleResult": "pinarms.optim.cycle.spec",
+    "run_line": "pinarms.optim.line.api",
+    "LineSpec": "pinarms.optim.line.api",
+    "LineResult": "pinarms.optim.line.api",
+    "search_layout": "pinarms.optim.layout.search",
+    "PinarmsError": "pinarms.errors",
+}
+
+__all__ = list(_EXPORTS)
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -4,7 +4,7 @@
 under :mod:`pinarms.studies` (``seed000`` ... ``seed004``, ``cell``, ``line``, ``handoff``;
 this module only lists them in :data:`STUDIES`). A study builds its
 robot, redoes the paper's computation with pinarms and returns the rows of the
-paper-vs-pinarms table (:class:`pinarms.report.Row`), a :class:`viz.Session` and the
+paper-vs-pinarms table (:class:`pinarms.report.Row`), a :class:`pinarms.viz.Session` and the
 plots. The runner writes, into ``out_dir``::
 
     table.md, table.json       the paper-vs-pinarms table
@@ -37,7 +37,7 @@ from pinarms.studies.seed002 import BOUNDS_002_S, study_002  # noqa: F401  (old 
 from pinarms.studies.seed004 import study_004
 from pinarms.studies.study import Study
 
-from .report import Row, format_table, markdown_table
+from pinarms.report import Row, format_table, markdown_table
 
 __all__ = ["Study", "DemoResult", "STUDIES", "run_demo", "study_000", "study_001", "study_002", "study_004",
            "study_cell", "study_line", "study_delta"]

@@ -4,10 +4,17 @@ Every error pinarms raises on purpose derives from :class:`PinarmsError`, so a c
 can catch the whole family with one ``except``. The hierarchy lives here, in the floor
 that every package may import (with the execution layer, atomic files and units), and
 imports nothing of ours; the packages above derive their own errors from it.
-``pinarms.robots.errors`` re-exports every name, so imports from there keep working.
+
+This is the one module users import errors from: the classes of the floor and of the robots are
+defined here; the errors of each area above (trajectories and paths, optimisation and motion
+planning, the line, sessions and viewers, exports) are defined in that area's ``errors`` module and
+offered here too (:data:`AREA_ERRORS`), loaded on first use, so that this module imports nothing of
+the packages above it: ``from pinarms.errors import NoPathFound, SessionFormatError``.
 """
 
 from __future__ import annotations
+
+from pinarms.lazy import lazy_exports
 
 __all__ = [
     "PinarmsError",
@@ -43,7 +50,7 @@ class InvalidInput(PinarmsError, ValueError):
 
 
 class RobotNotFound(PinarmsError, LookupError):
-    """A robot name is not known to :func:`robots.load`."""
+    """A robot name is not known to :func:`pinarms.robots.load`."""
 
 
 class ModelError(PinarmsError):
@@ -168,3 +175,49 @@ class XacroFileNotFound(XacroError, CellNotFound):
     Both a :class:`XacroError` and the not-found error of cells (:class:`CellNotFound`, a
     ``LookupError``), so a cell whose included arm file is missing is caught either way.
     """
+
+
+#: The errors of the areas above the floor, each defined in its area's ``errors`` module and offered
+#: here on first use (:func:`pinarms.lazy.lazy_exports`): every error of pinarms from one module.
+AREA_ERRORS = {
+    "TrajectoryError": "pinarms.planning.errors",
+    "ConditionCountError": "pinarms.planning.errors",
+    "OutOfTimeRange": "pinarms.planning.errors",
+    "BlendTooLarge": "pinarms.planning.errors",
+    "PathError": "pinarms.planning.errors",
+    "SingularityOnPath": "pinarms.planning.errors",
+    "JointLimitOnPath": "pinarms.planning.errors",
+    "UnreachableOnPath": "pinarms.planning.errors",
+    "OptimError": "pinarms.optim.errors",
+    "InfeasibleProblem": "pinarms.optim.errors",
+    "InvalidLimits": "pinarms.optim.errors",
+    "InvalidSettings": "pinarms.optim.errors",
+    "SettingOutOfRange": "pinarms.optim.errors",
+    "PlanningError": "pinarms.optim.errors",
+    "EndpointInCollision": "pinarms.optim.errors",
+    "StartInCollision": "pinarms.optim.errors",
+    "GoalInCollision": "pinarms.optim.errors",
+    "NoPathFound": "pinarms.optim.errors",
+    "BeltOutOfReach": "pinarms.optim.line.errors",
+    "ArrivalsFileError": "pinarms.optim.line.errors",
+    "TaskMapError": "pinarms.optim.line.errors",
+    "VizError": "pinarms.viz.errors",
+    "SessionFormatError": "pinarms.viz.errors",
+    "ViewerError": "pinarms.viz.errors",
+    "ExportError": "pinarms.export.errors",
+    "MeshNotFound": "pinarms.export.errors",
+    "MeshNotAllowed": "pinarms.export.errors",
+    "InvalidRate": "pinarms.export.errors",
+    "JointMismatch": "pinarms.export.errors",
+    "InvalidJointName": "pinarms.export.errors",
+    "TrajectoryFileError": "pinarms.export.errors",
+    "ClosuresFileError": "pinarms.robots.delta.errors",
+    "NotADelta": "pinarms.robots.delta.errors",
+    "DeltaUnreachable": "pinarms.robots.delta.errors",
+    "ProjectionFailed": "pinarms.robots.delta.errors",
+    "DeltaInputError": "pinarms.robots.delta.errors",
+}
+
+__all__ += list(AREA_ERRORS)
+
+__getattr__, __dir__ = lazy_exports(__name__, AREA_ERRORS)

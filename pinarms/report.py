@@ -134,7 +134,7 @@ def format_table(rows: Sequence[Row], title: str = "paper vs pinarms", width: in
     ``table.json`` hold the same rows unwrapped).
     """
     if width is not None and (isinstance(width, bool) or not isinstance(width, int) or width < 40):
-        from pinarms.robots.errors import InvalidInput
+        from pinarms.errors import InvalidInput
 
         raise InvalidInput(f"table width must be an integer of at least 40 characters, got {width!r}")
     cells = [_cells(r) for r in rows]
@@ -180,7 +180,7 @@ def splice_table(document: str, rows: Sequence[Row]) -> str:
     Raises:
         InvalidInput: the document lacks the two markers (in that order, once each).
     """
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     begin, end = document.find(TABLE_BEGIN), document.find(TABLE_END)
     if document.count(TABLE_BEGIN) != 1 or document.count(TABLE_END) != 1 or end < begin:

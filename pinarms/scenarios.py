@@ -20,7 +20,7 @@ __all__ = ["PaperScenario", "seed000", "seed001", "seed002", "GANTRY_PATH_AXIS_M
            "GANTRY_MOTOR_RAD_PER_M"]
 
 #: Motor-side radians per metre of gantry axis travel: 1 / the gantry model's transmission
-#: (:data:`robots.conventions.GANTRY_TRANSMISSION_M_PER_RAD`); seed 002's limits are motor-side.
+#: (:data:`pinarms.robots.conventions.GANTRY_TRANSMISSION_M_PER_RAD`); seed 002's limits are motor-side.
 GANTRY_MOTOR_RAD_PER_M: float = 1.0 / GANTRY_TRANSMISSION_M_PER_RAD
 
 #: pinarms's representative lift-feed-lower path of the flower gantry (seed 002 prints no
@@ -39,7 +39,7 @@ GANTRY_PATH_AXIS_M.setflags(write=False)
 def gantry_path_motor_rad() -> np.ndarray:
     """:data:`GANTRY_PATH_AXIS_M` in motor radians, (11, 3), a fresh array.
 
-    Axis metres / :data:`robots.conventions.GANTRY_TRANSMISSION_M_PER_RAD`, so that the
+    Axis metres / :data:`pinarms.robots.conventions.GANTRY_TRANSMISSION_M_PER_RAD`, so that the
     paper's motor-side limits (100 rad/s, 1500 rad/s^2, 20000 rad/s^3) apply unchanged.
     """
     return GANTRY_PATH_AXIS_M / GANTRY_TRANSMISSION_M_PER_RAD

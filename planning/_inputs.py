@@ -1,6 +1,6 @@
 """Shared argument checks of the trajectory constructors (private).
 
-Every check raises :class:`planning.errors.TrajectoryError` naming the argument and the
+Every check raises :class:`pinarms.planning.errors.TrajectoryError` naming the argument and the
 offending value, so that callers see *what* to fix rather than a numpy broadcasting error.
 """
 

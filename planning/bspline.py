@@ -15,7 +15,7 @@ derivatives at the start of every piece.
 population of timings at once: a C⁴ quintic spline through the points with these end
 conditions is unique, so it solves the equivalent piecewise system (m quintic pieces, 6m
 unknowns: positions at both ends of every piece, continuity of derivatives 1..4 at the
-m-1 interior knots, the 4 end conditions) with :mod:`planning.piecewise`'s batched solver.
+m-1 interior knots, the 4 end conditions) with :mod:`pinarms.planning.piecewise`'s batched solver.
 The tests check that both give the same coefficients.
 """
 

@@ -1,6 +1,6 @@
 """Cartesian helpers: waypoints (TCP poses) to joint via points by IK, and the TCP path of a trajectory.
 
-These are the only functions of :mod:`planning` that talk to a robot. They use only the
+These are the only functions of :mod:`pinarms.planning` that talk to a robot. They use only the
 robot's public methods (duck typing, so any object with the same methods works):
 
 * ``has_analytic_ik`` (bool) and ``ik_branches(pose, q_ref=...) -> (q (k, nq), branch (k,))``
@@ -30,7 +30,7 @@ from pinarms.planning.multi_quintic import multi_quintic
 from pinarms.planning.piecewise import piecewise_polynomial
 from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import Trajectory
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "tcp_speed", "PATH_KINDS"]
@@ -61,7 +61,7 @@ def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
     the module docstring).
 
     Raises:
-        robots.errors.UnreachableTarget: naming the waypoint index that has no solution.
+        pinarms.errors.UnreachableTarget: naming the waypoint index that has no solution.
     """
     P = _poses(poses)
     nq = int(robot.nq)
@@ -108,7 +108,7 @@ def joint_path_from_waypoints(
     """Joint trajectory through TCP waypoints: IK per pose (:func:`joint_waypoints`), then ``kind``.
 
     Args:
-        robot: a :class:`robots.Robot` (or an object with the same IK/FK methods).
+        robot: a :class:`pinarms.robots.Robot` (or an object with the same IK/FK methods).
         poses: (N, 4, 4) TCP poses in the base frame (m).
         times: (N,) knot times (s), strictly increasing.
         kind: ``"multi-quintic"`` (default), ``"quintic-bspline"``, ``"piecewise-polynomial"``

@@ -1,8 +1,8 @@
 """The joint-space image of a tool path: IK along the path, on one branch, within a tolerance.
 
-:func:`cartesian_path` (tcp poses → :class:`planning.ToolPath` → joints) and
+:func:`cartesian_path` (tcp poses → :class:`pinarms.planning.ToolPath` → joints) and
 :func:`joint_image` (a ToolPath you built) return a :class:`CartesianPath`: a
-:class:`planning.JointPath` ``q(s)`` whose tcp stays within ``tolerance`` of the tool path
+:class:`pinarms.planning.JointPath` ``q(s)`` whose tcp stays within ``tolerance`` of the tool path
 at the same arc length s.
 
 **How.** Knots ``s_k`` carry the exact IK solution ``q_k`` and its path derivatives
@@ -11,15 +11,15 @@ axes with the angular rows weighted by the path's ``w``; J̇ q' by a central dif
 along q'). Between knots q(s) is the **quintic Hermite** interpolant of (q, q', q'') at
 both ends: C² in s, error O(h⁶).
 
-1. *Continuation, one branch* (:mod:`planning.ik_continuation`). From the start
+1. *Continuation, one branch* (:mod:`pinarms.planning.ik_continuation`). From the start
    configuration each knot is reached by a predictor (Taylor step) and Newton's method on
    the pose error, so the solution moves continuously and never jumps to another IK branch. A step is refused — and halved —
    when Newton does not converge, when the correction or the joint step is large (a jump),
    when a joint leaves its limits, or when the Jacobian's smallest singular value falls
    below ``singular_tolerance``. When the step has shrunk below ``locate`` (10 µm of arc
    length by default) the path stops there with a named error:
-   :class:`planning.errors.SingularityOnPath`, :class:`~planning.errors.JointLimitOnPath`
-   or :class:`~planning.errors.UnreachableOnPath` (s, pose, reason).
+   :class:`pinarms.planning.errors.SingularityOnPath`, :class:`~pinarms.planning.errors.JointLimitOnPath`
+   or :class:`~pinarms.planning.errors.UnreachableOnPath` (s, pose, reason).
 2. *Tolerance rule.* Every interval is checked by FK at 1/4, 1/2 and 3/4 of its length:
    it is split in two when the tcp there is farther than ``tolerance / 2`` from the tool
    path's position (or its orientation more than ``tolerance / (2 w)`` rad away), or when
@@ -48,7 +48,7 @@ from pinarms.planning.ik_continuation import MAX_CORRECTION, Knot, PathSolver, S
 from pinarms.planning.joint_path import JointPath
 from pinarms.planning.multi_quintic import quintic_hermite_coefficients
 from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
@@ -65,7 +65,7 @@ _CHECKS = np.array([0.25, 0.5, 0.75])
 
 
 class CartesianPath(JointPath):
-    """A :class:`planning.JointPath` that follows a :class:`planning.ToolPath` (module docstring).
+    """A :class:`pinarms.planning.JointPath` that follows a :class:`pinarms.planning.ToolPath` (module docstring).
 
     Extra attributes:
         tool_path: the followed :class:`ToolPath` (s is its arc length, m).
@@ -311,9 +311,9 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     """The joint path that makes the tcp follow ``path`` within ``tolerance`` (module docstring).
 
     Args:
-        robot: a :class:`robots.Robot` (``fk``, ``jacobian``, ``lower``/``upper``, ``ik`` or
+        robot: a :class:`pinarms.robots.Robot` (``fk``, ``jacobian``, ``lower``/``upper``, ``ik`` or
             ``ik_branches``, ``ik_failure_reason``).
-        path: the :class:`planning.ToolPath` (tcp → base poses, m).
+        path: the :class:`pinarms.planning.ToolPath` (tcp → base poses, m).
         tolerance: largest tcp position deviation [m] (default 0.1 mm); the orientation's is
             ``tolerance / path.weight`` rad.
         q_start: configuration (nq,) selecting the branch: the path starts at the IK solution
@@ -370,14 +370,14 @@ def cartesian_path(robot: Any, poses: Any, *, blend: Any = 0.0, weight: float = 
                    frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE) -> CartesianPath:
     """Straight tcp lines through ``poses`` (blends of radius ``blend`` at the corners), as joints.
 
-    :func:`planning.tool_path` builds the geometry (position linear, orientation by SLERP,
+    :func:`pinarms.planning.tool_path` builds the geometry (position linear, orientation by SLERP,
     arc length with ``weight`` m/rad), :func:`joint_image` its joint-space image on one IK
-    branch within ``tolerance`` (default 0.1 mm). Time it with :func:`optim.time_optimal`.
+    branch within ``tolerance`` (default 0.1 mm). Time it with :func:`pinarms.optim.time_optimal`.
 
     Args:
-        robot: a :class:`robots.Robot`.
+        robot: a :class:`pinarms.robots.Robot`.
         poses: (N, 4, 4) tcp → base poses [m].
-        blend, weight, stops: see :func:`planning.tool_path`.
+        blend, weight, stops: see :func:`pinarms.planning.tool_path`.
         tolerance, q_start, frame, singular_tolerance: see :func:`joint_image`.
     """
     return joint_image(robot, tool_path(poses, blend=blend, weight=weight, stops=stops), tolerance=tolerance,

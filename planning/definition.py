@@ -1,6 +1,6 @@
 """Rebuild a trajectory from its JSON-able ``definition`` (used by saved sessions).
 
-Every constructor of :mod:`planning` records its inputs in ``Trajectory.definition``;
+Every constructor of :mod:`pinarms.planning` records its inputs in ``Trajectory.definition``;
 :func:`from_definition` calls the same constructor again, so the rebuilt trajectory is
 the same (same breaks and coefficients). Derived trajectories record how they were
 derived (``"scaled"``, ``"shifted"``, ``"concatenated"``); a trajectory built directly

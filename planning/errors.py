@@ -1,12 +1,12 @@
 """Exceptions of the trajectory layer.
 
-Everything here derives from :class:`robots.errors.PinarmsError`, so a caller can catch
+Everything here derives from :class:`pinarms.errors.PinarmsError`, so a caller can catch
 the whole pinarms family with one ``except``; :class:`TrajectoryError` is also a
 ``ValueError`` because it is raised for bad arguments (times, positions, degrees).
 
 The Cartesian path errors (:class:`PathError` and its subclasses) say *where* along the
 path the arm cannot follow it: the arc length ``s`` [m, weighted, see
-:mod:`planning.tool_path`], the tcp pose there (4, 4) and the reason, as attributes and in
+:mod:`pinarms.planning.tool_path`], the tcp pose there (4, 4) and the reason, as attributes and in
 the message.
 """
 
@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
+from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
 __all__ = ["TrajectoryError", "ConditionCountError", "OutOfTimeRange", "BlendTooLarge", "PathError",
            "SingularityOnPath", "JointLimitOnPath", "UnreachableOnPath"]

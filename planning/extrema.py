@@ -7,7 +7,7 @@ derivative orders at once: closed form up to degree 3 (Cardano / trigonometric f
 cubics), batched companion-matrix eigenvalues above. The r-th derivative in real time is
 the r-th derivative in ``s`` divided by ``h**r``.
 
-:class:`planning.Trajectory` uses :func:`piece_extrema` for its peaks and limit checks;
+:class:`pinarms.planning.Trajectory` uses :func:`piece_extrema` for its peaks and limit checks;
 optimisers that time many trajectories at once (a GA population, finite-difference
 Jacobians) call :func:`piece_peaks_batch` / :func:`peaks_batch` on the coefficient arrays
 returned by the ``*_batch`` constructors, so that one numpy pass peaks every piece of every
@@ -201,7 +201,7 @@ def piece_peaks_batch(times: Any, coefficients: Any) -> np.ndarray:
         times: (P, m+1) knot times (s) of P trajectories, each row strictly increasing.
         coefficients: (P, m, K+1, n_joints) piece coefficients in ascending powers of the
             time since each piece's start (as returned by the ``*_batch`` constructors and
-            stored by :class:`planning.Trajectory`).
+            stored by :class:`pinarms.planning.Trajectory`).
 
     Returns:
         (P, 3, m, n_joints): maxima of |qd|, |qdd|, |qddd| on each piece (unit/s, /s², /s³).

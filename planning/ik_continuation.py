@@ -1,11 +1,11 @@
 """IK followed along a tool path on one branch: Newton on the pose, path derivatives, continuation.
 
-:class:`PathSolver` holds one robot and one :class:`planning.ToolPath` and solves, batched,
+:class:`PathSolver` holds one robot and one :class:`pinarms.planning.ToolPath` and solves, batched,
 the pose error by chord Newton and the path derivatives ``q' = J⁺ X'`` and
 ``q'' = J⁺ (X'' − J̇ q')`` (weighted Jacobian). :func:`continue_to` walks from a knot to a
 later arc length by predictor (Taylor step) and corrector (Newton), halving the step where
 it is refused, so that the solution never jumps to another IK branch; where it cannot go on
-it raises :class:`Stop` with the arc length and the reason (:mod:`planning.cartesian_path`
+it raises :class:`Stop` with the arc length and the reason (:mod:`pinarms.planning.cartesian_path`
 turns that into a named error). Units: m, rad; s in m of the tool path's arc length.
 """
 
@@ -126,7 +126,7 @@ def solve_knots(sv: PathSolver, s: np.ndarray, q: np.ndarray) -> list[Knot]:
 
 class Stop(Exception):
     """Internal: the continuation of one start cannot pass arc length ``s`` (diagnosed once, by
-    :func:`planning.cartesian_path.joint_image`, which names the error)."""
+    :func:`pinarms.planning.cartesian_path.joint_image`, which names the error)."""
 
     def __init__(self, s: float, q_last: np.ndarray, kind: str, detail: str) -> None:
         super().__init__(detail)

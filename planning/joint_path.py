@@ -1,20 +1,20 @@
 """A geometric path in joint space: ``q(s)``, a piecewise polynomial in the path parameter s.
 
 A :class:`JointPath` is the input of the time-optimal path scaling
-(:func:`optim.time_optimal`): geometry only, no time. ``s`` runs from 0 to
+(:func:`pinarms.optim.time_optimal`): geometry only, no time. ``s`` runs from 0 to
 :attr:`JointPath.length`; on piece k (``breaks[k] <= s <= breaks[k+1]``) joint j is
 
     ``q_j(s) = sum_i coefficients[k, i, j] * (s - breaks[k])**i``
 
-(ascending powers, like :class:`planning.Trajectory` with time replaced by s). Its
+(ascending powers, like :class:`pinarms.planning.Trajectory` with time replaced by s). Its
 derivatives ``dq/ds`` and ``d²q/ds²`` are what the path constraints need
-(:mod:`planning.path_constraints`). Where the tangent ``dq/ds`` jumps (a corner of a
+(:mod:`pinarms.planning.path_constraints`). Where the tangent ``dq/ds`` jumps (a corner of a
 Cartesian path without a blend) the arm must stop: those ``s`` are :attr:`JointPath.stops`
 and the time scaling brings ``ds/dt`` to 0 there.
 
 Build one from joint waypoints with :func:`joint_spline` (a C² cubic spline, parameter =
 cumulative joint-space chord length, e.g. for a sampling planner's path), or from tcp
-poses with :func:`planning.cartesian_path` (its :class:`planning.CartesianPath` subclass
+poses with :func:`pinarms.planning.cartesian_path` (its :class:`pinarms.planning.CartesianPath` subclass
 follows straight tool lines). ``robot`` and ``frame`` (optional) let tool-space
 constraints (tcp speed) evaluate the tcp along the path.
 
@@ -42,7 +42,7 @@ class JointPath:
         breaks: (K+1,) strictly increasing, ``breaks[0] == 0``.
         coefficients: (K, D+1, n_joints), ascending powers of ``s - breaks[k]``.
         stops: interior values of s where the path's tangent jumps (the arm must stop there).
-        robot: optional :class:`robots.Robot` the joints belong to (for tool constraints).
+        robot: optional :class:`pinarms.robots.Robot` the joints belong to (for tool constraints).
         frame: the robot's frame that is the tool (default its tcp).
     """
 

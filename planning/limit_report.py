@@ -1,7 +1,7 @@
 """The report of a trajectory's limit check: one :class:`Violation` per joint, kind and piece.
 
-:meth:`planning.Trajectory.check` finds the exact extrema of the trajectory (and the torque
-peaks with a robot); the functions here compare them with a :class:`planning.JointLimits`
+:meth:`pinarms.planning.Trajectory.check` finds the exact extrema of the trajectory (and the torque
+peaks with a robot); the functions here compare them with a :class:`pinarms.planning.JointLimits`
 spec and list what exceeds it, each at the time of its worst value, in a :class:`LimitReport`.
 """
 

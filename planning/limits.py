@@ -1,7 +1,7 @@
 """Kinematic limits of a set of joints, as a specification object.
 
-A :class:`JointLimits` only *describes* limits; :meth:`planning.Trajectory.check` and the
-optimisers of :mod:`optim` apply them. Units are SI and per joint: rad, rad/s, rad/s²,
+A :class:`JointLimits` only *describes* limits; :meth:`pinarms.planning.Trajectory.check` and the
+optimisers of :mod:`pinarms.optim` apply them. Units are SI and per joint: rad, rad/s, rad/s²,
 rad/s³ for revolute joints (m, m/s, ... for prismatic ones).
 """
 
@@ -33,7 +33,7 @@ class JointLimits:
             for a joint without that bound (a continuous joint: :meth:`from_robot` gives it none).
         torque: max |joint torque| (N·m, or N for prismatic joints), optional, > 0; checking it
             needs the robot whose inverse dynamics give the torques
-            (:meth:`planning.Trajectory.check` with ``robot=``).
+            (:meth:`pinarms.planning.Trajectory.check` with ``robot=``).
     """
 
     velocity: Any

@@ -11,7 +11,7 @@ shape (N, m) meaning
 
     ``lo[i, r] <= a[i, r] * u + b[i, r] * x <= hi[i, r]``   at grid point i, for each row r
 
-(``±inf`` where a side is free). The time-optimal scaling (:func:`optim.time_optimal`, a
+(``±inf`` where a side is free). The time-optimal scaling (:func:`pinarms.optim.time_optimal`, a
 reachability analysis) reads nothing else, so **adding a limit never touches the
 algorithm** (the split toppra makes). The classes here:
 
@@ -49,7 +49,7 @@ __all__ = ["PathSamples", "PathRows", "PathConstraint", "JointVelocityConstraint
 class PathSamples:
     """A path at grid points ``s`` (N,): joints ``q``, ``dq = q'(s)``, ``ddq = q''(s)`` (N, n).
 
-    ``path`` is the :class:`planning.JointPath` sampled (its ``robot`` and ``frame`` serve
+    ``path`` is the :class:`pinarms.planning.JointPath` sampled (its ``robot`` and ``frame`` serve
     tool and dynamics constraints); ``side`` tells which piece was used at a break.
     :attr:`tool` is evaluated once, on first use.
     """
@@ -113,7 +113,7 @@ class PathConstraint:
     def exact_dilation(self, trajectory: Any) -> float:
         """Smallest time dilation factor f >= 1 that makes a timed ``trajectory`` satisfy the limit exactly.
 
-        ``trajectory`` is a :class:`planning.Trajectory`, or the timing's stand-in with
+        ``trajectory`` is a :class:`pinarms.planning.Trajectory`, or the timing's stand-in with
         ``n_joints``, ``peaks()`` (computed once for every constraint) and ``trajectory`` (the
         Trajectory itself). Default 1 (not known exactly: the timing checks the rows densely
         instead); joint limits use the exact peaks, joint torque its refined torque peaks.

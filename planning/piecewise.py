@@ -13,7 +13,7 @@ Segment ``i`` (duration ``h_i``) is a polynomial of degree ``d_i`` in its normal
 There must be exactly as many conditions as unknowns, otherwise :class:`ConditionCountError`
 names both counts. For 3-5-3: 4+6+4 = 14 unknowns and 6 + 4 + 4 = 14 conditions (seed 000);
 4-3-4 also has 14. Quintic pieces with ``continuity=4`` and given end velocities and
-accelerations are the interpolating quintic B-spline (:mod:`planning.bspline` uses this
+accelerations are the interpolating quintic B-spline (:mod:`pinarms.planning.bspline` uses this
 system).
 
 Populations: :func:`piecewise_polynomial_batch` solves the system for P timings of the same
@@ -228,7 +228,7 @@ def piecewise_polynomial_batch(
     Returns:
         (P, m, K+1, n_joints) coefficients in ascending powers of the time since each
         piece's start (row p is ``piecewise_polynomial(times[p], ...).coefficients``, from
-        the same code); peak them with :func:`planning.peaks_batch`.
+        the same code); peak them with :func:`pinarms.planning.peaks_batch`.
     """
     t = _inputs.knot_times_batch(times)
     degs = _check_options(degrees, t.shape[1], continuity, end_order)

@@ -1,7 +1,7 @@
 """Arrays of polynomial pieces: derivatives, re-expansion about a new origin, padding, blocked evaluation.
 
 Pieces are stored as coefficients ``(m, K+1, n)``: piece i, ascending powers of the local
-variable (the time since the piece's start for a :class:`planning.Trajectory`), one column
+variable (the time since the piece's start for a :class:`pinarms.planning.Trajectory`), one column
 per joint. These functions work on such arrays, for every piece and joint at once.
 """
 

@@ -11,7 +11,7 @@ derivatives zero at both ends (velocity, then acceleration, then jerk, ...). Exa
 
 The coefficients come from one Vandermonde-like solve in normalised time
 ``s = (t - t_0) / (t_m - t_0)`` (well conditioned for the degrees used here), converted to
-the common piecewise representation of :class:`planning.Trajectory` (one piece).
+the common piecewise representation of :class:`pinarms.planning.Trajectory` (one piece).
 """
 
 from __future__ import annotations

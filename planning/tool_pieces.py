@@ -1,9 +1,9 @@
 """The pieces of a tool path: what is left of a straight line, and a circular blend at a corner.
 
 Each piece is pure geometry in its own local arc length σ [m] (the weighted metric of
-:mod:`planning.tool_path`): ``length`` and ``evaluate(σ)`` → tcp poses (N, 4, 4) and the
+:mod:`pinarms.planning.tool_path`): ``length`` and ``evaluate(σ)`` → tcp poses (N, 4, 4) and the
 first and second derivatives (N, 6) of position and rotation (base axes) in σ.
-:func:`planning.tool_path` cuts the lines and places the blends.
+:func:`pinarms.planning.tool_path` cuts the lines and places the blends.
 """
 
 from __future__ import annotations

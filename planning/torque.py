@@ -2,7 +2,7 @@
 
 A trajectory is kinematic (positions, velocities, accelerations per joint); the torques
 that make a given arm follow it come from the arm's inverse dynamics,
-``tau(t) = M(q) qdd + C(q, qd) qd + g(q)`` (:meth:`robots.Robot.inverse_dynamics`,
+``tau(t) = M(q) qdd + C(q, qd) qd + g(q)`` (:meth:`pinarms.robots.Robot.inverse_dynamics`,
 Pinocchio's RNEA; N·m for revolute, N for prismatic joints). Torques are not polynomials
 in time, so their peaks are not exact like the velocity peaks: each polynomial piece is
 sampled on a grid of ``samples_per_piece`` instants (both ends included, evaluated with that
@@ -12,9 +12,9 @@ the largest ``|tau_j|`` of every piece and joint is then refined by a bracketing
 about 1e-7 of the grid spacing). A peak narrower than the grid spacing can be missed; raise
 ``samples_per_piece`` for very fast, long pieces.
 
-Along a geometric path (:func:`optim.time_optimal`) the torque is linear in (s̈, ṡ²):
+Along a geometric path (:func:`pinarms.optim.time_optimal`) the torque is linear in (s̈, ṡ²):
 :class:`JointTorqueConstraint` gives those rows to the time-optimal path scaling like the
-other :mod:`planning.path_constraints`.
+other :mod:`pinarms.planning.path_constraints`.
 
 The batched helpers (:func:`piece_states`, :func:`piece_torques`) work on the coefficient
 arrays of a whole population of timings (``(P, m, K+1, n)``, as the ``*_batch``
@@ -143,7 +143,7 @@ def torques(trajectory: Any, robot: Any, t: Any) -> np.ndarray:
     """Joint torques [N·m or N] of ``robot`` following ``trajectory`` at instants ``t`` [s].
 
     Returns (len(t), nq), or (nq,) for a scalar ``t``. At an interior knot the piece that
-    starts there is used (as :meth:`planning.Trajectory.sample` does).
+    starts there is used (as :meth:`pinarms.planning.Trajectory.sample` does).
     """
     _robot_joints(robot, trajectory.n_joints)
     q, qd, qdd, _ = trajectory.sample(t)
@@ -252,14 +252,14 @@ def torque_dilation(trajectory: Any, robot: Any, limit: Any, samples_per_piece: 
 class JointTorqueConstraint(PathConstraint):
     """Joint torque limits ``|tau_j| <= limit_j`` [N·m or N] of one arm: the one torque-limit object.
 
-    Path timing (:func:`optim.time_optimal`) reads :meth:`rows`: with ``u = s̈`` and
+    Path timing (:func:`pinarms.optim.time_optimal`) reads :meth:`rows`: with ``u = s̈`` and
     ``x = ṡ²`` the inverse dynamics along ``q(s)`` is
     ``tau = M(q) q' u + (M(q) q'' + C(q, q') q') x + g(q)``, so the rows are ``a = M q'``,
     ``b = M q'' + C(q, q') q'`` and ``-limit - g <= a u + b x <= limit - g`` (three batched
     RNEA calls per grid; the split toppra makes for its own ``JointTorqueConstraint``).
     Gravity beyond a limit at some s leaves no feasible speed there (the timing says where).
 
-    Segment timing (:func:`optim.minimize_time`, :class:`optim.TimingProblem`) reads
+    Segment timing (:func:`pinarms.optim.minimize_time`, :class:`pinarms.optim.TimingProblem`) reads
     :meth:`piece_ratios` and :meth:`minimal_scale` on a grid of ``samples_per_piece``
     instants per polynomial piece, and :meth:`refined_scale` for the refined peaks. The
     scaling law: with every duration multiplied by ``s`` the torque is

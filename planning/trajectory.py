@@ -1,6 +1,6 @@
 """The joint-space trajectory: a piecewise polynomial in time, one column per joint.
 
-Every trajectory family of :mod:`planning` (single polynomials, 3-5-3, multi-segment
+Every trajectory family of :mod:`pinarms.planning` (single polynomials, 3-5-3, multi-segment
 quintics, quintic B-splines, trapezoidal and double-S profiles) is converted to one common
 representation, so that sampling, exact peak search, limit checks, time scaling and
 concatenation are written once and vectorised over instants and joints:
@@ -13,14 +13,14 @@ concatenation are written once and vectorised over instants and joints:
 
 A trajectory knows nothing about limits or optimisers (the split follows toppra: path,
 constraints and algorithm are separate objects). :meth:`Trajectory.check` takes a
-:class:`planning.JointLimits` spec and returns a :class:`planning.LimitReport`
-(:mod:`planning.limit_report`). The arithmetic on the coefficient arrays (derivatives,
-re-expansion, blocked products) is :mod:`planning.poly_pieces`.
+:class:`pinarms.planning.JointLimits` spec and returns a :class:`pinarms.planning.LimitReport`
+(:mod:`pinarms.planning.limit_report`). The arithmetic on the coefficient arrays (derivatives,
+re-expansion, blocked products) is :mod:`pinarms.planning.poly_pieces`.
 
 Peaks are *exact*: on each piece the extrema of ``|d^r q / dt^r|`` are at the piece ends
 or at real roots of the next derivative, which are found for all pieces, joints and
 derivative orders at once (closed form up to degree 3, batched companion-matrix
-eigenvalues above; :mod:`planning.extrema`, which also peaks whole populations).
+eigenvalues above; :mod:`pinarms.planning.extrema`, which also peaks whole populations).
 """
 
 from __future__ import annotations
@@ -68,11 +68,11 @@ class Peaks:
 class Trajectory:
     """A joint trajectory: piecewise polynomial in time, per joint (see the module docstring).
 
-    Build one with the constructors of :mod:`planning` (``polynomial``,
+    Build one with the constructors of :mod:`pinarms.planning` (``polynomial``,
     ``piecewise_polynomial``, ``multi_quintic``, ``quintic_bspline``, ``trapezoidal``,
     ``double_s``) or directly from ``breaks`` (s, strictly increasing, (m+1,)) and
     ``coefficients`` ((m, K+1, n_joints), ascending powers of the time since each piece's
-    start). ``definition`` is the JSON-able recipe :func:`planning.from_definition` rebuilds
+    start). ``definition`` is the JSON-able recipe :func:`pinarms.planning.from_definition` rebuilds
     it from; when omitted the raw breaks and coefficients are used.
     """
 
@@ -152,7 +152,7 @@ class Trajectory:
 
     @property
     def definition(self) -> dict:
-        """JSON-able recipe (kind, knot times, via points, options) for :func:`planning.from_definition`."""
+        """JSON-able recipe (kind, knot times, via points, options) for :func:`pinarms.planning.from_definition`."""
         if self._definition is not None:
             return _json_copy(self._definition)
         return {
@@ -201,7 +201,7 @@ class Trajectory:
 
         Returns ``(q, qd, qdd, qddd)``, each ``(len(t), n_joints)`` (or ``(n_joints,)`` for a
         scalar ``t``). At an interior knot the piece that starts there is used. Raises
-        :class:`planning.errors.OutOfTimeRange` for instants outside
+        :class:`pinarms.planning.errors.OutOfTimeRange` for instants outside
         ``[start_time, end_time]`` (beyond a 1e-12 relative tolerance, which is clipped).
         """
         tt, scalar = self._check_times(t)
@@ -272,7 +272,7 @@ class Trajectory:
 
         Returns ``(values, times)``, each (len(orders), m, n, C): the derivative of order r
         (in the joint's unit / s^r) at the piece ends and at every root of the next
-        derivative within the piece (:func:`planning.extrema.piece_extrema`). Max/min over
+        derivative within the piece (:func:`pinarms.planning.extrema.piece_extrema`). Max/min over
         the last axis are the exact extrema.
         """
         h = np.diff(self._breaks)
@@ -300,16 +300,16 @@ class Trajectory:
         return values[0].min(axis=(0, 2)), values[0].max(axis=(0, 2))
 
     def check(self, limits: Any, rtol: float = 1e-9, *, robot: Any = None) -> LimitReport:
-        """Check against a :class:`planning.JointLimits`; report every violation.
+        """Check against a :class:`pinarms.planning.JointLimits`; report every violation.
 
         A value counts as a violation when it exceeds the limit by more than ``rtol``
         relative (so an optimised trajectory that touches a limit passes). One
         :class:`Violation` is reported per joint, kind and piece, at the time of the worst
         value on that piece; the list is sorted by time.
 
-        Torque limits (``limits.torque``) need ``robot`` (a :class:`robots.Robot`, with its
+        Torque limits (``limits.torque``) need ``robot`` (a :class:`pinarms.robots.Robot`, with its
         payload if it carries one): its inverse dynamics give the torques, peaked per piece
-        on a dense grid refined around each maximum (:mod:`planning.torque`). With a robot
+        on a dense grid refined around each maximum (:mod:`pinarms.planning.torque`). With a robot
         the report names the joints.
         """
         from pinarms.planning.limits import JointLimits
@@ -341,17 +341,17 @@ class Trajectory:
         """Joint torques [N·m or N] of ``robot`` following this trajectory at instants ``t`` [s].
 
         ``(len(t), nq)`` (or ``(nq,)`` for a scalar ``t``), by the robot's inverse dynamics
-        (:func:`planning.torque.torques`); a payload is the robot's own (``robot.with_payload``).
+        (:func:`pinarms.planning.torque.torques`); a payload is the robot's own (``robot.with_payload``).
         """
         from pinarms.planning.torque import torques
 
         return torques(self, robot, t)
 
     def torque_peaks(self, robot: Any, samples_per_piece: int | None = None) -> Any:
-        """Per-joint peaks of ``|torque|`` with their instants (:class:`planning.torque.TorquePeaks`).
+        """Per-joint peaks of ``|torque|`` with their instants (:class:`pinarms.planning.torque.TorquePeaks`).
 
-        Dense grid per piece (default :data:`planning.torque.SAMPLES_PER_PIECE`) refined
-        around each maximum; see :mod:`planning.torque`.
+        Dense grid per piece (default :data:`pinarms.planning.torque.SAMPLES_PER_PIECE`) refined
+        around each maximum; see :mod:`pinarms.planning.torque`.
         """
         from pinarms.planning.torque import SAMPLES_PER_PIECE, torque_peaks
 

@@ -5,134 +5,98 @@
 >>> T = arm.fk(arm.neutral)          # (4, 4) tcp → base
 """
 
-from .errors import (
-    ExecutionError,
-    InvalidInput,
-    CellError,
-    CellNotFound,
-    CollisionError,
-    CollisionGeometryError,
-    LimitViolation,
-    MissingMesh,
-    ModelError,
-    PinarmsError,
-    RobotNotFound,
-    UnreachableTarget,
-    XacroArgError,
-    XacroError,
-    XacroFileNotFound,
-    XacroForbidden,
-    XacroLimitExceeded,
-)
-from .registry import builtin_names, from_urdf, from_urdf_text, from_xacro, info, load, names
-from .robot import Robot
+from __future__ import annotations
+
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "ExecutionError": "pinarms.errors",
+    "InvalidInput": "pinarms.errors",
+    "CellError": "pinarms.errors",
+    "CellNotFound": "pinarms.errors",
+    "CollisionError": "pinarms.errors",
+    "CollisionGeometryError": "pinarms.errors",
+    "LimitViolation": "pinarms.errors",
+    "MissingMesh": "pinarms.errors",
+    "ModelError": "pinarms.errors",
+    "PinarmsError": "pinarms.errors",
+    "RobotNotFound": "pinarms.errors",
+    "UnreachableTarget": "pinarms.errors",
+    "XacroArgError": "pinarms.errors",
+    "XacroError": "pinarms.errors",
+    "XacroFileNotFound": "pinarms.errors",
+    "XacroForbidden": "pinarms.errors",
+    "XacroLimitExceeded": "pinarms.errors",
+    "builtin_names": "pinarms.robots.registry",
+    "from_urdf": "pinarms.robots.registry",
+    "from_urdf_text": "pinarms.robots.registry",
+    "from_xacro": "pinarms.robots.registry",
+    "info": "pinarms.robots.registry",
+    "load": "pinarms.robots.registry",
+    "names": "pinarms.robots.registry",
+    "Robot": "pinarms.robots.robot",
+    "LayoutReport": "pinarms.robots.reach.layout",
+    "check_layout": "pinarms.robots.reach.layout",
+    "RecommendedRegion": "pinarms.robots.reach.table_band",
+    "recommend_region": "pinarms.robots.reach.table_band",
+    "SelfCollision": "pinarms.robots.self_collision",
+    "VoxelMap": "pinarms.robots.reach.voxels",
+    "suggest_voxel_size": "pinarms.robots.reach.voxels",
+    "SphereFit": "pinarms.robots.reach.sphere_fit",
+    "Workspace": "pinarms.robots.reach.workspace",
+    "WorkspaceSummary": "pinarms.robots.reach.workspace",
+    "fit_sphere": "pinarms.robots.reach.sphere_fit",
+    "sample_workspace": "pinarms.robots.reach.workspace",
+    "StreamedWorkspace": "pinarms.robots.reach.workspace_stream",
+    "stream_workspace": "pinarms.robots.reach.workspace_stream",
+    "MissingInertials": "pinarms.robots.dynamics",
+    "InvalidPayload": "pinarms.robots.payload",
+    "Payload": "pinarms.robots.payload",
+    "XacroLimits": "pinarms.robots.xacro_expand",
+    "expand_xacro": "pinarms.robots.xacro_expand",
+    "ArmMotion": "pinarms.robots.cell.timeline",
+    "Cell": "pinarms.robots.cell.cell",
+    "CellArm": "pinarms.robots.cell.components",
+    "Clearance": "pinarms.robots.cell.collision",
+    "Collisions": "pinarms.robots.cell.collision",
+    "CollisionPair": "pinarms.robots.cell.pairs",
+    "MotionCheck": "pinarms.robots.cell.motion_report",
+    "cell_names": "pinarms.robots.cell.library",
+    "load_cell": "pinarms.robots.cell.library",
+    "ArmPlacement": "pinarms.robots.cell.compose_file",
+    "FixturePrimitive": "pinarms.robots.cell.compose_file",
+    "ToolPoint": "pinarms.robots.cell.compose_file",
+    "compose_cell": "pinarms.robots.cell.compose",
+    "OrientationSet": "pinarms.robots.reach.orientations",
+    "so3_orientations": "pinarms.robots.reach.orientations",
+    "tool_axis_orientations": "pinarms.robots.reach.orientations",
+    "tool_down_orientations": "pinarms.robots.reach.orientations",
+    "ReachabilityFileError": "pinarms.robots.reach.reach_check",
+    "load_reachability": "pinarms.robots.reach.reach_io",
+    "save_reachability": "pinarms.robots.reach.reach_io",
+    "ReachabilityMap": "pinarms.robots.reach.reach_map",
+    "reach_bound": "pinarms.robots.reach.reach_grid",
+    "reachability_map": "pinarms.robots.reach.reachability",
+    "MAX_RESTARTS": "pinarms.robots._checks",
+    "BasePlacements": "pinarms.robots.reach.inverse_reach",
+    "base_placements": "pinarms.robots.reach.inverse_reach",
+    "tool_down_poses": "pinarms.robots.reach.inverse_reach",
+}
 
 __all__ = [
-    "Robot",
-    "load",
-    "names",
-    "builtin_names",
-    "info",
-    "from_urdf",
-    "from_urdf_text",
-    "from_xacro",
-    "PinarmsError",
-    "InvalidInput",
-    "RobotNotFound",
-    "ModelError",
-    "UnreachableTarget",
-    "LimitViolation",
-    "ExecutionError",
-    "XacroError",
-    "XacroForbidden",
-    "XacroFileNotFound",
-    "XacroLimitExceeded",
-    "XacroArgError",
-    "MissingMesh",
-    "CellError",
-    "CellNotFound",
-    "CollisionGeometryError",
-    "CollisionError",
-]
-
-# workspace analysis and station layout
-from .reach.layout import LayoutReport, check_layout  # noqa: E402
-from .reach.table_band import RecommendedRegion, recommend_region  # noqa: E402
-from .self_collision import SelfCollision  # noqa: E402
-from .reach.voxels import VoxelMap, suggest_voxel_size  # noqa: E402
-from .reach.workspace import SphereFit, Workspace, WorkspaceSummary, fit_sphere, sample_workspace  # noqa: E402
-from .reach.workspace_stream import StreamedWorkspace, stream_workspace  # noqa: E402
-
-__all__ += [
-    "Workspace",
-    "WorkspaceSummary",
-    "SphereFit",
-    "sample_workspace",
-    "fit_sphere",
-    "StreamedWorkspace",
-    "stream_workspace",
-    "VoxelMap",
-    "suggest_voxel_size",
-    "RecommendedRegion",
-    "recommend_region",
-    "SelfCollision",
-    "LayoutReport",
-    "check_layout",
-]
-
-# dynamics: payloads, joint torques (Robot.inverse_dynamics, Robot.gravity, Robot.with_payload)
-from .dynamics import MissingInertials  # noqa: E402
-from .payload import InvalidPayload, Payload  # noqa: E402
-
-__all__ += ["Payload", "InvalidPayload", "MissingInertials"]
-
-# users' xacro files, expanded behind a wall
-from .xacro_expand import XacroLimits, expand_xacro  # noqa: E402
-
-__all__ += ["XacroLimits", "expand_xacro"]
-
-# cells: several arms, fixtures, collision checks
-from .cell import (  # noqa: E402
-    ArmMotion,
-    Cell,
-    CellArm,
-    Clearance,
-    Collisions,
-    CollisionPair,
-    MotionCheck,
-    cell_names,
-    load_cell,
-)
-from .cell.compose import ArmPlacement, FixturePrimitive, ToolPoint, compose_cell  # noqa: E402
-
-__all__ += ["Cell", "CellArm", "Clearance", "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names",
-            "load_cell", "ArmPlacement", "FixturePrimitive", "ToolPoint", "compose_cell"]
-
-# reachability maps: tool poses per voxel, orientation sets, HDF5 files
-from .reach.orientations import (  # noqa: E402
-    OrientationSet,
-    so3_orientations,
-    tool_axis_orientations,
-    tool_down_orientations,
-)
-from .reach.reach_io import ReachabilityFileError, load_reachability, save_reachability  # noqa: E402
-from .reach.reachability import ReachabilityMap, reach_bound, reachability_map  # noqa: E402
-from ._checks import MAX_RESTARTS  # noqa: E402
-from .reach.inverse_reach import BasePlacements, base_placements, tool_down_poses  # noqa: E402
-
-__all__ += [
-    "ReachabilityMap",
-    "MAX_RESTARTS",
-    "reachability_map",
-    "reach_bound",
-    "OrientationSet",
-    "so3_orientations",
-    "tool_axis_orientations",
-    "tool_down_orientations",
-    "ReachabilityFileError",
-    "save_reachability",
-    "load_reachability",
-    "BasePlacements",
-    "base_placements",
+    "Robot", "load", "names", "builtin_names", "info", "from_urdf", "from_urdf_text", "from_xacro", "PinarmsError",
+    "InvalidInput", "RobotNotFound", "ModelError", "UnreachableTarget", "LimitViolation", "ExecutionError",
+    "XacroError", "XacroForbidden", "XacroFileNotFound", "XacroLimitExceeded", "XacroArgError", "MissingMesh",
+    "CellError", "CellNotFound", "CollisionGeometryError", "CollisionError", "Workspace", "WorkspaceSummary",
+    "SphereFit", "sample_workspace", "fit_sphere", "StreamedWorkspace", "stream_workspace", "VoxelMap",
+    "suggest_voxel_size", "RecommendedRegion", "recommend_region", "SelfCollision", "LayoutReport", "check_layout",
+    "Payload", "InvalidPayload", "MissingInertials", "XacroLimits", "expand_xacro", "Cell", "CellArm", "Clearance",
+    "Collisions", "CollisionPair", "ArmMotion", "MotionCheck", "cell_names", "load_cell", "ArmPlacement",
+    "FixturePrimitive", "ToolPoint", "compose_cell", "ReachabilityMap", "MAX_RESTARTS", "reachability_map",
+    "reach_bound", "OrientationSet", "so3_orientations", "tool_axis_orientations", "tool_down_orientations",
+    "ReachabilityFileError", "save_reachability", "load_reachability", "BasePlacements", "base_placements",
     "tool_down_poses",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["real_array", "as_batch", "check_seed", "as_generator", "check_tolerance", "check_restarts", "MAX_RESTARTS", "check_path_name"]
 

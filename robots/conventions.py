@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import _as_float_array, deg_to_rad, m_to_mm, mm_to_m, rad_to_deg, wrap_angle
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""Rigid-body dynamics of a :class:`robots.Robot`: joint torques, energies, holding torques.
+"""Rigid-body dynamics of a :class:`pinarms.robots.Robot`: joint torques, energies, holding torques.
 
 Conventions
 -----------
@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ._checks import as_batch
-from .errors import InvalidInput, ModelError
+from pinarms.robots._checks import as_batch
+from pinarms.errors import InvalidInput, ModelError
 
 __all__ = [
     "GRAVITY",

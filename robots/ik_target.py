@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import real_array
-from .errors import InvalidInput
+from pinarms.robots._checks import real_array
+from pinarms.errors import InvalidInput
 
 __all__ = ["check_ik_target"]
 
@@ -21,7 +21,7 @@ _F64 = np.dtype(np.float64)
 
 
 def check_ik_target(target: Any, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
-    """The targets as ``(N, 4, 4)`` and whether a single target was given (see :meth:`robots.Robot.check_target`).
+    """The targets as ``(N, 4, 4)`` and whether a single target was given (see :meth:`pinarms.robots.Robot.check_target`).
 
     Raises:
         InvalidInput: wrong shape, non-finite entries, or a rotation block that is not a

@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .errors import ModelError
-from .so3 import frame_z_to as _rotation_z_to
+from pinarms.errors import ModelError
+from pinarms.robots.so3 import frame_z_to as _rotation_z_to
 
 __all__ = ["KinematicTree", "JointCoordinates"]
 

@@ -1,7 +1,7 @@
 """Yoshikawa's manipulability of a frame Jacobian: the volume of its velocity ellipsoid.
 
 ``w = sqrt(det(J Jᵀ))`` of the chosen rows of a frame Jacobian ``(6, nq)`` (linear rows
-first, as :meth:`robots.Robot.jacobian` gives it): all six, the three linear rows
+first, as :meth:`pinarms.robots.Robot.jacobian` gives it): all six, the three linear rows
 (position) or the three angular rows (orientation). When the Jacobian has fewer columns
 than rows (an arm with fewer joints than task dimensions), ``w = sqrt(det(Jᵀ J))``: the
 volume within the arm's own motion space.
@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.linalg.lapack import dpotrf as _potrf
 
-from .errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["PARTS", "manipulability_of_jacobian"]
 

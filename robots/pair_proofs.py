@@ -32,7 +32,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .coaxial import AXIS_TOL, revolute_axis, symmetry
+from pinarms.robots.coaxial import AXIS_TOL, revolute_axis, symmetry
 
 __all__ = ["joint_path", "invariant_pair", "axial_gap", "interval_on_line", "neutral_distance"]
 

@@ -4,8 +4,8 @@ A pair is skipped only for a reason that is proven from the structure and the sh
 declared by the description's author (:class:`PairReason`); a sample never skips a pair on its
 own. :func:`by_design` gives the structural reasons (same link, rigid, coaxial, adjacent),
 :func:`declared_pairs` reads the declarations (``<disable_collisions link1= link2= reason=/>``,
-the SRDF element, at the top level of a URDF; Pinocchio ignores it). :class:`robots.SelfCollision`
-(one arm) and :mod:`robots.cell.pairs` (a cell, which adds ``out of reach`` and ``constant``)
+the SRDF element, at the top level of a URDF; Pinocchio ignores it). :class:`pinarms.robots.SelfCollision`
+(one arm) and :mod:`pinarms.robots.cell.pairs` (a cell, which adds ``out of reach`` and ``constant``)
 both build on them; the shapes that turn about their own axis come from :mod:`.coaxial`.
 """
 
@@ -33,7 +33,7 @@ class PairReason(enum.StrEnum):
     (:mod:`.coaxial`); ``adjacent``: their links are joined by one joint (``<mimic>`` joints
     count as part of the joint they follow); ``declared``: named by the description's author;
     ``out of reach`` and ``constant``: a cell's proven gaps, kept with their bound and checked again at a
-    clearance above it (:mod:`robots.cell.pairs`, :mod:`.pair_proofs`).
+    clearance above it (:mod:`pinarms.robots.cell.pairs`, :mod:`.pair_proofs`).
     """
 
     SAME_LINK = "same link"

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["Payload", "InvalidPayload", "as_payload", "with_payload"]
 

@@ -19,14 +19,14 @@ import pinocchio as pin
 
 from pinarms.files import read_bounded_text
 
-from .errors import InvalidInput, ModelError, RobotNotFound
-from .robot import Robot
+from pinarms.errors import InvalidInput, ModelError, RobotNotFound
+from pinarms.robots.robot import Robot
 # the URDF checks, under the names robots/cell/compose.py imports from here
-from ._checks import check_path_name
-from .urdf_checks import check_inertials as _check_inertials
-from .urdf_checks import check_limits as _check_limits
-from .urdf_checks import check_tree as _check_tree
-from .urdf_checks import refuse_dtd as _refuse_dtd
+from pinarms.robots._checks import check_path_name
+from pinarms.robots.urdf_checks import check_inertials as _check_inertials
+from pinarms.robots.urdf_checks import check_limits as _check_limits
+from pinarms.robots.urdf_checks import check_tree as _check_tree
+from pinarms.robots.urdf_checks import refuse_dtd as _refuse_dtd
 
 __all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest",
            "match_builtin", "MAX_URDF_BYTES"]
@@ -190,7 +190,7 @@ def _kinematics(robot: Robot) -> tuple[tuple[int, ...], np.ndarray]:
     Returns ``(integers, floats)``: parents, kinds and coordinate indices; then every
     joint's placement and axis, mimic multiplier and offset, the limits and the tcp.
     """
-    tree, model = robot._tree, robot.model
+    tree, model = robot.kinematic_tree, robot.model
     n = model.njoints
     ints = (n, *tree.parent.tolist(), *tree.kind.tolist(), *tree.q_index.tolist())
     place = [np.asarray(model.jointPlacements[i].homogeneous[:3]).ravel() for i in range(1, n)]
@@ -255,7 +255,7 @@ def from_urdf_text(
     """Build a :class:`Robot` from URDF text (see :func:`from_urdf`).
 
     Its closed-form IK, when its kinematic structure matches a family, is attached
-    (:func:`robots.ik.recognise`; ``robot.ik_family``).
+    (:func:`pinarms.robots.ik.recognise`; ``robot.ik_family``).
 
     Raises:
         InvalidInput: ``urdf_text`` is not a string.
@@ -300,7 +300,7 @@ def from_urdf_text(
         tcp_frame=tcp,
         description=description,
     )
-    from .ik import attach_analytic_ik  # late import: ik solvers need the Robot class
+    from pinarms.robots.ik import attach_analytic_ik  # late import: ik solvers need the Robot class
 
     attach_analytic_ik(robot)  # by geometry, proven by FK round trips (robot.ik_family)
     return robot
@@ -326,7 +326,7 @@ def from_urdf(
         package_dirs: folders that resolve ``package://`` mesh paths (for the viewer).
         freeze: joints to fix at zero (e.g. gripper fingers).
         declare: pairs of links in contact by design, ``(link1, link2, reason)``, added as
-            ``<disable_collisions>`` elements (:class:`~robots.SelfCollision` skips them).
+            ``<disable_collisions>`` elements (:class:`~pinarms.robots.SelfCollision` skips them).
 
     Raises:
         ModelError: the file is missing, not a regular file, larger than :data:`MAX_URDF_BYTES`,
@@ -382,7 +382,7 @@ def from_xacro(
         MissingMesh: a mesh file named by the URDF does not exist.
         ModelError: Pinocchio cannot build a model of the result.
     """
-    from .xacro_expand import check_mesh_files, expand_xacro
+    from pinarms.robots.xacro_expand import check_mesh_files, expand_xacro
 
     check_path_name(path, "xacro file")
     path = Path(path)

@@ -22,13 +22,13 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ._checks import as_batch as _as_batch
-from ._checks import as_generator as _as_generator
-from ._checks import check_tolerance as _check_tolerance
-from .errors import InvalidInput, ModelError
-from .kinematic_tree import KinematicTree
-from .manipulability import manipulability_of_jacobian
-from .robot_ik import RobotIK
+from pinarms.robots._checks import as_batch as _as_batch
+from pinarms.robots._checks import as_generator as _as_generator
+from pinarms.robots._checks import check_tolerance as _check_tolerance
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.kinematic_tree import KinematicTree
+from pinarms.robots.manipulability import manipulability_of_jacobian
+from pinarms.robots.robot_ik import RobotIK
 
 __all__ = ["Robot", "MAX_RANDOM_SAMPLES", "ACCELERATION_RISE_TIME"]
 
@@ -61,7 +61,7 @@ class _PerThread(threading.local):
 class Robot(RobotIK):
     """A robot arm: Pinocchio model plus batched kinematics.
 
-    Build one with :func:`robots.load` (by name) or :func:`robots.from_urdf` (any URDF).
+    Build one with :func:`pinarms.robots.load` (by name) or :func:`pinarms.robots.from_urdf` (any URDF).
 
     Attributes:
         name: registry name, or the URDF's robot name.
@@ -190,9 +190,14 @@ class Robot(RobotIK):
         self._tcp_frame = name
         self._frame_lookup = {**self._frame_ids, "tcp": self._frame_ids[name]}
         if changed and (self.__dict__.get("_analytic_ik") is not None or self.__dict__.get("_ik_auto", False)):
-            from .ik import attach_analytic_ik  # the closed form was proven for the old tcp: recognise again
+            from pinarms.robots.ik import attach_analytic_ik  # the closed form was proven for the old tcp: recognise again
 
             attach_analytic_ik(self)
+
+    @property
+    def kinematic_tree(self) -> KinematicTree:
+        """The joint tree behind batched FK and Jacobians (:class:`~pinarms.robots.kinematic_tree.KinematicTree`)."""
+        return self._tree
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame`` (``"tcp"`` means :attr:`tcp_frame`)."""
@@ -381,37 +386,37 @@ class Robot(RobotIK):
 
         Returns:
             a float for one ``q (nq,)``, an array ``(N,)`` for a batch
-            (:func:`robots.manipulability.manipulability_of_jacobian`).
+            (:func:`pinarms.robots.manipulability.manipulability_of_jacobian`).
         """
         return manipulability_of_jacobian(self.jacobian(q, frame), part)
 
     # --------------------------------------------------------------- dynamics
-    #: The :class:`robots.payload.Payload` this robot carries (``None``: the bare arm).
+    #: The :class:`pinarms.robots.payload.Payload` this robot carries (``None``: the bare arm).
     payload = None
 
     def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
         """A copy of this robot carrying a payload (this robot is unchanged).
 
-        ``mass`` [kg] (or a :class:`robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
+        ``mass`` [kg] (or a :class:`pinarms.robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
         (default the tcp), ``inertia`` (3, 3) [kg·m²] about the centre of mass (default a point
-        mass). See :func:`robots.payload.with_payload`.
+        mass). See :func:`pinarms.robots.payload.with_payload`.
         """
-        from .payload import with_payload
+        from pinarms.robots.payload import with_payload
 
         return with_payload(self, mass, com=com, inertia=inertia, frame=frame)
 
     def inverse_dynamics(self, q: Any, qd: Any, qdd: Any) -> np.ndarray:
         """Joint torques [N·m or N] for ``q, qd, qdd`` (each (nq,) or (N, nq)), by Pinocchio's RNEA.
 
-        See :func:`robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
+        See :func:`pinarms.robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
         mapped onto the independent joints).
         """
-        from .dynamics import inverse_dynamics
+        from pinarms.robots.dynamics import inverse_dynamics
 
         return inverse_dynamics(self, q, qd, qdd)
 
     def gravity(self, q: Any) -> np.ndarray:
         """Joint torques [N·m or N] holding ``q`` ((nq,) or (N, nq)) still against gravity."""
-        from .dynamics import gravity_torques
+        from pinarms.robots.dynamics import gravity_torques
 
         return gravity_torques(self, q)

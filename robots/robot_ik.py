@@ -1,23 +1,23 @@
-"""Inverse kinematics of a :class:`robots.Robot`: the methods ``ik``, ``ik_all``, ``ik_branches``,
+"""Inverse kinematics of a :class:`pinarms.robots.Robot`: the methods ``ik``, ``ik_all``, ``ik_branches``,
 ``check_target``, ``ik_failure_reason`` and their helpers, as a base class of ``Robot`` (a target's
-checks: :mod:`robots.ik_target`).
+checks: :mod:`pinarms.robots.ik_target`).
 
 Its own module so that ``robots/robot.py`` (model, kinematics, dynamics) stays readable; the
-conventions (units, frames, shapes) are those of :mod:`robots.robot`.
+conventions (units, frames, shapes) are those of :mod:`pinarms.robots.robot`.
 """
 
 
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
-from ._checks import check_restarts as _check_restarts
-from ._checks import check_seed as _check_seed
-from ._checks import check_tolerance as _check_tolerance
-from .errors import InvalidInput, ModelError, UnreachableTarget
-from .ik.numerical import NumericalIK
-from .ik.solver import LIMIT_TOL, split_by_target
-from .ik_target import check_ik_target
+from pinarms.robots._checks import check_restarts as _check_restarts
+from pinarms.robots._checks import check_seed as _check_seed
+from pinarms.robots._checks import check_tolerance as _check_tolerance
+from pinarms.errors import InvalidInput, ModelError, UnreachableTarget
+from pinarms.robots.ik.numerical import NumericalIK
+from pinarms.robots.ik.solver import LIMIT_TOL, split_by_target
+from pinarms.robots.ik_target import check_ik_target
 
 
 __all__: list[str] = []
@@ -29,13 +29,31 @@ def _limit_tolerance(value: Any) -> float:
 
 
 class RobotIK:
-    """The inverse-kinematics methods of :class:`robots.Robot` (which inherits them)."""
+    """The inverse-kinematics methods of :class:`pinarms.robots.Robot` (which inherits them)."""
 
     # -------------------------------------------------------- inverse kinematics
     @property
     def has_analytic_ik(self) -> bool:
         """Whether :meth:`ik_all` has a closed form for this arm."""
         return self._analytic_ik is not None
+
+    @property
+    def analytic_ik(self) -> Any:
+        """The closed-form solver of :meth:`ik_all` (``candidates``, ``solve``, ``starts``), or ``None``."""
+        return self._analytic_ik
+
+    def set_analytic_ik(self, solver: Any, *, rejected: Mapping[str, str] | None = None,
+                        recognised: bool = False) -> None:
+        """Give this arm the closed-form ``solver`` (``None``: numerical IK only).
+
+        ``rejected``: why each closed-form family was refused (named when :meth:`ik_all` has no
+        closed form); ``recognised``: the solver was recognised from the geometry, so a new tcp
+        frame recognises it again (:func:`~pinarms.robots.ik.attach_analytic_ik`).
+        """
+        self._analytic_ik = solver
+        self._ik_rejected = dict(rejected or {})
+        if recognised:
+            self._ik_auto = True
 
     @property
     def ik_family(self) -> str | None:
@@ -82,7 +100,7 @@ class RobotIK:
                 printed pose lies outside a range. Check them with :meth:`within_limits`.
             limit_tolerance: accept solutions up to this far outside a joint's range [rad or
                 m] (returned as they are, never clamped), e.g. a printed pose that needs a
-                joint a rounding error past its limit (see :mod:`robots.ik.near_limits`).
+                joint a rounding error past its limit (see :mod:`pinarms.robots.ik.near_limits`).
 
         Returns:
             ``(k, nq)`` for one target (``k = 0`` allowed: see :meth:`ik_failure_reason`), a
@@ -112,7 +130,7 @@ class RobotIK:
             arm-plane candidates). Along a continuous path a solution keeps its label until
             the path crosses a singularity, so equal labels mean "the same arm
             configuration" for consecutive waypoints (see
-            :func:`planning.joint_waypoints`).
+            :func:`pinarms.planning.joint_waypoints`).
         """
         T, single, ref = self._analytic_targets(target, q_ref)
         if not single:
@@ -137,7 +155,8 @@ class RobotIK:
                 raise InvalidInput(f"q_ref must be one configuration or one per target ({T.shape[0]}), got {ref.shape[0]}")
         return T, single, ref
 
-    def _numerical_ik(self) -> NumericalIK:
+    def numerical_ik(self) -> NumericalIK:
+        """This arm's numerical solver (:class:`~pinarms.robots.ik.numerical.NumericalIK`), built once."""
         solver = getattr(self, "_numerical_ik_solver", None)
         if solver is None:  # two threads may both build one: either is fine (no shared scratch state)
             solver = self._numerical_ik_solver = NumericalIK(self)
@@ -184,11 +203,11 @@ class RobotIK:
                 )
             # none from the closed form (also at singular poses, where θ free joints were fixed):
             # the numerical diagnosis below decides
-        solver = self._numerical_ik()
-        res = solver._solve(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=True)
+        solver = self.numerical_ik()
+        res = solver.solve_checked(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=True)
         if res.success:
             return None
-        free = solver._solve(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=False)
+        free = solver.solve_checked(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=False)
         if free.success:
             return (
                 f"the {what} is within reach but needs a joint outside its limits: "
@@ -198,7 +217,7 @@ class RobotIK:
 
     def _unreachable_text(self, T: np.ndarray, position_only: bool, res=None) -> str:
         if res is None:
-            res = self._numerical_ik()._solve(
+            res = self.numerical_ik().solve_checked(
                 T, None, position_only=position_only, tol=1e-9, max_restarts=10, seed=0, limits=False
             )
         if res.position_error > 1e-6 or position_only:
@@ -274,14 +293,14 @@ class RobotIK:
             if not one:
                 raise InvalidInput(f"q_seed of one target must have shape ({self.nq},), got {np.shape(q_seed)}")
             seed_q = seed_q[0]
-        solver = self._numerical_ik()
+        solver = self.numerical_ik()
         T0 = T[0]
         # compiled Levenberg–Marquardt: the first start, then the seeded restarts, in one native call
-        res = solver._solve_compiled(T0, seed_q, bool(position_only), tol, int(max_restarts), seed)
+        res = solver.solve_compiled(T0, seed_q, bool(position_only), tol, int(max_restarts), seed)
         if res.success:
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         # not found: the interpreted solver's path (closed-form branches, restarts, a final polish) for the diagnosis
-        res = solver._solve(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
+        res = solver.solve_checked(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
                             polish=False, compiled=False)
         if res.success:
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
@@ -293,7 +312,7 @@ class RobotIK:
                     pe, re = solver.errors(q2, T0, False)
                     if pe <= tol and re <= tol:
                         return q2
-        res = solver._solve(
+        res = solver.solve_checked(
             T0, seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True,
             first=False,
         )
@@ -312,7 +331,7 @@ class RobotIK:
         Starts: the closed-form branches within the widened limits, then ``best`` (the
         strict search's closest configuration); each refined with the joints free.
         """
-        solver = self._numerical_ik()
+        solver = self.numerical_ik()
         starts = [best]
         if self._analytic_ik is not None and not position_only:
             ref = self.neutral if seed_q is None else seed_q
@@ -343,7 +362,7 @@ class RobotIK:
             seeds, _ = self.check_q(q_seed)
             if seeds.shape[0] not in (1, N):
                 raise InvalidInput(f"q_seed must be one configuration or one per target ({N}), got {seeds.shape[0]}")
-        solver = self._numerical_ik()
+        solver = self.numerical_ik()
         # the compiled solver for every target (≈ 10-30 µs each): cheaper than the closed form's
         # batched evaluation, FK check and sorting, which cost ≈ 10-80 µs per pose here
         res = solver.solve_batch(T, seeds, position_only=position_only, tol=tol, max_restarts=max_restarts, seed=seed)
@@ -355,7 +374,7 @@ class RobotIK:
             return res.q
         bad = np.flatnonzero(~ok)
         k = int(bad[0])
-        from .ik.numerical import IKResult
+        from pinarms.robots.ik.numerical import IKResult
 
         first = IKResult(res.q[k], False, float(res.position_error[k]), float(res.rotation_error[k]), 1 + max_restarts, 0)
         exc = UnreachableTarget(

@@ -3,7 +3,7 @@
 :class:`SelfCollision` loads the ``<collision>`` geometry of a robot's URDF, keeps the
 pairs of bodies that can really touch, and tells for a batch of configurations which
 ones bring two bodies into contact. A pair is skipped only for a reason
-(:class:`~robots.pair_rules.PairReason`, the same as a cell's, :mod:`robots.pair_rules`), listed
+(:class:`~pinarms.robots.pair_rules.PairReason`, the same as a cell's, :mod:`pinarms.robots.pair_rules`), listed
 per pair in :attr:`SelfCollision.allowed`:
 
 1. ``same link``, ``rigid`` (no joint between them) or ``adjacent`` (bodies on joints directly
@@ -11,9 +11,9 @@ per pair in :attr:`SelfCollision.allowed`:
    parallelogram's passive links touch their neighbours by design), from the structure;
 2. ``declared``: named by a ``<disable_collisions link1= link2= reason=/>`` element at the top
    level of the URDF (the SRDF element; Pinocchio ignores it);
-3. for a pair in contact in at least :data:`~robots.pair_rules.ALWAYS_SHARE` of
+3. for a pair in contact in at least :data:`~pinarms.robots.pair_rules.ALWAYS_SHARE` of
    :data:`ALWAYS_SAMPLES` seeded random configurations: ``coaxial`` or ``adjacent`` through a
-   shape that turns about its own axis (:mod:`robots.coaxial`, proven from the shapes). Such a
+   shape that turns about its own axis (:mod:`pinarms.robots.coaxial`, proven from the shapes). Such a
    pair with no reason is a :class:`~pinarms.errors.SelfContactError` naming the links, the
    share and the deepest penetration: the sample selects the pairs to explain, it never skips
    one alone. A pair in contact at the neutral configuration is checked like any other.
@@ -40,14 +40,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .coaxial import still_frames
-from .collision_requests import cold_start, pair_probe
-from .errors import InvalidInput, ModelError, SelfContactError
-from .pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
+from pinarms.robots.coaxial import still_frames
+from pinarms.robots.collision_requests import cold_start, pair_probe
+from pinarms.errors import InvalidInput, ModelError, SelfContactError
+from pinarms.robots.pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, declared_pairs, effective_joint,
                          structural_reason)
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["SelfCollision", "ALWAYS_SAMPLES"]
 
@@ -64,7 +64,7 @@ class SelfCollision:
     Attributes:
         robot: the robot.
         pairs: ``(k, 2)`` names of the geometry pairs that are checked.
-        allowed: the pairs that are not checked, each with its reason (:class:`~robots.pair_rules.AllowedPair`).
+        allowed: the pairs that are not checked, each with its reason (:class:`~pinarms.robots.pair_rules.AllowedPair`).
         n_geometries: number of collision primitives.
 
     Raises:

@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from pinarms.files import write_text
-from pinarms.robots.errors import ModelError, RobotNotFound
+from pinarms.errors import ModelError, RobotNotFound
 
 __all__ = [
     "XACRO_DIR",
@@ -87,10 +87,10 @@ def build_file(path: str | os.PathLike, source_label: str | None = None) -> str:
 
     Raises:
         ModelError: the file is missing, is not well-formed XML, xacro fails on it, or
-            its root element is not ``<robot>`` (a :class:`~pinarms.robots.errors.XacroError`
+            its root element is not ``<robot>`` (a :class:`~pinarms.errors.XacroError`
             naming the file and quoting xacro's message).
     """
-    from .xacro_expand import expand_xacro
+    from pinarms.robots.xacro_expand import expand_xacro
 
     path = Path(path)
     label = source_label if source_label is not None else path.name

@@ -11,7 +11,7 @@
 - :func:`check_inertials`: every ``<mass value>`` is a finite number ≥ 0 (urdfdom drops an
   inertial whose mass is ``nan`` or ``inf`` with a message on stderr and loads the link massless).
 
-Each raises :class:`~robots.errors.ModelError` naming the file (``source``) and the problem.
+Each raises :class:`~pinarms.errors.ModelError` naming the file (``source``) and the problem.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import xml.parsers.expat
 import numpy as np
 import pinocchio as pin
 
-from .errors import ModelError
+from pinarms.errors import ModelError
 
 __all__ = ["refuse_dtd", "check_tree", "check_limits", "check_inertials", "MAX_POSITION_LIMIT", "MAX_SPEED_LIMIT", "MAX_EFFORT_LIMIT"]
 

@@ -26,19 +26,19 @@ machine's files or hang it, so :func:`expand_xacro` runs xacro in a child proces
   arithmetic, comparisons, ``and`` / ``or`` / ``not``, ``a if c else b``, subscripts of
   lists and dicts, and calls of a fixed set of math functions (``radians``, ``sin``, ...,
   ``xacro.arg``, ``xacro.tokenize``, ``load_yaml``); anything else is
-  :class:`~pinarms.robots.errors.XacroForbidden` naming the construct, and numbers or
-  strings beyond the size bounds are :class:`~pinarms.robots.errors.XacroLimitExceeded`
+  :class:`~pinarms.errors.XacroForbidden` naming the construct, and numbers or
+  strings beyond the size bounds are :class:`~pinarms.errors.XacroLimitExceeded`
   at once. ``$(env)``, ``$(optenv)``, ``$(eval)`` and ``$(cwd)`` are refused.
 
 Everything else of xacro works as documented by ROS: properties, macros with default and
 block parameters, ``xacro:if``/``unless``, ``xacro:arg`` with defaults, includes with
-namespaces. Errors are named: :class:`~pinarms.robots.errors.XacroForbidden` (the wall),
-:class:`~pinarms.robots.errors.XacroLimitExceeded` (time, memory, size),
-:class:`~pinarms.robots.errors.XacroFileNotFound` (the file, an included file or a yaml
-file does not exist; also a :class:`~pinarms.robots.errors.CellNotFound`),
-:class:`~pinarms.robots.errors.XacroArgError` (an argument the file does not declare, or
+namespaces. Errors are named: :class:`~pinarms.errors.XacroForbidden` (the wall),
+:class:`~pinarms.errors.XacroLimitExceeded` (time, memory, size),
+:class:`~pinarms.errors.XacroFileNotFound` (the file, an included file or a yaml
+file does not exist; also a :class:`~pinarms.errors.CellNotFound`),
+:class:`~pinarms.errors.XacroArgError` (an argument the file does not declare, or
 a non-number for an argument whose default is a number) and
-:class:`~pinarms.robots.errors.XacroError` (xacro itself fails: unknown macro, undefined
+:class:`~pinarms.errors.XacroError` (xacro itself fails: unknown macro, undefined
 property, malformed XML: the message names the file, included or not, and the line).
 See docs/files.md.
 """
@@ -54,8 +54,8 @@ from typing import Any, Mapping
 
 from pinarms.files import check_regular
 
-from ._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
-from .errors import (
+from pinarms.robots._xacro_child import WorkerFailed, WorkerOutputTooLarge, WorkerTimeout, run_worker
+from pinarms.errors import (
     InvalidInput,
     MissingMesh,
     XacroArgError,

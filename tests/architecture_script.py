@@ -1,4 +1,4 @@
-"""``benchmarks/architecture.py`` loaded as a module for the architecture tests (it is a script, not a package)."""
+"""``benchmarks/architecture.py`` and ``architecture_walls.py`` loaded as modules for the architecture tests (scripts, not a package)."""
 
 from __future__ import annotations
 
@@ -18,5 +18,19 @@ def architecture() -> ModuleType:
         spec = importlib.util.spec_from_file_location(NAME, SCRIPT)
         module = importlib.util.module_from_spec(spec)
         sys.modules[NAME] = module  # dataclasses look their module up by name
+        spec.loader.exec_module(module)
+    return module
+
+
+WALLS = SCRIPT.with_name("architecture_walls.py")
+
+
+def walls() -> ModuleType:
+    """``benchmarks/architecture_walls.py`` (loaded once per process): private-name uses, references, signatures."""
+    module = sys.modules.get("architecture_walls")
+    if module is None:
+        spec = importlib.util.spec_from_file_location("architecture_walls", WALLS)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["architecture_walls"] = module
         spec.loader.exec_module(module)
     return module

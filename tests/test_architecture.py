@@ -98,9 +98,11 @@ def test_the_execution_layer_imports_only_numpy_dask_threadpoolctl_and_the_error
         m.split(".")[0] for m in modules - ours if m.split(".")[0] not in sys.stdlib_module_names
     }
     assert third_party <= {"numpy", "dask", "distributed", "threadpoolctl"}, third_party
-    # and the errors module it reaches imports nothing of ours
+    # and the errors module it reaches imports nothing of ours but the floor's lazy loading (the areas'
+    # errors it offers load on first use)
     errors = _imported_modules(ROOT / "pinarms" / "errors.py")
-    assert not {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}}, errors
+    assert {m for m in errors if m.split(".")[0] in SUBPACKAGES | {"pinarms"}} == {"pinarms.lazy"}, errors
+    assert _imported_modules(ROOT / "pinarms" / "lazy.py") <= sys.stdlib_module_names | {"__future__"}
 
 
 @pytest.mark.parametrize("floor", sorted(set(BOTTOM.values()) - {"errors", "execution"}))
@@ -111,18 +113,33 @@ def test_the_floor_imports_nothing_of_ours_but_the_floor(floor):
     assert all(floor in ALLOWED[pkg] for pkg in ORDER)
 
 
-def test_the_old_errors_path_names_the_same_classes():
-    import pinarms.robots.errors as old
+def test_one_errors_module_offers_every_error():
+    """``pinarms.errors`` offers every exception class of every area's ``errors`` module (the same class
+    objects); no other module re-exports them (the old ``pinarms.errors`` is gone)."""
+    import importlib
 
-    import pinarms.errors as floor
+    import pinarms.errors as errors
 
-    assert old.__all__ == floor.__all__
-    assert all(getattr(old, name) is getattr(floor, name) for name in floor.__all__)
+    assert not (ROOT / "robots" / "errors.py").exists()
+    defined = {}
+    for path in sorted(ROOT.glob("**/errors.py")):
+        if ".venv" in path.parts or "tests" in path.parts:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        assert not [n for n in tree.body if isinstance(n, ast.ImportFrom) and any(a.name == "*" for a in n.names)], path
+        for node in tree.body:
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                defined[node.name] = path
+    assert len(defined) >= 50
+    for name, path in defined.items():
+        assert name in errors.__all__, f"{name} ({path}) is missing from pinarms.errors"
+        home = importlib.import_module(getattr(errors, name).__module__)
+        assert getattr(home, name) is getattr(errors, name)
 
 
 def test_robot_and_its_dynamics_are_no_circle():
     """robots/robot.py uses robots/dynamics.py; dynamics imports nothing of robot (not even for types)."""
-    assert "robot" not in _relative_imports(ROOT / "robots" / "dynamics.py")
+    assert "robot" not in _sibling_imports(ROOT / "robots" / "dynamics.py")
     assert "pinarms.robots.robot" not in _imported_modules(ROOT / "robots" / "dynamics.py")
 
 
@@ -154,13 +171,14 @@ def test_tests_and_benchmarks_import_the_namespace_only():
     assert not offenders, f"import pinarms.robots etc., not top-level robots: {offenders}"
 
 
-def _relative_imports(path: Path) -> set[str]:
-    """Sibling modules a module of ``robots/`` imports (``from .x import``, at any level)."""
+def _sibling_imports(path: Path) -> set[str]:
+    """Sibling modules a module of ``robots/`` imports (``from pinarms.robots.reach.x import``: ``x``)."""
+    package = "pinarms." + ".".join(path.relative_to(ROOT).parent.parts)
     tree = ast.parse(path.read_text(encoding="utf-8"))
     return {
-        node.module.split(".")[0]
+        node.module[len(package) + 1:].split(".")[0]
         for node in ast.walk(tree)
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith(package + ".")
     }
 
 
@@ -173,6 +191,22 @@ def test_workspace_analysis_modules_import_one_way():
         "table_band": {"layout", "workspace_stream"},
     }
     wrong = {
-        m: sorted(_relative_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
+        m: sorted(_sibling_imports(ROOT / "robots" / "reach" / f"{m}.py") & forbidden) for m, forbidden in above.items()
     }
     assert not any(wrong.values()), f"robots modules import modules above them: {wrong}"
+
+
+def test_one_import_style_absolute():
+    """Every import of our own code names the importable module (``from pinarms.robots.cell.cell import Cell``):
+    the folders install under ``pinarms.`` (pyproject.toml's package-dir), so a relative import hides where a
+    module lives; the lazy tables of the package ``__init__`` s name absolute modules too."""
+    relative = []
+    for folder in ("pinarms", *SUBPACKAGES):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            relative += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree)
+                         if isinstance(n, ast.ImportFrom) and n.level > 0]
+            relative += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree) if isinstance(n, ast.Constant)
+                         and isinstance(n.value, str) and path.name == "__init__.py" and n.value.startswith(".")
+                         and n.value[1:2].isalpha()]
+    assert relative == [], relative[:20]

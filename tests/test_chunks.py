@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import execution
 from pinarms.chunks import chunk_seeds, split_count
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def test_chunk_seeds_follow_the_seed_sequence_rule():

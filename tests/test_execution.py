@@ -14,7 +14,7 @@ import pytest
 
 from pinarms import execution
 from pinarms.execution import chunk_seeds, map_chunks
-from pinarms.robots.errors import ExecutionError, InvalidInput, PinarmsError
+from pinarms.errors import ExecutionError, InvalidInput, PinarmsError
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.

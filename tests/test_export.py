@@ -12,7 +12,7 @@ import yourdfpy
 
 from pinarms import robots
 from pinarms.export import export_urdf, mesh_references
-from pinarms.robots.errors import InvalidInput, PinarmsError, RobotNotFound
+from pinarms.errors import InvalidInput, PinarmsError, RobotNotFound
 
 ALL = robots.names()
 N_CONFIGS = 8

@@ -13,7 +13,7 @@ import pytest
 
 from pinarms.export import MeshNotFound, contact_pairs, export_cell, export_urdf
 from pinarms.robots.cell import Cell, cell_names, load_cell
-from pinarms.robots.errors import InvalidInput, MissingMesh
+from pinarms.errors import InvalidInput, MissingMesh
 
 ARMS = ["aubo_i3", "scara_mushroom", "koji_turner", "gantry_flower", "koji_turner_rail"]
 

@@ -15,7 +15,7 @@ from pinarms import robots
 from pinarms.export import export_cell, export_mjcf
 from pinarms.cli import cli
 from pinarms.robots.cell import load_cell
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 
 # an asymmetric tetrahedron [m]: MuJoCo's convex hull of it is itself
 VERTICES = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.1]])

@@ -20,7 +20,7 @@ from pinarms import robots
 from pinarms.cli import cli
 from pinarms.export import MeshNotAllowed, export_cell, export_mjcf, export_urdf, mesh_references
 from pinarms.robots.cell import load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 # an ASCII STL of one triangle (pinarms writes it as binary STL in a cell export)
 STL = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\nendloop\nendfacet\nendsolid t\n"

@@ -12,7 +12,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.export import export_mjcf, export_urdf
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 TOL_M = 1e-9
 

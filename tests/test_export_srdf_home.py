@@ -14,7 +14,7 @@ from pinarms import robots
 from pinarms.cli import cli
 from pinarms.export import export_cell, export_urdf
 from pinarms.robots.cell import load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def _arm(lower: float, upper: float) -> str:

@@ -20,7 +20,7 @@ from pinarms.export import (
     write_trajectory_yaml,
 )
 from pinarms.planning import multi_quintic
-from pinarms.robots.errors import InvalidInput, LimitViolation
+from pinarms.errors import InvalidInput, LimitViolation
 
 TOL = 1e-9
 

@@ -13,7 +13,7 @@ from pinarms.demo import LINE_TASKS
 from pinarms.export import compare_in_mujoco, controller_trajectory, read_trajectory_yaml, write_trajectory_yaml
 from pinarms.export.verify import TOLERANCE_M
 from pinarms.robots.cell import load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import re
 import pytest
 
 from pinarms.report import Row, format_table
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 ROWS = [
     Row("000", "3-5-3 at the paper's optimised times: peak |v|", 54.2, 44.459, "deg/s", 0.1,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from pinarms import execution
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.schedulers import describe_scheduler, parse_scheduler
 
 

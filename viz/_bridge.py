@@ -1,6 +1,6 @@
 """MeshCat server bound to 127.0.0.1 only, on a free (or given) port, serving pinarms' page.
 
-Run as ``python viz/_bridge.py [--port N]`` (:class:`viz.server.MeshcatServer` does): it
+Run as ``python viz/_bridge.py [--port N]`` (:class:`pinarms.viz.server.MeshcatServer` does): it
 prints ``zmq_url=...`` and ``web_url=...`` (the same lines as MeshCat's own server) and
 serves until terminated. MeshCat 0.3.2's own server makes its web server listen on every
 network interface and takes no port option; this one reuses MeshCat's bridge but binds

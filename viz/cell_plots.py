@@ -1,7 +1,7 @@
 """Plots of a cell's motions (matplotlib Agg): clearance over time, and the arms' schedule in a shared zone.
 
 Every function takes data and an output path ending in ``.png`` or ``.svg``, writes the figure
-atomically (:func:`viz.figure_files.save_figure`) and returns the path. Units: SI inside;
+atomically (:func:`pinarms.viz.figure_files.save_figure`) and returns the path. Units: SI inside;
 ``mm=True`` labels distances in millimetres.
 """
 
@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .figure_files import checked_numbers, save_figure
+from pinarms.viz.figure_files import checked_numbers, save_figure
 
 __all__ = ["plot_clearance", "plot_schedule"]
 
@@ -24,10 +24,10 @@ __all__ = ["plot_clearance", "plot_schedule"]
 def plot_clearance(path: str | Path, check: Any, *, title: str = "clearance over time", mm: bool = True) -> Path:
     """Each moving arm's distance to everything else against time, one curve per group of pairs.
 
-    ``check`` is a :class:`robots.cell.MotionCheck` checked with ``curve=True`` (its
+    ``check`` is a :class:`pinarms.robots.cell.MotionCheck` checked with ``curve=True`` (its
     ``curves``: each moving arm against the fixtures, each other arm and its own links, shapes
     that do not move left out, so an idle arm's constant distance never hides the moving
-    one's) or a planned motion's :class:`optim.motion.ClearanceProfile`. A check without
+    one's) or a planned motion's :class:`pinarms.optim.motion.ClearanceProfile`. A check without
     curves draws its smallest distance over every pair (screened samples as dots: at least
     that far). Samples in contact are marked red, the required clearance is a dashed line,
     the closest point is annotated with its pair.
@@ -93,7 +93,7 @@ def _annotate_closest(ax: Any, check: Any, t: np.ndarray, lowest: tuple, k: floa
 def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: str | None = None) -> Path:
     """Each arm's busy intervals in the shared zone over ``periods`` line periods (a Gantt chart).
 
-    ``schedule`` is an :class:`optim.LineSchedule`; each arm's cycle start is marked.
+    ``schedule`` is an :class:`pinarms.optim.LineSchedule`; each arm's cycle start is marked.
     """
     arms = list(getattr(schedule, "arms", ()))
     period = float(getattr(schedule, "period", float("nan")))

@@ -1,6 +1,6 @@
 """A cell in a session: its arms and fixtures as one robot, their motions as one trajectory, contacts as points.
 
-:meth:`viz.Session.add_cell` stores a :class:`robots.cell.Cell` with its URDF embedded (poses
+:meth:`pinarms.viz.Session.add_cell` stores a :class:`pinarms.robots.cell.Cell` with its URDF embedded (poses
 in the world frame), the arms' motions sampled over their window as one trajectory of the
 whole cell (the viewer animates all arms together), the arms' tcp frames in
 ``metadata["cells"]`` (the viewer draws each arm's tcp path) and, from a motion check, the
@@ -15,14 +15,14 @@ import numpy as np
 
 from pinarms.robots.cell import Cell
 from pinarms.robots.cell.timeline import arm_motions, configurations, sample_motions
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["add_cell"]
 
 
 def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
              name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
-    """Add ``cell`` to ``session`` (:meth:`viz.Session.add_cell` says how); return its robot key."""
+    """Add ``cell`` to ``session`` (:meth:`pinarms.viz.Session.add_cell` says how); return its robot key."""
     if not isinstance(cell, Cell):
         raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")
     hold_q = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]

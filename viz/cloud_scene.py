@@ -14,9 +14,9 @@ from typing import Any
 import matplotlib
 import numpy as np
 
-from ._meshcat import meshcat, mg
-from .page import colorbar_stops, manipulability_unit
-from .shapes import transform_points
+from pinarms.viz._meshcat import meshcat, mg
+from pinarms.viz.page import colorbar_stops, manipulability_unit
+from pinarms.viz.shapes import transform_points
 
 __all__ = ["colors_by_value", "Clouds", "draw_clouds", "cloud_colorbar"]
 

@@ -26,9 +26,9 @@ import numpy as np
 from pinarms.files import atomic_write
 from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position, rod_endpoints
 from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._meshcat import meshcat, mg
+from pinarms.viz._meshcat import meshcat, mg
 
 __all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT"]
 
@@ -110,9 +110,9 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
                base_to_world: Any = None) -> Path:
     """A standalone page (HTML, written atomically) of ``delta`` moving through ``theta`` (F, 3) [rad],
     one row a frame at ``fps``; return the path."""
-    from .page import PAGE_PROPERTY, with_page
-    from .scene import ROOT
-    from .server import MeshcatServer
+    from pinarms.viz.page import PAGE_PROPERTY, with_page
+    from pinarms.viz.scene import ROOT
+    from pinarms.viz.server import MeshcatServer
 
     poses = delta_poses(delta, theta, base_to_world)
     frames = next(iter(poses.values())).shape[0]

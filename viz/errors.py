@@ -1,14 +1,14 @@
-"""Exceptions of :mod:`viz`, derived from :class:`robots.errors.PinarmsError`."""
+"""Exceptions of :mod:`pinarms.viz`, derived from :class:`pinarms.errors.PinarmsError`."""
 
 from __future__ import annotations
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 
 __all__ = ["VizError", "SessionFormatError", "ViewerError"]
 
 
 class VizError(PinarmsError):
-    """Base of the errors raised by :mod:`viz`."""
+    """Base of the errors raised by :mod:`pinarms.viz`."""
 
 
 class SessionFormatError(VizError):

@@ -9,9 +9,9 @@ from typing import Any
 
 from pinarms.files import atomic_write
 
-from .page import with_page
-from .scene import SceneInfo, build_scene
-from .server import MeshcatServer
+from pinarms.viz.page import with_page
+from pinarms.viz.scene import SceneInfo, build_scene
+from pinarms.viz.server import MeshcatServer
 
 __all__ = ["export_html", "scene_html"]
 
@@ -20,7 +20,7 @@ def scene_html(session: Any, **scene_options: Any) -> tuple[str, SceneInfo]:
     """The session's scene as one self-contained HTML page, and what was drawn.
 
     A MeshCat server runs for a moment (MeshCat replays its scene tree into the page);
-    the page carries pinarms' title, colour bar and controls (:mod:`viz.page`).
+    the page carries pinarms' title, colour bar and controls (:mod:`pinarms.viz.page`).
     """
     with MeshcatServer() as server, contextlib.redirect_stdout(io.StringIO()):
         info = build_scene(server.visualizer, session, **scene_options)
@@ -34,7 +34,7 @@ def export_html(session: Any, path: str | Path, **scene_options: Any) -> Path:
     The page holds MeshCat's JavaScript, the geometry, the clouds, the paths and the
     animation, framed on the robots, with the study's title, the clouds' colour bar, and
     play/pause, a time slider and a cloud switch at the bottom. ``scene_options`` go to
-    :func:`viz.scene.build_scene`. The file is written atomically.
+    :func:`pinarms.viz.scene.build_scene`. The file is written atomically.
     """
     html, _ = scene_html(session, **scene_options)
     data = html.encode("utf-8")

@@ -1,7 +1,7 @@
 """A layout search as a session: the arm at its best placement, its cycle, the candidates.
 
-:func:`layout_search_session` builds a :class:`viz.Session` from an
-:class:`optim.LayoutSearch`: the robot stands at the best placement (``base_to_world``), its
+:func:`layout_search_session` builds a :class:`pinarms.viz.Session` from an
+:class:`pinarms.optim.LayoutSearch`: the robot stands at the best placement (``base_to_world``), its
 best cycle is the animated trajectory, the candidate base positions are a point cloud
 coloured by picks per minute (stored as a workspace cloud whose value is picks/min, in the
 robot's base frame as clouds are), and the picks and places are target points (line frame).
@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .session import Session
+from pinarms.viz.session import Session
 
 __all__ = ["layout_search_session"]
 

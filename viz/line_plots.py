@@ -5,7 +5,7 @@
   row of red crosses for the missed items at the time they leave the last window;
 - :func:`plot_line_sizing` — throughput (picks/min) and miss rate against a swept quantity
   (flow, belt speed, number of arms, ...), one column per quantity, the mean over the seeds
-  with its 95 % interval (Student's t over the seeds: :func:`optim.line.report.confidence_interval`)
+  with its 95 % interval (Student's t over the seeds: :func:`pinarms.optim.line.report.confidence_interval`)
   as a band.
 
 ``schedule_figure`` and ``sizing_figure`` return the :class:`matplotlib.figure.Figure`
@@ -21,9 +21,9 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .plots import _save
+from pinarms.viz.plots import _save
 
 __all__ = ["schedule_figure", "plot_line_schedule", "sizing_figure", "plot_line_sizing", "line_curve",
            "MAX_LABELLED_PICKS"]
@@ -49,7 +49,7 @@ def _run_of(result: Any, run: int) -> tuple[Any, float | None, float | None]:
 
 def schedule_figure(result: Any, *, run: int = 0, window: tuple[float, float] = (0.0, 60.0),
                     title: str | None = None) -> Figure:
-    """The schedule of ``result`` (a :class:`optim.line.LineResult` or a :class:`SimResult`) over ``window`` [s].
+    """The schedule of ``result`` (a :class:`pinarms.optim.line.LineResult` or a :class:`SimResult`) over ``window`` [s].
 
     Bars: picks whose start lies in the window; crosses: missed items whose miss time (the
     item leaving the last window; its arrival for a bare SimResult) lies in it.
@@ -123,7 +123,7 @@ def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]], *
 
     Args:
         curves: ``{x label: (x values, results)}``: one column per entry; ``results`` are
-            :class:`optim.line.LineResult` (band from their runs) or :class:`LineFigures`.
+            :class:`pinarms.optim.line.LineResult` (band from their runs) or :class:`LineFigures`.
         target_miss: the miss rate asked for, drawn as a dashed line (fraction; None: none).
     """
     if not isinstance(curves, Mapping) or not curves:

@@ -1,7 +1,7 @@
 """A belt line in a session: the belt, the items on it and what became of each, ready to animate.
 
 A :class:`LineRecord` keeps what the viewer needs to animate a window of a simulated line
-(:mod:`optim.line`): the belt (its pose ``belt_to_world``: ``u`` along the belt from its
+(:mod:`pinarms.optim.line`): the belt (its pose ``belt_to_world``: ``u`` along the belt from its
 start, ``w`` across to the left, ``z`` up from the surface; its length, width, thickness and
 speed), the arms (keys of the session's robots, whose trajectories move them through their
 picks) and one row per item (:data:`ITEM_COLUMNS`):
@@ -16,7 +16,7 @@ picks) and one row per item (:data:`ITEM_COLUMNS`):
   tool is at the box and lets go (both 0 unless picked).
 
 Times are those of the animation (0 = the start of the window shown). In ``session.json`` it
-is an item of the optional section ``"lines"`` (a row of :data:`viz.session_format.KINDS`;
+is an item of the optional section ``"lines"`` (a row of :data:`pinarms.viz.session_format.KINDS`;
 absent when a session holds no line, so older files and readers are unaffected). Hostile
 files: every JSON number is checked finite and in range, the item table's shape, its
 values (sizes > 0, items on the belt, arm indices, ordered times) and its row count
@@ -32,9 +32,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .names import NAME_RE
+from pinarms.viz.names import NAME_RE
 
 __all__ = ["LineRecord", "BOX_DEPTH", "ITEM_COLUMNS", "MISSED", "NOT_DRAWN", "MAX_LINE_ITEMS", "MAX_LINE_ARMS",
            "MAX_LINE_LENGTH", "check_line", "encode_line", "decode_line"]
@@ -131,7 +131,7 @@ def check_line(rec: LineRecord) -> str | None:
 
 
 def encode_line(r: LineRecord) -> tuple[dict, dict, dict]:
-    """JSON fields, arrays and texts of one record (see :class:`viz.session_format.Kind`)."""
+    """JSON fields, arrays and texts of one record (see :class:`pinarms.viz.session_format.Kind`)."""
     return ({"name": r.name, "arms": list(r.arms), "length": r.length, "width": r.width, "thickness": r.thickness,
              "speed": r.speed, "u_miss": r.u_miss, "duration": r.duration},
             {"belt_to_world": r.belt_to_world, "items": r.items}, {})

@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from ._meshcat import mg
-from .errors import ViewerError
-from .line_record import BOX_DEPTH, MISSED, NOT_DRAWN
+from pinarms.viz._meshcat import mg
+from pinarms.viz.errors import ViewerError
+from pinarms.viz.line_record import BOX_DEPTH, MISSED, NOT_DRAWN
 
 __all__ = ["draw_lines", "animate_lines", "item_positions", "ITEM_COLOR", "MISSED_COLOR"]
 

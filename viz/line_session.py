@@ -1,18 +1,18 @@
 """A simulated belt line into a session: its arms, their picks as joint trajectories, the belt, the items.
 
-:func:`add_line` takes a line (:class:`optim.line.LineSpec`) and its result
-(:class:`optim.line.LineResult`, one :class:`SimResult` per seed) and adds to a
-:class:`viz.Session`, for a window of one run (default the first 20 s of the first seed):
+:func:`add_line` takes a line (:class:`pinarms.optim.line.LineSpec`) and its result
+(:class:`pinarms.optim.line.LineResult`, one :class:`SimResult` per seed) and adds to a
+:class:`pinarms.viz.Session`, for a window of one run (default the first 20 s of the first seed):
 
 - each station's arm as a robot (key: the station's name) at its base pose, and its box as
   a translucent static box under the release point;
 - each arm's joint trajectory through its picks of the window, ``"<station> picks"``: the
   simulator keeps only pick times, so every pick of the window is planned again exactly
-  (:func:`optim.line.tracking.plan_pick` at the simulated rendezvous point, rest at the box
+  (:func:`pinarms.optim.line.tracking.plan_pick` at the simulated rendezvous point, rest at the box
   between picks). The exact plan's times differ from the task map's by its error (≤ 1 %); a
   pick that would start before the previous one ends waits for it (the item is then met a
   little downstream of the simulated point: the picture, not the figures);
-- a :class:`viz.line_record.LineRecord` with the belt and every item on it during the window.
+- a :class:`pinarms.viz.line_record.LineRecord` with the belt and every item on it during the window.
 
 Units: m, s, rad.
 """
@@ -23,14 +23,14 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
-from .line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
+from pinarms.viz.line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
 #: The gap between an item's bottom and the drawn place box's rim at release [m] (the box's
-#: depth, :data:`BOX_DEPTH`, lives in :mod:`viz.line_record`, shared with the scene).
+#: depth, :data:`BOX_DEPTH`, lives in :mod:`pinarms.viz.line_record`, shared with the scene).
 BOX_GAP = 0.01
 DEFAULT_WINDOW_S = 20.0
 
@@ -86,8 +86,8 @@ def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float
     """Add the window [``start``, ``start + duration``] s of run ``run`` of ``result`` (module doc).
 
     Args:
-        session: a :class:`viz.Session` (its robot keys must not clash with the stations' names).
-        spec: the :class:`optim.line.LineSpec` simulated; ``result``: its :class:`optim.line.LineResult`.
+        session: a :class:`pinarms.viz.Session` (its robot keys must not clash with the stations' names).
+        spec: the :class:`pinarms.optim.line.LineSpec` simulated; ``result``: its :class:`pinarms.optim.line.LineResult`.
         run: index of the seed's run in ``result.runs``.
         hz: sampling rate of the arms' trajectories [1/s].
 

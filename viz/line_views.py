@@ -1,6 +1,6 @@
 """What a line engineer looks at, written in one call: a session, its standalone page, the schedule plot.
 
-Sits above the session, the HTML export and the plots (:mod:`viz.line_session` only adds a
+Sits above the session, the HTML export and the plots (:mod:`pinarms.viz.line_session` only adds a
 line to a session it is handed, so it imports none of them).
 """
 
@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from .html import export_html
-from .line_plots import plot_line_schedule
-from .line_session import DEFAULT_WINDOW_S, add_line
-from .session import Session
+from pinarms.viz.html import export_html
+from pinarms.viz.line_plots import plot_line_schedule
+from pinarms.viz.line_session import DEFAULT_WINDOW_S, add_line
+from pinarms.viz.session import Session
 
 __all__ = ["save_line_views"]
 

@@ -14,7 +14,7 @@ import re
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from .errors import SessionFormatError
+from pinarms.viz.errors import SessionFormatError
 
 __all__ = ["check_mesh_paths", "MESH_SUFFIXES"]
 
@@ -28,7 +28,7 @@ def check_mesh_paths(urdf_text: str, package_dirs: tuple[str, ...], source: str,
                      recorded: tuple[str, ...] = ()) -> tuple[str, ...]:
     """Refuse an embedded URDF whose meshes may lie outside the allowed folders ``package_dirs``.
 
-    ``package_dirs`` are the folders the *caller* allows (:func:`viz.load_session` passes the
+    ``package_dirs`` are the folders the *caller* allows (:func:`pinarms.viz.load_session` passes the
     session file's own folder and its ``package_dirs`` argument); folders named inside the
     file (``recorded``, the ``package_dirs`` of ``session.json``) never widen them.
     Pinocchio resolves ``package://p`` (and ``model://p``) and relative paths ``p`` against

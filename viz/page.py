@@ -2,7 +2,7 @@
 
 MeshCat's own page shows the 3-D scene and a collapsed control panel. pinarms adds, in
 the standalone HTML export and in the live viewer alike, a small script
-(``viz/page.js``) that reads what :func:`viz.scene.build_scene` stored on the scene root
+(``viz/page.js``) that reads what :func:`pinarms.viz.scene.build_scene` stored on the scene root
 (property :data:`PAGE_PROPERTY`, a JSON object) and
 
 - names the page and the study (``title``; ``lines``: one line per robot, trajectory and

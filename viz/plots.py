@@ -6,8 +6,8 @@ figure atomically and returns the path. Units: the data's SI units (rad, m, s); 
 ``degrees=True`` to label revolute joints in degrees (conversion happens here, at the edge).
 
 The other plot families have their own modules, re-exported here: searches
-(:mod:`viz.search_plots`: GA convergence, layout search), cells (:mod:`viz.cell_plots`:
-clearance over time, multi-arm schedules), reach (:mod:`viz.reach_plots`: workspace
+(:mod:`pinarms.viz.search_plots`: GA convergence, layout search), cells (:mod:`pinarms.viz.cell_plots`:
+clearance over time, multi-arm schedules), reach (:mod:`pinarms.viz.reach_plots`: workspace
 projections).
 """
 
@@ -22,12 +22,12 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .cell_plots import plot_clearance, plot_schedule
-from .figure_files import checked_numbers, save_figure
-from .reach_plots import plot_workspace
-from .search_plots import plot_ga_convergence, plot_layout_search
+from pinarms.viz.cell_plots import plot_clearance, plot_schedule
+from pinarms.viz.figure_files import checked_numbers, save_figure
+from pinarms.viz.reach_plots import plot_workspace
+from pinarms.viz.search_plots import plot_ga_convergence, plot_layout_search
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
            "plot_clearance", "plot_schedule", "plot_torques",
@@ -215,7 +215,7 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
 
 def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
                     title: str = "tcp speed") -> Path:
-    """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
+    """The tcp's Cartesian speed versus time (e.g. from :func:`pinarms.planning.tcp_speed`).
 
     Args:
         t: instants (N,) [s]; speed: linear speed (N,) [m/s]; angular: optional (N,) [rad/s]

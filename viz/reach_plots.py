@@ -20,10 +20,10 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .figure_files import checked_numbers, save_figure
-from .reach_scene import INDEX_COLORMAP
+from pinarms.viz.figure_files import checked_numbers, save_figure
+from pinarms.viz.reach_scene import INDEX_COLORMAP
 
 __all__ = ["plot_workspace", "plot_reachability_section", "section_index"]
 
@@ -107,7 +107,7 @@ def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *,
                    colormap: str = "viridis", mm: bool = False) -> Path:
     """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
 
-    ``points`` (n, 3) m (or a ``Workspace``/:class:`viz.WorkspaceRecord` with ``points`` and
+    ``points`` (n, 3) m (or a ``Workspace``/:class:`pinarms.viz.WorkspaceRecord` with ``points`` and
     ``manipulability``); ``mm=True`` labels the axes in millimetres.
     """
     if hasattr(points, "points"):

@@ -1,10 +1,10 @@
-"""Reachability maps in a session: the reachable voxels of a :class:`robots.ReachabilityMap`, ready to draw.
+"""Reachability maps in a session: the reachable voxels of a :class:`pinarms.robots.ReachabilityMap`, ready to draw.
 
 A :class:`ReachabilityRecord` keeps what the viewer shows (not the whole map: the HDF5 file
 keeps that): the centres of the voxels whose reachability index exceeds ``min_index``, in
 the robot's base frame [m], their index in (0, 1], their best manipulability, the voxel edge
 [m] and a one-line description of the orientation set. In ``session.json`` it is an item of
-the optional section ``"reachability"`` (a row of :data:`viz.session_format.KINDS`; absent
+the optional section ``"reachability"`` (a row of :data:`pinarms.viz.session_format.KINDS`; absent
 when a session holds no map, so older files and readers are unaffected).
 """
 
@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["ReachabilityRecord", "make_record", "encode_reachability", "decode_reachability", "MAX_DESCRIPTION"]
 
@@ -65,7 +65,7 @@ def make_record(name: str, robot_key: str, reach_map: Any, min_index: float, flo
 
 
 def encode_reachability(r: ReachabilityRecord) -> tuple[dict, dict, dict]:
-    """JSON fields, arrays and texts of one record (see :class:`viz.session_format.Kind`)."""
+    """JSON fields, arrays and texts of one record (see :class:`pinarms.viz.session_format.Kind`)."""
     return ({"name": r.name, "robot": r.robot, "resolution": r.resolution, "description": r.description},
             {"centres": r.centres, "index": r.index, "manipulability": r.manipulability}, {})
 

@@ -4,7 +4,7 @@ Scene paths (under MeshCat's root ``/meshcat``):
 ``pinarms/reachability/<name>/layers/z<mm>mm`` — the voxels of one horizontal layer (their
 centres' height in the robot's base frame, in mm) as square points the size of a voxel,
 coloured by reachability index on a fixed scale (0 → the colormap's low end, 1 → its high
-end). One object per layer is what the page's slice control switches (:mod:`viz.page`, key
+end). One object per layer is what the page's slice control switches (:mod:`pinarms.viz.page`, key
 ``"reachability"``): all layers, the layers up to a height, or one layer; MeshCat's own
 Controls panel lists them too.
 """
@@ -16,7 +16,7 @@ from typing import Any
 import matplotlib
 import numpy as np
 
-from ._meshcat import mg
+from pinarms.viz._meshcat import mg
 
 __all__ = ["draw_reachability", "layer_name", "INDEX_COLORMAP"]
 
@@ -40,7 +40,7 @@ def draw_reachability(vis: Any, session: Any, root: str, bounds: list) -> tuple[
     ``description``, ``label``, ``colors``, ``layers``: ``path`` and ``z_mm``). ``bounds``
     (a list of ``(n, 3)`` world points) is extended with each map's voxels.
     """
-    from .page import colorbar_stops
+    from pinarms.viz.page import colorbar_stops
 
     out: dict[str, list[str]] = {}
     page: list[dict] = []

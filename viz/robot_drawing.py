@@ -17,8 +17,8 @@ from typing import Any, Sequence
 import numpy as np
 import pinocchio as pin
 
-from ._meshcat import MeshcatVisualizer, meshcat
-from .errors import ViewerError
+from pinarms.viz._meshcat import MeshcatVisualizer, meshcat
+from pinarms.viz.errors import ViewerError
 
 __all__ = ["RobotDrawing", "resolved_package_meshes"]
 
@@ -30,7 +30,7 @@ def resolved_package_meshes(urdf_text: str, package_dirs: Sequence[str]) -> str:
 
     A package folder is found either way a caller may list it: as the folder that holds
     ``NAME/`` (Pinocchio's convention, ``<dir>/NAME/rel``) or as the package folder itself
-    (``--package NAME=FOLDER``: ``<dir>/rel``, the convention of :mod:`viz.mesh_paths`). Only
+    (``--package NAME=FOLDER``: ``<dir>/rel``, the convention of :mod:`pinarms.viz.mesh_paths`). Only
     files inside those folders are named; a mesh found nowhere is left for Pinocchio to report.
     """
     roots = [Path(d) for d in package_dirs if d]

@@ -1,26 +1,26 @@
-"""A MeshCat scene built from a :class:`viz.Session`.
+"""A MeshCat scene built from a :class:`pinarms.viz.Session`.
 
 Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
 
 - ``pinarms/robots/<key>`` — a robot, placed at its ``base_to_world``; its visual geometry
   (Pinocchio's visual model of the URDF) in ``pinarms/robots/<key>/visuals/<geometry>``
-  (:mod:`viz.robot_drawing`);
+  (:mod:`pinarms.viz.robot_drawing`);
 - ``pinarms/objects/<name>`` — static boxes (conveyor, crate);
 - ``pinarms/workspace/<name>`` — a workspace cloud (``Points``, translucent) coloured by
-  manipulability (:mod:`viz.cloud_scene`);
+  manipulability (:mod:`pinarms.viz.cloud_scene`);
 - ``pinarms/paths/<name>`` — the TCP path of a trajectory, world frame: a thin tube
   (``Mesh``), since browsers draw WebGL lines one pixel wide whatever their width;
 - ``pinarms/vias/<name>/<i>`` — the TCP at the trajectory's knots (small spheres);
 - ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres);
 - ``pinarms/reachability/<name>/layers/z<mm>mm`` — reachability maps: the voxels of one
-  horizontal layer each (:mod:`viz.reach_scene`; the page's slice control shows/hides them).
+  horizontal layer each (:mod:`pinarms.viz.reach_scene`; the page's slice control shows/hides them).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
 robot) play together from time 0, sampled at ``fps`` frames per second, looping
-(:mod:`viz.trajectory_scene`).
+(:mod:`pinarms.viz.trajectory_scene`).
 
 What the page around the scene shows (title, colour bar, framing, controls: see
-:mod:`viz.page`) is stored on the scene root as the property ``pinarms_page`` (JSON), so
+:mod:`pinarms.viz.page`) is stored on the scene root as the property ``pinarms_page`` (JSON), so
 that the standalone page and the live viewer read it the same way.
 """
 
@@ -33,14 +33,14 @@ from typing import Any, Sequence
 import matplotlib
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._meshcat import meshcat, mg
-from .cloud_scene import draw_clouds, cloud_colorbar
-from .page import PAGE_PROPERTY
-from .robot_drawing import RobotDrawing
-from .shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
-from .trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
+from pinarms.viz._meshcat import meshcat, mg
+from pinarms.viz.cloud_scene import draw_clouds, cloud_colorbar
+from pinarms.viz.page import PAGE_PROPERTY
+from pinarms.viz.robot_drawing import RobotDrawing
+from pinarms.viz.shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
+from pinarms.viz.trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
@@ -69,7 +69,7 @@ class SceneInfo:
         target: the point the view is centred on and orbits around (world, m): the middle
             of the robots and their tcp paths (not of the clouds or boxes).
         camera: where the camera opens (world, m).
-        page: what the page around the scene shows (see :mod:`viz.page`).
+        page: what the page around the scene shows (see :mod:`pinarms.viz.page`).
         reachability: reachability map name → scene paths of its voxel layers (lowest first).
     """
 
@@ -121,7 +121,7 @@ def build_scene(
 
     Args:
         vis: a ``meshcat.Visualizer`` (e.g. ``viz.MeshcatServer().visualizer``).
-        session: a :class:`viz.Session`.
+        session: a :class:`pinarms.viz.Session`.
         animate: trajectory names to animate (at most one per robot); default: the first
             trajectory of each robot; ``()`` for no animation.
         fps: animation frame rate (1/s).
@@ -144,10 +144,10 @@ def build_scene(
     _draw_boxes(vis, session, bounds)
     clouds = draw_clouds(vis, session, ROOT, bounds, colormap=colormap, point_pixels=point_pixels,
                           cloud_opacity=cloud_opacity, show_clouds=show_clouds, max_cloud_points=max_cloud_points)
-    from .reach_scene import draw_reachability  # voxel layers coloured by reachability index
+    from pinarms.viz.reach_scene import draw_reachability  # voxel layers coloured by reachability index
 
     reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
-    from .line_scene import draw_lines  # belt lines: belt, items
+    from pinarms.viz.line_scene import draw_lines  # belt lines: belt, items
 
     line_lines = draw_lines(vis, session, ROOT, bounds)
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
@@ -252,7 +252,7 @@ def _draw_tcp_paths(vis: meshcat.Visualizer, tcp_paths: dict[str, np.ndarray], k
 def _frame(session: Any, bounds: list[np.ndarray], framed: list[np.ndarray],
            tcp_paths: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """``(lo, hi)`` of everything drawn and the view ``(target, camera, radius)`` framed on the robots and paths."""
-    from .line_scene import line_focus  # a long belt line: its first arms
+    from pinarms.viz.line_scene import line_focus  # a long belt line: its first arms
 
     parts = bounds + [_point_set_world(session, n) for n in session.point_sets]
     everything = np.vstack(parts) if parts else np.zeros((1, 3))
@@ -319,7 +319,7 @@ def _place_camera(vis: meshcat.Visualizer, camera: np.ndarray) -> None:
 
     The camera object sits in a y-up frame (three.js), so the world point (x, y, z) is
     written (x, z, -y). MeshCat orbits around the world origin; the page script
-    (:mod:`viz.page`) moves the orbit's centre to the framed target.
+    (:mod:`pinarms.viz.page`) moves the orbit's centre to the framed target.
     """
     x, y, z = (float(v) for v in camera)
     vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])

@@ -1,7 +1,7 @@
 """Plots of searches (matplotlib Agg): a GA's convergence, and a layout search's picks per minute by base position.
 
 Every function takes data and an output path ending in ``.png`` or ``.svg``, writes the figure
-atomically (:func:`viz.figure_files.save_figure`) and returns the path.
+atomically (:func:`pinarms.viz.figure_files.save_figure`) and returns the path.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .figure_files import checked_numbers, save_figure
+from pinarms.viz.figure_files import checked_numbers, save_figure
 
 __all__ = ["plot_ga_convergence", "plot_layout_search"]
 
@@ -24,7 +24,7 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     """Best-so-far and mean objective per generation, and the feasible share when recorded.
 
     ``history``: a GA history (``best``, ``feasible_mean`` or ``mean``, optional
-    ``feasible_share``), a result with ``.history``, a :class:`viz.HistoryRecord` or a
+    ``feasible_share``), a result with ``.history``, a :class:`pinarms.viz.HistoryRecord` or a
     mapping of columns. Generations recorded as ``inf`` (no finite objective) are left as
     gaps in the curves.
 
@@ -81,7 +81,7 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
 
 def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
                        mm: bool = True) -> Path:
-    """Picks per minute over the (x, y) placements of a layout search (:class:`optim.LayoutSearch`).
+    """Picks per minute over the (x, y) placements of a layout search (:class:`pinarms.optim.LayoutSearch`).
 
     One square per (x, y) of the candidates, coloured by the best picks/min over their z and
     yaw; placements where no candidate could run the cycle are grey crosses. The picks

@@ -1,6 +1,6 @@
 """A MeshCat server process on 127.0.0.1 and the ``meshcat.Visualizer`` that talks to it.
 
-The process runs :mod:`viz._bridge` (MeshCat's bridge with both sockets on the loopback
+The process runs :mod:`pinarms.viz._bridge` (MeshCat's bridge with both sockets on the loopback
 interface, serving pinarms' page); :class:`MeshcatServer` starts it, hands out its URLs
 and stops it (also when garbage-collected or at exit).
 """
@@ -16,10 +16,10 @@ import weakref
 from pathlib import Path
 from typing import Any
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._meshcat import ViewerWindow, meshcat
-from .errors import ViewerError
+from pinarms.viz._meshcat import ViewerWindow, meshcat
+from pinarms.viz.errors import ViewerError
 
 __all__ = ["MeshcatServer"]
 

@@ -30,12 +30,12 @@ from typing import Any, Mapping
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
 
-from .session_archive import SessionLimits
-from .session_format import read_session, to_document, write_session
-from .session_inputs import (
+from pinarms.viz.session_archive import SessionLimits
+from pinarms.viz.session_format import read_session, to_document, write_session
+from pinarms.viz.session_inputs import (
     MAX_TRAJECTORY_SAMPLES,
     box_record,
     float_array,
@@ -45,7 +45,7 @@ from .session_inputs import (
     trajectory_record,
     workspace_record,
 )
-from .session_records import (
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -54,8 +54,8 @@ from .session_records import (
     WorkspaceRecord,
     check_name as _check_name,
 )
-from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
+from pinarms.viz.session_robots import rebuild_robot, robot_entry, shipped_model_dirs
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 __all__ = [
     "FORMAT_NAME",
@@ -90,7 +90,7 @@ class Session:
     >>> s2 = load_session("study.pinarms")
 
     Args:
-        robot: first robot (a :class:`robots.Robot` or a registry name), or ``None``.
+        robot: first robot (a :class:`pinarms.robots.Robot` or a registry name), or ``None``.
         title: human title, stored in the metadata.
         metadata: free JSON-able metadata (stored under ``metadata["user"]``).
         base_to_world: pose of the first robot's base in the world frame (4, 4); default identity.
@@ -166,7 +166,7 @@ class Session:
         return key
 
     def robot(self, key: str | None = None) -> Robot:
-        """The :class:`robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
+        """The :class:`pinarms.robots.Robot` of ``key`` (default: the only robot), loaded on first use."""
         entry = self._entry(key)
         rob = self._loaded.get(entry.key)
         if rob is not None:
@@ -198,16 +198,16 @@ class Session:
 
     def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
                  name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
-        """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
+        """Add a :class:`pinarms.robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
         Args:
             cell: the cell; its joint vector is the robot's, poses are in the world frame
                 (``base_to_world`` is the identity).
             key: its key (default: the cell's name).
-            motions: the arms' motions (:class:`robots.cell.ArmMotion` objects or
+            motions: the arms' motions (:class:`pinarms.robots.cell.ArmMotion` objects or
                 ``{arm: trajectory}``), stored as one trajectory ``name`` of the whole cell,
                 sampled at ``hz`` over their window: the viewer animates all arms together.
-            check: a :class:`robots.cell.MotionCheck` of those motions: its samples in
+            check: a :class:`pinarms.robots.cell.MotionCheck` of those motions: its samples in
                 contact become the point set ``"<name> contacts"`` (kind ``"contact"``, drawn
                 red), at the middle of the contact pair's nearest points.
             hold: cell configuration ``(nq,)`` of the arms without a motion (default
@@ -217,7 +217,7 @@ class Session:
         The arms' tcp frames and the hold are recorded in ``metadata["cells"][key]`` so that
         the viewer draws each arm's tcp path.
         """
-        from .cell_session import add_cell
+        from pinarms.viz.cell_session import add_cell
 
         return add_cell(self, cell, key=key, motions=motions, check=check, name=name, hz=hz, hold=hold)
 
@@ -258,7 +258,7 @@ class Session:
         """Add a trajectory of robot ``robot`` (default: the only robot).
 
         Args:
-            trajectory: a :class:`planning.Trajectory` (its ``definition`` is kept and it is
+            trajectory: a :class:`pinarms.planning.Trajectory` (its ``definition`` is kept and it is
                 sampled at ``hz``, knots included), or a pair ``(t, q)`` of samples
                 (t (N,) s, q (N, nq)).
             hz: sampling rate (1/s) for a Trajectory.
@@ -302,11 +302,11 @@ class Session:
         return rec
 
     def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
-        """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
+        """Add the voxels of a :class:`pinarms.robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
 
-        The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).
+        The viewer and the standalone page draw them as coloured voxels (see :mod:`pinarms.viz.reach_record`).
         """
-        from .reach_record import make_record
+        from pinarms.viz.reach_record import make_record
 
         name = self._free(self.reachability, name, "reachability")
         rec = make_record(name, self._entry(robot).key, reach_map, min_index, float_array)
@@ -314,8 +314,8 @@ class Session:
         return rec
 
     def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
-        """Add an animated window of a simulated belt line (:func:`viz.line_session.add_line`)."""
-        from .line_session import add_line
+        """Add an animated window of a simulated belt line (:func:`pinarms.viz.line_session.add_line`)."""
+        from pinarms.viz.line_session import add_line
 
         return add_line(self, spec, result, **options)
 

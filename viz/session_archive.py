@@ -8,7 +8,7 @@ until checked, so :func:`open_archive` and :class:`ArchiveReader`:
   (a directory of millions of entries is refused before it fills memory);
 - parse ``session.json`` under a size cap, refusing NaN/Infinity, duplicate keys, lone
   surrogates and nesting deeper than :attr:`SessionLimits.max_json_depth`
-  (:mod:`viz.session_json`);
+  (:mod:`pinarms.viz.session_json`);
 - check each member reference against the zip directory (one entry per member, a known
   compression, a declared size that the reference's shape explains and that deflate can
   produce from the stored bytes) and the total against :class:`SessionLimits`, before
@@ -38,14 +38,14 @@ from typing import TYPE_CHECKING, Any, BinaryIO, Iterator
 import numpy as np
 
 from pinarms.files import open_regular
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .errors import SessionFormatError
-from .names import NAME_RE
-from .session_json import JSON_MEMBER, parse_document
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.names import NAME_RE
+from pinarms.viz.session_json import JSON_MEMBER, parse_document
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .session_schema import ArraySpec
+    from pinarms.viz.session_specs import ArraySpec
 
 __all__ = ["JSON_MEMBER", "F8", "SessionLimits", "DEFAULT_LIMITS", "ArrayRef", "ArchiveReader", "open_archive",
            "invalid_session"]

@@ -1,9 +1,9 @@
 """Validation of a session document: ``session.json``'s header, its index of items, then their members.
 
-Reading is two passes over the kinds of :data:`viz.session_schema.KINDS`: first the index
+Reading is two passes over the kinds of :data:`pinarms.viz.session_schema.KINDS`: first the index
 (names, robot references, every array's declared dtype and shape, every member's zip entry
 and size, the total against the limits) **before any member is read**; then the members,
-bounded and streamed (:class:`viz.session_archive.ArchiveReader`), and each kind's decoder
+bounded and streamed (:class:`pinarms.viz.session_archive.ArchiveReader`), and each kind's decoder
 builds its records. Every problem raises :class:`SessionFormatError` naming the file, the
 item or member, and why.
 """
@@ -13,10 +13,10 @@ from __future__ import annotations
 import zipfile
 from typing import Any
 
-from .errors import SessionFormatError
-from .names import NAME_RE
-from .session_archive import JSON_MEMBER, ArchiveReader
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.names import NAME_RE
+from pinarms.viz.session_archive import JSON_MEMBER, ArchiveReader
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
 
 __all__ = ["SessionItem", "read_document"]
 

@@ -6,14 +6,14 @@ read with ``allow_pickle=False``), plus ``robots/<i>.urdf`` for embedded URDFs. 
 in docs/viz.md. Files users exchange are hostile until checked; the pieces of the format
 live in their own modules, all re-exported here:
 
-- :mod:`viz.session_schema`: the format's name and version and the table of kinds
+- :mod:`pinarms.viz.session_schema`: the format's name and version and the table of kinds
   (:data:`KINDS`: a new kind is a record class, an encoder, a decoder and its array specs);
-- :mod:`viz.session_archive`: the bounded reader of the zip (:class:`SessionLimits`, the
+- :mod:`pinarms.viz.session_archive`: the bounded reader of the zip (:class:`SessionLimits`, the
   zip directory checked before :mod:`zipfile` parses it, ``session.json`` parsed under caps,
   members checked against the directory before a byte is read, arrays streamed);
-- :mod:`viz.session_document`: ``session.json``'s header and index, checked whole before
+- :mod:`pinarms.viz.session_document`: ``session.json``'s header and index, checked whole before
   the members are read;
-- :mod:`viz.mesh_paths`: meshes of embedded URDFs kept inside the allowed folders.
+- :mod:`pinarms.viz.mesh_paths`: meshes of embedded URDFs kept inside the allowed folders.
 
 Every problem raises :class:`SessionFormatError` naming the file, the member or field, and
 why.
@@ -32,12 +32,12 @@ from typing import Any, BinaryIO, Mapping
 import numpy as np
 
 from pinarms.files import atomic_write
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .mesh_paths import check_mesh_paths
-from .session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive
-from .session_document import read_document
-from .session_records import (
+from pinarms.viz.mesh_paths import check_mesh_paths
+from pinarms.viz.session_archive import DEFAULT_LIMITS, JSON_MEMBER, SessionLimits, open_archive
+from pinarms.viz.session_document import read_document
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -46,7 +46,8 @@ from .session_records import (
     WorkspaceRecord,
     check_name,
 )
-from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, ArraySpec, Kind, SessionContents, TextSpec
+from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, Kind, SessionContents
+from pinarms.viz.session_specs import ArraySpec, TextSpec
 
 __all__ = [
     "FORMAT_NAME",

@@ -1,6 +1,6 @@
 """The user's values checked and turned into session records (boxes, trajectories, workspaces, histories).
 
-What :class:`viz.Session`'s ``add_*`` methods take is checked here: numbers real and finite
+What :class:`pinarms.viz.Session`'s ``add_*`` methods take is checked here: numbers real and finite
 (±inf only where a history allows it), shapes, rigid poses, JSON-able metadata; every array
 kept is a fresh read-only float64 copy. Errors are :class:`InvalidInput` naming the value.
 
@@ -15,10 +15,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .session_archive import F8
-from .session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
+from pinarms.viz.session_archive import F8
+from pinarms.viz.session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
 
 __all__ = ["MAX_TRAJECTORY_SAMPLES", "json_normalised", "real_array", "float_array", "pose_array", "box_record",
            "trajectory_record", "workspace_record", "history_record"]

@@ -3,7 +3,7 @@
 Strict where :func:`json.loads` is lenient: NaN and Infinity, duplicate keys in one object,
 a number too large for float64, a string with a lone surrogate (not writable as UTF-8) and
 nesting deeper than a bound are all refused, the depth checked without recursion. The
-bytes come from :class:`viz.session_archive.ArchiveReader`, which caps their size first.
+bytes come from :class:`pinarms.viz.session_archive.ArchiveReader`, which caps their size first.
 """
 
 from __future__ import annotations

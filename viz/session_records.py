@@ -2,7 +2,7 @@
 workspaces, point sets, GA histories), and the rule for their names.
 
 Their file format (JSON fields, arrays, texts per kind; reading and writing) is
-:mod:`viz.session_format`, which re-exports every name here.
+:mod:`pinarms.viz.session_format`, which re-exports every name here.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .names import NAME_RE
+from pinarms.viz.names import NAME_RE
 
 __all__ = ["RobotEntry", "BoxObject", "TrajectoryRecord", "WorkspaceRecord", "PointSet", "HistoryRecord", "check_name"]
 
@@ -35,7 +35,7 @@ class RobotEntry:
         package_dirs: folders that resolved ``package://`` meshes when saved: a hint shown in
             error messages only; loading never reads meshes from them unless the caller
             passes them (``load_session(..., package_dirs=...)``).
-        payload: the payload the robot carries (:meth:`robots.payload.Payload.as_dict`:
+        payload: the payload the robot carries (:meth:`pinarms.robots.payload.Payload.as_dict`:
             ``mass_kg``, ``com_m``, ``inertia_kg_m2``, ``frame``), or ``None``; reapplied
             with ``robot.with_payload`` when the session reopens.
     """
@@ -85,7 +85,7 @@ class TrajectoryRecord:
     definition: dict | None
 
     def rebuild(self) -> Any:
-        """The :class:`planning.Trajectory` rebuilt from :attr:`definition`."""
+        """The :class:`pinarms.planning.Trajectory` rebuilt from :attr:`definition`."""
         if self.definition is None:
             raise InvalidInput(f"trajectory {self.name!r} was saved from samples only; it has no definition to rebuild")
         from pinarms import planning  # late import: only this method needs it

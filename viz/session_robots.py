@@ -4,7 +4,7 @@ A robot that ``robots.load(name)`` rebuilds exactly is stored by name; any other
 URDF text embedded (with the folders its meshes came from, recorded for messages only) so
 that the session reopens anywhere. A payload is stored beside it and reapplied. Rebuilding an
 embedded URDF reads meshes only from the folders the caller allowed
-(:func:`viz.mesh_paths.check_mesh_paths`), pinarms' own model folders among them.
+(:func:`pinarms.viz.mesh_paths.check_mesh_paths`), pinarms' own model folders among them.
 """
 
 from __future__ import annotations
@@ -13,13 +13,13 @@ from pathlib import Path
 from typing import Any
 
 from pinarms import robots
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 from pinarms.robots.robot import Robot
 
-from .errors import SessionFormatError
-from .mesh_paths import check_mesh_paths
-from .session_inputs import pose_array
-from .session_records import RobotEntry
+from pinarms.viz.errors import SessionFormatError
+from pinarms.viz.mesh_paths import check_mesh_paths
+from pinarms.viz.session_inputs import pose_array
+from pinarms.viz.session_records import RobotEntry
 
 __all__ = ["robot_entry", "rebuild_robot", "shipped_model_dirs"]
 
@@ -54,7 +54,7 @@ def robot_entry(robot: Robot, key: str, base_to_world: Any) -> RobotEntry:
 
 
 def rebuild_robot(entry: RobotEntry, mesh_dirs: tuple[str, ...]) -> Robot:
-    """The :class:`robots.Robot` of ``entry``, its meshes read only from ``mesh_dirs``, its payload reapplied.
+    """The :class:`pinarms.robots.Robot` of ``entry``, its meshes read only from ``mesh_dirs``, its payload reapplied.
 
     Raises:
         SessionFormatError: a mesh outside ``mesh_dirs``, or the robot now loads with other joints.

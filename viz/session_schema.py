@@ -2,11 +2,11 @@
 
 Each kind of content (robots, objects, trajectories, workspaces, point sets, histories,
 reachability maps, belt lines) is a row of :data:`KINDS`: its list in ``session.json``,
-the :class:`viz.Session` attribute holding its records, its arrays (:class:`ArraySpec`:
+the :class:`pinarms.viz.Session` attribute holding its records, its arrays (:class:`~.session_specs.ArraySpec`:
 dtype float64, shapes with named dimensions shared within an item), its text members
-(:class:`TextSpec`), whether it refers to a robot, and an encoder and a decoder. A new kind
+(:class:`~.session_specs.TextSpec`), whether it refers to a robot, and an encoder and a decoder. A new kind
 is a record class, a row and two small functions; the reader
-(:mod:`viz.session_document`, :mod:`viz.session_archive`) applies its bounds to it unchanged.
+(:mod:`pinarms.viz.session_document`, :mod:`pinarms.viz.session_archive`) applies its bounds to it unchanged.
 
 Frames and units: positions in metres, angles in radians, times in seconds.
 """
@@ -14,13 +14,13 @@ Frames and units: positions in metres, angles in radians, times in seconds.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 
 import numpy as np
 
-from .line_record import decode_line, encode_line  # a belt line: its own module
-from .reach_record import decode_reachability, encode_reachability  # a kind defined in its own module
-from .session_records import (
+from pinarms.viz.line_record import decode_line, encode_line  # a belt line: its own module
+from pinarms.viz.reach_record import decode_reachability, encode_reachability  # a kind defined in its own module
+from pinarms.viz.session_records import (
     BoxObject,
     HistoryRecord,
     PointSet,
@@ -29,42 +29,14 @@ from .session_records import (
     WorkspaceRecord,
 )
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .session_document import SessionItem
+from pinarms.viz.session_specs import ArraySpec, SessionItemView, TextSpec
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "POINT_KINDS", "ArraySpec", "TextSpec", "Kind", "KINDS", "SessionContents"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "POINT_KINDS", "Kind", "KINDS", "SessionContents"]
 
 FORMAT_NAME = "pinarms-session"
 FORMAT_VERSION = 1
 
 POINT_KINDS = ("via", "target", "contact")
-
-
-@dataclass(frozen=True)
-class ArraySpec:
-    """An array field of an item: ``shape`` entries are ints (fixed), or names of dimensions.
-
-    A named dimension takes the first value met in the item and every other use must
-    repeat it; ``"nq"`` is bound to the joint count of the item's robot. ``min_rows``
-    bounds the first dimension from below. ``columns=True``: the field is a JSON object of
-    named arrays of this shape (history columns), ``required`` names those that must exist.
-    """
-
-    field: str
-    shape: tuple[int | str, ...]
-    allow_inf: bool = False
-    min_rows: int = 0
-    columns: bool = False
-    required: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class TextSpec:
-    """A text member of an item (UTF-8), referenced by the JSON field ``field`` (or null when ``optional``)."""
-
-    field: str
-    member: str  # pattern with {i}
-    xml: bool = False
 
 
 @dataclass(frozen=True)
@@ -74,7 +46,7 @@ class Kind:
     ``encode(record)`` gives the item's JSON fields (without arrays and texts), its arrays
     ({field: array} or, for ``columns`` specs, {field: {column: array}}) and its texts
     ({field: text or None}). ``decode(item)`` builds the record from a validated
-    :class:`SessionItem` (JSON fields checked with ``item.field``, arrays and texts already read).
+    :class:`~.session_specs.SessionItemView` (JSON fields checked with ``item.field``, arrays and texts already read).
     """
 
     section: str
@@ -83,7 +55,7 @@ class Kind:
     key_field: str
     arrays: tuple[ArraySpec, ...]
     encode: Callable[[Any], tuple[dict, dict, dict]]
-    decode: Callable[["SessionItem"], Any]
+    decode: Callable[["SessionItemView"], Any]
     texts: tuple[TextSpec, ...] = ()
     robot_ref: str | None = None  # "required" / "optional": the item's "robot" field names a session robot
     optional: bool = False  # the section may be absent (written only when it has items): older files lack it
@@ -97,7 +69,7 @@ def _encode_robot(e: RobotEntry) -> tuple[dict, dict, dict]:
     return fields, {"base_to_world": e.base_to_world}, {"urdf_member": e.urdf_text}
 
 
-def _decode_robot(it: SessionItem) -> RobotEntry:
+def _decode_robot(it: SessionItemView) -> RobotEntry:
     source = it.field("source", str)
     if source not in ("registry", "urdf"):
         raise it.fail(f"{it.where}.source must be 'registry' or 'urdf', got {source!r}")
@@ -123,7 +95,7 @@ def _encode_box(b: BoxObject) -> tuple[dict, dict, dict]:
     return {"name": b.name, "shape": "box", "color": list(b.color)}, {"size": b.size, "pose": b.pose}, {}
 
 
-def _decode_box(it: SessionItem) -> BoxObject:
+def _decode_box(it: SessionItemView) -> BoxObject:
     shape = it.field("shape", str)
     if shape != "box":
         raise it.fail(f"{it.where}.shape {shape!r} is not known (this version knows 'box')")
@@ -139,7 +111,7 @@ def _encode_trajectory(r: TrajectoryRecord) -> tuple[dict, dict, dict]:
             {"t": r.t, "q": r.q, "knot_times": r.knot_times}, {})
 
 
-def _decode_trajectory(it: SessionItem) -> TrajectoryRecord:
+def _decode_trajectory(it: SessionItemView) -> TrajectoryRecord:
     if "definition" not in it.obj or not (it.obj["definition"] is None or isinstance(it.obj["definition"], dict)):
         raise it.fail(f"{it.where}.definition must be a JSON object or null")
     t = it.arrays["t"]
@@ -152,7 +124,7 @@ def _encode_workspace(r: WorkspaceRecord) -> tuple[dict, dict, dict]:
     return {"name": r.name, "robot": r.robot}, {"points": r.points, "manipulability": r.manipulability}, {}
 
 
-def _decode_workspace(it: SessionItem) -> WorkspaceRecord:
+def _decode_workspace(it: SessionItemView) -> WorkspaceRecord:
     return WorkspaceRecord(it.key, it.robot, it.arrays["points"], it.arrays["manipulability"])
 
 
@@ -160,7 +132,7 @@ def _encode_points(p: PointSet) -> tuple[dict, dict, dict]:
     return {"name": p.name, "kind": p.kind, "robot": p.robot}, {"points": p.points}, {}
 
 
-def _decode_points(it: SessionItem) -> PointSet:
+def _decode_points(it: SessionItemView) -> PointSet:
     kind = it.field("kind", str)
     if kind not in POINT_KINDS:
         raise it.fail(f"{it.where}.kind must be one of {POINT_KINDS}, got {kind!r}")
@@ -171,7 +143,7 @@ def _encode_history(h: HistoryRecord) -> tuple[dict, dict, dict]:
     return {"name": h.name}, {"columns": dict(h.columns)}, {}
 
 
-def _decode_history(it: SessionItem) -> HistoryRecord:
+def _decode_history(it: SessionItemView) -> HistoryRecord:
     return HistoryRecord(it.key, dict(it.arrays["columns"]))
 
 

@@ -1,6 +1,6 @@
 """The trajectories of a scene: their world tcp paths, which of them play, and the one looping animation.
 
-:func:`viz.scene.build_scene` draws what these compute: the tcp path of each trajectory in
+:func:`pinarms.viz.scene.build_scene` draws what these compute: the tcp path of each trajectory in
 the world frame (one per arm for a cell) with the tcp at its knots, the trajectories that
 play (default: the first of each robot; at most one per robot), each robot posed at the
 start of its motion, and one MeshCat animation of them all (and of the belt lines) from
@@ -13,11 +13,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._meshcat import meshcat
-from .robot_drawing import RobotDrawing
-from .shapes import transform_points
+from pinarms.viz._meshcat import meshcat
+from pinarms.viz.robot_drawing import RobotDrawing
+from pinarms.viz.shapes import transform_points
 
 __all__ = ["interp_rows", "world_tcp_paths", "animated_trajectories", "show_start_poses", "animate_scene",
            "frame_times"]
@@ -82,7 +82,7 @@ def show_start_poses(session: Any, drawings: dict[str, RobotDrawing], animated: 
 def animate_scene(vis: meshcat.Visualizer, session: Any, root: str, drawings: dict[str, RobotDrawing],
                   animated: tuple[str, ...], lines: bool, fps: float, play: bool) -> tuple[float, int]:
     """One looping animation of the ``animated`` trajectories and the belt ``lines``; return (duration, frames)."""
-    from .line_scene import animate_lines, line_duration
+    from pinarms.viz.line_scene import animate_lines, line_duration
 
     if not (animated or lines):
         return 0.0, 0

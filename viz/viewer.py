@@ -10,8 +10,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from .scene import SceneInfo, build_scene
-from .server import MeshcatServer
+from pinarms.viz.scene import SceneInfo, build_scene
+from pinarms.viz.server import MeshcatServer
 
 __all__ = ["Viewer", "show"]
 
@@ -19,7 +19,7 @@ __all__ = ["Viewer", "show"]
 class Viewer(MeshcatServer):
     """A running viewer showing a session (see :func:`show`).
 
-    Attributes (besides :class:`MeshcatServer`'s): ``scene`` — the :class:`viz.scene.SceneInfo`
+    Attributes (besides :class:`MeshcatServer`'s): ``scene`` — the :class:`pinarms.viz.scene.SceneInfo`
     of what was drawn (scene paths, animation length).
     """
 
@@ -41,11 +41,11 @@ def show(session: Any, port: int | None = None, open_browser: bool = False, wait
     """Start MeshCat on 127.0.0.1 and show ``session``; return the running :class:`Viewer`.
 
     Args:
-        session: a :class:`viz.Session`.
+        session: a :class:`pinarms.viz.Session`.
         port: HTTP port (default: a free one).
         open_browser: open the page in the default web browser.
         wait: block until Ctrl+C, then stop the server (same as ``show(...).wait()``).
-        scene_options: passed to :func:`viz.scene.build_scene` (``animate``, ``fps``, ...).
+        scene_options: passed to :func:`pinarms.viz.scene.build_scene` (``animate``, ``fps``, ...).
 
     Stop it with ``viewer.close()`` or use it as a context manager; the server process is
     also stopped when the viewer is garbage-collected or Python exits.

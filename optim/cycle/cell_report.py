@@ -1,4 +1,4 @@
-"""What :func:`optim.plan_cycle` with a cell reports about the clearance it kept (:mod:`.in_cell`)."""
+"""What :func:`pinarms.optim.plan_cycle` with a cell reports about the clearance it kept (:mod:`.in_cell`)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ class CellCycleReport:
         cycle_time_without_cell: the cycle planned ignoring the cell [s];
             ``extra_time``: the kept cycle's time minus it [s].
         attempts: each attempt in order: ``(description, clear, min clearance [m], pair)``.
-        planned_transfer: the transfer was planned around the cell (:mod:`optim.motion.transfer`)
+        planned_transfer: the transfer was planned around the cell (:mod:`pinarms.optim.motion.transfer`)
             after raising the lift and via points could not clear.
     """
 

@@ -1,23 +1,23 @@
 """Pick-and-place cycles that keep a clearance from the cell around the arm.
 
 :func:`plan_cycle` with a cell (:class:`CellSettings` in the request) lands here. The cycle
-is first planned as without a cell (:func:`optim.cycle.straight.approach_cycle`), then
+is first planned as without a cell (:func:`pinarms.optim.cycle.straight.approach_cycle`), then
 checked continuously in the cell
-(:meth:`robots.cell.Cell.check_motion`): every pair of the arm with a fixture or another
+(:meth:`pinarms.robots.cell.Cell.check_motion`): every pair of the arm with a fixture or another
 arm (held still at ``hold``) must keep ``clearance`` [m], and the arm's own links must
 not touch (they are designed close, so no clearance is asked of them). When the check
 fails, the cycle is re-planned, in this order, until it passes:
 
 1. **raise the transfer**: the vertical lift at pick and place grows by ``lift_step``
    (the transfer then starts and ends higher), up to the highest lift the arm reaches or
-   :data:`optim.caps.MAX_LIFT_ATTEMPTS` rises;
+   :data:`pinarms.optim.caps.MAX_LIFT_ATTEMPTS` rises;
 2. **add a via point** above the middle of the transfer (between "above pick" and
    "above place", at the highest lifted height plus ``lift_step`` per attempt, three
    heights), then two via points at one and two thirds;
 3. **plan the transfer** round what blocks (a crate under a guard, a shelf, the other
-   arm's column): :func:`optim.motion.transfer.planned_cycle` keeps the lift and lowering at
+   arm's column): :func:`pinarms.optim.motion.transfer.planned_cycle` keeps the lift and lowering at
    the spec's height and plans the transfer between them with OMPL, every edge proven
-   continuously (:mod:`optim.motion`).
+   continuously (:mod:`pinarms.optim.motion`).
 
 Each re-planned cycle is re-timed (time-optimal under the same limits) and re-checked.
 With ``CellSettings.screen`` (default), an attempt is first screened by exact distances at a few
@@ -31,7 +31,7 @@ always the one the continuous check proved.
 The result carries a :class:`CellCycleReport`: what was tried, the lift and via points
 kept, the smallest clearance, and the extra time against the cycle planned without the
 cell. If the pick or the place itself is closer than ``clearance`` to a fixture, or no
-attempt clears, :class:`robots.errors.CollisionError` says which bodies block and where.
+attempt clears, :class:`pinarms.errors.CollisionError` says which bodies block and where.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from pinarms.optim.errors import PlanningError
 from pinarms.optim.motion.transfer import planned_cycle
 from pinarms.robots.cell import ArmMotion
 from pinarms.robots.cell.idle import idle_contacts
-from pinarms.robots.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
+from pinarms.errors import CollisionError, InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["CellCycleReport", "plan_cycle_in_cell", "SCREEN_SAMPLES", "SCREEN_TOL", "SCREEN_BRANCHES", "SCREEN_MOVES"]
 
@@ -327,7 +327,7 @@ def _add_vias(trials: _Trials, spec: PickPlace, top: float,
 
 
 def _plan_transfer(trials: _Trials, base: CycleResult) -> tuple[bool, CycleResult | None]:
-    """Step 3: the transfer planned round what blocks (OMPL, :mod:`optim.motion`), checked like the others."""
+    """Step 3: the transfer planned round what blocks (OMPL, :mod:`pinarms.optim.motion`), checked like the others."""
     request = trials.request
     try:
         result = planned_cycle(request, base, arm=trials.cell_arm, hold=trials.hold_q)

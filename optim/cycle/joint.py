@@ -10,12 +10,12 @@ with the gripper closing at the pick and opening at the place (``dwell`` s each)
 
 * the Cartesian waypoints of one full cycle (tcp → base poses, m): the lift points are the
   pick and place poses moved ``lift`` m along the base's +z (vertical approach/retreat);
-* the joint via points, by IK on ONE branch (:func:`planning.joint_waypoints`: each
+* the joint via points, by IK on ONE branch (:func:`pinarms.planning.joint_waypoints`: each
   waypoint keeps the previous waypoint's branch; without ``q_start`` the pick's solutions
   are tried in turn until one keeps a single branch through every waypoint, see
   :attr:`CycleResult.branches`). The return move runs through the same joint via points
   in reverse, so the cycle closes exactly;
-* the time-optimal timing of each move (:func:`optim.minimize_time` under the given
+* the time-optimal timing of each move (:func:`pinarms.optim.minimize_time` under the given
   velocity/acceleration/jerk limits): at rest at the pick and the place, moving through the
   lift points and the transfer vias (``"multi-quintic"`` uses the sign-of-slopes via
   velocities, ``velocities="heuristic"``: a joint keeps moving through a via point unless it
@@ -41,7 +41,7 @@ from pinarms.optim.cycle.spec import CycleResult, _hold, _line_deviation, _verti
 from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import joint_waypoints
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
 __all__ = ["joint_cycle"]
@@ -54,13 +54,13 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     ``via``: the joint via points and branch labels of the move to place, when the caller has
     them (:func:`_via_points` of the request: the same). ``there_clear``: called with the move
     to place's trajectory once it is timed; when it says False the move back is not timed and
-    None is returned (:mod:`optim.cycle.in_cell` screens an attempt so).
+    None is returned (:mod:`pinarms.optim.cycle.in_cell` screens an attempt so).
 
     Raises:
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
-        InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        InfeasibleProblem: no timing found (from :func:`pinarms.optim.minimize_time`).
     """
     robot, spec = request.robot, request.spec
     poses = spec.poses(robot)
@@ -154,7 +154,7 @@ def _branch_labels(robot: Any, poses: np.ndarray, q: np.ndarray) -> np.ndarray:
 def _one_branch_waypoints(robot: Any, poses: np.ndarray, q_start: Any) -> tuple[np.ndarray, np.ndarray]:
     """Joint via points (k, nq) and their branch labels (k,).
 
-    With ``q_start`` the branch is the one :func:`planning.joint_waypoints` takes from it. Without,
+    With ``q_start`` the branch is the one :func:`pinarms.planning.joint_waypoints` takes from it. Without,
     for a closed-form arm, each solution at the pick is tried in the robot's order and the first
     whose path stays on one branch at every waypoint is kept (the limits can force a branch
     switch on the way from one pick solution but not from another); if none does, the first.

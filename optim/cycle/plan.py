@@ -3,13 +3,13 @@
 :func:`plan_cycle` picks the planner the request asks for, each in a module below this one
 (plain imports, no callbacks):
 
-* no cell: :func:`optim.cycle.straight.approach_cycle` — the joint-space cycle
-  (:mod:`optim.cycle.joint`: IK on one branch, time-optimal moves through the lift points),
+* no cell: :func:`pinarms.optim.cycle.straight.approach_cycle` — the joint-space cycle
+  (:mod:`pinarms.optim.cycle.joint`: IK on one branch, time-optimal moves through the lift points),
   or, with ``approach="straight"``, that cycle with straight vertical lines at pick and place
-  (:mod:`optim.cycle.straight`);
-* a cell (:class:`CellSettings`): :func:`optim.cycle.in_cell.plan_cycle_in_cell` — the same
+  (:mod:`pinarms.optim.cycle.straight`);
+* a cell (:class:`CellSettings`): :func:`pinarms.optim.cycle.in_cell.plan_cycle_in_cell` — the same
   cycle checked continuously in the cell and re-planned (higher lift, via points, then a
-  transfer planned round what blocks, :mod:`optim.motion.transfer`) until it keeps its clearance.
+  transfer planned round what blocks, :mod:`pinarms.optim.motion.transfer`) until it keeps its clearance.
 
 Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 """
@@ -27,7 +27,7 @@ from pinarms.optim.cycle.spec import (  # noqa: F401  (the spec and result, re-e
     PickPlace,
 )
 from pinarms.optim.cycle.straight import approach_cycle
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "LINE_NAMES", "CycleResult", "PickPlace",
            "CycleRequest", "CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "plan_cycle"]
@@ -54,7 +54,7 @@ def plan_cycle(request: CycleRequest) -> CycleResult:
         UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
             above pick, via k, above place, place), its position and why
             (``robot.ik_failure_reason``).
-        InfeasibleProblem: no timing found (from :func:`optim.minimize_time`).
+        InfeasibleProblem: no timing found (from :func:`pinarms.optim.minimize_time`).
         CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
             re-planned cycle keeps the clearance; the message names the blocking bodies.
     """

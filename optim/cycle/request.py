@@ -1,6 +1,6 @@
 """The input of a cycle plan: one :class:`CycleRequest`, its settings grouped and checked when built.
 
-:func:`optim.plan_cycle` takes one request (the ruckig way: an input object, one call, a
+:func:`pinarms.optim.plan_cycle` takes one request (the ruckig way: an input object, one call, a
 result with a status)::
 
     request = CycleRequest(arm, PickPlace(pick, place),
@@ -11,7 +11,7 @@ result with a status)::
     result = plan_cycle(request)
 
 Each group checks its own values in its constructor (the project's errors, the caps of
-:mod:`optim.caps`), and the request checks what needs the robot: the limits per joint
+:mod:`pinarms.optim.caps`), and the request checks what needs the robot: the limits per joint
 (``vmax`` defaults to the URDF's) and the torque limits with the payload. A request that
 exists is a valid one; what is left for planning is what only planning can find out (no IK
 solution, no timing, no clearance).
@@ -32,7 +32,7 @@ from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning.torque import JointTorqueConstraint
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.robots import Robot
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
 
 __all__ = ["CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "CycleRequest"]
 
-#: The optimisers a cycle's moves can be timed with (:func:`optim.minimize_time`).
+#: The optimisers a cycle's moves can be timed with (:func:`pinarms.optim.minimize_time`).
 CYCLE_METHODS = ("exact", "ga")
 
 
@@ -50,13 +50,13 @@ class CycleTiming:
     """How each move is timed.
 
     Attributes:
-        kind: trajectory family of each move, one of :data:`optim.cycle.CYCLE_KINDS`
+        kind: trajectory family of each move, one of :data:`pinarms.optim.cycle.CYCLE_KINDS`
             (``"3-5-3"`` needs exactly 4 waypoints per move: no transfer vias).
         vmax, amax, jmax: limits per joint (scalar or (nq,)), rad/s, rad/s², rad/s³ (m/… for
             prismatic joints); ``vmax`` None: the robot's URDF limits; ``amax``/``jmax`` None:
             not limited. Checked against the robot by :class:`CycleRequest`.
         method: ``"exact"`` (deterministic scaling-law optimiser) or ``"ga"``, as
-            :func:`optim.minimize_time`; ``seed``: the optimiser's seed.
+            :func:`pinarms.optim.minimize_time`; ``seed``: the optimiser's seed.
 
     Raises:
         InvalidInput: ``kind`` is not a cycle family. InvalidSettings: unknown ``method``.
@@ -82,7 +82,7 @@ class CycleLoad:
 
     Attributes:
         payload: what the gripper carries from pick to place: a mass [kg], a
-            :class:`robots.Payload` or its dict form (the move back is timed empty).
+            :class:`pinarms.robots.Payload` or its dict form (the move back is timed empty).
         torque_limits: ``True`` (the URDF's ``effort`` limits) or limits per joint [N·m or N]:
             both moves are also timed under joint-torque limits; ``False``: kinematic limits only.
 
@@ -105,7 +105,7 @@ class CycleApproach:
     Attributes:
         approach: ``"joint"`` (through the lift points in joint space) or ``"straight"``
             (straight vertical lines, time-optimal along them; needs ``amax``:
-            :mod:`optim.cycle.straight`).
+            :mod:`pinarms.optim.cycle.straight`).
         tool_speed: with ``"straight"``, a tcp speed limit on the lines [m/s], or None.
 
     Raises:
@@ -127,7 +127,7 @@ def _check_tool_speed(tool_speed: float | None) -> None:
 
 
 def check_cell_numbers(clearance: float, margin: float, lift_step: float) -> tuple[float, float, float]:
-    """``(clearance, margin, lift_step)`` as floats in their ranges (:mod:`optim.caps`), lift_step checked first."""
+    """``(clearance, margin, lift_step)`` as floats in their ranges (:mod:`pinarms.optim.caps`), lift_step checked first."""
     lift_step = number_setting(lift_step, "lift_step (rise per re-planning attempt)", *LIFT_STEP_RANGE, unit="m")
     margin = number_setting(margin, "margin (resolution of the continuous check)", MIN_MARGIN, unit="m")
     clearance = number_setting(clearance, "clearance", 0.0, MAX_CLEARANCE, unit="m")
@@ -136,17 +136,17 @@ def check_cell_numbers(clearance: float, margin: float, lift_step: float) -> tup
 
 @dataclass(frozen=True, eq=False)
 class CellSettings:
-    """The cell a cycle must keep its clearance in (:mod:`optim.cycle.in_cell`).
+    """The cell a cycle must keep its clearance in (:mod:`pinarms.optim.cycle.in_cell`).
 
     Attributes:
-        cell: a :class:`robots.cell.Cell` holding the request's robot (``cell.arm(name).robot``);
+        cell: a :class:`pinarms.robots.cell.Cell` holding the request's robot (``cell.arm(name).robot``);
             ``arm`` names the arm when the robot is not the cell's object.
         clearance: distance kept from the fixtures and the other arms [m] (0 … 1).
         hold: cell configuration of the other arms (default :attr:`Cell.hold`).
-        margin: resolution of the continuous check [m] (≥ :data:`optim.caps.MIN_MARGIN`).
-        lift_step: rise of the lift per re-planning attempt [m] (:data:`optim.caps.LIFT_STEP_RANGE`).
+        margin: resolution of the continuous check [m] (≥ :data:`pinarms.optim.caps.MIN_MARGIN`).
+        lift_step: rise of the lift per re-planning attempt [m] (:data:`pinarms.optim.caps.LIFT_STEP_RANGE`).
         plan_transfer: when raising the lift and via points cannot clear, plan the transfer
-            round what blocks (:mod:`optim.motion.transfer`).
+            round what blocks (:mod:`pinarms.optim.motion.transfer`).
         screen: reject an attempt by exact distances at its via points and a few timed states
             before timing it or checking it continuously (proofs of failure only: the same
             verdicts and kept cycle; ``False``: every attempt timed and checked in full).
@@ -196,7 +196,7 @@ class CycleRequest:
     """One cycle to plan: the robot, the task and the settings (module doc).
 
     Attributes:
-        robot: a :class:`robots.Robot` (or an object with its IK/FK methods, ``nq``, ``name``,
+        robot: a :class:`pinarms.robots.Robot` (or an object with its IK/FK methods, ``nq``, ``name``,
             ``joint_names``, ``velocity_limit``).
         spec: the :class:`PickPlace` task.
         timing, load, approach: the settings groups (defaults: multi-quintic, exact, the URDF's
@@ -206,7 +206,7 @@ class CycleRequest:
             selects the IK branch of the whole cycle), or None.
         vmax, amax, jmax: the limits per joint the moves are timed under, (nq,) arrays or None
             (set when the request is built).
-        torque: the torque limits with the payload carried (:class:`planning.JointTorqueConstraint`),
+        torque: the torque limits with the payload carried (:class:`pinarms.planning.JointTorqueConstraint`),
             or None (set when the request is built).
 
     Raises:

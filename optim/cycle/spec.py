@@ -1,6 +1,6 @@
 """The pick-and-place cycle's input and output: :class:`PickPlace` (the spec) and :class:`CycleResult`.
 
-The data of :mod:`optim.cycle` (planned by :func:`optim.plan_cycle`), in a module of
+The data of :mod:`pinarms.optim.cycle` (planned by :func:`pinarms.optim.plan_cycle`), in a module of
 their own so that every way of planning a cycle (joint space, straight vertical approach,
 in a cell, around obstacles) shares them without importing the planner back. Also the
 helpers those planners share: a hold at rest and the tcp's distance from the vertical
@@ -21,7 +21,7 @@ from pinarms.optim.caps import MAX_DWELL, number_setting
 from pinarms.optim.timing.segments import TimingResult
 from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.optim.cycle.cell_report import CellCycleReport
@@ -35,7 +35,7 @@ __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "LINE_NAMES", "LINE
 CYCLE_KINDS = ("multi-quintic", "quintic-bspline", "3-5-3")
 
 #: How the tcp approaches and leaves pick and place: through the lift points in joint space, or on
-#: straight vertical lines (:mod:`optim.cycle.straight`).
+#: straight vertical lines (:mod:`pinarms.optim.cycle.straight`).
 CYCLE_APPROACHES = ("joint", "straight")
 
 
@@ -43,14 +43,14 @@ class CycleStatus(enum.Enum):
     """How a cycle was planned (:attr:`CycleResult.status`; the value is the word the reports print).
 
     A cycle that cannot be planned raises instead (no IK solution at a waypoint, no timing, no
-    re-planned cycle that keeps the cell's clearance: :func:`optim.plan_cycle`).
+    re-planned cycle that keeps the cell's clearance: :func:`pinarms.optim.plan_cycle`).
     """
 
     #: as asked (without a cell, or its first check in the cell passed)
     OK = "ok"
     #: in a cell, the lift was raised or via points added to keep the clearance
     REPLANNED = "re-planned"
-    #: in a cell, the transfer was planned round what blocks (:mod:`optim.motion.transfer`)
+    #: in a cell, the transfer was planned round what blocks (:mod:`pinarms.optim.motion.transfer`)
     TRANSFER_PLANNED = "transfer planned"
 
 
@@ -101,16 +101,16 @@ class PickPlace:
         lift: height [m] of the vertical approach and retreat at pick and place (> 0),
             along the base's +z.
         dwell: time [s] the arm stays at rest at the pick and at the place for the gripper
-            (0 to :data:`optim.caps.MAX_DWELL`).
+            (0 to :data:`pinarms.optim.caps.MAX_DWELL`).
         via: transfer waypoints between "above pick" and "above place" (positions (3,) or
             poses (4, 4), in order); the return move passes them in reverse.
         orientation: tool orientation (3, 3) of the targets given as positions; default
-            :func:`robots.reach.layout.default_orientation` (tool pointing down on six-axis arms,
+            :func:`pinarms.robots.reach.layout.default_orientation` (tool pointing down on six-axis arms,
             the neutral orientation on SCARA, gantry and koji arm).
 
     Raises:
         InvalidInput: a malformed point, NaN/inf, ``lift <= 0``; ``SettingOutOfRange`` (an
-            ``InvalidInput``): ``dwell`` outside 0 … :data:`optim.caps.MAX_DWELL`.
+            ``InvalidInput``): ``dwell`` outside 0 … :data:`pinarms.optim.caps.MAX_DWELL`.
     """
 
     pick: np.ndarray
@@ -182,7 +182,7 @@ class CycleResult:
         waypoints: (2 k - 1, 4, 4) tcp → base poses [m] of the full cycle.
         q_via: (2 k - 1, nq) joint via points [rad or m] (one IK branch; the return move's
             are the move to place's in reverse).
-        moves: the timings of the move to place and the move to pick (:class:`optim.TimingResult`).
+        moves: the timings of the move to place and the move to pick (:class:`pinarms.optim.TimingResult`).
         trajectory: the whole cycle: dwell at pick, move to place, dwell at place, move to pick.
         peaks: exact peaks of ``trajectory`` (velocity, acceleration, jerk per joint).
         vmax, amax, jmax: the limits used (nq,) (None: not limited).
@@ -191,13 +191,13 @@ class CycleResult:
         branches: (2 k - 1,) closed-form IK branch label of each joint via point
             (``robot.ik_branches``; -1 for arms solved numerically).
         approach: ``"joint"`` or ``"straight"`` (straight vertical lines at pick and place;
-            ``moves`` are then :class:`optim.cycle.straight.StraightMove`).
+            ``moves`` are then :class:`pinarms.optim.cycle.straight.StraightMove`).
         joint_cycle_time: with ``approach="straight"``, the joint-space cycle's time [s] under
             the same limits (None otherwise).
-        payload: the payload carried on the move to place (:class:`robots.Payload`), or None.
+        payload: the payload carried on the move to place (:class:`pinarms.robots.Payload`), or None.
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
-        cell_report: planned in a cell (:class:`optim.CellSettings`), how the cycle keeps its clearance
-            (:class:`optim.cycle.in_cell.CellCycleReport`); else None.
+        cell_report: planned in a cell (:class:`pinarms.optim.CellSettings`), how the cycle keeps its clearance
+            (:class:`pinarms.optim.cycle.in_cell.CellCycleReport`); else None.
         status: how it was planned (:class:`CycleStatus`).
     """
 

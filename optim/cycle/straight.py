@@ -4,19 +4,19 @@ Each move of the cycle becomes *line, transfer, line*::
 
     pick ─straight line─▶ above pick ─transfer (joint space, via points)─▶ above place ─straight line─▶ place
 
-The lines are Cartesian (:func:`planning.cartesian_path`, tcp within ``tolerance`` of the
+The lines are Cartesian (:func:`pinarms.planning.cartesian_path`, tcp within ``tolerance`` of the
 vertical segment, on the branch of the cycle's joint via points) and time-optimal
-(:func:`optim.time_optimal` under the joint velocity and acceleration limits, a tool-speed
+(:func:`pinarms.optim.time_optimal` under the joint velocity and acceleration limits, a tool-speed
 limit if given, joint torques with the payload on the move to place and without it on
 the way back when torque limits are asked for, the jerk limit as a smoothed result).
 The transfer is the joint-space
-family of the cycle (``kind``) timed by :func:`optim.minimize_time`, from rest above the
+family of the cycle (``kind``) timed by :func:`pinarms.optim.minimize_time`, from rest above the
 pick to rest above the place. The arm stops at the lift points: a line's tangent and the
 transfer's meet at an angle there. The joint-space cycle of the same spec is timed too
-(:attr:`optim.CycleResult.straight_cost`: against today's cycle, whose moves are smooth
+(:attr:`pinarms.optim.CycleResult.straight_cost`: against today's cycle, whose moves are smooth
 polynomials through the lift points), and each line is also timed as a *joint-space*
 line between the same configurations under the same limits and time scaling
-(:attr:`optim.CycleResult.line_cost`: what the straightness itself costs).
+(:attr:`pinarms.optim.CycleResult.line_cost`: what the straightness itself costs).
 
 Units: m, rad, s.
 """
@@ -37,7 +37,7 @@ from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint, JointVelocityConstraint,
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["StraightMove", "straight_cycle", "approach_cycle"]
 
@@ -47,8 +47,8 @@ class StraightMove:
     """One move with straight approach and retreat: a line, the transfer, a line (at rest between).
 
     Attributes:
-        lines: the two timed lines (:class:`optim.PathTiming`): the lift, then the lowering.
-        transfer: the joint-space transfer (:class:`optim.TimingResult`).
+        lines: the two timed lines (:class:`pinarms.optim.PathTiming`): the lift, then the lowering.
+        transfer: the joint-space transfer (:class:`pinarms.optim.TimingResult`).
         trajectory: the three concatenated.
         joint_lines: (2,) [s] the same two moves as straight lines in *joint* space between the
             same configurations, timed the same way (the reference for :attr:`line_cost`).
@@ -86,12 +86,12 @@ def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "
     Args:
         robot: the robot of ``joint``.
         joint: the joint-space cycle of the same spec (its via points fix the IK branch).
-        kind, method, seed: the transfer's trajectory family and optimiser (as :func:`optim.plan_cycle`).
+        kind, method, seed: the transfer's trajectory family and optimiser (as :func:`pinarms.optim.plan_cycle`).
         tool_speed: tcp speed limit on the lines [m/s] (e.g. 0.5 carrying food), or None.
         tolerance: largest tcp deviation from the vertical lines [m].
-        payload, torque_limits: as :func:`optim.plan_cycle`: the move to place (lines and
+        payload, torque_limits: as :func:`pinarms.optim.plan_cycle`: the move to place (lines and
             transfer) is timed carrying the payload, the move back empty, both under the torque
-            limits (:class:`planning.JointTorqueConstraint` on the lines).
+            limits (:class:`pinarms.planning.JointTorqueConstraint` on the lines).
 
     Raises:
         InvalidLimits: no acceleration limit (a time-optimal line needs one).
@@ -167,7 +167,7 @@ class _Legs:
         return time_optimal(path, self.legs[leg][0], jerk=self.j)
 
     def transfer(self, q_via: np.ndarray, leg: int) -> TimingResult:
-        """The joint-space transfer through ``q_via``, timed by :func:`optim.minimize_time`."""
+        """The joint-space transfer through ``q_via``, timed by :func:`pinarms.optim.minimize_time`."""
         return minimize_time(TimingRequest(q_via, self.kind, self.v, self.a, self.j, method=self.method, seed=self.seed,
                              trajectory_options=self.options, **self.legs[leg][1]))
 
@@ -199,7 +199,7 @@ def _line_deviations(robot: Any, lines: tuple[PathTiming, ...], ends: np.ndarray
 def approach_cycle(request: CycleRequest) -> CycleResult:
     """The cycle of ``request`` ignoring its cell, with the approach it asks for.
 
-    ``"joint"``: the joint-space cycle (:func:`optim.cycle.joint.joint_cycle`); ``"straight"``:
+    ``"joint"``: the joint-space cycle (:func:`pinarms.optim.cycle.joint.joint_cycle`); ``"straight"``:
     that cycle with straight lines at pick and place (:func:`straight_cycle`, on its branch).
     """
     joint = joint_cycle(request)

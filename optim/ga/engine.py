@@ -10,9 +10,9 @@ elites, select parents (tournament or rank + SUS), cross pairs (SBX / arithmetic
 blend, fixed or adaptive pc), mutate (non-uniform / polynomial, fixed or adaptive pm),
 evaluate the children.
 
-:func:`run_ga` takes one :class:`~optim.ga.request.GARequest` (checked when built: bad bounds,
+:func:`run_ga` takes one :class:`~pinarms.optim.ga.request.GARequest` (checked when built: bad bounds,
 settings, seed or budgets raise there) and returns a :class:`GAResult` whose ``stop_reason``
-is a :class:`~optim.ga.request.GAStop` (:mod:`optim.status`).
+is a :class:`~pinarms.optim.ga.request.GAStop` (:mod:`pinarms.optim.status`).
 """
 
 from __future__ import annotations

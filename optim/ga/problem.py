@@ -2,13 +2,13 @@
 
 A :class:`TimingProblem` holds via points (m+1, n_joints), a trajectory family and
 per-joint limits. For durations ``h`` (m,) it builds the trajectory with knot times
-``[0, cumsum(h)]`` through :mod:`planning` and reads its exact peaks. It is the bridge
+``[0, cumsum(h)]`` through :mod:`pinarms.planning` and reads its exact peaks. It is the bridge
 between trajectories and the optimisers: the GA sees only arrays.
 
 A population of durations (P, m) is evaluated in a few numpy calls: planning's batched
 constructor (``piecewise_polynomial_batch``, ``multi_quintic_batch``,
 ``quintic_bspline_batch``) gives the coefficients of all P trajectories from one batched
-solve, and :func:`planning.piece_peaks_batch` peaks every piece of every individual in
+solve, and :func:`pinarms.planning.piece_peaks_batch` peaks every piece of every individual in
 one pass. Single timings go through the same code with P = 1.
 
 Scaling laws used by the exact optimiser and by the final rescaling: with durations
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable, Protocol
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 from pinarms.planning.torque import piece_states
 from pinarms.optim.types import JointLimit
@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 __all__ = ["TimingProblem", "KINDS", "Builder", "BatchBuilder", "check_limit"]
 
-#: Trajectory families known to :func:`optim.minimize_time`.
+#: Trajectory families known to :func:`pinarms.optim.minimize_time`.
 KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
 
 #: Relative margin under the limits kept by rescaled answers (round-off safety).
@@ -55,7 +55,7 @@ class _PeaksLike(Protocol):
 
 
 class _TrajectoryLike(Protocol):
-    """What a custom builder must return (a :class:`planning.Trajectory` does)."""
+    """What a custom builder must return (a :class:`pinarms.planning.Trajectory` does)."""
 
     knot_times: np.ndarray
     coefficients: np.ndarray
@@ -175,7 +175,7 @@ class TimingProblem:
             ``velocities=0`` for multi-quintic rest at every via point).
         builder: Replace the planning constructor (advanced; tests and custom families).
             A custom builder is called once per individual (no batched form).
-        torque: Joint-torque limits of a robot (:class:`planning.JointTorqueConstraint`),
+        torque: Joint-torque limits of a robot (:class:`pinarms.planning.JointTorqueConstraint`),
             checked on a grid per piece beside the exact v/a/jerk peaks, with their own
             scaling law in :meth:`minimal_scale`; None: kinematic limits only.
     """
@@ -290,7 +290,7 @@ class TimingProblem:
         """Exact peaks per polynomial piece, (pop, 3, pieces, n_joints), for durations (pop, m).
 
         The coefficients of all individuals come from :meth:`coefficients_batch`; the exact
-        peak search (:func:`planning.piece_peaks_batch`) then runs once for the whole
+        peak search (:func:`pinarms.planning.piece_peaks_batch`) then runs once for the whole
         population.
         """
         from pinarms import planning

@@ -1,7 +1,7 @@
 """What a GA run is asked: :class:`GARequest`, one frozen object checked when built, and
-:class:`GAStop`, why :func:`optim.run_ga` stopped.
+:class:`GAStop`, why :func:`pinarms.optim.run_ga` stopped.
 
-Statuses and exceptions (:mod:`optim.status`): bad bounds, settings, seed, budgets or initial
+Statuses and exceptions (:mod:`pinarms.optim.status`): bad bounds, settings, seed, budgets or initial
 individuals raise :class:`InvalidSettings` (or :class:`SettingOutOfRange`) when the request is
 built, before any objective is evaluated. A run that ends returns a :class:`GAResult` whose
 ``stop_reason`` is a :class:`GAStop`; whether its best satisfies the constraints is
@@ -124,7 +124,7 @@ class GARequest:
 
     Raises (when built):
         InvalidSettings: bad bounds, settings, seed, budgets or initial individuals (named).
-        SettingOutOfRange: ``max_generations`` beyond :data:`optim.caps.MAX_GENERATIONS`.
+        SettingOutOfRange: ``max_generations`` beyond :data:`pinarms.optim.caps.MAX_GENERATIONS`.
     """
 
     objective: Objective

@@ -30,7 +30,7 @@ CONSTRAINT_HANDLINGS = ("adaptive-penalty", "feasibility-rules")
 
 @dataclass(frozen=True)
 class GASettings:
-    """Configuration of :func:`optim.run_ga` (real coding, minimisation).
+    """Configuration of :func:`pinarms.optim.run_ga` (real coding, minimisation).
 
     Attributes:
         population: Number of individuals (>= 4, even numbers pair up cleanly).

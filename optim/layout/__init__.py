@@ -9,8 +9,28 @@
 
 """
 
-from .search import (FAILURES, CandidateFailure, LayoutRequest, LayoutSearch, LayoutStatus, Refinement, base_to_world,
-                     grid_candidates, points_in_base_frame, random_candidates, search_layout)
+from __future__ import annotations
 
-__all__ = ["FAILURES", "CandidateFailure", "LayoutRequest", "LayoutStatus", "LayoutSearch", "Refinement",
-           "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame", "search_layout"]
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "FAILURES": "pinarms.optim.layout.search",
+    "CandidateFailure": "pinarms.optim.layout.search",
+    "LayoutRequest": "pinarms.optim.layout.search",
+    "LayoutSearch": "pinarms.optim.layout.search",
+    "LayoutStatus": "pinarms.optim.layout.search",
+    "Refinement": "pinarms.optim.layout.search",
+    "base_to_world": "pinarms.optim.layout.search",
+    "grid_candidates": "pinarms.optim.layout.search",
+    "points_in_base_frame": "pinarms.optim.layout.search",
+    "random_candidates": "pinarms.optim.layout.search",
+    "search_layout": "pinarms.optim.layout.search",
+}
+
+__all__ = [
+    "FAILURES", "CandidateFailure", "LayoutRequest", "LayoutStatus", "LayoutSearch", "Refinement",
+    "grid_candidates", "random_candidates", "base_to_world", "points_in_base_frame", "search_layout",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

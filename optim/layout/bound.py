@@ -36,7 +36,7 @@ from pinarms.optim.types import JointLimit, Scheduler
 if TYPE_CHECKING:
     from pinarms.robots.robot import Robot
 
-from .candidates import _PPM_RTOL
+from pinarms.optim.layout.candidates import _PPM_RTOL
 
 __all__: list[str] = []  # search_layout's (bound=True)
 

@@ -1,5 +1,5 @@
 """Candidate base placements of a layout search, and the frames they define (stage 0 of
-:func:`optim.layout.search_layout`): grids, seeded random samples, ``base_to_world`` and the
+:func:`pinarms.optim.layout.search_layout`): grids, seeded random samples, ``base_to_world`` and the
 points moved into each candidate's base frame. Units: m, rad.
 """
 
@@ -15,7 +15,7 @@ from pinarms.optim.types import AxisRange, Placement
 from pinarms.optim.caps import MAX_AXIS_VALUES, MAX_PLACEMENTS, count_setting
 from pinarms.optim.errors import SettingOutOfRange
 from pinarms.optim.status import Status
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["CandidateFailure", "FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world",
            "points_in_base_frame"]

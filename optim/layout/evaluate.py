@@ -1,5 +1,5 @@
 """Evaluating one candidate placement of a layout search (stages 2 and 4 of
-:func:`optim.layout.search_layout`): the settings a search passes to its tasks, the cycle
+:func:`pinarms.optim.layout.search_layout`): the settings a search passes to its tasks, the cycle
 plans of every (pick, place) pair, the failure classes, and the Nelder-Mead refinement of one
 start. Every task is a pure function of its inputs (the execution layer may run it anywhere).
 """
@@ -13,9 +13,9 @@ import numpy as np
 
 from pinarms.optim.cycle import CellSettings, CycleRequest, CycleTiming, PickPlace, plan_cycle
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.robots.errors import LimitViolation, PinarmsError, UnreachableTarget
+from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
-from .candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
+from pinarms.optim.layout.candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
 
 __all__: list[str] = []  # the tasks of a search (private: search_layout runs them)
 

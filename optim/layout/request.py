@@ -1,8 +1,8 @@
 """What a layout search is asked: :class:`LayoutRequest`, one frozen object checked when built,
-and :class:`LayoutStatus`, what :func:`optim.layout.search_layout` found.
+and :class:`LayoutStatus`, what :func:`pinarms.optim.layout.search_layout` found.
 
-Statuses and exceptions (:mod:`optim.status`): a malformed request (points, candidates,
-orientation, counts beyond :mod:`optim.caps`, an unknown cycle kind, an arm or fixture the cell
+Statuses and exceptions (:mod:`pinarms.optim.status`): a malformed request (points, candidates,
+orientation, counts beyond :mod:`pinarms.optim.caps`, an unknown cycle kind, an arm or fixture the cell
 does not have) raises when the request is built, before any work; a search that runs but finds
 no placement able to run the cycle is a :class:`LayoutSearch` with status
 :attr:`LayoutStatus.NO_PLACEMENT` and a ``status_reason`` counting the failures.
@@ -21,7 +21,7 @@ from pinarms.optim.caps import (MAX_CLEARANCE, MAX_PLACEMENTS, MAX_POINT_PAIRS, 
 from pinarms.optim.cycle import CYCLE_KINDS, PickPlace
 from pinarms.optim.errors import InvalidSettings, SettingOutOfRange
 from pinarms.optim.status import Status
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.robots.cell import Cell
@@ -61,22 +61,22 @@ class LayoutRequest:
     """A layout search: which arm, which points, which placements, which cycle.
 
     Attributes:
-        robot: a :class:`robots.Robot` (the arm to place), or a :class:`robots.cell.Cell`:
+        robot: a :class:`pinarms.robots.Robot` (the arm to place), or a :class:`pinarms.robots.cell.Cell`:
             then the arm ``arm`` of the cell (its only arm by default) is moved among the
             cell's fixtures (the line frame is the cell's world; :meth:`Cell.with_arm_base`,
             the fixtures named in ``carry``, e.g. its stand, move with it) and every cycle
             must keep ``clearance`` [m] from the fixtures and the other arms
-            (:func:`optim.plan_cycle` with a cell: re-planned with a higher lift or via
+            (:func:`pinarms.optim.plan_cycle` with a cell: re-planned with a higher lift or via
             points when needed); a candidate whose cycle cannot clear fails as ``"collision"``.
             ``screen``: each re-planning attempt is first screened by exact distances at its
-            via points and a few timed states (:class:`optim.CellSettings`; proofs of failure
+            via points and a few timed states (:class:`pinarms.optim.CellSettings`; proofs of failure
             only, so the same verdicts; ``False``: every attempt timed and checked in full).
         picks, places: points ``(3,)`` or ``(N, 3)`` in the line frame [m]; every pick is
             paired with every place (stored as ``(P, 3)``, ``(Q, 3)`` float arrays).
         candidates: placements ``(M, 4)`` ``(x, y, z, yaw)`` of the base in the line frame
             [m, rad] (:func:`grid_candidates`, :func:`random_candidates`).
-        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`optim.PickPlace` and
-            :func:`optim.plan_cycle`); limits per joint (scalar or ``(nq,)``), None: the
+        lift, dwell, kind, vmax, amax, jmax: the cycle (see :class:`pinarms.optim.PickPlace` and
+            :func:`pinarms.optim.plan_cycle`); limits per joint (scalar or ``(nq,)``), None: the
             robot's (``vmax``) or none (``amax``, ``jmax``).
         orientation: tool orientation ``(3, 3)`` in the line frame at the points; default
             the robot's (tool down for six-axis arms), in its base frame.
@@ -89,7 +89,7 @@ class LayoutRequest:
         seed: seed of the workspace samples and of the timing optimiser (results repeat).
         chunk_size: candidates per task (a task plans ``chunk_size × pairs`` cycles, ~0.5 s each
             for a six-axis arm).
-        bound: branch and bound (:mod:`optim.layout.bound`): the candidates are planned in
+        bound: branch and bound (:mod:`pinarms.optim.layout.bound`): the candidates are planned in
             increasing order of a proven lower bound of their cycle time, and those that cannot
             reach the first ``max(1, refine)`` places of the ranking are not planned (they fail
             as ``"outranked"``): the best placement, the refinement starts and every planned

@@ -12,8 +12,8 @@ import numpy as np
 
 from pinarms.optim.cycle import CycleResult
 
-from .candidates import FAILURES, CandidateFailure
-from .request import LayoutStatus
+from pinarms.optim.layout.candidates import FAILURES, CandidateFailure
+from pinarms.optim.layout.request import LayoutStatus
 
 __all__ = ["LayoutSearch", "Refinement"]
 
@@ -67,10 +67,10 @@ class LayoutSearch:
         refinement: the continuous improvement, or ``None``.
         best_placement: ``(4,)`` the best placement found (refined when that gained), or None.
         best_picks_per_minute: its picks/min (0 if no candidate succeeded).
-        best_cycle: its first pair's cycle (:class:`optim.CycleResult`, in the base frame), or None.
+        best_cycle: its first pair's cycle (:class:`pinarms.optim.CycleResult`, in the base frame), or None.
         seed: seed of the search (optimiser starts; random candidates are drawn by the caller).
         lower_bound: ``(M,)`` each candidate's proven lower bound of its cycle time [s] with
-            ``bound=True`` (:mod:`optim.layout.bound`; 0 where none), else None.
+            ``bound=True`` (:mod:`pinarms.optim.layout.bound`; 0 where none), else None.
         seconds: the search's phases (``"screen"``, ``"cycles"``, ``"refine"``, ``"best"``: the
             best placement's cycle planned again with its report) as ``(wall, CPU)`` seconds; the
             CPU is this process's (a cluster's workers are not counted).

@@ -10,7 +10,7 @@ candidate base placements ``(x, y, z, yaw)`` of the arm's base frame in the line
    batched closed-form IK over all candidates: a candidate with a point beyond reach is
    ``"unreachable"``, one whose point is within reach but needs a joint outside its limits
    is ``"joint limit"`` (both named with the point);
-2. plans the time-optimal cycle (:func:`optim.plan_cycle`, ``method="exact"``) of every
+2. plans the time-optimal cycle (:func:`pinarms.optim.plan_cycle`, ``method="exact"``) of every
    (pick, place) pair: IK branch, moves, dwells; ``picks_per_minute = 60 / mean cycle time``
    over the pairs (a line cycling through them); a failing plan is classified the same way
    (``"timing"`` when no timing meets the limits); with ``bound=True`` in increasing order of a
@@ -30,7 +30,7 @@ The cycles run through :func:`pinarms.execution.map_chunks` (``scheduler``: seri
 processes or a Dask cluster): results are identical whoever runs them (the plans are
 deterministic and every task is a pure function of its candidates).
 
-One input, one result (:mod:`optim.status`): :func:`search_layout` takes a
+One input, one result (:mod:`pinarms.optim.status`): :func:`search_layout` takes a
 :class:`LayoutRequest` (checked when built: bad input raises there, naming the field) and
 returns a :class:`LayoutSearch` whose ``status`` is :attr:`LayoutStatus.FOUND` or, when every
 candidate failed, :attr:`LayoutStatus.NO_PLACEMENT` with a ``status_reason``; per candidate,
@@ -45,12 +45,12 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .candidates import (_PPM_RTOL, AXES, FAILURES, CandidateFailure, _rot_z, base_to_world, grid_candidates,
+from pinarms.optim.layout.candidates import (_PPM_RTOL, AXES, FAILURES, CandidateFailure, _rot_z, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
-from .evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
+from pinarms.optim.layout.evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
                        _Settings)
-from .request import LayoutRequest, LayoutStatus, is_cell
-from .result import LayoutSearch, Refinement
+from pinarms.optim.layout.request import LayoutRequest, LayoutStatus, is_cell
+from pinarms.optim.layout.result import LayoutSearch, Refinement
 
 if TYPE_CHECKING:
     from pinarms.execution import Scheduler
@@ -137,9 +137,9 @@ def _cell_recipe(request: LayoutRequest, token: str) -> "_CellRecipe | None":
     if not is_cell(request.robot):
         return None
     cell = request.robot
-    recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell._base_dir),
-                         tuple(sorted((k, str(v)) for k, v in cell._packages.items())),
-                         tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell._seed), str(request.arm),
+    recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell.base_dir),
+                         tuple(sorted((k, str(v)) for k, v in cell.packages.items())),
+                         tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell.seed), str(request.arm),
                          tuple(request.carry), float(request.clearance), tuple(cell.arm_placements))
     _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
     return recipe
@@ -177,7 +177,7 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
     """
     from pinarms.execution import map_chunks
 
-    from .bound import SLACK, outranked, threshold, wave_size
+    from pinarms.optim.layout.bound import SLACK, outranked, threshold, wave_size
 
     M = cand.shape[0]
     todo = [m for m in range(M) if not failure[m]]
@@ -256,7 +256,7 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
 
 def _lower_bounds(robot: Any, st: _Settings, targets: np.ndarray | None, M: int) -> np.ndarray:
     """Each candidate's lower bound of its cycle time [s] (:mod:`.bound`; 0 without a closed form)."""
-    from .bound import cycle_lower_bounds
+    from pinarms.optim.layout.bound import cycle_lower_bounds
 
     if targets is None:
         return np.zeros(M)

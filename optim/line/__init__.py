@@ -15,32 +15,69 @@
 - :mod:`~.schedule` keeps the time offsets of several arms cycling together (:func:`schedule_line`).
 """
 
-from pinarms.optim.line.api import (LineCurve, LineResult, LineSpec, LineStatus, Stream, build_maps, line_curve,
-                                    run_line)
-from pinarms.optim.line.belt import Belt, PlaceBox
-from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
-from pinarms.optim.line.items import ItemType, Items, poisson_items, read_arrivals, regular_items
-from pinarms.optim.line.report import LineFigures, summarise
-from pinarms.optim.line.rules import RULES, AssignmentRule, Rule
-from pinarms.optim.line.schedule import LineSchedule, schedule_line
-from pinarms.optim.line.simulate import SimArm, SimResult, simulate
-from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.task_map_build import build_task_map, measure_yaw
-from pinarms.optim.line.task_map_error import MapError, map_error
-from pinarms.optim.line.task_maps import TaskMap
-from pinarms.optim.line.tracking import PickPlan, TrackingSpec, plan_pick
-from pinarms.optim.line.tray_maps import TrayMap, build_tray_map, tray_map_error
-from pinarms.optim.line.tray_sim import SimPlace
-from pinarms.optim.line.trays import TrayBelt, TrayPickPlan, plan_pick_to_tray, trays_beside
-from pinarms.optim.line.windows import PickWindow, check_reach
+from __future__ import annotations
+
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "LineCurve": "pinarms.optim.line.api",
+    "LineResult": "pinarms.optim.line.api",
+    "LineSpec": "pinarms.optim.line.api",
+    "LineStatus": "pinarms.optim.line.api",
+    "Stream": "pinarms.optim.line.api",
+    "build_maps": "pinarms.optim.line.api",
+    "line_curve": "pinarms.optim.line.api",
+    "run_line": "pinarms.optim.line.api",
+    "Belt": "pinarms.optim.line.belt",
+    "PlaceBox": "pinarms.optim.line.belt",
+    "ArrivalsFileError": "pinarms.optim.line.errors",
+    "BeltOutOfReach": "pinarms.optim.line.errors",
+    "ItemType": "pinarms.optim.line.items",
+    "Items": "pinarms.optim.line.items",
+    "poisson_items": "pinarms.optim.line.items",
+    "read_arrivals": "pinarms.optim.line.items",
+    "regular_items": "pinarms.optim.line.items",
+    "LineFigures": "pinarms.optim.line.report",
+    "summarise": "pinarms.optim.line.report",
+    "RULES": "pinarms.optim.line.rules",
+    "AssignmentRule": "pinarms.optim.line.rules",
+    "Rule": "pinarms.optim.line.rules",
+    "LineSchedule": "pinarms.optim.line.schedule",
+    "schedule_line": "pinarms.optim.line.schedule",
+    "SimArm": "pinarms.optim.line.simulate",
+    "SimResult": "pinarms.optim.line.simulate",
+    "simulate": "pinarms.optim.line.simulate",
+    "Station": "pinarms.optim.line.station",
+    "base_pose": "pinarms.optim.line.station",
+    "build_task_map": "pinarms.optim.line.task_map_build",
+    "measure_yaw": "pinarms.optim.line.task_map_build",
+    "MapError": "pinarms.optim.line.task_map_error",
+    "map_error": "pinarms.optim.line.task_map_error",
+    "TaskMap": "pinarms.optim.line.task_maps",
+    "PickPlan": "pinarms.optim.line.tracking",
+    "TrackingSpec": "pinarms.optim.line.tracking",
+    "plan_pick": "pinarms.optim.line.tracking",
+    "TrayMap": "pinarms.optim.line.tray_maps",
+    "build_tray_map": "pinarms.optim.line.tray_maps",
+    "tray_map_error": "pinarms.optim.line.tray_maps",
+    "SimPlace": "pinarms.optim.line.tray_sim",
+    "TrayBelt": "pinarms.optim.line.trays",
+    "TrayPickPlan": "pinarms.optim.line.trays",
+    "plan_pick_to_tray": "pinarms.optim.line.trays",
+    "trays_beside": "pinarms.optim.line.trays",
+    "PickWindow": "pinarms.optim.line.windows",
+    "check_reach": "pinarms.optim.line.windows",
+}
 
 __all__ = [
-    "LineSchedule", "schedule_line",
-    "Belt", "PlaceBox", "ItemType", "Items", "poisson_items", "regular_items", "read_arrivals",
-    "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick", "PickWindow", "check_reach",
-    "TaskMap", "build_task_map", "measure_yaw", "map_error", "MapError", "Rule", "RULES", "AssignmentRule",
-    "SimArm", "SimResult", "simulate",
-    "LineFigures", "summarise", "Stream", "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
-    "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray",
-    "TrayMap", "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
+    "LineSchedule", "schedule_line", "Belt", "PlaceBox", "ItemType", "Items", "poisson_items",
+    "regular_items", "read_arrivals", "Station", "base_pose", "TrackingSpec", "PickPlan", "plan_pick",
+    "PickWindow", "check_reach", "TaskMap", "build_task_map", "measure_yaw", "map_error", "MapError", "Rule",
+    "RULES", "AssignmentRule", "SimArm", "SimResult", "simulate", "LineFigures", "summarise", "Stream",
+    "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
+    "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "TrayMap",
+    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

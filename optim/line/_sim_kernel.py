@@ -1,12 +1,12 @@
 """The line simulator's event loop compiled (numba): the same decisions, in the same order, the same bits.
 
-:func:`run_events` is the loop of :mod:`optim.line.sim_loop` for the built-in rules
-(:class:`~optim.line.rules.base.KernelForm`) without a neighbour guard or trays: the arms' next
+:func:`run_events` is the loop of :mod:`pinarms.optim.line.sim_loop` for the built-in rules
+(:class:`~pinarms.optim.line.rules.base.KernelForm`) without a neighbour guard or trays: the arms' next
 events (one per arm at most, so the earliest of an array is the heap's top, ties to the upstream
 arm), each decision's window of items (binary searches on the arrival times), the intercepts of the
 items left in it, scalar by scalar in the order numpy evaluates them in
-:meth:`~optim.line.sim_arm.ArmState.intercept`, the rule's choice, and the pick. The look-ahead's
-branch and bound (:func:`~optim.line.rules.lookahead.best_sequence`) runs here depth first with
+:meth:`~pinarms.optim.line.sim_arm.ArmState.intercept`, the rule's choice, and the pick. The look-ahead's
+branch and bound (:func:`~pinarms.optim.line.rules.lookahead.best_sequence`) runs here depth first with
 an explicit stack, trying the items in the same order.
 
 Arrays: ``t0``, ``w`` (n,) the items; per arm ``a`` (upstream first): ``group[a]`` its rows in
@@ -113,7 +113,7 @@ def intercept(t, i, a, g, t0, speed, U, RA, RC, EX, out):
 @jit_inline
 def best_first(ready, pool, a, g, t0, speed, U, RA, RC, EX):
     """Position in ``pool`` of the first item of the best order (most picks, then earliest end), -1
-    when no item can be picked: :func:`~optim.line.rules.lookahead.best_sequence`, depth first."""
+    when no item can be picked: :func:`~pinarms.optim.line.rules.lookahead.best_sequence`, depth first."""
     P = pool.size
     used = np.zeros(P, dtype=np.bool_)
     seq = np.empty(P + 1, dtype=np.int64)
@@ -268,7 +268,7 @@ def run_events(t0, w, speed, width, group, RA, RC, EX, U, u_min, u_max, max_tA, 
 
 @jit
 def cell_rows(w, sel, g, ends, tA, tC):
-    """Rows ``sel`` of ``tA``, ``tC`` (n, K) for items at ``w[sel]``: :meth:`~optim.line.map_rows.CellRows.rows`
+    """Rows ``sel`` of ``tA``, ``tC`` (n, K) for items at ``w[sel]``: :meth:`~pinarms.optim.line.map_rows.CellRows.rows`
     item by item (the cell ``j`` and place ``f`` of numpy's ``searchsorted`` and division, then
     ``T_j · (1 − f) + T_j+1 · f`` per node; NaN off the grid)."""
     nc, K = ends.shape[1], ends.shape[2]

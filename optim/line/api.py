@@ -7,7 +7,7 @@ shape: stations that differ only by their place along the belt share them), simu
 seed on the execution layer (serial by default, a Dask cluster by address; same results
 either way) and returns a :class:`LineResult` with a status and the figures.
 
-Statuses and exceptions (:mod:`optim.status`): a malformed :class:`LineSpec` raises when it is
+Statuses and exceptions (:mod:`pinarms.optim.status`): a malformed :class:`LineSpec` raises when it is
 built; a line that runs but misses more items than ``target_miss_rate`` is a result with
 ``status`` :attr:`LineStatus.MISSES_ABOVE_TARGET` and a ``status_reason``.
 """
@@ -35,7 +35,7 @@ from pinarms.optim.line.tracking import TrackingSpec, can_yaw
 from pinarms.optim.line.trays import TrayBelt
 from pinarms.optim.line.windows import PickWindow, window_of, windows_overlap
 from pinarms.optim.status import Status
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "map_warnings", "sim_arms", "LineStatus",
            "LineCurve", "line_curve", "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
@@ -92,7 +92,7 @@ class Stream:
 @dataclass(frozen=True, eq=False)
 class LineSpec:
     """A line (module doc). ``target_miss_rate``: the miss rate asked for (fraction);
-    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`robots.cell.Cell` whose arms
+    ``map_grid``: (nu, nw) of the task maps; ``cell``: a :class:`pinarms.robots.cell.Cell` whose arms
     are the stations (same names and bases) — then neighbours whose windows overlap start a pick
     only when the cell's continuous check proves it keeps ``clearance`` [m] from the neighbour's
     (:mod:`~.neighbours`; the seeds then run in this process), and every map node whose planned pick

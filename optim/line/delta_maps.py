@@ -31,7 +31,7 @@ from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.robots.delta import inverse_position
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["build_delta_map", "delta_span", "yaw_layers", "delta_map_error"]
 

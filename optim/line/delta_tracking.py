@@ -1,6 +1,6 @@
 """A delta robot above the belt: conveyor tracking timed in its actuated space.
 
-A delta (:mod:`pinarms.robots.delta`) is not a serial :class:`robots.Robot`: its line picks are
+A delta (:mod:`pinarms.robots.delta`) is not a serial :class:`pinarms.robots.Robot`: its line picks are
 timed here, from its closed form and closed-chain dynamics, and stored in the same
 :class:`~.task_maps.TaskMap` the simulator reads (:mod:`~.delta_maps`).
 
@@ -10,7 +10,7 @@ A pick is the serial arm's rendezvous (:mod:`~.tracking`), on the platform:
   *moving with the belt*: the platform centre's path a cubic Hermite in space whose start tangent is
   the chord and end tangent the belt's direction; its motor angles from the closed-form IK
   (primary branch), timed by the project's TOPP-RA under the three motors' speed, acceleration and
-  torque limits (closed-chain torques, :func:`optim.standard_cycle.delta_path_rows`) with the path
+  torque limits (closed-chain torques, :func:`pinarms.optim.standard_cycle.delta_path_rows`) with the path
   speed at the end fixed to the belt's;
 - **tracking**: the item's path plus a vertical quintic down and up (``descend`` s each, ``grasp``
   s between), checked at 41 instants against the motor range, speed and acceleration (finite

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["BeltOutOfReach", "ArrivalsFileError", "TaskMapError"]
 

@@ -3,15 +3,15 @@
 A pick is a timed joint trajectory (:attr:`~.tracking.PickPlan.trajectory`: approach, tracking
 dwell, lift, leave or transfer, place, return). Two routes prove it keeps a clearance ``c``:
 
-- **fast** (:func:`optim.motion.fast_check`, compiled, on the sphere cover): the trajectory is
+- **fast** (:func:`pinarms.optim.motion.fast_check`, compiled, on the sphere cover): the trajectory is
   sampled at its knots and on a uniform time grid of step ``h``; between two samples each joint
   leaves its chord by at most ``a_j h² / 8`` (``a_j`` its exact acceleration peak, the samples
   including every knot so that each interval is one polynomial piece), so every point of the arm
   stays within ``Σ_j ℓ_j a_j h² / 8 ≤ chord`` of the polyline's (``ℓ_j`` the joint levers of the
   checker). The polyline proven at ``c + chord`` proves the trajectory at ``c``.
 - **exact** where the fast route does not prove (or the cover is not tight for the cell):
-  :meth:`optim.motion.MotionChecker.trajectory_valid` (one arm against the fixtures) or
-  :meth:`robots.cell.Cell.check_motion` (two arms), continuous in time (coal where the cover
+  :meth:`pinarms.optim.motion.MotionChecker.trajectory_valid` (one arm against the fixtures) or
+  :meth:`pinarms.robots.cell.Cell.check_motion` (two arms), continuous in time (coal where the cover
   is inconclusive).
 
 :class:`FixtureCheck` holds one arm against the fixtures (``cell.with_pairs("arm-fixture")``);
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["FixtureCheck", "PairCheck", "CHORD", "chord_polyline", "fixture_check", "check_in_cell"]
 
@@ -134,7 +134,7 @@ _CHECKS: dict = {}
 
 def check_in_cell(cell: Any, station: Any) -> None:
     """InvalidInput unless ``station`` is an arm of ``cell`` (same name, same base)."""
-    from pinarms.robots.errors import PinarmsError
+    from pinarms.errors import PinarmsError
 
     try:
         arm = cell.arm(station.name)
@@ -175,7 +175,7 @@ class PairCheck:
         self.counts = {"fast": 0, "exact": 0, "blocked": 0}
 
     def clear(self, motions: list, window: tuple[float, float], margin: float) -> bool:
-        """``motions``: the two arms' :class:`robots.cell.ArmMotion` (in the order of ``arms``);
+        """``motions``: the two arms' :class:`pinarms.robots.cell.ArmMotion` (in the order of ``arms``);
         proven over cell times ``window``; ``margin`` [m]: the exact check's time step. The window is
         cut into slices of at most :data:`SLICE` s: those the fast route proves are clear, the others go
         to the exact check one by one (the first not clear ends it)."""

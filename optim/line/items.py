@@ -27,7 +27,7 @@ import numpy as np
 from pinarms.files import read_bounded
 from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.errors import ArrivalsFileError
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["ItemType", "Items", "poisson_items", "regular_items", "read_arrivals", "MAX_ITEMS", "MAX_FILE_BYTES",
            "MAX_FIELD_CHARS"]

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 
 __all__ = ["CellRows", "map_rows", "CHECKED_ITEMS", "ROWS_CHUNK"]
 

@@ -1,11 +1,11 @@
 """Neighbouring arms whose windows overlap: their picks proven clear by the cell's continuous check.
 
-:class:`NeighbourGuard` is the ``guard`` of :func:`optim.line.simulate.simulate`. For two picks
+:class:`NeighbourGuard` is the ``guard`` of :func:`pinarms.optim.line.simulate.simulate`. For two picks
 (one starting now, one under way at a neighbour) it plans both exactly
-(:func:`optim.line.tracking.plan_pick`, cached per arm and item), places each on the cell's
+(:func:`pinarms.optim.line.tracking.plan_pick`, cached per arm and item), places each on the cell's
 clock so that its rendezvous is at the simulated rendezvous time, and proves them over the time
 both move at the clearance asked (arm–arm and arm–fixture pairs, continuously in time): the compiled
-cover check (:func:`optim.motion.fast_check`) where it proves, :meth:`robots.cell.Cell.check_motion`
+cover check (:func:`pinarms.optim.motion.fast_check`) where it proves, :meth:`pinarms.robots.cell.Cell.check_motion`
 otherwise (:class:`~.fixtures.PairCheck`). The stations must be arms of the cell (same
 names, same bases). A pick that exact planning cannot make (near the edge of the window, where
 the map interpolates feasibility) is not proven clear: the guard says no.
@@ -22,7 +22,7 @@ from pinarms.optim.line.items import ItemType
 from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
 __all__ = ["NeighbourGuard"]
 

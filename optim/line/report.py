@@ -14,7 +14,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from pinarms.optim.line.simulate import SimResult
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["LineFigures", "summarise", "confidence_interval"]
 

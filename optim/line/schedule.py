@@ -1,9 +1,9 @@
 """Several arms of one cell cycling together: time offsets that never collide, the line's rate.
 
-Every arm repeats its own pick-and-place cycle (:func:`optim.plan_cycle`) with the line's
+Every arm repeats its own pick-and-place cycle (:func:`pinarms.optim.plan_cycle`) with the line's
 period ``T`` (the longest cycle; a faster arm waits at its pick until the next period).
 The first arm starts at 0; each next arm's start (its *offset*) is scanned over ``[0, T)``
-and every offset is checked with :meth:`robots.cell.Cell.check_motion` over one period of
+and every offset is checked with :meth:`pinarms.robots.cell.Cell.check_motion` over one period of
 the periodic motion (all arms moving at once, continuously in time). The offset kept is
 the **centre of the widest run of clear offsets** (the most tolerant of timing jitter; a
 scanned offset, the lower middle one of an even run), lowest offset on ties. When no offset clears, the line slows down: ``T`` grows by 10 % of
@@ -28,7 +28,7 @@ import numpy as np
 from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting,
                                number_setting)
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["LineSchedule", "schedule_line"]
 
@@ -161,14 +161,14 @@ def schedule_line(
             order is the order offsets are chosen in.
         clearance: distance every pair must keep [m] (0: no contact).
         margin: resolution of the continuous checks [m].
-        n_offsets: offsets scanned per arm and period (2 to :data:`optim.caps.MAX_OFFSETS`).
+        n_offsets: offsets scanned per arm and period (2 to :data:`pinarms.optim.caps.MAX_OFFSETS`).
         hold: cell configuration of the arms without a cycle (default :attr:`Cell.hold`).
         progress: optional callable ``progress(done, total)`` (for a progress bar).
 
     Raises:
         InvalidInput: fewer than two arms, an unknown arm, a cycle of the wrong width;
             ``SettingOutOfRange`` (an ``InvalidInput``): ``n_offsets``, ``clearance``, ``margin``
-            or a cycle time outside its cap (:mod:`optim.caps`).
+            or a cycle time outside its cap (:mod:`pinarms.optim.caps`).
         InfeasibleProblem: no offset clears even at twice the longest cycle.
     """
     from pinarms.robots.cell import ArmMotion

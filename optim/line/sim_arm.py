@@ -1,6 +1,6 @@
 """An arm as the line simulation sees it: its description and its pick times along the belt.
 
-:class:`SimArm` is what :func:`optim.line.simulate.simulate` is given for each arm (its base
+:class:`SimArm` is what :func:`pinarms.optim.line.simulate.simulate` is given for each arm (its base
 on the belt, one task map per item type, its rest point, its tray place). :class:`ArmState`
 is that arm during a run: its task maps read on one grid of pre-grasp points for every item
 of the stream, and :meth:`ArmState.intercept`, the earliest reachable intercept of items by
@@ -18,7 +18,7 @@ import numpy as np
 from pinarms.optim.line.items import Items
 from pinarms.optim.line.map_rows import map_rows
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SimArm", "ArmState", "ItemRows", "Intercepts", "item_rows", "arm_states", "sim_grid"]
 

@@ -2,7 +2,7 @@
 
 Arms sharing their maps share their rows (:class:`~.sim_arm.ItemRows`): the kernel gets one table
 per distinct set of maps (padded with infeasible nodes to the longest grid) and each arm's index
-into it. numba is imported here, on the first compiled run, not with :mod:`optim.line`.
+into it. numba is imported here, on the first compiled run, not with :mod:`pinarms.optim.line`.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 :func:`run_events` processes the arms' events in time order (ties: upstream arm first); at each,
 :func:`decide` shows the arm its candidates and starts the pick its rule prefers (module doc of
-:mod:`optim.line.simulate`). The run's state is named: :class:`Run` (what the loop changes),
+:mod:`pinarms.optim.line.simulate`). The run's state is named: :class:`Run` (what the loop changes),
 :class:`Pick` (a pick as the neighbour guard sees it), :class:`Ongoing` (an arm's pick under way),
 :class:`Columns` (what happened to each item), :class:`TrayState` (slots and places, for arms that
 place in trays). The compiled loop (:mod:`~._sim_kernel`) gives the same runs for the built-in
@@ -111,7 +111,7 @@ class Run:
 
 def run_events(arms: Sequence[SimArm], states: Sequence[ArmState], items: Items, speed: float,
                rule: AssignmentRule, width: float, guard: Any) -> Run:
-    """Run the line (:func:`optim.line.simulate.simulate`) and return its final :class:`Run`."""
+    """Run the line (:func:`pinarms.optim.line.simulate.simulate`) and return its final :class:`Run`."""
     n = len(items)
     run = Run(arms, states, items, speed, rule, width, guard, Columns.empty(n), TrayState.empty(n),
               np.zeros(n, dtype=bool), _overlapping(states) if guard else {}, [None] * len(arms))

@@ -11,7 +11,7 @@ downstream), the first ``u`` where ``t + t_A(u) ≤ t0 + u / v`` (the arm, leavi
 ``u`` no later than the item), refined linearly between grid points; the arm leaves at
 ``start = t0 + u/v − t_A(u) ≥ t`` so that it meets the item exactly (:class:`~.sim_arm.ArmState`).
 Items whose start is ``t`` can be started now; the rule (an :class:`~.rules.AssignmentRule` object,
-:mod:`optim.line.rules`: its ``prefer`` orders the candidates) picks one, or, when only later starts
+:mod:`pinarms.optim.line.rules`: its ``prefer`` orders the candidates) picks one, or, when only later starts
 exist, the arm sleeps until the earliest its rule prefers. An item that no arm takes is **missed**
 (it leaves the last window).
 
@@ -19,7 +19,7 @@ Two loops run this: :mod:`~.sim_loop` in Python (any rule object, the guard, tra
 :mod:`~._sim_kernel` compiled (the built-in rules without guard or trays, a few microseconds a
 decision); they give the same runs (``tests/optim/line/test_simulate_recorded.py``).
 
-Neighbouring arms whose windows overlap: with a ``guard`` (:class:`optim.line.neighbours.NeighbourGuard`:
+Neighbouring arms whose windows overlap: with a ``guard`` (:class:`pinarms.optim.line.neighbours.NeighbourGuard`:
 exact picks through the cell's continuous check at the clearance), an arm starts a pick only when
 it is proven clear of every ongoing pick of such a neighbour; otherwise it tries its rule's next
 choice, or waits until that neighbour's pick ends. Each guarded pair is counted in
@@ -43,7 +43,7 @@ from pinarms.optim.line.rules import AssignmentRule, Rule, assignment_rule
 from pinarms.optim.line.rules.base import EPS
 from pinarms.optim.line.sim_arm import SimArm, arm_states
 from pinarms.optim.line.sim_loop import NO_TRAY, Columns, run_events
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SimArm", "SimResult", "simulate", "EPS", "NO_TRAY"]
 

@@ -1,6 +1,6 @@
 """Sizing a line: the fewest arms, their places along the belt and the belt speed for a flow.
 
-For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`optim.run_ga`) searches the
+For ``n = n_min, n_min + 1, …`` arms the project's GA (:func:`pinarms.optim.run_ga`) searches the
 gaps between neighbouring arms (each in ``[min_gap, max_gap]`` m) and the belt speed (one of
 the given speeds, a gene rounded to the nearest) for the lowest mean miss rate over the
 seeds (Monte Carlo: every individual of a generation is one task on the execution layer,
@@ -11,7 +11,7 @@ line misses no more than asked is the answer, with its positions and speed.
 ``n_min`` defaults to the flow over one saturated arm's rate. The maps (one per belt speed)
 are built once: moving an arm along the belt keeps its map valid (:mod:`~.task_maps`).
 
-One input, one result (:mod:`optim.status`): :func:`size_line` takes a :class:`SizingProblem`
+One input, one result (:mod:`pinarms.optim.status`): :func:`size_line` takes a :class:`SizingProblem`
 (checked when built: bad maps, gaps, counts raise ``InvalidInput`` naming the field) and
 returns a :class:`SizingResult` whose ``status`` is :attr:`SizingStatus.OK` or, when no
 ``n <= max_arms`` meets the miss rate, :attr:`SizingStatus.NOT_FOUND` with a ``status_reason``.
@@ -33,11 +33,11 @@ from pinarms.optim.line.rules import Rule
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.status import Status
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SizingProblem", "SizingResult", "SizingStatus", "size_line", "evaluate_layouts"]
 
-#: Most arms a sizing tries (as many as one line may hold, :data:`optim.line.api.MAX_LINE_ARMS`).
+#: Most arms a sizing tries (as many as one line may hold, :data:`pinarms.optim.line.api.MAX_LINE_ARMS`).
 MAX_SIZING_ARMS = 64
 
 
@@ -62,7 +62,7 @@ class SizingProblem:
     same ``min_gap`` along the belt (no arms facing each other: no neighbour check needed).
 
     The search: ``n_min`` arms first (None: the flow over one saturated arm's rate), then one
-    more up to ``max_arms``; for each, the GA (:func:`optim.run_ga`) with ``population``
+    more up to ``max_arms``; for each, the GA (:func:`pinarms.optim.run_ga`) with ``population``
     individuals over ``generations`` generations, seeded ``seed + n``."""
 
     maps: dict

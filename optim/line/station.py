@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.line.belt import PlaceBox
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["Station", "ACCELERATION_FACTOR", "base_pose"]
 
@@ -38,7 +38,7 @@ class Station:
 
     Attributes:
         name: the arm's name (named in errors and reports).
-        robot: a :class:`robots.Robot` (``robots.load(...)``).
+        robot: a :class:`pinarms.robots.Robot` (``robots.load(...)``).
         base_to_world: (4, 4) pose of its base in the world frame (z up).
         place: the :class:`PlaceBox` it releases items into (world frame).
         vmax, amax: joint velocity [rad/s or m/s] and acceleration limits (nq,) (None: defaults).

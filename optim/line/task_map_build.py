@@ -27,7 +27,7 @@ from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["build_task_map", "measure_yaw", "YAW_MODES", "PROBE_COLUMNS", "PROBE_YAWS"]
 
@@ -230,7 +230,7 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     ``yaw_refine`` (passes that add yaw nodes where the time bends along yaw): the item's yaw
     (module doc). ``progress(done, total)``: picks columns planned so far (the total grows as the
     yaw measure and the refinement add columns).
-    ``cell``: a :class:`robots.cell.Cell` with the station as one of its arms (same name and base):
+    ``cell``: a :class:`pinarms.robots.cell.Cell` with the station as one of its arms (same name and base):
     a node whose planned pick (the whole trajectory) comes closer than ``clearance`` [m] to the
     cell's fixtures is infeasible (:mod:`~.fixtures`; counted in ``TaskMap.fixture_infeasible``).
 

@@ -19,7 +19,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick, rest_configuration, tool_yaw
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
 __all__ = ["MapError", "map_error", "MAP_ERROR_TARGET"]
 

@@ -1,6 +1,6 @@
 """Per-arm task-time maps: pick times over the belt, built once from exact planning, interpolated.
 
-Planning a pick exactly (:func:`optim.line.tracking.plan_pick`: IK of the tracking segment and
+Planning a pick exactly (:func:`pinarms.optim.line.tracking.plan_pick`: IK of the tracking segment and
 two time-optimal moves) takes about 0.2 s; a simulation asks for millions. A :class:`TaskMap`
 stores, on a grid of pre-grasp points relative to the arm (``du`` along the belt from the
 arm's base, ``w`` across), the approach time ``t_A`` (from rest at the box to the pre-grasp

@@ -12,13 +12,13 @@ at rest, and releases the item (``release`` s)::
 
 Approach and leave are joint-space cubic Hermite paths whose end tangents are the tracking
 segment's joint velocities (``q̇ = J⁺ ṗ`` from the Jacobian), timed by the project's
-time-optimal TOPP-RA (:func:`optim.time_optimal`) with the path speed at that end fixed so
+time-optimal TOPP-RA (:func:`pinarms.optim.time_optimal`) with the path speed at that end fixed so
 the joint velocities match exactly; limits: joint velocity, acceleration and — where the arm
 has inertials — torque, with the item as payload on the leave move. The tracking segment's
 joints are the arm's IK at dense instants (one branch, continuous), a clamped cubic spline in
 time whose end velocities are the exact ``J⁺ ṗ``; it is checked against the same limits.
 
-Tool orientation: the arm's default tool orientation (:func:`robots.reach.layout.default_orientation`,
+Tool orientation: the arm's default tool orientation (:func:`pinarms.robots.reach.layout.default_orientation`,
 pointing down on a SCARA) turned about the vertical by the item's yaw (:func:`tool_yaw`, modulo the
 gripper's symmetry) through the whole tracking segment; an arm without a hand rotation (a gantry
 of three slides) grasps at its own fixed yaw.
@@ -38,7 +38,7 @@ from pinarms.optim.line.belt import Belt, _number
 from pinarms.optim.line.station import Station
 from pinarms.planning import Trajectory
 from pinarms.planning.joint_path import JointPath
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
            "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError"]
@@ -89,10 +89,10 @@ class PickPlan:
 
     Attributes:
         station: the arm's name; ``u_pre``, ``w``: belt coordinates of the pre-grasp point [m];
-        approach, leave: the :class:`optim.PathTiming` of the two moves; ``tracking``: the
-        tracking segment's :class:`planning.Trajectory`; ``q_rest``: the arm at its box;
+        approach, leave: the :class:`pinarms.optim.PathTiming` of the two moves; ``tracking``: the
+        tracking segment's :class:`pinarms.planning.Trajectory`; ``q_rest``: the arm at its box;
         :attr:`trajectory`: the whole pick (approach, tracking, leave, release), one
-        :class:`planning.Trajectory`; ``grasp_window``: (start, end) of the gripper closing [s]; ``times``: approach,
+        :class:`pinarms.planning.Trajectory`; ``grasp_window``: (start, end) of the gripper closing [s]; ``times``: approach,
         tracking, leave, release [s].
     """
 
@@ -171,7 +171,7 @@ def _poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarra
 def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int | None = None) -> np.ndarray:
     """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget.
 
-    ``branch``: the closed form's branch label to start on (:meth:`robots.Robot.ik_branches`);
+    ``branch``: the closed form's branch label to start on (:meth:`pinarms.robots.Robot.ik_branches`);
     None: the rest configuration's branch where it reaches, else the nearest solution."""
     robot = station.robot
     if robot.has_analytic_ik:
@@ -305,7 +305,7 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
 
     ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
     ``branch``: the closed-form IK branch of the tracking segment (:func:`ik_branch_labels`; what a
-    task map chose there, :meth:`optim.line.TaskMap.branch_at`); None: the rest configuration's
+    task map chose there, :meth:`pinarms.optim.line.TaskMap.branch_at`); None: the rest configuration's
     branch where it reaches the pre-grasp point, else the nearest solution; when that plan leaves the
     position limits, the other branches reaching the pre-grasp point are tried in label order and
     the first within them is returned. ``yaw`` [rad]: the

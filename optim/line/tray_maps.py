@@ -39,7 +39,7 @@ from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
-from pinarms.robots.errors import InvalidInput, PinarmsError, UnreachableTarget
+from pinarms.errors import InvalidInput, PinarmsError, UnreachableTarget
 
 __all__ = ["TrayMap", "build_tray_map", "tray_map_error"]
 

@@ -36,7 +36,7 @@ from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_lim
                                          rest_configuration, tool_yaw, tracking_points)
 from pinarms.planning import Trajectory
 from pinarms.optim.errors import InfeasibleProblem, OptimError
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "trays_beside", "parse_trays"]
 

@@ -1,7 +1,7 @@
 """Each arm's pick window on the belt, from its reach, and whether neighbours' windows overlap.
 
 The window of an arm is the set of pre-grasp points (belt coordinates ``u``, ``w``) whose
-whole pick (:func:`optim.line.tracking.plan_pick`) is feasible: inside the reach with the
+whole pick (:func:`pinarms.optim.line.tracking.plan_pick`) is feasible: inside the reach with the
 tool orientation the gripper needs and within the joint limits at the belt's speed. Its
 extent along the belt is read from the arm's task-time map; before any planning,
 :func:`check_reach` proves from a sampled workspace that the arm reaches the belt at all.

@@ -6,7 +6,7 @@ See docs/motion.md.
   a goal joint vector or tool pose, every IK branch a goal; :class:`MotionOptions`,
   :class:`MotionLimits`) in, one :class:`MotionPlan` out: its :class:`MotionStatus` (solved, or
   what planning found: start or goal in collision, no path in time, ...), and when solved the
-  raw, shortcut and smooth paths, the time-optimal :class:`planning.Trajectory`, the cell's
+  raw, shortcut and smooth paths, the time-optimal :class:`pinarms.planning.Trajectory`, the cell's
   re-check, the clearance profile.
 - :class:`MotionChecker`: state, edge and timed-motion validity (:mod:`.checker`), exact (coal
   where the sphere cover is inconclusive); :func:`fast_check` its compiled side on the cover
@@ -19,20 +19,50 @@ See docs/motion.md.
   as xacro macros (:mod:`.arm_macros`).
 """
 
-from pinarms.optim.motion.checker import MotionChecker, TimedArm, Verdict
-from pinarms.optim.motion.fast import FastCheck, fast_check, fast_search, fast_shortcut
-from pinarms.optim.motion.goals import GoalCandidate
-from pinarms.optim.motion.plan import plan_motion
-from pinarms.optim.motion.report import ClearanceProfile
-from pinarms.optim.motion.request import MotionLimits, MotionOptions, MotionRequest
-from pinarms.optim.motion.result import MotionPlan, MotionStatus
-from pinarms.optim.motion.scenes import SCENES, Query, Region, Scene, load_scene, scene_names, scene_path, scene_queries
-from pinarms.optim.motion.search import PLANNERS
-from pinarms.optim.motion.two_arms import AroundPlan, TwoArmPlan, plan_around, plan_two_arms
-from pinarms.optim.motion.transfer import PlannedMove, planned_cycle
+from __future__ import annotations
 
-__all__ = ["plan_motion", "MotionRequest", "MotionOptions", "MotionLimits", "MotionPlan", "MotionStatus",
-           "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict",
-           "FastCheck", "fast_check", "fast_search", "fast_shortcut",
-           "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names", "scene_path", "load_scene", "scene_queries",
-           "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan", "planned_cycle", "PlannedMove"]
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "MotionChecker": "pinarms.optim.motion.checker",
+    "TimedArm": "pinarms.optim.motion.checker",
+    "Verdict": "pinarms.optim.motion.checker",
+    "FastCheck": "pinarms.optim.motion.fast",
+    "fast_check": "pinarms.optim.motion.fast",
+    "fast_search": "pinarms.optim.motion.fast",
+    "fast_shortcut": "pinarms.optim.motion.fast",
+    "GoalCandidate": "pinarms.optim.motion.goals",
+    "plan_motion": "pinarms.optim.motion.plan",
+    "ClearanceProfile": "pinarms.optim.motion.report",
+    "MotionLimits": "pinarms.optim.motion.request",
+    "MotionOptions": "pinarms.optim.motion.request",
+    "MotionRequest": "pinarms.optim.motion.request",
+    "MotionPlan": "pinarms.optim.motion.result",
+    "MotionStatus": "pinarms.optim.motion.result",
+    "SCENES": "pinarms.optim.motion.scenes",
+    "Query": "pinarms.optim.motion.scenes",
+    "Region": "pinarms.optim.motion.scenes",
+    "Scene": "pinarms.optim.motion.scenes",
+    "load_scene": "pinarms.optim.motion.scenes",
+    "scene_names": "pinarms.optim.motion.scenes",
+    "scene_path": "pinarms.optim.motion.scenes",
+    "scene_queries": "pinarms.optim.motion.scenes",
+    "PLANNERS": "pinarms.optim.motion.search",
+    "AroundPlan": "pinarms.optim.motion.two_arms",
+    "TwoArmPlan": "pinarms.optim.motion.two_arms",
+    "plan_around": "pinarms.optim.motion.two_arms",
+    "plan_two_arms": "pinarms.optim.motion.two_arms",
+    "PlannedMove": "pinarms.optim.motion.transfer",
+    "planned_cycle": "pinarms.optim.motion.transfer",
+}
+
+__all__ = [
+    "plan_motion", "MotionRequest", "MotionOptions", "MotionLimits", "MotionPlan", "MotionStatus",
+    "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict", "FastCheck", "fast_check",
+    "fast_search", "fast_shortcut", "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names",
+    "scene_path", "load_scene", "scene_queries", "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan",
+    "planned_cycle", "PlannedMove",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -2,13 +2,13 @@
 
 A state is the planned arms' joint vector ``x``; the cell configuration is ``hold`` with
 ``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
-(:func:`robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b`` is
+(:func:`pinarms.robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b`` is
 proven on the *scaled* excess ``Ẽ(x) = min_k ê_k(x) / w_g`` (:func:`excess_scaled`): ``w_g``
 bounds how much the distance of the pairs of group ``g`` (two links, or a link and a
 fixture) changes along the whole edge (``Σ_j |Δx_j| λ_{g,j}``, at most the whole-arm travel
 ``T = Σ |Δx_j| ℓ_j``; :mod:`.link_levers` states the Lipschitz argument); an interval
 ``[s_a, s_b]`` of the edge is proven when ``Ẽ_a + Ẽ_b ≥ s_b − s_a``, all ``Ẽ ≥ 0`` (the ladder's rule,
-:func:`robots.cell.ladder.interval_proven`, where the argument is written); ``Ẽ`` is
+:func:`pinarms.robots.cell.ladder.interval_proven`, where the argument is written); ``Ẽ`` is
 capped at ``cap / T`` (the pairs left out are more than ``cap`` above their thresholds).
 An interval not proven is halved (splitting at the middle of the stretch its ends do not
 prove instead checked as many states on the Panda scenes); intervals are taken first in,

@@ -6,7 +6,7 @@ The path ``q(s)`` is piecewise polynomial (``breaks (K+1,)``, ``coefs (K, W, n)`
 arm moves more than ``T(s_b) − T(s_a)``. ``E(x)`` is the cover's lower bound of the excess
 ``min_k (d_k − margin_k)`` (:func:`._fast_kernel.state_excess`, capped), 1-Lipschitz in that
 travel: an interval whose ends have ``E_a + E_b ≥ T(s_b) − T(s_a)`` keeps every margin (the
-ladder's rule, :func:`robots.cell.ladder.interval_proven`). An interval not proven is halved at
+ladder's rule, :func:`pinarms.robots.cell.ladder.interval_proven`). An interval not proven is halved at
 the middle of its travel bound, first in, first out, down to the exact proof's finest travel.
 What is not proven — an end the cover does not prove clear, an end outside the joint limits, an
 interval still unproven at the finest travel, the state budget spent — is returned as a range

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from pinarms.files import write_text
 from pinarms.robots import registry
-from pinarms.robots.errors import RobotNotFound
+from pinarms.errors import RobotNotFound
 
 __all__ = ["MACRO_ARMS", "PACKAGE", "arm_macro_text", "example_packages"]
 

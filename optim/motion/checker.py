@@ -10,12 +10,12 @@ or follow their own timed trajectories (:class:`TimedArm`):
   links of one arm (an arm's own links are close by design). One Pinocchio call (coal with
   each pair's security margin, GJK started cold), stopping at the first pair too close.
 - **Edge** ``x_a → x_b`` (a straight line in joint space): the continuous rule of
-  :func:`robots.cell.check_motion`, in joint space instead of time. Every point of the
+  :func:`pinarms.robots.cell.check_motion`, in joint space instead of time. Every point of the
   planned arms' geometry moves at most ``T = Σ_j |Δq_j| ℓ_j`` along the edge (the levers
-  ``ℓ_j`` of :func:`robots.cell.motion.joint_levers`). The smallest excess
+  ``ℓ_j`` of :func:`pinarms.robots.cell.motion.joint_levers`). The smallest excess
   ``E = min_k (d_k − margin_k)`` is 1-Lipschitz in that travel, so between two samples with
   travel ``B`` between them ``E ≥ (E_a + E_b − B)/2`` (the rule and its ladder:
-  :mod:`robots.cell.ladder`). Samples whose pairs all pass with their margins raised by
+  :mod:`pinarms.robots.cell.ladder`). Samples whose pairs all pass with their margins raised by
   ``s`` have ``E ≥ s``; two such neighbours with ``B ≤ 2s`` prove the interval. The proof is a **ladder of batched screens**: the edge is first cut into
   pieces of at most ``step · 2^k`` travel (``k ≤`` :data:`COARSE_LEVELS`; ``step`` defaults
   to the margin: nothing thinner than the margin fits between two samples of the finest
@@ -53,7 +53,7 @@ from pinarms.optim.motion import coal_batches
 from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 #: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
 #: :meth:`MotionChecker.trajectory_valid` (the rounding of a time scaling's re-expanded
@@ -70,7 +70,7 @@ class TimedArm:
 
     Attributes:
         arm: the arm's name in the cell.
-        trajectory: its :class:`planning.Trajectory` (the arm's own joint order).
+        trajectory: its :class:`pinarms.planning.Trajectory` (the arm's own joint order).
         offset: cell time [s] at which the trajectory's ``start_time`` is played; before
             and after, the arm holds the trajectory's first and last configuration.
     """
@@ -90,7 +90,7 @@ class MotionChecker(CoalBatches, LadderProof):
     """State, edge and path validity of the planned arms of ``cell`` (module docstring).
 
     Args:
-        cell: a :class:`robots.Cell`.
+        cell: a :class:`pinarms.robots.Cell`.
         arms: the planned arms' names (their coordinates, in this order, make ``x``).
         margin: clearance every pair with a fixture or another arm keeps [m] (> 0).
         self_margin: clearance between two links of one planned arm [m] (≥ 0).
@@ -101,7 +101,7 @@ class MotionChecker(CoalBatches, LadderProof):
         step: largest travel [m] of any point between two samples of an edge (default
             ``margin``).
         threads: threads of Pinocchio's batch checks.
-        cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
+        cover: screen every check on the sphere cover first (:mod:`pinarms.robots.cell.cover`; the same
             verdicts, coal only where the cover is inconclusive).
         pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal only on the
             pairs the cover does not prove, not on every pair of a state it does not prove.
@@ -184,7 +184,7 @@ class MotionChecker(CoalBatches, LadderProof):
         #: ``time.perf_counter()`` after which proofs give up and call their edge not valid (a
         #: search's time limit; ``None``: never). Giving up never calls anything clear.
         self.deadline: float | None = None
-        #: The sphere cover screening every check (:mod:`robots.cell.cover`): what it proves clear is
+        #: The sphere cover screening every check (:mod:`pinarms.robots.cell.cover`): what it proves clear is
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
         self.cover = link_cover(cell) if cover else None
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
@@ -201,7 +201,7 @@ class MotionChecker(CoalBatches, LadderProof):
         On each bin of width h the point speed is at most ``max(v_a, v_b) + A h / 2`` (``v``
         from the exact joint speeds at the bin ends times the levers, ``A`` from the exact
         acceleration peaks), and never more than the exact velocity peaks allow: the rule of
-        :func:`robots.cell.check_motion`. Outside its trajectory an arm holds still.
+        :func:`pinarms.robots.cell.check_motion`. Outside its trajectory an arm holds still.
         """
         if not self.moving:
             return np.array([0.0, 1.0]), np.zeros(2)
@@ -273,7 +273,7 @@ class MotionChecker(CoalBatches, LadderProof):
 
         ``mask (P,)`` bool: only those pairs (e.g. the arm–environment ones). coal's distances
         of the pairs in increasing order of a numpy lower bound
-        (:func:`robots.cell.collision.pair_lower_bounds`), stopping when the next bound
+        (:func:`pinarms.robots.cell.collision.pair_lower_bounds`), stopping when the next bound
         exceeds the best found: exact, not sampled."""
         from pinarms.robots.cell.collision import pair_lower_bounds
 

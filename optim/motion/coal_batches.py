@@ -1,6 +1,6 @@
 """coal's side of a :class:`.checker.MotionChecker`: Pinocchio's batch loops, their pools per screen, the deadline.
 
-Every check first asks the sphere cover (:mod:`robots.cell.cover`); with the per-pair route
+Every check first asks the sphere cover (:mod:`pinarms.robots.cell.cover`); with the per-pair route
 (:attr:`PAIRWISE`) coal computes only the pairs the cover does not prove, per configuration
 (:meth:`CoalBatches.pair_collides`); otherwise what it does not prove as a whole goes to coal through Pinocchio's C++ batch loop (``computeCollisionsInParallel``), one pool
 per screen level (the margins raised by ``step / 2^(L+1)``) and one at the margins
@@ -34,7 +34,7 @@ PAIRWISE = True
 
 def cold(gd: pin.GeometryData) -> pin.GeometryData:
     """Cold-started GJK (a cached guess from another configuration misses contacts between a
-    planner's far-apart samples: :mod:`robots.collision_requests`), exact distances."""
+    planner's far-apart samples: :mod:`pinarms.robots.collision_requests`), exact distances."""
     from pinarms.robots.collision_requests import cold_start
 
     return cold_start(gd, distance_tolerance=1e-10)
@@ -176,7 +176,7 @@ class CoalBatches:
 
     def _travel_share(self, xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
         """``(P,)`` in [0, 1]: how far each pair's distance can change along the edge ``xa → xb`` (the joints
-        upstream of one of its links and not of the other, :func:`optim.motion.link_levers.group_levers`)
+        upstream of one of its links and not of the other, :func:`pinarms.optim.motion.link_levers.group_levers`)
         over the edge's travel ``T``. Two samples whose pair ``k`` keeps ``share_k · s`` above its margin,
         with travel ``B ≤ 2s`` between them, keep it above its margin in between: the ladder's raise is
         scaled per pair (:meth:`_thresholds`)."""
@@ -196,7 +196,7 @@ class CoalBatches:
 
     def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
         """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
-        cover (:meth:`robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
+        cover (:meth:`pinarms.robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
         threshold (``which``: the margins, or a screen level; :meth:`_thresholds`)."""
         Q = np.atleast_2d(Q)
         P = len(self.pairs)
@@ -356,7 +356,7 @@ def shared_coal(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> d
     thread: making them costs tens of ms per checker (cold-starting every request)."""
     key = (tuple((p.index_a, p.index_b) for p in pairs), margins.tobytes(), threads, threading.get_ident())
     with _SHARED_LOCK:
-        store = cell.__dict__.setdefault("_motion_checker_shared", {})
+        store = cell.memo("motion checker shared", dict)
         entry = store.pop(key, None)
         if entry is None:
             entry = {}

@@ -11,7 +11,7 @@ import numpy as np
 
 from pinarms.optim.errors import GoalInCollision, StartInCollision
 from pinarms.optim.motion.goals import GoalCandidate, describe_pair, ik_candidates, point_in_fixture
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 if TYPE_CHECKING:
     from pinarms.optim.motion.checker import MotionChecker

@@ -19,7 +19,7 @@ levers, held arms), all in compiled code (:mod:`._fast_kernel`):
 samples near one of its own nodes: an end deep in a crate gets the samples it needs,
 :data:`._fast_kernel.LOCAL_SHARE`; seeded SplitMix64 stream, chunks of iterations between which
 the clock is read: the time limit holds to a chunk, a few ms) and
-:func:`fast_shortcut` shortcuts on it. A path so found is proven; :func:`optim.plan_motion`
+:func:`fast_shortcut` shortcuts on it. A path so found is proven; :func:`pinarms.optim.plan_motion`
 still proves it again with the exact checker before reporting it.
 """
 
@@ -184,7 +184,7 @@ def fast_check(checker: Any) -> FastCheck | None:
 
 def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
     """The kernels' scratch arrays placed at ``hold`` once, with what moves with the planned columns ``cols``
-    (:func:`robots.cell._cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
+    (:func:`pinarms.robots.cell._cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
     spheres and cylinder axes on those joints. The held arms and the fixtures stay where they were placed."""
     parent, index = cover.fk[0], cover.fk[1]
     planned = set(int(c) for c in cols)

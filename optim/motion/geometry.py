@@ -24,7 +24,7 @@ from pinarms.optim.motion.fast import fast_search, fast_shortcut
 from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
 from pinarms.optim.motion.search import search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.optim.motion.checker import MotionChecker

@@ -41,12 +41,12 @@ def closed_form(robot: Robot) -> Robot:
     family = _families_by_joints().get(tuple(robot.joint_names))
     if family is not None:
         from pinarms.robots.ik import attach_analytic_ik
-        from pinarms.robots.errors import ModelError
+        from pinarms.errors import ModelError
 
         try:
             attach_analytic_ik(robot, family)
         except ModelError:
-            robot._analytic_ik = None
+            robot.set_analytic_ik(None)
     return robot
 
 
@@ -104,7 +104,7 @@ def ik_candidates(robot: Robot, T_base: np.ndarray, q_ref: np.ndarray, *, seed: 
                   attempts: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``(k, nq)`` reaching ``T_base`` (arm base frame) and their branch labels ``(k,)``.
 
-    A closed-form arm: every branch once (:meth:`robots.Robot.ik_branches`, each angle at its
+    A closed-form arm: every branch once (:meth:`pinarms.robots.Robot.ik_branches`, each angle at its
     2π equivalent nearest ``q_ref``). Otherwise the numerical solver from ``q_ref`` and from
     ``attempts − 1`` seeded random starts, distinct solutions only (1e-3 rad apart), branch −1.
     """
@@ -114,7 +114,7 @@ def ik_candidates(robot: Robot, T_base: np.ndarray, q_ref: np.ndarray, *, seed: 
         q = np.asarray(q, dtype=float).reshape(-1, robot.nq)
         ok = np.asarray(robot.within_limits(q), dtype=bool).reshape(-1) if q.shape[0] else np.zeros(0, bool)
         return q[ok], np.asarray(branch, dtype=int).reshape(-1)[ok]
-    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.errors import UnreachableTarget
 
     rng = np.random.default_rng(seed)
     found: list[np.ndarray] = []

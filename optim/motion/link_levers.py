@@ -6,7 +6,7 @@
 (axis ``u_i`` through its origin ``o_i``, configuration column ``c(i)``, mimic ``scale_i``),
 and ``scale_i Δq_{c(i)} u_i`` for a prismatic one. ``|u_i × (P − o_i)| ≤ |P − o_i|`` and
 ``|P − o_i| ≤ ρ_{i,L}``: the largest ``|centre| + radius`` of ``L``'s cover spheres (they
-contain its geometry, :mod:`robots.cell.cover`) plus, up the chain from ``L`` to the child
+contain its geometry, :mod:`pinarms.robots.cell.cover`) plus, up the chain from ``L`` to the child
 of ``i``, every joint's offset ``|M_p|`` and, for a prismatic joint, its largest stroke
 ``max |scale·q + offset|`` over its limits — whatever the other joints are. So ``P`` moves
 at most ``(s₁ − s₀) Σ_i |Δq_{c(i)}| λ_{i,L}`` between ``s₀`` and ``s₁``, with
@@ -18,7 +18,7 @@ their common ancestor, ``A``'s points move by the joints upstream of ``A`` and n
 ``B``'s by those upstream of ``B`` and not of ``A``, so ``d`` (and the pair's excess
 ``d − t``) changes by at most ``(s₁ − s₀) w`` with
 ``w = Σ_{i ∈ up(A)∖up(B)} |Δq| λ_{i,A} + Σ_{i ∈ up(B)∖up(A)} |Δq| λ_{i,B}`` (a static fixture:
-``up = ∅``). The whole-arm bound ``T = Σ_j |Δq_j| ℓ_j`` (:func:`robots.cell.motion.joint_levers`)
+``up = ∅``). The whole-arm bound ``T = Σ_j |Δq_j| ℓ_j`` (:func:`pinarms.robots.cell.motion.joint_levers`)
 holds for every pair too; each group's weight is ``min(w, T)``.
 
 With ``e_k(s)`` the excess of pair ``k`` (of group ``g``, weight ``w_g``) and ``ê_k ≤ e_k`` the

@@ -18,12 +18,12 @@ exception; what planning finds out is a status (the rule: :mod:`.result`). The s
 3. **Shortcut.** OMPL's path simplifier, every new edge proven by the same rule.
 4. **Smooth.** The cubic spline through the shortcut path, proven again; vertices are
    added where it strays, the polyline with stops is the fallback (:mod:`.smoothing`).
-5. **Time.** :func:`optim.time_optimal` along the smooth path (TOPP-RA written here) under
+5. **Time.** :func:`pinarms.optim.time_optimal` along the smooth path (TOPP-RA written here) under
    the joint velocity limits, joint acceleration limits (the arms' by default), and joint torque limits
    (the URDF's efforts, the arm's inertials) by default: the time-optimal ``s(t)`` of the
    fixed path (bang–bang: jerk is not limited).
 6. **Check and report.** The timed motion is re-checked by the cell's own continuous time
-   check (:func:`robots.cell.check_motion`, an independent code path: contact-free must be
+   check (:func:`pinarms.robots.cell.check_motion`, an independent code path: contact-free must be
    proven) and its clearance is reported over time: the smallest distance to a fixture or
    another arm, and between links of the arm, with the pairs (:class:`ClearanceProfile`).
 
@@ -48,13 +48,13 @@ from pinarms.optim.topp.path_timing import PathTiming
 from pinarms.planning import JointPath, Trajectory
 from pinarms.planning.path_constraints import PathConstraint
 from pinarms.robots.cell.motion_report import MotionCheck
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 __all__ = ["plan_motion", "time_path"]
 
 
 def time_path(path: JointPath, constraints: Sequence[PathConstraint], grid: int = 200) -> PathTiming:
-    """:func:`optim.time_optimal` of ``path`` (a clear error if the limits cannot be met)."""
+    """:func:`pinarms.optim.time_optimal` of ``path`` (a clear error if the limits cannot be met)."""
     from pinarms.optim.topp.path_timing import time_optimal
 
     try:

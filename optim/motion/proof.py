@@ -2,9 +2,9 @@
 
 Between two samples with travel ``B`` between them the excess ``E = min_k (d_k − margin_k)``
 (1-Lipschitz in travel) keeps ``E ≥ (E_a + E_b − B)/2`` (the rule and its ladder:
-:mod:`robots.cell.ladder`); samples that pass with their margins raised by ``s`` have
+:mod:`pinarms.robots.cell.ladder`); samples that pass with their margins raised by ``s`` have
 ``E ≥ s``. :meth:`LadderProof.prove` screens the samples of a motion at the coarsest level,
-then climbs the ladder (:func:`robots.cell.ladder.climb`): the intervals not proven are
+then climbs the ladder (:func:`pinarms.robots.cell.ladder.climb`): the intervals not proven are
 halved and their ends screened with half the raise, down to ``step / 2^MAX_SPLITS`` (the
 module docstring of :mod:`.checker`).
 """
@@ -137,7 +137,7 @@ class LadderProof:
 
 
 class _ScreenRungs:
-    """The samples of one proof for the ladder (:func:`robots.cell.ladder.climb`): midpoints from the
+    """The samples of one proof for the ladder (:func:`pinarms.robots.cell.ladder.climb`): midpoints from the
     caller's ``midpoint``, and as excess of a sample the raise of the margins its screen passes at
     each level (``s_L = step / 2^(L+1)``; 0: it keeps the margins only)."""
 

@@ -278,7 +278,7 @@ class _Distances:
         self.calls = 0  # coal distance calls
 
     def _bounds(self, Q: np.ndarray) -> np.ndarray:
-        """``(N, P)`` numpy lower bounds of the pairs' distances (:func:`robots.cell.collision.pair_lower_bounds`)."""
+        """``(N, P)`` numpy lower bounds of the pairs' distances (:func:`pinarms.robots.cell.collision.pair_lower_bounds`)."""
         from pinarms.robots.cell.collision import pair_lower_bounds
 
         c = self.checker

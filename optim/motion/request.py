@@ -29,7 +29,7 @@ from pinarms.optim.motion.coal_batches import check_threads
 from pinarms.optim.motion.ends import arm_joints, is_pose, planned_arms
 from pinarms.optim.motion.search import PLANNERS
 from pinarms.planning.path_constraints import JointAccelerationConstraint, JointVelocityConstraint
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.robots.cell import Cell
@@ -55,10 +55,10 @@ class MotionOptions:
         margin: clearance [m] kept to fixtures and other arms everywhere along the motion (> 0);
             it also sets the step of the continuous check.
         self_margin: clearance [m] kept between two links of one arm (≥ 0; default 0: no contact).
-        planner: an OMPL planner, one of :data:`optim.motion.search.PLANNERS` (default RRT-Connect).
+        planner: an OMPL planner, one of :data:`pinarms.optim.motion.search.PLANNERS` (default RRT-Connect).
         time_limit: seconds the search may take (> 0).
         seed: seed of the search and the shortcutting, 0 to 2**63 − 1 (same seed, same path).
-        threads: threads of the batched collision checks (1 to :data:`optim.motion.checker.MAX_THREADS`).
+        threads: threads of the batched collision checks (1 to :data:`pinarms.optim.motion.checker.MAX_THREADS`).
         compiled: search RRT-Connect compiled on the sphere cover first where it is tight
             (:mod:`.geometry`); ``False``: OMPL with the exact checker alone.
         recheck: re-check the timed motion by the cell's own continuous check and report its
@@ -250,7 +250,7 @@ class MotionRequest:
     """One motion to plan: where, which arm(s), from where to where, and how (module doc).
 
     Attributes:
-        cell: the :class:`robots.Cell` the motion is planned in.
+        cell: the :class:`pinarms.robots.Cell` the motion is planned in.
         arm: the arm's name, or two names to plan both arms together in their joint space.
         start: the planned arms' joint coordinates ``(n,)`` (two arms: concatenated, or
             ``{arm: q}``); stored as the ``(n,)`` array.

@@ -11,7 +11,7 @@ limit (the planner, the states explored), a path that cannot be timed under the 
 motion the cell's independent check refuses. The search never proves that no path exists (a
 sampling planner stops at its time limit), so "no path" always means "none within
 ``time_limit``". :meth:`MotionPlan.raise_for_status` raises the status as the project's error
-(:class:`optim.StartInCollision`, :class:`optim.NoPathFound`, ...), and every property that
+(:class:`pinarms.optim.StartInCollision`, :class:`pinarms.optim.NoPathFound`, ...), and every property that
 needs the motion (``duration``, ``tool_path``, ...) does so on a plan that was not solved.
 
 Joint coordinates in rad or m, distances in m, times in s.
@@ -75,12 +75,12 @@ class MotionPlan:
             collision (``(k, n)`` planned joints: the start, each goal configuration; ``(1, nq)``
             the cell configuration for ``"hold"``).
         raw_path: ``(M, n)`` the planner's path; ``simplified``: ``(K, n)`` after shortcutting
-            (:data:`.report.SIMPLIFIER`); ``path``: the smooth :class:`planning.JointPath` that
+            (:data:`.report.SIMPLIFIER`); ``path``: the smooth :class:`pinarms.planning.JointPath` that
             was timed, ``smoothing`` how it was made (``"cubic spline"``, ``"straight line"``
             or ``"polyline with stops"``).
-        timing: the :class:`optim.PathTiming`; ``trajectory``: the arms' joint trajectory
-            (:class:`planning.Trajectory`, the planned arms' joints in order).
-        check: the cell's continuous check of the timed motion (:class:`robots.cell.MotionCheck`;
+        timing: the :class:`pinarms.optim.PathTiming`; ``trajectory``: the arms' joint trajectory
+            (:class:`pinarms.planning.Trajectory`, the planned arms' joints in order).
+        check: the cell's continuous check of the timed motion (:class:`pinarms.robots.cell.MotionCheck`;
             ``None`` when planned with ``recheck=False``).
         clearance: the distances along it (:class:`ClearanceProfile`; ``None`` likewise).
         hold: the cell configuration of the arms not planned.
@@ -132,8 +132,8 @@ class MotionPlan:
         return self.status is MotionStatus.SOLVED
 
     def raise_for_status(self) -> MotionPlan:
-        """The plan itself when solved; else raise its error (:class:`optim.StartInCollision`,
-        :class:`optim.GoalInCollision`, :class:`optim.NoPathFound`, ...; the message is :attr:`reason`)."""
+        """The plan itself when solved; else raise its error (:class:`pinarms.optim.StartInCollision`,
+        :class:`pinarms.optim.GoalInCollision`, :class:`pinarms.optim.NoPathFound`, ...; the message is :attr:`reason`)."""
         if self.status is MotionStatus.SOLVED:
             return self
         if self.error is not None:

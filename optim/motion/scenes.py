@@ -1,7 +1,7 @@
 """The planning scenes: cell files with task regions, and seeded queries in them.
 
 Each scene is a cell file in ``optim/motion/scene_files/`` (xacro, expanded behind the
-wall of :func:`robots.expand_xacro` like any user's file) and a few **task regions**:
+wall of :func:`pinarms.robots.expand_xacro` like any user's file) and a few **task regions**:
 boxes (world frame, m) where the tool works, each with its approach direction (``"down"``:
 tool z along world −z; ``"+x"``: tool z along world +x). :func:`scene_queries` draws
 seeded start/goal pairs: a tcp position uniform in one region, the tool turned by a
@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import CellNotFound, InvalidInput, UnreachableTarget
+from pinarms.errors import CellNotFound, InvalidInput, UnreachableTarget
 
 __all__ = ["Region", "Scene", "Query", "SCENES", "SCENE_DIR", "scene_names", "scene_path", "load_scene",
            "scene_queries", "region_pose", "valid_ik"]
@@ -142,7 +142,7 @@ def scene_path(name: str) -> Path:
 
 @lru_cache(maxsize=8)
 def load_scene(name: str) -> Any:
-    """The :class:`robots.Cell` of scene ``name`` (loaded once per process)."""
+    """The :class:`pinarms.robots.Cell` of scene ``name`` (loaded once per process)."""
     from pinarms import robots
     from pinarms.optim.motion.arm_macros import example_packages
 

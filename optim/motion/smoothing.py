@@ -2,7 +2,7 @@
 
 The planner's path is a polyline in joint space: timed as it is, the arm would stop at
 every corner. :func:`smooth_path` replaces it by the C² cubic spline through its vertices
-(:func:`planning.joint_spline`, parameter = joint-space chord length), which the time
+(:func:`pinarms.planning.joint_spline`, parameter = joint-space chord length), which the time
 scaling passes without stopping. A spline is not the polyline that was proven: it is
 **proven again** (:func:`prove_path`) with the same continuous rule as the edges, its travel
 bound taken from the exact peaks of ``|q'(s)|`` on parts of every piece (:func:`_travel_bound`:

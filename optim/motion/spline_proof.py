@@ -59,7 +59,7 @@ def _outside_limits(checker: Any, path: Any) -> np.ndarray:
 
 
 def _outside_limits_arrays(checker: Any, path: Any) -> np.ndarray:
-    """:func:`_outside_limits` from :func:`planning.extrema.piece_extrema` (any degree)."""
+    """:func:`_outside_limits` from :func:`pinarms.planning.extrema.piece_extrema` (any degree)."""
     h = np.diff(np.asarray(path.breaks, dtype=float))
     values, _ = piece_extrema(normalised_pieces(path.coefficients, h), h, (0,))
     lo = np.nanmin(values[0], axis=-1)

@@ -1,16 +1,16 @@
 """The planned transfer: what ``plan_cycle`` in a cell falls back to when raising it cannot clear.
 
-:func:`optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
-adding via points (:mod:`optim.cycle.in_cell`). A crate under a guard, a shelf or the other
+:func:`pinarms.optim.plan_cycle` with a cell first re-plans its transfer by raising the lift and
+adding via points (:mod:`pinarms.optim.cycle.in_cell`). A crate under a guard, a shelf or the other
 arm's column defeat that: the way round is sideways or underneath. :func:`planned_cycle`
 then keeps the vertical moves at pick and place (the cycle's lift and lowering, joint-space
 lines or the straight Cartesian lines of ``approach="straight"``), proves them clear, and
-plans the transfer between "above pick" and "above place" with :func:`optim.plan_motion`'s
+plans the transfer between "above pick" and "above place" with :func:`pinarms.optim.plan_motion`'s
 search, shortcut and smoothing (OMPL, every edge proven continuously); the move back runs
 the same path in reverse. Each part is timed optimally from rest to rest under the cycle's
 limits (joint velocity and acceleration; the URDF's torque limits when no acceleration
 limit is given) and the parts are joined at rest. The cycle (dwells, move to place, move
-back) is returned as a :class:`optim.CycleResult` whose moves are :class:`PlannedMove` s.
+back) is returned as a :class:`pinarms.optim.CycleResult` whose moves are :class:`PlannedMove` s.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from pinarms.optim.motion.plan import time_path
 from pinarms.optim.motion.request import MotionLimits, MotionOptions, motion_constraints
 from pinarms.optim.motion.smoothing import polyline_path, prove_path, smooth_path
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import CollisionError, InvalidInput
+from pinarms.errors import CollisionError, InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.optim.cycle.request import CycleRequest
@@ -44,7 +44,7 @@ class PlannedMove:
     """One move of a cycle with a planned transfer: the lift, the transfer, the lowering (at rest between).
 
     Attributes:
-        parts: the three timings (:class:`optim.PathTiming`).
+        parts: the three timings (:class:`pinarms.optim.PathTiming`).
         trajectory: the three concatenated.
         planner: the OMPL planner that found the transfer; ``states``: the states it explored.
     """
@@ -132,18 +132,18 @@ def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hol
     """The cycle ``base`` (the request planned without its cell) with its transfer planned around the cell.
 
     Args:
-        request: the cycle's :class:`optim.CycleRequest`, with its :class:`optim.CellSettings`:
+        request: the cycle's :class:`pinarms.optim.CycleRequest`, with its :class:`pinarms.optim.CellSettings`:
             ``clearance`` kept from fixtures and other arms [m] (the arm's own links: no
             contact), ``margin`` the check's resolution when ``clearance`` is 0; the search is
             seeded with ``request.timing.seed``.
-        base: the :class:`optim.CycleResult` of the request without the cell (its via points
+        base: the :class:`pinarms.optim.CycleResult` of the request without the cell (its via points
             fix the IK branch; its limits are used).
-        arm: the :class:`robots.cell.CellArm`; ``hold``: the cell configuration of the other arms.
+        arm: the :class:`pinarms.robots.cell.CellArm`; ``hold``: the cell configuration of the other arms.
 
     Raises:
         InvalidInput: a request without a cell.
         CollisionError: a vertical move itself is too close to something (no transfer can
-            help), or :class:`optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
+            help), or :class:`pinarms.optim.NoPathFound` (a :class:`PlanningError`): no transfer found.
     """
     if request.cell is None:
         raise InvalidInput("planned_cycle plans a cycle in a cell: give the request a CellSettings")

@@ -5,7 +5,7 @@
 1. **Path.** B's path is planned (:func:`plan_motion`'s search, shortcut and smoothing)
    with A parked at the **end** of its trajectory, where it stays once its move is done:
    B's path can never be blocked by A for good.
-2. **Time.** B's path is timed optimally (:func:`optim.time_optimal`), and B leaves its start
+2. **Time.** B's path is timed optimally (:func:`pinarms.optim.time_optimal`), and B leaves its start
    at the earliest instant ``t0 + d`` (``d`` in steps of ``delay_step``) for which the
    continuous proof with A **at the same instants** accepts the whole motion: B waiting at
    its start, then moving, against A moving (:meth:`MotionChecker.trajectory_valid`: samples
@@ -19,7 +19,7 @@
 start instant up to A's end), plans both arms in their joint space (:func:`plan_motion`
 with two arms: A from its trajectory's start to its end, B from its start to its goal).
 Every result is re-checked by the cell's own continuous time check with both arms moving
-(:func:`robots.cell.check_motion`).
+(:func:`pinarms.robots.cell.check_motion`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from pinarms.optim.motion.plan import plan_motion
 from pinarms.optim.motion.request import MotionRequest
 from pinarms.optim.motion.result import MotionPlan, MotionStatus
 from pinarms.planning import Trajectory
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:
     from pinarms.robots.cell import Cell
@@ -97,7 +97,7 @@ class TwoArmPlan:
         method: ``"around"`` (B planned around A's trajectory, A unchanged) or ``"joint"``
             (both planned together; A's path changed, its ends kept).
         trajectories: ``{arm: Trajectory}``; ``offsets``: ``{arm: offset}`` [s] to play them
-            with (:class:`robots.cell.ArmMotion`: the cell time at which each trajectory's
+            with (:class:`pinarms.robots.cell.ArmMotion`: the cell time at which each trajectory's
             ``start_time`` is played).
         around: the :class:`AroundPlan` (``None`` when it failed); ``joint``: the two-arm
             :class:`MotionPlan` (``None`` when not needed).

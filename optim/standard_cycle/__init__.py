@@ -7,10 +7,10 @@
 - :mod:`.serial_cycle`: a serial arm (its IK and RNEA).
 """
 
-from .delta_cycle import delta_gate_rows, delta_path_rows, delta_standard_cycle
-from .path import StandardCycle, gate_breaks, gate_length, gate_points
-from .serial_cycle import serial_gate_rows, serial_standard_cycle
-from .timing import GateTiming, JointPathRows, limit_usage, time_rows
+from pinarms.optim.standard_cycle.delta_cycle import delta_gate_rows, delta_path_rows, delta_standard_cycle
+from pinarms.optim.standard_cycle.path import StandardCycle, gate_breaks, gate_length, gate_points
+from pinarms.optim.standard_cycle.serial_cycle import serial_gate_rows, serial_standard_cycle
+from pinarms.optim.standard_cycle.timing import GateTiming, JointPathRows, limit_usage, time_rows
 
 __all__ = ["StandardCycle", "gate_length", "gate_points", "gate_breaks", "GateTiming", "JointPathRows",
            "time_rows", "limit_usage", "delta_gate_rows", "delta_path_rows", "delta_standard_cycle",

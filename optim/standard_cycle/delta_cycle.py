@@ -13,8 +13,8 @@ import numpy as np
 
 from pinarms.robots.delta import DeltaRobot, closed_chain_state, inverse_position, motor_torques
 
-from .path import StandardCycle, gate_breaks, gate_length, gate_points
-from .timing import GateTiming, JointPathRows, time_rows
+from pinarms.optim.standard_cycle.path import StandardCycle, gate_breaks, gate_length, gate_points
+from pinarms.optim.standard_cycle.timing import GateTiming, JointPathRows, time_rows
 
 __all__ = ["delta_path_rows", "delta_gate_rows", "delta_standard_cycle"]
 

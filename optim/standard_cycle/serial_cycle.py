@@ -15,8 +15,8 @@ import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
 
-from .path import StandardCycle, gate_breaks, gate_length, gate_points
-from .timing import GateTiming, JointPathRows, time_rows
+from pinarms.optim.standard_cycle.path import StandardCycle, gate_breaks, gate_length, gate_points
+from pinarms.optim.standard_cycle.timing import GateTiming, JointPathRows, time_rows
 
 __all__ = ["serial_gate_rows", "serial_standard_cycle"]
 

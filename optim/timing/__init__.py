@@ -9,7 +9,20 @@
 
 """
 
-from . import segments as _segments
-from .segments import *  # noqa: F401,F403
+from __future__ import annotations
 
-__all__ = list(_segments.__all__)
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "TimingResult": "pinarms.optim.timing.segments",
+    "minimize_time": "pinarms.optim.timing.segments",
+    "finish_timing": "pinarms.optim.timing.segments",
+    "rescale_to_limits": "pinarms.optim.timing.segments",
+}
+
+__all__ = [
+    "TimingResult", "minimize_time", "finish_timing", "rescale_to_limits",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -8,7 +8,7 @@ forward-difference Jacobians (all perturbed timings evaluated in one batched pea
 converges in a few dozen iterations.
 
 Start points come from the scaling laws: for ratios ``r`` the smallest feasible total is
-``s*(r)`` (see :mod:`optim.ga.problem`), so ``h0 = s*(r) r`` is feasible for equal ratios,
+``s*(r)`` (see :mod:`pinarms.optim.ga.problem`), so ``h0 = s*(r) r`` is feasible for equal ratios,
 ratios from the segment lengths, their square roots and seeded random ratios. The best
 SLSQP answer is finally rescaled along its own ratios onto the limits
 (``s*(r) (1 + SAFETY)``, within the bounds), which makes it feasible by construction
@@ -92,7 +92,7 @@ def polish_durations(problem: TimingProblem, durations: np.ndarray,
     """Local refinement of a timing: SLSQP started from ``durations``, rescaled onto the limits.
 
     The answer is the local minimum of the total nearest (for SLSQP) to the given timing,
-    not a global search: :func:`optim.minimize_time` uses it as the optional final polish
+    not a global search: :func:`pinarms.optim.minimize_time` uses it as the optional final polish
     of a GA answer (``polish=True``). Returns the better of the refined and the given
     timing (both rescaled onto the limits by :func:`scaled_to_limits`) and whether it
     meets the upper bounds.

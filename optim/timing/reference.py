@@ -7,8 +7,8 @@
   by TOPP-RA (Pham and Pham 2018; the ``toppra`` package, optional: ``pip install
   pinarms[reference]``). The path is a cubic spline through samples of the trajectory spaced
   evenly in joint-space arc length, cut where the trajectory rests.
-- :func:`toppra_path_duration`: TOPP-RA (toppra) on a :class:`planning.JointPath` itself,
-  read through an adapter (the same q(s), q'(s), q''(s) that :func:`optim.time_optimal`
+- :func:`toppra_path_duration`: TOPP-RA (toppra) on a :class:`pinarms.planning.JointPath` itself,
+  read through an adapter (the same q(s), q'(s), q''(s) that :func:`pinarms.optim.time_optimal`
   uses), on a grid of the caller's choice: the independent check of the time scaling
   written here.
 - :func:`ruckig_limit` / :func:`double_s_limit`: jerk-limited, rest-to-rest point to
@@ -99,7 +99,7 @@ def toppra_limit(trajectory: Trajectory, vmax: JointLimit, amax: JointLimit | No
     Args:
         trajectory: the path (its geometric shape is kept, its timing is not).
         vmax: velocity limits per joint (required); amax: acceleration limits or None.
-        robot, torque_limits, payload: as in :func:`optim.minimize_time`: with torque limits
+        robot, torque_limits, payload: as in :func:`pinarms.optim.minimize_time`: with torque limits
             (``True``: the URDF's efforts) TOPP-RA's ``JointTorqueConstraint`` gets the
             robot's inverse dynamics (Pinocchio's RNEA, payload included), no dry friction.
 
@@ -151,7 +151,7 @@ def toppra_limit(trajectory: Trajectory, vmax: JointLimit, amax: JointLimit | No
 
 
 def toppra_path(path: JointPath) -> Any:
-    """``path`` (a :class:`planning.JointPath`) as toppra's geometric path: toppra reads q, q', q''
+    """``path`` (a :class:`pinarms.planning.JointPath`) as toppra's geometric path: toppra reads q, q', q''
     through ``path.sample(s)`` directly (no spline fitted in between)."""
     try:
         from toppra.interpolator import AbstractGeometricPath
@@ -176,7 +176,7 @@ def toppra_path(path: JointPath) -> Any:
 
 def toppra_path_duration(path: JointPath, vmax: JointLimit, amax: JointLimit, gridpoints: np.ndarray, *, tool_speed: float | None = None,
                          discretization: str = "interpolation") -> float:
-    """Duration (s) of toppra's time-optimal parameterisation of ``path`` (a :class:`planning.JointPath`).
+    """Duration (s) of toppra's time-optimal parameterisation of ``path`` (a :class:`pinarms.planning.JointPath`).
 
     Args:
         path: the joint path; toppra evaluates ``path.sample(s)`` (q, q', q'') directly.

@@ -1,13 +1,13 @@
 """What a minimum-time timing is asked: :class:`TimingRequest`, one frozen object checked when
-built, and :class:`TimingStatus`, how :func:`optim.minimize_time` ended.
+built, and :class:`TimingStatus`, how :func:`pinarms.optim.minimize_time` ended.
 
-Statuses and exceptions (:mod:`optim.status`): a malformed request (limits, via points,
+Statuses and exceptions (:mod:`pinarms.optim.status`): a malformed request (limits, via points,
 bounds, method, seed, generations, torque settings) raises when the request is built, before
 any work. Every returned :class:`TimingResult` holds a timing verified against the limits;
 its ``status`` says how the optimiser ended (the exact solver's optimum, or why the GA
 stopped: a time limit or a callback leaves a feasible answer that may not be the best, and
 ``status_reason`` says so). When no timing within the bounds meets the limits there is no
-trajectory to return: :func:`optim.minimize_time` raises :class:`InfeasibleProblem`.
+trajectory to return: :func:`pinarms.optim.minimize_time` raises :class:`InfeasibleProblem`.
 """
 
 from __future__ import annotations
@@ -69,11 +69,11 @@ class TimingRequest:
             total with equal durations (so equal durations s0/m are inside and feasible).
             Pass wider bounds if one segment may need more than 4x the average.
         max_generations, stall_generations, time_limit: GA stopping rules (``max_generations``
-            1 to :data:`optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
+            1 to :data:`pinarms.optim.caps.MAX_GENERATIONS`, else ``SettingOutOfRange``).
         rescale: GA only: scale the GA's best (same ratios) down until the first limit is
             reached; the unscaled total is kept in ``raw_total``.
         polish: GA only: refine the GA's (rescaled) answer by a local gradient method
-            (SLSQP from it, :func:`optim.timing.exact.polish_durations`) and keep the better of
+            (SLSQP from it, :func:`pinarms.optim.timing.exact.polish_durations`) and keep the better of
             the two; the result's method is then ``"ga+polish"`` and the GA's own total is
             kept in ``unpolished_total``. Off by default: the default answer is the GA's.
         initial: GA only: (k, m) durations put into the initial population (e.g. the
@@ -82,13 +82,13 @@ class TimingRequest:
         problem: A prebuilt :class:`TimingProblem` (then positions/kind/limits/bounds
             are not given); else the problem built from them when the request is built.
         robot: The arm whose joints the via points are; needed for torque limits.
-        payload: What the tcp carries: a mass [kg], a :class:`robots.Payload` or its dict
+        payload: What the tcp carries: a mass [kg], a :class:`pinarms.robots.Payload` or its dict
             form (``robot.with_payload``); only with ``torque_limits``.
         torque_limits: ``True``: also limit every joint's torque to the URDF's ``effort``
             (``robot.effort_limit``, N·m or N); or limits per joint; ``False``: kinematic
             limits only. The torques (inverse dynamics of the robot with its payload) are
             checked on ``torque_samples`` instants per piece (default 48) with their own
-            scaling law (:mod:`optim.torque`), and the answer is finally stretched onto the
+            scaling law (:mod:`pinarms.optim.torque`), and the answer is finally stretched onto the
             refined torque peaks, so it is feasible when re-checked densely. A torque-limited
             timing is never shorter than the kinematic one.
         torque_samples: Grid instants per polynomial piece for the torque constraint.

@@ -1,12 +1,12 @@
 """Minimum-time segment timing of a trajectory through via points: GA or exact.
 
-``minimize_time`` is the user-facing entry: it takes a :class:`~optim.timing.request.TimingRequest`
-(checked when built, with its :class:`~optim.ga.problem.TimingProblem`), solves it with the GA
+``minimize_time`` is the user-facing entry: it takes a :class:`~pinarms.optim.timing.request.TimingRequest`
+(checked when built, with its :class:`~pinarms.optim.ga.problem.TimingProblem`), solves it with the GA
 of this package (``method="ga"``) or with the deterministic scaling-law optimiser
 (``method="exact"``), verifies the answer with planning's exact peaks, and returns a
 :class:`TimingResult` whose ``status`` (:class:`TimingStatus`) says how the optimiser ended. It
 never returns an infeasible timing: with none within the bounds it raises
-:class:`InfeasibleProblem` (there is no trajectory to return; :mod:`optim.status`).
+:class:`InfeasibleProblem` (there is no trajectory to return; :mod:`pinarms.optim.status`).
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ class TimingResult:
         unpolished_total: ``"ga+polish"``: total (s) of the GA's answer (rescaled onto the
             limits) before the local polish; None otherwise.
         torque_peaks: with torque limits, the refined per-joint torque peaks of
-            ``trajectory`` (:class:`planning.TorquePeaks`, N·m or N); None otherwise.
+            ``trajectory`` (:class:`pinarms.planning.TorquePeaks`, N·m or N); None otherwise.
         torque_limit: the torque limits (n,) used [N·m or N], or None.
         status: how the optimiser ended (:class:`TimingStatus`: ``SOLVED`` for the exact
             solver, else the GA's stop reason); the timing is verified in every case.
@@ -150,7 +150,7 @@ def minimize_time(request: TimingRequest, *,
 
     Args:
         request: what to time and how (:class:`TimingRequest`, checked when built).
-        callback: GA progress callback (see :func:`optim.run_ga`); returning True stops the GA
+        callback: GA progress callback (see :func:`pinarms.optim.run_ga`); returning True stops the GA
             (status :attr:`TimingStatus.CALLBACK`).
 
     Returns:

@@ -18,10 +18,10 @@ time-optimal answer (weighted: the time-optimal timing; two-stage: T* scaled up 
 cap). For ratios r and total s, J = J1(r) s^-5 (J1 the cost at total 1), so the
 two-stage optimum uses the whole allowed time (unless the upper bounds stop it). ``method="ga"`` runs the GA on h.
 
-:func:`minimize_time_jerk` takes the same :class:`~optim.timing.request.TimingRequest` as
+:func:`minimize_time_jerk` takes the same :class:`~pinarms.optim.timing.request.TimingRequest` as
 :func:`minimize_time` (via points, limits, method, seed, GA settings) and the trade's own
 options; bad input raises when the request is built or before any work, and no feasible
-timing raises :class:`InfeasibleProblem` (:mod:`optim.status`).
+timing raises :class:`InfeasibleProblem` (:mod:`pinarms.optim.status`).
 """
 
 from __future__ import annotations

@@ -11,7 +11,25 @@
 
 """
 
-from . import profile as _profile
-from .profile import *  # noqa: F401,F403
+from __future__ import annotations
 
-__all__ = list(_profile.__all__)
+from pinarms.lazy import lazy_exports
+
+#: Where each public name is defined: loaded on first use (:func:`pinarms.lazy.lazy_exports`).
+_EXPORTS = {
+    "Profile": "pinarms.optim.topp.profile",
+    "feasible_states": "pinarms.optim.topp.profile",
+    "controllable_sets": "pinarms.optim.topp.profile",
+    "greedy_profile": "pinarms.optim.topp.profile",
+    "interpolated_rows": "pinarms.optim.topp.profile",
+    "topp_profile": "pinarms.optim.topp.profile",
+    "reachability_profile": "pinarms.optim.topp.profile",
+    "X_CAP": "pinarms.optim.topp.profile",
+}
+
+__all__ = [
+    "Profile", "feasible_states", "controllable_sets", "greedy_profile", "interpolated_rows", "topp_profile",
+    "reachability_profile", "X_CAP",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,10 +1,10 @@
-"""Compiled loops of :mod:`optim.topp.profile` (numba): the backward pass and the greedy forward pass.
+"""Compiled loops of :mod:`pinarms.optim.topp.profile` (numba): the backward pass and the greedy forward pass.
 
 Each step of both passes is a minimum and a maximum of rows ``slope · y + offset`` over every
 row of one grid point (y: μ or λ of the next controllable set, or the state itself), the same
 product and sum per row as the Python loops they replace, in the same order of grid points:
 the same bits. A row that does not apply carries the neutral offset (+inf for an upper bound,
-−inf for a lower one, :func:`optim.topp.row_bounds.row_bounds`) and a zero slope, so it never
+−inf for a lower one, :func:`pinarms.optim.topp.row_bounds.row_bounds`) and a zero slope, so it never
 decides a minimum or a maximum; no row needs to be left out beforehand.
 """
 
@@ -92,7 +92,7 @@ def forward_pass(up_s, up_o, dn_s, dn_o, delta, K, x_first, cap, xs, us):
 
 @jit
 def pair_states(a, b, lo, hi, lower, upper, xlo, xhi):
-    """The x-interval each grid point's pairs of rows admit (:func:`optim.topp.profile.feasible_states`).
+    """The x-interval each grid point's pairs of rows admit (:func:`pinarms.optim.topp.profile.feasible_states`).
 
     For a lower row ``(a, b, lo)`` and an upper row ``(a', b', hi')`` (``lower``/``upper`` say which
     rows are, a > 0) some u exists iff ``(a b' − a' b) x <= a hi' − a' lo``; ``xlo``, ``xhi`` (N,)

@@ -1,11 +1,11 @@
 """The checks of a path timing against its constraints: rows between grid points, along a time law, exact peaks.
 
-The profile (:func:`optim.topp.topp_profile`) meets the rows at the grid points only. These
+The profile (:func:`pinarms.optim.topp.topp_profile`) meets the rows at the grid points only. These
 checks read the rows elsewhere — at fractions :data:`CHECK_FRACTIONS` of every grid interval
 or law piece — and say which uniform time dilation f each needs (:func:`dilation_needed`,
 as f²) and how close each constraint comes to its bound (:func:`ratios`). For joint limits
 :class:`Peaked` gives the composed trajectory's exact peaks (what
-:meth:`planning.PathConstraint.exact_dilation` reads).
+:meth:`pinarms.planning.PathConstraint.exact_dilation` reads).
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """The reachability grid of a path section, and the profile on it checked and refined (path_timing, steps 2–4).
 
 :func:`path_grid` places the grid points (the path's breaks, equal steps, halved where the
-tangent bends); :func:`refined_section` runs :func:`optim.topp.topp_profile` on it, checks
+tangent bends); :func:`refined_section` runs :func:`pinarms.optim.topp.topp_profile` on it, checks
 the rows between grid points and splits the intervals that exceed them, until they pass or
-the rounds run out. A grid never grows past :data:`optim.caps.MAX_PATH_GRID_POINTS`.
+the rounds run out. A grid never grows past :data:`pinarms.optim.caps.MAX_PATH_GRID_POINTS`.
 """
 
 from __future__ import annotations

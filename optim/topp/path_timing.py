@@ -1,8 +1,8 @@
 """Time-optimal timing of a geometric path under a list of constraints: a ``Trajectory`` out.
 
-:func:`time_optimal` takes a :class:`planning.JointPath` ``q(s)`` (a Cartesian line's
-joint image, a joint spline, ...) and :mod:`planning.path_constraints` objects, and
-returns a :class:`PathTiming` whose ``trajectory`` is a :class:`planning.Trajectory` like
+:func:`time_optimal` takes a :class:`pinarms.planning.JointPath` ``q(s)`` (a Cartesian line's
+joint image, a joint spline, ...) and :mod:`pinarms.planning.path_constraints` objects, and
+returns a :class:`PathTiming` whose ``trajectory`` is a :class:`pinarms.planning.Trajectory` like
 every other (sampling, exact peaks, limit checks, sessions, plots, viewer).
 
 1. **Sections.** The path is cut at its stops (tangent discontinuities): each section is
@@ -10,7 +10,7 @@ every other (sampling, exact peaks, limit checks, sessions, plots, viewer).
 2. **Grid.** The path's own breaks, each piece cut in equal steps so that the whole path
    has about ``grid`` intervals, then intervals halved until the tangent ``q'`` changes by
    at most ``kappa`` (2 %) of its size across each (dense where the path bends).
-3. **Profile.** :func:`optim.topp.topp_profile` (TOPP-RA, interpolation
+3. **Profile.** :func:`pinarms.optim.topp.topp_profile` (TOPP-RA, interpolation
    discretisation) on the rows of all constraints: ``ṡ²`` at the grid points, constant
    ``s̈`` between.
 4. **Check and refine.** Between grid points the rows are evaluated at 1/4, 1/2, 3/4 and
@@ -75,9 +75,9 @@ class PathTiming:
     """A timing of a path (see the module docstring).
 
     Attributes:
-        path: the :class:`planning.JointPath` timed.
+        path: the :class:`pinarms.planning.JointPath` timed.
         constraints: the constraint objects used.
-        trajectory: q(t), a :class:`planning.Trajectory` (q(s(t)) composed exactly).
+        trajectory: q(t), a :class:`pinarms.planning.Trajectory` (q(s(t)) composed exactly).
         law_breaks: (P+1,) instants [s] of the pieces of the time law s(t).
         law_coefficients: (P, k+1) s(t) on each piece, ascending powers of the time since its
             start (k = 2: the time-optimal profile; k = 3: smoothed under a jerk limit).
@@ -233,8 +233,8 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
     """Time-optimal timing of ``path`` under ``constraints`` (module docstring).
 
     Args:
-        path: a :class:`planning.JointPath` (q(s) piecewise polynomial, with ``stops``).
-        constraints: :class:`planning.path_constraints.PathConstraint` objects, e.g.
+        path: a :class:`pinarms.planning.JointPath` (q(s) piecewise polynomial, with ``stops``).
+        constraints: :class:`pinarms.planning.path_constraints.PathConstraint` objects, e.g.
             ``[JointVelocityConstraint(v), JointAccelerationConstraint(a), ToolSpeedConstraint(0.5)]``.
         jerk: joint jerk limit(s) [rad/s³ or m/s³] (scalar or per joint): a smoothed result
             (module docstring), only from rest to rest (``start_speed = end_speed = 0``).

@@ -9,17 +9,17 @@ grid for both, best of 11 repeats), the rows plus this profile take 5.03 ms agai
 for toppra 0.6.10's ``compute_parameterization`` (0.08×, two shared cores, load 4.8; before
 the loops were compiled: 44.2 ms against 55.6 ms, 0.80×), with the same duration (9.063810 s
 both). It is faster than toppra, keeps the timings' figures to the last bit (toppra's answer
-differs by its own rounding), and takes every :class:`planning.PathConstraint` as rows. The
-whole timing (:func:`optim.time_optimal`: refined grid, checks between grid points, exact
+differs by its own rounding), and takes every :class:`pinarms.planning.PathConstraint` as rows. The
+whole timing (:func:`pinarms.optim.time_optimal`: refined grid, checks between grid points, exact
 joint peaks, q(t) composed exactly) takes 1.9× toppra's ``compute_trajectory`` (56.6 ms
 against 30.4 ms, same run; 3.3–4.4× before), which does none of that (its duration is 0.034 %
 shorter: it meets the limits at the grid points only). toppra (test extra) stays the
-independent cross-check (:func:`optim.toppra_path_duration`, ``tests/optim/topp/test_path_timing.py``).
+independent cross-check (:func:`pinarms.optim.toppra_path_duration`, ``tests/optim/topp/test_path_timing.py``).
 
 On a grid ``s_0 < … < s_N`` with steps ``Δ_i`` the state is ``x_i = ṡ²(s_i)`` and the
 control ``u_i = s̈`` is constant on ``[s_i, s_{i+1}]``, so ``x_{i+1} = x_i + 2 Δ_i u_i``. At
 each grid point the limits are rows ``lo <= a u + b x <= hi``
-(:class:`planning.PathRows`, collocation: the point's rows with that interval's u).
+(:class:`pinarms.planning.PathRows`, collocation: the point's rows with that interval's u).
 
 1. **Controllable sets, backwards.** ``K_N = {x_end}``; ``K_i`` is the set of x at s_i from
    which some admissible u reaches ``K_{i+1}``. It is an interval: u must satisfy every
@@ -40,7 +40,7 @@ each grid point the limits are rows ``lo <= a u + b x <= hi``
    the result is time-optimal on the grid (the paper's theorem).
 
 The profile's duration is ``sum 2 Δ_i / (√x_i + √x_{i+1})`` (exact for constant s̈ on each
-interval). Limits are enforced at the grid points only; :func:`optim.time_optimal` checks
+interval). Limits are enforced at the grid points only; :func:`pinarms.optim.time_optimal` checks
 between them and refines the grid where needed.
 """
 

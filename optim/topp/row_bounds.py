@@ -1,6 +1,6 @@
 """The rows of the TOPP-RA loops as bounds on the state x.
 
-Both passes of :mod:`optim.topp.profile` reduce, at each grid point, rows ``c x <= slope y +
+Both passes of :mod:`pinarms.optim.topp.profile` reduce, at each grid point, rows ``c x <= slope y +
 offset`` (y: the neighbouring set's end in step 1, the state itself in step 2) to a min and
 a max. :func:`row_bounds` writes the rows as upper and lower bounds on x, each row that does
 not apply with a neutral offset, so that the compiled loops (:mod:`._profile_kernel`) reduce

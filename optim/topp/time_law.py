@@ -2,9 +2,9 @@
 
 A law is ``(tb, C)``: breaks ``tb`` (P+1,) [s] and ascending coefficients ``C`` (P, k+1) of
 s(t) in the time since each piece's start (k = 2 for the time-optimal profile, 3 once
-smoothed under a jerk limit, the shape's degree for :func:`optim.time_scaled`). This module
+smoothed under a jerk limit, the shape's degree for :func:`pinarms.optim.time_scaled`). This module
 builds laws (:func:`bang_bang`, :func:`smoothed`, :func:`scaled_law`), evaluates them
-(:func:`law_eval`), and turns them into a :class:`planning.Trajectory` exactly
+(:func:`law_eval`), and turns them into a :class:`pinarms.planning.Trajectory` exactly
 (:func:`assemble`: pieces cut at the path's breaks, ``q(s(t))`` a polynomial in t on each).
 """
 
@@ -65,7 +65,7 @@ def _polyint(C: np.ndarray) -> np.ndarray:
 def smoothed(tb: np.ndarray, C: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
     """The law averaged over a trailing window τ: ``s_τ(t) = (1/τ) ∫_{t−τ}^{t} s`` on [t0, t_end + τ].
 
-    (:mod:`optim.topp.path_timing`, jerk.) The law is extended at rest before its start and after its end.
+    (:mod:`pinarms.optim.topp.path_timing`, jerk.) The law is extended at rest before its start and after its end.
     """
     a, b = C[0, 0], law_eval(tb, C, tb[-1:])[0][0]
     # the law at rest before its start and after its end, one piece each (length τ)

@@ -1,6 +1,6 @@
 """The joint torque rows of several samplings of a path from one batched inverse dynamics call.
 
-:class:`planning.torque.JointTorqueConstraint` gives at each sample ``a = M(q) q'``,
+:class:`pinarms.planning.torque.JointTorqueConstraint` gives at each sample ``a = M(q) q'``,
 ``b = M(q) q'' + C(q, q') q'`` and the bounds ``±L − g(q)`` from three RNEA evaluations:
 ``g = τ(q, 0, 0)``, ``a = τ(q, 0, q') − g``, ``b = τ(q, q', q'') − g``. :func:`torque_rows`
 evaluates the same three for every point of every sampling in **one** call of Pinocchio's

@@ -15,7 +15,7 @@ A new command group is a new module here that decorates its commands with
 
 from __future__ import annotations
 
-from . import (  # noqa: F401  (each module registers its commands on ``cli``)
+from pinarms.cli import (  # noqa: F401  (each module registers its commands on ``cli``)
     belt_commands,
     cell_commands,
     cycle_commands,
@@ -32,7 +32,7 @@ from . import (  # noqa: F401  (each module registers its commands on ``cli``)
     warm_command,
     workspace_commands,
 )
-from ._common import cli, main
-from .via_points import read_via_file
+from pinarms.cli._common import cli, main
+from pinarms.cli.via_points import read_via_file
 
 __all__ = ["cli", "main", "read_via_file"]

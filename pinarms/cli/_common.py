@@ -15,7 +15,7 @@ import click
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 from pinarms.robots.robot import Robot
 
 __all__ = ["cli", "main", "json_option", "skipped_pair_lines", "package_map", "PinarmsCommand", "name_the_flag", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
@@ -282,7 +282,7 @@ scheduler_option = click.option(
 
 
 def new_session(robot: Robot | str | None, title: str):
-    """A :class:`viz.Session` for ``robot`` (built-in name or any URDF)."""
+    """A :class:`pinarms.viz.Session` for ``robot`` (built-in name or any URDF)."""
     from pinarms import viz
 
     return viz.Session(robot=robot, title=title)

@@ -12,10 +12,10 @@ from dataclasses import replace
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._common import cli, emit, json_option, progress_bar, scheduler_option
-from .belt_robot import box_value, grid_value, load_belt_robot, robot_options
+from pinarms.cli._common import cli, emit, json_option, progress_bar, scheduler_option
+from pinarms.cli.belt_robot import box_value, grid_value, load_belt_robot, robot_options
 
 PRESETS = ("scara", "gantry")
 
@@ -122,7 +122,7 @@ def _maps(spec, robot: dict | None, as_json: bool, scheduler=None) -> dict:
             except BeltOutOfReach as exc:
                 raise InvalidInput(f"--speed: {' '.join(str(exc).split())}") from None
     from pinarms.optim.line.errors import BeltOutOfReach
-    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.errors import UnreachableTarget
 
     with _progress(as_json) as step:
         try:

@@ -18,9 +18,9 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 
-from ._common import floats, package_map
+from pinarms.cli._common import floats, package_map
 
 __all__ = ["robot_options", "load_belt_robot", "box_value", "grid_value", "TOOL_AXES", "TOOL_LINK"]
 

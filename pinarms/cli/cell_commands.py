@@ -10,11 +10,11 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
+from pinarms.cli._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
                       skipped_pair_lines)
-from .motion_commands import hold_option
+from pinarms.cli.motion_commands import hold_option
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."

@@ -10,7 +10,7 @@ from pinarms.units import (
     mass_kg,
 )
 
-from ._common import (
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 import click
 
-from . import _common as common
-from ._common import (
+from pinarms.cli import _common as common
+from pinarms.cli._common import (
     cli,
     emit,
     json_option,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._common import (
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

@@ -7,10 +7,10 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import angle_scale, joints_from_si, joints_to_si, length_scale
 
-from ._common import (NUMBERS, PinarmsCommand, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
+from pinarms.cli._common import (NUMBERS, PinarmsCommand, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
                       si_limit)
 
 #: Options that take a pose: X Y Z, optionally followed by ROLL PITCH YAW.

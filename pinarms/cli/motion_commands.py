@@ -13,12 +13,12 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import angle_scale, length_scale
 
-from ._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
-from ._common import package_map
-from .line_commands import _pose, _PoseCommand
+from pinarms.cli._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
+from pinarms.cli._common import package_map
+from pinarms.cli.line_commands import _pose, _PoseCommand
 
 __all__ = ["load_any_cell", "hold_option"]
 

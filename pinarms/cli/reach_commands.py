@@ -7,7 +7,7 @@ import numpy as np
 
 from pinarms.units import parse_angle, parse_length
 
-from ._common import _scheduler_value, cli, emit, json_option, load_robot, new_session, progress_bar, save_session
+from pinarms.cli._common import _scheduler_value, cli, emit, json_option, load_robot, new_session, progress_bar, save_session
 
 
 @cli.command("reach")

@@ -6,7 +6,7 @@ import click
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import (
     angle_scale,
     joints_from_si,
@@ -15,7 +15,7 @@ from pinarms.units import (
     prismatic_mask,
 )
 
-from ._common import (
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,
@@ -159,7 +159,7 @@ def ik_cmd(robot: str, pose: tuple[float, ...], all_solutions: bool, deg: bool, 
     solutions that miss a joint range by less than 1° (1 mm) are named with how far they
     miss; --limit-tol accepts them (a solution within the limits is always preferred).
     """
-    from pinarms.robots.errors import UnreachableTarget
+    from pinarms.errors import UnreachableTarget
     from pinarms.robots.ik import near_limit_solutions
 
     arm = load_robot(robot)

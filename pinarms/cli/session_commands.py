@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from ._common import (
+from pinarms.cli._common import (
     cli,
     emit,
     json_option,

@@ -8,15 +8,15 @@ from typing import Any
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
 from pinarms.units import (
     angle_scale,
     prismatic_mask,
 )
 
-from . import _common as common
-from ._common import (
+from pinarms.cli import _common as common
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,
@@ -29,7 +29,7 @@ from ._common import (
     save_session,
     si_limit,
 )
-from .via_points import TRAJECTORY_KINDS, via_input
+from pinarms.cli.via_points import TRAJECTORY_KINDS, via_input
 
 OPTIMIZE_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
 

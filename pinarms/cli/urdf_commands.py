@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._common import (
+from pinarms.cli._common import (
     PinarmsGroup,
     cli,
     emit,
@@ -17,7 +17,7 @@ from ._common import (
     json_option,
     load_robot,
 )
-from ._common import package_map
+from pinarms.cli._common import package_map
 
 
 # --------------------------------------------------------------------------- urdf

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
+from pinarms.cli._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
 
 
 @cli.group("verify", cls=PinarmsGroup)
@@ -47,10 +47,10 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
     """
     from pinarms.export.verify import compare_configurations_in_mujoco, compare_in_mujoco
 
-    from ._common import package_map
-    from .cell_commands import _load
+    from pinarms.cli._common import package_map
+    from pinarms.cli.cell_commands import _load
 
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     if samples < 2:
         raise InvalidInput(f"--samples must be 2 or more, got {samples}")
@@ -78,7 +78,7 @@ def _arm_state(c, arm, text: str, end: str):
     """A --plan end: a named state of ``arm`` or its comma-separated joint values, checked against its length."""
     import numpy as np
 
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     states = {"neutral": np.array(c.neutral[arm.q_slice]), **dict(getattr(arm, "states", None) or {})}
     if text.strip() in states:
@@ -97,7 +97,7 @@ def _plan_between(c, arm_name: str | None, ends: tuple[str, str], *, margin: flo
                   amax):
     """The planned move of ``--plan FROM TO`` (errors name --plan, --arm, --margin or --time-limit)."""
     from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest, MotionStatus, plan_motion
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     if arm_name is None:
         if len(c.arms) != 1:

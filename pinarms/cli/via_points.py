@@ -18,9 +18,9 @@ import click
 import numpy as np
 
 from pinarms.files import read_bounded_text
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from ._common import floats
+from pinarms.cli._common import floats
 
 __all__ = ["TRAJECTORY_KINDS", "read_via_file", "via_input"]
 

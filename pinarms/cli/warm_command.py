@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import click
 
-from . import _common as common
-from ._common import cli, emit, json_option
+from pinarms.cli import _common as common
+from pinarms.cli._common import cli, emit, json_option
 
 
 @cli.command("warm")

@@ -7,11 +7,11 @@ import click
 import numpy as np
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.units import length_scale
 
-from . import _common as common
-from ._common import (
+from pinarms.cli import _common as common
+from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,

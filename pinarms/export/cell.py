@@ -31,12 +31,12 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .mesh_convert import binary_stl
-from .mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
-from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
-from .srdf import geometry_links, home_notes, srdf_text
+from pinarms.export.mesh_convert import binary_stl
+from pinarms.export.mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
+from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
+from pinarms.export.srdf import geometry_links, home_notes, srdf_text
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
 
@@ -165,7 +165,7 @@ def _mujoco():
     try:
         import mujoco
     except ImportError as exc:
-        from pinarms.robots.errors import ModelError
+        from pinarms.errors import ModelError
 
         raise ModelError("the MJCF export needs MuJoCo's Python package: pip install mujoco "
                          "(or pip install 'pinarms[mujoco]')") from exc

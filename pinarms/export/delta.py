@@ -20,9 +20,9 @@ import pinocchio as pin
 
 from pinarms.files import publish_folder
 from pinarms.robots.delta import DeltaRobot, closures_to_xml, load_delta
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 
-from .urdf_files import _check_folder
+from pinarms.export.urdf_files import _check_folder
 
 __all__ = ["ExportedDelta", "delta_mjcf_text", "export_delta", "closure_site"]
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.robots.delta import ClosedChainState, DeltaRobot, ProjectionFailed, forward_position
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 
 __all__ = ["DeltaReplay", "replay_delta_in_mujoco", "mujoco_motor_torques"]
 

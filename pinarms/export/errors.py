@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pinarms.robots.errors import InvalidInput, MissingMesh, PinarmsError
+from pinarms.errors import InvalidInput, MissingMesh, PinarmsError
 
 __all__ = ["ExportError", "MeshNotFound", "MeshNotAllowed", "InvalidRate", "JointMismatch", "InvalidJointName", "TrajectoryFileError"]
 

@@ -21,9 +21,9 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Iterator
 
 from pinarms.files import path_inside
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 
-from .errors import MeshNotFound
+from pinarms.export.errors import MeshNotFound
 
 __all__ = ["collada_to_obj", "binary_stl", "is_ascii_stl", "mujoco_conversions", "OBJ_DIGITS"]
 

@@ -36,7 +36,7 @@ from typing import Mapping
 
 from pinarms.files import safe_file_name
 
-from .errors import MeshNotAllowed, MeshNotFound
+from pinarms.export.errors import MeshNotAllowed, MeshNotFound
 
 __all__ = ["MESH_SUFFIXES", "TEXTURE_SUFFIXES", "MAX_COPY_BYTES", "MeshFolders", "MeshSource", "mesh_source",
            "collada_textures"]

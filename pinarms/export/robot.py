@@ -7,7 +7,7 @@
         meshes/<package>/... every mesh it references (and the images a COLLADA mesh uses)
 
 so that PyBullet, MuJoCo, yourdfpy, MATLAB ``importrobot`` or ROS load it without pinarms
-and without a ROS package path. The URDF text is the one the :class:`robots.Robot` was
+and without a ROS package path. The URDF text is the one the :class:`pinarms.robots.Robot` was
 built from (joints frozen by the registry stay frozen), edited only in its ``<mesh
 filename=...>`` attributes: everything else, ``<mimic>`` included, is kept byte for byte.
 (yourdfpy's ``write_xml`` is not used: it drops ``<mimic>``.)
@@ -27,12 +27,12 @@ from typing import Mapping
 
 from pinarms import robots
 from pinarms.files import safe_file_name
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
-from .cell import export_robot_with_srdf
-from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
-from .urdf_files import SITE_SIZE_M, ExportedURDF, mesh_references  # noqa: F401  (public names of this module)
+from pinarms.export.cell import export_robot_with_srdf
+from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
+from pinarms.export.urdf_files import SITE_SIZE_M, ExportedURDF, mesh_references  # noqa: F401  (public names of this module)
 
 __all__ = ["ExportedURDF", "ExportedMJCF", "export_urdf", "export_mjcf", "mesh_references"]
 
@@ -43,7 +43,7 @@ def export_urdf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, overw
     """Write a self-contained URDF folder for ``robot_or_name`` into ``out_dir``.
 
     Args:
-        robot_or_name: a :class:`robots.Robot` or a name :func:`robots.load` accepts.
+        robot_or_name: a :class:`pinarms.robots.Robot` or a name :func:`pinarms.robots.load` accepts.
         out_dir: the folder to create. It must not exist or be empty, unless ``overwrite``. A
             symbolic link to a folder is written through (the link stays). The folder gets the
             umask's permissions.

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-from .srdf import cycle_states
+from pinarms.export.srdf import cycle_states
 
 __all__ = ["ShippedMotion", "shipped_motions", "study_states", "STUDY_CELLS"]
 

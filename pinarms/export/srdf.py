@@ -35,7 +35,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "home_notes", "cycle_states"]
 

@@ -38,11 +38,11 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from pinarms.robots.errors import InvalidInput, LimitViolation
+from pinarms.errors import InvalidInput, LimitViolation
 from pinarms.files import atomic_write
 
-from .acceleration_check import acceleration_limits_of, flag_accelerations
-from .errors import InvalidJointName, InvalidRate, JointMismatch
+from pinarms.export.acceleration_check import acceleration_limits_of, flag_accelerations
+from pinarms.export.errors import InvalidJointName, InvalidRate, JointMismatch
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
            "line_arm_sampler", "check_joint_names", "ROS_NAME"]
@@ -169,10 +169,10 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
     """Sample ``source`` at ``rate`` [Hz] for a controller (module doc).
 
     Args:
-        source: a :class:`planning.Trajectory`, :class:`optim.CycleResult`,
-            :class:`optim.motion.MotionPlan` or :class:`optim.LineSchedule`.
+        source: a :class:`pinarms.planning.Trajectory`, :class:`pinarms.optim.CycleResult`,
+            :class:`pinarms.optim.motion.MotionPlan` or :class:`pinarms.optim.LineSchedule`.
         rate: samples per second (> 0).
-        robot: the :class:`robots.Robot` it is for, or the cell (then ``arm`` names the arm;
+        robot: the :class:`pinarms.robots.Robot` it is for, or the cell (then ``arm`` names the arm;
             joint names carry the arm's prefix). Not needed for a MotionPlan.
         cycles: with a LineSchedule, the ``{arm: CycleResult}`` it scheduled.
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from pinarms.files import read_bounded_text
 
-from .errors import JointMismatch, TrajectoryFileError
-from .trajectory import MAX_POINTS, ControllerTrajectory
+from pinarms.export.errors import JointMismatch, TrajectoryFileError
+from pinarms.export.trajectory import MAX_POINTS, ControllerTrajectory
 
 __all__ = ["read_trajectory_yaml", "read_trajectory_csv", "MAX_FILE_BYTES", "MAX_JOINTS"]
 

@@ -15,12 +15,12 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Mapping
 
 from pinarms.files import copy_new_file, output_folder, path_inside, publish_folder, safe_file_name, write_new_file
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
-from .errors import ExportError, MeshNotAllowed
-from .mesh_convert import mujoco_conversions
-from .mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
+from pinarms.export.errors import ExportError, MeshNotAllowed
+from pinarms.export.mesh_convert import mujoco_conversions
+from pinarms.export.mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
 
 __all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
            "copy_files", "SITE_SIZE_M"]

@@ -35,9 +35,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinarms.robots.collision_requests import cold_start
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 
-from .srdf import contact_pairs
+from pinarms.export.srdf import contact_pairs
 
 __all__ = ["EngineComparison", "compare_in_mujoco", "compare_configurations_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
 
@@ -163,7 +163,7 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
     """Replay ``source`` in MuJoCo and compare with pinarms (module doc).
 
     Args:
-        cell: the :class:`robots.cell.Cell` the motion was planned in.
+        cell: the :class:`pinarms.robots.cell.Cell` the motion was planned in.
         source: a CycleResult (with ``arm``), a MotionPlan, or a LineSchedule (with ``cycles``).
         samples: evenly spaced instants, ends included (≥ 2).
         mjcf: an MJCF exported from this cell (default: exported to a temporary folder).
@@ -205,7 +205,7 @@ def _compare(cell: Any, label: str, qs: np.ndarray, mjcf: str | Path | None,
 
     with tempfile.TemporaryDirectory() as tmp:
         if mjcf is None:
-            from .cell import export_cell
+            from pinarms.export.cell import export_cell
 
             mjcf_path = export_cell(cell, Path(tmp) / "cell", srdf=False, packages=packages).mjcf
         else:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.optim.line import Belt, ItemType, LineSpec, PlaceBox, Rule, Station, Stream, TrackingSpec, base_pose
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["arm_line", "ITEM"]
 
@@ -38,7 +38,7 @@ def arm_line(robot: Any, n_arms: int, rate: float, *, speed: float = 0.1, base_o
              belt_height: float = 0.8, width: float = 0.3, descend: float = 0.5, rule: str = "first",
              seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, map_grid: tuple[int, int] = (12, 5),
              map_yaw: str = "auto", item: ItemType = ITEM) -> LineSpec:
-    """``n_arms`` copies of ``robot`` (a :class:`robots.Robot`) along a belt at ``speed`` [m/s],
+    """``n_arms`` copies of ``robot`` (a :class:`pinarms.robots.Robot`) along a belt at ``speed`` [m/s],
     ``rate`` items per minute at random (module doc); ``descend`` [s] of the tracking pick.
 
     Raises:

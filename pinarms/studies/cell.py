@@ -7,8 +7,8 @@ import numpy as np
 
 from pinarms.report import Row
 
-from .handoff_plans import remember
-from .study import MM, Study
+from pinarms.studies.handoff_plans import remember
+from pinarms.studies.study import MM, Study
 
 __all__ = ["study_cell", "LINE_TASKS"]
 

@@ -16,7 +16,7 @@ import numpy as np
 from pinarms.papers import IRB360_1600
 from pinarms.report import Row
 
-from .study import Study
+from pinarms.studies.study import Study
 
 __all__ = ["DELTA_CYCLE_START_M", "SCARA_CYCLE_START_M", "delta_cycle_rows", "study_delta"]
 

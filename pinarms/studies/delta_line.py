@@ -5,7 +5,7 @@ enoki bunches, 0.15 kg, Poisson, a 0.3 m belt at 0.2 m/s, first in window, 5 see
 by copies of a shipped delta (``delta_flexpicker``, docs/delta.md) hung above the belt's centre line,
 ``DELTA_SPACING`` m apart (each pick window is about 1.5 m of belt: the windows do not overlap), each
 base ``DELTA_HEIGHT`` m above the belt's surface and its box beside the belt. The delta's task maps
-(:func:`optim.line.delta_maps.build_delta_map`) are built, not stored (about 20 s a map): one map
+(:func:`pinarms.optim.line.delta_maps.build_delta_map`) are built, not stored (about 20 s a map): one map
 serves every delta of a line (the same shape shifted along the belt).
 
 :func:`delta_arms_needed` is :func:`pinarms.studies.line.arms_needed` for deltas; :func:`delta_rows`
@@ -20,7 +20,7 @@ from pinarms.optim.line import Belt, LineSpec, PlaceBox, Rule, Station, Stream, 
 from pinarms.optim.line.delta_maps import build_delta_map
 from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.robots.delta import delta_names, load_delta
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["delta_line", "delta_maps", "delta_arms_needed", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
 
@@ -38,7 +38,7 @@ def delta_line(n_arms: int, rate: float, *, item: Any,
                height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
                map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
     """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min of ``item``
-    (an :class:`optim.line.ItemType`; the study: :data:`pinarms.studies.line.ENOKI`) (module doc).
+    (an :class:`pinarms.optim.line.ItemType`; the study: :data:`pinarms.studies.line.ENOKI`) (module doc).
 
     Raises:
         InvalidInput: a name that is not a shipped delta (names them)."""

@@ -76,7 +76,7 @@ def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
 
 def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Any = None) -> dict:
     """Task maps of every station of ``spec`` from :data:`DATA` (built when missing and ``build``).
-    A spec with a cell gets maps built against the cell's fixtures (:func:`optim.line.build_maps`;
+    A spec with a cell gets maps built against the cell's fixtures (:func:`pinarms.optim.line.build_maps`;
     not stored: they hold for that cell only)."""
     if spec.cell is not None:
         if not build:
@@ -118,7 +118,7 @@ def arms_needed(rate: float, *, paper_limit: bool, max_arms: int = 20, start: in
 
 def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: int = 1,
                   **kw: Any) -> tuple[int | None, Any, Any]:
-    """:func:`arms_needed` and the curve (:class:`optim.line.LineCurve`) of the lines tried."""
+    """:func:`arms_needed` and the curve (:class:`pinarms.optim.line.LineCurve`) of the lines tried."""
     from pinarms.optim.line import LineCurve, LineStatus
 
     last, tried = None, []
@@ -230,7 +230,7 @@ def line_views(n_arms: int, rate: float = 60.0, *, seeds: tuple[int, ...] = (0, 
     ``html/line.html``, ``plots/line_schedule.png`` and ``plots/line_sizing.png``.
 
     Belt speed is not swept here: the package's task maps hold seed 000's belt at 0.2 m/s only
-    (:func:`viz.line_plots.line_curve` sweeps it where maps for other speeds exist or may be built).
+    (:func:`pinarms.viz.line_plots.line_curve` sweeps it where maps for other speeds exist or may be built).
     """
     from pinarms import viz
     from pinarms.optim.line import run_line

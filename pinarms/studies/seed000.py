@@ -10,7 +10,7 @@ from pinarms import robots
 from pinarms.papers import SEED000
 from pinarms.report import Row
 
-from .study import DEG, Study, _plots, _session
+from pinarms.studies.study import DEG, Study, _plots, _session
 
 __all__ = ["study_000"]
 

@@ -11,15 +11,15 @@ from pinarms.papers import SEED001
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from .seed001_dynamics import _dynamics_001, _tool_down_band
-from .seed001_motion import (
+from pinarms.studies.seed001_dynamics import _dynamics_001, _tool_down_band
+from pinarms.studies.seed001_motion import (
     _layout_search_001,
     _planned_move_001,
     _straight_lines_001,
     _tool_speed_plot,
     _unwrap_rows,
 )
-from .study import MM, Study, _plots, _session, _workspace_plots
+from pinarms.studies.study import MM, Study, _plots, _session, _workspace_plots
 
 __all__ = ["study_001"]
 

@@ -12,7 +12,7 @@ from pinarms.papers import SEED001
 from pinarms.report import Row, signed_percent
 from pinarms.robots import conventions as conv
 
-from .study import DEG, MM
+from pinarms.studies.study import DEG, MM
 
 __all__ = ["AUBO_PAYLOADS_KG"]
 

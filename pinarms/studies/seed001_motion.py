@@ -13,7 +13,7 @@ from pinarms.papers import SEED001
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from .study import MM, _segment_distance
+from pinarms.studies.study import MM, _segment_distance
 
 
 #: Seeds of the planned move's searches (the fastest move is kept).

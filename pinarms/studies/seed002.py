@@ -9,7 +9,7 @@ from pinarms.papers import SEED002
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from .study import Study, _plots, _session
+from pinarms.studies.study import Study, _plots, _session
 
 __all__ = ["study_002", "BOUNDS_002_S"]
 

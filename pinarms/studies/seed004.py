@@ -11,7 +11,7 @@ from pinarms.papers import SEED004
 from pinarms.report import Row, signed_percent
 from pinarms.robots import conventions as conv
 
-from .study import DEG, MM, Study, _plots, _segment_distance, _session
+from pinarms.studies.study import DEG, MM, Study, _plots, _segment_distance, _session
 
 __all__ = ["study_004", "KOJI_LIFT_M", "KOJI_BLOCK_KG"]
 

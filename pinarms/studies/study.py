@@ -2,7 +2,7 @@
 
 A study (one module per paper seed under :mod:`pinarms.studies`, plus the cell, line and
 hand-off studies) builds its robot, redoes the paper's computation with pinarms and returns a
-:class:`Study`: the rows of the paper-vs-pinarms table, a :class:`viz.Session` and plot
+:class:`Study`: the rows of the paper-vs-pinarms table, a :class:`pinarms.viz.Session` and plot
 writers. :mod:`pinarms.demo` lists the studies and runs them.
 """
 

@@ -3,7 +3,7 @@
 Joints as in :class:`.placements.BatchedPlacements` (the same arrays): joint ``i`` sits at
 ``(M_R[i], M_p[i])`` after its parent and rotates about (revolute) or moves along its unit
 ``axis[i]`` by ``scale[i]·q[index[i]] + offset[i]``; joint 0 is the world. Cached on disk
-like :mod:`robots.ik._kernel` (compiled per process where no cache location is writable).
+like :mod:`pinarms.robots.ik._kernel` (compiled per process where no cache location is writable).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit, jit_inline
 
-from . import _box_kernel
-from ._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
+from pinarms.robots.cell import _box_kernel
+from pinarms.robots.cell._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
 
 # these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
 drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
@@ -360,7 +360,7 @@ def excess_kernel(Q, fk, cov, grp, cap, floor, work, out):
 def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
     """:func:`excess_one` with the pairs of group ``g`` weighed by ``inv[g] > 0``: a lower bound of
     ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
-    proof's scaled excess (``inv``: one over each group's travel weight, :mod:`optim.motion.link_levers`);
+    proof's scaled excess (``inv``: one over each group's travel weight, :mod:`pinarms.optim.motion.link_levers`);
     ``inv`` empty (:data:`UNWEIGHTED`): every weight 1, the excess itself (:func:`excess_one`)."""
     _place(q, fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
     return excess_placed(cov, grp, inv, cap, floor, work)

@@ -18,8 +18,8 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 
-from . import _box_kernel, _cover_kernel
-from ._cover_kernel import _apart, _fixture_distance, _place, pair_proven
+from pinarms.robots.cell import _box_kernel, _cover_kernel
+from pinarms.robots.cell._cover_kernel import _apart, _fixture_distance, _place, pair_proven
 
 __all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .mesh_cover import mesh_arrays, split_triangles
+from pinarms.robots.cell.mesh_cover import mesh_arrays, split_triangles
 
 __all__ = ["axis_arrays"]
 
@@ -158,7 +158,7 @@ class _Pair:
     def __init__(self, cell: Any, a: int, b: int, side_a: list, side_b: list, turning: tuple[bool, bool]):
         import coal
 
-        self.bp = bp = cell._placements
+        self.bp = bp = cell.batched_placements
         objs = cell.collision_model.geometryObjects
         self.A = _Side(objs[a], side_a, bp, side_b[0] if side_b else None, turning[0])
         self.B = _Side(objs[b], side_b, bp, side_a[0] if side_a else None, turning[1])

@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ArmStateError, CellError
-from .components import CellArm
-from .compose_file import ArmPlacement, ToolPoint
+from pinarms.errors import ArmStateError, CellError
+from pinarms.robots.cell.components import CellArm
+from pinarms.robots.cell.compose_file import ArmPlacement, ToolPoint
 
 __all__ = ["rewrite_arm", "arm_with_keys", "tcp_choice"]
 

@@ -17,19 +17,19 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
-from ..errors import CellError, CollisionGeometryError
-from ..robot import Robot
-from ..xacro_expand import mesh_path
-from .components import CellArm, Fixture, Shape
-from .description import ArmSpec, arm_urdf
+from pinarms.robots.collision_requests import cold_start
+from pinarms.errors import CellError, CollisionGeometryError
+from pinarms.robots.robot import Robot
+from pinarms.robots.xacro_expand import mesh_path
+from pinarms.robots.cell.components import CellArm, Fixture, Shape
+from pinarms.robots.cell.description import ArmSpec, arm_urdf
 
 __all__ = ["build_arm", "build_geometry", "package_dirs", "plain_pin_index", "probe_pairs", "read_fixtures"]
 
 
 def package_dirs(base_dir: Path, packages: Mapping[str, str | Path]) -> list[str]:
     """Where the cell's ``package://`` meshes are looked for: its folder, the built-in package, the given packages."""
-    from ..xacro_expand import BUILTIN_PACKAGE
+    from pinarms.robots.xacro_expand import BUILTIN_PACKAGE
 
     return [str(base_dir.resolve()), str(BUILTIN_PACKAGE[1]), *(str(Path(v)) for v in packages.values())]
 
@@ -41,7 +41,7 @@ def build_arm(model: pin.Model, cell_robot: Robot, root: ET.Element, spec: ArmSp
     Raises:
         CellError: the arm's joints are not one block of the cell joint vector.
     """
-    from ..registry import from_urdf_text, match_builtin
+    from pinarms.robots.registry import from_urdf_text, match_builtin
 
     text = arm_urdf(root, spec)
     # closed-form IK by geometry (robot.ik_family); the built-in it is by kinematics, not names
@@ -86,7 +86,7 @@ def plain_pin_index(model: pin.Model, nq: int) -> np.ndarray | None:
 def _resolved_urdf(root: ET.Element, base_dir: Path, packages: Mapping[str, str | Path]) -> str:
     """The URDF with every mesh filename replaced by its checked absolute path (for Pinocchio)."""
     resolved = ET.fromstring(ET.tostring(root))
-    from .limits import check_mesh_size
+    from pinarms.robots.cell.limits import check_mesh_size
 
     for mesh in resolved.iter("mesh"):
         path = mesh_path(mesh.get("filename", ""), base_dir, packages)

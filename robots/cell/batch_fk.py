@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ModelError
+from pinarms.errors import ModelError
 
 __all__ = ["BatchedPlacements"]
 

@@ -19,22 +19,29 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, TypeVar
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CellError, CellTooLarge, InvalidInput
-from ..robot import Robot
-from .arm_keys import arm_with_keys
-from .assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
-from .components import CellArm, Fixture
-from .compose_file import ArmPlacement
-from .description import CellSpec, describe
-from .move_arm import urdf_with_arm_base
-from .batch_fk import BatchedPlacements
+from pinarms.errors import CellError, CellTooLarge, InvalidInput
+from pinarms.robots.robot import Robot
+from pinarms.robots.cell.arm_keys import arm_with_keys
+from pinarms.robots.cell.assembly import build_arm, build_geometry, package_dirs, plain_pin_index, probe_pairs, read_fixtures
+from pinarms.robots.cell.components import CellArm, Fixture
+from pinarms.robots.cell.compose_file import ArmPlacement
+from pinarms.robots.cell.description import CellSpec, describe
+from pinarms.robots.cell.move_arm import urdf_with_arm_base
+from pinarms.robots.cell.batch_fk import BatchedPlacements
 
-__all__ = ["Cell"]
+__all__ = ["Cell", "GEOMETRY_MEMOS"]
+
+T = TypeVar("T")
+
+#: Keys of :meth:`Cell.memo` that do not depend on which pairs the cell checks (the geometry
+#: alone, or caches keyed by the pairs themselves): a cell of fewer pairs (:meth:`Cell.with_pairs`)
+#: shares them.
+GEOMETRY_MEMOS = frozenset({"sphere cover", "joint levers", "motion cover pairs", "motion checker shared"})
 
 
 class Cell:
@@ -76,7 +83,7 @@ class Cell:
         seed: int = 0,
         placements: Sequence[ArmPlacement] = (),
     ) -> None:
-        from .pairs import classify_pairs
+        from pinarms.robots.cell.pairs import classify_pairs
 
         self.source = source
         self.urdf_text = urdf_text
@@ -88,7 +95,7 @@ class Cell:
             root = ET.fromstring(urdf_text)
         except ET.ParseError as exc:
             raise CellError(f"{source} is not well-formed XML: {exc}") from exc
-        from .limits import MAX_CELL_FILE_BYTES, check_counts, check_extent, check_geometry
+        from pinarms.robots.cell.limits import MAX_CELL_FILE_BYTES, check_counts, check_extent, check_geometry
 
         if len(urdf_text) > MAX_CELL_FILE_BYTES:
             raise CellTooLarge(f"{source}: the cell's URDF is {len(urdf_text)} characters; the limit is {MAX_CELL_FILE_BYTES}")
@@ -133,7 +140,7 @@ class Cell:
 
     def _finish_geometry(self) -> None:
         """Keep only the checked pairs in the collision model, the candidate pairs, and test every checked pair once."""
-        from .pairs import reach_pairs
+        from pinarms.robots.cell.pairs import reach_pairs
 
         reach, bounds = reach_pairs(self, self.allowed)
         self._set_candidates(self.pairs, reach, bounds)
@@ -142,25 +149,69 @@ class Cell:
 
     def _set_candidates(self, pairs: tuple, reach: tuple, bounds: np.ndarray) -> None:
         """Checked pairs, then out-of-reach pairs by increasing bound; the collision model keeps the checked ones."""
-        from .views import PairViews
+        from pinarms.robots.cell.views import PairViews
 
         self.pairs = tuple(pairs)
         self._reach = tuple(reach)
         self._reach_bounds = np.asarray(bounds, dtype=float)
+        self._reach_bounds.setflags(write=False)
         self._candidates = self.pairs + self._reach
         gm = self.collision_model
         gm.removeAllCollisionPairs()
         for p in self.pairs:
             gm.addCollisionPair(pin.CollisionPair(p.index_a, p.index_b))
         self._views = PairViews(self.model, gm, self._candidates)
-        for cache in ("_bounds",):
-            self.__dict__.pop(cache, None)
+        # a cell of other pairs (with_pairs) keeps only what depends on the geometry alone
+        self._memo = {k: v for k, v in getattr(self, "_memo", {}).items() if k in GEOMETRY_MEMOS}
+
+    def memo(self, key: str, build: Callable[[], T]) -> T:
+        """The value kept with this cell under ``key``, built by ``build()`` the first time.
+
+        For data derived from the cell's geometry and pairs that its checks reuse (the sphere
+        cover, the joint levers, the broad phase's bounds, shared coal data): the cache belongs
+        to the cell, and :meth:`with_pairs` starts a fresh one except for the keys of
+        :data:`GEOMETRY_MEMOS`, which do not depend on the pairs.
+        """
+        memo = self._memo
+        if key not in memo:
+            memo[key] = build()
+        return memo[key]
+
+    def cover(self):
+        """The sphere cover of every collision geometry (:func:`~pinarms.robots.cell.cover.link_cover`), built once."""
+        from pinarms.robots.cell.cover import link_cover
+
+        return link_cover(self)
 
     # ------------------------------------------------------------------ pairs
-    def _n_for(self, clearance: float, *, strict: bool = False) -> int:
-        """How many candidate pairs a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it)."""
+    def pair_count(self, clearance: float, *, strict: bool = False) -> int:
+        """How many of :attr:`candidates` a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it).
+
+        ``candidates[:pair_count(c)]`` is :meth:`pairs_for` ``(c)`` without its checks of ``c``.
+        """
         side = "left" if strict else "right"
         return len(self.pairs) + int(np.searchsorted(self._reach_bounds, clearance, side=side))
+
+    @property
+    def candidates(self) -> tuple:
+        """Every pair a check at some clearance may look at: :attr:`pairs`, then the out-of-reach
+        pairs by increasing proven bound (:meth:`pairs_for` ``(inf)``)."""
+        return self._candidates
+
+    @property
+    def reach_bounds(self) -> np.ndarray:
+        """``(len(candidates) - len(pairs),)`` proven distance bounds [m] of the out-of-reach candidates, increasing (read-only)."""
+        return self._reach_bounds
+
+    @property
+    def pair_views(self):
+        """The per-thread Pinocchio and coal data of the candidate pairs (:class:`~pinarms.robots.cell.views.PairViews`)."""
+        return self._views
+
+    @property
+    def batched_placements(self) -> BatchedPlacements:
+        """Batched forward kinematics of every joint (:class:`~pinarms.robots.cell.batch_fk.BatchedPlacements`)."""
+        return self._placements
 
     def pairs_for(self, clearance: float) -> tuple:
         """The pairs a check at ``clearance`` (or margin) [m] must look at.
@@ -179,7 +230,7 @@ class Cell:
         value = float(clearance) if ok else float("nan")
         if not value >= 0.0:
             raise InvalidInput(f"clearance must be a number >= 0 [m] (inf allowed), got {clearance!r}")
-        return self._candidates[: self._n_for(value)]
+        return self._candidates[: self.pair_count(value)]
 
     # --------------------------------------------------------------- joint vector
     @property
@@ -191,6 +242,11 @@ class Cell:
     def packages(self) -> dict[str, Path]:
         """``{name: folder}`` of the ``package://name/`` files it was loaded with (a copy)."""
         return {str(k): Path(v) for k, v in self._packages.items()}
+
+    @property
+    def seed(self) -> int:
+        """The seed its pair classification sampled with (a rebuilt cell reuses it)."""
+        return self._seed
 
     @property
     def base_dir(self) -> Path:
@@ -275,7 +331,7 @@ class Cell:
         """Pose(s) ``(4, 4)`` / ``(N, 4, 4)`` of any cell frame (``"left_tcp"``) in the world."""
         return self.robot.fk(q, frame)
 
-    def _q_pin_single(self, q: Any) -> np.ndarray | None:
+    def pin_vector_or_none(self, q: Any) -> np.ndarray | None:
         """Pinocchio's vector for one finite float ``q (nq,)`` without the general checks, else ``None``."""
         if type(q) is not np.ndarray or q.shape != (self.nq,) or q.dtype != np.float64:
             return None
@@ -366,13 +422,13 @@ class Cell:
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
-        from .collision import in_collision
+        from pinarms.robots.cell.collision import in_collision
 
         return in_collision(self, q, margin=margin, threads=threads)
 
     def collisions(self, q: Any, *, margin: float = 0.0):
         """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
-        from .collision import collisions
+        from pinarms.robots.cell.collision import collisions
 
         return collisions(self, q, margin=margin)
 
@@ -382,7 +438,7 @@ class Cell:
         The checked pairs and every out-of-reach pair whose bound is below the smallest
         distance found: the true minimum over all pairs but those allowed by design.
         """
-        from .collision import clearance
+        from pinarms.robots.cell.collision import clearance
 
         return clearance(self, q, margin=margin)
 
@@ -391,6 +447,6 @@ class Cell:
 
         See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
         """
-        from .motion import check_motion
+        from pinarms.robots.cell.motion import check_motion
 
         return check_motion(self, motions, margin=margin, **kwargs)

@@ -19,16 +19,15 @@ Distances are in m, in the world frame; the pairs are :attr:`Cell.pairs`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CollisionGeometryError, InvalidInput
-from .pairs import CollisionPair
+from pinarms.errors import CollisionGeometryError, InvalidInput
+from pinarms.robots.cell.pairs import CollisionPair
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["Collisions", "Clearance", "in_collision", "collisions", "clearance", "pair_lower_bounds"]
 
@@ -132,14 +131,14 @@ def _margin(margin: Any) -> float:
 MAX_THREADS = 64
 
 
-def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+def in_collision(cell: "CellModel", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
     """See :meth:`Cell.in_collision`."""
     if margin != 0.0:
         margin = _margin(margin)
-    n = cell._n_for(float(margin)) if margin == margin else 0
-    fast = cell._q_pin_single(q)  # one finite (nq,) vector: skip the batch machinery
+    n = cell.pair_count(float(margin)) if margin == margin else 0
+    fast = cell.pin_vector_or_none(q)  # one finite (nq,) vector: skip the batch machinery
     if fast is not None and n:
-        return cell._views.checker(n).single(fast, float(margin))
+        return cell.pair_views.checker(n).single(fast, float(margin))
     margin = _margin(margin)
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= MAX_THREADS:
         raise InvalidInput(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
@@ -147,13 +146,13 @@ def in_collision(cell: "Cell", q: Any, *, margin: float = 0.0, threads: int = 1)
     if not n:
         return False if single else np.zeros(arr.shape[0], dtype=bool)
     qp = cell.robot.q_to_pinocchio(arr)
-    checker = cell._views.checker(n)
+    checker = cell.pair_views.checker(n)
     if single:
         return checker.single(qp[0], margin)
     return checker.batch(qp, margin, int(threads))
 
 
-def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
+def collisions(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Collisions:
     """See :meth:`Cell.collisions`."""
     margin = _margin(margin)
     arr, single = cell.robot.check_q(q)
@@ -161,10 +160,10 @@ def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
     if single:
         hit = np.array([hit[0]])
     touching: list[tuple[int, ...]] = [()] * arr.shape[0]
-    n = cell._n_for(margin)
+    n = cell.pair_count(margin)
     if hit.any():
         qp = cell.robot.q_to_pinocchio(arr)
-        views = cell._views
+        views = cell.pair_views
         gm, gd, data = views.geometry(n), views.collision_data(n, margin), views.data()
         for i in np.flatnonzero(hit):
             pin.updateGeometryPlacements(cell.model, data, gm, gd, qp[i])
@@ -174,11 +173,12 @@ def collisions(cell: "Cell", q: Any, *, margin: float = 0.0) -> Collisions:
 
 
 # ------------------------------------------------------------------ broad phase
-def _bounds_data(cell: "Cell") -> dict:
-    """Constant data of the broad phase: bounding spheres, static boxes, pair index lists."""
-    cached = getattr(cell, "_bounds", None)
-    if cached is not None:
-        return cached
+def _bounds_data(cell: "CellModel") -> dict:
+    """Constant data of the broad phase: bounding spheres, static boxes, pair index lists (built once per cell)."""
+    return cell.memo("broad phase", lambda: _broad_phase(cell))
+
+
+def _broad_phase(cell: "CellModel") -> dict:
     objs = list(cell.collision_model.geometryObjects)
     G = len(objs)
     radius = np.zeros(G)
@@ -197,8 +197,8 @@ def _bounds_data(cell: "Cell") -> dict:
     pin.forwardKinematics(cell.model, data, pin.neutral(cell.model))
     box_R = np.array([g.placement.rotation for g in objs])  # static: parent joint is the world
     box_c = offset.copy()
-    ia = np.array([p.index_a for p in cell._candidates], dtype=int)
-    ib = np.array([p.index_b for p in cell._candidates], dtype=int)
+    ia = np.array([p.index_a for p in cell.candidates], dtype=int)
+    ib = np.array([p.index_b for p in cell.candidates], dtype=int)
     # pairs of a moving geometry with a static one, grouped by the static geometry
     static_groups = []
     for s_idx in np.flatnonzero(static):
@@ -212,11 +212,10 @@ def _bounds_data(cell: "Cell") -> dict:
         "radius": radius, "half": half, "offset": offset, "by_joint": by_joint, "static": static,
         "box_R": box_R, "box_c": box_c, "ia": ia, "ib": ib, "static_groups": static_groups,
     }
-    cell._bounds = cached
     return cached
 
 
-def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.ndarray:
+def pair_lower_bounds(cell: "CellModel", q: np.ndarray, n: int | None = None) -> np.ndarray:
     """``(N, P)`` lower bounds of the candidate pairs' distances [m] for a batch ``q (N, nq)``.
 
     Columns: the first ``n`` candidate pairs (default all: :meth:`Cell.pairs_for` ``(inf)``;
@@ -231,7 +230,7 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.n
     b = _bounds_data(cell)
     arr = np.asarray(q, dtype=float)
     N, G = arr.shape[0], len(b["radius"])
-    R, p = cell._placements.joints(arr)
+    R, p = cell.batched_placements.joints(arr)
     c = np.empty((N, G, 3))
     c[:, b["static"]] = b["box_c"][b["static"]]
     for j, idx in b["by_joint"].items():
@@ -258,18 +257,18 @@ def pair_lower_bounds(cell: "Cell", q: np.ndarray, n: int | None = None) -> np.n
 ONE_PASS_REACH = 2000
 
 
-def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
+def clearance(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Clearance:
     """See :meth:`Cell.clearance`."""
     margin = _margin(margin)
     arr, single = cell.robot.check_q(q)
     N = arr.shape[0]
-    pairs = cell._candidates
+    pairs = cell.candidates
     if not pairs:
         inf = np.full(N, np.inf)
         nan3 = np.full((N, 3), np.nan)
         pick = (lambda x: x[0]) if single else (lambda x: x)
         return Clearance(pick(inf), pick(np.full(N, -1)), pick(nan3), pick(nan3), margin, pairs)
-    if N <= 4 or len(cell._reach) > ONE_PASS_REACH:
+    if N <= 4 or len(cell.reach_bounds) > ONE_PASS_REACH:
         # a few configurations (the checked pairs in Pinocchio's loop), or a huge cell: the checked
         # pairs first, then only the out-of-reach pairs whose bound is below each row's distance
         dist, pair, pa, pb = exact_min_distance(cell, arr)
@@ -277,25 +276,25 @@ def clearance(cell: "Cell", q: Any, *, margin: float = 0.0) -> Clearance:
     else:  # one pass over every candidate, each out-of-reach pair's bound raised to its proven one
         lb = pair_lower_bounds(cell, arr)
         n0 = len(cell.pairs)
-        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell.reach_bounds)
         dist, pair, pa, pb = exact_min_distance(cell, arr, lb=lb, n=len(pairs))
     if single:
         return Clearance(float(dist[0]), int(pair[0]), pa[0], pb[0], margin, pairs)
     return Clearance(dist, pair, pa, pb, margin, pairs)
 
 
-def _reach_pass(cell: "Cell", arr: np.ndarray, dist: np.ndarray, pair: np.ndarray, pa: np.ndarray,
+def _reach_pass(cell: "CellModel", arr: np.ndarray, dist: np.ndarray, pair: np.ndarray, pa: np.ndarray,
                 pb: np.ndarray) -> None:
     """Bring in the out-of-reach pairs whose bound is below each row's smallest distance (in place)."""
     n0 = len(cell.pairs)
-    need = [i for i in range(arr.shape[0]) if cell._n_for(float(dist[i]), strict=True) > n0]
+    need = [i for i in range(arr.shape[0]) if cell.pair_count(float(dist[i]), strict=True) > n0]
     if not need:
         return
-    n_max = max(cell._n_for(float(dist[i]), strict=True) for i in need)
-    views = cell._views
+    n_max = max(cell.pair_count(float(dist[i]), strict=True) for i in need)
+    views = cell.pair_views
     gm, gd, data = views.geometry(n_max), views.distance_data(n_max), views.data()
     lb = pair_lower_bounds(cell, arr[need], n_max)[:, n0:]
-    bounds = cell._reach_bounds
+    bounds = cell.reach_bounds
     qp = cell.robot.q_to_pinocchio(arr[need])
     for row, i in enumerate(need):
         pin.updateGeometryPlacements(cell.model, data, gm, gd, qp[row])
@@ -311,14 +310,14 @@ def _reach_pass(cell: "Cell", arr: np.ndarray, dist: np.ndarray, pair: np.ndarra
                 pa[i], pb[i] = np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2())
 
 
-def _finite(cell: "Cell", d: float, k: int) -> float:
+def _finite(cell: "CellModel", d: float, k: int) -> float:
     if not np.isfinite(d):
-        p = cell._candidates[k]
+        p = cell.candidates[k]
         raise CollisionGeometryError(f"coal returned distance {d} for {p.body_a} – {p.body_b}")
     return float(d)
 
 
-def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = None, n: int | None = None,
+def exact_min_distance(cell: "CellModel", arr: np.ndarray, lb: np.ndarray | None = None, n: int | None = None,
                        cap: float = np.inf):
     """Exact smallest distance over the first ``n`` candidate pairs (default: the checked pairs) per row of ``arr (N, nq)``.
 
@@ -339,7 +338,7 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
     order = np.argsort(lb, axis=1, kind="stable")
     sorted_lb = np.take_along_axis(lb, order, axis=1)
     qp = cell.robot.q_to_pinocchio(arr)
-    views = cell._views
+    views = cell.pair_views
     gm, gd, model, data = views.geometry(n), views.distance_data(n), cell.model, views.data()
     dist = np.empty(N)
     best_pair = np.empty(N, dtype=int)
@@ -366,9 +365,9 @@ def exact_min_distance(cell: "Cell", arr: np.ndarray, lb: np.ndarray | None = No
     return dist, best_pair, pa, pb
 
 
-def _all_pairs_min_distance(cell: "Cell", arr: np.ndarray, n: int):
+def _all_pairs_min_distance(cell: "CellModel", arr: np.ndarray, n: int):
     qp = cell.robot.q_to_pinocchio(arr)
-    views = cell._views
+    views = cell.pair_views
     gm, gd, data = views.geometry(n), views.distance_data(n), views.data()
     N = arr.shape[0]
     dist, pair = np.empty(N), np.empty(N, dtype=int)

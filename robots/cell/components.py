@@ -11,8 +11,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InvalidInput
-from ..robot import Robot
+from pinarms.errors import InvalidInput
+from pinarms.robots.robot import Robot
 
 __all__ = ["CellArm", "Fixture", "Shape"]
 

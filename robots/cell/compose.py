@@ -39,10 +39,10 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ..errors import CellError, ModelError, XacroForbidden
-from ..urdf_checks import check_tree, refuse_dtd
-from .cell import Cell
-from .compose_file import (
+from pinarms.errors import CellError, ModelError, XacroForbidden
+from pinarms.robots.urdf_checks import check_tree, refuse_dtd
+from pinarms.robots.cell.cell import Cell
+from pinarms.robots.cell.compose_file import (
     _SHAPES,
     MAX_ARM_BYTES,
     MAX_ARMS,
@@ -56,8 +56,8 @@ from .compose_file import (
     _read_bounded,
     read_cell_description,
 )
-from .arm_keys import rewrite_arm
-from .description import _MOVABLE
+from pinarms.robots.cell.arm_keys import rewrite_arm
+from pinarms.robots.cell.description import _MOVABLE
 
 __all__ = [
     "ArmPlacement",

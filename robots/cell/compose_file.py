@@ -16,7 +16,7 @@ from typing import Any, Mapping, Sequence
 
 from pinarms.files import read_bounded_text
 
-from ..errors import CellError, CellNotFound
+from pinarms.errors import CellError, CellNotFound
 
 __all__ = [
     "ArmPlacement",

@@ -35,7 +35,7 @@ threshold per pair, which configurations are **proven** to keep every pair farth
 than its threshold: the distance between two covers (or a cover and an exact fixture) is a
 lower bound of the geometries' distance. The rest is *inconclusive*: the exact check (coal)
 decides them. Forward kinematics of the batch and the screen run compiled (numba, cached
-like :mod:`robots.ik._kernel`). Distances in m, the world frame.
+like :mod:`pinarms.robots.ik._kernel`). Distances in m, the world frame.
 """
 
 from __future__ import annotations
@@ -47,9 +47,9 @@ from typing import Any
 
 import numpy as np
 
-from ._cover_kernel import excess_kernel, screen_kernel
-from .mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
-from .pair_tables import PairTables, no_tables, pair_tables
+from pinarms.robots.cell._cover_kernel import excess_kernel, screen_kernel
+from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
+from pinarms.robots.cell.pair_tables import PairTables, no_tables, pair_tables
 
 __all__ = [
     "CYLINDER_SHARE",
@@ -254,7 +254,7 @@ class Cover:
 
     def world_centers(self, Q: np.ndarray) -> np.ndarray:
         """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
-        from ._cover_kernel import centers_kernel
+        from pinarms.robots.cell._cover_kernel import centers_kernel
 
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.empty((Q.shape[0], self.joint.size, 3))
@@ -321,7 +321,7 @@ class Cover:
     def pair_screener(self, pairs: PairSet, threshold: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`pair_screen` with its arrays prepared once: a function of ``Q`` alone (one state costs
         the kernel's few µs, not the tens of µs of matching its arguments' types at every call)."""
-        from ._pair_kernel import pair_screener
+        from pinarms.robots.cell._pair_kernel import pair_screener
 
         return pair_screener(self, pairs, threshold)
 
@@ -377,16 +377,17 @@ class PairSet:
 
 
 def _fk_arrays(cell: Any) -> tuple:
-    bp = cell._placements
+    bp = cell.batched_placements
     return (np.asarray(bp.parent, dtype=np.int64), np.asarray(bp.index, dtype=np.int64), bp.scale.copy(),
             bp.offset.copy(), bp.revolute.copy(), bp.axis.copy(), bp.M_R.copy(), bp.M_p.copy())
 
 
 def link_cover(cell: Any) -> Cover:
-    """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell)."""
-    cached = getattr(cell, "_sphere_cover", None)
-    if cached is not None:
-        return cached
+    """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell: :meth:`Cell.memo`)."""
+    return cell.memo("sphere cover", lambda: _build_cover(cell))
+
+
+def _build_cover(cell: Any) -> Cover:
     objs = list(cell.collision_model.geometryObjects)
     G = len(objs)
     start = np.zeros(G + 1, dtype=np.int64)
@@ -409,7 +410,6 @@ def link_cover(cell: Any) -> Cover:
     if TABLES:  # an arm's own pairs close in the chain that the spheres leave loose get distance tables
         own = [(p.index_a, p.index_b) for p in cell.pairs if p.kind == "self"]
         cover = replace(cover, tables=pair_tables(cell, own, cover))
-    cell._sphere_cover = cover
     return cover
 
 

@@ -23,8 +23,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-from ..errors import CellError
-from ..pair_rules import declared_pairs
+from pinarms.errors import CellError
+from pinarms.robots.pair_rules import declared_pairs
 
 __all__ = ["ArmSpec", "CellSpec", "describe", "arm_urdf"]
 

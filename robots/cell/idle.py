@@ -9,14 +9,13 @@ so that the caller names the idle arm and the hold pose instead.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Iterable
+from typing import Any, Iterable
 
 import numpy as np
 
-from .pairs import CollisionPair
+from pinarms.robots.cell.pairs import CollisionPair
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["IdleContacts", "idle_contacts"]
 
@@ -49,11 +48,11 @@ class IdleContacts:
                 f"it a clear hold pose ({how})")
 
 
-def _pair_distances(cell: "Cell", q: np.ndarray, pairs: Iterable[CollisionPair]) -> tuple[float, ...]:
+def _pair_distances(cell: "CellModel", q: np.ndarray, pairs: Iterable[CollisionPair]) -> tuple[float, ...]:
     import coal
     import pinocchio as pin
 
-    from ..collision_requests import cold_start
+    from pinarms.robots.collision_requests import cold_start
 
     model, gm = cell.model, cell.collision_model
     gd = cold_start(pin.GeometryData(gm))
@@ -71,7 +70,7 @@ def _pair_distances(cell: "Cell", q: np.ndarray, pairs: Iterable[CollisionPair])
     return tuple(out)
 
 
-def idle_contacts(cell: "Cell", q: Any, moving: Iterable[str]) -> IdleContacts:
+def idle_contacts(cell: "CellModel", q: Any, moving: Iterable[str]) -> IdleContacts:
     """The touching pairs (distance ≤ 0) at the cell configuration ``q (nq,)`` with no body on an arm of ``moving``.
 
     Only pairs with at least one idle arm count (two fixtures never touch: rigid pairs are

@@ -23,11 +23,11 @@ must be kept ends its intervals (the motion fails there).
 
 The users, each with its own samples and excess (a :class:`Rungs`):
 
-- :func:`robots.cell.check_motion`: timed trajectories of a cell; samples in time, budget
+- :func:`pinarms.robots.cell.check_motion`: timed trajectories of a cell; samples in time, budget
   from the speed bounds, excess the smallest distance (coal) over the target clearance.
-- :class:`optim.motion.proof.LadderProof`: joint-space edges and timed paths of a planner;
+- :class:`pinarms.optim.motion.proof.LadderProof`: joint-space edges and timed paths of a planner;
   sample excesses are the margins' raises the batched screens pass at each level.
-- The compiled edge proof on the sphere cover (:mod:`optim.motion._fast_kernel`): the scalar
+- The compiled edge proof on the sphere cover (:mod:`pinarms.optim.motion._fast_kernel`): the scalar
   rule :data:`interval_proven` (compiled on first use: numba is imported only then).
 """
 

@@ -15,12 +15,12 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from pinarms.files import check_regular
-from .._checks import check_path_name
-from ..errors import CellNotFound, InvalidInput, ModelError
-from ..urdf_build import URDF_DIR, XACRO_DIR, write_atomic
-from ..xacro_expand import XacroLimits, expand_xacro
-from .cell import Cell
-from .limits import MAX_CELL_FILE_BYTES, check_file_size, read_cell_file
+from pinarms.robots._checks import check_path_name
+from pinarms.errors import CellNotFound, InvalidInput, ModelError
+from pinarms.robots.urdf_build import URDF_DIR, XACRO_DIR, write_atomic
+from pinarms.robots.xacro_expand import XacroLimits, expand_xacro
+from pinarms.robots.cell.cell import Cell
+from pinarms.robots.cell.limits import MAX_CELL_FILE_BYTES, check_file_size, read_cell_file
 
 __all__ = [
     "CELL_XACRO_DIR",
@@ -146,7 +146,7 @@ def load_cell(
     if path.name.endswith(".toml"):  # a cell description: arms by URDF file under prefixes (compose.py)
         if all_args:
             raise InvalidInput(f"{str(path)!r} is a cell description: it takes no xacro arguments")
-        from .compose import load_cell_description
+        from pinarms.robots.cell.compose import load_cell_description
 
         return load_cell_description(path, packages=packages, seed=seed)
     if path.name.endswith(".xacro"):

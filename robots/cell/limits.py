@@ -5,12 +5,12 @@ A real production cell has a few arms and some tens of collision geometries (the
 and keep a hostile or mistaken file from taking minutes or gigabytes: files and meshes are
 sized by ``stat`` before they are read (and then read up to the cap only), and the counts of
 arms, fixtures, collision geometries and geometry pairs are taken from the XML before
-Pinocchio builds anything. Every refusal is a :class:`~pinarms.robots.errors.CellTooLarge`
+Pinocchio builds anything. Every refusal is a :class:`~pinarms.errors.CellTooLarge`
 stating the limit.
 
 Collision primitives must have finite, positive sizes up to :data:`MAX_CELL_EXTENT` (a box of
 size −0.2 or 0 is no obstacle coal can check): :func:`check_geometry` raises
-:class:`~pinarms.robots.errors.CollisionGeometryError` naming the fixture (or link); so does
+:class:`~pinarms.errors.CollisionGeometryError` naming the fixture (or link); so does
 :func:`check_extent` for a geometry placed farther than :data:`MAX_CELL_EXTENT` from the world
 origin (coal's broadphase fails on a box at 1e15 m: "negative volume").
 """
@@ -25,7 +25,7 @@ from typing import Any
 
 from pinarms.files import read_bounded_text
 
-from ..errors import CellTooLarge, CollisionGeometryError, ModelError
+from pinarms.errors import CellTooLarge, CollisionGeometryError, ModelError
 
 __all__ = [
     "MAX_CELL_FILE_BYTES", "MAX_MESH_BYTES", "MAX_ARMS", "MAX_FIXTURES", "MAX_GEOMETRIES", "MAX_GEOMETRY_PAIRS",

@@ -49,23 +49,22 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
-from .collision import _margin, exact_min_distance
-from .ladder import Intervals, climb
-from .motion_curves import moving_arm_curves
-from .motion_minimum import TIE_M, FirstRound, first_round, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
-from .motion_report import Contact, MotionCheck
-from .pairs import CollisionPair
-from .speed_bound import joint_levers, speed_profile, travel_stops
-from .timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
+from pinarms.errors import InvalidInput
+from pinarms.robots.cell.collision import _margin, exact_min_distance
+from pinarms.robots.cell.ladder import Intervals, climb
+from pinarms.robots.cell.motion_curves import moving_arm_curves
+from pinarms.robots.cell.motion_minimum import TIE_M, FirstRound, first_round, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
+from pinarms.robots.cell.motion_report import Contact, MotionCheck
+from pinarms.robots.cell.pairs import CollisionPair
+from pinarms.robots.cell.speed_bound import joint_levers, speed_profile, travel_stops
+from pinarms.robots.cell.timeline import (MAX_SAMPLES, MAX_TIME, ArmMotion, arm_motions, as_time, configurations,  # noqa: F401  (MAX_TIME, re-exported)
                        motion_window, sample_motions)
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["ArmMotion", "Contact", "MotionCheck", "check_motion", "joint_levers", "motion_window", "sample_motions"]
 
@@ -80,7 +79,7 @@ MAX_BISECTIONS = 64
 
 # ------------------------------------------------------------------ the check
 def check_motion(
-    cell: "Cell",
+    cell: "CellModel",
     motions: Any,
     *,
     margin: float = 0.01,
@@ -107,7 +106,7 @@ def check_motion(
             clearance-over-time plot draws.
         cover: screen the samples on the sphere cover before the broad phase (same verdicts,
             faster); ``False``: the broad phase and coal alone — a check that shares no code
-            with the cover, as :func:`optim.plan_motion`'s re-check of a path the cover proved.
+            with the cover, as :func:`pinarms.optim.plan_motion`'s re-check of a path the cover proved.
 
     Raises:
         InvalidInput: an unknown arm, a trajectory of the wrong width, bad numbers, or a
@@ -121,9 +120,9 @@ def check_motion(
     screen = required + margin
     # every pair not proven farther than the screen distance (Cell.pairs_for): the pairs left
     # out keep a distance above `screen` >= `required` in every configuration
-    n_pairs = cell._n_for(screen + 1e-6)
-    pairs = cell._candidates[:n_pairs]
-    left_out = cell._reach_bounds[n_pairs - len(cell.pairs):]
+    n_pairs = cell.pair_count(screen + 1e-6)
+    pairs = cell.candidates[:n_pairs]
+    left_out = cell.reach_bounds[n_pairs - len(cell.pairs):]
     samples = _Samples(cell, motions, hold_q, n_pairs, bool(cover))
     d = samples.screen(schedule.times, screen, curve)
     lower, unresolved = _prove(schedule, d, required, samples)
@@ -176,7 +175,7 @@ class _Schedule:
         return np.interp(tb, self.grid, self.budget) - np.interp(ta, self.grid, self.budget)
 
 
-def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, margin: float) -> _Schedule:
+def _schedule(cell: "CellModel", motions: list[ArmMotion], t0: float, t1: float, margin: float) -> _Schedule:
     """A fine grid at the global speed bound's step, then a sample every ``margin`` of approach budget.
 
     Raises:
@@ -204,7 +203,7 @@ def _schedule(cell: "Cell", motions: list[ArmMotion], t0: float, t1: float, marg
 class _Samples:
     """Every sample of one check: time [s], smallest distance [m], closest pair (−1: screened), exact or not."""
 
-    def __init__(self, cell: "Cell", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
+    def __init__(self, cell: "CellModel", motions: list[ArmMotion], hold_q: np.ndarray, n_pairs: int,
                  cover: bool = True) -> None:
         self.cell, self.motions, self.hold_q, self.n_pairs, self.cover = cell, motions, hold_q, n_pairs, cover
         self.first: FirstRound | None = None  # the smallest clearance's first round (.motion_minimum)
@@ -264,7 +263,7 @@ class _Samples:
         """
         if not (self.cover and ts.size >= COVER_ROWS):
             return np.full(ts.size, -np.inf)
-        n = len(self.cell._candidates)
+        n = len(self.cell.candidates)
         cover, pair_set = _cover_pairs(self.cell, n)
         return np.concatenate([cover.excess(self.configurations(ts[a:a + BOUND_ROWS]), pair_set, np.zeros(n))
                                for a in range(0, ts.size, BOUND_ROWS)])
@@ -289,14 +288,14 @@ class _Samples:
 COVER_ROWS, BOUND_ROWS = 8, 4096
 
 
-def _cover_pairs(cell: "Cell", n_pairs: int) -> tuple[Any, Any]:
+def _cover_pairs(cell: "CellModel", n_pairs: int) -> tuple[Any, Any]:
     """The cell's sphere cover and its :class:`.cover.PairSet` of the first ``n_pairs`` candidates (kept with the cell)."""
-    from .cover import link_cover, pair_arrays
+    from pinarms.robots.cell.cover import link_cover, pair_arrays
 
-    # keyed by the pairs themselves: a view of the cell (Cell.only) shares this dict, not its pairs
-    pair_a, pair_b = pair_arrays(cell._candidates[:n_pairs])
+    # keyed by the pairs themselves: a cell of fewer pairs (Cell.with_pairs) shares this dict, not its pairs
+    pair_a, pair_b = pair_arrays(cell.candidates[:n_pairs])
     key = (pair_a.tobytes(), pair_b.tobytes())
-    cache = cell.__dict__.setdefault("_motion_cover_pairs", {})
+    cache = cell.memo("motion cover pairs", dict)
     if key not in cache:
         cover = link_cover(cell)
         cache[key] = (cover, cover.prepare(pair_a, pair_b))

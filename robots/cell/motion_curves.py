@@ -16,14 +16,13 @@ missed because it was proven far.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Sequence
+from typing import Sequence
 
 import numpy as np
 
-from .collision import exact_min_distance, pair_lower_bounds
+from pinarms.robots.cell.collision import exact_min_distance, pair_lower_bounds
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["moving_arm_groups", "moving_arm_curves"]
 
@@ -31,7 +30,7 @@ __all__ = ["moving_arm_groups", "moving_arm_curves"]
 ROWS = 2048
 
 
-def moving_arm_groups(cell: "Cell", arms: Sequence[str]) -> dict[str, np.ndarray]:
+def moving_arm_groups(cell: "CellModel", arms: Sequence[str]) -> dict[str, np.ndarray]:
     """``{group name: candidate pair indices}`` of the pairs involving one of the moving ``arms`` (module doc).
 
     Groups in the order of ``arms``: fixtures, each other arm, own links; empty groups left out.
@@ -39,7 +38,7 @@ def moving_arm_groups(cell: "Cell", arms: Sequence[str]) -> dict[str, np.ndarray
     moving = list(dict.fromkeys(arms))
     arm_names = {a.name for a in cell.arms}
     groups: dict[str, list[int]] = {}
-    for k, p in enumerate(cell._candidates):
+    for k, p in enumerate(cell.candidates):
         a, b = p.owner_a, p.owner_b
         if a not in moving and b in moving:
             a, b = b, a
@@ -60,7 +59,7 @@ def moving_arm_groups(cell: "Cell", arms: Sequence[str]) -> dict[str, np.ndarray
     return {n: np.asarray(groups[n], dtype=int) for n in dict.fromkeys(order) if n in groups}
 
 
-def moving_arm_curves(cell: "Cell", arms: Sequence[str], Q: np.ndarray) -> tuple[dict[str, np.ndarray], dict]:
+def moving_arm_curves(cell: "CellModel", arms: Sequence[str], Q: np.ndarray) -> tuple[dict[str, np.ndarray], dict]:
     """``{group name: (N,) exact smallest distance [m]}`` at the cell configurations ``Q (N, nq)``, and
     ``{group name: CollisionPair}`` the closest pair of each group over all of ``Q``.
 
@@ -68,17 +67,17 @@ def moving_arm_curves(cell: "Cell", arms: Sequence[str], Q: np.ndarray) -> tuple
     bound, stopped once the next bound is no smaller than the smallest distance found.
     """
     groups = moving_arm_groups(cell, arms)
-    N, n_all, n0 = Q.shape[0], len(cell._candidates), len(cell.pairs)
+    N, n_all, n0 = Q.shape[0], len(cell.candidates), len(cell.pairs)
     curves = {name: np.empty(N) for name in groups}
     closest = {name: np.empty(N, dtype=int) for name in groups}
     for start in range(0, N, ROWS):
         rows = Q[start:start + ROWS]
         lb = pair_lower_bounds(cell, rows)
-        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell.reach_bounds)
         for name, idx in groups.items():
             masked = np.full_like(lb, np.inf)
             masked[:, idx] = lb[:, idx]
             d, k, _, _ = exact_min_distance(cell, rows, lb=masked, n=n_all)
             curves[name][start:start + rows.shape[0]], closest[name][start:start + rows.shape[0]] = d, k
-    pairs = {name: cell._candidates[int(closest[name][int(np.argmin(d))])] for name, d in curves.items() if N}
+    pairs = {name: cell.candidates[int(closest[name][int(np.argmin(d))])] for name, d in curves.items() if N}
     return curves, pairs

@@ -31,16 +31,33 @@ when a proven bound shows it cannot come within :data:`TIE_M` of the smallest fo
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from .collision import exact_min_distance, pair_lower_bounds
-from .pairs import CollisionPair
+from pinarms.robots.cell.collision import exact_min_distance, pair_lower_bounds
+from pinarms.robots.cell.pairs import CollisionPair
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
-    from .motion import _Samples, _Schedule
+    from pinarms.robots.cell.cell_model import CellModel as Cell
+
+
+class _Samples(Protocol):
+    """What the search reads of a check's samples (:class:`pinarms.robots.cell.motion` keeps them)."""
+
+    cell: "Cell"
+    first: "FirstRound | None"
+
+    def configurations(self, ts: np.ndarray) -> np.ndarray: ...
+
+    def cover_bounds(self, ts: np.ndarray) -> np.ndarray: ...
+
+
+class _Schedule(Protocol):
+    """What the search reads of a check's schedule: the fine ``grid`` [s] and the approach ``budget`` [m] on it."""
+
+    grid: np.ndarray
+    budget: np.ndarray
 
 __all__ = ["smallest_clearance", "first_round", "FirstRound", "SMALLEST_BATCH", "TIE_M"]
 
@@ -69,15 +86,15 @@ def smallest_clearance(samples: "_Samples", schedule: "_Schedule", t: np.ndarray
     exact_d = np.where(exact, d, np.inf)
     i = earliest_of_smallest(t, exact_d)
     if exact_d[i] < screen:
-        return float(d[i]), float(t[i]), cell._candidates[int(k[i])]
-    n_all, n0 = len(cell._candidates), len(cell.pairs)
+        return float(d[i]), float(t[i]), cell.candidates[int(k[i])]
+    n_all, n0 = len(cell.candidates), len(cell.pairs)
     if n_all == 0:
         return float("inf"), float(t[0]), None
 
     def bounds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Q = samples.configurations(t[rows])
         lb = pair_lower_bounds(cell, Q)
-        lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+        lb[:, n0:] = np.maximum(lb[:, n0:], cell.reach_bounds)
         return Q, lb
 
     row_lb = samples.cover_bounds(t)
@@ -116,7 +133,7 @@ def smallest_clearance(samples: "_Samples", schedule: "_Schedule", t: np.ndarray
         best = min(best, float(np.min(dist)))
         row_lb = np.maximum(row_lb, _budget_bound(dist, budget, rows))
     i = earliest_of_smallest(t, found_d)
-    return float(found_d[i]), float(t[i]), cell._candidates[int(found_k[i])] if found_k[i] >= 0 else None
+    return float(found_d[i]), float(t[i]), cell.candidates[int(found_k[i])] if found_k[i] >= 0 else None
 
 
 def _budget_bound(dist: np.ndarray, budget: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -156,12 +173,12 @@ def first_round(cell: "Cell", Q: np.ndarray, times: np.ndarray, screen: float) -
     screen then looks only at the samples flagged here (the same verdicts, one pass instead of
     two), and the search at the samples flagged here.
     """
-    n_all, n0 = len(cell._candidates), len(cell.pairs)
+    n_all, n0 = len(cell.candidates), len(cell.pairs)
     rows = np.unique(np.linspace(0, times.size - 1, min(SMALLEST_BATCH, times.size)).round().astype(int))
     if n_all == 0 or not rows.size:
         return FirstRound(times, rows[:0], np.empty(0), np.empty(0, dtype=int), np.inf, np.ones(times.size, dtype=bool))
     lb = pair_lower_bounds(cell, Q[rows])
-    lb[:, n0:] = np.maximum(lb[:, n0:], cell._reach_bounds)
+    lb[:, n0:] = np.maximum(lb[:, n0:], cell.reach_bounds)
     dist, pair, _, _ = exact_min_distance(cell, Q[rows], lb=lb, n=n_all)
     best = float(np.min(dist))
     if not best >= screen + SWEEP_GAP or times.size <= SMALLEST_BATCH:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .pairs import CollisionPair
+from pinarms.robots.cell.pairs import CollisionPair
 
 __all__ = ["Contact", "MotionCheck"]
 

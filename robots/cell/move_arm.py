@@ -7,20 +7,19 @@ the URDF :func:`urdf_with_arm_base` writes.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CellError, InvalidInput
+from pinarms.errors import CellError, InvalidInput
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["urdf_with_arm_base"]
 
 
-def urdf_with_arm_base(cell: "Cell", name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> str:
+def urdf_with_arm_base(cell: "CellModel", name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> str:
     """The URDF of ``cell`` with arm ``name``'s base at ``base_to_world`` ``(4, 4)`` [m] in the world.
 
     The fixed joint that holds the arm's base link to its parent gets the origin that puts

@@ -23,19 +23,17 @@ from __future__ import annotations
 import hashlib
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import coal
 import numpy as np
 import pinocchio as pin
 
-from .. import robot as _robot
-from ..collision_requests import pair_probe
-from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
-from .mesh_cover import mesh_arrays
+from pinarms.robots import robot as _robot
+from pinarms.robots.collision_requests import pair_probe
+from pinarms.robots.cell.disk_cache import cache_folder, code_digest, read_arrays, write_arrays
+from pinarms.robots.cell.mesh_cover import mesh_arrays
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["SAMPLES", "VERIFY", "MIN_SECONDS", "sample_pairs"]
 
@@ -49,7 +47,7 @@ _CODE = (Path(__file__), Path(_robot.__file__))
 _NAMES = ("hits", "dmin", "dmax", "first_d", "first_hit")
 
 
-def sample_pairs(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
+def sample_pairs(cell: "CellModel", objs: list, data: pin.Data, checked: list[tuple[int, int]],
                  seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(hits, dmin, dmax)`` per pair of ``checked`` over :data:`SAMPLES` seeded configurations: contacts counted,
     smallest and largest distance [m]; from the disk cache when a file of the same content passes its check."""
@@ -110,7 +108,7 @@ def _trusted(got: dict, model: pin.Model, data: pin.Data, probe: tuple, qs: np.n
                 and np.all(hits >= seen) and np.all(SAMPLES - hits >= VERIFY - seen))
 
 
-def _key(cell: "Cell", objs: list, checked: list[tuple[int, int]], seed: int) -> str:
+def _key(cell: "CellModel", objs: list, checked: list[tuple[int, int]], seed: int) -> str:
     """A digest of everything the sampling depends on (module docstring)."""
     h = hashlib.sha256(repr((SAMPLES, VERIFY, int(seed), code_digest(_CODE), getattr(coal, "__version__", ""),
                              pin.__version__, np.__version__)).encode())

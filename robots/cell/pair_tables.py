@@ -79,7 +79,7 @@ from typing import Any
 
 import numpy as np
 
-from ._table_build import (
+from pinarms.robots.cell._table_build import (
     CAP,
     CONTACT_TOL,
     EXACT_LOSS,
@@ -97,9 +97,9 @@ from ._table_build import (
     _turning,
     axis_arrays,
 )
-from . import _table_build, mesh_cover
-from .disk_cache import cache_folder, code_digest, read_arrays, write_arrays
-from .mesh_cover import mesh_arrays
+from pinarms.robots.cell import _table_build, mesh_cover
+from pinarms.robots.cell.disk_cache import cache_folder, code_digest, read_arrays, write_arrays
+from pinarms.robots.cell.mesh_cover import mesh_arrays
 
 __all__ = [
     "CAP",
@@ -214,7 +214,7 @@ def table_paths(cell: Any, pairs: Sequence[tuple[int, int]]) -> list[tuple[int, 
     """The pairs ``(a, b)`` that get a table, each with its path joints top-down on ``a``'s side and on
     ``b``'s (at most two in all, revolute, at least one of the two geometries a mesh)."""
     objs = cell.collision_model.geometryObjects
-    bp = cell._placements
+    bp = cell.batched_placements
     parent = np.asarray(bp.parent)
     out = []
     for a, b in pairs:
@@ -236,7 +236,7 @@ def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
     the path joints' placements and axes, the build's constants, its code (:data:`_CODE`) and coal's version."""
     import coal
 
-    bp = cell._placements
+    bp = cell.batched_placements
     objs = cell.collision_model.geometryObjects
     h = hashlib.sha256(repr((_VERSION, TOL, REL, CAP, CONTACT_TOL, TURNING, TURN_SAMPLES, TURN_NEAR, SLACK, MAX_NODES,
                              EXACT_LOSS, PART_LENGTH, MAX_PARTS, len(side_a), len(side_b), code_digest(_CODE),
@@ -296,7 +296,7 @@ def _trusted(cell: Any, a: int, b: int, side_a: list, side_b: list, table: dict)
     at :data:`CHECK_STATES` seeded random configurations of ``cell`` (NaN bounds fail)."""
     import coal
 
-    bp = cell._placements
+    bp = cell.batched_placements
     path = side_a + side_b
     Q = cell.random_q(CHECK_STATES, seed=1)
     angles = np.zeros((CHECK_STATES, 2))
@@ -391,7 +391,7 @@ def assemble(cell: Any, found: list, tabs: list, seconds: float = 0.0) -> PairTa
     sizes = np.array([t["child"].size for t in tabs], dtype=np.int64)
     root = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if tabs else np.zeros(0, dtype=np.int64)
     child = [np.where(t["child"] >= 0, t["child"] + r, -1) for t, r in zip(tabs, root)]
-    axes = [axis_arrays(cell._placements, f[2] + f[3], t["axis"]) for f, t in zip(found, tabs)]
+    axes = [axis_arrays(cell.batched_placements, f[2] + f[3], t["axis"]) for f, t in zip(found, tabs)]
 
     def cat(i: int, shape: tuple, dtype: Any) -> np.ndarray:
         return np.ascontiguousarray(np.stack([x[i] for x in axes]) if tabs else np.zeros(shape, dtype=dtype))

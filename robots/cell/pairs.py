@@ -19,7 +19,7 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
     along the chain, the prismatic strokes and the geometry's own bounding sphere, by the
     triangle inequality), and that ball does not reach the other geometry's bounding box (a
     fixture) or ball (another arm). *Axial gap* (:attr:`AllowedPair.note` :data:`AXIAL_GAP`,
-    :mod:`robots.pair_proofs`): every joint between the two that neither shape turns about its
+    :mod:`pinarms.robots.pair_proofs`): every joint between the two that neither shape turns about its
     own axis of symmetry is revolute about one common line, so each shape's projection onto
     that line never changes, and the two projections (computed from the shapes: box corners,
     cylinder end discs, mesh vertices, ...) are apart (the SCARA's upper arm turning above its
@@ -38,11 +38,11 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
 ``coaxial``
     in contact in (almost) every sampled configuration, and proven to be: one of the two turns
     only about its own axis of symmetry relative to the other (a sphere centred on every joint
-    axis between them, a cylinder, capsule or cone along it, :mod:`robots.coaxial`), so it fills the
+    axis between them, a cylinder, capsule or cone along it, :mod:`pinarms.robots.coaxial`), so it fills the
     same space at every angle and their distance never changes (the Panda's link-1 capsule
     standing on its table, the SCARA's shoulder hub);
 ``constant``
-    proven apart by one distance in every configuration (:func:`robots.pair_proofs.invariant_pair`):
+    proven apart by one distance in every configuration (:func:`pinarms.robots.pair_proofs.invariant_pair`):
     walking the joints between the two, each is one about which the shape on its moving side
     is symmetric (a sphere centred on its axis, a cylinder, capsule or cone along it), taken from
     either end, so no joint moves one shape relative to the other (the AUBO base and its upper
@@ -54,7 +54,7 @@ of geometries is **not checked** (an :class:`AllowedPair`) for one of these reas
 are proven from the structure and the shapes. ``adjacent`` is the usual assumption of SRDF files (two
 links joined by a joint are designed to touch at it), taken only from the structure, never
 from a sample; for a pair in contact in (almost) every sample, a shape turning about its own
-axis counts as part of the link it is fixed to (:mod:`robots.coaxial`: the Panda's link-3 sphere at
+axis counts as part of the link it is fixed to (:mod:`pinarms.robots.coaxial`: the Panda's link-3 sphere at
 joint 2 is adjacent to link 1). ``declared`` is the user's word. The sample only selects the
 pairs that must be explained (in contact in at least :data:`ALWAYS_SHARE` of them); it never
 skips one: a pair found at one distance in every sample but covered by no proof (a quill
@@ -78,22 +78,20 @@ clearance: they touch by construction, or keep a contact no motion changes.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import coal
 import numpy as np
 import pinocchio as pin
 
-from ..coaxial import still_frames
-from ..errors import PlacementError
-from ..pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
-from ..pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
+from pinarms.robots.coaxial import still_frames
+from pinarms.errors import PlacementError
+from pinarms.robots.pair_proofs import SAFETY, axial_gap, invariant_pair, neutral_distance
+from pinarms.robots.pair_rules import (ALWAYS_SHARE, AllowedPair, PairReason, by_design, contact_rows, effective_joint,
                           structural_reason)
-from .pair_samples import SAMPLES, sample_pairs
-from .reach import root_cylinders, tighter_bound
+from pinarms.robots.cell.pair_samples import SAMPLES, sample_pairs
+from pinarms.robots.cell.reach import root_cylinders, tighter_bound
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["CollisionPair", "AllowedPair", "PairReason", "classify_pairs", "reach_pairs", "ALWAYS_SHARE",
            "ALWAYS_SAMPLES", "BY_DESIGN", "BOUNDED", "AXIAL_GAP"]
@@ -157,10 +155,10 @@ def _local_sphere(geometry) -> tuple[np.ndarray, float, np.ndarray]:
     return center, float(np.linalg.norm(half)), half
 
 
-def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
+def classify_pairs(cell: "CellModel", seed: int = 0) -> tuple[tuple[CollisionPair, ...], tuple[AllowedPair, ...]]:
     """Split every pair of the cell's collision geometries into checked and allowed pairs.
 
-    The rules by design, the declared pairs and the proof of reach first (:func:`robots.pair_rules.by_design`,
+    The rules by design, the declared pairs and the proof of reach first (:func:`pinarms.robots.pair_rules.by_design`,
     :func:`_reach_gaps`), then the seeded sampling of the pairs left (:func:`_sampled_contacts`);
     the checked pairs come back arm-fixture first, then arm-arm, then self.
 
@@ -210,7 +208,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
                 else:
                     allow(a, b, *proven)
 
-    from .limits import check_pairs
+    from pinarms.robots.cell.limits import check_pairs
 
     check_pairs(len(checked), cell.source)  # before the sampling below, whose cost grows with it
     keep, through = [], []
@@ -235,7 +233,7 @@ def classify_pairs(cell: "Cell", seed: int = 0) -> tuple[tuple[CollisionPair, ..
 def _proven_gap(model: pin.Model, data: pin.Data, objs: list, gd: pin.GeometryData, a: int,
                b: int) -> tuple[PairReason, float, str] | None:
     """``("constant", distance)`` for a pair proven apart at one distance in every configuration, ``("out of reach",
-    gap)`` for one proven apart along the common axis of every joint between them (:mod:`robots.pair_proofs`; the
+    gap)`` for one proven apart along the common axis of every joint between them (:mod:`pinarms.robots.pair_proofs`; the
     neutral ``data`` and ``gd``), else ``None`` (the pair is checked). A bound is kept only when it is > 0."""
     if invariant_pair(model, data, objs[a], objs[b]):
         d = neutral_distance(objs[a].geometry, gd.oMg[a], objs[b].geometry, gd.oMg[b]) - SAFETY
@@ -244,13 +242,13 @@ def _proven_gap(model: pin.Model, data: pin.Data, objs: list, gd: pin.GeometryDa
     return (PairReason.OUT_OF_REACH, gap, AXIAL_GAP) if gap > 0.0 else None
 
 
-def _declared(cell: "Cell") -> dict[frozenset, str]:
+def _declared(cell: "CellModel") -> dict[frozenset, str]:
     """The pairs of links the cell file declares in contact by design (names checked by :func:`.description.describe`),
     with the reason given."""
     return {frozenset((a, b)): note for a, b, note in cell.spec.declared}
 
 
-def _placement_error(cell: "Cell", objs: list, link: list[str], owner: list[str], is_arm: list[bool],
+def _placement_error(cell: "CellModel", objs: list, link: list[str], owner: list[str], is_arm: list[bool],
                      through: list[tuple[int, int, float, float]]) -> PlacementError:
     """The :class:`PlacementError` of the geometry pairs ``through`` ``(a, b, share, depth)``, by pair of links."""
     rows, shown = contact_rows([(*_pair(a, b, objs, link, owner, is_arm).bodies, share, depth)
@@ -307,7 +305,7 @@ def _reach_balls(model: pin.Model, data: pin.Data, objs: list, joint: list[int],
     return ball_center, ball_radius
 
 
-def _sampled_contacts(cell: "Cell", objs: list, data: pin.Data, checked: list[tuple[int, int]],
+def _sampled_contacts(cell: "CellModel", objs: list, data: pin.Data, checked: list[tuple[int, int]],
                       seed: int) -> list[tuple[float, float]]:
     """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations (:mod:`.pair_samples`, cached by
     content): the share of them in contact and the deepest penetration found [m] (0 if none). Only for the
@@ -316,7 +314,7 @@ def _sampled_contacts(cell: "Cell", objs: list, data: pin.Data, checked: list[tu
     return [(float(h) / ALWAYS_SAMPLES, max(0.0, -float(dmin[k]))) for k, h in enumerate(hits)]
 
 
-def _owners(cell: "Cell") -> tuple[list[str], list[str], list[bool]]:
+def _owners(cell: "CellModel") -> tuple[list[str], list[str], list[bool]]:
     model, objs = cell.model, list(cell.collision_model.geometryObjects)
     link = [model.frames[g.parentFrame].name for g in objs]
     owner_of_link: dict[str, str] = {}
@@ -340,7 +338,7 @@ def _pair(a: int, b: int, objs: list, link: list[str], owner: list[str], is_arm:
     return CollisionPair(a, b, objs[a].name, objs[b].name, link[a], link[b], owner[a], owner[b], kind)
 
 
-def reach_pairs(cell: "Cell", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
+def reach_pairs(cell: "CellModel", allowed: tuple[AllowedPair, ...]) -> tuple[tuple[CollisionPair, ...], np.ndarray]:
     """The ``"out of reach"`` and ``"constant"`` pairs (:data:`BOUNDED`) as :class:`CollisionPair` s, in increasing order of
     their bound, and the bounds [m]."""
     objs = list(cell.collision_model.geometryObjects)

@@ -16,28 +16,29 @@ than a given travel apart.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import InvalidInput
-from .timeline import ArmMotion
+from pinarms.errors import InvalidInput
+from pinarms.robots.cell.timeline import ArmMotion
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["joint_levers", "peak_speed", "speed_profile", "travel_stops"]
 
 
-def joint_levers(cell: "Cell") -> np.ndarray:
+def joint_levers(cell: "CellModel") -> np.ndarray:
     """``(nq,)`` levers ``ℓ`` [m per rad, or 1 for prismatic]: point speed ≤ ``Σ |q̇_c| ℓ_c``.
 
-    See the module doc; a mimic joint adds ``|scale| ×`` its own lever to its master's.
+    See the module doc; a mimic joint adds ``|scale| ×`` its own lever to its master's. Built once
+    per cell (:meth:`Cell.memo`).
     """
-    cached = getattr(cell, "_levers", None)
-    if cached is not None:
-        return cached
+    return cell.memo("joint levers", lambda: _levers(cell))
+
+
+def _levers(cell: "CellModel") -> np.ndarray:
     model, gm = cell.model, cell.collision_model
     data = model.createData()
     pin.forwardKinematics(model, data, pin.neutral(model))
@@ -70,7 +71,6 @@ def joint_levers(cell: "Cell") -> np.ndarray:
     for i in range(1, n):
         c = model.joints[i].idx_v
         levers[c] += abs(scale[i]) * (reach[i] if revolute[i] else 1.0)
-    cell._levers = levers
     return levers
 
 
@@ -91,7 +91,7 @@ def peak_speed(traj: Any, nq: int, what: str) -> np.ndarray:
     return v
 
 
-def speed_profile(cell: "Cell", motions: list[ArmMotion], grid: np.ndarray) -> tuple[np.ndarray, float]:
+def speed_profile(cell: "CellModel", motions: list[ArmMotion], grid: np.ndarray) -> tuple[np.ndarray, float]:
     """Bound of the approach speed ``V`` [m/s] on each step of ``grid`` ``(len(grid) - 1,)``, and the global bound.
 
     Per arm: the larger end speed plus ``A h / 2`` (``A`` from the exact acceleration peaks),

@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .cell import Cell
+from pinarms.robots.cell.cell_model import CellModel
 
 __all__ = ["ArmMotion", "arm_motions", "as_time", "configurations", "motion_window", "sample_motions", "MAX_SAMPLES",
            "MAX_TIME"]
@@ -69,7 +68,7 @@ class ArmMotion:
         return np.clip(tau + traj.start_time, traj.start_time, traj.end_time)
 
 
-def arm_motions(cell: "Cell", motions: Any) -> list[ArmMotion]:
+def arm_motions(cell: "CellModel", motions: Any) -> list[ArmMotion]:
     """The motions as a checked list of :class:`ArmMotion`.
 
     Takes :class:`ArmMotion` objects (or one), or ``{arm: trajectory}`` /
@@ -127,7 +126,7 @@ def _check_trajectory(m: ArmMotion, nq: int) -> None:
             )
 
 
-def configurations(cell: "Cell", motions: list[ArmMotion], times: np.ndarray, hold: np.ndarray) -> np.ndarray:
+def configurations(cell: "CellModel", motions: list[ArmMotion], times: np.ndarray, hold: np.ndarray) -> np.ndarray:
     """Cell configurations ``(M, nq)`` at cell ``times`` (arms without a motion at ``hold``)."""
     Q = np.tile(hold, (times.size, 1))
     for m in motions:
@@ -149,7 +148,7 @@ def motion_window(motions: list[ArmMotion]) -> tuple[float, float]:
     )
 
 
-def sample_motions(cell: "Cell", motions: Any, *, hz: float = 100.0, window: tuple[float, float] | None = None,
+def sample_motions(cell: "CellModel", motions: Any, *, hz: float = 100.0, window: tuple[float, float] | None = None,
                    hold: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """The arms' motions sampled together: times ``(M,)`` [s] and cell configurations ``(M, nq)``.
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..collision_requests import cold_start
+from pinarms.robots.collision_requests import cold_start
 
 __all__ = ["PairViews", "Checker"]
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..urdf_build import build_file, write_atomic
-from .closures import closures_to_xml
-from .family import family_closures
-from .shipped import delta_info, delta_names
+from pinarms.robots.urdf_build import build_file, write_atomic
+from pinarms.robots.delta.closures import closures_to_xml
+from pinarms.robots.delta.family import family_closures
+from pinarms.robots.delta.shipped import delta_info, delta_names
 
 __all__ = ["build_delta", "build_deltas", "stale_deltas"]
 

@@ -33,9 +33,9 @@ import pinocchio as pin
 
 from pinarms.files import read_bounded_text, write_text
 
-from ..errors import ModelError
-from ..urdf_checks import refuse_dtd
-from .errors import ClosuresFileError
+from pinarms.errors import ModelError
+from pinarms.robots.urdf_checks import refuse_dtd
+from pinarms.robots.delta.errors import ClosuresFileError
 
 __all__ = ["LoopClosure", "ClosureSet", "MAX_CLOSURES", "MAX_CLOSURES_BYTES", "CLOSURE_TYPES", "parse_closures",
            "read_closures", "closures_to_xml", "write_closures", "constraint_models"]

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
-from .errors import DeltaInputError
-from .kinematics import elbow_positions, forward_position
-from .model import DeltaRobot
-from .rods import rod_endpoints
+from pinarms.robots.delta.errors import DeltaInputError
+from pinarms.robots.delta.kinematics import elbow_positions, forward_position
+from pinarms.robots.delta.model import DeltaRobot
+from pinarms.robots.delta.rods import rod_endpoints
 
 __all__ = ["PART_RADII", "PLATFORM_THICKNESS", "DeltaBody", "collision_bodies", "fixture_clearance"]
 

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .errors import DeltaInputError
-from .kinematics import inverse_position
-from .model import DeltaRobot
+from pinarms.robots.delta.errors import DeltaInputError
+from pinarms.robots.delta.kinematics import inverse_position
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["ClosedChainState", "closed_chain_state", "motor_torques", "check_with_constraint_dynamics"]
 

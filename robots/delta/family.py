@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from .closures import ClosureSet, LoopClosure
-from .geometry import LEG_COUNT, leg_frames
+from pinarms.robots.delta.closures import ClosureSet, LoopClosure
+from pinarms.robots.delta.geometry import LEG_COUNT, leg_frames
 
 __all__ = ["family_closures"]
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .errors import NotADelta
+from pinarms.robots.delta.errors import NotADelta
 
 __all__ = ["DeltaGeometry", "LEG_COUNT", "motor_joint", "leg_frames"]
 

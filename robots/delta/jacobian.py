@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import DeltaGeometry
-from .kinematics import _rows, forward_position, virtual_elbows
-from .model import DeltaRobot
+from pinarms.robots.delta.geometry import DeltaGeometry
+from pinarms.robots.delta.kinematics import _rows, forward_position, virtual_elbows
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["constraint_matrices", "platform_jacobian", "platform_jacobian_pinocchio"]
 

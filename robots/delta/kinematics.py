@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import DeltaInputError, DeltaUnreachable
-from .geometry import DeltaGeometry
+from pinarms.robots.delta.errors import DeltaInputError, DeltaUnreachable
+from pinarms.robots.delta.geometry import DeltaGeometry
 
 __all__ = ["virtual_elbows", "elbow_positions", "forward_position", "inverse_position_branches",
            "inverse_position", "BRANCH_COUNT", "PRIMARY_BRANCH", "branch_signs"]

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .closures import ClosureSet, constraint_models
-from .errors import DeltaInputError, ProjectionFailed
-from .geometry import LEG_COUNT, DeltaGeometry, motor_joint
-from .kinematics import forward_position
+from pinarms.robots.delta.closures import ClosureSet, constraint_models
+from pinarms.robots.delta.errors import DeltaInputError, ProjectionFailed
+from pinarms.robots.delta.geometry import LEG_COUNT, DeltaGeometry, motor_joint
+from pinarms.robots.delta.kinematics import forward_position
 
 __all__ = ["DeltaRobot", "MotorLimits"]
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from .geometry import LEG_COUNT, leg_frames
-from .model import DeltaRobot
+from pinarms.robots.delta.geometry import LEG_COUNT, leg_frames
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["rod_endpoints"]
 

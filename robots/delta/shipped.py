@@ -15,13 +15,13 @@ import pinocchio as pin
 
 from pinarms.files import read_bounded_text
 
-from ..errors import ModelError, RobotNotFound
-from ..registry import MAX_URDF_BYTES
-from ..urdf_build import URDF_DIR
-from ..urdf_checks import check_inertials, check_tree, refuse_dtd
-from .closures import read_closures
-from .errors import ClosuresFileError, DeltaInputError
-from .model import DeltaRobot
+from pinarms.errors import ModelError, RobotNotFound
+from pinarms.robots.registry import MAX_URDF_BYTES
+from pinarms.robots.urdf_build import URDF_DIR
+from pinarms.robots.urdf_checks import check_inertials, check_tree, refuse_dtd
+from pinarms.robots.delta.closures import read_closures
+from pinarms.robots.delta.errors import ClosuresFileError, DeltaInputError
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["DeltaInfo", "delta_names", "delta_info", "load_delta", "delta_from_files", "XACRO_DIR"]
 

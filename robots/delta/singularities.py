@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import DeltaGeometry
-from .jacobian import constraint_matrices
+from pinarms.robots.delta.geometry import DeltaGeometry
+from pinarms.robots.delta.jacobian import constraint_matrices
 
 __all__ = ["SingularityReport", "singularities"]
 

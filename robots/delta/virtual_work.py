@@ -19,8 +19,8 @@ from typing import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .kinematics import forward_position, inverse_position
-from .model import DeltaRobot
+from pinarms.robots.delta.kinematics import forward_position, inverse_position
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["body_frames", "virtual_work_torques"]
 

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import DeltaInputError
-from .kinematics import PRIMARY_BRANCH, forward_position, inverse_position_branches
-from .model import DeltaRobot
+from pinarms.robots.delta.errors import DeltaInputError
+from pinarms.robots.delta.kinematics import PRIMARY_BRANCH, forward_position, inverse_position_branches
+from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["WorkspaceSamples", "sample_workspace", "reachable", "CylinderDome", "cylinder_dome"]
 

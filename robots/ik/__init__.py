@@ -7,24 +7,24 @@
 - :func:`near_limit_solutions`: closed-form solutions a little outside the joint ranges,
   and by how much (to tell users; ``limit_tolerance=`` accepts them).
 
-Every robot loaded by :mod:`robots.registry` (``load``, ``from_urdf``, ``from_urdf_text``,
+Every robot loaded by :mod:`pinarms.robots.registry` (``load``, ``from_urdf``, ``from_urdf_text``,
 ``from_xacro``) and every arm of a cell gets the closed form of its family when its
 kinematic structure matches one (:func:`recognise`, by geometry, proven by FK round trips
-at load); ``robot.ik_family`` says which. Users normally call :meth:`robots.Robot.ik_all`
-and :meth:`robots.Robot.ik`.
+at load); ``robot.ik_family`` says which. Users normally call :meth:`pinarms.robots.Robot.ik_all`
+and :meth:`pinarms.robots.Robot.ik`.
 """
 
 from __future__ import annotations
 
-from .families import FAMILIES
-from .gantry import GantryIK
-from .koji import KojiIK
-from .near_limits import OutsideLimits, limit_excess, near_limit_solutions
-from .numerical import IKResult, NumericalIK
-from .recognise import Recognition, recognise
-from .scara import ScaraIK
-from .solver import FK_TOL, LIMIT_TOL, AnalyticIK
-from .ur_type import URTypeIK
+from pinarms.robots.ik.families import FAMILIES
+from pinarms.robots.ik.gantry import GantryIK
+from pinarms.robots.ik.koji import KojiIK
+from pinarms.robots.ik.near_limits import OutsideLimits, limit_excess, near_limit_solutions
+from pinarms.robots.ik.numerical import IKResult, NumericalIK
+from pinarms.robots.ik.recognise import Recognition, recognise
+from pinarms.robots.ik.scara import ScaraIK
+from pinarms.robots.ik.solver import FK_TOL, LIMIT_TOL, AnalyticIK
+from pinarms.robots.ik.ur_type import URTypeIK
 
 __all__ = [
     "attach_analytic_ik",
@@ -67,7 +67,7 @@ def analytic_solver(robot, family: str, frame: str = "tcp") -> AnalyticIK:
         InvalidInput: unknown family.
         ModelError: the robot does not have the structure the family's solver assumes.
     """
-    from ..errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     if family not in FAMILIES:
         raise InvalidInput(f"unknown IK family {family!r}; known: {', '.join(FAMILIES)}")
@@ -79,7 +79,7 @@ def attach_analytic_ik(robot, family: str | None = None) -> str | None:
 
     Without ``family`` the family is recognised from the robot's kinematic structure and
     proven by FK round trips (:func:`recognise`); a robot that matches none keeps
-    ``robot._analytic_ik = None`` (numerical IK only). With ``family`` that solver is built
+    ``robot.analytic_ik`` ``None`` (numerical IK only). With ``family`` that solver is built
     (and proven) or an error is raised.
 
     Raises:
@@ -88,10 +88,7 @@ def attach_analytic_ik(robot, family: str | None = None) -> str | None:
     """
     if family is None:
         found = recognise(robot)
-        robot._analytic_ik = found.solver
-        robot._ik_rejected = found.rejected
-        robot._ik_auto = True  # recognised again if the tcp frame changes
+        robot.set_analytic_ik(found.solver, rejected=found.rejected, recognised=True)  # again if the tcp changes
         return found.family
-    robot._analytic_ik = analytic_solver(robot, family)
-    robot._ik_rejected = {}
+    robot.set_analytic_ik(analytic_solver(robot, family))
     return family

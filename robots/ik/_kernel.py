@@ -31,8 +31,8 @@ import math
 
 import numpy as np
 
-from ._chain import errors, grid_index, grid_neighbours, jacobian, jit, jit_inline, pose_cost, pose_error, table_index
-from ._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
+from pinarms.robots.ik._chain import errors, grid_index, grid_neighbours, jacobian, jit, jit_inline, pose_cost, pose_error, table_index
+from pinarms.robots.ik._limits_kernel import CLIP, FREE, WINDOW, clip, in_limits, wrap, wrap_unbounded
 
 __all__ = ["FREE", "WINDOW", "CLIP", "descend", "errors", "attempt_within_limits", "table_index", "solve",
            "solve_many", "workspace", "grid_index"]

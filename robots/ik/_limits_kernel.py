@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ._chain import jit
+from pinarms.robots.ik._chain import jit
 
 FREE, WINDOW, CLIP = 0, 1, 2  # free descent; free then wrapped to the ranges' windows; projected descent
 _TWO_PI = 2.0 * math.pi

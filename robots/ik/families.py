@@ -1,16 +1,16 @@
 """The closed-form solver class of each arm family, by family name.
 
-Its own module so that :func:`robots.ik.recognise` and the package's
-:func:`robots.ik.analytic_solver` read the same table without importing each other.
+Its own module so that :func:`pinarms.robots.ik.recognise` and the package's
+:func:`pinarms.robots.ik.analytic_solver` read the same table without importing each other.
 """
 
 from __future__ import annotations
 
-from .gantry import GantryIK
-from .koji import KojiIK
-from .scara import ScaraIK
-from .solver import AnalyticIK
-from .ur_type import URTypeIK
+from pinarms.robots.ik.gantry import GantryIK
+from pinarms.robots.ik.koji import KojiIK
+from pinarms.robots.ik.scara import ScaraIK
+from pinarms.robots.ik.solver import AnalyticIK
+from pinarms.robots.ik.ur_type import URTypeIK
 
 __all__ = ["FAMILIES"]
 

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from .geometry import chain_axes
-from .solver import AnalyticIK
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import chain_axes
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["GantryIK"]
 

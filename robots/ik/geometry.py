@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ModelError
-from ..so3 import hat as _skew
+from pinarms.errors import ModelError
+from pinarms.robots.so3 import hat as _skew
 
 __all__ = [
     "ChainAxis",
@@ -86,7 +86,7 @@ def chain_axes(robot, frame: str = "tcp") -> Chain:
         ModelError: a joint on the path is not a 1-DoF revolute/prismatic joint.
     """
     model = robot.model
-    tree = robot._tree
+    tree = robot.kinematic_tree
     fid = robot.frame_id(frame)
     data = model.createData()
     q0 = robot.q_to_pinocchio(np.zeros(robot.nq))

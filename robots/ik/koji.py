@@ -25,9 +25,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from .geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link, rotate, solve_cos_sin
-from .solver import AnalyticIK
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link, rotate, solve_cos_sin
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["KojiIK"]
 

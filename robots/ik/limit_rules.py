@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematic_tree import _REVOLUTE
+from pinarms.robots.kinematic_tree import _REVOLUTE
 
 __all__ = ["JointLimitRules"]
 
@@ -34,7 +34,7 @@ class JointLimitRules:
 
     def _init_limits(self, robot) -> None:
         """Read the limits and joint kinds of ``robot`` (called by the solver's constructor)."""
-        tree = robot._tree
+        tree = robot.kinematic_tree
         nq = robot.nq
         self.unbounded = np.array(tree.coordinates.is_unbounded, dtype=bool)
         self._any_unbounded = bool(self.unbounded.any())

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["OutsideLimits", "limit_excess", "near_limit_solutions"]
 
@@ -64,13 +64,13 @@ def near_limit_solutions(robot: Any, target: Any, within: float) -> list[Outside
     """Closed-form solutions of one pose ``(4, 4)`` that lie outside the joint ranges by at most ``within``.
 
     Args:
-        robot: a :class:`robots.Robot` with a closed form (``robot.has_analytic_ik``).
+        robot: a :class:`pinarms.robots.Robot` with a closed form (``robot.has_analytic_ik``).
         target: tcp pose ``(4, 4)``, frame → base [m].
         within: the largest excess of any joint [rad or m] reported (> 0).
 
     Returns:
         The solutions outside the limits, smallest worst excess first (ties: the order of
-        :meth:`robots.Robot.ik_all`); solutions within the limits are not listed.
+        :meth:`pinarms.robots.Robot.ik_all`); solutions within the limits are not listed.
     """
     if isinstance(within, bool) or not isinstance(within, (int, float, np.integer, np.floating)) \
             or not (np.isfinite(within) and within > 0):

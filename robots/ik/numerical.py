@@ -63,17 +63,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InvalidInput
-from ..kinematic_tree import _REVOLUTE
-from .._checks import check_restarts as _check_restarts
-from .._checks import check_seed as _check_seed
-from .._checks import check_tolerance as _check_tolerance
-from .descent import CLIP as _CLIP
-from .descent import FREE as _FREE
-from .descent import LMDescent
-from .limit_rules import JointLimitRules
-from .numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
-from .starts import StartTable
+from pinarms.errors import InvalidInput
+from pinarms.robots.kinematic_tree import _REVOLUTE
+from pinarms.robots._checks import check_restarts as _check_restarts
+from pinarms.robots._checks import check_seed as _check_seed
+from pinarms.robots._checks import check_tolerance as _check_tolerance
+from pinarms.robots.ik.descent import CLIP as _CLIP
+from pinarms.robots.ik.descent import FREE as _FREE
+from pinarms.robots.ik.descent import LMDescent
+from pinarms.robots.ik.limit_rules import JointLimitRules
+from pinarms.robots.ik.numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
+from pinarms.robots.ik.starts import StartTable
 
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
 
@@ -104,7 +104,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
     """Levenberg–Marquardt IK of one robot frame, joint limits respected, seeded random restarts.
 
     Args:
-        robot: a :class:`robots.Robot`.
+        robot: a :class:`pinarms.robots.Robot`.
         frame: target frame (default the tcp).
         max_iter: iterations per attempt.
         damping: initial ``μ`` of ``λ = μ‖e‖² + λ_min``.
@@ -142,7 +142,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         self.nq = robot.nq
         self._init_limits(robot)
         self._identity_coords = (not self._any_unbounded) and self.model.nq == self.nq
-        self._coords = robot._tree.coordinates
+        self._coords = robot.kinematic_tree.coordinates
         self.max_iter = int(max_iter)
         self.damping = float(damping)
         self.min_damping = float(min_damping)
@@ -156,9 +156,9 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         """``(kernel module, C, L, P, table)``: the chain, limits and settings as arrays for :mod:`._kernel`, made once."""
         args = self._kernel_args
         if args is None:
-            from . import _kernel  # numba: imported (and its functions loaded from the cache) on first use
+            from pinarms.robots.ik import _kernel  # numba: imported (and its functions loaded from the cache) on first use
 
-            tree = self.robot._tree
+            tree = self.robot.kinematic_tree
             joint, fR, fp = tree.frame_of(self.frame_id)
             chain = np.array(tree.ancestors[joint], dtype=np.int64)
             C = (
@@ -186,9 +186,9 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
             args = self._kernel_args = (_kernel, C, L, P, table)  # one assignment: thread-safe
         return args
 
-    def _solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
+    def solve_compiled(self, target: np.ndarray, q_seed, position_only: bool, tol: float, max_restarts: int,
                         seed) -> IKResult:
-        """:meth:`_solve` (limits on, no final polish) compiled: the first start (``q_seed`` or the nearest of
+        """:meth:`solve_checked` (limits on, no final polish) compiled: the first start (``q_seed`` or the nearest of
         32 768 stored poses), then up to ``max_restarts`` more: the 8 stored poses next nearest the
         target, then seeded uniform starts nearest pose first.
 
@@ -250,12 +250,12 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         if q_seed is not None:
             q_seed = robot.check_q(q_seed)[0][0]
         _check_restarts(max_restarts)
-        return self._solve(
+        return self.solve_checked(
             T[0], q_seed, position_only=position_only, tol=_check_tolerance(tol, "tol [m, rad]", positive=True),
             max_restarts=int(max_restarts), seed=_check_seed(seed), limits=bool(limits),
         )
 
-    def _solve(
+    def solve_checked(
         self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True,
         compiled: bool = True,
     ) -> IKResult:
@@ -269,7 +269,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         target_to_base, target_in_base = self._target(target, position_only)
         tol = float(tol)
         if compiled and limits and first:
-            res = self._solve_compiled(target, q_seed, bool(position_only), tol, int(max_restarts), seed)
+            res = self.solve_compiled(target, q_seed, bool(position_only), tol, int(max_restarts), seed)
             if res.success or not polish:
                 return res
             # the closest configuration within the limits: a patient projected descent from the best end

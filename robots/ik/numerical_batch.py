@@ -1,7 +1,7 @@
-"""The batched numerical IK solver (:meth:`robots.ik.NumericalIK.solve_batch`) and its result.
+"""The batched numerical IK solver (:meth:`pinarms.robots.ik.NumericalIK.solve_batch`) and its result.
 
-Functions of a :class:`robots.ik.numerical.NumericalIK` (``self``), attached to the class by
-:mod:`robots.ik.numerical`; this module imports nothing of it. Units: m, rad.
+Functions of a :class:`pinarms.robots.ik.numerical.NumericalIK` (``self``), attached to the class by
+:mod:`pinarms.robots.ik.numerical`; this module imports nothing of it. Units: m, rad.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import check_restarts
+from pinarms.robots._checks import check_restarts
 
 
 __all__ = ["BatchIKResult", "solve_batch"]
@@ -162,7 +162,7 @@ def solve_batch(
     success &= (pos_err <= tol) & (rot_err <= tol) & inside
     left = np.flatnonzero(~success)
     for k in left:  # the few the batch left: per-target solver with restarts
-        res = self._solve(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
+        res = self.solve_checked(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
                           seed=rng, limits=True)
         q[k] = res.q
         success[k] = res.success

@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError
-from .families import FAMILIES
-from .geometry import chain_axes
-from .solver import AnalyticIK
+from pinarms.errors import ModelError
+from pinarms.robots.ik.families import FAMILIES
+from pinarms.robots.ik.geometry import chain_axes
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["Recognition", "recognise"]
 

@@ -1,6 +1,6 @@
 """Closed-form IK of a SCARA arm (seed 000): both elbow branches, the vertical stroke and the hand rotation.
 
-Structure assumed (checked on the model, :class:`~robots.errors.ModelError` otherwise): four
+Structure assumed (checked on the model, :class:`~pinarms.errors.ModelError` otherwise): four
 independent joints, three revolute and one prismatic, every axis parallel to the first
 one's direction ``w`` (vertical for the mushroom-packing SCARA). The first two revolute
 joints form the planar arm, the third turns the hand. Lengths and axis positions come from
@@ -8,7 +8,7 @@ the model (:mod:`.geometry`).
 
 A SCARA reaches a *position and a yaw* about ``w``: a target whose orientation is tilted
 has no solution (the FK check of :class:`~.solver.AnalyticIK` drops it, and
-:meth:`robots.Robot.ik_failure_reason` says so). With ``g = T_target · M⁻¹``:
+:meth:`pinarms.robots.Robot.ik_failure_reason` says so). With ``g = T_target · M⁻¹``:
 
 - stroke: translations along ``w`` commute with rotations about axes parallel to ``w``,
   so ``d = w·(g P − P) / (w·a)`` for a point ``P`` of the hand axis (``a``: the slide's axis);
@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from .geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link
-from .solver import AnalyticIK
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import STRUCTURE_TOL, angle_about, chain_axes, plane_basis, planar_two_link
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["ScaraIK"]
 

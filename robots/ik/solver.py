@@ -23,8 +23,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..errors import ModelError
-from ..ties import argsort_tied
+from pinarms.errors import ModelError
+from pinarms.robots.ties import argsort_tied
 
 __all__ = ["AnalyticIK", "LIMIT_TOL", "FK_TOL", "split_by_target"]
 
@@ -59,13 +59,13 @@ class AnalyticIK:
     """Base of the closed-form solvers. Subclasses set :attr:`family` and implement :meth:`raw`.
 
     Args:
-        robot: the :class:`robots.Robot` to solve for; the solver reads its geometry from
+        robot: the :class:`pinarms.robots.Robot` to solve for; the solver reads its geometry from
             ``robot.model`` when built and checks the structure it assumes.
         frame: the target frame (default the robot's tcp).
     """
 
     family = "analytic"
-    #: Short name of the family (a key of :data:`robots.ik.FAMILIES`), reported as ``Robot.ik_family``.
+    #: Short name of the family (a key of :data:`pinarms.robots.ik.FAMILIES`), reported as ``Robot.ik_family``.
     key = "analytic"
     #: Number of geometric branches of :meth:`raw` (its candidate slots modulo this are the
     #: branch labels; extra slots, e.g. at a singular wrist, repeat branches). None: every slot.
@@ -140,7 +140,7 @@ class AnalyticIK:
         ranges = self._shift_ranges(limit_tol)
         total = float(np.prod([k1 - k0 + 1.0 for _, k0, k1 in ranges]))
         if total > MAX_EQUIVALENTS:
-            from ..errors import InvalidInput
+            from pinarms.errors import InvalidInput
 
             raise InvalidInput(
                 f"robot '{self.robot.name}': its joint ranges hold {total:.3g} combinations of 2π equivalents per "
@@ -253,7 +253,7 @@ class AnalyticIK:
         With ``respect_limits=False`` the joint limits are ignored (each revolute angle is
         given once, wrapped to ``(-π, π]``): used to tell *out of reach* from *limits*.
         With ``with_branches`` a third array ``branch (M,)`` gives each solution's branch
-        label (see :meth:`robots.Robot.ik_branches`). ``limit_tol`` [rad or m]: how far
+        label (see :meth:`pinarms.robots.Robot.ik_branches`). ``limit_tol`` [rad or m]: how far
         outside its range a joint may lie (default the solver's own :data:`LIMIT_TOL`).
         """
         robot = self.robot
@@ -291,7 +291,7 @@ class AnalyticIK:
         (nq,)``; branches that do not exist, or that no equivalent brings within the limits,
         are dropped, the rest sorted by distance to ``q_ref``. Unlike :meth:`solve` the
         candidates are *not* checked by forward kinematics (nor every 2π equivalent listed):
-        :meth:`robots.Robot.ik` refines and checks them with Pinocchio, which costs less for
+        :meth:`pinarms.robots.Robot.ik` refines and checks them with Pinocchio, which costs less for
         one target than the batched machinery. ``limit_tol`` [rad or m] widens the limits.
         """
         widen = limit_tol - LIMIT_TOL

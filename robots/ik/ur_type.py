@@ -1,6 +1,6 @@
 """Closed-form IK of six-revolute arms with three parallel axes (UR3/5/10, AUBO-i3): up to 8 solutions.
 
-Structure assumed (checked on the model, :class:`~robots.errors.ModelError` otherwise):
+Structure assumed (checked on the model, :class:`~pinarms.errors.ModelError` otherwise):
 axes 2, 3, 4 parallel (direction ``w2``, either sign), axis 1 not parallel to them,
 axes 5 and 6 intersecting at a point ``C``, axis 5 not parallel to ``w2``. No length is
 hard-coded: axes, points and the home pose ``M`` come from the model (:mod:`.geometry`).
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from .geometry import (
+from pinarms.errors import ModelError
+from pinarms.robots.ik.geometry import (
     STRUCTURE_TOL,
     angle_about,
     chain_axes,
@@ -34,7 +34,7 @@ from .geometry import (
     rotate_const,
     solve_cos_sin,
 )
-from .solver import AnalyticIK
+from pinarms.robots.ik.solver import AnalyticIK
 
 __all__ = ["URTypeIK"]
 

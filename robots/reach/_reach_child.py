@@ -1,4 +1,4 @@
-"""The parent's side of the bounded map reader: start :mod:`robots.reach._reach_worker`, limit it, read its frames.
+"""The parent's side of the bounded map reader: start :mod:`pinarms.robots.reach._reach_worker`, limit it, read its frames.
 
 The child runs ``python -I _reach_worker.py`` with an almost empty environment (one BLAS
 thread), in a new session, with its address space, CPU time, file size, core dumps (and,

@@ -1,4 +1,4 @@
-"""Inspect and read one reachability map file inside a bounded child process (run by :mod:`robots.reach.reach_io`).
+"""Inspect and read one reachability map file inside a bounded child process (run by :mod:`pinarms.robots.reach.reach_io`).
 
 This file runs as a script (``python -I _reach_worker.py``) in a child process whose address
 space, CPU time and file writes the parent limits and whose wall-clock time it bounds. It

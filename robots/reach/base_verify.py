@@ -3,8 +3,8 @@
 :func:`verify_bases` solves every task pose (every roll about the tool axis for roll-free
 tasks) seen from each candidate base: every closed-form branch within the limits when the arm
 and the map have a closed form, else the numerical solver (seeded per pose); the collision
-checks of :func:`robots.reach.reachability.reachability_map` drop solutions. Used by
-:func:`robots.reach.inverse_reach.base_placements`. Units: m, rad.
+checks of :func:`pinarms.robots.reach.reachability.reachability_map` drop solutions. Used by
+:func:`pinarms.robots.reach.inverse_reach.base_placements`. Units: m, rad.
 """
 
 from __future__ import annotations
@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .orientations import _rotation_about
-from .reach_chunk import ChunkTask, collision_free, manipulability_of
-from .reach_map import ReachabilityMap
-from .robot_spec import spec_of
+from pinarms.robots.reach.orientations import _rotation_about
+from pinarms.robots.reach.reach_chunk import ChunkTask, collision_free, manipulability_of
+from pinarms.robots.reach.reach_map import ReachabilityMap
+from pinarms.robots.reach.robot_spec import spec_of
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["verify_bases"]
 
@@ -50,7 +50,7 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
                      self_collision=bool(self_collision), collision=collision, keep_solutions=False, seed=0)
     best = np.full(T.shape[0], np.nan)
     if robot.has_analytic_ik and reach_map.solver == "analytic":
-        idx, q = robot._analytic_ik.candidates(T)
+        idx, q = robot.analytic_ik.candidates(T)
         keep = collision_free(task, robot, q)
         idx, q = idx[keep], q[keep]
         w = manipulability_of(robot, q, reach_map.manipulability_kind)
@@ -58,7 +58,7 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
         np.maximum.at(top, idx, w)
         best = np.where(np.isfinite(top), top, np.nan)
     else:
-        from ..errors import UnreachableTarget
+        from pinarms.errors import UnreachableTarget
 
         for k in range(T.shape[0]):
             try:

@@ -9,8 +9,8 @@ origin and, from the *linear* rows ``J_v`` of its Jacobian:
 
 It runs one pass over the joints per chunk of samples (the robot's compiled kinematic tree)
 on all cores; :func:`position_dexterity` takes the Jacobians themselves. Used by the sampled
-and streamed workspaces (:mod:`robots.reach.workspace`, :mod:`robots.reach.workspace_stream`)
-and the layout check (:mod:`robots.reach.layout`).
+and streamed workspaces (:mod:`pinarms.robots.reach.workspace`, :mod:`pinarms.robots.reach.workspace_stream`)
+and the layout check (:mod:`pinarms.robots.reach.layout`).
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["position_dexterity", "positions_and_dexterity", "CHUNK"]
 
@@ -102,7 +102,7 @@ def positions_and_dexterity(
     points = np.empty((N, 3))
     w = np.empty(N)
     c = np.empty(N)
-    tree = getattr(robot, "_tree", None)
+    tree = getattr(robot, "kinematic_tree", None)
     fast = tree is not None and robot.nq >= 3 and hasattr(tree, "origin_and_columns")
 
     def block(start: int) -> None:

@@ -4,7 +4,7 @@ The arm's base stands on a plane at height ``z`` [m] (world frame), at ``(x, y)`
 ``ψ`` about the vertical: ``T_base_to_world = Trans(x, y, z) · Rz(ψ)``. A task pose
 ``task_to_world`` (tool frame → world) is, seen from that base, ``task_to_base = T_base_to_world⁻¹ · task_to_world``.
 
-:func:`base_placements` answers with the inverse of a :class:`~robots.reach.reachability.ReachabilityMap`
+:func:`base_placements` answers with the inverse of a :class:`~pinarms.robots.reach.reachability.ReachabilityMap`
 restricted to bases on the plane:
 
 1. **Candidates.** A grid of ``(x, y) = (i, j)·xy_step`` (default step: the map's resolution)
@@ -21,7 +21,7 @@ restricted to bases on the plane:
    count: how much orientation freedom is left around the tasks; then the smallest best
    manipulability of the tasks' voxels; then the candidate's grid order (x, then y, then
    yaw). Manipulabilities within 1e-9 relative count as tied.
-4. **Check** (:mod:`robots.reach.base_verify`). The ``verify`` best candidates are solved exactly by IK (every closed-form branch
+4. **Check** (:mod:`pinarms.robots.reach.base_verify`). The ``verify`` best candidates are solved exactly by IK (every closed-form branch
    within the limits, or the numerical solver) at the exact task poses (rolls tried for
    roll-free tasks) with the collision checks given; ``verified`` says whether every task has
    a solution, ``ik_manipulability`` the smallest (over tasks) best manipulability. The final
@@ -39,14 +39,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput, ModelError
-from .orientations import _align, _rotation_about
-from .base_verify import verify_bases
-from .reach_map import ReachabilityMap
-from .robot_spec import urdf_sha256
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.orientations import _align, _rotation_about
+from pinarms.robots.reach.base_verify import verify_bases
+from pinarms.robots.reach.reach_map import ReachabilityMap
+from pinarms.robots.reach.robot_spec import urdf_sha256
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["BasePlacements", "base_placements", "tool_down_poses", "MAX_CANDIDATES"]
 
@@ -59,7 +59,7 @@ _DOWN = np.array([0.0, 0.0, -1.0])
 def tool_down_poses(points: Any, tool_axis: Any = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Task poses ``(N, 4, 4)`` at ``points (N, 3)`` [m] with ``tool_axis`` (tool frame) pointing straight down.
 
-    Roll zero as in :func:`robots.reach.orientations.tool_axis_orientations` (a fixed rotation taking
+    Roll zero as in :func:`pinarms.robots.reach.orientations.tool_axis_orientations` (a fixed rotation taking
     the tool axis to ``(0, 0, −1)``); a roll-free task ignores it.
     """
     P = _as_points(points)
@@ -213,7 +213,7 @@ def base_placements(
         roll_steps: rolls tried per roll-free task on an SO(3) map and in the exact check.
         verify: how many of the best map candidates to check by IK (needs ``robot``).
         self_collision, collision: collision checks of the exact IK solutions (as in
-            :func:`robots.reachability_map`).
+            :func:`pinarms.robots.reachability_map`).
 
     Raises:
         InvalidInput: bad tasks, steps, a grid larger than :data:`MAX_CANDIDATES`.

@@ -1,7 +1,7 @@
 """Slices of an arm's seeded joint-sample stream: any samples of ``robot.random_q(n, seed)`` without the others.
 
-The sampled workspace cut into tasks (:func:`robots.reach.workspace.sample_workspace`) and
-the streamed workspace (:mod:`robots.reach.workspace_stream`) draw each task's samples here,
+The sampled workspace cut into tasks (:func:`pinarms.robots.reach.workspace.sample_workspace`) and
+the streamed workspace (:mod:`pinarms.robots.reach.workspace_stream`) draw each task's samples here,
 so that their result equals the one-piece run bit for bit, whoever runs the tasks.
 Joint values in rad or m.
 """
@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["random_q_slice", "generator_at"]
 

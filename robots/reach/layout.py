@@ -9,7 +9,7 @@ condition of each, and the dexterity margin of the best one:
   manipulability of the robot's sampled workspace (> 1: better than a typical
   configuration; near 0: close to a singularity),
 - ``boundary_margin`` = distance [m] from the point to the edge of the sampled workspace,
-  read from a voxel map (:class:`~robots.reach.voxels.VoxelMap`).
+  read from a voxel map (:class:`~pinarms.robots.reach.voxels.VoxelMap`).
 
 Solutions come from ``robot.ik_all`` when the arm has a closed form
 (``robot.has_analytic_ik``), else from ``robot.ik`` started from several seeded joint
@@ -37,13 +37,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput, UnreachableTarget
-from ..so3 import rot_z as _rot_z
-from .dexterity import position_dexterity
-from .workspace import Workspace, sample_workspace
+from pinarms.errors import InvalidInput, UnreachableTarget
+from pinarms.robots.so3 import rot_z as _rot_z
+from pinarms.robots.reach.dexterity import position_dexterity
+from pinarms.robots.reach.workspace import Workspace, sample_workspace
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["PointCheck", "LayoutReport", "check_layout", "default_orientation"]
 
@@ -220,14 +220,14 @@ def check_layout(
     """Which of the line's ``points`` the arm reaches, with which IK branches and dexterity margin.
 
     Args:
-        robot: any :class:`~robots.robot.Robot`.
+        robot: any :class:`~pinarms.robots.robot.Robot`.
         points: positions ``(N, 3)`` [m] (tool orientation from ``orientation`` or
             :func:`default_orientation`) or poses ``(N, 4, 4)`` (tcp → base).
         names: labels of the points (default ``P1, P2, ...``).
         workspace: a sampled workspace of the robot's tcp used for the dexterity median
             and the boundary margin (default: 100 000 samples with ``seed``).
         voxel_size: voxel edge of the boundary-margin map [m]; default: about 10 samples
-            per reachable voxel (:func:`robots.reach.voxels.suggest_voxel_size`).
+            per reachable voxel (:func:`pinarms.robots.reach.voxels.suggest_voxel_size`).
         n_seeds: starts of the numerical IK (arms without a closed form), ≥ 1.
         seed: seed of the default workspace and of the numerical IK starts.
 

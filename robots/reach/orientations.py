@@ -33,10 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
-from ..so3 import about as _rotation_about
-from ..so3 import frame_z_to as _frame_z_to
-from ..so3 import from_quaternion as _quat_to_matrix
+from pinarms.errors import InvalidInput
+from pinarms.robots.so3 import about as _rotation_about
+from pinarms.robots.so3 import frame_z_to as _frame_z_to
+from pinarms.robots.so3 import from_quaternion as _quat_to_matrix
 
 __all__ = [
     "OrientationSet",

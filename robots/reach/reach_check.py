@@ -18,11 +18,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import PinarmsError
-from .orientations import MAX_ORIENTATIONS, OrientationSet
-from .reach_digest import PosesDigest, map_checksum
-from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
-from .reach_write import FORMAT_NAME, FORMAT_VERSION
+from pinarms.errors import PinarmsError
+from pinarms.robots.reach.orientations import MAX_ORIENTATIONS, OrientationSet
+from pinarms.robots.reach.reach_digest import PosesDigest, map_checksum
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from pinarms.robots.reach.reach_write import FORMAT_NAME, FORMAT_VERSION
 
 __all__ = ["ReachabilityFileError", "MapChecker", "check_map", "MAX_JOINTS", "MAX_TEXT", "MIN_RESOLUTION",
            "MAX_RESOLUTION", "MAX_EXTENT"]

@@ -4,7 +4,7 @@ A chunk is a fixed run of voxels; for each voxel and each rotation of the orient
 pose is solved by every closed-form branch at once (batched) or by the seeded numerical solver,
 solutions are dropped by the optional collision checks, and the most dexterous one is kept
 (ties within :data:`TIE_RTOL` go to the solver's first). Step 3 and 4 of the method in
-:mod:`robots.reach.reachability`. Units: m, rad.
+:mod:`pinarms.robots.reach.reachability`. Units: m, rad.
 """
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
-from .reach_map import _centres
-from .robot_spec import RobotSpec, robot_of, spec_key
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.reach_map import _centres
+from pinarms.robots.reach.robot_spec import RobotSpec, robot_of, spec_key
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["ChunkTask", "solve_chunk", "manipulability_of", "collision_free", "TIE_RTOL"]
 
@@ -79,7 +79,7 @@ def _self_collision(spec: RobotSpec, robot: "Robot"):
     key = spec_key(spec)
     checker = _COLLISION_CACHE.get(key)
     if checker is None:
-        from ..self_collision import SelfCollision
+        from pinarms.robots.self_collision import SelfCollision
 
         checker = _COLLISION_CACHE[key] = SelfCollision(robot, seed=0)
     return checker
@@ -138,7 +138,7 @@ def _poses(task: ChunkTask) -> np.ndarray:
 def _solve_analytic(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """``(pose index (K,), q (K, nq), w (K,), n_solutions)``: the chosen solution of each reached pose."""
     T = _poses(task)
-    idx, q = robot._analytic_ik.candidates(T)
+    idx, q = robot.analytic_ik.candidates(T)
     n_all = int(idx.size)
     keep = collision_free(task, robot, q)
     idx, q = idx[keep], q[keep]
@@ -156,7 +156,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
     order), else the previous roll of the same direction in this voxel; then ``restarts``
     random starts drawn by the generator seeded with ``(seed, voxel flat index)``.
     """
-    solver = robot._numerical_ik()
+    solver = robot.numerical_ik()
     T = _poses(task)
     n, M = task.voxels.size, task.rotations.shape[0]
     nq = robot.nq
@@ -175,7 +175,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
             start = next((a[k] for a in neighbours if np.isfinite(a[k, 0])), None)
             if start is None and k > 0 and task.group[k] == task.group[k - 1] and np.isfinite(here[k - 1, 0]):
                 start = here[k - 1]  # previous roll of the same direction
-            res = solver._solve(T[r * M + k], start, position_only=False, tol=task.tol,
+            res = solver.solve_checked(T[r * M + k], start, position_only=False, tol=task.tol,
                                 max_restarts=task.restarts, seed=rng, limits=True)
             if res.success and collision_free(task, robot, res.q[None])[0]:
                 here[k] = res.q

@@ -2,7 +2,7 @@
 
 HDF5 stores small datasets uncompressed and without a checksum: a flipped byte in
 ``/voxels/best_manipulability`` once changed the map silently. :func:`map_checksum` is the
-SHA-256 of every value of a :class:`~robots.reach.reachability.ReachabilityMap` except its
+SHA-256 of every value of a :class:`~pinarms.robots.reach.reachability.ReachabilityMap` except its
 stored solutions (attributes, limits, grid, orientations, voxels); :class:`PosesDigest` that
 of the stored solutions, fed chunk by chunk as they are written (the streamed writer) or at
 once (a map in memory, or the solutions read back). The writer stores both as the root

@@ -4,7 +4,7 @@
 sphere's bounding box on a grid of edge ``resolution`` aligned so that voxel centres lie at
 ``(i + ½)·resolution``; :func:`seed_voxels` marks the voxels seeded joint samples enter, and
 :func:`face_neighbours` grows a set of voxels by its 6 face neighbours inside the sphere (steps 1
-and 2 of the method in :mod:`robots.reach.reachability`). Units: m.
+and 2 of the method in :mod:`pinarms.robots.reach.reachability`). Units: m.
 """
 
 from __future__ import annotations
@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from ..errors import InvalidInput, ModelError
-from .reach_map import MAX_GRID_VOXELS, _centres
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, _centres
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["reach_bound", "ReachGrid", "bounding_grid", "seed_voxels", "face_neighbours"]
 
@@ -46,7 +46,7 @@ def reach_bound(robot: "Robot", frame: str = "tcp") -> tuple[np.ndarray, float]:
     centre = np.array(model.jointPlacements[chain[0]].translation, dtype=float)
     radius = float(np.linalg.norm(f.placement.translation))
     radius += sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in chain[1:])
-    tree = robot._tree
+    tree = robot.kinematic_tree
     for j in chain:
         if tree.kind[j] == 2:  # prismatic (mimic prismatic joints move by scale·q + offset)
             q_index = tree.q_index[j]

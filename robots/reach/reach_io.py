@@ -28,13 +28,13 @@ array larger than ``max_bytes`` in memory, a shape that disagrees with the other
 numbers are needed, indices out of range, a rotation that is not a rotation, an index that
 does not follow from the reached bits, or a stored solution outside the joint limits all
 raise :class:`ReachabilityFileError` naming the member and the problem (the checks of the
-content are :mod:`robots.reach.reach_check`; this module writes, and reads through a child).
+content are :mod:`pinarms.robots.reach.reach_check`; this module writes, and reads through a child).
 
-The HDF5 library runs in a child process (:mod:`robots.reach._reach_worker`, started by
-:mod:`robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
+The HDF5 library runs in a child process (:mod:`pinarms.robots.reach._reach_worker`, started by
+:mod:`pinarms.robots.reach._reach_child`) bounded in address space (:data:`READER_MEMORY`), CPU time and
 wall-clock time (``timeout`` for opening the file and checking its layout, then 1 s per
 20 MB of data): a damaged file that makes libhdf5 loop is killed and refused. Before it
-opens the map the child walls itself in (Landlock, :mod:`robots._sandbox`): it may read
+opens the map the child walls itself in (Landlock, :mod:`pinarms.robots._sandbox`): it may read
 only the map file and Python's folders and write or execute nothing;
 :attr:`ReachabilityMap.reader_wall` says which wall was up. Before any
 data is read, the declared dtypes and shapes are checked against each other (joints,
@@ -58,11 +58,11 @@ import numpy as np
 
 from pinarms.files import check_regular
 
-from ..errors import InvalidInput
-from .orientations import MAX_ORIENTATIONS
-from .reach_check import MAX_JOINTS, MapChecker, ReachabilityFileError, check_map
-from .reach_write import FORMAT_NAME, FORMAT_VERSION, StreamWriter, write_map
-from .reach_map import MAX_GRID_VOXELS, ReachabilityMap
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.orientations import MAX_ORIENTATIONS
+from pinarms.robots.reach.reach_check import MAX_JOINTS, MapChecker, ReachabilityFileError, check_map
+from pinarms.robots.reach.reach_write import FORMAT_NAME, FORMAT_VERSION, StreamWriter, write_map
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, ReachabilityMap
 
 __all__ = [
     "ReachabilityFileError",
@@ -140,7 +140,7 @@ def load_reachability(path: str | os.PathLike, *, solutions: bool = True, max_by
 
 def _receive(p: Path, request: dict, timeout: float, cpu: int) -> tuple[dict, dict[str, np.ndarray], str]:
     """Run the reader child; its checked attributes and arrays, and the wall it was behind."""
-    from ._reach_child import ChildGone, ChildTimeout, ReaderChild
+    from pinarms.robots.reach._reach_child import ChildGone, ChildTimeout, ReaderChild
 
     shown = str(p)
     stage = "starting the reader"
@@ -198,7 +198,7 @@ def _expect(p: Path, child: Any, frame: tuple[bytes, int], want: bytes, deadline
     if tag == want:
         return
     if tag != b"E":
-        from ._reach_child import ChildGone
+        from pinarms.robots.reach._reach_child import ChildGone
 
         child.close()
         raise ChildGone(f"unexpected frame {tag!r}")
@@ -220,7 +220,7 @@ def _expect(p: Path, child: Any, frame: tuple[bytes, int], want: bytes, deadline
 
 def _manifest(p: Path, raw: bytes, request: dict) -> dict:
     """The child's manifest, checked again (names, dtypes, shapes, shared sizes, budget); arrays allocated."""
-    from ._reach_worker import DATASETS, POSES
+    from pinarms.robots.reach._reach_worker import DATASETS, POSES
 
     def bad(what: str) -> ReachabilityFileError:
         return ReachabilityFileError(f"{str(p)!r} is not a valid pinarms reachability map: the reader's answer {what}")

@@ -1,8 +1,8 @@
 """A reachability map as data: :class:`ReachabilityMap` and its stored solutions (:class:`PoseSolutions`).
 
-Built by :func:`robots.reach.reachability.reachability_map` (its module docstring says what
-a map holds and how it is computed), written and read by :mod:`robots.reach.reach_write` and
-:mod:`robots.reach.reach_io`. Units: m, rad.
+Built by :func:`pinarms.robots.reach.reachability.reachability_map` (its module docstring says what
+a map holds and how it is computed), written and read by :mod:`pinarms.robots.reach.reach_write` and
+:mod:`pinarms.robots.reach.reach_io`. Units: m, rad.
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import ndimage
 
-from ..errors import InvalidInput
-from .orientations import OrientationSet
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.orientations import OrientationSet
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .voxels import VoxelMap
+    from pinarms.robots.reach.voxels import VoxelMap
 
 __all__ = ["ReachabilityMap", "PoseSolutions", "MAX_GRID_VOXELS"]
 
@@ -67,7 +67,7 @@ class ReachabilityMap:
             ``shape`` the grid ``(nx, ny, nz)``. Voxel ``(i, j, k)`` has centre
             ``origin + (i + ½, j + ½, k + ½)·resolution`` and flat index
             ``(i·ny + j)·nz + k``.
-        orientations: the :class:`~robots.reach.orientations.OrientationSet` tried per voxel.
+        orientations: the :class:`~pinarms.robots.reach.orientations.OrientationSet` tried per voxel.
         voxels: ``(V,)`` sorted flat indices of the computed voxels (the others have index 0).
         reached: ``(V, M)`` bool, pose ``k`` of voxel ``voxels[v]`` reached.
         index: ``(V,)`` reachability index in [0, 1].
@@ -188,14 +188,14 @@ class ReachabilityMap:
         return int(np.count_nonzero(edge))
 
     def voxel_map(self, min_index: float = 0.0) -> "VoxelMap":
-        """The map as a :class:`~robots.reach.voxels.VoxelMap` (reuse its margins and queries).
+        """The map as a :class:`~pinarms.robots.reach.voxels.VoxelMap` (reuse its margins and queries).
 
         ``count`` = reached directions of the voxel (a voxel is reachable when its index exceeds
         ``min_index``: ``min_count`` = the smallest count above it); ``mean_manipulability`` and
         ``min_manipulability`` both hold the voxel's *best* manipulability; ``margin`` the
         distance to the nearest voxel at or below ``min_index`` (minus half a voxel) [m].
         """
-        from .voxels import VoxelMap
+        from pinarms.robots.reach.voxels import VoxelMap
 
         G = self.orientations.n_index
         counts = np.zeros(int(np.prod(self.shape)), dtype=np.int64)
@@ -268,8 +268,8 @@ class ReachabilityMap:
         )
 
     def save(self, path: Any) -> Any:
-        """Write the map to an HDF5 file (atomically; see :mod:`robots.reach.reach_io`); return the path."""
-        from .reach_write import write_map
+        """Write the map to an HDF5 file (atomically; see :mod:`pinarms.robots.reach.reach_io`); return the path."""
+        from pinarms.robots.reach.reach_write import write_map
 
         return write_map(self, path)
 

@@ -1,8 +1,8 @@
 """Writing reachability map files (HDF5, format ``pinarms-reachability``): atomically, chunk by chunk.
 
-The layout is described in :mod:`robots.reach.reach_io`, which also reads and checks the files.
+The layout is described in :mod:`pinarms.robots.reach.reach_io`, which also reads and checks the files.
 This module writes them and imports nothing of the map's module (it reads the map's fields),
-so :class:`robots.reach.reachability.ReachabilityMap` and the streamed computation
+so :class:`pinarms.robots.reach.reachability.ReachabilityMap` and the streamed computation
 (``reachability_map(out=...)``) use it without an import circle.
 """
 
@@ -18,8 +18,8 @@ import numpy as np
 
 from pinarms.files import discard, publish, temporary_for
 
-from ..errors import InvalidInput
-from .reach_digest import PosesDigest, map_checksum
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.reach_digest import PosesDigest, map_checksum
 
 __all__ = ["StreamWriter", "write_map", "FORMAT_NAME", "FORMAT_VERSION"]
 
@@ -152,8 +152,8 @@ class StreamWriter:
 def write_map(reach_map: Any, path: str | os.PathLike) -> Path:
     """Write ``reach_map`` to ``path`` (HDF5, written to a temporary file then renamed); return the path.
 
-    ``reach_map`` is a :class:`robots.reach.reachability.ReachabilityMap` (checked by
-    :func:`robots.reach.reach_io.save_reachability`, the public entry).
+    ``reach_map`` is a :class:`pinarms.robots.reach.reachability.ReachabilityMap` (checked by
+    :func:`pinarms.robots.reach.reach_io.save_reachability`, the public entry).
 
     Raises:
         InvalidInput: the target folder does not exist / the target is a folder.

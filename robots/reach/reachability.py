@@ -1,7 +1,7 @@
 """Reachability maps: which tool poses an arm reaches, voxel by voxel, with which orientations.
 
 :func:`reachability_map` answers, for every voxel centre ``p`` of a grid of edge
-``resolution`` [m] and every rotation ``R_k`` of an :class:`~robots.reach.orientations.OrientationSet`,
+``resolution`` [m] and every rotation ``R_k`` of an :class:`~pinarms.robots.reach.orientations.OrientationSet`,
 whether the tool pose ``(R_k, p)`` (tool frame → base) has an inverse-kinematics solution
 within the joint limits, and how dexterous the best one is (the capability / reachability map
 of Zacharias et al., 2007; ROS-Industrial's reuleaux builds the same kind of map).
@@ -44,9 +44,9 @@ serially by default or on a Dask cluster (``scheduler=``, see :mod:`pinarms.exec
 Workers rebuild the robot from its registry name or URDF text (checked by its SHA-256).
 A map built serially equals the one built on a cluster bit for bit.
 
-Steps 1–2 live in :mod:`robots.reach.reach_grid`, steps 3–4 (one chunk) in
-:mod:`robots.reach.reach_chunk`, the robot a worker rebuilds in :mod:`robots.reach.robot_spec`,
-the map itself in :mod:`robots.reach.reach_map`; this module checks the arguments and runs the
+Steps 1–2 live in :mod:`pinarms.robots.reach.reach_grid`, steps 3–4 (one chunk) in
+:mod:`pinarms.robots.reach.reach_chunk`, the robot a worker rebuilds in :mod:`pinarms.robots.reach.robot_spec`,
+the map itself in :mod:`pinarms.robots.reach.reach_map`; this module checks the arguments and runs the
 rounds.
 
 Units: metres, radians; rotations tool frame → base; joint values in the robot's ``q`` order.
@@ -60,19 +60,19 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .._checks import check_restarts
-from ..errors import InvalidInput, ModelError
-from .orientations import OrientationSet, so3_orientations, tool_down_orientations
-from .reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
-from .reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels
-from .reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
-from .robot_spec import RobotSpec, spec_of
+from pinarms.robots._checks import check_restarts
+from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.reach.orientations import OrientationSet, so3_orientations, tool_down_orientations
+from pinarms.robots.reach.reach_chunk import TIE_RTOL, ChunkTask, solve_chunk
+from pinarms.robots.reach.reach_grid import ReachGrid, bounding_grid, face_neighbours, reach_bound, seed_voxels
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, PoseSolutions, ReachabilityMap
+from pinarms.robots.reach.robot_spec import RobotSpec, spec_of
 
 #: Most joint samples :func:`reachability_map` draws to mark its first voxels (``samples=``).
 MAX_SEED_SAMPLES = 50_000_000
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "ReachabilityMap",
@@ -113,11 +113,11 @@ def reachability_map(
     """Build the reachability map of ``arm``'s tool frame (see the module doc).
 
     Args:
-        arm: any :class:`~robots.robot.Robot`.
+        arm: any :class:`~pinarms.robots.robot.Robot`.
         resolution: voxel edge [m].
         orientations: poses per voxel spread over SO(3) (super-Fibonacci), or with ``tool_down``
             the number of tool-axis directions in the cone; or any
-            :class:`~robots.reach.orientations.OrientationSet`.
+            :class:`~pinarms.robots.reach.orientations.OrientationSet`.
         tool_down: cone half-angle [rad] around straight down for the tool axis; roll free
             (``roll_steps`` rolls tried, any counts).
         tool_axis: the tool-frame axis pointed down (default: the tool's +z, or −z for tools
@@ -133,7 +133,7 @@ def reachability_map(
         out: an HDF5 file to write the map to, the stored solutions streamed into it chunk by
             chunk (then the returned map holds no solutions: memory stays flat in the number of
             voxels but for the per-voxel arrays; read them back with
-            :func:`robots.reach.reach_io.load_reachability`). Written to a temporary file and renamed
+            :func:`pinarms.robots.reach.reach_io.load_reachability`). Written to a temporary file and renamed
             when complete.
         chunk_voxels: voxels per task (default: about 10⁵ poses for closed forms, 10⁴ for
             the numerical solver). The map depends on it only through the numerical warm starts.
@@ -159,7 +159,7 @@ def reachability_map(
     spec = spec_of(arm)
     writer = None
     if out is not None:
-        from .reach_write import StreamWriter
+        from pinarms.robots.reach.reach_write import StreamWriter
 
         writer = StreamWriter(out, arm.nq)
     acc = _Accumulator(s.keep, writer)

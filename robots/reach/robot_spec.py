@@ -3,8 +3,8 @@
 A spec is small and picklable: the registry name when the robot is the registry's (same URDF
 by SHA-256, same tool frame, same closed-form family), else the URDF text itself.
 :func:`robot_of` rebuilds the robot once per process and checks its URDF against the SHA-256.
-Used by the chunk tasks of :func:`robots.reach.reachability.reachability_map` and by the
-exact check of :func:`robots.reach.inverse_reach.base_placements`.
+Used by the chunk tasks of :func:`pinarms.robots.reach.reachability.reachability_map` and by the
+exact check of :func:`pinarms.robots.reach.inverse_reach.base_placements`.
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ import hashlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ModelError
+from pinarms.errors import ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = ["RobotSpec", "spec_of", "robot_of", "spec_key", "urdf_sha256"]
 
@@ -43,10 +43,10 @@ def urdf_sha256(robot: "Robot") -> str:
 
 
 def _family(robot: "Robot") -> str | None:
-    solver = getattr(robot, "_analytic_ik", None)
+    solver = getattr(robot, "analytic_ik", None)
     if solver is None:
         return None
-    from ..ik import FAMILIES
+    from pinarms.robots.ik import FAMILIES
 
     for key, cls in FAMILIES.items():
         if type(solver) is cls:
@@ -56,7 +56,7 @@ def _family(robot: "Robot") -> str | None:
 
 def spec_of(robot: "Robot") -> RobotSpec:
     """The spec of ``robot`` (the robot itself is cached for this process under the spec's key)."""
-    from .. import registry
+    from pinarms.robots import registry
 
     sha = urdf_sha256(robot)
     family = _family(robot)
@@ -90,8 +90,8 @@ def robot_of(spec: RobotSpec) -> "Robot":
     key = spec_key(spec)
     robot = _ROBOT_CACHE.get(key)
     if robot is None:
-        from .. import registry
-        from ..ik import attach_analytic_ik
+        from pinarms.robots import registry
+        from pinarms.robots.ik import attach_analytic_ik
 
         if spec.registry:
             robot = registry.load(spec.name)

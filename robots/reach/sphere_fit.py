@@ -1,6 +1,6 @@
 """Sphere fits of a point cloud (a workspace's reach): least squares on the points or on their hull.
 
-Part of the reach family (:mod:`robots.reach.workspace` re-exports every name). Units: m.
+Part of the reach family (:mod:`pinarms.robots.reach.workspace` re-exports every name). Units: m.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["SPHERE_COVERAGE_MIN", "SphereFit", "fit_sphere", "fit_sphere_to_hull", "hull_points", "direction_coverage"]
 

@@ -6,7 +6,7 @@ radial shells around a fixed centre and the farthest sample of every direction c
 :func:`add_block` folds a block of samples into it, :func:`sparse_voxels` packs its voxels for
 shipping and :func:`merge` folds a task's reduction into the accumulator; merging in task
 order gives the same result bit for bit whoever ran the tasks
-(:mod:`robots.reach.workspace_stream`). Units: m.
+(:mod:`pinarms.robots.reach.workspace_stream`). Units: m.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .sphere_fit import _direction_cells
+from pinarms.robots.reach.sphere_fit import _direction_cells
 
 __all__ = ["Reduction", "ReductionSpec", "add_block", "merge", "sparse_voxels"]
 

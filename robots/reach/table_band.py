@@ -1,7 +1,7 @@
 """Where to place the pick/place tables: a radial band of the sampled workspace.
 
 :func:`recommend_region` derives the band from the samples of a
-:class:`~robots.reach.workspace.Workspace` with three criteria, all evaluated per radial shell
+:class:`~pinarms.robots.reach.workspace.Workspace` with three criteria, all evaluated per radial shell
 (width ``width``) around the workspace's outer-hull sphere centre (``about="centre"``) or
 around the base's vertical axis (``about="axis"``):
 
@@ -15,7 +15,7 @@ around the base's vertical axis (``about="axis"``):
 3. **Crowded centre (own body).** For a seeded sub-sample of ``n_collision`` samples,
    each configuration is checked for collisions between the arm and its *core* bodies
    (base, and the bodies carried only by the first ``core_joints`` joints: the turret)
-   with the URDF's collision primitives (:class:`~robots.self_collision.SelfCollision`).
+   with the URDF's collision primitives (:class:`~pinarms.robots.self_collision.SelfCollision`).
    A shell is rejected when more than ``max_collision_share`` of its configurations
    collide so: most ways of reaching it fold the arm onto its own base. Collisions among
    the moving links (wrist against forearm) are not counted: they depend on the tool
@@ -34,11 +34,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
-from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .workspace import Workspace
+    from pinarms.robots.reach.workspace import Workspace
 
 __all__ = ["RecommendedRegion", "recommend_region"]
 
@@ -230,7 +230,7 @@ def _core_collision_share(workspace: "Workspace", keep: np.ndarray, shell: np.nd
     ``n_collision`` of them (seeded) are checked. A shell with none checked has share NaN (0 when
     ``n_collision`` is 0: the check is skipped).
     """
-    from ..self_collision import SelfCollision
+    from pinarms.robots.self_collision import SelfCollision
 
     checked = np.zeros(k, dtype=int)
     collided = np.zeros(k)

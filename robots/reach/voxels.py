@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from ..errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["VoxelMap", "VoxelQuery", "suggest_voxel_size", "SAMPLES_PER_VOXEL"]
 

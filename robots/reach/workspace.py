@@ -18,8 +18,8 @@ A sample is *near-singular* when its inverse condition is below
 
 :meth:`Workspace.summary` gives the bounding box, the best-fit sphere of the outer hull
 (:func:`fit_sphere_to_hull`), the radial density profile and the near-singular share.
-The dexterity measures are computed by :mod:`robots.reach.dexterity` (``position_dexterity`` is
-re-exported here). Where the tables should stand is :func:`robots.reach.table_band.recommend_region` (the module above
+The dexterity measures are computed by :mod:`pinarms.robots.reach.dexterity` (``position_dexterity`` is
+re-exported here). Where the tables should stand is :func:`pinarms.robots.reach.table_band.recommend_region` (the module above
 this one: table_band imports workspace, never the other way).
 """
 
@@ -30,17 +30,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInput
-from ..robot import MAX_RANDOM_SAMPLES
-from .dexterity import CHUNK, position_dexterity, positions_and_dexterity
-from .joint_samples import random_q_slice
-from .sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
+from pinarms.errors import InvalidInput
+from pinarms.robots.robot import MAX_RANDOM_SAMPLES
+from pinarms.robots.reach.dexterity import CHUNK, position_dexterity, positions_and_dexterity
+from pinarms.robots.reach.joint_samples import random_q_slice
+from pinarms.robots.reach.sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
     SPHERE_COVERAGE_MIN, SphereFit, _as_points, _direction_cells, direction_coverage,
     fit_sphere, fit_sphere_to_hull, hull_points)
-from .voxels import VoxelMap, suggest_voxel_size
+from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",
@@ -153,7 +153,7 @@ class Workspace:
     """Sampled workspace of ``robot`` (arrays are read-only).
 
     Attributes:
-        robot: the sampled :class:`~robots.robot.Robot`.
+        robot: the sampled :class:`~pinarms.robots.robot.Robot`.
         frame: the frame whose origin was sampled.
         seed: the seed of the joint samples (``None`` when a Generator was given).
         q: ``(n, nq)`` joint samples [rad or m].
@@ -258,9 +258,9 @@ class Workspace:
         )
 
     def voxel_map(self, voxel_size: float | None = None, *, min_count: int = 1) -> "VoxelMap":
-        """Voxel reachability map of the samples (see :class:`robots.reach.voxels.VoxelMap`).
+        """Voxel reachability map of the samples (see :class:`pinarms.robots.reach.voxels.VoxelMap`).
 
-        ``voxel_size`` [m]; default: :func:`robots.reach.voxels.suggest_voxel_size` (about 10
+        ``voxel_size`` [m]; default: :func:`pinarms.robots.reach.voxels.suggest_voxel_size` (about 10
         samples per reachable voxel, so that chance holes do not fake a boundary).
         """
         if voxel_size is None:
@@ -282,10 +282,10 @@ def sample_workspace(
     """Monte Carlo workspace: ``n`` joint vectors uniform within the limits, and their frame origins.
 
     Args:
-        robot: any :class:`~robots.robot.Robot`.
+        robot: any :class:`~pinarms.robots.robot.Robot`.
         n: number of samples (> 0, at most ``MAX_RANDOM_SAMPLES`` = 5·10⁷ in one call). 10⁶ samples
             take about 100 MB; for 10⁸ and more use
-            :func:`robots.reach.workspace_stream.stream_workspace` (reductions only, flat memory).
+            :func:`pinarms.robots.reach.workspace_stream.stream_workspace` (reductions only, flat memory).
         seed: seed or ``numpy.random.Generator``; the same seed gives the same samples
             (``q`` equals ``robot.random_q(n, seed)``).
         frame: frame whose origin is sampled (``"tcp"`` = the robot's tool frame).

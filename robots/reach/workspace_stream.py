@@ -1,12 +1,12 @@
 """Workspaces of 10⁸–10⁹ samples: streamed reductions, flat memory, serial or on Dask.
 
-:func:`stream_workspace` draws the same joint samples as :func:`~robots.reach.workspace.sample_workspace`
+:func:`stream_workspace` draws the same joint samples as :func:`~pinarms.robots.reach.workspace.sample_workspace`
 (``robot.random_q(n, seed)``) but never holds them: the samples are cut into tasks of
 ``task_samples`` (10⁷ by default, about 10 s each), each task evaluates its samples in
 blocks and returns only reductions, and the reductions are folded **in task order** into
 
 - the bounding box, the mean and maximum position manipulability, the near-singular share;
-- a voxel map (:class:`~robots.reach.voxels.VoxelMap`): samples, mean and minimum manipulability
+- a voxel map (:class:`~pinarms.robots.reach.voxels.VoxelMap`): samples, mean and minimum manipulability
   per voxel on a grid anchored at the base origin (voxel ``i`` spans ``[i s, (i+1) s)``),
   the margin to the boundary as in the in-memory map;
 - the radial profile around a centre fixed before the sweep (see below);
@@ -21,7 +21,7 @@ a Dask cluster (:func:`pinarms.execution.map_chunks`).
 
 **Pilot.** The centre of the direction cells and of the radial shells, and the default voxel
 edge, come from a *pilot*: the first ``min(n, 200 000)`` samples of the same stream, held in
-memory (:meth:`~robots.reach.workspace.Workspace.fit_sphere`, :func:`~robots.reach.voxels.suggest_voxel_size`).
+memory (:meth:`~pinarms.robots.reach.workspace.Workspace.fit_sphere`, :func:`~pinarms.robots.reach.voxels.suggest_voxel_size`).
 The final sphere is refitted to the hull of all ``n`` samples around the pilot's centre: the
 last of the in-memory fit's iterations. The default voxel edge aims at 10 samples per voxel
 but is never below :data:`MIN_DEFAULT_VOXEL` (memory of the grid: about 40 bytes per voxel of
@@ -37,12 +37,12 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from ..errors import InvalidInput
-from .dexterity import positions_and_dexterity
-from .joint_samples import generator_at
-from .stream_reduction import Reduction, ReductionSpec, add_block, merge, sparse_voxels
-from .voxels import VoxelMap, suggest_voxel_size
-from .workspace import (
+from pinarms.errors import InvalidInput
+from pinarms.robots.reach.dexterity import positions_and_dexterity
+from pinarms.robots.reach.joint_samples import generator_at
+from pinarms.robots.reach.stream_reduction import Reduction, ReductionSpec, add_block, merge, sparse_voxels
+from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
+from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,
     RadialProfile,
     SphereFit,
@@ -53,7 +53,7 @@ from .workspace import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..robot import Robot
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "StreamedWorkspace",
@@ -119,8 +119,8 @@ class StreamedWorkspace:
 
     Attributes:
         summary: bounding box, hull sphere, radial profile (around :attr:`centre`),
-            near-singular share, manipulability mean and max (:class:`~robots.reach.workspace.WorkspaceSummary`).
-        voxels: occupancy and manipulability per voxel, margins (:class:`~robots.reach.voxels.VoxelMap`).
+            near-singular share, manipulability mean and max (:class:`~pinarms.robots.reach.workspace.WorkspaceSummary`).
+        voxels: occupancy and manipulability per voxel, margins (:class:`~pinarms.robots.reach.voxels.VoxelMap`).
         seed: the seed of the samples (``robot.random_q(n, seed)``).
         centre: ``(3,)`` centre of the direction cells and of the radial shells [m] (the pilot's hull centre).
         n_tasks: number of tasks the samples were cut into.
@@ -163,7 +163,7 @@ def stream_workspace(
     """Workspace statistics of ``n`` samples in flat memory (see the module docstring).
 
     Args:
-        robot: any :class:`~robots.robot.Robot` with finite joint limits.
+        robot: any :class:`~pinarms.robots.robot.Robot` with finite joint limits.
         n: number of samples (10⁸ take about 1.5 min on one core for a 6-axis arm).
         seed: a non-negative integer (the samples are ``robot.random_q(n, seed)``).
         frame: the frame whose origin is sampled.

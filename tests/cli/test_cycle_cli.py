@@ -96,7 +96,7 @@ def test_payload_options_are_checked():
 
 
 def test_mass_units_at_the_edge():
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
     from pinarms.units import mass_kg
 
     assert mass_kg("3kg") == 3.0 and mass_kg(" 1.5 KG ") == 1.5 and mass_kg("800g") == pytest.approx(0.8)

@@ -12,7 +12,7 @@ import pytest
 
 from pinarms.robots.cell import load_cell
 from pinarms.export import compare_configurations_in_mujoco
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 # the table: a closed box 0.4 x 0.4 x 0.05 m as ASCII STL (two triangles per face)
 _QUADS = (((-1, -1, -1), (-1, 1, -1), (1, 1, -1), (1, -1, -1)), ((-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)),

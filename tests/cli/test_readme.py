@@ -63,7 +63,7 @@ def test_readme_table_is_the_code_s_table(quick_study):
 
 def test_splice_table_replaces_only_the_marked_block():
     from pinarms.report import TABLE_BEGIN, TABLE_END, Row, splice_table
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     doc = f"intro\n{TABLE_BEGIN}\nold table\n{TABLE_END}\noutro\n"
     rows = [Row("004", "x", 1.0, 1.0, "mm", 0.1), Row("004", "y", 1.0, 2.0, "mm", 0.1, "typo")]

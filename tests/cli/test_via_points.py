@@ -10,7 +10,7 @@ import pytest
 
 from pinarms.cli import read_via_file
 from pinarms.cli.via_points import TRAJECTORY_KINDS, via_input
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def test_csv_file_gives_times_positions_and_joint_names(tmp_path):

@@ -15,7 +15,7 @@ import numpy as np
 from hypothesis import event
 from hypothesis.errors import InvalidArgument
 
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 
 EXPLORE = 10 if os.environ.get("HYPOTHESIS_PROFILE") == "explore" else 1
 

@@ -488,7 +488,7 @@ def _quickly(call, error, match):
 
 def test_ik_restarts_past_the_cap_are_refused_at_once(arms):
     from pinarms.robots import MAX_RESTARTS
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
     from pinarms.robots.ik import NumericalIK
 
     ur5 = arms["ur5"]
@@ -527,7 +527,7 @@ def test_plan_motion_seed_outside_its_range_is_a_named_error(seed):
 @pytest.mark.parametrize("path", ["arm\0.urdf", "a" * 300 + ".urdf", "d/" * 3000 + "arm.urdf"])
 @pytest.mark.parametrize("load", ["from_urdf", "load_cell", "from_xacro"])
 def test_a_description_path_with_a_nul_byte_or_too_long_is_a_named_error(load, path):
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     path = path.replace(".urdf", ".xacro") if load == "from_xacro" else path
     _quickly(lambda: getattr(robots, load)(path), InvalidInput, "NUL byte|too long")

@@ -13,7 +13,7 @@ from fuzz_support import outcome
 from pinarms import optim, planning, robots, viz
 from pinarms.optim.errors import InvalidLimits
 from pinarms.planning.errors import TrajectoryError
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 
 _ur5 = None
 

@@ -14,7 +14,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.errors import ArrivalsFileError, TaskMapError
 from pinarms.optim.line.items import ItemType, read_arrivals
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 TYPES = (ItemType("enoki", 0.15, (0.10, 0.06, 0.04)), ItemType("bunch", 0.2, (0.10, 0.08, 0.05)))

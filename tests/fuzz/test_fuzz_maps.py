@@ -114,7 +114,7 @@ def test_attributes_out_of_bounds_are_refused(base, tmp_path, key, value, match)
 
 
 def test_seed_samples_are_capped_before_any_is_drawn():
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     t0 = time.perf_counter()
     with pytest.raises(InvalidInput, match="samples = 1,000,000,000,000 is more than"):

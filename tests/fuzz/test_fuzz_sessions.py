@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 from fuzz_support import EXPLORE, listing, outcome
 from pinarms import planning, robots, viz
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 from pinarms.viz import SessionFormatError
 
 LEVER_URDF = """<robot name="lever">

@@ -20,7 +20,7 @@ from pinarms.optim.motion import MotionChecker, MotionLimits, MotionOptions, Mot
 from pinarms.optim.motion.goals import ik_candidates
 from pinarms.optim.motion.scenes import Region, region_pose
 from pinarms.robots.cell.motion import joint_levers
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 from tests.optim.motion_helpers import BulletScene, dense_times
 

@@ -12,7 +12,7 @@ from pinarms.optim.motion import (SCENES, MotionChecker, MotionLimits, MotionOpt
                                    plan_motion)
 from pinarms.robots import load_cell
 from pinarms.robots.cell.cover import geometry_spheres, link_cover, pair_arrays, pairs_for
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 MARGIN = 0.01
 

@@ -89,7 +89,7 @@ def test_a_layout_worker_rebuilds_the_cell_with_its_hold(tmp_path):
 
 def test_a_cycle_next_to_an_idle_arm_in_collision_names_it_before_any_attempt(tmp_path):
     from pinarms import optim
-    from pinarms.robots.errors import CollisionError
+    from pinarms.errors import CollisionError
 
     cell = _cell(tmp_path)  # b at neutral, in the table
     a = cell.arm("a")

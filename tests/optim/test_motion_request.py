@@ -11,7 +11,7 @@ import pytest
 from pinarms import robots
 from pinarms.optim import InvalidLimits, InvalidSettings
 from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest, load_scene
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 DATA = Path(__file__).parent / "data"
 

@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import planning
 from pinarms.planning.errors import TrajectoryError
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 
 
 class PlanarArm:

@@ -8,7 +8,7 @@ import pytest
 from pinarms import planning
 from pinarms.planning import JointLimits
 from pinarms.planning.errors import ConditionCountError, TrajectoryError
-from pinarms.robots.errors import PinarmsError
+from pinarms.errors import PinarmsError
 
 
 @pytest.mark.parametrize(

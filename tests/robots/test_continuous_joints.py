@@ -106,7 +106,7 @@ def test_plan_motion_start_beyond_pi_says_to_give_the_same_pose_in_one_turn(turn
     """plan_motion searches a continuous joint in one turn (docs/ik.md): a start beyond it is refused before any
     search, with the same pose inside it."""
     from pinarms.optim.motion import MotionLimits, MotionRequest, plan_motion
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     request = MotionRequest(turner_cell, "arm", np.array([0.2, 3.23083]), np.array([0.3, 1.0]),
                             limits=MotionLimits(amax=1.0, torque=False))

@@ -17,7 +17,7 @@ from pinarms.robots.conventions import (
     rad_to_deg,
     wrap_angle,
 )
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def test_angle_and_length_conversions_on_arrays():

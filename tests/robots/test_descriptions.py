@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import ModelError, RobotNotFound
+from pinarms.errors import ModelError, RobotNotFound
 from pinarms.robots.urdf_build import XACRO_DIR, build, build_all, build_file, source_names, stale, urdf_path
 
 from _descriptions import independent_joint_names, pin_frame, pin_model, random_q, urdf_file, yourdf_model

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from pinarms import robots
 from pinarms.robots.conventions import aubo_joint_to_mdh, aubo_mdh_to_joint
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.papers import SEED001
 from pinarms.robots.ik import FK_TOL, LIMIT_TOL, GantryIK, KojiIK, ScaraIK, URTypeIK, analytic_solver
 
@@ -91,7 +91,7 @@ def test_aubo_solution_counts_match_a_numerical_search():
     T = _AUBO.fk(q4)
     _, free = _AUBO._analytic_ik.candidates(T[None], respect_limits=False)
     assert free.shape[0] == 4
-    solver = _AUBO._numerical_ik()
+    solver = _AUBO.numerical_ik()
     rng = np.random.default_rng(0)
     found = []
     for _ in range(120):

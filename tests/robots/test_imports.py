@@ -8,17 +8,19 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _relative_imports(path: Path) -> set[str]:
+def _imports(path: Path) -> set[str]:
+    """The modules a file imports from (absolute: the package's one import style)."""
     names = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.ImportFrom) and node.level > 0:
-            names.add("." * node.level + (node.module or ""))
+        if isinstance(node, ast.ImportFrom):
+            assert node.level == 0, f"{path.name}:{node.lineno}: a relative import"
+            names.add(node.module or "")
     return names
 
 
 def test_ik_solvers_do_not_import_the_robot_module():
     offenders = {
-        f.name: sorted(m for m in _relative_imports(f) if m.endswith("robot") or m in ("..", "..robot"))
+        f.name: sorted(m for m in _imports(f) if m in ("pinarms.robots", "pinarms.robots.robot"))
         for f in sorted((ROOT / "robots" / "ik").glob("*.py"))
     }
     offenders = {k: v for k, v in offenders.items() if v}
@@ -27,4 +29,4 @@ def test_ik_solvers_do_not_import_the_robot_module():
 
 def test_robot_imports_the_solvers_at_module_level():
     # the IK methods of Robot live in robot_ik.py (a base class of Robot)
-    assert ".ik.numerical" in _relative_imports(ROOT / "robots" / "robot_ik.py")
+    assert "pinarms.robots.ik.numerical" in _imports(ROOT / "robots" / "robot_ik.py")

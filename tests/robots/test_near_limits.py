@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ik import limit_excess, near_limit_solutions
 
 DEG = np.pi / 180.0

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 from pinarms.robots.ik import _FAMILY_OF, analytic_solver, attach_analytic_ik, recognise
 from pinarms.robots.ik.solver import PROOF_SAMPLES
 from pinarms.robots.registry import builtin_urdf_path, match_builtin
@@ -171,7 +171,7 @@ def test_an_explicit_family_that_does_not_fit_raises():
 
 
 def test_huge_joint_ranges_cost_nothing_at_load_and_equivalents_are_bounded():
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     text = (DATA / "user_scara.urdf").read_text(encoding="utf-8").replace('lower="-2.6" upper="2.6"',
                                                                           'lower="-1e9" upper="1e9"')

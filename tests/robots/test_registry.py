@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import RobotNotFound
+from pinarms.errors import RobotNotFound
 from pinarms.robots.registry import suggest
 
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import UnreachableTarget
+from pinarms.errors import UnreachableTarget
 
 
 def _work(robot, q, T, k):

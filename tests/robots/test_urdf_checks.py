@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 from pinarms.robots.urdf_checks import check_limits, check_tree, refuse_dtd
 
 TWO_LINKS = """<robot name="r"><link name="a"/><link name="b"/>

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import (
+from pinarms.errors import (
     CellNotFound,
     InvalidInput,
     MissingMesh,

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.studies import handoff_plans
 from pinarms.studies.handoff import handoff_motions
 

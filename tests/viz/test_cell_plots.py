@@ -8,7 +8,7 @@ import pytest
 from pinarms import planning
 from pinarms.optim.line import LineSchedule
 from pinarms.robots.cell import ArmMotion, load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.plots import plot_clearance, plot_schedule
 
 

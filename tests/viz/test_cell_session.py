@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import planning, viz
 from pinarms.robots.cell import ArmMotion, load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.scene import build_scene
 from pinarms.viz.viewer import MeshcatServer
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms.robots.delta import forward_position, load_delta
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.delta_scene import delta_page, delta_parts, delta_poses
 
 

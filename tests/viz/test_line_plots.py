@@ -8,7 +8,7 @@ from matplotlib.container import BarContainer
 
 from pinarms.optim.line import SimResult, summarise
 from pinarms.optim.line.report import confidence_interval
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.line_plots import plot_line_schedule, plot_line_sizing, schedule_figure, sizing_figure
 
 

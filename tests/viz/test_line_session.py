@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.errors import SessionFormatError
 from pinarms.viz.line_record import ITEM_COLUMNS, MAX_LINE_ITEMS, MISSED
 from pinarms.viz.line_scene import item_positions

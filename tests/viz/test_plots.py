@@ -11,7 +11,7 @@ from PIL import Image
 
 from pinarms import planning
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.papers import SEED000
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def test_workspace_views(tmp_path):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots, viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.reachability import reachability_map
 from pinarms.viz.errors import SessionFormatError
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.viz.scene import build_scene
 from pinarms.viz.server import MeshcatServer
 

@@ -8,7 +8,7 @@ import pytest
 from PIL import Image
 
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def test_ga_convergence(tmp_path):

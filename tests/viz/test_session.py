@@ -15,7 +15,7 @@ import pytest
 
 from pinarms import viz
 import pinarms.viz.session as vs
-from pinarms.robots.errors import InvalidInput, PinarmsError
+from pinarms.errors import InvalidInput, PinarmsError
 from pinarms.viz import SessionFormatError
 
 from session_files import LEVER_URDF, document, rewrite

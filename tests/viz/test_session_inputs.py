@@ -8,7 +8,7 @@ import pytest
 
 from pinarms import planning
 from pinarms import viz
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 

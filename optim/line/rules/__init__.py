@@ -17,7 +17,7 @@ commercial tools, ``LINE_NOTES.md``):
   candidates, by exhaustive branch and bound (most picks, then earliest end), its first item (Han,
   Feng, Yu 2020 solve the same finite-horizon problem by dynamic programming).
 
-:class:`Rule` names a built-in rule (what a :class:`~optim.line.api.LineSpec` and the CLI carry);
+:class:`Rule` names a built-in rule (what a :class:`~pinarms.optim.line.api.LineSpec` and the CLI carry);
 :func:`assignment_rule` turns a name, a :class:`Rule` or a rule object into the object the simulator calls.
 """
 
@@ -34,7 +34,7 @@ from pinarms.optim.line.rules.lookahead import MAX_HORIZON, LookAhead, best_sequ
 from pinarms.optim.line.rules.nearest import Nearest
 from pinarms.optim.line.rules.shortest import Shortest
 from pinarms.optim.line.rules.split import Split
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["RULES", "Rule", "AssignmentRule", "Candidates", "Decision", "KernelForm", "FirstInWindow", "Nearest",
            "Shortest", "Bands", "Split", "LookAhead", "best_sequence", "assignment_rule"]

@@ -1,6 +1,6 @@
 """The base of every assignment rule: what an idle arm sees at its decision, and what a rule answers.
 
-At a decision at time ``t`` the simulator (:func:`optim.line.simulate.simulate`) hands the rule a
+At a decision at time ``t`` the simulator (:func:`pinarms.optim.line.simulate.simulate`) hands the rule a
 :class:`Decision`: the arm, the feasible picks of the items it may take (:class:`Candidates`, some
 startable now, some only later) and the arm's intercept, for rules that plan several picks ahead.
 The rule answers with :meth:`AssignmentRule.prefer`: the candidates in its order of preference.
@@ -9,7 +9,7 @@ tried), or, when the first preferred starts later than ``t``, lets the arm sleep
 
 A new rule is a subclass with a ``name`` and its own :meth:`~AssignmentRule.prefer` (and, when it
 keeps some items for other arms, :meth:`~AssignmentRule.takes`); it is passed to ``simulate`` or
-:class:`~optim.line.api.LineSpec` as an object. The built-in rules (one module each) also describe
+:class:`~pinarms.optim.line.api.LineSpec` as an object. The built-in rules (one module each) also describe
 themselves to the compiled loop (:meth:`~AssignmentRule.kernel_form`), which then runs them without
 a call back into Python; a rule without that form runs in the simulator's Python loop.
 """

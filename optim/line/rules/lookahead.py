@@ -10,7 +10,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms.optim.line.rules.base import AssignmentRule, Decision, KernelForm
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 __all__ = ["LookAhead", "best_sequence", "MAX_HORIZON"]
 

@@ -8,7 +8,7 @@ import pytest
 from pinarms import optim
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.motion import configurations
-from pinarms.robots.errors import CollisionError, InvalidInput
+from pinarms.errors import CollisionError, InvalidInput
 
 LINE_TASKS = {"left": ((-0.05, -0.03, 0.84), (0.22, 0.68, 0.84)), "right": ((0.05, 0.03, 0.84), (0.22, -0.68, 0.84))}
 

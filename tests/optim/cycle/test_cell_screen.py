@@ -14,7 +14,7 @@ from pinarms.optim.motion.scenes import scene_path
 from pinarms.optim.motion.transfer import _joined
 from pinarms.planning import Trajectory
 from pinarms.robots.cell import ArmMotion, load_cell
-from pinarms.robots.errors import CollisionError
+from pinarms.errors import CollisionError
 
 PICK, CRATE = np.array([0.36, 0.0, 0.75]), np.array([0.0, -0.42, 0.77])
 

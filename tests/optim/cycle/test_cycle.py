@@ -9,7 +9,7 @@ from pinarms import robots
 from pinarms.optim.cycle import LINE_NAMES, CycleApproach, CycleLoad, CycleRequest, CycleTiming, PickPlace, plan_cycle
 from pinarms.optim.errors import InvalidLimits
 from pinarms.planning import JointLimits
-from pinarms.robots.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 # pick / place points inside each arm's working region (base frame, m)
 POINTS = {

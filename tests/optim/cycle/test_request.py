@@ -16,7 +16,7 @@ from pinarms import robots
 from pinarms.optim.cycle import (CellSettings, CycleApproach, CycleLoad, CycleRequest, CycleStatus, CycleTiming,
                                  PickPlace, plan_cycle)
 from pinarms.optim.errors import InvalidLimits, InvalidSettings, SettingOutOfRange
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 PICK, PLACE = [0.30, 0.25, 0.10], [-0.20, 0.35, 0.08]
 

@@ -8,7 +8,7 @@ import pytest
 from pinarms import optim, robots
 from pinarms.optim.layout.search import (CandidateFailure, LayoutRequest, LayoutStatus, base_to_world, grid_candidates,
                                          random_candidates, search_layout)
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.

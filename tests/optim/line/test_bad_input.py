@@ -13,7 +13,7 @@ from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.station import Station, base_pose
 from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 TYPES = (ItemType("enoki", 0.15, (0.10, 0.06, 0.04)),)

@@ -15,7 +15,7 @@ from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.tracking import plan_pick
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.cell import Cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 ENOKI = ItemType("enoki bunch", 0.15, (0.12, 0.06, 0.04))
 CLEARANCE = 0.01

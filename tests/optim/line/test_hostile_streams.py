@@ -14,7 +14,7 @@ from pinarms.optim.line.api import Stream
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.errors import ArrivalsFileError
 from pinarms.optim.line.items import MAX_ITEMS, ItemType, poisson_items, read_arrivals, regular_items
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 TYPES = (ItemType("enoki", 0.15, (0.10, 0.06, 0.04)),)

@@ -6,7 +6,7 @@ import pytest
 from pinarms.optim.line import Belt, ItemType, PlaceBox, Station, TrackingSpec
 from pinarms.optim.line.neighbours import NeighbourGuard
 from pinarms.robots.cell import load_cell
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 ENOKI = ItemType("enoki bunch", 0.15, (0.12, 0.06, 0.04))
 

@@ -11,7 +11,7 @@ from pinarms.optim.line.rules import RULES, AssignmentRule, Bands, FirstInWindow
 from pinarms.optim.line.rules.base import startable
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 

@@ -7,7 +7,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType, Items
 from pinarms.optim.line.sim_arm import ArmState, SimArm
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 

@@ -6,7 +6,7 @@ import pytest
 from pinarms.optim.line import ItemType, TaskMap
 from pinarms.optim.errors import SettingOutOfRange
 from pinarms.optim.line.sizing import SizingProblem, SizingStatus, evaluate_layouts, size_line
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def _map(speed=0.2, cycle_part=1.0):

@@ -10,7 +10,7 @@ from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.station import Station, base_pose
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw, plan_pick, tool_yaw
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def _tool_world(station, q):

@@ -182,7 +182,7 @@ def test_bad_tray_input(scara_line):
     from pinarms.optim.line.tray_maps import build_tray_map
     from pinarms.optim.line.trays import parse_trays
     from pinarms.optim.line.windows import BeltOutOfReach
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     belt, station = scara_line
     for bad in (0.0, -0.1, float("nan")):

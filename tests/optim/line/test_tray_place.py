@@ -17,7 +17,7 @@ from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.tray_maps import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace, find_place
 from pinarms.optim.line.trays import TrayBelt
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 BELT = Belt((0.0, 0.0, 0.8), speed=0.2, width=0.3, length=4.0)
 DU, W, DV = np.array([-0.2, 0.0, 0.2]), np.array([-0.1, 0.0, 0.1]), np.linspace(-0.3, 0.3, 6)

@@ -6,7 +6,7 @@ import pytest
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def _tool(station, q):

@@ -135,7 +135,7 @@ def test_single_segment_point_to_point_is_solved(kind, method):
 
 
 def test_353_needs_exactly_four_via_points():
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     for q in ([0.0, 1.0], [0.0, 1.0, 2.0], [0.0, 1.0, 2.0, 3.0, 4.0]):
         with pytest.raises(InvalidInput, match=f"needs 4 via points, got {len(q)}"):
@@ -144,7 +144,7 @@ def test_353_needs_exactly_four_via_points():
 
 def test_non_numeric_positions_bounds_and_unknown_options_are_named():
     from pinarms.optim import InvalidSettings
-    from pinarms.robots.errors import InvalidInput
+    from pinarms.errors import InvalidInput
 
     with pytest.raises(InvalidInput, match="positions=.*not numeric"):
         TimingRequest(["a", "b"], "multi-quintic", 1.0)

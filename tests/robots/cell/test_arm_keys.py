@@ -11,7 +11,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots import ArmPlacement, FixturePrimitive, ToolPoint, compose_cell, load_cell
-from pinarms.robots.errors import ArmStateError, CellError
+from pinarms.errors import ArmStateError, CellError
 from tests.robots.cell.bent_pair import bent_pair
 
 DATA = Path(__file__).parent.parent / "data"

@@ -10,7 +10,7 @@ from pinarms import robots
 from pinarms.robots.cell import cell_names, load_cell, stale_cells
 from pinarms.robots.collision_requests import cold_start
 from pinarms.robots.self_collision import SelfCollision
-from pinarms.robots.errors import (
+from pinarms.errors import (
     CellError,
     CellNotFound,
     CollisionGeometryError,

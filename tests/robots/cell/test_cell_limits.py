@@ -11,7 +11,7 @@ import pytest
 from pinarms import planning
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell import limits
-from pinarms.robots.errors import CellTooLarge, CollisionGeometryError, InvalidInput
+from pinarms.errors import CellTooLarge, CollisionGeometryError, InvalidInput
 
 from _cells import facing_cell_text, make_cell, post_cell_text, prefixed_scara
 

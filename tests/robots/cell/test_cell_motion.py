@@ -8,7 +8,7 @@ import pytest
 from pinarms import planning
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.motion import configurations
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 UP = np.array([0.0, 0.0, -0.13, 0.0])  # SCARA j3 up by 0.13 m
 

@@ -9,7 +9,7 @@ import pytest
 
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.move_arm import urdf_with_arm_base
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 def turn_and_shift(yaw: float, xyz: tuple[float, float, float]) -> np.ndarray:

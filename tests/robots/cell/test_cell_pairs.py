@@ -14,7 +14,7 @@ from pinarms.optim.motion.scenes import load_scene, scene_names
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.collision import exact_min_distance
 from pinarms.robots.cell.pairs import PairReason
-from pinarms.robots.errors import CellError, InvalidInput, PlacementError
+from pinarms.errors import CellError, InvalidInput, PlacementError
 
 from _cells import POST_GAP, Reference, facing_cell_text, make_cell, post_cell_text
 

@@ -9,7 +9,7 @@ from pinarms import planning
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.motion import joint_levers
 from pinarms.robots.cell.speed_bound import peak_speed
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 @pytest.fixture(scope="module")

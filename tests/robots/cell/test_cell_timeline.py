@@ -8,7 +8,7 @@ import pytest
 from pinarms import planning
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.robots.cell.timeline import arm_motions, configurations, motion_window, sample_motions
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 
 
 @pytest.fixture(scope="module")

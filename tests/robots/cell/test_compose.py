@@ -14,7 +14,7 @@ from pinarms import robots
 from pinarms.robots import ArmPlacement, FixturePrimitive, compose_cell, load_cell
 from pinarms.robots.cell.compose import compose_cell_urdf, read_cell_description
 from pinarms.robots.cell.compose_file import MAX_DESCRIPTION_BYTES
-from pinarms.robots.errors import CellError, CellNotFound, XacroForbidden
+from pinarms.errors import CellError, CellNotFound, XacroForbidden
 from pinarms.robots.registry import builtin_urdf_path
 
 DATA = Path(__file__).parent.parent / "data"

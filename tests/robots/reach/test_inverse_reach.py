@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.robots.reach.inverse_reach import base_placements, tool_down_poses
-from pinarms.robots.errors import InvalidInput, ModelError
+from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.reach.reachability import reachability_map
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.joint_samples import random_q_slice
 from pinarms.robots.reach.workspace import sample_workspace
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.layout import check_layout, default_orientation
 from pinarms.robots.reach.workspace import sample_workspace
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.reach_io import ReachabilityFileError, load_reachability, save_reachability
 from pinarms.robots.reach.reachability import reachability_map
 
@@ -219,7 +219,7 @@ class _Raises:
 
 
 def test_a_failing_chunk_leaves_no_file(tmp_path):
-    from pinarms.robots.errors import ExecutionError
+    from pinarms.errors import ExecutionError
 
     with pytest.raises(ExecutionError, match="chunk 0.*collision checker broke"):
         reachability_map(robots.load("aubo_i3"), 0.2, 8, collision=_Raises(), out=tmp_path / "broken.h5")

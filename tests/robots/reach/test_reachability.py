@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput, ModelError, UnreachableTarget
+from pinarms.errors import InvalidInput, ModelError, UnreachableTarget
 from pinarms.robots.reach.orientations import so3_orientations, tool_down_orientations
 from pinarms.robots.reach.reachability import reachability_map
 

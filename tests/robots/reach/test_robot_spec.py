@@ -7,7 +7,7 @@ import dataclasses
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import ModelError
+from pinarms.errors import ModelError
 from pinarms.robots.reach.robot_spec import robot_of, spec_of, urdf_sha256
 
 

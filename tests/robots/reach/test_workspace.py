@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.table_band import recommend_region
 from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,

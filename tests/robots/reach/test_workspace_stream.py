@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.robots.errors import InvalidInput
+from pinarms.errors import InvalidInput
 from pinarms.robots.reach.workspace import fit_sphere, hull_points, sample_workspace
 from pinarms.robots.reach.workspace_stream import stream_workspace
 
