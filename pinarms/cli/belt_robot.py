@@ -55,7 +55,8 @@ robot_options = [
     click.option("--descend", type=float, default=0.5, show_default=True,
                  help="--robot: seconds of the tracking pick's descend (and lift); longer for a slow arm."),
     click.option("--map-grid", default="12,5", show_default=True, metavar="NU,NW",
-                 help="--robot: task map nodes along and across the belt."),
+                 help="--robot: task map nodes along the belt (over the arm's whole reach) and across it; a "
+                      "cell is feasible where its four nodes are, so a coarse grid may leave none."),
 ]
 
 
