@@ -34,6 +34,7 @@ GROUP_SECONDS = {
     "tests/robots/test_xacro_expand.py": 69.0,
     "tests/optim/cycle/test_cell_cycle.py": 60.0,
     "tests/optim/test_motion_transfer.py": 54.0,
+    "tests/foreign/test_foreign_arms.py": 266.0,  # one foreign arm's whole path (measured at a load average of 10)
     "tests/test_export_verify.py": 49.0,
     "tests/test_execution.py": 44.0,
     "tests/viz/test_browser.py": 26.0,

@@ -4,6 +4,7 @@ an arm whose zero pose is outside its limits exports without a forced home, and 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -84,3 +85,24 @@ def test_cli_says_when_no_home_is_written(tmp_path, offset_arm):
     run = CliRunner().invoke(cli, ["urdf", "export", str(offset_arm.urdf_path), str(tmp_path / "out"), "--srdf"])
     assert run.exit_code == 0, run.output
     assert "no home state" in run.output and "j2" in run.output
+
+
+def test_the_states_of_a_cell_description_are_its_srdf_states(tmp_path):
+    """Issue 36: the cell description's own ``home`` (and other states) go into the SRDF; no note that the arm has
+    no home (the Jaco2's zero pose lies outside its joint 2 range)."""
+    from pinarms.export.srdf import home_notes, srdf_text
+    from pinarms.optim.motion.arm_macros import example_packages
+
+    cells = Path(__file__).parent / "foreign" / "cells"
+    cell = load_cell(cells / "jaco2_table.toml", packages={"example-robot-data": example_packages()["example-robot-data"]})
+    path = tmp_path / "jaco.srdf"
+    path.write_text(srdf_text(cell))
+    states = _states(path)
+    arm = cell.arm("arm")
+    for name in ("home", "place"):
+        assert list(states[name].values()) == pytest.approx(list(arm.states[name]), abs=1e-12)
+        assert list(states[name]) == [f"arm_{j}" for j in arm.robot.joint_names]
+    assert home_notes(cell) == ()
+    given = np.array(arm.states["place"])
+    path.write_text(srdf_text(cell, states={"home": {"arm": given}}))  # a state given on export wins
+    assert list(_states(path)["home"].values()) == pytest.approx(list(given), abs=1e-12)

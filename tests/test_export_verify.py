@@ -108,3 +108,21 @@ def test_cli_bad_rate_fails_before_planning():
 
     run = CliRunner().invoke(cli, ["verify", "shipped", "--controller-dir", "x", "--rate", "0"])
     assert run.exit_code == 1 and "rate" in run.output
+
+
+def test_a_contact_only_of_mujocos_convex_hull_of_a_mesh_is_counted_apart_and_agrees():
+    """Issue 36: MuJoCo collides a mesh as its convex hull, which contains the mesh; at random configurations of the
+    SO-101 on a table (a concave gripper mesh) MuJoCo's hull touches the table where the mesh is clear. That is the
+    hull, not a disagreement: counted as ``hull_only``; ``mujoco_only`` counts the pairs of primitives."""
+    from pathlib import Path
+
+    from pinarms.export import compare_configurations_in_mujoco
+    from pinarms.optim.motion.arm_macros import example_packages
+    from pinarms.robots.cell import load_cell
+
+    packages = {"example-robot-data": example_packages()["example-robot-data"]}
+    cell = load_cell(Path(__file__).parent / "foreign" / "cells" / "so101_table.toml", packages=packages)
+    result = compare_configurations_in_mujoco(cell, cell.random_q(6, seed=0), packages=packages)
+    assert result.hull_only == 1 and result.mujoco_only == 0 and result.agrees
+    assert result.contacts_mujoco == result.contacts_pinarms + result.hull_only
+    assert "hull only 1" in "\n".join(result.lines())

@@ -169,7 +169,8 @@ def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin,
                 bar.__exit__(None, None, None)
         seconds = time.perf_counter() - t0
         sample = np.flatnonzero(out)[:500]
-        counts = Counter(p for i in range(sample.size) for p in c.collisions(Q[sample[i]], margin=margin).bodies_at())
+        counts = Counter(p for i in range(sample.size)  # a pair of links once per configuration, however many shapes
+                         for p in dict.fromkeys(c.collisions(Q[sample[i]], margin=margin).bodies_at()))
         top = counts.most_common(5)
         data["random"] = {"n": n_random, "seed": seed, "colliding": int(out.sum()), "share": float(out.mean()),
                           "configurations_per_s": n_random / seconds,

@@ -107,12 +107,12 @@ def _zero_outside(arm: Any) -> str | None:
 def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
     """``([(state name, group, [(joint, value)])], notes)``: the homes, then the given states.
 
-    A home the caller gives (``home``, or ``ARM_home`` in a cell of several arms) is written
-    as given; otherwise the all-zero pose, only where it lies inside the joint limits; an arm
+    A home the caller gives (``home``, or ``ARM_home`` in a cell of several arms), or the cell
+    description's own (its ``states``, :func:`_description_states`), is written as given; otherwise the all-zero pose, only where it lies inside the joint limits; an arm
     whose limits exclude 0 gets no home, and a note says why.
     """
     several = len(cell.arms) > 1
-    given = dict(states or {})
+    given = {**_description_states(cell, several), **dict(states or {})}
     for name in given:
         if not isinstance(name, str) or not _STATE_NAME.match(name):
             raise InvalidInput(f"state name {name!r} must be an identifier (letters, digits, _ . -)")
@@ -146,6 +146,13 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[
     return out, notes
 
 
+def _description_states(cell: Any, several: bool) -> dict[str, dict[str, Any]]:
+    """The named states of the cell description's arms (``arm.states``): ``NAME`` in a cell of one arm,
+    ``ARM_NAME`` in a cell of several; a ``home`` among them is the arm's home (states given to the export win)."""
+    return {(f"{arm.name}_{name}" if several else name): {arm.name: q}
+            for arm in cell.arms for name, q in getattr(arm, "states", {}).items()}
+
+
 def home_notes(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
     """Why :func:`srdf_text` writes no home for an arm (its limits exclude the all-zero pose and no home is given)."""
     return tuple(_states(cell, states)[1])
@@ -156,7 +163,8 @@ def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = Non
 
     Args:
         states: extra named states ``{name: {arm name: q_arm (nq_arm,)}}`` [rad or m]
-            (a study's pick and place poses, :func:`cycle_states`). A state named ``home``
+            (a study's pick and place poses, :func:`cycle_states`), besides the named states of the
+            cell description (``arm.states``; a state given here wins). A state named ``home``
             (``ARM_home`` in a cell of several arms) is that arm's home; without it the home
             is the all-zero pose where it lies inside the limits, and none otherwise (an XML
             comment and :func:`home_notes` say why).

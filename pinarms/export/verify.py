@@ -18,8 +18,9 @@ hull** of a mesh. The hull contains the mesh, so for a pair with a mesh MuJoCo's
 may be smaller than coal's (never larger, up to the tolerance): such pairs are compared
 one-sided. Primitive pairs agree within :data:`TOLERANCE_M`.
 
-The comparison passes when MuJoCo finds no contact where pinarms says clear (distance >
-0), and the distances agree as above.
+The comparison passes when MuJoCo finds no contact between primitives where pinarms says clear
+(distance > 0), and the distances agree as above. A contact of a mesh's hull where coal's mesh
+is clear is counted apart (``hull_only``): the hull is larger than the mesh by design.
 """
 
 from __future__ import annotations
@@ -62,7 +63,9 @@ class EngineComparison:
         contacts_pinarms: (instant, pair) in contact for pinarms (distance ≤ 0);
             ``contacts_mujoco``: (instant, pair) with a contact from MuJoCo's collision pass
             (a box on a box gives several contact points: counted once);
-            ``mujoco_only``: (instant, pair) where MuJoCo touches and pinarms says clear.
+            ``mujoco_only``: (instant, pair of primitives) where MuJoCo touches and pinarms says clear;
+            ``hull_only``: (instant, pair with a mesh) where MuJoCo's convex hull touches and coal's mesh is clear
+            (the hull contains the mesh: not a disagreement; its distances are checked by ``max_mesh_excess``).
         tolerance: :data:`TOLERANCE_M`.
     """
 
@@ -81,6 +84,7 @@ class EngineComparison:
     contacts_pinarms: int
     contacts_mujoco: int
     mujoco_only: int
+    hull_only: int = 0
     tolerance: float = TOLERANCE_M
     #: what a sample is: ``instants`` of a motion, or ``configurations``
     sampled: str = "instants"
@@ -104,7 +108,7 @@ class EngineComparison:
              f"below by at most {self.max_mesh_gap:.3e} m") if math.isfinite(self.max_mesh_excess)
             else "  meshes: no pair with a mesh",
             f"  contacts (instant, pair): pinarms {self.contacts_pinarms}, MuJoCo {self.contacts_mujoco}, "
-            f"MuJoCo only {self.mujoco_only}  -> {'agree' if self.agrees else 'DISAGREE'}",
+            f"MuJoCo only {self.mujoco_only}, hull only {self.hull_only}  -> {'agree' if self.agrees else 'DISAGREE'}",
         ]
 
 
@@ -237,6 +241,7 @@ def _compare(cell: Any, label: str, qs: np.ndarray, mjcf: str | Path | None,
     prim, mesh = near & ~is_mesh[None, :], near & is_mesh[None, :]
     i_pin, i_mj = np.unravel_index(np.argmin(d_pin), d_pin.shape), np.unravel_index(np.argmin(d_mj), d_mj.shape)
     name = lambda k: f"{pairs[k].geometry_a} - {pairs[k].geometry_b}"  # noqa: E731
+    only = (mj_touch | (d_mj < 0.0)) & (d_pin > 0.0)
     return EngineComparison(
         label=label, cell=cell.name, mjcf=str(mjcf_path), samples=len(qs), pairs=len(pairs),
         min_pinarms=float(d_pin[i_pin]), min_pinarms_pair=name(i_pin[1]),
@@ -245,7 +250,7 @@ def _compare(cell: Any, label: str, qs: np.ndarray, mjcf: str | Path | None,
         max_mesh_excess=float(diff[mesh].max()) if mesh.any() else -math.inf,
         max_mesh_gap=float((-diff[mesh]).max()) if mesh.any() else 0.0,
         contacts_pinarms=int((d_pin <= 0.0).sum()), contacts_mujoco=int(mj_touch.sum()),
-        mujoco_only=int(((mj_touch | (d_mj < 0.0)) & (d_pin > 0.0)).sum()),
+        mujoco_only=int((only & ~is_mesh[None, :]).sum()), hull_only=int((only & is_mesh[None, :]).sum()),
     )
 
 

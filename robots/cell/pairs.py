@@ -310,8 +310,8 @@ def _sampled_contacts(cell: "CellModel", objs: list, data: pin.Data, checked: li
     """Per pair, from :data:`ALWAYS_SAMPLES` seeded random configurations (:mod:`.pair_samples`, cached by
     content): the share of them in contact and the deepest penetration found [m] (0 if none). Only for the
     :data:`ALWAYS_SHARE` rule: a sample never skips a pair."""
-    hits, dmin, _ = sample_pairs(cell, objs, data, checked, seed)
-    return [(float(h) / ALWAYS_SAMPLES, max(0.0, -float(dmin[k]))) for k, h in enumerate(hits)]
+    hits, depth = sample_pairs(cell, objs, data, checked, seed)
+    return [(float(h) / ALWAYS_SAMPLES, float(depth[k])) for k, h in enumerate(hits)]
 
 
 def _owners(cell: "CellModel") -> tuple[list[str], list[str], list[bool]]:

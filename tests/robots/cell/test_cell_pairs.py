@@ -289,7 +289,8 @@ def test_cell_show_lists_the_skipped_pairs_with_their_reason(tmp_path):
 
 def test_the_sampled_pair_reasons_are_cached_by_content_and_a_poisoned_file_is_sampled_again(tmp_path, monkeypatch):
     """Issue 36 item 8: the 200-configuration sampling is kept in the user's cache folder; a planted file that
-    calls every pair constant (never checked) is refused by the check of its first configurations."""
+    calls every pair in contact in every configuration (a placement error, or pairs allowed) is refused by the check
+    of its first configurations."""
     from pinarms.robots.cell import pair_samples
 
     monkeypatch.setenv("PINARMS_CACHE_DIR", str(tmp_path))
@@ -305,8 +306,9 @@ def test_the_sampled_pair_reasons_are_cached_by_content_and_a_poisoned_file_is_s
     with np.load(path) as z:
         stored = {k: np.array(z[k]) for k in z.files}
     P = stored["hits"].size
-    poison = dict(stored, hits=np.zeros(P), dmin=np.full(P, 1.0), dmax=np.full(P, 1.0),
-                  first_d=np.full_like(stored["first_d"], 1.0), first_hit=np.zeros_like(stored["first_hit"]))
+    poison = dict(stored, hits=np.full(P, float(pair_samples.SAMPLES)), depth=np.full(P, 0.001),
+                  first_depth=np.full_like(stored["first_depth"], 0.001),
+                  first_hit=np.ones_like(stored["first_hit"]))
     np.savez(path, **poison)
     sampled = make_cell(post_cell_text(), "post")
     assert calls == [1] and sampled.pairs == clean.pairs and sampled.allowed == clean.allowed

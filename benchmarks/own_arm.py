@@ -1,0 +1,119 @@
+"""Your own arm, end to end, as a user runs it: each step a real ``pinarms`` process, timed per arm.
+
+Run: python benchmarks/own_arm.py [--arms jaco2_table,z1_table,...] [--out DIR]
+The arms are the cell descriptions of tests/foreign/cells (example-robot-data arms pinarms does not ship:
+Kinova Jaco2 j2s6s200, Unitree Z1, UFactory xArm7, SO-100, SO-101). Steps per arm:
+
+  show      pinarms cell show CELL --package example-robot-data=DIR         (the cell load, cold cache)
+  show-warm the same again                                                   (a warm CLI call)
+  check     pinarms cell check CELL --package ... --random 20
+  motion    pinarms motion CELL --package ... --to X Y Z --time-limit 2      (X Y Z: the tcp at the state 'place')
+  export    pinarms urdf export CELL DIR --cell --srdf --mjcf --package ...
+  verify    pinarms verify cell CELL --package ... --samples 20 --plan home place
+  page      pinarms cell show CELL --package ... --html PAGE
+
+and, in this process, the cell load itself (``load_cell`` with an empty cache folder, then warm). Each figure is
+printed against its goal (cell load <= 5 s, warm CLI call <= 10 s; benchmarks/first_use.py measures the first IK
+and the first plan). The belt step is not measured here yet. Wall times on a shared machine vary: the load
+average is printed with them. A step that fails is reported with its first error line, never fatal.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CELLS = ROOT / "tests" / "foreign" / "cells"
+ARMS = ("jaco2_table", "z1_table", "xarm7_table", "so100_table", "so101_table")
+GOALS = {"load (cold)": 5.0, "load (warm)": 5.0, "show-warm": 10.0}
+
+
+def _pinarms() -> list[str]:
+    return [sys.executable, "-m", "pinarms.cli"]
+
+
+def _step(args: list[str], env: dict[str, str]) -> tuple[float, str]:
+    """``(wall seconds, '' or the first error line)`` of one CLI call."""
+    t0 = time.perf_counter()
+    done = subprocess.run([*_pinarms(), *args], capture_output=True, text=True, env=env)
+    seconds = time.perf_counter() - t0
+    if done.returncode == 0:
+        return seconds, ""
+    lines = (done.stderr or done.stdout).strip().splitlines()
+    return seconds, lines[-1] if lines else f"exit {done.returncode}"
+
+
+def _loads(cell: Path, package: dict[str, str], cache: Path) -> tuple[float, float]:
+    """Cold (empty cache folder) and warm ``load_cell`` of ``cell`` [s], each in a new process."""
+    code = ("import sys, time; from pinarms.robots.cell import load_cell; t = time.perf_counter(); "
+            f"load_cell({str(cell)!r}, packages={package!r}); print(time.perf_counter() - t)")
+    env = dict(os.environ, PINARMS_CACHE_DIR=str(cache))
+    out = [float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                                check=True).stdout.split()[-1]) for _ in range(2)]
+    return out[0], out[1]
+
+
+def _place_tcp(cell: Path, package: dict[str, str]) -> list[str]:
+    from pinarms.robots.cell import load_cell
+
+    c = load_cell(cell, packages=package)
+    q = c.q_from_arms({"arm": c.arm("arm").states["place"]})
+    return [f"{v:.4f}" for v in c.world_pose(q, "arm_tcp")[:3, 3]]
+
+
+def run(arms: list[str], out: Path) -> None:
+    from pinarms.optim.motion.arm_macros import example_packages
+
+    share = str(example_packages()["example-robot-data"])
+    package = {"example-robot-data": share}
+    flag = ["--package", f"example-robot-data={share}"]
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    for name in arms:
+        cell = CELLS / f"{name}.toml"
+        with tempfile.TemporaryDirectory() as tmp:
+            env = dict(os.environ, PINARMS_CACHE_DIR=str(Path(tmp) / "cache"))
+            cold, warm = _loads(cell, package, Path(tmp) / "loads")
+            rows = [("load (cold)", cold, ""), ("load (warm)", warm, "")]
+            steps = {
+                "show": ["cell", "show", str(cell), *flag],
+                "show-warm": ["cell", "show", str(cell), *flag],
+                "check": ["cell", "check", str(cell), *flag, "--random", "20"],
+                "motion": ["motion", str(cell), *flag, "--to", *_place_tcp(cell, package), "--time-limit", "2"],
+                "export": ["urdf", "export", str(cell), str(out / name), "--cell", "--srdf", "--mjcf", "--overwrite",
+                           *flag],
+                "verify": ["verify", "cell", str(cell), *flag, "--samples", "20", "--plan", "home", "place"],
+                "page": ["cell", "show", str(cell), *flag, "--html", str(out / f"{name}.html")],
+            }
+            rows += [(step, *_step(args, env)) for step, args in steps.items()]
+        print(f"\n{name}")
+        for step, seconds, error in rows:
+            goal = GOALS.get(step)
+            verdict = "" if goal is None else ("  (goal <= %.0f s: met)" % goal if seconds <= goal
+                                               else "  (goal <= %.0f s: NOT met)" % goal)
+            print(f"  {step:12s} {seconds:7.2f} s{verdict}" + (f"  FAILED: {error}" if error else ""))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--arms", default=",".join(ARMS))
+    parser.add_argument("--out", default=None, help="folder for the exports and pages (default: a temporary one)")
+    args = parser.parse_args()
+    arms = [a for a in args.arms.split(",") if a]
+    unknown = sorted(set(arms) - set(ARMS))
+    if unknown:
+        parser.error(f"unknown arm(s) {', '.join(unknown)}; known: {', '.join(ARMS)}")
+    if args.out:
+        run(arms, Path(args.out))
+    else:
+        with tempfile.TemporaryDirectory() as tmp:
+            run(arms, Path(tmp))
+
+
+if __name__ == "__main__":
+    main()
