@@ -119,5 +119,5 @@ def test_frozen_and_arrays_are_fresh_copies(paper):
 
 
 def test_public_names():
-    assert set(papers.__all__) == {"ScaraPaper", "AuboPaper", "GantryPaper", "KojiPaper",
-                                   "SEED000", "SEED001", "SEED002", "SEED004"}
+    assert set(papers.__all__) == {"ScaraPaper", "AuboPaper", "GantryPaper", "KojiPaper", "DeltaDatasheet",
+                                   "SEED000", "SEED001", "SEED002", "SEED004", "IRB360_1600"}

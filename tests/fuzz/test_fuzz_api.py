@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from fuzz_support import EXPLORE, outcome
 from pinarms import optim, planning, robots
+from pinarms.planning import definition as planning_definition
 
 ARMS = ("ur5", "scara_mushroom", "gantry_flower", "koji_turner")
 
@@ -270,7 +271,7 @@ def _def_paths(obj, prefix=()):
 
 
 _json = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-5, 10**6), st.floats(-1e3, 1e3),
-                               st.text(max_size=6), st.sampled_from(list(planning.definition.KINDS))),
+                               st.text(max_size=6), st.sampled_from(list(planning_definition.KINDS))),
                      lambda c: st.one_of(st.lists(c, max_size=4), st.dictionaries(st.text(max_size=6), c, max_size=3)),
                      max_leaves=8)
 

@@ -74,11 +74,14 @@ def test_a_saved_cell_without_motions_rests_at_its_hold(tmp_path):
 def test_a_layout_worker_rebuilds_the_cell_with_its_hold(tmp_path):
     import pickle
 
+    from pinarms.optim.layout import LayoutRequest
     from pinarms.optim.layout.evaluate import _CELLS, _cell_of
-    from pinarms.optim.layout.search import _cell_target
+    from pinarms.optim.layout.search import _cell_recipe
 
     cell = _cell(tmp_path, "hold = [0.0, -1.2]")
-    _, recipe = _cell_target(cell, "a", 0.02, (), "hold-test-token")
+    request = LayoutRequest(cell, np.array([0.3, 0.0, 0.8]), np.array([0.0, 0.3, 0.8]), np.zeros((1, 4)), arm="a",
+                            clearance=0.02)
+    recipe = _cell_recipe(request, "hold-test-token")
     _CELLS.pop("hold-test-token")  # as in a worker process: the cell is rebuilt from the (pickled) recipe
     rebuilt = _cell_of(pickle.loads(pickle.dumps(recipe)))
     _CELLS.pop("hold-test-token")
