@@ -132,6 +132,7 @@ def plan_motion(request: MotionRequest, *, progress: Callable[[str], None] | Non
     seconds: dict = {}
     try:
         check_hold(checker)  # an idle arm in collision: named now, not after the search
+        checker.span_turns(x0[None])  # a continuous joint may start at any angle (the goal widens it again)
         check_end(checker, x0, "start")
         speed = request.constraints[0].vmax if o.goals == "best" else None  # the velocity limits come first
         geo = plan_geometry(checker, arms, x0, np.array(request.goal), o, frame=request.frame, say=say, best_goal=speed)
