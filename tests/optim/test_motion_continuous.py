@@ -132,3 +132,27 @@ def test_planning_around_a_moving_arm_turns_the_short_way(two_cell):
     assert f"{np.abs(np.diff(q[:, 1])).sum():.3f}" == f"{2.0 * np.pi - 6.0:.3f}"
     assert f"{q[-1, 1]:.4f}" == f"{2.0 * np.pi - 2.5:.4f}"
     assert around.check.collision_free
+
+
+def test_a_pose_goal_is_reached_the_short_way_and_exported_unwrapped(shelf_cell, tmp_path):
+    """The goal as a tool pose (the hand at wrist -3.0 rad): its IK solution is taken at the angle nearest the start;
+    the controller file and CSV hold the unwrapped angles the wrist turns through."""
+    from pinarms.export import controller_trajectory, read_trajectory_csv, write_trajectory_csv, write_trajectory_yaml
+    from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest, plan_motion
+
+    arm = shelf_cell.arm("arm")
+    pose = arm.tcp_to_world(np.array([0.0, -3.0]))
+    plan = plan_motion(MotionRequest(shelf_cell, "arm", np.array([0.0, 3.0]), pose, options=MotionOptions(seed=0),
+                                     limits=MotionLimits(amax=1.0, torque=False)))
+    assert plan.status.name == "SOLVED" and plan.check.collision_free
+    np.testing.assert_allclose(arm.tcp_to_world(plan.goal), pose, atol=1e-6)
+    assert f"{plan.goal[1]:.3f}" == f"{2.0 * np.pi - 3.0:.3f}"
+    sampled = controller_trajectory(plan, 100)
+    wrist = sampled.positions[:, 1]
+    assert f"{wrist[0]:.4f}" == "3.0000" and f"{wrist[-1]:.3f}" == "3.283" and np.all(np.diff(wrist) >= -1e-12)
+    back = read_trajectory_csv(write_trajectory_csv(tmp_path / "turn.csv", sampled))
+    np.testing.assert_allclose(back.positions, sampled.positions, atol=1e-12, rtol=0)
+    from pathlib import Path
+
+    text = Path(write_trajectory_yaml(tmp_path / "turn.yaml", sampled)).read_text()
+    assert "3.28" in text and "-3.0" not in text  # the JointTrajectory's last point unwrapped, never wrapped back
