@@ -130,11 +130,15 @@ def _q_text(robot: Any, q: np.ndarray) -> str:
 
 
 def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndarray | Mapping[str, np.ndarray],
-                    start: np.ndarray, seed: int,
-                     frame: str | None) -> list[GoalCandidate]:
+                    start: np.ndarray, seed: int, frame: str | None, *, nearest: bool = True) -> list[GoalCandidate]:
+    """The goal's configurations, clear or not (with why). ``nearest``: each continuous joint of a joint goal
+    (or of each IK branch) at its 2π equivalent nearest the start (:func:`nearest_turn`); ``False``: a joint
+    goal as given (a cycle's transfer must end where its lowering starts). The checker's box of the
+    continuous joints is widened to hold the start and the goals (:meth:`MotionChecker.span_turns`)."""
     cell = checker.cell
+    turn = checker.continuous if nearest else np.zeros(checker.n, dtype=bool)
     if not is_pose(goal):
-        x = nearest_turn(arm_joints(cell, arms, goal, "goal"), start, checker.continuous)
+        x = nearest_turn(arm_joints(cell, arms, goal, "goal"), start, turn)
         checker.span_turns(np.vstack([start, x]))
         check_end(checker, x, "goal")
         return [GoalCandidate(x, True)]
@@ -159,7 +163,7 @@ def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndar
         reason = robot.ik_failure_reason(T_base) or "no IK solution within the joint limits"
         raise UnreachableTarget(f"the goal pose at {np.round(T[:3, 3], 4).tolist()} m is unreachable for arm "
                                 f"{arm.name!r}: {reason}")
-    q = nearest_turn(q, start, checker.continuous)  # each branch's continuous joints the short way from the start
+    q = nearest_turn(q, start, turn)  # each branch's continuous joints the short way from the start
     checker.span_turns(np.vstack([start, q]))
     out = []
     for qi, bi in zip(q, branch):

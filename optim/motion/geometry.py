@@ -130,17 +130,19 @@ def find_path(checker: MotionChecker, x0: np.ndarray, G: np.ndarray, *, planner:
 
 def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray, goal: np.ndarray,
                   options: MotionOptions, *, frame: str | None = None, say: Callable[[str], None] = lambda _m: None,
-                  best_goal: np.ndarray | None = None) -> dict:
+                  best_goal: np.ndarray | None = None, nearest: bool = True) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
     ``options``: the planner, time limit, seed and ``compiled`` (``False``: OMPL alone) of
-    :class:`.request.MotionOptions`. Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``,
-    ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``, ``compiled``.
+    :class:`.request.MotionOptions`. ``nearest``: continuous joints of the goal at the 2π equivalent
+    nearest the start (:func:`.ends.goal_candidates`; ``False``: as given). Returns a dict: ``goals``,
+    ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``,
+    ``compiled``.
     """
     planner, time_limit, seed, compiled = options.planner, options.time_limit, options.seed, options.compiled
     t_start = time.perf_counter()
     cell = checker.cell
-    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame, nearest=nearest)
     G = np.array([g.q for g in goals if g.valid])
     same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
     if same.size:
