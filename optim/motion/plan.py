@@ -12,6 +12,9 @@ exception; what planning finds out is a status (the rule: :mod:`.result`). The s
    for every IK branch (closed form: each branch once; numerical: seeded restarts), and
    every branch that is clear becomes a goal state; the others are kept with the reason
    (:class:`GoalCandidate`). No clear branch: ``GOAL_IN_COLLISION`` listing them.
+   Continuous joints: any start angle; each goal's angle at its 2π equivalent nearest the
+   start, the search box half a turn beyond both (the short way across ±π; the other way
+   round when the short way finds no path; docs/motion.md).
 2. **Search.** OMPL (RRT-Connect by default) with pinarms' state and continuous, batched
    edge validity (:mod:`.checker`, :mod:`.search`), seeded; no path within ``time_limit``
    is ``NO_PATH`` with the planner, the time and the states explored.

@@ -156,3 +156,36 @@ def test_a_pose_goal_is_reached_the_short_way_and_exported_unwrapped(shelf_cell,
 
     text = Path(write_trajectory_yaml(tmp_path / "turn.yaml", sampled)).read_text()
     assert "3.28" in text and "-3.0" not in text  # the JointTrajectory's last point unwrapped, never wrapped back
+
+
+@pytest.fixture(scope="module")
+def post_cell(tmp_path_factory):
+    """The arm with its lift held within ±0.05 rad and a post from floor to ceiling at x = 0.3 m: the hand
+    pointing back (wrist near π) hits it, so the wrist cannot cross π."""
+    import re
+
+    from pinarms.robots.cell import load_cell
+
+    arm = ARM.replace('lower="-1.5" upper="1.5"', 'lower="-0.05" upper="0.05"')
+    body = re.sub(r'(name|link)="(?!world)([^"]+)"', r'\1="arm_\2"', arm)
+    post = ('<link name="post"><collision><geometry><box size="0.04 0.04 2.0"/></geometry></collision></link>'
+            '<joint name="post_mount" type="fixed"><parent link="world"/><child link="post"/>'
+            '<origin xyz="0.3 0 0.3"/></joint>')
+    path = tmp_path_factory.mktemp("post_cell") / "post_cell.urdf"
+    path.write_text(f'<robot name="post_cell"><link name="world"/>{body}{post}</robot>')
+    return load_cell(path)
+
+
+def test_a_blocked_short_way_is_planned_the_other_way_round(post_cell):
+    """Wrist 2.5 → -2.5 rad: the short way (0.78 rad across π) runs into the post; the long way (5.0 rad through
+    0) is planned instead, ending at -2.5 rad."""
+    from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest, plan_motion
+
+    request = MotionRequest(post_cell, "arm", np.array([0.0, 2.5]), np.array([0.0, -2.5]),
+                            options=MotionOptions(seed=0, time_limit=0.5), limits=MotionLimits(amax=1.0, torque=False))
+    plan = plan_motion(request)
+    assert plan.status.name == "SOLVED", plan.reason
+    tr = plan.trajectory
+    q = np.asarray(tr.sample(np.linspace(tr.start_time, tr.end_time, 400))[0])
+    assert f"{q[-1, 1]:.4f}" == "-2.5000" and np.all(np.abs(q[:, 1]) <= 2.5 + 1e-9)  # through 0, never across π
+    assert plan.check.collision_free
