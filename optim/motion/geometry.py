@@ -167,7 +167,7 @@ def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray,
     try:
         found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled,
                           say=say, best_goal=best_goal)
-    except NoPathFound:
+    except NoPathFound as short:
         G = other_way(checker, x0, G) if nearest else None
         if G is None:
             raise
@@ -175,6 +175,7 @@ def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray,
         checker.span_turns(G)
         found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled,
                           say=say, best_goal=best_goal)
+        found["seconds"]["search"] += float(short.seconds)  # both searches' time
     t = time.perf_counter()
     path, method, _ = smooth_path(checker, found["simplified"], robot)
     if found["compiled"] and method != "cubic spline" and not _exact(checker, found["simplified"]):
