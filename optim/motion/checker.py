@@ -135,6 +135,9 @@ class MotionChecker(CoalBatches, LadderProof):
         self.n = int(self.cols.size)
         self.lower = np.asarray(cell.lower, dtype=float)[self.cols]
         self.upper = np.asarray(cell.upper, dtype=float)[self.cols]
+        #: the planned columns that are continuous joints (any angle, the same pose every 2π): their
+        #: search box is one turn until :meth:`span_turns` widens it around a query's ends
+        self.continuous = np.asarray(cell.robot.continuous, dtype=bool)[self.cols]
         base = cell.hold if hold is None else cell.robot.check_q(hold)[0][0]
         self.hold = np.array(base, dtype=float)
         self.moving = tuple(moving)
@@ -246,6 +249,15 @@ class MotionChecker(CoalBatches, LadderProof):
             for m, c in zip(self.moving, self._moving_cols):
                 Q[:, c] = m.q_at(t)
         return Q
+
+    def span_turns(self, X: Any) -> None:
+        """Widen the search box of the continuous columns to hold the states ``X (k, n)`` and half a turn
+        beyond: ``[min − π, max + π]`` (never narrowed; the other columns keep their joint limits)."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))[:, : self.n]
+        c = self.continuous
+        if X.size and c.any():
+            self.lower[c] = np.minimum(self.lower[c], X[:, c].min(axis=0) - np.pi)
+            self.upper[c] = np.maximum(self.upper[c], X[:, c].max(axis=0) + np.pi)
 
     def within_limits(self, X: np.ndarray) -> np.ndarray:
         X = np.atleast_2d(X)

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from pinarms.optim.motion.checker import MotionChecker
     from pinarms.robots.cell import Cell
 
-__all__ = ["planned_arms", "arm_joints", "is_pose", "check_end", "check_hold", "goal_candidates"]
+__all__ = ["planned_arms", "arm_joints", "is_pose", "nearest_turn", "check_end", "check_hold", "goal_candidates"]
 
 
 def planned_arms(cell: Cell, arm: str | Sequence[str]) -> tuple[str, ...]:
@@ -59,6 +59,14 @@ def is_pose(value: object) -> bool:
     return arr.shape == (4, 4)
 
 
+def nearest_turn(x: np.ndarray, ref: np.ndarray, continuous: np.ndarray) -> np.ndarray:
+    """``x (..., n)`` with each continuous column moved by a multiple of 2π to the angle nearest ``ref (n,)``
+    (the same pose; within ``ref ± π``); the other columns as they are."""
+    x = np.array(x, dtype=float)
+    turns = np.round((np.asarray(ref, dtype=float) - x) / (2.0 * np.pi))
+    return np.where(np.asarray(continuous, dtype=bool), x + 2.0 * np.pi * turns, x)
+
+
 def _idle_arms(checker: Any) -> tuple[str, ...]:
     """The cell's arms neither planned nor moving on their own trajectory: they stay at the hold pose."""
     moving = {m.arm for m in checker.moving}
@@ -97,14 +105,13 @@ def check_hold(checker: MotionChecker) -> None:
 
 
 def check_end(checker: MotionChecker, x: np.ndarray, label: str = "start") -> None:
+    """``x`` within the checker's box (continuous joints: widen it first, :meth:`MotionChecker.span_turns`) and
+    clear of every pair at its margin; else :class:`InvalidInput` naming the joints, or the collision error."""
     if not checker.within_limits(x[None])[0]:
         names = checker.cell.joint_names
         bad = [f"{names[c]} = {x[i]:.4g} outside [{checker.lower[i]:.4g}, {checker.upper[i]:.4g}]"
                for i, c in enumerate(checker.cols) if not checker.lower[i] - 1e-12 <= x[i] <= checker.upper[i] + 1e-12]
-        turn = [f"{names[c]} is continuous: the search keeps it in one turn [-π, π], give the same pose there "
-                f"({x[i]:.6g} → {np.pi - np.mod(np.pi - x[i], 2.0 * np.pi):.6g})"
-                for i, c in enumerate(checker.cols) if checker.cell.robot.continuous[c] and not -np.pi <= x[i] <= np.pi]
-        raise InvalidInput(f"the {label} is outside the joint limits: {'; '.join(bad + turn)}")
+        raise InvalidInput(f"the {label} is outside the joint limits: {'; '.join(bad)}")
     if not checker.state_valid(x):
         e, pair, d = checker.closest(x)
         m = checker.self_margin if pair is not None and pair.kind == "self" else checker.margin
@@ -123,11 +130,16 @@ def _q_text(robot: Any, q: np.ndarray) -> str:
 
 
 def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndarray | Mapping[str, np.ndarray],
-                    start: np.ndarray, seed: int,
-                     frame: str | None) -> list[GoalCandidate]:
+                    start: np.ndarray, seed: int, frame: str | None, *, nearest: bool = True) -> list[GoalCandidate]:
+    """The goal's configurations, clear or not (with why). ``nearest``: each continuous joint of a joint goal
+    (or of each IK branch) at its 2π equivalent nearest the start (:func:`nearest_turn`); ``False``: a joint
+    goal as given (a cycle's transfer must end where its lowering starts). The checker's box of the
+    continuous joints is widened to hold the start and the goals (:meth:`MotionChecker.span_turns`)."""
     cell = checker.cell
+    turn = checker.continuous if nearest else np.zeros(checker.n, dtype=bool)
     if not is_pose(goal):
-        x = arm_joints(cell, arms, goal, "goal")
+        x = nearest_turn(arm_joints(cell, arms, goal, "goal"), start, turn)
+        checker.span_turns(np.vstack([start, x]))
         check_end(checker, x, "goal")
         return [GoalCandidate(x, True)]
     if len(arms) != 1:
@@ -151,6 +163,8 @@ def goal_candidates(checker: MotionChecker, arms: tuple[str, ...], goal: np.ndar
         reason = robot.ik_failure_reason(T_base) or "no IK solution within the joint limits"
         raise UnreachableTarget(f"the goal pose at {np.round(T[:3, 3], 4).tolist()} m is unreachable for arm "
                                 f"{arm.name!r}: {reason}")
+    q = nearest_turn(q, start, turn)  # each branch's continuous joints the short way from the start
+    checker.span_turns(np.vstack([start, q]))
     out = []
     for qi, bi in zip(q, branch):
         if checker.state_valid(qi):

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from pinarms.optim.motion.checker import MotionChecker
     from pinarms.optim.motion.request import MotionOptions
 
-__all__ = ["plan_geometry", "find_path", "fast_share", "travel_time_bound", "FAST_SHARE"]
+__all__ = ["plan_geometry", "find_path", "other_way", "fast_share", "travel_time_bound", "FAST_SHARE"]
 
 #: Share of the time limit the compiled search may take when the cover proves at least half of the
 #: clear random states (:attr:`MotionChecker.cover_share`); OMPL has the rest. Measured on
@@ -128,19 +128,35 @@ def find_path(checker: MotionChecker, x0: np.ndarray, G: np.ndarray, *, planner:
             "seconds": seconds}
 
 
+def other_way(checker: MotionChecker, x0: np.ndarray, G: np.ndarray) -> np.ndarray | None:
+    """The goals ``G (k, n)``, each with one continuous joint turned the other way round (its angle 2π farther
+    from the start's, the same pose), one row per goal and joint that moves; ``None`` when none moves."""
+    rows = []
+    for g in np.atleast_2d(G):
+        for j in np.flatnonzero(checker.continuous):
+            d = g[j] - x0[j]
+            if abs(d) > 1e-9:
+                y = g.copy()
+                y[j] -= 2.0 * np.pi * np.sign(d)
+                rows.append(y)
+    return np.array(rows) if rows else None
+
+
 def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray, goal: np.ndarray,
                   options: MotionOptions, *, frame: str | None = None, say: Callable[[str], None] = lambda _m: None,
-                  best_goal: np.ndarray | None = None) -> dict:
+                  best_goal: np.ndarray | None = None, nearest: bool = True) -> dict:
     """Steps 1-4 of :func:`.plan.plan_motion` for a checked start: goals, search, shortcut, smoothing.
 
     ``options``: the planner, time limit, seed and ``compiled`` (``False``: OMPL alone) of
-    :class:`.request.MotionOptions`. Returns a dict: ``goals``, ``raw``, ``simplified``, ``path``,
-    ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``, ``compiled``.
+    :class:`.request.MotionOptions`. ``nearest``: continuous joints of the goal at the 2π equivalent
+    nearest the start (:func:`.ends.goal_candidates`; ``False``: as given). Returns a dict: ``goals``,
+    ``raw``, ``simplified``, ``path``, ``smoothing``, ``planner``, ``states``, ``seconds``, ``simplifier``,
+    ``compiled``.
     """
     planner, time_limit, seed, compiled = options.planner, options.time_limit, options.seed, options.compiled
     t_start = time.perf_counter()
     cell = checker.cell
-    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame)
+    goals = goal_candidates(checker, arms, goal, x0, int(seed), frame, nearest=nearest)
     G = np.array([g.q for g in goals if g.valid])
     same = np.flatnonzero(np.abs(G - x0).max(axis=1) <= 1e-9)
     if same.size:
@@ -148,8 +164,18 @@ def plan_geometry(checker: MotionChecker, arms: tuple[str, ...], x0: np.ndarray,
                            "plan; give a goal different from the start")
     say(f"{len(G)} clear goal configuration(s) of {len(goals)}; searching")
     robot = cell.arm(arms[0]).robot if len(arms) == 1 else None
-    found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled, say=say,
-                      best_goal=best_goal)
+    try:
+        found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled,
+                          say=say, best_goal=best_goal)
+    except NoPathFound as short:
+        G = other_way(checker, x0, G) if nearest else None
+        if G is None:
+            raise
+        say(f"no path the short way; searching the other way round ({len(G)} goal configuration(s))")
+        checker.span_turns(G)
+        found = find_path(checker, x0, G, planner=planner, time_limit=time_limit, seed=seed, compiled=compiled,
+                          say=say, best_goal=best_goal)
+        found["seconds"]["search"] += float(short.seconds)  # both searches' time
     t = time.perf_counter()
     path, method, _ = smooth_path(checker, found["simplified"], robot)
     if found["compiled"] and method != "cubic spline" and not _exact(checker, found["simplified"]):

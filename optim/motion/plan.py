@@ -12,6 +12,9 @@ exception; what planning finds out is a status (the rule: :mod:`.result`). The s
    for every IK branch (closed form: each branch once; numerical: seeded restarts), and
    every branch that is clear becomes a goal state; the others are kept with the reason
    (:class:`GoalCandidate`). No clear branch: ``GOAL_IN_COLLISION`` listing them.
+   Continuous joints: any start angle; each goal's angle at its 2π equivalent nearest the
+   start, the search box half a turn beyond both (the short way across ±π; the other way
+   round when the short way finds no path; docs/motion.md).
 2. **Search.** OMPL (RRT-Connect by default) with pinarms' state and continuous, batched
    edge validity (:mod:`.checker`, :mod:`.search`), seeded; no path within ``time_limit``
    is ``NO_PATH`` with the planner, the time and the states explored.
@@ -132,6 +135,7 @@ def plan_motion(request: MotionRequest, *, progress: Callable[[str], None] | Non
     seconds: dict = {}
     try:
         check_hold(checker)  # an idle arm in collision: named now, not after the search
+        checker.span_turns(x0[None])  # a continuous joint may start at any angle (the goal widens it again)
         check_end(checker, x0, "start")
         speed = request.constraints[0].vmax if o.goals == "best" else None  # the velocity limits come first
         geo = plan_geometry(checker, arms, x0, np.array(request.goal), o, frame=request.frame, say=say, best_goal=speed)

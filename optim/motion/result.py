@@ -67,7 +67,8 @@ class MotionPlan:
         arms: the planned arms; ``status``: the :class:`MotionStatus`; ``reason``: why it is not
             solved, in words (empty when solved).
         start: the planned arms' joint coordinates ``(n,)``; ``goal``: the goal reached ``(n,)``
-            (not solved: the joint goal asked, or ``None`` for a pose goal).
+            (continuous joints unwrapped: the goal asked plus a multiple of 2π, where the
+            trajectory ends; not solved: the joint goal asked, or ``None`` for a pose goal).
         goals: every goal configuration tried (:class:`GoalCandidate`: valid or why not).
         which, pairs, distances, configurations: with a status ``*_IN_COLLISION``: which end
             (``"start"``, ``"goal"``, ``"hold"``), the pairs ``(body_a, body_b)`` nearest their

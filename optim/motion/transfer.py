@@ -160,7 +160,8 @@ def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hol
                                  f"{checker.margin * 1e3:.1f} mm to something: no transfer can clear it; move the "
                                  "pick/place or lower the lift")
     options = MotionOptions(margin=checker.margin, planner=planner, time_limit=time_limit, seed=seed)
-    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], options)
+    # the transfer ends where the lowering at the place starts: its continuous joints as the cycle's IK gave them
+    geo = plan_geometry(checker, (arm.name,), q[1], q[k - 2], options, nearest=False)
     transfer = geo["path"]
     reverse, _, _ = smooth_path(checker, geo["simplified"][::-1], arm.robot)
     amax = base.amax

@@ -199,6 +199,7 @@ def plan_around(request: MotionRequest,
         parked[cell.arm(m.arm).q_slice] = m.trajectory.sample(m.trajectory.end_time)[0]
     together = MotionChecker(cell, arms, margin=o.margin, self_margin=o.self_margin, hold=base, moving=timed)
     x0 = np.array(request.start)
+    together.span_turns(x0[None])  # continuous joints at any angle (docs/motion.md), as in plan_motion
     check_end(together, np.append(x0, t0), "start")
     say("planning the path around the other arm(s) parked at the end of their motion")
     # no re-check of the motion against A parked: the motion kept is checked against A moving
@@ -208,6 +209,7 @@ def plan_around(request: MotionRequest,
                           "it cannot wait there; plan both arms together", planner="",
                           time_limit=o.time_limit) from plan.error
     plan.raise_for_status()
+    together.span_turns(plan.trajectory.position_range())  # the path's continuous joints: within the box
     t = time.perf_counter()
     t_end = max(m.offset + m.trajectory.duration for m in timed)
     delays = np.arange(0.0, max(t_end - t0, 0.0) + delay_step, delay_step)

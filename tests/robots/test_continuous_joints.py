@@ -102,13 +102,15 @@ def test_srdf_state_of_a_continuous_joint_is_written_wrapped(turner_cell):
     assert f'<joint name="arm_wrist" value="{3.23083 - 2.0 * np.pi!r}" />' in turned
 
 
-def test_plan_motion_start_beyond_pi_says_to_give_the_same_pose_in_one_turn(turner_cell):
-    """plan_motion searches a continuous joint in one turn (docs/ik.md): a start beyond it is refused before any
-    search, with the same pose inside it."""
+def test_plan_motion_starts_beyond_pi_and_turns_the_short_way(turner_cell):
+    """plan_motion takes a continuous joint at any angle (tests/optim/test_motion_continuous.py): from 3.23083 rad
+    to 1.0 rad it turns 2.23 rad, not the same pose inside one turn first."""
     from pinarms.optim.motion import MotionLimits, MotionRequest, plan_motion
-    from pinarms.errors import InvalidInput
 
     request = MotionRequest(turner_cell, "arm", np.array([0.2, 3.23083]), np.array([0.3, 1.0]),
                             limits=MotionLimits(amax=1.0, torque=False))
-    with pytest.raises(InvalidInput, match=r"arm_wrist is continuous: .* \(3\.23083 → -3\.05236\)"):
-        plan_motion(request)
+    plan = plan_motion(request)
+    assert plan.status.name == "SOLVED" and plan.check.collision_free
+    tr = plan.trajectory
+    ends = np.array([np.asarray(tr.sample(t)[0]).reshape(-1) for t in (tr.start_time, tr.end_time)])
+    assert ends.round(5).tolist() == [[0.2, 3.23083], [0.3, 1.0]]
