@@ -36,9 +36,10 @@ Units: m, rad; s in m (the tool path's weighted arc length).
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Iterable, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array, per_joint
@@ -50,6 +51,9 @@ from pinarms.planning.multi_quintic import quintic_hermite_coefficients
 from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
 from pinarms.robots.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
 
@@ -76,7 +80,7 @@ class CartesianPath(JointPath):
         max_deviation: (position [m], rotation [rad]) largest tcp deviation found at the check points.
     """
 
-    def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Any, frame: str,
+    def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Robot, frame: str,
                  tolerance: float, q_knots: np.ndarray, sigma_min: np.ndarray, branch: int | None,
                  max_deviation: tuple[float, float]) -> None:
         super().__init__(breaks, coefficients, stops=tool.stops, robot=robot, frame=frame)
@@ -89,7 +93,7 @@ class CartesianPath(JointPath):
         for arr in (self.q_knots, self.sigma_min):
             arr.flags.writeable = False
 
-    def deviation(self, s: Any) -> tuple[np.ndarray, np.ndarray]:
+    def deviation(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """tcp deviation at arc lengths ``s``: position [m] and rotation [rad] from the tool path at the same s."""
         arr, _ = self._check_s(s)
         T = np.asarray(self.robot.fk(self(arr), frame=self.frame))
@@ -305,7 +309,7 @@ def _coefficients(knots: list[Knot]) -> np.ndarray:
     return quintic_hermite_coefficients(s[1:] - s[:-1], *a, *b)
 
 
-def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+def joint_image(robot: Robot, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: ArrayLike | None = None,
                 frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE,
                 locate: float = 1e-5) -> CartesianPath:
     """The joint path that makes the tcp follow ``path`` within ``tolerance`` (module docstring).
@@ -365,8 +369,8 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     raise _failure(sv, farthest.s, farthest.q_last, farthest.kind, farthest.detail)
 
 
-def cartesian_path(robot: Any, poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT,
-                   stops: Iterable[int] = (), tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+def cartesian_path(robot: Robot, poses: ArrayLike, *, blend: ArrayLike = 0.0, weight: float = DEFAULT_WEIGHT,
+                   stops: Iterable[int] = (), tolerance: float = DEFAULT_TOLERANCE, q_start: ArrayLike | None = None,
                    frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE) -> CartesianPath:
     """Straight tcp lines through ``poses`` (blends of radius ``blend`` at the corners), as joints.
 

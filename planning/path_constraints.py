@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
@@ -62,7 +63,7 @@ class PathSamples:
     side: str = "right"
 
     @classmethod
-    def of(cls, path: Any, s: Any, side: str = "right") -> "PathSamples":
+    def of(cls, path: Any, s: ArrayLike, side: str = "right") -> "PathSamples":
         """Sample ``path`` at ``s``."""
         arr = np.atleast_1d(np.asarray(s, dtype=float))
         q, dq, ddq = path.sample(arr, side)

@@ -42,6 +42,7 @@ from __future__ import annotations
 from typing import Any, Iterable, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array
@@ -111,7 +112,7 @@ class ToolPath:
             raise TrajectoryError(f"arc length s must lie in [0, {self.length!r}] m, got {arr.min()!r} .. {arr.max()!r}")
         return np.clip(arr, 0.0, self.length), single
 
-    def evaluate(self, s: Any, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, s: ArrayLike, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose and its first two derivatives in s at the arc lengths ``s`` [m].
 
         Returns ``(T (N, 4, 4), d1 (N, 6), d2 (N, 6))``: ``d1 = (dp/ds, ω)`` with ω the angular
@@ -133,13 +134,13 @@ class ToolPath:
             T[sel], d1[sel], d2[sel] = self._pieces[k].evaluate(arr[sel] - self.breaks[k])
         return T, d1, d2
 
-    def pose(self, s: Any) -> np.ndarray:
+    def pose(self, s: ArrayLike) -> np.ndarray:
         """tcp pose(s) at arc length ``s`` [m]: (4, 4) for a scalar, (N, 4, 4) for (N,)."""
         arr, single = self._arc(s)
         T = self.evaluate(arr)[0]
         return T[0] if single else T
 
-    def position(self, s: Any) -> np.ndarray:
+    def position(self, s: ArrayLike) -> np.ndarray:
         """tcp position(s) [m] at ``s``: (3,) or (N, 3)."""
         return self.pose(s)[..., :3, 3]
 
@@ -150,7 +151,7 @@ class ToolPath:
                 "via_s_m": self.via_s.tolist(), "blend_radii_m": self.radii.tolist()}
 
 
-def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, stops: Iterable[int] = ()) -> ToolPath:
+def tool_path(poses: ArrayLike, *, blend: ArrayLike = 0.0, weight: float = DEFAULT_WEIGHT, stops: Iterable[int] = ()) -> ToolPath:
     """Straight lines through tcp ``poses`` with circular blends at the corners (module docstring).
 
     Args:
