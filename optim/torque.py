@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit, path_static_check, static_check
@@ -26,7 +27,7 @@ __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static
 TorqueConstraint = JointTorqueConstraint
 
 
-def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,
+def torque_constraint(robot: Any, torque_limits: ArrayLike, payload: Any = None,
                       samples_per_piece: int | None = None) -> JointTorqueConstraint | None:
     """The :class:`planning.JointTorqueConstraint` asked for by ``minimize_time``/``plan_cycle`` keywords, or None.
 

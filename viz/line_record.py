@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.errors import InvalidInput
 
@@ -151,7 +152,7 @@ def decode_line(it: Any) -> LineRecord:
     return rec
 
 
-def make_line(name: str, arms: tuple[str, ...], belt_to_world: Any, *, length: float, width: float, thickness: float,
+def make_line(name: str, arms: tuple[str, ...], belt_to_world: ArrayLike, *, length: float, width: float, thickness: float,
               speed: float, u_miss: float, duration: float, items: Any) -> LineRecord:
     """A checked record; :class:`InvalidInput` naming what is wrong."""
     T = np.array(belt_to_world, dtype=float)

@@ -19,6 +19,7 @@ from typing import Any, Mapping, Sequence
 
 import matplotlib
 import numpy as np
+from numpy.typing import ArrayLike
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
@@ -81,13 +82,13 @@ def _joint_labels(n: int, robot: Any, joint_names: Sequence[str] | None,
 
 def plot_joint_curves(
     path: str | Path,
-    t: Any,
-    q: Any,
-    qd: Any = None,
-    qdd: Any = None,
-    qddd: Any = None,
+    t: ArrayLike,
+    q: ArrayLike,
+    qd: ArrayLike | None = None,
+    qdd: ArrayLike | None = None,
+    qddd: ArrayLike | None = None,
     *,
-    knot_times: Any = None,
+    knot_times: ArrayLike | None = None,
     limits: Any = None,
     robot: Any = None,
     joint_names: Sequence[str] | None = None,
@@ -213,7 +214,7 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
     return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=drawn, limits=limits, **options)
 
 
-def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
+def plot_tool_speed(path: str | Path, t: ArrayLike, speed: ArrayLike, *, limit: float | None = None, angular: Any = None,
                     title: str = "tcp speed") -> Path:
     """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
 
@@ -245,7 +246,7 @@ def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None
     return save_figure(fig, path)
 
 
-def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
+def plot_torques(path: str | Path, t: ArrayLike, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
                  units: Sequence[str] | None = None, series: Mapping[str, Any] | None = None, title: str = "joint torques") -> Path:
     """Joint torques against their limits: one panel per joint, ±limit dashed, peaks marked.
 

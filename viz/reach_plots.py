@@ -18,6 +18,7 @@ from typing import Any
 
 import matplotlib
 import numpy as np
+from numpy.typing import ArrayLike
 from matplotlib.figure import Figure
 
 from pinarms.robots.errors import InvalidInput
@@ -103,7 +104,7 @@ def plot_reachability_section(
     return save_figure(fig, path)
 
 
-def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *, title: str = "workspace",
+def plot_workspace(path: str | Path, points: ArrayLike, manipulability: ArrayLike | None = None, *, title: str = "workspace",
                    colormap: str = "viridis", mm: bool = False) -> Path:
     """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
 

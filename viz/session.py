@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms import robots
 from pinarms.robots.errors import InvalidInput
@@ -103,7 +104,7 @@ class Session:
         *,
         title: str = "",
         metadata: Mapping[str, Any] | None = None,
-        base_to_world: Any = None,
+        base_to_world: ArrayLike | None = None,
         key: str | None = None,
     ) -> None:
         if not isinstance(title, str):
@@ -147,7 +148,7 @@ class Session:
         )
 
     # ---------------------------------------------------------------- robots
-    def add_robot(self, robot: Robot | str, *, key: str | None = None, base_to_world: Any = None) -> str:
+    def add_robot(self, robot: Robot | str, *, key: str | None = None, base_to_world: ArrayLike | None = None) -> str:
         """Add a robot placed at ``base_to_world`` (4, 4) in the world; return its key.
 
         A robot that ``robots.load`` rebuilds exactly is stored by name; any other has its
@@ -248,7 +249,7 @@ class Session:
         return q if q.shape == (nq,) and np.all(np.isfinite(q)) else None
 
     # ---------------------------------------------------------------- content
-    def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
+    def add_box(self, name: str, size: Any, pose: ArrayLike | None = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""
         box = box_record(self._free(self.objects, name, "object"), size, pose, color)
         self.objects[box.name] = box
@@ -267,7 +268,7 @@ class Session:
         self.trajectories[rec.name] = rec
         return rec
 
-    def add_workspace(self, name: str, workspace: Any = None, *, points: Any = None, manipulability: Any = None,
+    def add_workspace(self, name: str, workspace: Any = None, *, points: ArrayLike | None = None, manipulability: ArrayLike | None = None,
                       robot: str | None = None) -> WorkspaceRecord:
         """Add a workspace cloud of robot ``robot``: a ``Workspace`` (``points``, ``manipulability``) or the two arrays.
 
@@ -278,7 +279,7 @@ class Session:
         self.workspaces[rec.name] = rec
         return rec
 
-    def add_points(self, name: str, points: Any, *, kind: str = "via", robot: str | None = None) -> PointSet:
+    def add_points(self, name: str, points: ArrayLike, *, kind: str = "via", robot: str | None = None) -> PointSet:
         """Add via points or targets (``kind`` ``"via"`` or ``"target"``), (n, 3) m.
 
         With ``robot`` the points are in that robot's base frame, without it in the world frame.

@@ -14,6 +14,7 @@ import math
 from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.errors import InvalidInput
 
@@ -69,7 +70,7 @@ def pose_array(values: Any, what: str) -> np.ndarray:
     return T
 
 
-def box_record(name: str, size: Any, pose: Any, color: Any) -> BoxObject:
+def box_record(name: str, size: Any, pose: ArrayLike, color: Any) -> BoxObject:
     """The static box ``name``: ``size`` (3,) positive edge lengths in m, ``pose`` (4, 4), ``color`` RGBA in [0, 1]."""
     size_arr = float_array(size, f"size of box {name!r}", 1, 3)
     if np.any(size_arr <= 0):
@@ -126,7 +127,7 @@ def _sampled(name: str, trajectory: Any, hz: float) -> tuple[np.ndarray, np.ndar
     return t, q, knots, definition
 
 
-def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: Any, manipulability: Any) -> WorkspaceRecord:
+def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: ArrayLike, manipulability: ArrayLike) -> WorkspaceRecord:
     """The workspace cloud ``name`` of robot ``entry``: a ``Workspace``, or ``points`` (n, 3) and ``manipulability`` (n,)."""
     if workspace is not None:
         if not (hasattr(workspace, "points") and hasattr(workspace, "manipulability")):

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.cycle.joint import joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
@@ -80,7 +81,7 @@ class StraightMove:
 
 def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "exact", seed: int = 0,
                    tool_speed: float | None = None, tolerance: float = 1e-4, payload: Any = None,
-                   torque_limits: Any = False) -> CycleResult:
+                   torque_limits: ArrayLike = False) -> CycleResult:
     """The cycle of ``joint`` (a joint-space :class:`CycleResult`) with straight lines at pick and place.
 
     Args:

@@ -16,6 +16,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType
@@ -34,7 +35,7 @@ class NeighbourGuard:
 
     def __init__(self, cell: Any, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
                  types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01,
-                 maps: dict | None = None, yaws: Any = None) -> None:
+                 maps: dict | None = None, yaws: ArrayLike | None = None) -> None:
         self.cell, self.belt, self.tracking, self.types = cell, belt, tracking, tuple(types)
         self.stations = {s.name: s for s in stations}
         for s in stations:

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.optim.motion import coal_batches
@@ -225,7 +226,7 @@ class MotionChecker(CoalBatches, LadderProof):
         cumulative = np.concatenate([[0.0], np.cumsum(speed * np.diff(grid))])
         return grid, cumulative
 
-    def moving_travel(self, ta: Any, tb: Any) -> np.ndarray:
+    def moving_travel(self, ta: ArrayLike, tb: ArrayLike) -> np.ndarray:
         """Bound [m] of how far any point of the moving arms travels between cell times ``ta`` and ``tb``."""
         I = np.interp(np.asarray(tb, dtype=float), self._travel_t, self._travel_i)
         return np.abs(I - np.interp(np.asarray(ta, dtype=float), self._travel_t, self._travel_i))
@@ -236,7 +237,7 @@ class MotionChecker(CoalBatches, LadderProof):
         q = self.cell.random_q(3, seed=0)
         return bool(np.array_equal(self.cell.robot.q_to_pinocchio(q), q))
 
-    def full(self, X: Any) -> np.ndarray:
+    def full(self, X: ArrayLike) -> np.ndarray:
         """Cell configurations ``(N, nq)`` for planned states ``X (N, n[+1])`` (time last when timed)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         Q = np.tile(self.hold, (X.shape[0], 1))
@@ -252,7 +253,7 @@ class MotionChecker(CoalBatches, LadderProof):
         return np.all((X[:, : self.n] >= self.lower - 1e-12) & (X[:, : self.n] <= self.upper + 1e-12), axis=1)
 
     # ------------------------------------------------------------------ states
-    def state_valid(self, x: Any) -> bool:
+    def state_valid(self, x: ArrayLike) -> bool:
         """One planned state: within the limits and every pair at least its margin apart."""
         x = np.asarray(x, dtype=float)
         self.counts["states"] += 1
@@ -305,7 +306,7 @@ class MotionChecker(CoalBatches, LadderProof):
             out[i], arg[i], dist[i] = best, k_best, d_best
         return out, arg, dist
 
-    def closest(self, x: Any) -> tuple[float, Any, float]:
+    def closest(self, x: ArrayLike) -> tuple[float, Any, float]:
         """``(excess [m], pair, distance [m])`` of the pair nearest its margin at state ``x``."""
         e, k, d = self.excess(self.full(np.asarray(x, dtype=float)[None]))
         return float(e[0]), (self.pairs[int(k[0])] if k[0] >= 0 else None), float(d[0])
@@ -315,7 +316,7 @@ class MotionChecker(CoalBatches, LadderProof):
         """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
-    def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
+    def edge_samples(self, xa: ArrayLike, xb: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
         X, budgets, _ = self._edge_samples(xa, xb, 0)
         return X, budgets
@@ -330,7 +331,7 @@ class MotionChecker(CoalBatches, LadderProof):
         f = np.arange(n + 1) / n
         return xa + f[:, None] * (xb - xa), np.full(n, T / n), -k
 
-    def edge_valid(self, xa: Any, xb: Any) -> Verdict:
+    def edge_valid(self, xa: ArrayLike, xb: ArrayLike) -> Verdict:
         """Whether the straight joint-space edge ``xa → xb`` keeps every margin everywhere (module docstring)."""
         if self.timed:
             raise InvalidInput("straight edges are checked with the other arms held; a moving arm is checked "

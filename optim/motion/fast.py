@@ -29,6 +29,7 @@ import time
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
@@ -144,17 +145,17 @@ class FastCheck:
             self._trees = (np.zeros((2, TREE_NODES, n)), np.full((2, TREE_NODES), -1, dtype=np.int64))
         return self._trees
 
-    def excess(self, x: Any) -> float:
+    def excess(self, x: ArrayLike) -> float:
         """The cover's lower bound of ``E`` [m] at planned state ``x`` (capped; below 0: not proven)."""
         return float(kernel.state_excess(np.ascontiguousarray(x, dtype=float), self.hold, self.cols, self.fk, self.cov,
                                          self.grp, self.cap, self.work, self._q))
 
-    def state_proven(self, x: Any) -> bool:
+    def state_proven(self, x: ArrayLike) -> bool:
         """Whether the cover proves state ``x`` clear of every margin (and ``x`` is within the joint limits)."""
         x = np.asarray(x, dtype=float)
         return bool(self.checker.within_limits(x[None])[0]) and self.excess(x) >= 0.0
 
-    def edge_proven(self, xa: Any, xb: Any) -> bool:
+    def edge_proven(self, xa: ArrayLike, xb: ArrayLike) -> bool:
         """Whether the cover proves the straight edge ``xa → xb`` clear of every margin (ends within the limits)."""
         xa = np.ascontiguousarray(xa, dtype=float)
         xb = np.ascontiguousarray(xb, dtype=float)
@@ -162,7 +163,7 @@ class FastCheck:
             return False
         return bool(kernel.edge_proven(xa, xb, *self.args, self._q, self._xm, self._queue, self._inv))
 
-    def path_proven(self, P: Any) -> bool:
+    def path_proven(self, P: ArrayLike) -> bool:
         """Whether the cover proves every edge of the polyline ``P (M, n)``."""
         P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
         if not self.checker.within_limits(P).all():

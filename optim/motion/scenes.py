@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.errors import CellNotFound, InvalidInput, UnreachableTarget
 
@@ -149,7 +150,7 @@ def load_scene(name: str) -> Any:
     return robots.load_cell(scene_path(name), packages=example_packages())
 
 
-def region_pose(region: Region, point: Any, yaw: float = 0.0) -> np.ndarray:
+def region_pose(region: Region, point: ArrayLike, yaw: float = 0.0) -> np.ndarray:
     """Tool pose (4, 4) in the world at ``point`` [m] with the region's approach, turned by ``yaw`` [rad]."""
     p = np.asarray(point, dtype=float)
     if region.approach == "down":

@@ -21,6 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInput
 
@@ -34,7 +35,7 @@ CHUNK = 16384
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
 
-def position_dexterity(Jv: Any) -> tuple[np.ndarray, np.ndarray]:
+def position_dexterity(Jv: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Manipulability and inverse condition of position Jacobians ``J_v (N, 3, nq)``.
 
     Returns ``(w, c)``: ``w = sqrt(det(J_v J_vᵀ))`` (``sqrt(det(J_vᵀ J_v))`` when

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInput, ModelError
 from .orientations import _align, _rotation_about
@@ -56,7 +57,7 @@ _BLOCK = 250_000
 _DOWN = np.array([0.0, 0.0, -1.0])
 
 
-def tool_down_poses(points: Any, tool_axis: Any = (0.0, 0.0, 1.0)) -> np.ndarray:
+def tool_down_poses(points: ArrayLike, tool_axis: ArrayLike = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Task poses ``(N, 4, 4)`` at ``points (N, 3)`` [m] with ``tool_axis`` (tool frame) pointing straight down.
 
     Roll zero as in :func:`robots.reach.orientations.tool_axis_orientations` (a fixed rotation taking

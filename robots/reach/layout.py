@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInput, UnreachableTarget
 from ..so3 import rot_z as _rot_z
@@ -208,10 +209,10 @@ def _numerical_solutions(robot: "Robot", T: np.ndarray, n_seeds: int, seed: int,
 
 def check_layout(
     robot: "Robot",
-    points: Any,
+    points: ArrayLike,
     *,
     names: Any = None,
-    orientation: Any = None,
+    orientation: ArrayLike | None = None,
     workspace: Workspace | None = None,
     voxel_size: float | None = None,
     n_seeds: int = 8,

@@ -59,6 +59,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._checks import check_restarts
 from ..errors import InvalidInput, ModelError
@@ -95,7 +96,7 @@ def reachability_map(
     *,
     tool_down: float | None = None,
     roll_steps: int = 8,
-    tool_axis: Any = None,
+    tool_axis: ArrayLike | None = None,
     ik: str = "auto",
     manipulability: str = "full",
     restarts: int = 2,

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInput
 from .workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
@@ -81,7 +82,7 @@ class RecommendedRegion:
         """True when no shell met the criteria."""
         return not np.isfinite(self.r_inner)
 
-    def contains(self, points: Any) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         """``(N,)`` bool: which ``points (N, 3)`` [m] lie in the region."""
         P = np.atleast_2d(np.asarray(points, dtype=float))
         if P.ndim != 2 or P.shape[1] != 3:
@@ -120,7 +121,7 @@ def recommend_region(
     workspace: "Workspace",
     *,
     about: str = "centre",
-    origin: Any = None,
+    origin: ArrayLike | None = None,
     width: float = 0.025,
     side: str = "auto",
     z_clearance: float = 0.0,

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInput
 from ..robot import MAX_RANDOM_SAMPLES
@@ -196,7 +197,7 @@ class Workspace:
 
     def radial_profile(
         self,
-        origin: Any = None,
+        origin: ArrayLike | None = None,
         *,
         about: str = "centre",
         width: float = 0.025,
