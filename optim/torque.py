@@ -12,7 +12,7 @@ exists (:class:`InfeasibleProblem` names the joint and the instant).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,13 +21,17 @@ from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit, path_static_check, static_check
 from pinarms.planning.torque import JointTorqueConstraint
 
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
+    from pinarms.robots.payload import Payload
+
 __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static_check"]
 
 #: The former name of :class:`planning.JointTorqueConstraint` in segment timing.
 TorqueConstraint = JointTorqueConstraint
 
 
-def torque_constraint(robot: Any, torque_limits: ArrayLike, payload: Any = None,
+def torque_constraint(robot: Robot, torque_limits: ArrayLike, payload: Payload | None = None,
                       samples_per_piece: int | None = None) -> JointTorqueConstraint | None:
     """The :class:`planning.JointTorqueConstraint` asked for by ``minimize_time``/``plan_cycle`` keywords, or None.
 

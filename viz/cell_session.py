@@ -20,7 +20,7 @@ from pinarms.robots.errors import InvalidInput
 __all__ = ["add_cell"]
 
 
-def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
+def add_cell(session: Any, cell: Cell, *, key: str | None = None, motions: Any = None, check: Any = None,
              name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
     """Add ``cell`` to ``session`` (:meth:`viz.Session.add_cell` says how); return its robot key."""
     if not isinstance(cell, Cell):

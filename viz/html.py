@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import io
 from pathlib import Path
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 from pinarms.files import atomic_write
 
@@ -13,10 +13,13 @@ from .page import with_page
 from .scene import SceneInfo, build_scene
 from .server import MeshcatServer
 
+if TYPE_CHECKING:
+    from .session import Session
+
 __all__ = ["export_html", "scene_html"]
 
 
-def scene_html(session: Any, **scene_options: Any) -> tuple[str, SceneInfo]:
+def scene_html(session: Session, **scene_options: Any) -> tuple[str, SceneInfo]:
     """The session's scene as one self-contained HTML page, and what was drawn.
 
     A MeshCat server runs for a moment (MeshCat replays its scene tree into the page);
@@ -28,7 +31,7 @@ def scene_html(session: Any, **scene_options: Any) -> tuple[str, SceneInfo]:
     return with_page(html, info.page["title"]), info
 
 
-def export_html(session: Any, path: str | Path, **scene_options: Any) -> Path:
+def export_html(session: Session, path: str | Path, **scene_options: Any) -> Path:
     """Write the session's scene as one self-contained HTML file (opens offline); return the path.
 
     The page holds MeshCat's JavaScript, the geometry, the clouds, the paths and the

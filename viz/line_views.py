@@ -16,7 +16,7 @@ from .session import Session
 __all__ = ["save_line_views"]
 
 
-def save_line_views(spec: Any, result: Any, *, session: Any = None, html: Any = None, schedule: Any = None,
+def save_line_views(spec: Any, result: Any, *, session: Session | None = None, html: Any = None, schedule: Any = None,
                     title: str | None = None, run: int = 0, duration: float = DEFAULT_WINDOW_S) -> list:
     """Write what a line engineer looks at: the session (``.pinarms``), its standalone page
     (``.html``) and the schedule plot (``.png``/``.svg``) of run ``run``, window [0, ``duration``] s

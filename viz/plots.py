@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -29,6 +29,10 @@ from .cell_plots import plot_clearance, plot_schedule
 from .figure_files import checked_numbers, save_figure
 from .reach_plots import plot_workspace
 from .search_plots import plot_ga_convergence, plot_layout_search
+
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.robot import Robot
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
            "plot_clearance", "plot_schedule", "plot_torques",
@@ -90,7 +94,7 @@ def plot_joint_curves(
     *,
     knot_times: ArrayLike | None = None,
     limits: Any = None,
-    robot: Any = None,
+    robot: Robot | None = None,
     joint_names: Sequence[str] | None = None,
     joint_units: Sequence[str] | None = None,
     degrees: bool = False,
@@ -203,7 +207,7 @@ def _draw_limits(ax: Any, lim: np.ndarray, names: list[str], units: list[str], c
                     xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=c)
 
 
-def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
+def plot_trajectory(path: str | Path, trajectory: Trajectory, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
     """:func:`plot_joint_curves` of a ``planning.Trajectory`` (sampled at ``samples`` instants plus its knots)."""
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
         raise InvalidInput(f"samples must be an integer >= 2 (instants drawn), got {samples!r}")

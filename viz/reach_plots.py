@@ -14,7 +14,7 @@ region), the shape the paper gives.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -26,10 +26,13 @@ from pinarms.robots.errors import InvalidInput
 from .figure_files import checked_numbers, save_figure
 from .reach_scene import INDEX_COLORMAP
 
+if TYPE_CHECKING:
+    from pinarms.robots.reach.reach_map import ReachabilityMap
+
 __all__ = ["plot_workspace", "plot_reachability_section", "section_index"]
 
 
-def section_index(reach_map: Any, cell: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def section_index(reach_map: ReachabilityMap, cell: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(rho_edges (a+1,), z_edges (b+1,), mean_index (a, b))`` [m] of the map over ``(ρ, z)`` cells of edge ``cell``.
 
     ``ρ`` is the horizontal distance of a voxel centre from the base's vertical axis; cells
@@ -56,7 +59,7 @@ def section_index(reach_map: Any, cell: float | None = None) -> tuple[np.ndarray
 
 def plot_reachability_section(
     path: str | Path,
-    reach_map: Any,
+    reach_map: ReachabilityMap,
     *,
     band: dict | None = None,
     title: str = "",

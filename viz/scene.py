@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -41,6 +41,9 @@ from .page import PAGE_PROPERTY
 from .robot_drawing import RobotDrawing
 from .shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
 from .trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
+
+if TYPE_CHECKING:
+    from .session import Session
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
@@ -101,7 +104,7 @@ def _sphere_set(vis: meshcat.Visualizer, base: str, points: np.ndarray, radius: 
 
 def build_scene(
     vis: meshcat.Visualizer,
-    session: Any,
+    session: Session,
     *,
     animate: Sequence[str] | None = None,
     fps: float = 30.0,

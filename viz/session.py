@@ -25,7 +25,7 @@ import os
 import threading
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -57,6 +57,11 @@ from .session_records import (
 )
 from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.reach.reach_map import ReachabilityMap
 
 __all__ = [
     "FORMAT_NAME",
@@ -197,7 +202,7 @@ class Session:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
         return name
 
-    def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
+    def add_cell(self, cell: Cell, *, key: str | None = None, motions: Any = None, check: Any = None,
                  name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
         """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
@@ -255,7 +260,7 @@ class Session:
         self.objects[box.name] = box
         return box
 
-    def add_trajectory(self, name: str, trajectory: Any, *, robot: str | None = None, hz: float = 100.0) -> TrajectoryRecord:
+    def add_trajectory(self, name: str, trajectory: Trajectory, *, robot: str | None = None, hz: float = 100.0) -> TrajectoryRecord:
         """Add a trajectory of robot ``robot`` (default: the only robot).
 
         Args:
@@ -302,7 +307,7 @@ class Session:
         self.histories[rec.name] = rec
         return rec
 
-    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+    def add_reachability(self, name: str, reach_map: ReachabilityMap, *, robot: str | None = None, min_index: float = 0.0) -> Any:
         """Add the voxels of a :class:`robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
 
         The viewer and the standalone page draw them as coloured voxels (see :mod:`viz.reach_record`).

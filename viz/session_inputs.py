@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -20,6 +20,9 @@ from pinarms.robots.errors import InvalidInput
 
 from .session_archive import F8
 from .session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
+
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["MAX_TRAJECTORY_SAMPLES", "json_normalised", "real_array", "float_array", "pose_array", "box_record",
            "trajectory_record", "workspace_record", "history_record"]
@@ -84,7 +87,7 @@ def box_record(name: str, size: Any, pose: ArrayLike, color: Any) -> BoxObject:
     return BoxObject(name, size_arr, pose_array(pose, f"pose of box {name!r}"), rgba)
 
 
-def trajectory_record(name: str, entry: RobotEntry, trajectory: Any, hz: float) -> TrajectoryRecord:
+def trajectory_record(name: str, entry: RobotEntry, trajectory: Trajectory, hz: float) -> TrajectoryRecord:
     """The trajectory ``name`` of robot ``entry``: a ``planning.Trajectory`` sampled at ``hz``, or a ``(t, q)`` pair."""
     if isinstance(trajectory, tuple) and len(trajectory) == 2:
         t, q = trajectory

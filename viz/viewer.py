@@ -8,10 +8,13 @@
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 from .scene import SceneInfo, build_scene
 from .server import MeshcatServer
+
+if TYPE_CHECKING:
+    from .session import Session
 
 __all__ = ["Viewer", "show"]
 
@@ -36,7 +39,7 @@ class Viewer(MeshcatServer):
             self.close()
 
 
-def show(session: Any, port: int | None = None, open_browser: bool = False, wait: bool = False,
+def show(session: Session, port: int | None = None, open_browser: bool = False, wait: bool = False,
          **scene_options: Any) -> Viewer:
     """Start MeshCat on 127.0.0.1 and show ``session``; return the running :class:`Viewer`.
 

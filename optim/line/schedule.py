@@ -21,7 +21,7 @@ over one period, for the schedule plot.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping, NamedTuple
+from typing import Any, Mapping, NamedTuple, TYPE_CHECKING
 
 import numpy as np
 
@@ -29,6 +29,9 @@ from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS,
                                number_setting)
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["LineSchedule", "schedule_line"]
 
@@ -145,7 +148,7 @@ def _busy_intervals(cell: Any, motions: list, period: float) -> dict[str, list[t
 
 
 def schedule_line(
-    cell: Any,
+    cell: Cell,
     cycles: Mapping[str, Any],
     *,
     clearance: float = 0.0,

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -55,6 +55,9 @@ from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_th
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 #: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
 #: :meth:`MotionChecker.trajectory_valid` (the rounding of a time scaling's re-expanded
@@ -111,7 +114,7 @@ class MotionChecker(CoalBatches, LadderProof):
         InvalidInput: an unknown arm, a bad hold configuration or margins.
     """
 
-    def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
+    def __init__(self, cell: Cell, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
                  threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
@@ -355,7 +358,7 @@ class MotionChecker(CoalBatches, LadderProof):
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
 
-    def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
+    def trajectory_valid(self, trajectory: Trajectory, t0: float = 0.0, until: float | None = None) -> Verdict:
         """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,
         against the moving arms at the same instants (and the fixtures, the held arms).
 

@@ -14,13 +14,16 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
            "set_margins"]
@@ -350,7 +353,7 @@ def check_threads(threads: Any) -> int:
 _SHARED_LOCK = threading.Lock()
 
 
-def shared_coal(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
+def shared_coal(cell: Cell, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
     """coal data (geometry copy, GeometryData, broad phase, batch pools per screen level) shared by
     the checkers of one cell with the same pairs, margins and thread count, made in the same
     thread: making them costs tens of ms per checker (cold-starting every request)."""

@@ -26,7 +26,7 @@ still proves it again with the exact checker before reporting it.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -37,6 +37,9 @@ from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.robots.cell._cover_kernel import _place
 from pinarms.robots.cell.cover import motion_pairs, pair_arrays
 from pinarms.optim.motion.search import SearchResult
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
 
 __all__ = ["FastCheck", "fast_check", "fast_search", "fast_shortcut", "COMPILED_PLANNER", "TREE_NODES"]
 
@@ -87,7 +90,7 @@ class FastCheck:
             trajectories (their checks stay with :meth:`MotionChecker.trajectory_valid`).
     """
 
-    def __init__(self, checker: Any, reach: float | None = None, max_states: int | None = None) -> None:
+    def __init__(self, checker: MotionChecker, reach: float | None = None, max_states: int | None = None) -> None:
         if checker.cover is None or checker.timed:
             raise ValueError("the compiled check needs a checker with the sphere cover and no moving arms")
         cover = checker.cover
@@ -171,7 +174,7 @@ class FastCheck:
         return bool(kernel.path_proven(P, *self.args))
 
 
-def fast_check(checker: Any) -> FastCheck | None:
+def fast_check(checker: MotionChecker) -> FastCheck | None:
     """The :class:`FastCheck` of ``checker`` (kept with it), or ``None`` when it has none (no cover, moving arms)."""
     got = getattr(checker, "_fast", False)
     if got is False:
@@ -205,7 +208,7 @@ def _rng(seed: int) -> np.ndarray:
     return np.array([(int(seed) * 0x9E3779B97F4A7C15 + 0x2545F4914F6CDD1D) % (1 << 64)], dtype=np.uint64)
 
 
-def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0, seed: int = 0,
+def fast_search(checker: MotionChecker, start: Any, goals: Any, *, time_limit: float = 1.0, seed: int = 0,
                 planner_range: float | None = None) -> SearchResult:
     """RRT-Connect from ``start (n,)`` to any of ``goals (G, n)`` on the compiled cover check.
 
@@ -298,7 +301,7 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:
     return np.array(rows)
 
 
-def fast_shortcut(checker: Any, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
+def fast_shortcut(checker: MotionChecker, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
     """Random shortcutting of the cover-proven polyline ``path (M, n)`` on the compiled check (seeded;
     ``tries`` default: 16 and 2 per vertex; a try gaining less than :data:`SHORTCUT_GAIN` of the length is
     skipped), then every vertex dropped whose neighbours join."""

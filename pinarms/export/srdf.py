@@ -31,11 +31,14 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "home_notes", "cycle_states"]
 
@@ -53,13 +56,13 @@ SRDF_REASON = {
 _STATE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
 
 
-def contact_pairs(cell: Any) -> tuple:
+def contact_pairs(cell: Cell) -> tuple:
     """The pairs a contact check of ``cell`` looks at (``cell.pairs_for(0.0)``, or ``cell.pairs``)."""
     pairs_for = getattr(cell, "pairs_for", None)
     return tuple(pairs_for(0.0)) if callable(pairs_for) else tuple(cell.pairs)
 
 
-def geometry_links(cell: Any) -> dict[str, str]:
+def geometry_links(cell: Cell) -> dict[str, str]:
     """``{geometry name: exported link}``: the k-th collision of link ``L`` is link ``L_collision_k`` (k ≥ 1)."""
     out: dict[str, str] = {}
     count: dict[str, int] = {}
@@ -146,12 +149,12 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[
     return out, notes
 
 
-def home_notes(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
+def home_notes(cell: Cell, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
     """Why :func:`srdf_text` writes no home for an arm (its limits exclude the all-zero pose and no home is given)."""
     return tuple(_states(cell, states)[1])
 
 
-def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
+def srdf_text(cell: Cell, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
     """The SRDF of ``cell`` (a :class:`pinarms.robots.cell.Cell`) against its exported URDF's links.
 
     Args:

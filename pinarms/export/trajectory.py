@@ -34,7 +34,7 @@ import math
 import os
 import re
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, TYPE_CHECKING
 
 import numpy as np
 
@@ -43,6 +43,9 @@ from pinarms.files import atomic_write
 
 from .acceleration_check import acceleration_limits_of, flag_accelerations
 from .errors import InvalidJointName, InvalidRate, JointMismatch
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
            "line_arm_sampler", "check_joint_names", "ROS_NAME"]
@@ -164,7 +167,7 @@ def _check_width(n: int, robot: Any, what: str) -> None:
                             f"({', '.join(robot.joint_names)}): write it for the robot it was planned for")
 
 
-def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: str | None = None,
+def controller_trajectory(source: Any, rate: float, *, robot: Robot | None = None, arm: str | None = None,
                           cycles: Mapping[str, Any] | None = None) -> ControllerTrajectory:
     """Sample ``source`` at ``rate`` [Hz] for a controller (module doc).
 
