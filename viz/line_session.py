@@ -142,7 +142,8 @@ def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float
     ends = [w.u_max for w in getattr(result, "windows", ())] or [belt.length]
     u_miss = float(min(belt.length, max(ends) + belt.speed * spec.tracking.track_time))
     thickness = max(0.05, 1.25 * max(max(tp.size) for tp in items.types))
-    rec = make_line(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world, length=belt.length,
-                    width=belt.width, thickness=thickness, speed=belt.speed, u_miss=u_miss, duration=dur, items=rows)
+    rec = make_line(LineRecord(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world,
+                               length=belt.length, width=belt.width, thickness=thickness, speed=belt.speed,
+                               u_miss=u_miss, duration=dur, items=rows))
     session.lines[rec.name] = rec
     return rec
