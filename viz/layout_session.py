@@ -9,7 +9,7 @@ robot's base frame as clouds are), and the picks and places are target points (l
 
 from __future__ import annotations
 
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,13 +18,14 @@ from pinarms.robots.errors import InvalidInput
 from .session import Session
 
 if TYPE_CHECKING:
+    from pinarms.optim.layout.result import LayoutSearch
     from pinarms.robots.cell.cell import Cell
     from pinarms.robots.robot import Robot
 
 __all__ = ["layout_search_session"]
 
 
-def layout_search_session(result: Any, robot: Robot, *, title: str | None = None, cell: Cell | None = None,
+def layout_search_session(result: LayoutSearch, robot: Robot, *, title: str | None = None, cell: Cell | None = None,
                           carry: tuple[str, ...] = ()) -> Session:
     """Session of a layout search of ``robot`` (see the module docstring).
 

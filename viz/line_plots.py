@@ -16,7 +16,7 @@ atomically) and return the path. Units: s, items/min, fractions shown in %.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -24,6 +24,10 @@ from matplotlib.figure import Figure
 from pinarms.robots.errors import InvalidInput
 
 from .plots import _save
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.api import LineResult
+    from pinarms.optim.line.simulate import SimResult
 
 __all__ = ["schedule_figure", "plot_line_schedule", "sizing_figure", "plot_line_sizing", "line_curve",
            "MAX_LABELLED_PICKS"]
@@ -47,7 +51,7 @@ def _run_of(result: Any, run: int) -> tuple[Any, float | None, float | None]:
     return result, None, None
 
 
-def schedule_figure(result: Any, *, run: int = 0, window: tuple[float, float] = (0.0, 60.0),
+def schedule_figure(result: LineResult | SimResult, *, run: int = 0, window: tuple[float, float] = (0.0, 60.0),
                     title: str | None = None) -> Figure:
     """The schedule of ``result`` (a :class:`optim.line.LineResult` or a :class:`SimResult`) over ``window`` [s].
 
@@ -96,7 +100,7 @@ def schedule_figure(result: Any, *, run: int = 0, window: tuple[float, float] = 
     return fig
 
 
-def plot_line_schedule(path: str | Path, result: Any, **options: Any) -> Path:
+def plot_line_schedule(path: str | Path, result: LineResult | SimResult, **options: Any) -> Path:
     """Write :func:`schedule_figure` of ``result`` to ``path`` (.png or .svg); return the path."""
     return _save(schedule_figure(result, **options), path)
 

@@ -19,13 +19,16 @@ Units: m, s, rad.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.robots.errors import InvalidInput, PinarmsError
 
 from .line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.api import LineResult, LineSpec
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
@@ -81,7 +84,7 @@ def _arm_samples(q_rest: np.ndarray, plans: list, t: np.ndarray) -> np.ndarray:
     return q
 
 
-def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float = 0.0,
+def add_line(session: Any, spec: LineSpec, result: LineResult, *, run: int = 0, start: float = 0.0,
              duration: float = DEFAULT_WINDOW_S, name: str = "line", hz: float = 30.0) -> LineRecord:
     """Add the window [``start``, ``start + duration``] s of run ``run`` of ``result`` (module doc).
 

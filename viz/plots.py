@@ -31,6 +31,7 @@ from .reach_plots import plot_workspace
 from .search_plots import plot_ga_convergence, plot_layout_search
 
 if TYPE_CHECKING:
+    from pinarms.planning.limits import JointLimits
     from pinarms.planning.trajectory import Trajectory
     from pinarms.robots.robot import Robot
 
@@ -93,7 +94,7 @@ def plot_joint_curves(
     qddd: ArrayLike | None = None,
     *,
     knot_times: ArrayLike | None = None,
-    limits: Any = None,
+    limits: JointLimits | None = None,
     robot: Robot | None = None,
     joint_names: Sequence[str] | None = None,
     joint_units: Sequence[str] | None = None,
@@ -207,7 +208,7 @@ def _draw_limits(ax: Any, lim: np.ndarray, names: list[str], units: list[str], c
                     xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=c)
 
 
-def plot_trajectory(path: str | Path, trajectory: Trajectory, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
+def plot_trajectory(path: str | Path, trajectory: Trajectory, *, limits: JointLimits | None = None, samples: int = 400, **options: Any) -> Path:
     """:func:`plot_joint_curves` of a ``planning.Trajectory`` (sampled at ``samples`` instants plus its knots)."""
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
         raise InvalidInput(f"samples must be an integer >= 2 (instants drawn), got {samples!r}")
@@ -218,7 +219,7 @@ def plot_trajectory(path: str | Path, trajectory: Trajectory, *, limits: Any = N
     return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=drawn, limits=limits, **options)
 
 
-def plot_tool_speed(path: str | Path, t: ArrayLike, speed: ArrayLike, *, limit: float | None = None, angular: Any = None,
+def plot_tool_speed(path: str | Path, t: ArrayLike, speed: ArrayLike, *, limit: float | None = None, angular: ArrayLike | None = None,
                     title: str = "tcp speed") -> Path:
     """The tcp's Cartesian speed versus time (e.g. from :func:`planning.tcp_speed`).
 
@@ -250,7 +251,7 @@ def plot_tool_speed(path: str | Path, t: ArrayLike, speed: ArrayLike, *, limit: 
     return save_figure(fig, path)
 
 
-def plot_torques(path: str | Path, t: ArrayLike, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
+def plot_torques(path: str | Path, t: ArrayLike, torques: ArrayLike, limits: JointLimits | None = None, *, joint_names: Sequence[str] | None = None,
                  units: Sequence[str] | None = None, series: Mapping[str, Any] | None = None, title: str = "joint torques") -> Path:
     """Joint torques against their limits: one panel per joint, ±limit dashed, peaks marked.
 

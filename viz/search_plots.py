@@ -7,7 +7,7 @@ atomically (:func:`viz.figure_files.save_figure`) and returns the path.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -16,6 +16,9 @@ from matplotlib.figure import Figure
 from pinarms.robots.errors import InvalidInput
 
 from .figure_files import checked_numbers, save_figure
+
+if TYPE_CHECKING:
+    from pinarms.optim.layout.result import LayoutSearch
 
 __all__ = ["plot_ga_convergence", "plot_layout_search"]
 
@@ -79,7 +82,7 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     return save_figure(fig, path)
 
 
-def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
+def plot_layout_search(path: str | Path, result: LayoutSearch, *, title: str | None = None, colormap: str = "viridis",
                        mm: bool = True) -> Path:
     """Picks per minute over the (x, y) placements of a layout search (:class:`optim.LayoutSearch`).
 

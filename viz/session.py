@@ -59,6 +59,7 @@ from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 if TYPE_CHECKING:
+    from pinarms.optim.line.api import LineResult, LineSpec
     from pinarms.robots.cell.cell import Cell
     from pinarms.planning.trajectory import Trajectory
     from pinarms.robots.reach.reach_map import ReachabilityMap
@@ -254,7 +255,7 @@ class Session:
         return q if q.shape == (nq,) and np.all(np.isfinite(q)) else None
 
     # ---------------------------------------------------------------- content
-    def add_box(self, name: str, size: Any, pose: ArrayLike | None = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
+    def add_box(self, name: str, size: ArrayLike, pose: ArrayLike | None = None, color: ArrayLike = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""
         box = box_record(self._free(self.objects, name, "object"), size, pose, color)
         self.objects[box.name] = box
@@ -319,7 +320,7 @@ class Session:
         self.reachability[name] = rec
         return rec
 
-    def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
+    def add_line(self, spec: LineSpec, result: LineResult, **options: Any) -> Any:
         """Add an animated window of a simulated belt line (:func:`viz.line_session.add_line`)."""
         from .line_session import add_line
 

@@ -39,7 +39,7 @@ def json_normalised(obj: Any, what: str) -> Any:
         raise InvalidInput(f"{what} must be JSON-able (dicts, lists, str, finite numbers, bool, None): {exc}") from exc
 
 
-def real_array(values: Any, what: str) -> np.ndarray:
+def real_array(values: ArrayLike, what: str) -> np.ndarray:
     """``values`` as a fresh float64 array; complex numbers and non-numbers raise InvalidInput."""
     try:
         if np.iscomplexobj(values):
@@ -49,7 +49,7 @@ def real_array(values: Any, what: str) -> np.ndarray:
         raise InvalidInput(f"{what} must be numbers (real), got {type(values).__name__}") from exc
 
 
-def float_array(values: Any, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
+def float_array(values: ArrayLike, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
     """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``); ±inf allowed on request."""
     arr = real_array(values, what)
     if arr.ndim != ndim or (width is not None and arr.shape[-1] != width):
@@ -61,7 +61,7 @@ def float_array(values: Any, what: str, ndim: int, width: int | None = None, *, 
     return arr
 
 
-def pose_array(values: Any, what: str) -> np.ndarray:
+def pose_array(values: ArrayLike, what: str) -> np.ndarray:
     """``values`` (default identity) as a read-only rigid transform (4, 4), or InvalidInput naming ``what``."""
     T = real_array(np.eye(4) if values is None else values, what)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
@@ -73,7 +73,7 @@ def pose_array(values: Any, what: str) -> np.ndarray:
     return T
 
 
-def box_record(name: str, size: Any, pose: ArrayLike, color: Any) -> BoxObject:
+def box_record(name: str, size: ArrayLike, pose: ArrayLike, color: ArrayLike) -> BoxObject:
     """The static box ``name``: ``size`` (3,) positive edge lengths in m, ``pose`` (4, 4), ``color`` RGBA in [0, 1]."""
     size_arr = float_array(size, f"size of box {name!r}", 1, 3)
     if np.any(size_arr <= 0):

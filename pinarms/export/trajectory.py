@@ -34,7 +34,7 @@ import math
 import os
 import re
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping, TYPE_CHECKING
+from typing import Any, Callable, Mapping, Sequence, TYPE_CHECKING
 
 import numpy as np
 
@@ -45,6 +45,7 @@ from .acceleration_check import acceleration_limits_of, flag_accelerations
 from .errors import InvalidJointName, InvalidRate, JointMismatch
 
 if TYPE_CHECKING:
+    from pinarms.optim.line.schedule import LineSchedule
     from pinarms.robots.robot import Robot
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
@@ -88,7 +89,7 @@ def _rate(rate: Any) -> float:
     return value
 
 
-def line_arm_sampler(schedule: Any, cycles: Mapping[str, Any], arm: str) -> tuple[float, float, Callable]:
+def line_arm_sampler(schedule: LineSchedule, cycles: Mapping[str, Any], arm: str) -> tuple[float, float, Callable]:
     """``(start, end, sample)`` of arm ``arm`` over one period of a line schedule (offset included)."""
     from pinarms.robots.cell import ArmMotion
 
@@ -215,7 +216,7 @@ def controller_trajectory(source: Any, rate: float, *, robot: Robot | None = Non
 ROS_NAME = re.compile(r"[A-Za-z/][A-Za-z0-9_/]{0,254}")
 
 
-def check_joint_names(names: Any) -> tuple[str, ...]:
+def check_joint_names(names: Sequence[str]) -> tuple[str, ...]:
     """``names`` as a tuple, each a ROS name (:data:`ROS_NAME`); else :class:`InvalidJointName` naming it."""
     out = tuple(names)
     for name in out:

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.robots.collision_requests import cold_start
@@ -178,7 +179,7 @@ def compare_in_mujoco(cell: Cell, source: Any, *, arm: str | None = None, cycles
     return _compare(cell, label, qs, mjcf, packages)
 
 
-def compare_configurations_in_mujoco(cell: Cell, qs: Any, *, label: str = "configurations",
+def compare_configurations_in_mujoco(cell: Cell, qs: ArrayLike, *, label: str = "configurations",
                                      mjcf: str | Path | None = None,
                                      packages: Mapping[str, str | Path] | None = None) -> EngineComparison:
     """Compare pinarms and MuJoCo at the cell configurations ``qs (N, nq)`` (module doc; ``samples`` = N).
