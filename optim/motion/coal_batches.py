@@ -154,7 +154,7 @@ class CoalBatches:
         return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
 
 
-    def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def batch_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
         margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
         stop at the first such row (the rows after it are then reported False). With
@@ -197,7 +197,7 @@ class CoalBatches:
             return np.ones(len(self.pairs))
         return np.minimum(self._pair_rows @ dx / T, 1.0)
 
-    def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+    def open_pairs(self, Q: np.ndarray, which: str | int = "margin") -> np.ndarray:
         """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
         cover (:meth:`robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
         threshold (``which``: the margins, or a screen level; :meth:`_thresholds`)."""
@@ -222,7 +222,7 @@ class CoalBatches:
         pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
         return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
-    def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def pair_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open
         (:meth:`open_pairs`); a configuration with none open is proven clear without coal. With ``stop``
         (or a deadline) a few configurations at a time, cover then coal, in their order (with ``stop`` 1, 2,
@@ -251,7 +251,7 @@ class CoalBatches:
                 break
         return out
 
-    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: configuration ``Q[i]`` closer than its threshold on one of the pairs ``want[i]``
         (``(N, P)`` bool) — coal on those pairs only, through Pinocchio's batch loop: the configurations
         with the same open pairs in one batch (``stop``: the rows after the first hit are reported False;
@@ -292,7 +292,7 @@ class CoalBatches:
             pool = self._pools["pairwise"] = self._make_pool("pairs", self.pair_margin)
         return pool
 
-    def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+    def covered(self, Q: np.ndarray, which: str | int = "margin") -> np.ndarray:
         """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
         or of the margins + ``step / 2^(L+1)`` (``which = L``); False: left to coal."""
         Q = np.atleast_2d(Q)
@@ -302,12 +302,12 @@ class CoalBatches:
         extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
         return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
 
-    def exact_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def exact_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` for configurations the cover did not prove as a whole: the per-pair route
         (:meth:`pair_collides`) with :attr:`pairwise`, else coal on every pair (:meth:`coal_collides`)."""
         return self.pair_collides(Q, which, stop) if self.pairwise else self.coal_collides(Q, which, stop)
 
-    def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def coal_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
         Q = np.atleast_2d(Q)
         self.counts["coal"] += Q.shape[0]

@@ -208,7 +208,7 @@ def _rng(seed: int) -> np.ndarray:
     return np.array([(int(seed) * 0x9E3779B97F4A7C15 + 0x2545F4914F6CDD1D) % (1 << 64)], dtype=np.uint64)
 
 
-def fast_search(checker: MotionChecker, start: Any, goals: Any, *, time_limit: float = 1.0, seed: int = 0,
+def fast_search(checker: MotionChecker, start: ArrayLike, goals: ArrayLike, *, time_limit: float = 1.0, seed: int = 0,
                 planner_range: float | None = None) -> SearchResult:
     """RRT-Connect from ``start (n,)`` to any of ``goals (G, n)`` on the compiled cover check.
 

@@ -44,7 +44,7 @@ jerk smoothing), :mod:`.time_law` (step 5 and the smoothing of the law).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -60,6 +60,9 @@ from pinarms.optim.topp.time_law import (acceleration_jumps, assemble, bang_bang
                                          smoothed)
 from pinarms.planning import Trajectory
 from pinarms.planning.path_constraints import PathConstraint, PathRows
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
 
 __all__ = ["PathTiming", "time_optimal", "time_scaled", "SHAPES", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
 
@@ -228,7 +231,7 @@ def _slowed(path: Any, tb: np.ndarray, C: np.ndarray, f: float) -> tuple[np.ndar
     return tb, C, Trajectory(tb, compose_law(path, tb, C))
 
 
-def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: ArrayLike | None = None, grid: int = 100,
+def time_optimal(path: JointPath, constraints: Sequence[PathConstraint], *, jerk: ArrayLike | None = None, grid: int = 100,
                  kappa: float = 0.02, start_speed: float = 0.0, end_speed: float = 0.0, rtol: float = 1e-3,
                  max_rounds: int = 8) -> PathTiming:
     """Time-optimal timing of ``path`` under ``constraints`` (module docstring).
@@ -275,7 +278,7 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Arra
     return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing), int(sum(r[4] for r in results)))
 
 
-def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
+def time_scaled(path: JointPath, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
                 samples: int = 2001) -> PathTiming:
     """The path timed by a fixed rest-to-rest shape ``s(t) = a + L σ(t / T)``, T as short as the limits allow.
 

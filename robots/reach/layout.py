@@ -33,7 +33,7 @@ whose last joint moves the tool point, e.g. the koji arm, whose wrist carries th
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -211,7 +211,7 @@ def check_layout(
     robot: "Robot",
     points: ArrayLike,
     *,
-    names: Any = None,
+    names: Sequence[str] | None = None,
     orientation: ArrayLike | None = None,
     workspace: Workspace | None = None,
     voxel_size: float | None = None,
