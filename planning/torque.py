@@ -36,6 +36,7 @@ from pinarms.planning.extrema import derivative_coefficients
 from pinarms.planning.path_constraints import PathConstraint, PathRows
 
 if TYPE_CHECKING:
+    from pinarms.planning.timed_curve import TimedCurve
     from pinarms.robots.robot import Robot
 
 __all__ = [
@@ -143,7 +144,7 @@ class TorquePeaks:
         return {"torque": self.torque.tolist(), "time": self.time.tolist(), "signed": self.signed.tolist()}
 
 
-def torques(trajectory: Any, robot: Robot, t: ArrayLike) -> np.ndarray:
+def torques(trajectory: TimedCurve, robot: Robot, t: ArrayLike) -> np.ndarray:
     """Joint torques [N·m or N] of ``robot`` following ``trajectory`` at instants ``t`` [s].
 
     Returns (len(t), nq), or (nq,) for a scalar ``t``. At an interior knot the piece that
@@ -155,7 +156,7 @@ def torques(trajectory: Any, robot: Robot, t: ArrayLike) -> np.ndarray:
 
 
 def piece_torque_peaks(
-    trajectory: Any, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE
+    trajectory: TimedCurve, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Refined peak of ``|tau_j|`` on every piece and joint (see the module docstring).
 
@@ -201,7 +202,7 @@ def piece_torque_peaks(
     return value.reshape(m, n), t_abs.reshape(m, n), signed.reshape(m, n)
 
 
-def torque_peaks(trajectory: Any, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE) -> TorquePeaks:
+def torque_peaks(trajectory: TimedCurve, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE) -> TorquePeaks:
     """Per-joint peaks of ``|tau|`` over the whole trajectory (module docstring: grid + refinement).
 
     Ties between pieces (equal peaks to the last bit) go to the earliest piece.
@@ -223,7 +224,7 @@ def check_torque_limit(limit: ArrayLike, n_joints: int) -> np.ndarray:
     return arr
 
 
-def torque_dilation(trajectory: Any, robot: Robot, limit: ArrayLike, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
+def torque_dilation(trajectory: TimedCurve, robot: Robot, limit: ArrayLike, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
     """Smallest uniform time dilation f >= 1 after which the refined torque peaks are within ``limit``.
 
     Scaling every duration by f leaves the path and the normalised instants unchanged and
@@ -330,7 +331,7 @@ class JointTorqueConstraint(PathConstraint):
         b = arm.inverse_dynamics(q, dq, ddq).reshape(q.shape) - g
         return PathRows(a, b, -L - g, L - g, tuple(f"torque of joint {j + 1}" for j in range(n)))
 
-    def exact_dilation(self, trajectory: Any) -> float:
+    def exact_dilation(self, trajectory: TimedCurve) -> float:
         """Uniform dilation making the timed trajectory's refined torque peaks meet the limits (:func:`torque_dilation`).
 
         1 with explicit ``columns`` (the rows are then checked densely by the timing).
@@ -375,7 +376,7 @@ class JointTorqueConstraint(PathConstraint):
         with np.errstate(divide="ignore"):
             return np.where(u > 0.0, 1.0 / np.sqrt(u), np.inf)
 
-    def refined_scale(self, trajectory: Any) -> float:
+    def refined_scale(self, trajectory: TimedCurve) -> float:
         """Factor (>= 1) on every duration that brings the *refined* torque peaks under the limits.
 
         The grid misses the exact peak by a hair; the refined peaks and the scaling law at
