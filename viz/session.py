@@ -59,6 +59,7 @@ from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 if TYPE_CHECKING:
+    from pinarms.robots.cell.motion_report import MotionCheck
     from pinarms.optim.line.api import LineResult, LineSpec
     from pinarms.robots.cell.cell import Cell
     from pinarms.planning.trajectory import Trajectory
@@ -203,8 +204,8 @@ class Session:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
         return name
 
-    def add_cell(self, cell: Cell, *, key: str | None = None, motions: Any = None, check: Any = None,
-                 name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
+    def add_cell(self, cell: Cell, *, key: str | None = None, motions: Any = None, check: MotionCheck | None = None,
+                 name: str = "cell motion", hz: float = 100.0, hold: ArrayLike | None = None) -> str:
         """Add a :class:`robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
         Args:

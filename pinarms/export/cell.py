@@ -39,6 +39,9 @@ from .urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
 from .srdf import geometry_links, home_notes, srdf_text
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from pinarms.robots.cell.cell import Cell
     from pinarms.robots.robot import Robot
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
@@ -185,8 +188,8 @@ def _load(cell_or_name: Any, packages: Mapping[str, str | os.PathLike] | None = 
     return cell
 
 
-def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
-                states: Mapping[str, Mapping[str, Any]] | None = None, overwrite: bool = False,
+def export_cell(cell_or_name: Cell | str | os.PathLike, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
+                states: Mapping[str, Mapping[str, ArrayLike]] | None = None, overwrite: bool = False,
                 packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """Write a whole cell (URDF + SRDF + MJCF + meshes) into ``out_dir`` (module doc).
 

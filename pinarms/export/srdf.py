@@ -34,10 +34,12 @@ import xml.etree.ElementTree as ET
 from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.errors import InvalidInput
 
 if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
     from pinarms.robots.cell.cell import Cell
 
 __all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "home_notes", "cycle_states"]
@@ -74,7 +76,7 @@ def geometry_links(cell: Cell) -> dict[str, str]:
     return out
 
 
-def cycle_states(cycle: Any) -> dict[str, np.ndarray]:
+def cycle_states(cycle: CycleResult) -> dict[str, np.ndarray]:
     """Named poses of a planned cycle (:class:`pinarms.optim.CycleResult`): its waypoints' joints, by label."""
     out: dict[str, np.ndarray] = {}
     for label, q in zip(cycle.names, np.asarray(cycle.q_via)):
@@ -107,7 +109,7 @@ def _zero_outside(arm: Any) -> str | None:
             f"[{float(lo[j])!r}, {float(hi[j])!r}]")
 
 
-def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
+def _states(cell: Any, states: Mapping[str, Mapping[str, ArrayLike]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
     """``([(state name, group, [(joint, value)])], notes)``: the homes, then the given states.
 
     A home the caller gives (``home``, or ``ARM_home`` in a cell of several arms) is written
@@ -149,12 +151,12 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[
     return out, notes
 
 
-def home_notes(cell: Cell, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
+def home_notes(cell: Cell, *, states: Mapping[str, Mapping[str, ArrayLike]] | None = None) -> tuple[str, ...]:
     """Why :func:`srdf_text` writes no home for an arm (its limits exclude the all-zero pose and no home is given)."""
     return tuple(_states(cell, states)[1])
 
 
-def srdf_text(cell: Cell, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
+def srdf_text(cell: Cell, *, states: Mapping[str, Mapping[str, ArrayLike]] | None = None) -> str:
     """The SRDF of ``cell`` (a :class:`pinarms.robots.cell.Cell`) against its exported URDF's links.
 
     Args:
