@@ -36,6 +36,7 @@ Units: m, rad; s in m (the tool path's weighted arc length).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Iterable, TYPE_CHECKING
 
 import numpy as np
@@ -55,7 +56,7 @@ from pinarms.robots.ties import argmin_tied
 if TYPE_CHECKING:
     from pinarms.robots.robot import Robot
 
-__all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
+__all__ = ["CartesianPath", "KnotFit", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
 
 #: Default largest tcp deviation from the tool path [m] (0.1 mm).
 DEFAULT_TOLERANCE = 1e-4
@@ -66,6 +67,42 @@ MIN_TOLERANCE = 1e-9  #: smallest tolerance [m]: a tighter one refines for minut
 _INITIAL_STEP = 0.1
 #: Check points of the tolerance rule, as fractions of an interval.
 _CHECKS = np.array([0.25, 0.5, 0.75])
+
+
+@dataclass(frozen=True)
+class KnotFit:
+    """What the continuation found at the knots of a :class:`CartesianPath` (its attributes of the same names).
+
+    Attributes:
+        q_knots: (K+1, nq) exact IK solutions at the knots (made read-only).
+        sigma_min: (K+1,) smallest singular value of the weighted Jacobian at the knots [m/rad] (made read-only).
+        branch: closed-form IK branch label of the whole path, or None (numerical IK).
+        max_deviation: (position [m], rotation [rad]) largest tcp deviation found at the check points.
+
+    Raises:
+        TrajectoryError: shapes that do not match, or a deviation that is not two finite numbers >= 0.
+    """
+
+    q_knots: np.ndarray
+    sigma_min: np.ndarray
+    branch: int | None
+    max_deviation: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        q = np.asarray(self.q_knots, dtype=float)
+        sigma = np.asarray(self.sigma_min, dtype=float)
+        if q.ndim != 2 or sigma.shape != (q.shape[0],):
+            raise TrajectoryError(f"KnotFit: q_knots must be (K+1, nq) and sigma_min (K+1,), "
+                                  f"got {q.shape} and {sigma.shape}")
+        dev = tuple(float(v) for v in self.max_deviation)
+        if len(dev) != 2 or not all(np.isfinite(v) and v >= 0.0 for v in dev):
+            raise TrajectoryError(f"KnotFit: max_deviation must be (position m, rotation rad), finite and >= 0, "
+                                  f"got {self.max_deviation!r}")
+        q.flags.writeable = False
+        sigma.flags.writeable = False
+        object.__setattr__(self, "q_knots", q)
+        object.__setattr__(self, "sigma_min", sigma)
+        object.__setattr__(self, "max_deviation", dev)
 
 
 class CartesianPath(JointPath):
@@ -81,17 +118,14 @@ class CartesianPath(JointPath):
     """
 
     def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Robot, frame: str,
-                 tolerance: float, q_knots: np.ndarray, sigma_min: np.ndarray, branch: int | None,
-                 max_deviation: tuple[float, float]) -> None:
+                 tolerance: float, fit: KnotFit) -> None:
         super().__init__(breaks, coefficients, stops=tool.stops, robot=robot, frame=frame)
         self.tool_path = tool
         self.tolerance = float(tolerance)
-        self.q_knots = q_knots
-        self.sigma_min = sigma_min
-        self.branch = branch
-        self.max_deviation = max_deviation
-        for arr in (self.q_knots, self.sigma_min):
-            arr.flags.writeable = False
+        self.q_knots = fit.q_knots
+        self.sigma_min = fit.sigma_min
+        self.branch = fit.branch
+        self.max_deviation = fit.max_deviation
 
     def deviation(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """tcp deviation at arc lengths ``s``: position [m] and rotation [rad] from the tool path at the same s."""
@@ -187,9 +221,9 @@ def _build(sv: PathSolver, q0: np.ndarray, tolerance: float, locate: float) -> C
         end = _labels(sv.robot, tool.pose(L), q[-1])
         if end is not None and end != branch:
             raise Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
-    return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance,
-                         q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
-                         max_deviation=(float(pos.max()), float(rot.max())))
+    fit = KnotFit(q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
+                  max_deviation=(float(pos.max()), float(rot.max())))
+    return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance, fit=fit)
 
 
 def _walked(sv: PathSolver, q0: np.ndarray, locate: float) -> list[Knot]:
