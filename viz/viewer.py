@@ -8,9 +8,10 @@
 from __future__ import annotations
 
 import time
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
 
 from .scene import SceneInfo, build_scene
+from .scene_options import SceneOptions
 from .server import MeshcatServer
 
 if TYPE_CHECKING:
@@ -40,7 +41,7 @@ class Viewer(MeshcatServer):
 
 
 def show(session: Session, port: int | None = None, open_browser: bool = False, wait: bool = False,
-         **scene_options: Any) -> Viewer:
+         options: SceneOptions | None = None) -> Viewer:
     """Start MeshCat on 127.0.0.1 and show ``session``; return the running :class:`Viewer`.
 
     Args:
@@ -48,14 +49,14 @@ def show(session: Session, port: int | None = None, open_browser: bool = False, 
         port: HTTP port (default: a free one).
         open_browser: open the page in the default web browser.
         wait: block until Ctrl+C, then stop the server (same as ``show(...).wait()``).
-        scene_options: passed to :func:`viz.scene.build_scene` (``animate``, ``fps``, ...).
+        options: a :class:`viz.scene_options.SceneOptions` for :func:`viz.scene.build_scene` (``animate``, ``fps``, ...).
 
     Stop it with ``viewer.close()`` or use it as a context manager; the server process is
     also stopped when the viewer is garbage-collected or Python exits.
     """
     viewer = Viewer(port)
     try:
-        viewer.scene = build_scene(viewer.visualizer, session, **scene_options)
+        viewer.scene = build_scene(viewer.visualizer, session, options)
     except BaseException:
         viewer.close()
         raise
