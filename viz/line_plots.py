@@ -26,7 +26,7 @@ from pinarms.robots.errors import InvalidInput
 from .plots import _save
 
 if TYPE_CHECKING:
-    from pinarms.optim.line.api import LineResult
+    from pinarms.optim.line.api import LineResult, LineSpec
     from pinarms.optim.line.simulate import SimResult
 
 __all__ = ["schedule_figure", "plot_line_schedule", "sizing_figure", "plot_line_sizing", "line_curve",
@@ -170,7 +170,7 @@ def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float
     return _save(sizing_figure(curves, **options), path)
 
 
-def line_curve(make_spec: Callable[[float], Any], values: Sequence[float], *, maps: Any = None,
+def line_curve(make_spec: Callable[[float], LineSpec], values: Sequence[float], *, maps: Any = None,
                scheduler: Any = None) -> tuple[list[float], list[Any]]:
     """``(values, [run_line(make_spec(v)) ...])``: one curve of :func:`sizing_figure`.
 

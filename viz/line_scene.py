@@ -19,13 +19,13 @@ few hundred items stays small.
 
 from __future__ import annotations
 
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._meshcat import mg
+from ._meshcat import meshcat, mg
 from .errors import ViewerError
-from .line_record import BOX_DEPTH, MISSED, NOT_DRAWN
+from .line_record import BOX_DEPTH, MISSED, NOT_DRAWN, LineRecord
 
 if TYPE_CHECKING:
     from .session import Session
@@ -41,7 +41,7 @@ def _to_world(T: np.ndarray, u: np.ndarray, w: np.ndarray, z: np.ndarray) -> np.
     return T[:3, 3] + u[..., None] * T[:3, 0] + w[..., None] * T[:3, 1] + z[..., None] * T[:3, 2]
 
 
-def draw_lines(vis: Any, session: Session, root: str, bounds: list) -> list[str]:
+def draw_lines(vis: meshcat.Visualizer, session: Session, root: str, bounds: list) -> list[str]:
     """Draw each line's belt and miss strip (static); return the page's summary lines. ``bounds`` grows."""
     lines = []
     for name, rec in getattr(session, "lines", {}).items():
@@ -66,7 +66,7 @@ def draw_lines(vis: Any, session: Session, root: str, bounds: list) -> list[str]
     return lines
 
 
-def item_positions(rec: Any, times: np.ndarray, tcp: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def item_positions(rec: LineRecord, times: np.ndarray, tcp: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """World centres (N, F, 3) of every item drawn normally and drawn red (missed) at ``times`` (F,) [s].
 
     ``tcp[k]`` (F, 3): arm ``k``'s tool point (world) at ``times``. Hidden items sit inside the belt.
@@ -113,7 +113,7 @@ def _kept(p: np.ndarray) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def animate_lines(vis: Any, anim: Any, session: Session, root: str, times: np.ndarray, animated: tuple[str, ...],
+def animate_lines(vis: meshcat.Visualizer, anim: meshcat.animation.Animation, session: Session, root: str, times: np.ndarray, animated: tuple[str, ...],
                   drawings: dict) -> None:
     """Draw each line's items and add their tracks to ``anim`` (frames at ``times`` (F,) [s])."""
     for name, rec in getattr(session, "lines", {}).items():

@@ -11,12 +11,12 @@ Controls panel lists them too.
 
 from __future__ import annotations
 
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
 
-from ._meshcat import mg
+from ._meshcat import meshcat, mg
 
 if TYPE_CHECKING:
     from .session import Session
@@ -36,7 +36,7 @@ def _transform(T: np.ndarray, p: np.ndarray) -> np.ndarray:
     return p @ T[:3, :3].T + T[:3, 3]
 
 
-def draw_reachability(vis: Any, session: Session, root: str, bounds: list) -> tuple[dict[str, list[str]], list[dict]]:
+def draw_reachability(vis: meshcat.Visualizer, session: Session, root: str, bounds: list) -> tuple[dict[str, list[str]], list[dict]]:
     """Draw every reachability record of ``session``.
 
     Returns ``name → layer paths`` (lowest layer first) and the page entries (``name``,

@@ -115,7 +115,7 @@ class MotionChecker(CoalBatches, LadderProof):
     """
 
     def __init__(self, cell: Cell, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
-                 hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
+                 hold: ArrayLike | None = None, moving: Sequence[TimedArm] = (), step: float | None = None,
                  threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -135,7 +135,7 @@ def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: 
     return found, last, LineCurve("arms", a[:, 0], *a[:, 1:].T)
 
 
-def max_flow(make_spec: Any, lo: float, hi: float, *, target: float = 0.01, steps: int = 8) -> float:
+def max_flow(make_spec: Callable[[float], LineSpec], lo: float, hi: float, *, target: float = 0.01, steps: int = 8) -> float:
     """Largest flow [items/min] in [lo, hi] with mean miss rate ≤ ``target`` (bisection)."""
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
