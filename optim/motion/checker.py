@@ -50,8 +50,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 import pinocchio as pin
 
+from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion import coal_batches
-from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
+from pinarms.optim.motion.coal_batches import (MAX_THREADS, CheckRoute, CoalBatches, check_threads, cold, set_margins,
+                                               shared_coal)
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
 from pinarms.robots.errors import InvalidInput
@@ -104,11 +106,9 @@ class MotionChecker(CoalBatches, LadderProof):
             with the time [s] and their configuration at that time is used.
         step: largest travel [m] of any point between two samples of an edge (default
             ``margin``).
-        threads: threads of Pinocchio's batch checks.
-        cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; the same
-            verdicts, coal only where the cover is inconclusive).
-        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal only on the
-            pairs the cover does not prove, not on every pair of a state it does not prove.
+        route: threads, sphere-cover screen and per-pair route of the checks
+            (:class:`.coal_batches.CheckRoute`; default ``CheckRoute()``: one thread, the cover,
+            the default route).
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
@@ -116,9 +116,12 @@ class MotionChecker(CoalBatches, LadderProof):
 
     def __init__(self, cell: Cell, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
                  hold: ArrayLike | None = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
+                 route: CheckRoute | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
+        route = CheckRoute() if route is None else route
+        if not isinstance(route, CheckRoute):
+            raise InvalidSettings(f"route must be a CheckRoute, got {type(route).__name__}")
         self.cell = cell
         names = [arms] if isinstance(arms, str) else list(arms)
         if not names or len(set(names)) != len(names):
@@ -163,7 +166,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self.pairs = tuple(chosen)
         self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
         self.model = cell.model
-        self.threads = check_threads(threads)
+        self.threads = route.threads
         self._data = self.model.createData()
         shared = shared_coal(cell, self.pairs, self.pair_margin, self.threads)
         if "geometry" not in shared:
@@ -190,10 +193,10 @@ class MotionChecker(CoalBatches, LadderProof):
         self.deadline: float | None = None
         #: The sphere cover screening every check (:mod:`robots.cell.cover`): what it proves clear is
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
-        self.cover = link_cover(cell) if cover else None
+        self.cover = link_cover(cell) if route.cover else None
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
         #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
-        self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
+        self.pairwise = bool(coal_batches.PAIRWISE if route.pairwise is None else route.pairwise) and self.cover is not None
         self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import dataclass
 from typing import Any, TYPE_CHECKING
 
 import numpy as np
@@ -25,7 +26,7 @@ from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
 if TYPE_CHECKING:
     from pinarms.robots.cell.cell import Cell
 
-__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
+__all__ = ["CoalBatches", "CheckRoute", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
            "set_margins"]
 
 #: Configurations per coal batch while a deadline runs (the clock is read between two).
@@ -337,6 +338,33 @@ class CoalBatches:
 MAX_THREADS = 256
 #: Checkers' coal data kept per cell (pairs, margins, threads, calling thread) before the oldest go.
 _SHARED_KEEP = 16
+
+
+@dataclass(frozen=True)
+class CheckRoute:
+    """How a :class:`pinarms.optim.motion.checker.MotionChecker` runs its checks (the verdicts are the same).
+
+    Attributes:
+        threads: threads of Pinocchio's batch checks (1 to :data:`MAX_THREADS`).
+        cover: screen every check on the sphere cover first (:mod:`robots.cell.cover`; coal only
+            where the cover is inconclusive).
+        pairwise: the per-pair route (``None``: :data:`PAIRWISE`, read when the checker is made):
+            coal only on the pairs the cover does not prove, not on every pair of a state it does not prove.
+
+    Raises:
+        InvalidSettings: a thread count out of range, ``cover`` or ``pairwise`` not a bool.
+    """
+
+    threads: int = 1
+    cover: bool = True
+    pairwise: bool | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "threads", check_threads(self.threads))
+        if not isinstance(self.cover, (bool, np.bool_)):
+            raise InvalidSettings(f"cover must be True or False, got {self.cover!r}")
+        if self.pairwise is not None and not isinstance(self.pairwise, (bool, np.bool_)):
+            raise InvalidSettings(f"pairwise must be True, False or None (the default route), got {self.pairwise!r}")
 
 
 def check_threads(threads: Any) -> int:
