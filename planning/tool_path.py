@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import BlendTooLarge, TrajectoryError
-from pinarms.planning.tool_pieces import Blend, Line
+from pinarms.planning.tool_pieces import Blend, BlendCorner, Line
 
 __all__ = ["ToolPath", "tool_path", "DEFAULT_WEIGHT"]
 
@@ -294,8 +294,8 @@ def _pieces(P: np.ndarray, seg: _Segments, r: np.ndarray, b: np.ndarray, arc: np
             s_now += piece.length
         if k + 1 < n - 1:
             if b[k + 1] > 0.0:
-                blend_piece = Blend(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]),
-                                     R[k + 1], phi[k], float(d[k]), phi[k + 1], float(d[k + 1]), w)
+                at = BlendCorner(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]))
+                blend_piece = Blend(at, R[k + 1], phi[k], float(d[k]), phi[k + 1], float(d[k + 1]), w)
                 pieces.append(blend_piece)
                 via_s[k + 1] = s_now + 0.5 * blend_piece.length
                 s_now += blend_piece.length
