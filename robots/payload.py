@@ -89,7 +89,7 @@ class Payload:
         }
 
     @classmethod
-    def from_dict(cls, data: Any) -> "Payload":
+    def from_dict(cls, data: object) -> "Payload":
         """Inverse of :meth:`as_dict` (checked like the constructor).
 
         Raises:

@@ -31,7 +31,7 @@ MAX_TRAJECTORY_SAMPLES = 2_000_000
 """Most samples :meth:`Session.add_trajectory` takes from a Trajectory (duration × hz)."""
 
 
-def json_normalised(obj: Any, what: str) -> Any:
+def json_normalised(obj: object, what: str) -> Any:
     """``obj`` as it will come back from JSON (tuples → lists); rejects NaN and non-JSON values."""
     try:
         return json.loads(json.dumps(obj, allow_nan=False, ensure_ascii=False).encode("utf-8"))

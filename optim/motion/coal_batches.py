@@ -367,7 +367,7 @@ class CheckRoute:
             raise InvalidSettings(f"pairwise must be True, False or None (the default route), got {self.pairwise!r}")
 
 
-def check_threads(threads: Any) -> int:
+def check_threads(threads: object) -> int:
     """``threads`` as an int in ``1..MAX_THREADS`` or :class:`InvalidSettings` (0 or fewer crash
     Pinocchio's batch loop; huge counts overflow its argument)."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):

@@ -7,7 +7,9 @@ a map holds and how it is computed), written and read by :mod:`robots.reach.reac
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -268,7 +270,7 @@ class ReachabilityMap:
             a[k].dtype == b[k].dtype and a[k].shape == b[k].shape and a[k].tobytes() == b[k].tobytes() for k in a
         )
 
-    def save(self, path: Any) -> Any:
+    def save(self, path: str | os.PathLike) -> Path:
         """Write the map to an HDF5 file (atomically; see :mod:`robots.reach.reach_io`); return the path."""
         from .reach_write import write_map
 
