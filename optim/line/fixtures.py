@@ -30,6 +30,7 @@ import numpy as np
 from pinarms.robots.errors import InvalidInput
 
 if TYPE_CHECKING:
+    from pinarms.optim.line.station import Station
     from pinarms.robots.cell.cell import Cell
 
 __all__ = ["FixtureCheck", "PairCheck", "CHORD", "chord_polyline", "fixture_check", "check_in_cell"]
@@ -135,7 +136,7 @@ class FixtureCheck:
 _CHECKS: dict = {}
 
 
-def check_in_cell(cell: Cell, station: Any) -> None:
+def check_in_cell(cell: Cell, station: Station) -> None:
     """InvalidInput unless ``station`` is an arm of ``cell`` (same name, same base)."""
     from pinarms.robots.errors import PinarmsError
 

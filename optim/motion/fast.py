@@ -301,7 +301,7 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:
     return np.array(rows)
 
 
-def fast_shortcut(checker: MotionChecker, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
+def fast_shortcut(checker: MotionChecker, path: ArrayLike, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
     """Random shortcutting of the cover-proven polyline ``path (M, n)`` on the compiled check (seeded;
     ``tries`` default: 16 and 2 per vertex; a try gaining less than :data:`SHORTCUT_GAIN` of the length is
     skipped), then every vertex dropped whose neighbours join."""
