@@ -21,7 +21,7 @@ over one period, for the schedule plot.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping, NamedTuple, TYPE_CHECKING
+from typing import Any, Callable, Mapping, NamedTuple, TYPE_CHECKING
 
 import numpy as np
 
@@ -155,7 +155,7 @@ def schedule_line(
     margin: float = 0.01,
     n_offsets: int = 24,
     hold: Any = None,
-    progress: Any = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> LineSchedule:
     """Time offsets for the arms of ``cell`` cycling together (module doc).
 

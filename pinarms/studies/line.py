@@ -74,7 +74,7 @@ def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
     return hashlib.sha256(repr(key).encode()).hexdigest()[:16]
 
 
-def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Any = None) -> dict:
+def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Callable[[str], None] | None = None) -> dict:
     """Task maps of every station of ``spec`` from :data:`DATA` (built when missing and ``build``).
     A spec with a cell gets maps built against the cell's fixtures (:func:`optim.line.build_maps`;
     not stored: they hold for that cell only)."""

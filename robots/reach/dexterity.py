@@ -18,7 +18,7 @@ from __future__ import annotations
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -90,7 +90,7 @@ def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]
 
 
 def positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = CHUNK, progress: Any = None, threads: int | None = None
+    robot: "Robot", q: np.ndarray, frame: str, chunk: int = CHUNK, progress: Callable[[int, int], None] | None = None, threads: int | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
 

@@ -73,6 +73,10 @@ from .robot_spec import RobotSpec, spec_of
 MAX_SEED_SAMPLES = 50_000_000
 
 if TYPE_CHECKING:  # pragma: no cover
+    import os
+
+    from distributed import Client
+
     from ..robot import Robot
 
 __all__ = [
@@ -104,11 +108,11 @@ def reachability_map(
     self_collision: bool = False,
     collision: Any = None,
     keep_solutions: bool = True,
-    out: Any = None,
+    out: str | os.PathLike | None = None,
     chunk_voxels: int | None = None,
     samples: int | None = None,
     seed: int = 0,
-    scheduler: Any = None,
+    scheduler: str | Client | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ReachabilityMap:
     """Build the reachability map of ``arm``'s tool frame (see the module doc).

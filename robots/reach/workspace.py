@@ -26,7 +26,7 @@ this one: table_band imports workspace, never the other way).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,6 +41,8 @@ from .sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-
 from .voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
+    from distributed import Client
+
     from ..robot import Robot
 
 __all__ = [
@@ -276,8 +278,8 @@ def sample_workspace(
     frame: str = "tcp",
     chunk: int = CHUNK,
     *,
-    scheduler: Any = None,
-    progress: Any = None,
+    scheduler: str | Client | None = None,
+    progress: Callable[[int, int], None] | None = None,
     task_samples: int = TASK_SAMPLES,
 ) -> Workspace:
     """Monte Carlo workspace: ``n`` joint vectors uniform within the limits, and their frame origins.

@@ -53,6 +53,8 @@ from .workspace import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
+    from distributed import Client
+
     from ..robot import Robot
 
 __all__ = [
@@ -182,7 +184,7 @@ def stream_workspace(
     grid: StreamGrid | None = None,
     task_samples: int = TASK_SAMPLES,
     block: int = _BLOCK,
-    scheduler: Any = None,
+    scheduler: str | Client | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> StreamedWorkspace:
     """Workspace statistics of ``n`` samples in flat memory (see the module docstring).
