@@ -26,6 +26,8 @@ from pinarms.robots.errors import InvalidInput
 from .plots import _save
 
 if TYPE_CHECKING:
+    from distributed import Client
+
     from pinarms.optim.line.api import LineResult, LineSpec
     from pinarms.optim.line.simulate import SimResult
 
@@ -121,7 +123,7 @@ def _band(result: Any) -> tuple[float, float, float, float, float, float]:
     return (*tp, float(fig.miss_rate), float(fig.miss_rate_ci[0]), float(fig.miss_rate_ci[1]))
 
 
-def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]], *, target_miss: float | None = 0.01,
+def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[LineResult]]], *, target_miss: float | None = 0.01,
                   title: str | None = None) -> Figure:
     """Throughput and miss rate against each swept quantity.
 
@@ -164,14 +166,14 @@ def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]], *
     return fig
 
 
-def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]],
+def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float], Sequence[LineResult]]],
                      **options: Any) -> Path:
     """Write :func:`sizing_figure` of ``curves`` to ``path`` (.png or .svg); return the path."""
     return _save(sizing_figure(curves, **options), path)
 
 
 def line_curve(make_spec: Callable[[float], LineSpec], values: Sequence[float], *, maps: Any = None,
-               scheduler: Any = None) -> tuple[list[float], list[Any]]:
+               scheduler: str | Client | None = None) -> tuple[list[float], list[Any]]:
     """``(values, [run_line(make_spec(v)) ...])``: one curve of :func:`sizing_figure`.
 
     ``maps``: task maps given to every run (``None``: each run builds its own), or a callable

@@ -7,23 +7,27 @@ atomically (:func:`viz.figure_files.save_figure`) and returns the path.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping, TYPE_CHECKING
+from typing import Mapping, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
 
 from pinarms.robots.errors import InvalidInput
 
 from .figure_files import checked_numbers, save_figure
 
 if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from .session_records import HistoryRecord
     from pinarms.optim.layout.result import LayoutSearch
 
 __all__ = ["plot_ga_convergence", "plot_layout_search"]
 
 
-def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
+def plot_ga_convergence(path: str | Path, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike], *,
+                        title: str = "GA convergence", ylabel: str = "objective") -> Path:
     """Best-so-far and mean objective per generation, and the feasible share when recorded.
 
     ``history``: a GA history (``best``, ``feasible_mean`` or ``mean``, optional

@@ -59,6 +59,8 @@ from .session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from .session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from pinarms.robots.reach.workspace import Workspace
     from pinarms.robots.cell.motion_report import MotionCheck
     from pinarms.optim.line.api import LineResult, LineSpec
     from pinarms.robots.cell.cell import Cell
@@ -110,7 +112,7 @@ class Session:
         robot: Robot | str | None = None,
         *,
         title: str = "",
-        metadata: Mapping[str, Any] | None = None,
+        metadata: Mapping[str, object] | None = None,
         base_to_world: ArrayLike | None = None,
         key: str | None = None,
     ) -> None:
@@ -275,7 +277,7 @@ class Session:
         self.trajectories[rec.name] = rec
         return rec
 
-    def add_workspace(self, name: str, workspace: Any = None, *, points: ArrayLike | None = None, manipulability: ArrayLike | None = None,
+    def add_workspace(self, name: str, workspace: Workspace | None = None, *, points: ArrayLike | None = None, manipulability: ArrayLike | None = None,
                       robot: str | None = None) -> WorkspaceRecord:
         """Add a workspace cloud of robot ``robot``: a ``Workspace`` (``points``, ``manipulability``) or the two arrays.
 
@@ -303,7 +305,7 @@ class Session:
         self.point_sets[name] = ps
         return ps
 
-    def add_history(self, name: str, history: Any) -> HistoryRecord:
+    def add_history(self, name: str, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike]) -> HistoryRecord:
         """Add an optimisation history: a GA history (``best``, ``mean``, ...), a result with ``.history``, or a mapping of columns."""
         rec = history_record(self._free(self.histories, name, "history"), history)
         self.histories[rec.name] = rec

@@ -22,6 +22,8 @@ from .session_archive import F8
 from .session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
 
 if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from pinarms.robots.reach.workspace import Workspace
     from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["MAX_TRAJECTORY_SAMPLES", "json_normalised", "real_array", "float_array", "pose_array", "box_record",
@@ -130,7 +132,7 @@ def _sampled(name: str, trajectory: Any, hz: float) -> tuple[np.ndarray, np.ndar
     return t, q, knots, definition
 
 
-def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: ArrayLike, manipulability: ArrayLike) -> WorkspaceRecord:
+def workspace_record(name: str, entry: RobotEntry, workspace: Workspace | None, points: ArrayLike, manipulability: ArrayLike) -> WorkspaceRecord:
     """The workspace cloud ``name`` of robot ``entry``: a ``Workspace``, or ``points`` (n, 3) and ``manipulability`` (n,)."""
     if workspace is not None:
         if not (hasattr(workspace, "points") and hasattr(workspace, "manipulability")):
@@ -151,7 +153,7 @@ def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: Array
     return WorkspaceRecord(name, entry.key, pts, w)
 
 
-def history_record(name: str, history: Any) -> HistoryRecord:
+def history_record(name: str, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike]) -> HistoryRecord:
     """The optimisation history ``name``: a GA history, a result with ``.history``, or a mapping of columns."""
     if hasattr(history, "history") and not isinstance(history, Mapping):
         history = history.history
