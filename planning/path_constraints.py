@@ -43,6 +43,7 @@ from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
 
 if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
     from pinarms.planning.timed_curve import TimedCurve
 
 __all__ = ["PathSamples", "PathRows", "PathConstraint", "JointVelocityConstraint", "JointAccelerationConstraint",
@@ -66,7 +67,7 @@ class PathSamples:
     side: str = "right"
 
     @classmethod
-    def of(cls, path: Any, s: ArrayLike, side: str = "right") -> "PathSamples":
+    def of(cls, path: JointPath, s: ArrayLike, side: str = "right") -> "PathSamples":
         """Sample ``path`` at ``s``."""
         arr = np.atleast_1d(np.asarray(s, dtype=float))
         q, dq, ddq = path.sample(arr, side)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -154,7 +154,7 @@ def _check_inertia(value: Any, mass: float) -> np.ndarray:
     return arr
 
 
-def as_payload(payload: Any, *, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Payload | None:
+def as_payload(payload: Payload | float | Mapping[str, object] | None, *, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Payload | None:
     """A :class:`Payload` from a mass [kg], a Payload, its dict form, or ``None`` (no payload).
 
     ``com``, ``inertia`` and ``frame`` apply when ``payload`` is a mass.
@@ -176,7 +176,7 @@ def as_payload(payload: Any, *, com: ArrayLike | None = None, inertia: ArrayLike
 
 
 
-def with_payload(robot: Any, mass: Any, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Any:
+def with_payload(robot: Any, mass: Payload | float, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Any:
     """A copy of ``robot`` carrying a payload; ``robot`` itself is unchanged.
 
     A payload replaces the one ``robot`` already carries (payloads do not stack); ``mass=0``

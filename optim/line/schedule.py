@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, NamedTuple, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting,
                                number_setting)
@@ -31,6 +32,7 @@ from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.robots.errors import InvalidInput
 
 if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
     from pinarms.robots.cell.cell import Cell
 
 __all__ = ["LineSchedule", "schedule_line"]
@@ -149,12 +151,12 @@ def _busy_intervals(cell: Any, motions: list, period: float) -> dict[str, list[t
 
 def schedule_line(
     cell: Cell,
-    cycles: Mapping[str, Any],
+    cycles: Mapping[str, CycleResult],
     *,
     clearance: float = 0.0,
     margin: float = 0.01,
     n_offsets: int = 24,
-    hold: Any = None,
+    hold: ArrayLike | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> LineSchedule:
     """Time offsets for the arms of ``cell`` cycling together (module doc).

@@ -234,7 +234,7 @@ def cell_of_urdf_folder(robot: Robot, folder: Path):
 
 
 def export_robot_with_srdf(robot: Robot, out_dir: str | os.PathLike, *, overwrite: bool = False,
-                           states: Mapping[str, Any] | None = None,
+                           states: Mapping[str, ArrayLike] | None = None,
                            packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """One arm as a folder with its URDF (one collision per link) and SRDF (one-arm cell rules)."""
     out = _check_folder(out_dir, overwrite)
