@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, TYPE_CHECKING
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
 
@@ -75,7 +75,7 @@ def study_states(cell: Cell) -> dict[str, dict[str, np.ndarray]]:
     raise InvalidInput(f"cell {cell.name!r} has no study poses; cells with them: {', '.join(STUDY_CELLS)}")
 
 
-def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Any = None) -> list[ShippedMotion]:
+def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Callable[[int, int], None] | None = None) -> list[ShippedMotion]:
     """Plan the shipped motions (about 10 s; ``line=False`` skips the mushroom line, 15 s more).
 
     ``progress(done, total)`` is called after each motion is planned.
