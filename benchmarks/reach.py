@@ -227,7 +227,7 @@ def memory() -> None:
 def station() -> None:
     from pinarms import optim, robots
     from pinarms.papers import SEED001
-    from pinarms.robots.reach.inverse_reach import base_placements, tool_down_poses
+    from pinarms.robots.reach.inverse_reach import IKCheck, base_placements, tool_down_poses
     from pinarms.robots.reach.reachability import reachability_map
 
     arm = robots.load("aubo_i3")
@@ -248,7 +248,7 @@ def station() -> None:
     t0 = time.perf_counter()
     chosen = []
     for z in heights:
-        bp = base_placements(m, tasks, robot=arm, z=z, yaw_step=2 * np.pi, verify=20)
+        bp = base_placements(m, tasks, z=z, yaw_step=2 * np.pi, check=IKCheck(arm, verify=20))
         chosen.append(bp.candidates[bp.verified][:20])
     cand = np.vstack(chosen)
     t_place = time.perf_counter() - t0

@@ -71,11 +71,11 @@ def child_layout(scheduler: str | None, quick: bool) -> dict:
 
 def child_workspace(scheduler: str | None, n: int) -> dict:
     from pinarms import robots
-    from pinarms.robots.reach.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import StreamGrid, stream_workspace
 
     arm = robots.load("aubo_i3")
     t0 = time.perf_counter()
-    s = stream_workspace(arm, n, seed=0, voxel_size=0.01, scheduler=scheduler)  # one grid for every n
+    s = stream_workspace(arm, n, seed=0, grid=StreamGrid(0.01), scheduler=scheduler)  # one grid for every n
     wall = time.perf_counter() - t0
     v = s.voxels
     return {"wall_s": wall, "n": n, "voxel_mm": v.voxel_size * 1000, "voxels": list(v.shape),

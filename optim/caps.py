@@ -12,7 +12,6 @@ Units: m, s.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
@@ -73,7 +72,7 @@ MAX_EXACT_ITERATIONS = 10_000
 MAX_POLISH_EVALUATIONS = 1_000_000
 
 
-def count_setting(value: Any, name: str, least: int, most: int) -> int:
+def count_setting(value: object, name: str, least: int, most: int) -> int:
     """``value`` as an int in ``[least, most]``; else :class:`SettingOutOfRange` naming ``name`` and the range."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise SettingOutOfRange(f"{name} must be an integer from {least} to {most:,}, got {value!r}")
@@ -83,7 +82,7 @@ def count_setting(value: Any, name: str, least: int, most: int) -> int:
     return int(value)
 
 
-def number_setting(value: Any, name: str, least: float, most: float = math.inf, *, unit: str = "",
+def number_setting(value: object, name: str, least: float, most: float = math.inf, *, unit: str = "",
                    open_low: bool = False) -> float:
     """``value`` as a finite float in ``[least, most]`` (``(least, most]`` with ``open_low``).
 

@@ -12,13 +12,18 @@ exists (:class:`InfeasibleProblem` names the joint and the instant).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.errors import InvalidLimits, InvalidSettings
 from pinarms.optim.ga.problem import check_limit, path_static_check, static_check
 from pinarms.planning.torque import JointTorqueConstraint
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
+    from pinarms.robots.payload import Payload
 
 __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static_check"]
 
@@ -26,7 +31,7 @@ __all__ = ["TorqueConstraint", "torque_constraint", "static_check", "path_static
 TorqueConstraint = JointTorqueConstraint
 
 
-def torque_constraint(robot: Any, torque_limits: Any, payload: Any = None,
+def torque_constraint(robot: Robot, torque_limits: ArrayLike, payload: Payload | None = None,
                       samples_per_piece: int | None = None) -> JointTorqueConstraint | None:
     """The :class:`pinarms.planning.JointTorqueConstraint` asked for by ``minimize_time``/``plan_cycle`` keywords, or None.
 

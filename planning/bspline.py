@@ -25,6 +25,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.interpolate import make_interp_spline
 
 from pinarms.planning import _inputs
@@ -45,13 +46,13 @@ def _end_values(n: int, values: dict[str, Any]) -> tuple[dict[str, np.ndarray], 
 
 
 def quintic_bspline_batch(
-    times: Any,
-    positions: Any,
+    times: ArrayLike,
+    positions: ArrayLike,
     *,
-    start_velocity: Any = 0.0,
-    end_velocity: Any = 0.0,
-    start_acceleration: Any = 0.0,
-    end_acceleration: Any = 0.0,
+    start_velocity: ArrayLike = 0.0,
+    end_velocity: ArrayLike = 0.0,
+    start_acceleration: ArrayLike = 0.0,
+    end_acceleration: ArrayLike = 0.0,
 ) -> np.ndarray:
     """Coefficients of :func:`quintic_bspline` for P timings of the same via points at once.
 
@@ -78,13 +79,13 @@ def quintic_bspline_batch(
 
 
 def quintic_bspline(
-    times: Any,
-    positions: Any,
+    times: ArrayLike,
+    positions: ArrayLike,
     *,
-    start_velocity: Any = 0.0,
-    end_velocity: Any = 0.0,
-    start_acceleration: Any = 0.0,
-    end_acceleration: Any = 0.0,
+    start_velocity: ArrayLike = 0.0,
+    end_velocity: ArrayLike = 0.0,
+    start_acceleration: ArrayLike = 0.0,
+    end_acceleration: ArrayLike = 0.0,
 ) -> Trajectory:
     """Degree-5 interpolating B-spline through ``positions`` at ``times`` (C⁴ at interior knots).
 

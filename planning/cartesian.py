@@ -19,9 +19,10 @@ Poses are homogeneous transforms of the TCP frame in the robot's base (world) fr
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.bspline import quintic_bspline
@@ -32,6 +33,9 @@ from pinarms.planning.polynomial import polynomial
 from pinarms.planning.trajectory import Trajectory
 from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["joint_waypoints", "joint_path_from_waypoints", "tcp_path", "tcp_speed", "PATH_KINDS"]
 
@@ -52,7 +56,7 @@ def _poses(poses: Any) -> np.ndarray:
     return P
 
 
-def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
+def joint_waypoints(robot: Robot, poses: ArrayLike, q_start: ArrayLike | None = None) -> np.ndarray:
     """Joint configurations (N, nq) for TCP poses (N, 4, 4) on one IK branch, each nearest the previous one.
 
     The first pose's solution is the one nearest ``q_start`` when given; otherwise, with
@@ -98,11 +102,11 @@ def joint_waypoints(robot: Any, poses: Any, q_start: Any = None) -> np.ndarray:
 
 
 def joint_path_from_waypoints(
-    robot: Any,
-    poses: Any,
-    times: Any,
+    robot: Robot,
+    poses: ArrayLike,
+    times: ArrayLike,
     kind: str = "multi-quintic",
-    q_start: Any = None,
+    q_start: ArrayLike | None = None,
     **options: Any,
 ) -> Trajectory:
     """Joint trajectory through TCP waypoints: IK per pose (:func:`joint_waypoints`), then ``kind``.
@@ -127,7 +131,7 @@ def joint_path_from_waypoints(
     return PATH_KINDS[key](t, q, **options)
 
 
-def tcp_path(robot: Any, trajectory: Trajectory, hz: float, frame: str = "tcp") -> tuple[np.ndarray, np.ndarray]:
+def tcp_path(robot: Robot, trajectory: Trajectory, hz: float, frame: str = "tcp") -> tuple[np.ndarray, np.ndarray]:
     """TCP positions along a trajectory sampled at ``hz``: ``(t (N,), positions (N, 3) in m)``, batched FK."""
     if trajectory.n_joints != int(robot.nq):
         raise TrajectoryError(
@@ -138,7 +142,7 @@ def tcp_path(robot: Any, trajectory: Trajectory, hz: float, frame: str = "tcp") 
     return t, T[:, :3, 3].copy()
 
 
-def tcp_speed(robot: Any, trajectory: Trajectory, hz: float, frame: str = "tcp") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def tcp_speed(robot: Robot, trajectory: Trajectory, hz: float, frame: str = "tcp") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """tcp speed along a trajectory sampled at ``hz``: ``(t (N,), linear (N,) [m/s], angular (N,) [rad/s])``.
 
     ``|J(q) q̇|`` per sample (batched Jacobian, base axes at the tcp): the Cartesian speed

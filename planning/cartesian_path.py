@@ -36,9 +36,11 @@ Units: m, rad; s in m (the tool path's weighted arc length).
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from dataclasses import dataclass
+from typing import Any, Iterable, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array, per_joint
@@ -51,7 +53,10 @@ from pinarms.planning.tool_path import DEFAULT_WEIGHT, ToolPath, tool_path
 from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
-__all__ = ["CartesianPath", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
+
+__all__ = ["CartesianPath", "KnotFit", "cartesian_path", "joint_image", "DEFAULT_TOLERANCE", "DEFAULT_SINGULAR_TOLERANCE"]
 
 #: Default largest tcp deviation from the tool path [m] (0.1 mm).
 DEFAULT_TOLERANCE = 1e-4
@@ -62,6 +67,42 @@ MIN_TOLERANCE = 1e-9  #: smallest tolerance [m]: a tighter one refines for minut
 _INITIAL_STEP = 0.1
 #: Check points of the tolerance rule, as fractions of an interval.
 _CHECKS = np.array([0.25, 0.5, 0.75])
+
+
+@dataclass(frozen=True)
+class KnotFit:
+    """What the continuation found at the knots of a :class:`CartesianPath` (its attributes of the same names).
+
+    Attributes:
+        q_knots: (K+1, nq) exact IK solutions at the knots (made read-only).
+        sigma_min: (K+1,) smallest singular value of the weighted Jacobian at the knots [m/rad] (made read-only).
+        branch: closed-form IK branch label of the whole path, or None (numerical IK).
+        max_deviation: (position [m], rotation [rad]) largest tcp deviation found at the check points.
+
+    Raises:
+        TrajectoryError: shapes that do not match, or a deviation that is not two finite numbers >= 0.
+    """
+
+    q_knots: np.ndarray
+    sigma_min: np.ndarray
+    branch: int | None
+    max_deviation: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        q = np.asarray(self.q_knots, dtype=float)
+        sigma = np.asarray(self.sigma_min, dtype=float)
+        if q.ndim != 2 or sigma.shape != (q.shape[0],):
+            raise TrajectoryError(f"KnotFit: q_knots must be (K+1, nq) and sigma_min (K+1,), "
+                                  f"got {q.shape} and {sigma.shape}")
+        dev = tuple(float(v) for v in self.max_deviation)
+        if len(dev) != 2 or not all(np.isfinite(v) and v >= 0.0 for v in dev):
+            raise TrajectoryError(f"KnotFit: max_deviation must be (position m, rotation rad), finite and >= 0, "
+                                  f"got {self.max_deviation!r}")
+        q.flags.writeable = False
+        sigma.flags.writeable = False
+        object.__setattr__(self, "q_knots", q)
+        object.__setattr__(self, "sigma_min", sigma)
+        object.__setattr__(self, "max_deviation", dev)
 
 
 class CartesianPath(JointPath):
@@ -76,20 +117,17 @@ class CartesianPath(JointPath):
         max_deviation: (position [m], rotation [rad]) largest tcp deviation found at the check points.
     """
 
-    def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Any, frame: str,
-                 tolerance: float, q_knots: np.ndarray, sigma_min: np.ndarray, branch: int | None,
-                 max_deviation: tuple[float, float]) -> None:
+    def __init__(self, breaks: np.ndarray, coefficients: np.ndarray, *, tool: ToolPath, robot: Robot, frame: str,
+                 tolerance: float, fit: KnotFit) -> None:
         super().__init__(breaks, coefficients, stops=tool.stops, robot=robot, frame=frame)
         self.tool_path = tool
         self.tolerance = float(tolerance)
-        self.q_knots = q_knots
-        self.sigma_min = sigma_min
-        self.branch = branch
-        self.max_deviation = max_deviation
-        for arr in (self.q_knots, self.sigma_min):
-            arr.flags.writeable = False
+        self.q_knots = fit.q_knots
+        self.sigma_min = fit.sigma_min
+        self.branch = fit.branch
+        self.max_deviation = fit.max_deviation
 
-    def deviation(self, s: Any) -> tuple[np.ndarray, np.ndarray]:
+    def deviation(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """tcp deviation at arc lengths ``s``: position [m] and rotation [rad] from the tool path at the same s."""
         arr, _ = self._check_s(s)
         T = np.asarray(self.robot.fk(self(arr), frame=self.frame))
@@ -183,9 +221,9 @@ def _build(sv: PathSolver, q0: np.ndarray, tolerance: float, locate: float) -> C
         end = _labels(sv.robot, tool.pose(L), q[-1])
         if end is not None and end != branch:
             raise Stop(L, q[-1], "singular", f"the closed-form branch changed from {branch} to {end} on the way")
-    return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance,
-                         q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
-                         max_deviation=(float(pos.max()), float(rot.max())))
+    fit = KnotFit(q_knots=q, sigma_min=np.array([k.sigma for k in knots]), branch=branch,
+                  max_deviation=(float(pos.max()), float(rot.max())))
+    return CartesianPath(s, _coefficients(knots), tool=tool, robot=sv.robot, frame=sv.frame, tolerance=tolerance, fit=fit)
 
 
 def _walked(sv: PathSolver, q0: np.ndarray, locate: float) -> list[Knot]:
@@ -305,7 +343,7 @@ def _coefficients(knots: list[Knot]) -> np.ndarray:
     return quintic_hermite_coefficients(s[1:] - s[:-1], *a, *b)
 
 
-def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+def joint_image(robot: Robot, path: ToolPath, *, tolerance: float = DEFAULT_TOLERANCE, q_start: ArrayLike | None = None,
                 frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE,
                 locate: float = 1e-5) -> CartesianPath:
     """The joint path that makes the tcp follow ``path`` within ``tolerance`` (module docstring).
@@ -365,8 +403,8 @@ def joint_image(robot: Any, path: ToolPath, *, tolerance: float = DEFAULT_TOLERA
     raise _failure(sv, farthest.s, farthest.q_last, farthest.kind, farthest.detail)
 
 
-def cartesian_path(robot: Any, poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT,
-                   stops: Iterable[int] = (), tolerance: float = DEFAULT_TOLERANCE, q_start: Any = None,
+def cartesian_path(robot: Robot, poses: ArrayLike, *, blend: ArrayLike = 0.0, weight: float = DEFAULT_WEIGHT,
+                   stops: Iterable[int] = (), tolerance: float = DEFAULT_TOLERANCE, q_start: ArrayLike | None = None,
                    frame: str = "tcp", singular_tolerance: float = DEFAULT_SINGULAR_TOLERANCE) -> CartesianPath:
     """Straight tcp lines through ``poses`` (blends of radius ``blend`` at the corners), as joints.
 

@@ -20,6 +20,7 @@ import functools
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
@@ -194,7 +195,7 @@ def _batch_inputs(times: Any, coefficients: Any) -> tuple[np.ndarray, np.ndarray
     return t, c
 
 
-def piece_peaks_batch(times: Any, coefficients: Any) -> np.ndarray:
+def piece_peaks_batch(times: ArrayLike, coefficients: ArrayLike) -> np.ndarray:
     """Exact peaks of |velocity|, |acceleration|, |jerk| per individual, piece and joint.
 
     Args:
@@ -217,7 +218,7 @@ def piece_peaks_batch(times: Any, coefficients: Any) -> np.ndarray:
     return np.moveaxis(top, 0, 1)
 
 
-def peaks_batch(times: Any, coefficients: Any) -> np.ndarray:
+def peaks_batch(times: ArrayLike, coefficients: ArrayLike) -> np.ndarray:
     """Exact whole-trajectory peaks (P, 3, n_joints): |velocity|, |acceleration|, |jerk| maxima.
 
     Same arguments as :func:`piece_peaks_batch`; row p equals

@@ -11,13 +11,16 @@ turns that into a named error). Units: m, rad; s in m of the tool path's arc len
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning.joint_path import jacobian_rate
 from pinarms.planning.tool_path import ToolPath
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["PathSolver", "Knot", "Stop", "solve_knots", "continue_to", "MAX_CORRECTION", "MAX_JOINT_STEP"]
 
@@ -33,7 +36,7 @@ MAX_JOINT_STEP = 0.3
 class PathSolver:
     """IK along one tool path for one robot: Newton, derivatives, conditioning (batched)."""
 
-    def __init__(self, robot: Any, tool: ToolPath, frame: str, singular_tolerance: float) -> None:
+    def __init__(self, robot: Robot, tool: ToolPath, frame: str, singular_tolerance: float) -> None:
         self.robot, self.tool, self.frame = robot, tool, frame
         self.w = tool.weight
         self.scale = np.array([1.0, 1.0, 1.0, self.w, self.w, self.w])

@@ -24,13 +24,17 @@ or m per joint.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
 from pinarms.planning.extrema import derivative_coefficients
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["JointPath", "joint_spline"]
 
@@ -46,7 +50,7 @@ class JointPath:
         frame: the robot's frame that is the tool (default its tcp).
     """
 
-    def __init__(self, breaks: Any, coefficients: Any, *, stops: Any = (), robot: Any = None,
+    def __init__(self, breaks: ArrayLike, coefficients: ArrayLike, *, stops: ArrayLike = (), robot: Robot | None = None,
                  frame: str = "tcp") -> None:
         b = finite_array(breaks, "breaks")
         c = finite_array(coefficients, "coefficients")
@@ -110,7 +114,7 @@ class JointPath:
             raise TrajectoryError(f"s must lie in [0, {self.length!r}], got {arr.min()!r} .. {arr.max()!r}")
         return np.clip(arr, 0.0, self.length), single
 
-    def sample(self, s: Any, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def sample(self, s: ArrayLike, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(q, dq/ds, d²q/ds²)`` at ``s``, each (N, n_joints) (or (n_joints,) for a scalar s).
 
         At a break ``side="right"`` takes the piece that starts there, ``"left"`` the one that
@@ -128,7 +132,7 @@ class JointPath:
             return out[0][0], out[1][0], out[2][0]
         return out
 
-    def __call__(self, s: Any) -> np.ndarray:
+    def __call__(self, s: ArrayLike) -> np.ndarray:
         """Joint positions at s."""
         return self.sample(s)[0]
 
@@ -137,7 +141,7 @@ class JointPath:
         edges = np.concatenate([[0.0], self._stops, [self.length]])
         return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]
 
-    def tool_derivatives(self, s: Any, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def tool_derivatives(self, s: ArrayLike, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """tcp pose and its first two s-derivatives along the joint path (needs ``robot``).
 
         Returns ``(T (N, 4, 4), d1 (N, 6), d2 (N, 6))`` with ``d1 = J(q) q'`` (linear [m per unit s],
@@ -154,7 +158,7 @@ class JointPath:
         return T, d1, d2
 
 
-def jacobian_rate(robot: Any, q: np.ndarray, dq: np.ndarray, frame: str = "tcp") -> np.ndarray:
+def jacobian_rate(robot: Robot, q: np.ndarray, dq: np.ndarray, frame: str = "tcp") -> np.ndarray:
     """``(dJ/ds) dq`` (N, 6): the Jacobian's change along ``dq`` applied to ``dq``, central difference.
 
     The step along ``dq`` is 1e-6 / max(1, |dq|∞) (rad), so the difference error (≈1e-12) and the
@@ -167,7 +171,7 @@ def jacobian_rate(robot: Any, q: np.ndarray, dq: np.ndarray, frame: str = "tcp")
     return np.einsum("nij,nj->ni", J[:n] - J[n:], dq) / (2.0 * eps[:, None])
 
 
-def joint_spline(waypoints: Any, *, robot: Any = None, frame: str = "tcp") -> JointPath:
+def joint_spline(waypoints: ArrayLike, *, robot: Robot | None = None, frame: str = "tcp") -> JointPath:
     """C² cubic spline through joint ``waypoints`` (M, n_joints), parameter = cumulative chord length.
 
     ``s`` at waypoint i is ``sum_k |q_{k+1} - q_k|`` (Euclidean, in rad or m); the spline is

@@ -8,9 +8,13 @@ spec and list what exceeds it, each at the time of its worst value, in a :class:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import NamedTuple, TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
+    from pinarms.planning.limits import JointLimits
 
 __all__ = ["Violation", "LimitReport", "KIND_BY_ORDER", "limited_orders", "torque_violations",
            "derivative_violations", "position_violations", "limit_report"]
@@ -68,7 +72,7 @@ class LimitReport:
         return "\n".join(lines)
 
 
-def limited_orders(limits: Any) -> tuple[int, ...]:
+def limited_orders(limits: JointLimits) -> tuple[int, ...]:
     """The derivative orders (1 velocity, 2 acceleration, 3 jerk) that ``limits`` bounds."""
     return tuple(r for r, name in KIND_BY_ORDER.items() if getattr(limits, name) is not None)
 
@@ -81,7 +85,7 @@ def torque_violations(peak: np.ndarray, when: np.ndarray, lim: np.ndarray, rtol:
     return found
 
 
-def derivative_violations(values: np.ndarray, times: np.ndarray, orders: tuple[int, ...], limits: Any, n: int,
+def derivative_violations(values: np.ndarray, times: np.ndarray, orders: tuple[int, ...], limits: JointLimits, n: int,
                           rtol: float) -> list[Violation]:
     """Velocity, acceleration and jerk beyond ``limits``: ``values`` and ``times`` (len(orders), m, n, C) are
     the candidate extrema per piece (:meth:`Trajectory._extrema`); the worst of each piece is compared."""
@@ -99,7 +103,7 @@ def derivative_violations(values: np.ndarray, times: np.ndarray, orders: tuple[i
     return found
 
 
-def position_violations(v: np.ndarray, tm: np.ndarray, limits: Any, n: int, rtol: float) -> list[Violation]:
+def position_violations(v: np.ndarray, tm: np.ndarray, limits: JointLimits, n: int, rtol: float) -> list[Violation]:
     """Positions below ``limits.lower`` or above ``limits.upper``, from the candidate extrema ``v`` at ``tm``
     (m, n, C); the tolerance is ``rtol`` of the largest |position| (at least 1)."""
     found = []
@@ -121,7 +125,7 @@ def position_violations(v: np.ndarray, tm: np.ndarray, limits: Any, n: int, rtol
     return found
 
 
-def limit_report(found: list[Violation], robot: Any, n: int) -> LimitReport:
+def limit_report(found: list[Violation], robot: Robot, n: int) -> LimitReport:
     """The violations sorted by time (then joint, kind), named by ``robot``'s joints when it has ``n``."""
     found.sort(key=lambda v: (v.time, v.joint, v.kind))
     names = tuple(robot.joint_names) if robot is not None and getattr(robot, "nq", None) == n else None

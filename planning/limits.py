@@ -8,12 +8,16 @@ rad/s³ for revolute joints (m, m/s, ... for prismatic ones).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["JointLimits"]
 
@@ -86,7 +90,7 @@ class JointLimits:
         return np.broadcast_to(arr.reshape(-1) if arr.ndim else arr, (n_joints,)).astype(float)
 
     @classmethod
-    def from_robot(cls, robot: Any, acceleration: Any = None, jerk: Any = None, torque: Any = None) -> "JointLimits":
+    def from_robot(cls, robot: Robot, acceleration: ArrayLike | None = None, jerk: ArrayLike | None = None, torque: bool | ArrayLike | None = None) -> "JointLimits":
         """Velocity and position limits of a robot (``velocity_limit``, ``position_limits`` or ``lower``, ``upper``), plus optional ones.
 
         ``torque=True`` takes the URDF's joint ``effort`` limits (``robot.effort_limit``);

@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
@@ -115,7 +116,7 @@ def _coefficients(t: np.ndarray, q: np.ndarray, velocities: Any, accelerations: 
     return coefs, v, a
 
 
-def multi_quintic_batch(times: Any, positions: Any, velocities: Any = None, accelerations: Any = None) -> np.ndarray:
+def multi_quintic_batch(times: ArrayLike, positions: ArrayLike, velocities: ArrayLike | None = None, accelerations: ArrayLike | None = None) -> np.ndarray:
     """Coefficients of :func:`multi_quintic` for P timings of the same via points at once.
 
     Args:
@@ -133,7 +134,7 @@ def multi_quintic_batch(times: Any, positions: Any, velocities: Any = None, acce
     return _coefficients(t, q, velocities, accelerations)[0]
 
 
-def multi_quintic(times: Any, positions: Any, velocities: Any = None, accelerations: Any = None) -> Trajectory:
+def multi_quintic(times: ArrayLike, positions: ArrayLike, velocities: ArrayLike | None = None, accelerations: ArrayLike | None = None) -> Trajectory:
     """One quintic per segment through the via points.
 
     Args:

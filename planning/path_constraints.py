@@ -34,12 +34,17 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
+    from pinarms.planning.timed_curve import TimedCurve
 
 __all__ = ["PathSamples", "PathRows", "PathConstraint", "JointVelocityConstraint", "JointAccelerationConstraint",
            "ToolSpeedConstraint", "ToolAccelerationConstraint"]
@@ -62,7 +67,7 @@ class PathSamples:
     side: str = "right"
 
     @classmethod
-    def of(cls, path: Any, s: Any, side: str = "right") -> "PathSamples":
+    def of(cls, path: JointPath, s: ArrayLike, side: str = "right") -> "PathSamples":
         """Sample ``path`` at ``s``."""
         arr = np.atleast_1d(np.asarray(s, dtype=float))
         q, dq, ddq = path.sample(arr, side)
@@ -110,7 +115,7 @@ class PathConstraint:
         """Linear bounds on (u, x) at every sample."""
         raise NotImplementedError
 
-    def exact_dilation(self, trajectory: Any) -> float:
+    def exact_dilation(self, trajectory: TimedCurve) -> float:
         """Smallest time dilation factor f >= 1 that makes a timed ``trajectory`` satisfy the limit exactly.
 
         ``trajectory`` is a :class:`pinarms.planning.Trajectory`, or the timing's stand-in with
@@ -152,7 +157,7 @@ class JointVelocityConstraint(PathConstraint):
         return PathRows(np.zeros((N, n)), samples.dq**2, np.full((N, n), -np.inf), np.broadcast_to(v * v, (N, n)).copy(),
                         tuple(f"velocity of joint {j + 1}" for j in range(n)))
 
-    def exact_dilation(self, trajectory: Any) -> float:
+    def exact_dilation(self, trajectory: TimedCurve) -> float:
         v = _limit(self.vmax, trajectory.n_joints, "vmax [rad/s or m/s]")
         return float(max(1.0, np.max(trajectory.peaks().velocity / v)))
 
@@ -170,7 +175,7 @@ class JointAccelerationConstraint(PathConstraint):
         return PathRows(samples.dq.copy(), samples.ddq.copy(), -a, a.copy(),
                         tuple(f"acceleration of joint {j + 1}" for j in range(n)))
 
-    def exact_dilation(self, trajectory: Any) -> float:
+    def exact_dilation(self, trajectory: TimedCurve) -> float:
         a = _limit(self.amax, trajectory.n_joints, "amax [rad/s² or m/s²]")
         return float(max(1.0, np.sqrt(np.max(trajectory.peaks().acceleration / a))))
 

@@ -25,9 +25,10 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import ConditionCountError, TrajectoryError
@@ -211,8 +212,8 @@ def solve_coefficients(
 
 
 def piecewise_polynomial_batch(
-    times: Any,
-    positions: Any,
+    times: ArrayLike,
+    positions: ArrayLike,
     degrees: str | Sequence[int] = (3, 5, 3),
     *,
     continuity: int = 2,
@@ -239,8 +240,8 @@ def piecewise_polynomial_batch(
 
 
 def piecewise_polynomial(
-    times: Any,
-    positions: Any,
+    times: ArrayLike,
+    positions: ArrayLike,
     degrees: str | Sequence[int] = (3, 5, 3),
     *,
     continuity: int = 2,

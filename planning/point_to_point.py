@@ -20,6 +20,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
@@ -139,7 +140,7 @@ def _quiet_floats(fn: Any) -> Any:
 
 
 @_quiet_floats
-def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = True) -> Trajectory:
+def trapezoidal(q0: ArrayLike, q1: ArrayLike, vmax: ArrayLike, amax: ArrayLike, *, synchronized: bool = True) -> Trajectory:
     """Rest-to-rest trapezoidal-velocity move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
 
     ``vmax`` (rad/s) and ``amax`` (rad/s²) are scalars or per joint. Pieces are quadratics.
@@ -185,7 +186,7 @@ def trapezoidal(q0: Any, q1: Any, vmax: Any, amax: Any, *, synchronized: bool = 
 
 
 @_quiet_floats
-def double_s(q0: Any, q1: Any, vmax: Any, amax: Any, jmax: Any, *, synchronized: bool = True) -> Trajectory:
+def double_s(q0: ArrayLike, q1: ArrayLike, vmax: ArrayLike, amax: ArrayLike, jmax: ArrayLike, *, synchronized: bool = True) -> Trajectory:
     """Rest-to-rest jerk-limited (double-S) move from ``q0`` to ``q1`` (rad or m), starting at t = 0.
 
     ``vmax`` (rad/s), ``amax`` (rad/s²), ``jmax`` (rad/s³): scalars or per joint. Pieces are

@@ -17,9 +17,10 @@ the common piecewise representation of :class:`pinarms.planning.Trajectory` (one
 from __future__ import annotations
 
 import functools
-from typing import Any
+
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning import _inputs
 from pinarms.planning.errors import ConditionCountError, TrajectoryError
@@ -38,7 +39,7 @@ def derivative_row(degree: int, order: int, s: float) -> np.ndarray:
     return np.where(k >= order, falling * float(s) ** expo, 0.0)
 
 
-def polynomial(times: Any, positions: Any, degree: int) -> Trajectory:
+def polynomial(times: ArrayLike, positions: ArrayLike, degree: int) -> Trajectory:
     """One polynomial of ``degree`` through ``positions`` at ``times``, at rest at both ends.
 
     Args:

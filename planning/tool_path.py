@@ -42,11 +42,12 @@ from __future__ import annotations
 from typing import Any, Iterable, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots import so3 as _so3
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import BlendTooLarge, TrajectoryError
-from pinarms.planning.tool_pieces import Blend, Line
+from pinarms.planning.tool_pieces import Blend, BlendCorner, Line
 
 __all__ = ["ToolPath", "tool_path", "DEFAULT_WEIGHT"]
 
@@ -111,7 +112,7 @@ class ToolPath:
             raise TrajectoryError(f"arc length s must lie in [0, {self.length!r}] m, got {arr.min()!r} .. {arr.max()!r}")
         return np.clip(arr, 0.0, self.length), single
 
-    def evaluate(self, s: Any, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, s: ArrayLike, side: str = "right") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose and its first two derivatives in s at the arc lengths ``s`` [m].
 
         Returns ``(T (N, 4, 4), d1 (N, 6), d2 (N, 6))``: ``d1 = (dp/ds, ω)`` with ω the angular
@@ -133,13 +134,13 @@ class ToolPath:
             T[sel], d1[sel], d2[sel] = self._pieces[k].evaluate(arr[sel] - self.breaks[k])
         return T, d1, d2
 
-    def pose(self, s: Any) -> np.ndarray:
+    def pose(self, s: ArrayLike) -> np.ndarray:
         """tcp pose(s) at arc length ``s`` [m]: (4, 4) for a scalar, (N, 4, 4) for (N,)."""
         arr, single = self._arc(s)
         T = self.evaluate(arr)[0]
         return T[0] if single else T
 
-    def position(self, s: Any) -> np.ndarray:
+    def position(self, s: ArrayLike) -> np.ndarray:
         """tcp position(s) [m] at ``s``: (3,) or (N, 3)."""
         return self.pose(s)[..., :3, 3]
 
@@ -150,7 +151,7 @@ class ToolPath:
                 "via_s_m": self.via_s.tolist(), "blend_radii_m": self.radii.tolist()}
 
 
-def tool_path(poses: Any, *, blend: Any = 0.0, weight: float = DEFAULT_WEIGHT, stops: Iterable[int] = ()) -> ToolPath:
+def tool_path(poses: ArrayLike, *, blend: ArrayLike = 0.0, weight: float = DEFAULT_WEIGHT, stops: Iterable[int] = ()) -> ToolPath:
     """Straight lines through tcp ``poses`` with circular blends at the corners (module docstring).
 
     Args:
@@ -293,8 +294,8 @@ def _pieces(P: np.ndarray, seg: _Segments, r: np.ndarray, b: np.ndarray, arc: np
             s_now += piece.length
         if k + 1 < n - 1:
             if b[k + 1] > 0.0:
-                blend_piece = Blend(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]),
-                                     R[k + 1], phi[k], float(d[k]), phi[k + 1], float(d[k + 1]), w)
+                at = BlendCorner(p[k + 1], e[k], e[k + 1], float(b[k + 1]), float(r[k]), bool(arc[k + 1]))
+                blend_piece = Blend(at, R[k + 1], phi[k], float(d[k]), phi[k + 1], float(d[k + 1]), w)
                 pieces.append(blend_piece)
                 via_s[k + 1] = s_now + 0.5 * blend_piece.length
                 s_now += blend_piece.length

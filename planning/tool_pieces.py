@@ -8,11 +8,14 @@ first and second derivatives (N, 6) of position and rotation (base axes) in σ.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from pinarms.planning.errors import TrajectoryError
 from pinarms.robots import so3 as _so3
 
-__all__ = ["Line", "Blend"]
+__all__ = ["Line", "Blend", "BlendCorner"]
 
 #: Nodes of the arc-length table of a blend that rotates (its s(ℓ) is integrated numerically).
 _TABLE = 257
@@ -49,6 +52,35 @@ class Line:
         return T, np.broadcast_to(self.d1, (n, 6)).copy(), np.zeros((n, 6))
 
 
+@dataclass(frozen=True)
+class BlendCorner:
+    """The position part of a :class:`Blend`: the corner it rounds (base frame, m).
+
+    Attributes:
+        point: (3,) the corner (the via point).
+        e_in, e_out: (3,) unit directions of the incoming and outgoing lines.
+        b: distance from the corner where the blend leaves each line [m] (> 0).
+        r: the arc's radius [m] (used when ``arc``).
+        arc: a circular arc (else a parabolic blend of length ``2 b``).
+
+    Raises:
+        TrajectoryError: a blend distance that is not a positive length, or an arc radius that is not one.
+    """
+
+    point: np.ndarray
+    e_in: np.ndarray
+    e_out: np.ndarray
+    b: float
+    r: float
+    arc: bool
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.b) and self.b > 0.0):
+            raise TrajectoryError(f"BlendCorner: b must be a positive length in m, got {self.b!r}")
+        if self.arc and not (np.isfinite(self.r) and self.r > 0.0):
+            raise TrajectoryError(f"BlendCorner: an arc needs a positive radius r in m, got {self.r!r}")
+
+
 class Blend:
     """Blend at a corner, local parameter ℓ ∈ [0, ℓ_b] (arc length of the position curve, m).
 
@@ -58,9 +90,9 @@ class Blend:
 
     kind = "blend"
 
-    def __init__(self, corner: np.ndarray, e_in: np.ndarray, e_out: np.ndarray, b: float, r: float, arc: bool,
-                 Rc: np.ndarray, phi_in: np.ndarray, d_in: float, phi_out: np.ndarray, d_out: float,
-                 weight: float) -> None:
+    def __init__(self, at: BlendCorner, Rc: np.ndarray, phi_in: np.ndarray, d_in: float, phi_out: np.ndarray,
+                 d_out: float, weight: float) -> None:
+        corner, e_in, e_out, b, r, arc = at.point, at.e_in, at.e_out, at.b, at.r, at.arc
         self.corner, self.e_in, self.b, self.r, self.arc = corner, e_in, b, r, arc
         self.Rc, self.w_in, self.w_out = Rc, phi_in / d_in, phi_out / d_out
         self.weight = weight

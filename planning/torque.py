@@ -25,14 +25,19 @@ RNEA batch.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array
 from pinarms.planning.errors import TrajectoryError
 from pinarms.planning.extrema import derivative_coefficients
 from pinarms.planning.path_constraints import PathConstraint, PathRows
+
+if TYPE_CHECKING:
+    from pinarms.planning.timed_curve import TimedCurve
+    from pinarms.robots.robot import Robot
 
 __all__ = [
     "SAMPLES_PER_PIECE",
@@ -85,7 +90,7 @@ def _evaluate(coefs: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return out[0], out[1], out[2]
 
 
-def piece_states(times: Any, coefs: Any, s: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def piece_states(times: ArrayLike, coefs: ArrayLike, s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, velocity, acceleration of every piece at normalised instants ``s``.
 
     Args:
@@ -108,7 +113,7 @@ def piece_states(times: Any, coefs: Any, s: Any) -> tuple[np.ndarray, np.ndarray
     return (q[0], qd[0], qdd[0]) if single else (q, qd, qdd)
 
 
-def piece_torques(robot: Any, times: Any, coefs: Any, s: Any) -> np.ndarray:
+def piece_torques(robot: Robot, times: ArrayLike, coefs: ArrayLike, s: ArrayLike) -> np.ndarray:
     """Joint torques (P, m, k, n) [N·m or N] of every piece at normalised instants ``s`` (one RNEA batch)."""
     q, qd, qdd = piece_states(times, coefs, s)
     shape = q.shape
@@ -130,7 +135,7 @@ class TorquePeaks:
     time: np.ndarray
     signed: np.ndarray
 
-    def ratios(self, limit: Any) -> np.ndarray:
+    def ratios(self, limit: ArrayLike) -> np.ndarray:
         """Peak / limit per joint for limits (n,) or a scalar [N·m or N]."""
         return self.torque / np.asarray(limit, dtype=float)
 
@@ -139,7 +144,7 @@ class TorquePeaks:
         return {"torque": self.torque.tolist(), "time": self.time.tolist(), "signed": self.signed.tolist()}
 
 
-def torques(trajectory: Any, robot: Any, t: Any) -> np.ndarray:
+def torques(trajectory: TimedCurve, robot: Robot, t: ArrayLike) -> np.ndarray:
     """Joint torques [N·m or N] of ``robot`` following ``trajectory`` at instants ``t`` [s].
 
     Returns (len(t), nq), or (nq,) for a scalar ``t``. At an interior knot the piece that
@@ -151,7 +156,7 @@ def torques(trajectory: Any, robot: Any, t: Any) -> np.ndarray:
 
 
 def piece_torque_peaks(
-    trajectory: Any, robot: Any, samples_per_piece: int = SAMPLES_PER_PIECE
+    trajectory: TimedCurve, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Refined peak of ``|tau_j|`` on every piece and joint (see the module docstring).
 
@@ -197,7 +202,7 @@ def piece_torque_peaks(
     return value.reshape(m, n), t_abs.reshape(m, n), signed.reshape(m, n)
 
 
-def torque_peaks(trajectory: Any, robot: Any, samples_per_piece: int = SAMPLES_PER_PIECE) -> TorquePeaks:
+def torque_peaks(trajectory: TimedCurve, robot: Robot, samples_per_piece: int = SAMPLES_PER_PIECE) -> TorquePeaks:
     """Per-joint peaks of ``|tau|`` over the whole trajectory (module docstring: grid + refinement).
 
     Ties between pieces (equal peaks to the last bit) go to the earliest piece.
@@ -208,7 +213,7 @@ def torque_peaks(trajectory: Any, robot: Any, samples_per_piece: int = SAMPLES_P
     return TorquePeaks(torque=value[k, cols], time=when[k, cols], signed=signed[k, cols])
 
 
-def check_torque_limit(limit: Any, n_joints: int) -> np.ndarray:
+def check_torque_limit(limit: ArrayLike, n_joints: int) -> np.ndarray:
     """Torque limits (n_joints,) [N·m or N], positive and finite."""
     arr = finite_array(limit, "torque limit")
     if arr.ndim > 1 or (arr.ndim == 1 and arr.size not in (1, n_joints)):
@@ -219,7 +224,7 @@ def check_torque_limit(limit: Any, n_joints: int) -> np.ndarray:
     return arr
 
 
-def torque_dilation(trajectory: Any, robot: Any, limit: Any, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
+def torque_dilation(trajectory: TimedCurve, robot: Robot, limit: ArrayLike, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
     """Smallest uniform time dilation f >= 1 after which the refined torque peaks are within ``limit``.
 
     Scaling every duration by f leaves the path and the normalised instants unchanged and
@@ -282,7 +287,7 @@ class JointTorqueConstraint(PathConstraint):
 
     name = "joint torque"
 
-    def __init__(self, robot: Any = None, limit: Any = None, columns: Any = None,
+    def __init__(self, robot: Robot | None = None, limit: ArrayLike | None = None, columns: ArrayLike | None = None,
                  samples_per_piece: int | None = None) -> None:
         if robot is not None and not hasattr(robot, "inverse_dynamics"):
             raise TrajectoryError(f"robot must be a robots.Robot (with inverse_dynamics), got {type(robot).__name__}")
@@ -314,7 +319,7 @@ class JointTorqueConstraint(PathConstraint):
         return int(self.robot.nq)
 
     # -- path timing --------------------------------------------------------------------
-    def rows(self, samples: Any) -> PathRows:
+    def rows(self, samples: ArrayLike) -> PathRows:
         """Linear bounds on (s̈, ṡ²) at the samples (see the class docstring)."""
         c = slice(None) if self.columns is None else self.columns
         q, dq, ddq = samples.q[:, c], samples.dq[:, c], samples.ddq[:, c]
@@ -326,7 +331,7 @@ class JointTorqueConstraint(PathConstraint):
         b = arm.inverse_dynamics(q, dq, ddq).reshape(q.shape) - g
         return PathRows(a, b, -L - g, L - g, tuple(f"torque of joint {j + 1}" for j in range(n)))
 
-    def exact_dilation(self, trajectory: Any) -> float:
+    def exact_dilation(self, trajectory: TimedCurve) -> float:
         """Uniform dilation making the timed trajectory's refined torque peaks meet the limits (:func:`torque_dilation`).
 
         1 with explicit ``columns`` (the rows are then checked densely by the timing).
@@ -371,7 +376,7 @@ class JointTorqueConstraint(PathConstraint):
         with np.errstate(divide="ignore"):
             return np.where(u > 0.0, 1.0 / np.sqrt(u), np.inf)
 
-    def refined_scale(self, trajectory: Any) -> float:
+    def refined_scale(self, trajectory: TimedCurve) -> float:
         """Factor (>= 1) on every duration that brings the *refined* torque peaks under the limits.
 
         The grid misses the exact peak by a hair; the refined peaks and the scaling law at
@@ -379,7 +384,7 @@ class JointTorqueConstraint(PathConstraint):
         """
         return torque_dilation(trajectory, self.robot, self.limit, self.samples_per_piece)
 
-    def holding_excess(self, positions: Any) -> tuple[np.ndarray, np.ndarray]:
+    def holding_excess(self, positions: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``|g(q)|`` (..., n) at ``positions`` (..., n) and where it exceeds the limit (no speed helps there)."""
         q = np.asarray(positions, dtype=float)
         g = np.abs(self.robot.gravity(q.reshape(-1, q.shape[-1]))).reshape(q.shape)

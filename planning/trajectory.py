@@ -27,9 +27,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.planning._inputs import finite_array, scalar
 from pinarms.planning.errors import OutOfTimeRange, TrajectoryError
@@ -37,6 +38,9 @@ from pinarms.planning.extrema import normalised_pieces, piece_extrema
 from pinarms.planning.limit_report import (LimitReport, Violation, derivative_violations, limit_report, limited_orders,
                                            position_violations, torque_violations)
 from pinarms.planning.poly_pieces import derivative_stack, evaluate_by_piece, pad_degree
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["Trajectory", "Peaks"]
 
@@ -76,7 +80,7 @@ class Trajectory:
     it from; when omitted the raw breaks and coefficients are used.
     """
 
-    def __init__(self, breaks: Any, coefficients: Any, definition: dict | None = None) -> None:
+    def __init__(self, breaks: ArrayLike, coefficients: ArrayLike, definition: dict | None = None) -> None:
         b = finite_array(breaks, "breaks")
         c = finite_array(coefficients, "coefficients")
         if b.ndim != 1 or b.size < 2:
@@ -196,7 +200,7 @@ class Trajectory:
             )
         return np.clip(arr, t0, t1), scalar
 
-    def sample(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def sample(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration and jerk at the instants ``t`` (s).
 
         Returns ``(q, qd, qdd, qddd)``, each ``(len(t), n_joints)`` (or ``(n_joints,)`` for a
@@ -237,7 +241,7 @@ class Trajectory:
             return q[0].copy(), qd[0].copy(), qdd[0].copy(), qddd[0].copy()
         return q, qd, qdd, qddd
 
-    def __call__(self, t: Any) -> np.ndarray:
+    def __call__(self, t: ArrayLike) -> np.ndarray:
         """Positions only: ``sample(t)[0]``."""
         return self.sample(t)[0]
 
@@ -299,7 +303,7 @@ class Trajectory:
         values, _ = self._extrema((0,), with_times=False)
         return values[0].min(axis=(0, 2)), values[0].max(axis=(0, 2))
 
-    def check(self, limits: Any, rtol: float = 1e-9, *, robot: Any = None) -> LimitReport:
+    def check(self, limits: JointLimits, rtol: float = 1e-9, *, robot: Robot | None = None) -> LimitReport:
         """Check against a :class:`pinarms.planning.JointLimits`; report every violation.
 
         A value counts as a violation when it exceeds the limit by more than ``rtol``
@@ -337,7 +341,7 @@ class Trajectory:
         return limit_report(found, robot, n)
 
     # --------------------------------------------------------------------- torques
-    def torques(self, robot: Any, t: Any) -> np.ndarray:
+    def torques(self, robot: Robot, t: ArrayLike) -> np.ndarray:
         """Joint torques [N·m or N] of ``robot`` following this trajectory at instants ``t`` [s].
 
         ``(len(t), nq)`` (or ``(nq,)`` for a scalar ``t``), by the robot's inverse dynamics
@@ -347,7 +351,7 @@ class Trajectory:
 
         return torques(self, robot, t)
 
-    def torque_peaks(self, robot: Any, samples_per_piece: int | None = None) -> Any:
+    def torque_peaks(self, robot: Robot, samples_per_piece: int | None = None) -> Any:
         """Per-joint peaks of ``|torque|`` with their instants (:class:`pinarms.planning.torque.TorquePeaks`).
 
         Dense grid per piece (default :data:`pinarms.planning.torque.SAMPLES_PER_PIECE`) refined

@@ -23,6 +23,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.robots._checks import as_batch
@@ -105,7 +106,7 @@ def _rnea_batch(robot: Any, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> n
     return np.ascontiguousarray(np.asarray(tau).reshape(robot.nq, n).T)
 
 
-def inverse_dynamics(robot: Any, q: Any, qd: Any, qdd: Any) -> np.ndarray:
+def inverse_dynamics(robot: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
     """Joint torques ``tau = M(q) qdd + C(q, qd) qd + g(q)`` (module conventions).
 
     Args:
@@ -127,7 +128,7 @@ def inverse_dynamics(robot: Any, q: Any, qd: Any, qdd: Any) -> np.ndarray:
     return tau[0] if single else tau
 
 
-def gravity_torques(robot: Any, q: Any) -> np.ndarray:
+def gravity_torques(robot: Any, q: ArrayLike) -> np.ndarray:
     """Torques [N·m or N] that hold ``q`` (nq,) or (N, nq) still against gravity: ``g(q)``."""
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -141,7 +142,7 @@ def _has_mimic(model: pin.Model) -> bool:
     return any("Mimic" in model.joints[i].shortname() for i in range(1, model.njoints))
 
 
-def kinetic_energy(robot: Any, q: Any, qd: Any) -> float | np.ndarray:
+def kinetic_energy(robot: Any, q: ArrayLike, qd: ArrayLike) -> float | np.ndarray:
     """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body (Pinocchio's ``computeKineticEnergy``).
 
     ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (mimic joints
@@ -167,7 +168,7 @@ def kinetic_energy(robot: Any, q: Any, qd: Any) -> float | np.ndarray:
     return float(out[0]) if single else out
 
 
-def potential_energy(robot: Any, q: Any) -> float | np.ndarray:
+def potential_energy(robot: Any, q: ArrayLike) -> float | np.ndarray:
     """Gravitational potential energy ``-Σ m_i g·c_i`` [J] of the moving bodies (zero at the base origin's height).
 
     Pinocchio's ``computePotentialEnergy`` (centres of mass ``c_i`` in the base frame from

@@ -8,9 +8,9 @@ into a pose with the identity rotation. One plain pose takes a fast path in Pyth
 """
 
 import math
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots._checks import real_array
 from pinarms.errors import InvalidInput
@@ -20,7 +20,7 @@ __all__ = ["check_ik_target"]
 _F64 = np.dtype(np.float64)
 
 
-def check_ik_target(target: Any, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
+def check_ik_target(target: ArrayLike, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
     """The targets as ``(N, 4, 4)`` and whether a single target was given (see :meth:`pinarms.robots.Robot.check_target`).
 
     Raises:

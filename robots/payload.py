@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import InvalidInput
@@ -88,7 +89,7 @@ class Payload:
         }
 
     @classmethod
-    def from_dict(cls, data: Any) -> "Payload":
+    def from_dict(cls, data: object) -> "Payload":
         """Inverse of :meth:`as_dict` (checked like the constructor).
 
         Raises:
@@ -153,7 +154,7 @@ def _check_inertia(value: Any, mass: float) -> np.ndarray:
     return arr
 
 
-def as_payload(payload: Any, *, com: Any = None, inertia: Any = None, frame: str | None = None) -> Payload | None:
+def as_payload(payload: Payload | float | Mapping[str, object] | None, *, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Payload | None:
     """A :class:`Payload` from a mass [kg], a Payload, its dict form, or ``None`` (no payload).
 
     ``com``, ``inertia`` and ``frame`` apply when ``payload`` is a mass.
@@ -175,7 +176,7 @@ def as_payload(payload: Any, *, com: Any = None, inertia: Any = None, frame: str
 
 
 
-def with_payload(robot: Any, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> Any:
+def with_payload(robot: Any, mass: Payload | float, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Any:
     """A copy of ``robot`` carrying a payload; ``robot`` itself is unchanged.
 
     A payload replaces the one ``robot`` already carries (payloads do not stack); ``mass=0``

@@ -10,6 +10,7 @@ conventions (units, frames, shapes) are those of :mod:`pinarms.robots.robot`.
 from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots._checks import check_restarts as _check_restarts
 from pinarms.robots._checks import check_seed as _check_seed
@@ -66,7 +67,7 @@ class RobotIK:
         solver = self._analytic_ik
         return None if solver is None else solver.key
 
-    def check_target(self, target: Any, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
+    def check_target(self, target: ArrayLike, *, position_only: bool = False) -> tuple[np.ndarray, bool]:
         """Validate IK target(s): a pose ``(4, 4)`` / ``(N, 4, 4)`` frame → base [m], proper rotation.
 
         With ``position_only`` a position ``(3,)`` / ``(N, 3)`` [m] is accepted too.
@@ -79,7 +80,7 @@ class RobotIK:
         return check_ik_target(target, position_only=position_only)
 
     def ik_all(
-        self, target: Any, q_ref: Any = None, *, respect_limits: bool = True, equivalents: bool = False,
+        self, target: ArrayLike, q_ref: ArrayLike | None = None, *, respect_limits: bool = True, equivalents: bool = False,
         limit_tolerance: float = 0.0,
     ) -> np.ndarray | list[np.ndarray]:
         """Every closed-form IK branch within the joint limits (tolerance 1e-9 rad or m), each once.
@@ -121,7 +122,7 @@ class RobotIK:
             sols = split_by_target(idx, q, T.shape[0])
         return sols[0] if single else sols
 
-    def ik_branches(self, target: Any, q_ref: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_branches(self, target: ArrayLike, q_ref: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`ik_all` of one pose ``(4, 4)`` with the branch label of every solution.
 
         Returns:
@@ -181,7 +182,7 @@ class RobotIK:
                 q[j] = mid + (q[j] - mid + np.pi) % (2.0 * np.pi) - np.pi
         return q
 
-    def ik_failure_reason(self, target: Any, *, position_only: bool = False) -> str | None:
+    def ik_failure_reason(self, target: ArrayLike, *, position_only: bool = False) -> str | None:
         """Why ``target`` (one pose ``(4, 4)``) has no IK solution within the limits, or ``None`` if it has one.
 
         The answer says whether the pose is out of reach (or has an orientation the arm cannot
@@ -232,8 +233,8 @@ class RobotIK:
 
     def ik(
         self,
-        target: Any,
-        q_seed: Any = None,
+        target: ArrayLike,
+        q_seed: ArrayLike | None = None,
         *,
         position_only: bool = False,
         tol: float = 1e-10,

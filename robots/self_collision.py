@@ -35,9 +35,10 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.robots.coaxial import still_frames
@@ -154,7 +155,7 @@ class SelfCollision:
         """Number of body pairs checked."""
         return len(self._gm.collisionPairs)
 
-    def in_collision(self, q: Any, pairs: np.ndarray | None = None) -> bool | np.ndarray:
+    def in_collision(self, q: ArrayLike, pairs: np.ndarray | None = None) -> bool | np.ndarray:
         """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) self-collides.
 
         Args:

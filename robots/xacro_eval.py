@@ -359,9 +359,9 @@ class _Evaluator:
 
 def evaluate(
     expr: str,
-    symbols: Mapping[str, Any],
+    symbols: Mapping[str, object],
     *,
-    functions: Mapping[str, Callable[..., Any]] | None = None,
+    functions: Mapping[str, Callable[..., object]] | None = None,
     namespaces: tuple[type, ...] = (),
     attr_dicts: tuple[type, ...] = (),
 ) -> Any:

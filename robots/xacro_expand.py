@@ -165,7 +165,7 @@ def _limit_resources(limits: XacroLimits):
 
 def expand_xacro(
     path: str | os.PathLike,
-    args: Mapping[str, Any] | None = None,
+    args: Mapping[str, str | float] | None = None,
     *,
     packages: Mapping[str, str | os.PathLike] | None = None,
     header: tuple[str, ...] | list[str] = (),

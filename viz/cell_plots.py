@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -18,10 +18,15 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz.figure_files import checked_numbers, save_figure
 
+if TYPE_CHECKING:
+    from pinarms.optim.line.schedule import LineSchedule
+    from pinarms.robots.cell.motion_report import MotionCheck
+    from pinarms.optim.motion.report import ClearanceProfile
+
 __all__ = ["plot_clearance", "plot_schedule"]
 
 
-def plot_clearance(path: str | Path, check: Any, *, title: str = "clearance over time", mm: bool = True) -> Path:
+def plot_clearance(path: str | Path, check: MotionCheck | ClearanceProfile, *, title: str = "clearance over time", mm: bool = True) -> Path:
     """Each moving arm's distance to everything else against time, one curve per group of pairs.
 
     ``check`` is a :class:`pinarms.robots.cell.MotionCheck` checked with ``curve=True`` (its
@@ -90,7 +95,7 @@ def _annotate_closest(ax: Any, check: Any, t: np.ndarray, lowest: tuple, k: floa
                 fontsize=8)
 
 
-def plot_schedule(path: str | Path, schedule: Any, *, periods: int = 2, title: str | None = None) -> Path:
+def plot_schedule(path: str | Path, schedule: LineSchedule, *, periods: int = 2, title: str | None = None) -> Path:
     """Each arm's busy intervals in the shared zone over ``periods`` line periods (a Gantt chart).
 
     ``schedule`` is an :class:`pinarms.optim.LineSchedule`; each arm's cycle start is marked.

@@ -9,19 +9,23 @@ samples in contact as a red point set.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.cell import Cell
 from pinarms.robots.cell.timeline import arm_motions, configurations, sample_motions
 from pinarms.errors import InvalidInput
 
+if TYPE_CHECKING:
+    from pinarms.robots.cell.motion_report import MotionCheck
+
 __all__ = ["add_cell"]
 
 
-def add_cell(session: Any, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
-             name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
+def add_cell(session: Any, cell: Cell, *, key: str | None = None, motions: Any = None, check: MotionCheck | None = None,
+             name: str = "cell motion", hz: float = 100.0, hold: ArrayLike | None = None) -> str:
     """Add ``cell`` to ``session`` (:meth:`pinarms.viz.Session.add_cell` says how); return its robot key."""
     if not isinstance(cell, Cell):
         raise InvalidInput(f"cell must be a robots.cell.Cell, got {type(cell).__name__}")

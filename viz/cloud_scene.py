@@ -9,7 +9,7 @@ maximum (0 → the colormap's low end).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -17,6 +17,9 @@ import numpy as np
 from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.page import colorbar_stops, manipulability_unit
 from pinarms.viz.shapes import transform_points
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["colors_by_value", "Clouds", "draw_clouds", "cloud_colorbar"]
 
@@ -53,7 +56,7 @@ class Clouds:
     w_max: float = 0.0
 
 
-def draw_clouds(vis: meshcat.Visualizer, session: Any, root: str, bounds: list[np.ndarray], *, colormap: str,
+def draw_clouds(vis: meshcat.Visualizer, session: Session, root: str, bounds: list[np.ndarray], *, colormap: str,
                  point_pixels: float, cloud_opacity: float, show_clouds: bool, max_cloud_points: int) -> Clouds:
     """Draw the workspace clouds under ``<root>/workspace/<name>`` in the world frame (joining ``bounds``), coloured by manipulability, a seeded subsample when too large."""
     clouds = Clouds()
@@ -77,7 +80,7 @@ def draw_clouds(vis: meshcat.Visualizer, session: Any, root: str, bounds: list[n
     return clouds
 
 
-def cloud_colorbar(session: Any, clouds: Clouds, colormap: str) -> dict[str, Any] | None:
+def cloud_colorbar(session: Session, clouds: Clouds, colormap: str) -> dict[str, Any] | None:
     """The page's manipulability colour bar, or None without clouds."""
     if not clouds.paths:
         return None

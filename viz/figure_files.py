@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import io
 from pathlib import Path
-from typing import Any
+
 
 import numpy as np
+from numpy.typing import ArrayLike
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -36,7 +37,7 @@ def save_figure(fig: Figure, path: str | Path) -> Path:
     return atomic_write(p, lambda f: f.write(data))
 
 
-def checked_numbers(values: Any, what: str, allow_inf: bool = False) -> np.ndarray:
+def checked_numbers(values: ArrayLike, what: str, allow_inf: bool = False) -> np.ndarray:
     """``values`` as a finite float array (±inf kept if ``allow_inf``), or InvalidInput naming ``what``."""
     try:
         arr = np.asarray(values, dtype=float)

@@ -9,7 +9,7 @@ robot's base frame as clouds are), and the picks and places are target points (l
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -17,10 +17,15 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz.session import Session
 
+if TYPE_CHECKING:
+    from pinarms.optim.layout.result import LayoutSearch
+    from pinarms.robots.cell.cell import Cell
+    from pinarms.robots.robot import Robot
+
 __all__ = ["layout_search_session"]
 
 
-def layout_search_session(result: Any, robot: Any, *, title: str | None = None, cell: Any = None,
+def layout_search_session(result: LayoutSearch, robot: Robot, *, title: str | None = None, cell: Cell | None = None,
                           carry: tuple[str, ...] = ()) -> Session:
     """Session of a layout search of ``robot`` (see the module docstring).
 

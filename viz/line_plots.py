@@ -16,7 +16,7 @@ atomically) and return the path. Units: s, items/min, fractions shown in %.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -24,6 +24,12 @@ from matplotlib.figure import Figure
 from pinarms.errors import InvalidInput
 
 from pinarms.viz.plots import _save
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+    from pinarms.optim.line.api import LineResult, LineSpec
+    from pinarms.optim.line.simulate import SimResult
 
 __all__ = ["schedule_figure", "plot_line_schedule", "sizing_figure", "plot_line_sizing", "line_curve",
            "MAX_LABELLED_PICKS"]
@@ -47,7 +53,7 @@ def _run_of(result: Any, run: int) -> tuple[Any, float | None, float | None]:
     return result, None, None
 
 
-def schedule_figure(result: Any, *, run: int = 0, window: tuple[float, float] = (0.0, 60.0),
+def schedule_figure(result: LineResult | SimResult, *, run: int = 0, window: tuple[float, float] = (0.0, 60.0),
                     title: str | None = None) -> Figure:
     """The schedule of ``result`` (a :class:`pinarms.optim.line.LineResult` or a :class:`SimResult`) over ``window`` [s].
 
@@ -96,7 +102,7 @@ def schedule_figure(result: Any, *, run: int = 0, window: tuple[float, float] = 
     return fig
 
 
-def plot_line_schedule(path: str | Path, result: Any, **options: Any) -> Path:
+def plot_line_schedule(path: str | Path, result: LineResult | SimResult, **options: Any) -> Path:
     """Write :func:`schedule_figure` of ``result`` to ``path`` (.png or .svg); return the path."""
     return _save(schedule_figure(result, **options), path)
 
@@ -117,7 +123,7 @@ def _band(result: Any) -> tuple[float, float, float, float, float, float]:
     return (*tp, float(fig.miss_rate), float(fig.miss_rate_ci[0]), float(fig.miss_rate_ci[1]))
 
 
-def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]], *, target_miss: float | None = 0.01,
+def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[LineResult]]], *, target_miss: float | None = 0.01,
                   title: str | None = None) -> Figure:
     """Throughput and miss rate against each swept quantity.
 
@@ -160,14 +166,14 @@ def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]], *
     return fig
 
 
-def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float], Sequence[Any]]],
+def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float], Sequence[LineResult]]],
                      **options: Any) -> Path:
     """Write :func:`sizing_figure` of ``curves`` to ``path`` (.png or .svg); return the path."""
     return _save(sizing_figure(curves, **options), path)
 
 
-def line_curve(make_spec: Callable[[float], Any], values: Sequence[float], *, maps: Any = None,
-               scheduler: Any = None) -> tuple[list[float], list[Any]]:
+def line_curve(make_spec: Callable[[float], LineSpec], values: Sequence[float], *, maps: Any = None,
+               scheduler: str | Client | None = None) -> tuple[list[float], list[Any]]:
     """``(values, [run_line(make_spec(v)) ...])``: one curve of :func:`sizing_figure`.
 
     ``maps``: task maps given to every run (``None``: each run builds its own), or a callable

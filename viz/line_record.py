@@ -151,17 +151,22 @@ def decode_line(it: Any) -> LineRecord:
     return rec
 
 
-def make_line(name: str, arms: tuple[str, ...], belt_to_world: Any, *, length: float, width: float, thickness: float,
-              speed: float, u_miss: float, duration: float, items: Any) -> LineRecord:
-    """A checked record; :class:`InvalidInput` naming what is wrong."""
-    T = np.array(belt_to_world, dtype=float)
-    rows = np.array(items, dtype=float).reshape(-1, len(ITEM_COLUMNS))
+def make_line(draft: LineRecord) -> LineRecord:
+    """``draft`` checked, its numbers as floats and its arrays read-only; :class:`InvalidInput` naming what is wrong.
+
+    The caller fills a :class:`LineRecord` with the belt (``belt_to_world`` (4, 4), ``length``,
+    ``width``, ``thickness`` [m], ``speed`` [m/s]), the window (``u_miss`` [m], ``duration`` [s])
+    and the item rows (anything shaped (N, 9)); this returns the record a session keeps.
+    """
+    name = draft.name
+    T = np.array(draft.belt_to_world, dtype=float)
+    rows = np.array(draft.items, dtype=float).reshape(-1, len(ITEM_COLUMNS))
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise InvalidInput(f"line {name!r}: belt_to_world must be a finite (4, 4) pose")
     T.flags.writeable = False
     rows.flags.writeable = False
-    rec = LineRecord(name, tuple(arms), T, float(length), float(width), float(thickness), float(speed),
-                     float(u_miss), float(duration), rows)
+    rec = LineRecord(name, tuple(draft.arms), T, float(draft.length), float(draft.width), float(draft.thickness),
+                     float(draft.speed), float(draft.u_miss), float(draft.duration), rows)
     bad = check_line(rec)
     if bad:
         raise InvalidInput(f"line {name!r}: {bad}")

@@ -19,13 +19,16 @@ few hundred items stays small.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pinarms.viz._meshcat import mg
+from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.errors import ViewerError
-from pinarms.viz.line_record import BOX_DEPTH, MISSED, NOT_DRAWN
+from pinarms.viz.line_record import BOX_DEPTH, MISSED, NOT_DRAWN, LineRecord
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["draw_lines", "animate_lines", "item_positions", "ITEM_COLOR", "MISSED_COLOR"]
 
@@ -38,7 +41,7 @@ def _to_world(T: np.ndarray, u: np.ndarray, w: np.ndarray, z: np.ndarray) -> np.
     return T[:3, 3] + u[..., None] * T[:3, 0] + w[..., None] * T[:3, 1] + z[..., None] * T[:3, 2]
 
 
-def draw_lines(vis: Any, session: Any, root: str, bounds: list) -> list[str]:
+def draw_lines(vis: meshcat.Visualizer, session: Session, root: str, bounds: list) -> list[str]:
     """Draw each line's belt and miss strip (static); return the page's summary lines. ``bounds`` grows."""
     lines = []
     for name, rec in getattr(session, "lines", {}).items():
@@ -63,7 +66,7 @@ def draw_lines(vis: Any, session: Any, root: str, bounds: list) -> list[str]:
     return lines
 
 
-def item_positions(rec: Any, times: np.ndarray, tcp: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def item_positions(rec: LineRecord, times: np.ndarray, tcp: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """World centres (N, F, 3) of every item drawn normally and drawn red (missed) at ``times`` (F,) [s].
 
     ``tcp[k]`` (F, 3): arm ``k``'s tool point (world) at ``times``. Hidden items sit inside the belt.
@@ -110,7 +113,7 @@ def _kept(p: np.ndarray) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def animate_lines(vis: Any, anim: Any, session: Any, root: str, times: np.ndarray, animated: tuple[str, ...],
+def animate_lines(vis: meshcat.Visualizer, anim: meshcat.animation.Animation, session: Session, root: str, times: np.ndarray, animated: tuple[str, ...],
                   drawings: dict) -> None:
     """Draw each line's items and add their tracks to ``anim`` (frames at ``times`` (F,) [s])."""
     for name, rec in getattr(session, "lines", {}).items():
@@ -145,7 +148,7 @@ def animate_lines(vis: Any, anim: Any, session: Any, root: str, times: np.ndarra
                         frame[path].set_transform(R)
 
 
-def line_duration(session: Any) -> float:
+def line_duration(session: Session) -> float:
     """Longest window of the session's lines [s] (0 without lines)."""
     return max((rec.duration for rec in getattr(session, "lines", {}).values()), default=0.0)
 
@@ -157,7 +160,7 @@ __all__.append("line_duration")
 FRAMED_ARMS = 3
 
 
-def line_focus(session: Any, points: np.ndarray) -> np.ndarray:
+def line_focus(session: Session, points: np.ndarray) -> np.ndarray:
     """What the view of a scene opens framed on: ``points`` (k, 3), or, for a line of more than
     :data:`FRAMED_ARMS` arms, those of them up to 0.6 m past the third arm's base along the belt
     and the belt from its start to there (the page's orbit and zoom reach the rest)."""

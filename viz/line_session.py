@@ -19,13 +19,16 @@ Units: m, s, rad.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.errors import InvalidInput, PinarmsError
 
 from pinarms.viz.line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, LineRecord, make_line
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.api import LineResult, LineSpec
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
@@ -81,7 +84,7 @@ def _arm_samples(q_rest: np.ndarray, plans: list, t: np.ndarray) -> np.ndarray:
     return q
 
 
-def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float = 0.0,
+def add_line(session: Any, spec: LineSpec, result: LineResult, *, run: int = 0, start: float = 0.0,
              duration: float = DEFAULT_WINDOW_S, name: str = "line", hz: float = 30.0) -> LineRecord:
     """Add the window [``start``, ``start + duration``] s of run ``run`` of ``result`` (module doc).
 
@@ -142,7 +145,8 @@ def add_line(session: Any, spec: Any, result: Any, *, run: int = 0, start: float
     ends = [w.u_max for w in getattr(result, "windows", ())] or [belt.length]
     u_miss = float(min(belt.length, max(ends) + belt.speed * spec.tracking.track_time))
     thickness = max(0.05, 1.25 * max(max(tp.size) for tp in items.types))
-    rec = make_line(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world, length=belt.length,
-                    width=belt.width, thickness=thickness, speed=belt.speed, u_miss=u_miss, duration=dur, items=rows)
+    rec = make_line(LineRecord(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world,
+                               length=belt.length, width=belt.width, thickness=thickness, speed=belt.speed,
+                               u_miss=u_miss, duration=dur, items=rows))
     session.lines[rec.name] = rec
     return rec

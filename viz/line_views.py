@@ -6,17 +6,21 @@ line to a session it is handed, so it imports none of them).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 from pinarms.viz.html import export_html
 from pinarms.viz.line_plots import plot_line_schedule
 from pinarms.viz.line_session import DEFAULT_WINDOW_S, add_line
 from pinarms.viz.session import Session
 
+if TYPE_CHECKING:
+    from pinarms.optim.line.api import LineResult, LineSpec
+    from pinarms.optim.line.schedule import LineSchedule
+
 __all__ = ["save_line_views"]
 
 
-def save_line_views(spec: Any, result: Any, *, session: Any = None, html: Any = None, schedule: Any = None,
+def save_line_views(spec: LineSpec, result: LineResult, *, session: Session | None = None, html: Any = None, schedule: LineSchedule | None = None,
                     title: str | None = None, run: int = 0, duration: float = DEFAULT_WINDOW_S) -> list:
     """Write what a line engineer looks at: the session (``.pinarms``), its standalone page
     (``.html``) and the schedule plot (``.png``/``.svg``) of run ``run``, window [0, ``duration``] s

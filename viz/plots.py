@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
+from numpy.typing import ArrayLike
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
@@ -26,8 +27,14 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz.cell_plots import plot_clearance, plot_schedule
 from pinarms.viz.figure_files import checked_numbers, save_figure
+from pinarms.viz.joint_curves import JointCurves
 from pinarms.viz.reach_plots import plot_workspace
 from pinarms.viz.search_plots import plot_ga_convergence, plot_layout_search
+
+if TYPE_CHECKING:
+    from pinarms.planning.limits import JointLimits
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.robot import Robot
 
 __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence", "plot_workspace",
            "plot_clearance", "plot_schedule", "plot_torques",
@@ -81,15 +88,10 @@ def _joint_labels(n: int, robot: Any, joint_names: Sequence[str] | None,
 
 def plot_joint_curves(
     path: str | Path,
-    t: Any,
-    q: Any,
-    qd: Any = None,
-    qdd: Any = None,
-    qddd: Any = None,
+    curves: JointCurves,
     *,
-    knot_times: Any = None,
-    limits: Any = None,
-    robot: Any = None,
+    limits: JointLimits | Mapping[str, ArrayLike] | None = None,
+    robot: Robot | None = None,
     joint_names: Sequence[str] | None = None,
     joint_units: Sequence[str] | None = None,
     degrees: bool = False,
@@ -99,9 +101,9 @@ def plot_joint_curves(
 
     Args:
         path: output file (.png or .svg).
-        t: instants (N,), s. q, qd, qdd, qddd: (N, n) (or (N,)) in rad, rad/s, ... (or m, m/s, ...);
-            derivatives left ``None`` are not drawn.
-        knot_times: knot (via point) instants (s): vertical dotted lines, markers on the curves.
+        curves: a :class:`pinarms.viz.joint_curves.JointCurves`: instants, the joint values at them
+            (derivatives left ``None`` are not drawn) and the knot instants (vertical dotted
+            lines, markers on the curves).
         limits: ``planning.JointLimits`` or a mapping with ``velocity``, ``acceleration``,
             ``jerk`` (per joint or scalar, SI): drawn as dashed ±limit lines, labelled.
         robot: a ``robots.Robot`` whose joints are drawn: the default names and units.
@@ -112,34 +114,19 @@ def plot_joint_curves(
 
     The legend stands to the right of the panels, outside the curves.
     """
-    fig = _joint_curves_figure(t, q, qd, qdd, qddd, knot_times=knot_times, limits=limits, robot=robot,
-                               joint_names=joint_names, joint_units=joint_units, degrees=degrees, title=title)
+    if not isinstance(curves, JointCurves):
+        raise InvalidInput(f"curves must be a viz.joint_curves.JointCurves, got {type(curves).__name__}")
+    fig = _joint_curves_figure(curves, limits=limits, robot=robot, joint_names=joint_names, joint_units=joint_units,
+                               degrees=degrees, title=title)
     return save_figure(fig, path)
 
 
-def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_times: Any, limits: Any, robot: Any,
-                         joint_names: Sequence[str] | None, joint_units: Sequence[str] | None, degrees: bool,
-                         title: str) -> Figure:
+def _joint_curves_figure(curves: JointCurves, *, limits: Any, robot: Any, joint_names: Sequence[str] | None,
+                         joint_units: Sequence[str] | None, degrees: bool, title: str) -> Figure:
     """The figure of :func:`plot_joint_curves` (checked inputs)."""
-    tt = checked_numbers(t, "t")
-    if tt.ndim != 1 or tt.size < 2:
-        raise InvalidInput(f"t must be (N,) instants in s with N >= 2, got shape {tt.shape}")
-    if np.any(np.diff(tt) <= 0):
-        raise InvalidInput("t must be strictly increasing instants in s")
-    series = []
-    for order, values in enumerate((q, qd, qdd, qddd)):
-        if values is None:
-            continue
-        arr = checked_numbers(values, _ORDERS[order])
-        arr = arr[:, None] if arr.ndim == 1 else arr
-        if arr.ndim != 2 or arr.shape[0] != tt.size:
-            raise InvalidInput(f"{_ORDERS[order]} must have shape ({tt.size}, n_joints), got {np.shape(values)}")
-        series.append((order, arr))
-    if not series:
-        raise InvalidInput("give at least one of q, qd, qdd, qddd")
+    tt = curves.t
+    series = curves.series
     n = series[0][1].shape[1]
-    if any(a.shape[1] != n for _, a in series):
-        raise InvalidInput("q, qd, qdd and qddd must have the same number of joints")
     names, units = _joint_labels(n, robot, joint_names, joint_units)
     if units is None:  # unknown kinds: SI values as given
         scale = np.full(n, 180.0 / math.pi if degrees else 1.0)
@@ -150,7 +137,7 @@ def _joint_curves_figure(t: Any, q: Any, qd: Any, qdd: Any, qddd: Any, *, knot_t
     kinds = sorted(set(shown), key=shown.index)
     mixed = len(kinds) > 1
     labels = [f"{name} [{u}]" if mixed else name for name, u in zip(names, shown)]
-    knots = None if knot_times is None else checked_numbers(knot_times, "knot_times").ravel()
+    knots = curves.knot_times
 
     fig = Figure(figsize=(8.8, 2.3 * len(series) + 0.5), layout="constrained")
     axes = fig.subplots(len(series), 1, sharex=True, squeeze=False)
@@ -202,7 +189,7 @@ def _draw_limits(ax: Any, lim: np.ndarray, names: list[str], units: list[str], c
                     xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=c)
 
 
-def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, samples: int = 400, **options: Any) -> Path:
+def plot_trajectory(path: str | Path, trajectory: Trajectory, *, limits: JointLimits | Mapping[str, ArrayLike] | None = None, samples: int = 400, **options: Any) -> Path:
     """:func:`plot_joint_curves` of a ``planning.Trajectory`` (sampled at ``samples`` instants plus its knots)."""
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
         raise InvalidInput(f"samples must be an integer >= 2 (instants drawn), got {samples!r}")
@@ -210,10 +197,10 @@ def plot_trajectory(path: str | Path, trajectory: Any, *, limits: Any = None, sa
     t = np.union1d(np.linspace(knots[0], knots[-1], int(samples)), knots)
     q, qd, qdd, qddd = trajectory.sample(t)
     drawn = knots if knots.size <= MAX_DRAWN_KNOTS else None
-    return plot_joint_curves(path, t, q, qd, qdd, qddd, knot_times=drawn, limits=limits, **options)
+    return plot_joint_curves(path, JointCurves(t, q, qd, qdd, qddd, knot_times=drawn), limits=limits, **options)
 
 
-def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None = None, angular: Any = None,
+def plot_tool_speed(path: str | Path, t: ArrayLike, speed: ArrayLike, *, limit: float | None = None, angular: ArrayLike | None = None,
                     title: str = "tcp speed") -> Path:
     """The tcp's Cartesian speed versus time (e.g. from :func:`pinarms.planning.tcp_speed`).
 
@@ -245,7 +232,7 @@ def plot_tool_speed(path: str | Path, t: Any, speed: Any, *, limit: float | None
     return save_figure(fig, path)
 
 
-def plot_torques(path: str | Path, t: Any, torques: Any, limits: Any = None, *, joint_names: Sequence[str] | None = None,
+def plot_torques(path: str | Path, t: ArrayLike, torques: ArrayLike, limits: ArrayLike | None = None, *, joint_names: Sequence[str] | None = None,
                  units: Sequence[str] | None = None, series: Mapping[str, Any] | None = None, title: str = "joint torques") -> Path:
     """Joint torques against their limits: one panel per joint, ±limit dashed, peaks marked.
 

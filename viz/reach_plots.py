@@ -14,10 +14,11 @@ region), the shape the paper gives.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
+from numpy.typing import ArrayLike
 from matplotlib.figure import Figure
 
 from pinarms.errors import InvalidInput
@@ -25,10 +26,13 @@ from pinarms.errors import InvalidInput
 from pinarms.viz.figure_files import checked_numbers, save_figure
 from pinarms.viz.reach_scene import INDEX_COLORMAP
 
+if TYPE_CHECKING:
+    from pinarms.robots.reach.reach_map import ReachabilityMap
+
 __all__ = ["plot_workspace", "plot_reachability_section", "section_index"]
 
 
-def section_index(reach_map: Any, cell: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def section_index(reach_map: ReachabilityMap, cell: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(rho_edges (a+1,), z_edges (b+1,), mean_index (a, b))`` [m] of the map over ``(ρ, z)`` cells of edge ``cell``.
 
     ``ρ`` is the horizontal distance of a voxel centre from the base's vertical axis; cells
@@ -55,7 +59,7 @@ def section_index(reach_map: Any, cell: float | None = None) -> tuple[np.ndarray
 
 def plot_reachability_section(
     path: str | Path,
-    reach_map: Any,
+    reach_map: ReachabilityMap,
     *,
     band: dict | None = None,
     title: str = "",
@@ -103,7 +107,7 @@ def plot_reachability_section(
     return save_figure(fig, path)
 
 
-def plot_workspace(path: str | Path, points: Any, manipulability: Any = None, *, title: str = "workspace",
+def plot_workspace(path: str | Path, points: ArrayLike, manipulability: ArrayLike | None = None, *, title: str = "workspace",
                    colormap: str = "viridis", mm: bool = False) -> Path:
     """Top (x-y) and side (x-z) projections of a workspace cloud coloured by manipulability.
 

@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.reach.reach_map import ReachabilityMap
 
 __all__ = ["ReachabilityRecord", "make_record", "encode_reachability", "decode_reachability", "MAX_DESCRIPTION"]
 
@@ -43,7 +46,7 @@ class ReachabilityRecord:
     description: str
 
 
-def make_record(name: str, robot_key: str, reach_map: Any, min_index: float, float_array: Callable) -> ReachabilityRecord:
+def make_record(name: str, robot_key: str, reach_map: ReachabilityMap, min_index: float, float_array: Callable) -> ReachabilityRecord:
     """A record of ``reach_map``'s voxels with index > ``min_index`` (checked like the session's other arrays)."""
     for attr in ("reachable_centres", "best_manipulability", "orientations", "resolution"):
         if not hasattr(reach_map, attr):

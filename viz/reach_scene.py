@@ -11,12 +11,15 @@ Controls panel lists them too.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
 
-from pinarms.viz._meshcat import mg
+from pinarms.viz._meshcat import meshcat, mg
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["draw_reachability", "layer_name", "INDEX_COLORMAP"]
 
@@ -33,7 +36,7 @@ def _transform(T: np.ndarray, p: np.ndarray) -> np.ndarray:
     return p @ T[:3, :3].T + T[:3, 3]
 
 
-def draw_reachability(vis: Any, session: Any, root: str, bounds: list) -> tuple[dict[str, list[str]], list[dict]]:
+def draw_reachability(vis: meshcat.Visualizer, session: Session, root: str, bounds: list) -> tuple[dict[str, list[str]], list[dict]]:
     """Draw every reachability record of ``session``.
 
     Returns ``name → layer paths`` (lowest layer first) and the page entries (``name``,

@@ -12,13 +12,16 @@ import os
 import re
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Sequence, TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from pinarms.viz._meshcat import MeshcatVisualizer, meshcat
 from pinarms.viz.errors import ViewerError
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["RobotDrawing", "resolved_package_meshes"]
 
@@ -52,7 +55,7 @@ def resolved_package_meshes(urdf_text: str, package_dirs: Sequence[str]) -> str:
 class RobotDrawing:
     """One robot's visual geometry in the scene, driven by Pinocchio's MeshcatVisualizer."""
 
-    def __init__(self, vis: meshcat.Visualizer, robot: Any, key: str, base_to_world: np.ndarray,
+    def __init__(self, vis: meshcat.Visualizer, robot: Robot, key: str, base_to_world: np.ndarray,
                  package_dirs: Sequence[str], root: str = "pinarms") -> None:
         self.robot = robot
         self.root = f"{root}/robots/{key}"

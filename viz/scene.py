@@ -28,9 +28,8 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, TYPE_CHECKING
 
-import matplotlib
 import numpy as np
 
 from pinarms.errors import InvalidInput
@@ -38,9 +37,13 @@ from pinarms.errors import InvalidInput
 from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.cloud_scene import draw_clouds, cloud_colorbar
 from pinarms.viz.page import PAGE_PROPERTY
+from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.robot_drawing import RobotDrawing
 from pinarms.viz.shapes import downsample_polyline, floor_grid, frame_view, transform_points, tube_mesh
 from pinarms.viz.trajectory_scene import animate_scene, animated_trajectories, show_start_poses, world_tcp_paths
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
@@ -99,21 +102,7 @@ def _sphere_set(vis: meshcat.Visualizer, base: str, points: np.ndarray, radius: 
     return paths
 
 
-def build_scene(
-    vis: meshcat.Visualizer,
-    session: Any,
-    *,
-    animate: Sequence[str] | None = None,
-    fps: float = 30.0,
-    play: bool = True,
-    point_pixels: float = 3.0,
-    cloud_opacity: float = 0.3,
-    show_clouds: bool = True,
-    max_cloud_points: int = 20_000,
-    sphere_radius: float | None = None,
-    colormap: str = "viridis",
-    hide_background: bool = False,
-) -> SceneInfo:
+def build_scene(vis: meshcat.Visualizer, session: Session, options: SceneOptions | None = None) -> SceneInfo:
     """Draw ``session`` into the MeshCat visualizer ``vis``; return what was drawn.
 
     The view opens framed on the robots and their tcp paths (clouds and boxes may extend
@@ -122,28 +111,19 @@ def build_scene(
     Args:
         vis: a ``meshcat.Visualizer`` (e.g. ``viz.MeshcatServer().visualizer``).
         session: a :class:`pinarms.viz.Session`.
-        animate: trajectory names to animate (at most one per robot); default: the first
-            trajectory of each robot; ``()`` for no animation.
-        fps: animation frame rate (1/s).
-        play: start playing (looping) when a browser opens the page.
-        point_pixels: size of the workspace points on screen [px]; cloud_opacity: their
-            opacity in (0, 1];
-            show_clouds: whether the clouds are shown when the page opens (the page has a
-            switch either way); max_cloud_points: a larger cloud is drawn as a seeded
-            uniform subsample of that many points (the page says so; the session keeps all).
-        sphere_radius: via-point sphere radius (m); default 1.5 % of the framed radius, at
-            least 12 mm; the tcp path tube's radius is 40 % of it.
-        colormap: matplotlib colormap for manipulability (low → high).
-        hide_background: hide MeshCat's background, grid and axes (plain white page).
+        options: what to animate and how to draw (:class:`pinarms.viz.scene_options.SceneOptions`;
+            default ``SceneOptions()``).
     """
-    _check_options(fps, colormap, cloud_opacity, point_pixels, sphere_radius, max_cloud_points)
+    o = SceneOptions() if options is None else options
+    if not isinstance(o, SceneOptions):
+        raise InvalidInput(f"options must be a viz.SceneOptions, got {type(o).__name__}")
     vis[ROOT].delete()
     bounds: list[np.ndarray] = []
     framed: list[np.ndarray] = []  # what the view is centred on: robots and tcp paths
     drawings = _draw_robots(vis, session, bounds)
     _draw_boxes(vis, session, bounds)
-    clouds = draw_clouds(vis, session, ROOT, bounds, colormap=colormap, point_pixels=point_pixels,
-                          cloud_opacity=cloud_opacity, show_clouds=show_clouds, max_cloud_points=max_cloud_points)
+    clouds = draw_clouds(vis, session, ROOT, bounds, colormap=o.colormap, point_pixels=o.point_pixels,
+                          cloud_opacity=o.cloud_opacity, show_clouds=o.show_clouds, max_cloud_points=o.max_cloud_points)
     from pinarms.viz.reach_scene import draw_reachability  # voxel layers coloured by reachability index
 
     reach_paths, reach_page = draw_reachability(vis, session, ROOT, bounds)
@@ -152,28 +132,27 @@ def build_scene(
     line_lines = draw_lines(vis, session, ROOT, bounds)
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
     tcp_paths, knots = world_tcp_paths(session, drawings, bounds, framed)
-    animated = animated_trajectories(session, animate)
+    animated = animated_trajectories(session, o.animate)
     show_start_poses(session, drawings, animated, framed)
 
     lo, hi, target, camera, radius = _frame(session, bounds, framed, tcp_paths)
 
-    if sphere_radius is None:
-        sphere_radius = max(0.012, 0.015 * radius)
+    sphere_radius = max(0.012, 0.015 * radius) if o.sphere_radius is None else o.sphere_radius
     points = {name: _sphere_set(vis, f"{ROOT}/points/{name}", _point_set_world(session, name), sphere_radius,
                                 _POINT_COLORS[ps.kind]) for name, ps in session.point_sets.items()}
     paths = _draw_tcp_paths(vis, tcp_paths, knots, sphere_radius)
 
-    duration, n_frames = animate_scene(vis, session, ROOT, drawings, animated, bool(line_lines), fps, play)
+    duration, n_frames = animate_scene(vis, session, ROOT, drawings, animated, bool(line_lines), o.fps, o.play)
 
     _place_camera(vis, camera)
-    floor_note = _dress_stage(vis, np.vstack(framed) if framed else np.vstack([lo, hi]), hide_background)
+    floor_note = _dress_stage(vis, np.vstack(framed) if framed else np.vstack([lo, hi]), o.hide_background)
     page = {
         "title": session.title or "pinarms session",
         "lines": _summary_lines(session, animated, clouds.shown, line_arms) + line_lines + [floor_note],
         "target": target.tolist(), "camera": camera.tolist(),
-        "clouds": list(clouds.paths.values()), "clouds_visible": bool(show_clouds),
-        "animation": {"duration": duration, "playing": bool(play and (animated or line_lines))},
-        "colorbar": cloud_colorbar(session, clouds, colormap),
+        "clouds": list(clouds.paths.values()), "clouds_visible": bool(o.show_clouds),
+        "animation": {"duration": duration, "playing": bool(o.play and (animated or line_lines))},
+        "colorbar": cloud_colorbar(session, clouds, o.colormap),
     }
     if reach_page:
         page["reachability"] = reach_page
@@ -184,27 +163,9 @@ def build_scene(
         robots={k: d.geometry_paths for k, d in drawings.items()},
         objects={n: f"{ROOT}/objects/{n}" for n in session.objects},
         clouds=clouds.paths, paths=paths, points=all_points, animated=animated, duration=duration,
-        n_frames=n_frames, fps=float(fps), bounds=(lo, hi), target=target, camera=camera, page=page,
+        n_frames=n_frames, fps=float(o.fps), bounds=(lo, hi), target=target, camera=camera, page=page,
         reachability=reach_paths,
     )
-
-
-def _check_options(fps: Any, colormap: Any, cloud_opacity: Any, point_pixels: Any, sphere_radius: Any,
-                   max_cloud_points: Any) -> None:
-    """Refuse options of :func:`build_scene` out of their range, naming the option and its unit."""
-    if not (np.isfinite(fps) and fps > 0):
-        raise InvalidInput(f"fps must be a positive frame rate in 1/s, got {fps!r}")
-    if colormap not in matplotlib.colormaps:
-        raise InvalidInput(f"unknown matplotlib colormap {colormap!r}")
-    if not (isinstance(cloud_opacity, (int, float)) and 0.0 < cloud_opacity <= 1.0):
-        raise InvalidInput(f"cloud_opacity must be in (0, 1], got {cloud_opacity!r}")
-    for name, value, unit in (("point_pixels", point_pixels, "px"), ("sphere_radius", sphere_radius, "m")):
-        if value is None and name == "sphere_radius":
-            continue
-        if isinstance(value, bool) or not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-            raise InvalidInput(f"{name} must be a positive size in {unit}, got {value!r}")
-    if isinstance(max_cloud_points, bool) or not isinstance(max_cloud_points, (int, np.integer)) or max_cloud_points < 1:
-        raise InvalidInput(f"max_cloud_points must be a positive integer, got {max_cloud_points!r}")
 
 
 def _draw_robots(vis: meshcat.Visualizer, session: Any, bounds: list[np.ndarray]) -> dict[str, RobotDrawing]:

@@ -7,20 +7,27 @@ atomically (:func:`pinarms.viz.figure_files.save_figure`) and returns the path.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping, TYPE_CHECKING
 
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
 from pinarms.viz.figure_files import checked_numbers, save_figure
 
+if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from pinarms.viz.session_records import HistoryRecord
+    from pinarms.optim.layout.result import LayoutSearch
+
 __all__ = ["plot_ga_convergence", "plot_layout_search"]
 
 
-def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA convergence", ylabel: str = "objective") -> Path:
+def plot_ga_convergence(path: str | Path, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike], *,
+                        title: str = "GA convergence", ylabel: str = "objective") -> Path:
     """Best-so-far and mean objective per generation, and the feasible share when recorded.
 
     ``history``: a GA history (``best``, ``feasible_mean`` or ``mean``, optional
@@ -79,7 +86,7 @@ def plot_ga_convergence(path: str | Path, history: Any, *, title: str = "GA conv
     return save_figure(fig, path)
 
 
-def plot_layout_search(path: str | Path, result: Any, *, title: str | None = None, colormap: str = "viridis",
+def plot_layout_search(path: str | Path, result: LayoutSearch, *, title: str | None = None, colormap: str = "viridis",
                        mm: bool = True) -> Path:
     """Picks per minute over the (x, y) placements of a layout search (:class:`pinarms.optim.LayoutSearch`).
 

@@ -14,7 +14,7 @@ import sys
 import threading
 import weakref
 from pathlib import Path
-from typing import Any
+
 
 from pinarms.errors import InvalidInput
 
@@ -110,7 +110,7 @@ class MeshcatServer:
     def __enter__(self) -> "MeshcatServer":
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 

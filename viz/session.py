@@ -25,9 +25,10 @@ import os
 import threading
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms import robots
 from pinarms.errors import InvalidInput
@@ -56,6 +57,15 @@ from pinarms.viz.session_records import (
 )
 from pinarms.viz.session_robots import rebuild_robot, robot_entry, shipped_model_dirs
 from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
+
+if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from pinarms.robots.reach.workspace import Workspace
+    from pinarms.robots.cell.motion_report import MotionCheck
+    from pinarms.optim.line.api import LineResult, LineSpec
+    from pinarms.robots.cell.cell import Cell
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.reach.reach_map import ReachabilityMap
 
 __all__ = [
     "FORMAT_NAME",
@@ -102,8 +112,8 @@ class Session:
         robot: Robot | str | None = None,
         *,
         title: str = "",
-        metadata: Mapping[str, Any] | None = None,
-        base_to_world: Any = None,
+        metadata: Mapping[str, object] | None = None,
+        base_to_world: ArrayLike | None = None,
         key: str | None = None,
     ) -> None:
         if not isinstance(title, str):
@@ -147,7 +157,7 @@ class Session:
         )
 
     # ---------------------------------------------------------------- robots
-    def add_robot(self, robot: Robot | str, *, key: str | None = None, base_to_world: Any = None) -> str:
+    def add_robot(self, robot: Robot | str, *, key: str | None = None, base_to_world: ArrayLike | None = None) -> str:
         """Add a robot placed at ``base_to_world`` (4, 4) in the world; return its key.
 
         A robot that ``robots.load`` rebuilds exactly is stored by name; any other has its
@@ -196,8 +206,8 @@ class Session:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
         return name
 
-    def add_cell(self, cell: Any, *, key: str | None = None, motions: Any = None, check: Any = None,
-                 name: str = "cell motion", hz: float = 100.0, hold: Any = None) -> str:
+    def add_cell(self, cell: Cell, *, key: str | None = None, motions: Any = None, check: MotionCheck | None = None,
+                 name: str = "cell motion", hz: float = 100.0, hold: ArrayLike | None = None) -> str:
         """Add a :class:`pinarms.robots.cell.Cell`: its arms and fixtures as one robot (the cell's URDF embedded).
 
         Args:
@@ -248,13 +258,13 @@ class Session:
         return q if q.shape == (nq,) and np.all(np.isfinite(q)) else None
 
     # ---------------------------------------------------------------- content
-    def add_box(self, name: str, size: Any, pose: Any = None, color: Any = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
+    def add_box(self, name: str, size: ArrayLike, pose: ArrayLike | None = None, color: ArrayLike = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""
         box = box_record(self._free(self.objects, name, "object"), size, pose, color)
         self.objects[box.name] = box
         return box
 
-    def add_trajectory(self, name: str, trajectory: Any, *, robot: str | None = None, hz: float = 100.0) -> TrajectoryRecord:
+    def add_trajectory(self, name: str, trajectory: Trajectory, *, robot: str | None = None, hz: float = 100.0) -> TrajectoryRecord:
         """Add a trajectory of robot ``robot`` (default: the only robot).
 
         Args:
@@ -267,7 +277,7 @@ class Session:
         self.trajectories[rec.name] = rec
         return rec
 
-    def add_workspace(self, name: str, workspace: Any = None, *, points: Any = None, manipulability: Any = None,
+    def add_workspace(self, name: str, workspace: Workspace | None = None, *, points: ArrayLike | None = None, manipulability: ArrayLike | None = None,
                       robot: str | None = None) -> WorkspaceRecord:
         """Add a workspace cloud of robot ``robot``: a ``Workspace`` (``points``, ``manipulability``) or the two arrays.
 
@@ -278,7 +288,7 @@ class Session:
         self.workspaces[rec.name] = rec
         return rec
 
-    def add_points(self, name: str, points: Any, *, kind: str = "via", robot: str | None = None) -> PointSet:
+    def add_points(self, name: str, points: ArrayLike, *, kind: str = "via", robot: str | None = None) -> PointSet:
         """Add via points or targets (``kind`` ``"via"`` or ``"target"``), (n, 3) m.
 
         With ``robot`` the points are in that robot's base frame, without it in the world frame.
@@ -295,13 +305,13 @@ class Session:
         self.point_sets[name] = ps
         return ps
 
-    def add_history(self, name: str, history: Any) -> HistoryRecord:
+    def add_history(self, name: str, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike]) -> HistoryRecord:
         """Add an optimisation history: a GA history (``best``, ``mean``, ...), a result with ``.history``, or a mapping of columns."""
         rec = history_record(self._free(self.histories, name, "history"), history)
         self.histories[rec.name] = rec
         return rec
 
-    def add_reachability(self, name: str, reach_map: Any, *, robot: str | None = None, min_index: float = 0.0) -> Any:
+    def add_reachability(self, name: str, reach_map: ReachabilityMap, *, robot: str | None = None, min_index: float = 0.0) -> Any:
         """Add the voxels of a :class:`pinarms.robots.ReachabilityMap` with index > ``min_index`` (robot ``robot``'s base frame).
 
         The viewer and the standalone page draw them as coloured voxels (see :mod:`pinarms.viz.reach_record`).
@@ -313,7 +323,7 @@ class Session:
         self.reachability[name] = rec
         return rec
 
-    def add_line(self, spec: Any, result: Any, **options: Any) -> Any:
+    def add_line(self, spec: LineSpec, result: LineResult, **options: Any) -> Any:
         """Add an animated window of a simulated belt line (:func:`pinarms.viz.line_session.add_line`)."""
         from pinarms.viz.line_session import add_line
 

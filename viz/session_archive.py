@@ -155,7 +155,7 @@ class ArchiveReader:
         return invalid_session(self.path, what)
 
     # ------------------------------------------------------------ json fields
-    def field(self, obj: Any, key: str, types: type | tuple, where: str) -> Any:
+    def field(self, obj: object, key: str, types: type | tuple, where: str) -> Any:
         if not isinstance(obj, dict):
             raise self.fail(f"{where} must be a JSON object")
         if key not in obj:
@@ -218,7 +218,7 @@ class ArchiveReader:
         except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError) as exc:
             raise self.fail(f"member {member!r} is corrupt ({exc})") from None
 
-    def text_ref(self, member: Any, where: str) -> zipfile.ZipInfo:
+    def text_ref(self, member: object, where: str) -> zipfile.ZipInfo:
         """Check a text member's entry and size before reading (cap :attr:`SessionLimits.max_text_bytes`)."""
         if not isinstance(member, str):
             raise self.fail(f"{where} must be a member name or null")
@@ -240,7 +240,7 @@ class ArchiveReader:
                             f"(entity expansion is refused)")
         return text
 
-    def array_ref(self, ref: Any, where: str, spec: ArraySpec, dims: dict[str, int]) -> ArrayRef:
+    def array_ref(self, ref: object, where: str, spec: ArraySpec, dims: dict[str, int]) -> ArrayRef:
         member = self.field(ref, "member", str, where)
         dtype = self.field(ref, "dtype", str, where)
         shape = self.field(ref, "shape", list, where)

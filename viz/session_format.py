@@ -75,7 +75,7 @@ __all__ = [
 
 
 # ---------------------------------------------------------------------------- writing
-def to_document(metadata: dict, tables: Mapping[str, Mapping[str, Any]]) -> tuple[dict, dict[str, np.ndarray], dict[str, str]]:
+def to_document(metadata: dict, tables: Mapping[str, Mapping[str, object]]) -> tuple[dict, dict[str, np.ndarray], dict[str, str]]:
     """The ``session.json`` document, the arrays by member name, and the text members."""
     arrays: dict[str, np.ndarray] = {}
     texts: dict[str, str] = {}
@@ -108,7 +108,7 @@ def to_document(metadata: dict, tables: Mapping[str, Mapping[str, Any]]) -> tupl
     return doc, arrays, texts
 
 
-def write_session(path: str | os.PathLike, metadata: dict, tables: Mapping[str, Mapping[str, Any]]) -> Path:
+def write_session(path: str | os.PathLike, metadata: dict, tables: Mapping[str, Mapping[str, object]]) -> Path:
     """Write a session file at ``path`` (one zip, atomically, arrays streamed); return the path."""
     doc, arrays, texts = to_document(metadata, tables)
     try:

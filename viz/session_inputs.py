@@ -11,14 +11,20 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
 from pinarms.viz.session_archive import F8
 from pinarms.viz.session_records import BoxObject, HistoryRecord, RobotEntry, TrajectoryRecord, WorkspaceRecord, check_name
+
+if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory, GAResult
+    from pinarms.robots.reach.workspace import Workspace
+    from pinarms.planning.trajectory import Trajectory
 
 __all__ = ["MAX_TRAJECTORY_SAMPLES", "json_normalised", "real_array", "float_array", "pose_array", "box_record",
            "trajectory_record", "workspace_record", "history_record"]
@@ -27,7 +33,7 @@ MAX_TRAJECTORY_SAMPLES = 2_000_000
 """Most samples :meth:`Session.add_trajectory` takes from a Trajectory (duration × hz)."""
 
 
-def json_normalised(obj: Any, what: str) -> Any:
+def json_normalised(obj: object, what: str) -> Any:
     """``obj`` as it will come back from JSON (tuples → lists); rejects NaN and non-JSON values."""
     try:
         return json.loads(json.dumps(obj, allow_nan=False, ensure_ascii=False).encode("utf-8"))
@@ -35,7 +41,7 @@ def json_normalised(obj: Any, what: str) -> Any:
         raise InvalidInput(f"{what} must be JSON-able (dicts, lists, str, finite numbers, bool, None): {exc}") from exc
 
 
-def real_array(values: Any, what: str) -> np.ndarray:
+def real_array(values: ArrayLike, what: str) -> np.ndarray:
     """``values`` as a fresh float64 array; complex numbers and non-numbers raise InvalidInput."""
     try:
         if np.iscomplexobj(values):
@@ -45,7 +51,7 @@ def real_array(values: Any, what: str) -> np.ndarray:
         raise InvalidInput(f"{what} must be numbers (real), got {type(values).__name__}") from exc
 
 
-def float_array(values: Any, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
+def float_array(values: ArrayLike, what: str, ndim: int, width: int | None = None, *, allow_inf: bool = False) -> np.ndarray:
     """A fresh, read-only, finite float64 array of ``ndim`` dims (last dim ``width``); ±inf allowed on request."""
     arr = real_array(values, what)
     if arr.ndim != ndim or (width is not None and arr.shape[-1] != width):
@@ -57,7 +63,7 @@ def float_array(values: Any, what: str, ndim: int, width: int | None = None, *, 
     return arr
 
 
-def pose_array(values: Any, what: str) -> np.ndarray:
+def pose_array(values: ArrayLike, what: str) -> np.ndarray:
     """``values`` (default identity) as a read-only rigid transform (4, 4), or InvalidInput naming ``what``."""
     T = real_array(np.eye(4) if values is None else values, what)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
@@ -69,7 +75,7 @@ def pose_array(values: Any, what: str) -> np.ndarray:
     return T
 
 
-def box_record(name: str, size: Any, pose: Any, color: Any) -> BoxObject:
+def box_record(name: str, size: ArrayLike, pose: ArrayLike, color: ArrayLike) -> BoxObject:
     """The static box ``name``: ``size`` (3,) positive edge lengths in m, ``pose`` (4, 4), ``color`` RGBA in [0, 1]."""
     size_arr = float_array(size, f"size of box {name!r}", 1, 3)
     if np.any(size_arr <= 0):
@@ -83,7 +89,7 @@ def box_record(name: str, size: Any, pose: Any, color: Any) -> BoxObject:
     return BoxObject(name, size_arr, pose_array(pose, f"pose of box {name!r}"), rgba)
 
 
-def trajectory_record(name: str, entry: RobotEntry, trajectory: Any, hz: float) -> TrajectoryRecord:
+def trajectory_record(name: str, entry: RobotEntry, trajectory: Trajectory, hz: float) -> TrajectoryRecord:
     """The trajectory ``name`` of robot ``entry``: a ``planning.Trajectory`` sampled at ``hz``, or a ``(t, q)`` pair."""
     if isinstance(trajectory, tuple) and len(trajectory) == 2:
         t, q = trajectory
@@ -126,7 +132,7 @@ def _sampled(name: str, trajectory: Any, hz: float) -> tuple[np.ndarray, np.ndar
     return t, q, knots, definition
 
 
-def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: Any, manipulability: Any) -> WorkspaceRecord:
+def workspace_record(name: str, entry: RobotEntry, workspace: Workspace | None, points: ArrayLike, manipulability: ArrayLike) -> WorkspaceRecord:
     """The workspace cloud ``name`` of robot ``entry``: a ``Workspace``, or ``points`` (n, 3) and ``manipulability`` (n,)."""
     if workspace is not None:
         if not (hasattr(workspace, "points") and hasattr(workspace, "manipulability")):
@@ -147,7 +153,7 @@ def workspace_record(name: str, entry: RobotEntry, workspace: Any, points: Any, 
     return WorkspaceRecord(name, entry.key, pts, w)
 
 
-def history_record(name: str, history: Any) -> HistoryRecord:
+def history_record(name: str, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike]) -> HistoryRecord:
     """The optimisation history ``name``: a GA history, a result with ``.history``, or a mapping of columns."""
     if hasattr(history, "history") and not isinstance(history, Mapping):
         history = history.history

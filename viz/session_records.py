@@ -134,7 +134,7 @@ class HistoryRecord:
         return self.columns.get("mean")
 
 
-def check_name(name: Any, what: str) -> str:
+def check_name(name: object, what: str) -> str:
     """``name`` when it is a valid session name, else :class:`InvalidInput`."""
     if not isinstance(name, str) or not NAME_RE.match(name):
         raise InvalidInput(

@@ -10,7 +10,8 @@ embedded URDF reads meshes only from the folders the caller allowed
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+
+from numpy.typing import ArrayLike
 
 from pinarms import robots
 from pinarms.errors import PinarmsError
@@ -37,7 +38,7 @@ def _registry_name(robot: Robot) -> str | None:
     return None
 
 
-def robot_entry(robot: Robot, key: str, base_to_world: Any) -> RobotEntry:
+def robot_entry(robot: Robot, key: str, base_to_world: ArrayLike) -> RobotEntry:
     """The session's record of ``robot`` under ``key``, placed at ``base_to_world`` (4, 4) in the world."""
     reg = _registry_name(robot)
     return RobotEntry(

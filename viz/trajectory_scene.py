@@ -9,7 +9,7 @@ time 0 at ``fps`` frames per second, looping. Times in s, positions in m.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Sequence, TYPE_CHECKING
 
 import numpy as np
 
@@ -18,6 +18,9 @@ from pinarms.errors import InvalidInput
 from pinarms.viz._meshcat import meshcat
 from pinarms.viz.robot_drawing import RobotDrawing
 from pinarms.viz.shapes import transform_points
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["interp_rows", "world_tcp_paths", "animated_trajectories", "show_start_poses", "animate_scene",
            "frame_times"]
@@ -28,7 +31,7 @@ def interp_rows(t_new: np.ndarray, t: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.stack([np.interp(t_new, t, q[:, j]) for j in range(q.shape[1])], axis=1)
 
 
-def world_tcp_paths(session: Any, drawings: dict[str, RobotDrawing], bounds: list[np.ndarray],
+def world_tcp_paths(session: Session, drawings: dict[str, RobotDrawing], bounds: list[np.ndarray],
                framed: list[np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """World tcp paths of the trajectories and the tcp at their knots, by label (a cell: one per arm)."""
     tcp_paths, knots = {}, {}
@@ -47,7 +50,7 @@ def world_tcp_paths(session: Any, drawings: dict[str, RobotDrawing], bounds: lis
     return tcp_paths, knots
 
 
-def animated_trajectories(session: Any, animate: Sequence[str] | None) -> tuple[str, ...]:
+def animated_trajectories(session: Session, animate: Sequence[str] | None) -> tuple[str, ...]:
     """The trajectories that play: ``animate`` checked (at most one per robot), default the first of each robot."""
     if animate is None:
         chosen: dict[str, str] = {}
@@ -64,7 +67,7 @@ def animated_trajectories(session: Any, animate: Sequence[str] | None) -> tuple[
     return animated
 
 
-def show_start_poses(session: Any, drawings: dict[str, RobotDrawing], animated: tuple[str, ...],
+def show_start_poses(session: Session, drawings: dict[str, RobotDrawing], animated: tuple[str, ...],
                       framed: list[np.ndarray]) -> None:
     """Pose each robot at the start of its animated (else first) trajectory, else its rest pose (a cell's
     hold, :meth:`Session.cell_hold`; else neutral); frame its motion."""
@@ -79,7 +82,7 @@ def show_start_poses(session: Any, drawings: dict[str, RobotDrawing], animated: 
         framed.append(transform_points(session.robots[key].base_to_world, drawing.extent(poses)))
 
 
-def animate_scene(vis: meshcat.Visualizer, session: Any, root: str, drawings: dict[str, RobotDrawing],
+def animate_scene(vis: meshcat.Visualizer, session: Session, root: str, drawings: dict[str, RobotDrawing],
                   animated: tuple[str, ...], lines: bool, fps: float, play: bool) -> tuple[float, int]:
     """One looping animation of the ``animated`` trajectories and the belt ``lines``; return (duration, frames)."""
     from pinarms.viz.line_scene import animate_lines, line_duration

@@ -8,10 +8,14 @@
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING
 
 from pinarms.viz.scene import SceneInfo, build_scene
+from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.server import MeshcatServer
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["Viewer", "show"]
 
@@ -36,8 +40,8 @@ class Viewer(MeshcatServer):
             self.close()
 
 
-def show(session: Any, port: int | None = None, open_browser: bool = False, wait: bool = False,
-         **scene_options: Any) -> Viewer:
+def show(session: Session, port: int | None = None, open_browser: bool = False, wait: bool = False,
+         options: SceneOptions | None = None) -> Viewer:
     """Start MeshCat on 127.0.0.1 and show ``session``; return the running :class:`Viewer`.
 
     Args:
@@ -45,14 +49,14 @@ def show(session: Any, port: int | None = None, open_browser: bool = False, wait
         port: HTTP port (default: a free one).
         open_browser: open the page in the default web browser.
         wait: block until Ctrl+C, then stop the server (same as ``show(...).wait()``).
-        scene_options: passed to :func:`pinarms.viz.scene.build_scene` (``animate``, ``fps``, ...).
+        options: a :class:`pinarms.viz.scene_options.SceneOptions` for :func:`pinarms.viz.scene.build_scene` (``animate``, ``fps``, ...).
 
     Stop it with ``viewer.close()`` or use it as a context manager; the server process is
     also stopped when the viewer is garbage-collected or Python exits.
     """
     viewer = Viewer(port)
     try:
-        viewer.scene = build_scene(viewer.visualizer, session, **scene_options)
+        viewer.scene = build_scene(viewer.visualizer, session, options)
     except BaseException:
         viewer.close()
         raise

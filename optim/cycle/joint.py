@@ -32,7 +32,7 @@ Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -44,11 +44,14 @@ from pinarms.planning import joint_waypoints
 from pinarms.errors import UnreachableTarget
 from pinarms.robots.ties import argmin_tied
 
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
+
 __all__ = ["joint_cycle"]
 
 
 def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | None = None,
-                there_clear: Callable[[Any], bool] | None = None) -> CycleResult | None:
+                there_clear: Callable[[Trajectory], bool] | None = None) -> CycleResult | None:
     """Plan and time the cycle of ``request`` in joint space, ignoring its approach and cell (module doc).
 
     ``via``: the joint via points and branch labels of the move to place, when the caller has

@@ -24,9 +24,10 @@ Units: m, rad, s.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.cycle.joint import joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
@@ -38,6 +39,11 @@ from pinarms.optim.torque import torque_constraint
 from pinarms.planning import (JointAccelerationConstraint, JointTorqueConstraint, JointVelocityConstraint,
                               ToolSpeedConstraint, Trajectory, cartesian_path, joint_spline, torque_peaks)
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.robot import Robot
+    from pinarms.robots.payload import Payload
 
 __all__ = ["StraightMove", "straight_cycle", "approach_cycle"]
 
@@ -78,9 +84,9 @@ class StraightMove:
         return float(self.durations.sum())
 
 
-def straight_cycle(robot: Any, joint: CycleResult, *, kind: str, method: str = "exact", seed: int = 0,
-                   tool_speed: float | None = None, tolerance: float = 1e-4, payload: Any = None,
-                   torque_limits: Any = False) -> CycleResult:
+def straight_cycle(robot: Robot, joint: CycleResult, *, kind: str, method: str = "exact", seed: int = 0,
+                   tool_speed: float | None = None, tolerance: float = 1e-4, payload: Payload | None = None,
+                   torque_limits: ArrayLike = False) -> CycleResult:
     """The cycle of ``joint`` (a joint-space :class:`CycleResult`) with straight lines at pick and place.
 
     Args:

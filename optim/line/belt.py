@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
@@ -94,13 +95,13 @@ class Belt:
         """Belt velocity in the world frame [m/s] (3,)."""
         return self.speed * self.direction
 
-    def to_world(self, u: Any, w: Any, z: Any = 0.0) -> np.ndarray:
+    def to_world(self, u: ArrayLike, w: ArrayLike, z: ArrayLike = 0.0) -> np.ndarray:
         """World points (..., 3) [m] of belt coordinates ``u``, ``w``, ``z`` (broadcast)."""
         u, w, z = np.broadcast_arrays(np.asarray(u, float), np.asarray(w, float), np.asarray(z, float))
         T = self.belt_to_world
         return self.origin + u[..., None] * T[:3, 0] + w[..., None] * T[:3, 1] + z[..., None] * T[:3, 2]
 
-    def to_belt(self, p_world: Any) -> np.ndarray:
+    def to_belt(self, p_world: ArrayLike) -> np.ndarray:
         """Belt coordinates (..., 3) (u, w, z) [m] of world points (..., 3)."""
         T = self.belt_to_world
         d = np.asarray(p_world, dtype=float) - self.origin

@@ -23,11 +23,15 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.station import Station
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["FixtureCheck", "PairCheck", "CHORD", "chord_polyline", "fixture_check", "check_in_cell"]
 
@@ -70,7 +74,7 @@ class FixtureCheck:
     ``counts``: trajectories proven by the fast route alone, runs of pieces sent to the exact one,
     trajectories found not clear, and outside the joint limits (:meth:`verdict`)."""
 
-    def __init__(self, cell: Any, arm: str, clearance: float, chord: float = CHORD) -> None:
+    def __init__(self, cell: Cell, arm: str, clearance: float, chord: float = CHORD) -> None:
         from pinarms.optim.motion import MotionChecker, fast_check
 
         self.clearance, self.chord = _clearance(clearance), float(chord)
@@ -81,7 +85,7 @@ class FixtureCheck:
         self.counts = {"fast": 0, "exact": 0, "blocked": 0, "limits": 0}
         self.seconds = 0.0  #: time spent in :meth:`verdict` [s]
 
-    def verdict(self, trajectory: Any) -> str:
+    def verdict(self, trajectory: Trajectory) -> str:
         """``"clear"``, ``"limits"`` (the trajectory leaves the arm's joint position limits: exact
         extrema; the checkers count such states as not valid) or ``"fixtures"`` (closer than the
         clearance to a fixture somewhere)."""
@@ -95,7 +99,7 @@ class FixtureCheck:
         finally:
             self.seconds += time.perf_counter() - start
 
-    def clear(self, trajectory: Any) -> bool:
+    def clear(self, trajectory: Trajectory) -> bool:
         """Whether the arm's joint ``trajectory`` keeps the clearance from every fixture over its whole time
         (and stays within the joint limits): each polynomial piece the fast route proves is clear; each run
         of pieces it does not prove goes to the exact check (a pick comes close to a fixture mostly while it
@@ -132,7 +136,7 @@ class FixtureCheck:
 _CHECKS: dict = {}
 
 
-def check_in_cell(cell: Any, station: Any) -> None:
+def check_in_cell(cell: Cell, station: Station) -> None:
     """InvalidInput unless ``station`` is an arm of ``cell`` (same name, same base)."""
     from pinarms.errors import PinarmsError
 
@@ -145,7 +149,7 @@ def check_in_cell(cell: Any, station: Any) -> None:
         raise InvalidInput(f"station {station.name!r} stands elsewhere than the cell's arm of that name")
 
 
-def fixture_check(cell: Any, arm: str, clearance: float) -> FixtureCheck:
+def fixture_check(cell: Cell, arm: str, clearance: float) -> FixtureCheck:
     """The :class:`FixtureCheck` of ``arm`` in ``cell`` at ``clearance``, kept per process (the
     checkers' covers and coal data take tens of ms to build; a map builds one per column)."""
     key = (id(cell), arm, float(clearance))
@@ -162,7 +166,7 @@ class PairCheck:
     the fixtures over a time window (module doc); ``counts``: windows proven by the fast route alone,
     slices sent to the exact check, windows found not clear."""
 
-    def __init__(self, cell: Any, arms: tuple[str, str], clearance: float, chord: float = CHORD) -> None:
+    def __init__(self, cell: Cell, arms: tuple[str, str], clearance: float, chord: float = CHORD) -> None:
         from pinarms.optim.motion import MotionChecker, fast_check
 
         self.cell, self.arms = cell, tuple(arms)

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.files import read_bounded
 from pinarms.optim.line.belt import Belt, _number
@@ -85,7 +86,7 @@ class Items:
     def height(self) -> np.ndarray:
         return np.array([t.size[2] for t in self.types])[self.kind]
 
-    def subset(self, index: Any) -> "Items":
+    def subset(self, index: ArrayLike) -> "Items":
         return Items(self.t0[index], self.w[index], self.kind[index], self.yaw[index], self.types)
 
 

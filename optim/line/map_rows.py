@@ -20,11 +20,14 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import replace
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.errors import PinarmsError
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.task_maps import TaskMap
 
 __all__ = ["CellRows", "map_rows", "CHECKED_ITEMS", "ROWS_CHUNK"]
 
@@ -38,7 +41,7 @@ class CellRows:
     """Per cell across the belt, the times at its two ends on the cell's branch (module doc):
     ``ends`` (4, nw − 1, K): approach at ``w_j``, at ``w_j+1``, leave at ``w_j``, at ``w_j+1``."""
 
-    def __init__(self, task_map: Any, grid: tuple) -> None:
+    def __init__(self, task_map: TaskMap, grid: tuple) -> None:
         w = task_map.w
         K = grid[0].size
         self.w = w
@@ -77,7 +80,7 @@ def _same(a: tuple, b: tuple) -> bool:
     return all(np.array_equal(x, y, equal_nan=True) for x, y in zip(a, b))
 
 
-def map_rows(task_map: Any, grid: tuple, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray,
+def map_rows(task_map: TaskMap, grid: tuple, w: np.ndarray, sel: np.ndarray, tA: np.ndarray, tC: np.ndarray,
              yaw: np.ndarray | None = None) -> None:
     """Rows ``sel`` of ``tA``, ``tC`` (n, K): ``task_map.rows(w[sel], grid, yaw[sel])`` (module doc). The
     cells of a map are read once per grid and kept while the map lives; every call compares them, in

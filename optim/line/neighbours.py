@@ -13,9 +13,10 @@ the map interpolates feasibility) is not proven clear: the guard says no.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType
@@ -23,6 +24,9 @@ from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
 from pinarms.errors import InvalidInput, PinarmsError
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["NeighbourGuard"]
 
@@ -32,9 +36,9 @@ class NeighbourGuard:
     the check's time step. ``checks`` counts the continuous checks run; ``counts``: of those, proven
     by the fast route, sent to the exact one, found not clear."""
 
-    def __init__(self, cell: Any, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
+    def __init__(self, cell: Cell, stations: Sequence[Station], belt: Belt, tracking: TrackingSpec,
                  types: Sequence[ItemType], *, clearance: float = 0.01, margin: float = 0.01,
-                 maps: dict | None = None, yaws: Any = None) -> None:
+                 maps: dict | None = None, yaws: ArrayLike | None = None) -> None:
         self.cell, self.belt, self.tracking, self.types = cell, belt, tracking, tuple(types)
         self.stations = {s.name: s for s in stations}
         for s in stations:

@@ -21,14 +21,19 @@ over one period, for the schedule plot.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping, NamedTuple
+from typing import Any, Callable, Mapping, NamedTuple, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.caps import (MAX_CLEARANCE, MAX_LINE_CYCLE_TIME, MAX_OFFSETS, MIN_MARGIN, count_setting,
                                number_setting)
 from pinarms.optim.errors import InfeasibleProblem, SettingOutOfRange
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["LineSchedule", "schedule_line"]
 
@@ -145,14 +150,14 @@ def _busy_intervals(cell: Any, motions: list, period: float) -> dict[str, list[t
 
 
 def schedule_line(
-    cell: Any,
-    cycles: Mapping[str, Any],
+    cell: Cell,
+    cycles: Mapping[str, CycleResult],
     *,
     clearance: float = 0.0,
     margin: float = 0.01,
     n_offsets: int = 24,
-    hold: Any = None,
-    progress: Any = None,
+    hold: ArrayLike | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> LineSchedule:
     """Time offsets for the arms of ``cell`` cycling together (module doc).
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.line.belt import PlaceBox
 from pinarms.errors import InvalidInput
@@ -86,7 +87,7 @@ class Station:
         """``{"vmax": (nq,), "amax": (nq,), "torque": bool}`` as used."""
         return self._limits
 
-    def world_to_base(self, p_world: Any) -> np.ndarray:
+    def world_to_base(self, p_world: ArrayLike) -> np.ndarray:
         """Points (..., 3) [m] from the world frame to the arm's base frame."""
         T = self.base_to_world
         return (np.asarray(p_world, float) - T[:3, 3]) @ T[:3, :3]

@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 
 from pinarms.optim.line.belt import Belt, _number
@@ -65,12 +66,12 @@ class TrayBelt:
         if not (isinstance(self.capacity, int) and not isinstance(self.capacity, bool) and self.capacity >= 1):
             raise InvalidInput(f"tray capacity must be an integer >= 1, got {self.capacity!r}")
 
-    def tray_u(self, k: Any, t: Any) -> np.ndarray:
+    def tray_u(self, k: ArrayLike, t: ArrayLike) -> np.ndarray:
         """u [m] of tray ``k``'s centre on its belt at time ``t`` [s] (broadcast)."""
         return self.phase - np.asarray(k, float) * self.pitch + self.belt.speed * np.asarray(t, float)
 
 
-def trays_beside(belt: Belt, place_world: Any, pitch: float, speed: float, capacity: int, *,
+def trays_beside(belt: Belt, place_world: ArrayLike, pitch: float, speed: float, capacity: int, *,
                  height: float = 0.03, width: float = 0.2) -> TrayBelt:
     """Trays on a belt parallel to ``belt`` (same direction and length) whose place point passes
     through ``place_world`` (e.g. the stations' box release point) [m]."""

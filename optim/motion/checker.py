@@ -44,16 +44,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
+from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion import coal_batches
-from pinarms.optim.motion.coal_batches import MAX_THREADS, CoalBatches, check_threads, cold, set_margins, shared_coal
+from pinarms.optim.motion.coal_batches import (MAX_THREADS, CheckRoute, CoalBatches, check_threads, cold, set_margins,
+                                               shared_coal)
 from pinarms.optim.motion.proof import COARSE_LEVELS, MAX_SPLITS, LadderProof, Verdict, coarse_first
 from pinarms.robots.cell.cover import link_cover, motion_pairs, pair_arrays
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 #: How far [rad or m] a timed motion's exact joint extremes may pass a joint limit in
 #: :meth:`MotionChecker.trajectory_valid` (the rounding of a time scaling's re-expanded
@@ -100,21 +106,22 @@ class MotionChecker(CoalBatches, LadderProof):
             with the time [s] and their configuration at that time is used.
         step: largest travel [m] of any point between two samples of an edge (default
             ``margin``).
-        threads: threads of Pinocchio's batch checks.
-        cover: screen every check on the sphere cover first (:mod:`pinarms.robots.cell.cover`; the same
-            verdicts, coal only where the cover is inconclusive).
-        pairwise: the per-pair route (default :data:`.coal_batches.PAIRWISE`): coal only on the
-            pairs the cover does not prove, not on every pair of a state it does not prove.
+        route: threads, sphere-cover screen and per-pair route of the checks
+            (:class:`.coal_batches.CheckRoute`; default ``CheckRoute()``: one thread, the cover,
+            the default route).
 
     Raises:
         InvalidInput: an unknown arm, a bad hold configuration or margins.
     """
 
-    def __init__(self, cell: Any, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
-                 hold: Any = None, moving: Sequence[TimedArm] = (), step: float | None = None,
-                 threads: int = 1, cover: bool = True, pairwise: bool | None = None) -> None:
+    def __init__(self, cell: Cell, arms: Sequence[str], *, margin: float = 0.01, self_margin: float = 0.0,
+                 hold: ArrayLike | None = None, moving: Sequence[TimedArm] = (), step: float | None = None,
+                 route: CheckRoute | None = None) -> None:
         from pinarms.robots.cell.motion import joint_levers
 
+        route = CheckRoute() if route is None else route
+        if not isinstance(route, CheckRoute):
+            raise InvalidSettings(f"route must be a CheckRoute, got {type(route).__name__}")
         self.cell = cell
         names = [arms] if isinstance(arms, str) else list(arms)
         if not names or len(set(names)) != len(names):
@@ -162,7 +169,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self.pairs = tuple(chosen)
         self.pair_margin = np.array([self.self_margin if p.kind == "self" else self.margin for p in self.pairs])
         self.model = cell.model
-        self.threads = check_threads(threads)
+        self.threads = route.threads
         self._data = self.model.createData()
         shared = shared_coal(cell, self.pairs, self.pair_margin, self.threads)
         if "geometry" not in shared:
@@ -189,10 +196,10 @@ class MotionChecker(CoalBatches, LadderProof):
         self.deadline: float | None = None
         #: The sphere cover screening every check (:mod:`pinarms.robots.cell.cover`): what it proves clear is
         #: clear; the rest goes to coal. ``None`` (``cover=False``): coal for every configuration.
-        self.cover = link_cover(cell) if cover else None
+        self.cover = link_cover(cell) if route.cover else None
         self._cover_pairs = None if self.cover is None else self.cover.prepare(*pair_arrays(self.pairs))
         #: Whether coal computes only the pairs the cover leaves open (:meth:`pair_collides`).
-        self.pairwise = bool(coal_batches.PAIRWISE if pairwise is None else pairwise) and self.cover is not None
+        self.pairwise = bool(coal_batches.PAIRWISE if route.pairwise is None else route.pairwise) and self.cover is not None
         self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
@@ -228,7 +235,7 @@ class MotionChecker(CoalBatches, LadderProof):
         cumulative = np.concatenate([[0.0], np.cumsum(speed * np.diff(grid))])
         return grid, cumulative
 
-    def moving_travel(self, ta: Any, tb: Any) -> np.ndarray:
+    def moving_travel(self, ta: ArrayLike, tb: ArrayLike) -> np.ndarray:
         """Bound [m] of how far any point of the moving arms travels between cell times ``ta`` and ``tb``."""
         I = np.interp(np.asarray(tb, dtype=float), self._travel_t, self._travel_i)
         return np.abs(I - np.interp(np.asarray(ta, dtype=float), self._travel_t, self._travel_i))
@@ -239,7 +246,7 @@ class MotionChecker(CoalBatches, LadderProof):
         q = self.cell.random_q(3, seed=0)
         return bool(np.array_equal(self.cell.robot.q_to_pinocchio(q), q))
 
-    def full(self, X: Any) -> np.ndarray:
+    def full(self, X: ArrayLike) -> np.ndarray:
         """Cell configurations ``(N, nq)`` for planned states ``X (N, n[+1])`` (time last when timed)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         Q = np.tile(self.hold, (X.shape[0], 1))
@@ -264,7 +271,7 @@ class MotionChecker(CoalBatches, LadderProof):
         return np.all((X[:, : self.n] >= self.lower - 1e-12) & (X[:, : self.n] <= self.upper + 1e-12), axis=1)
 
     # ------------------------------------------------------------------ states
-    def state_valid(self, x: Any) -> bool:
+    def state_valid(self, x: ArrayLike) -> bool:
         """One planned state: within the limits and every pair at least its margin apart."""
         x = np.asarray(x, dtype=float)
         self.counts["states"] += 1
@@ -317,7 +324,7 @@ class MotionChecker(CoalBatches, LadderProof):
             out[i], arg[i], dist[i] = best, k_best, d_best
         return out, arg, dist
 
-    def closest(self, x: Any) -> tuple[float, Any, float]:
+    def closest(self, x: ArrayLike) -> tuple[float, Any, float]:
         """``(excess [m], pair, distance [m])`` of the pair nearest its margin at state ``x``."""
         e, k, d = self.excess(self.full(np.asarray(x, dtype=float)[None]))
         return float(e[0]), (self.pairs[int(k[0])] if k[0] >= 0 else None), float(d[0])
@@ -327,7 +334,7 @@ class MotionChecker(CoalBatches, LadderProof):
         """Bound [m] of how far any point of the planned arms moves along the straight edge ``xa → xb``."""
         return float(np.abs(xb[: self.n] - xa[: self.n]) @ self.levers)
 
-    def edge_samples(self, xa: Any, xb: Any) -> tuple[np.ndarray, np.ndarray]:
+    def edge_samples(self, xa: ArrayLike, xb: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The samples ``(n+1, n_joints)`` of the straight edge ``xa → xb`` and their travel budgets ``(n,)`` [m]."""
         X, budgets, _ = self._edge_samples(xa, xb, 0)
         return X, budgets
@@ -342,7 +349,7 @@ class MotionChecker(CoalBatches, LadderProof):
         f = np.arange(n + 1) / n
         return xa + f[:, None] * (xb - xa), np.full(n, T / n), -k
 
-    def edge_valid(self, xa: Any, xb: Any) -> Verdict:
+    def edge_valid(self, xa: ArrayLike, xb: ArrayLike) -> Verdict:
         """Whether the straight joint-space edge ``xa → xb`` keeps every margin everywhere (module docstring)."""
         if self.timed:
             raise InvalidInput("straight edges are checked with the other arms held; a moving arm is checked "
@@ -366,7 +373,7 @@ class MotionChecker(CoalBatches, LadderProof):
             return v
         return Verdict(False, v.first_bad, max(0.0, (v.first_bad - 1) / n) if v.first_bad >= 0 else 0.0, v.exact)
 
-    def trajectory_valid(self, trajectory: Any, t0: float = 0.0, until: float | None = None) -> Verdict:
+    def trajectory_valid(self, trajectory: Trajectory, t0: float = 0.0, until: float | None = None) -> Verdict:
         """Prove a timed motion of the planned arms (their joints, in order), played from cell time ``t0``,
         against the moving arms at the same instants (and the fixtures, the held arms).
 

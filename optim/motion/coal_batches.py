@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -22,7 +23,10 @@ import pinocchio as pin
 from pinarms.optim.errors import InvalidSettings
 from pinarms.optim.motion.proof import COARSE_LEVELS, GiveUp
 
-__all__ = ["CoalBatches", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
+
+__all__ = ["CoalBatches", "CheckRoute", "MAX_THREADS", "COAL_CHUNK", "PAIRWISE", "check_threads", "shared_coal", "cold",
            "set_margins"]
 
 #: Configurations per coal batch while a deadline runs (the clock is read between two).
@@ -151,7 +155,7 @@ class CoalBatches:
         return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
 
 
-    def batch_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def batch_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: cell configurations ``Q`` closer than the margins (``"margin"``) or the
         margins + ``step / 2^(L+1)`` (``which = L``, a screen level) on some pair; ``stop``:
         stop at the first such row (the rows after it are then reported False). With
@@ -194,7 +198,7 @@ class CoalBatches:
             return np.ones(len(self.pairs))
         return np.minimum(self._pair_rows @ dx / T, 1.0)
 
-    def open_pairs(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+    def open_pairs(self, Q: np.ndarray, which: str | int = "margin") -> np.ndarray:
         """``(N, P)`` bool: the pairs the exact check must decide at cell configurations ``Q`` — those the
         cover (:meth:`pinarms.robots.cell.cover.Cover.pair_screen`) does not prove farther apart than their
         threshold (``which``: the margins, or a screen level; :meth:`_thresholds`)."""
@@ -219,7 +223,7 @@ class CoalBatches:
         pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
         return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
-    def pair_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def pair_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by the per-pair route: coal computes only the pairs the cover leaves open
         (:meth:`open_pairs`); a configuration with none open is proven clear without coal. With ``stop``
         (or a deadline) a few configurations at a time, cover then coal, in their order (with ``stop`` 1, 2,
@@ -248,7 +252,7 @@ class CoalBatches:
                 break
         return out
 
-    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def coal_pairs(self, Q: np.ndarray, want: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """``(N,)`` bool: configuration ``Q[i]`` closer than its threshold on one of the pairs ``want[i]``
         (``(N, P)`` bool) — coal on those pairs only, through Pinocchio's batch loop: the configurations
         with the same open pairs in one batch (``stop``: the rows after the first hit are reported False;
@@ -289,7 +293,7 @@ class CoalBatches:
             pool = self._pools["pairwise"] = self._make_pool("pairs", self.pair_margin)
         return pool
 
-    def covered(self, Q: np.ndarray, which: Any = "margin") -> np.ndarray:
+    def covered(self, Q: np.ndarray, which: str | int = "margin") -> np.ndarray:
         """``(N,)`` bool: configurations the sphere cover proves clear of the margins (``"margin"``)
         or of the margins + ``step / 2^(L+1)`` (``which = L``); False: left to coal."""
         Q = np.atleast_2d(Q)
@@ -299,12 +303,12 @@ class CoalBatches:
         extra = 0.0 if which == "margin" else self.step * 2.0 ** (-int(which) - 1)
         return self.cover.screen(Q, self._cover_pairs, self.pair_margin + extra)
 
-    def exact_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def exact_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` for configurations the cover did not prove as a whole: the per-pair route
         (:meth:`pair_collides`) with :attr:`pairwise`, else coal on every pair (:meth:`coal_collides`)."""
         return self.pair_collides(Q, which, stop) if self.pairwise else self.coal_collides(Q, which, stop)
 
-    def coal_collides(self, Q: np.ndarray, which: Any = "margin", stop: bool = False) -> np.ndarray:
+    def coal_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
         """:meth:`batch_collides` by coal alone (Pinocchio's batch loop), no cover."""
         Q = np.atleast_2d(Q)
         self.counts["coal"] += Q.shape[0]
@@ -336,7 +340,34 @@ MAX_THREADS = 256
 _SHARED_KEEP = 16
 
 
-def check_threads(threads: Any) -> int:
+@dataclass(frozen=True)
+class CheckRoute:
+    """How a :class:`pinarms.optim.motion.checker.MotionChecker` runs its checks (the verdicts are the same).
+
+    Attributes:
+        threads: threads of Pinocchio's batch checks (1 to :data:`MAX_THREADS`).
+        cover: screen every check on the sphere cover first (:mod:`pinarms.robots.cell.cover`; coal only
+            where the cover is inconclusive).
+        pairwise: the per-pair route (``None``: :data:`PAIRWISE`, read when the checker is made):
+            coal only on the pairs the cover does not prove, not on every pair of a state it does not prove.
+
+    Raises:
+        InvalidSettings: a thread count out of range, ``cover`` or ``pairwise`` not a bool.
+    """
+
+    threads: int = 1
+    cover: bool = True
+    pairwise: bool | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "threads", check_threads(self.threads))
+        if not isinstance(self.cover, (bool, np.bool_)):
+            raise InvalidSettings(f"cover must be True or False, got {self.cover!r}")
+        if self.pairwise is not None and not isinstance(self.pairwise, (bool, np.bool_)):
+            raise InvalidSettings(f"pairwise must be True, False or None (the default route), got {self.pairwise!r}")
+
+
+def check_threads(threads: object) -> int:
     """``threads`` as an int in ``1..MAX_THREADS`` or :class:`InvalidSettings` (0 or fewer crash
     Pinocchio's batch loop; huge counts overflow its argument)."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
@@ -350,7 +381,7 @@ def check_threads(threads: Any) -> int:
 _SHARED_LOCK = threading.Lock()
 
 
-def shared_coal(cell: Any, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
+def shared_coal(cell: Cell, pairs: tuple, margins: np.ndarray, threads: int) -> dict:
     """coal data (geometry copy, GeometryData, broad phase, batch pools per screen level) shared by
     the checkers of one cell with the same pairs, margins and thread count, made in the same
     thread: making them costs tens of ms per checker (cold-starting every request)."""

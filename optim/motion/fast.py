@@ -26,9 +26,10 @@ still proves it again with the exact checker before reporting it.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
@@ -36,6 +37,9 @@ from pinarms.optim.motion.proof import MAX_SPLITS
 from pinarms.robots.cell._cover_kernel import _place
 from pinarms.robots.cell.cover import motion_pairs, pair_arrays
 from pinarms.optim.motion.search import SearchResult
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
 
 __all__ = ["FastCheck", "fast_check", "fast_search", "fast_shortcut", "COMPILED_PLANNER", "TREE_NODES"]
 
@@ -86,7 +90,7 @@ class FastCheck:
             trajectories (their checks stay with :meth:`MotionChecker.trajectory_valid`).
     """
 
-    def __init__(self, checker: Any, reach: float | None = None, max_states: int | None = None) -> None:
+    def __init__(self, checker: MotionChecker, reach: float | None = None, max_states: int | None = None) -> None:
         if checker.cover is None or checker.timed:
             raise ValueError("the compiled check needs a checker with the sphere cover and no moving arms")
         cover = checker.cover
@@ -144,17 +148,17 @@ class FastCheck:
             self._trees = (np.zeros((2, TREE_NODES, n)), np.full((2, TREE_NODES), -1, dtype=np.int64))
         return self._trees
 
-    def excess(self, x: Any) -> float:
+    def excess(self, x: ArrayLike) -> float:
         """The cover's lower bound of ``E`` [m] at planned state ``x`` (capped; below 0: not proven)."""
         return float(kernel.state_excess(np.ascontiguousarray(x, dtype=float), self.hold, self.cols, self.fk, self.cov,
                                          self.grp, self.cap, self.work, self._q))
 
-    def state_proven(self, x: Any) -> bool:
+    def state_proven(self, x: ArrayLike) -> bool:
         """Whether the cover proves state ``x`` clear of every margin (and ``x`` is within the joint limits)."""
         x = np.asarray(x, dtype=float)
         return bool(self.checker.within_limits(x[None])[0]) and self.excess(x) >= 0.0
 
-    def edge_proven(self, xa: Any, xb: Any) -> bool:
+    def edge_proven(self, xa: ArrayLike, xb: ArrayLike) -> bool:
         """Whether the cover proves the straight edge ``xa → xb`` clear of every margin (ends within the limits)."""
         xa = np.ascontiguousarray(xa, dtype=float)
         xb = np.ascontiguousarray(xb, dtype=float)
@@ -162,7 +166,7 @@ class FastCheck:
             return False
         return bool(kernel.edge_proven(xa, xb, *self.args, self._q, self._xm, self._queue, self._inv))
 
-    def path_proven(self, P: Any) -> bool:
+    def path_proven(self, P: ArrayLike) -> bool:
         """Whether the cover proves every edge of the polyline ``P (M, n)``."""
         P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
         if not self.checker.within_limits(P).all():
@@ -170,7 +174,7 @@ class FastCheck:
         return bool(kernel.path_proven(P, *self.args))
 
 
-def fast_check(checker: Any) -> FastCheck | None:
+def fast_check(checker: MotionChecker) -> FastCheck | None:
     """The :class:`FastCheck` of ``checker`` (kept with it), or ``None`` when it has none (no cover, moving arms)."""
     got = getattr(checker, "_fast", False)
     if got is False:
@@ -204,7 +208,7 @@ def _rng(seed: int) -> np.ndarray:
     return np.array([(int(seed) * 0x9E3779B97F4A7C15 + 0x2545F4914F6CDD1D) % (1 << 64)], dtype=np.uint64)
 
 
-def fast_search(checker: Any, start: Any, goals: Any, *, time_limit: float = 1.0, seed: int = 0,
+def fast_search(checker: MotionChecker, start: ArrayLike, goals: ArrayLike, *, time_limit: float = 1.0, seed: int = 0,
                 planner_range: float | None = None) -> SearchResult:
     """RRT-Connect from ``start (n,)`` to any of ``goals (G, n)`` on the compiled cover check.
 
@@ -297,7 +301,7 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, leaf: int) -> np.ndarray:
     return np.array(rows)
 
 
-def fast_shortcut(checker: Any, path: Any, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
+def fast_shortcut(checker: MotionChecker, path: ArrayLike, *, seed: int = 0, tries: int | None = None) -> np.ndarray:
     """Random shortcutting of the cover-proven polyline ``path (M, n)`` on the compiled check (seeded;
     ``tries`` default: 16 and 2 per vertex; a try gaining less than :data:`SHORTCUT_GAIN` of the length is
     skipped), then every vertex dropped whose neighbours join."""

@@ -34,9 +34,13 @@ the moving joints then cost far fewer states than under one lever for the whole 
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cover import Cover
 
 __all__ = ["link_levers", "group_levers"]
 
@@ -77,7 +81,7 @@ def _joint_levers(cover: Any, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     return J * (1.0 + 1e-9)  # a hair over the rounding of the sums
 
 
-def link_levers(cover: Any, lower: Any, upper: Any) -> np.ndarray:
+def link_levers(cover: Cover, lower: ArrayLike, upper: ArrayLike) -> np.ndarray:
     """``(nj, nq)``: row ``L`` bounds how far any point of link ``L``'s cover moves per unit change of each
     configuration column (``Σ_c |Δq_c| · row[c]``), for a cell with limits ``lower``, ``upper (nq,)``."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
@@ -89,7 +93,7 @@ def link_levers(cover: Any, lower: Any, upper: Any) -> np.ndarray:
     return out
 
 
-def group_levers(cover: Any, pairs: Any, lower: Any, upper: Any, cols: Any) -> np.ndarray:
+def group_levers(cover: Cover, pairs: tuple, lower: ArrayLike, upper: ArrayLike, cols: ArrayLike) -> np.ndarray:
     """``(G, n)``: for each pair group of ``pairs`` (:meth:`Cover.prepare`: two links, or a link and a
     fixture), how much its distance can change per unit change of each planned column ``cols``
     (module docstring: the joints upstream of one link and not of the other)."""

@@ -42,6 +42,7 @@ import numpy as np
 
 from pinarms.optim.errors import EndpointInCollision, InfeasibleProblem, NoPathFound, PlanningError
 from pinarms.optim.motion.checker import MotionChecker
+from pinarms.optim.motion.coal_batches import CheckRoute
 from pinarms.optim.motion.ends import check_end, check_hold
 from pinarms.optim.motion.geometry import plan_geometry
 from pinarms.optim.motion.report import clearance_profile
@@ -131,7 +132,7 @@ def plan_motion(request: MotionRequest, *, progress: Callable[[str], None] | Non
     say = progress or (lambda _m: None)
     o, arms, x0 = request.options, request.arms, np.array(request.start)
     checker = MotionChecker(request.cell, arms, margin=o.margin, self_margin=o.self_margin, hold=request.hold,
-                            threads=o.threads)
+                            route=CheckRoute(threads=o.threads))
     seconds: dict = {}
     try:
         check_hold(checker)  # an idle arm in collision: named now, not after the search

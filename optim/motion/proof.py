@@ -17,6 +17,7 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.cell.ladder import Intervals, climb
 
@@ -76,7 +77,7 @@ def _coarse_order(n: int) -> np.ndarray:
 class LadderProof:
     """The ladder of batched screens (a mixin of :class:`.checker.MotionChecker`)."""
 
-    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: Any, convex: bool = False, top: int = 0) -> Verdict:
+    def prove(self, X: np.ndarray, budgets: np.ndarray, midpoint: ArrayLike, convex: bool = False, top: int = 0) -> Verdict:
         """Prove that the motion through samples ``X (N, n[+1])`` keeps every margin (:meth:`_prove`);
         past :attr:`deadline` the proof gives up: not valid."""
         try:

@@ -42,11 +42,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import CellNotFound, InvalidInput, UnreachableTarget
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["Region", "Scene", "Query", "SCENES", "SCENE_DIR", "scene_names", "scene_path", "load_scene",
            "scene_queries", "region_pose", "valid_ik"]
@@ -149,7 +153,7 @@ def load_scene(name: str) -> Any:
     return robots.load_cell(scene_path(name), packages=example_packages())
 
 
-def region_pose(region: Region, point: Any, yaw: float = 0.0) -> np.ndarray:
+def region_pose(region: Region, point: ArrayLike, yaw: float = 0.0) -> np.ndarray:
     """Tool pose (4, 4) in the world at ``point`` [m] with the region's approach, turned by ``yaw`` [rad]."""
     p = np.asarray(point, dtype=float)
     if region.approach == "down":
@@ -177,7 +181,7 @@ class Query:
     goal_pose: np.ndarray
 
 
-def valid_ik(checker: Any, T_world: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+def valid_ik(checker: MotionChecker, T_world: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
     """A configuration of the checker's (one) arm reaching ``T_world`` that is a valid state, or None.
 
     Closed-form arms: the first valid branch; others: up to 6 seeded numerical solutions."""
@@ -205,7 +209,7 @@ def valid_ik(checker: Any, T_world: np.ndarray, rng: np.random.Generator) -> np.
 
 
 def scene_queries(name: str, n: int = 50, *, seed: int = 0, margin: float = 0.01,
-                  cell: Any = None) -> tuple[list[Query], np.ndarray]:
+                  cell: Cell | None = None) -> tuple[list[Query], np.ndarray]:
     """``n`` seeded queries of scene ``name`` and the cell configuration the other arms hold.
 
     Returns ``(queries, hold)``; ``hold`` (nq_cell,) puts each held arm at a seeded IK

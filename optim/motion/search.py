@@ -23,11 +23,14 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.optim.errors import InvalidSettings
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
 
 __all__ = ["PLANNERS", "SearchResult", "search", "shortcut"]
 
@@ -126,7 +129,7 @@ def _setup(ob, og, checker, lower, upper):
     return ss, si, validator, valid
 
 
-def search(checker: Any, start: np.ndarray, goals: np.ndarray, *, planner: str = "rrtconnect",
+def search(checker: MotionChecker, start: np.ndarray, goals: np.ndarray, *, planner: str = "rrtconnect",
            time_limit: float = 1.0, seed: int = 0, lower: np.ndarray | None = None, upper: np.ndarray | None = None,
            planner_range: float | None = None, scale: np.ndarray | None = None,
            progress: Callable[[str], None] | None = None) -> SearchResult:
@@ -197,7 +200,7 @@ class _Scaled:
         return self.checker.edge_valid(a / self.scale, b / self.scale)
 
 
-def shortcut(checker: Any, path: np.ndarray, *, seed: int = 0, rounds: int = 10, scale: np.ndarray | None = None,
+def shortcut(checker: MotionChecker, path: np.ndarray, *, seed: int = 0, rounds: int = 10, scale: np.ndarray | None = None,
              lower: np.ndarray | None = None, upper: np.ndarray | None = None) -> np.ndarray:
     """OMPL's shortcutting of ``path (M, dim)`` under the checker's continuous edge proof (module docstring)."""
     ob, og, ou = _ompl()

@@ -26,7 +26,7 @@ itself is the path, with stops at its corners, proven by the search.
 from __future__ import annotations
 
 from bisect import bisect_right
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +34,10 @@ from pinarms.optim.motion.proof import Verdict
 from pinarms.optim.motion.spline_proof import LIMIT_TOL, MAX_OPEN, cover_proof, joint_extrema, merged, outside_joints
 from pinarms.planning import JointPath, joint_spline
 from pinarms.planning.extrema import normalised_pieces, piece_extrema
+
+if TYPE_CHECKING:
+    from pinarms.optim.motion.checker import MotionChecker
+    from pinarms.robots.robot import Robot
 
 __all__ = ["REFINE_ROUNDS", "LIMIT_TOL", "prove_path", "polyline_path", "smooth_path", "path_speed_bounds",
            "within_limits"]
@@ -248,7 +252,7 @@ def _open_groups(s: np.ndarray, ranges: np.ndarray, focus: tuple[float, float] |
     return [np.unique(np.concatenate(g)) for g in groups if g]
 
 
-def prove_path(checker: Any, path: JointPath, extra: np.ndarray | None = None, *,
+def prove_path(checker: MotionChecker, path: JointPath, extra: np.ndarray | None = None, *,
                focus: tuple[float, float] | None = None, compiled: bool = True) -> Any:
     """Prove that every configuration of ``path`` keeps the checker's margins (module docstring).
 
@@ -311,7 +315,7 @@ def _prove_groups(checker: Any, path: JointPath, s: np.ndarray, budgets: np.ndar
     return verdict, None
 
 
-def polyline_path(waypoints: np.ndarray, robot: Any = None) -> JointPath:
+def polyline_path(waypoints: np.ndarray, robot: Robot | None = None) -> JointPath:
     """The polyline through ``waypoints (K, n)`` as a :class:`JointPath` (s = chord length) with stops at its corners."""
     W = np.asarray(waypoints, dtype=float)
     step = np.linalg.norm(np.diff(W, axis=0), axis=1)
@@ -335,7 +339,7 @@ def _refined(W: np.ndarray, piece: int) -> tuple[np.ndarray, tuple[int, int]]:
     return np.concatenate(rows), (lo, lo + 3 * (hi - lo + 1))
 
 
-def smooth_path(checker: Any, waypoints: np.ndarray, robot: Any = None, *,
+def smooth_path(checker: MotionChecker, waypoints: np.ndarray, robot: Robot | None = None, *,
                 compiled: bool = True) -> tuple[JointPath, str, int]:
     """A proven joint path through the polyline ``waypoints``: ``(path, method, rounds)``.
 

@@ -9,7 +9,7 @@ central differences; torques from the arm's RNEA with the payload at the tcp.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
@@ -17,6 +17,9 @@ from pinarms.optim.errors import InfeasibleProblem
 
 from pinarms.optim.standard_cycle.path import StandardCycle, gate_breaks, gate_length, gate_points
 from pinarms.optim.standard_cycle.timing import GateTiming, JointPathRows, time_rows
+
+if TYPE_CHECKING:
+    from pinarms.robots.robot import Robot
 
 __all__ = ["serial_gate_rows", "serial_standard_cycle"]
 
@@ -38,7 +41,7 @@ def _joint_path(robot: Any, rotation: np.ndarray, points: np.ndarray, q_ref: np.
     return out
 
 
-def serial_gate_rows(robot: Any, cycle: StandardCycle, q_ref, n: int = 400) -> JointPathRows:
+def serial_gate_rows(robot: Robot, cycle: StandardCycle, q_ref, n: int = 400) -> JointPathRows:
     """The rows of the gate for a serial arm (about ``n`` grid intervals)."""
     arm = robot.with_payload(cycle.payload) if cycle.payload > 0 else robot
     q_ref = np.asarray(q_ref, dtype=float)
@@ -60,7 +63,7 @@ def serial_gate_rows(robot: Any, cycle: StandardCycle, q_ref, n: int = 400) -> J
                          np.hstack([cl, cr]))
 
 
-def serial_standard_cycle(robot: Any, cycle: StandardCycle, q_ref, n: int = 400) -> GateTiming:
+def serial_standard_cycle(robot: Robot, cycle: StandardCycle, q_ref, n: int = 400) -> GateTiming:
     """Time-optimal one-way move of the gate (rest to rest) under the arm's ``velocity_limit``,
     ``acceleration_limit`` and the URDF's effort limits; the cycle takes twice its ``duration``."""
     rows = serial_gate_rows(robot, cycle, q_ref, n)

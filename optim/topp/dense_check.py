@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 from math import comb
-from typing import Any, Sequence
+from typing import Sequence, TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from pinarms.optim.topp.time_law import law_eval
 from pinarms.planning import Trajectory
 from pinarms.planning.extrema import derivative_coefficients, normalised_pieces, piece_extrema
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
 
 __all__ = ["CHECK_FRACTIONS", "Peaked", "rows_at", "rows_at_sets", "row_names", "dilation_needed", "ratios", "law_rows", "law_check"]
 
@@ -101,12 +104,12 @@ def _exact_peaks(normalised: np.ndarray, h: np.ndarray, r: int) -> np.ndarray:
     return peaks
 
 
-def rows_at(path: Any, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:
+def rows_at(path: JointPath, constraints: Sequence[PathConstraint], s: np.ndarray, side: str) -> PathRows:
     """The rows of all ``constraints`` at path positions ``s``, pieces taken on ``side`` of a break."""
     return rows_at_sets(path, constraints, [(s, side)])[0]
 
 
-def rows_at_sets(path: Any, constraints: Sequence[PathConstraint], sets: Sequence[tuple[np.ndarray, str]]) -> list[PathRows]:
+def rows_at_sets(path: JointPath, constraints: Sequence[PathConstraint], sets: Sequence[tuple[np.ndarray, str]]) -> list[PathRows]:
     """:func:`rows_at` at several ``(s, side)`` at once: the joint torque rows of all in one batched call
     (:mod:`.torque_rows`; the same rows, bit for bit)."""
     from pinarms.optim.topp.torque_rows import rows_of_samplings
@@ -114,7 +117,7 @@ def rows_at_sets(path: Any, constraints: Sequence[PathConstraint], sets: Sequenc
     return rows_of_samplings(constraints, [PathSamples.of(path, s, side) for s, side in sets])
 
 
-def row_names(path: Any, constraints: Sequence[PathConstraint]) -> list[str]:
+def row_names(path: JointPath, constraints: Sequence[PathConstraint]) -> list[str]:
     """The constraint name of every row column (a constraint gives one or more rows)."""
     return [c.name for c in constraints for _ in range(c.rows(PathSamples.of(path, [0.0])).a.shape[1])]
 
@@ -142,7 +145,7 @@ def ratios(rows: PathRows, u: np.ndarray, x: np.ndarray, names: list[str]) -> di
     return out
 
 
-def law_rows(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray,
+def law_rows(path: JointPath, constraints: Sequence[PathConstraint], tb: np.ndarray,
              C: np.ndarray) -> tuple[PathRows, np.ndarray, np.ndarray]:
     """Rows of the constraints at 0, 1/4 … 1 of every law piece, with the law's (u, x) there.
 
@@ -160,7 +163,7 @@ def law_rows(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray,
     return PathRows.concatenate_points(rows_at_sets(path, constraints, sets)), np.concatenate(u), np.concatenate(x)
 
 
-def law_check(path: Any, constraints: Sequence[PathConstraint], tb: np.ndarray, C: np.ndarray) -> float:
+def law_check(path: JointPath, constraints: Sequence[PathConstraint], tb: np.ndarray, C: np.ndarray) -> float:
     """f² the path constraints need on a law (dense rows)."""
     rows, u, x = law_rows(path, constraints, tb, C)
     need = dilation_needed(rows, u, x)

@@ -8,7 +8,7 @@ the rounds run out. A grid never grows past :data:`pinarms.optim.caps.MAX_PATH_G
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
 
@@ -18,10 +18,13 @@ from pinarms.optim.topp.dense_check import CHECK_FRACTIONS, dilation_needed, rat
 from pinarms.optim.topp.profile import topp_profile
 from pinarms.planning.path_constraints import PathConstraint, PathRows, PathSamples
 
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
+
 __all__ = ["path_grid", "refined_section"]
 
 
-def path_grid(path: Any, a: float, b: float, total: float, n: int, kappa: float) -> np.ndarray:
+def path_grid(path: JointPath, a: float, b: float, total: float, n: int, kappa: float) -> np.ndarray:
     """Grid of [a, b]: the path breaks inside, each piece cut in steps of about total / n, then
     intervals halved until the tangent q' changes by at most ``kappa`` of its size across each."""
     breaks = np.asarray(path.breaks)
@@ -117,7 +120,7 @@ def _refined_rows(path: Any, constraints: Sequence[PathConstraint], grid: np.nda
     return refined, _merged(rows, old_point, at_points), _merged(_taken(inner, was), kept, at_inner)
 
 
-def refined_section(path: Any, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
+def refined_section(path: JointPath, constraints: Sequence[PathConstraint], grid: np.ndarray, x0: float, x1: float,
                     rtol: float, max_rounds: int,
                     with_ratios: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, dict]:
     """Profile of one section with the check-and-refine loop: (s, x, u, f², rounds, ratios).

@@ -44,9 +44,10 @@ jerk smoothing), :mod:`.time_law` (step 5 and the smoothing of the law).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.optim.caps import (MAX_PATH_GRID, MAX_PATH_ROUNDS, MAX_TIME_SCALED_SAMPLES, MIN_PATH_KAPPA,
                                MIN_PATH_RTOL, count_setting)
@@ -59,6 +60,9 @@ from pinarms.optim.topp.time_law import (acceleration_jumps, assemble, bang_bang
                                          smoothed)
 from pinarms.planning import Trajectory
 from pinarms.planning.path_constraints import PathConstraint, PathRows
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
 
 __all__ = ["PathTiming", "time_optimal", "time_scaled", "SHAPES", "CHECK_FRACTIONS", "SMOOTHING_FACTORS"]
 
@@ -115,11 +119,11 @@ class PathTiming:
         """Total time [s]."""
         return float(self.law_breaks[-1] - self.law_breaks[0])
 
-    def state(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def state(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Path position s, speed ṡ and acceleration s̈ at instants ``t`` (N,) [s]."""
         return law_eval(self.law_breaks, self.law_coefficients, np.atleast_1d(np.asarray(t, dtype=float)))
 
-    def time_at(self, s: Any) -> np.ndarray:
+    def time_at(self, s: ArrayLike) -> np.ndarray:
         """First instants [s] at which the path reaches ``s`` (N,) (bisection on the monotone law)."""
         target = np.atleast_1d(np.asarray(s, dtype=float))
         lo = np.full(target.shape, self.law_breaks[0])
@@ -131,7 +135,7 @@ class PathTiming:
             hi = np.where(below, hi, mid)
         return hi
 
-    def tool_speed(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
+    def tool_speed(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """tcp linear [m/s] and angular [rad/s] speed at instants ``t`` (needs ``path.robot``)."""
         s, sd, _ = self.state(t)
         _, d1, _ = self.path.tool_derivatives(s)
@@ -227,7 +231,7 @@ def _slowed(path: Any, tb: np.ndarray, C: np.ndarray, f: float) -> tuple[np.ndar
     return tb, C, Trajectory(tb, compose_law(path, tb, C))
 
 
-def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any = None, grid: int = 100,
+def time_optimal(path: JointPath, constraints: Sequence[PathConstraint], *, jerk: ArrayLike | None = None, grid: int = 100,
                  kappa: float = 0.02, start_speed: float = 0.0, end_speed: float = 0.0, rtol: float = 1e-3,
                  max_rounds: int = 8) -> PathTiming:
     """Time-optimal timing of ``path`` under ``constraints`` (module docstring).
@@ -274,7 +278,7 @@ def time_optimal(path: Any, constraints: Sequence[PathConstraint], *, jerk: Any 
     return PathTiming(path, cons, traj, tb, C, grid_all, float(f), float(smoothing), int(sum(r[4] for r in results)))
 
 
-def time_scaled(path: Any, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
+def time_scaled(path: JointPath, constraints: Sequence[PathConstraint], *, shape: str = "quintic",
                 samples: int = 2001) -> PathTiming:
     """The path timed by a fixed rest-to-rest shape ``s(t) = a + L σ(t / T)``, T as short as the limits allow.
 

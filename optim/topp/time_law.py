@@ -10,12 +10,15 @@ builds laws (:func:`bang_bang`, :func:`smoothed`, :func:`scaled_law`), evaluates
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.planning import Trajectory
 from pinarms.planning.poly_pieces import taylor_shift
+
+if TYPE_CHECKING:
+    from pinarms.planning.joint_path import JointPath
 
 __all__ = ["law_eval", "polyval", "bang_bang", "smoothed", "split_at_breaks", "compose_law", "assemble",
            "scaled_law", "acceleration_jumps"]
@@ -114,7 +117,7 @@ def split_at_breaks(tb: np.ndarray, C: np.ndarray, s_breaks: np.ndarray) -> tupl
     return new, out
 
 
-def compose_law(path: Any, tb: np.ndarray, C: np.ndarray) -> np.ndarray:
+def compose_law(path: JointPath, tb: np.ndarray, C: np.ndarray) -> np.ndarray:
     """Coefficients (P, D·k+1, n) in the local time of q(s(t)) on each law piece (path_timing, step 5)."""
     breaks, Q = np.asarray(path.breaks), path.coefficients  # (K, D+1, n)
     h = np.diff(tb)
@@ -138,7 +141,7 @@ def compose_law(path: Any, tb: np.ndarray, C: np.ndarray) -> np.ndarray:
     return out
 
 
-def assemble(path: Any, laws: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, Trajectory]:
+def assemble(path: JointPath, laws: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, Trajectory]:
     """Sections' laws end to end (each cut at the path breaks) and the composed trajectory."""
     tbs, Cs, offset = [], [], 0.0
     width = max(C.shape[1] for _, C in laws)

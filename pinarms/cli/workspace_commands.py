@@ -88,11 +88,11 @@ def workspace_cmd(robot: str, n: int, seed: int, frame: str, session_path: str |
 
 def _streamed_workspace(arm, n, seed, frame, voxel_mm, scheduler, session_path, as_json) -> None:
     from pinarms.execution import describe_scheduler
-    from pinarms.robots.reach.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import StreamGrid, stream_workspace
 
     with common.progress_bar("workspace tasks", None, as_json) as bar:
         res = stream_workspace(arm, n, seed=seed, frame=frame,
-                               voxel_size=None if voxel_mm is None else voxel_mm * 1e-3,
+                               grid=StreamGrid(None if voxel_mm is None else voxel_mm * 1e-3),
                                scheduler=scheduler, progress=bar if bar.enabled else None)
     v = res.voxels
     data = {

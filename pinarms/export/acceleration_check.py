@@ -14,9 +14,16 @@ limits are a stated rule, not the drive's): re-time under ``amax`` before sendin
 from __future__ import annotations
 
 import warnings
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.optim.line.schedule import LineSchedule
+    from pinarms.optim.motion.result import MotionPlan
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.robot import Robot
 
 __all__ = ["AccelerationWarning", "acceleration_limits_of", "flag_accelerations", "ACCELERATION_TOL"]
 
@@ -28,7 +35,7 @@ class AccelerationWarning(UserWarning):
     """A trajectory for a controller accelerates a joint beyond that arm's acceleration limit."""
 
 
-def acceleration_limits_of(source: Any, robot: Any = None, arm: str | None = None) -> np.ndarray:
+def acceleration_limits_of(source: Trajectory | CycleResult | MotionPlan | LineSchedule, robot: Robot | None = None, arm: str | None = None) -> np.ndarray:
     """The acceleration limits ``(n,)`` [rad/s² or m/s²] of the joints a controller file of ``source`` holds.
 
     ``source`` a MotionPlan: its planned arms' limits, in its order; otherwise ``robot`` (a Robot)

@@ -28,7 +28,7 @@ import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
 from pinarms.errors import InvalidInput
@@ -37,6 +37,12 @@ from pinarms.export.mesh_convert import binary_stl
 from pinarms.export.mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
 from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
 from pinarms.export.srdf import geometry_links, home_notes, srdf_text
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from pinarms.robots.cell.cell import Cell
+    from pinarms.robots.robot import Robot
 
 __all__ = ["ExportedCell", "export_cell", "one_collision_per_link", "cell_of_urdf_folder"]
 
@@ -97,7 +103,7 @@ def one_collision_per_link(root: ET.Element) -> dict[str, str]:
     return added
 
 
-def cell_folders(cell: Any, packages: Mapping[str, str | os.PathLike] | None = None) -> MeshFolders:
+def cell_folders(cell: Cell, packages: Mapping[str, str | os.PathLike] | None = None) -> MeshFolders:
     """The folders a cell's export may copy meshes from: its folder, pinarms' package, its packages and ``packages``."""
     from pinarms.robots.xacro_expand import BUILTIN_PACKAGE
 
@@ -182,8 +188,8 @@ def _load(cell_or_name: Any, packages: Mapping[str, str | os.PathLike] | None = 
     return cell
 
 
-def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
-                states: Mapping[str, Mapping[str, Any]] | None = None, overwrite: bool = False,
+def export_cell(cell_or_name: Cell | str | os.PathLike, out_dir: str | os.PathLike, *, srdf: bool = True, mjcf: bool = True,
+                states: Mapping[str, Mapping[str, ArrayLike]] | None = None, overwrite: bool = False,
                 packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """Write a whole cell (URDF + SRDF + MJCF + meshes) into ``out_dir`` (module doc).
 
@@ -219,7 +225,7 @@ def export_cell(cell_or_name: Any, out_dir: str | os.PathLike, *, srdf: bool = T
                         r.notes)
 
 
-def cell_of_urdf_folder(robot: Any, folder: Path):
+def cell_of_urdf_folder(robot: Robot, folder: Path):
     """A one-arm :class:`Cell` of ``robot`` built from its exported (self-contained) URDF folder."""
     from pinarms.robots.cell import Cell
 
@@ -227,8 +233,8 @@ def cell_of_urdf_folder(robot: Any, folder: Path):
     return Cell(text, source=f"robot {robot.name!r}", base_dir=folder)
 
 
-def export_robot_with_srdf(robot: Any, out_dir: str | os.PathLike, *, overwrite: bool = False,
-                           states: Mapping[str, Any] | None = None,
+def export_robot_with_srdf(robot: Robot, out_dir: str | os.PathLike, *, overwrite: bool = False,
+                           states: Mapping[str, ArrayLike] | None = None,
                            packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """One arm as a folder with its URDF (one collision per link) and SRDF (one-arm cell rules)."""
     out = _check_folder(out_dir, overwrite)

@@ -8,13 +8,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
 
 from pinarms.errors import InvalidInput
 
 from pinarms.export.srdf import cycle_states
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["ShippedMotion", "shipped_motions", "study_states", "STUDY_CELLS"]
 
@@ -58,7 +61,7 @@ def _line_cycles(cell: Any, step: Any = None) -> dict[str, Any]:
     return cycles
 
 
-def study_states(cell: Any) -> dict[str, dict[str, np.ndarray]]:
+def study_states(cell: Cell) -> dict[str, dict[str, np.ndarray]]:
     """SRDF states of a built-in cell from the demo's cycles in it (``pick``, ``place``, ...; ``left_pick`` with several arms).
 
     Raises:
@@ -72,7 +75,7 @@ def study_states(cell: Any) -> dict[str, dict[str, np.ndarray]]:
     raise InvalidInput(f"cell {cell.name!r} has no study poses; cells with them: {', '.join(STUDY_CELLS)}")
 
 
-def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Any = None) -> list[ShippedMotion]:
+def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Callable[[int, int], None] | None = None) -> list[ShippedMotion]:
     """Plan the shipped motions (about 10 s; ``line=False`` skips the mushroom line, 15 s more).
 
     ``progress(done, total)`` is called after each motion is planned.

@@ -31,11 +31,16 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["SRDF_REASON", "contact_pairs", "srdf_text", "home_notes", "cycle_states"]
 
@@ -53,13 +58,13 @@ SRDF_REASON = {
 _STATE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
 
 
-def contact_pairs(cell: Any) -> tuple:
+def contact_pairs(cell: Cell) -> tuple:
     """The pairs a contact check of ``cell`` looks at (``cell.pairs_for(0.0)``, or ``cell.pairs``)."""
     pairs_for = getattr(cell, "pairs_for", None)
     return tuple(pairs_for(0.0)) if callable(pairs_for) else tuple(cell.pairs)
 
 
-def geometry_links(cell: Any) -> dict[str, str]:
+def geometry_links(cell: Cell) -> dict[str, str]:
     """``{geometry name: exported link}``: the k-th collision of link ``L`` is link ``L_collision_k`` (k ≥ 1)."""
     out: dict[str, str] = {}
     count: dict[str, int] = {}
@@ -71,7 +76,7 @@ def geometry_links(cell: Any) -> dict[str, str]:
     return out
 
 
-def cycle_states(cycle: Any) -> dict[str, np.ndarray]:
+def cycle_states(cycle: CycleResult) -> dict[str, np.ndarray]:
     """Named poses of a planned cycle (:class:`pinarms.optim.CycleResult`): its waypoints' joints, by label."""
     out: dict[str, np.ndarray] = {}
     for label, q in zip(cycle.names, np.asarray(cycle.q_via)):
@@ -104,7 +109,7 @@ def _zero_outside(arm: Any) -> str | None:
             f"[{float(lo[j])!r}, {float(hi[j])!r}]")
 
 
-def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
+def _states(cell: Any, states: Mapping[str, Mapping[str, ArrayLike]] | None) -> tuple[list[tuple[str, str, list]], list[str]]:
     """``([(state name, group, [(joint, value)])], notes)``: the homes, then the given states.
 
     A home the caller gives (``home``, or ``ARM_home`` in a cell of several arms), or the cell
@@ -146,19 +151,19 @@ def _states(cell: Any, states: Mapping[str, Mapping[str, Any]] | None) -> tuple[
     return out, notes
 
 
-def _description_states(cell: Any, several: bool) -> dict[str, dict[str, Any]]:
+def _description_states(cell: Cell, several: bool) -> dict[str, dict[str, Any]]:
     """The named states of the cell description's arms (``arm.states``): ``NAME`` in a cell of one arm,
     ``ARM_NAME`` in a cell of several; a ``home`` among them is the arm's home (states given to the export win)."""
     return {(f"{arm.name}_{name}" if several else name): {arm.name: q}
             for arm in cell.arms for name, q in getattr(arm, "states", {}).items()}
 
 
-def home_notes(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> tuple[str, ...]:
+def home_notes(cell: Cell, *, states: Mapping[str, Mapping[str, ArrayLike]] | None = None) -> tuple[str, ...]:
     """Why :func:`srdf_text` writes no home for an arm (its limits exclude the all-zero pose and no home is given)."""
     return tuple(_states(cell, states)[1])
 
 
-def srdf_text(cell: Any, *, states: Mapping[str, Mapping[str, Any]] | None = None) -> str:
+def srdf_text(cell: Cell, *, states: Mapping[str, Mapping[str, ArrayLike]] | None = None) -> str:
     """The SRDF of ``cell`` (a :class:`pinarms.robots.cell.Cell`) against its exported URDF's links.
 
     Args:

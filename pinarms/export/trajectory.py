@@ -34,7 +34,7 @@ import math
 import os
 import re
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence, TYPE_CHECKING
 
 import numpy as np
 
@@ -43,6 +43,13 @@ from pinarms.files import atomic_write
 
 from pinarms.export.acceleration_check import acceleration_limits_of, flag_accelerations
 from pinarms.export.errors import InvalidJointName, InvalidRate, JointMismatch
+
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.optim.line.schedule import LineSchedule
+    from pinarms.optim.motion.result import MotionPlan
+    from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots.robot import Robot
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
            "line_arm_sampler", "check_joint_names", "ROS_NAME"]
@@ -85,7 +92,7 @@ def _rate(rate: Any) -> float:
     return value
 
 
-def line_arm_sampler(schedule: Any, cycles: Mapping[str, Any], arm: str) -> tuple[float, float, Callable]:
+def line_arm_sampler(schedule: LineSchedule, cycles: Mapping[str, CycleResult], arm: str) -> tuple[float, float, Callable]:
     """``(start, end, sample)`` of arm ``arm`` over one period of a line schedule (offset included)."""
     from pinarms.robots.cell import ArmMotion
 
@@ -164,8 +171,8 @@ def _check_width(n: int, robot: Any, what: str) -> None:
                             f"({', '.join(robot.joint_names)}): write it for the robot it was planned for")
 
 
-def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: str | None = None,
-                          cycles: Mapping[str, Any] | None = None) -> ControllerTrajectory:
+def controller_trajectory(source: Trajectory | CycleResult | MotionPlan | LineSchedule, rate: float, *, robot: Robot | None = None, arm: str | None = None,
+                          cycles: Mapping[str, CycleResult] | None = None) -> ControllerTrajectory:
     """Sample ``source`` at ``rate`` [Hz] for a controller (module doc).
 
     Args:
@@ -212,7 +219,7 @@ def controller_trajectory(source: Any, rate: float, *, robot: Any = None, arm: s
 ROS_NAME = re.compile(r"[A-Za-z/][A-Za-z0-9_/]{0,254}")
 
 
-def check_joint_names(names: Any) -> tuple[str, ...]:
+def check_joint_names(names: Sequence[str]) -> tuple[str, ...]:
     """``names`` as a tuple, each a ROS name (:data:`ROS_NAME`); else :class:`InvalidJointName` naming it."""
     out = tuple(names)
     for name in out:

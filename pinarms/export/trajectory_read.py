@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import csv
 import os
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -136,7 +136,7 @@ def _expect(names: tuple[str, ...], joint_names: Any, path: Any) -> None:
         raise JointMismatch(f"{path}: the file's joints {list(names)} are not the expected {list(joint_names)}")
 
 
-def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) -> ControllerTrajectory:
+def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Sequence[str] | None = None) -> ControllerTrajectory:
     """Read a file of :func:`~.trajectory.write_trajectory_yaml` (any JointTrajectory YAML with those fields).
 
     Raises:
@@ -153,7 +153,7 @@ def read_trajectory_yaml(path: str | os.PathLike, *, joint_names: Any = None) ->
     return traj
 
 
-def read_trajectory_csv(path: str | os.PathLike, *, joint_names: Any = None) -> ControllerTrajectory:
+def read_trajectory_csv(path: str | os.PathLike, *, joint_names: Sequence[str] | None = None) -> ControllerTrajectory:
     """Read a file of :func:`~.trajectory.write_trajectory_csv`.
 
     Raises:

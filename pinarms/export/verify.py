@@ -30,15 +30,19 @@ import math
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.robots.collision_requests import cold_start
 from pinarms.errors import InvalidInput, ModelError
 
 from pinarms.export.srdf import contact_pairs
+
+if TYPE_CHECKING:
+    from pinarms.robots.cell.cell import Cell
 
 __all__ = ["EngineComparison", "compare_in_mujoco", "compare_configurations_in_mujoco", "motion_sampler", "TOLERANCE_M", "DISTMAX"]
 
@@ -112,7 +116,7 @@ class EngineComparison:
         ]
 
 
-def motion_sampler(source: Any, cell: Any, *, arm: str | None = None,
+def motion_sampler(source: Any, cell: Cell, *, arm: str | None = None,
                    cycles: Mapping[str, Any] | None = None) -> tuple[str, float, float, Any]:
     """``(label, start, end, q_of_t)`` of a planned motion in ``cell`` (``q_of_t(t (N,)) -> (N, nq)``)."""
     from pinarms.optim import CycleResult, LineSchedule
@@ -161,7 +165,7 @@ def _mujoco_setter(model: Any, cell: Any):
     return set_q
 
 
-def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles: Mapping[str, Any] | None = None,
+def compare_in_mujoco(cell: Cell, source: Any, *, arm: str | None = None, cycles: Mapping[str, Any] | None = None,
                       samples: int = 200, mjcf: str | Path | None = None,
                       packages: Mapping[str, str | Path] | None = None) -> EngineComparison:
     """Replay ``source`` in MuJoCo and compare with pinarms (module doc).
@@ -179,7 +183,7 @@ def compare_in_mujoco(cell: Any, source: Any, *, arm: str | None = None, cycles:
     return _compare(cell, label, qs, mjcf, packages)
 
 
-def compare_configurations_in_mujoco(cell: Any, qs: Any, *, label: str = "configurations",
+def compare_configurations_in_mujoco(cell: Cell, qs: ArrayLike, *, label: str = "configurations",
                                      mjcf: str | Path | None = None,
                                      packages: Mapping[str, str | Path] | None = None) -> EngineComparison:
     """Compare pinarms and MuJoCo at the cell configurations ``qs (N, nq)`` (module doc; ``samples`` = N).

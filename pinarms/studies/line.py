@@ -19,7 +19,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -74,7 +74,7 @@ def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
     return hashlib.sha256(repr(key).encode()).hexdigest()[:16]
 
 
-def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Any = None) -> dict:
+def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress: Callable[[str], None] | None = None) -> dict:
     """Task maps of every station of ``spec`` from :data:`DATA` (built when missing and ``build``).
     A spec with a cell gets maps built against the cell's fixtures (:func:`pinarms.optim.line.build_maps`;
     not stored: they hold for that cell only)."""
@@ -135,7 +135,7 @@ def _arms_history(rate: float, *, paper_limit: bool, max_arms: int = 20, start: 
     return found, last, LineCurve("arms", a[:, 0], *a[:, 1:].T)
 
 
-def max_flow(make_spec: Any, lo: float, hi: float, *, target: float = 0.01, steps: int = 8) -> float:
+def max_flow(make_spec: Callable[[float], LineSpec], lo: float, hi: float, *, target: float = 0.01, steps: int = 8) -> float:
     """Largest flow [items/min] in [lo, hi] with mean miss rate ≤ ``target`` (bisection)."""
     for _ in range(steps):
         mid = 0.5 * (lo + hi)

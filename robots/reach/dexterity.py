@@ -18,9 +18,10 @@ from __future__ import annotations
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
@@ -34,7 +35,7 @@ CHUNK = 16384
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
 
-def position_dexterity(Jv: Any) -> tuple[np.ndarray, np.ndarray]:
+def position_dexterity(Jv: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Manipulability and inverse condition of position Jacobians ``J_v (N, 3, nq)``.
 
     Returns ``(w, c)``: ``w = sqrt(det(J_v J_vᵀ))`` (``sqrt(det(J_vᵀ J_v))`` when
@@ -89,7 +90,7 @@ def _dexterity_from_columns(cols: list, n: int) -> tuple[np.ndarray, np.ndarray]
 
 
 def positions_and_dexterity(
-    robot: "Robot", q: np.ndarray, frame: str, chunk: int = CHUNK, progress: Any = None, threads: int | None = None
+    robot: "Robot", q: np.ndarray, frame: str, chunk: int = CHUNK, progress: Callable[[int, int], None] | None = None, threads: int | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame positions ``(N, 3)``, manipulability and inverse condition ``(N,)`` for ``q (N, nq)``.
 

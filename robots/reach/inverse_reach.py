@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.reach.orientations import _align, _rotation_about
@@ -48,7 +49,7 @@ from pinarms.robots.reach.robot_spec import urdf_sha256
 if TYPE_CHECKING:  # pragma: no cover
     from pinarms.robots.robot import Robot
 
-__all__ = ["BasePlacements", "base_placements", "tool_down_poses", "MAX_CANDIDATES"]
+__all__ = ["BasePlacements", "IKCheck", "base_placements", "tool_down_poses", "MAX_CANDIDATES"]
 
 #: Most (x, y, yaw) candidates one call evaluates on the map.
 MAX_CANDIDATES = 20_000_000
@@ -56,7 +57,7 @@ _BLOCK = 250_000
 _DOWN = np.array([0.0, 0.0, -1.0])
 
 
-def tool_down_poses(points: Any, tool_axis: Any = (0.0, 0.0, 1.0)) -> np.ndarray:
+def tool_down_poses(points: ArrayLike, tool_axis: ArrayLike = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Task poses ``(N, 4, 4)`` at ``points (N, 3)`` [m] with ``tool_axis`` (tool frame) pointing straight down.
 
     Roll zero as in :func:`pinarms.robots.reach.orientations.tool_axis_orientations` (a fixed rotation taking
@@ -187,39 +188,64 @@ def _tie_ranks(values: np.ndarray) -> np.ndarray:
     return ranks
 
 
+@dataclass(frozen=True)
+class IKCheck:
+    """How :func:`base_placements` checks its best map candidates by exact IK.
+
+    Attributes:
+        robot: the arm (its URDF must be the map's).
+        verify: how many of the best map candidates to check (0: none).
+        self_collision, collision: collision checks of the exact IK solutions (as in
+            :func:`pinarms.robots.reachability_map`).
+
+    Raises:
+        InvalidInput: no robot, or ``verify`` not a non-negative integer.
+    """
+
+    robot: Robot
+    verify: int = 20
+    self_collision: bool = False
+    collision: Any = None
+
+    def __post_init__(self) -> None:
+        if self.robot is None:
+            raise InvalidInput("IKCheck needs the robot=... the map was built for (or pass no check)")
+        v = self.verify
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise InvalidInput(f"verify must be a non-negative integer, got {v!r}")
+
+
 def base_placements(
     reach_map: ReachabilityMap,
-    tasks: Any,
+    tasks: ArrayLike,
     *,
-    robot: "Robot | None" = None,
     z: float = 0.0,
     roll_free: bool = True,
     xy_step: float | None = None,
     yaw_step: float = np.radians(10.0),
     roll_steps: int = 8,
-    verify: int = 20,
-    self_collision: bool = False,
-    collision: Any = None,
+    check: IKCheck | None = None,
 ) -> BasePlacements:
     """Bases ``(x, y, yaw)`` on the plane at ``z`` from which every task pose is reachable (module doc).
 
     Args:
         reach_map: the arm's reachability map (its base frame).
         tasks: task poses ``(N, 4, 4)``, tool frame → world [m] (see :func:`tool_down_poses`).
-        robot: the arm, to check the best candidates by exact IK (its URDF must be the map's).
         z: height of the base plane in the world [m].
         roll_free: only the tool axis of each task matters (the map set's tool axis).
         xy_step: grid step [m] (default the map's resolution); yaw_step [rad].
         roll_steps: rolls tried per roll-free task on an SO(3) map and in the exact check.
-        verify: how many of the best map candidates to check by IK (needs ``robot``).
-        self_collision, collision: collision checks of the exact IK solutions (as in
-            :func:`pinarms.robots.reachability_map`).
+        check: the exact IK check of the best candidates (:class:`IKCheck`); ``None``: none.
 
     Raises:
         InvalidInput: bad tasks, steps, a grid larger than :data:`MAX_CANDIDATES`.
         ModelError: ``robot`` is not the robot the map was built for.
     """
-    T_tasks, z, step = _checked_arguments(reach_map, tasks, robot, z, xy_step, yaw_step, roll_steps, verify)
+    if check is not None and not isinstance(check, IKCheck):
+        raise InvalidInput(f"check must be a robots.reach.inverse_reach.IKCheck, got {type(check).__name__}")
+    robot, verify = (None, 0) if check is None else (check.robot, check.verify)
+    self_collision, collision = (False, None) if check is None else (check.self_collision, check.collision)
+    T_tasks, z, step = _checked_arguments(reach_map, tasks, robot, z, xy_step, yaw_step, roll_steps)
     X, Y, yaws, n_grid = _candidate_grid(reach_map, T_tasks[:, :3, 3], step, yaw_step)
     xyyaw, sums, wmin, n_lookups = _feasible_on_map(reach_map, T_tasks, X, Y, yaws, z, roll_free, roll_steps)
     order = _map_order(xyyaw, sums, wmin)
@@ -241,7 +267,7 @@ def base_placements(
 
 
 def _checked_arguments(reach_map: Any, tasks: Any, robot: "Robot | None", z: Any, xy_step: Any, yaw_step: Any,
-                       roll_steps: Any, verify: Any) -> tuple[np.ndarray, float, float]:
+                       roll_steps: Any) -> tuple[np.ndarray, float, float]:
     """The tasks ``(N, 4, 4)``, the plane's height ``z`` [m] and the grid step [m], every argument checked in order."""
     if not isinstance(reach_map, ReachabilityMap):
         raise InvalidInput(f"reach_map must be a ReachabilityMap, got {type(reach_map).__name__}")
@@ -256,12 +282,8 @@ def _checked_arguments(reach_map: Any, tasks: Any, robot: "Robot | None", z: Any
         raise InvalidInput(f"yaw_step must be in (0, 2π] rad, got {yaw_step!r}")
     if isinstance(roll_steps, bool) or not isinstance(roll_steps, (int, np.integer)) or roll_steps < 1:
         raise InvalidInput(f"roll_steps must be a positive integer, got {roll_steps!r}")
-    if isinstance(verify, bool) or not isinstance(verify, (int, np.integer)) or verify < 0:
-        raise InvalidInput(f"verify must be a non-negative integer, got {verify!r}")
     if robot is not None and urdf_sha256(robot) != reach_map.urdf_sha256:
         raise ModelError(f"the map was built for '{reach_map.robot}' (another URDF than robot '{robot.name}')")
-    if verify and robot is None:
-        raise InvalidInput("pass robot=... to check the best candidates by IK (or verify=0)")
     return T_tasks, z, step
 
 

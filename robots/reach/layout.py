@@ -33,9 +33,10 @@ whose last joint moves the tool point, e.g. the koji arm, whose wrist carries th
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.so3 import rot_z as _rot_z
@@ -208,10 +209,10 @@ def _numerical_solutions(robot: "Robot", T: np.ndarray, n_seeds: int, seed: int,
 
 def check_layout(
     robot: "Robot",
-    points: Any,
+    points: ArrayLike,
     *,
-    names: Any = None,
-    orientation: Any = None,
+    names: Sequence[str] | None = None,
+    orientation: ArrayLike | None = None,
     workspace: Workspace | None = None,
     voxel_size: float | None = None,
     n_seeds: int = 8,

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 from pinarms.robots.so3 import about as _rotation_about
@@ -135,7 +136,7 @@ class OrientationSet:
             f"over {where} × {p.get('roll_steps')} roll steps = {self.size} poses, {roll}"
         )
 
-    def nearest(self, rotations: Any) -> tuple[np.ndarray, np.ndarray]:
+    def nearest(self, rotations: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Index of the nearest member and the angle to it [rad] for ``rotations (N, 3, 3)`` (or ``(3, 3)``).
 
         ``so3`` sets: geodesic angle between rotations. ``tool_axis`` sets: the angle between
@@ -251,7 +252,7 @@ def so3_orientations(n: int = 50) -> OrientationSet:
     return OrientationSet("so3", rot, np.arange(n), n, False, axis, rot[:, :, 2].copy(), {"n": n})
 
 
-def fibonacci_directions(n: int, *, cone: float | None = None, about: Any = (0.0, 0.0, -1.0)) -> np.ndarray:
+def fibonacci_directions(n: int, *, cone: float | None = None, about: ArrayLike = (0.0, 0.0, -1.0)) -> np.ndarray:
     """``n`` unit directions ``(n, 3)`` spread over the sphere, or over a cone of half-angle ``cone`` [rad] around ``about``.
 
     Equal area per point by a golden-angle spiral (module doc); the cap's centre and rim are
@@ -279,9 +280,9 @@ def tool_axis_orientations(
     n_directions: int,
     roll_steps: int = 1,
     *,
-    tool_axis: Any = (0.0, 0.0, 1.0),
+    tool_axis: ArrayLike = (0.0, 0.0, 1.0),
     cone: float | None = None,
-    about: Any = (0.0, 0.0, -1.0),
+    about: ArrayLike = (0.0, 0.0, -1.0),
     roll_free: bool = False,
 ) -> OrientationSet:
     """Tool-axis directions (Fibonacci spiral) × ``roll_steps`` rolls about the tool axis.
@@ -321,7 +322,7 @@ def tool_axis_orientations(
 
 
 def tool_down_orientations(
-    cone: float = np.radians(15.0), n_directions: int = 16, roll_steps: int = 8, *, tool_axis: Any = (0.0, 0.0, 1.0)
+    cone: float = np.radians(15.0), n_directions: int = 16, roll_steps: int = 8, *, tool_axis: ArrayLike = (0.0, 0.0, 1.0)
 ) -> OrientationSet:
     """The food-line set: ``tool_axis`` within ``cone`` [rad] of straight down, roll free.
 

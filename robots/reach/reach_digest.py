@@ -16,6 +16,7 @@ import json
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["map_checksum", "PosesDigest"]
 
@@ -52,7 +53,7 @@ class PosesDigest:
     def __init__(self) -> None:
         self._h = {name: hashlib.sha256(f"pinarms-reachability-poses-1|{name}".encode()) for name, _ in _POSES}
 
-    def update(self, voxel: Any, orientation: Any, q: Any, manipulability: Any) -> None:
+    def update(self, voxel: ArrayLike, orientation: ArrayLike, q: ArrayLike, manipulability: ArrayLike) -> None:
         for (name, dtype), values in zip(_POSES, (voxel, orientation, q, manipulability)):
             a = np.ascontiguousarray(values, dtype=dtype)
             if a.size:

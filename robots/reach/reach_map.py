@@ -7,10 +7,13 @@ a map holds and how it is computed), written and read by :mod:`pinarms.robots.re
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from pinarms.errors import InvalidInput
@@ -135,7 +138,7 @@ class ReachabilityMap:
         flat = self.voxels if voxels is None else np.asarray(voxels, dtype=np.int64)
         return _centres(self.origin, self.resolution, self.shape, flat)
 
-    def rows_of(self, points: Any) -> np.ndarray:
+    def rows_of(self, points: ArrayLike) -> np.ndarray:
         """Row into :attr:`voxels` of the voxel holding each of ``points (N, 3)`` [m]; −1 when not computed or outside."""
         P = _points(points, "points")
         ijk = np.floor((P - self.origin) / self.resolution).astype(np.int64)
@@ -147,12 +150,12 @@ class ReachabilityMap:
         found = inside & (self.n_voxels > 0) & (self.voxels[pos] == flat) if self.n_voxels else np.zeros(P.shape[0], bool)
         return np.where(found, pos, -1)
 
-    def index_at(self, points: Any) -> np.ndarray:
+    def index_at(self, points: ArrayLike) -> np.ndarray:
         """Reachability index ``(N,)`` of the voxels holding ``points (N, 3)`` [m] (0 outside or not computed)."""
         rows = self.rows_of(points)
         return np.where(rows >= 0, self.index[np.maximum(rows, 0)], 0.0)
 
-    def reaches(self, poses: Any) -> np.ndarray:
+    def reaches(self, poses: ArrayLike) -> np.ndarray:
         """``(N,)`` bool: does the map mark ``poses (N, 4, 4)`` reachable (their voxel, their nearest orientation)?
 
         For a roll-free set, a pose counts when its tool-axis direction's group is reached with
@@ -267,7 +270,7 @@ class ReachabilityMap:
             a[k].dtype == b[k].dtype and a[k].shape == b[k].shape and a[k].tobytes() == b[k].tobytes() for k in a
         )
 
-    def save(self, path: Any) -> Any:
+    def save(self, path: str | os.PathLike) -> Path:
         """Write the map to an HDF5 file (atomically; see :mod:`pinarms.robots.reach.reach_io`); return the path."""
         from pinarms.robots.reach.reach_write import write_map
 

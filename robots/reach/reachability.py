@@ -59,6 +59,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots._checks import check_restarts
 from pinarms.errors import InvalidInput, ModelError
@@ -72,6 +73,10 @@ from pinarms.robots.reach.robot_spec import RobotSpec, spec_of
 MAX_SEED_SAMPLES = 50_000_000
 
 if TYPE_CHECKING:  # pragma: no cover
+    import os
+
+    from distributed import Client
+
     from pinarms.robots.robot import Robot
 
 __all__ = [
@@ -95,7 +100,7 @@ def reachability_map(
     *,
     tool_down: float | None = None,
     roll_steps: int = 8,
-    tool_axis: Any = None,
+    tool_axis: ArrayLike | None = None,
     ik: str = "auto",
     manipulability: str = "full",
     restarts: int = 2,
@@ -103,11 +108,11 @@ def reachability_map(
     self_collision: bool = False,
     collision: Any = None,
     keep_solutions: bool = True,
-    out: Any = None,
+    out: str | os.PathLike | None = None,
     chunk_voxels: int | None = None,
     samples: int | None = None,
     seed: int = 0,
-    scheduler: Any = None,
+    scheduler: str | Client | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ReachabilityMap:
     """Build the reachability map of ``arm``'s tool frame (see the module doc).

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
@@ -55,7 +56,7 @@ class SphereFit:
         return self.rms_residual / self.radius if self.radius > 0 else float("inf")
 
 
-def fit_sphere(points: Any) -> SphereFit:
+def fit_sphere(points: ArrayLike) -> SphereFit:
     """Linear least-squares sphere through ``points (N, 3)``.
 
     Solves ``|p|² = 2 c·p + (r² − |c|²)`` for ``c`` and ``r`` (the algebraic fit): exact for
@@ -110,14 +111,14 @@ def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = Non
     return idx[first]
 
 
-def direction_coverage(points: Any, centre: Any, n_bins: int | None = None) -> float:
+def direction_coverage(points: ArrayLike, centre: ArrayLike, n_bins: int | None = None) -> float:
     """Share of the direction cells around ``centre`` [m] that hold at least one of ``points``."""
     P = _as_points(points, "points")
     cell, _, n_cells = _direction_cells(P, np.asarray(centre, dtype=float), n_bins)
     return float(np.unique(cell).size / n_cells)
 
 
-def fit_sphere_to_hull(points: Any, n_bins: int | None = None, iterations: int = 3) -> SphereFit:
+def fit_sphere_to_hull(points: ArrayLike, n_bins: int | None = None, iterations: int = 3) -> SphereFit:
     """Sphere fitted to the outer hull of a point cloud [m].
 
     Start from the algebraic fit of all points, take the farthest sample in each

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
@@ -40,7 +41,7 @@ from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, _as_point
 if TYPE_CHECKING:  # pragma: no cover
     from pinarms.robots.reach.workspace import Workspace
 
-__all__ = ["RecommendedRegion", "recommend_region"]
+__all__ = ["RegionCriteria", "RecommendedRegion", "recommend_region"]
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,7 @@ class RecommendedRegion:
         """True when no shell met the criteria."""
         return not np.isfinite(self.r_inner)
 
-    def contains(self, points: Any) -> np.ndarray:
+    def contains(self, points: ArrayLike) -> np.ndarray:
         """``(N,)`` bool: which ``points (N, 3)`` [m] lie in the region."""
         P = np.atleast_2d(np.asarray(points, dtype=float))
         if P.ndim != 2 or P.shape[1] != 3:
@@ -116,20 +117,54 @@ class RecommendedRegion:
         return "\n".join(lines)
 
 
+@dataclass(frozen=True)
+class RegionCriteria:
+    """When a shell of :func:`recommend_region` is accepted (see the module doc), checked when made.
+
+    Attributes:
+        singular_threshold: ``sigma_min / sigma_max`` below which a sample is near-singular.
+        max_singular_share: outer-shell criterion: largest near-singular share in [0, 1].
+        max_collision_share: crowded-centre criterion: largest core-collision share in [0, 1].
+        n_collision: samples (seeded by ``seed``) checked for collisions with the core bodies
+            (base and the bodies of the first ``core_joints`` joints); 0 skips the check.
+        core_joints: how many joints' bodies count as the core.
+        seed: seed of the collision sub-sample (>= 0).
+
+    Raises:
+        InvalidInput: a criterion out of range, naming it.
+    """
+
+    singular_threshold: float = SINGULAR_INVERSE_CONDITION
+    max_singular_share: float = 0.25
+    max_collision_share: float = 0.5
+    n_collision: int = 10_000
+    core_joints: int = 1
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("max_singular_share", "max_collision_share"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool):
+                raise InvalidInput(f"{name} must be a number, got {v!r}")
+            if not (0.0 <= v <= 1.0):
+                raise InvalidInput(f"{name} must be a share in [0, 1], got {v!r}")
+        object.__setattr__(self, "singular_threshold", _check_threshold(self.singular_threshold))
+        seed, n = self.seed, self.n_collision
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+            raise InvalidInput(f"n_collision must be an integer ≥ 0, got {n!r}")
+
+
 def recommend_region(
     workspace: "Workspace",
     *,
     about: str = "centre",
-    origin: Any = None,
+    origin: ArrayLike | None = None,
     width: float = 0.025,
     side: str = "auto",
     z_clearance: float = 0.0,
-    singular_threshold: float = SINGULAR_INVERSE_CONDITION,
-    max_singular_share: float = 0.25,
-    max_collision_share: float = 0.5,
-    n_collision: int = 10_000,
-    core_joints: int = 1,
-    seed: int = 0,
+    criteria: RegionCriteria | None = None,
 ) -> RecommendedRegion:
     """Radial band where tables should stand, from the workspace samples (see the module doc).
 
@@ -141,16 +176,19 @@ def recommend_region(
         width: shell width [m].
         side: ``"above"``, ``"below"`` or ``"auto"`` (the side of ``z = 0`` with most samples).
         z_clearance: distance kept from the base plane [m] (≥ 0).
-        singular_threshold, max_singular_share: outer-shell criterion.
-        max_collision_share: crowded-centre criterion; ``n_collision`` samples (seeded by
-            ``seed``) are checked for collisions with the core bodies (base and the
-            bodies of the first ``core_joints`` joints). ``n_collision=0`` skips the check.
+        criteria: the outer-shell and crowded-centre criteria (:class:`RegionCriteria`;
+            default ``RegionCriteria()``).
 
     Raises:
         InvalidInput: an option is out of range.
     """
-    singular_threshold = _checked_options(about, side, width, max_singular_share, max_collision_share, z_clearance,
-                                          singular_threshold, seed, n_collision)
+    c = RegionCriteria() if criteria is None else criteria
+    if not isinstance(c, RegionCriteria):
+        raise InvalidInput(f"criteria must be a robots.reach.table_band.RegionCriteria, got {type(c).__name__}")
+    _checked_options(about, side, width, z_clearance)
+    singular_threshold, max_singular_share, max_collision_share = c.singular_threshold, c.max_singular_share, \
+        c.max_collision_share
+    n_collision, core_joints, seed = c.n_collision, c.core_joints, c.seed
     P = workspace.points
     origin = _shells_origin(workspace, origin, about)
     if side == "auto":
@@ -193,33 +231,19 @@ def _shells_origin(workspace: "Workspace", origin: Any, about: str) -> np.ndarra
     return _as_point(origin, "origin")
 
 
-def _checked_options(about: Any, side: Any, width: Any, max_singular_share: Any, max_collision_share: Any,
-                     z_clearance: Any, singular_threshold: Any, seed: Any, n_collision: Any) -> float:
-    """Check the options of :func:`recommend_region` (raising :class:`InvalidInput`); return the singular threshold."""
+def _checked_options(about: Any, side: Any, width: Any, z_clearance: Any) -> None:
+    """Check the shell options of :func:`recommend_region` (raising :class:`InvalidInput`)."""
     if about not in ("centre", "axis"):
         raise InvalidInput(f"about must be 'centre' or 'axis', got {about!r}")
     if side not in ("auto", "above", "below"):
         raise InvalidInput(f"side must be 'auto', 'above' or 'below', got {side!r}")
-    for name, v, lo, hi in (
-        ("width", width, 0.0, np.inf),
-        ("max_singular_share", max_singular_share, 0.0, 1.0),
-        ("max_collision_share", max_collision_share, 0.0, 1.0),
-    ):
-        if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool):
-            raise InvalidInput(f"{name} must be a number, got {v!r}")
-        if name == "width" and not (np.isfinite(v) and v > 0):
-            raise InvalidInput(f"width must be a positive shell width in m, got {v!r}")
-        if name != "width" and not (lo <= v <= hi):
-            raise InvalidInput(f"{name} must be a share in [{lo:g}, {hi:g}], got {v!r}")
+    if not isinstance(width, (int, float, np.integer, np.floating)) or isinstance(width, bool):
+        raise InvalidInput(f"width must be a number, got {width!r}")
+    if not (np.isfinite(width) and width > 0):
+        raise InvalidInput(f"width must be a positive shell width in m, got {width!r}")
     real = (int, float, np.integer, np.floating)
     if isinstance(z_clearance, bool) or not isinstance(z_clearance, real) or not (np.isfinite(z_clearance) and z_clearance >= 0):
         raise InvalidInput(f"z_clearance must be a length ≥ 0 in m, got {z_clearance!r}")
-    singular_threshold = _check_threshold(singular_threshold)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
-    if isinstance(n_collision, bool) or not isinstance(n_collision, (int, np.integer)) or n_collision < 0:
-        raise InvalidInput(f"n_collision must be an integer ≥ 0, got {n_collision!r}")
-    return singular_threshold
 
 
 def _core_collision_share(workspace: "Workspace", keep: np.ndarray, shell: np.ndarray, k: int, n_collision: int,

@@ -15,9 +15,10 @@ Sampling leaves holes where samples are sparse: use several samples per voxel on
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from pinarms.errors import InvalidInput
@@ -28,7 +29,7 @@ SAMPLES_PER_VOXEL = 10
 """Mean samples per reachable voxel aimed at by :func:`suggest_voxel_size`."""
 
 
-def suggest_voxel_size(points: Any, samples_per_voxel: float = SAMPLES_PER_VOXEL) -> float:
+def suggest_voxel_size(points: ArrayLike, samples_per_voxel: float = SAMPLES_PER_VOXEL) -> float:
     """Voxel edge [m] at which the reachable voxels hold about ``samples_per_voxel`` samples each.
 
     With fewer samples per voxel many reachable voxels stay empty by chance and the map
@@ -92,7 +93,7 @@ class VoxelMap:
     min_count: int = 1
 
     @classmethod
-    def from_samples(cls, points: Any, manipulability: Any, voxel_size: float, *, min_count: int = 1) -> "VoxelMap":
+    def from_samples(cls, points: ArrayLike, manipulability: ArrayLike, voxel_size: float, *, min_count: int = 1) -> "VoxelMap":
         """Build the map from ``points (N, 3)`` [m] and their ``manipulability (N,)``."""
         if not (isinstance(voxel_size, (int, float, np.floating)) and np.isfinite(voxel_size) and voxel_size > 0):
             raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
@@ -126,7 +127,7 @@ class VoxelMap:
     @classmethod
     def from_counts(
         cls,
-        origin: Any,
+        origin: ArrayLike,
         voxel_size: float,
         count: np.ndarray,
         mean_manipulability: np.ndarray,
@@ -180,7 +181,7 @@ class VoxelMap:
         """Centres of the reachable voxels ``(k, 3)`` [m]."""
         return self.origin + (np.argwhere(self.reachable) + 0.5) * self.voxel_size
 
-    def query(self, points: Any) -> VoxelQuery:
+    def query(self, points: ArrayLike) -> VoxelQuery:
         """Is each of ``points (N, 3)`` or ``(3,)`` [m] reachable, with what margin and dexterity?"""
         try:
             P = np.asarray(points, dtype=float)

@@ -26,9 +26,10 @@ this one: table_band imports workspace, never the other way).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 from pinarms.robots.robot import MAX_RANDOM_SAMPLES
@@ -40,6 +41,8 @@ from pinarms.robots.reach.sphere_fit import (  # noqa: F401  (the sphere fits: t
 from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
 
 if TYPE_CHECKING:  # pragma: no cover
+    from distributed import Client
+
     from pinarms.robots.robot import Robot
 
 __all__ = [
@@ -196,7 +199,7 @@ class Workspace:
 
     def radial_profile(
         self,
-        origin: Any = None,
+        origin: ArrayLike | None = None,
         *,
         about: str = "centre",
         width: float = 0.025,
@@ -275,8 +278,8 @@ def sample_workspace(
     frame: str = "tcp",
     chunk: int = CHUNK,
     *,
-    scheduler: Any = None,
-    progress: Any = None,
+    scheduler: str | Client | None = None,
+    progress: Callable[[int, int], None] | None = None,
     task_samples: int = TASK_SAMPLES,
 ) -> Workspace:
     """Monte Carlo workspace: ``n`` joint vectors uniform within the limits, and their frame origins.

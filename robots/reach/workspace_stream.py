@@ -53,10 +53,13 @@ from pinarms.robots.reach.workspace import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
+    from distributed import Client
+
     from pinarms.robots.robot import Robot
 
 __all__ = [
     "StreamedWorkspace",
+    "StreamGrid",
     "stream_workspace",
     "TASK_SAMPLES",
     "PILOT_SAMPLES",
@@ -146,18 +149,42 @@ class StreamedWorkspace:
         )
 
 
+@dataclass(frozen=True)
+class StreamGrid:
+    """The grids a :func:`stream_workspace` sweep reduces onto, checked when made.
+
+    Attributes:
+        voxel_size: voxel edge [m]; ``None``: from the pilot (≥ :data:`MIN_DEFAULT_VOXEL`).
+        width: radial shell width [m].
+        singular_threshold: ``σ_min/σ_max`` of ``J_v`` below which a sample is near-singular.
+
+    Raises:
+        InvalidInput: a size that is not a positive length, a threshold out of (0, 1].
+    """
+
+    voxel_size: float | None = None
+    width: float = 0.05
+    singular_threshold: float = SINGULAR_INVERSE_CONDITION
+
+    def __post_init__(self) -> None:
+        w, v = self.width, self.voxel_size
+        if not (isinstance(w, (int, float, np.integer, np.floating)) and np.isfinite(w) and w > 0):
+            raise InvalidInput(f"shell width must be a positive length in m, got {w!r}")
+        object.__setattr__(self, "singular_threshold", _check_threshold(self.singular_threshold))
+        if v is not None and not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v) and v > 0):
+            raise InvalidInput(f"voxel_size must be a positive length in m, got {v!r}")
+
+
 def stream_workspace(
     robot: "Robot",
     n: int,
     seed: int = 0,
     frame: str = "tcp",
     *,
-    voxel_size: float | None = None,
-    width: float = 0.05,
-    singular_threshold: float = SINGULAR_INVERSE_CONDITION,
+    grid: StreamGrid | None = None,
     task_samples: int = TASK_SAMPLES,
     block: int = _BLOCK,
-    scheduler: Any = None,
+    scheduler: str | Client | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> StreamedWorkspace:
     """Workspace statistics of ``n`` samples in flat memory (see the module docstring).
@@ -167,9 +194,8 @@ def stream_workspace(
         n: number of samples (10⁸ take about 1.5 min on one core for a 6-axis arm).
         seed: a non-negative integer (the samples are ``robot.random_q(n, seed)``).
         frame: the frame whose origin is sampled.
-        voxel_size: voxel edge [m]; default from the pilot (≥ :data:`MIN_DEFAULT_VOXEL`).
-        width: radial shell width [m].
-        singular_threshold: ``σ_min/σ_max`` of ``J_v`` below which a sample is near-singular.
+        grid: voxel size, shell width and near-singular threshold (:class:`StreamGrid`;
+            default ``StreamGrid()``).
         task_samples: samples per task (a task should last a second or more on a cluster).
         block: samples evaluated at once inside a task (bounds a task's memory).
         scheduler, progress: see :func:`pinarms.execution.map_chunks`.
@@ -185,13 +211,10 @@ def stream_workspace(
             raise InvalidInput(f"{name} must be a positive integer, got {v!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidInput(f"a streamed workspace needs an integer seed >= 0 (tasks re-create the stream), got {seed!r}")
-    if not (isinstance(width, (int, float, np.integer, np.floating)) and np.isfinite(width) and width > 0):
-        raise InvalidInput(f"shell width must be a positive length in m, got {width!r}")
-    singular_threshold = _check_threshold(singular_threshold)
-    if voxel_size is not None and not (
-        isinstance(voxel_size, (int, float, np.integer, np.floating)) and np.isfinite(voxel_size) and voxel_size > 0
-    ):
-        raise InvalidInput(f"voxel_size must be a positive length in m, got {voxel_size!r}")
+    g = StreamGrid() if grid is None else grid
+    if not isinstance(g, StreamGrid):
+        raise InvalidInput(f"grid must be a robots.reach.workspace_stream.StreamGrid, got {type(g).__name__}")
+    voxel_size, width, singular_threshold = g.voxel_size, g.width, g.singular_threshold
     n, seed = int(n), int(seed)
     if n > MAX_STREAM_SAMPLES:
         raise InvalidInput(f"n = {n:,} samples is more than {MAX_STREAM_SAMPLES:,} (about a week on 100 cores)")

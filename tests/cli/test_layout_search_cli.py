@@ -66,14 +66,14 @@ def test_bad_ranges_are_usage_errors():
 
 
 def test_workspace_stream_option(tmp_path):
-    from pinarms.robots.reach.workspace_stream import stream_workspace
+    from pinarms.robots.reach.workspace_stream import StreamGrid, stream_workspace
 
     out = tmp_path / "voxels.pinarms"
     result = CliRunner().invoke(cli, ["workspace", "aubo_i3", "-n", "60000", "--stream", "--voxel", "50",
                                       "--json", "--session", str(out)])
     assert result.exit_code == 0, (result.output, result.exception)
     data = json.loads(result.stdout)
-    api = stream_workspace(robots.load("aubo_i3"), 60_000, seed=0, voxel_size=0.05)
+    api = stream_workspace(robots.load("aubo_i3"), 60_000, seed=0, grid=StreamGrid(0.05))
     assert data["streamed"] and data["tasks"] == 1 and data["ran_on"] == "serial (this process)"
     assert data["summary"]["bbox_max"] == api.summary.bbox_max.tolist()
     assert data["voxels"]["reachable"] == int(api.voxels.reachable.sum())

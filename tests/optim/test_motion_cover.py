@@ -10,6 +10,7 @@ import pytest
 from pinarms.optim import InvalidSettings
 from pinarms.optim.motion import (SCENES, MotionChecker, MotionLimits, MotionOptions, MotionRequest, load_scene,
                                    plan_motion)
+from pinarms.optim.motion.coal_batches import CheckRoute
 from pinarms.robots import load_cell
 from pinarms.robots.cell.cover import geometry_spheres, link_cover, pair_arrays, pairs_for
 from pinarms.errors import InvalidInput
@@ -90,7 +91,7 @@ def test_cover_clear_states_are_clear_for_coal(cells, name):
     where inconclusive) equal coal's on every state, at the margin and at a raised screen."""
     cell = cells[name]
     fast = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN)
-    exact = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, cover=False)
+    exact = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, route=CheckRoute(cover=False))
     Q = fast.full(cell.random_q(300, seed=7)[:, fast.cols])
     proven = fast.cover.screen(Q, fast._cover_pairs, fast.pair_margin)  # the cover's own verdict
     excess, _, _ = exact.excess(Q[proven])
@@ -112,7 +113,7 @@ def test_cover_clear_states_are_clear_for_coal(cells, name):
 def test_fast_and_exact_edge_proofs_agree(cells, name):
     cell = cells[name]
     fast = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN)
-    exact = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, cover=False)
+    exact = MotionChecker(cell, [SCENES[name].arm], margin=MARGIN, route=CheckRoute(cover=False))
     X = cell.random_q(200, seed=11)[:, fast.cols]
     X = X[[exact.state_valid(x) for x in X]][:16]
     rng = np.random.default_rng(5)

@@ -12,6 +12,7 @@ import pinocchio as pin
 import pytest
 
 from pinarms.optim.motion import MotionChecker, load_scene
+from pinarms.optim.motion.coal_batches import CheckRoute
 from pinarms.robots.cell.cover import link_cover
 
 MARGIN = 0.01
@@ -23,8 +24,8 @@ def setups():
     out = {}
     for name, arm in SCENE_ARMS:
         cell = load_scene(name)
-        pairwise = MotionChecker(cell, [arm], margin=MARGIN, pairwise=True)
-        whole = MotionChecker(cell, [arm], margin=MARGIN, pairwise=False)
+        pairwise = MotionChecker(cell, [arm], margin=MARGIN, route=CheckRoute(pairwise=True))
+        whole = MotionChecker(cell, [arm], margin=MARGIN, route=CheckRoute(pairwise=False))
         out[name] = (cell, pairwise, whole, _states(cell, whole))
     return out
 
@@ -149,3 +150,16 @@ def test_edges_proven_with_per_pair_shares_are_clear_when_sampled_densely(setups
         S = xa + np.linspace(0.0, 1.0, n)[:, None] * (xb - xa)
         assert not whole.coal_collides(whole.full(S), "margin").any()
     assert proven >= 2
+
+
+def test_check_route_is_one_checked_object():
+    """MotionChecker takes threads, cover and per-pair route as one CheckRoute, checked when made."""
+    from pinarms.optim import InvalidSettings
+
+    assert (CheckRoute().threads, CheckRoute().cover, CheckRoute().pairwise) == (1, True, None)
+    with pytest.raises(InvalidSettings, match="threads must be"):
+        CheckRoute(threads=0)
+    with pytest.raises(InvalidSettings, match="cover must be True or False"):
+        CheckRoute(cover="yes")
+    with pytest.raises(InvalidSettings, match="route must be a CheckRoute, got dict"):
+        MotionChecker(None, ["a"], route={"threads": 2})

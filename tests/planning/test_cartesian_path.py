@@ -168,3 +168,16 @@ def test_joint_spline_through_waypoints():
     assert q.shape == dq.shape == ddq.shape == (7, 2)
     line = joint_spline(Q[:2])
     assert np.abs(line.sample(0.3)[1] - (Q[1] - Q[0]) / chord[1]).max() < 1e-15
+
+
+def test_knot_fit_checks_its_shapes_and_deviation():
+    """The knot facts a CartesianPath is built from travel as one checked KnotFit."""
+    from pinarms.planning.cartesian_path import KnotFit
+    from pinarms.planning.errors import TrajectoryError
+
+    fit = KnotFit(q_knots=np.zeros((3, 6)), sigma_min=np.ones(3), branch=None, max_deviation=(1e-5, 0))
+    assert fit.max_deviation == (1e-5, 0.0) and not fit.q_knots.flags.writeable and not fit.sigma_min.flags.writeable
+    with pytest.raises(TrajectoryError, match="KnotFit: q_knots must be"):
+        KnotFit(q_knots=np.zeros((3, 6)), sigma_min=np.ones(2), branch=None, max_deviation=(0.0, 0.0))
+    with pytest.raises(TrajectoryError, match="KnotFit: max_deviation"):
+        KnotFit(q_knots=np.zeros((3, 6)), sigma_min=np.ones(3), branch=None, max_deviation=(float("nan"), 0.0))

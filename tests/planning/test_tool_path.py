@@ -124,3 +124,16 @@ def test_bad_blend_weight_and_stops():
         tool_path(P, weight=0.0)
     with pytest.raises(TrajectoryError, match="stops"):
         tool_path(P, stops=[2])
+
+
+def test_blend_corner_is_one_checked_object():
+    """A Blend takes its corner as one BlendCorner: the blend distance and an arc's radius are checked."""
+    from pinarms.planning.errors import TrajectoryError
+    from pinarms.planning.tool_pieces import BlendCorner
+
+    x, y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    assert BlendCorner(np.zeros(3), x, y, 0.05, 0.05, True).b == 0.05
+    with pytest.raises(TrajectoryError, match="BlendCorner: b must be a positive length"):
+        BlendCorner(np.zeros(3), x, y, 0.0, 0.05, True)
+    with pytest.raises(TrajectoryError, match="BlendCorner: an arc needs a positive radius"):
+        BlendCorner(np.zeros(3), x, y, 0.05, float("nan"), True)

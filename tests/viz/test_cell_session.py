@@ -9,6 +9,7 @@ from pinarms import planning, viz
 from pinarms.robots.cell import ArmMotion, load_cell
 from pinarms.errors import InvalidInput
 from pinarms.viz.scene import build_scene
+from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.viewer import MeshcatServer
 
 
@@ -57,7 +58,7 @@ def test_the_scene_draws_every_fixture_and_one_tcp_path_per_arm(line_with_motion
     session = viz.Session(title="two arms")
     session.add_cell(cell, motions=motions, check=check)
     with MeshcatServer() as server:
-        info = build_scene(server.visualizer, session, fps=20)
+        info = build_scene(server.visualizer, session, SceneOptions(fps=20))
     drawn = " ".join(info.robots["mushroom_line"])
     for fixture in ("conveyor_belt", "conveyor_leg_1", "left_box_wall_xpos", "right_table", "left_pedestal"):
         assert fixture in drawn, fixture

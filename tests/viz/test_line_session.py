@@ -12,7 +12,7 @@ import pytest
 from pinarms import viz
 from pinarms.errors import InvalidInput
 from pinarms.viz.errors import SessionFormatError
-from pinarms.viz.line_record import ITEM_COLUMNS, MAX_LINE_ITEMS, MISSED
+from pinarms.viz.line_record import ITEM_COLUMNS, MAX_LINE_ITEMS, MISSED, LineRecord, make_line
 from pinarms.viz.line_scene import item_positions
 
 
@@ -83,6 +83,22 @@ def test_add_line_bad_input(belt_line):
     with pytest.raises(InvalidInput, match="run must index"):
         s.add_line(spec, result, run=3)
     assert s.lines == {} and s.robots == {}
+
+
+def test_make_line_takes_one_draft_record():
+    """make_line checks a LineRecord draft: floats and read-only arrays out, InvalidInput naming the line."""
+    item = [[0.5, 0.0, 0.0, 0.1, 0.1, 0.05, MISSED, 0.0, 0.0]]
+    draft = LineRecord("belt", ("a",), np.eye(4).tolist(), length=2, width=0.6, thickness=0.05, speed=0.2,
+                       u_miss=2, duration=5, items=item)
+    rec = make_line(draft)
+    assert (rec.length, rec.u_miss, rec.items.shape) == (2.0, 2.0, (1, len(ITEM_COLUMNS)))
+    assert isinstance(rec.length, float) and not rec.items.flags.writeable and not rec.belt_to_world.flags.writeable
+    bad_pose = LineRecord("belt", ("a",), np.full((4, 4), np.nan), 2, 0.6, 0.05, 0.2, 2, 5, item)
+    with pytest.raises(InvalidInput, match="line 'belt': belt_to_world must be a finite"):
+        make_line(bad_pose)
+    off_belt = LineRecord("belt", ("a",), np.eye(4), 2, 0.6, 0.05, 0.2, 3, 5, item)
+    with pytest.raises(InvalidInput, match="u_miss must lie on the belt"):
+        make_line(off_belt)
 
 
 # ---------------------------------------------------------------------------- hostile files

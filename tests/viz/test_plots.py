@@ -11,6 +11,7 @@ from PIL import Image
 
 from pinarms import planning
 from pinarms import viz
+from pinarms.viz.joint_curves import JointCurves
 from pinarms.errors import InvalidInput
 from pinarms.papers import SEED000
 
@@ -35,7 +36,7 @@ def test_joint_curves_png(traj, tmp_path):
 def test_joint_curves_svg_labels(traj, tmp_path):
     t = np.linspace(0.0, 6.0, 50)
     q, qd, _, _ = traj.sample(t)
-    out = viz.plot_joint_curves(tmp_path / "c.svg", t, q, qd, knot_times=traj.knot_times, limits={"velocity": 0.9})
+    out = viz.plot_joint_curves(tmp_path / "c.svg", JointCurves(t, q, qd, knot_times=traj.knot_times), limits={"velocity": 0.9})
     text = out.read_text()
     assert "position" in text and "velocity" in text and "acceleration" not in text
     # ±limit lines: two horizontal dashed lines at ±0.9 in the velocity panel
@@ -49,14 +50,25 @@ def test_bad_suffix_writes_nothing(traj, tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+def test_joint_curves_are_one_checked_object(tmp_path):
+    """plot_joint_curves takes one JointCurves; its series come back as (N, n) float arrays."""
+    c = JointCurves([0.0, 1.0, 2.0], None, [1, 2, 3], knot_times=[[1.0]])
+    assert [k for k, _ in c.series] == [1] and c.qd.shape == (3, 1) and c.knot_times.tolist() == [1.0]
+    with pytest.raises(InvalidInput, match="give at least one of q, qd, qdd, qddd"):
+        JointCurves([0.0, 1.0], None)
+    with pytest.raises(InvalidInput, match="curves must be a viz.joint_curves.JointCurves, got list"):
+        viz.plot_joint_curves(tmp_path / "c.png", [0.0, 1.0])
+    assert os.listdir(tmp_path) == []
+
+
 @pytest.mark.parametrize(
     "call, match",
     [
-        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 0.5], [1.0, 2.0, 3.0]), "strictly increasing"),
-        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1.0, np.nan, 3.0]), "NaN"),
-        (lambda p: viz.plot_joint_curves(p, "abc", [1.0, 2.0, 3.0]), "t must be numbers"),
-        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": -1.0}), "positive"),
-        (lambda p: viz.plot_joint_curves(p, [0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3], limits={"velocity": [1.0, 2.0]}), "one per joint"),
+        (lambda p: viz.plot_joint_curves(p, JointCurves([0.0, 1.0, 0.5], [1.0, 2.0, 3.0])), "strictly increasing"),
+        (lambda p: viz.plot_joint_curves(p, JointCurves([0.0, 1.0, 2.0], [1.0, np.nan, 3.0])), "NaN"),
+        (lambda p: viz.plot_joint_curves(p, JointCurves("abc", [1.0, 2.0, 3.0])), "t must be numbers"),
+        (lambda p: viz.plot_joint_curves(p, JointCurves([0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3]), limits={"velocity": -1.0}), "positive"),
+        (lambda p: viz.plot_joint_curves(p, JointCurves([0.0, 1.0, 2.0], [1, 2, 3], [1, 2, 3]), limits={"velocity": [1.0, 2.0]}), "one per joint"),
     ],
 )
 def test_bad_plot_data_raises_invalid_input_and_writes_nothing(call, match, tmp_path):
@@ -81,7 +93,7 @@ def test_joint_axes_say_the_unit_of_the_joints_drawn():
     def figure(robot, q, **kw):
         t = np.linspace(0.0, 1.0, 20)
         qd = np.gradient(q, t, axis=0)
-        return _joint_curves_figure(t, q, qd, None, None, knot_times=[0.0, 1.0], limits={"velocity": 2.0}, robot=robot,
+        return _joint_curves_figure(JointCurves(t, q, qd, knot_times=[0.0, 1.0]), limits={"velocity": 2.0}, robot=robot,
                                     joint_names=None, joint_units=None, title="", **kw)
 
     aubo, scara, gantry = robots.load("aubo_i3"), robots.load("scara_mushroom"), robots.load("gantry_flower")
@@ -110,7 +122,7 @@ def test_joint_axes_say_the_unit_of_the_joints_drawn():
     with pytest.raises(InvalidInput, match="robot 'aubo_i3' has 6"):
         figure(aubo, q6[:, :4], degrees=False)
     with pytest.raises(InvalidInput, match="joint_units"):
-        _joint_curves_figure(np.linspace(0, 1, 5), np.zeros((5, 2)), None, None, None, knot_times=None, limits=None,
+        _joint_curves_figure(JointCurves(np.linspace(0, 1, 5), np.zeros((5, 2))), limits=None,
                              robot=None, joint_names=None, joint_units=["rad", "deg"], degrees=False, title="")
 
 

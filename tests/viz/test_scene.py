@@ -11,6 +11,7 @@ import pytest
 from pinarms import viz
 from pinarms.errors import InvalidInput
 from pinarms.viz.scene import build_scene
+from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.server import MeshcatServer
 
 
@@ -31,7 +32,7 @@ def _listening_addresses(port: int) -> set[str]:
 
 def test_scene_contents_and_animation(line_session):
     with MeshcatServer() as server:
-        info = build_scene(server.visualizer, line_session, fps=25)
+        info = build_scene(server.visualizer, line_session, SceneOptions(fps=25))
         assert server.running
     arm = line_session.robot("scara")
     rec = line_session.trajectories["pick-place 3-5-3"]
@@ -58,8 +59,8 @@ def test_scene_contents_and_animation(line_session):
 def test_animate_choice_is_checked(line_session):
     with MeshcatServer() as server:
         with pytest.raises(InvalidInput, match="cannot animate"):
-            build_scene(server.visualizer, line_session, animate=["nope"])
-        info = build_scene(server.visualizer, line_session, animate=())
+            build_scene(server.visualizer, line_session, SceneOptions(animate=["nope"]))
+        info = build_scene(server.visualizer, line_session, SceneOptions(animate=()))
         assert info.animated == () and info.n_frames == 0
 
 
@@ -113,7 +114,7 @@ def test_two_robots_with_base_placement(tmp_path):
     q = panda.random_q(20, seed=1)
     s.add_trajectory("panda move", (np.linspace(0.0, 1.0, 20), q), robot="panda")
     with MeshcatServer() as server:
-        info = build_scene(server.visualizer, s, fps=10)
+        info = build_scene(server.visualizer, s, SceneOptions(fps=10))
     assert set(info.robots) == {"ur5", "panda"}
     assert info.animated == ("panda move",)
     # the path is drawn in the world frame: panda's TCP shifted by its base placement
@@ -126,13 +127,13 @@ def test_page_info_frames_the_robot_and_names_the_colours(line_session):
     from pinarms.viz.page import manipulability_unit
 
     with MeshcatServer() as server:
-        info = build_scene(server.visualizer, line_session, max_cloud_points=1000)
+        info = build_scene(server.visualizer, line_session, SceneOptions(max_cloud_points=1000))
         with pytest.raises(InvalidInput, match="cloud_opacity"):
-            build_scene(server.visualizer, line_session, cloud_opacity=0.0)
+            build_scene(server.visualizer, line_session, SceneOptions(cloud_opacity=0.0))
         with pytest.raises(InvalidInput, match="max_cloud_points"):
-            build_scene(server.visualizer, line_session, max_cloud_points=0)
+            build_scene(server.visualizer, line_session, SceneOptions(max_cloud_points=0))
         with pytest.raises(InvalidInput, match="point_pixels"):
-            build_scene(server.visualizer, line_session, point_pixels=-1.0)
+            build_scene(server.visualizer, line_session, SceneOptions(point_pixels=-1.0))
     page = info.page
     assert page["title"] == "enoki packing line"
     assert "cloud scara cloud: 1000 of 1500 samples shown" in page["lines"]
@@ -149,3 +150,14 @@ def test_page_info_frames_the_robot_and_names_the_colours(line_session):
     distance = np.linalg.norm(info.camera - info.target)
     assert 0.5 < distance < 3.0
     assert info.camera[2] > info.target[2]  # from above
+
+
+def test_scene_options_are_one_checked_object(line_session):
+    """build_scene takes one SceneOptions: a mapping of keywords is refused, each option checked when made."""
+    with pytest.raises(InvalidInput, match="options must be a viz.SceneOptions, got dict"):
+        build_scene(None, line_session, {"fps": 10})
+    assert SceneOptions(animate=["a"]).animate == ("a",) and SceneOptions().fps == 30.0
+    with pytest.raises(InvalidInput, match="fps must be a positive frame rate"):
+        SceneOptions(fps=0.0)
+    with pytest.raises(InvalidInput, match="unknown matplotlib colormap"):
+        SceneOptions(colormap="no such map")

@@ -18,7 +18,7 @@ __all__ = ["LookAhead", "best_sequence", "MAX_HORIZON"]
 MAX_HORIZON = 8
 
 
-def best_sequence(ready: float, items: list[int], intercept: Callable[[float, int], Any],
+def best_sequence(ready: float, items: list[int], intercept: Callable[[float, int], tuple[float, float] | None],
                   horizon: int) -> tuple[int, float, list[int]]:
     """Branch and bound over orders of up to ``horizon`` of ``items`` from an arm ready at ``ready``.
 

@@ -7,7 +7,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.errors import InvalidInput
-from pinarms.robots.reach.table_band import recommend_region
+from pinarms.robots.reach.table_band import RegionCriteria, recommend_region
 from pinarms.robots.reach.workspace import (
     SINGULAR_INVERSE_CONDITION,
     fit_sphere,
@@ -163,7 +163,7 @@ def test_aubo_recommended_region(aubo):
 def test_suspended_arm_region_is_below_the_base():
     koji = robots.load("koji_turner")
     ws = sample_workspace(koji, n=20000, seed=0)
-    reg = recommend_region(ws, n_collision=1000)
+    reg = recommend_region(ws, criteria=RegionCriteria(n_collision=1000))
     assert reg.side == "below"
     assert not reg.empty and reg.r_outer > reg.r_inner
 
@@ -188,7 +188,7 @@ def test_bad_options_raise_invalid_input(aubo):
     with pytest.raises(InvalidInput, match="width"):
         ws.radial_profile(width=-1.0)
     with pytest.raises(InvalidInput, match="max_collision_share"):
-        recommend_region(ws, max_collision_share=1.5)
+        recommend_region(ws, criteria=RegionCriteria(max_collision_share=1.5))
 
 
 def test_workspace_arrays_are_read_only(aubo):
@@ -218,12 +218,12 @@ def test_default_voxel_size_keeps_the_interior_free_of_chance_holes(aubo):
         (lambda ws: ws.summary(singular_threshold=-1.0), "singular_threshold"),
         (lambda ws: ws.near_singular(2.0), "singular_threshold"),
         (lambda ws: ws.radial_profile(singular_threshold=0.0), "singular_threshold"),
-        (lambda ws: recommend_region(ws, singular_threshold=float("nan"), n_collision=0), "singular_threshold"),
-        (lambda ws: recommend_region(ws, origin=[0.0, 0.0], n_collision=0), "origin must be one point"),
-        (lambda ws: recommend_region(ws, origin=[np.nan, 0.0, 0.0], n_collision=0), "origin holds NaN"),
-        (lambda ws: recommend_region(ws, z_clearance="1", n_collision=0), "z_clearance"),
-        (lambda ws: recommend_region(ws, seed="a"), "seed"),
-        (lambda ws: recommend_region(ws, max_singular_share=float("nan"), n_collision=0), "max_singular_share"),
+        (lambda ws: recommend_region(ws, criteria=RegionCriteria(singular_threshold=float("nan"), n_collision=0)), "singular_threshold"),
+        (lambda ws: recommend_region(ws, origin=[0.0, 0.0], criteria=RegionCriteria(n_collision=0)), "origin must be one point"),
+        (lambda ws: recommend_region(ws, origin=[np.nan, 0.0, 0.0], criteria=RegionCriteria(n_collision=0)), "origin holds NaN"),
+        (lambda ws: recommend_region(ws, z_clearance="1", criteria=RegionCriteria(n_collision=0)), "z_clearance"),
+        (lambda ws: recommend_region(ws, criteria=RegionCriteria(seed="a")), "seed"),
+        (lambda ws: recommend_region(ws, criteria=RegionCriteria(max_singular_share=float("nan"), n_collision=0)), "max_singular_share"),
         (lambda ws: fit_sphere_to_hull(ws.points, iterations=0), "iterations"),
         (lambda ws: fit_sphere_to_hull(ws.points, n_bins=-5), "n_bins"),
         (lambda ws: ws.voxel_map(0.1).query("conveyor"), "query points"),
@@ -237,7 +237,7 @@ def test_bad_analysis_options_raise_invalid_input(aubo, call, match):
 
 def test_region_text_of_a_plane_at_zero_has_no_negative_zero(aubo):
     ws = sample_workspace(aubo, n=2000, seed=0)
-    assert "z < 0 mm" in recommend_region(ws, side="below", n_collision=0).text()
+    assert "z < 0 mm" in recommend_region(ws, side="below", criteria=RegionCriteria(n_collision=0)).text()
 
 
 def test_direction_coverage_tells_a_ball_from_a_patch():
@@ -258,3 +258,14 @@ def test_sphere_fit_of_a_slab_is_flagged_not_trusted():
     fit = rail.fit_sphere()
     assert not fit.meaningful and fit.coverage < 0.2  # a 28 m "sphere" through a slab of rail positions
     assert "does not describe them" in rail.summary().text()
+
+
+def test_region_criteria_are_one_checked_object(aubo):
+    """recommend_region takes its thresholds as one RegionCriteria: a mapping is refused, the defaults kept."""
+    ws = sample_workspace(aubo, n=500, seed=0)
+    with pytest.raises(InvalidInput, match="criteria must be a robots.reach.table_band.RegionCriteria, got dict"):
+        recommend_region(ws, criteria={"n_collision": 0})
+    c = RegionCriteria()
+    assert (c.max_singular_share, c.max_collision_share, c.n_collision, c.core_joints, c.seed) == (0.25, 0.5, 10_000, 1, 0)
+    with pytest.raises(InvalidInput, match="n_collision must be an integer"):
+        RegionCriteria(n_collision=-1)

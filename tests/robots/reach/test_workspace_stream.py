@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.errors import InvalidInput
 from pinarms.robots.reach.workspace import fit_sphere, hull_points, sample_workspace
-from pinarms.robots.reach.workspace_stream import stream_workspace
+from pinarms.robots.reach.workspace_stream import StreamGrid, stream_workspace
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.
@@ -26,7 +26,7 @@ def aubo():
 
 @pytest.fixture(scope="module")
 def streamed(aubo):
-    return stream_workspace(aubo, N, seed=5, frame="flange", task_samples=25_000, block=10_000, voxel_size=0.05)
+    return stream_workspace(aubo, N, seed=5, frame="flange", task_samples=25_000, block=10_000, grid=StreamGrid(0.05))
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +83,7 @@ def test_streamed_on_a_cluster_equals_serial_bit_for_bit(aubo, streamed):
     ) as cluster, distributed.Client(cluster) as client:
         seen = []
         remote = stream_workspace(
-            aubo, N, seed=5, frame="flange", task_samples=25_000, block=10_000, voxel_size=0.05,
+            aubo, N, seed=5, frame="flange", task_samples=25_000, block=10_000, grid=StreamGrid(0.05),
             scheduler=client, progress=lambda d, t: seen.append((d, t)),
         )
         big = sample_workspace(aubo, 9_000, seed=2, task_samples=4_000, scheduler=client)
@@ -109,4 +109,8 @@ def test_default_voxel_edge_and_bad_input(aubo):
     with pytest.raises(InvalidInput, match="task_samples"):
         stream_workspace(aubo, 10, task_samples=0)
     with pytest.raises(InvalidInput, match="voxel_size"):
-        stream_workspace(aubo, 10, voxel_size=-1.0)
+        stream_workspace(aubo, 10, grid=StreamGrid(voxel_size=-1.0))
+    with pytest.raises(InvalidInput, match="shell width must be a positive length"):
+        StreamGrid(width=0.0)
+    with pytest.raises(InvalidInput, match="grid must be a robots.reach.workspace_stream.StreamGrid, got dict"):
+        stream_workspace(aubo, 10, grid={"voxel_size": 0.05})
