@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_spheres", "split_triangles",
-           "static_primitive"]
+__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_parts_owned", "mesh_spheres",
+           "split_triangles", "static_primitive"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
@@ -174,6 +174,12 @@ def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDG
     each group lies in the intersection of its cylinder and its sphere. Screened exactly against
     static boxes (:func:`._cover_kernel._held_low`): a cylinder's flat ends where the sphere
     overshoots them, and a flaring housing in thin cylinders."""
+    return _sphere_cover(V, T, count, edge)[:6]
+
+
+def mesh_parts_owned(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_parts` and, last, the cylinder ``(K,)`` holding each piece of :func:`split_triangles`
+    ``(V[T], edge)`` (with its sphere): what lets a stored cover be checked piece by piece."""
     return _sphere_cover(V, T, count, edge)
 
 
@@ -192,13 +198,14 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
 
 
 def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple[np.ndarray, ...]:
-    """:func:`mesh_parts` (:func:`mesh_spheres` its first two arrays)."""
+    """:func:`mesh_parts_owned` (:func:`mesh_parts` its first six arrays, :func:`mesh_spheres` its first two)."""
     S, mid, parts, cyls = _part_cylinders(V, T, count, edge)
     low, high = 1e-5, 1.0
     for _ in range(40):  # the smallest overshoot whose slices fit the count
         b = np.sqrt(low * high)
         low, high = (b, high) if sum(_slices(c, b) for c in cyls) > int(count) else (low, b)
     centres, radii, a, b, rad, sphere = [], [], [], [], [], []
+    owner = np.full(S.shape[0], -1, dtype=np.int64)
     for idx, cyl in zip(parts, cyls):
         _, axis, centre, _, lo, hi = cyl
         k = _slices(cyl, high)
@@ -219,13 +226,14 @@ def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tupl
                              SLICE_CYLINDERS - 1)
             for m in np.unique(sub):
                 Y = S[inside[sub == m]].reshape(-1, 3)
+                owner[inside[sub == m]] = len(rad)
                 a.append(c.copy())
                 b.append(c.copy())
                 a[-1][axis], b[-1][axis] = Y[:, axis].min(), Y[:, axis].max()
                 rad.append(float(np.sqrt(((Y[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
                 sphere.append(len(radii) - 1)
     return (np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad),
-            np.array(sphere, dtype=np.int64))
+            np.array(sphere, dtype=np.int64), owner)
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
