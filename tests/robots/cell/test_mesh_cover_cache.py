@@ -189,3 +189,38 @@ def test_a_cover_of_more_spheres_than_asked_or_of_other_pieces_is_refused():
     assert not holds_mesh(cover, V, T, len(cover[1]) - 1, EDGE)
     assert not holds_mesh(cover, V, T, COUNT, EDGE / 2)  # other pieces: the owners do not fit
     assert not holds_mesh(cover[:6], V, T, COUNT, EDGE)
+
+
+def test_a_mesh_is_read_once_per_object_and_again_when_its_vertices_change():
+    """mesh_arrays keeps a coal mesh's arrays (a Python call per triangle): the same arrays for the same
+    object, read-only; another object or changed vertices read again."""
+    import coal
+
+    from pinarms.robots.cell.mesh_cover import mesh_arrays
+
+    V, T = _link_mesh()
+
+    def model(V):
+        m = coal.BVHModelOBBRSS()
+        m.beginModel(len(T), len(V))
+        m.addVertices(V)
+        m.addTriangles(T)
+        m.endModel()
+        return m
+
+    geo = model(V)
+    first = mesh_arrays(geo)
+    np.testing.assert_array_equal(first[0], V)
+    np.testing.assert_array_equal(first[1], T)
+    assert mesh_arrays(geo)[1] is first[1]  # kept
+    with pytest.raises(ValueError):
+        first[0][0, 0] = 1.0  # read-only: a caller cannot change the kept copy
+    geo.beginReplaceModel()
+    geo.replaceVertex(V[0] + 0.01)
+    for v in V[1:]:
+        geo.replaceVertex(v)
+    geo.endReplaceModel(True, True)
+    moved = mesh_arrays(geo)
+    np.testing.assert_array_equal(moved[0][0], V[0] + 0.01)
+    other = mesh_arrays(model(V * 2.0))
+    np.testing.assert_array_equal(other[0], V * 2.0)
