@@ -36,8 +36,9 @@ __all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mes
 SPLIT_EDGE = 0.01
 
 
-#: :func:`mesh_arrays` of the last :data:`_KEPT` geometry objects of this process: ``id -> (object, vertices,
-#: triangles)`` (the object held, so its id is not reused).
+#: :func:`mesh_arrays` of the last :data:`_KEPT` geometry objects of this process: ``coal id -> (object, vertices,
+#: triangles)``, keyed by the C++ object (Pinocchio gives a new Python wrapper at each access), held so that
+#: its address is not reused.
 _ARRAYS: OrderedDict = OrderedDict()
 _KEPT = 64
 
@@ -54,9 +55,10 @@ def mesh_arrays(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if V.shape[0] == 0:
         return None
-    kept = _ARRAYS.get(id(geo))
-    if kept is not None and kept[0] is geo and kept[2].shape[0] == (n or V.shape[0]) and np.array_equal(kept[1], V):
-        _ARRAYS.move_to_end(id(geo))
+    key = geo.id() if callable(getattr(geo, "id", None)) else id(geo)
+    kept = _ARRAYS.get(key)
+    if kept is not None and kept[2].shape[0] == (n or V.shape[0]) and np.array_equal(kept[1], V):
+        _ARRAYS.move_to_end(key)
         return kept[1], kept[2]
     try:
         tri = geo.tri_indices
@@ -68,7 +70,7 @@ def mesh_arrays(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
         T = np.repeat(np.arange(V.shape[0])[:, None], 3, axis=1)
     V.flags.writeable = False
     T.flags.writeable = False
-    _ARRAYS[id(geo)] = (geo, V, T)
+    _ARRAYS[key] = (geo, V, T)
     if len(_ARRAYS) > _KEPT:
         _ARRAYS.popitem(last=False)
     return V, T

@@ -213,6 +213,8 @@ def test_a_mesh_is_read_once_per_object_and_again_when_its_vertices_change():
     np.testing.assert_array_equal(first[0], V)
     np.testing.assert_array_equal(first[1], T)
     assert mesh_arrays(geo)[1] is first[1]  # kept
+    holder = coal.CollisionObject(geo)
+    assert mesh_arrays(holder.collisionGeometry())[1] is first[1]  # another Python wrapper of the same mesh
     with pytest.raises(ValueError):
         first[0][0, 0] = 1.0  # read-only: a caller cannot change the kept copy
     geo.beginReplaceModel()
