@@ -48,7 +48,8 @@ from typing import Any
 import numpy as np
 
 from pinarms.robots.cell._cover_kernel import excess_kernel, screen_kernel
-from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, mesh_parts, static_primitive
+from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, static_primitive
+from pinarms.robots.cell.mesh_cover_cache import cached_mesh_parts
 from pinarms.robots.cell.pair_tables import PairTables, no_tables, pair_tables
 
 __all__ = [
@@ -111,13 +112,14 @@ def _slices(length: float, width: float) -> int:
 
 
 def _mesh_cover(geo: Any) -> tuple[np.ndarray, ...] | None:
-    """:func:`.mesh_cover.mesh_parts` of a mesh (kept per content), or None for a shape without triangles."""
+    """:func:`.mesh_cover.mesh_parts` of a mesh (kept per content, and on disk: :mod:`.mesh_cover_cache`), or None
+    for a shape without triangles."""
     got = mesh_arrays(geo)
     if got is None:
         return None
     key = (got[0].tobytes(), got[1].tobytes(), MESH_SPHERES)
     if key not in _MESH_CACHE:
-        _MESH_CACHE[key] = mesh_parts(*got, MESH_SPHERES)
+        _MESH_CACHE[key] = cached_mesh_parts(*got, MESH_SPHERES)
     return _MESH_CACHE[key]
 
 

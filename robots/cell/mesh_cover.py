@@ -24,30 +24,55 @@ Lengths in m, in the mesh's own frame.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import Any
 
 import numpy as np
 
-__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_spheres", "split_triangles",
-           "static_primitive"]
+__all__ = ["SLICE_CYLINDERS", "SPLIT_EDGE", "mesh_arrays", "mesh_cylinder", "mesh_parts", "mesh_parts_owned", "mesh_spheres",
+           "split_triangles", "static_primitive"]
 
 #: Longest edge [m] of the pieces the triangles are cut into before they are grouped.
 SPLIT_EDGE = 0.01
 
 
+#: :func:`mesh_arrays` of the last :data:`_KEPT` geometry objects of this process: ``coal id -> (object, vertices,
+#: triangles)``, keyed by the C++ object (Pinocchio gives a new Python wrapper at each access), held so that
+#: its address is not reused.
+_ARRAYS: OrderedDict = OrderedDict()
+_KEPT = 64
+
+
 def mesh_arrays(geo: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """Vertices ``(V, 3)`` and triangles ``(T, 3)`` (vertex indices) of a coal ``BVHModel``, or None
-    for a shape without them. A point cloud: each vertex a degenerate triangle."""
+    for a shape without them. A point cloud: each vertex a degenerate triangle. Read-only arrays, read
+    from the object once per process (a Python call per triangle, about 0.1 s for 40 000): again while the
+    object's vertices and triangle count are the same (pinarms never replaces a mesh's triangles)."""
     try:
-        V = np.asarray(geo.vertices(), dtype=float).reshape(-1, 3)
-        T = np.array([[t[0], t[1], t[2]] for t in (geo.tri_indices(i) for i in range(int(geo.num_tris)))],
-                     dtype=np.int64).reshape(-1, 3)
+        V = np.array(geo.vertices(), dtype=float).reshape(-1, 3)
+        n = int(geo.num_tris)
     except (AttributeError, TypeError, RuntimeError):
         return None
     if V.shape[0] == 0:
         return None
+    key = geo.id() if callable(getattr(geo, "id", None)) else id(geo)
+    kept = _ARRAYS.get(key)
+    if kept is not None and kept[2].shape[0] == (n or V.shape[0]) and np.array_equal(kept[1], V):
+        _ARRAYS.move_to_end(key)
+        return kept[1], kept[2]
+    try:
+        tri = geo.tri_indices
+        T = np.fromiter((t[k] for t in (tri(i) for i in range(n)) for k in (0, 1, 2)), dtype=np.int64,
+                        count=3 * n).reshape(-1, 3)
+    except (AttributeError, TypeError, RuntimeError):
+        return None
     if T.shape[0] == 0:
         T = np.repeat(np.arange(V.shape[0])[:, None], 3, axis=1)
+    V.flags.writeable = False
+    T.flags.writeable = False
+    _ARRAYS[key] = (geo, V, T)
+    if len(_ARRAYS) > _KEPT:
+        _ARRAYS.popitem(last=False)
     return V, T
 
 
@@ -174,6 +199,12 @@ def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDG
     each group lies in the intersection of its cylinder and its sphere. Screened exactly against
     static boxes (:func:`._cover_kernel._held_low`): a cylinder's flat ends where the sphere
     overshoots them, and a flaring housing in thin cylinders."""
+    return _sphere_cover(V, T, count, edge)[:6]
+
+
+def mesh_parts_owned(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDGE) -> tuple[np.ndarray, ...]:
+    """:func:`mesh_parts` and, last, the cylinder ``(K,)`` holding each piece of :func:`split_triangles`
+    ``(V[T], edge)`` (with its sphere): what lets a stored cover be checked piece by piece."""
     return _sphere_cover(V, T, count, edge)
 
 
@@ -192,13 +223,14 @@ def mesh_spheres(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_E
 
 
 def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tuple[np.ndarray, ...]:
-    """:func:`mesh_parts` (:func:`mesh_spheres` its first two arrays)."""
+    """:func:`mesh_parts_owned` (:func:`mesh_parts` its first six arrays, :func:`mesh_spheres` its first two)."""
     S, mid, parts, cyls = _part_cylinders(V, T, count, edge)
     low, high = 1e-5, 1.0
     for _ in range(40):  # the smallest overshoot whose slices fit the count
         b = np.sqrt(low * high)
         low, high = (b, high) if sum(_slices(c, b) for c in cyls) > int(count) else (low, b)
     centres, radii, a, b, rad, sphere = [], [], [], [], [], []
+    owner = np.full(S.shape[0], -1, dtype=np.int64)
     for idx, cyl in zip(parts, cyls):
         _, axis, centre, _, lo, hi = cyl
         k = _slices(cyl, high)
@@ -219,13 +251,14 @@ def _sphere_cover(V: np.ndarray, T: np.ndarray, count: int, edge: float) -> tupl
                              SLICE_CYLINDERS - 1)
             for m in np.unique(sub):
                 Y = S[inside[sub == m]].reshape(-1, 3)
+                owner[inside[sub == m]] = len(rad)
                 a.append(c.copy())
                 b.append(c.copy())
                 a[-1][axis], b[-1][axis] = Y[:, axis].min(), Y[:, axis].max()
                 rad.append(float(np.sqrt(((Y[:, [u, w]] - c[[u, w]]) ** 2).sum(axis=1).max())))
                 sphere.append(len(radii) - 1)
     return (np.array(centres), np.array(radii), np.array(a), np.array(b), np.array(rad),
-            np.array(sphere, dtype=np.int64))
+            np.array(sphere, dtype=np.int64), owner)
 
 
 def static_primitive(V: np.ndarray) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:

@@ -7,10 +7,15 @@ the package's meshes). The CLI runs in-process (click's runner); one export per 
 
 The belt step (``pinarms belt ... --robot URDF --tcp LINK``) is not here: its flags are being added elsewhere.
 
-Cost: one arm's path took 266 s on a shared two-core machine at a load average of 10 (the planned move 157 s, most
-of it building the planner's sphere cover of the mesh links, robots/cell/cover.py, at every call; the page 47 s).
-So the suite runs the SO-101 by default and all five arms with ``PINARMS_FOREIGN_ARMS=all`` (docs/own-arm.md), until
-those steps take seconds."""
+Cost: one arm's path took 266 s on a shared two-core machine at a load average of 10 (the planned move 157 s, the
+page 47 s). The planner's sphere cover of the mesh links (robots/cell/cover.py) was rebuilt at every call: it is now
+kept on disk by content (robots/cell/mesh_cover_cache.py) and a mesh's arrays are read from coal once per process;
+the SO-101's cover takes 5.5 s warm against 49 s cold (load average 1-2; 13 s against 99 s at 4, before the second
+change). Most of what is left of the planned move is the MuJoCo re-check's coal distances
+(pinarms/export/verify.py ``_pinarms_distances``: 150 of 187 s under the profiler, warm cache; 207 s as its own
+process at a load average of 2-3); the page took 7.4 s
+in-process (cell load 3.9 s, drawing 1.6 s). So the suite runs the SO-101 by default and all five arms with
+``PINARMS_FOREIGN_ARMS=all`` (docs/own-arm.md), until those steps take seconds."""
 
 from __future__ import annotations
 
