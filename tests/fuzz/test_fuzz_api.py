@@ -327,7 +327,10 @@ def test_minimize_time_arguments(data):
                   max_generations=arg("max_generations", st.integers(1, 3), _scalars),
                   # a wall-clock limit would make the answer depend on the machine's load: only its checks are fuzzed
                   time_limit=arg("time_limit", st.sampled_from([None, 600.0]), _scalars))
-    result, err = outcome(optim.minimize_time, positions, kind, *limits, **kwargs, seconds=30)
+    def minimize(*args, **keywords):  # the request is checked when built, the call runs it
+        return optim.minimize_time(optim.TimingRequest(*args, **keywords))
+
+    result, err = outcome(minimize, positions, kind, *limits, **kwargs, seconds=30)
     if err is None:
         assert np.all(np.asarray(result.durations) > 0)
 
