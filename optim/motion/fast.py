@@ -182,7 +182,7 @@ def fast_check(checker: MotionChecker) -> FastCheck | None:
         except ValueError:
             return None
 
-    return checker.kept("fast_check", build)
+    return checker.memo("fast_check", build)
 
 
 def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
