@@ -265,7 +265,7 @@ class Cover:
 
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.empty((Q.shape[0], self.joint.size, 3))
-        centers_kernel(Q, *self.fk, self.joint, self.center, out)
+        centers_kernel(Q, self.fk, self.joint, self.center, out)
         return out
 
     def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> PairSet:
