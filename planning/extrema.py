@@ -169,6 +169,11 @@ def piece_extrema(normalised: np.ndarray, durations: np.ndarray, orders: tuple[i
     """
     M, n, width = normalised.shape
     o = len(orders)
+    if o and width - min(orders) <= 5 and M * n:  # every next derivative of degree <= 3: the compiled loop
+        from pinarms.planning._extrema_kernel import extrema_values
+
+        return extrema_values(np.ascontiguousarray(normalised, dtype=float), np.ascontiguousarray(durations, dtype=float),
+                              np.asarray(orders, dtype=np.int64))
     D = _derivative_matrices(width, tuple(orders))  # (o, W, 2W-1): [derivative r | derivative r+1]
     PR = np.matmul(normalised.reshape(M * n, width), D)  # (o, M*n, 2W-1), coefficients in s
     scale = np.repeat(durations[None, :] ** -np.asarray(orders, dtype=float)[:, None], n, axis=1)
