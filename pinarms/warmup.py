@@ -41,7 +41,7 @@ KERNEL_MODULES = (
     "pinarms.optim.motion._spline_kernel",
     "pinarms.optim.topp._profile_kernel",
     "pinarms.optim.line._sim_kernel",
-    "pinarms.planning._extrema_kernel",
+    "pinarms.planning.extrema_kernel",
 )
 
 

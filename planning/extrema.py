@@ -170,7 +170,7 @@ def piece_extrema(normalised: np.ndarray, durations: np.ndarray, orders: tuple[i
     M, n, width = normalised.shape
     o = len(orders)
     if o and width - min(orders) <= 5 and M * n:  # every next derivative of degree <= 3: the compiled loop
-        from pinarms.planning._extrema_kernel import extrema_values
+        from pinarms.planning.extrema_kernel import extrema_values
 
         return extrema_values(np.ascontiguousarray(normalised, dtype=float), np.ascontiguousarray(durations, dtype=float),
                               np.asarray(orders, dtype=np.int64))

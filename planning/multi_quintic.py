@@ -142,10 +142,10 @@ def multi_quintic_peaks_batch(times: np.ndarray, positions: np.ndarray, heuristi
     ``positions`` (m+1, n); via velocities by the sign-of-slopes rule (``heuristic``) or zero, via
     accelerations zero. Equals :func:`pinarms.planning.peaks_batch` of :func:`multi_quintic_batch`
     (``velocities="heuristic"`` or None) to rounding, without building the coefficient arrays: one
-    compiled loop (:mod:`pinarms.planning._extrema_kernel`), for optimisers that peak one timing
+    compiled loop (:mod:`pinarms.planning.extrema_kernel`), for optimisers that peak one timing
     at a time.
     """
-    from pinarms.planning._extrema_kernel import multi_quintic_peaks
+    from pinarms.planning.extrema_kernel import multi_quintic_peaks
 
     return multi_quintic_peaks(np.ascontiguousarray(times, dtype=float), np.ascontiguousarray(positions, dtype=float),
                                bool(heuristic))
