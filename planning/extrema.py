@@ -25,7 +25,12 @@ from numpy.typing import ArrayLike
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
 
-__all__ = ["piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
+__all__ = ["COMPILED", "piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
+
+#: Pieces of degree <= 5 (every next derivative of degree <= 3) take the compiled loop
+#: (:mod:`pinarms.planning.extrema_kernel`, the same operations); ``False``: the numpy route for every
+#: piece (the code before it, for benchmarks that time both).
+COMPILED = True
 
 #: Relative size below which a leading polynomial coefficient counts as zero in the root
 #: search (in normalised piece time s in [0, 1], where all coefficients are comparable).
@@ -169,7 +174,7 @@ def piece_extrema(normalised: np.ndarray, durations: np.ndarray, orders: tuple[i
     """
     M, n, width = normalised.shape
     o = len(orders)
-    if o and width - min(orders) <= 5 and M * n:  # every next derivative of degree <= 3: the compiled loop
+    if COMPILED and o and width - min(orders) <= 5 and M * n:  # every next derivative of degree <= 3: compiled
         from pinarms.planning.extrema_kernel import extrema_values
 
         return extrema_values(np.ascontiguousarray(normalised, dtype=float), np.ascontiguousarray(durations, dtype=float),

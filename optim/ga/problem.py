@@ -271,7 +271,9 @@ class TimingProblem:
 
         r = np.atleast_2d(np.asarray(ratios, dtype=float))
         r = r / r.sum(axis=1, keepdims=True)
-        if self._quintic_rule is not None and self.torque is None:  # the compiled loop: the same peaks
+        from pinarms.planning import extrema
+
+        if self._quintic_rule is not None and self.torque is None and extrema.COMPILED:  # compiled: the same peaks
             self.evaluations += r.shape[0]
             times = np.concatenate([np.zeros((r.shape[0], 1)), np.cumsum(r, axis=1)], axis=1)
             pk = planning.multi_quintic_peaks_batch(times, self.positions, self._quintic_rule)
