@@ -27,7 +27,7 @@ from pinarms.planning.errors import TrajectoryError
 
 __all__ = ["COMPILED", "piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
 
-#: Pieces of degree <= 5 (every next derivative of degree <= 3) take the compiled loop
+#: Pieces whose next derivatives have degree <= 4 (degree <= 6 for velocities and up) take the compiled loop
 #: (:mod:`pinarms.planning.extrema_kernel`, the same operations); ``False``: the numpy route for every
 #: piece (the code before it, for benchmarks that time both).
 COMPILED = True
@@ -174,7 +174,7 @@ def piece_extrema(normalised: np.ndarray, durations: np.ndarray, orders: tuple[i
     """
     M, n, width = normalised.shape
     o = len(orders)
-    if COMPILED and o and width - min(orders) <= 5 and M * n:  # every next derivative of degree <= 3: compiled
+    if COMPILED and o and width - min(orders) <= 6 and M * n:  # every next derivative of degree <= 4: compiled
         from pinarms.planning.extrema_kernel import extrema_values
 
         return extrema_values(np.ascontiguousarray(normalised, dtype=float), np.ascontiguousarray(durations, dtype=float),

@@ -1,12 +1,14 @@
-"""Compiled loop of :func:`pinarms.planning.extrema.piece_extrema` (numba) for pieces of degree <= 5.
+"""Compiled loop of :func:`pinarms.planning.extrema.piece_extrema` (numba) for next derivatives of degree <= 4.
 
 The same operations in the same order as the numpy code (derivative coefficients, the degree
 of each next derivative, its real roots in closed form up to degree 3, Horner at the piece
 ends and the roots), one piece, joint and order at a time, without the numpy calls' overhead
-(about 40 of them per call, which dominated the timing of a short trajectory). Every next
-derivative of a piece of degree <= 5 has degree <= 3 for the orders >= 1 and is solved in
-closed form; orders 0 (positions) and higher degrees stay on the numpy path, whose
-companion-matrix eigenvalues this kernel does not have.
+(about 40 of them per call, which dominated the timing of a short trajectory). A next
+derivative of degree 4 (the velocity of a degree-6 piece, as the time-optimal timing's
+pieces are) has its sign changes in [0, 1] found between the roots of its own derivative
+(Newton steps kept in the bracket) where the numpy code takes companion-matrix eigenvalues:
+the same extrema (a complex pair or a root without sign change is no extremum), to rounding.
+Higher degrees stay on the numpy path.
 """
 
 from __future__ import annotations
@@ -17,8 +19,8 @@ from pinarms.compiled import jit
 
 __all__ = ["extrema_values", "multi_quintic_peaks", "MAX_WIDTH"]
 
-#: Widest piece (coefficients, degree + 1) the kernel takes: a next derivative of degree <= 3 for orders >= 1.
-MAX_WIDTH = 6
+#: Widest piece (coefficients, degree + 1) the kernel takes: a next derivative of degree <= 4 for orders >= 1.
+MAX_WIDTH = 7
 
 
 @jit
@@ -64,6 +66,71 @@ def _roots(R, d, out):
 
 
 @jit
+def _quartic_value(R, x):
+    return (((R[4] * x + R[3]) * x + R[2]) * x + R[1]) * x + R[0]
+
+
+@jit
+def _quartic_roots(R, out):
+    """The real roots in [0, 1] where ``R[0] + ... + R[4] s^4`` (R[4] != 0) changes sign, into ``out[:4]``; returns
+    how many. Between two of the roots of its derivative (a cubic, closed form) it is monotone: a sign change
+    there is one root, found by Newton steps kept inside the bracket (bisection when a step leaves it). A root
+    where it touches zero without changing sign is no extremum of the integral, and a complex pair none either:
+    the extrema found are those of the numpy route's eigenvalues."""
+    D = np.zeros(4)
+    for k in range(4):
+        D[k] = (k + 1) * R[k + 1]
+    crit = np.zeros(3)
+    big = max(max(abs(D[0]), abs(D[1])), max(abs(D[2]), abs(D[3])))
+    d = 0
+    for k in range(4):
+        if abs(D[k]) > 1e-12 * big:
+            d = k
+    if d >= 1:
+        _roots(D, d, crit)
+    ends = np.zeros(5)
+    ends[0] = 0.0
+    m = 1
+    for k in range(d):
+        x = min(max(crit[k], 0.0), 1.0)
+        ends[m] = x
+        m += 1
+    ends[m] = 1.0
+    m += 1
+    ends[:m].sort()
+    count = 0
+    for k in range(1, m - 1):  # a root at a critical point (of odd multiplicity: a sign change) is found here
+        if _quartic_value(R, ends[k]) == 0.0 and ends[k] != ends[k - 1] and count < 4:
+            out[count] = ends[k]
+            count += 1
+    for k in range(m - 1):
+        lo, hi = ends[k], ends[k + 1]
+        flo, fhi = _quartic_value(R, lo), _quartic_value(R, hi)
+        if hi <= lo or flo == 0.0 or fhi == 0.0 or (flo < 0.0) == (fhi < 0.0):
+            continue
+        x = 0.5 * (lo + hi)
+        for _ in range(100):
+            fx = _quartic_value(R, x)
+            if fx == 0.0:
+                break
+            if (fx < 0.0) == (flo < 0.0):
+                lo = x
+            else:
+                hi = x
+            dfx = ((4.0 * R[4] * x + 3.0 * R[3]) * x + 2.0 * R[2]) * x + R[1]
+            step = x - fx / dfx if dfx != 0.0 else 0.5 * (lo + hi)
+            nxt = step if lo < step < hi else 0.5 * (lo + hi)
+            if abs(nxt - x) <= 4e-16 * max(abs(x), 1e-300) or hi - lo <= 4e-16:
+                x = nxt
+                break
+            x = nxt
+        if count < 4:
+            out[count] = x
+            count += 1
+    return count
+
+
+@jit
 def extrema_values(normalised, durations, orders):
     """``(values (o, M, n, C), s (o * M * n, C))`` of :func:`pinarms.planning.extrema.piece_extrema`.
 
@@ -78,7 +145,7 @@ def extrema_values(normalised, durations, orders):
     s = np.zeros((o * M * n, C))
     P = np.zeros(W)
     R = np.zeros(max(W - 1, 1))
-    roots = np.zeros(3)
+    roots = np.zeros(4)
     for a in range(o):
         r = orders[a]
         for i in range(M):
@@ -99,7 +166,10 @@ def extrema_values(normalised, durations, orders):
                             d = k
                 row = (a * M + i) * n + j
                 s[row, 1] = 1.0
-                if d >= 1:
+                if d == 4:
+                    for k in range(_quartic_roots(R, roots)):
+                        s[row, 2 + k] = roots[k]
+                elif d >= 1:
                     _roots(R, d, roots)
                     for k in range(d):
                         s[row, 2 + k] = min(max(roots[k], 0.0), 1.0)
