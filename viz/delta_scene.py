@@ -35,7 +35,7 @@ from pinarms.errors import InvalidInput
 from pinarms.viz._meshcat import meshcat, mg
 
 __all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT", "TOOL_WIDTH",
-           "draw_session_deltas", "animate_session_deltas", "session_delta_poses"]
+           "draw_session_deltas", "animate_session_deltas", "session_delta_poses", "session_delta_tcp"]
 
 #: Scene folder of the deltas.
 DELTA_ROOT = "pinarms/deltas"
@@ -194,3 +194,18 @@ def animate_session_deltas(anim: Any, vis: Any, session: Any, times: np.ndarray)
     """Add each delta's motion at the animation's ``times`` (F,) [s] to ``anim`` (held after its end)."""
     for key in getattr(session, "deltas", {}):
         animate_delta(anim, vis, f"{DELTA_ROOT}/{key}", session_delta_poses(session, key, times))
+
+
+def session_delta_tcp(session: Any, key: str, times: Any) -> np.ndarray:
+    """(F, 3) world position [m] of the tcp of the session's delta ``key`` at ``times`` (F,) [s] from its motion's
+    start: the closed-form platform plus the tcp's offset turned by the tool angle."""
+    rec = session.deltas[key]
+    delta = session.delta(key)
+    act = rec.sample(np.atleast_1d(np.asarray(times, dtype=float)))
+    p = forward_position(delta.geometry, act[:, :3])
+    if act.shape[1] == 4:
+        p = p + _rz(act[:, 3]) @ _tcp_offset(delta)
+    else:
+        p = p + _tcp_offset(delta)
+    T = rec.base_to_world
+    return p @ T[:3, :3].T + T[:3, 3]

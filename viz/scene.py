@@ -132,9 +132,11 @@ def build_scene(vis: meshcat.Visualizer, session: Session, options: SceneOptions
     from pinarms.viz.line_scene import draw_lines  # belt lines: belt, items
 
     line_lines = draw_lines(vis, session, ROOT, bounds)
-    from pinarms.viz.delta_scene import draw_session_deltas  # deltas: the closed chain from the actuated angles
+    delta_lines: list[str] = []
+    if getattr(session, "deltas", None):  # deltas: the closed chain from the actuated angles (imported when needed)
+        from pinarms.viz.delta_scene import draw_session_deltas
 
-    delta_lines = draw_session_deltas(vis, session, bounds, framed)
+        delta_lines = draw_session_deltas(vis, session, bounds, framed)
     moving = any(rec.duration > 0 for rec in getattr(session, "deltas", {}).values())
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
     tcp_paths, knots = world_tcp_paths(session, drawings, bounds, framed)
@@ -265,7 +267,8 @@ def _summary_lines(session: Any, animated: tuple[str, ...], cloud_shown: dict[st
     the arms of a belt line (``line_arms``) and their trajectories in one line."""
     lines = []
     if line_arms:
-        names = sorted({session.robots[k].name for k in line_arms if k in session.robots})
+        names = sorted({session.robots[k].name for k in line_arms if k in session.robots}
+                       | {session.deltas[k].delta for k in line_arms if k in getattr(session, "deltas", {})})
         lines.append(f"{len(line_arms)} arms along the belt ({', '.join(names)}), each through its picks")
     for key, entry in session.robots.items():
         if key in line_arms:

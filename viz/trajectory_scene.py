@@ -86,7 +86,6 @@ def animate_scene(vis: meshcat.Visualizer, session: Session, root: str, drawings
                   animated: tuple[str, ...], lines: bool, fps: float, play: bool) -> tuple[float, int]:
     """One looping animation of the ``animated`` trajectories, the belt ``lines`` and the session's deltas
     (``lines`` true when a line or a delta moves); return (duration, frames)."""
-    from pinarms.viz.delta_scene import animate_session_deltas
     from pinarms.viz.line_scene import animate_lines, line_duration
 
     if not (animated or lines):
@@ -99,7 +98,10 @@ def animate_scene(vis: meshcat.Visualizer, session: Session, root: str, drawings
         rec = session.trajectories[name]
         drawings[rec.robot].record(anim, vis, interp_rows(rec.t[0] + times, rec.t, rec.q))
     animate_lines(vis, anim, session, root, times, animated, drawings)
-    animate_session_deltas(anim, vis, session, times)
+    if getattr(session, "deltas", None):
+        from pinarms.viz.delta_scene import animate_session_deltas
+
+        animate_session_deltas(anim, vis, session, times)
     vis.set_animation(anim, play=play, repetitions=float("inf"))
     return duration, times.size
 
