@@ -33,12 +33,13 @@ from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
 from pinarms.errors import InvalidInput
 
 from pinarms.viz._meshcat import meshcat, mg
+from pinarms.viz.names import SCENE_ROOT
 
 __all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT", "TOOL_WIDTH",
            "draw_session_deltas", "animate_session_deltas", "session_delta_poses", "session_delta_tcp"]
 
 #: Scene folder of the deltas.
-DELTA_ROOT = "pinarms/deltas"
+DELTA_ROOT = f"{SCENE_ROOT}/deltas"
 _COLORS = {"upper_arm": 0x4A6FA5, "rod": 0xC8C8C8, "platform": 0x8C8C8C, "tool": 0xE0A030}
 #: Width of the drawn tool paddle [m] (its thickness is the tool capsule's diameter).
 TOOL_WIDTH = 0.06
@@ -144,7 +145,6 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
     """A standalone page (HTML, written atomically) of ``delta`` moving through ``theta`` (F, 3) [rad],
     one row a frame at ``fps``; return the path."""
     from pinarms.viz.page import PAGE_PROPERTY, with_page
-    from pinarms.viz.scene import ROOT
     from pinarms.viz.server import MeshcatServer
 
     poses = delta_poses(delta, theta, base_to_world)
@@ -159,7 +159,7 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
         anim = meshcat.animation.Animation(default_framerate=fps)
         animate_delta(anim, vis, root, poses)
         vis.set_animation(anim, play=True, repetitions=float("inf"))
-        vis[ROOT].set_property(PAGE_PROPERTY, json.dumps(page))
+        vis[SCENE_ROOT].set_property(PAGE_PROPERTY, json.dumps(page))
         text = with_page(server.static_html(), page["title"])
     data = text.encode("utf-8")
     return atomic_write(path, lambda f: f.write(data))

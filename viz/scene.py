@@ -38,6 +38,7 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.cloud_scene import draw_clouds, cloud_colorbar
+from pinarms.viz.names import SCENE_ROOT
 from pinarms.viz.page import PAGE_PROPERTY
 from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.robot_drawing import RobotDrawing
@@ -49,7 +50,7 @@ if TYPE_CHECKING:
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
-ROOT = "pinarms"
+ROOT = SCENE_ROOT
 _BACKGROUND = ([0.96, 0.97, 0.99], [0.74, 0.78, 0.85])  # top, bottom (RGB in [0, 1])
 
 _PATH_COLORS = (0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B)
