@@ -34,14 +34,13 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.standard_cycle import JointPathRows, delta_path_rows, time_rows
+from pinarms.optim.standard_cycle.delta_cycle import TOOL_ACCELERATION_FACTOR, tool_turn_time  # the fourth axis
 from pinarms.robots.delta import DeltaRobot, forward_position, inverse_position
 
 __all__ = ["DeltaArm", "delta_pick_times", "platform_move_time", "platform_move_profile", "tracking_platform",
            "hermite_points", "tool_turn_time",
            "TOOL_ACCELERATION_FACTOR", "TRACK_SAMPLES"]
 
-#: Acceleration limit of the fourth axis: this many times its speed limit [1/s] (assumed).
-TOOL_ACCELERATION_FACTOR = 10.0
 #: Instants at which the tracking segment is checked against the motor limits.
 TRACK_SAMPLES = 41
 
@@ -77,14 +76,6 @@ class DeltaArm:
         if m not in self._loaded:
             self._loaded[m] = self.delta.with_payload(m) if m > 0 else self.delta
         return self._loaded[m]
-
-
-def tool_turn_time(angle: float, vmax: float, amax: float) -> float:
-    """Shortest rest-to-rest time [s] of a turn by ``angle`` [rad] under ``vmax``, ``amax``."""
-    a = abs(float(angle))
-    if a * amax <= vmax ** 2:
-        return 2.0 * np.sqrt(a / amax)
-    return a / vmax + vmax / amax
 
 
 def hermite_points(p0: np.ndarray, p1: np.ndarray, m0: np.ndarray, m1: np.ndarray, length: float):
