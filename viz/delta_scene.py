@@ -180,13 +180,16 @@ def draw_session_deltas(vis: Any, session: Any, bounds: list, framed: list) -> l
     for key, rec in getattr(session, "deltas", {}).items():
         delta = session.delta(key)
         draw_delta(vis, key, delta, session_delta_poses(session, key, [0.0]))
-        motors = rec.base_to_world[:3, :3] @ (delta.geometry.base_radius * delta.geometry.radial).T
-        path = session_delta_poses(session, key, np.linspace(0.0, rec.duration, 9))["platform"][:, :3, 3]
-        extent = np.vstack([motors.T + rec.base_to_world[:3, 3], path])
+        # framed: both ends of every part at 9 instants of its motion (the whole chain, not only the platform)
+        poses = session_delta_poses(session, key, np.linspace(0.0, rec.duration, 9))
+        ends = [T[:, :3, 3] + sign * 0.5 * length * T[:, :3, 1] for part, (_, length, _) in delta_parts(delta).items()
+                for T in (poses[part],) for sign in (-1.0, 1.0)]
+        extent = np.vstack(ends)
         bounds.append(extent)
         framed.append(extent)
-        lines.append(f"delta {key} ({rec.delta}): {rec.t.size} samples over {rec.duration:.3g} s" if rec.t.size > 1
-                     else f"delta {key} ({rec.delta}): at rest")
+        label = key if key == rec.delta else f"{key} ({rec.delta})"
+        lines.append(f"delta {label}: {rec.t.size} samples over {rec.duration:.3g} s" if rec.t.size > 1
+                     else f"delta {label}: at rest")
     return lines
 
 

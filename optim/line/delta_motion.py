@@ -6,8 +6,8 @@ fourth axis), on the same paths and profiles:
 
 - **approach** (``times[0]``): the platform on its cubic Hermite from rest above the box to the
   pre-grasp point, arriving with the belt, along the time-optimal profile
-  (:func:`~.delta_tracking.platform_move_profile`; within each grid interval the path acceleration is
-  constant, so the position is exact there); the tool turns rest to rest from 0 to the item's yaw
+  (:func:`~.delta_tracking.platform_move_profile`, sampled by
+  :func:`pinarms.optim.standard_cycle.timing.profile_position`); the tool turns rest to rest from 0 to the item's yaw
   (:func:`~.tracking.tool_yaw`) in :func:`~.delta_tracking.tool_turn_time`. The longer of the two sets
   the approach: the platform then waits at the box first (as the task maps time it);
 - **tracking** (``times[1]``): :func:`~.delta_tracking.tracking_platform`, the tool at the yaw;
@@ -26,13 +26,14 @@ import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt
-from pinarms.optim.line.delta_tracking import (DeltaArm, platform_move_profile, tool_turn_time,
-                                                tracking_platform)
+from pinarms.optim.line.delta_tracking import DeltaArm, platform_move_profile, tool_turn_time, tracking_platform
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec, tool_yaw
+from pinarms.optim.standard_cycle.delta_cycle import turn_angle
+from pinarms.optim.standard_cycle.timing import profile_position
 from pinarms.robots.delta import inverse_position
 
-__all__ = ["DeltaPickMotion", "delta_pick_motion", "delta_rest", "profile_position", "turn_angle"]
+__all__ = ["DeltaPickMotion", "delta_pick_motion", "delta_rest"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,36 +53,6 @@ class DeltaPickMotion:
     def sample(self, t: np.ndarray) -> np.ndarray:
         """Actuated coordinates at ``t`` (F,) [s] (linear between samples, held at the ends): (F, 3|4)."""
         return np.stack([np.interp(t, self.t, col) for col in self.actuated.T], axis=1)
-
-
-def profile_position(timing, tau: np.ndarray) -> np.ndarray:
-    """Path position ``s`` [m] at instants ``tau`` [s] of a time-optimal profile (``timing.s``, ``timing.sd``:
-    constant path acceleration on each interval, so ``dt = 2 ds / (sd_k + sd_k+1)``), held at its end."""
-    s, sd = np.asarray(timing.s, float), np.asarray(timing.sd, float)
-    ds = np.diff(s)
-    dt = 2.0 * ds / np.maximum(sd[:-1] + sd[1:], 1e-300)
-    t_nodes = np.concatenate([[0.0], np.cumsum(dt)])
-    tau = np.clip(np.asarray(tau, float), 0.0, t_nodes[-1])
-    k = np.clip(np.searchsorted(t_nodes, tau, side="right") - 1, 0, ds.size - 1)
-    local = tau - t_nodes[k]
-    acc = (sd[k + 1] - sd[k]) / dt[k]
-    return np.minimum(s[k] + sd[k] * local + 0.5 * acc * local ** 2, s[k + 1])
-
-
-def turn_angle(angle: float, vmax: float, amax: float, tau: np.ndarray) -> np.ndarray:
-    """Angle [rad] at ``tau`` [s] of the shortest rest-to-rest turn by ``angle`` under ``vmax``, ``amax``
-    (bang-bang, or with a cruise at ``vmax``; :func:`~.delta_tracking.tool_turn_time` long), held after it."""
-    a = abs(float(angle))
-    if a == 0.0:
-        return np.zeros(np.shape(tau))
-    total = tool_turn_time(a, vmax, amax)
-    ramp = min(vmax / amax, total / 2.0)
-    tau = np.clip(np.asarray(tau, float), 0.0, total)
-    peak = amax * ramp
-    out = np.where(tau < ramp, 0.5 * amax * tau ** 2,
-                   np.where(tau > total - ramp, a - 0.5 * amax * (total - tau) ** 2,
-                            0.5 * amax * ramp ** 2 + peak * (tau - ramp)))
-    return np.sign(angle) * out
 
 
 def delta_rest(station: Station) -> np.ndarray:

@@ -31,7 +31,7 @@ from pinarms.optim.standard_cycle.path import StandardCycle, gate_breaks, gate_l
 from pinarms.optim.standard_cycle.timing import GateTiming, JointPathRows, time_rows
 
 __all__ = ["delta_path_rows", "delta_gate_rows", "delta_standard_cycle", "delta_cycle_time", "DeltaCycleTime",
-           "tool_turn_time", "tool_turn_limits", "TOOL_ACCELERATION_FACTOR"]
+           "tool_turn_time", "turn_angle", "tool_turn_limits", "TOOL_ACCELERATION_FACTOR"]
 
 _H = 1e-4   # step of the central differences along the path [m]
 #: Acceleration limit of the fourth axis: this many times its speed limit [1/s] (assumed).
@@ -44,6 +44,22 @@ def tool_turn_time(angle: float, vmax: float, amax: float) -> float:
     if a * amax <= vmax ** 2:
         return 2.0 * np.sqrt(a / amax)
     return a / vmax + vmax / amax
+
+
+def turn_angle(angle: float, vmax: float, amax: float, tau: np.ndarray) -> np.ndarray:
+    """Angle [rad] at ``tau`` [s] of the shortest rest-to-rest turn by ``angle`` under ``vmax``, ``amax``
+    (bang-bang, or with a cruise at ``vmax``; :func:`tool_turn_time` long), held after it."""
+    a = abs(float(angle))
+    if a == 0.0:
+        return np.zeros(np.shape(tau))
+    total = tool_turn_time(a, vmax, amax)
+    ramp = min(vmax / amax, total / 2.0)
+    tau = np.clip(np.asarray(tau, float), 0.0, total)
+    peak = amax * ramp
+    out = np.where(tau < ramp, 0.5 * amax * tau ** 2,
+                   np.where(tau > total - ramp, a - 0.5 * amax * (total - tau) ** 2,
+                            0.5 * amax * ramp ** 2 + peak * (tau - ramp)))
+    return np.sign(angle) * out
 
 
 def tool_turn_limits(delta: DeltaRobot) -> tuple[float, float]:

@@ -4,7 +4,8 @@ belt while tracking, the tool turned to the item's yaw and back, the motors with
 import numpy as np
 import pytest
 
-from pinarms.optim.line.delta_motion import delta_pick_motion, delta_rest, turn_angle
+from pinarms.optim.line.delta_motion import delta_pick_motion, delta_rest
+from pinarms.optim.standard_cycle.delta_cycle import turn_angle
 from pinarms.optim.line.delta_tracking import delta_pick_times, tool_turn_time
 from pinarms.robots.delta import forward_position
 from pinarms.studies.delta_line import delta_line

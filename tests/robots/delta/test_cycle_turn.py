@@ -54,3 +54,32 @@ def test_a_turn_needs_a_fourth_axis():
 
     with pytest.raises(InvalidSettings, match="no fourth axis"):
         tool_turn_limits(NoTool())
+
+
+def test_the_demo_page_runs_the_cycle_with_its_turn():
+    """The delta study's session (the demo's html/delta.html): the platform on the gate (closed-form FK of the
+    stored motor angles against the gate's points), at the pick and the place during the air dwells, the tool
+    at 90 deg at the place and back at 0 at the pick; the cycle as long as the 1 kg row says."""
+    from pinarms.optim.standard_cycle import gate_length, gate_points
+    from pinarms.papers import IRB360_1600
+    from pinarms.robots.delta import forward_position
+    from pinarms.studies.delta_cycle import PAGE_BASE_HEIGHT_M, cycle_session
+
+    s = cycle_session(1.0, quick=True, hz=100.0)
+    rec = s.deltas["delta_flexpicker"]
+    delta = s.delta("delta_flexpicker")
+    cycle = StandardCycle(start=DELTA_CYCLE_START_M, payload=1.0)
+    way = delta_cycle_time(delta, cycle, np.pi / 2, n=80)
+    air = IRB360_1600.air_activation_s
+    assert rec.duration == pytest.approx(2 * way.one_way_s + 2 * air, abs=1e-12)
+    assert rec.base_to_world[2, 3] == PAGE_BASE_HEIGHT_M
+    p = forward_position(delta.geometry, rec.theta)
+    # every sample on the gate: its nearest point of a fine sampling of the gate within 0.2 mm
+    gate = gate_points(cycle, np.linspace(0.0, gate_length(cycle), 4001))[0]
+    nearest = np.min(np.linalg.norm(p[:, None, :] - gate[None], axis=2), axis=1)
+    assert nearest.max() < 2e-4
+    at_place = (rec.t > way.one_way_s + 1e-9) & (rec.t < way.one_way_s + air - 1e-9)
+    np.testing.assert_allclose(p[at_place], np.broadcast_to(gate[-1], p[at_place].shape), atol=1e-9)
+    np.testing.assert_allclose(rec.tool[at_place], np.pi / 2, atol=1e-12)
+    np.testing.assert_allclose(p[-1], gate[0], atol=1e-9)
+    assert rec.tool[0] == 0.0 and rec.tool[-1] == pytest.approx(0.0, abs=1e-12)
