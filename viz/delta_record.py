@@ -19,13 +19,18 @@ built from other files (:func:`~pinarms.robots.delta.delta_from_files`) is refus
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
 from pinarms.viz.session_inputs import float_array, pose_array
+from pinarms.viz.session_specs import SessionItemView
+
+if TYPE_CHECKING:
+    from pinarms.robots.delta import DeltaRobot
 
 __all__ = ["DeltaRecord", "delta_record", "encode_delta", "decode_delta", "assembly_problem", "DELTA_RANGE_TOL"]
 
@@ -74,11 +79,11 @@ class DeltaRecord:
         return np.stack([np.interp(tt, self.t, self.actuated[:, j]) for j in range(self.actuated.shape[1])], axis=1)
 
 
-def _actuated_columns(delta: Any) -> int:
+def _actuated_columns(delta: DeltaRobot) -> int:
     return 4 if delta.has_tool_axis else 3
 
 
-def assembly_problem(delta: Any, actuated: np.ndarray) -> str | None:
+def assembly_problem(delta: DeltaRobot, actuated: np.ndarray) -> str | None:
     """What is wrong with ``actuated`` (N, A) for ``delta`` (columns, motor range, rows that do not
     assemble), or ``None``."""
     from pinarms.robots.delta import forward_position
@@ -100,7 +105,8 @@ def assembly_problem(delta: Any, actuated: np.ndarray) -> str | None:
     return None
 
 
-def delta_record(name: str, delta: Any, base_to_world: Any, motion: Any) -> DeltaRecord:
+def delta_record(name: str, delta: DeltaRobot, base_to_world: ArrayLike | None,
+                 motion: tuple[ArrayLike, ArrayLike] | None) -> DeltaRecord:
     """The record of ``delta`` (a shipped :class:`pinarms.robots.delta.DeltaRobot`) under ``name``, its base at
     ``base_to_world`` (checked 4 × 4 rigid), its ``motion`` a pair ``(t (N,) s, actuated (N, 3|4) rad)`` or
     ``None`` (at rest at its home configuration).
@@ -139,7 +145,7 @@ def encode_delta(r: DeltaRecord) -> tuple[dict, dict, dict]:
     return {"name": r.name, "delta": r.delta}, {"base_to_world": r.base_to_world, "t": r.t, "actuated": r.actuated}, {}
 
 
-def decode_delta(it: Any) -> DeltaRecord:
+def decode_delta(it: SessionItemView) -> DeltaRecord:
     """The record of a validated session item: a shipped delta's name, its motion checked against it (module doc)."""
     from pinarms.robots.delta import delta_names, load_delta
 

@@ -23,9 +23,10 @@ import contextlib
 import io
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.files import atomic_write
 from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position, rod_endpoints
@@ -34,6 +35,9 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.names import SCENE_ROOT
+
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
 
 __all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT", "TOOL_WIDTH",
            "draw_session_deltas", "animate_session_deltas", "session_delta_poses", "session_delta_tcp"]
@@ -82,7 +86,8 @@ def _rz(a: np.ndarray) -> np.ndarray:
     return R
 
 
-def delta_poses(delta: DeltaRobot, theta: Any, base_to_world: Any = None, tool: Any = None) -> dict[str, np.ndarray]:
+def delta_poses(delta: DeltaRobot, theta: ArrayLike, base_to_world: ArrayLike | None = None,
+                tool: ArrayLike | None = None) -> dict[str, np.ndarray]:
     """World transforms (F, 4, 4) of every part (module doc) at motor angles ``theta`` (F, 3) [rad] and,
     for a delta with the fourth axis, tool angles ``tool`` (F,) [rad] (default 0).
 
@@ -165,7 +170,7 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
     return atomic_write(path, lambda f: f.write(data))
 
 
-def session_delta_poses(session: Any, key: str, times: Any) -> dict[str, np.ndarray]:
+def session_delta_poses(session: Session, key: str, times: ArrayLike) -> dict[str, np.ndarray]:
     """World transforms (F, 4, 4) of the parts of the session's delta ``key`` at ``times`` (F,) [s] from its
     motion's start (held at the ends); the passive joints from the closed form."""
     rec = session.deltas[key]
@@ -173,7 +178,7 @@ def session_delta_poses(session: Any, key: str, times: Any) -> dict[str, np.ndar
     return delta_poses(session.delta(key), act[:, :3], rec.base_to_world, act[:, 3] if act.shape[1] == 4 else None)
 
 
-def draw_session_deltas(vis: Any, session: Any, bounds: list, framed: list) -> list[str]:
+def draw_session_deltas(vis: meshcat.Visualizer, session: Session, bounds: list, framed: list) -> list[str]:
     """Draw each delta of ``session`` at the start of its motion; its base and platform path join ``bounds``
     and ``framed`` (what the view centres on). Returns the page's summary lines."""
     lines = []
@@ -193,13 +198,14 @@ def draw_session_deltas(vis: Any, session: Any, bounds: list, framed: list) -> l
     return lines
 
 
-def animate_session_deltas(anim: Any, vis: Any, session: Any, times: np.ndarray) -> None:
+def animate_session_deltas(anim: meshcat.animation.Animation, vis: meshcat.Visualizer, session: Session,
+                           times: np.ndarray) -> None:
     """Add each delta's motion at the animation's ``times`` (F,) [s] to ``anim`` (held after its end)."""
     for key in getattr(session, "deltas", {}):
         animate_delta(anim, vis, f"{DELTA_ROOT}/{key}", session_delta_poses(session, key, times))
 
 
-def session_delta_tcp(session: Any, key: str, times: Any) -> np.ndarray:
+def session_delta_tcp(session: Session, key: str, times: ArrayLike) -> np.ndarray:
     """(F, 3) world position [m] of the tcp of the session's delta ``key`` at ``times`` (F,) [s] from its motion's
     start: the closed-form platform plus the tcp's offset turned by the tool angle."""
     rec = session.deltas[key]

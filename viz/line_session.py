@@ -31,6 +31,11 @@ from pinarms.viz.line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, 
 
 if TYPE_CHECKING:
     from pinarms.optim.line.api import LineResult, LineSpec
+    from pinarms.optim.line.belt import Belt
+    from pinarms.optim.line.delta_motion import DeltaPickMotion
+    from pinarms.optim.line.items import ItemType
+    from pinarms.optim.line.station import Station
+    from pinarms.optim.line.tracking import TrackingSpec
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
@@ -48,7 +53,8 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
     return float(start), float(duration)
 
 
-def _delta_pick(st: Any, belt: Any, tr: Any, u: float, w: float, kind: Any, yaw: float) -> Any:
+def _delta_pick(st: Station, belt: Belt, tr: TrackingSpec, u: float, w: float, kind: ItemType, yaw: float
+                ) -> DeltaPickMotion:
     from pinarms.optim.line.delta_motion import delta_pick_motion
 
     return delta_pick_motion(st, belt, tr, u, w, mass=kind.mass, item_height=kind.size[2], yaw=yaw)
@@ -87,7 +93,7 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
     return out, times
 
 
-def _rest(st: Any) -> np.ndarray:
+def _rest(st: Station) -> np.ndarray:
     """The arm at rest at its box: joint values, or a delta's actuated coordinates."""
     from pinarms.optim.line.delta_motion import delta_rest
     from pinarms.optim.line.delta_tracking import DeltaArm

@@ -59,6 +59,8 @@ from pinarms.viz.session_robots import rebuild_robot, robot_entry, shipped_model
 from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 if TYPE_CHECKING:
+    from pinarms.robots.delta import DeltaRobot
+    from pinarms.viz.delta_record import DeltaRecord
     from pinarms.optim.ga.engine import GAHistory, GAResult
     from pinarms.robots.reach.workspace import Workspace
     from pinarms.robots.cell.motion_report import MotionCheck
@@ -331,8 +333,8 @@ class Session:
 
         return add_line(self, spec, result, **options)
 
-    def add_delta(self, delta: Any, *, key: str | None = None, base_to_world: ArrayLike | None = None,
-                  motion: Any = None) -> Any:
+    def add_delta(self, delta: DeltaRobot | str, *, key: str | None = None, base_to_world: ArrayLike | None = None,
+                  motion: tuple[ArrayLike, ArrayLike] | None = None) -> DeltaRecord:
         """Add a shipped delta robot (:func:`pinarms.robots.delta.load_delta`, or its registry name) hung at
         ``base_to_world`` (4, 4), with its ``motion``: ``(t (N,) s, actuated (N, 3|4) rad)``, the motor angles
         (and the tool angle of the fourth axis) over time, or ``None`` (at rest). Only the actuated
@@ -348,7 +350,7 @@ class Session:
         self.deltas[name] = rec
         return rec
 
-    def delta(self, key: str) -> Any:
+    def delta(self, key: str) -> DeltaRobot:
         """The :class:`pinarms.robots.delta.DeltaRobot` of the session's delta ``key`` (loaded once by name)."""
         from pinarms.robots.delta import load_delta
 
