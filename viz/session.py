@@ -157,7 +157,8 @@ class Session:
     def __repr__(self) -> str:
         return (
             f"Session(title={self.title!r}, robots={list(self.robots)}, trajectories={list(self.trajectories)}, "
-            f"workspaces={list(self.workspaces)}, points={list(self.point_sets)}, histories={list(self.histories)})"
+            f"workspaces={list(self.workspaces)}, points={list(self.point_sets)}, histories={list(self.histories)}"
+            + (f", deltas={list(self.deltas)})" if self.deltas else ")")
         )
 
     # ---------------------------------------------------------------- robots
