@@ -18,6 +18,7 @@ built from other files (:func:`~pinarms.robots.delta.delta_from_files`) is refus
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -115,11 +116,11 @@ def delta_record(name: str, delta: DeltaRobot, base_to_world: ArrayLike | None,
         InvalidInput: not a shipped delta, or a motion of the wrong shape, not increasing in time,
             outside the motor range or that does not assemble.
     """
-    from pinarms.robots.delta import DeltaRobot, delta_names, load_delta
+    from pinarms.robots.delta import DeltaRobot, delta_names
 
     if not isinstance(delta, DeltaRobot):
         raise InvalidInput(f"delta {name!r} must be a robots.delta.DeltaRobot (load_delta), got {type(delta).__name__}")
-    if delta.name not in delta_names() or load_delta(delta.name).urdf_text != delta.urdf_text:
+    if delta.name not in delta_names() or _shipped(delta.name).urdf_text != delta.urdf_text:
         raise InvalidInput(f"delta {name!r} ({delta.name}) is not a shipped delta ({', '.join(delta_names())}): a session "
                            "stores deltas by registry name; ship it first (docs/delta.md, robots/delta/shipped.py)")
     if motion is None:
@@ -145,9 +146,18 @@ def encode_delta(r: DeltaRecord) -> tuple[dict, dict, dict]:
     return {"name": r.name, "delta": r.delta}, {"base_to_world": r.base_to_world, "t": r.t, "actuated": r.actuated}, {}
 
 
+@functools.lru_cache(maxsize=8)
+def _shipped(name: str) -> DeltaRobot:
+    """The shipped delta ``name``, loaded once per process: a file of many delta items costs one load each name
+    (only its geometry and limits are read here)."""
+    from pinarms.robots.delta import load_delta
+
+    return load_delta(name)
+
+
 def decode_delta(it: SessionItemView) -> DeltaRecord:
     """The record of a validated session item: a shipped delta's name, its motion checked against it (module doc)."""
-    from pinarms.robots.delta import delta_names, load_delta
+    from pinarms.robots.delta import delta_names
 
     name = it.field("delta", str)
     if name not in delta_names():
@@ -155,7 +165,7 @@ def decode_delta(it: SessionItemView) -> DeltaRecord:
     t, actuated = it.arrays["t"], it.arrays["actuated"]
     if np.any(np.diff(t) <= 0):
         raise it.fail(f"{it.where}.t must be strictly increasing")
-    problem = assembly_problem(load_delta(name), actuated)
+    problem = assembly_problem(_shipped(name), actuated)
     if problem:
         raise it.fail(f"{it.where}.actuated {problem}")
     try:
