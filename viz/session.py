@@ -351,7 +351,7 @@ class Session:
 
         if isinstance(delta, str):
             delta = load_delta(delta)
-        name = self._free(self.deltas, getattr(delta, "name", "delta") if key is None else key, "delta")
+        name = self.free_name(self.deltas, getattr(delta, "name", "delta") if key is None else key, "delta")
         rec = delta_record(name, delta, base_to_world, motion)
         self.deltas[name] = rec
         return rec
