@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from pinarms.robots.delta import forward_position, load_delta
+from pinarms.robots.delta import DeltaRobot, forward_position, load_delta
 from pinarms.errors import InvalidInput
 from pinarms.viz import SessionFormatError
 from pinarms.viz.session import Session, SessionLimits, load_session
@@ -68,7 +68,7 @@ def test_add_delta_refuses_bad_motions(delta):
     with pytest.raises(InvalidInput, match="outside the range"):
         s.add_delta(delta, motion=(t, act + [2.0, 0.0, 0.0, 0.0]))
     with pytest.raises(InvalidInput, match="not a shipped delta"):
-        s.add_delta(delta.with_payload(1.0).__class__(delta.model, delta.closures, name="mine", acceleration=1.0))
+        s.add_delta(DeltaRobot(delta.model, delta.closures, name="mine", acceleration=1.0))
     with pytest.raises(InvalidInput, match="DeltaRobot"):
         s.add_delta(object(), key="x")
     s.add_delta(delta, motion=(t, act))
