@@ -16,10 +16,16 @@ per process, as in a serial build where every task shares the caller's station.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, TypeVar
 
 from pinarms.errors import UnreachableTarget
 from pinarms.optim.errors import InfeasibleProblem, OptimError
+
+if TYPE_CHECKING:
+    from pinarms.optim.line.fixtures import FixtureCheck
+    from pinarms.optim.line.station import Station
+
+Plan = TypeVar("Plan")
 
 __all__ = ["plan_node", "node_fixtures", "task_station", "map_key", "plan_yaw", "PLAN_FAILURES"]
 
@@ -37,7 +43,7 @@ def map_key() -> str:
     return uuid.uuid4().hex
 
 
-def task_station(task: dict) -> Any:
+def task_station(task: dict) -> Station:
     """The task's station, the same object for every task of one map in this process (module doc)."""
     key = task.get("key")
     if key is None:
@@ -47,7 +53,7 @@ def task_station(task: dict) -> Any:
     return _STATIONS.setdefault(str(key), task["station"])
 
 
-def node_fixtures(task: dict) -> Any:
+def node_fixtures(task: dict) -> FixtureCheck | None:
     """The task's :class:`~.fixtures.FixtureCheck` for its station (None: no cell given), kept per map
     and process like :func:`task_station`."""
     if task.get("cell") is None:
@@ -63,7 +69,7 @@ def node_fixtures(task: dict) -> Any:
     return known
 
 
-def plan_node(plan: Callable[[], Any], fixtures: Any) -> tuple[Any, bool]:
+def plan_node(plan: Callable[[], Plan], fixtures: FixtureCheck | None) -> tuple[Plan | None, bool]:
     """``(plan(), False)`` when the pick is possible and clear of the fixtures; ``(None, blocked)``
     otherwise, ``blocked`` True when the plan exists but comes closer than the clearance to the
     cell's fixtures (module doc)."""
@@ -71,7 +77,7 @@ def plan_node(plan: Callable[[], Any], fixtures: Any) -> tuple[Any, bool]:
         p = plan()
     except PLAN_FAILURES:
         return None, False
-    verdict = "clear" if fixtures is None else fixtures.verdict(p.trajectory)
+    verdict = "clear" if fixtures is None else fixtures.verdict(p.trajectory)  # type: ignore[attr-defined]
     if verdict != "clear":
         return None, verdict == "fixtures"
     return p, False

@@ -23,7 +23,7 @@ from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.task_map_build import PROBE_COLUMNS, PROBE_YAWS
-from pinarms.optim.line.tracking import (TrackingSpec, _branch_label, can_yaw, ik_branch_labels, plan_pick,
+from pinarms.optim.line.tracking import (TrackingSpec, branch_label, can_yaw, ik_branch_labels, plan_pick,
                                          rest_configuration)
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
@@ -61,7 +61,7 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                 if p is None:
                     continue
                 A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
-                P[j] = _branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
+                P[j] = branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
     return A, X, R, P, blocked
 
 
