@@ -14,14 +14,17 @@ smooth bend, so the two intervals beside it get a node in their middle.
   planned only at the nodes whose time bends there; at the others it holds the linear
   interpolation of its two neighbours (what the map gave there before the layer, within the
   tolerance by the test above), so a yaw layer costs only the plans the bend needs.
-- :func:`merge_nodes` puts new nodes and their tables into a grid, sorted.
+- :func:`merge_nodes` puts new nodes and their tables into a grid, sorted; :func:`add_yaw_nodes`
+  is one yaw pass (the nodes that bend planned, the others interpolated).
 """
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
-__all__ = ["bent_lines", "bent_nodes", "merge_nodes"]
+__all__ = ["bent_lines", "bent_nodes", "merge_nodes", "add_yaw_nodes"]
 
 
 def _deviation(x: np.ndarray, T: np.ndarray) -> np.ndarray:
@@ -70,3 +73,23 @@ def merge_nodes(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axi
     order = np.argsort(np.concatenate([x, new]), kind="stable")
     return (np.concatenate([x, new])[order],
             *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
+
+
+def add_yaw_nodes(yaw: np.ndarray, A: np.ndarray, C: np.ndarray, extra: float, tolerance: float,
+                  plan: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]) -> tuple:
+    """One yaw refinement pass over tables (ny, nb, nu, nw): a yaw node in the middle of every yaw
+    interval that bends at some (du, w) node (:func:`bent_nodes`); ``plan(mid, need)`` gives the
+    tables (len(mid), nb, nu, nw) planned where ``need`` (len(mid), nu, nw), and every other node of
+    the new layer holds the mean of its two neighbours (the linear interpolation it had). Returns
+    ``(yaw, A, C, added)``, ``added`` the new yaw nodes (0: nothing bends)."""
+    mark = bent_nodes(yaw, A, C, extra, tolerance)  # (ny - 1, nu, nw)
+    ks = np.flatnonzero(mark.any(axis=(1, 2)))
+    if not ks.size:
+        return yaw, A, C, 0
+    mid = 0.5 * (yaw[ks] + yaw[ks + 1])
+    PA, PC = plan(mid, mark[ks])
+    need = mark[ks][:, None]
+    FA = np.where(need, PA, 0.5 * (A[ks] + A[ks + 1]))
+    FC = np.where(need, PC, 0.5 * (C[ks] + C[ks + 1]))
+    yaw, A, C = merge_nodes(yaw, mid, (A, C), (FA, FC), 0)
+    return yaw, A, C, int(ks.size)

@@ -25,7 +25,7 @@ import numpy as np
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.map_request import MapRequest, MapResult, MapStatus
 from pinarms.optim.line.map_nodes import map_key, node_fixtures, plan_node, plan_yaw, task_station
-from pinarms.optim.line.map_refine import bent_lines, bent_nodes, merge_nodes
+from pinarms.optim.line.map_refine import add_yaw_nodes, bent_lines, bent_nodes, merge_nodes
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
@@ -175,16 +175,8 @@ def _refine(plan: _Planner, du: np.ndarray, w: np.ndarray, yaw: np.ndarray | Non
                 w, A, C = merge_nodes(w, new_w, (A, C), plan(du, new_w, ys), 3)
             added = new_u.size + new_w.size
         if yaw is not None and k < yaw_passes:
-            mark = bent_nodes(ys, A, C, extra, tolerance)  # (ny - 1, nu, nw)
-            ks = np.flatnonzero(mark.any(axis=(1, 2)))
-            if ks.size:
-                mid = 0.5 * (ys[ks] + ys[ks + 1])
-                PA, PC = plan.nodes(du, w, mid, mark[ks])
-                need = mark[ks][:, None]
-                FA = np.where(need, PA, 0.5 * (A[ks] + A[ks + 1]))  # the linear interpolation where not planned
-                FC = np.where(need, PC, 0.5 * (C[ks] + C[ks + 1]))
-                ys, A, C = merge_nodes(ys, mid, (A, C), (FA, FC), 0)
-                added += ks.size
+            ys, A, C, more = add_yaw_nodes(ys, A, C, extra, tolerance, partial(plan.nodes, du, w))
+            added += more
         if not added:
             break
     return du, w, (None if yaw is None else ys), A, C
