@@ -32,9 +32,9 @@ GOAL_P95 = 0.01  # issue 36: map error p95 at random yaw against exact planning
 def jaco_line():
     from pinarms import robots
     from pinarms.optim.line import Belt, PlaceBox, Station, TrackingSpec, base_pose
-    from pinarms.robots.registry import _example_robot_data_share
+    from pinarms.robots.registry import example_robot_data_share
 
-    share = _example_robot_data_share()
+    share = example_robot_data_share()
     jaco = robots.from_urdf(share / "robots/kinova_description/robots/kinova.urdf", tcp="j2s6s200_end_effector",
                             package_dirs=(str(share.parent),))
     belt = Belt((0.0, 0.0, 0.80), speed=0.1, width=0.3, length=2.0)
