@@ -196,11 +196,9 @@ class TrayMapRequest:
         from pinarms.optim.line.task_maps import TaskMap
         from pinarms.optim.line.trays import TrayBelt
 
-        m = self.approach_map
-        if m is not None and not (isinstance(m, TaskMap) and abs(m.speed - self.belt.speed)
-                                  <= 1e-9 * max(1.0, abs(getattr(self.belt, "speed", 1.0)))):
-            raise InvalidInput(f"approach_map must be the station's TaskMap built at the belt's "
-                               f"{getattr(self.belt, 'speed', '?')} m/s, got "
+        m, speed = self.approach_map, float(getattr(self.belt, "speed", float("nan")))
+        if m is not None and not (isinstance(m, TaskMap) and abs(m.speed - speed) <= 1e-9 * max(1.0, speed)):
+            raise InvalidInput(f"approach_map must be the station's TaskMap built at the belt's {speed} m/s, got "
                                f"{getattr(m, 'speed', type(m).__name__)!r}")
         _common(self)
         if not isinstance(self.trays, TrayBelt):
