@@ -69,7 +69,7 @@ def gantry_line(rate: float, *, kind: str = "poisson", speed: float = 0.3, seeds
 
 
 def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
-    key = (stationstation_shape_key(station, spec.belt), spec.belt.speed, kind.mass, kind.size, spec.tracking, spec.map_grid,
+    key = (station_shape_key(station, spec.belt), spec.belt.speed, kind.mass, kind.size, spec.tracking, spec.map_grid,
            spec.belt.width, PLAN_VERSION)
     return hashlib.sha256(repr(key).encode()).hexdigest()[:16]
 
