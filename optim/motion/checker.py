@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence, TYPE_CHECKING
+from typing import Any, Callable, Sequence, TYPE_CHECKING, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -68,6 +68,8 @@ TIMED_LIMIT_TOL = 1e-9
 
 __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "COARSE_LEVELS", "check_threads",
            "coarse_first"]
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -203,7 +205,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
-        self._kept: dict[str, Any] = {}  # what helpers build once per checker (kept)
+        self._memo: dict[str, Any] = {}  # what helpers build once per checker (memo)
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -325,12 +327,12 @@ class MotionChecker(CoalBatches, LadderProof):
             out[i], arg[i], dist[i] = best, k_best, d_best
         return out, arg, dist
 
-    def kept(self, key: str, build: Callable[[], Any]) -> Any:
-        """``build()``, built on the first call for ``key`` and kept with this checker (the fast check of
-        :func:`pinarms.optim.motion.fast.fast_check`)."""
-        if key not in self._kept:
-            self._kept[key] = build()
-        return self._kept[key]
+    def memo(self, key: str, build: Callable[[], T]) -> T:
+        """The value kept with this checker under ``key``, built by ``build()`` the first time (as
+        :meth:`pinarms.robots.cell.Cell.memo`; the fast check of :func:`pinarms.optim.motion.fast.fast_check`)."""
+        if key not in self._memo:
+            self._memo[key] = build()
+        return self._memo[key]
 
     def place_geometry(self, qp: np.ndarray) -> None:
         """Place every collision body at Pinocchio configuration ``qp`` (one row of :meth:`to_pinocchio`) for

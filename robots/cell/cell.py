@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import CellError, CellTooLarge, InvalidInput
@@ -299,7 +300,7 @@ class Cell:
                 return f
         raise InvalidInput(f"cell {self.name!r} has no fixture {name!r}; fixtures: {', '.join(f.name for f in self.fixtures)}")
 
-    def q_from_arms(self, arm_q: Mapping[str, Any], base: Any = None) -> np.ndarray:
+    def q_from_arms(self, arm_q: Mapping[str, ArrayLike], base: ArrayLike | None = None) -> np.ndarray:
         """A cell joint vector from ``{arm name: q_arm (nq_arm,) or (N, nq_arm)}``.
 
         Arms not named keep ``base`` (default :attr:`hold`). Batches of the named arms
@@ -321,17 +322,17 @@ class Cell:
             out[:, arm.q_slice] = arr
         return out[0] if rows is None else out
 
-    def arm_q(self, q: Any, name: str) -> np.ndarray:
+    def arm_q(self, q: ArrayLike, name: str) -> np.ndarray:
         """The block of arm ``name`` in the cell vector(s) ``q``."""
         arr, single = self.robot.check_q(q)
         out = arr[:, self.arm(name).q_slice]
         return out[0] if single else out
 
-    def world_pose(self, q: Any, frame: str) -> np.ndarray:
+    def world_pose(self, q: ArrayLike, frame: str) -> np.ndarray:
         """Pose(s) ``(4, 4)`` / ``(N, 4, 4)`` of any cell frame (``"left_tcp"``) in the world."""
         return self.robot.fk(q, frame)
 
-    def pin_vector_or_none(self, q: Any) -> np.ndarray | None:
+    def pin_vector_or_none(self, q: ArrayLike) -> np.ndarray | None:
         """Pinocchio's vector for one finite float ``q (nq,)`` without the general checks, else ``None``."""
         if type(q) is not np.ndarray or q.shape != (self.nq,) or q.dtype != np.float64:
             return None
@@ -349,7 +350,7 @@ class Cell:
         """Names of the collision geometries, in :attr:`collision_model` order."""
         return tuple(g.name for g in self.collision_model.geometryObjects)
 
-    def geometry_placements(self, q: Any) -> tuple[np.ndarray, np.ndarray]:
+    def geometry_placements(self, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """World rotations ``(N, G, 3, 3)`` and centres ``(N, G, 3)`` of every geometry frame, batched."""
         arr, _ = self.robot.check_q(q)
         R, p = self._placements.joints(arr)
@@ -361,7 +362,7 @@ class Cell:
         pg = p[:, parents] + np.einsum("ngij,gj->ngi", R[:, parents], local_p)
         return Rg, pg
 
-    def with_arm_base(self, name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> "Cell":
+    def with_arm_base(self, name: str, base_to_world: ArrayLike, carry: tuple[str, ...] = ()) -> "Cell":
         """A new cell: this one with arm ``name``'s base at ``base_to_world`` ``(4, 4)`` [m] in the world.
 
         The fixed joint that holds the arm's base link to its parent gets the origin that puts
@@ -414,7 +415,7 @@ class Cell:
         )
 
     # ------------------------------------------------------------------ checks
-    def in_collision(self, q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+    def in_collision(self, q: ArrayLike, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
         """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) touches.
 
         A pair touches when its distance is at most ``margin`` [m] (0: contact or
@@ -426,13 +427,13 @@ class Cell:
 
         return in_collision(self, q, margin=margin, threads=threads)
 
-    def collisions(self, q: Any, *, margin: float = 0.0):
+    def collisions(self, q: ArrayLike, *, margin: float = 0.0):
         """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
         from pinarms.robots.cell.collision import collisions
 
         return collisions(self, q, margin=margin)
 
-    def clearance(self, q: Any, *, margin: float = 0.0):
+    def clearance(self, q: ArrayLike, *, margin: float = 0.0):
         """Smallest signed distance [m] over every pair not allowed by design, and the pair: a :class:`~.collision.Clearance`.
 
         The checked pairs and every out-of-reach pair whose bound is below the smallest
