@@ -1,0 +1,243 @@
+"""The pairs a cell's deltas form, which of them are checked, and their distances (coal, exact).
+
+Every body of a delta (:mod:`.delta_arm`) is paired with every collision geometry of the cell's
+tree (fixtures, the serial arms' links), every body of every other delta, and every body of its
+own delta. A pair is **not checked** (:class:`~pinarms.robots.pair_rules.AllowedPair`) only for
+these reasons:
+
+``adjacent``
+    two bodies of one delta joined at a joint by design: the base and each upper arm (the
+    motor), each upper arm and its two rods (the upper ball joints), each rod and the platform
+    (the lower ball joints), the platform and the tool;
+``rigid``
+    the delta's base housing and a geometry that does not move either (a fixture, a serial
+    arm's fixed base parts, another delta's base): their distance never changes;
+``declared``
+    a rod of leg ``i`` on the ``a`` side and the ``b`` rod of the next leg, when they cross at the
+    delta's home configuration: in the shipped FlexPicker geometry (Williams' ``sP`` = 76 mm
+    platform, ``h`` = 131 mm rod spacing) the platform ball pairs of neighbouring legs are 27 mm
+    apart and these two rods cross just above the platform in every configuration (their
+    capsules overlap by 5 to 16 mm), where the real robot's rods pass beside each other: a limit of
+    the model's platform, stated in the pair's note, not a contact a motion could change.
+
+Every other pair of the kinds the cell checks (:attr:`Cell.kinds`, :meth:`Cell.with_pairs`) is a checked :class:`~pinarms.robots.cell.pairs.CollisionPair` (``index_a``
+−1: the delta's body is not in the cell's collision model; ``index_b`` the other's index there,
+or −1 for another delta's body), of kind ``"self"`` (two bodies of one delta: rods of one
+parallelogram included, they stay ``rod_spacing`` apart along the motor axis but their distance
+changes with the elbow's swing), ``"arm-arm"`` or ``"arm-fixture"``.
+
+Distances (:class:`DeltaPairSet`): per configuration, every delta's bodies are posed from the
+closed form, the cell's geometries by the cell's batched forward kinematics
+(:meth:`Cell.geometry_placements`); a pair's distance is bounded from below by its bounding
+spheres (centre distance minus radii), and coal's exact distance is computed in increasing order
+of that bound until the next bound exceeds the smallest distance found (clearance) or the margin
+(contacts). The result is the exact minimum over every checked pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+
+from pinarms.errors import CollisionGeometryError
+from pinarms.robots.cell.delta_arm import CellDelta
+from pinarms.robots.cell.pairs import CollisionPair
+from pinarms.robots.pair_rules import AllowedPair, PairReason
+
+__all__ = ["DeltaPairSet", "delta_pair_set", "adjacent_bodies", "crossing_rods"]
+
+
+def adjacent_bodies(has_tool: bool) -> frozenset[frozenset[str]]:
+    """The body pairs of one delta joined at a joint (names without the arm's prefix)."""
+    out = []
+    for i in (1, 2, 3):
+        out.append(("base", f"upper_arm_{i}"))
+        for r in "ab":
+            out += [(f"upper_arm_{i}", f"rod_{i}{r}"), (f"rod_{i}{r}", "platform")]
+    if has_tool:
+        out.append(("platform", "tool"))
+    return frozenset(frozenset(p) for p in out)
+
+
+def crossing_rods(delta: CellDelta) -> dict[frozenset[str], float]:
+    """``{pair of body names (without prefix): distance [m]}`` of the neighbouring legs' rods (``rod_{i}a``,
+    ``rod_{i+1}b``) that overlap at the delta's home configuration (module doc, ``declared``)."""
+    home = delta.delta.home()[delta.delta.motor_q]
+    poses = delta.poses(home)[0]
+    index = {n[len(delta.name) + 1:]: j for j, n in enumerate(delta.body_names)}
+    out = {}
+    for i in (1, 2, 3):
+        a, b = f"rod_{i}a", f"rod_{i % 3 + 1}b"
+        ja, jb = index[a], index[b]
+        d = coal.distance(delta.shapes[ja], _transform(poses[ja]), delta.shapes[jb], _transform(poses[jb]),
+                          coal.DistanceRequest(), coal.DistanceResult())
+        if d <= 0.0:
+            out[frozenset((a, b))] = float(d)
+    return out
+
+
+def _transform(T: np.ndarray) -> coal.Transform3s:
+    return coal.Transform3s(np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3]))
+
+
+@dataclass(frozen=True, eq=False)
+class _Side:
+    """Where a pair's second body is: a cell geometry (``delta`` −1, ``index`` its geometry index) or a delta's part."""
+
+    delta: int
+    index: int
+
+
+class DeltaPairSet:
+    """The checked and allowed pairs of a cell's deltas and their exact distances (module doc).
+
+    Attributes:
+        pairs: the checked pairs (:class:`CollisionPair`), ``allowed``: the others with their reason.
+    """
+
+    def __init__(self, cell, deltas: tuple[CellDelta, ...]) -> None:
+        self.cell, self.deltas = cell, deltas
+        gm, model = cell.collision_model, cell.model
+        owner_of = {link: arm.name for arm in cell.spec.arms for link in arm.links}
+        geoms = []
+        for g, obj in enumerate(gm.geometryObjects):
+            link = model.frames[obj.parentFrame].name
+            static = obj.parentJoint == 0
+            geoms.append((g, link, owner_of.get(link, link), link in owner_of, static))
+        self._geom_shapes = [obj.geometry for obj in gm.geometryObjects]
+        centres, radii = [], []
+        for shape in self._geom_shapes:
+            shape.computeLocalAABB()
+            lo, hi = np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)
+            centres.append((lo + hi) / 2.0)
+            radii.append(float(np.linalg.norm(hi - lo) / 2.0))
+        self._geom_centre = np.array(centres).reshape(-1, 3)
+        self._geom_radius = np.array(radii)
+        names = [d.body_names for d in deltas]
+        self._geom_shapes = self._geom_shapes
+        pairs, allowed, sides_a, sides_b = [], [], [], []
+        for k, d in enumerate(deltas):
+            short = [n[len(d.name) + 1:] for n in names[k]]
+            adjacent = adjacent_bodies("tool" in short)
+            crossing = crossing_rods(d)
+            for j, body in enumerate(names[k]):
+                for g, link, owner, is_arm, static in geoms:
+                    if short[j] == "base" and static:
+                        allowed.append(AllowedPair(body, gm.geometryObjects[g].name, body, link, PairReason.RIGID,
+                                                   index_b=g))
+                        continue
+                    kind = "arm-arm" if is_arm else "arm-fixture"
+                    if kind not in cell.kinds:
+                        continue
+                    pairs.append(CollisionPair(-1, g, body, gm.geometryObjects[g].name, body, link, d.name, owner, kind))
+                    sides_a.append((k, j)), sides_b.append(_Side(-1, g))
+                for k2 in range(k, len(deltas)):
+                    for j2, other in enumerate(names[k2]):
+                        if k2 == k and j2 <= j:
+                            continue
+                        if k2 == k and frozenset((short[j], short[j2])) in adjacent:
+                            allowed.append(AllowedPair(body, other, body, other, PairReason.ADJACENT))
+                            continue
+                        if k2 == k and frozenset((short[j], short[j2])) in crossing:
+                            depth = -crossing[frozenset((short[j], short[j2]))]
+                            allowed.append(AllowedPair(body, other, body, other, PairReason.DECLARED, note=(
+                                f"neighbouring legs' rods cross above the platform in this geometry (overlap "
+                                f"{depth * 1e3:.1f} mm at home): a limit of the model, docs/delta.md")))
+                            continue
+                        if k2 != k and short[j] == "base" and names[k2][j2].endswith("_base"):
+                            allowed.append(AllowedPair(body, other, body, other, PairReason.RIGID))
+                            continue
+                        kind = "self" if k2 == k else "arm-arm"
+                        if kind not in cell.kinds:
+                            continue
+                        pairs.append(CollisionPair(-1, -1, body, other, body, other, d.name, deltas[k2].name, kind))
+                        sides_a.append((k, j)), sides_b.append(_Side(k2, j2))
+        self.pairs: tuple[CollisionPair, ...] = tuple(pairs)
+        self.allowed: tuple[AllowedPair, ...] = tuple(allowed)
+        self._a = np.array(sides_a, dtype=int).reshape(-1, 2)
+        self._b_delta = np.array([s.delta for s in sides_b], dtype=int)
+        self._b_index = np.array([s.index for s in sides_b], dtype=int)
+
+    # ---------------------------------------------------------------- batches
+    def _state(self, arr: np.ndarray):
+        """World poses of every delta's bodies (per delta (N, B, 4, 4)), the cell geometries' placements and the
+        bounding-sphere lower bound (N, P) of every pair, for configurations ``arr (N, nq)``."""
+        poses = [d.poses(d.theta(arr)) for d in self.deltas]
+        radii = [d.radii for d in self.deltas]
+        ka, ja = self._a[:, 0], self._a[:, 1]
+        ca = np.empty((arr.shape[0], len(self.pairs), 3))
+        ra = np.empty(len(self.pairs))
+        for k in range(len(self.deltas)):
+            sel = ka == k
+            ca[:, sel] = poses[k][:, ja[sel]][..., :3, 3]
+            ra[sel] = radii[k][ja[sel]]
+        cb, rb = np.empty_like(ca), np.empty_like(ra)
+        geo = self._b_delta < 0
+        R = p = None
+        if geo.any():
+            R, p = self.cell.geometry_placements(arr)
+            g = self._b_index[geo]
+            cb[:, geo] = np.einsum("ngij,gj->ngi", R[:, g], self._geom_centre[g]) + p[:, g]
+            rb[geo] = self._geom_radius[g]
+        for k in range(len(self.deltas)):
+            sel = self._b_delta == k
+            cb[:, sel] = poses[k][:, self._b_index[sel]][..., :3, 3]
+            rb[sel] = radii[k][self._b_index[sel]]
+        return poses, R, p, np.linalg.norm(ca - cb, axis=2) - ra - rb
+
+    def _distance(self, m: int, n: int, poses, R, p) -> tuple[float, np.ndarray, np.ndarray]:
+        """coal's exact distance of pair ``m`` at configuration ``n`` and its nearest points (world)."""
+        k, j = self._a[m]
+        shape_a, pose_a = self.deltas[k].shapes[j], poses[k][n, j]
+        if self._b_delta[m] < 0:
+            g = self._b_index[m]
+            pose_b = np.eye(4)
+            pose_b[:3, :3], pose_b[:3, 3] = R[n, g], p[n, g]
+            shape_b = self._geom_shapes[g]
+        else:
+            k2, j2 = self._b_delta[m], self._b_index[m]
+            shape_b, pose_b = self.deltas[k2].shapes[j2], poses[k2][n, j2]
+        res = coal.DistanceResult()
+        d = coal.distance(shape_a, _transform(pose_a), shape_b, _transform(pose_b), coal.DistanceRequest(), res)
+        if not np.isfinite(d):
+            raise CollisionGeometryError(f"coal returned distance {d} for {self.pairs[m]}")
+        return float(d), np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2())
+
+    def clearance(self, arr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``: the exact smallest distance over
+        :attr:`pairs` at each cell configuration of ``arr (N, nq)`` (pair −1 and ``inf`` without pairs)."""
+        N = arr.shape[0]
+        dist, pair = np.full(N, np.inf), np.full(N, -1)
+        pa, pb = np.full((N, 3), np.nan), np.full((N, 3), np.nan)
+        if not self.pairs or not N:
+            return dist, pair, pa, pb
+        poses, R, p, lb = self._state(arr)
+        for n in range(N):
+            for m in np.argsort(lb[n], kind="stable"):
+                if lb[n, m] >= dist[n]:
+                    break
+                d, xa, xb = self._distance(int(m), n, poses, R, p)
+                if d < dist[n]:
+                    dist[n], pair[n], pa[n], pb[n] = d, m, xa, xb
+        return dist, pair, pa, pb
+
+    def touching(self, arr: np.ndarray, margin: float) -> list[tuple[int, ...]]:
+        """Per configuration of ``arr (N, nq)``, the indices of :attr:`pairs` at distance ≤ ``margin`` [m]."""
+        if not self.pairs or not arr.shape[0]:
+            return [()] * arr.shape[0]
+        poses, R, p, lb = self._state(arr)
+        return [tuple(int(m) for m in np.flatnonzero(lb[n] <= margin)
+                      if self._distance(int(m), n, poses, R, p)[0] <= margin) for n in range(arr.shape[0])]
+
+    def distances(self, arr: np.ndarray) -> np.ndarray:
+        """``(N, P)`` coal's exact distance [m] of every pair at every configuration of ``arr (N, nq)``."""
+        poses, R, p, lb = self._state(arr)
+        return np.array([[self._distance(m, n, poses, R, p)[0] for m in range(len(self.pairs))]
+                         for n in range(arr.shape[0])]).reshape(arr.shape[0], len(self.pairs))
+
+
+def delta_pair_set(cell) -> DeltaPairSet:
+    """The cell's :class:`DeltaPairSet`, built once (:meth:`Cell.memo`)."""
+    return cell.memo("delta pairs", lambda: DeltaPairSet(cell, cell.deltas))
