@@ -467,6 +467,6 @@ class Cell:
 
         See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
         """
-        from pinarms.robots.cell.motion import check_motion
+        from pinarms.robots.cell import delta_checks, motion
 
-        return check_motion(self, motions, margin=margin, **kwargs)
+        return (delta_checks if self.deltas else motion).check_motion(self, motions, margin=margin, **kwargs)

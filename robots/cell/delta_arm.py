@@ -26,7 +26,7 @@ from pinarms.errors import InvalidInput
 from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position
 from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
 
-__all__ = ["CellDelta", "DeltaPart", "cell_deltas", "base_housing"]
+__all__ = ["CellDelta", "DeltaPart", "cell_deltas", "base_housing", "SPHERES_PER_CAPSULE"]
 
 
 def base_housing(delta: DeltaRobot) -> tuple[tuple[float, float, float], float]:
@@ -54,6 +54,19 @@ def _sphere_radius(shape: object) -> float:
     if isinstance(shape, coal.Cylinder):
         return float(np.hypot(shape.radius, shape.halfLength))
     return float(np.linalg.norm(shape.halfSide))
+
+
+#: Spheres covering one capsule of a delta (:attr:`CellDelta.spheres`).
+SPHERES_PER_CAPSULE = 8
+
+
+def _spheres(shape: object) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (k, 3) and radii (k,) of spheres containing ``shape`` (in its frame)."""
+    if isinstance(shape, coal.Capsule):
+        k, half = SPHERES_PER_CAPSULE, float(shape.halfLength)
+        z = -half + (2.0 * np.arange(k) + 1.0) * half / k
+        return np.stack([np.zeros(k), np.zeros(k), z], axis=1), np.full(k, float(shape.radius) + half / k)
+    return np.zeros((1, 3)), np.array([_sphere_radius(shape)])
 
 
 def _along(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -107,6 +120,12 @@ class CellDelta:
             built.append((f"{self.name}_{name}", shape))
         object.__setattr__(self, "_drop", drop)
         object.__setattr__(self, "_shapes", tuple(built))
+        object.__setattr__(self, "_shape_list", tuple(s for _, s in built))
+        centres, radii, owner = [], [], []
+        for b, (_, shape) in enumerate(built):
+            c, r = _spheres(shape)
+            centres.append(c), radii.append(r), owner.append(np.full(len(r), b))
+        object.__setattr__(self, "_spheres", (np.vstack(centres), np.concatenate(radii), np.concatenate(owner)))
 
     @staticmethod
     def _moving_names(drop: np.ndarray) -> list[str]:
@@ -124,7 +143,14 @@ class CellDelta:
     @property
     def shapes(self) -> tuple[object, ...]:
         """The coal shapes of its bodies, in part order (constant: only their poses change)."""
-        return tuple(s for _, s in self._shapes)
+        return self._shape_list
+
+    @property
+    def spheres(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(centres (S, 3) in their body's frame, radii (S,), body (S,))``: spheres that together contain
+        every body (a capsule of half-length H and radius ρ: :data:`SPHERES_PER_CAPSULE` spheres of radius
+        ρ + H / k centred on its axis, each containing its piece of the capsule), for lower bounds of distances."""
+        return self._spheres
 
     @property
     def radii(self) -> np.ndarray:

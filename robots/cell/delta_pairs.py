@@ -20,18 +20,20 @@ these reasons:
     capsules overlap by 5 to 16 mm), where the real robot's rods pass beside each other: a limit of
     the model's platform, stated in the pair's note, not a contact a motion could change.
 
-Every other pair of the kinds the cell checks (:attr:`Cell.kinds`, :meth:`Cell.with_pairs`) is a checked :class:`~pinarms.robots.cell.pairs.CollisionPair` (``index_a``
-−1: the delta's body is not in the cell's collision model; ``index_b`` the other's index there,
-or −1 for another delta's body), of kind ``"self"`` (two bodies of one delta: rods of one
-parallelogram included, they stay ``rod_spacing`` apart along the motor axis but their distance
-changes with the elbow's swing), ``"arm-arm"`` or ``"arm-fixture"``.
+Every other pair of the kinds the cell checks (:attr:`Cell.kinds`, :meth:`Cell.with_pairs`) is a
+checked :class:`~pinarms.robots.cell.pairs.CollisionPair` (``index_a`` −1: the delta's body is not
+in the cell's collision model; ``index_b`` the other's index there, or −1 for another delta's
+body), of kind ``"self"`` (two bodies of one delta: the rods of one parallelogram included, they
+stay ``rod_spacing`` apart along the motor axis but their distance changes with the elbow's
+swing), ``"arm-arm"`` or ``"arm-fixture"``.
 
 Distances (:class:`DeltaPairSet`): per configuration, every delta's bodies are posed from the
 closed form, the cell's geometries by the cell's batched forward kinematics
-(:meth:`Cell.geometry_placements`); a pair's distance is bounded from below by its bounding
-spheres (centre distance minus radii), and coal's exact distance is computed in increasing order
-of that bound until the next bound exceeds the smallest distance found (clearance) or the margin
-(contacts). The result is the exact minimum over every checked pair.
+(:meth:`Cell.geometry_placements`); a pair's distance is bounded from below by the spheres that
+cover the delta's bodies (:attr:`~.delta_arm.CellDelta.spheres`) against the other body's spheres
+or the other geometry's own bounding box (in its frame), and coal's exact distance is computed in
+increasing order of that bound until the next bound exceeds the smallest distance found
+(clearance) or the margin (contacts). The result is the exact minimum over every checked pair.
 """
 
 from __future__ import annotations
@@ -107,14 +109,12 @@ class DeltaPairSet:
             static = obj.parentJoint == 0
             geoms.append((g, link, owner_of.get(link, link), link in owner_of, static))
         self._geom_shapes = [obj.geometry for obj in gm.geometryObjects]
-        centres, radii = [], []
+        boxes = []
         for shape in self._geom_shapes:
             shape.computeLocalAABB()
-            lo, hi = np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)
-            centres.append((lo + hi) / 2.0)
-            radii.append(float(np.linalg.norm(hi - lo) / 2.0))
-        self._geom_centre = np.array(centres).reshape(-1, 3)
-        self._geom_radius = np.array(radii)
+            boxes.append((np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)))
+        self._geom_lo = np.array([b[0] for b in boxes]).reshape(-1, 3)
+        self._geom_hi = np.array([b[1] for b in boxes]).reshape(-1, 3)
         names = [d.body_names for d in deltas]
         self._geom_shapes = self._geom_shapes
         pairs, allowed, sides_a, sides_b = [], [], [], []
@@ -162,30 +162,37 @@ class DeltaPairSet:
 
     # ---------------------------------------------------------------- batches
     def _state(self, arr: np.ndarray):
-        """World poses of every delta's bodies (per delta (N, B, 4, 4)), the cell geometries' placements and the
-        bounding-sphere lower bound (N, P) of every pair, for configurations ``arr (N, nq)``."""
+        """World poses of every delta's bodies (per delta (N, B, 4, 4)), the cell geometries' placements and a
+        lower bound (N, P) of every pair's distance (the bodies' covering spheres against the other body's
+        spheres, or against the other geometry's box in its own frame), for configurations ``arr (N, nq)``."""
+        N = arr.shape[0]
         poses = [d.poses(d.theta(arr)) for d in self.deltas]
-        radii = [d.radii for d in self.deltas]
-        ka, ja = self._a[:, 0], self._a[:, 1]
-        ca = np.empty((arr.shape[0], len(self.pairs), 3))
-        ra = np.empty(len(self.pairs))
-        for k in range(len(self.deltas)):
-            sel = ka == k
-            ca[:, sel] = poses[k][:, ja[sel]][..., :3, 3]
-            ra[sel] = radii[k][ja[sel]]
-        cb, rb = np.empty_like(ca), np.empty_like(ra)
-        geo = self._b_delta < 0
+        world = []   # per delta: sphere centres (N, S, 3) in the world and radii (S,)
+        for d, T in zip(self.deltas, poses):
+            c, r, body = d.spheres
+            Tb = T[:, body]
+            world.append((np.einsum("nsij,sj->nsi", Tb[..., :3, :3], c) + Tb[..., :3, 3], r, body))
         R = p = None
-        if geo.any():
+        if (self._b_delta < 0).any():
             R, p = self.cell.geometry_placements(arr)
-            g = self._b_index[geo]
-            cb[:, geo] = np.einsum("ngij,gj->ngi", R[:, g], self._geom_centre[g]) + p[:, g]
-            rb[geo] = self._geom_radius[g]
-        for k in range(len(self.deltas)):
-            sel = self._b_delta == k
-            cb[:, sel] = poses[k][:, self._b_index[sel]][..., :3, 3]
-            rb[sel] = radii[k][self._b_index[sel]]
-        return poses, R, p, np.linalg.norm(ca - cb, axis=2) - ra - rb
+        lb = np.empty((N, len(self.pairs)))
+        for m in range(len(self.pairs)):
+            k, j = self._a[m]
+            ca, ra, body = world[k]
+            sel = body == j
+            ca, ra = ca[:, sel], ra[sel]
+            if self._b_delta[m] < 0:
+                g = self._b_index[m]
+                local = np.einsum("nji,nsj->nsi", R[:, g], ca - p[:, g, None, :])
+                gap = np.maximum(np.maximum(self._geom_lo[g] - local, local - self._geom_hi[g]), 0.0)
+                lb[:, m] = (np.linalg.norm(gap, axis=2) - ra).min(axis=1)
+            else:
+                cb, rb, body_b = world[self._b_delta[m]]
+                sel_b = body_b == self._b_index[m]
+                cb, rb = cb[:, sel_b], rb[sel_b]
+                dist = np.linalg.norm(ca[:, :, None, :] - cb[:, None, :, :], axis=3)
+                lb[:, m] = (dist - ra[:, None] - rb[None, :]).min(axis=(1, 2))
+        return poses, R, p, lb
 
     def _distance(self, m: int, n: int, poses, R, p) -> tuple[float, np.ndarray, np.ndarray]:
         """coal's exact distance of pair ``m`` at configuration ``n`` and its nearest points (world)."""
@@ -208,20 +215,34 @@ class DeltaPairSet:
     def clearance(self, arr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(distance (N,), pair (N,), point_a (N, 3), point_b (N, 3))``: the exact smallest distance over
         :attr:`pairs` at each cell configuration of ``arr (N, nq)`` (pair −1 and ``inf`` without pairs)."""
+        dist, _, pair, pa, pb = self.bounded(arr, np.inf)
+        return dist, pair, pa, pb
+
+    def bounded(self, arr: np.ndarray, cutoff: float):
+        """``(value (N,), exact (N,), pair (N,), point_a, point_b)`` at each configuration of ``arr (N, nq)``:
+        the exact smallest distance over :attr:`pairs` where it is below ``cutoff`` [m] (``exact`` true),
+        else a proven lower bound of it that is at least ``cutoff`` (bounding spheres; pair −1)."""
         N = arr.shape[0]
-        dist, pair = np.full(N, np.inf), np.full(N, -1)
+        dist, exact, pair = np.full(N, np.inf), np.ones(N, dtype=bool), np.full(N, -1)
         pa, pb = np.full((N, 3), np.nan), np.full((N, 3), np.nan)
         if not self.pairs or not N:
-            return dist, pair, pa, pb
+            return dist, exact, pair, pa, pb
         poses, R, p, lb = self._state(arr)
         for n in range(N):
+            best, stop = np.inf, np.inf
             for m in np.argsort(lb[n], kind="stable"):
-                if lb[n, m] >= dist[n]:
+                if lb[n, m] >= min(best, cutoff):
+                    stop = lb[n, m]
                     break
                 d, xa, xb = self._distance(int(m), n, poses, R, p)
-                if d < dist[n]:
-                    dist[n], pair[n], pa[n], pb[n] = d, m, xa, xb
-        return dist, pair, pa, pb
+                if d < best:
+                    best, pair[n], pa[n], pb[n] = d, m, xa, xb
+            if best < cutoff:
+                dist[n] = best
+            else:  # every pair at least `cutoff` away: the smaller of the exact ones and the next bound
+                dist[n], exact[n], pair[n] = min(best, stop), False, -1
+                pa[n] = pb[n] = np.nan
+        return dist, exact, pair, pa, pb
 
     def touching(self, arr: np.ndarray, margin: float) -> list[tuple[int, ...]]:
         """Per configuration of ``arr (N, nq)``, the indices of :attr:`pairs` at distance ≤ ``margin`` [m]."""
