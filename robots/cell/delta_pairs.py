@@ -8,17 +8,13 @@ these reasons:
 ``adjacent``
     two bodies of one delta joined at a joint by design: the base and each upper arm (the
     motor), each upper arm and its two rods (the upper ball joints), each rod and the platform
-    (the lower ball joints), the platform and the tool;
+    (the lower ball joints), the platform and the tool; and, with a note, the two rods of neighbouring legs whose lower ball centres on the platform
+    are closer than two rod radii (:func:`meeting_rods`; in the shipped FlexPicker, Williams'
+    platform triangle puts them 10.5 mm apart, the rods are 16 mm thick): the platform rigidly
+    holds both ends, so their capsules overlap there in every configuration, by design;
 ``rigid``
     the delta's base housing and a geometry that does not move either (a fixture, a serial
-    arm's fixed base parts, another delta's base): their distance never changes;
-``declared``
-    a rod of leg ``i`` on the ``a`` side and the ``b`` rod of the next leg, when they cross at the
-    delta's home configuration: in the shipped FlexPicker geometry (Williams' ``sP`` = 76 mm
-    platform, ``h`` = 131 mm rod spacing) the platform ball pairs of neighbouring legs are 27 mm
-    apart and these two rods cross just above the platform in every configuration (their
-    capsules overlap by 5 to 16 mm), where the real robot's rods pass beside each other: a limit of
-    the model's platform, stated in the pair's note, not a contact a motion could change.
+    arm's fixed base parts, another delta's base): their distance never changes.
 
 Every other pair of the kinds the cell checks (:attr:`Cell.kinds`, :meth:`Cell.with_pairs`) is a
 checked :class:`~pinarms.robots.cell.pairs.CollisionPair` (``index_a`` −1: the delta's body is not
@@ -46,9 +42,10 @@ import numpy as np
 from pinarms.errors import CollisionGeometryError
 from pinarms.robots.cell.delta_arm import CellDelta
 from pinarms.robots.cell.pairs import CollisionPair
+from pinarms.robots.delta.collision import PART_RADII
 from pinarms.robots.pair_rules import AllowedPair, PairReason
 
-__all__ = ["DeltaPairSet", "delta_pair_set", "adjacent_bodies", "crossing_rods"]
+__all__ = ["DeltaPairSet", "delta_pair_set", "adjacent_bodies", "meeting_rods"]
 
 
 def adjacent_bodies(has_tool: bool) -> frozenset[frozenset[str]]:
@@ -63,20 +60,20 @@ def adjacent_bodies(has_tool: bool) -> frozenset[frozenset[str]]:
     return frozenset(frozenset(p) for p in out)
 
 
-def crossing_rods(delta: CellDelta) -> dict[frozenset[str], float]:
-    """``{pair of body names (without prefix): distance [m]}`` of the neighbouring legs' rods (``rod_{i}a``,
-    ``rod_{i+1}b``) that overlap at the delta's home configuration (module doc, ``declared``)."""
-    home = delta.delta.home()[delta.delta.motor_q]
-    poses = delta.poses(home)[0]
-    index = {n[len(delta.name) + 1:]: j for j, n in enumerate(delta.body_names)}
+def meeting_rods(delta: CellDelta) -> dict[frozenset[str], float]:
+    """``{pair of body names (without prefix): distance of their lower ball centres [m]}`` of the rods of
+    neighbouring legs (``rod_{i}a``, ``rod_{i+1}b``) whose lower ends, held by the platform, are closer than
+    two rod radii: their capsules overlap at the platform in every configuration (module doc)."""
+    g = delta.delta.geometry
+    e, u = g.radial, g.tangential
     out = {}
-    for i in (1, 2, 3):
-        a, b = f"rod_{i}a", f"rod_{i % 3 + 1}b"
-        ja, jb = index[a], index[b]
-        d = coal.distance(delta.shapes[ja], _transform(poses[ja]), delta.shapes[jb], _transform(poses[jb]),
-                          coal.DistanceRequest(), coal.DistanceResult())
-        if d <= 0.0:
-            out[frozenset((a, b))] = float(d)
+    for i in range(3):
+        j = (i + 1) % 3
+        a = g.platform_radius * e[i] + 0.5 * g.rod_spacing * u[i]
+        b = g.platform_radius * e[j] - 0.5 * g.rod_spacing * u[j]
+        gap = float(np.linalg.norm(a - b))
+        if gap < 2.0 * PART_RADII["rod"]:
+            out[frozenset((f"rod_{i + 1}a", f"rod_{j + 1}b"))] = gap
     return out
 
 
@@ -121,7 +118,7 @@ class DeltaPairSet:
         for k, d in enumerate(deltas):
             short = [n[len(d.name) + 1:] for n in names[k]]
             adjacent = adjacent_bodies("tool" in short)
-            crossing = crossing_rods(d)
+            meeting = meeting_rods(d)
             for j, body in enumerate(names[k]):
                 for g, link, owner, is_arm, static in geoms:
                     if short[j] == "base" and static:
@@ -140,11 +137,11 @@ class DeltaPairSet:
                         if k2 == k and frozenset((short[j], short[j2])) in adjacent:
                             allowed.append(AllowedPair(body, other, body, other, PairReason.ADJACENT))
                             continue
-                        if k2 == k and frozenset((short[j], short[j2])) in crossing:
-                            depth = -crossing[frozenset((short[j], short[j2]))]
-                            allowed.append(AllowedPair(body, other, body, other, PairReason.DECLARED, note=(
-                                f"neighbouring legs' rods cross above the platform in this geometry (overlap "
-                                f"{depth * 1e3:.1f} mm at home): a limit of the model, docs/delta.md")))
+                        if k2 == k and frozenset((short[j], short[j2])) in meeting:
+                            gap = meeting[frozenset((short[j], short[j2]))]
+                            allowed.append(AllowedPair(body, other, body, other, PairReason.ADJACENT, note=(
+                                f"both held by the platform: lower ball centres {gap * 1e3:.1f} mm apart, less "
+                                f"than two rod radii")))
                             continue
                         if k2 != k and short[j] == "base" and names[k2][j2].endswith("_base"):
                             allowed.append(AllowedPair(body, other, body, other, PairReason.RIGID))
