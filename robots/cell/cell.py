@@ -128,6 +128,13 @@ class Cell:
         #: The deltas among the arms (:class:`~.delta_arm.CellDelta`): bodies from the closed form, pairs in
         #: :attr:`delta_pairs`; empty for a cell of serial arms only.
         self.deltas = cell_deltas(self.arms, self.arm_placements)
+        if self.deltas:
+            from dataclasses import replace
+
+            tcp_text = ("the platform's tcp (closed form; CellDelta.tcp_to_world): the cell's tree holds the delta's "
+                        "motors only")
+            names = {d.name for d in self.deltas}
+            self.arms = tuple(replace(a, tcp_choice=tcp_text) if a.name in names else a for a in self.arms)
         self._hold = self.robot.neutral.copy()
         for a in self.arms:
             self._hold[a.q_slice] = a.hold

@@ -174,15 +174,19 @@ def check_delta_pairs(cell, motions: list[ArmMotion], hold: np.ndarray, window: 
 
 
 def _exact_minimum(cell, motions, hold, T, D, E, K):
-    """Exact distances at the screened samples whose bound is below the smallest exact one (the true sample minimum)."""
+    """Exact distances at the screened samples whose bound is below the smallest exact one, until none is: the
+    smallest exact distance is then the true minimum over the samples (branch and bound)."""
     dps = delta_pair_set(cell)
-    best = float(D[E].min()) if E.any() else np.inf
-    need = np.flatnonzero(~E & (D < best)) if np.isfinite(best) else np.flatnonzero(D == D.min())[:1]
-    if need.size:
+    D, E, K = D.copy(), E.copy(), K.copy()
+    while True:
+        best = float(D[E].min()) if E.any() else np.inf
+        need = np.flatnonzero(~E & (D < best))
+        if np.isinf(best) and (~E).any():
+            need = np.flatnonzero(~E & (D <= D[~E].min()))[:16]
+        if not need.size:
+            return D, E, K
         d, _, k, _, _ = dps.bounded(configurations(cell, motions, T[need], hold), np.inf)
-        D, E, K = D.copy(), E.copy(), K.copy()
         D[need], E[need], K[need] = d, True, k
-    return D, E, K
 
 
 def _report(cell, motions, hold, dps, samples, lower, proven_all, positive_all, speeds, times, window, margin,

@@ -29,7 +29,8 @@ closed form, the cell's geometries by the cell's batched forward kinematics
 cover the delta's bodies (:attr:`~.delta_arm.CellDelta.spheres`) against the other body's spheres
 or the other geometry's own bounding box (in its frame), and coal's exact distance is computed in
 increasing order of that bound until the next bound exceeds the smallest distance found
-(clearance) or the margin (contacts). The result is the exact minimum over every checked pair.
+(clearance) or the margin (contacts), and is not negative (two bodies whose bounds overlap may
+overlap by any depth: coal's signed distance is computed for each). The result is the exact minimum over every checked pair.
 """
 
 from __future__ import annotations
@@ -75,6 +76,12 @@ def meeting_rods(delta: CellDelta) -> dict[frozenset[str], float]:
         if gap < 2.0 * PART_RADII["rod"]:
             out[frozenset((f"rod_{i + 1}a", f"rod_{j + 1}b"))] = gap
     return out
+
+
+def _reduce_min(out: np.ndarray, pair: np.ndarray, values: np.ndarray) -> None:
+    """``out[:, k]`` = min of ``values[:, i]`` over the ``i`` with ``pair[i] == k`` (``pair`` sorted), in place."""
+    starts = np.flatnonzero(np.r_[True, pair[1:] != pair[:-1]])
+    out[:, pair[starts]] = np.minimum.reduceat(values, starts, axis=1)
 
 
 def _transform(T: np.ndarray) -> coal.Transform3s:
@@ -156,6 +163,23 @@ class DeltaPairSet:
         self._a = np.array(sides_a, dtype=int).reshape(-1, 2)
         self._b_delta = np.array([s.delta for s in sides_b], dtype=int)
         self._b_index = np.array([s.index for s in sides_b], dtype=int)
+        self._sphere_pairs()
+
+    def _sphere_pairs(self) -> None:
+        """Index arrays of every (sphere, sphere) and (sphere, geometry) a pair's lower bound looks at, by pair."""
+        offsets = np.cumsum([0] + [len(d.spheres[1]) for d in self.deltas])
+        spheres_of = [[offsets[k] + np.flatnonzero(d.spheres[2] == j) for j in range(len(d.body_names))]
+                      for k, d in enumerate(self.deltas)]
+        dd, dg = [], []   # (pair, sphere a, sphere b) and (pair, sphere a, geometry)
+        for m, (k, j) in enumerate(self._a):
+            sa = spheres_of[k][j]
+            if self._b_delta[m] < 0:
+                dg += [(m, a, self._b_index[m]) for a in sa]
+            else:
+                sb = spheres_of[self._b_delta[m]][self._b_index[m]]
+                dd += [(m, a, b) for a in sa for b in sb]
+        self._dd = np.array(dd, dtype=int).reshape(-1, 3)
+        self._dg = np.array(dg, dtype=int).reshape(-1, 3)
 
     # ---------------------------------------------------------------- batches
     def _state(self, arr: np.ndarray):
@@ -164,31 +188,24 @@ class DeltaPairSet:
         spheres, or against the other geometry's box in its own frame), for configurations ``arr (N, nq)``."""
         N = arr.shape[0]
         poses = [d.poses(d.theta(arr)) for d in self.deltas]
-        world = []   # per delta: sphere centres (N, S, 3) in the world and radii (S,)
+        centres, radii = [], []
         for d, T in zip(self.deltas, poses):
             c, r, body = d.spheres
             Tb = T[:, body]
-            world.append((np.einsum("nsij,sj->nsi", Tb[..., :3, :3], c) + Tb[..., :3, 3], r, body))
+            centres.append(np.einsum("nsij,sj->nsi", Tb[..., :3, :3], c) + Tb[..., :3, 3])
+            radii.append(r)
+        C, r = np.concatenate(centres, axis=1), np.concatenate(radii)
+        lb = np.full((N, len(self.pairs)), np.inf)
         R = p = None
-        if (self._b_delta < 0).any():
+        if len(self._dg):
             R, p = self.cell.geometry_placements(arr)
-        lb = np.empty((N, len(self.pairs)))
-        for m in range(len(self.pairs)):
-            k, j = self._a[m]
-            ca, ra, body = world[k]
-            sel = body == j
-            ca, ra = ca[:, sel], ra[sel]
-            if self._b_delta[m] < 0:
-                g = self._b_index[m]
-                local = np.einsum("nji,nsj->nsi", R[:, g], ca - p[:, g, None, :])
-                gap = np.maximum(np.maximum(self._geom_lo[g] - local, local - self._geom_hi[g]), 0.0)
-                lb[:, m] = (np.linalg.norm(gap, axis=2) - ra).min(axis=1)
-            else:
-                cb, rb, body_b = world[self._b_delta[m]]
-                sel_b = body_b == self._b_index[m]
-                cb, rb = cb[:, sel_b], rb[sel_b]
-                dist = np.linalg.norm(ca[:, :, None, :] - cb[:, None, :, :], axis=3)
-                lb[:, m] = (dist - ra[:, None] - rb[None, :]).min(axis=(1, 2))
+            m, a, g = self._dg.T
+            local = np.einsum("ngji,ngj->ngi", R[:, g], C[:, a] - p[:, g])
+            gap = np.maximum(np.maximum(self._geom_lo[g] - local, local - self._geom_hi[g]), 0.0)
+            _reduce_min(lb, m, np.linalg.norm(gap, axis=2) - r[a])
+        if len(self._dd):
+            m, a, b = self._dd.T
+            _reduce_min(lb, m, np.linalg.norm(C[:, a] - C[:, b], axis=2) - r[a] - r[b])
         return poses, R, p, lb
 
     def _distance(self, m: int, n: int, poses, R, p) -> tuple[float, np.ndarray, np.ndarray]:
@@ -228,7 +245,7 @@ class DeltaPairSet:
         for n in range(N):
             best, stop = np.inf, np.inf
             for m in np.argsort(lb[n], kind="stable"):
-                if lb[n, m] >= min(best, cutoff):
+                if lb[n, m] >= min(best, cutoff) and lb[n, m] >= 0.0:   # below 0 a pair may overlap by any depth
                     stop = lb[n, m]
                     break
                 d, xa, xb = self._distance(int(m), n, poses, R, p)
