@@ -69,15 +69,22 @@ def _spheres(shape: object) -> tuple[np.ndarray, np.ndarray]:
     return np.zeros((1, 3)), np.array([_sphere_radius(shape)])
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of (..., 3) vectors (broadcast)."""
+    a, b = np.broadcast_arrays(a, b)
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
 def _along(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
     """(..., 4, 4) poses at the middle of p0 -> p1 (..., 3) whose z axis runs along it (coal's capsules)."""
     z = p1 - p0
     z = z / np.linalg.norm(z, axis=-1, keepdims=True)
     helper = np.where((np.abs(z[..., :1]) < 0.9), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
-    x = np.cross(helper, z)
+    x = _cross(helper, z)
     x /= np.linalg.norm(x, axis=-1, keepdims=True)
     T = np.zeros(z.shape[:-1] + (4, 4))
-    T[..., :3, 0], T[..., :3, 1], T[..., :3, 2], T[..., :3, 3] = x, np.cross(z, x), z, 0.5 * (p0 + p1)
+    T[..., :3, 0], T[..., :3, 1], T[..., :3, 2], T[..., :3, 3] = x, _cross(z, x), z, 0.5 * (p0 + p1)
     T[..., 3, 3] = 1.0
     return T
 

@@ -147,25 +147,28 @@ def check_delta_pairs(cell, motions: list[ArmMotion], hold: np.ndarray, window: 
     T, D, E, K = list(times), list(value), list(exact), list(pair)
     open_ = [(a, a + 1, float(speeds[a] * (times[a + 1] - times[a])), speeds[a], 0) for a in range(len(times) - 1)]
     lower, proven_all, positive_all = np.inf, True, True
-    while open_:
-        nxt = []
+    while open_:   # level by level: the midpoints of every interval halved at a level in one batch
+        split = []
         for a, b, budget, speed, level in open_:
             bound = float(interval_bound(D[a], D[b], budget))
             ends = min(D[a], D[b])
             if bound >= required and ends > 0.0:
                 lower = min(lower, bound)
-                continue
-            if ends <= 0.0 or ends < required or level >= _SPLITS:
+            elif ends <= 0.0 or ends < required or level >= _SPLITS:
                 lower = min(lower, bound if ends > 0.0 else ends)
                 proven_all = False
                 positive_all &= bound > 0.0
-                continue
-            t_mid = 0.5 * (T[a] + T[b])
-            v, e, k, _, _ = dps.bounded(configurations(cell, motions, np.array([t_mid]), hold), screen)
-            T.append(t_mid), D.append(float(v[0])), E.append(bool(e[0])), K.append(int(k[0]))
+            else:
+                split.append((a, b, budget, speed, level))
+        if not split:
+            break
+        mids = np.array([0.5 * (T[a] + T[b]) for a, b, *_ in split])
+        v, e, k, _, _ = dps.bounded(configurations(cell, motions, mids, hold), screen)
+        open_ = []
+        for n, (a, b, budget, speed, level) in enumerate(split):
+            T.append(float(mids[n])), D.append(float(v[n])), E.append(bool(e[n])), K.append(int(k[n]))
             m = len(T) - 1
-            nxt += [(a, m, 0.5 * budget, speed, level + 1), (m, b, 0.5 * budget, speed, level + 1)]
-        open_ = nxt
+            open_ += [(a, m, 0.5 * budget, speed, level + 1), (m, b, 0.5 * budget, speed, level + 1)]
     order = np.argsort(T, kind="stable")
     T, D, E, K = (np.asarray(x)[order] for x in (T, D, E, K))
     D, E, K = _exact_minimum(cell, motions, hold, T, D, E, K)

@@ -222,10 +222,10 @@ def test_motion_through_the_bin_touches_it_first_where_dense_sampling_does(cell)
     assert not check.collision_free and check.first_contact is not None
     assert set(check.first_contact.pair.bodies) <= {"picker_tool", "picker_platform", "bin"} | {
         f"picker_rod_{i}{r}" for i in (1, 2, 3) for r in "ab"} and "bin" in check.first_contact.pair.bodies
-    t = np.linspace(0.0, 0.5, 2001)
+    t = np.linspace(0.0, 0.5, 801)
     dense = cell.with_pairs("external").clearance(cell.q_from_arms({"picker": traj.sample(t)[0]})).distance
     t_first = t[np.argmax(dense <= 0.0)]
-    assert t_first - 0.5 / 2000 <= check.first_contact.time <= t_first + 1e-6
+    assert t_first - 0.5 / 800 <= check.first_contact.time <= t_first + 1e-6
 
 
 def test_motion_above_the_bin_is_proven_clear_with_its_true_minimum(cell):
@@ -234,7 +234,7 @@ def test_motion_above_the_bin_is_proven_clear_with_its_true_minimum(cell):
     external = cell.with_pairs("external")
     check = external.check_motion({"picker": traj}, margin=0.01, clearance=0.02)
     assert check.collision_free and check.clear
-    t = np.linspace(0.0, 0.5, 2001)
+    t = np.linspace(0.0, 0.5, 801)
     dense = external.clearance(external.q_from_arms({"picker": traj.sample(t)[0]}))
     assert check.lower_bound <= dense.distance.min() <= check.min_clearance + 1e-9
     assert check.min_clearance - dense.distance.min() <= check.margin
