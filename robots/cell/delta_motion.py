@@ -22,10 +22,12 @@ it failed would contradict it). On such a step every point of
   direction turns at most at ``(L c_i + P) / l``) at ``max(L c_i, P) + ρ_rod (L c_i + P) / l``;
 - the platform and the tool (they translate; the tool turns about its own axis, which moves no
   point of its capsule) at ``P``; the base not at all.
-Their largest is the delta's bound ``v``. Two bodies approach at most at ``V = 2 max_k v_k +
-v_serial`` (two bodies of one delta or of two deltas: the two largest ``v``; a delta and a serial
-arm's link: ``v_serial``, the largest ``Σ_j max|q̇_j| ℓ_j`` of the moving serial arms,
-:func:`~.speed_bound.joint_levers`; a fixture: 0).
+Their largest is the delta's bound ``v``. Two bodies of the checked pairs approach at most at
+``V``, the largest of: ``2 v`` (two bodies of one delta, if such pairs are checked), the sum of the
+two largest ``v`` (two deltas), ``v + v_serial`` (a delta and a serial arm's link; ``v_serial`` the
+largest ``Σ_j max|q̇_j| ℓ_j`` of the moving serial arms, :func:`~.speed_bound.joint_levers`), ``v``
+(a fixture). A motion that gives its platform's speed bound (``platform_speed``: a platform path,
+:class:`~pinarms.robots.delta.path_motion.PlatformPath`) has ``P`` from it and no ``σ`` rule.
 
 The samples
 -----------
@@ -59,10 +61,12 @@ MAX_DELTA_SAMPLES = 200_000
 _SPLITS = 6
 
 
-def delta_speed(delta, theta, caps) -> tuple[np.ndarray, np.ndarray]:
+def delta_speed(delta, theta, caps, platform: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(v, h_sigma)`` (each (M,)) at motor angles ``theta (M, 3)`` [rad] with motor speed caps ``caps (3,)``
     [rad/s]: the bound of every point's speed of the delta's bodies on a step from each sample, and the
-    longest such step [s] (module doc); ``inf`` steps when the motors do not move."""
+    longest such step [s] (module doc); ``inf`` steps when the motors do not move. ``platform``: a proven
+    bound of the platform's speed [m/s] given with the motion (a platform path's): used as ``P``, no ``σ``
+    rule needed (infinite steps)."""
     g = delta.geometry
     th = np.atleast_2d(np.asarray(theta, dtype=float))
     c = np.asarray(caps, dtype=float)
@@ -73,23 +77,26 @@ def delta_speed(delta, theta, caps) -> tuple[np.ndarray, np.ndarray]:
         raise InvalidInput(f"{delta.name}: the motion reaches a parallel singularity (smallest singular value of the "
                            "rod directions 0): its speed cannot be bounded")
     big_l, small_l, cmax = g.upper_arm, g.forearm, float(c.max())
-    P = 2.0 * big_l * float(np.linalg.norm(c)) / sigma
+    P = 2.0 * big_l * float(np.linalg.norm(c)) / sigma if platform is None else np.full(sigma.size, float(platform))
     arm = (big_l + PART_RADII["upper_arm"]) * cmax
     rod = np.maximum(big_l * cmax, P) + PART_RADII["rod"] * (big_l * cmax + P) / small_l
     v = np.maximum(np.maximum(arm, rod), P)
     with np.errstate(divide="ignore"):
         h = np.where(cmax > 0.0, 0.999 * sigma * small_l / (2.0 * np.sqrt(3.0) * (P + big_l * cmax)), np.inf)
-    return v, h
+    return v, (h if platform is None else np.full(sigma.size, np.inf))
 
 
-def _caps(cell, motions: list[ArmMotion]) -> tuple[list[np.ndarray], float]:
-    """Motor speed caps (3,) of each delta (0 without a motion) and the serial arms' largest speed bound [m/s]."""
+def _caps(cell, motions: list[ArmMotion]) -> tuple[list[tuple[np.ndarray, float | None]], float]:
+    """Per delta: its motor speed caps (3,) (0 without a motion) and its platform's proven speed bound when its
+    trajectory gives one (``platform_speed``, :class:`~pinarms.robots.delta.path_motion.PlatformPath`), else None;
+    and the serial arms' largest speed bound [m/s]."""
     levers = joint_levers(cell)
     by_arm = {m.arm: peak_speed(m.trajectory, cell.arm(m.arm).nq, f"the trajectory of arm {m.arm!r}") for m in motions}
+    platform = {m.arm: getattr(m.trajectory, "platform_speed", None) for m in motions}
     caps = []
     for d in cell.deltas:
         v = by_arm.get(d.name)
-        caps.append(np.zeros(3) if v is None else v[d.motor_cols - d.q_slice.start])
+        caps.append((np.zeros(3) if v is None else v[d.motor_cols - d.q_slice.start], platform.get(d.name)))
     names = {d.name for d in cell.deltas}
     serial = [float(v @ levers[cell.arm(a).q_slice]) for a, v in by_arm.items() if a not in names]
     return caps, max(serial, default=0.0)
@@ -99,11 +106,18 @@ def _step_rule(cell, motions, hold, times: np.ndarray, caps, v_serial: float, ma
     """At each of ``times`` (M,): the approach speed bound ``V`` on a step from it [m/s] and the longest step [s]
     the rule allows there (``margin / V`` and every delta's ``σ`` step)."""
     Q = configurations(cell, motions, times, hold)
-    v, h = np.zeros(times.size), np.full(times.size, np.inf)
-    for d, c in zip(cell.deltas, caps):
-        vd, hd = delta_speed(d.delta, d.theta(Q), c)
-        v, h = np.maximum(v, vd), np.minimum(h, hd)
-    speed = 2.0 * v + v_serial
+    v = np.zeros((len(cell.deltas), times.size))
+    h = np.full(times.size, np.inf)
+    for k, (d, (c, platform)) in enumerate(zip(cell.deltas, caps)):
+        v[k], hd = delta_speed(d.delta, d.theta(Q), c, platform)
+        h = np.minimum(h, hd)
+    kinds = {p.kind for p in delta_pair_set(cell).pairs}
+    top = np.sort(np.vstack([v, np.zeros((2, times.size))]), axis=0)
+    # a delta's own bodies or two deltas: the two largest; a delta and a serial arm; a delta and a fixture
+    speed = np.maximum.reduce([top[-1] + top[-2] if "self" in kinds or len(cell.deltas) > 1 else top[-1],
+                               top[-1] + (v_serial if "arm-arm" in kinds else 0.0), top[-1]])
+    if "self" in kinds:
+        speed = np.maximum(speed, 2.0 * top[-1])
     with np.errstate(divide="ignore"):
         return speed, np.minimum(h, np.where(speed > 0.0, margin / speed, np.inf))
 
