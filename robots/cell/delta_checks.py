@@ -35,8 +35,7 @@ def in_collision(cell: Any, q: Any, *, margin: float = 0.0, threads: int = 1) ->
     hit = np.atleast_1d(np.array(tree, dtype=bool)).copy()
     rows = np.flatnonzero(~hit)
     if rows.size:
-        touching = delta_pair_set(cell).touching(arr[rows], float(margin))
-        hit[rows] = [bool(t) for t in touching]
+        hit[rows] = delta_pair_set(cell).any_touching(arr[rows], float(margin))
     return bool(hit[0]) if single else hit
 
 

@@ -266,6 +266,21 @@ class DeltaPairSet:
         return [tuple(int(m) for m in np.flatnonzero(lb[n] <= margin)
                       if self._distance(int(m), n, poses, R, p)[0] <= margin) for n in range(arr.shape[0])]
 
+    def any_touching(self, arr: np.ndarray, margin: float) -> np.ndarray:
+        """``(N,)`` bool: some pair of :attr:`pairs` at distance ≤ ``margin`` [m] (pairs by increasing bound, the
+        first contact ends a configuration)."""
+        out = np.zeros(arr.shape[0], dtype=bool)
+        if not self.pairs or not arr.shape[0]:
+            return out
+        poses, R, p, lb = self._state(arr)
+        for n in range(arr.shape[0]):
+            near = np.flatnonzero(lb[n] <= margin)
+            for m in near[np.argsort(lb[n, near], kind="stable")]:
+                if self._distance(int(m), n, poses, R, p)[0] <= margin:
+                    out[n] = True
+                    break
+        return out
+
     def distances(self, arr: np.ndarray) -> np.ndarray:
         """``(N, P)`` coal's exact distance [m] of every pair at every configuration of ``arr (N, nq)``."""
         poses, R, p, lb = self._state(arr)
