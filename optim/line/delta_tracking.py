@@ -36,7 +36,7 @@ from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.standard_cycle import JointPathRows, delta_path_rows, time_rows
 from pinarms.robots.delta import DeltaRobot, forward_position, inverse_position
 
-__all__ = ["DeltaArm", "delta_pick_times", "platform_move_time", "hermite_points", "tool_turn_time",
+__all__ = ["DeltaArm", "delta_pick_times", "platform_move_time", "platform_move_timing", "hermite_points", "tool_turn_time",
            "TOOL_ACCELERATION_FACTOR", "TRACK_SAMPLES"]
 
 #: Acceleration limit of the fourth axis: this many times its speed limit [1/s] (assumed).
@@ -101,10 +101,11 @@ def hermite_points(p0: np.ndarray, p1: np.ndarray, m0: np.ndarray, m1: np.ndarra
     return points
 
 
-def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_dir: np.ndarray, speed: float,
-                       onto: bool, mass: float, n: int) -> float:
-    """Time [s] of the platform's move ``start`` → ``end`` (base frame), onto the belt (arriving with
-    it) or off it (leaving with it), rest at the box end."""
+def platform_move_timing(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_dir: np.ndarray, speed: float,
+                         onto: bool, mass: float, n: int):
+    """The time-optimal profile (:class:`~pinarms.optim.standard_cycle.GateTiming`, along the arc parameter
+    ``s`` ∈ [0, length]), the path ``points(s)`` and ``length`` [m] of the platform's move ``start`` → ``end``
+    (base frame), onto the belt (arriving with it) or off it (leaving with it), rest at the box end."""
     chord = end - start
     length = float(np.linalg.norm(chord))
     if length < 1e-6:
@@ -120,7 +121,14 @@ def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_d
         raise InfeasibleProblem(f"{arm.name}: the move leaves the motors' range or the workspace")
     rows = JointPathRows(s, *delta_path_rows(delta, s, points))
     ends = {"sd_end": speed} if onto else {"sd_start": speed}
-    return float(time_rows(rows, lim.velocity, lim.acceleration, lim.torque, **ends).duration)
+    return time_rows(rows, lim.velocity, lim.acceleration, lim.torque, **ends), points, length
+
+
+def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_dir: np.ndarray, speed: float,
+                       onto: bool, mass: float, n: int) -> float:
+    """Time [s] of the platform's move ``start`` → ``end`` (base frame), onto the belt (arriving with
+    it) or off it (leaving with it), rest at the box end (:func:`platform_move_timing`)."""
+    return float(platform_move_timing(arm, start, end, belt_dir, speed, onto, mass, n)[0].duration)
 
 
 def _check_tracking(arm: DeltaArm, pre: np.ndarray, velocity: np.ndarray, spec: TrackingSpec) -> None:

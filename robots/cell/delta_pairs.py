@@ -8,10 +8,11 @@ these reasons:
 ``adjacent``
     two bodies of one delta joined at a joint by design: the base and each upper arm (the
     motor), each upper arm and its two rods (the upper ball joints), each rod and the platform
-    (the lower ball joints), the platform and the tool; and, with a note, the two rods of neighbouring legs whose lower ball centres on the platform
-    are closer than two rod radii (:func:`meeting_rods`; in the shipped FlexPicker, Williams'
-    platform triangle puts them 10.5 mm apart, the rods are 16 mm thick): the platform rigidly
-    holds both ends, so their capsules overlap there in every configuration, by design;
+    (the lower ball joints), the platform and the tool; and, with a note, the two rods of
+    neighbouring legs whose lower ball centres on the platform are closer than two rod radii
+    (:func:`meeting_rods`; in the shipped FlexPicker, Williams' platform triangle puts them
+    10.5 mm apart, the rods are 16 mm thick): the platform rigidly holds both ends, so their
+    capsules overlap there in every configuration, by design;
 ``rigid``
     the delta's base housing and a geometry that does not move either (a fixture, a serial
     arm's fixed base parts, another delta's base): their distance never changes.
@@ -30,7 +31,8 @@ cover the delta's bodies (:attr:`~.delta_arm.CellDelta.spheres`) against the oth
 or the other geometry's own bounding box (in its frame), and coal's exact distance is computed in
 increasing order of that bound until the next bound exceeds the smallest distance found
 (clearance) or the margin (contacts), and is not negative (two bodies whose bounds overlap may
-overlap by any depth: coal's signed distance is computed for each). The result is the exact minimum over every checked pair.
+overlap by any depth: coal's signed distance is computed for each). The result is the exact
+minimum over every checked pair.
 """
 
 from __future__ import annotations
