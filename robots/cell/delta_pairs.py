@@ -184,12 +184,40 @@ class DeltaPairSet:
         self._dg = np.array(dg, dtype=int).reshape(-1, 3)
 
     # ---------------------------------------------------------------- batches
-    def _state(self, arr: np.ndarray):
+    def _state(self, arr: np.ndarray, threshold: float = np.inf):
         """World poses of every delta's bodies (per delta (N, B, 4, 4)), the cell geometries' placements and a
-        lower bound (N, P) of every pair's distance (the bodies' covering spheres against the other body's
-        spheres, or against the other geometry's box in its own frame), for configurations ``arr (N, nq)``."""
+        lower bound (N, P) of every pair's distance, for configurations ``arr (N, nq)``: each body's bounding
+        sphere against the other's (or the other geometry's box, in its frame); for the pairs where that is
+        below ``threshold`` somewhere, the spheres covering the bodies (:attr:`~.delta_arm.CellDelta.spheres`)."""
         N = arr.shape[0]
         poses = [d.poses(d.theta(arr)) for d in self.deltas]
+        body_c = np.concatenate([T[..., :3, 3] for T in poses], axis=1)             # (N, all bodies, 3)
+        body_r = np.concatenate([d.radii for d in self.deltas])
+        first = np.cumsum([0] + [len(d.body_names) for d in self.deltas])
+        ia = first[self._a[:, 0]] + self._a[:, 1]
+        geo = self._b_delta < 0
+        R = p = None
+        lb = np.empty((N, len(self.pairs)))
+        if geo.any():
+            R, p = self.cell.geometry_placements(arr)
+            g = self._b_index[geo]
+            lb[:, geo] = self._box_gap(R[:, g], p[:, g], body_c[:, ia[geo]], g) - body_r[ia[geo]]
+        if (~geo).any():
+            ib = first[np.maximum(self._b_delta[~geo], 0)] + self._b_index[~geo]
+            lb[:, ~geo] = np.linalg.norm(body_c[:, ia[~geo]] - body_c[:, ib], axis=2) - body_r[ia[~geo]] - body_r[ib]
+        fine = np.flatnonzero((lb < threshold).any(axis=0))
+        if fine.size:
+            self._fine_bounds(lb, fine, poses, R, p)
+        return poses, R, p, lb
+
+    def _box_gap(self, R: np.ndarray, p: np.ndarray, centres: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """Distance from ``centres (N, K, 3)`` to geometry ``g (K,)``'s own bounding box, placed at ``R, p (N, K, ...)``."""
+        local = np.einsum("nkji,nkj->nki", R, centres - p)
+        gap = np.maximum(np.maximum(self._geom_lo[g] - local, local - self._geom_hi[g]), 0.0)
+        return np.linalg.norm(gap, axis=2)
+
+    def _fine_bounds(self, lb: np.ndarray, pairs: np.ndarray, poses, R, p) -> None:
+        """Raise ``lb`` of ``pairs`` to the covering spheres' bound (in place)."""
         centres, radii = [], []
         for d, T in zip(self.deltas, poses):
             c, r, body = d.spheres
@@ -197,18 +225,18 @@ class DeltaPairSet:
             centres.append(np.einsum("nsij,sj->nsi", Tb[..., :3, :3], c) + Tb[..., :3, 3])
             radii.append(r)
         C, r = np.concatenate(centres, axis=1), np.concatenate(radii)
-        lb = np.full((N, len(self.pairs)), np.inf)
-        R = p = None
-        if len(self._dg):
-            R, p = self.cell.geometry_placements(arr)
-            m, a, g = self._dg.T
-            local = np.einsum("ngji,ngj->ngi", R[:, g], C[:, a] - p[:, g])
-            gap = np.maximum(np.maximum(self._geom_lo[g] - local, local - self._geom_hi[g]), 0.0)
-            _reduce_min(lb, m, np.linalg.norm(gap, axis=2) - r[a])
-        if len(self._dd):
-            m, a, b = self._dd.T
-            _reduce_min(lb, m, np.linalg.norm(C[:, a] - C[:, b], axis=2) - r[a] - r[b])
-        return poses, R, p, lb
+        wanted = np.zeros(len(self.pairs), dtype=bool)
+        wanted[pairs] = True
+        fine = np.full_like(lb, -np.inf)
+        dg = self._dg[wanted[self._dg[:, 0]]] if len(self._dg) else self._dg
+        if len(dg):
+            m, a, g = dg.T
+            _reduce_min(fine, m, self._box_gap(R[:, g], p[:, g], C[:, a], g) - r[a])
+        dd = self._dd[wanted[self._dd[:, 0]]] if len(self._dd) else self._dd
+        if len(dd):
+            m, a, b = dd.T
+            _reduce_min(fine, m, np.linalg.norm(C[:, a] - C[:, b], axis=2) - r[a] - r[b])
+        np.maximum(lb, fine, out=lb)
 
     def _distance(self, m: int, n: int, poses, R, p) -> tuple[float, np.ndarray, np.ndarray]:
         """coal's exact distance of pair ``m`` at configuration ``n`` and its nearest points (world)."""
@@ -243,7 +271,7 @@ class DeltaPairSet:
         pa, pb = np.full((N, 3), np.nan), np.full((N, 3), np.nan)
         if not self.pairs or not N:
             return dist, exact, pair, pa, pb
-        poses, R, p, lb = self._state(arr)
+        poses, R, p, lb = self._state(arr, cutoff)
         for n in range(N):
             best, stop = np.inf, np.inf
             for m in np.argsort(lb[n], kind="stable"):
@@ -264,7 +292,7 @@ class DeltaPairSet:
         """Per configuration of ``arr (N, nq)``, the indices of :attr:`pairs` at distance ≤ ``margin`` [m]."""
         if not self.pairs or not arr.shape[0]:
             return [()] * arr.shape[0]
-        poses, R, p, lb = self._state(arr)
+        poses, R, p, lb = self._state(arr, margin)
         return [tuple(int(m) for m in np.flatnonzero(lb[n] <= margin)
                       if self._distance(int(m), n, poses, R, p)[0] <= margin) for n in range(arr.shape[0])]
 
@@ -274,7 +302,7 @@ class DeltaPairSet:
         out = np.zeros(arr.shape[0], dtype=bool)
         if not self.pairs or not arr.shape[0]:
             return out
-        poses, R, p, lb = self._state(arr)
+        poses, R, p, lb = self._state(arr, margin)
         for n in range(arr.shape[0]):
             near = np.flatnonzero(lb[n] <= margin)
             for m in near[np.argsort(lb[n, near], kind="stable")]:
