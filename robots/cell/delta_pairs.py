@@ -28,7 +28,8 @@ Distances (:class:`DeltaPairSet`): per configuration, every delta's bodies are p
 closed form, the cell's geometries by the cell's batched forward kinematics
 (:meth:`Cell.geometry_placements`); a pair's distance is bounded from below by the spheres that
 cover the delta's bodies (:attr:`~.delta_arm.CellDelta.spheres`) against the other body's spheres
-or the other geometry's own bounding box (in its frame), and coal's exact distance is computed in
+or the other geometry's own bounding box (in its frame), two capsules by their axes' exact distance
+(:func:`segment_distance`) less their radii, and coal's exact distance is computed in
 increasing order of that bound until the next bound exceeds the smallest distance found
 (clearance) or the margin (contacts), and is not negative (two bodies whose bounds overlap may
 overlap by any depth: coal's signed distance is computed for each). The result is the exact
@@ -48,7 +49,7 @@ from pinarms.robots.cell.pairs import CollisionPair
 from pinarms.robots.delta.collision import PART_RADII
 from pinarms.robots.pair_rules import AllowedPair, PairReason
 
-__all__ = ["DeltaPairSet", "delta_pair_set", "adjacent_bodies", "meeting_rods"]
+__all__ = ["DeltaPairSet", "delta_pair_set", "adjacent_bodies", "meeting_rods", "segment_distance"]
 
 
 def adjacent_bodies(has_tool: bool) -> frozenset[frozenset[str]]:
@@ -78,6 +79,22 @@ def meeting_rods(delta: CellDelta) -> dict[frozenset[str], float]:
         if gap < 2.0 * PART_RADII["rod"]:
             out[frozenset((f"rod_{i + 1}a", f"rod_{j + 1}b"))] = gap
     return out
+
+
+def segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Distance between the segments ``p1 q1`` and ``p2 q2`` (each (..., 3), of nonzero length), exact: the
+    closest parameters of the two lines, each clamped to its segment and the other recomputed (Ericson,
+    *Real-Time Collision Detection*, 5.1.9)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e = np.einsum("...i,...i", d1, d1), np.einsum("...i,...i", d2, d2)
+    b, c, f = np.einsum("...i,...i", d1, d2), np.einsum("...i,...i", d1, r), np.einsum("...i,...i", d2, r)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > 1e-12 * a * e, np.clip((b * f - c * e) / denom, 0.0, 1.0), 0.0)
+        t = (b * s + f) / e
+        s = np.where(t < 0.0, np.clip(-c / a, 0.0, 1.0), np.where(t > 1.0, np.clip((b - c) / a, 0.0, 1.0), s))
+        t = np.clip(t, 0.0, 1.0)
+    return np.linalg.norm(p1 + d1 * s[..., None] - p2 - d2 * t[..., None], axis=-1)
 
 
 def _reduce_min(out: np.ndarray, pair: np.ndarray, values: np.ndarray) -> None:
@@ -172,16 +189,24 @@ class DeltaPairSet:
         offsets = np.cumsum([0] + [len(d.spheres[1]) for d in self.deltas])
         spheres_of = [[offsets[k] + np.flatnonzero(d.spheres[2] == j) for j in range(len(d.body_names))]
                       for k, d in enumerate(self.deltas)]
-        dd, dg = [], []   # (pair, sphere a, sphere b) and (pair, sphere a, geometry)
+        first = np.cumsum([0] + [len(d.body_names) for d in self.deltas])
+        capsule = np.concatenate([[isinstance(s, coal.Capsule) for s in d.shapes] for d in self.deltas])
+        dd, dg, cc = [], [], []   # (pair, sphere a, sphere b), (pair, sphere a, geometry), (pair, body a, body b)
         for m, (k, j) in enumerate(self._a):
             sa = spheres_of[k][j]
             if self._b_delta[m] < 0:
                 dg += [(m, a, self._b_index[m]) for a in sa]
+                continue
+            ba, bb = first[k] + j, first[self._b_delta[m]] + self._b_index[m]
+            if capsule[ba] and capsule[bb]:   # two capsules: their axes' exact distance less the radii
+                cc.append((m, ba, bb))
             else:
                 sb = spheres_of[self._b_delta[m]][self._b_index[m]]
                 dd += [(m, a, b) for a in sa for b in sb]
         self._dd = np.array(dd, dtype=int).reshape(-1, 3)
         self._dg = np.array(dg, dtype=int).reshape(-1, 3)
+        self._cc = np.array(cc, dtype=int).reshape(-1, 3)
+        self._capsule = capsule
 
     # ---------------------------------------------------------------- batches
     def _state(self, arr: np.ndarray, threshold: float = np.inf):
@@ -236,6 +261,16 @@ class DeltaPairSet:
         if len(dd):
             m, a, b = dd.T
             _reduce_min(fine, m, np.linalg.norm(C[:, a] - C[:, b], axis=2) - r[a] - r[b])
+        cc = self._cc[wanted[self._cc[:, 0]]] if len(self._cc) else self._cc
+        if len(cc):
+            T = np.concatenate(poses, axis=1)
+            shapes = [s for d in self.deltas for s in d.shapes]
+            half = np.array([s.halfLength if isinstance(s, coal.Capsule) else 0.0 for s in shapes])
+            rad = np.array([s.radius if isinstance(s, coal.Capsule) else 0.0 for s in shapes])
+            m, a, b = cc.T
+            ends = lambda k: (T[:, k][..., :3, 3] - half[k][None, :, None] * T[:, k][..., :3, 2],  # noqa: E731
+                              T[:, k][..., :3, 3] + half[k][None, :, None] * T[:, k][..., :3, 2])
+            fine[:, m] = segment_distance(*ends(a), *ends(b)) - rad[a] - rad[b]
         np.maximum(lb, fine, out=lb)
 
     def _distance(self, m: int, n: int, poses, R, p) -> tuple[float, np.ndarray, np.ndarray]:
