@@ -83,3 +83,39 @@ def test_station_must_be_a_delta_of_the_cell(setting):
     line, station, cells, _, _ = setting
     with pytest.raises(InvalidInput, match="not an arm"):
         build_delta_map(replace(station, name="other"), line.belt, line.tracking, cell=cells["clear"], nu=2, nw=2)
+
+
+@pytest.fixture(scope="module")
+def two_deltas(tmp_path_factory):
+    from pinarms.optim.line import Station
+    from pinarms.optim.line.neighbours import NeighbourGuard
+
+    line = delta_line(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0)
+    st = [Station(f"delta{k + 1}", s.robot, s.base_to_world, s.place) for k, s in enumerate(line.stations)]
+    text = 'name = "two_deltas"\n' + "".join(f'[[arm]]\nname = "{s.name}"\ndelta = "delta_flexpicker"\n'
+                                              f'xyz = {[float(v) for v in s.base_to_world[:3, 3]]}\n' for s in st)
+    folder = tmp_path_factory.mktemp("two_deltas")
+    (folder / "cell.toml").write_text(text, encoding="utf-8")
+    cell = load_cell(folder / "cell.toml")
+    guard = NeighbourGuard(cell, st, line.belt, line.tracking, (ENOKI,), clearance=0.01, margin=0.05)
+    mid = float(line.belt.to_belt((st[0].base_to_world[:3, 3] + st[1].base_to_world[:3, 3]) / 2)[0])
+    return cell, guard, mid
+
+
+def test_neighbour_guard_refuses_two_deltas_at_one_spot_and_passes_them_apart(two_deltas):
+    from pinarms.robots.cell import ArmMotion
+
+    cell, guard, mid = two_deltas
+    a = ("delta1", 0, 0.0, 2.0, mid, 0.05, 0)
+    b = ("delta2", 1, 0.0, 2.0, mid + 0.05, -0.05, 0)
+    assert guard(a, b) is False
+    apart = ("delta1", 2, 0.0, 2.0, mid - 0.7, 0.0, 0), ("delta2", 3, 0.0, 2.0, mid + 0.7, 0.0, 0)
+    assert guard(*apart) is True
+    # independently: the two picks on the clock, sampled densely, come closer than the clearance
+    pa, pb = guard._plan(a), guard._plan(b)
+    motions = [ArmMotion("delta1", pa.trajectory, 2.0 - pa.times[0]), ArmMotion("delta2", pb.trajectory, 2.0 - pb.times[0])]
+    t = np.linspace(2.0 - pa.times[0], 2.0 + pa.times[1], 201)
+    from pinarms.robots.cell.timeline import configurations
+
+    Q = configurations(cell, motions, t, cell.hold)
+    assert cell.with_pairs("arm-arm").clearance(Q).distance.min() < 0.01
