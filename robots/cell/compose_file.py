@@ -242,7 +242,9 @@ def _tool_point(value: Any, where: str) -> ToolPoint:
 def _arm_of(table: Any, where: str) -> ArmPlacement:
     """One ``[[arm]]`` table: name, urdf, pose, and the optional tcp, freeze, states and hold."""
     _keys(table, _ARM_KEYS, {"name"}, where)
-    if ("urdf" in table) == ("delta" in table):
+    if "urdf" not in table and "delta" not in table:
+        raise CellError(f"{where}: missing key(s) urdf (a serial arm's file), or delta (a shipped delta's name)")
+    if "urdf" in table and "delta" in table:
         raise CellError(f"{where}: give exactly one of urdf (a serial arm's file) or delta (a shipped delta's name)")
     if "delta" in table:
         extra = sorted({"tcp", "freeze"} & set(table))
