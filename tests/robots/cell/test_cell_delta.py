@@ -277,3 +277,12 @@ def test_cli_show_and_check_name_the_delta_and_the_fixture(cell, tmp_path):
     assert shown.exit_code == 0 and "delta delta_flexpicker" in shown.output
     checked = CliRunner().invoke(cli, ["cell", "check", cell.source, "--q", q])
     assert checked.exit_code == 0 and "picker_tool – bin" in checked.output
+
+
+def test_cell_export_refuses_a_delta_it_would_lose(cell, tmp_path):
+    from pinarms.errors import InvalidInput
+    from pinarms.export.cell import export_cell
+
+    with pytest.raises(InvalidInput, match="holds a delta"):
+        export_cell(cell, tmp_path / "out", mjcf=False)
+    assert not (tmp_path / "out").exists()
