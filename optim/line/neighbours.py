@@ -12,8 +12,8 @@ the map interpolates feasibility) is not proven clear: the guard says no.
 
 A delta station (:class:`~.delta_tracking.DeltaArm`, a delta of the cell: docs/cells.md) has its pick on
 the clock from :func:`~.delta_pick_path.delta_pick_plan` (its platform path along the time-optimal
-profiles, a proven speed bound); a pair with a delta goes through the cell's exact check alone (the
-compiled cover knows only the tree's geometry, not the delta's bodies).
+profiles, a proven speed bound); in a cell with a delta every pair goes through the cell's exact check
+alone (the compiled cover knows only the tree's geometry, not the delta's bodies).
 """
 
 from __future__ import annotations
@@ -112,7 +112,7 @@ class NeighbourGuard:
             return True
         motions = [ArmMotion(pick.arm, a.trajectory, off_a), ArmMotion(other.arm, b.trajectory, off_b)]
         self.checks += 1
-        if not self.fast or any(isinstance(self.stations[n].robot, DeltaArm) for n in (pick.arm, other.arm)):
+        if not self.fast or self.cell.deltas:   # the compiled cover sees only the tree, not a delta's bodies
             res = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance, window=(t0, t1))
             return bool(res.clear if self.clearance > 0 else res.collision_free)
         key = (pick.arm, other.arm)

@@ -286,3 +286,12 @@ def test_cell_export_refuses_a_delta_it_would_lose(cell, tmp_path):
     with pytest.raises(InvalidInput, match="holds a delta"):
         export_cell(cell, tmp_path / "out", mjcf=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_motion_checker_refuses_what_it_cannot_see(cell):
+    from pinarms.errors import InvalidInput
+    from pinarms.optim.motion import MotionChecker
+
+    for arms in (["picker"], ["scara"]):   # the delta itself; a serial arm a delta's body may touch
+        with pytest.raises(InvalidInput, match="holds a delta"):
+            MotionChecker(cell, arms)
