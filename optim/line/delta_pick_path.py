@@ -13,7 +13,7 @@ the tool lies on its axis). :meth:`pinarms.robots.cell.Cell.check_motion` of tha
 pick's fixture verdict (:func:`~.delta_maps.build_delta_map` with a cell).
 
 :func:`delta_pick_plan` is the same pick on the clock (approach and leave along their time-optimal
-profiles, :func:`~.delta_tracking.platform_move_timing`, the tracking segment in its own time, the
+profiles, :func:`~.delta_tracking.platform_move_profile`, the tracking segment in its own time, the
 release held at the box), what the neighbour guard places beside another arm's pick: its platform's
 speed bound is the path's largest ``|dp/ds|`` (exact, :func:`tangent_bound`) times the profile's
 largest path speed (``ṡ`` is linear in time between the profile's grid points, so its largest value
@@ -27,7 +27,7 @@ import numpy as np
 from dataclasses import dataclass
 
 from pinarms.optim.line.belt import Belt
-from pinarms.optim.line.delta_tracking import platform_move_timing
+from pinarms.optim.line.delta_tracking import platform_move_profile
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.robots.delta.path_motion import PlatformPath, tangent_bound
@@ -137,8 +137,10 @@ def delta_pick_plan(station: Station, belt: Belt, spec: TrackingSpec, u: float, 
     box = station.world_to_base(station.place.position) - arm.tcp_offset
     d = R.T @ belt.direction
     end = pre + velocity * spec.track_time
-    approach, t_a, v_a = _profile(*platform_move_timing(arm, box, pre, d, belt.speed, True, 0.0, n))
-    leave, t_c, v_c = _profile(*platform_move_timing(arm, end, box, d, belt.speed, False, mass, n))
+    approach, t_a, v_a = _profile(*platform_move_profile(arm, box, pre, d, belt.speed, True, 0.0, n),
+                                  float(np.linalg.norm(pre - box)))
+    leave, t_c, v_c = _profile(*platform_move_profile(arm, end, box, d, belt.speed, False, mass, n),
+                               float(np.linalg.norm(box - end)))
     g_a = v_a * _hermite(box, pre, pre - box, float(np.linalg.norm(pre - box)) * d)[1] / float(np.linalg.norm(pre - box))
     g_c = v_c * _hermite(end, box, float(np.linalg.norm(box - end)) * d, box - end)[1] / float(np.linalg.norm(box - end))
     T, z = spec.track_time, np.array([0.0, 0.0, 1.0])
