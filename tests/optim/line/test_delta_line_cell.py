@@ -7,6 +7,7 @@ import pytest
 
 from pinarms.errors import InvalidInput
 from pinarms.optim.line.delta_maps import build_delta_map
+from pinarms.optim.line.map_request import DeltaMapRequest
 from pinarms.optim.line.delta_pick_path import delta_pick_path
 from pinarms.robots.cell import load_cell
 from pinarms.robots.delta import forward_position
@@ -37,7 +38,7 @@ def setting(tmp_path_factory):
     line = delta_line(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0)
     station = replace(line.stations[0], name="delta1")
     kw = dict(mass=ENOKI.mass, item_height=ENOKI.size[2], nu=3, nw=2, n=12)   # the middle row feasible
-    plain = build_delta_map(station, line.belt, line.tracking, **kw)
+    plain = build_delta_map(DeltaMapRequest(station, line.belt, line.tracking, **kw)).task_map
     # a small post where the tool passes on the approach to node (1, 0), or far from every path
     u0 = float(line.belt.to_belt(station.base_to_world[:3, 3])[0])
     path = delta_pick_path(station, line.belt, line.tracking, u0 + plain.du[1], plain.w[0], item_height=ENOKI.size[2])
@@ -49,7 +50,9 @@ def setting(tmp_path_factory):
         folder = tmp_path_factory.mktemp(name)
         (folder / "cell.toml").write_text(CELL.format(x=xyz[0], y=xyz[1], z=xyz[2]), encoding="utf-8")
         cells[name] = load_cell(folder / "cell.toml")
-        maps[name] = build_delta_map(station, line.belt, line.tracking, cell=cells[name], **kw)
+        result = build_delta_map(DeltaMapRequest(station, line.belt, line.tracking, cell=cells[name], **kw))
+        assert result.blocked == result.task_map.fixture_infeasible
+        maps[name] = result.task_map
     return line, station, cells, maps, path
 
 
@@ -82,7 +85,8 @@ def test_pick_path_runs_box_to_belt_to_box_and_meets_the_post(setting):
 def test_station_must_be_a_delta_of_the_cell(setting):
     line, station, cells, _, _ = setting
     with pytest.raises(InvalidInput, match="not an arm"):
-        build_delta_map(replace(station, name="other"), line.belt, line.tracking, cell=cells["clear"], nu=2, nw=2)
+        build_delta_map(DeltaMapRequest(replace(station, name="other"), line.belt, line.tracking, cell=cells["clear"],
+                                        nu=2, nw=2))
 
 
 @pytest.fixture(scope="module")
