@@ -94,6 +94,19 @@ class TimedArm:
 
 
 
+def _refuse_delta_pairs(cell: Cell, arms: tuple[str, ...]) -> None:
+    """InvalidInput when the checker would miss a pair with a delta's body (docs/cells.md, "A delta robot in a
+    cell"): its bodies are not in the tree this checker proves on, so a planned arm that is a delta, or one that
+    a delta's body may touch, is refused rather than proven against part of the cell."""
+    deltas = getattr(cell, "deltas", ())
+    if not deltas:
+        return
+    if any(d.name in arms for d in deltas) or any({p.owner_a, p.owner_b} & set(arms) for p in cell.delta_pairs):
+        raise InvalidInput(f"cell {cell.name!r} holds a delta ({', '.join(d.name for d in deltas)}) whose bodies "
+                           f"the motion checker of {', '.join(arms)} cannot see: check the motion with "
+                           "Cell.check_motion (planning beside or for a delta is not supported)")
+
+
 class MotionChecker(CoalBatches, LadderProof):
     """State, edge and path validity of the planned arms of ``cell`` (module docstring).
 
@@ -129,6 +142,7 @@ class MotionChecker(CoalBatches, LadderProof):
         if not names or len(set(names)) != len(names):
             raise InvalidInput(f"arms must name distinct arms of the cell, got {arms!r}")
         self.arms = tuple(cell.arm(a).name for a in names)
+        _refuse_delta_pairs(cell, self.arms)
         for name, value in (("margin", margin), ("self_margin", self_margin)):
             ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
             if not ok or not math.isfinite(float(value)) or float(value) < 0.0:

@@ -124,6 +124,18 @@ class Cell:
         by_name = {p.name: p for p in self.arm_placements}
         arms = tuple(arm_with_keys(a, by_name.get(a.name), source) for a in arms)
         self.arms = tuple(sorted(arms, key=lambda a: a.q_slice.start))
+        from pinarms.robots.cell.delta_arm import cell_deltas
+
+        #: The deltas among the arms (:class:`~.delta_arm.CellDelta`): bodies from the closed form, pairs in
+        #: :attr:`delta_pairs`; empty for a cell of serial arms only.
+        self.deltas = cell_deltas(self.arms, self.arm_placements)
+        if self.deltas:
+            from dataclasses import replace
+
+            tcp_text = ("the platform's tcp (closed form; CellDelta.tcp_to_world): the cell's tree holds the delta's "
+                        "motors only")
+            names = {d.name for d in self.deltas}
+            self.arms = tuple(replace(a, tcp_choice=tcp_text) if a.name in names else a for a in self.arms)
         self._hold = self.robot.neutral.copy()
         for a in self.arms:
             self._hold[a.q_slice] = a.hold
@@ -185,6 +197,21 @@ class Cell:
         return link_cover(self)
 
     # ------------------------------------------------------------------ pairs
+    @property
+    def delta_pairs(self) -> tuple:
+        """The checked pairs with a delta's body (:mod:`.delta_pairs`; empty without deltas): checked with
+        :attr:`pairs` by every check, listed after them in its results."""
+        from pinarms.robots.cell.delta_pairs import delta_pair_set
+
+        return delta_pair_set(self).pairs if self.deltas else ()
+
+    @property
+    def delta_allowed(self) -> tuple:
+        """The pairs with a delta's body not checked, each with its reason (``adjacent``, ``rigid``)."""
+        from pinarms.robots.cell.delta_pairs import delta_pair_set
+
+        return delta_pair_set(self).allowed if self.deltas else ()
+
     def pair_count(self, clearance: float, *, strict: bool = False) -> int:
         """How many of :attr:`candidates` a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it).
 
@@ -423,15 +450,15 @@ class Cell:
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
-        from pinarms.robots.cell.collision import in_collision
+        from pinarms.robots.cell import collision, delta_checks
 
-        return in_collision(self, q, margin=margin, threads=threads)
+        return (delta_checks if self.deltas else collision).in_collision(self, q, margin=margin, threads=threads)
 
     def collisions(self, q: ArrayLike, *, margin: float = 0.0):
         """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
-        from pinarms.robots.cell.collision import collisions
+        from pinarms.robots.cell import collision, delta_checks
 
-        return collisions(self, q, margin=margin)
+        return (delta_checks if self.deltas else collision).collisions(self, q, margin=margin)
 
     def clearance(self, q: ArrayLike, *, margin: float = 0.0):
         """Smallest signed distance [m] over every pair not allowed by design, and the pair: a :class:`~.collision.Clearance`.
@@ -439,15 +466,15 @@ class Cell:
         The checked pairs and every out-of-reach pair whose bound is below the smallest
         distance found: the true minimum over all pairs but those allowed by design.
         """
-        from pinarms.robots.cell.collision import clearance
+        from pinarms.robots.cell import collision, delta_checks
 
-        return clearance(self, q, margin=margin)
+        return (delta_checks if self.deltas else collision).clearance(self, q, margin=margin)
 
     def check_motion(self, motions: Any, *, margin: float = 0.01, **kwargs):
         """Check the arms' trajectories together, continuously in time: a :class:`~.motion.MotionCheck`.
 
         See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
         """
-        from pinarms.robots.cell.motion import check_motion
+        from pinarms.robots.cell import delta_checks, motion
 
-        return check_motion(self, motions, margin=margin, **kwargs)
+        return (delta_checks if self.deltas else motion).check_motion(self, motions, margin=margin, **kwargs)
