@@ -5,7 +5,8 @@ from __future__ import annotations
 import sys
 import time
 from collections import Counter
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import click
 import numpy as np
@@ -15,6 +16,7 @@ from pinarms.errors import InvalidInput
 from pinarms.cli._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
                       skipped_pair_lines)
 from pinarms.cli.motion_commands import hold_option
+from pinarms.cli.option_groups import JSON_FLAG, Flag, flag, option_group
 
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."
@@ -191,31 +193,61 @@ def _closest_arms(check: Any, k: float, lu: str) -> str:
             f" proven never closer than {check.lower_bound / k:.4g} {lu})")
 
 
+@dataclass(frozen=True)
+class CellCycleFlags:
+    """How the cells' cycles are planned: starting ``lift`` and ``clearance`` kept, the continuous checks'
+    ``margin`` (``None``: 0.05 m, 0.02 m, 0.005 m; user lengths), the gripper's ``dwell`` [s] and the time
+    offsets scanned per arm (``n_offsets``)."""
+
+    lift: float | None = None
+    dwell: float = 0.2
+    clearance: float | None = None
+    margin: float | None = None
+    n_offsets: int = 24
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--lift", default=None, type=float, help="Starting lift [default 0.05 m, 50 mm]."),
+        flag("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and place [s]."),
+        flag("--clearance", default=None, type=float,
+             help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm]."),
+        flag("--margin", default=None, type=float, help="Resolution of the continuous checks [default 0.005 m, 5 mm]."),
+        flag("--offsets", "n_offsets", default=24, show_default=True, type=int,
+             help="Time offsets scanned per arm (two or more arms)."),
+    )
+
+
+@dataclass(frozen=True)
+class CellCycleOutput:
+    """What ``cell cycle`` writes besides its text: a session, the clearance and schedule plots, JSON."""
+
+    session_path: str | None = None
+    plot_clearance: str | None = None
+    plot_schedule: str | None = None
+    as_json: bool = False
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+             help="Save the cell with all arms' cycles (animated together) into a session file."),
+        flag("--plot-clearance", "plot_clearance", default=None, type=click.Path(dir_okay=False),
+             help="Plot the clearance over time (.png or .svg)."),
+        flag("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
+             help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms)."),
+        JSON_FLAG,
+    )
+
+
 @cell_group.command("cycle", context_settings=NUMBERS)
 @_cell_options
 @click.option("--task", "tasks", nargs=7, multiple=True, required=True, metavar="ARM PX PY PZ QX QY QZ",
               help="An arm's pick P and place Q (world frame); repeat for each arm.")
-@click.option("--lift", default=None, type=float, help="Starting lift [default 0.05 m, 50 mm].")
-@click.option("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and place [s].")
-@click.option("--clearance", default=None, type=float,
-              help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm].")
-@click.option("--margin", default=None, type=float,
-              help="Resolution of the continuous checks [default 0.005 m, 5 mm].")
+@option_group(CellCycleFlags, "settings")
 @click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
               help="Where an arm without a --task stays (repeatable): joint values (rad and m; m as mm with --mm) or a "
                    "named state of the cell description (default: the description's hold, else neutral).")
-@click.option("--offsets", "n_offsets", default=24, show_default=True, type=int,
-              help="Time offsets scanned per arm (two or more arms).")
 @click.option("--mm", is_flag=True, help="Points, lift, clearance and margin in millimetres.")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the cell with all arms' cycles (animated together) into a session file.")
-@click.option("--plot-clearance", "plot_clearance", default=None, type=click.Path(dir_okay=False),
-              help="Plot the clearance over time (.png or .svg).")
-@click.option("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
-              help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms).")
-@json_option
-def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, holds, n_offsets, mm, session_path,
-                   plot_clearance, plot_schedule, as_json) -> None:
+@option_group(CellCycleOutput, "output")
+def cell_cycle_cmd(cell: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], tasks: tuple, settings: CellCycleFlags,
+                   holds: tuple[str, ...], mm: bool, output: CellCycleOutput) -> None:
     """Collision-aware pick-and-place cycles of CELL's arms and, for two or more arms, their schedule.
 
     Each arm's cycle keeps --clearance from the fixtures and the other arms (re-planned
@@ -230,6 +262,10 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.robots.cell import ArmMotion
 
+    lift, dwell, clearance, margin, n_offsets = (settings.lift, settings.dwell, settings.clearance, settings.margin,
+                                                 settings.n_offsets)
+    session_path, plot_clearance, plot_schedule, as_json = (output.session_path, output.plot_clearance,
+                                                            output.plot_schedule, output.as_json)
     k = 1e-3 if mm else 1.0
     lu = "mm" if mm else "m"
     lift = 0.05 / k if lift is None else lift  # all lengths in the user's unit until multiplied by k
