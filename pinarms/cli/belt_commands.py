@@ -87,21 +87,23 @@ def _spec(flow: BeltFlow, arms: int, arrivals: str | None, robot: dict | None = 
                            f"holds at most {MAX_ITEMS}: lower --rate or --duration")
     kw = {"seeds": tuple(range(seeds)), "duration": duration}
     if robot is not None and "delta" in robot:
-        from pinarms.studies.delta_line import delta_line
+        from pinarms.studies.delta_line import DeltaLineRequest, delta_line
 
         if paper_limit:
             raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
         from pinarms.studies.line import ENOKI
 
-        spec = delta_line(arms, rate, item=ENOKI, name=robot["delta"], rule=rule, map_grid=robot["map_grid"], **kw, **({} if speed is None else {"speed": speed}))
+        spec = delta_line(DeltaLineRequest(arms, rate, item=ENOKI, name=robot["delta"], rule=rule, map_grid=robot["map_grid"],
+                                           **kw, **({} if speed is None else {"speed": speed})))
     elif robot is not None:
-        from pinarms.studies.arm_line import arm_line
+        from pinarms.studies.arm_line import ArmLineRequest, arm_line
 
         if paper_limit:
             raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
-        spec = arm_line(robot["robot"], arms, rate, rule=rule, base_offset=robot["base_offset"],
-                        base_height=robot["base_height"], box=robot["box"], spacing=robot["spacing"], descend=robot["descend"], map_grid=robot["map_grid"], **kw,
-                        **({} if speed is None else {"speed": speed}))
+        spec = arm_line(ArmLineRequest(robot["robot"], arms, rate, rule=rule, base_offset=robot["base_offset"],
+                                       base_height=robot["base_height"], box=robot["box"], spacing=robot["spacing"],
+                                       descend=robot["descend"], map_grid=robot["map_grid"], **kw,
+                                       **({} if speed is None else {"speed": speed})))
     elif preset == "scara":
         spec = scara_line(arms, rate, rule=rule, paper_limit=paper_limit, **kw, **({} if speed is None else {"speed": speed}))
     else:
