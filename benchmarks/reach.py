@@ -161,12 +161,13 @@ def _binned_misses(arm, m, n_samples: int, seed: int, max_checks: int) -> dict:
     missed = np.flatnonzero(~reached)
     pick = missed if missed.size <= max_checks else np.sort(
         np.random.default_rng(seed + 1).choice(missed, size=max_checks, replace=False))
+    from pinarms.robots.ik.attempts import IKAttempts
+
     solver = arm.numerical_ik()
     confirmed = 0
     for i in pick:
         r, kk = divmod(int(cells[i]), o.size)
-        res = solver.solve_checked(m.pose(r, kk), qs[first[i]], position_only=False, tol=1e-9, max_restarts=0, seed=0,
-                            limits=True)
+        res = solver.solve_checked(m.pose(r, kk), qs[first[i]], IKAttempts())
         confirmed += bool(res.success)
     scale = missed.size / max(pick.size, 1)
     return {"samples": n_samples, "cells_hit": int(cells.size), "cells_reached": int(reached.sum()),
