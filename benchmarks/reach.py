@@ -51,7 +51,7 @@ def _rss_mb() -> float:
 def child(name: str, args: dict) -> dict:
     """One measurement (runs in its own process)."""
     from pinarms import robots
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     if args.get("one_core"):
         # one core: no thread pools either (pinarms sizes them by os.cpu_count(), not by the affinity)
@@ -70,7 +70,7 @@ def child(name: str, args: dict) -> dict:
         opts["out"] = os.path.join(tempfile.mkdtemp(prefix="reach-bench-"), "map.h5")
     base_rss = _rss_mb()
     t0, c0 = time.perf_counter(), time.process_time()
-    m = reachability_map(arm, args["resolution"], args["orientations"], **opts)
+    m = reachability_map(ReachabilityRequest(arm, args["resolution"], args["orientations"], **opts))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     traced = None
     if args.get("trace"):
@@ -229,7 +229,7 @@ def station() -> None:
     from pinarms import optim, robots
     from pinarms.papers import SEED001
     from pinarms.robots.reach.inverse_reach import IKCheck, base_placements, tool_down_poses
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     arm = robots.load("aubo_i3")
     p1, p2 = (np.array(p) * 1e-3 for p in SEED001.table2_p1_p2_mm)
@@ -242,7 +242,7 @@ def station() -> None:
     t_blind = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    m = reachability_map(arm, 0.05, 8, tool_down=np.radians(15), keep_solutions=False)
+    m = reachability_map(ReachabilityRequest(arm, 0.05, 8, tool_down=np.radians(15), keep_solutions=False))
     t_map = time.perf_counter() - t0
     points = np.vstack([p1, p1 + [0, 0, lift], place, place + [0, 0, lift]])
     tasks = tool_down_poses(points, m.orientations.tool_axis)

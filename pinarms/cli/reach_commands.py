@@ -62,7 +62,7 @@ def reach_cmd(robot: str, sampling: ReachFlags, scheduler: str | None, out_path:
     Closed-form arms get every branch; any other URDF the seeded numerical solver. The index of a
     voxel is the fraction of orientations (or tool-down directions) reached.
     """
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     arm = load_robot(robot)
     res = parse_length(sampling.resolution, "--resolution")
@@ -71,8 +71,9 @@ def reach_cmd(robot: str, sampling: ReachFlags, scheduler: str | None, out_path:
     roll_steps, ik, self_collision, seed = sampling.roll_steps, sampling.ik, sampling.self_collision, sampling.seed
     sched = _scheduler(scheduler)
     with progress_bar("reachability voxels", None, as_json) as bar:
-        m = reachability_map(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik, self_collision=self_collision,
-                             seed=seed, keep_solutions=False, out=out_path, scheduler=sched, progress=bar)
+        request = ReachabilityRequest(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik,
+                                      self_collision=self_collision, seed=seed, keep_solutions=False, out=out_path)
+        m = reachability_map(request, scheduler=sched, progress=bar)
     reach = m.index > 0
     data = {
         "robot": m.robot,

@@ -95,11 +95,11 @@ def _tool_down_band(arm: Any, quick: bool) -> tuple[list[Row], Any, Callable[[Pa
     tool-down reachability map of the tcp (15° cone, roll free; coarse voxels to stay fast).
 
     ``quick`` is accepted for symmetry with the other helpers; the map is the same either way."""
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     paper = SEED001
     res = 0.06  # the same map in quick and full runs (about 4 s on one core): the rows are reproducible
-    m = reachability_map(arm, res, 6, tool_down=15.0 * DEG, roll_steps=6)
+    m = reachability_map(ReachabilityRequest(arm, res, 6, tool_down=15.0 * DEG, roll_steps=6))
     centre = paper.sphere_centre_m
     c = m.centres()
     r = np.linalg.norm(c - centre, axis=1)
