@@ -70,7 +70,8 @@ def child(name: str, args: dict) -> dict:
         opts["out"] = os.path.join(tempfile.mkdtemp(prefix="reach-bench-"), "map.h5")
     base_rss = _rss_mb()
     t0, c0 = time.perf_counter(), time.process_time()
-    m = reachability_map(ReachabilityRequest(arm, args["resolution"], args["orientations"], **opts))
+    scheduler = opts.pop("scheduler", None)
+    m = reachability_map(ReachabilityRequest(arm, args["resolution"], args["orientations"], **opts), scheduler=scheduler)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     traced = None
     if args.get("trace"):
