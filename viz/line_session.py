@@ -49,7 +49,7 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
 def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float,
               maps: tuple = ()) -> tuple[list, dict]:
     """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}."""
-    from pinarms.optim.line.tracking import plan_pick, rest_configuration
+    from pinarms.optim.line.tracking import PickRequest, plan_pick, rest_configuration
 
     st = spec.stations[k]
     q_rest = rest_configuration(st)
@@ -64,8 +64,8 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
         u, w = float(run.u_meet[i]), float(items.w[i])
         branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps else None  # the branch the map timed
         try:
-            plan = plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
-                             branch=branch, yaw=float(items.yaw[i]))
+            plan = plan_pick(PickRequest(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass,
+                    q_rest=q_rest, branch=branch, yaw=float(items.yaw[i])))
         except PinarmsError:
             continue  # drawn on the belt, not marked (NOT_DRAWN)
         s = max(float(run.meet[i]) - plan.times[0], free_at)

@@ -138,7 +138,7 @@ def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool
             spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
             try:
                 timing = CycleTiming(st.kind, st.vmax, st.amax, st.jmax, method="exact", seed=st.seed)
-                cycle = plan_cycle(CycleRequest(robot, spec, timing=timing, cell=in_cell))
+                cycle = plan_cycle(CycleRequest(robot, spec, timing=timing, cell=in_cell)).raise_for_status()
             except PinarmsError as exc:
                 where = f"pick {i + 1} → place {j + 1}"
                 return _Outcome(_classify(exc), f"{where}: {exc}"), None

@@ -22,7 +22,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import ItemType
 from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, plan_pick
 from pinarms.errors import InvalidInput, PinarmsError
 
 if TYPE_CHECKING:
@@ -75,8 +75,8 @@ class NeighbourGuard:
                 u_base = float(self.belt.to_belt(st.base_to_world[:3, 3])[0])
                 branch = self.maps[name][kind].branch_at(u - u_base, w, None if self.yaws is None else self.yaws[item])
             yaw = 0.0 if self.yaws is None else float(self.yaws[item])
-            self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
-                                         branch=branch, yaw=yaw)
+            self._plans[key] = plan_pick(PickRequest(st, self.belt, self.tracking, u, w, item_height=t.size[2],
+                    mass=t.mass, branch=branch, yaw=yaw))
         return self._plans[key]
 
     def __call__(self, pick: Pick | tuple, other: Pick | tuple) -> bool:

@@ -25,7 +25,7 @@ from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput, UnreachableTarget
 
@@ -94,8 +94,8 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int]:
     for b, label in enumerate(labels):
         for j, w in enumerate(task["w"]):
             try:
-                plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
-                                 q_rest=q_rest, branch=None if label < 0 else label, yaw=yaw)
+                plan = plan_pick(PickRequest(st, belt, spec, u_base + task["du"], w, item_height=task["height"],
+                        mass=task["mass"], q_rest=q_rest, branch=None if label < 0 else label, yaw=yaw))
             except (UnreachableTarget, InfeasibleProblem, OptimError):
                 continue
             verdict = "clear" if fixtures is None else fixtures.verdict(plan.trajectory)

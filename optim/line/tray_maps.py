@@ -36,8 +36,8 @@ from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_map_build import _fixtures
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
-from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
+from pinarms.optim.line.trays import TrayBelt, TrayPickRequest, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput, PinarmsError, UnreachableTarget
 
@@ -210,16 +210,16 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
     for j, w in enumerate(task["w"]):
         try:
-            pick = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
-                             q_rest=q_rest)
+            pick = plan_pick(PickRequest(st, belt, spec, u_base + task["du"], w, item_height=task["height"],
+                    mass=task["mass"], q_rest=q_rest))
         except (UnreachableTarget, InfeasibleProblem, OptimError):
             continue  # no pick here: no place either
         for b, label in enumerate(labels):
             for k, dv in enumerate(task["dv"]):
                 try:
-                    p = plan_pick_to_tray(st, belt, trays, spec, u_base + task["du"], w, v_base + dv,
-                                          item_height=task["height"], mass=task["mass"], q_rest=q_rest,
-                                          place_branch=None if label < 0 else label, pick=pick)
+                    p = plan_pick_to_tray(TrayPickRequest(PickRequest(st, belt, spec, u_base + task["du"], w,
+                            item_height=task["height"], mass=task["mass"], q_rest=q_rest), trays, v_base + dv,
+                            place_branch=None if label < 0 else label), pick=pick)
                 except (UnreachableTarget, InfeasibleProblem, OptimError):
                     continue
                 verdict = "clear" if fixtures is None else fixtures.verdict(p.trajectory)
@@ -323,8 +323,9 @@ def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayB
         if not np.isfinite(tA + tX + tR):
             continue
         try:
-            p = plan_pick_to_tray(station, belt, trays, spec, u_base + du, w, v_base + dv, item_height=item_height,
-                                  mass=m.mass, q_rest=q_rest, place_branch=m.branch_at(du, w, dv))
+            p = plan_pick_to_tray(TrayPickRequest(PickRequest(station, belt, spec, u_base + du, w,
+                    item_height=item_height, mass=m.mass, q_rest=q_rest), trays, v_base + dv,
+                    place_branch=m.branch_at(du, w, dv)))
         except PinarmsError:
             continue
         approx = float(tA + tX + tR) + m.track + m.place

@@ -293,6 +293,7 @@ def cell_cycle_cmd(cell: str, xacro_args: tuple[str, ...], packages: tuple[str, 
         spec = optim.PickPlace(arm.to_base(values[:3]), arm.to_base(values[3:]), lift=lift * k, dwell=dwell)
         res = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(c, clearance=clearance * k,
                                                                                margin=margin * k, hold=hold)))
+        res.raise_for_status()  # no cycle that keeps the clearance: one Error line naming what blocks
         cycles[name] = res
         rep = res.cell_report
         data["arms"][name] = {"cycle": res.as_dict(), "cycle_time_s": res.cycle_time,

@@ -108,7 +108,7 @@ def cycle_cmd(robot: str, task: CycleTask, units: UnitFlags, timing: TimingFlags
     shape = CycleApproach("straight" if approach.straight else "joint",
                           None if approach.vtool is None else approach.vtool * scale)
     res = optim.plan_cycle(CycleRequest(arm, spec, timing=cycle_timing, load=CycleLoad(kg, load.torque_limits(arm.nq)),
-                                        approach=shape))
+                                        approach=shape)).raise_for_status()  # no cycle: one Error line saying why
     data = res.as_dict()
     data["units"] = {"lengths": "m", "times": "s", "limits": "rad or m per s^k", "given_points": lu}
     dev = res.line_deviation / scale
