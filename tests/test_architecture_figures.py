@@ -249,8 +249,10 @@ def test_private_uses_reference_and_signature_figures_of_a_known_package(wall, t
 #: a ratchet, lowered as they go; none of them is a ``Cell``'s or a ``Robot``'s member.
 PRIVATE_USES_LEFT = 125
 #: Public functions or methods with ten parameters or more, and the share of public parameters typed
-#: ``Any`` (a ratchet; the goal is <= 3 and <= 5 %).
-LONG_SIGNATURES = 38
+#: ``Any`` (a ratchet; the goal is <= 3 and <= 5 %). The command line takes its flags in option groups
+#: (``pinarms.cli.option_groups``), the library's big calls one request object; the three left are the
+#: task-map builders (``build_task_map``, ``build_tray_map``, ``build_delta_map``).
+LONG_SIGNATURES = 3
 ANY_SHARE = 0.227
 
 

@@ -45,7 +45,7 @@ class Flag:
         return str(click.Option(list(self.decls), **self.attrs).name)
 
 
-def flag(*decls: str, **attrs: Any) -> Flag:
+def flag(*decls: str, **attrs: object) -> Flag:
     """A :class:`Flag` written as :func:`click.option` is."""
     return Flag(tuple(decls), dict(attrs))
 
@@ -55,7 +55,7 @@ JSON_FLAG = flag("--json", "as_json", is_flag=True, help="Print one JSON documen
 
 
 def option_group(group: type, name: str, *, only: tuple[str, ...] | None = None,
-                 **changes: Mapping[str, Any]) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+                 **changes: Mapping[str, object]) -> Callable[[Callable[..., object]], Callable[..., object]]:
     """Add the options of ``group`` (a frozen dataclass with ``FLAGS``) to a command; pass it one ``group``.
 
     ``only`` keeps some of the group's options (the other fields take their defaults);
@@ -72,9 +72,9 @@ def option_group(group: type, name: str, *, only: tuple[str, ...] | None = None,
     options = [click.option(*f.decls, **{**f.attrs, **changes.get(f.name, {})}) for f in used]
     names = tuple(f.name for f in used)
 
-    def decorate(command: Callable[..., Any]) -> Callable[..., Any]:
+    def decorate(command: Callable[..., object]) -> Callable[..., object]:
         @functools.wraps(command)
-        def run(*args: Any, **values: Any) -> Any:
+        def run(*args: object, **values: object) -> object:
             mine = {n: values.pop(n) for n in names}
             return command(*args, **values, **{name: group(**mine)})
 
