@@ -56,6 +56,7 @@ _EXPORTS = {
     "map_error": "pinarms.optim.line.task_map_error",
     "TaskMap": "pinarms.optim.line.task_maps",
     "PickPlan": "pinarms.optim.line.tracking",
+    "PickRequest": "pinarms.optim.line.tracking",
     "TrackingSpec": "pinarms.optim.line.tracking",
     "plan_pick": "pinarms.optim.line.tracking",
     "TrayMap": "pinarms.optim.line.tray_maps",
@@ -64,6 +65,7 @@ _EXPORTS = {
     "SimPlace": "pinarms.optim.line.tray_sim",
     "TrayBelt": "pinarms.optim.line.trays",
     "TrayPickPlan": "pinarms.optim.line.trays",
+    "TrayPickRequest": "pinarms.optim.line.trays",
     "plan_pick_to_tray": "pinarms.optim.line.trays",
     "trays_beside": "pinarms.optim.line.trays",
     "PickWindow": "pinarms.optim.line.windows",
@@ -77,7 +79,7 @@ __all__ = [
     "RULES", "AssignmentRule", "SimArm", "SimResult", "simulate", "LineFigures", "summarise", "Stream",
     "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "TrayMap",
-    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
+    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside", "PickRequest", "TrayPickRequest",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
