@@ -29,6 +29,8 @@ from typing import Any, Callable, ClassVar, Mapping
 import click
 import numpy as np
 
+from pinarms.cli._common import floats, si_limit
+
 __all__ = ["Flag", "flag", "option_group", "TimingFlags", "LoadFlags", "UnitFlags", "OutputFlags", "JSON_FLAG"]
 
 
@@ -109,8 +111,6 @@ class TimingFlags:
     )
 
     def __post_init__(self) -> None:
-        from pinarms.cli._common import floats
-
         for what in ("vmax", "amax", "jmax"):
             text = getattr(self, what)
             if text is not None:
@@ -119,8 +119,6 @@ class TimingFlags:
     def limits(self, scale: float | np.ndarray) -> tuple[Any, Any, Any]:
         """``(vmax, amax, jmax)`` in SI (``None`` where not given): each value times ``scale`` (one per joint
         checks the count: one value or one per joint)."""
-        from pinarms.cli._common import si_limit
-
         return (si_limit(self.vmax, "--vmax", scale), si_limit(self.amax, "--amax", scale),
                 si_limit(self.jmax, "--jmax", scale))
 
@@ -141,8 +139,6 @@ class LoadFlags:
     )
 
     def __post_init__(self) -> None:
-        from pinarms.cli._common import floats
-
         if self.torque_max is not None:
             floats(self.torque_max, "--torque-max")
 
@@ -161,8 +157,6 @@ class LoadFlags:
     def torque_limits(self, nq: int) -> np.ndarray | float | bool:
         """The torque limits: ``--torque-max`` per joint, else ``True`` (the URDF's) when a payload or
         ``--torque`` asks for them, else ``False``."""
-        from pinarms.cli._common import si_limit
-
         given = si_limit(self.torque_max, "--torque-max", np.ones(nq))
         if given is not None:
             return given
