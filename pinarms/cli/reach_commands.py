@@ -10,7 +10,7 @@ import numpy as np
 
 from pinarms.units import parse_angle, parse_length
 
-from pinarms.cli._common import _scheduler_value, cli, emit, json_option, load_robot, new_session, progress_bar, save_session
+from pinarms.cli._common import cli, emit, json_option, load_robot, new_session, progress_bar, save_session, scheduler_value
 from pinarms.cli.option_groups import Flag, flag, option_group
 
 
@@ -47,7 +47,7 @@ class ReachFlags:
 @cli.command("reach")
 @click.argument("robot")
 @option_group(ReachFlags, "sampling")
-@click.option("--scheduler", default=None, callback=_scheduler_value,
+@click.option("--scheduler", default=None, callback=scheduler_value,
               help="Where to run the chunks: omit (here, serially), processes[:N] (local Dask workers), "
                    "tcp://HOST:8786 (a Dask cluster) or env (DASK_SCHEDULER_ADDRESS).")
 @click.option("--out", "out_path", default=None, type=click.Path(dir_okay=False),
