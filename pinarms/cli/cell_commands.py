@@ -220,6 +220,22 @@ class CellCycleFlags:
              help="Time offsets scanned per arm (two or more arms)."),
     )
 
+    def lengths(self, k: float, n_tasks: int) -> tuple[float, float, float]:
+        """``(lift, clearance, margin)`` in the user's length unit (``k`` metres each), defaults filled in,
+        every setting checked against its range (:mod:`pinarms.optim.caps`; the error names the flag)."""
+        from pinarms.optim import caps
+
+        lift = 0.05 / k if self.lift is None else self.lift
+        clearance = 0.02 / k if self.clearance is None else self.clearance
+        margin = 0.005 / k if self.margin is None else self.margin
+        if n_tasks >= 2:
+            caps.count_setting(self.n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
+        caps.number_setting(self.dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
+        caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
+        caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
+        caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
+        return lift, clearance, margin
+
 
 @dataclass(frozen=True)
 class CellCycleOutput:
@@ -263,26 +279,16 @@ def cell_cycle_cmd(cell: str, xacro_args: tuple[str, ...], packages: tuple[str, 
     --task right 50 30 840 220 -680 840 --mm
     """
     from pinarms import optim
-    from pinarms.optim import caps
     from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.robots.cell import ArmMotion
 
-    lift, dwell, clearance, margin, n_offsets = (settings.lift, settings.dwell, settings.clearance, settings.margin,
-                                                 settings.n_offsets)
     session_path, plot_clearance, plot_schedule, as_json = (output.session_path, output.plot_clearance,
                                                             output.plot_schedule, output.as_json)
     k = 1e-3 if mm else 1.0
     lu = "mm" if mm else "m"
-    lift = 0.05 / k if lift is None else lift  # all lengths in the user's unit until multiplied by k
-    clearance = 0.02 / k if clearance is None else clearance
-    margin = 0.005 / k if margin is None else margin
     # the settings first: a slip in them is an error at once, before the cell loads or a cycle is planned
-    if len(tasks) >= 2:
-        caps.count_setting(n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
-    caps.number_setting(dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
-    caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
-    caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
-    caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
+    lift, clearance, margin = settings.lengths(k, len(tasks))  # in the user's unit until multiplied by k
+    dwell, n_offsets = settings.dwell, settings.n_offsets
     c = load_cell_option(cell, xacro_args, packages)
     hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}

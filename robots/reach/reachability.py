@@ -55,7 +55,7 @@ Units: metres, radians; rotations tool frame → base; joint values in the robot
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
@@ -151,8 +151,11 @@ class ReachabilityRequest:
     samples: int | None = None
     seed: int = 0
 
+    #: the fields checked, the defaults resolved and the grid around the arm's reach built (by ``__post_init__``)
+    settings: _Settings = field(init=False, repr=False)
+
     def __post_init__(self) -> None:
-        object.__setattr__(self, "_settings", _checked_settings(
+        object.__setattr__(self, "settings", _checked_settings(
             self.arm, resolution=self.resolution, orientations=self.orientations, tool_down=self.tool_down,
             roll_steps=self.roll_steps, tool_axis=self.tool_axis, ik=self.ik, manipulability=self.manipulability,
             restarts=self.restarts, tol=self.tol, self_collision=self.self_collision, collision=self.collision,
@@ -172,7 +175,7 @@ def reachability_map(request: ReachabilityRequest, *, scheduler: "str | Client |
     """
     t0 = time.perf_counter()
     arm, out = request.arm, request.out
-    s = request._settings
+    s = request.settings
     spec = spec_of(arm)
     writer = None
     if out is not None:
