@@ -8,13 +8,13 @@ group, built (and so checked, in its ``__post_init__``) from the values the user
     @cli.command("cycle")
     @option_group(TimingFlags, "timing", vmax={"help": "Joint speed limit(s) ..."})
     def cycle_cmd(robot, timing: TimingFlags, ...) -> None:
-        timing.limits(arm.nq)            # (vmax, amax, jmax) in SI, checked per joint
+        timing.limits(np.ones(arm.nq))   # (vmax, amax, jmax) in SI, one value or one per joint
 
 The flags stay the user's: a group changes the command's signature, never its command line.
 A group's checks raise :class:`~pinarms.errors.InvalidInput` naming the flag, one ``Error:`` line.
 
 The groups shared by several commands are here: :class:`TimingFlags` (the trajectory kind,
-joint limits and the optimiser of ``cycle``, ``layout-search``, ``plan``, ``optimize``, ``line``),
+joint limits and the optimiser of ``cycle``, ``layout-search``, ``plan`` and ``optimize``),
 :class:`LoadFlags` (payload and torque limits of ``cycle`` and ``optimize``), :class:`UnitFlags`
 (``--mm`` and ``--deg``) and :class:`OutputFlags` (``--session``, ``--plot`` and ``--json``).
 """
