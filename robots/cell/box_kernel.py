@@ -68,7 +68,8 @@ def held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut)
     box ``o``: the least over cylinders ``k`` of the larger of its gaps (:func:`_box_gap`, :func:`_toward_gap`) and
     the distances of the spheres ``spart[k]`` holding its pieces. Only a bound at most ``cut`` is meant: a cylinder
     whose spheres are farther is passed over (so ``inf`` where none is nearer), and at one at most ``t`` (with
-    ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early."""
+    ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early. Fourteen parameters: a compiled kernel
+    takes plain arrays (numba takes no request object)."""
     low = np.inf
     near = np.inf
     held = -1

@@ -79,7 +79,9 @@ def _centers(R, p, joint, center, W):
 
 @jit
 def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, out):
-    """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)``."""
+    """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)``.
+
+    Twelve parameters: a compiled kernel takes plain arrays (numba takes no request object)."""
     nj = parent.shape[0]
     R = np.empty((nj, 3, 3))
     p = np.empty((nj, 3))
@@ -320,7 +322,8 @@ def _hd(HW, hrad, a, b):
 @jit
 def place_world(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work):
     """Forward kinematics of cell configuration ``q`` and the world centres of the cover's spheres,
-    its cylinders' axis ends and the bounding spheres, into ``work`` (:meth:`Cover.work`'s arrays)."""
+    its cylinders' axis ends and the bounding spheres, into ``work`` (:meth:`Cover.work`'s arrays).
+    Ten parameters: a compiled kernel takes plain arrays (numba takes no request object)."""
     parent, index, scale, offset, revolute, axis, MR, Mp = fk
     R, p, W, SA, SB, HW = work
     _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
