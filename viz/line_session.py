@@ -56,8 +56,9 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
 def _delta_pick(st: Station, belt: Belt, tr: TrackingSpec, u: float, w: float, kind: ItemType, yaw: float
                 ) -> DeltaPickMotion:
     from pinarms.optim.line.delta_motion import delta_pick_motion
+    from pinarms.optim.line.tracking import PickRequest
 
-    return delta_pick_motion(st, belt, tr, u, w, mass=kind.mass, item_height=kind.size[2], yaw=yaw)
+    return delta_pick_motion(PickRequest(st, belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, yaw=yaw))
 
 
 def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float,
