@@ -25,10 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.delta_tracking import DeltaArm, platform_move_profile, tool_turn_time, tracking_platform
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import PickRequest, TrackingSpec, tool_yaw
+from pinarms.optim.line.tracking import PickRequest, tool_yaw
 from pinarms.optim.standard_cycle.delta_cycle import turn_angle
 from pinarms.optim.standard_cycle.timing import profile_position
 from pinarms.robots.delta import inverse_position
