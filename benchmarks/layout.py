@@ -218,7 +218,7 @@ def two_arms(reps: int) -> None:
     import statistics
 
     from pinarms.optim.motion import MotionOptions, MotionRequest
-    from pinarms.optim.motion.two_arms import plan_around
+    from pinarms.optim.motion.two_arms import AroundRequest, plan_around
 
     belt, hold, qb0, qb1, A = _belt_query()
     wall: dict[bool, list[float]] = {False: [], True: []}
@@ -227,7 +227,7 @@ def two_arms(reps: int) -> None:
         for screen in (False, True):
             t = time.perf_counter()
             request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
-            plan = plan_around(request, {"right": A}, screen=screen)
+            plan = plan_around(AroundRequest(request, {"right": A}, screen=screen)).raise_for_status()
             wall[screen].append(time.perf_counter() - t)
             kept.add((plan.delay, plan.delays_tried, float(plan.trajectory.end_time)))
     print(f"two arms, plan_around on aubo_two_belt, {reps} repetitions; the same delay every time: "

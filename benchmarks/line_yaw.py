@@ -45,7 +45,7 @@ def jaco_line():
 def plan_cost(station, belt, spec, plans: int) -> None:
     """Picks planned with the torque screen and with the refined peaks alone, interleaved."""
     import pinarms.planning.torque as torque
-    from pinarms.optim.line.tracking import plan_pick, rest_configuration
+    from pinarms.optim.line.tracking import PickRequest, plan_pick, rest_configuration
 
     screen = torque.clearly_within
     q_rest = rest_configuration(station)
@@ -59,7 +59,7 @@ def plan_cost(station, belt, spec, plans: int) -> None:
             torque.clearly_within = screen if name == "screen" else (lambda *a, **kw: False)
             t = time.process_time()
             try:
-                times.append(plan_pick(station, belt, spec, u0 + du, w, q_rest=q_rest, yaw=yaw).times)
+                times.append(plan_pick(PickRequest(station, belt, spec, u0 + du, w, q_rest=q_rest, yaw=yaw)).times)
             except Exception as exc:  # an infeasible pick costs too; both ways must agree on it
                 times.append(type(exc).__name__)
             spent[name].append(time.process_time() - t)

@@ -51,7 +51,7 @@ def _rss_mb() -> float:
 def child(name: str, args: dict) -> dict:
     """One measurement (runs in its own process)."""
     from pinarms import robots
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     if args.get("one_core"):
         # one core: no thread pools either (pinarms sizes them by os.cpu_count(), not by the affinity)
@@ -70,7 +70,8 @@ def child(name: str, args: dict) -> dict:
         opts["out"] = os.path.join(tempfile.mkdtemp(prefix="reach-bench-"), "map.h5")
     base_rss = _rss_mb()
     t0, c0 = time.perf_counter(), time.process_time()
-    m = reachability_map(arm, args["resolution"], args["orientations"], **opts)
+    scheduler = opts.pop("scheduler", None)
+    m = reachability_map(ReachabilityRequest(arm, args["resolution"], args["orientations"], **opts), scheduler=scheduler)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     traced = None
     if args.get("trace"):
@@ -161,12 +162,13 @@ def _binned_misses(arm, m, n_samples: int, seed: int, max_checks: int) -> dict:
     missed = np.flatnonzero(~reached)
     pick = missed if missed.size <= max_checks else np.sort(
         np.random.default_rng(seed + 1).choice(missed, size=max_checks, replace=False))
+    from pinarms.robots.ik.attempts import IKAttempts
+
     solver = arm.numerical_ik()
     confirmed = 0
     for i in pick:
         r, kk = divmod(int(cells[i]), o.size)
-        res = solver.solve_checked(m.pose(r, kk), qs[first[i]], position_only=False, tol=1e-9, max_restarts=0, seed=0,
-                            limits=True)
+        res = solver.solve_checked(m.pose(r, kk), qs[first[i]], IKAttempts())
         confirmed += bool(res.success)
     scale = missed.size / max(pick.size, 1)
     return {"samples": n_samples, "cells_hit": int(cells.size), "cells_reached": int(reached.sum()),
@@ -228,7 +230,7 @@ def station() -> None:
     from pinarms import optim, robots
     from pinarms.papers import SEED001
     from pinarms.robots.reach.inverse_reach import IKCheck, base_placements, tool_down_poses
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     arm = robots.load("aubo_i3")
     p1, p2 = (np.array(p) * 1e-3 for p in SEED001.table2_p1_p2_mm)
@@ -241,7 +243,7 @@ def station() -> None:
     t_blind = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    m = reachability_map(arm, 0.05, 8, tool_down=np.radians(15), keep_solutions=False)
+    m = reachability_map(ReachabilityRequest(arm, 0.05, 8, tool_down=np.radians(15), keep_solutions=False))
     t_map = time.perf_counter() - t0
     points = np.vstack([p1, p1 + [0, 0, lift], place, place + [0, 0, lift]])
     tasks = tool_down_poses(points, m.orientations.tool_axis)

@@ -16,6 +16,7 @@ from pinarms.robots._checks import check_restarts as _check_restarts
 from pinarms.robots._checks import check_seed as _check_seed
 from pinarms.robots._checks import check_tolerance as _check_tolerance
 from pinarms.errors import InvalidInput, ModelError, UnreachableTarget
+from pinarms.robots.ik.attempts import IKAttempts
 from pinarms.robots.ik.numerical import NumericalIK
 from pinarms.robots.ik.solver import LIMIT_TOL, split_by_target
 from pinarms.robots.ik_target import check_ik_target
@@ -205,10 +206,10 @@ class RobotIK:
             # none from the closed form (also at singular poses, where θ free joints were fixed):
             # the numerical diagnosis below decides
         solver = self.numerical_ik()
-        res = solver.solve_checked(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=True)
+        res = solver.solve_checked(T[0], None, IKAttempts(bool(position_only), 1e-9, 20, 0, True))
         if res.success:
             return None
-        free = solver.solve_checked(T[0], None, position_only=position_only, tol=1e-9, max_restarts=20, seed=0, limits=False)
+        free = solver.solve_checked(T[0], None, IKAttempts(bool(position_only), 1e-9, 20, 0, False))
         if free.success:
             return (
                 f"the {what} is within reach but needs a joint outside its limits: "
@@ -218,9 +219,7 @@ class RobotIK:
 
     def _unreachable_text(self, T: np.ndarray, position_only: bool, res=None) -> str:
         if res is None:
-            res = self.numerical_ik().solve_checked(
-                T, None, position_only=position_only, tol=1e-9, max_restarts=10, seed=0, limits=False
-            )
+            res = self.numerical_ik().solve_checked(T, None, IKAttempts(bool(position_only), 1e-9, 10, 0, False))
         if res.position_error > 1e-6 or position_only:
             return (
                 f"the target is out of reach: the closest tcp position found is {res.position_error:.4g} m away "
@@ -301,8 +300,8 @@ class RobotIK:
         if res.success:
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         # not found: the interpreted solver's path (closed-form branches, restarts, a final polish) for the diagnosis
-        res = solver.solve_checked(T0, seed_q, position_only=position_only, tol=tol, max_restarts=0, seed=seed, limits=True,
-                            polish=False, compiled=False)
+        res = solver.solve_checked(T0, seed_q, IKAttempts(bool(position_only), tol, 0, seed, True, polish=False,
+                                                          compiled=False))
         if res.success:
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         if self._analytic_ik is not None and not position_only:  # closed-form starts: where the first descent failed
@@ -313,10 +312,8 @@ class RobotIK:
                     pe, re = solver.errors(q2, T0, False)
                     if pe <= tol and re <= tol:
                         return q2
-        res = solver.solve_checked(
-            T0, seed_q, position_only=position_only, tol=tol, max_restarts=int(max_restarts), seed=seed, limits=True,
-            first=False,
-        )
+        res = solver.solve_checked(T0, seed_q, IKAttempts(bool(position_only), tol, int(max_restarts), seed, True,
+                                                          first=False))
         if res.success and self.within_limits(res.q):
             return res.q if seed_q is None else solver.nearest_equivalent(res.q, seed_q)
         if limit_tol > LIMIT_TOL:

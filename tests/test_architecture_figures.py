@@ -245,9 +245,11 @@ def test_private_uses_reference_and_signature_figures_of_a_known_package(wall, t
 
 
 # ----------------------------------------------------------------- the walls, measured on this repository
-#: Public functions or methods with ten parameters or more (a ratchet; the goal is <= 3), and the share of
-#: public parameters typed ``Any`` (3.5 % measured; the goal is <= 5 %: a parameter with a real type has it).
-LONG_SIGNATURES = 38
+#: Public functions or methods with ten parameters or more (a ratchet; the goal is <= 3: the command line
+#: takes its flags in option groups, ``pinarms.cli.option_groups``, the library's big calls one request
+#: object), and the share of public parameters typed ``Any`` (3.5 % measured; the goal is <= 5 %: a
+#: parameter with a real type has it).
+LONG_SIGNATURES = 0
 ANY_SHARE = 0.045
 
 

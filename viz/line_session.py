@@ -56,8 +56,9 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
 def _delta_pick(st: Station, belt: Belt, tr: TrackingSpec, u: float, w: float, kind: ItemType, yaw: float
                 ) -> DeltaPickMotion:
     from pinarms.optim.line.delta_motion import delta_pick_motion
+    from pinarms.optim.line.tracking import PickRequest
 
-    return delta_pick_motion(st, belt, tr, u, w, mass=kind.mass, item_height=kind.size[2], yaw=yaw)
+    return delta_pick_motion(PickRequest(st, belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, yaw=yaw))
 
 
 def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float,
@@ -65,7 +66,7 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
     """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}.
     A delta's picks are motions of its actuated coordinates (:mod:`pinarms.optim.line.delta_motion`)."""
     from pinarms.optim.line.delta_tracking import DeltaArm
-    from pinarms.optim.line.tracking import plan_pick
+    from pinarms.optim.line.tracking import PickRequest, plan_pick
 
     st = spec.stations[k]
     is_delta = isinstance(st.robot, DeltaArm)
@@ -82,8 +83,8 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
         branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps and not is_delta else None  # as timed
         try:
             plan = _delta_pick(st, spec.belt, tr, u, w, kind, float(items.yaw[i])) if is_delta else \
-                plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
-                          branch=branch, yaw=float(items.yaw[i]))
+                plan_pick(PickRequest(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
+                                      branch=branch, yaw=float(items.yaw[i])))
         except PinarmsError:
             continue  # drawn on the belt, not marked (NOT_DRAWN)
         s = max(float(run.meet[i]) - plan.times[0], free_at)

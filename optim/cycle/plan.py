@@ -27,7 +27,8 @@ from pinarms.optim.cycle.spec import (  # noqa: F401  (the spec and result, re-e
     PickPlace,
 )
 from pinarms.optim.cycle.straight import approach_cycle
-from pinarms.errors import InvalidInput
+from pinarms.errors import CollisionError, InvalidInput, UnreachableTarget
+from pinarms.optim.errors import InfeasibleProblem, InvalidLimits, InvalidSettings
 
 __all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "LINE_NAMES", "CycleResult", "PickPlace",
            "CycleRequest", "CycleTiming", "CycleLoad", "CycleApproach", "CellSettings", "plan_cycle"]
@@ -44,23 +45,38 @@ def plan_cycle(request: CycleRequest) -> CycleResult:
             :class:`CellSettings`, which document them and check them when built).
 
     Returns:
-        :class:`CycleResult`; its ``status`` (:class:`CycleStatus`) says whether the cycle
-        was planned as asked or re-planned to keep a cell's clearance.
+        :class:`CycleResult`; its ``status`` (:class:`CycleStatus`) says whether the cycle was
+        planned as asked or re-planned to keep a cell's clearance, or why there is none, with
+        :attr:`CycleResult.reason`: a waypoint without an IK solution (``unreachable``; the reason
+        names it: pick, above pick, via k, above place, place, its position and why), no timing
+        under the limits (``limits not met``), or in a cell a pose, an idle arm or every re-planned
+        cycle too close to something (``in collision``; the reason names the blocking bodies).
+        :meth:`CycleResult.raise_for_status` raises that failure as an exception.
 
     Raises:
-        InvalidInput: ``request`` is not a :class:`CycleRequest`, a bad ``q_start``.
-            (Building the request raises the other input errors: :class:`CycleRequest`.)
+        InvalidInput: ``request`` is not a :class:`CycleRequest`, a bad ``q_start``, a robot that
+            is not an arm of the cell. (Building the request raises the other input errors:
+            :class:`CycleRequest`.)
         InvalidLimits: with ``approach="straight"``, no ``amax``.
-        UnreachableTarget: a waypoint has no IK solution; the message names it (pick,
-            above pick, via k, above place, place), its position and why
-            (``robot.ik_failure_reason``).
-        InfeasibleProblem: no timing found (from :func:`pinarms.optim.minimize_time`).
-        CollisionError: with a cell, the pick or place pose is too close to a fixture, or no
-            re-planned cycle keeps the clearance; the message names the blocking bodies.
     """
     if not isinstance(request, CycleRequest):
         raise InvalidInput(f"plan_cycle takes one CycleRequest, got {type(request).__name__}: "
                            "plan_cycle(CycleRequest(robot, PickPlace(pick, place), timing=CycleTiming(...)))")
-    if request.cell is not None:
-        return plan_cycle_in_cell(request)
-    return approach_cycle(request)
+    try:
+        if request.cell is not None:
+            return plan_cycle_in_cell(request)
+        return approach_cycle(request)
+    except (InvalidInput, InvalidLimits, InvalidSettings):
+        raise
+    except UnreachableTarget as exc:
+        return _failed(request, CycleStatus.UNREACHABLE, exc)
+    except CollisionError as exc:
+        return _failed(request, CycleStatus.IN_COLLISION, exc)
+    except InfeasibleProblem as exc:
+        return _failed(request, CycleStatus.LIMITS_NOT_MET, exc)
+
+
+def _failed(request: CycleRequest, status: CycleStatus, exc: Exception) -> CycleResult:
+    """The result of a request without a cycle: its status, the reason in words and the exception."""
+    return CycleResult(str(getattr(request.robot, "name", "robot")), request.spec, status=status,
+                       reason=str(exc), error=exc)

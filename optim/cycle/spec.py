@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pinarms.optim.caps import MAX_DWELL, number_setting
+from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.timing.segments import TimingResult
 from pinarms.planning import Trajectory
 from pinarms.planning.trajectory import Peaks
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
     from pinarms.robots import Robot
     from pinarms.robots.payload import Payload
 
-__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
+__all__ = ["CYCLE_KINDS", "CYCLE_APPROACHES", "CycleStatus", "SOLVED_STATUSES", "LINE_NAMES", "LINE_SAMPLES", "CycleResult",
            "PickPlace"]
 
 #: Trajectory families a cycle can be timed with (``"3-5-3"`` only without transfer vias).
@@ -40,10 +41,10 @@ CYCLE_APPROACHES = ("joint", "straight")
 
 
 class CycleStatus(enum.Enum):
-    """How a cycle was planned (:attr:`CycleResult.status`; the value is the word the reports print).
+    """How a cycle plan ended (:attr:`CycleResult.status`; the value is the word the reports print).
 
-    A cycle that cannot be planned raises instead (no IK solution at a waypoint, no timing, no
-    re-planned cycle that keeps the cell's clearance: :func:`pinarms.optim.plan_cycle`).
+    The first three are cycles (:attr:`CycleResult.solved`); the others say why there is none, with
+    :attr:`CycleResult.reason` in words (bad input raises instead: :func:`pinarms.optim.plan_cycle`).
     """
 
     #: as asked (without a cell, or its first check in the cell passed)
@@ -52,6 +53,17 @@ class CycleStatus(enum.Enum):
     REPLANNED = "re-planned"
     #: in a cell, the transfer was planned round what blocks (:mod:`pinarms.optim.motion.transfer`)
     TRANSFER_PLANNED = "transfer planned"
+    #: a waypoint (pick, above pick, via k, above place, place) has no IK solution within the joint limits
+    UNREACHABLE = "unreachable"
+    #: no timing of a move meets the limits (velocity, acceleration, jerk, torque)
+    LIMITS_NOT_MET = "limits not met"
+    #: in a cell: the pick or place pose, or an arm that does not move, is too close to something, or no
+    #: re-planned cycle keeps the clearance (the reason names the blocking bodies)
+    IN_COLLISION = "in collision"
+
+
+#: The statuses of a planned cycle (:attr:`CycleResult.solved`).
+SOLVED_STATUSES = (CycleStatus.OK, CycleStatus.REPLANNED, CycleStatus.TRANSFER_PLANNED)
 
 
 #: The four vertical segments whose straightness :class:`CycleResult` reports, in cycle order.
@@ -198,22 +210,25 @@ class CycleResult:
         torque_limit: torque limits (nq,) [N·m or N] the moves were timed under, or None.
         cell_report: planned in a cell (:class:`pinarms.optim.CellSettings`), how the cycle keeps its clearance
             (:class:`pinarms.optim.cycle.in_cell.CellCycleReport`); else None.
-        status: how it was planned (:class:`CycleStatus`).
+        status: how it was planned (:class:`CycleStatus`); ``reason``: why there is no cycle, in words
+            (empty when :attr:`solved`); ``error``: that failure as the exception
+            :meth:`raise_for_status` raises. A result that is not solved holds ``robot``, ``spec``,
+            ``status``, ``reason`` and ``error`` only (the other fields are None).
     """
 
     robot: str
     spec: PickPlace
-    names: tuple[str, ...]
-    waypoints: np.ndarray = field(repr=False)
-    q_via: np.ndarray = field(repr=False)
-    moves: tuple[TimingResult, TimingResult] = field(repr=False)
-    trajectory: Trajectory = field(repr=False)
-    peaks: Peaks = field(repr=False)
-    vmax: np.ndarray = field(repr=False)
-    amax: np.ndarray | None = field(repr=False)
-    jmax: np.ndarray | None = field(repr=False)
-    line_deviation: np.ndarray = field(repr=False)
-    branches: np.ndarray = field(repr=False)
+    names: tuple[str, ...] = ()
+    waypoints: np.ndarray | None = field(default=None, repr=False)
+    q_via: np.ndarray | None = field(default=None, repr=False)
+    moves: tuple[TimingResult, TimingResult] | None = field(default=None, repr=False)
+    trajectory: Trajectory | None = field(default=None, repr=False)
+    peaks: Peaks | None = field(default=None, repr=False)
+    vmax: np.ndarray | None = field(default=None, repr=False)
+    amax: np.ndarray | None = field(default=None, repr=False)
+    jmax: np.ndarray | None = field(default=None, repr=False)
+    line_deviation: np.ndarray | None = field(default=None, repr=False)
+    branches: np.ndarray | None = field(default=None, repr=False)
     payload: Payload | None = None
     torque_limit: np.ndarray | None = field(default=None, repr=False)
     approach: str = "joint"
@@ -238,6 +253,23 @@ class CycleResult:
         return np.maximum(*(m.torque_ratios for m in self.moves))
     cell_report: CellCycleReport | None = field(default=None, repr=False)
     status: CycleStatus = CycleStatus.OK
+    reason: str = ""
+    error: Exception | None = field(default=None, repr=False)
+
+    @property
+    def solved(self) -> bool:
+        """Whether there is a cycle (status ok, re-planned or transfer planned)."""
+        return self.status in SOLVED_STATUSES
+
+    def raise_for_status(self) -> "CycleResult":
+        """The result itself when :attr:`solved`; else raise its failure (:class:`pinarms.errors.UnreachableTarget`,
+        :class:`pinarms.optim.errors.InfeasibleProblem`, :class:`pinarms.errors.CollisionError`; the message is
+        :attr:`reason`)."""
+        if self.solved:
+            return self
+        if self.error is not None:
+            raise self.error
+        raise InfeasibleProblem(f"{self.status.value}: {self.reason}")
 
     @property
     def one_branch(self) -> bool:
@@ -246,8 +278,8 @@ class CycleResult:
 
     @property
     def move_times(self) -> np.ndarray:
-        """(2,) durations [s] of the move to place and the move to pick."""
-        return np.array([m.total for m in self.moves])
+        """(2,) durations [s] of the move to place and the move to pick (raises when not :attr:`solved`)."""
+        return np.array([m.total for m in self.raise_for_status().moves])
 
     @property
     def cycle_time(self) -> float:
@@ -275,7 +307,9 @@ class CycleResult:
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-able summary (SI units)."""
+        """JSON-able summary (SI units); not :attr:`solved`: the status, the reason and the robot."""
+        if not self.solved:
+            return {"status": self.status.value, "reason": self.reason, "robot": self.robot}
         return {
             "status": self.status.value,
             "robot": self.robot,

@@ -157,7 +157,7 @@ def evaluate_placement(robot: Robot, placement: np.ndarray, st: EvaluationSettin
             spec = PickPlace(pick, place, lift=st.lift, dwell=st.dwell, orientation=R)
             try:
                 timing = CycleTiming(st.kind, st.vmax, st.amax, st.jmax, method="exact", seed=st.seed)
-                cycle = plan_cycle(CycleRequest(robot, spec, timing=timing, cell=in_cell))
+                cycle = plan_cycle(CycleRequest(robot, spec, timing=timing, cell=in_cell)).raise_for_status()
             except PinarmsError as exc:
                 where = f"pick {i + 1} → place {j + 1}"
                 return _Outcome(_classify(exc), f"{where}: {exc}"), None

@@ -61,6 +61,7 @@ _EXPORTS = {
     "map_error": "pinarms.optim.line.task_map_error",
     "TaskMap": "pinarms.optim.line.task_maps",
     "PickPlan": "pinarms.optim.line.tracking",
+    "PickRequest": "pinarms.optim.line.tracking",
     "TrackingSpec": "pinarms.optim.line.tracking",
     "plan_pick": "pinarms.optim.line.tracking",
     "TrayMap": "pinarms.optim.line.tray_map",
@@ -69,6 +70,7 @@ _EXPORTS = {
     "SimPlace": "pinarms.optim.line.tray_sim",
     "TrayBelt": "pinarms.optim.line.trays",
     "TrayPickPlan": "pinarms.optim.line.trays",
+    "TrayPickRequest": "pinarms.optim.line.trays",
     "plan_pick_to_tray": "pinarms.optim.line.trays",
     "trays_beside": "pinarms.optim.line.trays",
     "PickWindow": "pinarms.optim.line.windows",
@@ -83,7 +85,7 @@ __all__ = [
     "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "TrayMap",
     "build_tray_map", "tray_map_error", "SimPlace", "trays_beside", "MapRequest", "TrayMapRequest",
-    "DeltaMapRequest", "MapResult", "MapStatus",
+    "DeltaMapRequest", "MapResult", "MapStatus", "PickRequest", "TrayPickRequest",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

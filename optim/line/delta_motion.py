@@ -25,10 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.delta_tracking import DeltaArm, platform_move_profile, tool_turn_time, tracking_platform
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import TrackingSpec, tool_yaw
+from pinarms.optim.line.tracking import PickRequest, tool_yaw
 from pinarms.optim.standard_cycle.delta_cycle import turn_angle
 from pinarms.optim.standard_cycle.timing import profile_position
 from pinarms.robots.delta import inverse_position
@@ -71,14 +70,17 @@ def _arm(station: Station) -> DeltaArm:
     return station.robot
 
 
-def delta_pick_motion(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, *, mass: float,
-                      item_height: float, yaw: float = 0.0, n: int = 24, hz: float = 100.0) -> DeltaPickMotion:
-    """The pick whose pre-grasp point is at belt coordinates (``u``, ``w``) as a motion (module doc),
-    sampled at ``hz`` [1/s] (segment ends included).
+def delta_pick_motion(request: PickRequest, *, n: int = 24, hz: float = 100.0) -> DeltaPickMotion:
+    """The pick ``request`` describes (a :class:`~pinarms.optim.line.tracking.PickRequest` of a delta's
+    station: its pre-grasp point at belt coordinates (``u_pre``, ``w``), the item's mass, height and yaw;
+    ``q_rest`` and ``branch`` do not apply to a delta) as a motion (module doc), sampled at ``hz`` [1/s]
+    (segment ends included), each move timed on ``n`` intervals.
 
     Raises:
         InfeasibleProblem: a point out of the workspace or the motors' range.
     """
+    station, belt, spec, u, w = request.station, request.belt, request.spec, request.u_pre, request.w
+    mass, item_height, yaw = request.mass, request.item_height, request.yaw
     arm = _arm(station)
     R = station.base_to_world[:3, :3]
     pre = station.world_to_base(belt.to_world(u, w, item_height + spec.lift))

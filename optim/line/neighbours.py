@@ -29,7 +29,7 @@ from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.optim.line.items import ItemType
 from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, plan_pick
 from pinarms.errors import InvalidInput, PinarmsError
 
 if TYPE_CHECKING:
@@ -89,8 +89,8 @@ class NeighbourGuard:
                 self._plans[key] = delta_pick_plan(st, self.belt, self.tracking, u, w, item_height=t.size[2],
                                                    mass=t.mass)
                 return self._plans[key]
-            self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
-                                         branch=branch, yaw=yaw)
+            self._plans[key] = plan_pick(PickRequest(st, self.belt, self.tracking, u, w, item_height=t.size[2],
+                                                     mass=t.mass, branch=branch, yaw=yaw))
         return self._plans[key]
 
     def __call__(self, pick: Pick | tuple, other: Pick | tuple) -> bool:

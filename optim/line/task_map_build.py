@@ -28,7 +28,7 @@ from pinarms.optim.line.map_nodes import map_key, node_fixtures, plan_node, plan
 from pinarms.optim.line.map_refine import add_yaw_nodes, bent_lines, bent_nodes, merge_nodes
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput
 from pinarms.execution import Scheduler, scheduler_session
@@ -57,9 +57,9 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int, float]:
     tC = np.full_like(tA, np.nan)
     for b, label in enumerate(labels):
         for j, w in enumerate(task["w"]):
-            plan, bad = plan_node(partial(plan_pick, st, belt, spec, u_base + task["du"], w, item_height=task["height"],
-                                          mass=task["mass"], q_rest=q_rest, branch=None if label < 0 else label,
-                                          yaw=yaw), fixtures)
+            request = PickRequest(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
+                                  q_rest=q_rest, branch=None if label < 0 else label, yaw=yaw)
+            plan, bad = plan_node(partial(plan_pick, request), fixtures)
             blocked += bad
             if plan is not None:
                 tA[b, j], tC[b, j] = plan.times[0], plan.times[2]

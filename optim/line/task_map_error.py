@@ -18,7 +18,7 @@ import numpy as np
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick, rest_configuration, tool_yaw
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, plan_pick, rest_configuration, tool_yaw
 from pinarms.errors import InvalidInput, PinarmsError
 
 __all__ = ["MapError", "map_error", "MAP_ERROR_TARGET"]
@@ -109,8 +109,8 @@ def map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpe
         if not (np.isfinite(tA) and np.isfinite(tC)):
             continue
         try:
-            plan = plan_pick(station, belt, spec, u_base + du, w, item_height=item_height, mass=task_map.mass,
-                             q_rest=q_rest, branch=task_map.branch_at(du, w, yaw), yaw=yaw)
+            plan = plan_pick(PickRequest(station, belt, spec, u_base + du, w, item_height=item_height,
+                    mass=task_map.mass, q_rest=q_rest, branch=task_map.branch_at(du, w, yaw), yaw=yaw))
         except PinarmsError:
             continue
         approx = float(tA + tC) + task_map.track + task_map.release

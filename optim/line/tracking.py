@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     from pinarms.planning.path_constraints import PathConstraint
     from pinarms.robots import Robot
 
-__all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
+__all__ = ["TrackingSpec", "PickPlan", "PickRequest", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
            "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError", "hand_joints", "tool_poses", "ik_path", "branch_label",
            "joint_rates", "hermite_path", "move_constraints", "timed_move", "check_rate_limits", "check_positions"]
 
@@ -311,18 +311,44 @@ def check_positions(station: Station, traj: Trajectory, what: str) -> None:
             "IK branch (try another branch, or move the arm or its box)")
 
 
-def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, *,
-              item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None, branch: int | None = None,
-              yaw: float = 0.0) -> PickPlan:
-    """Plan one pick whose pre-grasp point is at belt coordinates (``u_pre``, ``w``) (module doc).
+@dataclass(frozen=True, eq=False)
+class PickRequest:
+    """One pick of ``station``'s arm on ``belt`` (tracking as ``spec`` says) whose pre-grasp point is at belt
+    coordinates (``u_pre``, ``w``) [m], of an item ``item_height`` [m] tall weighing ``mass`` [kg] lying at
+    ``yaw`` [rad] on the belt (module doc).
 
     ``q_rest``: the arm's configuration at its box (default: IK of the place point nearest neutral).
     ``branch``: the closed-form IK branch of the tracking segment (:func:`ik_branch_labels`; what a
     task map chose there, :meth:`pinarms.optim.line.TaskMap.branch_at`); None: the rest configuration's
     branch where it reaches the pre-grasp point, else the nearest solution; when that plan leaves the
     position limits, the other branches reaching the pre-grasp point are tried in label order and
-    the first within them is returned. ``yaw`` [rad]: the
-    item's yaw on the belt; the hand turns to :func:`tool_yaw` for the whole tracking segment.
+    the first within them is returned. The hand turns to :func:`tool_yaw` for the whole tracking segment.
+
+    Raises:
+        InvalidInput: a coordinate, height, mass or yaw that is not a finite number (height and mass >= 0).
+    """
+
+    station: Station
+    belt: Belt
+    spec: TrackingSpec
+    u_pre: float
+    w: float
+    item_height: float = 0.04
+    mass: float = 0.0
+    q_rest: np.ndarray | None = None
+    branch: int | None = None
+    yaw: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("u_pre", "w", "yaw", "item_height", "mass"):
+            object.__setattr__(self, name, finite_number(getattr(self, name), f"pick {name}"))
+        for name in ("item_height", "mass"):
+            if getattr(self, name) < 0.0:
+                raise InvalidInput(f"pick {name} must be >= 0, got {getattr(self, name)!r}")
+
+
+def plan_pick(request: PickRequest) -> PickPlan:
+    """Plan the pick ``request`` describes (a :class:`PickRequest`; module doc).
 
     Raises:
         UnreachableTarget: a point of the tracking segment or the box out of reach.
@@ -330,6 +356,8 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
             the planned joint trajectory leaves the arm's position limits (:data:`POSITION_TOL`) on
             every IK branch tried.
     """
+    station, belt, spec, u_pre, w = request.station, request.belt, request.spec, request.u_pre, request.w
+    item_height, mass, q_rest, branch, yaw = request.item_height, request.mass, request.q_rest, request.branch, request.yaw
     robot = station.robot
     q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
     tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)

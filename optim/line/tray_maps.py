@@ -23,9 +23,9 @@ from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.task_map_build import PROBE_COLUMNS, PROBE_YAWS
-from pinarms.optim.line.tracking import (TrackingSpec, branch_label, can_yaw, ik_branch_labels, plan_pick,
+from pinarms.optim.line.tracking import (PickRequest, TrackingSpec, branch_label, can_yaw, ik_branch_labels, plan_pick,
                                          rest_configuration)
-from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
+from pinarms.optim.line.trays import TrayBelt, TrayPickRequest, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput, PinarmsError
 from pinarms.execution import Scheduler, scheduler_session
@@ -48,15 +48,15 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     u = u_base + task["du"]
     yaw = plan_yaw(task.get("yaw", 0.0), spec.yaw_period)
     for j, w in enumerate(task["w"]):
-        pick, _ = plan_node(partial(plan_pick, st, belt, spec, u, w, item_height=task["height"], mass=task["mass"],
-                                    q_rest=q_rest, yaw=yaw), None)
+        request = PickRequest(st, belt, spec, u, w, item_height=task["height"], mass=task["mass"], q_rest=q_rest,
+                              yaw=yaw)
+        pick, _ = plan_node(partial(plan_pick, request), None)
         if pick is None:
             continue  # no pick here: no place either
         for b, label in enumerate(labels):
             for k, dv in enumerate(task["dv"]):
-                p, bad = plan_node(partial(plan_pick_to_tray, st, belt, trays, spec, u, w, v_base + dv,
-                                           item_height=task["height"], mass=task["mass"], q_rest=q_rest,
-                                           place_branch=None if label < 0 else label, pick=pick, yaw=yaw), fixtures)
+                place = TrayPickRequest(request, trays, v_base + dv, place_branch=None if label < 0 else label)
+                p, bad = plan_node(partial(plan_pick_to_tray, place, pick=pick), fixtures)
                 blocked += bad
                 if p is None:
                     continue
@@ -194,8 +194,9 @@ def tray_map_error(tray_map: TrayMap, station: Station, belt: Belt, trays: TrayB
         if not np.isfinite(tA + tX + tR):
             continue
         try:
-            p = plan_pick_to_tray(station, belt, trays, spec, u_base + du, w, v_base + dv, item_height=item_height,
-                                  mass=m.mass, q_rest=q_rest, place_branch=m.branch_at(du, w, dv))
+            p = plan_pick_to_tray(TrayPickRequest(PickRequest(station, belt, spec, u_base + du, w,
+                    item_height=item_height, mass=m.mass, q_rest=q_rest), trays, v_base + dv,
+                    place_branch=m.branch_at(du, w, dv)))
         except PinarmsError:
             continue
         approx = float(tA + tX + tR) + m.track + m.place

@@ -34,13 +34,14 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.numbers import finite_number
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, check_rate_limits, move_constraints, hand_joints,
-                                         check_positions, hermite_path, ik_path, joint_rates, tool_poses, timed_move, plan_pick,
+                                         check_positions, hermite_path, ik_path, joint_rates, tool_poses, timed_move, PickPlan,
+                                         PickRequest, plan_pick,
                                          rest_configuration, tool_yaw, tracking_points)
 from pinarms.planning import Trajectory
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "trays_beside", "parse_trays"]
+__all__ = ["TrayBelt", "TrayPickPlan", "TrayPickRequest", "plan_pick_to_tray", "trays_beside", "parse_trays"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,25 +203,43 @@ def _segments(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: flo
     return out
 
 
-def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: TrackingSpec, u_pre: float, w: float,
-                      u_place: float, *, item_height: float = 0.04, mass: float = 0.0, q_rest: Any = None,
-                      branch: int | None = None, yaw: float = 0.0, place_branch: int | None = None,
-                      pick: Any = None) -> TrayPickPlan:
-    """Pick at (``u_pre``, ``w``) on ``belt`` and place in the tray whose place point passes
-    ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); arguments as
-    :func:`~.tracking.plan_pick`; ``place_branch``: the IK branch label of the place tracking
-    segment (None: the pick's where it reaches, else the nearest); ``pick``: the
-    :func:`~.tracking.plan_pick` of this very pick when already planned (the tray maps plan it
-    once for every place point), else planned here.
+@dataclass(frozen=True, eq=False)
+class TrayPickRequest:
+    """A pick (``pick``, a :class:`~.tracking.PickRequest`) placed in the tray of ``trays`` whose place point
+    passes ``u_place`` [m] (tray belt) at the place's rendezvous (module doc); ``place_branch``: the IK
+    branch label of the place tracking segment (None: the pick's where it reaches, else the nearest).
+
+    Raises:
+        InvalidInput: ``u_place`` not a finite number.
+    """
+
+    pick: PickRequest
+    trays: TrayBelt
+    u_place: float
+    place_branch: int | None = None
+
+    def __post_init__(self) -> None:
+        u = float(self.u_place) if isinstance(self.u_place, (int, float, np.integer, np.floating)) else float("nan")
+        if not np.isfinite(u) or isinstance(self.u_place, bool):
+            raise InvalidInput(f"u_place [m] must be a finite number, got {self.u_place!r}")
+        object.__setattr__(self, "u_place", u)
+
+
+def plan_pick_to_tray(request: TrayPickRequest, *, pick: PickPlan | None = None) -> TrayPickPlan:
+    """Plan the pick and place ``request`` describes (a :class:`TrayPickRequest`; module doc); ``pick``: the
+    :func:`~.tracking.plan_pick` of this very pick when already planned (the tray maps plan it once for
+    every place point), else planned here.
 
     Raises:
         UnreachableTarget: a point of either tracking segment out of reach.
         InfeasibleProblem: a belt too fast for the arm there, or a move beyond its limits.
     """
-    q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
+    r = request.pick
+    station, spec, mass, yaw, u_pre, w = r.station, r.spec, r.mass, r.yaw, r.u_pre, r.w
+    trays, u_place, place_branch = request.trays, request.u_place, request.place_branch
+    q_rest = rest_configuration(station) if r.q_rest is None else np.asarray(r.q_rest, float)
     if pick is None:
-        pick = plan_pick(station, belt, spec, u_pre, w, item_height=item_height, mass=mass, q_rest=q_rest,
-                         branch=branch, yaw=yaw)
+        pick = plan_pick(replace(r, q_rest=q_rest))
     q_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[0][0]
     qd_end = pick.tracking.sample(np.array([pick.tracking.end_time]))[1][0]
     place_spec = replace(spec, grasp=spec.release)  # the dwell is the gripper opening

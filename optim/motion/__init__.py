@@ -49,7 +49,10 @@ _EXPORTS = {
     "scene_path": "pinarms.optim.motion.scenes",
     "scene_queries": "pinarms.optim.motion.scenes",
     "PLANNERS": "pinarms.optim.motion.search",
+    "SearchSettings": "pinarms.optim.motion.search",
+    "AroundRequest": "pinarms.optim.motion.two_arms",
     "AroundPlan": "pinarms.optim.motion.two_arms",
+    "TwoArmRequest": "pinarms.optim.motion.two_arms",
     "TwoArmPlan": "pinarms.optim.motion.two_arms",
     "plan_around": "pinarms.optim.motion.two_arms",
     "plan_two_arms": "pinarms.optim.motion.two_arms",
@@ -62,7 +65,7 @@ __all__ = [
     "ClearanceProfile", "GoalCandidate", "MotionChecker", "TimedArm", "Verdict", "FastCheck", "fast_check",
     "fast_search", "fast_shortcut", "PLANNERS", "SCENES", "Scene", "Region", "Query", "scene_names",
     "scene_path", "load_scene", "scene_queries", "plan_around", "plan_two_arms", "AroundPlan", "TwoArmPlan",
-    "planned_cycle", "PlannedMove",
+    "AroundRequest", "TwoArmRequest", "SearchSettings", "planned_cycle", "PlannedMove",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -22,7 +22,7 @@ from pinarms.optim.errors import NoPathFound
 from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_search, fast_shortcut
 from pinarms.optim.motion.report import FAST_SIMPLIFIER, SIMPLIFIER
-from pinarms.optim.motion.search import search, shortcut
+from pinarms.optim.motion.search import SearchSettings, search, shortcut
 from pinarms.optim.motion.smoothing import smooth_path
 from pinarms.errors import InvalidInput
 
@@ -112,7 +112,7 @@ def find_path(checker: MotionChecker, x0: np.ndarray, G: np.ndarray, *, planner:
             return {"result": fast, "simplified": simplified, "simplifier": FAST_SIMPLIFIER, "compiled": True,
                     "seconds": {"search": fast.seconds, "shortcut": time.perf_counter() - t}}
     rest = max(float(time_limit) - (time.perf_counter() - t0), 1e-3)
-    result = search(checker, x0, G, planner=planner, time_limit=rest, seed=int(seed))
+    result = search(checker, x0, G, SearchSettings(planner=planner, time_limit=rest, seed=int(seed)))
     seconds = {"search": spent + result.seconds}
     if result.path is None:
         raise NoPathFound(

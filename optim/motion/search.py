@@ -32,7 +32,7 @@ from pinarms.optim.errors import InvalidSettings
 if TYPE_CHECKING:
     from pinarms.optim.motion.checker import MotionChecker
 
-__all__ = ["PLANNERS", "SearchResult", "search", "shortcut"]
+__all__ = ["PLANNERS", "SearchResult", "SearchSettings", "search", "shortcut"]
 
 #: Planner names accepted by :func:`search` (OMPL classes of ``ompl.geometric``).
 PLANNERS = {
@@ -129,19 +129,39 @@ def _setup(ob, og, checker, lower, upper):
     return ss, si, validator, valid
 
 
-def search(checker: MotionChecker, start: np.ndarray, goals: np.ndarray, *, planner: str = "rrtconnect",
-           time_limit: float = 1.0, seed: int = 0, lower: np.ndarray | None = None, upper: np.ndarray | None = None,
-           planner_range: float | None = None, scale: np.ndarray | None = None,
-           progress: Callable[[str], None] | None = None) -> SearchResult:
-    """Search a path from ``start (dim,)`` to any of ``goals (G, dim)`` with OMPL (module docstring).
+@dataclass(frozen=True)
+class SearchSettings:
+    """How :func:`search` searches: the OMPL ``planner`` (a key of :data:`PLANNERS`), its ``time_limit`` [s]
+    and ``seed``, the box of the state space (``lower``/``upper``, default the checker's joint limits), the
+    planner's ``planner_range`` (its step; ``None``: OMPL's) and ``scale``: per-coordinate factors the search
+    works in (the time coordinate of a space-time search), undone on the returned path.
 
-    ``lower``/``upper``: the box of the state space (default the checker's joint limits);
-    ``scale``: per-coordinate factors the search works in (the time coordinate of a
-    space-time search), undone on the returned path.
+    Raises:
+        InvalidSettings: an unknown planner, a time limit that is not a finite positive number.
     """
+
+    planner: str = "rrtconnect"
+    time_limit: float = 1.0
+    seed: int = 0
+    lower: np.ndarray | None = None
+    upper: np.ndarray | None = None
+    planner_range: float | None = None
+    scale: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if str(self.planner).lower() not in PLANNERS:
+            raise InvalidSettings(f"unknown planner {self.planner!r}; use one of {', '.join(PLANNERS)}")
+        if not (np.isfinite(self.time_limit) and self.time_limit > 0.0):
+            raise InvalidSettings(f"time_limit must be a finite positive number of seconds, got {self.time_limit!r}")
+
+
+def search(checker: MotionChecker, start: np.ndarray, goals: np.ndarray, settings: SearchSettings = SearchSettings(),
+           *, progress: Callable[[str], None] | None = None) -> SearchResult:
+    """Search a path from ``start (dim,)`` to any of ``goals (G, dim)`` with OMPL (module docstring), as
+    ``settings`` say (:class:`SearchSettings`)."""
+    planner, time_limit, seed = settings.planner, settings.time_limit, settings.seed
+    lower, upper, planner_range, scale = settings.lower, settings.upper, settings.planner_range, settings.scale
     key = str(planner).lower()
-    if key not in PLANNERS:
-        raise InvalidSettings(f"unknown planner {planner!r}; use one of {', '.join(PLANNERS)}")
     ob, og, ou = _ompl()
     lo = np.asarray(checker.lower if lower is None else lower, dtype=float)
     hi = np.asarray(checker.upper if upper is None else upper, dtype=float)

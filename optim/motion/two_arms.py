@@ -20,6 +20,13 @@ start instant up to A's end), plans both arms in their joint space (:func:`plan_
 with two arms: A from its trajectory's start to its end, B from its start to its goal).
 Every result is re-checked by the cell's own continuous time check with both arms moving
 (:func:`pinarms.robots.cell.check_motion`).
+
+Both take one frozen request (:class:`AroundRequest`, :class:`TwoArmRequest`, checked when
+built: bad input raises there) and return a plan whose ``status`` is a
+:class:`~pinarms.optim.motion.result.MotionStatus` as :func:`plan_motion`'s: ``solved``, or what
+planning found (start in collision with a moving arm, no path, no start delay that clears the
+moving arms' sweep, goal in collision, limits not met, the re-check failed), with the ``reason``
+in words; ``raise_for_status()`` raises it as the project's error.
 """
 
 from __future__ import annotations
@@ -31,20 +38,21 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from pinarms.optim.errors import InvalidSettings, NoPathFound, PlanningError
+from pinarms.optim.errors import EndpointInCollision, InfeasibleProblem, InvalidSettings, NoPathFound, PlanningError
 from pinarms.optim.motion.checker import MotionChecker, TimedArm
 from pinarms.optim.motion.ends import check_end
 from pinarms.optim.motion.plan import plan_motion
 from pinarms.optim.motion.request import MotionRequest
 from pinarms.optim.motion.result import MotionPlan, MotionStatus
 from pinarms.planning import Trajectory
-from pinarms.errors import InvalidInput
+from pinarms.errors import InvalidInput, UnreachableTarget
 
 if TYPE_CHECKING:
     from pinarms.robots.cell import Cell
     from pinarms.robots.cell.motion_report import MotionCheck
 
-__all__ = ["AroundPlan", "TwoArmPlan", "plan_around", "plan_two_arms", "DELAY_SAMPLES"]
+__all__ = ["AroundRequest", "AroundPlan", "TwoArmRequest", "TwoArmPlan", "plan_around", "plan_two_arms",
+           "DELAY_SAMPLES"]
 
 #: Instants per start delay at which :func:`plan_around` screens the delays before proving them.
 DELAY_SAMPLES = 64
@@ -53,10 +61,54 @@ DELAY_BLOCK = 8
 
 
 @dataclass(frozen=True, eq=False)
-class AroundPlan:
-    """Arm B planned around timed arms (see the module docstring).
+class AroundRequest:
+    """Arm B's motion around arms that follow their own timed trajectories (:func:`plan_around`).
 
     Attributes:
+        motion: B's motion (one arm; :class:`.request.MotionRequest`: its options and limits,
+            ``hold`` the cell configuration of the arms neither planned nor moving).
+        moving: ``{arm: trajectory}``, ``{arm: (trajectory, offset)}`` or :class:`TimedArm` s:
+            the arms that follow their own trajectories meanwhile (cell time = offset +
+            trajectory time − its start; they hold their ends outside); kept as :class:`TimedArm` s.
+        t0: when B may leave its start [s, cell time].
+        delay_step: resolution of the start delay [s].
+        screen: screen the delays in batches before proving them (module docstring; proofs of
+            failure only, the same delay kept); ``False``: every delay proven in turn.
+
+    Raises:
+        InvalidInput: a motion that is not one arm's :class:`MotionRequest`, no moving arm.
+        InvalidSettings: ``delay_step`` not a positive number of seconds.
+    """
+
+    motion: MotionRequest
+    moving: Mapping[str, Trajectory | tuple[Trajectory, float]] | Sequence[TimedArm]
+    t0: float = 0.0
+    delay_step: float = 0.05
+    screen: bool = True
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.motion, MotionRequest) or len(self.motion.arms) != 1:
+            raise InvalidInput("plan_around takes the MotionRequest of one arm (plan both together with plan_motion)")
+        timed = _timed_arms(self.motion.cell, self.moving)
+        if not timed:
+            raise InvalidInput("plan_around needs at least one moving arm (use plan_motion otherwise)")
+        object.__setattr__(self, "moving", timed)
+        step = self.delay_step
+        ok = isinstance(step, (int, float)) and not isinstance(step, bool) and np.isfinite(step)
+        if not ok or step <= 0.0:
+            raise InvalidSettings(f"delay_step must be a positive number of seconds, got {step!r}")
+        if not np.isfinite(float(self.t0)):
+            raise InvalidInput(f"t0 must be a finite time [s], got {self.t0!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class AroundPlan:
+    """Arm B planned around timed arms (see the module docstring), or why not.
+
+    Attributes:
+        status: a :class:`MotionStatus` (``solved``, or what planning found); ``reason``: why it is
+            not solved, in words; ``error``: that failure as the exception :meth:`raise_for_status` raises.
+            Not solved: ``cell``, ``arm`` and ``moving`` are set, the others may be None.
         arm: B's name; ``moving``: the :class:`TimedArm` s it avoids; ``t0``: when B may
             leave [s, cell time]; ``delay``: how long it waits there for them [s].
         plan: B's geometric path and its time-optimal timing (a :class:`MotionPlan` made
@@ -70,30 +122,77 @@ class AroundPlan:
     cell: Cell = field(repr=False)
     arm: str
     moving: tuple
-    t0: float
-    delay: float
-    plan: MotionPlan = field(repr=False)
-    trajectory: Trajectory = field(repr=False)
-    check: MotionCheck = field(repr=False)
-    delays_tried: int
-    seconds: dict = field(repr=False)
+    t0: float | None = None
+    delay: float | None = None
+    plan: MotionPlan | None = field(default=None, repr=False)
+    trajectory: Trajectory | None = field(default=None, repr=False)
+    check: MotionCheck | None = field(default=None, repr=False)
+    delays_tried: int | None = None
+    seconds: dict | None = field(default=None, repr=False)
+    status: MotionStatus = MotionStatus.SOLVED
+    reason: str = ""
+    error: Exception | None = field(default=None, repr=False)
+
+    def raise_for_status(self) -> AroundPlan:
+        """The plan itself when solved; else raise its failure (:class:`pinarms.optim.StartInCollision`,
+        :class:`pinarms.optim.NoPathFound`, ...; the message is :attr:`reason`)."""
+        if self.status is MotionStatus.SOLVED:
+            return self
+        if self.error is not None:
+            raise self.error
+        raise PlanningError(f"{self.status.value}: {self.reason}")
 
     @property
     def end_time(self) -> float:
         """When B arrives [s, cell time]."""
-        return float(self.trajectory.end_time)
+        return float(self.raise_for_status().trajectory.end_time)
 
     @property
     def duration(self) -> float:
         """B's motion time without the wait [s]."""
-        return float(self.plan.duration)
+        return float(self.raise_for_status().plan.duration)
+
+
+@dataclass(frozen=True, eq=False)
+class TwoArmRequest:
+    """Arm B's motion (``motion``, one arm) while ``other`` (A) follows ``other_trajectory``, played from cell
+    time ``other_offset`` [s]; B may leave at ``t0`` [s] (:func:`plan_two_arms`).
+
+    Raises:
+        InvalidInput: a motion that is not one arm's :class:`MotionRequest`, ``other`` not another arm
+            of the cell, a trajectory that is not one, an offset or ``t0`` that is not a finite time.
+    """
+
+    motion: MotionRequest
+    other: str
+    other_trajectory: Trajectory
+    other_offset: float = 0.0
+    t0: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.motion, MotionRequest) or len(self.motion.arms) != 1:
+            raise InvalidInput("plan_two_arms takes the MotionRequest of one arm (B); A is other and other_trajectory")
+        names = [a.name for a in self.motion.cell.arms]
+        if self.other not in names or self.other == self.motion.arms[0]:
+            raise InvalidInput(f"other must be another arm of cell {self.motion.cell.name!r} than "
+                               f"{self.motion.arms[0]!r}; arms: {', '.join(names)}, got {self.other!r}")
+        if not isinstance(self.other_trajectory, Trajectory):
+            raise InvalidInput(f"other_trajectory must be a pinarms.planning.Trajectory, got "
+                               f"{type(self.other_trajectory).__name__}")
+        for name in ("other_offset", "t0"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not np.isfinite(value):
+                raise InvalidInput(f"{name} must be a finite time [s], got {value!r}")
 
 
 @dataclass(frozen=True, eq=False)
 class TwoArmPlan:
-    """The outcome of :func:`plan_two_arms`: which method worked and each arm's trajectory.
+    """The outcome of :func:`plan_two_arms`: which method worked and each arm's trajectory, or why none.
 
     Attributes:
+        status: a :class:`MotionStatus` (``solved``, or the joint plan's / the first failure's status);
+            ``reason`` in words; ``error``: the exception :meth:`raise_for_status` raises.
         method: ``"around"`` (B planned around A's trajectory, A unchanged) or ``"joint"``
             (both planned together; A's path changed, its ends kept).
         trajectories: ``{arm: Trajectory}``; ``offsets``: ``{arm: offset}`` [s] to play them
@@ -105,18 +204,30 @@ class TwoArmPlan:
         check: the cell's continuous check of both arms together.
     """
 
-    method: str
-    trajectories: dict
-    offsets: dict
-    around: AroundPlan | None = field(repr=False)
-    joint: MotionPlan | None = field(repr=False)
-    attempts: tuple
-    check: MotionCheck = field(repr=False)
+    method: str | None = None
+    trajectories: dict | None = None
+    offsets: dict | None = None
+    around: AroundPlan | None = field(default=None, repr=False)
+    joint: MotionPlan | None = field(default=None, repr=False)
+    attempts: tuple = ()
+    check: MotionCheck | None = field(default=None, repr=False)
+    status: MotionStatus = MotionStatus.SOLVED
+    reason: str = ""
+    error: Exception | None = field(default=None, repr=False)
+
+    def raise_for_status(self) -> TwoArmPlan:
+        """The plan itself when solved; else raise its failure (:meth:`AroundPlan.raise_for_status`)."""
+        if self.status is MotionStatus.SOLVED:
+            return self
+        if self.error is not None:
+            raise self.error
+        raise PlanningError(f"{self.status.value}: {self.reason}")
 
     @property
     def end_time(self) -> float:
         """When the last arm arrives [s, cell time]."""
-        return max(self.offsets[a] + t.duration for a, t in self.trajectories.items())
+        plan = self.raise_for_status()
+        return max(plan.offsets[a] + t.duration for a, t in plan.trajectories.items())
 
 
 def _timed_arms(cell: Any, moving: Any) -> tuple[TimedArm, ...]:
@@ -157,42 +268,44 @@ def _screened_delays(together: MotionChecker, trajectory: Trajectory, x0: np.nda
     return together.batch_collides(together.full(X)).reshape(len(delays), DELAY_SAMPLES).any(axis=1)
 
 
-def plan_around(request: MotionRequest,
-                moving: Mapping[str, Trajectory | tuple[Trajectory, float]] | Sequence[TimedArm], *,
-                t0: float = 0.0, delay_step: float = 0.05, screen: bool = True,
-                progress: Callable[[str], None] | None = None) -> AroundPlan:
-    """Plan the request's arm (B) from its start (ready at cell time ``t0``) to its goal around the ``moving`` arms.
+def plan_around(request: AroundRequest, *, progress: Callable[[str], None] | None = None) -> AroundPlan:
+    """Plan the request's arm (B) from its start (ready at cell time ``request.t0``) to its goal around the
+    ``request.moving`` arms (:class:`AroundRequest`; module docstring).
 
-    Args:
-        request: B's motion (one arm; :class:`.request.MotionRequest`: its options and limits,
-            ``hold`` the cell configuration of the arms neither planned nor moving).
-        moving: ``{arm: trajectory}``, ``{arm: (trajectory, offset)}`` or :class:`TimedArm` s:
-            the arms that follow their own trajectories meanwhile (cell time = offset +
-            trajectory time − its start; they hold their ends outside).
-        t0: when B may leave its start [s, cell time].
-        delay_step: resolution of the start delay [s].
-        screen: screen the delays in batches before proving them (module docstring; proofs of
-            failure only, the same delay kept); ``False``: every delay proven in turn.
-
-    Raises:
-        InvalidInput: a request for two arms, no moving arm.
-        StartInCollision: B's start touches a moving arm at ``t0``.
-        NoPathFound: no path around the moving arms' end configuration, or no start delay up
-            to their end that clears their motion (the message says which).
-        GoalInCollision, ...: the other statuses of :func:`plan_motion`, raised
-            (:meth:`.result.MotionPlan.raise_for_status`).
+    Returns:
+        :class:`AroundPlan`; its ``status`` says ``solved`` or why not, with the reason: B's start
+        touching a moving arm at ``t0`` (``start in collision``), no path around the moving arms'
+        end configuration or no start delay up to their end that clears their motion (``no path``;
+        the reason says which), or the other statuses of :func:`plan_motion` (goal in collision,
+        limits not met, ...), or the check of both arms together failing (``recheck failed``).
     """
     t_all = time.perf_counter()
-    say = progress or (lambda _m: None)
-    if not isinstance(request, MotionRequest) or len(request.arms) != 1:
-        raise InvalidInput("plan_around takes the MotionRequest of one arm (plan both together with plan_motion)")
+    timed, arm = request.moving, request.motion.arms[0]
+    try:
+        return _around(request, progress or (lambda _m: None), t_all)
+    except (PlanningError, UnreachableTarget, InfeasibleProblem) as exc:
+        return AroundPlan(cell=request.motion.cell, arm=arm, moving=timed, t0=float(request.t0),
+                          status=_status_of(exc), reason=str(exc), error=exc)
+
+
+def _status_of(exc: Exception) -> MotionStatus:
+    """The :class:`MotionStatus` of a planning failure (as :func:`plan_motion` reports it)."""
+    if isinstance(exc, EndpointInCollision):
+        return {"start": MotionStatus.START_IN_COLLISION, "hold": MotionStatus.HOLD_IN_COLLISION}.get(
+            exc.which, MotionStatus.GOAL_IN_COLLISION)
+    if isinstance(exc, UnreachableTarget):
+        return MotionStatus.GOAL_UNREACHABLE
+    if isinstance(exc, NoPathFound):
+        return MotionStatus.NO_PATH
+    if isinstance(exc, InfeasibleProblem):
+        return MotionStatus.LIMITS_NOT_MET
+    return MotionStatus.RECHECK_FAILED
+
+
+def _around(around: AroundRequest, say: Callable[[str], None], t_all: float) -> AroundPlan:
+    """:func:`plan_around`'s work; its failures raised (the caller makes them statuses)."""
+    request, timed, t0, delay_step = around.motion, around.moving, float(around.t0), float(around.delay_step)
     cell, arms, o = request.cell, request.arms, request.options
-    timed = _timed_arms(cell, moving)
-    if not timed:
-        raise InvalidInput("plan_around needs at least one moving arm (use plan_motion otherwise)")
-    ok = isinstance(delay_step, (int, float)) and not isinstance(delay_step, bool) and np.isfinite(delay_step)
-    if not ok or delay_step <= 0.0:
-        raise InvalidSettings(f"delay_step must be a positive number of seconds, got {delay_step!r}")
     base = cell.hold if request.hold is None else np.array(request.hold)
     parked = base.copy()
     for m in timed:
@@ -218,7 +331,7 @@ def plan_around(request: MotionRequest,
     for k, d in enumerate(delays):
         if k == rejected.size:  # the next block of delays screened at once
             block = delays[k : k + DELAY_BLOCK]
-            more = (_screened_delays(together, plan.trajectory, x0, float(t0), block, t_end) if screen
+            more = (_screened_delays(together, plan.trajectory, x0, float(t0), block, t_end) if around.screen
                     else np.zeros(block.size, dtype=bool))
             rejected = np.append(rejected, more)
         if rejected[k]:
@@ -256,46 +369,54 @@ def _check_together(cell: Any, planned: Mapping[str, tuple], timed: tuple, check
     return check
 
 
-def plan_two_arms(request: MotionRequest, other: str, other_trajectory: Trajectory, *, other_offset: float = 0.0,
-                  t0: float = 0.0, progress: Callable[[str], None] | None = None) -> TwoArmPlan:
-    """Plan the request's arm (B) while ``other`` (A) follows ``other_trajectory``; both together if that fails.
+def plan_two_arms(request: TwoArmRequest, *, progress: Callable[[str], None] | None = None) -> TwoArmPlan:
+    """Plan the request's arm (B) while ``request.other`` (A) follows its trajectory; both together if that fails.
 
-    First :func:`plan_around` (A keeps its trajectory). If it finds nothing, both arms are
-    planned in their joint space with :func:`plan_motion` (the request's options and limits),
-    both leaving at ``t0``: A from where its trajectory has it at ``t0`` to the trajectory's
-    last configuration, B from its start to its goal (a joint goal). A's own path and timing
-    are then replaced.
+    First :func:`plan_around` (A keeps its trajectory). If it finds no path (``no path``: no path
+    around A's end, or no start instant that clears A's sweep), both arms are planned in their
+    joint space with :func:`plan_motion` (the request's options and limits), both leaving at
+    ``t0``: A from where its trajectory has it at ``t0`` to the trajectory's last configuration,
+    B from its start to its goal (a joint goal). A's own path and timing are then replaced.
+
+    Returns:
+        :class:`TwoArmPlan`; ``status`` ``solved`` (``method`` says which worked), else the status of
+        :func:`plan_around` when it failed otherwise than ``no path`` (e.g. B's start in collision
+        with A), or the joint plan's status, with the reason.
 
     Raises:
-        InvalidInput: a request for two arms, or a pose goal when both must be planned together.
-        NoPathFound, GoalInCollision, ...: the joint plan's status, raised
-            (:meth:`.result.MotionPlan.raise_for_status`).
+        InvalidInput: a pose goal when both must be planned together (bad requests raise when built:
+            :class:`TwoArmRequest`).
     """
-    if not isinstance(request, MotionRequest) or len(request.arms) != 1:
-        raise InvalidInput("plan_two_arms takes the MotionRequest of one arm (B); A is other and other_trajectory")
-    cell, arm = request.cell, request.arms[0]
+    motion, other, tr, other_offset, t0 = (request.motion, request.other, request.other_trajectory,
+                                           float(request.other_offset), float(request.t0))
+    cell, arm = motion.cell, motion.arms[0]
     attempts = []
-    try:
-        around = plan_around(request, {other: (other_trajectory, other_offset)}, t0=t0, progress=progress)
+    around = plan_around(AroundRequest(motion, {other: (tr, other_offset)}, t0=t0), progress=progress)
+    if around.status is MotionStatus.SOLVED:
         attempts.append(("around", f"leaves after {around.delay:.2f} s, arrives at {around.end_time:.3f} s"))
-        return TwoArmPlan("around", {arm: around.trajectory, other: other_trajectory},
+        return TwoArmPlan("around", {arm: around.trajectory, other: tr},
                           {arm: around.trajectory.start_time, other: other_offset}, around, None, tuple(attempts),
                           around.check)
-    except NoPathFound as exc:
-        attempts.append(("around", str(exc)))
+    attempts.append(("around", around.reason))
+    if around.status is not MotionStatus.NO_PATH:
+        return TwoArmPlan(around=around, attempts=tuple(attempts), status=around.status, reason=around.reason,
+                          error=around.error)
     if progress:
         progress("planning both arms together")
-    tr = other_trajectory
     now = float(np.clip(t0 - other_offset + tr.start_time, tr.start_time, tr.end_time))
     a_start = np.asarray(tr.sample(now)[0], dtype=float)  # where A is when both leave
     a_end = np.asarray(tr.sample(tr.end_time)[0], dtype=float)
-    both = MotionRequest(cell, (other, arm), {other: a_start, arm: np.array(request.start)},
-                         {other: a_end, arm: np.array(request.goal)}, options=request.options, hold=request.hold,
-                         limits=request.limits)
-    joint = plan_motion(both, progress=progress).raise_for_status()
+    both = MotionRequest(cell, (other, arm), {other: a_start, arm: np.array(motion.start)},
+                         {other: a_end, arm: np.array(motion.goal)}, options=motion.options, hold=motion.hold,
+                         limits=motion.limits)
+    joint = plan_motion(both, progress=progress)
+    if joint.status is not MotionStatus.SOLVED:
+        attempts.append(("joint", joint.reason))
+        return TwoArmPlan(around=around, joint=joint, attempts=tuple(attempts), status=joint.status,
+                          reason=joint.reason, error=joint.error)
     attempts.append(("joint", f"both arms together, {joint.duration:.3f} s"))
     na = cell.arm(other).nq
     traj = joint.trajectory
     ta = Trajectory(traj.knot_times + t0, traj.coefficients[:, :, :na])
     tb = Trajectory(traj.knot_times + t0, traj.coefficients[:, :, na:])
-    return TwoArmPlan("joint", {other: ta, arm: tb}, {other: t0, arm: t0}, None, joint, tuple(attempts), joint.check)
+    return TwoArmPlan("joint", {other: ta, arm: tb}, {other: t0, arm: t0}, around, joint, tuple(attempts), joint.check)

@@ -7,7 +7,8 @@ maps are built (a progress line on stderr while a step takes over 2 s)."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import click
 import numpy as np
@@ -15,13 +16,62 @@ import numpy as np
 from pinarms.errors import InvalidInput
 
 from pinarms.cli._common import cli, emit, json_option, progress_bar, scheduler_option
-from pinarms.cli.belt_robot import box_value, grid_value, load_belt_robot, robot_options
+from pinarms.cli.belt_robot import BeltRobotFlags
+from pinarms.cli.option_groups import Flag, flag, option_group
 
 PRESETS = ("scara", "gantry")
 
 
-def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit: bool, rule: str, seeds: int,
-          duration: float, arrivals: str | None, robot: dict | None = None):
+@dataclass(frozen=True)
+class BeltFlow:
+    """The line simulated: the ``preset``'s arms, the flow (``rate`` items/min), the belt ``speed`` [m/s]
+    (``None``: the preset's), seed 000's joint-1 limit (``paper_limit``), the assignment ``rule``, the Monte
+    Carlo ``seeds`` and the simulated ``duration`` [s] per seed."""
+
+    preset: str = "scara"
+    rate: float = 60.0
+    speed: float | None = None
+    paper_limit: bool = False
+    rule: str = "first"
+    seeds: int = 5
+    duration: float = 600.0
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--preset", type=click.Choice(PRESETS), default="scara", show_default=True,
+             help="scara: seed 000's SCARAs and enoki bunches; gantry: seed 002's gantry and flowers."),
+        flag("--rate", type=float, default=60.0, show_default=True, help="Items per minute (Poisson)."),
+        flag("--speed", type=float, default=None, help="Belt speed [m/s] (default 0.2 scara, 0.3 gantry, 0.1 --robot)."),
+        flag("--paper-limit", is_flag=True, help="Seed 000's 55 deg/s limit on the SCARA's joint 1."),
+        flag("--rule", type=click.Choice(["first", "nearest", "shortest", "bands", "split", "lookahead"]),
+             default="first", show_default=True, help="Assignment rule."),
+        flag("--seeds", type=int, default=5, show_default=True, help="Seeds (Monte Carlo runs)."),
+        flag("--duration", type=float, default=600.0, show_default=True, help="Simulated time per seed [s]."),
+    )
+
+
+@dataclass(frozen=True)
+class BeltViews:
+    """The views of a run: a session file, a standalone page, a schedule plot and the seconds animated."""
+
+    session_path: str | None = None
+    html_path: str | None = None
+    plot_path: str | None = None
+    window: float = 20.0
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--session", "session_path", type=click.Path(dir_okay=False), default=None,
+             help="Also save the first seed's first --window seconds as a session (.pinarms; pinarms view)."),
+        flag("--html", "html_path", type=click.Path(dir_okay=False), default=None,
+             help="Also write that window as a standalone page (.html)."),
+        flag("--plot", "plot_path", type=click.Path(dir_okay=False), default=None,
+             help="Also plot who picked what when (.png or .svg; 3 x --window seconds)."),
+        flag("--window", type=float, default=20.0, show_default=True, help="Seconds animated in --session/--html."),
+    )
+
+
+def _spec(flow: BeltFlow, arms: int, arrivals: str | None, robot: dict | None = None):
+    preset, rate, speed, paper_limit = flow.preset, flow.rate, flow.speed, flow.paper_limit
+    rule, seeds, duration = flow.rule, flow.seeds, flow.duration
     from pinarms.optim.line import Stream
     from pinarms.studies.line import gantry_line, scara_line
 
@@ -37,21 +87,23 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
                            f"holds at most {MAX_ITEMS}: lower --rate or --duration")
     kw = {"seeds": tuple(range(seeds)), "duration": duration}
     if robot is not None and "delta" in robot:
-        from pinarms.studies.delta_line import delta_line
+        from pinarms.studies.delta_line import DeltaLineRequest, delta_line
 
         if paper_limit:
             raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
         from pinarms.studies.line import ENOKI
 
-        spec = delta_line(arms, rate, item=ENOKI, name=robot["delta"], rule=rule, map_grid=robot["map_grid"], **kw, **({} if speed is None else {"speed": speed}))
+        spec = delta_line(DeltaLineRequest(arms, rate, item=ENOKI, name=robot["delta"], rule=rule, map_grid=robot["map_grid"],
+                                           **kw, **({} if speed is None else {"speed": speed})))
     elif robot is not None:
-        from pinarms.studies.arm_line import arm_line
+        from pinarms.studies.arm_line import ArmLineRequest, arm_line
 
         if paper_limit:
             raise InvalidInput("--paper-limit is seed 000's SCARA limit: drop it with --robot")
-        spec = arm_line(robot["robot"], arms, rate, rule=rule, base_offset=robot["base_offset"],
-                        base_height=robot["base_height"], box=robot["box"], spacing=robot["spacing"], descend=robot["descend"], map_grid=robot["map_grid"], **kw,
-                        **({} if speed is None else {"speed": speed}))
+        spec = arm_line(ArmLineRequest(robot["robot"], arms, rate, rule=rule, base_offset=robot["base_offset"],
+                                       base_height=robot["base_height"], box=robot["box"], spacing=robot["spacing"],
+                                       descend=robot["descend"], map_grid=robot["map_grid"], **kw,
+                                       **({} if speed is None else {"speed": speed})))
     elif preset == "scara":
         spec = scara_line(arms, rate, rule=rule, paper_limit=paper_limit, **kw, **({} if speed is None else {"speed": speed}))
     else:
@@ -62,46 +114,6 @@ def _spec(preset: str, arms: int, rate: float, speed: float | None, paper_limit:
     if arrivals:
         spec = replace(spec, stream=Stream("file", rate / 60.0, duration, path=arrivals, types=spec.stream.types), seeds=(0,))
     return spec
-
-
-common = [
-    click.option("--preset", type=click.Choice(PRESETS), default="scara", show_default=True,
-                 help="scara: seed 000's SCARAs and enoki bunches; gantry: seed 002's gantry and flowers."),
-    click.option("--rate", type=float, default=60.0, show_default=True, help="Items per minute (Poisson)."),
-    click.option("--speed", type=float, default=None,
-                 help="Belt speed [m/s] (default 0.2 scara, 0.3 gantry, 0.1 --robot)."),
-    click.option("--paper-limit", is_flag=True, help="Seed 000's 55 deg/s limit on the SCARA's joint 1."),
-    click.option("--rule", type=click.Choice(["first", "nearest", "shortest", "bands", "split", "lookahead"]),
-                 default="first", show_default=True, help="Assignment rule."),
-    click.option("--seeds", type=int, default=5, show_default=True, help="Seeds (Monte Carlo runs)."),
-    click.option("--duration", type=float, default=600.0, show_default=True, help="Simulated time per seed [s]."),
-    *robot_options,
-]
-
-
-def _robot(kw: dict) -> dict | None:
-    """The ``--robot`` options (:mod:`~.belt_robot`) popped from a command's ``kw``: None without ``--robot``."""
-    keys = ("robot_urdf", "packages", "tcp", "tcp_offset", "tool_axis", "base_offset", "base_height", "box", "spacing",
-            "descend", "map_grid")
-    opts = {k: kw.pop(k) for k in keys}
-    if opts["robot_urdf"] is None:
-        given = [f"--{k.replace('_', '-')}" for k in ("packages", "tcp", "tcp_offset") if opts[k]]
-        if given or opts["tool_axis"] != "z":
-            flag = (given or ["--tool-axis"])[0].replace("--packages", "--package")
-            raise InvalidInput(f"{flag} describes the arm of --robot URDF: give --robot, or drop {flag}")
-        return None
-    from pinarms.robots.delta import delta_names
-
-    if opts["robot_urdf"] in delta_names():  # a shipped delta, above the belt (pinarms.studies.delta_line)
-        given = [f"--{k.replace('_', '-')}" for k in ("packages", "tcp", "tcp_offset") if opts[k]]
-        if given or opts["tool_axis"] != "z":
-            flag = (given or ["--tool-axis"])[0].replace("--packages", "--package")
-            raise InvalidInput(f"{flag} describes a URDF arm; --robot {opts['robot_urdf']} is a shipped delta: drop {flag}")
-        return {"delta": opts["robot_urdf"], "map_grid": grid_value(opts["map_grid"])}
-    robot = load_belt_robot(opts["robot_urdf"], opts["packages"], opts["tcp"], opts["tcp_offset"], opts["tool_axis"])
-    return {"robot": robot, "base_offset": opts["base_offset"], "base_height": opts["base_height"],
-            "box": box_value(opts["box"]), "spacing": opts["spacing"], "descend": opts["descend"],
-            "map_grid": grid_value(opts["map_grid"])}
 
 
 def _maps(spec, robot: dict | None, as_json: bool, scheduler=None) -> dict:
@@ -164,43 +176,31 @@ class _progress:
             self.bar.close()
 
 
-def _with(options):
-    def wrap(f):
-        for o in reversed(options):
-            f = o(f)
-        return f
-    return wrap
-
-
 @cli.group("belt")
 def belt() -> None:
     """Items on a moving belt: several arms picking on the fly (docs/line.md)."""
 
 
 @belt.command("run")
-@_with(common)
+@option_group(BeltFlow, "flow")
+@option_group(BeltRobotFlags, "arm")
 @click.option("--arms", type=int, default=3, show_default=True, help="Arms along the belt.")
 @click.option("--arrivals", type=click.Path(exists=True, dir_okay=False), default=None,
               help="CSV arrivals file (time,across,type[,yaw]) instead of the Poisson stream.")
-@click.option("--session", "session_path", type=click.Path(dir_okay=False), default=None,
-              help="Also save the first seed's first --window seconds as a session (.pinarms; pinarms view).")
-@click.option("--html", "html_path", type=click.Path(dir_okay=False), default=None,
-              help="Also write that window as a standalone page (.html).")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None,
-              help="Also plot who picked what when (.png or .svg; 3 x --window seconds).")
-@click.option("--window", type=float, default=20.0, show_default=True, help="Seconds animated in --session/--html.")
+@option_group(BeltViews, "views")
 @click.option("--trays", default=None, help="Place in trays on a second belt through the boxes: PITCH,SPEED,SLOTS "
               "(m, m/s, items per tray; tray maps built, minutes).")
 @scheduler_option
 @json_option
-def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arrivals, session_path, html_path,
-             plot_path, window, trays, scheduler, as_json, **kw) -> None:
+def belt_run(flow: BeltFlow, arm: BeltRobotFlags, arms: int, arrivals: str | None, views: BeltViews,
+             trays: str | None, scheduler: str | None, as_json: bool) -> None:
     """Simulate a line and print picks/min, miss rate, utilisation (a preset's arms, or --robot URDF)."""
     from pinarms.optim.line import run_line
     from pinarms.studies.line import maps_for
 
-    robot = _robot(kw)
-    spec = _spec(preset, arms, rate, speed, paper_limit, rule, seeds, duration, arrivals, robot)
+    robot = arm.resolve()
+    session_path, html_path, plot_path = views.session_path, views.html_path, views.plot_path
+    spec = _spec(flow, arms, arrivals, robot)
     if trays and robot is not None:
         raise InvalidInput("--trays with --robot: the tray line takes a preset's arms only; drop --trays")
     if trays:
@@ -221,21 +221,22 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
     if session_path or html_path or plot_path:
         from pinarms.viz.line_views import save_line_views
 
-        save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=window)
-    what = preset if robot is None else f"{robot['delta'] if 'delta' in robot else robot['robot'].name} (--robot)"
-    emit(as_json, res.as_dict(), res.summary(f"belt run: {what}, {arms} arm(s), rule {rule}").splitlines())
+        save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=views.window)
+    what = flow.preset if robot is None else f"{robot['delta'] if 'delta' in robot else robot['robot'].name} (--robot)"
+    emit(as_json, res.as_dict(), res.summary(f"belt run: {what}, {arms} arm(s), rule {flow.rule}").splitlines())
 
 
 @belt.command("arms")
-@_with(common)
+@option_group(BeltFlow, "flow")
+@option_group(BeltRobotFlags, "arm")
 @click.option("--max-arms", type=int, default=20, show_default=True)
 @json_option
-def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms, as_json, **kw) -> None:
+def belt_arms(flow: BeltFlow, arm: BeltRobotFlags, max_arms: int, as_json: bool) -> None:
     """Fewest SCARAs (preset scara), or arms of --robot URDF, whose miss rate is <= 1 % at the flow."""
     from pinarms.optim.line import LineStatus, run_line
 
-    robot = _robot(kw)
-    if preset != "scara" and robot is None:
+    robot = arm.resolve()
+    if flow.preset != "scara" and robot is None:
         raise InvalidInput("belt arms adds SCARAs along the belt: use --preset scara (or --robot URDF)")
     from pinarms.optim.caps import count_setting
     from pinarms.optim.line.api import MAX_LINE_ARMS
@@ -243,7 +244,7 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
     count_setting(max_arms, "--max-arms", 1, MAX_LINE_ARMS)
     one = None  # --robot: the first arm's maps, shared by every arm (same shape, shifted along the belt)
     for n in range(1, max_arms + 1):
-        spec = _spec(preset, n, rate, speed, paper_limit, rule, seeds, duration, None, robot)
+        spec = _spec(flow, n, None, robot)
         if robot is None:
             maps = _maps(spec, None, as_json)
         else:
@@ -253,32 +254,34 @@ def belt_arms(preset, rate, speed, paper_limit, rule, seeds, duration, max_arms,
         if res.status is LineStatus.OK:
             break
     data = {"arms_needed": n if res.status is LineStatus.OK else None, **res.as_dict()}
-    lines = res.summary(f"belt arms: {rate:g} items/min at <= 1 % miss -> "
+    lines = res.summary(f"belt arms: {flow.rate:g} items/min at <= 1 % miss -> "
                         f"{n if res.status is LineStatus.OK else f'more than {max_arms}'} arm(s)").splitlines()
     emit(as_json, data, lines)
 
 
 @belt.command("size")
-@_with(common)
+@option_group(BeltFlow, "flow")
+@option_group(BeltRobotFlags, "arm")
 @click.option("--max-miss", type=float, default=0.01, show_default=True, help="Miss rate asked for (fraction).")
 @click.option("--generations", type=int, default=6, show_default=True)
 @click.option("--population", type=int, default=10, show_default=True)
 @scheduler_option
 @json_option
-def belt_size(preset, rate, speed, paper_limit, rule, seeds, duration, max_miss, generations, population, scheduler,
-              as_json, **kw) -> None:
+def belt_size(flow: BeltFlow, arm: BeltRobotFlags, max_miss: float, generations: int, population: int,
+              scheduler: str | None, as_json: bool) -> None:
     """Fewest SCARAs (or arms of --robot URDF), their places along the belt and the belt speed (the project's GA)."""
     from pinarms.optim.line import Rule
     from pinarms.optim.line.sizing import SizingProblem, size_line
     from pinarms.studies.line import ENOKI
 
-    robot = _robot(kw)
+    robot = arm.resolve()
+    preset, rate, speed, rule, seeds, duration = flow.preset, flow.rate, flow.speed, flow.rule, flow.seeds, flow.duration
     if preset != "scara" and robot is None:
         raise InvalidInput("belt size places SCARAs along the belt: use --preset scara (or --robot URDF)")
     speeds = [0.2 if robot is None or "delta" in robot else 0.1] if speed is None else [speed]
     maps, item, extra = {}, ENOKI, {}
     for v in speeds:
-        spec = _spec(preset, 1, rate, v, paper_limit, rule, 1, duration, None, robot)
+        spec = _spec(replace(flow, speed=v, seeds=1), 1, None, robot)
         maps[v] = _maps(spec, robot, as_json, scheduler)[spec.stations[0].name][0]
     if robot is not None:
         st = spec.stations[0]

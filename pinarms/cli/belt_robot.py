@@ -12,8 +12,9 @@ that its z axis is the link's x axis. Every bad value is one ``Error:`` line nam
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import click
 import numpy as np
@@ -21,8 +22,9 @@ import numpy as np
 from pinarms.errors import InvalidInput, PinarmsError
 
 from pinarms.cli._common import floats, package_map
+from pinarms.cli.option_groups import Flag, flag
 
-__all__ = ["robot_options", "load_belt_robot", "box_value", "grid_value", "TOOL_AXES", "TOOL_LINK"]
+__all__ = ["BeltRobotFlags", "load_belt_robot", "box_value", "grid_value", "TOOL_AXES", "TOOL_LINK"]
 
 #: ``--tool-axis`` values: the tcp link's axis the tool points along -> roll, pitch, yaw [rad] of
 #: a tool point whose z axis is that axis.
@@ -31,33 +33,78 @@ TOOL_AXES = {"z": (0.0, 0.0, 0.0), "x": (0.0, np.pi / 2, 0.0), "y": (-np.pi / 2,
 #: Name of the link added for a tool point with an offset or a turned axis.
 TOOL_LINK = "belt_tool_point"
 
-robot_options = [
-    click.option("--robot", "robot_urdf", type=click.Path(dir_okay=False), default=None, metavar="URDF",
-                 help="Your arm's URDF file: copies of it along the belt instead of --preset (maps built, minutes "
-                      "for a 6-axis arm; a progress line shows); or a shipped delta's name (delta_flexpicker): "
-                      "deltas above the belt's centre line, the layout of pinarms.studies.delta_line."),
-    click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
-                 help="A folder for package://NAME/ in --robot's file (repeatable; the belt needs no meshes)."),
-    click.option("--tcp", "tcp", default=None, metavar="LINK",
-                 help="The link of --robot whose frame is the tool point (default: a link 'tcp', else the last link)."),
-    click.option("--tcp-offset", "tcp_offset", default=None, metavar="X,Y,Z",
-                 help="The tool point's offset from --tcp's link, in that link's frame [m]."),
-    click.option("--tool-axis", "tool_axis", type=click.Choice(list(TOOL_AXES)), default="z", show_default=True,
-                 help="The axis of the tool point's link the tool points along; the picks hold it vertical, "
-                      "pointing down (tool down = the tcp z axis down)."),
-    click.option("--base-offset", type=float, default=0.4, show_default=True,
-                 help="--robot: the arms' bases from the belt's centre line, across [m]."),
-    click.option("--box", "box", default="-0.1,0.25,0.15", show_default=True, metavar="DX,DY,DZ",
-                 help="--robot: each arm's box from its base [m] (world x along the belt, y across, z up)."),
-    click.option("--base-height", type=float, default=0.0, show_default=True,
-                 help="--robot: the arms' bases above the belt's surface [m] (negative: below)."),
-    click.option("--spacing", type=float, default=1.0, show_default=True, help="--robot: distance between arms [m]."),
-    click.option("--descend", type=float, default=0.5, show_default=True,
-                 help="--robot: seconds of the tracking pick's descend (and lift); longer for a slow arm."),
-    click.option("--map-grid", default="12,5", show_default=True, metavar="NU,NW",
-                 help="--robot: task map nodes along the belt (over the arm's whole reach) and across it; a "
-                      "cell is feasible where its four nodes are, so a coarse grid may leave none."),
-]
+
+@dataclass(frozen=True)
+class BeltRobotFlags:
+    """The user's arm on the belt as typed (module doc): its URDF (``robot_urdf``; ``None``: a preset's
+    arms) or a shipped delta's name, the files' packages, the tool point (``tcp``, ``tcp_offset``,
+    ``tool_axis``) and the line's layout (``base_offset``, ``box``, ``base_height``, ``spacing`` [m],
+    ``descend`` [s], ``map_grid``). Flags of the arm without ``--robot`` are refused, naming the flag."""
+
+    robot_urdf: str | None = None
+    packages: tuple[str, ...] = ()
+    tcp: str | None = None
+    tcp_offset: str | None = None
+    tool_axis: str = "z"
+    base_offset: float = 0.4
+    box: str = "-0.1,0.25,0.15"
+    base_height: float = 0.0
+    spacing: float = 1.0
+    descend: float = 0.5
+    map_grid: str = "12,5"
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--robot", "robot_urdf", type=click.Path(dir_okay=False), default=None, metavar="URDF",
+             help="Your arm's URDF file: copies of it along the belt instead of --preset (maps built, minutes "
+                  "for a 6-axis arm; a progress line shows); or a shipped delta's name (delta_flexpicker): "
+                  "deltas above the belt's centre line, the layout of pinarms.studies.delta_line."),
+        flag("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+             help="A folder for package://NAME/ in --robot's file (repeatable; the belt needs no meshes)."),
+        flag("--tcp", "tcp", default=None, metavar="LINK",
+             help="The link of --robot whose frame is the tool point (default: a link 'tcp', else the last link)."),
+        flag("--tcp-offset", "tcp_offset", default=None, metavar="X,Y,Z",
+             help="The tool point's offset from --tcp's link, in that link's frame [m]."),
+        flag("--tool-axis", "tool_axis", type=click.Choice(list(TOOL_AXES)), default="z", show_default=True,
+             help="The axis of the tool point's link the tool points along; the picks hold it vertical, "
+                  "pointing down (tool down = the tcp z axis down)."),
+        flag("--base-offset", type=float, default=0.4, show_default=True,
+             help="--robot: the arms' bases from the belt's centre line, across [m]."),
+        flag("--box", "box", default="-0.1,0.25,0.15", show_default=True, metavar="DX,DY,DZ",
+             help="--robot: each arm's box from its base [m] (world x along the belt, y across, z up)."),
+        flag("--base-height", type=float, default=0.0, show_default=True,
+             help="--robot: the arms' bases above the belt's surface [m] (negative: below)."),
+        flag("--spacing", type=float, default=1.0, show_default=True, help="--robot: distance between arms [m]."),
+        flag("--descend", type=float, default=0.5, show_default=True,
+             help="--robot: seconds of the tracking pick's descend (and lift); longer for a slow arm."),
+        flag("--map-grid", default="12,5", show_default=True, metavar="NU,NW",
+             help="--robot: task map nodes along the belt (over the arm's whole reach) and across it; a "
+                  "cell is feasible where its four nodes are, so a coarse grid may leave none."),
+    )
+
+    def __post_init__(self) -> None:
+        given = [f"--{k.replace('_', '-')}" for k in ("packages", "tcp", "tcp_offset") if getattr(self, k)]
+        flag_name = (given or ["--tool-axis"])[0].replace("--packages", "--package")
+        if self.robot_urdf is None and (given or self.tool_axis != "z"):
+            raise InvalidInput(f"{flag_name} describes the arm of --robot URDF: give --robot, or drop {flag_name}")
+
+    def resolve(self) -> dict | None:
+        """``None`` without ``--robot``; a shipped delta: ``{"delta": name, "map_grid": ...}``; else the loaded arm
+        (:func:`load_belt_robot`) with the layout's values checked (``box``, ``map_grid``)."""
+        if self.robot_urdf is None:
+            return None
+        from pinarms.robots.delta import delta_names
+
+        if self.robot_urdf in delta_names():  # a shipped delta, above the belt (pinarms.studies.delta_line)
+            given = [f"--{k.replace('_', '-')}" for k in ("packages", "tcp", "tcp_offset") if getattr(self, k)]
+            if given or self.tool_axis != "z":
+                flag_name = (given or ["--tool-axis"])[0].replace("--packages", "--package")
+                raise InvalidInput(f"{flag_name} describes a URDF arm; --robot {self.robot_urdf} is a shipped delta: "
+                                   f"drop {flag_name}")
+            return {"delta": self.robot_urdf, "map_grid": grid_value(self.map_grid)}
+        robot = load_belt_robot(self.robot_urdf, self.packages, self.tcp, self.tcp_offset, self.tool_axis)
+        return {"robot": robot, "base_offset": self.base_offset, "base_height": self.base_height,
+                "box": box_value(self.box), "spacing": self.spacing, "descend": self.descend,
+                "map_grid": grid_value(self.map_grid)}
 
 
 def _tool_point_text(text: str, link: str, xyz: np.ndarray, rpy: tuple[float, float, float], source: str) -> str:

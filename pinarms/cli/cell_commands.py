@@ -5,7 +5,8 @@ from __future__ import annotations
 import sys
 import time
 from collections import Counter
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import click
 import numpy as np
@@ -15,6 +16,7 @@ from pinarms.errors import InvalidInput
 from pinarms.cli._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_option, package_map, save_session, show_progress,
                       skipped_pair_lines)
 from pinarms.cli.motion_commands import hold_option
+from pinarms.cli.option_groups import JSON_FLAG, Flag, flag, option_group
 
 if TYPE_CHECKING:
     from pinarms.robots.cell import Cell
@@ -200,31 +202,77 @@ def _closest_arms(check: Any, k: float, lu: str) -> str:
             f" proven never closer than {check.lower_bound / k:.4g} {lu})")
 
 
+@dataclass(frozen=True)
+class CellCycleFlags:
+    """How the cells' cycles are planned: starting ``lift`` and ``clearance`` kept, the continuous checks'
+    ``margin`` (``None``: 0.05 m, 0.02 m, 0.005 m; user lengths), the gripper's ``dwell`` [s] and the time
+    offsets scanned per arm (``n_offsets``)."""
+
+    lift: float | None = None
+    dwell: float = 0.2
+    clearance: float | None = None
+    margin: float | None = None
+    n_offsets: int = 24
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--lift", default=None, type=float, help="Starting lift [default 0.05 m, 50 mm]."),
+        flag("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and place [s]."),
+        flag("--clearance", default=None, type=float,
+             help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm]."),
+        flag("--margin", default=None, type=float, help="Resolution of the continuous checks [default 0.005 m, 5 mm]."),
+        flag("--offsets", "n_offsets", default=24, show_default=True, type=int,
+             help="Time offsets scanned per arm (two or more arms)."),
+    )
+
+    def lengths(self, k: float, n_tasks: int) -> tuple[float, float, float]:
+        """``(lift, clearance, margin)`` in the user's length unit (``k`` metres each), defaults filled in,
+        every setting checked against its range (:mod:`pinarms.optim.caps`; the error names the flag)."""
+        from pinarms.optim import caps
+
+        lift = 0.05 / k if self.lift is None else self.lift
+        clearance = 0.02 / k if self.clearance is None else self.clearance
+        margin = 0.005 / k if self.margin is None else self.margin
+        if n_tasks >= 2:
+            caps.count_setting(self.n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
+        caps.number_setting(self.dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
+        caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
+        caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
+        caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
+        return lift, clearance, margin
+
+
+@dataclass(frozen=True)
+class CellCycleOutput:
+    """What ``cell cycle`` writes besides its text: a session, the clearance and schedule plots, JSON."""
+
+    session_path: str | None = None
+    plot_clearance: str | None = None
+    plot_schedule: str | None = None
+    as_json: bool = False
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--session", "session_path", default=None, type=click.Path(dir_okay=False),
+             help="Save the cell with all arms' cycles (animated together) into a session file."),
+        flag("--plot-clearance", "plot_clearance", default=None, type=click.Path(dir_okay=False),
+             help="Plot the clearance over time (.png or .svg)."),
+        flag("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
+             help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms)."),
+        JSON_FLAG,
+    )
+
+
 @cell_group.command("cycle", context_settings=NUMBERS)
 @_cell_options
 @click.option("--task", "tasks", nargs=7, multiple=True, required=True, metavar="ARM PX PY PZ QX QY QZ",
               help="An arm's pick P and place Q (world frame); repeat for each arm.")
-@click.option("--lift", default=None, type=float, help="Starting lift [default 0.05 m, 50 mm].")
-@click.option("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and place [s].")
-@click.option("--clearance", default=None, type=float,
-              help="Distance kept from fixtures and other arms [default 0.02 m, 20 mm].")
-@click.option("--margin", default=None, type=float,
-              help="Resolution of the continuous checks [default 0.005 m, 5 mm].")
+@option_group(CellCycleFlags, "settings")
 @click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
               help="Where an arm without a --task stays (repeatable): joint values (rad and m; m as mm with --mm) or a "
                    "named state of the cell description (default: the description's hold, else neutral).")
-@click.option("--offsets", "n_offsets", default=24, show_default=True, type=int,
-              help="Time offsets scanned per arm (two or more arms).")
 @click.option("--mm", is_flag=True, help="Points, lift, clearance and margin in millimetres.")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the cell with all arms' cycles (animated together) into a session file.")
-@click.option("--plot-clearance", "plot_clearance", default=None, type=click.Path(dir_okay=False),
-              help="Plot the clearance over time (.png or .svg).")
-@click.option("--plot-schedule", "plot_schedule", default=None, type=click.Path(dir_okay=False),
-              help="Plot the arms' busy intervals in the shared zone (.png or .svg; two or more arms).")
-@json_option
-def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, margin, holds, n_offsets, mm, session_path,
-                   plot_clearance, plot_schedule, as_json) -> None:
+@option_group(CellCycleOutput, "output")
+def cell_cycle_cmd(cell: str, xacro_args: tuple[str, ...], packages: tuple[str, ...], tasks: tuple, settings: CellCycleFlags,
+                   holds: tuple[str, ...], mm: bool, output: CellCycleOutput) -> None:
     """Collision-aware pick-and-place cycles of CELL's arms and, for two or more arms, their schedule.
 
     Each arm's cycle keeps --clearance from the fixtures and the other arms (re-planned
@@ -235,22 +283,16 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     --task right 50 30 840 220 -680 840 --mm
     """
     from pinarms import optim
-    from pinarms.optim import caps
     from pinarms.optim.cycle import CellSettings, CycleRequest
     from pinarms.robots.cell import ArmMotion
 
+    session_path, plot_clearance, plot_schedule, as_json = (output.session_path, output.plot_clearance,
+                                                            output.plot_schedule, output.as_json)
     k = 1e-3 if mm else 1.0
     lu = "mm" if mm else "m"
-    lift = 0.05 / k if lift is None else lift  # all lengths in the user's unit until multiplied by k
-    clearance = 0.02 / k if clearance is None else clearance
-    margin = 0.005 / k if margin is None else margin
     # the settings first: a slip in them is an error at once, before the cell loads or a cycle is planned
-    if len(tasks) >= 2:
-        caps.count_setting(n_offsets, "--offsets", 2, caps.MAX_OFFSETS)
-    caps.number_setting(dwell, "--dwell", 0.0, caps.MAX_DWELL, unit="s")
-    caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
-    caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
-    caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
+    lift, clearance, margin = settings.lengths(k, len(tasks))  # in the user's unit until multiplied by k
+    dwell, n_offsets = settings.dwell, settings.n_offsets
     c = load_cell_option(cell, xacro_args, packages)
     hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}
@@ -266,6 +308,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
         spec = optim.PickPlace(arm.to_base(values[:3]), arm.to_base(values[3:]), lift=lift * k, dwell=dwell)
         res = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(c, clearance=clearance * k,
                                                                                margin=margin * k, hold=hold)))
+        res.raise_for_status()  # no cycle that keeps the clearance: one Error line naming what blocks
         cycles[name] = res
         rep = res.cell_report
         data["arms"][name] = {"cycle": res.as_dict(), "cycle_time_s": res.cycle_time,

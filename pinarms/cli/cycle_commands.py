@@ -2,57 +2,84 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import click
 import numpy as np
-
-from pinarms.units import (
-    length_scale,
-    mass_kg,
-)
 
 from pinarms.cli._common import (
     NUMBERS,
     cli,
     emit,
     fmt,
-    json_option,
     load_robot,
     new_session,
     save_session,
-    si_limit,
 )
+from pinarms.cli.option_groups import Flag, LoadFlags, OutputFlags, TimingFlags, UnitFlags, flag, option_group
 
 
 # --------------------------------------------------------------------------- cycle
+@dataclass(frozen=True)
+class CycleTask:
+    """The pick and the place (base frame, user lengths), the transfer's via points, the lift (``None``:
+    0.05 m) and the gripper's dwell [s]."""
+
+    pick: tuple[float, float, float]
+    place: tuple[float, float, float]
+    via: tuple[tuple[float, float, float], ...] = ()
+    lift: float | None = None
+    dwell: float = 0.2
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--pick", nargs=3, type=float, required=True, help="X Y Z of the pick point (base frame)."),
+        flag("--place", nargs=3, type=float, required=True, help="X Y Z of the place point (base frame)."),
+        flag("--via", nargs=3, type=float, multiple=True, help="X Y Z of a transfer via point (repeat, in order)."),
+        flag("--lift", default=None, type=float, help="Vertical approach/retreat height [default 0.05 m, 50 mm]."),
+        flag("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and at place [s]."),
+    )
+
+    def spec(self, scale: float):
+        """The :class:`pinarms.optim.PickPlace` in SI, lengths typed times ``scale`` [m per unit]."""
+        from pinarms import optim
+
+        lift = 0.05 if self.lift is None else self.lift * scale
+        return optim.PickPlace(np.array(self.pick) * scale, np.array(self.place) * scale, lift=lift, dwell=self.dwell,
+                               via=[np.array(v) * scale for v in self.via])
+
+
+@dataclass(frozen=True)
+class ApproachFlags:
+    """The approach and retreat: straight vertical lines (``straight``, with a tcp speed limit ``vtool``
+    [user lengths / s]) or joint-space moves."""
+
+    straight: bool = False
+    vtool: float | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--straight", is_flag=True,
+             help="Straight vertical lines at pick and place, time-optimal along them (needs --amax); "
+                  "the joint-space cycle's time is reported beside it."),
+        flag("--vtool", default=None, type=float,
+             help="With --straight: tcp speed limit on the lines [m/s, or mm/s with --mm]."),
+    )
+
+
 @cli.command("cycle", context_settings=NUMBERS)
 @click.argument("robot")
-@click.option("--pick", nargs=3, type=float, required=True, help="X Y Z of the pick point (base frame).")
-@click.option("--place", nargs=3, type=float, required=True, help="X Y Z of the place point (base frame).")
-@click.option("--via", nargs=3, type=float, multiple=True, help="X Y Z of a transfer via point (repeat, in order).")
-@click.option("--lift", default=None, type=float, help="Vertical approach/retreat height [default 0.05 m, 50 mm].")
-@click.option("--dwell", default=0.2, show_default=True, type=float, help="Gripper time at pick and at place [s].")
-@click.option("--mm", is_flag=True, help="Points, lift and the straightness deviation in millimetres.")
-@click.option("--kind", type=click.Choice(["multi-quintic", "quintic-bspline", "3-5-3"]), default="multi-quintic",
-              show_default=True)
-@click.option("--vmax", default=None, help="Joint speed limit(s) [rad/s or m/s], one or per joint (default: the URDF's).")
-@click.option("--amax", default=None, help="Acceleration limit(s) [rad/s² or m/s²].")
-@click.option("--jmax", default=None, help="Jerk limit(s) [rad/s³ or m/s³].")
-@click.option("--method", type=click.Choice(["exact", "ga"]), default="exact", show_default=True)
-@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the optimiser.")
-@click.option("--payload", default=None,
-              help="What the gripper carries from pick to place, e.g. 3kg or 800g (its centre of mass at the tcp); "
-                   "times both moves also under joint torque limits (--torque-max, default the URDF's efforts).")
-@click.option("--torque", "torque", is_flag=True, help="Also limit joint torques (the URDF's efforts), without a payload.")
-@click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints], one or per joint.")
-@click.option("--straight", is_flag=True,
-              help="Straight vertical lines at pick and place, time-optimal along them (needs --amax); "
-                   "the joint-space cycle's time is reported beside it.")
-@click.option("--vtool", default=None, type=float, help="With --straight: tcp speed limit on the lines [m/s, or mm/s with --mm].")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the cycle (trajectory, via points, pick and place) into a session file.")
-@json_option
-def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, method, seed, payload, torque,
-              torque_max, straight, vtool, session_path, as_json) -> None:
+@option_group(CycleTask, "task")
+@option_group(UnitFlags, "units", only=("mm",), mm={"help": "Points, lift and the straightness deviation in millimetres."})
+@option_group(TimingFlags, "timing")
+@option_group(LoadFlags, "load", payload={"help": (
+    "What the gripper carries from pick to place, e.g. 3kg or 800g (its centre of mass at the tcp); "
+    "times both moves also under joint torque limits (--torque-max, default the URDF's efforts).")},
+    torque={"help": "Also limit joint torques (the URDF's efforts), without a payload."})
+@option_group(ApproachFlags, "approach")
+@option_group(OutputFlags, "output", only=("session_path", "as_json"), session_path={
+    "help": "Save the cycle (trajectory, via points, pick and place) into a session file."})
+def cycle_cmd(robot: str, task: CycleTask, units: UnitFlags, timing: TimingFlags, load: LoadFlags,
+              approach: ApproachFlags, output: OutputFlags) -> None:
     """Time-optimal pick-and-place cycle of ROBOT: pick, lift, transfer, lower, place, and back.
 
     Prints the time of each move, the cycle time, picks per minute and how far the tcp
@@ -72,18 +99,16 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
     from pinarms.optim.cycle import CycleApproach, CycleLoad, CycleRequest, CycleTiming
 
     arm = load_robot(robot)
-    scale = length_scale(mm)
-    lu = "mm" if mm else "m"
-    lift_m = 0.05 if lift is None else lift * scale
-    spec = optim.PickPlace(np.array(pick) * scale, np.array(place) * scale, lift=lift_m, dwell=dwell,
-                           via=[np.array(v) * scale for v in via])
-    kg = None if payload is None else mass_kg(payload)
-    limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
-    torque_limits = limits if limits is not None else (True if (kg is not None or torque) else False)
-    timing = CycleTiming(kind, si_limit(vmax, "--vmax", np.ones(arm.nq)), si_limit(amax, "--amax", np.ones(arm.nq)),
-                         si_limit(jmax, "--jmax", np.ones(arm.nq)), method=method, seed=seed)
-    shape = CycleApproach("straight" if straight else "joint", None if vtool is None else vtool * scale)
-    res = optim.plan_cycle(CycleRequest(arm, spec, timing=timing, load=CycleLoad(kg, torque_limits), approach=shape))
+    scale = units.length
+    lu = units.length_unit
+    spec = task.spec(scale)
+    lift_m, dwell, kind, method = spec.lift, spec.dwell, timing.kind, timing.method
+    kg = load.kg
+    cycle_timing = CycleTiming(kind, *timing.limits(np.ones(arm.nq)), method=method, seed=timing.seed)
+    shape = CycleApproach("straight" if approach.straight else "joint",
+                          None if approach.vtool is None else approach.vtool * scale)
+    res = optim.plan_cycle(CycleRequest(arm, spec, timing=cycle_timing, load=CycleLoad(kg, load.torque_limits(arm.nq)),
+                                        approach=shape)).raise_for_status()  # no cycle: one Error line saying why
     data = res.as_dict()
     data["units"] = {"lengths": "m", "times": "s", "limits": "rad or m per s^k", "given_points": lu}
     dev = res.line_deviation / scale
@@ -107,14 +132,14 @@ def cycle_cmd(robot, pick, place, via, lift, dwell, mm, kind, vmax, amax, jmax, 
         carried = "nothing" if res.payload is None else f"{res.payload.mass:g} kg"
         lines.insert(4, f"torque / limit (carrying {carried} to the place, empty back): "
                         + ", ".join(f"{n} {r:.3f}" for n, r in zip(arm.joint_names, res.torque_ratios)))
-    if session_path:
+    if output.session_path:
         session = new_session(arm if res.payload is None else arm.with_payload(res.payload),
                               f"pick-and-place cycle of {arm.name}")
         session.add_trajectory("cycle", res.trajectory)
         session.add_points("cycle_via_points", res.waypoints[:, :3, 3], kind="via")
         place_m = res.waypoints[res.names.index("place"), :3, 3]
         session.add_points("pick_place", np.stack([res.waypoints[0, :3, 3], place_m]), kind="target")
-        save_session(session, session_path, data, lines)
-    emit(as_json, data, lines)
+        save_session(session, output.session_path, data, lines)
+    emit(output.as_json, data, lines)
 
 

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import click
 import numpy as np
@@ -11,34 +12,71 @@ from pinarms.errors import InvalidInput
 from pinarms.units import joints_from_si, joints_to_si, length_scale
 
 from pinarms.cli.pose_options import PoseCommand, parse_pose
-from pinarms.cli._common import (NUMBERS, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
+from pinarms.cli._common import (NUMBERS, cli, emit, floats, fmt, load_robot, new_session, save_session,
                       si_limit)
+from pinarms.cli.option_groups import Flag, OutputFlags, UnitFlags, flag, option_group
+
+@dataclass(frozen=True)
+class LinePathFlags:
+    """The joint path along the lines: corner ``blend`` radius [user lengths], ``stop_at_vias``, the
+    ``tolerance`` kept to the lines (``None``: 0.1 mm), the rotations' ``weight`` [m/rad] and the
+    ``q_start`` picking the IK branch (as typed)."""
+
+    blend: float = 0.0
+    stop_at_vias: bool = False
+    tolerance: float | None = None
+    weight: float = 0.1
+    q_start: str | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--blend", default=0.0, show_default=True, type=float,
+             help="Corner radius at the vias [m, or mm with --mm]; 0: stop at every corner."),
+        flag("--stop", "stop_at_vias", is_flag=True, help="Stop at every via (no blend)."),
+        flag("--tolerance", default=None, type=float, help="Largest tcp deviation from the lines [default 0.1 mm]."),
+        flag("--weight", default=0.1, show_default=True, type=float, help="Arc-length weight of rotations [m/rad]."),
+        flag("--q-start", "q_start", default=None, help="Comma-separated joint values picking the IK branch."),
+    )
+
+
+@dataclass(frozen=True)
+class LineLimits:
+    """The timing's limits as typed: tcp speed and acceleration (``vtool``, ``atool`` [user lengths / s^k])
+    and the joints' (``vmax``, ``amax``, ``jmax``: one value or one per joint, SI)."""
+
+    vtool: float | None = None
+    atool: float | None = None
+    vmax: str | None = None
+    amax: str | None = None
+    jmax: str | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--vtool", default=None, type=float,
+             help="tcp speed limit [m/s, or mm/s with --mm], e.g. 0.5 carrying food."),
+        flag("--atool", default=None, type=float, help="tcp acceleration limit [m/s², or mm/s² with --mm]."),
+        flag("--vmax", default=None, help="Joint speed limit(s) [rad/s or m/s], one or per joint (default: the URDF's)."),
+        flag("--amax", default=None,
+             help="Joint acceleration limit(s): time-optimal (TOPP-RA); without: a quintic time law."),
+        flag("--jmax", default=None, help="Joint jerk limit(s) (with --amax): a smoothed time-optimal result."),
+    )
+
+    def __post_init__(self) -> None:
+        if self.jmax is not None and self.amax is None:
+            raise InvalidInput("--jmax smooths the time-optimal profile: give --amax too")
+
 
 @cli.command("line", cls=PoseCommand, context_settings=NUMBERS)
 @click.argument("robot")
 @click.option("--from", "start", required=True, help="X Y Z [ROLL PITCH YAW] of the start pose (tcp in the base frame).")
 @click.option("--to", "goal", required=True, help="X Y Z [ROLL PITCH YAW] of the end pose.")
 @click.option("--via", multiple=True, help="X Y Z [ROLL PITCH YAW] of a pose on the way (repeat, in order).")
-@click.option("--blend", default=0.0, show_default=True, type=float,
-              help="Corner radius at the vias [m, or mm with --mm]; 0: stop at every corner.")
-@click.option("--stop", "stop_at_vias", is_flag=True, help="Stop at every via (no blend).")
-@click.option("--vtool", default=None, type=float, help="tcp speed limit [m/s, or mm/s with --mm], e.g. 0.5 carrying food.")
-@click.option("--atool", default=None, type=float, help="tcp acceleration limit [m/s², or mm/s² with --mm].")
-@click.option("--vmax", default=None, help="Joint speed limit(s) [rad/s or m/s], one or per joint (default: the URDF's).")
-@click.option("--amax", default=None, help="Joint acceleration limit(s): time-optimal (TOPP-RA); without: a quintic time law.")
-@click.option("--jmax", default=None, help="Joint jerk limit(s) (with --amax): a smoothed time-optimal result.")
-@click.option("--tolerance", default=None, type=float, help="Largest tcp deviation from the lines [default 0.1 mm].")
-@click.option("--weight", default=0.1, show_default=True, type=float, help="Arc-length weight of rotations [m/rad].")
-@click.option("--q-start", "q_start", default=None, help="Comma-separated joint values picking the IK branch.")
-@click.option("--deg", is_flag=True, help="ROLL PITCH YAW, --q-start and joint output in degrees.")
-@click.option("--mm", is_flag=True, help="Positions, --blend, --tolerance, --vtool, --atool and deviations in millimetres.")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the timed line (trajectory, poses) into a session file.")
-@json_option
-def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: float, stop_at_vias: bool,
-             vtool: float | None, atool: float | None, vmax: str | None, amax: str | None, jmax: str | None,
-             tolerance: float | None, weight: float, q_start: str | None, deg: bool, mm: bool,
-             session_path: str | None, as_json: bool) -> None:
+@option_group(LinePathFlags, "shape")
+@option_group(LineLimits, "limits")
+@option_group(UnitFlags, "units", deg={"help": "ROLL PITCH YAW, --q-start and joint output in degrees."},
+              mm={"help": "Positions, --blend, --tolerance, --vtool, --atool and deviations in millimetres."})
+@option_group(OutputFlags, "output", only=("session_path", "as_json"),
+              session_path={"help": "Save the timed line (trajectory, poses) into a session file."})
+def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], shape: LinePathFlags, limits: LineLimits,
+             units: UnitFlags, output: OutputFlags) -> None:
     """Straight tcp lines from --from through the --via poses to --to, on one IK branch, timed.
 
     The tcp moves on straight lines (orientation by SLERP), with circular blends of radius
@@ -54,24 +92,25 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
     from pinarms.robots.reach.layout import default_orientation
 
     arm = load_robot(robot)
+    mm, deg = units.mm, units.deg
     lu = length_scale(mm)
     R = default_orientation(arm)
     poses = np.stack([parse_pose(start, "--from", mm, deg, R), *(parse_pose(v, "--via", mm, deg, R) for v in via),
                       parse_pose(goal, "--to", mm, deg, R)])
-    q0 = _q_start(arm, q_start, deg, mm)
-    tol = 1e-4 if tolerance is None else tolerance * lu
-    stops = range(1, poses.shape[0] - 1) if stop_at_vias else ()
-    path = planning.cartesian_path(arm, poses, blend=blend * lu, weight=weight, stops=stops, tolerance=tol,
+    q0 = _q_start(arm, shape.q_start, deg, mm)
+    tol = 1e-4 if shape.tolerance is None else shape.tolerance * lu
+    stops = range(1, poses.shape[0] - 1) if shape.stop_at_vias else ()
+    path = planning.cartesian_path(arm, poses, blend=shape.blend * lu, weight=shape.weight, stops=stops, tolerance=tol,
                                    q_start=q0)
-    timing, law = _timed(arm, path, vmax, amax, jmax, None if vtool is None else vtool * lu,
-                         None if atool is None else atool * lu)
+    timing, law = _timed(arm, path, limits, lu)
     data, lines = _line_report(arm, poses, path, timing, law, tol, mm, deg)
+    session_path = output.session_path
     if session_path:
         session = new_session(arm, f"{arm.name}: straight tcp lines")
         session.add_trajectory("line", timing.trajectory, hz=200.0)
         session.add_points("poses", poses[:, :3, 3], kind="via")
         save_session(session, session_path, data, lines)
-    emit(as_json, data, lines)
+    emit(output.as_json, data, lines)
 
 
 def _q_start(arm: Any, q_start: str | None, deg: bool, mm: bool) -> np.ndarray | None:
@@ -85,18 +124,17 @@ def _q_start(arm: Any, q_start: str | None, deg: bool, mm: bool) -> np.ndarray |
     return joints_to_si(arm, values, deg=deg, mm=mm)
 
 
-def _timed(arm: Any, path: Any, vmax: str | None, amax: str | None, jmax: str | None, vtool: float | None,
-           atool: float | None) -> tuple[Any, str]:
-    """The timing of ``path`` under the limits of the flags (tool limits in SI units) and its law in words:
-    time-optimal with ``--amax``, else the fastest rest-to-rest quintic time law."""
+def _timed(arm: Any, path: Any, limits: LineLimits, lu: float) -> tuple[Any, str]:
+    """The timing of ``path`` under the limits of the flags (tool limits typed times ``lu`` [m per unit]) and its
+    law in words: time-optimal with ``--amax``, else the fastest rest-to-rest quintic time law."""
     from pinarms import optim, planning
 
-    v = si_limit(vmax, "--vmax", 1.0)
+    v = si_limit(limits.vmax, "--vmax", 1.0)
     v = np.asarray(arm.velocity_limit, dtype=float) if v is None else v
-    a = si_limit(amax, "--amax", 1.0)
-    j = si_limit(jmax, "--jmax", 1.0)
-    if j is not None and a is None:
-        raise InvalidInput("--jmax smooths the time-optimal profile: give --amax too")
+    a = si_limit(limits.amax, "--amax", 1.0)
+    j = si_limit(limits.jmax, "--jmax", 1.0)
+    vtool = None if limits.vtool is None else limits.vtool * lu
+    atool = None if limits.atool is None else limits.atool * lu
     constraints: list[Any] = [planning.JointVelocityConstraint(v)]
     if a is not None:
         constraints.append(planning.JointAccelerationConstraint(a))

@@ -8,7 +8,8 @@ options meaningless in each mode (docs/motion.md).
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import click
 import numpy as np
@@ -16,9 +17,10 @@ import numpy as np
 from pinarms.errors import InvalidInput
 from pinarms.units import angle_scale, length_scale
 
-from pinarms.cli._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
+from pinarms.cli._common import NUMBERS, cli, emit, floats, fmt, save_session, show_progress
 from pinarms.cli._common import package_map
 from pinarms.cli.pose_options import PoseCommand, parse_pose
+from pinarms.cli.option_groups import Flag, OutputFlags, UnitFlags, flag, option_group
 
 __all__ = ["load_any_cell", "hold_option"]
 
@@ -79,42 +81,91 @@ def load_any_cell(name: str, packages: dict[str, str] | None = None) -> Any:
     return robots.load_cell(name, packages=packages or None)
 
 
+@dataclass(frozen=True)
+class StartFlags:
+    """Where the move starts: a tcp pose (``start``, 'X Y Z [ROLL PITCH YAW]'), joint values (``start_q``),
+    or neither (the arm's hold pose)."""
+
+    start: str | None = None
+    start_q: str | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--from", "start", default=None,
+             help="X Y Z [ROLL PITCH YAW] of the start pose (the clear IK solution nearest the arm's neutral; "
+                  "without ROLL PITCH YAW the tool points down on six-axis arms)."),
+        flag("--from-q", "start_q", default=None,
+             help="Comma-separated joint values of the start (default: the arm's hold pose, else neutral)."),
+    )
+
+    def __post_init__(self) -> None:
+        if self.start is not None and self.start_q is not None:
+            raise click.UsageError("give --from (a pose) or --from-q (joint values), not both")
+
+
+@dataclass(frozen=True)
+class MotionFlags:
+    """The planner's settings (clearance ``margin`` [user lengths], OMPL ``planner``, ``time_limit`` [s],
+    ``seed``, which goal branch ``goal_choice``) and the timing's limits (``amax`` as typed, torques)."""
+
+    margin: float = 0.01
+    planner: str = "rrtconnect"
+    time_limit: float = 2.0
+    seed: int = 0
+    goal_choice: str = "best"
+    amax: str | None = None
+    no_torque: bool = False
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--margin", default=0.01, show_default=True, type=float,
+             help="Clearance kept to fixtures and other arms [m, or mm with --mm]."),
+        flag("--planner", default="rrtconnect", show_default=True, help="OMPL planner (rrtconnect, rrt, prm, ...)."),
+        flag("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take."),
+        flag("--seed", default=0, show_default=True, type=int, help="Seed of the search (same seed, same path)."),
+        flag("--goals", "goal_choice", type=click.Choice(["first", "best"]), default="best", show_default=True,
+             help="With several clear IK branches of the goal: each searched and the path with the shortest time "
+                  "bound kept, or the path to the first one reached (a little less planning)."),
+        flag("--amax", default=None, help="Joint acceleration limit(s) [rad/s² or m/s²] (torque limits apply too; "
+                                          "default: each arm's, velocity limit / 0.25 s unless set)."),
+        flag("--no-torque", is_flag=True, help="Time under velocity (and --amax) limits only, not the URDF's torques."),
+    )
+
+    def __post_init__(self) -> None:
+        if self.amax is not None:
+            floats(self.amax, "--amax")
+
+    def options(self, length: float):
+        """The :class:`~pinarms.optim.motion.MotionOptions` (``margin`` times ``length`` [m per unit])."""
+        from pinarms.optim.motion import MotionOptions
+
+        return MotionOptions(margin=self.margin * length, planner=self.planner, time_limit=self.time_limit,
+                             seed=self.seed, goals=self.goal_choice)
+
+    def limits(self):
+        """The :class:`~pinarms.optim.motion.MotionLimits` (``amax``: one value or one per joint)."""
+        from pinarms.optim.motion import MotionLimits
+
+        a = None if self.amax is None else floats(self.amax, "--amax")
+        return MotionLimits(amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not self.no_torque)
+
+
 @cli.command("motion", cls=PoseCommand, context_settings=NUMBERS)
 @click.argument("cell")
 @click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
               help="A folder for $(find NAME) and package://NAME/ in CELL (repeatable).")
 @click.option("--arm", "arm_name", default=None, help="The arm to move (default: the cell's only arm).")
 @click.option("--to", "goal", required=True, help="X Y Z [ROLL PITCH YAW] of the goal (tcp in the world frame).")
-@click.option("--from", "start", default=None,
-              help="X Y Z [ROLL PITCH YAW] of the start pose (the clear IK solution nearest the arm's neutral; "
-                   "without ROLL PITCH YAW the tool points down on six-axis arms).")
-@click.option("--from-q", "start_q", default=None,
-              help="Comma-separated joint values of the start (default: the arm's hold pose, else neutral).")
+@option_group(StartFlags, "starts")
 @click.option("--hold", "holds", multiple=True, metavar="ARM=Q1,Q2,...|ARM=STATE",
               help="Where an arm that does not move stays (repeatable): its joint values (rad and m, or --deg/--mm) "
                    "or a named state of the cell description (default: the description's hold, else neutral).")
-@click.option("--margin", default=0.01, show_default=True, type=float,
-              help="Clearance kept to fixtures and other arms [m, or mm with --mm].")
-@click.option("--planner", default="rrtconnect", show_default=True, help="OMPL planner (rrtconnect, rrt, prm, ...).")
-@click.option("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take.")
-@click.option("--seed", default=0, show_default=True, type=int, help="Seed of the search (same seed, same path).")
-@click.option("--goals", "goal_choice", type=click.Choice(["first", "best"]), default="best", show_default=True,
-              help="With several clear IK branches of the goal: each searched and the path with the shortest time "
-                   "bound kept, or the path to the first one reached (a little less planning).")
-@click.option("--amax", default=None, help="Joint acceleration limit(s) [rad/s² or m/s²] (torque limits apply too; "
-                                            "default: each arm's, velocity limit / 0.25 s unless set).")
-@click.option("--no-torque", is_flag=True, help="Time under velocity (and --amax) limits only, not the URDF's torques.")
-@click.option("--deg", is_flag=True, help="ROLL PITCH YAW and --from-q in degrees.")
-@click.option("--mm", is_flag=True, help="Positions and --margin in millimetres.")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the whole cell and the planned motion (tool path, goal) into a session file.")
-@click.option("--plot", "plot_path", default=None, type=click.Path(dir_okay=False),
-              help="Write the clearance-over-time plot (PNG).")
-@json_option
-def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal: str, start: str | None,
-               start_q: str | None, holds: tuple[str, ...], margin: float,
-               planner: str, time_limit: float, seed: int, goal_choice: str, amax: str | None, no_torque: bool,
-               deg: bool, mm: bool, session_path: str | None, plot_path: str | None, as_json: bool) -> None:
+@option_group(MotionFlags, "motion")
+@option_group(UnitFlags, "units", deg={"help": "ROLL PITCH YAW and --from-q in degrees."},
+              mm={"help": "Positions and --margin in millimetres."})
+@option_group(OutputFlags, "output", session_path={
+    "help": "Save the whole cell and the planned motion (tool path, goal) into a session file."},
+    plot_path={"help": "Write the clearance-over-time plot (PNG)."})
+def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal: str, starts: StartFlags,
+               holds: tuple[str, ...], motion: MotionFlags, units: UnitFlags, output: OutputFlags) -> None:
     """Plan a collision-free move of an arm in CELL to a tool pose, prove it clear, time it optimally.
 
     CELL is a planning scene (aubo_crate_guard, panda_shelf, ...), a built-in cell
@@ -125,11 +176,11 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     """
     import sys
 
-    from pinarms.optim.motion import MotionChecker, MotionLimits, MotionOptions, MotionRequest, plan_motion
+    from pinarms.optim.motion import MotionChecker, MotionRequest, plan_motion
     from pinarms.optim.motion.goals import ik_candidates
 
     def progress(message: str) -> None:
-        if show_progress(as_json):
+        if show_progress(output.as_json):
             click.echo(f"  … {message}", err=True)
             sys.stderr.flush()
 
@@ -140,10 +191,10 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
             raise InvalidInput(f"cell {c.name!r} has several arms ({', '.join(a.name for a in c.arms)}): give --arm")
         arm_name = c.arms[0].name
     arm = c.arm(arm_name)
+    deg, mm, seed = units.deg, units.mm, motion.seed
+    start, start_q = starts.start, starts.start_q
     lu = length_scale(mm)
-    margin_m = margin * lu
-    if start is not None and start_q is not None:
-        raise click.UsageError("give --from (a pose) or --from-q (joint values), not both")
+    margin_m = motion.margin * lu
     hold = hold_option(c, holds, arm.name, deg, mm)
     if start_q is not None:
         q0 = floats(start_q, "--from-q")
@@ -167,10 +218,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
         q0 = np.array(arm.hold)
     R0 = arm.tcp_to_world(q0)[:3, :3]
     T = parse_pose(goal, "--to", mm, deg, R0)
-    a = None if amax is None else floats(amax, "--amax")
-    options = MotionOptions(margin=margin_m, planner=planner, time_limit=time_limit, seed=seed, goals=goal_choice)
-    limits = MotionLimits(amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque)
-    plan = plan_motion(MotionRequest(c, arm.name, q0, T, options=options, limits=limits, hold=hold),
+    plan = plan_motion(MotionRequest(c, arm.name, q0, T, options=motion.options(lu), limits=motion.limits(), hold=hold),
                        progress=progress).raise_for_status()  # not solved: one Error line saying why
     u = "mm" if mm else "m"
     cl = plan.clearance
@@ -190,6 +238,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
         f"{plan.seconds['shortcut']:.3f}, smooth {plan.seconds['smooth']:.3f}, time {plan.seconds['time']:.3f}, "
         f"check {plan.seconds['check']:.3f})",
     ]
+    plot_path, session_path = output.plot_path, output.session_path
     if plot_path:
         from pinarms.viz.plots import plot_clearance
 
@@ -205,4 +254,4 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
         session.add_points("tool_path", plan.tool_path(samples=100), kind="via")
         session.add_points("goal", T[:3, 3][None], kind="target")
         save_session(session, session_path, data, lines)
-    emit(as_json, data, lines)
+    emit(output.as_json, data, lines)

@@ -2,27 +2,51 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import click
 import numpy as np
 
 from pinarms.units import parse_angle, parse_length
 
 from pinarms.cli._common import cli, emit, json_option, load_robot, new_session, progress_bar, save_session, scheduler_value
+from pinarms.cli.option_groups import Flag, flag, option_group
+
+
+@dataclass(frozen=True)
+class ReachFlags:
+    """What the map samples, as typed: the voxel ``resolution`` (a length), ``orientations`` per voxel
+    (``None``: 50, or 16 with ``tool_down``), the tool-down cone (an angle) and its ``roll_steps``, the IK
+    solver, whether self-collisions are dropped and the ``seed``."""
+
+    resolution: str = "0.025"
+    orientations: int | None = None
+    tool_down: str | None = None
+    roll_steps: int = 8
+    ik: str = "auto"
+    self_collision: bool = False
+    seed: int = 0
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--resolution", default="0.025", show_default=True, help="Voxel edge: metres, or with a unit (25mm, 2.5cm)."),
+        flag("--orientations", "orientations", default=None, type=click.IntRange(min=1),
+             help="Rotations per voxel over SO(3) [default 50]; with --tool-down, tool-axis directions in the cone "
+                  "[default 16]."),
+        flag("--tool-down", "tool_down", default=None,
+             help="Only the tool pointing down within this cone half-angle (15deg, 0.26rad; a bare number is degrees), "
+                  "roll free."),
+        flag("--roll-steps", default=8, show_default=True, type=click.IntRange(min=1),
+             help="Rolls tried per tool-down direction (any counts)."),
+        flag("--ik", "ik", default="auto", show_default=True, type=click.Choice(["auto", "analytic", "numerical"])),
+        flag("--self-collision", is_flag=True, help="Drop IK solutions where the arm hits itself."),
+        flag("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the samples and IK restarts."),
+    )
 
 
 @cli.command("reach")
 @click.argument("robot")
-@click.option("--resolution", default="0.025", show_default=True,
-              help="Voxel edge: metres, or with a unit (25mm, 2.5cm).")
-@click.option("--orientations", "orientations", default=None, type=click.IntRange(min=1),
-              help="Rotations per voxel over SO(3) [default 50]; with --tool-down, tool-axis directions in the cone [default 16].")
-@click.option("--tool-down", "tool_down", default=None,
-              help="Only the tool pointing down within this cone half-angle (15deg, 0.26rad; a bare number is degrees), roll free.")
-@click.option("--roll-steps", default=8, show_default=True, type=click.IntRange(min=1),
-              help="Rolls tried per tool-down direction (any counts).")
-@click.option("--ik", "ik", default="auto", show_default=True, type=click.Choice(["auto", "analytic", "numerical"]))
-@click.option("--self-collision", is_flag=True, help="Drop IK solutions where the arm hits itself.")
-@click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the samples and IK restarts.")
+@option_group(ReachFlags, "sampling")
 @click.option("--scheduler", default=None, callback=scheduler_value,
               help="Where to run the chunks: omit (here, serially), processes[:N] (local Dask workers), "
                    "tcp://HOST:8786 (a Dask cluster) or env (DASK_SCHEDULER_ADDRESS).")
@@ -31,24 +55,25 @@ from pinarms.cli._common import cli, emit, json_option, load_robot, new_session,
 @click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
               help="Also save a session that shows the map as coloured voxels (pinarms view / html).")
 @json_option
-def reach_cmd(robot: str, resolution: str, orientations: int | None, tool_down: str | None, roll_steps: int, ik: str,
-              self_collision: bool, seed: int, scheduler: str | None, out_path: str | None, session_path: str | None,
+def reach_cmd(robot: str, sampling: ReachFlags, scheduler: str | None, out_path: str | None, session_path: str | None,
               as_json: bool) -> None:
     """Reachability map of ROBOT's tool: per voxel, which orientations have an IK solution within the limits.
 
     Closed-form arms get every branch; any other URDF the seeded numerical solver. The index of a
     voxel is the fraction of orientations (or tool-down directions) reached.
     """
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     arm = load_robot(robot)
-    res = parse_length(resolution, "--resolution")
-    cone = None if tool_down is None else parse_angle(tool_down, "--tool-down")
-    n = orientations if orientations is not None else (50 if cone is None else 16)
+    res = parse_length(sampling.resolution, "--resolution")
+    cone = None if sampling.tool_down is None else parse_angle(sampling.tool_down, "--tool-down")
+    n = sampling.orientations if sampling.orientations is not None else (50 if cone is None else 16)
+    roll_steps, ik, self_collision, seed = sampling.roll_steps, sampling.ik, sampling.self_collision, sampling.seed
     sched = _scheduler(scheduler)
     with progress_bar("reachability voxels", None, as_json) as bar:
-        m = reachability_map(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik, self_collision=self_collision,
-                             seed=seed, keep_solutions=False, out=out_path, scheduler=sched, progress=bar)
+        request = ReachabilityRequest(arm, res, n, tool_down=cone, roll_steps=roll_steps, ik=ik,
+                                      self_collision=self_collision, seed=seed, keep_solutions=False, out=out_path)
+        m = reachability_map(request, scheduler=sched, progress=bar)
     reach = m.index > 0
     data = {
         "robot": m.robot,

@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import click
 import numpy as np
@@ -23,15 +24,40 @@ from pinarms.cli._common import (
     floats,
     fmt,
     joint_scale_at,
-    json_option,
     load_robot,
     new_session,
     save_session,
-    si_limit,
 )
+from pinarms.cli.option_groups import Flag, LoadFlags, OutputFlags, TimingFlags, flag, option_group
 from pinarms.cli.via_points import TRAJECTORY_KINDS, via_input
 
 OPTIMIZE_KINDS = ("3-5-3", "multi-quintic", "quintic-bspline")
+
+
+@dataclass(frozen=True)
+class ViaFlags:
+    """The via points as typed: ``--via`` (comma-separated joint values, in order), knot ``--times`` [s],
+    or a ``--file`` (.json or .csv) with both."""
+
+    via: tuple[str, ...] = ()
+    times: str | None = None
+    file: str | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order)."),
+        flag("--times", default=None, help="Comma-separated knot times [s], one per via point."),
+        flag("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
+             help="Via points (and times) from a .json or .csv file."),
+    )
+
+    def read(self) -> tuple[np.ndarray | None, np.ndarray, dict]:
+        """``(times or None, positions (n, nq), extras of the file)`` (:func:`~pinarms.cli.via_points.via_input`)."""
+        return via_input(self.via, self.times, self.file)
+
+
+#: The limits of ``plan`` and ``optimize`` (user units: degrees with --deg).
+_LIMIT_WORDS = {"vmax": {"help": "Velocity limit(s), one or per joint, comma-separated."},
+                "amax": {"help": "Acceleration limit(s)."}, "jmax": {"help": "Jerk limit(s)."}}
 
 
 def _build_trajectory(kind: str, times: np.ndarray, positions: np.ndarray, degree: int | None, degrees: str | None):
@@ -98,14 +124,12 @@ def _peaks_dict(peaks: Any, scale: float | np.ndarray) -> dict:
     }
 
 
-def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float | np.ndarray):
+def _limits_from_options(timing: TimingFlags, robot: Robot | None, scale: float | np.ndarray):
     """Velocity/acceleration/jerk limits (SI) from options, else the robot's velocity limits.
 
     ``--amax``/``--jmax`` without a velocity limit are a usage error, not silently ignored.
     """
-    v = si_limit(vmax, "--vmax", scale)
-    a = si_limit(amax, "--amax", scale)
-    j = si_limit(jmax, "--jmax", scale)
+    v, a, j = timing.limits(scale)
     if v is None and robot is not None:
         v = robot.velocity_limit
         if not np.all(v > 0):
@@ -117,23 +141,18 @@ def _limits_from_options(vmax, amax, jmax, robot: Robot | None, scale: float | n
 
 # --------------------------------------------------------------------------- plan
 @cli.command("plan", context_settings=NUMBERS)
-@click.option("--kind", type=click.Choice(TRAJECTORY_KINDS), default="3-5-3", show_default=True)
-@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
-@click.option("--times", default=None, help="Comma-separated knot times [s], one per via point.")
-@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
-              help="Via points (and times) from a .json or .csv file.")
+@option_group(TimingFlags, "timing", only=("kind", "vmax", "amax", "jmax"),
+              kind={"type": click.Choice(TRAJECTORY_KINDS), "default": "3-5-3"}, **_LIMIT_WORDS)
+@option_group(ViaFlags, "vias")
 @click.option("--degree", type=int, default=None, help="Degree for --kind polynomial.")
 @click.option("--degrees", default=None, help="Per-segment degrees for --kind piecewise, e.g. 4,3,4.")
 @click.option("--deg", is_flag=True,
               help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
 @click.option("--robot", default=None, help="Take velocity limits from this robot (and store it in the session).")
-@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint, comma-separated.")
-@click.option("--amax", default=None, help="Acceleration limit(s).")
-@click.option("--jmax", default=None, help="Jerk limit(s).")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the trajectory into a session file.")
-@json_option
-def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jmax, session_path, as_json) -> None:
+@option_group(OutputFlags, "output", only=("session_path", "as_json"),
+              session_path={"help": "Save the trajectory into a session file."})
+def plan_cmd(timing: TimingFlags, vias: ViaFlags, degree: int | None, degrees: str | None, deg: bool,
+             robot: str | None, output: OutputFlags) -> None:
     """Plan a joint trajectory through via points; print its exact peaks and the limit check.
 
     Example (seed 000, joint 1): pinarms plan --kind 3-5-3 --deg --times 0,2,4,6
@@ -141,9 +160,10 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     """
     from pinarms import planning
 
+    kind, session_path, as_json = timing.kind, output.session_path, output.as_json
     if session_path and not robot:
         raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
-    t, positions, extra = via_input(via, times, file)
+    t, positions, extra = vias.read()
     if t is None:
         raise click.UsageError("give knot times with --times (or a 't' column / 'times' key in the file)")
     if extra.get("kind") and kind == "3-5-3" and extra["kind"] in TRAJECTORY_KINDS:
@@ -154,7 +174,7 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
     traj = _build_trajectory(kind, t, positions * scale, degree, degrees)
     peaks = traj.peaks()
     unit = _unit_label(arm, deg)
-    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
+    v, a, j = _limits_from_options(timing, arm, scale)
     report = None
     if v is not None:
         report = traj.check(planning.JointLimits(v, a, j))
@@ -192,29 +212,23 @@ def plan_cmd(kind, via, times, file, degree, degrees, deg, robot, vmax, amax, jm
 
 # --------------------------------------------------------------------------- optimize
 @cli.command("optimize", context_settings=NUMBERS)
-@click.option("--kind", type=click.Choice(OPTIMIZE_KINDS), default="3-5-3", show_default=True)
-@click.option("--via", multiple=True, help="One via point: comma-separated joint values (repeat, in order).")
-@click.option("--file", "file", default=None, type=click.Path(exists=True, dir_okay=False),
-              help="Via points from a .json or .csv file.")
+@option_group(TimingFlags, "timing", kind={"type": click.Choice(OPTIMIZE_KINDS), "default": "3-5-3"},
+              method={"type": click.Choice(["ga", "exact"]), "default": "ga"},
+              seed={"help": "Random seed of the GA."},
+              **{**_LIMIT_WORDS, "vmax": {"help": "Velocity limit(s), one or per joint."}})
+@option_group(ViaFlags, "vias", only=("via", "file"), file={"help": "Via points from a .json or .csv file."})
 @click.option("--deg", is_flag=True,
               help="Joint values and limits in degrees (with --robot: its revolute joints; prismatic stay in m).")
 @click.option("--robot", default=None, help="Take velocity limits from this robot.")
-@click.option("--vmax", default=None, help="Velocity limit(s), one or per joint.")
-@click.option("--amax", default=None, help="Acceleration limit(s).")
-@click.option("--jmax", default=None, help="Jerk limit(s).")
-@click.option("--method", type=click.Choice(["ga", "exact"]), default="ga", show_default=True)
-@click.option("--seed", default=0, show_default=True, type=int, help="Random seed of the GA.")
 @click.option("--generations", default=None, type=click.IntRange(min=1), help="Maximum GA generations.")
-@click.option("--payload", default=None,
-              help="Mass at the tcp, e.g. 3kg or 800g (needs --robot): also limits joint torques "
-                   "(--torque-max, default the URDF's efforts).")
-@click.option("--torque", "torque", is_flag=True, help="Also limit joint torques to the URDF's efforts (needs --robot).")
-@click.option("--torque-max", default=None, help="Joint torque limit(s) [N·m, or N for prismatic joints] (needs --robot).")
-@click.option("--session", "session_path", default=None, type=click.Path(dir_okay=False),
-              help="Save the optimised trajectory (and GA history) into a session file.")
-@json_option
-def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, generations, payload, torque, torque_max,
-                 session_path, as_json) -> None:
+@option_group(LoadFlags, "load", payload={"help": "Mass at the tcp, e.g. 3kg or 800g (needs --robot): also limits joint "
+                                                  "torques (--torque-max, default the URDF's efforts)."},
+              torque={"help": "Also limit joint torques to the URDF's efforts (needs --robot)."},
+              torque_max={"help": "Joint torque limit(s) [N·m, or N for prismatic joints] (needs --robot)."})
+@option_group(OutputFlags, "output", only=("session_path", "as_json"),
+              session_path={"help": "Save the optimised trajectory (and GA history) into a session file."})
+def optimize_cmd(timing: TimingFlags, vias: ViaFlags, deg: bool, robot: str | None, generations: int | None,
+                 load: LoadFlags, output: OutputFlags) -> None:
     """Shortest segment times through via points under velocity/acceleration/jerk limits.
 
     With --payload, --torque or --torque-max the joint torques of --robot (Pinocchio's RNEA,
@@ -225,27 +239,25 @@ def optimize_cmd(kind, via, file, deg, robot, vmax, amax, jmax, method, seed, ge
     """
     from pinarms import optim
 
+    kind, method, seed = timing.kind, timing.method, timing.seed
+    session_path, as_json = output.session_path, output.as_json
     if session_path and not robot:
         raise click.UsageError("--session needs --robot: a session stores the trajectory with its robot")
-    _, positions, _ = via_input(via, None, file)
+    _, positions, _ = vias.read()
     arm = load_robot(robot) if robot else None
     scale = _joint_scale(arm, deg, positions.shape[1])
     unit = _unit_label(arm, deg)
-    v, a, j = _limits_from_options(vmax, amax, jmax, arm, scale)
+    v, a, j = _limits_from_options(timing, arm, scale)
     if v is None:
         raise click.UsageError("give a velocity limit with --vmax (or --robot)")
     kwargs: dict[str, Any] = {}
     callback = None
     if generations is not None and method == "ga":
         kwargs["max_generations"] = generations
-    if payload is not None or torque or torque_max is not None:
+    if load.asked:
         if arm is None:
             raise click.UsageError("--payload, --torque and --torque-max need --robot (its inverse dynamics give the torques)")
-        from pinarms.units import mass_kg
-
-        limits = si_limit(torque_max, "--torque-max", np.ones(arm.nq))
-        kwargs.update(robot=arm, payload=None if payload is None else mass_kg(payload),
-                      torque_limits=True if limits is None else limits)
+        kwargs.update(robot=arm, payload=load.kg, torque_limits=load.torque_limits(arm.nq))
     budget = generations or optim.GASettings.seed002().max_generations  # minimize_time's default settings
     bar = common.progress_bar("GA generations", budget, as_json or method != "ga")
     if bar.enabled:

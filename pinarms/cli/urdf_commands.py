@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import click
 import numpy as np
@@ -18,6 +20,7 @@ from pinarms.cli._common import (
     load_robot,
 )
 from pinarms.cli._common import package_map
+from pinarms.cli.option_groups import Flag, flag, option_group
 
 
 # --------------------------------------------------------------------------- urdf
@@ -119,6 +122,32 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
     )
 
 
+@dataclass(frozen=True)
+class SrdfFlags:
+    """The SRDF written beside the URDF (``srdf``) and its named states: the demo's poses (``study_poses``,
+    a built-in cell) and the ``--state`` items as typed. States without ``--srdf`` are refused."""
+
+    srdf: bool = False
+    study_poses: bool = False
+    state_items: tuple[str, ...] = ()
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--srdf", is_flag=True,
+             help="Also write the SRDF (MoveIt: groups, end effector, home, disable_collisions from pinarms' pairs)."),
+        flag("--study-poses", is_flag=True,
+             help="With --srdf, a built-in cell: also the demo's pick/place poses as named states (plans its cycles)."),
+        flag("--state", "state_items", multiple=True, metavar="NAME=[ARM:]V1,V2,...",
+             help="With --srdf, a named state (repeatable): joint values [rad or m]; in a cell of several arms "
+                  "NAME=ARM:V1,... (repeat NAME for each arm of a whole-cell state). 'home' is the arm's home."),
+    )
+
+    def __post_init__(self) -> None:
+        if self.study_poses and not self.srdf:
+            raise click.UsageError("--study-poses are SRDF states: add --srdf")
+        if self.state_items and not self.srdf:
+            raise InvalidInput("--state gives SRDF states: add --srdf")
+
+
 @urdf_group.command("export")
 @click.argument("robot")
 @click.argument("out_dir", type=click.Path(file_okay=True))
@@ -126,21 +155,15 @@ def _build_user_xacro(source: str, xacro_args: tuple[str, ...], packages: tuple[
 @click.option("--mjcf", is_flag=True,
               help="Write a MuJoCo model (MJCF) instead (a cell: beside its URDF), with sites at the flange and tcp "
                    "(needs: pip install mujoco).")
-@click.option("--srdf", is_flag=True,
-              help="Also write the SRDF (MoveIt: groups, end effector, home, disable_collisions from pinarms' pairs).")
+@option_group(SrdfFlags, "srdf_flags")
 @click.option("--cell", "is_cell", is_flag=True,
               help="ROBOT is a cell file (a built-in cell name is recognised without it).")
-@click.option("--study-poses", is_flag=True,
-              help="With --srdf, a built-in cell: also the demo's pick/place poses as named states (plans its cycles).")
 @click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
               help="A folder for package://NAME/ meshes (repeatable). Meshes are copied only from ROBOT's own "
                    "folder and these.")
-@click.option("--state", "state_items", multiple=True, metavar="NAME=[ARM:]V1,V2,...",
-              help="With --srdf, a named state (repeatable): joint values [rad or m]; in a cell of several arms "
-                   "NAME=ARM:V1,... (repeat NAME for each arm of a whole-cell state). 'home' is the arm's home.")
 @json_option
-def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf: bool, is_cell: bool,
-                    study_poses: bool, packages: tuple[str, ...], state_items: tuple[str, ...], as_json: bool) -> None:
+def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf_flags: SrdfFlags, is_cell: bool,
+                    packages: tuple[str, ...], as_json: bool) -> None:
     """Write ROBOT (an arm or a whole cell) as a self-contained folder (URDF with relative mesh paths + meshes) into OUT_DIR.
 
     With --mjcf the folder holds ROBOT.xml for MuJoCo: every link kept as a body, a site
@@ -155,10 +178,7 @@ def urdf_export_cmd(robot: str, out_dir: str, overwrite: bool, mjcf: bool, srdf:
     from pinarms.export import export_cell, export_mjcf, export_urdf
     from pinarms.robots.cell import cell_names, load_cell
 
-    if study_poses and not srdf:
-        raise click.UsageError("--study-poses are SRDF states: add --srdf")
-    if state_items and not srdf:
-        raise InvalidInput("--state gives SRDF states: add --srdf")
+    srdf, study_poses, state_items = srdf_flags.srdf, srdf_flags.study_poses, srdf_flags.state_items
     pkgs = package_map(packages)
     if is_cell or robot in cell_names():
         cell = load_cell(robot, packages=pkgs)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import click
 import numpy as np
 
 from pinarms.cli._common import NUMBERS, PinarmsGroup, cli, emit, floats, json_option
+from pinarms.cli.option_groups import Flag, flag, option_group
 
 
 @cli.group("verify", cls=PinarmsGroup)
@@ -18,6 +21,30 @@ def verify_group() -> None:
     """
 
 
+@dataclass(frozen=True)
+class PlanFlags:
+    """The move ``verify cell --plan FROM TO`` plans and replays: its ends (as typed), the arm, the
+    clearance ``margin`` [m], the search's ``time_limit`` [s] and the acceleration limit(s) ``amax``."""
+
+    plan_ends: tuple[str, str] | None = None
+    arm_name: str | None = None
+    margin: float = 0.01
+    time_limit: float = 2.0
+    amax: str | None = None
+
+    FLAGS: ClassVar[tuple[Flag, ...]] = (
+        flag("--plan", "plan_ends", nargs=2, default=None, metavar="FROM TO",
+             help="Also plan a move of --arm from FROM to TO and replay it: each comma-separated joint values "
+                  "[rad or m] or a named state (neutral, or a state of the arm in the cell description)."),
+        flag("--arm", "arm_name", default=None, help="The arm --plan moves (default: the cell's only arm)."),
+        flag("--margin", default=0.01, show_default=True, type=float,
+             help="Clearance the planned move keeps to fixtures and other arms [m]."),
+        flag("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take."),
+        flag("--amax", default=None,
+             help="Joint acceleration limit(s) of the planned move [rad/s² or m/s²] (torque limits apply too)."),
+    )
+
+
 @verify_group.command("cell", context_settings=NUMBERS)
 @click.argument("cell")
 @click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
@@ -26,19 +53,10 @@ def verify_group() -> None:
 @click.option("--samples", default=200, show_default=True, type=int,
               help="Random cell configurations compared (seeded), and instants of the planned move with --plan.")
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of the random configurations and the search.")
-@click.option("--plan", "plan_ends", nargs=2, default=None, metavar="FROM TO",
-              help="Also plan a move of --arm from FROM to TO and replay it: each comma-separated joint values "
-                   "[rad or m] or a named state (neutral, or a state of the arm in the cell description).")
-@click.option("--arm", "arm_name", default=None, help="The arm --plan moves (default: the cell's only arm).")
-@click.option("--margin", default=0.01, show_default=True, type=float,
-              help="Clearance the planned move keeps to fixtures and other arms [m].")
-@click.option("--time-limit", default=2.0, show_default=True, type=float, help="Seconds the search may take.")
-@click.option("--amax", default=None,
-              help="Joint acceleration limit(s) of the planned move [rad/s² or m/s²] (torque limits apply too).")
+@option_group(PlanFlags, "plan")
 @json_option
 def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str, ...], samples: int, seed: int,
-                    plan_ends: tuple[str, str] | None, arm_name: str | None, margin: float, time_limit: float,
-                    amax: str | None, as_json: bool) -> None:
+                    plan: PlanFlags, as_json: bool) -> None:
     """Compare CELL's collision state in pinarms and MuJoCo (exported MJCF) at random configurations.
 
     With --plan FROM TO, also plan a collision-free move of --arm (pinarms motion's planner)
@@ -58,14 +76,15 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
     pkgs = package_map(packages)
     results = [("configurations", compare_configurations_in_mujoco(
         c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", packages=pkgs))]
+    plan_ends, arm_name, amax = plan.plan_ends, plan.arm_name, plan.amax
     if plan_ends is not None:
         a = None if amax is None else floats(amax, "--amax")
         if a is not None and not (a.size and np.all(np.isfinite(a)) and np.all(a > 0.0)):
             raise InvalidInput(f"--amax must be one positive acceleration limit or one per planned joint "
                                f"[rad/s² or m/s²], got {amax!r}")
-        plan = _plan_between(c, arm_name, plan_ends, margin=margin, time_limit=time_limit, seed=seed,
+        move = _plan_between(c, arm_name, plan_ends, margin=plan.margin, time_limit=plan.time_limit, seed=seed,
                              amax=None if a is None else (float(a[0]) if a.size == 1 else a))
-        results.append(("plan", compare_in_mujoco(c, plan, samples=samples, packages=pkgs)))
+        results.append(("plan", compare_in_mujoco(c, move, samples=samples, packages=pkgs)))
     elif arm_name is not None or amax is not None:
         raise InvalidInput("--arm and --amax apply to the move of --plan FROM TO: add --plan")
     lines = [line for _, r in results for line in r.lines()]

@@ -43,7 +43,7 @@ def _station_cycle(station: Any) -> Any:
     arm = station.arm("aubo")
     spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
                            lift=0.05, dwell=0.2)
-    return optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(station, clearance=0.02)))
+    return optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(station, clearance=0.02))).raise_for_status()
 
 
 def _line_cycles(cell: Any, step: Any = None) -> dict[str, Any]:
@@ -55,7 +55,7 @@ def _line_cycles(cell: Any, step: Any = None) -> dict[str, Any]:
     for name, (pick, place) in LINE_TASKS.items():
         a = cell.arm(name)
         spec = optim.PickPlace(a.to_base(np.array(pick)), a.to_base(np.array(place)), lift=0.03, dwell=0.15)
-        cycles[name] = optim.plan_cycle(CycleRequest(a.robot, spec, cell=CellSettings(cell, clearance=0.02)))
+        cycles[name] = optim.plan_cycle(CycleRequest(a.robot, spec, cell=CellSettings(cell, clearance=0.02))).raise_for_status()
         if step is not None:
             step(name, cycles[name])
     return cycles

@@ -31,7 +31,8 @@ def study_cell(quick: bool = False) -> Study:
     for name, (pick, place) in LINE_TASKS.items():
         arm = line.arm(name)
         spec = optim.PickPlace(arm.to_base(np.array(pick)), arm.to_base(np.array(place)), lift=0.03, dwell=0.15)
-        cycles[name] = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(line, clearance=0.02)))
+        request = CycleRequest(arm.robot, spec, cell=CellSettings(line, clearance=0.02))
+        cycles[name] = optim.plan_cycle(request).raise_for_status()
     for name, res in cycles.items():
         rep = res.cell_report
         rows.append(Row("000", f"mushroom_line, {name} SCARA: cycle keeping 20 mm from belt, box and the other arm",
@@ -54,6 +55,7 @@ def study_cell(quick: bool = False) -> Study:
     spec = optim.PickPlace(arm.to_base(np.array([0.36, 0.0, 0.75])), arm.to_base(np.array([0.0, -0.42, 0.77])),
                            lift=0.05, dwell=0.2)
     crate = optim.plan_cycle(CycleRequest(arm.robot, spec, cell=CellSettings(station, clearance=0.02)))
+    crate.raise_for_status()
     rep = crate.cell_report
     rows.append(Row("001", "aubo_food_station: table → crate cycle keeping 20 mm (table and crate in the band)",
                     None, crate.cycle_time, "s", None,

@@ -14,6 +14,7 @@ puts deltas beside the SCARAs (the rows of the demo's line study).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 from pinarms.optim.line import Belt, LineSpec, PlaceBox, Rule, Station, Stream, TrackingSpec, base_pose, run_line
@@ -23,7 +24,7 @@ from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.robots.delta import delta_names, load_delta
 from pinarms.errors import InvalidInput
 
-__all__ = ["delta_line", "delta_maps", "delta_arms_needed", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
+__all__ = ["delta_line", "DeltaLineRequest", "delta_maps", "delta_arms_needed", "delta_rows", "DELTA_SPACING", "DELTA_HEIGHT", "DELTA_BOX"]
 
 #: Distance between deltas along the belt [m].
 DELTA_SPACING = 1.6
@@ -33,27 +34,48 @@ DELTA_HEIGHT = 1.1
 DELTA_BOX = (0.0, 0.45, -1.0)
 
 
-def delta_line(n_arms: int, rate: float, *, item: Any,
-               name: str = "delta_flexpicker", speed: float = 0.2, rule: str = "first",
-               seeds: tuple[int, ...] = (0, 1, 2, 3, 4), duration: float = 600.0, spacing: float = DELTA_SPACING,
-               height: float = DELTA_HEIGHT, box: tuple[float, float, float] = DELTA_BOX, first: float = 1.0,
-               map_grid: tuple[int, int] = (12, 5)) -> LineSpec:
-    """``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min of ``item``
-    (an :class:`pinarms.optim.line.ItemType`; the study: :data:`pinarms.studies.line.ENOKI`) (module doc).
+@dataclass(frozen=True)
+class DeltaLineRequest:
+    """A line of ``n_arms`` deltas ``name`` above seed 000's belt at ``speed`` [m/s], ``rate`` items/min of
+    ``item`` (an :class:`pinarms.optim.line.ItemType`; the study: :data:`pinarms.studies.line.ENOKI`), the
+    assignment ``rule``, Monte Carlo ``seeds`` and ``duration`` [s], the layout (``spacing``, ``height``,
+    ``box``, ``first`` [m]) and the task maps' ``map_grid`` (module doc).
 
     Raises:
         InvalidInput: a name that is not a shipped delta (names them)."""
-    if name not in delta_names():
-        raise InvalidInput(f"{name!r} is not a shipped delta; shipped: {', '.join(delta_names())}")
-    arm = DeltaArm(load_delta(name))
+
+    n_arms: int
+    rate: float
+    item: Any
+    name: str = "delta_flexpicker"
+    speed: float = 0.2
+    rule: str = "first"
+    seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
+    duration: float = 600.0
+    spacing: float = DELTA_SPACING
+    height: float = DELTA_HEIGHT
+    box: tuple[float, float, float] = DELTA_BOX
+    first: float = 1.0
+    map_grid: tuple[int, int] = (12, 5)
+
+    def __post_init__(self) -> None:
+        if self.name not in delta_names():
+            raise InvalidInput(f"{self.name!r} is not a shipped delta; shipped: {', '.join(delta_names())}")
+
+
+def delta_line(request: DeltaLineRequest) -> LineSpec:
+    """The :class:`~pinarms.optim.line.LineSpec` of ``request``'s line of deltas (module doc)."""
+    r = request
+    arm = DeltaArm(load_delta(r.name))
     z = 0.80
+    first, spacing, height, box = r.first, r.spacing, r.height, r.box
     stations = tuple(Station(f"delta {k + 1}", arm, base_pose(first + spacing * k, 0.0, z + height),
                              PlaceBox((first + spacing * k + box[0], box[1], z + height + box[2]), f"box {k + 1}"),
                              vmax=arm.velocity_limit, amax=arm.acceleration_limit)
-                     for k in range(int(n_arms)))
-    belt = Belt((0.0, 0.0, z), speed=speed, width=0.3, length=first + spacing * int(n_arms) + 0.5)
-    return LineSpec(belt, stations, Stream("poisson", rate / 60.0, duration, types=(item,)), TrackingSpec(), Rule(rule),
-                    seeds, 0.01, tuple(map_grid))
+                     for k in range(int(r.n_arms)))
+    belt = Belt((0.0, 0.0, z), speed=r.speed, width=0.3, length=first + spacing * int(r.n_arms) + 0.5)
+    return LineSpec(belt, stations, Stream("poisson", r.rate / 60.0, r.duration, types=(r.item,)), TrackingSpec(),
+                    Rule(r.rule), r.seeds, 0.01, tuple(r.map_grid))
 
 
 def delta_maps(spec: LineSpec, *, n: int = 24, progress: Any = None) -> dict:
@@ -71,7 +93,7 @@ def delta_arms_needed(rate: float, *, max_arms: int = 20, maps: Any = None, **kw
     result, the map used)."""
     last, one = None, maps
     for k in range(1, max_arms + 1):
-        spec = delta_line(k, rate, **kw)
+        spec = delta_line(DeltaLineRequest(k, rate, **kw))
         one = one or delta_maps(spec)[spec.stations[0].name]
         last = run_line(spec, maps={st.name: one for st in spec.stations})
         if last.status == "ok":
@@ -100,7 +122,7 @@ def delta_rows(scara: dict[str, Any], rate: float = 60.0, *, item: Any, seeds: t
             f"{100 * f.miss_rate_ci[0]:.2f}-{100 * f.miss_rate_ci[1]:.2f} %, {len(seeds)} seeds); against "
             f"{scara['arms']} SCARAs ({scara['picks_per_min']:.1f} picks/min, miss {100 * scara['miss_rate']:.2f} %); "
             f"task times depend on the item's yaw by up to {100 * m[0].yaw_spread:.0f} % (fourth axis)")
-    one = delta_line(1, rate, item=item, seeds=(0,), duration=120.0)
+    one = delta_line(DeltaLineRequest(1, rate, item=item, seeds=(0,), duration=120.0))
     sat = run_line(replace(one, stream=Stream("regular", 4.0, 120.0, types=(item,))), maps={"delta 1": m})
     rows = [Row("000", f"SCARA or delta: deltas for {rate:g} bunches/min at <= 1 % miss", None, k, "arms", None, note),
             Row("000", "one delta saturated on the belt", None, sat.figures.picks_per_minute, "picks/min", None,

@@ -68,7 +68,7 @@ def study_000(quick: bool = False) -> Study:
 
     # the whole pick-and-place cycle between the same pick (conveyor) and place (box) poses
     spec = optim.PickPlace(arm.fk(q_via[0]), arm.fk(q_via[-1]), lift=0.05, dwell=0.2)
-    cycle = optim.plan_cycle(CycleRequest(arm, spec, q_start=q_via[0]))
+    cycle = optim.plan_cycle(CycleRequest(arm, spec, q_start=q_via[0])).raise_for_status()
     what = ("pick-and-place cycle of the SCARA (pick on the conveyor, place in the box, lift 50 mm, dwell 0.2 s, "
             "joint limits of the model)")
     why = (f"the paper gives none for the SCARA; moves {cycle.move_times[0]:.3f} + {cycle.move_times[1]:.3f} s "

@@ -62,12 +62,12 @@ def dynamics_001(arm: Robot, table2: np.ndarray, quick: bool) -> tuple[list[Row]
                 f"{gens} generations, seed 0; ×{ga.total / ex.total:.3f} the exact optimum above; peak torque/limit "
                 f"{ga.torque_ratios.max():.3f}"))
     spec = optim.PickPlace(AUBO_PICK_M, AUBO_PLACE_M, lift=0.08, dwell=0.3)
-    free = optim.plan_cycle(CycleRequest(arm, spec))
+    free = optim.plan_cycle(CycleRequest(arm, spec)).raise_for_status()
     what = "AUBO-i3 pick-and-place (r ≈ 0.46 m, 115° apart, lift 80 mm, dwell 0.3 s)"
     rows.append(Row("001", f"{what}: cycle time, joint speed only", None, free.cycle_time, "s", None,
                     f"{free.picks_per_minute:.1f} picks/min; the paper gives none"))
     for kg in AUBO_PAYLOADS_KG:
-        cyc = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(kg, torque_limits=True)))
+        cyc = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(kg, torque_limits=True))).raise_for_status()
         tight = [arm.joint_names[k] for k in near_max(cyc.torque_ratios)]
         rows.append(Row(
             "001", f"{what}: cycle time with {kg:g} kg, speed + torque", None, cyc.cycle_time, "s", None,
@@ -98,11 +98,11 @@ def tool_down_band_001(arm: Robot, quick: bool) -> tuple[list[Row], Any, Callabl
     tool-down reachability map of the tcp (15° cone, roll free; coarse voxels to stay fast).
 
     ``quick`` is accepted for symmetry with the other helpers; the map is the same either way."""
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
     paper = SEED001
     res = 0.06  # the same map in quick and full runs (about 4 s on one core): the rows are reproducible
-    m = reachability_map(arm, res, 6, tool_down=15.0 * DEG, roll_steps=6)
+    m = reachability_map(ReachabilityRequest(arm, res, 6, tool_down=15.0 * DEG, roll_steps=6))
     centre = paper.sphere_centre_m
     c = m.centres()
     r = np.linalg.norm(c - centre, axis=1)

@@ -74,7 +74,7 @@ def study_002(quick: bool = False) -> Study:
     tcp = arm.position(np.array(GANTRY_PATH_AXIS_M))
     spec = optim.PickPlace(tcp[0], tcp[-1], lift=float(tcp[1, 2] - tcp[0, 2]), dwell=0.2, via=list(tcp[2:-2]))
     timing = CycleTiming("quintic-bspline", arm.velocity_limit, a * transmission, j * transmission)
-    cycle = optim.plan_cycle(CycleRequest(arm, spec, timing=timing))
+    cycle = optim.plan_cycle(CycleRequest(arm, spec, timing=timing)).raise_for_status()
     what = ("pick-and-place cycle of the gantry (the lift-feed-lower move and back, dwell 0.2 s, axis limits "
             f"{arm.velocity_limit[0]:g} m/s of the model, {a * transmission:g} m/s², {j * transmission:g} m/s³)")
     rows.append(Row("002", f"{what}: cycle time", None, cycle.cycle_time, "s", None,

@@ -143,29 +143,30 @@ KOJI_BLOCK_KG = 4.0
 def _koji_block_rows(arm: Any) -> list[Row]:
     """The koji arm turning one block: lift it, swing 90°, turn it 90° on the wrist, set it down (and back)."""
     from pinarms import optim
-    from pinarms.optim import InfeasibleProblem
     from pinarms.optim.cycle import CycleLoad, CycleRequest
     from pinarms.robots.ties import near_max
 
     q_pick = np.array([0.0, 0.15, -0.35, 0.0])
     q_place = np.array([np.pi / 2, 0.15, -0.35, np.pi / 2])
     spec = optim.PickPlace(arm.fk(q_pick), arm.fk(q_place), lift=0.10, dwell=0.5)
-    free = optim.plan_cycle(CycleRequest(arm, spec))
+    free = optim.plan_cycle(CycleRequest(arm, spec)).raise_for_status()
     what = "koji block turn (swing 90°, turn the block 90°, lift 0.1 m, dwell 0.5 s)"
     rows = [Row("004", f"{what}: cycle time, joint speed only", None, free.cycle_time, "s", None,
                 "the paper times no cycle; joint speeds of the model (0.3–1 rad/s)")]
-    loaded = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(KOJI_BLOCK_KG, torque_limits=True)))
+    loaded = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(KOJI_BLOCK_KG, torque_limits=True))).raise_for_status()
     tight = [arm.joint_names[k] for k in near_max(loaded.torque_ratios)]
     rows.append(Row("004", f"{what}: cycle time with one {KOJI_BLOCK_KG:g} kg block, speed + torque", None,
                     loaded.cycle_time, "s", None,
                     f"block mass assumed (0.32 × 0.19 × 0.055 m of pressed moist koji, ≈1.2 kg/dm³); "
                     f"{signed_percent(loaded.cycle_time / free.cycle_time - 1.0)}; peak torque/limit "
                     f"{loaded.torque_ratios.max():.3f} ({', '.join(tight)})"))
-    try:
-        optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(2 * KOJI_BLOCK_KG, torque_limits=True)))
+    both = optim.plan_cycle(CycleRequest(arm, spec, load=CycleLoad(2 * KOJI_BLOCK_KG, torque_limits=True)))
+    if both.solved:
         two = "feasible"
-    except InfeasibleProblem as exc:
-        two = str(exc).split(":")[1].split(";")[0].strip()
+    elif both.status is optim.CycleStatus.LIMITS_NOT_MET:
+        two = both.reason.split(":")[1].split(";")[0].strip()
+    else:
+        both.raise_for_status()
     rows.append(Row("004", f"{what}: two blocks ({2 * KOJI_BLOCK_KG:g} kg) at once", None,
                     "infeasible" if two != "feasible" else "feasible", "", None,
                     f"{two}; efforts sized for one block, no balancing cylinder or counterweight modelled "

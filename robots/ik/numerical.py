@@ -70,6 +70,7 @@ from pinarms.robots._checks import check_seed as _check_seed
 from pinarms.robots._checks import check_tolerance as _check_tolerance
 from pinarms.robots.ik.descent import CLIP as _CLIP
 from pinarms.robots.ik.descent import FREE as _FREE
+from pinarms.robots.ik.attempts import IKAttempts
 from pinarms.robots.ik.descent import LMDescent
 from pinarms.robots.ik.limit_rules import JointLimitRules
 from pinarms.robots.ik.numerical_batch import BatchIKResult, batch_errors, seed_int32, solve_batch
@@ -250,21 +251,21 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
         if q_seed is not None:
             q_seed = robot.check_q(q_seed)[0][0]
         _check_restarts(max_restarts)
-        return self.solve_checked(
-            T[0], q_seed, position_only=position_only, tol=_check_tolerance(tol, "tol [m, rad]", positive=True),
-            max_restarts=int(max_restarts), seed=_check_seed(seed), limits=bool(limits),
-        )
+        return self.solve_checked(T[0], q_seed, IKAttempts(
+            bool(position_only), _check_tolerance(tol, "tol [m, rad]", positive=True), int(max_restarts),
+            _check_seed(seed), bool(limits)))
 
-    def solve_checked(
-        self, target, q_seed, *, position_only, tol, max_restarts, seed, limits, first: bool = True, polish: bool = True,
-        compiled: bool = True,
-    ) -> IKResult:
-        """:meth:`solve` on arguments already checked (``Robot.ik`` checks them once).
+    def solve_checked(self, target, q_seed, attempts: IKAttempts) -> IKResult:
+        """:meth:`solve` on a target and start already checked (``Robot.ik`` checks them once), searching as
+        ``attempts`` says (:class:`~pinarms.robots.ik.attempts.IKAttempts`).
 
-        ``first=False`` skips the attempt from the first start (already tried by the caller);
+        ``attempts.first=False`` skips the attempt from the first start (already tried by the caller);
         ``polish=False`` skips the final projected descent of a failed solve; ``compiled=False``
         runs the attempts interpreted (step by step through Pinocchio) instead of :mod:`._kernel`.
         """
+        position_only, tol, max_restarts = attempts.position_only, attempts.tol, attempts.max_restarts
+        seed, limits, first, polish = attempts.seed, attempts.limits, attempts.first, attempts.polish
+        compiled = attempts.compiled
         target = np.asarray(target, dtype=float)
         target_to_base, target_in_base = self._target(target, position_only)
         tol = float(tol)

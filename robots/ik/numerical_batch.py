@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.robots._checks import check_restarts
+from pinarms.robots.ik.attempts import IKAttempts
 
 
 __all__ = ["BatchIKResult", "solve_batch", "batch_errors", "seed_int32"]
@@ -161,9 +162,9 @@ def solve_batch(
     inside = np.all((q >= self.lower) & (q <= self.upper), axis=1)
     success &= (pos_err <= tol) & (rot_err <= tol) & inside
     left = np.flatnonzero(~success)
+    attempts = IKAttempts(bool(position_only), float(tol), int(max_restarts), rng, True)
     for k in left:  # the few the batch left: per-target solver with restarts
-        res = self.solve_checked(targets[k], None, position_only=position_only, tol=tol, max_restarts=max_restarts,
-                          seed=rng, limits=True)
+        res = self.solve_checked(targets[k], None, attempts)
         q[k] = res.q
         success[k] = res.success
     if left.size:

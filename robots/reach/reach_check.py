@@ -133,7 +133,7 @@ def _check_checksums(r: MapChecker, m: ReachabilityMap, sols: PoseSolutions | No
     stored = r.attrs["/"].get("checksum")
     if not isinstance(stored, str):
         raise r.fail("it holds no checksum of its values (written by an older pinarms): rebuild it with "
-                     "reachability_map(..., out=...) or save_reachability")
+                     "reachability_map(ReachabilityRequest(..., out=...)) or save_reachability")
     if stored != map_checksum(m):
         raise r.fail("its values do not match the checksum stored with them (a byte was changed or damaged): "
                      "rebuild the map")

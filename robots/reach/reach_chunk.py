@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pinarms.errors import InvalidInput
+from pinarms.robots.ik.attempts import IKAttempts
 from pinarms.robots.reach.reach_map import cell_centres
 from pinarms.robots.reach.robot_spec import RobotSpec, robot_of, spec_key
 
@@ -166,6 +167,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
     for r in range(n):
         v = int(task.voxels[r])
         rng = np.random.default_rng([task.seed, v])
+        attempts = IKAttempts(False, task.tol, task.restarts, rng, True)
         k_idx = v % nz
         j_idx = (v // nz) % ny
         neighbours = [solved.get(u) for u, ok in ((v - 1, k_idx > 0), (v - nz, j_idx > 0), (v - ny * nz, True)) if ok]
@@ -175,8 +177,7 @@ def _solve_numerical(task: ChunkTask, robot: "Robot") -> tuple[np.ndarray, np.nd
             start = next((a[k] for a in neighbours if np.isfinite(a[k, 0])), None)
             if start is None and k > 0 and task.group[k] == task.group[k - 1] and np.isfinite(here[k - 1, 0]):
                 start = here[k - 1]  # previous roll of the same direction
-            res = solver.solve_checked(T[r * M + k], start, position_only=False, tol=task.tol,
-                                max_restarts=task.restarts, seed=rng, limits=True)
+            res = solver.solve_checked(T[r * M + k], start, attempts)
             if res.success and collision_free(task, robot, res.q[None])[0]:
                 here[k] = res.q
                 poses.append(r * M + k)

@@ -3,7 +3,7 @@
 The layout is described in :mod:`pinarms.robots.reach.reach_io`, which also reads and checks the files.
 This module writes them and imports nothing of the map's module (it reads the map's fields),
 so :class:`pinarms.robots.reach.reachability.ReachabilityMap` and the streamed computation
-(``reachability_map(out=...)``) use it without an import circle.
+(``ReachabilityRequest(out=...)``) use it without an import circle.
 """
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ def _write(h5: Any, m: Any, poses: str | None = None) -> None:
 
 
 class StreamWriter:
-    """Writes a map whose stored solutions arrive chunk by chunk (``reachability_map(out=...)``).
+    """Writes a map whose stored solutions arrive chunk by chunk (``ReachabilityRequest(out=...)``).
 
     :meth:`append` adds solutions to extendable, chunked, gzip datasets under ``/poses`` of a
     temporary file; :meth:`finish` writes the rest of the map and renames the file to its

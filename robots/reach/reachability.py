@@ -55,7 +55,7 @@ Units: metres, radians; rotations tool frame → base; joint values in the robot
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
@@ -83,6 +83,7 @@ __all__ = [
     "ReachabilityMap",
     "PoseSolutions",
     "reachability_map",
+    "ReachabilityRequest",
     "reach_bound",
     "solve_chunk",
     "MAX_GRID_VOXELS",
@@ -93,31 +94,11 @@ _POSES_PER_CHUNK = {"analytic": 100_000, "numerical": 10_000}
 
 
 # ----------------------------------------------------------------------------- building
-def reachability_map(
-    arm: "Robot",
-    resolution: float = 0.025,
-    orientations: int | OrientationSet = 50,
-    *,
-    tool_down: float | None = None,
-    roll_steps: int = 8,
-    tool_axis: ArrayLike | None = None,
-    ik: str = "auto",
-    manipulability: str = "full",
-    restarts: int = 2,
-    tol: float = 1e-9,
-    self_collision: bool = False,
-    collision: Any = None,
-    keep_solutions: bool = True,
-    out: str | os.PathLike | None = None,
-    chunk_voxels: int | None = None,
-    samples: int | None = None,
-    seed: int = 0,
-    scheduler: str | Client | None = None,
-    progress: Callable[[int, int], None] | None = None,
-) -> ReachabilityMap:
-    """Build the reachability map of ``arm``'s tool frame (see the module doc).
+@dataclass(frozen=True, eq=False)
+class ReachabilityRequest:
+    """What :func:`reachability_map` computes: the map of ``arm``'s tool frame (see the module doc).
 
-    Args:
+    Attributes:
         arm: any :class:`~pinarms.robots.robot.Robot`.
         resolution: voxel edge [m].
         orientations: poses per voxel spread over SO(3) (super-Fibonacci), or with ``tool_down``
@@ -145,22 +126,56 @@ def reachability_map(
         samples: joint samples marking the first voxels (default: 2 per voxel of the bound
             sphere, between 2·10⁵ and 5·10⁶).
         seed: seed of the samples and of the numerical restarts.
-        scheduler: ``None`` (serial, here), ``"processes[:N]"``, ``"tcp://HOST:8786"``, ``"env"`` or a
-            ``distributed.Client`` (see :mod:`pinarms.execution`).
-        progress: ``progress(voxels_done, voxels_to_do)`` after each chunk (the second number
-            grows when a closure round adds voxels).
 
     Raises:
         InvalidInput: a bad argument (resolution not positive, an unknown ``ik`` or
             ``manipulability``, a grid of more than :data:`MAX_GRID_VOXELS` voxels, ...).
         ModelError: ``ik="analytic"`` for an arm without a closed form.
     """
+
+    arm: "Robot"
+    resolution: float = 0.025
+    orientations: int | OrientationSet = 50
+    tool_down: float | None = None
+    roll_steps: int = 8
+    tool_axis: ArrayLike | None = None
+    ik: str = "auto"
+    manipulability: str = "full"
+    restarts: int = 2
+    tol: float = 1e-9
+    self_collision: bool = False
+    collision: Any = None
+    keep_solutions: bool = True
+    out: "str | os.PathLike | None" = None
+    chunk_voxels: int | None = None
+    samples: int | None = None
+    seed: int = 0
+
+    #: the fields checked, the defaults resolved and the grid around the arm's reach built (by ``__post_init__``)
+    settings: _Settings = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "settings", _checked_settings(
+            self.arm, resolution=self.resolution, orientations=self.orientations, tool_down=self.tool_down,
+            roll_steps=self.roll_steps, tool_axis=self.tool_axis, ik=self.ik, manipulability=self.manipulability,
+            restarts=self.restarts, tol=self.tol, self_collision=self.self_collision, collision=self.collision,
+            keep_solutions=self.keep_solutions, streamed=self.out is not None, chunk_voxels=self.chunk_voxels,
+            samples=self.samples, seed=self.seed))
+
+
+def reachability_map(request: ReachabilityRequest, *, scheduler: "str | Client | None" = None,
+                     progress: Callable[[int, int], None] | None = None) -> ReachabilityMap:
+    """Build the reachability map ``request`` asks for (a :class:`ReachabilityRequest`; module doc).
+
+    Args:
+        scheduler: ``None`` (serial, here), ``"processes[:N]"``, ``"tcp://HOST:8786"``, ``"env"`` or a
+            ``distributed.Client`` (see :mod:`pinarms.execution`).
+        progress: ``progress(voxels_done, voxels_to_do)`` after each chunk (the second number
+            grows when a closure round adds voxels).
+    """
     t0 = time.perf_counter()
-    s = _checked_settings(arm, resolution=resolution, orientations=orientations, tool_down=tool_down,
-                          roll_steps=roll_steps, tool_axis=tool_axis, ik=ik, manipulability=manipulability,
-                          restarts=restarts, tol=tol, self_collision=self_collision, collision=collision,
-                          keep_solutions=keep_solutions, streamed=out is not None, chunk_voxels=chunk_voxels,
-                          samples=samples, seed=seed)
+    arm, out = request.arm, request.out
+    s = request.settings
     spec = spec_of(arm)
     writer = None
     if out is not None:

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from pinarms import robots, viz
 from pinarms.cli import cli
 from pinarms.robots.reach.reach_io import load_reachability
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 
 def invoke(*args: str):
@@ -22,7 +22,7 @@ def test_tool_down_map_text_file_and_session(tmp_path):
     result = invoke("aubo_i3", "--resolution", "150mm", "--tool-down", "15deg", "--orientations", "4",
                     "--roll-steps", "4", "--out", str(h5), "--session", str(sess))
     assert result.exit_code == 0, (result.output, result.exception)
-    api = reachability_map(robots.load("aubo_i3"), 0.15, 4, tool_down=np.radians(15), roll_steps=4)
+    api = reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.15, 4, tool_down=np.radians(15), roll_steps=4))
     assert f"computed {api.n_voxels} voxels, {api.n_poses} poses; reached {api.n_reached} poses" in result.stdout
     assert "4 tool-axis directions" in result.stdout and "15° cone" in result.stdout
     m = load_reachability(h5)

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from fuzz_support import EXPLORE, outcome
 from pinarms import optim, planning, robots
 from pinarms.planning import definition as planning_definition
+from pinarms.errors import PinarmsError
 
 ARMS = ("ur5", "scara_mushroom", "gantry_flower", "koji_turner")
 
@@ -369,8 +370,10 @@ def test_plan_cycle_settings(arms, data):
         return optim.plan_cycle(request)
 
     result, err = outcome(plan_cycle, seconds=30)
-    if err is None:
+    if err is None and result.solved:
         assert result.cycle_time > 0 and np.isfinite(result.cycle_time)
+    elif err is None:  # no cycle: a status saying why (bad input raised above)
+        assert result.reason and isinstance(result.error, PinarmsError) and result.trajectory is None
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ import pytest
 from fuzz_support import EXPLORE, assert_finite, damaged_file
 from pinarms import robots
 from pinarms.robots.reach.reach_io import DEFAULT_TIMEOUT, ReachabilityFileError, load_reachability, save_reachability
-from pinarms.robots.reach.reachability import ReachabilityMap, reachability_map
+from pinarms.robots.reach.reachability import ReachabilityMap, ReachabilityRequest, reachability_map
 
 N_FLIPS = 24 * EXPLORE  # anywhere in the file
 N_HEAD_FLIPS = 10 * EXPLORE  # in the first 4 kB: superblock, object headers, B-trees, the global heap
@@ -26,7 +26,7 @@ BOUND_S = DEFAULT_TIMEOUT + 4.0
 
 @pytest.fixture(scope="module")
 def base(tmp_path_factory):
-    m = reachability_map(robots.load("aubo_i3"), 0.2, 8)
+    m = reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8))
     path = save_reachability(m, tmp_path_factory.mktemp("fuzz_maps") / "base.h5")
     return m, path.read_bytes()
 
@@ -118,5 +118,5 @@ def test_seed_samples_are_capped_before_any_is_drawn():
 
     t0 = time.perf_counter()
     with pytest.raises(InvalidInput, match="samples = 1,000,000,000,000 is more than"):
-        reachability_map(robots.load("aubo_i3"), 0.2, 8, samples=10**12)
+        reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8, samples=10**12))
     assert time.perf_counter() - t0 < 5.0

@@ -48,9 +48,9 @@ def _build_base() -> bytes:
     s.add_robot(robots.from_urdf_text(LEVER_URDF).with_payload(0.5, com=[0.0, 0.0, 0.02]), base_to_world=np.eye(4))
     s.add_box("crate", [0.3, 0.2, 0.1])
     # the kinds added by others later are fuzzed the same way: a payload and a small reachability map
-    from pinarms.robots.reach.reachability import reachability_map
+    from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
-    s.add_reachability("reach", reachability_map(gantry, 0.25, 2, tool_down=0.1, roll_steps=2), robot="gantry_flower")
+    s.add_reachability("reach", reachability_map(ReachabilityRequest(gantry, 0.25, 2, tool_down=0.1, roll_steps=2)), robot="gantry_flower")
     import tempfile
 
     with tempfile.TemporaryDirectory() as d:

@@ -30,7 +30,7 @@ def test_ik_restarts_past_the_cap_are_refused_at_once():
     _quickly(lambda: ur5.ik(far, max_restarts=10**9), InvalidInput, f"max_restarts.*{MAX_RESTARTS}")
     _quickly(lambda: ur5.ik(np.stack([far, far]), max_restarts=MAX_RESTARTS + 1), InvalidInput, "max_restarts")
     _quickly(lambda: NumericalIK(ur5).solve(far, max_restarts=10**9), InvalidInput, "max_restarts")
-    _quickly(lambda: robots.reachability_map(ur5, 0.5, restarts=10**9), InvalidInput, "restarts")
+    _quickly(lambda: robots.reachability_map(robots.ReachabilityRequest(ur5, 0.5, restarts=10**9)), InvalidInput, "restarts")
 
 
 def test_minimize_time_max_generations_outside_its_documented_range_is_refused():

@@ -120,13 +120,13 @@ def test_planning_around_a_moving_arm_turns_the_short_way(two_cell):
     """plan_around (B around A's timed move) takes B's wrist from 3.5 rad to -2.5 rad (3.783 rad) across π."""
     from pinarms import planning
     from pinarms.optim.motion import MotionLimits, MotionOptions, MotionRequest
-    from pinarms.optim.motion.two_arms import plan_around
+    from pinarms.optim.motion.two_arms import AroundRequest, plan_around
 
     assert [a.name for a in two_cell.arms] == ["a", "b"]
     A = planning.polynomial([0.0, 1.0], np.array([[0.0, 0.0], [0.3, 1.0]]), 5)
     request = MotionRequest(two_cell, "b", np.array([0.0, 3.5]), np.array([0.0, -2.5]),
                             options=MotionOptions(seed=0), limits=MotionLimits(amax=1.0, torque=False))
-    around = plan_around(request, {"a": A})
+    around = plan_around(AroundRequest(request, {"a": A})).raise_for_status()
     q = np.asarray(around.trajectory.sample(np.linspace(around.trajectory.start_time, around.trajectory.end_time,
                                                         400))[0])
     assert f"{np.abs(np.diff(q[:, 1])).sum():.3f}" == f"{2.0 * np.pi - 6.0:.3f}"

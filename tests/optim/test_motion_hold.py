@@ -97,8 +97,11 @@ def test_a_cycle_next_to_an_idle_arm_in_collision_names_it_before_any_attempt(tm
     cell = _cell(tmp_path)  # b at neutral, in the table
     a = cell.arm("a")
     spec = optim.PickPlace(pick=[0.3, 0.1, 0.1], place=[0.3, -0.1, 0.1], lift=0.03)
-    with pytest.raises(CollisionError, match=r"idle arm 'b' is in collision at its hold pose: b_link2 – table"):
-        optim.plan_cycle(optim.CycleRequest(a.robot, spec, cell=optim.CellSettings(cell, clearance=0.01)))
+    res = optim.plan_cycle(optim.CycleRequest(a.robot, spec, cell=optim.CellSettings(cell, clearance=0.01)))
+    assert res.status is optim.CycleStatus.IN_COLLISION
+    assert "idle arm 'b' is in collision at its hold pose: b_link2 – table" in res.reason
+    with pytest.raises(CollisionError, match="idle arm 'b'"):
+        res.raise_for_status()
 
 
 @pytest.mark.slow

@@ -13,7 +13,8 @@ from pinarms import planning
 from pinarms.optim.motion import MotionChecker, MotionOptions, MotionRequest, load_scene
 from pinarms.optim.motion.goals import ik_candidates
 from pinarms.optim.motion.scenes import Region, region_pose
-from pinarms.optim.motion.two_arms import plan_two_arms
+from pinarms.optim.motion import MotionStatus
+from pinarms.optim.motion.two_arms import TwoArmRequest, plan_two_arms
 from pinarms.robots.cell.motion import joint_levers
 
 from tests.optim.motion_helpers import BulletScene, dense_times
@@ -82,8 +83,8 @@ def test_b_waits_for_a_to_leave_the_shared_belt(belt, stations):
     A = there.concatenated(_quintic(qa1, qa0, vA).shifted(there.duration))  # ... and goes back
     qb1 = _ik(belt, "left", (0.05, 0.10, 0.86), hold)  # B's goal: where A was
     request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
-    plan = plan_two_arms(request, "right", A)
-    assert plan.method == "around"
+    plan = plan_two_arms(TwoArmRequest(request, "right", A))
+    assert plan.status is MotionStatus.SOLVED and plan.method == "around"
     around = plan.around
     assert around.delay > 0.0  # B must wait for A
     # leaving one step earlier is proven unsafe (the delays are tried in order)
@@ -119,8 +120,10 @@ def test_start_in_a_s_way_falls_back_to_both_arms_together(belt, stations):
     in_way = clear_end.batch_collides(clear_end.full(X))
     qbs = X[np.flatnonzero(ok_now & in_way)[0]]  # clear of A now, but where A ends
     request = MotionRequest(belt, "left", qbs, qb0, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
-    plan = plan_two_arms(request, "right", A, other_offset=offset)
-    assert plan.method == "joint"
+    plan = plan_two_arms(TwoArmRequest(request, "right", A, other_offset=offset))
+    assert plan.status is MotionStatus.SOLVED and plan.method == "joint"
+    # B alone around A: no start instant clears A's sweep, a status saying so (both together solved it)
+    assert plan.around.status is MotionStatus.NO_PATH and plan.around.trajectory is None
     assert plan.attempts[0][0] == "around" and "plan both arms together" in plan.attempts[0][1]
     assert plan.joint.arms == ("right", "left")
     ta, tb = plan.trajectories["right"], plan.trajectories["left"]

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinarms.optim.motion import MotionChecker, MotionOptions, MotionRequest, plan_motion
+from pinarms.optim.motion import MotionChecker, MotionOptions, MotionRequest, MotionStatus, plan_motion
 from pinarms.optim.motion.checker import TimedArm
-from pinarms.optim.motion.two_arms import _screened_delays, _waiting, plan_around
+from pinarms.optim.motion.two_arms import AroundRequest, _screened_delays, _waiting, plan_around
 
 from tests.optim.test_motion_two_arms import MARGIN, _ik, _quintic, belt, stations  # noqa: F401 (fixtures)
 
@@ -19,8 +19,8 @@ def test_screened_delays_fail_the_proof_and_the_first_clear_delay_is_kept(belt, 
     A = there.concatenated(_quintic(qa1, qa0, vA).shifted(there.duration))
     qb1 = _ik(belt, "left", (0.05, 0.10, 0.86), hold)
     request = MotionRequest(belt, "left", qb0, qb1, hold=hold, options=MotionOptions(seed=0, time_limit=20.0))
-    around = plan_around(request, {"right": A})
-    assert around.delay > 0.0 and around.check.collision_free
+    around = plan_around(AroundRequest(request, {"right": A}))
+    assert around.status is MotionStatus.SOLVED and around.delay > 0.0 and around.check.collision_free
 
     # the same path, every delay up to the kept one proven in turn, without the screen
     parked = hold.copy()

@@ -9,6 +9,7 @@ import pytest
 from pinarms import robots
 from pinarms.errors import InvalidInput, UnreachableTarget
 from pinarms.robots.ik import NumericalIK
+from pinarms.robots.ik.attempts import IKAttempts
 
 ALL_ARMS = ["scara_mushroom", "gantry_flower", "koji_turner", "koji_turner_rail", "aubo_i3", "ur5", "panda"]
 
@@ -183,7 +184,7 @@ def test_a_free_descent_ending_outside_the_limits_is_never_returned():
     assert pe <= 1e-10 and re <= 1e-10
     assert any("upperArm_joint" in v for v in aubo.limit_violations(aubo._wrapped_to_range(q_free)))  # ≈ −3.10 rad
     # interpreted path: the projected descent from there does not recover, a restart does
-    res = solver.solve_checked(T, start, position_only=False, tol=1e-10, max_restarts=40, seed=0, limits=True, compiled=False)
+    res = solver.solve_checked(T, start, IKAttempts(tol=1e-10, max_restarts=40, compiled=False))
     assert res.success and res.attempts >= 2
     for res in (res, solver.solve(T, start, seed=0)):  # and the compiled path (solve's default)
         assert res.success and aubo.within_limits(res.q, tol=0.0)

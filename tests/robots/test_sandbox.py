@@ -20,7 +20,7 @@ import pytest
 from pinarms import robots
 from pinarms.robots.reach import _reach_child, reach_io
 from pinarms.robots.reach.reach_io import load_reachability, save_reachability
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 WORKER = _reach_child._WORKER
 SECRET = "not for the reader\n"
@@ -92,7 +92,7 @@ else:
 
 @pytest.fixture(scope="module")
 def small_map():
-    return reachability_map(robots.load("aubo_i3"), 0.2, 8)
+    return reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8))
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ import pytest
 
 from pinarms import robots, viz
 from pinarms.errors import InvalidInput
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 from pinarms.viz.errors import SessionFormatError
 
 CHROMIUM = "/usr/bin/chromium"
@@ -20,7 +20,7 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-f
 @pytest.fixture(scope="module")
 def reach_session():
     arm = robots.load("aubo_i3")
-    m = reachability_map(arm, 0.1, 6, tool_down=np.radians(15), roll_steps=4)
+    m = reachability_map(ReachabilityRequest(arm, 0.1, 6, tool_down=np.radians(15), roll_steps=4))
     s = viz.Session(arm, title="AUBO-i3 tool-down reachability")
     s.add_reachability("tool down <15°>", m)
     return s, m

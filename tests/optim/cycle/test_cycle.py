@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
 from pinarms import robots
-from pinarms.optim.cycle import LINE_NAMES, CycleApproach, CycleLoad, CycleRequest, CycleTiming, PickPlace, plan_cycle
+from pinarms.optim.cycle import (LINE_NAMES, CycleApproach, CycleLoad, CycleRequest, CycleStatus, CycleTiming, PickPlace,
+                                 plan_cycle)
 from pinarms.optim.errors import InvalidLimits
 from pinarms.planning import JointLimits
 from pinarms.errors import InvalidInput, UnreachableTarget
@@ -122,13 +125,17 @@ def test_transfer_vias_and_the_gantry_path():
     assert res.max_line_deviation < 1e-9  # Cartesian axes: the multi-quintic keeps x, y still while lifting
 
 
-def test_unreachable_place_raises_naming_it():
+def test_an_unreachable_place_is_a_status_naming_it():
     arm = robots.load("aubo_i3")
-    with pytest.raises(UnreachableTarget, match=r"the place point \[1\.5, 0\.0, 0\.2\] m .*out of reach"):
-        plan_cycle(CycleRequest(arm, PickPlace([0.35, 0.2, 0.15], [1.5, 0.0, 0.2])))
+    res = plan_cycle(CycleRequest(arm, PickPlace([0.35, 0.2, 0.15], [1.5, 0.0, 0.2])))
+    assert res.status is CycleStatus.UNREACHABLE and not res.solved and res.trajectory is None
+    assert re.search(r"the place point \[1\.5, 0\.0, 0\.2\] m .*out of reach", res.reason)
+    assert res.as_dict() == {"status": "unreachable", "reason": res.reason, "robot": "aubo_i3"}
+    with pytest.raises(UnreachableTarget, match="the place point"):  # asked for a cycle: the failure raised
+        res.raise_for_status()
     scara = robots.load("scara_mushroom")
-    with pytest.raises(UnreachableTarget, match="the above place point"):  # the lift leaves the J3 stroke
-        plan_cycle(CycleRequest(scara, PickPlace(POINTS["scara_mushroom"][0], [-0.2, 0.35, 0.17])))
+    res = plan_cycle(CycleRequest(scara, PickPlace(POINTS["scara_mushroom"][0], [-0.2, 0.35, 0.17])))
+    assert res.status is CycleStatus.UNREACHABLE and "the above place point" in res.reason  # the lift leaves J3
 
 
 @pytest.mark.parametrize(

@@ -35,7 +35,9 @@ def test_the_request_plans_the_cycle_with_a_status(scara, spec):
     request = CycleRequest(scara, spec, timing=CycleTiming("quintic-bspline", amax=8.0))
     by_request = plan_cycle(request)
     assert by_request.status is CycleStatus.OK and by_request.as_dict()["status"] == "ok"
-    assert [s.value for s in CycleStatus] == ["ok", "re-planned", "transfer planned"]
+    assert [s.value for s in CycleStatus] == ["ok", "re-planned", "transfer planned", "unreachable", "limits not met",
+                                              "in collision"]
+    assert by_request.solved and by_request.raise_for_status() is by_request and by_request.reason == ""
     # the limits the request resolved are those the result was timed under
     np.testing.assert_array_equal(by_request.vmax, np.asarray(scara.velocity_limit, dtype=float))
     np.testing.assert_array_equal(request.amax, np.full(scara.nq, 8.0))

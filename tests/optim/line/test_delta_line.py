@@ -13,13 +13,13 @@ from pinarms.optim.line.delta_tracking import delta_pick_times, hermite_points, 
 from pinarms.optim.line.tracking import can_yaw
 from pinarms.optim.standard_cycle import JointPathRows, delta_path_rows
 from pinarms.robots.delta import forward_position, inverse_position, platform_jacobian
-from pinarms.studies.delta_line import delta_line
+from pinarms.studies.delta_line import DeltaLineRequest, delta_line
 from pinarms.studies.line import ENOKI
 
 
 @pytest.fixture(scope="module")
 def line():
-    return delta_line(2, 60.0, item=ENOKI, seeds=(0, 1), duration=120.0)
+    return delta_line(DeltaLineRequest(2, 60.0, item=ENOKI, seeds=(0, 1), duration=120.0))
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ from pinarms.optim.line.map_request import DeltaMapRequest
 from pinarms.optim.line.delta_pick_path import delta_pick_path
 from pinarms.robots.cell import load_cell
 from pinarms.robots.delta import forward_position
-from pinarms.studies.delta_line import delta_line
+from pinarms.studies.delta_line import DeltaLineRequest, delta_line
 from pinarms.studies.line import ENOKI
 
 CELL = """name = "delta_over_belt"
@@ -35,7 +35,7 @@ xyz = [{x}, {y}, {z}]
 
 @pytest.fixture(scope="module")
 def setting(tmp_path_factory):
-    line = delta_line(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0)
+    line = delta_line(DeltaLineRequest(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0))
     station = replace(line.stations[0], name="delta1")
     kw = dict(mass=ENOKI.mass, item_height=ENOKI.size[2], nu=3, nw=2, n=12)   # the middle row feasible
     plain = build_delta_map(DeltaMapRequest(station, line.belt, line.tracking, **kw)).task_map
@@ -94,7 +94,7 @@ def two_deltas(tmp_path_factory):
     from pinarms.optim.line import Station
     from pinarms.optim.line.neighbours import NeighbourGuard
 
-    line = delta_line(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0)
+    line = delta_line(DeltaLineRequest(2, 60.0, item=ENOKI, seeds=(0,), duration=10.0))
     st = [Station(f"delta{k + 1}", s.robot, s.base_to_world, s.place) for k, s in enumerate(line.stations)]
     text = 'name = "two_deltas"\n' + "".join(f'[[arm]]\nname = "{s.name}"\ndelta = "delta_flexpicker"\n'
                                               f'xyz = {[float(v) for v in s.base_to_world[:3, 3]]}\n' for s in st)

@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 from pinarms.optim.line.delta_motion import delta_pick_motion, delta_rest
+from pinarms.optim.line.tracking import PickRequest
 from pinarms.optim.standard_cycle.delta_cycle import turn_angle
 from pinarms.optim.line.delta_tracking import delta_pick_times, tool_turn_time
 from pinarms.robots.delta import forward_position
-from pinarms.studies.delta_line import delta_line
+from pinarms.studies.delta_line import DeltaLineRequest, delta_line
 from pinarms.studies.line import ENOKI
 
 YAW = 1.55  # rad (just under the two-finger gripper's pi/2): the tool's turn outlasts the platform's approach
@@ -16,11 +17,11 @@ YAW = 1.55  # rad (just under the two-finger gripper's pi/2): the tool's turn ou
 
 @pytest.fixture(scope="module")
 def case():
-    line = delta_line(1, 60.0, item=ENOKI, seeds=(0,), duration=30.0)
+    line = delta_line(DeltaLineRequest(1, 60.0, item=ENOKI, seeds=(0,), duration=30.0))
     st = line.stations[0]
     u = float(st.base_to_world[0, 3]) - 0.25
-    motion = delta_pick_motion(st, line.belt, line.tracking, u, 0.05, mass=ENOKI.mass, item_height=ENOKI.size[2],
-                               yaw=YAW, hz=500.0)
+    motion = delta_pick_motion(PickRequest(st, line.belt, line.tracking, u, 0.05, item_height=ENOKI.size[2],
+                                           mass=ENOKI.mass, yaw=YAW), hz=500.0)
     return line, st, u, motion
 
 

@@ -13,7 +13,7 @@ from pinarms.optim.line import Belt, ItemType, LineSpec, PlaceBox, Station, Stre
 from pinarms.optim.line.fixtures import FixtureCheck, chord_polyline
 from pinarms.optim.line.map_request import MapRequest
 from pinarms.optim.line.task_map_build import build_task_map
-from pinarms.optim.line.tracking import plan_pick
+from pinarms.optim.line.tracking import PickRequest, plan_pick
 from pinarms.robots.cell import load_cell
 from pinarms.robots.cell.cell import Cell
 from pinarms.errors import InvalidInput
@@ -67,8 +67,8 @@ def test_exactly_the_nodes_whose_pick_enters_the_block_are_infeasible(blocked_li
     assert after.fixture_infeasible - before.fixture_infeasible == int(np.sum(was & ~now))
     judged = newly = 0
     for b, i, j in zip(*np.nonzero(was)):
-        plan = plan_pick(st, belt, TrackingSpec(), 1.0 + before.du[i], before.w[j], item_height=0.04, mass=0.15,
-                         branch=None if before.branches[b] < 0 else int(before.branches[b]))
+        plan = plan_pick(PickRequest(st, belt, TrackingSpec(), 1.0 + before.du[i], before.w[j], item_height=0.04,
+                mass=0.15, branch=None if before.branches[b] < 0 else int(before.branches[b])))
         d = _block_distance(cell, plan.trajectory)
         if CLEARANCE - BAND < d < CLEARANCE + BAND:
             continue
@@ -100,7 +100,7 @@ def test_fast_route_agrees_with_the_exact_check_and_bad_clearance_is_named():
     cell = load_cell("mushroom_line")
     belt = Belt((-1.0, 0.0, 0.80), speed=0.1, width=0.30, length=2.0)
     st = Station("left", cell.arm("left").robot, cell.arm("left").base_to_world, PlaceBox((0.22, 0.68, 0.93), "box"))
-    plan = plan_pick(st, belt, TrackingSpec(), 1.05, 0.0, item_height=0.04, mass=0.15)
+    plan = plan_pick(PickRequest(st, belt, TrackingSpec(), 1.05, 0.0, item_height=0.04, mass=0.15))
     for clearance in (0.005, 0.02):
         check = FixtureCheck(cell, "left", clearance)
         assert check.clear(plan.trajectory) == bool(check.exact.trajectory_valid(plan.trajectory, 0.0).ok)

@@ -8,7 +8,7 @@ from pinarms.optim.line.map_request import MapRequest
 from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.task_map_error import MapError, map_error
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, plan_pick
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, plan_pick
 from pinarms.optim.line.windows import window_of
 
 
@@ -26,8 +26,8 @@ def test_map_nodes_are_exact_plans(scara_line, small_map):
     i, j = 2, 1
     assert small_map.branches == (0, 1)  # the SCARA's two elbows, each tabled
     for b, label in enumerate(small_map.branches):
-        plan = plan_pick(station, belt, TrackingSpec(), 1.0 + small_map.du[i], small_map.w[j], mass=small_map.mass,
-                         branch=label)
+        plan = plan_pick(PickRequest(station, belt, TrackingSpec(), 1.0 + small_map.du[i], small_map.w[j],
+                mass=small_map.mass, branch=label))
         assert small_map.branch_approach[b, i, j] == pytest.approx(plan.times[0], rel=1e-12)
         assert small_map.branch_leave[b, i, j] == pytest.approx(plan.times[2], rel=1e-12)
     tot = small_map.branch_approach[:, i, j] + small_map.branch_leave[:, i, j]
@@ -56,7 +56,7 @@ def test_no_interpolation_across_ik_branches(scara_line, small_map):
     for du in (small_map.du[n] - 0.004, small_map.du[n] + 0.004):  # either side of the node
         tA, tC = small_map.times(du, w)
         label = small_map.branch_at(du, w)
-        plan = plan_pick(station, belt, TrackingSpec(), 1.0 + du, w, mass=small_map.mass, branch=label)
+        plan = plan_pick(PickRequest(station, belt, TrackingSpec(), 1.0 + du, w, mass=small_map.mass, branch=label))
         assert float(tA + tC) + plan.times[1] + plan.times[3] == pytest.approx(plan.duration, rel=0.01)
     assert small_map.branch_at(small_map.du[n] - 0.004, w) != small_map.branch_at(small_map.du[n] + 0.004, w)
 

@@ -9,7 +9,7 @@ from pinarms import robots
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt, PlaceBox
 from pinarms.optim.line.station import Station, base_pose
-from pinarms.optim.line.tracking import TrackingSpec, can_yaw, plan_pick, tool_yaw
+from pinarms.optim.line.tracking import PickRequest, TrackingSpec, can_yaw, plan_pick, tool_yaw
 from pinarms.errors import InvalidInput
 
 
@@ -20,7 +20,7 @@ def _tool_world(station, q):
 
 
 def _check_rendezvous(station, belt, spec, u_pre, w, height, yaw=0.0):
-    plan = plan_pick(station, belt, spec, u_pre, w, item_height=height, mass=0.1, yaw=yaw)
+    plan = plan_pick(PickRequest(station, belt, spec, u_pre, w, item_height=height, mass=0.1, yaw=yaw))
     traj = plan.trajectory
     t_a = plan.times[0]
     g0, g1 = plan.grasp_window
@@ -68,7 +68,7 @@ def _hand_angle(station, q):
 def test_scara_hand_matches_the_item_yaw_from_fk(scara_line):
     belt, station = scara_line
     spec = TrackingSpec()
-    ref = plan_pick(station, belt, spec, 1.05, -0.05, item_height=0.04, mass=0.1)
+    ref = plan_pick(PickRequest(station, belt, spec, 1.05, -0.05, item_height=0.04, mass=0.1))
     a0 = _hand_angle(station, ref.trajectory.sample(np.array([ref.grasp_window[0]]))[0])[0]
     for yaw in (0.6, -1.2, 2.9):  # 2.9 rad: a two-finger gripper takes it at 2.9 - π
         plan = _check_rendezvous(station, belt, spec, 1.05, -0.05, 0.04, yaw=yaw)
@@ -86,9 +86,9 @@ def test_item_yaw_is_a_zero_separable_term_of_the_task_time(scara_line):
     time is the same at every yaw (to the timing's tolerance), at points on both elbows."""
     belt, station = scara_line
     for u, w, branch in ((1.05, -0.05, None), (0.93, 0.03, 1), (1.2, 0.1, 0)):
-        base = plan_pick(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch).duration
+        base = plan_pick(PickRequest(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch)).duration
         for yaw in (-np.pi / 2, -0.8, 0.7, np.pi / 2 - 1e-3):
-            t = plan_pick(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch, yaw=yaw).duration
+            t = plan_pick(PickRequest(station, belt, TrackingSpec(), u, w, mass=0.15, branch=branch, yaw=yaw)).duration
             assert t == pytest.approx(base, rel=1e-3)
 
 
@@ -118,9 +118,9 @@ def test_a_pick_beyond_the_position_limits_is_infeasible_and_the_other_branch_is
     st = Station("left", cell.arm("left").robot, cell.arm("left").base_to_world, PlaceBox((0.22, 0.68, 0.93), "box"))
     robot = st.robot
     with pytest.raises(PositionLimitError, match=r"approach move takes joint 1 .*outside its position limits"):
-        plan_pick(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15, branch=0)
+        plan_pick(PickRequest(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15, branch=0))
     assert issubclass(PositionLimitError, InfeasibleProblem)  # the maps' NaN node, as any infeasible pick
-    plan = plan_pick(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15)
+    plan = plan_pick(PickRequest(st, belt, TrackingSpec(), 1.0, 0.125, item_height=0.04, mass=0.15))
     assert _sampled_out_of_limits(robot, plan.trajectory) <= 1e-9
     assert plan.approach.trajectory.sample(plan.times[0])[0][1] < 0.0  # elbow the other way (branch 1)
 
@@ -132,7 +132,7 @@ def test_belt_too_fast_says_which_descend_fixes_it():
     station = Station("scara 1", robots.load("scara_mushroom"), base_pose(1.0, 0.30, 0.78),
                       PlaceBox((0.8, 0.45, 0.93)), amax=[30.0, 30.0, 2.0, 60.0])
     with pytest.raises(InfeasibleProblem) as info:
-        plan_pick(station, belt, TrackingSpec(), 1.05, -0.05, item_height=0.04)
+        plan_pick(PickRequest(station, belt, TrackingSpec(), 1.05, -0.05, item_height=0.04))
     text = str(info.value)
     m = re.search(r"joint 3 \(\w+\) at ([\d.]+) m/s² against its limit 2 m/s².*descend \(TrackingSpec.descend, "
                   r"now 0.2 s\) to ([\d.]+) s.*--speed.*0.2 m/s", text)
@@ -140,7 +140,7 @@ def test_belt_too_fast_says_which_descend_fixes_it():
     assert 4.0 < float(m.group(1)) < 4.7
     descend = float(m.group(2))
     assert 0.25 < descend < 0.4
-    plan = plan_pick(station, belt, TrackingSpec(descend=descend), 1.05, -0.05, item_height=0.04)
+    plan = plan_pick(PickRequest(station, belt, TrackingSpec(descend=descend), 1.05, -0.05, item_height=0.04))
     assert plan.tracking.peaks().acceleration[2] <= 2.0 * (1 + 1e-9)
 
 
@@ -157,7 +157,7 @@ def test_a_continuous_wrist_stays_on_one_turn_through_the_tracking_segment():
                             tcp="j2s6s200_end_effector", package_dirs=(str(share.parent),))
     belt = Belt((0.0, 0.0, 0.80), speed=0.1, width=0.3, length=2.0)
     station = Station("jaco", jaco, base_pose(1.0, 0.40, 0.80), PlaceBox((0.9, 0.65, 0.95), "box"))
-    plan = plan_pick(station, belt, TrackingSpec(descend=0.6), 1.0, 0.05, item_height=0.04, mass=0.1)
+    plan = plan_pick(PickRequest(station, belt, TrackingSpec(descend=0.6), 1.0, 0.05, item_height=0.04, mass=0.1))
     q = plan.tracking.sample(np.linspace(0.0, plan.tracking.duration, 200))[0]
     assert np.abs(np.diff(q, axis=0)).max() < 0.1  # no jump of a turn between two samples
     assert np.all(plan.tracking.peaks().acceleration <= station.limits["amax"] * (1 + 1e-9))

@@ -151,7 +151,8 @@ def test_simulated_place_tracks_its_tray_from_fk(tray_scene):
     # a placement chosen by the simulation, planned exactly (pick at its rendezvous, place at its
     # pre-place point on the branch the map chose), its release dwell put on the simulation's clock:
     # the tool is on the promised tray's place point and moves with it
-    from pinarms.optim.line.trays import plan_pick_to_tray
+    from pinarms.optim.line.tracking import PickRequest
+    from pinarms.optim.line.trays import TrayPickRequest, plan_pick_to_tray
 
     belt, station, trays, tm = tray_scene
     assert np.isfinite(tm.transfer[:, :, :, 1:]).all()  # both elbows reach the place for dv >= 0.15 m
@@ -164,8 +165,8 @@ def test_simulated_place_tracks_its_tray_from_fk(tray_scene):
     assert done.size >= 5
     i = int(done[np.argmin(r.place_wait[done])])  # a place met at a crossing (no hold) if any
     du, dv = r.u_meet[i] - u_base, r.u_place[i] - v_base
-    plan = plan_pick_to_tray(station, belt, trays, TrackingSpec(), r.u_meet[i], 0.0, r.u_place[i], mass=0.1,
-                             place_branch=int(r.place_branch[i]))
+    plan = plan_pick_to_tray(TrayPickRequest(PickRequest(station, belt, TrackingSpec(), r.u_meet[i], 0.0, mass=0.1),
+            trays, r.u_place[i], place_branch=int(r.place_branch[i])))
     approx = sum(tm.times(du, 0.0, dv)) + tm.track + tm.place
     assert approx == pytest.approx(plan.duration, rel=0.01)  # the map's time of this placement
     t_place_plan = sum(plan.times[:3])

@@ -5,7 +5,8 @@ import pytest
 
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.tracking import TrackingSpec
-from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
+from pinarms.optim.line.tracking import PickRequest
+from pinarms.optim.line.trays import TrayBelt, TrayPickRequest, plan_pick_to_tray
 from pinarms.errors import InvalidInput
 
 
@@ -27,7 +28,8 @@ def test_place_in_a_moving_tray_from_fk(scara_line, direction):
     trays = TrayBelt(tray_belt, pitch=0.3, w=0.0, height=0.02)
     u_place = 0.9 if direction[0] > 0 else 2.1  # world x 0.9 either way, beside the arm
     spec = TrackingSpec()
-    plan = plan_pick_to_tray(station, belt, trays, spec, 1.05, -0.05, u_place, mass=0.1, yaw=0.4)
+    plan = plan_pick_to_tray(TrayPickRequest(PickRequest(station, belt, spec, 1.05, -0.05, mass=0.1, yaw=0.4), trays,
+            u_place))
     traj = plan.trajectory
     assert plan.duration == pytest.approx(traj.end_time - traj.start_time, abs=1e-6)
     # the pick is still a rendezvous with the item
@@ -72,8 +74,8 @@ def test_place_hand_takes_the_short_turn_home():
     q_rest = rest_configuration(st)
     back, q4 = [], []
     for w in (0.0625, 0.125):
-        p = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, w, u0 - 0.35, item_height=0.04,
-                              mass=0.1, q_rest=q_rest, place_branch=0)
+        p = plan_pick_to_tray(TrayPickRequest(PickRequest(st, belt, spec.tracking, u0 + 0.07, w, item_height=0.04,
+                mass=0.1, q_rest=q_rest), trays, u0 - 0.35, place_branch=0))
         back.append(p.times[4])
         q4.append(p.pieces[3].sample(np.array([p.pieces[3].end_time]))[0][0, 3])
     assert back[1] == pytest.approx(back[0], rel=0.05)
@@ -100,8 +102,9 @@ def test_place_time_has_no_jump_where_the_hand_turn_switches():
     trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
     u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
-    t = [sum(plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.038, -0.02, u0 + dv, item_height=0.04,
-                               mass=0.1, q_rest=q_rest, place_branch=0).times[2::2]) for dv in (0.19, 0.2, 0.21)]
+    t = [sum(plan_pick_to_tray(TrayPickRequest(PickRequest(st, belt, spec.tracking, u0 + 0.038, -0.02,
+            item_height=0.04, mass=0.1, q_rest=q_rest), trays, u0 + dv, place_branch=0)).times[2::2]) for dv in (0.19,
+            0.2, 0.21)]
     assert abs(t[1] - t[0]) < 0.03 and abs(t[2] - t[1]) < 0.03
 
 
@@ -117,10 +120,10 @@ def test_a_tray_place_whose_transfer_leaves_the_joint_limits_is_infeasible():
     trays = trays_beside(belt, st.place.position, 0.3, 0.1, 2)
     u0 = float(belt.to_belt(st.base_to_world[:3, 3])[0])
     with pytest.raises(PositionLimitError, match=r"transfer to the tray takes joint 1 .* outside its position limits"):
-        plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, 0.0625, u0 - 0.391, item_height=0.04,
-                          mass=0.1, q_rest=rest_configuration(st), place_branch=0)
-    ok = plan_pick_to_tray(st, belt, trays, spec.tracking, u0 + 0.07, 0.0625, u0 - 0.35, item_height=0.04,
-                           mass=0.1, q_rest=rest_configuration(st), place_branch=0)
+        plan_pick_to_tray(TrayPickRequest(PickRequest(st, belt, spec.tracking, u0 + 0.07, 0.0625, item_height=0.04,
+                mass=0.1, q_rest=rest_configuration(st)), trays, u0 - 0.391, place_branch=0))
+    ok = plan_pick_to_tray(TrayPickRequest(PickRequest(st, belt, spec.tracking, u0 + 0.07, 0.0625, item_height=0.04,
+            mass=0.1, q_rest=rest_configuration(st)), trays, u0 - 0.35, place_branch=0))
     t = np.linspace(ok.pieces[2].start_time, ok.pieces[2].end_time, 2001)
     q = ok.pieces[2].sample(t)[0]
     assert np.all(q >= st.robot.lower - 1e-9) and np.all(q <= st.robot.upper + 1e-9)

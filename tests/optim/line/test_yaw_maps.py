@@ -21,7 +21,7 @@ from pinarms.optim.line.task_map_build import build_task_map, measure_yaw
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_map_file import read_map_file
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
-from pinarms.optim.line.tracking import plan_pick
+from pinarms.optim.line.tracking import PickRequest, plan_pick
 
 DU = np.array([0.0, 0.1])
 W = np.array([-0.1, 0.1])
@@ -205,8 +205,8 @@ def test_a_map_at_yaw_0_is_wrong_for_a_slow_hand_and_a_yaw_axis_fixes_it(slow_ha
     rng = np.random.default_rng(5)
     before, after = [], []
     for du, w, yaw in zip(rng.choice(auto.du, 4), rng.choice(auto.w, 4), rng.uniform(-np.pi, np.pi, 4)):
-        plan = plan_pick(station, belt, TrackingSpec(), 1.0 + du, w, mass=auto.mass, branch=auto.branch_at(du, w, yaw),
-                         yaw=yaw)
+        plan = plan_pick(PickRequest(station, belt, TrackingSpec(), 1.0 + du, w, mass=auto.mass,
+                branch=auto.branch_at(du, w, yaw), yaw=yaw))
         for m, out in ((flat, before), (auto, after)):
             tA, tC = m.times(du, w, yaw)
             out.append(abs(float(tA + tC) + m.track + m.release - plan.duration) / plan.duration)
@@ -226,6 +226,6 @@ def test_the_scara_is_measured_independent_of_yaw(scara_line):
     du, w = measured.du[1], measured.w[0]
     tA, tC = measured.times(du, w)
     for yaw in (-1.4, 1.1):  # a node of the map, exact plans at two yaws on the branch the map names
-        plan = plan_pick(station, belt, TrackingSpec(), 1.0 + du, w, mass=m.mass, branch=measured.branch_at(du, w, yaw),
-                         yaw=yaw)
+        plan = plan_pick(PickRequest(station, belt, TrackingSpec(), 1.0 + du, w, mass=m.mass,
+                branch=measured.branch_at(du, w, yaw), yaw=yaw))
         assert float(tA + tC) + m.track + m.release == pytest.approx(plan.duration, rel=0.001)

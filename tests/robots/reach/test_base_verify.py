@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.robots.reach.inverse_reach import tool_down_poses
 from pinarms.robots.reach.base_verify import verify_bases
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 
 @pytest.fixture(scope="module")
@@ -17,7 +17,7 @@ def aubo():
 
 
 def test_a_base_within_reach_is_verified_and_one_out_of_reach_is_not(aubo):
-    m = reachability_map(aubo, 0.2, 4, tool_down=np.radians(15), roll_steps=2, keep_solutions=False)
+    m = reachability_map(ReachabilityRequest(aubo, 0.2, 4, tool_down=np.radians(15), roll_steps=2, keep_solutions=False))
     tasks = tool_down_poses([[0.4, 0.0, 0.1]], m.orientations.tool_axis)
     bases = np.array([[0.0, 0.0, 0.0, 0.0], [3.0, 0.0, 0.0, 0.0]])  # x, y, z, yaw [m, rad]
     verified, w = verify_bases(aubo, m, bases, tasks, roll_free=False, roll_steps=1, self_collision=False,

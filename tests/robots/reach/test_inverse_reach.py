@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.robots.reach.inverse_reach import IKCheck, base_placements, tool_down_poses
 from pinarms.errors import InvalidInput, ModelError
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 
 @pytest.fixture(scope="module")
@@ -18,7 +18,7 @@ def aubo():
 
 @pytest.fixture(scope="module")
 def down_map(aubo):
-    return reachability_map(aubo, 0.08, 6, tool_down=np.radians(15), roll_steps=6)
+    return reachability_map(ReachabilityRequest(aubo, 0.08, 6, tool_down=np.radians(15), roll_steps=6))
 
 
 def _station(tool_axis):

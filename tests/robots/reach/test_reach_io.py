@@ -15,12 +15,12 @@ import pytest
 from pinarms import robots
 from pinarms.errors import InvalidInput
 from pinarms.robots.reach.reach_io import ReachabilityFileError, load_reachability, save_reachability
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 
 @pytest.fixture(scope="module")
 def small_map():
-    return reachability_map(robots.load("aubo_i3"), 0.2, 8)
+    return reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8))
 
 
 @pytest.fixture
@@ -34,7 +34,7 @@ def test_round_trip_is_exact(small_map, saved, tmp_path):
     assert back.solutions is not None and len(back.solutions) == small_map.n_reached
     light = load_reachability(saved, solutions=False)
     assert light.solutions is None and np.array_equal(light.reached, small_map.reached)
-    down = reachability_map(robots.load("scara_mushroom"), 0.15, 3, tool_down=0.2, keep_solutions=False)
+    down = reachability_map(ReachabilityRequest(robots.load("scara_mushroom"), 0.15, 3, tool_down=0.2, keep_solutions=False))
     assert load_reachability(down.save(tmp_path / "scara.h5")).identical(down)
 
 
@@ -208,7 +208,7 @@ def test_an_unknown_filter_is_refused(saved, tmp_path):
 
 
 def test_a_streamed_map_file_equals_the_map_built_in_memory(small_map, tmp_path):
-    streamed = reachability_map(robots.load("aubo_i3"), 0.2, 8, out=tmp_path / "streamed.h5")
+    streamed = reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8, out=tmp_path / "streamed.h5"))
     assert streamed.solutions is None
     assert load_reachability(tmp_path / "streamed.h5").identical(small_map)
 
@@ -222,7 +222,7 @@ def test_a_failing_chunk_leaves_no_file(tmp_path):
     from pinarms.errors import ExecutionError
 
     with pytest.raises(ExecutionError, match="chunk 0.*collision checker broke"):
-        reachability_map(robots.load("aubo_i3"), 0.2, 8, collision=_Raises(), out=tmp_path / "broken.h5")
+        reachability_map(ReachabilityRequest(robots.load("aubo_i3"), 0.2, 8, collision=_Raises(), out=tmp_path / "broken.h5"))
     assert list(tmp_path.iterdir()) == []
 
 

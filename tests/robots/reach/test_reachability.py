@@ -8,7 +8,7 @@ import pytest
 from pinarms import robots
 from pinarms.errors import InvalidInput, ModelError, UnreachableTarget
 from pinarms.robots.reach.orientations import so3_orientations, tool_down_orientations
-from pinarms.robots.reach.reachability import reachability_map
+from pinarms.robots.reach.reachability import ReachabilityRequest, reachability_map
 
 #: The scheduler's HTTP endpoint (health and metrics; no dashboard) on a free loopback port, not on
 #: the fixed 8787 that every other LocalCluster of a parallel run tries first.
@@ -24,7 +24,7 @@ def aubo():
 
 @pytest.fixture(scope="module")
 def aubo_map(aubo):
-    return reachability_map(aubo, 0.1, 30)
+    return reachability_map(ReachabilityRequest(aubo, 0.1, 30))
 
 
 def test_a_voxel_out_of_reach_has_index_zero_and_the_comfortable_centre_a_high_one(aubo, aubo_map):
@@ -85,11 +85,11 @@ def test_poses_marked_unreached_have_no_numerical_solution_either(aubo, aubo_map
 
 def test_serial_and_local_cluster_maps_are_bit_identical(aubo):
     distributed = pytest.importorskip("distributed")
-    serial = reachability_map(aubo, 0.15, 10, chunk_voxels=100)
+    serial = reachability_map(ReachabilityRequest(aubo, 0.15, 10, chunk_voxels=100))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=None,
                                   scheduler_kwargs=LOOPBACK_HTTP) as cluster, distributed.Client(cluster) as client:
-        dask_map = reachability_map(aubo, 0.15, 10, chunk_voxels=100, scheduler=client)
+        dask_map = reachability_map(ReachabilityRequest(aubo, 0.15, 10, chunk_voxels=100), scheduler=client)
     assert serial.n_voxels > 500 and serial.n_reached > 1000
     assert serial.identical(dask_map)
     assert dask_map.parameters["scheduler"] != "serial"
@@ -99,7 +99,7 @@ def test_numerical_map_of_a_redundant_arm_is_checked_by_forward_kinematics():
     panda = robots.load("panda")
     assert not panda.has_analytic_ik
     oset = so3_orientations(4)
-    m = reachability_map(panda, 0.25, oset, restarts=1, samples=20_000)
+    m = reachability_map(ReachabilityRequest(panda, 0.25, oset, restarts=1, samples=20_000))
     assert m.solver == "numerical"
     assert m.n_reached > 50
     s = m.solutions
@@ -111,8 +111,8 @@ def test_numerical_map_of_a_redundant_arm_is_checked_by_forward_kinematics():
 
 def test_forcing_numerical_ik_on_a_closed_form_arm_agrees_on_most_poses(aubo):
     oset = so3_orientations(4)
-    a = reachability_map(aubo, 0.25, oset)
-    n = reachability_map(aubo, 0.25, oset, ik="numerical", restarts=2)
+    a = reachability_map(ReachabilityRequest(aubo, 0.25, oset))
+    n = reachability_map(ReachabilityRequest(aubo, 0.25, oset, ik="numerical", restarts=2))
     assert np.array_equal(a.voxels, n.voxels)
     assert not np.any(n.reached & ~a.reached), "a numerical solution where every closed-form branch fails"
     assert n.n_reached >= 0.9 * a.n_reached
@@ -120,7 +120,7 @@ def test_forcing_numerical_ik_on_a_closed_form_arm_agrees_on_most_poses(aubo):
 
 def test_tool_down_map_of_a_scara_reaches_only_straight_down():
     scara = robots.load("scara_mushroom")
-    m = reachability_map(scara, 0.1, 5, tool_down=np.radians(15))
+    m = reachability_map(ReachabilityRequest(scara, 0.1, 5, tool_down=np.radians(15)))
     np.testing.assert_allclose(m.orientations.tool_axis, [0, 0, -1])  # its tool frame has z up
     assert m.index.max() == pytest.approx(1 / 5)  # only the cone's centre direction
     assert np.all(m.reached[:, m.orientations.group != 0] == 0)
@@ -128,7 +128,7 @@ def test_tool_down_map_of_a_scara_reaches_only_straight_down():
 
 
 def test_tool_down_map_of_the_aubo_counts_a_direction_when_any_roll_reaches_it(aubo):
-    m = reachability_map(aubo, 0.15, 6, tool_down=np.radians(15), roll_steps=4)
+    m = reachability_map(ReachabilityRequest(aubo, 0.15, 6, tool_down=np.radians(15), roll_steps=4))
     o = m.orientations
     assert o.roll_free and o.size == 24 and o.n_groups == 6
     per_direction = m.reached.reshape(m.n_voxels, 6, 4).any(axis=2)
@@ -177,9 +177,9 @@ def test_orientation_sets_are_spread_evenly():
 def test_bad_arguments_raise_named_errors(aubo, kwargs, error, match):
     args = {"resolution": 0.2, **kwargs}
     with pytest.raises(error, match=match):
-        reachability_map(aubo, **args)
+        reachability_map(ReachabilityRequest(aubo, **args))
 
 
 def test_analytic_ik_on_an_arm_without_a_closed_form_is_a_model_error():
     with pytest.raises(ModelError, match="no closed-form"):
-        reachability_map(robots.load("panda"), 0.3, 2, ik="analytic")
+        reachability_map(ReachabilityRequest(robots.load("panda"), 0.3, 2, ik="analytic"))
