@@ -37,7 +37,8 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from pinarms.optim.cycle.request import CycleRequest
-from pinarms.optim.cycle.spec import CycleResult, _hold, _line_deviation, _vertical_segments
+from pinarms.optim.cycle.spec import CycleResult
+from pinarms.optim.cycle.vertical import at_rest, line_deviation, vertical_segments
 from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import joint_waypoints
@@ -74,7 +75,7 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     moves = (there, _timed_move(request, q_out, back=True))
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
-        parts = [_hold(q_out[0], spec.dwell), parts[0], _hold(q_out[-1], spec.dwell), parts[1]]
+        parts = [at_rest(q_out[0], spec.dwell), parts[0], at_rest(q_out[-1], spec.dwell), parts[1]]
     trajectory = parts[0]
     for part in parts[1:]:
         trajectory = trajectory.concatenated(part)
@@ -92,7 +93,7 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
         vmax=request.vmax,
         amax=request.amax,
         jmax=request.jmax,
-        line_deviation=_line_deviation(robot, moves, _vertical_segments(poses)),
+        line_deviation=line_deviation(robot, moves, vertical_segments(poses)),
         branches=np.concatenate([branches, branches[-2::-1]]),
         payload=None if loaded is None else loaded.robot.payload,
         torque_limit=None if loaded is None else loaded.limit.copy(),

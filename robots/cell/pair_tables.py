@@ -41,7 +41,7 @@ pair, the larger of its own and its parent's bound; pairs whose parent bound is 
 node's least so far are not recomputed. Each leaf stores its bound less :data:`SLACK` (GJK's
 tolerance, the angles' rounding).
 
-**In the kernels** (:mod:`._cover_kernel`: ``cov[14]`` the tables, ``grp[11]`` each pair's table
+**In the kernels** (:mod:`.cover_kernel`: ``cov[14]`` the tables, ``grp[11]`` each pair's table
 or −1): a pair with a table takes the larger of the table's bound and its cover's, the table
 first (a pair it keeps above the threshold, or above the running excess, costs no cover test);
 the angles come from the joint frames already placed (``atan2`` of two dot products; no joint
@@ -164,7 +164,7 @@ class PairTables:
     seconds: float = 0.0
 
     def arrays(self) -> tuple:
-        """The arrays in the kernels' order (:func:`._cover_kernel.table_low`)."""
+        """The arrays in the kernels' order (:func:`.cover_kernel.table_low`)."""
         return (self.joint, self.parent, self.ea, self.eb, self.e, self.root, self.child, self.split, self.low)
 
     def of_pairs(self, pair_a: np.ndarray, pair_b: np.ndarray) -> np.ndarray:

@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.robots.kinematic_tree import _REVOLUTE
+from pinarms.robots.kinematic_tree import REVOLUTE
 from pinarms.robots._checks import check_restarts as _check_restarts
 from pinarms.robots._checks import check_seed as _check_seed
 from pinarms.robots._checks import check_tolerance as _check_tolerance
@@ -165,7 +165,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
                 np.ascontiguousarray(tree.q_index[chain], dtype=np.int64),
                 np.ascontiguousarray(tree.scale[chain], dtype=float),
                 np.ascontiguousarray(tree.offset[chain], dtype=float),
-                np.ascontiguousarray(tree.kind[chain] == _REVOLUTE),
+                np.ascontiguousarray(tree.kind[chain] == REVOLUTE),
                 np.ascontiguousarray(tree.local_R[chain], dtype=float).reshape(-1, 3, 3),
                 np.ascontiguousarray(tree.local_p[chain], dtype=float).reshape(-1, 3),
                 np.ascontiguousarray(fR, dtype=float),
