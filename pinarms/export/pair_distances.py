@@ -11,8 +11,8 @@ instant. Most of those values cannot change what the re-check reports. Per pair 
   1e-10 on each side; measured at most 1e-10 above the exact mesh distance). Hulls that touch give
   ``-inf``.
 - ``upper``: the distance between two points **on** the shapes: each hull's closest point moved to the
-  nearest vertex of its mesh (a vertex lies on the mesh; a primitive's closest point lies on it), plus
-  :data:`SLACK_M`. Where the hulls touch: ``+inf``.
+  nearest point of the mesh triangles around it (:func:`closest_on_triangles`; a primitive's closest point
+  lies on it), plus :data:`SLACK_M`. Where the hulls touch: ``+inf``.
 
 :func:`needed` says which entries a figure of :func:`pinarms.export.verify.compare_in_mujoco` may depend on,
 given MuJoCo's distances: the sign where ``lower <= 0``; whether the pair is within ``DISTMAX`` where the
@@ -37,7 +37,7 @@ import pinocchio as pin
 
 from pinarms.robots.collision_requests import cold_start
 
-__all__ = ["SLACK_M", "BATCH", "PairDistances", "pair_bounds", "needed", "settle", "exact_distances", "pinarms_distances"]
+__all__ = ["SLACK_M", "BATCH", "NEAR_TRIANGLES", "closest_on_triangles", "PairDistances", "pair_bounds", "needed", "settle", "exact_distances", "pinarms_distances"]
 
 #: Added to each bound [m]: coal's GJK on the hulls and its exact mesh distance each iterate to 1e-10 m.
 SLACK_M = 1e-9
@@ -159,7 +159,8 @@ def pair_bounds(cell: Any, pairs: tuple, qs: np.ndarray) -> tuple[np.ndarray, np
                 for side, i, point in ((0, p.index_a, result.getNearestPoint1()),
                                        (1, p.index_b, result.getNearestPoint2())):
                     local[k, j, side] = R[k, slot[i]].T @ (np.asarray(point, dtype=float) - t[k, slot[i]])
-    ends = _on_meshes(local, pairs, {i: h[1] for i, h in hulls.items()})
+    ends = _on_meshes(local, pairs, {i: None if hulls[i][1] is None else gm.geometryObjects[i].geometry
+                                     for i in hulls})
     sides = np.array([[slot[p.index_a], slot[p.index_b]] for p in pairs], dtype=int).reshape(m, 2)
     rows = np.arange(n)[:, None, None]
     world = np.einsum("nmsij,nmsj->nmsi", R[rows, sides[None]], ends) + t[rows, sides[None]]
@@ -169,17 +170,24 @@ def pair_bounds(cell: Any, pairs: tuple, qs: np.ndarray) -> tuple[np.ndarray, np
     return np.where(found, lower - SLACK_M, -np.inf), upper
 
 
-def _on_meshes(local: np.ndarray, pairs: tuple, vertices: dict[int, np.ndarray | None]) -> np.ndarray:
-    """The closest points ``local (N, P, 2, 3)`` of the hulls, each moved to its mesh's nearest vertex (a
-    point on the mesh; a primitive's point is on it already): one tree query per mesh for all configurations."""
+def _on_meshes(local: np.ndarray, pairs: tuple, meshes: dict[int, Any]) -> np.ndarray:
+    """The closest points ``local (N, P, 2, 3)`` of the hulls, each moved onto its mesh (``meshes``: geometry index
+    -> coal mesh, or None for a primitive, whose point is on it already): to the nearest point of the
+    :data:`NEAR_TRIANGLES` triangles whose centroids are nearest (a point on the mesh; on a face the hull
+    shares with the mesh, the point itself). One tree query per mesh for all configurations."""
     from scipy.spatial import cKDTree
+
+    from pinarms.robots.cell.mesh_cover import mesh_arrays
 
     ends = local.copy()
     index = np.array([[p.index_a, p.index_b] for p in pairs], dtype=int).reshape(-1, 2)
-    for i, V in vertices.items():
-        if V is None:
+    for i, geo in meshes.items():
+        arrays = None if geo is None else mesh_arrays(geo)
+        if arrays is None:
             continue
-        tree = cKDTree(V)
+        corners = arrays[0][arrays[1]]  # (T, 3, 3)
+        tree = cKDTree(corners.mean(axis=1))
+        k = min(NEAR_TRIANGLES, corners.shape[0])
         for side in (0, 1):
             cols = np.flatnonzero(index[:, side] == i)
             if cols.size == 0:
@@ -187,9 +195,40 @@ def _on_meshes(local: np.ndarray, pairs: tuple, vertices: dict[int, np.ndarray |
             block = local[:, cols, side].reshape(-1, 3)
             ok = np.all(np.isfinite(block), axis=1)
             moved = np.full_like(block, np.nan)
-            moved[ok] = V[tree.query(block[ok])[1]]
+            if ok.any():
+                near = tree.query(block[ok], k=k)[1].reshape(-1, k)
+                moved[ok] = closest_on_triangles(block[ok], corners[near])
             ends[:, cols, side] = moved.reshape(local.shape[0], cols.size, 3)
     return ends
+
+
+#: Triangles (nearest by centroid) a hull's closest point is projected on, to move it onto the mesh.
+NEAR_TRIANGLES = 8
+
+
+def closest_on_triangles(P: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """The point nearest ``P (m, 3)`` on the union of the triangles ``tri (m, k, 3, 3)`` (each row its own
+    ``k`` triangles): the projection on a triangle's plane where it falls inside, else the nearest point of
+    its edges; degenerate triangles by their edges."""
+    A, B, C = tri[..., 0, :], tri[..., 1, :], tri[..., 2, :]
+    X = P[:, None, :]
+    n = np.cross(B - A, C - A)
+    nn = np.einsum("mki,mki->mk", n, n)
+    safe = np.where(nn > 0.0, nn, 1.0)
+    proj = X - (np.einsum("mki,mki->mk", X - A, n) / safe)[..., None] * n
+    inside = nn > 0.0
+    for U, W in ((A, B), (B, C), (C, A)):  # the projection is on the inner side of every edge
+        inside &= np.einsum("mki,mki->mk", np.cross(W - U, proj - U), n) >= 0.0
+    candidates = [np.where(inside[..., None], proj, np.nan)]
+    for U, W in ((A, B), (B, C), (C, A)):
+        e = W - U
+        ee = np.einsum("mki,mki->mk", e, e)
+        s = np.clip(np.einsum("mki,mki->mk", X - U, e) / np.where(ee > 0.0, ee, 1.0), 0.0, 1.0)
+        candidates.append(U + s[..., None] * e)
+    Q = np.stack(candidates, axis=2).reshape(P.shape[0], -1, 3)  # (m, 4k, 3)
+    d = np.linalg.norm(Q - X, axis=-1)
+    d = np.where(np.isnan(d), np.inf, d)
+    return Q[np.arange(P.shape[0]), np.argmin(d, axis=1)]
 
 
 def needed(lower: np.ndarray, upper: np.ndarray, exact: np.ndarray, d_mujoco: np.ndarray, mesh: np.ndarray,

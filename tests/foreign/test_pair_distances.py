@@ -79,3 +79,26 @@ def test_the_bounds_hold_and_the_reports_are_those_of_every_exact_distance(so101
     monkeypatch.setattr(verify, "pinarms_distances", every_exact)
     reference = verify.compare_configurations_in_mujoco(cell, qs, mjcf=mjcf)
     assert settled.as_dict() == reference.as_dict() and settled.lines() == reference.lines()
+
+
+def test_closest_points_on_triangles_are_on_them_and_nearest():
+    rng = np.random.default_rng(5)
+    m, k = 200, 4
+    tri = rng.normal(size=(m, k, 3, 3))
+    tri[:, 0, 2] = tri[:, 0, 1]  # a degenerate triangle (two corners equal) in every row
+    P = rng.normal(size=(m, 3)) * 2.0
+    Q = pd.closest_on_triangles(P, tri)
+    # nearest: no point of a fine barycentric sampling of the row's triangles is nearer
+    g = np.linspace(0.0, 1.0, 41)
+    u, v = np.meshgrid(g, g)
+    keep = (u + v) <= 1.0
+    u, v = u[keep], v[keep]
+    samples = tri[:, :, None, 0] + u[None, None, :, None] * (tri[:, :, None, 1] - tri[:, :, None, 0]) \
+        + v[None, None, :, None] * (tri[:, :, None, 2] - tri[:, :, None, 0])
+    sampled = np.linalg.norm(samples - P[:, None, None, :], axis=-1).min(axis=(1, 2))
+    got = np.linalg.norm(Q - P, axis=1)
+    assert np.all(got <= sampled + 1e-12)
+    # on a triangle: its distance to the nearest triangle (by a finer projection) is nil
+    assert np.all(got >= sampled - 0.2)  # the sampling's spacing bounds how much nearer the exact point is
+    back = pd.closest_on_triangles(Q, tri)
+    np.testing.assert_allclose(back, Q, atol=1e-9)
