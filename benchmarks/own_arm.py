@@ -107,7 +107,7 @@ def _place_tcp(cell: Path, package: dict[str, str]) -> list[str]:
     return [f"{v:.4f}" for v in c.world_pose(q, "arm_tcp")[:3, 3]]
 
 
-def run(arms: list[str], out: Path, grid: str = "4,3") -> None:
+def run(arms: list[str], out: Path, grid: str = "12,5") -> None:
     from pinarms.optim.motion.arm_macros import example_packages
 
     share = str(example_packages()["example-robot-data"])
@@ -151,8 +151,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--arms", default=",".join(ARMS))
     parser.add_argument("--out", default=None, help="folder for the exports and pages (default: a temporary one)")
-    parser.add_argument("--map-grid", default="4,3", help="the belt step's --map-grid NU,NW (default 4,3: coarse, "
-                                                          "its error measured)")
+    parser.add_argument("--map-grid", default="12,5", help="the belt step's --map-grid NU,NW (the CLI's default; "
+                                                          "4,3 and 6,4 left the Jaco2 and Z1 no feasible cell)")
     args = parser.parse_args()
     arms = [a for a in args.arms.split(",") if a]
     unknown = sorted(set(arms) - set(ARMS))
