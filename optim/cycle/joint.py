@@ -47,8 +47,9 @@ from pinarms.robots.ties import argmin_tied
 
 if TYPE_CHECKING:
     from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots import Robot
 
-__all__ = ["joint_cycle"]
+__all__ = ["joint_cycle", "via_points"]
 
 
 def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | None = None,
@@ -56,7 +57,7 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     """Plan and time the cycle of ``request`` in joint space, ignoring its approach and cell (module doc).
 
     ``via``: the joint via points and branch labels of the move to place, when the caller has
-    them (:func:`_via_points` of the request: the same). ``there_clear``: called with the move
+    them (:func:`via_points` of the request: the same). ``there_clear``: called with the move
     to place's trajectory once it is timed; when it says False the move back is not timed and
     None is returned (:mod:`pinarms.optim.cycle.in_cell` screens an attempt so).
 
@@ -68,7 +69,7 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     """
     robot, spec = request.robot, request.spec
     poses = spec.poses(robot)
-    q_out, branches = _via_points(robot, poses, spec.names, request.q_start) if via is None else via
+    q_out, branches = via_points(robot, poses, spec.names, request.q_start) if via is None else via
     there = _timed_move(request, q_out, back=False)
     if there_clear is not None and not there_clear(there.trajectory):
         return None
@@ -100,9 +101,10 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     )
 
 
-def _via_points(robot: Any, poses: np.ndarray, names: tuple[str, ...],
-                q_start: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Joint via points (k, nq) on one branch and their labels; an unreachable waypoint named, with why."""
+def via_points(robot: Robot, poses: np.ndarray, names: tuple[str, ...],
+               q_start: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Joint via points (k, nq) on one branch through tcp ``poses`` (k, 4, 4) (base frame) named ``names``, the
+    nearest ``q_start`` at the pick, and their branch labels; an unreachable waypoint named, with why."""
     try:
         return _one_branch_waypoints(robot, poses, q_start)
     except UnreachableTarget as exc:

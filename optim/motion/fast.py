@@ -176,14 +176,13 @@ class FastCheck:
 
 def fast_check(checker: MotionChecker) -> FastCheck | None:
     """The :class:`FastCheck` of ``checker`` (kept with it), or ``None`` when it has none (no cover, moving arms)."""
-    got = getattr(checker, "_fast", False)
-    if got is False:
+    def build() -> FastCheck | None:
         try:
-            got = FastCheck(checker)
+            return FastCheck(checker)
         except ValueError:
-            got = None
-        checker._fast = got
-    return got
+            return None
+
+    return checker.kept("fast_check", build)
 
 
 def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:

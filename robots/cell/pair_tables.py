@@ -92,9 +92,9 @@ from pinarms.robots.cell._table_build import (
     TURN_NEAR,
     TURN_SAMPLES,
     TURNING,
-    _build_one,
-    _points,
-    _turning,
+    build_table,
+    geometry_points,
+    turning_sides,
     axis_arrays,
 )
 from pinarms.robots.cell import _table_build, mesh_cover
@@ -251,7 +251,7 @@ def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
         obj = objs[g]
         got = mesh_arrays(obj.geometry)
         if got is None:
-            h.update(_points(obj).tobytes())
+            h.update(geometry_points(obj).tobytes())
         else:
             h.update(got[0].tobytes() + got[1].tobytes())
         M = np.asarray(obj.placement.homogeneous, dtype=float)
@@ -330,7 +330,7 @@ def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict,
     seconds = 0.0
     if got is None:
         t0 = time.perf_counter()
-        got = _build_one(cell, a, b, side_a, side_b, _turning(cell, a, b, side_a, side_b))
+        got = build_table(cell, a, b, side_a, side_b, turning_sides(cell, a, b, side_a, side_b))
         seconds = time.perf_counter() - t0
         _save(key, got)
     _MEMORY[key] = got
