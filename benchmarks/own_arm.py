@@ -107,7 +107,7 @@ def _place_tcp(cell: Path, package: dict[str, str]) -> list[str]:
     return [f"{v:.4f}" for v in c.world_pose(q, "arm_tcp")[:3, 3]]
 
 
-def run(arms: list[str], out: Path, grid: str = "12,5") -> None:
+def run(arms: list[str], out: Path, grid: str = "12,5", only: tuple[str, ...] | None = None) -> None:
     from pinarms.optim.motion.arm_macros import example_packages
 
     share = str(example_packages()["example-robot-data"])
@@ -133,7 +133,7 @@ def run(arms: list[str], out: Path, grid: str = "12,5") -> None:
                          "--seeds", "1", "--duration", "60", "--arms", "2", "--map-error", "10",
                          "--html", str(out / f"{name}_belt.html")],
             }
-            rows += [(step, *_step(args, env)) for step, args in steps.items()]
+            rows += [(step, *_step(args, env)) for step, args in steps.items() if only is None or step in only]
         print(f"\n{name} (load average {os.getloadavg()[0]:.1f})")
         for step, seconds, cpu, text, error in rows:
             goal = GOALS.get(step)
@@ -153,16 +153,19 @@ def main() -> None:
     parser.add_argument("--out", default=None, help="folder for the exports and pages (default: a temporary one)")
     parser.add_argument("--map-grid", default="12,5", help="the belt step's --map-grid NU,NW (the CLI's default; "
                                                           "4,3 and 6,4 left the Jaco2 and Z1 no feasible cell)")
+    parser.add_argument("--steps", default=None, help="comma-separated steps to run (default: all; e.g. "
+                                                       "show,show-warm,check,export,verify,page)")
     args = parser.parse_args()
+    only = None if args.steps is None else tuple(s for s in args.steps.split(",") if s)
     arms = [a for a in args.arms.split(",") if a]
     unknown = sorted(set(arms) - set(ARMS))
     if unknown:
         parser.error(f"unknown arm(s) {', '.join(unknown)}; known: {', '.join(ARMS)}")
     if args.out:
-        run(arms, Path(args.out), args.map_grid)
+        run(arms, Path(args.out), args.map_grid, only)
     else:
         with tempfile.TemporaryDirectory() as tmp:
-            run(arms, Path(tmp), args.map_grid)
+            run(arms, Path(tmp), args.map_grid, only)
 
 
 if __name__ == "__main__":
