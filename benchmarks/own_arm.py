@@ -89,14 +89,19 @@ def _map_error(text: str) -> tuple[str, float | None]:
     return "", None
 
 
-def _loads(cell: Path, package: dict[str, str], cache: Path) -> tuple[float, float]:
-    """Cold (empty cache folder) and warm ``load_cell`` of ``cell`` [s], each in a new process."""
-    code = ("import sys, time; from pinarms.robots.cell import load_cell; t = time.perf_counter(); "
-            f"load_cell({str(cell)!r}, packages={package!r}); print(time.perf_counter() - t)")
+def _loads(cell: Path, package: dict[str, str], cache: Path) -> list[tuple[float, float]]:
+    """Cold (empty cache folder) and warm ``load_cell`` of ``cell``: ``[(wall s, CPU s)] * 2``, each in a new
+    process."""
+    code = ("import sys, time; from pinarms.robots.cell import load_cell; t, c = time.perf_counter(), "
+            f"time.process_time(); load_cell({str(cell)!r}, packages={package!r}); "
+            "print(time.perf_counter() - t, time.process_time() - c)")
     env = dict(os.environ, PINARMS_CACHE_DIR=str(cache))
-    out = [float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
-                                check=True).stdout.split()[-1]) for _ in range(2)]
-    return out[0], out[1]
+    out = []
+    for _ in range(2):
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+        wall, cpu = (float(v) for v in done.stdout.split()[-2:])
+        out.append((wall, cpu))
+    return out
 
 
 def _place_tcp(cell: Path, package: dict[str, str]) -> list[str]:
@@ -118,8 +123,8 @@ def run(arms: list[str], out: Path, grid: str = "12,5", only: tuple[str, ...] | 
         cell = CELLS / f"{name}.toml"
         with tempfile.TemporaryDirectory() as tmp:
             env = dict(os.environ, PINARMS_CACHE_DIR=str(Path(tmp) / "cache"))
-            cold, warm = _loads(cell, package, Path(tmp) / "loads")
-            rows = [("load (cold)", cold, None, "", ""), ("load (warm)", warm, None, "", "")]
+            (cold, cold_cpu), (warm, warm_cpu) = _loads(cell, package, Path(tmp) / "loads")
+            rows = [("load (cold)", cold, cold_cpu, "", ""), ("load (warm)", warm, warm_cpu, "", "")]
             steps = {
                 "show": ["cell", "show", str(cell), *flag],
                 "show-warm": ["cell", "show", str(cell), *flag],
