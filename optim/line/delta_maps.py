@@ -18,7 +18,7 @@ A delta without the fourth axis grasps at its own yaw: spread 0, no yaw coordina
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.delta_tracking import DeltaArm, delta_pick_times, tool_turn_time
 from pinarms.optim.line.errors import BeltOutOfReach
+from pinarms.optim.line.map_request import DeltaMapRequest, MapResult, MapStatus
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
@@ -70,25 +71,23 @@ def yaw_layers(arm: DeltaArm, approach: np.ndarray, leave: np.ndarray, yaw: np.n
     return np.maximum(approach[None], turn), np.maximum(leave[None], turn)
 
 
-def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.0,
-                    item_height: float = 0.04, margin: float = 0.025, nu: int = 12, nw: int = 5, n: int = 24,
-                    yaw_nodes: int = 33, progress: Any = None) -> TaskMap:
-    """The delta's task map (module doc); ``n`` TOPP grid intervals per move; ``progress(done, total)``
-    after each du column.
+def build_delta_map(request: DeltaMapRequest, *, progress: Callable[[int, int], None] | None = None) -> MapResult:
+    """The delta's task map (module doc); the request's ``n`` TOPP grid intervals per move;
+    ``progress(done, total)`` after each du column.
+
+    Returns:
+        :class:`~.map_request.MapResult`: the ``TaskMap``, status ``built`` (its plans: the picks timed).
 
     Raises:
-        InvalidInput: a grid size or margin out of its domain, a station without a delta.
+        InvalidInput: not a :class:`~.map_request.DeltaMapRequest`.
         BeltOutOfReach: the delta reaches no pick on the belt."""
-    if not isinstance(station.robot, DeltaArm):
-        raise InvalidInput(f"station {station.name!r} holds no delta (optim.line.delta_tracking.DeltaArm)")
-    for name, value, low in (("nu", nu, 2), ("nw", nw, 2), ("n", n, 4), ("yaw_nodes", yaw_nodes, 3)):
-        if not (isinstance(value, int) and value >= low):
-            raise InvalidInput(f"{name} must be an integer >= {low}, got {value!r}")
-    if yaw_nodes % 2 != 1:
-        raise InvalidInput(f"yaw_nodes must be odd (0 is the middle node), got {yaw_nodes}")
+    if not isinstance(request, DeltaMapRequest):
+        raise InvalidInput(f"build_delta_map takes a DeltaMapRequest (optim.line.DeltaMapRequest), got "
+                           f"{type(request).__name__}")
+    rq, station, belt, spec = request, request.station, request.belt, request.spec
+    mass, item_height, margin, nu, nw, n, yaw_nodes = (rq.mass, rq.item_height, rq.margin, rq.nu, rq.nw, rq.n,
+                                                       rq.yaw_nodes)
     half = belt.width / 2.0 - margin
-    if not half > 0.0:
-        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
     start = time.perf_counter()
     w = np.linspace(-half, half, nw)
     lo, hi = delta_span(station, belt, item_height + spec.lift, w)
@@ -119,8 +118,10 @@ def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingS
         fields = {"yaw_spread": spread}
         if spread > YAW_TOLERANCE:
             fields.update(yaw=yaw, yaw_approach=YA[:, None], yaw_leave=YC[:, None])
-    return TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start, yaw_period=spec.yaw_period, **fields)
+    seconds = time.perf_counter() - start
+    m = TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass), seconds,
+                yaw_period=spec.yaw_period, **fields)
+    return MapResult(MapStatus.BUILT, "", m, nu * nw, 0, seconds)
 
 
 def delta_map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
