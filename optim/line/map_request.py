@@ -216,7 +216,9 @@ class TrayMapRequest:
 class DeltaMapRequest:
     """A delta's task map (:func:`~.delta_maps.build_delta_map`): fields as :class:`MapRequest`'s, with
     ``n`` TOPP grid intervals per move (>= 4) and ``yaw_nodes`` (odd, >= 3) tool-yaw layers where
-    the fourth axis makes the time depend on yaw.
+    the fourth axis makes the time depend on yaw; ``cell``, ``clearance``: a cell whose delta the station
+    is (docs/cells.md): nodes whose pick path is not proven ``clearance`` [m] clear of its fixtures are
+    infeasible (checked by the build).
 
     Raises:
         InvalidInput: a field out of its domain (named), a station without a delta.
@@ -232,6 +234,8 @@ class DeltaMapRequest:
     nw: int = 5
     n: int = 24
     yaw_nodes: int = 33
+    cell: Cell | None = None
+    clearance: float = 0.01
 
     def __post_init__(self) -> None:
         from pinarms.optim.line.delta_tracking import DeltaArm
