@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg.lapack import dpotrf as _potrf
 
 from pinarms.errors import InvalidInput
 
@@ -20,6 +19,19 @@ __all__ = ["PARTS", "manipulability_of_jacobian"]
 
 #: Rows of the frame Jacobian each ``part`` takes.
 PARTS = {"full": slice(0, 6), "position": slice(0, 3), "orientation": slice(3, 6)}
+
+
+#: LAPACK's Cholesky (scipy), imported at the first one-configuration call: scipy.linalg takes about a second to
+#: import, which every command line call paid (robots.Robot imports this module).
+_POTRF: list = []
+
+
+def _potrf():
+    if not _POTRF:
+        from scipy.linalg.lapack import dpotrf
+
+        _POTRF.append(dpotrf)
+    return _POTRF[0]
 
 
 def manipulability_of_jacobian(J: np.ndarray, part: str = "full") -> float | np.ndarray:
@@ -38,7 +50,7 @@ def manipulability_of_jacobian(J: np.ndarray, part: str = "full") -> float | np.
     m, n = J.shape[-2:]
     if J.ndim == 2:  # one configuration: sqrt(det G) is the product of G's Cholesky diagonal
         G = J.dot(J.T) if m <= n else J.T.dot(J)
-        L, info = _potrf(G, overwrite_a=1)
+        L, info = _potrf()(G, overwrite_a=1)
         if info == 0:
             return math.prod(L.diagonal().tolist())
         G = J.dot(J.T) if m <= n else J.T.dot(J)  # singular in floating point: as the batch does

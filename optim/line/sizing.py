@@ -91,7 +91,7 @@ class SizingProblem:
         count_setting(self.max_arms, "max_arms", 1, MAX_SIZING_ARMS)
         if self.n_min is not None:
             count_setting(self.n_min, "n_min", 1, self.max_arms)
-        count_setting(self.population, "population", 2, MAX_POPULATION)
+        count_setting(self.population, "population", 4, MAX_POPULATION)  # the GA's own least (GASettings)
         count_setting(self.generations, "generations", 1, MAX_GENERATIONS)
         count_setting(self.seed, "seed", 0, 2**63 - 1)
         if not self.maps or not all(isinstance(m, TaskMap) for m in self.maps.values()):

@@ -190,15 +190,23 @@ def belt() -> None:
 @option_group(BeltViews, "views")
 @click.option("--trays", default=None, help="Place in trays on a second belt through the boxes: PITCH,SPEED,SLOTS "
               "(m, m/s, items per tray; tray maps built, minutes).")
+@click.option("--map-error", "map_error_n", type=int, default=0, show_default=True, metavar="N",
+              help="--robot: also measure the first arm's task map against exact planning at N seeded random "
+                   "picks at random item yaw (mean, p95, max; goal p95 <= 1 %); 0: not measured.")
 @scheduler_option
 @json_option
 def belt_run(flow: BeltFlow, arm: BeltRobotFlags, arms: int, arrivals: str | None, views: BeltViews,
-             trays: str | None, scheduler: str | None, as_json: bool) -> None:
+             trays: str | None, map_error_n: int, scheduler: str | None, as_json: bool) -> None:
     """Simulate a line and print picks/min, miss rate, utilisation (a preset's arms, or --robot URDF)."""
     from pinarms.optim.line import run_line
     from pinarms.studies.line import maps_for
 
+    from pinarms.optim.caps import count_setting
+
+    count_setting(map_error_n, "--map-error", 0, MAX_MAP_ERROR_PICKS)
     robot = arm.resolve()
+    if map_error_n and (robot is None or "delta" in robot):
+        raise InvalidInput("--map-error measures the task map of --robot URDF: give --robot, or drop --map-error")
     session_path, html_path, plot_path = views.session_path, views.html_path, views.plot_path
     spec = _spec(flow, arms, arrivals, robot)
     if trays and robot is not None:
@@ -223,7 +231,38 @@ def belt_run(flow: BeltFlow, arm: BeltRobotFlags, arms: int, arrivals: str | Non
 
         save_line_views(spec, res, session=session_path, html=html_path, schedule=plot_path, duration=views.window)
     what = flow.preset if robot is None else f"{robot['delta'] if 'delta' in robot else robot['robot'].name} (--robot)"
-    emit(as_json, res.as_dict(), res.summary(f"belt run: {what}, {arms} arm(s), rule {flow.rule}").splitlines())
+    data, lines = res.as_dict(), res.summary(f"belt run: {what}, {arms} arm(s), rule {flow.rule}").splitlines()
+    if map_error_n:
+        data["map_error"], more = _map_error(spec, maps, map_error_n, as_json)
+        lines += more
+    emit(as_json, data, lines)
+
+
+#: Largest ``--map-error N`` (each pick is planned exactly: about a second each on a 6-axis arm).
+MAX_MAP_ERROR_PICKS = 1000
+
+
+def _map_error(spec, maps: dict, n: int, as_json: bool) -> tuple[dict, list[str]]:
+    """The first station's map (first item type) against exact planning at ``n`` seeded random picks at random
+    yaw (:func:`pinarms.optim.line.map_error`): ``(JSON figures, text lines)``."""
+    from pinarms.optim.line import map_error
+    from pinarms.optim.line.task_map_error import MAP_ERROR_TARGET
+
+    st, item = spec.stations[0], spec.stream.types[0]
+    m = maps[st.name][0]
+    with _progress(as_json) as step:
+        step(0, None, f"map error: {n} exact picks")
+        err = map_error(m, st, spec.belt, spec.tracking, n=n, item_height=item.size[2], seed=0)
+    verdict = "met" if err.p95 <= MAP_ERROR_TARGET else "NOT met"
+    yaw = "with a yaw coordinate" if m.yaw is not None else "without a yaw coordinate"
+    data = {"points": int(err.relative.size), "mean": err.mean, "p95": err.p95, "max": err.max,
+            "target_p95": MAP_ERROR_TARGET, "seconds": err.planning_seconds, "yaw_axis": m.yaw is not None,
+            "by_yaw": [dict(zip(("low_rad", "high_rad", "points", "mean", "p95", "max"), row)) for row in err.by_yaw()]}
+    lines = [f"  map error        {err.relative.size} exact picks at random yaw (seed 0), map {m.du.size} x {m.w.size} "
+             f"{yaw}: mean {100 * err.mean:.2f} %, p95 {100 * err.p95:.2f} %, max {100 * err.max:.2f} % "
+             f"(goal p95 <= {100 * MAP_ERROR_TARGET:g} %: {verdict}; {err.planning_seconds:.1f} s)",
+             *err.table().splitlines()]
+    return data, lines
 
 
 @belt.command("arms")
@@ -274,6 +313,10 @@ def belt_size(flow: BeltFlow, arm: BeltRobotFlags, max_miss: float, generations:
     from pinarms.optim.line.sizing import SizingProblem, size_line
     from pinarms.studies.line import ENOKI
 
+    from pinarms.optim.caps import MAX_GENERATIONS, MAX_POPULATION, count_setting
+
+    count_setting(population, "--population", 4, MAX_POPULATION)  # the GA's range, named by the flag, before
+    count_setting(generations, "--generations", 1, MAX_GENERATIONS)  # any map is built
     robot = arm.resolve()
     preset, rate, speed, rule, seeds, duration = flow.preset, flow.rate, flow.speed, flow.rule, flow.seeds, flow.duration
     if preset != "scara" and robot is None:

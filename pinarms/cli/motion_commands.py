@@ -176,7 +176,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     """
     import sys
 
-    from pinarms.optim.motion import MotionChecker, MotionRequest, plan_motion
+    from pinarms.optim.motion import MotionChecker, MotionRequest, MotionStatus, plan_motion
     from pinarms.optim.motion.goals import ik_candidates
 
     def progress(message: str) -> None:
@@ -219,7 +219,10 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     R0 = arm.tcp_to_world(q0)[:3, :3]
     T = parse_pose(goal, "--to", mm, deg, R0)
     plan = plan_motion(MotionRequest(c, arm.name, q0, T, options=motion.options(lu), limits=motion.limits(), hold=hold),
-                       progress=progress).raise_for_status()  # not solved: one Error line saying why
+                       progress=progress)
+    if plan.status is MotionStatus.GOAL_UNREACHABLE and len(goal.replace(",", " ").split()) == 3:
+        _position_only_reach(arm, T, goal, mm)
+    plan.raise_for_status()  # not solved: one Error line saying why
     u = "mm" if mm else "m"
     cl = plan.clearance
     data: dict[str, Any] = {"cell": c.name, "arm": arm.name, **plan.as_dict(),
@@ -255,3 +258,21 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
         session.add_points("goal", T[:3, 3][None], kind="target")
         save_session(session, session_path, data, lines)
     emit(output.as_json, data, lines)
+
+
+
+def _position_only_reach(arm: Any, T: np.ndarray, goal: str, mm: bool) -> None:
+    """A goal ``--to X Y Z`` that plan_motion found unreachable with the start's tool orientation: when the
+    arm reaches the position itself (position-only IK within the limits), one error saying so and which
+    flag to give (an arm with fewer than six joints cannot hold every orientation at every point)."""
+    from pinarms.errors import UnreachableTarget
+
+    try:
+        arm.robot.ik(arm.to_base(T)[:3, 3], position_only=True)
+    except UnreachableTarget:
+        return  # out of reach as a position too: plan_motion's own error says so
+    u = "mm" if mm else "m"
+    raise InvalidInput(f"--to {goal.strip()}: arm {arm.name!r} reaches that position, but not with the tool's "
+                       f"orientation at the start (kept when --to gives no angles; an arm with {arm.nq} joints cannot "
+                       f"hold every orientation everywhere): give the tool's orientation there as --to X Y Z ROLL "
+                       f"PITCH YAW ({u}, rad or --deg)")

@@ -63,6 +63,9 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
     and replay it in MuJoCo. Prints the agreement figures; exit status 1 when the engines
     disagree. Example: pinarms verify cell my_cell.urdf --package vendor=./vendor --plan neutral 0.5,1.0
     """
+    import tempfile
+
+    from pinarms.export.cell import export_cell
     from pinarms.export.verify import compare_configurations_in_mujoco, compare_in_mujoco
 
     from pinarms.cli._common import package_map
@@ -74,19 +77,21 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
         raise InvalidInput(f"--samples must be 2 or more, got {samples}")
     c = load_cell_option(cell, xacro_args, packages)
     pkgs = package_map(packages)
-    results = [("configurations", compare_configurations_in_mujoco(
-        c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", packages=pkgs))]
     plan_ends, arm_name, amax = plan.plan_ends, plan.arm_name, plan.amax
-    if plan_ends is not None:
-        a = None if amax is None else floats(amax, "--amax")
-        if a is not None and not (a.size and np.all(np.isfinite(a)) and np.all(a > 0.0)):
-            raise InvalidInput(f"--amax must be one positive acceleration limit or one per planned joint "
-                               f"[rad/s² or m/s²], got {amax!r}")
-        move = _plan_between(c, arm_name, plan_ends, margin=plan.margin, time_limit=plan.time_limit, seed=seed,
-                             amax=None if a is None else (float(a[0]) if a.size == 1 else a))
-        results.append(("plan", compare_in_mujoco(c, move, samples=samples, packages=pkgs)))
-    elif arm_name is not None or amax is not None:
+    if plan_ends is None and (arm_name is not None or amax is not None):
         raise InvalidInput("--arm and --amax apply to the move of --plan FROM TO: add --plan")
+    with tempfile.TemporaryDirectory() as tmp:  # one export (and one MuJoCo model) for both comparisons
+        mjcf = export_cell(c, Path(tmp) / "cell", srdf=False, packages=pkgs).mjcf
+        results = [("configurations", compare_configurations_in_mujoco(
+            c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", mjcf=mjcf))]
+        if plan_ends is not None:
+            a = None if amax is None else floats(amax, "--amax")
+            if a is not None and not (a.size and np.all(np.isfinite(a)) and np.all(a > 0.0)):
+                raise InvalidInput(f"--amax must be one positive acceleration limit or one per planned joint "
+                                   f"[rad/s² or m/s²], got {amax!r}")
+            move = _plan_between(c, arm_name, plan_ends, margin=plan.margin, time_limit=plan.time_limit, seed=seed,
+                                 amax=None if a is None else (float(a[0]) if a.size == 1 else a))
+            results.append(("plan", compare_in_mujoco(c, move, samples=samples, mjcf=mjcf)))
     lines = [line for _, r in results for line in r.lines()]
     emit(as_json, {"cell": c.name, **{name: r.as_dict() for name, r in results}}, lines)
     if not all(r.agrees for _, r in results):

@@ -11,8 +11,8 @@ from it (:data:`.pairs.ALWAYS_SHARE`) need the contact counts only.
 
 The result is kept in the user's cache folder (:mod:`.disk_cache`, ``pair_samples/<sha256>.npz``), named by a
 digest of everything it depends on: the cell's URDF text, every collision geometry (shape,
-size, mesh vertices and triangles, placement, parent joint), the pairs sampled, the seed, the
-count, this module's and the joint sampler's source files, and the versions of coal,
+size, mesh vertices and triangles (those as the digest of the mesh file they were read from),
+placement, parent joint), the pairs sampled, the seed, the count, this module's and the joint sampler's source files, and the versions of coal,
 Pinocchio and numpy.
 
 Only a sampling that took at least :data:`MIN_SECONDS` is written (a cell of primitives samples
@@ -27,6 +27,7 @@ from __future__ import annotations
 import hashlib
 import time
 from pathlib import Path
+from typing import Any
 
 import coal
 import numpy as np
@@ -128,8 +129,23 @@ def _key(cell: "CellModel", objs: list, checked: list[tuple[int, int]], seed: in
         h.update(repr((g.name, type(geo).__name__, int(g.parentJoint))).encode())
         h.update(np.asarray(g.placement.homogeneous, dtype=float).tobytes())
         h.update(np.concatenate([np.asarray(geo.aabb_local.min_), np.asarray(geo.aabb_local.max_)]).tobytes())
-        mesh = mesh_arrays(geo)
-        if mesh is not None:
-            h.update(mesh[0].tobytes() + mesh[1].tobytes())
+        h.update(_mesh_content(g))
     h.update(np.asarray(checked, dtype=np.int64).tobytes())
     return h.hexdigest()
+
+
+def _mesh_content(g: Any) -> bytes:
+    """A mesh's content for the key: its vertices, and for its triangles the digest of the mesh file coal read
+    them from (the same file gives the same triangles; reading them back from coal costs a Python call per
+    triangle, a second per cell with mesh arms); read from coal for a mesh without a file. ``b""``: no mesh."""
+    geo = g.geometry
+    try:
+        V = np.asarray(geo.vertices(), dtype=float)
+        n = int(geo.num_tris)
+    except (AttributeError, TypeError, RuntimeError):
+        return b""
+    path = Path(str(getattr(g, "meshPath", "") or ""))
+    if str(path) and path.is_file():
+        return V.tobytes() + repr(n).encode() + hashlib.sha256(path.read_bytes()).digest()
+    mesh = mesh_arrays(geo)
+    return b"" if mesh is None else mesh[0].tobytes() + mesh[1].tobytes()

@@ -26,13 +26,25 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg.lapack import dposv as _posv
 
 __all__ = ["LMDescent", "FREE", "WINDOW", "CLIP"]
 
 _TWO_PI = 2.0 * np.pi
 _MU_MAX = 1e8  # an attempt gives up when no step with μ below this lowers the error
 FREE, WINDOW, CLIP = 0, 1, 2  # free descent; free then wrapped to the ranges' windows; projected descent
+
+
+#: LAPACK's ``posv`` (scipy), imported at the first step: scipy.linalg takes about a second to import, which every
+#: command line call paid (robots.Robot imports this module).
+_POSV: list = []
+
+
+def _posv(a: np.ndarray, b: np.ndarray, overwrite_a: int = 0):
+    if not _POSV:
+        from scipy.linalg.lapack import dposv
+
+        _POSV.append(dposv)
+    return _POSV[0](a, b, overwrite_a=overwrite_a)
 
 
 def _nielsen(mu: float, E: float, E_t: float, e: np.ndarray, A: np.ndarray, dq: np.ndarray) -> float:

@@ -15,7 +15,6 @@ import threading
 
 import numpy as np
 import pinocchio as pin
-from scipy.spatial.transform import Rotation
 
 __all__ = ["StartTable", "TABLE_SIZE", "POOL", "ROT_WEIGHT", "LIMIT_PENALTY", "LIMIT_MARGIN"]
 
@@ -98,6 +97,8 @@ class StartTable:
         order = np.argsort(key, kind="stable")
         cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         p = np.ascontiguousarray(p[order])
+        from scipy.spatial.transform import Rotation  # here: scipy.spatial takes a second to import
+
         wxyz = Rotation.from_matrix(T[order, :3, :3]).as_quat()[:, [3, 0, 1, 2]]  # scipy: (x, y, z, w)
         grid = np.array([lo[0], lo[1], lo[2], 1.0 / size, dims[0], dims[1], dims[2]], dtype=float)
         q = np.ascontiguousarray(q[order])

@@ -67,9 +67,13 @@ def test_tool_axis_and_offset_turn_and_move_the_tool_point():
 
 @pytest.mark.slow
 def test_belt_run_with_the_users_arm():
-    r = CliRunner().invoke(cli, ["belt", "run", *GANTRY_LINE, "--json"])
+    r = CliRunner().invoke(cli, ["belt", "run", *GANTRY_LINE, "--map-error", "4", "--json"])
     assert r.exit_code == 0, (r.output, r.exception)
     data = json.loads(r.stdout)
     f = data["figures"]
     assert f["arms"] == ["arm 1"] and data["belt_speed_m_s"] == 0.3 and 0.0 < f["picks_per_minute"]
     assert data["map_warnings"] == []  # a gantry cannot turn its tool: its time cannot depend on yaw
+    e = data["map_error"]  # the map against exact planning at 4 random picks (--map-error)
+    assert 1 <= e["points"] <= 4 and not e["yaw_axis"] and e["target_p95"] == 0.01 and e["seconds"] > 0.0
+    assert 0.0 <= e["mean"] <= e["max"] and e["p95"] <= e["max"] + 1e-15
+    assert sum(row["points"] for row in e["by_yaw"]) == e["points"]
