@@ -23,9 +23,9 @@ def main(nu: int = 8, nw: int = 4, nodes: int = 9, refine: int = 1, n: int = 30)
     from pinarms import robots
     from pinarms.optim.line import (Belt, PlaceBox, Station, TaskMap, TrackingSpec, base_pose, build_task_map,
                                     map_error)
-    from pinarms.robots.registry import _example_robot_data_share
+    from pinarms.robots.registry import example_robot_data_share
 
-    share = _example_robot_data_share()
+    share = example_robot_data_share()
     jaco = robots.from_urdf(share / "robots/kinova_description/robots/kinova.urdf", tcp="j2s6s200_end_effector",
                             package_dirs=(str(share.parent),))
     belt = Belt((0.0, 0.0, 0.80), speed=0.1, width=0.3, length=2.0)

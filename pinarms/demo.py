@@ -32,7 +32,6 @@ from typing import Any, Callable
 from pinarms.studies.cell import LINE_TASKS, study_cell  # noqa: F401  (old import path of LINE_TASKS)
 from pinarms.studies.seed000 import study_000
 from pinarms.studies.seed001 import study_001
-from pinarms.studies.seed001_motion import _planned_move_001  # noqa: F401  (old import path)
 from pinarms.studies.seed002 import BOUNDS_002_S, study_002  # noqa: F401  (old import path of BOUNDS_002_S)
 from pinarms.studies.seed004 import study_004
 from pinarms.studies.study import Study

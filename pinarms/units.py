@@ -13,14 +13,20 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
-__all__ = ["deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
+__all__ = ["as_float_array", "deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
            "joints_from_si", "length_scale", "angle_scale", "mass_kg", "parse_length", "parse_angle"]
 
 
-def _as_float_array(x, what: str) -> np.ndarray:
+def as_float_array(x: ArrayLike, what: str) -> np.ndarray:
+    """``x`` as a float64 array; ``what`` names it in the error.
+
+    Raises:
+        InvalidInput: ``x`` is not numeric.
+    """
     try:
         return np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -29,27 +35,27 @@ def _as_float_array(x, what: str) -> np.ndarray:
 
 def deg_to_rad(angle_deg) -> np.ndarray:
     """Degrees → radians, element-wise (any shape)."""
-    return np.deg2rad(_as_float_array(angle_deg, "angle_deg"))
+    return np.deg2rad(as_float_array(angle_deg, "angle_deg"))
 
 
 def rad_to_deg(angle_rad) -> np.ndarray:
     """Radians → degrees, element-wise (any shape)."""
-    return np.rad2deg(_as_float_array(angle_rad, "angle_rad"))
+    return np.rad2deg(as_float_array(angle_rad, "angle_rad"))
 
 
 def mm_to_m(length_mm) -> np.ndarray:
     """Millimetres → metres, element-wise (any shape)."""
-    return _as_float_array(length_mm, "length_mm") * 1e-3
+    return as_float_array(length_mm, "length_mm") * 1e-3
 
 
 def m_to_mm(length_m) -> np.ndarray:
     """Metres → millimetres, element-wise (any shape)."""
-    return _as_float_array(length_m, "length_m") * 1e3
+    return as_float_array(length_m, "length_m") * 1e3
 
 
 def wrap_angle(angle_rad) -> np.ndarray:
     """Wrap angles (rad) to [−π, π), element-wise."""
-    a = _as_float_array(angle_rad, "angle_rad")
+    a = as_float_array(angle_rad, "angle_rad")
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 

@@ -46,8 +46,8 @@ KERNEL_MODULES = (
     "pinarms.robots.ik._chain",
     "pinarms.robots.ik._limits_kernel",
     "pinarms.robots.ik._kernel",
-    "pinarms.robots.cell._box_kernel",
-    "pinarms.robots.cell._cover_kernel",
+    "pinarms.robots.cell.box_kernel",
+    "pinarms.robots.cell.cover_kernel",
     "pinarms.robots.cell._pair_kernel",
     "pinarms.robots.cell.ladder",
     "pinarms.optim.motion._fast_kernel",
@@ -124,7 +124,7 @@ def _plan() -> None:
 def _cover() -> None:
     """The sphere cover's own entries outside the search: world centres, the excess, a cylinder's gap to a box."""
     from pinarms.optim.motion import load_scene
-    from pinarms.robots.cell._cover_kernel import _cylinder_box_gap
+    from pinarms.robots.cell.box_kernel import cylinder_box_gap
     from pinarms.robots.cell.cover import link_cover, pair_arrays, pairs_for
 
     cell = load_scene("aubo_crate_guard")
@@ -133,7 +133,7 @@ def _cover() -> None:
     cover.world_centers(Q)
     a, b = pair_arrays(pairs_for(cell, 0.01))
     cover.excess(Q, cover.prepare(a, b), np.full(a.size, 0.01))
-    _cylinder_box_gap(np.zeros(3), np.array([0.0, 0.0, 0.1]), 0.05, np.eye(3), np.array([0.0, 0.0, 1.0]),
+    cylinder_box_gap(np.zeros(3), np.array([0.0, 0.0, 0.1]), 0.05, np.eye(3), np.array([0.0, 0.0, 1.0]),
                       np.full(3, 0.1))
 
 

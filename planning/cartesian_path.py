@@ -145,7 +145,7 @@ class CartesianPath(JointPath):
 
 
 # ---------------------------------------------------------------------------- helpers
-def _eval(c: np.ndarray, sig: np.ndarray) -> np.ndarray:
+def _quintic_values(c: np.ndarray, sig: np.ndarray) -> np.ndarray:
     """Value of quintic pieces c (K, 6, n) at local offsets sig (K, M) -> (K, M, n)."""
     powers = sig[..., None] ** np.arange(6)
     return np.einsum("kmd,kdn->kmn", powers, c)
@@ -272,7 +272,7 @@ def _failing_intervals(sv: PathSolver, knots: list[Knot], s: np.ndarray, h: np.n
         Stop: a check point is singular on an interval already as short as ``locate``.
     """
     sc = s[:-1, None] + h[:, None] * _CHECKS
-    qc = _eval(coefs, h[:, None] * _CHECKS)  # (K, 3, n)
+    qc = _quintic_values(coefs, h[:, None] * _CHECKS)  # (K, 3, n)
     K, C, n = qc.shape
     flat = qc.reshape(-1, n)
     ref = sv.tool.pose(sc.reshape(-1))
@@ -317,7 +317,7 @@ def _bisected(sv: PathSolver, knots: list[Knot], bad: np.ndarray, s: np.ndarray,
     interpolant's prediction, or by continuation across the interval where the batch fails."""
     idx = np.flatnonzero(bad)
     mids = s[idx] + 0.5 * h[idx]
-    pred = _eval(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
+    pred = _quintic_values(coefs[idx], (0.5 * h[idx])[:, None])[:, 0]
     q_new, ok = sv.newton(pred, sv.tool.pose(mids))
     ok &= np.abs(q_new - pred).max(axis=1) <= MAX_CORRECTION
     ok &= sv.outside(q_new) <= 1e-9

@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.units import _as_float_array, deg_to_rad, m_to_mm, mm_to_m, rad_to_deg, wrap_angle
+from pinarms.units import as_float_array, deg_to_rad, m_to_mm, mm_to_m, rad_to_deg, wrap_angle
 
 __all__ = [
     "deg_to_rad",
@@ -82,7 +82,7 @@ _AUBO_OFFSET = np.array([0.0, -np.pi / 2, 0.0, np.pi / 2, 0.0, 0.0])
 
 
 def _six(x, what: str) -> np.ndarray:
-    a = _as_float_array(x, what)
+    a = as_float_array(x, what)
     if a.ndim not in (1, 2) or a.shape[-1] != 6:
         raise InvalidInput(f"{what} must have shape (6,) or (N, 6), got {a.shape}")
     return a
@@ -159,7 +159,7 @@ def koji_fk_paper(theta) -> np.ndarray:
     taken from the parallelogram (absolute forearm angle), which reproduces its first
     printed example; the printed expansion of P has typos (docs/robots/koji_turner.md).
     """
-    t = _as_float_array(theta, "theta")
+    t = as_float_array(theta, "theta")
     if t.ndim not in (1, 2) or t.shape[-1] != 4:
         raise InvalidInput(f"theta must have shape (4,) or (N, 4), got {t.shape}")
     b = t.reshape(-1, 4)
@@ -192,4 +192,4 @@ def gantry_motor_to_axis(value_motor, transmission_m_per_rad: float = GANTRY_TRA
     """
     if not np.isfinite(transmission_m_per_rad) or transmission_m_per_rad <= 0:
         raise InvalidInput(f"transmission_m_per_rad must be a positive number, got {transmission_m_per_rad!r}")
-    return _as_float_array(value_motor, "value_motor") * float(transmission_m_per_rad)
+    return as_float_array(value_motor, "value_motor") * float(transmission_m_per_rad)

@@ -25,12 +25,13 @@ import pinocchio as pin
 from pinarms.errors import ModelError
 from pinarms.robots.so3 import frame_z_to as _rotation_z_to
 
-__all__ = ["KinematicTree", "JointCoordinates"]
+__all__ = ["KinematicTree", "JointCoordinates", "REVOLUTE", "PRISMATIC"]
 
 _CHUNK = 16384  # samples per block: keeps the working set in cache and memory bounded
 _WORKERS = max(1, min(4, os.cpu_count() or 1))
 
-_REVOLUTE, _PRISMATIC = 1, 2
+#: Codes of a 1-DoF joint's kind in :attr:`KinematicTree.kind`: rotating about its axis, or sliding along it.
+REVOLUTE, PRISMATIC = 1, 2
 
 
 @dataclass(frozen=True)
@@ -187,7 +188,7 @@ class KinematicTree:
                 int(self.q_index[i]),
                 float(self.scale[i]),
                 float(self.offset[i]),
-                int(self.kind[i]) == _REVOLUTE,
+                int(self.kind[i]) == REVOLUTE,
             )
             for i in range(1, n)
         ]
@@ -277,7 +278,7 @@ class KinematicTree:
         cols: list = [[0.0] * 6 for _ in range(self.nq)]
         for i in self.ancestors[joint]:
             w = [Rs[i][k][2] for k in range(3)]
-            if self.kind[i] == _REVOLUTE:
+            if self.kind[i] == REVOLUTE:
                 d = [p[a] - ps[i][a] for a in range(3)]
                 six = [w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0]] + w
             else:
@@ -305,12 +306,12 @@ class KinematicTree:
 
 
 def _joint_kind(name: str, short: str, motion: np.ndarray) -> tuple[int, np.ndarray]:
-    """``(_REVOLUTE or _PRISMATIC, axis)`` of a 1-DoF joint from its motion subspace ``(6,)`` (linear first)."""
+    """``(REVOLUTE or PRISMATIC, axis)`` of a 1-DoF joint from its motion subspace ``(6,)`` (linear first)."""
     linear, angular = motion[:3], motion[3:]
     if np.linalg.norm(angular) > 1e-12 and np.linalg.norm(linear) < 1e-12:
-        return _REVOLUTE, angular
+        return REVOLUTE, angular
     if np.linalg.norm(linear) > 1e-12 and np.linalg.norm(angular) < 1e-12:
-        return _PRISMATIC, linear
+        return PRISMATIC, linear
     raise ModelError(
         f"joint '{name}' ({short}) is neither a pure rotation nor a pure "
         "translation; pinarms cannot evaluate it in batch"

@@ -29,7 +29,7 @@ from pinarms.robots.urdf_checks import check_tree as _check_tree
 from pinarms.robots.urdf_checks import refuse_dtd as _refuse_dtd
 
 __all__ = ["load", "names", "from_urdf", "from_urdf_text", "from_xacro", "builtin_names", "RobotInfo", "info", "suggest",
-           "match_builtin", "MAX_URDF_BYTES"]
+           "match_builtin", "MAX_URDF_BYTES", "example_robot_data_share"]
 
 #: Largest URDF file :func:`from_urdf` reads [bytes] (as much as a xacro expansion may produce).
 MAX_URDF_BYTES = 64 * 2**20
@@ -131,7 +131,7 @@ def suggest(name: str, limit: int = 3) -> list[str]:
 
 
 @lru_cache(maxsize=1)
-def _example_robot_data_share() -> Path:
+def example_robot_data_share() -> Path:
     """The installed ``share/example-robot-data`` folder (example-robot-data ships no Python loader)."""
     try:
         dist = importlib.metadata.distribution("example-robot-data")
@@ -169,7 +169,7 @@ def load(name: str) -> Robot:
             raise ModelError(f"the URDF of {name!r} is missing ({path.name}); regenerate it with `pinarms urdf build`")
         robot = from_urdf(path, tcp=entry.tcp, name=name, description=entry.description)
     else:
-        share = _example_robot_data_share()
+        share = example_robot_data_share()
         path = share / "robots" / entry.urdf_relpath
         robot = from_urdf(
             path,

@@ -115,7 +115,7 @@ def test_after_the_warm_up_no_kernel_compiles_again():
     # compiled once per phase constant (numba literals), the cover's excess once more for a module's read-only empty
     # array, the spline proof's search for a path's read-only breaks; left: the cover's excess, for the cover's
     # scratch arrays and for the search's (which hold the moving arm's too)
-    assert set(first.repeated) <= {"pinarms.robots.cell._cover_kernel.excess_placed"}
+    assert set(first.repeated) <= {"pinarms.robots.cell.cover_kernel.excess_placed"}
     out = subprocess.run([sys.executable, "-c", _SECOND_PROCESS], capture_output=True, text=True, timeout=600,
                          cwd=ROOT)
     assert out.returncode == 0, out.stderr[-2000:]

@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 
 from pinarms.errors import InvalidInput
 
-from pinarms.viz.plots import _save
+from pinarms.viz.figure_files import save_figure
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -104,7 +104,7 @@ def schedule_figure(result: LineResult | SimResult, *, run: int = 0, window: tup
 
 def plot_line_schedule(path: str | Path, result: LineResult | SimResult, **options: Any) -> Path:
     """Write :func:`schedule_figure` of ``result`` to ``path`` (.png or .svg); return the path."""
-    return _save(schedule_figure(result, **options), path)
+    return save_figure(schedule_figure(result, **options), path)
 
 
 def _band(result: Any) -> tuple[float, float, float, float, float, float]:
@@ -169,7 +169,7 @@ def sizing_figure(curves: Mapping[str, tuple[Sequence[float], Sequence[LineResul
 def plot_line_sizing(path: str | Path, curves: Mapping[str, tuple[Sequence[float], Sequence[LineResult]]],
                      **options: Any) -> Path:
     """Write :func:`sizing_figure` of ``curves`` to ``path`` (.png or .svg); return the path."""
-    return _save(sizing_figure(curves, **options), path)
+    return save_figure(sizing_figure(curves, **options), path)
 
 
 def line_curve(make_spec: Callable[[float], LineSpec], values: Sequence[float], *, maps: Any = None,

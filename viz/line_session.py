@@ -145,7 +145,7 @@ def add_line(session: Any, spec: LineSpec, result: LineResult, *, run: int = 0, 
     ends = [w.u_max for w in getattr(result, "windows", ())] or [belt.length]
     u_miss = float(min(belt.length, max(ends) + belt.speed * spec.tracking.track_time))
     thickness = max(0.05, 1.25 * max(max(tp.size) for tp in items.types))
-    rec = make_line(LineRecord(session._free(session.lines, name, "line"), tuple(arms), belt.belt_to_world,
+    rec = make_line(LineRecord(session.free_name(session.lines, name, "line"), tuple(arms), belt.belt_to_world,
                                length=belt.length, width=belt.width, thickness=thickness, speed=belt.speed,
                                u_miss=u_miss, duration=dur, items=rows))
     session.lines[rec.name] = rec

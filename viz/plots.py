@@ -40,7 +40,6 @@ __all__ = ["plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_c
            "plot_clearance", "plot_schedule", "plot_torques",
            "plot_layout_search"]
 
-_save = save_figure  # the name viz.line_plots imports
 
 #: A trajectory with more knots than this (e.g. a time-optimal path timing, one piece per grid
 #: interval) is drawn without knot markers and lines.

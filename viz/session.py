@@ -25,7 +25,7 @@ import os
 import threading
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Mapping, TYPE_CHECKING
+from typing import Any, Collection, Mapping, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -200,7 +200,12 @@ class Session:
             raise InvalidInput(f"no robot {key!r} in this session; robots: {', '.join(self.robots) or 'none (add_robot first)'}")
         return self.robots[key]
 
-    def _free(self, table: Mapping[str, Any], name: Any, what: str) -> str:
+    def free_name(self, table: Collection[str], name: str, what: str) -> str:
+        """``name`` checked as a name of a ``what`` (a record kind) not yet in ``table`` (the names taken).
+
+        Raises:
+            InvalidInput: not a valid name, or taken.
+        """
         name = _check_name(name, what)
         if name in table:
             raise InvalidInput(f"{what} {name!r} already exists in this session; choose another name")
@@ -260,7 +265,7 @@ class Session:
     # ---------------------------------------------------------------- content
     def add_box(self, name: str, size: ArrayLike, pose: ArrayLike | None = None, color: ArrayLike = (0.6, 0.6, 0.6, 1.0)) -> BoxObject:
         """Add a static box: ``size`` (3,) edge lengths in m, ``pose`` box centre → world (4, 4), ``color`` RGBA."""
-        box = box_record(self._free(self.objects, name, "object"), size, pose, color)
+        box = box_record(self.free_name(self.objects, name, "object"), size, pose, color)
         self.objects[box.name] = box
         return box
 
@@ -273,7 +278,7 @@ class Session:
                 (t (N,) s, q (N, nq)).
             hz: sampling rate (1/s) for a Trajectory.
         """
-        rec = trajectory_record(self._free(self.trajectories, name, "trajectory"), self._entry(robot), trajectory, hz)
+        rec = trajectory_record(self.free_name(self.trajectories, name, "trajectory"), self._entry(robot), trajectory, hz)
         self.trajectories[rec.name] = rec
         return rec
 
@@ -283,7 +288,7 @@ class Session:
 
         ``points`` (n, 3) m in the robot's base frame; ``manipulability`` (n,) ≥ 0.
         """
-        rec = workspace_record(self._free(self.workspaces, name, "workspace"), self._entry(robot), workspace, points,
+        rec = workspace_record(self.free_name(self.workspaces, name, "workspace"), self._entry(robot), workspace, points,
                                manipulability)
         self.workspaces[rec.name] = rec
         return rec
@@ -293,7 +298,7 @@ class Session:
 
         With ``robot`` the points are in that robot's base frame, without it in the world frame.
         """
-        name = self._free(self.point_sets, name, "point set")
+        name = self.free_name(self.point_sets, name, "point set")
         if kind not in _POINT_KINDS:
             raise InvalidInput(f"kind of point set {name!r} must be one of {_POINT_KINDS}, got {kind!r}")
         key = None if robot is None else self._entry(robot).key
@@ -307,7 +312,7 @@ class Session:
 
     def add_history(self, name: str, history: GAHistory | GAResult | HistoryRecord | Mapping[str, ArrayLike]) -> HistoryRecord:
         """Add an optimisation history: a GA history (``best``, ``mean``, ...), a result with ``.history``, or a mapping of columns."""
-        rec = history_record(self._free(self.histories, name, "history"), history)
+        rec = history_record(self.free_name(self.histories, name, "history"), history)
         self.histories[rec.name] = rec
         return rec
 
@@ -318,7 +323,7 @@ class Session:
         """
         from pinarms.viz.reach_record import make_record
 
-        name = self._free(self.reachability, name, "reachability")
+        name = self.free_name(self.reachability, name, "reachability")
         rec = make_record(name, self._entry(robot).key, reach_map, min_index, float_array)
         self.reachability[name] = rec
         return rec

@@ -2,6 +2,7 @@
 
 - :mod:`.spec`: the task and the result (:class:`PickPlace`, :class:`CycleResult` with its
   ``status``) and the helpers every way of planning a cycle shares;
+- :mod:`.vertical`: the vertical lines measured and the rest between moves (shared by every planner);
 - :mod:`.request`: :class:`CycleRequest` and its settings groups (:class:`CycleTiming`,
   :class:`CycleLoad`, :class:`CycleApproach`, :class:`CellSettings`), checked when built;
 - :mod:`.joint`: the joint-space cycle (IK on one branch, time-optimal moves);

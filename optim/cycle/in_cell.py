@@ -43,7 +43,7 @@ import numpy as np
 
 from pinarms.optim.caps import MAX_LIFT_ATTEMPTS
 from pinarms.optim.cycle.cell_report import CellCycleReport
-from pinarms.optim.cycle.joint import _via_points, joint_cycle
+from pinarms.optim.cycle.joint import via_points, joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
 from pinarms.optim.cycle.spec import CycleResult, CycleStatus, PickPlace
 from pinarms.optim.cycle.straight import approach_cycle
@@ -233,7 +233,7 @@ class _Trials:
             robot = request.robot
             if SCREEN_BRANCHES and not self.branches_screened(description, spec.poses(robot)[1:-1]):
                 return False, None
-            via = _via_points(robot, spec.poses(robot), spec.names, request.q_start)  # as the cycle will have them
+            via = via_points(robot, spec.poses(robot), spec.names, request.q_start)  # as the cycle will have them
             if not self.screened(description, via[0]):
                 return False, None
             there_clear = (lambda move: self.move_screened(description, move, spec.dwell)) if SCREEN_MOVES else None

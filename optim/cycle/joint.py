@@ -37,7 +37,8 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from pinarms.optim.cycle.request import CycleRequest
-from pinarms.optim.cycle.spec import CycleResult, _hold, _line_deviation, _vertical_segments
+from pinarms.optim.cycle.spec import CycleResult
+from pinarms.optim.cycle.vertical import at_rest, line_deviation, vertical_segments
 from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
 from pinarms.optim.torque import torque_constraint
 from pinarms.planning import joint_waypoints
@@ -46,8 +47,9 @@ from pinarms.robots.ties import argmin_tied
 
 if TYPE_CHECKING:
     from pinarms.planning.trajectory import Trajectory
+    from pinarms.robots import Robot
 
-__all__ = ["joint_cycle"]
+__all__ = ["joint_cycle", "via_points"]
 
 
 def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | None = None,
@@ -55,7 +57,7 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     """Plan and time the cycle of ``request`` in joint space, ignoring its approach and cell (module doc).
 
     ``via``: the joint via points and branch labels of the move to place, when the caller has
-    them (:func:`_via_points` of the request: the same). ``there_clear``: called with the move
+    them (:func:`via_points` of the request: the same). ``there_clear``: called with the move
     to place's trajectory once it is timed; when it says False the move back is not timed and
     None is returned (:mod:`pinarms.optim.cycle.in_cell` screens an attempt so).
 
@@ -67,14 +69,14 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
     """
     robot, spec = request.robot, request.spec
     poses = spec.poses(robot)
-    q_out, branches = _via_points(robot, poses, spec.names, request.q_start) if via is None else via
+    q_out, branches = via_points(robot, poses, spec.names, request.q_start) if via is None else via
     there = _timed_move(request, q_out, back=False)
     if there_clear is not None and not there_clear(there.trajectory):
         return None
     moves = (there, _timed_move(request, q_out, back=True))
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
-        parts = [_hold(q_out[0], spec.dwell), parts[0], _hold(q_out[-1], spec.dwell), parts[1]]
+        parts = [at_rest(q_out[0], spec.dwell), parts[0], at_rest(q_out[-1], spec.dwell), parts[1]]
     trajectory = parts[0]
     for part in parts[1:]:
         trajectory = trajectory.concatenated(part)
@@ -92,16 +94,17 @@ def joint_cycle(request: CycleRequest, *, via: tuple[np.ndarray, np.ndarray] | N
         vmax=request.vmax,
         amax=request.amax,
         jmax=request.jmax,
-        line_deviation=_line_deviation(robot, moves, _vertical_segments(poses)),
+        line_deviation=line_deviation(robot, moves, vertical_segments(poses)),
         branches=np.concatenate([branches, branches[-2::-1]]),
         payload=None if loaded is None else loaded.robot.payload,
         torque_limit=None if loaded is None else loaded.limit.copy(),
     )
 
 
-def _via_points(robot: Any, poses: np.ndarray, names: tuple[str, ...],
-                q_start: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Joint via points (k, nq) on one branch and their labels; an unreachable waypoint named, with why."""
+def via_points(robot: Robot, poses: np.ndarray, names: tuple[str, ...],
+               q_start: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Joint via points (k, nq) on one branch through tcp ``poses`` (k, 4, 4) (base frame) named ``names``, the
+    nearest ``q_start`` at the pick, and their branch labels; an unreachable waypoint named, with why."""
     try:
         return _one_branch_waypoints(robot, poses, q_start)
     except UnreachableTarget as exc:

@@ -2,9 +2,9 @@
 
 The data of :mod:`pinarms.optim.cycle` (planned by :func:`pinarms.optim.plan_cycle`), in a module of
 their own so that every way of planning a cycle (joint space, straight vertical approach,
-in a cell, around obstacles) shares them without importing the planner back. Also the
-helpers those planners share: a hold at rest and the tcp's distance from the vertical
-segments.
+in a cell, around obstacles) shares them without importing the planner back (the helpers
+they share, a hold at rest and the tcp's distance from the vertical segments, are in
+:mod:`pinarms.optim.cycle.vertical`).
 
 Units: m, rad, s (rad/s … or m/s … for prismatic joints).
 """
@@ -305,34 +305,3 @@ class CycleResult:
             "line_cost_s": self.line_cost,
         }
 
-
-def _hold(q: np.ndarray, seconds: float) -> Trajectory:
-    """The arm at rest at ``q`` for ``seconds``."""
-    return Trajectory([0.0, seconds], np.asarray(q, dtype=float)[None, None, :])
-
-
-def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Distance [m] of points p (..., 3) from the segments a–b (..., 3)."""
-    ab = b - a
-    s = np.clip(np.sum((p - a) * ab, axis=-1) / np.sum(ab * ab, axis=-1), 0.0, 1.0)
-    return np.linalg.norm(p - (a + s[..., None] * ab), axis=-1)
-
-
-def _vertical_segments(poses: np.ndarray) -> np.ndarray:
-    """(4, 2, 3) ends [m] of the vertical segments of waypoints ``poses`` (k, 4, 4), in :data:`LINE_NAMES` order."""
-    P = poses[:, :3, 3]
-    return np.array([[P[0], P[1]], [P[-2], P[-1]], [P[-1], P[-2]], [P[1], P[0]]])
-
-
-def _line_deviation(robot: Any, moves: tuple[TimingResult, TimingResult], ends: np.ndarray) -> np.ndarray:
-    """(4,) max tcp distance [m] from the vertical segments, all samples in one batched FK."""
-    samples = []
-    for move in moves:
-        t = move.knot_times
-        for k in (0, len(t) - 2):  # first and last segment of each move
-            samples.append(move.trajectory.sample(np.linspace(t[k], t[k + 1], LINE_SAMPLES))[0])
-    q = np.concatenate(samples)
-    p = np.asarray(robot.fk(q))[:, :3, 3].reshape(4, LINE_SAMPLES, 3)
-    a = ends[:, 0][:, None]
-    b = ends[:, 1][:, None]
-    return _segment_distance(p, a, b).max(axis=1)

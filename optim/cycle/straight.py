@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike
 
 from pinarms.optim.cycle.joint import joint_cycle
 from pinarms.optim.cycle.request import CycleRequest
-from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult, _hold, _segment_distance, _vertical_segments
+from pinarms.optim.cycle.spec import LINE_SAMPLES, CycleResult
+from pinarms.optim.cycle.vertical import at_rest, segment_distance, vertical_segments
 from pinarms.optim.errors import InvalidLimits
 from pinarms.optim.topp.path_timing import PathTiming, time_optimal
 from pinarms.optim.timing.segments import TimingRequest, TimingResult, minimize_time
@@ -125,11 +126,11 @@ def straight_cycle(robot: Robot, joint: CycleResult, *, kind: str, method: str =
                                                                  (up_place, back, down_pick)))]
     parts = [moves[0].trajectory, moves[1].trajectory]
     if spec.dwell > 0.0:
-        parts = [_hold(q[0], spec.dwell), parts[0], _hold(_end(down_place), spec.dwell), parts[1]]
+        parts = [at_rest(q[0], spec.dwell), parts[0], at_rest(_end(down_place), spec.dwell), parts[1]]
     trajectory = parts[0]
     for part in parts[1:]:
         trajectory = trajectory.concatenated(part)
-    deviation = _line_deviations(robot, (up_pick, down_place, up_place, down_pick), _vertical_segments(poses))
+    deviation = _line_deviations(robot, (up_pick, down_place, up_place, down_pick), vertical_segments(poses))
     v, a, j = joint.vmax, joint.amax, joint.jmax
     return CycleResult(
         robot=joint.robot, spec=spec, names=joint.names, waypoints=joint.waypoints, q_via=joint.q_via,
@@ -199,7 +200,7 @@ def _line_deviations(robot: Any, lines: tuple[PathTiming, ...], ends: np.ndarray
     for i, timing in enumerate(lines):
         t = np.linspace(0.0, timing.duration, LINE_SAMPLES)
         p = np.asarray(robot.fk(timing.trajectory(t)))[:, :3, 3]
-        deviation[i] = _segment_distance(p, ends[i, 0], ends[i, 1]).max()
+        deviation[i] = segment_distance(p, ends[i, 0], ends[i, 1]).max()
     return deviation
 
 def approach_cycle(request: CycleRequest) -> CycleResult:

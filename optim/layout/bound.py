@@ -36,13 +36,13 @@ from pinarms.optim.types import JointLimit, Scheduler
 if TYPE_CHECKING:
     from pinarms.robots.robot import Robot
 
-from pinarms.optim.layout.candidates import _PPM_RTOL
+from pinarms.optim.layout.candidates import PPM_RTOL
 
 __all__: list[str] = []  # search_layout's (bound=True)
 
 #: A candidate is skipped only when its bound exceeds the ``keep``-th best cycle by more than this
 #: (relative): ties of the ranking (1e-9 relative in picks/min) are always planned.
-SLACK = 8.0 * _PPM_RTOL
+SLACK = 8.0 * PPM_RTOL
 
 
 def _travel(a: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:

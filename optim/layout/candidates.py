@@ -18,7 +18,7 @@ from pinarms.optim.status import Status
 from pinarms.errors import InvalidInput
 
 __all__ = ["CandidateFailure", "FAILURES", "AXES", "grid_candidates", "random_candidates", "base_to_world",
-           "points_in_base_frame"]
+           "points_in_base_frame", "PPM_RTOL"]
 
 
 
@@ -43,7 +43,8 @@ class CandidateFailure(Status):
 FAILURES = tuple(CandidateFailure)
 #: Names of the placement coordinates (columns of a candidate array).
 AXES = ("x", "y", "z", "yaw")
-_PPM_RTOL = 1e-9
+#: Relative tolerance under which two picks-per-minute figures count as tied (the lower index wins).
+PPM_RTOL = 1e-9
 
 
 # ------------------------------------------------------------------ candidates
@@ -138,8 +139,3 @@ def points_in_base_frame(points: np.ndarray, placements: np.ndarray) -> np.ndarr
     out[..., 1] = -s * d[..., 0] + c * d[..., 1]
     out[..., 2] = d[..., 2]
     return out
-
-
-def _rot_z(yaw: float) -> np.ndarray:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

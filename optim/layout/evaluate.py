@@ -7,7 +7,7 @@ start. Every task is a pure function of its inputs (the execution layer may run 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -15,14 +15,21 @@ from pinarms.optim.cycle import CellSettings, CycleRequest, CycleTiming, PickPla
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.errors import LimitViolation, PinarmsError, UnreachableTarget
 
-from pinarms.optim.layout.candidates import _PPM_RTOL, _rot_z, base_to_world, points_in_base_frame
+from pinarms.optim.layout.candidates import PPM_RTOL, base_to_world, points_in_base_frame
+from pinarms.robots.so3 import rot_z
 
-__all__: list[str] = []  # the tasks of a search (private: search_layout runs them)
+if TYPE_CHECKING:
+    from pinarms.optim.cycle.spec import CycleResult
+    from pinarms.robots.cell import Cell
+    from pinarms.robots.robot import Robot
+
+__all__ = ["EvaluationSettings", "PhaseClock", "CellRecipe", "keep_cell", "forget_cell", "evaluate_placement", "ChunkTask",
+           "evaluate_chunk", "RefineTask", "refine_placement"]  # the tasks search_layout runs
 
 
 # --------------------------------------------------------------------- settings
 @dataclass(frozen=True)
-class _Settings:
+class EvaluationSettings:
     """What every candidate's evaluation needs (shipped with each task)."""
 
     picks: np.ndarray  # (P, 3) line frame
@@ -35,11 +42,11 @@ class _Settings:
     amax: Any
     jmax: Any
     seed: int
-    cell: "_CellRecipe | None" = None
+    cell: "CellRecipe | None" = None
     screen: bool = True  # CellSettings.screen of every cycle in the cell
 
 
-class _Clock:
+class PhaseClock:
     """Wall and CPU seconds (this process) of a search's phases: ``laps[name] = (wall, cpu)``."""
 
     def __init__(self) -> None:
@@ -56,7 +63,7 @@ class _Clock:
 
 
 @dataclass(frozen=True)
-class _CellRecipe:
+class CellRecipe:
     """How a worker rebuilds the cell (a Cell holds coal objects that do not pickle)."""
 
     token: str
@@ -73,10 +80,20 @@ class _CellRecipe:
 
 
 #: Cells by search token in this process (the caller's own cell, or one rebuilt from its recipe).
-_CELLS: dict[str, Any] = {}
+_CELLS: dict[str, Cell] = {}
 
 
-def _cell_of(recipe: _CellRecipe) -> Any:
+def keep_cell(token: str, cell: Cell) -> None:
+    """Use ``cell`` itself for the search ``token`` in this process (workers elsewhere rebuild it from its recipe)."""
+    _CELLS[token] = cell
+
+
+def forget_cell(token: str) -> None:
+    """Drop the cell of search ``token`` from this process (the next task rebuilds it from its recipe)."""
+    _CELLS.pop(token, None)
+
+
+def _cell_of(recipe: CellRecipe) -> Cell:
     if recipe.token not in _CELLS:
         from pinarms.robots.cell import Cell
 
@@ -116,11 +133,13 @@ def _classify(exc: PinarmsError) -> str:
     return "timing"
 
 
-def _evaluate(robot: Any, placement: np.ndarray, st: _Settings, keep_cycle: bool = False):
-    """Plan every (pick, place) pair's cycle from this placement; ``_Outcome`` (and the first cycle)."""
+def evaluate_placement(robot: Robot, placement: np.ndarray, st: EvaluationSettings,
+                       keep_cycle: bool = False) -> tuple[_Outcome, CycleResult | None]:
+    """Plan every (pick, place) pair's cycle from ``placement`` (4,) (x, y, z [m], yaw [rad]): its outcome, and its
+    first cycle when ``keep_cycle``."""
     picks_b = points_in_base_frame(st.picks, placement[None, :])[0]
     places_b = points_in_base_frame(st.places, placement[None, :])[0]
-    R = None if st.orientation is None else _rot_z(-placement[3]) @ st.orientation
+    R = None if st.orientation is None else rot_z(-placement[3]) @ st.orientation
     in_cell = None
     if st.cell is not None:
         try:
@@ -166,20 +185,25 @@ def _warm(robot: Any, token: str) -> Any:
 
 
 @dataclass(frozen=True)
-class _ChunkTask:
+class ChunkTask:
+    """A worker's share of the grid: ``placements`` (m, 4) evaluated with ``robot`` under ``settings``."""
+
     robot: Any
     token: str  # one per search (and robot)
     placements: np.ndarray  # (m, 4)
-    settings: _Settings
+    settings: EvaluationSettings
 
 
-def _evaluate_chunk(task: _ChunkTask) -> list[_Outcome]:
+def evaluate_chunk(task: ChunkTask) -> list[_Outcome]:
+    """The outcomes of the task's placements (a worker's share of the grid)."""
     robot = _warm(task.robot, task.token)
-    return [_evaluate(robot, p, task.settings)[0] for p in task.placements]
+    return [evaluate_placement(robot, p, task.settings)[0] for p in task.placements]
 
 
 @dataclass(frozen=True)
-class _RefineTask:
+class RefineTask:
+    """One Nelder-Mead refinement from ``start`` (4,) over the ``free`` coordinates within ``bounds`` (4, 2)."""
+
     robot: Any
     token: str
     start: np.ndarray  # (4,)
@@ -187,10 +211,10 @@ class _RefineTask:
     bounds: np.ndarray  # (4, 2)
     step: np.ndarray  # (4,) initial simplex step
     evaluations: int
-    settings: _Settings
+    settings: EvaluationSettings
 
 
-def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
+def refine_placement(task: RefineTask) -> tuple[np.ndarray, float, int]:
     """Bounded Nelder-Mead from ``start`` over the free coordinates: (placement, picks/min, evaluations)."""
     from scipy.optimize import minimize
 
@@ -208,10 +232,10 @@ def _refine(task: _RefineTask) -> tuple[np.ndarray, float, int]:
         p = placement(z)
         key = p.tobytes()
         if key not in seen:
-            ppm = _evaluate(robot, p, task.settings)[0].picks_per_minute
+            ppm = evaluate_placement(robot, p, task.settings)[0].picks_per_minute
             seen[key] = -ppm
             # strictly better by more than the tie tolerance: the earliest evaluation wins ties
-            if best["ppm"] is None or ppm > best["ppm"] * (1.0 + _PPM_RTOL) + 1e-12:
+            if best["ppm"] is None or ppm > best["ppm"] * (1.0 + PPM_RTOL) + 1e-12:
                 best["placement"], best["ppm"] = p, ppm
         return seen[key]
 

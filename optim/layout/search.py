@@ -45,12 +45,13 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from pinarms.optim.layout.candidates import (_PPM_RTOL, AXES, FAILURES, CandidateFailure, _rot_z, base_to_world, grid_candidates,
+from pinarms.optim.layout.candidates import (PPM_RTOL, AXES, FAILURES, CandidateFailure, base_to_world, grid_candidates,
                          points_in_base_frame, random_candidates)
-from pinarms.optim.layout.evaluate import (_CELLS, _CellRecipe, _ChunkTask, _Clock, _evaluate, _evaluate_chunk, _RefineTask, _refine,
-                       _Settings)
+from pinarms.optim.layout.evaluate import (CellRecipe, ChunkTask, EvaluationSettings, PhaseClock, RefineTask, evaluate_chunk,
+                                           evaluate_placement, keep_cell, refine_placement)
 from pinarms.optim.layout.request import LayoutRequest, LayoutStatus, is_cell
 from pinarms.optim.layout.result import LayoutSearch, Refinement
+from pinarms.robots.so3 import rot_z
 
 if TYPE_CHECKING:
     from pinarms.execution import Scheduler
@@ -72,7 +73,7 @@ __all__ = [
 
 
 # ------------------------------------------------------------------------ search
-def _screen(robot: Robot, cand: np.ndarray, st: _Settings) -> tuple[list[str], list[str], np.ndarray | None]:
+def _screen(robot: Robot, cand: np.ndarray, st: EvaluationSettings) -> tuple[list[str], list[str], np.ndarray | None]:
     """Batched closed-form IK of every waypoint from every placement: failure and reason per candidate,
     and the tcp poses ``(M, K, 4, 4)`` of the picks, places and lift points in each base frame (None
     without a closed form)."""
@@ -93,7 +94,7 @@ def _screen(robot: Robot, cand: np.ndarray, st: _Settings) -> tuple[list[str], l
     if st.orientation is None:
         T[:, :, :3, :3] = default_orientation(robot)
     else:
-        T[:, :, :3, :3] = np.einsum("mij,jk->mik", np.stack([_rot_z(-y) for y in cand[:, 3]]), st.orientation)[:, None]
+        T[:, :, :3, :3] = np.einsum("mij,jk->mik", np.stack([rot_z(-y) for y in cand[:, 3]]), st.orientation)[:, None]
     T[:, :, :3, 3] = P
     T[:, :, 3, 3] = 1.0
     flat = T.reshape(M * K, 4, 4)
@@ -119,12 +120,12 @@ def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
     """Picks/min descending (1e-9 relative ties), then margin descending, then index; failures last."""
     from pinarms.robots.ties import argsort_tied
 
-    order = argsort_tied(-ppm, rtol=_PPM_RTOL)
+    order = argsort_tied(-ppm, rtol=PPM_RTOL)
     out, i = [], 0
     while i < order.size:
         j = i + 1
         ref = -ppm[order[i]]
-        while j < order.size and -ppm[order[j]] <= ref + _PPM_RTOL * abs(ref) + 1e-12:
+        while j < order.size and -ppm[order[j]] <= ref + PPM_RTOL * abs(ref) + 1e-12:
             j += 1
         run = sorted(order[i:j].tolist(), key=lambda k: (-margin[k], k))
         out.extend(run)
@@ -132,20 +133,20 @@ def _ranking(ppm: np.ndarray, margin: np.ndarray) -> np.ndarray:
     return np.asarray(out, dtype=np.intp)
 
 
-def _cell_recipe(request: LayoutRequest, token: str) -> "_CellRecipe | None":
+def _cell_recipe(request: LayoutRequest, token: str) -> "CellRecipe | None":
     """When ``request.robot`` is a cell, the recipe its workers rebuild the cell from (None for a robot)."""
     if not is_cell(request.robot):
         return None
     cell = request.robot
-    recipe = _CellRecipe(token, cell.urdf_text, cell.source, str(cell.base_dir),
+    recipe = CellRecipe(token, cell.urdf_text, cell.source, str(cell.base_dir),
                          tuple(sorted((k, str(v)) for k, v in cell.packages.items())),
                          tuple(sorted((k, str(v)) for k, v in cell.args.items())), int(cell.seed), str(request.arm),
                          tuple(request.carry), float(request.clearance), tuple(cell.arm_placements))
-    _CELLS[token] = cell  # this process uses the caller's cell; workers rebuild it from the recipe
+    keep_cell(token, cell)  # this process uses the caller's cell; workers rebuild it from the recipe
     return recipe
 
 
-def _margins(robot: Any, st: _Settings, cand: np.ndarray, samples: int) -> tuple[Any, np.ndarray]:
+def _margins(robot: Any, st: EvaluationSettings, cand: np.ndarray, samples: int) -> tuple[Any, np.ndarray]:
     """The workspace's voxel map and the boundary margin of every pick and place (M, P + Q) [m] from each candidate."""
     from pinarms.robots.reach.workspace import sample_workspace
 
@@ -155,7 +156,7 @@ def _margins(robot: Any, st: _Settings, cand: np.ndarray, samples: int) -> tuple
     return vmap, vmap.query(pts.reshape(-1, 3)).margin.reshape(cand.shape[0], -1)
 
 
-def _boundary_failures(failure: list[str], reason: list[str], point_margin: np.ndarray, st: _Settings,
+def _boundary_failures(failure: list[str], reason: list[str], point_margin: np.ndarray, st: EvaluationSettings,
                        min_margin: float) -> None:
     """Mark the candidates still in the running with a point closer than ``min_margin`` to the edge ``"boundary"``."""
     margin = point_margin.min(axis=1)
@@ -167,7 +168,7 @@ def _boundary_failures(failure: list[str], reason: list[str], point_margin: np.n
                      f"less than min_margin {min_margin * 1e3:.0f} mm")
 
 
-def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, failure: list[str], reason: list[str],
+def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: EvaluationSettings, failure: list[str], reason: list[str],
                      chunk_size: int, scheduler: Any, progress: Any,
                      lower: np.ndarray | None = None, keep: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Plan the cycles of every candidate still in the running, in tasks of ``chunk_size``; record the failures.
@@ -202,9 +203,9 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
                 progress(n_tasks, n_tasks)
             break
         i += len(wave)
-        tasks = [_ChunkTask(robot, token, cand[wave[s : s + chunk_size]], st) for s in range(0, len(wave), chunk_size)]
+        tasks = [ChunkTask(robot, token, cand[wave[s : s + chunk_size]], st) for s in range(0, len(wave), chunk_size)]
         step = None if progress is None else (lambda d, _t, o=done: progress(o + d, n_tasks))
-        chunks = map_chunks(_evaluate_chunk, tasks, scheduler=scheduler, progress=step)
+        chunks = map_chunks(evaluate_chunk, tasks, scheduler=scheduler, progress=step)
         done += len(tasks)
         for m, o in zip(wave, (o for chunk in chunks for o in chunk)):
             failure[m], reason[m] = o.failure, o.reason
@@ -214,7 +215,7 @@ def _plan_candidates(robot: Any, token: str, cand: np.ndarray, st: _Settings, fa
     return cycle_time, branch, manip
 
 
-def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: np.ndarray, ok: np.ndarray,
+def _refine_best(robot: Any, token: str, cand: np.ndarray, st: EvaluationSettings, ppm: np.ndarray, ok: np.ndarray,
                  order: np.ndarray, n_refine: int, evaluations: int, vmap: Any, min_margin: float,
                  scheduler: Any, progress: Any) -> tuple[Refinement | None, np.ndarray | None, float]:
     """Refine the best ``n_refine`` candidates over the free coordinates.
@@ -234,8 +235,8 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
         return refinement, best_placement, best_ppm
     bounds = np.column_stack([cand.min(axis=0), cand.max(axis=0)])
     step = np.ptp(cand, axis=0) / max(2.0, M ** (1.0 / free.size))  # about the grid's spacing
-    rtasks = [_RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(evaluations), st) for i in starts]
-    found = map_chunks(_refine, rtasks, scheduler=scheduler, progress=progress)
+    rtasks = [RefineTask(robot, token, cand[i].copy(), free, bounds, step, int(evaluations), st) for i in starts]
+    found = map_chunks(refine_placement, rtasks, scheduler=scheduler, progress=progress)
     refinement = Refinement(
         starts=np.array(starts),
         start_picks_per_minute=ppm[starts],
@@ -249,12 +250,12 @@ def _refine_best(robot: Any, token: str, cand: np.ndarray, st: _Settings, ppm: n
     )
     eligible = np.where(refinement.margin >= min_margin, refinement.picks_per_minute, -np.inf)
     k = int(np.argmax(eligible))
-    if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + _PPM_RTOL):
+    if np.isfinite(eligible[k]) and eligible[k] > best_ppm * (1.0 + PPM_RTOL):
         best_placement, best_ppm = refinement.placements[k].copy(), float(refinement.picks_per_minute[k])
     return refinement, best_placement, best_ppm
 
 
-def _lower_bounds(robot: Any, st: _Settings, targets: np.ndarray | None, M: int) -> np.ndarray:
+def _lower_bounds(robot: Any, st: EvaluationSettings, targets: np.ndarray | None, M: int) -> np.ndarray:
     """Each candidate's lower bound of its cycle time [s] (:mod:`.bound`; 0 without a closed form)."""
     from pinarms.optim.layout.bound import cycle_lower_bounds
 
@@ -294,10 +295,10 @@ def search_layout(request: LayoutRequest, *, scheduler: Scheduler = None,
     robot = rq.arm_robot
     recipe = _cell_recipe(rq, token)
     cand = rq.candidates
-    st = _Settings(rq.picks, rq.places, rq.orientation, float(rq.lift), float(rq.dwell), rq.kind, rq.vmax, rq.amax,
+    st = EvaluationSettings(rq.picks, rq.places, rq.orientation, float(rq.lift), float(rq.dwell), rq.kind, rq.vmax, rq.amax,
                    rq.jmax, int(rq.seed), recipe, bool(rq.screen))
 
-    clock = _Clock()
+    clock = PhaseClock()
     failure, reason, targets = _screen(robot, cand, st)
     lower = _lower_bounds(robot, st, targets, cand.shape[0]) if rq.bound else None
     vmap, point_margin = _margins(robot, st, cand, rq.workspace_samples)
@@ -321,7 +322,7 @@ def search_layout(request: LayoutRequest, *, scheduler: Scheduler = None,
     clock.lap("refine")
     best_cycle = None
     if best_placement is not None:
-        best_cycle = _evaluate(robot, best_placement, st, keep_cycle=True)[1]
+        best_cycle = evaluate_placement(robot, best_placement, st, keep_cycle=True)[1]
     clock.lap("best")
     failed = tuple(CandidateFailure(f) if f else None for f in failure)
     status, why = LayoutStatus.FOUND, ""

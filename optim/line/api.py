@@ -23,7 +23,8 @@ import numpy as np
 from pinarms.optim.types import Scheduler
 
 from pinarms.optim.caps import count_setting
-from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.numbers import finite_number
 from pinarms.optim.line.items import MAX_ITEMS, ItemType, Items, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.report import LineFigures, summarise
 from pinarms.optim.line.rules import AssignmentRule, Rule
@@ -38,7 +39,7 @@ from pinarms.optim.status import Status
 from pinarms.errors import InvalidInput
 
 __all__ = ["Stream", "LineSpec", "LineResult", "run_line", "build_maps", "map_warnings", "sim_arms", "LineStatus",
-           "LineCurve", "line_curve", "MAX_LINE_ARMS", "MAX_LINE_SEEDS"]
+           "LineCurve", "line_curve", "MAX_LINE_ARMS", "MAX_LINE_SEEDS", "station_shape_key"]
 
 STREAM_KINDS = ("poisson", "regular", "file")
 #: Most arms (stations) along one line, and most seeds (Monte Carlo runs) of one line result.
@@ -73,8 +74,8 @@ class Stream:
             raise InvalidInput(f"stream kind must be one of {STREAM_KINDS}, got {self.kind!r}")
         if self.kind == "file" and not self.path:
             raise InvalidInput("a 'file' stream needs the path of its arrivals file")
-        rate = _number(self.rate_per_s, "stream rate_per_s [items/s]", positive=True)
-        duration = _number(self.duration, "stream duration [s]", positive=True)
+        rate = finite_number(self.rate_per_s, "stream rate_per_s [items/s]", positive=True)
+        duration = finite_number(self.duration, "stream duration [s]", positive=True)
         expected = rate * duration
         if self.kind != "file" and not expected <= MAX_ITEMS:
             raise InvalidInput(f"a stream of {rate:g} items/s over {duration:g} s is {expected:.3g} items; a stream "
@@ -128,7 +129,7 @@ class LineSpec:
         if not self.seeds:
             raise InvalidInput("seeds must hold at least one seed")
         object.__setattr__(self, "seeds", tuple(int(s) for s in self.seeds))
-        rate = _number(self.target_miss_rate, "target miss rate")
+        rate = finite_number(self.target_miss_rate, "target miss rate")
         if not 0.0 <= rate < 1.0:
             raise InvalidInput(f"target miss rate must be in [0, 1), got {self.target_miss_rate!r}")
         if isinstance(self.rule, str):
@@ -211,7 +212,9 @@ class LineResult:
                 "windows": [w.__dict__ for w in self.windows], "overlapping": [list(p) for p in self.overlapping]}
 
 
-def _shape_key(st: Station, belt: Belt) -> tuple:
+def station_shape_key(st: Station, belt: Belt) -> tuple:
+    """What a station's task maps depend on besides the items: its arm, its base on ``belt`` (height, offset,
+    rotation), its place in its base frame and its limits (part of the key that names stored maps)."""
     b = belt.to_belt(st.base_to_world[:3, 3])
     rel = st.world_to_base(st.place.position)
     lim = st.limits
@@ -238,7 +241,7 @@ def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | Non
             t = spec.stream.types[0]
             on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
             fine = (approach_maps or {}).get(st.name, (None,))[0]
-            key = (_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
+            key = (station_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
                    spec.tray_grid, id(fine), own)
             if key not in cache:
                 from pinarms.optim.line.tray_maps import build_tray_map
@@ -251,7 +254,7 @@ def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | Non
             continue
         maps = []
         for t in spec.stream.types:
-            key = (_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own,
+            key = (station_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own,
                    spec.map_yaw)
             if key not in cache:
                 cache[key] = build_task_map(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],

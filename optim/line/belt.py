@@ -17,18 +17,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
+from pinarms.optim.line.numbers import finite_number
 
 __all__ = ["Belt", "PlaceBox"]
-
-
-def _number(value: Any, what: str, *, positive: bool = False) -> float:
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    x = float(value) if ok else float("nan")
-    if not np.isfinite(x):
-        raise InvalidInput(f"{what} must be a finite number, got {value!r}")
-    if positive and x <= 0.0:
-        raise InvalidInput(f"{what} must be > 0, got {value!r}")
-    return x
 
 
 def _vector(value: Any, what: str) -> np.ndarray:
@@ -72,9 +63,9 @@ class Belt:
         d /= np.linalg.norm(d)
         d.setflags(write=False)
         object.__setattr__(self, "direction", d)
-        object.__setattr__(self, "speed", _number(self.speed, "belt speed [m/s]", positive=True))
-        object.__setattr__(self, "width", _number(self.width, "belt width [m]", positive=True))
-        object.__setattr__(self, "length", _number(self.length, "belt length [m]", positive=True))
+        object.__setattr__(self, "speed", finite_number(self.speed, "belt speed [m/s]", positive=True))
+        object.__setattr__(self, "width", finite_number(self.width, "belt width [m]", positive=True))
+        object.__setattr__(self, "length", finite_number(self.length, "belt length [m]", positive=True))
 
     def with_speed(self, speed: float) -> "Belt":
         """The same belt running at ``speed`` [m/s]."""

@@ -26,7 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.files import read_bounded
-from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.numbers import finite_number
 from pinarms.optim.line.errors import ArrivalsFileError
 from pinarms.errors import InvalidInput
 
@@ -50,12 +51,12 @@ class ItemType:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name or "," in self.name:
             raise InvalidInput(f"item type name must be a non-empty string without commas, got {self.name!r}")
-        m = _number(self.mass, f"mass [kg] of item type {self.name!r}")
+        m = finite_number(self.mass, f"mass [kg] of item type {self.name!r}")
         if m < 0.0:
             raise InvalidInput(f"mass [kg] of item type {self.name!r} must be >= 0, got {self.mass!r}")
         if np.ndim(self.size) != 1 or len(self.size) != 3:
             raise InvalidInput(f"size of item type {self.name!r} must be 3 numbers [m], got {self.size!r}")
-        size = tuple(_number(s, f"size [m] of item type {self.name!r}", positive=True) for s in self.size)
+        size = tuple(finite_number(s, f"size [m] of item type {self.name!r}", positive=True) for s in self.size)
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "size", size)
 
@@ -123,8 +124,8 @@ def poisson_items(belt: Belt, rate: float, duration: float, *, types: Sequence[I
                   seed: int = 0) -> Items:
     """Items arriving as a Poisson process of ``rate`` [items/s] over ``duration`` [s], each at a
     uniform random position across (within the belt), of a uniform random type, yaw uniform in [-π, π)."""
-    rate = _number(rate, "rate [items/s]", positive=True)
-    duration = _number(duration, "duration [s]", positive=True)
+    rate = finite_number(rate, "rate [items/s]", positive=True)
+    duration = finite_number(duration, "duration [s]", positive=True)
     tt = _types(types)
     expected = rate * duration
     if not expected <= MAX_ITEMS:  # inf too; checked before numpy draws or allocates
@@ -146,8 +147,8 @@ def regular_items(belt: Belt, period: float, duration: float, *, w: float | None
                   types: Sequence[ItemType] | None = None, seed: int = 0) -> Items:
     """Items every ``period`` [s] from t = 0 over ``duration`` [s] (a regular pitch of
     ``belt.speed · period`` m), all at ``w`` across (default: uniform random, seeded)."""
-    period = _number(period, "period [s]", positive=True)
-    duration = _number(duration, "duration [s]", positive=True)
+    period = finite_number(period, "period [s]", positive=True)
+    duration = finite_number(duration, "duration [s]", positive=True)
     tt = _types(types)
     count = math.ceil(duration / period) if duration / period < 2.0 * MAX_ITEMS else math.inf
     if count > MAX_ITEMS:  # counted before numpy allocates
@@ -156,7 +157,7 @@ def regular_items(belt: Belt, period: float, duration: float, *, w: float | None
     rng = np.random.default_rng(seed)
     t0 = np.arange(0.0, duration, period)
     kind = np.zeros(t0.size, dtype=int)
-    ww = _lateral(rng, t0.size, belt, tt, kind) if w is None else np.full(t0.size, _number(w, "across [m]"))
+    ww = _lateral(rng, t0.size, belt, tt, kind) if w is None else np.full(t0.size, finite_number(w, "across [m]"))
     return _checked(belt, t0, ww, kind, np.zeros(t0.size), tt)
 
 

@@ -17,7 +17,7 @@ Dask cluster), one task per ``du`` column and yaw node, same result either way.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -29,7 +29,10 @@ from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels,
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput, UnreachableTarget
 
-__all__ = ["build_task_map", "measure_yaw", "YAW_MODES", "PROBE_COLUMNS", "PROBE_YAWS"]
+if TYPE_CHECKING:
+    from pinarms.optim.line.fixtures import FixtureCheck
+
+__all__ = ["build_task_map", "measure_yaw", "YAW_MODES", "PROBE_COLUMNS", "PROBE_YAWS", "task_fixture_check"]
 
 #: ``"auto"``: a yaw coordinate where the task time depends on yaw (measured); ``"axis"``: always
 #: (arms that can turn their tool); ``"none"``: never, the spread not measured (the maps before).
@@ -64,8 +67,9 @@ def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: in
             *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
 
 
-def _fixtures(task: dict) -> Any:
-    """The column's :class:`~.fixtures.FixtureCheck` (None: no cell given)."""
+def task_fixture_check(task: dict) -> FixtureCheck | None:
+    """The fixture check of a map column's ``task`` (its ``cell``, ``station`` and ``clearance``; None: no cell given):
+    a :class:`~.fixtures.FixtureCheck`."""
     if task.get("cell") is None:
         return None
     from pinarms.optim.line.fixtures import fixture_check
@@ -87,7 +91,7 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int]:
     q_rest = rest_configuration(st)
     labels = task.get("branches", (-1,))
     yaw = _plan_yaw(task.get("yaw", 0.0), spec.yaw_period)
-    fixtures = _fixtures(task)
+    fixtures = task_fixture_check(task)
     blocked = 0
     tA = np.full((len(labels), len(task["w"])), np.nan)
     tC = np.full_like(tA, np.nan)

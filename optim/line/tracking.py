@@ -28,20 +28,27 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from pinarms.optim.errors import InfeasibleProblem
-from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.numbers import finite_number
 from pinarms.optim.line.station import Station
 from pinarms.planning import Trajectory
 from pinarms.planning.joint_path import JointPath
 from pinarms.errors import InvalidInput, UnreachableTarget
 
+if TYPE_CHECKING:
+    from pinarms.optim.topp.path_timing import PathTiming
+    from pinarms.planning.path_constraints import PathConstraint
+    from pinarms.robots import Robot
+
 __all__ = ["TrackingSpec", "PickPlan", "plan_pick", "tracking_points", "ik_branch_labels", "tool_yaw", "can_yaw",
-           "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError"]
+           "TRACK_SAMPLES", "POSITION_TOL", "PositionLimitError", "hand_joints", "tool_poses", "ik_path", "branch_label",
+           "joint_rates", "hermite_path", "move_constraints", "timed_move", "check_rate_limits", "check_positions"]
 
 #: IK instants per tracking segment (spline knots).
 TRACK_SAMPLES = 41
@@ -68,13 +75,13 @@ class TrackingSpec:
     yaw_period: float = float(np.pi)
 
     def __post_init__(self) -> None:
-        if not (0.0 < _number(self.yaw_period, "yaw_period [rad] of the tracking spec") <= 2.0 * np.pi + 1e-12):
+        if not (0.0 < finite_number(self.yaw_period, "yaw_period [rad] of the tracking spec") <= 2.0 * np.pi + 1e-12):
             raise InvalidInput(f"yaw_period [rad] of the tracking spec must be in (0, 2π] (π: a two-finger "
                                f"gripper), got {self.yaw_period!r}")
         for name in ("lift", "descend"):
-            _number(getattr(self, name), f"{name} of the tracking spec", positive=True)
+            finite_number(getattr(self, name), f"{name} of the tracking spec", positive=True)
         for name in ("grasp", "release"):
-            if _number(getattr(self, name), f"{name} [s] of the tracking spec") < 0.0:
+            if finite_number(getattr(self, name), f"{name} [s] of the tracking spec") < 0.0:
                 raise InvalidInput(f"{name} [s] of the tracking spec must be >= 0")
 
     @property
@@ -130,7 +137,7 @@ def tracking_points(belt: Belt, spec: TrackingSpec, u_pre: float, w: float, z_gr
     return belt.to_world(u_pre + belt.speed * tau, w, z_grasp + spec.lift * h)
 
 
-def _hand_joints(robot: Any) -> np.ndarray:
+def hand_joints(robot: Robot) -> np.ndarray:
     """(nq,) bool: joints that turn the tool without moving its point at neutral (SCARA joint 4)."""
     return np.linalg.norm(robot.jacobian(robot.neutral)[:3], axis=0) < 1e-9
 
@@ -149,14 +156,16 @@ def tool_yaw(station: Station, spec: "TrackingSpec", yaw: float) -> float:
     """The hand angle [rad] about the vertical, relative to the tool's default, that grasps an item at
     ``yaw`` [rad] (belt frame): ``yaw`` reduced by the gripper's symmetry ``spec.yaw_period`` into
     [-period/2, period/2); 0 for an arm that cannot yaw (:func:`can_yaw`: it grasps at its own yaw)."""
-    y = _number(yaw, "item yaw [rad]")
+    y = finite_number(yaw, "item yaw [rad]")
     if not can_yaw(station.robot):
         return 0.0
     per = spec.yaw_period
     return float((y + per / 2.0) % per - per / 2.0)
 
 
-def _poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarray:
+def tool_poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarray:
+    """Tool poses (N, 4, 4) in the station's base frame at world points ``p_world`` (N, 3) [m]: the arm's default
+    tool orientation turned by ``yaw`` [rad] about the base's vertical."""
     from pinarms.robots.reach.layout import default_orientation
 
     c, s = np.cos(yaw), np.sin(yaw)
@@ -168,7 +177,7 @@ def _poses(station: Station, p_world: np.ndarray, yaw: float = 0.0) -> np.ndarra
     return T
 
 
-def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int | None = None) -> np.ndarray:
+def ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int | None = None) -> np.ndarray:
     """Joint configurations (N, nq) on one branch, starting nearest ``q_ref``; raises UnreachableTarget.
 
     ``branch``: the closed form's branch label to start on (:meth:`pinarms.robots.Robot.ik_branches`);
@@ -179,7 +188,7 @@ def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int
         out = np.empty((poses.shape[0], robot.nq))
         prev = q_ref
         q0, labels = robot.ik_branches(poses[0], q_ref)
-        want = _branch_label(robot, q_ref) if branch is None else int(branch)
+        want = branch_label(robot, q_ref) if branch is None else int(branch)
         same = q0[labels == want]
         if same.shape[0]:  # stay on the rest configuration's branch (maps continuous over the belt)
             prev = same[np.argmin(np.abs(same - q_ref).sum(axis=1))]
@@ -204,7 +213,7 @@ def _ik_path(station: Station, poses: np.ndarray, q_ref: np.ndarray, branch: int
     return out
 
 
-def _branch_label(robot: Any, q: np.ndarray) -> int:
+def branch_label(robot: Robot, q: np.ndarray) -> int:
     """The closed-form branch label of configuration ``q`` (-1 when none matches)."""
     sols, labels = robot.ik_branches(robot.fk(q), q)
     if sols.shape[0] == 0:
@@ -213,7 +222,7 @@ def _branch_label(robot: Any, q: np.ndarray) -> int:
     return int(labels[k]) if np.abs(sols[k] - q).max() < 1e-6 else -1
 
 
-def _joint_rates(station: Station, q: np.ndarray, v_world: np.ndarray) -> np.ndarray:
+def joint_rates(station: Station, q: np.ndarray, v_world: np.ndarray) -> np.ndarray:
     """Joint velocities (nq,) that move the tcp at ``v_world`` [m/s] with no rotation."""
     J = station.robot.jacobian(q)  # (6, nq) in the base frame (linear; angular)
     twist = np.concatenate([station.base_to_world[:3, :3].T @ v_world, np.zeros(3)])
@@ -221,12 +230,15 @@ def _joint_rates(station: Station, q: np.ndarray, v_world: np.ndarray) -> np.nda
     return qd
 
 
-def _hermite(q0: np.ndarray, m0: np.ndarray, q1: np.ndarray, m1: np.ndarray, robot: Any) -> JointPath:
+def hermite_path(q0: np.ndarray, m0: np.ndarray, q1: np.ndarray, m1: np.ndarray, robot: Robot) -> JointPath:
+    """The cubic Hermite joint path from ``q0`` to ``q1`` (nq,) over s in [0, 1] with end tangents ``m0``, ``m1``."""
     c = np.stack([q0, m0, 3.0 * (q1 - q0) - 2.0 * m0 - m1, 2.0 * (q0 - q1) + m0 + m1])
     return JointPath([0.0, 1.0], c[None], robot=robot)
 
 
-def _constraints(station: Station, mass: float) -> list:
+def move_constraints(station: Station, mass: float) -> list[PathConstraint]:
+    """The station's joint velocity and acceleration limits, and its torque limits (with ``mass`` [kg] as payload)
+    where its limits say so: the constraints every timed move of a pick keeps."""
     from pinarms.planning.path_constraints import JointAccelerationConstraint, JointVelocityConstraint
     from pinarms.planning.torque import JointTorqueConstraint
 
@@ -238,12 +250,13 @@ def _constraints(station: Station, mass: float) -> list:
     return cons
 
 
-def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> Any:
+def timed_move(station: Station, q0: np.ndarray, qd0: np.ndarray, q1: np.ndarray, qd1: np.ndarray, mass: float,
+               grid: int) -> PathTiming:
     """Time-optimal move q0 → q1 starting with joint velocity qd0 and ending with qd1 (one of them 0)."""
     from pinarms.optim.topp.path_timing import time_optimal
 
     chord = q1 - q0
-    arm = ~_hand_joints(station.robot)  # the path's scale from the joints that move the tool point,
+    arm = ~hand_joints(station.robot)  # the path's scale from the joints that move the tool point,
     if not np.any(arm):                 # so the hand's angle (the item's yaw) leaves their path unchanged
         arm = np.ones(chord.size, bool)
     L = float(np.linalg.norm(chord[arm]))
@@ -251,12 +264,12 @@ def _timed_move(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) -> A
     speed = float(np.linalg.norm(moving[arm]))
     k = L / speed if speed > 1e-12 and L > 1e-9 else 1.0
     m0, m1 = (chord, k * qd1) if np.any(qd1) else (k * qd0, chord)
-    path = _hermite(q0, m0, q1, m1, station.robot)
+    path = hermite_path(q0, m0, q1, m1, station.robot)
     ends = {"end_speed": 1.0 / k} if np.any(qd1) else {"start_speed": 1.0 / k}
-    return time_optimal(path, _constraints(station, mass), grid=grid, **ends)
+    return time_optimal(path, move_constraints(station, mass), grid=grid, **ends)
 
 
-def _check_limits(station: Station, traj: Trajectory, what: str, spec: TrackingSpec, speed: float) -> None:
+def check_rate_limits(station: Station, traj: Trajectory, what: str, spec: TrackingSpec, speed: float) -> None:
     """InfeasibleProblem when ``traj`` (a tracking segment) needs a joint beyond its velocity or
     acceleration limit, with the figures and the descend [s] that would lower the worst of them to
     its limit if it all came from the vertical move (acceleration ∝ 1/descend², velocity ∝ 1/descend)."""
@@ -282,7 +295,7 @@ class PositionLimitError(InfeasibleProblem):
     """A planned move's joint trajectory leaves the arm's position limits (an infeasible pick)."""
 
 
-def _check_positions(station: Station, traj: Trajectory, what: str) -> None:
+def check_positions(station: Station, traj: Trajectory, what: str) -> None:
     """Raise :class:`PositionLimitError` where the exact extrema of ``traj`` leave the position
     limits by more than :data:`POSITION_TOL` (never clamps)."""
     lo, hi = traj.position_range()
@@ -321,7 +334,7 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
     q_rest = rest_configuration(station) if q_rest is None else np.asarray(q_rest, float)
     tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
     p = tracking_points(belt, spec, u_pre, w, item_height, tau)
-    poses = _poses(station, p, tool_yaw(station, spec, yaw))
+    poses = tool_poses(station, p, tool_yaw(station, spec, yaw))
     args = (station, belt, spec, u_pre, w, poses, mass, q_rest)
     try:
         return _plan_on_branch(*args, branch)
@@ -339,20 +352,20 @@ def plan_pick(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w:
 
 def _plan_on_branch(station: Station, belt: Belt, spec: TrackingSpec, u_pre: float, w: float, poses: np.ndarray,
                     mass: float, q_rest: np.ndarray, branch: int | None) -> PickPlan:
-    """:func:`plan_pick` on one IK branch (None: as :func:`_ik_path` chooses), position limits checked."""
+    """:func:`plan_pick` on one IK branch (None: as :func:`ik_path` chooses), position limits checked."""
     robot = station.robot
     tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
-    q = _ik_path(station, poses, q_rest, branch)
-    qd_in = _joint_rates(station, q[0], belt.velocity)
-    qd_out = _joint_rates(station, q[-1], belt.velocity)
+    q = ik_path(station, poses, q_rest, branch)
+    qd_in = joint_rates(station, q[0], belt.velocity)
+    qd_out = joint_rates(station, q[-1], belt.velocity)
     spline = CubicSpline(tau, q, axis=0, bc_type=((1, qd_in), (1, qd_out)))
     tracking = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
-    _check_limits(station, tracking, "tracking segment", spec, belt.speed)
-    _check_positions(station, tracking, "tracking segment")
-    approach = _timed_move(station, q_rest, np.zeros(robot.nq), q[0], qd_in, 0.0, spec.grid)
-    _check_positions(station, approach.trajectory, "approach move")
-    leave = _timed_move(station, q[-1], qd_out, q_rest, np.zeros(robot.nq), mass, spec.grid)
-    _check_positions(station, leave.trajectory, "leave move")
+    check_rate_limits(station, tracking, "tracking segment", spec, belt.speed)
+    check_positions(station, tracking, "tracking segment")
+    approach = timed_move(station, q_rest, np.zeros(robot.nq), q[0], qd_in, 0.0, spec.grid)
+    check_positions(station, approach.trajectory, "approach move")
+    leave = timed_move(station, q[-1], qd_out, q_rest, np.zeros(robot.nq), mass, spec.grid)
+    check_positions(station, leave.trajectory, "leave move")
     tA = float(approach.duration)
     times = (tA, spec.track_time, float(leave.duration), spec.release)
     return PickPlan(station.name, float(u_pre), float(w), approach, tracking, leave, q_rest,
@@ -365,7 +378,7 @@ def ik_branch_labels(station: Station, points_world: np.ndarray) -> tuple[int, .
     robot = station.robot
     if not robot.has_analytic_ik:
         return (-1,)
-    poses = _poses(station, np.asarray(points_world, float).reshape(-1, 3))
+    poses = tool_poses(station, np.asarray(points_world, float).reshape(-1, 3))
     found: set[int] = set()
     for T in poses:
         found.update(int(b) for b in robot.ik_branches(T, robot.neutral)[1])
@@ -374,9 +387,9 @@ def ik_branch_labels(station: Station, points_world: np.ndarray) -> tuple[int, .
 
 def rest_configuration(station: Station) -> np.ndarray:
     """The arm's configuration at rest at its box (IK of the place point, nearest neutral)."""
-    pose = _poses(station, station.place.position[None])
+    pose = tool_poses(station, station.place.position[None])
     try:
-        return _ik_path(station, pose, station.robot.neutral)[0]
+        return ik_path(station, pose, station.robot.neutral)[0]
     except UnreachableTarget:
         raise UnreachableTarget(f"arm {station.name!r} cannot reach its place box {station.place.name!r} at "
                                 f"{station.place.position.tolist()} m (world): move the box into its reach") from None

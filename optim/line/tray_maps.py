@@ -33,10 +33,10 @@ import numpy as np
 from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_map_build import _fixtures
+from pinarms.optim.line.task_map_build import task_fixture_check
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import TaskMap
-from pinarms.optim.line.tracking import TrackingSpec, _branch_label, ik_branch_labels, plan_pick, rest_configuration
+from pinarms.optim.line.tracking import TrackingSpec, branch_label, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.trays import TrayBelt, plan_pick_to_tray
 from pinarms.optim.line.windows import belt_span, check_reach
 from pinarms.errors import InvalidInput, PinarmsError, UnreachableTarget
@@ -204,7 +204,7 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     v_base = float(trays.belt.to_belt(st.base_to_world[:3, 3])[0])
     q_rest = rest_configuration(st)
     nw, nv, labels = len(task["w"]), len(task["dv"]), task["branches"]
-    fixtures = _fixtures(task)
+    fixtures = task_fixture_check(task)
     blocked = 0
     A, P = np.full(nw, np.nan), np.full(nw, -1)
     X, R = np.full((len(labels), nw, nv), np.nan), np.full((len(labels), nw, nv), np.nan)
@@ -227,7 +227,7 @@ def _column(task: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                     blocked += verdict == "fixtures"
                     continue
                 A[j], X[b, j, k], R[b, j, k] = p.times[0], p.times[2], p.times[4]
-                P[j] = _branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
+                P[j] = branch_label(st.robot, p.pieces[1].sample(np.array([0.0]))[0][0])
     return A, X, R, P, blocked
 
 

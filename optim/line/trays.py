@@ -30,10 +30,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 
-from pinarms.optim.line.belt import Belt, _number
+from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.numbers import finite_number
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, _check_limits, _constraints, _hand_joints,
-                                         _check_positions, _hermite, _ik_path, _joint_rates, _poses, _timed_move, plan_pick,
+from pinarms.optim.line.tracking import (TRACK_SAMPLES, TrackingSpec, check_rate_limits, move_constraints, hand_joints,
+                                         check_positions, hermite_path, ik_path, joint_rates, tool_poses, timed_move, plan_pick,
                                          rest_configuration, tool_yaw, tracking_points)
 from pinarms.planning import Trajectory
 from pinarms.optim.errors import InfeasibleProblem, OptimError
@@ -58,10 +59,10 @@ class TrayBelt:
     def __post_init__(self) -> None:
         if not isinstance(self.belt, Belt):
             raise InvalidInput(f"belt of the trays must be an optim.line.Belt, got {type(self.belt).__name__}")
-        _number(self.pitch, "tray pitch [m]", positive=True)
-        _number(self.height, "place height above the tray belt [m]")
-        _number(self.phase, "tray phase [m]")
-        if abs(_number(self.w, "place point across the tray belt [m]")) > self.belt.width / 2.0:
+        finite_number(self.pitch, "tray pitch [m]", positive=True)
+        finite_number(self.height, "place height above the tray belt [m]")
+        finite_number(self.phase, "tray phase [m]")
+        if abs(finite_number(self.w, "place point across the tray belt [m]")) > self.belt.width / 2.0:
             raise InvalidInput(f"place point w = {self.w} m lies off the tray belt (width {self.belt.width} m)")
         if not (isinstance(self.capacity, int) and not isinstance(self.capacity, bool) and self.capacity >= 1):
             raise InvalidInput(f"tray capacity must be an integer >= 1, got {self.capacity!r}")
@@ -130,14 +131,14 @@ def _timed_transfer(station: Station, q0, qd0, q1, qd1, mass: float, grid: int) 
     from pinarms.optim.topp.path_timing import time_optimal
 
     chord = q1 - q0
-    arm = ~_hand_joints(station.robot)
+    arm = ~hand_joints(station.robot)
     if not np.any(arm):
         arm = np.ones(chord.size, bool)
     L = max(float(np.linalg.norm(chord[arm])), 1e-9)
     k0 = L / max(float(np.linalg.norm(qd0[arm])), 1e-12)
     k1 = L / max(float(np.linalg.norm(qd1[arm])), 1e-12)
-    path = _hermite(q0, k0 * qd0, q1, k1 * qd1, station.robot)
-    return time_optimal(path, _constraints(station, mass), grid=grid, start_speed=1.0 / k0, end_speed=1.0 / k1)
+    path = hermite_path(q0, k0 * qd0, q1, k1 * qd1, station.robot)
+    return time_optimal(path, move_constraints(station, mass), grid=grid, start_speed=1.0 / k0, end_speed=1.0 / k1)
 
 
 #: Hand turns whose travel pick → place → home is within this of the shortest [rad] are all planned
@@ -158,7 +159,7 @@ def _hand_turns(station: Station, q: np.ndarray, q_ref: np.ndarray, q_home: np.n
     other joints: the caller plans each and keeps the faster, so the time has no jump there."""
     robot = station.robot
     options = [q.copy()]
-    for h in np.flatnonzero(_hand_joints(robot)):
+    for h in np.flatnonzero(hand_joints(robot)):
         path, ranked = np.unwrap(q[:, h]), []
         for turns in range(-3, 4):
             p = path + 2.0 * np.pi * turns
@@ -183,15 +184,15 @@ def _segments(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: flo
     """The tracking segment on ``belt`` on each hand turn of :func:`_hand_turns`: (trajectory, joint
     velocities at its start and end) each; the turns beyond a joint's rates are left out."""
     tau = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
-    q = _ik_path(station, _poses(station, tracking_points(belt, spec, u, w, z, tau), yaw), q_ref, branch)
+    q = ik_path(station, tool_poses(station, tracking_points(belt, spec, u, w, z, tau), yaw), q_ref, branch)
     out, error = [], None
     for qq in _hand_turns(station, q, q_ref, np.asarray(q_home, float)):
-        qd_in = _joint_rates(station, qq[0], belt.velocity)
-        qd_out = _joint_rates(station, qq[-1], belt.velocity)
+        qd_in = joint_rates(station, qq[0], belt.velocity)
+        qd_out = joint_rates(station, qq[-1], belt.velocity)
         spline = CubicSpline(tau, qq, axis=0, bc_type=((1, qd_in), (1, qd_out)))
         traj = Trajectory(tau, np.ascontiguousarray(spline.c[::-1].transpose(1, 0, 2)))
         try:
-            _check_limits(station, traj, what, spec, belt.speed)
+            check_rate_limits(station, traj, what, spec, belt.speed)
         except InfeasibleProblem as exc:
             error = exc
             continue
@@ -231,10 +232,10 @@ def plan_pick_to_tray(station: Station, belt: Belt, trays: TrayBelt, spec: Track
             transfer = _timed_transfer(station, q_end, qd_end, place.sample(np.array([0.0]))[0][0], qd_in, mass,
                                        spec.grid)
             q_last = place.sample(np.array([place.end_time]))[0][0]
-            ret = _timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
+            ret = timed_move(station, q_last, qd_out, q_rest, np.zeros(station.robot.nq), 0.0, spec.grid)
             for piece, what in ((place, "place tracking segment"), (transfer.trajectory, "transfer to the tray"),
                                 (ret.trajectory, "return from the tray")):
-                _check_positions(station, piece, what)
+                check_positions(station, piece, what)
         except (InfeasibleProblem, OptimError) as exc:
             error = exc
             continue

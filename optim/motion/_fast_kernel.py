@@ -2,7 +2,7 @@
 
 A state is the planned arms' joint vector ``x``; the cell configuration is ``hold`` with
 ``x`` written at ``cols``. ``E(x)`` is the cover's lower bound of the excess
-(:func:`pinarms.robots.cell._cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b`` is
+(:func:`pinarms.robots.cell.cover_kernel.excess_one`), capped at ``cap``. An edge ``x_a → x_b`` is
 proven on the *scaled* excess ``Ẽ(x) = min_k ê_k(x) / w_g`` (:func:`excess_scaled`): ``w_g``
 bounds how much the distance of the pairs of group ``g`` (two links, or a link and a
 fixture) changes along the whole edge (``Σ_j |Δx_j| λ_{g,j}``, at most the whole-arm travel
@@ -28,12 +28,12 @@ from pathlib import Path
 import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
-from pinarms.robots.cell import _box_kernel, _cover_kernel, ladder
-from pinarms.robots.cell._cover_kernel import excess_placed, place_moving
+from pinarms.robots.cell import box_kernel, cover_kernel, ladder
+from pinarms.robots.cell.cover_kernel import excess_placed, place_moving
 from pinarms.robots.cell.ladder import interval_proven
 
 # these kernels call the cover's and the ladder's rule: their changes must compile them again (pinarms.compiled)
-drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
+drop_stale_caches([Path(box_kernel.__file__), Path(cover_kernel.__file__), Path(ladder.__file__), Path(__file__)],
                   "fast_kernels.sha256")
 
 #: Most intervals waiting in one edge proof (more: the edge counts as not proven).

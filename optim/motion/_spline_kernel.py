@@ -22,11 +22,11 @@ import numpy as np
 from pinarms.compiled import drop_stale_caches, jit
 from pinarms.optim.motion import _fast_kernel
 from pinarms.optim.motion._fast_kernel import state_scaled
-from pinarms.robots.cell import _box_kernel, _cover_kernel, ladder
+from pinarms.robots.cell import box_kernel, cover_kernel, ladder
 from pinarms.robots.cell.ladder import interval_proven
 
 # these kernels call the search's state check, the cover's kernels and the ladder's rule (pinarms.compiled)
-drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(ladder.__file__),
+drop_stale_caches([Path(box_kernel.__file__), Path(cover_kernel.__file__), Path(ladder.__file__),
                    Path(_fast_kernel.__file__), Path(__file__)],
                   "spline_kernels.sha256")
 

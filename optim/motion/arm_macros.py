@@ -55,7 +55,7 @@ def arm_macro_text(name: str) -> str:
     if name not in MACRO_ARMS:
         raise RobotNotFound(f"no macro for {name!r}; example arms with a macro: {', '.join(MACRO_ARMS)}")
     entry = registry.info(name)
-    share = registry._example_robot_data_share()
+    share = registry.example_robot_data_share()
     path = share / "robots" / _SOURCE.get(name, entry.urdf_relpath)
     root = ET.parse(path).getroot()
     strip = _STRIP.get(name, "")
@@ -124,4 +124,4 @@ def _macro_dir() -> Path:
 
 def example_packages() -> dict[str, Path]:
     """``{"pinarms_examples": folder of the generated macros, "example-robot-data": its share folder}``."""
-    return {PACKAGE: _macro_dir(), "example-robot-data": registry._example_robot_data_share()}
+    return {PACKAGE: _macro_dir(), "example-robot-data": registry.example_robot_data_share()}

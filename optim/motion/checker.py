@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence, TYPE_CHECKING
+from typing import Any, Callable, Sequence, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -203,6 +203,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
+        self._kept: dict[str, Any] = {}  # what helpers build once per checker (kept)
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -284,7 +285,7 @@ class MotionChecker(CoalBatches, LadderProof):
             return True
         self.counts["coal"] += 1
         self.counts["coal_pairs"] += len(self.pairs)
-        return not pin.computeCollisions(self.model, self._data, self._manager, self._to_pin(q[None])[0], True)
+        return not pin.computeCollisions(self.model, self._data, self._manager, self.to_pinocchio(q[None])[0], True)
 
     def excess(self, Q: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Exact smallest ``d_k − margin_k`` over the pairs [m] per row of cell configurations ``Q``,
@@ -306,7 +307,7 @@ class MotionChecker(CoalBatches, LadderProof):
         if mask is not None:
             lb[:, ~np.asarray(mask, dtype=bool)] = np.inf
         order = np.argsort(lb, axis=1, kind="stable")
-        qp = self._to_pin(Q)
+        qp = self.to_pinocchio(Q)
         gm, gd = self.geometry, self._gd_dist
         out = np.full(N, np.inf)
         arg = np.full(N, -1, dtype=int)
@@ -323,6 +324,22 @@ class MotionChecker(CoalBatches, LadderProof):
                     best, k_best, d_best = e, int(k), d
             out[i], arg[i], dist[i] = best, k_best, d_best
         return out, arg, dist
+
+    def kept(self, key: str, build: Callable[[], Any]) -> Any:
+        """``build()``, built on the first call for ``key`` and kept with this checker (the fast check of
+        :func:`pinarms.optim.motion.fast.fast_check`)."""
+        if key not in self._kept:
+            self._kept[key] = build()
+        return self._kept[key]
+
+    def place_geometry(self, qp: np.ndarray) -> None:
+        """Place every collision body at Pinocchio configuration ``qp`` (one row of :meth:`to_pinocchio`) for
+        :meth:`pair_distance`."""
+        pin.updateGeometryPlacements(self.model, self._data, self.geometry, self._gd_dist, qp)
+
+    def pair_distance(self, k: int) -> float:
+        """The exact distance [m] of collision pair ``k`` of :attr:`geometry` where :meth:`place_geometry` last put them."""
+        return float(pin.computeDistance(self.geometry, self._gd_dist, int(k)).min_distance)
 
     def closest(self, x: ArrayLike) -> tuple[float, Any, float]:
         """``(excess [m], pair, distance [m])`` of the pair nearest its margin at state ``x``."""

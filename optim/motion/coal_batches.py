@@ -66,7 +66,7 @@ class CoalBatches:
         if self.timed:
             x = np.column_stack([x, np.zeros(2)])
         Q = self.full(x[0] + np.linspace(0.0, 1.0, 96)[:, None] * (x[1] - x[0]))
-        qp = np.asfortranarray(self._to_pin(Q).T)
+        qp = np.asfortranarray(self.to_pinocchio(Q).T)
         best, choice = np.inf, "broad phase"
         for name in ("broad phase", "pairs"):
             pool = self._make_pool(name, self.pair_margin)
@@ -108,7 +108,7 @@ class CoalBatches:
             self._pool(level)
         _ = self.cover_decides_screens
 
-    def _timed_out(self) -> bool:
+    def timed_out(self) -> bool:
         """Past :attr:`deadline` (a proof then gives up: the edge counts as not valid)."""
         if self.deadline is None or time.perf_counter() <= self.deadline:
             return False
@@ -151,7 +151,8 @@ class CoalBatches:
         :meth:`_calibrate`); ``None`` until the first batch."""
         return self._shared["loop"]
 
-    def _to_pin(self, Q: np.ndarray) -> np.ndarray:
+    def to_pinocchio(self, Q: np.ndarray) -> np.ndarray:
+        """Cell configurations ``Q`` (N, nq) as Pinocchio configuration vectors (the same array where they coincide)."""
         return Q if self._identity else self.cell.robot.q_to_pinocchio(Q)
 
 
@@ -220,7 +221,7 @@ class CoalBatches:
         self.counts["coal"] += 1
         self.counts["coal_pairs"] += int(want.size)
         gm, gd = self.geometry, self._gd
-        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self._to_pin(q[None])[0])
+        pin.updateGeometryPlacements(self.model, self._data, gm, gd, self.to_pinocchio(q[None])[0])
         return any(pin.computeCollision(gm, gd, k) for k in want.tolist())
 
     def pair_collides(self, Q: np.ndarray, which: str | int = "margin", stop: bool = False) -> np.ndarray:
@@ -235,7 +236,7 @@ class CoalBatches:
         chunked = stop or self.deadline is not None
         a, chunk = 0, (1 if stop else COAL_CHUNK) if chunked else max(N, 1)
         while a < N:
-            if self.deadline is not None and self._timed_out():
+            if self.deadline is not None and self.timed_out():
                 raise GiveUp
             a0 = a
             want = self.open_pairs(Q[a0:a0 + chunk], which)
@@ -264,7 +265,7 @@ class CoalBatches:
             return out
         self.counts["coal"] += N
         self.counts["coal_pairs"] += int(want.sum())
-        qp = np.asfortranarray(self._to_pin(Q).T)
+        qp = np.asfortranarray(self.to_pinocchio(Q).T)
         pool = self._pair_pool(which)
         datas = pool.getGeometryDatas()
         t = self._thresholds(which).tolist()
@@ -315,14 +316,14 @@ class CoalBatches:
         self.counts["coal_pairs"] += Q.shape[0] * len(self.pairs)
         if Q.shape[0] == 0:
             return np.zeros(0, dtype=bool)
-        qp = np.asfortranarray(self._to_pin(Q).T)
+        qp = np.asfortranarray(self.to_pinocchio(Q).T)
         pool = self._pool(which)
         if self.deadline is None:
             hit = pin.computeCollisionsInParallel(self.threads, pool, qp, True, bool(stop))
             return np.asarray(hit, dtype=bool).reshape(-1)
         out = np.zeros(Q.shape[0], dtype=bool)
         for a in range(0, Q.shape[0], COAL_CHUNK):  # under a deadline: in chunks, looking at the clock
-            if self._timed_out():
+            if self.timed_out():
                 raise GiveUp
             chunk = np.asfortranarray(qp[:, a:a + COAL_CHUNK])
             hit = np.asarray(pin.computeCollisionsInParallel(self.threads, pool, chunk, True, bool(stop)),

@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike
 from pinarms.optim.motion import _fast_kernel as kernel
 from pinarms.optim.motion.link_levers import group_levers
 from pinarms.optim.motion.proof import MAX_SPLITS
-from pinarms.robots.cell._cover_kernel import _place
+from pinarms.robots.cell.cover_kernel import place_world
 from pinarms.robots.cell.cover import motion_pairs, pair_arrays
 from pinarms.optim.motion.search import SearchResult
 
@@ -176,19 +176,18 @@ class FastCheck:
 
 def fast_check(checker: MotionChecker) -> FastCheck | None:
     """The :class:`FastCheck` of ``checker`` (kept with it), or ``None`` when it has none (no cover, moving arms)."""
-    got = getattr(checker, "_fast", False)
-    if got is False:
+    def build() -> FastCheck | None:
         try:
-            got = FastCheck(checker)
+            return FastCheck(checker)
         except ValueError:
-            got = None
-        checker._fast = got
-    return got
+            return None
+
+    return checker.kept("fast_check", build)
 
 
 def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
     """The kernels' scratch arrays placed at ``hold`` once, with what moves with the planned columns ``cols``
-    (:func:`pinarms.robots.cell._cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
+    (:func:`pinarms.robots.cell.cover_kernel.place_moving`): the joints below them, the bounding spheres, cover
     spheres and cylinder axes on those joints. The held arms and the fixtures stay where they were placed."""
     parent, index = cover.fk[0], cover.fk[1]
     planned = set(int(c) for c in cols)
@@ -197,7 +196,7 @@ def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> 
         moves[i] = int(index[i]) in planned or moves[parent[i]]
     work = cover.work(pairs)
     hold = np.ascontiguousarray(hold, dtype=float)
-    _place(hold, cover.fk, cover.joint, cover.center, cover.segments[0], cover.segments[1], cover.segments[2],
+    place_world(hold, cover.fk, cover.joint, cover.center, cover.segments[0], cover.segments[1], cover.segments[2],
            pairs.hjoint, pairs.hcenter, work)
     moving = (np.flatnonzero(moves), np.flatnonzero(moves[pairs.hjoint]), np.flatnonzero(moves[cover.joint]),
               np.flatnonzero(moves[cover.segments[0]]), np.empty((3, 3)))

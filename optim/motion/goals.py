@@ -19,10 +19,10 @@ __all__ = ["closed_form", "GoalCandidate", "describe_pair", "point_in_fixture", 
 @lru_cache(maxsize=1)
 def _families_by_joints() -> dict[tuple[str, ...], str]:
     from pinarms.robots import registry
-    from pinarms.robots.ik import _FAMILY_OF
+    from pinarms.robots.ik import FAMILY_OF
 
     out = {}
-    for name, family in _FAMILY_OF.items():
+    for name, family in FAMILY_OF.items():
         try:
             out[registry.load(name).joint_names] = family
         except Exception:  # an arm whose model cannot load here has no say

@@ -104,7 +104,7 @@ class LadderProof:
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         N = X.shape[0]
-        if self._timed_out():
+        if self.timed_out():
             return Verdict(False, -1, 0.0)
         if not convex:
             inside = self.within_limits(X)
@@ -187,5 +187,5 @@ class _ScreenRungs:
         return lb, -1
 
     def give_up(self) -> bool:
-        """Past the checker's deadline (:meth:`.coal_batches.CoalBatches._timed_out`)."""
-        return self.checker._timed_out()
+        """Past the checker's deadline (:meth:`.coal_batches.CoalBatches.timed_out`)."""
+        return self.checker.timed_out()

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
-import pinocchio as pin
 
 from pinarms.planning import Trajectory
 from pinarms.robots.cell.ladder import interval_bound
@@ -298,14 +297,14 @@ class _Distances:
         if c.timed:
             X = np.column_stack([X, t])
         Q = c.full(X)
-        qp = c._to_pin(Q)
+        qp = c.to_pinocchio(Q)
         N = t.size
         geo = self._bounds(Q)
         env, env_k, own_d = np.full(N, np.inf), np.full(N, -1, dtype=int), np.full(N, np.inf)
         bounds = np.empty((N, self.own.size))
         kinds = (np.flatnonzero(~self.own), np.flatnonzero(self.own))
         for i in range(N):
-            pin.updateGeometryPlacements(c.model, c._data, c.geometry, c._gd_dist, qp[i])
+            c.place_geometry(qp[i])
             self.row += 1
             slack = self.speed * np.abs(t[i] - self.last_t)
             low = np.maximum(geo[i], self.last_low - slack)
@@ -328,7 +327,7 @@ class _Distances:
             if low[r] >= best:
                 break
             k = int(idx[r])
-            d = float(pin.computeDistance(c.geometry, c._gd_dist, k).min_distance)
+            d = c.pair_distance(k)
             self.calls += 1
             self.last_low[k] = self.last_high[k] = d
             self.last_t[k], self.stamp[k] = t, self.row

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pinarms.optim.cycle.spec import _hold, _line_deviation, _vertical_segments
+from pinarms.optim.cycle.vertical import at_rest, line_deviation, vertical_segments
 from pinarms.optim.motion.checker import MotionChecker
 from pinarms.optim.motion.geometry import plan_geometry
 from pinarms.optim.motion.plan import time_path
@@ -179,10 +179,10 @@ def planned_cycle(request: CycleRequest, base: CycleResult, *, arm: CellArm, hol
     (m1, d1), (m2, d2) = move([there[0], transfer, there[1]]), move([back[0], reverse, back[1]])
     pieces, defs = [m1.trajectory, m2.trajectory], [d1, d2]
     if spec.dwell > 0.0:
-        holds = [_hold(q[0], spec.dwell), _hold(q[k - 1], spec.dwell)]
+        holds = [at_rest(q[0], spec.dwell), at_rest(q[k - 1], spec.dwell)]
         pieces = [holds[0], pieces[0], holds[1], pieces[1]]
         defs = [_parts_of(holds[0]), d1, _parts_of(holds[1]), d2]
     trajectory = _joined(pieces, defs)
-    ends = _vertical_segments(spec.poses(robot))
+    ends = vertical_segments(spec.poses(robot))
     return dataclasses.replace(base, moves=(m1, m2), trajectory=trajectory, peaks=trajectory.peaks(),
-                               line_deviation=_line_deviation(robot, (m1, m2), ends))
+                               line_deviation=line_deviation(robot, (m1, m2), ends))

@@ -45,14 +45,14 @@ class Peaked:
         self._coefs = trajectory.coefficients
         self._h = trajectory.segment_durations
         self._normalised = None
-        self._cache: dict[int, np.ndarray] = {}
+        self._peaks_of_order: dict[int, np.ndarray] = {}
 
     def _order(self, r: int) -> np.ndarray:
-        if r not in self._cache:
+        if r not in self._peaks_of_order:
             if self._normalised is None:
                 self._normalised = normalised_pieces(self._coefs, self._h)
-            self._cache[r] = _exact_peaks(self._normalised, self._h, r)
-        return self._cache[r]
+            self._peaks_of_order[r] = _exact_peaks(self._normalised, self._h, r)
+        return self._peaks_of_order[r]
 
     @property
     def velocity(self) -> np.ndarray:

@@ -20,7 +20,7 @@ from pinarms.robots.robot import Robot
 
 __all__ = ["cli", "main", "json_option", "skipped_pair_lines", "package_map", "PinarmsCommand", "name_the_flag", "NUMBERS", "PinarmsGroup", "one_line", "jsonable", "emit", "fmt",
            "show_progress", "progress_bar", "terminal_width", "load_robot", "floats", "si_limit", "vectors_from_args",
-           "joint_scale_at", "new_session", "save_session", "scheduler_option", "quiet_dask"]
+           "joint_scale_at", "new_session", "save_session", "scheduler_option", "scheduler_value", "quiet_dask"]
 
 # numbers may be negative: "-0.5" must reach the command as a value, not as an option
 NUMBERS = {"ignore_unknown_options": True}
@@ -263,7 +263,7 @@ def quiet_dask() -> None:
         logging.getLogger(name).setLevel(logging.CRITICAL)
 
 
-def _scheduler_value(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+def scheduler_value(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
     """Check ``--scheduler`` at once (its form, not the cluster) and quiet Dask when one is used."""
     if value is None or not value.strip() or value.strip() == "serial":
         return None if value is None or not value.strip() else value
@@ -276,7 +276,7 @@ def _scheduler_value(ctx: click.Context, param: click.Parameter, value: str | No
 
 scheduler_option = click.option(
     "--scheduler", default=None, envvar="DASK_SCHEDULER_ADDRESS", show_envvar=True, metavar="ADDRESS",
-    callback=_scheduler_value,
+    callback=scheduler_value,
     help="Run the work on Dask: tcp://HOST:8786 (a running `dask scheduler`), or 'processes' / 'processes:N' "
          "(local worker processes). Default: serially here, or DASK_SCHEDULER_ADDRESS when it is set.")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 from collections import Counter
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
@@ -16,11 +16,16 @@ from pinarms.cli._common import (NUMBERS, PinarmsGroup, cli, emit, floats, json_
                       skipped_pair_lines)
 from pinarms.cli.motion_commands import hold_option
 
+if TYPE_CHECKING:
+    from pinarms.robots.cell import Cell
+
 _ARG_HELP = "A xacro:arg value of CELL (repeatable), e.g. --arg belt_top=0.85."
 _PKG_HELP = "A folder for $(find NAME) and package://NAME/ in CELL (repeatable)."
 
 
-def _load(cell: str, args: tuple[str, ...], packages: tuple[str, ...]):
+def load_cell_option(cell: str, args: tuple[str, ...], packages: tuple[str, ...]) -> Cell:
+    """The cell of a ``CELL`` argument with its ``--xacro-arg`` and ``--package`` options (InvalidInput for a file that
+    is not UTF-8 text)."""
     from pinarms.robots.cell import load_cell
     from pinarms.robots.xacro_expand import parse_xacro_args
 
@@ -78,7 +83,7 @@ def cell_group() -> None:
 @json_option
 def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_json) -> None:
     """The arms, fixtures and collision pairs of CELL."""
-    c = _load(cell, xacro_args, packages)
+    c = load_cell_option(cell, xacro_args, packages)
     k, lu = (1000.0, "mm") if mm else (1.0, "m")
     arms = [{"name": a.name, "model": a.model, "prefix": a.prefix, "joints": list(a.robot.joint_names),
              "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world,
@@ -132,7 +137,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
 @json_option
 def cell_check_cmd(cell, xacro_args, packages, q_values, n_random, seed, margin, as_json) -> None:
     """Collisions and clearance of CELL at given (--q) or random (--random N) configurations."""
-    c = _load(cell, xacro_args, packages)
+    c = load_cell_option(cell, xacro_args, packages)
     if not q_values and n_random <= 0:
         raise click.UsageError("give configurations with --q or a count with --random N")
     data: dict[str, Any] = {"cell": c.name, "joint_names": list(c.joint_names), "margin_m": margin}
@@ -242,7 +247,7 @@ def cell_cycle_cmd(cell, xacro_args, packages, tasks, lift, dwell, clearance, ma
     caps.number_setting(clearance * k, "--clearance", 0.0, caps.MAX_CLEARANCE, unit="m")
     caps.number_setting(margin * k, "--margin", caps.MIN_MARGIN, unit="m")
     caps.number_setting(lift * k, "--lift", 0.0, open_low=True, unit="m")
-    c = _load(cell, xacro_args, packages)
+    c = load_cell_option(cell, xacro_args, packages)
     hold = hold_option(c, holds, tuple(t[0] for t in tasks), False, mm, "it has a --task")
     cycles = {}
     data: dict[str, Any] = {"cell": c.name, "clearance_m": clearance * k, "arms": {}}

@@ -8,61 +8,13 @@ import click
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.units import angle_scale, joints_from_si, joints_to_si, length_scale
+from pinarms.units import joints_from_si, joints_to_si, length_scale
 
-from pinarms.cli._common import (NUMBERS, PinarmsCommand, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
+from pinarms.cli.pose_options import PoseCommand, parse_pose
+from pinarms.cli._common import (NUMBERS, cli, emit, floats, fmt, json_option, load_robot, new_session, save_session,
                       si_limit)
 
-#: Options that take a pose: X Y Z, optionally followed by ROLL PITCH YAW.
-POSE_OPTIONS = ("--from", "--to", "--via")
-
-
-class _PoseCommand(PinarmsCommand):
-    """A command whose pose options take 3 or 6 numbers (``--from X Y Z [R P Y]``).
-
-    Before click parses, the numbers following a pose option are joined into one value
-    (as many as parse as numbers, up to six), so negative numbers and an optional
-    orientation both work.
-    """
-
-    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
-        out: list[str] = []
-        i = 0
-        while i < len(args):
-            token = args[i]
-            out.append(token)
-            i += 1
-            if token in POSE_OPTIONS:
-                numbers = []
-                while i < len(args) and len(numbers) < 6 and _is_number(args[i]):
-                    numbers.append(args[i])
-                    i += 1
-                out.append(" ".join(numbers))
-        return super().parse_args(ctx, out)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _pose(text: str, what: str, mm: bool, deg: bool, orientation: np.ndarray) -> np.ndarray:
-    """'X Y Z [R P Y]' in user units → a tcp → base pose (4, 4) [m]; no R P Y: ``orientation``."""
-    import pinocchio as pin
-
-    values = floats(text.replace(" ", ","), what) if text.strip() else np.zeros(0)
-    if values.size not in (3, 6):
-        raise InvalidInput(f"{what} takes X Y Z or X Y Z ROLL PITCH YAW (3 or 6 numbers), got {values.size}")
-    T = np.eye(4)
-    T[:3, 3] = values[:3] * length_scale(mm)
-    T[:3, :3] = pin.rpy.rpyToMatrix(*(values[3:] * angle_scale(deg))) if values.size == 6 else orientation
-    return T
-
-
-@cli.command("line", cls=_PoseCommand, context_settings=NUMBERS)
+@cli.command("line", cls=PoseCommand, context_settings=NUMBERS)
 @click.argument("robot")
 @click.option("--from", "start", required=True, help="X Y Z [ROLL PITCH YAW] of the start pose (tcp in the base frame).")
 @click.option("--to", "goal", required=True, help="X Y Z [ROLL PITCH YAW] of the end pose.")
@@ -104,8 +56,8 @@ def line_cmd(robot: str, start: str, goal: str, via: tuple[str, ...], blend: flo
     arm = load_robot(robot)
     lu = length_scale(mm)
     R = default_orientation(arm)
-    poses = np.stack([_pose(start, "--from", mm, deg, R), *(_pose(v, "--via", mm, deg, R) for v in via),
-                      _pose(goal, "--to", mm, deg, R)])
+    poses = np.stack([parse_pose(start, "--from", mm, deg, R), *(parse_pose(v, "--via", mm, deg, R) for v in via),
+                      parse_pose(goal, "--to", mm, deg, R)])
     q0 = _q_start(arm, q_start, deg, mm)
     tol = 1e-4 if tolerance is None else tolerance * lu
     stops = range(1, poses.shape[0] - 1) if stop_at_vias else ()

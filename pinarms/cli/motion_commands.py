@@ -18,7 +18,7 @@ from pinarms.units import angle_scale, length_scale
 
 from pinarms.cli._common import NUMBERS, cli, emit, floats, fmt, json_option, save_session, show_progress
 from pinarms.cli._common import package_map
-from pinarms.cli.line_commands import _pose, _PoseCommand
+from pinarms.cli.pose_options import PoseCommand, parse_pose
 
 __all__ = ["load_any_cell", "hold_option"]
 
@@ -79,7 +79,7 @@ def load_any_cell(name: str, packages: dict[str, str] | None = None) -> Any:
     return robots.load_cell(name, packages=packages or None)
 
 
-@cli.command("motion", cls=_PoseCommand, context_settings=NUMBERS)
+@cli.command("motion", cls=PoseCommand, context_settings=NUMBERS)
 @click.argument("cell")
 @click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
               help="A folder for $(find NAME) and package://NAME/ in CELL (repeatable).")
@@ -155,7 +155,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     elif start is not None:
         from pinarms.robots.reach.layout import default_orientation
 
-        T0 = _pose(start, "--from", mm, deg, arm.base_to_world[:3, :3] @ default_orientation(arm.robot))
+        T0 = parse_pose(start, "--from", mm, deg, arm.base_to_world[:3, :3] @ default_orientation(arm.robot))
         checker = MotionChecker(c, [arm.name], margin=margin_m, hold=hold)
         cands, _ = ik_candidates(arm.robot, arm.to_base(T0), arm.hold, seed=seed)
         clear = [q for q in cands if checker.state_valid(q)]
@@ -166,7 +166,7 @@ def motion_cmd(cell: str, packages: tuple[str, ...], arm_name: str | None, goal:
     else:
         q0 = np.array(arm.hold)
     R0 = arm.tcp_to_world(q0)[:3, :3]
-    T = _pose(goal, "--to", mm, deg, R0)
+    T = parse_pose(goal, "--to", mm, deg, R0)
     a = None if amax is None else floats(amax, "--amax")
     options = MotionOptions(margin=margin_m, planner=planner, time_limit=time_limit, seed=seed, goals=goal_choice)
     limits = MotionLimits(amax=None if a is None else (float(a[0]) if a.size == 1 else a), torque=not no_torque)

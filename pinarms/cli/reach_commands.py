@@ -7,7 +7,7 @@ import numpy as np
 
 from pinarms.units import parse_angle, parse_length
 
-from pinarms.cli._common import _scheduler_value, cli, emit, json_option, load_robot, new_session, progress_bar, save_session
+from pinarms.cli._common import cli, emit, json_option, load_robot, new_session, progress_bar, save_session, scheduler_value
 
 
 @cli.command("reach")
@@ -23,7 +23,7 @@ from pinarms.cli._common import _scheduler_value, cli, emit, json_option, load_r
 @click.option("--ik", "ik", default="auto", show_default=True, type=click.Choice(["auto", "analytic", "numerical"]))
 @click.option("--self-collision", is_flag=True, help="Drop IK solutions where the arm hits itself.")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the samples and IK restarts.")
-@click.option("--scheduler", default=None, callback=_scheduler_value,
+@click.option("--scheduler", default=None, callback=scheduler_value,
               help="Where to run the chunks: omit (here, serially), processes[:N] (local Dask workers), "
                    "tcp://HOST:8786 (a Dask cluster) or env (DASK_SCHEDULER_ADDRESS).")
 @click.option("--out", "out_path", default=None, type=click.Path(dir_okay=False),

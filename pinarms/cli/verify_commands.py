@@ -48,13 +48,13 @@ def verify_cell_cmd(cell: str, packages: tuple[str, ...], xacro_args: tuple[str,
     from pinarms.export.verify import compare_configurations_in_mujoco, compare_in_mujoco
 
     from pinarms.cli._common import package_map
-    from pinarms.cli.cell_commands import _load
+    from pinarms.cli.cell_commands import load_cell_option
 
     from pinarms.errors import InvalidInput
 
     if samples < 2:
         raise InvalidInput(f"--samples must be 2 or more, got {samples}")
-    c = _load(cell, xacro_args, packages)
+    c = load_cell_option(cell, xacro_args, packages)
     pkgs = package_map(packages)
     results = [("configurations", compare_configurations_in_mujoco(
         c, c.random_q(samples, seed=seed), label=f"{samples} random configurations (seed {seed})", packages=pkgs))]
@@ -137,11 +137,11 @@ def verify_shipped_cmd(samples: int, no_line: bool, controller_dir: str | None, 
     """
     from pinarms.export import compare_in_mujoco
     from pinarms.export.shipped import shipped_motions
-    from pinarms.export.trajectory import _rate
+    from pinarms.export.trajectory import check_rate
     from pinarms.progress import ProgressBar, wanted
 
     if controller_dir is not None:
-        _rate(rate)  # a bad rate fails before the planning
+        check_rate(rate)  # a bad rate fails before the planning
     with ProgressBar("planning the shipped motions", enabled=wanted(as_json)) as bar:
         motions = shipped_motions(line=not no_line, progress=bar)
     results, written = [], []

@@ -30,12 +30,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, TYPE_CHECKING
 
-from pinarms.files import copy_new_file, path_inside, safe_file_name, write_new_file
+from pinarms.files import copy_new_file, path_inside, publish_folder, safe_file_name, write_new_file
 from pinarms.errors import InvalidInput
 
 from pinarms.export.mesh_convert import binary_stl
 from pinarms.export.mesh_sources import MAX_COPY_BYTES, MeshFolders, mesh_source
-from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
+from pinarms.export.urdf_files import check_export_folder, compile_mjcf, write_urdf_folder
 from pinarms.export.srdf import geometry_links, home_notes, srdf_text
 
 if TYPE_CHECKING:
@@ -211,14 +211,14 @@ def export_cell(cell_or_name: Cell | str | os.PathLike, out_dir: str | os.PathLi
         ModelError: MuJoCo is missing or refuses the model.
     """
     cell = _load(cell_or_name, packages)
-    out = _check_folder(out_dir, overwrite)
+    out = check_export_folder(out_dir, overwrite)
     result: dict[str, ExportedCell] = {}
     folders = cell_folders(cell, packages)
 
     def fill(tmp: Path) -> None:
         result["cell"] = _write_cell(cell, tmp, srdf=srdf, mjcf=mjcf, states=states, folders=folders)
 
-    _publish(out, fill)
+    publish_folder(out, fill)
     r = result["cell"]
     move = lambda p: None if p is None else out / p.name  # noqa: E731
     return ExportedCell(out, out / r.urdf.name, move(r.srdf), move(r.mjcf), r.meshes, r.sites, r.geometry_links,
@@ -237,7 +237,7 @@ def export_robot_with_srdf(robot: Robot, out_dir: str | os.PathLike, *, overwrit
                            states: Mapping[str, ArrayLike] | None = None,
                            packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedCell:
     """One arm as a folder with its URDF (one collision per link) and SRDF (one-arm cell rules)."""
-    out = _check_folder(out_dir, overwrite)
+    out = check_export_folder(out_dir, overwrite)
     result: dict[str, ExportedCell] = {}
 
     def fill(tmp: Path) -> None:
@@ -251,6 +251,6 @@ def export_robot_with_srdf(robot: Robot, out_dir: str | os.PathLike, *, overwrit
         (tmp / "out").rmdir()
         shutil.rmtree(staged.folder)
 
-    _publish(out, fill)
+    publish_folder(out, fill)
     r = result["cell"]
     return ExportedCell(out, out / r.urdf.name, out / r.srdf.name, None, r.meshes, (), r.geometry_links, r.notes)

@@ -22,7 +22,7 @@ from pinarms.files import publish_folder
 from pinarms.robots.delta import DeltaRobot, closures_to_xml, load_delta
 from pinarms.errors import InvalidInput, ModelError
 
-from pinarms.export.urdf_files import _check_folder
+from pinarms.export.urdf_files import check_export_folder
 
 __all__ = ["ExportedDelta", "delta_mjcf_text", "export_delta", "closure_site"]
 
@@ -113,7 +113,7 @@ def export_delta(delta_or_name: DeltaRobot | str, out_dir: str | os.PathLike, *,
     delta = load_delta(delta_or_name) if isinstance(delta_or_name, str) else delta_or_name
     if not isinstance(delta, DeltaRobot):
         raise InvalidInput(f"export_delta takes a DeltaRobot or a shipped delta's name, got {delta_or_name!r}")
-    out = _check_folder(out_dir, overwrite)
+    out = check_export_folder(out_dir, overwrite)
     mjcf = delta_mjcf_text(delta)
     names = {"urdf": f"{delta.name}.urdf", "closures": f"{delta.name}.closures.xml", "mjcf": f"{delta.name}.xml"}
 

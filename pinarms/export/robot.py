@@ -26,12 +26,12 @@ from pathlib import Path
 from typing import Mapping
 
 from pinarms import robots
-from pinarms.files import safe_file_name
+from pinarms.files import publish_folder, safe_file_name
 from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.robot import Robot
 
 from pinarms.export.cell import export_robot_with_srdf
-from pinarms.export.urdf_files import _check_folder, _publish, compile_mjcf, write_urdf_folder
+from pinarms.export.urdf_files import check_export_folder, compile_mjcf, write_urdf_folder
 from pinarms.export.urdf_files import SITE_SIZE_M, ExportedURDF, mesh_references  # noqa: F401  (public names of this module)
 
 __all__ = ["ExportedURDF", "ExportedMJCF", "export_urdf", "export_mjcf", "mesh_references"]
@@ -138,7 +138,7 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
     robot = robots.load(robot_or_name) if isinstance(robot_or_name, str) else robot_or_name
     if not isinstance(robot, Robot):
         raise InvalidInput(f"export_mjcf takes a robots.Robot or a robot name, got {robot_or_name!r}")
-    out = _check_folder(out_dir, overwrite)
+    out = check_export_folder(out_dir, overwrite)
     links = {link.get("name") for link in ET.fromstring(robot.urdf_text).iter("link")}
     if sites is None:
         sites = tuple(dict.fromkeys(f for f in ("flange", robot.tcp_frame) if f in links))
@@ -153,5 +153,5 @@ def export_mjcf(robot_or_name: Robot | str, out_dir: str | os.PathLike, *, sites
         written["meshes"] = compile_mjcf(mujoco, staged.urdf, staged.meshes, tmp / name, sites, f"robot '{robot.name}'")
         shutil.rmtree(staged.folder)
 
-    _publish(out, fill)
+    publish_folder(out, fill)
     return ExportedMJCF(folder=out, mjcf=out / name, sites=tuple(sites), meshes=written["meshes"])

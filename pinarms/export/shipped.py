@@ -81,7 +81,7 @@ def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Callabl
     ``progress(done, total)`` is called after each motion is planned.
     """
     from pinarms import optim
-    from pinarms.studies.seed001_motion import _planned_move_001
+    from pinarms.optim.motion.crate_guard import crate_guard_move
     from pinarms.robots.cell import load_cell
 
     total = 5 if line else 2
@@ -94,7 +94,7 @@ def shipped_motions(*, line: bool = True, n_offsets: int = 24, progress: Callabl
     station = load_cell("aubo_food_station")
     out.append(ShippedMotion("station_cycle", station, _station_cycle(station), arm="aubo"))
     step()
-    plan = _planned_move_001()[1]["plan"]
+    plan = crate_guard_move().plan
     out.append(ShippedMotion("crate_guard_move", plan.cell, plan))
     step()
     if line:

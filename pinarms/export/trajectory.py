@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from pinarms.robots.robot import Robot
 
 __all__ = ["ControllerTrajectory", "controller_trajectory", "write_trajectory_yaml", "write_trajectory_csv",
-           "line_arm_sampler", "check_joint_names", "ROS_NAME"]
+           "line_arm_sampler", "check_joint_names", "check_rate", "ROS_NAME"]
 
 #: Most points one file may hold.
 MAX_POINTS = 2_000_000
@@ -83,7 +83,12 @@ class ControllerTrajectory:
         return self.time_ns.astype(float) * 1e-9
 
 
-def _rate(rate: Any) -> float:
+def check_rate(rate: float) -> float:
+    """``rate`` [Hz] as a float, checked before anything is planned or sampled.
+
+    Raises:
+        InvalidRate: not a finite number > 0 (a bool counts as no number).
+    """
     if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
         raise InvalidRate(f"rate must be a number of samples per second (Hz), got {rate!r}")
     value = float(rate)
@@ -187,7 +192,7 @@ def controller_trajectory(source: Trajectory | CycleResult | MotionPlan | LineSc
         InvalidRate: rate ≤ 0, NaN or infinite. JointMismatch: a trajectory for other joints.
         LimitViolation: a sample outside the joint limits. InvalidInput: anything else missing.
     """
-    hz = _rate(rate)
+    hz = check_rate(rate)
     names, (lower, upper, vmax), start, end, sample = _source(source, robot, arm, cycles)
     duration_ns = int(math.floor((end - start) * 1e9))  # the last instant never after the end
     step_ns = 1e9 / hz

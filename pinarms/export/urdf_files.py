@@ -12,7 +12,7 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
-from typing import Callable, Mapping
+from typing import Mapping
 
 from pinarms.files import copy_new_file, output_folder, path_inside, publish_folder, safe_file_name, write_new_file
 from pinarms.errors import InvalidInput, ModelError
@@ -22,7 +22,7 @@ from pinarms.export.errors import ExportError, MeshNotAllowed
 from pinarms.export.mesh_convert import mujoco_conversions
 from pinarms.export.mesh_sources import MAX_COPY_BYTES, MeshFolders, MeshSource, collada_textures, mesh_source
 
-__all__ = ["ExportedURDF", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
+__all__ = ["ExportedURDF", "check_export_folder", "mesh_references", "write_urdf_folder", "compile_mjcf", "robot_folders", "plan_copies",
            "copy_files", "SITE_SIZE_M"]
 
 #: Radius of the exported sites [m] (they are markers: no mass, no collision).
@@ -130,8 +130,13 @@ def _rewrite_filenames(urdf_text: str, mapping: dict[str, str], *, complete: boo
     return text
 
 
-def _check_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
-    """The real export folder of ``out_dir`` (a link to a folder: that folder), refused when not empty."""
+def check_export_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
+    """The real export folder of ``out_dir`` (a link to a folder: that folder), refused when not empty
+    unless ``overwrite`` (every export writes its files through :func:`pinarms.files.publish_folder` into it).
+
+    Raises:
+        InvalidInput: the folder holds files and ``overwrite`` is False.
+    """
     out = output_folder(out_dir)
     if out.is_dir() and any(out.iterdir()) and not overwrite:
         raise InvalidInput(f"export folder {str(out_dir)!r} is not empty; choose another folder or pass "
@@ -139,15 +144,10 @@ def _check_folder(out_dir: str | os.PathLike, overwrite: bool) -> Path:
     return out
 
 
-def _publish(out: Path, fill: Callable[[Path], None]) -> None:
-    """Fill a temporary sibling folder with ``fill(tmp)``, then rename it to ``out`` (:func:`pinarms.files.publish_folder`)."""
-    publish_folder(out, fill)
-
-
 def write_urdf_folder(robot: Robot, out_dir: str | os.PathLike, overwrite: bool = False,
                       packages: Mapping[str, str | os.PathLike] | None = None) -> ExportedURDF:
     """The URDF folder of :func:`pinarms.export.export_urdf` without an SRDF (``robot`` already loaded)."""
-    out = _check_folder(out_dir, overwrite)
+    out = check_export_folder(out_dir, overwrite)
     mapping, copies = plan_copies(mesh_references(robot.urdf_text), robot_folders(robot, packages))
     text = _rewrite_filenames(robot.urdf_text, mapping, complete=True)
     urdf_name = f"{safe_file_name(robot.name, 'robot')}.urdf"
@@ -156,7 +156,7 @@ def write_urdf_folder(robot: Robot, out_dir: str | os.PathLike, overwrite: bool 
         write_new_file(tmp, urdf_name, text.encode("utf-8"))
         copy_files(tmp, copies)
 
-    _publish(out, fill)
+    publish_folder(out, fill)
     return ExportedURDF(folder=out, urdf=out / urdf_name, meshes=tuple(sorted(copies)))
 
 

@@ -43,16 +43,16 @@ def handoff_motions() -> list:
     """The shipped motions in :func:`~pinarms.export.shipped.shipped_motions`'s order (station
     cycle, crate-guard move, the line's left and right cycles, the line schedule), taking what the
     cell study kept (:mod:`~pinarms.studies.handoff_plans`) and planning the rest; the crate-guard
-    move is seed 001's (:func:`~pinarms.studies.seed001_motion._planned_move_001`, planned once per
+    move is seed 001's (:func:`~pinarms.optim.motion.crate_guard.crate_guard_move`, planned once per
     process)."""
     from pinarms.export.shipped import ShippedMotion, shipped_motions
     from pinarms.studies.handoff_plans import KEPT_NAMES, kept
-    from pinarms.studies.seed001_motion import _planned_move_001
+    from pinarms.optim.motion.crate_guard import crate_guard_move
 
     plans = kept()
     if not all(k in plans for k in KEPT_NAMES):
         return shipped_motions(line=True)
-    plan = _planned_move_001()[1]["plan"]
+    plan = crate_guard_move().plan
     line, cycles = plans["line"], plans["line_cycles"]
     out = [ShippedMotion("station_cycle", plans["station"], plans["station_cycle"], arm="aubo"),
            ShippedMotion("crate_guard_move", plan.cell, plan)]

@@ -6,7 +6,7 @@ specifications :func:`pinarms.export.shipped.shipped_motions` uses; it hands the
 (:func:`remember`), and the hand-off study, which runs after it in the demo, takes them
 (:func:`pinarms.studies.handoff.handoff_motions`) instead of planning them again (about 25 s).
 This module imports nothing of the project above its errors (the cell study imports it). The crate-guard move is
-seed 001's planned move (:func:`pinarms.studies.seed001_motion._planned_move_001`, planned once
+seed 001's planned move (:func:`pinarms.optim.motion.crate_guard.crate_guard_move`, planned once
 per process). When the cell study has not run, everything is planned as before, so the hand-off
 study alone gives the same motions and the same figures.
 """

@@ -26,7 +26,7 @@ import numpy as np
 from pinarms import robots
 from pinarms.optim.line import (Belt, ItemType, LineSpec, PlaceBox, Rule, Station, Stream, TaskMap, TrackingSpec,
                                 base_pose, build_task_map, map_error, run_line)
-from pinarms.optim.line.api import _shape_key, build_maps
+from pinarms.optim.line.api import build_maps, station_shape_key
 from pinarms.optim.line.tracking import PLAN_VERSION
 
 __all__ = ["ENOKI", "FLOWER", "PAPER_J1_DEG_S", "scara_line", "gantry_line", "maps_for", "arms_needed",
@@ -69,7 +69,7 @@ def gantry_line(rate: float, *, kind: str = "poisson", speed: float = 0.3, seeds
 
 
 def _digest(spec: LineSpec, station: Station, kind: ItemType) -> str:
-    key = (_shape_key(station, spec.belt), spec.belt.speed, kind.mass, kind.size, spec.tracking, spec.map_grid,
+    key = (station_shape_key(station, spec.belt), spec.belt.speed, kind.mass, kind.size, spec.tracking, spec.map_grid,
            spec.belt.width, PLAN_VERSION)
     return hashlib.sha256(repr(key).encode()).hexdigest()[:16]
 

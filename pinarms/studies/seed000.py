@@ -10,7 +10,7 @@ from pinarms import robots
 from pinarms.papers import SEED000
 from pinarms.report import Row
 
-from pinarms.studies.study import DEG, Study, _plots, _session
+from pinarms.studies.study import DEG, Study, trajectory_plots, study_session
 
 __all__ = ["study_000"]
 
@@ -60,7 +60,7 @@ def study_000(quick: bool = False) -> Study:
     rows.append(Row("000", "total time reduced by", paper.reduction_percent, reduction, "%", 1.0,
                     "" if abs(reduction - paper.reduction_percent) <= 1.0 else "follows from the totals above"))
 
-    session = _session(arm, "seed 000: SCARA 3-5-3 time-optimal (joint 1)")
+    session = study_session(arm, "seed 000: SCARA 3-5-3 time-optimal (joint 1)")
     # joints 2-4 held still for the animation (the paper studies joint 1 only)
     hold = np.clip(np.array([0.0, 60.0 * DEG, 0.05, 0.0]), arm.lower, arm.upper)
     q_via = np.tile(hold, (4, 1))
@@ -84,7 +84,7 @@ def study_000(quick: bool = False) -> Study:
     session.add_history("ga_time", ga.history)
     _add_line_objects(session, arm.position(q_via[0]), arm.position(q_via[-1]))
     # the paper draws its joint curves in degrees: so do ours (joint 1 is revolute)
-    plots = _plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised",
+    plots = trajectory_plots(ga.trajectory, planning.JointLimits(vmax), ga.history, "seed 000: joint 1, 3-5-3 optimised",
                    degrees=True, joint_names=[arm.joint_names[0]], joint_units=[arm.joint_units[0]])
     return Study("000", "SCARA enoki-mushroom packer: 3-5-3 + GA timing", rows, session, plots)
 

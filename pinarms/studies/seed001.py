@@ -11,15 +11,15 @@ from pinarms.papers import SEED001
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from pinarms.studies.seed001_dynamics import _dynamics_001, _tool_down_band
+from pinarms.studies.seed001_dynamics import dynamics_001, tool_down_band_001
 from pinarms.studies.seed001_motion import (
-    _layout_search_001,
-    _planned_move_001,
-    _straight_lines_001,
-    _tool_speed_plot,
-    _unwrap_rows,
+    layout_search_001,
+    planned_move_001,
+    straight_lines_001,
+    tool_speed_plot,
+    unwrap_rows,
 )
-from pinarms.studies.study import MM, Study, _plots, _session, _workspace_plots
+from pinarms.studies.study import MM, Study, study_session, trajectory_plots, workspace_plots
 
 __all__ = ["study_001"]
 
@@ -32,41 +32,41 @@ def study_001(quick: bool = False) -> Study:
     paper = SEED001
     table2 = paper.table2_joints
     rows, ws = _workspace_rows_001(arm, quick)
-    layout_rows, layout = _layout_search_001(arm)
+    layout_rows, layout = layout_search_001(arm)
     rows.extend(layout_rows)
 
     times = np.array(paper.via_times_s)
     traj = planning.multi_quintic(times, table2)
     rows.extend(_table3_rows_001(traj))
     rows.append(_time_optimal_row_001(arm, table2, times))
-    dyn_rows, dyn_plots = _dynamics_001(arm, table2, quick)
+    dyn_rows, dyn_plots = dynamics_001(arm, table2, quick)
     rows.extend(dyn_rows)
     rows.extend(_polynomial_rows_001(table2, times))
-    line_rows, lines = _straight_lines_001(arm, table2, times)
+    line_rows, lines = straight_lines_001(arm, table2, times)
     rows.extend(line_rows)
     fk_mm = conv.aubo_fk_mdh(table2[:2])[:, :3, 3] / MM
     for name, xyz, p in zip(("P1", "P2"), fk_mm, paper.table2_p1_p2_mm):
         rows.append(Row("001", f"Table 2 {name} Cartesian from its joints (paper MDH)", p, tuple(np.round(xyz, 1)),
                         "mm", 1.0, "paper's D-H frame: x, y negated (180° base yaw) and ~21 mm off; z agrees"))
 
-    reach_rows, reach_map, reach_plot = _tool_down_band(arm, quick)
+    reach_rows, reach_map, reach_plot = tool_down_band_001(arm, quick)
     rows.extend(reach_rows)
-    planned_rows, planned = _planned_move_001()
+    planned_rows, planned = planned_move_001()
     rows.extend(planned_rows)
 
-    session = _session(arm, "seed 001: AUBO-i3 workspace and 3-segment quintic")
+    session = study_session(arm, "seed 001: AUBO-i3 workspace and 3-segment quintic")
     q_robot = conv.aubo_mdh_to_joint(table2)
-    robot_traj = planning.multi_quintic(times, _unwrap_rows(q_robot))
+    robot_traj = planning.multi_quintic(times, unwrap_rows(q_robot))
     session.add_trajectory("P1-P4_multi_quintic", robot_traj)
     session.add_workspace("workspace_flange", ws)
-    session.add_points("P1-P4_via", arm.position(_unwrap_rows(q_robot)), kind="via")
+    session.add_points("P1-P4_via", arm.position(unwrap_rows(q_robot)), kind="via")
     for name, timing in lines.items():
         session.add_trajectory(name, timing.trajectory, hz=1000.0)
     limits = planning.JointLimits(arm.velocity_limit)
-    plots = _plots(traj, limits, None, "seed 001: 3-segment quintic (paper angles)", robot=arm)
+    plots = trajectory_plots(traj, limits, None, "seed 001: 3-segment quintic (paper angles)", robot=arm)
     lift = lines["P1-P2_straight"]
-    plots["lift_tool_speed"] = lambda path: _tool_speed_plot(path, lift, "seed 001: straight P1→P2 lift, quintic law at 210 °/s")
-    plots.update(_workspace_plots(ws, "seed 001: AUBO-i3 workspace (flange)"))
+    plots["lift_tool_speed"] = lambda path: tool_speed_plot(path, lift, "seed 001: straight P1→P2 lift, quintic law at 210 °/s")
+    plots.update(workspace_plots(ws, "seed 001: AUBO-i3 workspace (flange)"))
     plots.update(dyn_plots)
     session.add_reachability("tool down 15 deg", reach_map)
     plots["reach_tool_down"] = reach_plot

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -14,7 +14,10 @@ from pinarms.robots import conventions as conv
 
 from pinarms.studies.study import DEG, MM
 
-__all__ = ["AUBO_PAYLOADS_KG"]
+if TYPE_CHECKING:
+    from pinarms.robots import Robot
+
+__all__ = ["AUBO_PAYLOADS_KG", "dynamics_001", "tool_down_band_001"]
 
 
 #: Payloads of the AUBO-i3 rows [kg]: empty gripper, half and full rated payload (3 kg, AUBO's datasheet).
@@ -25,7 +28,7 @@ AUBO_PAYLOADS_KG = (0.0, 1.5, 3.0)
 AUBO_PICK_M, AUBO_PLACE_M = (0.45, -0.10, 0.02), (-0.10, 0.45, 0.02)
 
 
-def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row], dict[str, Callable[[Path], Any]]]:
+def dynamics_001(arm: Robot, table2: np.ndarray, quick: bool) -> tuple[list[Row], dict[str, Callable[[Path], Any]]]:
     """Seed 001 under joint torque limits: P1→P4 and a pick-and-place with 0, 1.5 and 3 kg.
 
     The paper's joints are converted to the manufacturer's convention (robots.conventions;
@@ -90,7 +93,7 @@ def _dynamics_001(arm: Any, table2: np.ndarray, quick: bool) -> tuple[list[Row],
     return rows, {"torques": write}
 
 
-def _tool_down_band(arm: Any, quick: bool) -> tuple[list[Row], Any, Callable[[Path], Any]]:
+def tool_down_band_001(arm: Robot, quick: bool) -> tuple[list[Row], Any, Callable[[Path], Any]]:
     """The paper's table band (z > 0, 200 mm < r < 500 mm around its sphere centre) over the
     tool-down reachability map of the tcp (15° cone, roll free; coarse voxels to stay fast).
 

@@ -3,9 +3,8 @@ layout search, straight-line moves (:func:`pinarms.studies.seed001.study_001` ca
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -13,74 +12,50 @@ from pinarms.papers import SEED001
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from pinarms.studies.study import MM, _segment_distance
+from pinarms.optim.cycle.vertical import segment_distance
+from pinarms.studies.study import MM
+
+if TYPE_CHECKING:
+    from pinarms.optim.layout.result import LayoutSearch
+    from pinarms.optim.topp.path_timing import PathTiming
+    from pinarms.robots import Robot
+
+__all__ = ["planned_move_001", "layout_search_001", "straight_lines_001", "tool_speed_plot", "unwrap_rows"]
 
 
-#: Seeds of the planned move's searches (the fastest move is kept).
-SEEDS = tuple(range(8))
+def planned_move_001() -> tuple[list[Row], dict[str, Any]]:
+    """The rows of the planned move in the AUBO-i3 food station with a crate under a guard, and what the
+    study draws (``trajectory``, ``boxes`` in the arm's base frame, the ``plan``).
 
-
-@functools.cache  # planned once per process: the hand-off study replays the same plan
-def _planned_move_001() -> tuple[list[Row], dict[str, Any]]:
-    """One planned move in the AUBO-i3 food station with a crate under a guard (optim.plan_motion).
-
-    From the food table to the crate's far half, under the guard plate: RRT-Connect (the
-    compiled search on the proven cover, OMPL where it finds nothing), every edge proven to
-    keep 10 mm, shortcut, spline proven again, time-optimal under the URDF's joint speed and
-    torque limits; every clear IK branch of the goal pose searched (``goals="best"``) and the
-    path with the shortest time bound kept. RRT-Connect's paths vary a lot with the seed (a line is planned once, offline):
-    :data:`SEEDS` seeded searches, the fastest move kept (ties: the lowest seed); the row's note
-    gives the median over them. Beside it the unobstructed move: the
-    straight joint-space move between the same configurations, timed the same way (it runs
-    through the cell: the row names the pair it hits).
+    The move is :func:`pinarms.optim.motion.crate_guard.crate_guard_move` (planned once per process):
+    RRT-Connect (the compiled search on the proven cover, OMPL where it finds nothing), every edge
+    proven to keep 10 mm, shortcut, spline proven again, time-optimal under the URDF's joint speed and
+    torque limits; every clear IK branch of the goal pose searched and the fastest of
+    :data:`~pinarms.optim.motion.crate_guard.SEEDS` seeded searches kept; the row's note gives the
+    median over them. Beside it the unobstructed move: the straight joint-space move between the same
+    configurations, timed the same way (it runs through the cell: the row names the pair it hits).
     """
-    from pinarms.optim.motion import SCENES, MotionChecker, MotionOptions, MotionRequest, load_scene, plan_motion
-    from pinarms.optim.motion.plan import time_path
-    from pinarms.optim.motion.request import MotionLimits, motion_constraints
-    from pinarms.optim.motion.scenes import region_pose
-    from pinarms.optim.motion.smoothing import polyline_path
+    from pinarms.optim.motion.crate_guard import SEEDS, crate_guard_move
 
-    cell = load_scene("aubo_crate_guard")
-    arm = cell.arm("aubo")
-    table, crate = SCENES["aubo_crate_guard"].regions
-    checker = MotionChecker(cell, ["aubo"], margin=0.01)
-    start_pose = region_pose(table, 0.5 * (np.array(table.lo) + np.array(table.hi)))
-    goal_pose = region_pose(crate, 0.5 * (np.array(crate.lo) + np.array(crate.hi)))
-    from pinarms.optim.motion.goals import ik_candidates
-
-    q0 = next(q for q in ik_candidates(arm.robot, arm.to_base(start_pose), cell.neutral)[0] if checker.state_valid(q))
-    plans = [plan_motion(MotionRequest(cell, "aubo", q0, goal_pose,
-                                       options=MotionOptions(margin=0.01, time_limit=60.0, seed=seed, goals="best")))
-             for seed in SEEDS]
-    durations = np.array([p.duration for p in plans])
-    best = int(np.argmin(durations))  # the first of equal minima: the lowest seed
-    plan = plans[best]
-    constraints, _ = motion_constraints(cell, ("aubo",), MotionLimits())
-    straight = time_path(polyline_path(np.stack([q0, plan.goal])), constraints)
-    s = np.linspace(0.0, 1.0, 401)[:, None]
-    line = cell.q_from_arms({"aubo": q0 + s * (plan.goal - q0)})
-    hit = cell.clearance(line)
-    k = int(np.argmin(hit.distance))
-    pair = hit.pair_of(k)
+    move = crate_guard_move()
+    plan, pair = move.plan, move.straight_pair
     rows = [
         Row("001", f"planned move food table → crate under the guard (RRT-Connect, fastest of {len(SEEDS)} seeds, "
             "10 mm, time-optimal)", None, round(plan.duration, 3), "s", None,
-            f"seed {SEEDS[best]}, median of the {len(SEEDS)} {np.median(durations):.3f} s; {plan.smoothing}, proven clear "
+            f"seed {move.seed}, median of the {len(SEEDS)} {np.median(move.durations):.3f} s; {plan.smoothing}, proven clear "
             f"(min {plan.clearance.min_environment * 1e3:.1f} mm, {plan.clearance.min_pair[0]} – "
             f"{plan.clearance.min_pair[1]}); search {plan.states} states"),
-        Row("001", "the unobstructed move (straight in joint space, same limits)", None, round(straight.duration, 3),
-            "s", None, f"goes {-hit.distance[k] * 1e3:.0f} mm into {pair.body_b} ({pair.body_a}): the detour costs "
-            f"{plan.duration - straight.duration:+.3f} s"),
+        Row("001", "the unobstructed move (straight in joint space, same limits)", None, round(move.straight.duration, 3),
+            "s", None, f"goes {move.straight_depth * 1e3:.0f} mm into {pair.body_b} ({pair.body_a}): the detour costs "
+            f"{plan.duration - move.straight.duration:+.3f} s"),
     ]
-    boxes = []
-    for fixture in cell.fixtures:
-        for shape in fixture.shapes:
-            if shape.kind == "box":
-                boxes.append((shape.geometry, shape.size, arm.to_base(shape.shape_to_world)))
+    arm = plan.cell.arm("aubo")
+    boxes = [(shape.geometry, shape.size, arm.to_base(shape.shape_to_world))
+             for fixture in plan.cell.fixtures for shape in fixture.shapes if shape.kind == "box"]
     return rows, {"trajectory": plan.trajectory, "boxes": boxes, "plan": plan}
 
 
-def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
+def layout_search_001(arm: Robot) -> tuple[list[Row], LayoutSearch]:
     """Where to bolt the AUBO-i3 for the station's pick P1 → place P4 (optim.search_layout, small grid).
 
     Line frame = the paper's frame, whose x and y are ours negated: the paper's own base is
@@ -127,7 +102,7 @@ def _layout_search_001(arm: Any) -> tuple[list[Row], Any]:
     return rows, res
 
 
-def _straight_lines_001(arm: Any, table2: np.ndarray, times: np.ndarray) -> tuple[list[Row], dict[str, Any]]:
+def straight_lines_001(arm: Robot, table2: np.ndarray, times: np.ndarray) -> tuple[list[Row], dict[str, Any]]:
     """The P1→P2 lift and P3→P4 lowering as straight tcp lines beside the paper's joint-space quintics.
 
     The paper gives no acceleration limit, so the straight moves use the paper's own kind of
@@ -138,7 +113,7 @@ def _straight_lines_001(arm: Any, table2: np.ndarray, times: np.ndarray) -> tupl
     from pinarms import optim, planning
 
     q = conv.aubo_mdh_to_joint(table2)  # robot joint values, each angle in (-π, π]
-    traj = planning.multi_quintic(times, _unwrap_rows(q))
+    traj = planning.multi_quintic(times, unwrap_rows(q))
     T = arm.fk(q)
     v = arm.velocity_limit
     rows: list[Row] = []
@@ -153,10 +128,10 @@ def _straight_lines_001(arm: Any, table2: np.ndarray, times: np.ndarray) -> tupl
         note = ("the paper's joint-space quintic over 1 s; FK of its joint values" if vertical else
                 "in our FK of the paper's joints this 45 mm move is slanted (its printed Cartesian P3/P4 are unreadable)")
         rows.append(Row("001", f"{name} paper quintic: tcp off the {what}", None,
-                        float(np.round(_segment_distance(p, pa, pb).max() / MM, 3)), "mm", None, note))
+                        float(np.round(segment_distance(p, pa, pb).max() / MM, 3)), "mm", None, note))
         path = planning.cartesian_path(arm, T[[a, b]], q_start=q[a])
         s = np.linspace(0.0, path.length, 10 * (path.breaks.size - 1) + 1)
-        off = _segment_distance(arm.position(path(s)), pa, pb).max()
+        off = segment_distance(arm.position(path(s)), pa, pb).max()
         rows.append(Row("001", f"{name} straight line: tcp off the {what}", None, float(np.round(off / MM, 4)), "mm",
                         None, f"Cartesian path, 0.1 mm tolerance; FK at 10x its {path.breaks.size} knots"))
         straight = optim.time_scaled(path, [planning.JointVelocityConstraint(v)], shape="quintic")
@@ -169,7 +144,8 @@ def _straight_lines_001(arm: Any, table2: np.ndarray, times: np.ndarray) -> tupl
     return rows, lines
 
 
-def _tool_speed_plot(path: Path, timing: Any, title: str) -> Any:
+def tool_speed_plot(path: Path, timing: PathTiming, title: str) -> Path:
+    """The tcp's linear and angular speed along ``timing`` over time, written to ``path``."""
     from pinarms.viz import plots as vplots
 
     t = np.linspace(0.0, timing.duration, 400)
@@ -177,6 +153,6 @@ def _tool_speed_plot(path: Path, timing: Any, title: str) -> Any:
     return vplots.plot_tool_speed(path, t, lin, angular=ang, title=title)
 
 
-def _unwrap_rows(q: np.ndarray) -> np.ndarray:
+def unwrap_rows(q: np.ndarray) -> np.ndarray:
     """Joint via points without 2π jumps between consecutive rows."""
     return np.unwrap(np.asarray(q, dtype=float), axis=0)

@@ -9,7 +9,7 @@ from pinarms.papers import SEED002
 from pinarms.report import Row
 from pinarms.robots import conventions as conv
 
-from pinarms.studies.study import Study, _plots, _session
+from pinarms.studies.study import Study, trajectory_plots, study_session
 
 __all__ = ["study_002", "BOUNDS_002_S"]
 
@@ -82,12 +82,12 @@ def study_002(quick: bool = False) -> Study:
     rows.append(Row("002", f"{what}: picks per minute", paper.grasps_per_minute, cycle.picks_per_minute, "1/min",
                     None, "different path (the paper's is not printed), limits of the model, not the machine's"))
 
-    session = _session(arm, "seed 002: flower gantry, quintic B-spline, improved GA")
+    session = study_session(arm, "seed 002: flower gantry, quintic B-spline, improved GA")
     axis_traj = planning.quintic_bspline(together.knot_times, path * transmission)
     session.add_trajectory("lift-feed-lower_time_optimal", axis_traj)
     session.add_points("via_points", arm.position(np.array(GANTRY_PATH_AXIS_M)), kind="via")
     session.add_history("improved_ga_3axes", together.history)
     limits = planning.JointLimits(v, a, j)
-    plots = _plots(together.trajectory, limits, together.history, "seed 002: motor side, time-optimal B-spline",
+    plots = trajectory_plots(together.trajectory, limits, together.history, "seed 002: motor side, time-optimal B-spline",
                    joint_names=[f"{name} motor" for name in arm.joint_names], joint_units=["rad"] * 3)
     return Study("002", "flower gantry: quintic B-spline + improved GA", rows, session, plots)

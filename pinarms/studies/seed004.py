@@ -11,7 +11,8 @@ from pinarms.papers import SEED004
 from pinarms.report import Row, signed_percent
 from pinarms.robots import conventions as conv
 
-from pinarms.studies.study import DEG, MM, Study, _plots, _segment_distance, _session
+from pinarms.optim.cycle.vertical import segment_distance
+from pinarms.studies.study import DEG, MM, Study, trajectory_plots, study_session
 
 __all__ = ["study_004", "KOJI_LIFT_M", "KOJI_BLOCK_KG"]
 
@@ -89,14 +90,14 @@ def study_004(quick: bool = False) -> Study:
     rows.extend(lift_rows)
     rows.extend(_koji_block_rows(arm))
 
-    session = _session(arm, "seed 004: koji turner, joints at constant rates")
+    session = study_session(arm, "seed 004: koji turner, joints at constant rates")
     session.add_trajectory("block_lifted_straight_up", lift.trajectory, hz=200.0)
     knots = np.linspace(0.0, paper.simulation_duration_s, 6)
     traj = planning.multi_quintic(knots, q0 + knots[:, None] * rates,
                                   velocities=np.tile(rates, (6, 1)), accelerations=np.zeros((6, 4)))
     session.add_trajectory("constant_rates_10s", traj)
     session.add_points("fk_examples", arm.position(angles_deg * DEG), kind="target")
-    plots = _plots(traj, planning.JointLimits(arm.velocity_limit), None, "seed 004: joint rates", robot=arm)
+    plots = trajectory_plots(traj, planning.JointLimits(arm.velocity_limit), None, "seed 004: joint rates", robot=arm)
     return Study("004", "koji-block turner: FK examples, IK, simulation", rows, session, plots)
 
 
@@ -118,8 +119,8 @@ def _koji_lift_004(arm: Any, q0: np.ndarray) -> tuple[list[Row], Any]:
     joint_line = planning.joint_spline(path.q_knots[[0, -1]])
     joint = optim.time_scaled(joint_line, [v], shape="quintic")
     s = np.linspace(0.0, path.length, 10 * (path.breaks.size - 1) + 1)
-    off = _segment_distance(arm.position(path(s)), T0[:3, 3], T1[:3, 3]).max()
-    bow = _segment_distance(arm.position(joint_line(np.linspace(0.0, joint_line.length, 2001))), T0[:3, 3],
+    off = segment_distance(arm.position(path(s)), T0[:3, 3], T1[:3, 3]).max()
+    bow = segment_distance(arm.position(joint_line(np.linspace(0.0, joint_line.length, 2001))), T0[:3, 3],
                             T1[:3, 3]).max()
     mm = f"{KOJI_LIFT_M / MM:.0f} mm"
     return [

@@ -10,13 +10,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from pinarms.report import Row
 
-__all__ = ["Study", "DEG", "MM"]
+if TYPE_CHECKING:
+    from pinarms.optim.ga.engine import GAHistory
+    from pinarms.planning import JointLimits, Trajectory
+    from pinarms.robots import Robot
+    from pinarms.robots.reach.workspace import Workspace
+    from pinarms.viz import Session
+
+__all__ = ["Study", "DEG", "MM", "study_session", "trajectory_plots", "workspace_plots"]
 
 
 DEG = np.pi / 180.0
@@ -36,21 +43,15 @@ class Study:
     exports: dict[str, Callable[[Path], list[Path]]] = field(default_factory=dict)  # name -> writer(folder) -> files
 
 
-def _session(robot: Any, title: str):
+def study_session(robot: Robot, title: str) -> Session:
+    """An empty :class:`pinarms.viz.Session` of ``robot`` for a study's scene."""
     from pinarms import viz
 
     return viz.Session(robot, title=title)
 
 
-def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Distance [m] of points p (N, 3) from the segment a–b."""
-    ab = b - a
-    t = np.clip((p - a) @ ab / (ab @ ab), 0.0, 1.0)
-    return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
-
-
-def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = False,
-           **joints: Any) -> dict[str, Callable[[Path], Any]]:
+def trajectory_plots(traj: Trajectory, limits: JointLimits, history: GAHistory | None, title: str,
+                     degrees: bool = False, **joints: Any) -> dict[str, Callable[[Path], Any]]:
     """Plot writers (path → file) of a trajectory's joint curves and a GA history.
 
     ``joints``: ``robot=`` or ``joint_names=`` and ``joint_units=`` of the joints drawn.
@@ -65,7 +66,8 @@ def _plots(traj: Any, limits: Any, history: Any, title: str, degrees: bool = Fal
     return out
 
 
-def _workspace_plots(ws: Any, title: str) -> dict[str, Callable[[Path], Any]]:
+def workspace_plots(ws: Workspace, title: str) -> dict[str, Callable[[Path], Any]]:
+    """The plot writer (path → file) of a sampled workspace, in mm."""
     from pinarms.viz import plots as vplots
 
     return {"workspace": lambda path: vplots.plot_workspace(path, ws, title=title, mm=True)}

@@ -1,11 +1,11 @@
 """Compiled per-pair screen of :mod:`.cover` (numba): which pairs the cover proves apart, state by state.
 
-:func:`._cover_kernel.screen_kernel` answers per configuration (every pair proven, or not);
+:func:`.cover_kernel.screen_kernel` answers per configuration (every pair proven, or not);
 :func:`pair_screen_kernel` answers per pair, so that the exact check (coal) needs to look
 only at the pairs the cover leaves open. The same tests in the same order (the group's two
 bounding spheres, a fixture's exact shape, each pair's bounding spheres, its distance table where it
 has one, then its covers),
-through :mod:`._cover_kernel`'s own helpers. Cached on disk like the other kernels.
+through :mod:`.cover_kernel`'s own helpers. Cached on disk like the other kernels.
 """
 
 from __future__ import annotations
@@ -18,13 +18,14 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit
 
-from pinarms.robots.cell import _box_kernel, _cover_kernel
-from pinarms.robots.cell._cover_kernel import _apart, _fixture_distance, _place, pair_proven
+from pinarms.robots.cell import box_kernel, cover_kernel
+from pinarms.robots.cell.box_kernel import fixture_distance
+from pinarms.robots.cell.cover_kernel import pair_proven, place_world, spheres_apart
 
 __all__ = ["compiled_entry", "pair_screen_kernel", "pair_screener"]
 
 # this kernel calls the cover's: its changes must compile it again (pinarms.compiled)
-drop_stale_caches([Path(_box_kernel.__file__), Path(_cover_kernel.__file__), Path(__file__)],
+drop_stale_caches([Path(box_kernel.__file__), Path(cover_kernel.__file__), Path(__file__)],
                   "pair_kernels.sha256")
 
 
@@ -33,20 +34,20 @@ def pair_screen_kernel(Q, fk, cov, grp, work, out):
     """``out[i, k]`` (``(N, P)`` bool, the pairs in the groups' order): True where the cover proves pair
     ``k`` more than its threshold ``t[k]`` apart at cell configuration ``Q[i]``; False: inconclusive.
 
-    ``fk``, ``cov``, ``grp``, ``work``: as :func:`._cover_kernel.excess_one` (:meth:`Cover.group_arrays`
+    ``fk``, ``cov``, ``grp``, ``work``: as :func:`.cover_kernel.excess_one` (:meth:`Cover.group_arrays`
     with the thresholds). A group proven on its two bounding spheres, or on its link's bounding sphere
     against its fixture's exact shape, at its largest threshold proves all its pairs."""
     exact, FR, Fp, size = cov[4], cov[5], cov[6], cov[7]
     hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
     for i in range(Q.shape[0]):
-        _place(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+        place_world(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
         HW = work[5]
         for g in range(group_t.shape[0]):
             a = group_a[g]
-            whole = _apart(HW, hrad, a, group_b[g], group_t[g])
+            whole = spheres_apart(HW, hrad, a, group_b[g], group_t[g])
             fixed = group_fixed[g]
             if not whole and fixed >= 0:
-                whole = _fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed) \
+                whole = fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed) \
                     - hrad[a] > group_t[g]
             for k in range(group_start[g], group_start[g + 1]):
                 out[i, k] = whole or pair_proven(cov, grp, work, k)

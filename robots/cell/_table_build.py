@@ -5,13 +5,17 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pinarms.robots.cell.cell_model import CellModel
 from pinarms.robots.cell.mesh_cover import mesh_arrays, split_triangles
 
-__all__ = ["axis_arrays"]
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+__all__ = ["axis_arrays", "geometry_points", "build_table", "turning_sides"]
 
 #: Loss [m] a cell may keep at zero distance; :data:`REL` times the distance is added.
 TOL = 1.5e-3
@@ -36,7 +40,7 @@ MAX_PARTS = 8
 #: Most nodes of one table (then no cell is split further; the bounds stay proven).
 MAX_NODES = 30_000
 
-def _points(obj: Any) -> np.ndarray:
+def geometry_points(obj: pin.GeometryObject) -> np.ndarray:
     """Points ``(n, 3)`` in the parent joint's frame whose convex hull holds the geometry: a mesh's vertices,
     another shape's local bounding box's corners."""
     got = mesh_arrays(obj.geometry)
@@ -87,7 +91,7 @@ class _Side:
             self.shapes = [_hull(P) for P in self.points]
             self.frames = [(np.eye(3), np.zeros(3))] * len(self.points)
         else:
-            self.points, self.shapes, self.frames = [_points(obj)], [obj.geometry], [self.M]
+            self.points, self.shapes, self.frames = [geometry_points(obj)], [obj.geometry], [self.M]
         # the axis fixed in this side's frame: its own joint's (on the path), else the first joint of the other side's
         self.turn = None
         if not turning or not mesh:
@@ -213,7 +217,7 @@ class _Pair:
         return low, exact
 
 
-def _build_one(cell: Any, a: int, b: int, side_a: list, side_b: list, turning: tuple = (False, False)) -> dict:
+def build_table(cell: CellModel, a: int, b: int, side_a: list, side_b: list, turning: tuple = (False, False)) -> dict:
     """One table's nodes and axes (module docstring), breadth first, a level's centres at once."""
     pair = _Pair(cell, a, b, side_a, side_b, turning)
     na = len(pair.axes)
@@ -268,7 +272,7 @@ def axis_arrays(bp: Any, path: list, axis: np.ndarray) -> tuple:
     return joint, par, e_, ea, eb
 
 
-def _turning(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[bool, bool]:
+def turning_sides(cell: CellModel, a: int, b: int, side_a: list, side_b: list) -> tuple[bool, bool]:
     """Which sides are taken as their coaxial cylinders (:data:`TURNING`)."""
     path = side_a + side_b
     rng = np.random.default_rng(0)

@@ -29,7 +29,7 @@ from pinarms.robots.cell.pairs import CollisionPair
 
 from pinarms.robots.cell.cell_model import CellModel
 
-__all__ = ["Collisions", "Clearance", "in_collision", "collisions", "clearance", "pair_lower_bounds"]
+__all__ = ["Collisions", "Clearance", "in_collision", "collisions", "clearance", "pair_lower_bounds", "check_margin"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,7 +119,12 @@ class Clearance:
                 f"{self.margin * 1e3:.1f} mm; {len(self.pairs)} pairs)")
 
 
-def _margin(margin: Any) -> float:
+def check_margin(margin: float) -> float:
+    """``margin`` [m] as a float.
+
+    Raises:
+        InvalidInput: not a finite number >= 0 (a bool counts as no number).
+    """
     ok = isinstance(margin, (int, float, np.integer, np.floating)) and not isinstance(margin, bool)
     value = float(margin) if ok else float("nan")
     if not np.isfinite(value) or value < 0.0:
@@ -134,12 +139,12 @@ MAX_THREADS = 64
 def in_collision(cell: "CellModel", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
     """See :meth:`Cell.in_collision`."""
     if margin != 0.0:
-        margin = _margin(margin)
+        margin = check_margin(margin)
     n = cell.pair_count(float(margin)) if margin == margin else 0
     fast = cell.pin_vector_or_none(q)  # one finite (nq,) vector: skip the batch machinery
     if fast is not None and n:
         return cell.pair_views.checker(n).single(fast, float(margin))
-    margin = _margin(margin)
+    margin = check_margin(margin)
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= MAX_THREADS:
         raise InvalidInput(f"threads must be an integer from 1 to {MAX_THREADS}, got {threads!r}")
     arr, single = cell.robot.check_q(q)
@@ -154,7 +159,7 @@ def in_collision(cell: "CellModel", q: Any, *, margin: float = 0.0, threads: int
 
 def collisions(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Collisions:
     """See :meth:`Cell.collisions`."""
-    margin = _margin(margin)
+    margin = check_margin(margin)
     arr, single = cell.robot.check_q(q)
     hit = np.atleast_1d(in_collision(cell, arr if not single else arr[0], margin=margin))
     if single:
@@ -259,7 +264,7 @@ ONE_PASS_REACH = 2000
 
 def clearance(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Clearance:
     """See :meth:`Cell.clearance`."""
-    margin = _margin(margin)
+    margin = check_margin(margin)
     arr, single = cell.robot.check_q(q)
     N = arr.shape[0]
     pairs = cell.candidates

@@ -43,7 +43,7 @@ from pinarms.errors import CellError, ModelError, XacroForbidden
 from pinarms.robots.urdf_checks import check_tree, refuse_dtd
 from pinarms.robots.cell.cell import Cell
 from pinarms.robots.cell.compose_file import (
-    _SHAPES,
+    FIXTURE_SIZES,
     MAX_ARM_BYTES,
     MAX_ARMS,
     MAX_FIXTURES,
@@ -51,13 +51,13 @@ from pinarms.robots.cell.compose_file import (
     CellDescription,
     FixturePrimitive,
     ToolPoint,
-    _name,
+    check_name,
     check_crate,
-    _read_bounded,
+    read_cell_file,
     read_cell_description,
 )
 from pinarms.robots.cell.arm_keys import rewrite_arm
-from pinarms.robots.cell.description import _MOVABLE
+from pinarms.robots.cell.description import MOVABLE_JOINTS
 
 __all__ = [
     "ArmPlacement",
@@ -125,7 +125,7 @@ def _mesh_ref(filename: str, arm_dir: Path, base_dir: Path, packages: Mapping[st
 
 
 def _parse_arm(path: Path, source: str) -> ET.Element:
-    text = _read_bounded(path, MAX_ARM_BYTES, source)
+    text = read_cell_file(path, MAX_ARM_BYTES, source)
     try:
         refuse_dtd(text, source)
         root = ET.fromstring(text)
@@ -153,7 +153,7 @@ def _base_of(root: ET.Element, source: str) -> tuple[str, str]:
         link = stack.pop()
         static.append(link)
         stack.extend(child for kind, child in below.get(link, ()) if kind == "fixed")
-    bases = [ln for ln in static if any(kind in _MOVABLE for kind, _ in below.get(ln, ()))]
+    bases = [ln for ln in static if any(kind in MOVABLE_JOINTS for kind, _ in below.get(ln, ()))]
     if len(bases) != 1:
         raise CellError(f"{source}: an arm has one base (a link reached through fixed joints from the root, with "
                         f"movable joints below it); found {len(bases)}: {bases[:5]}")
@@ -256,14 +256,14 @@ def _check_entries(arms: Sequence[ArmPlacement], fixtures: Sequence[FixturePrimi
     for a in arms:
         if not isinstance(a, ArmPlacement):
             raise CellError(f"arms must be ArmPlacement entries, got {type(a).__name__}")
-        _name(a.name, f"arm {a.name!r}")
+        check_name(a.name, f"arm {a.name!r}")
     for f in fixtures:
         if not isinstance(f, FixturePrimitive):
             raise CellError(f"fixtures must be FixturePrimitive entries, got {type(f).__name__}")
-        _name(f.name, f"fixture {f.name!r}")
-        if f.kind not in _SHAPES or len(f.size) != _SHAPES[f.kind] or min(f.size) <= 0.0:
-            raise CellError(f"fixture {f.name!r}: a {f.kind!r} needs {_SHAPES.get(f.kind, '?')} positive size(s); "
-                            f"kinds: {', '.join(_SHAPES)}")
+        check_name(f.name, f"fixture {f.name!r}")
+        if f.kind not in FIXTURE_SIZES or len(f.size) != FIXTURE_SIZES[f.kind] or min(f.size) <= 0.0:
+            raise CellError(f"fixture {f.name!r}: a {f.kind!r} needs {FIXTURE_SIZES.get(f.kind, '?')} positive size(s); "
+                            f"kinds: {', '.join(FIXTURE_SIZES)}")
         check_crate(f, f"fixture {f.name!r}")
         for a in arms:
             if f.name == a.name or f.name.startswith(a.name + "_"):
@@ -303,7 +303,7 @@ def compose_cell_urdf(
         XacroForbidden: an arm file outside the allowed folders.
     """
     _check_entries(arms, fixtures)
-    _name(name, "cell")
+    check_name(name, "cell")
     base = Path(base_dir).resolve()
     pkgs = {str(k): Path(v) for k, v in (packages or {}).items()}
     robot = ET.Element("robot", {"name": name})

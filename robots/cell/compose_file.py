@@ -19,6 +19,9 @@ from pinarms.files import read_bounded_text
 from pinarms.errors import CellError, CellNotFound
 
 __all__ = [
+    "FIXTURE_SIZES",
+    "check_name",
+    "read_cell_file",
     "ArmPlacement",
     "ToolPoint",
     "FixturePrimitive",
@@ -42,7 +45,8 @@ MAX_FIXTURES = 1000
 MAX_DECLARED = 10_000
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
-_SHAPES = {"box": 3, "cylinder": 2, "sphere": 1, "crate": 3}
+#: How many size numbers [m] each fixture kind takes in a cell description.
+FIXTURE_SIZES = {"box": 3, "cylinder": 2, "sphere": 1, "crate": 3}
 _ARM_KEYS = {"name", "urdf", "xyz", "rpy", "tcp", "freeze", "states", "hold"}
 
 
@@ -103,7 +107,7 @@ class ArmPlacement:
                                                  for k, v in freeze.items()))
         states = dict(self.states)
         for state in states:
-            _name(state, f"{where} state")
+            check_name(state, f"{where} state")
         object.__setattr__(self, "states", tuple((k, _numbers(list(v), f"state {k!r}", where))
                                                  for k, v in states.items()))
         if self.hold is not None and not isinstance(self.hold, str):
@@ -148,7 +152,12 @@ class CellDescription:
 
 
 # ----------------------------------------------------------------- reading files
-def _read_bounded(path: Path, limit: int, what: str) -> str:
+def read_cell_file(path: Path, limit: int, what: str) -> str:
+    """The text of a cell's file ``path`` (at most ``limit`` bytes; ``what`` names it in the error).
+
+    Raises:
+        CellNotFound: no such file. CellError: too large, or not UTF-8 text.
+    """
     return read_bounded_text(path, limit, what, error=CellError, missing=CellNotFound)
 
 
@@ -181,7 +190,12 @@ def _keys(table: Any, allowed: set[str], required: set[str], where: str) -> dict
     return table
 
 
-def _name(value: Any, where: str) -> str:
+def check_name(value: object, where: str) -> str:
+    """``value`` checked as a cell, arm, fixture or state name (a letter, then letters, digits, ``_``; at most 64).
+
+    Raises:
+        CellError: not such a name (``where`` says where it was read).
+    """
     if not isinstance(value, str) or not _NAME.match(value):
         raise CellError(f"{where}: name {value!r} must start with a letter and hold only letters, digits and '_' "
                         "(at most 64 characters)")
@@ -189,15 +203,15 @@ def _name(value: Any, where: str) -> str:
 
 
 def _fixture_of(table: dict, where: str) -> FixturePrimitive:
-    _keys(table, {"name", "xyz", "rpy", "wall", "floor", *_SHAPES}, {"name"}, where)
-    name = _name(table["name"], where)
-    kinds = [k for k in _SHAPES if k in table]
+    _keys(table, {"name", "xyz", "rpy", "wall", "floor", *FIXTURE_SIZES}, {"name"}, where)
+    name = check_name(table["name"], where)
+    kinds = [k for k in FIXTURE_SIZES if k in table]
     if len(kinds) != 1:
-        raise CellError(f"{where} ({name!r}): give exactly one of {', '.join(_SHAPES)}")
+        raise CellError(f"{where} ({name!r}): give exactly one of {', '.join(FIXTURE_SIZES)}")
     kind = kinds[0]
     size = _numbers(table[kind], kind, where)
-    if len(size) != _SHAPES[kind] or min(size) <= 0.0:
-        raise CellError(f"{where} ({name!r}): {kind} takes {_SHAPES[kind]} positive number(s) [m], got {table[kind]!r}")
+    if len(size) != FIXTURE_SIZES[kind] or min(size) <= 0.0:
+        raise CellError(f"{where} ({name!r}): {kind} takes {FIXTURE_SIZES[kind]} positive number(s) [m], got {table[kind]!r}")
     extra = [k for k in ("wall", "floor") if k in table]
     if extra and kind != "crate":
         raise CellError(f"{where} ({name!r}): {' and '.join(extra)} belong to a crate, not a {kind}")
@@ -246,7 +260,7 @@ def _arm_of(table: Any, where: str) -> ArmPlacement:
     for key, value in states.items():
         if not isinstance(value, list):
             raise CellError(f"{where}: state {key!r} must be a list of joint values, got {value!r}")
-    return ArmPlacement(_name(table["name"], where), table["urdf"],
+    return ArmPlacement(check_name(table["name"], where), table["urdf"],
                         _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
                         _triple(table.get("rpy", [0, 0, 0]), "rpy", where),
                         tcp=tcp, freeze=freeze, states=states, hold=hold)
@@ -261,7 +275,7 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
             too many arms or fixtures, duplicate names.
     """
     path = Path(path)
-    text = _read_bounded(path, MAX_DESCRIPTION_BYTES, "cell description")
+    text = read_cell_file(path, MAX_DESCRIPTION_BYTES, "cell description")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -270,7 +284,7 @@ def read_cell_description(path: str | os.PathLike) -> CellDescription:
         raise CellError(f"cell description {str(path)!r} nests arrays or tables too deeply") from None
     _keys(doc, {"name", "arm", "fixture", "disable_collisions"}, {"arm"}, f"cell description {str(path)!r}")
     default = re.sub(r"\W", "_", path.name.split(".")[0])
-    name = _name(doc.get("name", default if _NAME.match(default) else "cell"), str(path))
+    name = check_name(doc.get("name", default if _NAME.match(default) else "cell"), str(path))
     arm_tables, fixture_tables = doc["arm"], doc.get("fixture", [])
     if not isinstance(arm_tables, list) or not isinstance(fixture_tables, list):
         raise CellError(f"{path}: write arms as [[arm]] tables and fixtures as [[fixture]] tables")

@@ -21,7 +21,7 @@ taken exactly against the other geometry's spheres (:func:`geometry_segments`). 
 mesh is also held by thin cylinders, each with the sphere of its slice (:func:`.mesh_cover.mesh_parts`):
 against a static box its bound is the least over the cylinders of the larger of its sphere's
 distance and the gaps of the cylinder's projections on the box's axes and on the line to the box's
-nearest point (:func:`._box_kernel._held_low`; the flat end of a housing over a table, a flaring
+nearest point (:func:`.box_kernel.held_low`; the flat end of a housing over a table, a flaring
 housing beside a pedestal's edge).
 
 Two geometries of one arm whose relative placement depends on at most two revolute joints, one
@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from pinarms.robots.cell._cover_kernel import excess_kernel, screen_kernel
+from pinarms.robots.cell.cover_kernel import excess_kernel, screen_kernel
 from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, static_primitive
 from pinarms.robots.cell.mesh_cover_cache import cached_mesh_parts
 from pinarms.robots.cell.pair_tables import PairTables, no_tables, pair_tables
@@ -256,7 +256,7 @@ class Cover:
 
     def world_centers(self, Q: np.ndarray) -> np.ndarray:
         """Sphere centres ``(N, S, 3)`` in the world for cell configurations ``Q (N, nq)`` (numpy)."""
-        from pinarms.robots.cell._cover_kernel import centers_kernel
+        from pinarms.robots.cell.cover_kernel import centers_kernel
 
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.empty((Q.shape[0], self.joint.size, 3))
@@ -328,7 +328,7 @@ class Cover:
         return pair_screener(self, pairs, threshold)
 
     def kernel_arrays(self) -> tuple:
-        """The cover's arrays in the order of the compiled kernels (:func:`._cover_kernel.excess_one`)."""
+        """The cover's arrays in the order of the compiled kernels (:func:`.cover_kernel.excess_one`)."""
         return (self.joint, self.center, self.radius, self.start, self.exact, self.frame_R, self.frame_p, self.size,
                 *self.segments[:6], self.tables.arrays(), self.segments[6])
 

@@ -26,10 +26,11 @@ from dataclasses import dataclass
 from pinarms.errors import CellError
 from pinarms.robots.pair_rules import declared_pairs
 
-__all__ = ["ArmSpec", "CellSpec", "describe", "arm_urdf"]
+__all__ = ["ArmSpec", "CellSpec", "describe", "arm_urdf", "MOVABLE_JOINTS"]
 
-_MOVABLE = {"revolute", "continuous", "prismatic"}
-_KINDS = _MOVABLE | {"fixed"}
+#: URDF joint types that move (the rest: fixed).
+MOVABLE_JOINTS = {"revolute", "continuous", "prismatic"}
+_KINDS = MOVABLE_JOINTS | {"fixed"}
 
 
 @dataclass(frozen=True)
@@ -100,7 +101,7 @@ def describe(root: ET.Element, source: str) -> CellSpec:
         static.append(link)
         stack.extend(child_of[j] for j in reversed(children[link]) if kind_of[j] == "fixed")
 
-    bases = [link for link in static if any(kind_of[j] in _MOVABLE for j in children[link])]
+    bases = [link for link in static if any(kind_of[j] in MOVABLE_JOINTS for j in children[link])]
     if not bases:
         raise CellError(f"{source}: no arm found (no movable joint hangs from a fixed link)")
     order = {name: k for k, name in enumerate(links)}

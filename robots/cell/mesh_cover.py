@@ -197,7 +197,7 @@ def mesh_parts(V: np.ndarray, T: np.ndarray, count: int, edge: float = SPLIT_EDG
     the mesh's frame, and ``sphere (c,)``: the sphere holding the same pieces. A cylinder holds its
     pieces' vertices, so (convex) the pieces: the union of the cylinders holds every triangle, and
     each group lies in the intersection of its cylinder and its sphere. Screened exactly against
-    static boxes (:func:`._cover_kernel._held_low`): a cylinder's flat ends where the sphere
+    static boxes (:func:`.box_kernel.held_low`): a cylinder's flat ends where the sphere
     overshoots them, and a flaring housing in thin cylinders."""
     return _sphere_cover(V, T, count, edge)[:6]
 

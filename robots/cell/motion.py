@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.robots.cell.collision import _margin, exact_min_distance
+from pinarms.robots.cell.collision import check_margin, exact_min_distance
 from pinarms.robots.cell.ladder import Intervals, climb
 from pinarms.robots.cell.motion_curves import moving_arm_curves
 from pinarms.robots.cell.motion_minimum import TIE_M, FirstRound, first_round, smallest_clearance  # noqa: F401  (TIE_M, re-exported)
@@ -136,10 +136,10 @@ def check_motion(
 
 def _distances(margin: Any, clearance: Any) -> tuple[float, float]:
     """The checked ``margin`` (> 0) and required ``clearance`` (≥ 0) [m], both at most :data:`MAX_DISTANCE`."""
-    margin = _margin(margin)
+    margin = check_margin(margin)
     if margin <= 0.0 or margin > MAX_DISTANCE:
         raise InvalidInput(f"margin must be > 0 m and at most {MAX_DISTANCE:g} m: it sets the time step, got {margin!r}")
-    required = _margin(clearance)
+    required = check_margin(clearance)
     if required > MAX_DISTANCE:
         raise InvalidInput(f"clearance must be at most {MAX_DISTANCE:g} m, got {clearance!r}")
     return margin, required

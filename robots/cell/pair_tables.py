@@ -41,7 +41,7 @@ pair, the larger of its own and its parent's bound; pairs whose parent bound is 
 node's least so far are not recomputed. Each leaf stores its bound less :data:`SLACK` (GJK's
 tolerance, the angles' rounding).
 
-**In the kernels** (:mod:`._cover_kernel`: ``cov[14]`` the tables, ``grp[11]`` each pair's table
+**In the kernels** (:mod:`.cover_kernel`: ``cov[14]`` the tables, ``grp[11]`` each pair's table
 or −1): a pair with a table takes the larger of the table's bound and its cover's, the table
 first (a pair it keeps above the threshold, or above the running excess, costs no cover test);
 the angles come from the joint frames already placed (``atan2`` of two dot products; no joint
@@ -92,9 +92,9 @@ from pinarms.robots.cell._table_build import (
     TURN_NEAR,
     TURN_SAMPLES,
     TURNING,
-    _build_one,
-    _points,
-    _turning,
+    build_table,
+    geometry_points,
+    turning_sides,
     axis_arrays,
 )
 from pinarms.robots.cell import _table_build, mesh_cover
@@ -164,7 +164,7 @@ class PairTables:
     seconds: float = 0.0
 
     def arrays(self) -> tuple:
-        """The arrays in the kernels' order (:func:`._cover_kernel.table_low`)."""
+        """The arrays in the kernels' order (:func:`.cover_kernel.table_low`)."""
         return (self.joint, self.parent, self.ea, self.eb, self.e, self.root, self.child, self.split, self.low)
 
     def of_pairs(self, pair_a: np.ndarray, pair_b: np.ndarray) -> np.ndarray:
@@ -251,7 +251,7 @@ def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
         obj = objs[g]
         got = mesh_arrays(obj.geometry)
         if got is None:
-            h.update(_points(obj).tobytes())
+            h.update(geometry_points(obj).tobytes())
         else:
             h.update(got[0].tobytes() + got[1].tobytes())
         M = np.asarray(obj.placement.homogeneous, dtype=float)
@@ -330,7 +330,7 @@ def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict,
     seconds = 0.0
     if got is None:
         t0 = time.perf_counter()
-        got = _build_one(cell, a, b, side_a, side_b, _turning(cell, a, b, side_a, side_b))
+        got = build_table(cell, a, b, side_a, side_b, turning_sides(cell, a, b, side_a, side_b))
         seconds = time.perf_counter() - t0
         _save(key, got)
     _MEMORY[key] = got

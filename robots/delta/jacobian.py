@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from pinarms.robots.delta.geometry import DeltaGeometry
-from pinarms.robots.delta.kinematics import _rows, forward_position, virtual_elbows
+from pinarms.robots.delta.kinematics import as_points, forward_position, virtual_elbows
 from pinarms.robots.delta.model import DeltaRobot
 
 __all__ = ["constraint_matrices", "platform_jacobian", "platform_jacobian_pinocchio"]
@@ -19,7 +19,7 @@ __all__ = ["constraint_matrices", "platform_jacobian", "platform_jacobian_pinocc
 
 def constraint_matrices(geom: DeltaGeometry, theta) -> tuple[np.ndarray, np.ndarray]:
     """``(A, d)`` of the velocity equation ``A p_dot = diag(d) theta_dot``: A (N, 3, 3) [m], d (N, 3) [m^2/rad]."""
-    th, _ = _rows(theta, "theta")
+    th, _ = as_points(theta, "theta")
     p = forward_position(geom, th)
     rel = p[:, None, :] - virtual_elbows(geom, th)                        # p - C_i, (N, 3, 3)
     e = geom.radial
@@ -29,7 +29,7 @@ def constraint_matrices(geom: DeltaGeometry, theta) -> tuple[np.ndarray, np.ndar
 
 def platform_jacobian(geom: DeltaGeometry, theta) -> np.ndarray:
     """Closed-form ``J`` (3, 3) or (N, 3, 3) [m/rad]; NaN/inf near a parallel singularity."""
-    th, single = _rows(theta, "theta")
+    th, single = as_points(theta, "theta")
     a, d = constraint_matrices(geom, th)
     jac = np.linalg.solve(a, d[:, :, None] * np.eye(3)[None])
     return jac[0] if single else jac

@@ -11,11 +11,12 @@ eight in all. Everything takes batches: ``theta`` (N, 3) or (3,), ``p`` (N, 3) o
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.delta.errors import DeltaInputError, DeltaUnreachable
 from pinarms.robots.delta.geometry import DeltaGeometry
 
-__all__ = ["virtual_elbows", "elbow_positions", "forward_position", "inverse_position_branches",
+__all__ = ["as_points", "virtual_elbows", "elbow_positions", "forward_position", "inverse_position_branches",
            "inverse_position", "BRANCH_COUNT", "PRIMARY_BRANCH", "branch_signs"]
 
 #: IK branches: two per leg.
@@ -24,7 +25,12 @@ BRANCH_COUNT = 8
 PRIMARY_BRANCH = 0
 
 
-def _rows(values, what: str) -> tuple[np.ndarray, bool]:
+def as_points(values: ArrayLike, what: str) -> tuple[np.ndarray, bool]:
+    """``values`` as an (N, 3) float array and whether it was one (3,) row (``what`` names it in the error).
+
+    Raises:
+        DeltaInputError: another shape, or a value that is not finite.
+    """
     arr = np.asarray(values, dtype=float)
     single = arr.ndim == 1
     arr = np.atleast_2d(arr)
@@ -37,7 +43,7 @@ def _rows(values, what: str) -> tuple[np.ndarray, bool]:
 
 def elbow_positions(geom: DeltaGeometry, theta) -> np.ndarray:
     """Elbow centres ``E_i`` [m], shape (N, 3 legs, 3) (or (3, 3) for one ``theta``)."""
-    th, single = _rows(theta, "theta")
+    th, single = as_points(theta, "theta")
     e, z = geom.radial, np.array([0.0, 0.0, 1.0])
     out = (geom.base_radius + geom.upper_arm * np.cos(th))[:, :, None] * e[None] \
         - (geom.upper_arm * np.sin(th))[:, :, None] * z
@@ -46,7 +52,7 @@ def elbow_positions(geom: DeltaGeometry, theta) -> np.ndarray:
 
 def virtual_elbows(geom: DeltaGeometry, theta) -> np.ndarray:
     """Sphere centres ``C_i = E_i - r e_i`` [m], shape (N, 3, 3): the platform centre is l from each."""
-    th, single = _rows(theta, "theta")
+    th, single = as_points(theta, "theta")
     out = elbow_positions(geom, th) - geom.platform_radius * geom.radial[None]
     return out[0] if single else out
 
@@ -65,7 +71,7 @@ def forward_position(geom: DeltaGeometry, theta, *, assembly: str = "lower") -> 
     """
     if assembly not in ("lower", "upper"):
         raise DeltaInputError(f"assembly must be 'lower' or 'upper', got {assembly!r}")
-    th, single = _rows(theta, "theta")
+    th, single = as_points(theta, "theta")
     c = virtual_elbows(geom, th)
     c1, d2, d3 = c[:, 0], c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
     n = np.cross(d2, d3)
@@ -105,7 +111,7 @@ def inverse_position_branches(geom: DeltaGeometry, p) -> tuple[np.ndarray, np.nd
         (N, 8) bool; branch ``b`` takes leg ``i``'s outward (bit 0) or inward (bit 1) root,
         see :func:`branch_signs`. Joint limits are not applied here.
     """
-    pts, single = _rows(p, "p")
+    pts, single = as_points(p, "p")
     e, u = geom.radial, geom.tangential
     x = pts @ e.T                                            # (N, 3 legs) along e_i
     y = pts @ u.T

@@ -32,6 +32,7 @@ __all__ = [
     "recognise",
     "Recognition",
     "FAMILIES",
+    "FAMILY_OF",
     "AnalyticIK",
     "URTypeIK",
     "ScaraIK",
@@ -49,7 +50,7 @@ __all__ = [
 #: Family of each registry robot that has a closed form (koji_turner_rail is redundant: numerical
 #: only). Kept for reference and for callers that look a family up by name; robots get their
 #: family by :func:`recognise`, never from this table.
-_FAMILY_OF = {
+FAMILY_OF = {
     "scara_mushroom": "scara",
     "aubo_i3": "ur_type",
     "gantry_flower": "gantry",

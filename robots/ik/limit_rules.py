@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinarms.robots.kinematic_tree import _REVOLUTE
+from pinarms.robots.kinematic_tree import REVOLUTE
 
 __all__ = ["JointLimitRules"]
 
@@ -44,7 +44,7 @@ class JointLimitRules:
         model = robot.model
         for i in range(1, model.njoints):
             joint = model.joints[i]
-            if "Mimic" not in joint.shortname() and tree.kind[i] == _REVOLUTE:
+            if "Mimic" not in joint.shortname() and tree.kind[i] == REVOLUTE:
                 revolute[joint.idx_v] = True
         #: bounded revolute joints whose range spans a full turn: leaving the range is undone by ∓2π
         self.full_turn = revolute & ~self.unbounded & (self.upper - self.lower >= _TWO_PI)

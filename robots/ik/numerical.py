@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.robots.kinematic_tree import _REVOLUTE
+from pinarms.robots.kinematic_tree import REVOLUTE
 from pinarms.robots._checks import check_restarts as _check_restarts
 from pinarms.robots._checks import check_seed as _check_seed
 from pinarms.robots._checks import check_tolerance as _check_tolerance
@@ -72,7 +72,7 @@ from pinarms.robots.ik.descent import CLIP as _CLIP
 from pinarms.robots.ik.descent import FREE as _FREE
 from pinarms.robots.ik.descent import LMDescent
 from pinarms.robots.ik.limit_rules import JointLimitRules
-from pinarms.robots.ik.numerical_batch import BatchIKResult, _batch_errors, _seed_int, solve_batch
+from pinarms.robots.ik.numerical_batch import BatchIKResult, batch_errors, seed_int32, solve_batch
 from pinarms.robots.ik.starts import StartTable
 
 __all__ = ["NumericalIK", "IKResult", "BatchIKResult"]
@@ -165,7 +165,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
                 np.ascontiguousarray(tree.q_index[chain], dtype=np.int64),
                 np.ascontiguousarray(tree.scale[chain], dtype=float),
                 np.ascontiguousarray(tree.offset[chain], dtype=float),
-                np.ascontiguousarray(tree.kind[chain] == _REVOLUTE),
+                np.ascontiguousarray(tree.kind[chain] == REVOLUTE),
                 np.ascontiguousarray(tree.local_R[chain], dtype=float).reshape(-1, 3, 3),
                 np.ascontiguousarray(tree.local_p[chain], dtype=float).reshape(-1, 3),
                 np.ascontiguousarray(fR, dtype=float),
@@ -204,7 +204,7 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
             q0 = np.ascontiguousarray(q_seed, dtype=float)
         q = np.empty(self.nq)
         ok, pe, re, attempts, its = kernel.solve(q0, table, C, L, P, Rt, pt, position_only, tol, max_restarts,
-                                                 _seed_int(seed), q)
+                                                 seed_int32(seed), q)
         if ok:
             pe, re = self.errors(q, target, position_only)
             ok = pe <= tol and re <= tol and self.in_limits(q)
@@ -327,4 +327,4 @@ class NumericalIK(JointLimitRules, StartTable, LMDescent):
 
 
 NumericalIK.solve_batch = solve_batch
-NumericalIK.batch_errors = _batch_errors
+NumericalIK.batch_errors = batch_errors

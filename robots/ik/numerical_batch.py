@@ -16,14 +16,14 @@ import numpy as np
 from pinarms.robots._checks import check_restarts
 
 
-__all__ = ["BatchIKResult", "solve_batch"]
+__all__ = ["BatchIKResult", "solve_batch", "batch_errors", "seed_int32"]
 
 _WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads of a batched solve (the compiled solver releases the GIL)
 _PARALLEL_MIN = 64  # targets per thread below which a batch runs in one thread
 _CHUNK = 64  # targets per block of a threaded batch (blocks are taken in turn: the threads stay balanced)
 
 
-def _seed_int(seed) -> int:
+def seed_int32(seed: int | np.random.Generator | None) -> int:
     """A 32-bit seed for the compiled solver's generator from ``seed`` (int, ``Generator`` or None)."""
     if isinstance(seed, np.random.Generator):
         return int(seed.integers(2**32))
@@ -77,7 +77,7 @@ def _log3(R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return out, theta
 
 
-def _batch_errors(self, q: np.ndarray, targets: np.ndarray, position_only: bool) -> tuple[np.ndarray, np.ndarray]:
+def batch_errors(self, q: np.ndarray, targets: np.ndarray, position_only: bool) -> tuple[np.ndarray, np.ndarray]:
     """Position [m] and rotation [rad] errors of ``q (N, nq)`` for ``targets (N, 4, 4)`` by a fresh batched FK."""
     T = self.robot.fk(q, self._frame)
     pe = np.linalg.norm(T[:, :3, 3] - targets[:, :3, 3], axis=1)
@@ -131,7 +131,7 @@ def solve_batch(
     q = np.empty((N, nq))
     success = np.zeros(N, dtype=bool)
     pe, re = np.empty(N), np.empty(N)
-    base = _seed_int(seed)  # target k's restarts: seed + k, as solve(targets[k], seed=seed + k); any blocks
+    base = seed_int32(seed)  # target k's restarts: seed + k, as solve(targets[k], seed=seed + k); any blocks
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(base)
     iterations = [0]
 
@@ -157,7 +157,7 @@ def solve_batch(
                 f.result()
     iterations = int(sum(iterations))
     # confirm by a fresh batched FK (independent of the compiled chain) and an exact limit check
-    pos_err, rot_err = _batch_errors(self, q, targets, position_only)
+    pos_err, rot_err = batch_errors(self, q, targets, position_only)
     inside = np.all((q >= self.lower) & (q <= self.upper), axis=1)
     success &= (pos_err <= tol) & (rot_err <= tol) & inside
     left = np.flatnonzero(~success)
@@ -167,5 +167,5 @@ def solve_batch(
         q[k] = res.q
         success[k] = res.success
     if left.size:
-        pos_err[left], rot_err[left] = _batch_errors(self, q[left], targets[left], position_only)
+        pos_err[left], rot_err[left] = batch_errors(self, q[left], targets[left], position_only)
     return BatchIKResult(q, success, pos_err, rot_err, iterations)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pinarms.robots.reach.orientations import _rotation_about
+from pinarms.robots.so3 import about as rotations_about
 from pinarms.robots.reach.reach_chunk import ChunkTask, collision_free, manipulability_of
 from pinarms.robots.reach.reach_map import ReachabilityMap
 from pinarms.robots.reach.robot_spec import spec_of
@@ -34,7 +34,7 @@ def verify_bases(robot: "Robot", reach_map: ReachabilityMap, candidates: np.ndar
     """
     tool_axis = reach_map.orientations.tool_axis
     n, N = candidates.shape[0], T_tasks.shape[0]
-    rolls = _rotation_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
+    rolls = rotations_about(tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else np.eye(3)[None]
     R = rolls.shape[0]
     B = np.tile(np.eye(4), (n, 1, 1))
     cz, sz = np.cos(candidates[:, 3]), np.sin(candidates[:, 3])

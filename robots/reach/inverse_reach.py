@@ -41,7 +41,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput, ModelError
-from pinarms.robots.reach.orientations import _align, _rotation_about
+from pinarms.robots.reach.orientations import align_rotations
+from pinarms.robots.so3 import about as rotations_about
 from pinarms.robots.reach.base_verify import verify_bases
 from pinarms.robots.reach.reach_map import ReachabilityMap
 from pinarms.robots.reach.robot_spec import urdf_sha256
@@ -67,7 +68,7 @@ def tool_down_poses(points: ArrayLike, tool_axis: ArrayLike = (0.0, 0.0, 1.0)) -
     axis = np.asarray(tool_axis, dtype=float)
     if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
         raise InvalidInput(f"tool_axis must be a finite non-zero 3-vector, got {tool_axis!r}")
-    R = _align(axis / np.linalg.norm(axis), _DOWN[None])[0]
+    R = align_rotations(axis / np.linalg.norm(axis), _DOWN[None])[0]
     T = np.tile(np.eye(4), (P.shape[0], 1, 1))
     T[:, :3, :3] = R
     T[:, :3, 3] = P
@@ -314,7 +315,7 @@ def _feasible_on_map(reach_map: ReachabilityMap, T_tasks: np.ndarray, X: np.ndar
     tasks' voxels ``(C,)`` and the number of map lookups made.
     """
     oset = reach_map.orientations
-    rolls = _rotation_about(oset.tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else None
+    rolls = rotations_about(oset.tool_axis, 2 * np.pi * np.arange(roll_steps) / roll_steps) if roll_free else None
     group_reached, count_per_voxel = _voxel_tables(reach_map, roll_free)
     P = T_tasks[:, :3, 3]
     N = T_tasks.shape[0]

@@ -47,6 +47,7 @@ __all__ = [
     "tool_axis_orientations",
     "tool_down_orientations",
     "MAX_ORIENTATIONS",
+    "align_rotations",
 ]
 
 #: Largest orientation set a map accepts (poses per voxel).
@@ -217,7 +218,7 @@ def _count(n: Any, what: str, low: int = 1) -> int:
     return int(n)
 
 
-def _align(a: np.ndarray, d: np.ndarray) -> np.ndarray:
+def align_rotations(a: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Rotations ``(N, 3, 3)`` taking the unit vector ``a`` to each unit direction ``d (N, 3)``.
 
     The smallest rotation (about ``a × d``); for ``d = −a`` a half turn about a fixed axis
@@ -296,7 +297,7 @@ def tool_axis_orientations(
         roll_free: a direction counts as reached when any of its rolls is.
 
     Roll zero of direction ``d`` is ``Q(d) · A``: ``A`` a fixed rotation taking ``tool_axis`` to
-    ``about`` (:func:`_align`), ``Q(d)`` the smallest rotation taking ``about`` to ``d``; roll
+    ``about`` (:func:`align_rotations`), ``Q(d)`` the smallest rotation taking ``about`` to ``d``; roll
     ``ρ`` is then ``Q(d) · A · Rot(tool_axis, ρ)``.
     """
     tool_axis = _unit(tool_axis, "tool_axis")
@@ -306,8 +307,8 @@ def tool_axis_orientations(
     total = dirs.shape[0] * roll_steps
     if total > MAX_ORIENTATIONS:
         raise InvalidInput(f"{dirs.shape[0]} directions × {roll_steps} rolls = {total} poses per voxel, more than {MAX_ORIENTATIONS}")
-    A = _align(tool_axis, about_u[None])[0]
-    Q = _align(about_u, dirs)
+    A = align_rotations(tool_axis, about_u[None])[0]
+    Q = align_rotations(about_u, dirs)
     rolls = _rotation_about(tool_axis, 2.0 * np.pi * np.arange(roll_steps) / roll_steps)
     rot = np.einsum("dij,jk,rkl->dril", Q, A, rolls).reshape(-1, 3, 3)
     group = np.repeat(np.arange(dirs.shape[0]), roll_steps)

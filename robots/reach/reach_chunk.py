@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pinarms.errors import InvalidInput
-from pinarms.robots.reach.reach_map import _centres
+from pinarms.robots.reach.reach_map import cell_centres
 from pinarms.robots.reach.robot_spec import RobotSpec, robot_of, spec_key
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -126,7 +126,7 @@ def _best_per_target(idx: np.ndarray, w: np.ndarray, n_targets: int) -> tuple[np
 
 def _poses(task: ChunkTask) -> np.ndarray:
     """Targets ``(n·M, 4, 4)``: voxel-major, orientation-minor."""
-    P = _centres(task.origin, task.resolution, task.shape, task.voxels)
+    P = cell_centres(task.origin, task.resolution, task.shape, task.voxels)
     n, M = P.shape[0], task.rotations.shape[0]
     T = np.zeros((n, M, 4, 4))
     T[:, :, :3, :3] = task.rotations[None]

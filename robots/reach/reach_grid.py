@@ -16,7 +16,7 @@ import numpy as np
 from scipy import ndimage
 
 from pinarms.errors import InvalidInput, ModelError
-from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, _centres
+from pinarms.robots.reach.reach_map import MAX_GRID_VOXELS, cell_centres
 
 if TYPE_CHECKING:  # pragma: no cover
     from pinarms.robots.robot import Robot
@@ -95,7 +95,7 @@ def bounding_grid(arm: "Robot", resolution: float) -> ReachGrid:
     all_centres_inside = np.zeros(n_grid, dtype=bool)
     for start in range(0, n_grid, 1 << 21):
         flat = np.arange(start, min(n_grid, start + (1 << 21)))
-        c = _centres(origin, resolution, shape, flat)
+        c = cell_centres(origin, resolution, shape, flat)
         all_centres_inside[flat] = np.einsum("ij,ij->i", c - centre, c - centre) <= radius * radius
     return ReachGrid(origin=origin, resolution=resolution, shape=shape, centre=centre, radius=radius,
                      inside=all_centres_inside)

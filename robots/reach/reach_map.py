@@ -22,13 +22,15 @@ from pinarms.robots.reach.orientations import OrientationSet
 if TYPE_CHECKING:  # pragma: no cover
     from pinarms.robots.reach.voxels import VoxelMap
 
-__all__ = ["ReachabilityMap", "PoseSolutions", "MAX_GRID_VOXELS"]
+__all__ = ["ReachabilityMap", "PoseSolutions", "MAX_GRID_VOXELS", "cell_centres"]
 
 #: Most voxels the grid box may hold (the guaranteed bound of the reach at this resolution).
 MAX_GRID_VOXELS = 200_000_000
 
 
-def _centres(origin: np.ndarray, resolution: float, shape: tuple, flat: np.ndarray) -> np.ndarray:
+def cell_centres(origin: np.ndarray, resolution: float, shape: tuple, flat: np.ndarray) -> np.ndarray:
+    """Centres (N, 3) [m] of the voxels with flat indices ``flat`` in a grid of ``shape`` from corner ``origin``
+    with edge ``resolution`` [m]."""
     ijk = np.stack(np.unravel_index(flat, shape), axis=1)
     return origin + (ijk + 0.5) * resolution
 
@@ -136,7 +138,7 @@ class ReachabilityMap:
     def centres(self, voxels: np.ndarray | None = None) -> np.ndarray:
         """Centres ``(n, 3)`` [m] of grid flat indices (default: the computed voxels)."""
         flat = self.voxels if voxels is None else np.asarray(voxels, dtype=np.int64)
-        return _centres(self.origin, self.resolution, self.shape, flat)
+        return cell_centres(self.origin, self.resolution, self.shape, flat)
 
     def rows_of(self, points: ArrayLike) -> np.ndarray:
         """Row into :attr:`voxels` of the voxel holding each of ``points (N, 3)`` [m]; −1 when not computed or outside."""

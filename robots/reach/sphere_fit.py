@@ -13,7 +13,8 @@ from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
-__all__ = ["SPHERE_COVERAGE_MIN", "SphereFit", "fit_sphere", "fit_sphere_to_hull", "hull_points", "direction_coverage"]
+__all__ = ["SPHERE_COVERAGE_MIN", "SphereFit", "fit_sphere", "fit_sphere_to_hull", "hull_points", "direction_coverage",
+           "direction_cells", "as_points"]
 
 #: :attr:`SphereFit.coverage` below which a sphere fit is flagged as not describing the cloud.
 SPHERE_COVERAGE_MIN = 0.5
@@ -62,7 +63,7 @@ def fit_sphere(points: ArrayLike) -> SphereFit:
     Solves ``|p|² = 2 c·p + (r² − |c|²)`` for ``c`` and ``r`` (the algebraic fit): exact for
     points on a sphere, and the usual first step for points near one.
     """
-    P = _as_points(points, "points")
+    P = as_points(points, "points")
     if P.shape[0] < 4:
         raise InvalidInput(f"a sphere fit needs at least 4 points, got {P.shape[0]}")
     A = np.column_stack([2.0 * P, np.ones(P.shape[0])])
@@ -75,7 +76,7 @@ def fit_sphere(points: ArrayLike) -> SphereFit:
                      direction_coverage(P, centre))
 
 
-def _direction_cells(points: np.ndarray, centre: np.ndarray, n_bins: int | None) -> tuple[np.ndarray, np.ndarray, int]:
+def direction_cells(points: np.ndarray, centre: np.ndarray, n_bins: int | None) -> tuple[np.ndarray, np.ndarray, int]:
     """Equal-area direction cell of every point seen from ``centre``, its distance, and the cell count.
 
     Directions are cut into ``n_z`` bands of ``cos(polar angle)`` times ``2 n_z`` azimuth
@@ -99,9 +100,9 @@ def _direction_cells(points: np.ndarray, centre: np.ndarray, n_bins: int | None)
 def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = None) -> np.ndarray:
     """The farthest point from ``centre`` in each direction cell (indices into ``points``).
 
-    Cells as in :func:`_direction_cells`: equal-area, about 30 samples each by default.
+    Cells as in :func:`direction_cells`: equal-area, about 30 samples each by default.
     """
-    cell, r, n_cells = _direction_cells(points, centre, n_bins)
+    cell, r, n_cells = direction_cells(points, centre, n_bins)
     rmax = np.full(n_cells, -1.0)
     np.maximum.at(rmax, cell, r)
     is_max = r == rmax[cell]
@@ -113,8 +114,8 @@ def hull_points(points: np.ndarray, centre: np.ndarray, n_bins: int | None = Non
 
 def direction_coverage(points: ArrayLike, centre: ArrayLike, n_bins: int | None = None) -> float:
     """Share of the direction cells around ``centre`` [m] that hold at least one of ``points``."""
-    P = _as_points(points, "points")
-    cell, _, n_cells = _direction_cells(P, np.asarray(centre, dtype=float), n_bins)
+    P = as_points(points, "points")
+    cell, _, n_cells = direction_cells(P, np.asarray(centre, dtype=float), n_bins)
     return float(np.unique(cell).size / n_cells)
 
 
@@ -127,7 +128,7 @@ def fit_sphere_to_hull(points: ArrayLike, n_bins: int | None = None, iterations:
     points: they measure how spherical the boundary is. With few samples the hull lies
     inside the true boundary (the outer shell is sparse), so the radius is biased low.
     """
-    P = _as_points(points, "points")
+    P = as_points(points, "points")
     if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or iterations < 1:
         raise InvalidInput(f"iterations must be an integer >= 1, got {iterations!r}")
     if n_bins is not None and (isinstance(n_bins, bool) or not isinstance(n_bins, (int, np.integer)) or n_bins < 8):
@@ -142,7 +143,12 @@ def fit_sphere_to_hull(points: ArrayLike, n_bins: int | None = None, iterations:
                      direction_coverage(P, fit.centre, n_bins))
 
 
-def _as_points(points: Any, what: str) -> np.ndarray:
+def as_points(points: ArrayLike, what: str) -> np.ndarray:
+    """``points`` as an (N, 3) float array [m] (one (3,) point as one row); ``what`` names them in the error.
+
+    Raises:
+        InvalidInput: not numbers, or another shape.
+    """
     try:
         P = np.asarray(points, dtype=float)
     except (TypeError, ValueError) as exc:

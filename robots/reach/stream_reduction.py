@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pinarms.robots.reach.sphere_fit import _direction_cells
+from pinarms.robots.reach.sphere_fit import direction_cells
 
 __all__ = ["Reduction", "ReductionSpec", "add_block", "merge", "sparse_voxels"]
 
@@ -113,7 +113,7 @@ def add_block(acc: Reduction, P: np.ndarray, w: np.ndarray, c: np.ndarray, spec:
     acc.shell_sum_w[:k] += np.bincount(shell, weights=w, minlength=k)
     acc.shell_singular[:k] += np.bincount(shell, weights=singular, minlength=k).astype(np.int64)
     # direction cells: the farthest sample per cell, first sample on ties
-    cell, rc, n_cells = _direction_cells(P, spec.centre, spec.n_dir_bins)
+    cell, rc, n_cells = direction_cells(P, spec.centre, spec.n_dir_bins)
     if acc.hull_r is None:
         acc.hull_r = np.full(n_cells, -1.0)
         acc.hull_point = np.zeros((n_cells, 3))

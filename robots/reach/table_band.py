@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
-from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, _as_point, _check_threshold, radial_distance
+from pinarms.robots.reach.workspace import SINGULAR_INVERSE_CONDITION, as_point, check_singular_threshold, radial_distance
 
 if TYPE_CHECKING:  # pragma: no cover
     from pinarms.robots.reach.workspace import Workspace
@@ -148,7 +148,7 @@ class RegionCriteria:
                 raise InvalidInput(f"{name} must be a number, got {v!r}")
             if not (0.0 <= v <= 1.0):
                 raise InvalidInput(f"{name} must be a share in [0, 1], got {v!r}")
-        object.__setattr__(self, "singular_threshold", _check_threshold(self.singular_threshold))
+        object.__setattr__(self, "singular_threshold", check_singular_threshold(self.singular_threshold))
         seed, n = self.seed, self.n_collision
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
@@ -228,7 +228,7 @@ def _shells_origin(workspace: "Workspace", origin: Any, about: str) -> np.ndarra
         origin = workspace.fit_sphere().centre.copy()
         if about == "axis":
             origin[2] = 0.0
-    return _as_point(origin, "origin")
+    return as_point(origin, "origin")
 
 
 def _checked_options(about: Any, side: Any, width: Any, z_clearance: Any) -> None:

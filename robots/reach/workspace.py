@@ -36,7 +36,7 @@ from pinarms.robots.robot import MAX_RANDOM_SAMPLES
 from pinarms.robots.reach.dexterity import CHUNK, position_dexterity, positions_and_dexterity
 from pinarms.robots.reach.joint_samples import random_q_slice
 from pinarms.robots.reach.sphere_fit import (  # noqa: F401  (the sphere fits: their own module, re-exported here)
-    SPHERE_COVERAGE_MIN, SphereFit, _as_points, _direction_cells, direction_coverage,
+    SPHERE_COVERAGE_MIN, SphereFit, as_points, direction_cells, direction_coverage,
     fit_sphere, fit_sphere_to_hull, hull_points)
 from pinarms.robots.reach.voxels import VoxelMap, suggest_voxel_size
 
@@ -47,6 +47,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "SINGULAR_INVERSE_CONDITION",
+    "as_point",
+    "check_singular_threshold",
     "SPHERE_COVERAGE_MIN",
     "Workspace",
     "WorkspaceSummary",
@@ -187,7 +189,7 @@ class Workspace:
 
     def near_singular(self, threshold: float = SINGULAR_INVERSE_CONDITION) -> np.ndarray:
         """``(n,)`` bool: samples whose ``σ_min/σ_max`` of ``J_v`` is below ``threshold`` (in (0, 1])."""
-        return self.inverse_condition < _check_threshold(threshold)
+        return self.inverse_condition < check_singular_threshold(threshold)
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """``(min (3,), max (3,))`` of the sampled points [m]."""
@@ -215,8 +217,8 @@ class Workspace:
         """
         if not (isinstance(width, (int, float, np.integer, np.floating)) and np.isfinite(width) and width > 0):
             raise InvalidInput(f"shell width must be a positive length in m, got {width!r}")
-        singular_threshold = _check_threshold(singular_threshold)
-        origin = self.fit_sphere().centre if origin is None else _as_point(origin, "origin")
+        singular_threshold = check_singular_threshold(singular_threshold)
+        origin = self.fit_sphere().centre if origin is None else as_point(origin, "origin")
         P, w, c = self.points, self.manipulability, self.inverse_condition
         if mask is not None:
             mask = np.asarray(mask, dtype=bool)
@@ -242,7 +244,7 @@ class Workspace:
 
     def summary(self, *, width: float = 0.05, singular_threshold: float = SINGULAR_INVERSE_CONDITION) -> WorkspaceSummary:
         """Bounding box, outer-hull sphere, radial profile (shells of ``width`` m) and singular share."""
-        singular_threshold = _check_threshold(singular_threshold)
+        singular_threshold = check_singular_threshold(singular_threshold)
         lo, hi = self.bounding_box()
         sphere = self.fit_sphere()
         profile = self.radial_profile(sphere.centre, width=width, singular_threshold=singular_threshold)
@@ -376,7 +378,7 @@ def _sample_in_tasks(robot, n, seed, frame, chunk, task_samples, scheduler, prog
 
 
 # ------------------------------------------------------------------ helpers
-def _check_threshold(threshold: Any) -> float:
+def check_singular_threshold(threshold: float) -> float:
     """``singular_threshold``: a ``σ_min/σ_max`` bound in (0, 1]."""
     ok = isinstance(threshold, (int, float, np.integer, np.floating)) and not isinstance(threshold, bool)
     if not (ok and 0.0 < float(threshold) <= 1.0):
@@ -386,10 +388,15 @@ def _check_threshold(threshold: Any) -> float:
     return float(threshold)
 
 
-def _as_point(point: Any, what: str) -> np.ndarray:
+def as_point(point: ArrayLike, what: str) -> np.ndarray:
+    """``point`` as one (3,) float array [m]; ``what`` names it in the error.
+
+    Raises:
+        InvalidInput: not one point of three numbers.
+    """
     if np.shape(point) not in ((3,), (1, 3)):
         raise InvalidInput(f"{what} must be one point (3,) [m], got shape {np.shape(point)}")
-    P = _as_points(point, what)
+    P = as_points(point, what)
     if P.shape[0] != 1:
         raise InvalidInput(f"{what} must be one point (3,) [m], got shape {np.shape(point)}")
     return P[0]

@@ -47,7 +47,7 @@ from pinarms.robots.reach.workspace import (
     RadialProfile,
     SphereFit,
     WorkspaceSummary,
-    _check_threshold,
+    check_singular_threshold,
     fit_sphere,
     sample_workspace,
 )
@@ -170,7 +170,7 @@ class StreamGrid:
         w, v = self.width, self.voxel_size
         if not (isinstance(w, (int, float, np.integer, np.floating)) and np.isfinite(w) and w > 0):
             raise InvalidInput(f"shell width must be a positive length in m, got {w!r}")
-        object.__setattr__(self, "singular_threshold", _check_threshold(self.singular_threshold))
+        object.__setattr__(self, "singular_threshold", check_singular_threshold(self.singular_threshold))
         if v is not None and not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v) and v > 0):
             raise InvalidInput(f"voxel_size must be a positive length in m, got {v!r}")
 

@@ -12,7 +12,7 @@ from pinarms.optim.motion import (SCENES, MotionChecker, MotionLimits, MotionOpt
                                    plan_motion, scene_queries)
 from pinarms.optim.motion.ends import goal_candidates
 from pinarms.optim.motion.fast import fast_check, fast_search, fast_shortcut
-from pinarms.robots.cell._cover_kernel import _cylinder_box_gap
+from pinarms.robots.cell.box_kernel import cylinder_box_gap
 
 from tests.robots.cell.random_shapes import cylinder_and_box
 
@@ -124,13 +124,13 @@ def test_cylinder_box_gap_is_a_lower_bound_of_coal_distance():
     for _ in range(300):
         r, h, half, Rb, pb, Rc, pc = cylinder_and_box(rng, 0.02)
         a, b = pc - h * Rc[:, 2], pc + h * Rc[:, 2]
-        gap = _cylinder_box_gap(a, b, r, Rb, pb, half)
+        gap = cylinder_box_gap(a, b, r, Rb, pb, half)
         req, res = coal.DistanceRequest(), coal.DistanceResult()
         d = coal.distance(coal.Cylinder(r, 2 * h), coal.Transform3s(Rc, pc), coal.Box(*(2 * half)),
                           coal.Transform3s(Rb, pb), req, res)
         assert gap <= max(d, 0.0) + 1e-9
     # upright over a face it is exact
-    gap = _cylinder_box_gap(np.array([0.0, 0.0, 0.15]), np.array([0.0, 0.0, 0.25]), 0.05, np.eye(3), np.zeros(3),
+    gap = cylinder_box_gap(np.array([0.0, 0.0, 0.15]), np.array([0.0, 0.0, 0.25]), 0.05, np.eye(3), np.zeros(3),
                             np.array([0.1, 0.1, 0.1]))
     assert gap == pytest.approx(0.05, abs=1e-12)
 

@@ -75,16 +75,16 @@ def test_a_layout_worker_rebuilds_the_cell_with_its_hold(tmp_path):
     import pickle
 
     from pinarms.optim.layout import LayoutRequest
-    from pinarms.optim.layout.evaluate import _CELLS, _cell_of
+    from pinarms.optim.layout.evaluate import _cell_of, forget_cell
     from pinarms.optim.layout.search import _cell_recipe
 
     cell = _cell(tmp_path, "hold = [0.0, -1.2]")
     request = LayoutRequest(cell, np.array([0.3, 0.0, 0.8]), np.array([0.0, 0.3, 0.8]), np.zeros((1, 4)), arm="a",
                             clearance=0.02)
     recipe = _cell_recipe(request, "hold-test-token")
-    _CELLS.pop("hold-test-token")  # as in a worker process: the cell is rebuilt from the (pickled) recipe
+    forget_cell("hold-test-token")  # as in a worker process: the cell is rebuilt from the (pickled) recipe
     rebuilt = _cell_of(pickle.loads(pickle.dumps(recipe)))
-    _CELLS.pop("hold-test-token")
+    forget_cell("hold-test-token")
     assert rebuilt is not cell
     np.testing.assert_array_equal(rebuilt.hold, cell.hold)
     assert dict(rebuilt.arm("b").frozen) == {"finger_joint": 0.0}

@@ -61,9 +61,9 @@ def test_trajectory_limits_and_controller_files_let_the_wrist_turn_past_pi(turne
 
 def test_kinova_jaco2_wrist_beyond_pi_is_within_its_limits():
     """The finding: the Jaco2's wrist (j2s6s200_joint_6, continuous) at 3.23083 rad was 'outside [-3.14159, 3.14159]'."""
-    from pinarms.robots.registry import _example_robot_data_share
+    from pinarms.robots.registry import example_robot_data_share
 
-    share = _example_robot_data_share()
+    share = example_robot_data_share()
     jaco = robots.from_urdf(share / "robots" / "kinova_description" / "robots" / "kinova.urdf",
                             package_dirs=(str(share.parent),))
     assert [n for n, c in zip(jaco.joint_names, jaco.continuous) if c] == [

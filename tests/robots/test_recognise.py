@@ -10,7 +10,7 @@ import pytest
 
 from pinarms import robots
 from pinarms.errors import ModelError
-from pinarms.robots.ik import _FAMILY_OF, analytic_solver, attach_analytic_ik, recognise
+from pinarms.robots.ik import FAMILY_OF, analytic_solver, attach_analytic_ik, recognise
 from pinarms.robots.ik.solver import PROOF_SAMPLES
 from pinarms.robots.registry import builtin_urdf_path, match_builtin
 
@@ -54,14 +54,14 @@ def _text(name: str) -> str:
 @pytest.mark.parametrize("name", robots.names())
 def test_every_registry_arm_gets_the_family_it_had_by_name(name):
     robot = robots.load(name)
-    assert robot.ik_family == _FAMILY_OF.get(name)  # koji_turner_rail (redundant) and panda (7 DoF): None
+    assert robot.ik_family == FAMILY_OF.get(name)  # koji_turner_rail (redundant) and panda (7 DoF): None
     assert robot.has_analytic_ik == (robot.ik_family is not None)
 
 
 @pytest.mark.parametrize("name", ["scara_mushroom", "aubo_i3", "gantry_flower", "koji_turner", "ur5"])
 def test_recognised_solver_gives_the_same_solutions_as_the_named_one(name):
     robot = robots.load(name)
-    named = analytic_solver(robot, _FAMILY_OF[name])
+    named = analytic_solver(robot, FAMILY_OF[name])
     T = robot.fk(robot.random_q(30, seed=3))
     for got, want in zip(robot.ik_all(T), named.solve(T)):
         np.testing.assert_array_equal(got, want)

@@ -32,9 +32,9 @@ def test_cell_study_plans_are_reused_and_equal_the_shipped_ones():
     assert by_name["station_cycle"].source is kept["station_cycle"]  # taken, not planned again
     assert by_name["line_schedule"].source is kept["schedule"]
     assert by_name["line_left_cycle"].source is kept["line_cycles"]["left"]
-    from pinarms.studies.seed001_motion import _planned_move_001
+    from pinarms.optim.motion.crate_guard import crate_guard_move
 
-    assert by_name["crate_guard_move"].source is _planned_move_001()[1]["plan"]  # planned once per process
+    assert by_name["crate_guard_move"].source is crate_guard_move().plan  # planned once per process
     # the same motions as planning them afresh: cycle times, schedule, trajectories
     for a, b in zip(reused, fresh):
         assert (a.arm, a.cell.name, sorted(a.cycles)) == (b.arm, b.cell.name, sorted(b.cycles))

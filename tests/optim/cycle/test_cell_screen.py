@@ -59,10 +59,10 @@ def test_an_attempt_rejected_at_a_via_point_is_recorded_and_named():
     # every attempt is there: the screens skip the timing and the checks, not the attempts
     assert int(str(err.value).split(" after ")[1].split()[0]) >= 10
     # a raised lift puts a via point closer than the clearance (what the screen rejects untimed)
-    from pinarms.optim.cycle.joint import _via_points
+    from pinarms.optim.cycle.joint import via_points
 
     last = dataclasses.replace(spec, lift=0.05 + 0.02 * 9)
-    q = _via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
+    q = via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
     Q = np.repeat(cell.neutral[None], len(q), axis=0)
     Q[:, arm.q_slice] = q
     assert cell.with_pairs("external").clearance(Q).distance.min() < 0.02
@@ -129,9 +129,9 @@ def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
     trials = in_cell._Trials(CycleRequest(arm.robot, spec, cell=settings), arm, cell.neutral.copy())
     last = dataclasses.replace(spec, lift=0.05 + 0.02 * 9)
     assert not trials.branches_screened("lift", last.poses(arm.robot)[1:-1])
-    from pinarms.optim.cycle.joint import _via_points
+    from pinarms.optim.cycle.joint import via_points
 
-    q = _via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
+    q = via_points(arm.robot, last.poses(arm.robot), last.names, None)[0]
     Q = np.repeat(cell.neutral[None], len(q), axis=0)
     Q[:, arm.q_slice] = q
     assert trials.attempts[-1][2] >= cell.with_pairs("external").clearance(Q).distance.min() - 1e-12
@@ -150,7 +150,7 @@ def test_the_branch_screen_rejects_only_what_the_via_points_reject(monkeypatch):
 
 def test_a_cycle_stopped_after_its_move_to_place_is_the_same_cycle_when_let_through(station):
     """joint_cycle's hook: the move to place first (the screen may stop it there), then the move back."""
-    from pinarms.optim.cycle.joint import _via_points, joint_cycle
+    from pinarms.optim.cycle.joint import via_points, joint_cycle
 
     arm = station.arm("aubo")
     spec = optim.PickPlace(arm.to_base(PICK), arm.to_base(CRATE), lift=0.05, dwell=0.2)
@@ -158,7 +158,7 @@ def test_a_cycle_stopped_after_its_move_to_place_is_the_same_cycle_when_let_thro
     seen = []
     assert joint_cycle(request, there_clear=lambda move: seen.append(move) or False) is None
     whole = joint_cycle(request)
-    via = _via_points(arm.robot, spec.poses(arm.robot), spec.names, None)
+    via = via_points(arm.robot, spec.poses(arm.robot), spec.names, None)
     let = joint_cycle(request, via=via, there_clear=lambda move: True)
     assert let.cycle_time == whole.cycle_time and np.array_equal(let.q_via, whole.q_via)
     # the move it was shown is the cycle's move to place

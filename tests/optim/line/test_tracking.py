@@ -150,9 +150,9 @@ def test_a_continuous_wrist_stays_on_one_turn_through_the_tracking_segment():
     continuous angle in (-π, π], so a wrist near ±π jumped a whole turn between two samples of the
     tracking segment (joint 6 at 1.31e4 rad/s², the pick infeasible). Each sample now takes the turn
     nearest the previous one: the tracking segment is smooth and within the limits."""
-    from pinarms.robots.registry import _example_robot_data_share
+    from pinarms.robots.registry import example_robot_data_share
 
-    share = _example_robot_data_share()
+    share = example_robot_data_share()
     jaco = robots.from_urdf(share / "robots" / "kinova_description" / "robots" / "kinova.urdf",
                             tcp="j2s6s200_end_effector", package_dirs=(str(share.parent),))
     belt = Belt((0.0, 0.0, 0.80), speed=0.1, width=0.3, length=2.0)

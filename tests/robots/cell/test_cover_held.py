@@ -1,5 +1,5 @@
 """A moving mesh held by its slices' cylinders beside its spheres (robots.cell.mesh_cover.mesh_parts,
-robots.cell._box_kernel): every piece of every UR5 mesh inside a cylinder and its sphere, the bounds against
+robots.cell.box_kernel): every piece of every UR5 mesh inside a cylinder and its sphere, the bounds against
 static boxes below coal's exact distance, and the cover never clearing a state coal finds closer than the margin."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import coal
 import numpy as np
 import pytest
 from pinarms.optim.motion import MotionChecker, load_scene
-from pinarms.robots.cell._box_kernel import _held_low, _toward_gap
-from pinarms.robots.cell._cover_kernel import _fk
+from pinarms.robots.cell.box_kernel import held_low, _toward_gap
+from pinarms.robots.cell.cover_kernel import _fk
 from pinarms.robots.cell.cover import MESH_SPHERES, link_cover, pair_arrays
 from pinarms.robots.cell.mesh_cover import (
     mesh_arrays,
@@ -121,8 +121,8 @@ def test_held_low_answers_early_and_passes_over_far_cylinders():
         SA[:] = np.einsum("sab,sb->sa", R[sjoint], sa) + p[sjoint]
         SB[:] = np.einsum("sab,sb->sa", R[sjoint], sb) + p[sjoint]
         args = (W, cover.radius, SA, SB, srad, sstart, spart, ua, cover.frame_R, cover.frame_p, cover.size, fx)
-        full = _held_low(*args, -np.inf, np.inf)
+        full = held_low(*args, -np.inf, np.inf)
         for t in (full - 1e-3, full + 1e-3):
-            assert (_held_low(*args, t, t) > t) == (full > t)  # the screen's question, answered early
-            cut = _held_low(*args, -np.inf, t)  # the excess: the bound where it is at most the cut, else above it
+            assert (held_low(*args, t, t) > t) == (full > t)  # the screen's question, answered early
+            cut = held_low(*args, -np.inf, t)  # the excess: the bound where it is at most the cut, else above it
             assert cut == full if full <= t else cut > t

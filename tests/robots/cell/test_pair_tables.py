@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from pinarms.optim.motion import MotionChecker, load_scene
 from pinarms.robots.cell import pair_tables as pt
-from pinarms.robots.cell._cover_kernel import _fk, table_low
+from pinarms.robots.cell.cover_kernel import _fk, table_low
 from pinarms.robots.cell.cover import link_cover, pair_arrays
 
 N = 2000

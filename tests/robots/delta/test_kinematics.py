@@ -18,6 +18,26 @@ def _serpentine(theta: np.ndarray, lower: float, upper: float, k: int = 12) -> n
     return np.lexsort((m2, j2, i))
 
 
+#: R. L. Williams II, "The Delta Parallel Robot: Kinematics Solutions" (Ohio University, 2015), worked
+#: examples for the ABB FlexPicker dimensions (sB 567, sP 76, L 524, l 1244 mm), as printed there and
+#: reproduced by github.com/Pieces98/Deltarobot_Kinematics: motor angles [deg] -> platform [mm], in
+#: Williams' frame (leg 1 along -y, so his frame is ours turned by -90 degrees about z).
+WILLIAMS_EXAMPLES = (((0.0, 0.0, 0.0), (0.0, 0.0, -1064.4517)),
+                     ((10.0, 20.0, 30.0), (108.1354, -180.3484, -1243.5413)),
+                     ((-20.5, -20.5, -20.5), (0.0, 0.0, -900.3195)),
+                     ((47.5, -11.6, 21.4), (300.4598, 499.9385, -1099.8281)))
+
+
+@pytest.mark.parametrize("theta_deg, p_mm", WILLIAMS_EXAMPLES)
+def test_the_shipped_delta_reproduces_williams_worked_examples(delta, theta_deg, p_mm):
+    """The shipped geometry is the published one: each example to its printed 0.1 um, both ways."""
+    ours_to_williams = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    p = ours_to_williams @ forward_position(delta.geometry, np.radians(theta_deg)) * 1000.0
+    assert np.round(p, 4) + 0.0 == pytest.approx(p_mm, abs=1e-4)
+    back = inverse_position(delta.geometry, ours_to_williams.T @ np.asarray(p_mm) / 1000.0)
+    assert np.degrees(back) == pytest.approx(theta_deg, abs=1e-3)
+
+
 @pytest.mark.slow
 def test_closed_form_equals_pinocchio_projection_on_10000_configurations(delta):
     """Every passive joint solved by Newton's projection onto the closures (Pinocchio's constraint

@@ -45,10 +45,10 @@ def test_the_best_base_reaches_every_task_by_an_independent_ik(aubo, down_map):
 
 
 def _roll(T, axis, angle):
-    from pinarms.robots.reach.orientations import _rotation_about
+    from pinarms.robots.so3 import about as rotations_about
 
     out = T.copy()
-    out[:3, :3] = T[:3, :3] @ _rotation_about(np.asarray(axis, float), np.array([angle]))[0]
+    out[:3, :3] = T[:3, :3] @ rotations_about(np.asarray(axis, float), np.array([angle]))[0]
     return out
 
 

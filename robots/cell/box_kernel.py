@@ -1,4 +1,4 @@
-"""Compiled lower bounds of distances to the static boxes, cylinders and spheres of a cell, for :mod:`._cover_kernel`
+"""Compiled lower bounds of distances to the static boxes, cylinders and spheres of a cell, for :mod:`.cover_kernel`
 (numba): a point's distance, and a moving cylinder's (one, or a mesh's slice cylinders beside their spheres,
 :func:`.mesh_cover.mesh_parts`) through the gaps of its projections on a few lines (a projection shortens every
 distance). Cached on disk like the other kernels. Lengths in m, the world frame.
@@ -14,7 +14,7 @@ from pinarms.compiled import jit, jit_inline
 
 
 @jit_inline
-def _fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
+def fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
     """Distance [m] from point ``x`` to the static box (1), cylinder (2, axis z) or sphere (3) ``o``
     (world rotation ``FR[o]``, centre ``Fp[o]``, ``size[o]``); 0 inside."""
     d0, d1, d2 = x0 - Fp[o, 0], x1 - Fp[o, 1], x2 - Fp[o, 2]
@@ -34,7 +34,7 @@ def _fixture_distance(x0, x1, x2, kind, FR, Fp, size, o):
 
 
 @jit
-def _cylinder_box_gap(a, b, r, FR, Fp, half):
+def cylinder_box_gap(a, b, r, FR, Fp, half):
     """A lower bound [m] of the distance between the solid cylinder of axis ``a b`` and radius ``r`` and a
     static box (world rotation ``FR``, centre ``Fp``, half sides ``half``): the widest gap between their
     projections on the box's three axes (a projection shortens every distance). Exact for a cylinder
@@ -45,7 +45,7 @@ def _cylinder_box_gap(a, b, r, FR, Fp, half):
 
 @jit_inline
 def _box_gap(SA, SB, k, r, FR, Fp, half, o):
-    """:func:`_cylinder_box_gap` of the cylinder ``SA[k] SB[k]`` and the box ``o`` (``FR[o]``, ``Fp[o]``, ``half[o]``)."""
+    """:func:`cylinder_box_gap` of the cylinder ``SA[k] SB[k]`` and the box ``o`` (``FR[o]``, ``Fp[o]``, ``half[o]``)."""
     u0, u1, u2 = SB[k, 0] - SA[k, 0], SB[k, 1] - SA[k, 1], SB[k, 2] - SA[k, 2]
     L = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
     if L > 0.0:
@@ -63,7 +63,7 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
 
 
 @jit_inline
-def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut):
+def held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut):
     """A lower bound [m] of the distance from moving geometry ``g`` held by its cylinders (:mod:`.cover`) to the static
     box ``o``: the least over cylinders ``k`` of the larger of its gaps (:func:`_box_gap`, :func:`_toward_gap`) and
     the distances of the spheres ``spart[k]`` holding its pieces. Only a bound at most ``cut`` is meant: a cylinder
@@ -81,7 +81,7 @@ def _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut
             held = spart[k, 0]  # a new sphere (a slice's cylinders follow each other, sharing their sphere)
             near = np.inf
             for s in range(spart[k, 0], spart[k, 1]):
-                near = min(near, _fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
+                near = min(near, fixture_distance(W[s, 0], W[s, 1], W[s, 2], 1, FR, Fp, half, o) - radius[s])
         if near >= low or near > cut:
             continue
         if not many:

@@ -15,11 +15,11 @@ import numpy as np
 
 from pinarms.compiled import drop_stale_caches, jit, jit_inline
 
-from pinarms.robots.cell import _box_kernel
-from pinarms.robots.cell._box_kernel import _cylinder_box_gap, _fixture_distance, _held_low  # noqa: F401 (importable from here)
+from pinarms.robots.cell import box_kernel
+from pinarms.robots.cell.box_kernel import fixture_distance, held_low
 
-# these kernels inline the bounds of _box_kernel: its changes must compile them again (pinarms.compiled)
-drop_stale_caches([Path(_box_kernel.__file__), Path(__file__)],
+# these kernels inline the bounds of box_kernel: its changes must compile them again (pinarms.compiled)
+drop_stale_caches([Path(box_kernel.__file__), Path(__file__)],
                   "cover_kernels.sha256")
 
 
@@ -108,7 +108,7 @@ def _cylinder_distance(x0, x1, x2, SA, SB, k, r):
 def _exact_distance(x0, x1, x2, other, exact, FR, Fp, size, SA, SB, srad, sstart):
     """Distance [m] from point ``x`` to geometry ``other`` taken exactly (a static shape, or a moving cylinder)."""
     if exact[other] != 0:
-        return _fixture_distance(x0, x1, x2, exact[other], FR, Fp, size, other)
+        return fixture_distance(x0, x1, x2, exact[other], FR, Fp, size, other)
     k = sstart[other]
     return _cylinder_distance(x0, x1, x2, SA, SB, k, srad[k])
 
@@ -121,7 +121,7 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
     if cyl[g] != 0 and exact[other] == 1:
-        return _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, t) > t
+        return held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, t) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -162,14 +162,14 @@ def screen_kernel(Q, fk, cov, grp, work, stop, out):
     hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
     HW = work[5]
     for i in range(Q.shape[0]):
-        _place(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+        place_world(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
         ok = True
         for g in range(group_t.shape[0]):
-            if _apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
+            if spheres_apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
                 continue
             fixed = group_fixed[g]
             ha = group_a[g]
-            if fixed >= 0 and _fixture_distance(HW[ha, 0], HW[ha, 1], HW[ha, 2], exact[fixed], FR, Fp, size, fixed) \
+            if fixed >= 0 and fixture_distance(HW[ha, 0], HW[ha, 1], HW[ha, 2], exact[fixed], FR, Fp, size, fixed) \
                     - hrad[ha] > group_t[g]:
                 continue
             for k in range(group_start[g], group_start[g + 1]):
@@ -189,7 +189,7 @@ def pair_proven(cov, grp, work, k):
     """Whether pair ``k`` (the groups' order) is proven more than its threshold apart on ``work`` placed:
     its bounding spheres, its table (:func:`table_low`), its covers (:func:`_pair_clear`)."""
     ga, gb, t = grp[8][k], grp[9][k], grp[10][k]
-    if _apart(work[5], grp[2], ga, gb, t):
+    if spheres_apart(work[5], grp[2], ga, gb, t):
         return True
     tab = grp[11][k]
     if tab >= 0 and table_low(work[0], cov[14], tab) > t:
@@ -239,7 +239,8 @@ def table_low(R, tabs, t):
 
 
 @jit
-def _apart(HW, hrad, a, b, t):
+def spheres_apart(HW, hrad, a, b, t):
+    """Whether the bounding spheres ``a`` and ``b`` (world centres ``HW``, radii ``hrad`` [m]) are more than ``t`` apart."""
     reach = hrad[a] + hrad[b] + t
     e0 = HW[a, 0] - HW[b, 0]
     e1 = HW[a, 1] - HW[b, 1]
@@ -256,12 +257,12 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             - t >= best:
         return best
     if cyl[g] != 0 and exact[other] == 1:
-        return min(best, _held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf,
+        return min(best, held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf,
                                    t + best) - t)
     low = np.inf
     if exact[other] != 0:
         for s in range(start[g], start[g + 1]):
-            d = _fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other)
+            d = fixture_distance(W[s, 0], W[s, 1], W[s, 2], exact[other], FR, Fp, size, other)
             low = min(low, d - radius[s] - t)
         return min(best, low)
     # a moving cylinder: its axis once for all the spheres (the same arithmetic as _cylinder_distance)
@@ -317,7 +318,7 @@ def _hd(HW, hrad, a, b):
 
 
 @jit
-def _place(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work):
+def place_world(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work):
     """Forward kinematics of cell configuration ``q`` and the world centres of the cover's spheres,
     its cylinders' axis ends and the bounding spheres, into ``work`` (:meth:`Cover.work`'s arrays)."""
     parent, index, scale, offset, revolute, axis, MR, Mp = fk
@@ -362,7 +363,7 @@ def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
     ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
     proof's scaled excess (``inv``: one over each group's travel weight, :mod:`pinarms.optim.motion.link_levers`);
     ``inv`` empty (:data:`UNWEIGHTED`): every weight 1, the excess itself (:func:`excess_one`)."""
-    _place(q, fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+    place_world(q, fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
     return excess_placed(cov, grp, inv, cap, floor, work)
 
 
@@ -401,7 +402,7 @@ def place_moving(q, fk, cov, grp, work, moving):
 
 @jit
 def excess_placed(cov, grp, inv, cap, floor, work):
-    """:func:`excess_scaled` on ``work`` already placed (:func:`_place` or :func:`place_moving`).
+    """:func:`excess_scaled` on ``work`` already placed (:func:`place_world` or :func:`place_moving`).
 
     The group and pair tests run on the bounding spheres; a pair with a distance table takes the
     larger of its table's bound and its cover's (the table first: a pair it keeps above the
@@ -420,7 +421,7 @@ def excess_placed(cov, grp, inv, cap, floor, work):
         if (_hd(HW, hrad, a, group_b[g]) - group_t[g]) * s >= best:
             continue
         fixed = group_fixed[g]
-        if fixed >= 0 and (_fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed)
+        if fixed >= 0 and (fixture_distance(HW[a, 0], HW[a, 1], HW[a, 2], exact[fixed], FR, Fp, size, fixed)
                            - hrad[a] - group_t[g]) * s >= best:
             continue
         for k in range(group_start[g], group_start[g + 1]):
