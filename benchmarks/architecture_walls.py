@@ -348,9 +348,9 @@ def report(modules: dict[str, Path], top: int = 10) -> list[str]:
 
     uses = private_uses(modules)
     kinds = Counter(u.kind for u in uses)
-    lines = [f"uses of another module's private names: {len(uses)} "
-             f"({', '.join(f'{n} {k}' for k, n in sorted(kinds.items()))}; "
-             f"{sum(u.across_folders for u in uses)} across package folders)"]
+    lines = [f"uses of another module's private names: {len(uses)}" + (
+        f" ({', '.join(f'{n} {k}' for k, n in sorted(kinds.items()))}; "
+        f"{sum(u.across_folders for u in uses)} across package folders)" if uses else "")]
     by_name = Counter(u.name for u in uses)
     lines += [f"  {n:4d}  {name}" for name, n in by_name.most_common(top)]
     refs = docstring_references(modules)

@@ -69,14 +69,14 @@ def part_simulate() -> None:
 
 
 def part_maps() -> None:
-    from pinarms.optim.line import build_task_map, map_error
+    from pinarms.optim.line import MapRequest, build_task_map, map_error
     from pinarms.studies.line import ENOKI, scara_line
 
     spec = scara_line(1, 60.0)
     st = spec.stations[0]
     t = time.perf_counter()
-    m = build_task_map(st, spec.belt, spec.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=24, nw=7,
-                       refine=2)
+    m = build_task_map(MapRequest(st, spec.belt, spec.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=24,
+                                  nw=7, refine=2)).task_map
     print(f"[maps] one SCARA, 24 x 7 grid refined to {m.du.size} x {m.w.size}, {len(m.branches)} IK branches: built in "
           f"{time.perf_counter() - t:.1f} s, {np.isfinite(m.approach).sum()} feasible nodes")
     e = map_error(m, st, spec.belt, spec.tracking, n=100, item_height=ENOKI.size[2], seed=11)
@@ -238,6 +238,7 @@ def tray_scene():
 
 def part_trays(grid=(10, 5, 8)) -> None:
     """``trays [NU,NW,NV] [coarse]``: ``coarse`` leaves out the box map's approach times."""
+    from pinarms.optim.line.map_request import TrayMapRequest
     from pinarms.optim.line.tray_maps import build_tray_map, tray_map_error
     from pinarms.studies.line import maps_for
 
@@ -247,8 +248,8 @@ def part_trays(grid=(10, 5, 8)) -> None:
     st, belt, trays, kind = spec.stations[0], spec.belt, spec.trays["scara 1"], spec.stream.types[0]
     fine = None if "coarse" in sys.argv else maps_for(spec)[st.name][0]
     t = time.perf_counter()
-    m = build_tray_map(st, belt, trays, spec.tracking, mass=kind.mass, item_height=kind.size[2], nu=grid[0],
-                       nw=grid[1], nv=grid[2], approach_map=fine)
+    m = build_tray_map(TrayMapRequest(st, belt, trays, spec.tracking, mass=kind.mass, item_height=kind.size[2],
+                                      nu=grid[0], nw=grid[1], nv=grid[2], approach_map=fine)).task_map
     ok = np.isfinite(m.transfer + m.back)
     print(f"tray map {m.du.size} x {m.w.size} x {m.dv.size} ({'approach from the box map' if fine else 'coarse'}): "
           f"{time.perf_counter() - t:.1f} s, {ok.mean():.0%} of nodes feasible, dv {np.round(m.dv, 3).tolist()} m")
@@ -272,7 +273,7 @@ def _mushroom():
 
 
 def part_fixtures() -> None:
-    from pinarms.optim.line import TrackingSpec, build_task_map
+    from pinarms.optim.line import MapRequest, TrackingSpec, build_task_map
     from pinarms.optim.line.fixtures import _CHECKS, fixture_check
 
     cell, belt, st = _mushroom()
@@ -283,8 +284,8 @@ def part_fixtures() -> None:
         if label == "exact alone":
             fixture_check(cell, "left", 0.01).fast = None
         t = time.perf_counter()
-        m = build_task_map(st[0], belt, TrackingSpec(), cell=None if label == "no cell" else cell, clearance=0.01,
-                           **kw)
+        m = build_task_map(MapRequest(st[0], belt, TrackingSpec(), cell=None if label == "no cell" else cell,
+                                      clearance=0.01, **kw)).task_map
         dt = time.perf_counter() - t
         check = None if label == "no cell" else fixture_check(cell, "left", 0.01)
         extra = "" if check is None else f"   checks {check.seconds:5.1f} s   {check.counts}"
@@ -293,13 +294,14 @@ def part_fixtures() -> None:
 
 
 def part_neighbours() -> None:
-    from pinarms.optim.line import ItemType, TrackingSpec, build_task_map, poisson_items, simulate
+    from pinarms.optim.line import ItemType, MapRequest, TrackingSpec, build_task_map, poisson_items, simulate
     from pinarms.optim.line.neighbours import NeighbourGuard
     from pinarms.optim.line.simulate import SimArm
 
     cell, belt, st = _mushroom()
     enoki = ItemType("enoki bunch", 0.15, (0.12, 0.06, 0.04))
-    maps = {s.name: (build_task_map(s, belt, TrackingSpec(), mass=0.15, item_height=0.04, nu=12, nw=5),) for s in st}
+    maps = {s.name: (build_task_map(MapRequest(s, belt, TrackingSpec(), mass=0.15, item_height=0.04, nu=12,
+                                               nw=5)).task_map,) for s in st}
     arms = [SimArm(s.name, float(belt.to_belt(s.base_to_world[:3, 3])[0]), maps[s.name]) for s in st]
     items = poisson_items(belt, 0.5, 120.0, types=(enoki,), seed=3)
     print(f"[neighbours] mushroom_line's two facing SCARAs, 30 items/min Poisson, 120 s: {len(items)} items")

@@ -15,6 +15,9 @@ call                      input                       status
 ``minimize_time``         ``TimingRequest``           ``TimingStatus`` (solved, or why the GA stopped)
 ``minimize_time_jerk``    ``TimingRequest``           (its ``TimeJerkResult``; raises as below)
 ``run_ga``                ``GARequest``               ``GAStop`` (``GAResult.stop_reason``)
+``build_task_map``        ``MapRequest``              ``MapStatus`` (built, refine left, no feasible
+                                                      node); ``build_tray_map``, ``build_delta_map``
+                                                      take ``TrayMapRequest``, ``DeltaMapRequest``
 ========================  ==========================  =============================================
 
 The rule for what is a status and what stays an exception:

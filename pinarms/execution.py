@@ -46,7 +46,8 @@ counts, tables), and make a task last about a second or more: a Dask task costs 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
@@ -67,6 +68,7 @@ __all__ = [
     "split_count",
     "map_chunks",
     "reduce_chunks",
+    "scheduler_session",
     "describe_scheduler",
     "task_threads",
     "ExecutionError",
@@ -270,14 +272,28 @@ def _map_serial(fn, tasks, on_result, progress):
             progress(index + 1, len(tasks))
 
 
-def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
+@contextmanager
+def scheduler_session(scheduler: Scheduler = None) -> Iterator[Scheduler]:
+    """``scheduler`` held open for several :func:`map_chunks` calls: ``"processes:N"`` starts its local
+    cluster once and yields a ``distributed.Client`` on it (closed with the cluster on exit), so a
+    build that maps several waves of tasks (a task map's layers and refinement passes) starts its
+    workers, and their imports and caches, once; any other scheduler is yielded as it is."""
+    kind, arg = parse_scheduler(scheduler)
+    if kind != "processes":
+        yield scheduler
+        return
+    with _local_cluster(arg) as client:
+        yield client
+
+
+@contextmanager
+def _local_cluster(n_workers: int) -> Iterator[Any]:
     import warnings
 
     from distributed import Client, LocalCluster
 
     import dask
 
-    n_workers = min(n_workers, len(tasks))
     # the workers' statistical profiler (a thread sampling every 10 ms) took 5-10 % of their CPU
     # on the sizing sweep (benchmarks/line.py sizing): off, as it only feeds the dashboard
     # one task at a time per worker (the default saturation 1.1 sends a second one ahead): a worker
@@ -296,6 +312,11 @@ def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
             dashboard_address=None,
         )
     with cluster, Client(cluster) as client:
+        yield client
+
+
+def _map_local_cluster(n_workers, fn, tasks, on_result, progress):
+    with _local_cluster(min(n_workers, len(tasks))) as client:
         _map_client(client, fn, tasks, on_result, progress)
 
 

@@ -10,15 +10,26 @@ read through its ``nq`` and ``model`` only).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 
-__all__ = ["as_float_array", "deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
+__all__ = ["JointModel", "as_float_array", "deg_to_rad", "rad_to_deg", "mm_to_m", "m_to_mm", "wrap_angle", "prismatic_mask", "joints_to_si",
            "joints_from_si", "length_scale", "angle_scale", "mass_kg", "parse_length", "parse_angle"]
+
+
+class JointModel(Protocol):
+    """What the joint-unit helpers read of a robot: its number of independent joints and its Pinocchio model
+    (a :class:`pinarms.robots.Robot` has both)."""
+
+    @property
+    def nq(self) -> int: ...
+
+    @property
+    def model(self) -> Any: ...
 
 
 def as_float_array(x: ArrayLike, what: str) -> np.ndarray:
@@ -59,7 +70,7 @@ def wrap_angle(angle_rad) -> np.ndarray:
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def prismatic_mask(robot: Any) -> np.ndarray:
+def prismatic_mask(robot: JointModel) -> np.ndarray:
     """``(nq,)`` bool: True where the independent joint is prismatic (metres), else revolute (rad)."""
     mask = np.zeros(robot.nq, dtype=bool)
     model = robot.model
@@ -83,13 +94,13 @@ def angle_scale(deg: bool) -> float:
     return np.pi / 180.0 if deg else 1.0
 
 
-def joints_to_si(robot: Any, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+def joints_to_si(robot: JointModel, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
     """User joint values (deg/rad for revolute, mm/m for prismatic) → SI, shape kept."""
     scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
     return np.asarray(values, dtype=float) * scale
 
 
-def joints_from_si(robot: Any, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
+def joints_from_si(robot: JointModel, values: np.ndarray, *, deg: bool, mm: bool) -> np.ndarray:
     """SI joint values → user units (inverse of :func:`joints_to_si`)."""
     scale = np.where(prismatic_mask(robot), length_scale(mm), angle_scale(deg))
     return np.asarray(values, dtype=float) / scale

@@ -54,6 +54,7 @@ KERNEL_MODULES = (
     "pinarms.optim.motion._spline_kernel",
     "pinarms.optim.topp._profile_kernel",
     "pinarms.optim.line._sim_kernel",
+    "pinarms.planning.extrema_kernel",
 )
 
 
@@ -149,12 +150,22 @@ def _line() -> None:
         simulate(arms, poisson_items(belt, 1.0, 20.0, seed=0), 0.2, rule, duration=20.0)
 
 
+def _timing() -> None:
+    """A trajectory's exact peaks and an exact multi-quintic timing (the compiled peaks of both)."""
+    from pinarms import optim
+
+    q = np.array([[0.0, 0.0], [0.1, 0.5], [0.4, 0.6]])
+    optim.minimize_time(optim.TimingRequest(q, "multi-quintic", 1.0, method="exact",
+                                            trajectory_options={"velocities": "heuristic"})).trajectory.peaks()
+
+
 #: What :func:`warm` runs, in order: (label, call).
 STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("inverse kinematics", _ik),
     ("motion planning", _plan),
     ("sphere cover", _cover),
     ("line simulation", _line),
+    ("trajectory timing", _timing),
 )
 
 #: Seconds each step took to compile on a fresh install, one after the other in one process (2026-12, two cores

@@ -53,6 +53,7 @@ _EXPORTS = {
     "heuristic_velocities": "pinarms.planning.multi_quintic",
     "multi_quintic": "pinarms.planning.multi_quintic",
     "multi_quintic_batch": "pinarms.planning.multi_quintic",
+    "multi_quintic_peaks_batch": "pinarms.planning.multi_quintic",
     "PRESETS": "pinarms.planning.piecewise",
     "piecewise_polynomial": "pinarms.planning.piecewise",
     "piecewise_polynomial_batch": "pinarms.planning.piecewise",
@@ -72,6 +73,7 @@ _EXPORTS = {
 __all__ = [
     "Trajectory", "Peaks", "LimitReport", "Violation", "JointLimits", "polynomial", "piecewise_polynomial", "PRESETS",
     "multi_quintic", "heuristic_velocities", "quintic_bspline", "piecewise_polynomial_batch", "multi_quintic_batch",
+    "multi_quintic_peaks_batch",
     "quintic_bspline_batch", "peaks_batch", "piece_peaks_batch", "trapezoidal", "double_s", "from_definition",
     "joint_waypoints", "joint_path_from_waypoints", "tcp_path", "tcp_speed", "ToolPath", "tool_path", "JointPath",
     "joint_spline", "CartesianPath", "cartesian_path", "joint_image", "PathConstraint", "PathSamples", "PathRows",

@@ -25,7 +25,12 @@ from numpy.typing import ArrayLike
 from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
 
-__all__ = ["piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
+__all__ = ["COMPILED", "piece_extrema", "piece_peaks_batch", "peaks_batch", "normalised_pieces", "derivative_coefficients"]
+
+#: Pieces whose next derivatives have degree <= 4 (degree <= 6 for velocities and up) take the compiled loop
+#: (:mod:`pinarms.planning.extrema_kernel`, the same operations); ``False``: the numpy route for every
+#: piece (the code before it, for benchmarks that time both).
+COMPILED = True
 
 #: Relative size below which a leading polynomial coefficient counts as zero in the root
 #: search (in normalised piece time s in [0, 1], where all coefficients are comparable).
@@ -169,6 +174,11 @@ def piece_extrema(normalised: np.ndarray, durations: np.ndarray, orders: tuple[i
     """
     M, n, width = normalised.shape
     o = len(orders)
+    if COMPILED and o and width - min(orders) <= 6 and M * n:  # every next derivative of degree <= 4: compiled
+        from pinarms.planning.extrema_kernel import extrema_values
+
+        return extrema_values(np.ascontiguousarray(normalised, dtype=float), np.ascontiguousarray(durations, dtype=float),
+                              np.asarray(orders, dtype=np.int64))
     D = _derivative_matrices(width, tuple(orders))  # (o, W, 2W-1): [derivative r | derivative r+1]
     PR = np.matmul(normalised.reshape(M * n, width), D)  # (o, M*n, 2W-1), coefficients in s
     scale = np.repeat(durations[None, :] ** -np.asarray(orders, dtype=float)[:, None], n, axis=1)

@@ -36,7 +36,8 @@ from pinarms.planning import _inputs
 from pinarms.planning.errors import TrajectoryError
 from pinarms.planning.trajectory import Trajectory
 
-__all__ = ["multi_quintic", "multi_quintic_batch", "quintic_hermite_coefficients", "heuristic_velocities"]
+__all__ = ["multi_quintic", "multi_quintic_batch", "multi_quintic_peaks_batch", "quintic_hermite_coefficients",
+           "heuristic_velocities"]
 
 
 def quintic_hermite_coefficients(
@@ -132,6 +133,22 @@ def multi_quintic_batch(times: ArrayLike, positions: ArrayLike, velocities: Arra
     t = _inputs.knot_times_batch(times)
     q = _inputs.via_positions(positions, t.shape[1])
     return _coefficients(t, q, velocities, accelerations)[0]
+
+
+def multi_quintic_peaks_batch(times: np.ndarray, positions: np.ndarray, heuristic: bool) -> np.ndarray:
+    """Peaks (P, 3, n) of |velocity|, |acceleration|, |jerk| of P multi-quintic timings of the same via points.
+
+    ``times`` (P, m+1) strictly increasing knot times (s, not checked: a timing optimiser's own),
+    ``positions`` (m+1, n); via velocities by the sign-of-slopes rule (``heuristic``) or zero, via
+    accelerations zero. Equals :func:`pinarms.planning.peaks_batch` of :func:`multi_quintic_batch`
+    (``velocities="heuristic"`` or None) to rounding, without building the coefficient arrays: one
+    compiled loop (:mod:`pinarms.planning.extrema_kernel`), for optimisers that peak one timing
+    at a time.
+    """
+    from pinarms.planning.extrema_kernel import multi_quintic_peaks
+
+    return multi_quintic_peaks(np.ascontiguousarray(times, dtype=float), np.ascontiguousarray(positions, dtype=float),
+                               bool(heuristic))
 
 
 def multi_quintic(times: ArrayLike, positions: ArrayLike, velocities: ArrayLike | None = None, accelerations: ArrayLike | None = None) -> Trajectory:

@@ -43,6 +43,7 @@ __all__ = [
     "SAMPLES_PER_PIECE",
     "JointTorqueConstraint",
     "torque_dilation",
+    "clearly_within",
     "TorquePeaks",
     "torques",
     "torque_peaks",
@@ -224,6 +225,24 @@ def check_torque_limit(limit: ArrayLike, n_joints: int) -> np.ndarray:
     return arr
 
 
+def clearly_within(trajectory: TimedCurve, robot: Robot, limit: np.ndarray, samples_per_piece: int = SAMPLES_PER_PIECE
+                   ) -> bool:
+    """Whether every piece's sampled peak of ``|tau_j|`` plus twice the largest change of ``tau_j`` between
+    two neighbouring samples of that piece is within ``limit`` (n,): then no refined peak reaches the limit.
+
+    The refinement (:func:`piece_torque_peaks`) looks within one sample step of the best sample, where the
+    torque differs from that sample by at most one step times its slope; the slope is taken as at most
+    twice the steepest change seen between samples (the grid resolution the refinement itself assumes,
+    module docstring). One RNEA batch of the grid instead of the grid and 12 bracketing batches: on a
+    Kinova Jaco2 pick, whose torques stay below a fifth of its limits, the timing of a move 10x faster.
+    """
+    tau = piece_torques(robot, trajectory.knot_times, trajectory.coefficients, grid(samples_per_piece))  # (m, k, n)
+    if tau.shape[1] < 2:
+        return False
+    reach = np.abs(tau).max(axis=1) + 2.0 * np.abs(np.diff(tau, axis=1)).max(axis=1)  # (m, n)
+    return bool(np.all(reach <= limit))
+
+
 def torque_dilation(trajectory: TimedCurve, robot: Robot, limit: ArrayLike, samples_per_piece: int = SAMPLES_PER_PIECE) -> float:
     """Smallest uniform time dilation f >= 1 after which the refined torque peaks are within ``limit``.
 
@@ -234,6 +253,8 @@ def torque_dilation(trajectory: TimedCurve, robot: Robot, limit: ArrayLike, samp
     beyond the limit: no speed helps.
     """
     L = check_torque_limit(limit, trajectory.n_joints)
+    if clearly_within(trajectory, robot, L, samples_per_piece):
+        return 1.0
     factor = 1.0
     traj = trajectory
     for _ in range(8):

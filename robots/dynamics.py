@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from pinarms.robots._checks import as_batch
 from pinarms.errors import InvalidInput, ModelError
+from pinarms.robots.robot_model import RobotModel
 
 __all__ = [
     "GRAVITY",
@@ -49,7 +50,7 @@ class MissingInertials(ModelError):
     """The robot's URDF gives no mass to the links a joint moves: its torques would be meaningless."""
 
 
-def check_inertials(robot: Any) -> None:
+def check_inertials(robot: RobotModel) -> None:
     """Raise :class:`MissingInertials` if a joint of ``robot`` moves no mass at all.
 
     Every independent joint must carry some mass beyond it (its links, or a payload): a URDF
@@ -76,24 +77,24 @@ def check_inertials(robot: Any) -> None:
     robot._inertials_checked = True
 
 
-def total_mass(robot: Any) -> float:
+def total_mass(robot: RobotModel) -> float:
     """Mass [kg] of every body of ``robot`` (base link and payload included)."""
     return float(sum(robot.model.inertias[i].mass for i in range(robot.model.njoints)))
 
 
-def _state(robot: Any, values: Any, what: str, n: int | None) -> tuple[np.ndarray, bool]:
+def _state(robot: RobotModel, values: Any, what: str, n: int | None) -> tuple[np.ndarray, bool]:
     arr, single = robot.check_q(values) if what == "q" else _as_rows(robot, values, what)
     if n is not None and arr.shape[0] != n:
         raise InvalidInput(f"{what} has {arr.shape[0]} rows but q has {n}: give one row per configuration")
     return arr, single
 
 
-def _as_rows(robot: Any, values: Any, what: str) -> tuple[np.ndarray, bool]:
+def _as_rows(robot: RobotModel, values: Any, what: str) -> tuple[np.ndarray, bool]:
     unit = {"qd": "rad/s or m/s", "qdd": "rad/s² or m/s²"}[what]
     return as_batch(values, robot.nq, f"{what} [{unit}] of '{robot.name}' (joints {list(robot.joint_names)})")
 
 
-def _rnea_batch(robot: Any, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+def _rnea_batch(robot: RobotModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
     """Pinocchio's RNEA on N states at once: (N, nq) each → (N, nq)."""
     n = q.shape[0]
     if n == 0:
@@ -106,7 +107,7 @@ def _rnea_batch(robot: Any, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> n
     return np.ascontiguousarray(np.asarray(tau).reshape(robot.nq, n).T)
 
 
-def inverse_dynamics(robot: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
+def inverse_dynamics(robot: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
     """Joint torques ``tau = M(q) qdd + C(q, qd) qd + g(q)`` (module conventions).
 
     Args:
@@ -128,7 +129,7 @@ def inverse_dynamics(robot: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) ->
     return tau[0] if single else tau
 
 
-def gravity_torques(robot: Any, q: ArrayLike) -> np.ndarray:
+def gravity_torques(robot: RobotModel, q: ArrayLike) -> np.ndarray:
     """Torques [N·m or N] that hold ``q`` (nq,) or (N, nq) still against gravity: ``g(q)``."""
     check_inertials(robot)
     qa, single = robot.check_q(q)
@@ -142,7 +143,7 @@ def _has_mimic(model: pin.Model) -> bool:
     return any("Mimic" in model.joints[i].shortname() for i in range(1, model.njoints))
 
 
-def kinetic_energy(robot: Any, q: ArrayLike, qd: ArrayLike) -> float | np.ndarray:
+def kinetic_energy(robot: RobotModel, q: ArrayLike, qd: ArrayLike) -> float | np.ndarray:
     """Kinetic energy ``½ qdᵀ M(q) qd`` [J], summed body by body (Pinocchio's ``computeKineticEnergy``).
 
     ``Σ_i ½ v_iᵀ Y_i v_i`` with ``v_i`` the spatial velocity of body i (mimic joints
@@ -168,7 +169,7 @@ def kinetic_energy(robot: Any, q: ArrayLike, qd: ArrayLike) -> float | np.ndarra
     return float(out[0]) if single else out
 
 
-def potential_energy(robot: Any, q: ArrayLike) -> float | np.ndarray:
+def potential_energy(robot: RobotModel, q: ArrayLike) -> float | np.ndarray:
     """Gravitational potential energy ``-Σ m_i g·c_i`` [J] of the moving bodies (zero at the base origin's height).
 
     Pinocchio's ``computePotentialEnergy`` (centres of mass ``c_i`` in the base frame from
@@ -195,7 +196,7 @@ def potential_energy(robot: Any, q: ArrayLike) -> float | np.ndarray:
 
 
 def holding_torques(
-    robot: Any, n: int = 20000, seed: int = 0, accel_time: float | None = None, starts: int = 3
+    robot: RobotModel, n: int = 20000, seed: int = 0, accel_time: float | None = None, starts: int = 3
 ) -> tuple[np.ndarray, np.ndarray]:
     """Largest torque each joint needs to hold the arm (and its payload) anywhere in its ranges.
 

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import InvalidInput
+from pinarms.robots.robot_model import RobotModel
 
 __all__ = ["Payload", "InvalidPayload", "as_payload", "with_payload"]
 
@@ -176,7 +177,7 @@ def as_payload(payload: Payload | float | Mapping[str, object] | None, *, com: A
 
 
 
-def with_payload(robot: Any, mass: Payload | float, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Any:
+def with_payload(robot: RobotModel, mass: Payload | float, com: ArrayLike | None = None, inertia: ArrayLike | None = None, frame: str | None = None) -> Any:
     """A copy of ``robot`` carrying a payload; ``robot`` itself is unchanged.
 
     A payload replaces the one ``robot`` already carries (payloads do not stack); ``mass=0``

@@ -17,9 +17,10 @@ from __future__ import annotations
 from math import isfinite as _isfinite
 import threading
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.robots._checks import as_batch as _as_batch
@@ -29,6 +30,9 @@ from pinarms.errors import InvalidInput, ModelError
 from pinarms.robots.kinematic_tree import KinematicTree
 from pinarms.robots.manipulability import manipulability_of_jacobian
 from pinarms.robots.robot_ik import RobotIK
+
+if TYPE_CHECKING:
+    from pinarms.robots.payload import Payload
 
 __all__ = ["Robot", "MAX_RANDOM_SAMPLES", "ACCELERATION_RISE_TIME"]
 
@@ -220,11 +224,11 @@ class Robot(RobotIK):
                 return q if self._same_q else self._tree.coordinates.to_pin(q)
         return None
 
-    def check_q(self, q: Any) -> tuple[np.ndarray, bool]:
+    def check_q(self, q: ArrayLike) -> tuple[np.ndarray, bool]:
         """``q`` as a ``(N, nq)`` array plus a flag telling it was one ``(nq,)`` vector."""
         return _as_batch(q, self.nq, f"joint vector q of '{self.name}' (joints {list(self.joint_names)})")
 
-    def q_to_pinocchio(self, q: Any) -> np.ndarray:
+    def q_to_pinocchio(self, q: ArrayLike) -> np.ndarray:
         """Pinocchio's configuration vector(s) for ``q`` (continuous joints as cos/sin)."""
         arr, single = self.check_q(q)
         out = self._tree.coordinates.to_pin(arr)
@@ -251,7 +255,7 @@ class Robot(RobotIK):
         :attr:`upper` with ``∓inf`` at continuous joints (the URDF gives them no limit)."""
         return np.where(self.continuous, -np.inf, self.lower), np.where(self.continuous, np.inf, self.upper)
 
-    def within_limits(self, q: Any, tol: float = 1e-9) -> bool | np.ndarray:
+    def within_limits(self, q: ArrayLike, tol: float = 1e-9) -> bool | np.ndarray:
         """Whether ``q`` lies within the position limits (``tol`` in rad or m; continuous joints: any angle); never clamps."""
         arr, single = self.check_q(q)
         tol = _check_tolerance(tol, "limit tolerance tol [rad or m]")
@@ -259,7 +263,7 @@ class Robot(RobotIK):
         ok = np.all((arr >= lower - tol) & (arr <= upper + tol), axis=1)
         return bool(ok[0]) if single else ok
 
-    def limit_violations(self, q: Any, tol: float = 1e-9) -> list[str]:
+    def limit_violations(self, q: ArrayLike, tol: float = 1e-9) -> list[str]:
         """Human-readable list of the joints of one ``q (nq,)`` that are out of their limits."""
         arr, single = self.check_q(q)
         if not single:
@@ -282,7 +286,7 @@ class Robot(RobotIK):
         return rng.uniform(self.lower, self.upper, size=(int(n), self.nq))
 
     # ------------------------------------------------------------- kinematics
-    def fk(self, q: Any, frame: str = "tcp") -> np.ndarray:
+    def fk(self, q: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """Pose ``T_frame_to_base``: ``(4, 4)`` for ``q (nq,)``, ``(N, 4, 4)`` for ``q (N, nq)``.
 
         One configuration (and batches of up to :data:`SMALL_BATCH`) are evaluated by
@@ -326,12 +330,12 @@ class Robot(RobotIK):
             out[k] = place(model, data, fid).homogeneous
         return out
 
-    def position(self, q: Any, frame: str = "tcp") -> np.ndarray:
+    def position(self, q: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """Origin of ``frame`` in the base frame [m]: ``(3,)`` or ``(N, 3)``."""
         T = self.fk(q, frame)
         return T[..., :3, 3]
 
-    def fk_pinocchio(self, q: Any, frame: str = "tcp") -> np.ndarray:
+    def fk_pinocchio(self, q: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """Reference FK by Pinocchio itself, one configuration at a time (slow; for checks)."""
         arr, single = self.check_q(q)
         fid = self.frame_id(frame)
@@ -343,7 +347,7 @@ class Robot(RobotIK):
             out[k] = data.oMf[fid].homogeneous
         return out[0] if single else out
 
-    def jacobian(self, q: Any, frame: str = "tcp") -> np.ndarray:
+    def jacobian(self, q: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """Frame Jacobian ``(6, nq)`` or ``(N, 6, nq)``: base axes at the frame origin, linear rows first.
 
         Small batches by Pinocchio directly, large ones batched, as :meth:`fk`.
@@ -375,7 +379,7 @@ class Robot(RobotIK):
             J = self._tree.frame_jacobian(arr, fid)
         return J[0] if single else J
 
-    def manipulability(self, q: Any, frame: str = "tcp", part: str = "full") -> float | np.ndarray:
+    def manipulability(self, q: ArrayLike, frame: str = "tcp", part: str = "full") -> float | np.ndarray:
         """Yoshikawa's manipulability ``w = sqrt(det(J Jᵀ))`` of the frame Jacobian.
 
         Args:
@@ -394,7 +398,8 @@ class Robot(RobotIK):
     #: The :class:`pinarms.robots.payload.Payload` this robot carries (``None``: the bare arm).
     payload = None
 
-    def with_payload(self, mass: Any, com: Any = None, inertia: Any = None, frame: str | None = None) -> "Robot":
+    def with_payload(self, mass: Payload | float, com: ArrayLike | None = None, inertia: ArrayLike | None = None,
+                     frame: str | None = None) -> "Robot":
         """A copy of this robot carrying a payload (this robot is unchanged).
 
         ``mass`` [kg] (or a :class:`pinarms.robots.payload.Payload`), ``com`` (3,) [m] in ``frame``
@@ -405,7 +410,7 @@ class Robot(RobotIK):
 
         return with_payload(self, mass, com=com, inertia=inertia, frame=frame)
 
-    def inverse_dynamics(self, q: Any, qd: Any, qdd: Any) -> np.ndarray:
+    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Joint torques [N·m or N] for ``q, qd, qdd`` (each (nq,) or (N, nq)), by Pinocchio's RNEA.
 
         See :func:`pinarms.robots.dynamics.inverse_dynamics` (gravity along the base's −z, mimic joints
@@ -415,7 +420,7 @@ class Robot(RobotIK):
 
         return inverse_dynamics(self, q, qd, qdd)
 
-    def gravity(self, q: Any) -> np.ndarray:
+    def gravity(self, q: ArrayLike) -> np.ndarray:
         """Joint torques [N·m or N] holding ``q`` ((nq,) or (N, nq)) still against gravity."""
         from pinarms.robots.dynamics import gravity_torques
 

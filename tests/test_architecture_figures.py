@@ -245,10 +245,10 @@ def test_private_uses_reference_and_signature_figures_of_a_known_package(wall, t
 
 
 # ----------------------------------------------------------------- the walls, measured on this repository
-#: Public functions or methods with ten parameters or more, and the share of public parameters typed
-#: ``Any`` (a ratchet; the goal is <= 3 and <= 5 %).
+#: Public functions or methods with ten parameters or more (a ratchet; the goal is <= 3), and the share of
+#: public parameters typed ``Any`` (3.5 % measured; the goal is <= 5 %: a parameter with a real type has it).
 LONG_SIGNATURES = 38
-ANY_SHARE = 0.227
+ANY_SHARE = 0.045
 
 
 def test_no_circle_counting_type_only_imports(arch):

@@ -156,6 +156,30 @@ def test_local_processes_scheduler_runs_the_same():
     assert not any(profiler for _, profiler in local)  # off in the workers: it cost them 5-10 % of their CPU
 
 
+def draw_and_pid(task):
+    """``draw`` and the worker process's id."""
+    import os
+
+    return draw(task), os.getpid()
+
+
+def test_a_session_starts_its_workers_once():
+    from pinarms.execution import scheduler_session
+
+    for plain in (None, "serial"):
+        with scheduler_session(plain) as held:
+            assert held == plain
+    tasks = _tasks(seed=4, n_chunks=4, n=200)
+    serial = map_chunks(draw, tasks)
+    with scheduler_session("processes:2") as held:
+        first = map_chunks(draw_and_pid, tasks, scheduler=held)
+        second = map_chunks(draw_and_pid, tasks, scheduler=held)
+    assert {pid for _, pid in second} <= {pid for _, pid in first}  # the same workers: started once
+    assert os.getpid() not in {pid for _, pid in first}
+    for a, (b, _), (c, _) in zip(serial, first, second):
+        assert a["sum"].tobytes() == b["sum"].tobytes() == c["sum"].tobytes()
+
+
 def test_importing_the_layer_loads_neither_dask_nor_the_robots():
     import subprocess
     import sys

@@ -39,6 +39,7 @@ _EXPORTS = {
     "SessionLimits": "pinarms.viz.session_archive",
     "TrajectoryRecord": "pinarms.viz.session_records",
     "WorkspaceRecord": "pinarms.viz.session_records",
+    "DeltaRecord": "pinarms.viz.delta_record",
     "load_session": "pinarms.viz.session",
     "MeshcatServer": "pinarms.viz.server",
     "Viewer": "pinarms.viz.viewer",
@@ -50,7 +51,7 @@ __all__ = [
     "TrajectoryRecord", "WorkspaceRecord", "PointSet", "HistoryRecord", "show", "Viewer", "MeshcatServer",
     "export_html", "build_scene", "plot_joint_curves", "plot_trajectory", "plot_tool_speed", "plot_ga_convergence",
     "plot_workspace", "plot_torques", "plot_layout_search", "layout_search_session", "SceneInfo", "VizError",
-    "SessionFormatError", "ViewerError",
+    "SessionFormatError", "ViewerError", "DeltaRecord",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -8,9 +8,13 @@ closed-form forward position (:func:`~pinarms.robots.delta.forward_position`).
 
 Scene paths, under ``pinarms/deltas/<name>``: ``upper_arm_<i>``, ``rod_<i><a|b>`` (cylinders,
 MeshCat's axis y along the part), ``platform`` (a disk), sized as the collision bodies
-(:mod:`pinarms.robots.delta.collision`). :func:`delta_poses` gives their world
-transforms per frame (the scene data; no viewer needed); :func:`draw_delta` and
-:func:`animate_delta` put them in a MeshCat scene; :func:`delta_page` writes one standalone page.
+(:mod:`pinarms.robots.delta.collision`), and for a delta with the fourth axis ``tool`` (a flat
+paddle from the platform centre to the tcp, turned by the tool angle, so that the turn shows).
+:func:`delta_poses` gives their world transforms per frame (the scene data; no viewer needed);
+:func:`draw_delta` and :func:`animate_delta` put them in a MeshCat scene; :func:`delta_page` writes
+one standalone page. The deltas of a :class:`pinarms.viz.Session` (:mod:`pinarms.viz.delta_record`)
+are drawn by :func:`draw_session_deltas` and animated by :func:`animate_session_deltas` in the
+session's page (:mod:`pinarms.viz.scene`).
 """
 
 from __future__ import annotations
@@ -19,9 +23,10 @@ import contextlib
 import io
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.files import atomic_write
 from pinarms.robots.delta import DeltaRobot, elbow_positions, forward_position, rod_endpoints
@@ -29,12 +34,19 @@ from pinarms.robots.delta.collision import PART_RADII, PLATFORM_THICKNESS
 from pinarms.errors import InvalidInput
 
 from pinarms.viz._meshcat import meshcat, mg
+from pinarms.viz.names import SCENE_ROOT
 
-__all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT"]
+if TYPE_CHECKING:
+    from pinarms.viz.session import Session
+
+__all__ = ["delta_poses", "delta_parts", "draw_delta", "animate_delta", "delta_page", "DELTA_ROOT", "TOOL_WIDTH",
+           "draw_session_deltas", "animate_session_deltas", "session_delta_poses", "session_delta_tcp"]
 
 #: Scene folder of the deltas.
-DELTA_ROOT = "pinarms/deltas"
-_COLORS = {"upper_arm": 0x4A6FA5, "rod": 0xC8C8C8, "platform": 0x8C8C8C}
+DELTA_ROOT = f"{SCENE_ROOT}/deltas"
+_COLORS = {"upper_arm": 0x4A6FA5, "rod": 0xC8C8C8, "platform": 0x8C8C8C, "tool": 0xE0A030}
+#: Width of the drawn tool paddle [m] (its thickness is the tool capsule's diameter).
+TOOL_WIDTH = 0.06
 
 
 def _segment(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -56,11 +68,28 @@ def delta_parts(delta: DeltaRobot) -> dict[str, tuple[str, float, float]]:
     parts = {f"upper_arm_{i}": ("upper_arm", g.upper_arm, PART_RADII["upper_arm"]) for i in (1, 2, 3)}
     parts.update({f"rod_{i}{r}": ("rod", g.forearm, PART_RADII["rod"]) for i in (1, 2, 3) for r in "ab"})
     parts["platform"] = ("platform", PLATFORM_THICKNESS, g.platform_radius + 0.5 * g.rod_spacing)
+    if delta.has_tool_axis:
+        parts["tool"] = ("tool", float(np.linalg.norm(_tcp_offset(delta))), PART_RADII["tool"])
     return parts
 
 
-def delta_poses(delta: DeltaRobot, theta: Any, base_to_world: Any = None) -> dict[str, np.ndarray]:
-    """World transforms (F, 4, 4) of every part (module doc) at motor angles ``theta`` (F, 3) [rad].
+def _tcp_offset(delta: DeltaRobot) -> np.ndarray:
+    """(3,) the tcp from the platform centre at tool angle 0 [m] (Pinocchio's FK of the tree)."""
+    home = delta.home()
+    return delta.tcp_position(home) - forward_position(delta.geometry, home[delta.motor_q])
+
+
+def _rz(a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(a.shape + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
+
+
+def delta_poses(delta: DeltaRobot, theta: ArrayLike, base_to_world: ArrayLike | None = None,
+                tool: ArrayLike | None = None) -> dict[str, np.ndarray]:
+    """World transforms (F, 4, 4) of every part (module doc) at motor angles ``theta`` (F, 3) [rad] and,
+    for a delta with the fourth axis, tool angles ``tool`` (F,) [rad] (default 0).
 
     Raises:
         InvalidInput: ``theta`` not (F, 3) finite, or a row the delta cannot assemble."""
@@ -84,6 +113,15 @@ def delta_poses(delta: DeltaRobot, theta: Any, base_to_world: Any = None) -> dic
     plat[:, :3, :3] = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]  # the disk's axis (y) vertical
     plat[:, :3, 3], plat[:, 3, 3] = p, 1.0
     out["platform"] = plat
+    if delta.has_tool_axis:
+        a = np.zeros(th.shape[0]) if tool is None else np.broadcast_to(np.asarray(tool, dtype=float), th.shape[:1])
+        off = _tcp_offset(delta)
+        T0 = _segment(np.zeros((1, 3)), off[None])[0]  # the paddle at tool angle 0, platform centre at the origin
+        Rz = _rz(a)
+        tl = np.zeros((th.shape[0], 4, 4))
+        tl[:, :3, :3] = Rz @ T0[:3, :3]
+        tl[:, :3, 3], tl[:, 3, 3] = p + Rz @ T0[:3, 3], 1.0
+        out["tool"] = tl
     return {k: T[None] @ v for k, v in out.items()}
 
 
@@ -92,7 +130,8 @@ def draw_delta(vis: Any, name: str, delta: DeltaRobot, poses: dict[str, np.ndarr
     root = f"{DELTA_ROOT}/{name}"
     for part, (kind, length, radius) in delta_parts(delta).items():
         node = vis[f"{root}/{part}"]
-        node.set_object(mg.Cylinder(length, radius), mg.MeshLambertMaterial(color=_COLORS[kind]))
+        shape = mg.Box([TOOL_WIDTH, length, 2.0 * radius]) if kind == "tool" else mg.Cylinder(length, radius)
+        node.set_object(shape, mg.MeshLambertMaterial(color=_COLORS[kind]))
         node.set_transform(poses[part][0])
     return root
 
@@ -111,7 +150,6 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
     """A standalone page (HTML, written atomically) of ``delta`` moving through ``theta`` (F, 3) [rad],
     one row a frame at ``fps``; return the path."""
     from pinarms.viz.page import PAGE_PROPERTY, with_page
-    from pinarms.viz.scene import ROOT
     from pinarms.viz.server import MeshcatServer
 
     poses = delta_poses(delta, theta, base_to_world)
@@ -126,7 +164,57 @@ def delta_page(delta: DeltaRobot, theta: Any, path: str | Path, *, fps: float = 
         anim = meshcat.animation.Animation(default_framerate=fps)
         animate_delta(anim, vis, root, poses)
         vis.set_animation(anim, play=True, repetitions=float("inf"))
-        vis[ROOT].set_property(PAGE_PROPERTY, json.dumps(page))
+        vis[SCENE_ROOT].set_property(PAGE_PROPERTY, json.dumps(page))
         text = with_page(server.static_html(), page["title"])
     data = text.encode("utf-8")
     return atomic_write(path, lambda f: f.write(data))
+
+
+def session_delta_poses(session: Session, key: str, times: ArrayLike) -> dict[str, np.ndarray]:
+    """World transforms (F, 4, 4) of the parts of the session's delta ``key`` at ``times`` (F,) [s] from its
+    motion's start (held at the ends); the passive joints from the closed form."""
+    rec = session.deltas[key]
+    act = rec.sample(np.atleast_1d(np.asarray(times, dtype=float)))
+    return delta_poses(session.delta(key), act[:, :3], rec.base_to_world, act[:, 3] if act.shape[1] == 4 else None)
+
+
+def draw_session_deltas(vis: meshcat.Visualizer, session: Session, bounds: list, framed: list) -> list[str]:
+    """Draw each delta of ``session`` at the start of its motion; its base and platform path join ``bounds``
+    and ``framed`` (what the view centres on). Returns the page's summary lines."""
+    lines = []
+    for key, rec in getattr(session, "deltas", {}).items():
+        delta = session.delta(key)
+        draw_delta(vis, key, delta, session_delta_poses(session, key, [0.0]))
+        # framed: both ends of every part at 9 instants of its motion (the whole chain, not only the platform)
+        poses = session_delta_poses(session, key, np.linspace(0.0, rec.duration, 9))
+        ends = [T[:, :3, 3] + sign * 0.5 * length * T[:, :3, 1] for part, (_, length, _) in delta_parts(delta).items()
+                for T in (poses[part],) for sign in (-1.0, 1.0)]
+        extent = np.vstack(ends)
+        bounds.append(extent)
+        framed.append(extent)
+        label = key if key == rec.delta else f"{key} ({rec.delta})"
+        lines.append(f"delta {label}: {rec.t.size} samples over {rec.duration:.3g} s" if rec.t.size > 1
+                     else f"delta {label}: at rest")
+    return lines
+
+
+def animate_session_deltas(anim: meshcat.animation.Animation, vis: meshcat.Visualizer, session: Session,
+                           times: np.ndarray) -> None:
+    """Add each delta's motion at the animation's ``times`` (F,) [s] to ``anim`` (held after its end)."""
+    for key in getattr(session, "deltas", {}):
+        animate_delta(anim, vis, f"{DELTA_ROOT}/{key}", session_delta_poses(session, key, times))
+
+
+def session_delta_tcp(session: Session, key: str, times: ArrayLike) -> np.ndarray:
+    """(F, 3) world position [m] of the tcp of the session's delta ``key`` at ``times`` (F,) [s] from its motion's
+    start: the closed-form platform plus the tcp's offset turned by the tool angle."""
+    rec = session.deltas[key]
+    delta = session.delta(key)
+    act = rec.sample(np.atleast_1d(np.asarray(times, dtype=float)))
+    p = forward_position(delta.geometry, act[:, :3])
+    if act.shape[1] == 4:
+        p = p + _rz(act[:, 3]) @ _tcp_offset(delta)
+    else:
+        p = p + _tcp_offset(delta)
+    T = rec.base_to_world
+    return p @ T[:3, :3].T + T[:3, 3]

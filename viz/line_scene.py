@@ -119,8 +119,13 @@ def animate_lines(vis: meshcat.Visualizer, anim: meshcat.animation.Animation, se
     for name, rec in getattr(session, "lines", {}).items():
         tcp: dict[int, np.ndarray] = {}
         for k, key in enumerate(rec.arms):
+            if key in getattr(session, "deltas", {}):
+                from pinarms.viz.delta_scene import session_delta_tcp  # robots.delta: imported when a delta is there
+
+                tcp[k] = session_delta_tcp(session, key, times)
+                continue
             if key not in session.robots:
-                raise ViewerError(f"line {name!r} names arm {key!r}, which is not a robot of this session")
+                raise ViewerError(f"line {name!r} names arm {key!r}, which is not a robot or delta of this session")
             traj = [session.trajectories[n] for n in animated if session.trajectories[n].robot == key]
             if traj:
                 tr = traj[0]
@@ -169,7 +174,8 @@ def line_focus(session: Session, points: np.ndarray) -> np.ndarray:
         return points
     rec = lines[0]
     T = rec.belt_to_world
-    bases = [session.robots[k].base_to_world[:3, 3] for k in rec.arms if k in session.robots]
+    placed = {**session.robots, **getattr(session, "deltas", {})}  # robots and deltas: both have base_to_world
+    bases = [placed[k].base_to_world[:3, 3] for k in rec.arms if k in placed]
     if len(bases) <= FRAMED_ARMS:
         return points
     u_bases = np.sort([(b - T[:3, 3]) @ T[:3, 0] for b in bases])

@@ -5,8 +5,10 @@
 :class:`pinarms.viz.Session`, for a window of one run (default the first 20 s of the first seed):
 
 - each station's arm as a robot (key: the station's name) at its base pose, and its box as
-  a translucent static box under the release point;
-- each arm's joint trajectory through its picks of the window, ``"<station> picks"``: the
+  a translucent static box under the release point; a delta (:class:`pinarms.optim.line.delta_tracking.DeltaArm`)
+  as a session delta (:meth:`pinarms.viz.Session.add_delta`) whose motion is its actuated angles;
+- each arm's joint trajectory through its picks of the window, ``"<station> picks"`` (a delta's:
+  its motion, :func:`pinarms.optim.line.delta_motion.delta_pick_motion`): the
   simulator keeps only pick times, so every pick of the window is planned again exactly
   (:func:`pinarms.optim.line.tracking.plan_pick` at the simulated rendezvous point, rest at the box
   between picks). The exact plan's times differ from the task map's by its error (≤ 1 %); a
@@ -29,6 +31,11 @@ from pinarms.viz.line_record import BOX_DEPTH, ITEM_COLUMNS, MISSED, NOT_DRAWN, 
 
 if TYPE_CHECKING:
     from pinarms.optim.line.api import LineResult, LineSpec
+    from pinarms.optim.line.belt import Belt
+    from pinarms.optim.line.delta_motion import DeltaPickMotion
+    from pinarms.optim.line.items import ItemType
+    from pinarms.optim.line.station import Station
+    from pinarms.optim.line.tracking import TrackingSpec
 
 __all__ = ["add_line", "BOX_DEPTH", "BOX_GAP", "DEFAULT_WINDOW_S"]
 
@@ -46,13 +53,23 @@ def _window(start: Any, duration: Any) -> tuple[float, float]:
     return float(start), float(duration)
 
 
+def _delta_pick(st: Station, belt: Belt, tr: TrackingSpec, u: float, w: float, kind: ItemType, yaw: float
+                ) -> DeltaPickMotion:
+    from pinarms.optim.line.delta_motion import delta_pick_motion
+
+    return delta_pick_motion(st, belt, tr, u, w, mass=kind.mass, item_height=kind.size[2], yaw=yaw)
+
+
 def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end: float,
               maps: tuple = ()) -> tuple[list, dict]:
-    """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}."""
-    from pinarms.optim.line.tracking import plan_pick, rest_configuration
+    """Exact plans of arm ``k``'s picks (item indices, by start) up to ``t_end``: [(start, plan)], {item: (tg, tr)}.
+    A delta's picks are motions of its actuated coordinates (:mod:`pinarms.optim.line.delta_motion`)."""
+    from pinarms.optim.line.delta_tracking import DeltaArm
+    from pinarms.optim.line.tracking import plan_pick
 
     st = spec.stations[k]
-    q_rest = rest_configuration(st)
+    is_delta = isinstance(st.robot, DeltaArm)
+    q_rest = None if is_delta else _rest(st)
     u_base = float(spec.belt.to_belt(st.base_to_world[:3, 3])[0])
     tr = spec.tracking
     out, times = [], {}
@@ -62,10 +79,11 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
             break
         kind = items.types[int(items.kind[i])]
         u, w = float(run.u_meet[i]), float(items.w[i])
-        branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps else None  # the branch the map timed
+        branch = maps[int(items.kind[i])].branch_at(u - u_base, w) if maps and not is_delta else None  # as timed
         try:
-            plan = plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
-                             branch=branch, yaw=float(items.yaw[i]))
+            plan = _delta_pick(st, spec.belt, tr, u, w, kind, float(items.yaw[i])) if is_delta else \
+                plan_pick(st, spec.belt, tr, u, w, item_height=kind.size[2], mass=kind.mass, q_rest=q_rest,
+                          branch=branch, yaw=float(items.yaw[i]))
         except PinarmsError:
             continue  # drawn on the belt, not marked (NOT_DRAWN)
         s = max(float(run.meet[i]) - plan.times[0], free_at)
@@ -75,12 +93,23 @@ def _plan_arm(spec: Any, k: int, picks: np.ndarray, run: Any, items: Any, t_end:
     return out, times
 
 
+def _rest(st: Station) -> np.ndarray:
+    """The arm at rest at its box: joint values, or a delta's actuated coordinates."""
+    from pinarms.optim.line.delta_motion import delta_rest
+    from pinarms.optim.line.delta_tracking import DeltaArm
+    from pinarms.optim.line.tracking import rest_configuration
+
+    return delta_rest(st) if isinstance(st.robot, DeltaArm) else rest_configuration(st)
+
+
 def _arm_samples(q_rest: np.ndarray, plans: list, t: np.ndarray) -> np.ndarray:
     q = np.tile(q_rest, (t.size, 1))
     for s, plan in plans:
         sel = (t >= s) & (t <= s + plan.duration)
         if sel.any():
-            q[sel] = plan.trajectory.sample(np.clip(t[sel] - s, 0.0, plan.trajectory.duration))[0]
+            tau = np.clip(t[sel] - s, 0.0, plan.duration)
+            q[sel] = plan.sample(tau) if hasattr(plan, "actuated") else plan.trajectory.sample(
+                np.minimum(tau, plan.trajectory.duration))[0]
     return q
 
 
@@ -97,7 +126,7 @@ def add_line(session: Any, spec: LineSpec, result: LineResult, *, run: int = 0, 
     Raises:
         InvalidInput: a bad window, run index or rate; a station name already used as a robot key.
     """
-    from pinarms.optim.line.tracking import rest_configuration
+    from pinarms.optim.line.delta_tracking import DeltaArm
 
     t_a, dur = _window(start, duration)
     runs = getattr(result, "runs", None)
@@ -115,14 +144,21 @@ def add_line(session: Any, spec: LineSpec, result: LineResult, *, run: int = 0, 
     grasp: dict[int, tuple[float, float]] = {}
     arms = []
     for k, st in enumerate(spec.stations):
-        key = session.add_robot(st.robot, key=st.name, base_to_world=st.base_to_world)
+        delta = isinstance(st.robot, DeltaArm)
+        if delta and st.name in session.robots or not delta and st.name in session.deltas:
+            raise InvalidInput(f"station {st.name!r}: its name is already a key of this session")
+        key = st.name if delta else session.add_robot(st.robot, key=st.name, base_to_world=st.base_to_world)
         arms.append(key)
         picks = np.flatnonzero(r.picked_by == k)
         picks = picks[np.argsort(r.start[picks], kind="stable")]
         arm_maps = tuple((getattr(result, "maps", None) or {}).get(st.name, ()))
         plans, times = _plan_arm(spec, k, picks, r, items, t_b, arm_maps)
         grasp.update(times)
-        session.add_trajectory(f"{st.name} picks", (t, _arm_samples(rest_configuration(st), plans, t_a + t)), robot=key)
+        samples = _arm_samples(_rest(st), plans, t_a + t)
+        if delta:  # a delta and its actuated angles (viz.delta_record); its passive joints are never stored
+            session.add_delta(st.robot.delta, key=key, base_to_world=st.base_to_world, motion=(t, samples))
+        else:
+            session.add_trajectory(f"{st.name} picks", (t, samples), robot=key)
         box = np.eye(4)
         box[:3, 3] = st.place.position - [0.0, 0.0, h_max + BOX_GAP + BOX_DEPTH / 2.0]
         session.add_box(f"{st.name}: {st.place.name}", [0.2, 0.16, BOX_DEPTH], pose=box, color=(0.75, 0.55, 0.3, 0.45))

@@ -13,10 +13,12 @@ Scene paths (under MeshCat's root ``/meshcat``), readable and stable:
 - ``pinarms/vias/<name>/<i>`` — the TCP at the trajectory's knots (small spheres);
 - ``pinarms/points/<name>/<i>`` — via points / targets of the session (small spheres);
 - ``pinarms/reachability/<name>/layers/z<mm>mm`` — reachability maps: the voxels of one
-  horizontal layer each (:mod:`pinarms.viz.reach_scene`; the page's slice control shows/hides them).
+  horizontal layer each (:mod:`pinarms.viz.reach_scene`; the page's slice control shows/hides them);
+- ``pinarms/deltas/<name>/<part>`` — a delta robot's upper arms, rods, platform and tool, its closed
+  chain solved from its actuated angles (:mod:`pinarms.viz.delta_scene`).
 
 One MeshCat animation per scene: the chosen trajectories (default: the first one of each
-robot) play together from time 0, sampled at ``fps`` frames per second, looping
+robot) and the deltas' motions play together from time 0, sampled at ``fps`` frames per second, looping
 (:mod:`pinarms.viz.trajectory_scene`).
 
 What the page around the scene shows (title, colour bar, framing, controls: see
@@ -36,6 +38,7 @@ from pinarms.errors import InvalidInput
 
 from pinarms.viz._meshcat import meshcat, mg
 from pinarms.viz.cloud_scene import draw_clouds, cloud_colorbar
+from pinarms.viz.names import SCENE_ROOT
 from pinarms.viz.page import PAGE_PROPERTY
 from pinarms.viz.scene_options import SceneOptions
 from pinarms.viz.robot_drawing import RobotDrawing
@@ -47,7 +50,7 @@ if TYPE_CHECKING:
 
 __all__ = ["SceneInfo", "build_scene", "ROOT"]
 
-ROOT = "pinarms"
+ROOT = SCENE_ROOT
 _BACKGROUND = ([0.96, 0.97, 0.99], [0.74, 0.78, 0.85])  # top, bottom (RGB in [0, 1])
 
 _PATH_COLORS = (0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B)
@@ -130,6 +133,12 @@ def build_scene(vis: meshcat.Visualizer, session: Session, options: SceneOptions
     from pinarms.viz.line_scene import draw_lines  # belt lines: belt, items
 
     line_lines = draw_lines(vis, session, ROOT, bounds)
+    delta_lines: list[str] = []
+    if getattr(session, "deltas", None):  # deltas: the closed chain from the actuated angles (imported when needed)
+        from pinarms.viz.delta_scene import draw_session_deltas
+
+        delta_lines = draw_session_deltas(vis, session, bounds, framed)
+    moving = any(rec.duration > 0 for rec in getattr(session, "deltas", {}).values())
     line_arms = {k for rec in getattr(session, "lines", {}).values() for k in rec.arms}  # summarised once
     tcp_paths, knots = world_tcp_paths(session, drawings, bounds, framed)
     animated = animated_trajectories(session, o.animate)
@@ -142,16 +151,18 @@ def build_scene(vis: meshcat.Visualizer, session: Session, options: SceneOptions
                                 _POINT_COLORS[ps.kind]) for name, ps in session.point_sets.items()}
     paths = _draw_tcp_paths(vis, tcp_paths, knots, sphere_radius)
 
-    duration, n_frames = animate_scene(vis, session, ROOT, drawings, animated, bool(line_lines), o.fps, o.play)
+    duration, n_frames = animate_scene(vis, session, ROOT, drawings, animated, bool(line_lines) or moving, o.fps,
+                                       o.play)
 
     _place_camera(vis, camera)
     floor_note = _dress_stage(vis, np.vstack(framed) if framed else np.vstack([lo, hi]), o.hide_background)
     page = {
         "title": session.title or "pinarms session",
-        "lines": _summary_lines(session, animated, clouds.shown, line_arms) + line_lines + [floor_note],
+        "lines": (_summary_lines(session, animated, clouds.shown, line_arms) + line_lines
+                  + [x for x, key in zip(delta_lines, session.deltas) if key not in line_arms] + [floor_note]),
         "target": target.tolist(), "camera": camera.tolist(),
         "clouds": list(clouds.paths.values()), "clouds_visible": bool(o.show_clouds),
-        "animation": {"duration": duration, "playing": bool(o.play and (animated or line_lines))},
+        "animation": {"duration": duration, "playing": bool(o.play and (animated or line_lines or moving))},
         "colorbar": cloud_colorbar(session, clouds, o.colormap),
     }
     if reach_page:
@@ -257,7 +268,8 @@ def _summary_lines(session: Any, animated: tuple[str, ...], cloud_shown: dict[st
     the arms of a belt line (``line_arms``) and their trajectories in one line."""
     lines = []
     if line_arms:
-        names = sorted({session.robots[k].name for k in line_arms if k in session.robots})
+        names = sorted({session.robots[k].name for k in line_arms if k in session.robots}
+                       | {session.deltas[k].delta for k in line_arms if k in getattr(session, "deltas", {})})
         lines.append(f"{len(line_arms)} arms along the belt ({', '.join(names)}), each through its picks")
     for key, entry in session.robots.items():
         if key in line_arms:

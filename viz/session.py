@@ -59,6 +59,8 @@ from pinarms.viz.session_robots import rebuild_robot, robot_entry, shipped_model
 from pinarms.viz.session_schema import FORMAT_NAME, FORMAT_VERSION, KINDS, POINT_KINDS as _POINT_KINDS
 
 if TYPE_CHECKING:
+    from pinarms.robots.delta import DeltaRobot
+    from pinarms.viz.delta_record import DeltaRecord
     from pinarms.optim.ga.engine import GAHistory, GAResult
     from pinarms.robots.reach.workspace import Workspace
     from pinarms.robots.cell.motion_report import MotionCheck
@@ -135,6 +137,8 @@ class Session:
         self.histories: dict[str, HistoryRecord] = {}
         self.reachability: dict[str, Any] = {}  # name → viz.reach_record.ReachabilityRecord
         self.lines: dict[str, Any] = {}  # name → viz.line_record.LineRecord (belt, items; viz.line_session)
+        self.deltas: dict[str, Any] = {}  # name → viz.delta_record.DeltaRecord (a shipped delta and its motion)
+        self._deltas: dict[str, Any] = {}  # delta registry name → DeltaRobot, loaded once
         self._loaded: dict[str, Robot] = {}
         self._loading = threading.Lock()  # one Robot per key, whichever thread asks first
         #: folders meshes of robots stored in a file may be read from (set by :func:`load_session`:
@@ -153,7 +157,8 @@ class Session:
     def __repr__(self) -> str:
         return (
             f"Session(title={self.title!r}, robots={list(self.robots)}, trajectories={list(self.trajectories)}, "
-            f"workspaces={list(self.workspaces)}, points={list(self.point_sets)}, histories={list(self.histories)})"
+            f"workspaces={list(self.workspaces)}, points={list(self.point_sets)}, histories={list(self.histories)}"
+            + (f", deltas={list(self.deltas)})" if self.deltas else ")")
         )
 
     # ---------------------------------------------------------------- robots
@@ -333,6 +338,35 @@ class Session:
         from pinarms.viz.line_session import add_line
 
         return add_line(self, spec, result, **options)
+
+    def add_delta(self, delta: DeltaRobot | str, *, key: str | None = None, base_to_world: ArrayLike | None = None,
+                  motion: tuple[ArrayLike, ArrayLike] | None = None) -> DeltaRecord:
+        """Add a shipped delta robot (:func:`pinarms.robots.delta.load_delta`, or its registry name) hung at
+        ``base_to_world`` (4, 4), with its ``motion``: ``(t (N,) s, actuated (N, 3|4) rad)``, the motor angles
+        (and the tool angle of the fourth axis) over time, or ``None`` (at rest). Only the actuated
+        coordinates are stored; the passive joints are solved from the closed form wherever the session is
+        read (:mod:`pinarms.viz.delta_record`). Returns the :class:`~pinarms.viz.delta_record.DeltaRecord`."""
+        from pinarms.robots.delta import load_delta
+        from pinarms.viz.delta_record import delta_record
+
+        if isinstance(delta, str):
+            delta = load_delta(delta)
+        name = self.free_name(self.deltas, getattr(delta, "name", "delta") if key is None else key, "delta")
+        rec = delta_record(name, delta, base_to_world, motion)
+        self.deltas[name] = rec
+        return rec
+
+    def delta(self, key: str) -> DeltaRobot:
+        """The :class:`pinarms.robots.delta.DeltaRobot` of the session's delta ``key`` (loaded once by name)."""
+        from pinarms.robots.delta import load_delta
+
+        if key not in self.deltas:
+            raise InvalidInput(f"no delta {key!r} in this session; deltas: {', '.join(self.deltas) or 'none (add_delta first)'}")
+        name = self.deltas[key].delta
+        with self._loading:
+            if name not in self._deltas:
+                self._deltas[name] = load_delta(name)
+        return self._deltas[name]
 
     # ---------------------------------------------------------------- (de)serialisation
     def _tables(self) -> dict[str, dict[str, Any]]:

@@ -1,7 +1,7 @@
 """The schema of a session document: the format's name and version, and the table of kinds.
 
 Each kind of content (robots, objects, trajectories, workspaces, point sets, histories,
-reachability maps, belt lines) is a row of :data:`KINDS`: its list in ``session.json``,
+reachability maps, belt lines, deltas) is a row of :data:`KINDS`: its list in ``session.json``,
 the :class:`pinarms.viz.Session` attribute holding its records, its arrays (:class:`~.session_specs.ArraySpec`:
 dtype float64, shapes with named dimensions shared within an item), its text members
 (:class:`~.session_specs.TextSpec`), whether it refers to a robot, and an encoder and a decoder. A new kind
@@ -18,6 +18,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from pinarms.viz.delta_record import decode_delta, encode_delta  # a delta and its motion: its own module
 from pinarms.viz.line_record import decode_line, encode_line  # a belt line: its own module
 from pinarms.viz.reach_record import decode_reachability, encode_reachability  # a kind defined in its own module
 from pinarms.viz.session_records import (
@@ -169,6 +170,9 @@ KINDS: tuple[Kind, ...] = (
          encode_reachability, decode_reachability, robot_ref="required", optional=True),
     Kind("lines", "lines", "line", "name", (ArraySpec("belt_to_world", (4, 4)), ArraySpec("items", ("N", 9))),
          encode_line, decode_line, optional=True),
+    Kind("deltas", "deltas", "delta", "name",
+         (ArraySpec("base_to_world", (4, 4)), ArraySpec("t", ("N",), min_rows=1), ArraySpec("actuated", ("N", "A"))),
+         encode_delta, decode_delta, optional=True),
 )
 
 

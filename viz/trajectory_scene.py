@@ -84,19 +84,24 @@ def show_start_poses(session: Session, drawings: dict[str, RobotDrawing], animat
 
 def animate_scene(vis: meshcat.Visualizer, session: Session, root: str, drawings: dict[str, RobotDrawing],
                   animated: tuple[str, ...], lines: bool, fps: float, play: bool) -> tuple[float, int]:
-    """One looping animation of the ``animated`` trajectories and the belt ``lines``; return (duration, frames)."""
+    """One looping animation of the ``animated`` trajectories, the belt ``lines`` and the session's deltas
+    (``lines`` true when a line or a delta moves); return (duration, frames)."""
     from pinarms.viz.line_scene import animate_lines, line_duration
 
     if not (animated or lines):
         return 0.0, 0
     duration = max([float(session.trajectories[n].t[-1] - session.trajectories[n].t[0]) for n in animated]
-                   + [line_duration(session)])
+                   + [line_duration(session)] + [rec.duration for rec in getattr(session, "deltas", {}).values()])
     times = frame_times(duration, fps)
     anim = meshcat.animation.Animation(default_framerate=fps)
     for name in animated:
         rec = session.trajectories[name]
         drawings[rec.robot].record(anim, vis, interp_rows(rec.t[0] + times, rec.t, rec.q))
     animate_lines(vis, anim, session, root, times, animated, drawings)
+    if getattr(session, "deltas", None):
+        from pinarms.viz.delta_scene import animate_session_deltas
+
+        animate_session_deltas(anim, vis, session, times)
     vis.set_animation(anim, play=play, repetitions=float("inf"))
     return duration, times.size
 

@@ -160,6 +160,20 @@ def _planning_builders(kind: str, options: dict[str, Any]) -> tuple[Builder, Bat
     return (lambda t, q: single(t, q, **options), lambda t, q: batch(t, q, **options))
 
 
+def _quintic_rule(kind: str, options: dict[str, Any]) -> bool | None:
+    """Whether the multi-quintic via velocities follow the sign-of-slopes rule (True), are zero (False),
+    or neither (None: given arrays, or other families)."""
+    if kind != "multi-quintic" or set(options) - {"velocities", "accelerations"}:
+        return None
+    zero = (None, "zero")
+    velocities, accelerations = options.get("velocities"), options.get("accelerations")
+    if not (isinstance(accelerations, str) or accelerations is None) or accelerations not in zero:
+        return None
+    if isinstance(velocities, str) and velocities == "heuristic":
+        return True
+    return False if (isinstance(velocities, str) or velocities is None) and velocities in zero else None
+
+
 class TimingProblem:
     """Minimum-time (and time-jerk) timing of a trajectory through fixed via points.
 
@@ -215,6 +229,9 @@ class TimingProblem:
         if np.all(np.ptp(q, axis=0) == 0.0):
             raise InvalidInput("positions do not move (all via points equal): nothing to time")
         self.trajectory_options = dict(trajectory_options or {})
+        #: multi-quintic through the planning constructor with via velocities zero (False) or by the
+        #: sign-of-slopes rule (True) and zero via accelerations: peaks by a compiled loop; else None
+        self._quintic_rule = _quintic_rule(kind, self.trajectory_options) if builder is None else None
         if builder is None:
             self._build, self._build_batch = _planning_builders(kind, self.trajectory_options)
         else:
@@ -254,8 +271,15 @@ class TimingProblem:
 
         r = np.atleast_2d(np.asarray(ratios, dtype=float))
         r = r / r.sum(axis=1, keepdims=True)
-        times, coefs = self.coefficients_batch(r)
-        pk = planning.piece_peaks_batch(times, coefs).max(axis=2)  # (pop, 3, n) at total 1
+        from pinarms.planning import extrema
+
+        if self._quintic_rule is not None and self.torque is None and extrema.COMPILED:  # compiled: the same peaks
+            self.evaluations += r.shape[0]
+            times = np.concatenate([np.zeros((r.shape[0], 1)), np.cumsum(r, axis=1)], axis=1)
+            pk = planning.multi_quintic_peaks_batch(times, self.positions, self._quintic_rule)
+        else:
+            times, coefs = self.coefficients_batch(r)
+            pk = planning.piece_peaks_batch(times, coefs).max(axis=2)  # (pop, 3, n) at total 1
         s = np.max(pk[:, 0] / self.vmax, axis=1)
         if self.torque is not None:
             s = np.maximum(s, self.torque.minimal_scale(times, coefs))

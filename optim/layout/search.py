@@ -261,7 +261,8 @@ def _lower_bounds(robot: Any, st: EvaluationSettings, targets: np.ndarray | None
 
     if targets is None:
         return np.zeros(M)
-    return cycle_lower_bounds(robot, targets[:, : len(st.picks) + len(st.places)], len(st.picks), st.dwell, st.vmax)
+    return cycle_lower_bounds(robot, targets[:, : len(st.picks) + len(st.places)], len(st.picks), st.dwell, st.vmax,
+                              st.amax)
 
 
 def _phase(progress: Callable[[int, int], None] | None, offset: int, total: int) -> Any:

@@ -50,6 +50,11 @@ _EXPORTS = {
     "simulate": "pinarms.optim.line.simulate",
     "Station": "pinarms.optim.line.station",
     "base_pose": "pinarms.optim.line.station",
+    "MapRequest": "pinarms.optim.line.map_request",
+    "TrayMapRequest": "pinarms.optim.line.map_request",
+    "DeltaMapRequest": "pinarms.optim.line.map_request",
+    "MapResult": "pinarms.optim.line.map_request",
+    "MapStatus": "pinarms.optim.line.map_request",
     "build_task_map": "pinarms.optim.line.task_map_build",
     "measure_yaw": "pinarms.optim.line.task_map_build",
     "MapError": "pinarms.optim.line.task_map_error",
@@ -58,7 +63,7 @@ _EXPORTS = {
     "PickPlan": "pinarms.optim.line.tracking",
     "TrackingSpec": "pinarms.optim.line.tracking",
     "plan_pick": "pinarms.optim.line.tracking",
-    "TrayMap": "pinarms.optim.line.tray_maps",
+    "TrayMap": "pinarms.optim.line.tray_map",
     "build_tray_map": "pinarms.optim.line.tray_maps",
     "tray_map_error": "pinarms.optim.line.tray_maps",
     "SimPlace": "pinarms.optim.line.tray_sim",
@@ -77,7 +82,8 @@ __all__ = [
     "RULES", "AssignmentRule", "SimArm", "SimResult", "simulate", "LineFigures", "summarise", "Stream",
     "LineSpec", "LineResult", "LineStatus", "run_line", "build_maps", "LineCurve", "line_curve",
     "BeltOutOfReach", "ArrivalsFileError", "TrayBelt", "TrayPickPlan", "plan_pick_to_tray", "TrayMap",
-    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside",
+    "build_tray_map", "tray_map_error", "SimPlace", "trays_beside", "MapRequest", "TrayMapRequest",
+    "DeltaMapRequest", "MapResult", "MapStatus",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

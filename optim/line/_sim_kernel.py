@@ -267,11 +267,12 @@ def run_events(t0, w, speed, width, group, RA, RC, EX, U, u_min, u_max, max_tA, 
 
 
 @jit
-def cell_rows(w, sel, g, ends, tA, tC):
+def cell_rows(w, sel, g, ends, layer, weight, tA, tC):
     """Rows ``sel`` of ``tA``, ``tC`` (n, K) for items at ``w[sel]``: :meth:`~pinarms.optim.line.map_rows.CellRows.rows`
     item by item (the cell ``j`` and place ``f`` of numpy's ``searchsorted`` and division, then
-    ``T_j · (1 − f) + T_j+1 · f`` per node; NaN off the grid)."""
-    nc, K = ends.shape[1], ends.shape[2]
+    ``T_j · (1 − f) + T_j+1 · f`` per node on yaw layer ``layer[i]``, blended with the next layer
+    as ``(1 − f_y) · lower + f_y · upper`` where ``weight[i]`` (f_y) > 0; NaN off the grid)."""
+    nc, K, ny = ends.shape[2], ends.shape[3], ends.shape[0]
     for x in range(sel.size):
         i = sel[x]
         wi = w[i]
@@ -279,6 +280,14 @@ def cell_rows(w, sel, g, ends, tA, tC):
         f = (wi - g[j]) / (g[j + 1] - g[j])
         if wi < g[0] or wi > g[g.size - 1]:
             f = np.nan
+        y = layer[i]
+        fy = weight[i]
+        y1 = min(y + 1, ny - 1)
         for k in range(K):
-            tA[i, k] = ends[0, j, k] * (1 - f) + ends[1, j, k] * f
-            tC[i, k] = ends[2, j, k] * (1 - f) + ends[3, j, k] * f
+            a = ends[y, 0, j, k] * (1 - f) + ends[y, 1, j, k] * f
+            c = ends[y, 2, j, k] * (1 - f) + ends[y, 3, j, k] * f
+            if fy > 0.0:
+                a = (1.0 - fy) * a + fy * (ends[y1, 0, j, k] * (1 - f) + ends[y1, 1, j, k] * f)
+                c = (1.0 - fy) * c + fy * (ends[y1, 2, j, k] * (1 - f) + ends[y1, 3, j, k] * f)
+            tA[i, k] = a
+            tC[i, k] = c

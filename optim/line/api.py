@@ -30,7 +30,8 @@ from pinarms.optim.line.report import LineFigures, summarise
 from pinarms.optim.line.rules import AssignmentRule, Rule
 from pinarms.optim.line.simulate import SimArm, SimResult, simulate
 from pinarms.optim.line.station import Station
-from pinarms.optim.line.task_map_build import YAW_MODES, build_task_map
+from pinarms.optim.line.map_request import YAW_MODES, MapRequest
+from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw
 from pinarms.optim.line.trays import TrayBelt
@@ -242,14 +243,17 @@ def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | Non
             on_trays = tuple(np.round(trays.belt.to_belt(st.base_to_world[:3, 3])[1:], 9))  # parallel belts: shared
             fine = (approach_maps or {}).get(st.name, (None,))[0]
             key = (station_shape_key(st, spec.belt), "trays", id(trays), on_trays, spec.belt.speed, t.mass, t.size[2], spec.tracking,
-                   spec.tray_grid, id(fine), own)
+                   spec.tray_grid, id(fine), own, spec.map_yaw == "none")
             if key not in cache:
+                from pinarms.optim.line.map_request import TrayMapRequest
                 from pinarms.optim.line.tray_maps import build_tray_map
 
                 nu, nw, nv = spec.tray_grid
-                cache[key] = build_tray_map(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=nu, nw=nw, nv=nv, scheduler=scheduler, approach_map=fine,
-                                            progress=_noted(progress, f"tray map {st.name!r}"), **near)
+                rq = TrayMapRequest(st, spec.belt, trays, spec.tracking, mass=t.mass, item_height=t.size[2], nu=nu,
+                                    nw=nw, nv=nv, approach_map=fine, yaw="none" if spec.map_yaw == "none" else "auto",
+                                    **near)
+                cache[key] = build_tray_map(rq, scheduler=scheduler,
+                                            progress=_noted(progress, f"tray map {st.name!r}")).task_map
             out[st.name] = (cache[key],)
             continue
         maps = []
@@ -257,10 +261,10 @@ def build_maps(spec: LineSpec, *, scheduler: Scheduler = None, known: dict | Non
             key = (station_shape_key(st, spec.belt), spec.belt.speed, t.mass, t.size[2], spec.tracking, spec.map_grid, own,
                    spec.map_yaw)
             if key not in cache:
-                cache[key] = build_task_map(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],
-                                            nu=spec.map_grid[0], nw=spec.map_grid[1], scheduler=scheduler,
-                                            yaw=spec.map_yaw, progress=_noted(progress, f"task map {st.name!r} ({t.name})"),
-                                            **near)
+                rq = MapRequest(st, spec.belt, spec.tracking, mass=t.mass, item_height=t.size[2],
+                                nu=spec.map_grid[0], nw=spec.map_grid[1], yaw=spec.map_yaw, **near)
+                cache[key] = build_task_map(rq, scheduler=scheduler,
+                                            progress=_noted(progress, f"task map {st.name!r} ({t.name})")).task_map
             maps.append(cache[key])
         out[st.name] = tuple(maps)
     return out
@@ -313,7 +317,7 @@ def map_warnings(spec: LineSpec, maps: dict) -> tuple[str, ...]:
         if not can_yaw(st.robot):
             continue
         for m in maps.get(st.name, ()):
-            for text in _pick_part(m).warnings():
+            for text in m.warnings():
                 if text not in out:
                     out.append(text)
     return tuple(out)

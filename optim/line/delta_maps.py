@@ -18,14 +18,16 @@ A delta without the fourth axis grasps at its own yaw: spread 0, no yaw coordina
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.delta_pick_path import delta_pick_path
 from pinarms.optim.line.delta_tracking import DeltaArm, delta_pick_times, tool_turn_time
 from pinarms.optim.line.errors import BeltOutOfReach
+from pinarms.optim.line.map_request import DeltaMapRequest, MapResult, MapStatus
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
@@ -70,43 +72,56 @@ def yaw_layers(arm: DeltaArm, approach: np.ndarray, leave: np.ndarray, yaw: np.n
     return np.maximum(approach[None], turn), np.maximum(leave[None], turn)
 
 
-def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.0,
-                    item_height: float = 0.04, margin: float = 0.025, nu: int = 12, nw: int = 5, n: int = 24,
-                    yaw_nodes: int = 33, progress: Any = None) -> TaskMap:
-    """The delta's task map (module doc); ``n`` TOPP grid intervals per move; ``progress(done, total)``
-    after each du column.
+def build_delta_map(request: DeltaMapRequest, *, progress: Callable[[int, int], None] | None = None) -> MapResult:
+    """The delta's task map (module doc); the request's ``n`` TOPP grid intervals per move;
+    ``progress(done, total)`` after each du column.
+
+    Returns:
+        :class:`~.map_request.MapResult`: the ``TaskMap``, status ``built`` (its plans: the picks timed).
+
+    The request's ``cell``: a :class:`pinarms.robots.cell.Cell` with the station as one of its deltas (same
+    name and base): each feasible node's pick path (:func:`~.delta_pick_path.delta_pick_path`) is checked
+    continuously against the cell's fixtures at ``clearance`` [m] (its bodies posed from the closed form,
+    :meth:`Cell.check_motion`); a pick not proven clear is infeasible (counted in ``TaskMap.fixture_infeasible``
+    and ``MapResult.blocked``).
 
     Raises:
-        InvalidInput: a grid size or margin out of its domain, a station without a delta.
+        InvalidInput: not a :class:`~.map_request.DeltaMapRequest`.
         BeltOutOfReach: the delta reaches no pick on the belt."""
-    if not isinstance(station.robot, DeltaArm):
-        raise InvalidInput(f"station {station.name!r} holds no delta (optim.line.delta_tracking.DeltaArm)")
-    for name, value, low in (("nu", nu, 2), ("nw", nw, 2), ("n", n, 4), ("yaw_nodes", yaw_nodes, 3)):
-        if not (isinstance(value, int) and value >= low):
-            raise InvalidInput(f"{name} must be an integer >= {low}, got {value!r}")
-    if yaw_nodes % 2 != 1:
-        raise InvalidInput(f"yaw_nodes must be odd (0 is the middle node), got {yaw_nodes}")
+    if not isinstance(request, DeltaMapRequest):
+        raise InvalidInput(f"build_delta_map takes a DeltaMapRequest (optim.line.DeltaMapRequest), got "
+                           f"{type(request).__name__}")
+    rq, station, belt, spec = request, request.station, request.belt, request.spec
+    mass, item_height, margin, nu, nw, n, yaw_nodes = (rq.mass, rq.item_height, rq.margin, rq.nu, rq.nw, rq.n,
+                                                       rq.yaw_nodes)
     half = belt.width / 2.0 - margin
-    if not half > 0.0:
-        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
     start = time.perf_counter()
     w = np.linspace(-half, half, nw)
     lo, hi = delta_span(station, belt, item_height + spec.lift, w)
     du = np.linspace(lo, hi, nu)
     u0 = float(belt.to_belt(station.base_to_world[:3, 3])[0])
     A, C = np.full((nu, nw), np.nan), np.full((nu, nw), np.nan)
+    clearance = rq.clearance
+    fixtures = _fixture_view(rq.cell, station, clearance)
+    blocked = 0
     for i, d in enumerate(du):
         for j, wj in enumerate(w):
             try:
                 A[i, j], C[i, j] = delta_pick_times(station, belt, spec, u0 + d, wj, mass=mass,
                                                     item_height=item_height, n=n)
             except InfeasibleProblem:
-                pass
+                continue
+            if fixtures is not None:
+                path = delta_pick_path(station, belt, spec, u0 + d, wj, item_height=item_height)
+                if not fixtures.check_motion({station.name: path}, margin=clearance, clearance=clearance).clear:
+                    A[i, j] = C[i, j] = np.nan
+                    blocked += 1
         if progress is not None:
             progress(i + 1, nu)
     if not np.isfinite(A).any():
-        raise BeltOutOfReach(f"arm {station.name!r}: no pick on the belt is feasible at {belt.speed} m/s "
-                             f"(slow the belt or lengthen the tracking's descend)")
+        why = f"; {blocked} meet the cell's fixtures" if blocked else ""
+        raise BeltOutOfReach(f"arm {station.name!r}: no pick on the belt is feasible at {belt.speed} m/s{why} "
+                             f"(slow the belt or lengthen the tracking's descend, or move the fixtures)")
     extra = spec.track_time + spec.release
     fields: dict[str, Any] = {"yaw_spread": 0.0}
     if station.robot.can_yaw:
@@ -119,8 +134,26 @@ def build_delta_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingS
         fields = {"yaw_spread": spread}
         if spread > YAW_TOLERANCE:
             fields.update(yaw=yaw, yaw_approach=YA[:, None], yaw_leave=YC[:, None])
-    return TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start, yaw_period=spec.yaw_period, **fields)
+    seconds = time.perf_counter() - start
+    m = TaskMap(station.name, du, w, A, C, spec.track_time, spec.release, belt.speed, float(mass), seconds,
+                yaw_period=spec.yaw_period, fixture_infeasible=blocked, **fields)
+    return MapResult(MapStatus.BUILT, "", m, nu * nw, blocked, seconds)
+
+
+def _fixture_view(cell: Any, station: Station, clearance: float) -> Any:
+    """The cell seen with its arm–fixture pairs only (None without a cell); InvalidInput unless the station is one
+    of its deltas, or the clearance is not a length > 0."""
+    if cell is None:
+        return None
+    from pinarms.optim.line.fixtures import check_in_cell
+
+    check_in_cell(cell, station)
+    if station.name not in {d.name for d in cell.deltas}:
+        raise InvalidInput(f"station {station.name!r} is not a delta of cell {cell.name!r}: place it in the cell "
+                           "description with delta = \"<name>\"")
+    if not (isinstance(clearance, (int, float)) and np.isfinite(clearance) and clearance > 0.0):
+        raise InvalidInput(f"clearance to the fixtures must be a finite length > 0 [m], got {clearance!r}")
+    return cell.with_pairs("arm-fixture")
 
 
 def delta_map_error(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,

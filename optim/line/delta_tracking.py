@@ -34,13 +34,13 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.tracking import TrackingSpec
 from pinarms.optim.standard_cycle import JointPathRows, delta_path_rows, time_rows
+from pinarms.optim.standard_cycle.delta_cycle import TOOL_ACCELERATION_FACTOR, tool_turn_time  # the fourth axis
 from pinarms.robots.delta import DeltaRobot, forward_position, inverse_position
 
-__all__ = ["DeltaArm", "delta_pick_times", "platform_move_time", "hermite_points", "tool_turn_time",
+__all__ = ["DeltaArm", "delta_pick_times", "platform_move_time", "platform_move_profile", "tracking_platform",
+           "hermite_points", "tool_turn_time",
            "TOOL_ACCELERATION_FACTOR", "TRACK_SAMPLES"]
 
-#: Acceleration limit of the fourth axis: this many times its speed limit [1/s] (assumed).
-TOOL_ACCELERATION_FACTOR = 10.0
 #: Instants at which the tracking segment is checked against the motor limits.
 TRACK_SAMPLES = 41
 
@@ -78,14 +78,6 @@ class DeltaArm:
         return self._loaded[m]
 
 
-def tool_turn_time(angle: float, vmax: float, amax: float) -> float:
-    """Shortest rest-to-rest time [s] of a turn by ``angle`` [rad] under ``vmax``, ``amax``."""
-    a = abs(float(angle))
-    if a * amax <= vmax ** 2:
-        return 2.0 * np.sqrt(a / amax)
-    return a / vmax + vmax / amax
-
-
 def hermite_points(p0: np.ndarray, p1: np.ndarray, m0: np.ndarray, m1: np.ndarray, length: float):
     """Cubic Hermite from p0 to p1 (tangents m0, m1 in t ∈ [0, 1]) as ``points(s)``, s = t · length."""
 
@@ -105,6 +97,13 @@ def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_d
                        onto: bool, mass: float, n: int) -> float:
     """Time [s] of the platform's move ``start`` → ``end`` (base frame), onto the belt (arriving with
     it) or off it (leaving with it), rest at the box end."""
+    return float(platform_move_profile(arm, start, end, belt_dir, speed, onto, mass, n)[0].duration)
+
+
+def platform_move_profile(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_dir: np.ndarray, speed: float,
+                          onto: bool, mass: float, n: int) -> tuple:
+    """The time-optimal profile of :func:`platform_move_time` and its path: ``(GateTiming, points)``,
+    ``points(s)`` the platform centre, its first and second derivatives along the path (``s`` [m])."""
     chord = end - start
     length = float(np.linalg.norm(chord))
     if length < 1e-6:
@@ -120,7 +119,7 @@ def platform_move_time(arm: DeltaArm, start: np.ndarray, end: np.ndarray, belt_d
         raise InfeasibleProblem(f"{arm.name}: the move leaves the motors' range or the workspace")
     rows = JointPathRows(s, *delta_path_rows(delta, s, points))
     ends = {"sd_end": speed} if onto else {"sd_start": speed}
-    return float(time_rows(rows, lim.velocity, lim.acceleration, lim.torque, **ends).duration)
+    return time_rows(rows, lim.velocity, lim.acceleration, lim.torque, **ends), points
 
 
 def _check_tracking(arm: DeltaArm, pre: np.ndarray, velocity: np.ndarray, spec: TrackingSpec) -> None:
@@ -128,15 +127,8 @@ def _check_tracking(arm: DeltaArm, pre: np.ndarray, velocity: np.ndarray, spec: 
     t = np.linspace(0.0, spec.track_time, TRACK_SAMPLES)
     h = 1e-4
 
-    def depth(x: np.ndarray) -> np.ndarray:
-        down = np.clip(x / spec.descend, 0.0, 1.0)
-        up = np.clip((x - spec.descend - spec.grasp) / spec.descend, 0.0, 1.0)
-        quintic = lambda r: 10 * r ** 3 - 15 * r ** 4 + 6 * r ** 5  # noqa: E731
-        return spec.lift * (quintic(down) - quintic(up))
-
     def theta(x: np.ndarray) -> np.ndarray:
-        p = pre[None] + x[:, None] * velocity[None] - depth(x)[:, None] * np.array([0.0, 0.0, 1.0])
-        return inverse_position(arm.delta.geometry, p - arm.tcp_offset)
+        return inverse_position(arm.delta.geometry, tracking_platform(arm, pre, velocity, spec, x))
 
     q, qp, qm = theta(t), theta(t + h), theta(t - h)
     lim = arm.delta.limits
@@ -148,6 +140,18 @@ def _check_tracking(arm: DeltaArm, pre: np.ndarray, velocity: np.ndarray, spec: 
         if not peak <= bound:
             raise InfeasibleProblem(f"{arm.name}: a motor's {what} {peak:.3g} exceeds its limit {bound:g} while "
                                     f"tracking: lengthen TrackingSpec.descend or slow the belt")
+
+
+def tracking_platform(arm: DeltaArm, pre: np.ndarray, velocity: np.ndarray, spec: TrackingSpec,
+                      x: np.ndarray) -> np.ndarray:
+    """(F, 3) platform centre [m] (base frame) at instants ``x`` (F,) [s] of the tracking segment: the
+    pre-grasp point ``pre`` (tcp) moving at the belt's ``velocity``, a vertical quintic down and up."""
+    x = np.asarray(x, dtype=float)
+    down = np.clip(x / spec.descend, 0.0, 1.0)
+    up = np.clip((x - spec.descend - spec.grasp) / spec.descend, 0.0, 1.0)
+    quintic = lambda r: 10 * r ** 3 - 15 * r ** 4 + 6 * r ** 5  # noqa: E731
+    depth = spec.lift * (quintic(down) - quintic(up))
+    return pre[None] + x[:, None] * velocity[None] - depth[:, None] * np.array([0.0, 0.0, 1.0]) - arm.tcp_offset
 
 
 def delta_pick_times(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, *, mass: float,

@@ -9,6 +9,11 @@ cover check (:func:`pinarms.optim.motion.fast_check`) where it proves, :meth:`pi
 otherwise (:class:`~.fixtures.PairCheck`). The stations must be arms of the cell (same
 names, same bases). A pick that exact planning cannot make (near the edge of the window, where
 the map interpolates feasibility) is not proven clear: the guard says no.
+
+A delta station (:class:`~.delta_tracking.DeltaArm`, a delta of the cell: docs/cells.md) has its pick on
+the clock from :func:`~.delta_pick_path.delta_pick_plan` (its platform path along the time-optimal
+profiles, a proven speed bound); in a cell with a delta every pair goes through the cell's exact check
+alone (the compiled cover knows only the tree's geometry, not the delta's bodies).
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.delta_pick_path import delta_pick_plan
+from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.optim.line.items import ItemType
 from pinarms.optim.line.sim_loop import Pick
 from pinarms.optim.line.station import Station
@@ -48,6 +55,9 @@ class NeighbourGuard:
                 raise InvalidInput(f"station {s.name!r} is not an arm of cell {cell.name!r}") from None
             if np.abs(arm.base_to_world - s.base_to_world).max() > 1e-9:
                 raise InvalidInput(f"station {s.name!r} stands elsewhere than the cell's arm of that name")
+            if isinstance(s.robot, DeltaArm) != (s.name in {d.name for d in cell.deltas}):
+                raise InvalidInput(f"station {s.name!r} and the cell's arm of that name are not both deltas: place a "
+                                   "delta station's delta in the cell description (delta = \"<name>\")")
         self.clearance, self.margin = float(clearance), float(margin)
         self._plans: dict = {}
         self.maps = maps or {}  # {station: task maps}: each pick on the IK branch its map chose
@@ -75,6 +85,10 @@ class NeighbourGuard:
                 u_base = float(self.belt.to_belt(st.base_to_world[:3, 3])[0])
                 branch = self.maps[name][kind].branch_at(u - u_base, w, None if self.yaws is None else self.yaws[item])
             yaw = 0.0 if self.yaws is None else float(self.yaws[item])
+            if isinstance(st.robot, DeltaArm):  # the tool's turn moves no body: the path alone
+                self._plans[key] = delta_pick_plan(st, self.belt, self.tracking, u, w, item_height=t.size[2],
+                                                   mass=t.mass)
+                return self._plans[key]
             self._plans[key] = plan_pick(st, self.belt, self.tracking, u, w, item_height=t.size[2], mass=t.mass,
                                          branch=branch, yaw=yaw)
         return self._plans[key]
@@ -98,7 +112,7 @@ class NeighbourGuard:
             return True
         motions = [ArmMotion(pick.arm, a.trajectory, off_a), ArmMotion(other.arm, b.trajectory, off_b)]
         self.checks += 1
-        if not self.fast:
+        if not self.fast or self.cell.deltas:   # the compiled cover sees only the tree, not a delta's bodies
             res = self.cell.check_motion(motions, margin=self.margin, clearance=self.clearance, window=(t0, t1))
             return bool(res.clear if self.clearance > 0 else res.collision_free)
         key = (pick.arm, other.arm)

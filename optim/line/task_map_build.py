@@ -17,112 +17,76 @@ Dask cluster), one task per ``du`` column and yaw node, same result either way.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Callable
+from functools import partial
+from typing import Any, Callable
 
 import numpy as np
 
-from pinarms.optim.errors import InfeasibleProblem, OptimError
 from pinarms.optim.line.belt import Belt
+from pinarms.optim.line.map_request import MapRequest, MapResult, MapStatus
+from pinarms.optim.line.map_nodes import map_key, node_fixtures, plan_node, plan_yaw, task_station
+from pinarms.optim.line.map_refine import add_yaw_nodes, bent_lines, bent_nodes, merge_nodes
 from pinarms.optim.line.station import Station
 from pinarms.optim.line.task_maps import YAW_TOLERANCE, TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, can_yaw, ik_branch_labels, plan_pick, rest_configuration
 from pinarms.optim.line.windows import belt_span, check_reach
-from pinarms.errors import InvalidInput, UnreachableTarget
+from pinarms.errors import InvalidInput
+from pinarms.execution import Scheduler, scheduler_session
 
-if TYPE_CHECKING:
-    from pinarms.optim.line.fixtures import FixtureCheck
+__all__ = ["build_task_map", "measure_yaw", "PROBE_COLUMNS", "PROBE_YAWS"]
 
-__all__ = ["build_task_map", "measure_yaw", "YAW_MODES", "PROBE_COLUMNS", "PROBE_YAWS", "task_fixture_check"]
-
-#: ``"auto"``: a yaw coordinate where the task time depends on yaw (measured); ``"axis"``: always
-#: (arms that can turn their tool); ``"none"``: never, the spread not measured (the maps before).
-YAW_MODES = ("auto", "axis", "none")
 #: Interior ``du`` columns on which ``yaw="auto"`` measures the yaw dependence (evenly spread).
 PROBE_COLUMNS = 3
 #: Where on the yaw grid (fractions of it, 0: -period/2, 1: +period/2) ``yaw="auto"`` probes.
 PROBE_YAWS = (0.0, 0.25, 0.75)
 
 
-def _refine_at(x: np.ndarray, A: np.ndarray, C: np.ndarray, extra: float, tolerance: float, axis: int) -> np.ndarray:
-    """Midpoints of the intervals of grid ``x`` (along ``axis`` of the (nb, nu, nw) tables: 1 du, 2 w)
-    next to a node where some branch's approach or leave time has a second difference above
-    ``4 × tolerance`` of the task time there: bilinear interpolation errs by about a quarter of it
-    at a kink, an eighth on a smooth bend."""
-    mark = np.zeros(x.size - 1, bool)
-    n = x.size
-    for T in (A, C):
-        T, tot = np.moveaxis(T, axis, 1), np.moveaxis(A + C, axis, 1)
-        d2 = np.abs(T[:, :-2] - 2.0 * T[:, 1:-1] + T[:, 2:])  # NaN where a node is infeasible
-        with np.errstate(invalid="ignore"):
-            bent = np.any(d2 > 4.0 * tolerance * (tot[:, 1:-1] + extra), axis=(0, 2))
-        mark[: n - 2] |= bent
-        mark[1:] |= bent
-    return 0.5 * (x[:-1] + x[1:])[mark]
-
-
-def _merge(x: np.ndarray, new: np.ndarray, tables: tuple, added: tuple, axis: int) -> tuple:
-    """Grid ``x`` with ``new`` points, and each table with its ``added`` slices along ``axis``, sorted."""
-    order = np.argsort(np.concatenate([x, new]), kind="stable")
-    return (np.concatenate([x, new])[order],
-            *(np.take(np.concatenate([t, a], axis=axis), order, axis=axis) for t, a in zip(tables, added)))
-
-
-def task_fixture_check(task: dict) -> FixtureCheck | None:
-    """The fixture check of a map column's ``task`` (its ``cell``, ``station`` and ``clearance``; None: no cell given):
-    a :class:`~.fixtures.FixtureCheck`."""
-    if task.get("cell") is None:
-        return None
-    from pinarms.optim.line.fixtures import fixture_check
-
-    return fixture_check(task["cell"], task["station"].name, task["clearance"])
-
-
-def _plan_yaw(yaw: float, period: float) -> float:
-    """The item yaw [rad] planned for tool-yaw node ``yaw``: the node itself, the last node
-    (+period/2, the same grasp as -period/2 reached from the other side) just below it."""
-    return min(float(yaw), period / 2.0 * (1.0 - 1e-9))
-
-
-def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int]:
-    """Exact times of one ``du`` column at one tool yaw (a task of the execution layer), and how
-    many of its planned picks came closer than the clearance to the cell's fixtures (their times NaN)."""
-    st, belt, spec = task["station"], task["belt"], task["spec"]
+def _column(task: dict) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """Exact times of one ``du`` column at one tool yaw (a task of the execution layer), how
+    many of its planned picks came closer than the clearance to the cell's fixtures (their times NaN),
+    and the CPU time [s] it took."""
+    cpu = time.process_time()
+    st, belt, spec = task_station(task), task["belt"], task["spec"]
     u_base = float(belt.to_belt(st.base_to_world[:3, 3])[0])
-    q_rest = rest_configuration(st)
+    q_rest = task["q_rest"]
     labels = task.get("branches", (-1,))
-    yaw = _plan_yaw(task.get("yaw", 0.0), spec.yaw_period)
-    fixtures = task_fixture_check(task)
+    yaw = plan_yaw(task.get("yaw", 0.0), spec.yaw_period)
+    fixtures = node_fixtures(task)
     blocked = 0
     tA = np.full((len(labels), len(task["w"])), np.nan)
     tC = np.full_like(tA, np.nan)
     for b, label in enumerate(labels):
         for j, w in enumerate(task["w"]):
-            try:
-                plan = plan_pick(st, belt, spec, u_base + task["du"], w, item_height=task["height"], mass=task["mass"],
-                                 q_rest=q_rest, branch=None if label < 0 else label, yaw=yaw)
-            except (UnreachableTarget, InfeasibleProblem, OptimError):
-                continue
-            verdict = "clear" if fixtures is None else fixtures.verdict(plan.trajectory)
-            if verdict != "clear":
-                blocked += verdict == "fixtures"
-                continue
-            tA[b, j], tC[b, j] = plan.times[0], plan.times[2]
-    return tA, tC, blocked
+            plan, bad = plan_node(partial(plan_pick, st, belt, spec, u_base + task["du"], w, item_height=task["height"],
+                                          mass=task["mass"], q_rest=q_rest, branch=None if label < 0 else label,
+                                          yaw=yaw), fixtures)
+            blocked += bad
+            if plan is not None:
+                tA[b, j], tC[b, j] = plan.times[0], plan.times[2]
+    return tA, tC, blocked, time.process_time() - cpu
 
 
 class _Planner:
     """Plans blocks of the 4-D tables (yaw, branch, du, w) through the execution layer, counting
-    blocked nodes and reporting progress as one count over every block (``progress(done, total)``)."""
+    plans and blocked nodes and reporting progress as one count over every block
+    (``progress(done, total)``: columns planned)."""
 
     def __init__(self, task: dict, scheduler: Any, progress: Callable | None) -> None:
         self.task, self.scheduler, self.progress = task, scheduler, progress
-        self.blocked, self.done, self.total = 0, 0, 0
+        self.blocked, self.done, self.total, self.plans, self.cpu = 0, 0, 0, 0, 0.0
 
     def __call__(self, du: np.ndarray, w: np.ndarray, yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Tables (len(yaw), nb, len(du), len(w)) of approach and leave times."""
+        """Tables (len(yaw), nb, len(du), len(w)) of approach and leave times at every node."""
+        return self.nodes(du, w, yaw, np.ones((len(yaw), len(du), len(w)), bool))
+
+    def nodes(self, du: np.ndarray, w: np.ndarray, yaw: np.ndarray, need: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Tables (len(yaw), nb, len(du), len(w)) planned where ``need`` (len(yaw), len(du), len(w)), NaN
+        elsewhere: one task per yaw and column that needs a node."""
         from pinarms.execution import map_chunks
 
-        tasks = [{**self.task, "du": float(d), "w": w.tolist(), "yaw": float(y)} for y in yaw for d in du]
+        where = [(k, i) for k in range(len(yaw)) for i in range(len(du)) if need[k, i].any()]
+        tasks = [{**self.task, "du": float(du[i]), "w": np.asarray(w)[need[k, i]].tolist(), "yaw": float(yaw[k])}
+                 for k, i in where]
         base, self.total = self.done, self.total + len(tasks)
 
         def report(done: int, total: int | None = None) -> None:
@@ -132,11 +96,14 @@ class _Planner:
 
         cols = map_chunks(_column, tasks, scheduler=self.scheduler, progress=report if self.progress else None)
         self.done = base + len(tasks)
-        self.blocked += sum(c[2] for c in cols)
         nb = len(self.task["branches"])
-        shape = (len(yaw), len(du), nb, len(w))
-        A = np.stack([c[0] for c in cols]).reshape(shape).transpose(0, 2, 1, 3)
-        C = np.stack([c[1] for c in cols]).reshape(shape).transpose(0, 2, 1, 3)
+        A = np.full((len(yaw), nb, len(du), len(w)), np.nan)
+        C = np.full_like(A, np.nan)
+        for (k, i), (a, c, blocked, cpu) in zip(where, cols):
+            A[k, :, i, need[k, i]], C[k, :, i, need[k, i]] = a.T, c.T
+            self.blocked += blocked
+            self.plans += a.size
+            self.cpu += cpu
         return A, C
 
 
@@ -194,88 +161,77 @@ def _same_columns(rows: list) -> list:
 
 def _refine(plan: _Planner, du: np.ndarray, w: np.ndarray, yaw: np.ndarray | None, A: np.ndarray, C: np.ndarray,
             extra: float, tolerance: float, passes: int, yaw_passes: int) -> tuple:
-    """Refinement passes (module doc of :func:`build_task_map`): du, then w, then yaw (4-D tables)."""
+    """Refinement passes (:mod:`~.map_refine`): whole du columns, then w rows, where a time bends;
+    then yaw nodes at each (du, w) node where its time bends along yaw (the others interpolated)."""
     ys = np.zeros(1) if yaw is None else yaw
     for k in range(max(passes, yaw_passes if yaw is not None else 0)):
-        flat = (A.reshape(-1, *A.shape[2:]), C.reshape(-1, *C.shape[2:]))  # yaw layers as more branches
-        new_u = _refine_at(du, *flat, extra, tolerance, 1) if k < passes else np.zeros(0)
-        if new_u.size:
-            du, A, C = _merge(du, new_u, (A, C), plan(new_u, w, ys), 2)
-            flat = (A.reshape(-1, *A.shape[2:]), C.reshape(-1, *C.shape[2:]))
-        new_w = _refine_at(w, *flat, extra, tolerance, 2) if k < passes else np.zeros(0)
-        if new_w.size:
-            w, A, C = _merge(w, new_w, (A, C), plan(du, new_w, ys), 3)
-        new_y = np.zeros(0)
+        added = 0
+        if k < passes:
+            new_u = bent_lines(du, A, C, extra, tolerance, 2)
+            if new_u.size:
+                du, A, C = merge_nodes(du, new_u, (A, C), plan(new_u, w, ys), 2)
+            new_w = bent_lines(w, A, C, extra, tolerance, 3)
+            if new_w.size:
+                w, A, C = merge_nodes(w, new_w, (A, C), plan(du, new_w, ys), 3)
+            added = new_u.size + new_w.size
         if yaw is not None and k < yaw_passes:
-            by_yaw = tuple(np.moveaxis(T, 0, 1).reshape(T.shape[1], T.shape[0], -1) for T in (A, C))
-            new_y = _refine_at(ys, *by_yaw, extra, tolerance, 1)
-            if new_y.size:
-                ys, A, C = _merge(ys, new_y, (A, C), plan(du, w, new_y), 0)
-        if new_u.size == 0 and new_w.size == 0 and new_y.size == 0:
+            ys, A, C, more = add_yaw_nodes(ys, A, C, extra, tolerance, partial(plan.nodes, du, w))
+            added += more
+        if not added:
             break
     return du, w, (None if yaw is None else ys), A, C
 
 
-def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *, mass: float = 0.1,
-                   item_height: float = 0.04, margin: float = 0.025, nu: int = 24, nw: int = 7,
-                   du_range: tuple[float, float] | None = None, scheduler: Any = None,
-                   progress: Any = None, refine: int = 0, tolerance: float = 0.005, cell: Any = None,
-                   clearance: float = 0.01, yaw: str = "auto", yaw_nodes: int = 9, yaw_refine: int = 2) -> TaskMap:
-    """Plan picks exactly on a ``nu`` × ``nw`` grid and keep their times (module doc).
+def build_task_map(request: MapRequest, *, scheduler: Scheduler = None,
+                   progress: Callable[[int, int], None] | None = None) -> MapResult:
+    """Plan picks exactly on the request's ``nu`` × ``nw`` grid and keep their times (module doc).
 
     ``du`` spans the sampled workspace over the belt (:func:`~.windows.belt_span`, or ``du_range`` [m]);
     ``w`` the belt's width less ``margin`` [m] at each edge (half an item's width).
     ``refine``: passes that add a ``du`` column, then a ``w`` row, at the middle of each interval
     where a branch's approach or leave time bends more than linear interpolation can follow
-    (:func:`_refine_at`: a second difference above ``4 × tolerance`` of the task time; a kink
+    (:func:`~.map_refine.bent_lines`: a second difference above ``4 × tolerance`` of the task time; a kink
     between nodes, e.g. where the limiting joint changes, shows there); the grid is then uneven.
     Maps of several item types of one arm must share their ``du`` grid: refine only single-type maps.
-    ``yaw`` (:data:`YAW_MODES`), ``yaw_nodes`` (odd, >= 3: the first yaw grid, 0 its middle node) and
-    ``yaw_refine`` (passes that add yaw nodes where the time bends along yaw): the item's yaw
-    (module doc). ``progress(done, total)``: picks columns planned so far (the total grows as the
-    yaw measure and the refinement add columns).
-    ``cell``: a :class:`pinarms.robots.cell.Cell` with the station as one of its arms (same name and base):
-    a node whose planned pick (the whole trajectory) comes closer than ``clearance`` [m] to the
-    cell's fixtures is infeasible (:mod:`~.fixtures`; counted in ``TaskMap.fixture_infeasible``).
+    ``yaw``, ``yaw_nodes`` and ``yaw_refine`` (passes that add a yaw node where the time bends along
+    yaw, planned only at the (du, w) nodes that bend: :func:`~.map_refine.bent_nodes`): the item's
+    yaw (module doc). ``cell``: nodes whose planned pick (the whole trajectory) comes closer than
+    ``clearance`` [m] to the cell's fixtures are infeasible (:mod:`~.fixtures`; counted in
+    ``TaskMap.fixture_infeasible`` and ``MapResult.blocked``).
+    ``scheduler``: where the plans run (:mod:`pinarms.execution`; ``"processes:N"`` starts its
+    workers once for the whole build); ``progress(done, total)``: columns planned so far (the total
+    grows as the yaw measure and the refinement add columns).
+
+    Returns:
+        :class:`~.map_request.MapResult`: the ``TaskMap``; status ``built``, ``refine left`` (a time
+        still bends more than the tolerance after the last refinement pass asked for) or ``no
+        feasible node``.
 
     Raises:
         BeltOutOfReach: the arm reaches no point of the belt (names the nearest belt point).
         UnreachableTarget: the arm cannot reach its box.
-        InvalidInput: a grid size, range, margin or yaw option out of its domain.
+        InvalidInput: not a :class:`~.map_request.MapRequest`.
     """
-    if not (isinstance(nu, int) and isinstance(nw, int) and nu >= 2 and nw >= 2):
-        raise InvalidInput(f"nu and nw must be integers >= 2, got {nu!r}, {nw!r}")
-    if yaw not in YAW_MODES:
-        raise InvalidInput(f"yaw must be one of {YAW_MODES}, got {yaw!r}")
-    if not (isinstance(yaw_nodes, int) and yaw_nodes >= 3 and yaw_nodes % 2 == 1):
-        raise InvalidInput(f"yaw_nodes must be an odd integer >= 3 (0 is the middle node), got {yaw_nodes!r}")
-    if not (isinstance(yaw_refine, int) and yaw_refine >= 0):
-        raise InvalidInput(f"yaw_refine must be an integer >= 0, got {yaw_refine!r}")
-    check_reach(station, belt, item_height)
-    rest_configuration(station)
-    if cell is not None:
-        from pinarms.optim.line.fixtures import check_in_cell, fixture_check
-
-        check_in_cell(cell, station)
-        fixture_check(cell, station.name, clearance)  # bad clearance: an error before any planning
+    if not isinstance(request, MapRequest):
+        raise InvalidInput(f"build_task_map takes a MapRequest (optim.line.MapRequest), got {type(request).__name__}")
+    rq, station, belt, spec = request, request.station, request.belt, request.spec
+    check_reach(station, belt, rq.item_height)
+    q_rest = rest_configuration(station)
     start = time.perf_counter()
-    lo, hi = belt_span(station, belt) if du_range is None else (float(du_range[0]), float(du_range[1]))
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise InvalidInput(f"du_range must be two finite numbers, low < high [m], got {du_range!r}")
-    du = np.linspace(lo, hi, nu)
-    half = belt.width / 2.0 - margin
-    if half <= 0.0:
-        raise InvalidInput(f"margin {margin} m leaves no belt width (width {belt.width} m)")
-    w = np.linspace(-half, half, nw)
+    lo, hi = belt_span(station, belt) if rq.du_range is None else (float(rq.du_range[0]), float(rq.du_range[1]))
+    du = np.linspace(lo, hi, rq.nu)
+    half = belt.width / 2.0 - rq.margin
+    w = np.linspace(-half, half, rq.nw)
     u_base = float(belt.to_belt(station.base_to_world[:3, 3])[0])
     uu, ww = np.meshgrid(u_base + du, w, indexing="ij")
-    labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), item_height + spec.lift))
-    task = {"station": station, "belt": belt, "spec": spec, "mass": mass, "height": item_height,
-            "seed": 0, "branches": labels, "cell": cell, "clearance": clearance}
-    plan = _Planner(task, scheduler, progress)
+    labels = ik_branch_labels(station, belt.to_world(uu.ravel(), ww.ravel(), rq.item_height + spec.lift))
+    task = {"station": station, "belt": belt, "spec": spec, "mass": rq.mass, "height": rq.item_height, "seed": 0,
+            "branches": labels, "cell": rq.cell, "clearance": rq.clearance, "q_rest": q_rest, "key": map_key()}
     extra = spec.track_time + spec.release
-    ygrid, A, C, spread = _yaw_axis(plan, du, w, yaw, yaw_nodes, spec.yaw_period, extra)
-    du, w, ygrid, A, C = _refine(plan, du, w, ygrid, A, C, extra, tolerance, refine, yaw_refine)
+    with scheduler_session(scheduler) as held:
+        plan = _Planner(task, held, progress)
+        ygrid, A, C, spread = _yaw_axis(plan, du, w, rq.yaw, rq.yaw_nodes, spec.yaw_period, extra)
+        du, w, ygrid, A, C = _refine(plan, du, w, ygrid, A, C, extra, rq.tolerance, rq.refine, rq.yaw_refine)
     zero = 0 if ygrid is None else int(np.flatnonzero(ygrid == 0.0)[0])
     A0, C0 = A[zero], C[zero]
     tot = A0 + C0
@@ -285,9 +241,31 @@ def build_task_map(station: Station, belt: Belt, spec: TrackingSpec = TrackingSp
     if ygrid is not None:
         spread = _spread(A, C, zero, extra)
     yaw_fields = {} if ygrid is None else {"yaw": ygrid, "yaw_approach": A, "yaw_leave": C}
-    return TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(mass),
-                   time.perf_counter() - start, labels, A0, C0, int(plan.blocked), yaw_period=spec.yaw_period,
-                   yaw_spread=spread, **yaw_fields)
+    seconds = time.perf_counter() - start
+    m = TaskMap(station.name, du, w, tA, tC, spec.track_time, spec.release, belt.speed, float(rq.mass), seconds,
+                labels, A0, C0, int(plan.blocked), yaw_period=spec.yaw_period, yaw_spread=spread, **yaw_fields)
+    status, reason = _status(rq, du, w, ygrid, A, C, extra)
+    return MapResult(status, reason, m, plan.plans, int(plan.blocked), seconds, plan.cpu)
+
+
+def _status(rq: MapRequest, du: np.ndarray, w: np.ndarray, yaw: np.ndarray | None, A: np.ndarray, C: np.ndarray,
+            extra: float) -> tuple[MapStatus, str]:
+    """The build's status and reason (:mod:`~.map_request`): no feasible node; bends left after the
+    refinement passes asked for (du/w with ``refine`` > 0, yaw with ``yaw_refine`` > 0); built."""
+    if not np.isfinite(A + C).any():
+        return MapStatus.NO_FEASIBLE, "no node of the grid is feasible: move the arm or its box, or widen du_range"
+    left = []
+    if rq.refine > 0:
+        lines = bent_lines(du, A, C, extra, rq.tolerance, 2).size + bent_lines(w, A, C, extra, rq.tolerance, 3).size
+        if lines:
+            left.append(f"{lines} du/w intervals (raise refine, now {rq.refine})")
+    if yaw is not None and rq.yaw_refine > 0:
+        nodes = int(bent_nodes(yaw, A, C, extra, rq.tolerance).sum())
+        if nodes:
+            left.append(f"{nodes} yaw intervals at (du, w) nodes (raise yaw_refine, now {rq.yaw_refine})")
+    if left:
+        return MapStatus.REFINE_LEFT, f"times still bend beyond tolerance {rq.tolerance:g} in " + " and ".join(left)
+    return MapStatus.BUILT, ""
 
 
 def measure_yaw(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingSpec = TrackingSpec(), *,
@@ -308,8 +286,9 @@ def measure_yaw(task_map: TaskMap, station: Station, belt: Belt, spec: TrackingS
         raise InvalidInput(f"yaw_nodes must be an odd integer >= 3 (0 is the middle node), got {yaw_nodes!r}")
     if not can_yaw(station.robot):
         return replace(task_map, yaw_spread=0.0, yaw_period=spec.yaw_period)
-    task = {"station": station, "belt": belt, "spec": spec, "mass": task_map.mass, "height": item_height,
-            "seed": 0, "branches": task_map.branches, "cell": None, "clearance": 0.01}
+    task = {"station": station, "belt": belt, "spec": spec, "mass": task_map.mass, "height": item_height, "seed": 0,
+            "branches": task_map.branches, "cell": None, "clearance": 0.01, "q_rest": rest_configuration(station),
+            "key": map_key()}
     plan = _Planner(task, scheduler, progress)
     du = task_map.du
     grid = np.linspace(-spec.yaw_period / 2.0, spec.yaw_period / 2.0, yaw_nodes)

@@ -171,7 +171,7 @@ class TaskMap:
         f = np.where((x < grid[0]) | (x > grid[-1]), np.nan, f)
         return i, f
 
-    def _yaw_weights(self, yaw: Any, shape: tuple) -> tuple[np.ndarray, np.ndarray]:
+    def yaw_weights(self, yaw: Any, shape: tuple) -> tuple[np.ndarray, np.ndarray]:
         """Layer index k and weight f in [0, 1) of layer k + 1 at item yaws ``yaw`` [rad] (broadcast
         to ``shape``): the yaw reduced by the gripper's symmetry (:func:`~.tracking.tool_yaw`); the
         layer at yaw 0 for a map without yaw or ``yaw`` None."""
@@ -208,7 +208,7 @@ class TaskMap:
             du, w, _ = np.broadcast_arrays(du, w, np.asarray(yaw, float))
         i, fu = self._weights(self.du, du)
         j, fw = self._weights(self.w, w)
-        k, fy = self._yaw_weights(yaw, du.shape)
+        k, fy = self.yaw_weights(yaw, du.shape)
 
         def one(kk: np.ndarray) -> tuple:
             b = self._cell_branch(i, j, fu + fw, kk)
@@ -247,7 +247,7 @@ class TaskMap:
         :func:`~.tracking.plan_pick` ``branch=`` plans it exactly."""
         i, fu = self._weights(self.du, np.asarray(du, float))
         j, fw = self._weights(self.w, np.asarray(w, float))
-        k, fy = self._yaw_weights(yaw, np.shape(i))
+        k, fy = self.yaw_weights(yaw, np.shape(i))
         b = int(self._cell_branch(i, j, fu + fw, np.where(fy > 0.5, k + 1, k)))
         return None if b < 0 or self.branches[b] < 0 else int(self.branches[b])
 
@@ -275,7 +275,7 @@ class TaskMap:
         _, node, cell = self.sim_grid() if grid is None else grid
         w = np.asarray(w, float)
         j, fw = self._weights(self.w, w)
-        k, fy = self._yaw_weights(None if yaw is None else np.asarray(yaw, float), w.shape)
+        k, fy = self.yaw_weights(None if yaw is None else np.asarray(yaw, float), w.shape)
         k, fy = k[:, None] + np.zeros(cell.size, int), fy[:, None] + np.zeros(cell.size)
 
         def one(kk: np.ndarray) -> tuple:

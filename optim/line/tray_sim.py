@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinarms.optim.line.tray_maps import TrayMap
+from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.trays import TrayBelt
 
 __all__ = ["SimPlace", "Place", "find_place", "tray_counts"]

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence, TYPE_CHECKING
+from typing import Any, Callable, Sequence, TYPE_CHECKING, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -69,6 +69,8 @@ TIMED_LIMIT_TOL = 1e-9
 __all__ = ["MotionChecker", "TimedArm", "Verdict", "MAX_SPLITS", "MAX_THREADS", "COARSE_LEVELS", "check_threads",
            "coarse_first"]
 
+T = TypeVar("T")
+
 
 @dataclass(frozen=True)
 class TimedArm:
@@ -90,6 +92,19 @@ class TimedArm:
         tau = np.clip(np.asarray(t, dtype=float) - self.offset + tr.start_time, tr.start_time, tr.end_time)
         return np.asarray(tr.sample(tau)[0], dtype=float).reshape(np.size(t), -1)
 
+
+
+def _refuse_delta_pairs(cell: Cell, arms: tuple[str, ...]) -> None:
+    """InvalidInput when the checker would miss a pair with a delta's body (docs/cells.md, "A delta robot in a
+    cell"): its bodies are not in the tree this checker proves on, so a planned arm that is a delta, or one that
+    a delta's body may touch, is refused rather than proven against part of the cell."""
+    deltas = getattr(cell, "deltas", ())
+    if not deltas:
+        return
+    if any(d.name in arms for d in deltas) or any({p.owner_a, p.owner_b} & set(arms) for p in cell.delta_pairs):
+        raise InvalidInput(f"cell {cell.name!r} holds a delta ({', '.join(d.name for d in deltas)}) whose bodies "
+                           f"the motion checker of {', '.join(arms)} cannot see: check the motion with "
+                           "Cell.check_motion (planning beside or for a delta is not supported)")
 
 
 class MotionChecker(CoalBatches, LadderProof):
@@ -127,6 +142,7 @@ class MotionChecker(CoalBatches, LadderProof):
         if not names or len(set(names)) != len(names):
             raise InvalidInput(f"arms must name distinct arms of the cell, got {arms!r}")
         self.arms = tuple(cell.arm(a).name for a in names)
+        _refuse_delta_pairs(cell, self.arms)
         for name, value in (("margin", margin), ("self_margin", self_margin)):
             ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
             if not ok or not math.isfinite(float(value)) or float(value) < 0.0:
@@ -203,7 +219,7 @@ class MotionChecker(CoalBatches, LadderProof):
         self._share: np.ndarray | None = None  # each pair's share of an edge's travel (_travel_share)
         self._pair_rows: np.ndarray | None = None
         self._screeners: dict[str, Any] = {}  # the cover's prepared per-pair screen (built on first use)
-        self._kept: dict[str, Any] = {}  # what helpers build once per checker (kept)
+        self._memo: dict[str, Any] = {}  # what helpers build once per checker (memo)
 
     # ------------------------------------------------------------------ plumbing
     def _moving_travel(self, levers: np.ndarray, bins: int = 1024) -> tuple[np.ndarray, np.ndarray]:
@@ -325,12 +341,12 @@ class MotionChecker(CoalBatches, LadderProof):
             out[i], arg[i], dist[i] = best, k_best, d_best
         return out, arg, dist
 
-    def kept(self, key: str, build: Callable[[], Any]) -> Any:
-        """``build()``, built on the first call for ``key`` and kept with this checker (the fast check of
-        :func:`pinarms.optim.motion.fast.fast_check`)."""
-        if key not in self._kept:
-            self._kept[key] = build()
-        return self._kept[key]
+    def memo(self, key: str, build: Callable[[], T]) -> T:
+        """The value kept with this checker under ``key``, built by ``build()`` the first time (as
+        :meth:`pinarms.robots.cell.Cell.memo`; the fast check of :func:`pinarms.optim.motion.fast.fast_check`)."""
+        if key not in self._memo:
+            self._memo[key] = build()
+        return self._memo[key]
 
     def place_geometry(self, qp: np.ndarray) -> None:
         """Place every collision body at Pinocchio configuration ``qp`` (one row of :meth:`to_pinocchio`) for

@@ -182,7 +182,7 @@ def fast_check(checker: MotionChecker) -> FastCheck | None:
         except ValueError:
             return None
 
-    return checker.kept("fast_check", build)
+    return checker.memo("fast_check", build)
 
 
 def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> tuple:
@@ -196,8 +196,7 @@ def _moving_work(cover: Any, pairs: Any, hold: np.ndarray, cols: np.ndarray) -> 
         moves[i] = int(index[i]) in planned or moves[parent[i]]
     work = cover.work(pairs)
     hold = np.ascontiguousarray(hold, dtype=float)
-    place_world(hold, cover.fk, cover.joint, cover.center, cover.segments[0], cover.segments[1], cover.segments[2],
-           pairs.hjoint, pairs.hcenter, work)
+    place_world(hold, cover.fk, cover.kernel_arrays(), pairs.hjoint, pairs.hcenter, work)
     moving = (np.flatnonzero(moves), np.flatnonzero(moves[pairs.hjoint]), np.flatnonzero(moves[cover.joint]),
               np.flatnonzero(moves[cover.segments[0]]), np.empty((3, 3)))
     return (*work, tuple(np.ascontiguousarray(m, dtype=np.int64) for m in moving[:4]) + (moving[4],))

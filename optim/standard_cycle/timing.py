@@ -15,7 +15,7 @@ import numpy as np
 
 from pinarms.optim.topp import topp_profile
 
-__all__ = ["JointPathRows", "GateTiming", "time_rows", "limit_usage"]
+__all__ = ["profile_position", "JointPathRows", "GateTiming", "time_rows", "limit_usage"]
 
 
 @dataclass(frozen=True)
@@ -70,3 +70,17 @@ def time_rows(path: JointPathRows, vmax, amax, tmax, *, sd_start: float = 0.0, s
                            x_end=float(sd_end) ** 2)
     return GateTiming(profile.duration, profile.s, profile.sd, profile.u,
                       limit_usage(path, profile.x, profile.u, vmax, amax, tmax))
+
+
+def profile_position(timing, tau: np.ndarray) -> np.ndarray:
+    """Path position ``s`` [m] at instants ``tau`` [s] of a time-optimal profile (``timing.s``, ``timing.sd``:
+    constant path acceleration on each interval, so ``dt = 2 ds / (sd_k + sd_k+1)``), held at its end."""
+    s, sd = np.asarray(timing.s, float), np.asarray(timing.sd, float)
+    ds = np.diff(s)
+    dt = 2.0 * ds / np.maximum(sd[:-1] + sd[1:], 1e-300)
+    t_nodes = np.concatenate([[0.0], np.cumsum(dt)])
+    tau = np.clip(np.asarray(tau, float), 0.0, t_nodes[-1])
+    k = np.clip(np.searchsorted(t_nodes, tau, side="right") - 1, 0, ds.size - 1)
+    local = tau - t_nodes[k]
+    acc = (sd[k + 1] - sd[k]) / dt[k]
+    return np.minimum(s[k] + sd[k] * local + 0.5 * acc * local ** 2, s[k + 1])

@@ -201,9 +201,6 @@ def belt_run(preset, rate, speed, paper_limit, rule, seeds, duration, arms, arri
 
     robot = _robot(kw)
     spec = _spec(preset, arms, rate, speed, paper_limit, rule, seeds, duration, arrivals, robot)
-    if robot is not None and "delta" in robot and (session_path or html_path):
-        raise InvalidInput("--session/--html with a delta: the line's page does not draw deltas yet (docs/delta.md); "
-                           "drop them (--plot works)")
     if trays and robot is not None:
         raise InvalidInput("--trays with --robot: the tray line takes a preset's arms only; drop --trays")
     if trays:

@@ -88,23 +88,27 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
     arms = [{"name": a.name, "model": a.model, "prefix": a.prefix, "joints": list(a.robot.joint_names),
              "q_slice": [a.q_slice.start, a.q_slice.stop], "base_to_world": a.base_to_world,
              "tcp_frame": a.robot.tcp_frame, "tcp": a.tcp_choice, "frozen": dict(a.frozen),
-             "hold": [float(v) for v in a.hold], "states": {n: [float(v) for v in q] for n, q in a.states.items()}}
+             "hold": [float(v) for v in a.hold], "states": {n: [float(v) for v in q] for n, q in a.states.items()},
+             "delta": next((d.delta.name for d in c.deltas if d.name == a.name), None)}
             for a in c.arms]
     fixtures = [{"name": f.name, "shapes": [{"kind": s.kind, "size": list(s.size), "mesh": s.mesh,
                                              "position_m": s.shape_to_world[:3, 3]} for s in f.shapes]}
                 for f in c.fixtures]
-    kinds = Counter(p.kind for p in c.pairs)
-    reasons = Counter(a.reason for a in c.allowed)
+    kinds = Counter(p.kind for p in c.pairs + c.delta_pairs)
+    allowed = c.allowed + c.delta_allowed
+    reasons = Counter(a.reason for a in allowed)
+    delta_of = {d.name: d.delta.name for d in c.deltas}
     data = {"cell": c.name, "source": c.source, "args": c.args, "nq": c.nq, "joint_names": list(c.joint_names),
             "arms": arms, "fixtures": fixtures, "pairs_checked": dict(kinds), "pairs_allowed": dict(reasons),
             "allowed": [{"bodies": [a.body_a, a.body_b], "geometries": [a.geometry_a, a.geometry_b],
                          "reason": str(a.reason), "distance_bound_m": a.distance_bound, "note": a.note}
-                        for a in c.allowed]}
+                        for a in allowed]}
     args_text = "; args " + ", ".join(f"{a}={v}" for a, v in c.args.items()) if c.args else ""
     lines = [f"cell {c.name} ({c.source}){args_text}", f"{len(c.arms)} arm(s), {c.nq} joints in the cell vector:"]
     for a in c.arms:
         p = a.base_to_world[:3, 3] * k
-        lines.append(f"  {a.name}: {a.model or 'arm'}, joints {a.q_slice.start}-{a.q_slice.stop - 1} "
+        kind = f"delta {delta_of[a.name]} (bodies from the closed form)" if a.name in delta_of else a.model or "arm"
+        lines.append(f"  {a.name}: {kind}, joints {a.q_slice.start}-{a.q_slice.stop - 1} "
                      f"({', '.join(a.robot.joint_names)}), base at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) {lu}")
         lines += _arm_keys_text(c, a)
     lines.append(f"{len(c.fixtures)} fixture(s):")
@@ -112,7 +116,7 @@ def cell_show_cmd(cell, xacro_args, packages, mm, session_path, html_path, as_js
         lines.append(f"  {f.name}: {', '.join(_shape_text(s, k, lu) for s in f.shapes)}")
     lines.append("pairs checked: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items())))
     lines.append("pairs allowed: " + ", ".join(f"{n} {r}" for r, n in sorted(reasons.items())))
-    lines.extend(skipped_pair_lines(c.allowed, k, lu))
+    lines.extend(skipped_pair_lines(allowed, k, lu))
     if session_path or html_path:
         from pinarms import viz
 

@@ -205,12 +205,16 @@ def export_cell(cell_or_name: Cell | str | os.PathLike, out_dir: str | os.PathLi
             the cell's packages and these (:mod:`.mesh_sources`).
 
     Raises:
-        CellNotFound: unknown cell name. InvalidInput: ``out_dir`` is a file or not empty
+        CellNotFound: unknown cell name. InvalidInput: a cell holding a delta; ``out_dir`` is a file or not empty
         (without ``overwrite``); a bad state. MeshNotFound: a mesh cannot be found.
         MeshNotAllowed: a mesh outside the allowed folders or not a mesh file.
         ModelError: MuJoCo is missing or refuses the model.
     """
     cell = _load(cell_or_name, packages)
+    if getattr(cell, "deltas", ()):
+        raise InvalidInput(f"cell {cell.name!r} holds a delta ({', '.join(d.name for d in cell.deltas)}): its URDF "
+                           "carries the delta's motors only (its bodies come from the closed form); export the delta "
+                           "with pinarms.export.delta and the rest of the cell without it")
     out = check_export_folder(out_dir, overwrite)
     result: dict[str, ExportedCell] = {}
     folders = cell_folders(cell, packages)

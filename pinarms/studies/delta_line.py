@@ -18,6 +18,7 @@ from typing import Any
 
 from pinarms.optim.line import Belt, LineSpec, PlaceBox, Rule, Station, Stream, TrackingSpec, base_pose, run_line
 from pinarms.optim.line.delta_maps import build_delta_map
+from pinarms.optim.line.map_request import DeltaMapRequest
 from pinarms.optim.line.delta_tracking import DeltaArm
 from pinarms.robots.delta import delta_names, load_delta
 from pinarms.errors import InvalidInput
@@ -60,8 +61,8 @@ def delta_maps(spec: LineSpec, *, n: int = 24, progress: Any = None) -> dict:
     every delta of ``spec`` (same arm, height, box and belt speed; shifted along the belt)."""
     st = spec.stations[0]
     kind = spec.stream.types[0]
-    m = build_delta_map(st, spec.belt, spec.tracking, mass=kind.mass, item_height=kind.size[2],
-                        nu=spec.map_grid[0], nw=spec.map_grid[1], n=n, progress=progress)
+    m = build_delta_map(DeltaMapRequest(st, spec.belt, spec.tracking, mass=kind.mass, item_height=kind.size[2],
+                                        nu=spec.map_grid[0], nw=spec.map_grid[1], n=n), progress=progress).task_map
     return {s.name: (m,) for s in spec.stations}
 
 

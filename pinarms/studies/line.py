@@ -24,8 +24,8 @@ from typing import Any, Callable
 import numpy as np
 
 from pinarms import robots
-from pinarms.optim.line import (Belt, ItemType, LineSpec, PlaceBox, Rule, Station, Stream, TaskMap, TrackingSpec,
-                                base_pose, build_task_map, map_error, run_line)
+from pinarms.optim.line import (Belt, ItemType, LineSpec, MapRequest, PlaceBox, Rule, Station, Stream, TaskMap,
+                                TrackingSpec, base_pose, build_task_map, map_error, run_line)
 from pinarms.optim.line.api import build_maps, station_shape_key
 from pinarms.optim.line.tracking import PLAN_VERSION
 
@@ -95,9 +95,9 @@ def maps_for(spec: LineSpec, *, build: bool = True, save: bool = False, progress
                     if progress:
                         progress(f"building the task map {name}")
                     one = len(spec.stream.types) == 1  # refined grids differ between types
-                    cache[name] = build_task_map(st, spec.belt, spec.tracking, mass=kind.mass,
-                                                 item_height=kind.size[2], nu=spec.map_grid[0], nw=spec.map_grid[1],
-                                                 refine=2 if one else 0)
+                    rq = MapRequest(st, spec.belt, spec.tracking, mass=kind.mass, item_height=kind.size[2],
+                                    nu=spec.map_grid[0], nw=spec.map_grid[1], refine=2 if one else 0)
+                    cache[name] = build_task_map(rq).task_map
                     if save:
                         DATA.mkdir(exist_ok=True)
                         cache[name].save(path)

@@ -40,7 +40,7 @@ def pair_screen_kernel(Q, fk, cov, grp, work, out):
     exact, FR, Fp, size = cov[4], cov[5], cov[6], cov[7]
     hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
     for i in range(Q.shape[0]):
-        place_world(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+        place_world(Q[i], fk, cov, grp[0], grp[1], work)
         HW = work[5]
         for g in range(group_t.shape[0]):
             a = group_a[g]

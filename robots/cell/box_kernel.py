@@ -63,12 +63,18 @@ def _box_gap(SA, SB, k, r, FR, Fp, half, o):
 
 
 @jit_inline
-def held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, half, o, t, cut):
+def held_low(held, g, boxes, o, t, cut):
     """A lower bound [m] of the distance from moving geometry ``g`` held by its cylinders (:mod:`.cover`) to the static
     box ``o``: the least over cylinders ``k`` of the larger of its gaps (:func:`_box_gap`, :func:`_toward_gap`) and
     the distances of the spheres ``spart[k]`` holding its pieces. Only a bound at most ``cut`` is meant: a cylinder
     whose spheres are farther is passed over (so ``inf`` where none is nearer), and at one at most ``t`` (with
-    ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early."""
+    ``t ≥ cut``: whether the bound exceeds ``t`` is meant) it returns early.
+
+    ``held``: the cover's ``(W, radius, SA, SB, srad, sstart, spart)`` (sphere world centres and radii, cylinder
+    axis ends and radii, each geometry's first cylinder, each cylinder's spheres); ``boxes``: the static shapes'
+    ``(FR, Fp, half)`` (world rotations, centres, half sides)."""
+    W, radius, SA, SB, srad, sstart, spart = held
+    FR, Fp, half = boxes
     low = np.inf
     near = np.inf
     held = -1

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import CellError, CellTooLarge, InvalidInput
@@ -123,6 +124,18 @@ class Cell:
         by_name = {p.name: p for p in self.arm_placements}
         arms = tuple(arm_with_keys(a, by_name.get(a.name), source) for a in arms)
         self.arms = tuple(sorted(arms, key=lambda a: a.q_slice.start))
+        from pinarms.robots.cell.delta_arm import cell_deltas
+
+        #: The deltas among the arms (:class:`~.delta_arm.CellDelta`): bodies from the closed form, pairs in
+        #: :attr:`delta_pairs`; empty for a cell of serial arms only.
+        self.deltas = cell_deltas(self.arms, self.arm_placements)
+        if self.deltas:
+            from dataclasses import replace
+
+            tcp_text = ("the platform's tcp (closed form; CellDelta.tcp_to_world): the cell's tree holds the delta's "
+                        "motors only")
+            names = {d.name for d in self.deltas}
+            self.arms = tuple(replace(a, tcp_choice=tcp_text) if a.name in names else a for a in self.arms)
         self._hold = self.robot.neutral.copy()
         for a in self.arms:
             self._hold[a.q_slice] = a.hold
@@ -184,6 +197,21 @@ class Cell:
         return link_cover(self)
 
     # ------------------------------------------------------------------ pairs
+    @property
+    def delta_pairs(self) -> tuple:
+        """The checked pairs with a delta's body (:mod:`.delta_pairs`; empty without deltas): checked with
+        :attr:`pairs` by every check, listed after them in its results."""
+        from pinarms.robots.cell.delta_pairs import delta_pair_set
+
+        return delta_pair_set(self).pairs if self.deltas else ()
+
+    @property
+    def delta_allowed(self) -> tuple:
+        """The pairs with a delta's body not checked, each with its reason (``adjacent``, ``rigid``)."""
+        from pinarms.robots.cell.delta_pairs import delta_pair_set
+
+        return delta_pair_set(self).allowed if self.deltas else ()
+
     def pair_count(self, clearance: float, *, strict: bool = False) -> int:
         """How many of :attr:`candidates` a check at ``clearance`` [m] needs (bound ≤ it; ``strict``: bound < it).
 
@@ -299,7 +327,7 @@ class Cell:
                 return f
         raise InvalidInput(f"cell {self.name!r} has no fixture {name!r}; fixtures: {', '.join(f.name for f in self.fixtures)}")
 
-    def q_from_arms(self, arm_q: Mapping[str, Any], base: Any = None) -> np.ndarray:
+    def q_from_arms(self, arm_q: Mapping[str, ArrayLike], base: ArrayLike | None = None) -> np.ndarray:
         """A cell joint vector from ``{arm name: q_arm (nq_arm,) or (N, nq_arm)}``.
 
         Arms not named keep ``base`` (default :attr:`hold`). Batches of the named arms
@@ -321,17 +349,17 @@ class Cell:
             out[:, arm.q_slice] = arr
         return out[0] if rows is None else out
 
-    def arm_q(self, q: Any, name: str) -> np.ndarray:
+    def arm_q(self, q: ArrayLike, name: str) -> np.ndarray:
         """The block of arm ``name`` in the cell vector(s) ``q``."""
         arr, single = self.robot.check_q(q)
         out = arr[:, self.arm(name).q_slice]
         return out[0] if single else out
 
-    def world_pose(self, q: Any, frame: str) -> np.ndarray:
+    def world_pose(self, q: ArrayLike, frame: str) -> np.ndarray:
         """Pose(s) ``(4, 4)`` / ``(N, 4, 4)`` of any cell frame (``"left_tcp"``) in the world."""
         return self.robot.fk(q, frame)
 
-    def pin_vector_or_none(self, q: Any) -> np.ndarray | None:
+    def pin_vector_or_none(self, q: ArrayLike) -> np.ndarray | None:
         """Pinocchio's vector for one finite float ``q (nq,)`` without the general checks, else ``None``."""
         if type(q) is not np.ndarray or q.shape != (self.nq,) or q.dtype != np.float64:
             return None
@@ -349,7 +377,7 @@ class Cell:
         """Names of the collision geometries, in :attr:`collision_model` order."""
         return tuple(g.name for g in self.collision_model.geometryObjects)
 
-    def geometry_placements(self, q: Any) -> tuple[np.ndarray, np.ndarray]:
+    def geometry_placements(self, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """World rotations ``(N, G, 3, 3)`` and centres ``(N, G, 3)`` of every geometry frame, batched."""
         arr, _ = self.robot.check_q(q)
         R, p = self._placements.joints(arr)
@@ -361,7 +389,7 @@ class Cell:
         pg = p[:, parents] + np.einsum("ngij,gj->ngi", R[:, parents], local_p)
         return Rg, pg
 
-    def with_arm_base(self, name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> "Cell":
+    def with_arm_base(self, name: str, base_to_world: ArrayLike, carry: tuple[str, ...] = ()) -> "Cell":
         """A new cell: this one with arm ``name``'s base at ``base_to_world`` ``(4, 4)`` [m] in the world.
 
         The fixed joint that holds the arm's base link to its parent gets the origin that puts
@@ -414,7 +442,7 @@ class Cell:
         )
 
     # ------------------------------------------------------------------ checks
-    def in_collision(self, q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+    def in_collision(self, q: ArrayLike, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
         """Whether ``q (nq,)`` (→ bool) or each row of ``q (N, nq)`` (→ ``(N,)`` bool) touches.
 
         A pair touches when its distance is at most ``margin`` [m] (0: contact or
@@ -422,31 +450,31 @@ class Cell:
         apart and coal decides the rest, stopping at the first contact; a batch runs in
         Pinocchio's C++ loop (``computeCollisionsInParallel``) on ``threads`` threads.
         """
-        from pinarms.robots.cell.collision import in_collision
+        from pinarms.robots.cell import collision, delta_checks
 
-        return in_collision(self, q, margin=margin, threads=threads)
+        return (delta_checks if self.deltas else collision).in_collision(self, q, margin=margin, threads=threads)
 
-    def collisions(self, q: Any, *, margin: float = 0.0):
+    def collisions(self, q: ArrayLike, *, margin: float = 0.0):
         """Which pairs of :meth:`pairs_for` ``(margin)`` touch (distance ≤ ``margin`` [m]) for ``q (nq,)`` or ``(N, nq)``: a :class:`~.collision.Collisions`."""
-        from pinarms.robots.cell.collision import collisions
+        from pinarms.robots.cell import collision, delta_checks
 
-        return collisions(self, q, margin=margin)
+        return (delta_checks if self.deltas else collision).collisions(self, q, margin=margin)
 
-    def clearance(self, q: Any, *, margin: float = 0.0):
+    def clearance(self, q: ArrayLike, *, margin: float = 0.0):
         """Smallest signed distance [m] over every pair not allowed by design, and the pair: a :class:`~.collision.Clearance`.
 
         The checked pairs and every out-of-reach pair whose bound is below the smallest
         distance found: the true minimum over all pairs but those allowed by design.
         """
-        from pinarms.robots.cell.collision import clearance
+        from pinarms.robots.cell import collision, delta_checks
 
-        return clearance(self, q, margin=margin)
+        return (delta_checks if self.deltas else collision).clearance(self, q, margin=margin)
 
     def check_motion(self, motions: Any, *, margin: float = 0.01, **kwargs):
         """Check the arms' trajectories together, continuously in time: a :class:`~.motion.MotionCheck`.
 
         See :func:`~pinarms.robots.cell.motion.check_motion` for the arguments and the time-step rule.
         """
-        from pinarms.robots.cell.motion import check_motion
+        from pinarms.robots.cell import delta_checks, motion
 
-        return check_motion(self, motions, margin=margin, **kwargs)
+        return (delta_checks if self.deltas else motion).check_motion(self, motions, margin=margin, **kwargs)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import CollisionGeometryError, InvalidInput
@@ -136,7 +137,7 @@ def check_margin(margin: float) -> float:
 MAX_THREADS = 64
 
 
-def in_collision(cell: "CellModel", q: Any, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
+def in_collision(cell: "CellModel", q: ArrayLike, *, margin: float = 0.0, threads: int = 1) -> bool | np.ndarray:
     """See :meth:`Cell.in_collision`."""
     if margin != 0.0:
         margin = check_margin(margin)
@@ -157,7 +158,7 @@ def in_collision(cell: "CellModel", q: Any, *, margin: float = 0.0, threads: int
     return checker.batch(qp, margin, int(threads))
 
 
-def collisions(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Collisions:
+def collisions(cell: "CellModel", q: ArrayLike, *, margin: float = 0.0) -> Collisions:
     """See :meth:`Cell.collisions`."""
     margin = check_margin(margin)
     arr, single = cell.robot.check_q(q)
@@ -262,7 +263,7 @@ def pair_lower_bounds(cell: "CellModel", q: np.ndarray, n: int | None = None) ->
 ONE_PASS_REACH = 2000
 
 
-def clearance(cell: "CellModel", q: Any, *, margin: float = 0.0) -> Clearance:
+def clearance(cell: "CellModel", q: ArrayLike, *, margin: float = 0.0) -> Clearance:
     """See :meth:`Cell.clearance`."""
     margin = check_margin(margin)
     arr, single = cell.robot.check_q(q)

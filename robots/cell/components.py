@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
 from pinarms.robots.robot import Robot
@@ -60,7 +61,7 @@ class CellArm:
         """The closed-form IK family recognised from the arm's geometry (``robot.ik_family``), or ``None``."""
         return self.robot.ik_family
 
-    def to_world(self, pose: Any) -> np.ndarray:
+    def to_world(self, pose: ArrayLike) -> np.ndarray:
         """A pose ``(4, 4)`` / ``(N, 4, 4)`` or a point ``(3,)`` / ``(N, 3)`` from the arm's base frame to the world."""
         arr = np.asarray(pose, dtype=float)
         if arr.shape[-2:] == (4, 4):
@@ -69,7 +70,7 @@ class CellArm:
             return arr @ self.base_to_world[:3, :3].T + self.base_to_world[:3, 3]
         raise InvalidInput(f"to_world takes poses (4, 4) or points (3,), got shape {arr.shape}")
 
-    def to_base(self, pose: Any) -> np.ndarray:
+    def to_base(self, pose: ArrayLike) -> np.ndarray:
         """Inverse of :meth:`to_world`: world pose(s) or point(s) in the arm's base frame."""
         inv = np.linalg.inv(self.base_to_world)
         arr = np.asarray(pose, dtype=float)
@@ -79,7 +80,7 @@ class CellArm:
             return arr @ inv[:3, :3].T + inv[:3, 3]
         raise InvalidInput(f"to_base takes poses (4, 4) or points (3,), got shape {arr.shape}")
 
-    def tcp_to_world(self, q_arm: Any) -> np.ndarray:
+    def tcp_to_world(self, q_arm: ArrayLike) -> np.ndarray:
         """Pose(s) of the arm's tcp in the world for the arm's own ``q (nq,)`` / ``(N, nq)``."""
         return self.base_to_world @ self.robot.fk(q_arm)
 

@@ -309,6 +309,11 @@ def compose_cell_urdf(
     robot = ET.Element("robot", {"name": name})
     ET.SubElement(robot, "link", {"name": "world"})
     for arm in arms:
+        if arm.delta is not None:  # a delta: its actuated joints only, its bodies from the closed form
+            from pinarms.robots.cell.delta_urdf import delta_elements
+
+            robot.extend(delta_elements(arm))
+            continue
         path = _arm_file(arm.urdf, base, pkgs, strict, f"arm {arm.name!r}")
         robot.extend(_arm_elements(arm, path, base, pkgs))
     for fixture in fixtures:

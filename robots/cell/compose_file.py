@@ -47,7 +47,7 @@ MAX_DECLARED = 10_000
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
 #: How many size numbers [m] each fixture kind takes in a cell description.
 FIXTURE_SIZES = {"box": 3, "cylinder": 2, "sphere": 1, "crate": 3}
-_ARM_KEYS = {"name", "urdf", "xyz", "rpy", "tcp", "freeze", "states", "hold"}
+_ARM_KEYS = {"name", "urdf", "delta", "xyz", "rpy", "tcp", "freeze", "states", "hold"}
 
 
 @dataclass(frozen=True)
@@ -84,6 +84,10 @@ class ArmPlacement:
             a ``home`` exists only when given.
         hold: the arm's configuration whenever it does not move (planning, checks, cycles,
             sessions): a state's name or joint values; ``None``: the neutral configuration.
+        delta: the name of a shipped delta robot (``"delta_flexpicker"``) placed instead of a
+            URDF arm (``urdf`` then empty): its joint vector is its three motor angles (and its
+            tool axis), its bodies are posed from the closed form (:mod:`.delta_arm`); no ``tcp``
+            or ``freeze``.
     """
 
     name: str
@@ -94,9 +98,14 @@ class ArmPlacement:
     freeze: Mapping[str, float] | tuple[tuple[str, float], ...] = ()
     states: Mapping[str, Sequence[float]] | tuple[tuple[str, tuple[float, ...]], ...] = ()
     hold: str | Sequence[float] | None = None
+    delta: str | None = None
 
     def __post_init__(self) -> None:  # mappings kept as tuples of pairs: the placement stays hashable
         where = f"arm {self.name!r}"
+        if self.delta is not None and (not isinstance(self.delta, str) or self.urdf or self.tcp is not None
+                                       or dict(self.freeze)):
+            raise CellError(f"{where}: a delta is placed by its name alone (delta = \"delta_flexpicker\"): no urdf, "
+                            f"tcp or freeze; got delta={self.delta!r}, urdf={self.urdf!r}")
         if self.tcp is not None and not isinstance(self.tcp, ToolPoint):
             raise CellError(f"{where}: tcp must be a ToolPoint(link, xyz, rpy), got {self.tcp!r}")
         freeze = dict(self.freeze)
@@ -246,8 +255,17 @@ def _tool_point(value: Any, where: str) -> ToolPoint:
 
 def _arm_of(table: Any, where: str) -> ArmPlacement:
     """One ``[[arm]]`` table: name, urdf, pose, and the optional tcp, freeze, states and hold."""
-    _keys(table, _ARM_KEYS, {"name", "urdf"}, where)
-    if not isinstance(table["urdf"], str):
+    _keys(table, _ARM_KEYS, {"name"}, where)
+    if "urdf" not in table and "delta" not in table:
+        raise CellError(f"{where}: missing key(s) urdf (a serial arm's file), or delta (a shipped delta's name)")
+    if "urdf" in table and "delta" in table:
+        raise CellError(f"{where}: give exactly one of urdf (a serial arm's file) or delta (a shipped delta's name)")
+    if "delta" in table:
+        extra = sorted({"tcp", "freeze"} & set(table))
+        if extra or not isinstance(table["delta"], str):
+            raise CellError(f"{where}: a delta takes its name (delta = \"delta_flexpicker\"), pose, states and hold; "
+                            f"not {', '.join(extra) or repr(table['delta'])}")
+    elif not isinstance(table["urdf"], str):
         raise CellError(f"{where}: urdf must be a string (a path), got {table['urdf']!r}")
     freeze, states = table.get("freeze", {}), table.get("states", {})
     for key, value in (("freeze", freeze), ("states", states)):
@@ -260,10 +278,10 @@ def _arm_of(table: Any, where: str) -> ArmPlacement:
     for key, value in states.items():
         if not isinstance(value, list):
             raise CellError(f"{where}: state {key!r} must be a list of joint values, got {value!r}")
-    return ArmPlacement(check_name(table["name"], where), table["urdf"],
+    return ArmPlacement(check_name(table["name"], where), table.get("urdf", ""),
                         _triple(table.get("xyz", [0, 0, 0]), "xyz", where),
                         _triple(table.get("rpy", [0, 0, 0]), "rpy", where),
-                        tcp=tcp, freeze=freeze, states=states, hold=hold)
+                        tcp=tcp, freeze=freeze, states=states, hold=hold, delta=table.get("delta"))
 
 
 def read_cell_description(path: str | os.PathLike) -> CellDescription:

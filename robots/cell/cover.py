@@ -43,9 +43,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from pinarms.robots.cell.cell_model import CellModel
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 from pinarms.robots.cell.cover_kernel import excess_kernel, screen_kernel
 from pinarms.robots.cell.mesh_cover import mesh_arrays, mesh_cylinder, static_primitive
@@ -82,14 +87,14 @@ _EXACT_NONE, _EXACT_BOX, _EXACT_CYLINDER, _EXACT_SPHERE = 0, 1, 2, 3
 _HELD_ONE, _HELD_PARTS = 1, 2
 
 
-def pairs_for(cell: Any, clearance: float) -> tuple:
+def pairs_for(cell: CellModel, clearance: float) -> tuple:
     """The pairs a check at ``clearance`` [m] must look at: ``cell.pairs_for(clearance)`` where the
     cell has it (pairs proven farther apart than the clearance left out), else every checked pair."""
     chooser = getattr(cell, "pairs_for", None)
     return tuple(cell.pairs) if chooser is None else tuple(chooser(float(clearance)))
 
 
-def motion_pairs(cell: Any, widest: float, planned: set, self_margin: float, margin: float) -> list:
+def motion_pairs(cell: CellModel, widest: float, planned: set, self_margin: float, margin: float) -> list:
     """The pairs a motion check of the ``planned`` arms looks at: :func:`pairs_for` ``(widest)`` (its coarsest
     screen) with a planned arm, less the ``constant`` pairs proven at least their margin apart (``self_margin``
     for one arm's links, else ``margin``): their distance never changes, so no motion and no screen raised for
@@ -134,7 +139,7 @@ def _mesh_parts(geo: Any) -> tuple[np.ndarray, ...] | None:
     return None if got is None else got[2:]
 
 
-def geometry_spheres(geometry_object: Any) -> tuple[np.ndarray, np.ndarray]:
+def geometry_spheres(geometry_object: pin.GeometryObject) -> tuple[np.ndarray, np.ndarray]:
     """Spheres ``(centres (k, 3) in the parent joint's frame [m], radii (k,) [m])`` whose union
     contains the geometry of a Pinocchio ``GeometryObject`` (module docstring)."""
     geo = geometry_object.geometry
@@ -183,7 +188,7 @@ CYLINDER_SHARE = 1.0
 TURNING_SHARE = 1.3
 
 
-def _mesh_cylinder(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, float] | None:
+def _mesh_cylinder(geometry_object: pin.GeometryObject, joint_axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, float] | None:
     """The axis ends (in the geometry's frame) and radius [m] of the cylinder holding a moving mesh where it
     is used (:data:`CYLINDER_SHARE`; ``joint_axis``: the parent joint's axis in its frame); else None."""
     if int(geometry_object.parentJoint) == 0:
@@ -201,7 +206,7 @@ def _mesh_cylinder(geometry_object: Any, joint_axis: Any = None) -> tuple[np.nda
     return None
 
 
-def geometry_segments(geometry_object: Any, joint_axis: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def geometry_segments(geometry_object: pin.GeometryObject, joint_axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The axis ``(end a (1, 3), end b (1, 3) in the parent joint's frame [m], radius (1,) [m])`` of a
     cylinder, or of the cylinder holding a moving mesh where it is smaller than the mesh's box (taken
     exactly against the other geometry's spheres; ``joint_axis``: the parent joint's unit axis in its
@@ -260,7 +265,7 @@ class Cover:
 
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
         out = np.empty((Q.shape[0], self.joint.size, 3))
-        centers_kernel(Q, *self.fk, self.joint, self.center, out)
+        centers_kernel(Q, self.fk, self.joint, self.center, out)
         return out
 
     def prepare(self, pair_a: np.ndarray, pair_b: np.ndarray) -> PairSet:
@@ -378,18 +383,18 @@ class PairSet:
     table: np.ndarray
 
 
-def _fk_arrays(cell: Any) -> tuple:
+def _fk_arrays(cell: CellModel) -> tuple:
     bp = cell.batched_placements
     return (np.asarray(bp.parent, dtype=np.int64), np.asarray(bp.index, dtype=np.int64), bp.scale.copy(),
             bp.offset.copy(), bp.revolute.copy(), bp.axis.copy(), bp.M_R.copy(), bp.M_p.copy())
 
 
-def link_cover(cell: Any) -> Cover:
+def link_cover(cell: CellModel) -> Cover:
     """The :class:`Cover` of every geometry of ``cell`` (built once, kept with the cell: :meth:`Cell.memo`)."""
     return cell.memo("sphere cover", lambda: _build_cover(cell))
 
 
-def _build_cover(cell: Any) -> Cover:
+def _build_cover(cell: CellModel) -> Cover:
     objs = list(cell.collision_model.geometryObjects)
     G = len(objs)
     start = np.zeros(G + 1, dtype=np.int64)

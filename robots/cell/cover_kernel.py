@@ -78,8 +78,10 @@ def _centers(R, p, joint, center, W):
 
 
 @jit
-def centers_kernel(Q, parent, index, scale, offset, revolute, axis, MR, Mp, joint, center, out):
-    """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)``."""
+def centers_kernel(Q, fk, joint, center, out):
+    """Sphere centres ``out (N, S, 3)`` in the world for the cell configurations ``Q (N, nq)`` (``fk``: the joints'
+    arrays, :meth:`Cover.fk`; ``joint``, ``center``: each sphere's joint and centre in its frame)."""
+    parent, index, scale, offset, revolute, axis, MR, Mp = fk
     nj = parent.shape[0]
     R = np.empty((nj, 3, 3))
     p = np.empty((nj, 3))
@@ -121,7 +123,7 @@ def _spheres_clear(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, srad
     if _exact_distance(HW[g, 0], HW[g, 1], HW[g, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart) - hrad[g] > t:
         return True
     if cyl[g] != 0 and exact[other] == 1:
-        return held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, t, t) > t
+        return held_low((W, radius, SA, SB, srad, sstart, spart), g, (FR, Fp, size), other, t, t) > t
     for s in range(start[g], start[g + 1]):
         d = _exact_distance(W[s, 0], W[s, 1], W[s, 2], other, exact, FR, Fp, size, SA, SB, srad, sstart)
         if d - radius[s] <= t:
@@ -162,7 +164,7 @@ def screen_kernel(Q, fk, cov, grp, work, stop, out):
     hrad, group_start, group_a, group_b, group_fixed, group_t = grp[2], grp[3], grp[4], grp[5], grp[6], grp[7]
     HW = work[5]
     for i in range(Q.shape[0]):
-        place_world(Q[i], fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+        place_world(Q[i], fk, cov, grp[0], grp[1], work)
         ok = True
         for g in range(group_t.shape[0]):
             if spheres_apart(HW, hrad, group_a[g], group_b[g], group_t[g]):
@@ -257,7 +259,7 @@ def _spheres_excess(W, radius, start, g, other, exact, FR, Fp, size, SA, SB, sra
             - t >= best:
         return best
     if cyl[g] != 0 and exact[other] == 1:
-        return min(best, held_low(W, radius, SA, SB, srad, sstart, spart, g, FR, Fp, size, other, -np.inf,
+        return min(best, held_low((W, radius, SA, SB, srad, sstart, spart), g, (FR, Fp, size), other, -np.inf,
                                    t + best) - t)
     low = np.inf
     if exact[other] != 0:
@@ -318,10 +320,12 @@ def _hd(HW, hrad, a, b):
 
 
 @jit
-def place_world(q, fk, joint, center, sjoint, sa_local, sb_local, hjoint, hcenter, work):
+def place_world(q, fk, cov, hjoint, hcenter, work):
     """Forward kinematics of cell configuration ``q`` and the world centres of the cover's spheres,
-    its cylinders' axis ends and the bounding spheres, into ``work`` (:meth:`Cover.work`'s arrays)."""
+    its cylinders' axis ends and the bounding spheres (joints ``hjoint``, centres ``hcenter``), into ``work``
+    (:meth:`Cover.work`'s arrays); ``cov``: :meth:`Cover.kernel_arrays`."""
     parent, index, scale, offset, revolute, axis, MR, Mp = fk
+    joint, center, sjoint, sa_local, sb_local = cov[0], cov[1], cov[8], cov[9], cov[10]
     R, p, W, SA, SB, HW = work
     _fk(q, parent, index, scale, offset, revolute, axis, MR, Mp, R, p)
     _centers(R, p, joint, center, W)
@@ -363,7 +367,7 @@ def excess_scaled(q, fk, cov, grp, inv, cap, floor, work):
     ``min_k inv[g(k)] · (d_k − t_k)``, at most ``cap`` (early out below ``floor``). The compiled edge
     proof's scaled excess (``inv``: one over each group's travel weight, :mod:`pinarms.optim.motion.link_levers`);
     ``inv`` empty (:data:`UNWEIGHTED`): every weight 1, the excess itself (:func:`excess_one`)."""
-    place_world(q, fk, cov[0], cov[1], cov[8], cov[9], cov[10], grp[0], grp[1], work)
+    place_world(q, fk, cov, grp[0], grp[1], work)
     return excess_placed(cov, grp, inv, cap, floor, work)
 
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Iterable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pinarms.robots.cell.pairs import CollisionPair
 
@@ -70,7 +71,7 @@ def _pair_distances(cell: "CellModel", q: np.ndarray, pairs: Iterable[CollisionP
     return tuple(out)
 
 
-def idle_contacts(cell: "CellModel", q: Any, moving: Iterable[str]) -> IdleContacts:
+def idle_contacts(cell: "CellModel", q: ArrayLike, moving: Iterable[str]) -> IdleContacts:
     """The touching pairs (distance ≤ 0) at the cell configuration ``q (nq,)`` with no body on an arm of ``moving``.
 
     Only pairs with at least one idle arm count (two fixtures never touch: rigid pairs are

@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 import pinocchio as pin
 
 from pinarms.errors import CellError, InvalidInput
@@ -19,7 +20,7 @@ from pinarms.robots.cell.cell_model import CellModel
 __all__ = ["urdf_with_arm_base"]
 
 
-def urdf_with_arm_base(cell: "CellModel", name: str, base_to_world: Any, carry: tuple[str, ...] = ()) -> str:
+def urdf_with_arm_base(cell: "CellModel", name: str, base_to_world: ArrayLike, carry: tuple[str, ...] = ()) -> str:
     """The URDF of ``cell`` with arm ``name``'s base at ``base_to_world`` ``(4, 4)`` [m] in the world.
 
     The fixed joint that holds the arm's base link to its parent gets the origin that puts

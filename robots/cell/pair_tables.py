@@ -79,6 +79,8 @@ from typing import Any
 
 import numpy as np
 
+from pinarms.robots.cell.cell_model import CellModel
+
 from pinarms.robots.cell._table_build import (
     CAP,
     CONTACT_TOL,
@@ -210,7 +212,7 @@ def _chain(parent: np.ndarray, j: int) -> list[int]:
     return out
 
 
-def table_paths(cell: Any, pairs: Sequence[tuple[int, int]]) -> list[tuple[int, int, list[int], list[int]]]:
+def table_paths(cell: CellModel, pairs: Sequence[tuple[int, int]]) -> list[tuple[int, int, list[int], list[int]]]:
     """The pairs ``(a, b)`` that get a table, each with its path joints top-down on ``a``'s side and on
     ``b``'s (at most two in all, revolute, at least one of the two geometries a mesh)."""
     objs = cell.collision_model.geometryObjects
@@ -231,7 +233,7 @@ def table_paths(cell: Any, pairs: Sequence[tuple[int, int]]) -> list[tuple[int, 
     return out
 
 
-def _key(cell: Any, a: int, b: int, side_a: list, side_b: list) -> str:
+def _key(cell: CellModel, a: int, b: int, side_a: list, side_b: list) -> str:
     """A digest of what a table depends on: both geometries (vertices, triangles or shape and size, placements),
     the path joints' placements and axes, the build's constants, its code (:data:`_CODE`) and coal's version."""
     import coal
@@ -291,7 +293,7 @@ def _load(key: str) -> dict | None:
     return got
 
 
-def _trusted(cell: Any, a: int, b: int, side_a: list, side_b: list, table: dict) -> bool:
+def _trusted(cell: CellModel, a: int, b: int, side_a: list, side_b: list, table: dict) -> bool:
     """Whether ``table``'s bound stays at most coal's exact distance of the pair ``(a, b)`` (+ :data:`CHECK_TOL`)
     at :data:`CHECK_STATES` seeded random configurations of ``cell`` (NaN bounds fail)."""
     import coal
@@ -318,7 +320,7 @@ def _save(key: str, table: dict) -> None:
     write_arrays(_path(key), table)
 
 
-def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict, float]:
+def _table(cell: CellModel, a: int, b: int, side_a: list, side_b: list) -> tuple[dict, float]:
     """The table of the pair: from memory, else from the disk cache if its values hold (:func:`_trusted`), else
     built (and saved)."""
     key = _key(cell, a, b, side_a, side_b)
@@ -337,7 +339,7 @@ def _table(cell: Any, a: int, b: int, side_a: list, side_b: list) -> tuple[dict,
     return got, seconds
 
 
-def loose_pairs(cell: Any, cover: Any, found: list) -> list:
+def loose_pairs(cell: CellModel, cover: Any, found: list) -> list:
     """The pairs of ``found`` (:func:`table_paths`) whose sphere ``cover`` (without tables) leaves open at least
     :data:`NEED_SHARE` of :data:`NEED_STATES` seeded random configurations where coal finds the pair more than
     2 mm beyond the threshold, at the thresholds :data:`NEED_THRESHOLDS` (a self margin, a usual margin):
@@ -366,7 +368,7 @@ def loose_pairs(cell: Any, cover: Any, found: list) -> list:
     return keep
 
 
-def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]], cover: Any = None) -> PairTables:
+def pair_tables(cell: CellModel, pairs: Sequence[tuple[int, int]], cover: Any = None) -> PairTables:
     """The tables of the geometry pairs ``(a, b)`` of ``cell`` that qualify (:func:`table_paths`) and, given the
     cell's sphere ``cover`` without tables, that it leaves loose (:func:`loose_pairs`), from the caches where
     they were built before (module docstring)."""
@@ -385,7 +387,7 @@ def pair_tables(cell: Any, pairs: Sequence[tuple[int, int]], cover: Any = None) 
     return assemble(cell, found, tabs, seconds)
 
 
-def assemble(cell: Any, found: list, tabs: list, seconds: float = 0.0) -> PairTables:
+def assemble(cell: CellModel, found: list, tabs: list, seconds: float = 0.0) -> PairTables:
     """The :class:`PairTables` of the pairs ``found`` (:func:`table_paths`) and their tables ``tabs`` (axes as
     positions on the pair's path, so that a table serves every cell of the same content)."""
     sizes = np.array([t["child"].size for t in tabs], dtype=np.int64)

@@ -30,7 +30,7 @@ MAX_SAMPLES = 2_000_000
 MAX_TIME = 1e6
 
 
-def as_time(value: Any, what: str) -> float:
+def as_time(value: float, what: str) -> float:
     """``value`` as a time [s]; :class:`InvalidInput` naming ``what`` unless a finite number within ±:data:`MAX_TIME`."""
     ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
     t = float(value) if ok else float("nan")

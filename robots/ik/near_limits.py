@@ -13,12 +13,12 @@ equivalent nearest its range (its excess is the smallest one over all equivalent
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from pinarms.errors import InvalidInput
+from pinarms.robots.robot_model import RobotModel
 
 __all__ = ["OutsideLimits", "limit_excess", "near_limit_solutions"]
 
@@ -47,7 +47,7 @@ class OutsideLimits:
         return float(np.max(np.abs(self.excess))) if self.excess.size else 0.0
 
 
-def limit_excess(robot: Any, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def limit_excess(robot: RobotModel, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``(q_wrapped, excess)`` of configurations ``q (N, nq)`` (or ``(nq,)``): see :class:`OutsideLimits`."""
     arr, single = robot.check_q(q)
     arr = arr.copy()
@@ -61,7 +61,7 @@ def limit_excess(robot: Any, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     return (arr[0], excess[0]) if single else (arr, excess)
 
 
-def near_limit_solutions(robot: Any, target: ArrayLike, within: float) -> list[OutsideLimits]:
+def near_limit_solutions(robot: RobotModel, target: ArrayLike, within: float) -> list[OutsideLimits]:
     """Closed-form solutions of one pose ``(4, 4)`` that lie outside the joint ranges by at most ``within``.
 
     Args:

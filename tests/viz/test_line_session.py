@@ -177,7 +177,7 @@ def test_arms_naming_no_robot_refused_when_drawn(saved, tmp_path):
     from pinarms.viz.errors import ViewerError
 
     bad = viz.load_session(_rewrite(saved, tmp_path / "ghost.pinarms", line={"arms": ["ghost 1", "ghost 2"]}))
-    with pytest.raises(ViewerError, match="arm 'ghost 1', which is not a robot of this session"):
+    with pytest.raises(ViewerError, match="arm 'ghost 1', which is not a robot or delta of this session"):
         viz.export_html(bad, tmp_path / "ghost.html")
     assert not (tmp_path / "ghost.html").exists()
 

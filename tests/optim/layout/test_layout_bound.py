@@ -64,3 +64,31 @@ def test_the_bound_measures_joint_travel_at_the_velocity_limits(scara):
     travel = _travel(qa[:, None], qb[None], scara.lower, scara.upper) / scara.velocity_limit
     assert got == pytest.approx(0.2 + 2.0 * travel.max(axis=-1).min(), rel=1e-12)
     assert threshold([3.0, 1.0, 2.0], 2) == 2.0 and threshold([3.0], 2) == float("inf")
+
+
+def test_with_an_acceleration_limit_the_bound_is_the_bang_bang_time_and_still_below_every_cycle(scara, candidates):
+    from pinarms.optim.layout.bound import rest_to_rest_time
+    from pinarms.planning.point_to_point import trapezoidal_phases
+
+    d, v, a = np.array([0.0, 0.05, 0.8, 3.0]), np.array([1.0, 2.0, 1.0, 1.5]), np.array([2.0, 4.0, 1.0, 0.5])
+    assert np.allclose(rest_to_rest_time(d, v, a), [trapezoidal_phases(*x)[1] for x in zip(d, v, a)], rtol=1e-14)
+    assert np.array_equal(rest_to_rest_time(d, v, None), d / v)
+    kw = dict(lift=0.02, dwell=0.05, refine=1, refine_evaluations=1, workspace_samples=2000, amax=4.0)
+    full = search_layout(LayoutRequest(scara, PICK, PLACE, candidates[:5], **kw))
+    fast = search_layout(LayoutRequest(scara, PICK, PLACE, candidates[:5], bound=True, **kw))
+    ok = np.array([not f for f in full.failure])
+    velocity_only = cycle_lower_bounds(scara, _targets(scara, candidates[:5]), 1, 0.05, None)
+    assert np.all(fast.lower_bound[ok] <= full.cycle_time[ok])
+    assert np.all(fast.lower_bound >= velocity_only) and np.any(fast.lower_bound > velocity_only * 1.05)
+    assert np.array_equal(fast.best_placement, full.best_placement)
+
+
+def _targets(robot, cand):
+    """The tcp poses (M, 2, 4, 4) of the pick and the place in each candidate's base frame (the screen's)."""
+    from pinarms.optim.layout.search import points_in_base_frame
+    from pinarms.robots.reach.layout import default_orientation
+
+    T = np.tile(np.eye(4), (cand.shape[0], 2, 1, 1))
+    T[:, :, :3, :3] = default_orientation(robot)
+    T[:, :, :3, 3] = points_in_base_frame(np.stack([PICK, PLACE]), cand)
+    return T

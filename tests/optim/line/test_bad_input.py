@@ -11,6 +11,7 @@ from pinarms.optim.line.errors import ArrivalsFileError, BeltOutOfReach
 from pinarms.optim.line.items import ItemType, poisson_items, read_arrivals, regular_items
 from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.station import Station, base_pose
+from pinarms.optim.line.map_request import MapRequest
 from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.errors import InvalidInput
@@ -44,7 +45,7 @@ def test_stream_is_seeded():
 def test_arm_that_cannot_reach_the_belt_is_named():
     far = Station("far scara", robots.load("scara_mushroom"), base_pose(1.0, 1.5, 0.78), PlaceBox((1.0, 1.6, 0.93)))
     with pytest.raises(BeltOutOfReach, match=r"'far scara'.*nearest to its reach is u = 1\.\d+ m along, w = 0\.150 m"):
-        build_task_map(far, BELT, nu=2, nw=2)
+        build_task_map(MapRequest(far, BELT, nu=2, nw=2))
 
 
 @pytest.mark.parametrize("text, row, column", [

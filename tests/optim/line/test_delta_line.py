@@ -8,6 +8,7 @@ import pytest
 from pinarms.optim.errors import InfeasibleProblem
 from pinarms.optim.line import Stream, TrackingSpec, run_line
 from pinarms.optim.line.delta_maps import build_delta_map
+from pinarms.optim.line.map_request import DeltaMapRequest
 from pinarms.optim.line.delta_tracking import delta_pick_times, hermite_points, platform_move_time, tool_turn_time
 from pinarms.optim.line.tracking import can_yaw
 from pinarms.optim.standard_cycle import JointPathRows, delta_path_rows
@@ -24,7 +25,8 @@ def line():
 @pytest.fixture(scope="module")
 def small_map(line):
     st = line.stations[0]
-    return build_delta_map(st, line.belt, line.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2], nu=5, nw=3, n=12)
+    return build_delta_map(DeltaMapRequest(st, line.belt, line.tracking, mass=ENOKI.mass, item_height=ENOKI.size[2],
+                                           nu=5, nw=3, n=12)).task_map
 
 
 def test_tool_turn_time_bang_bang():

@@ -11,6 +11,7 @@ import pytest
 
 from pinarms.optim.line import Belt, ItemType, LineSpec, PlaceBox, Station, Stream, TrackingSpec, run_line
 from pinarms.optim.line.fixtures import FixtureCheck, chord_polyline
+from pinarms.optim.line.map_request import MapRequest
 from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.tracking import plan_pick
 from pinarms.robots.cell import load_cell
@@ -36,8 +37,8 @@ def blocked_line():
                       base_dir=cell._base_dir)
     belt = Belt((-1.0, 0.0, 0.80), speed=0.1, width=0.30, length=2.0)
     st = Station("left", cell.arm("left").robot, cell.arm("left").base_to_world, PlaceBox((0.22, 0.68, 0.93), "box"))
-    before = build_task_map(st, belt, TrackingSpec(), cell=cell, clearance=CLEARANCE, **GRID)
-    after = build_task_map(st, belt, TrackingSpec(), cell=with_block, clearance=CLEARANCE, **GRID)
+    before = build_task_map(MapRequest(st, belt, TrackingSpec(), cell=cell, clearance=CLEARANCE, **GRID)).task_map
+    after = build_task_map(MapRequest(st, belt, TrackingSpec(), cell=with_block, clearance=CLEARANCE, **GRID)).task_map
     return with_block, belt, st, before, after
 
 
@@ -110,7 +111,7 @@ def test_fast_route_agrees_with_the_exact_check_and_bad_clearance_is_named():
     with pytest.raises(InvalidInput, match="clearance"):
         FixtureCheck(cell, "left", 0.0)
     with pytest.raises(InvalidInput, match="not an arm of cell"):
-        build_task_map(Station("middle", st.robot, st.base_to_world, st.place), belt, cell=cell, **GRID)
+        MapRequest(Station("middle", st.robot, st.base_to_world, st.place), belt, cell=cell, **GRID)
 
 
 @pytest.mark.slow

@@ -62,3 +62,47 @@ def test_a_map_the_cells_do_not_reproduce_is_read_itself():
     ref = m.rows(w, grid)
     assert not np.array_equal(CellRows(m, grid).rows(w)[0], ref[0], equal_nan=True)
     assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, read(m, grid, w)))
+
+
+def yaw_map(seed: int) -> TaskMap:
+    """``branchy_map``'s grid with five yaw layers of random times (holes too), yaw 0 the middle one."""
+    base = branchy_map(seed)
+    rng = np.random.default_rng(seed + 20)
+    yaw = np.array([-np.pi / 2, -0.9, 0.0, 0.4, np.pi / 2])
+    A = 0.3 + rng.random((yaw.size, *base.branch_approach.shape))
+    C = 0.2 + 2.0 * rng.random(A.shape)
+    A[rng.random(A.shape) < 0.1] = np.nan
+    C[np.isnan(A)] = np.nan
+    A[2], C[2] = base.branch_approach, base.branch_leave
+    return TaskMap("m", base.du, base.w, base.approach, base.leave, 0.5, 0.1, 0.2, 0.1, branches=(0, 1),
+                   branch_approach=base.branch_approach, branch_leave=base.branch_leave, yaw=yaw, yaw_approach=A,
+                   yaw_leave=C, yaw_spread=0.5)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_cells_of_a_yaw_map_give_the_same_bits_as_the_map(seed, monkeypatch):
+    m = yaw_map(seed)
+    grid = m.sim_grid()
+    rng = np.random.default_rng(seed + 30)
+    w = np.concatenate([rng.uniform(-0.16, 0.16, 3000), m.w, m.w])
+    yaw = np.concatenate([rng.uniform(-4.0, 4.0, 3000), np.zeros(m.w.size), np.full(m.w.size, 0.4)])
+    ref = m.rows(w, grid, yaw)
+    assert np.isfinite(ref[0]).any() and np.isnan(ref[0]).any()
+    cells = CellRows(m, grid)
+    assert cells.ends.shape[0] == m.yaw.size
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, cells.rows(w, yaw)))
+    compiled = np.full((w.size, grid[0].size), -1.0), np.full((w.size, grid[0].size), -1.0)
+    cells.fill(w, np.arange(w.size), *compiled, yaw=yaw)
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, compiled))
+    # map_rows takes the cells (fast) path and gives the map's rows for a part of the items
+    sel = np.arange(0, w.size, 3)
+    tA, tC = np.full((w.size, grid[0].size), -1.0), np.full((w.size, grid[0].size), -1.0)
+    filled = []
+    fill = CellRows.fill
+    monkeypatch.setattr(CellRows, "fill", lambda self, ww, s, *a, **k: (filled.append(s.size), fill(self, ww, s, *a, **k)))
+    map_rows(m, grid, w, sel, tA, tC, yaw=yaw)
+    assert filled[-1] == sel.size  # the items went through the cells (the fast path), after the check
+    assert np.array_equal(tA[sel], ref[0][sel], equal_nan=True) and np.array_equal(tC[sel], ref[1][sel], equal_nan=True)
+    assert np.all(np.delete(tA, sel, axis=0) == -1.0)
+    # yaw not given: the yaw-0 layer
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(m.rows(w, grid), cells.rows(w)))

@@ -20,7 +20,7 @@ from pinarms.optim.line.simulate import SimArm, simulate
 from pinarms.optim.line.station import Station, base_pose
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec
-from pinarms.optim.line.tray_maps import TrayMap
+from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace
 from pinarms.optim.line.trays import TrayBelt
 

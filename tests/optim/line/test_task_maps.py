@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from pinarms.optim.line.task_map_build import _refine_at, build_task_map
+from pinarms.optim.line.map_refine import bent_lines
+from pinarms.optim.line.map_request import MapRequest
+from pinarms.optim.line.task_map_build import build_task_map
 from pinarms.optim.line.task_map_error import MapError, map_error
 from pinarms.optim.line.task_maps import TaskMap
 from pinarms.optim.line.tracking import TrackingSpec, plan_pick
@@ -15,7 +17,8 @@ def small_map(scara_line):
     belt, station = scara_line
     # part of the window (0.04 m grid along, 0.05 m across): a few seconds to build
     # yaw="none": the SCARA's independence of yaw is measured in test_yaw_maps.py
-    return build_task_map(station, belt, TrackingSpec(), nu=6, nw=3, du_range=(0.0, 0.2), margin=0.075, yaw="none")
+    return build_task_map(MapRequest(station, belt, TrackingSpec(), nu=6, nw=3, du_range=(0.0, 0.2), margin=0.075,
+                                     yaw="none")).task_map
 
 
 def test_map_nodes_are_exact_plans(scara_line, small_map):
@@ -76,11 +79,11 @@ def test_refinement_marks_a_kink_between_nodes_only():
     du = np.linspace(0.0, 0.3, 7)
     A = np.full((1, 7, 2), 1.5)
     C = np.tile(1.0 + np.abs(du - 0.15)[None, :, None], (1, 1, 2))
-    assert np.allclose(_refine_at(du, A, C, 0.6, 0.005, 1), [0.125, 0.175])
-    assert _refine_at(du, A, A.copy() + 0.1 * du[None, :, None], 0.6, 0.005, 1).size == 0
-    assert _refine_at(np.array([-0.1, 0.1]), A, C, 0.6, 0.005, 2).size == 0
+    assert np.allclose(bent_lines(du, A, C, 0.6, 0.005, 1), [0.125, 0.175])
+    assert bent_lines(du, A, A.copy() + 0.1 * du[None, :, None], 0.6, 0.005, 1).size == 0
+    assert bent_lines(np.array([-0.1, 0.1]), A, C, 0.6, 0.005, 2).size == 0
     C[0, 3, 0] = np.nan
-    assert _refine_at(du, A, C, 0.6, 0.005, 1).size == 2  # still seen on the other row
+    assert bent_lines(du, A, C, 0.6, 0.005, 1).size == 2  # still seen on the other row
 
 
 def test_reprs_are_short_and_give_the_figures():

@@ -7,7 +7,7 @@ from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import regular_items
 from pinarms.optim.line.simulate import NO_TRAY, SimArm, simulate
 from pinarms.optim.line.tracking import TrackingSpec
-from pinarms.optim.line.tray_maps import TrayMap
+from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace, tray_counts
 from pinarms.optim.line.trays import TrayBelt
 
@@ -136,12 +136,13 @@ def _velocity(station, q, qd):
 def tray_scene(scara_line):
     belt, station = scara_line
     trays = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2, length=3.0), pitch=0.3, capacity=2, height=0.02)
+    from pinarms.optim.line.map_request import TrayMapRequest
     from pinarms.optim.line.tray_maps import build_tray_map
 
     # du from 0.05 m: at du = 0, w = 0.05 m the rest elbow's approach swings joint 1 past its limit
     # (plan_pick takes the other elbow there, and a cell on two elbows holds no pick)
-    tm = build_tray_map(station, belt, trays, mass=0.1, nu=2, nw=2, nv=3, margin=0.1, du_range=(0.05, 0.1),
-                        dv_range=(0.05, 0.25))
+    tm = build_tray_map(TrayMapRequest(station, belt, trays, mass=0.1, nu=2, nw=2, nv=3, margin=0.1,
+                                       du_range=(0.05, 0.1), dv_range=(0.05, 0.25), yaw="none")).task_map
     return belt, station, trays, tm
 
 
@@ -179,6 +180,7 @@ def test_simulated_place_tracks_its_tray_from_fk(tray_scene):
 
 def test_bad_tray_input(scara_line):
     from pinarms.optim.line.api import LineSpec
+    from pinarms.optim.line.map_request import TrayMapRequest
     from pinarms.optim.line.tray_maps import build_tray_map
     from pinarms.optim.line.trays import parse_trays
     from pinarms.optim.line.windows import BeltOutOfReach
@@ -194,7 +196,7 @@ def test_bad_tray_input(scara_line):
         parse_trays("0.3,0.1,1.5")
     far = TrayBelt(Belt((0.0, 3.0, 0.82), speed=0.1, width=0.2), pitch=0.3)
     with pytest.raises(BeltOutOfReach, match="scara 1"):
-        build_tray_map(station, belt, far)
+        build_tray_map(TrayMapRequest(station, belt, far))
     ok = TrayBelt(Belt((0.0, 0.52, 0.82), speed=0.1, width=0.2))
     with pytest.raises(InvalidInput, match="not in the line"):
         LineSpec(belt, (station,), trays={"scara 9": ok})

@@ -14,7 +14,7 @@ import pytest
 from pinarms.optim.line.belt import Belt
 from pinarms.optim.line.items import regular_items
 from pinarms.optim.line.simulate import SimArm, simulate
-from pinarms.optim.line.tray_maps import TrayMap
+from pinarms.optim.line.tray_map import TrayMap
 from pinarms.optim.line.tray_sim import SimPlace, find_place
 from pinarms.optim.line.trays import TrayBelt
 from pinarms.errors import InvalidInput
@@ -184,6 +184,6 @@ def test_approach_from_a_finer_box_map():
     assert pm.times(0.09, y)[0] == pytest.approx(box.approach_on(0, 0.09, y), abs=1e-12)  # up to the border
     assert pm.branch_at(x, y) == 0
     with pytest.raises(InvalidInput, match="approach_map"):
-        from pinarms.optim.line.tray_maps import build_tray_map
+        from pinarms.optim.line.map_request import TrayMapRequest
 
-        build_tray_map(None, BELT, None, approach_map=replace(box, speed=0.3))
+        TrayMapRequest(None, BELT, None, approach_map=replace(box, speed=0.3))

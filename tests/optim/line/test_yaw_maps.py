@@ -15,6 +15,8 @@ from pinarms.optim.line import Belt, ItemType, Items, LineSpec, PlaceBox, Statio
 from pinarms.optim.line.api import map_warnings, run_line
 from pinarms.optim.line.errors import TaskMapError
 from pinarms.optim.line.sim_arm import ArmState, SimArm
+from pinarms.optim.line.map_request import MapRequest
+from pinarms.optim.line.map_rows import map_rows
 from pinarms.optim.line.task_map_build import build_task_map, measure_yaw
 from pinarms.optim.line.task_map_error import MapError
 from pinarms.optim.line.task_map_file import read_map_file
@@ -183,13 +185,23 @@ def test_a_map_at_yaw_0_is_wrong_for_a_slow_hand_and_a_yaw_axis_fixes_it(slow_ha
     """Before: the map built at yaw 0 errs by up to 17 % at other yaws (its nodes, exact plans at
     random yaws); after: the map measures the dependence, gets a yaw coordinate and errs < 1 %."""
     belt, station = slow_hand
-    flat = build_task_map(station, belt, TrackingSpec(), yaw="none", **GRID)
+    flat = build_task_map(MapRequest(station, belt, TrackingSpec(), yaw="none", **GRID)).task_map
     assert flat.yaw is None and "never measured" in flat.warnings()[0]
     calls = []
-    auto = build_task_map(station, belt, TrackingSpec(), yaw_nodes=9, yaw_refine=0,
-                          progress=lambda done, total: calls.append((done, total)), **GRID)
-    assert calls[-1] == (2 * 9, 2 * 9) and all(d <= t for d, t in calls)  # every column at every yaw node
-    assert auto.yaw is not None and auto.yaw.size == 9 and auto.yaw_spread > 0.05 and auto.warnings() == ()
+    res = build_task_map(MapRequest(station, belt, TrackingSpec(), yaw_nodes=5, yaw_refine=1, **GRID),
+                         progress=lambda done, total: calls.append((done, total)))
+    auto = res.task_map
+    assert calls[-1][0] == calls[-1][1] >= 2 * 5 and all(d <= t for d, t in calls)  # every column at 5 yaw nodes
+    assert auto.yaw is not None and 5 < auto.yaw.size <= 9 and auto.yaw_spread > 0.05 and auto.warnings() == ()
+    # the refinement's layers planned where the time bends only: at most the nodes of whole layers
+    assert 5 * 2 * 4 <= res.plans <= auto.yaw.size * 2 * 4 and res.status in ("built", "refine left")
+    # the simulator's fast rows (cells per yaw layer) give the map's own rows to the bit
+    grid, ws = auto.sim_grid(), np.linspace(auto.w[0], auto.w[-1], 50)
+    yaws = np.random.default_rng(6).uniform(-np.pi, np.pi, 50)
+    tA, tC = np.empty((50, grid[0].size)), np.empty((50, grid[0].size))
+    map_rows(auto, grid, ws, np.arange(50), tA, tC, yaw=yaws)
+    ref = auto.rows(ws, grid, yaws)
+    assert np.isfinite(ref[0]).any() and all(np.array_equal(a, b, equal_nan=True) for a, b in zip((tA, tC), ref))
     rng = np.random.default_rng(5)
     before, after = [], []
     for du, w, yaw in zip(rng.choice(auto.du, 4), rng.choice(auto.w, 4), rng.uniform(-np.pi, np.pi, 4)):
@@ -207,7 +219,7 @@ def test_the_scara_is_measured_independent_of_yaw(scara_line):
     """Seed 000's SCARA with its own limits: the spread over yaw is measured below the tolerance, so
     its map keeps no yaw coordinate (the shipped maps and the demo's figures stay as they were)."""
     belt, station = scara_line
-    m = build_task_map(station, belt, TrackingSpec(), yaw="none", **GRID)
+    m = build_task_map(MapRequest(station, belt, TrackingSpec(), yaw="none", **GRID)).task_map
     measured = measure_yaw(m, station, belt, TrackingSpec())
     assert measured.yaw is None and 0.0 <= measured.yaw_spread <= YAW_TOLERANCE and measured.warnings() == ()
     np.testing.assert_array_equal(measured.approach, m.approach)

@@ -37,7 +37,7 @@ def test_peaked_gives_the_trajectory_exact_peaks_once_per_order():
     np.testing.assert_array_equal(peaked.velocity, exact.velocity)
     np.testing.assert_array_equal(peaked.acceleration, exact.acceleration)
     assert peaked.peaks() is peaked and peaked.n_joints == 2
-    assert 3 not in peaked._cache  # jerk not asked for: never computed
+    assert 3 not in peaked._peaks_of_order  # jerk not asked for: never computed
 
 
 def test_exact_peaks_skip_only_pieces_that_cannot_hold_the_peak():

@@ -120,7 +120,7 @@ def test_held_low_answers_early_and_passes_over_far_cylinders():
         W[:] = np.einsum("sab,sb->sa", R[cover.joint], cover.center) + p[cover.joint]
         SA[:] = np.einsum("sab,sb->sa", R[sjoint], sa) + p[sjoint]
         SB[:] = np.einsum("sab,sb->sa", R[sjoint], sb) + p[sjoint]
-        args = (W, cover.radius, SA, SB, srad, sstart, spart, ua, cover.frame_R, cover.frame_p, cover.size, fx)
+        args = ((W, cover.radius, SA, SB, srad, sstart, spart), ua, (cover.frame_R, cover.frame_p, cover.size), fx)
         full = held_low(*args, -np.inf, np.inf)
         for t in (full - 1e-3, full + 1e-3):
             assert (held_low(*args, t, t) > t) == (full > t)  # the screen's question, answered early

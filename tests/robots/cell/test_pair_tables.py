@@ -128,7 +128,7 @@ def test_the_disk_cache_round_trips_and_rejects_a_bad_file(ur5, tmp_path, monkey
     names = [o.name for o in objs]
     a, b = names.index("ur5_wrist_1_link_0"), names.index("ur5_ee_link_0")
     (found,) = [f for f in pt.table_paths(cell, [(a, b)])]
-    table = pt._build_one(cell, *found)
+    table = pt.build_table(cell, *found)
     key = "0" * 64
     pt._save(key, table)
     got = pt._load(key)
@@ -206,7 +206,7 @@ def test_a_table_of_the_aubo_food_station_stays_below_coal():
     found = pt.table_paths(cell, [(p.index_a, p.index_b) for p in cell.pairs])
     assert [(objs[a].name, objs[b].name) for a, b, _, _ in found] == [("aubo_upperArm_Link_2", "hopper_0")]
     a, b, side_a, side_b = found[0]
-    tables = pt.assemble(cell, found, [pt._build_one(cell, a, b, side_a, side_b)])
+    tables = pt.assemble(cell, found, [pt.build_table(cell, a, b, side_a, side_b)])
     Q = cell.random_q(N, seed=12)
     bound = tables.bound(0, _angles(cell, tables, 0, Q))
     Rg, pg = cell.geometry_placements(Q)
