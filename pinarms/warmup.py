@@ -170,7 +170,8 @@ STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 
 #: Seconds each step took to compile on a fresh install, one after the other in one process (2026-12, two cores
 #: at a load of 15): only their ratio matters, it decides which process runs which step (:func:`plan_processes`).
-STEP_COST = {"inverse kinematics": 155.0, "motion planning": 915.0, "sphere cover": 329.0, "line simulation": 91.0}
+STEP_COST = {"inverse kinematics": 155.0, "motion planning": 915.0, "sphere cover": 329.0, "line simulation": 91.0,
+             "trajectory timing": 60.0}  # (the timing step's: estimated, one small kernel; added after the measurement)
 
 #: A line a worker process writes on stdout for its parent starts with this.
 _EVENT = "pinarms-warm-event "

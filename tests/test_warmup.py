@@ -90,14 +90,14 @@ def test_the_steps_are_shared_out_longest_first():
     labels = [label for label, _ in warmup.STEPS]
     assert set(warmup.STEP_COST) == set(labels)
     two = warmup.plan_processes(2)
-    assert two == [["motion planning"], ["inverse kinematics", "sphere cover", "line simulation"]]
+    assert two == [["motion planning"], [label for label in labels if label != "motion planning"]]
     for n in (1, 2, 3, 4, 9):
         plan = warmup.plan_processes(n)
         assert len(plan) == min(n, len(labels)) and all(plan)
         assert sorted(label for part in plan for label in part) == sorted(labels)  # each step once
         assert all(part == sorted(part, key=labels.index) for part in plan)
     assert warmup.plan_processes(2, {"inverse kinematics": 10.0}) == [
-        ["inverse kinematics"], ["motion planning", "sphere cover", "line simulation"]]
+        ["inverse kinematics"], [label for label in labels if label != "inverse kinematics"]]
     with pytest.raises(ValueError, match="processes must be at least 1"):
         warmup.plan_processes(0)
 
