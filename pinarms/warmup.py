@@ -9,6 +9,12 @@ search, the spline proof and the time-optimal timing; the sphere cover's other e
 every later process loads them from the cache (about a second). ``make install`` runs it
 (``pinarms warm``); a second run loads everything and compiles nothing.
 
+The steps run in parallel, one process per core (:func:`plan_processes`: the longest step first,
+each next step to the process with the least work, by :data:`STEP_COST`); numba writes each cache
+file atomically (a temporary file renamed), so two processes that compile the same small callee
+both leave a whole file. On two cores the motion plan's kernels compile in one process while the
+IK's, the cover's and the line simulator's compile in the other.
+
 :func:`kernels` lists every kernel of :data:`KERNEL_MODULES` by name; :func:`cache_misses` counts
 the signatures numba compiled in this process (a signature loaded from the cache is a hit), which is
 how :class:`WarmResult` tells compiled from loaded, and how the tests check that after a warm-up
@@ -18,15 +24,22 @@ no kernel is compiled again.
 from __future__ import annotations
 
 import importlib
+import json
+import os
+import queue
+import subprocess
+import sys
+import tempfile
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 __all__ = ["KERNEL_MODULES", "WarmStep", "WarmResult", "kernels", "cached_signatures", "cache_misses", "warm",
-           "STEPS"]
+           "STEPS", "STEP_COST", "plan_processes", "cores"]
 
 #: Every module holding kernels of :func:`pinarms.compiled.jit` (the ladder compiles its rule on first access).
 KERNEL_MODULES = (
@@ -155,6 +168,14 @@ STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("trajectory timing", _timing),
 )
 
+#: Seconds each step took to compile on a fresh install, one after the other in one process (2026-12, two cores
+#: at a load of 15): only their ratio matters, it decides which process runs which step (:func:`plan_processes`).
+STEP_COST = {"inverse kinematics": 155.0, "motion planning": 915.0, "sphere cover": 329.0, "line simulation": 91.0,
+             "trajectory timing": 60.0}  # (the timing step's: estimated, one small kernel; added after the measurement)
+
+#: A line a worker process writes on stdout for its parent starts with this.
+_EVENT = "pinarms-warm-event "
+
 
 @dataclass(frozen=True)
 class WarmStep:
@@ -168,16 +189,27 @@ class WarmStep:
 @dataclass(frozen=True)
 class WarmResult:
     """What :func:`warm` did; ``missing``: kernels that no step called (each is compiled on its first real use);
-    ``repeated``: kernels this run compiled for several signatures (each one more compile: a literal argument,
-    a read-only array; seen only where they were not cached yet)."""
+    ``repeated``: kernels a process compiled for several signatures (each one more compile: a literal argument,
+    a read-only array; seen only where they were not cached yet); ``overlap``: kernels compiled by more than one
+    of the parallel processes (the same small callee reached by two steps); ``wall_seconds``: the whole warm-up's
+    wall time, ``processes``: how many processes ran the steps."""
 
     steps: tuple[WarmStep, ...]
     kernels: int
     missing: tuple[str, ...]
     repeated: tuple[str, ...] = ()
+    overlap: tuple[str, ...] = ()
+    wall_seconds: float | None = None
+    processes: int = 1
 
     @property
     def seconds(self) -> float:
+        """Wall time [s] of the whole warm-up (the steps added up where it was not measured)."""
+        return self.step_seconds if self.wall_seconds is None else self.wall_seconds
+
+    @property
+    def step_seconds(self) -> float:
+        """The steps' wall times added up [s] (more than :attr:`seconds` where processes ran them in parallel)."""
         return sum(s.seconds for s in self.steps)
 
     @property
@@ -188,32 +220,166 @@ class WarmResult:
         """A short text report."""
         out = [f"{s.label}: {s.seconds:.1f} s, " + (f"{s.compiled} kernel signatures compiled" if s.compiled
                                                       else "every kernel loaded from the cache") for s in self.steps]
-        out.append(f"{self.kernels} kernels ready in {self.seconds:.1f} s")
+        ready = f"{self.kernels} kernels ready in {self.seconds:.1f} s"
+        if self.processes > 1:
+            ready += f" ({self.processes} processes in parallel; the steps add up to {self.step_seconds:.1f} s)"
+        out.append(ready)
         if self.missing:
             out.append("not compiled ahead (compiled on first use): " + ", ".join(self.missing))
         if self.repeated:
             out.append("compiled for several signatures in this run: " + ", ".join(self.repeated))
+        if self.overlap:
+            out.append("compiled by more than one process: " + ", ".join(self.overlap))
         return out
 
     def as_dict(self) -> dict[str, Any]:
         return {"steps": [{"label": s.label, "seconds": s.seconds, "compiled": s.compiled} for s in self.steps],
                 "kernels": self.kernels, "missing": list(self.missing), "repeated": list(self.repeated),
-                "seconds": self.seconds}
+                "overlap": list(self.overlap), "seconds": self.seconds, "step_seconds": self.step_seconds,
+                "processes": self.processes}
 
 
-def warm(progress: Callable[[str], None] | None = None) -> WarmResult:
-    """Run :data:`STEPS` (each kernel compiled, or loaded from numba's cache); ``progress(label)`` before each."""
-    steps = []
-    for label, call in STEPS:
-        if progress is not None:
-            progress(label)
+def cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it, else the machine's count)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+def plan_processes(processes: int, cost: dict[str, float] | None = None) -> list[list[str]]:
+    """The labels of :data:`STEPS` split over at most ``processes`` processes: the longest step first, each next
+    step to the process with the least work so far (by ``cost``, :data:`STEP_COST` by default); each process keeps
+    the order of :data:`STEPS`. No empty process: never more processes than steps."""
+    if processes < 1:
+        raise ValueError(f"processes must be at least 1, got {processes}")
+    cost = STEP_COST if cost is None else cost
+    labels = [label for label, _ in STEPS]
+    bins: list[list[str]] = [[] for _ in range(min(processes, len(labels)))]
+    load = [0.0] * len(bins)
+    for label in sorted(labels, key=lambda name: -cost.get(name, 0.0)):
+        i = load.index(min(load))
+        bins[i].append(label)
+        load[i] += cost.get(label, 0.0)
+    return [sorted(b, key=labels.index) for b in bins]
+
+
+def _run_steps(labels: Sequence[str], emit: Callable[[str, Any], None]) -> dict[str, int]:
+    """Run the steps named ``labels`` here, in order: ``emit("start", label)`` before each, ``emit("step", step)``
+    after; return the signatures compiled per kernel in this process."""
+    calls = dict(STEPS)
+    for label in labels:
+        emit("start", label)
         before = cache_misses()
         start = time.perf_counter()
-        call()
-        steps.append(WarmStep(label, time.perf_counter() - start, cache_misses() - before))
-    found = kernels()
+        calls[label]()
+        emit("step", WarmStep(label, time.perf_counter() - start, cache_misses() - before))
+    return {name: n for name, k in kernels().items() if (n := sum(k.stats.cache_misses.values()))}
+
+
+def run_worker(labels: Sequence[str]) -> None:
+    """A worker process of :func:`warm`: run the steps ``labels`` and report each on stdout (one JSON line each)."""
+    def emit(kind: str, value: Any) -> None:
+        if isinstance(value, WarmStep):
+            value = [value.label, value.seconds, value.compiled]
+        print(_EVENT + json.dumps([kind, value]), flush=True)
+
+    emit("misses", _run_steps(labels, emit))
+
+
+def _start_worker(labels: list[str], events: queue.Queue) -> tuple[subprocess.Popen, Any, threading.Thread]:
+    """A new interpreter of this environment running :func:`run_worker`; a thread passes its events to ``events``."""
+    code = "import sys; from pinarms.warmup import run_worker; run_worker(sys.argv[1:])"
+    errors = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
+    process = subprocess.Popen([sys.executable, "-c", code, *labels], stdout=subprocess.PIPE, stderr=errors,
+                               text=True, encoding="utf-8")
+
+    def read() -> None:
+        assert process.stdout is not None
+        for line in process.stdout:
+            if line.startswith(_EVENT):
+                events.put(tuple(json.loads(line[len(_EVENT):])))
+        events.put(("exit", None))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    return process, errors, reader
+
+
+def _run_parallel(plan: list[list[str]], progress: Callable[[str], None] | None,
+                  done: Callable[[WarmStep], None] | None) -> tuple[list[WarmStep], list[dict[str, int]]]:
+    """Run each list of labels of ``plan`` in its own process; the steps in :data:`STEPS`' order and each
+    process's compiles per kernel."""
+    events: queue.Queue = queue.Queue()
+    workers = [_start_worker(labels, events) for labels in plan]
+    steps: dict[str, WarmStep] = {}
+    misses: list[dict[str, int]] = []
+    try:
+        running = len(workers)
+        while running:
+            kind, value = events.get()
+            if kind == "start" and progress is not None:
+                progress(value)
+            elif kind == "step":
+                steps[value[0]] = WarmStep(value[0], float(value[1]), int(value[2]))
+                if done is not None:
+                    done(steps[value[0]])
+            elif kind == "misses":
+                misses.append({str(k): int(n) for k, n in value.items()})
+            elif kind == "exit":
+                running -= 1
+        failed = []
+        for (process, errors, reader), labels in zip(workers, plan):
+            process.wait()
+            reader.join()
+            if process.returncode:
+                errors.seek(0)
+                failed.append(f"{', '.join(labels)} (exit {process.returncode}): {errors.read()[-2000:]}")
+        if failed:
+            raise RuntimeError("the warm-up's process failed: " + "; ".join(failed))
+    finally:
+        for process, errors, _ in workers:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+            errors.close()
+    order = [label for label, _ in STEPS]
+    return sorted(steps.values(), key=lambda s: order.index(s.label)), misses
+
+
+def warm(progress: Callable[[str], None] | None = None, done: Callable[[WarmStep], None] | None = None,
+         processes: int | None = None) -> WarmResult:
+    """Run :data:`STEPS` (each kernel compiled, or loaded from numba's cache); ``progress(label)`` as each step
+    starts, ``done(step)`` as it ends (several run at once in parallel processes).
+
+    ``processes``: how many processes run the steps (default: one per core, :func:`cores`; never more than the
+    steps); each is a new interpreter of this Python environment, with its own numba (:func:`plan_processes`
+    says which steps each runs). ``processes=1`` runs them one after the other in this process, which then
+    holds every kernel.
+    """
+    processes = cores() if processes is None else processes
+    plan = plan_processes(processes)
+    start = time.perf_counter()
+    found = kernels()  # imports every kernel module here first: their stale-cache guards run once, before the workers
+    if len(plan) == 1:
+        steps: list[WarmStep] = []
+
+        def emit(kind: str, value: Any) -> None:
+            if kind == "start":
+                if progress is not None:
+                    progress(value)
+                return
+            steps.append(value)
+            if done is not None:
+                done(value)
+
+        misses = [_run_steps(plan[0], emit)]
+    else:
+        steps, misses = _run_parallel(plan, progress, done)
+    wall = time.perf_counter() - start
     # a kernel called only by kernels loaded from the cache has no signature in memory, but one on disk
     missing = tuple(sorted(name for name, k in found.items() if not k.signatures and not cached_signatures(k)))
-    # compiled more than once in this run (signatures another process or a test cached are not counted)
-    repeated = tuple(sorted(name for name, k in found.items() if sum(k.stats.cache_misses.values()) > 1))
-    return WarmResult(tuple(steps), len(found) - len(missing), missing, repeated)
+    # compiled more than once by one process (signatures another process or a test cached are not counted)
+    repeated = tuple(sorted({name for m in misses for name, n in m.items() if n > 1}))
+    overlap = tuple(sorted(name for name in found if sum(name in m for m in misses) > 1))
+    return WarmResult(tuple(steps), len(found) - len(missing), missing, repeated, overlap, wall, len(plan))

@@ -22,25 +22,36 @@ import pytest
 #: The group of the tests that use :func:`quick_study`: one worker builds each study once for all of them.
 DEMO_STUDIES = "demo-studies"
 
-#: Seconds that the longest groups took in one process on a loaded 2-core machine (``--durations``,
-#: 2026-11): only their order matters. A group not listed starts after these when it has a test
-#: marked ``slow`` (weight 30), else in collection order at the end.
+#: CPU seconds (user + system, the test processes and their children) that the longest groups took in ``make test``
+#: (2026-12, two workers): only their order matters. A group not listed starts after these when it has a test marked
+#: ``slow`` (weight :data:`SLOW_SECONDS`), else in collection order at the end.
 GROUP_SECONDS = {
-    "tests/test_packaging.py": 60.0,  # builds the wheel, installs it beside the namesakes in a fresh venv
-    "tests/cli/test_demo.py": 150.0,  # `pinarms demo --quick` end to end
-    "tests/cli/test_cli.py": 113.0,  # the first IK call compiles the numba kernel in a clean clone
-    DEMO_STUDIES: 110.0,  # the demo's quick studies 000, 001 and 004, built once
-    "tests/optim/layout/test_layout_search.py": 89.0,
-    "tests/robots/test_xacro_expand.py": 69.0,
-    "tests/optim/cycle/test_cell_cycle.py": 60.0,
-    "tests/optim/test_motion_transfer.py": 54.0,
-    "tests/foreign/test_foreign_arms.py": 266.0,  # one foreign arm's whole path (measured at a load average of 10)
-    "tests/test_export_verify.py": 49.0,
-    "tests/test_execution.py": 44.0,
-    "tests/viz/test_browser.py": 26.0,
-    "tests/optim/cycle/test_cycle.py": 35.0,
-    "tests/robots/test_descriptions.py": 29.0,
+    DEMO_STUDIES: 96.0,  # the demo's quick studies 000, 001 and 004, built once; `pinarms demo --quick` end to end
+    "tests/foreign/test_foreign_arms.py": 76.0,  # one foreign arm's whole path
+    "tests/optim/line/test_fixtures.py": 37.0,
+    "tests/robots/test_xacro_expand.py": 30.0,
+    "tests/optim/line/test_yaw_maps.py": 29.0,
+    "tests/test_architecture_figures.py": 28.0,
+    "tests/optim/layout/test_layout_search.py": 26.0,
+    "tests/optim/line/test_task_maps.py": 20.0,
+    "tests/optim/cycle/test_cell_screen.py": 20.0,
+    "tests/optim/test_motion_transfer.py": 19.0,
+    "tests/test_export_verify.py": 18.0,
+    "tests/studies/test_handoff_plans.py": 18.0,
+    "tests/cli/test_layout_search_cli.py": 16.0,
+    "tests/fuzz/test_fuzz_api.py": 16.0,
+    "tests/robots/cell/test_pair_tables.py": 15.0,
+    "tests/robots/reach/test_reach_io.py": 14.0,
+    "tests/test_packaging.py": 14.0,  # builds the wheel, installs it beside the namesakes in a fresh venv
+    "tests/test_execution.py": 13.0,
+    "tests/optim/cycle/test_cell_cycle.py": 12.0,
+    "tests/robots/test_descriptions.py": 11.0,
+    "tests/optim/line/test_tray_line.py": 11.0,
+    "tests/optim/layout/test_layout_bound.py": 10.0,
 }
+
+#: The weight of an unlisted group that holds a test marked ``slow``.
+SLOW_SECONDS = 5.0
 
 
 def _group_of(item: pytest.Item) -> str:
@@ -60,7 +71,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
     def weight(item: pytest.Item) -> float:
         group = _group_of(item)
-        return GROUP_SECONDS.get(group, 30.0 if group in slow else 0.0)
+        return GROUP_SECONDS.get(group, SLOW_SECONDS if group in slow else 0.0)
 
     items.sort(key=weight, reverse=True)
 

@@ -5,7 +5,11 @@ outside the repository; the editable install maps the repository's folders to ``
 The fresh virtualenv takes pinarms' dependencies (Pinocchio, coal, numba, ...) from the
 environment running the tests, behind its own site-packages, instead of installing them again
 (minutes): what is checked is the wheel's content and its namespace beside the namesakes. That the
-wheel asks for the same dependencies as ``pyproject.toml`` is checked on its metadata.
+wheel asks for the same dependencies as ``pyproject.toml`` is checked on its metadata. The test
+environment's pip installs into it (``pip --python``: no pip of its own to set up), and the
+quickstart loads the compiled kernels that ``pinarms warm`` left beside the checkout's sources
+(numba's cache, copied beside the wheel's identical sources), as after ``pinarms warm`` on a fresh
+install, instead of compiling them again (the cold compile is measured by benchmarks/first_use.py).
 """
 
 from __future__ import annotations
@@ -27,6 +31,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 NAMESAKES = ("robots", "optim", "planning", "viz")  # PyPI projects unrelated to pinarms
 PINARMS_PACKAGES = ("robots", "planning", "optim", "viz", "urdf")
+#: the checkout's folders and where the wheel puts them (pyproject.toml's package-dir)
+LAYOUT = {"pinarms": "pinarms", "robots": "pinarms/robots", "planning": "pinarms/planning", "optim": "pinarms/optim",
+          "viz": "pinarms/viz"}
 
 PROBE = f"""
 import importlib, importlib.resources, importlib.util, json, sys
@@ -84,6 +91,30 @@ def _dependencies_behind(env_dir: Path) -> None:
     (own / "zz_test_dependencies.pth").write_text(lines, encoding="utf-8")
 
 
+def _kernel_caches_beside(site_packages: Path) -> int:
+    """Copy numba's caches of the checkout's kernels (and the stale-cache guards' digests) beside the installed
+    copies of their sources, each source stamped with its checkout twin's modification time (numba's cache key is
+    the source's time and size, the guards' the sources' bytes); only where the two sources are the same bytes.
+    Return the number of cache files copied (0 where the checkout has none: the kernels then compile there)."""
+    copied = 0
+    for folder, target in LAYOUT.items():
+        for cache in (ROOT / folder).rglob("__pycache__"):
+            source_dir = cache.parent
+            installed = site_packages / target / source_dir.relative_to(ROOT / folder)
+            files = [f for f in cache.iterdir() if f.suffix in (".nbi", ".nbc", ".sha256")]
+            if not files or not installed.is_dir():
+                continue
+            for source in source_dir.glob("*.py"):
+                twin = installed / source.name
+                if twin.is_file() and twin.read_bytes() == source.read_bytes():
+                    os.utime(twin, ns=(source.stat().st_atime_ns, source.stat().st_mtime_ns))
+            (installed / "__pycache__").mkdir(exist_ok=True)
+            for f in files:
+                shutil.copy2(f, installed / "__pycache__" / f.name)
+                copied += 1
+    return copied
+
+
 @pytest.mark.slow
 def test_wheel_beside_pypi_namesakes_runs_the_quickstart(tmp_path):
     """About half a minute with a warm pip cache (the dependencies come from the test environment)."""
@@ -94,12 +125,15 @@ def test_wheel_beside_pypi_namesakes_runs_the_quickstart(tmp_path):
     declared = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["dependencies"]
     assert _requirements(wheel) == {d.replace(" ", "") for d in declared}
     env_dir = tmp_path / "venv"
-    venv.create(env_dir, with_pip=True)
+    venv.create(env_dir, with_pip=False)
     py = env_dir / "bin" / "python"
+    pip = [sys.executable, "-m", "pip", "--python", py, "install", "-q", "--no-compile"]
     # pinarms first, then the namesakes: pip would silently overwrite a top-level package of the same name
-    _run([py, "-m", "pip", "install", "-q", "--no-compile", "--no-deps", wheel], tmp_path)
-    _run([py, "-m", "pip", "install", "-q", "--no-compile", *NAMESAKES], tmp_path)
+    _run([*pip, "--no-deps", wheel], tmp_path)
+    _run([*pip, *NAMESAKES], tmp_path)
     _dependencies_behind(env_dir)
+    (own,) = (env_dir / "lib").glob("python3*/site-packages")
+    _kernel_caches_beside(own)
     work = tmp_path / "outside"
     work.mkdir()
     found = json.loads(_run([py, "-c", PROBE], work).stdout)

@@ -71,7 +71,7 @@ from pinarms import optim, robots, warmup
 from pinarms.optim.motion import SCENES, load_scene
 from pinarms.optim.motion.scenes import region_pose
 
-result = warmup.warm()
+result = warmup.warm(processes=1)  # in this process: every kernel loaded here
 # another arm, another goal, every goal branch searched
 panda = robots.load("panda")
 T = panda.fk(panda.neutral)
@@ -86,12 +86,31 @@ print(json.dumps({"warm": result.as_dict(), "compiled": result.compiled, "after"
 """
 
 
+def test_the_steps_are_shared_out_longest_first():
+    labels = [label for label, _ in warmup.STEPS]
+    assert set(warmup.STEP_COST) == set(labels)
+    two = warmup.plan_processes(2)
+    assert two == [["motion planning"], [label for label in labels if label != "motion planning"]]
+    for n in (1, 2, 3, 4, 9):
+        plan = warmup.plan_processes(n)
+        assert len(plan) == min(n, len(labels)) and all(plan)
+        assert sorted(label for part in plan for label in part) == sorted(labels)  # each step once
+        assert all(part == sorted(part, key=labels.index) for part in plan)
+    assert warmup.plan_processes(2, {"inverse kinematics": 10.0}) == [
+        ["inverse kinematics"], [label for label in labels if label != "inverse kinematics"]]
+    with pytest.raises(ValueError, match="processes must be at least 1"):
+        warmup.plan_processes(0)
+
+
 @pytest.mark.slow
 def test_after_the_warm_up_no_kernel_compiles_again():
-    """Warm up here (minutes on a fresh checkout, seconds once cached), then a new process loads every kernel
-    it needs, for the warm-up's calls and for other calls (another arm's IK, another plan), from numba's cache."""
-    first = warmup.warm()
-    assert first.missing == ()
+    """Warm up here in parallel processes (minutes on a fresh checkout, seconds once cached), then a new process
+    warms up in itself and loads every kernel it needs, for the warm-up's calls and for other calls (another arm's
+    IK, another plan), from numba's cache."""
+    first = warmup.warm(processes=2)
+    assert first.missing == () and first.processes == 2
+    assert [s.label for s in first.steps] == [label for label, _ in warmup.STEPS]
+    assert first.seconds >= max(s.seconds for s in first.steps)  # the wall time spans every step
     # one compile per kernel (checked where this warm-up compiles, as on a fresh checkout): the IK descent was
     # compiled once per phase constant (numba literals), the cover's excess once more for a module's read-only empty
     # array, the spline proof's search for a path's read-only breaks; left: the cover's excess, for the cover's

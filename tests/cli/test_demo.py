@@ -1,7 +1,13 @@
-"""`pinarms demo --quick`: the table rows, the files, and the paper numbers that must agree."""
+"""`pinarms demo --quick`: the table rows, the files, and the paper numbers that must agree.
+
+The demo's quick studies 000, 001 and 004 come from the session's ``quick_study`` (tests/conftest.py), which
+builds each once for every file that checks them: ``shared_studies`` hands them to ``run_demo`` (the same
+``study_<key>(quick=True)`` call the demo makes), so that ``pinarms demo --quick`` builds only the others here.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
@@ -9,9 +15,30 @@ from click.testing import CliRunner
 
 from pinarms.cli import cli
 
+SHARED = ("000", "001", "004")
+
+
+@pytest.fixture
+def shared_studies(monkeypatch, quick_study):
+    """``run_demo`` takes studies 000, 001 and 004 from ``quick_study`` (each a copy: it sets their seconds)."""
+    from pinarms import demo
+
+    calls = []
+    for key in SHARED:
+        assert demo.STUDIES[key] is getattr(demo, f"study_{key}"), f"the demo no longer runs study_{key}"
+
+        def shared(quick: bool, key: str = key):
+            assert quick is True, "the demo tests run --quick"
+            calls.append(key)
+            return dataclasses.replace(quick_study(key))
+
+        monkeypatch.setitem(demo.STUDIES, key, shared)
+    return calls
+
 
 @pytest.mark.slow
-def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path, shared_studies):
     out = tmp_path / "demo"
     result = CliRunner().invoke(cli, ["demo", "--quick", "--out", str(out), "--json"])
     assert result.exit_code == 0, (result.output, result.exception)
@@ -52,9 +79,11 @@ def test_demo_quick_writes_table_sessions_html_and_plots(tmp_path):
 
     session = viz.load_session(out / "sessions" / "seed001.pinarms")
     assert session.trajectories and session.workspaces
+    assert shared_studies == list(SHARED)
 
 
-def test_demo_text_table_only_one_study(tmp_path):
+@pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
+def test_demo_text_table_only_one_study(tmp_path, shared_studies):
     result = CliRunner().invoke(cli, ["demo", "--quick", "--only", "004", "--out", str(tmp_path)])
     assert result.exit_code == 0, (result.output, result.exception)
     assert "paper vs pinarms" in result.stdout
@@ -70,6 +99,7 @@ def test_demo_text_table_only_one_study(tmp_path):
     assert sorted(table.replace(" ", "").replace("-", "").replace("\n", "")) == sorted(
         result.stdout.split("\n\nwrote ")[0].replace(" ", "").replace("-", "").replace("\n", ""))
     assert any(len(line) > 100 for line in (tmp_path / "table.md").read_text(encoding="utf-8").splitlines())
+    assert shared_studies == ["004", "004"]
 
 
 @pytest.mark.xdist_group("demo-studies")  # shares the quick studies (tests/conftest.py)
