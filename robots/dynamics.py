@@ -20,6 +20,7 @@ Conventions
 
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 import numpy as np
@@ -50,15 +51,20 @@ class MissingInertials(ModelError):
     """The robot's URDF gives no mass to the links a joint moves: its torques would be meaningless."""
 
 
+#: The Pinocchio models whose masses :func:`check_inertials` found complete (weakly held: a model that goes
+#: away leaves; a robot with a payload has a model of its own, checked afresh).
+_CHECKED_MODELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def check_inertials(robot: RobotModel) -> None:
     """Raise :class:`MissingInertials` if a joint of ``robot`` moves no mass at all.
 
     Every independent joint must carry some mass beyond it (its links, or a payload): a URDF
     without ``<inertial>`` elements loads for kinematics, but its torques would all be zero.
     """
-    if getattr(robot, "_inertials_checked", False):
-        return
     model = robot.model
+    if model in _CHECKED_MODELS:
+        return
     data = model.createData()
     pin.computeSubtreeMasses(model, data)
     subtree = np.asarray(data.mass, dtype=float)  # mass supported by each joint (its subtree)
@@ -74,7 +80,7 @@ def check_inertials(robot: RobotModel) -> None:
             "<inertial> (mass, centre of mass, inertia); add them, or use robots.load(...) for a built-in arm "
             "whose URDF carries inertials"
         )
-    robot._inertials_checked = True
+    _CHECKED_MODELS[model] = True
 
 
 def total_mass(robot: RobotModel) -> float:

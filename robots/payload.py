@@ -216,5 +216,4 @@ def with_payload(robot: RobotModel, mass: Payload | float, com: ArrayLike | None
     new._model_without_payload = base_model
     new.payload = load
     new.__dict__.pop("_numerical_ik_solver", None)
-    new.__dict__.pop("_inertials_checked", None)
     return new
