@@ -52,16 +52,23 @@ def _hermite(p0, p1, m0, m1):
     return points, tangent_bound([m0, -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1, 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1])
 
 
+def _pick_points(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float,
+                 item_height: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The pick's platform points in the delta's base frame [m]: above the item at (``u``, ``w``), at the box,
+    at the end of the tracking segment, and the belt's direction there."""
+    R = station.base_to_world[:3, :3]
+    pre = station.world_to_base(belt.to_world(u, w, item_height + spec.lift)) - station.robot.tcp_offset
+    box = station.world_to_base(station.place.position) - station.robot.tcp_offset
+    d = R.T @ belt.direction
+    return pre, box, pre + belt.speed * d * spec.track_time, d
+
+
 def delta_pick_path(station: Station, belt: Belt, spec: TrackingSpec, u: float, w: float, *,
                     item_height: float) -> PlatformPath:
     """The platform path of the pick at belt coordinates (``u``, ``w``) (module doc), in the delta's base frame."""
     arm = station.robot
-    R = station.base_to_world[:3, :3]
-    pre = station.world_to_base(belt.to_world(u, w, item_height + spec.lift)) - arm.tcp_offset
-    velocity = belt.speed * (R.T @ belt.direction)
-    box = station.world_to_base(station.place.position) - arm.tcp_offset
-    d = R.T @ belt.direction
-    end = pre + velocity * spec.track_time
+    pre, box, end, d = _pick_points(station, belt, spec, u, w, item_height)
+    velocity = belt.speed * d
     approach, g_a = _hermite(box, pre, pre - box, float(np.linalg.norm(pre - box)) * d)
     leave, g_c = _hermite(end, box, float(np.linalg.norm(box - end)) * d, box - end)
     T, z = spec.track_time, np.array([0.0, 0.0, 1.0])
@@ -131,19 +138,15 @@ def delta_pick_plan(station: Station, belt: Belt, spec: TrackingSpec, u: float, 
     """The pick at belt coordinates (``u``, ``w``) on the clock (module doc): the same moves as
     :func:`~.delta_tracking.delta_pick_times` (the tool axis held)."""
     arm = station.robot
-    R = station.base_to_world[:3, :3]
-    pre = station.world_to_base(belt.to_world(u, w, item_height + spec.lift)) - arm.tcp_offset
-    velocity = belt.speed * (R.T @ belt.direction)
-    box = station.world_to_base(station.place.position) - arm.tcp_offset
-    d = R.T @ belt.direction
-    end = pre + velocity * spec.track_time
+    pre, box, end, d = _pick_points(station, belt, spec, u, w, item_height)
+    velocity = belt.speed * d
     approach, t_a, v_a = _profile(*platform_move_profile(arm, box, pre, d, belt.speed, True, 0.0, n),
                                   float(np.linalg.norm(pre - box)))
     leave, t_c, v_c = _profile(*platform_move_profile(arm, end, box, d, belt.speed, False, mass, n),
                                float(np.linalg.norm(box - end)))
     g_a = v_a * _hermite(box, pre, pre - box, float(np.linalg.norm(pre - box)) * d)[1] / float(np.linalg.norm(pre - box))
     g_c = v_c * _hermite(end, box, float(np.linalg.norm(box - end)) * d, box - end)[1] / float(np.linalg.norm(box - end))
-    T, z = spec.track_time, np.array([0.0, 0.0, 1.0])
+    T = spec.track_time
     track = _tracking(spec, pre, velocity)
     edges = np.cumsum([0.0, t_a, T, t_c, spec.release])
 
