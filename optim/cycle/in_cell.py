@@ -71,6 +71,15 @@ SCREEN_MOVES = True
 AHEAD = 8
 
 def _arm_of(cell: Any, robot: Any, arm: str | None):
+    found = _find_arm(cell, robot, arm)
+    if any(d.name == found.name for d in getattr(cell, "deltas", ())):
+        raise InvalidInput(f"arm {found.name!r} of cell {cell.name!r} is a delta: a cycle in a cell plans a serial "
+                           "arm's IK and moves; a delta's picks are planned on the line (optim.line.delta_tracking, "
+                           "pinarms belt run --robot delta_flexpicker) and its standard cycle by optim.standard_cycle")
+    return found
+
+
+def _find_arm(cell: Any, robot: Any, arm: str | None):
     if arm is not None:
         found = cell.arm(arm)
         if robot is not found.robot and tuple(robot.joint_names) != tuple(found.robot.joint_names):

@@ -295,3 +295,14 @@ def test_motion_checker_refuses_what_it_cannot_see(cell):
     for arms in (["picker"], ["scara"]):   # the delta itself; a serial arm a delta's body may touch
         with pytest.raises(InvalidInput, match="holds a delta"):
             MotionChecker(cell, arms)
+
+
+def test_a_cycle_in_a_cell_refuses_a_delta_arm_by_name(cell):
+    """The cell's tree holds the delta's motors only, so a serial cycle of it would be meaningless: refused."""
+    from pinarms import optim
+    from pinarms.errors import InvalidInput
+
+    picker = cell.arm("picker")
+    spec = optim.PickPlace(pick=np.eye(4), place=np.eye(4), lift=0.05, dwell=0.1)
+    with pytest.raises(InvalidInput, match=r"'picker'.*is a delta.*belt run --robot delta_flexpicker"):
+        optim.plan_cycle(optim.CycleRequest(picker.robot, spec, cell=optim.CellSettings(cell, arm="picker")))
