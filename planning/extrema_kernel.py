@@ -131,6 +131,26 @@ def _quartic_roots(R, out):
 
 
 @jit
+def _derivatives(c, r, scale, W, P, R):
+    """Fill ``P`` with the coefficients of the ``r``-th derivative of the piece ``c (W,)`` (normalised
+    time, times ``scale``) and ``R`` with those of the next one (unscaled: only its roots matter);
+    return the degree of ``R`` (its coefficients below 1e-12 of its largest count as zero)."""
+    for k in range(W):
+        P[k] = c[k + r] * _falling(k + r, r) * scale if k + r < W else 0.0
+    top = 0.0
+    for k in range(R.shape[0]):
+        R[k] = c[k + r + 1] * _falling(k + r + 1, r + 1) if k + r + 1 < W else 0.0
+        top = max(top, abs(R[k]))
+    threshold = 1e-12 * top
+    d = 0
+    if threshold != 0.0:
+        for k in range(R.shape[0]):
+            if abs(R[k]) > threshold:
+                d = k
+    return d
+
+
+@jit
 def extrema_values(normalised, durations, orders):
     """``(values (o, M, n, C), s (o * M * n, C))`` of :func:`pinarms.planning.extrema.piece_extrema`.
 
@@ -151,19 +171,7 @@ def extrema_values(normalised, durations, orders):
         for i in range(M):
             scale = durations[i] ** -float(r)
             for j in range(n):
-                c = normalised[i, j]
-                for k in range(W):
-                    P[k] = c[k + r] * _falling(k + r, r) * scale if k + r < W else 0.0
-                top = 0.0
-                for k in range(R.shape[0]):
-                    R[k] = c[k + r + 1] * _falling(k + r + 1, r + 1) if k + r + 1 < W else 0.0
-                    top = max(top, abs(R[k]))
-                threshold = 1e-12 * top
-                d = 0
-                if threshold != 0.0:
-                    for k in range(R.shape[0]):
-                        if abs(R[k]) > threshold:
-                            d = k
+                d = _derivatives(normalised[i, j], r, scale, W, P, R)
                 row = (a * M + i) * n + j
                 s[row, 1] = 1.0
                 if d == 4:
@@ -188,18 +196,7 @@ def _piece_peaks(c, h, W, orders, top, P, R, roots):
     for a in range(orders.shape[0]):
         r = orders[a]
         scale = h ** -float(r)
-        for k in range(W):
-            P[k] = c[k + r] * _falling(k + r, r) * scale if k + r < W else 0.0
-        big = 0.0
-        for k in range(R.shape[0]):
-            R[k] = c[k + r + 1] * _falling(k + r + 1, r + 1) if k + r + 1 < W else 0.0
-            big = max(big, abs(R[k]))
-        threshold = 1e-12 * big
-        d = 0
-        if threshold != 0.0:
-            for k in range(R.shape[0]):
-                if abs(R[k]) > threshold:
-                    d = k
+        d = _derivatives(c, r, scale, W, P, R)
         if d >= 1:
             _roots(R, d, roots)
         for m in range(2 + d):
